@@ -1,0 +1,197 @@
+//! Zenoh key expressions. Every key is `flexdyn/<sc-id>/<suffix>`, where
+//! `<sc-id>` is the string spacecraft id (1..=[`MAX_ID_LEN`] chars of
+//! `[A-Za-z0-9_-]`); the numeric id in [`crate::Header::spacecraft_id`] names
+//! the same vehicle.
+
+use crate::KeyError;
+
+/// First chunk of every key.
+pub const KEY_ROOT: &str = "flexdyn";
+/// Suffix of the state topic.
+pub const STATE_SUFFIX: &str = "tlm/state";
+/// Prefix of the IMU topics; the IMU name follows after a `/`.
+pub const IMU_PREFIX: &str = "tlm/imu";
+/// Suffix of the wrench-command topic.
+pub const CMD_WRENCH_SUFFIX: &str = "cmd/wrench";
+/// Suffix of the status topic.
+pub const STATUS_SUFFIX: &str = "status";
+/// Longest accepted spacecraft id or IMU name (bytes).
+pub const MAX_ID_LEN: usize = 64;
+
+fn validate(what: &'static str, id: &str) -> Result<(), KeyError> {
+    if id.is_empty() {
+        return Err(KeyError::Empty { what });
+    }
+    if let Some((index, ch)) = id
+        .char_indices()
+        .find(|&(_, c)| !(c.is_ascii_alphanumeric() || c == '_' || c == '-'))
+    {
+        return Err(KeyError::InvalidChar { what, ch, index });
+    }
+    if id.len() > MAX_ID_LEN {
+        return Err(KeyError::TooLong {
+            what,
+            len: id.len(),
+            max: MAX_ID_LEN,
+        });
+    }
+    Ok(())
+}
+
+/// Check a spacecraft id.
+pub fn validate_sc_id(sc: &str) -> Result<(), KeyError> {
+    validate("spacecraft id", sc)
+}
+
+/// Check an IMU name.
+pub fn validate_imu_name(name: &str) -> Result<(), KeyError> {
+    validate("imu name", name)
+}
+
+/// `flexdyn/<sc>/tlm/state`
+pub fn state_key(sc: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{STATE_SUFFIX}"))
+}
+
+/// `flexdyn/<sc>/tlm/imu/<name>`
+pub fn imu_key(sc: &str, name: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    validate_imu_name(name)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{IMU_PREFIX}/{name}"))
+}
+
+/// `flexdyn/<sc>/tlm/imu/*` — subscribe to every IMU of a spacecraft.
+pub fn imu_wildcard_key(sc: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{IMU_PREFIX}/*"))
+}
+
+/// `flexdyn/<sc>/cmd/wrench`
+pub fn cmd_wrench_key(sc: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{CMD_WRENCH_SUFFIX}"))
+}
+
+/// `flexdyn/<sc>/status`
+pub fn status_key(sc: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{STATUS_SUFFIX}"))
+}
+
+/// All keys of one spacecraft, validated once.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Topics {
+    sc_id: String,
+    state: String,
+    cmd_wrench: String,
+    status: String,
+}
+
+impl Topics {
+    /// Validate `sc` and build its keys.
+    pub fn new(sc: &str) -> Result<Self, KeyError> {
+        Ok(Self {
+            sc_id: sc.to_owned(),
+            state: state_key(sc)?,
+            cmd_wrench: cmd_wrench_key(sc)?,
+            status: status_key(sc)?,
+        })
+    }
+
+    /// The string spacecraft id.
+    pub fn sc_id(&self) -> &str {
+        &self.sc_id
+    }
+
+    /// `flexdyn/<sc>/tlm/state`
+    pub fn state(&self) -> &str {
+        &self.state
+    }
+
+    /// `flexdyn/<sc>/cmd/wrench`
+    pub fn cmd_wrench(&self) -> &str {
+        &self.cmd_wrench
+    }
+
+    /// `flexdyn/<sc>/status`
+    pub fn status(&self) -> &str {
+        &self.status
+    }
+
+    /// `flexdyn/<sc>/tlm/imu/<name>`
+    pub fn imu(&self, name: &str) -> Result<String, KeyError> {
+        imu_key(&self.sc_id, name)
+    }
+
+    /// `flexdyn/<sc>/tlm/imu/*`
+    pub fn imu_wildcard(&self) -> String {
+        format!("{KEY_ROOT}/{}/{IMU_PREFIX}/*", self.sc_id)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys() {
+        assert_eq!(state_key("sc-1").unwrap(), "flexdyn/sc-1/tlm/state");
+        assert_eq!(
+            imu_key("sc-1", "imu_A").unwrap(),
+            "flexdyn/sc-1/tlm/imu/imu_A"
+        );
+        assert_eq!(cmd_wrench_key("SC_2").unwrap(), "flexdyn/SC_2/cmd/wrench");
+        assert_eq!(status_key("x").unwrap(), "flexdyn/x/status");
+        assert_eq!(imu_wildcard_key("x").unwrap(), "flexdyn/x/tlm/imu/*");
+        let t = Topics::new("sc-1").unwrap();
+        assert_eq!(t.sc_id(), "sc-1");
+        assert_eq!(t.state(), "flexdyn/sc-1/tlm/state");
+        assert_eq!(t.cmd_wrench(), "flexdyn/sc-1/cmd/wrench");
+        assert_eq!(t.status(), "flexdyn/sc-1/status");
+        assert_eq!(t.imu("g").unwrap(), "flexdyn/sc-1/tlm/imu/g");
+        assert_eq!(t.imu_wildcard(), "flexdyn/sc-1/tlm/imu/*");
+    }
+
+    #[test]
+    fn rejects_bad_ids() {
+        assert_eq!(
+            state_key(""),
+            Err(KeyError::Empty {
+                what: "spacecraft id"
+            })
+        );
+        for bad in ["a/b", "a*", "$x", "a b", "é", "a?", "a#"] {
+            assert!(
+                matches!(state_key(bad), Err(KeyError::InvalidChar { .. })),
+                "{bad}"
+            );
+        }
+        assert_eq!(
+            state_key("ab/c"),
+            Err(KeyError::InvalidChar {
+                what: "spacecraft id",
+                ch: '/',
+                index: 2
+            })
+        );
+        assert_eq!(imu_key("sc", ""), Err(KeyError::Empty { what: "imu name" }));
+        assert!(matches!(
+            imu_key("sc", "a/b"),
+            Err(KeyError::InvalidChar {
+                what: "imu name",
+                ..
+            })
+        ));
+        let long = "a".repeat(MAX_ID_LEN + 1);
+        assert!(matches!(
+            Topics::new(&long),
+            Err(KeyError::TooLong {
+                len: 65,
+                max: 64,
+                ..
+            })
+        ));
+        assert!(Topics::new(&"a".repeat(MAX_ID_LEN)).is_ok());
+    }
+}

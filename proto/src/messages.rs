@@ -1,0 +1,415 @@
+//! Message types. Field order here *is* the wire order (see the crate-level
+//! "Layout" section and `proto/README.md` for byte offsets).
+//!
+//! Naming: `<quantity>_<frames>_<components>_<unit>`. `bn` is "body B relative to
+//! inertial N"; a trailing `_b`/`_n`/`_p` names the frame the components are
+//! expressed in (body, inertial, IMU platform); the unit closes the name.
+
+use serde::{Deserialize, Serialize};
+
+use crate::PROTOCOL_VERSION;
+
+/// Common header, the first 30 bytes of every message.
+///
+/// | offset | size | field |
+/// |---|---|---|
+/// | 0 | 2 | `protocol_version` u16 |
+/// | 2 | 4 | `spacecraft_id` u32 |
+/// | 6 | 8 | `tick` u64 |
+/// | 14 | 8 | `sim_time_ns` u64 |
+/// | 22 | 8 | `seq` u64 |
+///
+/// All fields are deterministic (no wall clock).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Header {
+    /// Wire protocol version, always [`PROTOCOL_VERSION`] when sent. Decoders check
+    /// it (first two bytes, u16 LE) before anything else.
+    pub protocol_version: u16,
+    /// Numeric spacecraft id, configured alongside the string sc-id used in the
+    /// key expression (`flexdyn/<sc-id>/…`). The two name the same vehicle; the
+    /// numeric id lets a receiver check a message against its configuration
+    /// without parsing the key.
+    pub spacecraft_id: u32,
+    /// Frame index `k`: the dynamics frame this message describes (state, IMU,
+    /// status) or applies to (command).
+    pub tick: u64,
+    /// Simulation time of `tick` (ns since simulation epoch).
+    pub sim_time_ns: u64,
+    /// Publisher's sequence number for this topic, +1 per message, so a gap
+    /// reveals a lost message.
+    pub seq: u64,
+}
+
+impl Header {
+    /// Header with the current [`PROTOCOL_VERSION`].
+    pub fn new(spacecraft_id: u32, tick: u64, sim_time_ns: u64, seq: u64) -> Self {
+        Self {
+            protocol_version: PROTOCOL_VERSION,
+            spacecraft_id,
+            tick,
+            sim_time_ns,
+            seq,
+        }
+    }
+}
+
+impl Default for Header {
+    /// Current [`PROTOCOL_VERSION`], everything else zero.
+    fn default() -> Self {
+        Self::new(0, 0, 0, 0)
+    }
+}
+
+/// State of one dual-hinged solar-panel pair (hinge 1 on the hub, hinge 2 between
+/// the two panels). 32 bytes on the wire.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PanelPairState {
+    /// Hinge-1 angle (rad).
+    pub theta1_rad: f64,
+    /// Hinge-1 rate (rad/s).
+    pub theta1_dot_rad_s: f64,
+    /// Hinge-2 angle (rad).
+    pub theta2_rad: f64,
+    /// Hinge-2 rate (rad/s).
+    pub theta2_dot_rad_s: f64,
+}
+
+/// Conserved quantities (for verification: constant when no external wrench
+/// acts and the panels have no damping). 64 bytes on the wire.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Conserved {
+    /// Total orbital energy (J).
+    pub orb_energy_j: f64,
+    /// Total rotational energy of hub + panels (J).
+    pub rot_energy_j: f64,
+    /// Orbital angular momentum about the inertial origin, N components (kg·m²/s).
+    pub orb_ang_mom_n: [f64; 3],
+    /// Rotational angular momentum about the system centre of mass C, N
+    /// components (kg·m²/s).
+    pub rot_ang_mom_c_n: [f64; 3],
+}
+
+/// External wrench held constant over a frame, body components about point B.
+/// 48 bytes on the wire (torque first, like [`CommandKind::Wrench`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AppliedWrench {
+    /// Torque about B, B components (N·m).
+    pub torque_b_nm: [f64; 3],
+    /// Force at B, B components (N).
+    pub force_b_n: [f64; 3],
+}
+
+/// Bits of [`StateMsg::command_flags`].
+pub mod command_flags {
+    /// Bit 0: the wrench held this frame comes from a command that is stale
+    /// (not addressed to this tick, or older than the staleness limit).
+    pub const STALE: u8 = 1 << 0;
+    /// Bit 1: the stale-command policy ([`crate::StalePolicy::Zero`]) replaced the
+    /// commanded wrench by zero for this frame.
+    pub const ZEROED_BY_POLICY: u8 = 1 << 1;
+    /// Bit 2: no command has been received since the run started; the wrench is zero.
+    pub const NO_COMMAND_YET: u8 = 1 << 2;
+    /// Bits 3..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 = !(STALE | ZEROED_BY_POLICY | NO_COMMAND_YET);
+}
+
+/// Bits of [`ImuMsg::saturation_flags`].
+pub mod saturation_flags {
+    /// Bit 0: at least one gyro rate axis (`omega_p_rad_s`) hit its range limit.
+    pub const GYRO_RATE: u8 = 1 << 0;
+    /// Bit 1: at least one accelerometer axis (`accel_p_m_s2`) hit its range limit.
+    pub const ACCEL: u8 = 1 << 1;
+    /// Bit 2: at least one integrated-angle axis (`dtheta_p_rad`) saturated.
+    pub const DTHETA: u8 = 1 << 2;
+    /// Bit 3: at least one integrated-velocity axis (`dv_p_m_s`) saturated.
+    pub const DV: u8 = 1 << 3;
+    /// Bits 4..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 = !(GYRO_RATE | ACCEL | DTHETA | DV);
+}
+
+/// Per-frame truth state, topic `flexdyn/<sc-id>/tlm/state`.
+///
+/// Deterministic: same scenario and command stream give the same bytes (no wall
+/// clock). 327 bytes + 32 per panel pair; `panels` is last on the wire so every
+/// other field sits at a fixed offset.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StateMsg {
+    /// Common header; `tick` is the frame this state belongs to.
+    pub header: Header,
+    /// Attitude of B relative to N as modified Rodrigues parameters (shadow set
+    /// switched so that |σ| ≤ 1).
+    pub sigma_bn: [f64; 3],
+    /// Same attitude as a unit quaternion, **scalar first**: `[q0, q1, q2, q3]`
+    /// with `q0` the scalar part. It maps N to B, i.e. it corresponds to the DCM
+    /// \[BN\] (`v_b = [BN] v_n`). Sign is chosen so that `q0 ≥ 0`.
+    pub q_bn: [f64; 4],
+    /// Angular velocity of B relative to N, B components (rad/s).
+    pub omega_bn_b_rad_s: [f64; 3],
+    /// Angular acceleration of B relative to N, B components (rad/s²).
+    pub omega_dot_bn_b_rad_s2: [f64; 3],
+    /// Position of point B relative to the inertial origin, N components (m).
+    pub r_bn_n_m: [f64; 3],
+    /// Inertial velocity of point B, N components (m/s).
+    pub v_bn_n_m_s: [f64; 3],
+    /// Non-gravitational acceleration of point B (what an ideal accelerometer at
+    /// B senses), N components (m/s²).
+    pub nongrav_accel_bn_n_m_s2: [f64; 3],
+    /// Conserved quantities.
+    pub conserved: Conserved,
+    /// External wrench held over the frame that ended at this tick.
+    pub wrench_applied: AppliedWrench,
+    /// Command bookkeeping bits, see [`command_flags`].
+    pub command_flags: u8,
+    /// Panel-pair states. On the wire: u64 LE count, then 32 bytes per pair. At
+    /// most [`crate::MAX_PANEL_PAIRS`]; decoders reject larger counts.
+    pub panels: Vec<PanelPairState>,
+}
+
+impl Default for StateMsg {
+    /// Zero state with the identity attitude (`q_bn = [1, 0, 0, 0]`) and no panels.
+    fn default() -> Self {
+        Self {
+            header: Header::default(),
+            sigma_bn: [0.0; 3],
+            q_bn: [1.0, 0.0, 0.0, 0.0],
+            omega_bn_b_rad_s: [0.0; 3],
+            omega_dot_bn_b_rad_s2: [0.0; 3],
+            r_bn_n_m: [0.0; 3],
+            v_bn_n_m_s: [0.0; 3],
+            nongrav_accel_bn_n_m_s2: [0.0; 3],
+            conserved: Conserved::default(),
+            wrench_applied: AppliedWrench::default(),
+            command_flags: 0,
+            panels: Vec::new(),
+        }
+    }
+}
+
+/// IMU sample, topic `flexdyn/<sc-id>/tlm/imu/<name>`. 127 bytes.
+///
+/// All vectors are in the IMU platform frame P.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ImuMsg {
+    /// Common header; `tick` is the frame at whose end the sample was taken.
+    pub header: Header,
+    /// Measured angular rate, P components (rad/s).
+    pub omega_p_rad_s: [f64; 3],
+    /// Measured specific force (non-gravitational acceleration), P components (m/s²).
+    pub accel_p_m_s2: [f64; 3],
+    /// Integrated angle over the sample interval, P components (rad).
+    pub dtheta_p_rad: [f64; 3],
+    /// Integrated velocity change over the sample interval, P components (m/s).
+    pub dv_p_m_s: [f64; 3],
+    /// Saturation bits, see [`saturation_flags`].
+    pub saturation_flags: u8,
+}
+
+/// What a [`CommandMsg`] asks for. Wire: u32 LE variant index (0 = `Wrench`,
+/// 1 = `NoCommand`), then the variant's fields.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum CommandKind {
+    /// Tag 0: hold this wrench, body components about B, over the frame
+    /// starting at `header.tick`. 48 bytes follow the tag.
+    Wrench {
+        /// Torque about B, B components (N·m).
+        torque_b_nm: [f64; 3],
+        /// Force at B, B components (N).
+        force_b_n: [f64; 3],
+    },
+    /// Tag 1: explicit "no command this tick" (a lockstep participant's way to
+    /// release the step without changing the wrench). Nothing follows the tag.
+    NoCommand,
+}
+
+impl Default for CommandKind {
+    /// [`CommandKind::NoCommand`].
+    fn default() -> Self {
+        Self::NoCommand
+    }
+}
+
+/// Command from flight code, topic `flexdyn/<sc-id>/cmd/wrench`.
+/// 86 bytes (`Wrench`) or 38 bytes (`NoCommand`).
+///
+/// Decoding rejects NaN/infinite torque or force components with
+/// [`crate::DecodeError::NonFinite`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CommandMsg {
+    /// Common header: `tick` is the tick the command applies to (in lockstep the
+    /// tick of the state it answers), `seq` the sender's own sequence number.
+    pub header: Header,
+    /// Numeric id of the sending participant, assigned in the server's
+    /// configuration (fixed width instead of a name; 0 is a valid id).
+    pub sender_id: u32,
+    /// The command.
+    pub kind: CommandKind,
+}
+
+impl CommandMsg {
+    /// A `Wrench` command.
+    pub fn wrench(
+        header: Header,
+        sender_id: u32,
+        torque_b_nm: [f64; 3],
+        force_b_n: [f64; 3],
+    ) -> Self {
+        Self {
+            header,
+            sender_id,
+            kind: CommandKind::Wrench {
+                torque_b_nm,
+                force_b_n,
+            },
+        }
+    }
+
+    /// A `NoCommand` command.
+    pub fn no_command(header: Header, sender_id: u32) -> Self {
+        Self {
+            header,
+            sender_id,
+            kind: CommandKind::NoCommand,
+        }
+    }
+}
+
+/// How the server paces frames. Wire: u32 LE tag.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Mode {
+    /// Tag 0: frames paced by the wall clock.
+    #[default]
+    RealTime,
+    /// Tag 1: each step waits for every lockstep participant's command.
+    Lockstep,
+    /// Tag 2: as fast as possible, no waiting.
+    Batch,
+}
+
+/// Server life cycle. Wire: u32 LE tag.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum RunState {
+    /// Tag 0: initialising, not stepping yet.
+    #[default]
+    Starting,
+    /// Tag 1: stepping.
+    Running,
+    /// Tag 2: shutdown requested, finishing the current frame.
+    Stopping,
+    /// Tag 3: ended normally (scenario end).
+    Finished,
+    /// Tag 4: ended on an error.
+    Failed,
+}
+
+/// What the server applies when the latest command is stale. Wire: u32 LE tag.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum StalePolicy {
+    /// Tag 0: keep applying the last commanded wrench.
+    #[default]
+    Hold,
+    /// Tag 1: apply zero wrench.
+    Zero,
+}
+
+/// Frame-timing statistics since the run started. 40 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FrameTiming {
+    /// Median frame-start lateness versus the wall-clock schedule (ns; early
+    /// starts count as 0).
+    pub lateness_p50_ns: u64,
+    /// 99th-percentile frame-start lateness (ns).
+    pub lateness_p99_ns: u64,
+    /// Largest frame-start lateness (ns).
+    pub lateness_max_ns: u64,
+    /// Frames whose computation did not finish within the frame period.
+    pub overrun_count: u64,
+    /// Frames dropped to catch up with the wall clock.
+    pub frames_skipped: u64,
+}
+
+/// Value of [`CommandStatus::last_command_tick`] and
+/// [`CommandStatus::command_age_ns`] before any command was accepted.
+pub const NO_COMMAND: u64 = u64::MAX;
+
+/// Command bookkeeping. 21 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CommandStatus {
+    /// `header.tick` of the last accepted command, [`NO_COMMAND`] if none yet.
+    pub last_command_tick: u64,
+    /// Simulation time since the last accepted command was received (ns),
+    /// [`NO_COMMAND`] if none yet.
+    pub command_age_ns: u64,
+    /// Whether the command in force is stale (1 byte: 0 or 1; other values are
+    /// rejected as malformed).
+    pub command_stale: bool,
+    /// Policy applied while stale.
+    pub stale_policy: StalePolicy,
+}
+
+/// Rejected-command counters by reason, cumulative since start. 48 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RejectCounters {
+    /// Undecodable: wrong length, trailing bytes, oversize, bad enum tag or bool.
+    pub malformed: u64,
+    /// Unknown `protocol_version`.
+    pub bad_version: u64,
+    /// NaN or infinite torque/force.
+    pub non_finite: u64,
+    /// `header.spacecraft_id` not this server's.
+    pub wrong_spacecraft: u64,
+    /// `header.tick` already stepped past (or otherwise not acceptable).
+    pub stale_tick: u64,
+    /// `sender_id` not configured.
+    pub unknown_sender: u64,
+}
+
+impl RejectCounters {
+    /// Count one decode failure under its reason: `UnknownVersion` →
+    /// `bad_version`, `NonFinite` → `non_finite`, everything else → `malformed`.
+    pub fn record(&mut self, err: &crate::DecodeError) {
+        use crate::DecodeError as E;
+        let c = match err {
+            E::UnknownVersion { .. } => &mut self.bad_version,
+            E::NonFinite { .. } => &mut self.non_finite,
+            E::Length { .. } | E::TrailingBytes { .. } | E::TooLarge { .. } | E::Malformed(_) => {
+                &mut self.malformed
+            }
+        };
+        *c = c.saturating_add(1);
+    }
+
+    /// Sum of all counters (saturating).
+    pub fn total(&self) -> u64 {
+        [
+            self.malformed,
+            self.bad_version,
+            self.non_finite,
+            self.wrong_spacecraft,
+            self.stale_tick,
+            self.unknown_sender,
+        ]
+        .iter()
+        .fold(0u64, |a, &b| a.saturating_add(b))
+    }
+}
+
+/// Server health, topic `flexdyn/<sc-id>/status`. 155 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct StatusMsg {
+    /// Common header; `tick` is the last frame stepped, `seq` counts status messages.
+    pub header: Header,
+    /// Pacing mode.
+    pub mode: Mode,
+    /// Life-cycle state.
+    pub run_state: RunState,
+    /// Frame timing statistics.
+    pub timing: FrameTiming,
+    /// Command bookkeeping.
+    pub command: CommandStatus,
+    /// Rejected commands by reason.
+    pub rejected: RejectCounters,
+    /// Wall-clock time of publication (ns since the Unix epoch). **Not
+    /// deterministic**: the only wall-clock field in the protocol; ignore it when
+    /// comparing runs.
+    pub wall_time_unix_ns: u64,
+}

@@ -1,0 +1,724 @@
+//! Golden byte vectors: the wire format pinned byte by byte.
+//!
+//! Each table below is derived by hand from the layout in `proto/README.md`,
+//! one row per primitive field: `(offset, little-endian hex, "type field = value")`.
+//! Integers are written little-endian; an `f64` is its IEEE-754 binary64 bit
+//! pattern (given in the comment column) with the 8 bytes reversed, e.g.
+//! 1.5 = 0x3FF8000000000000 → "000000000000f83f". Values are mostly exact dyadic
+//! fractions so the bits can be checked by hand (or with
+//! `python3 -c 'import struct; print(struct.pack("<d", 1.5).hex())'`), distinct
+//! per slot so a swapped field shows up, and include -0.0 (sign bit) and
+//! multi-byte integers like 0x0102030405060708 (byte order).
+//!
+//! The offsets are checked too: every row must start where the previous one ended.
+//!
+//! **What a mismatch means**: the bytes the Rust encoder produces for these
+//! messages changed, i.e. the wire format changed (field order, a type, an enum
+//! tag, the bincode config or version). Flight code written against the README
+//! will misread such messages. Do not "fix" the test by pasting the new output:
+//! if the change is intended, bump `PROTOCOL_VERSION`, update the README tables,
+//! then re-mint the affected rows by hand from the new layout (the failure
+//! message lists field, offset, expected and actual bytes to help review).
+
+use flexdyn_proto::{
+    command_flags, decode, decode_header, encode, saturation_flags, AppliedWrench, CommandKind,
+    CommandMsg, CommandStatus, Conserved, FrameTiming, Header, ImuMsg, Mode, PanelPairState,
+    RejectCounters, RunState, StalePolicy, StateMsg, StatusMsg, WireMessage,
+    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, IMU_LEN, PANEL_PAIR_LEN, STATE_FIXED_LEN,
+    STATUS_LEN,
+};
+
+type Golden = &'static [(usize, &'static str, &'static str)];
+
+fn unhex(s: &str) -> Vec<u8> {
+    assert!(s.len() % 2 == 0, "odd hex length: {s}");
+    (0..s.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&s[i..i + 2], 16).expect("hex digit"))
+        .collect()
+}
+
+fn hex(b: &[u8]) -> String {
+    b.iter().map(|x| format!("{x:02x}")).collect()
+}
+
+/// Concatenate a table, checking that the offsets are contiguous.
+fn golden_bytes(table: Golden) -> Vec<u8> {
+    let mut out = Vec::new();
+    for &(offset, h, what) in table {
+        assert_eq!(
+            offset,
+            out.len(),
+            "golden row `{what}` claims offset {offset}, but previous rows end at {}",
+            out.len()
+        );
+        out.extend(unhex(h));
+    }
+    out
+}
+
+/// Compare `actual` against the table, reporting every differing field.
+fn assert_matches_golden(name: &str, table: Golden, actual: &[u8]) {
+    let expected = golden_bytes(table);
+    let mut report = String::new();
+    for &(offset, h, what) in table {
+        let want = unhex(h);
+        let got = actual.get(offset..offset + want.len()).unwrap_or(&[]);
+        if got != want.as_slice() {
+            report += &format!("  @{offset:>3} {what}: expected {h}, got {}\n", hex(got));
+        }
+    }
+    if actual.len() != expected.len() {
+        report += &format!(
+            "  length: expected {}, got {}\n",
+            expected.len(),
+            actual.len()
+        );
+    }
+    assert!(
+        report.is_empty(),
+        "{name} encoding differs from the golden bytes (wire format changed?):\n{report}"
+    );
+}
+
+/// encode(msg) == golden, decode(golden) == msg.
+fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden, msg: &M) {
+    assert_matches_golden(name, table, &encode(msg));
+    let bytes = golden_bytes(table);
+    assert_eq!(
+        &decode::<M>(&bytes).expect("golden decodes"),
+        msg,
+        "{name}: decoding the golden bytes"
+    );
+    assert_eq!(
+        &decode_header(&bytes).expect("golden header decodes"),
+        msg.header()
+    );
+}
+
+const STATE_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0100", "u16 header.protocol_version = 1"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (
+        6,
+        "0807060504030201",
+        "u64 header.tick = 72623859790382856 (0x102030405060708)",
+    ),
+    (
+        14,
+        "002f685900000000",
+        "u64 header.sim_time_ns = 1500000000 (0x59682F00)",
+    ),
+    (22, "0201000000000000", "u64 header.seq = 258 (0x102)"),
+    (
+        30,
+        "000000000000c03f",
+        "f64 sigma_bn[0] = 0.125 (bits 0x3FC0000000000000)",
+    ),
+    (
+        38,
+        "000000000000d0bf",
+        "f64 sigma_bn[1] = -0.25 (bits 0xBFD0000000000000)",
+    ),
+    (
+        46,
+        "000000000000e03f",
+        "f64 sigma_bn[2] = 0.5 (bits 0x3FE0000000000000)",
+    ),
+    (
+        54,
+        "000000000000ec3f",
+        "f64 q_bn[0] = 0.875 (bits 0x3FEC000000000000)",
+    ),
+    (
+        62,
+        "000000000000d03f",
+        "f64 q_bn[1] = 0.25 (bits 0x3FD0000000000000)",
+    ),
+    (
+        70,
+        "000000000000d8bf",
+        "f64 q_bn[2] = -0.375 (bits 0xBFD8000000000000)",
+    ),
+    (
+        78,
+        "000000000000c83f",
+        "f64 q_bn[3] = 0.1875 (bits 0x3FC8000000000000)",
+    ),
+    (
+        86,
+        "000000000000503f",
+        "f64 omega_bn_b_rad_s[0] = 0.0009765625 (bits 0x3F50000000000000)",
+    ),
+    (
+        94,
+        "00000000000060bf",
+        "f64 omega_bn_b_rad_s[1] = -0.001953125 (bits 0xBF60000000000000)",
+    ),
+    (
+        102,
+        "000000000000703f",
+        "f64 omega_bn_b_rad_s[2] = 0.00390625 (bits 0x3F70000000000000)",
+    ),
+    (
+        110,
+        "000000000000f83f",
+        "f64 omega_dot_bn_b_rad_s2[0] = 1.5 (bits 0x3FF8000000000000)",
+    ),
+    (
+        118,
+        "00000000000008c0",
+        "f64 omega_dot_bn_b_rad_s2[1] = -3.0 (bits 0xC008000000000000)",
+    ),
+    (
+        126,
+        "0000000000001840",
+        "f64 omega_dot_bn_b_rad_s2[2] = 6.0 (bits 0x4018000000000000)",
+    ),
+    (
+        134,
+        "00000000f0b35a41",
+        "f64 r_bn_n_m[0] = 7000000.0 (bits 0x415AB3F000000000)",
+    ),
+    (
+        142,
+        "00000000000090c0",
+        "f64 r_bn_n_m[1] = -1024.0 (bits 0xC090000000000000)",
+    ),
+    (
+        150,
+        "000000000000e03f",
+        "f64 r_bn_n_m[2] = 0.5 (bits 0x3FE0000000000000)",
+    ),
+    (
+        158,
+        "000000000000d03f",
+        "f64 v_bn_n_m_s[0] = 0.25 (bits 0x3FD0000000000000)",
+    ),
+    (
+        166,
+        "00000000004cbd40",
+        "f64 v_bn_n_m_s[1] = 7500.0 (bits 0x40BD4C0000000000)",
+    ),
+    (
+        174,
+        "00000000000020c0",
+        "f64 v_bn_n_m_s[2] = -8.0 (bits 0xC020000000000000)",
+    ),
+    (
+        182,
+        "0000000000000000",
+        "f64 nongrav_accel_bn_n_m_s2[0] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        190,
+        "0000000000000080",
+        "f64 nongrav_accel_bn_n_m_s2[1] = -0.0 (bits 0x8000000000000000)",
+    ),
+    (
+        198,
+        "000000000000b03e",
+        "f64 nongrav_accel_bn_n_m_s2[2] = 9.5367431640625e-07 (bits 0x3EB0000000000000)",
+    ),
+    (
+        206,
+        "000000e8764817c2",
+        "f64 conserved.orb_energy_j = -25000000000.0 (bits 0xC2174876E8000000)",
+    ),
+    (
+        214,
+        "0000000000002940",
+        "f64 conserved.rot_energy_j = 12.5 (bits 0x4029000000000000)",
+    ),
+    (
+        222,
+        "000000a2941a6d42",
+        "f64 conserved.orb_ang_mom_n[0] = 1000000000000.0 (bits 0x426D1A94A2000000)",
+    ),
+    (
+        230,
+        "00000000000000c0",
+        "f64 conserved.orb_ang_mom_n[1] = -2.0 (bits 0xC000000000000000)",
+    ),
+    (
+        238,
+        "0000000000001040",
+        "f64 conserved.orb_ang_mom_n[2] = 4.0 (bits 0x4010000000000000)",
+    ),
+    (
+        246,
+        "0000000000005940",
+        "f64 conserved.rot_ang_mom_c_n[0] = 100.0 (bits 0x4059000000000000)",
+    ),
+    (
+        254,
+        "000000000000e8bf",
+        "f64 conserved.rot_ang_mom_c_n[1] = -0.75 (bits 0xBFE8000000000000)",
+    ),
+    (
+        262,
+        "000000000000f43f",
+        "f64 conserved.rot_ang_mom_c_n[2] = 1.25 (bits 0x3FF4000000000000)",
+    ),
+    (
+        270,
+        "000000000000b03f",
+        "f64 wrench_applied.torque_b_nm[0] = 0.0625 (bits 0x3FB0000000000000)",
+    ),
+    (
+        278,
+        "000000000000c0bf",
+        "f64 wrench_applied.torque_b_nm[1] = -0.125 (bits 0xBFC0000000000000)",
+    ),
+    (
+        286,
+        "000000000000d03f",
+        "f64 wrench_applied.torque_b_nm[2] = 0.25 (bits 0x3FD0000000000000)",
+    ),
+    (
+        294,
+        "000000000000f03f",
+        "f64 wrench_applied.force_b_n[0] = 1.0 (bits 0x3FF0000000000000)",
+    ),
+    (
+        302,
+        "00000000000000c0",
+        "f64 wrench_applied.force_b_n[1] = -2.0 (bits 0xC000000000000000)",
+    ),
+    (
+        310,
+        "0000000000000840",
+        "f64 wrench_applied.force_b_n[2] = 3.0 (bits 0x4008000000000000)",
+    ),
+    (318, "05", "u8 command_flags = 5 (STALE | NO_COMMAND_YET)"),
+    (
+        319,
+        "0200000000000000",
+        "u64 panels count = 2 (Vec length prefix)",
+    ),
+    (
+        327,
+        "000000000000e03f",
+        "f64 panels[0].theta1_rad = 0.5 (bits 0x3FE0000000000000)",
+    ),
+    (
+        335,
+        "000000000000b0bf",
+        "f64 panels[0].theta1_dot_rad_s = -0.0625 (bits 0xBFB0000000000000)",
+    ),
+    (
+        343,
+        "000000000000f43f",
+        "f64 panels[0].theta2_rad = 1.25 (bits 0x3FF4000000000000)",
+    ),
+    (
+        351,
+        "000000000000a03f",
+        "f64 panels[0].theta2_dot_rad_s = 0.03125 (bits 0x3FA0000000000000)",
+    ),
+    (
+        359,
+        "000000000000e0bf",
+        "f64 panels[1].theta1_rad = -0.5 (bits 0xBFE0000000000000)",
+    ),
+    (
+        367,
+        "000000000000b03f",
+        "f64 panels[1].theta1_dot_rad_s = 0.0625 (bits 0x3FB0000000000000)",
+    ),
+    (
+        375,
+        "000000000000f4bf",
+        "f64 panels[1].theta2_rad = -1.25 (bits 0xBFF4000000000000)",
+    ),
+    (
+        383,
+        "000000000000a0bf",
+        "f64 panels[1].theta2_dot_rad_s = -0.03125 (bits 0xBFA0000000000000)",
+    ),
+];
+const IMU_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0100", "u16 header.protocol_version = 1"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "0900000000000000", "u64 header.tick = 9"),
+    (
+        14,
+        "4054890000000000",
+        "u64 header.sim_time_ns = 9000000 (0x895440)",
+    ),
+    (22, "0a00000000000000", "u64 header.seq = 10"),
+    (
+        30,
+        "000000000000503f",
+        "f64 omega_p_rad_s[0] = 0.0009765625 (bits 0x3F50000000000000)",
+    ),
+    (
+        38,
+        "000000000000e0bf",
+        "f64 omega_p_rad_s[1] = -0.5 (bits 0xBFE0000000000000)",
+    ),
+    (
+        46,
+        "0000000000000040",
+        "f64 omega_p_rad_s[2] = 2.0 (bits 0x4000000000000000)",
+    ),
+    (
+        54,
+        "0000000000000000",
+        "f64 accel_p_m_s2[0] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        62,
+        "0000000000802340",
+        "f64 accel_p_m_s2[1] = 9.75 (bits 0x4023800000000000)",
+    ),
+    (
+        70,
+        "000000000000c0bf",
+        "f64 accel_p_m_s2[2] = -0.125 (bits 0xBFC0000000000000)",
+    ),
+    (
+        78,
+        "000000000000b03e",
+        "f64 dtheta_p_rad[0] = 9.5367431640625e-07 (bits 0x3EB0000000000000)",
+    ),
+    (
+        86,
+        "000000000000c0be",
+        "f64 dtheta_p_rad[1] = -1.9073486328125e-06 (bits 0xBEC0000000000000)",
+    ),
+    (
+        94,
+        "000000000000d03e",
+        "f64 dtheta_p_rad[2] = 3.814697265625e-06 (bits 0x3ED0000000000000)",
+    ),
+    (
+        102,
+        "fca9f1d24d62503f",
+        "f64 dv_p_m_s[0] = 0.001 (bits 0x3F50624DD2F1A9FC)",
+    ),
+    (
+        110,
+        "000000000000f8bf",
+        "f64 dv_p_m_s[1] = -1.5 (bits 0xBFF8000000000000)",
+    ),
+    (
+        118,
+        "0000000000000840",
+        "f64 dv_p_m_s[2] = 3.0 (bits 0x4008000000000000)",
+    ),
+    (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
+];
+const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0100", "u16 header.protocol_version = 1"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "2a00000000000000", "u64 header.tick = 42"),
+    (
+        14,
+        "00b1081900000000",
+        "u64 header.sim_time_ns = 420000000 (0x1908B100)",
+    ),
+    (22, "0700000000000000", "u64 header.seq = 7"),
+    (30, "efbeadde", "u32 sender_id = 3735928559 (0xDEADBEEF)"),
+    (34, "00000000", "u32 kind tag = 0 (Wrench)"),
+    (
+        38,
+        "000000000000b03f",
+        "f64 kind.torque_b_nm[0] = 0.0625 (bits 0x3FB0000000000000)",
+    ),
+    (
+        46,
+        "000000000000c0bf",
+        "f64 kind.torque_b_nm[1] = -0.125 (bits 0xBFC0000000000000)",
+    ),
+    (
+        54,
+        "000000000000d03f",
+        "f64 kind.torque_b_nm[2] = 0.25 (bits 0x3FD0000000000000)",
+    ),
+    (
+        62,
+        "000000000000f0bf",
+        "f64 kind.force_b_n[0] = -1.0 (bits 0xBFF0000000000000)",
+    ),
+    (
+        70,
+        "0000000000000000",
+        "f64 kind.force_b_n[1] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        78,
+        "000000000000e03f",
+        "f64 kind.force_b_n[2] = 0.5 (bits 0x3FE0000000000000)",
+    ),
+];
+const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0100", "u16 header.protocol_version = 1"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "2b00000000000000", "u64 header.tick = 43"),
+    (
+        14,
+        "8047a11900000000",
+        "u64 header.sim_time_ns = 430000000 (0x19A14780)",
+    ),
+    (22, "0800000000000000", "u64 header.seq = 8"),
+    (30, "05000000", "u32 sender_id = 5"),
+    (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
+];
+const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0100", "u16 header.protocol_version = 1"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (
+        6,
+        "0807060504030201",
+        "u64 header.tick = 72623859790382856 (0x102030405060708)",
+    ),
+    (
+        14,
+        "002f685900000000",
+        "u64 header.sim_time_ns = 1500000000 (0x59682F00)",
+    ),
+    (22, "6300000000000000", "u64 header.seq = 99"),
+    (30, "01000000", "u32 mode tag = 1 (Lockstep)"),
+    (34, "01000000", "u32 run_state tag = 1 (Running)"),
+    (
+        38,
+        "e803000000000000",
+        "u64 timing.lateness_p50_ns = 1000 (0x3E8)",
+    ),
+    (
+        46,
+        "90d0030000000000",
+        "u64 timing.lateness_p99_ns = 250000 (0x3D090)",
+    ),
+    (
+        54,
+        "c0c62d0000000000",
+        "u64 timing.lateness_max_ns = 3000000 (0x2DC6C0)",
+    ),
+    (62, "0300000000000000", "u64 timing.overrun_count = 3"),
+    (70, "0200000000000000", "u64 timing.frames_skipped = 2"),
+    (78, "2900000000000000", "u64 command.last_command_tick = 41"),
+    (
+        86,
+        "40420f0000000000",
+        "u64 command.command_age_ns = 1000000 (0xF4240)",
+    ),
+    (94, "01", "bool command.command_stale = true"),
+    (95, "01000000", "u32 command.stale_policy tag = 1 (Zero)"),
+    (99, "0100000000000000", "u64 rejected.malformed = 1"),
+    (107, "0200000000000000", "u64 rejected.bad_version = 2"),
+    (115, "0300000000000000", "u64 rejected.non_finite = 3"),
+    (123, "0400000000000000", "u64 rejected.wrong_spacecraft = 4"),
+    (131, "0500000000000000", "u64 rejected.stale_tick = 5"),
+    (139, "0600000000000000", "u64 rejected.unknown_sender = 6"),
+    (
+        147,
+        "15cd853dfe9c9717",
+        "u64 wall_time_unix_ns = 1700000000123456789 (0x17979CFE3D85CD15)",
+    ),
+];
+
+const SC: u32 = 0x1122_3344;
+
+fn state_msg() -> StateMsg {
+    StateMsg {
+        header: Header::new(SC, 0x0102_0304_0506_0708, 1_500_000_000, 0x102),
+        sigma_bn: [0.125, -0.25, 0.5],
+        q_bn: [0.875, 0.25, -0.375, 0.1875],
+        omega_bn_b_rad_s: [1.0 / 1024.0, -2.0 / 1024.0, 4.0 / 1024.0],
+        omega_dot_bn_b_rad_s2: [1.5, -3.0, 6.0],
+        r_bn_n_m: [7_000_000.0, -1024.0, 0.5],
+        v_bn_n_m_s: [0.25, 7500.0, -8.0],
+        nongrav_accel_bn_n_m_s2: [0.0, -0.0, 1.0 / 1_048_576.0],
+        conserved: Conserved {
+            orb_energy_j: -2.5e10,
+            rot_energy_j: 12.5,
+            orb_ang_mom_n: [1.0e12, -2.0, 4.0],
+            rot_ang_mom_c_n: [100.0, -0.75, 1.25],
+        },
+        wrench_applied: AppliedWrench {
+            torque_b_nm: [0.0625, -0.125, 0.25],
+            force_b_n: [1.0, -2.0, 3.0],
+        },
+        command_flags: command_flags::STALE | command_flags::NO_COMMAND_YET,
+        panels: vec![
+            PanelPairState {
+                theta1_rad: 0.5,
+                theta1_dot_rad_s: -0.0625,
+                theta2_rad: 1.25,
+                theta2_dot_rad_s: 0.03125,
+            },
+            PanelPairState {
+                theta1_rad: -0.5,
+                theta1_dot_rad_s: 0.0625,
+                theta2_rad: -1.25,
+                theta2_dot_rad_s: -0.03125,
+            },
+        ],
+    }
+}
+
+#[test]
+fn state_golden() {
+    let msg = state_msg();
+    check("StateMsg", STATE_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), STATE_FIXED_LEN + 2 * PANEL_PAIR_LEN);
+    // The -0.0 survives the round trip with its sign bit.
+    let back: StateMsg = decode(&golden_bytes(STATE_GOLDEN)).unwrap();
+    assert!(back.nongrav_accel_bn_n_m_s2[1].is_sign_negative());
+}
+
+#[test]
+fn state_without_panels_is_the_fixed_part() {
+    let mut msg = state_msg();
+    msg.panels.clear();
+    let bytes = encode(&msg);
+    assert_eq!(bytes.len(), STATE_FIXED_LEN);
+    let golden = golden_bytes(STATE_GOLDEN);
+    // Same bytes up to the count, which is now 0.
+    assert_eq!(bytes[..319], golden[..319]);
+    assert_eq!(bytes[319..], [0u8; 8]);
+}
+
+#[test]
+fn imu_golden() {
+    let msg = ImuMsg {
+        header: Header::new(SC, 9, 9_000_000, 10),
+        omega_p_rad_s: [1.0 / 1024.0, -0.5, 2.0],
+        accel_p_m_s2: [0.0, 9.75, -0.125],
+        dtheta_p_rad: [1.0 / 1_048_576.0, -2.0 / 1_048_576.0, 4.0 / 1_048_576.0],
+        dv_p_m_s: [0.001, -1.5, 3.0],
+        saturation_flags: saturation_flags::GYRO_RATE | saturation_flags::DV,
+    };
+    check("ImuMsg", IMU_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), IMU_LEN);
+}
+
+#[test]
+fn command_wrench_golden() {
+    let msg = CommandMsg::wrench(
+        Header::new(SC, 42, 420_000_000, 7),
+        0xDEAD_BEEF,
+        [0.0625, -0.125, 0.25],
+        [-1.0, 0.0, 0.5],
+    );
+    check("CommandMsg::Wrench", COMMAND_WRENCH_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), COMMAND_WRENCH_LEN);
+}
+
+#[test]
+fn command_no_command_golden() {
+    let msg = CommandMsg::no_command(Header::new(SC, 43, 430_000_000, 8), 5);
+    assert_eq!(msg.kind, CommandKind::NoCommand);
+    check("CommandMsg::NoCommand", COMMAND_NO_COMMAND_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), COMMAND_NO_COMMAND_LEN);
+}
+
+#[test]
+fn status_golden() {
+    let msg = StatusMsg {
+        header: Header::new(SC, 0x0102_0304_0506_0708, 1_500_000_000, 99),
+        mode: Mode::Lockstep,
+        run_state: RunState::Running,
+        timing: FrameTiming {
+            lateness_p50_ns: 1000,
+            lateness_p99_ns: 250_000,
+            lateness_max_ns: 3_000_000,
+            overrun_count: 3,
+            frames_skipped: 2,
+        },
+        command: CommandStatus {
+            last_command_tick: 41,
+            command_age_ns: 1_000_000,
+            command_stale: true,
+            stale_policy: StalePolicy::Zero,
+        },
+        rejected: RejectCounters {
+            malformed: 1,
+            bad_version: 2,
+            non_finite: 3,
+            wrong_spacecraft: 4,
+            stale_tick: 5,
+            unknown_sender: 6,
+        },
+        wall_time_unix_ns: 1_700_000_000_123_456_789,
+    };
+    check("StatusMsg", STATUS_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), STATUS_LEN);
+}
+
+/// Every enum tag, pinned: the u32 at the tag's offset for each variant.
+#[test]
+fn enum_tags() {
+    let tag_at = |b: &[u8], at: usize| u32::from_le_bytes(b[at..at + 4].try_into().unwrap());
+    let status = |mode, run_state, stale_policy| {
+        let mut s = StatusMsg {
+            mode,
+            run_state,
+            ..Default::default()
+        };
+        s.command.stale_policy = stale_policy;
+        encode(&s)
+    };
+    for (m, t) in [(Mode::RealTime, 0), (Mode::Lockstep, 1), (Mode::Batch, 2)] {
+        assert_eq!(
+            tag_at(&status(m, RunState::Starting, StalePolicy::Hold), 30),
+            t,
+            "{m:?}"
+        );
+    }
+    for (r, t) in [
+        (RunState::Starting, 0),
+        (RunState::Running, 1),
+        (RunState::Stopping, 2),
+        (RunState::Finished, 3),
+        (RunState::Failed, 4),
+    ] {
+        assert_eq!(
+            tag_at(&status(Mode::RealTime, r, StalePolicy::Hold), 34),
+            t,
+            "{r:?}"
+        );
+    }
+    for (p, t) in [(StalePolicy::Hold, 0), (StalePolicy::Zero, 1)] {
+        assert_eq!(
+            tag_at(&status(Mode::RealTime, RunState::Starting, p), 95),
+            t,
+            "{p:?}"
+        );
+    }
+}
+
+#[test]
+fn flag_bits() {
+    assert_eq!(command_flags::STALE, 0b001);
+    assert_eq!(command_flags::ZEROED_BY_POLICY, 0b010);
+    assert_eq!(command_flags::NO_COMMAND_YET, 0b100);
+    assert_eq!(command_flags::RESERVED_MASK, 0b1111_1000);
+    assert_eq!(saturation_flags::GYRO_RATE, 0b0001);
+    assert_eq!(saturation_flags::ACCEL, 0b0010);
+    assert_eq!(saturation_flags::DTHETA, 0b0100);
+    assert_eq!(saturation_flags::DV, 0b1000);
+    assert_eq!(saturation_flags::RESERVED_MASK, 0b1111_0000);
+}

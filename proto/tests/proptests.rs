@@ -1,0 +1,303 @@
+//! Property tests of the codec: no input makes a decoder panic, random
+//! messages round-trip, and every truncation or extension is an error.
+
+use flexdyn_proto::{
+    decode, decode_command, decode_header, decode_imu, decode_state, decode_status, encode,
+    AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, DecodeError, FrameTiming,
+    Header, ImuMsg, Mode, PanelPairState, RejectCounters, RunState, StalePolicy, StateMsg,
+    StatusMsg, WireMessage,
+};
+use proptest::prelude::*;
+
+/// Any f64 bit pattern, NaN and infinities included.
+fn any_bits_f64() -> impl Strategy<Value = f64> + Clone {
+    any::<u64>().prop_map(f64::from_bits)
+}
+
+fn v3(s: impl Strategy<Value = f64> + Clone) -> impl Strategy<Value = [f64; 3]> {
+    [s.clone(), s.clone(), s]
+}
+
+fn header() -> impl Strategy<Value = Header> {
+    (any::<u32>(), any::<u64>(), any::<u64>(), any::<u64>())
+        .prop_map(|(sc, tick, t, seq)| Header::new(sc, tick, t, seq))
+}
+
+fn state() -> impl Strategy<Value = StateMsg> {
+    state_with(any_bits_f64())
+}
+
+/// State messages whose f64 fields are drawn from `floats`.
+fn state_with(floats: impl Strategy<Value = f64> + Clone) -> impl Strategy<Value = StateMsg> {
+    let f = || floats.clone();
+    let panel = (f(), f(), f(), f()).prop_map(|(a, b, c, d)| PanelPairState {
+        theta1_rad: a,
+        theta1_dot_rad_s: b,
+        theta2_rad: c,
+        theta2_dot_rad_s: d,
+    });
+    let conserved = (f(), f(), v3(f()), v3(f())).prop_map(|(a, b, c, d)| Conserved {
+        orb_energy_j: a,
+        rot_energy_j: b,
+        orb_ang_mom_n: c,
+        rot_ang_mom_c_n: d,
+    });
+    (
+        header(),
+        (v3(f()), [f(), f(), f(), f()], v3(f()), v3(f())),
+        (v3(f()), v3(f()), v3(f())),
+        conserved,
+        (v3(f()), v3(f()), any::<u8>()),
+        prop::collection::vec(panel, 0..8),
+    )
+        .prop_map(
+            |(header, (sigma, q, w, wd), (r, v, a), conserved, (tq, fo, flags), panels)| StateMsg {
+                header,
+                sigma_bn: sigma,
+                q_bn: q,
+                omega_bn_b_rad_s: w,
+                omega_dot_bn_b_rad_s2: wd,
+                r_bn_n_m: r,
+                v_bn_n_m_s: v,
+                nongrav_accel_bn_n_m_s2: a,
+                conserved,
+                wrench_applied: AppliedWrench {
+                    torque_b_nm: tq,
+                    force_b_n: fo,
+                },
+                command_flags: flags,
+                panels,
+            },
+        )
+}
+
+fn imu() -> impl Strategy<Value = ImuMsg> {
+    let f = any_bits_f64;
+    (header(), v3(f()), v3(f()), v3(f()), v3(f()), any::<u8>()).prop_map(
+        |(header, w, a, dt, dv, s)| ImuMsg {
+            header,
+            omega_p_rad_s: w,
+            accel_p_m_s2: a,
+            dtheta_p_rad: dt,
+            dv_p_m_s: dv,
+            saturation_flags: s,
+        },
+    )
+}
+
+/// Valid (finite) commands.
+fn command() -> impl Strategy<Value = CommandMsg> {
+    let f = any::<f64>; // finite only
+    let kind = prop_oneof![
+        (v3(f()), v3(f())).prop_map(|(t, fo)| CommandKind::Wrench {
+            torque_b_nm: t,
+            force_b_n: fo
+        }),
+        Just(CommandKind::NoCommand),
+    ];
+    (header(), any::<u32>(), kind).prop_map(|(header, sender_id, kind)| CommandMsg {
+        header,
+        sender_id,
+        kind,
+    })
+}
+
+fn status() -> impl Strategy<Value = StatusMsg> {
+    let u = any::<u64>;
+    let mode = prop_oneof![
+        Just(Mode::RealTime),
+        Just(Mode::Lockstep),
+        Just(Mode::Batch)
+    ];
+    let run = prop_oneof![
+        Just(RunState::Starting),
+        Just(RunState::Running),
+        Just(RunState::Stopping),
+        Just(RunState::Finished),
+        Just(RunState::Failed),
+    ];
+    let policy = prop_oneof![Just(StalePolicy::Hold), Just(StalePolicy::Zero)];
+    (
+        header(),
+        mode,
+        run,
+        (u(), u(), u(), u(), u()),
+        (u(), u(), any::<bool>(), policy),
+        (u(), u(), u(), u(), u(), u()),
+        u(),
+    )
+        .prop_map(|(header, mode, run_state, t, c, r, wall)| StatusMsg {
+            header,
+            mode,
+            run_state,
+            timing: FrameTiming {
+                lateness_p50_ns: t.0,
+                lateness_p99_ns: t.1,
+                lateness_max_ns: t.2,
+                overrun_count: t.3,
+                frames_skipped: t.4,
+            },
+            command: CommandStatus {
+                last_command_tick: c.0,
+                command_age_ns: c.1,
+                command_stale: c.2,
+                stale_policy: c.3,
+            },
+            rejected: RejectCounters {
+                malformed: r.0,
+                bad_version: r.1,
+                non_finite: r.2,
+                wrong_spacecraft: r.3,
+                stale_tick: r.4,
+                unknown_sender: r.5,
+            },
+            wall_time_unix_ns: wall,
+        })
+}
+
+/// Run every decoder; the only requirement is that none panics.
+fn decode_all(bytes: &[u8]) {
+    let _ = decode_state(bytes);
+    let _ = decode_imu(bytes);
+    let _ = decode_command(bytes);
+    let _ = decode_status(bytes);
+    let _ = decode_header(bytes);
+}
+
+/// encode → decode → encode gives the same bytes (bitwise, so NaN payloads
+/// count), and every strict prefix and every one-byte extension is an error.
+fn round_trip_and_truncate<M: WireMessage + std::fmt::Debug>(msg: &M) -> Result<(), TestCaseError> {
+    let bytes = encode(msg);
+    let back: M = decode(&bytes).map_err(|e| TestCaseError::fail(format!("{e}")))?;
+    prop_assert_eq!(&encode(&back), &bytes);
+    for cut in 0..bytes.len() {
+        let r = decode::<M>(&bytes[..cut]);
+        prop_assert!(
+            matches!(r, Err(DecodeError::Length { .. })),
+            "prefix of {} bytes: {:?}",
+            cut,
+            r.map(|_| ())
+        );
+    }
+    let mut longer = bytes.clone();
+    longer.push(0);
+    prop_assert!(
+        matches!(decode::<M>(&longer), Err(DecodeError::TrailingBytes { .. })),
+        "extended"
+    );
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    #[test]
+    fn arbitrary_bytes_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..600)) {
+        decode_all(&bytes);
+    }
+
+    /// Past the version check: random bytes behind a valid version.
+    #[test]
+    fn arbitrary_bytes_with_valid_version_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..600)) {
+        let mut b = vec![1u8, 0];
+        b.extend_from_slice(&bytes);
+        decode_all(&b);
+    }
+
+    /// Random bodies of exactly the right length reach bincode: the result is a
+    /// message, Malformed or NonFinite, never a panic or a length error.
+    #[test]
+    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 155)) {
+        let mut b = vec![1u8, 0];
+        b.extend_from_slice(&body);
+        for r in [
+            decode_imu(&b[..flexdyn_proto::IMU_LEN]).map(|_| ()),
+            decode_status(&b[..flexdyn_proto::STATUS_LEN]).map(|_| ()),
+        ] {
+            prop_assert!(matches!(r, Ok(()) | Err(DecodeError::Malformed(_))), "{:?}", r);
+        }
+        let mut c = b[..flexdyn_proto::COMMAND_WRENCH_LEN].to_vec();
+        c[flexdyn_proto::COMMAND_KIND_OFFSET..flexdyn_proto::COMMAND_KIND_OFFSET + 4].copy_from_slice(&[0; 4]);
+        let r = decode_command(&c);
+        prop_assert!(matches!(r, Ok(_) | Err(DecodeError::NonFinite { .. })), "{:?}", r);
+    }
+
+    /// Valid messages with random bytes overwritten never panic any decoder.
+    #[test]
+    fn mutated_messages_never_panic(
+        msg in state(),
+        edits in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8),
+    ) {
+        let mut b = encode(&msg);
+        for (i, v) in &edits {
+            let at = i.index(b.len());
+            b[at] = *v;
+        }
+        decode_all(&b);
+    }
+
+    #[test]
+    fn mutated_commands_never_panic(
+        msg in command(),
+        edits in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8),
+    ) {
+        let mut b = encode(&msg);
+        for (i, v) in &edits {
+            let at = i.index(b.len());
+            b[at] = *v;
+        }
+        decode_all(&b);
+    }
+
+    #[test]
+    fn state_round_trip(msg in state()) {
+        round_trip_and_truncate(&msg)?;
+    }
+
+    #[test]
+    fn imu_round_trip(msg in imu()) {
+        round_trip_and_truncate(&msg)?;
+    }
+
+    #[test]
+    fn command_round_trip(msg in command()) {
+        round_trip_and_truncate(&msg)?;
+        prop_assert_eq!(decode_command(&encode(&msg)), Ok(msg));
+    }
+
+    #[test]
+    fn status_round_trip(msg in status()) {
+        round_trip_and_truncate(&msg)?;
+        prop_assert_eq!(decode_status(&encode(&msg)), Ok(msg));
+    }
+
+    /// Finite state messages compare equal after a round trip.
+    #[test]
+    fn finite_state_round_trip_eq(msg in state_with(any::<f64>())) {
+        prop_assert_eq!(decode_state(&encode(&msg)), Ok(msg));
+    }
+
+    #[test]
+    fn finite_imu_round_trip_eq(msg in imu().prop_filter("finite", |m| {
+        [m.omega_p_rad_s, m.accel_p_m_s2, m.dtheta_p_rad, m.dv_p_m_s].iter().flatten().all(|x| x.is_finite())
+    })) {
+        prop_assert_eq!(decode_imu(&encode(&msg)), Ok(msg));
+    }
+
+    /// Any non-finite component in a wrench is rejected with NonFinite.
+    #[test]
+    fn non_finite_command_rejected(
+        msg in command(),
+        slot in 0usize..6,
+        bad in prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(f64::NEG_INFINITY)],
+    ) {
+        let (mut t, mut f) = match msg.kind {
+            CommandKind::Wrench { torque_b_nm, force_b_n } => (torque_b_nm, force_b_n),
+            CommandKind::NoCommand => ([0.0; 3], [0.0; 3]),
+        };
+        if slot < 3 { t[slot] = bad } else { f[slot - 3] = bad }
+        let cmd = CommandMsg::wrench(msg.header, msg.sender_id, t, f);
+        let r = decode_command(&encode(&cmd));
+        prop_assert!(matches!(r, Err(DecodeError::NonFinite { .. })), "{:?}", r);
+    }
+}
