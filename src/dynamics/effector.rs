@@ -1,0 +1,219 @@
+//! The state-effector contract: how an appended body plugs into the hub's back-substitution solve.
+//!
+//! Every appended body (a dual-hinged panel pair today; a single hinged panel, a reaction wheel or
+//! an N-panel chain tomorrow) implements [`StateEffector`]. Per derivative evaluation the
+//! [`Spacecraft`](super::Spacecraft) calls, in order:
+//!
+//! 1. [`StateEffector::update_mass_props`] — the effector's mass, first moment and inertia about B
+//!    (their sums give m_sc, c, c′ and [I_sc,B] of Eqs. 3, 4 and 19);
+//! 2. [`StateEffector::update_contributions`] — its [A], [B], [C], [D], v_trans and v_rot
+//!    contributions to the hub system (Eqs. 139–144 for a panel pair). The body's share of
+//!    Eq. 150's −[I′_sc,B]ω is part of its v_rot contribution, because only the product with ω is
+//!    ever needed and it is far cheaper than a 3×3 [I′] per body;
+//! 3. the hub solves Eqs. 151–153 for r̈_B/N and ω̇_B/N;
+//! 4. [`StateEffector::compute_derivatives`] — back-substitution of its own second derivatives
+//!    (Eqs. 131–132 for a panel pair).
+//!
+//! The hub code only ever sees the summed [`EffectorMassProps`] and [`BackSubContributions`], so a
+//! new kind of body plugs in without touching it. Effectors add into the sums in place (as
+//! Basilisk's `updateContributions` does) instead of returning them: a returned
+//! [`BackSubContributions`] is 336 bytes, copied and added per effector per RK4 stage.
+
+use std::ops::AddAssign;
+
+use nalgebra::{Matrix3, Vector3};
+
+/// Hub kinematics an effector needs for its contributions.
+#[derive(Debug, Clone, Copy)]
+pub struct HubKinematics {
+    /// [rad/s] ω_B/N in B components.
+    pub omega_bn_b: Vector3<f64>,
+}
+
+/// The hub's solved accelerations, handed to each effector for back-substitution.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct HubAccel {
+    /// [m/s²] non-gravitational acceleration of point B relative to N, in B components
+    /// (r̈_B/N minus the uniform gravity field g(r_C/N)). Effector equations use this one: a
+    /// uniform gravity field accelerates every body alike and drops out of the hinge equations.
+    pub nongrav_accel_bn_b: Vector3<f64>,
+    /// [rad/s²] ω̇_B/N in B components.
+    pub omega_dot_bn_b: Vector3<f64>,
+}
+
+/// Mass properties of an effector about point B, B components (summed into Eqs. 3, 4 and 19).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EffectorMassProps {
+    /// [kg] mass.
+    pub mass_kg: f64,
+    /// [kg·m] first moment Σ m r_Sc/B.
+    pub first_moment_b_kg_m: Vector3<f64>,
+    /// [kg·m/s] body-frame derivative of the first moment, Σ m r′_Sc/B.
+    pub first_moment_prime_b_kg_m_s: Vector3<f64>,
+    /// [kg·m²] inertia about point B.
+    pub inertia_pnt_b_b_kg_m2: Matrix3<f64>,
+}
+
+impl Default for EffectorMassProps {
+    fn default() -> Self {
+        Self {
+            mass_kg: 0.0,
+            first_moment_b_kg_m: Vector3::zeros(),
+            first_moment_prime_b_kg_m_s: Vector3::zeros(),
+            inertia_pnt_b_b_kg_m2: Matrix3::zeros(),
+        }
+    }
+}
+
+impl AddAssign for EffectorMassProps {
+    fn add_assign(&mut self, o: Self) {
+        self.mass_kg += o.mass_kg;
+        self.first_moment_b_kg_m += o.first_moment_b_kg_m;
+        self.first_moment_prime_b_kg_m_s += o.first_moment_prime_b_kg_m_s;
+        self.inertia_pnt_b_b_kg_m2 += o.inertia_pnt_b_b_kg_m2;
+    }
+}
+
+/// An effector's contributions to the hub system of Eq. 151:
+/// `[[A, B], [C, D]] [r̈_B/N; ω̇_B/N] = [v_trans; v_rot]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BackSubContributions {
+    /// [kg] [A_contr], Eq. 139.
+    pub matrix_a: Matrix3<f64>,
+    /// [kg·m] [B_contr], Eq. 140.
+    pub matrix_b: Matrix3<f64>,
+    /// [kg·m] [C_contr], Eq. 142.
+    pub matrix_c: Matrix3<f64>,
+    /// [kg·m²] [D_contr], Eq. 143.
+    pub matrix_d: Matrix3<f64>,
+    /// [N] v_trans,contr, Eq. 141.
+    pub vec_trans: Vector3<f64>,
+    /// [N·m] v_rot,contr, Eq. 144, plus the body's −[I′]ω share of Eq. 150.
+    pub vec_rot: Vector3<f64>,
+}
+
+impl Default for BackSubContributions {
+    fn default() -> Self {
+        Self {
+            matrix_a: Matrix3::zeros(),
+            matrix_b: Matrix3::zeros(),
+            matrix_c: Matrix3::zeros(),
+            matrix_d: Matrix3::zeros(),
+            vec_trans: Vector3::zeros(),
+            vec_rot: Vector3::zeros(),
+        }
+    }
+}
+
+impl AddAssign for BackSubContributions {
+    fn add_assign(&mut self, o: Self) {
+        self.matrix_a += o.matrix_a;
+        self.matrix_b += o.matrix_b;
+        self.matrix_c += o.matrix_c;
+        self.matrix_d += o.matrix_d;
+        self.vec_trans += o.vec_trans;
+        self.vec_rot += o.vec_rot;
+    }
+}
+
+/// An effector's share of the system's energy and momentum, taken about point B for motion
+/// relative to B's translation, in B components. All fields are additive across bodies; the
+/// [`Spacecraft`](super::Spacecraft) shifts the sums to the system centre of mass C.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnergyMomentum {
+    /// [kg] mass.
+    pub mass_kg: f64,
+    /// [kg·m] first moment Σ m r_i/B.
+    pub first_moment_b_kg_m: Vector3<f64>,
+    /// [kg·m/s] linear momentum relative to B's translation, Σ m ṙ_i/B (ṙ = r′ + ω × r).
+    pub lin_mom_rel_b_kg_m_s: Vector3<f64>,
+    /// [kg·m²/s] angular momentum about B, Σ ([I_i] ω_i + m r_i/B × ṙ_i/B).
+    pub ang_mom_pnt_b_b_kg_m2_s: Vector3<f64>,
+    /// [J] kinetic energy relative to B's translation, ½ Σ (ω_iᵀ[I_i]ω_i + m |ṙ_i/B|²).
+    pub kinetic_rel_b_j: f64,
+    /// [J] stored potential energy (springs).
+    pub potential_j: f64,
+}
+
+impl Default for EnergyMomentum {
+    fn default() -> Self {
+        Self {
+            mass_kg: 0.0,
+            first_moment_b_kg_m: Vector3::zeros(),
+            lin_mom_rel_b_kg_m_s: Vector3::zeros(),
+            ang_mom_pnt_b_b_kg_m2_s: Vector3::zeros(),
+            kinetic_rel_b_j: 0.0,
+            potential_j: 0.0,
+        }
+    }
+}
+
+impl AddAssign for EnergyMomentum {
+    fn add_assign(&mut self, o: Self) {
+        self.mass_kg += o.mass_kg;
+        self.first_moment_b_kg_m += o.first_moment_b_kg_m;
+        self.lin_mom_rel_b_kg_m_s += o.lin_mom_rel_b_kg_m_s;
+        self.ang_mom_pnt_b_b_kg_m2_s += o.ang_mom_pnt_b_b_kg_m2_s;
+        self.kinetic_rel_b_j += o.kinetic_rel_b_j;
+        self.potential_j += o.potential_j;
+    }
+}
+
+impl EnergyMomentum {
+    /// The contribution of one rigid body of mass `mass_kg` whose centre of mass is at `r_b`
+    /// (relative to B, B components) moving at `r_prime_b` relative to the B frame, with inertia
+    /// `inertia_c_b` about its own centre of mass (B components) and inertial angular velocity
+    /// `omega_body_b`, when the B frame rotates at `omega_bn_b`.
+    #[inline]
+    pub fn rigid_body(
+        mass_kg: f64,
+        r_b: &Vector3<f64>,
+        r_prime_b: &Vector3<f64>,
+        inertia_c_b: &Matrix3<f64>,
+        omega_body_b: &Vector3<f64>,
+        omega_bn_b: &Vector3<f64>,
+    ) -> Self {
+        let r_dot_b = r_prime_b + omega_bn_b.cross(r_b);
+        let i_omega = inertia_c_b * omega_body_b;
+        Self {
+            mass_kg,
+            first_moment_b_kg_m: r_b * mass_kg,
+            lin_mom_rel_b_kg_m_s: r_dot_b * mass_kg,
+            ang_mom_pnt_b_b_kg_m2_s: i_omega + r_b.cross(&r_dot_b) * mass_kg,
+            kinetic_rel_b_j: 0.5 * (omega_body_b.dot(&i_omega) + mass_kg * r_dot_b.norm_squared()),
+            potential_j: 0.0,
+        }
+    }
+}
+
+/// A body appended to the hub, with its own integrated states, solved by back-substitution.
+///
+/// Implementations validate their parameters at construction. None of these methods may allocate,
+/// lock, do I/O or fail: they run inside every RK4 stage. They receive the effector's own slice of
+/// the integrated state (`x`, length [`StateEffector::state_len`]) and may cache geometry in
+/// `self` between the calls of one evaluation.
+pub trait StateEffector: Send + std::fmt::Debug {
+    /// Name for logs and output headers.
+    fn name(&self) -> &str;
+    /// Number of integrated states this effector owns.
+    fn state_len(&self) -> usize;
+    /// Names of the integrated states (e.g. `theta1`), for output headers.
+    fn state_names(&self) -> Vec<String>;
+    /// Writes the effector's initial state into `x`.
+    fn initial_state(&self, x: &mut [f64]);
+    /// Pass 1: adds the mass properties about B at state `x` into `sum`.
+    fn update_mass_props(&mut self, x: &[f64], sum: &mut EffectorMassProps);
+    /// Pass 2: adds the contributions to the hub system at state `x` into `sum` (after pass 1 on
+    /// the same `x`).
+    fn update_contributions(
+        &mut self,
+        x: &[f64],
+        hub: &HubKinematics,
+        sum: &mut BackSubContributions,
+    );
+    /// Pass 3: the effector's state derivative `dx` once the hub accelerations are known
+    /// (after pass 2 on the same `x`).
+    fn compute_derivatives(&mut self, x: &[f64], hub_accel: &HubAccel, dx: &mut [f64]);
+    /// Energy and momentum contributions at state `x` when the hub rotates at `omega_bn_b`.
+    fn energy_momentum(&self, x: &[f64], omega_bn_b: &Vector3<f64>) -> EnergyMomentum;
+}

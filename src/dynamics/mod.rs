@@ -1,0 +1,125 @@
+//! Rigid hub + dual-hinged panel pairs, by back-substitution.
+//!
+//! The equations are those of Allard & Schaub, "Spacecraft Dynamical Model with Dual-Connected
+//! Hinged Rigid Bodies" (draft; `../shared/reference/000_981bdc22e0818a6f.txt`), Sections III and
+//! V, with the two numerical errata of `../shared/reference/ERRATA.md` applied:
+//! - **E1** (Eqs. 80/81/120/123b): the ω̇ coefficient of the panel-2 row is
+//!   `I_s22 ŝ22ᵀ − m2 d2 ŝ23ᵀ[r̃_Sc2/B]` — see [`panel_pair`];
+//! - **E2** (Eq. 148): `[C] = m_sc[c̃] + [C_contr]` — see [`spacecraft`].
+//!
+//! # Notation legend
+//! Names follow the paper in snake case, with frames, points and units in the name:
+//! - `r_xy_f`: position of point X relative to point Y, in frame F components
+//!   (`r_bn_n` = r_B/N in N; `r_sc1b_b` = r_Sc1/B in B; `r_h1b_b` = r_H1/B in B);
+//! - `v_bn_n`: inertial velocity of B in N; `omega_bn_b`: ω_B/N in B; `omega_dot_bn_b`: ω̇_B/N in B;
+//! - `sigma_bn`: MRP of B relative to N;
+//! - `dcm_xy`: the DCM [XY] that maps Y components to X components (`v_x = dcm_xy * v_y`), so
+//!   `dcm_bn` maps N to B and `dcm_h1b` maps B to H1;
+//! - `r_prime_*`: body-frame (B-relative) time derivative (the paper's ′); `*_dot`: inertial;
+//! - `s11`, `s12`, `s13` (`s21`, …): the panel-1 (panel-2) frame axes ŝ_i1,k (ŝ_i2,k) in B;
+//! - units are SI unless the name says otherwise (`step_ns`, `t_sim_ns`).
+//!
+//! # Conventions
+//! - [S1 B] = M2(θ1)[H1 B], [S2 B] = M2(θ2) M2(θ_H2S1) [S1 B], M2(a) = [[c,0,−s],[0,1,0],[s,0,c]];
+//!   θ2 is measured relative to panel 1; both hinge axes are ŝ12 = ĥ12.
+//! - A positive θ rotates the panel about +ŝ2 by the right-hand rule; the panel's centre of mass
+//!   lies at −d ŝ1 from its hinge, so at θ = 0 the panel extends along −ĥ1.
+//! - Gravity acts at the system centre of mass as a uniform field.
+
+pub mod effector;
+pub mod panel_pair;
+pub mod params;
+pub mod spacecraft;
+
+pub use effector::{
+    BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
+};
+pub use panel_pair::PanelPair;
+pub use params::{
+    GravityModel, HubParams, PanelPairInitial, PanelPairParams, PanelParams, WrenchSegment,
+};
+pub use spacecraft::{
+    gravity_accel_n, gravity_potential, Conserved, HubInitial, HubOutputs, InitialTranslation,
+    Spacecraft, State,
+};
+
+/// A parameter that fails validation. Every variant names the offending field with its
+/// configuration path (e.g. `panel_pairs[1].panel1.mass_kg`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ParamError {
+    /// NaN or ±Inf.
+    #[error("{field}: must be finite (got NaN or Inf)")]
+    NotFinite {
+        /// Field path.
+        field: String,
+    },
+    /// Must be strictly positive.
+    #[error("{field}: must be > 0 (got {value})")]
+    NotPositive {
+        /// Field path.
+        field: String,
+        /// The value given.
+        value: f64,
+    },
+    /// Must be ≥ 0.
+    #[error("{field}: must be >= 0 (got {value})")]
+    Negative {
+        /// Field path.
+        field: String,
+        /// The value given.
+        value: f64,
+    },
+    /// Inertia matrix not symmetric.
+    #[error("{field}: inertia matrix is not symmetric (max |I - I^T| = {asymmetry:e})")]
+    NotSymmetric {
+        /// Field path.
+        field: String,
+        /// Largest asymmetry.
+        asymmetry: f64,
+    },
+    /// Inertia not positive-definite.
+    #[error(
+        "{field}: inertia is not positive-definite (smallest principal moment {min_eigenvalue})"
+    )]
+    NotPositiveDefinite {
+        /// Field path.
+        field: String,
+        /// Smallest eigenvalue.
+        min_eigenvalue: f64,
+    },
+    /// Principal moments violate the triangle inequality.
+    #[error("{field}: principal moments {moments:?} violate the triangle inequality (each must be <= the sum of the other two)")]
+    TriangleInequality {
+        /// Field path.
+        field: String,
+        /// The principal moments.
+        moments: [f64; 3],
+    },
+    /// DCM not orthonormal (or not proper).
+    #[error("{field}: DCM is not proper orthonormal within 1e-9 (error {error:e})")]
+    NotOrthonormal {
+        /// Field path.
+        field: String,
+        /// max |C Cᵀ − I| or |det C − 1|.
+        error: f64,
+    },
+    /// Hinge-to-CoM distance beyond the panel length.
+    #[error("{field}: d ({d_m} m) exceeds the panel length l ({l_m} m)")]
+    DExceedsLength {
+        /// Field path.
+        field: String,
+        /// d.
+        d_m: f64,
+        /// l.
+        l_m: f64,
+    },
+    /// A state vector of the wrong length was supplied.
+    #[error("state: expected {expected} effector states, got {found}")]
+    StateLength {
+        /// Expected length.
+        expected: usize,
+        /// Given length.
+        found: usize,
+    },
+}

@@ -1,0 +1,302 @@
+//! Validated physical parameters of the spacecraft: the hub, the panel pairs and the forcing.
+//!
+//! These are plain data. They are built by [`crate::config`] (which validates them and reports
+//! errors that name the field) or directly in code, and consumed once by
+//! [`crate::dynamics::Spacecraft::new`], which validates them again (cheaply) so a hand-built
+//! parameter set can never reach the stepping hot path unchecked.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// Rigid hub parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HubParams {
+    /// [kg] hub mass.
+    pub mass_kg: f64,
+    /// [kg·m²] hub inertia about its own centre of mass Bc, in B components (symmetric positive-definite).
+    pub inertia_bc_b_kg_m2: Matrix3<f64>,
+    /// [m] position of the hub centre of mass Bc relative to point B, in B components.
+    pub r_bcb_b_m: Vector3<f64>,
+}
+
+/// One rigid panel of a dual-hinged pair.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PanelParams {
+    /// [kg] panel mass.
+    pub mass_kg: f64,
+    /// [kg·m²] principal inertia about the panel centre of mass, in its S frame: (I_s1, I_s2, I_s3).
+    pub inertia_s_kg_m2: Vector3<f64>,
+    /// [m] distance from the panel's hinge to its centre of mass, along −ŝ1.
+    pub d_m: f64,
+    /// [N·m/rad] torsional stiffness of the panel's hinge.
+    pub k_n_m_rad: f64,
+    /// [N·m·s/rad] torsional damping of the panel's hinge.
+    pub c_n_m_s_rad: f64,
+}
+
+/// A pair of dual-linked hinged panels: panel 1 hinged to the hub at H1, panel 2 hinged to the tip
+/// of panel 1 at H2 (a distance `l1_m` from H1 along −ŝ11).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PanelPairParams {
+    /// Name used in logs and error messages.
+    pub name: String,
+    /// [m] hinge 1 location H1 relative to B, in B components.
+    pub r_h1b_b_m: Vector3<f64>,
+    /// DCM [H1B]: maps B components to hinge-1 frame H1 components (rows are ĥ1, ĥ2, ĥ3 in B).
+    pub dcm_h1b: Matrix3<f64>,
+    /// [rad] fixed rotation of the hinge-2 frame H2 about the (common) hinge axis ŝ12,
+    /// relative to S1: [H2 S1] = M2(theta_h2s1). Non-zero models folded or undeployed wings.
+    pub theta_h2s1_rad: f64,
+    /// [m] length of panel 1 (hinge 1 to hinge 2).
+    pub l1_m: f64,
+    /// Panel 1 (inboard).
+    pub panel1: PanelParams,
+    /// Panel 2 (outboard).
+    pub panel2: PanelParams,
+    /// [N·m] constant motor torques at (hinge 1, hinge 2). Hinge 1's motor acts between the hub and
+    /// panel 1, hinge 2's between panel 1 and panel 2; both are internal torques.
+    pub motor_torque_nm: [f64; 2],
+}
+
+/// Initial state of one pair.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PanelPairInitial {
+    /// [rad] θ1, panel 1 deflection about ŝ12 from H1.
+    pub theta1_rad: f64,
+    /// [rad/s] θ̇1.
+    pub theta1_dot_rad_s: f64,
+    /// [rad] θ2, panel 2 deflection relative to panel 1 (and H2).
+    pub theta2_rad: f64,
+    /// [rad/s] θ̇2.
+    pub theta2_dot_rad_s: f64,
+}
+
+/// Gravity model. The field is evaluated at the system centre of mass C and applied uniformly
+/// (no gravity-gradient torque), as the paper and Basilisk do.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GravityModel {
+    /// Free space.
+    None,
+    /// Point-mass central body.
+    PointMass {
+        /// [m³/s²] gravitational parameter μ.
+        mu_m3_s2: f64,
+    },
+    /// Point mass plus the J2 zonal term (N frame ẑ is the body's pole).
+    J2 {
+        /// [m³/s²] gravitational parameter μ.
+        mu_m3_s2: f64,
+        /// [-] J2 coefficient.
+        j2: f64,
+        /// [m] equatorial radius.
+        r_eq_m: f64,
+    },
+}
+
+/// One row of the piecewise-constant external wrench schedule on the hub.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WrenchSegment {
+    /// [ns] time from which this row applies (until the next row).
+    pub t_start_ns: u64,
+    /// [N] force on the hub, B components, applied at point B.
+    pub force_b_n: Vector3<f64>,
+    /// [N·m] torque on the hub, B components.
+    pub torque_b_nm: Vector3<f64>,
+}
+
+use super::ParamError;
+
+/// Tolerance on ‖[C][C]ᵀ − I‖ (max element) and |det C − 1| for a DCM to count as orthonormal.
+pub const DCM_ORTHONORMAL_TOL: f64 = 1e-9;
+/// Relative tolerance on the asymmetry of an inertia matrix.
+pub const INERTIA_SYMMETRY_TOL: f64 = 1e-9;
+
+fn join(path: &str, field: &str) -> String {
+    if path.is_empty() {
+        field.to_string()
+    } else {
+        format!("{path}.{field}")
+    }
+}
+
+pub(crate) fn check_finite(path: &str, field: &str, values: &[f64]) -> Result<(), ParamError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(ParamError::NotFinite {
+            field: join(path, field),
+        })
+    }
+}
+
+pub(crate) fn check_positive(path: &str, field: &str, v: f64) -> Result<(), ParamError> {
+    check_finite(path, field, &[v])?;
+    if v > 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::NotPositive {
+            field: join(path, field),
+            value: v,
+        })
+    }
+}
+
+pub(crate) fn check_non_negative(path: &str, field: &str, v: f64) -> Result<(), ParamError> {
+    check_finite(path, field, &[v])?;
+    if v >= 0.0 {
+        Ok(())
+    } else {
+        Err(ParamError::Negative {
+            field: join(path, field),
+            value: v,
+        })
+    }
+}
+
+/// Checks that principal moments are positive and satisfy the triangle inequality
+/// (each moment ≤ the sum of the other two), which any real mass distribution obeys.
+fn check_principal_moments(path: &str, field: &str, m: &[f64; 3]) -> Result<(), ParamError> {
+    // Positivity first for all three, so a negative moment is never reported as a triangle
+    // violation.
+    let min = m.iter().copied().fold(f64::INFINITY, f64::min);
+    if min <= 0.0 {
+        return Err(ParamError::NotPositiveDefinite {
+            field: join(path, field),
+            min_eigenvalue: min,
+        });
+    }
+    for (i, v) in m.iter().enumerate() {
+        let others = m[(i + 1) % 3] + m[(i + 2) % 3];
+        // A small relative slack admits thin-plate limits (I3 = I1 + I2) up to round-off.
+        if *v > others * (1.0 + 1e-12) {
+            return Err(ParamError::TriangleInequality {
+                field: join(path, field),
+                moments: *m,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Validates a full inertia matrix: finite, symmetric, positive-definite, triangle inequality on
+/// its principal moments.
+pub(crate) fn check_inertia_matrix(
+    path: &str,
+    field: &str,
+    i: &Matrix3<f64>,
+) -> Result<(), ParamError> {
+    check_finite(path, field, i.as_slice())?;
+    let scale = i.abs().max().max(f64::MIN_POSITIVE);
+    let asym = (i - i.transpose()).abs().max();
+    if asym > INERTIA_SYMMETRY_TOL * scale {
+        return Err(ParamError::NotSymmetric {
+            field: join(path, field),
+            asymmetry: asym,
+        });
+    }
+    let eig = i.symmetric_eigenvalues();
+    check_principal_moments(path, field, &[eig[0], eig[1], eig[2]])
+}
+
+/// Validates a DCM: finite, orthonormal within [`DCM_ORTHONORMAL_TOL`], proper (det = +1).
+pub(crate) fn check_dcm(path: &str, field: &str, c: &Matrix3<f64>) -> Result<(), ParamError> {
+    check_finite(path, field, c.as_slice())?;
+    let err = (c * c.transpose() - Matrix3::identity()).abs().max();
+    let det = c.determinant();
+    if err > DCM_ORTHONORMAL_TOL || (det - 1.0).abs() > DCM_ORTHONORMAL_TOL {
+        return Err(ParamError::NotOrthonormal {
+            field: join(path, field),
+            error: err.max((det - 1.0).abs()),
+        });
+    }
+    Ok(())
+}
+
+impl HubParams {
+    /// Validates the hub: positive mass, SPD inertia obeying the triangle inequality, finite offset.
+    pub fn validate(&self, path: &str) -> Result<(), ParamError> {
+        check_positive(path, "mass_kg", self.mass_kg)?;
+        check_inertia_matrix(path, "inertia_bc_b_kg_m2", &self.inertia_bc_b_kg_m2)?;
+        check_finite(path, "r_bcb_b_m", self.r_bcb_b_m.as_slice())
+    }
+}
+
+impl PanelParams {
+    /// Validates one panel (`path` is e.g. `panel_pairs[0].panel1`).
+    pub fn validate(&self, path: &str) -> Result<(), ParamError> {
+        check_positive(path, "mass_kg", self.mass_kg)?;
+        check_finite(path, "inertia_s_kg_m2", self.inertia_s_kg_m2.as_slice())?;
+        check_principal_moments(
+            path,
+            "inertia_s_kg_m2",
+            &[
+                self.inertia_s_kg_m2.x,
+                self.inertia_s_kg_m2.y,
+                self.inertia_s_kg_m2.z,
+            ],
+        )?;
+        check_positive(path, "d_m", self.d_m)?;
+        check_non_negative(path, "k_n_m_rad", self.k_n_m_rad)?;
+        check_non_negative(path, "c_n_m_s_rad", self.c_n_m_s_rad)
+    }
+}
+
+impl PanelPairParams {
+    /// Validates the pair (`path` is e.g. `panel_pairs[0]`).
+    pub fn validate(&self, path: &str) -> Result<(), ParamError> {
+        check_finite(path, "r_h1b_b_m", self.r_h1b_b_m.as_slice())?;
+        check_dcm(path, "dcm_h1b", &self.dcm_h1b)?;
+        check_finite(path, "theta_h2s1_rad", &[self.theta_h2s1_rad])?;
+        check_finite(path, "motor_torque_nm", &self.motor_torque_nm)?;
+        let p1 = join(path, "panel1");
+        self.panel1.validate(&p1)?;
+        self.panel2.validate(&join(path, "panel2"))?;
+        check_positive(&p1, "l_m", self.l1_m)?;
+        if self.panel1.d_m > self.l1_m {
+            return Err(ParamError::DExceedsLength {
+                field: join(&p1, "d_m"),
+                d_m: self.panel1.d_m,
+                l_m: self.l1_m,
+            });
+        }
+        Ok(())
+    }
+}
+
+impl PanelPairInitial {
+    /// Validates the initial panel state (all finite).
+    pub fn validate(&self, path: &str) -> Result<(), ParamError> {
+        let p1 = join(path, "panel1");
+        let p2 = join(path, "panel2");
+        check_finite(&p1, "theta_rad", &[self.theta1_rad])?;
+        check_finite(&p1, "theta_dot_rad_s", &[self.theta1_dot_rad_s])?;
+        check_finite(&p2, "theta_rad", &[self.theta2_rad])?;
+        check_finite(&p2, "theta_dot_rad_s", &[self.theta2_dot_rad_s])
+    }
+}
+
+impl GravityModel {
+    /// Validates the gravity parameters (`path` is e.g. `gravity`).
+    pub fn validate(&self, path: &str) -> Result<(), ParamError> {
+        match *self {
+            GravityModel::None => Ok(()),
+            GravityModel::PointMass { mu_m3_s2 } => check_positive(path, "mu_m3_s2", mu_m3_s2),
+            GravityModel::J2 {
+                mu_m3_s2,
+                j2,
+                r_eq_m,
+            } => {
+                check_positive(path, "mu_m3_s2", mu_m3_s2)?;
+                check_finite(path, "j2", &[j2])?;
+                check_positive(path, "r_eq_m", r_eq_m)
+            }
+        }
+    }
+}
+
+impl WrenchSegment {
+    /// Validates one schedule row (finite force and torque).
+    pub fn validate(&self, path: &str) -> Result<(), ParamError> {
+        check_finite(path, "force_b_n", self.force_b_n.as_slice())?;
+        check_finite(path, "torque_b_nm", self.torque_b_nm.as_slice())
+    }
+}

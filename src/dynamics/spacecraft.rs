@@ -1,0 +1,590 @@
+//! The spacecraft: a rigid hub plus any number of [`StateEffector`]s, propagated by fixed-step RK4.
+//!
+//! Per derivative evaluation the hub sums the effectors' mass properties and back-substitution
+//! contributions, assembles Eqs. 145–150 (with erratum E2: [C] = m_sc[c̃] + [C_contr]) and solves
+//! Eq. 151 by the Schur complement of Eqs. 152–153, using LU factorisations — never explicit
+//! inverses. Gravity is evaluated at the system centre of mass C and applied as a uniform field.
+
+use std::ops::Range;
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::effector::{
+    BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
+};
+use super::params::{GravityModel, HubParams};
+use super::ParamError;
+use crate::attitude::{mrp_rate, mrp_switch, mrp_to_dcm, tilde};
+
+/// The integrated state (also used for its time derivative).
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
+    /// [m] r_B/N in N components (derivative: ṙ = v).
+    pub r_bn_n: Vector3<f64>,
+    /// [m/s] v_B/N in N components (derivative: r̈_B/N in N).
+    pub v_bn_n: Vector3<f64>,
+    /// MRP σ_B/N (derivative: σ̇).
+    pub sigma_bn: Vector3<f64>,
+    /// [rad/s] ω_B/N in B components (derivative: ω̇).
+    pub omega_bn_b: Vector3<f64>,
+    /// Effector states, concatenated in effector order (for a panel pair: θ1, θ̇1, θ2, θ̇2).
+    pub effectors: Vec<f64>,
+}
+
+impl State {
+    fn zeros(n: usize) -> Self {
+        Self {
+            r_bn_n: Vector3::zeros(),
+            v_bn_n: Vector3::zeros(),
+            sigma_bn: Vector3::zeros(),
+            omega_bn_b: Vector3::zeros(),
+            effectors: vec![0.0; n],
+        }
+    }
+
+    /// self = x + h·k, elementwise (no allocation; all lengths are equal by construction).
+    #[inline(always)]
+    fn set_axpy(&mut self, x: &State, h: f64, k: &State) {
+        self.r_bn_n = x.r_bn_n + k.r_bn_n * h;
+        self.v_bn_n = x.v_bn_n + k.v_bn_n * h;
+        self.sigma_bn = x.sigma_bn + k.sigma_bn * h;
+        self.omega_bn_b = x.omega_bn_b + k.omega_bn_b * h;
+        for ((o, xi), ki) in self
+            .effectors
+            .iter_mut()
+            .zip(&x.effectors)
+            .zip(&k.effectors)
+        {
+            *o = xi + h * ki;
+        }
+    }
+}
+
+/// How the initial translational state is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum InitialTranslation {
+    /// Position [m] and velocity [m/s] of point B relative to N, N components.
+    PointB {
+        /// r_B/N.
+        r_bn_n_m: Vector3<f64>,
+        /// v_B/N.
+        v_bn_n_m_s: Vector3<f64>,
+    },
+    /// Position [m] and velocity [m/s] of the system centre of mass C relative to N, N components.
+    CenterOfMass {
+        /// r_C/N.
+        r_cn_n_m: Vector3<f64>,
+        /// v_C/N.
+        v_cn_n_m_s: Vector3<f64>,
+    },
+}
+
+/// The hub's initial state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HubInitial {
+    /// Translational initial condition.
+    pub translation: InitialTranslation,
+    /// MRP σ_B/N.
+    pub sigma_bn: Vector3<f64>,
+    /// [rad/s] ω_B/N in B components.
+    pub omega_bn_b_rad_s: Vector3<f64>,
+}
+
+/// Conserved quantities (Basilisk's totOrbEnergy, totRotEnergy, totOrbAngMomPntN_N and
+/// totRotAngMomPntC_N), computed from the state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Conserved {
+    /// [J] orbital energy of the centre of mass: ½ m_sc |v_C/N|² + m_sc U(r_C/N).
+    pub orb_energy_j: f64,
+    /// [J] rotational kinetic energy about C plus spring energy.
+    pub rot_energy_j: f64,
+    /// [kg·m²/s] orbital angular momentum of C about N, m_sc r_C/N × v_C/N, N components.
+    pub orb_ang_mom_n: Vector3<f64>,
+    /// [kg·m²/s] angular momentum about C, N components.
+    pub rot_ang_mom_c_n: Vector3<f64>,
+}
+
+/// Accelerations of the hub at one state, from one derivative evaluation.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HubOutputs {
+    /// [m/s²] non-gravitational acceleration of point B, B components.
+    pub nongrav_accel_bn_b: Vector3<f64>,
+    /// [rad/s²] ω̇_B/N, B components.
+    pub omega_dot_bn_b: Vector3<f64>,
+    /// [m/s²] gravitational acceleration at the system CoM, N components.
+    pub gravity_n: Vector3<f64>,
+}
+
+/// 3×3 LU factorisation with partial pivoting, on the stack, infallible.
+///
+/// Callers only factor matrices that are non-singular by construction (the hub mass matrix
+/// blocks of a validated spacecraft); a zero pivot would yield non-finite results, not a panic.
+#[derive(Debug, Clone, Copy)]
+struct Lu3 {
+    lu: Matrix3<f64>,
+    perm: [usize; 3],
+}
+
+impl Lu3 {
+    #[inline(always)]
+    fn factor(m: &Matrix3<f64>) -> Self {
+        let mut lu = *m;
+        let mut perm = [0usize, 1, 2];
+        for k in 0..3 {
+            let mut p = k;
+            for i in (k + 1)..3 {
+                if lu[(i, k)].abs() > lu[(p, k)].abs() {
+                    p = i;
+                }
+            }
+            if p != k {
+                lu.swap_rows(p, k);
+                perm.swap(p, k);
+            }
+            let inv_pivot = 1.0 / lu[(k, k)];
+            for i in (k + 1)..3 {
+                let f = lu[(i, k)] * inv_pivot;
+                lu[(i, k)] = f;
+                for j in (k + 1)..3 {
+                    lu[(i, j)] -= f * lu[(k, j)];
+                }
+            }
+        }
+        Self { lu, perm }
+    }
+
+    #[inline(always)]
+    fn solve(&self, b: &Vector3<f64>) -> Vector3<f64> {
+        let lu = &self.lu;
+        let y0 = b[self.perm[0]];
+        let y1 = b[self.perm[1]] - lu[(1, 0)] * y0;
+        let y2 = b[self.perm[2]] - lu[(2, 0)] * y0 - lu[(2, 1)] * y1;
+        let x2 = y2 / lu[(2, 2)];
+        let x1 = (y1 - lu[(1, 2)] * x2) / lu[(1, 1)];
+        let x0 = (y0 - lu[(0, 1)] * x1 - lu[(0, 2)] * x2) / lu[(0, 0)];
+        Vector3::new(x0, x1, x2)
+    }
+
+    #[inline(always)]
+    fn solve_matrix(&self, b: &Matrix3<f64>) -> Matrix3<f64> {
+        Matrix3::from_columns(&[
+            self.solve(&b.column(0).into_owned()),
+            self.solve(&b.column(1).into_owned()),
+            self.solve(&b.column(2).into_owned()),
+        ])
+    }
+}
+
+/// Gravitational acceleration [m/s²] at `r_n` (N components) for `model`.
+#[inline]
+pub fn gravity_accel_n(model: &GravityModel, r_n: &Vector3<f64>) -> Vector3<f64> {
+    match *model {
+        GravityModel::None => Vector3::zeros(),
+        GravityModel::PointMass { mu_m3_s2 } => {
+            let r2 = r_n.norm_squared();
+            -r_n * (mu_m3_s2 / (r2 * r2.sqrt()))
+        }
+        GravityModel::J2 {
+            mu_m3_s2,
+            j2,
+            r_eq_m,
+        } => {
+            let r2 = r_n.norm_squared();
+            let r = r2.sqrt();
+            let point = -r_n * (mu_m3_s2 / (r2 * r));
+            // a_J2 = −(3/2) μ J2 R² / r⁵ [ r (1 − 5 z²/r²) + 2 z ẑ ]
+            let z2_r2 = r_n.z * r_n.z / r2;
+            let f = -1.5 * mu_m3_s2 * j2 * r_eq_m * r_eq_m / (r2 * r2 * r);
+            let mut a = r_n * (f * (1.0 - 5.0 * z2_r2));
+            a.z += f * 2.0 * r_n.z;
+            point + a
+        }
+    }
+}
+
+/// Gravitational potential per unit mass [J/kg] at `r_n`, consistent with [`gravity_accel_n`].
+pub fn gravity_potential(model: &GravityModel, r_n: &Vector3<f64>) -> f64 {
+    match *model {
+        GravityModel::None => 0.0,
+        GravityModel::PointMass { mu_m3_s2 } => -mu_m3_s2 / r_n.norm(),
+        GravityModel::J2 {
+            mu_m3_s2,
+            j2,
+            r_eq_m,
+        } => {
+            let r = r_n.norm();
+            let z2_r2 = r_n.z * r_n.z / (r * r);
+            -mu_m3_s2 / r
+                + 0.5 * mu_m3_s2 * j2 * r_eq_m * r_eq_m / (r * r * r) * (3.0 * z2_r2 - 1.0)
+        }
+    }
+}
+
+/// RK4 stage buffers, sized once at construction.
+#[derive(Debug, Clone)]
+struct Rk4Workspace {
+    k1: State,
+    k2: State,
+    k3: State,
+    k4: State,
+    stage: State,
+}
+
+/// The equations of motion: the hub, its effectors, gravity and the applied wrench. Split from
+/// the integrator state so RK4 can evaluate it while borrowing its stage buffers.
+#[derive(Debug)]
+struct EquationsOfMotion {
+    hub: HubParams,
+    /// Hub mass properties about B (constant): m r_Bc/B and [I_hub,B] = [I_hub,Bc] + m[r̃][r̃]ᵀ.
+    hub_first_moment_b: Vector3<f64>,
+    hub_inertia_pnt_b_b: Matrix3<f64>,
+    gravity: GravityModel,
+    effectors: Vec<Box<dyn StateEffector>>,
+    ranges: Vec<Range<usize>>,
+    force_b_n: Vector3<f64>,
+    torque_b_nm: Vector3<f64>,
+}
+
+/// A rigid hub with appended state effectors, integrated with fixed-step RK4.
+#[derive(Debug)]
+pub struct Spacecraft {
+    eom: EquationsOfMotion,
+    state: State,
+    t_sim_ns: u64,
+    step_ns: u64,
+    ws: Rk4Workspace,
+}
+
+impl EquationsOfMotion {
+    /// Evaluates the state derivative `dx` at state `x` with the current wrench and returns the hub
+    /// accelerations (Eqs. 145–153 with the effector passes around them).
+    #[inline(always)]
+    fn eval(&mut self, x: &State, dx: &mut State) -> HubOutputs {
+        let omega = x.omega_bn_b;
+        // Pass 1: mass properties (Eqs. 3, 4, 19): m_sc, c, c′, [I_sc,B].
+        let mut mp = EffectorMassProps {
+            mass_kg: self.hub.mass_kg,
+            first_moment_b_kg_m: self.hub_first_moment_b,
+            inertia_pnt_b_b_kg_m2: self.hub_inertia_pnt_b_b,
+            ..EffectorMassProps::default()
+        };
+        for (e, r) in self.effectors.iter_mut().zip(&self.ranges) {
+            e.update_mass_props(&x.effectors[r.clone()], &mut mp);
+        }
+        let m_sc = mp.mass_kg;
+        let c_b = mp.first_moment_b_kg_m / m_sc;
+        let c_prime_b = mp.first_moment_prime_b_kg_m_s / m_sc;
+
+        // Pass 2: effector contributions (Eqs. 139–144).
+        let kin = HubKinematics { omega_bn_b: omega };
+        let mut contr = BackSubContributions::default();
+        for (e, r) in self.effectors.iter_mut().zip(&self.ranges) {
+            e.update_contributions(&x.effectors[r.clone()], &kin, &mut contr);
+        }
+
+        // Eqs. 145–150, with erratum E2 in Eq. 148.
+        let c_tilde = tilde(&c_b);
+        let matrix_a = Matrix3::from_diagonal_element(m_sc) + contr.matrix_a;
+        let matrix_b = -c_tilde * m_sc + contr.matrix_b;
+        let matrix_c = c_tilde * m_sc + contr.matrix_c;
+        let matrix_d = mp.inertia_pnt_b_b_kg_m2 + contr.matrix_d;
+        let v_trans = self.force_b_n
+            - omega.cross(&c_prime_b) * (2.0 * m_sc)
+            - omega.cross(&omega.cross(&c_b)) * m_sc
+            + contr.vec_trans;
+        // The hub is rigid ([I′_hub] = 0); each effector's −[I′]ω is in its vec_rot.
+        let v_rot =
+            -omega.cross(&(mp.inertia_pnt_b_b_kg_m2 * omega)) + self.torque_b_nm + contr.vec_rot;
+
+        // Eqs. 152–153 by factorisation: A = LU; X = A⁻¹B and y = A⁻¹v_trans by solves;
+        // S = D − C X factored; ω̇ = S⁻¹(v_rot − C y); r̈ = y − X ω̇.
+        let lu_a = Lu3::factor(&matrix_a);
+        let a_inv_b = lu_a.solve_matrix(&matrix_b);
+        let a_inv_vt = lu_a.solve(&v_trans);
+        let lu_s = Lu3::factor(&(matrix_d - matrix_c * a_inv_b));
+        let omega_dot = lu_s.solve(&(v_rot - matrix_c * a_inv_vt));
+        let accel_b = a_inv_vt - a_inv_b * omega_dot;
+
+        // Pass 3: effector back-substitution (Eqs. 131–132).
+        let hub_accel = HubAccel {
+            nongrav_accel_bn_b: accel_b,
+            omega_dot_bn_b: omega_dot,
+        };
+        for (e, r) in self.effectors.iter_mut().zip(&self.ranges) {
+            e.compute_derivatives(
+                &x.effectors[r.clone()],
+                &hub_accel,
+                &mut dx.effectors[r.clone()],
+            );
+        }
+
+        // Uniform gravity evaluated at the system CoM: r_C/N = r_B/N + [NB] c.
+        let dcm_nb = mrp_to_dcm(&x.sigma_bn).transpose();
+        let gravity_n = gravity_accel_n(&self.gravity, &(x.r_bn_n + dcm_nb * c_b));
+        dx.r_bn_n = x.v_bn_n;
+        dx.v_bn_n = dcm_nb * accel_b + gravity_n;
+        dx.sigma_bn = mrp_rate(&x.sigma_bn, &omega);
+        dx.omega_bn_b = omega_dot;
+        HubOutputs {
+            nongrav_accel_bn_b: accel_b,
+            omega_dot_bn_b: omega_dot,
+            gravity_n,
+        }
+    }
+}
+
+impl Spacecraft {
+    /// Builds the spacecraft after validating every parameter; the effectors validate their own
+    /// at their construction. Fails with an error naming the field.
+    pub fn new(
+        hub: HubParams,
+        gravity: GravityModel,
+        effectors: Vec<Box<dyn StateEffector>>,
+        initial: HubInitial,
+        step_ns: u64,
+    ) -> Result<Self, ParamError> {
+        hub.validate("hub")?;
+        gravity.validate("gravity")?;
+        super::params::check_finite("initial", "sigma_bn", initial.sigma_bn.as_slice())?;
+        super::params::check_finite(
+            "initial",
+            "omega_bn_b_rad_s",
+            initial.omega_bn_b_rad_s.as_slice(),
+        )?;
+        match initial.translation {
+            InitialTranslation::PointB {
+                r_bn_n_m,
+                v_bn_n_m_s,
+            } => {
+                super::params::check_finite("initial", "r_bn_n_m", r_bn_n_m.as_slice())?;
+                super::params::check_finite("initial", "v_bn_n_m_s", v_bn_n_m_s.as_slice())?;
+            }
+            InitialTranslation::CenterOfMass {
+                r_cn_n_m,
+                v_cn_n_m_s,
+            } => {
+                super::params::check_finite("initial", "r_cn_n_m", r_cn_n_m.as_slice())?;
+                super::params::check_finite("initial", "v_cn_n_m_s", v_cn_n_m_s.as_slice())?;
+            }
+        }
+        if step_ns == 0 {
+            return Err(ParamError::NotPositive {
+                field: "simulation.step_s".into(),
+                value: 0.0,
+            });
+        }
+        let mut ranges = Vec::with_capacity(effectors.len());
+        let mut n = 0;
+        for e in &effectors {
+            ranges.push(n..n + e.state_len());
+            n += e.state_len();
+        }
+        let hub_first_moment_b = hub.r_bcb_b_m * hub.mass_kg;
+        let r = hub.r_bcb_b_m;
+        let hub_inertia_pnt_b_b = hub.inertia_bc_b_kg_m2
+            + (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose()) * hub.mass_kg;
+        let zero = State::zeros(n);
+        let mut sc = Self {
+            eom: EquationsOfMotion {
+                hub,
+                hub_first_moment_b,
+                hub_inertia_pnt_b_b,
+                gravity,
+                effectors,
+                ranges,
+                force_b_n: Vector3::zeros(),
+                torque_b_nm: Vector3::zeros(),
+            },
+            state: zero.clone(),
+            t_sim_ns: 0,
+            step_ns,
+            ws: Rk4Workspace {
+                k1: zero.clone(),
+                k2: zero.clone(),
+                k3: zero.clone(),
+                k4: zero.clone(),
+                stage: zero,
+            },
+        };
+        for (e, r) in sc.eom.effectors.iter().zip(&sc.eom.ranges) {
+            e.initial_state(&mut sc.state.effectors[r.clone()]);
+        }
+        sc.state.sigma_bn = initial.sigma_bn;
+        mrp_switch(&mut sc.state.sigma_bn);
+        sc.state.omega_bn_b = initial.omega_bn_b_rad_s;
+        match initial.translation {
+            InitialTranslation::PointB {
+                r_bn_n_m,
+                v_bn_n_m_s,
+            } => {
+                sc.state.r_bn_n = r_bn_n_m;
+                sc.state.v_bn_n = v_bn_n_m_s;
+            }
+            InitialTranslation::CenterOfMass {
+                r_cn_n_m,
+                v_cn_n_m_s,
+            } => {
+                // r_B/N = r_C/N − [NB] c;  v_B/N = v_C/N − [NB] ċ, ċ = c′ + ω × c (relative to B).
+                let em = sc.energy_momentum_sum(&sc.state);
+                let c_b = em.first_moment_b_kg_m / em.mass_kg;
+                let c_dot_b = em.lin_mom_rel_b_kg_m_s / em.mass_kg;
+                let dcm_nb = mrp_to_dcm(&sc.state.sigma_bn).transpose();
+                sc.state.r_bn_n = r_cn_n_m - dcm_nb * c_b;
+                sc.state.v_bn_n = v_cn_n_m_s - dcm_nb * c_dot_b;
+            }
+        }
+        Ok(sc)
+    }
+
+    /// The current state.
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    /// Replaces the state (e.g. to restore a snapshot). Lengths must match [`Self::state`]'s.
+    pub fn set_state(&mut self, state: &State) -> Result<(), ParamError> {
+        if state.effectors.len() != self.state.effectors.len() {
+            return Err(ParamError::StateLength {
+                expected: self.state.effectors.len(),
+                found: state.effectors.len(),
+            });
+        }
+        self.state.clone_from(state);
+        Ok(())
+    }
+
+    /// [ns] simulation time.
+    pub fn t_sim_ns(&self) -> u64 {
+        self.t_sim_ns
+    }
+
+    /// [ns] RK4 step.
+    pub fn step_ns(&self) -> u64 {
+        self.step_ns
+    }
+
+    /// The effectors, in state order.
+    pub fn effectors(&self) -> &[Box<dyn StateEffector>] {
+        &self.eom.effectors
+    }
+
+    /// Range of each effector's states within [`State::effectors`].
+    pub fn effector_ranges(&self) -> &[Range<usize>] {
+        &self.eom.ranges
+    }
+
+    /// The hub parameters.
+    pub fn hub(&self) -> &HubParams {
+        &self.eom.hub
+    }
+
+    /// The gravity model.
+    pub fn gravity(&self) -> &GravityModel {
+        &self.eom.gravity
+    }
+
+    /// Sets the external force [N] and torque [N·m] on the hub (B components, force applied at B),
+    /// held constant until the next call.
+    pub fn set_wrench(&mut self, force_b_n: Vector3<f64>, torque_b_nm: Vector3<f64>) {
+        self.eom.force_b_n = force_b_n;
+        self.eom.torque_b_nm = torque_b_nm;
+    }
+
+    /// The external (force [N], torque [N·m]) currently applied, B components.
+    pub fn wrench(&self) -> (Vector3<f64>, Vector3<f64>) {
+        (self.eom.force_b_n, self.eom.torque_b_nm)
+    }
+
+    /// Evaluates the state derivative `dx` at state `x` with the current wrench, and returns the
+    /// hub accelerations. This is the equation-of-motion function RK4 integrates: it allocates
+    /// nothing and cannot fail.
+    pub fn derivatives(&mut self, x: &State, dx: &mut State) -> HubOutputs {
+        self.eom.eval(x, dx)
+    }
+
+    /// Advances one RK4 step of [`Self::step_ns`] with the current wrench, then switches σ to its
+    /// shadow set if |σ| > 1. Allocates nothing.
+    pub fn step(&mut self) {
+        let h = self.step_ns as f64 * 1e-9;
+        let Self { eom, state, ws, .. } = self;
+        eom.eval(state, &mut ws.k1);
+        ws.stage.set_axpy(state, 0.5 * h, &ws.k1);
+        eom.eval(&ws.stage, &mut ws.k2);
+        ws.stage.set_axpy(state, 0.5 * h, &ws.k2);
+        eom.eval(&ws.stage, &mut ws.k3);
+        ws.stage.set_axpy(state, h, &ws.k3);
+        eom.eval(&ws.stage, &mut ws.k4);
+        let h6 = h / 6.0;
+        let (k1, k2, k3, k4) = (&ws.k1, &ws.k2, &ws.k3, &ws.k4);
+        state.r_bn_n += (k1.r_bn_n + (k2.r_bn_n + k3.r_bn_n) * 2.0 + k4.r_bn_n) * h6;
+        state.v_bn_n += (k1.v_bn_n + (k2.v_bn_n + k3.v_bn_n) * 2.0 + k4.v_bn_n) * h6;
+        state.sigma_bn += (k1.sigma_bn + (k2.sigma_bn + k3.sigma_bn) * 2.0 + k4.sigma_bn) * h6;
+        state.omega_bn_b +=
+            (k1.omega_bn_b + (k2.omega_bn_b + k3.omega_bn_b) * 2.0 + k4.omega_bn_b) * h6;
+        for i in 0..state.effectors.len() {
+            state.effectors[i] += h6
+                * (k1.effectors[i] + 2.0 * (k2.effectors[i] + k3.effectors[i]) + k4.effectors[i]);
+        }
+        mrp_switch(&mut state.sigma_bn);
+        self.t_sim_ns += self.step_ns;
+    }
+
+    /// Hub accelerations at the current state with the current wrench (one derivative evaluation;
+    /// the result is not cached, so call it once per output).
+    pub fn hub_outputs(&mut self) -> HubOutputs {
+        self.eom.eval(&self.state, &mut self.ws.stage)
+    }
+
+    fn energy_momentum_sum(&self, x: &State) -> EnergyMomentum {
+        let omega = x.omega_bn_b;
+        let mut em = EnergyMomentum::rigid_body(
+            self.eom.hub.mass_kg,
+            &self.eom.hub.r_bcb_b_m,
+            &Vector3::zeros(),
+            &self.eom.hub.inertia_bc_b_kg_m2,
+            &omega,
+            &omega,
+        );
+        for (e, r) in self.eom.effectors.iter().zip(&self.eom.ranges) {
+            em += e.energy_momentum(&x.effectors[r.clone()], &omega);
+        }
+        em
+    }
+
+    /// Conserved quantities at state `x`, in N components.
+    pub fn conserved_at(&self, x: &State) -> Conserved {
+        let em = self.energy_momentum_sum(x);
+        let m = em.mass_kg;
+        let c_b = em.first_moment_b_kg_m / m;
+        let c_dot_b = em.lin_mom_rel_b_kg_m_s / m;
+        let dcm_nb = mrp_to_dcm(&x.sigma_bn).transpose();
+        // Shift from B to C: H_C = H_B − c × p, T_C = T_B − |p|²/(2m), with p = m ċ.
+        let h_c_b = em.ang_mom_pnt_b_b_kg_m2_s - c_b.cross(&em.lin_mom_rel_b_kg_m_s);
+        let t_c = em.kinetic_rel_b_j - em.lin_mom_rel_b_kg_m_s.norm_squared() / (2.0 * m);
+        let r_cn_n = x.r_bn_n + dcm_nb * c_b;
+        let v_cn_n = x.v_bn_n + dcm_nb * c_dot_b;
+        Conserved {
+            orb_energy_j: 0.5 * m * v_cn_n.norm_squared()
+                + m * gravity_potential(&self.eom.gravity, &r_cn_n),
+            rot_energy_j: t_c + em.potential_j,
+            orb_ang_mom_n: r_cn_n.cross(&v_cn_n) * m,
+            rot_ang_mom_c_n: dcm_nb * h_c_b,
+        }
+    }
+
+    /// Conserved quantities at the current state.
+    pub fn conserved(&self) -> Conserved {
+        self.conserved_at(&self.state)
+    }
+
+    /// [kg] total mass, [m] centre of mass relative to B (B components), and [m/s] its velocity
+    /// relative to B's translation (B components) at the current state.
+    pub fn center_of_mass(&self) -> (f64, Vector3<f64>, Vector3<f64>) {
+        let em = self.energy_momentum_sum(&self.state);
+        (
+            em.mass_kg,
+            em.first_moment_b_kg_m / em.mass_kg,
+            em.lin_mom_rel_b_kg_m_s / em.mass_kg,
+        )
+    }
+}

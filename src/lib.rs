@@ -1,0 +1,10 @@
+//! flexdyn: a real-time flight-software-in-the-loop dynamics server.
+//!
+//! # Layout
+//! - [`attitude`]: MRP, DCM and quaternion kernels.
+//! - [`dynamics`]: the physics core — rigid hub + dual-hinged panel pairs by back-substitution.
+
+#![warn(missing_docs)]
+
+pub mod attitude;
+pub mod dynamics;

@@ -1,0 +1,184 @@
+//! Shared fixtures for the physics tests: the reference spacecraft of `scenarios/reference.toml`,
+//! built in code so each test can vary one thing (gravity, damping, pair count, hub mass).
+#![allow(dead_code)]
+
+use flexdyn::dynamics::{
+    GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
+    PanelPairParams, PanelParams, Spacecraft, StateEffector,
+};
+use nalgebra::{Matrix3, Vector3};
+
+/// μ of the Earth [m³/s²], as in the reference config.
+pub const MU_EARTH: f64 = 3.986004415e14;
+
+pub fn reference_hub() -> HubParams {
+    HubParams {
+        mass_kg: 750.0,
+        inertia_bc_b_kg_m2: Matrix3::from_diagonal(&Vector3::new(900.0, 800.0, 600.0)),
+        r_bcb_b_m: Vector3::new(0.0, 0.0, 1.0),
+    }
+}
+
+pub fn reference_panel(c_n_m_s_rad: f64) -> PanelParams {
+    PanelParams {
+        mass_kg: 50.0,
+        inertia_s_kg_m2: Vector3::new(50.0, 25.0, 25.0),
+        d_m: 0.75,
+        k_n_m_rad: 100.0,
+        c_n_m_s_rad,
+    }
+}
+
+pub fn pair_params(
+    name: &str,
+    r_h1b_b_m: Vector3<f64>,
+    dcm_h1b: Matrix3<f64>,
+    c: f64,
+) -> PanelPairParams {
+    PanelPairParams {
+        name: name.into(),
+        r_h1b_b_m,
+        dcm_h1b,
+        theta_h2s1_rad: 0.0,
+        l1_m: 1.5,
+        panel1: reference_panel(c),
+        panel2: reference_panel(c),
+        motor_torque_nm: [0.0; 2],
+    }
+}
+
+/// The two wings of the reference spacecraft with their initial deflections.
+pub fn reference_pairs(c: f64) -> Vec<(PanelPairParams, PanelPairInitial)> {
+    vec![
+        (
+            pair_params(
+                "wing_px",
+                Vector3::new(0.5, 0.0, 1.0),
+                Matrix3::from_diagonal(&Vector3::new(-1.0, -1.0, 1.0)),
+                c,
+            ),
+            PanelPairInitial {
+                theta1_rad: 5f64.to_radians(),
+                theta1_dot_rad_s: 0.0,
+                theta2_rad: -3f64.to_radians(),
+                theta2_dot_rad_s: 0.0,
+            },
+        ),
+        (
+            pair_params(
+                "wing_mx",
+                Vector3::new(-0.5, 0.0, 1.0),
+                Matrix3::identity(),
+                c,
+            ),
+            PanelPairInitial {
+                theta1_rad: -2f64.to_radians(),
+                theta1_dot_rad_s: 0.0,
+                theta2_rad: 4f64.to_radians(),
+                theta2_dot_rad_s: 0.0,
+            },
+        ),
+    ]
+}
+
+/// `n` pairs spread evenly around the hub's b3 axis (the benchmark and scaling tests use it),
+/// with the reference wing geometry and small distinct deflections.
+pub fn ring_pairs(n: usize, c: f64) -> Vec<(PanelPairParams, PanelPairInitial)> {
+    (0..n)
+        .map(|k| {
+            let a = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
+            let (s, co) = a.sin_cos();
+            // H1 axes: ĥ1 points inward (the panel extends along −ĥ1, outward), ĥ3 = b̂3.
+            let dcm_h1b = Matrix3::new(-co, -s, 0.0, s, -co, 0.0, 0.0, 0.0, 1.0);
+            let params = pair_params(
+                &format!("wing{k}"),
+                Vector3::new(0.5 * co, 0.5 * s, 1.0),
+                dcm_h1b,
+                c,
+            );
+            let init = PanelPairInitial {
+                theta1_rad: 0.05 * (1.0 + k as f64).sin(),
+                theta1_dot_rad_s: 0.0,
+                theta2_rad: -0.04 * (2.0 + k as f64).cos(),
+                theta2_dot_rad_s: 0.0,
+            };
+            (params, init)
+        })
+        .collect()
+}
+
+pub fn reference_initial() -> HubInitial {
+    HubInitial {
+        translation: InitialTranslation::CenterOfMass {
+            r_cn_n_m: Vector3::new(-4020338.69, 7490566.74, 5248299.04),
+            v_cn_n_m_s: Vector3::new(-5199.77710904, -3436.68156331, 1041.57627160),
+        },
+        sigma_bn: Vector3::zeros(),
+        omega_bn_b_rad_s: Vector3::new(0.05, -0.05, 0.05),
+    }
+}
+
+pub fn build(
+    hub: HubParams,
+    gravity: GravityModel,
+    pairs: Vec<(PanelPairParams, PanelPairInitial)>,
+    initial: HubInitial,
+    step_ns: u64,
+) -> Spacecraft {
+    let effectors: Vec<Box<dyn StateEffector>> = pairs
+        .into_iter()
+        .enumerate()
+        .map(|(i, (p, init))| {
+            Box::new(PanelPair::new(p, init, &format!("panel_pairs[{i}]")).expect("valid pair"))
+                as Box<dyn StateEffector>
+        })
+        .collect();
+    Spacecraft::new(hub, gravity, effectors, initial, step_ns).expect("valid spacecraft")
+}
+
+/// The reference spacecraft with the given gravity model and hinge damping, 1 ms step.
+pub fn reference(gravity: GravityModel, c: f64) -> Spacecraft {
+    build(
+        reference_hub(),
+        gravity,
+        reference_pairs(c),
+        reference_initial(),
+        1_000_000,
+    )
+}
+
+/// Largest relative drift max_t |x(t) − x(0)| / |x(0)| of scalars and vectors.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct Drift {
+    pub rot_energy: f64,
+    pub rot_ang_mom: f64,
+    pub orb_energy: f64,
+    pub orb_ang_mom: f64,
+}
+
+/// Steps `n` times, tracking the relative drift of every conserved quantity.
+pub fn run_drift(sc: &mut Spacecraft, n: usize) -> Drift {
+    let c0 = sc.conserved();
+    let mut d = Drift::default();
+    for _ in 0..n {
+        sc.step();
+        let c = sc.conserved();
+        d.rot_energy = d
+            .rot_energy
+            .max(((c.rot_energy_j - c0.rot_energy_j) / c0.rot_energy_j).abs());
+        d.rot_ang_mom = d
+            .rot_ang_mom
+            .max((c.rot_ang_mom_c_n - c0.rot_ang_mom_c_n).norm() / c0.rot_ang_mom_c_n.norm());
+        if c0.orb_energy_j != 0.0 {
+            d.orb_energy = d
+                .orb_energy
+                .max(((c.orb_energy_j - c0.orb_energy_j) / c0.orb_energy_j).abs());
+        }
+        if c0.orb_ang_mom_n.norm() != 0.0 {
+            d.orb_ang_mom = d
+                .orb_ang_mom
+                .max((c.orb_ang_mom_n - c0.orb_ang_mom_n).norm() / c0.orb_ang_mom_n.norm());
+        }
+    }
+    d
+}
