@@ -7,4 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod attitude;
+pub mod cli;
+pub mod config;
 pub mod dynamics;
+pub mod sim;

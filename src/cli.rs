@@ -1,0 +1,373 @@
+//! The offline subcommands of the `flexdyn` binary: `simulate`, `check-config` and
+//! `print-default-config`. `src/main.rs` only parses arguments and reports errors; the work is
+//! here so tests can call it.
+
+use std::fmt::{self, Write as _};
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::config::{whole_ns, ConfigError, SimConfig, DEFAULT_CONFIG_TOML};
+use crate::dynamics::GravityModel;
+use crate::sim::{Simulation, Snapshot};
+
+/// Arguments of `flexdyn simulate`.
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+pub struct SimulateArgs {
+    /// Configuration file (TOML). Default: the embedded reference spacecraft
+    /// (`flexdyn print-default-config`).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Simulated duration in seconds; must be a whole number of RK4 steps.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 10.0,
+        allow_negative_numbers = true
+    )]
+    pub duration_s: f64,
+    /// Interval between CSV rows in seconds; must be a whole number of RK4 steps. A row is also written
+    /// at t = 0.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 0.01,
+        allow_negative_numbers = true
+    )]
+    pub log_every_s: f64,
+    /// CSV output file; `-` (or no option) writes to standard output.
+    #[arg(long, short, value_name = "FILE.csv")]
+    pub output: Option<PathBuf>,
+}
+
+impl Default for SimulateArgs {
+    fn default() -> Self {
+        Self {
+            config: None,
+            duration_s: 10.0,
+            log_every_s: 0.01,
+            output: None,
+        }
+    }
+}
+
+/// An error of an offline subcommand.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CliError {
+    /// The configuration is invalid or unreadable.
+    #[error("{}", config_message(file.as_deref(), source))]
+    Config {
+        /// The file, or `None` for the embedded default.
+        file: Option<PathBuf>,
+        /// The error; it names the field.
+        #[source]
+        source: ConfigError,
+    },
+    /// A command-line value is invalid.
+    #[error("{flag}: {problem}")]
+    Arg {
+        /// The option, e.g. `--log-every-s`.
+        flag: &'static str,
+        /// What is wrong.
+        problem: String,
+    },
+    /// Writing the output failed.
+    #[error("cannot write {target}: {source}")]
+    Output {
+        /// Where the output was going.
+        target: String,
+        /// The I/O error.
+        #[source]
+        source: io::Error,
+    },
+}
+
+fn config_message(file: Option<&Path>, e: &ConfigError) -> String {
+    match (file, e) {
+        (Some(f), e) if !matches!(e, ConfigError::Io { .. }) => format!("{}: {e}", f.display()),
+        _ => e.to_string(),
+    }
+}
+
+impl CliError {
+    /// The process exit code for this error: 2 for invalid input (configuration or arguments),
+    /// 1 for a failure while running (output not writable).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Config { .. } | CliError::Arg { .. } => 2,
+            CliError::Output { .. } => 1,
+        }
+    }
+}
+
+/// What `simulate` did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimulateReport {
+    /// RK4 steps taken.
+    pub steps: u64,
+    /// CSV data rows written (excluding the header).
+    pub rows: u64,
+    /// \[s\] wall time of the loop that steps and writes the rows (excludes configuration parsing,
+    /// spacecraft construction and the final flush).
+    pub wall_s: f64,
+}
+
+impl SimulateReport {
+    /// Steps per wall-clock second.
+    pub fn steps_per_s(&self) -> f64 {
+        if self.wall_s > 0.0 {
+            self.steps as f64 / self.wall_s
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The one-line summary printed to stderr: `steps=<n> wall_s=<x> steps_per_s=<y>`.
+impl fmt::Display for SimulateReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "steps={} wall_s={:.6} steps_per_s={:.1}",
+            self.steps,
+            self.wall_s,
+            self.steps_per_s()
+        )
+    }
+}
+
+/// Loads `path`, or the embedded default if `None`.
+pub fn load_config(path: Option<&Path>) -> Result<SimConfig, CliError> {
+    match path {
+        Some(p) => SimConfig::from_file(p).map_err(|source| CliError::Config {
+            file: Some(p.to_path_buf()),
+            source,
+        }),
+        None => SimConfig::from_toml_str(DEFAULT_CONFIG_TOML)
+            .map_err(|source| CliError::Config { file: None, source }),
+    }
+}
+
+/// A duration option as a whole number of steps.
+fn whole_steps(
+    flag: &'static str,
+    seconds: f64,
+    step_ns: u64,
+    allow_zero: bool,
+) -> Result<u64, CliError> {
+    let step_s = step_ns as f64 * 1e-9;
+    if !seconds.is_finite() {
+        return Err(CliError::Arg {
+            flag,
+            problem: format!("must be finite (got {seconds})"),
+        });
+    }
+    if seconds < 0.0 || (!allow_zero && seconds == 0.0) {
+        let bound = if allow_zero { ">= 0" } else { "> 0" };
+        return Err(CliError::Arg {
+            flag,
+            problem: format!("must be {bound} (got {seconds})"),
+        });
+    }
+    match whole_ns(seconds) {
+        Some(ns) if ns % step_ns == 0 => Ok(ns / step_ns),
+        _ => Err(CliError::Arg {
+            flag,
+            problem: format!(
+                "{seconds} s is not a whole number of RK4 steps (step = {step_s} s = {step_ns} ns)"
+            ),
+        }),
+    }
+}
+
+/// The CSV header for `n_pairs` panel pairs (no trailing newline).
+pub fn csv_header(n_pairs: usize) -> String {
+    let mut h = String::from("t_s");
+    for base in ["sigma_bn", "omega_bn_b", "r_bn_n", "v_bn_n"] {
+        for i in 1..=3 {
+            let _ = write!(h, ",{base}_{i}");
+        }
+    }
+    for k in 1..=n_pairs {
+        for col in ["theta1", "theta1_dot", "theta2", "theta2_dot"] {
+            let _ = write!(h, ",pair{k}_{col}");
+        }
+    }
+    h.push_str(",orb_energy_j,rot_energy_j");
+    for base in ["orb_ang_mom_n", "rot_ang_mom_c_n"] {
+        for i in 1..=3 {
+            let _ = write!(h, ",{base}_{i}");
+        }
+    }
+    h
+}
+
+/// Appends one CSV row for `s` to `row` (cleared first; no trailing newline). Floats have 17
+/// significant digits (`{:.16e}`), so they round-trip exactly.
+pub fn csv_row(s: &Snapshot, row: &mut String) {
+    row.clear();
+    let mut push = |v: f64| {
+        if !row.is_empty() {
+            row.push(',');
+        }
+        let _ = write!(row, "{v:.16e}");
+    };
+    push(s.t_s());
+    for v in [&s.sigma_bn, &s.omega_bn_b, &s.r_bn_n, &s.v_bn_n] {
+        v.iter().for_each(|x| push(*x));
+    }
+    for p in &s.panels {
+        p.iter().for_each(|x| push(*x));
+    }
+    push(s.conserved.orb_energy_j);
+    push(s.conserved.rot_energy_j);
+    s.conserved.orb_ang_mom_n.iter().for_each(|x| push(*x));
+    s.conserved.rot_ang_mom_c_n.iter().for_each(|x| push(*x));
+}
+
+/// Simulates `cfg` for `duration_s`, writing a CSV row at t = 0 and every `log_every_s` to
+/// `out` (through a `BufWriter`). `target` names the output in errors.
+pub fn simulate_to<W: Write>(
+    cfg: &SimConfig,
+    duration_s: f64,
+    log_every_s: f64,
+    out: W,
+    target: &str,
+) -> Result<SimulateReport, CliError> {
+    let total_steps = whole_steps("--duration-s", duration_s, cfg.step_ns, true)?;
+    let log_steps = whole_steps("--log-every-s", log_every_s, cfg.step_ns, false)?;
+    let mut sim = Simulation::new(cfg).map_err(|source| CliError::Config { file: None, source })?;
+    let io_err = |source| CliError::Output {
+        target: target.to_string(),
+        source,
+    };
+
+    let mut out = BufWriter::new(out);
+    let mut row = csv_header(sim.n_pairs());
+    row.push('\n');
+    out.write_all(row.as_bytes()).map_err(io_err)?;
+
+    let mut snap = Snapshot::with_capacity(sim.n_pairs());
+    let n_logged = total_steps / log_steps;
+    let start = Instant::now();
+    for k in 0..=n_logged {
+        if k > 0 {
+            sim.step_n(log_steps);
+        }
+        sim.snapshot_into(&mut snap);
+        csv_row(&snap, &mut row);
+        row.push('\n');
+        out.write_all(row.as_bytes()).map_err(io_err)?;
+    }
+    // Steps after the last multiple of the log interval, up to the duration.
+    sim.step_n(total_steps - n_logged * log_steps);
+    let wall_s = start.elapsed().as_secs_f64();
+    out.flush().map_err(io_err)?;
+    tracing::debug!(steps = total_steps, rows = n_logged + 1, "simulate done");
+    Ok(SimulateReport {
+        steps: total_steps,
+        rows: n_logged + 1,
+        wall_s,
+    })
+}
+
+/// `flexdyn simulate`: loads the configuration, checks the options, and writes the CSV to the
+/// output file or stdout. The output file is created only once everything else is valid.
+pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
+    let cfg = load_config(args.config.as_deref())?;
+    // Check the options before creating (and truncating) the output file.
+    whole_steps("--duration-s", args.duration_s, cfg.step_ns, true)?;
+    whole_steps("--log-every-s", args.log_every_s, cfg.step_ns, false)?;
+    match args.output.as_deref() {
+        None => simulate_to(
+            &cfg,
+            args.duration_s,
+            args.log_every_s,
+            io::stdout().lock(),
+            "stdout",
+        ),
+        Some(p) if p == Path::new("-") => simulate_to(
+            &cfg,
+            args.duration_s,
+            args.log_every_s,
+            io::stdout().lock(),
+            "stdout",
+        ),
+        Some(p) => {
+            let target = format!("CSV output `{}`", p.display());
+            let file = std::fs::File::create(p).map_err(|source| CliError::Output {
+                target: target.clone(),
+                source,
+            })?;
+            simulate_to(&cfg, args.duration_s, args.log_every_s, file, &target)
+        }
+    }
+}
+
+/// Short name of a gravity model, as in the configuration file.
+pub fn gravity_model_name(g: &GravityModel) -> &'static str {
+    match g {
+        GravityModel::None => "none",
+        GravityModel::PointMass { .. } => "point_mass",
+        GravityModel::J2 { .. } => "j2",
+    }
+}
+
+/// One-line summary of a valid configuration.
+pub fn config_summary(cfg: &SimConfig) -> String {
+    format!(
+        "{} panel pairs, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows",
+        cfg.panel_pairs.len(),
+        cfg.total_mass_kg(),
+        cfg.step_ns as f64 * 1e-9,
+        cfg.step_ns,
+        cfg.frame_hz,
+        cfg.frame_ns,
+        cfg.steps_per_frame(),
+        gravity_model_name(&cfg.gravity),
+        cfg.wrench_schedule.len(),
+    )
+}
+
+/// `flexdyn check-config FILE`: parses, validates and builds the spacecraft; returns the summary
+/// line `ok: FILE: …`.
+pub fn check_config(path: &Path) -> Result<String, CliError> {
+    let cfg = load_config(Some(path))?;
+    cfg.build_spacecraft().map_err(|source| CliError::Config {
+        file: Some(path.to_path_buf()),
+        source,
+    })?;
+    Ok(format!("ok: {}: {}", path.display(), config_summary(&cfg)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn header_and_rows() {
+        let cfg = SimConfig::reference();
+        let mut buf = Vec::new();
+        let rep = simulate_to(&cfg, 0.1, 0.01, &mut buf, "buffer").unwrap();
+        assert_eq!(rep.steps, 100);
+        assert_eq!(rep.rows, 11);
+        let text = String::from_utf8(buf).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 12);
+        let n_cols = lines[0].split(',').count();
+        assert_eq!(n_cols, 1 + 12 + 8 + 2 + 6);
+        assert!(lines[1..].iter().all(|l| l.split(',').count() == n_cols));
+    }
+
+    #[test]
+    fn bad_intervals() {
+        let cfg = SimConfig::reference();
+        let e = simulate_to(&cfg, 0.1, 0.0015, Vec::new(), "buffer").unwrap_err();
+        assert!(e.to_string().starts_with("--log-every-s:"), "{e}");
+        let e = simulate_to(&cfg, 0.1005, 0.01, Vec::new(), "buffer").unwrap_err();
+        assert!(e.to_string().starts_with("--duration-s:"), "{e}");
+        let e = simulate_to(&cfg, 0.1, -0.01, Vec::new(), "buffer").unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+    }
+}

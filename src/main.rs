@@ -1,0 +1,77 @@
+//! The `flexdyn` command-line entry point: parses arguments, initialises logging and calls the
+//! library. Every error is reported as one `error: …` line on stderr with a non-zero exit code
+//! (2 for invalid input, 1 for a failure while running); nothing here panics on bad input.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{CommandFactory, Parser, Subcommand};
+use flexdyn::cli::{self, CliError, SimulateArgs};
+use flexdyn::config::DEFAULT_CONFIG_TOML;
+
+/// Real-time flight-software-in-the-loop spacecraft dynamics: rigid hub + dual-hinged panels.
+#[derive(Debug, Parser)]
+#[command(name = "flexdyn", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    // The real-time server's `Run` subcommand goes here.
+    /// Propagate a configuration offline and write the state history as CSV.
+    Simulate(SimulateArgs),
+    /// Validate a configuration file and print a one-line summary (exit 2 if invalid).
+    CheckConfig {
+        /// The configuration file (TOML).
+        file: PathBuf,
+    },
+    /// Print the embedded default configuration (scenarios/reference.toml) verbatim.
+    PrintDefaultConfig,
+}
+
+fn init_tracing() {
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
+    // Ignore the error if a subscriber is already set.
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .try_init();
+}
+
+fn print_default_config() -> Result<(), CliError> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(DEFAULT_CONFIG_TOML.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|source| CliError::Output {
+            target: "stdout".into(),
+            source,
+        })
+}
+
+fn main() -> ExitCode {
+    let args = Cli::parse();
+    init_tracing();
+    let result = match args.command {
+        Some(Command::Simulate(a)) => cli::simulate(&a).map(|report| eprintln!("{report}")),
+        Some(Command::CheckConfig { file }) => {
+            cli::check_config(&file).map(|summary| println!("{summary}"))
+        }
+        Some(Command::PrintDefaultConfig) => print_default_config(),
+        // No subcommand: the server engineer makes this run the real-time server.
+        None => {
+            eprintln!("{}", Cli::command().render_help());
+            return ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

@@ -1,0 +1,267 @@
+//! The shared simulation runner used by `flexdyn simulate` and by the real-time server.
+//!
+//! A [`Simulation`] owns the [`Spacecraft`], the configured external-wrench schedule and the
+//! wrench commanded by the attitude-control software. Before every RK4 step it applies
+//! `schedule(t) + command`, where `t` is the time at the start of the step; the wrench is then
+//! held constant over the step.
+
+use nalgebra::{Vector3, Vector4};
+
+use crate::attitude::{mrp_to_dcm, mrp_to_quat};
+use crate::config::{ConfigError, SimConfig};
+use crate::dynamics::{Conserved, Spacecraft, WrenchSegment};
+
+/// A spacecraft being propagated, with its external wrench sources.
+#[derive(Debug)]
+pub struct Simulation {
+    sc: Spacecraft,
+    frame_ns: u64,
+    schedule: Vec<WrenchSegment>,
+    /// Number of schedule rows whose start time is ≤ the last time the wrench was applied;
+    /// the active row is `cursor - 1` (none if 0).
+    cursor: usize,
+    command_force_b_n: Vector3<f64>,
+    command_torque_b_nm: Vector3<f64>,
+}
+
+/// Everything a telemetry frame or a CSV row needs, at one instant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Snapshot {
+    /// \[ns\] simulation time.
+    pub t_sim_ns: u64,
+    /// MRP σ_B/N (|σ| ≤ 1).
+    pub sigma_bn: Vector3<f64>,
+    /// Quaternion of B relative to N, scalar first (see [`crate::attitude::mrp_to_quat`]).
+    pub q_bn: Vector4<f64>,
+    /// [rad/s] ω_B/N, B components.
+    pub omega_bn_b: Vector3<f64>,
+    /// [rad/s²] ω̇_B/N, B components, with the wrench of [`Self::force_b_n`]/[`Self::torque_b_nm`].
+    pub omega_dot_bn_b: Vector3<f64>,
+    /// \[m\] r_B/N, N components.
+    pub r_bn_n: Vector3<f64>,
+    /// [m/s] v_B/N, N components.
+    pub v_bn_n: Vector3<f64>,
+    /// \[m/s²\] non-gravitational acceleration of point B, N components (\[NB\]·a_B).
+    pub nongrav_accel_bn_n: Vector3<f64>,
+    /// Per panel pair: [θ1 rad, θ̇1 rad/s, θ2 rad, θ̇2 rad/s].
+    pub panels: Vec<[f64; 4]>,
+    /// Conserved quantities (N components).
+    pub conserved: Conserved,
+    /// \[N\] total external force on the hub (schedule + command), B components, applied from
+    /// this instant.
+    pub force_b_n: Vector3<f64>,
+    /// [N·m] total external torque on the hub (schedule + command), B components.
+    pub torque_b_nm: Vector3<f64>,
+}
+
+impl Snapshot {
+    /// An all-zero snapshot with room for `n_pairs` panel pairs, to be filled by
+    /// [`Simulation::snapshot_into`].
+    pub fn with_capacity(n_pairs: usize) -> Self {
+        let z = Vector3::zeros();
+        Self {
+            t_sim_ns: 0,
+            sigma_bn: z,
+            q_bn: Vector4::new(1.0, 0.0, 0.0, 0.0),
+            omega_bn_b: z,
+            omega_dot_bn_b: z,
+            r_bn_n: z,
+            v_bn_n: z,
+            nongrav_accel_bn_n: z,
+            panels: Vec::with_capacity(n_pairs),
+            conserved: Conserved {
+                orb_energy_j: 0.0,
+                rot_energy_j: 0.0,
+                orb_ang_mom_n: z,
+                rot_ang_mom_c_n: z,
+            },
+            force_b_n: z,
+            torque_b_nm: z,
+        }
+    }
+
+    /// \[s\] simulation time.
+    pub fn t_s(&self) -> f64 {
+        self.t_sim_ns as f64 / 1e9
+    }
+}
+
+impl Simulation {
+    /// Builds the spacecraft of `cfg` at t = 0 with a zero commanded wrench.
+    pub fn new(cfg: &SimConfig) -> Result<Self, ConfigError> {
+        let sc = cfg.build_spacecraft()?;
+        let mut sim = Self {
+            sc,
+            frame_ns: cfg.frame_ns,
+            schedule: cfg.wrench_schedule.clone(),
+            cursor: 0,
+            command_force_b_n: Vector3::zeros(),
+            command_torque_b_nm: Vector3::zeros(),
+        };
+        sim.apply_wrench();
+        Ok(sim)
+    }
+
+    /// The spacecraft.
+    pub fn spacecraft(&self) -> &Spacecraft {
+        &self.sc
+    }
+
+    /// The spacecraft, mutably (e.g. to restore a state). Its wrench is overwritten before each
+    /// step; use [`Self::set_command_wrench`] to apply one.
+    pub fn spacecraft_mut(&mut self) -> &mut Spacecraft {
+        &mut self.sc
+    }
+
+    /// \[ns\] simulation time.
+    pub fn t_sim_ns(&self) -> u64 {
+        self.sc.t_sim_ns()
+    }
+
+    /// \[ns\] RK4 step.
+    pub fn step_ns(&self) -> u64 {
+        self.sc.step_ns()
+    }
+
+    /// \[ns\] frame period.
+    pub fn frame_ns(&self) -> u64 {
+        self.frame_ns
+    }
+
+    /// RK4 steps per frame.
+    pub fn steps_per_frame(&self) -> u64 {
+        self.frame_ns / self.sc.step_ns()
+    }
+
+    /// Number of panel pairs (effectors).
+    pub fn n_pairs(&self) -> usize {
+        self.sc.effectors().len()
+    }
+
+    /// Commanded wrench (from the ACS controller), added to the scheduled disturbance wrench.
+    /// Force \[N\] at B and torque \[N·m\], B components; held until the next call.
+    pub fn set_command_wrench(&mut self, force_b_n: Vector3<f64>, torque_b_nm: Vector3<f64>) {
+        self.command_force_b_n = force_b_n;
+        self.command_torque_b_nm = torque_b_nm;
+    }
+
+    /// The commanded (force \[N\], torque \[N·m\]), B components.
+    pub fn command_wrench(&self) -> (Vector3<f64>, Vector3<f64>) {
+        (self.command_force_b_n, self.command_torque_b_nm)
+    }
+
+    /// Sets the spacecraft's wrench to schedule(t) + command for the current time t.
+    #[inline]
+    fn apply_wrench(&mut self) {
+        let t = self.sc.t_sim_ns();
+        while self.cursor < self.schedule.len() && self.schedule[self.cursor].t_start_ns <= t {
+            self.cursor += 1;
+        }
+        let (mut force, mut torque) = (self.command_force_b_n, self.command_torque_b_nm);
+        if let Some(seg) = self.cursor.checked_sub(1).map(|i| &self.schedule[i]) {
+            force += seg.force_b_n;
+            torque += seg.torque_b_nm;
+        }
+        self.sc.set_wrench(force, torque);
+    }
+
+    /// One RK4 step: total wrench = schedule(t at step start) + command, then
+    /// [`Spacecraft::step`]. Allocates nothing.
+    #[inline]
+    pub fn step(&mut self) {
+        self.apply_wrench();
+        self.sc.step();
+    }
+
+    /// [`Self::steps_per_frame`] steps.
+    pub fn step_frame(&mut self) {
+        for _ in 0..self.steps_per_frame() {
+            self.step();
+        }
+    }
+
+    /// `n` steps.
+    pub fn step_n(&mut self, n: u64) {
+        for _ in 0..n {
+            self.step();
+        }
+    }
+
+    /// The current state and outputs (one derivative evaluation, with the wrench that applies
+    /// from now on: schedule(t) + command).
+    pub fn snapshot(&mut self) -> Snapshot {
+        let mut out = Snapshot::with_capacity(self.n_pairs());
+        self.snapshot_into(&mut out);
+        out
+    }
+
+    /// Like [`Self::snapshot`], reusing `out` (its `panels` Vec is cleared and refilled, so after
+    /// the first call this allocates nothing).
+    pub fn snapshot_into(&mut self, out: &mut Snapshot) {
+        self.apply_wrench();
+        let hub = self.sc.hub_outputs();
+        let state = self.sc.state();
+        let dcm_nb = mrp_to_dcm(&state.sigma_bn).transpose();
+        out.t_sim_ns = self.sc.t_sim_ns();
+        out.sigma_bn = state.sigma_bn;
+        out.q_bn = mrp_to_quat(&state.sigma_bn);
+        out.omega_bn_b = state.omega_bn_b;
+        out.omega_dot_bn_b = hub.omega_dot_bn_b;
+        out.r_bn_n = state.r_bn_n;
+        out.v_bn_n = state.v_bn_n;
+        out.nongrav_accel_bn_n = dcm_nb * hub.nongrav_accel_bn_b;
+        out.panels.clear();
+        for r in self.sc.effector_ranges() {
+            let x = &state.effectors[r.clone()];
+            let mut p = [0.0; 4];
+            for (o, v) in p.iter_mut().zip(x) {
+                *o = *v;
+            }
+            out.panels.push(p);
+        }
+        out.conserved = self.sc.conserved();
+        let (force, torque) = self.sc.wrench();
+        out.force_b_n = force;
+        out.torque_b_nm = torque;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn schedule_plus_command() {
+        let text = format!(
+            "{}\n[[wrench_schedule]]\nt_s = 0.002\nforce_b_n = [1.0, 0.0, 0.0]\ntorque_b_nm = [0.0, 0.0, 2.0]\n\n\
+             [[wrench_schedule]]\nt_s = 0.004\nforce_b_n = [0.0, 0.0, 0.0]\ntorque_b_nm = [0.0, 0.0, 0.0]\n",
+            crate::config::DEFAULT_CONFIG_TOML
+        );
+        let cfg = SimConfig::from_toml_str(&text).unwrap();
+        let mut sim = Simulation::new(&cfg).unwrap();
+        sim.set_command_wrench(Vector3::new(0.0, 3.0, 0.0), Vector3::zeros());
+        let s = sim.snapshot();
+        assert_eq!(s.force_b_n, Vector3::new(0.0, 3.0, 0.0));
+        sim.step_n(2);
+        let s = sim.snapshot();
+        assert_eq!(s.t_sim_ns, 2_000_000);
+        assert_eq!(s.force_b_n, Vector3::new(1.0, 3.0, 0.0));
+        assert_eq!(s.torque_b_nm, Vector3::new(0.0, 0.0, 2.0));
+        sim.step_n(2);
+        let s = sim.snapshot();
+        assert_eq!(s.force_b_n, Vector3::new(0.0, 3.0, 0.0));
+        assert_eq!(s.panels.len(), 2);
+    }
+
+    #[test]
+    fn frame_stepping() {
+        let mut sim = Simulation::new(&SimConfig::reference()).unwrap();
+        assert_eq!(sim.steps_per_frame(), 10);
+        sim.step_frame();
+        assert_eq!(sim.t_sim_ns(), sim.frame_ns());
+        let mut snap = Snapshot::with_capacity(2);
+        sim.snapshot_into(&mut snap);
+        assert_eq!(snap.t_sim_ns, 10_000_000);
+        assert!((snap.q_bn.norm() - 1.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,325 @@
+//! The `flexdyn` binary's offline subcommands, run as a user would: `simulate`, `check-config`
+//! and `print-default-config`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
+
+fn flexdyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args(args)
+        .env("RUST_LOG", "info")
+        .output()
+        .expect("runs the flexdyn binary")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).expect("UTF-8 stdout")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8(o.stderr.clone()).expect("UTF-8 stderr")
+}
+
+/// A fresh file path in the test scratch directory.
+fn scratch(name: &str) -> PathBuf {
+    let dir =
+        Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_simulate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn expected_header() -> Vec<String> {
+    let mut h = vec!["t_s".to_string()];
+    for base in ["sigma_bn", "omega_bn_b", "r_bn_n", "v_bn_n"] {
+        h.extend((1..=3).map(|i| format!("{base}_{i}")));
+    }
+    for k in 1..=2 {
+        for c in ["theta1", "theta1_dot", "theta2", "theta2_dot"] {
+            h.push(format!("pair{k}_{c}"));
+        }
+    }
+    h.push("orb_energy_j".into());
+    h.push("rot_energy_j".into());
+    h.extend((1..=3).map(|i| format!("orb_ang_mom_n_{i}")));
+    h.extend((1..=3).map(|i| format!("rot_ang_mom_c_n_{i}")));
+    h
+}
+
+/// Significant digits of a `{:.16e}`-formatted number: the mantissa has 1 + 16 digits.
+fn significant_digits(field: &str) -> usize {
+    let mantissa = field.split(['e', 'E']).next().unwrap();
+    mantissa.chars().filter(char::is_ascii_digit).count()
+}
+
+#[track_caller]
+fn assert_summary_line(err: &str) {
+    let line = err.lines().last().expect("a stderr line");
+    let parts: Vec<&str> = line.split(' ').collect();
+    assert_eq!(parts.len(), 3, "summary line: {line}");
+    let value = |i: usize, key: &str| -> f64 {
+        let v = parts[i]
+            .strip_prefix(key)
+            .unwrap_or_else(|| panic!("`{key}` in {line}"));
+        v.parse()
+            .unwrap_or_else(|_| panic!("number after {key} in {line}"))
+    };
+    assert_eq!(value(0, "steps="), 100.0, "{line}");
+    assert!(value(1, "wall_s=") >= 0.0, "{line}");
+    assert!(value(2, "steps_per_s=") >= 0.0, "{line}");
+}
+
+#[test]
+fn simulate_writes_the_documented_csv() {
+    let out = flexdyn(&["simulate", "--duration-s", "0.1", "--log-every-s", "0.01"]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "stderr: {err}");
+    let text = stdout(&out);
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    assert_eq!(header, expected_header());
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 11);
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(row.len(), header.len(), "row {k}");
+        for f in row {
+            assert_eq!(significant_digits(f), 17, "`{f}` in row {k}");
+            let v: f64 = f.parse().unwrap_or_else(|_| panic!("`{f}` is a number"));
+            assert!(v.is_finite());
+        }
+        let t: f64 = row[0].parse().unwrap();
+        assert!((t - 0.01 * k as f64).abs() < 1e-12, "row {k}: t = {t}");
+    }
+    assert_eq!(rows[0][0].parse::<f64>().unwrap(), 0.0);
+    // Row 0 is the configured initial state.
+    assert_eq!(rows[0][4].parse::<f64>().unwrap(), 0.05); // omega_bn_b_1
+    assert_eq!(rows[0][13].parse::<f64>().unwrap(), 0.08726646259971647); // pair1_theta1
+                                                                          // Exactly one stderr line: the summary.
+    assert_eq!(err.lines().count(), 1, "stderr: {err}");
+    assert_summary_line(&err);
+}
+
+#[test]
+fn output_dash_is_stdout_and_file_output_matches() {
+    let args = ["simulate", "--duration-s", "0.1", "--log-every-s", "0.01"];
+    let plain = flexdyn(&args);
+    let dash = flexdyn(&[&args[..], &["--output", "-"]].concat());
+    assert!(dash.status.success(), "{}", stderr(&dash));
+    assert_eq!(stdout(&dash), stdout(&plain));
+    assert_summary_line(&stderr(&dash));
+
+    let path = scratch("out.csv");
+    let file = flexdyn(&[&args[..], &["--output", path.to_str().unwrap()]].concat());
+    assert!(file.status.success(), "{}", stderr(&file));
+    assert!(file.stdout.is_empty());
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), stdout(&plain));
+    assert_summary_line(&stderr(&file));
+}
+
+#[test]
+fn simulate_with_a_config_file() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/eight_pairs.toml");
+    let out = flexdyn(&[
+        "simulate",
+        "--config",
+        path.to_str().unwrap(),
+        "--duration-s",
+        "0.02",
+        "--log-every-s",
+        "0.01",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let header = text.lines().next().unwrap();
+    assert_eq!(header.split(',').count(), 1 + 12 + 8 * 4 + 2 + 6);
+    assert!(header.contains("pair8_theta2_dot"));
+    assert_eq!(text.lines().count(), 1 + 3);
+}
+
+#[test]
+fn log_interval_not_a_whole_number_of_steps() {
+    let path = scratch("never-written.csv");
+    let out = flexdyn(&[
+        "simulate",
+        "--duration-s",
+        "0.1",
+        "--log-every-s",
+        "0.0015",
+        "--output",
+        path.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.starts_with("error: --log-every-s:"), "{err}");
+    assert!(err.contains("whole number of RK4 steps"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        !path.exists(),
+        "the output file is not created on an argument error"
+    );
+}
+
+#[test]
+fn bad_duration_and_interval_values() {
+    for (flag, value, problem) in [
+        ("--duration-s", "0.0105", "whole number of RK4 steps"),
+        ("--duration-s", "-1", "must be >= 0"),
+        ("--log-every-s", "0", "must be > 0"),
+        ("--log-every-s", "nan", "must be finite"),
+    ] {
+        let mut args = vec!["simulate", "--duration-s", "0.1", "--log-every-s", "0.01"];
+        let i = args.iter().position(|a| *a == flag).unwrap();
+        args[i + 1] = value;
+        let out = flexdyn(&args);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}");
+        let err = stderr(&out);
+        assert!(err.starts_with(&format!("error: {flag}:")), "{err}");
+        assert!(err.contains(problem), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn check_config_accepts_the_reference() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/reference.toml");
+    let out = flexdyn(&["check-config", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let summary = stdout(&out);
+    assert_eq!(summary.lines().count(), 1);
+    for word in [
+        "2 panel pairs",
+        "total mass 950 kg",
+        "step 0.001 s",
+        "frame 100 Hz",
+    ] {
+        assert!(summary.contains(word), "{summary}");
+    }
+}
+
+#[test]
+fn check_config_rejects_a_bad_file() {
+    let cases = [
+        (
+            "mass_kg = 750.0",
+            "mass_kg = -750.0",
+            "hub.mass_kg",
+            "must be > 0",
+        ),
+        (
+            "mass_kg = 750.0",
+            "mass_kg = nan",
+            "hub.mass_kg",
+            "must be finite",
+        ),
+        (
+            "mass_kg = 750.0",
+            "mass_kg = 750.0\ncolour = \"red\"",
+            "hub.colour",
+            "unknown key",
+        ),
+        (
+            "step_s = 0.001 ",
+            "step_s = 0.0000000015 ",
+            "simulation.step_s",
+            "whole number of nanoseconds",
+        ),
+        (
+            "d_m = 0.75, l_m = 1.5",
+            "d_m = 1.75, l_m = 1.5",
+            "panel_pairs[0].panel1.d_m",
+            "exceeds",
+        ),
+    ];
+    for (i, (from, to, field, problem)) in cases.iter().enumerate() {
+        let path = scratch(&format!("bad{i}.toml"));
+        std::fs::write(&path, DEFAULT_CONFIG_TOML.replacen(from, to, 1)).unwrap();
+        let out = flexdyn(&["check-config", path.to_str().unwrap()]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.starts_with("error: "), "{err}");
+        assert!(err.contains(field) && err.contains(problem), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(out.stdout.is_empty());
+    }
+}
+
+#[test]
+fn check_config_on_a_missing_file_or_garbage() {
+    let missing = scratch("missing.toml");
+    let out = flexdyn(&["check-config", missing.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.starts_with("error: cannot read config file") && err.contains("missing.toml"),
+        "{err}"
+    );
+
+    let garbage = scratch("garbage.toml");
+    std::fs::write(&garbage, b"\xff\xfe not toml [[[").unwrap();
+    let out = flexdyn(&["check-config", garbage.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_ne!(out.status.code(), Some(0));
+    assert!(
+        err.starts_with("error: ") && !err.contains("panicked"),
+        "{err}"
+    );
+
+    let syntax = scratch("syntax.toml");
+    std::fs::write(&syntax, "[simulation\nstep_s = 0.001\n").unwrap();
+    let out = flexdyn(&["check-config", syntax.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("TOML syntax error at line 1"), "{err}");
+}
+
+#[test]
+fn simulate_with_a_bad_config_fails_cleanly() {
+    let path = scratch("bad-sim.toml");
+    std::fs::write(
+        &path,
+        DEFAULT_CONFIG_TOML.replacen("k_n_m_rad = 100.0", "k_n_m_rad = -100.0", 1),
+    )
+    .unwrap();
+    let out = flexdyn(&[
+        "simulate",
+        "--config",
+        path.to_str().unwrap(),
+        "--duration-s",
+        "0.01",
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("panel_pairs[0].panel1.k_n_m_rad") && err.contains(">= 0"),
+        "{err}"
+    );
+    assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn print_default_config_is_the_embedded_default() {
+    let out = flexdyn(&["print-default-config"]);
+    assert!(out.status.success());
+    let text = stdout(&out);
+    assert_eq!(text, DEFAULT_CONFIG_TOML);
+    assert_eq!(
+        SimConfig::from_toml_str(&text).unwrap(),
+        SimConfig::reference()
+    );
+}
+
+#[test]
+fn no_subcommand_prints_help_and_fails() {
+    let out = flexdyn(&[]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    for sub in ["simulate", "check-config", "print-default-config"] {
+        assert!(err.contains(sub), "{err}");
+    }
+}
