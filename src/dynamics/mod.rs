@@ -36,11 +36,12 @@ pub use effector::{
 };
 pub use panel_pair::PanelPair;
 pub use params::{
-    GravityModel, HubParams, PanelPairInitial, PanelPairParams, PanelParams, WrenchSegment,
+    GravityModel, HubParams, PanelPairInitial, PanelPairParams, PanelParams, SensorPoint,
+    WrenchSegment,
 };
 pub use spacecraft::{
-    gravity_accel_n, gravity_potential, Conserved, HubInitial, HubOutputs, InitialTranslation,
-    Spacecraft, State,
+    gravity_accel_n, gravity_potential, specific_force_b, Conserved, HubInitial, HubOutputs,
+    InitialTranslation, Spacecraft, State,
 };
 
 /// A parameter that fails validation. Every variant names the offending field with its

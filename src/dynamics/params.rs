@@ -92,6 +92,15 @@ pub enum GravityModel {
     },
 }
 
+/// A point fixed on the hub where a sensor (an IMU) sits, with its platform frame P.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorPoint {
+    /// [m] sensor location S relative to B, in B components.
+    pub r_sb_b_m: Vector3<f64>,
+    /// DCM [PB]: maps B components to platform P components.
+    pub dcm_pb: Matrix3<f64>,
+}
+
 /// One row of the piecewise-constant external wrench schedule on the hub.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WrenchSegment {
@@ -290,6 +299,14 @@ impl GravityModel {
                 check_positive(path, "r_eq_m", r_eq_m)
             }
         }
+    }
+}
+
+impl SensorPoint {
+    /// Validates the sensor point (`path` is e.g. `imus[0]`): finite position, orthonormal DCM.
+    pub fn validate(&self, path: &str) -> Result<(), ParamError> {
+        check_finite(path, "r_sb_b_m", self.r_sb_b_m.as_slice())?;
+        check_dcm(path, "dcm_pb", &self.dcm_pb)
     }
 }
 

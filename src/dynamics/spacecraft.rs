@@ -12,7 +12,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::effector::{
     BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
-use super::params::{GravityModel, HubParams};
+use super::params::{GravityModel, HubParams, SensorPoint};
 use super::ParamError;
 use crate::attitude::{mrp_rate, mrp_switch, mrp_to_dcm, tilde};
 
@@ -29,16 +29,22 @@ pub struct State {
     pub omega_bn_b: Vector3<f64>,
     /// Effector states, concatenated in effector order (for a panel pair: θ1, θ̇1, θ2, θ̇2).
     pub effectors: Vec<f64>,
+    /// [m/s] per sensor point, the velocity increment Δv_P = ∫ [PB] f_B dt accumulated since the
+    /// last [`Spacecraft::reset_sensor_dv`], f the specific force at the point (derivative: f in P
+    /// components). Integrated by the same RK4 stages as the dynamics, so it is exact to
+    /// integrator precision; it never feeds back into the dynamics.
+    pub sensor_dv_p: Vec<Vector3<f64>>,
 }
 
 impl State {
-    fn zeros(n: usize) -> Self {
+    fn zeros(n: usize, n_sensors: usize) -> Self {
         Self {
             r_bn_n: Vector3::zeros(),
             v_bn_n: Vector3::zeros(),
             sigma_bn: Vector3::zeros(),
             omega_bn_b: Vector3::zeros(),
             effectors: vec![0.0; n],
+            sensor_dv_p: vec![Vector3::zeros(); n_sensors],
         }
     }
 
@@ -56,6 +62,14 @@ impl State {
             .zip(&k.effectors)
         {
             *o = xi + h * ki;
+        }
+        for ((o, xi), ki) in self
+            .sensor_dv_p
+            .iter_mut()
+            .zip(&x.sensor_dv_p)
+            .zip(&k.sensor_dv_p)
+        {
+            *o = xi + ki * h;
         }
     }
 }
@@ -175,6 +189,18 @@ impl Lu3 {
     }
 }
 
+/// [m/s²] specific force (non-gravitational acceleration) of a point fixed on the hub at
+/// `r_sb_b` from B: f = a_B,nongrav + ω̇ × r + ω × (ω × r), all B components.
+#[inline(always)]
+pub fn specific_force_b(
+    nongrav_accel_bn_b: &Vector3<f64>,
+    omega_bn_b: &Vector3<f64>,
+    omega_dot_bn_b: &Vector3<f64>,
+    r_sb_b: &Vector3<f64>,
+) -> Vector3<f64> {
+    nongrav_accel_bn_b + omega_dot_bn_b.cross(r_sb_b) + omega_bn_b.cross(&omega_bn_b.cross(r_sb_b))
+}
+
 /// Gravitational acceleration [m/s²] at `r_n` (N components) for `model`.
 #[inline]
 pub fn gravity_accel_n(model: &GravityModel, r_n: &Vector3<f64>) -> Vector3<f64> {
@@ -243,6 +269,7 @@ struct EquationsOfMotion {
     ranges: Vec<Range<usize>>,
     force_b_n: Vector3<f64>,
     torque_b_nm: Vector3<f64>,
+    sensors: Vec<SensorPoint>,
 }
 
 /// A rigid hub with appended state effectors, integrated with fixed-step RK4.
@@ -325,6 +352,11 @@ impl EquationsOfMotion {
         dx.v_bn_n = dcm_nb * accel_b + gravity_n;
         dx.sigma_bn = mrp_rate(&x.sigma_bn, &omega);
         dx.omega_bn_b = omega_dot;
+        // Specific force at each sensor point, in its platform frame:
+        // f = a_B,nongrav + ω̇ × r_S/B + ω × (ω × r_S/B).
+        for (s, d) in self.sensors.iter().zip(dx.sensor_dv_p.iter_mut()) {
+            *d = s.dcm_pb * specific_force_b(&accel_b, &omega, &omega_dot, &s.r_sb_b_m);
+        }
         HubOutputs {
             nongrav_accel_bn_b: accel_b,
             omega_dot_bn_b: omega_dot,
@@ -383,7 +415,7 @@ impl Spacecraft {
         let r = hub.r_bcb_b_m;
         let hub_inertia_pnt_b_b = hub.inertia_bc_b_kg_m2
             + (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose()) * hub.mass_kg;
-        let zero = State::zeros(n);
+        let zero = State::zeros(n, 0);
         let mut sc = Self {
             eom: EquationsOfMotion {
                 hub,
@@ -394,6 +426,7 @@ impl Spacecraft {
                 ranges,
                 force_b_n: Vector3::zeros(),
                 torque_b_nm: Vector3::zeros(),
+                sensors: Vec::new(),
             },
             state: zero.clone(),
             t_sim_ns: 0,
@@ -443,10 +476,12 @@ impl Spacecraft {
 
     /// Replaces the state (e.g. to restore a snapshot). Lengths must match [`Self::state`]'s.
     pub fn set_state(&mut self, state: &State) -> Result<(), ParamError> {
-        if state.effectors.len() != self.state.effectors.len() {
+        if state.effectors.len() != self.state.effectors.len()
+            || state.sensor_dv_p.len() != self.state.sensor_dv_p.len()
+        {
             return Err(ParamError::StateLength {
-                expected: self.state.effectors.len(),
-                found: state.effectors.len(),
+                expected: self.state.effectors.len() + 3 * self.state.sensor_dv_p.len(),
+                found: state.effectors.len() + 3 * state.sensor_dv_p.len(),
             });
         }
         self.state.clone_from(state);
@@ -525,8 +560,65 @@ impl Spacecraft {
             state.effectors[i] += h6
                 * (k1.effectors[i] + 2.0 * (k2.effectors[i] + k3.effectors[i]) + k4.effectors[i]);
         }
+        for i in 0..state.sensor_dv_p.len() {
+            state.sensor_dv_p[i] += (k1.sensor_dv_p[i]
+                + (k2.sensor_dv_p[i] + k3.sensor_dv_p[i]) * 2.0
+                + k4.sensor_dv_p[i])
+                * h6;
+        }
         mrp_switch(&mut state.sigma_bn);
         self.t_sim_ns += self.step_ns;
+    }
+
+    /// Adds a sensor point (an IMU location and platform frame) whose Δv is accumulated inside the
+    /// RK4 integration; returns its index. Construction-time only: it resizes the state buffers.
+    pub fn add_sensor_point(
+        &mut self,
+        point: SensorPoint,
+        path: &str,
+    ) -> Result<usize, ParamError> {
+        point.validate(path)?;
+        self.eom.sensors.push(point);
+        for s in [
+            &mut self.state,
+            &mut self.ws.k1,
+            &mut self.ws.k2,
+            &mut self.ws.k3,
+            &mut self.ws.k4,
+            &mut self.ws.stage,
+        ] {
+            s.sensor_dv_p.push(Vector3::zeros());
+        }
+        Ok(self.eom.sensors.len() - 1)
+    }
+
+    /// The sensor points, in index order.
+    pub fn sensor_points(&self) -> &[SensorPoint] {
+        &self.eom.sensors
+    }
+
+    /// [m/s] Δv accumulated at each sensor point since the last reset, platform components.
+    pub fn sensor_dv_p(&self) -> &[Vector3<f64>] {
+        &self.state.sensor_dv_p
+    }
+
+    /// Zeroes every sensor's Δv accumulator (at a frame or log boundary).
+    pub fn reset_sensor_dv(&mut self) {
+        for dv in &mut self.state.sensor_dv_p {
+            *dv = Vector3::zeros();
+        }
+    }
+
+    /// Truth at sensor point `i` given the hub outputs at the current state: ([rad/s] ω_B/N in P,
+    /// [m/s²] specific force in P).
+    pub fn sensor_truth(&self, i: usize, out: &HubOutputs) -> (Vector3<f64>, Vector3<f64>) {
+        let s = &self.eom.sensors[i];
+        let w = &self.state.omega_bn_b;
+        (
+            s.dcm_pb * w,
+            s.dcm_pb
+                * specific_force_b(&out.nongrav_accel_bn_b, w, &out.omega_dot_bn_b, &s.r_sb_b_m),
+        )
     }
 
     /// Hub accelerations at the current state with the current wrench (one derivative evaluation;
