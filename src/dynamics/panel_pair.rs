@@ -23,17 +23,20 @@ use super::ParamError;
 /// Geometry and back-substitution terms cached between the passes of one evaluation.
 #[derive(Debug, Clone, Copy)]
 struct Cache {
+    /// (sin, cos) of θ1 and of φ = θ2 + θ_H2S1.
+    sin1: f64,
+    cos1: f64,
+    sin_phi: f64,
+    cos_phi: f64,
     /// Panel-1 frame axes in B components (rows of [S1 B]).
     s11: Vector3<f64>,
     s13: Vector3<f64>,
     /// Panel-2 frame axes in B components (rows of [S2 B]); ŝ22 = ŝ12.
     s21: Vector3<f64>,
     s23: Vector3<f64>,
-    /// r_Sc1/B, r_Sc2/B and their body-frame derivatives (Eqs. 6–8, 10).
+    /// r_Sc1/B and r_Sc2/B (Eqs. 6–7).
     r_sc1b_b: Vector3<f64>,
     r_sc2b_b: Vector3<f64>,
-    r_prime_sc1b_b: Vector3<f64>,
-    r_prime_sc2b_b: Vector3<f64>,
     /// Solutions of [A_i] X = [F_i | G_i | v_i] (rows 1 and 2): θ̈_k = x_f_k·r̈ + x_g_k·ω̇ + x_v_k.
     x_f: [Vector3<f64>; 2],
     x_g: [Vector3<f64>; 2],
@@ -44,14 +47,16 @@ impl Default for Cache {
     fn default() -> Self {
         let z = Vector3::zeros();
         Self {
+            sin1: 0.0,
+            cos1: 1.0,
+            sin_phi: 0.0,
+            cos_phi: 1.0,
             s11: z,
             s13: z,
             s21: z,
             s23: z,
             r_sc1b_b: z,
             r_sc2b_b: z,
-            r_prime_sc1b_b: z,
-            r_prime_sc2b_b: z,
             x_f: [z; 2],
             x_g: [z; 2],
             x_v: [0.0; 2],
@@ -75,6 +80,21 @@ pub struct PanelPair {
     /// with ŝ1ŝ1ᵀ + ŝ2ŝ2ᵀ + ŝ3ŝ3ᵀ = I, each panel's Σ I_k ŝ_kŝ_kᵀ is
     /// I_1 [1] + (I_2 − I_1) ĥ2ĥ2ᵀ + (I_3 − I_1) ŝ3ŝ3ᵀ, and only the last term moves.
     inertia_const_b: Matrix3<f64>,
+    /// [m²] r_H1/B × ĥ11 and r_H1/B × ĥ13: every r_H1 × ŝ is a rotation of these two.
+    rho1: Vector3<f64>,
+    rho3: Vector3<f64>,
+    /// [m] ĥ11 · r_H1/B and ĥ13 · r_H1/B.
+    h11_rh: f64,
+    h13_rh: f64,
+    /// [kg·m] μ1 = m1 d1 + m2 l1 and μ2 = m2 d2: the first moments about H1 of the two panels'
+    /// rotation about hinge 1, and of panel 2 about H2. [F_i] = −[μ1 ŝ13ᵀ; μ2 ŝ23ᵀ] (Eq. 122).
+    mu1: f64,
+    mu2: f64,
+    /// [kg·m²] θ-independent parts of Eq. 121: a11 = a11_0 + κ cos φ, a12 = κ cos φ,
+    /// a21 = a22 + κ cos φ, a22, with κ = m2 l1 d2 and ŝ13·ŝ23 = cos φ.
+    a11_0: f64,
+    a22: f64,
+    kappa: f64,
     cache: Cache,
 }
 
@@ -105,8 +125,21 @@ impl PanelPair {
         );
         let inertia_const_b = Matrix3::from_diagonal_element(i1.x + i2.x)
             + h12 * h12.transpose() * (i1.y - i1.x + i2.y - i2.x);
+        let r_h = params.r_h1b_b_m;
+        let (h11, h13): (Vector3<f64>, Vector3<f64>) = (h.row(0).transpose(), h.row(2).transpose());
+        let (m1, m2) = (params.panel1.mass_kg, params.panel2.mass_kg);
+        let (d1, d2, l1) = (params.panel1.d_m, params.panel2.d_m, params.l1_m);
         Ok(Self {
             inertia_const_b,
+            rho1: r_h.cross(&h11),
+            rho3: r_h.cross(&h13),
+            h11_rh: h11.dot(&r_h),
+            h13_rh: h13.dot(&r_h),
+            mu1: m1 * d1 + m2 * l1,
+            mu2: m2 * d2,
+            a11_0: i1.y + m1 * d1 * d1 + m2 * l1 * l1,
+            a22: i2.y + m2 * d2 * d2,
+            kappa: m2 * l1 * d2,
             h11: h.row(0).transpose(),
             h12: h.row(1).transpose(),
             h13: h.row(2).transpose(),
@@ -153,6 +186,30 @@ impl PanelPair {
     }
 }
 
+/// `m += diag(d) + Σ α v vᵀ` for symmetric rank-one terms, computing each product once.
+#[inline(always)]
+fn add_symmetric_rank_ones(m: &mut Matrix3<f64>, d: f64, terms: &[(f64, &Vector3<f64>); 4]) {
+    let (mut xx, mut yy, mut zz, mut xy, mut xz, mut yz) = (d, d, d, 0.0, 0.0, 0.0);
+    for (alpha, v) in terms {
+        let (ax, ay, az) = (alpha * v.x, alpha * v.y, alpha * v.z);
+        xx += ax * v.x;
+        yy += ay * v.y;
+        zz += az * v.z;
+        xy += ax * v.y;
+        xz += ax * v.z;
+        yz += ay * v.z;
+    }
+    m[(0, 0)] += xx;
+    m[(1, 1)] += yy;
+    m[(2, 2)] += zz;
+    m[(0, 1)] += xy;
+    m[(1, 0)] += xy;
+    m[(0, 2)] += xz;
+    m[(2, 0)] += xz;
+    m[(1, 2)] += yz;
+    m[(2, 1)] += yz;
+}
+
 impl StateEffector for PanelPair {
     fn name(&self) -> &str {
         &self.params.name
@@ -181,34 +238,41 @@ impl StateEffector for PanelPair {
         let (m1, m2) = (p.panel1.mass_kg, p.panel2.mass_kg);
         let (d1, d2, l1) = (p.panel1.d_m, p.panel2.d_m, p.l1_m);
         let (i1, i2) = (&p.panel1.inertia_s_kg_m2, &p.panel2.inertia_s_kg_m2);
-        let (th1_dot, th2_dot) = (x[THETA1_DOT], x[THETA2_DOT]);
-        let [[s11, _, s13], [s21, _, s23]] = self.panel_axes_b(x);
+        let (th1_dot, th12_dot) = (x[THETA1_DOT], x[THETA1_DOT] + x[THETA2_DOT]);
         let c = &mut self.cache;
-        c.s11 = s11;
-        c.s13 = s13;
-        c.s21 = s21;
-        c.s23 = s23;
-        // Eqs. 6–7: centre-of-mass positions; Eqs. 8 and 10: their body-frame rates.
-        let r1 = p.r_h1b_b_m - s11 * d1;
-        let r2 = p.r_h1b_b_m - s11 * l1 - s21 * d2;
-        c.r_sc1b_b = r1;
-        c.r_sc2b_b = r2;
-        c.r_prime_sc1b_b = s13 * (d1 * th1_dot);
-        c.r_prime_sc2b_b = s13 * (l1 * th1_dot) + s23 * (d2 * (th1_dot + th2_dot));
+        // [S1 B] = M2(θ1)[H1 B]; [S2 B] = M2(θ2 + θ_H2S1)[S1 B] (angle-sum identities).
+        (c.sin1, c.cos1) = x[THETA1].sin_cos();
+        let (sn2, cs2) = x[THETA2].sin_cos();
+        c.sin_phi = sn2 * self.cos_h2s1 + cs2 * self.sin_h2s1;
+        c.cos_phi = cs2 * self.cos_h2s1 - sn2 * self.sin_h2s1;
+        c.s11 = self.h11 * c.cos1 - self.h13 * c.sin1;
+        c.s13 = self.h11 * c.sin1 + self.h13 * c.cos1;
+        c.s21 = c.s11 * c.cos_phi - c.s13 * c.sin_phi;
+        c.s23 = c.s11 * c.sin_phi + c.s13 * c.cos_phi;
+        // Eqs. 6–7: centre-of-mass positions.
+        c.r_sc1b_b = p.r_h1b_b_m - c.s11 * d1;
+        c.r_sc2b_b = p.r_h1b_b_m - c.s11 * l1 - c.s21 * d2;
 
         sum.mass_kg += m1 + m2;
-        sum.first_moment_b_kg_m += r1 * m1 + r2 * m2;
-        sum.first_moment_prime_b_kg_m_s += c.r_prime_sc1b_b * m1 + c.r_prime_sc2b_b * m2;
-        // [I_Sc1] + [I_Sc2] + m1[r̃1][r̃1]ᵀ + m2[r̃2][r̃2]ᵀ, with [r̃][r̃]ᵀ = |r|² I − r rᵀ.
+        sum.first_moment_b_kg_m += c.r_sc1b_b * m1 + c.r_sc2b_b * m2;
+        // Eqs. 8 and 10: m1 r′_Sc1 + m2 r′_Sc2 = μ1 θ̇1 ŝ13 + μ2 (θ̇1 + θ̇2) ŝ23.
+        sum.first_moment_prime_b_kg_m_s +=
+            c.s13 * (self.mu1 * th1_dot) + c.s23 * (self.mu2 * th12_dot);
+        // [I_Sc1] + [I_Sc2] + m1[r̃1][r̃1]ᵀ + m2[r̃2][r̃2]ᵀ, with [r̃][r̃]ᵀ = |r|² I − r rᵀ: the constant
+        // part plus four symmetric rank-one terms.
+        let (r1, r2) = (&c.r_sc1b_b, &c.r_sc2b_b);
         let i_b = &mut sum.inertia_pnt_b_b_kg_m2;
         *i_b += self.inertia_const_b;
-        for k in 0..3 {
-            i_b[(k, k)] += m1 * r1.norm_squared() + m2 * r2.norm_squared();
-        }
-        i_b.ger(i1.z - i1.x, &s13, &s13, 1.0);
-        i_b.ger(i2.z - i2.x, &s23, &s23, 1.0);
-        i_b.ger(-m1, &r1, &r1, 1.0);
-        i_b.ger(-m2, &r2, &r2, 1.0);
+        add_symmetric_rank_ones(
+            i_b,
+            m1 * r1.norm_squared() + m2 * r2.norm_squared(),
+            &[
+                (i1.z - i1.x, &c.s13),
+                (i2.z - i2.x, &c.s23),
+                (-m1, r1),
+                (-m2, r2),
+            ],
+        );
     }
 
     fn update_contributions(
@@ -225,56 +289,78 @@ impl StateEffector for PanelPair {
         let (i1, i2) = (&p.panel1.inertia_s_kg_m2, &p.panel2.inertia_s_kg_m2);
         let (th1, th1_dot, th2, th2_dot) = (x[THETA1], x[THETA1_DOT], x[THETA2], x[THETA2_DOT]);
         let th12_dot = th1_dot + th2_dot;
-        let s12 = &self.h12;
+        let (mu1, mu2) = (self.mu1, self.mu2);
+        let e = &self.h12; // ŝ12 = ŝ22 = ĥ12
         let (s11, s13, s21, s23) = (&c.s11, &c.s13, &c.s21, &c.s23);
         let (r1, r2) = (&c.r_sc1b_b, &c.r_sc2b_b);
-        let (r1p, r2p) = (&c.r_prime_sc1b_b, &c.r_prime_sc2b_b);
+        let (sn, cs) = (c.sin_phi, c.cos_phi);
 
-        // Eq. 121: [A_i].
-        let s13_s23 = s13.dot(s23);
-        let a11 = i1.y + m1 * d1 * d1 + m2 * l1 * l1 + m2 * l1 * d2 * s13_s23;
-        let a12 = m2 * l1 * d2 * s13_s23;
-        let a21 = i2.y + m2 * d2 * d2 + m2 * l1 * d2 * s13_s23;
-        let a22 = i2.y + m2 * d2 * d2;
+        // Frame identities used below, for the right-handed triads (ŝ11, ê, ŝ13) and (ŝ21, ê, ŝ23)
+        // with ŝ21 = cos φ ŝ11 − sin φ ŝ13 and ŝ23 = sin φ ŝ11 + cos φ ŝ13:
+        //   ŝ11 × ŝ13 = −ê, ŝ21 × ŝ23 = −ê, ŝ13 × ŝ21 = cos φ ê, ŝ13 × ŝ23 = sin φ ê,
+        //   ŝ11 × ŝ21 = sin φ ê, ŝ11 × ŝ23 = −cos φ ê; ŝ13·ŝ21 = −sin φ, ŝ13·ŝ23 = cos φ,
+        //   ŝ11·ŝ23 = sin φ. With R_jk = r_H1/B × ŝ_jk this gives, from Eqs. 6–7:
+        //   r1 × ŝ13 = R13 + d1 ê,  r2 × ŝ13 = R13 + (l1 + d2 cos φ) ê,
+        //   r2 × ŝ23 = R23 + (d2 + l1 cos φ) ê,  r1 × ŝ11 = R11,
+        //   r2 × ŝ11 = R11 + d2 sin φ ê,  r2 × ŝ21 = R21 − l1 sin φ ê.
+        let r11 = self.rho1 * c.cos1 - self.rho3 * c.sin1;
+        let r13 = self.rho1 * c.sin1 + self.rho3 * c.cos1;
+        let r21 = r11 * cs - r13 * sn;
+        let r23 = r11 * sn + r13 * cs;
+        let s13_rh = self.h11_rh * c.sin1 + self.h13_rh * c.cos1;
+        let s11_rh = self.h11_rh * c.cos1 - self.h13_rh * c.sin1;
+        let s23_rh = s11_rh * sn + s13_rh * cs;
 
-        // Eq. 122: rows of [F_i].
-        let f1 = s13 * (-(m2 * l1 + m1 * d1));
-        let f2 = s23 * (-m2 * d2);
-        // Eq. 123a, and 123b with erratum E1 (the m2 d2 term's sign): rows of [G_i], written as
-        // vectors using ŝᵀ[r̃] = −(r × ŝ)ᵀ.
-        let g1 = -(s12 * i1.y + r1.cross(s13) * (m1 * d1) + r2.cross(s13) * (m2 * l1));
-        let g2 = -(s12 * i2.y + r2.cross(s23) * (m2 * d2));
+        // Eq. 121: [A_i], with ŝ13·ŝ23 = cos φ.
+        let a12 = self.kappa * cs;
+        let a11 = self.a11_0 + a12;
+        let a22 = self.a22;
+        let a21 = a22 + a12;
+        // Eq. 122: rows of [F_i] are −μ1 ŝ13 and −μ2 ŝ23.
+        // Eq. 123a, and 123b with erratum E1: with the identities above, the rows of [G_i] are
+        //   g1 = −[I12 ê + m1 d1 r1 × ŝ13 + m2 l1 r2 × ŝ13] = −(μ1 R13 + a11 ê),
+        //   g2 = −[I22 ê + m2 d2 r2 × ŝ23] = −(μ2 R23 + a21 ê).
 
-        // Coriolis and centripetal accelerations of the panel centres of mass,
-        // 2[ω̃]r′ + [ω̃][ω̃]r (the bracketed terms of Eqs. 124–125).
-        let acc1 = w.cross(r1p) * 2.0 + w.cross(&w.cross(r1));
-        let acc2 = w.cross(r2p) * 2.0 + w.cross(&w.cross(r2));
-        // Centripetal terms of r″ (Eqs. 9 and 11).
-        let cent1 = s11 * (d1 * th1_dot * th1_dot);
-        let cent2 = s11 * (l1 * th1_dot * th1_dot) + s21 * (d2 * th12_dot * th12_dot);
-        // ω_B/N components along the panel axes (Eq. 53).
-        let (w_s11, w_s13, w_s21, w_s23) = (w.dot(s11), w.dot(s13), w.dot(s21), w.dot(s23));
+        // ω_B/N components (Eq. 53) and the dot products of the Coriolis/centripetal terms.
+        let (w11, w13, w21, w23, we) = (w.dot(s11), w.dot(s13), w.dot(s21), w.dot(s23), w.dot(e));
+        let w_sq = w.norm_squared();
+        let w_rh = w.dot(&p.r_h1b_b_m);
+        let w_r1 = w_rh - d1 * w11;
+        let w_r2 = w_rh - l1 * w11 - d2 * w21;
+        // ŝ13·(2ω × r′1 + ω × (ω × r1)) (r′1 ∥ ŝ13 drops out; ŝ13·r1 = ŝ13·r_H1):
+        let s13_acc1 = w13 * w_r1 - w_sq * s13_rh;
+        // ŝ13·(2ω × r′2 + ω × (ω × r2) + l1 θ̇1² ŝ11 + d2 θ̇12² ŝ21):
+        let s13_acc2 = -2.0 * d2 * th12_dot * sn * we + w13 * w_r2
+            - w_sq * (s13_rh + d2 * sn)
+            - d2 * th12_dot * th12_dot * sn;
+        // ŝ23·(2ω × r′2 + ω × (ω × r2) + l1 θ̇1² ŝ11):
+        let s23_acc2 = 2.0 * l1 * th1_dot * sn * we + w23 * w_r2 - w_sq * (s23_rh - l1 * sn)
+            + l1 * th1_dot * th1_dot * sn;
         let [u1, u2] = p.motor_torque_nm;
         let (k1, k2) = (p.panel1.k_n_m_rad, p.panel2.k_n_m_rad);
         let (c1, c2) = (p.panel1.c_n_m_s_rad, p.panel2.c_n_m_s_rad);
         // Eq. 124, plus the hinge motor torques: u1 acts on panel 1 (reaction on the hub), u2 on
         // panel 2 (reaction −u2 on panel 1).
         let v1 =
-            -(i1.x - i1.z) * w_s13 * w_s11 - k1 * th1 - c1 * th1_dot + k2 * th2 + c2 * th2_dot + u1
+            -(i1.x - i1.z) * w13 * w11 - k1 * th1 - c1 * th1_dot + k2 * th2 + c2 * th2_dot + u1
                 - u2
-                - m1 * d1 * s13.dot(&acc1)
-                - m2 * l1 * s13.dot(&(acc2 + cent2));
+                - m1 * d1 * s13_acc1
+                - m2 * l1 * s13_acc2;
         // Eq. 125 (with E1's sign carried through from Eq. 80).
-        let v2 = -(i2.x - i2.z) * w_s23 * w_s21 - k2 * th2 - c2 * th2_dot + u2
-            - m2 * d2 * s23.dot(&(acc2 + s11 * (l1 * th1_dot * th1_dot)));
+        let v2 = -(i2.x - i2.z) * w23 * w21 - k2 * th2 - c2 * th2_dot + u2 - m2 * d2 * s23_acc2;
 
-        // Eqs. 129–132: solve [A_i] X = [F_i | G_i | v_i] by Cramer's rule (2×2, det > 0 because
-        // [A_i] is a row operation away from the positive-definite Kane mass matrix).
+        // Eqs. 129–132: [A_i] X = [F_i | G_i | v_i] by Cramer's rule (2×2, det > 0 because [A_i]
+        // is a row operation away from the positive-definite Kane mass matrix). Written out,
+        //   x_f1 = −α11 ŝ13 + α12 ŝ23,       x_f2 = α21 ŝ13 − α22 ŝ23,
+        //   x_g1 = −α11 R13 + α12 R23 − ê,   x_g2 = α21 R13 − α22 R23,
+        // with α11 = a22 μ1/det, α12 = a12 μ2/det, α21 = a21 μ1/det, α22 = a11 μ2/det.
         let inv_det = 1.0 / (a11 * a22 - a12 * a21);
-        let xf1 = (f1 * a22 - f2 * a12) * inv_det;
-        let xf2 = (f2 * a11 - f1 * a21) * inv_det;
-        let xg1 = (g1 * a22 - g2 * a12) * inv_det;
-        let xg2 = (g2 * a11 - g1 * a21) * inv_det;
+        let (al11, al12) = (a22 * mu1 * inv_det, a12 * mu2 * inv_det);
+        let (al21, al22) = (a21 * mu1 * inv_det, a11 * mu2 * inv_det);
+        let xf1 = s23 * al12 - s13 * al11;
+        let xf2 = s13 * al21 - s23 * al22;
+        let xg1 = r23 * al12 - r13 * al11 - e;
+        let xg2 = r13 * al21 - r23 * al22;
         let xv1 = (v1 * a22 - v2 * a12) * inv_det;
         let xv2 = (v2 * a11 - v1 * a21) * inv_det;
         c.x_f = [xf1, xf2];
@@ -282,40 +368,42 @@ impl StateEffector for PanelPair {
         c.x_v = [xv1, xv2];
 
         // Coefficients of θ̈1 and θ̈2 in the hub equations 133 (translation) and 134 (rotation):
-        // p_1 = (m1 d1 + m2 l1) ŝ13 + m2 d2 ŝ23 = −(f1 + f2), p_2 = m2 d2 ŝ23 = −f2,
-        // q_1 = I12 ŝ12 + m1 d1 r̃1 ŝ13 + I22 ŝ22 + m2 l1 r̃2 ŝ13 + m2 d2 r̃2 ŝ23 = −(g1 + g2),
-        // q_2 = I22 ŝ22 + m2 d2 r̃2 ŝ23 = −g2.
-        let p1 = -(f1 + f2);
-        let p2 = -f2;
-        let q1 = -(g1 + g2);
-        let q2 = -g2;
+        // p1 = −(f1 + f2) = μ1 ŝ13 + μ2 ŝ23, p2 = −f2 = μ2 ŝ23,
+        // q1 = −(g1 + g2) = μ1 R13 + μ2 R23 + (a11 + a21) ê, q2 = −g2 = μ2 R23 + a21 ê.
+        let p2 = s23 * mu2;
+        let p1 = s13 * mu1 + p2;
+        let q2 = r23 * mu2 + e * a21;
+        let q1 = r13 * mu1 + q2 + e * a11;
 
         // Eqs. 139, 140, 142, 143 as rank-one updates of the hub sums.
-        sum.matrix_a.ger(1.0, &p1, &xf1, 1.0);
-        sum.matrix_a.ger(1.0, &p2, &xf2, 1.0);
-        sum.matrix_b.ger(1.0, &p1, &xg1, 1.0);
-        sum.matrix_b.ger(1.0, &p2, &xg2, 1.0);
-        sum.matrix_c.ger(1.0, &q1, &xf1, 1.0);
-        sum.matrix_c.ger(1.0, &q2, &xf2, 1.0);
-        sum.matrix_d.ger(1.0, &q1, &xg1, 1.0);
-        sum.matrix_d.ger(1.0, &q2, &xg2, 1.0);
+        sum.matrix_a += p1 * xf1.transpose() + p2 * xf2.transpose();
+        sum.matrix_b += p1 * xg1.transpose() + p2 * xg2.transpose();
+        sum.matrix_c += q1 * xf1.transpose() + q2 * xf2.transpose();
+        sum.matrix_d += q1 * xg1.transpose() + q2 * xg2.transpose();
 
-        // Eq. 141: the remaining (non-second-order) terms of Eq. 133.
-        sum.vec_trans -= cent1 * m1 + cent2 * m2 + p1 * xv1 + p2 * xv2;
-        // Eq. 144: the remaining terms of Eq. 134.
-        let v_rot_144 = w.cross(
-            &(s12 * (th1_dot * i1.y + th12_dot * i2.y) + r1.cross(r1p) * m1 + r2.cross(r2p) * m2),
-        ) + r1.cross(&cent1) * m1
-            + r2.cross(&cent2) * m2
+        // Eq. 141: m1 d1 θ̇1² ŝ11 + m2 (l1 θ̇1² ŝ11 + d2 θ̇12² ŝ21) = μ1 θ̇1² ŝ11 + μ2 θ̇12² ŝ21.
+        let (th1_dot_sq, th12_dot_sq) = (th1_dot * th1_dot, th12_dot * th12_dot);
+        sum.vec_trans -= s11 * (mu1 * th1_dot_sq) + s21 * (mu2 * th12_dot_sq) + p1 * xv1 + p2 * xv2;
+        // Eq. 144. The bodies' relative angular momentum about B,
+        // θ̇1 I12 ê + θ̇12 I22 ê + m1 r1 × r′1 + m2 r2 × r′2, equals q1 θ̇1 + q2 θ̇2 by the identities
+        // above; the centripetal torques m1 r1 × (d1 θ̇1² ŝ11) + m2 r2 × (l1 θ̇1² ŝ11 + d2 θ̇12² ŝ21)
+        // equal μ1 θ̇1² R11 + μ2 θ̇12² R21 + κ sin φ (θ̇1² − θ̇12²) ê.
+        let v_rot_144 = w.cross(&(q1 * th1_dot + q2 * th2_dot))
+            + r11 * (mu1 * th1_dot_sq)
+            + r21 * (mu2 * th12_dot_sq)
+            + e * (self.kappa * sn * (th1_dot_sq - th12_dot_sq))
             + q1 * xv1
             + q2 * xv2;
         // This pair's share of Eq. 150's −[I′_sc,B]ω. With ŝ3′ = θ̇ ŝ1, the moving inertia term
         // (I_3 − I_1) ŝ3ŝ3ᵀ has derivative θ̇ (I_3 − I_1)(ŝ1ŝ3ᵀ + ŝ3ŝ1ᵀ); the parallel-axis term
-        // m(|r|² I − r rᵀ) has derivative m(2 r·r′ I − r′rᵀ − r r′ᵀ).
-        let i_prime_omega = (s11 * w_s13 + s13 * w_s11) * (th1_dot * (i1.z - i1.x))
-            + (s21 * w_s23 + s23 * w_s21) * (th12_dot * (i2.z - i2.x))
-            + (w * (2.0 * r1.dot(r1p)) - r1p * r1.dot(w) - r1 * r1p.dot(w)) * m1
-            + (w * (2.0 * r2.dot(r2p)) - r2p * r2.dot(w) - r2 * r2p.dot(w)) * m2;
+        // m(|r|² I − r rᵀ) has derivative m(2 r·r′ I − r′rᵀ − r r′ᵀ), with r′1 = d1 θ̇1 ŝ13 and
+        // r′2 = l1 θ̇1 ŝ13 + d2 θ̇12 ŝ23 (Eqs. 8, 10).
+        let r2_r2p = l1 * th1_dot * (s13_rh + d2 * sn) + d2 * th12_dot * (s23_rh - l1 * sn);
+        let r2p = s13 * (l1 * th1_dot) + s23 * (d2 * th12_dot);
+        let i_prime_omega = (s11 * w13 + s13 * w11) * (th1_dot * (i1.z - i1.x))
+            + (s21 * w23 + s23 * w21) * (th12_dot * (i2.z - i2.x))
+            + (w * (2.0 * s13_rh) - s13 * w_r1 - r1 * w13) * (m1 * d1 * th1_dot)
+            + (w * (2.0 * r2_r2p) - r2p * w_r2 - r2 * r2p.dot(w)) * m2;
         sum.vec_rot -= v_rot_144 + i_prime_omega;
     }
 
