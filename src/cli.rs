@@ -4,11 +4,13 @@
 
 use std::fmt::{self, Write as _};
 use std::io::{self, BufWriter, Write};
+use std::num::NonZeroU64;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::config::{whole_ns, ConfigError, SimConfig, DEFAULT_CONFIG_TOML};
 use crate::dynamics::GravityModel;
+use crate::imu::ImuSample;
 use crate::sim::{Simulation, Snapshot};
 
 /// Arguments of `flexdyn simulate`.
@@ -203,6 +205,37 @@ pub fn csv_header(n_pairs: usize) -> String {
     h
 }
 
+/// The IMU columns appended to [`csv_header`], for IMUs `names` in config order: for each,
+/// `imu_<name>_omega_p_1..3`, `imu_<name>_accel_p_1..3`, `imu_<name>_dtheta_p_1..3`,
+/// `imu_<name>_dv_p_1..3` (each prefixed by a comma; empty for no IMU).
+pub fn csv_imu_header(names: &[String]) -> String {
+    let mut h = String::new();
+    for name in names {
+        for q in ["omega_p", "accel_p", "dtheta_p", "dv_p"] {
+            for i in 1..=3 {
+                let _ = write!(h, ",imu_{name}_{q}_{i}");
+            }
+        }
+    }
+    h
+}
+
+/// Appends the IMU columns of one row (each value prefixed by a comma, `{:.16e}`) to `row`.
+pub fn csv_imu_row(samples: &[ImuSample], row: &mut String) {
+    for s in samples {
+        for v in [
+            &s.omega_p_rad_s,
+            &s.accel_p_m_s2,
+            &s.dtheta_p_rad,
+            &s.dv_p_m_s,
+        ] {
+            for x in v.iter() {
+                let _ = write!(row, ",{x:.16e}");
+            }
+        }
+    }
+}
+
 /// Appends one CSV row for `s` to `row` (cleared first; no trailing newline). Floats have 17
 /// significant digits (`{:.16e}`), so they round-trip exactly.
 pub fn csv_row(s: &Snapshot, row: &mut String) {
@@ -238,6 +271,10 @@ pub fn simulate_to<W: Write>(
     let total_steps = whole_steps("--duration-s", duration_s, cfg.step_ns, true)?;
     let log_steps = whole_steps("--log-every-s", log_every_s, cfg.step_ns, false)?;
     let mut sim = Simulation::new(cfg).map_err(|source| CliError::Config { file: None, source })?;
+    // The IMU sample interval is the log interval (log_steps ≥ 1 and step_ns ≥ 1).
+    if let Some(ns) = NonZeroU64::new(log_steps * cfg.step_ns) {
+        sim.set_imu_sample_interval_ns(ns);
+    }
     let io_err = |source| CliError::Output {
         target: target.to_string(),
         source,
@@ -245,10 +282,12 @@ pub fn simulate_to<W: Write>(
 
     let mut out = BufWriter::new(out);
     let mut row = csv_header(sim.n_pairs());
+    row.push_str(&csv_imu_header(sim.imu_names()));
     row.push('\n');
     out.write_all(row.as_bytes()).map_err(io_err)?;
 
     let mut snap = Snapshot::with_capacity(sim.n_pairs());
+    let mut imu_samples = Vec::with_capacity(sim.n_imus());
     let n_logged = total_steps / log_steps;
     let start = Instant::now();
     for k in 0..=n_logged {
@@ -256,7 +295,9 @@ pub fn simulate_to<W: Write>(
             sim.step_n(log_steps);
         }
         sim.snapshot_into(&mut snap);
+        sim.imu_samples_into(&mut imu_samples);
         csv_row(&snap, &mut row);
+        csv_imu_row(&imu_samples, &mut row);
         row.push('\n');
         out.write_all(row.as_bytes()).map_err(io_err)?;
     }

@@ -12,7 +12,8 @@
 //!    ([`ConfigError::Param`] wrapping [`ParamError::NotFinite`]);
 //! 4. physics and timing: the dynamics' own `validate` functions ([`ConfigError::Param`]) and the
 //!    checks that only make sense for a file (step and frame in whole nanoseconds, which point the
-//!    initial state describes, gravity model name, wrench schedule times).
+//!    initial state describes, gravity model name, wrench schedule times), then the IMUs'
+//!    ([`ImuConfig::validate`], unique names).
 //!
 //! The built-in default is [`DEFAULT_CONFIG_TOML`], the verbatim text of
 //! `scenarios/reference.toml`. The README's "Configuration" section documents every key.
@@ -31,6 +32,7 @@ use crate::dynamics::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
     PanelPairParams, PanelParams, ParamError, Spacecraft, StateEffector, WrenchSegment,
 };
+use crate::imu::{AccelErrors, GyroErrors, ImuConfig, ImuParamError};
 
 /// The built-in default configuration (the text of `scenarios/reference.toml`).
 pub const DEFAULT_CONFIG_TOML: &str = include_str!("../scenarios/reference.toml");
@@ -209,6 +211,19 @@ impl From<ParamError> for ConfigError {
     }
 }
 
+impl From<ImuParamError> for ConfigError {
+    fn from(e: ImuParamError) -> Self {
+        match e {
+            ImuParamError::Param(source) => source.into(),
+            ImuParamError::Invalid { field, problem } => ConfigError::Invalid {
+                field,
+                problem,
+                at: At(None),
+            },
+        }
+    }
+}
+
 /// The field path a [`ParamError`] names, if any.
 fn param_field(e: &ParamError) -> Option<&str> {
     match e {
@@ -245,8 +260,9 @@ pub struct SimConfig {
     pub wrench_schedule: Vec<WrenchSegment>,
     /// The `[server]` table, uninterpreted (empty if absent); the server validates it.
     pub server: toml::Table,
-    /// The `[[imus]]` tables, uninterpreted (empty if absent).
-    pub imus: Vec<toml::Table>,
+    /// The IMUs (`[[imus]]`), validated, in file order (empty if absent). IMU `i` is sensor
+    /// point `i` of the spacecraft built by [`Self::build_spacecraft`].
+    pub imus: Vec<ImuConfig>,
     /// The configuration text this was parsed from.
     pub source_toml: String,
 }
@@ -302,20 +318,25 @@ impl SimConfig {
     }
 
     /// Builds the spacecraft: one [`PanelPair`] per configured pair (errors name
-    /// `panel_pairs[i]…`), then [`Spacecraft::new`].
+    /// `panel_pairs[i]…`), then [`Spacecraft::new`], then one sensor point per IMU in file order
+    /// (sensor point `i` is `imus[i]`).
     pub fn build_spacecraft(&self) -> Result<Spacecraft, ConfigError> {
         let mut effectors: Vec<Box<dyn StateEffector>> = Vec::with_capacity(self.panel_pairs.len());
         for (i, (params, initial)) in self.panel_pairs.iter().enumerate() {
             let pair = PanelPair::new(params.clone(), *initial, &format!("panel_pairs[{i}]"))?;
             effectors.push(Box::new(pair));
         }
-        Ok(Spacecraft::new(
+        let mut sc = Spacecraft::new(
             self.hub.clone(),
             self.gravity,
             effectors,
             self.initial,
             self.step_ns,
-        )?)
+        )?;
+        for (i, imu) in self.imus.iter().enumerate() {
+            sc.add_sensor_point(imu.sensor_point(), &format!("imus[{i}]"))?;
+        }
+        Ok(sc)
     }
 }
 
@@ -352,7 +373,7 @@ struct RawConfig {
     #[serde(default)]
     server: toml::Table,
     #[serde(default)]
-    imus: Vec<toml::Table>,
+    imus: Vec<RawImu>,
 }
 
 #[derive(Deserialize)]
@@ -425,6 +446,88 @@ struct RawPanel2 {
     c_n_m_s_rad: f64,
     theta_rad: f64,
     theta_dot_rad_s: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawImu {
+    name: String,
+    r_sb_b_m: [f64; 3],
+    dcm_pb: [[f64; 3]; 3],
+    seed: u64,
+    #[serde(default)]
+    gyro: RawGyro,
+    #[serde(default)]
+    accel: RawAccel,
+}
+
+/// `[imus.gyro]`: every key optional, zero by default (see [`GyroErrors`]).
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+struct RawGyro {
+    arw_rad_s_sqrt_hz: f64,
+    bias_instability_sigma_rad_s: f64,
+    bias_instability_tau_s: f64,
+    rrw_rad_s2_sqrt_hz: f64,
+    bias_rad_s: [f64; 3],
+    scale_factor: [f64; 3],
+    misalignment_rad: [[f64; 3]; 3],
+    range_rad_s: f64,
+    lsb_rad_s: f64,
+    dtheta_lsb_rad: f64,
+}
+
+/// `[imus.accel]`: every key optional, zero by default (see [`AccelErrors`]).
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+struct RawAccel {
+    vrw_m_s2_sqrt_hz: f64,
+    bias_instability_sigma_m_s2: f64,
+    bias_instability_tau_s: f64,
+    rrw_m_s3_sqrt_hz: f64,
+    bias_m_s2: [f64; 3],
+    scale_factor: [f64; 3],
+    misalignment_rad: [[f64; 3]; 3],
+    range_m_s2: f64,
+    lsb_m_s2: f64,
+    dv_lsb_m_s: f64,
+}
+
+impl RawImu {
+    fn into_config(self) -> ImuConfig {
+        let g = self.gyro;
+        let a = self.accel;
+        ImuConfig {
+            name: self.name,
+            r_sb_b_m: vec3(&self.r_sb_b_m),
+            dcm_pb: mat3(&self.dcm_pb),
+            seed: self.seed,
+            gyro: GyroErrors {
+                arw_rad_s_sqrt_hz: g.arw_rad_s_sqrt_hz,
+                bias_instability_sigma_rad_s: g.bias_instability_sigma_rad_s,
+                bias_instability_tau_s: g.bias_instability_tau_s,
+                rrw_rad_s2_sqrt_hz: g.rrw_rad_s2_sqrt_hz,
+                bias_rad_s: vec3(&g.bias_rad_s),
+                scale_factor: vec3(&g.scale_factor),
+                misalignment_rad: mat3(&g.misalignment_rad),
+                range_rad_s: g.range_rad_s,
+                lsb_rad_s: g.lsb_rad_s,
+                dtheta_lsb_rad: g.dtheta_lsb_rad,
+            },
+            accel: AccelErrors {
+                vrw_m_s2_sqrt_hz: a.vrw_m_s2_sqrt_hz,
+                bias_instability_sigma_m_s2: a.bias_instability_sigma_m_s2,
+                bias_instability_tau_s: a.bias_instability_tau_s,
+                rrw_m_s3_sqrt_hz: a.rrw_m_s3_sqrt_hz,
+                bias_m_s2: vec3(&a.bias_m_s2),
+                scale_factor: vec3(&a.scale_factor),
+                misalignment_rad: mat3(&a.misalignment_rad),
+                range_m_s2: a.range_m_s2,
+                lsb_m_s2: a.lsb_m_s2,
+                dv_lsb_m_s: a.dv_lsb_m_s,
+            },
+        }
+    }
 }
 
 #[derive(Deserialize)]
@@ -576,6 +679,22 @@ impl RawConfig {
             wrench_schedule.push(seg);
         }
 
+        // [[imus]]
+        let mut imus = Vec::with_capacity(self.imus.len());
+        let mut imu_names = HashSet::new();
+        for (i, raw) in self.imus.into_iter().enumerate() {
+            let path = format!("imus[{i}]");
+            let imu = raw.into_config();
+            imu.validate(&path).map_err(|e| map.imu_error(e))?;
+            if !imu_names.insert(imu.name.clone()) {
+                return Err(map.invalid(
+                    &format!("{path}.name"),
+                    format!("duplicate IMU name `{}` (names must be unique)", imu.name),
+                ));
+            }
+            imus.push(imu);
+        }
+
         Ok(SimConfig {
             step_ns,
             frame_ns,
@@ -586,7 +705,7 @@ impl RawConfig {
             panel_pairs,
             wrench_schedule,
             server: self.server,
-            imus: self.imus,
+            imus,
             source_toml: source.to_string(),
         })
     }
@@ -979,6 +1098,25 @@ impl<'s> SourceMap<'s> {
             field: field.to_string(),
             problem,
             at: self.at(field),
+        }
+    }
+
+    fn imu_error(&self, e: ImuParamError) -> ConfigError {
+        match e {
+            ImuParamError::Param(p) => self.param_error(p),
+            ImuParamError::Invalid { field, problem } => {
+                // An absent key (e.g. a missing time constant) points at its table.
+                let mut at = self.at(&field);
+                let mut parent = field.as_str();
+                while at.0.is_none() {
+                    match parent.rfind('.') {
+                        Some(i) => parent = &parent[..i],
+                        None => break,
+                    }
+                    at = self.at(parent);
+                }
+                ConfigError::Invalid { field, problem, at }
+            }
         }
     }
 

@@ -3,6 +3,7 @@
 //! # Layout
 //! - [`attitude`]: MRP, DCM and quaternion kernels.
 //! - [`dynamics`]: the physics core — rigid hub + dual-hinged panel pairs by back-substitution.
+//! - [`imu`]: gyro and accelerometer measurement models (truth at the sensor, error model, RNG).
 
 #![warn(missing_docs)]
 
@@ -10,4 +11,5 @@ pub mod attitude;
 pub mod cli;
 pub mod config;
 pub mod dynamics;
+pub mod imu;
 pub mod sim;

@@ -4,12 +4,19 @@
 //! wrench commanded by the attitude-control software. Before every RK4 step it applies
 //! `schedule(t) + command`, where `t` is the time at the start of the step; the wrench is then
 //! held constant over the step.
+//!
+//! It also owns the IMU error models ([`crate::imu`]): [`Simulation::imu_samples_into`] closes
+//! the current IMU sample interval (every frame in the server, every log interval in
+//! `simulate`) and returns one [`ImuSample`] per configured IMU.
+
+use std::num::NonZeroU64;
 
 use nalgebra::{Vector3, Vector4};
 
 use crate::attitude::{mrp_to_dcm, mrp_to_quat};
 use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::{Conserved, Spacecraft, WrenchSegment};
+use crate::imu::{attitude_increment_b, Imu, ImuSample, ImuTruth};
 
 /// A spacecraft being propagated, with its external wrench sources.
 #[derive(Debug)]
@@ -22,6 +29,13 @@ pub struct Simulation {
     cursor: usize,
     command_force_b_n: Vector3<f64>,
     command_torque_b_nm: Vector3<f64>,
+    /// The IMUs in config order; IMU `i` is the spacecraft's sensor point `i`.
+    imus: Vec<Imu>,
+    imu_names: Vec<String>,
+    /// \[ns\] start of the current IMU sample interval.
+    imu_interval_start_ns: u64,
+    /// σ_B/N at the start of the current IMU sample interval.
+    imu_sigma_bn_start: Vector3<f64>,
 }
 
 /// Everything a telemetry frame or a CSV row needs, at one instant.
@@ -90,6 +104,12 @@ impl Simulation {
     /// Builds the spacecraft of `cfg` at t = 0 with a zero commanded wrench.
     pub fn new(cfg: &SimConfig) -> Result<Self, ConfigError> {
         let sc = cfg.build_spacecraft()?;
+        let frame_s = cfg.frame_ns as f64 * 1e-9;
+        let mut imus = Vec::with_capacity(cfg.imus.len());
+        for (i, imu) in cfg.imus.iter().enumerate() {
+            imus.push(Imu::new(imu, &format!("imus[{i}]"), frame_s)?);
+        }
+        let imu_sigma_bn_start = sc.state().sigma_bn;
         let mut sim = Self {
             sc,
             frame_ns: cfg.frame_ns,
@@ -97,6 +117,10 @@ impl Simulation {
             cursor: 0,
             command_force_b_n: Vector3::zeros(),
             command_torque_b_nm: Vector3::zeros(),
+            imu_names: cfg.imus.iter().map(|c| c.name.clone()).collect(),
+            imus,
+            imu_interval_start_ns: 0,
+            imu_sigma_bn_start,
         };
         sim.apply_wrench();
         Ok(sim)
@@ -223,6 +247,80 @@ impl Simulation {
         let (force, torque) = self.sc.wrench();
         out.force_b_n = force;
         out.torque_b_nm = torque;
+    }
+
+    /// The IMU names in config order (topic `flexdyn/<sc-id>/tlm/imu/<name>`).
+    pub fn imu_names(&self) -> &[String] {
+        &self.imu_names
+    }
+
+    /// Number of IMUs.
+    pub fn n_imus(&self) -> usize {
+        self.imus.len()
+    }
+
+    /// The IMU error models, in config order.
+    pub fn imus(&self) -> &[Imu] {
+        &self.imus
+    }
+
+    /// \[ns\] start of the current IMU sample interval.
+    pub fn imu_interval_start_ns(&self) -> u64 {
+        self.imu_interval_start_ns
+    }
+
+    /// Sets every IMU's nominal sample interval T_s (default: the frame period). The
+    /// instantaneous outputs carry white noise of standard deviation N/√T_s; `simulate` sets it
+    /// to the log interval. It does not change where intervals end: that is when
+    /// [`Self::imu_samples_into`] is called.
+    pub fn set_imu_sample_interval_ns(&mut self, interval_ns: NonZeroU64) {
+        let t_s = interval_ns.get() as f64 * 1e-9;
+        for imu in &mut self.imus {
+            // Cannot fail: a positive whole number of ns is finite and > 0.
+            let _ = imu.set_sample_interval_s(t_s);
+        }
+    }
+
+    /// Closes the current IMU sample interval at the current time and writes one measurement per
+    /// IMU (config order) into `out` (cleared first; after the first call this allocates
+    /// nothing). Then starts the next interval here.
+    ///
+    /// Truth (see [`crate::imu`]): rate and specific force at the current state, with the
+    /// wrench that applies from now on (schedule(t) + command, as in [`Self::snapshot_into`]);
+    /// Δθ from σ_B/N at the interval's start and now; Δv from the RK4 accumulators, which are
+    /// then reset. Each IMU's error model is stepped with dt = the interval's length (0 for the
+    /// first call at t = 0, whose Δθ and Δv are exactly zero).
+    pub fn imu_samples_into(&mut self, out: &mut Vec<ImuSample>) {
+        out.clear();
+        if self.imus.is_empty() {
+            return;
+        }
+        self.apply_wrench();
+        let hub = self.sc.hub_outputs();
+        let t_ns = self.sc.t_sim_ns();
+        let dt_s = t_ns.saturating_sub(self.imu_interval_start_ns) as f64 * 1e-9;
+        let sigma_bn = self.sc.state().sigma_bn;
+        let dtheta_b = attitude_increment_b(&self.imu_sigma_bn_start, &sigma_bn);
+        for (i, imu) in self.imus.iter_mut().enumerate() {
+            let (omega_p, accel_p) = self.sc.sensor_truth(i, &hub);
+            let truth = ImuTruth {
+                omega_p_rad_s: omega_p,
+                accel_p_m_s2: accel_p,
+                dtheta_p_rad: imu.dcm_pb() * dtheta_b,
+                dv_p_m_s: self.sc.sensor_dv_p()[i],
+            };
+            out.push(imu.sample(&truth, dt_s));
+        }
+        self.restart_imu_interval();
+    }
+
+    /// Starts a new IMU sample interval at the current state without sampling (discards the Δv
+    /// accumulated so far). Call it after replacing the spacecraft state (e.g. a snapshot
+    /// restore) so the next Δθ/Δv do not span the jump.
+    pub fn restart_imu_interval(&mut self) {
+        self.sc.reset_sensor_dv();
+        self.imu_interval_start_ns = self.sc.t_sim_ns();
+        self.imu_sigma_bn_start = self.sc.state().sigma_bn;
     }
 }
 

@@ -185,6 +185,7 @@ fn every_shipped_scenario_is_valid() {
             "damped_wing",
             "eight_pairs",
             "folded_wing",
+            "imu_tactical",
             "j2_orbit",
             "no_gravity",
             "reference"
@@ -295,7 +296,13 @@ fn optional_keys_are_mapped() {
     t.insert("server".into(), Value::Table(server.clone()));
     let mut imu = Table::new();
     imu.insert("name".into(), Value::String("imu0".into()));
-    t.insert("imus".into(), Value::Array(vec![Value::Table(imu.clone())]));
+    imu.insert("r_sb_b_m".into(), vec_value(&[0.2, 0.1, 1.2]));
+    imu.insert(
+        "dcm_pb".into(),
+        mat_value([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+    );
+    imu.insert("seed".into(), Value::Integer(1));
+    t.insert("imus".into(), Value::Array(vec![Value::Table(imu)]));
     let cfg = SimConfig::from_toml_str(&toml::to_string(&t).unwrap()).unwrap();
     assert_eq!(cfg.panel_pairs[1].0.motor_torque_nm, [1.5, -0.5]);
     assert_eq!(cfg.panel_pairs[0].0.motor_torque_nm, [0.0, 0.0]);
@@ -311,7 +318,16 @@ fn optional_keys_are_mapped() {
     );
     assert_eq!(cfg.wrench_schedule[1].t_start_ns, 250_000_000);
     assert_eq!(cfg.server, server);
-    assert_eq!(cfg.imus, vec![imu]);
+    // An IMU without [imus.gyro] / [imus.accel] tables has every error term zero.
+    assert_eq!(
+        cfg.imus,
+        vec![flexdyn::imu::ImuConfig::ideal(
+            "imu0",
+            Vector3::new(0.2, 0.1, 1.2),
+            Matrix3::identity(),
+            1
+        )]
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
