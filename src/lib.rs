@@ -4,6 +4,7 @@
 //! - [`attitude`]: MRP, DCM and quaternion kernels.
 //! - [`dynamics`]: the physics core — rigid hub + dual-hinged panel pairs by back-substitution.
 //! - [`imu`]: gyro and accelerometer measurement models (truth at the sensor, error model, RNG).
+//! - [`server`]: the Zenoh server (`flexdyn run`): real-time, lockstep and batch propagation.
 
 #![warn(missing_docs)]
 
@@ -12,4 +13,5 @@ pub mod cli;
 pub mod config;
 pub mod dynamics;
 pub mod imu;
+pub mod server;
 pub mod sim;

@@ -6,9 +6,10 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{CommandFactory, Parser, Subcommand};
+use clap::{Parser, Subcommand};
 use flexdyn::cli::{self, CliError, SimulateArgs};
 use flexdyn::config::DEFAULT_CONFIG_TOML;
+use flexdyn::server::cli::{run_from_args, RunArgs};
 
 /// Real-time flight-software-in-the-loop spacecraft dynamics: rigid hub + dual-hinged panels.
 #[derive(Debug, Parser)]
@@ -20,7 +21,9 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    // The real-time server's `Run` subcommand goes here.
+    /// Run the server (the default without a subcommand): propagate the spacecraft and talk to
+    /// flight code over Zenoh, in real time, lockstep or batch.
+    Run(Box<RunArgs>),
     /// Propagate a configuration offline and write the state history as CSV.
     Simulate(SimulateArgs),
     /// Validate a configuration file and print a one-line summary (exit 2 if invalid).
@@ -52,6 +55,18 @@ fn print_default_config() -> Result<(), CliError> {
         })
 }
 
+/// `flexdyn run`: the server until its duration, a signal or an error. Exit code 0 on success,
+/// 2 for invalid settings or configuration, 1 for a failure while running.
+fn run_server(args: &RunArgs) -> ExitCode {
+    match run_from_args(args) {
+        Ok(_report) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let args = Cli::parse();
     init_tracing();
@@ -61,11 +76,9 @@ fn main() -> ExitCode {
             cli::check_config(&file).map(|summary| println!("{summary}"))
         }
         Some(Command::PrintDefaultConfig) => print_default_config(),
-        // No subcommand: the server engineer makes this run the real-time server.
-        None => {
-            eprintln!("{}", Cli::command().render_help());
-            return ExitCode::from(2);
-        }
+        Some(Command::Run(a)) => return run_server(&a),
+        // No subcommand: the real-time server with every default.
+        None => return run_server(&RunArgs::default()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

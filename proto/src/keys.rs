@@ -15,6 +15,9 @@ pub const IMU_PREFIX: &str = "tlm/imu";
 pub const CMD_WRENCH_SUFFIX: &str = "cmd/wrench";
 /// Suffix of the status topic.
 pub const STATUS_SUFFIX: &str = "status";
+/// Prefix of the lockstep-participant liveliness tokens; the decimal sender id
+/// follows after a `/` (`flexdyn/<sc>/participant/<sender_id>`).
+pub const PARTICIPANT_PREFIX: &str = "participant";
 /// Longest accepted spacecraft id or IMU name (bytes).
 pub const MAX_ID_LEN: usize = 64;
 
@@ -79,6 +82,20 @@ pub fn status_key(sc: &str) -> Result<String, KeyError> {
     Ok(format!("{KEY_ROOT}/{sc}/{STATUS_SUFFIX}"))
 }
 
+/// `flexdyn/<sc>/participant/<sender_id>`: the Zenoh liveliness token a lockstep
+/// participant declares once it is subscribed to the state topic, so the server
+/// knows it is present before publishing tick 0.
+pub fn participant_key(sc: &str, sender_id: u32) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{PARTICIPANT_PREFIX}/{sender_id}"))
+}
+
+/// `flexdyn/<sc>/participant/*` — every participant token of a spacecraft.
+pub fn participant_wildcard_key(sc: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{PARTICIPANT_PREFIX}/*"))
+}
+
 /// All keys of one spacecraft, validated once.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Topics {
@@ -128,6 +145,32 @@ impl Topics {
     pub fn imu_wildcard(&self) -> String {
         format!("{KEY_ROOT}/{}/{IMU_PREFIX}/*", self.sc_id)
     }
+
+    /// `flexdyn/<sc>/participant/<sender_id>` (liveliness token of a lockstep participant).
+    pub fn participant(&self, sender_id: u32) -> String {
+        format!("{KEY_ROOT}/{}/{PARTICIPANT_PREFIX}/{sender_id}", self.sc_id)
+    }
+
+    /// `flexdyn/<sc>/participant/*`
+    pub fn participant_wildcard(&self) -> String {
+        format!("{KEY_ROOT}/{}/{PARTICIPANT_PREFIX}/*", self.sc_id)
+    }
+
+    /// The sender id of a participant token key of this spacecraft
+    /// (`flexdyn/<sc>/participant/<decimal u32>`), `None` for any other key.
+    pub fn participant_id(&self, key: &str) -> Option<u32> {
+        let rest = key
+            .strip_prefix(KEY_ROOT)?
+            .strip_prefix('/')?
+            .strip_prefix(self.sc_id.as_str())?
+            .strip_prefix('/')?
+            .strip_prefix(PARTICIPANT_PREFIX)?
+            .strip_prefix('/')?;
+        if rest.is_empty() || !rest.bytes().all(|b| b.is_ascii_digit()) {
+            return None;
+        }
+        rest.parse().ok()
+    }
 }
 
 #[cfg(test)]
@@ -151,6 +194,28 @@ mod tests {
         assert_eq!(t.status(), "flexdyn/sc-1/status");
         assert_eq!(t.imu("g").unwrap(), "flexdyn/sc-1/tlm/imu/g");
         assert_eq!(t.imu_wildcard(), "flexdyn/sc-1/tlm/imu/*");
+        assert_eq!(t.participant(7), "flexdyn/sc-1/participant/7");
+        assert_eq!(participant_key("sc-1", 7).unwrap(), t.participant(7));
+        assert_eq!(t.participant_wildcard(), "flexdyn/sc-1/participant/*");
+        assert_eq!(
+            participant_wildcard_key("sc-1").unwrap(),
+            t.participant_wildcard()
+        );
+        assert_eq!(t.participant_id("flexdyn/sc-1/participant/7"), Some(7));
+        assert_eq!(
+            t.participant_id("flexdyn/sc-1/participant/4294967295"),
+            Some(u32::MAX)
+        );
+        for bad in [
+            "flexdyn/sc-1/participant/",
+            "flexdyn/sc-1/participant/x",
+            "flexdyn/sc-1/participant/+7",
+            "flexdyn/sc-1/participant/4294967296",
+            "flexdyn/sc-2/participant/7",
+            "flexdyn/sc-1/tlm/state",
+        ] {
+            assert_eq!(t.participant_id(bad), None, "{bad}");
+        }
     }
 
     #[test]

@@ -13,6 +13,7 @@
 //! | `flexdyn/<sc-id>/tlm/imu/<name>` | [`ImuMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/cmd/wrench` | [`CommandMsg`] | flight code → server |
 //! | `flexdyn/<sc-id>/status` | [`StatusMsg`] | server → anyone |
+//! | `flexdyn/<sc-id>/participant/<sender-id>` | Zenoh liveliness token (no payload) | lockstep participant → server |
 //!
 //! Build keys with [`Topics`] or [`state_key`] & co; ids are validated
 //! ([`KeyError`]).
@@ -45,7 +46,10 @@
 //! In [`Mode::Lockstep`] the server publishes the state for tick `k`, then waits
 //! until every lockstep participant has published a [`CommandMsg`] with
 //! `header.tick == k` (either [`CommandKind::Wrench`] or
-//! [`CommandKind::NoCommand`]) before stepping to `k + 1`.
+//! [`CommandKind::NoCommand`]) before stepping to `k + 1`. Before tick 0 it waits
+//! until every participant has declared its Zenoh liveliness token
+//! [`Topics::participant`] (declared after the participant's state subscriber),
+//! so the first publication is not lost.
 //!
 //! # Example
 //!
@@ -72,9 +76,9 @@ pub use codec::{
 };
 pub use error::{DecodeError, KeyError};
 pub use keys::{
-    cmd_wrench_key, imu_key, imu_wildcard_key, state_key, status_key, validate_imu_name,
-    validate_sc_id, Topics, CMD_WRENCH_SUFFIX, IMU_PREFIX, KEY_ROOT, MAX_ID_LEN, STATE_SUFFIX,
-    STATUS_SUFFIX,
+    cmd_wrench_key, imu_key, imu_wildcard_key, participant_key, participant_wildcard_key,
+    state_key, status_key, validate_imu_name, validate_sc_id, Topics, CMD_WRENCH_SUFFIX,
+    IMU_PREFIX, KEY_ROOT, MAX_ID_LEN, PARTICIPANT_PREFIX, STATE_SUFFIX, STATUS_SUFFIX,
 };
 pub use layout::{
     WireLayout, WireMessage, COMMAND_KIND_OFFSET, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN,

@@ -156,7 +156,9 @@ pub struct StateMsg {
     pub nongrav_accel_bn_n_m_s2: [f64; 3],
     /// Conserved quantities.
     pub conserved: Conserved,
-    /// External wrench held over the frame that ended at this tick.
+    /// Commanded wrench (the flight-code commands summed in sender-id order, after
+    /// the stale-command policy) held over the frame that ended at this tick; zero
+    /// at tick 0. The configuration's scheduled disturbance wrench is not included.
     pub wrench_applied: AppliedWrench,
     /// Command bookkeeping bits, see [`command_flags`].
     pub command_flags: u8,

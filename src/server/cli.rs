@@ -1,0 +1,185 @@
+//! `flexdyn run`: its arguments, and the process-level wrapper around [`super::run`] (settings
+//! from the file and the options, the tokio runtime, the Zenoh session, SIGINT/SIGTERM).
+
+use std::path::PathBuf;
+
+use super::error::{ServerError, SettingsError};
+use super::settings::{Origin, ServerSettings, Value};
+use super::zenoh_cfg::{zenoh_config, Role, ZenohArgs};
+use super::RunReport;
+use crate::config::{SimConfig, DEFAULT_CONFIG_TOML};
+
+/// Arguments of `flexdyn run` (plain `flexdyn` runs with all defaults). Every server option
+/// overrides the same key of the configuration's `[server]` table.
+#[derive(Clone, Debug, Default, PartialEq, clap::Args)]
+pub struct RunArgs {
+    /// Configuration file (TOML). Default: the embedded reference spacecraft
+    /// (`flexdyn print-default-config`).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Pacing mode [default: realtime].
+    #[arg(long, value_parser = ["realtime", "lockstep", "batch"])]
+    pub mode: Option<String>,
+    /// Lockstep participants / accepted command senders (sender ids, comma-separated)
+    /// [default: 1].
+    #[arg(long, value_name = "ID,...", value_delimiter = ',', num_args = 1.., allow_negative_numbers = true)]
+    pub participants: Option<Vec<i64>>,
+    /// Lockstep: seconds to wait for each participant's answer to a tick [default: 10].
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub participant_timeout_s: Option<f64>,
+    /// Lockstep: seconds to wait before tick 0 for every participant [default: 30].
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub presence_timeout_s: Option<f64>,
+    /// String spacecraft id in the key expressions flexdyn/ID/... [default: sc1].
+    #[arg(long, value_name = "ID")]
+    pub sc_id: Option<String>,
+    /// Numeric spacecraft id in every message header [default: 1].
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub spacecraft_id: Option<i64>,
+    /// Simulated duration in seconds, a whole number of frames [default: run until stopped].
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub duration_s: Option<f64>,
+    /// Real time: overrun policy [default: catch_up].
+    #[arg(long, value_parser = ["catch_up", "skip", "abort"])]
+    pub overrun_policy: Option<String>,
+    /// Real time, abort policy: consecutive overruns tolerated [default: 10].
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub overrun_limit: Option<i64>,
+    /// A command older than this (simulation seconds) is stale [default: 0.1].
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub stale_after_s: Option<f64>,
+    /// Stale-command policy [default: hold].
+    #[arg(long, value_parser = ["hold", "zero"])]
+    pub stale_policy: Option<String>,
+    /// StatusMsg rate in Hz [default: 10].
+    #[arg(long, value_name = "HZ", allow_negative_numbers = true)]
+    pub status_hz: Option<f64>,
+    /// Seconds between timing summaries in the log [default: 10].
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub summary_interval_s: Option<f64>,
+    /// Real time: spin this many µs before each deadline instead of sleeping [default: 200].
+    #[arg(long, value_name = "US", allow_negative_numbers = true)]
+    pub spin_us: Option<i64>,
+    /// Preallocated telemetry buffers [default: 8].
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub telemetry_buffers: Option<i64>,
+    /// Command queue capacity [default: 1024].
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub command_queue: Option<i64>,
+    /// Zenoh endpoints and configuration file.
+    #[command(flatten)]
+    pub zenoh: ZenohArgs,
+}
+
+impl RunArgs {
+    /// The command-line overrides as `(key, value)` pairs, in [`super::settings::KEYS`] order.
+    fn overrides(&self) -> Vec<(&'static str, Value)> {
+        let mut out = Vec::new();
+        let s = |v: &Option<String>| v.clone().map(Value::Str);
+        let f = |v: &Option<f64>| v.map(Value::Float);
+        let i = |v: &Option<i64>| v.map(Value::Int);
+        let pairs: [(&'static str, Option<Value>); 16] = [
+            ("mode", s(&self.mode)),
+            ("sc_id", s(&self.sc_id)),
+            ("spacecraft_id", i(&self.spacecraft_id)),
+            ("participants", self.participants.clone().map(Value::Ints)),
+            ("participant_timeout_s", f(&self.participant_timeout_s)),
+            ("presence_timeout_s", f(&self.presence_timeout_s)),
+            ("duration_s", f(&self.duration_s)),
+            ("overrun_policy", s(&self.overrun_policy)),
+            ("overrun_limit", i(&self.overrun_limit)),
+            ("stale_after_s", f(&self.stale_after_s)),
+            ("stale_policy", s(&self.stale_policy)),
+            ("status_hz", f(&self.status_hz)),
+            ("summary_interval_s", f(&self.summary_interval_s)),
+            ("spin_us", i(&self.spin_us)),
+            ("telemetry_buffers", i(&self.telemetry_buffers)),
+            ("command_queue", i(&self.command_queue)),
+        ];
+        for (k, v) in pairs {
+            if let Some(v) = v {
+                out.push((k, v));
+            }
+        }
+        out
+    }
+
+    /// The settings of `cfg`'s `[server]` table with these options applied on top.
+    pub fn settings(&self, cfg: &SimConfig) -> Result<ServerSettings, SettingsError> {
+        let mut settings = ServerSettings::from_table(&cfg.server)?;
+        for (key, value) in self.overrides() {
+            settings.apply(key, &value, Origin::Cli)?;
+        }
+        settings.validate()?;
+        Ok(settings)
+    }
+
+    /// Loads the configuration file, or the embedded default.
+    pub fn load_config(&self) -> Result<SimConfig, ServerError> {
+        match &self.config {
+            Some(p) => SimConfig::from_file(p).map_err(|source| ServerError::Config {
+                file: Some(p.clone()),
+                source,
+            }),
+            None => SimConfig::from_toml_str(DEFAULT_CONFIG_TOML)
+                .map_err(|source| ServerError::Config { file: None, source }),
+        }
+    }
+}
+
+/// Completes on the first SIGINT or SIGTERM (Ctrl-C only on non-Unix platforms).
+async fn shutdown_signal() -> Result<impl std::future::Future<Output = ()>, ServerError> {
+    #[cfg(unix)]
+    {
+        use tokio::signal::unix::{signal, SignalKind};
+        let mut int = signal(SignalKind::interrupt()).map_err(|source| ServerError::Signal {
+            signal: "SIGINT",
+            source,
+        })?;
+        let mut term = signal(SignalKind::terminate()).map_err(|source| ServerError::Signal {
+            signal: "SIGTERM",
+            source,
+        })?;
+        Ok(async move {
+            let which = tokio::select! {
+                _ = int.recv() => "SIGINT",
+                _ = term.recv() => "SIGTERM",
+            };
+            tracing::info!(signal = which, "shutdown signal received");
+        })
+    }
+    #[cfg(not(unix))]
+    {
+        Ok(async {
+            let _ = tokio::signal::ctrl_c().await;
+            tracing::info!("Ctrl-C received");
+        })
+    }
+}
+
+/// `flexdyn run`: builds the settings and the Zenoh configuration, starts a tokio runtime, opens
+/// the session, runs the server until the duration, a signal or an error, and closes the
+/// session (which flushes the last samples).
+pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
+    let cfg = args.load_config()?;
+    let settings = args.settings(&cfg)?;
+    settings.duration_frames(cfg.frame_ns)?;
+    let zcfg = zenoh_config(&args.zenoh, Role::Server)?;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .thread_name("flexdyn-io")
+        .build()
+        .map_err(|e| ServerError::Internal(format!("cannot start the tokio runtime: {e}")))?;
+    runtime.block_on(async move {
+        let shutdown = shutdown_signal().await?;
+        let session = zenoh::open(zcfg)
+            .await
+            .map_err(|e| ServerError::zenoh("open the session", e))?;
+        let result = super::run(session.clone(), settings, cfg, shutdown).await;
+        if let Err(e) = session.close().await {
+            tracing::warn!(error = %e, "closing the Zenoh session failed");
+        }
+        result
+    })
+}

@@ -1,0 +1,327 @@
+//! Command bookkeeping on the physics thread: which command each participant holds, whether a
+//! lockstep tick is fully answered, staleness, and the wrench to hold over the next frame.
+//!
+//! Everything here is a deterministic function of the accepted commands and the tick: no wall
+//! clock. All storage is allocated in [`CommandBook::new`]; offering a command or computing the
+//! held wrench allocates nothing.
+
+use flexdyn_proto::{
+    command_flags, CommandKind, CommandMsg, CommandStatus, StalePolicy, NO_COMMAND,
+};
+
+/// What the book did with an offered command.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Offer {
+    /// Accepted (in lockstep: it answers the current tick).
+    Accepted,
+    /// Rejected: its tick is not acceptable now (past, future, older than the held command, or a
+    /// second answer to the same lockstep tick). Counted as `rejected.stale_tick`.
+    StaleTick,
+    /// Rejected: the sender is not a configured participant (`rejected.unknown_sender`).
+    UnknownSender,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    sender_id: u32,
+    /// \[N·m\] the participant's last commanded torque, B components.
+    torque_b_nm: [f64; 3],
+    /// \[N\] the participant's last commanded force, B components.
+    force_b_n: [f64; 3],
+    /// Whether any command has been accepted from this sender.
+    has_command: bool,
+    /// `header.tick` of the last accepted command.
+    last_tick: u64,
+    /// Frame boundary (tick) at which the last command was taken by the physics loop.
+    received_tick: u64,
+    /// Lockstep: answered the current tick.
+    answered: bool,
+}
+
+/// The wrench held over one frame, with its telemetry flags and status.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Held {
+    /// \[N·m\] summed commanded torque about B, B components.
+    pub torque_b_nm: [f64; 3],
+    /// \[N\] summed commanded force at B, B components.
+    pub force_b_n: [f64; 3],
+    /// [`command_flags`] bits for the StateMsg that ends this frame.
+    pub flags: u8,
+    /// Command bookkeeping for the StatusMsg.
+    pub status: CommandStatus,
+}
+
+impl Held {
+    /// Zero wrench, before any command (the flags of tick 0).
+    pub fn initial(policy: StalePolicy) -> Self {
+        Self {
+            torque_b_nm: [0.0; 3],
+            force_b_n: [0.0; 3],
+            flags: command_flags::NO_COMMAND_YET,
+            status: CommandStatus {
+                last_command_tick: NO_COMMAND,
+                command_age_ns: NO_COMMAND,
+                command_stale: false,
+                stale_policy: policy,
+            },
+        }
+    }
+}
+
+/// Per-participant command state, in ascending sender-id order.
+#[derive(Clone, Debug)]
+pub struct CommandBook {
+    slots: Vec<Slot>,
+    frame_ns: u64,
+    stale_after_ns: u64,
+    policy: StalePolicy,
+    answered: usize,
+}
+
+impl CommandBook {
+    /// A book for `participants` (sorted, unique sender ids).
+    pub fn new(
+        participants: &[u32],
+        frame_ns: u64,
+        stale_after_ns: u64,
+        policy: StalePolicy,
+    ) -> Self {
+        let mut ids = participants.to_vec();
+        ids.sort_unstable();
+        ids.dedup();
+        Self {
+            slots: ids
+                .into_iter()
+                .map(|sender_id| Slot {
+                    sender_id,
+                    torque_b_nm: [0.0; 3],
+                    force_b_n: [0.0; 3],
+                    has_command: false,
+                    last_tick: 0,
+                    received_tick: 0,
+                    answered: false,
+                })
+                .collect(),
+            frame_ns,
+            stale_after_ns,
+            policy,
+            answered: 0,
+        }
+    }
+
+    fn slot(&mut self, sender_id: u32) -> Option<&mut Slot> {
+        let i = self
+            .slots
+            .binary_search_by_key(&sender_id, |s| s.sender_id)
+            .ok()?;
+        self.slots.get_mut(i)
+    }
+
+    fn take(slot: &mut Slot, cmd: &CommandMsg, k: u64) {
+        if let CommandKind::Wrench {
+            torque_b_nm,
+            force_b_n,
+        } = cmd.kind
+        {
+            slot.torque_b_nm = torque_b_nm;
+            slot.force_b_n = force_b_n;
+        }
+        slot.has_command = true;
+        slot.last_tick = cmd.header.tick;
+        slot.received_tick = k;
+    }
+
+    /// Lockstep: start waiting for the answers to a new tick.
+    pub fn begin_tick(&mut self) {
+        for s in &mut self.slots {
+            s.answered = false;
+        }
+        self.answered = 0;
+    }
+
+    /// Lockstep: whether every participant has answered the current tick.
+    pub fn all_answered(&self) -> bool {
+        self.answered == self.slots.len()
+    }
+
+    /// Lockstep: the lowest sender id that has not answered the current tick.
+    pub fn first_unanswered(&self) -> Option<u32> {
+        self.slots.iter().find(|s| !s.answered).map(|s| s.sender_id)
+    }
+
+    /// Lockstep: offer a command while waiting for the answers to tick `k`. Only a sender's
+    /// first command stamped `k` is accepted; `NoCommand` keeps its previous wrench.
+    pub fn offer_lockstep(&mut self, cmd: &CommandMsg, k: u64) -> Offer {
+        let Some(slot) = self.slot(cmd.sender_id) else {
+            return Offer::UnknownSender;
+        };
+        if cmd.header.tick != k || slot.answered {
+            return Offer::StaleTick;
+        }
+        Self::take(slot, cmd, k);
+        slot.answered = true;
+        self.answered += 1;
+        Offer::Accepted
+    }
+
+    /// Real time / batch: offer a command at frame boundary `k`. Accepted unless its tick is in
+    /// the future (`> k`) or older than the sender's held command (re-ordered or replayed).
+    pub fn offer_latest(&mut self, cmd: &CommandMsg, k: u64) -> Offer {
+        let Some(slot) = self.slot(cmd.sender_id) else {
+            return Offer::UnknownSender;
+        };
+        if cmd.header.tick > k || (slot.has_command && cmd.header.tick < slot.last_tick) {
+            return Offer::StaleTick;
+        }
+        Self::take(slot, cmd, k);
+        Offer::Accepted
+    }
+
+    /// The wrench to hold over frame `k` → `k + 1`: every participant's held command summed in
+    /// ascending sender-id order. A command taken more than `stale_after` (simulation time) ago
+    /// is stale; with [`StalePolicy::Zero`] it contributes zero.
+    pub fn held(&self, k: u64) -> Held {
+        let mut out = Held {
+            torque_b_nm: [0.0; 3],
+            force_b_n: [0.0; 3],
+            flags: 0,
+            status: CommandStatus {
+                last_command_tick: NO_COMMAND,
+                command_age_ns: NO_COMMAND,
+                command_stale: false,
+                stale_policy: self.policy,
+            },
+        };
+        let mut any = false;
+        for s in self.slots.iter().filter(|s| s.has_command) {
+            let age_ns = k
+                .saturating_sub(s.received_tick)
+                .saturating_mul(self.frame_ns);
+            let stale = age_ns > self.stale_after_ns;
+            if !any {
+                out.status.last_command_tick = s.last_tick;
+                out.status.command_age_ns = age_ns;
+                any = true;
+            } else {
+                out.status.last_command_tick = out.status.last_command_tick.max(s.last_tick);
+                out.status.command_age_ns = out.status.command_age_ns.max(age_ns);
+            }
+            if stale {
+                out.flags |= command_flags::STALE;
+                out.status.command_stale = true;
+                if self.policy == StalePolicy::Zero {
+                    out.flags |= command_flags::ZEROED_BY_POLICY;
+                    continue;
+                }
+            }
+            for i in 0..3 {
+                out.torque_b_nm[i] += s.torque_b_nm[i];
+                out.force_b_n[i] += s.force_b_n[i];
+            }
+        }
+        if !any {
+            out.flags |= command_flags::NO_COMMAND_YET;
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flexdyn_proto::Header;
+
+    fn wrench(sender: u32, tick: u64, tz: f64) -> CommandMsg {
+        CommandMsg::wrench(
+            Header::new(1, tick, 0, 0),
+            sender,
+            [0.0, 0.0, tz],
+            [tz, 0.0, 0.0],
+        )
+    }
+
+    fn none(sender: u32, tick: u64) -> CommandMsg {
+        CommandMsg::no_command(Header::new(1, tick, 0, 0), sender)
+    }
+
+    #[test]
+    fn lockstep_needs_every_participant_once() {
+        let mut b = CommandBook::new(&[2, 1], 10, 100, StalePolicy::Hold);
+        b.begin_tick();
+        assert_eq!(b.first_unanswered(), Some(1));
+        assert_eq!(b.offer_lockstep(&wrench(2, 5, 1.0), 5), Offer::Accepted);
+        assert_eq!(b.offer_lockstep(&wrench(2, 5, 9.0), 5), Offer::StaleTick);
+        assert_eq!(b.offer_lockstep(&wrench(1, 4, 1.0), 5), Offer::StaleTick);
+        assert_eq!(b.offer_lockstep(&wrench(1, 6, 1.0), 5), Offer::StaleTick);
+        assert_eq!(
+            b.offer_lockstep(&wrench(3, 5, 1.0), 5),
+            Offer::UnknownSender
+        );
+        assert!(!b.all_answered());
+        assert_eq!(b.first_unanswered(), Some(1));
+        assert_eq!(b.offer_lockstep(&wrench(1, 5, 0.5), 5), Offer::Accepted);
+        assert!(b.all_answered());
+        let h = b.held(5);
+        assert_eq!(h.torque_b_nm, [0.0, 0.0, 1.5]);
+        assert_eq!(h.force_b_n, [1.5, 0.0, 0.0]);
+        assert_eq!(h.flags, 0);
+        assert_eq!(h.status.last_command_tick, 5);
+        assert_eq!(h.status.command_age_ns, 0);
+        // NoCommand keeps the previous wrench.
+        b.begin_tick();
+        assert_eq!(b.offer_lockstep(&none(1, 6), 6), Offer::Accepted);
+        assert_eq!(b.offer_lockstep(&wrench(2, 6, 2.0), 6), Offer::Accepted);
+        assert_eq!(b.held(6).torque_b_nm, [0.0, 0.0, 2.5]);
+    }
+
+    #[test]
+    fn no_command_yet_flag() {
+        let b = CommandBook::new(&[1], 10, 100, StalePolicy::Hold);
+        let h = b.held(3);
+        assert_eq!(h.flags, command_flags::NO_COMMAND_YET);
+        assert_eq!(h.status.last_command_tick, NO_COMMAND);
+        assert_eq!(
+            h,
+            Held {
+                ..Held::initial(StalePolicy::Hold)
+            }
+        );
+    }
+
+    #[test]
+    fn latest_value_staleness_hold_and_zero() {
+        for policy in [StalePolicy::Hold, StalePolicy::Zero] {
+            // frame 10 ns, stale after 25 ns: fresh for ages 0, 10, 20; stale from 30.
+            let mut b = CommandBook::new(&[1], 10, 25, policy);
+            assert_eq!(b.offer_latest(&wrench(1, 3, 1.0), 4), Offer::Accepted);
+            assert_eq!(b.offer_latest(&wrench(1, 9, 1.0), 4), Offer::StaleTick);
+            assert_eq!(b.offer_latest(&wrench(1, 2, 1.0), 4), Offer::StaleTick);
+            for k in 4..=6 {
+                let h = b.held(k);
+                assert_eq!(h.flags, 0, "k={k}");
+                assert_eq!(h.torque_b_nm[2], 1.0);
+            }
+            let h = b.held(7);
+            assert_eq!(h.status.command_age_ns, 30);
+            assert!(h.status.command_stale);
+            match policy {
+                StalePolicy::Hold => {
+                    assert_eq!(h.flags, command_flags::STALE);
+                    assert_eq!(h.torque_b_nm[2], 1.0);
+                }
+                StalePolicy::Zero => {
+                    assert_eq!(
+                        h.flags,
+                        command_flags::STALE | command_flags::ZEROED_BY_POLICY
+                    );
+                    assert_eq!(h.torque_b_nm[2], 0.0);
+                }
+            }
+            // A NoCommand refreshes the age and keeps the wrench.
+            assert_eq!(b.offer_latest(&none(1, 7), 7), Offer::Accepted);
+            let h = b.held(7);
+            assert_eq!(h.flags, 0);
+            assert_eq!(h.torque_b_nm[2], 1.0);
+        }
+    }
+}

@@ -1,0 +1,177 @@
+//! Typed errors of the server layer (STYLE 13): settings, Zenoh configuration, and the run itself.
+
+use std::path::PathBuf;
+
+use crate::config::ConfigError;
+
+/// An invalid server setting. The message starts with the setting's name as the user wrote it:
+/// `server.<key>` for the `[server]` TOML table, `--<flag>` for a command-line option.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SettingsError {
+    /// A key of the `[server]` table that the server does not know.
+    #[error("server.{key}: unknown key (expected one of: {expected})")]
+    UnknownKey {
+        /// The key as written (without the `server.` prefix).
+        key: String,
+        /// Every accepted key, comma-separated.
+        expected: String,
+    },
+    /// A value of the wrong type or out of range.
+    #[error("{name}: {problem}")]
+    Invalid {
+        /// `server.<key>` or `--<flag>`.
+        name: String,
+        /// What is wrong, with the offending value.
+        problem: String,
+    },
+}
+
+/// A Zenoh configuration that cannot be built.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ZenohConfigError {
+    /// The JSON5 file given with `--zenoh-config` cannot be read.
+    #[error("cannot read Zenoh config file `{}`: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The JSON5 file is not a valid Zenoh configuration.
+    #[error("invalid Zenoh config file `{}`: {message}", path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// What JSON5 or Zenoh reported.
+        message: String,
+    },
+    /// An endpoint or other value that Zenoh rejects.
+    #[error("{what}: {message}")]
+    Value {
+        /// The option (`--listen`, `--connect`, or a Zenoh config key).
+        what: String,
+        /// What Zenoh reported.
+        message: String,
+    },
+}
+
+/// Why a server run failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ServerError {
+    /// An invalid server setting (`[server]` table or command line).
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+    /// The simulation configuration is invalid or unreadable.
+    #[error("{}", config_message(file.as_deref(), source))]
+    Config {
+        /// The file, or `None` for the embedded default.
+        file: Option<PathBuf>,
+        /// The error; it names the TOML field.
+        #[source]
+        source: ConfigError,
+    },
+    /// The Zenoh configuration cannot be built.
+    #[error(transparent)]
+    ZenohConfig(#[from] ZenohConfigError),
+    /// A Zenoh operation failed (opening the session, declaring a publisher, ...).
+    #[error("zenoh: cannot {what}: {message}")]
+    Zenoh {
+        /// What was being done, e.g. `open the session`.
+        what: &'static str,
+        /// What Zenoh reported.
+        message: String,
+    },
+    /// Lockstep: some participants did not show up (no liveliness token
+    /// `flexdyn/<sc>/participant/<id>`, or no subscriber on the state topic) before tick 0.
+    #[error(
+        "lockstep participant(s) {} not present after {waited_s} s (server.presence_timeout_s): \
+         start the flight code and check it connects to this server and declares its \
+         liveliness token flexdyn/{sc_id}/participant/<id>",
+        list_ids(missing)
+    )]
+    ParticipantsAbsent {
+        /// Sender ids whose token (or state subscriber) was not seen.
+        missing: Vec<u32>,
+        /// The string spacecraft id of the key expressions.
+        sc_id: String,
+        /// \[s\] how long the server waited.
+        waited_s: f64,
+    },
+    /// Lockstep: a participant did not answer a tick in time.
+    #[error(
+        "lockstep participant {participant} did not answer tick {tick} within {timeout_s} s \
+         (server.participant_timeout_s); stopping the run"
+    )]
+    ParticipantTimeout {
+        /// Sender id of the first participant that has not answered.
+        participant: u32,
+        /// The tick whose answer is missing.
+        tick: u64,
+        /// \[s\] the configured timeout.
+        timeout_s: f64,
+    },
+    /// Real time with `overrun_policy = "abort"`: too many consecutive overruns.
+    #[error(
+        "aborting: {consecutive} consecutive frame overruns at tick {tick} exceed \
+         server.overrun_limit = {limit} (overrun_policy = \"abort\")"
+    )]
+    OverrunLimit {
+        /// The tick at which the limit was exceeded.
+        tick: u64,
+        /// Consecutive overrun frames.
+        consecutive: u32,
+        /// The configured limit.
+        limit: u32,
+    },
+    /// A thread of the server could not be started or panicked.
+    #[error("internal error: {0}")]
+    Internal(String),
+    /// Installing the signal handlers failed.
+    #[error("cannot install the {signal} handler: {source}")]
+    Signal {
+        /// `SIGINT` or `SIGTERM`.
+        signal: &'static str,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+fn list_ids(ids: &[u32]) -> String {
+    ids.iter()
+        .map(u32::to_string)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn config_message(file: Option<&std::path::Path>, e: &ConfigError) -> String {
+    match (file, e) {
+        (Some(f), e) if !matches!(e, ConfigError::Io { .. }) => format!("{}: {e}", f.display()),
+        _ => e.to_string(),
+    }
+}
+
+impl ServerError {
+    /// Process exit code: 2 for invalid input (settings, configuration files), 1 for a failure
+    /// while running (participant timeout, overrun abort, Zenoh failure).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            ServerError::Settings(_) | ServerError::Config { .. } | ServerError::ZenohConfig(_) => {
+                2
+            }
+            _ => 1,
+        }
+    }
+
+    /// A [`ServerError::Zenoh`] from any Zenoh error.
+    pub(crate) fn zenoh(what: &'static str, e: impl std::fmt::Display) -> Self {
+        ServerError::Zenoh {
+            what,
+            message: e.to_string(),
+        }
+    }
+}

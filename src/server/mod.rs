@@ -1,0 +1,485 @@
+//! The flexdyn server: propagates a spacecraft and talks to flight code over Zenoh, in real
+//! time, in lockstep or in batch.
+//!
+//! [`run`] is the whole server as a library function with its I/O injected (a Zenoh session, the
+//! settings, the simulation configuration and a shutdown future); `src/main.rs` only parses
+//! arguments, initialises tracing and calls [`cli::run_from_args`], which calls [`run`].
+//!
+//! # Layout
+//! - [`settings`]: [`ServerSettings`], the `[server]` table and `flexdyn run` options.
+//! - [`zenoh_cfg`]: [`zenoh_config`], the one builder of every Zenoh configuration (loopback
+//!   defaults, multicast scouting always off).
+//! - [`commands`]: per-participant command book (lockstep answers, staleness, summation).
+//! - [`pacing`]: absolute-deadline real-time pacing (sleep, then spin) and overrun policies.
+//! - [`physics`]: the physics thread's frame loop.
+//! - [`telemetry`]: the I/O thread that publishes state and status.
+//! - [`shared`]: lock-free counters and the preallocated telemetry buffers.
+//! - [`error`]: typed errors.
+//! - [`cli`]: `flexdyn run` arguments and the process-level wrapper (runtime, signals).
+//!
+//! # Threads
+//! ```text
+//!  zenoh rx (callback) --CommandMsg, bounded--> physics thread --Frame, bounded--> telemetry thread --> zenoh
+//!                                               ^                                      |
+//!                                               +------------ free Frame pool ---------+
+//! ```
+//! The physics thread never allocates, locks or touches the network; in real time it never
+//! blocks on the I/O side (a frame without a free buffer loses its telemetry, counted).
+
+pub mod cli;
+pub mod commands;
+pub mod error;
+pub mod pacing;
+pub mod physics;
+pub mod settings;
+pub mod shared;
+pub mod telemetry;
+pub mod zenoh_cfg;
+
+use std::collections::BTreeSet;
+use std::fmt;
+use std::future::Future;
+use std::sync::mpsc::{sync_channel, SyncSender};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use flexdyn_proto::{
+    decode_command, FrameTiming, Mode, RejectCounters, RunState, StalePolicy, Topics,
+};
+use tokio::sync::{oneshot, Notify};
+use zenoh::qos::CongestionControl;
+use zenoh::sample::SampleKind;
+use zenoh::Session;
+
+pub use error::{ServerError, SettingsError, ZenohConfigError};
+pub use settings::{mode_name, OverrunPolicy, ServerSettings};
+pub use telemetry::frame_stamp_ns;
+pub use zenoh_cfg::{zenoh_config, Role, ZenohArgs, DEFAULT_ENDPOINT};
+
+use crate::config::SimConfig;
+use crate::sim::Simulation;
+use physics::{Ending, PhysicsCtx};
+use shared::{Frame, Shared};
+use telemetry::{timing_of, TelemetryCtx};
+
+/// How a run ended without error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// The configured duration was reached.
+    Finished,
+    /// The shutdown future completed (SIGINT/SIGTERM).
+    Stopped,
+}
+
+/// Summary of a completed run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunReport {
+    /// Pacing mode.
+    pub mode: Mode,
+    /// Why the run ended.
+    pub outcome: Outcome,
+    /// Last tick reached.
+    pub last_tick: u64,
+    /// \[ns\] simulation time of `last_tick`.
+    pub sim_time_ns: u64,
+    /// StateMsg samples published.
+    pub states_published: u64,
+    /// Real time: frames whose telemetry was dropped (no free buffer).
+    pub telemetry_dropped: u64,
+    /// Real time: lateness percentiles, overruns, skipped frames (zeros otherwise).
+    pub timing: FrameTiming,
+    /// Rejected commands by reason.
+    pub rejected: RejectCounters,
+    /// Valid commands dropped because the command queue was full.
+    pub commands_dropped: u64,
+    /// \[s\] wall time from the first frame to the end.
+    pub wall_s: f64,
+}
+
+impl fmt::Display for RunReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "run {}: mode={} last_tick={} sim_time_s={} states_published={} telemetry_dropped={} \
+             wall_s={:.3} lateness_us p50={:.1} p99={:.1} max={:.1} overruns={} frames_skipped={} \
+             rejected={} commands_dropped={}",
+            match self.outcome {
+                Outcome::Finished => "finished",
+                Outcome::Stopped => "stopped",
+            },
+            mode_name(self.mode),
+            self.last_tick,
+            self.sim_time_ns as f64 / 1e9,
+            self.states_published,
+            self.telemetry_dropped,
+            self.wall_s,
+            self.timing.lateness_p50_ns as f64 * 1e-3,
+            self.timing.lateness_p99_ns as f64 * 1e-3,
+            self.timing.lateness_max_ns as f64 * 1e-3,
+            self.timing.overrun_count,
+            self.timing.frames_skipped,
+            self.rejected.total(),
+            self.commands_dropped,
+        )
+    }
+}
+
+/// Participants seen through their liveliness tokens, and a wake-up for the presence wait.
+#[derive(Default)]
+struct Presence {
+    ids: Mutex<BTreeSet<u32>>,
+    changed: Notify,
+}
+
+impl Presence {
+    fn missing(&self, wanted: &[u32]) -> Vec<u32> {
+        let ids = self.ids.lock().unwrap_or_else(|p| p.into_inner());
+        wanted
+            .iter()
+            .copied()
+            .filter(|id| !ids.contains(id))
+            .collect()
+    }
+}
+
+/// The zenoh callback for `flexdyn/<sc>/cmd/wrench`: decode and check, count rejections, and
+/// queue valid commands for the physics thread (never blocks).
+fn command_callback(
+    tx: SyncSender<flexdyn_proto::CommandMsg>,
+    shared: Arc<Shared>,
+    spacecraft_id: u32,
+    participants: Vec<u32>,
+) -> impl Fn(zenoh::sample::Sample) + Send + Sync + 'static {
+    let tx = Mutex::new(tx);
+    move |sample| {
+        let bytes = sample.payload().to_bytes();
+        let cmd = match decode_command(&bytes) {
+            Ok(cmd) => cmd,
+            Err(e) => {
+                tracing::debug!(error = %e, "rejected command");
+                shared.reject_decode(&e);
+                return;
+            }
+        };
+        if cmd.header.spacecraft_id != spacecraft_id {
+            shared.reject_wrong_spacecraft();
+            return;
+        }
+        if participants.binary_search(&cmd.sender_id).is_err() {
+            shared.reject_unknown_sender();
+            return;
+        }
+        let tx = tx.lock().unwrap_or_else(|p| p.into_inner());
+        if tx.try_send(cmd).is_err() {
+            shared
+                .commands_dropped
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
+    }
+}
+
+/// Lockstep: waits until every participant's liveliness token is present and the state
+/// publisher has a subscriber. `Ok(true)` to start, `Ok(false)` if `shutdown` completed first.
+async fn await_presence(
+    state_pub: &zenoh::pubsub::Publisher<'static>,
+    presence: &Arc<Presence>,
+    settings: &ServerSettings,
+    topics: &Topics,
+    mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
+) -> Result<bool, ServerError> {
+    let waited_from = Instant::now();
+    let give_up = tokio::time::Instant::now() + settings.presence_timeout;
+    let p = presence.clone();
+    let _matching = state_pub
+        .matching_listener()
+        .callback(move |_| p.changed.notify_one())
+        .await
+        .map_err(|e| ServerError::zenoh("declare a matching listener", e))?;
+    tracing::info!(
+        participants = ?settings.participants,
+        key = topics.participant_wildcard(),
+        "waiting for the lockstep participants"
+    );
+    loop {
+        let missing = presence.missing(&settings.participants);
+        let matching = state_pub
+            .matching_status()
+            .await
+            .map_err(|e| ServerError::zenoh("query the state publisher's matching status", e))?
+            .matching();
+        if missing.is_empty() && matching {
+            tracing::info!("every lockstep participant is present; starting at tick 0");
+            return Ok(true);
+        }
+        tokio::select! {
+            () = shutdown.as_mut() => {
+                tracing::info!("shutdown requested before tick 0");
+                return Ok(false);
+            }
+            r = tokio::time::timeout_at(give_up, presence.changed.notified()) => {
+                if r.is_err() {
+                    return Err(ServerError::ParticipantsAbsent {
+                        missing: if missing.is_empty() {
+                            settings.participants.clone()
+                        } else {
+                            missing
+                        },
+                        sc_id: settings.sc_id.clone(),
+                        waited_s: waited_from.elapsed().as_secs_f64(),
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// Runs the server until the configured duration is reached, `shutdown` completes, or an error
+/// stops it.
+///
+/// `settings` are usually [`ServerSettings::from_table`] of `cfg.server` with command-line
+/// overrides applied. The session is used as given (see [`zenoh_config`] for the loopback
+/// defaults) and is not closed: close it after `run` returns to flush the last samples.
+pub async fn run(
+    session: Session,
+    settings: ServerSettings,
+    cfg: SimConfig,
+    shutdown: impl Future<Output = ()>,
+) -> Result<RunReport, ServerError> {
+    let mut shutdown = std::pin::pin!(shutdown);
+    settings.validate()?;
+    let total_frames = settings.duration_frames(cfg.frame_ns)?;
+    let topics = Topics::new(&settings.sc_id).map_err(|e| SettingsError::Invalid {
+        name: "server.sc_id".into(),
+        problem: e.to_string(),
+    })?;
+    let sim = Simulation::new(&cfg).map_err(|source| ServerError::Config { file: None, source })?;
+    let mode = settings.mode;
+    tracing::info!(
+        mode = mode_name(mode),
+        zid = %session.zid(),
+        state = topics.state(),
+        commands = topics.cmd_wrench(),
+        status = topics.status(),
+        imus = ?sim.imu_names(),
+        "flexdyn server starting: {}",
+        crate::cli::config_summary(&cfg)
+    );
+    tracing::info!("server settings: {}", settings.summary());
+    if mode == Mode::RealTime && settings.stale_policy == StalePolicy::Hold {
+        tracing::debug!("stale commands are held (stale_policy = hold)");
+    }
+
+    // Real time drops telemetry under congestion rather than delaying the frame; lockstep and
+    // batch block, so no sample of the deterministic stream is lost. Delivery is reliable
+    // (Zenoh's default `Reliability::Reliable`, over TCP); its setter is unstable in Zenoh 1.10.
+    let congestion = if mode == Mode::RealTime {
+        CongestionControl::Drop
+    } else {
+        CongestionControl::Block
+    };
+    let express = mode != Mode::Batch;
+    let state_pub = session
+        .declare_publisher(topics.state().to_owned())
+        .congestion_control(congestion)
+        .express(express)
+        .await
+        .map_err(|e| ServerError::zenoh("declare the state publisher", e))?;
+    let status_pub = session
+        .declare_publisher(topics.status().to_owned())
+        .congestion_control(congestion)
+        .await
+        .map_err(|e| ServerError::zenoh("declare the status publisher", e))?;
+
+    let mut imu_pubs = Vec::with_capacity(sim.n_imus());
+    for (i, name) in sim.imu_names().iter().enumerate() {
+        let key = topics.imu(name).map_err(|e| SettingsError::Invalid {
+            name: format!("imus[{i}].name"),
+            problem: e.to_string(),
+        })?;
+        imu_pubs.push(
+            session
+                .declare_publisher(key)
+                .congestion_control(congestion)
+                .express(express)
+                .await
+                .map_err(|e| ServerError::zenoh("declare an IMU publisher", e))?,
+        );
+    }
+
+    let shared = Arc::new(Shared::default());
+    shared.set_run_state(RunState::Starting);
+    let (cmd_tx, cmd_rx) = sync_channel(settings.command_queue);
+    let n_buffers = settings.telemetry_buffers;
+    let (free_tx, free_rx) = sync_channel::<Box<Frame>>(n_buffers);
+    let (full_tx, full_rx) = sync_channel::<Box<Frame>>(n_buffers);
+    for _ in 0..n_buffers {
+        free_tx
+            .send(Box::new(Frame::with_capacity(sim.n_pairs(), sim.n_imus())))
+            .map_err(|_| ServerError::Internal("telemetry pool".into()))?;
+    }
+
+    let _cmd_sub = session
+        .declare_subscriber(topics.cmd_wrench().to_owned())
+        .callback(command_callback(
+            cmd_tx,
+            shared.clone(),
+            settings.spacecraft_id,
+            settings.participants.clone(),
+        ))
+        .await
+        .map_err(|e| ServerError::zenoh("declare the command subscriber", e))?;
+
+    // Lockstep participants announce themselves with a liveliness token.
+    let presence = Arc::new(Presence::default());
+    let _presence_sub = if mode == Mode::Lockstep {
+        let p = presence.clone();
+        let t = topics.clone();
+        let shared_p = shared.clone();
+        Some(
+            session
+                .liveliness()
+                .declare_subscriber(topics.participant_wildcard())
+                .history(true)
+                .callback(move |sample| {
+                    let Some(id) = t.participant_id(sample.key_expr().as_str()) else {
+                        return;
+                    };
+                    let mut ids = p.ids.lock().unwrap_or_else(|e| e.into_inner());
+                    match sample.kind() {
+                        SampleKind::Put => {
+                            if ids.insert(id) {
+                                tracing::info!(participant = id, "lockstep participant present");
+                            }
+                        }
+                        SampleKind::Delete => {
+                            if ids.remove(&id) {
+                                tracing::warn!(
+                                    participant = id,
+                                    tick = shared_p.tick.load(std::sync::atomic::Ordering::Relaxed),
+                                    "lockstep participant left (liveliness token dropped)"
+                                );
+                            }
+                        }
+                    }
+                    drop(ids);
+                    p.changed.notify_one();
+                })
+                .await
+                .map_err(|e| {
+                    ServerError::zenoh("declare the participant liveliness subscriber", e)
+                })?,
+        )
+    } else {
+        None
+    };
+
+    // The telemetry thread starts first, so StatusMsg (run_state = Starting) goes out while a
+    // lockstep server waits for its participants.
+    let state_pub = Arc::new(state_pub);
+    let telemetry = TelemetryCtx {
+        state_pub: state_pub.clone(),
+        status_pub,
+        imu_pubs,
+        full_rx,
+        free_tx,
+        shared: shared.clone(),
+        settings: settings.clone(),
+        frame_ns: cfg.frame_ns,
+    };
+    let (tlm_done_tx, tlm_done_rx) = oneshot::channel();
+    std::thread::Builder::new()
+        .name("flexdyn-telemetry".into())
+        .spawn(move || {
+            let _ = tlm_done_tx.send(telemetry.run());
+        })
+        .map_err(|e| ServerError::Internal(format!("cannot start the telemetry thread: {e}")))?;
+
+    if mode == Mode::Lockstep {
+        let ready =
+            await_presence(&state_pub, &presence, &settings, &topics, shutdown.as_mut()).await;
+        if !matches!(ready, Ok(true)) {
+            // Not starting: end the telemetry thread (it publishes a final status) first.
+            shared.set_run_state(if ready.is_ok() {
+                RunState::Stopping
+            } else {
+                RunState::Failed
+            });
+            drop(full_tx);
+            let _ = tlm_done_rx.await;
+            ready?;
+            return Ok(RunReport {
+                mode,
+                outcome: Outcome::Stopped,
+                last_tick: 0,
+                sim_time_ns: 0,
+                states_published: 0,
+                telemetry_dropped: 0,
+                timing: FrameTiming::default(),
+                rejected: shared.rejected(),
+                commands_dropped: 0,
+                wall_s: 0.0,
+            });
+        }
+    }
+
+    let physics = PhysicsCtx {
+        sim,
+        settings: settings.clone(),
+        total_frames,
+        cmd_rx,
+        free_rx,
+        full_tx,
+        shared: shared.clone(),
+    };
+    let started = Instant::now();
+    let (phys_done_tx, mut phys_done_rx) = oneshot::channel();
+    std::thread::Builder::new()
+        .name("flexdyn-physics".into())
+        .spawn(move || {
+            let _ = phys_done_tx.send(physics.run());
+        })
+        .map_err(|e| ServerError::Internal(format!("cannot start the physics thread: {e}")))?;
+
+    let physics_result = tokio::select! {
+        r = &mut phys_done_rx => r,
+        () = &mut shutdown => {
+            tracing::info!("shutdown requested; stopping at the next frame boundary");
+            shared.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            phys_done_rx.await
+        }
+    }
+    .map_err(|_| ServerError::Internal("the physics thread panicked".into()))?;
+    let wall_s = started.elapsed().as_secs_f64();
+    let tlm = tlm_done_rx
+        .await
+        .map_err(|_| ServerError::Internal("the telemetry thread panicked".into()))?;
+
+    let phys = physics_result?;
+    let report = RunReport {
+        mode,
+        outcome: match phys.ending {
+            Ending::Finished => Outcome::Finished,
+            Ending::Stopped => Outcome::Stopped,
+        },
+        last_tick: phys.last_tick,
+        sim_time_ns: phys.sim_time_ns,
+        states_published: tlm.published,
+        telemetry_dropped: shared
+            .telemetry_dropped
+            .load(std::sync::atomic::Ordering::Relaxed),
+        timing: timing_of(
+            &tlm.lateness,
+            shared.overruns.load(std::sync::atomic::Ordering::Relaxed),
+            shared
+                .frames_skipped
+                .load(std::sync::atomic::Ordering::Relaxed),
+        ),
+        rejected: shared.rejected(),
+        commands_dropped: shared
+            .commands_dropped
+            .load(std::sync::atomic::Ordering::Relaxed),
+        wall_s,
+    };
+    tracing::info!("{report}");
+    Ok(report)
+}

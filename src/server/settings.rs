@@ -1,0 +1,566 @@
+//! Server settings: the `[server]` table of the configuration file and the matching
+//! `flexdyn run` options (a command-line option overrides the table).
+//!
+//! Every setting has one TOML key `x_y` and one option `--x-y`; both go through
+//! [`ServerSettings::apply`], so they accept the same values and report errors the same way,
+//! naming the setting as the user wrote it (`server.x_y` or `--x-y`). [`KEYS`] lists them; the
+//! README's "Server settings" table documents each one and its default.
+
+use std::time::Duration;
+
+use flexdyn_proto::{validate_sc_id, Mode, StalePolicy};
+
+use super::error::SettingsError;
+
+/// What the real-time loop does when a frame's work ends after the next frame's deadline.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OverrunPolicy {
+    /// `catch_up` (default): keep the absolute schedule t0 + k·period; late frames run back to
+    /// back without sleeping until the loop is on time again, so simulation time never drifts
+    /// from wall time.
+    #[default]
+    CatchUp,
+    /// `skip`: when a frame boundary is reached one or more whole periods late, drop those
+    /// deadlines (counted in `frames_skipped`): the schedule moves forward by the missed periods
+    /// and simulation time falls behind wall time by as much. Smaller lateness is caught up.
+    Skip,
+    /// `abort`: like `catch_up`, but stop the run with an error once more than
+    /// `overrun_limit` consecutive frames overran.
+    Abort,
+}
+
+impl OverrunPolicy {
+    /// The setting's spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            OverrunPolicy::CatchUp => "catch_up",
+            OverrunPolicy::Skip => "skip",
+            OverrunPolicy::Abort => "abort",
+        }
+    }
+}
+
+/// The spelling of a [`Mode`] in settings and logs.
+pub fn mode_name(mode: Mode) -> &'static str {
+    match mode {
+        Mode::RealTime => "realtime",
+        Mode::Lockstep => "lockstep",
+        Mode::Batch => "batch",
+    }
+}
+
+/// The spelling of a [`StalePolicy`] in settings and logs.
+pub fn stale_policy_name(p: StalePolicy) -> &'static str {
+    match p {
+        StalePolicy::Hold => "hold",
+        StalePolicy::Zero => "zero",
+    }
+}
+
+/// Every key of the `[server]` table (and, with `-` for `_`, every `flexdyn run` option that
+/// sets a server setting).
+pub const KEYS: &[&str] = &[
+    "mode",
+    "sc_id",
+    "spacecraft_id",
+    "participants",
+    "participant_timeout_s",
+    "presence_timeout_s",
+    "duration_s",
+    "overrun_policy",
+    "overrun_limit",
+    "stale_after_s",
+    "stale_policy",
+    "status_hz",
+    "summary_interval_s",
+    "spin_us",
+    "telemetry_buffers",
+    "command_queue",
+];
+
+/// Validated server settings. [`Default`] gives the documented defaults.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ServerSettings {
+    /// Pacing: real time (default), lockstep or batch.
+    pub mode: Mode,
+    /// String spacecraft id used in the key expressions `flexdyn/<sc_id>/…` (default `sc1`).
+    pub sc_id: String,
+    /// Numeric spacecraft id written in every header and required in commands (default 1).
+    pub spacecraft_id: u32,
+    /// Sender ids allowed to command, sorted and unique (default `[1]`, the demo controller).
+    /// In lockstep every one of them must answer every tick.
+    pub participants: Vec<u32>,
+    /// Lockstep: how long to wait for a participant's answer to one tick (default 10 s).
+    pub participant_timeout: Duration,
+    /// Lockstep: how long to wait before tick 0 for every participant to be present (default 30 s).
+    pub presence_timeout: Duration,
+    /// \[ns\] simulated duration, a whole number of frames; `None` runs until stopped.
+    pub duration_ns: Option<u64>,
+    /// Real time: what to do on overruns (default `catch_up`).
+    pub overrun_policy: OverrunPolicy,
+    /// Real time, `abort` policy: consecutive overrun frames tolerated (default 10).
+    pub overrun_limit: u32,
+    /// Real time/batch: a command held longer than this (simulation time) is stale (default 0.1 s).
+    pub stale_after: Duration,
+    /// What a stale command turns into: `hold` (keep it, default) or `zero`.
+    pub stale_policy: StalePolicy,
+    /// \[Hz\] StatusMsg publication rate (default 10).
+    pub status_hz: f64,
+    /// Interval of the timing summary in the log (default 10 s).
+    pub summary_interval: Duration,
+    /// Real time: the loop sleeps until this long before a deadline, then spins (default 200 µs).
+    pub spin: Duration,
+    /// Preallocated telemetry buffers between the physics and the I/O threads (default 8).
+    pub telemetry_buffers: usize,
+    /// Capacity of the command queue from the I/O side to the physics thread (default 1024).
+    pub command_queue: usize,
+}
+
+impl Default for ServerSettings {
+    fn default() -> Self {
+        Self {
+            mode: Mode::RealTime,
+            sc_id: "sc1".into(),
+            spacecraft_id: 1,
+            participants: vec![1],
+            participant_timeout: Duration::from_secs(10),
+            presence_timeout: Duration::from_secs(30),
+            duration_ns: None,
+            overrun_policy: OverrunPolicy::CatchUp,
+            overrun_limit: 10,
+            stale_after: Duration::from_millis(100),
+            stale_policy: StalePolicy::Hold,
+            status_hz: 10.0,
+            summary_interval: Duration::from_secs(10),
+            spin: Duration::from_micros(200),
+            telemetry_buffers: 8,
+            command_queue: 1024,
+        }
+    }
+}
+
+/// Where a setting came from; decides how errors name it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Origin {
+    /// The `[server]` TOML table: `server.<key>`.
+    Table,
+    /// A `flexdyn run` option: `--<key with - for _>`.
+    Cli,
+}
+
+impl Origin {
+    /// How the user wrote the setting `key`.
+    pub fn name(self, key: &str) -> String {
+        match self {
+            Origin::Table => format!("server.{key}"),
+            Origin::Cli => format!("--{}", key.replace('_', "-")),
+        }
+    }
+}
+
+/// A setting's value before validation.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Value {
+    /// A string.
+    Str(String),
+    /// An integer (also accepted where a float is expected).
+    Int(i64),
+    /// A float.
+    Float(f64),
+    /// A list of integers.
+    Ints(Vec<i64>),
+}
+
+impl Value {
+    fn describe(&self) -> String {
+        match self {
+            Value::Str(s) => format!("string {s:?}"),
+            Value::Int(i) => format!("integer {i}"),
+            Value::Float(f) => format!("float {f}"),
+            Value::Ints(v) => format!("list {v:?}"),
+        }
+    }
+
+    /// A TOML value as a setting value (`None` for types no setting takes).
+    fn from_toml(v: &toml::Value) -> Option<Self> {
+        Some(match v {
+            toml::Value::String(s) => Value::Str(s.clone()),
+            toml::Value::Integer(i) => Value::Int(*i),
+            toml::Value::Float(f) => Value::Float(*f),
+            toml::Value::Array(a) => Value::Ints(
+                a.iter()
+                    .map(|x| x.as_integer())
+                    .collect::<Option<Vec<i64>>>()?,
+            ),
+            _ => return None,
+        })
+    }
+}
+
+struct Setter<'a> {
+    name: String,
+    value: &'a Value,
+}
+
+impl Setter<'_> {
+    fn bad(&self, problem: impl Into<String>) -> SettingsError {
+        SettingsError::Invalid {
+            name: self.name.clone(),
+            problem: problem.into(),
+        }
+    }
+
+    fn expected(&self, what: &str) -> SettingsError {
+        self.bad(format!("expected {what}, got {}", self.value.describe()))
+    }
+
+    fn string(&self) -> Result<&str, SettingsError> {
+        match self.value {
+            Value::Str(s) => Ok(s),
+            _ => Err(self.expected("a string")),
+        }
+    }
+
+    fn float(&self) -> Result<f64, SettingsError> {
+        let f = match self.value {
+            Value::Float(f) => *f,
+            Value::Int(i) => *i as f64,
+            _ => return Err(self.expected("a number")),
+        };
+        if !f.is_finite() {
+            return Err(self.bad(format!("must be finite (got {f})")));
+        }
+        Ok(f)
+    }
+
+    fn positive(&self) -> Result<f64, SettingsError> {
+        let f = self.float()?;
+        if f <= 0.0 {
+            return Err(self.bad(format!("must be > 0 (got {f})")));
+        }
+        Ok(f)
+    }
+
+    fn seconds(&self) -> Result<Duration, SettingsError> {
+        let s = self.positive()?;
+        Duration::try_from_secs_f64(s).map_err(|_| self.bad(format!("{s} s is out of range")))
+    }
+
+    fn int_in(&self, lo: i64, hi: i64) -> Result<i64, SettingsError> {
+        match self.value {
+            Value::Int(i) if (lo..=hi).contains(i) => Ok(*i),
+            Value::Int(i) => Err(self.bad(format!("must be in {lo}..={hi} (got {i})"))),
+            _ => Err(self.expected("an integer")),
+        }
+    }
+}
+
+impl ServerSettings {
+    /// The settings of a configuration's `[server]` table (empty table: the defaults).
+    /// Unknown keys and bad values are errors naming `server.<key>`.
+    pub fn from_table(table: &toml::Table) -> Result<Self, SettingsError> {
+        let mut s = Self::default();
+        for (key, v) in table {
+            if !KEYS.contains(&key.as_str()) {
+                return Err(SettingsError::UnknownKey {
+                    key: key.clone(),
+                    expected: KEYS.join(", "),
+                });
+            }
+            let value = Value::from_toml(v).ok_or_else(|| SettingsError::Invalid {
+                name: Origin::Table.name(key),
+                problem: format!("unsupported value type {}", v.type_str()),
+            })?;
+            s.apply(key, &value, Origin::Table)?;
+        }
+        Ok(s)
+    }
+
+    /// Sets one setting. `key` is one of [`KEYS`]; `origin` decides how errors name it.
+    pub fn apply(&mut self, key: &str, value: &Value, origin: Origin) -> Result<(), SettingsError> {
+        let set = Setter {
+            name: origin.name(key),
+            value,
+        };
+        match key {
+            "mode" => {
+                self.mode = match set.string()? {
+                    "realtime" => Mode::RealTime,
+                    "lockstep" => Mode::Lockstep,
+                    "batch" => Mode::Batch,
+                    other => {
+                        return Err(set.bad(format!(
+                        "unknown mode {other:?} (expected \"realtime\", \"lockstep\" or \"batch\")"
+                    )))
+                    }
+                }
+            }
+            "sc_id" => {
+                let id = set.string()?;
+                validate_sc_id(id).map_err(|e| set.bad(e.to_string()))?;
+                self.sc_id = id.to_owned();
+            }
+            "spacecraft_id" => self.spacecraft_id = set.int_in(0, u32::MAX.into())? as u32,
+            "participants" => {
+                let Value::Ints(ids) = value else {
+                    return Err(set.expected("a list of sender ids (integers)"));
+                };
+                let mut out = Vec::with_capacity(ids.len());
+                for &id in ids {
+                    let id = u32::try_from(id)
+                        .map_err(|_| set.bad(format!("sender id {id} is not in 0..=4294967295")))?;
+                    if out.contains(&id) {
+                        return Err(set.bad(format!("sender id {id} is listed twice")));
+                    }
+                    out.push(id);
+                }
+                out.sort_unstable();
+                self.participants = out;
+            }
+            "participant_timeout_s" => self.participant_timeout = set.seconds()?,
+            "presence_timeout_s" => self.presence_timeout = set.seconds()?,
+            "duration_s" => {
+                let s = set.positive()?;
+                let ns = crate::config::whole_ns(s).ok_or_else(|| {
+                    set.bad(format!("{s} s is not a whole number of nanoseconds"))
+                })?;
+                self.duration_ns = Some(ns);
+            }
+            "overrun_policy" => {
+                self.overrun_policy = match set.string()? {
+                    "catch_up" => OverrunPolicy::CatchUp,
+                    "skip" => OverrunPolicy::Skip,
+                    "abort" => OverrunPolicy::Abort,
+                    other => {
+                        return Err(set.bad(format!(
+                        "unknown policy {other:?} (expected \"catch_up\", \"skip\" or \"abort\")"
+                    )))
+                    }
+                }
+            }
+            "overrun_limit" => self.overrun_limit = set.int_in(0, u32::MAX.into())? as u32,
+            "stale_after_s" => self.stale_after = set.seconds()?,
+            "stale_policy" => {
+                self.stale_policy = match set.string()? {
+                    "hold" => StalePolicy::Hold,
+                    "zero" => StalePolicy::Zero,
+                    other => {
+                        return Err(set.bad(format!(
+                            "unknown policy {other:?} (expected \"hold\" or \"zero\")"
+                        )))
+                    }
+                }
+            }
+            "status_hz" => {
+                let hz = set.positive()?;
+                if hz > 1000.0 {
+                    return Err(set.bad(format!("must be <= 1000 Hz (got {hz})")));
+                }
+                self.status_hz = hz;
+            }
+            "summary_interval_s" => self.summary_interval = set.seconds()?,
+            "spin_us" => self.spin = Duration::from_micros(set.int_in(0, 1_000_000)? as u64),
+            "telemetry_buffers" => self.telemetry_buffers = set.int_in(2, 1 << 16)? as usize,
+            "command_queue" => self.command_queue = set.int_in(1, 1 << 20)? as usize,
+            other => {
+                return Err(SettingsError::UnknownKey {
+                    key: other.to_owned(),
+                    expected: KEYS.join(", "),
+                })
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks that hold across settings (called by the server before it starts):
+    /// lockstep needs at least one participant.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        if self.mode == Mode::Lockstep && self.participants.is_empty() {
+            return Err(SettingsError::Invalid {
+                name: "server.participants".into(),
+                problem: "lockstep needs at least one participant (use mode \"batch\" to run \
+                          without any)"
+                    .into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// \[ns\] the StatusMsg period.
+    pub fn status_period(&self) -> Duration {
+        Duration::from_secs_f64(1.0 / self.status_hz)
+    }
+
+    /// The number of frames in [`Self::duration_ns`] for a frame of `frame_ns`, or an error
+    /// naming the setting if it is not a whole number of frames.
+    pub fn duration_frames(&self, frame_ns: u64) -> Result<Option<u64>, SettingsError> {
+        match self.duration_ns {
+            None => Ok(None),
+            Some(ns) if ns % frame_ns == 0 => Ok(Some(ns / frame_ns)),
+            Some(ns) => Err(SettingsError::Invalid {
+                name: "server.duration_s (or --duration-s)".into(),
+                problem: format!(
+                    "{} s is not a whole number of frames (frame = {} s = {frame_ns} ns)",
+                    ns as f64 / 1e9,
+                    frame_ns as f64 / 1e9
+                ),
+            }),
+        }
+    }
+
+    /// One-line description for the start-up log.
+    pub fn summary(&self) -> String {
+        format!(
+            "mode={} sc_id={} spacecraft_id={} participants={:?} participant_timeout_s={} \
+             presence_timeout_s={} duration_s={} overrun_policy={} overrun_limit={} \
+             stale_after_s={} stale_policy={} status_hz={} summary_interval_s={} spin_us={} \
+             telemetry_buffers={} command_queue={}",
+            mode_name(self.mode),
+            self.sc_id,
+            self.spacecraft_id,
+            self.participants,
+            self.participant_timeout.as_secs_f64(),
+            self.presence_timeout.as_secs_f64(),
+            self.duration_ns
+                .map_or("unlimited".to_owned(), |ns| format!("{}", ns as f64 / 1e9)),
+            self.overrun_policy.as_str(),
+            self.overrun_limit,
+            self.stale_after.as_secs_f64(),
+            stale_policy_name(self.stale_policy),
+            self.status_hz,
+            self.summary_interval.as_secs_f64(),
+            self.spin.as_micros(),
+            self.telemetry_buffers,
+            self.command_queue,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(s: &str) -> toml::Table {
+        s.parse().unwrap()
+    }
+
+    #[test]
+    fn empty_table_gives_defaults() {
+        assert_eq!(
+            ServerSettings::from_table(&toml::Table::new()).unwrap(),
+            ServerSettings::default()
+        );
+    }
+
+    #[test]
+    fn every_key_parses() {
+        let s = ServerSettings::from_table(&table(
+            r#"
+            mode = "lockstep"
+            sc_id = "craft-2"
+            spacecraft_id = 42
+            participants = [3, 1, 2]
+            participant_timeout_s = 2.5
+            presence_timeout_s = 5
+            duration_s = 12.0
+            overrun_policy = "skip"
+            overrun_limit = 3
+            stale_after_s = 0.05
+            stale_policy = "zero"
+            status_hz = 20
+            summary_interval_s = 1
+            spin_us = 50
+            telemetry_buffers = 4
+            command_queue = 16
+            "#,
+        ))
+        .unwrap();
+        assert_eq!(s.mode, Mode::Lockstep);
+        assert_eq!(s.sc_id, "craft-2");
+        assert_eq!(s.spacecraft_id, 42);
+        assert_eq!(s.participants, vec![1, 2, 3]);
+        assert_eq!(s.participant_timeout, Duration::from_millis(2500));
+        assert_eq!(s.presence_timeout, Duration::from_secs(5));
+        assert_eq!(s.duration_ns, Some(12_000_000_000));
+        assert_eq!(s.overrun_policy, OverrunPolicy::Skip);
+        assert_eq!(s.overrun_limit, 3);
+        assert_eq!(s.stale_after, Duration::from_millis(50));
+        assert_eq!(s.stale_policy, StalePolicy::Zero);
+        assert_eq!(s.status_hz, 20.0);
+        assert_eq!(s.summary_interval, Duration::from_secs(1));
+        assert_eq!(s.spin, Duration::from_micros(50));
+        assert_eq!(s.telemetry_buffers, 4);
+        assert_eq!(s.command_queue, 16);
+        assert_eq!(s.duration_frames(10_000_000).unwrap(), Some(1200));
+        assert!(s.duration_frames(7_000_000).is_err());
+        s.validate().unwrap();
+    }
+
+    #[test]
+    fn errors_name_the_key() {
+        let cases = [
+            ("colour = 1", "server.colour: unknown key"),
+            ("mode = \"fast\"", "server.mode: unknown mode"),
+            ("mode = 1", "server.mode: expected a string"),
+            ("sc_id = \"a/b\"", "server.sc_id: spacecraft id contains"),
+            ("spacecraft_id = -1", "server.spacecraft_id: must be in"),
+            (
+                "participants = [1, 1]",
+                "server.participants: sender id 1 is listed twice",
+            ),
+            (
+                "participants = [\"a\"]",
+                "server.participants: unsupported value type",
+            ),
+            (
+                "participant_timeout_s = 0",
+                "server.participant_timeout_s: must be > 0",
+            ),
+            ("duration_s = -1.0", "server.duration_s: must be > 0"),
+            (
+                "overrun_policy = \"panic\"",
+                "server.overrun_policy: unknown policy",
+            ),
+            (
+                "stale_policy = \"drop\"",
+                "server.stale_policy: unknown policy",
+            ),
+            ("status_hz = 1e6", "server.status_hz: must be <= 1000"),
+            ("spin_us = 1.5", "server.spin_us: expected an integer"),
+            (
+                "telemetry_buffers = 1",
+                "server.telemetry_buffers: must be in 2..=",
+            ),
+            (
+                "stale_after_s = inf",
+                "server.stale_after_s: must be finite",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = ServerSettings::from_table(&table(text)).unwrap_err();
+            assert!(e.to_string().starts_with(want), "{text}: {e}");
+        }
+        let lockstep_alone =
+            ServerSettings::from_table(&table("mode = \"lockstep\"\nparticipants = []")).unwrap();
+        assert!(lockstep_alone
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("server.participants:"));
+    }
+
+    #[test]
+    fn cli_names() {
+        let mut s = ServerSettings::default();
+        let e = s
+            .apply("stale_after_s", &Value::Float(-1.0), Origin::Cli)
+            .unwrap_err();
+        assert!(
+            e.to_string().starts_with("--stale-after-s: must be > 0"),
+            "{e}"
+        );
+        s.apply("mode", &Value::Str("batch".into()), Origin::Cli)
+            .unwrap();
+        assert_eq!(s.mode, Mode::Batch);
+    }
+}

@@ -1,0 +1,169 @@
+//! State shared between the physics thread and the I/O side: lock-free counters and the
+//! preallocated telemetry buffers that cycle between them.
+
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
+
+use flexdyn_proto::{
+    CommandStatus, DecodeError, PanelPairState, RejectCounters, RunState, StateMsg,
+};
+
+use super::commands::Held;
+use crate::imu::ImuSample;
+
+/// One frame's telemetry, filled by the physics thread and published by the I/O thread. A
+/// fixed pool of these is allocated at start-up and cycled through two bounded channels
+/// (free → physics fills → I/O publishes → free), so the stepping path never allocates.
+#[derive(Debug)]
+pub struct Frame {
+    /// The state message, `panels` preallocated to the spacecraft's pair count.
+    pub state: StateMsg,
+    /// \[ns since the Unix epoch\] wall clock at the frame boundary, sent as the sample's
+    /// attachment (never in the deterministic payload).
+    pub boundary_unix_ns: u64,
+    /// \[ns\] lateness of the boundary against its real-time deadline (0 outside real time).
+    pub lateness_ns: u64,
+    /// Command bookkeeping of the frame that ended at this tick.
+    pub command: CommandStatus,
+    /// One IMU sample per configured IMU (config order), taken at this tick.
+    pub imu: Vec<ImuSample>,
+}
+
+impl Frame {
+    /// An empty frame with room for `n_pairs` panel pairs and `n_imus` IMU samples.
+    pub fn with_capacity(n_pairs: usize, n_imus: usize) -> Self {
+        Self {
+            state: StateMsg {
+                panels: Vec::with_capacity(n_pairs),
+                ..StateMsg::default()
+            },
+            boundary_unix_ns: 0,
+            lateness_ns: 0,
+            command: Held::initial(flexdyn_proto::StalePolicy::Hold).status,
+            imu: Vec::with_capacity(n_imus),
+        }
+    }
+}
+
+/// Fills `out` from a snapshot without allocating (the panel vector keeps its capacity).
+pub fn fill_state(
+    out: &mut StateMsg,
+    snap: &crate::sim::Snapshot,
+    header: flexdyn_proto::Header,
+    held: &Held,
+) {
+    out.header = header;
+    out.sigma_bn = snap.sigma_bn.into();
+    out.q_bn = snap.q_bn.into();
+    out.omega_bn_b_rad_s = snap.omega_bn_b.into();
+    out.omega_dot_bn_b_rad_s2 = snap.omega_dot_bn_b.into();
+    out.r_bn_n_m = snap.r_bn_n.into();
+    out.v_bn_n_m_s = snap.v_bn_n.into();
+    out.nongrav_accel_bn_n_m_s2 = snap.nongrav_accel_bn_n.into();
+    out.conserved.orb_energy_j = snap.conserved.orb_energy_j;
+    out.conserved.rot_energy_j = snap.conserved.rot_energy_j;
+    out.conserved.orb_ang_mom_n = snap.conserved.orb_ang_mom_n.into();
+    out.conserved.rot_ang_mom_c_n = snap.conserved.rot_ang_mom_c_n.into();
+    out.wrench_applied.torque_b_nm = held.torque_b_nm;
+    out.wrench_applied.force_b_n = held.force_b_n;
+    out.command_flags = held.flags;
+    out.panels.clear();
+    for p in &snap.panels {
+        out.panels.push(PanelPairState {
+            theta1_rad: p[0],
+            theta1_dot_rad_s: p[1],
+            theta2_rad: p[2],
+            theta2_dot_rad_s: p[3],
+        });
+    }
+}
+
+/// Counters and flags shared by every thread of a run (atomics only, no locks).
+#[derive(Debug, Default)]
+pub struct Shared {
+    /// Set to ask the physics loop to stop at the next frame boundary.
+    pub stop: AtomicBool,
+    /// [`RunState`] as its wire tag.
+    run_state: AtomicU8,
+    /// Last tick published (boundary reached).
+    pub tick: AtomicU64,
+    malformed: AtomicU64,
+    bad_version: AtomicU64,
+    non_finite: AtomicU64,
+    wrong_spacecraft: AtomicU64,
+    stale_tick: AtomicU64,
+    unknown_sender: AtomicU64,
+    /// Valid commands dropped because the command queue was full.
+    pub commands_dropped: AtomicU64,
+    /// Real time: frames whose work overran the next deadline.
+    pub overruns: AtomicU64,
+    /// Real time, `skip` policy: deadlines dropped.
+    pub frames_skipped: AtomicU64,
+    /// Real time: frames whose telemetry was dropped (no free buffer).
+    pub telemetry_dropped: AtomicU64,
+}
+
+fn bump(c: &AtomicU64) {
+    c.fetch_add(1, Ordering::Relaxed);
+}
+
+impl Shared {
+    /// Count an undecodable command under its reason.
+    pub fn reject_decode(&self, e: &DecodeError) {
+        match e {
+            DecodeError::UnknownVersion { .. } => bump(&self.bad_version),
+            DecodeError::NonFinite { .. } => bump(&self.non_finite),
+            _ => bump(&self.malformed),
+        }
+    }
+
+    /// Count a command for another spacecraft.
+    pub fn reject_wrong_spacecraft(&self) {
+        bump(&self.wrong_spacecraft);
+    }
+
+    /// Count a command with an unacceptable tick.
+    pub fn reject_stale_tick(&self) {
+        bump(&self.stale_tick);
+    }
+
+    /// Count a command from an unknown sender.
+    pub fn reject_unknown_sender(&self) {
+        bump(&self.unknown_sender);
+    }
+
+    /// The rejection counters so far.
+    pub fn rejected(&self) -> RejectCounters {
+        let l = |c: &AtomicU64| c.load(Ordering::Relaxed);
+        RejectCounters {
+            malformed: l(&self.malformed),
+            bad_version: l(&self.bad_version),
+            non_finite: l(&self.non_finite),
+            wrong_spacecraft: l(&self.wrong_spacecraft),
+            stale_tick: l(&self.stale_tick),
+            unknown_sender: l(&self.unknown_sender),
+        }
+    }
+
+    /// Sets the life-cycle state.
+    pub fn set_run_state(&self, s: RunState) {
+        let tag = match s {
+            RunState::Starting => 0,
+            RunState::Running => 1,
+            RunState::Stopping => 2,
+            RunState::Finished => 3,
+            RunState::Failed => 4,
+        };
+        self.run_state.store(tag, Ordering::Release);
+    }
+
+    /// The life-cycle state.
+    pub fn run_state(&self) -> RunState {
+        match self.run_state.load(Ordering::Acquire) {
+            0 => RunState::Starting,
+            1 => RunState::Running,
+            2 => RunState::Stopping,
+            3 => RunState::Finished,
+            _ => RunState::Failed,
+        }
+    }
+}

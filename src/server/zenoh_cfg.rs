@@ -1,0 +1,278 @@
+//! The one place that builds a Zenoh configuration, for the server, the tools, the tests and
+//! the benchmarks.
+//!
+//! Rules, in order:
+//! 1. Start from the JSON5 file of `--zenoh-config` if given (standard Zenoh format), else from
+//!    Zenoh's defaults in **peer** mode.
+//! 2. `--listen` / `--connect` (repeatable) replace the file's endpoints. Without them, and if
+//!    the file does not set them either, the role's loopback defaults apply: the server listens
+//!    on `tcp/127.0.0.1:7447` and connects nowhere; a tool listens nowhere and connects to
+//!    `tcp/127.0.0.1:7447`. (Zenoh's own peer default would listen on every interface.)
+//! 3. Multicast scouting is **always** switched off (`scouting/multicast/enabled = false`),
+//!    even if the file switches it on (a warning is logged): flexdyn never sends multicast, so
+//!    nothing leaves this machine unless an endpoint says so.
+
+use std::path::PathBuf;
+
+use super::error::ZenohConfigError;
+
+/// The default Zenoh endpoint of the server (`flexdyn run` listens, the tools connect).
+pub const DEFAULT_ENDPOINT: &str = "tcp/127.0.0.1:7447";
+
+/// Zenoh connection options shared by `flexdyn run` and every tool (flattened with clap).
+#[derive(Clone, Debug, Default, PartialEq, Eq, clap::Args)]
+pub struct ZenohArgs {
+    /// Zenoh endpoint to listen on, e.g. `tcp/127.0.0.1:7447` (repeatable). Default: the server
+    /// listens on tcp/127.0.0.1:7447, the tools listen nowhere.
+    #[arg(long = "listen", value_name = "ENDPOINT")]
+    pub listen: Vec<String>,
+    /// Zenoh endpoint to connect to (repeatable). Default: the server connects nowhere, the
+    /// tools connect to tcp/127.0.0.1:7447.
+    #[arg(long = "connect", value_name = "ENDPOINT")]
+    pub connect: Vec<String>,
+    /// Standard Zenoh JSON5 configuration file; `--listen`/`--connect` override its endpoints.
+    /// Multicast scouting is forced off whatever the file says.
+    #[arg(long = "zenoh-config", value_name = "FILE")]
+    pub zenoh_config: Option<PathBuf>,
+}
+
+/// Which side of the link a configuration is for: decides the default endpoints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    /// The server: listens on [`DEFAULT_ENDPOINT`], connects nowhere.
+    Server,
+    /// A tool or flight code: listens nowhere, connects to [`DEFAULT_ENDPOINT`].
+    Tool,
+}
+
+impl Role {
+    fn default_listen(self) -> &'static [&'static str] {
+        match self {
+            Role::Server => &[DEFAULT_ENDPOINT],
+            Role::Tool => &[],
+        }
+    }
+
+    fn default_connect(self) -> &'static [&'static str] {
+        match self {
+            Role::Server => &[],
+            Role::Tool => &[DEFAULT_ENDPOINT],
+        }
+    }
+}
+
+fn json_list<S: AsRef<str>>(items: &[S]) -> String {
+    let quoted: Vec<String> = items
+        .iter()
+        .map(|s| serde_json::Value::String(s.as_ref().to_owned()).to_string())
+        .collect();
+    format!("[{}]", quoted.join(","))
+}
+
+fn insert(
+    config: &mut zenoh::Config,
+    key: &str,
+    value: &str,
+    what: &str,
+) -> Result<(), ZenohConfigError> {
+    config
+        .insert_json5(key, value)
+        .map_err(|e| ZenohConfigError::Value {
+            what: what.to_owned(),
+            message: format!("{value}: {e}"),
+        })
+}
+
+/// Whether the parsed JSON5 document sets `path` (a `/`-separated key) to anything.
+fn json_has(doc: &serde_json::Value, path: &str) -> Option<serde_json::Value> {
+    let mut v = doc;
+    for part in path.split('/') {
+        v = v.get(part)?;
+    }
+    Some(v.clone())
+}
+
+/// Builds the Zenoh configuration for `role` from `args` (see the module docs for the rules).
+pub fn zenoh_config(args: &ZenohArgs, role: Role) -> Result<zenoh::Config, ZenohConfigError> {
+    let (mut config, doc) = match &args.zenoh_config {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|source| ZenohConfigError::Read {
+                path: path.clone(),
+                source,
+            })?;
+            let doc: serde_json::Value =
+                json5::from_str(&text).map_err(|e| ZenohConfigError::Parse {
+                    path: path.clone(),
+                    message: e.to_string(),
+                })?;
+            let config = zenoh::Config::from_json5(&text).map_err(|e| ZenohConfigError::Parse {
+                path: path.clone(),
+                message: e.to_string(),
+            })?;
+            (config, Some(doc))
+        }
+        None => {
+            let mut config = zenoh::Config::default();
+            insert(&mut config, "mode", "\"peer\"", "mode")?;
+            // Tools may start before the server: retry the connection quickly.
+            insert(
+                &mut config,
+                "connect/retry",
+                "{ period_init_ms: 100, period_max_ms: 1000, period_increase_factor: 2 }",
+                "connect/retry",
+            )?;
+            (config, None)
+        }
+    };
+    let file_sets = |key: &str| doc.as_ref().and_then(|d| json_has(d, key)).is_some();
+
+    if !args.listen.is_empty() {
+        insert(
+            &mut config,
+            "listen/endpoints",
+            &json_list(&args.listen),
+            "--listen",
+        )?;
+    } else if !file_sets("listen/endpoints") {
+        insert(
+            &mut config,
+            "listen/endpoints",
+            &json_list(role.default_listen()),
+            "listen",
+        )?;
+    }
+    if !args.connect.is_empty() {
+        insert(
+            &mut config,
+            "connect/endpoints",
+            &json_list(&args.connect),
+            "--connect",
+        )?;
+    } else if !file_sets("connect/endpoints") {
+        insert(
+            &mut config,
+            "connect/endpoints",
+            &json_list(role.default_connect()),
+            "connect",
+        )?;
+    }
+
+    if let (Some(path), Some(doc)) = (&args.zenoh_config, &doc) {
+        if json_has(doc, "scouting/multicast/enabled") == Some(serde_json::Value::Bool(true)) {
+            tracing::warn!(
+                file = %path.display(),
+                "the Zenoh config enables multicast scouting; flexdyn forces \
+                 scouting/multicast/enabled = false (loopback/explicit endpoints only)"
+            );
+        }
+    }
+    insert(
+        &mut config,
+        "scouting/multicast/enabled",
+        "false",
+        "scouting/multicast/enabled",
+    )?;
+    Ok(config)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn get(c: &zenoh::Config, key: &str) -> serde_json::Value {
+        serde_json::from_str(&c.get_json(key).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn defaults_are_loopback_peer_without_multicast() {
+        let c = zenoh_config(&ZenohArgs::default(), Role::Server).unwrap();
+        assert_eq!(get(&c, "mode"), serde_json::json!("peer"));
+        assert_eq!(
+            get(&c, "scouting/multicast/enabled"),
+            serde_json::json!(false)
+        );
+        assert_eq!(
+            get(&c, "listen/endpoints"),
+            serde_json::json!(["tcp/127.0.0.1:7447"])
+        );
+        assert_eq!(get(&c, "connect/endpoints"), serde_json::json!([]));
+        let t = zenoh_config(&ZenohArgs::default(), Role::Tool).unwrap();
+        assert_eq!(get(&t, "listen/endpoints"), serde_json::json!([]));
+        assert_eq!(
+            get(&t, "connect/endpoints"),
+            serde_json::json!(["tcp/127.0.0.1:7447"])
+        );
+        assert_eq!(
+            get(&t, "scouting/multicast/enabled"),
+            serde_json::json!(false)
+        );
+    }
+
+    #[test]
+    fn flags_override_and_file_cannot_enable_multicast() {
+        let dir = std::env::temp_dir().join(format!("flexdyn-zcfg-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("z.json5");
+        std::fs::write(
+            &file,
+            r#"{ mode: "peer", scouting: { multicast: { enabled: true } },
+                 listen: { endpoints: ["tcp/127.0.0.1:17999"] } }"#,
+        )
+        .unwrap();
+        let args = ZenohArgs {
+            listen: vec![],
+            connect: vec!["tcp/127.0.0.1:17998".into()],
+            zenoh_config: Some(file.clone()),
+        };
+        let c = zenoh_config(&args, Role::Server).unwrap();
+        assert_eq!(
+            get(&c, "scouting/multicast/enabled"),
+            serde_json::json!(false)
+        );
+        // The file's listen endpoints are kept, the flag's connect endpoint applies.
+        assert_eq!(
+            get(&c, "listen/endpoints"),
+            serde_json::json!(["tcp/127.0.0.1:17999"])
+        );
+        assert_eq!(
+            get(&c, "connect/endpoints"),
+            serde_json::json!(["tcp/127.0.0.1:17998"])
+        );
+        let args = ZenohArgs {
+            listen: vec!["tcp/127.0.0.1:17997".into()],
+            ..args
+        };
+        let c = zenoh_config(&args, Role::Tool).unwrap();
+        assert_eq!(
+            get(&c, "listen/endpoints"),
+            serde_json::json!(["tcp/127.0.0.1:17997"])
+        );
+
+        std::fs::write(&file, "{ mode: ").unwrap();
+        let e = zenoh_config(&args, Role::Server).unwrap_err();
+        assert!(
+            e.to_string().starts_with("invalid Zenoh config file"),
+            "{e}"
+        );
+        let missing = ZenohArgs {
+            zenoh_config: Some(dir.join("missing.json5")),
+            ..ZenohArgs::default()
+        };
+        let e = zenoh_config(&missing, Role::Server).unwrap_err();
+        assert!(
+            e.to_string().starts_with("cannot read Zenoh config file"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn bad_endpoint_is_an_error() {
+        let args = ZenohArgs {
+            listen: vec!["not an endpoint".into()],
+            ..ZenohArgs::default()
+        };
+        let e = zenoh_config(&args, Role::Server).unwrap_err();
+        assert!(e.to_string().starts_with("--listen:"), "{e}");
+    }
+}

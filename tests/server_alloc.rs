@@ -1,0 +1,80 @@
+//! The physics thread's per-frame path allocates nothing: command intake and bookkeeping, the
+//! RK4 frame, IMU sampling, the telemetry fill, and the buffer hand-off through the bounded
+//! channels.
+//!
+//! `assert_no_alloc`'s global allocator counts (de)allocations made on this thread inside
+//! `assert_no_alloc(..)` (features `warn_debug`/`warn_release`: count and warn, don't abort).
+
+use std::sync::mpsc::sync_channel;
+
+use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
+use flexdyn::config::SimConfig;
+use flexdyn::server::commands::CommandBook;
+use flexdyn::server::shared::{fill_state, Frame};
+use flexdyn::sim::{Simulation, Snapshot};
+use flexdyn_proto::{CommandMsg, Header, StalePolicy};
+use nalgebra::Vector3;
+
+#[global_allocator]
+static ALLOC: AllocDisabler = AllocDisabler;
+
+#[test]
+fn the_frame_path_does_not_allocate() {
+    // The reference spacecraft plus the two IMUs of the tactical-IMU scenario.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/imu_tactical.toml");
+    let cfg = SimConfig::from_file(&path).unwrap();
+    let mut sim = Simulation::new(&cfg).unwrap();
+    assert!(sim.n_imus() > 0);
+    let mut imu = Vec::with_capacity(sim.n_imus());
+    let mut book = CommandBook::new(&[1, 2], cfg.frame_ns, 100_000_000, StalePolicy::Hold);
+    let mut snap = Snapshot::with_capacity(sim.n_pairs());
+    let (cmd_tx, cmd_rx) = sync_channel::<CommandMsg>(16);
+    let (free_tx, free_rx) = sync_channel::<Box<Frame>>(2);
+    let (full_tx, full_rx) = sync_channel::<Box<Frame>>(2);
+    for _ in 0..2 {
+        free_tx
+            .send(Box::new(Frame::with_capacity(sim.n_pairs(), sim.n_imus())))
+            .unwrap();
+    }
+    let mut frame_once = |k: u64| {
+        for sender in [1, 2] {
+            let cmd =
+                CommandMsg::wrench(Header::new(1, k, 0, k), sender, [0.0, 0.0, 0.01], [0.0; 3]);
+            cmd_tx.try_send(cmd).unwrap();
+        }
+        book.begin_tick();
+        while let Ok(cmd) = cmd_rx.try_recv() {
+            book.offer_lockstep(&cmd, k);
+        }
+        assert!(book.all_answered());
+        let held = book.held(k);
+        sim.set_command_wrench(
+            Vector3::from(held.force_b_n),
+            Vector3::from(held.torque_b_nm),
+        );
+        sim.step_frame();
+        sim.imu_samples_into(&mut imu);
+        let mut f = free_rx.try_recv().unwrap();
+        sim.snapshot_into(&mut snap);
+        f.imu.clear();
+        f.imu.extend_from_slice(&imu);
+        fill_state(
+            &mut f.state,
+            &snap,
+            Header::new(1, k + 1, snap.t_sim_ns, k + 1),
+            &held,
+        );
+        full_tx.try_send(f).unwrap();
+        // The I/O side returns the buffer.
+        free_tx.try_send(full_rx.try_recv().unwrap()).unwrap();
+    };
+    // Warm up (first-use thread-locals, lazily sized buffers).
+    frame_once(0);
+    reset_violation_count();
+    assert_no_alloc(|| {
+        for k in 1..200 {
+            frame_once(k);
+        }
+    });
+    assert_eq!(violation_count(), 0, "the frame path allocated");
+}

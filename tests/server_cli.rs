@@ -1,0 +1,290 @@
+//! The `flexdyn run` binary as a separate process: exit codes and messages of a participant
+//! timeout, of missing participants and of bad settings; graceful SIGTERM; batch mode.
+//! Ports 17340–17349. Every wait is bounded; a child still running at the end is killed.
+
+mod server_support;
+
+use std::io::Read;
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use flexdyn_proto::{decode_state, encode, CommandMsg, Header, Topics};
+use server_support::{connecting_session, endpoint, wait_until, Observer};
+use zenoh::qos::CongestionControl;
+use zenoh::Wait;
+
+/// A running `flexdyn` process; stderr is collected by a thread; killed on drop.
+struct Server {
+    child: Child,
+    stderr: Arc<Mutex<String>>,
+}
+
+impl Server {
+    fn spawn(args: &[&str]) -> Self {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+            .args(args)
+            .env("RUST_LOG", "info")
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawn flexdyn");
+        let stderr = Arc::new(Mutex::new(String::new()));
+        let mut pipe = child.stderr.take().unwrap();
+        let sink = stderr.clone();
+        std::thread::spawn(move || {
+            let mut buf = [0u8; 4096];
+            while let Ok(n) = pipe.read(&mut buf) {
+                if n == 0 {
+                    break;
+                }
+                sink.lock()
+                    .unwrap()
+                    .push_str(&String::from_utf8_lossy(&buf[..n]));
+            }
+        });
+        Self { child, stderr }
+    }
+
+    fn wait(&mut self, timeout: Duration) -> ExitStatus {
+        let give_up = Instant::now() + timeout;
+        loop {
+            if let Some(s) = self.child.try_wait().unwrap() {
+                // Let the reader thread drain the pipe.
+                std::thread::sleep(Duration::from_millis(50));
+                return s;
+            }
+            assert!(
+                Instant::now() < give_up,
+                "flexdyn did not exit within {timeout:?}; stderr:\n{}",
+                self.stderr()
+            );
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+
+    fn stderr(&self) -> String {
+        self.stderr.lock().unwrap().clone()
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+#[test]
+fn lockstep_participant_timeout_exits_nonzero_naming_participant_and_tick() {
+    let port = 17340;
+    let ep = endpoint(port);
+    let mut server = Server::spawn(&[
+        "run",
+        "--mode",
+        "lockstep",
+        "--participants",
+        "7",
+        "--participant-timeout-s",
+        "1",
+        "--listen",
+        &ep,
+        "--duration-s",
+        "100",
+    ]);
+    // A participant that answers ticks 0..=4, then goes silent.
+    let topics = Topics::new("sc1").unwrap();
+    let session = connecting_session(port);
+    let publisher = session
+        .declare_publisher(topics.cmd_wrench().to_owned())
+        .congestion_control(CongestionControl::Block)
+        .wait()
+        .unwrap();
+    let _sub = session
+        .declare_subscriber(topics.state().to_owned())
+        .callback(move |sample| {
+            let Ok(s) = decode_state(&sample.payload().to_bytes()) else {
+                return;
+            };
+            let h = s.header;
+            if h.tick < 5 {
+                let cmd =
+                    CommandMsg::no_command(Header::new(h.spacecraft_id, h.tick, 0, h.tick), 7);
+                let _ = publisher.put(encode(&cmd)).wait();
+            }
+        })
+        .wait()
+        .unwrap();
+    let _token = session
+        .liveliness()
+        .declare_token(topics.participant(7))
+        .wait()
+        .unwrap();
+    let status = server.wait(Duration::from_secs(30));
+    let err = server.stderr();
+    assert_eq!(status.code(), Some(1), "stderr:\n{err}");
+    assert!(
+        err.contains("error: lockstep participant 7 did not answer tick 5 within 1 s"),
+        "stderr:\n{err}"
+    );
+}
+
+#[test]
+fn lockstep_without_participants_gives_up_after_the_presence_timeout() {
+    let port = 17341;
+    let ep = endpoint(port);
+    let mut server = Server::spawn(&[
+        "run",
+        "--mode",
+        "lockstep",
+        "--participants",
+        "3,4",
+        "--presence-timeout-s",
+        "2",
+        "--listen",
+        &ep,
+    ]);
+    // While it waits, the status says so.
+    let obs = Observer::start(port, &Topics::new("sc1").unwrap());
+    assert!(
+        wait_until(Duration::from_secs(30), || obs.last_status().is_some_and(
+            |s| {
+                s.mode == flexdyn_proto::Mode::Lockstep
+                    && s.run_state == flexdyn_proto::RunState::Starting
+            }
+        )),
+        "no Starting status; stderr:\n{}",
+        server.stderr()
+    );
+    let status = server.wait(Duration::from_secs(30));
+    let err = server.stderr();
+    assert_eq!(status.code(), Some(1), "stderr:\n{err}");
+    assert!(
+        err.contains("participant(s) 3, 4 not present"),
+        "stderr:\n{err}"
+    );
+}
+
+#[test]
+fn bad_settings_exit_2_naming_the_setting() {
+    let dir = std::env::temp_dir().join(format!("flexdyn-server-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("bad_server.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "{}\n[server]\ncolour = \"blue\"\n",
+            flexdyn::config::DEFAULT_CONFIG_TOML
+        ),
+    )
+    .unwrap();
+    let file_s = file.to_str().unwrap();
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["run", "--config", file_s],
+            "error: server.colour: unknown key",
+        ),
+        (
+            &[
+                "run",
+                "--duration-s",
+                "0.015",
+                "--listen",
+                "tcp/127.0.0.1:17342",
+            ],
+            "is not a whole number of frames",
+        ),
+        (
+            &[
+                "run",
+                "--stale-after-s",
+                "-1",
+                "--listen",
+                "tcp/127.0.0.1:17342",
+            ],
+            "error: --stale-after-s: must be > 0",
+        ),
+    ];
+    for (args, want) in cases {
+        let mut server = Server::spawn(args);
+        let status = server.wait(Duration::from_secs(30));
+        let err = server.stderr();
+        assert_eq!(status.code(), Some(2), "{args:?}: stderr:\n{err}");
+        assert!(err.contains(want), "{args:?}: stderr:\n{err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn sigterm_stops_the_realtime_server_gracefully() {
+    let port = 17343;
+    let ep = endpoint(port);
+    let mut server = Server::spawn(&["run", "--listen", &ep]);
+    let topics = Topics::new("sc1").unwrap();
+    let obs = Observer::start(port, &topics);
+    assert!(
+        wait_until(Duration::from_secs(30), || obs
+            .last_tick()
+            .is_some_and(|t| t >= 10)),
+        "no telemetry; stderr:\n{}",
+        server.stderr()
+    );
+    let killed = Command::new("kill")
+        .args(["-TERM", &server.child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let status = server.wait(Duration::from_secs(30));
+    let err = server.stderr();
+    assert_eq!(status.code(), Some(0), "stderr:\n{err}");
+    assert!(
+        err.contains("SIGTERM") && err.contains("run stopped"),
+        "stderr:\n{err}"
+    );
+}
+
+#[test]
+fn batch_mode_runs_to_the_duration() {
+    let ep = endpoint(17344);
+    let mut server = Server::spawn(&[
+        "run",
+        "--mode",
+        "batch",
+        "--duration-s",
+        "20",
+        "--listen",
+        &ep,
+    ]);
+    let status = server.wait(Duration::from_secs(60));
+    let err = server.stderr();
+    assert_eq!(status.code(), Some(0), "stderr:\n{err}");
+    assert!(
+        err.contains("run finished: mode=batch last_tick=2000"),
+        "stderr:\n{err}"
+    );
+}
+
+#[test]
+fn help_lists_the_run_subcommand() {
+    let out = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args(["run", "--help"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    for flag in [
+        "--mode",
+        "--participants",
+        "--participant-timeout-s",
+        "--listen",
+        "--connect",
+        "--zenoh-config",
+        "--sc-id",
+        "--duration-s",
+        "--overrun-policy",
+        "--stale-policy",
+    ] {
+        assert!(text.contains(flag), "{flag} missing from:\n{text}");
+    }
+}

@@ -1,0 +1,167 @@
+//! Harness for the server tests: loopback sessions built with the one config builder
+//! (multicast scouting off), an in-process server with a bounded join, and condition waits.
+#![allow(dead_code)]
+
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
+use flexdyn::server::{self, zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::{decode_state, decode_status, StateMsg, StatusMsg, Topics};
+use zenoh::{Session, Wait};
+
+/// `tcp/127.0.0.1:<port>`.
+pub fn endpoint(port: u16) -> String {
+    format!("tcp/127.0.0.1:{port}")
+}
+
+/// A session listening on `port`.
+pub fn listening_session(port: u16) -> Session {
+    let args = ZenohArgs {
+        listen: vec![endpoint(port)],
+        ..ZenohArgs::default()
+    };
+    zenoh::open(zenoh_config(&args, Role::Server).unwrap())
+        .wait()
+        .unwrap()
+}
+
+/// A session connecting to `port`.
+pub fn connecting_session(port: u16) -> Session {
+    let args = ZenohArgs {
+        connect: vec![endpoint(port)],
+        ..ZenohArgs::default()
+    };
+    zenoh::open(zenoh_config(&args, Role::Tool).unwrap())
+        .wait()
+        .unwrap()
+}
+
+/// The embedded reference spacecraft at `frame_hz`.
+pub fn reference_config(frame_hz: f64) -> SimConfig {
+    let text =
+        DEFAULT_CONFIG_TOML.replace("frame_hz = 100.0 ", &format!("frame_hz = {frame_hz:?} "));
+    SimConfig::from_toml_str(&text).unwrap()
+}
+
+/// Polls `cond` every millisecond until it holds or `timeout` passes.
+pub fn wait_until(timeout: Duration, mut cond: impl FnMut() -> bool) -> bool {
+    let give_up = Instant::now() + timeout;
+    loop {
+        if cond() {
+            return true;
+        }
+        if Instant::now() >= give_up {
+            return false;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}
+
+/// Everything a test observer saw: decoded states (with the attachment stamp) and statuses.
+#[derive(Default)]
+pub struct Seen {
+    pub states: Vec<(StateMsg, Option<u64>)>,
+    pub statuses: Vec<StatusMsg>,
+}
+
+/// Subscribes to a spacecraft's state and status topics.
+pub struct Observer {
+    pub seen: Arc<Mutex<Seen>>,
+    pub session: Session,
+    _subs: Vec<zenoh::pubsub::Subscriber<()>>,
+}
+
+impl Observer {
+    pub fn start(port: u16, topics: &Topics) -> Self {
+        let session = connecting_session(port);
+        let seen: Arc<Mutex<Seen>> = Arc::default();
+        let s = seen.clone();
+        let states = session
+            .declare_subscriber(topics.state().to_owned())
+            .callback(move |sample| {
+                if let Ok(st) = decode_state(&sample.payload().to_bytes()) {
+                    let stamp = server::frame_stamp_ns(&sample);
+                    s.lock().unwrap().states.push((st, stamp));
+                }
+            })
+            .wait()
+            .unwrap();
+        let s = seen.clone();
+        let statuses = session
+            .declare_subscriber(topics.status().to_owned())
+            .callback(move |sample| {
+                if let Ok(st) = decode_status(&sample.payload().to_bytes()) {
+                    s.lock().unwrap().statuses.push(st);
+                }
+            })
+            .wait()
+            .unwrap();
+        Self {
+            seen,
+            session,
+            _subs: vec![states, statuses],
+        }
+    }
+
+    pub fn last_tick(&self) -> Option<u64> {
+        self.seen
+            .lock()
+            .unwrap()
+            .states
+            .last()
+            .map(|(s, _)| s.header.tick)
+    }
+
+    pub fn last_status(&self) -> Option<StatusMsg> {
+        self.seen.lock().unwrap().statuses.last().copied()
+    }
+}
+
+/// `server::run` on its own runtime in a background thread, with a bounded join.
+pub struct ServerHandle {
+    done: std::sync::mpsc::Receiver<Result<server::RunReport, server::ServerError>>,
+    stop: Option<tokio::sync::oneshot::Sender<()>>,
+}
+
+impl ServerHandle {
+    pub fn start(port: u16, settings: server::ServerSettings, cfg: SimConfig) -> Self {
+        let (done_tx, done) = std::sync::mpsc::channel();
+        let (stop_tx, stop_rx) = tokio::sync::oneshot::channel::<()>();
+        let session = listening_session(port);
+        std::thread::spawn(move || {
+            let rt = tokio::runtime::Builder::new_multi_thread()
+                .worker_threads(2)
+                .enable_all()
+                .build()
+                .unwrap();
+            let result = rt.block_on(async {
+                let shutdown = async {
+                    let _ = stop_rx.await;
+                };
+                let r = server::run(session.clone(), settings, cfg, shutdown).await;
+                let _ = session.close().await;
+                r
+            });
+            let _ = done_tx.send(result);
+        });
+        Self {
+            done,
+            stop: Some(stop_tx),
+        }
+    }
+
+    /// Completes the shutdown future (like SIGINT).
+    pub fn stop(&mut self) {
+        if let Some(s) = self.stop.take() {
+            let _ = s.send(());
+        }
+    }
+
+    /// The run's result, waiting at most `timeout`.
+    pub fn join(&self, timeout: Duration) -> Result<server::RunReport, server::ServerError> {
+        self.done
+            .recv_timeout(timeout)
+            .expect("the server did not finish in time")
+    }
+}

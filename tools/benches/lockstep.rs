@@ -1,0 +1,156 @@
+//! Lockstep throughput versus a plain Zenoh ping-pong, measured in the same run.
+//!
+//! Each round runs, on loopback with the same transport settings:
+//! 1. ping-pong: this process pings (a StateMsg-sized sample), `flexdyn-pingpong pong` (a child
+//!    process) answers with a CommandMsg-sized sample;
+//! 2. lockstep, one RK4 step per frame (1 kHz frames): the server in this process, the demo
+//!    controller `flexdyn-acs-demo` as a child process;
+//! 3. lockstep with the reference configuration (100 Hz frames, 10 RK4 steps per frame).
+//!
+//! It prints each round and the medians: round trips/s, ticks/s, and the median of the per-round
+//! ratios (target ≥ 0.8 for the one-step case, where the link dominates). Rounds alternate the
+//! measurements so that a change in machine load hits both sides alike. The physics cost of a
+//! frame is measured alone too, to explain the reference case.
+//!
+//! `cargo bench -p flexdyn-tools --bench lockstep`; environment: `FLEXDYN_BENCH_TICKS`
+//! (default 10000 ticks per measurement), `FLEXDYN_BENCH_ROUNDS` (default 9). Ports 17400–17459.
+
+#[path = "../tests/support/mod.rs"]
+mod support;
+
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use flexdyn::server::ServerSettings;
+use flexdyn::sim::Simulation;
+use flexdyn_proto::{Mode, Topics, PANEL_PAIR_LEN, STATE_FIXED_LEN};
+use flexdyn_tools::pingpong;
+use support::{endpoint, listening_session, reference_config, ChildGuard, ServerHandle};
+
+fn env_usize(name: &str, default: usize) -> usize {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+/// Round trips per second of `ticks` ping-pongs; the pong answers inside its Zenoh callback, or
+/// from a receive loop (`recv_loop`, the demo controller's structure).
+fn pingpong_rate(port: u16, ticks: usize, recv_loop: bool) -> f64 {
+    let topics = Topics::new("bench").unwrap();
+    let session = listening_session(port);
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_flexdyn-pingpong"));
+    cmd.args(["--connect", &endpoint(port), "--sc-id", "bench"])
+        .args(["pong", "--duration-s", "300"]);
+    if recv_loop {
+        cmd.arg("--recv-loop");
+    }
+    let _pong = ChildGuard::spawn(&mut cmd);
+    let rtts = pingpong::ping(
+        &session,
+        &topics,
+        STATE_FIXED_LEN + 2 * PANEL_PAIR_LEN,
+        1000,
+        ticks,
+        Duration::from_secs(30),
+    )
+    .expect("ping-pong");
+    let total: Duration = rtts.iter().sum();
+    ticks as f64 / total.as_secs_f64()
+}
+
+/// Ticks per second of a lockstep run of `ticks` frames at `frame_hz` with the demo controller.
+fn lockstep_rate(port: u16, ticks: usize, frame_hz: f64) -> f64 {
+    let cfg = reference_config(frame_hz);
+    let settings = ServerSettings {
+        mode: Mode::Lockstep,
+        participants: vec![1],
+        duration_ns: Some(ticks as u64 * cfg.frame_ns),
+        summary_interval: Duration::from_secs(3600),
+        ..ServerSettings::default()
+    };
+    let server = ServerHandle::start(port, settings, cfg);
+    let _ctrl = ChildGuard::spawn(Command::new(env!("CARGO_BIN_EXE_flexdyn-acs-demo")).args([
+        "--connect",
+        &endpoint(port),
+        "--log-every-s",
+        "0",
+    ]));
+    let report = server.join(Duration::from_secs(300)).expect("lockstep run");
+    report.last_tick as f64 / report.wall_s
+}
+
+/// \[µs\] physics cost of one frame (step_frame + snapshot), alone.
+fn physics_frame_us(frame_hz: f64) -> f64 {
+    let cfg = reference_config(frame_hz);
+    let mut sim = Simulation::new(&cfg).unwrap();
+    let mut snap = flexdyn::sim::Snapshot::with_capacity(sim.n_pairs());
+    let n = 20_000;
+    let t = Instant::now();
+    for _ in 0..n {
+        sim.step_frame();
+        sim.snapshot_into(&mut snap);
+    }
+    std::hint::black_box(&snap);
+    t.elapsed().as_secs_f64() * 1e6 / n as f64
+}
+
+fn main() {
+    // `cargo bench` passes `--bench`; ignore arguments.
+    let ticks = env_usize("FLEXDYN_BENCH_TICKS", 10_000);
+    let rounds = env_usize("FLEXDYN_BENCH_ROUNDS", 9).clamp(1, 15);
+    println!("lockstep benchmark: {rounds} rounds x {ticks} ticks, loopback TCP, 2-core machine");
+    let (mut pp, mut ppl, mut ls1, mut lsr) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut ratio1, mut ratio1l, mut ratior) = (Vec::new(), Vec::new(), Vec::new());
+    for r in 0..rounds {
+        let base = 17400 + 4 * r as u16;
+        let p = pingpong_rate(base, ticks, false);
+        let pl = pingpong_rate(base + 1, ticks, true);
+        let a = lockstep_rate(base + 2, ticks, 1000.0);
+        let b = lockstep_rate(base + 3, ticks / 4, 100.0);
+        println!(
+            "round {r}: ping-pong {p:.0} rt/s (recv-loop pong {pl:.0}) | lockstep 1 step/frame \
+             {a:.0} ticks/s (ratio {:.2}) | reference 10 steps/frame {b:.0} ticks/s (ratio {:.2})",
+            a / p,
+            b / p
+        );
+        ratio1.push(a / p);
+        ratio1l.push(a / pl);
+        ratior.push(b / p);
+        pp.push(p);
+        ppl.push(pl);
+        ls1.push(a);
+        lsr.push(b);
+    }
+    let (p, pl) = (median(&mut pp), median(&mut ppl));
+    let (a, b) = (median(&mut ls1), median(&mut lsr));
+    let phys1 = physics_frame_us(1000.0);
+    let phys10 = physics_frame_us(100.0);
+    println!(
+        "median ping-pong round trips/s: {p:.0} (rtt {:.1} us); with a receive-loop pong: {pl:.0} \
+         (rtt {:.1} us)",
+        1e6 / p,
+        1e6 / pl
+    );
+    let (r1, r1l, rr) = (
+        median(&mut ratio1),
+        median(&mut ratio1l),
+        median(&mut ratior),
+    );
+    println!(
+        "median lockstep ticks/s, 1 RK4 step per frame: {a:.0} ({:.1} us/tick); median ratio \
+         {r1:.2} (target >= 0.8), {r1l:.2} vs the receive-loop pong",
+        1e6 / a
+    );
+    println!(
+        "median lockstep ticks/s, reference (10 RK4 steps per frame): {b:.0} ({:.1} us/tick); \
+         median ratio {rr:.2}",
+        1e6 / b
+    );
+    println!("physics alone per frame: {phys1:.1} us (1 step), {phys10:.1} us (10 steps)");
+}

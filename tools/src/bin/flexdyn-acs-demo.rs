@@ -1,0 +1,332 @@
+//! `flexdyn-acs-demo`: a demo attitude controller for the flexdyn server — and the template to
+//! copy when you attach your own flight code.
+//!
+//! # What it does
+//! Every time the server publishes the spacecraft state (`flexdyn/<sc>/tlm/state`, one
+//! [`StateMsg`] per frame) this program computes the MRP proportional-derivative control torque
+//!
+//! ```text
+//!     L = −K σ_BR − P ω_BR            (Schaub & Junkins, Analytical Mechanics of Space
+//!                                      Systems, ch. 8: MRP feedback control)
+//! ```
+//!
+//! and publishes it as a [`CommandMsg`] on `flexdyn/<sc>/cmd/wrench`, stamped with the tick of
+//! the state it answers. σ_BR is the MRP attitude error of the body B relative to the target
+//! frame R (given as σ_RN with ω_RN = 0, so ω_BR = ω_BN).
+//!
+//! # Real time and lockstep: one loop
+//! The loop is the same in both server modes:
+//! - **real time**: the server never waits; it applies the latest command it has (typically the
+//!   answer to the previous frame) and flags commands that get too old;
+//! - **lockstep**: the server waits for our answer to tick k before stepping to k+1, so the run
+//!   is bit-for-bit reproducible. Two rules make that work, both followed below:
+//!   1. answer **every** state, stamped with **its** tick (send `CommandKind::NoCommand` if you
+//!      have nothing to command);
+//!   2. subscribe to the state topic **before** declaring the liveliness token
+//!      `flexdyn/<sc>/participant/<sender-id>`: the server starts at tick 0 only once it sees
+//!      the token.
+//!
+//! # Tuning (linearised closed loop, per principal axis with inertia I)
+//! With σ̇ ≈ ω/4 for small errors, I ω̇ = −Kσ − Pω gives σ̈ + (P/I) σ̇ + (K/4I) σ = 0:
+//! ω_n = √(K/(4I)), ζ = P/√(K I), decay rate ζ ω_n = P/(2I), 2 % settling ≈ 8 I / P.
+//! The defaults (K = 100 N·m, P = 300 N·m·s) suit the reference spacecraft
+//! (I ≈ 1100…1800 kg·m² about the centre of mass): ζ ≈ 0.7…0.9, settling ≈ 30…50 s.
+//!
+//! # Copying this file
+//! Keep `main`'s order (session → subscriber → publisher → token → loop). Replace
+//! [`rate_feedback`] by your rate source (e.g. the IMU gyro on `flexdyn/<sc>/tlm/imu/<name>`) and
+//! [`Controller::torque_b_nm`] by your control law. Everything on the wire comes from the
+//! `flexdyn-proto` crate (see `proto/README.md` for C/Python byte layouts).
+
+use std::time::Duration;
+
+use anyhow::{bail, Context as _};
+use clap::Parser;
+use flexdyn_proto::{decode_state, encode_into, CommandMsg, Header, StateMsg};
+use flexdyn_tools::CommonArgs;
+use zenoh::handlers::RingChannel;
+use zenoh::qos::CongestionControl;
+use zenoh::Wait;
+
+/// Demo MRP PD attitude controller: subscribes to flexdyn state, publishes torque commands.
+#[derive(Debug, Parser)]
+#[command(name = "flexdyn-acs-demo", version)]
+struct Args {
+    #[command(flatten)]
+    common: CommonArgs,
+    /// Our sender id (must be in the server's `participants`).
+    #[arg(long, default_value_t = 1)]
+    sender_id: u32,
+    /// Attitude gain K [N·m per unit MRP].
+    #[arg(long, default_value_t = 100.0)]
+    k_nm: f64,
+    /// Rate gain P [N·m·s/rad].
+    #[arg(long, default_value_t = 300.0)]
+    p_nms: f64,
+    /// Target attitude σ_RN (MRP, three comma-separated numbers); ω_RN = 0.
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', default_values_t = [0.0, 0.0, 0.0],
+          allow_negative_numbers = true)]
+    sigma_rn: Vec<f64>,
+    /// Log a progress line every this many seconds of simulation time (0: never).
+    #[arg(long, default_value_t = 10.0)]
+    log_every_s: f64,
+    /// Exit after this many seconds without a state (default: run until killed).
+    #[arg(long)]
+    idle_exit_s: Option<f64>,
+}
+
+// ---------------------------------------------------------------------------------------------
+// MRP kinematics (Schaub & Junkins §3.7; conventions as in proto/README.md: σ_BN is the MRP
+// set of B relative to N, |σ| ≤ 1 after shadow switching).
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The shadow set −σ/|σ|², which describes the same attitude.
+fn mrp_shadow(s: [f64; 3]) -> [f64; 3] {
+    let n2 = dot(s, s);
+    [-s[0] / n2, -s[1] / n2, -s[2] / n2]
+}
+
+/// σ_BR from σ_BN and σ_RN (MRP subtraction, Schaub & Junkins §3.7, MRP composition):
+///
+/// σ_BR = [(1 − |σ_RN|²) σ_BN − (1 − |σ_BN|²) σ_RN + 2 σ_BN × σ_RN]
+///        / [1 + |σ_RN|² |σ_BN|² + 2 σ_RN · σ_BN]
+///
+/// The denominator vanishes when the two attitudes are 360° apart in this MRP pair; then σ_BN's
+/// shadow set is used instead. The result is switched to its shadow set if |σ_BR| > 1.
+pub fn mrp_subtract(sigma_bn: [f64; 3], sigma_rn: [f64; 3]) -> [f64; 3] {
+    let eval = |b: [f64; 3], r: [f64; 3]| {
+        let (b2, r2) = (dot(b, b), dot(r, r));
+        let den = 1.0 + r2 * b2 + 2.0 * dot(r, b);
+        let c = cross(b, r);
+        let num = [
+            (1.0 - r2) * b[0] - (1.0 - b2) * r[0] + 2.0 * c[0],
+            (1.0 - r2) * b[1] - (1.0 - b2) * r[1] + 2.0 * c[1],
+            (1.0 - r2) * b[2] - (1.0 - b2) * r[2] + 2.0 * c[2],
+        ];
+        (num, den)
+    };
+    let (mut num, mut den) = eval(sigma_bn, sigma_rn);
+    if den.abs() < 0.1 && dot(sigma_bn, sigma_bn) > 0.0 {
+        (num, den) = eval(mrp_shadow(sigma_bn), sigma_rn);
+    }
+    let s = [num[0] / den, num[1] / den, num[2] / den];
+    if dot(s, s) > 1.0 {
+        mrp_shadow(s)
+    } else {
+        s
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The controller.
+
+/// The rate used for feedback, ω_BN in B components [rad/s].
+///
+/// Today: the truth rate from the state message. Swap this function to change the rate source
+/// (a later version reads the IMU gyro, `ImuMsg::omega_p_rad_s` rotated from P to B).
+fn rate_feedback(state: &StateMsg) -> [f64; 3] {
+    state.omega_bn_b_rad_s
+}
+
+/// MRP PD attitude controller, L = −K σ_BR − P ω_BR, with a fixed target (ω_RN = 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Controller {
+    /// K [N·m per unit MRP].
+    pub k_nm: f64,
+    /// P [N·m·s/rad].
+    pub p_nms: f64,
+    /// Target attitude σ_RN.
+    pub sigma_rn: [f64; 3],
+}
+
+impl Controller {
+    /// The attitude error σ_BR.
+    pub fn sigma_br(&self, sigma_bn: [f64; 3]) -> [f64; 3] {
+        mrp_subtract(sigma_bn, self.sigma_rn)
+    }
+
+    /// Control torque about B, B components [N·m], from the attitude σ_BN and the rate ω_BN
+    /// [rad/s, B components]. With ω_RN = 0, ω_BR = ω_BN.
+    pub fn torque_b_nm(&self, sigma_bn: [f64; 3], omega_bn_b_rad_s: [f64; 3]) -> [f64; 3] {
+        let sigma_br = self.sigma_br(sigma_bn);
+        let omega_br = omega_bn_b_rad_s;
+        [
+            -self.k_nm * sigma_br[0] - self.p_nms * omega_br[0],
+            -self.k_nm * sigma_br[1] - self.p_nms * omega_br[1],
+            -self.k_nm * sigma_br[2] - self.p_nms * omega_br[2],
+        ]
+    }
+}
+
+fn main() -> anyhow::Result<()> {
+    flexdyn_tools::init_tracing();
+    let args = Args::parse();
+    let topics = args.common.topics()?;
+    if args.sigma_rn.len() != 3 {
+        bail!("--sigma-rn takes three comma-separated numbers, e.g. 0.1,0.2,-0.1");
+    }
+    let controller = Controller {
+        k_nm: args.k_nm,
+        p_nms: args.p_nms,
+        sigma_rn: [args.sigma_rn[0], args.sigma_rn[1], args.sigma_rn[2]],
+    };
+    if !(controller.k_nm.is_finite() && controller.p_nms.is_finite())
+        || controller.sigma_rn.iter().any(|x| !x.is_finite())
+    {
+        bail!("gains and target must be finite");
+    }
+
+    // 1. Session: peer, connects to the server (tcp/127.0.0.1:7447 unless --connect says
+    //    otherwise), multicast scouting off.
+    let session = args.common.open_session()?;
+
+    // 2. Subscribe to the state. A small ring buffer: in real time, if we ever fall behind,
+    //    we skip to the newest states instead of queueing stale ones; in lockstep at most one
+    //    state is outstanding, so nothing is ever dropped.
+    let states = session
+        .declare_subscriber(topics.state())
+        .with(RingChannel::new(8))
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.state()))?;
+
+    // 3. The command publisher. Block (never drop) and express (no batching: lowest latency).
+    let commands = session
+        .declare_publisher(topics.cmd_wrench())
+        .congestion_control(CongestionControl::Block)
+        .express(true)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot declare {}: {e}", topics.cmd_wrench()))?;
+
+    // 4. Announce ourselves to a lockstep server (harmless in real time). Declared after the
+    //    subscriber, so the server cannot publish tick 0 before we can receive it.
+    let _token = session
+        .liveliness()
+        .declare_token(topics.participant(args.sender_id))
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot declare the liveliness token: {e}"))?;
+    tracing::info!(
+        sender_id = args.sender_id,
+        k_nm = controller.k_nm,
+        p_nms = controller.p_nms,
+        sigma_rn = ?controller.sigma_rn,
+        state = topics.state(),
+        commands = topics.cmd_wrench(),
+        "flexdyn-acs-demo running"
+    );
+
+    // 5. The loop: one command per state received.
+    let idle = args.idle_exit_s.map(Duration::from_secs_f64);
+    let log_every_ns = (args.log_every_s.max(0.0) * 1e9) as u64;
+    let mut next_log_ns = 0u64;
+    let mut seq = 0u64;
+    let mut buf = Vec::with_capacity(128);
+    loop {
+        let sample = match idle {
+            None => Some(states.recv().map_err(|e| anyhow::anyhow!("{e}"))?),
+            Some(d) => states.recv_timeout(d).map_err(|e| anyhow::anyhow!("{e}"))?,
+        };
+        let Some(sample) = sample else {
+            tracing::info!("no state for {:?}; exiting", idle.unwrap_or_default());
+            return Ok(());
+        };
+        let state = match decode_state(&sample.payload().to_bytes()) {
+            Ok(s) => s,
+            Err(e) => {
+                tracing::warn!(error = %e, "ignoring an undecodable state");
+                continue;
+            }
+        };
+
+        // The control law.
+        let torque_b_nm = controller.torque_b_nm(state.sigma_bn, rate_feedback(&state));
+
+        // Answer with the state's spacecraft id, tick and sim time; our own sequence number.
+        let h = state.header;
+        let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
+        let cmd = CommandMsg::wrench(header, args.sender_id, torque_b_nm, [0.0; 3]);
+        encode_into(&cmd, &mut buf);
+        commands
+            .put(buf.as_slice())
+            .wait()
+            .map_err(|e| anyhow::anyhow!("cannot publish the command: {e}"))
+            .context("publishing")?;
+        seq += 1;
+
+        if log_every_ns > 0 && h.sim_time_ns >= next_log_ns {
+            let e = controller.sigma_br(state.sigma_bn);
+            tracing::info!(
+                tick = h.tick,
+                t_s = h.sim_time_ns as f64 / 1e9,
+                sigma_br_norm = dot(e, e).sqrt(),
+                omega_norm_rad_s = dot(state.omega_bn_b_rad_s, state.omega_bn_b_rad_s).sqrt(),
+                torque_b_nm = ?torque_b_nm,
+                "control"
+            );
+            next_log_ns = h.sim_time_ns.saturating_add(log_every_ns);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flexdyn::attitude::mrp_error;
+    use nalgebra::Vector3;
+
+    fn close(a: [f64; 3], b: Vector3<f64>, tol: f64) -> bool {
+        (0..3).all(|i| (a[i] - b[i]).abs() < tol)
+    }
+
+    /// Validated against a second algorithm: flexdyn's DCM-based [BR] = [BN][RN]ᵀ.
+    #[test]
+    fn validate_mrp_subtract_against_dcm() {
+        let sets = [
+            [0.0, 0.0, 0.0],
+            [0.1, 0.2, -0.1],
+            [-0.5, 0.3, 0.7],
+            [0.9, -0.1, 0.2],
+            [0.05, -0.6, 0.55],
+        ];
+        for b in sets {
+            for r in sets {
+                let got = mrp_subtract(b, r);
+                let want = mrp_error(&Vector3::from(b), &Vector3::from(r));
+                assert!(
+                    close(got, want, 1e-12),
+                    "b={b:?} r={r:?}: {got:?} vs {want:?}"
+                );
+            }
+        }
+        // 360° apart in this MRP pair: the denominator vanishes, the shadow set saves it.
+        let b = [0.6, 0.0, 0.0];
+        let r = mrp_shadow([0.6, 0.0, 0.0]);
+        let got = mrp_subtract(b, r);
+        assert!(got.iter().all(|x| x.is_finite()));
+        assert!(close(got, Vector3::zeros(), 1e-12), "{got:?}");
+    }
+
+    #[test]
+    fn pd_law_signs() {
+        let c = Controller {
+            k_nm: 2.0,
+            p_nms: 3.0,
+            sigma_rn: [0.0; 3],
+        };
+        assert_eq!(
+            c.torque_b_nm([0.1, 0.0, 0.0], [0.0, 0.0, 0.0]),
+            [-0.2, 0.0, 0.0]
+        );
+        assert_eq!(c.torque_b_nm([0.0; 3], [0.0, 1.0, 0.0]), [0.0, -3.0, 0.0]);
+    }
+}

@@ -1,0 +1,228 @@
+//! End-to-end lockstep: the flexdyn server (in this test process, on its own loopback port) and
+//! the demo controller `flexdyn-acs-demo` (a separate process) run a closed loop.
+//!
+//! Why the server runs in-process: Cargo gives integration tests the path of their own
+//! package's binaries only (`CARGO_BIN_EXE_flexdyn-acs-demo` here), so the controller is the
+//! child process and the server is `flexdyn::server::run`, the same function `flexdyn run`
+//! calls. `tests/server_cli.rs` in the root package covers the `flexdyn` binary itself (exit
+//! code and message of a participant timeout).
+//!
+//! A second, passive participant (sender 2, in this process) records every StateMsg payload and
+//! answers `NoCommand`; being a participant guarantees it sees every tick from 0.
+//!
+//! Ports 17310–17319.
+
+mod support;
+
+use std::process::Command;
+use std::time::Duration;
+
+use flexdyn::attitude::mrp_error;
+use flexdyn::server::{ServerError, ServerSettings};
+use flexdyn_proto::{decode_state, Mode, Topics};
+use nalgebra::Vector3;
+use sha2::{Digest, Sha256};
+use support::{endpoint, reference_config, signal, ChildGuard, Recorder, ServerHandle};
+
+/// Controller gains and target used by every run.
+const K_NM: f64 = 100.0;
+const P_NMS: f64 = 300.0;
+const SIGMA_RN: [f64; 3] = [0.1, 0.2, -0.1];
+/// Simulated duration [s] (100 Hz frames).
+const DURATION_S: f64 = 80.0;
+
+/// Convergence bound derived from the gains.
+///
+/// Linearised MRP PD loop per principal axis (σ̇ ≈ ω/4, inertia I about the centre of mass):
+/// σ̈ + (P/I) σ̇ + (K/(4I)) σ = 0, so ω_n = √(K/(4I)), ζ = P/√(K I) and the envelope decays
+/// as exp(−ζ ω_n t) with ζ ω_n = P/(2I); the usual 2 % settling time is 4/(ζ ω_n) = 8 I / P.
+/// (Written with the Euler-angle convention ω_n = √(K/I), ζ = P/(2√(K I)), the product ζ ω_n —
+/// and so the settling time — is the same.)
+///
+/// Reference spacecraft about its centre of mass: hub (900, 800, 600) kg·m² plus four 50 kg
+/// panels centred 1.25 m and 2.75 m out along ±x (25 kg·m² each about y and z):
+/// I_y,z ≈ 800 or 600 + 2·(2·25 + 50·(1.25² + 2.75²)) ≈ 1812 / 1612 kg·m², I_x ≈ 1100 kg·m².
+/// With K = 100, P = 300: ζ ∈ [0.70, 0.90] (all underdamped) and
+/// t_settle ≤ 8 · 1812 / 300 ≈ 48 s. The wings are undamped flexible appendages, which the
+/// rigid-body model ignores, so the check allows 1.25× the bound (60 s) and a threshold of
+/// 0.02 on |σ_BR| (≈ 8 % of the initial 0.245, i.e. 2.3°), and requires |σ_BR| to stay below
+/// it until the end of the run.
+const I_MAX_KG_M2: f64 = 1812.0;
+const SIGMA_THRESHOLD: f64 = 0.02;
+
+fn settling_bound_s() -> f64 {
+    1.25 * 8.0 * I_MAX_KG_M2 / P_NMS
+}
+
+fn settings(participant_timeout_s: f64) -> ServerSettings {
+    ServerSettings {
+        mode: Mode::Lockstep,
+        participants: vec![1, 2],
+        participant_timeout: Duration::from_secs_f64(participant_timeout_s),
+        presence_timeout: Duration::from_secs(30),
+        duration_ns: Some((DURATION_S * 1e9) as u64),
+        ..ServerSettings::default()
+    }
+}
+
+fn controller(port: u16) -> ChildGuard {
+    let sigma = format!("{},{},{}", SIGMA_RN[0], SIGMA_RN[1], SIGMA_RN[2]);
+    ChildGuard::spawn(
+        Command::new(env!("CARGO_BIN_EXE_flexdyn-acs-demo"))
+            .args(["--connect", &endpoint(port), "--sender-id", "1"])
+            .args(["--k-nm", &K_NM.to_string(), "--p-nms", &P_NMS.to_string()])
+            .args(["--sigma-rn", &sigma, "--log-every-s", "0"]),
+    )
+}
+
+enum Sabotage {
+    None,
+    /// SIGSTOP the controller once tick `at` is recorded, SIGCONT it after `pause`.
+    Pause {
+        at: u64,
+        pause: Duration,
+    },
+    /// SIGKILL the controller once tick `at` is recorded.
+    Kill {
+        at: u64,
+    },
+}
+
+struct Run {
+    result: Result<flexdyn::server::RunReport, ServerError>,
+    states: Vec<(u64, Vec<u8>)>,
+}
+
+fn lockstep_run(port: u16, participant_timeout_s: f64, sabotage: Sabotage) -> Run {
+    let topics = Topics::new("sc1").unwrap();
+    let server = ServerHandle::start(
+        port,
+        settings(participant_timeout_s),
+        reference_config(100.0),
+    );
+    let recorder = Recorder::start(port, &topics, 2);
+    let mut ctrl = controller(port);
+    match sabotage {
+        Sabotage::None => {}
+        Sabotage::Pause { at, pause } => {
+            assert!(
+                recorder.wait_for_tick(at, Duration::from_secs(60)),
+                "never reached tick {at}"
+            );
+            signal(ctrl.id(), "-STOP");
+            // Let the answers already in flight land, then the server must stand still.
+            std::thread::sleep(Duration::from_millis(100));
+            let frozen_at = recorder.last_tick();
+            std::thread::sleep(pause);
+            let still_at = recorder.last_tick();
+            signal(ctrl.id(), "-CONT");
+            assert_eq!(
+                frozen_at, still_at,
+                "the server stepped without the controller"
+            );
+        }
+        Sabotage::Kill { at } => {
+            assert!(
+                recorder.wait_for_tick(at, Duration::from_secs(60)),
+                "never reached tick {at}"
+            );
+            ctrl.0.kill().unwrap();
+        }
+    }
+    let result = server.join(Duration::from_secs(120));
+    let mut states = recorder.states.lock().unwrap().clone();
+    states.sort_by_key(|(t, _)| *t);
+    Run { result, states }
+}
+
+fn digest(states: &[(u64, Vec<u8>)]) -> String {
+    let mut h = Sha256::new();
+    for (i, (tick, bytes)) in states.iter().enumerate() {
+        assert_eq!(*tick, i as u64, "ticks are not contiguous from 0");
+        h.update(bytes);
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[test]
+fn lockstep_converges_and_is_bit_identical_across_runs_and_pauses() {
+    let n_ticks = (DURATION_S * 100.0) as u64 + 1;
+
+    let a = lockstep_run(17310, 10.0, Sabotage::None);
+    let report = a.result.expect("run A");
+    assert_eq!(report.last_tick, n_ticks - 1);
+    assert_eq!(a.states.len() as u64, n_ticks);
+    let hash_a = digest(&a.states);
+
+    // Convergence: |σ_BR| below the threshold from the derived bound to the end.
+    let sigma_rn = Vector3::from(SIGMA_RN);
+    let mut settled_at_s = None;
+    for (tick, bytes) in &a.states {
+        let s = decode_state(bytes).unwrap();
+        let e = mrp_error(&Vector3::from(s.sigma_bn), &sigma_rn).norm();
+        let t_s = *tick as f64 / 100.0;
+        if e >= SIGMA_THRESHOLD {
+            settled_at_s = None;
+        } else if settled_at_s.is_none() {
+            settled_at_s = Some(t_s);
+        }
+        assert!(
+            t_s < settling_bound_s() || e < SIGMA_THRESHOLD,
+            "|sigma_BR| = {e} at t = {t_s} s, after the bound {} s",
+            settling_bound_s()
+        );
+    }
+    eprintln!(
+        "run A: settled (|sigma_BR| < {SIGMA_THRESHOLD} for good) at {:?} s, bound {} s, \
+         {} ticks in {:.2} s wall, sha256 {hash_a}",
+        settled_at_s,
+        settling_bound_s(),
+        n_ticks,
+        report.wall_s
+    );
+    // The controller actually commanded torque (commands were applied).
+    let mid = decode_state(&a.states[100].1).unwrap();
+    assert!(mid.wrench_applied.torque_b_nm.iter().any(|t| *t != 0.0));
+    assert_eq!(mid.command_flags, 0);
+
+    let b = lockstep_run(17311, 10.0, Sabotage::None);
+    b.result.expect("run B");
+    assert_eq!(digest(&b.states), hash_a, "two identical runs differ");
+
+    let c = lockstep_run(
+        17312,
+        10.0,
+        Sabotage::Pause {
+            at: 2000,
+            pause: Duration::from_millis(1500),
+        },
+    );
+    c.result.expect("run C (paused controller)");
+    assert_eq!(
+        digest(&c.states),
+        hash_a,
+        "a paused controller changed the telemetry"
+    );
+}
+
+#[test]
+fn killed_controller_stops_the_run_with_a_timeout_naming_it() {
+    let run = lockstep_run(17313, 2.0, Sabotage::Kill { at: 300 });
+    let err = run.result.expect_err("the run must fail");
+    let msg = err.to_string();
+    match err {
+        ServerError::ParticipantTimeout {
+            participant, tick, ..
+        } => {
+            assert_eq!(participant, 1);
+            assert!(tick >= 300, "tick {tick}");
+            // The last state published is the tick the controller never answered.
+            assert_eq!(run.states.last().map(|(t, _)| *t), Some(tick));
+            assert!(
+                msg.contains("participant 1") && msg.contains(&format!("tick {tick}")),
+                "{msg}"
+            );
+        }
+        other => panic!("expected a participant timeout, got {other:?}"),
+    }
+}
