@@ -2,7 +2,8 @@
 //!
 //! Every appended body (a dual-hinged panel pair today; a single hinged panel, a reaction wheel or
 //! an N-panel chain tomorrow) implements [`StateEffector`]. Per derivative evaluation the
-//! [`Spacecraft`](super::Spacecraft) calls, in order:
+//! [`Spacecraft`](super::Spacecraft) calls, in order (steps 1 and 2 back to back for each effector:
+//! contributions depend on ω, never on the other effectors' mass properties):
 //!
 //! 1. [`StateEffector::update_mass_props`] — the effector's mass, first moment and inertia about B
 //!    (their sums give m_sc, c, c′ and [I_sc,B] of Eqs. 3, 4 and 19);

@@ -210,6 +210,26 @@ fn add_symmetric_rank_ones(m: &mut Matrix3<f64>, d: f64, terms: &[(f64, &Vector3
     m[(2, 1)] += yz;
 }
 
+/// `m += a1 b1ᵀ + a2 b2ᵀ` for a sum known to be symmetric: computes the upper triangle once and
+/// mirrors it, so the result is exactly symmetric.
+#[inline(always)]
+fn add_symmetric_rank_two(
+    m: &mut Matrix3<f64>,
+    a1: &Vector3<f64>,
+    b1: &Vector3<f64>,
+    a2: &Vector3<f64>,
+    b2: &Vector3<f64>,
+) {
+    for i in 0..3 {
+        m[(i, i)] += a1[i] * b1[i] + a2[i] * b2[i];
+        for j in (i + 1)..3 {
+            let v = a1[i] * b1[j] + a2[i] * b2[j];
+            m[(i, j)] += v;
+            m[(j, i)] += v;
+        }
+    }
+}
+
 impl StateEffector for PanelPair {
     fn name(&self) -> &str {
         &self.params.name
@@ -375,11 +395,16 @@ impl StateEffector for PanelPair {
         let q2 = r23 * mu2 + e * a21;
         let q1 = r13 * mu1 + q2 + e * a11;
 
-        // Eqs. 139, 140, 142, 143 as rank-one updates of the hub sums.
-        sum.matrix_a += p1 * xf1.transpose() + p2 * xf2.transpose();
-        sum.matrix_b += p1 * xg1.transpose() + p2 * xg2.transpose();
-        sum.matrix_c += q1 * xf1.transpose() + q2 * xf2.transpose();
-        sum.matrix_d += q1 * xg1.transpose() + q2 * xg2.transpose();
+        // Eqs. 139, 140, 142, 143 as rank-one updates of the hub sums. [A_i] = T⁻¹ M_θθ with
+        // T = [[1, 1], [0, 1]] (Kane's θ1 row is Eq. 119 + Eq. 120, ERRATA.md) and M_θθ the
+        // symmetric Kane block, so [A_contr] = −(T F)ᵀ M_θθ⁻¹ (T F) and [D_contr] are symmetric
+        // and [C_contr] = [B_contr]ᵀ: the same symmetry that erratum E2 restores in the hub's
+        // [C] = m_sc[c̃] + [C_contr] = [B]ᵀ. Only their independent entries are computed.
+        add_symmetric_rank_two(&mut sum.matrix_a, &p1, &xf1, &p2, &xf2);
+        add_symmetric_rank_two(&mut sum.matrix_d, &q1, &xg1, &q2, &xg2);
+        let b_contr = p1 * xg1.transpose() + p2 * xg2.transpose();
+        sum.matrix_b += b_contr;
+        sum.matrix_c += b_contr.transpose();
 
         // Eq. 141: m1 d1 θ̇1² ŝ11 + m2 (l1 θ̇1² ŝ11 + d2 θ̇12² ŝ21) = μ1 θ̇1² ŝ11 + μ2 θ̇12² ŝ21.
         let (th1_dot_sq, th12_dot_sq) = (th1_dot * th1_dot, th12_dot * th12_dot);

@@ -295,19 +295,18 @@ impl EquationsOfMotion {
             inertia_pnt_b_b_kg_m2: self.hub_inertia_pnt_b_b,
             ..EffectorMassProps::default()
         };
+        // Pass 2: effector contributions (Eqs. 139–144). They need ω but not the summed mass
+        // properties, so each effector runs both passes back to back while its geometry is hot.
+        let kin = HubKinematics { omega_bn_b: omega };
+        let mut contr = BackSubContributions::default();
         for (e, r) in self.effectors.iter_mut().zip(&self.ranges) {
-            e.update_mass_props(&x.effectors[r.clone()], &mut mp);
+            let xe = &x.effectors[r.clone()];
+            e.update_mass_props(xe, &mut mp);
+            e.update_contributions(xe, &kin, &mut contr);
         }
         let m_sc = mp.mass_kg;
         let c_b = mp.first_moment_b_kg_m / m_sc;
         let c_prime_b = mp.first_moment_prime_b_kg_m_s / m_sc;
-
-        // Pass 2: effector contributions (Eqs. 139–144).
-        let kin = HubKinematics { omega_bn_b: omega };
-        let mut contr = BackSubContributions::default();
-        for (e, r) in self.effectors.iter_mut().zip(&self.ranges) {
-            e.update_contributions(&x.effectors[r.clone()], &kin, &mut contr);
-        }
 
         // Eqs. 145–150, with erratum E2 in Eq. 148.
         let c_tilde = tilde(&c_b);
