@@ -3,7 +3,7 @@
 //!
 //! # What it does
 //! Every time the server publishes the spacecraft state (`flexdyn/<sc>/tlm/state`, one
-//! [`StateMsg`] per frame) this program computes the MRP proportional-derivative control torque
+//! [`StateMsg`](flexdyn_proto::StateMsg) per frame) this program computes the MRP proportional-derivative control torque
 //!
 //! ```text
 //!     L = −K σ_BR − P ω_BR            (Schaub & Junkins, Analytical Mechanics of Space
@@ -32,20 +32,32 @@
 //! The defaults (K = 100 N·m, P = 300 N·m·s) suit the reference spacecraft
 //! (I ≈ 1100…1800 kg·m² about the centre of mass): ζ ≈ 0.7…0.9, settling ≈ 30…50 s.
 //!
+//! # Rate feedback from the gyro
+//! Flight code reads rate gyros, not truth, so by default the rate comes from an IMU the server
+//! publishes on `flexdyn/<sc>/tlm/imu/<name>` ([`ImuMsg`], one per frame, stamped with the same
+//! tick as the state and published just before it): ω_B = [PB]ᵀ ω_P, with [PB] the IMU's
+//! mounting (`--imu-dcm-pb`, as in the server's `[[imus]]`). `--rate-source`:
+//! - `gyro`: use the IMU `--imu NAME` (error if the server does not publish it);
+//! - `auto` (default): use `--imu NAME` if given, otherwise the first IMU (by name) that
+//!   publishes for the first state received; if the server publishes no IMU at all, say so in the
+//!   log and use the state message's truth rate;
+//! - `truth`: the state message's ω_BN.
+//!
 //! # Copying this file
-//! Keep `main`'s order (session → subscriber → publisher → token → loop). Replace
-//! [`rate_feedback`] by your rate source (e.g. the IMU gyro on `flexdyn/<sc>/tlm/imu/<name>`) and
-//! [`Controller::torque_b_nm`] by your control law. Everything on the wire comes from the
-//! `flexdyn-proto` crate (see `proto/README.md` for C/Python byte layouts).
+//! Keep `main`'s order (session → subscribers → publisher → token → loop). Replace
+//! [`GyroFeedback`] by your rate source and [`Controller::torque_b_nm`] by your control law.
+//! Everything on the wire comes from the `flexdyn-proto` crate (see `proto/README.md` for C and
+//! Python byte layouts).
 
 use std::time::Duration;
 
 use anyhow::{bail, Context as _};
 use clap::Parser;
-use flexdyn_proto::{decode_state, encode_into, CommandMsg, Header, StateMsg};
+use flexdyn_proto::{decode_imu, decode_state, encode_into, CommandMsg, Header, ImuMsg};
 use flexdyn_tools::CommonArgs;
-use zenoh::handlers::RingChannel;
+use zenoh::handlers::{RingChannel, RingChannelHandler};
 use zenoh::qos::CongestionControl;
+use zenoh::sample::Sample;
 use zenoh::Wait;
 
 /// Demo MRP PD attitude controller: subscribes to flexdyn state, publishes torque commands.
@@ -73,6 +85,30 @@ struct Args {
     /// Exit after this many seconds without a state (default: run until killed).
     #[arg(long)]
     idle_exit_s: Option<f64>,
+    /// Where the rate feedback comes from: `auto`, `gyro` or `truth` (see the module docs).
+    #[arg(long, value_enum, default_value_t = RateSource::Auto)]
+    rate_source: RateSource,
+    /// The IMU whose gyro feeds the rate loop (its `[[imus]] name` in the server config).
+    #[arg(long)]
+    imu: Option<String>,
+    /// That IMU's mounting [PB] (maps B to platform P), nine comma-separated numbers, row-major.
+    #[arg(long, value_name = "9 NUMBERS", value_delimiter = ',', allow_negative_numbers = true,
+          default_values_t = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])]
+    imu_dcm_pb: Vec<f64>,
+    /// Longest wait [s] for the gyro sample of a state's tick before giving up (error).
+    #[arg(long, default_value_t = 5.0)]
+    imu_timeout_s: f64,
+}
+
+/// Rate feedback source.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum RateSource {
+    /// The named IMU, else the first IMU found, else (with a log line) the truth rate.
+    Auto,
+    /// The IMU named by `--imu`.
+    Gyro,
+    /// The truth rate in the state message.
+    Truth,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -131,12 +167,95 @@ pub fn mrp_subtract(sigma_bn: [f64; 3], sigma_rn: [f64; 3]) -> [f64; 3] {
 // ---------------------------------------------------------------------------------------------
 // The controller.
 
-/// The rate used for feedback, ω_BN in B components [rad/s].
-///
-/// Today: the truth rate from the state message. Swap this function to change the rate source
-/// (a later version reads the IMU gyro, `ImuMsg::omega_p_rad_s` rotated from P to B).
-fn rate_feedback(state: &StateMsg) -> [f64; 3] {
-    state.omega_bn_b_rad_s
+/// The gyro rate feedback: pairs each state with the `ImuMsg` of the same tick from one IMU and
+/// rotates its rate to B, ω_B = [PB]ᵀ ω_P.
+struct GyroFeedback {
+    /// The IMU followed (None until chosen in `auto` mode).
+    name: Option<String>,
+    /// [PB], row-major.
+    dcm_pb: [[f64; 3]; 3],
+    /// Latest sample of the followed IMU not yet used (a sample can arrive before its state).
+    pending: Option<ImuMsg>,
+}
+
+impl GyroFeedback {
+    /// ω_BN in B from a platform-frame gyro rate: [PB]ᵀ ω_P.
+    fn rate_b(&self, omega_p: [f64; 3]) -> [f64; 3] {
+        let c = &self.dcm_pb;
+        [
+            c[0][0] * omega_p[0] + c[1][0] * omega_p[1] + c[2][0] * omega_p[2],
+            c[0][1] * omega_p[0] + c[1][1] * omega_p[1] + c[2][1] * omega_p[2],
+            c[0][2] * omega_p[0] + c[1][2] * omega_p[1] + c[2][2] * omega_p[2],
+        ]
+    }
+
+    /// Waits (at most `timeout`) for the followed IMU's sample of `tick`. In `auto` mode with no
+    /// IMU chosen yet, adopts the first IMU (by name) that publishes `tick`. Older samples are
+    /// skipped; `Ok(None)` means no IMU published `tick` within `timeout`.
+    fn sample_for(
+        &mut self,
+        tick: u64,
+        imus: &RingChannelHandler<Sample>,
+        timeout: Duration,
+    ) -> anyhow::Result<Option<[f64; 3]>> {
+        if let Some(m) = self.pending.take() {
+            if m.header.tick == tick {
+                return Ok(Some(self.rate_b(m.omega_p_rad_s)));
+            }
+            if m.header.tick > tick {
+                self.pending = Some(m);
+                return Ok(None);
+            }
+        }
+        let deadline = std::time::Instant::now() + timeout;
+        // In auto discovery, all IMUs that publish `tick` are gathered to pick the first by name.
+        let mut found: Vec<(String, ImuMsg)> = Vec::new();
+        loop {
+            let left = deadline.saturating_duration_since(std::time::Instant::now());
+            let wait = if self.name.is_none() && !found.is_empty() {
+                left.min(Duration::from_millis(50))
+            } else {
+                left
+            };
+            let Some(sample) = imus
+                .recv_timeout(wait)
+                .map_err(|e| anyhow::anyhow!("{e}"))?
+            else {
+                break;
+            };
+            let name = sample
+                .key_expr()
+                .as_str()
+                .rsplit('/')
+                .next()
+                .unwrap_or_default()
+                .to_string();
+            let Ok(msg) = decode_imu(&sample.payload().to_bytes()) else {
+                tracing::warn!(imu = %name, "ignoring an undecodable IMU sample");
+                continue;
+            };
+            match &self.name {
+                Some(n) if *n != name => continue,
+                Some(_) if msg.header.tick < tick => continue,
+                Some(_) if msg.header.tick > tick => {
+                    self.pending = Some(msg);
+                    return Ok(None);
+                }
+                Some(_) => return Ok(Some(self.rate_b(msg.omega_p_rad_s))),
+                None if msg.header.tick == tick => found.push((name, msg)),
+                None => continue,
+            }
+        }
+        found.sort_by(|a, b| a.0.cmp(&b.0));
+        match found.into_iter().next() {
+            Some((name, msg)) => {
+                tracing::info!(imu = %name, "rate feedback from this IMU's gyro");
+                self.name = Some(name);
+                Ok(Some(self.rate_b(msg.omega_p_rad_s)))
+            }
+            None => Ok(None),
+        }
+    }
 }
 
 /// MRP PD attitude controller, L = −K σ_BR − P ω_BR, with a fixed target (ω_RN = 0).
@@ -169,6 +288,26 @@ impl Controller {
     }
 }
 
+/// A 3×3 DCM from nine row-major numbers, checked proper orthonormal within 1e-9.
+fn parse_dcm(v: &[f64]) -> anyhow::Result<[[f64; 3]; 3]> {
+    if v.len() != 9 || v.iter().any(|x| !x.is_finite()) {
+        bail!("--imu-dcm-pb takes nine finite comma-separated numbers (row-major [PB])");
+    }
+    let c = [[v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]];
+    for i in 0..3 {
+        for j in 0..3 {
+            let d = dot(c[i], c[j]) - if i == j { 1.0 } else { 0.0 };
+            if d.abs() > 1e-9 {
+                bail!("--imu-dcm-pb is not orthonormal within 1e-9 (rows {i}, {j}: {d:e})");
+            }
+        }
+    }
+    if (dot(cross(c[0], c[1]), c[2]) - 1.0).abs() > 1e-9 {
+        bail!("--imu-dcm-pb is a reflection (determinant -1), not a rotation");
+    }
+    Ok(c)
+}
+
 fn main() -> anyhow::Result<()> {
     flexdyn_tools::init_tracing();
     let args = Args::parse();
@@ -186,6 +325,14 @@ fn main() -> anyhow::Result<()> {
     {
         bail!("gains and target must be finite");
     }
+    let dcm_pb = parse_dcm(&args.imu_dcm_pb)?;
+    if args.rate_source == RateSource::Gyro && args.imu.is_none() {
+        bail!("--rate-source gyro needs --imu NAME (the [[imus]] name in the server config)");
+    }
+    if !(args.imu_timeout_s.is_finite() && args.imu_timeout_s > 0.0) {
+        bail!("--imu-timeout-s must be a positive number of seconds");
+    }
+    let imu_timeout = Duration::from_secs_f64(args.imu_timeout_s);
 
     // 1. Session: peer, connects to the server (tcp/127.0.0.1:7447 unless --connect says
     //    otherwise), multicast scouting off.
@@ -199,6 +346,27 @@ fn main() -> anyhow::Result<()> {
         .with(RingChannel::new(8))
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.state()))?;
+
+    // 2b. The gyro: one IMU's topic, or all of them while `auto` looks for one.
+    let imu_key = match &args.imu {
+        Some(name) => topics.imu(name)?,
+        None => topics.imu_wildcard(),
+    };
+    let (imus, mut gyro) = if args.rate_source == RateSource::Truth {
+        (None, None)
+    } else {
+        let sub = session
+            .declare_subscriber(&imu_key)
+            .with(RingChannel::new(64))
+            .wait()
+            .map_err(|e| anyhow::anyhow!("cannot subscribe to {imu_key}: {e}"))?;
+        let g = GyroFeedback {
+            name: args.imu.clone(),
+            dcm_pb,
+            pending: None,
+        };
+        (Some(sub), Some(g))
+    };
 
     // 3. The command publisher. Block (never drop) and express (no batching: lowest latency).
     let commands = session
@@ -248,11 +416,37 @@ fn main() -> anyhow::Result<()> {
             }
         };
 
+        // The rate feedback: the gyro sample of this tick (see the module docs), or truth.
+        let h = state.header;
+        let rate_b = match (&mut gyro, &imus) {
+            (Some(g), Some(sub)) => {
+                let discovering = g.name.is_none();
+                let wait = if discovering {
+                    imu_timeout.min(Duration::from_secs(1))
+                } else {
+                    imu_timeout
+                };
+                match g.sample_for(h.tick, sub, wait)? {
+                    Some(w) => w,
+                    None if discovering => {
+                        tracing::warn!(topics = %imu_key, "the server publishes no IMU; rate feedback uses the truth rate from the state message");
+                        gyro = None;
+                        state.omega_bn_b_rad_s
+                    }
+                    None => bail!(
+                        "no gyro sample on {imu_key} for tick {} within {:?}: is there an [[imus]] entry with that name in the server config? (or use --rate-source truth)",
+                        h.tick,
+                        imu_timeout
+                    ),
+                }
+            }
+            _ => state.omega_bn_b_rad_s,
+        };
+
         // The control law.
-        let torque_b_nm = controller.torque_b_nm(state.sigma_bn, rate_feedback(&state));
+        let torque_b_nm = controller.torque_b_nm(state.sigma_bn, rate_b);
 
         // Answer with the state's spacecraft id, tick and sim time; our own sequence number.
-        let h = state.header;
         let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
         let cmd = CommandMsg::wrench(header, args.sender_id, torque_b_nm, [0.0; 3]);
         encode_into(&cmd, &mut buf);
