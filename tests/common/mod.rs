@@ -156,6 +156,39 @@ pub struct Drift {
     pub orb_ang_mom: f64,
 }
 
+impl Drift {
+    /// Asserts the rotational + spring energy and the angular momentum about C each drifted by at
+    /// most `bound`. The energy is checked on its own: summed with the orbital energy, erratum E1
+    /// would hide at the 1e-11 level (ERRATA.md).
+    pub fn assert_rotational(&self, bound: f64) {
+        assert!(
+            self.rot_energy <= bound,
+            "rotational + spring energy drift {:e}",
+            self.rot_energy
+        );
+        assert!(
+            self.rot_ang_mom <= bound,
+            "angular momentum about C drift {:e}",
+            self.rot_ang_mom
+        );
+    }
+
+    /// [`Self::assert_rotational`] plus the orbital energy and orbital angular momentum.
+    pub fn assert_all(&self, bound: f64) {
+        self.assert_rotational(bound);
+        assert!(
+            self.orb_energy <= bound,
+            "orbital energy drift {:e}",
+            self.orb_energy
+        );
+        assert!(
+            self.orb_ang_mom <= bound,
+            "orbital angular momentum drift {:e}",
+            self.orb_ang_mom
+        );
+    }
+}
+
 /// Steps `n` times, tracking the relative drift of every conserved quantity.
 pub fn run_drift(sc: &mut Spacecraft, n: usize) -> Drift {
     let c0 = sc.conserved();
