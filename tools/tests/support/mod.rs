@@ -6,49 +6,19 @@ use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
-use flexdyn::server::{self, zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::{decode_state, encode, CommandMsg, Header, Topics};
 use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
 
-/// `tcp/127.0.0.1:<port>`.
-pub fn endpoint(port: u16) -> String {
-    format!("tcp/127.0.0.1:{port}")
-}
-
-/// A session listening on `port` (loopback, multicast scouting off: the one config builder).
-pub fn listening_session(port: u16) -> Session {
-    let args = ZenohArgs {
-        listen: vec![endpoint(port)],
-        ..ZenohArgs::default()
-    };
-    zenoh::open(zenoh_config(&args, Role::Server).unwrap())
-        .wait()
-        .unwrap()
-}
-
-/// A session connecting to `port`.
-pub fn connecting_session(port: u16) -> Session {
-    let args = ZenohArgs {
-        connect: vec![endpoint(port)],
-        ..ZenohArgs::default()
-    };
-    zenoh::open(zenoh_config(&args, Role::Tool).unwrap())
-        .wait()
-        .unwrap()
-}
-
-/// The embedded reference spacecraft with its frame rate replaced.
-pub fn reference_config(frame_hz: f64) -> SimConfig {
-    let text =
-        DEFAULT_CONFIG_TOML.replace("frame_hz = 100.0 ", &format!("frame_hz = {frame_hz:?} "));
-    assert!(
-        frame_hz == 100.0 || text != DEFAULT_CONFIG_TOML,
-        "frame_hz line not found"
-    );
-    SimConfig::from_toml_str(&text).unwrap()
-}
+// The server harness (sessions on the test's own loopback port, the reference config with
+// another frame rate, `server::run` in a background thread) is the root package's.
+#[path = "../../../tests/server_support/mod.rs"]
+mod server_support;
+// Each test or bench that includes this module uses a different subset.
+#[allow(unused_imports)]
+pub use server_support::{
+    connecting_session, endpoint, listening_session, reference_config, ServerHandle,
+};
 
 /// Every StateMsg payload seen, with its tick.
 pub type Recorded = Arc<Mutex<Vec<(u64, Vec<u8>)>>>;
@@ -120,54 +90,6 @@ impl Recorder {
             std::thread::sleep(Duration::from_millis(2));
         }
         false
-    }
-}
-
-/// Runs `server::run` on a fresh runtime in a background thread; returns a handle whose `join`
-/// is bounded. Dropping the stop sender (or calling `stop`) shuts the server down.
-pub struct ServerHandle {
-    pub done: std::sync::mpsc::Receiver<Result<server::RunReport, server::ServerError>>,
-    stop: Option<tokio::sync::oneshot::Sender<()>>,
-}
-
-impl ServerHandle {
-    pub fn start(port: u16, settings: server::ServerSettings, cfg: SimConfig) -> Self {
-        let (done_tx, done) = std::sync::mpsc::channel();
-        let (stop_tx, stop_rx) = tokio::sync::oneshot::channel::<()>();
-        let session = listening_session(port);
-        std::thread::spawn(move || {
-            let rt = tokio::runtime::Builder::new_multi_thread()
-                .worker_threads(2)
-                .enable_all()
-                .build()
-                .unwrap();
-            let result = rt.block_on(async {
-                let shutdown = async {
-                    let _ = stop_rx.await;
-                };
-                let r = server::run(session.clone(), settings, cfg, shutdown).await;
-                let _ = session.close().await;
-                r
-            });
-            let _ = done_tx.send(result);
-        });
-        Self {
-            done,
-            stop: Some(stop_tx),
-        }
-    }
-
-    pub fn stop(&mut self) {
-        if let Some(s) = self.stop.take() {
-            let _ = s.send(());
-        }
-    }
-
-    /// The run's result, waiting at most `timeout`.
-    pub fn join(&self, timeout: Duration) -> Result<server::RunReport, server::ServerError> {
-        self.done
-            .recv_timeout(timeout)
-            .expect("the server did not finish in time")
     }
 }
 
