@@ -60,6 +60,9 @@ pub struct RunArgs {
     /// Real time: spin this many µs before each deadline instead of sleeping [default: 200].
     #[arg(long, value_name = "US", allow_negative_numbers = true)]
     pub spin_us: Option<i64>,
+    /// Real time: SCHED_FIFO priority 1–99 for the physics thread, 0 = normal [default: 0].
+    #[arg(long, value_name = "P", allow_negative_numbers = true)]
+    pub realtime_priority: Option<i64>,
     /// Preallocated telemetry buffers [default: 8].
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub telemetry_buffers: Option<i64>,
@@ -78,7 +81,7 @@ impl RunArgs {
         let s = |v: &Option<String>| v.clone().map(Value::Str);
         let f = |v: &Option<f64>| v.map(Value::Float);
         let i = |v: &Option<i64>| v.map(Value::Int);
-        let pairs: [(&'static str, Option<Value>); 16] = [
+        let pairs: [(&'static str, Option<Value>); 17] = [
             ("mode", s(&self.mode)),
             ("sc_id", s(&self.sc_id)),
             ("spacecraft_id", i(&self.spacecraft_id)),
@@ -93,6 +96,7 @@ impl RunArgs {
             ("status_hz", f(&self.status_hz)),
             ("summary_interval_s", f(&self.summary_interval_s)),
             ("spin_us", i(&self.spin_us)),
+            ("realtime_priority", i(&self.realtime_priority)),
             ("telemetry_buffers", i(&self.telemetry_buffers)),
             ("command_queue", i(&self.command_queue)),
         ];

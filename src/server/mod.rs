@@ -433,9 +433,21 @@ pub async fn run(
     };
     let started = Instant::now();
     let (phys_done_tx, mut phys_done_rx) = oneshot::channel();
+    let realtime_priority = (mode == Mode::RealTime).then_some(settings.realtime_priority);
     std::thread::Builder::new()
         .name("flexdyn-physics".into())
         .spawn(move || {
+            if let Some(p) = realtime_priority.filter(|p| *p > 0) {
+                match set_fifo_priority(p) {
+                    Ok(()) => tracing::info!(priority = p, "physics thread runs under SCHED_FIFO"),
+                    Err(e) => tracing::warn!(
+                        priority = p,
+                        error = %e,
+                        "cannot put the physics thread under SCHED_FIFO (needs CAP_SYS_NICE); \
+                         running at normal priority"
+                    ),
+                }
+            }
             let _ = phys_done_tx.send(physics.run());
         })
         .map_err(|e| ServerError::Internal(format!("cannot start the physics thread: {e}")))?;
@@ -482,4 +494,60 @@ pub async fn run(
     };
     tracing::info!("{report}");
     Ok(report)
+}
+
+/// Puts the calling thread under SCHED_FIFO at `priority` (1–99); the error says why the OS
+/// refused (typically: no CAP_SYS_NICE).
+#[cfg(unix)]
+fn set_fifo_priority(priority: u8) -> Result<(), String> {
+    use thread_priority::{
+        set_thread_priority_and_policy, thread_native_id, RealtimeThreadSchedulePolicy,
+        ThreadPriority, ThreadPriorityValue, ThreadSchedulePolicy,
+    };
+    let value = ThreadPriorityValue::try_from(priority).map_err(|e| format!("{e:?}"))?;
+    set_thread_priority_and_policy(
+        thread_native_id(),
+        ThreadPriority::Crossplatform(value),
+        ThreadSchedulePolicy::Realtime(RealtimeThreadSchedulePolicy::Fifo),
+    )
+    .map_err(|e| format!("{e:?}"))
+}
+
+/// SCHED_FIFO is a POSIX policy: elsewhere the setting is refused.
+#[cfg(not(unix))]
+fn set_fifo_priority(_priority: u8) -> Result<(), String> {
+    Err("realtime_priority needs a POSIX system".into())
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::set_fifo_priority;
+    use thread_priority::{
+        thread_native_id, thread_schedule_policy, RealtimeThreadSchedulePolicy,
+        ThreadSchedulePolicy,
+    };
+
+    #[test]
+    fn fifo_priority_applies_to_the_calling_thread_or_reports_why_not() {
+        std::thread::spawn(|| match set_fifo_priority(10) {
+            Ok(()) => {
+                assert_eq!(
+                    thread_schedule_policy().unwrap(),
+                    ThreadSchedulePolicy::Realtime(RealtimeThreadSchedulePolicy::Fifo)
+                );
+                let params =
+                    thread_priority::unix::thread_schedule_policy_param(thread_native_id())
+                        .unwrap()
+                        .1;
+                assert_eq!(params.sched_priority, 10);
+            }
+            Err(e) => assert!(!e.is_empty(), "a refusal must say why"),
+        })
+        .join()
+        .unwrap();
+        assert!(
+            set_fifo_priority(0).is_err(),
+            "0 is not a SCHED_FIFO priority"
+        );
+    }
 }

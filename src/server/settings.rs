@@ -74,6 +74,7 @@ pub const KEYS: &[&str] = &[
     "status_hz",
     "summary_interval_s",
     "spin_us",
+    "realtime_priority",
     "telemetry_buffers",
     "command_queue",
 ];
@@ -110,6 +111,10 @@ pub struct ServerSettings {
     pub summary_interval: Duration,
     /// Real time: the loop sleeps until this long before a deadline, then spins (default 200 µs).
     pub spin: Duration,
+    /// Real time: SCHED_FIFO priority 1–99 for the physics thread, 0 = the normal scheduler
+    /// (default 0). Needs CAP_SYS_NICE (or root); if the OS refuses, the server logs a warning
+    /// and runs at normal priority.
+    pub realtime_priority: u8,
     /// Preallocated telemetry buffers between the physics and the I/O threads (default 8).
     pub telemetry_buffers: usize,
     /// Capacity of the command queue from the I/O side to the physics thread (default 1024).
@@ -133,6 +138,7 @@ impl Default for ServerSettings {
             status_hz: 10.0,
             summary_interval: Duration::from_secs(10),
             spin: Duration::from_micros(200),
+            realtime_priority: 0,
             telemetry_buffers: 8,
             command_queue: 1024,
         }
@@ -360,6 +366,7 @@ impl ServerSettings {
             }
             "summary_interval_s" => self.summary_interval = set.seconds()?,
             "spin_us" => self.spin = Duration::from_micros(set.int_in(0, 1_000_000)? as u64),
+            "realtime_priority" => self.realtime_priority = set.int_in(0, 99)? as u8,
             "telemetry_buffers" => self.telemetry_buffers = set.int_in(2, 1 << 16)? as usize,
             "command_queue" => self.command_queue = set.int_in(1, 1 << 20)? as usize,
             other => {
@@ -414,7 +421,7 @@ impl ServerSettings {
             "mode={} sc_id={} spacecraft_id={} participants={:?} participant_timeout_s={} \
              presence_timeout_s={} duration_s={} overrun_policy={} overrun_limit={} \
              stale_after_s={} stale_policy={} status_hz={} summary_interval_s={} spin_us={} \
-             telemetry_buffers={} command_queue={}",
+             realtime_priority={} telemetry_buffers={} command_queue={}",
             mode_name(self.mode),
             self.sc_id,
             self.spacecraft_id,
@@ -430,6 +437,7 @@ impl ServerSettings {
             self.status_hz,
             self.summary_interval.as_secs_f64(),
             self.spin.as_micros(),
+            self.realtime_priority,
             self.telemetry_buffers,
             self.command_queue,
         )
@@ -527,6 +535,10 @@ mod tests {
             ),
             ("status_hz = 1e6", "server.status_hz: must be <= 1000"),
             ("spin_us = 1.5", "server.spin_us: expected an integer"),
+            (
+                "realtime_priority = 100",
+                "server.realtime_priority: must be in 0..=99",
+            ),
             (
                 "telemetry_buffers = 1",
                 "server.telemetry_buffers: must be in 2..=",

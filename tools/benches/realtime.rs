@@ -9,7 +9,9 @@
 //! telemetry latency p50/p99. Targets on an idle machine: lateness p99 ≤ 50 µs, no overruns.
 //!
 //! `cargo bench -p flexdyn-tools --bench realtime`; environment: `FLEXDYN_BENCH_RT_S`
-//! (default 60 s). Ports 17450–17459.
+//! (default 60 s), `FLEXDYN_BENCH_RT_PRIORITY` (the server's `realtime_priority`, default 0:
+//! normal scheduling; e.g. 50 puts the physics thread under SCHED_FIFO, which needs
+//! CAP_SYS_NICE). Ports 17450–17459.
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -39,9 +41,18 @@ fn main() {
     let cfg = reference_config(1000.0);
     let frames = (seconds * 1000.0).round() as u64;
     println!("real-time benchmark: 1 kHz for {seconds} s with the demo controller, 2-core machine");
+    let realtime_priority: u8 = std::env::var("FLEXDYN_BENCH_RT_PRIORITY")
+        .ok()
+        .map(|v| {
+            v.parse()
+                .expect("FLEXDYN_BENCH_RT_PRIORITY: an integer 0..=99")
+        })
+        .unwrap_or(0);
+    println!("physics thread realtime_priority = {realtime_priority} (0: normal scheduler)");
     let settings = ServerSettings {
         duration_ns: Some(frames * cfg.frame_ns),
         summary_interval: Duration::from_secs(10),
+        realtime_priority,
         ..ServerSettings::default()
     };
     let server = ServerHandle::start(port, settings, cfg);
