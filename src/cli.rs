@@ -358,8 +358,15 @@ pub fn gravity_model_name(g: &GravityModel) -> &'static str {
 /// One-line summary of a valid configuration.
 pub fn config_summary(cfg: &SimConfig) -> String {
     format!(
-        "{} panel pairs, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows",
+        "{} panel pairs, {} IMUs{}, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows",
         cfg.panel_pairs.len(),
+        cfg.imus.len(),
+        if cfg.imus.is_empty() {
+            String::new()
+        } else {
+            let names: Vec<&str> = cfg.imus.iter().map(|i| i.name.as_str()).collect();
+            format!(" ({})", names.join(", "))
+        },
         cfg.total_mass_kg(),
         cfg.step_ns as f64 * 1e-9,
         cfg.step_ns,

@@ -186,6 +186,18 @@ fn bad_duration_and_interval_values() {
 }
 
 #[test]
+fn check_config_names_the_imus() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/imu_tactical.toml");
+    let out = flexdyn(&["check-config", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("2 IMUs (hub, bracket)"),
+        "{}",
+        stdout(&out)
+    );
+}
+
+#[test]
 fn check_config_accepts_the_reference() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/reference.toml");
     let out = flexdyn(&["check-config", path.to_str().unwrap()]);
@@ -194,6 +206,7 @@ fn check_config_accepts_the_reference() {
     assert_eq!(summary.lines().count(), 1);
     for word in [
         "2 panel pairs",
+        "0 IMUs,",
         "total mass 950 kg",
         "step 0.001 s",
         "frame 100 Hz",
