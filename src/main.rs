@@ -35,16 +35,6 @@ enum Command {
     PrintDefaultConfig,
 }
 
-fn init_tracing() {
-    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
-        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
-    // Ignore the error if a subscriber is already set.
-    let _ = tracing_subscriber::fmt()
-        .with_env_filter(filter)
-        .with_writer(std::io::stderr)
-        .try_init();
-}
-
 fn print_default_config() -> Result<(), CliError> {
     let mut out = std::io::stdout().lock();
     out.write_all(DEFAULT_CONFIG_TOML.as_bytes())
@@ -69,7 +59,7 @@ fn run_server(args: &RunArgs) -> ExitCode {
 
 fn main() -> ExitCode {
     let args = Cli::parse();
-    init_tracing();
+    flexdyn::cli::init_tracing();
     let result = match args.command {
         Some(Command::Simulate(a)) => cli::simulate(&a).map(|report| eprintln!("{report}")),
         Some(Command::CheckConfig { file }) => {

@@ -58,15 +58,8 @@ impl CommonArgs {
     }
 }
 
-/// Logs to stderr at `RUST_LOG` (default `info`).
-pub fn init_tracing() {
-    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
-        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
-    let _ = tracing_subscriber::fmt()
-        .with_env_filter(filter)
-        .with_writer(std::io::stderr)
-        .try_init();
-}
+/// Logs to stderr at `RUST_LOG` (default `info`): the server's own setup.
+pub use flexdyn::cli::init_tracing;
 
 /// Percentile `q` (0..=1) of sorted values (nearest rank); `None` if empty.
 pub fn percentile<T: Copy>(sorted: &[T], q: f64) -> Option<T> {
