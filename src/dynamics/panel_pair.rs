@@ -20,20 +20,42 @@ use super::effector::{
 use super::params::{PanelPairInitial, PanelPairParams};
 use super::ParamError;
 
-/// Geometry and back-substitution terms cached between the passes of one evaluation.
+/// The panel frames at one state: [S1 B] = M2(θ1)[H1 B], [S2 B] = M2(φ)[S1 B], φ = θ2 + θ_H2S1.
 #[derive(Debug, Clone, Copy)]
-struct Cache {
-    /// (sin, cos) of θ1 and of φ = θ2 + θ_H2S1.
+struct Frames {
+    /// (sin, cos) of θ1 and of φ.
     sin1: f64,
     cos1: f64,
     sin_phi: f64,
     cos_phi: f64,
-    /// Panel-1 frame axes in B components (rows of [S1 B]).
+    /// Panel-1 axes ŝ11, ŝ13 and panel-2 axes ŝ21, ŝ23 in B components (ŝ12 = ŝ22 = ĥ12).
     s11: Vector3<f64>,
     s13: Vector3<f64>,
-    /// Panel-2 frame axes in B components (rows of [S2 B]); ŝ22 = ŝ12.
     s21: Vector3<f64>,
     s23: Vector3<f64>,
+}
+
+impl Default for Frames {
+    fn default() -> Self {
+        let z = Vector3::zeros();
+        Self {
+            sin1: 0.0,
+            cos1: 1.0,
+            sin_phi: 0.0,
+            cos_phi: 1.0,
+            s11: z,
+            s13: z,
+            s21: z,
+            s23: z,
+        }
+    }
+}
+
+/// Geometry and back-substitution terms cached between the passes of one evaluation.
+#[derive(Debug, Clone, Copy)]
+struct Cache {
+    /// Panel frames at the evaluated state.
+    f: Frames,
     /// r_Sc1/B and r_Sc2/B (Eqs. 6–7).
     r_sc1b_b: Vector3<f64>,
     r_sc2b_b: Vector3<f64>,
@@ -47,14 +69,7 @@ impl Default for Cache {
     fn default() -> Self {
         let z = Vector3::zeros();
         Self {
-            sin1: 0.0,
-            cos1: 1.0,
-            sin_phi: 0.0,
-            cos_phi: 1.0,
-            s11: z,
-            s13: z,
-            s21: z,
-            s23: z,
+            f: Frames::default(),
             r_sc1b_b: z,
             r_sc2b_b: z,
             x_f: [z; 2],
@@ -162,16 +177,46 @@ impl PanelPair {
     /// ŝ13 = sin θ1 ĥ11 + cos θ1 ĥ13; panel 2 repeats this about ŝ12 with θ2 + θ_H2S1.
     #[inline(always)]
     pub fn panel_axes_b(&self, x: &[f64]) -> [[Vector3<f64>; 3]; 2] {
-        let (sn1, cs1) = x[THETA1].sin_cos();
-        let s11 = self.h11 * cs1 - self.h13 * sn1;
-        let s13 = self.h11 * sn1 + self.h13 * cs1;
-        // M2(θ2) M2(θ_H2S1) = M2(θ2 + θ_H2S1), expanded with the angle-sum identities.
+        let f = self.frames(x);
+        [[f.s11, self.h12, f.s13], [f.s21, self.h12, f.s23]]
+    }
+
+    /// The panel frames at state `x`; M2(θ2) M2(θ_H2S1) = M2(θ2 + θ_H2S1) is expanded with the
+    /// angle-sum identities, so only θ1 and θ2 need a `sin_cos`.
+    #[inline(always)]
+    fn frames(&self, x: &[f64]) -> Frames {
+        let (sin1, cos1) = x[THETA1].sin_cos();
         let (sn2, cs2) = x[THETA2].sin_cos();
-        let sn = sn2 * self.cos_h2s1 + cs2 * self.sin_h2s1;
-        let cs = cs2 * self.cos_h2s1 - sn2 * self.sin_h2s1;
-        let s21 = s11 * cs - s13 * sn;
-        let s23 = s11 * sn + s13 * cs;
-        [[s11, self.h12, s13], [s21, self.h12, s23]]
+        let sin_phi = sn2 * self.cos_h2s1 + cs2 * self.sin_h2s1;
+        let cos_phi = cs2 * self.cos_h2s1 - sn2 * self.sin_h2s1;
+        let s11 = self.h11 * cos1 - self.h13 * sin1;
+        let s13 = self.h11 * sin1 + self.h13 * cos1;
+        let s21 = s11 * cos_phi - s13 * sin_phi;
+        let s23 = s11 * sin_phi + s13 * cos_phi;
+        Frames {
+            sin1,
+            cos1,
+            sin_phi,
+            cos_phi,
+            s11,
+            s13,
+            s21,
+            s23,
+        }
+    }
+
+    /// Eqs. 6–7: r_Sc1/B = r_H1/B − d1 ŝ11 and r_Sc2/B = r_H1/B − l1 ŝ11 − d2 ŝ21.
+    #[inline(always)]
+    fn com_positions(
+        &self,
+        s11: &Vector3<f64>,
+        s21: &Vector3<f64>,
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let p = &self.params;
+        (
+            p.r_h1b_b_m - s11 * p.panel1.d_m,
+            p.r_h1b_b_m - s11 * p.l1_m - s21 * p.panel2.d_m,
+        )
     }
 
     /// Inertia about a panel's centre of mass in B components: Σ_k I_k ŝ_k ŝ_kᵀ.
@@ -256,41 +301,32 @@ impl StateEffector for PanelPair {
     fn update_mass_props(&mut self, x: &[f64], sum: &mut EffectorMassProps) {
         let p = &self.params;
         let (m1, m2) = (p.panel1.mass_kg, p.panel2.mass_kg);
-        let (d1, d2, l1) = (p.panel1.d_m, p.panel2.d_m, p.l1_m);
         let (i1, i2) = (&p.panel1.inertia_s_kg_m2, &p.panel2.inertia_s_kg_m2);
         let (th1_dot, th12_dot) = (x[THETA1_DOT], x[THETA1_DOT] + x[THETA2_DOT]);
+        let f = self.frames(x);
+        let (r1, r2) = self.com_positions(&f.s11, &f.s21);
         let c = &mut self.cache;
-        // [S1 B] = M2(θ1)[H1 B]; [S2 B] = M2(θ2 + θ_H2S1)[S1 B] (angle-sum identities).
-        (c.sin1, c.cos1) = x[THETA1].sin_cos();
-        let (sn2, cs2) = x[THETA2].sin_cos();
-        c.sin_phi = sn2 * self.cos_h2s1 + cs2 * self.sin_h2s1;
-        c.cos_phi = cs2 * self.cos_h2s1 - sn2 * self.sin_h2s1;
-        c.s11 = self.h11 * c.cos1 - self.h13 * c.sin1;
-        c.s13 = self.h11 * c.sin1 + self.h13 * c.cos1;
-        c.s21 = c.s11 * c.cos_phi - c.s13 * c.sin_phi;
-        c.s23 = c.s11 * c.sin_phi + c.s13 * c.cos_phi;
-        // Eqs. 6–7: centre-of-mass positions.
-        c.r_sc1b_b = p.r_h1b_b_m - c.s11 * d1;
-        c.r_sc2b_b = p.r_h1b_b_m - c.s11 * l1 - c.s21 * d2;
+        c.f = f;
+        c.r_sc1b_b = r1;
+        c.r_sc2b_b = r2;
 
         sum.mass_kg += m1 + m2;
-        sum.first_moment_b_kg_m += c.r_sc1b_b * m1 + c.r_sc2b_b * m2;
+        sum.first_moment_b_kg_m += r1 * m1 + r2 * m2;
         // Eqs. 8 and 10: m1 r′_Sc1 + m2 r′_Sc2 = μ1 θ̇1 ŝ13 + μ2 (θ̇1 + θ̇2) ŝ23.
         sum.first_moment_prime_b_kg_m_s +=
-            c.s13 * (self.mu1 * th1_dot) + c.s23 * (self.mu2 * th12_dot);
+            f.s13 * (self.mu1 * th1_dot) + f.s23 * (self.mu2 * th12_dot);
         // [I_Sc1] + [I_Sc2] + m1[r̃1][r̃1]ᵀ + m2[r̃2][r̃2]ᵀ, with [r̃][r̃]ᵀ = |r|² I − r rᵀ: the constant
         // part plus four symmetric rank-one terms.
-        let (r1, r2) = (&c.r_sc1b_b, &c.r_sc2b_b);
         let i_b = &mut sum.inertia_pnt_b_b_kg_m2;
         *i_b += self.inertia_const_b;
         add_symmetric_rank_ones(
             i_b,
             m1 * r1.norm_squared() + m2 * r2.norm_squared(),
             &[
-                (i1.z - i1.x, &c.s13),
-                (i2.z - i2.x, &c.s23),
-                (-m1, r1),
-                (-m2, r2),
+                (i1.z - i1.x, &f.s13),
+                (i2.z - i2.x, &f.s23),
+                (-m1, &r1),
+                (-m2, &r2),
             ],
         );
     }
@@ -311,9 +347,10 @@ impl StateEffector for PanelPair {
         let th12_dot = th1_dot + th2_dot;
         let (mu1, mu2) = (self.mu1, self.mu2);
         let e = &self.h12; // ŝ12 = ŝ22 = ĥ12
-        let (s11, s13, s21, s23) = (&c.s11, &c.s13, &c.s21, &c.s23);
+        let f = &c.f;
+        let (s11, s13, s21, s23) = (&f.s11, &f.s13, &f.s21, &f.s23);
         let (r1, r2) = (&c.r_sc1b_b, &c.r_sc2b_b);
-        let (sn, cs) = (c.sin_phi, c.cos_phi);
+        let (sn, cs) = (f.sin_phi, f.cos_phi);
 
         // Frame identities used below, for the right-handed triads (ŝ11, ê, ŝ13) and (ŝ21, ê, ŝ23)
         // with ŝ21 = cos φ ŝ11 − sin φ ŝ13 and ŝ23 = sin φ ŝ11 + cos φ ŝ13:
@@ -323,12 +360,12 @@ impl StateEffector for PanelPair {
         //   r1 × ŝ13 = R13 + d1 ê,  r2 × ŝ13 = R13 + (l1 + d2 cos φ) ê,
         //   r2 × ŝ23 = R23 + (d2 + l1 cos φ) ê,  r1 × ŝ11 = R11,
         //   r2 × ŝ11 = R11 + d2 sin φ ê,  r2 × ŝ21 = R21 − l1 sin φ ê.
-        let r11 = self.rho1 * c.cos1 - self.rho3 * c.sin1;
-        let r13 = self.rho1 * c.sin1 + self.rho3 * c.cos1;
+        let r11 = self.rho1 * f.cos1 - self.rho3 * f.sin1;
+        let r13 = self.rho1 * f.sin1 + self.rho3 * f.cos1;
         let r21 = r11 * cs - r13 * sn;
         let r23 = r11 * sn + r13 * cs;
-        let s13_rh = self.h11_rh * c.sin1 + self.h13_rh * c.cos1;
-        let s11_rh = self.h11_rh * c.cos1 - self.h13_rh * c.sin1;
+        let s13_rh = self.h11_rh * f.sin1 + self.h13_rh * f.cos1;
+        let s11_rh = self.h11_rh * f.cos1 - self.h13_rh * f.sin1;
         let s23_rh = s11_rh * sn + s13_rh * cs;
 
         // Eq. 121: [A_i], with ŝ13·ŝ23 = cos φ.
@@ -447,8 +484,7 @@ impl StateEffector for PanelPair {
         let (d1, d2, l1) = (p.panel1.d_m, p.panel2.d_m, p.l1_m);
         let (th1_dot, th2_dot) = (x[THETA1_DOT], x[THETA2_DOT]);
         let [[s11, s12, s13], [s21, _, s23]] = self.panel_axes_b(x);
-        let r1 = p.r_h1b_b_m - s11 * d1;
-        let r2 = p.r_h1b_b_m - s11 * l1 - s21 * d2;
+        let (r1, r2) = self.com_positions(&s11, &s21);
         let r1p = s13 * (d1 * th1_dot);
         let r2p = s13 * (l1 * th1_dot) + s23 * (d2 * (th1_dot + th2_dot));
         let i1 = Self::inertia_b(&p.panel1.inertia_s_kg_m2, &s11, &s12, &s13);
