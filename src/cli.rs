@@ -9,8 +9,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::config::{whole_ns, ConfigError, SimConfig, DEFAULT_CONFIG_TOML};
-use crate::dynamics::GravityModel;
 use crate::imu::ImuSample;
+use crate::numfmt::Num;
+use crate::server::error::SettingsError;
+use crate::server::settings::ServerSettings;
 use crate::sim::{Simulation, Snapshot};
 
 /// Arguments of `flexdyn simulate`.
@@ -74,6 +76,30 @@ pub enum CliError {
         /// What is wrong.
         problem: String,
     },
+    /// The `[server]` table is invalid (checked by `check-config`, as `run` would).
+    #[error("{}: {source}", file.display())]
+    Settings {
+        /// The configuration file.
+        file: PathBuf,
+        /// The error; it names `server.<key>`.
+        #[source]
+        source: SettingsError,
+    },
+    /// The propagated state stopped being finite; the row was not written.
+    #[error(
+        "the state became non-finite at step {step} (t = {} s): {quantity} is NaN or infinite; \
+         stopping without writing that row (check the configuration's rates, stiffnesses and \
+         wrenches for values the step cannot resolve)",
+        Num(*t_s)
+    )]
+    NonFinite {
+        /// The RK4 step count at the row.
+        step: u64,
+        /// \[s\] simulation time of the row.
+        t_s: f64,
+        /// The first non-finite quantity, by its CSV column name.
+        quantity: String,
+    },
     /// Writing the output failed.
     #[error("cannot write {target}: {source}")]
     Output {
@@ -97,8 +123,8 @@ impl CliError {
     /// 1 for a failure while running (output not writable).
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Config { .. } | CliError::Arg { .. } => 2,
-            CliError::Output { .. } => 1,
+            CliError::Config { .. } | CliError::Arg { .. } | CliError::Settings { .. } => 2,
+            CliError::Output { .. } | CliError::NonFinite { .. } => 1,
         }
     }
 }
@@ -220,7 +246,8 @@ pub fn csv_imu_header(names: &[String]) -> String {
     h
 }
 
-/// Appends the IMU columns of one row (each value prefixed by a comma, `{:.16e}`) to `row`.
+/// Appends the IMU columns of one row (each value prefixed by a comma, in the shortest form
+/// that reads back to the same f64: [`Num`]) to `row`.
 pub fn csv_imu_row(samples: &[ImuSample], row: &mut String) {
     for s in samples {
         for v in [
@@ -230,21 +257,22 @@ pub fn csv_imu_row(samples: &[ImuSample], row: &mut String) {
             &s.dv_p_m_s,
         ] {
             for x in v.iter() {
-                let _ = write!(row, ",{x:.16e}");
+                let _ = write!(row, ",{}", Num(*x));
             }
         }
     }
 }
 
-/// Appends one CSV row for `s` to `row` (cleared first; no trailing newline). Floats have 17
-/// significant digits (`{:.16e}`), so they round-trip exactly.
+/// Appends one CSV row for `s` to `row` (cleared first; no trailing newline). Floats are in the
+/// shortest form that reads back to the same f64 ([`Num`]: `0.03`, `-4020338.689621511`,
+/// `1.5e-20`), so they round-trip exactly.
 pub fn csv_row(s: &Snapshot, row: &mut String) {
     row.clear();
     let mut push = |v: f64| {
         if !row.is_empty() {
             row.push(',');
         }
-        let _ = write!(row, "{v:.16e}");
+        let _ = write!(row, "{}", Num(v));
     };
     push(s.t_s());
     for v in [&s.sigma_bn, &s.omega_bn_b, &s.r_bn_n, &s.v_bn_n] {
@@ -296,6 +324,22 @@ pub fn simulate_to<W: Write>(
         }
         sim.snapshot_into(&mut snap);
         sim.imu_samples_into(&mut imu_samples);
+        // Once per row, outside the stepping loop: never write a non-finite state.
+        let imu_bad = imu_samples
+            .iter()
+            .zip(sim.imu_names())
+            .find_map(|(s, name)| {
+                s.first_non_finite()
+                    .map(|q| format!("imu_{name}_{q} (an IMU output)"))
+            });
+        if let Some(quantity) = snap.first_non_finite().or(imu_bad) {
+            out.flush().map_err(io_err)?;
+            return Err(CliError::NonFinite {
+                step: k * log_steps,
+                t_s: snap.t_s(),
+                quantity,
+            });
+        }
         csv_row(&snap, &mut row);
         csv_imu_row(&imu_samples, &mut row);
         row.push('\n');
@@ -346,47 +390,28 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
     }
 }
 
-/// Short name of a gravity model, as in the configuration file.
-pub fn gravity_model_name(g: &GravityModel) -> &'static str {
-    match g {
-        GravityModel::None => "none",
-        GravityModel::PointMass { .. } => "point_mass",
-        GravityModel::J2 { .. } => "j2",
-    }
-}
-
-/// One-line summary of a valid configuration.
-pub fn config_summary(cfg: &SimConfig) -> String {
-    format!(
-        "{} panel pairs, {} IMUs{}, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows",
-        cfg.panel_pairs.len(),
-        cfg.imus.len(),
-        if cfg.imus.is_empty() {
-            String::new()
-        } else {
-            let names: Vec<&str> = cfg.imus.iter().map(|i| i.name.as_str()).collect();
-            format!(" ({})", names.join(", "))
-        },
-        cfg.total_mass_kg(),
-        cfg.step_ns as f64 * 1e-9,
-        cfg.step_ns,
-        cfg.frame_hz,
-        cfg.frame_ns,
-        cfg.steps_per_frame(),
-        gravity_model_name(&cfg.gravity),
-        cfg.wrench_schedule.len(),
-    )
-}
-
 /// `flexdyn check-config FILE`: parses, validates and builds the spacecraft; returns the summary
 /// line `ok: FILE: …`.
+///
+/// It runs every check that `flexdyn run` and `flexdyn simulate` run on a file, the `[server]`
+/// table's included (keys, values, cross-setting rules, and a duration that is a whole number of
+/// frames), and says `ok` only when all pass.
 pub fn check_config(path: &Path) -> Result<String, CliError> {
     let cfg = load_config(Some(path))?;
     cfg.build_spacecraft().map_err(|source| CliError::Config {
         file: Some(path.to_path_buf()),
         source,
     })?;
-    Ok(format!("ok: {}: {}", path.display(), config_summary(&cfg)))
+    let settings_err = |source| CliError::Settings {
+        file: path.to_path_buf(),
+        source,
+    };
+    let settings = ServerSettings::from_table(&cfg.server).map_err(settings_err)?;
+    settings.validate().map_err(settings_err)?;
+    settings
+        .duration_frames(cfg.frame_ns)
+        .map_err(settings_err)?;
+    Ok(format!("ok: {}: {}", path.display(), cfg.summary()))
 }
 
 /// Logs to stderr at `RUST_LOG` (default `info`); shared by `flexdyn` and the tools. Does nothing

@@ -683,6 +683,19 @@ pub struct ImuSample {
 }
 
 impl ImuSample {
+    /// The first non-finite output (`omega_p`, `accel_p`, `dtheta_p`, `dv_p`), if any.
+    pub fn first_non_finite(&self) -> Option<&'static str> {
+        [
+            ("omega_p", &self.omega_p_rad_s),
+            ("accel_p", &self.accel_p_m_s2),
+            ("dtheta_p", &self.dtheta_p_rad),
+            ("dv_p", &self.dv_p_m_s),
+        ]
+        .into_iter()
+        .find(|(_, v)| v.iter().any(|x| !x.is_finite()))
+        .map(|(n, _)| n)
+    }
+
     /// The wire message for this sample with `header`.
     pub fn to_msg(&self, header: Header) -> ImuMsg {
         ImuMsg {

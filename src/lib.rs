@@ -13,5 +13,6 @@ pub mod cli;
 pub mod config;
 pub mod dynamics;
 pub mod imu;
+pub mod numfmt;
 pub mod server;
 pub mod sim;

@@ -98,6 +98,49 @@ impl Snapshot {
     pub fn t_s(&self) -> f64 {
         self.t_sim_ns as f64 / 1e9
     }
+
+    /// The first non-finite quantity, by its CSV column name (`omega_bn_b_2`, `pair1_theta2`,
+    /// `rot_energy_j`, …), or `None` if every value is finite. Allocates only when it finds one,
+    /// so it can run once per logged row or frame.
+    pub fn first_non_finite(&self) -> Option<String> {
+        let vectors: [(&str, &[f64]); 7] = [
+            ("sigma_bn", self.sigma_bn.as_slice()),
+            ("omega_bn_b", self.omega_bn_b.as_slice()),
+            ("omega_dot_bn_b", self.omega_dot_bn_b.as_slice()),
+            ("r_bn_n", self.r_bn_n.as_slice()),
+            ("v_bn_n", self.v_bn_n.as_slice()),
+            ("nongrav_accel_bn_n", self.nongrav_accel_bn_n.as_slice()),
+            ("q_bn", self.q_bn.as_slice()),
+        ];
+        for (name, v) in vectors {
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                return Some(format!("{name}_{}", i + 1));
+            }
+        }
+        const PANEL: [&str; 4] = ["theta1", "theta1_dot", "theta2", "theta2_dot"];
+        for (k, p) in self.panels.iter().enumerate() {
+            if let Some(i) = p.iter().position(|x| !x.is_finite()) {
+                return Some(format!("pair{}_{}", k + 1, PANEL[i]));
+            }
+        }
+        let c = &self.conserved;
+        let scalars = [
+            ("orb_energy_j", c.orb_energy_j),
+            ("rot_energy_j", c.rot_energy_j),
+        ];
+        if let Some((name, _)) = scalars.iter().find(|(_, x)| !x.is_finite()) {
+            return Some((*name).to_string());
+        }
+        for (name, v) in [
+            ("orb_ang_mom_n", &c.orb_ang_mom_n),
+            ("rot_ang_mom_c_n", &c.rot_ang_mom_c_n),
+        ] {
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                return Some(format!("{name}_{}", i + 1));
+            }
+        }
+        None
+    }
 }
 
 impl Simulation {

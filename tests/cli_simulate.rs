@@ -48,9 +48,26 @@ fn expected_header() -> Vec<String> {
 }
 
 /// Significant digits of a `{:.16e}`-formatted number: the mantissa has 1 + 16 digits.
+/// Significant digits of a decimal field (leading zeros and, for integers, trailing zeros do
+/// not count).
 fn significant_digits(field: &str) -> usize {
     let mantissa = field.split(['e', 'E']).next().unwrap();
-    mantissa.chars().filter(char::is_ascii_digit).count()
+    let digits: String = mantissa.chars().filter(char::is_ascii_digit).collect();
+    let digits = digits.trim_start_matches('0');
+    let digits = if mantissa.contains('.') {
+        digits
+    } else {
+        digits.trim_end_matches('0')
+    };
+    digits.len().max(1)
+}
+
+/// The fewest significant digits that read back to `v` exactly (found by trying each
+/// precision, independent of how the CSV writer formats).
+fn shortest_digits(v: f64) -> usize {
+    (1..=17)
+        .find(|p| format!("{:.*e}", p - 1, v).parse::<f64>().unwrap() == v)
+        .unwrap()
 }
 
 #[track_caller]
@@ -89,14 +106,21 @@ fn simulate_writes_the_documented_csv() {
     for (k, row) in rows.iter().enumerate() {
         assert_eq!(row.len(), header.len(), "row {k}");
         for f in row {
-            assert_eq!(significant_digits(f), 17, "`{f}` in row {k}");
             let v: f64 = f.parse().unwrap_or_else(|_| panic!("`{f}` is a number"));
             assert!(v.is_finite());
+            // The shortest form that round-trips: no digit more than needed.
+            assert_eq!(
+                significant_digits(f),
+                shortest_digits(v),
+                "`{f}` in row {k} is not the shortest round-trip form"
+            );
         }
         let t: f64 = row[0].parse().unwrap();
         assert!((t - 0.01 * k as f64).abs() < 1e-12, "row {k}: t = {t}");
     }
     assert_eq!(rows[0][0].parse::<f64>().unwrap(), 0.0);
+    // t = 0.03 s prints as such, not as 2.9999999999999999e-2.
+    assert_eq!(rows[3][0], "0.03");
     // Row 0 is the configured initial state.
     assert_eq!(rows[0][4].parse::<f64>().unwrap(), 0.05); // omega_bn_b_1
     assert_eq!(rows[0][13].parse::<f64>().unwrap(), 0.08726646259971647); // pair1_theta1
@@ -337,4 +361,124 @@ fn help_lists_every_subcommand() {
     for sub in ["run", "simulate", "check-config", "print-default-config"] {
         assert!(text.contains(sub), "{text}");
     }
+}
+
+/// The reference text with `[server]` lines appended.
+fn with_server(lines: &str) -> String {
+    format!("{DEFAULT_CONFIG_TOML}\n[server]\n{lines}\n")
+}
+
+#[test]
+fn check_config_validates_the_server_table_as_run_does() {
+    let cases = [
+        ("mode = \"fast\"", "server.mode: unknown mode"),
+        ("colour = 1", "server.colour: unknown key"),
+        ("stale_after_s = -0.5", "server.stale_after_s: must be > 0"),
+        (
+            "participants = \"1,2\"",
+            "server.participants: expected a list of sender ids",
+        ),
+        ("sc_id = \"a/b\"", "server.sc_id:"),
+        (
+            "mode = \"lockstep\"\nparticipants = []",
+            "server.participants: lockstep needs at least one participant",
+        ),
+        ("duration_s = 0.015", "not a whole number of frames"),
+    ];
+    for (i, (lines, want)) in cases.iter().enumerate() {
+        let path = scratch(&format!("server{i}.toml"));
+        std::fs::write(&path, with_server(lines)).unwrap();
+        let p = path.to_str().unwrap();
+        let check = flexdyn(&["check-config", p]);
+        let err = stderr(&check);
+        assert_eq!(check.status.code(), Some(2), "{lines}: {err}");
+        assert_eq!(err.lines().count(), 1, "{lines}: {err}");
+        let line = err.lines().next().unwrap();
+        assert!(line.starts_with(&format!("error: {p}: ")), "{line}");
+        assert!(line.contains(want), "{lines}: {line}");
+        assert!(stdout(&check).is_empty());
+        // `run` rejects the same file the same way, before opening any session.
+        let run = flexdyn(&["run", "--config", p, "--listen", "tcp/127.0.0.1:17359"]);
+        assert_eq!(run.status.code(), Some(2), "run {lines}: {}", stderr(&run));
+        assert!(stderr(&run).contains(want), "run {lines}: {}", stderr(&run));
+    }
+    // A valid [server] table passes.
+    let path = scratch("server_ok.toml");
+    std::fs::write(
+        &path,
+        with_server("mode = \"lockstep\"\nparticipants = [1, 2]\nduration_s = 12.0"),
+    )
+    .unwrap();
+    let ok = flexdyn(&["check-config", path.to_str().unwrap()]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    assert!(stdout(&ok).starts_with("ok: "));
+}
+
+/// A configuration that passes every check but whose state overflows: from t = 0.5 s a hub
+/// torque of 1e300 N·m spins the hub up until its rotational energy overflows to infinity.
+fn blow_up_config() -> PathBuf {
+    let path = scratch("blow_up.toml");
+    let text = format!(
+        "{DEFAULT_CONFIG_TOML}\n[[wrench_schedule]]\nt_s = 0.5\nforce_b_n = [0.0, 0.0, 0.0]\n\
+         torque_b_nm = [0.0, 0.0, 1e300]\n"
+    );
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn simulate_stops_on_a_non_finite_state_naming_step_and_quantity() {
+    let path = blow_up_config();
+    let p = path.to_str().unwrap();
+    let check = flexdyn(&["check-config", p]);
+    assert!(check.status.success(), "{}", stderr(&check));
+    let out = flexdyn(&["simulate", "--config", p, "--duration-s", "1"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: the state became non-finite at step ")
+            && err.contains("is NaN or infinite"),
+        "{err}"
+    );
+    // Every row written is finite; the bad row is not among them.
+    let text = stdout(&out);
+    let rows: Vec<&str> = text.lines().skip(1).collect();
+    assert!(!rows.is_empty(), "the initial row is finite and written");
+    for r in &rows {
+        for f in r.split(',') {
+            assert!(f.parse::<f64>().unwrap().is_finite(), "{f} in {r}");
+        }
+    }
+    // The message names the step of the first row not written.
+    let step: u64 = err["error: the state became non-finite at step ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(step, 10 * rows.len() as u64, "{err}");
+}
+
+#[test]
+fn the_server_stops_on_a_non_finite_state_with_exit_1() {
+    let path = blow_up_config();
+    let out = flexdyn(&[
+        "run",
+        "--config",
+        path.to_str().unwrap(),
+        "--mode",
+        "batch",
+        "--duration-s",
+        "1",
+        "--listen",
+        "tcp/127.0.0.1:17358",
+    ]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let last = err.lines().last().unwrap();
+    assert!(
+        last.starts_with("error: the state became non-finite at tick 51 (t = 0.51 s): "),
+        "{err}"
+    );
 }

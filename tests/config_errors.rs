@@ -455,7 +455,7 @@ fn wrong_type_or_shape() {
     let e = error_after(|t| {
         table(t, "hub").insert("r_bcb_b_m".into(), vec_value(&[0.0, 1.0]));
     });
-    assert_names(&e, "hub.r_bcb_b_m", &["invalid length 2"]);
+    assert_names(&e, "hub.r_bcb_b_m", &["expected 3 elements, got 2"]);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -933,4 +933,322 @@ fn unreadable_file_names_the_path() {
     let e = SimConfig::from_file(&path).unwrap_err();
     assert!(matches!(e, ConfigError::Io { .. }));
     assert!(e.to_string().contains("does-not-exist.toml"), "{e}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Holes an outside configuration fuzzer found: each of these was accepted (or misreported)
+// before the typed reader.
+
+/// The error of the reference text with `from` replaced by `to` (which must occur).
+fn text_error(from: &str, to: &str) -> ConfigError {
+    assert!(
+        DEFAULT_CONFIG_TOML.contains(from),
+        "reference lacks {from:?}"
+    );
+    let text = DEFAULT_CONFIG_TOML.replacen(from, to, 1);
+    match SimConfig::from_toml_str(&text) {
+        Ok(_) => panic!("expected an error after replacing {from:?} by {to:?}"),
+        Err(e) => e,
+    }
+}
+
+/// No message may name a Rust type or serde internals.
+#[track_caller]
+fn assert_speaks_toml(e: &ConfigError) {
+    let msg = e.to_string();
+    for leak in [
+        "Raw", "struct", "i128", "$__", "f64", "u64", "usize", "Vec<", "Option<",
+    ] {
+        assert!(!msg.contains(leak), "message leaks `{leak}`: {msg}");
+    }
+}
+
+#[test]
+fn over_long_arrays_are_rejected_with_their_length() {
+    let e = text_error(
+        "r_bcb_b_m = [0.0, 0.0, 1.0]",
+        r#"r_bcb_b_m = [0.0, 0.0, 1.0, "junk", true]"#,
+    );
+    assert_names(&e, "hub.r_bcb_b_m", &["expected 3 elements, got 5", "line"]);
+    assert_speaks_toml(&e);
+    // A 4th row in a 3×3 matrix, and a 4-element row.
+    let e = error_after(|t| {
+        let m = Value::Array(vec![
+            vec_value(&[900.0, 0.0, 0.0]),
+            vec_value(&[0.0, 800.0, 0.0]),
+            vec_value(&[0.0, 0.0, 600.0]),
+            vec_value(&[0.0, 0.0, 0.0]),
+        ]);
+        table(t, "hub").insert("inertia_bc_b_kg_m2".into(), m);
+    });
+    assert_names(&e, "hub.inertia_bc_b_kg_m2", &["expected 3 rows", "got 4"]);
+    let e = error_after(|t| {
+        let m = Value::Array(vec![
+            vec_value(&[900.0, 0.0, 0.0]),
+            vec_value(&[0.0, 800.0, 0.0, 1.0]),
+            vec_value(&[0.0, 0.0, 600.0]),
+        ]);
+        table(t, "hub").insert("inertia_bc_b_kg_m2".into(), m);
+    });
+    assert_names(
+        &e,
+        "hub.inertia_bc_b_kg_m2[1]",
+        &["expected 3 elements, got 4"],
+    );
+    let e = error_after(|t| {
+        pair(t, 0).insert("motor_torque_nm".into(), vec_value(&[0.0, 0.0, 0.0]));
+    });
+    assert_names(
+        &e,
+        "panel_pairs[0].motor_torque_nm",
+        &["expected 2 elements, got 3"],
+    );
+    // An element of the wrong type is named by its index.
+    let e = text_error(
+        "r_bcb_b_m = [0.0, 0.0, 1.0]",
+        r#"r_bcb_b_m = [0.0, "0", 1.0]"#,
+    );
+    assert_names(&e, "hub.r_bcb_b_m[1]", &["expected a number, got a string"]);
+}
+
+#[test]
+fn positional_inline_tables_are_rejected() {
+    let e = error_after(|t| {
+        let positional = Value::Array(vec![
+            Value::Float(50.0),
+            vec_value(&[50.0, 25.0, 25.0]),
+            Value::Float(0.75),
+            Value::Float(1.5),
+            Value::Float(100.0),
+            Value::Float(0.0),
+            Value::Float(0.0),
+            Value::Float(0.0),
+        ]);
+        pair(t, 0).insert("panel1".into(), positional);
+    });
+    assert_names(
+        &e,
+        "panel_pairs[0].panel1",
+        &["expected a table with named keys", "positional"],
+    );
+    assert_speaks_toml(&e);
+    // The same for a top-level table and an array-of-tables entry.
+    let e = error_after(|t| {
+        t.insert("gravity".into(), vec_value(&[1.0, 2.0]));
+    });
+    assert_names(&e, "gravity", &["expected a table with named keys"]);
+    assert_speaks_toml(&e);
+}
+
+#[test]
+fn imu_seed_range_is_toml_non_negative_integers() {
+    let base = std::fs::read_to_string(scenarios_dir().join("imu_tactical.toml")).unwrap();
+    let seed_line = base
+        .lines()
+        .find(|l| l.trim_start().starts_with("seed ="))
+        .expect("a seed line")
+        .to_string();
+    let with = |v: &str| base.replacen(&seed_line, &format!("seed = {v}"), 1);
+    // 2^63 − 1 is accepted; 2^63 and 2^64 − 1 are outside TOML's integers; −1 is below the range.
+    let ok = SimConfig::from_toml_str(&with("9223372036854775807")).unwrap();
+    assert_eq!(ok.imus[0].seed, i64::MAX as u64);
+    for v in ["9223372036854775808", "18446744073709551615"] {
+        let e = SimConfig::from_toml_str(&with(v)).unwrap_err();
+        assert_names(&e, "imus[0].seed", &["64-bit integer range"]);
+        assert_speaks_toml(&e);
+    }
+    let e = SimConfig::from_toml_str(&with("-1")).unwrap_err();
+    assert_names(
+        &e,
+        "imus[0].seed",
+        &["from 0 to 9223372036854775807", "got -1"],
+    );
+    let e = SimConfig::from_toml_str(&with("1.5")).unwrap_err();
+    assert_names(&e, "imus[0].seed", &["expected an integer, got a float"]);
+}
+
+#[test]
+fn positions_gravity_cannot_propagate_are_rejected() {
+    // At the centre of a point mass: an infinite field.
+    let e = error_after(|t| {
+        table(t, "initial").insert("r_cn_n_m".into(), vec_value(&[0.0, 0.0, 0.0]));
+    });
+    assert_names(&e, "initial.r_cn_n_m", &["at least", "dynamical time"]);
+    // The bound: √(r³/μ) ≥ 100 steps ⇔ r ≥ (μ (100 h)²)^(1/3). Just outside passes, just
+    // inside fails (reference: μ = 3.986004418e14, h = 1 ms).
+    let cfg = SimConfig::reference();
+    let GravityModel::PointMass { mu_m3_s2 } = cfg.gravity else {
+        panic!("reference gravity is point mass")
+    };
+    let r_min = (mu_m3_s2 * (100.0f64 * 1e-3).powi(2)).cbrt();
+    for (r, ok) in [(1.01 * r_min, true), (0.99 * r_min, false)] {
+        let mut t = reference_table();
+        table(&mut t, "initial").insert("r_cn_n_m".into(), vec_value(&[r, 0.0, 0.0]));
+        let res = SimConfig::from_toml_str(&toml::to_string(&t).unwrap());
+        assert_eq!(res.is_ok(), ok, "r = {r} m, bound {r_min} m: {res:?}");
+    }
+    // J2: inside the equatorial radius is rejected, even where the point-mass bound holds.
+    let j2 = std::fs::read_to_string(scenarios_dir().join("j2_orbit.toml")).unwrap();
+    let mut t: Table = j2.parse().unwrap();
+    let r_eq = table(&mut t, "gravity")["r_eq_m"].as_float().unwrap();
+    let key = if table(&mut t, "initial").contains_key("r_cn_n_m") {
+        "r_cn_n_m"
+    } else {
+        "r_bn_n_m"
+    };
+    table(&mut t, "initial").insert(key.into(), vec_value(&[0.9 * r_eq, 0.0, 0.0]));
+    let e = SimConfig::from_toml_str(&toml::to_string(&t).unwrap()).unwrap_err();
+    assert_names(&e, &format!("initial.{key}"), &["equatorial radius"]);
+    // Free space has no bound.
+    let mut t = reference_table();
+    table(&mut t, "gravity").remove("mu_m3_s2");
+    table(&mut t, "gravity").insert("model".into(), Value::String("none".into()));
+    table(&mut t, "initial").insert("r_cn_n_m".into(), vec_value(&[0.0, 0.0, 0.0]));
+    SimConfig::from_toml_str(&toml::to_string(&t).unwrap()).unwrap();
+}
+
+#[test]
+fn messages_never_name_rust_types() {
+    let cases: [(&str, &str, &str); 6] = [
+        // A table where a string-keyed table is expected.
+        (
+            "model = \"point_mass\"",
+            "model = { kind = 1 }",
+            "gravity.model",
+        ),
+        // A datetime where a number is expected.
+        (
+            "mass_kg = 750.0",
+            "mass_kg = 1979-05-27T07:32:00Z",
+            "hub.mass_kg",
+        ),
+        // An integer beyond TOML's range.
+        (
+            "mass_kg = 750.0",
+            "mass_kg = 99999999999999999999",
+            "hub.mass_kg",
+        ),
+        // A boolean.
+        ("mass_kg = 750.0", "mass_kg = true", "hub.mass_kg"),
+        // A whole table replaced by a number.
+        ("[gravity]\n", "gravity = 3\n[gravity_x]\n", "gravity"),
+        // A datetime key in a table.
+        ("step_s = 0.001", "step_s = 07:32:00", "simulation.step_s"),
+    ];
+    for (from, to, field) in cases {
+        let e = text_error(from, to);
+        assert_speaks_toml(&e);
+        assert!(e.to_string().starts_with(field), "{e}");
+    }
+    let e = text_error("mass_kg = 750.0", "mass_kg = 1979-05-27T07:32:00Z");
+    assert_names(&e, "hub.mass_kg", &["expected a number, got a datetime"]);
+    let e = text_error("mass_kg = 750.0", "mass_kg = 99999999999999999999");
+    assert_names(&e, "hub.mass_kg", &["64-bit integer range", "1e20"]);
+}
+
+#[test]
+fn huge_values_are_compact_and_say_the_problem() {
+    let e = error_after(|t| {
+        t.insert(
+            "wrench_schedule".into(),
+            Value::Array(vec![wrench_row(1e300, [0.0; 3], [0.0; 3])]),
+        );
+    });
+    let msg = e.to_string();
+    assert_names(
+        &e,
+        "wrench_schedule[0].t_s",
+        &["1e300", "beyond the maximum simulation time"],
+    );
+    assert!(msg.len() < 200, "{} characters: {msg}", msg.len());
+    let e = error_after(|t| {
+        table(t, "hub").insert("mass_kg".into(), Value::Float(-1e300));
+    });
+    assert_names(&e, "hub.mass_kg", &["must be > 0 (got -1e300)"]);
+    assert!(e.to_string().len() < 120, "{e}");
+    let e = error_after(|t| {
+        table(t, "simulation").insert("step_s".into(), Value::Float(1e300));
+    });
+    assert_names(
+        &e,
+        "simulation.step_s",
+        &["beyond the maximum simulation time"],
+    );
+}
+
+#[test]
+fn wire_limits_are_enforced_at_configuration_time() {
+    // 1024 pairs fit a StateMsg; 1025 do not.
+    let mut t = reference_table();
+    let p = t["panel_pairs"].as_array().unwrap()[0].clone();
+    let many = |n: usize| {
+        Value::Array(
+            (0..n)
+                .map(|i| {
+                    let mut q = p.as_table().unwrap().clone();
+                    q.insert("name".into(), Value::String(format!("p{i}")));
+                    Value::Table(q)
+                })
+                .collect(),
+        )
+    };
+    t.insert("panel_pairs".into(), many(flexdyn_proto::MAX_PANEL_PAIRS));
+    SimConfig::from_toml_str(&toml::to_string(&t).unwrap()).expect("1024 pairs are accepted");
+    t.insert(
+        "panel_pairs".into(),
+        many(flexdyn_proto::MAX_PANEL_PAIRS + 1),
+    );
+    let e = SimConfig::from_toml_str(&toml::to_string(&t).unwrap()).unwrap_err();
+    assert_names(&e, "panel_pairs", &["1025 panel pairs", "at most 1024"]);
+}
+
+#[test]
+fn rates_the_step_cannot_resolve_are_rejected() {
+    // Reference panel: I_s2 = 25, m = 50, d = 0.75 → I about the hinge = 53.125 kg·m²; with a
+    // 1 ms step, sqrt(k / I) · h ≤ 1 ⇔ k ≤ 53.125e6 N·m/rad.
+    let i_hinge = 25.0 + 50.0 * 0.75 * 0.75;
+    for (k, ok) in [(0.99e6 * i_hinge, true), (1.01e6 * i_hinge, false)] {
+        let mut t = reference_table();
+        panel(&mut t, 0, "panel1").insert("k_n_m_rad".into(), Value::Float(k));
+        let res = SimConfig::from_toml_str(&toml::to_string(&t).unwrap());
+        match res {
+            Ok(_) => assert!(ok, "k = {k} accepted"),
+            Err(e) => {
+                assert!(!ok, "k = {k} rejected: {e}");
+                assert_names(&e, "panel_pairs[0].panel1.k_n_m_rad", &["too fast", "step"]);
+            }
+        }
+    }
+    let e = error_after(|t| {
+        panel(t, 1, "panel2").insert("c_n_m_s_rad".into(), Value::Float(2e3 * i_hinge));
+    });
+    assert_names(
+        &e,
+        "panel_pairs[1].panel2.c_n_m_s_rad",
+        &["damping rate", "too fast"],
+    );
+    let e = error_after(|t| {
+        table(t, "initial").insert("omega_bn_b_rad_s".into(), vec_value(&[0.0, 0.0, 1e150]));
+    });
+    assert_names(
+        &e,
+        "initial.omega_bn_b_rad_s",
+        &["1e150 rad/s is too fast for the 0.001 s step"],
+    );
+    let e = error_after(|t| {
+        panel(t, 0, "panel1").insert("theta_dot_rad_s".into(), Value::Float(-2000.0));
+    });
+    assert_names(&e, "panel_pairs[0].panel1.theta_dot_rad_s", &["too fast"]);
+}
+
+#[test]
+fn initial_outputs_that_overflow_are_rejected() {
+    // Every input finite and in range, but the initial torque gives an infinite acceleration.
+    let e = error_after(|t| {
+        t.insert(
+            "wrench_schedule".into(),
+            Value::Array(vec![wrench_row(0.0, [0.0; 3], [f64::MAX, f64::MAX, 0.0])]),
+        );
+    });
+    assert_names(&e, "initial", &["overflows to infinity"]);
 }

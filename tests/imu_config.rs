@@ -162,7 +162,7 @@ fn negative_terms_are_rejected() {
             assert_names(
                 &e,
                 &format!("imus[0].{table}.{key}"),
-                &["must be >= 0", "-0.000001"],
+                &["must be >= 0", "(got -1e-6)"],
             );
         }
     }

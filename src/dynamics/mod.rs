@@ -44,6 +44,8 @@ pub use spacecraft::{
     InitialTranslation, Spacecraft, State,
 };
 
+use crate::numfmt::Num;
+
 /// A parameter that fails validation. Every variant names the offending field with its
 /// configuration path (e.g. `panel_pairs[1].panel1.mass_kg`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -56,7 +58,7 @@ pub enum ParamError {
         field: String,
     },
     /// Must be strictly positive.
-    #[error("{field}: must be > 0 (got {value})")]
+    #[error("{field}: must be > 0 (got {})", Num(*.value))]
     NotPositive {
         /// Field path.
         field: String,
@@ -64,7 +66,7 @@ pub enum ParamError {
         value: f64,
     },
     /// Must be ≥ 0.
-    #[error("{field}: must be >= 0 (got {value})")]
+    #[error("{field}: must be >= 0 (got {})", Num(*.value))]
     Negative {
         /// Field path.
         field: String,
@@ -81,7 +83,8 @@ pub enum ParamError {
     },
     /// Inertia not positive-definite.
     #[error(
-        "{field}: inertia is not positive-definite (smallest principal moment {min_eigenvalue})"
+        "{field}: inertia is not positive-definite (smallest principal moment {})",
+        Num(*.min_eigenvalue)
     )]
     NotPositiveDefinite {
         /// Field path.
@@ -90,7 +93,7 @@ pub enum ParamError {
         min_eigenvalue: f64,
     },
     /// Principal moments violate the triangle inequality.
-    #[error("{field}: principal moments {moments:?} violate the triangle inequality (each must be <= the sum of the other two)")]
+    #[error("{field}: principal moments [{}, {}, {}] violate the triangle inequality (each must be <= the sum of the other two)", Num(.moments[0]), Num(.moments[1]), Num(.moments[2]))]
     TriangleInequality {
         /// Field path.
         field: String,
@@ -106,7 +109,7 @@ pub enum ParamError {
         error: f64,
     },
     /// Hinge-to-CoM distance beyond the panel length.
-    #[error("{field}: d ({d_m} m) exceeds the panel length l ({l_m} m)")]
+    #[error("{field}: d ({} m) exceeds the panel length l ({} m)", Num(*.d_m), Num(*.l_m))]
     DExceedsLength {
         /// Field path.
         field: String,

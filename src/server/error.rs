@@ -127,6 +127,21 @@ pub enum ServerError {
         /// The configured limit.
         limit: u32,
     },
+    /// The propagated state (or a quantity derived from it) stopped being finite: the run is
+    /// stopped before that frame is published.
+    #[error(
+        "the state became non-finite at tick {tick} (t = {t_s} s): {quantity} is NaN or \
+         infinite; stopping the run without publishing it (check the configuration's rates, \
+         stiffnesses and wrenches for values the step cannot resolve)"
+    )]
+    NonFinite {
+        /// The tick whose state is not finite.
+        tick: u64,
+        /// \[s\] its simulation time.
+        t_s: f64,
+        /// The first non-finite quantity, by its CSV column name.
+        quantity: String,
+    },
     /// A thread of the server could not be started or panicked.
     #[error("internal error: {0}")]
     Internal(String),

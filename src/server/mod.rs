@@ -262,7 +262,7 @@ pub async fn run(
         status = topics.status(),
         imus = ?sim.imu_names(),
         "flexdyn server starting: {}",
-        crate::cli::config_summary(&cfg)
+        cfg.summary()
     );
     tracing::info!("server settings: {}", settings.summary());
     if mode == Mode::RealTime && settings.stale_policy == StalePolicy::Hold {

@@ -283,6 +283,19 @@ impl PhysicsCtx {
             if let Some(mut f) = pending.take() {
                 self.fill(&mut f, &mut snap, &imu, k, &held);
                 pending = Some(f);
+            } else {
+                // No buffer for this frame's telemetry: still check what was propagated.
+                self.sim.snapshot_into(&mut snap);
+            }
+            // Once per frame, outside the RK4 loop: never publish a non-finite state.
+            let imu_bad = imu.iter().find_map(|s| s.first_non_finite());
+            let imu_bad = imu_bad.map(|q| format!("an IMU's {q} output"));
+            if let Some(quantity) = snap.first_non_finite().or(imu_bad) {
+                return Err(ServerError::NonFinite {
+                    tick: k,
+                    t_s: snap.t_s(),
+                    quantity,
+                });
             }
             if realtime {
                 match pacer.end_frame(k) {

@@ -1,0 +1,206 @@
+//! The configuration's error type and the text positions it points to.
+
+use std::fmt;
+use std::path::PathBuf;
+
+use crate::dynamics::ParamError;
+use crate::imu::ImuParamError;
+
+/// A position in the configuration text (1-based line and column, in characters).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Location {
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column (characters).
+    pub column: usize,
+}
+
+/// Where an error points to, if known; displays as ` (line L, column C)` or nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct At(pub Option<Location>);
+
+impl fmt::Display for At {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            Some(l) => write!(f, " (line {}, column {})", l.line, l.column),
+            None => Ok(()),
+        }
+    }
+}
+
+/// A configuration that cannot be used. The message always starts with the TOML path of the
+/// offending field (except for I/O and syntax errors, which name the file or the line).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ConfigError {
+    /// The file could not be read.
+    #[error("cannot read config file `{}`: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The text is not valid TOML.
+    #[error("TOML syntax error at line {line}, column {column}: {message}")]
+    Syntax {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What the TOML parser reported.
+        message: String,
+    },
+    /// A key that the schema does not have.
+    #[error("{field}: unknown key ({message}){at}")]
+    UnknownKey {
+        /// TOML path of the unknown key.
+        field: String,
+        /// What the TOML parser reported (lists the expected keys).
+        message: String,
+        /// Position of the key.
+        at: At,
+    },
+    /// A required key is absent.
+    #[error("{field}: missing required key{}", in_table(at))]
+    MissingKey {
+        /// TOML path of the missing key.
+        field: String,
+        /// Position of the table that lacks it.
+        at: At,
+    },
+    /// A value of the wrong type or shape (e.g. a string for a number, 2 elements for 3).
+    #[error("{field}: invalid value: {message}{at}")]
+    InvalidValue {
+        /// TOML path of the value.
+        field: String,
+        /// What the TOML parser reported.
+        message: String,
+        /// Position of the value.
+        at: At,
+    },
+    /// A parameter rejected by the dynamics' validation (non-finite, non-positive, inertia,
+    /// DCM, panel geometry, …).
+    #[error("{source}{at}")]
+    Param {
+        /// The validation error; it names the field.
+        #[source]
+        source: ParamError,
+        /// Position of the value.
+        at: At,
+    },
+    /// A duration that is not a whole number of nanoseconds or of RK4 steps, or a step that does
+    /// not divide the frame period.
+    #[error("{field}: {problem}{at}")]
+    Timing {
+        /// TOML path (`simulation.step_s`, `simulation.frame_hz`, `wrench_schedule[i].t_s`).
+        field: String,
+        /// What is wrong.
+        problem: String,
+        /// Position of the value.
+        at: At,
+    },
+    /// The initial translational state does not name exactly one point (CoM or B).
+    #[error("{field}: {problem}{at}")]
+    InitialPoint {
+        /// TOML path (`initial` or one of its keys).
+        field: String,
+        /// What is wrong.
+        problem: String,
+        /// Position.
+        at: At,
+    },
+    /// Unknown gravity model name, or a parameter the chosen model does not take or needs.
+    #[error("{field}: {problem}{at}")]
+    Gravity {
+        /// TOML path (`gravity.model`, `gravity.j2`, …).
+        field: String,
+        /// What is wrong.
+        problem: String,
+        /// Position.
+        at: At,
+    },
+    /// Wrench schedule rows out of order.
+    #[error("{field}: {problem}{at}")]
+    WrenchSchedule {
+        /// TOML path (`wrench_schedule[i].t_s`).
+        field: String,
+        /// What is wrong.
+        problem: String,
+        /// Position.
+        at: At,
+    },
+    /// Any other invalid value (e.g. duplicate panel pair names).
+    #[error("{field}: {problem}{at}")]
+    Invalid {
+        /// TOML path.
+        field: String,
+        /// What is wrong.
+        problem: String,
+        /// Position.
+        at: At,
+    },
+}
+
+fn in_table(at: &At) -> String {
+    match at.0 {
+        Some(l) => format!(" (in the table at line {}, column {})", l.line, l.column),
+        None => String::new(),
+    }
+}
+
+impl ConfigError {
+    /// The TOML path of the offending field, if the error is about one.
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            ConfigError::Io { .. } | ConfigError::Syntax { .. } => None,
+            ConfigError::UnknownKey { field, .. }
+            | ConfigError::MissingKey { field, .. }
+            | ConfigError::InvalidValue { field, .. }
+            | ConfigError::Timing { field, .. }
+            | ConfigError::InitialPoint { field, .. }
+            | ConfigError::Gravity { field, .. }
+            | ConfigError::WrenchSchedule { field, .. }
+            | ConfigError::Invalid { field, .. } => Some(field),
+            ConfigError::Param { source, .. } => param_field(source),
+        }
+    }
+}
+
+impl From<ParamError> for ConfigError {
+    fn from(source: ParamError) -> Self {
+        ConfigError::Param {
+            source,
+            at: At(None),
+        }
+    }
+}
+
+impl From<ImuParamError> for ConfigError {
+    fn from(e: ImuParamError) -> Self {
+        match e {
+            ImuParamError::Param(source) => source.into(),
+            ImuParamError::Invalid { field, problem } => ConfigError::Invalid {
+                field,
+                problem,
+                at: At(None),
+            },
+        }
+    }
+}
+
+/// The field path a [`ParamError`] names, if any.
+pub(crate) fn param_field(e: &ParamError) -> Option<&str> {
+    match e {
+        ParamError::NotFinite { field }
+        | ParamError::NotPositive { field, .. }
+        | ParamError::Negative { field, .. }
+        | ParamError::NotSymmetric { field, .. }
+        | ParamError::NotPositiveDefinite { field, .. }
+        | ParamError::TriangleInequality { field, .. }
+        | ParamError::NotOrthonormal { field, .. }
+        | ParamError::DExceedsLength { field, .. } => Some(field),
+        _ => None,
+    }
+}

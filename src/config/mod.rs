@@ -1,0 +1,1261 @@
+//! The TOML configuration file: schema, parsing and validation.
+//!
+//! A configuration is parsed in four passes, and the first problem found is reported as one
+//! [`ConfigError`] that names the offending field with its TOML path (e.g.
+//! `panel_pairs[1].panel1.mass_kg`) and, where the file has it, its line and column:
+//!
+//! 1. TOML syntax ([`ConfigError::Syntax`]);
+//! 2. structure: unknown keys, missing keys, wrong types and wrong array lengths, by the typed
+//!    reader of `reader.rs` ([`ConfigError::UnknownKey`], [`ConfigError::MissingKey`],
+//!    [`ConfigError::InvalidValue`]), whose messages speak TOML (tables, keys, numbers,
+//!    datetimes), never Rust types;
+//! 3. every float in the document must be finite — TOML accepts `nan` and `inf` literals
+//!    ([`ConfigError::Param`] wrapping [`ParamError::NotFinite`]);
+//! 4. physics and timing: the dynamics' own `validate` functions ([`ConfigError::Param`]) and the
+//!    checks that only make sense for a file (step and frame in whole nanoseconds, which point the
+//!    initial state describes, gravity model name, wrench schedule times), then the IMUs'
+//!    ([`ImuConfig::validate`], unique names).
+//!
+//! The built-in default is [`DEFAULT_CONFIG_TOML`], the verbatim text of
+//! `scenarios/reference.toml`. The README's "Configuration" section documents every key.
+
+mod error;
+mod reader;
+mod source_map;
+
+use std::collections::HashSet;
+use std::path::Path;
+
+use nalgebra::{Matrix3, Vector3};
+use toml::de::DeTable;
+
+use crate::numfmt::{Num, Rounded};
+pub use error::{At, ConfigError, Location};
+use flexdyn_proto::MAX_PANEL_PAIRS;
+use reader::TableReader;
+use source_map::{location, SourceMap};
+
+use crate::dynamics::{
+    GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
+    PanelPairParams, PanelParams, ParamError, Spacecraft, StateEffector, WrenchSegment,
+};
+use crate::imu::{AccelErrors, GyroErrors, ImuConfig};
+
+/// The built-in default configuration (the text of `scenarios/reference.toml`).
+pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../scenarios/reference.toml");
+
+/// Largest allowed distance of `seconds · 1e9` from a whole number of nanoseconds.
+pub const WHOLE_NS_TOL: f64 = 1e-6;
+
+/// A validated simulation configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimConfig {
+    /// \[ns\] RK4 step.
+    pub step_ns: u64,
+    /// \[ns\] telemetry/command frame period (a whole multiple of `step_ns`).
+    pub frame_ns: u64,
+    /// \[Hz\] frame rate as configured.
+    pub frame_hz: f64,
+    /// Hub parameters.
+    pub hub: HubParams,
+    /// Gravity model.
+    pub gravity: GravityModel,
+    /// Hub initial state.
+    pub initial: HubInitial,
+    /// Panel pairs and their initial states, in file order.
+    pub panel_pairs: Vec<(PanelPairParams, PanelPairInitial)>,
+    /// Piecewise-constant external wrench on the hub, sorted by strictly increasing start time.
+    pub wrench_schedule: Vec<WrenchSegment>,
+    /// The `[server]` table, uninterpreted (empty if absent); the server validates it.
+    pub server: toml::Table,
+    /// The IMUs (`[[imus]]`), validated, in file order (empty if absent). IMU `i` is sensor
+    /// point `i` of the spacecraft built by [`Self::build_spacecraft`].
+    pub imus: Vec<ImuConfig>,
+    /// The configuration text this was parsed from.
+    pub source_toml: String,
+}
+
+impl SimConfig {
+    /// Parses and validates a configuration. The error names the first offending field.
+    pub fn from_toml_str(s: &str) -> Result<Self, ConfigError> {
+        let doc = DeTable::parse(s).map_err(|e| {
+            let loc = e
+                .span()
+                .map(|sp| location(s, sp.start))
+                .unwrap_or(Location { line: 1, column: 1 });
+            ConfigError::Syntax {
+                line: loc.line,
+                column: loc.column,
+                message: e.message().to_string(),
+            }
+        })?;
+        let map = SourceMap::new(s, doc.get_ref());
+        let raw = RawConfig::read(s, doc.get_ref())?;
+        map.check_all_finite(doc.get_ref())?;
+        raw.into_config(s, &map)
+    }
+
+    /// Reads, parses and validates a configuration file. An I/O error names the path.
+    pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_toml_str(&text)
+    }
+
+    /// The built-in default ([`DEFAULT_CONFIG_TOML`]).
+    pub fn reference() -> Self {
+        Self::from_toml_str(DEFAULT_CONFIG_TOML)
+            .expect("the embedded default configuration is valid (see the unit test)")
+    }
+
+    /// One-line summary, as `check-config` prints it after `ok: FILE: `.
+    pub fn summary(&self) -> String {
+        config_summary(self)
+    }
+
+    /// RK4 steps per frame.
+    pub fn steps_per_frame(&self) -> u64 {
+        self.frame_ns / self.step_ns
+    }
+
+    /// \[kg\] total mass: hub plus every panel.
+    pub fn total_mass_kg(&self) -> f64 {
+        self.hub.mass_kg
+            + self
+                .panel_pairs
+                .iter()
+                .map(|(p, _)| p.panel1.mass_kg + p.panel2.mass_kg)
+                .sum::<f64>()
+    }
+
+    /// Builds the spacecraft: one [`PanelPair`] per configured pair (errors name
+    /// `panel_pairs[i]…`), then [`Spacecraft::new`], then one sensor point per IMU in file order
+    /// (sensor point `i` is `imus[i]`).
+    pub fn build_spacecraft(&self) -> Result<Spacecraft, ConfigError> {
+        let mut effectors: Vec<Box<dyn StateEffector>> = Vec::with_capacity(self.panel_pairs.len());
+        for (i, (params, initial)) in self.panel_pairs.iter().enumerate() {
+            let pair = PanelPair::new(params.clone(), *initial, &format!("panel_pairs[{i}]"))?;
+            effectors.push(Box::new(pair));
+        }
+        let mut sc = Spacecraft::new(
+            self.hub.clone(),
+            self.gravity,
+            effectors,
+            self.initial,
+            self.step_ns,
+        )?;
+        for (i, imu) in self.imus.iter().enumerate() {
+            sc.add_sensor_point(imu.sensor_point(), &format!("imus[{i}]"))?;
+        }
+        Ok(sc)
+    }
+}
+
+/// Short name of a gravity model, as in the configuration file.
+pub fn gravity_model_name(g: &GravityModel) -> &'static str {
+    match g {
+        GravityModel::None => "none",
+        GravityModel::PointMass { .. } => "point_mass",
+        GravityModel::J2 { .. } => "j2",
+    }
+}
+
+/// One-line summary of a valid configuration.
+pub fn config_summary(cfg: &SimConfig) -> String {
+    format!(
+        "{} panel pairs, {} IMUs{}, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows",
+        cfg.panel_pairs.len(),
+        cfg.imus.len(),
+        if cfg.imus.is_empty() {
+            String::new()
+        } else {
+            let names: Vec<&str> = cfg.imus.iter().map(|i| i.name.as_str()).collect();
+            format!(" ({})", names.join(", "))
+        },
+        cfg.total_mass_kg(),
+        cfg.step_ns as f64 * 1e-9,
+        cfg.step_ns,
+        cfg.frame_hz,
+        cfg.frame_ns,
+        cfg.steps_per_frame(),
+        gravity_model_name(&cfg.gravity),
+        cfg.wrench_schedule.len(),
+    )
+}
+
+/// Converts seconds to a whole number of nanoseconds: `None` unless `seconds` is finite, ≥ 0,
+/// representable in `u64` nanoseconds and within [`WHOLE_NS_TOL`] (or 4 ulp of the product for
+/// long durations) of a whole number.
+pub fn whole_ns(seconds: f64) -> Option<u64> {
+    round_ns(seconds * 1e9)
+}
+
+/// `ns` as a whole number of nanoseconds, with the tolerance of [`whole_ns`].
+fn round_ns(ns: f64) -> Option<u64> {
+    if !ns.is_finite() || ns < 0.0 || ns >= u64::MAX as f64 {
+        return None;
+    }
+    let rounded = ns.round();
+    let tol = WHOLE_NS_TOL.max(ns * 4.0 * f64::EPSILON);
+    ((ns - rounded).abs() <= tol).then_some(rounded as u64)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Raw (file-shaped) schema, read by [`TableReader`]: every key, type and length is checked here
+// (pass 2), before any value is interpreted.
+
+/// Keys of the document's root table.
+const ROOT_KEYS: &[&str] = &[
+    "simulation",
+    "gravity",
+    "hub",
+    "initial",
+    "panel_pairs",
+    "wrench_schedule",
+    "server",
+    "imus",
+];
+
+struct RawConfig {
+    simulation: RawSimulation,
+    gravity: RawGravity,
+    hub: RawHub,
+    initial: RawInitial,
+    panel_pairs: Vec<RawPanelPair>,
+    wrench_schedule: Vec<RawWrench>,
+    server: toml::Table,
+    imus: Vec<RawImu>,
+}
+
+struct RawSimulation {
+    step_s: f64,
+    frame_hz: f64,
+}
+
+struct RawGravity {
+    model: String,
+    mu_m3_s2: Option<f64>,
+    j2: Option<f64>,
+    r_eq_m: Option<f64>,
+}
+
+struct RawHub {
+    mass_kg: f64,
+    inertia_bc_b_kg_m2: [[f64; 3]; 3],
+    r_bcb_b_m: [f64; 3],
+}
+
+struct RawInitial {
+    r_cn_n_m: Option<[f64; 3]>,
+    v_cn_n_m_s: Option<[f64; 3]>,
+    r_bn_n_m: Option<[f64; 3]>,
+    v_bn_n_m_s: Option<[f64; 3]>,
+    sigma_bn: [f64; 3],
+    omega_bn_b_rad_s: [f64; 3],
+}
+
+struct RawPanelPair {
+    name: String,
+    r_h1b_b_m: [f64; 3],
+    dcm_h1b: [[f64; 3]; 3],
+    theta_h2s1_rad: f64,
+    motor_torque_nm: Option<[f64; 2]>,
+    panel1: RawPanel,
+    panel2: RawPanel,
+}
+
+/// Panel 1 has `l_m`; panel 2 does not (the reader enforces which keys each allows).
+struct RawPanel {
+    mass_kg: f64,
+    inertia_s_kg_m2: [f64; 3],
+    d_m: f64,
+    l_m: Option<f64>,
+    k_n_m_rad: f64,
+    c_n_m_s_rad: f64,
+    theta_rad: f64,
+    theta_dot_rad_s: f64,
+}
+
+struct RawImu {
+    name: String,
+    r_sb_b_m: [f64; 3],
+    dcm_pb: [[f64; 3]; 3],
+    seed: u64,
+    gyro: RawTriad,
+    accel: RawTriad,
+}
+
+/// `[imus.gyro]` or `[imus.accel]`: every key optional, zero by default (see [`GyroErrors`],
+/// [`AccelErrors`]). The key names differ by unit; the values are read in this order:
+/// white noise, bias-instability σ, its τ, random walk, bias, scale factor, misalignment,
+/// range, output LSB, increment LSB.
+#[derive(Default)]
+struct RawTriad {
+    white: f64,
+    bias_instability_sigma: f64,
+    bias_instability_tau_s: f64,
+    random_walk: f64,
+    bias: [f64; 3],
+    scale_factor: [f64; 3],
+    misalignment_rad: [[f64; 3]; 3],
+    range: f64,
+    lsb: f64,
+    increment_lsb: f64,
+}
+
+/// The keys of a triad table, in [`RawTriad`]'s order.
+const GYRO_KEYS: [&str; 10] = [
+    "arw_rad_s_sqrt_hz",
+    "bias_instability_sigma_rad_s",
+    "bias_instability_tau_s",
+    "rrw_rad_s2_sqrt_hz",
+    "bias_rad_s",
+    "scale_factor",
+    "misalignment_rad",
+    "range_rad_s",
+    "lsb_rad_s",
+    "dtheta_lsb_rad",
+];
+const ACCEL_KEYS: [&str; 10] = [
+    "vrw_m_s2_sqrt_hz",
+    "bias_instability_sigma_m_s2",
+    "bias_instability_tau_s",
+    "rrw_m_s3_sqrt_hz",
+    "bias_m_s2",
+    "scale_factor",
+    "misalignment_rad",
+    "range_m_s2",
+    "lsb_m_s2",
+    "dv_lsb_m_s",
+];
+
+struct RawWrench {
+    t_s: f64,
+    force_b_n: [f64; 3],
+    torque_b_nm: [f64; 3],
+}
+
+impl RawConfig {
+    /// Pass 2: reads the whole document against the schema.
+    fn read(source: &str, doc: &DeTable<'_>) -> Result<Self, ConfigError> {
+        let root = TableReader::root(source, doc, ROOT_KEYS)?;
+        let sim = root.table("simulation", &["step_s", "frame_hz"])?;
+        let simulation = RawSimulation {
+            step_s: sim.f64("step_s")?,
+            frame_hz: sim.f64("frame_hz")?,
+        };
+        let g = root.table("gravity", &["model", "mu_m3_s2", "j2", "r_eq_m"])?;
+        let gravity = RawGravity {
+            model: g.string("model")?,
+            mu_m3_s2: g.opt_f64("mu_m3_s2")?,
+            j2: g.opt_f64("j2")?,
+            r_eq_m: g.opt_f64("r_eq_m")?,
+        };
+        let h = root.table("hub", &["mass_kg", "inertia_bc_b_kg_m2", "r_bcb_b_m"])?;
+        let hub = RawHub {
+            mass_kg: h.f64("mass_kg")?,
+            inertia_bc_b_kg_m2: h.mat3("inertia_bc_b_kg_m2")?,
+            r_bcb_b_m: h.floats("r_bcb_b_m")?,
+        };
+        let i = root.table(
+            "initial",
+            &[
+                "r_cn_n_m",
+                "v_cn_n_m_s",
+                "r_bn_n_m",
+                "v_bn_n_m_s",
+                "sigma_bn",
+                "omega_bn_b_rad_s",
+            ],
+        )?;
+        let initial = RawInitial {
+            r_cn_n_m: i.opt_floats("r_cn_n_m")?,
+            v_cn_n_m_s: i.opt_floats("v_cn_n_m_s")?,
+            r_bn_n_m: i.opt_floats("r_bn_n_m")?,
+            v_bn_n_m_s: i.opt_floats("v_bn_n_m_s")?,
+            sigma_bn: i.floats("sigma_bn")?,
+            omega_bn_b_rad_s: i.floats("omega_bn_b_rad_s")?,
+        };
+        let panel_pairs = root
+            .req_tables(
+                "panel_pairs",
+                &[
+                    "name",
+                    "r_h1b_b_m",
+                    "dcm_h1b",
+                    "theta_h2s1_rad",
+                    "motor_torque_nm",
+                    "panel1",
+                    "panel2",
+                ],
+            )?
+            .iter()
+            .map(RawPanelPair::read)
+            .collect::<Result<Vec<_>, _>>()?;
+        let wrench_schedule = root
+            .tables("wrench_schedule", &["t_s", "force_b_n", "torque_b_nm"])?
+            .unwrap_or_default()
+            .iter()
+            .map(|w| {
+                Ok(RawWrench {
+                    t_s: w.f64("t_s")?,
+                    force_b_n: w.floats("force_b_n")?,
+                    torque_b_nm: w.floats("torque_b_nm")?,
+                })
+            })
+            .collect::<Result<Vec<_>, ConfigError>>()?;
+        // `[server]` is read and validated by the server's own schema
+        // (`flexdyn::server::settings`); here it only has to be a table. `check-config` runs
+        // that schema too.
+        let server = if root.is_table("server")? {
+            let full: toml::Table =
+                source
+                    .parse()
+                    .map_err(|e: toml::de::Error| ConfigError::Syntax {
+                        line: 1,
+                        column: 1,
+                        message: e.message().to_string(),
+                    })?;
+            match full.get("server") {
+                Some(toml::Value::Table(t)) => t.clone(),
+                _ => toml::Table::new(),
+            }
+        } else {
+            toml::Table::new()
+        };
+        let imus = root
+            .tables(
+                "imus",
+                &["name", "r_sb_b_m", "dcm_pb", "seed", "gyro", "accel"],
+            )?
+            .unwrap_or_default()
+            .iter()
+            .map(RawImu::read)
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(RawConfig {
+            simulation,
+            gravity,
+            hub,
+            initial,
+            panel_pairs,
+            wrench_schedule,
+            server,
+            imus,
+        })
+    }
+}
+
+impl RawPanelPair {
+    fn read(t: &TableReader<'_, '_>) -> Result<Self, ConfigError> {
+        const PANEL2: [&str; 7] = [
+            "mass_kg",
+            "inertia_s_kg_m2",
+            "d_m",
+            "k_n_m_rad",
+            "c_n_m_s_rad",
+            "theta_rad",
+            "theta_dot_rad_s",
+        ];
+        let panel1_keys: Vec<&str> = PANEL2.iter().copied().chain(["l_m"]).collect();
+        let read_panel =
+            |p: &TableReader<'_, '_>, has_length: bool| -> Result<RawPanel, ConfigError> {
+                Ok(RawPanel {
+                    mass_kg: p.f64("mass_kg")?,
+                    inertia_s_kg_m2: p.floats("inertia_s_kg_m2")?,
+                    d_m: p.f64("d_m")?,
+                    l_m: if has_length {
+                        Some(p.f64("l_m")?)
+                    } else {
+                        None
+                    },
+                    k_n_m_rad: p.f64("k_n_m_rad")?,
+                    c_n_m_s_rad: p.f64("c_n_m_s_rad")?,
+                    theta_rad: p.f64("theta_rad")?,
+                    theta_dot_rad_s: p.f64("theta_dot_rad_s")?,
+                })
+            };
+        Ok(RawPanelPair {
+            name: t.string("name")?,
+            r_h1b_b_m: t.floats("r_h1b_b_m")?,
+            dcm_h1b: t.mat3("dcm_h1b")?,
+            theta_h2s1_rad: t.f64("theta_h2s1_rad")?,
+            motor_torque_nm: t.opt_floats("motor_torque_nm")?,
+            panel1: read_panel(&t.table("panel1", &panel1_keys)?, true)?,
+            panel2: read_panel(&t.table("panel2", &PANEL2)?, false)?,
+        })
+    }
+}
+
+impl RawTriad {
+    fn read(t: Option<TableReader<'_, '_>>, keys: &[&str; 10]) -> Result<Self, ConfigError> {
+        let Some(t) = t else {
+            return Ok(Self::default());
+        };
+        let f = |k: &str| t.opt_f64(k).map(Option::unwrap_or_default);
+        Ok(RawTriad {
+            white: f(keys[0])?,
+            bias_instability_sigma: f(keys[1])?,
+            bias_instability_tau_s: f(keys[2])?,
+            random_walk: f(keys[3])?,
+            bias: t.opt_floats(keys[4])?.unwrap_or_default(),
+            scale_factor: t.opt_floats(keys[5])?.unwrap_or_default(),
+            misalignment_rad: t.opt_mat3(keys[6])?.unwrap_or_default(),
+            range: f(keys[7])?,
+            lsb: f(keys[8])?,
+            increment_lsb: f(keys[9])?,
+        })
+    }
+}
+
+impl RawImu {
+    fn read(t: &TableReader<'_, '_>) -> Result<Self, ConfigError> {
+        Ok(RawImu {
+            name: t.string("name")?,
+            r_sb_b_m: t.floats("r_sb_b_m")?,
+            dcm_pb: t.mat3("dcm_pb")?,
+            // The documented range 0 ≤ seed ≤ 2⁶³ − 1 is TOML's non-negative integers.
+            seed: t.int_in("seed", 0, i64::MAX)? as u64,
+            gyro: RawTriad::read(t.opt_table("gyro", &GYRO_KEYS)?, &GYRO_KEYS)?,
+            accel: RawTriad::read(t.opt_table("accel", &ACCEL_KEYS)?, &ACCEL_KEYS)?,
+        })
+    }
+
+    fn into_config(self) -> ImuConfig {
+        let g = self.gyro;
+        let a = self.accel;
+        ImuConfig {
+            name: self.name,
+            r_sb_b_m: vec3(&self.r_sb_b_m),
+            dcm_pb: mat3(&self.dcm_pb),
+            seed: self.seed,
+            gyro: GyroErrors {
+                arw_rad_s_sqrt_hz: g.white,
+                bias_instability_sigma_rad_s: g.bias_instability_sigma,
+                bias_instability_tau_s: g.bias_instability_tau_s,
+                rrw_rad_s2_sqrt_hz: g.random_walk,
+                bias_rad_s: vec3(&g.bias),
+                scale_factor: vec3(&g.scale_factor),
+                misalignment_rad: mat3(&g.misalignment_rad),
+                range_rad_s: g.range,
+                lsb_rad_s: g.lsb,
+                dtheta_lsb_rad: g.increment_lsb,
+            },
+            accel: AccelErrors {
+                vrw_m_s2_sqrt_hz: a.white,
+                bias_instability_sigma_m_s2: a.bias_instability_sigma,
+                bias_instability_tau_s: a.bias_instability_tau_s,
+                rrw_m_s3_sqrt_hz: a.random_walk,
+                bias_m_s2: vec3(&a.bias),
+                scale_factor: vec3(&a.scale_factor),
+                misalignment_rad: mat3(&a.misalignment_rad),
+                range_m_s2: a.range,
+                lsb_m_s2: a.lsb,
+                dv_lsb_m_s: a.increment_lsb,
+            },
+        }
+    }
+}
+
+fn mat3(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| rows[i][j])
+}
+
+fn vec3(v: &[f64; 3]) -> Vector3<f64> {
+    Vector3::new(v[0], v[1], v[2])
+}
+
+impl RawConfig {
+    fn into_config(self, source: &str, map: &SourceMap) -> Result<SimConfig, ConfigError> {
+        let param = |e: ParamError| map.param_error(e);
+
+        // [simulation]
+        let sim = &self.simulation;
+        if sim.step_s <= 0.0 {
+            return Err(param(ParamError::NotPositive {
+                field: "simulation.step_s".into(),
+                value: sim.step_s,
+            }));
+        }
+        beyond_max_time(map, "simulation.step_s", sim.step_s)?;
+        let step_ns = match whole_ns(sim.step_s) {
+            Some(ns) if ns > 0 => ns,
+            _ => {
+                return Err(map.timing(
+                    "simulation.step_s",
+                    format!(
+                        "step {} s is not a whole number of nanoseconds",
+                        Num(sim.step_s)
+                    ),
+                ))
+            }
+        };
+        if sim.frame_hz <= 0.0 {
+            return Err(param(ParamError::NotPositive {
+                field: "simulation.frame_hz".into(),
+                value: sim.frame_hz,
+            }));
+        }
+        let frame_ns = match round_ns(1e9 / sim.frame_hz) {
+            Some(ns) if ns > 0 => ns,
+            _ => {
+                return Err(map.timing(
+                    "simulation.frame_hz",
+                    format!(
+                        "frame period 1/{} Hz = {} ns is not a whole number of nanoseconds",
+                        Num(sim.frame_hz),
+                        Num(1e9 / sim.frame_hz)
+                    ),
+                ))
+            }
+        };
+        if frame_ns % step_ns != 0 {
+            return Err(map.timing(
+                "simulation.frame_hz",
+                format!(
+                    "the step ({step_ns} ns, simulation.step_s) does not divide the frame period \
+                     ({frame_ns} ns = 1/{} Hz): the frame must be a whole number of steps",
+                    Num(sim.frame_hz)
+                ),
+            ));
+        }
+
+        // [gravity]
+        let gravity = self.gravity.to_model(map)?;
+        gravity.validate("gravity").map_err(param)?;
+
+        // [hub]
+        let hub = HubParams {
+            mass_kg: self.hub.mass_kg,
+            inertia_bc_b_kg_m2: mat3(&self.hub.inertia_bc_b_kg_m2),
+            r_bcb_b_m: vec3(&self.hub.r_bcb_b_m),
+        };
+        hub.validate("hub").map_err(param)?;
+
+        // [initial]
+        let initial = self.initial.to_initial(map)?;
+
+        // [[panel_pairs]]
+        if self.panel_pairs.len() > MAX_PANEL_PAIRS {
+            return Err(map.invalid(
+                "panel_pairs",
+                format!(
+                    "{} panel pairs is more than the wire format carries: a StateMsg holds at \
+                     most {MAX_PANEL_PAIRS} (proto/README.md)",
+                    self.panel_pairs.len()
+                ),
+            ));
+        }
+        let mut panel_pairs = Vec::with_capacity(self.panel_pairs.len());
+        let mut names = HashSet::new();
+        for (i, raw) in self.panel_pairs.into_iter().enumerate() {
+            let path = format!("panel_pairs[{i}]");
+            if raw.name.trim().is_empty() {
+                return Err(map.invalid(&format!("{path}.name"), "must not be empty".into()));
+            }
+            if !names.insert(raw.name.clone()) {
+                return Err(map.invalid(
+                    &format!("{path}.name"),
+                    format!(
+                        "duplicate panel pair name `{}` (names must be unique)",
+                        raw.name
+                    ),
+                ));
+            }
+            let (params, init) = raw.into_params();
+            params.validate(&path).map_err(param)?;
+            init.validate(&path).map_err(param)?;
+            panel_pairs.push((params, init));
+        }
+
+        // [[wrench_schedule]]
+        let mut wrench_schedule = Vec::with_capacity(self.wrench_schedule.len());
+        for (i, row) in self.wrench_schedule.iter().enumerate() {
+            let path = format!("wrench_schedule[{i}]");
+            let t_field = format!("{path}.t_s");
+            if row.t_s < 0.0 {
+                return Err(param(ParamError::Negative {
+                    field: t_field,
+                    value: row.t_s,
+                }));
+            }
+            beyond_max_time(map, &t_field, row.t_s)?;
+            let t_start_ns = match whole_ns(row.t_s) {
+                Some(ns) if ns % step_ns == 0 => ns,
+                _ => {
+                    return Err(map.timing(
+                        &t_field,
+                        format!(
+                            "t_s = {} s is not a whole number of steps (step = {step_ns} ns)",
+                            Num(row.t_s)
+                        ),
+                    ))
+                }
+            };
+            if let Some(prev) = wrench_schedule.last().map(|w: &WrenchSegment| w.t_start_ns) {
+                if t_start_ns <= prev {
+                    return Err(map.wrench_order(
+                        &t_field,
+                        format!(
+                            "t_s = {} s is not after the previous row's ({} s): t_s must be strictly increasing",
+                            Num(row.t_s),
+                            Num(prev as f64 * 1e-9)
+                        ),
+                    ));
+                }
+            }
+            let seg = WrenchSegment {
+                t_start_ns,
+                force_b_n: vec3(&row.force_b_n),
+                torque_b_nm: vec3(&row.torque_b_nm),
+            };
+            seg.validate(&path).map_err(param)?;
+            wrench_schedule.push(seg);
+        }
+
+        // [[imus]]
+        let mut imus = Vec::with_capacity(self.imus.len());
+        let mut imu_names = HashSet::new();
+        for (i, raw) in self.imus.into_iter().enumerate() {
+            let path = format!("imus[{i}]");
+            let imu = raw.into_config();
+            imu.validate(&path).map_err(|e| map.imu_error(e))?;
+            if !imu_names.insert(imu.name.clone()) {
+                return Err(map.invalid(
+                    &format!("{path}.name"),
+                    format!("duplicate IMU name `{}` (names must be unique)", imu.name),
+                ));
+            }
+            imus.push(imu);
+        }
+
+        let cfg = SimConfig {
+            step_ns,
+            frame_ns,
+            frame_hz: sim.frame_hz,
+            hub,
+            gravity,
+            initial,
+            panel_pairs,
+            wrench_schedule,
+            server: self.server,
+            imus,
+            source_toml: source.to_string(),
+        };
+        check_body_extent(&cfg, map)?;
+        check_imu_magnitudes(&cfg, map)?;
+        check_resolved_by_step(&cfg, map)?;
+        check_gravity_bound(&cfg, map)?;
+        check_initial_outputs_finite(&cfg, map)?;
+        Ok(cfg)
+    }
+}
+
+/// The longest simulation time a `u64` count of nanoseconds holds: 2⁶⁴ − 1 ns ≈ 584.5 years.
+pub const MAX_SIM_TIME_S: f64 = u64::MAX as f64 * 1e-9;
+
+/// An error naming `field` if `seconds` is beyond [`MAX_SIM_TIME_S`].
+fn beyond_max_time(map: &SourceMap, field: &str, seconds: f64) -> Result<(), ConfigError> {
+    if seconds >= MAX_SIM_TIME_S {
+        return Err(map.timing(
+            field,
+            format!(
+                "{} s is beyond the maximum simulation time ({} s ≈ 584 years, 2^64 − 1 ns)",
+                Num(seconds),
+                Rounded(MAX_SIM_TIME_S, 6)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// \[m\] Largest body-fixed distance in a spacecraft: a hub CoM offset, a hinge or sensor
+/// location, a panel length. The largest structure ever flown (the ISS truss) is about 110 m;
+/// 10 km leaves room for any tether-free design, while offsets of 1e18 m (a unit or exponent
+/// slip) would make the system inertia about C ill-conditioned beyond what f64 resolves.
+pub const MAX_BODY_EXTENT_M: f64 = 1e4;
+
+/// Rejects body-fixed distances beyond [`MAX_BODY_EXTENT_M`].
+fn check_body_extent(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError> {
+    let check = |field: &str, r_m: f64| -> Result<(), ConfigError> {
+        if r_m > MAX_BODY_EXTENT_M {
+            return Err(map.invalid(
+                field,
+                format!(
+                    "{} m is beyond the largest body-fixed distance flexdyn accepts ({} m): \
+                     check the units",
+                    Rounded(r_m, 4),
+                    Num(MAX_BODY_EXTENT_M)
+                ),
+            ));
+        }
+        Ok(())
+    };
+    check("hub.r_bcb_b_m", cfg.hub.r_bcb_b_m.norm())?;
+    for (i, (p, _)) in cfg.panel_pairs.iter().enumerate() {
+        let path = format!("panel_pairs[{i}]");
+        check(&format!("{path}.r_h1b_b_m"), p.r_h1b_b_m.norm())?;
+        check(&format!("{path}.panel1.l_m"), p.l1_m)?;
+        check(&format!("{path}.panel1.d_m"), p.panel1.d_m)?;
+        check(&format!("{path}.panel2.d_m"), p.panel2.d_m)?;
+    }
+    for (i, imu) in cfg.imus.iter().enumerate() {
+        check(&format!("imus[{i}].r_sb_b_m"), imu.r_sb_b_m.norm())?;
+    }
+    // Mass and inertia ratios: the hub's 3×3 Schur complement (Eqs. 151–153) subtracts the
+    // panels' contributions from the hub's; beyond MAX_MASS_RATIO the difference loses the
+    // digits the back-substitution needs (the dense-Kane cross-check measured κ ≈ 3.5e3 for a
+    // 200:1 panel-to-hub ratio).
+    let hub_m = cfg.hub.mass_kg;
+    let hub_i_min = cfg.hub.inertia_bc_b_kg_m2.symmetric_eigenvalues().min();
+    for (i, (p, _)) in cfg.panel_pairs.iter().enumerate() {
+        for (which, panel) in [("panel1", &p.panel1), ("panel2", &p.panel2)] {
+            let path = format!("panel_pairs[{i}].{which}");
+            let ratio = (panel.mass_kg / hub_m).max(hub_m / panel.mass_kg);
+            if ratio > MAX_MASS_RATIO {
+                return Err(map.invalid(
+                    &format!("{path}.mass_kg"),
+                    format!(
+                        "{} kg against a {} kg hub is a mass ratio of {}; flexdyn accepts at \
+                         most {} either way (the hub solve would lose its precision)",
+                        Num(panel.mass_kg),
+                        Num(hub_m),
+                        Rounded(ratio, 3),
+                        Num(MAX_MASS_RATIO)
+                    ),
+                ));
+            }
+            let i_max = panel.inertia_s_kg_m2.max();
+            if i_max > MAX_MASS_RATIO * hub_i_min {
+                return Err(map.invalid(
+                    &format!("{path}.inertia_s_kg_m2"),
+                    format!(
+                        "a principal moment of {} kg·m² is more than {} times the hub's \
+                         smallest principal moment ({} kg·m²)",
+                        Num(i_max),
+                        Num(MAX_MASS_RATIO),
+                        Rounded(hub_i_min, 6)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Largest ratio between a panel's mass and the hub's (either way), and between a panel's
+/// largest principal moment and the hub's smallest.
+pub const MAX_MASS_RATIO: f64 = 1e6;
+
+/// Largest magnitude of an IMU error term or range, in its SI unit (rad/s, m/s², …). No gyro
+/// or accelerometer errs by a million SI units; such a value is a unit slip, and values near the
+/// float range would overflow the noise (σ·z) to infinity.
+pub const MAX_IMU_TERM_SI: f64 = 1e6;
+
+/// Rejects IMU error terms beyond [`MAX_IMU_TERM_SI`] (the correlation times are not bounded:
+/// a long τ only makes the bias steadier).
+fn check_imu_magnitudes(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError> {
+    for (i, imu) in cfg.imus.iter().enumerate() {
+        let g = &imu.gyro;
+        let a = &imu.accel;
+        let terms: [(&str, f64); 14] = [
+            ("gyro.arw_rad_s_sqrt_hz", g.arw_rad_s_sqrt_hz),
+            (
+                "gyro.bias_instability_sigma_rad_s",
+                g.bias_instability_sigma_rad_s,
+            ),
+            ("gyro.rrw_rad_s2_sqrt_hz", g.rrw_rad_s2_sqrt_hz),
+            ("gyro.bias_rad_s", g.bias_rad_s.amax()),
+            ("gyro.range_rad_s", g.range_rad_s),
+            ("gyro.lsb_rad_s", g.lsb_rad_s),
+            ("gyro.dtheta_lsb_rad", g.dtheta_lsb_rad),
+            ("accel.vrw_m_s2_sqrt_hz", a.vrw_m_s2_sqrt_hz),
+            (
+                "accel.bias_instability_sigma_m_s2",
+                a.bias_instability_sigma_m_s2,
+            ),
+            ("accel.rrw_m_s3_sqrt_hz", a.rrw_m_s3_sqrt_hz),
+            ("accel.bias_m_s2", a.bias_m_s2.amax()),
+            ("accel.range_m_s2", a.range_m_s2),
+            ("accel.lsb_m_s2", a.lsb_m_s2),
+            ("accel.dv_lsb_m_s", a.dv_lsb_m_s),
+        ];
+        for (key, v) in terms {
+            if v.abs() > MAX_IMU_TERM_SI {
+                return Err(map.invalid(
+                    &format!("imus[{i}].{key}"),
+                    format!(
+                        "{} is beyond {} (SI units): no sensor errs by this much; check the units",
+                        Num(v),
+                        Num(MAX_IMU_TERM_SI)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Largest product of a rate and the RK4 step that a configuration may start with or build in:
+/// a hinge's natural frequency √(k/I) or damping rate c/I, or an initial angular rate, times the
+/// step. RK4 loses stability at ω·h ≈ 2.83 for an oscillator (2.79 for decay), and well before
+/// that its error is no longer small; 1 rad per step keeps every configured motion resolved.
+pub const MAX_RATE_TIMES_STEP: f64 = 1.0;
+
+/// Rejects hinge stiffnesses, dampings and initial rates that the step cannot resolve (see
+/// [`MAX_RATE_TIMES_STEP`]). Each panel is taken about its own hinge with the hub held fixed,
+/// I = I_s2 + m d² (the inertia about the hinge axis ŝ2, by the parallel-axis theorem).
+fn check_resolved_by_step(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError> {
+    let h = cfg.step_ns as f64 * 1e-9;
+    let too_fast = |field: &str, what: &str, rate: f64| -> Result<(), ConfigError> {
+        if rate * h > MAX_RATE_TIMES_STEP {
+            return Err(map.invalid(
+                field,
+                format!(
+                    "{what} = {} rad/s is too fast for the {} s step: rate × step = {} > {} \
+                     (use a smaller simulation.step_s or a slower value)",
+                    Rounded(rate, 4),
+                    Num(h),
+                    Rounded(rate * h, 4),
+                    MAX_RATE_TIMES_STEP
+                ),
+            ));
+        }
+        Ok(())
+    };
+    too_fast(
+        "initial.omega_bn_b_rad_s",
+        "|omega_bn_b|",
+        cfg.initial.omega_bn_b_rad_s.norm(),
+    )?;
+    for (i, (p, init)) in cfg.panel_pairs.iter().enumerate() {
+        for (which, panel, theta_dot) in [
+            ("panel1", &p.panel1, init.theta1_dot_rad_s),
+            ("panel2", &p.panel2, init.theta2_dot_rad_s),
+        ] {
+            let path = format!("panel_pairs[{i}].{which}");
+            let i_hinge = panel.inertia_s_kg_m2.y + panel.mass_kg * panel.d_m * panel.d_m;
+            too_fast(
+                &format!("{path}.k_n_m_rad"),
+                "the hinge frequency sqrt(k / (I_s2 + m d^2))",
+                (panel.k_n_m_rad / i_hinge).sqrt(),
+            )?;
+            too_fast(
+                &format!("{path}.c_n_m_s_rad"),
+                "the hinge damping rate c / (I_s2 + m d^2)",
+                panel.c_n_m_s_rad / i_hinge,
+            )?;
+            too_fast(
+                &format!("{path}.theta_dot_rad_s"),
+                "theta_dot",
+                theta_dot.abs(),
+            )?;
+            let theta = if which == "panel1" {
+                init.theta1_rad
+            } else {
+                init.theta2_rad
+            };
+            if theta.abs() > std::f64::consts::PI {
+                return Err(map.invalid(
+                    &format!("{path}.theta_rad"),
+                    format!(
+                        "{} rad is more than half a turn from the hinge's rest angle: a hinged \
+                         panel's angle must be within [-pi, pi] (fold a wing with \
+                         theta_h2s1_rad instead)",
+                        Rounded(theta, 6)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Rejects a configuration whose initial outputs overflow (an energy, a momentum or an
+/// acceleration that is not finite although every input is): nothing could be published.
+fn check_initial_outputs_finite(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError> {
+    let mut sc = cfg.build_spacecraft()?;
+    if let Some(w) = cfg.wrench_schedule.first().filter(|w| w.t_start_ns == 0) {
+        sc.set_wrench(w.force_b_n, w.torque_b_nm);
+    }
+    let out = sc.hub_outputs();
+    let c = sc.conserved();
+    let named: [(&str, &[f64]); 6] = [
+        ("omega_dot_bn_b", out.omega_dot_bn_b.as_slice()),
+        ("nongrav_accel_bn_b", out.nongrav_accel_bn_b.as_slice()),
+        ("orb_energy_j", std::slice::from_ref(&c.orb_energy_j)),
+        ("rot_energy_j", std::slice::from_ref(&c.rot_energy_j)),
+        ("orb_ang_mom_n", c.orb_ang_mom_n.as_slice()),
+        ("rot_ang_mom_c_n", c.rot_ang_mom_c_n.as_slice()),
+    ];
+    let bad = named
+        .iter()
+        .find(|(_, v)| v.iter().any(|x| !x.is_finite()))
+        .map(|(n, _)| *n);
+    match bad {
+        None => Ok(()),
+        Some(quantity) => Err(map.invalid(
+            "initial",
+            format!(
+                "the initial {quantity} overflows to infinity: the masses, inertias, rates and \
+                 wrenches are too large together to be represented"
+            ),
+        )),
+    }
+}
+
+/// Smallest ratio of the dynamical time √(r³/μ) at the initial CoM radius to the RK4 step.
+///
+/// √(r³/μ) is the time scale of motion in a point-mass field at radius r (a circular orbit's
+/// period is 2π times it, and the free-fall time from rest is (π/2√2) times it). RK4 needs many
+/// steps per such time: with fewer than [`MIN_STEPS_PER_DYNAMICAL_TIME`] the orbit is not
+/// resolved, and at r = 0 the field itself is infinite (NaN from the first step).
+pub const MIN_STEPS_PER_DYNAMICAL_TIME: f64 = 100.0;
+
+/// Rejects an initial position that gravity cannot propagate: under `point_mass` and `j2`, the
+/// system CoM must be where the field is finite and resolved by the step
+/// (√(r³/μ) ≥ [`MIN_STEPS_PER_DYNAMICAL_TIME`] steps); under `j2` it must also be outside the
+/// equatorial radius, where the zonal expansion no longer describes the field.
+fn check_gravity_bound(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError> {
+    let (mu_m3_s2, r_eq_m) = match cfg.gravity {
+        GravityModel::None => return Ok(()),
+        GravityModel::PointMass { mu_m3_s2 } => (mu_m3_s2, None),
+        GravityModel::J2 {
+            mu_m3_s2, r_eq_m, ..
+        } => (mu_m3_s2, Some(r_eq_m)),
+    };
+    let field = match cfg.initial.translation {
+        InitialTranslation::CenterOfMass { .. } => "initial.r_cn_n_m",
+        InitialTranslation::PointB { .. } => "initial.r_bn_n_m",
+    };
+    let sc = cfg.build_spacecraft()?;
+    let (_, r_cb_b_m, _) = sc.center_of_mass();
+    let x = sc.state();
+    let dcm_nb = crate::attitude::mrp_to_dcm(&x.sigma_bn).transpose();
+    let r_cn_n_m = x.r_bn_n + dcm_nb * r_cb_b_m;
+    let r_m = r_cn_n_m.norm();
+    if let Some(r_eq_m) = r_eq_m {
+        if r_m <= r_eq_m {
+            return Err(map.invalid(
+                field,
+                format!(
+                    "the system centre of mass is {} m from the central body's centre, at or \
+                     inside its equatorial radius gravity.r_eq_m = {} m: J2 gravity is only \
+                     defined outside the body",
+                    Rounded(r_m, 6),
+                    Num(r_eq_m)
+                ),
+            ));
+        }
+    }
+    let step_s = cfg.step_ns as f64 * 1e-9;
+    let r_min_m = (mu_m3_s2 * (MIN_STEPS_PER_DYNAMICAL_TIME * step_s).powi(2)).cbrt();
+    if r_m.is_nan() || r_m < r_min_m {
+        return Err(map.invalid(
+            field,
+            format!(
+                "the system centre of mass is {} m from the central body's centre; with \
+                 gravity.mu_m3_s2 = {} and a {} s step it must be at least {} m away, where \
+                 the dynamical time sqrt(r^3/mu) spans {} steps (at r = 0 the field is infinite)",
+                Rounded(r_m, 6),
+                Num(mu_m3_s2),
+                Num(step_s),
+                Rounded(r_min_m, 6),
+                MIN_STEPS_PER_DYNAMICAL_TIME
+            ),
+        ));
+    }
+    Ok(())
+}
+
+impl RawGravity {
+    fn to_model(&self, map: &SourceMap) -> Result<GravityModel, ConfigError> {
+        let needs = |key: &str, v: Option<f64>| -> Result<f64, ConfigError> {
+            v.ok_or_else(|| ConfigError::MissingKey {
+                field: format!("gravity.{key}"),
+                at: map.at("gravity"),
+            })
+        };
+        let forbid = |key: &str, v: Option<f64>| -> Result<(), ConfigError> {
+            match v {
+                Some(_) => Err(map.gravity(
+                    &format!("gravity.{key}"),
+                    format!("not used by model \"{}\"; remove it", self.model),
+                )),
+                None => Ok(()),
+            }
+        };
+        match self.model.as_str() {
+            "none" => {
+                forbid("mu_m3_s2", self.mu_m3_s2)?;
+                forbid("j2", self.j2)?;
+                forbid("r_eq_m", self.r_eq_m)?;
+                Ok(GravityModel::None)
+            }
+            "point_mass" => {
+                let mu_m3_s2 = needs("mu_m3_s2", self.mu_m3_s2)?;
+                forbid("j2", self.j2)?;
+                forbid("r_eq_m", self.r_eq_m)?;
+                Ok(GravityModel::PointMass { mu_m3_s2 })
+            }
+            "j2" => Ok(GravityModel::J2 {
+                mu_m3_s2: needs("mu_m3_s2", self.mu_m3_s2)?,
+                j2: needs("j2", self.j2)?,
+                r_eq_m: needs("r_eq_m", self.r_eq_m)?,
+            }),
+            other => Err(map.gravity(
+                "gravity.model",
+                format!("unknown gravity model \"{other}\" (expected \"none\", \"point_mass\" or \"j2\")"),
+            )),
+        }
+    }
+}
+
+impl RawInitial {
+    fn to_initial(&self, map: &SourceMap) -> Result<HubInitial, ConfigError> {
+        let err = |field: &str, problem: String| {
+            let at = map.at(field);
+            ConfigError::InitialPoint {
+                field: field.to_string(),
+                problem,
+                at: if at.0.is_some() {
+                    at
+                } else {
+                    map.at("initial")
+                },
+            }
+        };
+        let both = |what: &str, a: &str, b: &str| {
+            err(
+                &format!("initial.{b}"),
+                format!(
+                    "both initial.{a} and initial.{b} are given: give the {what} of exactly one \
+                     point (system centre of mass: {a}; point B: {b})"
+                ),
+            )
+        };
+        if self.r_cn_n_m.is_some() && self.r_bn_n_m.is_some() {
+            return Err(both("position", "r_cn_n_m", "r_bn_n_m"));
+        }
+        if self.v_cn_n_m_s.is_some() && self.v_bn_n_m_s.is_some() {
+            return Err(both("velocity", "v_cn_n_m_s", "v_bn_n_m_s"));
+        }
+        let translation = match (
+            self.r_cn_n_m,
+            self.r_bn_n_m,
+            self.v_cn_n_m_s,
+            self.v_bn_n_m_s,
+        ) {
+            (Some(r), None, Some(v), None) => InitialTranslation::CenterOfMass {
+                r_cn_n_m: vec3(&r),
+                v_cn_n_m_s: vec3(&v),
+            },
+            (None, Some(r), None, Some(v)) => InitialTranslation::PointB {
+                r_bn_n_m: vec3(&r),
+                v_bn_n_m_s: vec3(&v),
+            },
+            (None, None, _, _) => {
+                return Err(err(
+                    "initial.r_cn_n_m",
+                    "missing initial position: give exactly one of initial.r_cn_n_m (system \
+                     centre of mass) or initial.r_bn_n_m (point B)"
+                        .into(),
+                ))
+            }
+            (_, _, None, None) => {
+                let (r, v) = if self.r_cn_n_m.is_some() {
+                    ("r_cn_n_m", "v_cn_n_m_s")
+                } else {
+                    ("r_bn_n_m", "v_bn_n_m_s")
+                };
+                return Err(err(
+                    &format!("initial.{v}"),
+                    format!("missing initial velocity: initial.{r} needs initial.{v}"),
+                ));
+            }
+            _ => {
+                let field = if self.r_cn_n_m.is_some() {
+                    "initial.v_bn_n_m_s"
+                } else {
+                    "initial.v_cn_n_m_s"
+                };
+                return Err(err(
+                    field,
+                    "position and velocity must be of the same point: use r_cn_n_m with \
+                     v_cn_n_m_s (system centre of mass) or r_bn_n_m with v_bn_n_m_s (point B)"
+                        .into(),
+                ));
+            }
+        };
+        Ok(HubInitial {
+            translation,
+            sigma_bn: vec3(&self.sigma_bn),
+            omega_bn_b_rad_s: vec3(&self.omega_bn_b_rad_s),
+        })
+    }
+}
+
+impl RawPanelPair {
+    fn into_params(self) -> (PanelPairParams, PanelPairInitial) {
+        let p1 = &self.panel1;
+        let p2 = &self.panel2;
+        let params = PanelPairParams {
+            name: self.name,
+            r_h1b_b_m: vec3(&self.r_h1b_b_m),
+            dcm_h1b: mat3(&self.dcm_h1b),
+            theta_h2s1_rad: self.theta_h2s1_rad,
+            l1_m: p1.l_m.unwrap_or_default(),
+            panel1: PanelParams {
+                mass_kg: p1.mass_kg,
+                inertia_s_kg_m2: vec3(&p1.inertia_s_kg_m2),
+                d_m: p1.d_m,
+                k_n_m_rad: p1.k_n_m_rad,
+                c_n_m_s_rad: p1.c_n_m_s_rad,
+            },
+            panel2: PanelParams {
+                mass_kg: p2.mass_kg,
+                inertia_s_kg_m2: vec3(&p2.inertia_s_kg_m2),
+                d_m: p2.d_m,
+                k_n_m_rad: p2.k_n_m_rad,
+                c_n_m_s_rad: p2.c_n_m_s_rad,
+            },
+            motor_torque_nm: self.motor_torque_nm.unwrap_or([0.0, 0.0]),
+        };
+        let initial = PanelPairInitial {
+            theta1_rad: p1.theta_rad,
+            theta1_dot_rad_s: p1.theta_dot_rad_s,
+            theta2_rad: p2.theta_rad,
+            theta2_dot_rad_s: p2.theta_dot_rad_s,
+        };
+        (params, initial)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_parses() {
+        let cfg = SimConfig::from_toml_str(DEFAULT_CONFIG_TOML).expect("reference parses");
+        assert_eq!(cfg.step_ns, 1_000_000);
+        assert_eq!(cfg.frame_ns, 10_000_000);
+        assert_eq!(cfg.steps_per_frame(), 10);
+        assert_eq!(cfg.panel_pairs.len(), 2);
+        assert_eq!(cfg.source_toml, DEFAULT_CONFIG_TOML);
+        assert_eq!(SimConfig::reference(), cfg);
+        cfg.build_spacecraft().expect("reference spacecraft builds");
+    }
+
+    #[test]
+    fn whole_ns_tolerance() {
+        assert_eq!(whole_ns(0.001), Some(1_000_000));
+        assert_eq!(whole_ns(1e-9), Some(1));
+        assert_eq!(whole_ns(0.01), Some(10_000_000));
+        assert_eq!(whole_ns(1.5e-9), None);
+        assert_eq!(whole_ns(-1.0), None);
+        assert_eq!(whole_ns(f64::NAN), None);
+        assert_eq!(whole_ns(86_400.0 * 365.0), Some(31_536_000_000_000_000));
+    }
+}

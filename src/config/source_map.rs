@@ -1,0 +1,221 @@
+//! Source map: TOML paths ↔ text positions, and the whole-document finiteness pass.
+
+use std::ops::Range;
+
+use toml::de::{DeTable, DeValue};
+use toml::Spanned;
+
+use super::error::{param_field, At, ConfigError, Location};
+use crate::dynamics::ParamError;
+use crate::imu::ImuParamError;
+
+/// 1-based line and column of byte `offset` in `s`.
+pub(crate) fn location(s: &str, offset: usize) -> Location {
+    let offset = offset.min(s.len());
+    let before = s.get(..offset).unwrap_or(s);
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    Location {
+        line: before.matches('\n').count() + 1,
+        column: before[line_start..].chars().count() + 1,
+    }
+}
+
+fn is_bare_key(k: &str) -> bool {
+    !k.is_empty()
+        && k.chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
+pub(crate) fn join_key(path: &str, key: &str) -> String {
+    let key = if is_bare_key(key) {
+        key.to_string()
+    } else {
+        format!("{key:?}")
+    };
+    if path.is_empty() {
+        key
+    } else {
+        format!("{path}.{key}")
+    }
+}
+
+struct SpanEntry {
+    span: Range<usize>,
+    path: String,
+    is_key: bool,
+}
+
+/// Every key and value of the document with its TOML path and byte span.
+pub(crate) struct SourceMap<'s> {
+    source: &'s str,
+    entries: Vec<SpanEntry>,
+}
+
+impl<'s> SourceMap<'s> {
+    pub(crate) fn new(source: &'s str, doc: &DeTable<'_>) -> Self {
+        let mut map = Self {
+            source,
+            entries: Vec::new(),
+        };
+        map.index_table(doc, "");
+        map
+    }
+
+    fn index_table(&mut self, t: &DeTable<'_>, path: &str) {
+        for (k, v) in t.iter() {
+            let p = join_key(path, k.get_ref());
+            self.entries.push(SpanEntry {
+                span: k.span(),
+                path: p.clone(),
+                is_key: true,
+            });
+            self.index_value(v, p);
+        }
+    }
+
+    fn index_value(&mut self, v: &Spanned<DeValue<'_>>, path: String) {
+        self.entries.push(SpanEntry {
+            span: v.span(),
+            path: path.clone(),
+            is_key: false,
+        });
+        match v.get_ref() {
+            DeValue::Table(t) => self.index_table(t, &path),
+            DeValue::Array(a) => {
+                for (i, e) in a.iter().enumerate() {
+                    self.index_value(e, format!("{path}[{i}]"));
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// Position of the value at `path` (or of its key), if the document has it.
+    pub(crate) fn at(&self, path: &str) -> At {
+        let entry = self
+            .entries
+            .iter()
+            .find(|e| !e.is_key && e.path == path)
+            .or_else(|| self.entries.iter().find(|e| e.path == path));
+        At(entry.map(|e| location(self.source, e.span.start)))
+    }
+
+    /// Rejects NaN and ±Inf anywhere in the document (including `[server]` and `[[imus]]`).
+    pub(crate) fn check_all_finite(&self, doc: &DeTable<'_>) -> Result<(), ConfigError> {
+        fn walk_table(t: &DeTable<'_>, path: &str, out: &mut Option<(String, usize)>) {
+            for (k, v) in t.iter() {
+                if out.is_some() {
+                    return;
+                }
+                walk_value(v, join_key(path, k.get_ref()), out);
+            }
+        }
+        fn walk_value(v: &Spanned<DeValue<'_>>, path: String, out: &mut Option<(String, usize)>) {
+            match v.get_ref() {
+                DeValue::Float(f) => {
+                    let s = f.as_str().to_ascii_lowercase();
+                    let finite = !s.contains("nan")
+                        && !s.contains("inf")
+                        && s.replace('_', "").parse::<f64>().is_ok_and(f64::is_finite);
+                    if !finite && out.is_none() {
+                        *out = Some((path, v.span().start));
+                    }
+                }
+                DeValue::Table(t) => walk_table(t, &path, out),
+                DeValue::Array(a) => {
+                    for (i, e) in a.iter().enumerate() {
+                        if out.is_some() {
+                            return;
+                        }
+                        walk_value(e, format!("{path}[{i}]"), out);
+                    }
+                }
+                _ => {}
+            }
+        }
+        let mut found = None;
+        walk_table(doc, "", &mut found);
+        match found {
+            None => Ok(()),
+            Some((field, offset)) => Err(ConfigError::Param {
+                source: ParamError::NotFinite { field },
+                at: At(Some(location(self.source, offset))),
+            }),
+        }
+    }
+
+    pub(crate) fn param_error(&self, source: ParamError) -> ConfigError {
+        let at = param_field(&source).map(|f| self.at(f)).unwrap_or_default();
+        ConfigError::Param { source, at }
+    }
+
+    pub(crate) fn timing(&self, field: &str, problem: String) -> ConfigError {
+        ConfigError::Timing {
+            field: field.to_string(),
+            problem,
+            at: self.at(field),
+        }
+    }
+
+    pub(crate) fn gravity(&self, field: &str, problem: String) -> ConfigError {
+        ConfigError::Gravity {
+            field: field.to_string(),
+            problem,
+            at: self.at(field),
+        }
+    }
+
+    pub(crate) fn wrench_order(&self, field: &str, problem: String) -> ConfigError {
+        ConfigError::WrenchSchedule {
+            field: field.to_string(),
+            problem,
+            at: self.at(field),
+        }
+    }
+
+    pub(crate) fn imu_error(&self, e: ImuParamError) -> ConfigError {
+        match e {
+            ImuParamError::Param(p) => self.param_error(p),
+            ImuParamError::Invalid { field, problem } => {
+                // An absent key (e.g. a missing time constant) points at its table.
+                let mut at = self.at(&field);
+                let mut parent = field.as_str();
+                while at.0.is_none() {
+                    match parent.rfind('.') {
+                        Some(i) => parent = &parent[..i],
+                        None => break,
+                    }
+                    at = self.at(parent);
+                }
+                ConfigError::Invalid { field, problem, at }
+            }
+        }
+    }
+
+    pub(crate) fn invalid(&self, field: &str, problem: String) -> ConfigError {
+        ConfigError::Invalid {
+            field: field.to_string(),
+            problem,
+            at: self.at(field),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn locations() {
+        let s = "a = 1\nbb = 2\n";
+        assert_eq!(location(s, 0), Location { line: 1, column: 1 });
+        assert_eq!(location(s, 6), Location { line: 2, column: 1 });
+        assert_eq!(location(s, 11), Location { line: 2, column: 6 });
+    }
+
+    #[test]
+    fn quoted_keys_in_paths() {
+        assert_eq!(join_key("", "hub"), "hub");
+        assert_eq!(join_key("server", "a.b"), "server.\"a.b\"");
+    }
+}
