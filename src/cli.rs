@@ -414,16 +414,8 @@ pub fn check_config(path: &Path) -> Result<String, CliError> {
     Ok(format!("ok: {}: {}", path.display(), cfg.summary()))
 }
 
-/// Logs to stderr at `RUST_LOG` (default `info`); shared by `flexdyn` and the tools. Does nothing
-/// if a subscriber is already installed.
-pub fn init_tracing() {
-    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
-        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
-    let _ = tracing_subscriber::fmt()
-        .with_env_filter(filter)
-        .with_writer(std::io::stderr)
-        .try_init();
-}
+/// Logs to stderr at `RUST_LOG` (default `info`); see [`crate::logging::init_tracing`].
+pub use crate::logging::init_tracing;
 
 #[cfg(test)]
 mod tests {

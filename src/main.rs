@@ -9,14 +9,27 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use flexdyn::cli::{self, CliError, SimulateArgs};
 use flexdyn::config::DEFAULT_CONFIG_TOML;
+use flexdyn::logging::print_error;
 use flexdyn::server::cli::{run_from_args, RunArgs};
 
 /// Real-time flight-software-in-the-loop spacecraft dynamics: rigid hub + dual-hinged panels.
+///
+/// Without a subcommand, `flexdyn [OPTIONS]` is `flexdyn run [OPTIONS]`.
 #[derive(Debug, Parser)]
-#[command(name = "flexdyn", version, about, long_about = None)]
+#[command(
+    name = "flexdyn",
+    version,
+    about,
+    long_about = None,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// The `run` options, accepted without the subcommand.
+    #[command(flatten)]
+    run: Box<RunArgs>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -51,29 +64,60 @@ fn run_server(args: &RunArgs) -> ExitCode {
     match run_from_args(args) {
         Ok(_report) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            print_error(&e);
             ExitCode::from(e.exit_code())
         }
     }
 }
 
+/// Parses the command line. A usage error is one `error:` line (clap's first line, plus the
+/// hint to run `--help`) with exit code 2; `--help` and `--version` print and exit 0.
+fn parse_args() -> Result<Cli, ExitCode> {
+    match Cli::try_parse() {
+        Ok(cli) => Ok(cli),
+        Err(e) => match e.kind() {
+            clap::error::ErrorKind::DisplayHelp
+            | clap::error::ErrorKind::DisplayVersion
+            | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                let _ = e.print();
+                Err(ExitCode::SUCCESS)
+            }
+            _ => {
+                print_error(flexdyn::logging::usage_line(&e.to_string()));
+                Err(ExitCode::from(2))
+            }
+        },
+    }
+}
+
 fn main() -> ExitCode {
-    let args = Cli::parse();
+    let args = match parse_args() {
+        Ok(a) => a,
+        Err(code) => return code,
+    };
     flexdyn::cli::init_tracing();
     let result = match args.command {
-        Some(Command::Simulate(a)) => cli::simulate(&a).map(|report| eprintln!("{report}")),
-        Some(Command::CheckConfig { file }) => {
-            cli::check_config(&file).map(|summary| println!("{summary}"))
-        }
+        Some(Command::Simulate(a)) => cli::simulate(&a).map(|report| {
+            let _ = writeln!(std::io::stderr(), "{report}");
+        }),
+        Some(Command::CheckConfig { file }) => cli::check_config(&file).and_then(|summary| {
+            let mut out = std::io::stdout().lock();
+            writeln!(out, "{summary}")
+                .and_then(|()| out.flush())
+                .map_err(|source| CliError::Output {
+                    target: "stdout".into(),
+                    source,
+                })
+        }),
         Some(Command::PrintDefaultConfig) => print_default_config(),
         Some(Command::Run(a)) => return run_server(&a),
-        // No subcommand: the real-time server with every default.
-        None => return run_server(&RunArgs::default()),
+        // No subcommand: `flexdyn run` with the options given.
+        None => return run_server(&args.run),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            print_error(&e);
             ExitCode::from(e.exit_code())
         }
     }

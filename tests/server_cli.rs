@@ -288,3 +288,113 @@ fn help_lists_the_run_subcommand() {
         assert!(text.contains(flag), "{flag} missing from:\n{text}");
     }
 }
+
+/// `flexdyn 2>&1 | tee log`, then Ctrl-C: the reader of stderr dies first. The server must keep
+/// running while it logs into the closed pipe, then stop on SIGTERM with exit 0 and its final
+/// status, instead of panicking on EPIPE (exit 101/134).
+#[test]
+fn a_closed_stderr_reader_never_takes_the_server_down() {
+    let port = 17345;
+    let ep = endpoint(port);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        // Log every frame's bookkeeping so that writes into the closed pipe happen for sure.
+        .args(["--listen", &ep, "--summary-interval-s", "0.05"])
+        .env("RUST_LOG", "debug")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn flexdyn");
+    // Read a little, then close the read end (drop), as a killed `tee` would.
+    let mut pipe = child.stderr.take().unwrap();
+    let mut buf = [0u8; 256];
+    let n = pipe.read(&mut buf).unwrap();
+    assert!(n > 0, "the server logs at start");
+    drop(pipe);
+    let topics = Topics::new("sc1").unwrap();
+    let obs = Observer::start(port, &topics);
+    assert!(
+        wait_until(Duration::from_secs(30), || obs
+            .last_tick()
+            .is_some_and(|t| t >= 30)),
+        "no telemetry after the stderr reader closed"
+    );
+    // Still alive after logging into the closed pipe for a while.
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(child.try_wait().unwrap().is_none(), "the server died");
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let give_up = Instant::now() + Duration::from_secs(30);
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        assert!(Instant::now() < give_up, "no exit after SIGTERM");
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    assert_eq!(status.code(), Some(0), "exit status {status:?}");
+    // The final status went out: the last one seen is no longer `Running`.
+    let last = obs.last_status().expect("status messages");
+    assert_ne!(
+        last.run_state,
+        flexdyn_proto::RunState::Running,
+        "final status: {last:?}"
+    );
+}
+
+#[test]
+fn plain_flexdyn_takes_the_run_options_and_usage_errors_are_one_line() {
+    // `flexdyn --config X` is `flexdyn run --config X`.
+    let out = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args(["--config", "/nonexistent/craft.toml"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(
+        err.trim_end(),
+        "error: cannot read config file `/nonexistent/craft.toml`: No such file or directory (os error 2)"
+    );
+    // A usage error is one line, exit 2.
+    for args in [
+        &["--bogus"][..],
+        &["simulate", "--duration-s"],
+        &["run", "--mode", "fast"],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains("--help"),
+            "{err}"
+        );
+    }
+    // Negative numbers reach the setting's own check.
+    let out = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args(["--stale-after-s", "-1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        err.trim_end(),
+        "error: --stale-after-s: must be > 0 (got -1)"
+    );
+    // Logs into a pipe carry no ANSI colour codes.
+    let out = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args(["simulate", "--duration-s", "0.01", "--output", "-"])
+        .env("RUST_LOG", "debug")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("DEBUG"), "a debug line was logged: {err}");
+    assert!(!err.contains('\u{1b}'), "colour codes in a pipe: {err:?}");
+}
