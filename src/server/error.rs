@@ -186,7 +186,7 @@ impl ServerError {
     pub(crate) fn zenoh(what: &'static str, e: impl std::fmt::Display) -> Self {
         ServerError::Zenoh {
             what,
-            message: e.to_string(),
+            message: super::zenoh_cfg::clean_zenoh_message(&e.to_string()),
         }
     }
 }

@@ -79,8 +79,68 @@ fn insert(
         .insert_json5(key, value)
         .map_err(|e| ZenohConfigError::Value {
             what: what.to_owned(),
-            message: format!("{value}: {e}"),
+            message: format!("{value}: {}", clean_zenoh_message(&e.to_string())),
         })
+}
+
+/// Zenoh's error text without its source locations (`… at /…/.cargo/registry/src/…/x.rs:61.`)
+/// and serde wrappers (`Json5Err(Message { msg: "…", location: … })`), which mean nothing to a
+/// user.
+pub fn clean_zenoh_message(message: &str) -> String {
+    let mut s = message.to_string();
+    // Unwrap `Json5Err(Message { msg: "<inner>", … })` to `<inner>`.
+    if let Some(i) = s.find("msg: \"") {
+        let rest = &s[i + 6..];
+        if let Some(j) = rest.find("\", location") {
+            s = rest[..j].to_string();
+        }
+    }
+    // Drop ` at <path>.rs:<line>` source locations.
+    while let Some(i) = s.find(" at /") {
+        let rest = &s[i..];
+        let end = rest
+            .find(".rs:")
+            .map(|j| {
+                let tail = &rest[j + 4..];
+                j + 4
+                    + tail
+                        .find(|c: char| !c.is_ascii_digit())
+                        .unwrap_or(tail.len())
+            })
+            .unwrap_or(rest.len());
+        s.replace_range(i..i + end, "");
+    }
+    s.trim_end_matches('.').trim().to_string()
+}
+
+/// Checks a `--listen`/`--connect` endpoint before Zenoh sees it: `<protocol>/<address>`, and
+/// the protocol must be one compiled in (only `tcp`).
+fn check_endpoint(what: &str, endpoint: &str) -> Result<(), ZenohConfigError> {
+    let bad = |problem: String| ZenohConfigError::Value {
+        what: what.to_owned(),
+        message: format!("`{endpoint}`: {problem}"),
+    };
+    let Some((proto, address)) = endpoint.split_once('/') else {
+        return Err(bad(
+            "not an endpoint: expected tcp/<host>:<port>, e.g. tcp/127.0.0.1:7447".into(),
+        ));
+    };
+    if proto != "tcp" {
+        return Err(bad(format!(
+            "protocol `{proto}` is not built into flexdyn (only tcp): use tcp/<host>:<port>"
+        )));
+    }
+    let address = address.split(['?', '#']).next().unwrap_or(address);
+    let port_ok = address
+        .rsplit_once(':')
+        .is_some_and(|(host, port)| !host.is_empty() && port.parse::<u16>().is_ok());
+    if !port_ok {
+        return Err(bad(
+            "expected tcp/<host>:<port> with a port from 0 to 65535, e.g. tcp/127.0.0.1:7447"
+                .into(),
+        ));
+    }
+    Ok(())
 }
 
 /// Whether the parsed JSON5 document sets `path` (a `/`-separated key) to anything.
@@ -94,6 +154,12 @@ fn json_has(doc: &serde_json::Value, path: &str) -> Option<serde_json::Value> {
 
 /// Builds the Zenoh configuration for `role` from `args` (see the module docs for the rules).
 pub fn zenoh_config(args: &ZenohArgs, role: Role) -> Result<zenoh::Config, ZenohConfigError> {
+    for e in &args.listen {
+        check_endpoint("--listen", e)?;
+    }
+    for e in &args.connect {
+        check_endpoint("--connect", e)?;
+    }
     let (mut config, doc) = match &args.zenoh_config {
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|source| ZenohConfigError::Read {
@@ -274,5 +340,43 @@ mod tests {
         };
         let e = zenoh_config(&args, Role::Server).unwrap_err();
         assert!(e.to_string().starts_with("--listen:"), "{e}");
+        for (bad, want) in [
+            ("garbage", "not an endpoint"),
+            (
+                "udp/127.0.0.1:7447",
+                "protocol `udp` is not built into flexdyn",
+            ),
+            ("tcp/127.0.0.1", "expected tcp/<host>:<port> with a port"),
+            (
+                "tcp/127.0.0.1:99999",
+                "expected tcp/<host>:<port> with a port",
+            ),
+        ] {
+            let args = ZenohArgs {
+                connect: vec![bad.into()],
+                ..ZenohArgs::default()
+            };
+            let msg = zenoh_config(&args, Role::Tool).unwrap_err().to_string();
+            assert!(
+                msg.starts_with(&format!("--connect: `{bad}`: {want}")),
+                "{msg}"
+            );
+            assert!(!msg.contains(".rs:") && !msg.contains("Json5Err"), "{msg}");
+        }
+    }
+
+    #[test]
+    fn zenoh_messages_lose_their_source_paths() {
+        let raw = "Json5Err(Message { msg: \"Endpoints must be of the form <protocol>/<address>: \
+                   garbage at /root/.cargo/registry/src/x/zenoh-protocol-1.10.2/src/core/endpoint.rs:615.\", \
+                   location: Some(Location { line: 1, column: 1 }) }) at /root/.cargo/registry/src/x/zenoh-1.10.2/src/api/config.rs:86.";
+        assert_eq!(
+            clean_zenoh_message(raw),
+            "Endpoints must be of the form <protocol>/<address>: garbage"
+        );
+        assert_eq!(
+            clean_zenoh_message("Can not create a new TCP listener bound to tcp/127.0.0.1:1: Permission denied at /r/.cargo/registry/src/tcp.rs:61."),
+            "Can not create a new TCP listener bound to tcp/127.0.0.1:1: Permission denied"
+        );
     }
 }

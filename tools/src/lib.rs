@@ -12,7 +12,8 @@
 //! ([`Role::Tool`]): peer mode, connect to `tcp/127.0.0.1:7447`, listen nowhere, multicast
 //! scouting always off.
 
-use anyhow::Context as _;
+use std::process::ExitCode;
+
 use flexdyn::server::{zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::Topics;
 use zenoh::{Session, Wait};
@@ -42,7 +43,7 @@ impl Default for CommonArgs {
 impl CommonArgs {
     /// The spacecraft's key expressions (validates `--sc-id`).
     pub fn topics(&self) -> anyhow::Result<Topics> {
-        Topics::new(&self.sc_id).with_context(|| format!("--sc-id {:?}", self.sc_id))
+        Topics::new(&self.sc_id).map_err(|e| usage(format!("--sc-id {:?}: {e}", self.sc_id)))
     }
 
     /// The tool's Zenoh configuration.
@@ -59,7 +60,61 @@ impl CommonArgs {
 }
 
 /// Logs to stderr at `RUST_LOG` (default `info`): the server's own setup.
-pub use flexdyn::cli::init_tracing;
+pub use flexdyn::logging::init_tracing;
+
+/// Invalid input on the command line (a bad option value): the tool exits with code 2.
+#[derive(Debug)]
+pub struct UsageError(pub String);
+
+impl std::fmt::Display for UsageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for UsageError {}
+
+/// A [`UsageError`] as an `anyhow::Error`.
+pub fn usage(message: impl Into<String>) -> anyhow::Error {
+    UsageError(message.into()).into()
+}
+
+/// Parses a tool's command line with the rules of `flexdyn`: a usage error is one `error:`
+/// line with exit code 2; `--help` and `--version` print and exit 0.
+pub fn parse_args<A: clap::Parser>() -> Result<A, ExitCode> {
+    match A::try_parse() {
+        Ok(a) => Ok(a),
+        Err(e) => match e.kind() {
+            clap::error::ErrorKind::DisplayHelp
+            | clap::error::ErrorKind::DisplayVersion
+            | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                let _ = e.print();
+                Err(ExitCode::SUCCESS)
+            }
+            _ => {
+                flexdyn::logging::print_error(flexdyn::logging::usage_line(&e.to_string()));
+                Err(ExitCode::from(2))
+            }
+        },
+    }
+}
+
+/// The exit code and one `error:` line for a tool's result: 0 on success; 2 for a
+/// [`UsageError`] or an invalid Zenoh configuration; 1 for a failure while running. The error's
+/// causes are joined on one line, with Zenoh's source paths removed.
+pub fn exit_with(result: anyhow::Result<()>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            let bad_input = e.chain().any(|c| {
+                c.is::<UsageError>() || c.is::<flexdyn::server::error::ZenohConfigError>()
+            });
+            let line = format!("{e:#}").replace('\n', " ");
+            flexdyn::logging::print_error(flexdyn::server::zenoh_cfg::clean_zenoh_message(&line));
+            ExitCode::from(if bad_input { 2 } else { 1 })
+        }
+    }
+}
 
 /// Percentile `q` (0..=1) of sorted values (nearest rank); `None` if empty.
 pub fn percentile<T: Copy>(sorted: &[T], q: f64) -> Option<T> {

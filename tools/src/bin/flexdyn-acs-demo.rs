@@ -70,20 +70,20 @@ struct Args {
     #[arg(long, default_value_t = 1)]
     sender_id: u32,
     /// Attitude gain K [N·m per unit MRP].
-    #[arg(long, default_value_t = 100.0)]
+    #[arg(long, default_value_t = 100.0, allow_negative_numbers = true)]
     k_nm: f64,
     /// Rate gain P [N·m·s/rad].
-    #[arg(long, default_value_t = 300.0)]
+    #[arg(long, default_value_t = 300.0, allow_negative_numbers = true)]
     p_nms: f64,
     /// Target attitude σ_RN (MRP, three comma-separated numbers); ω_RN = 0.
     #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', default_values_t = [0.0, 0.0, 0.0],
-          allow_negative_numbers = true)]
+          allow_hyphen_values = true)]
     sigma_rn: Vec<f64>,
     /// Log a progress line every this many seconds of simulation time (0: never).
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     log_every_s: f64,
     /// Exit after this many seconds without a state (default: run until killed).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     idle_exit_s: Option<f64>,
     /// Where the rate feedback comes from: `auto`, `gyro` or `truth` (see the module docs).
     #[arg(long, value_enum, default_value_t = RateSource::Auto)]
@@ -92,11 +92,11 @@ struct Args {
     #[arg(long)]
     imu: Option<String>,
     /// That IMU's mounting [PB] (maps B to platform P), nine comma-separated numbers, row-major.
-    #[arg(long, value_name = "9 NUMBERS", value_delimiter = ',', allow_negative_numbers = true,
+    #[arg(long, value_name = "9 NUMBERS", value_delimiter = ',', allow_hyphen_values = true,
           default_values_t = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])]
     imu_dcm_pb: Vec<f64>,
     /// Longest wait [s] for the gyro sample of a state's tick before giving up (error).
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
     imu_timeout_s: f64,
 }
 
@@ -291,14 +291,18 @@ impl Controller {
 /// A 3×3 DCM from nine row-major numbers, checked proper orthonormal within 1e-9.
 fn parse_dcm(v: &[f64]) -> anyhow::Result<[[f64; 3]; 3]> {
     if v.len() != 9 || v.iter().any(|x| !x.is_finite()) {
-        bail!("--imu-dcm-pb takes nine finite comma-separated numbers (row-major [PB])");
+        return Err(flexdyn_tools::usage(
+            "--imu-dcm-pb takes nine finite comma-separated numbers (row-major [PB])",
+        ));
     }
     let c = [[v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]];
     for i in 0..3 {
         for j in 0..3 {
             let d = dot(c[i], c[j]) - if i == j { 1.0 } else { 0.0 };
             if d.abs() > 1e-9 {
-                bail!("--imu-dcm-pb is not orthonormal within 1e-9 (rows {i}, {j}: {d:e})");
+                return Err(flexdyn_tools::usage(format!(
+                    "--imu-dcm-pb is not orthonormal within 1e-9 (rows {i}, {j}: {d:e})"
+                )));
             }
         }
     }
@@ -308,12 +312,21 @@ fn parse_dcm(v: &[f64]) -> anyhow::Result<[[f64; 3]; 3]> {
     Ok(c)
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> std::process::ExitCode {
+    let args = match flexdyn_tools::parse_args::<Args>() {
+        Ok(a) => a,
+        Err(code) => return code,
+    };
     flexdyn_tools::init_tracing();
-    let args = Args::parse();
+    flexdyn_tools::exit_with(run(args))
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
     let topics = args.common.topics()?;
     if args.sigma_rn.len() != 3 {
-        bail!("--sigma-rn takes three comma-separated numbers, e.g. 0.1,0.2,-0.1");
+        return Err(flexdyn_tools::usage(
+            "--sigma-rn takes three comma-separated numbers, e.g. 0.1,0.2,-0.1",
+        ));
     }
     let controller = Controller {
         k_nm: args.k_nm,
@@ -323,14 +336,18 @@ fn main() -> anyhow::Result<()> {
     if !(controller.k_nm.is_finite() && controller.p_nms.is_finite())
         || controller.sigma_rn.iter().any(|x| !x.is_finite())
     {
-        bail!("gains and target must be finite");
+        return Err(flexdyn_tools::usage("gains and target must be finite"));
     }
     let dcm_pb = parse_dcm(&args.imu_dcm_pb)?;
     if args.rate_source == RateSource::Gyro && args.imu.is_none() {
-        bail!("--rate-source gyro needs --imu NAME (the [[imus]] name in the server config)");
+        return Err(flexdyn_tools::usage(
+            "--rate-source gyro needs --imu NAME (the [[imus]] name in the server config)",
+        ));
     }
     if !(args.imu_timeout_s.is_finite() && args.imu_timeout_s > 0.0) {
-        bail!("--imu-timeout-s must be a positive number of seconds");
+        return Err(flexdyn_tools::usage(
+            "--imu-timeout-s must be a positive number of seconds",
+        ));
     }
     let imu_timeout = Duration::from_secs_f64(args.imu_timeout_s);
 

@@ -132,11 +132,18 @@ fn line(w: &mut Window, interval: Duration) -> String {
     out
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> std::process::ExitCode {
+    let args = match flexdyn_tools::parse_args::<Args>() {
+        Ok(a) => a,
+        Err(code) => return code,
+    };
     flexdyn_tools::init_tracing();
-    let args = Args::parse();
+    flexdyn_tools::exit_with(run(args))
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
     if !(args.interval_s.is_finite() && args.interval_s > 0.0) {
-        anyhow::bail!("--interval-s must be > 0");
+        return Err(flexdyn_tools::usage("--interval-s must be > 0"));
     }
     let topics = args.common.topics()?;
     let session = args.common.open_session()?;

@@ -54,9 +54,16 @@ enum RoleCmd {
     },
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> std::process::ExitCode {
+    let args = match flexdyn_tools::parse_args::<Args>() {
+        Ok(a) => a,
+        Err(code) => return code,
+    };
     flexdyn_tools::init_tracing();
-    let args = Args::parse();
+    flexdyn_tools::exit_with(run(args))
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
     let topics = args.common.topics()?;
     let session = args.common.open_session()?;
     match args.role {
