@@ -1,6 +1,6 @@
 //! Dual-linked hinged rigid panels: the state effector of Allard & Schaub, Sections III.C and V.
 //!
-//! Geometry (ERRATA.md, "Conventions"):
+//! Geometry (README "Physics and conventions"; docs/errata.md):
 //! - [S1 B] = M2(θ1) [H1 B];  [S2 B] = M2(θ2) M2(θ_H2S1) [S1 B]  (θ2 is relative to panel 1);
 //! - the hinge axes coincide: ŝ12 = ŝ22 = ĥ12;
 //! - r_Sc1/B = r_H1/B − d1 ŝ11 (Eq. 6);  r_Sc2/B = r_H1/B − l1 ŝ11 − d2 ŝ21 (Eq. 7).
@@ -433,7 +433,7 @@ impl StateEffector for PanelPair {
         let q1 = r13 * mu1 + q2 + e * a11;
 
         // Eqs. 139, 140, 142, 143 as rank-one updates of the hub sums. [A_i] = T⁻¹ M_θθ with
-        // T = [[1, 1], [0, 1]] (Kane's θ1 row is Eq. 119 + Eq. 120, ERRATA.md) and M_θθ the
+        // T = [[1, 1], [0, 1]] (Kane's θ1 row is Eq. 119 + Eq. 120, docs/errata.md) and M_θθ the
         // symmetric Kane block, so [A_contr] = −(T F)ᵀ M_θθ⁻¹ (T F) and [D_contr] are symmetric
         // and [C_contr] = [B_contr]ᵀ: the same symmetry that erratum E2 restores in the hub's
         // [C] = m_sc[c̃] + [C_contr] = [B]ᵀ. Only their independent entries are computed.

@@ -85,7 +85,11 @@ struct Args {
     /// Exit after this many seconds without a state (default: run until killed).
     #[arg(long, allow_negative_numbers = true)]
     idle_exit_s: Option<f64>,
-    /// Where the rate feedback comes from: `auto`, `gyro` or `truth` (see the module docs).
+    /// Where the rate feedback comes from. `gyro`: the IMU named by --imu, mounted as
+    /// --imu-dcm-pb (error if the server does not publish it). `truth`: the state message's
+    /// ω_BN. `auto`: --imu if given, else the first IMU by name that publishes for the first
+    /// state, else the truth rate (logged). `auto` assumes the mounting --imu-dcm-pb (identity
+    /// by default) for whichever IMU it picks: name the IMU and its mounting for flight-like use.
     #[arg(long, value_enum, default_value_t = RateSource::Auto)]
     rate_source: RateSource,
     /// The IMU whose gyro feeds the rate loop (its `[[imus]] name` in the server config).
