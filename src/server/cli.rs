@@ -22,7 +22,12 @@ pub struct RunArgs {
     pub mode: Option<String>,
     /// Lockstep participants / accepted command senders (sender ids, comma-separated)
     /// [default: 1].
-    #[arg(long, value_name = "ID,...", value_delimiter = ',', num_args = 1.., allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "ID,...",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
     pub participants: Option<Vec<i64>>,
     /// Lockstep: seconds to wait for each participant's answer to a tick [default: 10].
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
