@@ -40,14 +40,16 @@ fn bad_commands_are_counted_and_the_server_keeps_running() {
     let good = CommandMsg::wrench(Header::new(1, tick, 0, 0), 1, [0.0, 0.0, 0.5], [0.0; 3]);
 
     // Malformed: too short, and a valid command with a trailing byte.
-    put(vec![1, 0, 7]);
+    let mut short = flexdyn_proto::PROTOCOL_VERSION.to_le_bytes().to_vec();
+    short.push(7);
+    put(short);
     let mut trailing = encode(&good);
     trailing.push(0);
     put(trailing);
     // Wrong protocol version.
-    let mut v2 = encode(&good);
-    v2[..2].copy_from_slice(&2u16.to_le_bytes());
-    put(v2);
+    let mut other_version = encode(&good);
+    other_version[..2].copy_from_slice(&(flexdyn_proto::PROTOCOL_VERSION + 1).to_le_bytes());
+    put(other_version);
     // NaN torque.
     put(encode(&CommandMsg::wrench(
         Header::new(1, tick, 0, 0),

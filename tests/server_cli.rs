@@ -67,6 +67,28 @@ impl Server {
     fn stderr(&self) -> String {
         self.stderr.lock().unwrap().clone()
     }
+
+    /// Waits (30 s at most) until `obs` has seen the state of `tick`.
+    #[track_caller]
+    fn await_tick(&self, obs: &Observer, tick: u64) {
+        assert!(
+            wait_until(Duration::from_secs(30), || obs
+                .last_tick()
+                .is_some_and(|t| t >= tick)),
+            "no telemetry up to tick {tick}; stderr:\n{}",
+            self.stderr()
+        );
+    }
+
+    /// Sends SIGTERM and returns the exit status (30 s at most).
+    fn terminate(&mut self) -> ExitStatus {
+        let killed = Command::new("kill")
+            .args(["-TERM", &self.child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(killed.success());
+        self.wait(Duration::from_secs(30))
+    }
 }
 
 impl Drop for Server {
@@ -223,24 +245,114 @@ fn sigterm_stops_the_realtime_server_gracefully() {
     let mut server = Server::spawn(&["run", "--listen", &ep]);
     let topics = Topics::new("sc1").unwrap();
     let obs = Observer::start(port, &topics);
-    assert!(
-        wait_until(Duration::from_secs(30), || obs
-            .last_tick()
-            .is_some_and(|t| t >= 10)),
-        "no telemetry; stderr:\n{}",
-        server.stderr()
-    );
-    let killed = Command::new("kill")
-        .args(["-TERM", &server.child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
-    let status = server.wait(Duration::from_secs(30));
+    server.await_tick(&obs, 10);
+    let status = server.terminate();
     let err = server.stderr();
     assert_eq!(status.code(), Some(0), "stderr:\n{err}");
     assert!(
         err.contains("SIGTERM") && err.contains("run stopped"),
         "stderr:\n{err}"
+    );
+    // The last StatusMsg says how the run ended, and its tick is the log's last_tick and the
+    // last state on the wire.
+    assert!(
+        wait_until(Duration::from_secs(5), || obs
+            .last_status()
+            .is_some_and(|s| s.run_state == flexdyn_proto::RunState::Stopped)),
+        "final status: {:?}",
+        obs.last_status()
+    );
+    let last = obs.last_status().unwrap();
+    let logged: u64 = err
+        .split("last_tick=")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no last_tick in the log:\n{err}"));
+    assert_eq!(last.header.tick, logged, "status tick vs log\n{err}");
+    assert_eq!(
+        obs.last_tick(),
+        Some(logged),
+        "last state on the wire vs log"
+    );
+    let published: u64 = err
+        .split("states_published=")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap();
+    assert_eq!(
+        published,
+        logged + 1,
+        "ticks 0..=last_tick were published\n{err}"
+    );
+}
+
+/// Commands dropped for a full queue reach StatusMsg (not only the final log line), and each
+/// rejection reason is logged at warn, naming the sender, once and then rate-limited.
+#[test]
+fn dropped_commands_reach_the_status_and_rejections_are_logged() {
+    let port = 17346;
+    let ep = endpoint(port);
+    let mut server = Server::spawn(&["run", "--listen", &ep, "--command-queue", "1"]);
+    let topics = Topics::new("sc1").unwrap();
+    let obs = Observer::start(port, &topics);
+    server.await_tick(&obs, 5);
+    let session = connecting_session(port);
+    let publisher = session
+        .declare_publisher(topics.cmd_wrench().to_owned())
+        .congestion_control(CongestionControl::Block)
+        .wait()
+        .unwrap();
+    let tick = obs.last_tick().unwrap();
+    // A burst far larger than the queue of 1 drained once per 10 ms frame.
+    for i in 0..2000u64 {
+        let cmd = CommandMsg::wrench(Header::new(1, tick, 0, i), 1, [0.0; 3], [0.0; 3]);
+        publisher.put(encode(&cmd)).wait().unwrap();
+    }
+    // Unknown sender, three times: logged once.
+    for i in 0..3u64 {
+        let cmd = CommandMsg::wrench(Header::new(1, tick, 0, i), 99, [0.0; 3], [0.0; 3]);
+        publisher.put(encode(&cmd)).wait().unwrap();
+    }
+    // Another spacecraft.
+    let cmd = CommandMsg::wrench(Header::new(7, tick, 0, 0), 1, [0.0; 3], [0.0; 3]);
+    publisher.put(encode(&cmd)).wait().unwrap();
+    assert!(
+        wait_until(Duration::from_secs(10), || obs.last_status().is_some_and(
+            |s| s.commands_dropped > 0 && s.rejected.unknown_sender == 3
+        )),
+        "status: {:?}",
+        obs.last_status()
+    );
+    let dropped_in_status = obs.last_status().unwrap().commands_dropped;
+    assert_eq!(server.terminate().code(), Some(0));
+    let err = server.stderr();
+    let final_status = obs.last_status().unwrap();
+    assert!(final_status.commands_dropped >= dropped_in_status);
+    assert!(
+        err.contains(&format!(
+            "commands_dropped={}",
+            final_status.commands_dropped
+        )),
+        "final status {} vs log:\n{err}",
+        final_status.commands_dropped
+    );
+    let warns: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("WARN") && l.contains("rejected a command"))
+        .collect();
+    let unknown: Vec<&&str> = warns
+        .iter()
+        .filter(|l| l.contains("reason=\"unknown_sender\"") || l.contains("reason=unknown_sender"))
+        .collect();
+    assert_eq!(unknown.len(), 1, "unknown_sender logged once:\n{err}");
+    assert!(unknown[0].contains("sender=99"), "{}", unknown[0]);
+    assert!(
+        warns
+            .iter()
+            .any(|l| l.contains("wrong_spacecraft") && l.contains("sender=1")),
+        "wrong_spacecraft logged:\n{err}"
     );
 }
 

@@ -23,7 +23,7 @@ pub const COMMAND_WRENCH_LEN: usize = 86;
 /// Encoded [`CommandMsg`] size with [`CommandKind::NoCommand`] (bytes).
 pub const COMMAND_NO_COMMAND_LEN: usize = 38;
 /// Encoded [`StatusMsg`] size (bytes).
-pub const STATUS_LEN: usize = 155;
+pub const STATUS_LEN: usize = 163;
 /// Largest panel count a [`StateMsg`] may carry; decoders reject more.
 pub const MAX_PANEL_PAIRS: usize = 1024;
 /// Largest buffer any decoder accepts (bytes); also the bincode decode limit.

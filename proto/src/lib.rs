@@ -36,7 +36,7 @@
 //! | [`StateMsg`] | [`STATE_FIXED_LEN`] = 327 + [`PANEL_PAIR_LEN`] = 32 per panel pair (count prefix at offset 319, panels last) |
 //! | [`ImuMsg`] | [`IMU_LEN`] = 127 |
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`) or [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`), tag at offset 34 |
-//! | [`StatusMsg`] | [`STATUS_LEN`] = 155 |
+//! | [`StatusMsg`] | [`STATUS_LEN`] = 163 |
 //!
 //! Decoders accept at most [`MAX_MESSAGE_BYTES`] and [`MAX_PANEL_PAIRS`], reject
 //! trailing bytes, and never panic ([`DecodeError`]).
@@ -92,4 +92,4 @@ pub use messages::{
 };
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
-pub const PROTOCOL_VERSION: u16 = 1;
+pub const PROTOCOL_VERSION: u16 = 2;

@@ -301,6 +301,9 @@ pub enum RunState {
     Finished,
     /// Tag 4: ended on an error.
     Failed,
+    /// Tag 5: ended on a stop request (SIGINT/SIGTERM or the library's shutdown future),
+    /// after the last frame was published. Added in protocol version 2.
+    Stopped,
 }
 
 /// What the server applies when the latest command is stale. Wire: u32 LE tag.
@@ -395,7 +398,7 @@ impl RejectCounters {
     }
 }
 
-/// Server health, topic `flexdyn/<sc-id>/status`. 155 bytes.
+/// Server health, topic `flexdyn/<sc-id>/status`. 163 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct StatusMsg {
     /// Common header; `tick` is the last frame stepped, `seq` counts status messages.
@@ -410,6 +413,9 @@ pub struct StatusMsg {
     pub command: CommandStatus,
     /// Rejected commands by reason.
     pub rejected: RejectCounters,
+    /// Valid commands dropped because the server's command queue was full
+    /// (`server.command_queue`), cumulative since start. Added in protocol version 2.
+    pub commands_dropped: u64,
     /// Wall-clock time of publication (ns since the Unix epoch). **Not
     /// deterministic**: the only wall-clock field in the protocol; ignore it when
     /// comparing runs.

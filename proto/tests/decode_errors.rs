@@ -21,7 +21,7 @@ fn state_with_panels(n: usize) -> StateMsg {
 
 #[test]
 fn unknown_version_is_checked_first() {
-    for version in [0u16, 2, 0xFFFF] {
+    for version in [0u16, 1, 3, 0xFFFF] {
         let mut b = encode(&StatusMsg::default());
         b[..2].copy_from_slice(&version.to_le_bytes());
         assert_eq!(
@@ -167,7 +167,7 @@ fn malformed_enum_tags_and_bools() {
     assert!(matches!(decode_command(&b), Err(DecodeError::Malformed(_))));
 
     let good = encode(&StatusMsg::default());
-    for (offset, value) in [(30usize, 3u8), (34, 5), (95, 2)] {
+    for (offset, value) in [(30usize, 3u8), (34, 6), (95, 2)] {
         let mut b = good.clone();
         b[offset] = value;
         assert!(
@@ -277,7 +277,7 @@ fn encode_into_reuses_the_buffer() {
 fn header_new_sets_version() {
     let h = Header::new(1, 2, 3, 4);
     assert_eq!(h.protocol_version, flexdyn_proto::PROTOCOL_VERSION);
-    assert_eq!(Header::default().protocol_version, 1);
+    assert_eq!(Header::default().protocol_version, 2);
     assert_eq!(StateMsg::default().q_bn, [1.0, 0.0, 0.0, 0.0]);
 }
 

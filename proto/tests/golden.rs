@@ -97,7 +97,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0100", "u16 header.protocol_version = 1"),
+    (0, "0200", "u16 header.protocol_version = 2"),
     (
         2,
         "44332211",
@@ -342,7 +342,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0100", "u16 header.protocol_version = 1"),
+    (0, "0200", "u16 header.protocol_version = 2"),
     (
         2,
         "44332211",
@@ -418,7 +418,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0100", "u16 header.protocol_version = 1"),
+    (0, "0200", "u16 header.protocol_version = 2"),
     (
         2,
         "44332211",
@@ -465,7 +465,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0100", "u16 header.protocol_version = 1"),
+    (0, "0200", "u16 header.protocol_version = 2"),
     (
         2,
         "44332211",
@@ -482,7 +482,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0100", "u16 header.protocol_version = 1"),
+    (0, "0200", "u16 header.protocol_version = 2"),
     (
         2,
         "44332211",
@@ -532,8 +532,9 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
     (123, "0400000000000000", "u64 rejected.wrong_spacecraft = 4"),
     (131, "0500000000000000", "u64 rejected.stale_tick = 5"),
     (139, "0600000000000000", "u64 rejected.unknown_sender = 6"),
+    (147, "0700000000000000", "u64 commands_dropped = 7"),
     (
-        147,
+        155,
         "15cd853dfe9c9717",
         "u64 wall_time_unix_ns = 1700000000123456789 (0x17979CFE3D85CD15)",
     ),
@@ -662,6 +663,7 @@ fn status_golden() {
             stale_tick: 5,
             unknown_sender: 6,
         },
+        commands_dropped: 7,
         wall_time_unix_ns: 1_700_000_000_123_456_789,
     };
     check("StatusMsg", STATUS_GOLDEN, &msg);
@@ -694,6 +696,7 @@ fn enum_tags() {
         (RunState::Stopping, 2),
         (RunState::Finished, 3),
         (RunState::Failed, 4),
+        (RunState::Stopped, 5),
     ] {
         assert_eq!(
             tag_at(&status(Mode::RealTime, r, StalePolicy::Hold), 34),

@@ -115,6 +115,7 @@ fn status() -> impl Strategy<Value = StatusMsg> {
         Just(RunState::Stopping),
         Just(RunState::Finished),
         Just(RunState::Failed),
+        Just(RunState::Stopped),
     ];
     let policy = prop_oneof![Just(StalePolicy::Hold), Just(StalePolicy::Zero)];
     (
@@ -124,35 +125,38 @@ fn status() -> impl Strategy<Value = StatusMsg> {
         (u(), u(), u(), u(), u()),
         (u(), u(), any::<bool>(), policy),
         (u(), u(), u(), u(), u(), u()),
-        u(),
+        (u(), u()),
     )
-        .prop_map(|(header, mode, run_state, t, c, r, wall)| StatusMsg {
-            header,
-            mode,
-            run_state,
-            timing: FrameTiming {
-                lateness_p50_ns: t.0,
-                lateness_p99_ns: t.1,
-                lateness_max_ns: t.2,
-                overrun_count: t.3,
-                frames_skipped: t.4,
+        .prop_map(
+            |(header, mode, run_state, t, c, r, (dropped, wall))| StatusMsg {
+                header,
+                mode,
+                run_state,
+                timing: FrameTiming {
+                    lateness_p50_ns: t.0,
+                    lateness_p99_ns: t.1,
+                    lateness_max_ns: t.2,
+                    overrun_count: t.3,
+                    frames_skipped: t.4,
+                },
+                command: CommandStatus {
+                    last_command_tick: c.0,
+                    command_age_ns: c.1,
+                    command_stale: c.2,
+                    stale_policy: c.3,
+                },
+                rejected: RejectCounters {
+                    malformed: r.0,
+                    bad_version: r.1,
+                    non_finite: r.2,
+                    wrong_spacecraft: r.3,
+                    stale_tick: r.4,
+                    unknown_sender: r.5,
+                },
+                commands_dropped: dropped,
+                wall_time_unix_ns: wall,
             },
-            command: CommandStatus {
-                last_command_tick: c.0,
-                command_age_ns: c.1,
-                command_stale: c.2,
-                stale_policy: c.3,
-            },
-            rejected: RejectCounters {
-                malformed: r.0,
-                bad_version: r.1,
-                non_finite: r.2,
-                wrong_spacecraft: r.3,
-                stale_tick: r.4,
-                unknown_sender: r.5,
-            },
-            wall_time_unix_ns: wall,
-        })
+        )
 }
 
 /// Run every decoder; the only requirement is that none panics.
@@ -199,7 +203,7 @@ proptest! {
     /// Past the version check: random bytes behind a valid version.
     #[test]
     fn arbitrary_bytes_with_valid_version_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..600)) {
-        let mut b = vec![1u8, 0];
+        let mut b = flexdyn_proto::PROTOCOL_VERSION.to_le_bytes().to_vec();
         b.extend_from_slice(&bytes);
         decode_all(&b);
     }
@@ -207,8 +211,8 @@ proptest! {
     /// Random bodies of exactly the right length reach bincode: the result is a
     /// message, Malformed or NonFinite, never a panic or a length error.
     #[test]
-    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 155)) {
-        let mut b = vec![1u8, 0];
+    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 163)) {
+        let mut b = flexdyn_proto::PROTOCOL_VERSION.to_le_bytes().to_vec();
         b.extend_from_slice(&body);
         for r in [
             decode_imu(&b[..flexdyn_proto::IMU_LEN]).map(|_| ()),

@@ -88,10 +88,11 @@ pub enum ServerError {
     /// Lockstep: some participants did not show up (no liveliness token
     /// `flexdyn/<sc>/participant/<id>`, or no subscriber on the state topic) before tick 0.
     #[error(
-        "lockstep participant(s) {} not present after {waited_s} s (server.presence_timeout_s): \
+        "lockstep participant(s) {} not present after {} s (server.presence_timeout_s): \
          start the flight code and check it connects to this server and declares its \
          liveliness token flexdyn/{sc_id}/participant/<id>",
-        list_ids(missing)
+        list_ids(missing),
+        crate::numfmt::Rounded(*waited_s, 3)
     )]
     ParticipantsAbsent {
         /// Sender ids whose token (or state subscriber) was not seen.
@@ -103,8 +104,9 @@ pub enum ServerError {
     },
     /// Lockstep: a participant did not answer a tick in time.
     #[error(
-        "lockstep participant {participant} did not answer tick {tick} within {timeout_s} s \
-         (server.participant_timeout_s); stopping the run"
+        "lockstep participant {participant} did not answer tick {tick} within {} s \
+         (server.participant_timeout_s); stopping the run",
+        crate::numfmt::Rounded(*timeout_s, 4)
     )]
     ParticipantTimeout {
         /// Sender id of the first participant that has not answered.
@@ -130,9 +132,10 @@ pub enum ServerError {
     /// The propagated state (or a quantity derived from it) stopped being finite: the run is
     /// stopped before that frame is published.
     #[error(
-        "the state became non-finite at tick {tick} (t = {t_s} s): {quantity} is NaN or \
+        "the state became non-finite at tick {tick} (t = {} s): {quantity} is NaN or \
          infinite; stopping the run without publishing it (check the configuration's rates, \
-         stiffnesses and wrenches for values the step cannot resolve)"
+         stiffnesses and wrenches for values the step cannot resolve)",
+        crate::numfmt::Num(*t_s)
     )]
     NonFinite {
         /// The tick whose state is not finite.

@@ -31,6 +31,7 @@ pub mod commands;
 pub mod error;
 pub mod pacing;
 pub mod physics;
+mod reject_log;
 pub mod settings;
 pub mod shared;
 pub mod telemetry;
@@ -151,21 +152,54 @@ fn command_callback(
     participants: Vec<u32>,
 ) -> impl Fn(zenoh::sample::Sample) + Send + Sync + 'static {
     let tx = Mutex::new(tx);
+    let log = Mutex::new(reject_log::RejectLog::default());
+    let warn = move |reason: &'static str, sender: Option<u32>, detail: &dyn std::fmt::Display| {
+        log.lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .record(reason, sender, 1, detail);
+    };
     move |sample| {
         let bytes = sample.payload().to_bytes();
         let cmd = match decode_command(&bytes) {
             Ok(cmd) => cmd,
             Err(e) => {
-                tracing::debug!(error = %e, "rejected command");
+                let reason = match e {
+                    flexdyn_proto::DecodeError::UnknownVersion { .. } => "bad_version",
+                    flexdyn_proto::DecodeError::NonFinite { .. } => "non_finite",
+                    _ => "malformed",
+                };
+                // The sender id sits at bytes 30..34 once the header is there.
+                let sender = bytes
+                    .get(30..34)
+                    .and_then(|b| b.try_into().ok())
+                    .map(u32::from_le_bytes)
+                    .filter(|_| reason == "non_finite");
+                warn(reason, sender, &e);
                 shared.reject_decode(&e);
                 return;
             }
         };
         if cmd.header.spacecraft_id != spacecraft_id {
+            warn(
+                "wrong_spacecraft",
+                Some(cmd.sender_id),
+                &format_args!(
+                    "header.spacecraft_id {} is not this server's {spacecraft_id}",
+                    cmd.header.spacecraft_id
+                ),
+            );
             shared.reject_wrong_spacecraft();
             return;
         }
         if participants.binary_search(&cmd.sender_id).is_err() {
+            warn(
+                "unknown_sender",
+                Some(cmd.sender_id),
+                &format_args!(
+                    "sender_id {} is not in server.participants {participants:?}",
+                    cmd.sender_id
+                ),
+            );
             shared.reject_unknown_sender();
             return;
         }
@@ -306,7 +340,7 @@ pub async fn run(
         );
     }
 
-    let shared = Arc::new(Shared::default());
+    let shared = Arc::new(Shared::new(&settings.participants));
     shared.set_run_state(RunState::Starting);
     let (cmd_tx, cmd_rx) = sync_channel(settings.command_queue);
     let n_buffers = settings.telemetry_buffers;
@@ -400,7 +434,7 @@ pub async fn run(
         if !matches!(ready, Ok(true)) {
             // Not starting: end the telemetry thread (it publishes a final status) first.
             shared.set_run_state(if ready.is_ok() {
-                RunState::Stopping
+                RunState::Stopped
             } else {
                 RunState::Failed
             });
@@ -456,6 +490,7 @@ pub async fn run(
         r = &mut phys_done_rx => r,
         () = &mut shutdown => {
             tracing::info!("shutdown requested; stopping at the next frame boundary");
+            shared.set_run_state(RunState::Stopping);
             shared.stop.store(true, std::sync::atomic::Ordering::Relaxed);
             phys_done_rx.await
         }

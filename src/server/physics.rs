@@ -88,7 +88,7 @@ impl PhysicsCtx {
         let result = self.frame_loop();
         self.shared.set_run_state(match &result {
             Ok(r) if r.ending == Ending::Finished => RunState::Finished,
-            Ok(_) => RunState::Stopping,
+            Ok(_) => RunState::Stopped,
             Err(_) => RunState::Failed,
         });
         result
@@ -122,10 +122,10 @@ impl PhysicsCtx {
         }
     }
 
-    fn count(&self, offer: Offer) {
+    fn count(&self, offer: Offer, sender_id: u32) {
         match offer {
             Offer::Accepted => {}
-            Offer::StaleTick => self.shared.reject_stale_tick(),
+            Offer::StaleTick => self.shared.reject_stale_tick_from(sender_id),
             Offer::UnknownSender => self.shared.reject_unknown_sender(),
         }
     }
@@ -133,7 +133,7 @@ impl PhysicsCtx {
     /// Real time / batch: take every command that has arrived.
     fn drain_commands(&self, book: &mut CommandBook, k: u64) {
         while let Ok(cmd) = self.cmd_rx.try_recv() {
-            self.count(book.offer_latest(&cmd, k));
+            self.count(book.offer_latest(&cmd, k), cmd.sender_id);
         }
     }
 
@@ -152,7 +152,7 @@ impl PhysicsCtx {
                 });
             }
             match self.cmd_rx.recv_timeout((give_up - now).min(POLL)) {
-                Ok(cmd) => self.count(book.offer_lockstep(&cmd, k)),
+                Ok(cmd) => self.count(book.offer_lockstep(&cmd, k), cmd.sender_id),
                 Err(RecvTimeoutError::Timeout) => {
                     if self.shared.stop.load(Ordering::Relaxed) {
                         return Ok(Wait::Stopped);
@@ -198,16 +198,21 @@ impl PhysicsCtx {
         // IMU samples close their interval every frame, published or not.
         let mut imu = Vec::with_capacity(self.sim.n_imus());
         let mut held = Held::initial(self.settings.stale_policy);
-        let stopped = |k: u64, t: u64| PhysicsReport {
-            ending: Ending::Stopped,
-            last_tick: k,
-            sim_time_ns: t,
+        // A stop reports the last boundary reached (the tick the last StateMsg and StatusMsg
+        // carry), not a tick that was stepped to but never published.
+        let stopped = |shared: &Shared| {
+            let k = shared.tick.load(Ordering::Relaxed);
+            PhysicsReport {
+                ending: Ending::Stopped,
+                last_tick: k,
+                sim_time_ns: k.saturating_mul(frame_ns),
+            }
         };
 
         let mut k: u64 = 0;
         let mut pending = match self.acquire(realtime) {
             Ok(f) => f,
-            Err(_) => return Ok(stopped(0, 0)),
+            Err(_) => return Ok(stopped(&self.shared)),
         };
         self.sim.imu_samples_into(&mut imu);
         if let Some(mut f) = pending.take() {
@@ -229,11 +234,11 @@ impl PhysicsCtx {
             let lateness_ns = if realtime {
                 match pacer.wait_boundary(k, &self.shared.stop) {
                     Some(l) => l,
-                    None => return Ok(stopped(k, self.sim.t_sim_ns())),
+                    None => return Ok(stopped(&self.shared)),
                 }
             } else {
                 if self.shared.stop.load(Ordering::Relaxed) {
-                    return Ok(stopped(k, self.sim.t_sim_ns()));
+                    return Ok(stopped(&self.shared));
                 }
                 0
             };
@@ -259,7 +264,7 @@ impl PhysicsCtx {
             match mode {
                 Mode::Lockstep => {
                     if let Wait::Stopped = self.await_answers(&mut book, k)? {
-                        return Ok(stopped(k, self.sim.t_sim_ns()));
+                        return Ok(stopped(&self.shared));
                     }
                 }
                 Mode::RealTime | Mode::Batch => self.drain_commands(&mut book, k),
@@ -277,7 +282,7 @@ impl PhysicsCtx {
             // 4. Fill the state of tick k.
             pending = match self.acquire(realtime) {
                 Ok(f) => f,
-                Err(_) => return Ok(stopped(k, self.sim.t_sim_ns())),
+                Err(_) => return Ok(stopped(&self.shared)),
             };
             self.sim.imu_samples_into(&mut imu);
             if let Some(mut f) = pending.take() {

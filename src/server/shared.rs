@@ -100,6 +100,9 @@ pub struct Shared {
     pub frames_skipped: AtomicU64,
     /// Real time: frames whose telemetry was dropped (no free buffer).
     pub telemetry_dropped: AtomicU64,
+    /// `stale_tick` rejections per participant (sender id, count), in ascending id order, so
+    /// the telemetry thread can name the sender in its warning (the physics thread only counts).
+    pub stale_by_participant: Vec<(u32, AtomicU64)>,
 }
 
 fn bump(c: &AtomicU64) {
@@ -107,6 +110,28 @@ fn bump(c: &AtomicU64) {
 }
 
 impl Shared {
+    /// Counters for a run whose participants are `participants` (sorted).
+    pub fn new(participants: &[u32]) -> Self {
+        Self {
+            stale_by_participant: participants
+                .iter()
+                .map(|&id| (id, AtomicU64::new(0)))
+                .collect(),
+            ..Self::default()
+        }
+    }
+
+    /// Count a stale-tick command of participant `sender_id` (allocation-free).
+    pub fn reject_stale_tick_from(&self, sender_id: u32) {
+        bump(&self.stale_tick);
+        if let Ok(i) = self
+            .stale_by_participant
+            .binary_search_by_key(&sender_id, |(id, _)| *id)
+        {
+            bump(&self.stale_by_participant[i].1);
+        }
+    }
+
     /// Count an undecodable command under its reason.
     pub fn reject_decode(&self, e: &DecodeError) {
         match e {
@@ -152,6 +177,7 @@ impl Shared {
             RunState::Stopping => 2,
             RunState::Finished => 3,
             RunState::Failed => 4,
+            RunState::Stopped => 5,
         };
         self.run_state.store(tag, Ordering::Release);
     }
@@ -163,6 +189,7 @@ impl Shared {
             1 => RunState::Running,
             2 => RunState::Stopping,
             3 => RunState::Finished,
+            5 => RunState::Stopped,
             _ => RunState::Failed,
         }
     }

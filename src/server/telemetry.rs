@@ -18,6 +18,7 @@ use zenoh::sample::Sample;
 use zenoh::Wait;
 
 use super::commands::Held;
+use super::reject_log::RejectLog;
 use super::settings::{mode_name, ServerSettings};
 use super::shared::{Frame, Shared};
 
@@ -117,6 +118,7 @@ impl TelemetryCtx {
             ),
             command: p.last_command,
             rejected: self.shared.rejected(),
+            commands_dropped: self.shared.commands_dropped.load(Ordering::Relaxed),
             wall_time_unix_ns: unix_now_ns(),
         };
         p.status_seq += 1;
@@ -124,6 +126,25 @@ impl TelemetryCtx {
         if let Err(e) = self.status_pub.put(buf.as_slice()).wait() {
             p.publish_errors += 1;
             tracing::warn!(error = %e, "cannot publish status");
+        }
+    }
+
+    /// Warns (rate-limited) about stale-tick rejections counted by the physics thread since the
+    /// last call, naming the participant.
+    fn warn_stale_ticks(&self, log: &mut RejectLog, seen: &mut [u64]) {
+        for ((id, count), last) in self.shared.stale_by_participant.iter().zip(seen) {
+            let now = count.load(Ordering::Relaxed);
+            if now > *last {
+                log.record(
+                    "stale_tick",
+                    Some(*id),
+                    now - *last,
+                    &"a command for a tick the server is not taking (lockstep: not the tick \
+                      being waited for, or a second answer; real time: a future tick, or older \
+                      than the sender's held command)",
+                );
+                *last = now;
+            }
         }
     }
 
@@ -175,9 +196,12 @@ impl TelemetryCtx {
         let mut next_summary = Instant::now() + summary_period;
         let mut window_start = Instant::now();
         let mut window_frames = 0u64;
+        let mut rejects = RejectLog::default();
+        let mut stale_seen = vec![0u64; self.shared.stale_by_participant.len()];
         loop {
             let now = Instant::now();
             if now >= next_status {
+                self.warn_stale_ticks(&mut rejects, &mut stale_seen);
                 self.publish_status(&mut p, &mut status_buf);
                 next_status += status_period;
                 if next_status < now {
@@ -234,6 +258,7 @@ impl TelemetryCtx {
                 Err(RecvTimeoutError::Disconnected) => break,
             }
         }
+        self.warn_stale_ticks(&mut rejects, &mut stale_seen);
         self.publish_status(&mut p, &mut status_buf);
         TelemetryReport {
             lateness: p.lateness,

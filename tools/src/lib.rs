@@ -13,6 +13,8 @@
 //! scouting always off.
 
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use flexdyn::server::{zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::Topics;
@@ -114,6 +116,45 @@ pub fn exit_with(result: anyhow::Result<()>) -> ExitCode {
             ExitCode::from(if bad_input { 2 } else { 1 })
         }
     }
+}
+
+/// A flag set on the first SIGINT or SIGTERM, for a tool's loop to check: the tool then
+/// undeclares, closes its session and exits 0. A handler is installed even where the shell
+/// started the tool with SIGINT ignored (a background job of a non-interactive shell).
+pub fn stop_on_signals() -> anyhow::Result<Arc<AtomicBool>> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let set = flag.clone();
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_io()
+        .build()
+        .map_err(|e| anyhow::anyhow!("cannot start the signal listener: {e}"))?;
+    #[cfg(unix)]
+    let (mut int, mut term) = {
+        use tokio::signal::unix::{signal, SignalKind};
+        let _guard = runtime.enter();
+        (
+            signal(SignalKind::interrupt())
+                .map_err(|e| anyhow::anyhow!("cannot handle SIGINT: {e}"))?,
+            signal(SignalKind::terminate())
+                .map_err(|e| anyhow::anyhow!("cannot handle SIGTERM: {e}"))?,
+        )
+    };
+    std::thread::Builder::new()
+        .name("flexdyn-signals".into())
+        .spawn(move || {
+            runtime.block_on(async move {
+                #[cfg(unix)]
+                tokio::select! {
+                    _ = int.recv() => {}
+                    _ = term.recv() => {}
+                }
+                #[cfg(not(unix))]
+                let _ = tokio::signal::ctrl_c().await;
+            });
+            set.store(true, Ordering::Relaxed);
+        })
+        .map_err(|e| anyhow::anyhow!("cannot start the signal listener: {e}"))?;
+    Ok(flag)
 }
 
 /// Percentile `q` (0..=1) of sorted values (nearest rank); `None` if empty.

@@ -65,3 +65,78 @@ fn the_monitor_and_pingpong_reject_bad_options_in_one_line() {
     let (c, e) = run(pingpong, &["fly"]);
     assert_one_error_line(c, &e, "unrecognized subcommand");
 }
+
+/// With nobody to talk to, the tools say so and fail, instead of a false pass.
+#[test]
+fn no_server_is_a_failure_not_a_pass() {
+    let demo = env!("CARGO_BIN_EXE_flexdyn-acs-demo");
+    let (c, e) = run(
+        demo,
+        &["--connect", "tcp/127.0.0.1:17391", "--idle-exit-s", "1"],
+    );
+    assert_eq!(c, Some(1), "{e}");
+    let last = e.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("error: no state received on flexdyn/sc1/tlm/state within 1 s"),
+        "{e}"
+    );
+    let monitor = env!("CARGO_BIN_EXE_flexdyn-monitor");
+    let out = Command::new(monitor)
+        .args(["--connect", "tcp/127.0.0.1:17392", "--duration-s", "1.5"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stdout
+            .lines()
+            .next()
+            .is_some_and(|l| l.starts_with("no data: no StateMsg")),
+        "the monitor must not print zeros that look like data: {stdout}"
+    );
+    assert!(
+        stderr
+            .lines()
+            .last()
+            .unwrap_or_default()
+            .starts_with("error: no data"),
+        "{stderr}"
+    );
+}
+
+/// A non-interactive shell starts background jobs with SIGINT ignored; the demo still stops
+/// on SIGINT (and SIGTERM), closes its session and exits 0.
+#[test]
+fn the_demo_stops_on_sigint_even_when_started_with_it_ignored() {
+    let demo = env!("CARGO_BIN_EXE_flexdyn-acs-demo");
+    for (sig, port) in [("-INT", "17393"), ("-TERM", "17394")] {
+        let mut child = Command::new("sh")
+            .args([
+                "-c",
+                &format!("trap '' INT; exec {demo} --connect tcp/127.0.0.1:{port}"),
+            ])
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(700));
+        assert!(child.try_wait().unwrap().is_none(), "the demo exited early");
+        let ok = Command::new("kill")
+            .args([sig, &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(ok.success());
+        let give_up = std::time::Instant::now() + std::time::Duration::from_secs(10);
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break s;
+            }
+            if std::time::Instant::now() > give_up {
+                let _ = child.kill();
+                panic!("the demo ignored {sig}");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        };
+        assert_eq!(status.code(), Some(0), "{sig}: {status:?}");
+    }
+}

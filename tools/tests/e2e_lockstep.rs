@@ -271,6 +271,18 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
         hash_a,
         "the gyro made no difference to the loop"
     );
+
+    // The default `--rate-source auto` without --imu must not guess an IMU (the rotated
+    // `bracket` is first by name and would be fed back with the wrong mounting): it uses the
+    // truth rate, so it converges and equals the truth-rate run bit for bit.
+    let auto = lockstep_run_with(17317, 10.0, Sabotage::None, imu_config(), &[]);
+    auto.result.expect("auto run");
+    assert_converges(&auto.states);
+    assert_eq!(
+        digest(&auto.states),
+        digest(&t.states),
+        "auto without --imu is not the truth-rate loop"
+    );
 }
 
 #[test]

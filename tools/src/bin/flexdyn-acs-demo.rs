@@ -37,10 +37,12 @@
 //! publishes on `flexdyn/<sc>/tlm/imu/<name>` ([`ImuMsg`], one per frame, stamped with the same
 //! tick as the state and published just before it): ω_B = [PB]ᵀ ω_P, with [PB] the IMU's
 //! mounting (`--imu-dcm-pb`, as in the server's `[[imus]]`). `--rate-source`:
-//! - `gyro`: use the IMU `--imu NAME` (error if the server does not publish it);
-//! - `auto` (default): use `--imu NAME` if given, otherwise the first IMU (by name) that
-//!   publishes for the first state received; if the server publishes no IMU at all, say so in the
-//!   log and use the state message's truth rate;
+//! - `gyro`: use the IMU `--imu NAME` (an error if it never publishes; a later missed sample
+//!   holds the previous rate, and is counted and logged);
+//! - `auto` (default): `gyro` if `--imu NAME` is given, otherwise the state message's truth
+//!   rate (said in the log). It never guesses an IMU: the mounting [PB] of an IMU it picked by
+//!   itself would be unknown, and a wrong mounting rotates the rate feedback (on a rotated IMU
+//!   that spins the craft up instead of damping it);
 //! - `truth`: the state message's ω_BN.
 //!
 //! # Copying this file
@@ -53,6 +55,7 @@ use std::time::Duration;
 
 use anyhow::{bail, Context as _};
 use clap::Parser;
+use flexdyn::numfmt::Rounded;
 use flexdyn_proto::{decode_imu, decode_state, encode_into, CommandMsg, Header, ImuMsg};
 use flexdyn_tools::CommonArgs;
 use zenoh::handlers::{RingChannel, RingChannelHandler};
@@ -82,14 +85,14 @@ struct Args {
     /// Log a progress line every this many seconds of simulation time (0: never).
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     log_every_s: f64,
-    /// Exit after this many seconds without a state (default: run until killed).
+    /// Exit after this many seconds without a state: exit 0 if states were received (the run
+    /// ended), exit 1 if none ever came (no server). Default: run until SIGINT/SIGTERM.
     #[arg(long, allow_negative_numbers = true)]
     idle_exit_s: Option<f64>,
     /// Where the rate feedback comes from. `gyro`: the IMU named by --imu, mounted as
-    /// --imu-dcm-pb (error if the server does not publish it). `truth`: the state message's
-    /// ω_BN. `auto`: --imu if given, else the first IMU by name that publishes for the first
-    /// state, else the truth rate (logged). `auto` assumes the mounting --imu-dcm-pb (identity
-    /// by default) for whichever IMU it picks: name the IMU and its mounting for flight-like use.
+    /// --imu-dcm-pb (an error if it never publishes; a missed sample holds the previous rate).
+    /// `truth`: the state message's ω_BN. `auto`: `gyro` if --imu is given, else `truth`
+    /// (logged); it never guesses an IMU, since its mounting would be unknown.
     #[arg(long, value_enum, default_value_t = RateSource::Auto)]
     rate_source: RateSource,
     /// The IMU whose gyro feeds the rate loop (its `[[imus]] name` in the server config).
@@ -99,7 +102,8 @@ struct Args {
     #[arg(long, value_name = "9 NUMBERS", value_delimiter = ',', allow_hyphen_values = true,
           default_values_t = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])]
     imu_dcm_pb: Vec<f64>,
-    /// Longest wait [s] for the gyro sample of a state's tick before giving up (error).
+    /// Longest wait [s] for the IMU's first sample before giving up (error); later samples are
+    /// waited for at most 50 ms, then the previous rate is held.
     #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
     imu_timeout_s: f64,
 }
@@ -107,7 +111,8 @@ struct Args {
 /// Rate feedback source.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum RateSource {
-    /// The named IMU, else the first IMU found, else (with a log line) the truth rate.
+    /// The IMU named by `--imu` if given, else (with a log line) the truth rate. Never an IMU
+    /// whose mounting was not given.
     Auto,
     /// The IMU named by `--imu`.
     Gyro,
@@ -171,15 +176,23 @@ pub fn mrp_subtract(sigma_bn: [f64; 3], sigma_rn: [f64; 3]) -> [f64; 3] {
 // ---------------------------------------------------------------------------------------------
 // The controller.
 
-/// The gyro rate feedback: pairs each state with the `ImuMsg` of the same tick from one IMU and
-/// rotates its rate to B, ω_B = [PB]ᵀ ω_P.
+/// The gyro rate feedback: pairs each state with the `ImuMsg` of the same tick from the IMU
+/// named by `--imu`, and rotates its rate to B, ω_B = [PB]ᵀ ω_P, with the mounting
+/// `--imu-dcm-pb`. A missed sample holds the previous rate (counted and logged); only an IMU
+/// that never publishes is an error.
 struct GyroFeedback {
-    /// The IMU followed (None until chosen in `auto` mode).
-    name: Option<String>,
+    /// The IMU followed (`--imu`).
+    name: String,
+    /// Its topic, for messages.
+    key: String,
     /// [PB], row-major.
     dcm_pb: [[f64; 3]; 3],
-    /// Latest sample of the followed IMU not yet used (a sample can arrive before its state).
+    /// Latest sample not yet used (a sample can arrive before its state).
     pending: Option<ImuMsg>,
+    /// The last rate used, held over a missed sample.
+    last_rate_b: Option<[f64; 3]>,
+    /// Samples missed so far.
+    missed: u64,
 }
 
 impl GyroFeedback {
@@ -193,9 +206,8 @@ impl GyroFeedback {
         ]
     }
 
-    /// Waits (at most `timeout`) for the followed IMU's sample of `tick`. In `auto` mode with no
-    /// IMU chosen yet, adopts the first IMU (by name) that publishes `tick`. Older samples are
-    /// skipped; `Ok(None)` means no IMU published `tick` within `timeout`.
+    /// Waits (at most `timeout`) for the sample of `tick`. Older samples are skipped; `Ok(None)`
+    /// means it did not arrive in time (or a later tick's came first).
     fn sample_for(
         &mut self,
         tick: u64,
@@ -212,52 +224,67 @@ impl GyroFeedback {
             }
         }
         let deadline = std::time::Instant::now() + timeout;
-        // In auto discovery, all IMUs that publish `tick` are gathered to pick the first by name.
-        let mut found: Vec<(String, ImuMsg)> = Vec::new();
         loop {
             let left = deadline.saturating_duration_since(std::time::Instant::now());
-            let wait = if self.name.is_none() && !found.is_empty() {
-                left.min(Duration::from_millis(50))
-            } else {
-                left
-            };
             let Some(sample) = imus
-                .recv_timeout(wait)
+                .recv_timeout(left)
                 .map_err(|e| anyhow::anyhow!("{e}"))?
             else {
-                break;
+                return Ok(None);
             };
-            let name = sample
-                .key_expr()
-                .as_str()
-                .rsplit('/')
-                .next()
-                .unwrap_or_default()
-                .to_string();
             let Ok(msg) = decode_imu(&sample.payload().to_bytes()) else {
-                tracing::warn!(imu = %name, "ignoring an undecodable IMU sample");
+                tracing::warn!(imu = %self.name, "ignoring an undecodable IMU sample");
                 continue;
             };
-            match &self.name {
-                Some(n) if *n != name => continue,
-                Some(_) if msg.header.tick < tick => continue,
-                Some(_) if msg.header.tick > tick => {
-                    self.pending = Some(msg);
-                    return Ok(None);
-                }
-                Some(_) => return Ok(Some(self.rate_b(msg.omega_p_rad_s))),
-                None if msg.header.tick == tick => found.push((name, msg)),
-                None => continue,
+            if msg.header.tick < tick {
+                continue;
             }
+            if msg.header.tick > tick {
+                self.pending = Some(msg);
+                return Ok(None);
+            }
+            return Ok(Some(self.rate_b(msg.omega_p_rad_s)));
         }
-        found.sort_by(|a, b| a.0.cmp(&b.0));
-        match found.into_iter().next() {
-            Some((name, msg)) => {
-                tracing::info!(imu = %name, "rate feedback from this IMU's gyro");
-                self.name = Some(name);
-                Ok(Some(self.rate_b(msg.omega_p_rad_s)))
+    }
+
+    /// The rate for `tick`: its sample, else the previous rate held (the first miss and every
+    /// 100th are logged), else an error if the IMU never published within `first_timeout`.
+    fn rate_for(
+        &mut self,
+        tick: u64,
+        imus: &RingChannelHandler<Sample>,
+        first_timeout: Duration,
+    ) -> anyhow::Result<[f64; 3]> {
+        // The sample is published just before its state, so once the IMU has been heard a short
+        // wait suffices; the first one may take as long as the server's start.
+        let wait = match self.last_rate_b {
+            None => first_timeout,
+            Some(_) => first_timeout.min(Duration::from_millis(50)),
+        };
+        match (self.sample_for(tick, imus, wait)?, self.last_rate_b) {
+            (Some(w), _) => {
+                self.last_rate_b = Some(w);
+                Ok(w)
             }
-            None => Ok(None),
+            (None, Some(prev)) => {
+                self.missed += 1;
+                if self.missed == 1 || self.missed % 100 == 0 {
+                    tracing::warn!(
+                        imu = %self.key,
+                        tick,
+                        missed = self.missed,
+                        "no gyro sample for this tick; holding the previous rate"
+                    );
+                }
+                Ok(prev)
+            }
+            (None, None) => bail!(
+                "no gyro sample on {} for tick {tick} within {} s: does the server's \
+                 configuration have an [[imus]] entry named `{}`? (or use --rate-source truth)",
+                self.key,
+                Rounded(first_timeout.as_secs_f64(), 3),
+                self.name
+            ),
         }
     }
 }
@@ -368,25 +395,40 @@ fn run(args: Args) -> anyhow::Result<()> {
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.state()))?;
 
-    // 2b. The gyro: one IMU's topic, or all of them while `auto` looks for one.
-    let imu_key = match &args.imu {
-        Some(name) => topics.imu(name)?,
-        None => topics.imu_wildcard(),
+    // 2b. The gyro: the named IMU's topic (`auto` without --imu uses the truth rate).
+    let gyro_imu = match (args.rate_source, &args.imu) {
+        (RateSource::Truth, _) => None,
+        (_, Some(name)) => Some(name.clone()),
+        (RateSource::Auto, None) => {
+            tracing::info!(
+                "--rate-source auto without --imu: rate feedback uses the truth rate from the \
+                 state message (name an IMU and its mounting with --imu and --imu-dcm-pb to \
+                 close the loop on its gyro)"
+            );
+            None
+        }
+        (RateSource::Gyro, None) => unreachable!("checked above"),
     };
-    let (imus, mut gyro) = if args.rate_source == RateSource::Truth {
-        (None, None)
-    } else {
-        let sub = session
-            .declare_subscriber(&imu_key)
-            .with(RingChannel::new(64))
-            .wait()
-            .map_err(|e| anyhow::anyhow!("cannot subscribe to {imu_key}: {e}"))?;
-        let g = GyroFeedback {
-            name: args.imu.clone(),
-            dcm_pb,
-            pending: None,
-        };
-        (Some(sub), Some(g))
+    let (imus, mut gyro) = match gyro_imu {
+        None => (None, None),
+        Some(name) => {
+            let key = topics.imu(&name)?;
+            let sub = session
+                .declare_subscriber(&key)
+                .with(RingChannel::new(64))
+                .wait()
+                .map_err(|e| anyhow::anyhow!("cannot subscribe to {key}: {e}"))?;
+            tracing::info!(imu = %key, "rate feedback from this IMU's gyro");
+            let g = GyroFeedback {
+                name,
+                key: key.to_string(),
+                dcm_pb,
+                pending: None,
+                last_rate_b: None,
+                missed: 0,
+            };
+            (Some(sub), Some(g))
+        }
     };
 
     // 3. The command publisher. Block (never drop) and express (no batching: lowest latency).
@@ -414,20 +456,44 @@ fn run(args: Args) -> anyhow::Result<()> {
         "flexdyn-acs-demo running"
     );
 
-    // 5. The loop: one command per state received.
+    // 5. The loop: one command per state received, until SIGINT/SIGTERM or --idle-exit-s.
+    let stop = flexdyn_tools::stop_on_signals()?;
     let idle = args.idle_exit_s.map(Duration::from_secs_f64);
     let log_every_ns = (args.log_every_s.max(0.0) * 1e9) as u64;
     let mut next_log_ns = 0u64;
     let mut seq = 0u64;
     let mut buf = Vec::with_capacity(128);
+    let mut states_received = 0u64;
+    let mut last_state_at = std::time::Instant::now();
     loop {
-        let sample = match idle {
-            None => Some(states.recv().map_err(|e| anyhow::anyhow!("{e}"))?),
-            Some(d) => states.recv_timeout(d).map_err(|e| anyhow::anyhow!("{e}"))?,
-        };
-        let Some(sample) = sample else {
-            tracing::info!("no state for {:?}; exiting", idle.unwrap_or_default());
-            return Ok(());
+        if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            tracing::info!(states_received, "stop signal: closing the session");
+            break;
+        }
+        if let Some(d) = idle {
+            if last_state_at.elapsed() >= d {
+                if states_received == 0 {
+                    bail!(
+                        "no state received on {} within {} s (--idle-exit-s): no server, or it \
+                         is not reachable at the --connect endpoint",
+                        topics.state(),
+                        Rounded(d.as_secs_f64(), 3)
+                    );
+                }
+                tracing::info!(
+                    states_received,
+                    "no state for {} s; exiting",
+                    Rounded(d.as_secs_f64(), 3)
+                );
+                break;
+            }
+        }
+        // Wake at least every 100 ms to notice a signal or the idle limit.
+        let Some(sample) = states
+            .recv_timeout(Duration::from_millis(100))
+            .map_err(|e| anyhow::anyhow!("{e}"))?
+        else {
+            continue;
         };
         let state = match decode_state(&sample.payload().to_bytes()) {
             Ok(s) => s,
@@ -436,31 +502,13 @@ fn run(args: Args) -> anyhow::Result<()> {
                 continue;
             }
         };
+        states_received += 1;
+        last_state_at = std::time::Instant::now();
 
         // The rate feedback: the gyro sample of this tick (see the module docs), or truth.
         let h = state.header;
         let rate_b = match (&mut gyro, &imus) {
-            (Some(g), Some(sub)) => {
-                let discovering = g.name.is_none();
-                let wait = if discovering {
-                    imu_timeout.min(Duration::from_secs(1))
-                } else {
-                    imu_timeout
-                };
-                match g.sample_for(h.tick, sub, wait)? {
-                    Some(w) => w,
-                    None if discovering => {
-                        tracing::warn!(topics = %imu_key, "the server publishes no IMU; rate feedback uses the truth rate from the state message");
-                        gyro = None;
-                        state.omega_bn_b_rad_s
-                    }
-                    None => bail!(
-                        "no gyro sample on {imu_key} for tick {} within {:?}: is there an [[imus]] entry with that name in the server config? (or use --rate-source truth)",
-                        h.tick,
-                        imu_timeout
-                    ),
-                }
-            }
+            (Some(g), Some(sub)) => g.rate_for(h.tick, sub, imu_timeout)?,
             _ => state.omega_bn_b_rad_s,
         };
 
@@ -491,6 +539,16 @@ fn run(args: Args) -> anyhow::Result<()> {
             next_log_ns = h.sim_time_ns.saturating_add(log_every_ns);
         }
     }
+    // Undeclare the token first (a lockstep server sees us leave), then close the session.
+    drop(_token);
+    drop(commands);
+    drop(imus);
+    drop(states);
+    session
+        .close()
+        .wait()
+        .map_err(|e| anyhow::anyhow!("closing the Zenoh session: {e}"))?;
+    Ok(())
 }
 
 #[cfg(test)]

@@ -2,13 +2,20 @@
 //! server status, for operators.
 //!
 //! ```text
-//! t=12.340s tick=1234 states/s=100.0 gaps=0 |sigma_bn|=0.1234 |omega|=0.0456rad/s flags=- latency_ms p50=0.120 p99=0.410 | realtime running lateness_us p50=3.1 p99=21.0 max=118.2 overruns=0 skipped=0 cmd_age_ms=10.0 stale=no rejected=0
+//! t=12.340s tick=1234 states/s=100.0 gaps=0 |sigma_bn|=0.1234 |omega|=0.0456rad/s flags=- latency_ms p50=0.120 p99=0.410 | realtime running lateness_us p50=3.1 p99=21.0 max=118.2 overruns=0 skipped=0 cmd_age_ms=10.0 stale=no rejected=0 dropped=0
 //! ```
+//!
+//! Before any state arrives it prints `no data: no StateMsg on … yet`, and once states stop it
+//! prefixes `no data for N s; last:` and shows the server's final run state (`stopped`,
+//! `finished`, `failed`), or `running (no status for N s: server gone?)` if the server died.
 //!
 //! - `gaps`: StateMsg sequence numbers missing in the interval (lost or dropped frames);
 //! - `latency_ms`: frame boundary (the sample's attachment) to receipt here, wall clock;
-//! - `flags`: `S` stale command, `Z` zeroed by policy, `N` no command yet.
+//! - `flags`: `S` stale command, `Z` zeroed by policy, `N` no command yet;
+//! - `rejected`: the server's rejected commands by reason (`stale_tick:2,unknown_sender:1`), and
+//!   `dropped` the valid commands it dropped for a full queue.
 
+use std::io::Write as _;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
@@ -27,7 +34,8 @@ struct Args {
     /// Seconds between summary lines.
     #[arg(long, default_value_t = 1.0)]
     interval_s: f64,
-    /// Exit after this many seconds (default: run until killed).
+    /// Exit after this many seconds: exit 0 if anything was received, exit 1 ("no data") if
+    /// nothing was (default: run until SIGINT/SIGTERM).
     #[arg(long)]
     duration_s: Option<f64>,
 }
@@ -45,6 +53,31 @@ struct Window {
     latencies_ns: Vec<u64>,
     undecodable: u64,
     status: Option<StatusMsg>,
+    /// When the last StateMsg arrived (None: never).
+    last_state_at: Option<Instant>,
+    /// When the last StatusMsg arrived (None: never).
+    last_status_at: Option<Instant>,
+}
+
+/// The rejection counters by reason, only the non-zero ones (`0` if none).
+fn rejected_by_reason(r: &flexdyn_proto::RejectCounters) -> String {
+    let parts: Vec<String> = [
+        ("malformed", r.malformed),
+        ("bad_version", r.bad_version),
+        ("non_finite", r.non_finite),
+        ("wrong_spacecraft", r.wrong_spacecraft),
+        ("stale_tick", r.stale_tick),
+        ("unknown_sender", r.unknown_sender),
+    ]
+    .iter()
+    .filter(|(_, n)| *n > 0)
+    .map(|(k, n)| format!("{k}:{n}"))
+    .collect();
+    if parts.is_empty() {
+        "0".into()
+    } else {
+        parts.join(",")
+    }
 }
 
 fn unix_now_ns() -> u64 {
@@ -81,25 +114,41 @@ fn run_state_name(s: RunState) -> &'static str {
         RunState::Stopping => "stopping",
         RunState::Finished => "finished",
         RunState::Failed => "failed",
+        RunState::Stopped => "stopped",
     }
 }
 
-fn line(w: &mut Window, interval: Duration) -> String {
+fn line(w: &mut Window, interval: Duration, state_topic: &str) -> String {
     let mut lat = std::mem::take(&mut w.latencies_ns);
     lat.sort_unstable();
     let ms = |v: Option<u64>| v.map_or("-".to_owned(), |ns| format!("{:.3}", ns as f64 * 1e-6));
-    let mut out = format!(
-        "t={:.3}s tick={} states/s={:.1} gaps={} |sigma_bn|={:.4} |omega|={:.4}rad/s flags={} latency_ms p50={} p99={}",
-        w.sim_time_ns as f64 / 1e9,
-        w.tick,
-        w.states as f64 / interval.as_secs_f64(),
-        w.gaps,
-        w.sigma_norm,
-        w.omega_norm,
-        flags_str(w.flags),
-        ms(percentile(&lat, 0.5)),
-        ms(percentile(&lat, 0.99)),
-    );
+    let mut out = match w.last_state_at {
+        // Never a state: say so, instead of zeros that look like data.
+        None => format!(
+            "no data: no StateMsg on {state_topic} yet (is the server running and reachable \
+             at --connect?)"
+        ),
+        Some(at) => {
+            let age = at.elapsed();
+            let mut o = String::new();
+            if age > interval {
+                o.push_str(&format!("no data for {:.1} s; last: ", age.as_secs_f64()));
+            }
+            o.push_str(&format!(
+                "t={:.3}s tick={} states/s={:.1} gaps={} |sigma_bn|={:.4} |omega|={:.4}rad/s flags={} latency_ms p50={} p99={}",
+                w.sim_time_ns as f64 / 1e9,
+                w.tick,
+                w.states as f64 / interval.as_secs_f64(),
+                w.gaps,
+                w.sigma_norm,
+                w.omega_norm,
+                flags_str(w.flags),
+                ms(percentile(&lat, 0.5)),
+                ms(percentile(&lat, 0.99)),
+            ));
+            o
+        }
+    };
     if w.undecodable > 0 {
         out.push_str(&format!(" undecodable={}", w.undecodable));
     }
@@ -107,10 +156,23 @@ fn line(w: &mut Window, interval: Duration) -> String {
         None => out.push_str(" | no status yet"),
         Some(s) => {
             let us = |ns: u64| ns as f64 * 1e-3;
+            let status_age = w.last_status_at.map_or(Duration::ZERO, |t| t.elapsed());
+            // A status that stopped coming while it said "running" means the server is gone.
+            let state = if status_age > interval.max(Duration::from_millis(500))
+                && matches!(s.run_state, RunState::Running | RunState::Starting)
+            {
+                format!(
+                    "{} (no status for {:.1} s: server gone?)",
+                    run_state_name(s.run_state),
+                    status_age.as_secs_f64()
+                )
+            } else {
+                run_state_name(s.run_state).to_owned()
+            };
             out.push_str(&format!(
-                " | {} {} lateness_us p50={:.1} p99={:.1} max={:.1} overruns={} skipped={} cmd_age_ms={} stale={} rejected={}",
+                " | {} {} lateness_us p50={:.1} p99={:.1} max={:.1} overruns={} skipped={} cmd_age_ms={} stale={} rejected={} dropped={}",
                 mode_name(s.mode),
-                run_state_name(s.run_state),
+                state,
                 us(s.timing.lateness_p50_ns),
                 us(s.timing.lateness_p99_ns),
                 us(s.timing.lateness_max_ns),
@@ -122,7 +184,8 @@ fn line(w: &mut Window, interval: Duration) -> String {
                     format!("{:.1}", s.command.command_age_ns as f64 * 1e-6)
                 },
                 if s.command.command_stale { "yes" } else { "no" },
-                s.rejected.total(),
+                rejected_by_reason(&s.rejected),
+                s.commands_dropped,
             ));
         }
     }
@@ -167,6 +230,7 @@ fn run(args: Args) -> anyhow::Result<()> {
                     w.sigma_norm = norm(s.sigma_bn);
                     w.omega_norm = norm(s.omega_bn_b_rad_s);
                     w.flags = s.command_flags;
+                    w.last_state_at = Some(Instant::now());
                     if let Some(stamp) = frame_stamp_ns(&sample) {
                         w.latencies_ns.push(received.saturating_sub(stamp));
                     }
@@ -181,35 +245,67 @@ fn run(args: Args) -> anyhow::Result<()> {
         .declare_subscriber(topics.status())
         .callback(move |sample| {
             if let Ok(s) = decode_status(&sample.payload().to_bytes()) {
-                w.lock().unwrap_or_else(|p| p.into_inner()).status = Some(s);
+                let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
+                w.status = Some(s);
+                w.last_status_at = Some(Instant::now());
             }
         })
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.status()))?;
 
-    eprintln!(
-        "flexdyn-monitor: watching {} and {} (Ctrl-C to stop)",
-        topics.state(),
-        topics.status()
+    tracing::info!(
+        state = topics.state(),
+        status = topics.status(),
+        "flexdyn-monitor watching (Ctrl-C to stop)"
     );
+    let stop = flexdyn_tools::stop_on_signals()?;
     let interval = Duration::from_secs_f64(args.interval_s);
     let end = args
         .duration_s
         .map(|s| Instant::now() + Duration::from_secs_f64(s.max(0.0)));
     let mut next = Instant::now() + interval;
     loop {
-        let now = Instant::now();
-        if let Some(end) = end {
-            if now >= end {
-                return Ok(());
-            }
+        if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            break;
         }
-        std::thread::sleep(next.saturating_duration_since(now));
+        let now = Instant::now();
+        if end.is_some_and(|end| now >= end) {
+            let w = window.lock().unwrap_or_else(|p| p.into_inner());
+            if w.last_state_at.is_none() && w.status.is_none() {
+                anyhow::bail!(
+                    "no data: nothing received on {} or {} during --duration-s: no server, or it \
+                     is not reachable at the --connect endpoint",
+                    topics.state(),
+                    topics.status()
+                );
+            }
+            break;
+        }
+        // Sleep in short slices so a signal is noticed promptly.
+        std::thread::sleep(
+            next.saturating_duration_since(now)
+                .min(Duration::from_millis(100)),
+        );
+        if Instant::now() < next {
+            continue;
+        }
         next += interval;
         let text = line(
             &mut window.lock().unwrap_or_else(|p| p.into_inner()),
             interval,
+            topics.state(),
         );
-        println!("{text}");
+        let mut out = std::io::stdout().lock();
+        if writeln!(out, "{text}").and_then(|()| out.flush()).is_err() {
+            // The reader went away (a closed pipe): stop quietly.
+            break;
+        }
     }
+    drop(_states);
+    drop(_status);
+    session
+        .close()
+        .wait()
+        .map_err(|e| anyhow::anyhow!("closing the Zenoh session: {e}"))?;
+    Ok(())
 }

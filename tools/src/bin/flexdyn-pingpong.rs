@@ -74,7 +74,11 @@ fn run(args: Args) -> anyhow::Result<()> {
         } => {
             let end =
                 duration_s.map(|s| std::time::Instant::now() + Duration::from_secs_f64(s.max(0.0)));
-            let stop = || end.is_some_and(|e| std::time::Instant::now() >= e);
+            let signalled = flexdyn_tools::stop_on_signals()?;
+            let stop = || {
+                signalled.load(std::sync::atomic::Ordering::Relaxed)
+                    || end.is_some_and(|e| std::time::Instant::now() >= e)
+            };
             if recv_loop {
                 pingpong::pong(&session, &topics, reply_size, stop)
             } else {
