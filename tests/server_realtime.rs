@@ -130,9 +130,16 @@ fn realtime_1khz_runs() {
     assert_eq!(report.outcome, Outcome::Finished);
     assert_eq!(report.last_tick, 1000);
     assert!(wait_until(Duration::from_secs(5), || obs.last_tick() == Some(1000)));
+    // Every frame boundary 0..=1000 was reached: each state went out or was counted dropped.
+    assert_eq!(
+        report.states_published + report.telemetry_dropped,
+        1001,
+        "{report}"
+    );
     let n = obs.seen.lock().unwrap().states.len();
-    // The observer may connect a little after the start; count loosely.
-    assert!(n >= 500, "{n} states at 1 kHz for 1 s");
+    // The observer connects some time after the start (later still on a loaded CI machine,
+    // where 499 of 1001 were seen once); count loosely.
+    assert!(n >= 300, "{n} states at 1 kHz for 1 s");
     eprintln!("1 kHz: {report}");
 }
 

@@ -140,3 +140,23 @@ fn the_demo_stops_on_sigint_even_when_started_with_it_ignored() {
         assert_eq!(status.code(), Some(0), "{sig}: {status:?}");
     }
 }
+
+/// Zenoh's "Scouting delay elapsed before start conditions are met" warning is filtered at the
+/// default level (it reports nothing actionable with multicast scouting off); naming its module
+/// in RUST_LOG brings it back, which shows the check can fail.
+#[test]
+fn the_scouting_delay_warning_is_quiet_by_default() {
+    let monitor = env!("CARGO_BIN_EXE_flexdyn-monitor");
+    let stderr_with = |rust_log: &str| {
+        let out = Command::new(monitor)
+            .args(["--connect", "tcp/127.0.0.1:17395", "--duration-s", "1"])
+            .env("RUST_LOG", rust_log)
+            .output()
+            .unwrap();
+        String::from_utf8_lossy(&out.stderr).to_string()
+    };
+    let quiet = stderr_with("info");
+    assert!(!quiet.contains("Scouting delay"), "{quiet}");
+    let loud = stderr_with("info,zenoh::net::runtime::orchestrator=warn");
+    assert!(loud.contains("Scouting delay"), "{loud}");
+}
