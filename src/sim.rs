@@ -15,7 +15,7 @@ use nalgebra::{Vector3, Vector4};
 
 use crate::attitude::{mrp_to_dcm, mrp_to_quat};
 use crate::config::{ConfigError, SimConfig};
-use crate::dynamics::{Conserved, Spacecraft, WrenchSegment};
+use crate::dynamics::{Conserved, Spacecraft, Wrench, WrenchSegment};
 use crate::imu::{attitude_increment_b, Imu, ImuSample, ImuTruth};
 
 /// A spacecraft being propagated, with its external wrench sources.
@@ -27,8 +27,8 @@ pub struct Simulation {
     /// Number of schedule rows whose start time is ≤ the last time the wrench was applied;
     /// the active row is `cursor - 1` (none if 0).
     cursor: usize,
-    command_force_b_n: Vector3<f64>,
-    command_torque_b_nm: Vector3<f64>,
+    /// The commanded wrench, added to the schedule's.
+    command: Wrench,
     /// The IMUs in config order; IMU `i` is the spacecraft's sensor point `i`.
     imus: Vec<Imu>,
     imu_names: Vec<String>,
@@ -158,8 +158,7 @@ impl Simulation {
             frame_ns: cfg.frame_ns,
             schedule: cfg.wrench_schedule.clone(),
             cursor: 0,
-            command_force_b_n: Vector3::zeros(),
-            command_torque_b_nm: Vector3::zeros(),
+            command: Wrench::ZERO,
             imu_names: cfg.imus.iter().map(|c| c.name.clone()).collect(),
             imus,
             imu_interval_start_ns: 0,
@@ -205,16 +204,15 @@ impl Simulation {
         self.sc.effectors().len()
     }
 
-    /// Commanded wrench (from the ACS controller), added to the scheduled disturbance wrench.
-    /// Force \[N\] at B and torque \[N·m\], B components; held until the next call.
-    pub fn set_command_wrench(&mut self, force_b_n: Vector3<f64>, torque_b_nm: Vector3<f64>) {
-        self.command_force_b_n = force_b_n;
-        self.command_torque_b_nm = torque_b_nm;
+    /// Commanded wrench (from the ACS controller), added to the scheduled disturbance wrench;
+    /// held until the next call.
+    pub fn set_command_wrench(&mut self, w: Wrench) {
+        self.command = w;
     }
 
-    /// The commanded (force \[N\], torque \[N·m\]), B components.
-    pub fn command_wrench(&self) -> (Vector3<f64>, Vector3<f64>) {
-        (self.command_force_b_n, self.command_torque_b_nm)
+    /// The commanded wrench.
+    pub fn command_wrench(&self) -> Wrench {
+        self.command
     }
 
     /// Sets the spacecraft's wrench to schedule(t) + command for the current time t.
@@ -224,12 +222,11 @@ impl Simulation {
         while self.cursor < self.schedule.len() && self.schedule[self.cursor].t_start_ns <= t {
             self.cursor += 1;
         }
-        let (mut force, mut torque) = (self.command_force_b_n, self.command_torque_b_nm);
+        let mut w = self.command;
         if let Some(seg) = self.cursor.checked_sub(1).map(|i| &self.schedule[i]) {
-            force += seg.force_b_n;
-            torque += seg.torque_b_nm;
+            w = w + seg.wrench();
         }
-        self.sc.set_wrench(force, torque);
+        self.sc.set_wrench(w);
     }
 
     /// One RK4 step: total wrench = schedule(t at step start) + command, then
@@ -287,9 +284,9 @@ impl Simulation {
             out.panels.push(p);
         }
         out.conserved = self.sc.conserved();
-        let (force, torque) = self.sc.wrench();
-        out.force_b_n = force;
-        out.torque_b_nm = torque;
+        let w = self.sc.wrench();
+        out.force_b_n = w.force_b_n;
+        out.torque_b_nm = w.torque_b_nm;
     }
 
     /// The IMU names in config order (topic `flexdyn/<sc-id>/tlm/imu/<name>`).
@@ -380,7 +377,10 @@ mod tests {
         );
         let cfg = SimConfig::from_toml_str(&text).unwrap();
         let mut sim = Simulation::new(&cfg).unwrap();
-        sim.set_command_wrench(Vector3::new(0.0, 3.0, 0.0), Vector3::zeros());
+        sim.set_command_wrench(Wrench {
+            force_b_n: Vector3::new(0.0, 3.0, 0.0),
+            torque_b_nm: Vector3::zeros(),
+        });
         let s = sim.snapshot();
         assert_eq!(s.force_b_n, Vector3::new(0.0, 3.0, 0.0));
         sim.step_n(2);

@@ -145,7 +145,10 @@ fn validate_external_torque_changes_momentum_at_the_applied_rate() {
     // zero), so H_C(T) − H_C(0) = ∫ [NB] L dt. Integrated alongside with the trapezoid rule.
     let mut sc = reference(GravityModel::None, 0.0);
     let torque_b = nalgebra::Vector3::new(0.3, -0.2, 0.1);
-    sc.set_wrench(nalgebra::Vector3::zeros(), torque_b);
+    sc.set_wrench(flexdyn::dynamics::Wrench {
+        force_b_n: nalgebra::Vector3::zeros(),
+        torque_b_nm: torque_b,
+    });
     let h0 = sc.conserved().rot_ang_mom_c_n;
     let dcm_nb = |sc: &flexdyn::dynamics::Spacecraft| {
         flexdyn::attitude::mrp_to_dcm(&sc.state().sigma_bn).transpose()

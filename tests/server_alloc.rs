@@ -7,6 +7,8 @@
 
 use std::sync::mpsc::sync_channel;
 
+use flexdyn::dynamics::Wrench;
+
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
 use flexdyn::config::SimConfig;
 use flexdyn::server::commands::CommandBook;
@@ -48,10 +50,10 @@ fn the_frame_path_does_not_allocate() {
         }
         assert!(book.all_answered());
         let held = book.held(k);
-        sim.set_command_wrench(
-            Vector3::from(held.force_b_n),
-            Vector3::from(held.torque_b_nm),
-        );
+        sim.set_command_wrench(Wrench {
+            force_b_n: Vector3::from(held.force_b_n),
+            torque_b_nm: Vector3::from(held.torque_b_nm),
+        });
         sim.step_frame();
         sim.imu_samples_into(&mut imu);
         let mut f = free_rx.try_recv().unwrap();

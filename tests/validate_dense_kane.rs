@@ -646,7 +646,10 @@ fn build_library(cfg: &Config) -> Spacecraft {
     };
     let mut sc = Spacecraft::new(cfg.hub.clone(), gravity, effectors, initial, 1_000_000)
         .expect("valid random spacecraft");
-    sc.set_wrench(cfg.force_b, cfg.torque_b);
+    sc.set_wrench(flexdyn::dynamics::Wrench {
+        force_b_n: cfg.force_b,
+        torque_b_nm: cfg.torque_b,
+    });
     sc
 }
 

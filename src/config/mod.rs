@@ -977,7 +977,7 @@ fn check_resolved_by_step(cfg: &SimConfig, map: &SourceMap) -> Result<(), Config
 fn check_initial_outputs_finite(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError> {
     let mut sc = cfg.build_spacecraft()?;
     if let Some(w) = cfg.wrench_schedule.first().filter(|w| w.t_start_ns == 0) {
-        sc.set_wrench(w.force_b_n, w.torque_b_nm);
+        sc.set_wrench(w.wrench());
     }
     let out = sc.hub_outputs();
     let c = sc.conserved();

@@ -36,7 +36,7 @@ pub use effector::{
 };
 pub use panel_pair::PanelPair;
 pub use params::{
-    GravityModel, HubParams, PanelPairInitial, PanelPairParams, PanelParams, SensorPoint,
+    GravityModel, HubParams, PanelPairInitial, PanelPairParams, PanelParams, SensorPoint, Wrench,
     WrenchSegment,
 };
 pub use spacecraft::{

@@ -101,6 +101,35 @@ pub struct SensorPoint {
     pub dcm_pb: Matrix3<f64>,
 }
 
+/// An external wrench on the hub: a force applied at point B and a torque, both in B
+/// components. Built with named fields only, so force and torque cannot be swapped silently
+/// (the wire carries torque first, the old API took force first).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Wrench {
+    /// \[N\] force on the hub, applied at point B, B components.
+    pub force_b_n: Vector3<f64>,
+    /// [N·m] torque on the hub, B components.
+    pub torque_b_nm: Vector3<f64>,
+}
+
+impl Wrench {
+    /// No force and no torque.
+    pub const ZERO: Wrench = Wrench {
+        force_b_n: Vector3::new(0.0, 0.0, 0.0),
+        torque_b_nm: Vector3::new(0.0, 0.0, 0.0),
+    };
+}
+
+impl std::ops::Add for Wrench {
+    type Output = Wrench;
+    fn add(self, rhs: Wrench) -> Wrench {
+        Wrench {
+            force_b_n: self.force_b_n + rhs.force_b_n,
+            torque_b_nm: self.torque_b_nm + rhs.torque_b_nm,
+        }
+    }
+}
+
 /// One row of the piecewise-constant external wrench schedule on the hub.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WrenchSegment {
@@ -110,6 +139,16 @@ pub struct WrenchSegment {
     pub force_b_n: Vector3<f64>,
     /// [N·m] torque on the hub, B components.
     pub torque_b_nm: Vector3<f64>,
+}
+
+impl WrenchSegment {
+    /// The row's wrench.
+    pub fn wrench(&self) -> Wrench {
+        Wrench {
+            force_b_n: self.force_b_n,
+            torque_b_nm: self.torque_b_nm,
+        }
+    }
 }
 
 use super::ParamError;

@@ -12,7 +12,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::effector::{
     BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
-use super::params::{GravityModel, HubParams, SensorPoint};
+use super::params::{GravityModel, HubParams, SensorPoint, Wrench};
 use super::ParamError;
 use crate::attitude::{mrp_rate, mrp_switch, mrp_to_dcm, tilde};
 
@@ -517,16 +517,18 @@ impl Spacecraft {
         &self.eom.gravity
     }
 
-    /// Sets the external force [N] and torque [N·m] on the hub (B components, force applied at B),
-    /// held constant until the next call.
-    pub fn set_wrench(&mut self, force_b_n: Vector3<f64>, torque_b_nm: Vector3<f64>) {
-        self.eom.force_b_n = force_b_n;
-        self.eom.torque_b_nm = torque_b_nm;
+    /// Sets the external wrench on the hub, held constant until the next call.
+    pub fn set_wrench(&mut self, w: Wrench) {
+        self.eom.force_b_n = w.force_b_n;
+        self.eom.torque_b_nm = w.torque_b_nm;
     }
 
-    /// The external (force [N], torque [N·m]) currently applied, B components.
-    pub fn wrench(&self) -> (Vector3<f64>, Vector3<f64>) {
-        (self.eom.force_b_n, self.eom.torque_b_nm)
+    /// The external wrench currently applied.
+    pub fn wrench(&self) -> Wrench {
+        Wrench {
+            force_b_n: self.eom.force_b_n,
+            torque_b_nm: self.eom.torque_b_nm,
+        }
     }
 
     /// Evaluates the state derivative `dx` at state `x` with the current wrench, and returns the

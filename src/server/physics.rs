@@ -27,6 +27,7 @@ use super::error::ServerError;
 use super::pacing::{FrameEnd, Pacer};
 use super::settings::ServerSettings;
 use super::shared::{fill_state, Frame, Shared};
+use crate::dynamics::Wrench;
 use crate::imu::ImuSample;
 use crate::sim::{Simulation, Snapshot};
 
@@ -270,10 +271,10 @@ impl PhysicsCtx {
                 Mode::RealTime | Mode::Batch => self.drain_commands(&mut book, k),
             }
             held = book.held(k);
-            self.sim.set_command_wrench(
-                Vector3::from(held.force_b_n),
-                Vector3::from(held.torque_b_nm),
-            );
+            self.sim.set_command_wrench(Wrench {
+                force_b_n: Vector3::from(held.force_b_n),
+                torque_b_nm: Vector3::from(held.torque_b_nm),
+            });
 
             // 3. Integrate the frame.
             self.sim.step_frame();
