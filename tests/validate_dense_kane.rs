@@ -1,9 +1,9 @@
 //! Independent cross-check of the back-substitution dynamics against a dense Kane formulation.
 //!
 //! The library (`flexdyn::dynamics`) solves the hub + dual-hinged-panel equations by the
-//! back-substitution of Section V of Allard & Schaub (draft, `../shared/reference/
-//! 000_981bdc22e0818a6f.txt`). This file re-derives the same dynamics from first principles with
-//! Kane's method (Section IV of the paper, corrected by `../shared/reference/ERRATA.md`), builds the
+//! back-substitution of Section V of Allard & Schaub (citation in `docs/errata.md`). This file
+//! re-derives the same dynamics from first principles with Kane's method (Section IV of the
+//! paper, corrected as `docs/errata.md` lists), builds the
 //! *full* system mass matrix and forcing vector, and solves them with a dense LU. Nothing here is
 //! taken from the library's dynamics code: the only library items used are the parameter types and
 //! the public `Spacecraft::derivatives` entry point being checked. The DCM/MRP helpers are written

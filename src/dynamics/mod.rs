@@ -1,8 +1,8 @@
 //! Rigid hub + dual-hinged panel pairs, by back-substitution.
 //!
 //! The equations are those of Allard & Schaub, "Spacecraft Dynamical Model with Dual-Connected
-//! Hinged Rigid Bodies" (draft; `../shared/reference/000_981bdc22e0818a6f.txt`), Sections III and
-//! V, with the two numerical errata of `docs/errata.md` applied:
+//! Hinged Rigid Bodies" (citation in `docs/errata.md`), Sections III and V, with the two
+//! numerical errata of `docs/errata.md` applied:
 //! - **E1** (Eqs. 80/81/120/123b): the ω̇ coefficient of the panel-2 row is
 //!   `I_s22 ŝ22ᵀ − m2 d2 ŝ23ᵀ[r̃_Sc2/B]` — see [`panel_pair`];
 //! - **E2** (Eq. 148): `[C] = m_sc[c̃] + [C_contr]` — see [`spacecraft`].
