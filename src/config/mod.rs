@@ -746,8 +746,10 @@ impl RawConfig {
         check_body_extent(&cfg, map)?;
         check_imu_magnitudes(&cfg, map)?;
         check_resolved_by_step(&cfg, map)?;
-        check_gravity_bound(&cfg, map)?;
-        check_initial_outputs_finite(&cfg, map)?;
+        // Both remaining checks look at the built spacecraft's initial state: build it once.
+        let mut sc = cfg.build_spacecraft()?;
+        check_gravity_bound(&cfg, &sc, map)?;
+        check_initial_outputs_finite(&cfg, &mut sc, map)?;
         Ok(cfg)
     }
 }
@@ -930,9 +932,9 @@ fn check_resolved_by_step(cfg: &SimConfig, map: &SourceMap) -> Result<(), Config
         cfg.initial.omega_bn_b_rad_s.norm(),
     )?;
     for (i, (p, init)) in cfg.panel_pairs.iter().enumerate() {
-        for (which, panel, theta_dot) in [
-            ("panel1", &p.panel1, init.theta1_dot_rad_s),
-            ("panel2", &p.panel2, init.theta2_dot_rad_s),
+        for (which, panel, theta, theta_dot) in [
+            ("panel1", &p.panel1, init.theta1_rad, init.theta1_dot_rad_s),
+            ("panel2", &p.panel2, init.theta2_rad, init.theta2_dot_rad_s),
         ] {
             let path = format!("panel_pairs[{i}].{which}");
             let i_hinge = panel.inertia_s_kg_m2.y + panel.mass_kg * panel.d_m * panel.d_m;
@@ -951,11 +953,6 @@ fn check_resolved_by_step(cfg: &SimConfig, map: &SourceMap) -> Result<(), Config
                 "theta_dot",
                 theta_dot.abs(),
             )?;
-            let theta = if which == "panel1" {
-                init.theta1_rad
-            } else {
-                init.theta2_rad
-            };
             if theta.abs() > std::f64::consts::PI {
                 return Err(map.invalid(
                     &format!("{path}.theta_rad"),
@@ -974,8 +971,11 @@ fn check_resolved_by_step(cfg: &SimConfig, map: &SourceMap) -> Result<(), Config
 
 /// Rejects a configuration whose initial outputs overflow (an energy, a momentum or an
 /// acceleration that is not finite although every input is): nothing could be published.
-fn check_initial_outputs_finite(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError> {
-    let mut sc = cfg.build_spacecraft()?;
+fn check_initial_outputs_finite(
+    cfg: &SimConfig,
+    sc: &mut Spacecraft,
+    map: &SourceMap,
+) -> Result<(), ConfigError> {
     if let Some(w) = cfg.wrench_schedule.first().filter(|w| w.t_start_ns == 0) {
         sc.set_wrench(w.wrench());
     }
@@ -1017,7 +1017,11 @@ pub const MIN_STEPS_PER_DYNAMICAL_TIME: f64 = 100.0;
 /// system CoM must be where the field is finite and resolved by the step
 /// (√(r³/μ) ≥ [`MIN_STEPS_PER_DYNAMICAL_TIME`] steps); under `j2` it must also be outside the
 /// equatorial radius, where the zonal expansion no longer describes the field.
-fn check_gravity_bound(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError> {
+fn check_gravity_bound(
+    cfg: &SimConfig,
+    sc: &Spacecraft,
+    map: &SourceMap,
+) -> Result<(), ConfigError> {
     let (mu_m3_s2, r_eq_m) = match cfg.gravity {
         GravityModel::None => return Ok(()),
         GravityModel::PointMass { mu_m3_s2 } => (mu_m3_s2, None),
@@ -1029,7 +1033,6 @@ fn check_gravity_bound(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigErr
         InitialTranslation::CenterOfMass { .. } => "initial.r_cn_n_m",
         InitialTranslation::PointB { .. } => "initial.r_bn_n_m",
     };
-    let sc = cfg.build_spacecraft()?;
     let (_, r_cb_b_m, _) = sc.center_of_mass();
     let x = sc.state();
     let dcm_nb = crate::attitude::mrp_to_dcm(&x.sigma_bn).transpose();
