@@ -1,4 +1,5 @@
-//! Logging setup shared by `flexdyn` and the tools, and an error line that never panics.
+//! Logging setup shared by `flexdyn` and the tools, an error line that never panics, and the
+//! command-line parsing that gives every binary the same usage-error rule.
 //!
 //! - Logs go to stderr at `RUST_LOG` (default `info`).
 //! - Colour only when stderr is a terminal: a file or a pipe gets plain text.
@@ -71,4 +72,25 @@ pub fn usage_line(clap_message: &str) -> String {
         .unwrap_or("invalid command line");
     let first = first.strip_prefix("error: ").unwrap_or(first).trim();
     format!("{first} (see --help)")
+}
+
+/// Parses a binary's command line with the rule every flexdyn binary follows: a usage error is
+/// one `error:` line ([`usage_line`]) with exit code 2; `--help` and `--version` print and
+/// exit 0. `Err` carries the exit code to return.
+pub fn parse_args<A: clap::Parser>() -> Result<A, std::process::ExitCode> {
+    match A::try_parse() {
+        Ok(a) => Ok(a),
+        Err(e) => match e.kind() {
+            clap::error::ErrorKind::DisplayHelp
+            | clap::error::ErrorKind::DisplayVersion
+            | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                let _ = e.print();
+                Err(std::process::ExitCode::SUCCESS)
+            }
+            _ => {
+                print_error(usage_line(&e.to_string()));
+                Err(std::process::ExitCode::from(2))
+            }
+        },
+    }
 }

@@ -70,28 +70,8 @@ fn run_server(args: &RunArgs) -> ExitCode {
     }
 }
 
-/// Parses the command line. A usage error is one `error:` line (clap's first line, plus the
-/// hint to run `--help`) with exit code 2; `--help` and `--version` print and exit 0.
-fn parse_args() -> Result<Cli, ExitCode> {
-    match Cli::try_parse() {
-        Ok(cli) => Ok(cli),
-        Err(e) => match e.kind() {
-            clap::error::ErrorKind::DisplayHelp
-            | clap::error::ErrorKind::DisplayVersion
-            | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
-                let _ = e.print();
-                Err(ExitCode::SUCCESS)
-            }
-            _ => {
-                print_error(flexdyn::logging::usage_line(&e.to_string()));
-                Err(ExitCode::from(2))
-            }
-        },
-    }
-}
-
 fn main() -> ExitCode {
-    let args = match parse_args() {
+    let args = match flexdyn::logging::parse_args::<Cli>() {
         Ok(a) => a,
         Err(code) => return code,
     };

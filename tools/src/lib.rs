@@ -81,25 +81,9 @@ pub fn usage(message: impl Into<String>) -> anyhow::Error {
     UsageError(message.into()).into()
 }
 
-/// Parses a tool's command line with the rules of `flexdyn`: a usage error is one `error:`
-/// line with exit code 2; `--help` and `--version` print and exit 0.
-pub fn parse_args<A: clap::Parser>() -> Result<A, ExitCode> {
-    match A::try_parse() {
-        Ok(a) => Ok(a),
-        Err(e) => match e.kind() {
-            clap::error::ErrorKind::DisplayHelp
-            | clap::error::ErrorKind::DisplayVersion
-            | clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
-                let _ = e.print();
-                Err(ExitCode::SUCCESS)
-            }
-            _ => {
-                flexdyn::logging::print_error(flexdyn::logging::usage_line(&e.to_string()));
-                Err(ExitCode::from(2))
-            }
-        },
-    }
-}
+/// Parses a tool's command line with the rules of `flexdyn` (see
+/// [`flexdyn::logging::parse_args`]).
+pub use flexdyn::logging::parse_args;
 
 /// The exit code and one `error:` line for a tool's result: 0 on success; 2 for a
 /// [`UsageError`] or an invalid Zenoh configuration; 1 for a failure while running. The error's
