@@ -22,9 +22,19 @@ struct Server {
 
 impl Server {
     fn spawn(args: &[&str]) -> Self {
+        Self::start(args, "info", false)
+    }
+
+    /// Like [`Self::spawn`], but the stderr reader closes its end of the pipe after the first
+    /// chunk, as a killed `tee` would; later log lines go into a closed pipe.
+    fn spawn_closing_stderr(args: &[&str], rust_log: &str) -> Self {
+        Self::start(args, rust_log, true)
+    }
+
+    fn start(args: &[&str], rust_log: &str, close_after_first_read: bool) -> Self {
         let mut child = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
             .args(args)
-            .env("RUST_LOG", "info")
+            .env("RUST_LOG", rust_log)
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(Stdio::piped())
@@ -42,6 +52,9 @@ impl Server {
                 sink.lock()
                     .unwrap()
                     .push_str(&String::from_utf8_lossy(&buf[..n]));
+                if close_after_first_read {
+                    break; // drops `pipe`: the read end closes
+                }
             }
         });
         Self { child, stderr }
@@ -408,45 +421,23 @@ fn help_lists_the_run_subcommand() {
 fn a_closed_stderr_reader_never_takes_the_server_down() {
     let port = 17345;
     let ep = endpoint(port);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
-        // Log every frame's bookkeeping so that writes into the closed pipe happen for sure.
-        .args(["--listen", &ep, "--summary-interval-s", "0.05"])
-        .env("RUST_LOG", "debug")
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn flexdyn");
-    // Read a little, then close the read end (drop), as a killed `tee` would.
-    let mut pipe = child.stderr.take().unwrap();
-    let mut buf = [0u8; 256];
-    let n = pipe.read(&mut buf).unwrap();
-    assert!(n > 0, "the server logs at start");
-    drop(pipe);
+    // Log at debug so that writes into the closed pipe happen for sure.
+    let mut server =
+        Server::spawn_closing_stderr(&["--listen", &ep, "--summary-interval-s", "0.05"], "debug");
     let topics = Topics::new("sc1").unwrap();
     let obs = Observer::start(port, &topics);
+    server.await_tick(&obs, 30);
     assert!(
-        wait_until(Duration::from_secs(30), || obs
-            .last_tick()
-            .is_some_and(|t| t >= 30)),
-        "no telemetry after the stderr reader closed"
+        !server.stderr().is_empty(),
+        "the server logs at start, before the reader closes"
     );
     // Still alive after logging into the closed pipe for a while.
     std::thread::sleep(Duration::from_millis(300));
-    assert!(child.try_wait().unwrap().is_none(), "the server died");
-    let killed = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(killed.success());
-    let give_up = Instant::now() + Duration::from_secs(30);
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        assert!(Instant::now() < give_up, "no exit after SIGTERM");
-        std::thread::sleep(Duration::from_millis(10));
-    };
+    assert!(
+        server.child.try_wait().unwrap().is_none(),
+        "the server died"
+    );
+    let status = server.terminate();
     assert_eq!(status.code(), Some(0), "exit status {status:?}");
     // The final status went out: the last one seen is no longer `Running`.
     let last = obs.last_status().expect("status messages");
