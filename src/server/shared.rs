@@ -146,11 +146,6 @@ impl Shared {
         bump(&self.wrong_spacecraft);
     }
 
-    /// Count a command with an unacceptable tick.
-    pub fn reject_stale_tick(&self) {
-        bump(&self.stale_tick);
-    }
-
     /// Count a command from an unknown sender.
     pub fn reject_unknown_sender(&self) {
         bump(&self.unknown_sender);
