@@ -49,7 +49,7 @@ pub struct Snapshot {
     pub q_bn: Vector4<f64>,
     /// [rad/s] ω_B/N, B components.
     pub omega_bn_b: Vector3<f64>,
-    /// [rad/s²] ω̇_B/N, B components, with the wrench of [`Self::force_b_n`]/[`Self::torque_b_nm`].
+    /// [rad/s²] ω̇_B/N, B components, with the wrench of [`Self::force_b_newton`]/[`Self::torque_b_nm`].
     pub omega_dot_bn_b: Vector3<f64>,
     /// \[m\] r_B/N, N components.
     pub r_bn_n: Vector3<f64>,
@@ -63,7 +63,7 @@ pub struct Snapshot {
     pub conserved: Conserved,
     /// \[N\] total external force on the hub (schedule + command), B components, applied from
     /// this instant.
-    pub force_b_n: Vector3<f64>,
+    pub force_b_newton: Vector3<f64>,
     /// [N·m] total external torque on the hub (schedule + command), B components.
     pub torque_b_nm: Vector3<f64>,
 }
@@ -89,7 +89,7 @@ impl Snapshot {
                 orb_ang_mom_n: z,
                 rot_ang_mom_c_n: z,
             },
-            force_b_n: z,
+            force_b_newton: z,
             torque_b_nm: z,
         }
     }
@@ -285,7 +285,7 @@ impl Simulation {
         }
         out.conserved = self.sc.conserved();
         let w = self.sc.wrench();
-        out.force_b_n = w.force_b_n;
+        out.force_b_newton = w.force_b_newton;
         out.torque_b_nm = w.torque_b_nm;
     }
 
@@ -371,26 +371,26 @@ mod tests {
     #[test]
     fn schedule_plus_command() {
         let text = format!(
-            "{}\n[[wrench_schedule]]\nt_s = 0.002\nforce_b_n = [1.0, 0.0, 0.0]\ntorque_b_nm = [0.0, 0.0, 2.0]\n\n\
-             [[wrench_schedule]]\nt_s = 0.004\nforce_b_n = [0.0, 0.0, 0.0]\ntorque_b_nm = [0.0, 0.0, 0.0]\n",
+            "{}\n[[wrench_schedule]]\nt_s = 0.002\nforce_b_newton = [1.0, 0.0, 0.0]\ntorque_b_nm = [0.0, 0.0, 2.0]\n\n\
+             [[wrench_schedule]]\nt_s = 0.004\nforce_b_newton = [0.0, 0.0, 0.0]\ntorque_b_nm = [0.0, 0.0, 0.0]\n",
             crate::config::DEFAULT_CONFIG_TOML
         );
         let cfg = SimConfig::from_toml_str(&text).unwrap();
         let mut sim = Simulation::new(&cfg).unwrap();
         sim.set_command_wrench(Wrench {
-            force_b_n: Vector3::new(0.0, 3.0, 0.0),
+            force_b_newton: Vector3::new(0.0, 3.0, 0.0),
             torque_b_nm: Vector3::zeros(),
         });
         let s = sim.snapshot();
-        assert_eq!(s.force_b_n, Vector3::new(0.0, 3.0, 0.0));
+        assert_eq!(s.force_b_newton, Vector3::new(0.0, 3.0, 0.0));
         sim.step_n(2);
         let s = sim.snapshot();
         assert_eq!(s.t_sim_ns, 2_000_000);
-        assert_eq!(s.force_b_n, Vector3::new(1.0, 3.0, 0.0));
+        assert_eq!(s.force_b_newton, Vector3::new(1.0, 3.0, 0.0));
         assert_eq!(s.torque_b_nm, Vector3::new(0.0, 0.0, 2.0));
         sim.step_n(2);
         let s = sim.snapshot();
-        assert_eq!(s.force_b_n, Vector3::new(0.0, 3.0, 0.0));
+        assert_eq!(s.force_b_newton, Vector3::new(0.0, 3.0, 0.0));
         assert_eq!(s.panels.len(), 2);
     }
 

@@ -29,7 +29,7 @@ fn linearised_modes(p: &PanelPairParams) -> [(f64, [f64; 2]); 2] {
     let (m1, m2) = (p.panel1.mass_kg, p.panel2.mass_kg);
     let (d1, d2, l1) = (p.panel1.d_m, p.panel2.d_m, p.l1_m);
     let (i1, i2) = (p.panel1.inertia_s_kg_m2.y, p.panel2.inertia_s_kg_m2.y);
-    let (k1, k2) = (p.panel1.k_n_m_rad, p.panel2.k_n_m_rad);
+    let (k1, k2) = (p.panel1.k_nm_rad, p.panel2.k_nm_rad);
     let cphi = p.theta_h2s1_rad.cos();
     let m11 = i1 + m1 * d1 * d1 + i2 + m2 * (l1 * l1 + d2 * d2 + 2.0 * l1 * d2 * cphi);
     let m12 = i2 + m2 * (d2 * d2 + l1 * d2 * cphi);
@@ -122,11 +122,11 @@ fn validate_fixed_hub_frequencies_folded_unequal_pair() {
     p.theta_h2s1_rad = 0.7;
     p.l1_m = 2.0;
     p.panel1.d_m = 1.1;
-    p.panel1.k_n_m_rad = 300.0;
+    p.panel1.k_nm_rad = 300.0;
     p.panel2.mass_kg = 20.0;
     p.panel2.inertia_s_kg_m2 = Vector3::new(12.0, 7.0, 6.0);
     p.panel2.d_m = 0.4;
-    p.panel2.k_n_m_rad = 40.0;
+    p.panel2.k_nm_rad = 40.0;
     let a = 0.4f64;
     p.dcm_h1b = Matrix3::new(a.cos(), 0.0, -a.sin(), 0.0, 1.0, 0.0, a.sin(), 0.0, a.cos())
         * Matrix3::new(0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 1.0);

@@ -320,7 +320,7 @@ fn simulate_with_a_bad_config_fails_cleanly() {
     let path = scratch("bad-sim.toml");
     std::fs::write(
         &path,
-        DEFAULT_CONFIG_TOML.replacen("k_n_m_rad = 100.0", "k_n_m_rad = -100.0", 1),
+        DEFAULT_CONFIG_TOML.replacen("k_nm_rad = 100.0", "k_nm_rad = -100.0", 1),
     )
     .unwrap();
     let out = flexdyn(&[
@@ -333,7 +333,7 @@ fn simulate_with_a_bad_config_fails_cleanly() {
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("panel_pairs[0].panel1.k_n_m_rad") && err.contains(">= 0"),
+        err.contains("panel_pairs[0].panel1.k_nm_rad") && err.contains(">= 0"),
         "{err}"
     );
     assert!(out.stdout.is_empty());
@@ -419,7 +419,7 @@ fn check_config_validates_the_server_table_as_run_does() {
 fn blow_up_config() -> PathBuf {
     let path = scratch("blow_up.toml");
     let text = format!(
-        "{DEFAULT_CONFIG_TOML}\n[[wrench_schedule]]\nt_s = 0.5\nforce_b_n = [0.0, 0.0, 0.0]\n\
+        "{DEFAULT_CONFIG_TOML}\n[[wrench_schedule]]\nt_s = 0.5\nforce_b_newton = [0.0, 0.0, 0.0]\n\
          torque_b_nm = [0.0, 0.0, 1e300]\n"
     );
     std::fs::write(&path, text).unwrap();

@@ -71,7 +71,7 @@ fn mat_value(m: [[f64; 3]; 3]) -> Value {
 fn wrench_row(t_s: f64, force: [f64; 3], torque: [f64; 3]) -> Value {
     let mut row = Table::new();
     row.insert("t_s".into(), Value::Float(t_s));
-    row.insert("force_b_n".into(), vec_value(&force));
+    row.insert("force_b_newton".into(), vec_value(&force));
     row.insert("torque_b_nm".into(), vec_value(&torque));
     Value::Table(row)
 }
@@ -144,8 +144,8 @@ fn reference_parses_to_the_documented_values() {
             assert_eq!(panel.mass_kg, 50.0);
             assert_eq!(panel.inertia_s_kg_m2, Vector3::new(50.0, 25.0, 25.0));
             assert_eq!(panel.d_m, 0.75);
-            assert_eq!(panel.k_n_m_rad, 100.0);
-            assert_eq!(panel.c_n_m_s_rad, 0.0);
+            assert_eq!(panel.k_nm_rad, 100.0);
+            assert_eq!(panel.c_nm_s_rad, 0.0);
         }
         assert_eq!(init.theta1_rad, theta[0]);
         assert_eq!(init.theta2_rad, theta[1]);
@@ -201,7 +201,7 @@ fn shipped_scenarios_have_their_advertised_features() {
     assert!(damped
         .panel_pairs
         .iter()
-        .all(|(p, _)| p.panel1.c_n_m_s_rad > 0.0 && p.panel2.c_n_m_s_rad > 0.0));
+        .all(|(p, _)| p.panel1.c_nm_s_rad > 0.0 && p.panel2.c_nm_s_rad > 0.0));
     assert!(load("folded_wing")
         .panel_pairs
         .iter()
@@ -309,7 +309,7 @@ fn optional_keys_are_mapped() {
     assert_eq!(cfg.wrench_schedule.len(), 2);
     assert_eq!(cfg.wrench_schedule[0].t_start_ns, 0);
     assert_eq!(
-        cfg.wrench_schedule[0].force_b_n,
+        cfg.wrench_schedule[0].force_b_newton,
         Vector3::new(1.0, 2.0, 3.0)
     );
     assert_eq!(
@@ -424,9 +424,9 @@ fn missing_key_in_a_table() {
 #[test]
 fn missing_key_in_a_panel() {
     let e = error_after(|t| {
-        panel(t, 1, "panel1").remove("k_n_m_rad");
+        panel(t, 1, "panel1").remove("k_nm_rad");
     });
-    assert_names(&e, "panel_pairs[1].panel1.k_n_m_rad", &["missing"]);
+    assert_names(&e, "panel_pairs[1].panel1.k_nm_rad", &["missing"]);
     let e = error_after(|t| {
         panel(t, 0, "panel1").remove("l_m");
     });
@@ -597,11 +597,11 @@ fn d_exceeds_panel_length() {
 #[test]
 fn negative_stiffness() {
     let e = error_after(|t| {
-        panel(t, 0, "panel2").insert("k_n_m_rad".into(), Value::Float(-1.0));
+        panel(t, 0, "panel2").insert("k_nm_rad".into(), Value::Float(-1.0));
     });
     assert_names(
         &e,
-        "panel_pairs[0].panel2.k_n_m_rad",
+        "panel_pairs[0].panel2.k_nm_rad",
         &["must be >= 0", "-1"],
     );
 }
@@ -609,11 +609,11 @@ fn negative_stiffness() {
 #[test]
 fn negative_damping() {
     let e = error_after(|t| {
-        panel(t, 1, "panel1").insert("c_n_m_s_rad".into(), Value::Float(-0.5));
+        panel(t, 1, "panel1").insert("c_nm_s_rad".into(), Value::Float(-0.5));
     });
     assert_names(
         &e,
-        "panel_pairs[1].panel1.c_n_m_s_rad",
+        "panel_pairs[1].panel1.c_nm_s_rad",
         &["must be >= 0", "-0.5"],
     );
 }
@@ -762,7 +762,7 @@ fn nan_or_inf_anywhere() {
                 Value::Array(vec![wrench_row(v, [0.0; 3], [0.0; 3])]),
             );
         }),
-        ("wrench_schedule[1].force_b_n[0]", |t, v| {
+        ("wrench_schedule[1].force_b_newton[0]", |t, v| {
             t.insert(
                 "wrench_schedule".into(),
                 Value::Array(vec![
@@ -1209,22 +1209,22 @@ fn rates_the_step_cannot_resolve_are_rejected() {
     let i_hinge = 25.0 + 50.0 * 0.75 * 0.75;
     for (k, ok) in [(0.99e6 * i_hinge, true), (1.01e6 * i_hinge, false)] {
         let mut t = reference_table();
-        panel(&mut t, 0, "panel1").insert("k_n_m_rad".into(), Value::Float(k));
+        panel(&mut t, 0, "panel1").insert("k_nm_rad".into(), Value::Float(k));
         let res = SimConfig::from_toml_str(&toml::to_string(&t).unwrap());
         match res {
             Ok(_) => assert!(ok, "k = {k} accepted"),
             Err(e) => {
                 assert!(!ok, "k = {k} rejected: {e}");
-                assert_names(&e, "panel_pairs[0].panel1.k_n_m_rad", &["too fast", "step"]);
+                assert_names(&e, "panel_pairs[0].panel1.k_nm_rad", &["too fast", "step"]);
             }
         }
     }
     let e = error_after(|t| {
-        panel(t, 1, "panel2").insert("c_n_m_s_rad".into(), Value::Float(2e3 * i_hinge));
+        panel(t, 1, "panel2").insert("c_nm_s_rad".into(), Value::Float(2e3 * i_hinge));
     });
     assert_names(
         &e,
-        "panel_pairs[1].panel2.c_n_m_s_rad",
+        "panel_pairs[1].panel2.c_nm_s_rad",
         &["damping rate", "too fast"],
     );
     let e = error_after(|t| {

@@ -146,7 +146,7 @@ fn validate_external_torque_changes_momentum_at_the_applied_rate() {
     let mut sc = reference(GravityModel::None, 0.0);
     let torque_b = nalgebra::Vector3::new(0.3, -0.2, 0.1);
     sc.set_wrench(flexdyn::dynamics::Wrench {
-        force_b_n: nalgebra::Vector3::zeros(),
+        force_b_newton: nalgebra::Vector3::zeros(),
         torque_b_nm: torque_b,
     });
     let h0 = sc.conserved().rot_ang_mom_c_n;

@@ -52,8 +52,8 @@ fn panel_value(p: &Panel, l: Option<f64>, theta: f64) -> Value {
     if let Some(l) = l {
         t.insert("l_m".into(), Value::Float(l));
     }
-    t.insert("k_n_m_rad".into(), Value::Float(p.k));
-    t.insert("c_n_m_s_rad".into(), Value::Float(0.0));
+    t.insert("k_nm_rad".into(), Value::Float(p.k));
+    t.insert("c_nm_s_rad".into(), Value::Float(0.0));
     t.insert("theta_rad".into(), Value::Float(theta));
     t.insert("theta_dot_rad_s".into(), Value::Float(0.0));
     Value::Table(t)

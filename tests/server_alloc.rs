@@ -51,7 +51,7 @@ fn the_frame_path_does_not_allocate() {
         assert!(book.all_answered());
         let held = book.held(k);
         sim.set_command_wrench(Wrench {
-            force_b_n: Vector3::from(held.force_b_n),
+            force_b_newton: Vector3::from(held.force_b_newton),
             torque_b_nm: Vector3::from(held.torque_b_nm),
         });
         sim.step_frame();

@@ -244,12 +244,12 @@ fn random_panel(rng: &mut Rng, size_m: f64, ranges: Ranges) -> PanelParams {
         mass_kg,
         inertia_s_kg_m2: rng.principal_moments(mass_kg * size_m * size_m),
         d_m: 0.0, // set by the caller
-        k_n_m_rad: if rng.unit() < 0.15 {
+        k_nm_rad: if rng.unit() < 0.15 {
             0.0
         } else {
             rng.log_range(0.1, 1000.0)
         },
-        c_n_m_s_rad: if rng.unit() < 0.15 {
+        c_nm_s_rad: if rng.unit() < 0.15 {
             0.0
         } else {
             rng.log_range(0.01, 100.0)
@@ -499,8 +499,8 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
         .map(|(i, p)| {
             let e = &x.eff[4 * i..4 * i + 4];
             (
-                -p.panel1.k_n_m_rad * e[0] - p.panel1.c_n_m_s_rad * e[1] + p.motor_torque_nm[0],
-                -p.panel2.k_n_m_rad * e[2] - p.panel2.c_n_m_s_rad * e[3] + p.motor_torque_nm[1],
+                -p.panel1.k_nm_rad * e[0] - p.panel1.c_nm_s_rad * e[1] + p.motor_torque_nm[0],
+                -p.panel2.k_nm_rad * e[2] - p.panel2.c_nm_s_rad * e[3] + p.motor_torque_nm[1],
             )
         })
         .collect();
@@ -647,7 +647,7 @@ fn build_library(cfg: &Config) -> Spacecraft {
     let mut sc = Spacecraft::new(cfg.hub.clone(), gravity, effectors, initial, 1_000_000)
         .expect("valid random spacecraft");
     sc.set_wrench(flexdyn::dynamics::Wrench {
-        force_b_n: cfg.force_b,
+        force_b_newton: cfg.force_b,
         torque_b_nm: cfg.torque_b,
     });
     sc

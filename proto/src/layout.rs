@@ -124,9 +124,9 @@ const TORQUE_FIELDS: [&str; 3] = [
     "kind.torque_b_nm[2]",
 ];
 const FORCE_FIELDS: [&str; 3] = [
-    "kind.force_b_n[0]",
-    "kind.force_b_n[1]",
-    "kind.force_b_n[2]",
+    "kind.force_b_newton[0]",
+    "kind.force_b_newton[1]",
+    "kind.force_b_newton[2]",
 ];
 
 impl WireMessage for CommandMsg {
@@ -145,13 +145,13 @@ impl WireMessage for CommandMsg {
     fn validate(&self) -> Result<(), DecodeError> {
         if let CommandKind::Wrench {
             torque_b_nm,
-            force_b_n,
+            force_b_newton,
         } = &self.kind
         {
             let fields = TORQUE_FIELDS
                 .iter()
                 .zip(torque_b_nm)
-                .chain(FORCE_FIELDS.iter().zip(force_b_n));
+                .chain(FORCE_FIELDS.iter().zip(force_b_newton));
             for (field, v) in fields {
                 if !v.is_finite() {
                     return Err(DecodeError::NonFinite { field });

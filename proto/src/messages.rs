@@ -96,7 +96,7 @@ pub struct AppliedWrench {
     /// Torque about B, B components (N·m).
     pub torque_b_nm: [f64; 3],
     /// Force at B, B components (N).
-    pub force_b_n: [f64; 3],
+    pub force_b_newton: [f64; 3],
 }
 
 /// Bits of [`StateMsg::command_flags`].
@@ -216,7 +216,7 @@ pub enum CommandKind {
         /// Torque about B, B components (N·m).
         torque_b_nm: [f64; 3],
         /// Force at B, B components (N).
-        force_b_n: [f64; 3],
+        force_b_newton: [f64; 3],
     },
     /// Tag 1: explicit "no command this tick" (a lockstep participant's way to
     /// release the step without changing the wrench). Nothing follows the tag.
@@ -253,14 +253,14 @@ impl CommandMsg {
         header: Header,
         sender_id: u32,
         torque_b_nm: [f64; 3],
-        force_b_n: [f64; 3],
+        force_b_newton: [f64; 3],
     ) -> Self {
         Self {
             header,
             sender_id,
             kind: CommandKind::Wrench {
                 torque_b_nm,
-                force_b_n,
+                force_b_newton,
             },
         }
     }

@@ -199,7 +199,7 @@ fn non_finite_commands() {
         ),
         (
             wrench([0.0; 3], [0.0, f64::NEG_INFINITY, 0.0]),
-            "kind.force_b_n[1]",
+            "kind.force_b_newton[1]",
         ),
         (
             wrench([0.0, f64::NAN, 0.0], [f64::NAN; 3]),

@@ -282,17 +282,17 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     (
         294,
         "000000000000f03f",
-        "f64 wrench_applied.force_b_n[0] = 1.0 (bits 0x3FF0000000000000)",
+        "f64 wrench_applied.force_b_newton[0] = 1.0 (bits 0x3FF0000000000000)",
     ),
     (
         302,
         "00000000000000c0",
-        "f64 wrench_applied.force_b_n[1] = -2.0 (bits 0xC000000000000000)",
+        "f64 wrench_applied.force_b_newton[1] = -2.0 (bits 0xC000000000000000)",
     ),
     (
         310,
         "0000000000000840",
-        "f64 wrench_applied.force_b_n[2] = 3.0 (bits 0x4008000000000000)",
+        "f64 wrench_applied.force_b_newton[2] = 3.0 (bits 0x4008000000000000)",
     ),
     (318, "05", "u8 command_flags = 5 (STALE | NO_COMMAND_YET)"),
     (
@@ -451,17 +451,17 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     (
         62,
         "000000000000f0bf",
-        "f64 kind.force_b_n[0] = -1.0 (bits 0xBFF0000000000000)",
+        "f64 kind.force_b_newton[0] = -1.0 (bits 0xBFF0000000000000)",
     ),
     (
         70,
         "0000000000000000",
-        "f64 kind.force_b_n[1] = 0.0 (bits 0x0000000000000000)",
+        "f64 kind.force_b_newton[1] = 0.0 (bits 0x0000000000000000)",
     ),
     (
         78,
         "000000000000e03f",
-        "f64 kind.force_b_n[2] = 0.5 (bits 0x3FE0000000000000)",
+        "f64 kind.force_b_newton[2] = 0.5 (bits 0x3FE0000000000000)",
     ),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
@@ -560,7 +560,7 @@ fn state_msg() -> StateMsg {
         },
         wrench_applied: AppliedWrench {
             torque_b_nm: [0.0625, -0.125, 0.25],
-            force_b_n: [1.0, -2.0, 3.0],
+            force_b_newton: [1.0, -2.0, 3.0],
         },
         command_flags: command_flags::STALE | command_flags::NO_COMMAND_YET,
         panels: vec![

@@ -63,7 +63,7 @@ fn state_with(floats: impl Strategy<Value = f64> + Clone) -> impl Strategy<Value
                 conserved,
                 wrench_applied: AppliedWrench {
                     torque_b_nm: tq,
-                    force_b_n: fo,
+                    force_b_newton: fo,
                 },
                 command_flags: flags,
                 panels,
@@ -91,7 +91,7 @@ fn command() -> impl Strategy<Value = CommandMsg> {
     let kind = prop_oneof![
         (v3(f()), v3(f())).prop_map(|(t, fo)| CommandKind::Wrench {
             torque_b_nm: t,
-            force_b_n: fo
+            force_b_newton: fo
         }),
         Just(CommandKind::NoCommand),
     ];
@@ -296,7 +296,7 @@ proptest! {
         bad in prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(f64::NEG_INFINITY)],
     ) {
         let (mut t, mut f) = match msg.kind {
-            CommandKind::Wrench { torque_b_nm, force_b_n } => (torque_b_nm, force_b_n),
+            CommandKind::Wrench { torque_b_nm, force_b_newton } => (torque_b_nm, force_b_newton),
             CommandKind::NoCommand => ([0.0; 3], [0.0; 3]),
         };
         if slot < 3 { t[slot] = bad } else { f[slot - 3] = bad }

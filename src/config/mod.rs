@@ -272,8 +272,8 @@ struct RawPanel {
     inertia_s_kg_m2: [f64; 3],
     d_m: f64,
     l_m: Option<f64>,
-    k_n_m_rad: f64,
-    c_n_m_s_rad: f64,
+    k_nm_rad: f64,
+    c_nm_s_rad: f64,
     theta_rad: f64,
     theta_dot_rad_s: f64,
 }
@@ -333,7 +333,7 @@ const ACCEL_KEYS: [&str; 10] = [
 
 struct RawWrench {
     t_s: f64,
-    force_b_n: [f64; 3],
+    force_b_newton: [f64; 3],
     torque_b_nm: [f64; 3],
 }
 
@@ -395,13 +395,13 @@ impl RawConfig {
             .map(RawPanelPair::read)
             .collect::<Result<Vec<_>, _>>()?;
         let wrench_schedule = root
-            .tables("wrench_schedule", &["t_s", "force_b_n", "torque_b_nm"])?
+            .tables("wrench_schedule", &["t_s", "force_b_newton", "torque_b_nm"])?
             .unwrap_or_default()
             .iter()
             .map(|w| {
                 Ok(RawWrench {
                     t_s: w.f64("t_s")?,
-                    force_b_n: w.floats("force_b_n")?,
+                    force_b_newton: w.floats("force_b_newton")?,
                     torque_b_nm: w.floats("torque_b_nm")?,
                 })
             })
@@ -453,8 +453,8 @@ impl RawPanelPair {
             "mass_kg",
             "inertia_s_kg_m2",
             "d_m",
-            "k_n_m_rad",
-            "c_n_m_s_rad",
+            "k_nm_rad",
+            "c_nm_s_rad",
             "theta_rad",
             "theta_dot_rad_s",
         ];
@@ -470,8 +470,8 @@ impl RawPanelPair {
                     } else {
                         None
                     },
-                    k_n_m_rad: p.f64("k_n_m_rad")?,
-                    c_n_m_s_rad: p.f64("c_n_m_s_rad")?,
+                    k_nm_rad: p.f64("k_nm_rad")?,
+                    c_nm_s_rad: p.f64("c_nm_s_rad")?,
                     theta_rad: p.f64("theta_rad")?,
                     theta_dot_rad_s: p.f64("theta_dot_rad_s")?,
                 })
@@ -707,7 +707,7 @@ impl RawConfig {
             }
             let seg = WrenchSegment {
                 t_start_ns,
-                force_b_n: vec3(&row.force_b_n),
+                force_b_newton: vec3(&row.force_b_newton),
                 torque_b_nm: vec3(&row.torque_b_nm),
             };
             seg.validate(&path).map_err(param)?;
@@ -939,14 +939,14 @@ fn check_resolved_by_step(cfg: &SimConfig, map: &SourceMap) -> Result<(), Config
             let path = format!("panel_pairs[{i}].{which}");
             let i_hinge = panel.inertia_s_kg_m2.y + panel.mass_kg * panel.d_m * panel.d_m;
             too_fast(
-                &format!("{path}.k_n_m_rad"),
+                &format!("{path}.k_nm_rad"),
                 "the hinge frequency sqrt(k / (I_s2 + m d^2))",
-                (panel.k_n_m_rad / i_hinge).sqrt(),
+                (panel.k_nm_rad / i_hinge).sqrt(),
             )?;
             too_fast(
-                &format!("{path}.c_n_m_s_rad"),
+                &format!("{path}.c_nm_s_rad"),
                 "the hinge damping rate c / (I_s2 + m d^2)",
-                panel.c_n_m_s_rad / i_hinge,
+                panel.c_nm_s_rad / i_hinge,
             )?;
             too_fast(
                 &format!("{path}.theta_dot_rad_s"),
@@ -1213,15 +1213,15 @@ impl RawPanelPair {
                 mass_kg: p1.mass_kg,
                 inertia_s_kg_m2: vec3(&p1.inertia_s_kg_m2),
                 d_m: p1.d_m,
-                k_n_m_rad: p1.k_n_m_rad,
-                c_n_m_s_rad: p1.c_n_m_s_rad,
+                k_nm_rad: p1.k_nm_rad,
+                c_nm_s_rad: p1.c_nm_s_rad,
             },
             panel2: PanelParams {
                 mass_kg: p2.mass_kg,
                 inertia_s_kg_m2: vec3(&p2.inertia_s_kg_m2),
                 d_m: p2.d_m,
-                k_n_m_rad: p2.k_n_m_rad,
-                c_n_m_s_rad: p2.c_n_m_s_rad,
+                k_nm_rad: p2.k_nm_rad,
+                c_nm_s_rad: p2.c_nm_s_rad,
             },
             motor_torque_nm: self.motor_torque_nm.unwrap_or([0.0, 0.0]),
         };

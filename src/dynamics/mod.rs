@@ -17,7 +17,11 @@
 //!   `dcm_bn` maps N to B and `dcm_h1b` maps B to H1;
 //! - `r_prime_*`: body-frame (B-relative) time derivative (the paper's ′); `*_dot`: inertial;
 //! - `s11`, `s12`, `s13` (`s21`, …): the panel-1 (panel-2) frame axes ŝ_i1,k (ŝ_i2,k) in B;
-//! - units are SI unless the name says otherwise (`step_ns`, `t_sim_ns`).
+//! - units are SI unless the name says otherwise (`step_ns`, `t_sim_ns`);
+//! - **suffix rule**: a single letter after a quantity names a frame or point, never a unit. So
+//!   `_n` is always the inertial frame N (`orb_ang_mom_n`, `r_bn_n`), and units are spelled so
+//!   they cannot be read as one: `_newton` for newtons (`force_b_newton`), `_nm` for newton-metres
+//!   (`torque_b_nm`, `k_nm_rad`, `c_nm_s_rad`), `_m` metres, `_kg`, `_s`, `_rad`, `_j` joules.
 //!
 //! # Conventions
 //! - [S1 B] = M2(θ1)[H1 B], [S2 B] = M2(θ2) M2(θ_H2S1) [S1 B], M2(a) = [[c,0,−s],[0,1,0],[s,0,c]];

@@ -394,8 +394,8 @@ impl StateEffector for PanelPair {
         let s23_acc2 = 2.0 * l1 * th1_dot * sn * we + w23 * w_r2 - w_sq * (s23_rh - l1 * sn)
             + l1 * th1_dot * th1_dot * sn;
         let [u1, u2] = p.motor_torque_nm;
-        let (k1, k2) = (p.panel1.k_n_m_rad, p.panel2.k_n_m_rad);
-        let (c1, c2) = (p.panel1.c_n_m_s_rad, p.panel2.c_n_m_s_rad);
+        let (k1, k2) = (p.panel1.k_nm_rad, p.panel2.k_nm_rad);
+        let (c1, c2) = (p.panel1.c_nm_s_rad, p.panel2.c_nm_s_rad);
         // Eq. 124, plus the hinge motor torques: u1 acts on panel 1 (reaction on the hub), u2 on
         // panel 2 (reaction −u2 on panel 1).
         let v1 =
@@ -494,8 +494,8 @@ impl StateEffector for PanelPair {
         let w2 = omega_bn_b + s12 * (th1_dot + th2_dot);
         let mut em = EnergyMomentum::rigid_body(p.panel1.mass_kg, &r1, &r1p, &i1, &w1, omega_bn_b);
         em += EnergyMomentum::rigid_body(p.panel2.mass_kg, &r2, &r2p, &i2, &w2, omega_bn_b);
-        em.potential_j = 0.5 * p.panel1.k_n_m_rad * x[THETA1] * x[THETA1]
-            + 0.5 * p.panel2.k_n_m_rad * x[THETA2] * x[THETA2];
+        em.potential_j = 0.5 * p.panel1.k_nm_rad * x[THETA1] * x[THETA1]
+            + 0.5 * p.panel2.k_nm_rad * x[THETA2] * x[THETA2];
         em
     }
 }

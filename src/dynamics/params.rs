@@ -28,9 +28,9 @@ pub struct PanelParams {
     /// [m] distance from the panel's hinge to its centre of mass, along −ŝ1.
     pub d_m: f64,
     /// [N·m/rad] torsional stiffness of the panel's hinge.
-    pub k_n_m_rad: f64,
+    pub k_nm_rad: f64,
     /// [N·m·s/rad] torsional damping of the panel's hinge.
-    pub c_n_m_s_rad: f64,
+    pub c_nm_s_rad: f64,
 }
 
 /// A pair of dual-linked hinged panels: panel 1 hinged to the hub at H1, panel 2 hinged to the tip
@@ -107,7 +107,7 @@ pub struct SensorPoint {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Wrench {
     /// \[N\] force on the hub, applied at point B, B components.
-    pub force_b_n: Vector3<f64>,
+    pub force_b_newton: Vector3<f64>,
     /// [N·m] torque on the hub, B components.
     pub torque_b_nm: Vector3<f64>,
 }
@@ -115,7 +115,7 @@ pub struct Wrench {
 impl Wrench {
     /// No force and no torque.
     pub const ZERO: Wrench = Wrench {
-        force_b_n: Vector3::new(0.0, 0.0, 0.0),
+        force_b_newton: Vector3::new(0.0, 0.0, 0.0),
         torque_b_nm: Vector3::new(0.0, 0.0, 0.0),
     };
 }
@@ -124,7 +124,7 @@ impl std::ops::Add for Wrench {
     type Output = Wrench;
     fn add(self, rhs: Wrench) -> Wrench {
         Wrench {
-            force_b_n: self.force_b_n + rhs.force_b_n,
+            force_b_newton: self.force_b_newton + rhs.force_b_newton,
             torque_b_nm: self.torque_b_nm + rhs.torque_b_nm,
         }
     }
@@ -136,7 +136,7 @@ pub struct WrenchSegment {
     /// [ns] time from which this row applies (until the next row).
     pub t_start_ns: u64,
     /// [N] force on the hub, B components, applied at point B.
-    pub force_b_n: Vector3<f64>,
+    pub force_b_newton: Vector3<f64>,
     /// [N·m] torque on the hub, B components.
     pub torque_b_nm: Vector3<f64>,
 }
@@ -145,7 +145,7 @@ impl WrenchSegment {
     /// The row's wrench.
     pub fn wrench(&self) -> Wrench {
         Wrench {
-            force_b_n: self.force_b_n,
+            force_b_newton: self.force_b_newton,
             torque_b_nm: self.torque_b_nm,
         }
     }
@@ -283,8 +283,8 @@ impl PanelParams {
             ],
         )?;
         check_positive(path, "d_m", self.d_m)?;
-        check_non_negative(path, "k_n_m_rad", self.k_n_m_rad)?;
-        check_non_negative(path, "c_n_m_s_rad", self.c_n_m_s_rad)
+        check_non_negative(path, "k_nm_rad", self.k_nm_rad)?;
+        check_non_negative(path, "c_nm_s_rad", self.c_nm_s_rad)
     }
 }
 
@@ -352,7 +352,7 @@ impl SensorPoint {
 impl WrenchSegment {
     /// Validates one schedule row (finite force and torque).
     pub fn validate(&self, path: &str) -> Result<(), ParamError> {
-        check_finite(path, "force_b_n", self.force_b_n.as_slice())?;
+        check_finite(path, "force_b_newton", self.force_b_newton.as_slice())?;
         check_finite(path, "torque_b_nm", self.torque_b_nm.as_slice())
     }
 }

@@ -267,7 +267,7 @@ struct EquationsOfMotion {
     gravity: GravityModel,
     effectors: Vec<Box<dyn StateEffector>>,
     ranges: Vec<Range<usize>>,
-    force_b_n: Vector3<f64>,
+    force_b_newton: Vector3<f64>,
     torque_b_nm: Vector3<f64>,
     sensors: Vec<SensorPoint>,
 }
@@ -314,7 +314,7 @@ impl EquationsOfMotion {
         let matrix_b = -c_tilde * m_sc + contr.matrix_b;
         let matrix_c = c_tilde * m_sc + contr.matrix_c;
         let matrix_d = mp.inertia_pnt_b_b_kg_m2 + contr.matrix_d;
-        let v_trans = self.force_b_n
+        let v_trans = self.force_b_newton
             - omega.cross(&c_prime_b) * (2.0 * m_sc)
             - omega.cross(&omega.cross(&c_b)) * m_sc
             + contr.vec_trans;
@@ -423,7 +423,7 @@ impl Spacecraft {
                 gravity,
                 effectors,
                 ranges,
-                force_b_n: Vector3::zeros(),
+                force_b_newton: Vector3::zeros(),
                 torque_b_nm: Vector3::zeros(),
                 sensors: Vec::new(),
             },
@@ -519,14 +519,14 @@ impl Spacecraft {
 
     /// Sets the external wrench on the hub, held constant until the next call.
     pub fn set_wrench(&mut self, w: Wrench) {
-        self.eom.force_b_n = w.force_b_n;
+        self.eom.force_b_newton = w.force_b_newton;
         self.eom.torque_b_nm = w.torque_b_nm;
     }
 
     /// The external wrench currently applied.
     pub fn wrench(&self) -> Wrench {
         Wrench {
-            force_b_n: self.eom.force_b_n,
+            force_b_newton: self.eom.force_b_newton,
             torque_b_nm: self.eom.torque_b_nm,
         }
     }

@@ -27,7 +27,7 @@ struct Slot {
     /// \[N·m\] the participant's last commanded torque, B components.
     torque_b_nm: [f64; 3],
     /// \[N\] the participant's last commanded force, B components.
-    force_b_n: [f64; 3],
+    force_b_newton: [f64; 3],
     /// Whether any command has been accepted from this sender.
     has_command: bool,
     /// `header.tick` of the last accepted command.
@@ -44,7 +44,7 @@ pub struct Held {
     /// \[N·m\] summed commanded torque about B, B components.
     pub torque_b_nm: [f64; 3],
     /// \[N\] summed commanded force at B, B components.
-    pub force_b_n: [f64; 3],
+    pub force_b_newton: [f64; 3],
     /// [`command_flags`] bits for the StateMsg that ends this frame.
     pub flags: u8,
     /// Command bookkeeping for the StatusMsg.
@@ -56,7 +56,7 @@ impl Held {
     pub fn initial(policy: StalePolicy) -> Self {
         Self {
             torque_b_nm: [0.0; 3],
-            force_b_n: [0.0; 3],
+            force_b_newton: [0.0; 3],
             flags: command_flags::NO_COMMAND_YET,
             status: CommandStatus {
                 last_command_tick: NO_COMMAND,
@@ -95,7 +95,7 @@ impl CommandBook {
                 .map(|sender_id| Slot {
                     sender_id,
                     torque_b_nm: [0.0; 3],
-                    force_b_n: [0.0; 3],
+                    force_b_newton: [0.0; 3],
                     has_command: false,
                     last_tick: 0,
                     received_tick: 0,
@@ -120,11 +120,11 @@ impl CommandBook {
     fn take(slot: &mut Slot, cmd: &CommandMsg, k: u64) {
         if let CommandKind::Wrench {
             torque_b_nm,
-            force_b_n,
+            force_b_newton,
         } = cmd.kind
         {
             slot.torque_b_nm = torque_b_nm;
-            slot.force_b_n = force_b_n;
+            slot.force_b_newton = force_b_newton;
         }
         slot.has_command = true;
         slot.last_tick = cmd.header.tick;
@@ -183,7 +183,7 @@ impl CommandBook {
     pub fn held(&self, k: u64) -> Held {
         let mut out = Held {
             torque_b_nm: [0.0; 3],
-            force_b_n: [0.0; 3],
+            force_b_newton: [0.0; 3],
             flags: 0,
             status: CommandStatus {
                 last_command_tick: NO_COMMAND,
@@ -216,7 +216,7 @@ impl CommandBook {
             }
             for i in 0..3 {
                 out.torque_b_nm[i] += s.torque_b_nm[i];
-                out.force_b_n[i] += s.force_b_n[i];
+                out.force_b_newton[i] += s.force_b_newton[i];
             }
         }
         if !any {
@@ -263,7 +263,7 @@ mod tests {
         assert!(b.all_answered());
         let h = b.held(5);
         assert_eq!(h.torque_b_nm, [0.0, 0.0, 1.5]);
-        assert_eq!(h.force_b_n, [1.5, 0.0, 0.0]);
+        assert_eq!(h.force_b_newton, [1.5, 0.0, 0.0]);
         assert_eq!(h.flags, 0);
         assert_eq!(h.status.last_command_tick, 5);
         assert_eq!(h.status.command_age_ns, 0);

@@ -272,7 +272,7 @@ impl PhysicsCtx {
             }
             held = book.held(k);
             self.sim.set_command_wrench(Wrench {
-                force_b_n: Vector3::from(held.force_b_n),
+                force_b_newton: Vector3::from(held.force_b_newton),
                 torque_b_nm: Vector3::from(held.torque_b_nm),
             });
 

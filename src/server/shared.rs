@@ -64,7 +64,7 @@ pub fn fill_state(
     out.conserved.orb_ang_mom_n = snap.conserved.orb_ang_mom_n.into();
     out.conserved.rot_ang_mom_c_n = snap.conserved.rot_ang_mom_c_n.into();
     out.wrench_applied.torque_b_nm = held.torque_b_nm;
-    out.wrench_applied.force_b_n = held.force_b_n;
+    out.wrench_applied.force_b_newton = held.force_b_newton;
     out.command_flags = held.flags;
     out.panels.clear();
     for p in &snap.panels {

@@ -19,13 +19,13 @@ pub fn reference_hub() -> HubParams {
     }
 }
 
-pub fn reference_panel(c_n_m_s_rad: f64) -> PanelParams {
+pub fn reference_panel(c_nm_s_rad: f64) -> PanelParams {
     PanelParams {
         mass_kg: 50.0,
         inertia_s_kg_m2: Vector3::new(50.0, 25.0, 25.0),
         d_m: 0.75,
-        k_n_m_rad: 100.0,
-        c_n_m_s_rad,
+        k_nm_rad: 100.0,
+        c_nm_s_rad,
     }
 }
 
