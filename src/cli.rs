@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::config::{whole_ns, ConfigError, SimConfig, DEFAULT_CONFIG_TOML};
-use crate::imu::ImuSample;
 use crate::numfmt::Num;
+use crate::sensors::imu::ImuSample;
 use crate::server::error::SettingsError;
 use crate::server::settings::ServerSettings;
 use crate::sim::{Simulation, Snapshot};

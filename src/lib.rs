@@ -3,7 +3,8 @@
 //! # Layout
 //! - [`attitude`]: MRP, DCM and quaternion kernels.
 //! - [`dynamics`]: the physics core — rigid hub + dual-hinged panel pairs by back-substitution.
-//! - [`imu`]: gyro and accelerometer measurement models (truth at the sensor, error model, RNG).
+//! - [`schema`]: the typed TOML reader the per-model schemas use.
+//! - [`sensors`]: sensor models — [`sensors::imu`] (gyro and accelerometer).
 //! - [`logging`]: the stderr log setup shared by `flexdyn` and the tools (EPIPE-safe).
 //! - [`server`]: the Zenoh server (`flexdyn run`): real-time, lockstep and batch propagation.
 
@@ -13,8 +14,9 @@ pub mod attitude;
 pub mod cli;
 pub mod config;
 pub mod dynamics;
-pub mod imu;
 pub mod logging;
 pub mod numfmt;
+pub mod schema;
+pub mod sensors;
 pub mod server;
 pub mod sim;

@@ -5,7 +5,7 @@
 //! `schedule(t) + command`, where `t` is the time at the start of the step; the wrench is then
 //! held constant over the step.
 //!
-//! It also owns the IMU error models ([`crate::imu`]): [`Simulation::imu_samples_into`] closes
+//! It also owns the IMU error models ([`crate::sensors::imu`]): [`Simulation::imu_samples_into`] closes
 //! the current IMU sample interval (every frame in the server, every log interval in
 //! `simulate`) and returns one [`ImuSample`] per configured IMU.
 
@@ -16,7 +16,7 @@ use nalgebra::{Vector3, Vector4};
 use crate::attitude::{mrp_to_dcm, mrp_to_quat};
 use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::{Conserved, Spacecraft, Wrench, WrenchSegment};
-use crate::imu::{attitude_increment_b, Imu, ImuSample, ImuTruth};
+use crate::sensors::imu::{attitude_increment_b, Imu, ImuSample, ImuTruth};
 
 /// A spacecraft being propagated, with its external wrench sources.
 #[derive(Debug)]
@@ -325,7 +325,7 @@ impl Simulation {
     /// IMU (config order) into `out` (cleared first; after the first call this allocates
     /// nothing). Then starts the next interval here.
     ///
-    /// Truth (see [`crate::imu`]): rate and specific force at the current state, with the
+    /// Truth (see [`crate::sensors::imu`]): rate and specific force at the current state, with the
     /// wrench that applies from now on (schedule(t) + command, as in [`Self::snapshot_into`]);
     /// Δθ from σ_B/N at the interval's start and now; Δv from the RK4 accumulators, which are
     /// then reset. Each IMU's error model is stepped with dt = the interval's length (0 for the

@@ -321,7 +321,7 @@ fn optional_keys_are_mapped() {
     // An IMU without [imus.gyro] / [imus.accel] tables has every error term zero.
     assert_eq!(
         cfg.imus,
-        vec![flexdyn::imu::ImuConfig::ideal(
+        vec![flexdyn::sensors::imu::ImuConfig::ideal(
             "imu0",
             Vector3::new(0.2, 0.1, 1.2),
             Matrix3::identity(),

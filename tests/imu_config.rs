@@ -6,7 +6,7 @@ mod imu_support;
 use std::path::Path;
 
 use flexdyn::config::{ConfigError, SimConfig};
-use flexdyn::imu::{AccelErrors, GyroErrors};
+use flexdyn::sensors::imu::{AccelErrors, GyroErrors};
 use flexdyn::sim::Simulation;
 use imu_support::*;
 use nalgebra::{Matrix3, Vector3};

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use flexdyn::cli::simulate_to;
 use flexdyn::config::SimConfig;
-use flexdyn::imu::{attitude_increment_b, ImuSample};
+use flexdyn::sensors::imu::{attitude_increment_b, ImuSample};
 use flexdyn::sim::Simulation;
 use flexdyn_proto::{encode, Header, ImuMsg};
 use nalgebra::Vector3;

@@ -13,7 +13,7 @@
 //! weighted linear least-squares fit of those basis functions (τ known) to the overlapping Allan
 //! variance of the integrated output Σ Δθ (or Σ Δv), weights ∝ the number of clusters L/T.
 
-use flexdyn::imu::{AccelErrors, GyroErrors, Imu, ImuConfig, ImuSample, ImuTruth};
+use flexdyn::sensors::imu::{AccelErrors, GyroErrors, Imu, ImuConfig, ImuSample, ImuTruth};
 use flexdyn_proto::saturation_flags;
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 

@@ -5,7 +5,7 @@
 
 mod imu_support;
 
-use flexdyn::imu::ImuSample;
+use flexdyn::sensors::imu::ImuSample;
 use flexdyn::sim::Simulation;
 use imu_support::*;
 use nalgebra::{Matrix3, Vector3};

@@ -1,32 +1,12 @@
 //! The configuration's error type and the text positions it points to.
 
-use std::fmt;
 use std::path::PathBuf;
 
 use crate::dynamics::ParamError;
-use crate::imu::ImuParamError;
+use crate::sensors::imu::ImuParamError;
 
-/// A position in the configuration text (1-based line and column, in characters).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Location {
-    /// 1-based line.
-    pub line: usize,
-    /// 1-based column (characters).
-    pub column: usize,
-}
-
-/// Where an error points to, if known; displays as ` (line L, column C)` or nothing.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct At(pub Option<Location>);
-
-impl fmt::Display for At {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.0 {
-            Some(l) => write!(f, " (line {}, column {})", l.line, l.column),
-            None => Ok(()),
-        }
-    }
-}
+use crate::schema::{in_table, SchemaError};
+pub use crate::schema::{At, Location};
 
 /// A configuration that cannot be used. The message always starts with the TOML path of the
 /// offending field (except for I/O and syntax errors, which name the file or the line).
@@ -143,13 +123,6 @@ pub enum ConfigError {
     },
 }
 
-fn in_table(at: &At) -> String {
-    match at.0 {
-        Some(l) => format!(" (in the table at line {}, column {})", l.line, l.column),
-        None => String::new(),
-    }
-}
-
 impl ConfigError {
     /// The TOML path of the offending field, if the error is about one.
     pub fn field(&self) -> Option<&str> {
@@ -164,6 +137,20 @@ impl ConfigError {
             | ConfigError::WrenchSchedule { field, .. }
             | ConfigError::Invalid { field, .. } => Some(field),
             ConfigError::Param { source, .. } => param_field(source),
+        }
+    }
+}
+
+impl From<SchemaError> for ConfigError {
+    fn from(e: SchemaError) -> Self {
+        match e {
+            SchemaError::UnknownKey { field, message, at } => {
+                ConfigError::UnknownKey { field, message, at }
+            }
+            SchemaError::MissingKey { field, at } => ConfigError::MissingKey { field, at },
+            SchemaError::InvalidValue { field, message, at } => {
+                ConfigError::InvalidValue { field, message, at }
+            }
         }
     }
 }

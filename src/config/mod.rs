@@ -20,7 +20,6 @@
 //! `scenarios/reference.toml`. The README's "Configuration" section documents every key.
 
 mod error;
-mod reader;
 mod source_map;
 
 use std::collections::HashSet;
@@ -30,16 +29,18 @@ use nalgebra::{Matrix3, Vector3};
 use toml::de::DeTable;
 
 use crate::numfmt::{Num, Rounded};
+use crate::schema::location;
+use crate::schema::TableReader;
 pub use error::{At, ConfigError, Location};
 use flexdyn_proto::MAX_PANEL_PAIRS;
-use reader::TableReader;
-use source_map::{location, SourceMap};
+use source_map::SourceMap;
 
+use crate::dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
 use crate::dynamics::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
-    PanelPairParams, PanelParams, ParamError, Spacecraft, StateEffector, WrenchSegment,
+    PanelPairParams, ParamError, Spacecraft, StateEffector, WrenchSegment,
 };
-use crate::imu::{AccelErrors, GyroErrors, ImuConfig};
+use crate::sensors::imu::{self, schema::RawImu, ImuConfig};
 
 /// The built-in default configuration (the text of `scenarios/reference.toml`).
 pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../scenarios/reference.toml");
@@ -256,81 +257,6 @@ struct RawInitial {
     omega_bn_b_rad_s: [f64; 3],
 }
 
-struct RawPanelPair {
-    name: String,
-    r_h1b_b_m: [f64; 3],
-    dcm_h1b: [[f64; 3]; 3],
-    theta_h2s1_rad: f64,
-    motor_torque_nm: Option<[f64; 2]>,
-    panel1: RawPanel,
-    panel2: RawPanel,
-}
-
-/// Panel 1 has `l_m`; panel 2 does not (the reader enforces which keys each allows).
-struct RawPanel {
-    mass_kg: f64,
-    inertia_s_kg_m2: [f64; 3],
-    d_m: f64,
-    l_m: Option<f64>,
-    k_nm_rad: f64,
-    c_nm_s_rad: f64,
-    theta_rad: f64,
-    theta_dot_rad_s: f64,
-}
-
-struct RawImu {
-    name: String,
-    r_sb_b_m: [f64; 3],
-    dcm_pb: [[f64; 3]; 3],
-    seed: u64,
-    gyro: RawTriad,
-    accel: RawTriad,
-}
-
-/// `[imus.gyro]` or `[imus.accel]`: every key optional, zero by default (see [`GyroErrors`],
-/// [`AccelErrors`]). The key names differ by unit; the values are read in this order:
-/// white noise, bias-instability σ, its τ, random walk, bias, scale factor, misalignment,
-/// range, output LSB, increment LSB.
-#[derive(Default)]
-struct RawTriad {
-    white: f64,
-    bias_instability_sigma: f64,
-    bias_instability_tau_s: f64,
-    random_walk: f64,
-    bias: [f64; 3],
-    scale_factor: [f64; 3],
-    misalignment_rad: [[f64; 3]; 3],
-    range: f64,
-    lsb: f64,
-    increment_lsb: f64,
-}
-
-/// The keys of a triad table, in [`RawTriad`]'s order.
-const GYRO_KEYS: [&str; 10] = [
-    "arw_rad_s_sqrt_hz",
-    "bias_instability_sigma_rad_s",
-    "bias_instability_tau_s",
-    "rrw_rad_s2_sqrt_hz",
-    "bias_rad_s",
-    "scale_factor",
-    "misalignment_rad",
-    "range_rad_s",
-    "lsb_rad_s",
-    "dtheta_lsb_rad",
-];
-const ACCEL_KEYS: [&str; 10] = [
-    "vrw_m_s2_sqrt_hz",
-    "bias_instability_sigma_m_s2",
-    "bias_instability_tau_s",
-    "rrw_m_s3_sqrt_hz",
-    "bias_m_s2",
-    "scale_factor",
-    "misalignment_rad",
-    "range_m_s2",
-    "lsb_m_s2",
-    "dv_lsb_m_s",
-];
-
 struct RawWrench {
     t_s: f64,
     force_b_newton: [f64; 3],
@@ -379,18 +305,7 @@ impl RawConfig {
             omega_bn_b_rad_s: i.floats("omega_bn_b_rad_s")?,
         };
         let panel_pairs = root
-            .req_tables(
-                "panel_pairs",
-                &[
-                    "name",
-                    "r_h1b_b_m",
-                    "dcm_h1b",
-                    "theta_h2s1_rad",
-                    "motor_torque_nm",
-                    "panel1",
-                    "panel2",
-                ],
-            )?
+            .req_tables("panel_pairs", &panel_pair::schema::KEYS)?
             .iter()
             .map(RawPanelPair::read)
             .collect::<Result<Vec<_>, _>>()?;
@@ -426,10 +341,7 @@ impl RawConfig {
             toml::Table::new()
         };
         let imus = root
-            .tables(
-                "imus",
-                &["name", "r_sb_b_m", "dcm_pb", "seed", "gyro", "accel"],
-            )?
+            .tables("imus", &imu::schema::KEYS)?
             .unwrap_or_default()
             .iter()
             .map(RawImu::read)
@@ -444,117 +356,6 @@ impl RawConfig {
             server,
             imus,
         })
-    }
-}
-
-impl RawPanelPair {
-    fn read(t: &TableReader<'_, '_>) -> Result<Self, ConfigError> {
-        const PANEL2: [&str; 7] = [
-            "mass_kg",
-            "inertia_s_kg_m2",
-            "d_m",
-            "k_nm_rad",
-            "c_nm_s_rad",
-            "theta_rad",
-            "theta_dot_rad_s",
-        ];
-        let panel1_keys: Vec<&str> = PANEL2.iter().copied().chain(["l_m"]).collect();
-        let read_panel =
-            |p: &TableReader<'_, '_>, has_length: bool| -> Result<RawPanel, ConfigError> {
-                Ok(RawPanel {
-                    mass_kg: p.f64("mass_kg")?,
-                    inertia_s_kg_m2: p.floats("inertia_s_kg_m2")?,
-                    d_m: p.f64("d_m")?,
-                    l_m: if has_length {
-                        Some(p.f64("l_m")?)
-                    } else {
-                        None
-                    },
-                    k_nm_rad: p.f64("k_nm_rad")?,
-                    c_nm_s_rad: p.f64("c_nm_s_rad")?,
-                    theta_rad: p.f64("theta_rad")?,
-                    theta_dot_rad_s: p.f64("theta_dot_rad_s")?,
-                })
-            };
-        Ok(RawPanelPair {
-            name: t.string("name")?,
-            r_h1b_b_m: t.floats("r_h1b_b_m")?,
-            dcm_h1b: t.mat3("dcm_h1b")?,
-            theta_h2s1_rad: t.f64("theta_h2s1_rad")?,
-            motor_torque_nm: t.opt_floats("motor_torque_nm")?,
-            panel1: read_panel(&t.table("panel1", &panel1_keys)?, true)?,
-            panel2: read_panel(&t.table("panel2", &PANEL2)?, false)?,
-        })
-    }
-}
-
-impl RawTriad {
-    fn read(t: Option<TableReader<'_, '_>>, keys: &[&str; 10]) -> Result<Self, ConfigError> {
-        let Some(t) = t else {
-            return Ok(Self::default());
-        };
-        let f = |k: &str| t.opt_f64(k).map(Option::unwrap_or_default);
-        Ok(RawTriad {
-            white: f(keys[0])?,
-            bias_instability_sigma: f(keys[1])?,
-            bias_instability_tau_s: f(keys[2])?,
-            random_walk: f(keys[3])?,
-            bias: t.opt_floats(keys[4])?.unwrap_or_default(),
-            scale_factor: t.opt_floats(keys[5])?.unwrap_or_default(),
-            misalignment_rad: t.opt_mat3(keys[6])?.unwrap_or_default(),
-            range: f(keys[7])?,
-            lsb: f(keys[8])?,
-            increment_lsb: f(keys[9])?,
-        })
-    }
-}
-
-impl RawImu {
-    fn read(t: &TableReader<'_, '_>) -> Result<Self, ConfigError> {
-        Ok(RawImu {
-            name: t.string("name")?,
-            r_sb_b_m: t.floats("r_sb_b_m")?,
-            dcm_pb: t.mat3("dcm_pb")?,
-            // The documented range 0 ≤ seed ≤ 2⁶³ − 1 is TOML's non-negative integers.
-            seed: t.int_in("seed", 0, i64::MAX)? as u64,
-            gyro: RawTriad::read(t.opt_table("gyro", &GYRO_KEYS)?, &GYRO_KEYS)?,
-            accel: RawTriad::read(t.opt_table("accel", &ACCEL_KEYS)?, &ACCEL_KEYS)?,
-        })
-    }
-
-    fn into_config(self) -> ImuConfig {
-        let g = self.gyro;
-        let a = self.accel;
-        ImuConfig {
-            name: self.name,
-            r_sb_b_m: vec3(&self.r_sb_b_m),
-            dcm_pb: mat3(&self.dcm_pb),
-            seed: self.seed,
-            gyro: GyroErrors {
-                arw_rad_s_sqrt_hz: g.white,
-                bias_instability_sigma_rad_s: g.bias_instability_sigma,
-                bias_instability_tau_s: g.bias_instability_tau_s,
-                rrw_rad_s2_sqrt_hz: g.random_walk,
-                bias_rad_s: vec3(&g.bias),
-                scale_factor: vec3(&g.scale_factor),
-                misalignment_rad: mat3(&g.misalignment_rad),
-                range_rad_s: g.range,
-                lsb_rad_s: g.lsb,
-                dtheta_lsb_rad: g.increment_lsb,
-            },
-            accel: AccelErrors {
-                vrw_m_s2_sqrt_hz: a.white,
-                bias_instability_sigma_m_s2: a.bias_instability_sigma,
-                bias_instability_tau_s: a.bias_instability_tau_s,
-                rrw_m_s3_sqrt_hz: a.random_walk,
-                bias_m_s2: vec3(&a.bias),
-                scale_factor: vec3(&a.scale_factor),
-                misalignment_rad: mat3(&a.misalignment_rad),
-                range_m_s2: a.range,
-                lsb_m_s2: a.lsb,
-                dv_lsb_m_s: a.increment_lsb,
-            },
-        }
     }
 }
 
@@ -1196,42 +997,6 @@ impl RawInitial {
             sigma_bn: vec3(&self.sigma_bn),
             omega_bn_b_rad_s: vec3(&self.omega_bn_b_rad_s),
         })
-    }
-}
-
-impl RawPanelPair {
-    fn into_params(self) -> (PanelPairParams, PanelPairInitial) {
-        let p1 = &self.panel1;
-        let p2 = &self.panel2;
-        let params = PanelPairParams {
-            name: self.name,
-            r_h1b_b_m: vec3(&self.r_h1b_b_m),
-            dcm_h1b: mat3(&self.dcm_h1b),
-            theta_h2s1_rad: self.theta_h2s1_rad,
-            l1_m: p1.l_m.unwrap_or_default(),
-            panel1: PanelParams {
-                mass_kg: p1.mass_kg,
-                inertia_s_kg_m2: vec3(&p1.inertia_s_kg_m2),
-                d_m: p1.d_m,
-                k_nm_rad: p1.k_nm_rad,
-                c_nm_s_rad: p1.c_nm_s_rad,
-            },
-            panel2: PanelParams {
-                mass_kg: p2.mass_kg,
-                inertia_s_kg_m2: vec3(&p2.inertia_s_kg_m2),
-                d_m: p2.d_m,
-                k_nm_rad: p2.k_nm_rad,
-                c_nm_s_rad: p2.c_nm_s_rad,
-            },
-            motor_torque_nm: self.motor_torque_nm.unwrap_or([0.0, 0.0]),
-        };
-        let initial = PanelPairInitial {
-            theta1_rad: p1.theta_rad,
-            theta1_dot_rad_s: p1.theta_dot_rad_s,
-            theta2_rad: p2.theta_rad,
-            theta2_dot_rad_s: p2.theta_dot_rad_s,
-        };
-        (params, initial)
     }
 }
 

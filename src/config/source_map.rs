@@ -5,39 +5,10 @@ use std::ops::Range;
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
-use super::error::{param_field, At, ConfigError, Location};
+use super::error::{param_field, ConfigError};
 use crate::dynamics::ParamError;
-use crate::imu::ImuParamError;
-
-/// 1-based line and column of byte `offset` in `s`.
-pub(crate) fn location(s: &str, offset: usize) -> Location {
-    let offset = offset.min(s.len());
-    let before = s.get(..offset).unwrap_or(s);
-    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-    Location {
-        line: before.matches('\n').count() + 1,
-        column: before[line_start..].chars().count() + 1,
-    }
-}
-
-fn is_bare_key(k: &str) -> bool {
-    !k.is_empty()
-        && k.chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-}
-
-pub(crate) fn join_key(path: &str, key: &str) -> String {
-    let key = if is_bare_key(key) {
-        key.to_string()
-    } else {
-        format!("{key:?}")
-    };
-    if path.is_empty() {
-        key
-    } else {
-        format!("{path}.{key}")
-    }
-}
+use crate::schema::{join_key, location, At};
+use crate::sensors::imu::ImuParamError;
 
 struct SpanEntry {
     span: Range<usize>,
@@ -198,24 +169,5 @@ impl<'s> SourceMap<'s> {
             problem,
             at: self.at(field),
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn locations() {
-        let s = "a = 1\nbb = 2\n";
-        assert_eq!(location(s, 0), Location { line: 1, column: 1 });
-        assert_eq!(location(s, 6), Location { line: 2, column: 1 });
-        assert_eq!(location(s, 11), Location { line: 2, column: 6 });
-    }
-
-    #[test]
-    fn quoted_keys_in_paths() {
-        assert_eq!(join_key("", "hub"), "hub");
-        assert_eq!(join_key("server", "a.b"), "server.\"a.b\"");
     }
 }

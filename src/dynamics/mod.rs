@@ -31,18 +31,15 @@
 //! - Gravity acts at the system centre of mass as a uniform field.
 
 pub mod effector;
-pub mod panel_pair;
+pub mod effectors;
 pub mod params;
 pub mod spacecraft;
 
 pub use effector::{
     BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
-pub use panel_pair::PanelPair;
-pub use params::{
-    GravityModel, HubParams, PanelPairInitial, PanelPairParams, PanelParams, SensorPoint, Wrench,
-    WrenchSegment,
-};
+pub use effectors::panel_pair::{PanelPair, PanelPairInitial, PanelPairParams, PanelParams};
+pub use params::{GravityModel, HubParams, SensorPoint, Wrench, WrenchSegment};
 pub use spacecraft::{
     gravity_accel_n, gravity_potential, specific_force_b, Conserved, HubInitial, HubOutputs,
     InitialTranslation, Spacecraft, State,

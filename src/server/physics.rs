@@ -28,7 +28,7 @@ use super::pacing::{FrameEnd, Pacer};
 use super::settings::ServerSettings;
 use super::shared::{fill_state, Frame, Shared};
 use crate::dynamics::Wrench;
-use crate::imu::ImuSample;
+use crate::sensors::imu::ImuSample;
 use crate::sim::{Simulation, Snapshot};
 
 /// Longest single blocking wait, so a stop request is seen quickly.

@@ -8,7 +8,7 @@ use flexdyn_proto::{
 };
 
 use super::commands::Held;
-use crate::imu::ImuSample;
+use crate::sensors::imu::ImuSample;
 
 /// One frame's telemetry, filled by the physics thread and published by the I/O thread. A
 /// fixed pool of these is allocated at start-up and cycled through two bounded channels

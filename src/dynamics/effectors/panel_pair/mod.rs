@@ -14,11 +14,14 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::effector::{
+use crate::dynamics::effector::{
     BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
-use super::params::{PanelPairInitial, PanelPairParams};
-use super::ParamError;
+mod params;
+pub(crate) mod schema;
+
+use crate::dynamics::ParamError;
+pub use params::{PanelPairInitial, PanelPairParams, PanelParams};
 
 /// The panel frames at one state: [S1 B] = M2(θ1)[H1 B], [S2 B] = M2(φ)[S1 B], φ = θ2 + θ_H2S1.
 #[derive(Debug, Clone, Copy)]

@@ -19,8 +19,7 @@
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
-use super::error::{At, ConfigError};
-use super::source_map::{join_key, location};
+use super::{join_key, location, At, SchemaError};
 
 /// A TOML value as this reader describes it in messages ("a string", "an array of 5 elements").
 pub(crate) fn describe(v: &DeValue<'_>) -> String {
@@ -52,7 +51,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
         source: &'a str,
         doc: &'a DeTable<'i>,
         allowed: &[&str],
-    ) -> Result<Self, ConfigError> {
+    ) -> Result<Self, SchemaError> {
         let r = Self {
             source,
             path: String::new(),
@@ -72,7 +71,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
         At(Some(location(self.source, start)))
     }
 
-    fn check_keys(&self, allowed: &[&str]) -> Result<(), ConfigError> {
+    fn check_keys(&self, allowed: &[&str]) -> Result<(), SchemaError> {
         // Report the unknown key that comes first in the file.
         let unknown = self
             .table
@@ -90,7 +89,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
                     ),
                     None => format!("expected one of: {}", allowed.join(", ")),
                 };
-                Err(ConfigError::UnknownKey {
+                Err(SchemaError::UnknownKey {
                     field: self.field(name),
                     message,
                     at: self.at_span(k.span().start),
@@ -104,32 +103,32 @@ impl<'a, 'i> TableReader<'a, 'i> {
         self.table.get(key)
     }
 
-    fn missing(&self, key: &str) -> ConfigError {
-        ConfigError::MissingKey {
+    fn missing(&self, key: &str) -> SchemaError {
+        SchemaError::MissingKey {
             field: self.field(key),
             at: self.at,
         }
     }
 
-    fn required(&self, key: &str) -> Result<&'a Spanned<DeValue<'i>>, ConfigError> {
+    fn required(&self, key: &str) -> Result<&'a Spanned<DeValue<'i>>, SchemaError> {
         self.get(key).ok_or_else(|| self.missing(key))
     }
 
-    fn invalid(&self, field: String, v: &Spanned<DeValue<'_>>, message: String) -> ConfigError {
-        ConfigError::InvalidValue {
+    fn invalid(&self, field: String, v: &Spanned<DeValue<'_>>, message: String) -> SchemaError {
+        SchemaError::InvalidValue {
             field,
             message,
             at: self.at_span(v.span().start),
         }
     }
 
-    fn expected(&self, field: String, v: &Spanned<DeValue<'_>>, what: &str) -> ConfigError {
+    fn expected(&self, field: String, v: &Spanned<DeValue<'_>>, what: &str) -> SchemaError {
         let message = format!("expected {what}, got {}", describe(v.get_ref()));
         self.invalid(field, v, message)
     }
 
     /// A number (float or integer) at `field`.
-    fn number(&self, field: String, v: &Spanned<DeValue<'_>>) -> Result<f64, ConfigError> {
+    fn number(&self, field: String, v: &Spanned<DeValue<'_>>) -> Result<f64, SchemaError> {
         match v.get_ref() {
             DeValue::Float(f) => {
                 let s = f.as_str().replace('_', "").to_ascii_lowercase();
@@ -152,7 +151,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
     }
 
     /// A TOML integer (64-bit signed) at `field`.
-    fn integer(&self, field: String, v: &Spanned<DeValue<'_>>) -> Result<i64, ConfigError> {
+    fn integer(&self, field: String, v: &Spanned<DeValue<'_>>) -> Result<i64, SchemaError> {
         match v.get_ref() {
             DeValue::Integer(i) => {
                 let digits = i.as_str().replace('_', "");
@@ -173,19 +172,19 @@ impl<'a, 'i> TableReader<'a, 'i> {
     }
 
     /// Required number.
-    pub(crate) fn f64(&self, key: &str) -> Result<f64, ConfigError> {
+    pub(crate) fn f64(&self, key: &str) -> Result<f64, SchemaError> {
         self.number(self.field(key), self.required(key)?)
     }
 
     /// Optional number.
-    pub(crate) fn opt_f64(&self, key: &str) -> Result<Option<f64>, ConfigError> {
+    pub(crate) fn opt_f64(&self, key: &str) -> Result<Option<f64>, SchemaError> {
         self.get(key)
             .map(|v| self.number(self.field(key), v))
             .transpose()
     }
 
     /// Required integer within `lo..=hi`.
-    pub(crate) fn int_in(&self, key: &str, lo: i64, hi: i64) -> Result<i64, ConfigError> {
+    pub(crate) fn int_in(&self, key: &str, lo: i64, hi: i64) -> Result<i64, SchemaError> {
         let v = self.required(key)?;
         let i = self.integer(self.field(key), v)?;
         if !(lo..=hi).contains(&i) {
@@ -199,7 +198,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
     }
 
     /// Required string.
-    pub(crate) fn string(&self, key: &str) -> Result<String, ConfigError> {
+    pub(crate) fn string(&self, key: &str) -> Result<String, SchemaError> {
         let v = self.required(key)?;
         match v.get_ref() {
             DeValue::String(s) => Ok(s.to_string()),
@@ -212,7 +211,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
         field: &str,
         v: &'v Spanned<DeValue<'i>>,
         n: usize,
-    ) -> Result<&'v [Spanned<DeValue<'i>>], ConfigError> {
+    ) -> Result<&'v [Spanned<DeValue<'i>>], SchemaError> {
         match v.get_ref() {
             DeValue::Array(a) if a.len() == n => Ok(a),
             DeValue::Array(a) => Err(self.invalid(
@@ -228,7 +227,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
         &self,
         field: &str,
         v: &Spanned<DeValue<'i>>,
-    ) -> Result<[f64; N], ConfigError> {
+    ) -> Result<[f64; N], SchemaError> {
         let a = self.array_of(field, v, N)?;
         let mut out = [0.0; N];
         for (i, (o, e)) in out.iter_mut().zip(a).enumerate() {
@@ -238,7 +237,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
     }
 
     /// Required array of exactly `N` numbers.
-    pub(crate) fn floats<const N: usize>(&self, key: &str) -> Result<[f64; N], ConfigError> {
+    pub(crate) fn floats<const N: usize>(&self, key: &str) -> Result<[f64; N], SchemaError> {
         self.floats_of(&self.field(key), self.required(key)?)
     }
 
@@ -246,13 +245,13 @@ impl<'a, 'i> TableReader<'a, 'i> {
     pub(crate) fn opt_floats<const N: usize>(
         &self,
         key: &str,
-    ) -> Result<Option<[f64; N]>, ConfigError> {
+    ) -> Result<Option<[f64; N]>, SchemaError> {
         self.get(key)
             .map(|v| self.floats_of(&self.field(key), v))
             .transpose()
     }
 
-    fn mat3_of(&self, field: &str, v: &Spanned<DeValue<'i>>) -> Result<[[f64; 3]; 3], ConfigError> {
+    fn mat3_of(&self, field: &str, v: &Spanned<DeValue<'i>>) -> Result<[[f64; 3]; 3], SchemaError> {
         let rows = match v.get_ref() {
             DeValue::Array(a) if a.len() == 3 => a,
             DeValue::Array(a) => {
@@ -278,12 +277,12 @@ impl<'a, 'i> TableReader<'a, 'i> {
     }
 
     /// Required 3×3 matrix, as an array of 3 rows of 3 numbers.
-    pub(crate) fn mat3(&self, key: &str) -> Result<[[f64; 3]; 3], ConfigError> {
+    pub(crate) fn mat3(&self, key: &str) -> Result<[[f64; 3]; 3], SchemaError> {
         self.mat3_of(&self.field(key), self.required(key)?)
     }
 
     /// Optional 3×3 matrix.
-    pub(crate) fn opt_mat3(&self, key: &str) -> Result<Option<[[f64; 3]; 3]>, ConfigError> {
+    pub(crate) fn opt_mat3(&self, key: &str) -> Result<Option<[[f64; 3]; 3]>, SchemaError> {
         self.get(key)
             .map(|v| self.mat3_of(&self.field(key), v))
             .transpose()
@@ -294,7 +293,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
         path: String,
         v: &'a Spanned<DeValue<'i>>,
         allowed: &[&str],
-    ) -> Result<TableReader<'a, 'i>, ConfigError> {
+    ) -> Result<TableReader<'a, 'i>, SchemaError> {
         match v.get_ref() {
             DeValue::Table(t) => {
                 let r = TableReader {
@@ -320,7 +319,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
     }
 
     /// Whether `key` is present; an error if it is present and not a table.
-    pub(crate) fn is_table(&self, key: &str) -> Result<bool, ConfigError> {
+    pub(crate) fn is_table(&self, key: &str) -> Result<bool, SchemaError> {
         match self.get(key) {
             None => Ok(false),
             Some(v) if matches!(v.get_ref(), DeValue::Table(_)) => Ok(true),
@@ -333,7 +332,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
         &self,
         key: &str,
         allowed: &[&str],
-    ) -> Result<TableReader<'a, 'i>, ConfigError> {
+    ) -> Result<TableReader<'a, 'i>, SchemaError> {
         self.open(self.field(key), self.required(key)?, allowed)
     }
 
@@ -342,7 +341,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
         &self,
         key: &str,
         allowed: &[&str],
-    ) -> Result<Option<TableReader<'a, 'i>>, ConfigError> {
+    ) -> Result<Option<TableReader<'a, 'i>>, SchemaError> {
         self.get(key)
             .map(|v| self.open(self.field(key), v, allowed))
             .transpose()
@@ -353,7 +352,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
         &self,
         key: &str,
         allowed: &[&str],
-    ) -> Result<Option<Vec<TableReader<'a, 'i>>>, ConfigError> {
+    ) -> Result<Option<Vec<TableReader<'a, 'i>>>, SchemaError> {
         let Some(v) = self.get(key) else {
             return Ok(None);
         };
@@ -373,7 +372,7 @@ impl<'a, 'i> TableReader<'a, 'i> {
         &self,
         key: &str,
         allowed: &[&str],
-    ) -> Result<Vec<TableReader<'a, 'i>>, ConfigError> {
+    ) -> Result<Vec<TableReader<'a, 'i>>, SchemaError> {
         self.tables(key, allowed)?.ok_or_else(|| self.missing(key))
     }
 }

@@ -66,6 +66,8 @@ use crate::dynamics::params::check_finite;
 use crate::dynamics::{ParamError, SensorPoint};
 use flexdyn_proto::{saturation_flags, Header, ImuMsg};
 
+pub(crate) mod schema;
+
 /// Largest allowed |misalignment| element \[rad\]: the model is first order in these angles.
 pub const MAX_MISALIGNMENT_RAD: f64 = 0.1;
 

@@ -1,0 +1,5 @@
+//! The appended bodies, one folder per kind. Each folder owns the kind's parameters, its
+//! configuration schema (`schema.rs`), its [`StateEffector`](super::StateEffector)
+//! implementation with its state, input and output names, and its tests.
+
+pub mod panel_pair;
