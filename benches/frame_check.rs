@@ -32,7 +32,7 @@ fn median_ns_per_frame(mut f: impl FnMut()) -> f64 {
 fn main() {
     let cfg = SimConfig::reference();
     let mut sim = Simulation::new(&cfg).expect("reference builds");
-    let mut snap = Snapshot::with_capacity(sim.n_pairs());
+    let mut snap = Snapshot::for_simulation(&sim);
     let frame = median_ns_per_frame(|| {
         sim.step_frame();
         black_box(sim.t_sim_ns());

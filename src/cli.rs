@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::config::{whole_ns, ConfigError, SimConfig, DEFAULT_CONFIG_TOML};
+use crate::dynamics::StateEffector;
 use crate::numfmt::Num;
 use crate::sensors::imu::ImuSample;
 use crate::server::error::SettingsError;
@@ -209,17 +210,25 @@ fn whole_steps(
     }
 }
 
-/// The CSV header for `n_pairs` panel pairs (no trailing newline).
-pub fn csv_header(n_pairs: usize) -> String {
+/// The CSV header for a spacecraft with `effectors` (no trailing newline). Each effector adds
+/// its states and then its outputs, named `<prefix><k>_<name>` with `k` its 1-based index among
+/// effectors of its kind (`pair1_theta1`, `rw2_omega_rad_s`), and, when it has outputs, a
+/// `<prefix><k>_flags` column with its status bits.
+pub fn csv_header(effectors: &[Box<dyn StateEffector>]) -> String {
     let mut h = String::from("t_s");
     for base in ["sigma_bn", "omega_bn_b", "r_bn_n", "v_bn_n"] {
         for i in 1..=3 {
             let _ = write!(h, ",{base}_{i}");
         }
     }
-    for k in 1..=n_pairs {
-        for col in ["theta1", "theta1_dot", "theta2", "theta2_dot"] {
-            let _ = write!(h, ",pair{k}_{col}");
+    for (i, e) in effectors.iter().enumerate() {
+        let kind = e.kind();
+        let k = 1 + effectors[..i].iter().filter(|o| o.kind() == kind).count();
+        for col in e.state_names().iter().chain(e.output_names()) {
+            let _ = write!(h, ",{}{k}_{col}", kind.column_prefix);
+        }
+        if !e.output_names().is_empty() {
+            let _ = write!(h, ",{}{k}_flags", kind.column_prefix);
         }
     }
     h.push_str(",orb_energy_j,rot_energy_j");
@@ -278,8 +287,11 @@ pub fn csv_row(s: &Snapshot, row: &mut String) {
     for v in [&s.sigma_bn, &s.omega_bn_b, &s.r_bn_n, &s.v_bn_n] {
         v.iter().for_each(|x| push(*x));
     }
-    for p in &s.panels {
-        p.iter().for_each(|x| push(*x));
+    for e in &s.effectors {
+        e.states.iter().chain(&e.outputs).for_each(|x| push(*x));
+        if !e.outputs.is_empty() {
+            push(f64::from(e.flags));
+        }
     }
     push(s.conserved.orb_energy_j);
     push(s.conserved.rot_energy_j);
@@ -309,12 +321,12 @@ pub fn simulate_to<W: Write>(
     };
 
     let mut out = BufWriter::new(out);
-    let mut row = csv_header(sim.n_pairs());
+    let mut row = csv_header(sim.spacecraft().effectors());
     row.push_str(&csv_imu_header(sim.imu_names()));
     row.push('\n');
     out.write_all(row.as_bytes()).map_err(io_err)?;
 
-    let mut snap = Snapshot::with_capacity(sim.n_pairs());
+    let mut snap = Snapshot::for_simulation(&sim);
     let mut imu_samples = Vec::with_capacity(sim.n_imus());
     let n_logged = total_steps / log_steps;
     let start = Instant::now();

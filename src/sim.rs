@@ -15,7 +15,9 @@ use nalgebra::{Vector3, Vector4};
 
 use crate::attitude::{mrp_to_dcm, mrp_to_quat};
 use crate::config::{ConfigError, SimConfig};
-use crate::dynamics::{Conserved, Spacecraft, Wrench, WrenchSegment};
+use crate::dynamics::{
+    Conserved, EffectorKind, HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment,
+};
 use crate::sensors::imu::{attitude_increment_b, Imu, ImuSample, ImuTruth};
 
 /// A spacecraft being propagated, with its external wrench sources.
@@ -29,6 +31,16 @@ pub struct Simulation {
     cursor: usize,
     /// The commanded wrench, added to the schedule's.
     command: Wrench,
+    /// The commanded effector inputs, flat (laid out by
+    /// [`Spacecraft::effector_input_ranges`]).
+    inputs: Vec<f64>,
+    /// Scratch for [`Spacecraft::effector_outputs`], sized once.
+    outputs_scratch: Vec<f64>,
+    flags_scratch: Vec<u32>,
+    /// Hub outputs at the current state with the current wrench and inputs, once evaluated:
+    /// the snapshot and every sensor share one evaluation per frame. Cleared by anything that
+    /// changes the state, the wrench or the inputs.
+    frame_outputs: Option<HubOutputs>,
     /// The IMUs in config order; IMU `i` is the spacecraft's sensor point `i`.
     imus: Vec<Imu>,
     imu_names: Vec<String>,
@@ -57,8 +69,9 @@ pub struct Snapshot {
     pub v_bn_n: Vector3<f64>,
     /// \[m/s²\] non-gravitational acceleration of point B, N components (\[NB\]·a_B).
     pub nongrav_accel_bn_n: Vector3<f64>,
-    /// Per panel pair: [θ1 rad, θ̇1 rad/s, θ2 rad, θ̇2 rad/s].
-    pub panels: Vec<[f64; 4]>,
+    /// Every effector's states, outputs and flags, in effector order (panel pairs, then
+    /// reaction wheels).
+    pub effectors: Vec<EffectorSnapshot>,
     /// Conserved quantities (N components).
     pub conserved: Conserved,
     /// \[N\] total external force on the hub (schedule + command), B components, applied from
@@ -68,10 +81,58 @@ pub struct Snapshot {
     pub torque_b_nm: Vector3<f64>,
 }
 
+/// One effector at one instant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EffectorSnapshot {
+    /// Its kind (wire tag, CSV prefix).
+    pub kind: EffectorKind,
+    /// Names of `states` ([`crate::dynamics::StateEffector::state_names`]).
+    pub state_names: &'static [&'static str],
+    /// Names of `outputs` ([`crate::dynamics::StateEffector::output_names`]).
+    pub output_names: &'static [&'static str],
+    /// Its integrated states.
+    pub states: Vec<f64>,
+    /// Its outputs, named by [`crate::dynamics::StateEffector::output_names`].
+    pub outputs: Vec<f64>,
+    /// Its kind's status flags (e.g. `flexdyn_proto::wheel_flags`).
+    pub flags: u32,
+}
+
 impl Snapshot {
-    /// An all-zero snapshot with room for `n_pairs` panel pairs, to be filled by
-    /// [`Simulation::snapshot_into`].
-    pub fn with_capacity(n_pairs: usize) -> Self {
+    /// An all-zero snapshot shaped for `sim`'s effectors, to be filled by
+    /// [`Simulation::snapshot_into`] without allocating.
+    pub fn for_simulation(sim: &Simulation) -> Self {
+        let mut s = Self::empty();
+        s.shape_for(sim.spacecraft());
+        s
+    }
+
+    /// Makes `effectors` match the spacecraft's layout (allocates only when it does not yet).
+    fn shape_for(&mut self, sc: &Spacecraft) {
+        let fits = self.effectors.len() == sc.effectors().len()
+            && self
+                .effectors
+                .iter()
+                .zip(sc.effectors())
+                .all(|(s, e)| s.kind == e.kind());
+        if !fits {
+            self.effectors = sc
+                .effectors()
+                .iter()
+                .map(|e| EffectorSnapshot {
+                    kind: e.kind(),
+                    state_names: e.state_names(),
+                    output_names: e.output_names(),
+                    states: Vec::with_capacity(e.state_len()),
+                    outputs: vec![0.0; e.output_names().len()],
+                    flags: 0,
+                })
+                .collect();
+        }
+    }
+
+    /// An all-zero snapshot with no effectors.
+    fn empty() -> Self {
         let z = Vector3::zeros();
         Self {
             t_sim_ns: 0,
@@ -82,7 +143,7 @@ impl Snapshot {
             r_bn_n: z,
             v_bn_n: z,
             nongrav_accel_bn_n: z,
-            panels: Vec::with_capacity(n_pairs),
+            effectors: Vec::new(),
             conserved: Conserved {
                 orb_energy_j: 0.0,
                 rot_energy_j: 0.0,
@@ -100,6 +161,7 @@ impl Snapshot {
     }
 
     /// The first non-finite quantity, by its CSV column name (`omega_bn_b_2`, `pair1_theta2`,
+    /// `rw1_omega_rad_s`,
     /// `rot_energy_j`, …), or `None` if every value is finite. Allocates only when it finds one,
     /// so it can run once per logged row or frame.
     pub fn first_non_finite(&self) -> Option<String> {
@@ -117,11 +179,19 @@ impl Snapshot {
                 return Some(format!("{name}_{}", i + 1));
             }
         }
-        const PANEL: [&str; 4] = ["theta1", "theta1_dot", "theta2", "theta2_dot"];
-        for (k, p) in self.panels.iter().enumerate() {
-            if let Some(i) = p.iter().position(|x| !x.is_finite()) {
-                return Some(format!("pair{}_{}", k + 1, PANEL[i]));
-            }
+        for (k, e) in self.effectors.iter().enumerate() {
+            let bad_state = e.states.iter().position(|x| !x.is_finite());
+            let bad_output = e.outputs.iter().position(|x| !x.is_finite());
+            let name = match (bad_state, bad_output) {
+                (Some(i), _) => e.state_names[i],
+                (None, Some(i)) => e.output_names[i],
+                (None, None) => continue,
+            };
+            let of_kind = self.effectors[..k]
+                .iter()
+                .filter(|o| o.kind == e.kind)
+                .count();
+            return Some(format!("{}{}_{name}", e.kind.column_prefix, of_kind + 1));
         }
         let c = &self.conserved;
         let scalars = [
@@ -154,6 +224,10 @@ impl Simulation {
         }
         let imu_sigma_bn_start = sc.state().sigma_bn;
         let mut sim = Self {
+            inputs: vec![0.0; sc.effector_input_len()],
+            outputs_scratch: vec![0.0; sc.effector_output_len()],
+            flags_scratch: vec![0; sc.effectors().len()],
+            frame_outputs: None,
             sc,
             frame_ns: cfg.frame_ns,
             schedule: cfg.wrench_schedule.clone(),
@@ -176,6 +250,7 @@ impl Simulation {
     /// The spacecraft, mutably (e.g. to restore a state). Its wrench is overwritten before each
     /// step; use [`Self::set_command_wrench`] to apply one.
     pub fn spacecraft_mut(&mut self) -> &mut Spacecraft {
+        self.frame_outputs = None;
         &mut self.sc
     }
 
@@ -199,15 +274,63 @@ impl Simulation {
         self.frame_ns / self.sc.step_ns()
     }
 
-    /// Number of panel pairs (effectors).
-    pub fn n_pairs(&self) -> usize {
+    /// Number of effectors (panel pairs, then reaction wheels).
+    pub fn n_effectors(&self) -> usize {
         self.sc.effectors().len()
     }
 
     /// Commanded wrench (from the ACS controller), added to the scheduled disturbance wrench;
     /// held until the next call.
     pub fn set_command_wrench(&mut self, w: Wrench) {
+        if w != self.command {
+            self.frame_outputs = None;
+        }
         self.command = w;
+    }
+
+    /// Sets every effector's commanded inputs from one flat vector laid out by
+    /// [`Spacecraft::effector_input_ranges`] (e.g. every wheel's motor torque), held until the
+    /// next call. Fails, changing nothing, on a wrong length or a non-finite value.
+    pub fn set_effector_inputs(&mut self, u: &[f64]) -> Result<(), ParamError> {
+        self.sc.set_effector_inputs(u)?;
+        if self.inputs != u {
+            self.frame_outputs = None;
+            self.inputs.copy_from_slice(u);
+        }
+        Ok(())
+    }
+
+    /// Sets the inputs of effector `index` only (its [`crate::dynamics::StateEffector::input_len`]
+    /// values), keeping the others'.
+    pub fn set_effector_input(&mut self, index: usize, values: &[f64]) -> Result<(), ParamError> {
+        let r =
+            self.sc
+                .effector_input_ranges()
+                .get(index)
+                .cloned()
+                .ok_or(ParamError::InputLength {
+                    expected: 0,
+                    found: values.len(),
+                })?;
+        if r.len() != values.len() {
+            return Err(ParamError::InputLength {
+                expected: r.len(),
+                found: values.len(),
+            });
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(ParamError::NotFinite {
+                field: format!("effector {index} input {i}"),
+            });
+        }
+        self.inputs[r].copy_from_slice(values);
+        self.frame_outputs = None;
+        self.sc.set_effector_inputs(&self.inputs)
+    }
+
+    /// The commanded effector inputs, flat.
+    pub fn effector_inputs(&self) -> &[f64] {
+        &self.inputs
     }
 
     /// The commanded wrench.
@@ -233,6 +356,7 @@ impl Simulation {
     /// [`Spacecraft::step`]. Allocates nothing.
     #[inline]
     pub fn step(&mut self) {
+        self.frame_outputs = None;
         self.apply_wrench();
         self.sc.step();
     }
@@ -254,16 +378,31 @@ impl Simulation {
     /// The current state and outputs (one derivative evaluation, with the wrench that applies
     /// from now on: schedule(t) + command).
     pub fn snapshot(&mut self) -> Snapshot {
-        let mut out = Snapshot::with_capacity(self.n_pairs());
+        let mut out = Snapshot::for_simulation(self);
         self.snapshot_into(&mut out);
         out
     }
 
-    /// Like [`Self::snapshot`], reusing `out` (its `panels` Vec is cleared and refilled, so after
-    /// the first call this allocates nothing).
-    pub fn snapshot_into(&mut self, out: &mut Snapshot) {
+    /// The hub outputs at the current state with the wrench and inputs that apply from now on:
+    /// one derivative evaluation, shared by the snapshot and every sensor until the state, the
+    /// wrench or the inputs change.
+    fn frame_outputs(&mut self) -> HubOutputs {
+        if let Some(o) = self.frame_outputs {
+            return o;
+        }
         self.apply_wrench();
-        let hub = self.sc.hub_outputs();
+        let o = self.sc.hub_outputs();
+        self.frame_outputs = Some(o);
+        o
+    }
+
+    /// Like [`Self::snapshot`], reusing `out` (shaped on first use; after that this allocates
+    /// nothing).
+    pub fn snapshot_into(&mut self, out: &mut Snapshot) {
+        out.shape_for(&self.sc);
+        let hub = self.frame_outputs();
+        self.sc
+            .effector_outputs(&mut self.outputs_scratch, &mut self.flags_scratch);
         let state = self.sc.state();
         let dcm_nb = mrp_to_dcm(&state.sigma_bn).transpose();
         out.t_sim_ns = self.sc.t_sim_ns();
@@ -274,14 +413,17 @@ impl Simulation {
         out.r_bn_n = state.r_bn_n;
         out.v_bn_n = state.v_bn_n;
         out.nongrav_accel_bn_n = dcm_nb * hub.nongrav_accel_bn_b;
-        out.panels.clear();
-        for r in self.sc.effector_ranges() {
-            let x = &state.effectors[r.clone()];
-            let mut p = [0.0; 4];
-            for (o, v) in p.iter_mut().zip(x) {
-                *o = *v;
-            }
-            out.panels.push(p);
+        let ranges = self
+            .sc
+            .effector_ranges()
+            .iter()
+            .zip(self.sc.effector_output_ranges())
+            .zip(&self.flags_scratch);
+        for (e, ((r, o), flags)) in out.effectors.iter_mut().zip(ranges) {
+            e.states.clear();
+            e.states.extend_from_slice(&state.effectors[r.clone()]);
+            e.outputs.copy_from_slice(&self.outputs_scratch[o.clone()]);
+            e.flags = *flags;
         }
         out.conserved = self.sc.conserved();
         let w = self.sc.wrench();
@@ -335,8 +477,7 @@ impl Simulation {
         if self.imus.is_empty() {
             return;
         }
-        self.apply_wrench();
-        let hub = self.sc.hub_outputs();
+        let hub = self.frame_outputs();
         let t_ns = self.sc.t_sim_ns();
         let dt_s = t_ns.saturating_sub(self.imu_interval_start_ns) as f64 * 1e-9;
         let sigma_bn = self.sc.state().sigma_bn;
@@ -391,7 +532,7 @@ mod tests {
         sim.step_n(2);
         let s = sim.snapshot();
         assert_eq!(s.force_b_newton, Vector3::new(0.0, 3.0, 0.0));
-        assert_eq!(s.panels.len(), 2);
+        assert_eq!(s.effectors.len(), 2);
     }
 
     #[test]
@@ -400,7 +541,7 @@ mod tests {
         assert_eq!(sim.steps_per_frame(), 10);
         sim.step_frame();
         assert_eq!(sim.t_sim_ns(), sim.frame_ns());
-        let mut snap = Snapshot::with_capacity(2);
+        let mut snap = Snapshot::for_simulation(&sim);
         sim.snapshot_into(&mut snap);
         assert_eq!(snap.t_sim_ns, 10_000_000);
         assert!((snap.q_bn.norm() - 1.0).abs() < 1e-12);

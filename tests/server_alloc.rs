@@ -28,14 +28,20 @@ fn the_frame_path_does_not_allocate() {
     let mut sim = Simulation::new(&cfg).unwrap();
     assert!(sim.n_imus() > 0);
     let mut imu = Vec::with_capacity(sim.n_imus());
-    let mut book = CommandBook::new(&[1, 2], cfg.frame_ns, 100_000_000, StalePolicy::Hold);
-    let mut snap = Snapshot::with_capacity(sim.n_pairs());
+    let mut book = CommandBook::new(
+        &[1, 2],
+        cfg.frame_ns,
+        100_000_000,
+        StalePolicy::Hold,
+        sim.spacecraft().effector_input_ranges(),
+    );
+    let mut snap = Snapshot::for_simulation(&sim);
     let (cmd_tx, cmd_rx) = sync_channel::<CommandMsg>(16);
     let (free_tx, free_rx) = sync_channel::<Box<Frame>>(2);
     let (full_tx, full_rx) = sync_channel::<Box<Frame>>(2);
     for _ in 0..2 {
         free_tx
-            .send(Box::new(Frame::with_capacity(sim.n_pairs(), sim.n_imus())))
+            .send(Box::new(Frame::for_snapshot(&snap, sim.n_imus())))
             .unwrap();
     }
     let mut frame_once = |k: u64| {
@@ -54,6 +60,7 @@ fn the_frame_path_does_not_allocate() {
             force_b_newton: Vector3::from(held.force_b_newton),
             torque_b_nm: Vector3::from(held.torque_b_nm),
         });
+        sim.set_effector_inputs(book.held_inputs()).unwrap();
         sim.step_frame();
         sim.imu_samples_into(&mut imu);
         let mut f = free_rx.try_recv().unwrap();

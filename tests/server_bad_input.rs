@@ -60,18 +60,33 @@ fn bad_commands_are_counted_and_the_server_keeps_running() {
     // Another spacecraft.
     put(encode(&CommandMsg {
         header: Header::new(99, tick, 0, 0),
-        ..good
+        ..good.clone()
     }));
     // Unknown sender.
     put(encode(&CommandMsg {
         sender_id: 42,
-        ..good
+        ..good.clone()
     }));
     // A tick in the future.
     put(encode(&CommandMsg {
         header: Header::new(1, tick + 1_000_000, 0, 0),
-        ..good
+        ..good.clone()
     }));
+
+    // Effector inputs the reference spacecraft cannot take: its effectors (two panel pairs)
+    // have no inputs, and there is no effector 99.
+    for index in [0, 99] {
+        put(encode(&CommandMsg::actuators(
+            Header::new(1, tick, 0, 0),
+            1,
+            [0.0; 3],
+            [0.0; 3],
+            vec![flexdyn_proto::EffectorInput {
+                effector_index: index,
+                values: vec![0.1],
+            }],
+        )));
+    }
 
     let want = RejectCounters {
         malformed: 2,
@@ -80,6 +95,7 @@ fn bad_commands_are_counted_and_the_server_keeps_running() {
         wrong_spacecraft: 1,
         stale_tick: 1,
         unknown_sender: 1,
+        bad_effector_input: 2,
     };
     assert!(
         wait_until(WAIT, || obs
@@ -96,7 +112,7 @@ fn bad_commands_are_counted_and_the_server_keeps_running() {
         .is_some_and(|t| t >= now + 10)));
     let fresh = CommandMsg {
         header: Header::new(1, obs.last_tick().unwrap(), 0, 1),
-        ..good
+        ..good.clone()
     };
     put(encode(&fresh));
     let applied = || {

@@ -72,7 +72,8 @@
 
 use flexdyn::dynamics::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
-    PanelPairParams, PanelParams, Spacecraft, State, StateEffector,
+    PanelPairParams, PanelParams, ReactionWheel, ReactionWheelParams, Spacecraft, State,
+    StateEffector,
 };
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use rand_chacha::ChaCha8Rng;
@@ -201,6 +202,9 @@ struct Config {
     mu: Option<f64>,
     force_b: V3,
     torque_b: V3,
+    /// Reaction wheels and their commanded motor torques [N·m] (after the panel pairs in the
+    /// library's effector order).
+    wheels: Vec<(ReactionWheelParams, f64)>,
 }
 
 #[derive(Debug, Clone)]
@@ -211,6 +215,8 @@ struct Sample {
     omega_bn_b: V3,
     /// θ1, θ̇1, θ2, θ̇2 per pair (the library's layout).
     eff: Vec<f64>,
+    /// [rad/s] wheel speeds Ω relative to the hub, one per wheel.
+    wheel_omega: Vec<f64>,
 }
 
 /// Sampling ranges. `Plausible` spacecraft (hub 100–2000 kg, panels 1–200 kg) are what the
@@ -296,7 +302,43 @@ fn random_config(rng: &mut Rng, n_pairs: usize, gravity: bool, ranges: Ranges) -
         mu: gravity.then_some(MU_EARTH),
         force_b: rng.vec(200.0),
         torque_b: rng.vec(200.0),
+        wheels: Vec::new(),
     }
+}
+
+/// `n` random balanced wheels with friction and a commanded torque within the motor's limit.
+/// The rotor: J_s = ½ m ρ² (a disk of radius ρ), J_t between ½ J_s and J_s (so the rotor's
+/// principal moments obey the triangle inequality).
+fn random_wheels(rng: &mut Rng, n: usize) -> Vec<(ReactionWheelParams, f64)> {
+    (0..n)
+        .map(|j| {
+            let axis = loop {
+                let a = rng.vec(1.0);
+                if (0.1..=1.0).contains(&a.norm()) {
+                    break a.normalize();
+                }
+            };
+            let mass = rng.log_range(0.5, 20.0);
+            let rho = rng.range(0.05, 0.25);
+            let j_s = 0.5 * mass * rho * rho;
+            let mut p = ReactionWheelParams::balanced(
+                &format!("rw{j}"),
+                axis,
+                rng.vec(1.5),
+                mass,
+                j_s,
+                j_s * rng.range(0.5, 1.0),
+                0.0,
+                1.0,
+                600.0,
+            );
+            if rng.unit() < 0.8 {
+                p.viscous_friction_nm_s_rad = rng.log_range(1e-6, 1e-3);
+                p.coulomb_friction_nm = rng.log_range(1e-4, 1e-2);
+            }
+            (p, rng.range(-0.9, 0.9))
+        })
+        .collect()
 }
 
 fn random_sample(rng: &mut Rng, n_pairs: usize) -> Sample {
@@ -334,6 +376,7 @@ fn random_sample(rng: &mut Rng, n_pairs: usize) -> Sample {
         sigma_bn,
         omega_bn_b: omega,
         eff,
+        wheel_omega: Vec::new(),
     }
 }
 
@@ -351,6 +394,30 @@ fn cases(seed: u64, ranges: Ranges) -> Vec<(Config, Vec<Sample>)> {
             let cfg = random_config(&mut rng, n_pairs, k % 4 == 3, ranges);
             let samples = (0..STATES_PER_CONFIG)
                 .map(|_| random_sample(&mut rng, n_pairs))
+                .collect();
+            (cfg, samples)
+        })
+        .collect()
+}
+
+/// Cases with reaction wheels: 1 or 2 pairs and 1–4 wheels, wheel speeds up to ±590 rad/s
+/// (within the motor's speed limit, so the commanded torque applies unclipped), 1 in 4 under
+/// point-mass gravity.
+fn cases_with_wheels(seed: u64) -> Vec<(Config, Vec<Sample>)> {
+    let mut rng = Rng::new(seed);
+    (0..N_CONFIGS)
+        .map(|k| {
+            let n_pairs = 1 + k % 2;
+            let mut cfg = random_config(&mut rng, n_pairs, k % 4 == 3, Ranges::Plausible);
+            cfg.wheels = random_wheels(&mut rng, 1 + k % 4);
+            let samples = (0..STATES_PER_CONFIG)
+                .map(|_| {
+                    let mut x = random_sample(&mut rng, n_pairs);
+                    x.wheel_omega = (0..cfg.wheels.len())
+                        .map(|_| rng.range(-590.0, 590.0))
+                        .collect();
+                    x
+                })
                 .collect();
             (cfg, samples)
         })
@@ -426,6 +493,9 @@ struct Body<'a> {
     /// Resultant applied force (through the CoM) and torque.
     force: V3,
     torque: V3,
+    /// ω_body × [I_c] ω_body when given in an expanded form (a spinning rotor: see the wheel
+    /// bodies); `None` computes it directly.
+    gyroscopic: Option<V3>,
 }
 
 impl Assembler {
@@ -435,7 +505,10 @@ impl Assembler {
         let i_c = DMatrix::from_column_slice(3, 3, b.i_c.as_slice());
         self.m += v.transpose() * v * b.mass + w.transpose() * (&i_c * w);
         let lin = b.force - b.a_vp * b.mass;
-        let ang = b.torque - b.i_c * b.alpha_vp - b.omega.cross(&(b.i_c * b.omega));
+        let gyro = b
+            .gyroscopic
+            .unwrap_or_else(|| b.omega.cross(&(b.i_c * b.omega)));
+        let ang = b.torque - b.i_c * b.alpha_vp - gyro;
         self.f += v.transpose() * DVector::from_column_slice(lin.as_slice())
             + w.transpose() * DVector::from_column_slice(ang.as_slice());
     }
@@ -451,7 +524,8 @@ fn set_col(m: &mut DMatrix<f64>, col: usize, v: &V3) {
 
 fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
     let np = cfg.pairs.len();
-    let n = 6 + 2 * np;
+    let nw = cfg.wheels.len();
+    let n = 6 + 2 * np + nw;
     let w = x.omega_bn_b;
     let hub = &cfg.hub;
 
@@ -473,6 +547,21 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
         m_sc += p.panel1.mass_kg + mass2(p);
         first += g.r1 * p.panel1.mass_kg + g.r2 * mass2(p);
     }
+    for (wp, _) in &cfg.wheels {
+        m_sc += wp.mass_kg;
+        first += wp.r_wb_b_m * wp.mass_kg;
+    }
+    // Wheel spin torques on the rotors (motor + friction), about +ĝ_s: the rotor's generalized
+    // speed is Ω, its partial angular velocity ĝ_s; the hub takes the reaction.
+    let wheel_taus: Vec<f64> = cfg
+        .wheels
+        .iter()
+        .zip(&x.wheel_omega)
+        .map(|((wp, u), &om)| {
+            let coulomb = wp.coulomb_friction_nm * (om / wp.coulomb_band_rad_s).clamp(-1.0, 1.0);
+            u - wp.viscous_friction_nm_s_rad * om - coulomb
+        })
+        .collect();
     let dcm_bn = dcm_bn_from_mrp(&x.sigma_bn);
     let g_b = match cfg.mu {
         None => V3::zeros(),
@@ -516,6 +605,9 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
         for (g, (tau1, _)) in geoms.iter().zip(&taus) {
             torque -= axis(&g.c1, 1) * *tau1; // reaction of hinge 1
         }
+        for ((wp, _), tau) in cfg.wheels.iter().zip(&wheel_taus) {
+            torque -= wp.spin_axis_b * *tau; // reaction of the wheel motor and bearing
+        }
         asm.add(&Body {
             mass: hub.mass_kg,
             i_c: hub.inertia_bc_b_kg_m2,
@@ -526,6 +618,7 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
             alpha_vp: V3::zeros(),
             force: g_b * hub.mass_kg,
             torque,
+            gyroscopic: None,
         });
     }
 
@@ -562,6 +655,7 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
             alpha_vp: w.cross(&(s12 * th1d)),
             force: g_b * m1,
             torque: s12 * (tau1 - tau2),
+            gyroscopic: None,
         });
 
         // Panel 2.
@@ -587,6 +681,7 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
             alpha_vp: w.cross(&(s12 * big_th2d)),
             force: g_b * m2,
             torque: s12 * *tau2,
+            gyroscopic: None,
         });
 
         if variant == Variant::PrintedE1 {
@@ -596,6 +691,39 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
                 asm.m[(c2i, 3 + k)] += delta[k];
             }
         }
+    }
+
+    // Wheel rotors: CoM fixed in B at r_W, angular velocity ω + Ω ĝ_s (ĝ_s fixed in B, so
+    // its inertial rate is ω × Ω ĝ_s), inertia J_s ĝĝᵀ + J_t (I − ĝĝᵀ) about the CoM. Each rotor
+    // adds one generalized speed Ω (partial velocity 0, partial angular velocity ĝ_s).
+    for (j, ((wp, _), tau)) in cfg.wheels.iter().zip(&wheel_taus).enumerate() {
+        let col = 6 + 2 * np + j;
+        let g = wp.spin_axis_b;
+        let om = x.wheel_omega[j];
+        let ggt = g * g.transpose();
+        let i_w = ggt * wp.j_s_kg_m2 + (M3::identity() - ggt) * wp.j_t_kg_m2;
+        let mut v = DMatrix::zeros(3, n);
+        let mut wm = DMatrix::zeros(3, n);
+        set_block(&mut v, 0, &M3::identity());
+        set_block(&mut v, 3, &(-skew(&wp.r_wb_b_m)));
+        set_block(&mut wm, 3, &M3::identity());
+        set_col(&mut wm, col, &g);
+        asm.add(&Body {
+            mass: wp.mass_kg,
+            i_c: i_w,
+            v: &v,
+            w: &wm,
+            a_vp: w.cross(&w.cross(&wp.r_wb_b_m)),
+            omega: w + g * om,
+            alpha_vp: w.cross(&(g * om)),
+            force: g_b * wp.mass_kg,
+            torque: g * *tau,
+            // (ω + Ωĝ) × [I_W](ω + Ωĝ), expanded with [I_W]ĝ = J_s ĝ so the Ω² ĝ × ĝ term, zero
+            // exactly, is not formed: at Ω ~ 500 rad/s its round-off alone would move Ω̇ by ~1e-11.
+            gyroscopic: Some(
+                w.cross(&(i_w * w)) + (w.cross(&g) * wp.j_s_kg_m2 + g.cross(&(i_w * w))) * om,
+            ),
+        });
     }
 
     Dense {
@@ -631,6 +759,11 @@ fn build_library(cfg: &Config) -> Spacecraft {
             .expect("valid random pair");
             Box::new(pair) as Box<dyn StateEffector>
         })
+        .chain(cfg.wheels.iter().enumerate().map(|(j, (wp, _))| {
+            let wheel = ReactionWheel::new(wp.clone(), &format!("reaction_wheels[{j}]"))
+                .expect("valid random wheel");
+            Box::new(wheel) as Box<dyn StateEffector>
+        }))
         .collect();
     let gravity = match cfg.mu {
         None => GravityModel::None,
@@ -650,6 +783,8 @@ fn build_library(cfg: &Config) -> Spacecraft {
         force_b_newton: cfg.force_b,
         torque_b_nm: cfg.torque_b,
     });
+    let u: Vec<f64> = cfg.wheels.iter().map(|(_, u)| *u).collect();
+    sc.set_effector_inputs(&u).expect("one input per wheel");
     sc
 }
 
@@ -661,14 +796,18 @@ fn library_accel(sc: &mut Spacecraft, x: &Sample) -> (DVector<f64>, V3) {
         v_bn_n: x.v_bn_n,
         sigma_bn: x.sigma_bn,
         omega_bn_b: x.omega_bn_b,
-        effectors: x.eff.clone(),
+        effectors: x.eff.iter().chain(&x.wheel_omega).copied().collect(),
         sensor_dv_p: Vec::new(),
     };
     let mut dx = state.clone();
     let out = sc.derivatives(&state, &mut dx);
     let np = x.eff.len() / 4;
+    let nw = x.wheel_omega.len();
     let a_b = dcm_bn_from_mrp(&x.sigma_bn) * dx.v_bn_n;
-    let mut q = DVector::zeros(6 + 2 * np);
+    let mut q = DVector::zeros(6 + 2 * np + nw);
+    for j in 0..nw {
+        q[6 + 2 * np + j] = dx.effectors[4 * np + j];
+    }
     q.fixed_rows_mut::<3>(0).copy_from(&a_b);
     q.fixed_rows_mut::<3>(3).copy_from(&dx.omega_bn_b);
     for i in 0..np {
@@ -856,7 +995,23 @@ fn validate_dense_kane_extreme_spacecraft() {
     compare_with_library(Ranges::Extreme);
 }
 
+/// Back-substitution with reaction wheels and panel pairs together (balanced wheels with
+/// commanded motor torques and viscous + Coulomb friction) against the dense Kane model with
+/// each rotor as a body: ≤ 1e-12 relative on every state.
+#[test]
+fn validate_dense_kane_with_wheels() {
+    compare_cases(
+        Ranges::Plausible,
+        cases_with_wheels(0x3EE1),
+        "with reaction wheels",
+    );
+}
+
 fn compare_with_library(ranges: Ranges) {
+    compare_cases(ranges, cases(0xD3E5E, ranges), "panel pairs");
+}
+
+fn compare_cases(ranges: Ranges, cases: Vec<(Config, Vec<Sample>)>, label: &str) {
     let t0 = std::time::Instant::now();
     struct Row {
         err: f64,
@@ -868,7 +1023,7 @@ fn compare_with_library(ranges: Ranges) {
         gravity: bool,
     }
     let mut rows = Vec::new();
-    for (cfg, samples) in cases(0xD3E5E, ranges) {
+    for (cfg, samples) in cases {
         let mut sc = build_library(&cfg);
         for x in &samples {
             let d = dense_kane(&cfg, x, Variant::Exact);
@@ -907,7 +1062,7 @@ fn compare_with_library(ranges: Ranges) {
     let max_ratio_2 = max_of(&mut rows.iter().map(|r| r.err / (r.kappa_2 * f64::EPSILON)));
     let max_ks = max_of(&mut rows.iter().map(|r| r.kappa_s));
     eprintln!(
-        "dense Kane vs library, {ranges:?} spacecraft, {n_all} states ({n_free} free space, {n_grav} point-mass gravity), {elapsed:.3} s:\n  \
+        "dense Kane vs library ({label}), {ranges:?} spacecraft, {n_all} states ({n_free} free space, {n_grav} point-mass gravity), {elapsed:.3} s:\n  \
          all states:        max rel err {max_all:.3e}, median {med_all:.3e}\n  \
          free space:        max rel err {max_free:.3e}, median {med_free:.3e}\n  \
          with gravity:      max rel err {max_grav:.3e}, median {med_grav:.3e}\n  \

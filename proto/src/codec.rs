@@ -11,7 +11,7 @@
 //! 2. first two bytes (u16 LE) ≠ [`PROTOCOL_VERSION`] → [`DecodeError::UnknownVersion`]
 //!    (fewer than two bytes → [`DecodeError::Length`]);
 //! 3. the total length implied by the message's [`WireLayout`](crate::WireLayout)
-//!    (fixed size, enum tag, or count prefix) is compared with the buffer →
+//!    (fixed size, enum tag, or the walked count prefixes) is compared with the buffer →
 //!    [`DecodeError::Length`] / [`DecodeError::TrailingBytes`], or
 //!    [`DecodeError::Malformed`] for an unknown tag or an excessive count; this
 //!    also bounds any allocation before bincode sees a length prefix;
@@ -21,8 +21,8 @@
 use bincode::config::{Configuration, Fixint, Limit, LittleEndian};
 
 use crate::{
-    CommandMsg, DecodeError, Header, ImuMsg, StateMsg, StatusMsg, WireMessage, HEADER_LEN,
-    MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
+    CommandMsg, DecodeError, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg, WireMessage,
+    HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
 };
 
 /// The bincode configuration of the wire format.
@@ -40,7 +40,7 @@ pub fn encode<M: WireMessage>(msg: &M) -> Vec<u8> {
 /// capacity, so a publisher can reuse one buffer without allocating per frame.
 ///
 /// Encoding cannot fail; it does not run [`WireMessage::validate`], and a
-/// [`StateMsg`] with more than [`crate::MAX_PANEL_PAIRS`] panels encodes fine but
+/// [`StateMsg`] with more than [`crate::MAX_EFFECTORS`] effectors encodes fine but
 /// is rejected by decoders.
 pub fn encode_into<M: WireMessage>(msg: &M, buf: &mut Vec<u8>) {
     buf.clear();
@@ -101,6 +101,11 @@ pub fn decode_state(bytes: &[u8]) -> Result<StateMsg, DecodeError> {
 
 /// [`decode`] for [`ImuMsg`].
 pub fn decode_imu(bytes: &[u8]) -> Result<ImuMsg, DecodeError> {
+    decode(bytes)
+}
+
+/// [`decode`] for [`StarTrackerMsg`].
+pub fn decode_star_tracker(bytes: &[u8]) -> Result<StarTrackerMsg, DecodeError> {
     decode(bytes)
 }
 

@@ -11,7 +11,9 @@ pub const KEY_ROOT: &str = "flexdyn";
 pub const STATE_SUFFIX: &str = "tlm/state";
 /// Prefix of the IMU topics; the IMU name follows after a `/`.
 pub const IMU_PREFIX: &str = "tlm/imu";
-/// Suffix of the wrench-command topic.
+/// Prefix of the star-tracker topics; the tracker name follows after a `/`.
+pub const STAR_TRACKER_PREFIX: &str = "tlm/st";
+/// Key suffix of the command topic (every [`crate::CommandKind`], despite the name).
 pub const CMD_WRENCH_SUFFIX: &str = "cmd/wrench";
 /// Suffix of the status topic.
 pub const STATUS_SUFFIX: &str = "status";
@@ -68,6 +70,24 @@ pub fn imu_key(sc: &str, name: &str) -> Result<String, KeyError> {
 pub fn imu_wildcard_key(sc: &str) -> Result<String, KeyError> {
     validate_sc_id(sc)?;
     Ok(format!("{KEY_ROOT}/{sc}/{IMU_PREFIX}/*"))
+}
+
+/// Check a star-tracker name.
+pub fn validate_star_tracker_name(name: &str) -> Result<(), KeyError> {
+    validate("star tracker name", name)
+}
+
+/// `flexdyn/<sc>/tlm/st/<name>`
+pub fn star_tracker_key(sc: &str, name: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    validate_star_tracker_name(name)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{STAR_TRACKER_PREFIX}/{name}"))
+}
+
+/// `flexdyn/<sc>/tlm/st/*` — subscribe to every star tracker of a spacecraft.
+pub fn star_tracker_wildcard_key(sc: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{STAR_TRACKER_PREFIX}/*"))
 }
 
 /// `flexdyn/<sc>/cmd/wrench`
@@ -141,6 +161,11 @@ impl Topics {
         imu_key(&self.sc_id, name)
     }
 
+    /// `flexdyn/<sc>/tlm/st/<name>`
+    pub fn star_tracker(&self, name: &str) -> Result<String, KeyError> {
+        star_tracker_key(&self.sc_id, name)
+    }
+
     /// `flexdyn/<sc>/tlm/imu/*`
     pub fn imu_wildcard(&self) -> String {
         format!("{KEY_ROOT}/{}/{IMU_PREFIX}/*", self.sc_id)
@@ -187,6 +212,15 @@ mod tests {
         assert_eq!(cmd_wrench_key("SC_2").unwrap(), "flexdyn/SC_2/cmd/wrench");
         assert_eq!(status_key("x").unwrap(), "flexdyn/x/status");
         assert_eq!(imu_wildcard_key("x").unwrap(), "flexdyn/x/tlm/imu/*");
+        assert_eq!(
+            star_tracker_key("sc-1", "st_A").unwrap(),
+            "flexdyn/sc-1/tlm/st/st_A"
+        );
+        assert_eq!(
+            star_tracker_wildcard_key("x").unwrap(),
+            "flexdyn/x/tlm/st/*"
+        );
+        assert!(star_tracker_key("sc", "a*").is_err());
         let t = Topics::new("sc-1").unwrap();
         assert_eq!(t.sc_id(), "sc-1");
         assert_eq!(t.state(), "flexdyn/sc-1/tlm/state");

@@ -4,57 +4,62 @@
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
-use crate::{CommandKind, CommandMsg, DecodeError, Header, ImuMsg, StateMsg, StatusMsg};
+use crate::{
+    CommandKind, CommandMsg, DecodeError, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg,
+};
 
 /// Encoded [`Header`] size (bytes).
 pub const HEADER_LEN: usize = 30;
-/// Encoded [`crate::PanelPairState`] size (bytes).
-pub const PANEL_PAIR_LEN: usize = 32;
-/// Offset of the u64 panel count in a [`StateMsg`].
-pub const STATE_PANEL_COUNT_OFFSET: usize = 319;
-/// Encoded [`StateMsg`] size with no panels (bytes); add [`PANEL_PAIR_LEN`] per pair.
+/// Offset of the u64 effector count in a [`StateMsg`].
+pub const STATE_EFFECTOR_COUNT_OFFSET: usize = 319;
+/// Encoded [`StateMsg`] size with no effectors (bytes).
 pub const STATE_FIXED_LEN: usize = 327;
+/// Encoded [`crate::EffectorState`] size with no states and no outputs (bytes): u16 kind,
+/// u32 flags, two u64 counts. Add 8 per value.
+pub const EFFECTOR_STATE_FIXED_LEN: usize = 22;
+/// Encoded [`crate::EffectorInput`] size with no values (bytes): u32 index, u64 count.
+pub const EFFECTOR_INPUT_FIXED_LEN: usize = 12;
 /// Encoded [`ImuMsg`] size (bytes).
 pub const IMU_LEN: usize = 127;
+/// Encoded [`StarTrackerMsg`] size (bytes).
+pub const STAR_TRACKER_LEN: usize = 64;
 /// Offset of the u32 [`CommandKind`] tag in a [`CommandMsg`].
 pub const COMMAND_KIND_OFFSET: usize = 34;
 /// Encoded [`CommandMsg`] size with [`CommandKind::Wrench`] (bytes).
 pub const COMMAND_WRENCH_LEN: usize = 86;
 /// Encoded [`CommandMsg`] size with [`CommandKind::NoCommand`] (bytes).
 pub const COMMAND_NO_COMMAND_LEN: usize = 38;
+/// Encoded [`CommandMsg`] size with [`CommandKind::Actuators`] and no inputs (bytes); the
+/// u64 input count sits at offset 86.
+pub const COMMAND_ACTUATORS_FIXED_LEN: usize = 94;
 /// Encoded [`StatusMsg`] size (bytes).
-pub const STATUS_LEN: usize = 163;
-/// Largest panel count a [`StateMsg`] may carry; decoders reject more.
-pub const MAX_PANEL_PAIRS: usize = 1024;
+pub const STATUS_LEN: usize = 171;
+/// Largest effector count a [`StateMsg`] (or input count a [`CommandKind::Actuators`]) may
+/// carry; decoders reject more.
+pub const MAX_EFFECTORS: usize = 1024;
+/// Largest panel-pair count a configuration may have (each pair is one effector).
+pub const MAX_PANEL_PAIRS: usize = MAX_EFFECTORS;
+/// Largest length of an effector's `states`, `outputs` or input `values`; decoders reject
+/// more.
+pub const MAX_EFFECTOR_VALUES: usize = 8;
 /// Largest buffer any decoder accepts (bytes); also the bincode decode limit.
 pub const MAX_MESSAGE_BYTES: usize = 65536;
 
 /// How the total encoded length of a message type follows from its bytes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug)]
 pub enum WireLayout {
     /// Always `len` bytes.
     Fixed {
         /// Encoded length (bytes).
         len: usize,
     },
-    /// `fixed_len` bytes, the last 8 of which (at `count_offset`) are a u64 LE
-    /// element count, then `count * elem_len` bytes.
-    TrailingSeq {
-        /// Length with zero elements, count prefix included (bytes).
-        fixed_len: usize,
-        /// Offset of the u64 LE count.
-        count_offset: usize,
-        /// Encoded element size (bytes).
-        elem_len: usize,
-        /// Largest accepted count.
-        max_count: usize,
-    },
-    /// A u32 LE enum tag at `tag_offset`; `lens[tag]` is the total length.
-    Tagged {
-        /// Offset of the u32 LE tag.
-        tag_offset: usize,
-        /// Total length per tag value.
-        lens: &'static [usize],
+    /// Nested variable-length lists: the length is found by walking the count
+    /// prefixes (each bounded before it is used).
+    Walked {
+        /// Shortest possible encoding (bytes).
+        min_len: usize,
+        /// Returns the total length implied by the bytes, or the error to report.
+        walk: fn(&[u8]) -> Result<usize, DecodeError>,
     },
 }
 
@@ -64,10 +69,11 @@ mod sealed {
     impl Sealed for super::ImuMsg {}
     impl Sealed for super::CommandMsg {}
     impl Sealed for super::StatusMsg {}
+    impl Sealed for super::StarTrackerMsg {}
 }
 
 /// A top-level message that can go on the wire. Implemented (only) by
-/// [`StateMsg`], [`ImuMsg`], [`CommandMsg`] and [`StatusMsg`].
+/// [`StateMsg`], [`ImuMsg`], [`StarTrackerMsg`], [`CommandMsg`] and [`StatusMsg`].
 pub trait WireMessage: Serialize + DeserializeOwned + sealed::Sealed {
     /// Type name used in error messages.
     const NAME: &'static str;
@@ -88,11 +94,9 @@ pub trait WireMessage: Serialize + DeserializeOwned + sealed::Sealed {
 
 impl WireMessage for StateMsg {
     const NAME: &'static str = "StateMsg";
-    const LAYOUT: WireLayout = WireLayout::TrailingSeq {
-        fixed_len: STATE_FIXED_LEN,
-        count_offset: STATE_PANEL_COUNT_OFFSET,
-        elem_len: PANEL_PAIR_LEN,
-        max_count: MAX_PANEL_PAIRS,
+    const LAYOUT: WireLayout = WireLayout::Walked {
+        min_len: STATE_FIXED_LEN,
+        walk: walk_state,
     };
     const MIN_LEN: usize = STATE_FIXED_LEN;
     fn header(&self) -> &Header {
@@ -104,6 +108,17 @@ impl WireMessage for ImuMsg {
     const NAME: &'static str = "ImuMsg";
     const LAYOUT: WireLayout = WireLayout::Fixed { len: IMU_LEN };
     const MIN_LEN: usize = IMU_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+impl WireMessage for StarTrackerMsg {
+    const NAME: &'static str = "StarTrackerMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed {
+        len: STAR_TRACKER_LEN,
+    };
+    const MIN_LEN: usize = STAR_TRACKER_LEN;
     fn header(&self) -> &Header {
         &self.header
     }
@@ -131,9 +146,9 @@ const FORCE_FIELDS: [&str; 3] = [
 
 impl WireMessage for CommandMsg {
     const NAME: &'static str = "CommandMsg";
-    const LAYOUT: WireLayout = WireLayout::Tagged {
-        tag_offset: COMMAND_KIND_OFFSET,
-        lens: &[COMMAND_WRENCH_LEN, COMMAND_NO_COMMAND_LEN],
+    const LAYOUT: WireLayout = WireLayout::Walked {
+        min_len: COMMAND_NO_COMMAND_LEN,
+        walk: walk_command,
     };
     const MIN_LEN: usize = COMMAND_NO_COMMAND_LEN;
     fn header(&self) -> &Header {
@@ -141,24 +156,127 @@ impl WireMessage for CommandMsg {
     }
 
     /// Rejects NaN/infinite components with [`DecodeError::NonFinite`] naming
-    /// the first offending field (torque checked before force).
+    /// the first offending field (torque, then force, then the inputs in order).
     fn validate(&self) -> Result<(), DecodeError> {
-        if let CommandKind::Wrench {
-            torque_b_nm,
-            force_b_newton,
-        } = &self.kind
-        {
-            let fields = TORQUE_FIELDS
-                .iter()
-                .zip(torque_b_nm)
-                .chain(FORCE_FIELDS.iter().zip(force_b_newton));
-            for (field, v) in fields {
-                if !v.is_finite() {
-                    return Err(DecodeError::NonFinite { field });
-                }
+        let (torque_b_nm, force_b_newton, inputs) = match &self.kind {
+            CommandKind::Wrench {
+                torque_b_nm,
+                force_b_newton,
+            } => (torque_b_nm, force_b_newton, &[][..]),
+            CommandKind::Actuators {
+                torque_b_nm,
+                force_b_newton,
+                inputs,
+            } => (torque_b_nm, force_b_newton, inputs.as_slice()),
+            CommandKind::NoCommand => return Ok(()),
+        };
+        let fields = TORQUE_FIELDS
+            .iter()
+            .zip(torque_b_nm)
+            .chain(FORCE_FIELDS.iter().zip(force_b_newton));
+        for (field, v) in fields {
+            if !v.is_finite() {
+                return Err(DecodeError::NonFinite { field });
             }
         }
+        if inputs
+            .iter()
+            .flat_map(|i| &i.values)
+            .any(|v| !v.is_finite())
+        {
+            return Err(DecodeError::NonFinite {
+                field: "kind.inputs[].values[]",
+            });
+        }
         Ok(())
+    }
+}
+
+/// A bounds-checked reader of count prefixes, for [`WireLayout::Walked`].
+struct Walker<'b> {
+    bytes: &'b [u8],
+    at: usize,
+}
+
+impl Walker<'_> {
+    /// Skips `n` bytes; an error if the buffer ends first.
+    fn skip(&mut self, n: usize) -> Result<(), DecodeError> {
+        let end = self.at.checked_add(n).ok_or(DecodeError::Length {
+            needed: usize::MAX,
+            actual: self.bytes.len(),
+        })?;
+        if end > self.bytes.len() {
+            return Err(DecodeError::Length {
+                needed: end,
+                actual: self.bytes.len(),
+            });
+        }
+        self.at = end;
+        Ok(())
+    }
+
+    /// Reads a u64 LE count at the cursor and checks it against `max`.
+    fn count(&mut self, what: &str, max: usize) -> Result<usize, DecodeError> {
+        let count = read_u64_le(self.bytes, self.at).ok_or(DecodeError::Length {
+            needed: self.at + 8,
+            actual: self.bytes.len(),
+        })?;
+        if count > max as u64 {
+            return Err(DecodeError::Malformed(format!(
+                "{what} count {count} at offset {} exceeds maximum {max}",
+                self.at
+            )));
+        }
+        self.at += 8;
+        Ok(count as usize)
+    }
+
+    /// Reads a count of f64 values and skips them.
+    fn values(&mut self, what: &str) -> Result<(), DecodeError> {
+        let n = self.count(what, MAX_EFFECTOR_VALUES)?;
+        self.skip(8 * n)
+    }
+}
+
+/// Length of a [`StateMsg`]: the fixed part, then each [`crate::EffectorState`].
+fn walk_state(bytes: &[u8]) -> Result<usize, DecodeError> {
+    let mut w = Walker {
+        bytes,
+        at: STATE_EFFECTOR_COUNT_OFFSET,
+    };
+    let n = w.count("effector", MAX_EFFECTORS)?;
+    for _ in 0..n {
+        w.skip(6)?;
+        w.values("effector states")?;
+        w.values("effector outputs")?;
+    }
+    Ok(w.at)
+}
+
+/// Length of a [`CommandMsg`]: fixed by the tag, or walked for `Actuators`.
+fn walk_command(bytes: &[u8]) -> Result<usize, DecodeError> {
+    let tag = read_u32_le(bytes, COMMAND_KIND_OFFSET).ok_or(DecodeError::Length {
+        needed: COMMAND_NO_COMMAND_LEN,
+        actual: bytes.len(),
+    })?;
+    match tag {
+        0 => Ok(COMMAND_WRENCH_LEN),
+        1 => Ok(COMMAND_NO_COMMAND_LEN),
+        2 => {
+            let mut w = Walker {
+                bytes,
+                at: COMMAND_ACTUATORS_FIXED_LEN - 8,
+            };
+            let n = w.count("effector input", MAX_EFFECTORS)?;
+            for _ in 0..n {
+                w.skip(4)?;
+                w.values("effector input values")?;
+            }
+            Ok(w.at)
+        }
+        _ => Err(DecodeError::Malformed(format!(
+            "unknown enum tag {tag} at offset {COMMAND_KIND_OFFSET}"
+        ))),
     }
 }
 
@@ -168,34 +286,7 @@ impl WireLayout {
     pub fn expected_len(&self, bytes: &[u8]) -> Result<usize, DecodeError> {
         match *self {
             WireLayout::Fixed { len } => Ok(len),
-            WireLayout::TrailingSeq {
-                fixed_len,
-                count_offset,
-                elem_len,
-                max_count,
-            } => {
-                let count = read_u64_le(bytes, count_offset).ok_or(DecodeError::Length {
-                    needed: fixed_len,
-                    actual: bytes.len(),
-                })?;
-                if count > max_count as u64 {
-                    return Err(DecodeError::Malformed(format!(
-                        "element count {count} exceeds maximum {max_count}"
-                    )));
-                }
-                // count <= max_count, so this cannot overflow.
-                Ok(fixed_len + count as usize * elem_len)
-            }
-            WireLayout::Tagged { tag_offset, lens } => {
-                let min = lens.iter().copied().min().unwrap_or(0).max(tag_offset + 4);
-                let tag = read_u32_le(bytes, tag_offset).ok_or(DecodeError::Length {
-                    needed: min,
-                    actual: bytes.len(),
-                })?;
-                lens.get(tag as usize).copied().ok_or_else(|| {
-                    DecodeError::Malformed(format!("unknown enum tag {tag} at offset {tag_offset}"))
-                })
-            }
+            WireLayout::Walked { walk, .. } => walk(bytes),
         }
     }
 }

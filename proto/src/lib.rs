@@ -11,6 +11,7 @@
 //! |---|---|---|
 //! | `flexdyn/<sc-id>/tlm/state` | [`StateMsg`] | server → flight code, every frame |
 //! | `flexdyn/<sc-id>/tlm/imu/<name>` | [`ImuMsg`] | server → flight code |
+//! | `flexdyn/<sc-id>/tlm/st/<name>` | [`StarTrackerMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/cmd/wrench` | [`CommandMsg`] | flight code → server |
 //! | `flexdyn/<sc-id>/status` | [`StatusMsg`] | server → anyone |
 //! | `flexdyn/<sc-id>/participant/<sender-id>` | Zenoh liveliness token (no payload) | lockstep participant → server |
@@ -33,20 +34,22 @@
 //! | message | size (bytes) |
 //! |---|---|
 //! | [`Header`] | [`HEADER_LEN`] = 30 |
-//! | [`StateMsg`] | [`STATE_FIXED_LEN`] = 327 + [`PANEL_PAIR_LEN`] = 32 per panel pair (count prefix at offset 319, panels last) |
+//! | [`StateMsg`] | [`STATE_FIXED_LEN`] = 327 + per effector [`EFFECTOR_STATE_FIXED_LEN`] = 22 + 8 per value (count prefix at offset 319, effectors last) |
 //! | [`ImuMsg`] | [`IMU_LEN`] = 127 |
-//! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`) or [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`), tag at offset 34 |
-//! | [`StatusMsg`] | [`STATUS_LEN`] = 163 |
+//! | [`StarTrackerMsg`] | [`STAR_TRACKER_LEN`] = 64 |
+//! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
+//! | [`StatusMsg`] | [`STATUS_LEN`] = 171 |
 //!
-//! Decoders accept at most [`MAX_MESSAGE_BYTES`] and [`MAX_PANEL_PAIRS`], reject
-//! trailing bytes, and never panic ([`DecodeError`]).
+//! Decoders accept at most [`MAX_MESSAGE_BYTES`], [`MAX_EFFECTORS`] and
+//! [`MAX_EFFECTOR_VALUES`], reject trailing bytes, and never panic ([`DecodeError`]).
 //!
 //! # Lockstep
 //!
 //! In [`Mode::Lockstep`] the server publishes the state for tick `k`, then waits
 //! until every lockstep participant has published a [`CommandMsg`] with
-//! `header.tick == k` (either [`CommandKind::Wrench`] or
-//! [`CommandKind::NoCommand`]) before stepping to `k + 1`. Before tick 0 it waits
+//! `header.tick == k` (any [`CommandKind`]: `Wrench`, `NoCommand` or `Actuators`;
+//! exactly one per participant per tick, so a participant that commands both a wrench
+//! and reaction wheels sends one `Actuators`) before stepping to `k + 1`. Before tick 0 it waits
 //! until every participant has declared its Zenoh liveliness token
 //! [`Topics::participant`] (declared after the participant's state subscriber),
 //! so the first publication is not lost.
@@ -71,25 +74,30 @@ mod layout;
 mod messages;
 
 pub use codec::{
-    decode, decode_command, decode_header, decode_imu, decode_state, decode_status, encode,
-    encode_into,
+    decode, decode_command, decode_header, decode_imu, decode_star_tracker, decode_state,
+    decode_status, encode, encode_into,
 };
 pub use error::{DecodeError, KeyError};
 pub use keys::{
     cmd_wrench_key, imu_key, imu_wildcard_key, participant_key, participant_wildcard_key,
-    state_key, status_key, validate_imu_name, validate_sc_id, Topics, CMD_WRENCH_SUFFIX,
-    IMU_PREFIX, KEY_ROOT, MAX_ID_LEN, PARTICIPANT_PREFIX, STATE_SUFFIX, STATUS_SUFFIX,
+    star_tracker_key, star_tracker_wildcard_key, state_key, status_key, validate_imu_name,
+    validate_sc_id, validate_star_tracker_name, Topics, CMD_WRENCH_SUFFIX, IMU_PREFIX, KEY_ROOT,
+    MAX_ID_LEN, PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX,
 };
 pub use layout::{
-    WireLayout, WireMessage, COMMAND_KIND_OFFSET, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN,
-    HEADER_LEN, IMU_LEN, MAX_MESSAGE_BYTES, MAX_PANEL_PAIRS, PANEL_PAIR_LEN, STATE_FIXED_LEN,
-    STATE_PANEL_COUNT_OFFSET, STATUS_LEN,
+    WireLayout, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
+    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN,
+    HEADER_LEN, IMU_LEN, MAX_EFFECTORS, MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES, MAX_PANEL_PAIRS,
+    STAR_TRACKER_LEN, STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN,
 };
 pub use messages::{
-    command_flags, saturation_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus,
-    Conserved, FrameTiming, Header, ImuMsg, Mode, PanelPairState, RejectCounters, RunState,
-    StalePolicy, StateMsg, StatusMsg, NO_COMMAND,
+    command_flags, effector_kind, saturation_flags, star_tracker_flags, wheel_flags, AppliedWrench,
+    CommandKind, CommandMsg, CommandStatus, Conserved, EffectorInput, EffectorState, FrameTiming,
+    Header, ImuMsg, Mode, RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg,
+    StatusMsg, NO_COMMAND,
 };
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
-pub const PROTOCOL_VERSION: u16 = 2;
+/// Version 3: generic effector states in [`StateMsg`], [`CommandKind::Actuators`],
+/// [`StarTrackerMsg`], [`RejectCounters::bad_effector_input`].
+pub const PROTOCOL_VERSION: u16 = 3;

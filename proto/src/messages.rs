@@ -60,18 +60,54 @@ impl Default for Header {
     }
 }
 
-/// State of one dual-hinged solar-panel pair (hinge 1 on the hub, hinge 2 between
-/// the two panels). 32 bytes on the wire.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct PanelPairState {
-    /// Hinge-1 angle (rad).
-    pub theta1_rad: f64,
-    /// Hinge-1 rate (rad/s).
-    pub theta1_dot_rad_s: f64,
-    /// Hinge-2 angle (rad).
-    pub theta2_rad: f64,
-    /// Hinge-2 rate (rad/s).
-    pub theta2_dot_rad_s: f64,
+/// Wire tags of [`EffectorState::kind`]: which model an effector entry describes, and so what
+/// its `states`, `outputs` and `flags` mean (`proto/README.md`, "Effector kinds").
+pub mod effector_kind {
+    /// A dual-hinged panel pair. States `[θ1 rad, θ̇1 rad/s, θ2 rad, θ̇2 rad/s]`; no outputs, no
+    /// flags, no inputs.
+    pub const PANEL_PAIR: u16 = 1;
+    /// A reaction wheel. States `[Ω rad/s]` (balanced) or `[Ω rad/s, wheel angle rad]` (with
+    /// imbalance); outputs `[applied motor torque N·m, friction torque N·m]`; flags
+    /// [`super::wheel_flags`]; one input, the commanded motor torque (N·m).
+    pub const REACTION_WHEEL: u16 = 2;
+}
+
+/// Bits of [`EffectorState::flags`] for a [`effector_kind::REACTION_WHEEL`] entry.
+pub mod wheel_flags {
+    /// Bit 0: the commanded motor torque exceeded `max_torque_nm` and was clipped.
+    pub const TORQUE_LIMITED: u32 = 1 << 0;
+    /// Bit 1: the wheel is at `max_speed_rad_s` and the motor torque that would spin it faster
+    /// was set to zero.
+    pub const SPEED_LIMITED: u32 = 1 << 1;
+}
+
+/// One effector (appended body) in a [`StateMsg`], in the server's effector order (the
+/// configuration's `panel_pairs`, then its `reaction_wheels`). On the wire: u16 LE `kind`,
+/// u32 LE `flags`, u64 LE count + f64 `states`, u64 LE count + f64 `outputs`:
+/// 22 + 8·(states + outputs) bytes.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EffectorState {
+    /// Model tag, see [`effector_kind`]. Receivers skip kinds they do not know.
+    pub kind: u16,
+    /// Kind-specific status bits (e.g. [`wheel_flags`]); 0 for kinds without flags.
+    pub flags: u32,
+    /// The effector's integrated states, in the kind's documented order and units. At most
+    /// [`crate::MAX_EFFECTOR_VALUES`].
+    pub states: Vec<f64>,
+    /// The effector's outputs (e.g. a wheel's applied torques), in the kind's documented order.
+    /// At most [`crate::MAX_EFFECTOR_VALUES`].
+    pub outputs: Vec<f64>,
+}
+
+/// Inputs for one effector in a [`CommandKind::Actuators`] command. On the wire: u32 LE
+/// `effector_index`, u64 LE count, f64 `values`: 12 + 8·values bytes.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EffectorInput {
+    /// Index of the effector in [`StateMsg::effectors`].
+    pub effector_index: u32,
+    /// Its inputs, as many as the kind takes (a reaction wheel: 1, the motor torque in N·m).
+    /// At most [`crate::MAX_EFFECTOR_VALUES`].
+    pub values: Vec<f64>,
 }
 
 /// Conserved quantities (for verification: constant when no external wrench
@@ -113,6 +149,16 @@ pub mod command_flags {
     pub const RESERVED_MASK: u8 = !(STALE | ZEROED_BY_POLICY | NO_COMMAND_YET);
 }
 
+/// Bits of [`StarTrackerMsg::status_flags`]: why a star tracker reports invalid.
+pub mod star_tracker_flags {
+    /// Bit 0: the boresight is within the configured exclusion angle of the Sun.
+    pub const SUN_EXCLUSION: u8 = 1 << 0;
+    /// Bit 1: |ω_B/N| exceeds the tracker's rate limit.
+    pub const RATE_LIMIT: u8 = 1 << 1;
+    /// Bits 2..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 = !(SUN_EXCLUSION | RATE_LIMIT);
+}
+
 /// Bits of [`ImuMsg::saturation_flags`].
 pub mod saturation_flags {
     /// Bit 0: at least one gyro rate axis (`omega_p_rad_s`) hit its range limit.
@@ -130,8 +176,8 @@ pub mod saturation_flags {
 /// Per-frame truth state, topic `flexdyn/<sc-id>/tlm/state`.
 ///
 /// Deterministic: same scenario and command stream give the same bytes (no wall
-/// clock). 327 bytes + 32 per panel pair; `panels` is last on the wire so every
-/// other field sits at a fixed offset.
+/// clock). 327 bytes + each [`EffectorState`]; `effectors` is last on the wire so
+/// every other field sits at a fixed offset.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StateMsg {
     /// Common header; `tick` is the frame this state belongs to.
@@ -162,13 +208,14 @@ pub struct StateMsg {
     pub wrench_applied: AppliedWrench,
     /// Command bookkeeping bits, see [`command_flags`].
     pub command_flags: u8,
-    /// Panel-pair states. On the wire: u64 LE count, then 32 bytes per pair. At
-    /// most [`crate::MAX_PANEL_PAIRS`]; decoders reject larger counts.
-    pub panels: Vec<PanelPairState>,
+    /// Every effector's state, outputs and flags, in the server's effector order.
+    /// On the wire: u64 LE count, then each [`EffectorState`]. At most
+    /// [`crate::MAX_EFFECTORS`]; decoders reject larger counts.
+    pub effectors: Vec<EffectorState>,
 }
 
 impl Default for StateMsg {
-    /// Zero state with the identity attitude (`q_bn = [1, 0, 0, 0]`) and no panels.
+    /// Zero state with the identity attitude (`q_bn = [1, 0, 0, 0]`) and no effectors.
     fn default() -> Self {
         Self {
             header: Header::default(),
@@ -182,7 +229,7 @@ impl Default for StateMsg {
             conserved: Conserved::default(),
             wrench_applied: AppliedWrench::default(),
             command_flags: 0,
-            panels: Vec::new(),
+            effectors: Vec::new(),
         }
     }
 }
@@ -206,9 +253,36 @@ pub struct ImuMsg {
     pub saturation_flags: u8,
 }
 
-/// What a [`CommandMsg`] asks for. Wire: u32 LE variant index (0 = `Wrench`,
-/// 1 = `NoCommand`), then the variant's fields.
+/// A star-tracker measurement, topic `flexdyn/<sc-id>/tlm/st/<name>`. 64 bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StarTrackerMsg {
+    /// Common header; `tick` is the frame at whose end the measurement was taken.
+    pub header: Header,
+    /// Measured attitude of the tracker's case frame C relative to N, unit quaternion,
+    /// **scalar first**, `q0 ≥ 0`; it maps N components to C components. While `valid` is
+    /// false it holds the last valid measurement (identity before the first).
+    pub q_cn: [f64; 4],
+    /// Whether `q_cn` is a fresh measurement (1 byte: 0 or 1; other values are malformed).
+    pub valid: bool,
+    /// Why the tracker is invalid, see [`star_tracker_flags`]; 0 when valid.
+    pub status_flags: u8,
+}
+
+impl Default for StarTrackerMsg {
+    /// Identity attitude, invalid, no flags.
+    fn default() -> Self {
+        Self {
+            header: Header::default(),
+            q_cn: [1.0, 0.0, 0.0, 0.0],
+            valid: false,
+            status_flags: 0,
+        }
+    }
+}
+
+/// What a [`CommandMsg`] asks for. Wire: u32 LE variant index (0 = `Wrench`,
+/// 1 = `NoCommand`, 2 = `Actuators`), then the variant's fields.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum CommandKind {
     /// Tag 0: hold this wrench, body components about B, over the frame
     /// starting at `header.tick`. 48 bytes follow the tag.
@@ -221,6 +295,19 @@ pub enum CommandKind {
     /// Tag 1: explicit "no command this tick" (a lockstep participant's way to
     /// release the step without changing the wrench). Nothing follows the tag.
     NoCommand,
+    /// Tag 2: hold this wrench **and** these effector inputs (e.g. reaction-wheel motor
+    /// torques) over the frame starting at `header.tick`. Effectors not listed keep the
+    /// sender's previous inputs. 48 bytes of wrench, then a u64 LE count and each
+    /// [`EffectorInput`]. At most [`crate::MAX_EFFECTORS`] entries; an effector index may
+    /// appear once. Added in protocol version 3.
+    Actuators {
+        /// Torque about B, B components (N·m).
+        torque_b_nm: [f64; 3],
+        /// Force at B, B components (N).
+        force_b_newton: [f64; 3],
+        /// Per-effector inputs.
+        inputs: Vec<EffectorInput>,
+    },
 }
 
 impl Default for CommandKind {
@@ -230,12 +317,14 @@ impl Default for CommandKind {
     }
 }
 
-/// Command from flight code, topic `flexdyn/<sc-id>/cmd/wrench`.
-/// 86 bytes (`Wrench`) or 38 bytes (`NoCommand`).
+/// Command from flight code, topic `flexdyn/<sc-id>/cmd/wrench` (every kind of command uses
+/// this one topic, so a lockstep participant's answer is one message).
+/// 86 bytes (`Wrench`), 38 bytes (`NoCommand`) or 94 + Σ(12 + 8·values) bytes
+/// (`Actuators`).
 ///
-/// Decoding rejects NaN/infinite torque or force components with
+/// Decoding rejects NaN/infinite torque, force or input values with
 /// [`crate::DecodeError::NonFinite`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CommandMsg {
     /// Common header: `tick` is the tick the command applies to (in lockstep the
     /// tick of the state it answers), `seq` the sender's own sequence number.
@@ -261,6 +350,25 @@ impl CommandMsg {
             kind: CommandKind::Wrench {
                 torque_b_nm,
                 force_b_newton,
+            },
+        }
+    }
+
+    /// An `Actuators` command: a wrench and effector inputs.
+    pub fn actuators(
+        header: Header,
+        sender_id: u32,
+        torque_b_nm: [f64; 3],
+        force_b_newton: [f64; 3],
+        inputs: Vec<EffectorInput>,
+    ) -> Self {
+        Self {
+            header,
+            sender_id,
+            kind: CommandKind::Actuators {
+                torque_b_nm,
+                force_b_newton,
+                inputs,
             },
         }
     }
@@ -351,7 +459,7 @@ pub struct CommandStatus {
     pub stale_policy: StalePolicy,
 }
 
-/// Rejected-command counters by reason, cumulative since start. 48 bytes.
+/// Rejected-command counters by reason, cumulative since start. 56 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct RejectCounters {
     /// Undecodable: wrong length, trailing bytes, oversize, bad enum tag or bool.
@@ -366,6 +474,10 @@ pub struct RejectCounters {
     pub stale_tick: u64,
     /// `sender_id` not configured.
     pub unknown_sender: u64,
+    /// An `Actuators` command naming an effector index that does not exist, an effector
+    /// that takes no inputs, the wrong number of values for its kind, or the same index
+    /// twice. Added in protocol version 3.
+    pub bad_effector_input: u64,
 }
 
 impl RejectCounters {
@@ -392,13 +504,14 @@ impl RejectCounters {
             self.wrong_spacecraft,
             self.stale_tick,
             self.unknown_sender,
+            self.bad_effector_input,
         ]
         .iter()
         .fold(0u64, |a, &b| a.saturating_add(b))
     }
 }
 
-/// Server health, topic `flexdyn/<sc-id>/status`. 163 bytes.
+/// Server health, topic `flexdyn/<sc-id>/status`. 171 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct StatusMsg {
     /// Common header; `tick` is the last frame stepped, `seq` counts status messages.

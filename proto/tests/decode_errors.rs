@@ -1,27 +1,49 @@
 //! Decoder error behaviour on hand-made bad inputs.
 
 use flexdyn_proto::{
-    decode, decode_command, decode_header, decode_imu, decode_state, decode_status, encode,
-    encode_into, CommandKind, CommandMsg, DecodeError, Header, ImuMsg, PanelPairState,
-    RejectCounters, StateMsg, StatusMsg, WireMessage, COMMAND_KIND_OFFSET, COMMAND_NO_COMMAND_LEN,
-    COMMAND_WRENCH_LEN, HEADER_LEN, IMU_LEN, MAX_MESSAGE_BYTES, MAX_PANEL_PAIRS, STATE_FIXED_LEN,
-    STATE_PANEL_COUNT_OFFSET, STATUS_LEN,
+    decode, decode_command, decode_header, decode_imu, decode_star_tracker, decode_state,
+    decode_status, effector_kind, encode, encode_into, CommandKind, CommandMsg, DecodeError,
+    EffectorInput, EffectorState, Header, ImuMsg, RejectCounters, StarTrackerMsg, StateMsg,
+    StatusMsg, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
+    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, EFFECTOR_STATE_FIXED_LEN, HEADER_LEN, IMU_LEN,
+    MAX_EFFECTORS, MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES, STAR_TRACKER_LEN,
+    STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN,
 };
 
 fn wrench(t: [f64; 3], f: [f64; 3]) -> CommandMsg {
     CommandMsg::wrench(Header::new(1, 2, 3, 4), 9, t, f)
 }
 
+/// A state with `n` panel-pair effectors (4 states each: 22 + 32 = 54 bytes per effector).
 fn state_with_panels(n: usize) -> StateMsg {
     StateMsg {
-        panels: vec![PanelPairState::default(); n],
+        effectors: vec![
+            EffectorState {
+                kind: effector_kind::PANEL_PAIR,
+                flags: 0,
+                states: vec![0.0; 4],
+                outputs: vec![],
+            };
+            n
+        ],
         ..Default::default()
+    }
+}
+
+fn actuators(inputs: Vec<EffectorInput>) -> CommandMsg {
+    CommandMsg::actuators(Header::new(1, 2, 3, 4), 9, [0.0; 3], [0.0; 3], inputs)
+}
+
+fn input(effector_index: u32, values: &[f64]) -> EffectorInput {
+    EffectorInput {
+        effector_index,
+        values: values.to_vec(),
     }
 }
 
 #[test]
 fn unknown_version_is_checked_first() {
-    for version in [0u16, 1, 3, 0xFFFF] {
+    for version in [0u16, 1, 2, 4, 0xFFFF] {
         let mut b = encode(&StatusMsg::default());
         b[..2].copy_from_slice(&version.to_le_bytes());
         assert_eq!(
@@ -80,20 +102,59 @@ fn length_errors() {
             actual: COMMAND_KIND_OFFSET
         })
     );
-    // State: panel count known → exact length.
+    // State: every count readable → exact length (3 effectors of 22 + 4·8 bytes).
     let b = encode(&state_with_panels(3));
+    assert_eq!(
+        b.len(),
+        STATE_FIXED_LEN + 3 * (EFFECTOR_STATE_FIXED_LEN + 32)
+    );
     assert_eq!(
         decode_state(&b[..b.len() - 1]),
         Err(DecodeError::Length {
-            needed: STATE_FIXED_LEN + 96,
+            needed: b.len(),
             actual: b.len() - 1
         })
     );
+    // Effector count missing → the fixed part.
     assert_eq!(
-        decode_state(&b[..STATE_PANEL_COUNT_OFFSET]),
+        decode_state(&b[..STATE_EFFECTOR_COUNT_OFFSET]),
         Err(DecodeError::Length {
             needed: STATE_FIXED_LEN,
-            actual: STATE_PANEL_COUNT_OFFSET
+            actual: STATE_EFFECTOR_COUNT_OFFSET
+        })
+    );
+    // Cut inside the second effector's state count → up to that count.
+    let second = STATE_FIXED_LEN + EFFECTOR_STATE_FIXED_LEN + 32;
+    assert_eq!(
+        decode_state(&b[..second + 8]),
+        Err(DecodeError::Length {
+            needed: second + 14,
+            actual: second + 8
+        })
+    );
+    // Actuators: inputs walked.
+    let b = encode(&actuators(vec![input(0, &[1.0]), input(3, &[2.0])]));
+    assert_eq!(b.len(), COMMAND_ACTUATORS_FIXED_LEN + 2 * 20);
+    assert_eq!(
+        decode_command(&b[..b.len() - 3]),
+        Err(DecodeError::Length {
+            needed: b.len(),
+            actual: b.len() - 3
+        })
+    );
+    assert_eq!(
+        decode_command(&b[..COMMAND_ACTUATORS_FIXED_LEN - 1]),
+        Err(DecodeError::Length {
+            needed: COMMAND_ACTUATORS_FIXED_LEN,
+            actual: COMMAND_ACTUATORS_FIXED_LEN - 1
+        })
+    );
+    let b = encode(&StarTrackerMsg::default());
+    assert_eq!(
+        decode_star_tracker(&b[..STAR_TRACKER_LEN - 1]),
+        Err(DecodeError::Length {
+            needed: STAR_TRACKER_LEN,
+            actual: STAR_TRACKER_LEN - 1
         })
     );
     assert_eq!(
@@ -147,24 +208,50 @@ fn too_large() {
 }
 
 #[test]
-fn huge_panel_count_is_rejected_without_allocating() {
+fn huge_counts_are_rejected_without_allocating() {
+    let at = STATE_EFFECTOR_COUNT_OFFSET;
     let mut b = encode(&StateMsg::default());
-    b[STATE_PANEL_COUNT_OFFSET..STATE_PANEL_COUNT_OFFSET + 8]
-        .copy_from_slice(&u64::MAX.to_le_bytes());
+    b[at..at + 8].copy_from_slice(&u64::MAX.to_le_bytes());
     assert!(matches!(decode_state(&b), Err(DecodeError::Malformed(_))));
-    let count = (MAX_PANEL_PAIRS as u64 + 1).to_le_bytes();
-    b[STATE_PANEL_COUNT_OFFSET..STATE_PANEL_COUNT_OFFSET + 8].copy_from_slice(&count);
+    let count = (MAX_EFFECTORS as u64 + 1).to_le_bytes();
+    b[at..at + 8].copy_from_slice(&count);
     assert!(matches!(decode_state(&b), Err(DecodeError::Malformed(_))));
     // The maximum itself is fine.
-    let b = encode(&state_with_panels(MAX_PANEL_PAIRS));
-    assert_eq!(decode_state(&b).unwrap().panels.len(), MAX_PANEL_PAIRS);
+    let b = encode(&state_with_panels(MAX_EFFECTORS));
+    assert_eq!(decode_state(&b).unwrap().effectors.len(), MAX_EFFECTORS);
+    // An effector's value count above the maximum.
+    let mut s = state_with_panels(1);
+    s.effectors[0].states = vec![0.0; MAX_EFFECTOR_VALUES + 1];
+    assert!(matches!(
+        decode_state(&encode(&s)),
+        Err(DecodeError::Malformed(m)) if m.contains("effector states count 9")
+    ));
+    s.effectors[0].states = vec![0.0; MAX_EFFECTOR_VALUES];
+    s.effectors[0].outputs = vec![0.0; MAX_EFFECTOR_VALUES];
+    assert_eq!(decode_state(&encode(&s)).unwrap(), s);
+    // Inputs: too many entries, too many values.
+    let mut b = encode(&actuators(vec![]));
+    b[86..94].copy_from_slice(&(MAX_EFFECTORS as u64 + 1).to_le_bytes());
+    assert!(matches!(decode_command(&b), Err(DecodeError::Malformed(_))));
+    let c = actuators(vec![input(0, &[0.0; MAX_EFFECTOR_VALUES + 1])]);
+    assert!(matches!(
+        decode_command(&encode(&c)),
+        Err(DecodeError::Malformed(m)) if m.contains("effector input values count 9")
+    ));
 }
 
 #[test]
 fn malformed_enum_tags_and_bools() {
     let mut b = encode(&wrench([0.0; 3], [0.0; 3]));
-    b[COMMAND_KIND_OFFSET] = 2;
+    b[COMMAND_KIND_OFFSET] = 3;
     assert!(matches!(decode_command(&b), Err(DecodeError::Malformed(_))));
+    // The star tracker's `valid` must be 0 or 1.
+    let mut b = encode(&StarTrackerMsg::default());
+    b[62] = 2;
+    assert!(matches!(
+        decode_star_tracker(&b),
+        Err(DecodeError::Malformed(_))
+    ));
 
     let good = encode(&StatusMsg::default());
     for (offset, value) in [(30usize, 3u8), (34, 6), (95, 2)] {
@@ -213,6 +300,23 @@ fn non_finite_commands() {
             Err(DecodeError::NonFinite { field })
         );
     }
+    let bad = actuators(vec![input(0, &[1.0]), input(1, &[f64::NAN])]);
+    let field = "kind.inputs[].values[]";
+    assert_eq!(bad.validate(), Err(DecodeError::NonFinite { field }));
+    assert_eq!(
+        decode_command(&encode(&bad)),
+        Err(DecodeError::NonFinite { field })
+    );
+    let mut bad = actuators(vec![input(0, &[1.0])]);
+    if let CommandKind::Actuators { torque_b_nm, .. } = &mut bad.kind {
+        torque_b_nm[1] = f64::INFINITY;
+    }
+    assert_eq!(
+        decode_command(&encode(&bad)),
+        Err(DecodeError::NonFinite {
+            field: "kind.torque_b_nm[1]"
+        })
+    );
     // Extreme finite values are fine.
     let ok = wrench([f64::MAX, f64::MIN, f64::MIN_POSITIVE], [-0.0, 5e-324, 0.0]);
     assert_eq!(decode_command(&encode(&ok)), Ok(ok));
@@ -267,7 +371,7 @@ fn encode_into_reuses_the_buffer() {
     let mut buf = Vec::with_capacity(1024);
     let ptr = buf.as_ptr();
     encode_into(&state_with_panels(2), &mut buf);
-    assert_eq!(buf.len(), STATE_FIXED_LEN + 64);
+    assert_eq!(buf.len(), STATE_FIXED_LEN + 2 * 54);
     encode_into(&ImuMsg::default(), &mut buf);
     assert_eq!(buf, encode(&ImuMsg::default()));
     assert_eq!(buf.as_ptr(), ptr, "no reallocation");
@@ -277,7 +381,7 @@ fn encode_into_reuses_the_buffer() {
 fn header_new_sets_version() {
     let h = Header::new(1, 2, 3, 4);
     assert_eq!(h.protocol_version, flexdyn_proto::PROTOCOL_VERSION);
-    assert_eq!(Header::default().protocol_version, 2);
+    assert_eq!(Header::default().protocol_version, 3);
     assert_eq!(StateMsg::default().q_bn, [1.0, 0.0, 0.0, 0.0]);
 }
 
@@ -298,6 +402,8 @@ fn reject_counters_record() {
     c.record(&DecodeError::Malformed(String::new()));
     assert_eq!((c.bad_version, c.non_finite, c.malformed), (1, 1, 4));
     assert_eq!(c.total(), 6);
+    c.bad_effector_input = 2;
+    assert_eq!(c.total(), 8);
     c.stale_tick = u64::MAX;
     assert_eq!(c.total(), u64::MAX);
 }

@@ -21,10 +21,12 @@
 //! message lists field, offset, expected and actual bytes to help review).
 
 use flexdyn_proto::{
-    command_flags, decode, decode_header, encode, saturation_flags, AppliedWrench, CommandKind,
-    CommandMsg, CommandStatus, Conserved, FrameTiming, Header, ImuMsg, Mode, PanelPairState,
-    RejectCounters, RunState, StalePolicy, StateMsg, StatusMsg, WireMessage,
-    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, IMU_LEN, PANEL_PAIR_LEN, STATE_FIXED_LEN,
+    command_flags, decode, decode_header, effector_kind, encode, saturation_flags,
+    star_tracker_flags, wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus,
+    Conserved, EffectorInput, EffectorState, FrameTiming, Header, ImuMsg, Mode, RejectCounters,
+    RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, WireMessage,
+    COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN,
+    EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, IMU_LEN, STAR_TRACKER_LEN, STATE_FIXED_LEN,
     STATUS_LEN,
 };
 
@@ -97,7 +99,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0200", "u16 header.protocol_version = 2"),
+    (0, "0300", "u16 header.protocol_version = 3"),
     (
         2,
         "44332211",
@@ -298,51 +300,66 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     (
         319,
         "0200000000000000",
-        "u64 panels count = 2 (Vec length prefix)",
+        "u64 effectors count = 2 (Vec length prefix)",
     ),
+    (327, "0100", "u16 effectors[0].kind = 1 (PANEL_PAIR)"),
+    (329, "00000000", "u32 effectors[0].flags = 0"),
+    (333, "0400000000000000", "u64 effectors[0].states count = 4"),
     (
-        327,
+        341,
         "000000000000e03f",
-        "f64 panels[0].theta1_rad = 0.5 (bits 0x3FE0000000000000)",
+        "f64 effectors[0].states[0] theta1_rad = 0.5 (bits 0x3FE0000000000000)",
     ),
     (
-        335,
+        349,
         "000000000000b0bf",
-        "f64 panels[0].theta1_dot_rad_s = -0.0625 (bits 0xBFB0000000000000)",
+        "f64 effectors[0].states[1] theta1_dot_rad_s = -0.0625 (bits 0xBFB0000000000000)",
     ),
     (
-        343,
+        357,
         "000000000000f43f",
-        "f64 panels[0].theta2_rad = 1.25 (bits 0x3FF4000000000000)",
+        "f64 effectors[0].states[2] theta2_rad = 1.25 (bits 0x3FF4000000000000)",
     ),
     (
-        351,
+        365,
         "000000000000a03f",
-        "f64 panels[0].theta2_dot_rad_s = 0.03125 (bits 0x3FA0000000000000)",
+        "f64 effectors[0].states[3] theta2_dot_rad_s = 0.03125 (bits 0x3FA0000000000000)",
     ),
     (
-        359,
-        "000000000000e0bf",
-        "f64 panels[1].theta1_rad = -0.5 (bits 0xBFE0000000000000)",
+        373,
+        "0000000000000000",
+        "u64 effectors[0].outputs count = 0",
     ),
-    (
-        367,
-        "000000000000b03f",
-        "f64 panels[1].theta1_dot_rad_s = 0.0625 (bits 0x3FB0000000000000)",
-    ),
-    (
-        375,
-        "000000000000f4bf",
-        "f64 panels[1].theta2_rad = -1.25 (bits 0xBFF4000000000000)",
-    ),
+    (381, "0200", "u16 effectors[1].kind = 2 (REACTION_WHEEL)"),
     (
         383,
-        "000000000000a0bf",
-        "f64 panels[1].theta2_dot_rad_s = -0.03125 (bits 0xBFA0000000000000)",
+        "03000000",
+        "u32 effectors[1].flags = 3 (TORQUE_LIMITED | SPEED_LIMITED)",
+    ),
+    (387, "0100000000000000", "u64 effectors[1].states count = 1"),
+    (
+        395,
+        "0000000000d062c0",
+        "f64 effectors[1].states[0] omega_rad_s = -150.5 (bits 0xC062D00000000000)",
+    ),
+    (
+        403,
+        "0200000000000000",
+        "u64 effectors[1].outputs count = 2",
+    ),
+    (
+        411,
+        "000000000000d03f",
+        "f64 effectors[1].outputs[0] motor_torque_nm = 0.25 (bits 0x3FD0000000000000)",
+    ),
+    (
+        419,
+        "00000000000080bf",
+        "f64 effectors[1].outputs[1] friction_torque_nm = -0.0078125 (bits 0xBF80000000000000)",
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0200", "u16 header.protocol_version = 2"),
+    (0, "0300", "u16 header.protocol_version = 3"),
     (
         2,
         "44332211",
@@ -418,7 +435,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0200", "u16 header.protocol_version = 2"),
+    (0, "0300", "u16 header.protocol_version = 3"),
     (
         2,
         "44332211",
@@ -464,8 +481,115 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
         "f64 kind.force_b_newton[2] = 0.5 (bits 0x3FE0000000000000)",
     ),
 ];
+const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0300", "u16 header.protocol_version = 3"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "2c00000000000000", "u64 header.tick = 44"),
+    (
+        14,
+        "00de391a00000000",
+        "u64 header.sim_time_ns = 440000000 (0x1A39DE00)",
+    ),
+    (22, "0900000000000000", "u64 header.seq = 9"),
+    (30, "07000000", "u32 sender_id = 7"),
+    (34, "02000000", "u32 kind tag = 2 (Actuators)"),
+    (
+        38,
+        "000000000000e03f",
+        "f64 kind.torque_b_nm[0] = 0.5 (bits 0x3FE0000000000000)",
+    ),
+    (
+        46,
+        "000000000000d0bf",
+        "f64 kind.torque_b_nm[1] = -0.25 (bits 0xBFD0000000000000)",
+    ),
+    (
+        54,
+        "0000000000000000",
+        "f64 kind.torque_b_nm[2] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        62,
+        "0000000000000000",
+        "f64 kind.force_b_newton[0] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        70,
+        "0000000000000000",
+        "f64 kind.force_b_newton[1] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        78,
+        "0000000000000080",
+        "f64 kind.force_b_newton[2] = -0.0 (bits 0x8000000000000000)",
+    ),
+    (86, "0200000000000000", "u64 kind.inputs count = 2"),
+    (94, "02000000", "u32 kind.inputs[0].effector_index = 2"),
+    (
+        98,
+        "0100000000000000",
+        "u64 kind.inputs[0].values count = 1",
+    ),
+    (
+        106,
+        "000000000000b03f",
+        "f64 kind.inputs[0].values[0] = 0.0625 (bits 0x3FB0000000000000)",
+    ),
+    (114, "05000000", "u32 kind.inputs[1].effector_index = 5"),
+    (
+        118,
+        "0100000000000000",
+        "u64 kind.inputs[1].values count = 1",
+    ),
+    (
+        126,
+        "000000000000a0bf",
+        "f64 kind.inputs[1].values[0] = -0.03125 (bits 0xBFA0000000000000)",
+    ),
+];
+const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0300", "u16 header.protocol_version = 3"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "0b00000000000000", "u64 header.tick = 11"),
+    (
+        14,
+        "80778e0600000000",
+        "u64 header.sim_time_ns = 110000000 (0x68E7780)",
+    ),
+    (22, "0c00000000000000", "u64 header.seq = 12"),
+    (
+        30,
+        "000000000000ec3f",
+        "f64 q_cn[0] = 0.875 (bits 0x3FEC000000000000)",
+    ),
+    (
+        38,
+        "000000000000d03f",
+        "f64 q_cn[1] = 0.25 (bits 0x3FD0000000000000)",
+    ),
+    (
+        46,
+        "000000000000d8bf",
+        "f64 q_cn[2] = -0.375 (bits 0xBFD8000000000000)",
+    ),
+    (
+        54,
+        "000000000000c83f",
+        "f64 q_cn[3] = 0.1875 (bits 0x3FC8000000000000)",
+    ),
+    (62, "00", "bool valid = false"),
+    (63, "01", "u8 status_flags = 1 (SUN_EXCLUSION)"),
+];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0200", "u16 header.protocol_version = 2"),
+    (0, "0300", "u16 header.protocol_version = 3"),
     (
         2,
         "44332211",
@@ -482,7 +606,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0200", "u16 header.protocol_version = 2"),
+    (0, "0300", "u16 header.protocol_version = 3"),
     (
         2,
         "44332211",
@@ -532,9 +656,14 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
     (123, "0400000000000000", "u64 rejected.wrong_spacecraft = 4"),
     (131, "0500000000000000", "u64 rejected.stale_tick = 5"),
     (139, "0600000000000000", "u64 rejected.unknown_sender = 6"),
-    (147, "0700000000000000", "u64 commands_dropped = 7"),
     (
-        155,
+        147,
+        "0800000000000000",
+        "u64 rejected.bad_effector_input = 8",
+    ),
+    (155, "0700000000000000", "u64 commands_dropped = 7"),
+    (
+        163,
         "15cd853dfe9c9717",
         "u64 wall_time_unix_ns = 1700000000123456789 (0x17979CFE3D85CD15)",
     ),
@@ -563,18 +692,18 @@ fn state_msg() -> StateMsg {
             force_b_newton: [1.0, -2.0, 3.0],
         },
         command_flags: command_flags::STALE | command_flags::NO_COMMAND_YET,
-        panels: vec![
-            PanelPairState {
-                theta1_rad: 0.5,
-                theta1_dot_rad_s: -0.0625,
-                theta2_rad: 1.25,
-                theta2_dot_rad_s: 0.03125,
+        effectors: vec![
+            EffectorState {
+                kind: effector_kind::PANEL_PAIR,
+                flags: 0,
+                states: vec![0.5, -0.0625, 1.25, 0.03125],
+                outputs: vec![],
             },
-            PanelPairState {
-                theta1_rad: -0.5,
-                theta1_dot_rad_s: 0.0625,
-                theta2_rad: -1.25,
-                theta2_dot_rad_s: -0.03125,
+            EffectorState {
+                kind: effector_kind::REACTION_WHEEL,
+                flags: wheel_flags::TORQUE_LIMITED | wheel_flags::SPEED_LIMITED,
+                states: vec![-150.5],
+                outputs: vec![0.25, -0.0078125],
             },
         ],
     }
@@ -584,16 +713,20 @@ fn state_msg() -> StateMsg {
 fn state_golden() {
     let msg = state_msg();
     check("StateMsg", STATE_GOLDEN, &msg);
-    assert_eq!(encode(&msg).len(), STATE_FIXED_LEN + 2 * PANEL_PAIR_LEN);
+    // Fixed part, then per effector 22 bytes + 8 per value (4 + 0 and 1 + 2 values).
+    assert_eq!(
+        encode(&msg).len(),
+        STATE_FIXED_LEN + 2 * EFFECTOR_STATE_FIXED_LEN + 8 * (4 + 3)
+    );
     // The -0.0 survives the round trip with its sign bit.
     let back: StateMsg = decode(&golden_bytes(STATE_GOLDEN)).unwrap();
     assert!(back.nongrav_accel_bn_n_m_s2[1].is_sign_negative());
 }
 
 #[test]
-fn state_without_panels_is_the_fixed_part() {
+fn state_without_effectors_is_the_fixed_part() {
     let mut msg = state_msg();
-    msg.panels.clear();
+    msg.effectors.clear();
     let bytes = encode(&msg);
     assert_eq!(bytes.len(), STATE_FIXED_LEN);
     let golden = golden_bytes(STATE_GOLDEN);
@@ -626,6 +759,43 @@ fn command_wrench_golden() {
     );
     check("CommandMsg::Wrench", COMMAND_WRENCH_GOLDEN, &msg);
     assert_eq!(encode(&msg).len(), COMMAND_WRENCH_LEN);
+}
+
+#[test]
+fn command_actuators_golden() {
+    let msg = CommandMsg::actuators(
+        Header::new(SC, 44, 440_000_000, 9),
+        7,
+        [0.5, -0.25, 0.0],
+        [0.0, 0.0, -0.0],
+        vec![
+            EffectorInput {
+                effector_index: 2,
+                values: vec![0.0625],
+            },
+            EffectorInput {
+                effector_index: 5,
+                values: vec![-0.03125],
+            },
+        ],
+    );
+    check("CommandMsg::Actuators", COMMAND_ACTUATORS_GOLDEN, &msg);
+    assert_eq!(
+        encode(&msg).len(),
+        COMMAND_ACTUATORS_FIXED_LEN + 2 * (EFFECTOR_INPUT_FIXED_LEN + 8)
+    );
+}
+
+#[test]
+fn star_tracker_golden() {
+    let msg = StarTrackerMsg {
+        header: Header::new(SC, 11, 110_000_000, 12),
+        q_cn: [0.875, 0.25, -0.375, 0.1875],
+        valid: false,
+        status_flags: star_tracker_flags::SUN_EXCLUSION,
+    };
+    check("StarTrackerMsg", STAR_TRACKER_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), STAR_TRACKER_LEN);
 }
 
 #[test]
@@ -662,6 +832,7 @@ fn status_golden() {
             wrong_spacecraft: 4,
             stale_tick: 5,
             unknown_sender: 6,
+            bad_effector_input: 8,
         },
         commands_dropped: 7,
         wall_time_unix_ns: 1_700_000_000_123_456_789,
@@ -724,4 +895,11 @@ fn flag_bits() {
     assert_eq!(saturation_flags::DTHETA, 0b0100);
     assert_eq!(saturation_flags::DV, 0b1000);
     assert_eq!(saturation_flags::RESERVED_MASK, 0b1111_0000);
+    assert_eq!(star_tracker_flags::SUN_EXCLUSION, 0b01);
+    assert_eq!(star_tracker_flags::RATE_LIMIT, 0b10);
+    assert_eq!(star_tracker_flags::RESERVED_MASK, 0b1111_1100);
+    assert_eq!(wheel_flags::TORQUE_LIMITED, 0b01);
+    assert_eq!(wheel_flags::SPEED_LIMITED, 0b10);
+    assert_eq!(effector_kind::PANEL_PAIR, 1);
+    assert_eq!(effector_kind::REACTION_WHEEL, 2);
 }

@@ -2,10 +2,10 @@
 //! messages round-trip, and every truncation or extension is an error.
 
 use flexdyn_proto::{
-    decode, decode_command, decode_header, decode_imu, decode_state, decode_status, encode,
-    AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, DecodeError, FrameTiming,
-    Header, ImuMsg, Mode, PanelPairState, RejectCounters, RunState, StalePolicy, StateMsg,
-    StatusMsg, WireMessage,
+    decode, decode_command, decode_header, decode_imu, decode_star_tracker, decode_state,
+    decode_status, encode, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved,
+    DecodeError, EffectorInput, EffectorState, FrameTiming, Header, ImuMsg, Mode, RejectCounters,
+    RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, WireMessage, MAX_EFFECTOR_VALUES,
 };
 use proptest::prelude::*;
 
@@ -30,12 +30,15 @@ fn state() -> impl Strategy<Value = StateMsg> {
 /// State messages whose f64 fields are drawn from `floats`.
 fn state_with(floats: impl Strategy<Value = f64> + Clone) -> impl Strategy<Value = StateMsg> {
     let f = || floats.clone();
-    let panel = (f(), f(), f(), f()).prop_map(|(a, b, c, d)| PanelPairState {
-        theta1_rad: a,
-        theta1_dot_rad_s: b,
-        theta2_rad: c,
-        theta2_dot_rad_s: d,
-    });
+    let values = || prop::collection::vec(f(), 0..=MAX_EFFECTOR_VALUES);
+    let effector = (any::<u16>(), any::<u32>(), values(), values()).prop_map(
+        |(kind, flags, states, outputs)| EffectorState {
+            kind,
+            flags,
+            states,
+            outputs,
+        },
+    );
     let conserved = (f(), f(), v3(f()), v3(f())).prop_map(|(a, b, c, d)| Conserved {
         orb_energy_j: a,
         rot_energy_j: b,
@@ -48,25 +51,27 @@ fn state_with(floats: impl Strategy<Value = f64> + Clone) -> impl Strategy<Value
         (v3(f()), v3(f()), v3(f())),
         conserved,
         (v3(f()), v3(f()), any::<u8>()),
-        prop::collection::vec(panel, 0..8),
+        prop::collection::vec(effector, 0..8),
     )
         .prop_map(
-            |(header, (sigma, q, w, wd), (r, v, a), conserved, (tq, fo, flags), panels)| StateMsg {
-                header,
-                sigma_bn: sigma,
-                q_bn: q,
-                omega_bn_b_rad_s: w,
-                omega_dot_bn_b_rad_s2: wd,
-                r_bn_n_m: r,
-                v_bn_n_m_s: v,
-                nongrav_accel_bn_n_m_s2: a,
-                conserved,
-                wrench_applied: AppliedWrench {
-                    torque_b_nm: tq,
-                    force_b_newton: fo,
-                },
-                command_flags: flags,
-                panels,
+            |(header, (sigma, q, w, wd), (r, v, a), conserved, (tq, fo, flags), effectors)| {
+                StateMsg {
+                    header,
+                    sigma_bn: sigma,
+                    q_bn: q,
+                    omega_bn_b_rad_s: w,
+                    omega_dot_bn_b_rad_s2: wd,
+                    r_bn_n_m: r,
+                    v_bn_n_m_s: v,
+                    nongrav_accel_bn_n_m_s2: a,
+                    conserved,
+                    wrench_applied: AppliedWrench {
+                        torque_b_nm: tq,
+                        force_b_newton: fo,
+                    },
+                    command_flags: flags,
+                    effectors,
+                }
             },
         )
 }
@@ -94,6 +99,28 @@ fn command() -> impl Strategy<Value = CommandMsg> {
             force_b_newton: fo
         }),
         Just(CommandKind::NoCommand),
+        (
+            v3(f()),
+            v3(f()),
+            prop::collection::vec(
+                (
+                    any::<u32>(),
+                    prop::collection::vec(f(), 0..=MAX_EFFECTOR_VALUES)
+                ),
+                0..6
+            )
+        )
+            .prop_map(|(t, fo, inputs)| CommandKind::Actuators {
+                torque_b_nm: t,
+                force_b_newton: fo,
+                inputs: inputs
+                    .into_iter()
+                    .map(|(effector_index, values)| EffectorInput {
+                        effector_index,
+                        values
+                    })
+                    .collect(),
+            }),
     ];
     (header(), any::<u32>(), kind).prop_map(|(header, sender_id, kind)| CommandMsg {
         header,
@@ -124,7 +151,7 @@ fn status() -> impl Strategy<Value = StatusMsg> {
         run,
         (u(), u(), u(), u(), u()),
         (u(), u(), any::<bool>(), policy),
-        (u(), u(), u(), u(), u(), u()),
+        (u(), u(), u(), u(), u(), u(), u()),
         (u(), u()),
     )
         .prop_map(
@@ -152,6 +179,7 @@ fn status() -> impl Strategy<Value = StatusMsg> {
                     wrong_spacecraft: r.3,
                     stale_tick: r.4,
                     unknown_sender: r.5,
+                    bad_effector_input: r.6,
                 },
                 commands_dropped: dropped,
                 wall_time_unix_ns: wall,
@@ -165,6 +193,7 @@ fn decode_all(bytes: &[u8]) {
     let _ = decode_imu(bytes);
     let _ = decode_command(bytes);
     let _ = decode_status(bytes);
+    let _ = decode_star_tracker(bytes);
     let _ = decode_header(bytes);
 }
 
@@ -211,12 +240,13 @@ proptest! {
     /// Random bodies of exactly the right length reach bincode: the result is a
     /// message, Malformed or NonFinite, never a panic or a length error.
     #[test]
-    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 163)) {
+    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 171)) {
         let mut b = flexdyn_proto::PROTOCOL_VERSION.to_le_bytes().to_vec();
         b.extend_from_slice(&body);
         for r in [
             decode_imu(&b[..flexdyn_proto::IMU_LEN]).map(|_| ()),
             decode_status(&b[..flexdyn_proto::STATUS_LEN]).map(|_| ()),
+            decode_star_tracker(&b[..flexdyn_proto::STAR_TRACKER_LEN]).map(|_| ()),
         ] {
             prop_assert!(matches!(r, Ok(()) | Err(DecodeError::Malformed(_))), "{:?}", r);
         }
@@ -270,6 +300,18 @@ proptest! {
     }
 
     #[test]
+    fn star_tracker_round_trip(
+        header in header(),
+        q in [any::<f64>(), any::<f64>(), any::<f64>(), any::<f64>()],
+        valid in any::<bool>(),
+        status_flags in any::<u8>(),
+    ) {
+        let msg = StarTrackerMsg { header, q_cn: q, valid, status_flags };
+        round_trip_and_truncate(&msg)?;
+        prop_assert_eq!(decode_star_tracker(&encode(&msg)), Ok(msg));
+    }
+
+    #[test]
     fn status_round_trip(msg in status()) {
         round_trip_and_truncate(&msg)?;
         prop_assert_eq!(decode_status(&encode(&msg)), Ok(msg));
@@ -296,7 +338,8 @@ proptest! {
         bad in prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(f64::NEG_INFINITY)],
     ) {
         let (mut t, mut f) = match msg.kind {
-            CommandKind::Wrench { torque_b_nm, force_b_newton } => (torque_b_nm, force_b_newton),
+            CommandKind::Wrench { torque_b_nm, force_b_newton }
+            | CommandKind::Actuators { torque_b_nm, force_b_newton, .. } => (torque_b_nm, force_b_newton),
             CommandKind::NoCommand => ([0.0; 3], [0.0; 3]),
         };
         if slot < 3 { t[slot] = bad } else { f[slot - 3] = bad }

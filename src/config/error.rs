@@ -187,7 +187,9 @@ pub(crate) fn param_field(e: &ParamError) -> Option<&str> {
         | ParamError::NotPositiveDefinite { field, .. }
         | ParamError::TriangleInequality { field, .. }
         | ParamError::NotOrthonormal { field, .. }
-        | ParamError::DExceedsLength { field, .. } => Some(field),
+        | ParamError::DExceedsLength { field, .. }
+        | ParamError::NotUnit { field, .. }
+        | ParamError::Exceeds { field, .. } => Some(field),
         _ => None,
     }
 }

@@ -36,9 +36,11 @@ use flexdyn_proto::MAX_PANEL_PAIRS;
 use source_map::SourceMap;
 
 use crate::dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
+use crate::dynamics::effectors::reaction_wheel;
 use crate::dynamics::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
-    PanelPairParams, ParamError, Spacecraft, StateEffector, WrenchSegment,
+    PanelPairParams, ParamError, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
+    WrenchSegment,
 };
 use crate::sensors::imu::{self, schema::RawImu, ImuConfig};
 
@@ -65,6 +67,9 @@ pub struct SimConfig {
     pub initial: HubInitial,
     /// Panel pairs and their initial states, in file order.
     pub panel_pairs: Vec<(PanelPairParams, PanelPairInitial)>,
+    /// Reaction wheels (`[[reaction_wheels]]`), validated, in file order (empty if absent).
+    /// They follow the panel pairs in the effector order.
+    pub reaction_wheels: Vec<ReactionWheelParams>,
     /// Piecewise-constant external wrench on the hub, sorted by strictly increasing start time.
     pub wrench_schedule: Vec<WrenchSegment>,
     /// The `[server]` table, uninterpreted (empty if absent); the server validates it.
@@ -121,7 +126,7 @@ impl SimConfig {
         self.frame_ns / self.step_ns
     }
 
-    /// \[kg\] total mass: hub plus every panel.
+    /// \[kg\] total mass: hub plus every panel and wheel rotor.
     pub fn total_mass_kg(&self) -> f64 {
         self.hub.mass_kg
             + self
@@ -129,16 +134,22 @@ impl SimConfig {
                 .iter()
                 .map(|(p, _)| p.panel1.mass_kg + p.panel2.mass_kg)
                 .sum::<f64>()
+            + self.reaction_wheels.iter().map(|w| w.mass_kg).sum::<f64>()
     }
 
     /// Builds the spacecraft: one [`PanelPair`] per configured pair (errors name
-    /// `panel_pairs[i]…`), then [`Spacecraft::new`], then one sensor point per IMU in file order
-    /// (sensor point `i` is `imus[i]`).
+    /// `panel_pairs[i]…`), then one [`ReactionWheel`] per wheel (`reaction_wheels[i]…`), then
+    /// [`Spacecraft::new`], then one sensor point per IMU in file order (sensor point `i` is
+    /// `imus[i]`).
     pub fn build_spacecraft(&self) -> Result<Spacecraft, ConfigError> {
         let mut effectors: Vec<Box<dyn StateEffector>> = Vec::with_capacity(self.panel_pairs.len());
         for (i, (params, initial)) in self.panel_pairs.iter().enumerate() {
             let pair = PanelPair::new(params.clone(), *initial, &format!("panel_pairs[{i}]"))?;
             effectors.push(Box::new(pair));
+        }
+        for (i, params) in self.reaction_wheels.iter().enumerate() {
+            let wheel = ReactionWheel::new(params.clone(), &format!("reaction_wheels[{i}]"))?;
+            effectors.push(Box::new(wheel));
         }
         let mut sc = Spacecraft::new(
             self.hub.clone(),
@@ -166,8 +177,13 @@ pub fn gravity_model_name(g: &GravityModel) -> &'static str {
 /// One-line summary of a valid configuration.
 pub fn config_summary(cfg: &SimConfig) -> String {
     format!(
-        "{} panel pairs, {} IMUs{}, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows",
+        "{} panel pairs{}, {} IMUs{}, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows",
         cfg.panel_pairs.len(),
+        if cfg.reaction_wheels.is_empty() {
+            String::new()
+        } else {
+            format!(", {} reaction wheels", cfg.reaction_wheels.len())
+        },
         cfg.imus.len(),
         if cfg.imus.is_empty() {
             String::new()
@@ -214,6 +230,7 @@ const ROOT_KEYS: &[&str] = &[
     "hub",
     "initial",
     "panel_pairs",
+    "reaction_wheels",
     "wrench_schedule",
     "server",
     "imus",
@@ -225,6 +242,7 @@ struct RawConfig {
     hub: RawHub,
     initial: RawInitial,
     panel_pairs: Vec<RawPanelPair>,
+    reaction_wheels: Vec<ReactionWheelParams>,
     wrench_schedule: Vec<RawWrench>,
     server: toml::Table,
     imus: Vec<RawImu>,
@@ -309,6 +327,12 @@ impl RawConfig {
             .iter()
             .map(RawPanelPair::read)
             .collect::<Result<Vec<_>, _>>()?;
+        let reaction_wheels = root
+            .tables("reaction_wheels", &reaction_wheel::schema::KEYS)?
+            .unwrap_or_default()
+            .iter()
+            .map(reaction_wheel::schema::read)
+            .collect::<Result<Vec<_>, _>>()?;
         let wrench_schedule = root
             .tables("wrench_schedule", &["t_s", "force_b_newton", "torque_b_nm"])?
             .unwrap_or_default()
@@ -352,6 +376,7 @@ impl RawConfig {
             hub,
             initial,
             panel_pairs,
+            reaction_wheels,
             wrench_schedule,
             server,
             imus,
@@ -452,23 +477,23 @@ impl RawConfig {
         let mut names = HashSet::new();
         for (i, raw) in self.panel_pairs.into_iter().enumerate() {
             let path = format!("panel_pairs[{i}]");
-            if raw.name.trim().is_empty() {
-                return Err(map.invalid(&format!("{path}.name"), "must not be empty".into()));
-            }
-            if !names.insert(raw.name.clone()) {
-                return Err(map.invalid(
-                    &format!("{path}.name"),
-                    format!(
-                        "duplicate panel pair name `{}` (names must be unique)",
-                        raw.name
-                    ),
-                ));
-            }
+            unique_name(map, &path, &raw.name, &mut names, "panel pair")?;
             let (params, init) = raw.into_params();
             params.validate(&path).map_err(param)?;
             init.validate(&path).map_err(param)?;
             panel_pairs.push((params, init));
         }
+
+        // [[reaction_wheels]]
+        let mut reaction_wheels = Vec::with_capacity(self.reaction_wheels.len());
+        let mut wheel_names = HashSet::new();
+        for (i, params) in self.reaction_wheels.into_iter().enumerate() {
+            let path = format!("reaction_wheels[{i}]");
+            unique_name(map, &path, &params.name, &mut wheel_names, "reaction wheel")?;
+            params.validate(&path).map_err(param)?;
+            reaction_wheels.push(params);
+        }
+        check_wire_capacity(map, panel_pairs.len(), &reaction_wheels)?;
 
         // [[wrench_schedule]]
         let mut wrench_schedule = Vec::with_capacity(self.wrench_schedule.len());
@@ -539,6 +564,7 @@ impl RawConfig {
             gravity,
             initial,
             panel_pairs,
+            reaction_wheels,
             wrench_schedule,
             server: self.server,
             imus,
@@ -553,6 +579,72 @@ impl RawConfig {
         check_initial_outputs_finite(&cfg, &mut sc, map)?;
         Ok(cfg)
     }
+}
+
+/// Checks that `<path>.name` is not blank and not already in `seen` (then adds it).
+fn unique_name(
+    map: &SourceMap,
+    path: &str,
+    name: &str,
+    seen: &mut HashSet<String>,
+    what: &str,
+) -> Result<(), ConfigError> {
+    let field = format!("{path}.name");
+    if name.trim().is_empty() {
+        return Err(map.invalid(&field, "must not be empty".into()));
+    }
+    if !seen.insert(name.to_string()) {
+        return Err(map.invalid(
+            &field,
+            format!("duplicate {what} name `{name}` (names must be unique)"),
+        ));
+    }
+    Ok(())
+}
+
+/// Checks that every effector fits one StateMsg: at most [`flexdyn_proto::MAX_EFFECTORS`]
+/// effectors and [`flexdyn_proto::MAX_MESSAGE_BYTES`] bytes.
+fn check_wire_capacity(
+    map: &SourceMap,
+    n_pairs: usize,
+    wheels: &[ReactionWheelParams],
+) -> Result<(), ConfigError> {
+    use flexdyn_proto::{
+        EFFECTOR_STATE_FIXED_LEN, MAX_EFFECTORS, MAX_MESSAGE_BYTES, STATE_FIXED_LEN,
+    };
+    let n = n_pairs + wheels.len();
+    if n > MAX_EFFECTORS {
+        return Err(map.invalid(
+            "reaction_wheels",
+            format!(
+                "{n_pairs} panel pairs and {} reaction wheels make {n} effectors, more than a \
+                 StateMsg carries ({MAX_EFFECTORS}, proto/README.md)",
+                wheels.len()
+            ),
+        ));
+    }
+    let wheel_len = |w: &ReactionWheelParams| {
+        let states = if w.static_imbalance_kg_m > 0.0 || w.dynamic_imbalance_kg_m2 > 0.0 {
+            2
+        } else {
+            1
+        };
+        EFFECTOR_STATE_FIXED_LEN + 8 * (states + 2)
+    };
+    let bytes = STATE_FIXED_LEN
+        + n_pairs * (EFFECTOR_STATE_FIXED_LEN + 32)
+        + wheels.iter().map(wheel_len).sum::<usize>();
+    if bytes > MAX_MESSAGE_BYTES {
+        return Err(map.invalid(
+            "reaction_wheels",
+            format!(
+                "the StateMsg of {n_pairs} panel pairs and {} reaction wheels would be {bytes} \
+                 bytes, more than the {MAX_MESSAGE_BYTES}-byte message limit",
+                wheels.len()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The longest simulation time a `u64` count of nanoseconds holds: 2⁶⁴ − 1 ns ≈ 584.5 years.
@@ -606,6 +698,9 @@ fn check_body_extent(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError
     for (i, imu) in cfg.imus.iter().enumerate() {
         check(&format!("imus[{i}].r_sb_b_m"), imu.r_sb_b_m.norm())?;
     }
+    for (i, w) in cfg.reaction_wheels.iter().enumerate() {
+        check(&format!("reaction_wheels[{i}].r_wb_b_m"), w.r_wb_b_m.norm())?;
+    }
     // Mass and inertia ratios: the hub's 3×3 Schur complement (Eqs. 151–153) subtracts the
     // panels' contributions from the hub's; beyond MAX_MASS_RATIO the difference loses the
     // digits the back-substitution needs (the dense-Kane cross-check measured κ ≈ 3.5e3 for a
@@ -642,6 +737,36 @@ fn check_body_extent(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError
                     ),
                 ));
             }
+        }
+    }
+    for (i, w) in cfg.reaction_wheels.iter().enumerate() {
+        let path = format!("reaction_wheels[{i}]");
+        let ratio = (w.mass_kg / hub_m).max(hub_m / w.mass_kg);
+        if ratio > MAX_MASS_RATIO {
+            return Err(map.invalid(
+                &format!("{path}.mass_kg"),
+                format!(
+                    "{} kg against a {} kg hub is a mass ratio of {}; flexdyn accepts at most {} \
+                     either way (the hub solve would lose its precision)",
+                    Num(w.mass_kg),
+                    Num(hub_m),
+                    Rounded(ratio, 3),
+                    Num(MAX_MASS_RATIO)
+                ),
+            ));
+        }
+        let i_max = w.j_s_kg_m2.max(w.j_t_kg_m2);
+        if i_max > MAX_MASS_RATIO * hub_i_min {
+            return Err(map.invalid(
+                &format!("{path}.j_s_kg_m2"),
+                format!(
+                    "a rotor moment of {} kg·m² is more than {} times the hub's smallest \
+                     principal moment ({} kg·m²)",
+                    Num(i_max),
+                    Num(MAX_MASS_RATIO),
+                    Rounded(hub_i_min, 6)
+                ),
+            ));
         }
     }
     Ok(())
@@ -765,6 +890,27 @@ fn check_resolved_by_step(cfg: &SimConfig, map: &SourceMap) -> Result<(), Config
                     ),
                 ));
             }
+        }
+    }
+    for (i, w) in cfg.reaction_wheels.iter().enumerate() {
+        let path = format!("reaction_wheels[{i}]");
+        too_fast(
+            &format!("{path}.viscous_friction_nm_s_rad"),
+            "the viscous spin-down rate b / J_s",
+            w.viscous_friction_nm_s_rad / w.j_s_kg_m2,
+        )?;
+        too_fast(
+            &format!("{path}.coulomb_band_rad_s"),
+            "the Coulomb friction's linear-region rate tau_c / (band J_s)",
+            w.coulomb_friction_nm / (w.coulomb_band_rad_s * w.j_s_kg_m2),
+        )?;
+        if w.static_imbalance_kg_m > 0.0 || w.dynamic_imbalance_kg_m2 > 0.0 {
+            // The jitter rotates at the wheel speed: the step must resolve it.
+            too_fast(
+                &format!("{path}.max_speed_rad_s"),
+                "the imbalanced wheel's max speed",
+                w.max_speed_rad_s,
+            )?;
         }
     }
     Ok(())

@@ -187,19 +187,68 @@ impl EnergyMomentum {
     }
 }
 
+/// What kind of body an effector is: its wire tag (`flexdyn_proto::effector_kind`) and the
+/// prefix of its CSV columns (`pair1_theta1`, `rw2_omega_rad_s`). Each kind defines one `const`
+/// in its own folder.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EffectorKind {
+    /// Human-readable kind name (`panel_pair`, `reaction_wheel`), also the config section's
+    /// singular.
+    pub name: &'static str,
+    /// [`flexdyn_proto::EffectorState::kind`] on the wire.
+    pub wire_tag: u16,
+    /// CSV column prefix; the 1-based index among effectors of this kind follows it.
+    pub column_prefix: &'static str,
+}
+
 /// A body appended to the hub, with its own integrated states, solved by back-substitution.
 ///
 /// Implementations validate their parameters at construction. None of these methods may allocate,
-/// lock, do I/O or fail: they run inside every RK4 stage. They receive the effector's own slice of
-/// the integrated state (`x`, length [`StateEffector::state_len`]) and may cache geometry in
-/// `self` between the calls of one evaluation.
+/// lock, do I/O or fail: they run inside every RK4 stage (or once per step or output). They
+/// receive the effector's own slice of the integrated state (`x`, length
+/// [`StateEffector::state_len`]) and may cache geometry in `self` between the calls of one
+/// evaluation.
+///
+/// Beyond the dynamics, an effector describes itself to every layer above it: its states'
+/// names (CSV headers, wire order), its inputs (commanded by flight code through
+/// `CommandKind::Actuators`) and its outputs and flags (telemetry). Adding a kind therefore
+/// touches only its own folder plus the one line that lists it in the configuration.
 pub trait StateEffector: Send + std::fmt::Debug {
-    /// Name for logs and output headers.
+    /// Name from the configuration, for logs and messages.
     fn name(&self) -> &str;
+    /// The kind of body (wire tag, CSV prefix).
+    fn kind(&self) -> EffectorKind;
     /// Number of integrated states this effector owns.
-    fn state_len(&self) -> usize;
-    /// Names of the integrated states (e.g. `theta1`), for output headers.
-    fn state_names(&self) -> Vec<String>;
+    fn state_len(&self) -> usize {
+        self.state_names().len()
+    }
+    /// Names of the integrated states with their units where they have one (e.g. `theta1`,
+    /// `omega_rad_s`), in state order: CSV headers and the wire's `states` order.
+    fn state_names(&self) -> &'static [&'static str];
+    /// Names of the inputs flight code may command (e.g. `motor_torque_nm`); empty if none.
+    fn input_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// Number of inputs.
+    fn input_len(&self) -> usize {
+        self.input_names().len()
+    }
+    /// Sets the commanded inputs, held until the next call. `u` has [`Self::input_len`]
+    /// values, each finite (the caller checks both).
+    fn set_inputs(&mut self, _u: &[f64]) {}
+    /// Names of the outputs reported by [`Self::outputs`] (e.g. `friction_torque_nm`).
+    fn output_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// Writes the outputs at state `x` into `out` (length `output_names().len()`) and returns
+    /// the kind's status flags. Call after [`Self::begin_step`] on the same `x`.
+    fn outputs(&self, _x: &[f64], _out: &mut [f64]) -> u32 {
+        0
+    }
+    /// Called once per RK4 step before its first stage (and before outputs are taken), with the
+    /// state at the start of the step: the place for logic that must hold over a whole step,
+    /// such as clipping a commanded torque against a speed limit.
+    fn begin_step(&mut self, _x: &[f64]) {}
     /// Writes the effector's initial state into `x`.
     fn initial_state(&self, x: &mut [f64]);
     /// Pass 1: adds the mass properties about B at state `x` into `sum`.

@@ -36,9 +36,11 @@ pub mod params;
 pub mod spacecraft;
 
 pub use effector::{
-    BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
+    BackSubContributions, EffectorKind, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics,
+    StateEffector,
 };
 pub use effectors::panel_pair::{PanelPair, PanelPairInitial, PanelPairParams, PanelParams};
+pub use effectors::reaction_wheel::{ReactionWheel, ReactionWheelParams};
 pub use params::{GravityModel, HubParams, SensorPoint, Wrench, WrenchSegment};
 pub use spacecraft::{
     gravity_accel_n, gravity_potential, specific_force_b, Conserved, HubInitial, HubOutputs,
@@ -118,6 +120,34 @@ pub enum ParamError {
         d_m: f64,
         /// l.
         l_m: f64,
+    },
+    /// A direction that must be a unit vector is not.
+    #[error("{field}: must be a unit vector (norm {}, expected 1 within 1e-6)", Num(*.norm))]
+    NotUnit {
+        /// Field path.
+        field: String,
+        /// Its norm.
+        norm: f64,
+    },
+    /// A value beyond a limit given by another field.
+    #[error("{field}: |{}| exceeds {limit_field} = {}", Num(*.value), Num(*.limit))]
+    Exceeds {
+        /// Field path.
+        field: String,
+        /// The value.
+        value: f64,
+        /// The key of the limit (in the same table).
+        limit_field: &'static str,
+        /// The limit.
+        limit: f64,
+    },
+    /// An effector-input vector of the wrong length was supplied.
+    #[error("effector inputs: expected {expected} values, got {found}")]
+    InputLength {
+        /// Expected length.
+        expected: usize,
+        /// Given length.
+        found: usize,
     },
     /// A state vector of the wrong length was supplied.
     #[error("state: expected {expected} effector states, got {found}")]

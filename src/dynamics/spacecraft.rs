@@ -267,6 +267,10 @@ struct EquationsOfMotion {
     gravity: GravityModel,
     effectors: Vec<Box<dyn StateEffector>>,
     ranges: Vec<Range<usize>>,
+    /// Range of each effector's inputs in the flat input vector of
+    /// [`Spacecraft::set_effector_inputs`], and of its outputs in [`Spacecraft::effector_outputs`].
+    input_ranges: Vec<Range<usize>>,
+    output_ranges: Vec<Range<usize>>,
     force_b_newton: Vector3<f64>,
     torque_b_nm: Vector3<f64>,
     sensors: Vec<SensorPoint>,
@@ -404,12 +408,18 @@ impl Spacecraft {
                 value: 0.0,
             });
         }
-        let mut ranges = Vec::with_capacity(effectors.len());
-        let mut n = 0;
-        for e in &effectors {
-            ranges.push(n..n + e.state_len());
-            n += e.state_len();
-        }
+        let layout = |len: &dyn Fn(&dyn StateEffector) -> usize| {
+            let mut ranges = Vec::with_capacity(effectors.len());
+            let mut n = 0;
+            for e in &effectors {
+                ranges.push(n..n + len(e.as_ref()));
+                n += len(e.as_ref());
+            }
+            (ranges, n)
+        };
+        let (ranges, n) = layout(&|e| e.state_len());
+        let (input_ranges, _) = layout(&|e| e.input_len());
+        let (output_ranges, _) = layout(&|e| e.output_names().len());
         let hub_first_moment_b = hub.r_bcb_b_m * hub.mass_kg;
         let r = hub.r_bcb_b_m;
         let hub_inertia_pnt_b_b = hub.inertia_bc_b_kg_m2
@@ -423,6 +433,8 @@ impl Spacecraft {
                 gravity,
                 effectors,
                 ranges,
+                input_ranges,
+                output_ranges,
                 force_b_newton: Vector3::zeros(),
                 torque_b_nm: Vector3::zeros(),
                 sensors: Vec::new(),
@@ -507,6 +519,75 @@ impl Spacecraft {
         &self.eom.ranges
     }
 
+    /// Range of each effector's inputs within the flat vector of [`Self::set_effector_inputs`].
+    pub fn effector_input_ranges(&self) -> &[Range<usize>] {
+        &self.eom.input_ranges
+    }
+
+    /// Total number of effector inputs (the length [`Self::set_effector_inputs`] takes).
+    pub fn effector_input_len(&self) -> usize {
+        self.eom.input_ranges.last().map_or(0, |r| r.end)
+    }
+
+    /// Range of each effector's outputs within the flat vector of [`Self::effector_outputs`].
+    pub fn effector_output_ranges(&self) -> &[Range<usize>] {
+        &self.eom.output_ranges
+    }
+
+    /// Total number of effector outputs.
+    pub fn effector_output_len(&self) -> usize {
+        self.eom.output_ranges.last().map_or(0, |r| r.end)
+    }
+
+    /// Sets every effector's commanded inputs from one flat vector laid out by
+    /// [`Self::effector_input_ranges`], held until the next call. Allocates nothing.
+    pub fn set_effector_inputs(&mut self, u: &[f64]) -> Result<(), ParamError> {
+        if u.len() != self.effector_input_len() {
+            return Err(ParamError::InputLength {
+                expected: self.effector_input_len(),
+                found: u.len(),
+            });
+        }
+        if let Some(i) = u.iter().position(|v| !v.is_finite()) {
+            return Err(ParamError::NotFinite {
+                field: format!("effector input {i}"),
+            });
+        }
+        for (e, r) in self.eom.effectors.iter_mut().zip(&self.eom.input_ranges) {
+            if !r.is_empty() {
+                e.set_inputs(&u[r.clone()]);
+            }
+        }
+        Ok(())
+    }
+
+    /// Every effector's outputs at the current state into `out` (laid out by
+    /// [`Self::effector_output_ranges`]) and its status flags into `flags` (one per effector).
+    /// Extra room is left untouched; allocates nothing.
+    pub fn effector_outputs(&mut self, out: &mut [f64], flags: &mut [u32]) {
+        self.begin_step();
+        let eom = &self.eom;
+        for (((e, r), o), f) in eom
+            .effectors
+            .iter()
+            .zip(&eom.ranges)
+            .zip(&eom.output_ranges)
+            .zip(flags.iter_mut())
+        {
+            if let Some(out) = out.get_mut(o.clone()) {
+                *f = e.outputs(&self.state.effectors[r.clone()], out);
+            }
+        }
+    }
+
+    /// Runs every effector's [`StateEffector::begin_step`] at the current state.
+    fn begin_step(&mut self) {
+        let Self { eom, state, .. } = self;
+        for (e, r) in eom.effectors.iter_mut().zip(&eom.ranges) {
+            e.begin_step(&state.effectors[r.clone()]);
+        }
+    }
+
     /// The hub parameters.
     pub fn hub(&self) -> &HubParams {
         &self.eom.hub
@@ -531,16 +612,22 @@ impl Spacecraft {
         }
     }
 
-    /// Evaluates the state derivative `dx` at state `x` with the current wrench, and returns the
-    /// hub accelerations. This is the equation-of-motion function RK4 integrates: it allocates
-    /// nothing and cannot fail.
+    /// Evaluates the state derivative `dx` at state `x` with the current wrench and effector
+    /// inputs (each effector's [`StateEffector::begin_step`] runs at `x` first, as at the start
+    /// of a step), and returns the hub accelerations. This is the equation-of-motion function RK4
+    /// integrates: it allocates nothing and cannot fail.
     pub fn derivatives(&mut self, x: &State, dx: &mut State) -> HubOutputs {
+        for (e, r) in self.eom.effectors.iter_mut().zip(&self.eom.ranges) {
+            e.begin_step(&x.effectors[r.clone()]);
+        }
         self.eom.eval(x, dx)
     }
 
-    /// Advances one RK4 step of [`Self::step_ns`] with the current wrench, then switches σ to its
-    /// shadow set if |σ| > 1. Allocates nothing.
+    /// Advances one RK4 step of [`Self::step_ns`] with the current wrench and effector inputs
+    /// (each effector's [`StateEffector::begin_step`] runs first, at the step's initial state),
+    /// then switches σ to its shadow set if |σ| > 1. Allocates nothing.
     pub fn step(&mut self) {
+        self.begin_step();
         let h = self.step_ns as f64 * 1e-9;
         let Self { eom, state, ws, .. } = self;
         eom.eval(state, &mut ws.k1);
@@ -625,6 +712,7 @@ impl Spacecraft {
     /// Hub accelerations at the current state with the current wrench (one derivative evaluation;
     /// the result is not cached, so call it once per output).
     pub fn hub_outputs(&mut self) -> HubOutputs {
+        self.begin_step();
         self.eom.eval(&self.state, &mut self.ws.stage)
     }
 

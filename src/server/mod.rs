@@ -346,9 +346,10 @@ pub async fn run(
     let n_buffers = settings.telemetry_buffers;
     let (free_tx, free_rx) = sync_channel::<Box<Frame>>(n_buffers);
     let (full_tx, full_rx) = sync_channel::<Box<Frame>>(n_buffers);
+    let shape = crate::sim::Snapshot::for_simulation(&sim);
     for _ in 0..n_buffers {
         free_tx
-            .send(Box::new(Frame::with_capacity(sim.n_pairs(), sim.n_imus())))
+            .send(Box::new(Frame::for_snapshot(&shape, sim.n_imus())))
             .map_err(|_| ServerError::Internal("telemetry pool".into()))?;
     }
 

@@ -128,6 +128,7 @@ impl PhysicsCtx {
             Offer::Accepted => {}
             Offer::StaleTick => self.shared.reject_stale_tick_from(sender_id),
             Offer::UnknownSender => self.shared.reject_unknown_sender(),
+            Offer::BadEffectorInput => self.shared.reject_bad_effector_input(),
         }
     }
 
@@ -194,8 +195,9 @@ impl PhysicsCtx {
             frame_ns,
             u64::try_from(self.settings.stale_after.as_nanos()).unwrap_or(u64::MAX),
             self.settings.stale_policy,
+            self.sim.spacecraft().effector_input_ranges(),
         );
-        let mut snap = Snapshot::with_capacity(self.sim.n_pairs());
+        let mut snap = Snapshot::for_simulation(&self.sim);
         // IMU samples close their interval every frame, published or not.
         let mut imu = Vec::with_capacity(self.sim.n_imus());
         let mut held = Held::initial(self.settings.stale_policy);
@@ -275,6 +277,9 @@ impl PhysicsCtx {
                 force_b_newton: Vector3::from(held.force_b_newton),
                 torque_b_nm: Vector3::from(held.torque_b_nm),
             });
+            // Cannot fail: the book's inputs have the spacecraft's layout and were checked
+            // finite by the decoder.
+            let _ = self.sim.set_effector_inputs(book.held_inputs());
 
             // 3. Integrate the frame.
             self.sim.step_frame();

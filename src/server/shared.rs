@@ -4,7 +4,7 @@
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
 
 use flexdyn_proto::{
-    CommandStatus, DecodeError, PanelPairState, RejectCounters, RunState, StateMsg,
+    CommandStatus, DecodeError, EffectorState, RejectCounters, RunState, StateMsg,
 };
 
 use super::commands::Held;
@@ -15,7 +15,7 @@ use crate::sensors::imu::ImuSample;
 /// (free → physics fills → I/O publishes → free), so the stepping path never allocates.
 #[derive(Debug)]
 pub struct Frame {
-    /// The state message, `panels` preallocated to the spacecraft's pair count.
+    /// The state message, `effectors` preallocated to the spacecraft's effector layout.
     pub state: StateMsg,
     /// \[ns since the Unix epoch\] wall clock at the frame boundary, sent as the sample's
     /// attachment (never in the deterministic payload).
@@ -29,11 +29,20 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// An empty frame with room for `n_pairs` panel pairs and `n_imus` IMU samples.
-    pub fn with_capacity(n_pairs: usize, n_imus: usize) -> Self {
+    /// An empty frame shaped for `snap`'s effectors, with room for `n_imus` IMU samples.
+    pub fn for_snapshot(snap: &crate::sim::Snapshot, n_imus: usize) -> Self {
         Self {
             state: StateMsg {
-                panels: Vec::with_capacity(n_pairs),
+                effectors: snap
+                    .effectors
+                    .iter()
+                    .map(|e| EffectorState {
+                        kind: e.kind.wire_tag,
+                        flags: 0,
+                        states: Vec::with_capacity(e.state_names.len()),
+                        outputs: Vec::with_capacity(e.output_names.len()),
+                    })
+                    .collect(),
                 ..StateMsg::default()
             },
             boundary_unix_ns: 0,
@@ -44,7 +53,8 @@ impl Frame {
     }
 }
 
-/// Fills `out` from a snapshot without allocating (the panel vector keeps its capacity).
+/// Fills `out` from a snapshot without allocating (`out` was shaped by [`Frame::for_snapshot`];
+/// its vectors keep their capacity).
 pub fn fill_state(
     out: &mut StateMsg,
     snap: &crate::sim::Snapshot,
@@ -66,14 +76,15 @@ pub fn fill_state(
     out.wrench_applied.torque_b_nm = held.torque_b_nm;
     out.wrench_applied.force_b_newton = held.force_b_newton;
     out.command_flags = held.flags;
-    out.panels.clear();
-    for p in &snap.panels {
-        out.panels.push(PanelPairState {
-            theta1_rad: p[0],
-            theta1_dot_rad_s: p[1],
-            theta2_rad: p[2],
-            theta2_dot_rad_s: p[3],
-        });
+    out.effectors
+        .resize_with(snap.effectors.len(), EffectorState::default);
+    for (o, e) in out.effectors.iter_mut().zip(&snap.effectors) {
+        o.kind = e.kind.wire_tag;
+        o.flags = e.flags;
+        o.states.clear();
+        o.states.extend_from_slice(&e.states);
+        o.outputs.clear();
+        o.outputs.extend_from_slice(&e.outputs);
     }
 }
 
@@ -92,6 +103,7 @@ pub struct Shared {
     wrong_spacecraft: AtomicU64,
     stale_tick: AtomicU64,
     unknown_sender: AtomicU64,
+    bad_effector_input: AtomicU64,
     /// Valid commands dropped because the command queue was full.
     pub commands_dropped: AtomicU64,
     /// Real time: frames whose work overran the next deadline.
@@ -151,6 +163,11 @@ impl Shared {
         bump(&self.unknown_sender);
     }
 
+    /// Count an `Actuators` command whose inputs do not fit the effectors.
+    pub fn reject_bad_effector_input(&self) {
+        bump(&self.bad_effector_input);
+    }
+
     /// The rejection counters so far.
     pub fn rejected(&self) -> RejectCounters {
         let l = |c: &AtomicU64| c.load(Ordering::Relaxed);
@@ -161,6 +178,7 @@ impl Shared {
             wrong_spacecraft: l(&self.wrong_spacecraft),
             stale_tick: l(&self.stale_tick),
             unknown_sender: l(&self.unknown_sender),
+            bad_effector_input: l(&self.bad_effector_input),
         }
     }
 

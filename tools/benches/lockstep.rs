@@ -23,7 +23,7 @@ use std::time::{Duration, Instant};
 
 use flexdyn::server::ServerSettings;
 use flexdyn::sim::Simulation;
-use flexdyn_proto::{Mode, Topics, PANEL_PAIR_LEN, STATE_FIXED_LEN};
+use flexdyn_proto::{Mode, Topics, EFFECTOR_STATE_FIXED_LEN, STATE_FIXED_LEN};
 use flexdyn_tools::pingpong;
 use support::{endpoint, listening_session, reference_config, ChildGuard, ServerHandle};
 
@@ -54,7 +54,7 @@ fn pingpong_rate(port: u16, ticks: usize, recv_loop: bool) -> f64 {
     let rtts = pingpong::ping(
         &session,
         &topics,
-        STATE_FIXED_LEN + 2 * PANEL_PAIR_LEN,
+        STATE_FIXED_LEN + 2 * (EFFECTOR_STATE_FIXED_LEN + 32),
         1000,
         ticks,
         Duration::from_secs(30),
@@ -93,7 +93,7 @@ fn lockstep_rate(port: u16, ticks: usize, frame_hz: f64) -> f64 {
 fn physics_frame_us(frame_hz: f64) -> f64 {
     let cfg = reference_config(frame_hz);
     let mut sim = Simulation::new(&cfg).unwrap();
-    let mut snap = flexdyn::sim::Snapshot::with_capacity(sim.n_pairs());
+    let mut snap = flexdyn::sim::Snapshot::for_simulation(&sim);
     let n = 20_000;
     let t = Instant::now();
     for _ in 0..n {

@@ -3,3 +3,4 @@
 //! implementation with its state, input and output names, and its tests.
 
 pub mod panel_pair;
+pub mod reaction_wheel;

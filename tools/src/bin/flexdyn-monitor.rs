@@ -68,6 +68,7 @@ fn rejected_by_reason(r: &flexdyn_proto::RejectCounters) -> String {
         ("wrong_spacecraft", r.wrong_spacecraft),
         ("stale_tick", r.stale_tick),
         ("unknown_sender", r.unknown_sender),
+        ("bad_effector_input", r.bad_effector_input),
     ]
     .iter()
     .filter(|(_, n)| *n > 0)

@@ -9,7 +9,7 @@
 use std::time::Duration;
 
 use clap::{Parser, Subcommand};
-use flexdyn_proto::{COMMAND_WRENCH_LEN, PANEL_PAIR_LEN, STATE_FIXED_LEN};
+use flexdyn_proto::{COMMAND_WRENCH_LEN, EFFECTOR_STATE_FIXED_LEN, STATE_FIXED_LEN};
 use flexdyn_tools::{percentile, pingpong, CommonArgs};
 
 /// Zenoh ping-pong over the flexdyn transport settings.
@@ -39,8 +39,8 @@ enum RoleCmd {
     },
     /// Measure round trips and print p50/p99 and round trips per second.
     Ping {
-        /// Ping size in bytes (default: a StateMsg with two panel pairs).
-        #[arg(long, default_value_t = STATE_FIXED_LEN + 2 * PANEL_PAIR_LEN)]
+        /// Ping size in bytes (default: a StateMsg with two panel pairs, 435 bytes).
+        #[arg(long, default_value_t = STATE_FIXED_LEN + 2 * (EFFECTOR_STATE_FIXED_LEN + 32))]
         size: usize,
         /// Unmeasured round trips first.
         #[arg(long, default_value_t = 1000)]

@@ -15,13 +15,24 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::dynamics::effector::{
-    BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
+    BackSubContributions, EffectorKind, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics,
+    StateEffector,
 };
 mod params;
 pub(crate) mod schema;
 
 use crate::dynamics::ParamError;
 pub use params::{PanelPairInitial, PanelPairParams, PanelParams};
+
+/// The panel pair's kind: wire tag `effector_kind::PANEL_PAIR`, CSV columns `pair<k>_…`.
+pub const KIND: EffectorKind = EffectorKind {
+    name: "panel_pair",
+    wire_tag: flexdyn_proto::effector_kind::PANEL_PAIR,
+    column_prefix: "pair",
+};
+
+/// State order: θ1 [rad], θ̇1 [rad/s], θ2 [rad], θ̇2 [rad/s].
+pub const STATE_NAMES: [&str; 4] = ["theta1", "theta1_dot", "theta2", "theta2_dot"];
 
 /// The panel frames at one state: [S1 B] = M2(θ1)[H1 B], [S2 B] = M2(φ)[S1 B], φ = θ2 + θ_H2S1.
 #[derive(Debug, Clone, Copy)]
@@ -283,15 +294,16 @@ impl StateEffector for PanelPair {
         &self.params.name
     }
 
+    fn kind(&self) -> EffectorKind {
+        KIND
+    }
+
     fn state_len(&self) -> usize {
         4
     }
 
-    fn state_names(&self) -> Vec<String> {
-        ["theta1", "theta1_dot", "theta2", "theta2_dot"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect()
+    fn state_names(&self) -> &'static [&'static str] {
+        &STATE_NAMES
     }
 
     fn initial_state(&self, x: &mut [f64]) {
