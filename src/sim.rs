@@ -19,6 +19,7 @@ use crate::dynamics::{
     Conserved, EffectorKind, HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment,
 };
 use crate::sensors::imu::{attitude_increment_b, Imu, ImuSample, ImuTruth};
+use crate::sensors::star_tracker::{StarTracker, StarTrackerSample};
 
 /// A spacecraft being propagated, with its external wrench sources.
 #[derive(Debug)]
@@ -48,6 +49,8 @@ pub struct Simulation {
     imu_interval_start_ns: u64,
     /// σ_B/N at the start of the current IMU sample interval.
     imu_sigma_bn_start: Vector3<f64>,
+    /// The star trackers in config order.
+    star_trackers: Vec<StarTracker>,
 }
 
 /// Everything a telemetry frame or a CSV row needs, at one instant.
@@ -223,6 +226,13 @@ impl Simulation {
             imus.push(Imu::new(imu, &format!("imus[{i}]"), frame_s)?);
         }
         let imu_sigma_bn_start = sc.state().sigma_bn;
+        let mut star_trackers = Vec::with_capacity(cfg.star_trackers.len());
+        for (i, st) in cfg.star_trackers.iter().enumerate() {
+            star_trackers.push(StarTracker::new(
+                st.clone(),
+                &format!("star_trackers[{i}]"),
+            )?);
+        }
         let mut sim = Self {
             inputs: vec![0.0; sc.effector_input_len()],
             outputs_scratch: vec![0.0; sc.effector_output_len()],
@@ -237,6 +247,7 @@ impl Simulation {
             imus,
             imu_interval_start_ns: 0,
             imu_sigma_bn_start,
+            star_trackers,
         };
         sim.apply_wrench();
         Ok(sim)
@@ -493,6 +504,28 @@ impl Simulation {
             out.push(imu.sample(&truth, dt_s));
         }
         self.restart_imu_interval();
+    }
+
+    /// The star trackers, in config order (topic `flexdyn/<sc-id>/tlm/st/<name>`).
+    pub fn star_trackers(&self) -> &[StarTracker] {
+        &self.star_trackers
+    }
+
+    /// Samples every star tracker due at frame boundary `tick` (see
+    /// [`StarTracker::due`]) at the current state, writing `(index, sample)` pairs into `out`
+    /// (cleared first; after the first call this allocates nothing).
+    pub fn star_tracker_samples_into(
+        &mut self,
+        tick: u64,
+        out: &mut Vec<(usize, StarTrackerSample)>,
+    ) {
+        out.clear();
+        let state = self.sc.state();
+        for (i, st) in self.star_trackers.iter_mut().enumerate() {
+            if st.due(tick) {
+                out.push((i, st.sample(&state.sigma_bn, &state.omega_bn_b)));
+            }
+        }
     }
 
     /// Starts a new IMU sample interval at the current state without sampling (discards the Δv

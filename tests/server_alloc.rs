@@ -22,12 +22,15 @@ static ALLOC: AllocDisabler = AllocDisabler;
 
 #[test]
 fn the_frame_path_does_not_allocate() {
-    // The reference spacecraft plus the two IMUs of the tactical-IMU scenario.
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/imu_tactical.toml");
+    // The reference spacecraft with four reaction wheels, an IMU and a star tracker.
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml");
     let cfg = SimConfig::from_file(&path).unwrap();
     let mut sim = Simulation::new(&cfg).unwrap();
     assert!(sim.n_imus() > 0);
     let mut imu = Vec::with_capacity(sim.n_imus());
+    let mut st = Vec::with_capacity(sim.star_trackers().len());
+    assert!(!sim.star_trackers().is_empty());
     let mut book = CommandBook::new(
         &[1, 2],
         cfg.frame_ns,
@@ -41,7 +44,11 @@ fn the_frame_path_does_not_allocate() {
     let (full_tx, full_rx) = sync_channel::<Box<Frame>>(2);
     for _ in 0..2 {
         free_tx
-            .send(Box::new(Frame::for_snapshot(&snap, sim.n_imus())))
+            .send(Box::new(Frame::for_snapshot(
+                &snap,
+                sim.n_imus(),
+                sim.star_trackers().len(),
+            )))
             .unwrap();
     }
     let mut frame_once = |k: u64| {
@@ -63,10 +70,13 @@ fn the_frame_path_does_not_allocate() {
         sim.set_effector_inputs(book.held_inputs()).unwrap();
         sim.step_frame();
         sim.imu_samples_into(&mut imu);
+        sim.star_tracker_samples_into(k + 1, &mut st);
         let mut f = free_rx.try_recv().unwrap();
         sim.snapshot_into(&mut snap);
         f.imu.clear();
         f.imu.extend_from_slice(&imu);
+        f.star_trackers.clear();
+        f.star_trackers.extend_from_slice(&st);
         fill_state(
             &mut f.state,
             &snap,

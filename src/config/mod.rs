@@ -43,6 +43,7 @@ use crate::dynamics::{
     WrenchSegment,
 };
 use crate::sensors::imu::{self, schema::RawImu, ImuConfig};
+use crate::sensors::star_tracker::{self, schema::RawStarTracker, StarTrackerConfig};
 
 /// The built-in default configuration (the text of `scenarios/reference.toml`).
 pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../scenarios/reference.toml");
@@ -77,6 +78,8 @@ pub struct SimConfig {
     /// The IMUs (`[[imus]]`), validated, in file order (empty if absent). IMU `i` is sensor
     /// point `i` of the spacecraft built by [`Self::build_spacecraft`].
     pub imus: Vec<ImuConfig>,
+    /// The star trackers (`[[star_trackers]]`), validated, in file order (empty if absent).
+    pub star_trackers: Vec<StarTrackerConfig>,
     /// The configuration text this was parsed from.
     pub source_toml: String,
 }
@@ -177,7 +180,7 @@ pub fn gravity_model_name(g: &GravityModel) -> &'static str {
 /// One-line summary of a valid configuration.
 pub fn config_summary(cfg: &SimConfig) -> String {
     format!(
-        "{} panel pairs{}, {} IMUs{}, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows",
+        "{} panel pairs{}, {} IMUs{}{}, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows",
         cfg.panel_pairs.len(),
         if cfg.reaction_wheels.is_empty() {
             String::new()
@@ -190,6 +193,12 @@ pub fn config_summary(cfg: &SimConfig) -> String {
         } else {
             let names: Vec<&str> = cfg.imus.iter().map(|i| i.name.as_str()).collect();
             format!(" ({})", names.join(", "))
+        },
+        if cfg.star_trackers.is_empty() {
+            String::new()
+        } else {
+            let names: Vec<&str> = cfg.star_trackers.iter().map(|s| s.name.as_str()).collect();
+            format!(", {} star trackers ({})", names.len(), names.join(", "))
         },
         cfg.total_mass_kg(),
         cfg.step_ns as f64 * 1e-9,
@@ -234,6 +243,7 @@ const ROOT_KEYS: &[&str] = &[
     "wrench_schedule",
     "server",
     "imus",
+    "star_trackers",
 ];
 
 struct RawConfig {
@@ -246,6 +256,7 @@ struct RawConfig {
     wrench_schedule: Vec<RawWrench>,
     server: toml::Table,
     imus: Vec<RawImu>,
+    star_trackers: Vec<RawStarTracker>,
 }
 
 struct RawSimulation {
@@ -370,6 +381,12 @@ impl RawConfig {
             .iter()
             .map(RawImu::read)
             .collect::<Result<Vec<_>, _>>()?;
+        let star_trackers = root
+            .tables("star_trackers", &star_tracker::schema::KEYS)?
+            .unwrap_or_default()
+            .iter()
+            .map(star_tracker::schema::read)
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(RawConfig {
             simulation,
             gravity,
@@ -380,6 +397,7 @@ impl RawConfig {
             wrench_schedule,
             server,
             imus,
+            star_trackers,
         })
     }
 }
@@ -556,6 +574,52 @@ impl RawConfig {
             imus.push(imu);
         }
 
+        // [[star_trackers]]
+        let mut star_trackers = Vec::with_capacity(self.star_trackers.len());
+        let mut tracker_names = HashSet::new();
+        for (i, raw) in self.star_trackers.into_iter().enumerate() {
+            let path = format!("star_trackers[{i}]");
+            unique_name(map, &path, &raw.name, &mut tracker_names, "star tracker")?;
+            if let Err(e) = flexdyn_proto::validate_star_tracker_name(&raw.name) {
+                return Err(map.invalid(&format!("{path}.name"), e.to_string()));
+            }
+            let field = format!("{path}.rate_hz");
+            if !(raw.rate_hz > 0.0) || !raw.rate_hz.is_finite() {
+                return Err(param(ParamError::NotPositive {
+                    field,
+                    value: raw.rate_hz,
+                }));
+            }
+            let ratio = sim.frame_hz / raw.rate_hz;
+            let every_frames = ratio.round();
+            if every_frames < 1.0 || (ratio - every_frames).abs() > 1e-9 * ratio {
+                return Err(map.invalid(
+                    &field,
+                    format!(
+                        "{} Hz is not the frame rate ({} Hz) divided by a whole number: the \
+                         tracker updates every whole number of frames",
+                        Num(raw.rate_hz),
+                        Num(sim.frame_hz)
+                    ),
+                ));
+            }
+            let cfg = StarTrackerConfig {
+                name: raw.name,
+                dcm_cb: raw.dcm_cb,
+                boresight_c: raw.boresight_c,
+                sigma_cross_boresight_rad: raw.sigma_cross_boresight_rad,
+                sigma_about_boresight_rad: raw.sigma_about_boresight_rad,
+                bias_c_rad: raw.bias_c_rad,
+                every_frames: every_frames as u64,
+                seed: raw.seed,
+                sun_direction_n: raw.sun_direction_n,
+                sun_exclusion_rad: raw.sun_exclusion_rad,
+                max_rate_rad_s: raw.max_rate_rad_s,
+            };
+            cfg.validate(&path).map_err(param)?;
+            star_trackers.push(cfg);
+        }
+
         let cfg = SimConfig {
             step_ns,
             frame_ns,
@@ -568,6 +632,7 @@ impl RawConfig {
             wrench_schedule,
             server: self.server,
             imus,
+            star_trackers,
             source_toml: source.to_string(),
         };
         check_body_extent(&cfg, map)?;

@@ -340,6 +340,25 @@ pub async fn run(
         );
     }
 
+    let mut st_pubs = Vec::with_capacity(sim.star_trackers().len());
+    for (i, st) in sim.star_trackers().iter().enumerate() {
+        let key = topics
+            .star_tracker(st.name())
+            .map_err(|e| SettingsError::Invalid {
+                name: format!("star_trackers[{i}].name"),
+                problem: e.to_string(),
+            })?;
+        st_pubs.push((
+            session
+                .declare_publisher(key)
+                .congestion_control(congestion)
+                .express(express)
+                .await
+                .map_err(|e| ServerError::zenoh("declare a star-tracker publisher", e))?,
+            st.config().every_frames,
+        ));
+    }
+
     let shared = Arc::new(Shared::new(&settings.participants));
     shared.set_run_state(RunState::Starting);
     let (cmd_tx, cmd_rx) = sync_channel(settings.command_queue);
@@ -349,7 +368,11 @@ pub async fn run(
     let shape = crate::sim::Snapshot::for_simulation(&sim);
     for _ in 0..n_buffers {
         free_tx
-            .send(Box::new(Frame::for_snapshot(&shape, sim.n_imus())))
+            .send(Box::new(Frame::for_snapshot(
+                &shape,
+                sim.n_imus(),
+                sim.star_trackers().len(),
+            )))
             .map_err(|_| ServerError::Internal("telemetry pool".into()))?;
     }
 
@@ -415,6 +438,7 @@ pub async fn run(
         state_pub: state_pub.clone(),
         status_pub,
         imu_pubs,
+        st_pubs,
         full_rx,
         free_tx,
         shared: shared.clone(),

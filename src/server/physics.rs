@@ -7,6 +7,7 @@
 //!    until every participant has answered tick `k`) and holds their sum over the frame;
 //! 3. integrates the frame's RK4 steps ([`Simulation::step_frame`]);
 //! 4. samples the IMUs ([`Simulation::imu_samples_into`], closing their interval every frame)
+//!    and the star trackers that are due ([`Simulation::star_tracker_samples_into`])
 //!    and fills the state and IMU samples of tick `k + 1` into a free telemetry buffer.
 //!
 //! The loop never allocates, locks or does I/O: commands arrive through a bounded channel, the
@@ -29,6 +30,7 @@ use super::settings::ServerSettings;
 use super::shared::{fill_state, Frame, Shared};
 use crate::dynamics::Wrench;
 use crate::sensors::imu::ImuSample;
+use crate::sensors::star_tracker::StarTrackerSample;
 use crate::sim::{Simulation, Snapshot};
 
 /// Longest single blocking wait, so a stop request is seen quickly.
@@ -174,6 +176,7 @@ impl PhysicsCtx {
         frame: &mut Frame,
         snap: &mut Snapshot,
         imu: &[ImuSample],
+        st: &[(usize, StarTrackerSample)],
         k: u64,
         held: &Held,
     ) {
@@ -184,6 +187,8 @@ impl PhysicsCtx {
         frame.lateness_ns = 0;
         frame.imu.clear();
         frame.imu.extend_from_slice(imu);
+        frame.star_trackers.clear();
+        frame.star_trackers.extend_from_slice(st);
     }
 
     fn frame_loop(&mut self) -> Result<PhysicsReport, ServerError> {
@@ -200,6 +205,7 @@ impl PhysicsCtx {
         let mut snap = Snapshot::for_simulation(&self.sim);
         // IMU samples close their interval every frame, published or not.
         let mut imu = Vec::with_capacity(self.sim.n_imus());
+        let mut st = Vec::with_capacity(self.sim.star_trackers().len());
         let mut held = Held::initial(self.settings.stale_policy);
         // A stop reports the last boundary reached (the tick the last StateMsg and StatusMsg
         // carry), not a tick that was stepped to but never published.
@@ -218,8 +224,9 @@ impl PhysicsCtx {
             Err(_) => return Ok(stopped(&self.shared)),
         };
         self.sim.imu_samples_into(&mut imu);
+        self.sim.star_tracker_samples_into(0, &mut st);
         if let Some(mut f) = pending.take() {
-            self.fill(&mut f, &mut snap, &imu, 0, &held);
+            self.fill(&mut f, &mut snap, &imu, &st, 0, &held);
             pending = Some(f);
         }
         // Real time: boundary 0 is due one frame from now, so the I/O side is settled.
@@ -291,8 +298,9 @@ impl PhysicsCtx {
                 Err(_) => return Ok(stopped(&self.shared)),
             };
             self.sim.imu_samples_into(&mut imu);
+            self.sim.star_tracker_samples_into(k, &mut st);
             if let Some(mut f) = pending.take() {
-                self.fill(&mut f, &mut snap, &imu, k, &held);
+                self.fill(&mut f, &mut snap, &imu, &st, k, &held);
                 pending = Some(f);
             } else {
                 // No buffer for this frame's telemetry: still check what was propagated.
@@ -301,6 +309,11 @@ impl PhysicsCtx {
             // Once per frame, outside the RK4 loop: never publish a non-finite state.
             let imu_bad = imu.iter().find_map(|s| s.first_non_finite());
             let imu_bad = imu_bad.map(|q| format!("an IMU's {q} output"));
+            let st_bad = st
+                .iter()
+                .find_map(|(_, s)| s.first_non_finite())
+                .map(|q| format!("a star tracker's {q} output"));
+            let imu_bad = imu_bad.or(st_bad);
             if let Some(quantity) = snap.first_non_finite().or(imu_bad) {
                 return Err(ServerError::NonFinite {
                     tick: k,

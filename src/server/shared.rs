@@ -9,6 +9,7 @@ use flexdyn_proto::{
 
 use super::commands::Held;
 use crate::sensors::imu::ImuSample;
+use crate::sensors::star_tracker::StarTrackerSample;
 
 /// One frame's telemetry, filled by the physics thread and published by the I/O thread. A
 /// fixed pool of these is allocated at start-up and cycled through two bounded channels
@@ -26,11 +27,18 @@ pub struct Frame {
     pub command: CommandStatus,
     /// One IMU sample per configured IMU (config order), taken at this tick.
     pub imu: Vec<ImuSample>,
+    /// The star trackers that updated at this tick: (config index, sample).
+    pub star_trackers: Vec<(usize, StarTrackerSample)>,
 }
 
 impl Frame {
-    /// An empty frame shaped for `snap`'s effectors, with room for `n_imus` IMU samples.
-    pub fn for_snapshot(snap: &crate::sim::Snapshot, n_imus: usize) -> Self {
+    /// An empty frame shaped for `snap`'s effectors, with room for `n_imus` IMU samples and
+    /// `n_star_trackers` star-tracker samples.
+    pub fn for_snapshot(
+        snap: &crate::sim::Snapshot,
+        n_imus: usize,
+        n_star_trackers: usize,
+    ) -> Self {
         Self {
             state: StateMsg {
                 effectors: snap
@@ -49,6 +57,7 @@ impl Frame {
             lateness_ns: 0,
             command: Held::initial(flexdyn_proto::StalePolicy::Hold).status,
             imu: Vec::with_capacity(n_imus),
+            star_trackers: Vec::with_capacity(n_star_trackers),
         }
     }
 }

@@ -73,6 +73,9 @@ pub struct TelemetryCtx {
     pub status_pub: Publisher<'static>,
     /// Publishers of `flexdyn/<sc>/tlm/imu/<name>`, in IMU config order.
     pub imu_pubs: Vec<Publisher<'static>>,
+    /// Publishers of `flexdyn/<sc>/tlm/st/<name>` with the tracker's update period in frames,
+    /// in star-tracker config order.
+    pub st_pubs: Vec<(Publisher<'static>, u64)>,
     /// Filled frames from the physics thread.
     pub full_rx: Receiver<Box<Frame>>,
     /// Buffers back to the physics thread.
@@ -233,6 +236,23 @@ impl TelemetryCtx {
                             p.publish_errors += 1;
                             if p.publish_errors.is_power_of_two() {
                                 tracing::warn!(error = %e, errors = p.publish_errors, "cannot publish an IMU sample");
+                            }
+                        }
+                    }
+                    for (i, sample) in &frame.star_trackers {
+                        let Some((publisher, every)) = self.st_pubs.get(*i) else {
+                            continue;
+                        };
+                        // seq counts this tracker's messages: +1 per update.
+                        let h = flexdyn_proto::Header {
+                            seq: header.tick / every,
+                            ..header
+                        };
+                        encode_into(&sample.to_msg(h), &mut imu_buf);
+                        if let Err(e) = publisher.put(imu_buf.as_slice()).attachment(stamp).wait() {
+                            p.publish_errors += 1;
+                            if p.publish_errors.is_power_of_two() {
+                                tracing::warn!(error = %e, errors = p.publish_errors, "cannot publish a star-tracker sample");
                             }
                         }
                     }

@@ -1,0 +1,149 @@
+//! The sensors' portable random numbers: standard normals by Marsaglia's polar method on
+//! ChaCha8, with `ln`/`exp` written with IEEE-754 basic operations only, so a seed gives the same
+//! noise bit for bit on every platform (see [`super::imu`]'s module docs for the method).
+
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+
+// ---------------------------------------------------------------------------------------------
+// Portable elementary functions (IEEE-754 +, −, ×, ÷ only; Rust never contracts them to FMA).
+
+/// ln 2 split so that `k * LN2_HI` is exact for |k| < 2¹¹ (fdlibm's constants).
+const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000); // 6.93147180369123816490e-01
+const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76); // 1.90821492927058770002e-10
+
+/// Natural logarithm of a positive, finite `x`, bit-reproducible on every IEEE-754 platform
+/// (within 2 ulp of the true value). x = m·2ᵉ with m ∈ [√½, √2); ln m = 2 atanh(f),
+/// f = (m − 1)/(m + 1), |f| ≤ 0.172, summed to f²⁵ (truncation < 1e-19 relative).
+pub fn ln_portable(x: f64) -> f64 {
+    if x.is_nan() || x < 0.0 {
+        return f64::NAN;
+    }
+    if x == 0.0 {
+        return f64::NEG_INFINITY;
+    }
+    if x == f64::INFINITY {
+        return x;
+    }
+    let (mut x, mut e) = (x, 0i64);
+    if x < f64::MIN_POSITIVE {
+        x *= 18_014_398_509_481_984.0; // 2^54, exact
+        e = -54;
+    }
+    let bits = x.to_bits();
+    e += ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let mut m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | (1023u64 << 52));
+    if m > std::f64::consts::SQRT_2 {
+        m *= 0.5;
+        e += 1;
+    }
+    let f = (m - 1.0) / (m + 1.0);
+    let f2 = f * f;
+    // 2 atanh f = 2 Σ f^(2k+1)/(2k+1), k = 0..12, Horner in f².
+    let mut s = 2.0 / 25.0;
+    for k in (0..12).rev() {
+        s = s * f2 + 2.0 / (2 * k + 1) as f64;
+    }
+    let ef = e as f64;
+    ef * LN2_HI + (f * s + ef * LN2_LO)
+}
+
+/// e^r − 1 for |r| ≤ ½ ln 2, by its Taylor series to r¹⁸ (truncation < 1e-22 relative).
+fn expm1_reduced(r: f64) -> f64 {
+    let mut s = 1.0 / 6_402_373_705_728_000.0; // 1/18!
+    let mut fact = 6_402_373_705_728_000.0;
+    for n in (1..18).rev() {
+        fact /= (n + 1) as f64;
+        s = s * r + 1.0 / fact;
+    }
+    // s = Σ_{n=1..18} r^(n−1)/n!
+    s * r
+}
+
+/// e^x, bit-reproducible on every IEEE-754 platform (within 2 ulp). x = k ln 2 + r,
+/// |r| ≤ ½ ln 2, e^x = 2ᵏ (1 + expm1(r)).
+pub fn exp_portable(x: f64) -> f64 {
+    if x.is_nan() {
+        return x;
+    }
+    if x > 709.78 {
+        return f64::INFINITY;
+    }
+    if x < -745.2 {
+        return 0.0;
+    }
+    let k = (x * std::f64::consts::LOG2_E).round();
+    let r = (x - k * LN2_HI) - k * LN2_LO;
+    let y = 1.0 + expm1_reduced(r);
+    scale_pow2(y, k as i64)
+}
+
+/// e^x − 1 without cancellation near 0, bit-reproducible (within 2 ulp).
+pub fn expm1_portable(x: f64) -> f64 {
+    if x.abs() <= 0.5 * std::f64::consts::LN_2 {
+        expm1_reduced(x)
+    } else {
+        exp_portable(x) - 1.0
+    }
+}
+
+/// y · 2ᵏ by exact power-of-two multiplications (handles subnormal results).
+fn scale_pow2(mut y: f64, mut k: i64) -> f64 {
+    while k > 1023 {
+        y *= f64::from_bits(2046u64 << 52); // 2^1023
+        k -= 1023;
+    }
+    while k < -1022 {
+        y *= f64::from_bits(1u64 << 52); // 2^-1022
+        k += 1022;
+    }
+    y * f64::from_bits(((k + 1023) as u64) << 52)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Random numbers.
+
+/// Standard normal pairs by Marsaglia's polar method on ChaCha8 (see the module docs).
+#[derive(Debug, Clone)]
+pub(crate) struct NormalRng {
+    rng: ChaCha8Rng,
+}
+
+impl NormalRng {
+    pub(crate) fn new(seed: u64) -> Self {
+        Self {
+            rng: ChaCha8Rng::seed_from_u64(seed),
+        }
+    }
+
+    /// Uniform on [−1, 1) with 53 random bits.
+    #[inline]
+    fn uniform_pm1(&mut self) -> f64 {
+        const TWO_POW_M52: f64 = 1.0 / 4_503_599_627_370_496.0;
+        (self.rng.next_u64() >> 11) as f64 * TWO_POW_M52 - 1.0
+    }
+
+    /// Two independent standard normals.
+    #[inline]
+    pub(crate) fn normal_pair(&mut self) -> (f64, f64) {
+        loop {
+            let u = self.uniform_pm1();
+            let v = self.uniform_pm1();
+            let s = u * u + v * v;
+            if s > 0.0 && s < 1.0 {
+                let f = (-2.0 * ln_portable(s) / s).sqrt();
+                return (u * f, v * f);
+            }
+        }
+    }
+
+    /// Fills `out` (even length) with standard normals, pair by pair.
+    #[inline]
+    pub(crate) fn fill(&mut self, out: &mut [f64]) {
+        for pair in out.chunks_exact_mut(2) {
+            let (a, b) = self.normal_pair();
+            pair[0] = a;
+            pair[1] = b;
+        }
+    }
+}
