@@ -584,7 +584,7 @@ impl RawConfig {
                 return Err(map.invalid(&format!("{path}.name"), e.to_string()));
             }
             let field = format!("{path}.rate_hz");
-            if !(raw.rate_hz > 0.0) || !raw.rate_hz.is_finite() {
+            if !raw.rate_hz.is_finite() || raw.rate_hz <= 0.0 {
                 return Err(param(ParamError::NotPositive {
                     field,
                     value: raw.rate_hz,
