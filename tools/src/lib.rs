@@ -20,6 +20,7 @@ use flexdyn::server::{zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::Topics;
 use zenoh::{Session, Wait};
 
+pub mod acs;
 pub mod pingpong;
 
 /// Connection options shared by every tool (flatten into a binary's arguments with clap).

@@ -285,6 +285,101 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
     );
 }
 
+/// Issue 11: flight-like ACS on sensor data only. The controller commands the four reaction
+/// wheels of `scenarios/wheels_star_tracker.toml` (`Actuators` commands, one per tick) from the
+/// star tracker's attitude, propagated with the `hub` IMU's gyro between the tracker's 10 Hz
+/// updates, and the gyro rate. Nothing it uses is truth.
+///
+/// Convergence bound: the wheel law gives the closed loop [I] ω̇ = −K σ − P ω as for the wrench
+/// (see `flexdyn_tools::acs`), so with K = 10 N·m and P = 150 N·m·s the linear settling time is
+/// 8 I / P ≈ 8 · 1812 / 150 ≈ 97 s, ζ = P / √(K I) ≥ 1.1. The linear bound ignores the wheels'
+/// 0.2 N·m motor limit, which saturates the first ~120 s: the initial 0.015 rad/s tumble holds
+/// |I ω| ≈ 27 N·m·s, and the pyramid's weakest axis takes at most 4 · 0.2 · cos 30° · cos 45°
+/// ≈ 0.49 N·m, so removing it alone takes ≥ 55 s while the attitude error first grows (to
+/// |σ| ≈ 0.25 at 60 s). The check allows 2.5× the linear bound (242 s), then requires
+/// |σ_BN| < 0.02 (2.3°) to the end of the 300 s run and < 0.005 at the end. Two runs hash the
+/// same.
+#[test]
+fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
+    const K: f64 = 10.0;
+    const P: f64 = 150.0;
+    const RUN_S: f64 = 300.0;
+    let bound_s = 2.5 * 8.0 * I_MAX_KG_M2 / P;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios/wheels_star_tracker.toml");
+    let path_s = path.to_str().unwrap().to_string();
+    let run = |port: u16| {
+        let cfg = flexdyn::config::SimConfig::from_file(&path).expect("wheels_star_tracker.toml");
+        let topics = Topics::new("sc1").unwrap();
+        let settings = ServerSettings {
+            duration_ns: Some((RUN_S * 1e9) as u64),
+            ..settings(10.0)
+        };
+        let server = ServerHandle::start(port, settings, cfg);
+        let recorder = Recorder::start(port, &topics, 2);
+        let _ctrl = ChildGuard::spawn(
+            Command::new(env!("CARGO_BIN_EXE_flexdyn-acs-demo"))
+                .args(["--connect", &endpoint(port), "--sender-id", "1"])
+                .args(["--k-nm", &K.to_string(), "--p-nms", &P.to_string()])
+                .args(["--log-every-s", "0", "--config", &path_s])
+                .args(["--actuator", "wheels", "--attitude-source", "star-tracker"])
+                .args([
+                    "--star-tracker",
+                    "st1",
+                    "--rate-source",
+                    "gyro",
+                    "--imu",
+                    "hub",
+                ]),
+        );
+        let report = server.join(Duration::from_secs(300)).expect("wheel run");
+        let mut states = recorder.states.lock().unwrap().clone();
+        states.sort_by_key(|(t, _)| *t);
+        (report, states)
+    };
+    let (report, a) = run(17318);
+    let mut settled_at = None;
+    let mut max_u = 0.0_f64;
+    let mut saturated = 0usize;
+    for (tick, bytes) in &a {
+        let s = decode_state(bytes).unwrap();
+        let e = Vector3::from(s.sigma_bn).norm();
+        let t_s = *tick as f64 / 100.0;
+        if e >= SIGMA_THRESHOLD {
+            settled_at = None;
+        } else if settled_at.is_none() {
+            settled_at = Some(t_s);
+        }
+        assert!(
+            t_s < bound_s || e < SIGMA_THRESHOLD,
+            "|sigma_BN| = {e} at t = {t_s} s, after the bound {bound_s} s"
+        );
+        // The wheels, not a wrench, act: the wrench stays zero, the wheels' motor torques do not.
+        assert_eq!(s.wrench_applied.torque_b_nm, [0.0; 3]);
+        for w in &s.effectors[2..] {
+            assert_eq!(w.kind, flexdyn_proto::effector_kind::REACTION_WHEEL);
+            max_u = max_u.max(w.outputs[0].abs());
+            saturated += usize::from(w.flags & flexdyn_proto::wheel_flags::TORQUE_LIMITED != 0);
+        }
+    }
+    let hash_a = digest(&a);
+    eprintln!(
+        "wheels on star tracker + gyro: settled at {settled_at:?} s (bound {bound_s} s), max \
+         |u| {max_u} N m, {saturated} torque-limited wheel-frames, {} ticks in {:.2} s wall, \
+         sha256 {hash_a}",
+        a.len(),
+        report.wall_s
+    );
+    assert!(max_u > 0.1, "the wheels were commanded");
+    let last = decode_state(&a.last().unwrap().1).unwrap();
+    assert!(
+        Vector3::from(last.sigma_bn).norm() < 0.005,
+        "final attitude error"
+    );
+    let (_, b) = run(17319);
+    assert_eq!(digest(&b), hash_a, "two wheel runs differ");
+}
+
 #[test]
 fn killed_controller_stops_the_run_with_a_timeout_naming_it() {
     let run = lockstep_run(17313, 2.0, Sabotage::Kill { at: 300 });

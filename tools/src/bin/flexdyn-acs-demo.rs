@@ -56,8 +56,11 @@ use std::time::Duration;
 use anyhow::{bail, Context as _};
 use clap::Parser;
 use flexdyn::numfmt::Rounded;
-use flexdyn_proto::{decode_imu, decode_state, encode_into, CommandMsg, Header, ImuMsg};
+use flexdyn_proto::{
+    decode_imu, decode_star_tracker, decode_state, encode_into, CommandMsg, Header, ImuMsg,
+};
 use flexdyn_tools::CommonArgs;
+use nalgebra::Vector3;
 use zenoh::handlers::{RingChannel, RingChannelHandler};
 use zenoh::qos::CongestionControl;
 use zenoh::sample::Sample;
@@ -103,9 +106,46 @@ struct Args {
           default_values_t = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])]
     imu_dcm_pb: Vec<f64>,
     /// Longest wait [s] for the IMU's first sample before giving up (error); later samples are
-    /// waited for at most 50 ms, then the previous rate is held.
+    /// waited for at most 50 ms, then the previous rate is held. The same limits apply to the
+    /// star tracker.
     #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
     imu_timeout_s: f64,
+    /// The server's scenario file: the flight code's copy of the spacecraft's geometry (wheel
+    /// axes and inertias, star-tracker and IMU mountings, mass properties). Needed by
+    /// `--actuator wheels` and `--attitude-source star-tracker`; with `--imu`, the IMU's
+    /// mounting is taken from it.
+    #[arg(long, value_name = "FILE")]
+    config: Option<std::path::PathBuf>,
+    /// What to command: `wrench` (a body torque) or `wheels` (reaction-wheel motor torques
+    /// through an `Actuators` command, with wheel-momentum gyroscopic compensation).
+    #[arg(long, value_enum, default_value_t = Actuator::Wrench)]
+    actuator: Actuator,
+    /// Where the attitude comes from: `truth` (the state message's σ_BN) or `star-tracker`
+    /// (the tracker named by --star-tracker, propagated with the rate feedback between its
+    /// updates; no command until its first valid measurement).
+    #[arg(long, value_enum, default_value_t = AttitudeSource::Truth)]
+    attitude_source: AttitudeSource,
+    /// The star tracker feeding the attitude (its `[[star_trackers]] name`).
+    #[arg(long)]
+    star_tracker: Option<String>,
+}
+
+/// What the controller commands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum Actuator {
+    /// A body torque (`CommandKind::Wrench`).
+    Wrench,
+    /// Reaction-wheel motor torques (`CommandKind::Actuators`).
+    Wheels,
+}
+
+/// Where the attitude comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum AttitudeSource {
+    /// The state message's σ_BN.
+    Truth,
+    /// A star tracker's q_CN, mounted as in --config.
+    StarTracker,
 }
 
 /// Rate feedback source.
@@ -187,8 +227,8 @@ struct GyroFeedback {
     key: String,
     /// [PB], row-major.
     dcm_pb: [[f64; 3]; 3],
-    /// Latest sample not yet used (a sample can arrive before its state).
-    pending: Option<ImuMsg>,
+    /// Latest sample not yet used, with its tick (a sample can arrive before its state).
+    pending: Option<(u64, ImuMsg)>,
     /// The last rate used, held over a missed sample.
     last_rate_b: Option<[f64; 3]>,
     /// Samples missed so far.
@@ -206,45 +246,17 @@ impl GyroFeedback {
         ]
     }
 
-    /// Waits (at most `timeout`) for the sample of `tick`. Older samples are skipped; `Ok(None)`
-    /// means it did not arrive in time (or a later tick's came first).
+    /// Waits (at most `timeout`) for the sample of `tick`; see [`message_for_tick`].
     fn sample_for(
         &mut self,
         tick: u64,
         imus: &RingChannelHandler<Sample>,
         timeout: Duration,
     ) -> anyhow::Result<Option<[f64; 3]>> {
-        if let Some(m) = self.pending.take() {
-            if m.header.tick == tick {
-                return Ok(Some(self.rate_b(m.omega_p_rad_s)));
-            }
-            if m.header.tick > tick {
-                self.pending = Some(m);
-                return Ok(None);
-            }
-        }
-        let deadline = std::time::Instant::now() + timeout;
-        loop {
-            let left = deadline.saturating_duration_since(std::time::Instant::now());
-            let Some(sample) = imus
-                .recv_timeout(left)
-                .map_err(|e| anyhow::anyhow!("{e}"))?
-            else {
-                return Ok(None);
-            };
-            let Ok(msg) = decode_imu(&sample.payload().to_bytes()) else {
-                tracing::warn!(imu = %self.name, "ignoring an undecodable IMU sample");
-                continue;
-            };
-            if msg.header.tick < tick {
-                continue;
-            }
-            if msg.header.tick > tick {
-                self.pending = Some(msg);
-                return Ok(None);
-            }
-            return Ok(Some(self.rate_b(msg.omega_p_rad_s)));
-        }
+        let msg = message_for_tick(&mut self.pending, tick, imus, timeout, |b| {
+            decode_imu(b).map(|m| (m.header.tick, m))
+        })?;
+        Ok(msg.map(|m| self.rate_b(m.omega_p_rad_s)))
     }
 
     /// The rate for `tick`: its sample, else the previous rate held (the first miss and every
@@ -286,6 +298,46 @@ impl GyroFeedback {
                 self.name
             ),
         }
+    }
+}
+
+/// Waits (at most `timeout`) on `rx` for the message stamped `tick`, decoded by `decode` into
+/// (tick, message). Older messages are skipped, undecodable ones logged and skipped; a later
+/// tick's message is kept in `pending` for its own turn. `Ok(None)`: it did not arrive in time.
+fn message_for_tick<M>(
+    pending: &mut Option<(u64, M)>,
+    tick: u64,
+    rx: &RingChannelHandler<Sample>,
+    timeout: Duration,
+    decode: impl Fn(&[u8]) -> Result<(u64, M), flexdyn_proto::DecodeError>,
+) -> anyhow::Result<Option<M>> {
+    if let Some((t, m)) = pending.take() {
+        if t == tick {
+            return Ok(Some(m));
+        }
+        if t > tick {
+            *pending = Some((t, m));
+            return Ok(None);
+        }
+    }
+    let deadline = std::time::Instant::now() + timeout;
+    loop {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        let Some(sample) = rx.recv_timeout(left).map_err(|e| anyhow::anyhow!("{e}"))? else {
+            return Ok(None);
+        };
+        let Ok((t, msg)) = decode(&sample.payload().to_bytes()) else {
+            tracing::warn!(key = %sample.key_expr(), "ignoring an undecodable message");
+            continue;
+        };
+        if t < tick {
+            continue;
+        }
+        if t > tick {
+            *pending = Some((t, msg));
+            return Ok(None);
+        }
+        return Ok(Some(msg));
     }
 }
 
@@ -369,7 +421,50 @@ fn run(args: Args) -> anyhow::Result<()> {
     {
         return Err(flexdyn_tools::usage("gains and target must be finite"));
     }
-    let dcm_pb = parse_dcm(&args.imu_dcm_pb)?;
+    let mut dcm_pb = parse_dcm(&args.imu_dcm_pb)?;
+    // The flight code's copy of the spacecraft: needed for wheels and the star tracker.
+    let cfg = match &args.config {
+        Some(path) => Some(
+            flexdyn::config::SimConfig::from_file(path)
+                .map_err(|e| anyhow::anyhow!("--config: {e}"))?,
+        ),
+        None => None,
+    };
+    let needs = |what: &str| {
+        flexdyn_tools::usage(format!(
+            "{what} needs --config FILE (the server's scenario, for the spacecraft's geometry)"
+        ))
+    };
+    let wheels = match (args.actuator, &cfg) {
+        (Actuator::Wrench, _) => None,
+        (Actuator::Wheels, None) => return Err(needs("--actuator wheels")),
+        (Actuator::Wheels, Some(c)) => Some((
+            flexdyn_tools::acs::WheelArray::from_config(c)?,
+            flexdyn_tools::acs::inertia_about_b(c),
+        )),
+    };
+    let mut tracker =
+        match (args.attitude_source, &cfg, &args.star_tracker) {
+            (AttitudeSource::Truth, _, _) => None,
+            (AttitudeSource::StarTracker, None, _) => {
+                return Err(needs("--attitude-source star-tracker"))
+            }
+            (AttitudeSource::StarTracker, Some(_), None) => return Err(flexdyn_tools::usage(
+                "--attitude-source star-tracker needs --star-tracker NAME (its [[star_trackers]] \
+                 name)",
+            )),
+            (AttitudeSource::StarTracker, Some(c), Some(name)) => Some((
+                flexdyn_tools::acs::StarTrackerAttitude::from_config(c, name)?,
+                name.clone(),
+            )),
+        };
+    let frame_s = cfg.as_ref().map_or(0.01, |c| c.frame_ns as f64 * 1e-9);
+    if let (Some(c), Some(name)) = (&cfg, &args.imu) {
+        let imu = c.imus.iter().find(|i| &i.name == name).ok_or_else(|| {
+            anyhow::anyhow!("--imu {name}: the --config file has no [[imus]] entry of that name")
+        })?;
+        dcm_pb = std::array::from_fn(|i| std::array::from_fn(|j| imu.dcm_pb[(i, j)]));
+    }
     if args.rate_source == RateSource::Gyro && args.imu.is_none() {
         return Err(flexdyn_tools::usage(
             "--rate-source gyro needs --imu NAME (the [[imus]] name in the server config)",
@@ -430,6 +525,24 @@ fn run(args: Args) -> anyhow::Result<()> {
             (Some(sub), Some(g))
         }
     };
+
+    // 2c. The star tracker's topic.
+    let st_sub = match &tracker {
+        None => None,
+        Some((_, name)) => {
+            let key = topics.star_tracker(name)?;
+            tracing::info!(star_tracker = %key, "attitude from this star tracker");
+            Some(
+                session
+                    .declare_subscriber(&key)
+                    .with(RingChannel::new(64))
+                    .wait()
+                    .map_err(|e| anyhow::anyhow!("cannot subscribe to {key}: {e}"))?,
+            )
+        }
+    };
+    let mut st_pending = None;
+    let mut st_heard = false;
 
     // 3. The command publisher. Block (never drop) and express (no batching: lowest latency).
     let commands = session
@@ -512,12 +625,67 @@ fn run(args: Args) -> anyhow::Result<()> {
             _ => state.omega_bn_b_rad_s,
         };
 
-        // The control law.
-        let torque_b_nm = controller.torque_b_nm(state.sigma_bn, rate_b);
+        // The attitude: truth, or the star tracker's (propagated with the rate between updates).
+        let sigma_bn = match (&mut tracker, &st_sub) {
+            (Some((est, name)), Some(sub)) => {
+                let meas = if est.due(h.tick) {
+                    let wait = if st_heard {
+                        imu_timeout.min(Duration::from_millis(50))
+                    } else {
+                        imu_timeout
+                    };
+                    let m = message_for_tick(&mut st_pending, h.tick, sub, wait, |b| {
+                        decode_star_tracker(b).map(|m| (m.header.tick, m))
+                    })?;
+                    if m.is_none() && !st_heard {
+                        bail!(
+                            "no sample from star tracker `{name}` for tick {}: does the server's \
+                             configuration have it?",
+                            h.tick
+                        );
+                    }
+                    st_heard |= m.is_some();
+                    m
+                } else {
+                    None
+                };
+                est.update(meas.as_ref(), &Vector3::from(rate_b), frame_s)
+                    .map(|s| [s.x, s.y, s.z])
+            }
+            _ => Some(state.sigma_bn),
+        };
 
         // Answer with the state's spacecraft id, tick and sim time; our own sequence number.
         let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
-        let cmd = CommandMsg::wrench(header, args.sender_id, torque_b_nm, [0.0; 3]);
+        let (cmd, torque_b_nm) = match (sigma_bn, &wheels) {
+            // No attitude yet (the star tracker has not given a valid one): answer the tick.
+            (None, _) => (CommandMsg::no_command(header, args.sender_id), [0.0; 3]),
+            (Some(sigma_bn), None) => {
+                let t = controller.torque_b_nm(sigma_bn, rate_b);
+                (CommandMsg::wrench(header, args.sender_id, t, [0.0; 3]), t)
+            }
+            (Some(sigma_bn), Some((array, inertia))) => {
+                let speeds = array.speeds(&state)?;
+                let omega = Vector3::from(rate_b);
+                let l = flexdyn_tools::acs::wheel_control_torque(
+                    controller.k_nm,
+                    controller.p_nms,
+                    &Vector3::from(controller.sigma_br(sigma_bn)),
+                    &omega,
+                    inertia,
+                    &array.momentum_b(&omega, &speeds),
+                );
+                let u = array.motor_torques(&l);
+                let cmd = CommandMsg::actuators(
+                    header,
+                    args.sender_id,
+                    [0.0; 3],
+                    [0.0; 3],
+                    array.inputs(&u),
+                );
+                (cmd, [l.x, l.y, l.z])
+            }
+        };
         encode_into(&cmd, &mut buf);
         commands
             .put(buf.as_slice())
@@ -543,6 +711,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     drop(_token);
     drop(commands);
     drop(imus);
+    drop(st_sub);
     drop(states);
     session
         .close()
