@@ -6,6 +6,8 @@
 //! - [`schema`]: the typed TOML reader the per-model schemas use.
 //! - [`sensors`]: sensor models — [`sensors::imu`] (gyro and accelerometer).
 //! - [`logging`]: the stderr log setup shared by `flexdyn` and the tools (EPIPE-safe).
+//! - [`transport`]: the one Zenoh configuration builder (loopback, multicast scouting off),
+//!   shared by the server and the tools.
 //! - [`server`]: the Zenoh server (`flexdyn run`): real-time, lockstep and batch propagation.
 
 #![warn(missing_docs)]
@@ -20,3 +22,4 @@ pub mod schema;
 pub mod sensors;
 pub mod server;
 pub mod sim;
+pub mod transport;

@@ -5,9 +5,9 @@ use std::path::PathBuf;
 
 use super::error::{ServerError, SettingsError};
 use super::settings::{Origin, ServerSettings, Value};
-use super::zenoh_cfg::{zenoh_config, Role, ZenohArgs};
 use super::RunReport;
 use crate::config::{SimConfig, DEFAULT_CONFIG_TOML};
+use crate::transport::{zenoh_config, Role, ZenohArgs};
 
 /// Arguments of `flexdyn run` (plain `flexdyn` runs with all defaults). Every server option
 /// overrides the same key of the configuration's `[server]` table.

@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+pub use crate::transport::ZenohConfigError;
+
 use crate::config::ConfigError;
 
 /// An invalid server setting. The message starts with the setting's name as the user wrote it:
@@ -24,37 +26,6 @@ pub enum SettingsError {
         name: String,
         /// What is wrong, with the offending value.
         problem: String,
-    },
-}
-
-/// A Zenoh configuration that cannot be built.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum ZenohConfigError {
-    /// The JSON5 file given with `--zenoh-config` cannot be read.
-    #[error("cannot read Zenoh config file `{}`: {source}", path.display())]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// The I/O error.
-        #[source]
-        source: std::io::Error,
-    },
-    /// The JSON5 file is not a valid Zenoh configuration.
-    #[error("invalid Zenoh config file `{}`: {message}", path.display())]
-    Parse {
-        /// The file.
-        path: PathBuf,
-        /// What JSON5 or Zenoh reported.
-        message: String,
-    },
-    /// An endpoint or other value that Zenoh rejects.
-    #[error("{what}: {message}")]
-    Value {
-        /// The option (`--listen`, `--connect`, or a Zenoh config key).
-        what: String,
-        /// What Zenoh reported.
-        message: String,
     },
 }
 
@@ -189,7 +160,7 @@ impl ServerError {
     pub(crate) fn zenoh(what: &'static str, e: impl std::fmt::Display) -> Self {
         ServerError::Zenoh {
             what,
-            message: super::zenoh_cfg::clean_zenoh_message(&e.to_string()),
+            message: crate::transport::clean_zenoh_message(&e.to_string()),
         }
     }
 }

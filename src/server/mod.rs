@@ -7,7 +7,7 @@
 //!
 //! # Layout
 //! - [`settings`]: [`ServerSettings`], the `[server]` table and `flexdyn run` options.
-//! - [`zenoh_cfg`]: [`zenoh_config`], the one builder of every Zenoh configuration (loopback
+//! - [`crate::transport`]: [`zenoh_config`], the one builder of every Zenoh configuration (loopback
 //!   defaults, multicast scouting always off).
 //! - [`commands`]: per-participant command book (lockstep answers, staleness, summation).
 //! - [`pacing`]: absolute-deadline real-time pacing (sleep, then spin) and overrun policies.
@@ -35,7 +35,6 @@ mod reject_log;
 pub mod settings;
 pub mod shared;
 pub mod telemetry;
-pub mod zenoh_cfg;
 
 use std::collections::BTreeSet;
 use std::fmt;
@@ -52,10 +51,10 @@ use zenoh::qos::CongestionControl;
 use zenoh::sample::SampleKind;
 use zenoh::Session;
 
+pub use crate::transport::frame_stamp_ns;
+pub use crate::transport::{zenoh_config, Role, ZenohArgs, DEFAULT_ENDPOINT};
 pub use error::{ServerError, SettingsError, ZenohConfigError};
 pub use settings::{mode_name, OverrunPolicy, ServerSettings};
-pub use telemetry::frame_stamp_ns;
-pub use zenoh_cfg::{zenoh_config, Role, ZenohArgs, DEFAULT_ENDPOINT};
 
 use crate::config::SimConfig;
 use crate::sim::Simulation;

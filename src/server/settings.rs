@@ -40,14 +40,7 @@ impl OverrunPolicy {
     }
 }
 
-/// The spelling of a [`Mode`] in settings and logs.
-pub fn mode_name(mode: Mode) -> &'static str {
-    match mode {
-        Mode::RealTime => "realtime",
-        Mode::Lockstep => "lockstep",
-        Mode::Batch => "batch",
-    }
-}
+pub use crate::transport::mode_name;
 
 /// The spelling of a [`StalePolicy`] in settings and logs.
 pub fn stale_policy_name(p: StalePolicy) -> &'static str {

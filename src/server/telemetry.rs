@@ -14,7 +14,6 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 use flexdyn_proto::{encode_into, CommandStatus, FrameTiming, Header, Mode, StatusMsg};
 use hdrhistogram::Histogram;
 use zenoh::pubsub::Publisher;
-use zenoh::sample::Sample;
 use zenoh::Wait;
 
 use super::commands::Held;
@@ -24,14 +23,6 @@ use super::shared::{Frame, Shared};
 
 /// Largest lateness the histogram resolves (larger values are clamped): 1 hour in ns.
 const LATENESS_MAX_NS: u64 = 3_600_000_000_000;
-
-/// The frame-boundary wall-clock stamp of a StateMsg sample (ns since the Unix epoch), from its
-/// 8-byte little-endian attachment; `None` if absent or malformed.
-pub fn frame_stamp_ns(sample: &Sample) -> Option<u64> {
-    let bytes = sample.attachment()?.to_bytes();
-    let arr: [u8; 8] = bytes.as_ref().try_into().ok()?;
-    Some(u64::from_le_bytes(arr))
-}
 
 /// A new lateness histogram (ns, 3 significant digits).
 pub fn lateness_histogram() -> Histogram<u64> {

@@ -6,7 +6,8 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
-use flexdyn::server::{self, zenoh_config, Role, ZenohArgs};
+use flexdyn::server;
+use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::{decode_state, decode_status, StateMsg, StatusMsg, Topics};
 use zenoh::{Session, Wait};
 

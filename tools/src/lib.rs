@@ -8,7 +8,7 @@
 //!   benchmark.
 //! - this library: [`CommonArgs`] (the connection options every tool shares) and [`pingpong`].
 //!
-//! Every tool builds its Zenoh configuration with [`flexdyn::server::zenoh_config`]
+//! Every tool builds its Zenoh configuration with [`flexdyn::transport::zenoh_config`]
 //! ([`Role::Tool`]): peer mode, connect to `tcp/127.0.0.1:7447`, listen nowhere, multicast
 //! scouting always off.
 
@@ -16,7 +16,7 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-use flexdyn::server::{zenoh_config, Role, ZenohArgs};
+use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::Topics;
 use zenoh::{Session, Wait};
 
@@ -93,11 +93,11 @@ pub fn exit_with(result: anyhow::Result<()>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            let bad_input = e.chain().any(|c| {
-                c.is::<UsageError>() || c.is::<flexdyn::server::error::ZenohConfigError>()
-            });
+            let bad_input = e
+                .chain()
+                .any(|c| c.is::<UsageError>() || c.is::<flexdyn::transport::ZenohConfigError>());
             let line = format!("{e:#}").replace('\n', " ");
-            flexdyn::logging::print_error(flexdyn::server::zenoh_cfg::clean_zenoh_message(&line));
+            flexdyn::logging::print_error(flexdyn::transport::clean_zenoh_message(&line));
             ExitCode::from(if bad_input { 2 } else { 1 })
         }
     }

@@ -20,7 +20,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use clap::Parser;
-use flexdyn::server::{frame_stamp_ns, mode_name};
+use flexdyn::transport::{frame_stamp_ns, mode_name};
 use flexdyn_proto::{command_flags, decode_state, decode_status, RunState, StatusMsg, NO_COMMAND};
 use flexdyn_tools::{percentile, CommonArgs};
 use zenoh::Wait;

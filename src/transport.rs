@@ -14,7 +14,7 @@
 
 use std::path::PathBuf;
 
-use super::error::ZenohConfigError;
+use zenoh::sample::Sample;
 
 /// The default Zenoh endpoint of the server (`flexdyn run` listens, the tools connect).
 pub const DEFAULT_ENDPOINT: &str = "tcp/127.0.0.1:7447";
@@ -378,5 +378,53 @@ mod tests {
             clean_zenoh_message("Can not create a new TCP listener bound to tcp/127.0.0.1:1: Permission denied at /r/.cargo/registry/src/tcp.rs:61."),
             "Can not create a new TCP listener bound to tcp/127.0.0.1:1: Permission denied"
         );
+    }
+}
+
+/// A Zenoh configuration that cannot be built.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ZenohConfigError {
+    /// The JSON5 file given with `--zenoh-config` cannot be read.
+    #[error("cannot read Zenoh config file `{}`: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The JSON5 file is not a valid Zenoh configuration.
+    #[error("invalid Zenoh config file `{}`: {message}", path.display())]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// What JSON5 or Zenoh reported.
+        message: String,
+    },
+    /// An endpoint or other value that Zenoh rejects.
+    #[error("{what}: {message}")]
+    Value {
+        /// The option (`--listen`, `--connect`, or a Zenoh config key).
+        what: String,
+        /// What Zenoh reported.
+        message: String,
+    },
+}
+
+/// The frame-boundary wall-clock stamp of a StateMsg sample (ns since the Unix epoch), from its
+/// 8-byte little-endian attachment; `None` if absent or malformed.
+pub fn frame_stamp_ns(sample: &Sample) -> Option<u64> {
+    let bytes = sample.attachment()?.to_bytes();
+    let arr: [u8; 8] = bytes.as_ref().try_into().ok()?;
+    Some(u64::from_le_bytes(arr))
+}
+
+/// The spelling of a [`flexdyn_proto::Mode`] in settings and logs.
+pub fn mode_name(mode: flexdyn_proto::Mode) -> &'static str {
+    match mode {
+        flexdyn_proto::Mode::RealTime => "realtime",
+        flexdyn_proto::Mode::Lockstep => "lockstep",
+        flexdyn_proto::Mode::Batch => "batch",
     }
 }
