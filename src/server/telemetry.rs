@@ -123,9 +123,14 @@ impl TelemetryCtx {
         }
     }
 
-    /// Warns (rate-limited) about stale-tick rejections counted by the physics thread since the
-    /// last call, naming the participant.
-    fn warn_stale_ticks(&self, log: &mut RejectLog, seen: &mut [u64]) {
+    /// Warns (rate-limited) about the rejections the physics thread counted since the last
+    /// call: stale ticks, naming the participant, and effector inputs that do not fit.
+    fn warn_physics_rejects(
+        &self,
+        log: &mut RejectLog,
+        seen: &mut [u64],
+        bad_inputs_seen: &mut u64,
+    ) {
         for ((id, count), last) in self.shared.stale_by_participant.iter().zip(seen) {
             let now = count.load(Ordering::Relaxed);
             if now > *last {
@@ -139,6 +144,18 @@ impl TelemetryCtx {
                 );
                 *last = now;
             }
+        }
+        let now = self.shared.rejected().bad_effector_input;
+        if now > *bad_inputs_seen {
+            log.record(
+                "bad_effector_input",
+                None,
+                now - *bad_inputs_seen,
+                &"an Actuators command naming an effector that does not exist or takes no \
+                  input, with the wrong number of values for it, or naming it twice (see the \
+                  StateMsg's effector list for the indices)",
+            );
+            *bad_inputs_seen = now;
         }
     }
 
@@ -192,10 +209,11 @@ impl TelemetryCtx {
         let mut window_frames = 0u64;
         let mut rejects = RejectLog::default();
         let mut stale_seen = vec![0u64; self.shared.stale_by_participant.len()];
+        let mut bad_inputs_seen = 0u64;
         loop {
             let now = Instant::now();
             if now >= next_status {
-                self.warn_stale_ticks(&mut rejects, &mut stale_seen);
+                self.warn_physics_rejects(&mut rejects, &mut stale_seen, &mut bad_inputs_seen);
                 self.publish_status(&mut p, &mut status_buf);
                 next_status += status_period;
                 if next_status < now {
@@ -269,7 +287,7 @@ impl TelemetryCtx {
                 Err(RecvTimeoutError::Disconnected) => break,
             }
         }
-        self.warn_stale_ticks(&mut rejects, &mut stale_seen);
+        self.warn_physics_rejects(&mut rejects, &mut stale_seen, &mut bad_inputs_seen);
         self.publish_status(&mut p, &mut status_buf);
         TelemetryReport {
             lateness: p.lateness,
