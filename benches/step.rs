@@ -1,8 +1,10 @@
-//! One RK4 step of the reference spacecraft with 1, 2, 4, 8 and 16 panel pairs.
+//! One RK4 step of the reference spacecraft with 1, 2, 4, 8 and 16 panel pairs, and of the
+//! reference spacecraft (2 pairs) with 0, 1, 2, 4 and 8 reaction wheels.
 //!
 //! Targets (issue 2): ≤ 2 µs per step for 2 pairs on one core, cost linear in the pair count at
-//! ≤ 0.5 µs per added pair. After criterion's own report this prints a summary of medians
-//! (31 batches of 20,000 steps per size) and the least-squares cost per added pair.
+//! ≤ 0.5 µs per added pair. Issue 11: ≤ 0.3 µs per added reaction wheel. After criterion's own
+//! report this prints a summary of medians (31 batches of 20,000 steps per size) and the
+//! least-squares cost per added pair and per added wheel.
 //!
 //! Peers in the same run: with `FLEXDYN_PEERS_PYTHON` pointing at a Python that has
 //! `mujoco==4.0.0` and `bsk==2.12.1` (see `tools/peers/README.md`), the bench then runs
@@ -16,9 +18,58 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use criterion::{BenchmarkId, Criterion};
-use flexdyn::dynamics::{GravityModel, Spacecraft};
+use flexdyn::dynamics::{
+    GravityModel, PanelPair, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
+};
+use nalgebra::Vector3;
 
 const PAIR_COUNTS: [usize; 5] = [1, 2, 4, 8, 16];
+const WHEEL_COUNTS: [usize; 5] = [0, 1, 2, 4, 8];
+
+/// The reference spacecraft (2 pairs) with `n` wheels: a pyramid's axes repeated, each with
+/// friction and a commanded motor torque, so every term of the wheel model is evaluated.
+fn spacecraft_with_wheels(n: usize) -> Spacecraft {
+    let mut effectors: Vec<Box<dyn StateEffector>> = common::reference_pairs(0.0)
+        .into_iter()
+        .enumerate()
+        .map(|(i, (p, init))| {
+            Box::new(PanelPair::new(p, init, &format!("panel_pairs[{i}]")).unwrap())
+                as Box<dyn StateEffector>
+        })
+        .collect();
+    let e = 30f64.to_radians();
+    for j in 0..n {
+        let az = (45.0 + 90.0 * j as f64).to_radians();
+        let axis = Vector3::new(e.cos() * az.cos(), e.cos() * az.sin(), e.sin());
+        let mut w = ReactionWheelParams::balanced(
+            &format!("rw{j}"),
+            axis,
+            Vector3::new(0.4 * az.cos(), 0.4 * az.sin(), 0.5),
+            4.0,
+            0.05,
+            0.03,
+            100.0,
+            0.2,
+            600.0,
+        );
+        w.viscous_friction_nm_s_rad = 1e-6;
+        w.coulomb_friction_nm = 5e-4;
+        effectors.push(Box::new(ReactionWheel::new(w, "reaction_wheels").unwrap()));
+    }
+    let mut sc = Spacecraft::new(
+        common::reference_hub(),
+        GravityModel::PointMass {
+            mu_m3_s2: common::MU_EARTH,
+        },
+        effectors,
+        common::reference_initial(),
+        1_000_000,
+    )
+    .unwrap();
+    let u: Vec<f64> = (0..n).map(|j| 0.01 * (j as f64 + 1.0)).collect();
+    sc.set_effector_inputs(&u).unwrap();
+    sc
+}
 
 fn spacecraft(pairs: usize) -> Spacecraft {
     let gravity = GravityModel::PointMass {
@@ -44,6 +95,19 @@ fn bench_step(c: &mut Criterion) {
         let mut sc = spacecraft(n);
         group.bench_with_input(
             BenchmarkId::from_parameter(format!("{n}_pairs")),
+            &n,
+            |b, _| {
+                b.iter(|| {
+                    sc.step();
+                    black_box(sc.state().omega_bn_b);
+                })
+            },
+        );
+    }
+    for n in WHEEL_COUNTS {
+        let mut sc = spacecraft_with_wheels(n);
+        group.bench_with_input(
+            BenchmarkId::from_parameter(format!("2_pairs_{n}_wheels")),
             &n,
             |b, _| {
                 b.iter(|| {
@@ -118,28 +182,28 @@ fn peers(flexdyn: &[(f64, f64)]) {
     }
 }
 
-fn summary() -> Vec<(f64, f64)> {
+/// Median ns per step of `sc` over 31 batches of 20,000 steps (after 20,000 warm-up steps).
+fn median_ns_per_step(mut sc: Spacecraft) -> f64 {
     let batches = 31;
     let steps = 20_000;
-    let mut rows = Vec::new();
-    for n in PAIR_COUNTS {
-        let mut sc = spacecraft(n);
-        for _ in 0..steps {
-            sc.step();
-        }
-        let per_step: Vec<f64> = (0..batches)
-            .map(|_| {
-                let t = Instant::now();
-                for _ in 0..steps {
-                    sc.step();
-                }
-                black_box(sc.state().omega_bn_b);
-                t.elapsed().as_secs_f64() * 1e9 / steps as f64
-            })
-            .collect();
-        rows.push((n as f64, median(per_step)));
+    for _ in 0..steps {
+        sc.step();
     }
-    // Least-squares line through (pairs, median ns).
+    let per_step: Vec<f64> = (0..batches)
+        .map(|_| {
+            let t = Instant::now();
+            for _ in 0..steps {
+                sc.step();
+            }
+            black_box(sc.state().omega_bn_b);
+            t.elapsed().as_secs_f64() * 1e9 / steps as f64
+        })
+        .collect();
+    median(per_step)
+}
+
+/// Least-squares line through (x, y): (intercept, slope).
+fn fit(rows: &[(f64, f64)]) -> (f64, f64) {
     let m = rows.len() as f64;
     let (sx, sy) = rows
         .iter()
@@ -148,7 +212,31 @@ fn summary() -> Vec<(f64, f64)> {
         .iter()
         .fold((0.0, 0.0), |(a, b), (x, y)| (a + x * x, b + x * y));
     let slope = (m * sxy - sx * sy) / (m * sxx - sx * sx);
-    let intercept = (sy - slope * sx) / m;
+    ((sy - slope * sx) / m, slope)
+}
+
+fn wheel_summary() {
+    let rows: Vec<(f64, f64)> = WHEEL_COUNTS
+        .iter()
+        .map(|&n| (n as f64, median_ns_per_step(spacecraft_with_wheels(n))))
+        .collect();
+    let (intercept, slope) = fit(&rows);
+    println!("
+rk4_step with reaction wheels, 2 pairs (median of 31 batches x 20000 steps):");
+    println!("{:>6} {:>14} {:>14}", "wheels", "median ns/step", "steps/s");
+    for (n, ns) in &rows {
+        println!("{:>6} {:>14.1} {:>14.0}", n, ns, 1e9 / ns);
+    }
+    println!("linear fit: {intercept:.1} ns + {slope:.1} ns per wheel (target <= 300 ns per wheel)");
+}
+
+fn summary() -> Vec<(f64, f64)> {
+    let (batches, steps) = (31, 20_000);
+    let rows: Vec<(f64, f64)> = PAIR_COUNTS
+        .iter()
+        .map(|&n| (n as f64, median_ns_per_step(spacecraft(n))))
+        .collect();
+    let (intercept, slope) = fit(&rows);
     println!("\nrk4_step summary (median of {batches} batches x {steps} steps):");
     println!("{:>6} {:>14} {:>14}", "pairs", "median ns/step", "steps/s");
     for (n, ns) in &rows {
@@ -164,5 +252,6 @@ fn main() {
     bench_step(&mut c);
     c.final_summary();
     let rows = summary();
+    wheel_summary();
     peers(&rows);
 }
