@@ -221,13 +221,17 @@ fn wheel_summary() {
         .map(|&n| (n as f64, median_ns_per_step(spacecraft_with_wheels(n))))
         .collect();
     let (intercept, slope) = fit(&rows);
-    println!("
-rk4_step with reaction wheels, 2 pairs (median of 31 batches x 20000 steps):");
+    println!(
+        "
+rk4_step with reaction wheels, 2 pairs (median of 31 batches x 20000 steps):"
+    );
     println!("{:>6} {:>14} {:>14}", "wheels", "median ns/step", "steps/s");
     for (n, ns) in &rows {
         println!("{:>6} {:>14.1} {:>14.0}", n, ns, 1e9 / ns);
     }
-    println!("linear fit: {intercept:.1} ns + {slope:.1} ns per wheel (target <= 300 ns per wheel)");
+    println!(
+        "linear fit: {intercept:.1} ns + {slope:.1} ns per wheel (target <= 300 ns per wheel)"
+    );
 }
 
 fn summary() -> Vec<(f64, f64)> {

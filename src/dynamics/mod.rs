@@ -1,4 +1,7 @@
-//! Rigid hub + dual-hinged panel pairs, by back-substitution.
+//! Rigid hub + appended bodies (dual-hinged panel pairs, reaction wheels), by back-substitution.
+//!
+//! Every appended body is a [`StateEffector`] in its own folder under [`effectors`]; the hub
+//! ([`spacecraft`]) only sees their summed mass properties and contributions.
 //!
 //! The equations are those of Allard & Schaub, "Spacecraft Dynamical Model with Dual-Connected
 //! Hinged Rigid Bodies" (citation in `docs/errata.md`), Sections III and V, with the two

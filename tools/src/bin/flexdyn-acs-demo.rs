@@ -45,6 +45,17 @@
 //!   that spins the craft up instead of damping it);
 //! - `truth`: the state message's ω_BN.
 //!
+//! # Reaction wheels and the star tracker
+//! With `--config` (the server's scenario: the flight code's copy of the geometry):
+//! - `--actuator wheels` turns the torque into reaction-wheel motor torques: the law adds the
+//!   wheel-momentum gyroscopic term, L = −Kσ − Pω + ω × ([I]ω + [G_s]h_s), and u = −[G_s]⁺L is
+//!   sent as one `CommandKind::Actuators` per tick ([`flexdyn_tools::acs`]);
+//! - `--attitude-source star-tracker --star-tracker NAME` takes σ_BN from that tracker's
+//!   q_CN through its mounting [CB], propagated with the rate feedback between its updates; until
+//!   its first valid sample the answer is `NoCommand`.
+//!
+//! With `--rate-source gyro --imu NAME` as well, the loop uses no truth at all.
+//!
 //! # Copying this file
 //! Keep `main`'s order (session → subscribers → publisher → token → loop). Replace
 //! [`GyroFeedback`] by your rate source and [`Controller::torque_b_nm`] by your control law.
