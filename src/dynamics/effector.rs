@@ -249,6 +249,11 @@ pub trait StateEffector: Send + std::fmt::Debug {
     /// state at the start of the step: the place for logic that must hold over a whole step,
     /// such as clipping a commanded torque against a speed limit.
     fn begin_step(&mut self, _x: &[f64]) {}
+    /// Whether [`Self::begin_step`] does anything: the spacecraft calls it only on effectors
+    /// that say so, keeping the per-step loop empty for bodies without step logic.
+    fn uses_begin_step(&self) -> bool {
+        false
+    }
     /// Writes the effector's initial state into `x`.
     fn initial_state(&self, x: &mut [f64]);
     /// Pass 1: adds the mass properties about B at state `x` into `sum`.

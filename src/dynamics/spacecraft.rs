@@ -267,13 +267,16 @@ struct EquationsOfMotion {
     gravity: GravityModel,
     effectors: Vec<Box<dyn StateEffector>>,
     ranges: Vec<Range<usize>>,
-    /// Range of each effector's inputs in the flat input vector of
-    /// [`Spacecraft::set_effector_inputs`], and of its outputs in [`Spacecraft::effector_outputs`].
-    input_ranges: Vec<Range<usize>>,
-    output_ranges: Vec<Range<usize>>,
     force_b_newton: Vector3<f64>,
     torque_b_nm: Vector3<f64>,
     sensors: Vec<SensorPoint>,
+    /// Indices of the effectors whose [`StateEffector::uses_begin_step`] is true.
+    stepped: Vec<usize>,
+    /// Range of each effector's inputs in the flat input vector of
+    /// [`Spacecraft::set_effector_inputs`], and of its outputs in [`Spacecraft::effector_outputs`]
+    /// (cold: after the fields every evaluation reads).
+    input_ranges: Vec<Range<usize>>,
+    output_ranges: Vec<Range<usize>>,
 }
 
 /// A rigid hub with appended state effectors, integrated with fixed-step RK4.
@@ -420,6 +423,9 @@ impl Spacecraft {
         let (ranges, n) = layout(&|e| e.state_len());
         let (input_ranges, _) = layout(&|e| e.input_len());
         let (output_ranges, _) = layout(&|e| e.output_names().len());
+        let stepped = (0..effectors.len())
+            .filter(|&i| effectors[i].uses_begin_step())
+            .collect();
         let hub_first_moment_b = hub.r_bcb_b_m * hub.mass_kg;
         let r = hub.r_bcb_b_m;
         let hub_inertia_pnt_b_b = hub.inertia_bc_b_kg_m2
@@ -435,6 +441,7 @@ impl Spacecraft {
                 ranges,
                 input_ranges,
                 output_ranges,
+                stepped,
                 force_b_newton: Vector3::zeros(),
                 torque_b_nm: Vector3::zeros(),
                 sensors: Vec::new(),
@@ -583,8 +590,8 @@ impl Spacecraft {
     /// Runs every effector's [`StateEffector::begin_step`] at the current state.
     fn begin_step(&mut self) {
         let Self { eom, state, .. } = self;
-        for (e, r) in eom.effectors.iter_mut().zip(&eom.ranges) {
-            e.begin_step(&state.effectors[r.clone()]);
+        for &i in &eom.stepped {
+            eom.effectors[i].begin_step(&state.effectors[eom.ranges[i].clone()]);
         }
     }
 
@@ -617,8 +624,8 @@ impl Spacecraft {
     /// of a step), and returns the hub accelerations. This is the equation-of-motion function RK4
     /// integrates: it allocates nothing and cannot fail.
     pub fn derivatives(&mut self, x: &State, dx: &mut State) -> HubOutputs {
-        for (e, r) in self.eom.effectors.iter_mut().zip(&self.eom.ranges) {
-            e.begin_step(&x.effectors[r.clone()]);
+        for &i in &self.eom.stepped {
+            self.eom.effectors[i].begin_step(&x.effectors[self.eom.ranges[i].clone()]);
         }
         self.eom.eval(x, dx)
     }

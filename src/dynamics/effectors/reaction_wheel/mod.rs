@@ -254,6 +254,10 @@ impl StateEffector for ReactionWheel {
         self.flags
     }
 
+    fn uses_begin_step(&self) -> bool {
+        true
+    }
+
     fn begin_step(&mut self, x: &[f64]) {
         (self.applied_nm, self.flags) = self.limit(x[OMEGA]);
     }
