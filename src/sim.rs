@@ -18,7 +18,7 @@ use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::{
     Conserved, EffectorKind, HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment,
 };
-use crate::sensors::imu::{attitude_increment_b, Imu, ImuSample, ImuTruth};
+use crate::sensors::imu::{Imu, ImuBank, ImuSample};
 use crate::sensors::star_tracker::{StarTracker, StarTrackerSample};
 
 /// A spacecraft being propagated, with its external wrench sources.
@@ -42,13 +42,9 @@ pub struct Simulation {
     /// the snapshot and every sensor share one evaluation per frame. Cleared by anything that
     /// changes the state, the wrench or the inputs.
     frame_outputs: Option<HubOutputs>,
-    /// The IMUs in config order; IMU `i` is the spacecraft's sensor point `i`.
-    imus: Vec<Imu>,
-    imu_names: Vec<String>,
-    /// \[ns\] start of the current IMU sample interval.
-    imu_interval_start_ns: u64,
-    /// σ_B/N at the start of the current IMU sample interval.
-    imu_sigma_bn_start: Vector3<f64>,
+    /// The IMUs and their sample-interval bookkeeping; IMU `i` is the spacecraft's sensor
+    /// point `i`.
+    imus: ImuBank,
     /// The star trackers in config order.
     star_trackers: Vec<StarTracker>,
 }
@@ -221,11 +217,7 @@ impl Simulation {
     pub fn new(cfg: &SimConfig) -> Result<Self, ConfigError> {
         let sc = cfg.build_spacecraft()?;
         let frame_s = cfg.frame_ns as f64 * 1e-9;
-        let mut imus = Vec::with_capacity(cfg.imus.len());
-        for (i, imu) in cfg.imus.iter().enumerate() {
-            imus.push(Imu::new(imu, &format!("imus[{i}]"), frame_s)?);
-        }
-        let imu_sigma_bn_start = sc.state().sigma_bn;
+        let imus = ImuBank::new(&cfg.imus, frame_s, &sc)?;
         let mut star_trackers = Vec::with_capacity(cfg.star_trackers.len());
         for (i, st) in cfg.star_trackers.iter().enumerate() {
             star_trackers.push(StarTracker::new(
@@ -243,10 +235,7 @@ impl Simulation {
             schedule: cfg.wrench_schedule.clone(),
             cursor: 0,
             command: Wrench::ZERO,
-            imu_names: cfg.imus.iter().map(|c| c.name.clone()).collect(),
             imus,
-            imu_interval_start_ns: 0,
-            imu_sigma_bn_start,
             star_trackers,
         };
         sim.apply_wrench();
@@ -444,22 +433,22 @@ impl Simulation {
 
     /// The IMU names in config order (topic `flexdyn/<sc-id>/tlm/imu/<name>`).
     pub fn imu_names(&self) -> &[String] {
-        &self.imu_names
+        self.imus.names()
     }
 
     /// Number of IMUs.
     pub fn n_imus(&self) -> usize {
-        self.imus.len()
+        self.imus.imus().len()
     }
 
     /// The IMU error models, in config order.
     pub fn imus(&self) -> &[Imu] {
-        &self.imus
+        self.imus.imus()
     }
 
     /// \[ns\] start of the current IMU sample interval.
     pub fn imu_interval_start_ns(&self) -> u64 {
-        self.imu_interval_start_ns
+        self.imus.interval_start_ns()
     }
 
     /// Sets every IMU's nominal sample interval T_s (default: the frame period). The
@@ -467,11 +456,9 @@ impl Simulation {
     /// to the log interval. It does not change where intervals end: that is when
     /// [`Self::imu_samples_into`] is called.
     pub fn set_imu_sample_interval_ns(&mut self, interval_ns: NonZeroU64) {
-        let t_s = interval_ns.get() as f64 * 1e-9;
-        for imu in &mut self.imus {
-            // Cannot fail: a positive whole number of ns is finite and > 0.
-            let _ = imu.set_sample_interval_s(t_s);
-        }
+        // A positive whole number of ns is finite and > 0.
+        self.imus
+            .set_sample_interval_s(interval_ns.get() as f64 * 1e-9);
     }
 
     /// Closes the current IMU sample interval at the current time and writes one measurement per
@@ -484,26 +471,12 @@ impl Simulation {
     /// then reset. Each IMU's error model is stepped with dt = the interval's length (0 for the
     /// first call at t = 0, whose Δθ and Δv are exactly zero).
     pub fn imu_samples_into(&mut self, out: &mut Vec<ImuSample>) {
-        out.clear();
-        if self.imus.is_empty() {
+        if self.imus.imus().is_empty() {
+            out.clear();
             return;
         }
         let hub = self.frame_outputs();
-        let t_ns = self.sc.t_sim_ns();
-        let dt_s = t_ns.saturating_sub(self.imu_interval_start_ns) as f64 * 1e-9;
-        let sigma_bn = self.sc.state().sigma_bn;
-        let dtheta_b = attitude_increment_b(&self.imu_sigma_bn_start, &sigma_bn);
-        for (i, imu) in self.imus.iter_mut().enumerate() {
-            let (omega_p, accel_p) = self.sc.sensor_truth(i, &hub);
-            let truth = ImuTruth {
-                omega_p_rad_s: omega_p,
-                accel_p_m_s2: accel_p,
-                dtheta_p_rad: imu.dcm_pb() * dtheta_b,
-                dv_p_m_s: self.sc.sensor_dv_p()[i],
-            };
-            out.push(imu.sample(&truth, dt_s));
-        }
-        self.restart_imu_interval();
+        self.imus.sample_into(&mut self.sc, &hub, out);
     }
 
     /// The star trackers, in config order (topic `flexdyn/<sc-id>/tlm/st/<name>`).
@@ -532,9 +505,7 @@ impl Simulation {
     /// accumulated so far). Call it after replacing the spacecraft state (e.g. a snapshot
     /// restore) so the next Δθ/Δv do not span the jump.
     pub fn restart_imu_interval(&mut self) {
-        self.sc.reset_sensor_dv();
-        self.imu_interval_start_ns = self.sc.t_sim_ns();
-        self.imu_sigma_bn_start = self.sc.state().sigma_bn;
+        self.imus.restart(&mut self.sc);
     }
 }
 

@@ -188,7 +188,8 @@ fn every_shipped_scenario_is_valid() {
             "imu_tactical",
             "j2_orbit",
             "no_gravity",
-            "reference"
+            "reference",
+            "wheels_star_tracker"
         ]
     );
 }

@@ -67,7 +67,10 @@ use flexdyn_proto::{saturation_flags, Header, ImuMsg};
 use super::rng::NormalRng;
 pub use super::rng::{exp_portable, expm1_portable, ln_portable};
 
+mod bank;
 pub(crate) mod schema;
+
+pub use bank::ImuBank;
 
 /// Largest allowed |misalignment| element \[rad\]: the model is first order in these angles.
 pub const MAX_MISALIGNMENT_RAD: f64 = 0.1;
