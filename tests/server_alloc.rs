@@ -1,6 +1,7 @@
-//! The physics thread's per-frame path allocates nothing: command intake and bookkeeping, the
-//! RK4 frame, IMU sampling, the telemetry fill, and the buffer hand-off through the bounded
-//! channels.
+//! The physics thread's per-frame path allocates and frees nothing: command intake and
+//! bookkeeping (wrench and wheel `Actuators` commands, the latter handed back through the
+//! recycle channel), the RK4 frame, IMU and star-tracker sampling, the telemetry fill, and the
+//! buffer hand-off through the bounded channels.
 //!
 //! `assert_no_alloc`'s global allocator counts (de)allocations made on this thread inside
 //! `assert_no_alloc(..)` (features `warn_debug`/`warn_release`: count and warn, don't abort).
@@ -14,7 +15,7 @@ use flexdyn::config::SimConfig;
 use flexdyn::server::commands::CommandBook;
 use flexdyn::server::shared::{fill_state, Frame};
 use flexdyn::sim::{Simulation, Snapshot};
-use flexdyn_proto::{CommandMsg, Header, StalePolicy};
+use flexdyn_proto::{CommandMsg, EffectorInput, Header, StalePolicy};
 use nalgebra::Vector3;
 
 #[global_allocator]
@@ -51,15 +52,31 @@ fn the_frame_path_does_not_allocate() {
             )))
             .unwrap();
     }
+    // Sender 2 commands the four wheels (effectors 2–5). Its Actuators commands own heap
+    // vectors: they are built here, as the Zenoh callback thread builds them, and after use the
+    // physics side hands them to the recycle channel, as the server does, to be freed by the
+    // I/O side (here: after the measured region).
+    let mut wheel_commands: Vec<CommandMsg> = (0..200u64)
+        .rev()
+        .map(|k| {
+            let inputs = (0..4)
+                .map(|j| EffectorInput {
+                    effector_index: 2 + j,
+                    values: vec![0.01 * f64::from(j + 1)],
+                })
+                .collect();
+            CommandMsg::actuators(Header::new(1, k, 0, k), 2, [0.0; 3], [0.0; 3], inputs)
+        })
+        .collect();
+    let (recycle_tx, recycle_rx) = sync_channel::<CommandMsg>(512);
     let mut frame_once = |k: u64| {
-        for sender in [1, 2] {
-            let cmd =
-                CommandMsg::wrench(Header::new(1, k, 0, k), sender, [0.0, 0.0, 0.01], [0.0; 3]);
-            cmd_tx.try_send(cmd).unwrap();
-        }
+        let wrench = CommandMsg::wrench(Header::new(1, k, 0, k), 1, [0.0, 0.0, 0.01], [0.0; 3]);
+        cmd_tx.try_send(wrench).unwrap();
+        cmd_tx.try_send(wheel_commands.pop().unwrap()).unwrap();
         book.begin_tick();
         while let Ok(cmd) = cmd_rx.try_recv() {
             book.offer_lockstep(&cmd, k);
+            recycle_tx.try_send(cmd).unwrap();
         }
         assert!(book.all_answered());
         let held = book.held(k);
@@ -96,4 +113,9 @@ fn the_frame_path_does_not_allocate() {
         }
     });
     assert_eq!(violation_count(), 0, "the frame path allocated");
+    // The wheels were commanded (torques 0.01–0.04 N·m held), and the recycled commands are
+    // freed here, on the "I/O side".
+    let s = sim.snapshot();
+    assert_eq!(s.effectors[3].outputs[0], 0.02);
+    assert_eq!(recycle_rx.try_iter().count(), 400);
 }

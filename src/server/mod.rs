@@ -361,6 +361,9 @@ pub async fn run(
     let shared = Arc::new(Shared::new(&settings.participants));
     shared.set_run_state(RunState::Starting);
     let (cmd_tx, cmd_rx) = sync_channel(settings.command_queue);
+    // Consumed commands go back to the telemetry thread to be freed there: an `Actuators`
+    // command owns heap vectors, and the physics thread frees nothing.
+    let (recycle_tx, recycle_rx) = sync_channel(settings.command_queue);
     let n_buffers = settings.telemetry_buffers;
     let (free_tx, free_rx) = sync_channel::<Box<Frame>>(n_buffers);
     let (full_tx, full_rx) = sync_channel::<Box<Frame>>(n_buffers);
@@ -440,6 +443,7 @@ pub async fn run(
         st_pubs,
         full_rx,
         free_tx,
+        recycle_rx,
         shared: shared.clone(),
         settings: settings.clone(),
         frame_ns: cfg.frame_ns,
@@ -485,6 +489,7 @@ pub async fn run(
         settings: settings.clone(),
         total_frames,
         cmd_rx,
+        recycle_tx,
         free_rx,
         full_tx,
         shared: shared.clone(),

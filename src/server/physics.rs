@@ -66,6 +66,9 @@ pub struct PhysicsCtx {
     pub total_frames: Option<u64>,
     /// Validated commands from the I/O side.
     pub cmd_rx: Receiver<CommandMsg>,
+    /// Consumed commands, handed back to be freed off this thread (when the channel is full the
+    /// command is freed here instead; never blocks).
+    pub recycle_tx: SyncSender<CommandMsg>,
     /// Free telemetry buffers returned by the I/O thread.
     pub free_rx: Receiver<Box<Frame>>,
     /// Filled telemetry buffers to publish.
@@ -138,6 +141,7 @@ impl PhysicsCtx {
     fn drain_commands(&self, book: &mut CommandBook, k: u64) {
         while let Ok(cmd) = self.cmd_rx.try_recv() {
             self.count(book.offer_latest(&cmd, k), cmd.sender_id);
+            let _ = self.recycle_tx.try_send(cmd);
         }
     }
 
@@ -156,7 +160,10 @@ impl PhysicsCtx {
                 });
             }
             match self.cmd_rx.recv_timeout((give_up - now).min(POLL)) {
-                Ok(cmd) => self.count(book.offer_lockstep(&cmd, k), cmd.sender_id),
+                Ok(cmd) => {
+                    self.count(book.offer_lockstep(&cmd, k), cmd.sender_id);
+                    let _ = self.recycle_tx.try_send(cmd);
+                }
                 Err(RecvTimeoutError::Timeout) => {
                     if self.shared.stop.load(Ordering::Relaxed) {
                         return Ok(Wait::Stopped);

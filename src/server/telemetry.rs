@@ -71,6 +71,8 @@ pub struct TelemetryCtx {
     pub full_rx: Receiver<Box<Frame>>,
     /// Buffers back to the physics thread.
     pub free_tx: SyncSender<Box<Frame>>,
+    /// Commands the physics thread has consumed, freed here.
+    pub recycle_rx: Receiver<flexdyn_proto::CommandMsg>,
     /// Counters.
     pub shared: Arc<Shared>,
     /// Settings (mode, ids, rates).
@@ -229,6 +231,8 @@ impl TelemetryCtx {
             let wait = next_status
                 .min(next_summary)
                 .saturating_duration_since(Instant::now());
+            // Free the commands the physics thread is done with.
+            while self.recycle_rx.try_recv().is_ok() {}
             match self.full_rx.recv_timeout(wait) {
                 Ok(frame) => {
                     if realtime {
