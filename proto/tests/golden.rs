@@ -903,3 +903,64 @@ fn flag_bits() {
     assert_eq!(effector_kind::PANEL_PAIR, 1);
     assert_eq!(effector_kind::REACTION_WHEEL, 2);
 }
+
+/// The golden vectors exported for the C and Python codecs (`proto/golden/*.bin`, listed in
+/// `proto/golden/MANIFEST.tsv`) are byte for byte the tables above, and the manifest names
+/// every table once with its message type and length.
+#[test]
+fn exported_golden_files_match_the_tables() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
+    let tables: [(&str, &str, Golden, &str); 7] = [
+        ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
+        ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
+        (
+            "command_wrench",
+            "CommandMsg",
+            COMMAND_WRENCH_GOLDEN,
+            "COMMAND_WRENCH_GOLDEN",
+        ),
+        (
+            "command_actuators",
+            "CommandMsg",
+            COMMAND_ACTUATORS_GOLDEN,
+            "COMMAND_ACTUATORS_GOLDEN",
+        ),
+        (
+            "star_tracker",
+            "StarTrackerMsg",
+            STAR_TRACKER_GOLDEN,
+            "STAR_TRACKER_GOLDEN",
+        ),
+        (
+            "command_no_command",
+            "CommandMsg",
+            COMMAND_NO_COMMAND_GOLDEN,
+            "COMMAND_NO_COMMAND_GOLDEN",
+        ),
+        ("status", "StatusMsg", STATUS_GOLDEN, "STATUS_GOLDEN"),
+    ];
+    let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");
+    let rows: Vec<Vec<&str>> = manifest
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .map(|l| l.split('\t').collect())
+        .collect();
+    assert_eq!(rows.len(), tables.len(), "manifest rows");
+    for (name, message, table, source) in tables {
+        let bytes = golden_bytes(table);
+        let file = std::fs::read(dir.join(format!("{name}.bin")))
+            .unwrap_or_else(|e| panic!("proto/golden/{name}.bin: {e}"));
+        assert!(
+            file == bytes,
+            "proto/golden/{name}.bin differs from {source}: re-export it from the table"
+        );
+        let row = rows
+            .iter()
+            .find(|r| r[0] == name)
+            .unwrap_or_else(|| panic!("{name} missing from MANIFEST.tsv"));
+        assert_eq!(
+            row.as_slice(),
+            [name, message, bytes.len().to_string().as_str(), source]
+        );
+    }
+}

@@ -1,0 +1,805 @@
+/*
+ * flexdyn_proto.h - the flexdyn wire protocol (version 3) for C99 flight code.
+ *
+ * Header-only: include it and call fd_decode_* / fd_encode_*. No allocation, no I/O, no
+ * global state. Bytes are assembled one by one (little-endian on the wire), never cast to a
+ * struct, so it is correct on big-endian hosts too. The byte tables are in proto/README.md;
+ * this file follows them and the decoder rules there in the same order, with the same error
+ * reasons as the Rust crate's DecodeError:
+ *
+ *   1. more than FD_MAX_MESSAGE_BYTES                      -> FD_ERR_TOO_LARGE
+ *   2. fewer than 2 bytes                                   -> FD_ERR_LENGTH
+ *      first two bytes (u16 LE) != FD_PROTOCOL_VERSION      -> FD_ERR_UNKNOWN_VERSION
+ *   3. total length from the layout (fixed, tag, walked counts; every count bounded first)
+ *      buffer shorter                                       -> FD_ERR_LENGTH (needed = length
+ *                                                              implied by the counts read)
+ *      unknown command tag, count above its maximum         -> FD_ERR_MALFORMED
+ *      buffer longer                                        -> FD_ERR_TRAILING_BYTES
+ *   4. fields in wire order: an enum tag out of range or a bool byte other than 0/1
+ *                                                           -> FD_ERR_MALFORMED
+ *   5. CommandMsg: a non-finite torque, force or input value (in that order)
+ *                                                           -> FD_ERR_NON_FINITE (field named)
+ *
+ * Decoders write into caller storage; a StateMsg's effectors and an Actuators command's inputs
+ * go into arrays the caller provides (capacity given), FD_ERR_CAPACITY if they do not fit (a C-only
+ * reason, checked after the wire rules). Compile with -std=c99 -Wall -Wextra -pedantic.
+ */
+#ifndef FLEXDYN_PROTO_H
+#define FLEXDYN_PROTO_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------------------------ */
+/* Constants (proto/README.md).                                                                */
+
+#define FD_PROTOCOL_VERSION 3u
+#define FD_HEADER_LEN 30u
+#define FD_STATE_FIXED_LEN 327u
+#define FD_STATE_EFFECTOR_COUNT_OFFSET 319u
+#define FD_EFFECTOR_STATE_FIXED_LEN 22u
+#define FD_EFFECTOR_INPUT_FIXED_LEN 12u
+#define FD_IMU_LEN 127u
+#define FD_STAR_TRACKER_LEN 64u
+#define FD_COMMAND_KIND_OFFSET 34u
+#define FD_COMMAND_WRENCH_LEN 86u
+#define FD_COMMAND_NO_COMMAND_LEN 38u
+#define FD_COMMAND_ACTUATORS_FIXED_LEN 94u
+#define FD_STATUS_LEN 171u
+#define FD_MAX_EFFECTORS 1024u
+#define FD_MAX_EFFECTOR_VALUES 8u
+#define FD_MAX_MESSAGE_BYTES 65536u
+
+/* Command kinds (CommandMsg tag at offset 34). */
+#define FD_COMMAND_WRENCH 0u
+#define FD_COMMAND_NO_COMMAND 1u
+#define FD_COMMAND_ACTUATORS 2u
+
+/* Effector kinds (EffectorState.kind). */
+#define FD_EFFECTOR_PANEL_PAIR 1u
+#define FD_EFFECTOR_REACTION_WHEEL 2u
+
+/* StateMsg.command_flags */
+#define FD_COMMAND_FLAG_STALE 0x01u
+#define FD_COMMAND_FLAG_ZEROED_BY_POLICY 0x02u
+#define FD_COMMAND_FLAG_NO_COMMAND_YET 0x04u
+/* ImuMsg.saturation_flags */
+#define FD_SATURATION_GYRO_RATE 0x01u
+#define FD_SATURATION_ACCEL 0x02u
+#define FD_SATURATION_DTHETA 0x04u
+#define FD_SATURATION_DV 0x08u
+/* StarTrackerMsg.status_flags */
+#define FD_STAR_TRACKER_SUN_EXCLUSION 0x01u
+#define FD_STAR_TRACKER_RATE_LIMIT 0x02u
+/* EffectorState.flags of a reaction wheel */
+#define FD_WHEEL_TORQUE_LIMITED 0x1u
+#define FD_WHEEL_SPEED_LIMITED 0x2u
+
+/* StatusMsg enums */
+#define FD_MODE_REAL_TIME 0u
+#define FD_MODE_LOCKSTEP 1u
+#define FD_MODE_BATCH 2u
+#define FD_RUN_STATE_STARTING 0u
+#define FD_RUN_STATE_RUNNING 1u
+#define FD_RUN_STATE_STOPPING 2u
+#define FD_RUN_STATE_FINISHED 3u
+#define FD_RUN_STATE_FAILED 4u
+#define FD_RUN_STATE_STOPPED 5u
+#define FD_STALE_POLICY_HOLD 0u
+#define FD_STALE_POLICY_ZERO 1u
+/* CommandStatus.last_command_tick / command_age_ns before any command. */
+#define FD_NO_COMMAND UINT64_MAX
+
+/* ------------------------------------------------------------------------------------------ */
+/* Errors: the Rust DecodeError variants, plus FD_ERR_CAPACITY for caller storage.              */
+
+typedef enum {
+    FD_OK = 0,
+    FD_ERR_LENGTH = 1,          /* needed, actual */
+    FD_ERR_TRAILING_BYTES = 2,  /* expected (in needed), actual */
+    FD_ERR_TOO_LARGE = 3,       /* actual; max = FD_MAX_MESSAGE_BYTES */
+    FD_ERR_UNKNOWN_VERSION = 4, /* found_version */
+    FD_ERR_NON_FINITE = 5,      /* field */
+    FD_ERR_MALFORMED = 6,       /* field: what was wrong */
+    FD_ERR_CAPACITY = 7         /* needed: the count that did not fit the caller's array */
+} fd_status;
+
+typedef struct {
+    fd_status status;
+    size_t needed;          /* LENGTH: total length required; TRAILING_BYTES: message length */
+    size_t actual;          /* the buffer length */
+    uint16_t found_version; /* UNKNOWN_VERSION */
+    const char *field;      /* NON_FINITE: the field path as in Rust; MALFORMED: a reason */
+} fd_error;
+
+/* ------------------------------------------------------------------------------------------ */
+/* Messages.                                                                                   */
+
+typedef struct {
+    uint16_t protocol_version;
+    uint32_t spacecraft_id;
+    uint64_t tick;
+    uint64_t sim_time_ns;
+    uint64_t seq;
+} fd_header;
+
+typedef struct {
+    uint16_t kind;
+    uint32_t flags;
+    uint64_t n_states;
+    double states[FD_MAX_EFFECTOR_VALUES];
+    uint64_t n_outputs;
+    double outputs[FD_MAX_EFFECTOR_VALUES];
+} fd_effector_state;
+
+typedef struct {
+    fd_header header;
+    double sigma_bn[3];
+    double q_bn[4]; /* scalar first */
+    double omega_bn_b_rad_s[3];
+    double omega_dot_bn_b_rad_s2[3];
+    double r_bn_n_m[3];
+    double v_bn_n_m_s[3];
+    double nongrav_accel_bn_n_m_s2[3];
+    double orb_energy_j;
+    double rot_energy_j;
+    double orb_ang_mom_n[3];
+    double rot_ang_mom_c_n[3];
+    double torque_b_nm[3];    /* wrench_applied */
+    double force_b_newton[3]; /* wrench_applied */
+    uint8_t command_flags;
+    uint64_t n_effectors;
+    fd_effector_state *effectors; /* caller storage */
+    size_t effectors_capacity;
+} fd_state_msg;
+
+typedef struct {
+    fd_header header;
+    double omega_p_rad_s[3];
+    double accel_p_m_s2[3];
+    double dtheta_p_rad[3];
+    double dv_p_m_s[3];
+    uint8_t saturation_flags;
+} fd_imu_msg;
+
+typedef struct {
+    fd_header header;
+    double q_cn[4]; /* scalar first */
+    uint8_t valid;  /* 0 or 1 */
+    uint8_t status_flags;
+} fd_star_tracker_msg;
+
+typedef struct {
+    uint32_t effector_index;
+    uint64_t n_values;
+    double values[FD_MAX_EFFECTOR_VALUES];
+} fd_effector_input;
+
+typedef struct {
+    fd_header header;
+    uint32_t sender_id;
+    uint32_t kind;            /* FD_COMMAND_* */
+    double torque_b_nm[3];    /* WRENCH, ACTUATORS */
+    double force_b_newton[3]; /* WRENCH, ACTUATORS */
+    uint64_t n_inputs;        /* ACTUATORS */
+    fd_effector_input *inputs; /* caller storage */
+    size_t inputs_capacity;
+} fd_command_msg;
+
+typedef struct {
+    fd_header header;
+    uint32_t mode;
+    uint32_t run_state;
+    uint64_t lateness_p50_ns;
+    uint64_t lateness_p99_ns;
+    uint64_t lateness_max_ns;
+    uint64_t overrun_count;
+    uint64_t frames_skipped;
+    uint64_t last_command_tick;
+    uint64_t command_age_ns;
+    uint8_t command_stale;
+    uint32_t stale_policy;
+    uint64_t rejected_malformed;
+    uint64_t rejected_bad_version;
+    uint64_t rejected_non_finite;
+    uint64_t rejected_wrong_spacecraft;
+    uint64_t rejected_stale_tick;
+    uint64_t rejected_unknown_sender;
+    uint64_t rejected_bad_effector_input;
+    uint64_t commands_dropped;
+    uint64_t wall_time_unix_ns;
+} fd_status_msg;
+
+/* ------------------------------------------------------------------------------------------ */
+/* Byte helpers (little-endian, assembled byte by byte).                                       */
+
+static inline uint16_t fd_get_u16(const uint8_t *p) {
+    return (uint16_t)((uint16_t)p[0] | (uint16_t)((uint16_t)p[1] << 8));
+}
+static inline uint32_t fd_get_u32(const uint8_t *p) {
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+static inline uint64_t fd_get_u64(const uint8_t *p) {
+    return (uint64_t)fd_get_u32(p) | ((uint64_t)fd_get_u32(p + 4) << 32);
+}
+static inline double fd_get_f64(const uint8_t *p) {
+    uint64_t bits = fd_get_u64(p);
+    double d;
+    memcpy(&d, &bits, sizeof d); /* IEEE-754 binary64 with the integer's byte order */
+    return d;
+}
+static inline void fd_put_u16(uint8_t *p, uint16_t v) {
+    p[0] = (uint8_t)v;
+    p[1] = (uint8_t)(v >> 8);
+}
+static inline void fd_put_u32(uint8_t *p, uint32_t v) {
+    p[0] = (uint8_t)v;
+    p[1] = (uint8_t)(v >> 8);
+    p[2] = (uint8_t)(v >> 16);
+    p[3] = (uint8_t)(v >> 24);
+}
+static inline void fd_put_u64(uint8_t *p, uint64_t v) {
+    fd_put_u32(p, (uint32_t)v);
+    fd_put_u32(p + 4, (uint32_t)(v >> 32));
+}
+static inline void fd_put_f64(uint8_t *p, double d) {
+    uint64_t bits;
+    memcpy(&bits, &d, sizeof bits);
+    fd_put_u64(p, bits);
+}
+static inline int fd_is_finite(double d) {
+    uint64_t bits;
+    memcpy(&bits, &d, sizeof bits);
+    return ((bits >> 52) & 0x7ffu) != 0x7ffu;
+}
+static inline void fd_get_f64s(const uint8_t *p, double *out, size_t n) {
+    size_t i;
+    for (i = 0; i < n; ++i) out[i] = fd_get_f64(p + 8 * i);
+}
+static inline void fd_put_f64s(uint8_t *p, const double *v, size_t n) {
+    size_t i;
+    for (i = 0; i < n; ++i) fd_put_f64(p + 8 * i, v[i]);
+}
+
+static inline fd_error fd_ok(void) {
+    fd_error e;
+    e.status = FD_OK;
+    e.needed = 0;
+    e.actual = 0;
+    e.found_version = 0;
+    e.field = NULL;
+    return e;
+}
+static inline fd_error fd_fail(fd_status s, size_t needed, size_t actual, const char *field) {
+    fd_error e = fd_ok();
+    e.status = s;
+    e.needed = needed;
+    e.actual = actual;
+    e.field = field;
+    return e;
+}
+
+/* Steps 1-2: size limit and version. min_len is the message type's shortest length. */
+static inline fd_error fd_check_size_and_version(const uint8_t *buf, size_t len, size_t min_len) {
+    uint16_t v;
+    if (len > FD_MAX_MESSAGE_BYTES) return fd_fail(FD_ERR_TOO_LARGE, 0, len, NULL);
+    if (len < 2) return fd_fail(FD_ERR_LENGTH, min_len, len, NULL);
+    v = fd_get_u16(buf);
+    if (v != FD_PROTOCOL_VERSION) {
+        fd_error e = fd_fail(FD_ERR_UNKNOWN_VERSION, 0, len, NULL);
+        e.found_version = v;
+        return e;
+    }
+    return fd_ok();
+}
+
+/* Step 3 helper: the expected total length versus the buffer. */
+static inline fd_error fd_check_total(size_t expected, size_t len) {
+    if (len < expected) return fd_fail(FD_ERR_LENGTH, expected, len, NULL);
+    if (len > expected) return fd_fail(FD_ERR_TRAILING_BYTES, expected, len, NULL);
+    return fd_ok();
+}
+
+/* A bounded cursor over count prefixes (step 3 of variable-length messages). */
+typedef struct {
+    size_t at;
+    size_t len;
+} fd_walker;
+
+static inline fd_error fd_walk_skip(fd_walker *w, size_t n) {
+    if (w->at + n > w->len) return fd_fail(FD_ERR_LENGTH, w->at + n, w->len, NULL);
+    w->at += n;
+    return fd_ok();
+}
+static inline fd_error fd_walk_count(fd_walker *w, const uint8_t *buf, uint64_t max,
+                                     const char *what, uint64_t *count) {
+    if (w->at + 8 > w->len) return fd_fail(FD_ERR_LENGTH, w->at + 8, w->len, NULL);
+    *count = fd_get_u64(buf + w->at);
+    if (*count > max) return fd_fail(FD_ERR_MALFORMED, 0, w->len, what);
+    w->at += 8;
+    return fd_ok();
+}
+static inline fd_error fd_walk_values(fd_walker *w, const uint8_t *buf, const char *what) {
+    uint64_t n;
+    fd_error e = fd_walk_count(w, buf, FD_MAX_EFFECTOR_VALUES, what, &n);
+    if (e.status != FD_OK) return e;
+    return fd_walk_skip(w, (size_t)(8 * n));
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Header.                                                                                     */
+
+static inline void fd_decode_header_at(const uint8_t *p, fd_header *h) {
+    h->protocol_version = fd_get_u16(p);
+    h->spacecraft_id = fd_get_u32(p + 2);
+    h->tick = fd_get_u64(p + 6);
+    h->sim_time_ns = fd_get_u64(p + 14);
+    h->seq = fd_get_u64(p + 22);
+}
+static inline void fd_encode_header_at(uint8_t *p, const fd_header *h) {
+    fd_put_u16(p, h->protocol_version);
+    fd_put_u32(p + 2, h->spacecraft_id);
+    fd_put_u64(p + 6, h->tick);
+    fd_put_u64(p + 14, h->sim_time_ns);
+    fd_put_u64(p + 22, h->seq);
+}
+
+/* A header with the current protocol version. */
+static inline fd_header fd_header_new(uint32_t spacecraft_id, uint64_t tick, uint64_t sim_time_ns,
+                                      uint64_t seq) {
+    fd_header h;
+    h.protocol_version = (uint16_t)FD_PROTOCOL_VERSION;
+    h.spacecraft_id = spacecraft_id;
+    h.tick = tick;
+    h.sim_time_ns = sim_time_ns;
+    h.seq = seq;
+    return h;
+}
+
+/* Only the header of any message (size, version and the first 30 bytes are checked). */
+static inline fd_error fd_decode_header(const uint8_t *buf, size_t len, fd_header *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_HEADER_LEN);
+    if (e.status != FD_OK) return e;
+    if (len < FD_HEADER_LEN) return fd_fail(FD_ERR_LENGTH, FD_HEADER_LEN, len, NULL);
+    fd_decode_header_at(buf, out);
+    return fd_ok();
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* StateMsg.                                                                                   */
+
+/* Encoded length of `m` (its n_effectors entries). */
+static inline size_t fd_state_len(const fd_state_msg *m) {
+    size_t n = FD_STATE_FIXED_LEN;
+    uint64_t i;
+    for (i = 0; i < m->n_effectors; ++i)
+        n += FD_EFFECTOR_STATE_FIXED_LEN +
+             8 * (size_t)(m->effectors[i].n_states + m->effectors[i].n_outputs);
+    return n;
+}
+
+static inline fd_error fd_decode_state(const uint8_t *buf, size_t len, fd_state_msg *out) {
+    fd_walker w;
+    uint64_t n, i;
+    fd_error e = fd_check_size_and_version(buf, len, FD_STATE_FIXED_LEN);
+    if (e.status != FD_OK) return e;
+    w.at = FD_STATE_EFFECTOR_COUNT_OFFSET;
+    w.len = len;
+    if (len < FD_STATE_EFFECTOR_COUNT_OFFSET + 8)
+        return fd_fail(FD_ERR_LENGTH, FD_STATE_FIXED_LEN, len, NULL);
+    e = fd_walk_count(&w, buf, FD_MAX_EFFECTORS, "effector count", &n);
+    if (e.status != FD_OK) return e;
+    for (i = 0; i < n; ++i) {
+        if ((e = fd_walk_skip(&w, 6)).status != FD_OK) return e;
+        if ((e = fd_walk_values(&w, buf, "effector states count")).status != FD_OK) return e;
+        if ((e = fd_walk_values(&w, buf, "effector outputs count")).status != FD_OK) return e;
+    }
+    if ((e = fd_check_total(w.at, len)).status != FD_OK) return e;
+    if (n > out->effectors_capacity) return fd_fail(FD_ERR_CAPACITY, (size_t)n, len, "effectors");
+    fd_decode_header_at(buf, &out->header);
+    fd_get_f64s(buf + 30, out->sigma_bn, 3);
+    fd_get_f64s(buf + 54, out->q_bn, 4);
+    fd_get_f64s(buf + 86, out->omega_bn_b_rad_s, 3);
+    fd_get_f64s(buf + 110, out->omega_dot_bn_b_rad_s2, 3);
+    fd_get_f64s(buf + 134, out->r_bn_n_m, 3);
+    fd_get_f64s(buf + 158, out->v_bn_n_m_s, 3);
+    fd_get_f64s(buf + 182, out->nongrav_accel_bn_n_m_s2, 3);
+    out->orb_energy_j = fd_get_f64(buf + 206);
+    out->rot_energy_j = fd_get_f64(buf + 214);
+    fd_get_f64s(buf + 222, out->orb_ang_mom_n, 3);
+    fd_get_f64s(buf + 246, out->rot_ang_mom_c_n, 3);
+    fd_get_f64s(buf + 270, out->torque_b_nm, 3);
+    fd_get_f64s(buf + 294, out->force_b_newton, 3);
+    out->command_flags = buf[318];
+    out->n_effectors = n;
+    w.at = FD_STATE_FIXED_LEN;
+    for (i = 0; i < n; ++i) {
+        fd_effector_state *s = &out->effectors[i];
+        s->kind = fd_get_u16(buf + w.at);
+        s->flags = fd_get_u32(buf + w.at + 2);
+        s->n_states = fd_get_u64(buf + w.at + 6);
+        fd_get_f64s(buf + w.at + 14, s->states, (size_t)s->n_states);
+        w.at += 14 + 8 * (size_t)s->n_states;
+        s->n_outputs = fd_get_u64(buf + w.at);
+        fd_get_f64s(buf + w.at + 8, s->outputs, (size_t)s->n_outputs);
+        w.at += 8 + 8 * (size_t)s->n_outputs;
+    }
+    return fd_ok();
+}
+
+/* Encodes `m` into `buf` (capacity `cap`); returns the length, 0 if it does not fit or a
+ * count exceeds its maximum. */
+static inline size_t fd_encode_state(const fd_state_msg *m, uint8_t *buf, size_t cap) {
+    size_t at, need;
+    uint64_t i;
+    if (m->n_effectors > FD_MAX_EFFECTORS) return 0;
+    for (i = 0; i < m->n_effectors; ++i)
+        if (m->effectors[i].n_states > FD_MAX_EFFECTOR_VALUES ||
+            m->effectors[i].n_outputs > FD_MAX_EFFECTOR_VALUES)
+            return 0;
+    need = fd_state_len(m);
+    if (need > cap) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_f64s(buf + 30, m->sigma_bn, 3);
+    fd_put_f64s(buf + 54, m->q_bn, 4);
+    fd_put_f64s(buf + 86, m->omega_bn_b_rad_s, 3);
+    fd_put_f64s(buf + 110, m->omega_dot_bn_b_rad_s2, 3);
+    fd_put_f64s(buf + 134, m->r_bn_n_m, 3);
+    fd_put_f64s(buf + 158, m->v_bn_n_m_s, 3);
+    fd_put_f64s(buf + 182, m->nongrav_accel_bn_n_m_s2, 3);
+    fd_put_f64(buf + 206, m->orb_energy_j);
+    fd_put_f64(buf + 214, m->rot_energy_j);
+    fd_put_f64s(buf + 222, m->orb_ang_mom_n, 3);
+    fd_put_f64s(buf + 246, m->rot_ang_mom_c_n, 3);
+    fd_put_f64s(buf + 270, m->torque_b_nm, 3);
+    fd_put_f64s(buf + 294, m->force_b_newton, 3);
+    buf[318] = m->command_flags;
+    fd_put_u64(buf + 319, m->n_effectors);
+    at = FD_STATE_FIXED_LEN;
+    for (i = 0; i < m->n_effectors; ++i) {
+        const fd_effector_state *s = &m->effectors[i];
+        fd_put_u16(buf + at, s->kind);
+        fd_put_u32(buf + at + 2, s->flags);
+        fd_put_u64(buf + at + 6, s->n_states);
+        fd_put_f64s(buf + at + 14, s->states, (size_t)s->n_states);
+        at += 14 + 8 * (size_t)s->n_states;
+        fd_put_u64(buf + at, s->n_outputs);
+        fd_put_f64s(buf + at + 8, s->outputs, (size_t)s->n_outputs);
+        at += 8 + 8 * (size_t)s->n_outputs;
+    }
+    return at;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* ImuMsg and StarTrackerMsg (fixed length).                                                   */
+
+static inline fd_error fd_decode_imu(const uint8_t *buf, size_t len, fd_imu_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_IMU_LEN);
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_IMU_LEN, len)).status != FD_OK) return e;
+    fd_decode_header_at(buf, &out->header);
+    fd_get_f64s(buf + 30, out->omega_p_rad_s, 3);
+    fd_get_f64s(buf + 54, out->accel_p_m_s2, 3);
+    fd_get_f64s(buf + 78, out->dtheta_p_rad, 3);
+    fd_get_f64s(buf + 102, out->dv_p_m_s, 3);
+    out->saturation_flags = buf[126];
+    return fd_ok();
+}
+
+static inline size_t fd_encode_imu(const fd_imu_msg *m, uint8_t *buf, size_t cap) {
+    if (cap < FD_IMU_LEN) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_f64s(buf + 30, m->omega_p_rad_s, 3);
+    fd_put_f64s(buf + 54, m->accel_p_m_s2, 3);
+    fd_put_f64s(buf + 78, m->dtheta_p_rad, 3);
+    fd_put_f64s(buf + 102, m->dv_p_m_s, 3);
+    buf[126] = m->saturation_flags;
+    return FD_IMU_LEN;
+}
+
+static inline fd_error fd_decode_star_tracker(const uint8_t *buf, size_t len,
+                                              fd_star_tracker_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_STAR_TRACKER_LEN);
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_STAR_TRACKER_LEN, len)).status != FD_OK) return e;
+    if (buf[62] > 1) return fd_fail(FD_ERR_MALFORMED, 0, len, "valid is not a bool");
+    fd_decode_header_at(buf, &out->header);
+    fd_get_f64s(buf + 30, out->q_cn, 4);
+    out->valid = buf[62];
+    out->status_flags = buf[63];
+    return fd_ok();
+}
+
+static inline size_t fd_encode_star_tracker(const fd_star_tracker_msg *m, uint8_t *buf,
+                                            size_t cap) {
+    if (cap < FD_STAR_TRACKER_LEN || m->valid > 1) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_f64s(buf + 30, m->q_cn, 4);
+    buf[62] = m->valid;
+    buf[63] = m->status_flags;
+    return FD_STAR_TRACKER_LEN;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* CommandMsg.                                                                                 */
+
+static const char *const fd_torque_fields[3] = {"kind.torque_b_nm[0]", "kind.torque_b_nm[1]",
+                                                "kind.torque_b_nm[2]"};
+static const char *const fd_force_fields[3] = {
+    "kind.force_b_newton[0]", "kind.force_b_newton[1]", "kind.force_b_newton[2]"};
+
+/* Encoded length of `m`, 0 for an unknown kind. */
+static inline size_t fd_command_len(const fd_command_msg *m) {
+    size_t n;
+    uint64_t i;
+    switch (m->kind) {
+    case FD_COMMAND_WRENCH: return FD_COMMAND_WRENCH_LEN;
+    case FD_COMMAND_NO_COMMAND: return FD_COMMAND_NO_COMMAND_LEN;
+    case FD_COMMAND_ACTUATORS:
+        n = FD_COMMAND_ACTUATORS_FIXED_LEN;
+        for (i = 0; i < m->n_inputs; ++i)
+            n += FD_EFFECTOR_INPUT_FIXED_LEN + 8 * (size_t)m->inputs[i].n_values;
+        return n;
+    default: return 0;
+    }
+}
+
+/* Step 5 (also usable before sending): every torque, force and input value finite. */
+static inline fd_error fd_validate_command(const fd_command_msg *m, size_t len) {
+    uint64_t i, j;
+    int k;
+    if (m->kind == FD_COMMAND_NO_COMMAND) return fd_ok();
+    for (k = 0; k < 3; ++k)
+        if (!fd_is_finite(m->torque_b_nm[k]))
+            return fd_fail(FD_ERR_NON_FINITE, 0, len, fd_torque_fields[k]);
+    for (k = 0; k < 3; ++k)
+        if (!fd_is_finite(m->force_b_newton[k]))
+            return fd_fail(FD_ERR_NON_FINITE, 0, len, fd_force_fields[k]);
+    if (m->kind == FD_COMMAND_ACTUATORS)
+        for (i = 0; i < m->n_inputs; ++i)
+            for (j = 0; j < m->inputs[i].n_values; ++j)
+                if (!fd_is_finite(m->inputs[i].values[j]))
+                    return fd_fail(FD_ERR_NON_FINITE, 0, len, "kind.inputs[].values[]");
+    return fd_ok();
+}
+
+static inline fd_error fd_decode_command(const uint8_t *buf, size_t len, fd_command_msg *out) {
+    uint32_t tag;
+    size_t expected;
+    uint64_t n = 0, i;
+    fd_error e = fd_check_size_and_version(buf, len, FD_COMMAND_NO_COMMAND_LEN);
+    if (e.status != FD_OK) return e;
+    if (len < FD_COMMAND_KIND_OFFSET + 4)
+        return fd_fail(FD_ERR_LENGTH, FD_COMMAND_NO_COMMAND_LEN, len, NULL);
+    tag = fd_get_u32(buf + FD_COMMAND_KIND_OFFSET);
+    if (tag == FD_COMMAND_WRENCH) {
+        expected = FD_COMMAND_WRENCH_LEN;
+    } else if (tag == FD_COMMAND_NO_COMMAND) {
+        expected = FD_COMMAND_NO_COMMAND_LEN;
+    } else if (tag == FD_COMMAND_ACTUATORS) {
+        fd_walker w;
+        w.at = FD_COMMAND_ACTUATORS_FIXED_LEN - 8;
+        w.len = len;
+        e = fd_walk_count(&w, buf, FD_MAX_EFFECTORS, "effector input count", &n);
+        if (e.status != FD_OK) return e;
+        for (i = 0; i < n; ++i) {
+            if ((e = fd_walk_skip(&w, 4)).status != FD_OK) return e;
+            if ((e = fd_walk_values(&w, buf, "effector input values count")).status != FD_OK)
+                return e;
+        }
+        expected = w.at;
+    } else {
+        return fd_fail(FD_ERR_MALFORMED, 0, len, "unknown command kind tag");
+    }
+    if ((e = fd_check_total(expected, len)).status != FD_OK) return e;
+    fd_decode_header_at(buf, &out->header);
+    out->sender_id = fd_get_u32(buf + 30);
+    out->kind = tag;
+    out->n_inputs = 0;
+    memset(out->torque_b_nm, 0, sizeof out->torque_b_nm);
+    memset(out->force_b_newton, 0, sizeof out->force_b_newton);
+    if (tag != FD_COMMAND_NO_COMMAND) {
+        fd_get_f64s(buf + 38, out->torque_b_nm, 3);
+        fd_get_f64s(buf + 62, out->force_b_newton, 3);
+    }
+    if (tag == FD_COMMAND_ACTUATORS) {
+        size_t at = FD_COMMAND_ACTUATORS_FIXED_LEN;
+        if (n > out->inputs_capacity) {
+            /* Validate what can be validated (Rust checks finiteness before any capacity). */
+            fd_command_msg probe = *out;
+            probe.n_inputs = 0;
+            e = fd_validate_command(&probe, len);
+            if (e.status != FD_OK) return e;
+            for (i = 0; i < n; ++i) {
+                uint64_t v = fd_get_u64(buf + at + 4), j;
+                for (j = 0; j < v; ++j)
+                    if (!fd_is_finite(fd_get_f64(buf + at + 12 + 8 * j)))
+                        return fd_fail(FD_ERR_NON_FINITE, 0, len, "kind.inputs[].values[]");
+                at += 12 + 8 * (size_t)v;
+            }
+            return fd_fail(FD_ERR_CAPACITY, (size_t)n, len, "inputs");
+        }
+        for (i = 0; i < n; ++i) {
+            fd_effector_input *in = &out->inputs[i];
+            in->effector_index = fd_get_u32(buf + at);
+            in->n_values = fd_get_u64(buf + at + 4);
+            fd_get_f64s(buf + at + 12, in->values, (size_t)in->n_values);
+            at += 12 + 8 * (size_t)in->n_values;
+        }
+        out->n_inputs = n;
+    }
+    return fd_validate_command(out, len);
+}
+
+/* Encodes `m` (any kind); returns the length, 0 for an unknown kind, a count above its
+ * maximum, or too small a buffer. It does not check finiteness: call fd_validate_command. */
+static inline size_t fd_encode_command(const fd_command_msg *m, uint8_t *buf, size_t cap) {
+    size_t need, at;
+    uint64_t i;
+    if (m->kind == FD_COMMAND_ACTUATORS) {
+        if (m->n_inputs > FD_MAX_EFFECTORS) return 0;
+        for (i = 0; i < m->n_inputs; ++i)
+            if (m->inputs[i].n_values > FD_MAX_EFFECTOR_VALUES) return 0;
+    }
+    need = fd_command_len(m);
+    if (need == 0 || need > cap) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_u32(buf + 30, m->sender_id);
+    fd_put_u32(buf + 34, m->kind);
+    if (m->kind == FD_COMMAND_NO_COMMAND) return need;
+    fd_put_f64s(buf + 38, m->torque_b_nm, 3);
+    fd_put_f64s(buf + 62, m->force_b_newton, 3);
+    if (m->kind == FD_COMMAND_WRENCH) return need;
+    fd_put_u64(buf + 86, m->n_inputs);
+    at = FD_COMMAND_ACTUATORS_FIXED_LEN;
+    for (i = 0; i < m->n_inputs; ++i) {
+        fd_put_u32(buf + at, m->inputs[i].effector_index);
+        fd_put_u64(buf + at + 4, m->inputs[i].n_values);
+        fd_put_f64s(buf + at + 12, m->inputs[i].values, (size_t)m->inputs[i].n_values);
+        at += 12 + 8 * (size_t)m->inputs[i].n_values;
+    }
+    return at;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* StatusMsg.                                                                                  */
+
+static inline fd_error fd_decode_status(const uint8_t *buf, size_t len, fd_status_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_STATUS_LEN);
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_STATUS_LEN, len)).status != FD_OK) return e;
+    /* Step 4 in wire order: mode tag, run_state tag, command_stale bool, stale_policy tag. */
+    if (fd_get_u32(buf + 30) > FD_MODE_BATCH) return fd_fail(FD_ERR_MALFORMED, 0, len, "mode tag");
+    if (fd_get_u32(buf + 34) > FD_RUN_STATE_STOPPED)
+        return fd_fail(FD_ERR_MALFORMED, 0, len, "run_state tag");
+    if (buf[94] > 1) return fd_fail(FD_ERR_MALFORMED, 0, len, "command_stale is not a bool");
+    if (fd_get_u32(buf + 95) > FD_STALE_POLICY_ZERO)
+        return fd_fail(FD_ERR_MALFORMED, 0, len, "stale_policy tag");
+    fd_decode_header_at(buf, &out->header);
+    out->mode = fd_get_u32(buf + 30);
+    out->run_state = fd_get_u32(buf + 34);
+    out->lateness_p50_ns = fd_get_u64(buf + 38);
+    out->lateness_p99_ns = fd_get_u64(buf + 46);
+    out->lateness_max_ns = fd_get_u64(buf + 54);
+    out->overrun_count = fd_get_u64(buf + 62);
+    out->frames_skipped = fd_get_u64(buf + 70);
+    out->last_command_tick = fd_get_u64(buf + 78);
+    out->command_age_ns = fd_get_u64(buf + 86);
+    out->command_stale = buf[94];
+    out->stale_policy = fd_get_u32(buf + 95);
+    out->rejected_malformed = fd_get_u64(buf + 99);
+    out->rejected_bad_version = fd_get_u64(buf + 107);
+    out->rejected_non_finite = fd_get_u64(buf + 115);
+    out->rejected_wrong_spacecraft = fd_get_u64(buf + 123);
+    out->rejected_stale_tick = fd_get_u64(buf + 131);
+    out->rejected_unknown_sender = fd_get_u64(buf + 139);
+    out->rejected_bad_effector_input = fd_get_u64(buf + 147);
+    out->commands_dropped = fd_get_u64(buf + 155);
+    out->wall_time_unix_ns = fd_get_u64(buf + 163);
+    return fd_ok();
+}
+
+static inline size_t fd_encode_status(const fd_status_msg *m, uint8_t *buf, size_t cap) {
+    if (cap < FD_STATUS_LEN || m->command_stale > 1) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_u32(buf + 30, m->mode);
+    fd_put_u32(buf + 34, m->run_state);
+    fd_put_u64(buf + 38, m->lateness_p50_ns);
+    fd_put_u64(buf + 46, m->lateness_p99_ns);
+    fd_put_u64(buf + 54, m->lateness_max_ns);
+    fd_put_u64(buf + 62, m->overrun_count);
+    fd_put_u64(buf + 70, m->frames_skipped);
+    fd_put_u64(buf + 78, m->last_command_tick);
+    fd_put_u64(buf + 86, m->command_age_ns);
+    buf[94] = m->command_stale;
+    fd_put_u32(buf + 95, m->stale_policy);
+    fd_put_u64(buf + 99, m->rejected_malformed);
+    fd_put_u64(buf + 107, m->rejected_bad_version);
+    fd_put_u64(buf + 115, m->rejected_non_finite);
+    fd_put_u64(buf + 123, m->rejected_wrong_spacecraft);
+    fd_put_u64(buf + 131, m->rejected_stale_tick);
+    fd_put_u64(buf + 139, m->rejected_unknown_sender);
+    fd_put_u64(buf + 147, m->rejected_bad_effector_input);
+    fd_put_u64(buf + 155, m->commands_dropped);
+    fd_put_u64(buf + 163, m->wall_time_unix_ns);
+    return FD_STATUS_LEN;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Key expressions (proto/README.md, "Topics").                                                */
+
+/* Whether `id` is a valid key chunk: 1-64 characters from [A-Za-z0-9_-]. */
+static inline int fd_valid_id(const char *id) {
+    size_t n = 0;
+    for (; id[n] != '\0'; ++n) {
+        char c = id[n];
+        int ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                 c == '_' || c == '-';
+        if (!ok || n >= 64) return 0;
+    }
+    return n > 0;
+}
+
+/* Writes "flexdyn/<sc>/<suffix>[/<name>]" into out (capacity cap, NUL-terminated); returns the
+ * length, or 0 if an id is invalid or it does not fit. name may be NULL. */
+static inline size_t fd_key(char *out, size_t cap, const char *sc, const char *suffix,
+                            const char *name) {
+    size_t n = 0, k;
+    const char *parts[6];
+    size_t count = 0;
+    if (!fd_valid_id(sc) || (name != NULL && !fd_valid_id(name))) return 0;
+    parts[count++] = "flexdyn/";
+    parts[count++] = sc;
+    parts[count++] = "/";
+    parts[count++] = suffix;
+    if (name != NULL) {
+        parts[count++] = "/";
+        parts[count++] = name;
+    }
+    for (k = 0; k < count; ++k) {
+        size_t l = strlen(parts[k]);
+        if (n + l + 1 > cap) return 0;
+        memcpy(out + n, parts[k], l);
+        n += l;
+    }
+    out[n] = '\0';
+    return n;
+}
+
+static inline size_t fd_state_key(char *out, size_t cap, const char *sc) {
+    return fd_key(out, cap, sc, "tlm/state", NULL);
+}
+static inline size_t fd_imu_key(char *out, size_t cap, const char *sc, const char *name) {
+    return fd_key(out, cap, sc, "tlm/imu", name);
+}
+static inline size_t fd_star_tracker_key(char *out, size_t cap, const char *sc, const char *name) {
+    return fd_key(out, cap, sc, "tlm/st", name);
+}
+static inline size_t fd_command_key(char *out, size_t cap, const char *sc) {
+    return fd_key(out, cap, sc, "cmd/wrench", NULL);
+}
+static inline size_t fd_status_key(char *out, size_t cap, const char *sc) {
+    return fd_key(out, cap, sc, "status", NULL);
+}
+/* The lockstep participant's liveliness token key, flexdyn/<sc>/participant/<sender_id>. */
+static inline size_t fd_participant_key(char *out, size_t cap, const char *sc, uint32_t sender_id) {
+    char digits[11];
+    int i = 10;
+    digits[10] = '\0';
+    do {
+        digits[--i] = (char)('0' + sender_id % 10u);
+        sender_id /= 10u;
+    } while (sender_id != 0 && i > 0);
+    return fd_key(out, cap, sc, "participant", digits + i);
+}
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* FLEXDYN_PROTO_H */

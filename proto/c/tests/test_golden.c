@@ -1,0 +1,366 @@
+/*
+ * The C codec against the golden vectors (proto/golden/<name>.bin, derived by hand from the layout in
+ * proto/README.md and pinned by proto/tests/golden.rs): for every message, encoding the values
+ * of the golden table gives the golden bytes, and decoding the golden bytes gives those values
+ * bit for bit. Then the decoder's error rules on edited copies. Usage: test_golden <golden dir>.
+ * Prints one line per check and exits non-zero on the first failure.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "flexdyn_proto.h"
+
+static int failures = 0;
+
+#define CHECK(cond, what)                                                                      \
+    do {                                                                                       \
+        if (!(cond)) {                                                                         \
+            fprintf(stderr, "FAIL %s:%d: %s\n", __FILE__, __LINE__, what);                   \
+            failures++;                                                                        \
+        }                                                                                      \
+    } while (0)
+
+static size_t read_file(const char *dir, const char *name, uint8_t *buf, size_t cap) {
+    char path[1024];
+    FILE *f;
+    size_t n;
+    snprintf(path, sizeof path, "%s/%s.bin", dir, name);
+    f = fopen(path, "rb");
+    if (f == NULL) {
+        fprintf(stderr, "cannot open %s\n", path);
+        exit(2);
+    }
+    n = fread(buf, 1, cap, f);
+    fclose(f);
+    return n;
+}
+
+static int same_bits(const double *a, const double *b, size_t n) {
+    return memcmp(a, b, n * sizeof(double)) == 0;
+}
+
+static int same_header(const fd_header *a, const fd_header *b) {
+    return a->protocol_version == b->protocol_version && a->spacecraft_id == b->spacecraft_id &&
+           a->tick == b->tick && a->sim_time_ns == b->sim_time_ns && a->seq == b->seq;
+}
+
+#define SC 0x11223344u
+
+static void check_encoded(const char *name, const uint8_t *golden, size_t golden_len,
+                          const uint8_t *enc, size_t enc_len) {
+    char what[128];
+    snprintf(what, sizeof what, "%s: C encoding equals the golden bytes", name);
+    CHECK(enc_len == golden_len && memcmp(enc, golden, golden_len) == 0, what);
+    printf("%s: encode %s\n", name, enc_len == golden_len ? "ok" : "length differs");
+}
+
+static void test_state(const char *dir) {
+    uint8_t golden[1024], enc[1024];
+    size_t n = read_file(dir, "state", golden, sizeof golden);
+    fd_effector_state eff[2], back_eff[4];
+    fd_state_msg m, back;
+    fd_error e;
+    double sigma[3] = {0.125, -0.25, 0.5}, q[4] = {0.875, 0.25, -0.375, 0.1875};
+    memset(&m, 0, sizeof m);
+    memset(eff, 0, sizeof eff);
+    m.header = fd_header_new(SC, 0x0102030405060708u, 1500000000u, 0x102u);
+    memcpy(m.sigma_bn, sigma, sizeof sigma);
+    memcpy(m.q_bn, q, sizeof q);
+    m.omega_bn_b_rad_s[0] = 1.0 / 1024.0;
+    m.omega_bn_b_rad_s[1] = -2.0 / 1024.0;
+    m.omega_bn_b_rad_s[2] = 4.0 / 1024.0;
+    m.omega_dot_bn_b_rad_s2[0] = 1.5;
+    m.omega_dot_bn_b_rad_s2[1] = -3.0;
+    m.omega_dot_bn_b_rad_s2[2] = 6.0;
+    m.r_bn_n_m[0] = 7000000.0;
+    m.r_bn_n_m[1] = -1024.0;
+    m.r_bn_n_m[2] = 0.5;
+    m.v_bn_n_m_s[0] = 0.25;
+    m.v_bn_n_m_s[1] = 7500.0;
+    m.v_bn_n_m_s[2] = -8.0;
+    m.nongrav_accel_bn_n_m_s2[0] = 0.0;
+    m.nongrav_accel_bn_n_m_s2[1] = -0.0;
+    m.nongrav_accel_bn_n_m_s2[2] = 1.0 / 1048576.0;
+    m.orb_energy_j = -2.5e10;
+    m.rot_energy_j = 12.5;
+    m.orb_ang_mom_n[0] = 1.0e12;
+    m.orb_ang_mom_n[1] = -2.0;
+    m.orb_ang_mom_n[2] = 4.0;
+    m.rot_ang_mom_c_n[0] = 100.0;
+    m.rot_ang_mom_c_n[1] = -0.75;
+    m.rot_ang_mom_c_n[2] = 1.25;
+    m.torque_b_nm[0] = 0.0625;
+    m.torque_b_nm[1] = -0.125;
+    m.torque_b_nm[2] = 0.25;
+    m.force_b_newton[0] = 1.0;
+    m.force_b_newton[1] = -2.0;
+    m.force_b_newton[2] = 3.0;
+    m.command_flags = FD_COMMAND_FLAG_STALE | FD_COMMAND_FLAG_NO_COMMAND_YET;
+    eff[0].kind = FD_EFFECTOR_PANEL_PAIR;
+    eff[0].n_states = 4;
+    eff[0].states[0] = 0.5;
+    eff[0].states[1] = -0.0625;
+    eff[0].states[2] = 1.25;
+    eff[0].states[3] = 0.03125;
+    eff[1].kind = FD_EFFECTOR_REACTION_WHEEL;
+    eff[1].flags = FD_WHEEL_TORQUE_LIMITED | FD_WHEEL_SPEED_LIMITED;
+    eff[1].n_states = 1;
+    eff[1].states[0] = -150.5;
+    eff[1].n_outputs = 2;
+    eff[1].outputs[0] = 0.25;
+    eff[1].outputs[1] = -0.0078125;
+    m.effectors = eff;
+    m.n_effectors = 2;
+    m.effectors_capacity = 2;
+    check_encoded("StateMsg", golden, n, enc, fd_encode_state(&m, enc, sizeof enc));
+
+    memset(&back, 0, sizeof back);
+    back.effectors = back_eff;
+    back.effectors_capacity = 4;
+    e = fd_decode_state(golden, n, &back);
+    CHECK(e.status == FD_OK, "StateMsg decodes");
+    CHECK(same_header(&back.header, &m.header), "StateMsg header");
+    CHECK(same_bits(back.sigma_bn, m.sigma_bn, 3) && same_bits(back.q_bn, m.q_bn, 4) &&
+              same_bits(back.omega_bn_b_rad_s, m.omega_bn_b_rad_s, 3) &&
+              same_bits(back.omega_dot_bn_b_rad_s2, m.omega_dot_bn_b_rad_s2, 3) &&
+              same_bits(back.r_bn_n_m, m.r_bn_n_m, 3) &&
+              same_bits(back.v_bn_n_m_s, m.v_bn_n_m_s, 3) &&
+              same_bits(back.nongrav_accel_bn_n_m_s2, m.nongrav_accel_bn_n_m_s2, 3) &&
+              same_bits(&back.orb_energy_j, &m.orb_energy_j, 1) &&
+              same_bits(&back.rot_energy_j, &m.rot_energy_j, 1) &&
+              same_bits(back.orb_ang_mom_n, m.orb_ang_mom_n, 3) &&
+              same_bits(back.rot_ang_mom_c_n, m.rot_ang_mom_c_n, 3) &&
+              same_bits(back.torque_b_nm, m.torque_b_nm, 3) &&
+              same_bits(back.force_b_newton, m.force_b_newton, 3),
+          "StateMsg fields bit for bit (including -0.0)");
+    CHECK(back.command_flags == 5 && back.n_effectors == 2, "StateMsg flags and count");
+    CHECK(back_eff[0].kind == 1 && back_eff[0].n_states == 4 && back_eff[0].n_outputs == 0 &&
+              same_bits(back_eff[0].states, eff[0].states, 4),
+          "StateMsg panel pair");
+    CHECK(back_eff[1].kind == 2 && back_eff[1].flags == 3 && back_eff[1].n_states == 1 &&
+              back_eff[1].n_outputs == 2 && same_bits(back_eff[1].states, eff[1].states, 1) &&
+              same_bits(back_eff[1].outputs, eff[1].outputs, 2),
+          "StateMsg wheel");
+    /* Too little storage: the wire rules pass, the caller's array is too small. */
+    back.effectors_capacity = 1;
+    e = fd_decode_state(golden, n, &back);
+    CHECK(e.status == FD_ERR_CAPACITY && e.needed == 2, "StateMsg capacity");
+    back.effectors_capacity = 4;
+    /* Truncated inside the second effector's state count: needed = that count's end. */
+    e = fd_decode_state(golden, 389, &back);
+    CHECK(e.status == FD_ERR_LENGTH && e.needed == 395 && e.actual == 389, "StateMsg walk");
+    e = fd_decode_state(golden, 100, &back);
+    CHECK(e.status == FD_ERR_LENGTH && e.needed == FD_STATE_FIXED_LEN, "StateMsg short");
+    printf("StateMsg: decode ok\n");
+}
+
+static void test_imu_and_star_tracker(const char *dir) {
+    uint8_t golden[256], enc[256];
+    size_t n = read_file(dir, "imu", golden, sizeof golden);
+    fd_imu_msg m, back;
+    fd_star_tracker_msg s, sback;
+    double q[4] = {0.875, 0.25, -0.375, 0.1875};
+    fd_error e;
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 9, 9000000u, 10);
+    m.omega_p_rad_s[0] = 1.0 / 1024.0;
+    m.omega_p_rad_s[1] = -0.5;
+    m.omega_p_rad_s[2] = 2.0;
+    m.accel_p_m_s2[0] = 0.0;
+    m.accel_p_m_s2[1] = 9.75;
+    m.accel_p_m_s2[2] = -0.125;
+    m.dtheta_p_rad[0] = 1.0 / 1048576.0;
+    m.dtheta_p_rad[1] = -2.0 / 1048576.0;
+    m.dtheta_p_rad[2] = 4.0 / 1048576.0;
+    m.dv_p_m_s[0] = 0.001;
+    m.dv_p_m_s[1] = -1.5;
+    m.dv_p_m_s[2] = 3.0;
+    m.saturation_flags = FD_SATURATION_GYRO_RATE | FD_SATURATION_DV;
+    check_encoded("ImuMsg", golden, n, enc, fd_encode_imu(&m, enc, sizeof enc));
+    e = fd_decode_imu(golden, n, &back);
+    CHECK(e.status == FD_OK && same_header(&back.header, &m.header) &&
+              same_bits(back.omega_p_rad_s, m.omega_p_rad_s, 3) &&
+              same_bits(back.accel_p_m_s2, m.accel_p_m_s2, 3) &&
+              same_bits(back.dtheta_p_rad, m.dtheta_p_rad, 3) &&
+              same_bits(back.dv_p_m_s, m.dv_p_m_s, 3) && back.saturation_flags == 0x09,
+          "ImuMsg decodes to the table");
+
+    n = read_file(dir, "star_tracker", golden, sizeof golden);
+    memset(&s, 0, sizeof s);
+    s.header = fd_header_new(SC, 11, 110000000u, 12);
+    memcpy(s.q_cn, q, sizeof q);
+    s.valid = 0;
+    s.status_flags = FD_STAR_TRACKER_SUN_EXCLUSION;
+    check_encoded("StarTrackerMsg", golden, n, enc, fd_encode_star_tracker(&s, enc, sizeof enc));
+    e = fd_decode_star_tracker(golden, n, &sback);
+    CHECK(e.status == FD_OK && same_header(&sback.header, &s.header) &&
+              same_bits(sback.q_cn, q, 4) && sback.valid == 0 && sback.status_flags == 1,
+          "StarTrackerMsg decodes to the table");
+    golden[62] = 2;
+    e = fd_decode_star_tracker(golden, n, &sback);
+    CHECK(e.status == FD_ERR_MALFORMED, "StarTrackerMsg bool other than 0/1");
+    printf("ImuMsg, StarTrackerMsg: decode ok\n");
+}
+
+static void test_commands(const char *dir) {
+    uint8_t golden[256], enc[256];
+    size_t n;
+    fd_command_msg m, back;
+    fd_effector_input in[2], back_in[4];
+    fd_error e;
+
+    /* Wrench */
+    n = read_file(dir, "command_wrench", golden, sizeof golden);
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 42, 420000000u, 7);
+    m.sender_id = 0xDEADBEEFu;
+    m.kind = FD_COMMAND_WRENCH;
+    m.torque_b_nm[0] = 0.0625;
+    m.torque_b_nm[1] = -0.125;
+    m.torque_b_nm[2] = 0.25;
+    m.force_b_newton[0] = -1.0;
+    m.force_b_newton[1] = 0.0;
+    m.force_b_newton[2] = 0.5;
+    check_encoded("CommandMsg::Wrench", golden, n, enc, fd_encode_command(&m, enc, sizeof enc));
+    memset(&back, 0, sizeof back);
+    back.inputs = back_in;
+    back.inputs_capacity = 4;
+    e = fd_decode_command(golden, n, &back);
+    CHECK(e.status == FD_OK && back.kind == FD_COMMAND_WRENCH && back.sender_id == 0xDEADBEEFu &&
+              same_header(&back.header, &m.header) &&
+              same_bits(back.torque_b_nm, m.torque_b_nm, 3) &&
+              same_bits(back.force_b_newton, m.force_b_newton, 3),
+          "Wrench decodes to the table");
+    /* A NaN torque is named like Rust's DecodeError::NonFinite. */
+    fd_put_u64(golden + 38 + 16, 0x7ff8000000000000u); /* a quiet NaN */
+    e = fd_decode_command(golden, n, &back);
+    CHECK(e.status == FD_ERR_NON_FINITE && e.field != NULL &&
+              strcmp(e.field, "kind.torque_b_nm[2]") == 0,
+          "NaN torque named");
+    /* Tag 1 with a wrench body: trailing bytes; tag 3: malformed. */
+    n = read_file(dir, "command_wrench", golden, sizeof golden);
+    golden[34] = 1;
+    e = fd_decode_command(golden, n, &back);
+    CHECK(e.status == FD_ERR_TRAILING_BYTES && e.needed == 38 && e.actual == 86, "tag 1, 86 bytes");
+    golden[34] = 3;
+    e = fd_decode_command(golden, n, &back);
+    CHECK(e.status == FD_ERR_MALFORMED, "tag 3");
+    golden[0] = 2;
+    e = fd_decode_command(golden, n, &back);
+    CHECK(e.status == FD_ERR_UNKNOWN_VERSION && e.found_version == 2, "version checked first");
+
+    /* Actuators */
+    n = read_file(dir, "command_actuators", golden, sizeof golden);
+    memset(&m, 0, sizeof m);
+    memset(in, 0, sizeof in);
+    m.header = fd_header_new(SC, 44, 440000000u, 9);
+    m.sender_id = 7;
+    m.kind = FD_COMMAND_ACTUATORS;
+    m.torque_b_nm[0] = 0.5;
+    m.torque_b_nm[1] = -0.25;
+    m.torque_b_nm[2] = 0.0;
+    m.force_b_newton[2] = -0.0;
+    in[0].effector_index = 2;
+    in[0].n_values = 1;
+    in[0].values[0] = 0.0625;
+    in[1].effector_index = 5;
+    in[1].n_values = 1;
+    in[1].values[0] = -0.03125;
+    m.inputs = in;
+    m.n_inputs = 2;
+    check_encoded("CommandMsg::Actuators", golden, n, enc, fd_encode_command(&m, enc, sizeof enc));
+    e = fd_decode_command(golden, n, &back);
+    CHECK(e.status == FD_OK && back.kind == FD_COMMAND_ACTUATORS && back.n_inputs == 2 &&
+              back_in[0].effector_index == 2 && back_in[1].effector_index == 5 &&
+              same_bits(back_in[0].values, in[0].values, 1) &&
+              same_bits(back_in[1].values, in[1].values, 1) &&
+              same_bits(back.force_b_newton, m.force_b_newton, 3),
+          "Actuators decodes to the table (including -0.0)");
+    e = fd_decode_command(golden, n - 3, &back);
+    CHECK(e.status == FD_ERR_LENGTH && e.needed == n, "Actuators truncated");
+
+    /* NoCommand */
+    n = read_file(dir, "command_no_command", golden, sizeof golden);
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 43, 430000000u, 8);
+    m.sender_id = 5;
+    m.kind = FD_COMMAND_NO_COMMAND;
+    check_encoded("CommandMsg::NoCommand", golden, n, enc, fd_encode_command(&m, enc, sizeof enc));
+    e = fd_decode_command(golden, n, &back);
+    CHECK(e.status == FD_OK && back.kind == FD_COMMAND_NO_COMMAND && back.sender_id == 5,
+          "NoCommand decodes");
+    printf("CommandMsg: decode ok\n");
+}
+
+static void test_status(const char *dir) {
+    uint8_t golden[256], enc[256];
+    size_t n = read_file(dir, "status", golden, sizeof golden);
+    fd_status_msg m, back;
+    fd_error e;
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 0x0102030405060708u, 1500000000u, 99);
+    m.mode = FD_MODE_LOCKSTEP;
+    m.run_state = FD_RUN_STATE_RUNNING;
+    m.lateness_p50_ns = 1000;
+    m.lateness_p99_ns = 250000;
+    m.lateness_max_ns = 3000000;
+    m.overrun_count = 3;
+    m.frames_skipped = 2;
+    m.last_command_tick = 41;
+    m.command_age_ns = 1000000;
+    m.command_stale = 1;
+    m.stale_policy = FD_STALE_POLICY_ZERO;
+    m.rejected_malformed = 1;
+    m.rejected_bad_version = 2;
+    m.rejected_non_finite = 3;
+    m.rejected_wrong_spacecraft = 4;
+    m.rejected_stale_tick = 5;
+    m.rejected_unknown_sender = 6;
+    m.rejected_bad_effector_input = 8;
+    m.commands_dropped = 7;
+    m.wall_time_unix_ns = 1700000000123456789u;
+    check_encoded("StatusMsg", golden, n, enc, fd_encode_status(&m, enc, sizeof enc));
+    e = fd_decode_status(golden, n, &back);
+    CHECK(e.status == FD_OK && same_header(&back.header, &m.header) &&
+              back.wall_time_unix_ns == m.wall_time_unix_ns &&
+              back.rejected_bad_effector_input == 8 && back.commands_dropped == 7 &&
+              back.stale_policy == 1 && back.command_stale == 1,
+          "StatusMsg decodes to the table");
+    golden[34] = 6;
+    e = fd_decode_status(golden, n, &back);
+    CHECK(e.status == FD_ERR_MALFORMED, "run_state tag 6");
+    printf("StatusMsg: decode ok\n");
+}
+
+static void test_keys(void) {
+    char key[128];
+    CHECK(fd_state_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/tlm/state") == 0,
+          "state key");
+    CHECK(fd_star_tracker_key(key, sizeof key, "sc1", "st1") > 0 &&
+              strcmp(key, "flexdyn/sc1/tlm/st/st1") == 0,
+          "star tracker key");
+    CHECK(fd_participant_key(key, sizeof key, "sc-1", 4294967295u) > 0 &&
+              strcmp(key, "flexdyn/sc-1/participant/4294967295") == 0,
+          "participant key");
+    CHECK(fd_imu_key(key, sizeof key, "sc1", "a/b") == 0, "a / in a name is rejected");
+    CHECK(fd_command_key(key, 10, "sc1") == 0, "a key that does not fit is rejected");
+    printf("keys: ok\n");
+}
+
+int main(int argc, char **argv) {
+    if (argc != 2) {
+        fprintf(stderr, "usage: %s <proto/golden directory>\n", argv[0]);
+        return 2;
+    }
+    test_state(argv[1]);
+    test_imu_and_star_tracker(argv[1]);
+    test_commands(argv[1]);
+    test_status(argv[1]);
+    test_keys();
+    if (failures != 0) {
+        fprintf(stderr, "%d check(s) failed\n", failures);
+        return 1;
+    }
+    printf("all C golden checks passed\n");
+    return 0;
+}
