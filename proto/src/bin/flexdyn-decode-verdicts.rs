@@ -1,0 +1,239 @@
+//! `flexdyn-decode-verdicts`: the Rust decoders' verdicts on a stream of buffers, in the
+//! canonical text form the other codecs' differential tests compare against (the C driver
+//! `proto/c/tests/fuzz_decode.c`, the Python package's `tests/test_proto_fuzz.py`).
+//!
+//! Input (stdin): records of a u32 LE length and that many bytes. Output (stdout): per record,
+//! six lines, one per decoder (state, imu, star tracker, command, status, header):
+//! `E <reason> [numbers or field]` for an error (the `DecodeError` variant; `Length needed
+//! actual`, `TrailingBytes expected actual`, `TooLarge actual`, `UnknownVersion found`,
+//! `NonFinite field`, `Malformed`), or `O <fields>` for a decoded message: every field in wire
+//! order, integers in lower-case hex, f64 as its bit pattern in hex.
+
+use std::fmt::Write as _;
+use std::io::{Read, Write};
+
+use flexdyn_proto::{
+    decode_command, decode_header, decode_imu, decode_star_tracker, decode_state, decode_status,
+    CommandKind, CommandMsg, DecodeError, Header, ImuMsg, Mode, RunState, StalePolicy,
+    StarTrackerMsg, StateMsg, StatusMsg,
+};
+
+fn err_line(e: &DecodeError) -> String {
+    match e {
+        DecodeError::Length { needed, actual } => format!("E Length {needed} {actual}"),
+        DecodeError::TrailingBytes { expected, actual } => {
+            format!("E TrailingBytes {expected} {actual}")
+        }
+        DecodeError::TooLarge { actual, .. } => format!("E TooLarge {actual}"),
+        DecodeError::UnknownVersion { found } => format!("E UnknownVersion {found}"),
+        DecodeError::NonFinite { field } => format!("E NonFinite {field}"),
+        DecodeError::Malformed(_) => "E Malformed".to_string(),
+    }
+}
+
+struct Line(String);
+
+impl Line {
+    fn new() -> Self {
+        Line("O".to_string())
+    }
+    fn u(&mut self, v: u64) -> &mut Self {
+        let _ = write!(self.0, " {v:x}");
+        self
+    }
+    fn f(&mut self, v: &[f64]) -> &mut Self {
+        for x in v {
+            let _ = write!(self.0, " {:x}", x.to_bits());
+        }
+        self
+    }
+    fn h(&mut self, h: &Header) -> &mut Self {
+        self.u(h.protocol_version.into())
+            .u(h.spacecraft_id.into())
+            .u(h.tick)
+            .u(h.sim_time_ns)
+            .u(h.seq)
+    }
+}
+
+fn state_line(m: &StateMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header)
+        .f(&m.sigma_bn)
+        .f(&m.q_bn)
+        .f(&m.omega_bn_b_rad_s)
+        .f(&m.omega_dot_bn_b_rad_s2)
+        .f(&m.r_bn_n_m)
+        .f(&m.v_bn_n_m_s)
+        .f(&m.nongrav_accel_bn_n_m_s2)
+        .f(&[m.conserved.orb_energy_j, m.conserved.rot_energy_j])
+        .f(&m.conserved.orb_ang_mom_n)
+        .f(&m.conserved.rot_ang_mom_c_n)
+        .f(&m.wrench_applied.torque_b_nm)
+        .f(&m.wrench_applied.force_b_newton)
+        .u(m.command_flags.into())
+        .u(m.effectors.len() as u64);
+    for e in &m.effectors {
+        l.u(e.kind.into())
+            .u(e.flags.into())
+            .u(e.states.len() as u64)
+            .f(&e.states)
+            .u(e.outputs.len() as u64)
+            .f(&e.outputs);
+    }
+    l.0
+}
+
+fn imu_line(m: &ImuMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header)
+        .f(&m.omega_p_rad_s)
+        .f(&m.accel_p_m_s2)
+        .f(&m.dtheta_p_rad)
+        .f(&m.dv_p_m_s)
+        .u(m.saturation_flags.into());
+    l.0
+}
+
+fn star_tracker_line(m: &StarTrackerMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header)
+        .f(&m.q_cn)
+        .u(m.valid.into())
+        .u(m.status_flags.into());
+    l.0
+}
+
+fn command_line(m: &CommandMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header).u(m.sender_id.into());
+    match &m.kind {
+        CommandKind::Wrench {
+            torque_b_nm,
+            force_b_newton,
+        } => {
+            l.u(0).f(torque_b_nm).f(force_b_newton);
+        }
+        CommandKind::NoCommand => {
+            l.u(1);
+        }
+        CommandKind::Actuators {
+            torque_b_nm,
+            force_b_newton,
+            inputs,
+        } => {
+            l.u(2)
+                .f(torque_b_nm)
+                .f(force_b_newton)
+                .u(inputs.len() as u64);
+            for i in inputs {
+                l.u(i.effector_index.into())
+                    .u(i.values.len() as u64)
+                    .f(&i.values);
+            }
+        }
+    }
+    l.0
+}
+
+fn tag(m: Mode) -> u64 {
+    match m {
+        Mode::RealTime => 0,
+        Mode::Lockstep => 1,
+        Mode::Batch => 2,
+    }
+}
+
+fn status_line(m: &StatusMsg) -> String {
+    let run = match m.run_state {
+        RunState::Starting => 0,
+        RunState::Running => 1,
+        RunState::Stopping => 2,
+        RunState::Finished => 3,
+        RunState::Failed => 4,
+        RunState::Stopped => 5,
+    };
+    let policy = match m.command.stale_policy {
+        StalePolicy::Hold => 0,
+        StalePolicy::Zero => 1,
+    };
+    let r = &m.rejected;
+    let mut l = Line::new();
+    l.h(&m.header)
+        .u(tag(m.mode))
+        .u(run)
+        .u(m.timing.lateness_p50_ns)
+        .u(m.timing.lateness_p99_ns)
+        .u(m.timing.lateness_max_ns)
+        .u(m.timing.overrun_count)
+        .u(m.timing.frames_skipped)
+        .u(m.command.last_command_tick)
+        .u(m.command.command_age_ns)
+        .u(m.command.command_stale.into())
+        .u(policy)
+        .u(r.malformed)
+        .u(r.bad_version)
+        .u(r.non_finite)
+        .u(r.wrong_spacecraft)
+        .u(r.stale_tick)
+        .u(r.unknown_sender)
+        .u(r.bad_effector_input)
+        .u(m.commands_dropped)
+        .u(m.wall_time_unix_ns);
+    l.0
+}
+
+/// The six verdicts for one buffer, in the order of the module docs.
+fn rust_lines(b: &[u8]) -> Vec<String> {
+    fn line<M>(r: Result<M, DecodeError>, f: impl Fn(&M) -> String) -> String {
+        match r {
+            Ok(m) => f(&m),
+            Err(e) => err_line(&e),
+        }
+    }
+    vec![
+        line(decode_state(b), state_line),
+        line(decode_imu(b), imu_line),
+        line(decode_star_tracker(b), star_tracker_line),
+        line(decode_command(b), command_line),
+        line(decode_status(b), status_line),
+        line(decode_header(b), |h| {
+            let mut l = Line::new();
+            l.h(h);
+            l.0
+        }),
+    ]
+}
+
+fn main() -> std::process::ExitCode {
+    let mut input = Vec::new();
+    if let Err(e) = std::io::stdin().read_to_end(&mut input) {
+        eprintln!("error: cannot read stdin: {e}");
+        return std::process::ExitCode::FAILURE;
+    }
+    let mut out = String::new();
+    let mut at = 0;
+    while at < input.len() {
+        let Some(len) = input
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+        else {
+            eprintln!("error: truncated record length at byte {at}");
+            return std::process::ExitCode::FAILURE;
+        };
+        let Some(buf) = input.get(at + 4..at + 4 + len) else {
+            eprintln!("error: truncated record at byte {at}");
+            return std::process::ExitCode::FAILURE;
+        };
+        for line in rust_lines(buf) {
+            out.push_str(&line);
+            out.push('\n');
+        }
+        at += 4 + len;
+    }
+    if let Err(e) = std::io::stdout().write_all(out.as_bytes()) {
+        eprintln!("error: cannot write stdout: {e}");
+        return std::process::ExitCode::FAILURE;
+    }
+    std::process::ExitCode::SUCCESS
+}
