@@ -1,0 +1,473 @@
+"""The flexdyn wire protocol, version 3, in pure Python.
+
+Every message of ``proto/README.md`` as a dataclass with ``encode()`` and ``decode(bytes)``.
+Decoding follows the README's decoder rules in the same order and raises :class:`DecodeError`
+with the same reasons as the Rust crate's ``DecodeError``:
+
+1. more than ``MAX_MESSAGE_BYTES`` -> ``TooLarge``;
+2. fewer than 2 bytes -> ``Length``; first two bytes (u16 LE) != 3 -> ``UnknownVersion``;
+3. the total length from the layout (fixed; command tag at 34; walked counts, each bounded
+   first) -> ``Length`` (needed = length implied by the counts read so far), ``Malformed``
+   (unknown tag, count above its maximum), ``TrailingBytes``;
+4. fields in wire order: an enum tag out of range or a bool byte other than 0/1 -> ``Malformed``;
+5. CommandMsg: a non-finite torque, force or input value -> ``NonFinite`` naming the field.
+
+Units are in the field names (SI; ``_nm`` newton-metres, ``_newton`` newtons); frames too
+(``_b`` body, ``_n`` inertial, ``_p`` IMU platform, ``_c`` star-tracker case).
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+from dataclasses import dataclass, field
+from typing import ClassVar, List, Optional, Tuple
+
+PROTOCOL_VERSION = 3
+HEADER_LEN = 30
+STATE_FIXED_LEN = 327
+STATE_EFFECTOR_COUNT_OFFSET = 319
+EFFECTOR_STATE_FIXED_LEN = 22
+EFFECTOR_INPUT_FIXED_LEN = 12
+IMU_LEN = 127
+STAR_TRACKER_LEN = 64
+COMMAND_KIND_OFFSET = 34
+COMMAND_WRENCH_LEN = 86
+COMMAND_NO_COMMAND_LEN = 38
+COMMAND_ACTUATORS_FIXED_LEN = 94
+STATUS_LEN = 171
+MAX_EFFECTORS = 1024
+MAX_EFFECTOR_VALUES = 8
+MAX_MESSAGE_BYTES = 65536
+NO_COMMAND = 2**64 - 1
+
+# CommandMsg kinds
+WRENCH, NO_COMMAND_KIND, ACTUATORS = 0, 1, 2
+# EffectorState.kind
+PANEL_PAIR, REACTION_WHEEL = 1, 2
+# Flags
+COMMAND_FLAG_STALE, COMMAND_FLAG_ZEROED_BY_POLICY, COMMAND_FLAG_NO_COMMAND_YET = 0x1, 0x2, 0x4
+SATURATION_GYRO_RATE, SATURATION_ACCEL, SATURATION_DTHETA, SATURATION_DV = 0x1, 0x2, 0x4, 0x8
+STAR_TRACKER_SUN_EXCLUSION, STAR_TRACKER_RATE_LIMIT = 0x1, 0x2
+WHEEL_TORQUE_LIMITED, WHEEL_SPEED_LIMITED = 0x1, 0x2
+# StatusMsg enums
+MODE_REAL_TIME, MODE_LOCKSTEP, MODE_BATCH = 0, 1, 2
+RUN_STATE_NAMES = ("Starting", "Running", "Stopping", "Finished", "Failed", "Stopped")
+STALE_POLICY_HOLD, STALE_POLICY_ZERO = 0, 1
+
+_HEADER = struct.Struct("<HIQQQ")
+
+
+class DecodeError(ValueError):
+    """Why a buffer is not a message. ``reason`` is the Rust ``DecodeError`` variant name:
+    ``Length`` (``needed``, ``actual``), ``TrailingBytes`` (``expected``, ``actual``),
+    ``TooLarge`` (``actual``), ``UnknownVersion`` (``found``), ``NonFinite`` (``field``) or
+    ``Malformed`` (``detail``)."""
+
+    def __init__(self, reason: str, **info: object) -> None:
+        self.reason = reason
+        self.info = info
+        super().__init__(f"{reason}: {info}")
+
+    def canonical(self) -> str:
+        """The verdict line of ``flexdyn-decode-verdicts`` for this error."""
+        i = self.info
+        if self.reason == "Length":
+            return f"E Length {i['needed']} {i['actual']}"
+        if self.reason == "TrailingBytes":
+            return f"E TrailingBytes {i['expected']} {i['actual']}"
+        if self.reason == "TooLarge":
+            return f"E TooLarge {i['actual']}"
+        if self.reason == "UnknownVersion":
+            return f"E UnknownVersion {i['found']}"
+        if self.reason == "NonFinite":
+            return f"E NonFinite {i['field']}"
+        return "E Malformed"
+
+
+def _check_size_and_version(buf: bytes, min_len: int) -> None:
+    if len(buf) > MAX_MESSAGE_BYTES:
+        raise DecodeError("TooLarge", actual=len(buf), max=MAX_MESSAGE_BYTES)
+    if len(buf) < 2:
+        raise DecodeError("Length", needed=min_len, actual=len(buf))
+    (version,) = struct.unpack_from("<H", buf, 0)
+    if version != PROTOCOL_VERSION:
+        raise DecodeError("UnknownVersion", found=version)
+
+
+def _check_total(expected: int, buf: bytes) -> None:
+    if len(buf) < expected:
+        raise DecodeError("Length", needed=expected, actual=len(buf))
+    if len(buf) > expected:
+        raise DecodeError("TrailingBytes", expected=expected, actual=len(buf))
+
+
+class _Walker:
+    """Bounded cursor over count prefixes (rule 3)."""
+
+    def __init__(self, buf: bytes, at: int) -> None:
+        self.buf, self.at = buf, at
+
+    def skip(self, n: int) -> None:
+        if self.at + n > len(self.buf):
+            raise DecodeError("Length", needed=self.at + n, actual=len(self.buf))
+        self.at += n
+
+    def count(self, maximum: int, what: str) -> int:
+        if self.at + 8 > len(self.buf):
+            raise DecodeError("Length", needed=self.at + 8, actual=len(self.buf))
+        (n,) = struct.unpack_from("<Q", self.buf, self.at)
+        if n > maximum:
+            raise DecodeError("Malformed", detail=f"{what} count {n} exceeds maximum {maximum}")
+        self.at += 8
+        return n
+
+    def values(self, what: str) -> None:
+        self.skip(8 * self.count(MAX_EFFECTOR_VALUES, what))
+
+
+@dataclass
+class Header:
+    """Common header, the first 30 bytes of every message."""
+
+    spacecraft_id: int = 0
+    tick: int = 0
+    sim_time_ns: int = 0  # [ns] simulation time of `tick`
+    seq: int = 0
+    protocol_version: int = PROTOCOL_VERSION
+
+    def encode(self) -> bytes:
+        return _HEADER.pack(
+            self.protocol_version, self.spacecraft_id, self.tick, self.sim_time_ns, self.seq
+        )
+
+    @staticmethod
+    def unpack(buf: bytes) -> "Header":
+        v, sc, tick, t, seq = _HEADER.unpack_from(buf, 0)
+        return Header(sc, tick, t, seq, v)
+
+    @staticmethod
+    def decode(buf: bytes) -> "Header":
+        """The header of any message (size, version and the first 30 bytes are checked)."""
+        _check_size_and_version(buf, HEADER_LEN)
+        if len(buf) < HEADER_LEN:
+            raise DecodeError("Length", needed=HEADER_LEN, actual=len(buf))
+        return Header.unpack(buf)
+
+
+def _f(buf: bytes, at: int, n: int) -> Tuple[float, ...]:
+    return struct.unpack_from(f"<{n}d", buf, at)
+
+
+def _pack_f(values) -> bytes:
+    return struct.pack(f"<{len(values)}d", *values)
+
+
+@dataclass
+class EffectorState:
+    """One effector of a StateMsg: kind (PANEL_PAIR, REACTION_WHEEL, ...), flags, its states
+    and outputs in the kind's order and units (proto/README.md, "Effector kinds")."""
+
+    kind: int = 0
+    flags: int = 0
+    states: List[float] = field(default_factory=list)
+    outputs: List[float] = field(default_factory=list)
+
+
+@dataclass
+class StateMsg:
+    """Per-frame truth state (``flexdyn/<sc-id>/tlm/state``)."""
+
+    header: Header = field(default_factory=Header)
+    sigma_bn: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # MRP of B relative to N
+    q_bn: Tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)  # scalar first
+    omega_bn_b_rad_s: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [rad/s]
+    omega_dot_bn_b_rad_s2: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [rad/s^2]
+    r_bn_n_m: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m]
+    v_bn_n_m_s: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m/s]
+    nongrav_accel_bn_n_m_s2: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m/s^2]
+    orb_energy_j: float = 0.0  # [J]
+    rot_energy_j: float = 0.0  # [J]
+    orb_ang_mom_n: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [kg m^2/s]
+    rot_ang_mom_c_n: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [kg m^2/s]
+    torque_b_nm: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # wrench_applied [N m]
+    force_b_newton: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # wrench_applied [N]
+    command_flags: int = 0
+    effectors: List[EffectorState] = field(default_factory=list)
+
+    def encode(self) -> bytes:
+        out = bytearray(self.header.encode())
+        for v in (
+            self.sigma_bn, self.q_bn, self.omega_bn_b_rad_s, self.omega_dot_bn_b_rad_s2,
+            self.r_bn_n_m, self.v_bn_n_m_s, self.nongrav_accel_bn_n_m_s2,
+            (self.orb_energy_j, self.rot_energy_j), self.orb_ang_mom_n, self.rot_ang_mom_c_n,
+            self.torque_b_nm, self.force_b_newton,
+        ):
+            out += _pack_f(v)
+        out += struct.pack("<BQ", self.command_flags, len(self.effectors))
+        for e in self.effectors:
+            out += struct.pack("<HIQ", e.kind, e.flags, len(e.states)) + _pack_f(e.states)
+            out += struct.pack("<Q", len(e.outputs)) + _pack_f(e.outputs)
+        return bytes(out)
+
+    @staticmethod
+    def decode(buf: bytes) -> "StateMsg":
+        _check_size_and_version(buf, STATE_FIXED_LEN)
+        w = _Walker(buf, STATE_EFFECTOR_COUNT_OFFSET)
+        n = w.count(MAX_EFFECTORS, "effector")
+        for _ in range(n):
+            w.skip(6)
+            w.values("effector states")
+            w.values("effector outputs")
+        _check_total(w.at, buf)
+        effectors = []
+        at = STATE_FIXED_LEN
+        for _ in range(n):
+            kind, flags, ns = struct.unpack_from("<HIQ", buf, at)
+            states = list(_f(buf, at + 14, ns))
+            at += 14 + 8 * ns
+            (no,) = struct.unpack_from("<Q", buf, at)
+            outputs = list(_f(buf, at + 8, no))
+            at += 8 + 8 * no
+            effectors.append(EffectorState(kind, flags, states, outputs))
+        return StateMsg(
+            Header.unpack(buf), _f(buf, 30, 3), _f(buf, 54, 4), _f(buf, 86, 3), _f(buf, 110, 3),
+            _f(buf, 134, 3), _f(buf, 158, 3), _f(buf, 182, 3), _f(buf, 206, 1)[0],
+            _f(buf, 214, 1)[0], _f(buf, 222, 3), _f(buf, 246, 3), _f(buf, 270, 3),
+            _f(buf, 294, 3), buf[318], effectors,
+        )
+
+
+@dataclass
+class ImuMsg:
+    """IMU sample (``flexdyn/<sc-id>/tlm/imu/<name>``), platform-frame components."""
+
+    header: Header = field(default_factory=Header)
+    omega_p_rad_s: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [rad/s]
+    accel_p_m_s2: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m/s^2]
+    dtheta_p_rad: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [rad]
+    dv_p_m_s: Tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m/s]
+    saturation_flags: int = 0
+
+    def encode(self) -> bytes:
+        return (
+            self.header.encode()
+            + _pack_f(self.omega_p_rad_s) + _pack_f(self.accel_p_m_s2)
+            + _pack_f(self.dtheta_p_rad) + _pack_f(self.dv_p_m_s)
+            + struct.pack("<B", self.saturation_flags)
+        )
+
+    @staticmethod
+    def decode(buf: bytes) -> "ImuMsg":
+        _check_size_and_version(buf, IMU_LEN)
+        _check_total(IMU_LEN, buf)
+        return ImuMsg(
+            Header.unpack(buf), _f(buf, 30, 3), _f(buf, 54, 3), _f(buf, 78, 3), _f(buf, 102, 3),
+            buf[126],
+        )
+
+
+@dataclass
+class StarTrackerMsg:
+    """Star-tracker measurement (``flexdyn/<sc-id>/tlm/st/<name>``): q_CN scalar first, held at
+    the last valid value while ``valid`` is False."""
+
+    header: Header = field(default_factory=Header)
+    q_cn: Tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    valid: bool = False
+    status_flags: int = 0
+
+    def encode(self) -> bytes:
+        return (
+            self.header.encode() + _pack_f(self.q_cn)
+            + struct.pack("<BB", 1 if self.valid else 0, self.status_flags)
+        )
+
+    @staticmethod
+    def decode(buf: bytes) -> "StarTrackerMsg":
+        _check_size_and_version(buf, STAR_TRACKER_LEN)
+        _check_total(STAR_TRACKER_LEN, buf)
+        if buf[62] > 1:
+            raise DecodeError("Malformed", detail="valid is not a bool")
+        return StarTrackerMsg(Header.unpack(buf), _f(buf, 30, 4), buf[62] == 1, buf[63])
+
+
+@dataclass
+class EffectorInput:
+    """Inputs for one effector (index in StateMsg.effectors) in an Actuators command."""
+
+    effector_index: int = 0
+    values: List[float] = field(default_factory=list)
+
+
+_TORQUE = ("kind.torque_b_nm[0]", "kind.torque_b_nm[1]", "kind.torque_b_nm[2]")
+_FORCE = ("kind.force_b_newton[0]", "kind.force_b_newton[1]", "kind.force_b_newton[2]")
+
+
+@dataclass
+class CommandMsg:
+    """Command from flight code (``flexdyn/<sc-id>/cmd/wrench``): ``kind`` WRENCH (torque about
+    B [N m] and force at B [N], B components), NO_COMMAND_KIND, or ACTUATORS (a wrench plus
+    effector inputs, e.g. reaction-wheel motor torques)."""
+
+    header: Header = field(default_factory=Header)
+    sender_id: int = 0
+    kind: int = NO_COMMAND_KIND
+    torque_b_nm: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    force_b_newton: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    inputs: List[EffectorInput] = field(default_factory=list)
+
+    def validate(self) -> None:
+        """Rule 5: every number finite (raises DecodeError NonFinite naming the field)."""
+        if self.kind == NO_COMMAND_KIND:
+            return
+        for name, v in zip(_TORQUE + _FORCE, tuple(self.torque_b_nm) + tuple(self.force_b_newton)):
+            if not math.isfinite(v):
+                raise DecodeError("NonFinite", field=name)
+        if self.kind == ACTUATORS:
+            for i in self.inputs:
+                if not all(math.isfinite(v) for v in i.values):
+                    raise DecodeError("NonFinite", field="kind.inputs[].values[]")
+
+    def encode(self) -> bytes:
+        out = self.header.encode() + struct.pack("<II", self.sender_id, self.kind)
+        if self.kind == NO_COMMAND_KIND:
+            return out
+        out += _pack_f(self.torque_b_nm) + _pack_f(self.force_b_newton)
+        if self.kind == WRENCH:
+            return out
+        if self.kind != ACTUATORS:
+            raise ValueError(f"unknown command kind {self.kind}")
+        out += struct.pack("<Q", len(self.inputs))
+        for i in self.inputs:
+            out += struct.pack("<IQ", i.effector_index, len(i.values)) + _pack_f(i.values)
+        return out
+
+    @staticmethod
+    def decode(buf: bytes) -> "CommandMsg":
+        _check_size_and_version(buf, COMMAND_NO_COMMAND_LEN)
+        if len(buf) < COMMAND_KIND_OFFSET + 4:
+            raise DecodeError("Length", needed=COMMAND_NO_COMMAND_LEN, actual=len(buf))
+        (tag,) = struct.unpack_from("<I", buf, COMMAND_KIND_OFFSET)
+        n = 0
+        if tag == WRENCH:
+            expected = COMMAND_WRENCH_LEN
+        elif tag == NO_COMMAND_KIND:
+            expected = COMMAND_NO_COMMAND_LEN
+        elif tag == ACTUATORS:
+            w = _Walker(buf, COMMAND_ACTUATORS_FIXED_LEN - 8)
+            n = w.count(MAX_EFFECTORS, "effector input")
+            for _ in range(n):
+                w.skip(4)
+                w.values("effector input values")
+            expected = w.at
+        else:
+            raise DecodeError("Malformed", detail=f"unknown enum tag {tag} at offset 34")
+        _check_total(expected, buf)
+        (sender,) = struct.unpack_from("<I", buf, 30)
+        m = CommandMsg(Header.unpack(buf), sender, tag)
+        if tag != NO_COMMAND_KIND:
+            m.torque_b_nm, m.force_b_newton = _f(buf, 38, 3), _f(buf, 62, 3)
+        if tag == ACTUATORS:
+            at = COMMAND_ACTUATORS_FIXED_LEN
+            for _ in range(n):
+                index, nv = struct.unpack_from("<IQ", buf, at)
+                m.inputs.append(EffectorInput(index, list(_f(buf, at + 12, nv))))
+                at += 12 + 8 * nv
+        m.validate()
+        return m
+
+
+@dataclass
+class StatusMsg:
+    """Server health (``flexdyn/<sc-id>/status``). ``wall_time_unix_ns`` is the only
+    non-deterministic field of the protocol."""
+
+    header: Header = field(default_factory=Header)
+    mode: int = MODE_REAL_TIME
+    run_state: int = 0
+    lateness_p50_ns: int = 0
+    lateness_p99_ns: int = 0
+    lateness_max_ns: int = 0
+    overrun_count: int = 0
+    frames_skipped: int = 0
+    last_command_tick: int = NO_COMMAND
+    command_age_ns: int = NO_COMMAND
+    command_stale: bool = False
+    stale_policy: int = STALE_POLICY_HOLD
+    rejected_malformed: int = 0
+    rejected_bad_version: int = 0
+    rejected_non_finite: int = 0
+    rejected_wrong_spacecraft: int = 0
+    rejected_stale_tick: int = 0
+    rejected_unknown_sender: int = 0
+    rejected_bad_effector_input: int = 0
+    commands_dropped: int = 0
+    wall_time_unix_ns: int = 0
+
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<II7QBI9Q")
+
+    def encode(self) -> bytes:
+        return self.header.encode() + self._BODY.pack(
+            self.mode, self.run_state, self.lateness_p50_ns, self.lateness_p99_ns,
+            self.lateness_max_ns, self.overrun_count, self.frames_skipped,
+            self.last_command_tick, self.command_age_ns, 1 if self.command_stale else 0,
+            self.stale_policy, self.rejected_malformed, self.rejected_bad_version,
+            self.rejected_non_finite, self.rejected_wrong_spacecraft, self.rejected_stale_tick,
+            self.rejected_unknown_sender, self.rejected_bad_effector_input,
+            self.commands_dropped, self.wall_time_unix_ns,
+        )
+
+    @staticmethod
+    def decode(buf: bytes) -> "StatusMsg":
+        _check_size_and_version(buf, STATUS_LEN)
+        _check_total(STATUS_LEN, buf)
+        f = StatusMsg._BODY.unpack_from(buf, HEADER_LEN)
+        if f[0] > MODE_BATCH:
+            raise DecodeError("Malformed", detail="mode tag")
+        if f[1] > 5:
+            raise DecodeError("Malformed", detail="run_state tag")
+        if f[9] > 1:
+            raise DecodeError("Malformed", detail="command_stale is not a bool")
+        if f[10] > STALE_POLICY_ZERO:
+            raise DecodeError("Malformed", detail="stale_policy tag")
+        return StatusMsg(Header.unpack(buf), *f[:9], f[9] == 1, *f[10:])
+
+
+# --------------------------------------------------------------------------------------------
+# Key expressions (proto/README.md, "Topics").
+
+def _valid_id(s: str) -> bool:
+    return 0 < len(s) <= 64 and all(c.isascii() and (c.isalnum() or c in "_-") for c in s)
+
+
+def _key(sc: str, suffix: str, name: Optional[str] = None) -> str:
+    if not _valid_id(sc):
+        raise ValueError(f"invalid spacecraft id {sc!r}: 1-64 characters from [A-Za-z0-9_-]")
+    if name is not None and not _valid_id(name):
+        raise ValueError(f"invalid name {name!r}: 1-64 characters from [A-Za-z0-9_-]")
+    return f"flexdyn/{sc}/{suffix}" + (f"/{name}" if name is not None else "")
+
+
+def state_key(sc: str) -> str:
+    return _key(sc, "tlm/state")
+
+
+def imu_key(sc: str, name: str) -> str:
+    return _key(sc, "tlm/imu", name)
+
+
+def star_tracker_key(sc: str, name: str) -> str:
+    return _key(sc, "tlm/st", name)
+
+
+def command_key(sc: str) -> str:
+    return _key(sc, "cmd/wrench")
+
+
+def status_key(sc: str) -> str:
+    return _key(sc, "status")
+
+
+def participant_key(sc: str, sender_id: int) -> str:
+    return _key(sc, "participant", str(sender_id))
