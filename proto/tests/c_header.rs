@@ -30,9 +30,14 @@ fn proto_dir() -> PathBuf {
 
 /// Compiles `proto/c/tests/<name>.c` into the test's temporary directory.
 fn compile(name: &str) -> PathBuf {
+    compile_file(&format!("tests/{name}.c"), name)
+}
+
+/// Compiles `proto/c/<rel>` into the test's temporary directory as `name`.
+fn compile_file(rel: &str, name: &str) -> PathBuf {
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".to_string());
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let src = proto_dir().join(format!("c/tests/{name}.c"));
+    let src = proto_dir().join("c").join(rel);
     let result = Command::new(&cc)
         .args([
             "-std=c99",
@@ -74,6 +79,35 @@ fn c_codec_matches_the_golden_vectors() {
     eprintln!("{text}{}", String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "test_golden failed");
     assert!(text.contains("all C golden checks passed"));
+}
+
+/// The C example control law (`proto/c/examples/pd_controller.c`) answers the golden StateMsg
+/// with the Wrench command L = −K σ − P ω (K = 100, P = 300) for its tick, which the Rust
+/// decoder accepts.
+#[test]
+fn c_pd_controller_example_answers_a_state() {
+    let exe = compile_file("examples/pd_controller.c", "pd_controller");
+    let golden = proto_dir().join("golden/state.bin");
+    let out = Command::new(&exe).arg(&golden).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let state = flexdyn_proto::decode_state(&std::fs::read(&golden).unwrap()).unwrap();
+    let cmd = flexdyn_proto::decode_command(&out.stdout).expect("a valid CommandMsg");
+    assert_eq!(cmd.header.tick, state.header.tick);
+    assert_eq!(cmd.header.spacecraft_id, state.header.spacecraft_id);
+    assert_eq!(cmd.sender_id, 1);
+    let want: [f64; 3] =
+        std::array::from_fn(|i| -100.0 * state.sigma_bn[i] - 300.0 * state.omega_bn_b_rad_s[i]);
+    assert_eq!(
+        cmd.kind,
+        CommandKind::Wrench {
+            torque_b_nm: want,
+            force_b_newton: [0.0; 3]
+        }
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
