@@ -43,6 +43,10 @@ class Client:
         self._subscribers: List[object] = []
         self._seq = 0
         self._lock = threading.Lock()
+        # Publishing happens on Zenoh callback threads (a participant's answers) as well as the
+        # caller's; this lock keeps a put and close() from overlapping.
+        self._pub_lock = threading.Lock()
+        self._closed = False
 
     # -- subscriptions ---------------------------------------------------------------------
 
@@ -87,7 +91,11 @@ class Client:
     def send(self, cmd: CommandMsg) -> None:
         """Publishes `cmd` as it is (checked finite first)."""
         cmd.validate()
-        self._command_pub.put(cmd.encode())
+        payload = cmd.encode()
+        with self._pub_lock:
+            if self._closed:
+                raise RuntimeError("flexdyn.Client is closed")
+            self._command_pub.put(payload)
 
     def send_wrench(self, sender_id: int, tick: int, sim_time_ns: int, torque_b_nm: Vec3,
                     force_b_newton: Vec3 = (0.0, 0.0, 0.0)) -> None:
@@ -111,7 +119,11 @@ class Client:
         for s in self._subscribers:
             s.undeclare()
         self._subscribers.clear()
-        self._command_pub.undeclare()
+        with self._pub_lock:
+            if self._closed:
+                return
+            self._closed = True
+            self._command_pub.undeclare()
         self.session.close()
 
     def __enter__(self) -> "Client":
