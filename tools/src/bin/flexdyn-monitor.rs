@@ -12,6 +12,8 @@
 //! - `gaps`: StateMsg sequence numbers missing in the interval (lost or dropped frames);
 //! - `latency_ms`: frame boundary (the sample's attachment) to receipt here, wall clock;
 //! - `flags`: `S` stale command, `Z` zeroed by policy, `N` no command yet;
+//! - `wheels`: with reaction wheels, each wheel's speed [rad/s] in effector order, marked `T`
+//!   when its motor torque is being clipped and `S` when it is held at its speed limit;
 //! - `rejected`: the server's rejected commands by reason (`stale_tick:2,unknown_sender:1`), and
 //!   `dropped` the valid commands it dropped for a full queue.
 
@@ -21,7 +23,10 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use clap::Parser;
 use flexdyn::transport::{frame_stamp_ns, mode_name};
-use flexdyn_proto::{command_flags, decode_state, decode_status, RunState, StatusMsg, NO_COMMAND};
+use flexdyn_proto::{
+    command_flags, decode_state, decode_status, effector_kind, wheel_flags, RunState, StatusMsg,
+    NO_COMMAND,
+};
 use flexdyn_tools::{percentile, CommonArgs};
 use zenoh::Wait;
 
@@ -50,6 +55,8 @@ struct Window {
     sigma_norm: f64,
     omega_norm: f64,
     flags: u8,
+    /// Reaction wheels of the latest state: (speed rad/s, flags).
+    wheels: Vec<(f64, u32)>,
     latencies_ns: Vec<u64>,
     undecodable: u64,
     status: Option<StatusMsg>,
@@ -108,6 +115,25 @@ fn flags_str(f: u8) -> String {
     s
 }
 
+/// `[100.0,-52.3T,600.0S]rad/s`: each wheel's speed with `T` (torque-limited) and `S`
+/// (speed-limited) marks.
+fn wheels_str(wheels: &[(f64, u32)]) -> String {
+    let parts: Vec<String> = wheels
+        .iter()
+        .map(|(omega, f)| {
+            let mut p = format!("{omega:.1}");
+            if f & wheel_flags::TORQUE_LIMITED != 0 {
+                p.push('T');
+            }
+            if f & wheel_flags::SPEED_LIMITED != 0 {
+                p.push('S');
+            }
+            p
+        })
+        .collect();
+    format!("[{}]rad/s", parts.join(","))
+}
+
 fn run_state_name(s: RunState) -> &'static str {
     match s {
         RunState::Starting => "starting",
@@ -147,6 +173,9 @@ fn line(w: &mut Window, interval: Duration, state_topic: &str) -> String {
                 ms(percentile(&lat, 0.5)),
                 ms(percentile(&lat, 0.99)),
             ));
+            if !w.wheels.is_empty() {
+                o.push_str(&format!(" wheels={}", wheels_str(&w.wheels)));
+            }
             o
         }
     };
@@ -231,6 +260,13 @@ fn run(args: Args) -> anyhow::Result<()> {
                     w.sigma_norm = norm(s.sigma_bn);
                     w.omega_norm = norm(s.omega_bn_b_rad_s);
                     w.flags = s.command_flags;
+                    w.wheels.clear();
+                    w.wheels.extend(
+                        s.effectors
+                            .iter()
+                            .filter(|e| e.kind == effector_kind::REACTION_WHEEL)
+                            .map(|e| (e.states.first().copied().unwrap_or(f64::NAN), e.flags)),
+                    );
                     w.last_state_at = Some(Instant::now());
                     if let Some(stamp) = frame_stamp_ns(&sample) {
                         w.latencies_ns.push(received.saturating_sub(stamp));
@@ -309,4 +345,22 @@ fn run(args: Args) -> anyhow::Result<()> {
         .wait()
         .map_err(|e| anyhow::anyhow!("closing the Zenoh session: {e}"))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wheel_summary_marks_the_limits() {
+        let w = [
+            (100.0, 0),
+            (-52.34, wheel_flags::TORQUE_LIMITED),
+            (
+                600.0,
+                wheel_flags::TORQUE_LIMITED | wheel_flags::SPEED_LIMITED,
+            ),
+        ];
+        assert_eq!(wheels_str(&w), "[100.0,-52.3T,600.0TS]rad/s");
+    }
 }
