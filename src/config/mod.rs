@@ -25,12 +25,11 @@ mod source_map;
 use std::collections::HashSet;
 use std::path::Path;
 
-use nalgebra::{Matrix3, Vector3};
 use toml::de::DeTable;
 
 use crate::numfmt::{Num, Rounded};
 use crate::schema::location;
-use crate::schema::TableReader;
+use crate::schema::{mat3, vec3, TableReader};
 pub use error::{At, ConfigError, Location};
 use flexdyn_proto::MAX_PANEL_PAIRS;
 use source_map::SourceMap;
@@ -400,14 +399,6 @@ impl RawConfig {
             star_trackers,
         })
     }
-}
-
-fn mat3(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {
-    Matrix3::from_fn(|i, j| rows[i][j])
-}
-
-fn vec3(v: &[f64; 3]) -> Vector3<f64> {
-    Vector3::new(v[0], v[1], v[2])
 }
 
 impl RawConfig {

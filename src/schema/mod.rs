@@ -11,6 +11,16 @@ mod reader;
 
 pub(crate) use reader::TableReader;
 
+/// A 3×3 matrix from the rows the reader returns (`TableReader::mat3`).
+pub(crate) fn mat3(rows: &[[f64; 3]; 3]) -> nalgebra::Matrix3<f64> {
+    nalgebra::Matrix3::from_fn(|i, j| rows[i][j])
+}
+
+/// A 3-vector from the array the reader returns (`TableReader::floats::<3>`).
+pub(crate) fn vec3(v: &[f64; 3]) -> nalgebra::Vector3<f64> {
+    nalgebra::Vector3::new(v[0], v[1], v[2])
+}
+
 /// A position in the configuration text (1-based line and column, in characters).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Location {

@@ -2,10 +2,8 @@
 //! terms. Keys are checked by the shared reader ([`crate::schema`]); values are validated by
 //! [`super::Imu::new`] and the configuration's magnitude bounds.
 
-use nalgebra::{Matrix3, Vector3};
-
 use super::{AccelErrors, GyroErrors, ImuConfig};
-use crate::schema::{SchemaError, TableReader};
+use crate::schema::{mat3, vec3, SchemaError, TableReader};
 
 /// The keys of one `[[imus]]` entry.
 pub(crate) const KEYS: [&str; 6] = ["name", "r_sb_b_m", "dcm_pb", "seed", "gyro", "accel"];
@@ -134,12 +132,4 @@ impl RawImu {
             },
         }
     }
-}
-
-fn mat3(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {
-    Matrix3::from_fn(|i, j| rows[i][j])
-}
-
-fn vec3(v: &[f64; 3]) -> Vector3<f64> {
-    Vector3::new(v[0], v[1], v[2])
 }

@@ -4,7 +4,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::schema::{SchemaError, TableReader};
+use crate::schema::{mat3, vec3, SchemaError, TableReader};
 
 /// The keys of one `[[star_trackers]]` entry (the first six are required).
 pub(crate) const KEYS: [&str; 11] = [
@@ -38,11 +38,10 @@ pub(crate) struct RawStarTracker {
 
 /// Reads one entry.
 pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawStarTracker, SchemaError> {
-    let v3 = |a: [f64; 3]| Vector3::new(a[0], a[1], a[2]);
-    let m = t.mat3("dcm_cb")?;
+    let v3 = |a: [f64; 3]| vec3(&a);
     Ok(RawStarTracker {
         name: t.string("name")?,
-        dcm_cb: Matrix3::from_fn(|i, j| m[i][j]),
+        dcm_cb: mat3(&t.mat3("dcm_cb")?),
         sigma_cross_boresight_rad: t.f64("sigma_cross_boresight_rad")?,
         sigma_about_boresight_rad: t.f64("sigma_about_boresight_rad")?,
         rate_hz: t.f64("rate_hz")?,

@@ -3,10 +3,8 @@
 //! Keys are checked by the shared reader ([`crate::schema`]); values are validated by
 //! [`super::PanelPair::new`], whose errors name the same TOML paths.
 
-use nalgebra::{Matrix3, Vector3};
-
 use super::{PanelPairInitial, PanelPairParams, PanelParams};
-use crate::schema::{SchemaError, TableReader};
+use crate::schema::{mat3, vec3, SchemaError, TableReader};
 
 /// The keys of one `[[panel_pairs]]` entry.
 pub(crate) const KEYS: [&str; 7] = [
@@ -116,12 +114,4 @@ impl RawPanelPair {
         };
         (params, initial)
     }
-}
-
-fn mat3(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {
-    Matrix3::from_fn(|i, j| rows[i][j])
-}
-
-fn vec3(v: &[f64; 3]) -> Vector3<f64> {
-    Vector3::new(v[0], v[1], v[2])
 }

@@ -2,11 +2,9 @@
 //! ([`crate::schema`]); values are validated by [`super::ReactionWheel::new`], whose errors name
 //! the same TOML paths.
 
-use nalgebra::Vector3;
-
 use super::params::DEFAULT_COULOMB_BAND_RAD_S;
 use super::ReactionWheelParams;
-use crate::schema::{SchemaError, TableReader};
+use crate::schema::{vec3, SchemaError, TableReader};
 
 /// The keys of one `[[reaction_wheels]]` entry (the first eight are required).
 pub(crate) const KEYS: [&str; 14] = [
@@ -28,7 +26,7 @@ pub(crate) const KEYS: [&str; 14] = [
 
 /// Reads one entry (shape only; [`ReactionWheelParams::validate`] checks the values).
 pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<ReactionWheelParams, SchemaError> {
-    let v3 = |a: [f64; 3]| Vector3::new(a[0], a[1], a[2]);
+    let v3 = |a: [f64; 3]| vec3(&a);
     let opt = |k: &str, default: f64| t.opt_f64(k).map(|v| v.unwrap_or(default));
     Ok(ReactionWheelParams {
         name: t.string("name")?,
