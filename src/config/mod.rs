@@ -679,16 +679,19 @@ fn check_wire_capacity(
             ),
         ));
     }
+    // Each effector's entry: the fixed part and 8 bytes per state and output, with the kinds'
+    // own state and output lists.
+    let entry = |states: usize, outputs: usize| EFFECTOR_STATE_FIXED_LEN + 8 * (states + outputs);
     let wheel_len = |w: &ReactionWheelParams| {
-        let states = if w.static_imbalance_kg_m > 0.0 || w.dynamic_imbalance_kg_m2 > 0.0 {
-            2
+        let states = if w.imbalanced() {
+            reaction_wheel::IMBALANCED_STATE_NAMES.len()
         } else {
-            1
+            reaction_wheel::BALANCED_STATE_NAMES.len()
         };
-        EFFECTOR_STATE_FIXED_LEN + 8 * (states + 2)
+        entry(states, reaction_wheel::OUTPUT_NAMES.len())
     };
     let bytes = STATE_FIXED_LEN
-        + n_pairs * (EFFECTOR_STATE_FIXED_LEN + 32)
+        + n_pairs * entry(panel_pair::STATE_NAMES.len(), 0)
         + wheels.iter().map(wheel_len).sum::<usize>();
     if bytes > MAX_MESSAGE_BYTES {
         return Err(map.invalid(
@@ -960,7 +963,7 @@ fn check_resolved_by_step(cfg: &SimConfig, map: &SourceMap) -> Result<(), Config
             "the Coulomb friction's linear-region rate tau_c / (band J_s)",
             w.coulomb_friction_nm / (w.coulomb_band_rad_s * w.j_s_kg_m2),
         )?;
-        if w.static_imbalance_kg_m > 0.0 || w.dynamic_imbalance_kg_m2 > 0.0 {
+        if w.imbalanced() {
             // The jitter rotates at the wheel speed: the step must resolve it.
             too_fast(
                 &format!("{path}.max_speed_rad_s"),

@@ -109,6 +109,8 @@ pub struct ReactionWheel {
     /// [N·m] motor torque applied over the current step, and the limit flags that produced it.
     applied_nm: f64,
     flags: u32,
+    /// [N·m] u + τ_f at the state of the current evaluation, from pass 2 for pass 3.
+    spin_torque_nm: f64,
 }
 
 impl ReactionWheel {
@@ -138,9 +140,10 @@ impl ReactionWheel {
             inertia_w_b,
             inertia_pnt_b_b,
             matrix_d: -ggt * params.j_s_kg_m2,
-            imbalanced: params.static_imbalance_kg_m > 0.0 || params.dynamic_imbalance_kg_m2 > 0.0,
+            imbalanced: params.imbalanced(),
             commanded_nm: 0.0,
             applied_nm: 0.0,
+            spin_torque_nm: 0.0,
             flags: 0,
             params,
         })
@@ -285,6 +288,7 @@ impl StateEffector for ReactionWheel {
         // (W4)
         let omega = x[OMEGA];
         let spin_torque = self.applied_nm + self.friction_nm(omega);
+        self.spin_torque_nm = spin_torque;
         sum.matrix_d += self.matrix_d;
         sum.vec_rot -= self.g_s * spin_torque
             + hub
@@ -300,11 +304,11 @@ impl StateEffector for ReactionWheel {
 
     fn compute_derivatives(&mut self, x: &[f64], hub_accel: &HubAccel, dx: &mut [f64]) {
         // (W3)
-        let omega = x[OMEGA];
-        let spin_torque = self.applied_nm + self.friction_nm(omega);
-        dx[OMEGA] = spin_torque / self.params.j_s_kg_m2 - self.g_s.dot(&hub_accel.omega_dot_bn_b);
+        // u + τ_f as pass 2 computed it at this same x.
+        dx[OMEGA] =
+            self.spin_torque_nm / self.params.j_s_kg_m2 - self.g_s.dot(&hub_accel.omega_dot_bn_b);
         if self.imbalanced {
-            dx[ANGLE] = omega;
+            dx[ANGLE] = x[OMEGA];
         }
     }
 

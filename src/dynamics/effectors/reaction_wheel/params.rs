@@ -77,6 +77,12 @@ impl ReactionWheelParams {
         }
     }
 
+    /// Whether the wheel has a static or dynamic imbalance (then it also integrates its angle
+    /// and applies the jitter of (W6)–(W7)).
+    pub fn imbalanced(&self) -> bool {
+        self.static_imbalance_kg_m > 0.0 || self.dynamic_imbalance_kg_m2 > 0.0
+    }
+
     /// Validates the wheel (`path` is e.g. `reaction_wheels[0]`).
     pub fn validate(&self, path: &str) -> Result<(), ParamError> {
         check_finite(path, "spin_axis_b", self.spin_axis_b.as_slice())?;
