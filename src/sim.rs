@@ -300,34 +300,6 @@ impl Simulation {
         Ok(())
     }
 
-    /// Sets the inputs of effector `index` only (its [`crate::dynamics::StateEffector::input_len`]
-    /// values), keeping the others'.
-    pub fn set_effector_input(&mut self, index: usize, values: &[f64]) -> Result<(), ParamError> {
-        let r =
-            self.sc
-                .effector_input_ranges()
-                .get(index)
-                .cloned()
-                .ok_or(ParamError::InputLength {
-                    expected: 0,
-                    found: values.len(),
-                })?;
-        if r.len() != values.len() {
-            return Err(ParamError::InputLength {
-                expected: r.len(),
-                found: values.len(),
-            });
-        }
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(ParamError::NotFinite {
-                field: format!("effector {index} input {i}"),
-            });
-        }
-        self.inputs[r].copy_from_slice(values);
-        self.frame_outputs = None;
-        self.sc.set_effector_inputs(&self.inputs)
-    }
-
     /// The commanded effector inputs, flat.
     pub fn effector_inputs(&self) -> &[f64] {
         &self.inputs

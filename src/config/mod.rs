@@ -556,12 +556,7 @@ impl RawConfig {
             let path = format!("imus[{i}]");
             let imu = raw.into_config();
             imu.validate(&path).map_err(|e| map.imu_error(e))?;
-            if !imu_names.insert(imu.name.clone()) {
-                return Err(map.invalid(
-                    &format!("{path}.name"),
-                    format!("duplicate IMU name `{}` (names must be unique)", imu.name),
-                ));
-            }
+            unique_name(map, &path, &imu.name, &mut imu_names, "IMU")?;
             imus.push(imu);
         }
 

@@ -290,6 +290,14 @@ pub struct Spacecraft {
 }
 
 impl EquationsOfMotion {
+    /// Runs [`StateEffector::begin_step`] at state `x` on the effectors that use it.
+    #[inline]
+    fn begin_step(&mut self, x: &State) {
+        for &i in &self.stepped {
+            self.effectors[i].begin_step(&x.effectors[self.ranges[i].clone()]);
+        }
+    }
+
     /// Evaluates the state derivative `dx` at state `x` with the current wrench and returns the hub
     /// accelerations (Eqs. 145–153 with the effector passes around them).
     #[inline(always)]
@@ -589,10 +597,7 @@ impl Spacecraft {
 
     /// Runs every effector's [`StateEffector::begin_step`] at the current state.
     fn begin_step(&mut self) {
-        let Self { eom, state, .. } = self;
-        for &i in &eom.stepped {
-            eom.effectors[i].begin_step(&state.effectors[eom.ranges[i].clone()]);
-        }
+        self.eom.begin_step(&self.state);
     }
 
     /// The hub parameters.
@@ -624,9 +629,7 @@ impl Spacecraft {
     /// of a step), and returns the hub accelerations. This is the equation-of-motion function RK4
     /// integrates: it allocates nothing and cannot fail.
     pub fn derivatives(&mut self, x: &State, dx: &mut State) -> HubOutputs {
-        for &i in &self.eom.stepped {
-            self.eom.effectors[i].begin_step(&x.effectors[self.eom.ranges[i].clone()]);
-        }
+        self.eom.begin_step(x);
         self.eom.eval(x, dx)
     }
 
