@@ -761,67 +761,60 @@ fn check_body_extent(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError
     // 200:1 panel-to-hub ratio).
     let hub_m = cfg.hub.mass_kg;
     let hub_i_min = cfg.hub.inertia_bc_b_kg_m2.symmetric_eigenvalues().min();
-    for (i, (p, _)) in cfg.panel_pairs.iter().enumerate() {
-        for (which, panel) in [("panel1", &p.panel1), ("panel2", &p.panel2)] {
-            let path = format!("panel_pairs[{i}].{which}");
-            let ratio = (panel.mass_kg / hub_m).max(hub_m / panel.mass_kg);
-            if ratio > MAX_MASS_RATIO {
-                return Err(map.invalid(
-                    &format!("{path}.mass_kg"),
-                    format!(
-                        "{} kg against a {} kg hub is a mass ratio of {}; flexdyn accepts at \
-                         most {} either way (the hub solve would lose its precision)",
-                        Num(panel.mass_kg),
-                        Num(hub_m),
-                        Rounded(ratio, 3),
-                        Num(MAX_MASS_RATIO)
-                    ),
-                ));
-            }
-            let i_max = panel.inertia_s_kg_m2.max();
-            if i_max > MAX_MASS_RATIO * hub_i_min {
-                return Err(map.invalid(
-                    &format!("{path}.inertia_s_kg_m2"),
-                    format!(
-                        "a principal moment of {} kg·m² is more than {} times the hub's \
-                         smallest principal moment ({} kg·m²)",
-                        Num(i_max),
-                        Num(MAX_MASS_RATIO),
-                        Rounded(hub_i_min, 6)
-                    ),
-                ));
-            }
-        }
-    }
-    for (i, w) in cfg.reaction_wheels.iter().enumerate() {
-        let path = format!("reaction_wheels[{i}]");
-        let ratio = (w.mass_kg / hub_m).max(hub_m / w.mass_kg);
+    // A body of mass `mass_kg` whose largest moment `i_max` is called `moment` in messages.
+    let check = |path: &str,
+                 mass_kg: f64,
+                 inertia_field: &str,
+                 i_max: f64,
+                 moment: &str|
+     -> Result<(), ConfigError> {
+        let ratio = (mass_kg / hub_m).max(hub_m / mass_kg);
         if ratio > MAX_MASS_RATIO {
             return Err(map.invalid(
                 &format!("{path}.mass_kg"),
                 format!(
                     "{} kg against a {} kg hub is a mass ratio of {}; flexdyn accepts at most {} \
                      either way (the hub solve would lose its precision)",
-                    Num(w.mass_kg),
+                    Num(mass_kg),
                     Num(hub_m),
                     Rounded(ratio, 3),
                     Num(MAX_MASS_RATIO)
                 ),
             ));
         }
-        let i_max = w.j_s_kg_m2.max(w.j_t_kg_m2);
         if i_max > MAX_MASS_RATIO * hub_i_min {
             return Err(map.invalid(
-                &format!("{path}.j_s_kg_m2"),
+                &format!("{path}.{inertia_field}"),
                 format!(
-                    "a rotor moment of {} kg·m² is more than {} times the hub's smallest \
-                     principal moment ({} kg·m²)",
+                    "a {moment} of {} kg·m² is more than {} times the hub's smallest principal \
+                     moment ({} kg·m²)",
                     Num(i_max),
                     Num(MAX_MASS_RATIO),
                     Rounded(hub_i_min, 6)
                 ),
             ));
         }
+        Ok(())
+    };
+    for (i, (p, _)) in cfg.panel_pairs.iter().enumerate() {
+        for (which, panel) in [("panel1", &p.panel1), ("panel2", &p.panel2)] {
+            check(
+                &format!("panel_pairs[{i}].{which}"),
+                panel.mass_kg,
+                "inertia_s_kg_m2",
+                panel.inertia_s_kg_m2.max(),
+                "principal moment",
+            )?;
+        }
+    }
+    for (i, w) in cfg.reaction_wheels.iter().enumerate() {
+        check(
+            &format!("reaction_wheels[{i}]"),
+            w.mass_kg,
+            "j_s_kg_m2",
+            w.j_s_kg_m2.max(w.j_t_kg_m2),
+            "rotor moment",
+        )?;
     }
     Ok(())
 }
