@@ -414,6 +414,33 @@ pub enum RunState {
     Stopped,
 }
 
+impl Mode {
+    /// The wire tag (the u32 LE variant index).
+    pub const fn tag(self) -> u32 {
+        self as u32
+    }
+}
+
+impl RunState {
+    /// The wire tag (the u32 LE variant index).
+    pub const fn tag(self) -> u32 {
+        self as u32
+    }
+
+    /// The state of wire tag `tag`, `None` for an unknown tag.
+    pub const fn from_tag(tag: u32) -> Option<Self> {
+        match tag {
+            0 => Some(Self::Starting),
+            1 => Some(Self::Running),
+            2 => Some(Self::Stopping),
+            3 => Some(Self::Finished),
+            4 => Some(Self::Failed),
+            5 => Some(Self::Stopped),
+            _ => None,
+        }
+    }
+}
+
 /// What the server applies when the latest command is stale. Wire: u32 LE tag.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum StalePolicy {
@@ -422,6 +449,13 @@ pub enum StalePolicy {
     Hold,
     /// Tag 1: apply zero wrench.
     Zero,
+}
+
+impl StalePolicy {
+    /// The wire tag (the u32 LE variant index).
+    pub const fn tag(self) -> u32 {
+        self as u32
+    }
 }
 
 /// Frame-timing statistics since the run started. 40 bytes.

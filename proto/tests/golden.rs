@@ -860,6 +860,7 @@ fn enum_tags() {
             t,
             "{m:?}"
         );
+        assert_eq!(m.tag(), t, "{m:?}.tag()");
     }
     for (r, t) in [
         (RunState::Starting, 0),
@@ -874,13 +875,16 @@ fn enum_tags() {
             t,
             "{r:?}"
         );
+        assert_eq!((r.tag(), RunState::from_tag(t)), (t, Some(r)), "{r:?} tag");
     }
+    assert_eq!(RunState::from_tag(6), None);
     for (p, t) in [(StalePolicy::Hold, 0), (StalePolicy::Zero, 1)] {
         assert_eq!(
             tag_at(&status(Mode::RealTime, RunState::Starting, p), 95),
             t,
             "{p:?}"
         );
+        assert_eq!(p.tag(), t, "{p:?}.tag()");
     }
 }
 

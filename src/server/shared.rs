@@ -193,26 +193,13 @@ impl Shared {
 
     /// Sets the life-cycle state.
     pub fn set_run_state(&self, s: RunState) {
-        let tag = match s {
-            RunState::Starting => 0,
-            RunState::Running => 1,
-            RunState::Stopping => 2,
-            RunState::Finished => 3,
-            RunState::Failed => 4,
-            RunState::Stopped => 5,
-        };
-        self.run_state.store(tag, Ordering::Release);
+        // Every tag fits a u8 (six states).
+        self.run_state.store(s.tag() as u8, Ordering::Release);
     }
 
     /// The life-cycle state.
     pub fn run_state(&self) -> RunState {
-        match self.run_state.load(Ordering::Acquire) {
-            0 => RunState::Starting,
-            1 => RunState::Running,
-            2 => RunState::Stopping,
-            3 => RunState::Finished,
-            5 => RunState::Stopped,
-            _ => RunState::Failed,
-        }
+        RunState::from_tag(self.run_state.load(Ordering::Acquire).into())
+            .unwrap_or(RunState::Failed)
     }
 }

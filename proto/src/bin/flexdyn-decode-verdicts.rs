@@ -14,8 +14,7 @@ use std::io::{Read, Write};
 
 use flexdyn_proto::{
     decode_command, decode_header, decode_imu, decode_star_tracker, decode_state, decode_status,
-    CommandKind, CommandMsg, DecodeError, Header, ImuMsg, Mode, RunState, StalePolicy,
-    StarTrackerMsg, StateMsg, StatusMsg,
+    CommandKind, CommandMsg, DecodeError, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg,
 };
 
 fn err_line(e: &DecodeError) -> String {
@@ -136,32 +135,12 @@ fn command_line(m: &CommandMsg) -> String {
     l.0
 }
 
-fn tag(m: Mode) -> u64 {
-    match m {
-        Mode::RealTime => 0,
-        Mode::Lockstep => 1,
-        Mode::Batch => 2,
-    }
-}
-
 fn status_line(m: &StatusMsg) -> String {
-    let run = match m.run_state {
-        RunState::Starting => 0,
-        RunState::Running => 1,
-        RunState::Stopping => 2,
-        RunState::Finished => 3,
-        RunState::Failed => 4,
-        RunState::Stopped => 5,
-    };
-    let policy = match m.command.stale_policy {
-        StalePolicy::Hold => 0,
-        StalePolicy::Zero => 1,
-    };
     let r = &m.rejected;
     let mut l = Line::new();
     l.h(&m.header)
-        .u(tag(m.mode))
-        .u(run)
+        .u(m.mode.tag().into())
+        .u(m.run_state.tag().into())
         .u(m.timing.lateness_p50_ns)
         .u(m.timing.lateness_p99_ns)
         .u(m.timing.lateness_max_ns)
@@ -170,7 +149,7 @@ fn status_line(m: &StatusMsg) -> String {
         .u(m.command.last_command_tick)
         .u(m.command.command_age_ns)
         .u(m.command.command_stale.into())
-        .u(policy)
+        .u(m.command.stale_policy.tag().into())
         .u(r.malformed)
         .u(r.bad_version)
         .u(r.non_finite)
