@@ -311,12 +311,15 @@ pub async fn run(
         CongestionControl::Block
     };
     let express = mode != Mode::Batch;
-    let state_pub = session
-        .declare_publisher(topics.state().to_owned())
-        .congestion_control(congestion)
-        .express(express)
-        .await
-        .map_err(|e| ServerError::zenoh("declare the state publisher", e))?;
+    // The state and every sensor topic are declared alike.
+    let telemetry_pub = |key: String, what: &'static str| {
+        let declared = session
+            .declare_publisher(key)
+            .congestion_control(congestion)
+            .express(express);
+        async move { declared.await.map_err(|e| ServerError::zenoh(what, e)) }
+    };
+    let state_pub = telemetry_pub(topics.state().to_owned(), "declare the state publisher").await?;
     let status_pub = session
         .declare_publisher(topics.status().to_owned())
         .congestion_control(congestion)
@@ -329,14 +332,7 @@ pub async fn run(
             name: format!("imus[{i}].name"),
             problem: e.to_string(),
         })?;
-        imu_pubs.push(
-            session
-                .declare_publisher(key)
-                .congestion_control(congestion)
-                .express(express)
-                .await
-                .map_err(|e| ServerError::zenoh("declare an IMU publisher", e))?,
-        );
+        imu_pubs.push(telemetry_pub(key, "declare an IMU publisher").await?);
     }
 
     let mut st_pubs = Vec::with_capacity(sim.star_trackers().len());
@@ -348,12 +344,7 @@ pub async fn run(
                 problem: e.to_string(),
             })?;
         st_pubs.push((
-            session
-                .declare_publisher(key)
-                .congestion_control(congestion)
-                .express(express)
-                .await
-                .map_err(|e| ServerError::zenoh("declare a star-tracker publisher", e))?,
+            telemetry_pub(key, "declare a star-tracker publisher").await?,
             st.config().every_frames,
         ));
     }
