@@ -603,27 +603,23 @@ static inline fd_error fd_decode_command(const uint8_t *buf, size_t len, fd_comm
     out->n_inputs = 0;
     memset(out->torque_b_nm, 0, sizeof out->torque_b_nm);
     memset(out->force_b_newton, 0, sizeof out->force_b_newton);
-    if (tag != FD_COMMAND_NO_COMMAND) {
-        fd_get_f64s(buf + 38, out->torque_b_nm, 3);
-        fd_get_f64s(buf + 62, out->force_b_newton, 3);
-    }
+    if (tag == FD_COMMAND_NO_COMMAND) return fd_ok();
+    fd_get_f64s(buf + 38, out->torque_b_nm, 3);
+    fd_get_f64s(buf + 62, out->force_b_newton, 3);
+    /* Rule 5 in order: torque and force (no inputs stored yet), then the input values, read
+     * from the buffer so the order holds even when they will not fit the caller's array. */
+    if ((e = fd_validate_command(out, len)).status != FD_OK) return e;
     if (tag == FD_COMMAND_ACTUATORS) {
         size_t at = FD_COMMAND_ACTUATORS_FIXED_LEN;
-        if (n > out->inputs_capacity) {
-            /* Validate what can be validated (Rust checks finiteness before any capacity). */
-            fd_command_msg probe = *out;
-            probe.n_inputs = 0;
-            e = fd_validate_command(&probe, len);
-            if (e.status != FD_OK) return e;
-            for (i = 0; i < n; ++i) {
-                uint64_t v = fd_get_u64(buf + at + 4), j;
-                for (j = 0; j < v; ++j)
-                    if (!fd_is_finite(fd_get_f64(buf + at + 12 + 8 * j)))
-                        return fd_fail(FD_ERR_NON_FINITE, 0, len, "kind.inputs[].values[]");
-                at += 12 + 8 * (size_t)v;
-            }
-            return fd_fail(FD_ERR_CAPACITY, (size_t)n, len, "inputs");
+        for (i = 0; i < n; ++i) {
+            uint64_t v = fd_get_u64(buf + at + 4), j;
+            for (j = 0; j < v; ++j)
+                if (!fd_is_finite(fd_get_f64(buf + at + 12 + 8 * j)))
+                    return fd_fail(FD_ERR_NON_FINITE, 0, len, "kind.inputs[].values[]");
+            at += 12 + 8 * (size_t)v;
         }
+        if (n > out->inputs_capacity) return fd_fail(FD_ERR_CAPACITY, (size_t)n, len, "inputs");
+        at = FD_COMMAND_ACTUATORS_FIXED_LEN;
         for (i = 0; i < n; ++i) {
             fd_effector_input *in = &out->inputs[i];
             in->effector_index = fd_get_u32(buf + at);
@@ -633,7 +629,7 @@ static inline fd_error fd_decode_command(const uint8_t *buf, size_t len, fd_comm
         }
         out->n_inputs = n;
     }
-    return fd_validate_command(out, len);
+    return fd_ok();
 }
 
 /* Encodes `m` (any kind); returns the length, 0 for an unknown kind, a count above its
