@@ -8,6 +8,7 @@
 //! - [`logging`]: the stderr log setup shared by `flexdyn` and the tools (EPIPE-safe).
 //! - [`transport`]: the one Zenoh configuration builder (loopback, multicast scouting off),
 //!   shared by the server and the tools.
+//! - [`sinks`]: recording (MCAP), replay, export, the live Foxglove view and plots.
 //! - [`server`]: the Zenoh server (`flexdyn run`): real-time, lockstep and batch propagation.
 
 #![warn(missing_docs)]
@@ -21,5 +22,7 @@ pub mod numfmt;
 pub mod schema;
 pub mod sensors;
 pub mod server;
+pub mod signals;
 pub mod sim;
+pub mod sinks;
 pub mod transport;

@@ -11,6 +11,7 @@ use flexdyn::cli::{self, CliError, SimulateArgs};
 use flexdyn::config::DEFAULT_CONFIG_TOML;
 use flexdyn::logging::print_error;
 use flexdyn::server::cli::{run_from_args, RunArgs};
+use flexdyn::sinks::{self, SinkError};
 
 /// Real-time flight-software-in-the-loop spacecraft dynamics: rigid hub + dual-hinged panels.
 ///
@@ -46,6 +47,26 @@ enum Command {
     },
     /// Print the embedded default configuration (scenarios/reference.toml) verbatim.
     PrintDefaultConfig,
+    /// Record every sample of flexdyn/<sc-id>/** (all vehicles by default) to an MCAP file.
+    Record(sinks::record_cmd::RecordArgs),
+    /// Republish a recording's raw channels to Zenoh with the recorded spacing.
+    Replay(sinks::replay::ReplayArgs),
+    /// Write one CSV per topic of a recording.
+    Export(sinks::export::ExportArgs),
+}
+
+/// Runs a sink subcommand and prints its one-line summary on stderr.
+fn run_sink<T>(result: Result<T, SinkError>, summary: impl FnOnce(&T) -> String) -> ExitCode {
+    match result {
+        Ok(r) => {
+            let _ = writeln!(std::io::stderr(), "{}", summary(&r));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            print_error(&e);
+            ExitCode::from(e.exit_code())
+        }
+    }
 }
 
 fn print_default_config() -> Result<(), CliError> {
@@ -90,6 +111,38 @@ fn main() -> ExitCode {
                 })
         }),
         Some(Command::PrintDefaultConfig) => print_default_config(),
+        Some(Command::Record(a)) => {
+            return run_sink(sinks::record_cmd::record(&a), |r| {
+                format!(
+                    "recorded {} samples ({} payload bytes, {} undecodable) to {}; dropped {}",
+                    r.stats.samples,
+                    r.stats.payload_bytes,
+                    r.stats.undecodable,
+                    a.output.display(),
+                    r.dropped
+                )
+            })
+        }
+        Some(Command::Replay(a)) => {
+            return run_sink(sinks::replay::replay(&a), |r| {
+                format!(
+                    "replayed {} samples in {:.3} s{}",
+                    r.published,
+                    r.wall_s,
+                    r.truncated
+                        .as_ref()
+                        .map_or(String::new(), |why| format!(" (file ends early: {why})"))
+                )
+            })
+        }
+        Some(Command::Export(a)) => {
+            return run_sink(sinks::export::export(&a), |r| {
+                r.iter()
+                    .map(|(p, n)| format!("{}: {n} rows", p.display()))
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            })
+        }
         Some(Command::Run(a)) => return run_server(&a),
         // No subcommand: `flexdyn run` with the options given.
         None => return run_server(&args.run),

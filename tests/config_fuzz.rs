@@ -117,7 +117,7 @@ fn extreme(rng: &mut ChaCha8Rng) -> Value {
         f64::MIN_POSITIVE,
         3.5,
     ];
-    if rng.next_u64() % 5 == 0 {
+    if rng.next_u64().is_multiple_of(5) {
         Value::Integer(*pick(rng, &[i64::MAX, i64::MIN, -1, 0, 1 << 40]))
     } else {
         Value::Float(*pick(rng, &floats))
@@ -161,7 +161,7 @@ fn edit(doc: &mut Value, rng: &mut ChaCha8Rng) -> String {
         (2, _, p) => {
             let target = get_mut(p, last).unwrap();
             match target {
-                Value::Array(a) if !a.is_empty() && rng.next_u64() % 2 == 0 => {
+                Value::Array(a) if !a.is_empty() && rng.next_u64().is_multiple_of(2) => {
                     a.pop();
                     format!("truncate {path:?}")
                 }

@@ -17,6 +17,9 @@ pub const STAR_TRACKER_PREFIX: &str = "tlm/st";
 pub const CMD_WRENCH_SUFFIX: &str = "cmd/wrench";
 /// Suffix of the status topic.
 pub const STATUS_SUFFIX: &str = "status";
+/// Suffix of the server's configuration queryable (a `get` returns a UTF-8 JSON description
+/// of the vehicle: its configuration TOML and the server settings). Not a bincode message.
+pub const CONFIG_SUFFIX: &str = "config";
 /// Prefix of the lockstep-participant liveliness tokens; the decimal sender id
 /// follows after a `/` (`flexdyn/<sc>/participant/<sender_id>`).
 pub const PARTICIPANT_PREFIX: &str = "participant";
@@ -164,6 +167,16 @@ impl Topics {
     /// `flexdyn/<sc>/tlm/st/<name>`
     pub fn star_tracker(&self, name: &str) -> Result<String, KeyError> {
         star_tracker_key(&self.sc_id, name)
+    }
+
+    /// `flexdyn/<sc>/config` (the server's configuration queryable).
+    pub fn config(&self) -> String {
+        format!("{KEY_ROOT}/{}/{CONFIG_SUFFIX}", self.sc_id)
+    }
+
+    /// `flexdyn/<sc>/**`: every key of this spacecraft.
+    pub fn all(&self) -> String {
+        format!("{KEY_ROOT}/{}/**", self.sc_id)
     }
 
     /// `flexdyn/<sc>/tlm/imu/*`

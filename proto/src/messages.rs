@@ -21,6 +21,7 @@ use crate::PROTOCOL_VERSION;
 ///
 /// All fields are deterministic (no wall clock).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct Header {
     /// Wire protocol version, always [`PROTOCOL_VERSION`] when sent. Decoders check
     /// it (first two bytes, u16 LE) before anything else.
@@ -86,6 +87,7 @@ pub mod wheel_flags {
 /// u32 LE `flags`, u64 LE count + f64 `states`, u64 LE count + f64 `outputs`:
 /// 22 + 8·(states + outputs) bytes.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct EffectorState {
     /// Model tag, see [`effector_kind`]. Receivers skip kinds they do not know.
     pub kind: u16,
@@ -102,6 +104,7 @@ pub struct EffectorState {
 /// Inputs for one effector in a [`CommandKind::Actuators`] command. On the wire: u32 LE
 /// `effector_index`, u64 LE count, f64 `values`: 12 + 8·values bytes.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct EffectorInput {
     /// Index of the effector in [`StateMsg::effectors`].
     pub effector_index: u32,
@@ -113,6 +116,7 @@ pub struct EffectorInput {
 /// Conserved quantities (for verification: constant when no external wrench
 /// acts and the panels have no damping). 64 bytes on the wire.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct Conserved {
     /// Total orbital energy (J).
     pub orb_energy_j: f64,
@@ -128,6 +132,7 @@ pub struct Conserved {
 /// External wrench held constant over a frame, body components about point B.
 /// 48 bytes on the wire (torque first, like [`CommandKind::Wrench`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct AppliedWrench {
     /// Torque about B, B components (N·m).
     pub torque_b_nm: [f64; 3],
@@ -179,6 +184,7 @@ pub mod saturation_flags {
 /// clock). 327 bytes + each [`EffectorState`]; `effectors` is last on the wire so
 /// every other field sits at a fixed offset.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct StateMsg {
     /// Common header; `tick` is the frame this state belongs to.
     pub header: Header,
@@ -238,6 +244,7 @@ impl Default for StateMsg {
 ///
 /// All vectors are in the IMU platform frame P.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct ImuMsg {
     /// Common header; `tick` is the frame at whose end the sample was taken.
     pub header: Header,
@@ -255,6 +262,7 @@ pub struct ImuMsg {
 
 /// A star-tracker measurement, topic `flexdyn/<sc-id>/tlm/st/<name>`. 64 bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct StarTrackerMsg {
     /// Common header; `tick` is the frame at whose end the measurement was taken.
     pub header: Header,
@@ -283,6 +291,7 @@ impl Default for StarTrackerMsg {
 /// What a [`CommandMsg`] asks for. Wire: u32 LE variant index (0 = `Wrench`,
 /// 1 = `NoCommand`, 2 = `Actuators`), then the variant's fields.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum CommandKind {
     /// Tag 0: hold this wrench, body components about B, over the frame
     /// starting at `header.tick`. 48 bytes follow the tag.
@@ -325,6 +334,7 @@ impl Default for CommandKind {
 /// Decoding rejects NaN/infinite torque, force or input values with
 /// [`crate::DecodeError::NonFinite`].
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct CommandMsg {
     /// Common header: `tick` is the tick the command applies to (in lockstep the
     /// tick of the state it answers), `seq` the sender's own sequence number.
@@ -385,6 +395,7 @@ impl CommandMsg {
 
 /// How the server paces frames. Wire: u32 LE tag.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum Mode {
     /// Tag 0: frames paced by the wall clock.
     #[default]
@@ -397,6 +408,7 @@ pub enum Mode {
 
 /// Server life cycle. Wire: u32 LE tag.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum RunState {
     /// Tag 0: initialising, not stepping yet.
     #[default]
@@ -443,6 +455,7 @@ impl RunState {
 
 /// What the server applies when the latest command is stale. Wire: u32 LE tag.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum StalePolicy {
     /// Tag 0: keep applying the last commanded wrench.
     #[default]
@@ -460,6 +473,7 @@ impl StalePolicy {
 
 /// Frame-timing statistics since the run started. 40 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct FrameTiming {
     /// Median frame-start lateness versus the wall-clock schedule (ns; early
     /// starts count as 0).
@@ -480,6 +494,7 @@ pub const NO_COMMAND: u64 = u64::MAX;
 
 /// Command bookkeeping. 21 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct CommandStatus {
     /// `header.tick` of the last accepted command, [`NO_COMMAND`] if none yet.
     pub last_command_tick: u64,
@@ -495,6 +510,7 @@ pub struct CommandStatus {
 
 /// Rejected-command counters by reason, cumulative since start. 56 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct RejectCounters {
     /// Undecodable: wrong length, trailing bytes, oversize, bad enum tag or bool.
     pub malformed: u64,
@@ -547,6 +563,7 @@ impl RejectCounters {
 
 /// Server health, topic `flexdyn/<sc-id>/status`. 171 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct StatusMsg {
     /// Common header; `tick` is the last frame stepped, `seq` counts status messages.
     pub header: Header,

@@ -74,6 +74,11 @@ pub struct RunArgs {
     /// Command queue capacity [default: 1024].
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub command_queue: Option<i64>,
+    /// Record the server's output (state, sensors, status, commands received) to this MCAP
+    /// file. Lockstep and batch record every sample; real time drops (and counts) what the
+    /// recorder cannot keep up with rather than delay the frame.
+    #[arg(long, value_name = "FILE.mcap")]
+    pub record: Option<PathBuf>,
     /// Zenoh endpoints and configuration file.
     #[command(flatten)]
     pub zenoh: ZenohArgs,
@@ -119,6 +124,7 @@ impl RunArgs {
         for (key, value) in self.overrides() {
             settings.apply(key, &value, Origin::Cli)?;
         }
+        settings.record.clone_from(&self.record);
         settings.validate()?;
         Ok(settings)
     }
@@ -136,34 +142,11 @@ impl RunArgs {
     }
 }
 
-/// Completes on the first SIGINT or SIGTERM (Ctrl-C only on non-Unix platforms).
+/// [`crate::signals::shutdown_signal`], its failure as a [`ServerError::Signal`].
 async fn shutdown_signal() -> Result<impl std::future::Future<Output = ()>, ServerError> {
-    #[cfg(unix)]
-    {
-        use tokio::signal::unix::{signal, SignalKind};
-        let mut int = signal(SignalKind::interrupt()).map_err(|source| ServerError::Signal {
-            signal: "SIGINT",
-            source,
-        })?;
-        let mut term = signal(SignalKind::terminate()).map_err(|source| ServerError::Signal {
-            signal: "SIGTERM",
-            source,
-        })?;
-        Ok(async move {
-            let which = tokio::select! {
-                _ = int.recv() => "SIGINT",
-                _ = term.recv() => "SIGTERM",
-            };
-            tracing::info!(signal = which, "shutdown signal received");
-        })
-    }
-    #[cfg(not(unix))]
-    {
-        Ok(async {
-            let _ = tokio::signal::ctrl_c().await;
-            tracing::info!("Ctrl-C received");
-        })
-    }
+    crate::signals::shutdown_signal()
+        .await
+        .map_err(|(signal, source)| ServerError::Signal { signal, source })
 }
 
 /// `flexdyn run`: builds the settings and the Zenoh configuration, starts a tokio runtime, opens

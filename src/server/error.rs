@@ -116,6 +116,9 @@ pub enum ServerError {
         /// The first non-finite quantity, by its CSV column name.
         quantity: String,
     },
+    /// `--record`: the recording could not be created or written.
+    #[error(transparent)]
+    Record(#[from] crate::sinks::mcap_file::RecordError),
     /// A thread of the server could not be started or panicked.
     #[error("internal error: {0}")]
     Internal(String),

@@ -49,7 +49,7 @@ use flexdyn_proto::{
 use tokio::sync::{oneshot, Notify};
 use zenoh::qos::CongestionControl;
 use zenoh::sample::SampleKind;
-use zenoh::Session;
+use zenoh::{Session, Wait};
 
 pub use crate::transport::frame_stamp_ns;
 pub use crate::transport::{zenoh_config, Role, ZenohArgs, DEFAULT_ENDPOINT};
@@ -58,9 +58,14 @@ pub use settings::{mode_name, OverrunPolicy, ServerSettings};
 
 use crate::config::SimConfig;
 use crate::sim::Simulation;
+use crate::sinks::mcap_file::{flexdyn_version, git_commit, RecordingInfo, VehicleInfo};
+use crate::sinks::recorder::{RecordItem, RecordReport, RecordTx, Recorder};
 use physics::{Ending, PhysicsCtx};
 use shared::{Frame, Shared};
 use telemetry::{timing_of, TelemetryCtx};
+
+/// Samples the `--record` queue holds before real time drops (lockstep waits instead).
+pub const RECORD_QUEUE: usize = 65_536;
 
 /// How a run ended without error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -94,6 +99,8 @@ pub struct RunReport {
     pub commands_dropped: u64,
     /// \[s\] wall time from the first frame to the end.
     pub wall_s: f64,
+    /// `--record`: what the recording holds and what the recorder dropped.
+    pub recording: Option<RecordReport>,
 }
 
 impl fmt::Display for RunReport {
@@ -120,7 +127,15 @@ impl fmt::Display for RunReport {
             self.timing.frames_skipped,
             self.rejected.total(),
             self.commands_dropped,
-        )
+        )?;
+        if let Some(r) = &self.recording {
+            write!(
+                f,
+                " recorded_samples={} record_dropped={}",
+                r.stats.samples, r.dropped
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -149,6 +164,7 @@ fn command_callback(
     shared: Arc<Shared>,
     spacecraft_id: u32,
     participants: Vec<u32>,
+    record: Option<(RecordTx, Arc<str>)>,
 ) -> impl Fn(zenoh::sample::Sample) + Send + Sync + 'static {
     let tx = Mutex::new(tx);
     let log = Mutex::new(reject_log::RejectLog::default());
@@ -159,6 +175,14 @@ fn command_callback(
     };
     move |sample| {
         let bytes = sample.payload().to_bytes();
+        // Every command that arrives is recorded, accepted or not: the file shows what was sent.
+        if let Some((rec, key)) = &record {
+            rec.submit(RecordItem {
+                key: key.clone(),
+                payload: bytes.to_vec(),
+                publish_time_ns: crate::transport::frame_stamp_ns(&sample),
+            });
+        }
         let cmd = match decode_command(&bytes) {
             Ok(cmd) => cmd,
             Err(e) => {
@@ -349,6 +373,46 @@ pub async fn run(
         ));
     }
 
+    // What this server runs, for recordings and for the `flexdyn/<sc>/config` queryable.
+    let vehicle = VehicleInfo {
+        sc_id: settings.sc_id.clone(),
+        spacecraft_id: settings.spacecraft_id,
+        config_toml: cfg.source_toml.clone(),
+        server_settings: settings.summary(),
+        flexdyn_version: flexdyn_version().to_owned(),
+        git_commit: git_commit().map(str::to_owned),
+    };
+    let vehicle_json = serde_json::to_string(&vehicle)
+        .map_err(|e| ServerError::Internal(format!("vehicle description: {e}")))?;
+    let _config_queryable = session
+        .declare_queryable(topics.config())
+        .callback(move |query| {
+            let key = query.key_expr().clone();
+            if let Err(e) = query.reply(key, vehicle_json.clone()).wait() {
+                tracing::debug!(error = %e, "cannot answer a configuration query");
+            }
+        })
+        .await
+        .map_err(|e| ServerError::zenoh("declare the configuration queryable", e))?;
+
+    // `--record`: the recorder thread, fed by the telemetry thread and the command callback.
+    // Real time drops (and counts) what it cannot keep up with; lockstep and batch wait for it.
+    let recorder = match &settings.record {
+        Some(path) => {
+            let info = RecordingInfo {
+                recorder: "flexdyn run --record".into(),
+                command_line: std::env::args().collect::<Vec<_>>().join(" "),
+            };
+            let (recorder, tx) =
+                Recorder::start(path, &info, RECORD_QUEUE, mode != Mode::RealTime)?;
+            tx.describe_vehicle(vehicle.clone());
+            tracing::info!(file = %path.display(), "recording to MCAP");
+            Some((recorder, tx))
+        }
+        None => None,
+    };
+    let record_tx = recorder.as_ref().map(|(_, tx)| tx.clone());
+
     let shared = Arc::new(Shared::new(&settings.participants));
     shared.set_run_state(RunState::Starting);
     let (cmd_tx, cmd_rx) = sync_channel(settings.command_queue);
@@ -376,6 +440,9 @@ pub async fn run(
             shared.clone(),
             settings.spacecraft_id,
             settings.participants.clone(),
+            record_tx
+                .clone()
+                .map(|tx| (tx, Arc::<str>::from(topics.cmd_wrench()))),
         ))
         .await
         .map_err(|e| ServerError::zenoh("declare the command subscriber", e))?;
@@ -438,6 +505,7 @@ pub async fn run(
         shared: shared.clone(),
         settings: settings.clone(),
         frame_ns: cfg.frame_ns,
+        record: record_tx,
     };
     let (tlm_done_tx, tlm_done_rx) = oneshot::channel();
     std::thread::Builder::new()
@@ -459,6 +527,10 @@ pub async fn run(
             });
             drop(full_tx);
             let _ = tlm_done_rx.await;
+            drop(_cmd_sub);
+            if let Some((recorder, tx)) = recorder {
+                recorder.finish(&tx)?;
+            }
             ready?;
             return Ok(RunReport {
                 mode,
@@ -471,6 +543,7 @@ pub async fn run(
                 rejected: shared.rejected(),
                 commands_dropped: 0,
                 wall_s: 0.0,
+                recording: None,
             });
         }
     }
@@ -521,6 +594,12 @@ pub async fn run(
         .await
         .map_err(|_| ServerError::Internal("the telemetry thread panicked".into()))?;
 
+    // Commands stop arriving, then the recorder writes what it holds and closes the file.
+    drop(_cmd_sub);
+    let recording = match recorder {
+        Some((recorder, tx)) => Some(recorder.finish(&tx)?),
+        None => None,
+    };
     let phys = physics_result?;
     let report = RunReport {
         mode,
@@ -546,6 +625,7 @@ pub async fn run(
             .commands_dropped
             .load(std::sync::atomic::Ordering::Relaxed),
         wall_s,
+        recording,
     };
     tracing::info!("{report}");
     Ok(report)

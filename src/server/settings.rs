@@ -112,6 +112,9 @@ pub struct ServerSettings {
     pub telemetry_buffers: usize,
     /// Capacity of the command queue from the I/O side to the physics thread (default 1024).
     pub command_queue: usize,
+    /// `flexdyn run --record FILE.mcap`: record the server's own output (state, sensors, status,
+    /// and every command received) to this file. Command line only (not a `[server]` key).
+    pub record: Option<std::path::PathBuf>,
 }
 
 impl Default for ServerSettings {
@@ -134,6 +137,7 @@ impl Default for ServerSettings {
             realtime_priority: 0,
             telemetry_buffers: 8,
             command_queue: 1024,
+            record: None,
         }
     }
 }
@@ -414,7 +418,7 @@ impl ServerSettings {
             "mode={} sc_id={} spacecraft_id={} participants={:?} participant_timeout_s={} \
              presence_timeout_s={} duration_s={} overrun_policy={} overrun_limit={} \
              stale_after_s={} stale_policy={} status_hz={} summary_interval_s={} spin_us={} \
-             realtime_priority={} telemetry_buffers={} command_queue={}",
+             realtime_priority={} telemetry_buffers={} command_queue={} record={}",
             mode_name(self.mode),
             self.sc_id,
             self.spacecraft_id,
@@ -433,6 +437,9 @@ impl ServerSettings {
             self.realtime_priority,
             self.telemetry_buffers,
             self.command_queue,
+            self.record
+                .as_ref()
+                .map_or("off".to_owned(), |p| p.display().to_string()),
         )
     }
 }

@@ -20,6 +20,7 @@ use super::commands::Held;
 use super::reject_log::RejectLog;
 use super::settings::{mode_name, ServerSettings};
 use super::shared::{Frame, Shared};
+use crate::sinks::recorder::{RecordItem, RecordTx};
 
 /// Largest lateness the histogram resolves (larger values are clamped): 1 hour in ns.
 const LATENESS_MAX_NS: u64 = 3_600_000_000_000;
@@ -79,6 +80,28 @@ pub struct TelemetryCtx {
     pub settings: ServerSettings,
     /// \[ns\] frame period.
     pub frame_ns: u64,
+    /// The recorder's queue (`flexdyn run --record`): every payload published here is also
+    /// queued for it.
+    pub record: Option<RecordTx>,
+}
+
+/// The recorder's queue and the keys it files payloads under.
+struct Recording {
+    tx: RecordTx,
+    state: Arc<str>,
+    status: Arc<str>,
+    imus: Vec<Arc<str>>,
+    sts: Vec<Arc<str>>,
+}
+
+impl Recording {
+    fn submit(&self, key: &Arc<str>, payload: &[u8], stamp_ns: Option<u64>) {
+        self.tx.submit(RecordItem {
+            key: key.clone(),
+            payload: payload.to_vec(),
+            publish_time_ns: stamp_ns,
+        });
+    }
 }
 
 fn unix_now_ns() -> u64 {
@@ -96,7 +119,18 @@ struct Publishing {
 }
 
 impl TelemetryCtx {
-    fn publish_status(&self, p: &mut Publishing, buf: &mut Vec<u8>) {
+    fn recording(&self) -> Option<Recording> {
+        let key = |p: &Publisher<'static>| -> Arc<str> { p.key_expr().as_str().into() };
+        self.record.as_ref().map(|tx| Recording {
+            tx: tx.clone(),
+            state: key(&self.state_pub),
+            status: key(&self.status_pub),
+            imus: self.imu_pubs.iter().map(key).collect(),
+            sts: self.st_pubs.iter().map(|(p, _)| key(p)).collect(),
+        })
+    }
+
+    fn publish_status(&self, p: &mut Publishing, buf: &mut Vec<u8>, rec: Option<&Recording>) {
         let tick = self.shared.tick.load(Ordering::Relaxed);
         let msg = StatusMsg {
             header: Header::new(
@@ -119,6 +153,9 @@ impl TelemetryCtx {
         };
         p.status_seq += 1;
         encode_into(&msg, buf);
+        if let Some(r) = rec {
+            r.submit(&r.status, buf, None);
+        }
         if let Err(e) = self.status_pub.put(buf.as_slice()).wait() {
             p.publish_errors += 1;
             tracing::warn!(error = %e, "cannot publish status");
@@ -192,6 +229,7 @@ impl TelemetryCtx {
     /// Runs until the physics thread drops its end of the channel, then publishes a final
     /// status.
     pub fn run(self) -> TelemetryReport {
+        let rec = self.recording();
         let realtime = self.settings.mode == Mode::RealTime;
         let status_period = self.settings.status_period();
         let summary_period = self.settings.summary_interval;
@@ -216,7 +254,7 @@ impl TelemetryCtx {
             let now = Instant::now();
             if now >= next_status {
                 self.warn_physics_rejects(&mut rejects, &mut stale_seen, &mut bad_inputs_seen);
-                self.publish_status(&mut p, &mut status_buf);
+                self.publish_status(&mut p, &mut status_buf, rec.as_ref());
                 next_status += status_period;
                 if next_status < now {
                     next_status = now + status_period;
@@ -243,8 +281,12 @@ impl TelemetryCtx {
                     encode_into(&frame.state, &mut state_buf);
                     let stamp = frame.boundary_unix_ns.to_le_bytes();
                     let header = frame.state.header;
-                    for (sample, publisher) in frame.imu.iter().zip(&self.imu_pubs) {
+                    for (i, (sample, publisher)) in frame.imu.iter().zip(&self.imu_pubs).enumerate()
+                    {
                         encode_into(&sample.to_msg(header), &mut imu_buf);
+                        if let Some(r) = &rec {
+                            r.submit(&r.imus[i], &imu_buf, Some(frame.boundary_unix_ns));
+                        }
                         if let Err(e) = publisher.put(imu_buf.as_slice()).attachment(stamp).wait() {
                             p.publish_errors += 1;
                             if p.publish_errors.is_power_of_two() {
@@ -262,6 +304,9 @@ impl TelemetryCtx {
                             ..header
                         };
                         encode_into(&sample.to_msg(h), &mut imu_buf);
+                        if let Some(r) = &rec {
+                            r.submit(&r.sts[*i], &imu_buf, Some(frame.boundary_unix_ns));
+                        }
                         if let Err(e) = publisher.put(imu_buf.as_slice()).attachment(stamp).wait() {
                             p.publish_errors += 1;
                             if p.publish_errors.is_power_of_two() {
@@ -269,6 +314,7 @@ impl TelemetryCtx {
                             }
                         }
                     }
+                    let boundary_unix_ns = frame.boundary_unix_ns;
                     // Return the buffer before the state goes out, so the physics thread has it.
                     let _ = self.free_tx.send(frame);
                     match self
@@ -285,6 +331,10 @@ impl TelemetryCtx {
                             }
                         }
                     }
+                    // Queued for the recorder after the state is out: the subscriber first.
+                    if let Some(r) = &rec {
+                        r.submit(&r.state, &state_buf, Some(boundary_unix_ns));
+                    }
                     window_frames += 1;
                 }
                 Err(RecvTimeoutError::Timeout) => {}
@@ -292,7 +342,7 @@ impl TelemetryCtx {
             }
         }
         self.warn_physics_rejects(&mut rejects, &mut stale_seen, &mut bad_inputs_seen);
-        self.publish_status(&mut p, &mut status_buf);
+        self.publish_status(&mut p, &mut status_buf, rec.as_ref());
         TelemetryReport {
             lateness: p.lateness,
             published: p.published,

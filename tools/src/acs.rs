@@ -175,7 +175,7 @@ impl StarTrackerAttitude {
 
     /// Whether a measurement is due at `tick`.
     pub fn due(&self, tick: u64) -> bool {
-        tick % self.every_frames == 0
+        tick.is_multiple_of(self.every_frames)
     }
 
     /// The estimate after this frame: a valid measurement replaces it; otherwise it is

@@ -4,3 +4,68 @@
 
 pub mod panel_pair;
 pub mod reaction_wheel;
+
+use super::EffectorKind;
+
+/// How a tool that only has the telemetry names an effector's values: its kind (CSV prefix),
+/// state names and output names, from the wire tag and the value counts of an
+/// [`flexdyn_proto::EffectorState`]. `None` for a kind this build does not know, or counts that
+/// do not match the kind (then the values have no names here).
+pub fn wire_names(
+    kind: u16,
+    n_states: usize,
+    n_outputs: usize,
+) -> Option<(
+    EffectorKind,
+    &'static [&'static str],
+    &'static [&'static str],
+)> {
+    let (k, states, outputs): (
+        EffectorKind,
+        &'static [&'static str],
+        &'static [&'static str],
+    ) = if kind == panel_pair::KIND.wire_tag {
+        (panel_pair::KIND, &panel_pair::STATE_NAMES, &[])
+    } else if kind == reaction_wheel::KIND.wire_tag {
+        let states: &'static [&'static str] = if n_states == 1 {
+            &reaction_wheel::BALANCED_STATE_NAMES
+        } else {
+            &reaction_wheel::IMBALANCED_STATE_NAMES
+        };
+        (reaction_wheel::KIND, states, &reaction_wheel::OUTPUT_NAMES)
+    } else {
+        return None;
+    };
+    (states.len() == n_states && outputs.len() == n_outputs).then_some((k, states, outputs))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+    use crate::dynamics::StateEffector;
+
+    #[test]
+    fn wire_names_match_what_each_built_effector_says() {
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/wheels_star_tracker.toml"
+        ))
+        .unwrap();
+        let sc = SimConfig::from_toml_str(&text)
+            .unwrap()
+            .build_spacecraft()
+            .unwrap();
+        let effectors: &[Box<dyn StateEffector>] = sc.effectors();
+        assert!(effectors.len() >= 3);
+        for e in effectors {
+            let (kind, states, outputs) =
+                wire_names(e.kind().wire_tag, e.state_len(), e.output_names().len()).unwrap();
+            assert_eq!(kind.column_prefix, e.kind().column_prefix);
+            assert_eq!(states, e.state_names());
+            assert_eq!(outputs, e.output_names());
+        }
+        assert!(wire_names(999, 1, 0).is_none());
+        assert!(wire_names(panel_pair::KIND.wire_tag, 3, 0).is_none());
+    }
+}

@@ -182,7 +182,7 @@ impl StarTracker {
 
     /// Whether the tracker updates at frame boundary `tick`.
     pub fn due(&self, tick: u64) -> bool {
-        tick % self.cfg.every_frames == 0
+        tick.is_multiple_of(self.cfg.every_frames)
     }
 
     /// The cross-boresight axes (ê₁, ê₂) in C, for tests that project errors on them.

@@ -291,7 +291,7 @@ impl GyroFeedback {
             }
             (None, Some(prev)) => {
                 self.missed += 1;
-                if self.missed == 1 || self.missed % 100 == 0 {
+                if self.missed == 1 || self.missed.is_multiple_of(100) {
                     tracing::warn!(
                         imu = %self.key,
                         tick,

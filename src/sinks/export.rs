@@ -1,0 +1,105 @@
+//! `flexdyn export FILE.mcap --csv DIR`: one CSV per recorded flexdyn topic, named after its key
+//! (`flexdyn/sc1/tlm/state` → `DIR/flexdyn_sc1_tlm_state.csv`), with the column names of
+//! [`super::table`]. A column a row does not have (an effector input one command sets and
+//! another does not) is left empty.
+
+use std::collections::{BTreeMap, HashMap};
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use super::error::SinkError;
+use super::reader::read_recording;
+use super::table::row;
+use super::topics::{classify, Decoded};
+
+/// Arguments of `flexdyn export`.
+#[derive(Clone, Debug, PartialEq, clap::Args)]
+pub struct ExportArgs {
+    /// The recording.
+    #[arg(value_name = "FILE.mcap")]
+    pub file: PathBuf,
+    /// Directory for the CSV files (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub csv: PathBuf,
+}
+
+/// What an export wrote: CSV path → rows.
+pub type ExportReport = BTreeMap<PathBuf, u64>;
+
+fn out_err(path: &Path, e: impl std::fmt::Display) -> SinkError {
+    SinkError::Output {
+        path: path.to_owned(),
+        problem: e.to_string(),
+    }
+}
+
+/// Exports `args.file` into `args.csv`.
+pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
+    let rec = read_recording(&args.file)?;
+    if let Some(why) = &rec.truncated {
+        tracing::warn!(file = %args.file.display(), reason = %why, "the recording ends early (not closed cleanly); exporting what it holds");
+    }
+    std::fs::create_dir_all(&args.csv).map_err(|e| out_err(&args.csv, e))?;
+    // Pass 1: each topic's columns, in first-seen order.
+    let mut columns: BTreeMap<String, (Vec<String>, HashMap<String, usize>)> = BTreeMap::new();
+    let mut undecodable = 0u64;
+    for s in &rec.samples {
+        let Some(topic) = classify(&s.key) else {
+            continue;
+        };
+        let Ok(d) = Decoded::decode(topic.kind, &s.payload) else {
+            undecodable += 1;
+            continue;
+        };
+        let (names, index) = columns.entry(s.key.clone()).or_default();
+        for (name, _) in row(&d) {
+            if !index.contains_key(&name) {
+                index.insert(name.clone(), names.len());
+                names.push(name);
+            }
+        }
+    }
+    if undecodable > 0 {
+        tracing::warn!(
+            undecodable,
+            "samples that do not decode were left out of the CSV files"
+        );
+    }
+    // Pass 2: rows.
+    let mut writers = BTreeMap::new();
+    let mut report = ExportReport::new();
+    for (key, (names, _)) in &columns {
+        let path = args.csv.join(format!("{}.csv", key.replace('/', "_")));
+        let f = std::fs::File::create(&path).map_err(|e| out_err(&path, e))?;
+        let mut w = BufWriter::new(f);
+        writeln!(w, "{}", names.join(",")).map_err(|e| out_err(&path, e))?;
+        writers.insert(key.clone(), (path.clone(), w));
+        report.insert(path, 0);
+    }
+    let mut cells: Vec<String> = Vec::new();
+    for s in &rec.samples {
+        let (Some(topic), Some((names, index))) = (classify(&s.key), columns.get(&s.key)) else {
+            continue;
+        };
+        let Ok(d) = Decoded::decode(topic.kind, &s.payload) else {
+            continue;
+        };
+        cells.clear();
+        cells.resize(names.len(), String::new());
+        for (name, cell) in row(&d) {
+            if let Some(i) = index.get(&name) {
+                cells[*i] = cell.to_string();
+            }
+        }
+        if let Some((path, w)) = writers.get_mut(&s.key) {
+            writeln!(w, "{}", cells.join(",")).map_err(|e| out_err(path, e))?;
+            if let Some(n) = report.get_mut(path) {
+                *n += 1;
+            }
+        }
+    }
+    for (_, (path, mut w)) in writers {
+        w.flush().map_err(|e| out_err(&path, e))?;
+    }
+    Ok(report)
+}

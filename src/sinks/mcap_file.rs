@@ -1,0 +1,438 @@
+//! The MCAP recording format of flexdyn: one writer shared by `flexdyn run --record` and
+//! `flexdyn record`.
+//!
+//! # Channels
+//! - **Raw**: topic = the Zenoh key (`flexdyn/sc1/tlm/state`), `message_encoding`
+//!   [`RAW_ENCODING`], schema `flexdyn.<Message>` with encoding [`RAW_SCHEMA_ENCODING`] whose data
+//!   is the message's wire layout from `proto/README.md` and the protocol version. The payload is
+//!   the exact wire bytes, so a recording can be hashed and replayed bit for bit.
+//! - **Decoded**: topic = key + [`DECODED_SUFFIX`], `message_encoding` `json`, schema
+//!   `flexdyn.<Message>` (`jsonschema`, derived from the wire structs): readable by any MCAP tool.
+//! - **3D**: `flexdyn/<sc>/tf` (`foxglove.FrameTransforms`) for every state and
+//!   `flexdyn/<sc>/scene` (`foxglove.SceneUpdate`) once per vehicle, when the vehicle's
+//!   configuration is known ([`VehicleInfo`]).
+//!
+//! Log time is the message's simulation time (`header.sim_time_ns`); publish time is the
+//! wall-clock stamp of the sample (its Zenoh attachment, or StatusMsg's `wall_time_unix_ns`, or
+//! the time it was received). Chunks are zstd-compressed and flushed at least once a second,
+//! so after a crash everything up to the last finished chunk can still be read; a clean stop
+//! writes the summary section and indexes.
+
+use std::collections::{BTreeMap, HashMap};
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::scene::Geometry;
+use super::scene::{frame_transforms, frame_transforms_schema, scene_update, scene_update_schema};
+use super::topics::{classify, json_schema, wire_layout_text, Decoded, TopicKind};
+use crate::config::SimConfig;
+
+/// `message_encoding` of the raw channels.
+pub const RAW_ENCODING: &str = "flexdyn-proto";
+/// Schema encoding of the raw channels: the schema data is the layout text.
+pub const RAW_SCHEMA_ENCODING: &str = "flexdyn-proto-layout";
+/// Suffix of a decoded channel's topic.
+pub const DECODED_SUFFIX: &str = "/json";
+/// Uncompressed bytes per chunk (Foxglove's own default is of this order).
+pub const CHUNK_SIZE_BYTES: u64 = 1 << 20;
+
+/// The flexdyn build that wrote a file.
+pub fn flexdyn_version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+/// The git commit flexdyn was built from, when the build saw a git checkout.
+pub fn git_commit() -> Option<&'static str> {
+    option_env!("FLEXDYN_GIT_COMMIT").filter(|s| !s.is_empty())
+}
+
+/// What a server says about the vehicle it runs: written into a recording's metadata, and the
+/// reply of the server's `flexdyn/<sc-id>/config` queryable.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VehicleInfo {
+    /// The string spacecraft id of the keys.
+    pub sc_id: String,
+    /// The numeric spacecraft id of the headers.
+    pub spacecraft_id: u32,
+    /// The configuration's TOML text, verbatim.
+    pub config_toml: String,
+    /// The server settings in effect (file and command line), as `key=value` pairs.
+    pub server_settings: String,
+    /// The server's flexdyn version.
+    pub flexdyn_version: String,
+    /// The server's git commit, when known.
+    pub git_commit: Option<String>,
+}
+
+/// Who is recording, for the file's `flexdyn` metadata record.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordingInfo {
+    /// `flexdyn run --record` or `flexdyn record`.
+    pub recorder: String,
+    /// The command line, for a reader to see how the file was made.
+    pub command_line: String,
+}
+
+/// An error of the recorder.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RecordError {
+    /// The file cannot be created.
+    #[error("cannot create the recording {}: {source}", path.display())]
+    Create {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Writing the file failed (disk full, …).
+    #[error("cannot write the recording {}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The MCAP writer's error.
+        #[source]
+        source: mcap::McapError,
+    },
+}
+
+/// What a recording holds, at the end.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SinkStats {
+    /// Samples given to the writer.
+    pub samples: u64,
+    /// Their payload bytes.
+    pub payload_bytes: u64,
+    /// Samples on keys that carry no flexdyn message (recorded raw only, untyped).
+    pub unknown_keys: u64,
+    /// Samples whose payload did not decode (recorded raw only).
+    pub undecodable: u64,
+    /// MCAP messages written (raw, decoded, transforms and scenes).
+    pub mcap_messages: u64,
+}
+
+struct ChannelIds {
+    kind: Option<TopicKind>,
+    sc_id: String,
+    raw: u16,
+    decoded: Option<u16>,
+}
+
+#[derive(Default)]
+struct Vehicle {
+    geometry: Option<Geometry>,
+    tf: Option<u16>,
+    scene_written: bool,
+}
+
+/// The MCAP writer with flexdyn's channel layout.
+pub struct McapSink {
+    path: PathBuf,
+    writer: mcap::Writer<BufWriter<File>>,
+    schemas: HashMap<String, u16>,
+    channels: HashMap<String, ChannelIds>,
+    vehicles: HashMap<String, Vehicle>,
+    sequences: HashMap<u16, u32>,
+    last_log_time_ns: u64,
+    stats: SinkStats,
+}
+
+impl McapSink {
+    /// Creates `path` and writes the `flexdyn` metadata record.
+    pub fn create(path: &Path, info: &RecordingInfo) -> Result<Self, RecordError> {
+        let file = File::create(path).map_err(|source| RecordError::Create {
+            path: path.to_owned(),
+            source,
+        })?;
+        let writer = mcap::WriteOptions::new()
+            .compression(Some(mcap::Compression::Zstd))
+            .chunk_size(Some(CHUNK_SIZE_BYTES))
+            .profile("")
+            .library(format!("flexdyn {}", flexdyn_version()))
+            .create(BufWriter::new(file))
+            .map_err(|source| RecordError::Write {
+                path: path.to_owned(),
+                source,
+            })?;
+        let mut sink = Self {
+            path: path.to_owned(),
+            writer,
+            schemas: HashMap::new(),
+            channels: HashMap::new(),
+            vehicles: HashMap::new(),
+            sequences: HashMap::new(),
+            last_log_time_ns: 0,
+            stats: SinkStats::default(),
+        };
+        let mut meta = BTreeMap::new();
+        meta.insert("recorder".to_owned(), info.recorder.clone());
+        meta.insert("command_line".to_owned(), info.command_line.clone());
+        meta.insert("flexdyn_version".to_owned(), flexdyn_version().to_owned());
+        meta.insert(
+            "git_commit".to_owned(),
+            git_commit().unwrap_or("unknown").to_owned(),
+        );
+        meta.insert(
+            "protocol_version".to_owned(),
+            flexdyn_proto::PROTOCOL_VERSION.to_string(),
+        );
+        sink.metadata("flexdyn", meta)?;
+        Ok(sink)
+    }
+
+    fn err(&self, source: mcap::McapError) -> RecordError {
+        RecordError::Write {
+            path: self.path.clone(),
+            source,
+        }
+    }
+
+    fn metadata(
+        &mut self,
+        name: &str,
+        metadata: BTreeMap<String, String>,
+    ) -> Result<(), RecordError> {
+        let m = mcap::records::Metadata {
+            name: name.to_owned(),
+            metadata,
+        };
+        self.writer.write_metadata(&m).map_err(|e| self.err(e))
+    }
+
+    /// Records `info` as the metadata record `flexdyn/<sc-id>` and, when its configuration
+    /// parses, starts the vehicle's transform and scene channels.
+    pub fn describe_vehicle(&mut self, info: &VehicleInfo) -> Result<(), RecordError> {
+        let mut meta = BTreeMap::new();
+        meta.insert("sc_id".to_owned(), info.sc_id.clone());
+        meta.insert("spacecraft_id".to_owned(), info.spacecraft_id.to_string());
+        meta.insert("config_toml".to_owned(), info.config_toml.clone());
+        meta.insert("server_settings".to_owned(), info.server_settings.clone());
+        meta.insert("flexdyn_version".to_owned(), info.flexdyn_version.clone());
+        meta.insert(
+            "git_commit".to_owned(),
+            info.git_commit
+                .clone()
+                .unwrap_or_else(|| "unknown".to_owned()),
+        );
+        self.metadata(&format!("flexdyn/{}", info.sc_id), meta)?;
+        let geometry = match SimConfig::from_toml_str(&info.config_toml) {
+            Ok(cfg) => Some(Geometry::from_config(&cfg)),
+            Err(e) => {
+                tracing::warn!(sc_id = %info.sc_id, error = %e, "the vehicle's configuration does not parse here; recording without its 3D transforms");
+                None
+            }
+        };
+        self.vehicles
+            .entry(info.sc_id.clone())
+            .or_default()
+            .geometry = geometry;
+        Ok(())
+    }
+
+    fn schema(
+        &mut self,
+        name: &str,
+        encoding: &str,
+        data: &dyn Fn() -> Vec<u8>,
+    ) -> Result<u16, RecordError> {
+        let key = format!("{encoding}\u{0}{name}");
+        if let Some(id) = self.schemas.get(&key) {
+            return Ok(*id);
+        }
+        let id = self
+            .writer
+            .add_schema(name, encoding, &data())
+            .map_err(|e| self.err(e))?;
+        self.schemas.insert(key, id);
+        Ok(id)
+    }
+
+    fn channel(&mut self, schema: u16, topic: &str, encoding: &str) -> Result<u16, RecordError> {
+        self.writer
+            .add_channel(schema, topic, encoding, &BTreeMap::new())
+            .map_err(|e| self.err(e))
+    }
+
+    fn open_channels(&mut self, key: &str) -> Result<(), RecordError> {
+        if self.channels.contains_key(key) {
+            return Ok(());
+        }
+        let ids = match classify(key) {
+            Some(topic) => {
+                let kind = topic.kind;
+                let name = format!("flexdyn.{}", kind.message_name());
+                let raw_schema = self.schema(&name, RAW_SCHEMA_ENCODING, &|| {
+                    wire_layout_text(kind).into_bytes()
+                })?;
+                let json_schema_id = self.schema(&name, "jsonschema", &|| {
+                    json_schema(kind).to_string().into_bytes()
+                })?;
+                let raw = self.channel(raw_schema, key, RAW_ENCODING)?;
+                let decoded =
+                    self.channel(json_schema_id, &format!("{key}{DECODED_SUFFIX}"), "json")?;
+                ChannelIds {
+                    kind: Some(kind),
+                    sc_id: topic.sc_id.to_owned(),
+                    raw,
+                    decoded: Some(decoded),
+                }
+            }
+            // Another application's key under the subscription: kept, untyped (schema id 0).
+            None => ChannelIds {
+                kind: None,
+                sc_id: String::new(),
+                raw: self.channel(0, key, "application/octet-stream")?,
+                decoded: None,
+            },
+        };
+        self.channels.insert(key.to_owned(), ids);
+        Ok(())
+    }
+
+    fn put(
+        &mut self,
+        channel: u16,
+        log_time: u64,
+        publish_time: u64,
+        data: &[u8],
+    ) -> Result<(), RecordError> {
+        let seq = self.sequences.entry(channel).or_insert(0);
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: *seq,
+            log_time,
+            publish_time,
+        };
+        *seq = seq.wrapping_add(1);
+        self.stats.mcap_messages += 1;
+        self.writer
+            .write_to_known_channel(&header, data)
+            .map_err(|e| self.err(e))
+    }
+
+    fn vehicle_channels(&mut self, sc_id: &str, t_ns: u64) -> Result<Option<u16>, RecordError> {
+        let Some(v) = self.vehicles.get(sc_id) else {
+            return Ok(None);
+        };
+        let Some(geometry) = v.geometry.clone() else {
+            return Ok(None);
+        };
+        if let Some(tf) = v.tf {
+            return Ok(Some(tf));
+        }
+        let tf_schema = self.schema("foxglove.FrameTransforms", "jsonschema", &|| {
+            frame_transforms_schema().to_string().into_bytes()
+        })?;
+        let scene_schema = self.schema("foxglove.SceneUpdate", "jsonschema", &|| {
+            scene_update_schema().to_string().into_bytes()
+        })?;
+        let tf = self.channel(tf_schema, &format!("flexdyn/{sc_id}/tf"), "json")?;
+        let scene = self.channel(scene_schema, &format!("flexdyn/{sc_id}/scene"), "json")?;
+        let prefix = format!("{sc_id}/");
+        let scene_json = scene_update(&geometry, &prefix, t_ns).to_string();
+        self.put(scene, t_ns, t_ns, scene_json.as_bytes())?;
+        if let Some(v) = self.vehicles.get_mut(sc_id) {
+            v.tf = Some(tf);
+            v.scene_written = true;
+        }
+        Ok(Some(tf))
+    }
+
+    /// Records one sample: its raw channel always, its decoded channel when it decodes, and the
+    /// vehicle's transforms for a StateMsg. `publish_time_ns` is the sample's wall-clock stamp
+    /// (the Zenoh attachment), `received_unix_ns` the time it reached the recorder.
+    pub fn write(
+        &mut self,
+        key: &str,
+        payload: &[u8],
+        publish_time_ns: Option<u64>,
+        received_unix_ns: u64,
+    ) -> Result<(), RecordError> {
+        self.stats.samples += 1;
+        self.stats.payload_bytes += payload.len() as u64;
+        self.open_channels(key)?;
+        let Some(ids) = self.channels.get(key) else {
+            return Ok(());
+        };
+        let (raw, decoded_channel, kind) = (ids.raw, ids.decoded, ids.kind);
+        let sc_id = ids.sc_id.clone();
+        let Some(kind) = kind else {
+            self.stats.unknown_keys += 1;
+            let t = self.last_log_time_ns;
+            return self.put(raw, t, publish_time_ns.unwrap_or(received_unix_ns), payload);
+        };
+        let decoded = match Decoded::decode(kind, payload) {
+            Ok(d) => d,
+            Err(e) => {
+                self.stats.undecodable += 1;
+                if self.stats.undecodable.is_power_of_two() {
+                    tracing::warn!(key, error = %e, count = self.stats.undecodable, "recording a payload that does not decode (raw channel only)");
+                }
+                let t = self.last_log_time_ns;
+                return self.put(raw, t, publish_time_ns.unwrap_or(received_unix_ns), payload);
+            }
+        };
+        let log_time = decoded.header().sim_time_ns;
+        self.last_log_time_ns = log_time;
+        let publish_time = match (&decoded, publish_time_ns) {
+            (_, Some(t)) => t,
+            (Decoded::Status(s), None) => s.wall_time_unix_ns,
+            (_, None) => received_unix_ns,
+        };
+        self.put(raw, log_time, publish_time, payload)?;
+        if let Some(channel) = decoded_channel {
+            let json = decoded.to_json().to_string();
+            self.put(channel, log_time, publish_time, json.as_bytes())?;
+        }
+        if let Decoded::State(state) = &decoded {
+            if let Some(tf) = self.vehicle_channels(&sc_id, log_time)? {
+                let geometry = self.vehicles.get(&sc_id).and_then(|v| v.geometry.as_ref());
+                if let Some(g) = geometry {
+                    let json = frame_transforms(state, g, &format!("{sc_id}/")).to_string();
+                    self.put(tf, log_time, publish_time, json.as_bytes())?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Finishes the current chunk and flushes it to the file, so a crash after this loses
+    /// nothing written before.
+    pub fn flush_chunk(&mut self) -> Result<(), RecordError> {
+        self.writer.flush().map_err(|e| self.err(e))
+    }
+
+    /// Writes `metadata` as a record named `name` (e.g. the recorder's final counters).
+    pub fn write_metadata(
+        &mut self,
+        name: &str,
+        metadata: BTreeMap<String, String>,
+    ) -> Result<(), RecordError> {
+        self.metadata(name, metadata)
+    }
+
+    /// What has been written so far.
+    pub fn stats(&self) -> &SinkStats {
+        &self.stats
+    }
+
+    /// Writes the summary section and indexes, and closes the file.
+    pub fn finish(mut self) -> Result<SinkStats, RecordError> {
+        self.writer.finish().map_err(|e| self.err(e))?;
+        let path = self.path.clone();
+        let inner = self.writer.into_inner();
+        inner
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .and_then(|f| f.sync_all())
+            .map_err(|source| RecordError::Write {
+                path,
+                source: mcap::McapError::Io(source),
+            })?;
+        Ok(self.stats)
+    }
+}

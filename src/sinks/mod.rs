@@ -1,0 +1,24 @@
+//! Output sinks: everything that turns the telemetry stream into something to keep or look at.
+//! None of it runs on the physics thread.
+//!
+//! - [`topics`]: which message a key carries, decoded, as JSON and its JSON Schema.
+//! - [`scene`]: Foxglove frame transforms and the spacecraft's 3D boxes.
+//! - [`mcap_file`]: the MCAP recording layout (raw + decoded + 3D channels, metadata).
+//! - [`recorder`]: the recorder thread behind a bounded queue (lossless or counted drops).
+//! - [`reader`]: reading a recording back, crash-truncated files included.
+//! - [`table`]: decoded messages as named columns (CSV export, plots).
+//! - [`record_cmd`], [`replay`], [`export`]: the `flexdyn record`, `replay` and `export`
+//!   subcommands.
+
+pub mod error;
+pub mod export;
+pub mod mcap_file;
+pub mod reader;
+pub mod record_cmd;
+pub mod recorder;
+pub mod replay;
+pub mod scene;
+pub mod table;
+pub mod topics;
+
+pub use error::SinkError;

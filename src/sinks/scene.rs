@@ -1,0 +1,456 @@
+//! The spacecraft for Foxglove's 3D panel: `foxglove.FrameTransforms` (N → B from σ_BN and
+//! r_BN, B → each panel at its hinge angles) and a `foxglove.SceneUpdate` with one box for the
+//! hub and one for each panel, sized from the configuration. Both as JSON with a JSON Schema
+//! (the schema names are Foxglove's well-known ones, so the 3D panel recognises them).
+//!
+//! # Frames (Allard & Schaub, Sec. II, Eqs. 1–7)
+//! - `N` inertial; `B` hub body frame at point B: translation r_BN (N components), rotation [NB].
+//! - `<pair>/panel1`: origin at hinge H1 (r_H1B in B), axes S1 with [S1 B] = M2(θ1) [H1 B]
+//!   (ŝ11 = ĥ11 cos θ1 − ĥ13 sin θ1, `src/dynamics/effectors/panel_pair/mod.rs`, `frames`).
+//! - `<pair>/panel2`: origin at hinge H2 = H1 − l1 ŝ11 (S1 components (−l1, 0, 0)), axes S2 with
+//!   [S2 S1] = M2(θ2 + θ_H2S1).
+//!
+//! A Foxglove transform from `parent` to `child` gives the child origin in the parent frame and
+//! the rotation that takes child components to parent components, i.e. [PC] = [CP]ᵀ. For a
+//! passive DCM [CP] with Euler parameters β (scalar first), that active rotation is the Hamilton
+//! quaternion (w, x, y, z) = (β0, β1, β2, β3) (Schaub & Junkins, Sec. 3.5), which is what
+//! [`crate::attitude::dcm_to_quat`] and [`crate::attitude::mrp_to_quat`] return.
+
+use nalgebra::{Matrix3, SymmetricEigen, Vector3, Vector4};
+use serde_json::{json, Value};
+
+use crate::attitude::{dcm_to_quat, m2, mrp_to_quat};
+use crate::config::SimConfig;
+use flexdyn_proto::StateMsg;
+
+/// Name of the inertial frame.
+pub const FRAME_N: &str = "N";
+/// Name of the hub body frame.
+pub const FRAME_B: &str = "B";
+
+/// A box: centre and axes in its frame, and edge lengths.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cuboid {
+    /// [m] centre, in the frame's components.
+    pub center_m: Vector3<f64>,
+    /// The box axes as the rotation from box to frame components, quaternion (w, x, y, z).
+    pub q_frame_box: Vector4<f64>,
+    /// [m] edge lengths along the box axes.
+    pub size_m: Vector3<f64>,
+}
+
+/// One panel pair's fixed geometry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairGeometry {
+    /// The pair's configured name (frame ids `<name>/panel1`, `<name>/panel2`).
+    pub name: String,
+    /// [m] hinge 1 location relative to B, B components.
+    pub r_h1b_b_m: Vector3<f64>,
+    /// [H1 B].
+    pub dcm_h1b: Matrix3<f64>,
+    /// [rad] fixed angle of H2 about ŝ12 relative to S1.
+    pub theta_h2s1_rad: f64,
+    /// [m] panel 1 length (H1 to H2).
+    pub l1_m: f64,
+    /// Panel 1's box in its S1 frame.
+    pub panel1: Cuboid,
+    /// Panel 2's box in its S2 frame.
+    pub panel2: Cuboid,
+}
+
+/// What the transforms and the scene need from a configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Geometry {
+    /// The hub's box in B.
+    pub hub: Cuboid,
+    /// The panel pairs, in effector order (they are effectors 0..n of every StateMsg).
+    pub pairs: Vec<PairGeometry>,
+}
+
+/// Edge lengths (a, b, c) of the homogeneous box of mass `m` with principal moments (I1, I2, I3)
+/// about its centre: I1 = m(b² + c²)/12 and cyclic, so a² = 6(I2 + I3 − I1)/m and cyclic. A
+/// thin plate (an edge → 0) keeps a visible thickness of 2 % of its largest edge.
+pub fn equivalent_box_m(mass_kg: f64, principal_kg_m2: &Vector3<f64>) -> Vector3<f64> {
+    let (i1, i2, i3) = (principal_kg_m2.x, principal_kg_m2.y, principal_kg_m2.z);
+    let edge = |sq: f64| (6.0 * sq / mass_kg).max(0.0).sqrt();
+    let mut e = Vector3::new(edge(i2 + i3 - i1), edge(i1 + i3 - i2), edge(i1 + i2 - i3));
+    let floor = 0.02 * e.max();
+    e.iter_mut().for_each(|x| *x = x.max(floor));
+    e
+}
+
+impl Geometry {
+    /// The geometry of `cfg`: the hub box from its mass and inertia about its centre of mass
+    /// (along the inertia's principal axes, centred on B_c), each panel's box from its mass and
+    /// principal inertia, with the panel's long edge 2·d from its hinge along −ŝ1 (so the box
+    /// centre is the panel's centre of mass, Eqs. 6–7).
+    pub fn from_config(cfg: &SimConfig) -> Self {
+        let hub = &cfg.hub;
+        let eig = SymmetricEigen::new(hub.inertia_bc_b_kg_m2);
+        let mut axes = eig.eigenvectors;
+        if axes.determinant() < 0.0 {
+            axes.column_mut(2).neg_mut();
+        }
+        // Columns are the principal axes in B: that matrix maps box components to B, i.e. it is
+        // [B P] = [P B]ᵀ, whose Euler parameters are those of [P B].
+        let hub_box = Cuboid {
+            center_m: hub.r_bcb_b_m,
+            q_frame_box: dcm_to_quat(&axes.transpose()),
+            size_m: equivalent_box_m(hub.mass_kg, &eig.eigenvalues),
+        };
+        let panel_box = |p: &crate::dynamics::PanelParams| {
+            let mut size = equivalent_box_m(p.mass_kg, &p.inertia_s_kg_m2);
+            size.x = 2.0 * p.d_m;
+            Cuboid {
+                center_m: Vector3::new(-p.d_m, 0.0, 0.0),
+                q_frame_box: Vector4::new(1.0, 0.0, 0.0, 0.0),
+                size_m: size,
+            }
+        };
+        let pairs = cfg
+            .panel_pairs
+            .iter()
+            .map(|(p, _)| PairGeometry {
+                name: p.name.clone(),
+                r_h1b_b_m: p.r_h1b_b_m,
+                dcm_h1b: p.dcm_h1b,
+                theta_h2s1_rad: p.theta_h2s1_rad,
+                l1_m: p.l1_m,
+                panel1: panel_box(&p.panel1),
+                panel2: panel_box(&p.panel2),
+            })
+            .collect();
+        Self {
+            hub: hub_box,
+            pairs,
+        }
+    }
+}
+
+fn stamp(sim_time_ns: u64) -> Value {
+    json!({
+        "sec": sim_time_ns / 1_000_000_000,
+        "nsec": sim_time_ns % 1_000_000_000,
+    })
+}
+
+fn vec3(v: &Vector3<f64>) -> Value {
+    json!({"x": v.x, "y": v.y, "z": v.z})
+}
+
+/// Foxglove quaternion from Euler parameters (w, x, y, z) → {x, y, z, w}.
+fn quat(q: &Vector4<f64>) -> Value {
+    json!({"x": q[1], "y": q[2], "z": q[3], "w": q[0]})
+}
+
+fn transform(t_ns: u64, parent: &str, child: &str, r: &Vector3<f64>, q: &Vector4<f64>) -> Value {
+    json!({
+        "timestamp": stamp(t_ns),
+        "parent_frame_id": parent,
+        "child_frame_id": child,
+        "translation": vec3(r),
+        "rotation": quat(q),
+    })
+}
+
+/// The `foxglove.FrameTransforms` of one state: N → B, then B → panel 1 and panel 1 → panel 2
+/// of each pair whose effector is in the message. `prefix` is prepended to every frame id
+/// (e.g. `sc1/`), so several vehicles can share one scene.
+pub fn frame_transforms(state: &StateMsg, geometry: &Geometry, prefix: &str) -> Value {
+    let t = state.header.sim_time_ns;
+    let sigma = Vector3::from(state.sigma_bn);
+    let (n, b) = (format!("{prefix}{FRAME_N}"), format!("{prefix}{FRAME_B}"));
+    let mut transforms = vec![transform(
+        t,
+        &n,
+        &b,
+        &Vector3::from(state.r_bn_n_m),
+        &mrp_to_quat(&sigma),
+    )];
+    for (pair, eff) in geometry.pairs.iter().zip(&state.effectors) {
+        let (Some(&theta1), Some(&theta2)) = (eff.states.first(), eff.states.get(2)) else {
+            continue;
+        };
+        let dcm_s1b = m2(theta1) * pair.dcm_h1b;
+        let p1 = format!("{prefix}{}/panel1", pair.name);
+        let p2 = format!("{prefix}{}/panel2", pair.name);
+        transforms.push(transform(
+            t,
+            &b,
+            &p1,
+            &pair.r_h1b_b_m,
+            &dcm_to_quat(&dcm_s1b),
+        ));
+        transforms.push(transform(
+            t,
+            &p1,
+            &p2,
+            &Vector3::new(-pair.l1_m, 0.0, 0.0),
+            &dcm_to_quat(&m2(theta2 + pair.theta_h2s1_rad)),
+        ));
+    }
+    json!({ "transforms": transforms })
+}
+
+fn cube_entity(t_ns: u64, frame: &str, id: &str, c: &Cuboid, rgba: [f64; 4]) -> Value {
+    json!({
+        "timestamp": stamp(t_ns),
+        "frame_id": frame,
+        "id": id,
+        "lifetime": {"sec": 0, "nsec": 0},
+        "frame_locked": true,
+        "metadata": [],
+        "arrows": [],
+        "cubes": [{
+            "pose": {"position": vec3(&c.center_m), "orientation": quat(&c.q_frame_box)},
+            "size": vec3(&c.size_m),
+            "color": {"r": rgba[0], "g": rgba[1], "b": rgba[2], "a": rgba[3]},
+        }],
+        "spheres": [],
+        "cylinders": [],
+        "lines": [],
+        "triangles": [],
+        "texts": [],
+        "models": [],
+    })
+}
+
+/// The `foxglove.SceneUpdate` that draws the spacecraft: a grey hub box in B and a blue box per
+/// panel in its own frame, frame-locked and never expiring (lifetime 0).
+pub fn scene_update(geometry: &Geometry, prefix: &str, t_ns: u64) -> Value {
+    let mut entities = vec![cube_entity(
+        t_ns,
+        &format!("{prefix}{FRAME_B}"),
+        &format!("{prefix}hub"),
+        &geometry.hub,
+        [0.75, 0.75, 0.78, 1.0],
+    )];
+    for pair in &geometry.pairs {
+        for (which, cube) in [("panel1", &pair.panel1), ("panel2", &pair.panel2)] {
+            let frame = format!("{prefix}{}/{which}", pair.name);
+            entities.push(cube_entity(
+                t_ns,
+                &frame,
+                &frame,
+                cube,
+                [0.15, 0.3, 0.8, 1.0],
+            ));
+        }
+    }
+    json!({ "deletions": [], "entities": entities })
+}
+
+fn obj(required: &[&str], properties: Value) -> Value {
+    json!({"type": "object", "required": required, "properties": properties})
+}
+
+fn num() -> Value {
+    json!({"type": "number"})
+}
+
+fn time_schema() -> Value {
+    obj(
+        &["sec", "nsec"],
+        json!({"sec": {"type": "integer", "minimum": 0}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999}}),
+    )
+}
+
+fn vector3_schema() -> Value {
+    obj(
+        &["x", "y", "z"],
+        json!({"x": num(), "y": num(), "z": num()}),
+    )
+}
+
+fn quaternion_schema() -> Value {
+    obj(
+        &["x", "y", "z", "w"],
+        json!({"x": num(), "y": num(), "z": num(), "w": num()}),
+    )
+}
+
+fn frame_transform_schema() -> Value {
+    let mut s = obj(
+        &[
+            "timestamp",
+            "parent_frame_id",
+            "child_frame_id",
+            "translation",
+            "rotation",
+        ],
+        json!({
+            "timestamp": time_schema(),
+            "parent_frame_id": {"type": "string", "description": "Name of the parent frame"},
+            "child_frame_id": {"type": "string", "description": "Name of the child frame"},
+            "translation": vector3_schema(),
+            "rotation": quaternion_schema(),
+        }),
+    );
+    s["title"] = json!("foxglove.FrameTransform");
+    s["description"] = json!("A transform between two reference frames in 3D space");
+    s
+}
+
+/// JSON Schema of `foxglove.FrameTransforms` (the fields of Foxglove's published schema that
+/// this module fills).
+pub fn frame_transforms_schema() -> Value {
+    let mut s = obj(
+        &["transforms"],
+        json!({"transforms": {"type": "array", "items": frame_transform_schema()}}),
+    );
+    s["$schema"] = json!("https://json-schema.org/draft/2020-12/schema");
+    s["title"] = json!("foxglove.FrameTransforms");
+    s["description"] = json!("An array of FrameTransform messages");
+    s
+}
+
+/// JSON Schema of `foxglove.SceneUpdate` (cube entities; the other primitive arrays are empty).
+pub fn scene_update_schema() -> Value {
+    let color = obj(
+        &["r", "g", "b", "a"],
+        json!({"r": num(), "g": num(), "b": num(), "a": num()}),
+    );
+    let cube = obj(
+        &["pose", "size", "color"],
+        json!({
+            "pose": obj(&["position", "orientation"], json!({"position": vector3_schema(), "orientation": quaternion_schema()})),
+            "size": vector3_schema(),
+            "color": color,
+        }),
+    );
+    let empty_array = json!({"type": "array"});
+    let entity = obj(
+        &[
+            "timestamp",
+            "frame_id",
+            "id",
+            "lifetime",
+            "frame_locked",
+            "cubes",
+        ],
+        json!({
+            "timestamp": time_schema(),
+            "frame_id": {"type": "string"},
+            "id": {"type": "string"},
+            "lifetime": time_schema(),
+            "frame_locked": {"type": "boolean"},
+            "metadata": empty_array,
+            "arrows": empty_array,
+            "cubes": {"type": "array", "items": cube},
+            "spheres": empty_array,
+            "cylinders": empty_array,
+            "lines": empty_array,
+            "triangles": empty_array,
+            "texts": empty_array,
+            "models": empty_array,
+        }),
+    );
+    let mut s = obj(
+        &["deletions", "entities"],
+        json!({
+            "deletions": {"type": "array"},
+            "entities": {"type": "array", "items": entity},
+        }),
+    );
+    s["$schema"] = json!("https://json-schema.org/draft/2020-12/schema");
+    s["title"] = json!("foxglove.SceneUpdate");
+    s["description"] = json!("An update to the entities displayed in a 3D scene");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::attitude::{mrp_to_dcm, quat_to_dcm};
+
+    fn q_of(v: &Value) -> Vector4<f64> {
+        let f = |k: &str| v[k].as_f64().unwrap();
+        Vector4::new(f("w"), f("x"), f("y"), f("z"))
+    }
+
+    /// Active rotation matrix of a Hamilton quaternion (w, x, y, z), written out independently
+    /// of `attitude`: R = (w² − |v|²) I + 2 v vᵀ + 2 w [ṽ].
+    fn active(q: &Vector4<f64>) -> Matrix3<f64> {
+        let (w, v) = (q[0], Vector3::new(q[1], q[2], q[3]));
+        let vt = Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0);
+        Matrix3::identity() * (w * w - v.norm_squared()) + v * v.transpose() * 2.0 + vt * (2.0 * w)
+    }
+
+    #[test]
+    fn transforms_rotate_child_components_into_the_parent_frame() {
+        let cfg = SimConfig::reference();
+        let geometry = Geometry::from_config(&cfg);
+        assert_eq!(geometry.pairs.len(), cfg.panel_pairs.len());
+        let mut state = StateMsg {
+            sigma_bn: [0.1, -0.2, 0.3],
+            r_bn_n_m: [7.0e6, 1.0, -2.0],
+            ..StateMsg::default()
+        };
+        state.header.sim_time_ns = 2_500_000_001;
+        state.effectors = (0..geometry.pairs.len())
+            .map(|k| flexdyn_proto::EffectorState {
+                kind: flexdyn_proto::effector_kind::PANEL_PAIR,
+                flags: 0,
+                states: vec![0.1 * (k as f64 + 1.0), 0.0, -0.05, 0.0],
+                outputs: vec![],
+            })
+            .collect();
+        let tf = frame_transforms(&state, &geometry, "");
+        let list = tf["transforms"].as_array().unwrap();
+        assert_eq!(list.len(), 1 + 2 * geometry.pairs.len());
+        assert_eq!(list[0]["timestamp"]["sec"], 2);
+        assert_eq!(list[0]["timestamp"]["nsec"], 500_000_001);
+        // N → B: R maps B components to N components: R = [BN]ᵀ.
+        let r_nb = active(&q_of(&list[0]["rotation"]));
+        let dcm_bn = mrp_to_dcm(&Vector3::from(state.sigma_bn));
+        assert!((r_nb - dcm_bn.transpose()).abs().max() < 1e-14);
+        // B → panel 1: the panel's ŝ11 axis (1, 0, 0 in S1) maps to ĥ1 cos θ1 − ĥ3 sin θ1 in B.
+        for (k, pair) in geometry.pairs.iter().enumerate() {
+            let th1 = state.effectors[k].states[0];
+            let r_b_s1 = active(&q_of(&list[1 + 2 * k]["rotation"]));
+            let h = pair.dcm_h1b;
+            let s11 = h.row(0).transpose() * th1.cos() - h.row(2).transpose() * th1.sin();
+            assert!((r_b_s1 * Vector3::x() - s11).norm() < 1e-14);
+            // Panel 1 → panel 2: rotation about ŝ12 by θ2 + θ_H2S1.
+            let phi = state.effectors[k].states[2] + pair.theta_h2s1_rad;
+            let r_s1_s2 = active(&q_of(&list[2 + 2 * k]["rotation"]));
+            let expect = quat_to_dcm(&Vector4::new(
+                (phi / 2.0).cos(),
+                0.0,
+                (phi / 2.0).sin(),
+                0.0,
+            ));
+            assert!((r_s1_s2 - expect.transpose()).abs().max() < 1e-14);
+            assert_eq!(list[2 + 2 * k]["translation"]["x"], -pair.l1_m);
+        }
+    }
+
+    #[test]
+    fn an_equivalent_box_has_the_inertia_it_came_from() {
+        // A 2 × 1 × 0.5 m box of 12 kg: I = m/12 (b² + c², a² + c², a² + b²).
+        let (a, b, c, m) = (2.0f64, 1.0f64, 0.5f64, 12.0);
+        let i = Vector3::new(b * b + c * c, a * a + c * c, a * a + b * b) * (m / 12.0);
+        let e = equivalent_box_m(m, &i);
+        assert!((e - Vector3::new(a, b, c)).norm() < 1e-12, "{e}");
+        // A thin plate keeps a visible thickness.
+        let plate = Vector3::new(b * b, a * a, a * a + b * b) * (m / 12.0);
+        let e = equivalent_box_m(m, &plate);
+        assert!((e.z - 0.04).abs() < 1e-12, "{e}");
+    }
+
+    #[test]
+    fn the_scene_has_a_hub_and_two_boxes_per_pair() {
+        let cfg = SimConfig::reference();
+        let g = Geometry::from_config(&cfg);
+        let scene = scene_update(&g, "sc1/", 0);
+        let entities = scene["entities"].as_array().unwrap();
+        assert_eq!(entities.len(), 1 + 2 * cfg.panel_pairs.len());
+        assert_eq!(entities[0]["frame_id"], "sc1/B");
+        for e in entities {
+            let size = &e["cubes"][0]["size"];
+            for axis in ["x", "y", "z"] {
+                assert!(size[axis].as_f64().unwrap() > 0.0, "{e}");
+            }
+        }
+    }
+}

@@ -1,0 +1,236 @@
+//! Which flexdyn message a Zenoh key carries, and the message decoded from its payload.
+//!
+//! Every sink (recorder, exporter, viewer, plotter) starts here: a key expression
+//! `flexdyn/<sc-id>/<suffix>` (see `proto/README.md`, "Topics") names the message type, and the
+//! payload decodes with the one `flexdyn-proto` codec.
+
+use flexdyn_proto::keys::{
+    CMD_WRENCH_SUFFIX, IMU_PREFIX, KEY_ROOT, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX,
+};
+use flexdyn_proto::{
+    decode_command, decode_imu, decode_star_tracker, decode_state, decode_status, CommandMsg,
+    DecodeError, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg,
+};
+
+/// The message type a flexdyn key carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum TopicKind {
+    /// `flexdyn/<sc>/tlm/state`: [`StateMsg`].
+    State,
+    /// `flexdyn/<sc>/tlm/imu/<name>`: [`ImuMsg`].
+    Imu,
+    /// `flexdyn/<sc>/tlm/st/<name>`: [`StarTrackerMsg`].
+    StarTracker,
+    /// `flexdyn/<sc>/cmd/wrench`: [`CommandMsg`].
+    Command,
+    /// `flexdyn/<sc>/status`: [`StatusMsg`].
+    Status,
+}
+
+impl TopicKind {
+    /// Every kind, in a fixed order.
+    pub const ALL: [TopicKind; 5] = [
+        TopicKind::State,
+        TopicKind::Imu,
+        TopicKind::StarTracker,
+        TopicKind::Command,
+        TopicKind::Status,
+    ];
+
+    /// The wire message's name, as in `proto/README.md` (`StateMsg`, …).
+    pub fn message_name(self) -> &'static str {
+        match self {
+            TopicKind::State => "StateMsg",
+            TopicKind::Imu => "ImuMsg",
+            TopicKind::StarTracker => "StarTrackerMsg",
+            TopicKind::Command => "CommandMsg",
+            TopicKind::Status => "StatusMsg",
+        }
+    }
+}
+
+/// A flexdyn key split into its spacecraft id, kind and (for sensors) sensor name.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Topic<'a> {
+    /// The string spacecraft id.
+    pub sc_id: &'a str,
+    /// The message type.
+    pub kind: TopicKind,
+    /// The IMU or star-tracker name; `None` for the other kinds.
+    pub sensor: Option<&'a str>,
+}
+
+/// Classifies `key`; `None` for keys that carry no flexdyn message (liveliness tokens, other
+/// applications' keys).
+pub fn classify(key: &str) -> Option<Topic<'_>> {
+    let rest = key.strip_prefix(KEY_ROOT)?.strip_prefix('/')?;
+    let (sc_id, suffix) = rest.split_once('/')?;
+    if sc_id.is_empty() {
+        return None;
+    }
+    let sensor = |prefix: &str| {
+        suffix
+            .strip_prefix(prefix)
+            .and_then(|s| s.strip_prefix('/'))
+            .filter(|name| !name.is_empty() && !name.contains('/'))
+    };
+    let (kind, sensor) = if suffix == STATE_SUFFIX {
+        (TopicKind::State, None)
+    } else if suffix == CMD_WRENCH_SUFFIX {
+        (TopicKind::Command, None)
+    } else if suffix == STATUS_SUFFIX {
+        (TopicKind::Status, None)
+    } else if let Some(name) = sensor(IMU_PREFIX) {
+        (TopicKind::Imu, Some(name))
+    } else if let Some(name) = sensor(STAR_TRACKER_PREFIX) {
+        (TopicKind::StarTracker, Some(name))
+    } else {
+        return None;
+    };
+    Some(Topic {
+        sc_id,
+        kind,
+        sensor,
+    })
+}
+
+/// One decoded flexdyn message.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Decoded {
+    /// A state.
+    State(StateMsg),
+    /// An IMU sample.
+    Imu(ImuMsg),
+    /// A star-tracker sample.
+    StarTracker(StarTrackerMsg),
+    /// A command.
+    Command(CommandMsg),
+    /// A server status.
+    Status(StatusMsg),
+}
+
+impl Decoded {
+    /// Decodes `payload` as the message `kind` names.
+    pub fn decode(kind: TopicKind, payload: &[u8]) -> Result<Self, DecodeError> {
+        Ok(match kind {
+            TopicKind::State => Decoded::State(decode_state(payload)?),
+            TopicKind::Imu => Decoded::Imu(decode_imu(payload)?),
+            TopicKind::StarTracker => Decoded::StarTracker(decode_star_tracker(payload)?),
+            TopicKind::Command => Decoded::Command(decode_command(payload)?),
+            TopicKind::Status => Decoded::Status(decode_status(payload)?),
+        })
+    }
+
+    /// The message header.
+    pub fn header(&self) -> &Header {
+        match self {
+            Decoded::State(m) => &m.header,
+            Decoded::Imu(m) => &m.header,
+            Decoded::StarTracker(m) => &m.header,
+            Decoded::Command(m) => &m.header,
+            Decoded::Status(m) => &m.header,
+        }
+    }
+
+    /// The message as JSON, field names as in the wire structs (they carry their units).
+    pub fn to_json(&self) -> serde_json::Value {
+        let v = match self {
+            Decoded::State(m) => serde_json::to_value(m),
+            Decoded::Imu(m) => serde_json::to_value(m),
+            Decoded::StarTracker(m) => serde_json::to_value(m),
+            Decoded::Command(m) => serde_json::to_value(m),
+            Decoded::Status(m) => serde_json::to_value(m),
+        };
+        // The wire structs hold only numbers, bools, enums and vectors: always representable.
+        v.unwrap_or(serde_json::Value::Null)
+    }
+}
+
+/// The JSON Schema (draft 2020-12) of the decoded JSON of `kind`, derived from the wire structs.
+pub fn json_schema(kind: TopicKind) -> serde_json::Value {
+    let schema = match kind {
+        TopicKind::State => schemars::schema_for!(StateMsg),
+        TopicKind::Imu => schemars::schema_for!(ImuMsg),
+        TopicKind::StarTracker => schemars::schema_for!(StarTrackerMsg),
+        TopicKind::Command => schemars::schema_for!(CommandMsg),
+        TopicKind::Status => schemars::schema_for!(StatusMsg),
+    };
+    schema.to_value()
+}
+
+/// The section of `proto/README.md` that specifies the wire layout of `kind`, after the
+/// encoding rules and the header: what a raw recording channel's schema holds.
+pub fn wire_layout_text(kind: TopicKind) -> String {
+    const README: &str = include_str!("../../proto/README.md");
+    let section = |starts: &str| -> &str {
+        let Some(begin) = README.find(starts) else {
+            return "";
+        };
+        let body = &README[begin..];
+        // Up to the next second-level heading.
+        let end = body[3..].find("\n## ").map_or(body.len(), |i| i + 4);
+        &body[..end]
+    };
+    let title = README.lines().next().unwrap_or_default();
+    format!(
+        "{title}\n\nflexdyn protocol_version {}; payload = one {} encoded as below.\n\n{}\n{}\n{}",
+        flexdyn_proto::PROTOCOL_VERSION,
+        kind.message_name(),
+        section("## Encoding rules"),
+        section("## Header"),
+        section(&format!("## {} ", kind.message_name())),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_classify_by_their_suffix() {
+        let t = classify("flexdyn/sc1/tlm/state").unwrap();
+        assert_eq!((t.sc_id, t.kind, t.sensor), ("sc1", TopicKind::State, None));
+        let t = classify("flexdyn/a-b/tlm/imu/hub").unwrap();
+        assert_eq!(
+            (t.sc_id, t.kind, t.sensor),
+            ("a-b", TopicKind::Imu, Some("hub"))
+        );
+        let t = classify("flexdyn/x/tlm/st/st1").unwrap();
+        assert_eq!(t.kind, TopicKind::StarTracker);
+        assert_eq!(
+            classify("flexdyn/x/cmd/wrench").unwrap().kind,
+            TopicKind::Command
+        );
+        assert_eq!(
+            classify("flexdyn/x/status").unwrap().kind,
+            TopicKind::Status
+        );
+        for other in [
+            "flexdyn/x/participant/1",
+            "flexdyn/x/tlm/imu/",
+            "flexdyn/x/tlm/imu/a/b",
+            "flexdyn//status",
+            "other/x/status",
+            "flexdyn/x",
+        ] {
+            assert_eq!(classify(other), None, "{other}");
+        }
+    }
+
+    #[test]
+    fn the_layout_text_holds_the_message_section_and_the_version() {
+        for kind in TopicKind::ALL {
+            let text = wire_layout_text(kind);
+            assert!(text.contains("## Encoding rules"), "{kind:?}");
+            assert!(text.contains("## Header"), "{kind:?}");
+            assert!(
+                text.contains(&format!("## {} ", kind.message_name())),
+                "{kind:?}: {text}"
+            );
+            assert!(text.contains(&format!(
+                "protocol_version {}",
+                flexdyn_proto::PROTOCOL_VERSION
+            )));
+        }
+    }
+}
