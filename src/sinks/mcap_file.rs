@@ -67,6 +67,43 @@ pub struct VehicleInfo {
     pub git_commit: Option<String>,
 }
 
+impl VehicleInfo {
+    /// Name of the metadata record that describes the vehicle `sc_id`.
+    pub fn metadata_name(sc_id: &str) -> String {
+        format!("flexdyn/{sc_id}")
+    }
+
+    /// The metadata record's key/value pairs.
+    pub fn to_metadata(&self) -> BTreeMap<String, String> {
+        let mut meta = BTreeMap::new();
+        meta.insert("sc_id".to_owned(), self.sc_id.clone());
+        meta.insert("spacecraft_id".to_owned(), self.spacecraft_id.to_string());
+        meta.insert("config_toml".to_owned(), self.config_toml.clone());
+        meta.insert("server_settings".to_owned(), self.server_settings.clone());
+        meta.insert("flexdyn_version".to_owned(), self.flexdyn_version.clone());
+        meta.insert(
+            "git_commit".to_owned(),
+            self.git_commit
+                .clone()
+                .unwrap_or_else(|| "unknown".to_owned()),
+        );
+        meta
+    }
+
+    /// Reads a metadata record written by [`Self::to_metadata`]; `None` if a field is missing.
+    pub fn from_metadata(meta: &BTreeMap<String, String>) -> Option<Self> {
+        let get = |k: &str| meta.get(k).cloned();
+        Some(Self {
+            sc_id: get("sc_id")?,
+            spacecraft_id: get("spacecraft_id")?.parse().ok()?,
+            config_toml: get("config_toml")?,
+            server_settings: get("server_settings")?,
+            flexdyn_version: get("flexdyn_version")?,
+            git_commit: get("git_commit").filter(|c| c != "unknown"),
+        })
+    }
+}
+
 /// Who is recording, for the file's `flexdyn` metadata record.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RecordingInfo {
@@ -122,11 +159,18 @@ struct ChannelIds {
     decoded: Option<u16>,
 }
 
+/// States of a vehicle heard before its description, kept (up to this many) so their
+/// transforms can be written once the description arrives.
+pub const PENDING_STATES_MAX: usize = 20_000;
+
 #[derive(Default)]
 struct Vehicle {
+    described: bool,
     geometry: Option<Geometry>,
     tf: Option<u16>,
-    scene_written: bool,
+    /// (log time, publish time, state) of states recorded before the description.
+    pending: Vec<(u64, u64, flexdyn_proto::StateMsg)>,
+    pending_overflow: bool,
 }
 
 /// The MCAP writer with flexdyn's channel layout.
@@ -226,10 +270,33 @@ impl McapSink {
                 None
             }
         };
-        self.vehicles
-            .entry(info.sc_id.clone())
-            .or_default()
-            .geometry = geometry;
+        let v = self.vehicles.entry(info.sc_id.clone()).or_default();
+        v.described = true;
+        v.geometry = geometry;
+        // States heard before the description get their transforms now (MCAP readers order
+        // messages by log time, so writing them late is fine).
+        let pending = std::mem::take(&mut v.pending);
+        for (log_time, publish_time, state) in &pending {
+            self.write_transforms(&info.sc_id, state, *log_time, *publish_time)?;
+        }
+        Ok(())
+    }
+
+    fn write_transforms(
+        &mut self,
+        sc_id: &str,
+        state: &flexdyn_proto::StateMsg,
+        log_time: u64,
+        publish_time: u64,
+    ) -> Result<(), RecordError> {
+        let Some(tf) = self.vehicle_channels(sc_id, log_time)? else {
+            return Ok(());
+        };
+        let geometry = self.vehicles.get(sc_id).and_then(|v| v.geometry.as_ref());
+        if let Some(g) = geometry {
+            let json = frame_transforms(state, g, &format!("{sc_id}/")).to_string();
+            self.put(tf, log_time, publish_time, json.as_bytes())?;
+        }
         Ok(())
     }
 
@@ -337,7 +404,6 @@ impl McapSink {
         self.put(scene, t_ns, t_ns, scene_json.as_bytes())?;
         if let Some(v) = self.vehicles.get_mut(sc_id) {
             v.tf = Some(tf);
-            v.scene_written = true;
         }
         Ok(Some(tf))
     }
@@ -388,13 +454,15 @@ impl McapSink {
             let json = decoded.to_json().to_string();
             self.put(channel, log_time, publish_time, json.as_bytes())?;
         }
-        if let Decoded::State(state) = &decoded {
-            if let Some(tf) = self.vehicle_channels(&sc_id, log_time)? {
-                let geometry = self.vehicles.get(&sc_id).and_then(|v| v.geometry.as_ref());
-                if let Some(g) = geometry {
-                    let json = frame_transforms(state, g, &format!("{sc_id}/")).to_string();
-                    self.put(tf, log_time, publish_time, json.as_bytes())?;
-                }
+        if let Decoded::State(state) = decoded {
+            let v = self.vehicles.entry(sc_id.clone()).or_default();
+            if v.described {
+                self.write_transforms(&sc_id, &state, log_time, publish_time)?;
+            } else if v.pending.len() < PENDING_STATES_MAX {
+                v.pending.push((log_time, publish_time, state));
+            } else if !v.pending_overflow {
+                v.pending_overflow = true;
+                tracing::warn!(sc_id = %sc_id, kept = PENDING_STATES_MAX, "no configuration from this vehicle's server yet; later states get no 3D transforms until it answers");
             }
         }
         Ok(())

@@ -39,6 +39,17 @@ fn input(path: &Path, problem: impl Into<String>) -> SinkError {
     }
 }
 
+impl Recording {
+    /// The vehicles the recording describes (its `flexdyn/<sc-id>` metadata records).
+    pub fn vehicles(&self) -> Vec<super::mcap_file::VehicleInfo> {
+        self.metadata
+            .iter()
+            .filter(|(name, _)| name.starts_with("flexdyn/"))
+            .filter_map(|(_, meta)| super::mcap_file::VehicleInfo::from_metadata(meta))
+            .collect()
+    }
+}
+
 /// Reads `path`'s raw flexdyn channels (and its metadata) in file order.
 pub fn read_recording(path: &Path) -> Result<Recording, SinkError> {
     let bytes = std::fs::read(path).map_err(|e| input(path, format!("cannot read: {e}")))?;

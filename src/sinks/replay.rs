@@ -8,13 +8,18 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use flexdyn_proto::keys::{CONFIG_SUFFIX, KEY_ROOT};
 use flexdyn_proto::validate_sc_id;
 use zenoh::qos::CongestionControl;
+use zenoh::Wait;
 
 use super::error::SinkError;
 use super::reader::read_recording;
 use super::topics::classify;
 use crate::transport::{zenoh_config, Role, ZenohArgs};
+
+/// How long the replay stays connected after its last sample.
+const LINGER: Duration = Duration::from_secs(1);
 
 /// Arguments of `flexdyn replay`.
 #[derive(Clone, Debug, PartialEq, clap::Args)]
@@ -101,10 +106,28 @@ pub fn replay(args: &ReplayArgs) -> Result<ReplayReport, SinkError> {
     let runtime = super::error::runtime()?;
     let pace = !args.as_fast_as_possible;
     let start_delay = Duration::from_secs_f64(args.start_delay_s);
+    let vehicles = rec.vehicles();
     let published = runtime.block_on(async move {
         let session = zenoh::open(zcfg)
             .await
             .map_err(|e| SinkError::zenoh("open the session", e))?;
+        // Answer each recorded vehicle's configuration query as its server did, so a recorder
+        // or viewer of the replay gets the same metadata and 3D geometry.
+        let mut queryables = Vec::new();
+        for v in vehicles {
+            let reply = serde_json::to_string(&v)
+                .map_err(|e| SinkError::Runtime(format!("vehicle description: {e}")))?;
+            let key = format!("{KEY_ROOT}/{}/{CONFIG_SUFFIX}", v.sc_id);
+            let q = session
+                .declare_queryable(key.as_str())
+                .callback(move |query| {
+                    let key = query.key_expr().clone();
+                    let _ = query.reply(key, reply.clone()).wait();
+                })
+                .await
+                .map_err(|e| SinkError::zenoh("declare the configuration queryable", e))?;
+            queryables.push(q);
+        }
         tokio::time::sleep(start_delay).await;
         let mut publishers = HashMap::new();
         let t0_log = samples[0].log_time_ns;
@@ -136,7 +159,11 @@ pub fn replay(args: &ReplayArgs) -> Result<ReplayReport, SinkError> {
             }
         }
         let wall_s = started.elapsed().as_secs_f64();
+        // Stay a moment so the last samples flush and late configuration queries (a recorder
+        // asks when it first hears a vehicle) are answered.
+        tokio::time::sleep(LINGER).await;
         drop(publishers);
+        drop(queryables);
         let _ = session.close().await;
         Ok::<_, SinkError>((published, wall_s))
     })?;

@@ -1,0 +1,243 @@
+//! Recordings checked from outside: the `flexdyn` binary writes them (`run --record`, `record`,
+//! `replay`, `export`) and independent readers check them — Python's `mcap` package (PyPI,
+//! `tests/py/check_recording.py`, in its own venv `<target>/python-mcap-venv`) and the CSV
+//! files.
+//!
+//! Ports 17370–17379.
+
+mod py_support;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use flexdyn::sinks::reader::read_recording;
+use flexdyn_proto::decode_state;
+use sha2::{Digest, Sha256};
+
+/// The pinned independent reader (with its zstd and lz4 dependencies).
+const MCAP_PY: &str = "mcap==1.6.0";
+
+fn flexdyn() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+}
+
+fn endpoint(port: u16) -> String {
+    format!("tcp/127.0.0.1:{port}")
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("recording_files");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn check_with_python(file: &Path, extra: &[&str]) -> String {
+    let python = py_support::venv_python("python-mcap-venv", &[MCAP_PY.into()], MCAP_PY);
+    py_support::run(
+        Command::new(python)
+            .arg(root().join("tests/py/check_recording.py"))
+            .arg(file)
+            .args(extra),
+        "check_recording.py",
+    )
+}
+
+/// A finished batch run of the wheel scenario recorded by the server itself.
+fn batch_recording(port: u16, name: &str) -> PathBuf {
+    let file = tmp(name);
+    let _ = std::fs::remove_file(&file);
+    py_support::run(
+        flexdyn()
+            .args(["run", "--mode", "batch", "--duration-s", "5"])
+            .args(["--listen", &endpoint(port)])
+            .arg("--config")
+            .arg(root().join("scenarios/wheels_star_tracker.toml"))
+            .arg("--record")
+            .arg(&file),
+        "flexdyn run --mode batch --record",
+    );
+    file
+}
+
+fn sha_by_key(file: &Path) -> BTreeMap<String, (usize, String)> {
+    let rec = read_recording(file).unwrap();
+    assert!(rec.truncated.is_none(), "{:?}", rec.truncated);
+    let mut h: BTreeMap<String, (usize, Sha256)> = BTreeMap::new();
+    for s in &rec.samples {
+        let e = h.entry(s.key.clone()).or_insert_with(|| (0, Sha256::new()));
+        e.0 += 1;
+        e.1.update(&s.payload);
+    }
+    h.into_iter()
+        .map(|(k, (n, d))| {
+            (
+                k,
+                (n, d.finalize().iter().map(|b| format!("{b:02x}")).collect()),
+            )
+        })
+        .collect()
+}
+
+struct Guard(Child);
+
+impl Drop for Guard {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn spawn(cmd: &mut Command) -> Guard {
+    Guard(
+        cmd.stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    )
+}
+
+fn wait_exit(child: &mut Guard, timeout: Duration) -> std::process::ExitStatus {
+    let give_up = Instant::now() + timeout;
+    loop {
+        if let Some(s) = child.0.try_wait().unwrap() {
+            return s;
+        }
+        assert!(Instant::now() < give_up, "the process did not exit in time");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn python_mcap_reads_every_channel_of_a_server_recording() {
+    let file = batch_recording(17370, "batch.mcap");
+    let out = check_with_python(&file, &[]);
+    eprintln!("{out}");
+    assert!(out.contains("OK clean: "), "{out}");
+
+    // The CSV export has one row per recorded sample, and the state rows' σ are the payloads'.
+    let dir = tmp("export");
+    let _ = std::fs::remove_dir_all(&dir);
+    py_support::run(
+        flexdyn().arg("export").arg(&file).arg("--csv").arg(&dir),
+        "flexdyn export",
+    );
+    let rec = read_recording(&file).unwrap();
+    let states: Vec<_> = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == "flexdyn/sc1/tlm/state")
+        .map(|s| decode_state(&s.payload).unwrap())
+        .collect();
+    assert_eq!(states.len(), 501, "5 s at 100 Hz, ticks 0..=500");
+    let csv = std::fs::read_to_string(dir.join("flexdyn_sc1_tlm_state.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (c_t, c_s2, c_rw) = (col("t_s"), col("sigma_bn_2"), col("rw4_omega_rad_s"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), states.len());
+    for (row, st) in rows.iter().zip(&states) {
+        assert_eq!(
+            row[c_t].parse::<f64>().unwrap(),
+            st.header.sim_time_ns as f64 * 1e-9
+        );
+        assert_eq!(row[c_s2].parse::<f64>().unwrap(), st.sigma_bn[1]);
+        assert_eq!(row[c_rw].parse::<f64>().unwrap(), st.effectors[5].states[0]);
+    }
+    for name in [
+        "flexdyn_sc1_tlm_imu_hub.csv",
+        "flexdyn_sc1_tlm_st_st1.csv",
+        "flexdyn_sc1_status.csv",
+    ] {
+        assert!(dir.join(name).is_file(), "{name}");
+    }
+}
+
+#[test]
+fn a_recorder_killed_mid_run_leaves_every_finished_chunk_readable() {
+    let port = 17371;
+    let mut server = spawn(
+        flexdyn()
+            .args(["run", "--duration-s", "10"])
+            .args(["--listen", &endpoint(port)]),
+    );
+    let file = tmp("killed.mcap");
+    let _ = std::fs::remove_file(&file);
+    let mut recorder = spawn(
+        flexdyn()
+            .args(["record", "--connect", &endpoint(port), "-o"])
+            .arg(&file),
+    );
+    std::thread::sleep(Duration::from_millis(3500));
+    recorder.0.kill().unwrap(); // SIGKILL
+    let _ = recorder.0.wait();
+    let rec = read_recording(&file).unwrap();
+    assert!(
+        rec.truncated.is_some(),
+        "a killed recorder cannot have closed the file"
+    );
+    let ticks: Vec<u64> = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == "flexdyn/sc1/tlm/state")
+        .map(|s| decode_state(&s.payload).unwrap().header.tick)
+        .collect();
+    // Chunks are flushed every second: after 3.5 s at 100 Hz at least ~2 s are on disk.
+    assert!(
+        ticks.len() >= 150,
+        "only {} states readable: {:?}",
+        ticks.len(),
+        rec.truncated
+    );
+    assert!(
+        ticks.windows(2).all(|w| w[1] == w[0] + 1),
+        "the readable states are not contiguous"
+    );
+    let out = check_with_python(&file, &["--truncated"]);
+    eprintln!("{out} ({} states in Rust)", ticks.len());
+    server.0.kill().unwrap();
+    let _ = server.0.wait();
+}
+
+#[test]
+fn a_replayed_recording_records_to_the_same_payloads() {
+    let original = batch_recording(17372, "original.mcap");
+    let port = 17373;
+    let again = tmp("again.mcap");
+    let _ = std::fs::remove_file(&again);
+    // The replay listens and waits 2 s for the recorder to subscribe.
+    let mut replay = spawn(
+        flexdyn()
+            .arg("replay")
+            .arg(&original)
+            .args(["--as-fast-as-possible", "--start-delay-s", "2"])
+            .args(["--listen", &endpoint(port)]),
+    );
+    let mut recorder = spawn(
+        flexdyn()
+            .args(["record", "--connect", &endpoint(port), "-o"])
+            .arg(&again),
+    );
+    assert!(wait_exit(&mut replay, Duration::from_secs(60)).success());
+    std::thread::sleep(Duration::from_millis(500));
+    // SIGINT: a clean stop writes the summary.
+    Command::new("kill")
+        .args(["-INT", &recorder.0.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(wait_exit(&mut recorder, Duration::from_secs(30)).success());
+    let a = sha_by_key(&original);
+    let b = sha_by_key(&again);
+    eprintln!("original {a:?}\nreplayed {b:?}");
+    assert_eq!(a["flexdyn/sc1/tlm/state"].0, 501);
+    assert_eq!(a, b, "the replayed payloads differ from the recorded ones");
+    // The replayed file is a complete recording too.
+    let out = check_with_python(&again, &[]);
+    assert!(out.contains("OK clean: "), "{out}");
+}
