@@ -53,6 +53,8 @@ enum Command {
     Replay(sinks::replay::ReplayArgs),
     /// Write one CSV per topic of a recording.
     Export(sinks::export::ExportArgs),
+    /// Serve the live stream (or a recording) to Foxglove over its WebSocket protocol.
+    View(sinks::view::ViewArgs),
 }
 
 /// Runs a sink subcommand and prints its one-line summary on stderr.
@@ -132,6 +134,14 @@ fn main() -> ExitCode {
                     r.truncated
                         .as_ref()
                         .map_or(String::new(), |why| format!(" (file ends early: {why})"))
+                )
+            })
+        }
+        Some(Command::View(a)) => {
+            return run_sink(sinks::view::view(&a), |r| {
+                format!(
+                    "viewer on port {} stopped after {} samples",
+                    r.port, r.samples
                 )
             })
         }

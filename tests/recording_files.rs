@@ -3,7 +3,7 @@
 //! `tests/py/check_recording.py`, in its own venv `<target>/python-mcap-venv`) and the CSV
 //! files.
 //!
-//! Ports 17370–17379.
+//! Ports 17370–17374.
 
 mod py_support;
 
@@ -240,4 +240,69 @@ fn a_replayed_recording_records_to_the_same_payloads() {
     // The replayed file is a complete recording too.
     let out = check_with_python(&again, &[]);
     assert!(out.contains("OK clean: "), "{out}");
+}
+
+/// Resolves a Foxglove message path's field part (`.a.b[0].c`) in a JSON message.
+fn resolve<'a>(msg: &'a serde_json::Value, fields: &str) -> Option<&'a serde_json::Value> {
+    let mut v = msg;
+    for part in fields.split('.').filter(|p| !p.is_empty()) {
+        let (name, indices) = part.split_once('[').map_or((part, ""), |(n, i)| (n, i));
+        v = v.get(name)?;
+        for idx in indices.split('[').filter(|i| !i.is_empty()) {
+            v = v.get(idx.trim_end_matches(']').parse::<usize>().ok()?)?;
+        }
+    }
+    Some(v)
+}
+
+#[test]
+fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
+    let file = batch_recording(17374, "layout.mcap");
+    let bytes = std::fs::read(&file).unwrap();
+    let mut first: BTreeMap<String, serde_json::Value> = BTreeMap::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        if m.channel.message_encoding == "json" && !first.contains_key(&m.channel.topic) {
+            first.insert(
+                m.channel.topic.clone(),
+                serde_json::from_slice(&m.data).unwrap(),
+            );
+        }
+    }
+    let layout: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(root().join("docs/foxglove/flexdyn-layout.json")).unwrap(),
+    )
+    .unwrap();
+    let mut checked = 0;
+    for (id, panel) in layout["configById"].as_object().unwrap() {
+        let mut paths: Vec<String> = panel["paths"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .map(|p| p["value"].as_str().unwrap().to_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        if let Some(t) = panel["topicPath"].as_str() {
+            paths.push(t.to_owned());
+        }
+        if let Some(topics) = panel["topics"].as_object() {
+            paths.extend(topics.keys().cloned());
+        }
+        for path in paths {
+            // The topic is the longest recorded topic the path starts with.
+            let (topic, msg) = first
+                .iter()
+                .filter(|(t, _)| path.starts_with(t.as_str()))
+                .max_by_key(|(t, _)| t.len())
+                .unwrap_or_else(|| panic!("{id}: no recorded topic for {path}"));
+            let fields = &path[topic.len()..];
+            assert!(
+                resolve(msg, fields).is_some(),
+                "{id}: {path}: no field {fields} in {topic}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 20, "only {checked} paths checked");
 }

@@ -6,10 +6,10 @@
 //!   [`RAW_ENCODING`], schema `flexdyn.<Message>` with encoding [`RAW_SCHEMA_ENCODING`] whose data
 //!   is the message's wire layout from `proto/README.md` and the protocol version. The payload is
 //!   the exact wire bytes, so a recording can be hashed and replayed bit for bit.
-//! - **Decoded**: topic = key + [`DECODED_SUFFIX`], `message_encoding` `json`, schema
+//! - **Decoded**: topic = `/` + key ([`decoded_topic`]), `message_encoding` `json`, schema
 //!   `flexdyn.<Message>` (`jsonschema`, derived from the wire structs): readable by any MCAP tool.
-//! - **3D**: `flexdyn/<sc>/tf` (`foxglove.FrameTransforms`) for every state and
-//!   `flexdyn/<sc>/scene` (`foxglove.SceneUpdate`) once per vehicle, when the vehicle's
+//! - **3D**: `/flexdyn/<sc>/tf` (`foxglove.FrameTransforms`) for every state and
+//!   `/flexdyn/<sc>/scene` (`foxglove.SceneUpdate`) once per vehicle, when the vehicle's
 //!   configuration is known ([`VehicleInfo`]).
 //!
 //! Log time is the message's simulation time (`header.sim_time_ns`); publish time is the
@@ -34,8 +34,22 @@ use crate::config::SimConfig;
 pub const RAW_ENCODING: &str = "flexdyn-proto";
 /// Schema encoding of the raw channels: the schema data is the layout text.
 pub const RAW_SCHEMA_ENCODING: &str = "flexdyn-proto-layout";
-/// Suffix of a decoded channel's topic.
-pub const DECODED_SUFFIX: &str = "/json";
+/// The topic of a key's decoded channel: the key with a leading `/` (`/flexdyn/sc1/tlm/state`),
+/// Foxglove's topic convention, so message paths like `/flexdyn/sc1/tlm/state.sigma_bn[0]` work
+/// unquoted.
+pub fn decoded_topic(key: &str) -> String {
+    format!("/{key}")
+}
+
+/// The topic of a vehicle's `foxglove.FrameTransforms`.
+pub fn tf_topic(sc_id: &str) -> String {
+    format!("/flexdyn/{sc_id}/tf")
+}
+
+/// The topic of a vehicle's `foxglove.SceneUpdate`.
+pub fn scene_topic(sc_id: &str) -> String {
+    format!("/flexdyn/{sc_id}/scene")
+}
 /// Uncompressed bytes per chunk (Foxglove's own default is of this order).
 pub const CHUNK_SIZE_BYTES: u64 = 1 << 20;
 
@@ -339,8 +353,7 @@ impl McapSink {
                     json_schema(kind).to_string().into_bytes()
                 })?;
                 let raw = self.channel(raw_schema, key, RAW_ENCODING)?;
-                let decoded =
-                    self.channel(json_schema_id, &format!("{key}{DECODED_SUFFIX}"), "json")?;
+                let decoded = self.channel(json_schema_id, &decoded_topic(key), "json")?;
                 ChannelIds {
                     kind: Some(kind),
                     sc_id: topic.sc_id.to_owned(),
@@ -397,8 +410,8 @@ impl McapSink {
         let scene_schema = self.schema("foxglove.SceneUpdate", "jsonschema", &|| {
             scene_update_schema().to_string().into_bytes()
         })?;
-        let tf = self.channel(tf_schema, &format!("flexdyn/{sc_id}/tf"), "json")?;
-        let scene = self.channel(scene_schema, &format!("flexdyn/{sc_id}/scene"), "json")?;
+        let tf = self.channel(tf_schema, &tf_topic(sc_id), "json")?;
+        let scene = self.channel(scene_schema, &scene_topic(sc_id), "json")?;
         let prefix = format!("{sc_id}/");
         let scene_json = scene_update(&geometry, &prefix, t_ns).to_string();
         self.put(scene, t_ns, t_ns, scene_json.as_bytes())?;

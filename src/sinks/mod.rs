@@ -9,6 +9,7 @@
 //! - [`table`]: decoded messages as named columns (CSV export, plots).
 //! - [`record_cmd`], [`replay`], [`export`]: the `flexdyn record`, `replay` and `export`
 //!   subcommands.
+//! - [`view`]: `flexdyn view`, the live (or recorded) Foxglove WebSocket view.
 
 pub mod error;
 pub mod export;
@@ -20,5 +21,7 @@ pub mod replay;
 pub mod scene;
 pub mod table;
 pub mod topics;
+pub mod view;
+pub mod ws_names;
 
 pub use error::SinkError;

@@ -1,0 +1,355 @@
+//! `flexdyn view` from the outside: a WebSocket client written here from the
+//! `foxglove.websocket.v1` specification (not the SDK) connects — offering the protocol's
+//! original name in the live test and its SDK name `foxglove.sdk.v1` in the file test — gets `serverInfo` and the
+//! channel advertisements, subscribes, and checks that the decoded states and the N → B frame
+//! transforms agree with the StateMsg stream it receives itself over Zenoh (live), or with the
+//! recording (`--file`, including a pause/seek through playback control).
+//!
+//! Ports 17376–17379.
+
+#[path = "server_support/mod.rs"]
+mod server_support;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use flexdyn::attitude::mrp_to_quat;
+use flexdyn::sinks::reader::read_recording;
+use flexdyn_proto::{decode_state, StateMsg};
+use futures_util::{SinkExt, StreamExt};
+use nalgebra::Vector3;
+use serde_json::{json, Value};
+use server_support::{connecting_session, endpoint};
+use tokio_tungstenite::tungstenite::client::IntoClientRequest;
+use tokio_tungstenite::tungstenite::Message;
+use zenoh::Wait;
+
+struct Guard(Child);
+
+impl Drop for Guard {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn flexdyn(args: &[&str]) -> Guard {
+    Guard(
+        Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+            .args(args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    )
+}
+
+type Ws =
+    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+
+async fn connect(port: u16, subprotocol: &str) -> Ws {
+    let give_up = Instant::now() + Duration::from_secs(20);
+    loop {
+        let mut req = format!("ws://127.0.0.1:{port}")
+            .into_client_request()
+            .unwrap();
+        req.headers_mut()
+            .insert("Sec-WebSocket-Protocol", subprotocol.parse().unwrap());
+        match tokio_tungstenite::connect_async(req).await {
+            Ok((ws, resp)) => {
+                assert_eq!(
+                    resp.headers()
+                        .get("Sec-WebSocket-Protocol")
+                        .map(|v| v.to_str().unwrap()),
+                    Some(subprotocol)
+                );
+                return ws;
+            }
+            Err(e) => {
+                assert!(
+                    Instant::now() < give_up,
+                    "cannot connect to the viewer: {e}"
+                );
+                tokio::time::sleep(Duration::from_millis(100)).await;
+            }
+        }
+    }
+}
+
+/// What the client saw.
+#[derive(Default)]
+struct Seen {
+    server_info: Option<Value>,
+    /// topic → (channel id, schema name, encoding)
+    channels: HashMap<String, (u64, String, String)>,
+    /// subscription id → payloads (JSON)
+    messages: HashMap<u32, Vec<(u64, Value)>>,
+    playback_states: Vec<Vec<u8>>,
+}
+
+impl Seen {
+    fn take(&mut self, msg: Message) {
+        match msg {
+            Message::Text(t) => {
+                let v: Value = serde_json::from_str(&t).unwrap();
+                match v["op"].as_str() {
+                    Some("serverInfo") => self.server_info = Some(v),
+                    Some("advertise") => {
+                        for c in v["channels"].as_array().unwrap() {
+                            self.channels.insert(
+                                c["topic"].as_str().unwrap().to_owned(),
+                                (
+                                    c["id"].as_u64().unwrap(),
+                                    c["schemaName"].as_str().unwrap().to_owned(),
+                                    c["encoding"].as_str().unwrap().to_owned(),
+                                ),
+                            );
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            Message::Binary(b) => match b[0] {
+                // messageData: opcode, u32 subscription id, u64 timestamp, payload.
+                1 => {
+                    let sub = u32::from_le_bytes(b[1..5].try_into().unwrap());
+                    let t = u64::from_le_bytes(b[5..13].try_into().unwrap());
+                    let v: Value = serde_json::from_slice(&b[13..]).unwrap();
+                    self.messages.entry(sub).or_default().push((t, v));
+                }
+                5 => self.playback_states.push(b.to_vec()),
+                _ => {}
+            },
+            _ => {}
+        }
+    }
+}
+
+async fn pump_until(ws: &mut Ws, seen: &mut Seen, timeout: Duration, done: impl Fn(&Seen) -> bool) {
+    let give_up = Instant::now() + timeout;
+    while !done(seen) {
+        let left = give_up.saturating_duration_since(Instant::now());
+        assert!(!left.is_zero(), "timed out waiting on the viewer");
+        if let Ok(Some(Ok(m))) = tokio::time::timeout(left, ws.next()).await {
+            seen.take(m);
+        }
+    }
+}
+
+const STATE_TOPIC: &str = "/flexdyn/sc1/tlm/state";
+const TF_TOPIC: &str = "/flexdyn/sc1/tf";
+
+/// Connects, checks serverInfo and the advertisements, subscribes to the state and transform
+/// channels, and collects until `enough` of each arrived.
+async fn watch(
+    port: u16,
+    subprotocol: &str,
+    enough: usize,
+    before_collect: Option<Vec<u8>>,
+) -> Seen {
+    let mut ws = connect(port, subprotocol).await;
+    let mut seen = Seen::default();
+    pump_until(&mut ws, &mut seen, Duration::from_secs(20), |s| {
+        s.server_info.is_some()
+            && s.channels.contains_key(STATE_TOPIC)
+            && s.channels.contains_key(TF_TOPIC)
+    })
+    .await;
+    let info = seen.server_info.clone().unwrap();
+    assert!(
+        info["name"].as_str().unwrap().starts_with("flexdyn"),
+        "{info}"
+    );
+    assert!(
+        info["capabilities"]
+            .as_array()
+            .unwrap()
+            .contains(&json!("time")),
+        "{info}"
+    );
+    let (state_id, state_schema, enc) = seen.channels[STATE_TOPIC].clone();
+    assert_eq!(
+        (state_schema.as_str(), enc.as_str()),
+        ("flexdyn.StateMsg", "json")
+    );
+    let (tf_id, tf_schema, _) = seen.channels[TF_TOPIC].clone();
+    assert_eq!(tf_schema, "foxglove.FrameTransforms");
+    assert!(seen.channels.contains_key("/flexdyn/sc1/scene"));
+    let subscribe = json!({"op": "subscribe", "subscriptions": [
+        {"id": 1, "channelId": state_id}, {"id": 2, "channelId": tf_id}]});
+    ws.send(Message::Text(subscribe.to_string().into()))
+        .await
+        .unwrap();
+    if let Some(request) = before_collect {
+        ws.send(Message::Binary(request.into())).await.unwrap();
+    }
+    pump_until(&mut ws, &mut seen, Duration::from_secs(30), |s| {
+        s.messages.get(&1).is_some_and(|m| m.len() >= enough)
+            && s.messages.get(&2).is_some_and(|m| m.len() >= enough)
+    })
+    .await;
+    let _ = ws.close(None).await;
+    seen
+}
+
+/// Every received state equals the reference state of its tick, and every N → B rotation is
+/// the quaternion of that state's σ_BN. Returns how many states were compared.
+fn check_against(seen: &Seen, reference: &HashMap<u64, StateMsg>) -> usize {
+    let by_time: HashMap<u64, &StateMsg> = reference
+        .values()
+        .map(|s| (s.header.sim_time_ns, s))
+        .collect();
+    let mut compared = 0;
+    for (t, v) in &seen.messages[&1] {
+        let got: StateMsg = serde_json::from_value(v.clone()).unwrap();
+        assert_eq!(
+            *t, got.header.sim_time_ns,
+            "message time is simulation time"
+        );
+        if let Some(want) = reference.get(&got.header.tick) {
+            assert_eq!(&got, want, "tick {}", got.header.tick);
+            compared += 1;
+        }
+    }
+    let mut tf_compared = 0;
+    for (t, v) in &seen.messages[&2] {
+        let Some(state) = by_time.get(t) else {
+            continue;
+        };
+        let nb = &v["transforms"][0];
+        assert_eq!(nb["parent_frame_id"], "sc1/N");
+        assert_eq!(nb["child_frame_id"], "sc1/B");
+        let q = mrp_to_quat(&Vector3::from(state.sigma_bn));
+        let r = &nb["rotation"];
+        let got = [
+            r["w"].as_f64().unwrap(),
+            r["x"].as_f64().unwrap(),
+            r["y"].as_f64().unwrap(),
+            r["z"].as_f64().unwrap(),
+        ];
+        for i in 0..4 {
+            assert!((got[i] - q[i]).abs() < 1e-15, "t = {t}: {got:?} vs {q:?}");
+        }
+        tf_compared += 1;
+    }
+    assert!(tf_compared > 0, "no transform matched a reference state");
+    compared
+}
+
+#[test]
+fn a_foxglove_client_sees_the_live_state_and_its_transforms() {
+    let (zport, wport) = (17376, 17377);
+    let _server = flexdyn(&["run", "--duration-s", "120", "--listen", &endpoint(zport)]);
+    let _viewer = flexdyn(&[
+        "view",
+        "--bind",
+        &format!("127.0.0.1:{wport}"),
+        "--connect",
+        &endpoint(zport),
+        "--duration-s",
+        "120",
+    ]);
+    // Our own view of the stream, over Zenoh.
+    let session = connecting_session(zport);
+    let states: Arc<Mutex<HashMap<u64, StateMsg>>> = Arc::default();
+    let s2 = states.clone();
+    let _sub = session
+        .declare_subscriber("flexdyn/sc1/tlm/state")
+        .callback(move |sample| {
+            if let Ok(s) = decode_state(&sample.payload().to_bytes()) {
+                s2.lock().unwrap().insert(s.header.tick, s);
+            }
+        })
+        .wait()
+        .unwrap();
+    let rt = tokio::runtime::Runtime::new().unwrap();
+    let seen = rt.block_on(watch(wport, "foxglove.websocket.v1", 100, None));
+    std::thread::sleep(Duration::from_millis(200));
+    let reference = states.lock().unwrap().clone();
+    let compared = check_against(&seen, &reference);
+    eprintln!(
+        "live: {} states and {} transforms received, {compared} compared with the Zenoh stream",
+        seen.messages[&1].len(),
+        seen.messages[&2].len()
+    );
+    assert!(
+        compared >= 50,
+        "only {compared} states matched a tick seen over Zenoh"
+    );
+}
+
+fn recording(port: u16) -> PathBuf {
+    let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join("view_file.mcap");
+    let _ = std::fs::remove_file(&file);
+    let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args([
+            "run",
+            "--mode",
+            "batch",
+            "--duration-s",
+            "20",
+            "--listen",
+            &endpoint(port),
+        ])
+        .arg("--record")
+        .arg(&file)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success());
+    file
+}
+
+#[test]
+fn a_recording_plays_back_with_seek() {
+    let file = recording(17378);
+    let wport = 17379;
+    let _viewer = flexdyn(&[
+        "view",
+        "--file",
+        file.to_str().unwrap(),
+        "--bind",
+        &format!("127.0.0.1:{wport}"),
+        "--duration-s",
+        "120",
+    ]);
+    let rec = read_recording(&file).unwrap();
+    let reference: HashMap<u64, StateMsg> = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == "flexdyn/sc1/tlm/state")
+        .map(|s| decode_state(&s.payload).unwrap())
+        .map(|s| (s.header.tick, s))
+        .collect();
+    // Play at 20× from t = 15 s: playbackControlRequest (client binary opcode 3).
+    let seek_ns: u64 = 15_000_000_000;
+    let mut req = vec![3u8, 0];
+    req.extend_from_slice(&20.0f32.to_le_bytes());
+    req.push(1);
+    req.extend_from_slice(&seek_ns.to_le_bytes());
+    let id = b"seek-1";
+    req.extend_from_slice(&(id.len() as u32).to_le_bytes());
+    req.extend_from_slice(id);
+    let rt = tokio::runtime::Runtime::new().unwrap();
+    let seen = rt.block_on(watch(wport, "foxglove.sdk.v1", 60, Some(req)));
+    let compared = check_against(&seen, &reference);
+    assert!(compared >= 60);
+    // After the seek every state is from t ≥ 15 s, except those already in flight before it.
+    let late = seen.messages[&1]
+        .iter()
+        .filter(|(t, _)| *t >= seek_ns)
+        .count();
+    assert!(late >= 50, "only {late} states after the seek point");
+    assert!(
+        !seen.playback_states.is_empty(),
+        "no playbackState answered the request"
+    );
+    eprintln!(
+        "file: {} states received, {compared} compared with the recording, {late} after the seek",
+        seen.messages[&1].len()
+    );
+}
