@@ -55,6 +55,8 @@ enum Command {
     Export(sinks::export::ExportArgs),
     /// Serve the live stream (or a recording) to Foxglove over its WebSocket protocol.
     View(sinks::view::ViewArgs),
+    /// Draw PNG figures of a recording or a simulate/export CSV.
+    Plot(sinks::plot::PlotArgs),
 }
 
 /// Runs a sink subcommand and prints its one-line summary on stderr.
@@ -135,6 +137,21 @@ fn main() -> ExitCode {
                         .as_ref()
                         .map_or(String::new(), |why| format!(" (file ends early: {why})"))
                 )
+            })
+        }
+        Some(Command::Plot(a)) => {
+            return run_sink(sinks::plot::plot(&a), |r| {
+                let mut lines: Vec<String> = r
+                    .written
+                    .iter()
+                    .map(|p| format!("wrote {}", p.display()))
+                    .collect();
+                lines.extend(
+                    r.skipped
+                        .iter()
+                        .map(|(f, why)| format!("skipped {f}: {why}")),
+                );
+                lines.join("\n")
             })
         }
         Some(Command::View(a)) => {

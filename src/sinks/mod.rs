@@ -9,11 +9,13 @@
 //! - [`table`]: decoded messages as named columns (CSV export, plots).
 //! - [`record_cmd`], [`replay`], [`export`]: the `flexdyn record`, `replay` and `export`
 //!   subcommands.
+//! - [`plot`]: `flexdyn plot`, PNG figures of a recording or a CSV.
 //! - [`view`]: `flexdyn view`, the live (or recorded) Foxglove WebSocket view.
 
 pub mod error;
 pub mod export;
 pub mod mcap_file;
+pub mod plot;
 pub mod reader;
 pub mod record_cmd;
 pub mod recorder;
