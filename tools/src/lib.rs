@@ -3,7 +3,8 @@
 //! # Layout
 //! - `src/bin/flexdyn-acs-demo.rs`: demo MRP PD attitude controller, the template for flight
 //!   code (works in real time and lockstep).
-//! - `src/bin/flexdyn-monitor.rs`: live one-line summaries of state and status for operators.
+//! - `src/bin/flexdyn-monitor.rs`: live telemetry and status for operators: a terminal UI
+//!   with sparklines ([`monitor_tui`]), or one summary line per interval (`--plain`).
 //! - `src/bin/flexdyn-pingpong.rs`: plain Zenoh round trips, the yardstick of the lockstep
 //!   benchmark.
 //! - this library: [`CommonArgs`] (the connection options every tool shares) and [`pingpong`].
@@ -21,6 +22,7 @@ use flexdyn_proto::Topics;
 use zenoh::{Session, Wait};
 
 pub mod acs;
+pub mod monitor_tui;
 pub mod pingpong;
 
 /// Connection options shared by every tool (flatten into a binary's arguments with clap).

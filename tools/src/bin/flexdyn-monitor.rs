@@ -1,5 +1,9 @@
-//! `flexdyn-monitor`: prints one line per interval summarising the live telemetry and the
-//! server status, for operators.
+//! `flexdyn-monitor`: the live telemetry and the server status, for operators.
+//!
+//! In a terminal it is a full-screen UI (ratatui): the summary below, split over lines, and
+//! sparklines of |σ_BN|, |ω_BN|, each panel angle |θ1|, |θ2| and the server's p99 frame
+//! lateness (`q`, Esc or Ctrl-C quits). With `--plain`, or when standard output is not a
+//! terminal (a pipe, a log file, CI), it prints one line per interval instead:
 //!
 //! ```text
 //! t=12.340s tick=1234 states/s=100.0 gaps=0 |sigma_bn|=0.1234 |omega|=0.0456rad/s flags=- latency_ms p50=0.120 p99=0.410 | realtime running lateness_us p50=3.1 p99=21.0 max=118.2 overruns=0 skipped=0 cmd_age_ms=10.0 stale=no rejected=0 dropped=0
@@ -17,7 +21,7 @@
 //! - `rejected`: the server's rejected commands by reason (`stale_tick:2,unknown_sender:1`), and
 //!   `dropped` the valid commands it dropped for a full queue.
 
-use std::io::Write as _;
+use std::io::{IsTerminal as _, Write as _};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
@@ -43,6 +47,10 @@ struct Args {
     /// nothing was (default: run until SIGINT/SIGTERM).
     #[arg(long)]
     duration_s: Option<f64>,
+    /// One summary line per interval on standard output (for logs and CI) instead of the
+    /// terminal UI. Implied when standard output is not a terminal.
+    #[arg(long)]
+    plain: bool,
 }
 
 #[derive(Default)]
@@ -57,6 +65,8 @@ struct Window {
     flags: u8,
     /// Reaction wheels of the latest state: (speed rad/s, flags).
     wheels: Vec<(f64, u32)>,
+    /// Panel pairs of the latest state: (θ1, θ2) rad.
+    thetas: Vec<(f64, f64)>,
     latencies_ns: Vec<u64>,
     undecodable: u64,
     status: Option<StatusMsg>,
@@ -267,6 +277,16 @@ fn run(args: Args) -> anyhow::Result<()> {
                             .filter(|e| e.kind == effector_kind::REACTION_WHEEL)
                             .map(|e| (e.states.first().copied().unwrap_or(f64::NAN), e.flags)),
                     );
+                    w.thetas.clear();
+                    w.thetas.extend(
+                        s.effectors
+                            .iter()
+                            .filter(|e| e.kind == effector_kind::PANEL_PAIR)
+                            .map(|e| {
+                                let th = |i: usize| e.states.get(i).copied().unwrap_or(f64::NAN);
+                                (th(0), th(2))
+                            }),
+                    );
                     w.last_state_at = Some(Instant::now());
                     if let Some(stamp) = frame_stamp_ns(&sample) {
                         w.latencies_ns.push(received.saturating_sub(stamp));
@@ -297,6 +317,14 @@ fn run(args: Args) -> anyhow::Result<()> {
     );
     let stop = flexdyn_tools::stop_on_signals()?;
     let interval = Duration::from_secs_f64(args.interval_s);
+    let tui = !args.plain && std::io::stdout().is_terminal();
+    if tui {
+        let result = run_tui(&window, &stop, interval, &args, topics.state());
+        drop(_states);
+        drop(_status);
+        let _ = session.close().wait();
+        return result;
+    }
     let end = args
         .duration_s
         .map(|s| Instant::now() + Duration::from_secs_f64(s.max(0.0)));
@@ -345,6 +373,106 @@ fn run(args: Args) -> anyhow::Result<()> {
         .wait()
         .map_err(|e| anyhow::anyhow!("closing the Zenoh session: {e}"))?;
     Ok(())
+}
+
+/// The terminal UI loop: sparkline samples and a redraw every 100 ms, the summary text every
+/// `interval`; ends on q/Esc/Ctrl-C, a signal, or `--duration-s`.
+fn run_tui(
+    window: &Arc<Mutex<Window>>,
+    stop: &std::sync::atomic::AtomicBool,
+    interval: Duration,
+    args: &Args,
+    state_topic: &str,
+) -> anyhow::Result<()> {
+    use flexdyn_tools::monitor_tui::{render, Screen, Series};
+    use ratatui::crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers};
+
+    let mut terminal = ratatui::try_init()
+        .map_err(|e| anyhow::anyhow!("cannot start the terminal UI ({e}); use --plain"))?;
+    let end = args
+        .duration_s
+        .map(|s| Instant::now() + Duration::from_secs_f64(s.max(0.0)));
+    let mut screen = Screen {
+        title: format!("flexdyn-monitor {}", args.common.sc_id),
+        summary: vec![format!("waiting for {state_topic} …")],
+        series: vec![
+            Series::new("|σ_BN| (–)"),
+            Series::new("|ω_BN| (rad/s)"),
+            Series::new("frame lateness p99 (µs)"),
+        ],
+    };
+    let mut next_summary = Instant::now() + interval;
+    let mut any_data = false;
+    let result = loop {
+        if stop.load(std::sync::atomic::Ordering::Relaxed)
+            || end.is_some_and(|e| Instant::now() >= e)
+        {
+            break Ok(());
+        }
+        {
+            let mut w = window.lock().unwrap_or_else(|p| p.into_inner());
+            any_data |= w.last_state_at.is_some() || w.status.is_some();
+            if w.last_state_at.is_some() {
+                screen.series[0].push(w.sigma_norm);
+                screen.series[1].push(w.omega_norm);
+            }
+            let p99 = w
+                .status
+                .as_ref()
+                .map_or(f64::NAN, |s| s.timing.lateness_p99_ns as f64 * 1e-3);
+            screen.series[2].push(p99);
+            // One sparkline per panel angle, added as pairs appear.
+            for (k, (th1, th2)) in w.thetas.clone().into_iter().enumerate() {
+                for (j, th) in [(1, th1), (2, th2)] {
+                    let title = format!("pair{} |θ{j}| (rad)", k + 1);
+                    match screen.series.iter_mut().find(|s| s.title == title) {
+                        Some(s) => s.push(th.abs()),
+                        None => {
+                            let mut s = Series::new(title);
+                            s.push(th.abs());
+                            screen.series.push(s);
+                        }
+                    }
+                }
+            }
+            if Instant::now() >= next_summary {
+                next_summary += interval;
+                let text = line(&mut w, interval, state_topic);
+                screen.summary = text.split(" | ").map(str::to_owned).collect();
+                if let Some(s) = &w.status {
+                    screen.title = format!(
+                        "flexdyn-monitor {} — {} {}",
+                        args.common.sc_id,
+                        mode_name(s.mode),
+                        run_state_name(s.run_state)
+                    );
+                }
+            }
+        }
+        if let Err(e) = terminal.draw(|f| render(f, &screen)) {
+            break Err(anyhow::anyhow!("terminal: {e}"));
+        }
+        match event::poll(Duration::from_millis(100)) {
+            Ok(true) => {
+                if let Ok(Event::Key(k)) = event::read() {
+                    let ctrl_c =
+                        k.code == KeyCode::Char('c') && k.modifiers.contains(KeyModifiers::CONTROL);
+                    if k.kind == KeyEventKind::Press
+                        && (matches!(k.code, KeyCode::Char('q') | KeyCode::Esc) || ctrl_c)
+                    {
+                        break Ok(());
+                    }
+                }
+            }
+            Ok(false) => {}
+            Err(e) => break Err(anyhow::anyhow!("terminal input: {e}")),
+        }
+    };
+    ratatui::restore();
+    if result.is_ok() && end.is_some() && !any_data {
+        anyhow::bail!("no data: nothing received during --duration-s: no server, or it is not reachable at the --connect endpoint");
+    }
+    result
 }
 
 #[cfg(test)]
