@@ -464,8 +464,8 @@ impl McapSink {
         };
         self.put(raw, log_time, publish_time, payload)?;
         if let Some(channel) = decoded_channel {
-            let json = decoded.to_json().to_string();
-            self.put(channel, log_time, publish_time, json.as_bytes())?;
+            let json = decoded.to_json_bytes();
+            self.put(channel, log_time, publish_time, &json)?;
         }
         if let Decoded::State(state) = decoded {
             let v = self.vehicles.entry(sc_id.clone()).or_default();

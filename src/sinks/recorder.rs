@@ -156,8 +156,29 @@ fn run(
     sink.finish()
 }
 
+/// Real time: the recorder yields the CPU to everything else (SCHED_BATCH at nice 19 on Linux),
+/// so on a machine with few cores it does not preempt the physics thread; what it cannot keep
+/// up with is dropped and counted. Needs no privilege (lowering is always allowed).
+fn lower_priority() {
+    #[cfg(target_os = "linux")]
+    {
+        use thread_priority::{
+            set_thread_priority_and_policy, thread_native_id, NormalThreadSchedulePolicy,
+            ThreadPriority, ThreadSchedulePolicy,
+        };
+        if let Err(e) = set_thread_priority_and_policy(
+            thread_native_id(),
+            ThreadPriority::Min,
+            ThreadSchedulePolicy::Normal(NormalThreadSchedulePolicy::Batch),
+        ) {
+            tracing::debug!(error = ?e, "cannot lower the recorder thread's priority");
+        }
+    }
+}
+
 impl Recorder {
-    /// Creates the file and starts the recorder thread with a queue of `capacity` samples.
+    /// Creates the file and starts the recorder thread with a queue of `capacity` samples. A
+    /// lossy recorder (real time) also runs at the lowest CPU priority.
     pub fn start(
         path: &Path,
         info: &RecordingInfo,
@@ -170,7 +191,12 @@ impl Recorder {
         let d = dropped.clone();
         let join = std::thread::Builder::new()
             .name("flexdyn-recorder".into())
-            .spawn(move || run(sink, rx, d))
+            .spawn(move || {
+                if !lossless {
+                    lower_priority();
+                }
+                run(sink, rx, d)
+            })
             .map_err(|source| RecordError::Create {
                 path: path.to_owned(),
                 source,

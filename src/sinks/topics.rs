@@ -132,6 +132,19 @@ impl Decoded {
         }
     }
 
+    /// The message as JSON text, serialised straight from the struct (the recorder's and the
+    /// viewer's path: no intermediate [`serde_json::Value`]).
+    pub fn to_json_bytes(&self) -> Vec<u8> {
+        let v = match self {
+            Decoded::State(m) => serde_json::to_vec(m),
+            Decoded::Imu(m) => serde_json::to_vec(m),
+            Decoded::StarTracker(m) => serde_json::to_vec(m),
+            Decoded::Command(m) => serde_json::to_vec(m),
+            Decoded::Status(m) => serde_json::to_vec(m),
+        };
+        v.unwrap_or_else(|_| b"null".to_vec())
+    }
+
     /// The message as JSON, field names as in the wire structs (they carry their units).
     pub fn to_json(&self) -> serde_json::Value {
         let v = match self {

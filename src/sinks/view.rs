@@ -161,8 +161,8 @@ impl Translator {
                 json_schema(kind).to_string().into_bytes(),
             )
         }) {
-            let json = decoded.to_json().to_string();
-            c.log_with_meta(json.as_bytes(), PartialMetadata { log_time: Some(t) });
+            let json = decoded.to_json_bytes();
+            c.log_with_meta(&json, PartialMetadata { log_time: Some(t) });
         }
         if let Decoded::State(state) = &decoded {
             self.latest_time_ns = self.latest_time_ns.max(t);

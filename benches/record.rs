@@ -1,0 +1,209 @@
+//! Recorder throughput: how fast [`McapSink`] turns a real telemetry stream into an MCAP file
+//! (raw + decoded JSON + frame transforms, zstd chunks), against the named peer measured in the
+//! same run: the `mcap` crate's own writer storing the same payloads raw only, with the same
+//! chunking and compression (the floor any recorder of this format pays).
+//!
+//! The stream is 20 000 frames of the wheel scenario (`scenarios/wheels_star_tracker.toml`:
+//! two panel pairs, four wheels, an IMU and a star tracker), encoded once up front: per frame a
+//! StateMsg and an ImuMsg, a StarTrackerMsg every 10th frame and a StatusMsg every 100th.
+//! Prints the median over rounds of messages/s, payload MB/s and file size for both writers.
+//!
+//! `cargo bench --bench record`; environment `FLEXDYN_BENCH_RECORD_ROUNDS` (default 7).
+
+use std::collections::BTreeMap;
+use std::io::BufWriter;
+use std::path::Path;
+use std::time::Instant;
+
+use flexdyn::config::SimConfig;
+use flexdyn::sim::Simulation;
+use flexdyn::sinks::mcap_file::{
+    McapSink, RecordingInfo, VehicleInfo, CHUNK_SIZE_BYTES, RAW_ENCODING,
+};
+use flexdyn_proto::{encode, EffectorState, Header, StateMsg, StatusMsg};
+
+const FRAMES: u64 = 20_000;
+
+fn stream(cfg: &SimConfig) -> Vec<(String, Vec<u8>, u64)> {
+    let mut sim = Simulation::new(cfg).expect("scenario");
+    let mut out = Vec::new();
+    let mut snap = flexdyn::sim::Snapshot::for_simulation(&sim);
+    let mut imu = Vec::new();
+    let mut st = Vec::new();
+    for tick in 0..FRAMES {
+        if tick > 0 {
+            sim.step_frame();
+        }
+        sim.snapshot_into(&mut snap);
+        let stamp = 1_700_000_000_000_000_000 + tick * cfg.frame_ns;
+        let header = Header::new(1, tick, tick * cfg.frame_ns, tick);
+        let state = StateMsg {
+            header,
+            sigma_bn: snap.sigma_bn.into(),
+            q_bn: snap.q_bn.into(),
+            omega_bn_b_rad_s: snap.omega_bn_b.into(),
+            omega_dot_bn_b_rad_s2: snap.omega_dot_bn_b.into(),
+            r_bn_n_m: snap.r_bn_n.into(),
+            v_bn_n_m_s: snap.v_bn_n.into(),
+            nongrav_accel_bn_n_m_s2: snap.nongrav_accel_bn_n.into(),
+            effectors: snap
+                .effectors
+                .iter()
+                .map(|e| EffectorState {
+                    kind: e.kind.wire_tag,
+                    flags: e.flags,
+                    states: e.states.clone(),
+                    outputs: e.outputs.clone(),
+                })
+                .collect(),
+            ..StateMsg::default()
+        };
+        out.push(("flexdyn/sc1/tlm/state".to_owned(), encode(&state), stamp));
+        sim.imu_samples_into(&mut imu);
+        for (s, name) in imu.iter().zip(sim.imu_names()) {
+            out.push((
+                format!("flexdyn/sc1/tlm/imu/{name}"),
+                encode(&s.to_msg(header)),
+                stamp,
+            ));
+        }
+        sim.star_tracker_samples_into(tick, &mut st);
+        for (i, s) in &st {
+            let name = sim.star_trackers()[*i].name();
+            out.push((
+                format!("flexdyn/sc1/tlm/st/{name}"),
+                encode(&s.to_msg(header)),
+                stamp,
+            ));
+        }
+        if tick % 100 == 0 {
+            let status = StatusMsg {
+                header,
+                wall_time_unix_ns: stamp,
+                ..StatusMsg::default()
+            };
+            out.push(("flexdyn/sc1/status".to_owned(), encode(&status), stamp));
+        }
+    }
+    out
+}
+
+fn flexdyn_sink(path: &Path, info: &VehicleInfo, msgs: &[(String, Vec<u8>, u64)]) -> u64 {
+    let mut sink = McapSink::create(
+        path,
+        &RecordingInfo {
+            recorder: "bench".into(),
+            command_line: String::new(),
+        },
+    )
+    .unwrap();
+    sink.describe_vehicle(info).unwrap();
+    for (key, payload, stamp) in msgs {
+        sink.write(key, payload, Some(*stamp), *stamp).unwrap();
+    }
+    sink.finish().unwrap().mcap_messages
+}
+
+fn raw_mcap(path: &Path, msgs: &[(String, Vec<u8>, u64)]) -> u64 {
+    let file = std::fs::File::create(path).unwrap();
+    let mut w = mcap::WriteOptions::new()
+        .compression(Some(mcap::Compression::Zstd))
+        .chunk_size(Some(CHUNK_SIZE_BYTES))
+        .create(BufWriter::new(file))
+        .unwrap();
+    let schema = w.add_schema("raw", "", b"").unwrap();
+    let mut channels: BTreeMap<&str, u16> = BTreeMap::new();
+    for (i, (key, payload, stamp)) in msgs.iter().enumerate() {
+        let id = match channels.get(key.as_str()) {
+            Some(id) => *id,
+            None => {
+                let id = w
+                    .add_channel(schema, key, RAW_ENCODING, &BTreeMap::new())
+                    .unwrap();
+                channels.insert(key, id);
+                id
+            }
+        };
+        let header = mcap::records::MessageHeader {
+            channel_id: id,
+            sequence: i as u32,
+            log_time: *stamp,
+            publish_time: *stamp,
+        };
+        w.write_to_known_channel(&header, payload).unwrap();
+    }
+    w.finish().unwrap();
+    msgs.len() as u64
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let rounds: usize = std::env::var("FLEXDYN_BENCH_RECORD_ROUNDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(7);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let cfg = SimConfig::from_toml_str(&text).unwrap();
+    let msgs = stream(&cfg);
+    let payload_bytes: usize = msgs.iter().map(|(_, p, _)| p.len()).sum();
+    let info = VehicleInfo {
+        sc_id: "sc1".into(),
+        spacecraft_id: 1,
+        config_toml: text,
+        server_settings: String::new(),
+        flexdyn_version: "bench".into(),
+        git_commit: None,
+    };
+    println!(
+        "recorder throughput: {} samples ({:.1} MB of payload, {FRAMES} frames of the wheel \
+         scenario), {rounds} rounds, median",
+        msgs.len(),
+        payload_bytes as f64 / 1e6
+    );
+    let dir = std::env::temp_dir().join(format!("flexdyn-bench-record-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (mut ours, mut peer) = (Vec::new(), Vec::new());
+    let (mut ours_size, mut peer_size, mut ours_msgs) = (0, 0, 0);
+    for _ in 0..rounds {
+        let a = dir.join("flexdyn.mcap");
+        let t = Instant::now();
+        ours_msgs = flexdyn_sink(&a, &info, &msgs);
+        ours.push(t.elapsed().as_secs_f64());
+        ours_size = std::fs::metadata(&a).unwrap().len();
+        let b = dir.join("raw.mcap");
+        let t = Instant::now();
+        raw_mcap(&b, &msgs);
+        peer.push(t.elapsed().as_secs_f64());
+        peer_size = std::fs::metadata(&b).unwrap().len();
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    let (a, b) = (median(ours), median(peer));
+    let n = msgs.len() as f64;
+    let mb = payload_bytes as f64 / 1e6;
+    println!(
+        "flexdyn McapSink (raw + JSON + transforms): {:.0} samples/s, {:.1} MB/s of payload, \
+         {:.3} s per run, {ours_msgs} MCAP messages, file {:.1} MB",
+        n / a,
+        mb / a,
+        a,
+        ours_size as f64 / 1e6
+    );
+    println!(
+        "peer: mcap::Writer raw only:                {:.0} samples/s, {:.1} MB/s of payload, \
+         {:.3} s per run, file {:.1} MB",
+        n / b,
+        mb / b,
+        b,
+        peer_size as f64 / 1e6
+    );
+    println!(
+        "ratio flexdyn/peer time: {:.2}; headroom at 1 kHz: {:.0} frames/s of this stream",
+        a / b,
+        FRAMES as f64 / a
+    );
+}
