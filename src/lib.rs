@@ -9,11 +9,13 @@
 //! - [`transport`]: the one Zenoh configuration builder (loopback, multicast scouting off),
 //!   shared by the server and the tools.
 //! - [`sinks`]: recording (MCAP), replay, export, the live Foxglove view and plots.
+//! - [`campaign`]: Monte Carlo campaigns with flight code in the loop.
 //! - [`server`]: the Zenoh server (`flexdyn run`): real-time, lockstep and batch propagation.
 
 #![warn(missing_docs)]
 
 pub mod attitude;
+pub mod campaign;
 pub mod cli;
 pub mod config;
 pub mod dynamics;

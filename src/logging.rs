@@ -37,9 +37,15 @@ impl Write for LossyStderr {
 /// Logs to stderr at `RUST_LOG` (default `info`), shared by `flexdyn` and the tools. Does
 /// nothing if a subscriber is already installed.
 pub fn init_tracing() {
+    init_tracing_at("info");
+}
+
+/// [`init_tracing`] with `default` (e.g. `warn`) as the level when `RUST_LOG` is unset: for
+/// commands whose own output would drown in the servers' info lines (`campaign run`).
+pub fn init_tracing_at(default: &str) {
     let env = std::env::var("RUST_LOG").unwrap_or_default();
     let mut directives = if env.trim().is_empty() {
-        "info".to_string()
+        default.to_string()
     } else {
         env.clone()
     };

@@ -57,6 +57,9 @@ enum Command {
     View(sinks::view::ViewArgs),
     /// Draw PNG figures of a recording or a simulate/export CSV.
     Plot(sinks::plot::PlotArgs),
+    /// Monte Carlo campaigns: plan, run (locally or one index at a time), summarize.
+    #[command(subcommand)]
+    Campaign(flexdyn::campaign::CampaignCommand),
 }
 
 /// Runs a sink subcommand and prints its one-line summary on stderr.
@@ -100,7 +103,12 @@ fn main() -> ExitCode {
         Ok(a) => a,
         Err(code) => return code,
     };
-    flexdyn::cli::init_tracing();
+    if matches!(args.command, Some(Command::Campaign(_))) {
+        // Each run's server would log its start and end at info: keep the progress bar readable.
+        flexdyn::logging::init_tracing_at("warn");
+    } else {
+        flexdyn::cli::init_tracing();
+    }
     let result = match args.command {
         Some(Command::Simulate(a)) => cli::simulate(&a).map(|report| {
             let _ = writeln!(std::io::stderr(), "{report}");
@@ -138,6 +146,18 @@ fn main() -> ExitCode {
                         .map_or(String::new(), |why| format!(" (file ends early: {why})"))
                 )
             })
+        }
+        Some(Command::Campaign(c)) => {
+            return match flexdyn::campaign::main(&c) {
+                Ok(text) => {
+                    let _ = writeln!(std::io::stderr(), "{text}");
+                    ExitCode::SUCCESS
+                }
+                Err((code, message)) => {
+                    let _ = writeln!(std::io::stderr(), "error: {message}");
+                    ExitCode::from(code)
+                }
+            }
         }
         Some(Command::Plot(a)) => {
             return run_sink(sinks::plot::plot(&a), |r| {

@@ -256,6 +256,11 @@ pub trait StateEffector: Send + std::fmt::Debug {
     }
     /// Writes the effector's initial state into `x`.
     fn initial_state(&self, x: &mut [f64]);
+    /// Every numeric parameter of the built body, keyed by its configuration path relative to
+    /// the effector's table (`panel1.k_nm_rad`, `r_h1b_b_m[0]`, `dcm_h1b[2][2]`); initial
+    /// values are read from `x0`, the body's slice of the initial state. A campaign reads the
+    /// dispersed values back from here, not from the file. Not on the stepping path.
+    fn parameters(&self, _x0: &[f64], _out: &mut Vec<(String, f64)>) {}
     /// Pass 1: adds the mass properties about B at state `x` into `sum`.
     fn update_mass_props(&mut self, x: &[f64], sum: &mut EffectorMassProps);
     /// Pass 2: adds the contributions to the hub system at state `x` into `sum` (after pass 1 on

@@ -7,7 +7,7 @@
 
 use std::fmt;
 
-mod reader;
+pub(crate) mod reader;
 
 pub(crate) use reader::TableReader;
 

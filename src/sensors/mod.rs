@@ -8,5 +8,5 @@
 //! evaluations.
 
 pub mod imu;
-mod rng;
+pub mod rng;
 pub mod star_tracker;

@@ -103,17 +103,36 @@ fn scale_pow2(mut y: f64, mut k: i64) -> f64 {
 // ---------------------------------------------------------------------------------------------
 // Random numbers.
 
-/// Standard normal pairs by Marsaglia's polar method on ChaCha8 (see the module docs).
+/// Standard normal pairs by Marsaglia's polar method on ChaCha8 (see the module docs). Also the
+/// campaign dispersions' generator.
 #[derive(Debug, Clone)]
-pub(crate) struct NormalRng {
+pub struct NormalRng {
     rng: ChaCha8Rng,
 }
 
 impl NormalRng {
-    pub(crate) fn new(seed: u64) -> Self {
+    /// A generator seeded with `seed` (ChaCha8's `seed_from_u64`).
+    pub fn new(seed: u64) -> Self {
         Self {
             rng: ChaCha8Rng::seed_from_u64(seed),
         }
+    }
+
+    /// Uniform on [0, 1) with 53 random bits.
+    pub fn uniform01(&mut self) -> f64 {
+        const TWO_POW_M53: f64 = 1.0 / 9_007_199_254_740_992.0;
+        (self.rng.next_u64() >> 11) as f64 * TWO_POW_M53
+    }
+
+    /// One standard normal (the first of a pair; the second is discarded, so every call uses
+    /// the same amount of the stream whatever came before).
+    pub fn normal(&mut self) -> f64 {
+        self.normal_pair().0
+    }
+
+    /// 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.rng.next_u64()
     }
 
     /// Uniform on [−1, 1) with 53 random bits.
@@ -125,7 +144,7 @@ impl NormalRng {
 
     /// Two independent standard normals.
     #[inline]
-    pub(crate) fn normal_pair(&mut self) -> (f64, f64) {
+    pub fn normal_pair(&mut self) -> (f64, f64) {
         loop {
             let u = self.uniform_pm1();
             let v = self.uniform_pm1();

@@ -28,7 +28,14 @@ use super::topics::{classify, Decoded, TopicKind};
 use crate::attitude::mrp_error;
 
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
-const FONT_NAME: &str = "flexdyn-sans";
+/// The name the embedded font is registered under (see [`register_font`]).
+pub const FONT_NAME: &str = "flexdyn-sans";
+
+/// Registers the embedded font with plotters as [`FONT_NAME`] (idempotent).
+pub fn register_font() -> Result<(), SinkError> {
+    plotters::style::register_font(FONT_NAME, FontStyle::Normal, FONT)
+        .map_err(|_| SinkError::Runtime("the embedded font does not load".into()))
+}
 const SIZE: (u32, u32) = (1200, 800);
 const COLORS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
@@ -461,8 +468,7 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
         path: args.output.clone(),
         problem: e.to_string(),
     })?;
-    plotters::style::register_font(FONT_NAME, FontStyle::Normal, FONT)
-        .map_err(|_| SinkError::Runtime("the embedded font does not load".into()))?;
+    register_font()?;
     let mut report = PlotReport::default();
     let s = &data.state;
     let t = &s.t_s;

@@ -3,12 +3,9 @@
 #![allow(dead_code)]
 
 use std::process::{Child, Command, ExitStatus, Stdio};
-use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use flexdyn_proto::{decode_state, encode, CommandMsg, Header, Topics};
-use zenoh::qos::CongestionControl;
-use zenoh::{Session, Wait};
+use flexdyn_proto::Topics;
 
 // The server harness (sessions on the test's own loopback port, the reference config with
 // another frame rate, `server::run` in a background thread) is the root package's.
@@ -21,57 +18,22 @@ pub use server_support::{
 };
 
 /// Every StateMsg payload seen, with its tick.
-pub type Recorded = Arc<Mutex<Vec<(u64, Vec<u8>)>>>;
+pub type Recorded = flexdyn::campaign::execute::Received;
 
 /// A passive lockstep participant living in the test process: records every state payload and
-/// answers it with `NoCommand` as `sender_id`. Keep the returned handles alive.
+/// answers it with `NoCommand` as `sender_id` (the campaign's observer). Keep it alive.
 pub struct Recorder {
     pub states: Recorded,
-    _session: Session,
-    _sub: zenoh::pubsub::Subscriber<()>,
-    _token: zenoh::liveliness::LivelinessToken,
+    _observer: flexdyn::campaign::execute::Observer,
 }
 
 impl Recorder {
     pub fn start(port: u16, topics: &Topics, sender_id: u32) -> Self {
-        let session = connecting_session(port);
-        let states: Recorded = Arc::default();
-        let publisher = session
-            .declare_publisher(topics.cmd_wrench().to_owned())
-            .congestion_control(CongestionControl::Block)
-            .express(true)
-            .wait()
-            .unwrap();
-        let rec = states.clone();
-        let mut seq = 0u64;
-        let sub = session
-            .declare_subscriber(topics.state().to_owned())
-            .callback_mut(move |sample| {
-                let bytes = sample.payload().to_bytes().into_owned();
-                let Ok(state) = decode_state(&bytes) else {
-                    return;
-                };
-                let h = state.header;
-                rec.lock().unwrap().push((h.tick, bytes));
-                let cmd = CommandMsg::no_command(
-                    Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq),
-                    sender_id,
-                );
-                seq += 1;
-                let _ = publisher.put(encode(&cmd)).wait();
-            })
-            .wait()
-            .unwrap();
-        let token = session
-            .liveliness()
-            .declare_token(topics.participant(sender_id))
-            .wait()
-            .unwrap();
+        let observer =
+            flexdyn::campaign::execute::Observer::start(port, topics, sender_id).unwrap();
         Self {
-            states,
-            _session: session,
-            _sub: sub,
-            _token: token,
+            states: observer.states.clone(),
+            _observer: observer,
         }
     }
 

@@ -306,6 +306,39 @@ impl StateEffector for PanelPair {
         &STATE_NAMES
     }
 
+    fn parameters(&self, x0: &[f64], out: &mut Vec<(String, f64)>) {
+        let p = &self.params;
+        let mut put = |k: String, v: f64| out.push((k, v));
+        for i in 0..3 {
+            put(format!("r_h1b_b_m[{i}]"), p.r_h1b_b_m[i]);
+            for j in 0..3 {
+                put(format!("dcm_h1b[{i}][{j}]"), p.dcm_h1b[(i, j)]);
+            }
+        }
+        put("theta_h2s1_rad".into(), p.theta_h2s1_rad);
+        put("motor_torque_nm[0]".into(), p.motor_torque_nm[0]);
+        put("motor_torque_nm[1]".into(), p.motor_torque_nm[1]);
+        put("panel1.l_m".into(), p.l1_m);
+        let states = [(THETA1, THETA1_DOT), (THETA2, THETA2_DOT)];
+        for (name, panel, (th, th_dot)) in [
+            ("panel1", &p.panel1, states[0]),
+            ("panel2", &p.panel2, states[1]),
+        ] {
+            put(format!("{name}.mass_kg"), panel.mass_kg);
+            for i in 0..3 {
+                put(
+                    format!("{name}.inertia_s_kg_m2[{i}]"),
+                    panel.inertia_s_kg_m2[i],
+                );
+            }
+            put(format!("{name}.d_m"), panel.d_m);
+            put(format!("{name}.k_nm_rad"), panel.k_nm_rad);
+            put(format!("{name}.c_nm_s_rad"), panel.c_nm_s_rad);
+            put(format!("{name}.theta_rad"), x0[th]);
+            put(format!("{name}.theta_dot_rad_s"), x0[th_dot]);
+        }
+    }
+
     fn initial_state(&self, x: &mut [f64]) {
         x[THETA1] = self.initial.theta1_rad;
         x[THETA1_DOT] = self.initial.theta1_dot_rad_s;

@@ -265,6 +265,26 @@ impl StateEffector for ReactionWheel {
         (self.applied_nm, self.flags) = self.limit(x[OMEGA]);
     }
 
+    fn parameters(&self, x0: &[f64], out: &mut Vec<(String, f64)>) {
+        let p = &self.params;
+        let mut put = |k: &str, v: f64| out.push((k.to_owned(), v));
+        for i in 0..3 {
+            put(&format!("spin_axis_b[{i}]"), p.spin_axis_b[i]);
+            put(&format!("r_wb_b_m[{i}]"), p.r_wb_b_m[i]);
+        }
+        put("mass_kg", p.mass_kg);
+        put("j_s_kg_m2", p.j_s_kg_m2);
+        put("j_t_kg_m2", p.j_t_kg_m2);
+        put("max_torque_nm", p.max_torque_nm);
+        put("max_speed_rad_s", p.max_speed_rad_s);
+        put("omega_rad_s", x0[0]);
+        put("viscous_friction_nm_s_rad", p.viscous_friction_nm_s_rad);
+        put("coulomb_friction_nm", p.coulomb_friction_nm);
+        put("coulomb_band_rad_s", p.coulomb_band_rad_s);
+        put("static_imbalance_kg_m", p.static_imbalance_kg_m);
+        put("dynamic_imbalance_kg_m2", p.dynamic_imbalance_kg_m2);
+    }
+
     fn initial_state(&self, x: &mut [f64]) {
         x[OMEGA] = self.params.omega_rad_s;
         if self.imbalanced {

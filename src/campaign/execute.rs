@@ -1,0 +1,580 @@
+//! `flexdyn campaign run`: each run is a lockstep server on its own loopback port, an observer
+//! participant in this process (sender id [`OBSERVER_ID`], answering `NoCommand`, so it sees
+//! every tick from 0), and the flight code as a child process (sender id 1), when the campaign
+//! has a `controller`. Open-loop runs have the observer only.
+//!
+//! A run writes `run-NNNN/result.json`: the parameters read back from its built model, its
+//! seeds, the SHA-256 over its StateMsg payloads in tick order, the criteria, the exit status of
+//! the server and the controller, and the wall time; with `--record`, `run-NNNN/recording.mcap`.
+//! A controller that exits before the end stops the run at once, which fails with its status.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use flexdyn_proto::{decode_state, encode, CommandMsg, Header, Mode, StateMsg, Topics};
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use zenoh::qos::CongestionControl;
+use zenoh::{Session, Wait};
+
+use super::plan::{readback, Plan, RunPlan};
+use super::spec::{Campaign, Criterion, Quantity, Statistic};
+use crate::attitude::mrp_error;
+use crate::config::SimConfig;
+use crate::server::ServerSettings;
+use crate::transport::{zenoh_config, Role, ZenohArgs};
+
+/// The observer's sender id.
+pub const OBSERVER_ID: u32 = 9;
+/// The flight code's sender id (`{sender_id}`).
+pub const CONTROLLER_ID: u32 = 1;
+/// The spacecraft id of every run (`{sc_id}`); runs are separated by port.
+pub const SC_ID: &str = "sc1";
+
+/// Splits a command line into words: whitespace separates, `'…'` and `"…"` quote (no escapes
+/// inside single quotes; `\` escapes the next character elsewhere). No shell is involved.
+pub fn split_command(line: &str) -> Result<Vec<String>, String> {
+    let mut words = Vec::new();
+    let mut cur = String::new();
+    let mut in_word = false;
+    let mut chars = line.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '\'' => {
+                in_word = true;
+                loop {
+                    match chars.next() {
+                        Some('\'') => break,
+                        Some(x) => cur.push(x),
+                        None => return Err("unterminated ' quote".into()),
+                    }
+                }
+            }
+            '"' => {
+                in_word = true;
+                loop {
+                    match chars.next() {
+                        Some('"') => break,
+                        Some('\\') => cur.push(chars.next().ok_or("trailing \\")?),
+                        Some(x) => cur.push(x),
+                        None => return Err("unterminated \" quote".into()),
+                    }
+                }
+            }
+            '\\' => {
+                in_word = true;
+                cur.push(chars.next().ok_or("trailing \\")?);
+            }
+            c if c.is_whitespace() => {
+                if in_word {
+                    words.push(std::mem::take(&mut cur));
+                    in_word = false;
+                }
+            }
+            c => {
+                in_word = true;
+                cur.push(c);
+            }
+        }
+    }
+    if in_word {
+        words.push(cur);
+    }
+    Ok(words)
+}
+
+/// One criterion's outcome.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CriterionResult {
+    /// Its name.
+    pub name: String,
+    /// The statistic's value.
+    pub value: f64,
+    /// Whether it is below the bound.
+    pub passed: bool,
+}
+
+/// What one run did (`run-NNNN/result.json`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunResult {
+    /// Index.
+    pub run: u32,
+    /// The run's seed and its sensors' seeds.
+    pub run_seed: u64,
+    /// Sensor seeds by key.
+    pub sensor_seeds: BTreeMap<String, u64>,
+    /// Draws rejected before the accepted one.
+    pub redraws: u32,
+    /// Dispersed parameters as read back from the built model, by key.
+    pub applied: BTreeMap<String, f64>,
+    /// SHA-256 over the StateMsg payloads, ticks 0..=N in order (empty if the run failed).
+    pub state_sha256: String,
+    /// States received.
+    pub states: u64,
+    /// Criteria.
+    pub criteria: Vec<CriterionResult>,
+    /// Every criterion passed and the run completed.
+    pub passed: bool,
+    /// `ok`, or why the run failed (server error, controller exit, invalid draw).
+    pub status: String,
+    /// The controller's exit status (`exit 0`, `exit 3`, `signal 9`, `still running: stopped`).
+    pub controller_exit: Option<String>,
+    /// \[s\] wall time of the run.
+    pub wall_s: f64,
+    /// \[s\] simulated time reached.
+    pub sim_s: f64,
+}
+
+/// Options of `campaign run`.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// Output directory (the plan's).
+    pub dir: PathBuf,
+    /// First port; run i uses `base_port + i`.
+    pub base_port: u16,
+    /// Record each run to `run-NNNN/recording.mcap`.
+    pub record: bool,
+}
+
+fn quantity(q: Quantity, s: &StateMsg, sigma_rn: &Vector3<f64>) -> f64 {
+    match q {
+        Quantity::SigmaBr => mrp_error(&Vector3::from(s.sigma_bn), sigma_rn).norm(),
+        Quantity::SigmaBn => Vector3::from(s.sigma_bn).norm(),
+        Quantity::Omega => Vector3::from(s.omega_bn_b_rad_s).norm(),
+        Quantity::Theta => s
+            .effectors
+            .iter()
+            .filter(|e| e.kind == flexdyn_proto::effector_kind::PANEL_PAIR)
+            .flat_map(|e| [e.states.first(), e.states.get(2)])
+            .flatten()
+            .fold(0.0f64, |m, x| m.max(x.abs())),
+    }
+}
+
+/// Evaluates `c` over `states` (in tick order).
+pub fn evaluate(
+    c: &Criterion,
+    states: &[StateMsg],
+    sigma_rn: [f64; 3],
+    frame_s: f64,
+) -> CriterionResult {
+    let target = Vector3::from(sigma_rn);
+    let series: Vec<(f64, f64)> = states
+        .iter()
+        .map(|s| {
+            (
+                s.header.sim_time_ns as f64 * 1e-9,
+                quantity(c.quantity, s, &target),
+            )
+        })
+        .collect();
+    let value = match c.statistic {
+        Statistic::Final => series.last().map_or(f64::NAN, |(_, v)| *v),
+        Statistic::Max => series
+            .iter()
+            .filter(|(t, _)| *t >= c.after_s - 1e-9)
+            .fold(f64::NEG_INFINITY, |m, (_, v)| m.max(*v)),
+        Statistic::SettlingTime { threshold } => {
+            // The first time after which every sample stays below the threshold.
+            // NaN counts as outside the band.
+            let last_out = series
+                .iter()
+                .rposition(|(_, v)| v.is_nan() || *v >= threshold);
+            match last_out {
+                None => series.first().map_or(f64::NAN, |(t, _)| *t),
+                Some(i) if i + 1 < series.len() => series[i + 1].0,
+                Some(i) => series[i].0 + frame_s,
+            }
+        }
+    };
+    CriterionResult {
+        name: c.name.clone(),
+        value,
+        passed: value < c.below,
+    }
+}
+
+/// Every (tick, StateMsg payload) the observer received.
+pub type Received = Arc<Mutex<Vec<(u64, Vec<u8>)>>>;
+
+/// A passive lockstep participant: records every state payload and answers it with
+/// `NoCommand` as its sender id, so it sees every tick from 0. Also the tests' recorder.
+pub struct Observer {
+    /// Every (tick, payload) received, in arrival order.
+    pub states: Received,
+    _sub: zenoh::pubsub::Subscriber<()>,
+    _token: zenoh::liveliness::LivelinessToken,
+    session: Session,
+}
+
+fn zenoh_args(port: u16, listen: bool) -> ZenohArgs {
+    let ep = format!("tcp/127.0.0.1:{port}");
+    ZenohArgs {
+        listen: if listen { vec![ep.clone()] } else { vec![] },
+        connect: if listen { vec![] } else { vec![ep] },
+        zenoh_config: None,
+    }
+}
+
+impl Observer {
+    /// Connects to the server on `127.0.0.1:port` and declares `sender_id`'s liveliness token.
+    pub fn start(port: u16, topics: &Topics, sender_id: u32) -> Result<Self, String> {
+        let cfg = zenoh_config(&zenoh_args(port, false), Role::Tool).map_err(|e| e.to_string())?;
+        let session = zenoh::open(cfg)
+            .wait()
+            .map_err(|e| format!("observer session: {e}"))?;
+        let publisher = session
+            .declare_publisher(topics.cmd_wrench().to_owned())
+            .congestion_control(CongestionControl::Block)
+            .express(true)
+            .wait()
+            .map_err(|e| format!("observer publisher: {e}"))?;
+        let states: Received = Arc::default();
+        let rec = states.clone();
+        let mut seq = 0u64;
+        let sub = session
+            .declare_subscriber(topics.state().to_owned())
+            .callback_mut(move |sample| {
+                let bytes = sample.payload().to_bytes().into_owned();
+                let Ok(state) = decode_state(&bytes) else {
+                    return;
+                };
+                let h = state.header;
+                rec.lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push((h.tick, bytes));
+                let cmd = CommandMsg::no_command(
+                    Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq),
+                    sender_id,
+                );
+                seq += 1;
+                let _ = publisher.put(encode(&cmd)).wait();
+            })
+            .wait()
+            .map_err(|e| format!("observer subscriber: {e}"))?;
+        let token = session
+            .liveliness()
+            .declare_token(topics.participant(sender_id))
+            .wait()
+            .map_err(|e| format!("observer token: {e}"))?;
+        Ok(Self {
+            states,
+            _sub: sub,
+            _token: token,
+            session,
+        })
+    }
+}
+
+fn exit_text(s: std::process::ExitStatus) -> String {
+    #[cfg(unix)]
+    {
+        use std::os::unix::process::ExitStatusExt;
+        if let Some(sig) = s.signal() {
+            return format!("signal {sig}");
+        }
+    }
+    s.code().map_or("unknown".into(), |c| format!("exit {c}"))
+}
+
+/// Runs one planned run and writes its `result.json`.
+pub fn execute(plan: &Plan, rp: &RunPlan, opts: &RunOptions) -> RunResult {
+    let started = Instant::now();
+    let c = &plan.campaign;
+    let run_dir = opts.dir.join(&rp.dir);
+    let _ = std::fs::create_dir_all(&run_dir);
+    let mut result = RunResult {
+        run: rp.run,
+        run_seed: rp.run_seed,
+        sensor_seeds: rp.sensor_seeds.clone(),
+        redraws: rp.redraws,
+        applied: BTreeMap::new(),
+        state_sha256: String::new(),
+        states: 0,
+        criteria: Vec::new(),
+        passed: false,
+        status: String::new(),
+        controller_exit: None,
+        wall_s: 0.0,
+        sim_s: 0.0,
+    };
+    let outcome = run_inner(c, rp, opts, &run_dir, &mut result);
+    result.status = match outcome {
+        Ok(()) => "ok".into(),
+        Err(e) => e,
+    };
+    result.passed = result.status == "ok" && result.criteria.iter().all(|k| k.passed);
+    result.wall_s = started.elapsed().as_secs_f64();
+    if let Ok(text) = serde_json::to_string_pretty(&result) {
+        let _ = std::fs::write(run_dir.join("result.json"), text + "\n");
+    }
+    result
+}
+
+fn run_inner(
+    c: &Campaign,
+    rp: &RunPlan,
+    opts: &RunOptions,
+    run_dir: &Path,
+    result: &mut RunResult,
+) -> Result<(), String> {
+    if !rp.valid {
+        return Err(format!(
+            "invalid: no valid draw in {} tries (last: {})",
+            rp.redraws,
+            rp.redraw_reasons.last().map_or("", String::as_str)
+        ));
+    }
+    let cfg = SimConfig::from_toml_str(&rp.config_toml).map_err(|e| format!("config: {e}"))?;
+    let model = readback(&cfg).map_err(|e| format!("model: {e}"))?;
+    result.applied = rp
+        .dispersed
+        .keys()
+        .filter_map(|k| model.get(k).map(|v| (k.clone(), *v)))
+        .collect();
+    let port = u32::from(opts.base_port) + rp.run;
+    let port = u16::try_from(port)
+        .map_err(|_| format!("port {port} is out of range: lower --base-port"))?;
+    let frame_s = cfg.frame_ns as f64 * 1e-9;
+    let mut participants = vec![OBSERVER_ID];
+    if c.controller.is_some() {
+        participants.insert(0, CONTROLLER_ID);
+    }
+    let settings = ServerSettings {
+        mode: Mode::Lockstep,
+        sc_id: SC_ID.into(),
+        participants,
+        participant_timeout: Duration::from_secs_f64(c.participant_timeout_s),
+        presence_timeout: Duration::from_secs_f64(c.participant_timeout_s.max(10.0)),
+        duration_ns: Some((c.duration_s * 1e9).round() as u64),
+        summary_interval: Duration::from_secs(3600),
+        record: opts.record.then(|| run_dir.join("recording.mcap")),
+        ..ServerSettings::default()
+    };
+    let topics = Topics::new(SC_ID).map_err(|e| e.to_string())?;
+    // The server, on its own runtime and thread; `stop` ends it early (controller exit).
+    let stop = Arc::new(tokio::sync::Notify::new());
+    let zcfg = zenoh_config(&zenoh_args(port, true), Role::Server).map_err(|e| e.to_string())?;
+    let stop2 = stop.clone();
+    let server = std::thread::spawn(move || {
+        let rt = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(1)
+            .enable_all()
+            .build()
+            .map_err(|e| e.to_string())?;
+        rt.block_on(async move {
+            let session = zenoh::open(zcfg)
+                .await
+                .map_err(|e| format!("server session: {e}"))?;
+            let r = crate::server::run(session.clone(), settings, cfg, async move {
+                stop2.notified().await
+            })
+            .await
+            .map_err(|e| e.to_string());
+            let _ = session.close().await;
+            r
+        })
+    });
+    let observer = Observer::start(port, &topics, OBSERVER_ID)?;
+    let mut child = match &c.controller {
+        Some(line) => {
+            let line = line
+                .replace("{endpoint}", &format!("tcp/127.0.0.1:{port}"))
+                .replace("{sc_id}", SC_ID)
+                .replace("{sender_id}", &CONTROLLER_ID.to_string())
+                .replace("{run}", &rp.run.to_string());
+            let words = split_command(&line)?;
+            let log =
+                std::fs::File::create(run_dir.join("controller.log")).map_err(|e| e.to_string())?;
+            let err = log.try_clone().map_err(|e| e.to_string())?;
+            Some(
+                Command::new(&words[0])
+                    .args(&words[1..])
+                    .stdin(Stdio::null())
+                    .stdout(log)
+                    .stderr(err)
+                    .spawn()
+                    .map_err(|e| format!("cannot start the controller {:?}: {e}", words[0]))?,
+            )
+        }
+        None => None,
+    };
+    // Wait for the server; a controller that exits first stops it.
+    let mut early_exit = None;
+    while !server.is_finished() {
+        if let (Some(ch), None) = (child.as_mut(), &early_exit) {
+            if let Ok(Some(status)) = ch.try_wait() {
+                early_exit = Some(status);
+                stop.notify_one();
+            }
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let server_result = server
+        .join()
+        .map_err(|_| "the server thread panicked".to_owned())?;
+    if let Some(mut ch) = child {
+        let status = match early_exit {
+            Some(s) => exit_text(s),
+            None => {
+                // The run is over: give the controller a moment to leave, then stop it.
+                let give_up = Instant::now() + Duration::from_secs(2);
+                loop {
+                    if let Ok(Some(s)) = ch.try_wait() {
+                        break exit_text(s);
+                    }
+                    if Instant::now() >= give_up {
+                        let _ = ch.kill();
+                        let _ = ch.wait();
+                        break "still running at the end: stopped".into();
+                    }
+                    std::thread::sleep(Duration::from_millis(10));
+                }
+            }
+        };
+        result.controller_exit = Some(status.clone());
+        if let Some(s) = early_exit {
+            let _ = observer.session.close().wait();
+            return Err(format!(
+                "the controller exited before the end ({}); the run stopped",
+                exit_text(s)
+            ));
+        }
+    }
+    let report = server_result?;
+    let mut states = observer
+        .states
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .clone();
+    let _ = observer.session.close().wait();
+    states.sort_by_key(|(t, _)| *t);
+    let ticks_ok = states.iter().enumerate().all(|(i, (t, _))| *t == i as u64);
+    if !ticks_ok || states.len() as u64 != report.last_tick + 1 {
+        return Err(format!(
+            "the observer saw {} states for ticks 0..={}",
+            states.len(),
+            report.last_tick
+        ));
+    }
+    let mut h = Sha256::new();
+    for (_, p) in &states {
+        h.update(p);
+    }
+    result.state_sha256 = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
+    result.states = states.len() as u64;
+    result.sim_s = report.sim_time_ns as f64 * 1e-9;
+    let decoded: Vec<StateMsg> = states
+        .iter()
+        .filter_map(|(_, p)| decode_state(p).ok())
+        .collect();
+    result.criteria = c
+        .criteria
+        .iter()
+        .map(|k| evaluate(k, &decoded, c.sigma_rn, frame_s))
+        .collect();
+    Ok(())
+}
+
+/// Runs `indices` of `plan`, `jobs` at a time, with a progress bar on stderr; returns the
+/// results in index order.
+pub fn execute_many(
+    plan: &Plan,
+    runs: &[RunPlan],
+    indices: &[u32],
+    jobs: usize,
+    opts: &RunOptions,
+) -> Vec<RunResult> {
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<RunResult>> = Mutex::new(Vec::new());
+    let bar = indicatif::ProgressBar::new(indices.len() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} runs, {elapsed} elapsed, ETA {eta} {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let failed = AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..jobs.max(1) {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(&index) = indices.get(i) else { break };
+                let r = execute(plan, &runs[index as usize], opts);
+                if !r.passed {
+                    failed.fetch_add(1, Ordering::Relaxed);
+                }
+                bar.set_message(format!("({} not passed)", failed.load(Ordering::Relaxed)));
+                bar.inc(1);
+                results.lock().unwrap_or_else(|e| e.into_inner()).push(r);
+            });
+        }
+    });
+    bar.finish();
+    let mut out = results.into_inner().unwrap_or_else(|e| e.into_inner());
+    out.sort_by_key(|r| r.run);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn commands_split_like_a_shell_without_one() {
+        assert_eq!(
+            split_command(r#"demo --a 1 'two words' "x\"y" c\ d"#).unwrap(),
+            ["demo", "--a", "1", "two words", "x\"y", "c d"]
+        );
+        assert!(split_command("a 'b").is_err());
+        assert_eq!(split_command("  ").unwrap(), Vec::<String>::new());
+    }
+
+    #[test]
+    fn statistics_follow_their_definitions() {
+        let states: Vec<StateMsg> = [0.3, 0.2, 0.05, 0.2, 0.01, 0.005]
+            .iter()
+            .enumerate()
+            .map(|(i, s)| StateMsg {
+                header: Header::new(1, i as u64, i as u64 * 1_000_000_000, i as u64),
+                sigma_bn: [*s, 0.0, 0.0],
+                ..StateMsg::default()
+            })
+            .collect();
+        let c = |statistic, after_s, below| Criterion {
+            name: "x".into(),
+            quantity: Quantity::SigmaBn,
+            statistic,
+            after_s,
+            below,
+        };
+        let r = evaluate(&c(Statistic::Final, 0.0, 0.01), &states, [0.0; 3], 1.0);
+        assert_eq!((r.value, r.passed), (0.005, true));
+        let r = evaluate(&c(Statistic::Max, 2.0, 0.1), &states, [0.0; 3], 1.0);
+        assert_eq!((r.value, r.passed), (0.2, false));
+        // Below 0.1 from t = 4 s on (t = 2 s dips but t = 3 s goes back up).
+        let r = evaluate(
+            &c(Statistic::SettlingTime { threshold: 0.1 }, 0.0, 5.0),
+            &states,
+            [0.0; 3],
+            1.0,
+        );
+        assert_eq!((r.value, r.passed), (4.0, true));
+        // |σ_BR| to a target equal to the state is 0.
+        let r = evaluate(
+            &Criterion {
+                quantity: Quantity::SigmaBr,
+                ..c(Statistic::Final, 0.0, 1e-12)
+            },
+            &states,
+            [0.005, 0.0, 0.0],
+            1.0,
+        );
+        assert!(r.value < 1e-15 && r.passed, "{r:?}");
+    }
+}

@@ -1,0 +1,134 @@
+//! Monte Carlo campaigns with flight code in the loop (`flexdyn campaign plan|run|summarize`).
+//!
+//! - [`spec`]: the campaign file, validated with field-named errors.
+//! - [`keys`]: TOML paths into a configuration (`panel_pairs[*].panel1.k_nm_rad`).
+//! - [`plan`]: per-run draws from the master seed, redraws of invalid draws, sensor seeds, the
+//!   manifest, and the read-back of parameters from the built model.
+//! - [`execute`]: one run = a lockstep server on its own port, an observer participant and the
+//!   flight code; `--jobs N` runs N at a time, `--index I` exactly one.
+//! - [`summary`]: `summary.csv`, the pass rate with its Wilson interval, worst and failed runs,
+//!   figures.
+
+pub mod execute;
+pub mod keys;
+pub mod plan;
+pub mod spec;
+pub mod summary;
+
+use std::path::PathBuf;
+
+/// Arguments of `flexdyn campaign`.
+#[derive(Debug, clap::Subcommand)]
+pub enum CampaignCommand {
+    /// Write every run's resolved configuration and the manifest; launch nothing.
+    Plan {
+        /// The campaign file (TOML).
+        file: PathBuf,
+        /// Output directory.
+        #[arg(long, short, value_name = "DIR")]
+        output: PathBuf,
+    },
+    /// Run the campaign (or one run of it) and write each run's result.json.
+    Run {
+        /// The campaign file (TOML).
+        file: PathBuf,
+        /// Output directory (the plan is written there too).
+        #[arg(long, short, value_name = "DIR")]
+        output: PathBuf,
+        /// Runs at a time on this machine [default: 1].
+        #[arg(long, value_name = "N", conflicts_with = "index")]
+        jobs: Option<usize>,
+        /// Run exactly this run (for Slurm arrays, Kubernetes Indexed Jobs, GNU parallel).
+        #[arg(long, value_name = "I")]
+        index: Option<u32>,
+        /// Record each run to run-NNNN/recording.mcap.
+        #[arg(long)]
+        record: bool,
+        /// Run i's server listens on 127.0.0.1:(base-port + i).
+        #[arg(long, value_name = "PORT", default_value_t = 17_600)]
+        base_port: u16,
+    },
+    /// Write summary.csv, summary.txt and figures from a campaign directory.
+    Summarize {
+        /// The output directory of `plan`/`run`.
+        dir: PathBuf,
+    },
+}
+
+/// Runs a `flexdyn campaign` subcommand; returns its report line(s) or an error message.
+pub fn main(cmd: &CampaignCommand) -> Result<String, (u8, String)> {
+    let bad = |e: spec::CampaignError| (2u8, e.to_string());
+    match cmd {
+        CampaignCommand::Plan { file, output } => {
+            let plan =
+                plan::Plan::new(spec::Campaign::from_file(file).map_err(bad)?).map_err(bad)?;
+            let runs = plan
+                .write(output)
+                .map_err(|e| (1, format!("{}: {e}", output.display())))?;
+            let invalid = runs.iter().filter(|r| !r.valid).count();
+            let redraws: u32 = runs.iter().map(|r| r.redraws).sum();
+            Ok(format!(
+                "planned {} runs in {} ({} redraws, {invalid} invalid); nothing launched",
+                runs.len(),
+                output.display(),
+                redraws
+            ))
+        }
+        CampaignCommand::Run {
+            file,
+            output,
+            jobs,
+            index,
+            record,
+            base_port,
+        } => {
+            let plan =
+                plan::Plan::new(spec::Campaign::from_file(file).map_err(bad)?).map_err(bad)?;
+            let runs = plan
+                .write(output)
+                .map_err(|e| (1, format!("{}: {e}", output.display())))?;
+            let indices: Vec<u32> = match index {
+                Some(i) if *i < plan.campaign.runs => vec![*i],
+                Some(i) => {
+                    return Err((
+                        2,
+                        format!(
+                            "--index: {i} is not a run of this campaign (0..{})",
+                            plan.campaign.runs
+                        ),
+                    ))
+                }
+                None => (0..plan.campaign.runs).collect(),
+            };
+            let opts = execute::RunOptions {
+                dir: output.clone(),
+                base_port: *base_port,
+                record: *record,
+            };
+            let started = std::time::Instant::now();
+            let results = execute::execute_many(&plan, &runs, &indices, jobs.unwrap_or(1), &opts);
+            let wall = started.elapsed().as_secs_f64();
+            let passed = results.iter().filter(|r| r.passed).count();
+            let sim: f64 = results.iter().map(|r| r.sim_s).sum();
+            let mut text = format!(
+                "{} runs in {wall:.1} s ({:.1} runs/min, {:.1} simulated s per wall s): {passed} passed",
+                results.len(),
+                results.len() as f64 / wall * 60.0,
+                sim / wall
+            );
+            for r in results.iter().filter(|r| r.status != "ok") {
+                text.push_str(&format!("\nrun {}: {}", r.run, r.status));
+            }
+            Ok(text)
+        }
+        CampaignCommand::Summarize { dir } => {
+            let s = summary::summarize(dir).map_err(|e| (2, e))?;
+            Ok(format!(
+                "{}wrote {} and {} figures",
+                s.text,
+                dir.join("summary.csv").display(),
+                s.figures.len()
+            ))
+        }
+    }
+}

@@ -1,0 +1,352 @@
+//! `flexdyn campaign plan`: every run's dispersed configuration, drawn from the master seed,
+//! and a manifest, with nothing launched.
+//!
+//! # Seeds
+//! Run `i` draws from the portable generator ([`crate::sensors::rng::NormalRng`]) seeded with
+//! `run_seed(i) = splitmix64(master_seed ⊕ splitmix64(i))`. Each sensor's `seed` key
+//! (`imus[k].seed`, `star_trackers[k].seed`) becomes `splitmix64(run_seed ⊕ fnv1a(key))`. A run
+//! therefore depends only on the campaign file and its index: `--index I` reproduces it alone.
+//!
+//! # Invalid draws
+//! A draw whose configuration fails validation (for example an inertia that breaks the
+//! triangle inequality, or a negative stiffness) is **redrawn** from the run's own stream, up
+//! to `max_redraws` times; each rejection is recorded in the manifest with its reason. A run
+//! that never validates is marked invalid: it is not executed and counts as failed.
+//!
+//! # Read-back
+//! A dispersion key must name parameters the built model reports (hub, initial state, panel
+//! pairs, reaction wheels; see [`readback`]). Any other key is an error at load time, so a
+//! dispersion can never be silently ignored; `result.json` then holds the values read back from
+//! each run's built model, not from its file.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use toml::Table;
+
+use super::keys;
+use super::spec::{Campaign, CampaignError, Distribution};
+use crate::config::SimConfig;
+use crate::sensors::rng::NormalRng;
+
+/// SplitMix64's finaliser (Steele, Lea & Flood 2014): a bijective 64-bit mix.
+pub fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+fn fnv1a(s: &str) -> u64 {
+    s.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// The seed of run `run`.
+pub fn run_seed(master: u64, run: u32) -> u64 {
+    splitmix64(master ^ splitmix64(u64::from(run)))
+}
+
+/// Every numeric parameter of the model built from `cfg`, by configuration path: the hub, the
+/// initial state (`initial.sigma_bn[i]`, `initial.omega_bn_b_rad_s[i]`, `initial.r_bn_n_m[i]`,
+/// `initial.v_bn_n_m_s[i]`), and each effector's [`crate::dynamics::StateEffector::parameters`]
+/// under `panel_pairs[k].` or `reaction_wheels[k].`.
+pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config::ConfigError> {
+    let sc = cfg.build_spacecraft()?;
+    let mut out = BTreeMap::new();
+    let hub = sc.hub();
+    out.insert("hub.mass_kg".to_owned(), hub.mass_kg);
+    for i in 0..3 {
+        out.insert(format!("hub.r_bcb_b_m[{i}]"), hub.r_bcb_b_m[i]);
+        for j in 0..3 {
+            out.insert(
+                format!("hub.inertia_bc_b_kg_m2[{i}][{j}]"),
+                hub.inertia_bc_b_kg_m2[(i, j)],
+            );
+        }
+    }
+    let x = sc.state();
+    for i in 0..3 {
+        out.insert(format!("initial.sigma_bn[{i}]"), x.sigma_bn[i]);
+        out.insert(format!("initial.omega_bn_b_rad_s[{i}]"), x.omega_bn_b[i]);
+        out.insert(format!("initial.r_bn_n_m[{i}]"), x.r_bn_n[i]);
+        out.insert(format!("initial.v_bn_n_m_s[{i}]"), x.v_bn_n[i]);
+    }
+    let mut per_kind: BTreeMap<&str, usize> = BTreeMap::new();
+    let mut params = Vec::new();
+    for (e, range) in sc.effectors().iter().zip(sc.effector_ranges()) {
+        let section = match e.kind().name {
+            "panel_pair" => "panel_pairs",
+            "reaction_wheel" => "reaction_wheels",
+            other => other,
+        };
+        let k = per_kind.entry(section).or_insert(0);
+        params.clear();
+        e.parameters(&x.effectors[range.clone()], &mut params);
+        for (key, v) in &params {
+            out.insert(format!("{section}[{k}].{key}"), *v);
+        }
+        *k += 1;
+    }
+    Ok(out)
+}
+
+/// One planned run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunPlan {
+    /// Index, 0-based.
+    pub run: u32,
+    /// Its directory name (`run-0042`).
+    pub dir: String,
+    /// The seed its dispersions were drawn with.
+    pub run_seed: u64,
+    /// The sensor seeds written into its configuration, by key.
+    pub sensor_seeds: BTreeMap<String, u64>,
+    /// Draws rejected before the accepted one.
+    pub redraws: u32,
+    /// Why each rejected draw was invalid.
+    pub redraw_reasons: Vec<String>,
+    /// Whether a valid draw was found.
+    pub valid: bool,
+    /// The values written into its configuration file, by concrete key.
+    pub dispersed: BTreeMap<String, f64>,
+    /// The full configuration, TOML (not in the manifest; written as `config.toml`).
+    #[serde(skip)]
+    pub config_toml: String,
+}
+
+/// A campaign's plan: the resolved dispersion keys and every run.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// The campaign.
+    pub campaign: Campaign,
+    /// For each dispersion, the concrete keys it names.
+    pub keys: Vec<Vec<String>>,
+    base: Table,
+    sensor_seed_keys: Vec<String>,
+}
+
+fn invalid(c: &Campaign, field: String, problem: String) -> CampaignError {
+    CampaignError::Invalid {
+        path: c.base_path.clone().unwrap_or_else(|| "campaign".into()),
+        field,
+        problem,
+    }
+}
+
+impl Plan {
+    /// Resolves every dispersion key against the base configuration and its built model.
+    pub fn new(campaign: Campaign) -> Result<Self, CampaignError> {
+        let base: Table = toml::from_str(&campaign.base_toml)
+            .map_err(|e| invalid(&campaign, "base".into(), format!("not a TOML table: {e}")))?;
+        let cfg = SimConfig::from_toml_str(&campaign.base_toml)
+            .map_err(|e| invalid(&campaign, "base".into(), e.to_string()))?;
+        let model = readback(&cfg).map_err(|e| invalid(&campaign, "base".into(), e.to_string()))?;
+        let mut all_keys = Vec::new();
+        for (i, d) in campaign.dispersions.iter().enumerate() {
+            let field = format!("dispersions[{i}].key");
+            let concrete = keys::expand(&base, &d.key)
+                .map_err(|e| invalid(&campaign, field.clone(), format!("{:?}: {e}", d.key)))?;
+            for k in &concrete {
+                if !model.contains_key(k) {
+                    return Err(invalid(
+                        &campaign,
+                        field,
+                        format!(
+                            "{k} is not a parameter the built model reports (the hub, initial \
+                             state, panel pairs and reaction wheels are), so its dispersion \
+                             could not be verified; it is refused rather than risk a silent \
+                             no-op"
+                        ),
+                    ));
+                }
+            }
+            if d.distribution == Distribution::UniformAttitude
+                && (concrete.len() != 3 || !d.key.ends_with("sigma_bn"))
+            {
+                return Err(invalid(
+                    &campaign,
+                    field,
+                    format!(
+                        "uniform_attitude needs an MRP set such as initial.sigma_bn, got {:?}",
+                        d.key
+                    ),
+                ));
+            }
+            if let Some(prev) = all_keys.iter().flatten().find(|k| concrete.contains(*k)) {
+                return Err(invalid(
+                    &campaign,
+                    field,
+                    format!("{prev} is dispersed twice"),
+                ));
+            }
+            all_keys.push(concrete);
+        }
+        let mut sensor_seed_keys = Vec::new();
+        for section in ["imus", "star_trackers"] {
+            if let Some(toml::Value::Array(items)) = base.get(section) {
+                for (k, item) in items.iter().enumerate() {
+                    if item.get("seed").is_some() {
+                        sensor_seed_keys.push(format!("{section}[{k}].seed"));
+                    }
+                }
+            }
+        }
+        Ok(Self {
+            campaign,
+            keys: all_keys,
+            base,
+            sensor_seed_keys,
+        })
+    }
+
+    /// Draws run `run` (the same result whichever other runs are drawn).
+    pub fn run(&self, run: u32) -> RunPlan {
+        let c = &self.campaign;
+        let seed = run_seed(c.seed, run);
+        let mut rng = NormalRng::new(seed);
+        let mut sensor_seeds = BTreeMap::new();
+        let mut reasons = Vec::new();
+        for attempt in 0..=c.max_redraws {
+            let mut doc = self.base.clone();
+            let mut dispersed = BTreeMap::new();
+            for (d, concrete) in c.dispersions.iter().zip(&self.keys) {
+                match &d.distribution {
+                    Distribution::Normal { mean, sigma } => {
+                        for k in concrete {
+                            let m = mean.unwrap_or_else(|| keys::get(&self.base, k).unwrap_or(0.0));
+                            let x = m + sigma * rng.normal();
+                            keys::set(&mut doc, k, x);
+                            dispersed.insert(k.clone(), x);
+                        }
+                    }
+                    Distribution::Uniform { low, high } => {
+                        for k in concrete {
+                            let x = low + (high - low) * rng.uniform01();
+                            keys::set(&mut doc, k, x);
+                            dispersed.insert(k.clone(), x);
+                        }
+                    }
+                    Distribution::UniformAttitude => {
+                        // Four independent normals, normalised: uniform on S³ (Marsaglia 1972),
+                        // i.e. a uniformly random rotation; the MRP set with |σ| ≤ 1 (β0 ≥ 0).
+                        let mut q = [0.0f64; 4];
+                        let mut n2 = 0.0;
+                        while n2 < 1e-12 {
+                            q = [rng.normal(), rng.normal(), rng.normal(), rng.normal()];
+                            n2 = q.iter().map(|v| v * v).sum();
+                        }
+                        let n = n2.sqrt();
+                        let s = if q[0] < 0.0 { -1.0 / n } else { 1.0 / n };
+                        let b0 = q[0] * s;
+                        for (i, k) in concrete.iter().enumerate() {
+                            let x = q[i + 1] * s / (1.0 + b0);
+                            keys::set(&mut doc, k, x);
+                            dispersed.insert(k.clone(), x);
+                        }
+                    }
+                }
+            }
+            sensor_seeds.clear();
+            for k in &self.sensor_seed_keys {
+                let s = splitmix64(seed ^ fnv1a(k)) >> 1; // TOML integers are signed
+                let (section, rest) = k.split_once('[').unwrap_or((k, ""));
+                let idx: usize = rest
+                    .split(']')
+                    .next()
+                    .and_then(|i| i.parse().ok())
+                    .unwrap_or(0);
+                if let Some(toml::Value::Array(items)) = doc.get_mut(section) {
+                    if let Some(toml::Value::Table(t)) = items.get_mut(idx) {
+                        t.insert("seed".into(), toml::Value::Integer(s as i64));
+                    }
+                }
+                sensor_seeds.insert(k.clone(), s);
+            }
+            let text = match toml::to_string(&doc) {
+                Ok(t) => t,
+                Err(e) => {
+                    reasons.push(format!("cannot write TOML: {e}"));
+                    continue;
+                }
+            };
+            let check =
+                SimConfig::from_toml_str(&text).and_then(|cfg| cfg.build_spacecraft().map(|_| ()));
+            match check {
+                Ok(()) => {
+                    return RunPlan {
+                        run,
+                        dir: run_dir(run),
+                        run_seed: seed,
+                        sensor_seeds,
+                        redraws: attempt,
+                        redraw_reasons: reasons,
+                        valid: true,
+                        dispersed,
+                        config_toml: text,
+                    }
+                }
+                Err(e) => reasons.push(e.to_string()),
+            }
+        }
+        RunPlan {
+            run,
+            dir: run_dir(run),
+            run_seed: seed,
+            sensor_seeds,
+            redraws: c.max_redraws + 1,
+            redraw_reasons: reasons,
+            valid: false,
+            dispersed: BTreeMap::new(),
+            config_toml: String::new(),
+        }
+    }
+
+    /// The manifest (JSON) of `runs`.
+    pub fn manifest(&self, runs: &[RunPlan]) -> serde_json::Value {
+        let c = &self.campaign;
+        let sha: String = Sha256::digest(c.source.as_bytes())
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        serde_json::json!({
+            "campaign_sha256": sha,
+            "flexdyn_version": env!("CARGO_PKG_VERSION"),
+            "base": c.base_path.as_ref().map_or("(embedded default)".to_owned(), |p| p.display().to_string()),
+            "runs": c.runs,
+            "seed": c.seed,
+            "duration_s": c.duration_s,
+            "controller": c.controller,
+            "dispersed_keys": self.keys.iter().flatten().collect::<Vec<_>>(),
+            "criteria": c.criteria.iter().map(|k| k.name.clone()).collect::<Vec<_>>(),
+            "run_plans": runs,
+        })
+    }
+
+    /// Writes `DIR/campaign.toml`, `DIR/manifest.json` and `DIR/run-NNNN/config.toml` for every
+    /// run; returns the plans.
+    pub fn write(&self, dir: &Path) -> Result<Vec<RunPlan>, std::io::Error> {
+        let runs: Vec<RunPlan> = (0..self.campaign.runs).map(|r| self.run(r)).collect();
+        std::fs::create_dir_all(dir)?;
+        std::fs::write(dir.join("campaign.toml"), &self.campaign.source)?;
+        for r in &runs {
+            let d = dir.join(&r.dir);
+            std::fs::create_dir_all(&d)?;
+            if r.valid {
+                std::fs::write(d.join("config.toml"), &r.config_toml)?;
+            }
+        }
+        let text =
+            serde_json::to_string_pretty(&self.manifest(&runs)).map_err(std::io::Error::other)?;
+        std::fs::write(dir.join("manifest.json"), text + "\n")?;
+        Ok(runs)
+    }
+}
+
+/// `run-0042`.
+pub fn run_dir(run: u32) -> String {
+    format!("run-{run:04}")
+}

@@ -1,0 +1,448 @@
+//! The campaign file (TOML), read with the configuration's schema reader, so every error names
+//! its field (`dispersions[2].sigma: invalid value: …`).
+//!
+//! ```toml
+//! base = "reference.toml"      # relative to this file; absent: the embedded default
+//! runs = 20
+//! seed = 1
+//! duration_s = 60.0
+//! controller = "flexdyn-acs-demo --connect {endpoint} --sc-id {sc_id} --sender-id {sender_id}"
+//! sigma_rn = [0.1, 0.2, -0.1]  # the target of the sigma_br criteria (default 0)
+//! max_redraws = 100
+//! participant_timeout_s = 5.0
+//!
+//! [[dispersions]]
+//! key = "hub.inertia_bc_b_kg_m2[0][0]"
+//! distribution = "normal"        # mean = the nominal value unless `mean` is given
+//! sigma = 45.0
+//!
+//! [[criteria]]
+//! name = "pointing"
+//! quantity = "sigma_br"          # sigma_br | sigma_bn | omega | theta
+//! statistic = "final"            # final | max | settling_time
+//! below = 0.01
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use toml::de::DeTable;
+
+use crate::config::{SimConfig, DEFAULT_CONFIG_TOML};
+use crate::schema::reader::TableReader;
+use crate::schema::SchemaError;
+
+/// A distribution of a dispersion.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Distribution {
+    /// Normal; `mean` `None` is the nominal (base) value of each element.
+    Normal {
+        /// The mean, or `None` for the nominal value.
+        mean: Option<f64>,
+        /// Standard deviation (≥ 0).
+        sigma: f64,
+    },
+    /// Uniform on [low, high).
+    Uniform {
+        /// Lower bound.
+        low: f64,
+        /// Upper bound (> low).
+        high: f64,
+    },
+    /// A uniformly random orientation (Haar measure), written as the MRP set with |σ| ≤ 1;
+    /// only for a 3-element MRP key such as `initial.sigma_bn`.
+    UniformAttitude,
+}
+
+/// One `[[dispersions]]` entry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dispersion {
+    /// The TOML path as written.
+    pub key: String,
+    /// Its distribution.
+    pub distribution: Distribution,
+}
+
+/// What a criterion measures at each state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// |σ_BR|, the attitude error to the campaign's `sigma_rn` (MRP, –).
+    SigmaBr,
+    /// |σ_BN| (–).
+    SigmaBn,
+    /// |ω_BN| (rad/s).
+    Omega,
+    /// The largest |θ1|, |θ2| over every panel pair (rad).
+    Theta,
+}
+
+/// How a criterion reduces the quantity over time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Statistic {
+    /// The value at the last state.
+    Final,
+    /// The maximum over the states at or after `after_s`.
+    Max,
+    /// The time (s) after which the quantity stays below `threshold` to the end; the run's
+    /// duration + 1 frame if it never settles.
+    SettlingTime {
+        /// The settling band.
+        threshold: f64,
+    },
+}
+
+/// One `[[criteria]]` entry: passes when the statistic is below `below`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Criterion {
+    /// Unique name (a column of `summary.csv`).
+    pub name: String,
+    /// The quantity.
+    pub quantity: Quantity,
+    /// The reduction.
+    pub statistic: Statistic,
+    /// \[s\] the window starts here (for `max`; default 0).
+    pub after_s: f64,
+    /// Pass if the statistic is strictly below this.
+    pub below: f64,
+}
+
+/// A validated campaign.
+#[derive(Clone, Debug)]
+pub struct Campaign {
+    /// The campaign file's text (hashed into the manifest).
+    pub source: String,
+    /// Where the base configuration came from (`None`: embedded default).
+    pub base_path: Option<PathBuf>,
+    /// The base configuration's text.
+    pub base_toml: String,
+    /// Number of runs.
+    pub runs: u32,
+    /// The master seed.
+    pub seed: u64,
+    /// \[s\] simulated duration of each run (a whole number of frames).
+    pub duration_s: f64,
+    /// The flight code's command line, if any.
+    pub controller: Option<String>,
+    /// Target attitude σ_RN of the `sigma_br` criteria.
+    pub sigma_rn: [f64; 3],
+    /// Draws allowed for a run whose dispersed configuration is invalid.
+    pub max_redraws: u32,
+    /// \[s\] lockstep wait for each answer.
+    pub participant_timeout_s: f64,
+    /// The dispersions.
+    pub dispersions: Vec<Dispersion>,
+    /// The criteria.
+    pub criteria: Vec<Criterion>,
+}
+
+/// Why a campaign file is not usable.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum CampaignError {
+    /// The file cannot be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Not TOML.
+    #[error("{}: not valid TOML: {message}", path.display())]
+    Syntax {
+        /// The file.
+        path: PathBuf,
+        /// The parser's message.
+        message: String,
+    },
+    /// A field has the wrong shape.
+    #[error("{}: {source}", path.display())]
+    Schema {
+        /// The file.
+        path: PathBuf,
+        /// The field-named error.
+        #[source]
+        source: SchemaError,
+    },
+    /// A field's value is not usable.
+    #[error("{}: {field}: {problem}", path.display())]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// The TOML path of the field.
+        field: String,
+        /// What is wrong.
+        problem: String,
+    },
+}
+
+const ROOT_KEYS: &[&str] = &[
+    "base",
+    "runs",
+    "seed",
+    "duration_s",
+    "controller",
+    "sigma_rn",
+    "max_redraws",
+    "participant_timeout_s",
+    "dispersions",
+    "criteria",
+];
+
+impl Campaign {
+    /// Reads and validates `path`. Dispersion keys are checked against the base configuration
+    /// later, by [`super::plan::Plan::new`], which also builds the model.
+    pub fn from_file(path: &Path) -> Result<Self, CampaignError> {
+        let source = std::fs::read_to_string(path).map_err(|source| CampaignError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::from_str_at(&source, path)
+    }
+
+    /// Reads a campaign from `source`; `path` names it in errors and anchors `base`.
+    pub fn from_str_at(source: &str, path: &Path) -> Result<Self, CampaignError> {
+        let schema = |source: SchemaError| CampaignError::Schema {
+            path: path.to_owned(),
+            source,
+        };
+        let invalid = |field: &str, problem: String| CampaignError::Invalid {
+            path: path.to_owned(),
+            field: field.to_owned(),
+            problem,
+        };
+        let doc = DeTable::parse(source).map_err(|e| CampaignError::Syntax {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })?;
+        let doc = doc.get_ref();
+        let root = TableReader::root(source, doc, ROOT_KEYS).map_err(schema)?;
+        let base_path = match root.get("base") {
+            Some(_) => {
+                let rel = PathBuf::from(root.string("base").map_err(schema)?);
+                Some(if rel.is_absolute() {
+                    rel
+                } else {
+                    path.parent().unwrap_or(Path::new(".")).join(rel)
+                })
+            }
+            None => None,
+        };
+        let base_toml = match &base_path {
+            Some(p) => std::fs::read_to_string(p)
+                .map_err(|e| invalid("base", format!("cannot read {}: {e}", p.display())))?,
+            None => DEFAULT_CONFIG_TOML.to_owned(),
+        };
+        let base = SimConfig::from_toml_str(&base_toml)
+            .map_err(|e| invalid("base", format!("the base configuration is invalid: {e}")))?;
+        let runs = root.int_in("runs", 1, 1_000_000).map_err(schema)? as u32;
+        let seed = root.int_in("seed", 0, i64::MAX).map_err(schema)? as u64;
+        let duration_s = root.f64("duration_s").map_err(schema)?;
+        let frames = duration_s * base.frame_hz;
+        if duration_s.is_nan() || duration_s <= 0.0 || (frames - frames.round()).abs() >= 1e-6 {
+            return Err(invalid(
+                "duration_s",
+                format!(
+                    "must be a positive whole number of frames ({} Hz), got {duration_s}",
+                    base.frame_hz
+                ),
+            ));
+        }
+        let controller = match root.get("controller") {
+            Some(_) => Some(root.string("controller").map_err(schema)?),
+            None => None,
+        };
+        if let Some(c) = &controller {
+            let words = super::execute::split_command(c).map_err(|e| invalid("controller", e))?;
+            if words.is_empty() {
+                return Err(invalid("controller", "is empty".into()));
+            }
+        }
+        let sigma_rn = root
+            .opt_floats::<3>("sigma_rn")
+            .map_err(schema)?
+            .unwrap_or([0.0; 3]);
+        let max_redraws = match root.get("max_redraws") {
+            Some(_) => root.int_in("max_redraws", 0, 1_000_000).map_err(schema)? as u32,
+            None => 100,
+        };
+        let participant_timeout_s = root
+            .opt_f64("participant_timeout_s")
+            .map_err(schema)?
+            .unwrap_or(5.0);
+        if participant_timeout_s.is_nan() || participant_timeout_s <= 0.0 {
+            return Err(invalid(
+                "participant_timeout_s",
+                format!("must be > 0, got {participant_timeout_s}"),
+            ));
+        }
+
+        let mut dispersions = Vec::new();
+        let tables = root
+            .tables(
+                "dispersions",
+                &["key", "distribution", "mean", "sigma", "low", "high"],
+            )
+            .map_err(schema)?
+            .unwrap_or_default();
+        for (i, t) in tables.iter().enumerate() {
+            let field = |k: &str| format!("dispersions[{i}].{k}");
+            let key = t.string("key").map_err(schema)?;
+            super::keys::parse(&key).map_err(|e| invalid(&field("key"), e))?;
+            let kind = t.string("distribution").map_err(schema)?;
+            let only = |allowed: &[&str]| -> Result<(), CampaignError> {
+                for k in ["mean", "sigma", "low", "high"] {
+                    if !allowed.contains(&k) && t.get(k).is_some() {
+                        return Err(invalid(
+                            &field(k),
+                            format!("does not apply to distribution {kind:?}"),
+                        ));
+                    }
+                }
+                Ok(())
+            };
+            let distribution = match kind.as_str() {
+                "normal" => {
+                    only(&["mean", "sigma"])?;
+                    let sigma = t.f64("sigma").map_err(schema)?;
+                    if sigma.is_nan() || sigma < 0.0 {
+                        return Err(invalid(
+                            &field("sigma"),
+                            format!("must be ≥ 0, got {sigma}"),
+                        ));
+                    }
+                    Distribution::Normal {
+                        mean: t.opt_f64("mean").map_err(schema)?,
+                        sigma,
+                    }
+                }
+                "uniform" => {
+                    only(&["low", "high"])?;
+                    let (low, high) = (
+                        t.f64("low").map_err(schema)?,
+                        t.f64("high").map_err(schema)?,
+                    );
+                    if high.is_nan() || low.is_nan() || high <= low {
+                        return Err(invalid(
+                            &field("high"),
+                            format!("must be greater than low ({low}), got {high}"),
+                        ));
+                    }
+                    Distribution::Uniform { low, high }
+                }
+                "uniform_attitude" => {
+                    only(&[])?;
+                    Distribution::UniformAttitude
+                }
+                other => {
+                    return Err(invalid(
+                        &field("distribution"),
+                        format!(
+                            "{other:?} is not one of \"normal\", \"uniform\", \"uniform_attitude\""
+                        ),
+                    ))
+                }
+            };
+            dispersions.push(Dispersion { key, distribution });
+        }
+
+        let mut criteria: Vec<Criterion> = Vec::new();
+        let tables = root
+            .tables(
+                "criteria",
+                &[
+                    "name",
+                    "quantity",
+                    "statistic",
+                    "after_s",
+                    "below",
+                    "threshold",
+                ],
+            )
+            .map_err(schema)?
+            .unwrap_or_default();
+        for (i, t) in tables.iter().enumerate() {
+            let field = |k: &str| format!("criteria[{i}].{k}");
+            let name = t.string("name").map_err(schema)?;
+            if name.is_empty() || name.contains([',', '"', '\n']) {
+                return Err(invalid(
+                    &field("name"),
+                    "must be non-empty, without commas, quotes or newlines".into(),
+                ));
+            }
+            if criteria.iter().any(|c| c.name == name) {
+                return Err(invalid(&field("name"), format!("{name:?} is used twice")));
+            }
+            let quantity = match t.string("quantity").map_err(schema)?.as_str() {
+                "sigma_br" => Quantity::SigmaBr,
+                "sigma_bn" => Quantity::SigmaBn,
+                "omega" => Quantity::Omega,
+                "theta" => Quantity::Theta,
+                other => {
+                    return Err(invalid(
+                        &field("quantity"),
+                        format!(
+                        "{other:?} is not one of \"sigma_br\", \"sigma_bn\", \"omega\", \"theta\""
+                    ),
+                    ))
+                }
+            };
+            let stat = t.string("statistic").map_err(schema)?;
+            let threshold = t.opt_f64("threshold").map_err(schema)?;
+            let statistic = match (stat.as_str(), threshold) {
+                ("final", None) => Statistic::Final,
+                ("max", None) => Statistic::Max,
+                ("settling_time", Some(threshold)) if threshold > 0.0 => {
+                    Statistic::SettlingTime { threshold }
+                }
+                ("settling_time", _) => {
+                    return Err(invalid(
+                        &field("threshold"),
+                        "settling_time needs a threshold > 0".into(),
+                    ))
+                }
+                ("final" | "max", Some(_)) => {
+                    return Err(invalid(
+                        &field("threshold"),
+                        format!("does not apply to statistic {stat:?}"),
+                    ))
+                }
+                (other, _) => {
+                    return Err(invalid(
+                        &field("statistic"),
+                        format!("{other:?} is not one of \"final\", \"max\", \"settling_time\""),
+                    ))
+                }
+            };
+            let after_s = t.opt_f64("after_s").map_err(schema)?.unwrap_or(0.0);
+            if !(0.0..=duration_s).contains(&after_s) {
+                return Err(invalid(
+                    &field("after_s"),
+                    format!("must be within 0..=duration_s ({duration_s}), got {after_s}"),
+                ));
+            }
+            let below = t.f64("below").map_err(schema)?;
+            criteria.push(Criterion {
+                name,
+                quantity,
+                statistic,
+                after_s,
+                below,
+            });
+        }
+        Ok(Self {
+            source: source.to_owned(),
+            base_path,
+            base_toml,
+            runs,
+            seed,
+            duration_s,
+            controller,
+            sigma_rn,
+            max_redraws,
+            participant_timeout_s,
+            dispersions,
+            criteria,
+        })
+    }
+}

@@ -1,0 +1,335 @@
+//! `flexdyn campaign summarize DIR`: `summary.csv` (one row per planned run), the pass rate with
+//! its Wilson score interval, the worst runs per criterion, the runs that are missing or failed
+//! (by index, to rerun with `--index`), and histograms and scatter plots.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use plotters::prelude::*;
+
+use super::execute::RunResult;
+use super::plan::RunPlan;
+
+/// What `summarize` found.
+#[derive(Clone, Debug, Default)]
+pub struct Summary {
+    /// Runs planned.
+    pub planned: u32,
+    /// Runs with a result that passed every criterion.
+    pub passed: u32,
+    /// Runs with a result.
+    pub completed: u32,
+    /// Planned runs without `result.json`.
+    pub missing: Vec<u32>,
+    /// Runs whose status is not `ok` (server error, controller exit, invalid draw).
+    pub failed: Vec<(u32, String)>,
+    /// Wilson 95 % interval of the pass rate over the planned runs.
+    pub wilson_95: (f64, f64),
+    /// The report text (also `summary.txt`).
+    pub text: String,
+    /// Figures written.
+    pub figures: Vec<PathBuf>,
+}
+
+/// Wilson score interval for `k` successes in `n` trials at z (Wilson 1927): centre
+/// (p̂ + z²/2n)/(1 + z²/n), half-width z/(1 + z²/n)·√(p̂(1−p̂)/n + z²/4n²).
+pub fn wilson(k: u32, n: u32, z: f64) -> (f64, f64) {
+    if n == 0 {
+        return (0.0, 1.0);
+    }
+    let (k, n) = (f64::from(k), f64::from(n));
+    let p = k / n;
+    let d = 1.0 + z * z / n;
+    let centre = (p + z * z / (2.0 * n)) / d;
+    let half = z / d * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt();
+    ((centre - half).max(0.0), (centre + half).min(1.0))
+}
+
+fn io(path: &Path, e: impl std::fmt::Display) -> String {
+    format!("{}: {e}", path.display())
+}
+
+/// Summarises the campaign in `dir` (written by `plan` and `run`).
+pub fn summarize(dir: &Path) -> Result<Summary, String> {
+    let manifest_path = dir.join("manifest.json");
+    let manifest: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(&manifest_path).map_err(|e| io(&manifest_path, e))?,
+    )
+    .map_err(|e| io(&manifest_path, e))?;
+    let plans: Vec<RunPlan> = serde_json::from_value(manifest["run_plans"].clone())
+        .map_err(|e| io(&manifest_path, format!("run_plans: {e}")))?;
+    let keys: Vec<String> = serde_json::from_value(manifest["dispersed_keys"].clone())
+        .map_err(|e| io(&manifest_path, format!("dispersed_keys: {e}")))?;
+    let criteria: Vec<String> = serde_json::from_value(manifest["criteria"].clone())
+        .map_err(|e| io(&manifest_path, format!("criteria: {e}")))?;
+    let mut s = Summary {
+        planned: plans.len() as u32,
+        ..Summary::default()
+    };
+    let mut results: Vec<RunResult> = Vec::new();
+    for p in &plans {
+        let path = dir.join(&p.dir).join("result.json");
+        match std::fs::read_to_string(&path) {
+            Ok(text) => {
+                let r: RunResult = serde_json::from_str(&text).map_err(|e| io(&path, e))?;
+                if r.status != "ok" {
+                    s.failed.push((r.run, r.status.clone()));
+                }
+                s.completed += 1;
+                if r.passed {
+                    s.passed += 1;
+                }
+                results.push(r);
+            }
+            Err(_) => s.missing.push(p.run),
+        }
+    }
+    // summary.csv
+    let mut csv = String::from("run,state_sha256,passed,status");
+    for k in &keys {
+        write!(csv, ",{k}").ok();
+    }
+    for c in &criteria {
+        write!(csv, ",{c},{c}_passed").ok();
+    }
+    csv.push('\n');
+    for p in &plans {
+        let r = results.iter().find(|r| r.run == p.run);
+        let status = r.map_or("missing".to_owned(), |r| r.status.replace([',', '\n'], ";"));
+        write!(
+            csv,
+            "{},{},{},{}",
+            p.run,
+            r.map_or("", |r| r.state_sha256.as_str()),
+            r.is_some_and(|r| r.passed),
+            status
+        )
+        .ok();
+        for k in &keys {
+            match r.and_then(|r| r.applied.get(k)) {
+                Some(v) => write!(csv, ",{v}").ok(),
+                None => write!(csv, ",").ok(),
+            };
+        }
+        for c in &criteria {
+            match r.and_then(|r| r.criteria.iter().find(|x| &x.name == c)) {
+                Some(x) => write!(csv, ",{},{}", x.value, x.passed).ok(),
+                None => write!(csv, ",,").ok(),
+            };
+        }
+        csv.push('\n');
+    }
+    let csv_path = dir.join("summary.csv");
+    std::fs::write(&csv_path, csv).map_err(|e| io(&csv_path, e))?;
+
+    s.wilson_95 = wilson(s.passed, s.planned, 1.959_963_984_540_054);
+    let mut t = String::new();
+    writeln!(
+        t,
+        "{} of {} planned runs passed ({:.1} %); Wilson 95 % interval {:.1} %–{:.1} % (missing and failed runs count as not passed)",
+        s.passed,
+        s.planned,
+        100.0 * f64::from(s.passed) / f64::from(s.planned.max(1)),
+        100.0 * s.wilson_95.0,
+        100.0 * s.wilson_95.1
+    )
+    .ok();
+    if !s.missing.is_empty() {
+        writeln!(
+            t,
+            "missing runs (no result.json; rerun with --index): {:?}",
+            s.missing
+        )
+        .ok();
+    }
+    for (run, why) in &s.failed {
+        writeln!(t, "failed run {run}: {why}").ok();
+    }
+    for c in &criteria {
+        let mut v: Vec<(u32, f64, bool)> = results
+            .iter()
+            .filter_map(|r| {
+                r.criteria
+                    .iter()
+                    .find(|x| &x.name == c)
+                    .map(|x| (r.run, x.value, x.passed))
+            })
+            .collect();
+        v.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let worst: Vec<String> = v
+            .iter()
+            .take(3)
+            .map(|(r, x, p)| format!("run {r}: {x:.6e}{}", if *p { "" } else { " (fail)" }))
+            .collect();
+        let fails = v.iter().filter(|x| !x.2).count();
+        writeln!(
+            t,
+            "criterion {c}: {fails} failing; worst: {}",
+            worst.join(", ")
+        )
+        .ok();
+    }
+    let text_path = dir.join("summary.txt");
+    std::fs::write(&text_path, &t).map_err(|e| io(&text_path, e))?;
+    s.text = t;
+    s.figures = figures(dir, &results, &keys, &criteria)?;
+    Ok(s)
+}
+
+fn figures(
+    dir: &Path,
+    results: &[RunResult],
+    keys: &[String],
+    criteria: &[String],
+) -> Result<Vec<PathBuf>, String> {
+    crate::sinks::plot::register_font().map_err(|e| e.to_string())?;
+    let fig_dir = dir.join("figures");
+    std::fs::create_dir_all(&fig_dir).map_err(|e| io(&fig_dir, e))?;
+    let mut out = Vec::new();
+    let font = crate::sinks::plot::FONT_NAME;
+    for (ci, c) in criteria.iter().enumerate() {
+        let values: Vec<(f64, bool, &RunResult)> = results
+            .iter()
+            .filter_map(|r| {
+                r.criteria
+                    .iter()
+                    .find(|x| &x.name == c)
+                    .map(|x| (x.value, x.passed, r))
+            })
+            .filter(|(v, _, _)| v.is_finite())
+            .collect();
+        if values.is_empty() {
+            continue;
+        }
+        let (lo, hi) = values
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (v, _, _)| {
+                (a.min(*v), b.max(*v))
+            });
+        let (lo, hi) = if hi > lo {
+            (lo, hi)
+        } else {
+            (
+                lo - 0.5 * lo.abs().max(1e-12),
+                hi + 0.5 * hi.abs().max(1e-12),
+            )
+        };
+        let bins = 12usize;
+        let width = (hi - lo) / bins as f64;
+        let mut counts = vec![0u32; bins];
+        for (v, _, _) in &values {
+            let b = (((v - lo) / width) as usize).min(bins - 1);
+            counts[b] += 1;
+        }
+        let path = fig_dir.join(format!("hist_{ci}_{}.png", sanitize(c)));
+        {
+            let root = BitMapBackend::new(&path, (900, 600)).into_drawing_area();
+            root.fill(&WHITE).map_err(|e| io(&path, e))?;
+            let max = counts.iter().copied().max().unwrap_or(1);
+            let mut chart = ChartBuilder::on(&root)
+                .caption(
+                    format!("Criterion {c}: distribution over {} runs", values.len()),
+                    (font, 24),
+                )
+                .margin(15)
+                .x_label_area_size(45)
+                .y_label_area_size(60)
+                .build_cartesian_2d(lo..hi, 0u32..max + 1)
+                .map_err(|e| io(&path, e))?;
+            chart
+                .configure_mesh()
+                .x_desc(format!("{c} (value of the criterion's statistic)"))
+                .y_desc("runs")
+                .label_style((font, 16))
+                .draw()
+                .map_err(|e| io(&path, e))?;
+            chart
+                .draw_series(counts.iter().enumerate().map(|(i, n)| {
+                    let x0 = lo + i as f64 * width;
+                    Rectangle::new([(x0, 0), (x0 + width, *n)], BLUE.mix(0.6).filled())
+                }))
+                .map_err(|e| io(&path, e))?;
+            root.present().map_err(|e| io(&path, e))?;
+        }
+        out.push(path);
+        for (ki, k) in keys.iter().enumerate() {
+            let pts: Vec<(f64, f64, bool)> = values
+                .iter()
+                .filter_map(|(v, p, r)| r.applied.get(k).map(|x| (*x, *v, *p)))
+                .collect();
+            if pts.is_empty() {
+                continue;
+            }
+            let (xl, xh) = pts
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (x, _, _)| {
+                    (a.min(*x), b.max(*x))
+                });
+            let pad = ((xh - xl) * 0.05).max(1e-12 * xl.abs().max(1.0));
+            let ypad = (hi - lo) * 0.05;
+            let path = fig_dir.join(format!(
+                "scatter_{ci}_{ki}_{}_vs_{}.png",
+                sanitize(c),
+                sanitize(k)
+            ));
+            {
+                let root = BitMapBackend::new(&path, (900, 600)).into_drawing_area();
+                root.fill(&WHITE).map_err(|e| io(&path, e))?;
+                let mut chart = ChartBuilder::on(&root)
+                    .caption(format!("{c} against {k} (red: failed)"), (font, 22))
+                    .margin(15)
+                    .x_label_area_size(45)
+                    .y_label_area_size(80)
+                    .build_cartesian_2d(xl - pad..xh + pad, lo - ypad..hi + ypad)
+                    .map_err(|e| io(&path, e))?;
+                chart
+                    .configure_mesh()
+                    .x_desc(k.as_str())
+                    .y_desc(c.as_str())
+                    .label_style((font, 16))
+                    .draw()
+                    .map_err(|e| io(&path, e))?;
+                chart
+                    .draw_series(pts.iter().map(|(x, y, p)| {
+                        Circle::new((*x, *y), 5, if *p { BLUE.filled() } else { RED.filled() })
+                    }))
+                    .map_err(|e| io(&path, e))?;
+                root.present().map_err(|e| io(&path, e))?;
+            }
+            out.push(path);
+        }
+    }
+    Ok(out)
+}
+
+fn sanitize(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wilson_matches_hand_computed_values() {
+        // 18/20 at z = 1.96: p̂ = 0.9, d = 1.19208, centre = (0.9 + 0.09604)/d = 0.835542,
+        // half = 1.96/d·√(0.0045 + 0.00240100) = 0.136579 → (0.698963, 0.972121).
+        let (lo, hi) = wilson(18, 20, 1.96);
+        assert!(
+            (lo - 0.698963).abs() < 1e-5 && (hi - 0.972121).abs() < 1e-5,
+            "{lo} {hi}"
+        );
+        // 0 of n stays within [0, 1] and is not a point.
+        let (lo, hi) = wilson(0, 10, 1.96);
+        assert_eq!(lo, 0.0);
+        assert!(hi > 0.2 && hi < 0.35, "{hi}");
+    }
+}

@@ -1,0 +1,291 @@
+//! Campaign planning without a server: the values read back from each run's built model follow
+//! the requested distributions (1000 draws, bounds from the sampling distributions of the mean
+//! and the variance), equal what the plan wrote, misspelled or unverifiable keys are load
+//! errors naming the field, invalid draws are redrawn and recorded, and the same file gives
+//! the same plan byte for byte.
+
+use std::path::{Path, PathBuf};
+
+use flexdyn::campaign::plan::{readback, Plan};
+use flexdyn::campaign::spec::Campaign;
+use flexdyn::config::SimConfig;
+
+fn campaign(text: &str) -> Result<Plan, String> {
+    let c =
+        Campaign::from_str_at(text, Path::new("test-campaign.toml")).map_err(|e| e.to_string())?;
+    Plan::new(c).map_err(|e| e.to_string())
+}
+
+const HEAD: &str = "runs = 1000\nseed = 7\nduration_s = 1.0\n";
+
+fn stats(x: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    let v = x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0);
+    (m, v)
+}
+
+/// |mean − μ| < 4 σ/√n and the sample variance within 4 standard errors of σ² (for a normal,
+/// se(s²) = σ²√(2/(n−1)); for a uniform, Var(s²) ≈ (μ4 − σ⁴)/n with μ4 = (b−a)⁴/80).
+fn check(name: &str, x: &[f64], mu: f64, var: f64, var_se: f64) {
+    let n = x.len() as f64;
+    let (m, v) = stats(x);
+    eprintln!("{name}: n {n}, mean {m:.6e} (want {mu:.6e}), var {v:.6e} (want {var:.6e})");
+    assert!(
+        (m - mu).abs() < 4.0 * (var / n).sqrt(),
+        "{name}: mean {m} vs {mu}"
+    );
+    assert!(
+        (v - var).abs() < 4.0 * var_se,
+        "{name}: variance {v} vs {var}"
+    );
+}
+
+#[test]
+fn applied_parameters_follow_the_requested_distributions() {
+    let plan = campaign(&format!(
+        "{HEAD}
+        [[dispersions]]
+        key = \"hub.inertia_bc_b_kg_m2[0][0]\"
+        distribution = \"normal\"
+        sigma = 45.0
+        [[dispersions]]
+        key = \"panel_pairs[*].panel1.k_nm_rad\"
+        distribution = \"uniform\"
+        low = 80.0
+        high = 120.0
+        [[dispersions]]
+        key = \"initial.omega_bn_b_rad_s\"
+        distribution = \"normal\"
+        mean = 0.0
+        sigma = 0.01
+        [[dispersions]]
+        key = \"initial.sigma_bn\"
+        distribution = \"uniform_attitude\"
+        "
+    ))
+    .unwrap();
+    let n = 1000;
+    let mut inertia = Vec::new();
+    let mut k = [Vec::new(), Vec::new()];
+    let mut omega = [Vec::new(), Vec::new(), Vec::new()];
+    let mut beta = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+    for r in 0..n {
+        let rp = plan.run(r);
+        assert!(
+            rp.valid && rp.redraws == 0,
+            "run {r}: {:?}",
+            rp.redraw_reasons
+        );
+        // Read back from the built model, not from the file.
+        let model = readback(&SimConfig::from_toml_str(&rp.config_toml).unwrap()).unwrap();
+        for (key, written) in &rp.dispersed {
+            assert_eq!(
+                model[key], *written,
+                "run {r}: {key} was not applied as drawn"
+            );
+        }
+        inertia.push(model["hub.inertia_bc_b_kg_m2[0][0]"]);
+        for (p, v) in k.iter_mut().enumerate() {
+            v.push(model[&format!("panel_pairs[{p}].panel1.k_nm_rad")]);
+        }
+        for (i, v) in omega.iter_mut().enumerate() {
+            v.push(model[&format!("initial.omega_bn_b_rad_s[{i}]")]);
+        }
+        let s: Vec<f64> = (0..3)
+            .map(|i| model[&format!("initial.sigma_bn[{i}]")])
+            .collect();
+        let s2: f64 = s.iter().map(|x| x * x).sum();
+        assert!(s2 <= 1.0 + 1e-12, "run {r}: |σ| > 1");
+        beta[0].push((1.0 - s2) / (1.0 + s2));
+        for i in 0..3 {
+            beta[i + 1].push(2.0 * s[i] / (1.0 + s2));
+        }
+        // Untouched parameters keep their nominal values.
+        assert_eq!(model["hub.inertia_bc_b_kg_m2[1][1]"], 800.0);
+        assert_eq!(model["panel_pairs[0].panel2.k_nm_rad"], 100.0);
+    }
+    let nf = n as f64;
+    check(
+        "inertia[0][0] ~ N(900, 45)",
+        &inertia,
+        900.0,
+        45.0f64.powi(2),
+        45.0f64.powi(2) * (2.0 / (nf - 1.0)).sqrt(),
+    );
+    let (a, b) = (80.0f64, 120.0f64);
+    let var_u = (b - a).powi(2) / 12.0;
+    let mu4 = (b - a).powi(4) / 80.0;
+    for (p, v) in k.iter().enumerate() {
+        assert!(
+            v.iter().all(|x| (a..b).contains(x)),
+            "pair {p}: a draw outside [80, 120)"
+        );
+        check(
+            &format!("pair {p} k ~ U(80, 120)"),
+            v,
+            100.0,
+            var_u,
+            ((mu4 - var_u * var_u) / nf).sqrt(),
+        );
+    }
+    // The two pairs are drawn independently: their correlation is within 4/√n of 0.
+    let (m0, v0) = stats(&k[0]);
+    let (m1, v1) = stats(&k[1]);
+    let cov = k[0]
+        .iter()
+        .zip(&k[1])
+        .map(|(x, y)| (x - m0) * (y - m1))
+        .sum::<f64>()
+        / (nf - 1.0);
+    assert!(
+        (cov / (v0 * v1).sqrt()).abs() < 4.0 / nf.sqrt(),
+        "pairs correlated"
+    );
+    for (i, v) in omega.iter().enumerate() {
+        check(
+            &format!("omega[{i}] ~ N(0, 0.01)"),
+            v,
+            0.0,
+            1e-4,
+            1e-4 * (2.0 / (nf - 1.0)).sqrt(),
+        );
+    }
+    // A uniform rotation: β uniform on the half 3-sphere β0 ≥ 0. E[β_i] = 0 (i = 1..3),
+    // E[β_k²] = 1/4 for all four, and E[β0] = 4/(3π) (marginal density ∝ √(1 − x²)).
+    for (i, b) in beta.iter().enumerate().skip(1) {
+        let (m, _) = stats(b);
+        assert!(m.abs() < 4.0 * (0.25 / nf).sqrt(), "E[β{i}] = {m}");
+    }
+    for (i, b) in beta.iter().enumerate() {
+        let m2 = b.iter().map(|x| x * x).sum::<f64>() / nf;
+        // Var(β²) for a uniform S³ point: E[β⁴] − 1/16 = 1/8 − 1/16.
+        assert!(
+            (m2 - 0.25).abs() < 4.0 * (1.0 / 16.0 / nf).sqrt(),
+            "E[β{i}²] = {m2}"
+        );
+    }
+    let (m0b, v0b) = stats(&beta[0]);
+    let want = 4.0 / (3.0 * std::f64::consts::PI);
+    assert!(
+        (m0b - want).abs() < 4.0 * (v0b / nf).sqrt(),
+        "E[β0] = {m0b}, want {want}"
+    );
+}
+
+#[test]
+fn wrong_keys_are_load_errors_that_name_the_field() {
+    for (key, want) in [
+        (
+            "hub.inertai_bc_b_kg_m2[0][0]",
+            "hub.inertai_bc_b_kg_m2 does not exist",
+        ),
+        (
+            "panel_pairs[5].panel1.k_nm_rad",
+            "panel_pairs[5] does not exist",
+        ),
+        (
+            "panel_pairs[*].panel1.k_n_m_rad",
+            "panel_pairs[0].panel1.k_n_m_rad does not exist",
+        ),
+        (
+            "simulation.frame_hz",
+            "is not a parameter the built model reports",
+        ),
+        ("hub.inertia_bc_b_kg_m2[0][0", "expected [index] or [*]"),
+    ] {
+        let e = campaign(&format!(
+            "{HEAD}[[dispersions]]\nkey = \"{key}\"\ndistribution = \"normal\"\nsigma = 1.0\n"
+        ))
+        .unwrap_err();
+        assert!(
+            e.contains("dispersions[0].key") && e.contains(want),
+            "{key}: {e}"
+        );
+    }
+    for (body, want) in [
+        (
+            "distribution = \"gauss\"\nsigma = 1.0",
+            "dispersions[0].distribution",
+        ),
+        (
+            "distribution = \"normal\"\nsigma = -1.0",
+            "dispersions[0].sigma: must be ≥ 0",
+        ),
+        (
+            "distribution = \"uniform\"\nlow = 2.0\nhigh = 1.0",
+            "dispersions[0].high",
+        ),
+        (
+            "distribution = \"normal\"\nsigma = 1.0\nlow = 0.0",
+            "dispersions[0].low: does not apply",
+        ),
+    ] {
+        let e = campaign(&format!(
+            "{HEAD}[[dispersions]]\nkey = \"hub.mass_kg\"\n{body}\n"
+        ))
+        .unwrap_err();
+        assert!(e.contains(want), "{body}: {e}");
+    }
+    let e = campaign("runs = 0\nseed = 1\nduration_s = 1.0\n").unwrap_err();
+    assert!(e.contains("runs"), "{e}");
+    let e = campaign("runs = 2\nseed = 1\nduration_s = 0.015\n").unwrap_err();
+    assert!(
+        e.contains("duration_s") && e.contains("whole number of frames"),
+        "{e}"
+    );
+}
+
+#[test]
+fn invalid_draws_are_redrawn_and_recorded_or_the_run_is_invalid() {
+    // I_xx ~ U(0, 3000) with I_yy = 800, I_zz = 600: the triangle inequality needs
+    // 200 < I_xx < 1400, so most draws are invalid.
+    let body = "[[dispersions]]\nkey = \"hub.inertia_bc_b_kg_m2[0][0]\"\ndistribution = \"uniform\"\nlow = 0.0\nhigh = 3000.0\n";
+    let plan = campaign(&format!("runs = 50\nseed = 3\nduration_s = 1.0\n{body}")).unwrap();
+    let runs: Vec<_> = (0..50).map(|r| plan.run(r)).collect();
+    let redrawn = runs.iter().filter(|r| r.redraws > 0).count();
+    assert!(redrawn > 20, "only {redrawn} runs needed a redraw");
+    for r in &runs {
+        assert!(r.valid);
+        assert_eq!(r.redraw_reasons.len(), r.redraws as usize);
+        let i = r.dispersed["hub.inertia_bc_b_kg_m2[0][0]"];
+        assert!(i > 200.0 && i < 1400.0, "run {}: accepted {i}", r.run);
+        for why in &r.redraw_reasons {
+            assert!(why.contains("hub.inertia_bc_b_kg_m2"), "{why}");
+        }
+    }
+    let plan = campaign(&format!(
+        "runs = 50\nseed = 3\nduration_s = 1.0\nmax_redraws = 0\n{body}"
+    ))
+    .unwrap();
+    let invalid = (0..50).filter(|r| !plan.run(*r).valid).count();
+    assert!(invalid > 20, "only {invalid} invalid runs without redraws");
+}
+
+#[test]
+fn the_same_campaign_gives_the_same_plan_byte_for_byte() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let file = root.join("scenarios/campaign.toml");
+    let dirs: Vec<PathBuf> = (0..2)
+        .map(|i| Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("campaign_plan_{i}")))
+        .collect();
+    for d in &dirs {
+        let _ = std::fs::remove_dir_all(d);
+        let plan = Plan::new(Campaign::from_file(&file).unwrap()).unwrap();
+        plan.write(d).unwrap();
+    }
+    let a = std::fs::read(dirs[0].join("manifest.json")).unwrap();
+    assert_eq!(a, std::fs::read(dirs[1].join("manifest.json")).unwrap());
+    for r in 0..20 {
+        let name = format!("run-{r:04}/config.toml");
+        let x = std::fs::read(dirs[0].join(&name)).unwrap();
+        assert_eq!(x, std::fs::read(dirs[1].join(&name)).unwrap(), "{name}");
+    }
+    // A run planned alone is the same run.
+    let plan = Plan::new(Campaign::from_file(&file).unwrap()).unwrap();
+    let alone = plan.run(13);
+    assert_eq!(
+        alone.config_toml.as_bytes(),
+        std::fs::read(dirs[0].join("run-0013/config.toml")).unwrap()
+    );
+}
