@@ -289,3 +289,30 @@ fn the_same_campaign_gives_the_same_plan_byte_for_byte() {
         std::fs::read(dirs[0].join("run-0013/config.toml")).unwrap()
     );
 }
+
+#[test]
+fn sensor_seeds_are_derived_per_run_and_reach_the_model() {
+    let base = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/imu_tactical.toml");
+    let plan = campaign(&format!(
+        "base = {:?}\nruns = 5\nseed = 9\nduration_s = 1.0\n",
+        base.display().to_string()
+    ))
+    .unwrap();
+    let mut seen = Vec::new();
+    for r in 0..5 {
+        let rp = plan.run(r);
+        assert_eq!(rp.sensor_seeds.len(), 2, "{:?}", rp.sensor_seeds);
+        let cfg = SimConfig::from_toml_str(&rp.config_toml).unwrap();
+        let built: Vec<u64> = cfg.imus.iter().map(|i| i.seed).collect();
+        let planned: Vec<u64> = rp.sensor_seeds.values().copied().collect();
+        assert_eq!(
+            built, planned,
+            "run {r}: the model's IMU seeds are the planned ones"
+        );
+        assert_eq!(plan.run(r).sensor_seeds, rp.sensor_seeds, "deterministic");
+        seen.extend(planned);
+    }
+    seen.sort_unstable();
+    seen.dedup();
+    assert_eq!(seen.len(), 10, "every run and sensor gets its own seed");
+}

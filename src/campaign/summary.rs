@@ -85,24 +85,23 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
         }
     }
     // summary.csv
-    let mut csv = String::from("run,state_sha256,passed,status");
+    let mut csv = String::from("run,state_sha256,passed");
     for k in &keys {
         write!(csv, ",{k}").ok();
     }
     for c in &criteria {
         write!(csv, ",{c},{c}_passed").ok();
     }
-    csv.push('\n');
+    csv.push_str(",status\n");
     for p in &plans {
         let r = results.iter().find(|r| r.run == p.run);
         let status = r.map_or("missing".to_owned(), |r| r.status.replace([',', '\n'], ";"));
         write!(
             csv,
-            "{},{},{},{}",
+            "{},{},{}",
             p.run,
             r.map_or("", |r| r.state_sha256.as_str()),
             r.is_some_and(|r| r.passed),
-            status
         )
         .ok();
         for k in &keys {
@@ -117,7 +116,7 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
                 None => write!(csv, ",,").ok(),
             };
         }
-        csv.push('\n');
+        writeln!(csv, ",{status}").ok();
     }
     let csv_path = dir.join("summary.csv");
     std::fs::write(&csv_path, csv).map_err(|e| io(&csv_path, e))?;
