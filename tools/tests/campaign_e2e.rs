@@ -131,9 +131,10 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
     let mut lines = csv.lines();
     let header = lines.next().unwrap();
     assert!(
-        header.starts_with("run,state_sha256,passed,status,"),
+        header.starts_with("run,state_sha256,passed,hub.inertia_bc_b_kg_m2[0][0],"),
         "{header}"
     );
+    assert!(header.ends_with(",status"), "{header}");
     assert!(
         header.contains("panel_pairs[1].panel1.k_nm_rad")
             && header.contains("impossible_pointing_passed")
