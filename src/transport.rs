@@ -412,6 +412,15 @@ pub enum ZenohConfigError {
     },
 }
 
+/// Now, in ns since the Unix epoch: the clock of the frame-boundary stamps (0 before 1970,
+/// saturating after 2554).
+pub fn unix_now_ns() -> u64 {
+    use std::time::{SystemTime, UNIX_EPOCH};
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX))
+}
+
 /// The frame-boundary wall-clock stamp of a StateMsg sample (ns since the Unix epoch), from its
 /// 8-byte little-endian attachment; `None` if absent or malformed.
 pub fn frame_stamp_ns(sample: &Sample) -> Option<u64> {

@@ -3,7 +3,9 @@
 
 mod server_support;
 
-use std::time::{Duration, SystemTime, UNIX_EPOCH};
+use std::time::Duration;
+
+use flexdyn::transport::unix_now_ns;
 
 use flexdyn::server::{Outcome, ServerSettings};
 use flexdyn_proto::{
@@ -13,13 +15,6 @@ use server_support::{reference_config, wait_until, Observer, ServerHandle};
 use zenoh::Wait;
 
 const WAIT: Duration = Duration::from_secs(30);
-
-fn unix_now_ns() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .unwrap()
-        .as_nanos() as u64
-}
 
 #[test]
 fn realtime_100hz_publishes_at_about_the_rate_and_zeroes_stale_commands() {

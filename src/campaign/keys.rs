@@ -64,8 +64,15 @@ pub fn parse(path: &str) -> Result<Vec<Step>, String> {
 /// error names the first step that does not exist or does not hold numbers.
 pub fn expand(doc: &Table, path: &str) -> Result<Vec<String>, String> {
     let steps = parse(path)?;
+    // `parse` always starts with a table key.
+    let (Some(Step::Key(first)), rest) = (steps.first(), &steps[1..]) else {
+        return Err("a key must start with a table key".into());
+    };
+    let child = doc
+        .get(first)
+        .ok_or_else(|| format!("{first} does not exist in the base configuration"))?;
     let mut out = Vec::new();
-    walk(&Value::Table(doc.clone()), &steps, String::new(), &mut out)?;
+    walk(child, rest, first.clone(), &mut out)?;
     if out.is_empty() {
         return Err("names no number (an empty array?)".into());
     }
@@ -143,8 +150,18 @@ fn leaf_mut<'a>(doc: &'a mut Table, path: &str) -> Option<&'a mut Value> {
 
 /// The number at a canonical path (from [`expand`]).
 pub fn get(doc: &Table, path: &str) -> Option<f64> {
-    let mut d = doc.clone();
-    match leaf_mut(&mut d, path)? {
+    let steps = parse(path).ok()?;
+    let (first, rest) = steps.split_first()?;
+    let Step::Key(k) = first else { return None };
+    let mut v = doc.get(k)?;
+    for s in rest {
+        v = match (s, v) {
+            (Step::Key(k), Value::Table(t)) => t.get(k)?,
+            (Step::Index(i), Value::Array(a)) => a.get(*i)?,
+            _ => return None,
+        };
+    }
+    match v {
         Value::Integer(i) => Some(*i as f64),
         Value::Float(x) => Some(*x),
         _ => None,

@@ -18,7 +18,9 @@
 use std::sync::atomic::Ordering;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TryRecvError};
 use std::sync::Arc;
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant};
+
+use crate::transport::unix_now_ns;
 
 use flexdyn_proto::{CommandMsg, Header, Mode, RunState};
 use nalgebra::Vector3;
@@ -75,12 +77,6 @@ pub struct PhysicsCtx {
     pub full_tx: SyncSender<Box<Frame>>,
     /// Counters and the stop flag.
     pub shared: Arc<Shared>,
-}
-
-fn unix_now_ns() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX))
 }
 
 enum Wait {

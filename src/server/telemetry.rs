@@ -9,7 +9,9 @@
 use std::sync::atomic::Ordering;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender};
 use std::sync::Arc;
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant};
+
+use crate::transport::unix_now_ns;
 
 use flexdyn_proto::{encode_into, CommandStatus, FrameTiming, Header, Mode, StatusMsg};
 use hdrhistogram::Histogram;
@@ -102,12 +104,6 @@ impl Recording {
             publish_time_ns: stamp_ns,
         });
     }
-}
-
-fn unix_now_ns() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX))
 }
 
 struct Publishing {

@@ -104,6 +104,11 @@ impl VehicleInfo {
         meta
     }
 
+    /// The 3D geometry of the configuration this vehicle runs.
+    pub fn geometry(&self) -> Result<Geometry, crate::config::ConfigError> {
+        SimConfig::from_toml_str(&self.config_toml).map(|cfg| Geometry::from_config(&cfg))
+    }
+
     /// Reads a metadata record written by [`Self::to_metadata`]; `None` if a field is missing.
     pub fn from_metadata(meta: &BTreeMap<String, String>) -> Option<Self> {
         let get = |k: &str| meta.get(k).cloned();
@@ -264,21 +269,9 @@ impl McapSink {
     /// Records `info` as the metadata record `flexdyn/<sc-id>` and, when its configuration
     /// parses, starts the vehicle's transform and scene channels.
     pub fn describe_vehicle(&mut self, info: &VehicleInfo) -> Result<(), RecordError> {
-        let mut meta = BTreeMap::new();
-        meta.insert("sc_id".to_owned(), info.sc_id.clone());
-        meta.insert("spacecraft_id".to_owned(), info.spacecraft_id.to_string());
-        meta.insert("config_toml".to_owned(), info.config_toml.clone());
-        meta.insert("server_settings".to_owned(), info.server_settings.clone());
-        meta.insert("flexdyn_version".to_owned(), info.flexdyn_version.clone());
-        meta.insert(
-            "git_commit".to_owned(),
-            info.git_commit
-                .clone()
-                .unwrap_or_else(|| "unknown".to_owned()),
-        );
-        self.metadata(&format!("flexdyn/{}", info.sc_id), meta)?;
-        let geometry = match SimConfig::from_toml_str(&info.config_toml) {
-            Ok(cfg) => Some(Geometry::from_config(&cfg)),
+        self.metadata(&VehicleInfo::metadata_name(&info.sc_id), info.to_metadata())?;
+        let geometry = match info.geometry() {
+            Ok(g) => Some(g),
             Err(e) => {
                 tracing::warn!(sc_id = %info.sc_id, error = %e, "the vehicle's configuration does not parse here; recording without its 3D transforms");
                 None
@@ -398,12 +391,14 @@ impl McapSink {
         let Some(v) = self.vehicles.get(sc_id) else {
             return Ok(None);
         };
-        let Some(geometry) = v.geometry.clone() else {
-            return Ok(None);
-        };
         if let Some(tf) = v.tf {
             return Ok(Some(tf));
         }
+        let Some(geometry) = &v.geometry else {
+            return Ok(None);
+        };
+        // First transforms of this vehicle: open its channels and write its scene once.
+        let scene_json = scene_update(geometry, &format!("{sc_id}/"), t_ns).to_string();
         let tf_schema = self.schema("foxglove.FrameTransforms", "jsonschema", &|| {
             frame_transforms_schema().to_string().into_bytes()
         })?;
@@ -412,8 +407,6 @@ impl McapSink {
         })?;
         let tf = self.channel(tf_schema, &tf_topic(sc_id), "json")?;
         let scene = self.channel(scene_schema, &scene_topic(sc_id), "json")?;
-        let prefix = format!("{sc_id}/");
-        let scene_json = scene_update(&geometry, &prefix, t_ns).to_string();
         self.put(scene, t_ns, t_ns, scene_json.as_bytes())?;
         if let Some(v) = self.vehicles.get_mut(sc_id) {
             v.tf = Some(tf);

@@ -208,6 +208,8 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
         }
         let mut state = Vec::with_capacity(fields.len());
         let mut imu: BTreeMap<String, Vec<(String, Cell)>> = BTreeMap::new();
+        // Column 0 is t_s (checked above), so the row's time is known before any IMU column.
+        let mut t_s = f64::NAN;
         for (name, f) in header.iter().zip(&fields) {
             let x = if f.is_empty() {
                 f64::NAN
@@ -216,6 +218,9 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
                     input_err(path, format!("line {}, column {name}: {f:?}: {e}", i + 2))
                 })?
             };
+            if *name == "t_s" {
+                t_s = x;
+            }
             // `simulate` puts each IMU's columns in the state CSV as imu_<name>_<field>.
             if let Some(rest) = name.strip_prefix("imu_") {
                 if let Some((imu_name, field)) = rest
@@ -228,7 +233,7 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
                 {
                     let cells = imu.entry(imu_name.to_owned()).or_default();
                     if cells.is_empty() {
-                        cells.push(("t_s".into(), Cell::Num(state_t(&header, &fields))));
+                        cells.push(("t_s".into(), Cell::Num(t_s)));
                     }
                     cells.push((field, Cell::Num(x)));
                     continue;
@@ -245,14 +250,6 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
         return Err(input_err(path, "no data rows"));
     }
     Ok(data)
-}
-
-fn state_t(header: &[&str], fields: &[&str]) -> f64 {
-    header
-        .iter()
-        .position(|h| *h == "t_s")
-        .and_then(|i| fields[i].parse().ok())
-        .unwrap_or(f64::NAN)
 }
 
 /// One line on a panel.

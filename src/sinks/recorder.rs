@@ -16,7 +16,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender, TrySendError};
 use std::sync::Arc;
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant};
+
+use crate::transport::unix_now_ns;
 
 use super::mcap_file::{McapSink, RecordError, RecordingInfo, SinkStats, VehicleInfo};
 
@@ -46,13 +48,6 @@ pub struct RecordTx {
     tx: SyncSender<Msg>,
     dropped: Arc<AtomicU64>,
     lossless: bool,
-}
-
-/// Now, in ns since the Unix epoch.
-pub fn unix_now_ns() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX))
 }
 
 impl RecordTx {

@@ -30,7 +30,6 @@ use super::scene::{
     frame_transforms, frame_transforms_schema, scene_update, scene_update_schema, Geometry,
 };
 use super::topics::{classify, json_schema, Decoded};
-use crate::config::SimConfig;
 use crate::transport::{zenoh_config, Role, ZenohArgs};
 
 /// Default address of the viewer (Foxglove's default connection is `ws://localhost:8765`).
@@ -105,10 +104,9 @@ impl Translator {
     }
 
     fn describe(&mut self, info: &VehicleInfo) {
-        match SimConfig::from_toml_str(&info.config_toml) {
-            Ok(cfg) => {
-                self.geometry
-                    .insert(info.sc_id.clone(), Geometry::from_config(&cfg));
+        match info.geometry() {
+            Ok(g) => {
+                self.geometry.insert(info.sc_id.clone(), g);
                 self.send_scenes();
             }
             Err(e) => {

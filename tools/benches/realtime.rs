@@ -20,19 +20,14 @@ mod support;
 
 use std::process::Command;
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, SystemTime, UNIX_EPOCH};
+use std::time::Duration;
 
 use flexdyn::server::{frame_stamp_ns, ServerSettings};
+use flexdyn::transport::unix_now_ns;
 use flexdyn_proto::{decode_state, Topics};
 use flexdyn_tools::percentile;
 use support::{connecting_session, endpoint, reference_config, ChildGuard, ServerHandle};
 use zenoh::Wait;
-
-fn unix_now_ns() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos() as u64)
-}
 
 /// What one real-time round measured.
 struct Round {

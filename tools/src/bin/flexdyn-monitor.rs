@@ -23,10 +23,10 @@
 
 use std::io::{IsTerminal as _, Write as _};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant};
 
 use clap::Parser;
-use flexdyn::transport::{frame_stamp_ns, mode_name};
+use flexdyn::transport::{frame_stamp_ns, mode_name, unix_now_ns};
 use flexdyn_proto::{
     command_flags, decode_state, decode_status, effector_kind, wheel_flags, RunState, StatusMsg,
     NO_COMMAND,
@@ -96,12 +96,6 @@ fn rejected_by_reason(r: &flexdyn_proto::RejectCounters) -> String {
     } else {
         parts.join(",")
     }
-}
-
-fn unix_now_ns() -> u64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos() as u64)
 }
 
 fn norm(v: [f64; 3]) -> f64 {
