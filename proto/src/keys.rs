@@ -174,11 +174,6 @@ impl Topics {
         format!("{KEY_ROOT}/{}/{CONFIG_SUFFIX}", self.sc_id)
     }
 
-    /// `flexdyn/<sc>/**`: every key of this spacecraft.
-    pub fn all(&self) -> String {
-        format!("{KEY_ROOT}/{}/**", self.sc_id)
-    }
-
     /// `flexdyn/<sc>/tlm/imu/*`
     pub fn imu_wildcard(&self) -> String {
         format!("{KEY_ROOT}/{}/{IMU_PREFIX}/*", self.sc_id)
