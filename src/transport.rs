@@ -192,6 +192,26 @@ pub fn zenoh_config(args: &ZenohArgs, role: Role) -> Result<zenoh::Config, Zenoh
     };
     let file_sets = |key: &str| doc.as_ref().and_then(|d| json_has(d, key)).is_some();
 
+    // A relative usrpwd dictionary path is relative to the JSON5 file, not to the working
+    // directory, so a shipped file works from anywhere.
+    if let (Some(path), Some(doc)) = (&args.zenoh_config, &doc) {
+        if let Some(serde_json::Value::String(dict)) =
+            json_has(doc, "transport/auth/usrpwd/dictionary_file")
+        {
+            let dict_path = std::path::Path::new(&dict);
+            if dict_path.is_relative() {
+                let base = path.parent().unwrap_or(std::path::Path::new("."));
+                let resolved = base.join(dict_path);
+                insert(
+                    &mut config,
+                    "transport/auth/usrpwd/dictionary_file",
+                    &serde_json::Value::String(resolved.to_string_lossy().into_owned()).to_string(),
+                    "transport/auth/usrpwd/dictionary_file",
+                )?;
+            }
+        }
+    }
+
     if !args.listen.is_empty() {
         insert(
             &mut config,

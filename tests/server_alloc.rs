@@ -1,22 +1,22 @@
-//! The physics thread's per-frame path allocates and frees nothing: command intake and
-//! bookkeeping (wrench and wheel `Actuators` commands, the latter handed back through the
-//! recycle channel), the RK4 frame, IMU and star-tracker sampling, the telemetry fill, and the
-//! buffer hand-off through the bounded channels.
+//! The per-frame path allocates and frees nothing: command intake and bookkeeping (wrench and
+//! wheel `Actuators` commands, the latter handed back through the recycle channel), then the
+//! server's own [`Stepper`] — the code both the physics thread and the direct lockstep core run
+//! — holding the commands, integrating the RK4 frame, sampling the IMU and star tracker,
+//! filling the telemetry and checking it finite, and the buffer hand-off through the bounded
+//! channels.
 //!
 //! `assert_no_alloc`'s global allocator counts (de)allocations made on this thread inside
 //! `assert_no_alloc(..)` (features `warn_debug`/`warn_release`: count and warn, don't abort).
 
 use std::sync::mpsc::sync_channel;
 
-use flexdyn::dynamics::Wrench;
-
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
 use flexdyn::config::SimConfig;
-use flexdyn::server::commands::CommandBook;
-use flexdyn::server::shared::{fill_state, Frame};
+use flexdyn::server::physics::Stepper;
+use flexdyn::server::shared::Frame;
+use flexdyn::server::ServerSettings;
 use flexdyn::sim::{Simulation, Snapshot};
-use flexdyn_proto::{CommandMsg, EffectorInput, Header, StalePolicy};
-use nalgebra::Vector3;
+use flexdyn_proto::{CommandMsg, EffectorInput, Header};
 
 #[global_allocator]
 static ALLOC: AllocDisabler = AllocDisabler;
@@ -27,29 +27,22 @@ fn the_frame_path_does_not_allocate() {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml");
     let cfg = SimConfig::from_file(&path).unwrap();
-    let mut sim = Simulation::new(&cfg).unwrap();
+    let sim = Simulation::new(&cfg).unwrap();
     assert!(sim.n_imus() > 0);
-    let mut imu = Vec::with_capacity(sim.n_imus());
-    let mut st = Vec::with_capacity(sim.star_trackers().len());
     assert!(!sim.star_trackers().is_empty());
-    let mut book = CommandBook::new(
-        &[1, 2],
-        cfg.frame_ns,
-        100_000_000,
-        StalePolicy::Hold,
-        sim.spacecraft().effector_input_ranges(),
-    );
-    let mut snap = Snapshot::for_simulation(&sim);
+    let snap = Snapshot::for_simulation(&sim);
+    let (n_imus, n_sts) = (sim.n_imus(), sim.star_trackers().len());
+    let settings = ServerSettings {
+        participants: vec![1, 2],
+        ..ServerSettings::default()
+    };
+    let mut w = Stepper::new(sim, &settings);
     let (cmd_tx, cmd_rx) = sync_channel::<CommandMsg>(16);
     let (free_tx, free_rx) = sync_channel::<Box<Frame>>(2);
     let (full_tx, full_rx) = sync_channel::<Box<Frame>>(2);
     for _ in 0..2 {
         free_tx
-            .send(Box::new(Frame::for_snapshot(
-                &snap,
-                sim.n_imus(),
-                sim.star_trackers().len(),
-            )))
+            .send(Box::new(Frame::for_snapshot(&snap, n_imus, n_sts)))
             .unwrap();
     }
     // Sender 2 commands the four wheels (effectors 2–5). Its Actuators commands own heap
@@ -73,33 +66,16 @@ fn the_frame_path_does_not_allocate() {
         let wrench = CommandMsg::wrench(Header::new(1, k, 0, k), 1, [0.0, 0.0, 0.01], [0.0; 3]);
         cmd_tx.try_send(wrench).unwrap();
         cmd_tx.try_send(wheel_commands.pop().unwrap()).unwrap();
-        book.begin_tick();
+        w.book.begin_tick();
         while let Ok(cmd) = cmd_rx.try_recv() {
-            book.offer_lockstep(&cmd, k);
+            w.book.offer_lockstep(&cmd, k);
             recycle_tx.try_send(cmd).unwrap();
         }
-        assert!(book.all_answered());
-        let held = book.held(k);
-        sim.set_command_wrench(Wrench {
-            force_b_newton: Vector3::from(held.force_b_newton),
-            torque_b_nm: Vector3::from(held.torque_b_nm),
-        });
-        sim.set_effector_inputs(book.held_inputs()).unwrap();
-        sim.step_frame();
-        sim.imu_samples_into(&mut imu);
-        sim.star_tracker_samples_into(k + 1, &mut st);
+        assert!(w.book.all_answered());
+        w.step(k);
         let mut f = free_rx.try_recv().unwrap();
-        sim.snapshot_into(&mut snap);
-        f.imu.clear();
-        f.imu.extend_from_slice(&imu);
-        f.star_trackers.clear();
-        f.star_trackers.extend_from_slice(&st);
-        fill_state(
-            &mut f.state,
-            &snap,
-            Header::new(1, k + 1, snap.t_sim_ns, k + 1),
-            &held,
-        );
+        w.fill(&mut f, k + 1);
+        w.check_finite(k + 1, true).unwrap();
         full_tx.try_send(f).unwrap();
         // The I/O side returns the buffer.
         free_tx.try_send(full_rx.try_recv().unwrap()).unwrap();
@@ -115,7 +91,7 @@ fn the_frame_path_does_not_allocate() {
     assert_eq!(violation_count(), 0, "the frame path allocated");
     // The wheels were commanded (torques 0.01–0.04 N·m held), and the recycled commands are
     // freed here, on the "I/O side".
-    let s = sim.snapshot();
+    let s = w.sim.snapshot();
     assert_eq!(s.effectors[3].outputs[0], 0.02);
     assert_eq!(recycle_rx.try_iter().count(), 400);
 }

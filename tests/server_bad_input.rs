@@ -30,12 +30,9 @@ fn bad_commands_are_counted_and_the_server_keeps_running() {
         wait_until(WAIT, || obs.last_tick().is_some_and(|t| t >= 5)),
         "no telemetry"
     );
-    let cmd_pub = obs
-        .session
-        .declare_publisher(topics.cmd_wrench().to_owned())
-        .wait()
-        .unwrap();
+    let cmd_pub = obs.session.declare_publisher(topics.cmd(1)).wait().unwrap();
     let put = |bytes: Vec<u8>| cmd_pub.put(bytes).wait().unwrap();
+    let put_on = |key: String, bytes: Vec<u8>| obs.session.put(key, bytes).wait().unwrap();
     let tick = obs.last_tick().unwrap();
     let good = CommandMsg::wrench(Header::new(1, tick, 0, 0), 1, [0.0, 0.0, 0.5], [0.0; 3]);
 
@@ -62,11 +59,17 @@ fn bad_commands_are_counted_and_the_server_keeps_running() {
         header: Header::new(99, tick, 0, 0),
         ..good.clone()
     }));
-    // Unknown sender.
-    put(encode(&CommandMsg {
-        sender_id: 42,
-        ..good.clone()
-    }));
+    // Unknown sender, on its own key.
+    put_on(
+        topics.cmd(42),
+        encode(&CommandMsg {
+            sender_id: 42,
+            ..good.clone()
+        }),
+    );
+    // Wrong identity: sender 1 on sender 2's key, and on the protocol-3 key naming no sender.
+    put_on(topics.cmd(2), encode(&good));
+    put_on("flexdyn/sc1/cmd/wrench".to_owned(), encode(&good));
     // A tick in the future.
     put(encode(&CommandMsg {
         header: Header::new(1, tick + 1_000_000, 0, 0),
@@ -96,6 +99,7 @@ fn bad_commands_are_counted_and_the_server_keeps_running() {
         stale_tick: 1,
         unknown_sender: 1,
         bad_effector_input: 2,
+        wrong_identity: 2,
     };
     assert!(
         wait_until(WAIT, || obs

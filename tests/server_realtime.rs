@@ -37,11 +37,7 @@ fn realtime_100hz_publishes_at_about_the_rate_and_zeroes_stale_commands() {
     );
 
     // One command, never refreshed: applied, then stale after 50 ms and zeroed.
-    let cmd_pub = obs
-        .session
-        .declare_publisher(topics.cmd_wrench().to_owned())
-        .wait()
-        .unwrap();
+    let cmd_pub = obs.session.declare_publisher(topics.cmd(1)).wait().unwrap();
     let tick = obs.last_tick().unwrap();
     cmd_pub
         .put(encode(&CommandMsg::wrench(

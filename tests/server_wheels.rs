@@ -66,10 +66,7 @@ fn actuators_drive_the_wheels_and_bad_inputs_are_counted() {
     // The participant: answers every state with the wheel torques; at tick 5 it first sends
     // every kind of bad effector input, none of which may answer the tick.
     let session = connecting_session(port);
-    let publisher = session
-        .declare_publisher(topics.cmd_wrench().to_owned())
-        .wait()
-        .unwrap();
+    let publisher = session.declare_publisher(topics.cmd(1)).wait().unwrap();
     let states = session
         .declare_subscriber(topics.state().to_owned())
         .wait()

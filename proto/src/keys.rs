@@ -13,8 +13,11 @@ pub const STATE_SUFFIX: &str = "tlm/state";
 pub const IMU_PREFIX: &str = "tlm/imu";
 /// Prefix of the star-tracker topics; the tracker name follows after a `/`.
 pub const STAR_TRACKER_PREFIX: &str = "tlm/st";
-/// Key suffix of the command topic (every [`crate::CommandKind`], despite the name).
-pub const CMD_WRENCH_SUFFIX: &str = "cmd/wrench";
+/// Prefix of the command topics; the sender's decimal `sender_id` follows after a `/`
+/// (`flexdyn/<sc>/cmd/<sender_id>`, every [`crate::CommandKind`]). One key per sender, so a
+/// Zenoh access-control list can reserve each participant's key for its authenticated subject.
+/// Protocol version 4; versions ≤ 3 used the single key `flexdyn/<sc>/cmd/wrench`.
+pub const CMD_PREFIX: &str = "cmd";
 /// Suffix of the status topic.
 pub const STATUS_SUFFIX: &str = "status";
 /// Suffix of the server's configuration queryable (a `get` returns a UTF-8 JSON description
@@ -93,10 +96,35 @@ pub fn star_tracker_wildcard_key(sc: &str) -> Result<String, KeyError> {
     Ok(format!("{KEY_ROOT}/{sc}/{STAR_TRACKER_PREFIX}/*"))
 }
 
-/// `flexdyn/<sc>/cmd/wrench`
-pub fn cmd_wrench_key(sc: &str) -> Result<String, KeyError> {
+/// `flexdyn/<sc>/cmd/<sender_id>`: where participant `sender_id` publishes its commands.
+pub fn cmd_key(sc: &str, sender_id: u32) -> Result<String, KeyError> {
     validate_sc_id(sc)?;
-    Ok(format!("{KEY_ROOT}/{sc}/{CMD_WRENCH_SUFFIX}"))
+    Ok(format!("{KEY_ROOT}/{sc}/{CMD_PREFIX}/{sender_id}"))
+}
+
+/// `flexdyn/<sc>/cmd/*` — every sender's command key (what the server subscribes to).
+pub fn cmd_wildcard_key(sc: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{CMD_PREFIX}/*"))
+}
+
+/// The canonical decimal u32 after `prefix/` in `key`: no sign, no leading zero (so one sender
+/// has exactly one key), `None` otherwise.
+fn decimal_after(key: &str, sc: &str, prefix: &str) -> Option<u32> {
+    let rest = key
+        .strip_prefix(KEY_ROOT)?
+        .strip_prefix('/')?
+        .strip_prefix(sc)?
+        .strip_prefix('/')?
+        .strip_prefix(prefix)?
+        .strip_prefix('/')?;
+    if rest.is_empty()
+        || !rest.bytes().all(|b| b.is_ascii_digit())
+        || (rest.len() > 1 && rest.starts_with('0'))
+    {
+        return None;
+    }
+    rest.parse().ok()
 }
 
 /// `flexdyn/<sc>/status`
@@ -124,7 +152,7 @@ pub fn participant_wildcard_key(sc: &str) -> Result<String, KeyError> {
 pub struct Topics {
     sc_id: String,
     state: String,
-    cmd_wrench: String,
+    cmd_wildcard: String,
     status: String,
 }
 
@@ -134,7 +162,7 @@ impl Topics {
         Ok(Self {
             sc_id: sc.to_owned(),
             state: state_key(sc)?,
-            cmd_wrench: cmd_wrench_key(sc)?,
+            cmd_wildcard: cmd_wildcard_key(sc)?,
             status: status_key(sc)?,
         })
     }
@@ -149,9 +177,20 @@ impl Topics {
         &self.state
     }
 
-    /// `flexdyn/<sc>/cmd/wrench`
-    pub fn cmd_wrench(&self) -> &str {
-        &self.cmd_wrench
+    /// `flexdyn/<sc>/cmd/<sender_id>`: participant `sender_id`'s command key.
+    pub fn cmd(&self, sender_id: u32) -> String {
+        format!("{KEY_ROOT}/{}/{CMD_PREFIX}/{sender_id}", self.sc_id)
+    }
+
+    /// `flexdyn/<sc>/cmd/*`: every sender's command key.
+    pub fn cmd_wildcard(&self) -> &str {
+        &self.cmd_wildcard
+    }
+
+    /// The sender id of a command key of this spacecraft (`flexdyn/<sc>/cmd/<decimal u32>`,
+    /// canonical: no leading zero), `None` for any other key.
+    pub fn cmd_sender(&self, key: &str) -> Option<u32> {
+        decimal_after(key, &self.sc_id, CMD_PREFIX)
     }
 
     /// `flexdyn/<sc>/status`
@@ -192,17 +231,7 @@ impl Topics {
     /// The sender id of a participant token key of this spacecraft
     /// (`flexdyn/<sc>/participant/<decimal u32>`), `None` for any other key.
     pub fn participant_id(&self, key: &str) -> Option<u32> {
-        let rest = key
-            .strip_prefix(KEY_ROOT)?
-            .strip_prefix('/')?
-            .strip_prefix(self.sc_id.as_str())?
-            .strip_prefix('/')?
-            .strip_prefix(PARTICIPANT_PREFIX)?
-            .strip_prefix('/')?;
-        if rest.is_empty() || !rest.bytes().all(|b| b.is_ascii_digit()) {
-            return None;
-        }
-        rest.parse().ok()
+        decimal_after(key, &self.sc_id, PARTICIPANT_PREFIX)
     }
 }
 
@@ -217,7 +246,8 @@ mod tests {
             imu_key("sc-1", "imu_A").unwrap(),
             "flexdyn/sc-1/tlm/imu/imu_A"
         );
-        assert_eq!(cmd_wrench_key("SC_2").unwrap(), "flexdyn/SC_2/cmd/wrench");
+        assert_eq!(cmd_key("SC_2", 7).unwrap(), "flexdyn/SC_2/cmd/7");
+        assert_eq!(cmd_wildcard_key("SC_2").unwrap(), "flexdyn/SC_2/cmd/*");
         assert_eq!(status_key("x").unwrap(), "flexdyn/x/status");
         assert_eq!(imu_wildcard_key("x").unwrap(), "flexdyn/x/tlm/imu/*");
         assert_eq!(
@@ -232,7 +262,22 @@ mod tests {
         let t = Topics::new("sc-1").unwrap();
         assert_eq!(t.sc_id(), "sc-1");
         assert_eq!(t.state(), "flexdyn/sc-1/tlm/state");
-        assert_eq!(t.cmd_wrench(), "flexdyn/sc-1/cmd/wrench");
+        assert_eq!(t.cmd(1), "flexdyn/sc-1/cmd/1");
+        assert_eq!(t.cmd(0), cmd_key("sc-1", 0).unwrap());
+        assert_eq!(t.cmd_wildcard(), "flexdyn/sc-1/cmd/*");
+        assert_eq!(t.cmd_sender("flexdyn/sc-1/cmd/1"), Some(1));
+        assert_eq!(t.cmd_sender("flexdyn/sc-1/cmd/0"), Some(0));
+        assert_eq!(t.cmd_sender(&t.cmd(u32::MAX)), Some(u32::MAX));
+        for bad in [
+            "flexdyn/sc-1/cmd/wrench",
+            "flexdyn/sc-1/cmd/01",
+            "flexdyn/sc-1/cmd/",
+            "flexdyn/sc-1/cmd/4294967296",
+            "flexdyn/sc-2/cmd/1",
+            "flexdyn/sc-1/participant/1",
+        ] {
+            assert_eq!(t.cmd_sender(bad), None, "{bad}");
+        }
         assert_eq!(t.status(), "flexdyn/sc-1/status");
         assert_eq!(t.imu("g").unwrap(), "flexdyn/sc-1/tlm/imu/g");
         assert_eq!(t.imu_wildcard(), "flexdyn/sc-1/tlm/imu/*");
@@ -252,6 +297,7 @@ mod tests {
             "flexdyn/sc-1/participant/",
             "flexdyn/sc-1/participant/x",
             "flexdyn/sc-1/participant/+7",
+            "flexdyn/sc-1/participant/07",
             "flexdyn/sc-1/participant/4294967296",
             "flexdyn/sc-2/participant/7",
             "flexdyn/sc-1/tlm/state",

@@ -33,7 +33,7 @@ pub const COMMAND_NO_COMMAND_LEN: usize = 38;
 /// u64 input count sits at offset 86.
 pub const COMMAND_ACTUATORS_FIXED_LEN: usize = 94;
 /// Encoded [`StatusMsg`] size (bytes).
-pub const STATUS_LEN: usize = 171;
+pub const STATUS_LEN: usize = 179;
 /// Largest effector count a [`StateMsg`] (or input count a [`CommandKind::Actuators`]) may
 /// carry; decoders reject more.
 pub const MAX_EFFECTORS: usize = 1024;

@@ -12,7 +12,7 @@
 //! | `flexdyn/<sc-id>/tlm/state` | [`StateMsg`] | server → flight code, every frame |
 //! | `flexdyn/<sc-id>/tlm/imu/<name>` | [`ImuMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/tlm/st/<name>` | [`StarTrackerMsg`] | server → flight code |
-//! | `flexdyn/<sc-id>/cmd/wrench` | [`CommandMsg`] | flight code → server |
+//! | `flexdyn/<sc-id>/cmd/<sender-id>` | [`CommandMsg`] | flight code → server |
 //! | `flexdyn/<sc-id>/status` | [`StatusMsg`] | server → anyone |
 //! | `flexdyn/<sc-id>/participant/<sender-id>` | Zenoh liveliness token (no payload) | lockstep participant → server |
 //!
@@ -38,7 +38,7 @@
 //! | [`ImuMsg`] | [`IMU_LEN`] = 127 |
 //! | [`StarTrackerMsg`] | [`STAR_TRACKER_LEN`] = 64 |
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
-//! | [`StatusMsg`] | [`STATUS_LEN`] = 171 |
+//! | [`StatusMsg`] | [`STATUS_LEN`] = 179 |
 //!
 //! Decoders accept at most [`MAX_MESSAGE_BYTES`], [`MAX_EFFECTORS`] and
 //! [`MAX_EFFECTOR_VALUES`], reject trailing bytes, and never panic ([`DecodeError`]).
@@ -79,10 +79,10 @@ pub use codec::{
 };
 pub use error::{DecodeError, KeyError};
 pub use keys::{
-    cmd_wrench_key, imu_key, imu_wildcard_key, participant_key, participant_wildcard_key,
-    star_tracker_key, star_tracker_wildcard_key, state_key, status_key, validate_imu_name,
-    validate_sc_id, validate_star_tracker_name, Topics, CMD_WRENCH_SUFFIX, IMU_PREFIX, KEY_ROOT,
-    MAX_ID_LEN, PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX,
+    cmd_key, cmd_wildcard_key, imu_key, imu_wildcard_key, participant_key,
+    participant_wildcard_key, star_tracker_key, star_tracker_wildcard_key, state_key, status_key,
+    validate_imu_name, validate_sc_id, validate_star_tracker_name, Topics, CMD_PREFIX, IMU_PREFIX,
+    KEY_ROOT, MAX_ID_LEN, PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX,
 };
 pub use layout::{
     WireLayout, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
@@ -99,5 +99,6 @@ pub use messages::{
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
 /// Version 3: generic effector states in [`StateMsg`], [`CommandKind::Actuators`],
-/// [`StarTrackerMsg`], [`RejectCounters::bad_effector_input`].
-pub const PROTOCOL_VERSION: u16 = 3;
+/// [`StarTrackerMsg`], [`RejectCounters::bad_effector_input`]. Version 4: one command key per
+/// sender (`flexdyn/<sc-id>/cmd/<sender_id>`) and [`RejectCounters::wrong_identity`].
+pub const PROTOCOL_VERSION: u16 = 4;

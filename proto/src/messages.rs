@@ -326,7 +326,7 @@ impl Default for CommandKind {
     }
 }
 
-/// Command from flight code, topic `flexdyn/<sc-id>/cmd/wrench` (every kind of command uses
+/// Command from flight code, topic `flexdyn/<sc-id>/cmd/<sender_id>` (every kind of command uses
 /// this one topic, so a lockstep participant's answer is one message).
 /// 86 bytes (`Wrench`), 38 bytes (`NoCommand`) or 94 + Σ(12 + 8·values) bytes
 /// (`Actuators`).
@@ -508,7 +508,7 @@ pub struct CommandStatus {
     pub stale_policy: StalePolicy,
 }
 
-/// Rejected-command counters by reason, cumulative since start. 56 bytes.
+/// Rejected-command counters by reason, cumulative since start. 64 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct RejectCounters {
@@ -528,6 +528,11 @@ pub struct RejectCounters {
     /// that takes no inputs, the wrong number of values for its kind, or the same index
     /// twice. Added in protocol version 3.
     pub bad_effector_input: u64,
+    /// A command whose `sender_id` is not the one its key names: a participant publishes only
+    /// on `flexdyn/<sc-id>/cmd/<its sender_id>`, and on a lab network the Zenoh access-control
+    /// list lets only the participant's authenticated subject put there. Added in protocol
+    /// version 4.
+    pub wrong_identity: u64,
 }
 
 impl RejectCounters {
@@ -555,13 +560,14 @@ impl RejectCounters {
             self.stale_tick,
             self.unknown_sender,
             self.bad_effector_input,
+            self.wrong_identity,
         ]
         .iter()
         .fold(0u64, |a, &b| a.saturating_add(b))
     }
 }
 
-/// Server health, topic `flexdyn/<sc-id>/status`. 171 bytes.
+/// Server health, topic `flexdyn/<sc-id>/status`. 179 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct StatusMsg {

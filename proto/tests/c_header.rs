@@ -231,6 +231,7 @@ impl Gen {
                     rejected: RejectCounters {
                         malformed: self.u64(),
                         bad_effector_input: self.u64(),
+                        wrong_identity: self.u64(),
                         ..RejectCounters::default()
                     },
                     ..StatusMsg::default()

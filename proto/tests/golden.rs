@@ -99,7 +99,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0300", "u16 header.protocol_version = 3"),
+    (0, "0400", "u16 header.protocol_version = 4"),
     (
         2,
         "44332211",
@@ -359,7 +359,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0300", "u16 header.protocol_version = 3"),
+    (0, "0400", "u16 header.protocol_version = 4"),
     (
         2,
         "44332211",
@@ -435,7 +435,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0300", "u16 header.protocol_version = 3"),
+    (0, "0400", "u16 header.protocol_version = 4"),
     (
         2,
         "44332211",
@@ -482,7 +482,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0300", "u16 header.protocol_version = 3"),
+    (0, "0400", "u16 header.protocol_version = 4"),
     (
         2,
         "44332211",
@@ -552,7 +552,7 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0300", "u16 header.protocol_version = 3"),
+    (0, "0400", "u16 header.protocol_version = 4"),
     (
         2,
         "44332211",
@@ -589,7 +589,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
     (63, "01", "u8 status_flags = 1 (SUN_EXCLUSION)"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0300", "u16 header.protocol_version = 3"),
+    (0, "0400", "u16 header.protocol_version = 4"),
     (
         2,
         "44332211",
@@ -606,7 +606,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0300", "u16 header.protocol_version = 3"),
+    (0, "0400", "u16 header.protocol_version = 4"),
     (
         2,
         "44332211",
@@ -661,9 +661,10 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
         "0800000000000000",
         "u64 rejected.bad_effector_input = 8",
     ),
-    (155, "0700000000000000", "u64 commands_dropped = 7"),
+    (155, "0900000000000000", "u64 rejected.wrong_identity = 9"),
+    (163, "0700000000000000", "u64 commands_dropped = 7"),
     (
-        163,
+        171,
         "15cd853dfe9c9717",
         "u64 wall_time_unix_ns = 1700000000123456789 (0x17979CFE3D85CD15)",
     ),
@@ -833,6 +834,7 @@ fn status_golden() {
             stale_tick: 5,
             unknown_sender: 6,
             bad_effector_input: 8,
+            wrong_identity: 9,
         },
         commands_dropped: 7,
         wall_time_unix_ns: 1_700_000_000_123_456_789,

@@ -151,7 +151,7 @@ fn status() -> impl Strategy<Value = StatusMsg> {
         run,
         (u(), u(), u(), u(), u()),
         (u(), u(), any::<bool>(), policy),
-        (u(), u(), u(), u(), u(), u(), u()),
+        (u(), u(), u(), u(), u(), u(), u(), u()),
         (u(), u()),
     )
         .prop_map(
@@ -180,6 +180,7 @@ fn status() -> impl Strategy<Value = StatusMsg> {
                     stale_tick: r.4,
                     unknown_sender: r.5,
                     bad_effector_input: r.6,
+                    wrong_identity: r.7,
                 },
                 commands_dropped: dropped,
                 wall_time_unix_ns: wall,
@@ -240,7 +241,7 @@ proptest! {
     /// Random bodies of exactly the right length reach bincode: the result is a
     /// message, Malformed or NonFinite, never a panic or a length error.
     #[test]
-    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 171)) {
+    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 177)) {
         let mut b = flexdyn_proto::PROTOCOL_VERSION.to_le_bytes().to_vec();
         b.extend_from_slice(&body);
         for r in [

@@ -229,7 +229,7 @@ impl Observer {
             .wait()
             .map_err(|e| format!("observer session: {e}"))?;
         let publisher = session
-            .declare_publisher(topics.cmd_wrench().to_owned())
+            .declare_publisher(topics.cmd(sender_id))
             .congestion_control(CongestionControl::Block)
             .express(true)
             .wait()

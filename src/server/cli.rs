@@ -74,6 +74,14 @@ pub struct RunArgs {
     /// Command queue capacity [default: 1024].
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub command_queue: Option<i64>,
+    /// Which thread publishes the frames: `direct` (the thread that finishes the frame) or
+    /// `thread` (a telemetry thread) [default: direct].
+    #[arg(long, value_parser = ["direct", "thread"])]
+    pub handoff: Option<String>,
+    /// Bind each participant's sender id to an authenticated Zenoh user name, e.g. `1=fsw`
+    /// (comma-separated) [default: none].
+    #[arg(long, value_name = "ID=USER,...", value_delimiter = ',')]
+    pub participant_subjects: Option<Vec<String>>,
     /// Record the server's output (state, sensors, status, commands received) to this MCAP
     /// file. Lockstep and batch record every sample; real time drops (and counts) what the
     /// recorder cannot keep up with rather than delay the frame.
@@ -91,7 +99,17 @@ impl RunArgs {
         let s = |v: &Option<String>| v.clone().map(Value::Str);
         let f = |v: &Option<f64>| v.map(Value::Float);
         let i = |v: &Option<i64>| v.map(Value::Int);
-        let pairs: [(&'static str, Option<Value>); 17] = [
+        let subjects = self.participant_subjects.as_ref().map(|v| {
+            Value::Strings(
+                v.iter()
+                    .map(|p| match p.split_once('=') {
+                        Some((id, user)) => (id.to_owned(), user.to_owned()),
+                        None => (p.clone(), String::new()),
+                    })
+                    .collect(),
+            )
+        });
+        let pairs: [(&'static str, Option<Value>); 19] = [
             ("mode", s(&self.mode)),
             ("sc_id", s(&self.sc_id)),
             ("spacecraft_id", i(&self.spacecraft_id)),
@@ -109,6 +127,8 @@ impl RunArgs {
             ("realtime_priority", i(&self.realtime_priority)),
             ("telemetry_buffers", i(&self.telemetry_buffers)),
             ("command_queue", i(&self.command_queue)),
+            ("handoff", s(&self.handoff)),
+            ("participant_subjects", subjects),
         ];
         for (k, v) in pairs {
             if let Some(v) = v {
@@ -157,6 +177,7 @@ pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
     let settings = args.settings(&cfg)?;
     settings.duration_frames(cfg.frame_ns)?;
     let zcfg = zenoh_config(&args.zenoh, Role::Server)?;
+    super::access::check(&zcfg, &settings)?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()

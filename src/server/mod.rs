@@ -26,11 +26,14 @@
 //! The physics thread never allocates, locks or touches the network; in real time it never
 //! blocks on the I/O side (a frame without a free buffer loses its telemetry, counted).
 
+pub mod access;
 pub mod cli;
 pub mod commands;
 pub mod error;
+pub mod lockstep;
 pub mod pacing;
 pub mod physics;
+pub mod publish;
 mod reject_log;
 pub mod settings;
 pub mod shared;
@@ -54,13 +57,15 @@ use zenoh::{Session, Wait};
 pub use crate::transport::frame_stamp_ns;
 pub use crate::transport::{zenoh_config, Role, ZenohArgs, DEFAULT_ENDPOINT};
 pub use error::{ServerError, SettingsError, ZenohConfigError};
-pub use settings::{mode_name, OverrunPolicy, ServerSettings};
+pub use settings::{mode_name, Handoff, OverrunPolicy, ServerSettings};
 
 use crate::config::SimConfig;
 use crate::sim::Simulation;
 use crate::sinks::mcap_file::{flexdyn_version, git_commit, RecordingInfo, VehicleInfo};
 use crate::sinks::recorder::{RecordItem, RecordReport, RecordTx, Recorder};
-use physics::{Ending, PhysicsCtx};
+use lockstep::LockstepCore;
+use physics::{Ending, PhysicsCtx, Stepper};
+use publish::FramePublisher;
 use shared::{Frame, Shared};
 use telemetry::{timing_of, TelemetryCtx};
 
@@ -101,6 +106,19 @@ pub struct RunReport {
     pub wall_s: f64,
     /// `--record`: what the recording holds and what the recorder dropped.
     pub recording: Option<RecordReport>,
+    /// Real time with `handoff = "direct"`: what publishing cost the physics thread, per frame.
+    pub direct_publish: Option<PublishCost>,
+}
+
+/// The time the physics thread spent publishing frames (real time, `handoff = "direct"`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PublishCost {
+    /// Frames published from the physics thread.
+    pub frames: u64,
+    /// \[ns\] mean time per frame.
+    pub mean_ns: f64,
+    /// \[ns\] largest time of one frame.
+    pub max_ns: u64,
 }
 
 impl fmt::Display for RunReport {
@@ -135,6 +153,14 @@ impl fmt::Display for RunReport {
                 r.stats.samples, r.dropped
             )?;
         }
+        if let Some(c) = &self.direct_publish {
+            write!(
+                f,
+                " direct_publish_us mean={:.1} max={:.1}",
+                c.mean_ns * 1e-3,
+                c.max_ns as f64 * 1e-3
+            )?;
+        }
         Ok(())
     }
 }
@@ -157,16 +183,24 @@ impl Presence {
     }
 }
 
-/// The zenoh callback for `flexdyn/<sc>/cmd/wrench`: decode and check, count rejections, and
-/// queue valid commands for the physics thread (never blocks).
+/// Where the command callback delivers a validated command.
+enum CommandSink {
+    /// The physics thread's bounded queue (never blocks: a full queue drops and counts).
+    Queue(Mutex<SyncSender<flexdyn_proto::CommandMsg>>),
+    /// Lockstep with `handoff = "direct"`: the core, stepped in this callback.
+    Core(Arc<Mutex<LockstepCore>>),
+}
+
+/// The zenoh callback for `flexdyn/<sc>/cmd/*`: decode and check (spacecraft, the key's
+/// sender, the participants), count rejections, and deliver valid commands to `sink`.
 fn command_callback(
-    tx: SyncSender<flexdyn_proto::CommandMsg>,
+    sink: CommandSink,
     shared: Arc<Shared>,
+    topics: Topics,
     spacecraft_id: u32,
     participants: Vec<u32>,
-    record: Option<(RecordTx, Arc<str>)>,
+    record: Option<RecordTx>,
 ) -> impl Fn(zenoh::sample::Sample) + Send + Sync + 'static {
-    let tx = Mutex::new(tx);
     let log = Mutex::new(reject_log::RejectLog::default());
     let warn = move |reason: &'static str, sender: Option<u32>, detail: &dyn std::fmt::Display| {
         log.lock()
@@ -175,10 +209,11 @@ fn command_callback(
     };
     move |sample| {
         let bytes = sample.payload().to_bytes();
+        let key = sample.key_expr().as_str();
         // Every command that arrives is recorded, accepted or not: the file shows what was sent.
-        if let Some((rec, key)) = &record {
+        if let Some(rec) = &record {
             rec.submit(RecordItem {
-                key: key.clone(),
+                key: Arc::from(key),
                 payload: bytes.to_vec(),
                 publish_time_ns: crate::transport::frame_stamp_ns(&sample),
             });
@@ -214,6 +249,20 @@ fn command_callback(
             shared.reject_wrong_spacecraft();
             return;
         }
+        if topics.cmd_sender(key) != Some(cmd.sender_id) {
+            warn(
+                "wrong_identity",
+                Some(cmd.sender_id),
+                &format_args!(
+                    "sender_id {} arrived on `{key}`; participant {} publishes on `{}` only",
+                    cmd.sender_id,
+                    cmd.sender_id,
+                    topics.cmd(cmd.sender_id)
+                ),
+            );
+            shared.reject_wrong_identity();
+            return;
+        }
         if participants.binary_search(&cmd.sender_id).is_err() {
             warn(
                 "unknown_sender",
@@ -226,11 +275,16 @@ fn command_callback(
             shared.reject_unknown_sender();
             return;
         }
-        let tx = tx.lock().unwrap_or_else(|p| p.into_inner());
-        if tx.try_send(cmd).is_err() {
-            shared
-                .commands_dropped
-                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        match &sink {
+            CommandSink::Queue(tx) => {
+                let tx = tx.lock().unwrap_or_else(|p| p.into_inner());
+                if tx.try_send(cmd).is_err() {
+                    shared
+                        .commands_dropped
+                        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                }
+            }
+            CommandSink::Core(core) => core.lock().unwrap_or_else(|p| p.into_inner()).offer(&cmd),
         }
     }
 }
@@ -315,7 +369,7 @@ pub async fn run(
         mode = mode_name(mode),
         zid = %session.zid(),
         state = topics.state(),
-        commands = topics.cmd_wrench(),
+        commands = topics.cmd_wildcard(),
         status = topics.status(),
         imus = ?sim.imu_names(),
         "flexdyn server starting: {}",
@@ -372,6 +426,8 @@ pub async fn run(
             st.config().every_frames,
         ));
     }
+    let state_pub = Arc::new(state_pub);
+    let publisher = FramePublisher::new(state_pub.clone(), imu_pubs, st_pubs);
 
     // What this server runs, for recordings and for the `flexdyn/<sc>/config` queryable.
     let vehicle = VehicleInfo {
@@ -395,8 +451,9 @@ pub async fn run(
         .await
         .map_err(|e| ServerError::zenoh("declare the configuration queryable", e))?;
 
-    // `--record`: the recorder thread, fed by the telemetry thread and the command callback.
-    // Real time drops (and counts) what it cannot keep up with; lockstep and batch wait for it.
+    // `--record`: the recorder thread, fed by whoever publishes the frames, the telemetry
+    // thread (status) and the command callback. Real time drops (and counts) what it cannot
+    // keep up with; lockstep and batch wait for it.
     let recorder = match &settings.record {
         Some(path) => {
             let info = RecordingInfo {
@@ -412,6 +469,25 @@ pub async fn run(
         None => None,
     };
     let record_tx = recorder.as_ref().map(|(_, tx)| tx.clone());
+    // The recorder's view of the keys, for the telemetry thread and (lockstep, direct) the core.
+    let telemetry_record = record_tx
+        .clone()
+        .map(|tx| publisher.recording(tx, &status_pub));
+    let core_record = record_tx
+        .clone()
+        .map(|tx| publisher.recording(tx, &status_pub));
+
+    // Who publishes the frames (see `publish`): batch always the telemetry thread.
+    let direct = settings.handoff == Handoff::Direct && mode != Mode::Batch;
+    tracing::info!(
+        handoff = if direct { "direct" } else { "thread" },
+        "frames are published by {}",
+        match (direct, mode) {
+            (true, Mode::Lockstep) => "the Zenoh thread that delivers each tick's last answer",
+            (true, _) => "the physics thread at each frame boundary",
+            (false, _) => "the telemetry thread",
+        }
+    );
 
     let shared = Arc::new(Shared::new(&settings.participants));
     shared.set_run_state(RunState::Starting);
@@ -423,26 +499,49 @@ pub async fn run(
     let (free_tx, free_rx) = sync_channel::<Box<Frame>>(n_buffers);
     let (full_tx, full_rx) = sync_channel::<Box<Frame>>(n_buffers);
     let shape = crate::sim::Snapshot::for_simulation(&sim);
+    let (n_imus, n_sts) = (sim.n_imus(), sim.star_trackers().len());
+    let new_frame = || Box::new(Frame::for_snapshot(&shape, n_imus, n_sts));
     for _ in 0..n_buffers {
         free_tx
-            .send(Box::new(Frame::for_snapshot(
-                &shape,
-                sim.n_imus(),
-                sim.star_trackers().len(),
-            )))
+            .send(new_frame())
             .map_err(|_| ServerError::Internal("telemetry pool".into()))?;
     }
+    let frame_ns = cfg.frame_ns;
+    let stepper = Stepper::new(sim, &settings);
+
+    // The frame publishers go to the physics thread (real time, direct), the lockstep core
+    // (lockstep, direct) or the telemetry thread (otherwise).
+    let events = Arc::new(Notify::new());
+    let (physics_parts, core, telemetry_publisher) = match (direct, mode) {
+        (true, Mode::Lockstep) => {
+            let core = LockstepCore::new(
+                stepper,
+                new_frame(),
+                publisher,
+                core_record,
+                shared.clone(),
+                total_frames,
+                events.clone(),
+            );
+            (None, Some(Arc::new(Mutex::new(core))), None)
+        }
+        (true, _) => (Some((stepper, Some(publisher))), None, None),
+        (false, _) => (Some((stepper, None)), None, Some(publisher)),
+    };
+    let sink = match &core {
+        Some(core) => CommandSink::Core(core.clone()),
+        None => CommandSink::Queue(Mutex::new(cmd_tx)),
+    };
 
     let _cmd_sub = session
-        .declare_subscriber(topics.cmd_wrench().to_owned())
+        .declare_subscriber(topics.cmd_wildcard().to_owned())
         .callback(command_callback(
-            cmd_tx,
+            sink,
             shared.clone(),
+            topics.clone(),
             settings.spacecraft_id,
             settings.participants.clone(),
-            record_tx
-                .clone()
-                .map(|tx| (tx, Arc::<str>::from(topics.cmd_wrench()))),
+            record_tx.clone(),
         ))
         .await
         .map_err(|e| ServerError::zenoh("declare the command subscriber", e))?;
@@ -493,19 +592,16 @@ pub async fn run(
 
     // The telemetry thread starts first, so StatusMsg (run_state = Starting) goes out while a
     // lockstep server waits for its participants.
-    let state_pub = Arc::new(state_pub);
     let telemetry = TelemetryCtx {
-        state_pub: state_pub.clone(),
+        publisher: telemetry_publisher,
         status_pub,
-        imu_pubs,
-        st_pubs,
         full_rx,
         free_tx,
         recycle_rx,
         shared: shared.clone(),
         settings: settings.clone(),
-        frame_ns: cfg.frame_ns,
-        record: record_tx,
+        frame_ns,
+        record: telemetry_record,
     };
     let (tlm_done_tx, tlm_done_rx) = oneshot::channel();
     std::thread::Builder::new()
@@ -544,51 +640,37 @@ pub async fn run(
                 commands_dropped: 0,
                 wall_s: 0.0,
                 recording: None,
+                direct_publish: None,
             });
         }
     }
 
-    let physics = PhysicsCtx {
-        sim,
-        settings: settings.clone(),
-        total_frames,
-        cmd_rx,
-        recycle_tx,
-        free_rx,
-        full_tx,
-        shared: shared.clone(),
-    };
     let started = Instant::now();
-    let (phys_done_tx, mut phys_done_rx) = oneshot::channel();
-    let realtime_priority = (mode == Mode::RealTime).then_some(settings.realtime_priority);
-    std::thread::Builder::new()
-        .name("flexdyn-physics".into())
-        .spawn(move || {
-            if let Some(p) = realtime_priority.filter(|p| *p > 0) {
-                match set_fifo_priority(p) {
-                    Ok(()) => tracing::info!(priority = p, "physics thread runs under SCHED_FIFO"),
-                    Err(e) => tracing::warn!(
-                        priority = p,
-                        error = %e,
-                        "cannot put the physics thread under SCHED_FIFO (needs CAP_SYS_NICE); \
-                         running at normal priority"
-                    ),
-                }
-            }
-            let _ = phys_done_tx.send(physics.run());
-        })
-        .map_err(|e| ServerError::Internal(format!("cannot start the physics thread: {e}")))?;
-
-    let physics_result = tokio::select! {
-        r = &mut phys_done_rx => r,
-        () = &mut shutdown => {
-            tracing::info!("shutdown requested; stopping at the next frame boundary");
-            shared.set_run_state(RunState::Stopping);
-            shared.stop.store(true, std::sync::atomic::Ordering::Relaxed);
-            phys_done_rx.await
+    let physics_result = match (physics_parts, core) {
+        (Some((stepper, direct)), _) => {
+            let physics = PhysicsCtx {
+                stepper: Some(stepper),
+                sim_frame_ns: frame_ns,
+                settings: settings.clone(),
+                total_frames,
+                cmd_rx,
+                recycle_tx,
+                free_rx,
+                full_tx,
+                shared: shared.clone(),
+                direct,
+            };
+            run_physics_thread(physics, &settings, &shared, shutdown.as_mut()).await?
         }
-    }
-    .map_err(|_| ServerError::Internal("the physics thread panicked".into()))?;
+        (None, Some(core)) => {
+            drop((cmd_rx, recycle_tx, free_rx));
+            let r = run_lockstep_core(&core, &settings, &shared, shutdown.as_mut()).await;
+            // No frame goes through the channel; closing it ends the telemetry thread.
+            drop(full_tx);
+            r
+        }
+        (None, None) => return Err(ServerError::Internal("no frame loop".into())),
+    };
     let wall_s = started.elapsed().as_secs_f64();
     let tlm = tlm_done_rx
         .await
@@ -609,7 +691,7 @@ pub async fn run(
         },
         last_tick: phys.last_tick,
         sim_time_ns: phys.sim_time_ns,
-        states_published: tlm.published,
+        states_published: shared.published.load(std::sync::atomic::Ordering::Relaxed),
         telemetry_dropped: shared
             .telemetry_dropped
             .load(std::sync::atomic::Ordering::Relaxed),
@@ -626,9 +708,102 @@ pub async fn run(
             .load(std::sync::atomic::Ordering::Relaxed),
         wall_s,
         recording,
+        direct_publish: {
+            let n = shared
+                .direct_publishes
+                .load(std::sync::atomic::Ordering::Relaxed);
+            (n > 0).then(|| PublishCost {
+                frames: n,
+                mean_ns: shared
+                    .direct_publish_ns_total
+                    .load(std::sync::atomic::Ordering::Relaxed) as f64
+                    / n as f64,
+                max_ns: shared
+                    .direct_publish_ns_max
+                    .load(std::sync::atomic::Ordering::Relaxed),
+            })
+        },
     };
     tracing::info!("{report}");
     Ok(report)
+}
+
+/// Runs the physics thread to its end (or a stop request); `Err` only if it panicked.
+async fn run_physics_thread(
+    physics: PhysicsCtx,
+    settings: &ServerSettings,
+    shared: &Arc<Shared>,
+    mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
+) -> Result<Result<physics::PhysicsReport, ServerError>, ServerError> {
+    let (phys_done_tx, mut phys_done_rx) = oneshot::channel();
+    let realtime_priority = (settings.mode == Mode::RealTime).then_some(settings.realtime_priority);
+    std::thread::Builder::new()
+        .name("flexdyn-physics".into())
+        .spawn(move || {
+            if let Some(p) = realtime_priority.filter(|p| *p > 0) {
+                match set_fifo_priority(p) {
+                    Ok(()) => tracing::info!(priority = p, "physics thread runs under SCHED_FIFO"),
+                    Err(e) => tracing::warn!(
+                        priority = p,
+                        error = %e,
+                        "cannot put the physics thread under SCHED_FIFO (needs CAP_SYS_NICE); \
+                         running at normal priority"
+                    ),
+                }
+            }
+            let _ = phys_done_tx.send(physics.run());
+        })
+        .map_err(|e| ServerError::Internal(format!("cannot start the physics thread: {e}")))?;
+
+    tokio::select! {
+        r = &mut phys_done_rx => r,
+        () = &mut shutdown => {
+            tracing::info!("shutdown requested; stopping at the next frame boundary");
+            shared.set_run_state(RunState::Stopping);
+            shared.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            phys_done_rx.await
+        }
+    }
+    .map_err(|_| ServerError::Internal("the physics thread panicked".into()))
+}
+
+/// Lockstep with `handoff = "direct"`: starts the core (publishes tick 0) and waits for it to
+/// end, checking the participant timeout every 50 ms; a stop request ends it at once.
+async fn run_lockstep_core(
+    core: &Arc<Mutex<LockstepCore>>,
+    settings: &ServerSettings,
+    shared: &Arc<Shared>,
+    mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
+) -> Result<physics::PhysicsReport, ServerError> {
+    let lock = || core.lock().unwrap_or_else(|p| p.into_inner());
+    let events = {
+        let mut c = lock();
+        c.start();
+        c.events()
+    };
+    loop {
+        if lock().ended() {
+            break;
+        }
+        tokio::select! {
+            () = events.notified() => {}
+            () = tokio::time::sleep(std::time::Duration::from_millis(50)) => {
+                lock().check_timeout(settings.participant_timeout);
+            }
+            () = &mut shutdown => {
+                tracing::info!("shutdown requested; stopping at the current tick");
+                shared.set_run_state(RunState::Stopping);
+                shared.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+                lock().stop();
+            }
+        }
+    }
+    let (ending, last_tick, sim_time_ns) = lock().outcome()?;
+    Ok(physics::PhysicsReport {
+        ending,
+        last_tick,
+        sim_time_ns,
+    })
 }
 
 /// Puts the calling thread under SCHED_FIFO at `priority` (1–99); the error says why the OS

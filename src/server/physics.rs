@@ -1,8 +1,10 @@
-//! The physics thread: the frame loop of every mode.
+//! The physics thread: the frame loop of real time, batch, and lockstep with
+//! `handoff = "thread"` (lockstep with `handoff = "direct"` steps in [`super::lockstep`]).
 //!
 //! At frame boundary `k` the loop
-//! 1. (real time) waits for the deadline `t0 + k·period`, then hands the already filled state of
-//!    tick `k` to the I/O thread, stamped with the boundary's wall-clock time;
+//! 1. (real time) waits for the deadline `t0 + k·period`, then publishes the already filled
+//!    state of tick `k` (`handoff = "direct"`, real time) or hands it to the telemetry thread,
+//!    stamped with the boundary's wall-clock time;
 //! 2. takes the commands for tick `k` (real time/batch: whatever has arrived; lockstep: waits
 //!    until every participant has answered tick `k`) and holds their sum over the frame;
 //! 3. integrates the frame's RK4 steps ([`Simulation::step_frame`]);
@@ -10,10 +12,14 @@
 //!    and the star trackers that are due ([`Simulation::star_tracker_samples_into`])
 //!    and fills the state and IMU samples of tick `k + 1` into a free telemetry buffer.
 //!
-//! The loop never allocates, locks or does I/O: commands arrive through a bounded channel, the
-//! telemetry buffers are a fixed pool cycled through two bounded channels, and counters are
-//! atomics. In real time it never blocks on the I/O side either: with no free buffer the frame's
-//! telemetry is dropped and counted.
+//! Steps 2–4 ([`Stepper`]) never allocate, lock or do I/O: commands arrive through a bounded
+//! channel, the telemetry buffers are a fixed pool cycled through two bounded channels, and
+//! counters are atomics. In real time the loop never blocks on the I/O side either: with no free
+//! buffer the frame's telemetry is dropped and counted, and a direct publication uses
+//! `CongestionControl::Drop`, so Zenoh drops a sample rather than make the put wait for the
+//! network. The put itself (Zenoh's encoding and queueing, a few µs, see
+//! `tools/benches/realtime.rs`) is the one piece of I/O-side work on this thread, at the
+//! boundary, which is what takes the thread hop out of the telemetry latency.
 
 use std::sync::atomic::Ordering;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TryRecvError};
@@ -28,6 +34,7 @@ use nalgebra::Vector3;
 use super::commands::{CommandBook, Held, Offer};
 use super::error::ServerError;
 use super::pacing::{FrameEnd, Pacer};
+use super::publish::FramePublisher;
 use super::settings::ServerSettings;
 use super::shared::{fill_state, Frame, Shared};
 use crate::dynamics::Wrench;
@@ -60,8 +67,10 @@ pub struct PhysicsReport {
 
 /// Everything the physics thread owns.
 pub struct PhysicsCtx {
-    /// The simulation, at t = 0.
-    pub sim: Simulation,
+    /// The simulation at t = 0 and its command book (taken by the loop).
+    pub stepper: Option<Stepper>,
+    /// \[ns\] frame period.
+    pub sim_frame_ns: u64,
     /// Server settings.
     pub settings: ServerSettings,
     /// Frames to run (`None`: until stopped).
@@ -77,6 +86,117 @@ pub struct PhysicsCtx {
     pub full_tx: SyncSender<Box<Frame>>,
     /// Counters and the stop flag.
     pub shared: Arc<Shared>,
+    /// Real time with `handoff = "direct"`: publish each frame from this thread at its boundary
+    /// (`CongestionControl::Drop`: never waits for the network), then hand it to the telemetry
+    /// thread for the books. `None`: the telemetry thread publishes.
+    pub direct: Option<FramePublisher>,
+}
+
+/// The per-frame work shared by the physics thread and the lockstep core
+/// ([`super::lockstep`]): the simulation, the command book, and the buffers the frame is
+/// sampled into. Nothing here allocates after [`Stepper::new`].
+pub struct Stepper {
+    /// The simulation.
+    pub sim: Simulation,
+    /// Per-participant commands.
+    pub book: CommandBook,
+    /// The command held over the current frame.
+    pub held: Held,
+    snap: Snapshot,
+    imu: Vec<ImuSample>,
+    st: Vec<(usize, StarTrackerSample)>,
+    spacecraft_id: u32,
+}
+
+impl Stepper {
+    /// A stepper at t = 0 with the sensors sampled at tick 0.
+    pub fn new(mut sim: Simulation, settings: &ServerSettings) -> Self {
+        let book = CommandBook::new(
+            &settings.participants,
+            sim.frame_ns(),
+            u64::try_from(settings.stale_after.as_nanos()).unwrap_or(u64::MAX),
+            settings.stale_policy,
+            sim.spacecraft().effector_input_ranges(),
+        );
+        let snap = Snapshot::for_simulation(&sim);
+        // IMU samples close their interval every frame, published or not.
+        let mut imu = Vec::with_capacity(sim.n_imus());
+        let mut st = Vec::with_capacity(sim.star_trackers().len());
+        sim.imu_samples_into(&mut imu);
+        sim.star_tracker_samples_into(0, &mut st);
+        Self {
+            sim,
+            book,
+            held: Held::initial(settings.stale_policy),
+            snap,
+            imu,
+            st,
+            spacecraft_id: settings.spacecraft_id,
+        }
+    }
+
+    /// Fills the telemetry of tick `k` (the sensors were sampled at `k`).
+    pub fn fill(&mut self, frame: &mut Frame, k: u64) {
+        self.sim.snapshot_into(&mut self.snap);
+        let header = Header::new(self.spacecraft_id, k, self.snap.t_sim_ns, k);
+        fill_state(&mut frame.state, &self.snap, header, &self.held);
+        frame.command = self.held.status;
+        frame.lateness_ns = 0;
+        frame.published = false;
+        frame.imu.clear();
+        frame.imu.extend_from_slice(&self.imu);
+        frame.star_trackers.clear();
+        frame.star_trackers.extend_from_slice(&self.st);
+    }
+
+    /// Frame `k` → `k + 1`: holds the book's commands for tick `k`, integrates the frame's RK4
+    /// steps and samples the sensors at `k + 1`.
+    pub fn step(&mut self, k: u64) {
+        self.held = self.book.held(k);
+        self.sim.set_command_wrench(Wrench {
+            force_b_newton: Vector3::from(self.held.force_b_newton),
+            torque_b_nm: Vector3::from(self.held.torque_b_nm),
+        });
+        // Cannot fail: the book's inputs have the spacecraft's layout and were checked
+        // finite by the decoder.
+        let _ = self.sim.set_effector_inputs(self.book.held_inputs());
+        self.sim.step_frame();
+        self.sim.imu_samples_into(&mut self.imu);
+        self.sim.star_tracker_samples_into(k + 1, &mut self.st);
+    }
+
+    /// Once per frame, outside the RK4 loop: never publish a non-finite state. `filled` says
+    /// whether [`Self::fill`] already took this tick's snapshot.
+    pub fn check_finite(&mut self, k: u64, filled: bool) -> Result<(), ServerError> {
+        if !filled {
+            self.sim.snapshot_into(&mut self.snap);
+        }
+        let imu_bad = self.imu.iter().find_map(|s| s.first_non_finite());
+        let imu_bad = imu_bad.map(|q| format!("an IMU's {q} output"));
+        let st_bad = self
+            .st
+            .iter()
+            .find_map(|(_, s)| s.first_non_finite())
+            .map(|q| format!("a star tracker's {q} output"));
+        match self.snap.first_non_finite().or(imu_bad.or(st_bad)) {
+            Some(quantity) => Err(ServerError::NonFinite {
+                tick: k,
+                t_s: self.snap.t_s(),
+                quantity,
+            }),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Counts a command the book rejected under its reason.
+pub fn count_offer(shared: &Shared, offer: Offer, sender_id: u32) {
+    match offer {
+        Offer::Accepted => {}
+        Offer::StaleTick => shared.reject_stale_tick_from(sender_id),
+        Offer::UnknownSender => shared.reject_unknown_sender(),
+        Offer::BadEffectorInput => shared.reject_bad_effector_input(),
+    }
 }
 
 enum Wait {
@@ -124,19 +244,10 @@ impl PhysicsCtx {
         }
     }
 
-    fn count(&self, offer: Offer, sender_id: u32) {
-        match offer {
-            Offer::Accepted => {}
-            Offer::StaleTick => self.shared.reject_stale_tick_from(sender_id),
-            Offer::UnknownSender => self.shared.reject_unknown_sender(),
-            Offer::BadEffectorInput => self.shared.reject_bad_effector_input(),
-        }
-    }
-
     /// Real time / batch: take every command that has arrived.
     fn drain_commands(&self, book: &mut CommandBook, k: u64) {
         while let Ok(cmd) = self.cmd_rx.try_recv() {
-            self.count(book.offer_latest(&cmd, k), cmd.sender_id);
+            count_offer(&self.shared, book.offer_latest(&cmd, k), cmd.sender_id);
             let _ = self.recycle_tx.try_send(cmd);
         }
     }
@@ -157,7 +268,7 @@ impl PhysicsCtx {
             }
             match self.cmd_rx.recv_timeout((give_up - now).min(POLL)) {
                 Ok(cmd) => {
-                    self.count(book.offer_lockstep(&cmd, k), cmd.sender_id);
+                    count_offer(&self.shared, book.offer_lockstep(&cmd, k), cmd.sender_id);
                     let _ = self.recycle_tx.try_send(cmd);
                 }
                 Err(RecvTimeoutError::Timeout) => {
@@ -173,43 +284,14 @@ impl PhysicsCtx {
         Ok(Wait::Done)
     }
 
-    /// Fills the telemetry of tick `k` (the IMU samples were taken into `imu` just before).
-    fn fill(
-        &mut self,
-        frame: &mut Frame,
-        snap: &mut Snapshot,
-        imu: &[ImuSample],
-        st: &[(usize, StarTrackerSample)],
-        k: u64,
-        held: &Held,
-    ) {
-        self.sim.snapshot_into(snap);
-        let header = Header::new(self.settings.spacecraft_id, k, snap.t_sim_ns, k);
-        fill_state(&mut frame.state, snap, header, held);
-        frame.command = held.status;
-        frame.lateness_ns = 0;
-        frame.imu.clear();
-        frame.imu.extend_from_slice(imu);
-        frame.star_trackers.clear();
-        frame.star_trackers.extend_from_slice(st);
-    }
-
     fn frame_loop(&mut self) -> Result<PhysicsReport, ServerError> {
         let mode = self.settings.mode;
         let realtime = mode == Mode::RealTime;
-        let frame_ns = self.sim.frame_ns();
-        let mut book = CommandBook::new(
-            &self.settings.participants,
-            frame_ns,
-            u64::try_from(self.settings.stale_after.as_nanos()).unwrap_or(u64::MAX),
-            self.settings.stale_policy,
-            self.sim.spacecraft().effector_input_ranges(),
-        );
-        let mut snap = Snapshot::for_simulation(&self.sim);
-        // IMU samples close their interval every frame, published or not.
-        let mut imu = Vec::with_capacity(self.sim.n_imus());
-        let mut st = Vec::with_capacity(self.sim.star_trackers().len());
-        let mut held = Held::initial(self.settings.stale_policy);
+        let frame_ns = self.sim_frame_ns;
+        let mut w = self
+            .stepper
+            .take()
+            .ok_or_else(|| ServerError::Internal("the physics loop ran twice".into()))?;
         // A stop reports the last boundary reached (the tick the last StateMsg and StatusMsg
         // carry), not a tick that was stepped to but never published.
         let stopped = |shared: &Shared| {
@@ -226,11 +308,8 @@ impl PhysicsCtx {
             Ok(f) => f,
             Err(_) => return Ok(stopped(&self.shared)),
         };
-        self.sim.imu_samples_into(&mut imu);
-        self.sim.star_tracker_samples_into(0, &mut st);
-        if let Some(mut f) = pending.take() {
-            self.fill(&mut f, &mut snap, &imu, &st, 0, &held);
-            pending = Some(f);
+        if let Some(f) = pending.as_mut() {
+            w.fill(f, 0);
         }
         // Real time: boundary 0 is due one frame from now, so the I/O side is settled.
         let mut pacer = Pacer::new(
@@ -259,6 +338,14 @@ impl PhysicsCtx {
             if let Some(mut f) = pending.take() {
                 f.boundary_unix_ns = stamp;
                 f.lateness_ns = lateness_ns;
+                if let Some(p) = self.direct.as_mut() {
+                    let t = Instant::now();
+                    p.publish(&f, &self.shared, None);
+                    self.shared.note_direct_publish(
+                        u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX),
+                    );
+                    f.published = true;
+                }
                 // The full channel holds the whole pool, so this never blocks.
                 if self.full_tx.send(f).is_err() {
                     return Err(ServerError::Internal("telemetry thread ended".into()));
@@ -269,30 +356,22 @@ impl PhysicsCtx {
                 return Ok(PhysicsReport {
                     ending: Ending::Finished,
                     last_tick: k,
-                    sim_time_ns: self.sim.t_sim_ns(),
+                    sim_time_ns: w.sim.t_sim_ns(),
                 });
             }
 
             // 2. Commands for tick k, held over the frame.
             match mode {
                 Mode::Lockstep => {
-                    if let Wait::Stopped = self.await_answers(&mut book, k)? {
+                    if let Wait::Stopped = self.await_answers(&mut w.book, k)? {
                         return Ok(stopped(&self.shared));
                     }
                 }
-                Mode::RealTime | Mode::Batch => self.drain_commands(&mut book, k),
+                Mode::RealTime | Mode::Batch => self.drain_commands(&mut w.book, k),
             }
-            held = book.held(k);
-            self.sim.set_command_wrench(Wrench {
-                force_b_newton: Vector3::from(held.force_b_newton),
-                torque_b_nm: Vector3::from(held.torque_b_nm),
-            });
-            // Cannot fail: the book's inputs have the spacecraft's layout and were checked
-            // finite by the decoder.
-            let _ = self.sim.set_effector_inputs(book.held_inputs());
 
             // 3. Integrate the frame.
-            self.sim.step_frame();
+            w.step(k);
             k += 1;
 
             // 4. Fill the state of tick k.
@@ -300,30 +379,10 @@ impl PhysicsCtx {
                 Ok(f) => f,
                 Err(_) => return Ok(stopped(&self.shared)),
             };
-            self.sim.imu_samples_into(&mut imu);
-            self.sim.star_tracker_samples_into(k, &mut st);
-            if let Some(mut f) = pending.take() {
-                self.fill(&mut f, &mut snap, &imu, &st, k, &held);
-                pending = Some(f);
-            } else {
-                // No buffer for this frame's telemetry: still check what was propagated.
-                self.sim.snapshot_into(&mut snap);
+            if let Some(f) = pending.as_mut() {
+                w.fill(f, k);
             }
-            // Once per frame, outside the RK4 loop: never publish a non-finite state.
-            let imu_bad = imu.iter().find_map(|s| s.first_non_finite());
-            let imu_bad = imu_bad.map(|q| format!("an IMU's {q} output"));
-            let st_bad = st
-                .iter()
-                .find_map(|(_, s)| s.first_non_finite())
-                .map(|q| format!("a star tracker's {q} output"));
-            let imu_bad = imu_bad.or(st_bad);
-            if let Some(quantity) = snap.first_non_finite().or(imu_bad) {
-                return Err(ServerError::NonFinite {
-                    tick: k,
-                    t_s: snap.t_s(),
-                    quantity,
-                });
-            }
+            w.check_finite(k, pending.is_some())?;
             if realtime {
                 match pacer.end_frame(k) {
                     FrameEnd::OnTime => {}

@@ -40,6 +40,30 @@ impl OverrunPolicy {
     }
 }
 
+/// Which thread publishes a frame's telemetry (`server.handoff`, see [`super::publish`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Handoff {
+    /// `direct` (default): the thread that finishes the frame publishes it: the physics thread
+    /// at the boundary in real time (never waiting for the network), and in lockstep the Zenoh
+    /// thread that delivers the tick's last answer steps the frame and publishes it. Batch
+    /// always uses the telemetry thread.
+    #[default]
+    Direct,
+    /// `thread`: the physics thread hands every frame to the telemetry thread, which publishes
+    /// it (the design before `direct`; one more thread hop per frame).
+    Thread,
+}
+
+impl Handoff {
+    /// The setting's spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Handoff::Direct => "direct",
+            Handoff::Thread => "thread",
+        }
+    }
+}
+
 pub use crate::transport::mode_name;
 
 /// The spelling of a [`StalePolicy`] in settings and logs.
@@ -70,6 +94,8 @@ pub const KEYS: &[&str] = &[
     "realtime_priority",
     "telemetry_buffers",
     "command_queue",
+    "handoff",
+    "participant_subjects",
 ];
 
 /// Validated server settings. [`Default`] gives the documented defaults.
@@ -112,6 +138,14 @@ pub struct ServerSettings {
     pub telemetry_buffers: usize,
     /// Capacity of the command queue from the I/O side to the physics thread (default 1024).
     pub command_queue: usize,
+    /// Which thread publishes the frames (default `direct`).
+    pub handoff: Handoff,
+    /// The authenticated Zenoh subject (usrpwd user name) each participant's sender id is bound
+    /// to, e.g. `{ "1" = "fsw" }`. Empty (default): no binding. When set, every participant
+    /// needs one, and the server refuses to start unless its Zenoh configuration authenticates
+    /// peers and its access-control list lets only that subject put on the participant's
+    /// command key ([`super::access`]).
+    pub participant_subjects: std::collections::BTreeMap<u32, String>,
     /// `flexdyn run --record FILE.mcap`: record the server's own output (state, sensors, status,
     /// and every command received) to this file. Command line only (not a `[server]` key).
     pub record: Option<std::path::PathBuf>,
@@ -137,6 +171,8 @@ impl Default for ServerSettings {
             realtime_priority: 0,
             telemetry_buffers: 8,
             command_queue: 1024,
+            handoff: Handoff::Direct,
+            participant_subjects: std::collections::BTreeMap::new(),
             record: None,
         }
     }
@@ -172,6 +208,8 @@ pub enum Value {
     Float(f64),
     /// A list of integers.
     Ints(Vec<i64>),
+    /// A table of strings (`{ "1" = "fsw" }`; on the command line `1=fsw,2=gnc`).
+    Strings(Vec<(String, String)>),
 }
 
 impl Value {
@@ -181,6 +219,7 @@ impl Value {
             Value::Int(i) => format!("integer {i}"),
             Value::Float(f) => format!("float {f}"),
             Value::Ints(v) => format!("list {v:?}"),
+            Value::Strings(v) => format!("table {v:?}"),
         }
     }
 
@@ -194,6 +233,11 @@ impl Value {
                 a.iter()
                     .map(|x| x.as_integer())
                     .collect::<Option<Vec<i64>>>()?,
+            ),
+            toml::Value::Table(t) => Value::Strings(
+                t.iter()
+                    .map(|(k, v)| Some((k.clone(), v.as_str()?.to_owned())))
+                    .collect::<Option<Vec<_>>>()?,
             ),
             _ => return None,
         })
@@ -366,6 +410,43 @@ impl ServerSettings {
             "realtime_priority" => self.realtime_priority = set.int_in(0, 99)? as u8,
             "telemetry_buffers" => self.telemetry_buffers = set.int_in(2, 1 << 16)? as usize,
             "command_queue" => self.command_queue = set.int_in(1, 1 << 20)? as usize,
+            "handoff" => {
+                self.handoff = match set.string()? {
+                    "direct" => Handoff::Direct,
+                    "thread" => Handoff::Thread,
+                    other => {
+                        return Err(set.bad(format!(
+                            "unknown handoff {other:?} (expected \"direct\" or \"thread\")"
+                        )))
+                    }
+                }
+            }
+            "participant_subjects" => {
+                let Value::Strings(pairs) = value else {
+                    return Err(
+                        set.expected("a table of sender id = subject, e.g. { \"1\" = \"fsw\" }")
+                    );
+                };
+                let mut out = std::collections::BTreeMap::new();
+                for (id, subject) in pairs {
+                    let sender = id.parse::<u32>().ok().filter(|n| n.to_string() == *id);
+                    let Some(sender) = sender else {
+                        return Err(set.bad(format!(
+                            "{id:?} is not a sender id (a decimal integer 0..=4294967295)"
+                        )));
+                    };
+                    if subject.is_empty() || subject.contains(char::is_whitespace) {
+                        return Err(set.bad(format!(
+                            "sender {sender}: {subject:?} is not a Zenoh user name (non-empty, \
+                             no spaces)"
+                        )));
+                    }
+                    if out.insert(sender, subject.clone()).is_some() {
+                        return Err(set.bad(format!("sender {sender} is listed twice")));
+                    }
+                }
+                self.participant_subjects = out;
+            }
             other => {
                 return Err(SettingsError::UnknownKey {
                     key: other.to_owned(),
@@ -379,6 +460,34 @@ impl ServerSettings {
     /// Checks that hold across settings (called by the server before it starts):
     /// lockstep needs at least one participant.
     pub fn validate(&self) -> Result<(), SettingsError> {
+        if !self.participant_subjects.is_empty() {
+            if let Some(id) = self
+                .participant_subjects
+                .keys()
+                .find(|id| !self.participants.contains(id))
+            {
+                return Err(SettingsError::Invalid {
+                    name: "server.participant_subjects".into(),
+                    problem: format!(
+                        "sender {id} is not in server.participants {:?}",
+                        self.participants
+                    ),
+                });
+            }
+            if let Some(id) = self
+                .participants
+                .iter()
+                .find(|id| !self.participant_subjects.contains_key(id))
+            {
+                return Err(SettingsError::Invalid {
+                    name: "server.participant_subjects".into(),
+                    problem: format!(
+                        "participant {id} has no subject: once one participant is bound to an \
+                         authenticated subject, every participant must be"
+                    ),
+                });
+            }
+        }
         if self.mode == Mode::Lockstep && self.participants.is_empty() {
             return Err(SettingsError::Invalid {
                 name: "server.participants".into(),
@@ -418,7 +527,8 @@ impl ServerSettings {
             "mode={} sc_id={} spacecraft_id={} participants={:?} participant_timeout_s={} \
              presence_timeout_s={} duration_s={} overrun_policy={} overrun_limit={} \
              stale_after_s={} stale_policy={} status_hz={} summary_interval_s={} spin_us={} \
-             realtime_priority={} telemetry_buffers={} command_queue={} record={}",
+             realtime_priority={} telemetry_buffers={} command_queue={} handoff={} \
+             participant_subjects={:?} record={}",
             mode_name(self.mode),
             self.sc_id,
             self.spacecraft_id,
@@ -437,6 +547,8 @@ impl ServerSettings {
             self.realtime_priority,
             self.telemetry_buffers,
             self.command_queue,
+            self.handoff.as_str(),
+            self.participant_subjects,
             self.record
                 .as_ref()
                 .map_or("off".to_owned(), |p| p.display().to_string()),

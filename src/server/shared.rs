@@ -29,6 +29,9 @@ pub struct Frame {
     pub imu: Vec<ImuSample>,
     /// The star trackers that updated at this tick: (config index, sample).
     pub star_trackers: Vec<(usize, StarTrackerSample)>,
+    /// Already published by the thread that finished the frame (`handoff = "direct"`): the
+    /// telemetry thread only records it and keeps the books.
+    pub published: bool,
 }
 
 impl Frame {
@@ -58,6 +61,7 @@ impl Frame {
             command: Held::initial(flexdyn_proto::StalePolicy::Hold).status,
             imu: Vec::with_capacity(n_imus),
             star_trackers: Vec::with_capacity(n_star_trackers),
+            published: false,
         }
     }
 }
@@ -113,6 +117,16 @@ pub struct Shared {
     stale_tick: AtomicU64,
     unknown_sender: AtomicU64,
     bad_effector_input: AtomicU64,
+    wrong_identity: AtomicU64,
+    /// StateMsg samples published (by whichever thread publishes).
+    pub published: AtomicU64,
+    /// Zenoh `put` failures of telemetry samples.
+    pub publish_errors: AtomicU64,
+    /// The command bookkeeping of the last state published ([`CommandStatus`] in three
+    /// atomics; StatusMsg reads it, a torn read between them is harmless there).
+    last_command_tick: AtomicU64,
+    command_age_ns: AtomicU64,
+    command_stale: AtomicBool,
     /// Valid commands dropped because the command queue was full.
     pub commands_dropped: AtomicU64,
     /// Real time: frames whose work overran the next deadline.
@@ -121,6 +135,13 @@ pub struct Shared {
     pub frames_skipped: AtomicU64,
     /// Real time: frames whose telemetry was dropped (no free buffer).
     pub telemetry_dropped: AtomicU64,
+    /// Real time, `handoff = "direct"`: frames published from the physics thread, and the
+    /// total and largest time those publications took there (ns).
+    pub direct_publishes: AtomicU64,
+    /// See [`Self::direct_publishes`].
+    pub direct_publish_ns_total: AtomicU64,
+    /// See [`Self::direct_publishes`].
+    pub direct_publish_ns_max: AtomicU64,
     /// `stale_tick` rejections per participant (sender id, count), in ascending id order, so
     /// the telemetry thread can name the sender in its warning (the physics thread only counts).
     pub stale_by_participant: Vec<(u32, AtomicU64)>,
@@ -177,6 +198,41 @@ impl Shared {
         bump(&self.bad_effector_input);
     }
 
+    /// Notes how long a publication on the physics thread took.
+    pub fn note_direct_publish(&self, ns: u64) {
+        self.direct_publishes.fetch_add(1, Ordering::Relaxed);
+        self.direct_publish_ns_total
+            .fetch_add(ns, Ordering::Relaxed);
+        self.direct_publish_ns_max.fetch_max(ns, Ordering::Relaxed);
+    }
+
+    /// Count a command whose `sender_id` is not the one its key names.
+    pub fn reject_wrong_identity(&self) {
+        bump(&self.wrong_identity);
+    }
+
+    /// Notes the command bookkeeping of the state just published.
+    pub fn set_last_command(&self, c: &CommandStatus) {
+        self.last_command_tick
+            .store(c.last_command_tick, Ordering::Relaxed);
+        self.command_age_ns
+            .store(c.command_age_ns, Ordering::Relaxed);
+        self.command_stale.store(c.command_stale, Ordering::Relaxed);
+    }
+
+    /// The command bookkeeping of the last state published (before any: no command yet).
+    pub fn last_command(&self, policy: flexdyn_proto::StalePolicy) -> CommandStatus {
+        if self.published.load(Ordering::Relaxed) == 0 {
+            return super::commands::Held::initial(policy).status;
+        }
+        CommandStatus {
+            last_command_tick: self.last_command_tick.load(Ordering::Relaxed),
+            command_age_ns: self.command_age_ns.load(Ordering::Relaxed),
+            command_stale: self.command_stale.load(Ordering::Relaxed),
+            stale_policy: policy,
+        }
+    }
+
     /// The rejection counters so far.
     pub fn rejected(&self) -> RejectCounters {
         let l = |c: &AtomicU64| c.load(Ordering::Relaxed);
@@ -188,6 +244,7 @@ impl Shared {
             stale_tick: l(&self.stale_tick),
             unknown_sender: l(&self.unknown_sender),
             bad_effector_input: l(&self.bad_effector_input),
+            wrong_identity: l(&self.wrong_identity),
         }
     }
 

@@ -5,7 +5,7 @@
 //! payload decodes with the one `flexdyn-proto` codec.
 
 use flexdyn_proto::keys::{
-    CMD_WRENCH_SUFFIX, IMU_PREFIX, KEY_ROOT, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX,
+    CMD_PREFIX, IMU_PREFIX, KEY_ROOT, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX,
 };
 use flexdyn_proto::{
     decode_command, decode_imu, decode_star_tracker, decode_state, decode_status, CommandMsg,
@@ -21,7 +21,7 @@ pub enum TopicKind {
     Imu,
     /// `flexdyn/<sc>/tlm/st/<name>`: [`StarTrackerMsg`].
     StarTracker,
-    /// `flexdyn/<sc>/cmd/wrench`: [`CommandMsg`].
+    /// `flexdyn/<sc>/cmd/<sender_id>`: [`CommandMsg`].
     Command,
     /// `flexdyn/<sc>/status`: [`StatusMsg`].
     Status,
@@ -56,7 +56,8 @@ pub struct Topic<'a> {
     pub sc_id: &'a str,
     /// The message type.
     pub kind: TopicKind,
-    /// The IMU or star-tracker name; `None` for the other kinds.
+    /// The IMU or star-tracker name, or a command key's decimal sender id; `None` for the
+    /// other kinds.
     pub sensor: Option<&'a str>,
 }
 
@@ -76,8 +77,10 @@ pub fn classify(key: &str) -> Option<Topic<'_>> {
     };
     let (kind, sensor) = if suffix == STATE_SUFFIX {
         (TopicKind::State, None)
-    } else if suffix == CMD_WRENCH_SUFFIX {
-        (TopicKind::Command, None)
+    } else if let Some(sender) =
+        sensor(CMD_PREFIX).filter(|s| s.bytes().all(|b| b.is_ascii_digit()))
+    {
+        (TopicKind::Command, Some(sender))
     } else if suffix == STATUS_SUFFIX {
         (TopicKind::Status, None)
     } else if let Some(name) = sensor(IMU_PREFIX) {
@@ -210,10 +213,9 @@ mod tests {
         );
         let t = classify("flexdyn/x/tlm/st/st1").unwrap();
         assert_eq!(t.kind, TopicKind::StarTracker);
-        assert_eq!(
-            classify("flexdyn/x/cmd/wrench").unwrap().kind,
-            TopicKind::Command
-        );
+        let t = classify("flexdyn/x/cmd/12").unwrap();
+        assert_eq!((t.kind, t.sensor), (TopicKind::Command, Some("12")));
+        assert_eq!(classify("flexdyn/x/cmd/wrench"), None, "the protocol-3 key");
         assert_eq!(
             classify("flexdyn/x/status").unwrap().kind,
             TopicKind::Status

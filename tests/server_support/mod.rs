@@ -127,9 +127,17 @@ pub struct ServerHandle {
 
 impl ServerHandle {
     pub fn start(port: u16, settings: server::ServerSettings, cfg: SimConfig) -> Self {
+        Self::start_with_session(listening_session(port), settings, cfg)
+    }
+
+    /// [`Self::start`] on a session the caller opened (e.g. with an authenticating config).
+    pub fn start_with_session(
+        session: Session,
+        settings: server::ServerSettings,
+        cfg: SimConfig,
+    ) -> Self {
         let (done_tx, done) = std::sync::mpsc::channel();
         let (stop_tx, stop_rx) = tokio::sync::oneshot::channel::<()>();
-        let session = listening_session(port);
         std::thread::spawn(move || {
             let rt = tokio::runtime::Builder::new_multi_thread()
                 .worker_threads(2)

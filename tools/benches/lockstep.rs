@@ -4,16 +4,20 @@
 //! 1. ping-pong: this process pings (a StateMsg-sized sample), `flexdyn-pingpong pong` (a child
 //!    process) answers with a CommandMsg-sized sample;
 //! 2. lockstep, one RK4 step per frame (1 kHz frames): the server in this process, the demo
-//!    controller `flexdyn-acs-demo` as a child process;
-//! 3. lockstep with the reference configuration (100 Hz frames, 10 RK4 steps per frame).
+//!    controller `flexdyn-acs-demo` as a child process, once with `handoff = "direct"` (the
+//!    default: the Zenoh thread that delivers the answer steps and publishes) and once with
+//!    `handoff = "thread"` (the previous design: physics thread + telemetry thread), so the
+//!    before and after are measured side by side;
+//! 3. lockstep with the reference configuration (100 Hz frames, 10 RK4 steps per frame), direct.
 //!
 //! It prints each round and the medians: round trips/s, ticks/s, and the median of the per-round
-//! ratios (target ≥ 0.8 for the one-step case, where the link dominates). Rounds alternate the
-//! measurements so that a change in machine load hits both sides alike. The physics cost of a
-//! frame is measured alone too, to explain the reference case.
+//! ratios (target ≥ 0.95 × the ping-pong for the one-step case, where the link dominates).
+//! Rounds alternate the measurements so that a change in machine load hits every side alike.
+//! The physics cost of a frame is measured alone too, to explain the reference case.
 //!
 //! `cargo bench -p flexdyn-tools --bench lockstep`; environment: `FLEXDYN_BENCH_TICKS`
-//! (default 10000 ticks per measurement), `FLEXDYN_BENCH_ROUNDS` (default 9). Ports 17400–17459.
+//! (default 10000 ticks per measurement), `FLEXDYN_BENCH_ROUNDS` (default 9, at most 11).
+//! Ports 17400–17459.
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -21,7 +25,7 @@ mod support;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use flexdyn::server::ServerSettings;
+use flexdyn::server::{Handoff, ServerSettings};
 use flexdyn::sim::Simulation;
 use flexdyn_proto::{Mode, Topics, EFFECTOR_STATE_FIXED_LEN, STATE_FIXED_LEN};
 use flexdyn_tools::pingpong;
@@ -65,10 +69,11 @@ fn pingpong_rate(port: u16, ticks: usize, recv_loop: bool) -> f64 {
 }
 
 /// Ticks per second of a lockstep run of `ticks` frames at `frame_hz` with the demo controller.
-fn lockstep_rate(port: u16, ticks: usize, frame_hz: f64) -> f64 {
+fn lockstep_rate(port: u16, ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
     let cfg = reference_config(frame_hz);
     let settings = ServerSettings {
         mode: Mode::Lockstep,
+        handoff,
         participants: vec![1],
         duration_ns: Some(ticks as u64 * cfg.frame_ns),
         summary_interval: Duration::from_secs(3600),
@@ -107,32 +112,39 @@ fn physics_frame_us(frame_hz: f64) -> f64 {
 fn main() {
     // `cargo bench` passes `--bench`; ignore arguments.
     let ticks = env_usize("FLEXDYN_BENCH_TICKS", 10_000);
-    let rounds = env_usize("FLEXDYN_BENCH_ROUNDS", 9).clamp(1, 15);
+    let rounds = env_usize("FLEXDYN_BENCH_ROUNDS", 9).clamp(1, 11);
     println!("lockstep benchmark: {rounds} rounds x {ticks} ticks, loopback TCP, 2-core machine");
-    let (mut pp, mut ppl, mut ls1, mut lsr) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let (mut ratio1, mut ratio1l, mut ratior) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut pp, mut ppl, mut ls1, mut lst, mut lsr) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut ratio1, mut ratio1l, mut ratiot, mut ratior) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for r in 0..rounds {
-        let base = 17400 + 4 * r as u16;
+        let base = 17400 + 5 * r as u16;
         let p = pingpong_rate(base, ticks, false);
         let pl = pingpong_rate(base + 1, ticks, true);
-        let a = lockstep_rate(base + 2, ticks, 1000.0);
-        let b = lockstep_rate(base + 3, ticks / 4, 100.0);
+        let a = lockstep_rate(base + 2, ticks, 1000.0, Handoff::Direct);
+        let t = lockstep_rate(base + 3, ticks, 1000.0, Handoff::Thread);
+        let b = lockstep_rate(base + 4, ticks / 4, 100.0, Handoff::Direct);
         println!(
-            "round {r}: ping-pong {p:.0} rt/s (recv-loop pong {pl:.0}) | lockstep 1 step/frame \
-             {a:.0} ticks/s (ratio {:.2}) | reference 10 steps/frame {b:.0} ticks/s (ratio {:.2})",
+            "round {r}: ping-pong {p:.0} rt/s (recv-loop pong {pl:.0}) | lockstep 1 step/frame: \
+             direct {a:.0} ticks/s (ratio {:.2}), thread {t:.0} ticks/s (ratio {:.2}) | reference \
+             10 steps/frame, direct {b:.0} ticks/s (ratio {:.2})",
             a / p,
+            t / p,
             b / p
         );
         ratio1.push(a / p);
         ratio1l.push(a / pl);
+        ratiot.push(t / p);
         ratior.push(b / p);
         pp.push(p);
         ppl.push(pl);
         ls1.push(a);
+        lst.push(t);
         lsr.push(b);
     }
     let (p, pl) = (median(&mut pp), median(&mut ppl));
-    let (a, b) = (median(&mut ls1), median(&mut lsr));
+    let (a, t, b) = (median(&mut ls1), median(&mut lst), median(&mut lsr));
     let phys1 = physics_frame_us(1000.0);
     let phys10 = physics_frame_us(100.0);
     println!(
@@ -141,19 +153,25 @@ fn main() {
         1e6 / p,
         1e6 / pl
     );
-    let (r1, r1l, rr) = (
+    let (r1, r1l, rt, rr) = (
         median(&mut ratio1),
         median(&mut ratio1l),
+        median(&mut ratiot),
         median(&mut ratior),
     );
     println!(
-        "median lockstep ticks/s, 1 RK4 step per frame: {a:.0} ({:.1} us/tick); median ratio \
-         {r1:.2} (target >= 0.8), {r1l:.2} vs the receive-loop pong",
+        "median lockstep ticks/s, 1 RK4 step per frame, handoff direct: {a:.0} ({:.1} us/tick); \
+         median ratio {r1:.2} (target >= 0.95), {r1l:.2} vs the receive-loop pong",
         1e6 / a
     );
     println!(
-        "median lockstep ticks/s, reference (10 RK4 steps per frame): {b:.0} ({:.1} us/tick); \
-         median ratio {rr:.2}",
+        "median lockstep ticks/s, 1 RK4 step per frame, handoff thread (before): {t:.0} ({:.1} \
+         us/tick); median ratio {rt:.2}",
+        1e6 / t
+    );
+    println!(
+        "median lockstep ticks/s, reference (10 RK4 steps per frame), direct: {b:.0} ({:.1} \
+         us/tick); median ratio {rr:.2}",
         1e6 / b
     );
     println!("physics alone per frame: {phys1:.1} us (1 step), {phys10:.1} us (10 steps)");

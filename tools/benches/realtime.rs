@@ -5,15 +5,27 @@
 //! over loopback TCP like any other subscriber) measures the telemetry latency: its receipt
 //! time minus the frame-boundary stamp carried in each sample's attachment.
 //!
-//! Prints frame lateness p50/p99/max, overruns, dropped telemetry, command freshness and the
-//! telemetry latency p50/p99, for rounds with `--record` off and on alternating, then the
-//! medians side by side. Targets on an idle machine: lateness p99 ≤ 50 µs, no overruns, and
-//! recording changing neither beyond round-to-round noise.
+//! Each round measures, one after the other (so a change in machine load hits every column):
+//! 1. the one-way latency of a plain Zenoh hop: half the median round trip of a ping-pong of
+//!    StateMsg-sized samples against `flexdyn-pingpong pong` (a child process answering in its
+//!    callback), the peer of the telemetry latency;
+//! 2. the server with `handoff = "direct"` (the default: the physics thread publishes at the
+//!    boundary), `--record` off;
+//! 3. the server with `handoff = "thread"` (the previous design: a telemetry thread
+//!    publishes), `--record` off;
+//! 4. `handoff = "direct"` with `--record` on.
+//!
+//! It prints frame lateness p50/p99/max, overruns, dropped telemetry, command freshness, the
+//! telemetry latency p50/p99 and (direct) the time publishing took the physics thread, then
+//! the medians side by side. Targets on an idle machine: telemetry latency p50 ≤ 1.3 × the
+//! one-way hop, lateness p99 ≤ 50 µs, no overruns, and neither the direct publication nor
+//! recording changing the overruns beyond round-to-round noise.
 //!
 //! `cargo bench -p flexdyn-tools --bench realtime`; environment: `FLEXDYN_BENCH_RT_S`
-//! (default 30 s per round), `FLEXDYN_BENCH_RT_ROUNDS` (default 3 of each), `FLEXDYN_BENCH_RT_PRIORITY` (the server's `realtime_priority`, default 0:
-//! normal scheduling; e.g. 50 puts the physics thread under SCHED_FIFO, which needs
-//! CAP_SYS_NICE). Ports 17450–17459.
+//! (default 30 s per run), `FLEXDYN_BENCH_RT_ROUNDS` (default 3, at most 10),
+//! `FLEXDYN_BENCH_RT_PRIORITY` (the server's `realtime_priority`, default 0: normal
+//! scheduling; e.g. 50 puts the physics thread under SCHED_FIFO, which needs CAP_SYS_NICE).
+//! Ports 17450–17489.
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -22,11 +34,13 @@ use std::process::Command;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use flexdyn::server::{frame_stamp_ns, ServerSettings};
+use flexdyn::server::{frame_stamp_ns, Handoff, ServerSettings};
 use flexdyn::transport::unix_now_ns;
-use flexdyn_proto::{decode_state, Topics};
-use flexdyn_tools::percentile;
-use support::{connecting_session, endpoint, reference_config, ChildGuard, ServerHandle};
+use flexdyn_proto::{decode_state, Topics, EFFECTOR_STATE_FIXED_LEN, STATE_FIXED_LEN};
+use flexdyn_tools::{percentile, pingpong};
+use support::{
+    connecting_session, endpoint, listening_session, reference_config, ChildGuard, ServerHandle,
+};
 use zenoh::Wait;
 
 /// What one real-time round measured.
@@ -39,12 +53,37 @@ struct Round {
     latency_p50_us: f64,
     latency_p99_us: f64,
     recorded: Option<(u64, u64)>,
+    direct_publish_mean_us: f64,
+    direct_publish_max_us: f64,
+}
+
+/// \[µs\] half the median round trip of 5000 StateMsg-sized pings (after 500 unmeasured).
+fn one_way_us(port: u16) -> f64 {
+    let topics = Topics::new("bench").unwrap();
+    let session = listening_session(port);
+    let _pong = ChildGuard::spawn(
+        Command::new(env!("CARGO_BIN_EXE_flexdyn-pingpong"))
+            .args(["--connect", &endpoint(port), "--sc-id", "bench"])
+            .args(["pong", "--duration-s", "300"]),
+    );
+    let mut rtts = pingpong::ping(
+        &session,
+        &topics,
+        STATE_FIXED_LEN + 2 * (EFFECTOR_STATE_FIXED_LEN + 32),
+        500,
+        5000,
+        Duration::from_secs(30),
+    )
+    .expect("ping-pong");
+    rtts.sort_unstable();
+    rtts[rtts.len() / 2].as_secs_f64() * 1e6 / 2.0
 }
 
 fn round(
     port: u16,
     seconds: f64,
     realtime_priority: u8,
+    handoff: Handoff,
     record: Option<std::path::PathBuf>,
 ) -> Round {
     let cfg = reference_config(1000.0);
@@ -53,6 +92,7 @@ fn round(
         duration_ns: Some(frames * cfg.frame_ns),
         summary_interval: Duration::from_secs(10),
         realtime_priority,
+        handoff,
         record,
         ..ServerSettings::default()
     };
@@ -116,6 +156,15 @@ fn round(
     println!(
         "  controller: {fresh} frames with a fresh command, {flagged} flagged (no command yet or stale)"
     );
+    let (direct_mean, direct_max) = report
+        .direct_publish
+        .map_or((0.0, 0.0), |c| (c.mean_ns * 1e-3, c.max_ns as f64 * 1e-3));
+    if report.direct_publish.is_some() {
+        println!(
+            "  publishing on the physics thread: mean {direct_mean:.1} us, max {direct_max:.1} us \
+             per frame"
+        );
+    }
     Round {
         lateness_p50_us: us(t.lateness_p50_ns),
         lateness_p99_us: us(t.lateness_p99_ns),
@@ -125,6 +174,8 @@ fn round(
         latency_p50_us: us(percentile(&lat, 0.5).unwrap_or(0)),
         latency_p99_us: us(percentile(&lat, 0.99).unwrap_or(0)),
         recorded: report.recording.map(|r| (r.stats.samples, r.dropped)),
+        direct_publish_mean_us: direct_mean,
+        direct_publish_max_us: direct_max,
     }
 }
 
@@ -141,7 +192,8 @@ fn main() {
     let rounds: usize = std::env::var("FLEXDYN_BENCH_RT_ROUNDS")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(3);
+        .unwrap_or(3)
+        .clamp(1, 10);
     let realtime_priority: u8 = std::env::var("FLEXDYN_BENCH_RT_PRIORITY")
         .ok()
         .map(|v| {
@@ -150,21 +202,51 @@ fn main() {
         })
         .unwrap_or(0);
     println!(
-        "real-time benchmark: 1 kHz, {seconds} s per round with the demo controller, {rounds} \
-         rounds each with --record off and on (alternating), 2-core machine"
+        "real-time benchmark: 1 kHz, {seconds} s per run with the demo controller, {rounds} \
+         rounds of [ping-pong, handoff direct, handoff thread, direct + --record], 2-core machine"
     );
     println!("physics thread realtime_priority = {realtime_priority} (0: normal scheduler)");
     let dir = std::env::temp_dir().join(format!("flexdyn-bench-rt-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let mut off = Vec::new();
-    let mut on = Vec::new();
+    let (mut one_way, mut direct, mut thread, mut on) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for r in 0..rounds {
-        let port = 17450 + 2 * r as u16;
-        println!("round {} --record off:", r + 1);
-        off.push(round(port, seconds, realtime_priority, None));
+        let port = 17450 + 4 * r as u16;
+        let ow = one_way_us(port);
+        println!(
+            "round {}: one-way Zenoh hop (half the median ping-pong rtt): {ow:.1} us",
+            r + 1
+        );
+        one_way.push(ow);
+        println!("round {} handoff direct, --record off:", r + 1);
+        direct.push(round(
+            port + 1,
+            seconds,
+            realtime_priority,
+            Handoff::Direct,
+            None,
+        ));
+        println!("round {} handoff thread, --record off:", r + 1);
+        thread.push(round(
+            port + 2,
+            seconds,
+            realtime_priority,
+            Handoff::Thread,
+            None,
+        ));
         let file = dir.join(format!("round{r}.mcap"));
-        println!("round {} --record on ({}):", r + 1, file.display());
-        let rec = round(port + 1, seconds, realtime_priority, Some(file.clone()));
+        println!(
+            "round {} handoff direct, --record on ({}):",
+            r + 1,
+            file.display()
+        );
+        let rec = round(
+            port + 3,
+            seconds,
+            realtime_priority,
+            Handoff::Direct,
+            Some(file.clone()),
+        );
         if let Some((samples, dropped)) = rec.recorded {
             let bytes = std::fs::metadata(&file).map_or(0, |m| m.len());
             println!("  recorded {samples} samples, {dropped} dropped, file {bytes} bytes");
@@ -173,9 +255,13 @@ fn main() {
     }
     let _ = std::fs::remove_dir_all(&dir);
     let col = |v: &[Round], f: fn(&Round) -> f64| median(v.iter().map(f).collect());
-    println!("medians over {rounds} rounds           record off   record on   on/off");
+    let ow = median(one_way.clone());
+    println!("median one-way Zenoh hop over {rounds} rounds: {ow:.1} us");
+    println!(
+        "medians over {rounds} rounds               direct      thread  direct+rec  direct/thread"
+    );
     type Metric = fn(&Round) -> f64;
-    let rows: [(&str, Metric); 7] = [
+    let rows: [(&str, Metric); 9] = [
         ("frame lateness p50 (us)", |r| r.lateness_p50_us),
         ("frame lateness p99 (us)", |r| r.lateness_p99_us),
         ("frame lateness max (us)", |r| r.lateness_max_us),
@@ -183,16 +269,38 @@ fn main() {
         ("telemetry dropped", |r| r.telemetry_dropped as f64),
         ("telemetry latency p50 (us)", |r| r.latency_p50_us),
         ("telemetry latency p99 (us)", |r| r.latency_p99_us),
+        ("publish on physics thread mean (us)", |r| {
+            r.direct_publish_mean_us
+        }),
+        ("publish on physics thread max (us)", |r| {
+            r.direct_publish_max_us
+        }),
     ];
     for (name, f) in rows {
-        let (a, b) = (col(&off, f), col(&on, f));
-        let ratio = if a > 0.0 {
-            format!("{:.2}", b / a)
+        let (a, b, c) = (col(&direct, f), col(&thread, f), col(&on, f));
+        let ratio = if b > 0.0 {
+            format!("{:.2}", a / b)
         } else {
             "-".into()
         };
-        println!("{name:<32} {a:>11.1} {b:>11.1} {ratio:>8}");
+        println!("{name:<36} {a:>11.1} {b:>11.1} {c:>11.1} {ratio:>14}");
     }
+    let lat: Vec<f64> = direct
+        .iter()
+        .zip(&one_way)
+        .map(|(r, ow)| r.latency_p50_us / ow)
+        .collect();
+    let lat_t: Vec<f64> = thread
+        .iter()
+        .zip(&one_way)
+        .map(|(r, ow)| r.latency_p50_us / ow)
+        .collect();
+    println!(
+        "telemetry latency p50 / one-way hop, median of the per-round ratios: direct {:.2} \
+         (target <= 1.3), thread {:.2}",
+        median(lat),
+        median(lat_t)
+    );
     let dropped: u64 = on.iter().filter_map(|r| r.recorded).map(|(_, d)| d).sum();
     println!("recorder drops over all rounds: {dropped}");
 }

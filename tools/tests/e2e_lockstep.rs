@@ -10,7 +10,11 @@
 //! A second, passive participant (sender 2, in this process) records every StateMsg payload and
 //! answers `NoCommand`; being a participant guarantees it sees every tick from 0.
 //!
-//! Ports 17310–17319.
+//! The default `handoff = "direct"` (the Zenoh thread delivering a tick's last answer steps and
+//! publishes) must give the stream of `handoff = "thread"` (physics and telemetry threads) bit
+//! for bit.
+//!
+//! Ports 17309–17319.
 
 mod support;
 
@@ -18,7 +22,7 @@ use std::process::Command;
 use std::time::Duration;
 
 use flexdyn::attitude::mrp_error;
-use flexdyn::server::{ServerError, ServerSettings};
+use flexdyn::server::{Handoff, ServerError, ServerSettings};
 use flexdyn_proto::{decode_state, Mode, Topics};
 use nalgebra::Vector3;
 use sha2::{Digest, Sha256};
@@ -121,8 +125,24 @@ fn lockstep_run_with(
     cfg: flexdyn::config::SimConfig,
     rate_args: &[&str],
 ) -> Run {
+    lockstep_run_settings(
+        port,
+        settings(participant_timeout_s),
+        sabotage,
+        cfg,
+        rate_args,
+    )
+}
+
+fn lockstep_run_settings(
+    port: u16,
+    settings: ServerSettings,
+    sabotage: Sabotage,
+    cfg: flexdyn::config::SimConfig,
+    rate_args: &[&str],
+) -> Run {
     let topics = Topics::new("sc1").unwrap();
-    let server = ServerHandle::start(port, settings(participant_timeout_s), cfg);
+    let server = ServerHandle::start(port, settings, cfg);
     let recorder = Recorder::start(port, &topics, 2);
     let mut ctrl = controller(port, rate_args);
     match sabotage {
@@ -209,6 +229,25 @@ fn lockstep_converges_and_is_bit_identical_across_runs_and_pauses() {
         digest(&c.states),
         hash_a,
         "a paused controller changed the telemetry"
+    );
+
+    // The previous design (physics thread + telemetry thread) gives the same stream.
+    assert_eq!(ServerSettings::default().handoff, Handoff::Direct);
+    let d = lockstep_run_settings(
+        17309,
+        ServerSettings {
+            handoff: Handoff::Thread,
+            ..settings(10.0)
+        },
+        Sabotage::None,
+        reference_config(100.0),
+        TRUTH_RATE,
+    );
+    d.result.expect("run D (handoff thread)");
+    assert_eq!(
+        digest(&d.states),
+        hash_a,
+        "handoff = \"thread\" and \"direct\" differ"
     );
 }
 

@@ -89,7 +89,11 @@ fn a_lockstep_recording_is_the_stream_the_participants_saw() {
     // Every answer of both participants to ticks 0..N−1 is in the file once, decodable. (An
     // answer to the last state N may land before the server stops listening, or not.)
     let mut answered: [Vec<u64>; 3] = Default::default();
-    for s in rec.samples.iter().filter(|s| s.key == topics.cmd_wrench()) {
+    for s in rec
+        .samples
+        .iter()
+        .filter(|s| s.key == topics.cmd(1) || s.key == topics.cmd(2))
+    {
         let cmd = decode_command(&s.payload).unwrap();
         answered[cmd.sender_id as usize].push(cmd.header.tick);
     }

@@ -72,7 +72,8 @@ def status_line(m):
         m.overrun_count, m.frames_skipped, m.last_command_tick, m.command_age_ns,
         m.command_stale, m.stale_policy, m.rejected_malformed, m.rejected_bad_version,
         m.rejected_non_finite, m.rejected_wrong_spacecraft, m.rejected_stale_tick,
-        m.rejected_unknown_sender, m.rejected_bad_effector_input, m.commands_dropped,
+        m.rejected_unknown_sender, m.rejected_bad_effector_input, m.rejected_wrong_identity,
+        m.commands_dropped,
         m.wall_time_unix_ns))
 
 

@@ -84,7 +84,7 @@ def test_commands(golden_dir):
 def test_status(golden_dir):
     m = StatusMsg(Header(SC, 0x0102030405060708, 1_500_000_000, 99), proto.MODE_LOCKSTEP, 1,
                   1000, 250_000, 3_000_000, 3, 2, 41, 1_000_000, True, proto.STALE_POLICY_ZERO,
-                  1, 2, 3, 4, 5, 6, 8, 7, 1_700_000_000_123_456_789)
+                  1, 2, 3, 4, 5, 6, 8, 9, 7, 1_700_000_000_123_456_789)
     golden = (golden_dir / "status.bin").read_bytes()
     assert m.encode() == golden and StatusMsg.decode(golden) == m
 
@@ -95,5 +95,10 @@ def test_versions_and_keys():
     assert (e.value.reason, e.value.info["found"]) == ("UnknownVersion", 2)
     assert proto.star_tracker_key("sc1", "st1") == "flexdyn/sc1/tlm/st/st1"
     assert proto.participant_key("sc-1", 7) == "flexdyn/sc-1/participant/7"
+    assert proto.command_key("sc-1", 7) == "flexdyn/sc-1/cmd/7"
+    assert proto.command_key("sc1", 4294967295) == "flexdyn/sc1/cmd/4294967295"
+    for bad in (-1, 2**32, "1"):
+        with pytest.raises(ValueError):
+            proto.command_key("sc1", bad)
     with pytest.raises(ValueError):
         proto.imu_key("sc1", "a/b")

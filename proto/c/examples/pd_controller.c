@@ -10,7 +10,7 @@
  *     zc_config_insert_json5(z_loan_mut(cfg), "listen/endpoints", "[]");
  *     zc_config_insert_json5(z_loan_mut(cfg), "scouting/multicast/enabled", "false");
  *     z_owned_session_t s;  z_open(&s, z_move(cfg), NULL);
- *     // publisher on fd_command_key(...) = "flexdyn/sc1/cmd/wrench"
+ *     // publisher on fd_command_key(..., SENDER_ID) = "flexdyn/sc1/cmd/1"
  *     // subscriber on fd_state_key(...) = "flexdyn/sc1/tlm/state", whose callback does:
  *     //     z_owned_slice_t b; z_bytes_to_slice(z_sample_payload(sample), &b);
  *     //     size_t n = answer(z_slice_data(z_loan(b)), z_slice_len(z_loan(b)), out, sizeof out);

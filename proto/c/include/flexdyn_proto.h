@@ -38,7 +38,7 @@ extern "C" {
 /* ------------------------------------------------------------------------------------------ */
 /* Constants (proto/README.md).                                                                */
 
-#define FD_PROTOCOL_VERSION 3u
+#define FD_PROTOCOL_VERSION 4u
 #define FD_HEADER_LEN 30u
 #define FD_STATE_FIXED_LEN 327u
 #define FD_STATE_EFFECTOR_COUNT_OFFSET 319u
@@ -50,7 +50,7 @@ extern "C" {
 #define FD_COMMAND_WRENCH_LEN 86u
 #define FD_COMMAND_NO_COMMAND_LEN 38u
 #define FD_COMMAND_ACTUATORS_FIXED_LEN 94u
-#define FD_STATUS_LEN 171u
+#define FD_STATUS_LEN 179u
 #define FD_MAX_EFFECTORS 1024u
 #define FD_MAX_EFFECTOR_VALUES 8u
 #define FD_MAX_MESSAGE_BYTES 65536u
@@ -211,6 +211,7 @@ typedef struct {
     uint64_t rejected_stale_tick;
     uint64_t rejected_unknown_sender;
     uint64_t rejected_bad_effector_input;
+    uint64_t rejected_wrong_identity; /* since protocol 4: sender_id is not the one its key names */
     uint64_t commands_dropped;
     uint64_t wall_time_unix_ns;
 } fd_status_msg;
@@ -695,8 +696,9 @@ static inline fd_error fd_decode_status(const uint8_t *buf, size_t len, fd_statu
     out->rejected_stale_tick = fd_get_u64(buf + 131);
     out->rejected_unknown_sender = fd_get_u64(buf + 139);
     out->rejected_bad_effector_input = fd_get_u64(buf + 147);
-    out->commands_dropped = fd_get_u64(buf + 155);
-    out->wall_time_unix_ns = fd_get_u64(buf + 163);
+    out->rejected_wrong_identity = fd_get_u64(buf + 155);
+    out->commands_dropped = fd_get_u64(buf + 163);
+    out->wall_time_unix_ns = fd_get_u64(buf + 171);
     return fd_ok();
 }
 
@@ -721,8 +723,9 @@ static inline size_t fd_encode_status(const fd_status_msg *m, uint8_t *buf, size
     fd_put_u64(buf + 131, m->rejected_stale_tick);
     fd_put_u64(buf + 139, m->rejected_unknown_sender);
     fd_put_u64(buf + 147, m->rejected_bad_effector_input);
-    fd_put_u64(buf + 155, m->commands_dropped);
-    fd_put_u64(buf + 163, m->wall_time_unix_ns);
+    fd_put_u64(buf + 155, m->rejected_wrong_identity);
+    fd_put_u64(buf + 163, m->commands_dropped);
+    fd_put_u64(buf + 171, m->wall_time_unix_ns);
     return FD_STATUS_LEN;
 }
 
@@ -776,22 +779,29 @@ static inline size_t fd_imu_key(char *out, size_t cap, const char *sc, const cha
 static inline size_t fd_star_tracker_key(char *out, size_t cap, const char *sc, const char *name) {
     return fd_key(out, cap, sc, "tlm/st", name);
 }
-static inline size_t fd_command_key(char *out, size_t cap, const char *sc) {
-    return fd_key(out, cap, sc, "cmd/wrench", NULL);
-}
 static inline size_t fd_status_key(char *out, size_t cap, const char *sc) {
     return fd_key(out, cap, sc, "status", NULL);
+}
+/* Writes the decimal form of v (no leading zero) into digits[11]; returns its first char. */
+static inline const char *fd_decimal_u32(char digits[11], uint32_t v) {
+    int i = 10;
+    digits[10] = '\0';
+    do {
+        digits[--i] = (char)('0' + v % 10u);
+        v /= 10u;
+    } while (v != 0 && i > 0);
+    return digits + i;
+}
+/* The command key of participant sender_id, flexdyn/<sc>/cmd/<sender_id> (protocol 4: one key
+ * per sender, so the server's Zenoh access-control list can reserve it for one subject). */
+static inline size_t fd_command_key(char *out, size_t cap, const char *sc, uint32_t sender_id) {
+    char digits[11];
+    return fd_key(out, cap, sc, "cmd", fd_decimal_u32(digits, sender_id));
 }
 /* The lockstep participant's liveliness token key, flexdyn/<sc>/participant/<sender_id>. */
 static inline size_t fd_participant_key(char *out, size_t cap, const char *sc, uint32_t sender_id) {
     char digits[11];
-    int i = 10;
-    digits[10] = '\0';
-    do {
-        digits[--i] = (char)('0' + sender_id % 10u);
-        sender_id /= 10u;
-    } while (sender_id != 0 && i > 0);
-    return fd_key(out, cap, sc, "participant", digits + i);
+    return fd_key(out, cap, sc, "participant", fd_decimal_u32(digits, sender_id));
 }
 
 #ifdef __cplusplus

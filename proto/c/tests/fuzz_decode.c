@@ -182,6 +182,7 @@ static void one(const uint8_t *buf, size_t len) {
             u(m.rejected_stale_tick);
             u(m.rejected_unknown_sender);
             u(m.rejected_bad_effector_input);
+            u(m.rejected_wrong_identity);
             u(m.commands_dropped);
             u(m.wall_time_unix_ns);
             printf("\n");

@@ -317,13 +317,15 @@ static void test_status(const char *dir) {
     m.rejected_stale_tick = 5;
     m.rejected_unknown_sender = 6;
     m.rejected_bad_effector_input = 8;
+    m.rejected_wrong_identity = 9;
     m.commands_dropped = 7;
     m.wall_time_unix_ns = 1700000000123456789u;
     check_encoded("StatusMsg", golden, n, enc, fd_encode_status(&m, enc, sizeof enc));
     e = fd_decode_status(golden, n, &back);
     CHECK(e.status == FD_OK && same_header(&back.header, &m.header) &&
               back.wall_time_unix_ns == m.wall_time_unix_ns &&
-              back.rejected_bad_effector_input == 8 && back.commands_dropped == 7 &&
+              back.rejected_bad_effector_input == 8 && back.rejected_wrong_identity == 9 &&
+              back.commands_dropped == 7 &&
               back.stale_policy == 1 && back.command_stale == 1,
           "StatusMsg decodes to the table");
     golden[34] = 6;
@@ -343,7 +345,11 @@ static void test_keys(void) {
               strcmp(key, "flexdyn/sc-1/participant/4294967295") == 0,
           "participant key");
     CHECK(fd_imu_key(key, sizeof key, "sc1", "a/b") == 0, "a / in a name is rejected");
-    CHECK(fd_command_key(key, 10, "sc1") == 0, "a key that does not fit is rejected");
+    CHECK(fd_command_key(key, sizeof key, "sc1", 1u) > 0 && strcmp(key, "flexdyn/sc1/cmd/1") == 0,
+          "command key");
+    CHECK(fd_command_key(key, sizeof key, "sc1", 0u) > 0 && strcmp(key, "flexdyn/sc1/cmd/0") == 0,
+          "command key of sender 0");
+    CHECK(fd_command_key(key, 10, "sc1", 1u) == 0, "a key that does not fit is rejected");
     printf("keys: ok\n");
 }
 

@@ -157,6 +157,7 @@ fn status_line(m: &StatusMsg) -> String {
         .u(r.stale_tick)
         .u(r.unknown_sender)
         .u(r.bad_effector_input)
+        .u(r.wrong_identity)
         .u(m.commands_dropped)
         .u(m.wall_time_unix_ns);
     l.0

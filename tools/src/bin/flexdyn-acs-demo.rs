@@ -10,7 +10,7 @@
 //!                                      Systems, ch. 8: MRP feedback control)
 //! ```
 //!
-//! and publishes it as a [`CommandMsg`] on `flexdyn/<sc>/cmd/wrench`, stamped with the tick of
+//! and publishes it as a [`CommandMsg`] on `flexdyn/<sc>/cmd/<sender-id>`, stamped with the tick of
 //! the state it answers. σ_BR is the MRP attitude error of the body B relative to the target
 //! frame R (given as σ_RN with ω_RN = 0, so ω_BR = ω_BN).
 //!
@@ -556,12 +556,13 @@ fn run(args: Args) -> anyhow::Result<()> {
     let mut st_heard = false;
 
     // 3. The command publisher. Block (never drop) and express (no batching: lowest latency).
+    let cmd_key = topics.cmd(args.sender_id);
     let commands = session
-        .declare_publisher(topics.cmd_wrench())
+        .declare_publisher(cmd_key.clone())
         .congestion_control(CongestionControl::Block)
         .express(true)
         .wait()
-        .map_err(|e| anyhow::anyhow!("cannot declare {}: {e}", topics.cmd_wrench()))?;
+        .map_err(|e| anyhow::anyhow!("cannot declare {cmd_key}: {e}"))?;
 
     // 4. Announce ourselves to a lockstep server (harmless in real time). Declared after the
     //    subscriber, so the server cannot publish tick 0 before we can receive it.
@@ -576,7 +577,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         p_nms = controller.p_nms,
         sigma_rn = ?controller.sigma_rn,
         state = topics.state(),
-        commands = topics.cmd_wrench(),
+        commands = cmd_key,
         "flexdyn-acs-demo running"
     );
 

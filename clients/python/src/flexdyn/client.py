@@ -15,9 +15,13 @@ from .proto import CommandMsg, EffectorInput, Header, ImuMsg, StarTrackerMsg, St
 Vec3 = Tuple[float, float, float]
 
 
-def session_config(endpoints: Sequence[str]) -> zenoh.Config:
-    """Peer mode, connect to `endpoints`, listen nowhere, multicast scouting off."""
-    conf = zenoh.Config()
+def session_config(endpoints: Sequence[str], zenoh_config: Optional[str] = None) -> zenoh.Config:
+    """Peer mode, connect to `endpoints`, listen nowhere, multicast scouting off.
+
+    ``zenoh_config`` is a Zenoh JSON5 file to start from instead of the defaults, e.g. one with
+    ``transport/auth/usrpwd`` credentials for a server on a lab network (see the README's
+    "Running on a lab network"); the endpoints and the scouting rule still apply."""
+    conf = zenoh.Config.from_file(zenoh_config) if zenoh_config else zenoh.Config()
     conf.insert_json5("mode", '"peer"')
     conf.insert_json5("connect/endpoints", json.dumps(list(endpoints)))
     conf.insert_json5("listen/endpoints", "[]")
@@ -34,12 +38,13 @@ class Client:
     """
 
     def __init__(self, endpoint: Union[str, Iterable[str]], sc_id: str = "sc1",
-                 spacecraft_id: int = 1) -> None:
+                 spacecraft_id: int = 1, zenoh_config: Optional[str] = None) -> None:
         endpoints = [endpoint] if isinstance(endpoint, str) else list(endpoint)
         self.sc_id = sc_id
         self.spacecraft_id = spacecraft_id
-        self.session = zenoh.open(session_config(endpoints))
-        self._command_pub = self.session.declare_publisher(proto.command_key(sc_id))
+        self.session = zenoh.open(session_config(endpoints, zenoh_config))
+        # One publisher per sender id, on flexdyn/<sc>/cmd/<sender_id>, declared on first use.
+        self._command_pubs: dict = {}
         self._subscribers: List[object] = []
         self._seq = 0
         self._lock = threading.Lock()
@@ -95,7 +100,11 @@ class Client:
         with self._pub_lock:
             if self._closed:
                 raise RuntimeError("flexdyn.Client is closed")
-            self._command_pub.put(payload)
+            pub = self._command_pubs.get(cmd.sender_id)
+            if pub is None:
+                pub = self.session.declare_publisher(proto.command_key(self.sc_id, cmd.sender_id))
+                self._command_pubs[cmd.sender_id] = pub
+            pub.put(payload)
 
     def send_wrench(self, sender_id: int, tick: int, sim_time_ns: int, torque_b_nm: Vec3,
                     force_b_newton: Vec3 = (0.0, 0.0, 0.0)) -> None:
@@ -123,7 +132,9 @@ class Client:
             if self._closed:
                 return
             self._closed = True
-            self._command_pub.undeclare()
+            for pub in self._command_pubs.values():
+                pub.undeclare()
+            self._command_pubs.clear()
         self.session.close()
 
     def __enter__(self) -> "Client":

@@ -23,7 +23,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import ClassVar, List, Optional, Tuple
 
-PROTOCOL_VERSION = 3
+PROTOCOL_VERSION = 4
 HEADER_LEN = 30
 STATE_FIXED_LEN = 327
 STATE_EFFECTOR_COUNT_OFFSET = 319
@@ -35,7 +35,7 @@ COMMAND_KIND_OFFSET = 34
 COMMAND_WRENCH_LEN = 86
 COMMAND_NO_COMMAND_LEN = 38
 COMMAND_ACTUATORS_FIXED_LEN = 94
-STATUS_LEN = 171
+STATUS_LEN = 179
 MAX_EFFECTORS = 1024
 MAX_EFFECTOR_VALUES = 8
 MAX_MESSAGE_BYTES = 65536
@@ -306,7 +306,7 @@ _FORCE = ("kind.force_b_newton[0]", "kind.force_b_newton[1]", "kind.force_b_newt
 
 @dataclass
 class CommandMsg:
-    """Command from flight code (``flexdyn/<sc-id>/cmd/wrench``): ``kind`` WRENCH (torque about
+    """Command from flight code (``flexdyn/<sc-id>/cmd/<sender_id>``): ``kind`` WRENCH (torque about
     B [N m] and force at B [N], B components), NO_COMMAND_KIND, or ACTUATORS (a wrench plus
     effector inputs, e.g. reaction-wheel motor torques)."""
 
@@ -402,10 +402,11 @@ class StatusMsg:
     rejected_stale_tick: int = 0
     rejected_unknown_sender: int = 0
     rejected_bad_effector_input: int = 0
+    rejected_wrong_identity: int = 0
     commands_dropped: int = 0
     wall_time_unix_ns: int = 0
 
-    _BODY: ClassVar[struct.Struct] = struct.Struct("<II7QBI9Q")
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<II7QBI10Q")
 
     def encode(self) -> bytes:
         return self.header.encode() + self._BODY.pack(
@@ -415,7 +416,7 @@ class StatusMsg:
             self.stale_policy, self.rejected_malformed, self.rejected_bad_version,
             self.rejected_non_finite, self.rejected_wrong_spacecraft, self.rejected_stale_tick,
             self.rejected_unknown_sender, self.rejected_bad_effector_input,
-            self.commands_dropped, self.wall_time_unix_ns,
+            self.rejected_wrong_identity, self.commands_dropped, self.wall_time_unix_ns,
         )
 
     @staticmethod
@@ -461,8 +462,13 @@ def star_tracker_key(sc: str, name: str) -> str:
     return _key(sc, "tlm/st", name)
 
 
-def command_key(sc: str) -> str:
-    return _key(sc, "cmd/wrench")
+def command_key(sc: str, sender_id: int) -> str:
+    """``flexdyn/<sc>/cmd/<sender_id>``: participant ``sender_id``'s command key (protocol 4:
+    one key per sender, which the server's Zenoh access-control list can reserve for one
+    authenticated subject)."""
+    if not (isinstance(sender_id, int) and 0 <= sender_id <= 0xFFFFFFFF):
+        raise ValueError(f"invalid sender_id {sender_id!r}: an integer 0..4294967295")
+    return _key(sc, "cmd", str(sender_id))
 
 
 def status_key(sc: str) -> str:
