@@ -132,7 +132,7 @@ fn lockstep_participant_timeout_exits_nonzero_naming_participant_and_tick() {
     let topics = Topics::new("sc1").unwrap();
     let session = connecting_session(port);
     let publisher = session
-        .declare_publisher(topics.cmd_wrench().to_owned())
+        .declare_publisher(topics.cmd(7))
         .congestion_control(CongestionControl::Block)
         .wait()
         .unwrap();
@@ -215,7 +215,53 @@ fn bad_settings_exit_2_naming_the_setting() {
     )
     .unwrap();
     let file_s = file.to_str().unwrap();
-    let cases: [(&[&str], &str); 3] = [
+    let secure = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/zenoh/secure-server.json5"
+    );
+    let listen = ["--listen", "tcp/127.0.0.1:17342"];
+    let cases: [(&[&str], &str); 7] = [
+        // Binding participants to subjects: the shipped ACL reserves cmd/1 for `fsw`.
+        (
+            &[
+                "run",
+                "--zenoh-config",
+                secure,
+                "--participant-subjects",
+                "1=operator",
+                listen[0],
+                listen[1],
+            ],
+            "error: server.participant_subjects: access_control lets user `fsw` (subject \
+             `flight-code`) put on `flexdyn/sc1/cmd/1`, participant 1's command key; only \
+             `operator` may",
+        ),
+        (
+            &[
+                "run",
+                "--participant-subjects",
+                "1=fsw",
+                listen[0],
+                listen[1],
+            ],
+            "needs authenticated peers: set transport/auth/usrpwd/dictionary_file",
+        ),
+        (
+            &[
+                "run",
+                "--zenoh-config",
+                secure,
+                "--participant-subjects",
+                "2=fsw",
+                listen[0],
+                listen[1],
+            ],
+            "error: server.participant_subjects: sender 2 is not in server.participants [1]",
+        ),
+        (
+            &["run", "--handoff", "inline", listen[0], listen[1]],
+            "invalid value 'inline' for '--handoff <HANDOFF>'",
+        ),
         (
             &["run", "--config", file_s],
             "error: server.colour: unknown key",
@@ -313,7 +359,7 @@ fn dropped_commands_reach_the_status_and_rejections_are_logged() {
     server.await_tick(&obs, 5);
     let session = connecting_session(port);
     let publisher = session
-        .declare_publisher(topics.cmd_wrench().to_owned())
+        .declare_publisher(topics.cmd(1))
         .congestion_control(CongestionControl::Block)
         .wait()
         .unwrap();
@@ -326,7 +372,7 @@ fn dropped_commands_reach_the_status_and_rejections_are_logged() {
     // Unknown sender, three times: logged once.
     for i in 0..3u64 {
         let cmd = CommandMsg::wrench(Header::new(1, tick, 0, i), 99, [0.0; 3], [0.0; 3]);
-        publisher.put(encode(&cmd)).wait().unwrap();
+        session.put(topics.cmd(99), encode(&cmd)).wait().unwrap();
     }
     // Another spacecraft.
     let cmd = CommandMsg::wrench(Header::new(7, tick, 0, 0), 1, [0.0; 3], [0.0; 3]);
