@@ -74,9 +74,10 @@ pub struct RunArgs {
     /// Command queue capacity [default: 1024].
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub command_queue: Option<i64>,
-    /// Which thread publishes the frames: `direct` (the thread that finishes the frame) or
-    /// `thread` (a telemetry thread) [default: direct].
-    #[arg(long, value_parser = ["direct", "thread"])]
+    /// Which thread publishes the frames: `direct` (the thread that finishes the frame),
+    /// `thread` (a telemetry thread) or `auto` (direct, but thread in real time with --record)
+    /// [default: auto].
+    #[arg(long, value_parser = ["auto", "direct", "thread"])]
     pub handoff: Option<String>,
     /// Bind each participant's sender id to an authenticated Zenoh user name, e.g. `1=fsw`
     /// (comma-separated) [default: none].

@@ -1,4 +1,5 @@
-//! Lockstep with `server.handoff = "direct"` (the default): the frame is stepped on the thread
+//! Lockstep with `server.handoff = "direct"` (what the default `auto` gives in lockstep): the
+//! frame is stepped on the thread
 //! that delivers its last answer.
 //!
 //! A lockstep tick is a round trip: the server publishes the state of tick `k`, every

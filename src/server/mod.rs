@@ -119,6 +119,8 @@ pub struct PublishCost {
     pub mean_ns: f64,
     /// \[ns\] largest time of one frame.
     pub max_ns: u64,
+    /// Frames whose publication took longer than [`shared::SLOW_PUBLISH_NS`] (100 µs).
+    pub slow_frames: u64,
 }
 
 impl fmt::Display for RunReport {
@@ -156,9 +158,10 @@ impl fmt::Display for RunReport {
         if let Some(c) = &self.direct_publish {
             write!(
                 f,
-                " direct_publish_us mean={:.1} max={:.1}",
+                " direct_publish_us mean={:.1} max={:.1} slow_over_100us={}",
                 c.mean_ns * 1e-3,
-                c.max_ns as f64 * 1e-3
+                c.max_ns as f64 * 1e-3,
+                c.slow_frames
             )?;
         }
         Ok(())
@@ -478,7 +481,7 @@ pub async fn run(
         .map(|tx| publisher.recording(tx, &status_pub));
 
     // Who publishes the frames (see `publish`): batch always the telemetry thread.
-    let direct = settings.handoff == Handoff::Direct && mode != Mode::Batch;
+    let direct = settings.handoff.is_direct(mode, settings.record.is_some());
     tracing::info!(
         handoff = if direct { "direct" } else { "thread" },
         "frames are published by {}",
@@ -720,6 +723,9 @@ pub async fn run(
                     / n as f64,
                 max_ns: shared
                     .direct_publish_ns_max
+                    .load(std::sync::atomic::Ordering::Relaxed),
+                slow_frames: shared
+                    .direct_publishes_slow
                     .load(std::sync::atomic::Ordering::Relaxed),
             })
         },

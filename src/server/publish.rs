@@ -3,7 +3,8 @@
 //! samples of the same tick already delivered).
 //!
 //! Which thread calls [`FramePublisher::publish`] is the `server.handoff` setting:
-//! - `direct` (default): the thread that finishes the frame. In real time that is the physics
+//! - `direct` (what the default `auto` gives, except in real time with `--record`): the thread
+//!   that finishes the frame. In real time that is the physics
 //!   thread, at the frame boundary, with `CongestionControl::Drop`, so the put never waits for
 //!   the network (a full Zenoh queue drops the sample, counted as a publish error); in lockstep
 //!   it is the Zenoh thread that delivered the tick's last answer and stepped the frame

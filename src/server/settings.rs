@@ -43,11 +43,16 @@ impl OverrunPolicy {
 /// Which thread publishes a frame's telemetry (`server.handoff`, see [`super::publish`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Handoff {
-    /// `direct` (default): the thread that finishes the frame publishes it: the physics thread
-    /// at the boundary in real time (never waiting for the network), and in lockstep the Zenoh
-    /// thread that delivers the tick's last answer steps the frame and publishes it. Batch
-    /// always uses the telemetry thread.
+    /// `auto` (default): `direct`, except in real time with `--record`, where `thread`: the
+    /// benchmark (`tools/benches/realtime.rs`) showed the recorder's threads making the physics
+    /// thread's own puts slow (about 100 puts over 100 µs per 30 000 frames instead of about
+    /// 20) and doubling the overruns, and recording must never slow the physics thread.
     #[default]
+    Auto,
+    /// `direct`: the thread that finishes the frame publishes it: the physics thread at the
+    /// boundary in real time (never waiting for the network), and in lockstep the Zenoh thread
+    /// that delivers the tick's last answer steps the frame and publishes it. Batch always uses
+    /// the telemetry thread.
     Direct,
     /// `thread`: the physics thread hands every frame to the telemetry thread, which publishes
     /// it (the design before `direct`; one more thread hop per frame).
@@ -58,8 +63,20 @@ impl Handoff {
     /// The setting's spelling.
     pub fn as_str(self) -> &'static str {
         match self {
+            Handoff::Auto => "auto",
             Handoff::Direct => "direct",
             Handoff::Thread => "thread",
+        }
+    }
+
+    /// Whether frames are published directly (not by the telemetry thread) in `mode`, with or
+    /// without a recording.
+    pub fn is_direct(self, mode: Mode, recording: bool) -> bool {
+        match self {
+            _ if mode == Mode::Batch => false,
+            Handoff::Auto => !(mode == Mode::RealTime && recording),
+            Handoff::Direct => true,
+            Handoff::Thread => false,
         }
     }
 }
@@ -138,7 +155,7 @@ pub struct ServerSettings {
     pub telemetry_buffers: usize,
     /// Capacity of the command queue from the I/O side to the physics thread (default 1024).
     pub command_queue: usize,
-    /// Which thread publishes the frames (default `direct`).
+    /// Which thread publishes the frames (default `auto`).
     pub handoff: Handoff,
     /// The authenticated Zenoh subject (usrpwd user name) each participant's sender id is bound
     /// to, e.g. `{ "1" = "fsw" }`. Empty (default): no binding. When set, every participant
@@ -171,7 +188,7 @@ impl Default for ServerSettings {
             realtime_priority: 0,
             telemetry_buffers: 8,
             command_queue: 1024,
-            handoff: Handoff::Direct,
+            handoff: Handoff::Auto,
             participant_subjects: std::collections::BTreeMap::new(),
             record: None,
         }
@@ -412,12 +429,13 @@ impl ServerSettings {
             "command_queue" => self.command_queue = set.int_in(1, 1 << 20)? as usize,
             "handoff" => {
                 self.handoff = match set.string()? {
+                    "auto" => Handoff::Auto,
                     "direct" => Handoff::Direct,
                     "thread" => Handoff::Thread,
                     other => {
                         return Err(set.bad(format!(
-                            "unknown handoff {other:?} (expected \"direct\" or \"thread\")"
-                        )))
+                        "unknown handoff {other:?} (expected \"auto\", \"direct\" or \"thread\")"
+                    )))
                     }
                 }
             }
@@ -559,6 +577,66 @@ impl ServerSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn handoff_parses_and_resolves_per_mode() {
+        let s = ServerSettings::from_table(&table("handoff = \"thread\"")).unwrap();
+        assert_eq!(s.handoff, Handoff::Thread);
+        assert_eq!(ServerSettings::default().handoff, Handoff::Auto);
+        let e = ServerSettings::from_table(&table("handoff = \"inline\"")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "server.handoff: unknown handoff \"inline\" (expected \"auto\", \"direct\" or \"thread\")"
+        );
+        use Mode::{Batch, Lockstep, RealTime};
+        // (handoff, mode, recording) -> direct?
+        for (h, mode, rec, want) in [
+            (Handoff::Auto, RealTime, false, true),
+            (Handoff::Auto, RealTime, true, false),
+            (Handoff::Auto, Lockstep, true, true),
+            (Handoff::Auto, Batch, false, false),
+            (Handoff::Direct, RealTime, true, true),
+            (Handoff::Direct, Batch, false, false),
+            (Handoff::Thread, Lockstep, false, false),
+        ] {
+            assert_eq!(h.is_direct(mode, rec), want, "{h:?} {mode:?} record={rec}");
+        }
+        let s = ServerSettings::from_table(&table(
+            "participants = [1, 2]\nparticipant_subjects = { \"1\" = \"fsw\", \"2\" = \"gnc\" }",
+        ))
+        .unwrap();
+        assert_eq!(
+            s.participant_subjects.get(&2).map(String::as_str),
+            Some("gnc")
+        );
+        s.validate().unwrap();
+        for (toml_text, want) in [
+            (
+                "participant_subjects = { \"01\" = \"fsw\" }",
+                "server.participant_subjects: \"01\" is not a sender id",
+            ),
+            (
+                "participant_subjects = { \"1\" = \"\" }",
+                "server.participant_subjects: sender 1: \"\" is not a Zenoh user name",
+            ),
+            (
+                "participant_subjects = [1]",
+                "server.participant_subjects: expected a table of sender id = subject",
+            ),
+        ] {
+            let e = ServerSettings::from_table(&table(toml_text)).unwrap_err();
+            assert!(e.to_string().starts_with(want), "{e}");
+        }
+        let partial = ServerSettings::from_table(&table(
+            "participants = [1, 2]\nparticipant_subjects = { \"1\" = \"fsw\" }",
+        ))
+        .unwrap();
+        assert!(partial
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("participant 2 has no subject"));
+    }
 
     fn table(s: &str) -> toml::Table {
         s.parse().unwrap()

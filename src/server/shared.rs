@@ -101,6 +101,9 @@ pub fn fill_state(
     }
 }
 
+/// \[ns\] a direct publication slower than this is counted as slow (a tenth of a 1 kHz frame).
+pub const SLOW_PUBLISH_NS: u64 = 100_000;
+
 /// Counters and flags shared by every thread of a run (atomics only, no locks).
 #[derive(Debug, Default)]
 pub struct Shared {
@@ -142,6 +145,8 @@ pub struct Shared {
     pub direct_publish_ns_total: AtomicU64,
     /// See [`Self::direct_publishes`].
     pub direct_publish_ns_max: AtomicU64,
+    /// Direct publications that took longer than [`SLOW_PUBLISH_NS`].
+    pub direct_publishes_slow: AtomicU64,
     /// `stale_tick` rejections per participant (sender id, count), in ascending id order, so
     /// the telemetry thread can name the sender in its warning (the physics thread only counts).
     pub stale_by_participant: Vec<(u32, AtomicU64)>,
@@ -201,6 +206,9 @@ impl Shared {
     /// Notes how long a publication on the physics thread took.
     pub fn note_direct_publish(&self, ns: u64) {
         self.direct_publishes.fetch_add(1, Ordering::Relaxed);
+        if ns > SLOW_PUBLISH_NS {
+            self.direct_publishes_slow.fetch_add(1, Ordering::Relaxed);
+        }
         self.direct_publish_ns_total
             .fetch_add(ns, Ordering::Relaxed);
         self.direct_publish_ns_max.fetch_max(ns, Ordering::Relaxed);

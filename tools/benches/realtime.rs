@@ -9,11 +9,13 @@
 //! 1. the one-way latency of a plain Zenoh hop: half the median round trip of a ping-pong of
 //!    StateMsg-sized samples against `flexdyn-pingpong pong` (a child process answering in its
 //!    callback), the peer of the telemetry latency;
-//! 2. the server with `handoff = "direct"` (the default: the physics thread publishes at the
+//! 2. the server with `handoff = "direct"` (the default `auto` without `--record`: the physics
+//!    thread publishes at the
 //!    boundary), `--record` off;
 //! 3. the server with `handoff = "thread"` (the previous design: a telemetry thread
 //!    publishes), `--record` off;
-//! 4. `handoff = "direct"` with `--record` on.
+//! 4. `handoff = "direct"` with `--record` on;
+//! 5. `handoff = "thread"` with `--record` on.
 //!
 //! It prints frame lateness p50/p99/max, overruns, dropped telemetry, command freshness, the
 //! telemetry latency p50/p99 and (direct) the time publishing took the physics thread, then
@@ -22,7 +24,7 @@
 //! recording changing the overruns beyond round-to-round noise.
 //!
 //! `cargo bench -p flexdyn-tools --bench realtime`; environment: `FLEXDYN_BENCH_RT_S`
-//! (default 30 s per run), `FLEXDYN_BENCH_RT_ROUNDS` (default 3, at most 10),
+//! (default 30 s per run), `FLEXDYN_BENCH_RT_ROUNDS` (default 3, at most 8),
 //! `FLEXDYN_BENCH_RT_PRIORITY` (the server's `realtime_priority`, default 0: normal
 //! scheduling; e.g. 50 puts the physics thread under SCHED_FIFO, which needs CAP_SYS_NICE).
 //! Ports 17450–17489.
@@ -55,6 +57,7 @@ struct Round {
     recorded: Option<(u64, u64)>,
     direct_publish_mean_us: f64,
     direct_publish_max_us: f64,
+    direct_publish_slow: u64,
 }
 
 /// \[µs\] half the median round trip of 5000 StateMsg-sized pings (after 500 unmeasured).
@@ -156,13 +159,13 @@ fn round(
     println!(
         "  controller: {fresh} frames with a fresh command, {flagged} flagged (no command yet or stale)"
     );
-    let (direct_mean, direct_max) = report
-        .direct_publish
-        .map_or((0.0, 0.0), |c| (c.mean_ns * 1e-3, c.max_ns as f64 * 1e-3));
+    let (direct_mean, direct_max, direct_slow) = report.direct_publish.map_or((0.0, 0.0, 0), |c| {
+        (c.mean_ns * 1e-3, c.max_ns as f64 * 1e-3, c.slow_frames)
+    });
     if report.direct_publish.is_some() {
         println!(
             "  publishing on the physics thread: mean {direct_mean:.1} us, max {direct_max:.1} us \
-             per frame"
+             per frame; {direct_slow} frames over 100 us"
         );
     }
     Round {
@@ -176,6 +179,7 @@ fn round(
         recorded: report.recording.map(|r| (r.stats.samples, r.dropped)),
         direct_publish_mean_us: direct_mean,
         direct_publish_max_us: direct_max,
+        direct_publish_slow: direct_slow,
     }
 }
 
@@ -193,7 +197,7 @@ fn main() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(3)
-        .clamp(1, 10);
+        .clamp(1, 8);
     let realtime_priority: u8 = std::env::var("FLEXDYN_BENCH_RT_PRIORITY")
         .ok()
         .map(|v| {
@@ -203,15 +207,16 @@ fn main() {
         .unwrap_or(0);
     println!(
         "real-time benchmark: 1 kHz, {seconds} s per run with the demo controller, {rounds} \
-         rounds of [ping-pong, handoff direct, handoff thread, direct + --record], 2-core machine"
+         rounds of [ping-pong, handoff direct, handoff thread, each again with --record], 2-core \
+         machine"
     );
     println!("physics thread realtime_priority = {realtime_priority} (0: normal scheduler)");
     let dir = std::env::temp_dir().join(format!("flexdyn-bench-rt-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let (mut one_way, mut direct, mut thread, mut on) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut one_way, mut direct, mut thread) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut on, mut thread_on) = (Vec::new(), Vec::new());
     for r in 0..rounds {
-        let port = 17450 + 4 * r as u16;
+        let port = 17450 + 5 * r as u16;
         let ow = one_way_us(port);
         println!(
             "round {}: one-way Zenoh hop (half the median ping-pong rtt): {ow:.1} us",
@@ -234,34 +239,34 @@ fn main() {
             Handoff::Thread,
             None,
         ));
-        let file = dir.join(format!("round{r}.mcap"));
-        println!(
-            "round {} handoff direct, --record on ({}):",
-            r + 1,
-            file.display()
-        );
-        let rec = round(
-            port + 3,
-            seconds,
-            realtime_priority,
-            Handoff::Direct,
-            Some(file.clone()),
-        );
-        if let Some((samples, dropped)) = rec.recorded {
-            let bytes = std::fs::metadata(&file).map_or(0, |m| m.len());
-            println!("  recorded {samples} samples, {dropped} dropped, file {bytes} bytes");
+        for (handoff, name, out, p) in [
+            (Handoff::Direct, "direct", &mut on, port + 3),
+            (Handoff::Thread, "thread", &mut thread_on, port + 4),
+        ] {
+            let file = dir.join(format!("round{r}-{name}.mcap"));
+            println!(
+                "round {} handoff {name}, --record on ({}):",
+                r + 1,
+                file.display()
+            );
+            let rec = round(p, seconds, realtime_priority, handoff, Some(file.clone()));
+            if let Some((samples, dropped)) = rec.recorded {
+                let bytes = std::fs::metadata(&file).map_or(0, |m| m.len());
+                println!("  recorded {samples} samples, {dropped} dropped, file {bytes} bytes");
+            }
+            out.push(rec);
         }
-        on.push(rec);
     }
     let _ = std::fs::remove_dir_all(&dir);
     let col = |v: &[Round], f: fn(&Round) -> f64| median(v.iter().map(f).collect());
     let ow = median(one_way.clone());
     println!("median one-way Zenoh hop over {rounds} rounds: {ow:.1} us");
     println!(
-        "medians over {rounds} rounds               direct      thread  direct+rec  direct/thread"
+        "medians over {rounds} rounds               direct      thread  direct+rec  thread+rec  \
+         direct/thread"
     );
     type Metric = fn(&Round) -> f64;
-    let rows: [(&str, Metric); 9] = [
+    let rows: [(&str, Metric); 10] = [
         ("frame lateness p50 (us)", |r| r.lateness_p50_us),
         ("frame lateness p99 (us)", |r| r.lateness_p99_us),
         ("frame lateness max (us)", |r| r.lateness_max_us),
@@ -275,15 +280,21 @@ fn main() {
         ("publish on physics thread max (us)", |r| {
             r.direct_publish_max_us
         }),
+        ("publishes over 100 us", |r| r.direct_publish_slow as f64),
     ];
     for (name, f) in rows {
-        let (a, b, c) = (col(&direct, f), col(&thread, f), col(&on, f));
+        let (a, b, c, d) = (
+            col(&direct, f),
+            col(&thread, f),
+            col(&on, f),
+            col(&thread_on, f),
+        );
         let ratio = if b > 0.0 {
             format!("{:.2}", a / b)
         } else {
             "-".into()
         };
-        println!("{name:<36} {a:>11.1} {b:>11.1} {c:>11.1} {ratio:>14}");
+        println!("{name:<36} {a:>11.1} {b:>11.1} {c:>11.1} {d:>11.1} {ratio:>14}");
     }
     let lat: Vec<f64> = direct
         .iter()
@@ -301,6 +312,11 @@ fn main() {
         median(lat),
         median(lat_t)
     );
-    let dropped: u64 = on.iter().filter_map(|r| r.recorded).map(|(_, d)| d).sum();
+    let dropped: u64 = on
+        .iter()
+        .chain(&thread_on)
+        .filter_map(|r| r.recorded)
+        .map(|(_, d)| d)
+        .sum();
     println!("recorder drops over all rounds: {dropped}");
 }

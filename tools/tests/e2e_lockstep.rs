@@ -232,7 +232,9 @@ fn lockstep_converges_and_is_bit_identical_across_runs_and_pauses() {
     );
 
     // The previous design (physics thread + telemetry thread) gives the same stream.
-    assert_eq!(ServerSettings::default().handoff, Handoff::Direct);
+    assert!(ServerSettings::default()
+        .handoff
+        .is_direct(Mode::Lockstep, false));
     let d = lockstep_run_settings(
         17309,
         ServerSettings {

@@ -86,6 +86,7 @@ fn rejected_by_reason(r: &flexdyn_proto::RejectCounters) -> String {
         ("stale_tick", r.stale_tick),
         ("unknown_sender", r.unknown_sender),
         ("bad_effector_input", r.bad_effector_input),
+        ("wrong_identity", r.wrong_identity),
     ]
     .iter()
     .filter(|(_, n)| *n > 0)
@@ -472,6 +473,18 @@ fn run_tui(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rejections_name_every_nonzero_reason() {
+        let none = flexdyn_proto::RejectCounters::default();
+        assert_eq!(rejected_by_reason(&none), "0");
+        let some = flexdyn_proto::RejectCounters {
+            malformed: 2,
+            wrong_identity: 7,
+            ..none
+        };
+        assert_eq!(rejected_by_reason(&some), "malformed:2,wrong_identity:7");
+    }
 
     #[test]
     fn wheel_summary_marks_the_limits() {
