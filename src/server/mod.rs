@@ -12,19 +12,29 @@
 //! - [`commands`]: per-participant command book (lockstep answers, staleness, summation).
 //! - [`pacing`]: absolute-deadline real-time pacing (sleep, then spin) and overrun policies.
 //! - [`physics`]: the physics thread's frame loop.
-//! - [`telemetry`]: the I/O thread that publishes state and status.
+//! - [`telemetry`]: the I/O thread that publishes status (and, with `handoff = "thread"`, the
+//!   frames) and keeps the books.
 //! - [`shared`]: lock-free counters and the preallocated telemetry buffers.
 //! - [`error`]: typed errors.
 //! - [`cli`]: `flexdyn run` arguments and the process-level wrapper (runtime, signals).
+//! - [`lockstep`]: lockstep stepped on the Zenoh thread that delivers a tick's last answer.
+//! - [`publish`]: the frame publishers (who calls them is the `handoff` setting).
+//! - [`access`]: the start-up check that the Zenoh ACL binds participants to subjects.
 //!
 //! # Threads
+//! With `handoff = "thread"` (and in batch):
 //! ```text
 //!  zenoh rx (callback) --CommandMsg, bounded--> physics thread --Frame, bounded--> telemetry thread --> zenoh
 //!                                               ^                                      |
 //!                                               +------------ free Frame pool ---------+
 //! ```
-//! The physics thread never allocates, locks or touches the network; in real time it never
-//! blocks on the I/O side (a frame without a free buffer loses its telemetry, counted).
+//! With `handoff = "direct"` in real time the physics thread puts each frame itself at its
+//! boundary (`CongestionControl::Drop`) and the frame then goes the same way for the books; in
+//! lockstep the callback steps the [`lockstep::LockstepCore`] and publishes, and the telemetry
+//! thread only publishes StatusMsg. `auto` (default) is `direct` except in real time with
+//! `--record`. The per-frame work ([`physics::Stepper`]) never allocates, locks or touches the
+//! network; in real time the physics thread never blocks on the I/O side (a frame without a
+//! free buffer loses its telemetry, counted).
 
 pub mod access;
 pub mod cli;
