@@ -12,7 +12,10 @@
 //! subject, a message is denied if any of its deny rules' key expressions includes the key;
 //! otherwise, with `default_permission: "deny"`, it is allowed only if one of its allow rules
 //! includes it. A subject that matches peers by anything other than a user name (interfaces,
-//! link protocols, …) could be any user, so it may not hold a command key.
+//! link protocols, …) could be any user, so it may not hold a command key. The same holds for
+//! the participant's lockstep liveliness token `flexdyn/<sc>/participant/<id>`: another user
+//! allowed to declare it could fake the participant's presence, and in lockstep the bound user
+//! must be allowed to.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -59,11 +62,12 @@ fn includes(rule_key: &str, key: &KeyExpr<'_>) -> Result<bool, SettingsError> {
     Ok(rule.includes(key))
 }
 
-/// Whether the rules `rule_ids` let a message `put`, flowing `ingress`, on `key`: deny wins,
-/// then any allow (the default permission being deny).
-fn may_put(
+/// Whether the rules `rule_ids` let a `message` (`put`, `liveliness_token`), flowing `ingress`,
+/// on `key`: deny wins, then any allow (the default permission being deny).
+fn may(
     rules: &[Value],
     rule_ids: &BTreeSet<String>,
+    message: &str,
     key: &KeyExpr<'_>,
 ) -> Result<bool, SettingsError> {
     let mut allowed = false;
@@ -77,7 +81,7 @@ fn may_put(
         let messages = strings(rule, "messages");
         // Zenoh applies a rule without `flows` to both directions.
         let flows = strings(rule, "flows");
-        if !messages.iter().any(|m| m == "put")
+        if !messages.iter().any(|m| m == message)
             || !(flows.is_empty() || flows.iter().any(|f| f == "ingress"))
         {
             continue;
@@ -157,43 +161,65 @@ pub fn check(config: &zenoh::Config, settings: &ServerSettings) -> Result<(), Se
     };
     let (rules, subjects, policies) = (list("rules"), list("subjects"), list("policies"));
     let topics = Topics::new(&settings.sc_id).map_err(|e| bad(e.to_string()))?;
+    let lockstep = settings.mode == flexdyn_proto::Mode::Lockstep;
     for (&sender, user) in &settings.participant_subjects {
-        let key_text = topics.cmd(sender);
-        let key = KeyExpr::try_from(key_text.as_str()).map_err(|e| bad(e.to_string()))?;
-        let mut owner_may_put = false;
-        for subject in &subjects {
-            let Some(subject_id) = subject.get("id").and_then(Value::as_str) else {
-                continue;
-            };
-            let rule_ids: BTreeSet<String> = policies
-                .iter()
-                .filter(|p| strings(p, "subjects").iter().any(|s| s == subject_id))
-                .flat_map(|p| strings(p, "rules"))
-                .collect();
-            if !may_put(&rules, &rule_ids, &key)? {
-                continue;
+        // The command key, and the lockstep liveliness token (whoever may declare it can make
+        // the server believe participant `sender` is present).
+        let checks = [
+            (
+                "put",
+                topics.cmd(sender),
+                "put on",
+                "command key",
+                "commands would never arrive",
+                true,
+            ),
+            (
+                "liveliness_token",
+                topics.participant(sender),
+                "declare",
+                "lockstep liveliness token",
+                "presence would never be seen and lockstep would not start",
+                lockstep,
+            ),
+        ];
+        for (message, key_text, verb, what, consequence, owner_needed) in checks {
+            let key = KeyExpr::try_from(key_text.as_str()).map_err(|e| bad(e.to_string()))?;
+            let mut owner_may = false;
+            for subject in &subjects {
+                let Some(subject_id) = subject.get("id").and_then(Value::as_str) else {
+                    continue;
+                };
+                let rule_ids: BTreeSet<String> = policies
+                    .iter()
+                    .filter(|p| strings(p, "subjects").iter().any(|s| s == subject_id))
+                    .flat_map(|p| strings(p, "rules"))
+                    .collect();
+                if !may(&rules, &rule_ids, message, &key)? {
+                    continue;
+                }
+                let usernames = strings(subject, "usernames");
+                if usernames.is_empty() {
+                    return Err(bad(format!(
+                        "access_control subject `{subject_id}` may {verb} `{key_text}` but \
+                         names no user (usernames), so any authenticated peer matching it \
+                         could act as participant {sender}; only `{user}` may"
+                    )));
+                }
+                if let Some(other) = usernames.iter().find(|u| *u != user) {
+                    return Err(bad(format!(
+                        "access_control lets user `{other}` (subject `{subject_id}`) {verb} \
+                         `{key_text}`, participant {sender}'s {what}; only `{user}` may"
+                    )));
+                }
+                owner_may = true;
             }
-            let usernames = strings(subject, "usernames");
-            if usernames.is_empty() {
+            if owner_needed && !owner_may {
                 return Err(bad(format!(
-                    "access_control subject `{subject_id}` may put on `{key_text}` but names no \
-                     user (usernames), so any authenticated peer matching it could command as \
-                     participant {sender}; only `{user}` may"
+                    "access_control does not let `{user}` {verb} `{key_text}`: participant \
+                     {sender}'s {consequence}"
                 )));
             }
-            if let Some(other) = usernames.iter().find(|u| *u != user) {
-                return Err(bad(format!(
-                    "access_control lets user `{other}` (subject `{subject_id}`) put on \
-                     `{key_text}`, participant {sender}'s command key; only `{user}` may"
-                )));
-            }
-            owner_may_put = true;
-        }
-        if !owner_may_put {
-            return Err(bad(format!(
-                "access_control does not let `{user}` put on `{key_text}`: participant \
-                 {sender}'s commands would never arrive"
-            )));
         }
     }
     Ok(())
@@ -321,6 +347,50 @@ mod tests {
             p.contains("does not let `fsw` put on `flexdyn/sc1/cmd/1`"),
             "{p}"
         );
+
+        // Liveliness tokens: GOOD grants none. Real time does not need them; lockstep does.
+        let lockstep = ServerSettings {
+            mode: flexdyn_proto::Mode::Lockstep,
+            ..s.clone()
+        };
+        let p = problem(check(&config(&dict, GOOD), &lockstep));
+        assert!(
+            p.contains("does not let `fsw` declare `flexdyn/sc1/participant/1`"),
+            "{p}"
+        );
+        let tokens = GOOD.replace(
+            "rules: [\n",
+            "rules: [\n          { id: \"tokens\", messages: [\"liveliness_token\"], \
+             flows: [\"ingress\"], permission: \"allow\", key_exprs: [\"flexdyn/sc1/participant/*\"] },\n",
+        );
+        // Everyone may declare every token: gnc could fake participant 1's presence.
+        let shared_tokens = tokens.replace(
+            "{ rules: [\"tlm\"], subjects: [\"anyone\"] }",
+            "{ rules: [\"tlm\", \"tokens\"], subjects: [\"anyone\"] }",
+        );
+        let p = problem(check(&config(&dict, &shared_tokens), &lockstep));
+        assert!(
+            p.contains("lets user `gnc` (subject `anyone`) declare `flexdyn/sc1/participant/1`"),
+            "{p}"
+        );
+        // Each participant its own token: accepted.
+        let own_tokens = GOOD
+            .replace(
+                "{ id: \"tlm\",",
+                "{ id: \"fsw-token\", messages: [\"liveliness_token\"], permission: \"allow\", \
+                 key_exprs: [\"flexdyn/sc1/participant/1\"] },\n          \
+                 { id: \"gnc-token\", messages: [\"liveliness_token\"], permission: \"allow\", \
+                 key_exprs: [\"flexdyn/sc1/participant/2\"] },\n          { id: \"tlm\",",
+            )
+            .replace(
+                "rules: [\"fsw-cmd\"]",
+                "rules: [\"fsw-cmd\", \"fsw-token\"]",
+            )
+            .replace(
+                "rules: [\"gnc-cmd\"]",
+                "rules: [\"gnc-cmd\", \"gnc-token\"]",
+            );
+        check(&config(&dict, &own_tokens), &lockstep).unwrap();
         std::fs::remove_dir_all(&dir).ok();
     }
 }
