@@ -1,6 +1,5 @@
 //! Lockstep with `server.handoff = "direct"` (what the default `auto` gives in lockstep): the
-//! frame is stepped on the thread
-//! that delivers its last answer.
+//! frame is stepped on the thread that delivers its last answer.
 //!
 //! A lockstep tick is a round trip: the server publishes the state of tick `k`, every
 //! participant answers it, and only then is frame `k → k + 1` computed. With a separate physics
@@ -30,7 +29,7 @@ use flexdyn_proto::{CommandMsg, RunState};
 use tokio::sync::Notify;
 
 use super::error::ServerError;
-use super::physics::{count_offer, Stepper};
+use super::physics::{count_offer, Ending, PhysicsReport, Stepper};
 use super::publish::{FramePublisher, Recording};
 use super::shared::{Frame, Shared};
 
@@ -57,7 +56,6 @@ pub struct LockstepCore {
     record: Option<Recording>,
     shared: Arc<Shared>,
     k: u64,
-    frame_ns: u64,
     total_frames: Option<u64>,
     phase: Phase,
     tick_published_at: Instant,
@@ -75,7 +73,6 @@ impl LockstepCore {
         total_frames: Option<u64>,
         events: Arc<Notify>,
     ) -> Self {
-        let frame_ns = w.sim.frame_ns();
         let mut core = Self {
             w,
             frame,
@@ -83,7 +80,6 @@ impl LockstepCore {
             record,
             shared,
             k: 0,
-            frame_ns,
             total_frames,
             phase: Phase::Waiting,
             tick_published_at: Instant::now(),
@@ -159,11 +155,6 @@ impl LockstepCore {
         self.events.notify_one();
     }
 
-    /// The notification sent when the run ends.
-    pub fn events(&self) -> Arc<Notify> {
-        self.events.clone()
-    }
-
     /// Whether the run has ended (finished, stopped or failed).
     pub fn ended(&self) -> bool {
         !matches!(self.phase, Phase::Waiting | Phase::Running)
@@ -189,13 +180,17 @@ impl LockstepCore {
     }
 
     /// The outcome once [`Self::ended`]: the last tick published and its simulation time, or
-    /// the failure (taken: a second call reports it as an internal error).
-    pub fn outcome(&mut self) -> Result<(super::physics::Ending, u64, u64), ServerError> {
-        let last = (self.k, self.k.saturating_mul(self.frame_ns));
+    /// the failure. The failure is taken out: a second call reports the run as stopped.
+    pub fn outcome(&mut self) -> Result<PhysicsReport, ServerError> {
+        let report = |ending| PhysicsReport {
+            ending,
+            last_tick: self.k,
+            sim_time_ns: self.k.saturating_mul(self.w.sim.frame_ns()),
+        };
         match std::mem::replace(&mut self.phase, Phase::Stopped) {
-            Phase::Finished => Ok((super::physics::Ending::Finished, last.0, last.1)),
+            Phase::Finished => Ok(report(Ending::Finished)),
             Phase::Failed(e) => Err(e),
-            _ => Ok((super::physics::Ending::Stopped, last.0, last.1)),
+            _ => Ok(report(Ending::Stopped)),
         }
     }
 }

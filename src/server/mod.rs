@@ -196,6 +196,13 @@ impl Presence {
     }
 }
 
+/// Who steps the frames: the physics thread (with the frame publishers when it publishes
+/// itself), or the lockstep core in the command callback.
+enum FrameLoop {
+    Physics(Box<Stepper>, Option<FramePublisher>),
+    Core(Arc<Mutex<LockstepCore>>),
+}
+
 /// Where the command callback delivers a validated command.
 enum CommandSink {
     /// The physics thread's bounded queue (never blocks: a full queue drops and counts).
@@ -483,10 +490,7 @@ pub async fn run(
     };
     let record_tx = recorder.as_ref().map(|(_, tx)| tx.clone());
     // The recorder's view of the keys, for the telemetry thread and (lockstep, direct) the core.
-    let telemetry_record = record_tx
-        .clone()
-        .map(|tx| publisher.recording(tx, &status_pub));
-    let core_record = record_tx
+    let recording = record_tx
         .clone()
         .map(|tx| publisher.recording(tx, &status_pub));
 
@@ -514,36 +518,39 @@ pub async fn run(
     let shape = crate::sim::Snapshot::for_simulation(&sim);
     let (n_imus, n_sts) = (sim.n_imus(), sim.star_trackers().len());
     let new_frame = || Box::new(Frame::for_snapshot(&shape, n_imus, n_sts));
-    for _ in 0..n_buffers {
-        free_tx
-            .send(new_frame())
-            .map_err(|_| ServerError::Internal("telemetry pool".into()))?;
-    }
     let frame_ns = cfg.frame_ns;
     let stepper = Stepper::new(sim, &settings);
 
-    // The frame publishers go to the physics thread (real time, direct), the lockstep core
-    // (lockstep, direct) or the telemetry thread (otherwise).
+    // Who steps the frames, and where the frame publishers go: the physics thread (real time,
+    // direct), the lockstep core (lockstep, direct) or the telemetry thread (otherwise).
     let events = Arc::new(Notify::new());
-    let (physics_parts, core, telemetry_publisher) = match (direct, mode) {
+    let (frame_loop, telemetry_publisher) = match (direct, mode) {
         (true, Mode::Lockstep) => {
             let core = LockstepCore::new(
                 stepper,
                 new_frame(),
                 publisher,
-                core_record,
+                recording.clone(),
                 shared.clone(),
                 total_frames,
                 events.clone(),
             );
-            (None, Some(Arc::new(Mutex::new(core))), None)
+            (FrameLoop::Core(Arc::new(Mutex::new(core))), None)
         }
-        (true, _) => (Some((stepper, Some(publisher))), None, None),
-        (false, _) => (Some((stepper, None)), None, Some(publisher)),
+        (true, _) => (FrameLoop::Physics(Box::new(stepper), Some(publisher)), None),
+        (false, _) => (FrameLoop::Physics(Box::new(stepper), None), Some(publisher)),
     };
-    let sink = match &core {
-        Some(core) => CommandSink::Core(core.clone()),
-        None => CommandSink::Queue(Mutex::new(cmd_tx)),
+    let sink = match &frame_loop {
+        FrameLoop::Core(core) => CommandSink::Core(core.clone()),
+        FrameLoop::Physics(..) => {
+            // The telemetry pool, which only the physics thread's frames go through.
+            for _ in 0..n_buffers {
+                free_tx
+                    .send(new_frame())
+                    .map_err(|_| ServerError::Internal("telemetry pool".into()))?;
+            }
+            CommandSink::Queue(Mutex::new(cmd_tx))
+        }
     };
 
     let _cmd_sub = session
@@ -614,7 +621,7 @@ pub async fn run(
         shared: shared.clone(),
         settings: settings.clone(),
         frame_ns,
-        record: telemetry_record,
+        record: recording,
     };
     let (tlm_done_tx, tlm_done_rx) = oneshot::channel();
     std::thread::Builder::new()
@@ -659,11 +666,9 @@ pub async fn run(
     }
 
     let started = Instant::now();
-    let physics_result = match (physics_parts, core) {
-        (Some((stepper, direct)), _) => {
+    let physics_result = match frame_loop {
+        FrameLoop::Physics(stepper, direct) => {
             let physics = PhysicsCtx {
-                stepper: Some(stepper),
-                sim_frame_ns: frame_ns,
                 settings: settings.clone(),
                 total_frames,
                 cmd_rx,
@@ -673,16 +678,15 @@ pub async fn run(
                 shared: shared.clone(),
                 direct,
             };
-            run_physics_thread(physics, &settings, &shared, shutdown.as_mut()).await?
+            run_physics_thread(physics, *stepper, &settings, &shared, shutdown.as_mut()).await?
         }
-        (None, Some(core)) => {
+        FrameLoop::Core(core) => {
             drop((cmd_rx, recycle_tx, free_rx));
-            let r = run_lockstep_core(&core, &settings, &shared, shutdown.as_mut()).await;
+            let r = run_lockstep_core(&core, &events, &settings, &shared, shutdown.as_mut()).await;
             // No frame goes through the channel; closing it ends the telemetry thread.
             drop(full_tx);
             r
         }
-        (None, None) => return Err(ServerError::Internal("no frame loop".into())),
     };
     let wall_s = started.elapsed().as_secs_f64();
     let tlm = tlm_done_rx
@@ -747,6 +751,7 @@ pub async fn run(
 /// Runs the physics thread to its end (or a stop request); `Err` only if it panicked.
 async fn run_physics_thread(
     physics: PhysicsCtx,
+    stepper: Stepper,
     settings: &ServerSettings,
     shared: &Arc<Shared>,
     mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
@@ -767,7 +772,7 @@ async fn run_physics_thread(
                     ),
                 }
             }
-            let _ = phys_done_tx.send(physics.run());
+            let _ = phys_done_tx.send(physics.run(stepper));
         })
         .map_err(|e| ServerError::Internal(format!("cannot start the physics thread: {e}")))?;
 
@@ -787,16 +792,13 @@ async fn run_physics_thread(
 /// end, checking the participant timeout every 50 ms; a stop request ends it at once.
 async fn run_lockstep_core(
     core: &Arc<Mutex<LockstepCore>>,
+    events: &Notify,
     settings: &ServerSettings,
     shared: &Arc<Shared>,
     mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
 ) -> Result<physics::PhysicsReport, ServerError> {
     let lock = || core.lock().unwrap_or_else(|p| p.into_inner());
-    let events = {
-        let mut c = lock();
-        c.start();
-        c.events()
-    };
+    lock().start();
     loop {
         if lock().ended() {
             break;
@@ -814,12 +816,7 @@ async fn run_lockstep_core(
             }
         }
     }
-    let (ending, last_tick, sim_time_ns) = lock().outcome()?;
-    Ok(physics::PhysicsReport {
-        ending,
-        last_tick,
-        sim_time_ns,
-    })
+    lock().outcome()
 }
 
 /// Puts the calling thread under SCHED_FIFO at `priority` (1–99); the error says why the OS

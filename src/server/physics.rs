@@ -65,12 +65,8 @@ pub struct PhysicsReport {
     pub sim_time_ns: u64,
 }
 
-/// Everything the physics thread owns.
+/// Everything the physics thread owns besides the [`Stepper`] it runs.
 pub struct PhysicsCtx {
-    /// The simulation at t = 0 and its command book (taken by the loop).
-    pub stepper: Option<Stepper>,
-    /// \[ns\] frame period.
-    pub sim_frame_ns: u64,
     /// Server settings.
     pub settings: ServerSettings,
     /// Frames to run (`None`: until stopped).
@@ -205,9 +201,9 @@ enum Wait {
 }
 
 impl PhysicsCtx {
-    /// Runs the loop to its end; sets the shared run state accordingly.
-    pub fn run(mut self) -> Result<PhysicsReport, ServerError> {
-        let result = self.frame_loop();
+    /// Runs the loop over `w` to its end; sets the shared run state accordingly.
+    pub fn run(mut self, w: Stepper) -> Result<PhysicsReport, ServerError> {
+        let result = self.frame_loop(w);
         self.shared.set_run_state(match &result {
             Ok(r) if r.ending == Ending::Finished => RunState::Finished,
             Ok(_) => RunState::Stopped,
@@ -284,14 +280,10 @@ impl PhysicsCtx {
         Ok(Wait::Done)
     }
 
-    fn frame_loop(&mut self) -> Result<PhysicsReport, ServerError> {
+    fn frame_loop(&mut self, mut w: Stepper) -> Result<PhysicsReport, ServerError> {
         let mode = self.settings.mode;
         let realtime = mode == Mode::RealTime;
-        let frame_ns = self.sim_frame_ns;
-        let mut w = self
-            .stepper
-            .take()
-            .ok_or_else(|| ServerError::Internal("the physics loop ran twice".into()))?;
+        let frame_ns = w.sim.frame_ns();
         // A stop reports the last boundary reached (the tick the last StateMsg and StatusMsg
         // carry), not a tick that was stepped to but never published.
         let stopped = |shared: &Shared| {

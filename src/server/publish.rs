@@ -25,7 +25,44 @@ use zenoh::Wait;
 use super::shared::{Frame, Shared};
 use crate::sinks::recorder::{RecordItem, RecordTx};
 
+/// Which sensor a payload comes from: its index among the IMUs or the star trackers (config
+/// order).
+#[derive(Clone, Copy)]
+enum Sensor {
+    Imu(usize),
+    StarTracker(usize),
+}
+
+/// Encodes each sensor sample of `frame` into `buf`, in publication order (the IMUs, then the
+/// star trackers due at its tick), and hands it to `each`. `st_every` gives a tracker's update
+/// period in frames (`None`: no such tracker, skipped); a tracker's `seq` counts its messages,
+/// +1 per update.
+fn for_each_sensor_payload(
+    frame: &Frame,
+    st_every: impl Fn(usize) -> Option<u64>,
+    buf: &mut Vec<u8>,
+    mut each: impl FnMut(Sensor, &[u8]),
+) {
+    let header = frame.state.header;
+    for (i, sample) in frame.imu.iter().enumerate() {
+        encode_into(&sample.to_msg(header), buf);
+        each(Sensor::Imu(i), buf);
+    }
+    for (i, sample) in &frame.star_trackers {
+        let Some(every) = st_every(*i) else {
+            continue;
+        };
+        let h = flexdyn_proto::Header {
+            seq: header.tick / every,
+            ..header
+        };
+        encode_into(&sample.to_msg(h), buf);
+        each(Sensor::StarTracker(*i), buf);
+    }
+}
+
 /// The recorder's queue and the keys it files payloads under.
+#[derive(Clone)]
 pub struct Recording {
     tx: RecordTx,
     state: Arc<str>,
@@ -37,26 +74,24 @@ pub struct Recording {
 }
 
 impl Recording {
+    /// The key a sensor's payloads are filed under (`None`: no such sensor).
+    fn sensor_key(&self, sensor: Sensor) -> Option<&Arc<str>> {
+        match sensor {
+            Sensor::Imu(i) => self.imus.get(i),
+            Sensor::StarTracker(i) => self.sts.get(i),
+        }
+    }
+
     /// Queues an already published `frame` (real time, `handoff = "direct"`: the physics thread
     /// published it; the telemetry thread encodes it again for the file, in `buf`).
     pub fn record_frame(&self, frame: &Frame, buf: &mut Vec<u8>) {
-        let header = frame.state.header;
         let stamp = Some(frame.boundary_unix_ns);
-        for (sample, key) in frame.imu.iter().zip(&self.imus) {
-            encode_into(&sample.to_msg(header), buf);
-            self.submit(key, buf, stamp);
-        }
-        for (i, sample) in &frame.star_trackers {
-            let (Some(every), Some(key)) = (self.st_every.get(*i), self.sts.get(*i)) else {
-                continue;
-            };
-            let h = flexdyn_proto::Header {
-                seq: header.tick / every,
-                ..header
-            };
-            encode_into(&sample.to_msg(h), buf);
-            self.submit(key, buf, stamp);
-        }
+        let st_every = |i: usize| self.st_every.get(i).copied();
+        for_each_sensor_payload(frame, st_every, buf, |sensor, payload| {
+            if let Some(key) = self.sensor_key(sensor) {
+                self.submit(key, payload, stamp);
+            }
+        });
         encode_into(&frame.state, buf);
         self.submit(&self.state, buf, stamp);
     }
@@ -125,41 +160,23 @@ impl FramePublisher {
     /// `shared.publish_errors`, and notes the frame's command bookkeeping.
     pub fn publish(&mut self, frame: &Frame, shared: &Shared, rec: Option<&Recording>) {
         let stamp = frame.boundary_unix_ns.to_le_bytes();
-        let header = frame.state.header;
-        for (i, (sample, publisher)) in frame.imu.iter().zip(&self.imu_pubs).enumerate() {
-            encode_into(&sample.to_msg(header), &mut self.sensor_buf);
-            if let Some(r) = rec {
-                r.submit(&r.imus[i], &self.sensor_buf, Some(frame.boundary_unix_ns));
-            }
-            if let Err(e) = publisher
-                .put(self.sensor_buf.as_slice())
-                .attachment(stamp)
-                .wait()
-            {
-                Self::count_error(shared, "an IMU sample", &e);
-            }
-        }
-        for (i, sample) in &frame.star_trackers {
-            let Some((publisher, every)) = self.st_pubs.get(*i) else {
-                continue;
+        let (imu_pubs, st_pubs) = (&self.imu_pubs, &self.st_pubs);
+        let st_every = |i: usize| st_pubs.get(i).map(|(_, every)| *every);
+        for_each_sensor_payload(frame, st_every, &mut self.sensor_buf, |sensor, payload| {
+            let (publisher, what) = match sensor {
+                Sensor::Imu(i) => (imu_pubs.get(i), "an IMU sample"),
+                Sensor::StarTracker(i) => (st_pubs.get(i).map(|(p, _)| p), "a star-tracker sample"),
             };
-            // seq counts this tracker's messages: +1 per update.
-            let h = flexdyn_proto::Header {
-                seq: header.tick / every,
-                ..header
+            let Some(publisher) = publisher else {
+                return;
             };
-            encode_into(&sample.to_msg(h), &mut self.sensor_buf);
-            if let Some(r) = rec {
-                r.submit(&r.sts[*i], &self.sensor_buf, Some(frame.boundary_unix_ns));
+            if let Some((r, key)) = rec.and_then(|r| Some((r, r.sensor_key(sensor)?))) {
+                r.submit(key, payload, Some(frame.boundary_unix_ns));
             }
-            if let Err(e) = publisher
-                .put(self.sensor_buf.as_slice())
-                .attachment(stamp)
-                .wait()
-            {
-                Self::count_error(shared, "a star-tracker sample", &e);
+            if let Err(e) = publisher.put(payload).attachment(stamp).wait() {
+                Self::count_error(shared, what, &e);
             }
-        }
+        });
         encode_into(&frame.state, &mut self.state_buf);
         shared.set_last_command(&frame.command);
         match self

@@ -27,9 +27,8 @@ use std::time::{Duration, Instant};
 
 use flexdyn::server::{Handoff, ServerSettings};
 use flexdyn::sim::Simulation;
-use flexdyn_proto::{Mode, Topics, EFFECTOR_STATE_FIXED_LEN, STATE_FIXED_LEN};
-use flexdyn_tools::pingpong;
-use support::{endpoint, listening_session, reference_config, ChildGuard, ServerHandle};
+use flexdyn_proto::Mode;
+use support::{endpoint, pingpong_rtts, reference_config, ChildGuard, ServerHandle};
 
 fn env_usize(name: &str, default: usize) -> usize {
     std::env::var(name)
@@ -46,24 +45,7 @@ fn median(v: &mut [f64]) -> f64 {
 /// Round trips per second of `ticks` ping-pongs; the pong answers inside its Zenoh callback, or
 /// from a receive loop (`recv_loop`, the demo controller's structure).
 fn pingpong_rate(port: u16, ticks: usize, recv_loop: bool) -> f64 {
-    let topics = Topics::new("bench").unwrap();
-    let session = listening_session(port);
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_flexdyn-pingpong"));
-    cmd.args(["--connect", &endpoint(port), "--sc-id", "bench"])
-        .args(["pong", "--duration-s", "300"]);
-    if recv_loop {
-        cmd.arg("--recv-loop");
-    }
-    let _pong = ChildGuard::spawn(&mut cmd);
-    let rtts = pingpong::ping(
-        &session,
-        &topics,
-        STATE_FIXED_LEN + 2 * (EFFECTOR_STATE_FIXED_LEN + 32),
-        1000,
-        ticks,
-        Duration::from_secs(30),
-    )
-    .expect("ping-pong");
+    let rtts = pingpong_rtts(port, 1000, ticks, recv_loop);
     let total: Duration = rtts.iter().sum();
     ticks as f64 / total.as_secs_f64()
 }

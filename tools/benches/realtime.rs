@@ -38,10 +38,10 @@ use std::time::Duration;
 
 use flexdyn::server::{frame_stamp_ns, Handoff, ServerSettings};
 use flexdyn::transport::unix_now_ns;
-use flexdyn_proto::{decode_state, Topics, EFFECTOR_STATE_FIXED_LEN, STATE_FIXED_LEN};
-use flexdyn_tools::{percentile, pingpong};
+use flexdyn_proto::{decode_state, Topics};
+use flexdyn_tools::percentile;
 use support::{
-    connecting_session, endpoint, listening_session, reference_config, ChildGuard, ServerHandle,
+    connecting_session, endpoint, pingpong_rtts, reference_config, ChildGuard, ServerHandle,
 };
 use zenoh::Wait;
 
@@ -62,22 +62,7 @@ struct Round {
 
 /// \[µs\] half the median round trip of 5000 StateMsg-sized pings (after 500 unmeasured).
 fn one_way_us(port: u16) -> f64 {
-    let topics = Topics::new("bench").unwrap();
-    let session = listening_session(port);
-    let _pong = ChildGuard::spawn(
-        Command::new(env!("CARGO_BIN_EXE_flexdyn-pingpong"))
-            .args(["--connect", &endpoint(port), "--sc-id", "bench"])
-            .args(["pong", "--duration-s", "300"]),
-    );
-    let mut rtts = pingpong::ping(
-        &session,
-        &topics,
-        STATE_FIXED_LEN + 2 * (EFFECTOR_STATE_FIXED_LEN + 32),
-        500,
-        5000,
-        Duration::from_secs(30),
-    )
-    .expect("ping-pong");
+    let mut rtts = pingpong_rtts(port, 500, 5000, false);
     rtts.sort_unstable();
     rtts[rtts.len() / 2].as_secs_f64() * 1e6 / 2.0
 }

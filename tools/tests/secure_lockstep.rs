@@ -41,8 +41,9 @@ fn scenario(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../scenarios/zenoh/{name}"))
 }
 
-/// A session built like every flexdyn session, from `file` (if any), listening or connecting.
-fn session(port: u16, role: Role, file: Option<PathBuf>) -> Session {
+/// A Zenoh configuration built like every flexdyn session's, from `file` (if any), listening
+/// or connecting on `port`.
+fn config(port: u16, role: Role, file: Option<PathBuf>) -> zenoh::Config {
     let ep = vec![endpoint(port)];
     let args = ZenohArgs {
         listen: if role == Role::Server {
@@ -53,9 +54,15 @@ fn session(port: u16, role: Role, file: Option<PathBuf>) -> Session {
         connect: if role == Role::Tool { ep } else { vec![] },
         zenoh_config: file,
     };
-    zenoh::open(zenoh_config(&args, role).unwrap())
-        .wait()
-        .unwrap()
+    zenoh_config(&args, role).unwrap()
+}
+
+fn session(port: u16, role: Role, file: Option<PathBuf>) -> Session {
+    open(config(port, role, file))
+}
+
+fn open(config: zenoh::Config) -> Session {
+    zenoh::open(config).wait().unwrap()
 }
 
 fn settings(participants: &[(u32, &str)], secure: bool) -> ServerSettings {
@@ -171,20 +178,11 @@ fn only_the_authenticated_flight_code_commands_the_spacecraft() {
     let port = 17731;
     let topics = Topics::new("sc1").unwrap();
     let server_file = scenario("secure-server.json5");
-    let server_session = session(port, Role::Server, Some(server_file.clone()));
     let s = settings(&[(1, "fsw")], true);
     // The server's own start-up check (as `flexdyn run` makes it) accepts the shipped files.
-    let zcfg = zenoh_config(
-        &ZenohArgs {
-            listen: vec![endpoint(port)],
-            connect: vec![],
-            zenoh_config: Some(server_file),
-        },
-        Role::Server,
-    )
-    .unwrap();
+    let zcfg = config(port, Role::Server, Some(server_file));
     flexdyn::server::access::check(&zcfg, &s).expect("the shipped ACL binds sender 1 to fsw");
-    let server = ServerHandle::start_with_session(server_session, s, reference_config(100.0));
+    let server = ServerHandle::start_with_session(open(zcfg), s, reference_config(100.0));
 
     // An authenticated operator: sees the telemetry, and tries to command as sender 1.
     let operator = session(port, Role::Tool, Some(scenario("operator-client.json5")));
@@ -336,21 +334,9 @@ fn a_participant_claiming_another_ones_sender_id_is_rejected_and_counted() {
     let topics = Topics::new("sc1").unwrap();
     let acl = two_participant_acl();
     let s = settings(&[(1, "fsw"), (2, "operator")], true);
-    let zcfg = zenoh_config(
-        &ZenohArgs {
-            listen: vec![endpoint(port)],
-            connect: vec![],
-            zenoh_config: Some(acl.clone()),
-        },
-        Role::Server,
-    )
-    .unwrap();
+    let zcfg = config(port, Role::Server, Some(acl.clone()));
     flexdyn::server::access::check(&zcfg, &s).expect("the test ACL binds 1 to fsw, 2 to operator");
-    let server = ServerHandle::start_with_session(
-        session(port, Role::Server, Some(acl.clone())),
-        s,
-        reference_config(100.0),
-    );
+    let server = ServerHandle::start_with_session(open(zcfg), s, reference_config(100.0));
 
     // Participant 2 (user `operator`): for every state, first an impostor command claiming
     // sender 1 on its own key, then its real answer.

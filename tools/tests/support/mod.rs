@@ -95,6 +95,32 @@ impl Drop for ChildGuard {
     }
 }
 
+/// Round-trip times of `count` StateMsg-sized pings (after `warmup` unmeasured ones) from a
+/// session listening on `port` to a `flexdyn-pingpong pong` child (reply CommandMsg-sized),
+/// which answers inside its Zenoh callback or, with `recv_loop`, from a receive loop (the demo
+/// controller's structure). The benchmarks' yardstick.
+pub fn pingpong_rtts(port: u16, warmup: usize, count: usize, recv_loop: bool) -> Vec<Duration> {
+    use flexdyn_proto::{EFFECTOR_STATE_FIXED_LEN, STATE_FIXED_LEN};
+    let topics = Topics::new("bench").unwrap();
+    let session = listening_session(port);
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_flexdyn-pingpong"));
+    cmd.args(["--connect", &endpoint(port), "--sc-id", "bench"])
+        .args(["pong", "--duration-s", "300"]);
+    if recv_loop {
+        cmd.arg("--recv-loop");
+    }
+    let _pong = ChildGuard::spawn(&mut cmd);
+    flexdyn_tools::pingpong::ping(
+        &session,
+        &topics,
+        STATE_FIXED_LEN + 2 * (EFFECTOR_STATE_FIXED_LEN + 32),
+        warmup,
+        count,
+        Duration::from_secs(30),
+    )
+    .expect("ping-pong")
+}
+
 /// Sends `signal` (e.g. `-STOP`) to `pid` with the `kill` utility.
 pub fn signal(pid: u32, signal: &str) {
     let status = Command::new("kill")
