@@ -33,11 +33,13 @@
 //!   lies at −d ŝ1 from its hinge, so at θ = 0 the panel extends along −ĥ1.
 //! - Gravity acts at the system centre of mass as a uniform field.
 
+pub mod dynamic_effector;
 pub mod effector;
 pub mod effectors;
 pub mod params;
 pub mod spacecraft;
 
+pub use dynamic_effector::{DynamicEffector, StageState};
 pub use effector::{
     BackSubContributions, EffectorKind, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics,
     StateEffector,

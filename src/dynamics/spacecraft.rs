@@ -9,12 +9,14 @@ use std::ops::Range;
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::dynamic_effector::{DynamicEffector, StageState};
 use super::effector::{
     BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
 use super::params::{GravityModel, HubParams, SensorPoint, Wrench};
 use super::ParamError;
 use crate::attitude::{mrp_rate, mrp_switch, mrp_to_dcm, tilde};
+use crate::environment::EnvironmentSample;
 
 /// The integrated state (also used for its time derivative).
 #[derive(Debug, Clone, PartialEq)]
@@ -260,6 +262,13 @@ struct Rk4Workspace {
 /// the integrator state so RK4 can evaluate it while borrowing its stage buffers.
 #[derive(Debug)]
 struct EquationsOfMotion {
+    /// The external forces and torques evaluated at every stage, in registration order.
+    dynamic: Vec<Box<dyn DynamicEffector>>,
+    /// Indices of the dynamic effectors whose [`DynamicEffector::uses_begin_step`] is true.
+    dynamic_stepped: Vec<usize>,
+    /// The environment the dynamic effectors read, held until the next
+    /// [`Spacecraft::set_environment`].
+    env: EnvironmentSample,
     hub: HubParams,
     /// Hub mass properties about B (constant): m r_Bc/B and [I_hub,B] = [I_hub,Bc] + m[r̃][r̃]ᵀ.
     hub_first_moment_b: Vector3<f64>,
@@ -290,18 +299,23 @@ pub struct Spacecraft {
 }
 
 impl EquationsOfMotion {
-    /// Runs [`StateEffector::begin_step`] at state `x` on the effectors that use it.
+    /// Runs [`StateEffector::begin_step`] at state `x`, and [`DynamicEffector::begin_step`] at
+    /// the step's start time `t_step_ns`, on the effectors that use them.
     #[inline]
-    fn begin_step(&mut self, x: &State) {
+    fn begin_step(&mut self, x: &State, t_step_ns: u64) {
         for &i in &self.stepped {
             self.effectors[i].begin_step(&x.effectors[self.ranges[i].clone()]);
         }
+        for &i in &self.dynamic_stepped {
+            self.dynamic[i].begin_step(t_step_ns);
+        }
     }
 
-    /// Evaluates the state derivative `dx` at state `x` with the current wrench and returns the hub
-    /// accelerations (Eqs. 145–153 with the effector passes around them).
+    /// Evaluates the state derivative `dx` at state `x`, the stage `dt_stage_s` into the step
+    /// that starts at `t_step_ns`, with the current wrench, and returns the hub accelerations
+    /// (Eqs. 145–153 with the effector passes around them).
     #[inline(always)]
-    fn eval(&mut self, x: &State, dx: &mut State) -> HubOutputs {
+    fn eval(&mut self, x: &State, dx: &mut State, t_step_ns: u64, dt_stage_s: f64) -> HubOutputs {
         let omega = x.omega_bn_b;
         // Pass 1: mass properties (Eqs. 3, 4, 19): m_sc, c, c′, [I_sc,B].
         let mut mp = EffectorMassProps {
@@ -322,6 +336,34 @@ impl EquationsOfMotion {
         let m_sc = mp.mass_kg;
         let c_b = mp.first_moment_b_kg_m / m_sc;
         let c_prime_b = mp.first_moment_prime_b_kg_m_s / m_sc;
+        let dcm_nb = mrp_to_dcm(&x.sigma_bn).transpose();
+        // The system CoM, where the uniform gravity field acts: r_C/N = r_B/N + [NB] c.
+        let r_cn_n = x.r_bn_n + dcm_nb * c_b;
+
+        // External forces and torques: the held wrench, then every dynamic effector at this
+        // stage (force at B, torque about B, B components).
+        let mut ext = Wrench {
+            force_b_newton: self.force_b_newton,
+            torque_b_nm: self.torque_b_nm,
+        };
+        if !self.dynamic.is_empty() {
+            let stage = StageState {
+                t_step_ns,
+                dt_stage_s,
+                r_bn_n_m: x.r_bn_n,
+                v_bn_n_m_s: x.v_bn_n,
+                sigma_bn: x.sigma_bn,
+                dcm_bn: dcm_nb.transpose(),
+                omega_bn_b_rad_s: omega,
+                mass_kg: m_sc,
+                r_cb_b_m: c_b,
+                r_cn_n_m: r_cn_n,
+                inertia_pnt_b_b_kg_m2: mp.inertia_pnt_b_b_kg_m2,
+            };
+            for e in &mut self.dynamic {
+                e.add_force_torque(&stage, &self.env, &mut ext);
+            }
+        }
 
         // Eqs. 145–150, with erratum E2 in Eq. 148.
         let c_tilde = tilde(&c_b);
@@ -329,13 +371,13 @@ impl EquationsOfMotion {
         let matrix_b = -c_tilde * m_sc + contr.matrix_b;
         let matrix_c = c_tilde * m_sc + contr.matrix_c;
         let matrix_d = mp.inertia_pnt_b_b_kg_m2 + contr.matrix_d;
-        let v_trans = self.force_b_newton
+        let v_trans = ext.force_b_newton
             - omega.cross(&c_prime_b) * (2.0 * m_sc)
             - omega.cross(&omega.cross(&c_b)) * m_sc
             + contr.vec_trans;
         // The hub is rigid ([I′_hub] = 0); each effector's −[I′]ω is in its vec_rot.
         let v_rot =
-            -omega.cross(&(mp.inertia_pnt_b_b_kg_m2 * omega)) + self.torque_b_nm + contr.vec_rot;
+            -omega.cross(&(mp.inertia_pnt_b_b_kg_m2 * omega)) + ext.torque_b_nm + contr.vec_rot;
 
         // Eqs. 152–153 by factorisation: A = LU; X = A⁻¹B and y = A⁻¹v_trans by solves;
         // S = D − C X factored; ω̇ = S⁻¹(v_rot − C y); r̈ = y − X ω̇.
@@ -359,9 +401,8 @@ impl EquationsOfMotion {
             );
         }
 
-        // Uniform gravity evaluated at the system CoM: r_C/N = r_B/N + [NB] c.
-        let dcm_nb = mrp_to_dcm(&x.sigma_bn).transpose();
-        let gravity_n = gravity_accel_n(&self.gravity, &(x.r_bn_n + dcm_nb * c_b));
+        // Uniform gravity evaluated at the system CoM.
+        let gravity_n = gravity_accel_n(&self.gravity, &r_cn_n);
         dx.r_bn_n = x.v_bn_n;
         dx.v_bn_n = dcm_nb * accel_b + gravity_n;
         dx.sigma_bn = mrp_rate(&x.sigma_bn, &omega);
@@ -441,6 +482,9 @@ impl Spacecraft {
         let zero = State::zeros(n, 0);
         let mut sc = Self {
             eom: EquationsOfMotion {
+                dynamic: Vec::new(),
+                dynamic_stepped: Vec::new(),
+                env: EnvironmentSample::NONE,
                 hub,
                 hub_first_moment_b,
                 hub_inertia_pnt_b_b,
@@ -595,9 +639,50 @@ impl Spacecraft {
         }
     }
 
-    /// Runs every effector's [`StateEffector::begin_step`] at the current state.
+    /// Each effector's own mass properties about B at the current state (pass 1 of the
+    /// equations of motion, one effector at a time) into `out`, one per effector (extra room is
+    /// left untouched). Not on the stepping path.
+    pub fn effector_mass_props(&mut self, out: &mut [EffectorMassProps]) {
+        let eom = &mut self.eom;
+        for ((e, r), o) in eom
+            .effectors
+            .iter_mut()
+            .zip(&eom.ranges)
+            .zip(out.iter_mut())
+        {
+            *o = EffectorMassProps::default();
+            e.update_mass_props(&self.state.effectors[r.clone()], o);
+        }
+    }
+
+    /// Runs every effector's [`StateEffector::begin_step`] at the current state and time.
     fn begin_step(&mut self) {
-        self.eom.begin_step(&self.state);
+        self.eom.begin_step(&self.state, self.t_sim_ns);
+    }
+
+    /// Adds a dynamic effector (an external force and torque evaluated at every RK4 stage);
+    /// returns its index. Construction-time only.
+    pub fn add_dynamic_effector(&mut self, effector: Box<dyn DynamicEffector>) -> usize {
+        if effector.uses_begin_step() {
+            self.eom.dynamic_stepped.push(self.eom.dynamic.len());
+        }
+        self.eom.dynamic.push(effector);
+        self.eom.dynamic.len() - 1
+    }
+
+    /// The dynamic effectors, in registration order.
+    pub fn dynamic_effectors(&self) -> &[Box<dyn DynamicEffector>] {
+        &self.eom.dynamic
+    }
+
+    /// Sets the environment the dynamic effectors read, held until the next call.
+    pub fn set_environment(&mut self, env: &EnvironmentSample) {
+        self.eom.env = *env;
+    }
+
+    /// The environment the dynamic effectors currently read.
+    pub fn environment(&self) -> &EnvironmentSample {
+        &self.eom.env
     }
 
     /// The hub parameters.
@@ -629,8 +714,8 @@ impl Spacecraft {
     /// of a step), and returns the hub accelerations. This is the equation-of-motion function RK4
     /// integrates: it allocates nothing and cannot fail.
     pub fn derivatives(&mut self, x: &State, dx: &mut State) -> HubOutputs {
-        self.eom.begin_step(x);
-        self.eom.eval(x, dx)
+        self.eom.begin_step(x, self.t_sim_ns);
+        self.eom.eval(x, dx, self.t_sim_ns, 0.0)
     }
 
     /// Advances one RK4 step of [`Self::step_ns`] with the current wrench and effector inputs
@@ -639,14 +724,15 @@ impl Spacecraft {
     pub fn step(&mut self) {
         self.begin_step();
         let h = self.step_ns as f64 * 1e-9;
+        let t0 = self.t_sim_ns;
         let Self { eom, state, ws, .. } = self;
-        eom.eval(state, &mut ws.k1);
+        eom.eval(state, &mut ws.k1, t0, 0.0);
         ws.stage.set_axpy(state, 0.5 * h, &ws.k1);
-        eom.eval(&ws.stage, &mut ws.k2);
+        eom.eval(&ws.stage, &mut ws.k2, t0, 0.5 * h);
         ws.stage.set_axpy(state, 0.5 * h, &ws.k2);
-        eom.eval(&ws.stage, &mut ws.k3);
+        eom.eval(&ws.stage, &mut ws.k3, t0, 0.5 * h);
         ws.stage.set_axpy(state, h, &ws.k3);
-        eom.eval(&ws.stage, &mut ws.k4);
+        eom.eval(&ws.stage, &mut ws.k4, t0, h);
         let h6 = h / 6.0;
         let (k1, k2, k3, k4) = (&ws.k1, &ws.k2, &ws.k3, &ws.k4);
         state.r_bn_n += (k1.r_bn_n + (k2.r_bn_n + k3.r_bn_n) * 2.0 + k4.r_bn_n) * h6;
@@ -723,7 +809,8 @@ impl Spacecraft {
     /// the result is not cached, so call it once per output).
     pub fn hub_outputs(&mut self) -> HubOutputs {
         self.begin_step();
-        self.eom.eval(&self.state, &mut self.ws.stage)
+        self.eom
+            .eval(&self.state, &mut self.ws.stage, self.t_sim_ns, 0.0)
     }
 
     fn energy_momentum_sum(&self, x: &State) -> EnergyMomentum {

@@ -1,0 +1,51 @@
+//! One sample of the environment: what the dynamic effectors and the sensors read of the world.
+//!
+//! A sample is filled by the environment models at their update rate (slow fields such as the
+//! magnetic field, the ephemerides and the density) and held between updates; the dynamic
+//! effectors combine it with the hub state of each RK4 stage (attitude, position, velocity).
+//! A quantity whose model is off keeps its neutral value ([`EnvironmentSample::NONE`]): no field,
+//! no Sun (a zero vector), full sunlight, vacuum, no wind. That way an effector never has to ask
+//! whether a model exists: a magnetic torque in a zero field is zero.
+
+use nalgebra::Vector3;
+
+/// The environment at one instant, in the inertial frame N unless a name says otherwise.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvironmentSample {
+    /// \[ns\] simulation time of the sample (since the epoch).
+    pub t_sim_ns: u64,
+    /// \[T\] the planet's magnetic field at the spacecraft, N components (zero when off).
+    pub b_field_n_t: Vector3<f64>,
+    /// \[m\] the Sun's position relative to the spacecraft's hub point B, N components (zero
+    /// when no ephemeris is configured).
+    pub r_sun_b_n_m: Vector3<f64>,
+    /// \[m\] the Moon's position relative to B, N components (zero when off).
+    pub r_moon_b_n_m: Vector3<f64>,
+    /// \[-\] fraction of the solar disc visible from the spacecraft: 1 in full sunlight, 0 in
+    /// umbra, in between in penumbra.
+    pub shadow_factor: f64,
+    /// \[kg/m³\] atmospheric mass density at the spacecraft (0 in vacuum).
+    pub density_kg_m3: f64,
+    /// \[m/s\] velocity of the local atmosphere relative to N, N components (e.g. a co-rotating
+    /// atmosphere's ω_E × r).
+    pub wind_n_m_s: Vector3<f64>,
+}
+
+impl EnvironmentSample {
+    /// No environment: no field, no Sun or Moon, full sunlight, vacuum, no wind.
+    pub const NONE: EnvironmentSample = EnvironmentSample {
+        t_sim_ns: 0,
+        b_field_n_t: Vector3::new(0.0, 0.0, 0.0),
+        r_sun_b_n_m: Vector3::new(0.0, 0.0, 0.0),
+        r_moon_b_n_m: Vector3::new(0.0, 0.0, 0.0),
+        shadow_factor: 1.0,
+        density_kg_m3: 0.0,
+        wind_n_m_s: Vector3::new(0.0, 0.0, 0.0),
+    };
+}
+
+impl Default for EnvironmentSample {
+    fn default() -> Self {
+        Self::NONE
+    }
+}
