@@ -34,6 +34,7 @@
 //! - Gravity acts at the system centre of mass as a uniform field.
 
 pub mod dynamic_effector;
+pub mod dynamic_effectors;
 pub mod effector;
 pub mod effectors;
 pub mod params;
