@@ -6,6 +6,10 @@
 //! report this prints a summary of medians (31 batches of 20,000 steps per size) and the
 //! least-squares cost per added pair and per added wheel.
 //!
+//! Issue 19 (environment): the reference spacecraft with each dynamic effector, printed beside
+//! the same spacecraft without it and beside the cost of one added panel pair, measured in the
+//! same run. The target: a full environment costs less than one panel pair per step.
+//!
 //! Peers in the same run: with `FLEXDYN_PEERS_PYTHON` pointing at a Python that has
 //! `mujoco==4.0.0` and `bsk==2.12.1` (see `tools/peers/README.md`), the bench then runs
 //! `tools/peers/{mujoco,basilisk}_step.py` one after the other — the same spacecraft, RK4 at 1 ms —
@@ -18,6 +22,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use criterion::{BenchmarkId, Criterion};
+use flexdyn::dynamics::dynamic_effectors::gravity_gradient::GravityGradient;
 use flexdyn::dynamics::{
     GravityModel, PanelPair, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
 };
@@ -251,11 +256,48 @@ fn summary() -> Vec<(f64, f64)> {
     rows
 }
 
+/// The reference spacecraft (2 pairs) with the gravity gradient of its own gravity model.
+fn spacecraft_with_gravity_gradient() -> Spacecraft {
+    let mut sc = spacecraft(2);
+    let mu_m3_s2 = match *sc.gravity() {
+        GravityModel::PointMass { mu_m3_s2 } | GravityModel::J2 { mu_m3_s2, .. } => mu_m3_s2,
+        GravityModel::None => unreachable!("the bench spacecraft orbits a planet"),
+    };
+    sc.add_dynamic_effector(Box::new(GravityGradient { mu_m3_s2 }));
+    sc
+}
+
+/// Each dynamic effector's cost per step against the same spacecraft without it and against
+/// one added panel pair (`pair_ns`, from the same run's fit).
+fn environment_summary(pair_ns: f64) {
+    let base = median_ns_per_step(spacecraft(2));
+    let rows = [(
+        "gravity gradient",
+        median_ns_per_step(spacecraft_with_gravity_gradient()),
+    )];
+    println!("\nrk4_step with dynamic effectors, 2 pairs (median of 31 batches x 20000 steps):");
+    println!(
+        "{:<18} {:>14} {:>12} {:>16}",
+        "effector", "median ns/step", "added ns", "x one panel pair"
+    );
+    println!("{:<18} {:>14.1} {:>12} {:>16}", "none", base, "-", "-");
+    for (name, ns) in rows {
+        println!(
+            "{:<18} {:>14.1} {:>12.1} {:>16.3}",
+            name,
+            ns,
+            ns - base,
+            (ns - base) / pair_ns
+        );
+    }
+}
+
 fn main() {
     let mut c = Criterion::default().configure_from_args();
     bench_step(&mut c);
     c.final_summary();
     let rows = summary();
     wheel_summary();
+    environment_summary(fit(&rows).1);
     peers(&rows);
 }
