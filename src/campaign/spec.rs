@@ -253,7 +253,7 @@ impl Campaign {
             None => None,
         };
         if let Some(c) = &controller {
-            let words = super::execute::split_command(c).map_err(|e| invalid("controller", e))?;
+            let words = super::command::split_command(c).map_err(|e| invalid("controller", e))?;
             if words.is_empty() {
                 return Err(invalid("controller", "is empty".into()));
             }
