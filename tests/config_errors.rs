@@ -694,7 +694,8 @@ fn non_finite_rows() -> Vec<Case> {
     fn server(t: &mut Table) {
         t.insert("server".into(), Value::Table(Table::new()));
     }
-    let fields: [(&'static str, fn(&mut Table)); 22] = [
+    type Setup = fn(&mut Table);
+    let fields: [(&'static str, Setup); 22] = [
         ("simulation.step_s", none),
         ("simulation.frame_hz", none),
         ("gravity.mu_m3_s2", none),
