@@ -300,7 +300,7 @@ fn run_inner(
         participants,
         participant_timeout: Duration::from_secs_f64(c.participant_timeout_s),
         presence_timeout: Duration::from_secs_f64(c.participant_timeout_s.max(10.0)),
-        duration_ns: Some((c.duration_s * 1e9).round() as u64),
+        duration_ns: Some(c.duration_ns),
         summary_interval: Duration::from_secs(3600),
         record: opts.record.then(|| run_dir.join("recording.mcap")),
         ..ServerSettings::default()
