@@ -8,7 +8,7 @@ use std::num::NonZeroU64;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::config::{whole_ns, ConfigError, SimConfig, DEFAULT_CONFIG_TOML};
+use crate::config::{config_message, whole_ns, ConfigError, SimConfig};
 use crate::dynamics::StateEffector;
 use crate::numfmt::Num;
 use crate::sensors::imu::ImuSample;
@@ -112,13 +112,6 @@ pub enum CliError {
     },
 }
 
-fn config_message(file: Option<&Path>, e: &ConfigError) -> String {
-    match (file, e) {
-        (Some(f), e) if !matches!(e, ConfigError::Io { .. }) => format!("{}: {e}", f.display()),
-        _ => e.to_string(),
-    }
-}
-
 impl CliError {
     /// The process exit code for this error: 2 for invalid input (configuration or arguments),
     /// 1 for a failure while running (output not writable).
@@ -166,16 +159,12 @@ impl fmt::Display for SimulateReport {
     }
 }
 
-/// Loads `path`, or the embedded default if `None`.
-pub fn load_config(path: Option<&Path>) -> Result<SimConfig, CliError> {
-    match path {
-        Some(p) => SimConfig::from_file(p).map_err(|source| CliError::Config {
-            file: Some(p.to_path_buf()),
-            source,
-        }),
-        None => SimConfig::from_toml_str(DEFAULT_CONFIG_TOML)
-            .map_err(|source| CliError::Config { file: None, source }),
-    }
+/// [`crate::config::load_config`], its error as a [`CliError::Config`] naming the file.
+fn load(path: Option<&Path>) -> Result<SimConfig, CliError> {
+    crate::config::load_config(path).map_err(|source| CliError::Config {
+        file: path.map(Path::to_path_buf),
+        source,
+    })
 }
 
 /// A duration option as a whole number of steps.
@@ -372,7 +361,7 @@ pub fn simulate_to<W: Write>(
 /// `flexdyn simulate`: loads the configuration, checks the options, and writes the CSV to the
 /// output file or stdout. The output file is created only once everything else is valid.
 pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
-    let cfg = load_config(args.config.as_deref())?;
+    let cfg = load(args.config.as_deref())?;
     // Check the options before creating (and truncating) the output file.
     whole_steps("--duration-s", args.duration_s, cfg.step_ns, true)?;
     whole_steps("--log-every-s", args.log_every_s, cfg.step_ns, false)?;
@@ -409,7 +398,7 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
 /// table's included (keys, values, cross-setting rules, and a duration that is a whole number of
 /// frames), and says `ok` only when all pass.
 pub fn check_config(path: &Path) -> Result<String, CliError> {
-    let cfg = load_config(Some(path))?;
+    let cfg = load(Some(path))?;
     cfg.build_spacecraft().map_err(|source| CliError::Config {
         file: Some(path.to_path_buf()),
         source,

@@ -316,3 +316,172 @@ fn sensor_seeds_are_derived_per_run_and_reach_the_model() {
     seen.dedup();
     assert_eq!(seen.len(), 10, "every run and sensor gets its own seed");
 }
+
+/// The error of `text` (a campaign file named `test-campaign.toml`), planned.
+fn plan_error(text: &str) -> String {
+    match campaign(text) {
+        Ok(_) => panic!("expected an error for:\n{text}"),
+        Err(e) => e,
+    }
+}
+
+/// 1-based line of `text` that contains `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    1 + text
+        .lines()
+        .position(|l| l.contains(needle))
+        .unwrap_or_else(|| panic!("no line contains {needle:?}"))
+}
+
+#[test]
+fn impossible_values_are_load_errors_naming_the_file_the_field_and_its_line() {
+    let criterion = "[[criteria]]\nname = \"c\"\nquantity = \"omega\"\n";
+    let normal = "[[dispersions]]\nkey = \"hub.mass_kg\"\ndistribution = \"normal\"\n";
+    let uniform = "[[dispersions]]\nkey = \"hub.mass_kg\"\ndistribution = \"uniform\"\n";
+    // (the file after `runs`, the field, the words, the line's marker)
+    let rows: Vec<(String, &str, &[&str], &str)> = vec![
+        // Beyond what a u64 count of nanoseconds holds (2^64 − 1 ns ≈ 1.8447e10 s).
+        (
+            "seed = 1\nduration_s = 1e300\n".into(),
+            "duration_s",
+            &["1e300 s", "beyond", "2^64"],
+            "duration_s",
+        ),
+        (
+            "seed = 1\nduration_s = 2e10\n".into(),
+            "duration_s",
+            &["beyond", "2^64"],
+            "duration_s",
+        ),
+        (
+            "seed = 1\nduration_s = 1.0\nparticipant_timeout_s = 1e300\n".into(),
+            "participant_timeout_s",
+            &["beyond", "2^64"],
+            "participant_timeout_s",
+        ),
+        // NaN and Inf anywhere, as the configuration rejects them.
+        (
+            "seed = 1\nduration_s = 1.0\nsigma_rn = [nan, 0, 0]\n".into(),
+            "sigma_rn[0]",
+            &["must be finite"],
+            "sigma_rn",
+        ),
+        (
+            format!("seed = 1\nduration_s = 1.0\n{criterion}statistic = \"final\"\nbelow = nan\n"),
+            "criteria[0].below",
+            &["must be finite"],
+            "below",
+        ),
+        (
+            format!("seed = 1\nduration_s = 1.0\n{normal}sigma = 1.0\nmean = inf\n"),
+            "dispersions[0].mean",
+            &["must be finite"],
+            "mean",
+        ),
+        (
+            format!("seed = 1\nduration_s = 1.0\n{uniform}low = 1.0\nhigh = inf\n"),
+            "dispersions[0].high",
+            &["must be finite"],
+            "high",
+        ),
+        (
+            format!(
+                "seed = 1\nduration_s = 1.0\n{criterion}statistic = \"settling_time\"\n\
+                 threshold = -inf\nbelow = 1.0\n"
+            ),
+            "criteria[0].threshold",
+            &["must be finite"],
+            "threshold",
+        ),
+        // A uniform range wider than a float holds.
+        (
+            format!("seed = 1\nduration_s = 1.0\n{uniform}low = -1e308\nhigh = 1e308\n"),
+            "dispersions[0].high",
+            &["high - low", "overflows"],
+            "high",
+        ),
+        // A criterion that can never pass: every quantity is a magnitude (≥ 0).
+        (
+            format!("seed = 1\nduration_s = 1.0\n{criterion}statistic = \"final\"\nbelow = 0.0\n"),
+            "criteria[0].below",
+            &["must be > 0", "could never pass"],
+            "below",
+        ),
+        // A window that only `max` uses.
+        (
+            format!(
+                "seed = 1\nduration_s = 1.0\n{criterion}statistic = \"final\"\nafter_s = 0.5\n\
+                 below = 1.0\n"
+            ),
+            "criteria[0].after_s",
+            &["does not apply to statistic \"final\""],
+            "after_s",
+        ),
+    ];
+    for (rest, field, says, marker) in rows {
+        let text = format!("runs = 2\n{rest}");
+        let e = plan_error(&text);
+        let head = format!("test-campaign.toml: {field}: ");
+        assert!(e.starts_with(&head), "{field}: {e}");
+        for w in says {
+            assert!(e.contains(w), "{field}: no `{w}`: {e}");
+        }
+        let at = format!("(line {}, column ", line_of(&text, marker));
+        assert!(e.contains(&at), "{field}: not at {at}: {e}");
+        assert!(e.len() < 240, "{field}: {} characters: {e}", e.len());
+    }
+    // 1e10 s is a whole number of nanoseconds below the bound: planned (nothing runs).
+    campaign("runs = 1\nseed = 1\nduration_s = 1e10\n").unwrap();
+}
+
+#[test]
+fn errors_start_with_the_file_that_holds_the_field() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("campaign_files");
+    std::fs::create_dir_all(&dir).unwrap();
+    let imu = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/imu_tactical.toml");
+    // A misspelled dispersion key is the campaign file's, with or without a base.
+    for base in [
+        String::new(),
+        format!("base = {:?}\n", imu.display().to_string()),
+    ] {
+        let text = format!(
+            "{base}runs = 1\nseed = 1\nduration_s = 1.0\n[[dispersions]]\nkey = \"hub.mas_kg\"\n\
+             distribution = \"normal\"\nsigma = 1.0\n"
+        );
+        let e = plan_error(&text);
+        assert!(
+            e.starts_with("test-campaign.toml: dispersions[0].key: "),
+            "{e}"
+        );
+        assert!(e.contains("hub.mas_kg does not exist"), "{e}");
+        let at = format!("(line {}, column 7)", line_of(&text, "hub.mas_kg"));
+        assert!(e.contains(&at), "not at {at}: {e}");
+    }
+    // A field of an invalid base is the base file's: its name, the field, its line.
+    let bad_base = dir.join("bad_base.toml");
+    let base_text =
+        std::fs::read_to_string(&imu)
+            .unwrap()
+            .replacen("mass_kg = 750.0", "mass_kg = -1.0", 1);
+    std::fs::write(&bad_base, &base_text).unwrap();
+    let campaign_file = dir.join("uses_bad_base.toml");
+    let error_with_base = |base: &str| {
+        let text = format!("base = {base:?}\nruns = 1\nseed = 1\nduration_s = 1.0\n");
+        std::fs::write(&campaign_file, text).unwrap();
+        Campaign::from_file(&campaign_file).unwrap_err().to_string()
+    };
+    let e = error_with_base("bad_base.toml");
+    let head = format!("{}: hub.mass_kg: must be > 0", bad_base.display());
+    assert!(e.starts_with(&head), "{e}");
+    let at = format!("(line {}, column", line_of(&base_text, "mass_kg = -1.0"));
+    assert!(e.contains(&at), "{e}");
+    assert!(
+        e.contains("uses_bad_base.toml"),
+        "names the campaign too: {e}"
+    );
+    // A base that cannot be read is the campaign's `base` field.
+    let e = error_with_base("no_such_base.toml");
+    let head = format!("{}: base: cannot read", campaign_file.display());
+    assert!(e.starts_with(&head), "{e}");
+    assert!(e.contains("(line 1, column 8)"), "{e}");
+}

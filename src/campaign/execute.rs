@@ -22,6 +22,7 @@ use sha2::{Digest, Sha256};
 use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
 
+use super::command::split_command;
 use super::plan::{readback, Plan, RunPlan};
 use super::spec::{Campaign, Criterion, Quantity, Statistic};
 use crate::attitude::mrp_error;
@@ -35,58 +36,6 @@ pub const OBSERVER_ID: u32 = 9;
 pub const CONTROLLER_ID: u32 = 1;
 /// The spacecraft id of every run (`{sc_id}`); runs are separated by port.
 pub const SC_ID: &str = "sc1";
-
-/// Splits a command line into words: whitespace separates, `'…'` and `"…"` quote (no escapes
-/// inside single quotes; `\` escapes the next character elsewhere). No shell is involved.
-pub fn split_command(line: &str) -> Result<Vec<String>, String> {
-    let mut words = Vec::new();
-    let mut cur = String::new();
-    let mut in_word = false;
-    let mut chars = line.chars();
-    while let Some(c) = chars.next() {
-        match c {
-            '\'' => {
-                in_word = true;
-                loop {
-                    match chars.next() {
-                        Some('\'') => break,
-                        Some(x) => cur.push(x),
-                        None => return Err("unterminated ' quote".into()),
-                    }
-                }
-            }
-            '"' => {
-                in_word = true;
-                loop {
-                    match chars.next() {
-                        Some('"') => break,
-                        Some('\\') => cur.push(chars.next().ok_or("trailing \\")?),
-                        Some(x) => cur.push(x),
-                        None => return Err("unterminated \" quote".into()),
-                    }
-                }
-            }
-            '\\' => {
-                in_word = true;
-                cur.push(chars.next().ok_or("trailing \\")?);
-            }
-            c if c.is_whitespace() => {
-                if in_word {
-                    words.push(std::mem::take(&mut cur));
-                    in_word = false;
-                }
-            }
-            c => {
-                in_word = true;
-                cur.push(c);
-            }
-        }
-    }
-    if in_word {
-        words.push(cur);
-    }
-    Ok(words)
-}
 
 /// One criterion's outcome.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -351,7 +300,7 @@ fn run_inner(
         participants,
         participant_timeout: Duration::from_secs_f64(c.participant_timeout_s),
         presence_timeout: Duration::from_secs_f64(c.participant_timeout_s.max(10.0)),
-        duration_ns: Some((c.duration_s * 1e9).round() as u64),
+        duration_ns: Some(c.duration_ns),
         summary_interval: Duration::from_secs(3600),
         record: opts.record.then(|| run_dir.join("recording.mcap")),
         ..ServerSettings::default()
@@ -524,16 +473,6 @@ pub fn execute_many(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn commands_split_like_a_shell_without_one() {
-        assert_eq!(
-            split_command(r#"demo --a 1 'two words' "x\"y" c\ d"#).unwrap(),
-            ["demo", "--a", "1", "two words", "x\"y", "c d"]
-        );
-        assert!(split_command("a 'b").is_err());
-        assert_eq!(split_command("  ").unwrap(), Vec::<String>::new());
-    }
 
     #[test]
     fn statistics_follow_their_definitions() {

@@ -1,6 +1,7 @@
 //! Monte Carlo campaigns with flight code in the loop (`flexdyn campaign plan|run|summarize`).
 //!
 //! - [`spec`]: the campaign file, validated with field-named errors.
+//! - [`command`]: the controller's command line, split into words without a shell.
 //! - [`keys`]: TOML paths into a configuration (`panel_pairs[*].panel1.k_nm_rad`).
 //! - [`plan`]: per-run draws from the master seed, redraws of invalid draws, sensor seeds, the
 //!   manifest, and the read-back of parameters from the built model.
@@ -9,6 +10,7 @@
 //! - [`summary`]: `summary.csv`, the pass rate with its Wilson interval, worst and failed runs,
 //!   figures.
 
+pub mod command;
 pub mod execute;
 pub mod keys;
 pub mod plan;

@@ -129,32 +129,24 @@ pub struct Plan {
     sensor_seed_keys: Vec<String>,
 }
 
-fn invalid(c: &Campaign, field: String, problem: String) -> CampaignError {
-    CampaignError::Invalid {
-        path: c.base_path.clone().unwrap_or_else(|| "campaign".into()),
-        field,
-        problem,
-    }
-}
-
 impl Plan {
     /// Resolves every dispersion key against the base configuration and its built model.
     pub fn new(campaign: Campaign) -> Result<Self, CampaignError> {
+        // Dispersion keys are the campaign file's fields; a bad base is the base file's.
         let base: Table = toml::from_str(&campaign.base_toml)
-            .map_err(|e| invalid(&campaign, "base".into(), format!("not a TOML table: {e}")))?;
-        let cfg = SimConfig::from_toml_str(&campaign.base_toml)
-            .map_err(|e| invalid(&campaign, "base".into(), e.to_string()))?;
-        let model = readback(&cfg).map_err(|e| invalid(&campaign, "base".into(), e.to_string()))?;
+            .map_err(|e| campaign.invalid("base", format!("not a TOML table: {e}")))?;
+        let cfg =
+            SimConfig::from_toml_str(&campaign.base_toml).map_err(|e| campaign.base_error(e))?;
+        let model = readback(&cfg).map_err(|e| campaign.base_error(e))?;
         let mut all_keys = Vec::new();
         for (i, d) in campaign.dispersions.iter().enumerate() {
             let field = format!("dispersions[{i}].key");
             let concrete = keys::expand(&base, &d.key)
-                .map_err(|e| invalid(&campaign, field.clone(), format!("{:?}: {e}", d.key)))?;
+                .map_err(|e| campaign.invalid(&field, format!("{:?}: {e}", d.key)))?;
             for k in &concrete {
                 if !model.contains_key(k) {
-                    return Err(invalid(
-                        &campaign,
-                        field,
+                    return Err(campaign.invalid(
+                        &field,
                         format!(
                             "{k} is not a parameter the built model reports (the hub, initial \
                              state, panel pairs and reaction wheels are), so its dispersion \
@@ -167,9 +159,8 @@ impl Plan {
             if d.distribution == Distribution::UniformAttitude
                 && (concrete.len() != 3 || !d.key.ends_with("sigma_bn"))
             {
-                return Err(invalid(
-                    &campaign,
-                    field,
+                return Err(campaign.invalid(
+                    &field,
                     format!(
                         "uniform_attitude needs an MRP set such as initial.sigma_bn, got {:?}",
                         d.key
@@ -177,11 +168,7 @@ impl Plan {
                 ));
             }
             if let Some(prev) = all_keys.iter().flatten().find(|k| concrete.contains(*k)) {
-                return Err(invalid(
-                    &campaign,
-                    field,
-                    format!("{prev} is dispersed twice"),
-                ));
+                return Err(campaign.invalid(&field, format!("{prev} is dispersed twice")));
             }
             all_keys.push(concrete);
         }

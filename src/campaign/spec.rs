@@ -27,9 +27,14 @@ use std::path::{Path, PathBuf};
 
 use toml::de::DeTable;
 
-use crate::config::{SimConfig, DEFAULT_CONFIG_TOML};
+use super::command::split_command;
+use crate::config::{
+    config_message, whole_ns, ConfigError, SimConfig, SourceMap, DEFAULT_CONFIG_TOML,
+    MAX_SIM_TIME_S,
+};
+use crate::numfmt::{Num, Rounded};
 use crate::schema::reader::TableReader;
-use crate::schema::SchemaError;
+use crate::schema::{location, At, SchemaError};
 
 /// A distribution of a dispersion.
 #[derive(Clone, Debug, PartialEq)]
@@ -108,6 +113,8 @@ pub struct Criterion {
 /// A validated campaign.
 #[derive(Clone, Debug)]
 pub struct Campaign {
+    /// The campaign file (errors start with its name).
+    pub path: PathBuf,
     /// The campaign file's text (hashed into the manifest).
     pub source: String,
     /// Where the base configuration came from (`None`: embedded default).
@@ -118,8 +125,10 @@ pub struct Campaign {
     pub runs: u32,
     /// The master seed.
     pub seed: u64,
-    /// \[s\] simulated duration of each run (a whole number of frames).
+    /// \[s\] simulated duration of each run, as written.
     pub duration_s: f64,
+    /// \[ns\] the same, a whole number of frames of the base configuration.
+    pub duration_ns: u64,
     /// The flight code's command line, if any.
     pub controller: Option<String>,
     /// Target attitude σ_RN of the `sigma_br` criteria.
@@ -134,7 +143,8 @@ pub struct Campaign {
     pub criteria: Vec<Criterion>,
 }
 
-/// Why a campaign file is not usable.
+/// Why a campaign file is not usable. Every message starts with the name of the file that
+/// holds the offending field: the campaign file, or its base configuration.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum CampaignError {
@@ -148,12 +158,14 @@ pub enum CampaignError {
         source: std::io::Error,
     },
     /// Not TOML.
-    #[error("{}: not valid TOML: {message}", path.display())]
+    #[error("{}: TOML syntax error{at}: {message}", path.display())]
     Syntax {
         /// The file.
         path: PathBuf,
         /// The parser's message.
         message: String,
+        /// Where the parser stopped.
+        at: At,
     },
     /// A field has the wrong shape.
     #[error("{}: {source}", path.display())]
@@ -165,7 +177,7 @@ pub enum CampaignError {
         source: SchemaError,
     },
     /// A field's value is not usable.
-    #[error("{}: {field}: {problem}", path.display())]
+    #[error("{}: {field}: {problem}{at}", path.display())]
     Invalid {
         /// The file.
         path: PathBuf,
@@ -173,6 +185,24 @@ pub enum CampaignError {
         field: String,
         /// What is wrong.
         problem: String,
+        /// Where the field is.
+        at: At,
+    },
+    /// The base configuration (`base`) is invalid: the message is the configuration's own,
+    /// starting with the base file's name, then names the campaign.
+    #[error(
+        "{} (the base configuration of {})",
+        config_message(base.as_deref(), source),
+        campaign.display()
+    )]
+    Base {
+        /// The campaign file.
+        campaign: PathBuf,
+        /// The base file (`None`: the embedded default).
+        base: Option<PathBuf>,
+        /// The configuration's error; it names the field.
+        #[source]
+        source: Box<ConfigError>,
     },
 }
 
@@ -189,6 +219,9 @@ const ROOT_KEYS: &[&str] = &[
     "criteria",
 ];
 
+/// \[s\] default of `participant_timeout_s`.
+const DEFAULT_PARTICIPANT_TIMEOUT_S: f64 = 5.0;
+
 impl Campaign {
     /// Reads and validates `path`. Dispersion keys are checked against the base configuration
     /// later, by [`super::plan::Plan::new`], which also builds the model.
@@ -200,23 +233,43 @@ impl Campaign {
         Self::from_str_at(&source, path)
     }
 
+    /// An error about `field` of the campaign file, with its position in the file.
+    pub fn invalid(&self, field: &str, problem: String) -> CampaignError {
+        invalid_at(&self.source, &self.path, field, problem)
+    }
+
+    /// An error of the base configuration (it names the base file).
+    pub fn base_error(&self, source: ConfigError) -> CampaignError {
+        CampaignError::Base {
+            campaign: self.path.clone(),
+            base: self.base_path.clone(),
+            source: Box::new(source),
+        }
+    }
+
     /// Reads a campaign from `source`; `path` names it in errors and anchors `base`.
     pub fn from_str_at(source: &str, path: &Path) -> Result<Self, CampaignError> {
         let schema = |source: SchemaError| CampaignError::Schema {
             path: path.to_owned(),
             source,
         };
-        let invalid = |field: &str, problem: String| CampaignError::Invalid {
-            path: path.to_owned(),
-            field: field.to_owned(),
-            problem,
-        };
+        let invalid = |field: &str, problem: String| invalid_at(source, path, field, problem);
         let doc = DeTable::parse(source).map_err(|e| CampaignError::Syntax {
             path: path.to_owned(),
-            message: e.to_string(),
+            message: e.message().to_owned(),
+            at: At(e.span().map(|sp| location(source, sp.start))),
         })?;
         let doc = doc.get_ref();
         let root = TableReader::root(source, doc, ROOT_KEYS).map_err(schema)?;
+        // As in a configuration, every float must be finite (TOML accepts `nan` and `inf`).
+        if let Some((field, at)) = SourceMap::new(source, doc).first_non_finite(doc) {
+            return Err(CampaignError::Invalid {
+                path: path.to_owned(),
+                field,
+                problem: "must be finite (got NaN or Inf)".into(),
+                at,
+            });
+        }
         let base_path = match root.get("base") {
             Some(_) => {
                 let rel = PathBuf::from(root.string("base").map_err(schema)?);
@@ -233,18 +286,24 @@ impl Campaign {
                 .map_err(|e| invalid("base", format!("cannot read {}: {e}", p.display())))?,
             None => DEFAULT_CONFIG_TOML.to_owned(),
         };
-        let base = SimConfig::from_toml_str(&base_toml)
-            .map_err(|e| invalid("base", format!("the base configuration is invalid: {e}")))?;
+        let base = SimConfig::from_toml_str(&base_toml).map_err(|source| CampaignError::Base {
+            campaign: path.to_owned(),
+            base: base_path.clone(),
+            source: Box::new(source),
+        })?;
         let runs = root.int_in("runs", 1, 1_000_000).map_err(schema)? as u32;
         let seed = root.int_in("seed", 0, i64::MAX).map_err(schema)? as u64;
         let duration_s = root.f64("duration_s").map_err(schema)?;
-        let frames = duration_s * base.frame_hz;
-        if duration_s.is_nan() || duration_s <= 0.0 || (frames - frames.round()).abs() >= 1e-6 {
+        let duration_ns =
+            within_time("duration_s", duration_s).map_err(|p| invalid("duration_s", p))?;
+        if duration_ns % base.frame_ns != 0 {
             return Err(invalid(
                 "duration_s",
                 format!(
-                    "must be a positive whole number of frames ({} Hz), got {duration_s}",
-                    base.frame_hz
+                    "{} s is not a whole number of frames (frame = {} s at {} Hz)",
+                    Num(duration_s),
+                    Num(base.frame_ns as f64 * 1e-9),
+                    Num(base.frame_hz)
                 ),
             ));
         }
@@ -253,7 +312,7 @@ impl Campaign {
             None => None,
         };
         if let Some(c) = &controller {
-            let words = super::execute::split_command(c).map_err(|e| invalid("controller", e))?;
+            let words = split_command(c).map_err(|e| invalid("controller", e))?;
             if words.is_empty() {
                 return Err(invalid("controller", "is empty".into()));
             }
@@ -269,13 +328,9 @@ impl Campaign {
         let participant_timeout_s = root
             .opt_f64("participant_timeout_s")
             .map_err(schema)?
-            .unwrap_or(5.0);
-        if participant_timeout_s.is_nan() || participant_timeout_s <= 0.0 {
-            return Err(invalid(
-                "participant_timeout_s",
-                format!("must be > 0, got {participant_timeout_s}"),
-            ));
-        }
+            .unwrap_or(DEFAULT_PARTICIPANT_TIMEOUT_S);
+        within_time("participant_timeout_s", participant_timeout_s)
+            .map_err(|p| invalid("participant_timeout_s", p))?;
 
         let mut dispersions = Vec::new();
         let tables = root
@@ -305,10 +360,10 @@ impl Campaign {
                 "normal" => {
                     only(&["mean", "sigma"])?;
                     let sigma = t.f64("sigma").map_err(schema)?;
-                    if sigma.is_nan() || sigma < 0.0 {
+                    if sigma < 0.0 {
                         return Err(invalid(
                             &field("sigma"),
-                            format!("must be ≥ 0, got {sigma}"),
+                            format!("must be ≥ 0, got {}", Num(sigma)),
                         ));
                     }
                     Distribution::Normal {
@@ -322,10 +377,20 @@ impl Campaign {
                         t.f64("low").map_err(schema)?,
                         t.f64("high").map_err(schema)?,
                     );
-                    if high.is_nan() || low.is_nan() || high <= low {
+                    if high <= low {
                         return Err(invalid(
                             &field("high"),
-                            format!("must be greater than low ({low}), got {high}"),
+                            format!("must be greater than low ({}), got {}", Num(low), Num(high)),
+                        ));
+                    }
+                    if !(high - low).is_finite() {
+                        return Err(invalid(
+                            &field("high"),
+                            format!(
+                                "high - low = {} - ({}) overflows a float: no draw could be made",
+                                Num(high),
+                                Num(low)
+                            ),
                         ));
                     }
                     Distribution::Uniform { low, high }
@@ -414,14 +479,38 @@ impl Campaign {
                     ))
                 }
             };
-            let after_s = t.opt_f64("after_s").map_err(schema)?.unwrap_or(0.0);
+            let after_s = t.opt_f64("after_s").map_err(schema)?;
+            if after_s.is_some() && statistic != Statistic::Max {
+                // Only `max` has a window; elsewhere the key would be silently ignored.
+                return Err(invalid(
+                    &field("after_s"),
+                    format!("does not apply to statistic {stat:?} (only \"max\" has a window)"),
+                ));
+            }
+            let after_s = after_s.unwrap_or(0.0);
             if !(0.0..=duration_s).contains(&after_s) {
                 return Err(invalid(
                     &field("after_s"),
-                    format!("must be within 0..=duration_s ({duration_s}), got {after_s}"),
+                    format!(
+                        "must be within 0..=duration_s ({}), got {}",
+                        Num(duration_s),
+                        Num(after_s)
+                    ),
                 ));
             }
             let below = t.f64("below").map_err(schema)?;
+            if below <= 0.0 {
+                // Every quantity is a magnitude or a time (≥ 0), and a criterion passes when
+                // its statistic is strictly below `below`.
+                return Err(invalid(
+                    &field("below"),
+                    format!(
+                        "must be > 0, got {}: every quantity is ≥ 0, so the criterion could never \
+                         pass",
+                        Num(below)
+                    ),
+                ));
+            }
             criteria.push(Criterion {
                 name,
                 quantity,
@@ -431,12 +520,14 @@ impl Campaign {
             });
         }
         Ok(Self {
+            path: path.to_owned(),
             source: source.to_owned(),
             base_path,
             base_toml,
             runs,
             seed,
             duration_s,
+            duration_ns,
             controller,
             sigma_rn,
             max_redraws,
@@ -444,5 +535,38 @@ impl Campaign {
             dispersions,
             criteria,
         })
+    }
+}
+
+/// `seconds` as a whole number of nanoseconds that a `u64` holds, or why not.
+fn within_time(field: &str, seconds: f64) -> Result<u64, String> {
+    if seconds <= 0.0 {
+        return Err(format!("must be > 0, got {}", Num(seconds)));
+    }
+    if seconds >= MAX_SIM_TIME_S {
+        return Err(format!(
+            "{} s is beyond the longest simulation time, {} s ≈ 584 years (2^64 − 1 ns)",
+            Num(seconds),
+            Rounded(MAX_SIM_TIME_S, 6)
+        ));
+    }
+    whole_ns(seconds).ok_or_else(|| {
+        format!(
+            "{} s is not a whole number of nanoseconds ({field})",
+            Num(seconds)
+        )
+    })
+}
+
+/// An error about `field` of the campaign file `path` (text `source`), with its position.
+fn invalid_at(source: &str, path: &Path, field: &str, problem: String) -> CampaignError {
+    let at = DeTable::parse(source)
+        .map(|doc| SourceMap::new(source, doc.get_ref()).at(field))
+        .unwrap_or_default();
+    CampaignError::Invalid {
+        path: path.to_owned(),
+        field: field.to_owned(),
+        problem,
+        at,
     }
 }

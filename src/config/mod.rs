@@ -20,6 +20,7 @@
 //! `scenarios/reference.toml`. The README's "Configuration" section documents every key.
 
 mod error;
+mod file;
 mod source_map;
 
 use std::collections::HashSet;
@@ -31,8 +32,9 @@ use crate::numfmt::{Num, Rounded};
 use crate::schema::location;
 use crate::schema::{mat3, vec3, TableReader};
 pub use error::{At, ConfigError, Location};
+pub use file::{config_message, load_config};
 use flexdyn_proto::MAX_PANEL_PAIRS;
-use source_map::SourceMap;
+pub(crate) use source_map::SourceMap;
 
 use crate::dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
 use crate::dynamics::effectors::reaction_wheel;

@@ -73,6 +73,18 @@ impl<'s> SourceMap<'s> {
 
     /// Rejects NaN and ±Inf anywhere in the document (including `[server]` and `[[imus]]`).
     pub(crate) fn check_all_finite(&self, doc: &DeTable<'_>) -> Result<(), ConfigError> {
+        match self.first_non_finite(doc) {
+            None => Ok(()),
+            Some((field, at)) => Err(ConfigError::Param {
+                source: ParamError::NotFinite { field },
+                at,
+            }),
+        }
+    }
+
+    /// The TOML path and position of the first NaN or ±Inf in the document, if any (TOML
+    /// accepts `nan` and `inf` literals; no flexdyn file does).
+    pub(crate) fn first_non_finite(&self, doc: &DeTable<'_>) -> Option<(String, At)> {
         fn walk_table(t: &DeTable<'_>, path: &str, out: &mut Option<(String, usize)>) {
             for (k, v) in t.iter() {
                 if out.is_some() {
@@ -106,13 +118,7 @@ impl<'s> SourceMap<'s> {
         }
         let mut found = None;
         walk_table(doc, "", &mut found);
-        match found {
-            None => Ok(()),
-            Some((field, offset)) => Err(ConfigError::Param {
-                source: ParamError::NotFinite { field },
-                at: At(Some(location(self.source, offset))),
-            }),
-        }
+        found.map(|(field, offset)| (field, At(Some(location(self.source, offset)))))
     }
 
     pub(crate) fn param_error(&self, source: ParamError) -> ConfigError {

@@ -1,12 +1,12 @@
 //! `flexdyn run`: its arguments, and the process-level wrapper around [`super::run`] (settings
 //! from the file and the options, the tokio runtime, the Zenoh session, SIGINT/SIGTERM).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use super::error::{ServerError, SettingsError};
 use super::settings::{Origin, ServerSettings, Value};
 use super::RunReport;
-use crate::config::{SimConfig, DEFAULT_CONFIG_TOML};
+use crate::config::{load_config, SimConfig};
 use crate::transport::{zenoh_config, Role, ZenohArgs};
 
 /// Arguments of `flexdyn run` (plain `flexdyn` runs with all defaults). Every server option
@@ -149,18 +149,6 @@ impl RunArgs {
         settings.validate()?;
         Ok(settings)
     }
-
-    /// Loads the configuration file, or the embedded default.
-    pub fn load_config(&self) -> Result<SimConfig, ServerError> {
-        match &self.config {
-            Some(p) => SimConfig::from_file(p).map_err(|source| ServerError::Config {
-                file: Some(p.clone()),
-                source,
-            }),
-            None => SimConfig::from_toml_str(DEFAULT_CONFIG_TOML)
-                .map_err(|source| ServerError::Config { file: None, source }),
-        }
-    }
 }
 
 /// [`crate::signals::shutdown_signal`], its failure as a [`ServerError::Signal`].
@@ -174,7 +162,11 @@ async fn shutdown_signal() -> Result<impl std::future::Future<Output = ()>, Serv
 /// the session, runs the server until the duration, a signal or an error, and closes the
 /// session (which flushes the last samples).
 pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
-    let cfg = args.load_config()?;
+    let file = args.config.as_deref();
+    let cfg = load_config(file).map_err(|source| ServerError::Config {
+        file: file.map(Path::to_path_buf),
+        source,
+    })?;
     let settings = args.settings(&cfg)?;
     settings.duration_frames(cfg.frame_ns)?;
     let zcfg = zenoh_config(&args.zenoh, Role::Server)?;

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 pub use crate::transport::ZenohConfigError;
 
-use crate::config::ConfigError;
+use crate::config::{config_message, ConfigError};
 
 /// An invalid server setting. The message starts with the setting's name as the user wrote it:
 /// `server.<key>` for the `[server]` TOML table, `--<flag>` for a command-line option.
@@ -138,13 +138,6 @@ fn list_ids(ids: &[u32]) -> String {
         .map(u32::to_string)
         .collect::<Vec<_>>()
         .join(", ")
-}
-
-fn config_message(file: Option<&std::path::Path>, e: &ConfigError) -> String {
-    match (file, e) {
-        (Some(f), e) if !matches!(e, ConfigError::Io { .. }) => format!("{}: {e}", f.display()),
-        _ => e.to_string(),
-    }
 }
 
 impl ServerError {
