@@ -12,6 +12,12 @@
 //!   decoded field bit for bit. Every buffer the C side decodes it also re-encodes, and that must
 //!   be the input again (C encode → Rust decode of random valid messages; the Rust encode → C
 //!   decode direction is the valid messages in the stream).
+//! - `c_header_is_clean_as_cpp_under_strict_lints`: the header alone, as C++ (`$CXX`, else
+//!   `g++`; and `clang++` too when it is installed) under `-Wold-style-cast
+//!   -Wzero-as-null-pointer-constant -Wuseless-cast -Wconversion -Wsign-conversion`, and as C99
+//!   under `-Wconversion -Wsign-conversion`, all with `-Werror`;
+//! - `c_docs_name_the_current_protocol_version`: the header's and the C README's opening lines
+//!   name `PROTOCOL_VERSION`.
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -66,6 +72,126 @@ fn compile_file(rel: &str, name: &str) -> PathBuf {
         String::from_utf8_lossy(&result.stderr)
     );
     out
+}
+
+/// A translation unit that includes only the header, valid as C and as C++. From C++11 on it
+/// defines `NULL` as a plain `0`, as some C++ libraries do (the standard allows it): g++'s own
+/// `NULL` is `__null`, which its `-Wzero-as-null-pointer-constant` does not flag, while clang++
+/// flags every `NULL` whatever its definition. With this, g++ finds each null-pointer `0` too.
+const HEADER_ONLY_TU: &str = r#"#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#if defined(__cplusplus) && __cplusplus >= 201103L
+#undef NULL
+#define NULL 0
+#endif
+#include "flexdyn_proto.h"
+int main(void) { return 0; }
+"#;
+
+/// Syntax-checks [`HEADER_ONLY_TU`] with `compiler` as `language` (`c` or `c++`) and `flags`;
+/// the compiler's complaints on failure.
+fn check_header_only(compiler: &str, language: &str, flags: &[&str]) -> Result<(), String> {
+    let tu = Path::new(env!("CARGO_TARGET_TMPDIR")).join("header_only.txt");
+    std::fs::write(&tu, HEADER_ONLY_TU).unwrap();
+    let out = Command::new(compiler)
+        .args(["-x", language, "-fsyntax-only", "-Werror"])
+        .args(flags)
+        .arg("-I")
+        .arg(proto_dir().join("c/include"))
+        .arg(&tu)
+        .output()
+        .map_err(|e| format!("cannot run `{compiler}`: {e}"))?;
+    if out.status.success() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{compiler} -x {language} {}:\n{}",
+            flags.join(" "),
+            String::from_utf8_lossy(&out.stderr)
+        ))
+    }
+}
+
+/// Whether `compiler --version` runs, and whether it is clang.
+fn probe(compiler: &str) -> Option<bool> {
+    let out = Command::new(compiler).arg("--version").output().ok()?;
+    out.status
+        .success()
+        .then(|| String::from_utf8_lossy(&out.stdout).contains("clang"))
+}
+
+/// C++ flight code includes the header under the lints MISRA-minded teams build with. Before
+/// the header wrote `static_cast` and `nullptr` in C++, clang++ gave 38 `-Wold-style-cast` and
+/// 15 `-Wzero-as-null-pointer-constant` warnings and g++ 14 `-Wuseless-cast` ones. (g++ does
+/// not apply `-Wold-style-cast` inside an `extern "C"` block, which is why the header has none:
+/// its functions are all `static inline`.) C99 stays clean as well.
+#[test]
+fn c_header_is_clean_as_cpp_under_strict_lints() {
+    const COMMON: &[&str] = &[
+        "-Wall",
+        "-Wextra",
+        "-pedantic",
+        "-Wconversion",
+        "-Wsign-conversion",
+        "-Wshadow",
+        "-Wcast-qual",
+    ];
+    const CXX_LINTS: &[&str] = &["-Wold-style-cast", "-Wzero-as-null-pointer-constant"];
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".to_string());
+    let cxx = std::env::var("CXX").unwrap_or_else(|_| "g++".to_string());
+    let mut compilers = vec![(
+        cxx.clone(),
+        probe(&cxx).unwrap_or_else(|| {
+            panic!(
+                "no C++ compiler: `{cxx} --version` failed. Install g++ (Debian: `apt install \
+                 g++`) or set CXX; the C header's C++ check needs it"
+            )
+        }),
+    )];
+    // clang++ when present (its -Wzero-as-null-pointer-constant also flags `__null`).
+    if !cxx.contains("clang") {
+        if let Some(is_clang) = probe("clang++") {
+            compilers.push(("clang++".to_string(), is_clang));
+        }
+    }
+    let mut failures = Vec::new();
+    let c99: Vec<&str> = ["-std=c99"].iter().chain(COMMON).copied().collect();
+    failures.extend(check_header_only(&cc, "c", &c99).err());
+    for (compiler, is_clang) in &compilers {
+        for std in ["-std=c++98", "-std=c++11", "-std=c++17"] {
+            let mut flags: Vec<&str> = vec![std];
+            flags.extend(COMMON);
+            flags.extend(CXX_LINTS);
+            if !is_clang {
+                flags.push("-Wuseless-cast");
+            }
+            failures.extend(check_header_only(compiler, "c++", &flags).err());
+        }
+    }
+    let names: Vec<&str> = compilers.iter().map(|(c, _)| c.as_str()).collect();
+    eprintln!("C++ compilers checked: {names:?}, C compiler: {cc}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The opening lines of the header and of its README name the protocol version they implement.
+#[test]
+fn c_docs_name_the_current_protocol_version() {
+    let want = format!("version {}", flexdyn_proto::PROTOCOL_VERSION);
+    for (file, lines) in [("c/include/flexdyn_proto.h", 3), ("c/README.md", 4)] {
+        let text = std::fs::read_to_string(proto_dir().join(file)).unwrap();
+        let head: Vec<&str> = text.lines().take(lines).collect();
+        let head = head.join(" ");
+        assert!(
+            head.contains(&want),
+            "{file} opens with {head:?}, which does not say {want:?}"
+        );
+    }
+    let header = std::fs::read_to_string(proto_dir().join("c/include/flexdyn_proto.h")).unwrap();
+    assert!(header.contains(&format!(
+        "#define FD_PROTOCOL_VERSION {}u",
+        flexdyn_proto::PROTOCOL_VERSION
+    )));
 }
 
 #[test]

@@ -1,5 +1,5 @@
 /*
- * flexdyn_proto.h - the flexdyn wire protocol (version 3) for C99 flight code.
+ * flexdyn_proto.h - the flexdyn wire protocol (version 4) for C99 and C++ flight code.
  *
  * Header-only: include it and call fd_decode_* / fd_encode_*. No allocation, no I/O, no
  * global state. Bytes are assembled one by one (little-endian on the wire), never cast to a
@@ -23,6 +23,19 @@
  * Decoders write into caller storage; a StateMsg's effectors and an Actuators command's inputs
  * go into arrays the caller provides (capacity given), FD_ERR_CAPACITY if they do not fit (a C-only
  * reason, checked after the wire rules). Compile with -std=c99 -Wall -Wextra -pedantic.
+ *
+ * C++: the same file compiles as C++ (C++98 on; nullptr from C++11) without a warning under the
+ * stricter lints C++ teams use: -Wold-style-cast, -Wzero-as-null-pointer-constant (clang, and
+ * compilers whose NULL is a plain 0), -Wuseless-cast (g++), -Wconversion, -Wsign-conversion.
+ * Casts are written FD_CAST(type, value), which is static_cast in C++; null pointers FD_NULL,
+ * which is nullptr from C++11 on. Every function is static inline (internal linkage, nothing to
+ * link), so there is no extern "C" block: it would add nothing, and g++ does not apply
+ * -Wold-style-cast inside one, which would hide regressions from the C++ check.
+ *
+ * Lockstep flight code: compute the answer to tick k from the StateMsg of tick k together with
+ * every sensor sample due at tick k. proto/README.md, "Lockstep protocol", says how: one
+ * subscriber on all of flexdyn/<sc>/tlm (the key expression ending in a double star), and the
+ * sensors and their rates from the flexdyn/<sc>/config queryable.
  */
 #ifndef FLEXDYN_PROTO_H
 #define FLEXDYN_PROTO_H
@@ -31,8 +44,17 @@
 #include <stdint.h>
 #include <string.h>
 
+/* Casts and null pointers that suit both languages (see the C++ note above). */
 #ifdef __cplusplus
-extern "C" {
+#define FD_CAST(type, value) (static_cast<type>(value))
+#if __cplusplus >= 201103L || (defined(_MSVC_LANG) && _MSVC_LANG >= 201103L)
+#define FD_NULL nullptr
+#else
+#define FD_NULL NULL
+#endif
+#else
+#define FD_CAST(type, value) ((type)(value))
+#define FD_NULL NULL
 #endif
 
 /* ------------------------------------------------------------------------------------------ */
@@ -220,13 +242,14 @@ typedef struct {
 /* Byte helpers (little-endian, assembled byte by byte).                                       */
 
 static inline uint16_t fd_get_u16(const uint8_t *p) {
-    return (uint16_t)((uint16_t)p[0] | (uint16_t)((uint16_t)p[1] << 8));
+    return FD_CAST(uint16_t, FD_CAST(unsigned, p[0]) | (FD_CAST(unsigned, p[1]) << 8));
 }
 static inline uint32_t fd_get_u32(const uint8_t *p) {
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+    return FD_CAST(uint32_t, p[0]) | (FD_CAST(uint32_t, p[1]) << 8) |
+           (FD_CAST(uint32_t, p[2]) << 16) | (FD_CAST(uint32_t, p[3]) << 24);
 }
 static inline uint64_t fd_get_u64(const uint8_t *p) {
-    return (uint64_t)fd_get_u32(p) | ((uint64_t)fd_get_u32(p + 4) << 32);
+    return FD_CAST(uint64_t, fd_get_u32(p)) | (FD_CAST(uint64_t, fd_get_u32(p + 4)) << 32);
 }
 static inline double fd_get_f64(const uint8_t *p) {
     uint64_t bits = fd_get_u64(p);
@@ -235,18 +258,18 @@ static inline double fd_get_f64(const uint8_t *p) {
     return d;
 }
 static inline void fd_put_u16(uint8_t *p, uint16_t v) {
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
+    p[0] = FD_CAST(uint8_t, v);
+    p[1] = FD_CAST(uint8_t, v >> 8);
 }
 static inline void fd_put_u32(uint8_t *p, uint32_t v) {
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
-    p[2] = (uint8_t)(v >> 16);
-    p[3] = (uint8_t)(v >> 24);
+    p[0] = FD_CAST(uint8_t, v);
+    p[1] = FD_CAST(uint8_t, v >> 8);
+    p[2] = FD_CAST(uint8_t, v >> 16);
+    p[3] = FD_CAST(uint8_t, v >> 24);
 }
 static inline void fd_put_u64(uint8_t *p, uint64_t v) {
-    fd_put_u32(p, (uint32_t)v);
-    fd_put_u32(p + 4, (uint32_t)(v >> 32));
+    fd_put_u32(p, FD_CAST(uint32_t, v));
+    fd_put_u32(p + 4, FD_CAST(uint32_t, v >> 32));
 }
 static inline void fd_put_f64(uint8_t *p, double d) {
     uint64_t bits;
@@ -257,6 +280,16 @@ static inline int fd_is_finite(double d) {
     uint64_t bits;
     memcpy(&bits, &d, sizeof bits);
     return ((bits >> 52) & 0x7ffu) != 0x7ffu;
+}
+/* A count the decoder or encoder has already bounded by its FD_MAX_* (so at most 1024) as a
+ * size_t. Without a cast where size_t is 64 bits wide (on LP64 it is the same type as uint64_t,
+ * and C++'s -Wuseless-cast rejects a cast to the same type); with one where it is narrower. */
+static inline size_t fd_size(uint64_t n) {
+#if SIZE_MAX < UINT64_MAX
+    return FD_CAST(size_t, n);
+#else
+    return n;
+#endif
 }
 static inline void fd_get_f64s(const uint8_t *p, double *out, size_t n) {
     size_t i;
@@ -273,7 +306,7 @@ static inline fd_error fd_ok(void) {
     e.needed = 0;
     e.actual = 0;
     e.found_version = 0;
-    e.field = NULL;
+    e.field = FD_NULL;
     return e;
 }
 static inline fd_error fd_fail(fd_status s, size_t needed, size_t actual, const char *field) {
@@ -288,11 +321,11 @@ static inline fd_error fd_fail(fd_status s, size_t needed, size_t actual, const 
 /* Steps 1-2: size limit and version. min_len is the message type's shortest length. */
 static inline fd_error fd_check_size_and_version(const uint8_t *buf, size_t len, size_t min_len) {
     uint16_t v;
-    if (len > FD_MAX_MESSAGE_BYTES) return fd_fail(FD_ERR_TOO_LARGE, 0, len, NULL);
-    if (len < 2) return fd_fail(FD_ERR_LENGTH, min_len, len, NULL);
+    if (len > FD_MAX_MESSAGE_BYTES) return fd_fail(FD_ERR_TOO_LARGE, 0, len, FD_NULL);
+    if (len < 2) return fd_fail(FD_ERR_LENGTH, min_len, len, FD_NULL);
     v = fd_get_u16(buf);
     if (v != FD_PROTOCOL_VERSION) {
-        fd_error e = fd_fail(FD_ERR_UNKNOWN_VERSION, 0, len, NULL);
+        fd_error e = fd_fail(FD_ERR_UNKNOWN_VERSION, 0, len, FD_NULL);
         e.found_version = v;
         return e;
     }
@@ -301,8 +334,8 @@ static inline fd_error fd_check_size_and_version(const uint8_t *buf, size_t len,
 
 /* Step 3 helper: the expected total length versus the buffer. */
 static inline fd_error fd_check_total(size_t expected, size_t len) {
-    if (len < expected) return fd_fail(FD_ERR_LENGTH, expected, len, NULL);
-    if (len > expected) return fd_fail(FD_ERR_TRAILING_BYTES, expected, len, NULL);
+    if (len < expected) return fd_fail(FD_ERR_LENGTH, expected, len, FD_NULL);
+    if (len > expected) return fd_fail(FD_ERR_TRAILING_BYTES, expected, len, FD_NULL);
     return fd_ok();
 }
 
@@ -313,13 +346,13 @@ typedef struct {
 } fd_walker;
 
 static inline fd_error fd_walk_skip(fd_walker *w, size_t n) {
-    if (w->at + n > w->len) return fd_fail(FD_ERR_LENGTH, w->at + n, w->len, NULL);
+    if (w->at + n > w->len) return fd_fail(FD_ERR_LENGTH, w->at + n, w->len, FD_NULL);
     w->at += n;
     return fd_ok();
 }
 static inline fd_error fd_walk_count(fd_walker *w, const uint8_t *buf, uint64_t max,
                                      const char *what, uint64_t *count) {
-    if (w->at + 8 > w->len) return fd_fail(FD_ERR_LENGTH, w->at + 8, w->len, NULL);
+    if (w->at + 8 > w->len) return fd_fail(FD_ERR_LENGTH, w->at + 8, w->len, FD_NULL);
     *count = fd_get_u64(buf + w->at);
     if (*count > max) return fd_fail(FD_ERR_MALFORMED, 0, w->len, what);
     w->at += 8;
@@ -329,7 +362,7 @@ static inline fd_error fd_walk_values(fd_walker *w, const uint8_t *buf, const ch
     uint64_t n;
     fd_error e = fd_walk_count(w, buf, FD_MAX_EFFECTOR_VALUES, what, &n);
     if (e.status != FD_OK) return e;
-    return fd_walk_skip(w, (size_t)(8 * n));
+    return fd_walk_skip(w, 8 * fd_size(n));
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -354,7 +387,7 @@ static inline void fd_encode_header_at(uint8_t *p, const fd_header *h) {
 static inline fd_header fd_header_new(uint32_t spacecraft_id, uint64_t tick, uint64_t sim_time_ns,
                                       uint64_t seq) {
     fd_header h;
-    h.protocol_version = (uint16_t)FD_PROTOCOL_VERSION;
+    h.protocol_version = FD_CAST(uint16_t, FD_PROTOCOL_VERSION);
     h.spacecraft_id = spacecraft_id;
     h.tick = tick;
     h.sim_time_ns = sim_time_ns;
@@ -366,7 +399,7 @@ static inline fd_header fd_header_new(uint32_t spacecraft_id, uint64_t tick, uin
 static inline fd_error fd_decode_header(const uint8_t *buf, size_t len, fd_header *out) {
     fd_error e = fd_check_size_and_version(buf, len, FD_HEADER_LEN);
     if (e.status != FD_OK) return e;
-    if (len < FD_HEADER_LEN) return fd_fail(FD_ERR_LENGTH, FD_HEADER_LEN, len, NULL);
+    if (len < FD_HEADER_LEN) return fd_fail(FD_ERR_LENGTH, FD_HEADER_LEN, len, FD_NULL);
     fd_decode_header_at(buf, out);
     return fd_ok();
 }
@@ -380,7 +413,7 @@ static inline size_t fd_state_len(const fd_state_msg *m) {
     uint64_t i;
     for (i = 0; i < m->n_effectors; ++i)
         n += FD_EFFECTOR_STATE_FIXED_LEN +
-             8 * (size_t)(m->effectors[i].n_states + m->effectors[i].n_outputs);
+             8 * fd_size(m->effectors[i].n_states + m->effectors[i].n_outputs);
     return n;
 }
 
@@ -392,7 +425,7 @@ static inline fd_error fd_decode_state(const uint8_t *buf, size_t len, fd_state_
     w.at = FD_STATE_EFFECTOR_COUNT_OFFSET;
     w.len = len;
     if (len < FD_STATE_EFFECTOR_COUNT_OFFSET + 8)
-        return fd_fail(FD_ERR_LENGTH, FD_STATE_FIXED_LEN, len, NULL);
+        return fd_fail(FD_ERR_LENGTH, FD_STATE_FIXED_LEN, len, FD_NULL);
     e = fd_walk_count(&w, buf, FD_MAX_EFFECTORS, "effector count", &n);
     if (e.status != FD_OK) return e;
     for (i = 0; i < n; ++i) {
@@ -401,7 +434,7 @@ static inline fd_error fd_decode_state(const uint8_t *buf, size_t len, fd_state_
         if ((e = fd_walk_values(&w, buf, "effector outputs count")).status != FD_OK) return e;
     }
     if ((e = fd_check_total(w.at, len)).status != FD_OK) return e;
-    if (n > out->effectors_capacity) return fd_fail(FD_ERR_CAPACITY, (size_t)n, len, "effectors");
+    if (n > out->effectors_capacity) return fd_fail(FD_ERR_CAPACITY, fd_size(n), len, "effectors");
     fd_decode_header_at(buf, &out->header);
     fd_get_f64s(buf + 30, out->sigma_bn, 3);
     fd_get_f64s(buf + 54, out->q_bn, 4);
@@ -424,11 +457,11 @@ static inline fd_error fd_decode_state(const uint8_t *buf, size_t len, fd_state_
         s->kind = fd_get_u16(buf + w.at);
         s->flags = fd_get_u32(buf + w.at + 2);
         s->n_states = fd_get_u64(buf + w.at + 6);
-        fd_get_f64s(buf + w.at + 14, s->states, (size_t)s->n_states);
-        w.at += 14 + 8 * (size_t)s->n_states;
+        fd_get_f64s(buf + w.at + 14, s->states, fd_size(s->n_states));
+        w.at += 14 + 8 * fd_size(s->n_states);
         s->n_outputs = fd_get_u64(buf + w.at);
-        fd_get_f64s(buf + w.at + 8, s->outputs, (size_t)s->n_outputs);
-        w.at += 8 + 8 * (size_t)s->n_outputs;
+        fd_get_f64s(buf + w.at + 8, s->outputs, fd_size(s->n_outputs));
+        w.at += 8 + 8 * fd_size(s->n_outputs);
     }
     return fd_ok();
 }
@@ -467,11 +500,11 @@ static inline size_t fd_encode_state(const fd_state_msg *m, uint8_t *buf, size_t
         fd_put_u16(buf + at, s->kind);
         fd_put_u32(buf + at + 2, s->flags);
         fd_put_u64(buf + at + 6, s->n_states);
-        fd_put_f64s(buf + at + 14, s->states, (size_t)s->n_states);
-        at += 14 + 8 * (size_t)s->n_states;
+        fd_put_f64s(buf + at + 14, s->states, fd_size(s->n_states));
+        at += 14 + 8 * fd_size(s->n_states);
         fd_put_u64(buf + at, s->n_outputs);
-        fd_put_f64s(buf + at + 8, s->outputs, (size_t)s->n_outputs);
-        at += 8 + 8 * (size_t)s->n_outputs;
+        fd_put_f64s(buf + at + 8, s->outputs, fd_size(s->n_outputs));
+        at += 8 + 8 * fd_size(s->n_outputs);
     }
     return at;
 }
@@ -544,7 +577,7 @@ static inline size_t fd_command_len(const fd_command_msg *m) {
     case FD_COMMAND_ACTUATORS:
         n = FD_COMMAND_ACTUATORS_FIXED_LEN;
         for (i = 0; i < m->n_inputs; ++i)
-            n += FD_EFFECTOR_INPUT_FIXED_LEN + 8 * (size_t)m->inputs[i].n_values;
+            n += FD_EFFECTOR_INPUT_FIXED_LEN + 8 * fd_size(m->inputs[i].n_values);
         return n;
     default: return 0;
     }
@@ -576,7 +609,7 @@ static inline fd_error fd_decode_command(const uint8_t *buf, size_t len, fd_comm
     fd_error e = fd_check_size_and_version(buf, len, FD_COMMAND_NO_COMMAND_LEN);
     if (e.status != FD_OK) return e;
     if (len < FD_COMMAND_KIND_OFFSET + 4)
-        return fd_fail(FD_ERR_LENGTH, FD_COMMAND_NO_COMMAND_LEN, len, NULL);
+        return fd_fail(FD_ERR_LENGTH, FD_COMMAND_NO_COMMAND_LEN, len, FD_NULL);
     tag = fd_get_u32(buf + FD_COMMAND_KIND_OFFSET);
     if (tag == FD_COMMAND_WRENCH) {
         expected = FD_COMMAND_WRENCH_LEN;
@@ -617,16 +650,16 @@ static inline fd_error fd_decode_command(const uint8_t *buf, size_t len, fd_comm
             for (j = 0; j < v; ++j)
                 if (!fd_is_finite(fd_get_f64(buf + at + 12 + 8 * j)))
                     return fd_fail(FD_ERR_NON_FINITE, 0, len, "kind.inputs[].values[]");
-            at += 12 + 8 * (size_t)v;
+            at += 12 + 8 * fd_size(v);
         }
-        if (n > out->inputs_capacity) return fd_fail(FD_ERR_CAPACITY, (size_t)n, len, "inputs");
+        if (n > out->inputs_capacity) return fd_fail(FD_ERR_CAPACITY, fd_size(n), len, "inputs");
         at = FD_COMMAND_ACTUATORS_FIXED_LEN;
         for (i = 0; i < n; ++i) {
             fd_effector_input *in = &out->inputs[i];
             in->effector_index = fd_get_u32(buf + at);
             in->n_values = fd_get_u64(buf + at + 4);
-            fd_get_f64s(buf + at + 12, in->values, (size_t)in->n_values);
-            at += 12 + 8 * (size_t)in->n_values;
+            fd_get_f64s(buf + at + 12, in->values, fd_size(in->n_values));
+            at += 12 + 8 * fd_size(in->n_values);
         }
         out->n_inputs = n;
     }
@@ -657,8 +690,8 @@ static inline size_t fd_encode_command(const fd_command_msg *m, uint8_t *buf, si
     for (i = 0; i < m->n_inputs; ++i) {
         fd_put_u32(buf + at, m->inputs[i].effector_index);
         fd_put_u64(buf + at + 4, m->inputs[i].n_values);
-        fd_put_f64s(buf + at + 12, m->inputs[i].values, (size_t)m->inputs[i].n_values);
-        at += 12 + 8 * (size_t)m->inputs[i].n_values;
+        fd_put_f64s(buf + at + 12, m->inputs[i].values, fd_size(m->inputs[i].n_values));
+        at += 12 + 8 * fd_size(m->inputs[i].n_values);
     }
     return at;
 }
@@ -745,18 +778,18 @@ static inline int fd_valid_id(const char *id) {
 }
 
 /* Writes "flexdyn/<sc>/<suffix>[/<name>]" into out (capacity cap, NUL-terminated); returns the
- * length, or 0 if an id is invalid or it does not fit. name may be NULL. */
+ * length, or 0 if an id is invalid or it does not fit. name may be null. */
 static inline size_t fd_key(char *out, size_t cap, const char *sc, const char *suffix,
                             const char *name) {
     size_t n = 0, k;
     const char *parts[6];
     size_t count = 0;
-    if (!fd_valid_id(sc) || (name != NULL && !fd_valid_id(name))) return 0;
+    if (!fd_valid_id(sc) || (name != FD_NULL && !fd_valid_id(name))) return 0;
     parts[count++] = "flexdyn/";
     parts[count++] = sc;
     parts[count++] = "/";
     parts[count++] = suffix;
-    if (name != NULL) {
+    if (name != FD_NULL) {
         parts[count++] = "/";
         parts[count++] = name;
     }
@@ -771,7 +804,7 @@ static inline size_t fd_key(char *out, size_t cap, const char *sc, const char *s
 }
 
 static inline size_t fd_state_key(char *out, size_t cap, const char *sc) {
-    return fd_key(out, cap, sc, "tlm/state", NULL);
+    return fd_key(out, cap, sc, "tlm/state", FD_NULL);
 }
 static inline size_t fd_imu_key(char *out, size_t cap, const char *sc, const char *name) {
     return fd_key(out, cap, sc, "tlm/imu", name);
@@ -780,14 +813,14 @@ static inline size_t fd_star_tracker_key(char *out, size_t cap, const char *sc, 
     return fd_key(out, cap, sc, "tlm/st", name);
 }
 static inline size_t fd_status_key(char *out, size_t cap, const char *sc) {
-    return fd_key(out, cap, sc, "status", NULL);
+    return fd_key(out, cap, sc, "status", FD_NULL);
 }
 /* Writes the decimal form of v (no leading zero) into digits[11]; returns its first char. */
 static inline const char *fd_decimal_u32(char digits[11], uint32_t v) {
     int i = 10;
     digits[10] = '\0';
     do {
-        digits[--i] = (char)('0' + v % 10u);
+        digits[--i] = FD_CAST(char, '0' + v % 10u);
         v /= 10u;
     } while (v != 0 && i > 0);
     return digits + i;
@@ -804,8 +837,7 @@ static inline size_t fd_participant_key(char *out, size_t cap, const char *sc, u
     return fd_key(out, cap, sc, "participant", fd_decimal_u32(digits, sender_id));
 }
 
-#ifdef __cplusplus
-}
-#endif
+#undef FD_CAST
+#undef FD_NULL
 
 #endif /* FLEXDYN_PROTO_H */

@@ -1,18 +1,23 @@
 """flexdyn: the Python SDK of the flexdyn dynamics server.
 
 - :mod:`flexdyn.proto`: every wire message as a dataclass, with encode/decode;
-- :class:`Client`: a Zenoh session the flexdyn way, typed subscriptions, commands;
-- :class:`LockstepParticipant`: answers every lockstep tick with your controller's output;
+- :class:`Client`: a Zenoh session the flexdyn way, typed subscriptions (all telemetry through
+  one ``flexdyn/<sc>/tlm/**`` subscriber, in publication order), commands, and the server's
+  configuration (:meth:`Client.vehicle`);
+- :class:`LockstepParticipant`: answers every lockstep tick with your controller's output,
+  computed from the tick's complete telemetry (the state and every sensor sample due at it);
 - :mod:`flexdyn.testing`: run a server for the duration of a test.
 """
 
 from . import proto
-from .client import Client, LockstepParticipant, session_config
+from .client import Client, Subscription, VehicleInfo, session_config
+from .lockstep import Answer, LockstepParticipant, SensorSchedule, Tick
 from .proto import (CommandMsg, DecodeError, EffectorInput, EffectorState, Header, ImuMsg,
                     StarTrackerMsg, StateMsg, StatusMsg)
 
 __all__ = [
-    "proto", "Client", "LockstepParticipant", "session_config", "CommandMsg", "DecodeError",
+    "proto", "Client", "Subscription", "VehicleInfo", "session_config", "Answer",
+    "LockstepParticipant", "SensorSchedule", "Tick", "CommandMsg", "DecodeError",
     "EffectorInput", "EffectorState", "Header", "ImuMsg", "StarTrackerMsg", "StateMsg",
     "StatusMsg",
 ]

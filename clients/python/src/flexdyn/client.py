@@ -1,11 +1,21 @@
 """Zenoh transport the flexdyn way: a peer session with multicast scouting off, connected to
-the given loopback endpoint(s), and typed helpers for the server's topics."""
+the given loopback endpoint(s), and typed helpers for the server's topics.
+
+Every telemetry callback of a :class:`Client` (state, IMUs, star trackers) is fed by **one**
+Zenoh subscriber on ``flexdyn/<sc>/tlm/**``, one sample at a time, in the order the server
+published them (a tick's sensor samples, then its state). Separate Zenoh subscribers would each
+be delivered on their own thread, and a StateMsg could then overtake the ImuMsg of its own tick
+(proto/README.md, "Lockstep protocol").
+"""
 
 from __future__ import annotations
 
 import json
+import logging
 import threading
-from typing import Callable, Iterable, List, Optional, Sequence, Tuple, Union
+import time
+from dataclasses import dataclass
+from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 import zenoh
 
@@ -13,6 +23,8 @@ from . import proto
 from .proto import CommandMsg, EffectorInput, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg
 
 Vec3 = Tuple[float, float, float]
+
+log = logging.getLogger("flexdyn")
 
 
 def session_config(endpoints: Sequence[str], zenoh_config: Optional[str] = None) -> zenoh.Config:
@@ -29,6 +41,43 @@ def session_config(endpoints: Sequence[str], zenoh_config: Optional[str] = None)
     return conf
 
 
+@dataclass(frozen=True)
+class VehicleInfo:
+    """The server's answer on ``flexdyn/<sc>/config`` (proto/README.md, "Topics"): what it runs.
+    ``config_toml`` is the configuration file verbatim; ``server_settings`` the settings in
+    effect as ``key=value`` pairs."""
+
+    sc_id: str
+    spacecraft_id: int
+    config_toml: str
+    server_settings: str
+    flexdyn_version: Optional[str]
+    git_commit: Optional[str]
+
+    def config(self) -> Dict[str, Any]:
+        """The configuration, parsed (``tomllib``; ``tomli`` before Python 3.11)."""
+        try:
+            import tomllib
+        except ImportError:  # Python < 3.11
+            import tomli as tomllib  # type: ignore[no-redef]
+        return tomllib.loads(self.config_toml)
+
+
+#: The decoder of each telemetry key kind: the part of the key after ``flexdyn/<sc>/tlm/``
+#: is ``state``, ``imu/<name>`` or ``st/<name>``.
+_DECODERS = {"state": StateMsg.decode, "imu": ImuMsg.decode, "st": StarTrackerMsg.decode}
+
+
+class Subscription:
+    """A callback registered on a :class:`Client`; ``undeclare()`` removes it."""
+
+    def __init__(self, client: "Client", route: str, callback: Callable) -> None:
+        self._client, self._route, self._callback = client, route, callback
+
+    def undeclare(self) -> None:
+        self._client._telemetry_remove(self._route, self._callback)
+
+
 class Client:
     """A Zenoh session to one flexdyn server and spacecraft.
 
@@ -42,6 +91,7 @@ class Client:
         endpoints = [endpoint] if isinstance(endpoint, str) else list(endpoint)
         self.sc_id = sc_id
         self.spacecraft_id = spacecraft_id
+        self._tlm_prefix = proto.telemetry_key(sc_id)[:-2]  # "flexdyn/<sc>/tlm/"
         self.session = zenoh.open(session_config(endpoints, zenoh_config))
         # One publisher per sender id, on flexdyn/<sc>/cmd/<sender_id>, declared on first use.
         self._command_pubs: dict = {}
@@ -52,38 +102,138 @@ class Client:
         # caller's; this lock keeps a put and close() from overlapping.
         self._pub_lock = threading.Lock()
         self._closed = False
+        # Telemetry: one subscriber on flexdyn/<sc>/tlm/**, declared on first use; the callbacks
+        # by route ("state", "imu/<name>", "st/<name>"), then the taps (every decoded sample).
+        # `_dispatch` is held while a sample is delivered, so callbacks never overlap.
+        self._dispatch = threading.RLock()
+        self._routes: Dict[str, List[Callable]] = {}
+        self._taps: List[Callable[[str, object], None]] = []
+        self._telemetry_sub: Optional[object] = None
+        #: Undecodable telemetry samples received (a sample that is not the message its key says).
+        self.undecodable = 0
+        #: Exceptions raised by telemetry callbacks (logged on the ``flexdyn`` logger; the other
+        #: callbacks of the same sample still run).
+        self.callback_errors: List[BaseException] = []
 
     # -- subscriptions ---------------------------------------------------------------------
 
-    def _subscribe(self, key: str, decode, callback) -> object:
-        def on_sample(sample) -> None:
+    def _on_telemetry(self, sample) -> None:
+        key = str(sample.key_expr)
+        if not key.startswith(self._tlm_prefix):
+            return
+        route = key[len(self._tlm_prefix):]
+        decode = _DECODERS.get(route.split("/", 1)[0])
+        if decode is None:
+            return
+        with self._dispatch:
+            callbacks = list(self._routes.get(route, ()))
+            taps = list(self._taps)
+            if not callbacks and not taps:
+                return
             try:
                 msg = decode(sample.payload.to_bytes())
+            except proto.DecodeError:
+                self.undecodable += 1
+                return
+            calls = [(c, (msg,)) for c in callbacks] + [(t, (route, msg)) for t in taps]
+            for fn, args in calls:
+                try:
+                    fn(*args)
+                except BaseException as e:  # one callback's failure does not starve the others
+                    if len(self.callback_errors) < 100:
+                        self.callback_errors.append(e)
+                    log.exception("a flexdyn telemetry callback on %s raised", key)
+
+    def _telemetry_subscriber(self) -> None:
+        """Declares the one ``tlm/**`` subscriber (once)."""
+        with self._dispatch:
+            if self._telemetry_sub is None:
+                self._telemetry_sub = self.session.declare_subscriber(
+                    proto.telemetry_key(self.sc_id), self._on_telemetry)
+
+    def _telemetry_add(self, route: str, callback: Callable) -> Subscription:
+        with self._dispatch:
+            self._routes.setdefault(route, []).append(callback)
+        self._telemetry_subscriber()
+        return Subscription(self, route, callback)
+
+    def _telemetry_remove(self, route: str, callback: Callable) -> None:
+        with self._dispatch:
+            callbacks = self._routes.get(route, [])
+            if callback in callbacks:
+                callbacks.remove(callback)
+
+    def add_telemetry_tap(self, tap: Callable[[str, object], None]) -> None:
+        """Calls ``tap(route, msg)`` with every telemetry sample, after the callbacks of its
+        route: ``route`` is ``"state"``, ``"imu/<name>"`` or ``"st/<name>"``, ``msg`` the decoded
+        message. (The lockstep participant's view of the stream.)"""
+        with self._dispatch:
+            self._taps.append(tap)
+        self._telemetry_subscriber()
+
+    def remove_telemetry_tap(self, tap: Callable[[str, object], None]) -> None:
+        """Removes a tap added by :meth:`add_telemetry_tap`."""
+        with self._dispatch:
+            if tap in self._taps:
+                self._taps.remove(tap)
+
+    def subscribe_state(self, callback: Callable[[StateMsg], None]) -> Subscription:
+        """Calls `callback` with every StateMsg (on a Zenoh thread; after the sensor samples
+        the server published before it)."""
+        return self._telemetry_add("state", callback)
+
+    def subscribe_imu(self, name: str, callback: Callable[[ImuMsg], None]) -> Subscription:
+        """Calls `callback` with every sample of the IMU `name` (before the StateMsg of its
+        tick)."""
+        return self._telemetry_add(proto.imu_key(self.sc_id, name)[len(self._tlm_prefix):],
+                                   callback)
+
+    def subscribe_star_tracker(self, name: str,
+                               callback: Callable[[StarTrackerMsg], None]) -> Subscription:
+        """Calls `callback` with every measurement of the star tracker `name` (before the
+        StateMsg of its tick)."""
+        key = proto.star_tracker_key(self.sc_id, name)
+        return self._telemetry_add(key[len(self._tlm_prefix):], callback)
+
+    def subscribe_status(self, callback: Callable[[StatusMsg], None]) -> object:
+        """Calls `callback` with every StatusMsg (its own subscriber: status is not telemetry
+        of a tick)."""
+        def on_sample(sample) -> None:
+            try:
+                msg = StatusMsg.decode(sample.payload.to_bytes())
             except proto.DecodeError:
                 return
             callback(msg)
 
-        sub = self.session.declare_subscriber(key, on_sample)
+        sub = self.session.declare_subscriber(proto.status_key(self.sc_id), on_sample)
         self._subscribers.append(sub)
         return sub
 
-    def subscribe_state(self, callback: Callable[[StateMsg], None]) -> object:
-        """Calls `callback` with every StateMsg (on a Zenoh thread)."""
-        return self._subscribe(proto.state_key(self.sc_id), StateMsg.decode, callback)
+    # -- the configuration queryable --------------------------------------------------------
 
-    def subscribe_imu(self, name: str, callback: Callable[[ImuMsg], None]) -> object:
-        """Calls `callback` with every sample of the IMU `name`."""
-        return self._subscribe(proto.imu_key(self.sc_id, name), ImuMsg.decode, callback)
-
-    def subscribe_star_tracker(self, name: str,
-                               callback: Callable[[StarTrackerMsg], None]) -> object:
-        """Calls `callback` with every measurement of the star tracker `name`."""
-        return self._subscribe(proto.star_tracker_key(self.sc_id, name), StarTrackerMsg.decode,
-                               callback)
-
-    def subscribe_status(self, callback: Callable[[StatusMsg], None]) -> object:
-        """Calls `callback` with every StatusMsg."""
-        return self._subscribe(proto.status_key(self.sc_id), StatusMsg.decode, callback)
+    def vehicle(self, timeout_s: float = 30.0) -> VehicleInfo:
+        """Asks the server's ``flexdyn/<sc>/config`` queryable what it runs, retrying until it
+        answers (it is declared a moment after the server starts listening) or `timeout_s`
+        passes (then ``TimeoutError``)."""
+        key = proto.config_key(self.sc_id)
+        deadline = time.monotonic() + timeout_s
+        while True:
+            left = deadline - time.monotonic()
+            for reply in self.session.get(key, timeout=max(0.1, min(left, 2.0))):
+                if reply.ok is None:
+                    continue
+                try:
+                    d = json.loads(reply.ok.payload.to_bytes().decode("utf-8"))
+                    return VehicleInfo(d["sc_id"], int(d["spacecraft_id"]), d["config_toml"],
+                                       d["server_settings"], d.get("flexdyn_version"),
+                                       d.get("git_commit"))
+                except (ValueError, KeyError, TypeError) as e:
+                    raise ValueError(f"{key}: the reply is not a flexdyn vehicle description "
+                                     f"({e})") from e
+            if time.monotonic() >= deadline:
+                raise TimeoutError(f"no answer on {key} within {timeout_s} s: is a flexdyn "
+                                   f"server running with sc_id {self.sc_id!r} at this endpoint?")
+            time.sleep(0.05)
 
     # -- commands ----------------------------------------------------------------------------
 
@@ -125,6 +275,12 @@ class Client:
 
     def close(self) -> None:
         """Undeclares everything and closes the session."""
+        with self._dispatch:
+            self._routes.clear()
+            self._taps.clear()
+            tlm, self._telemetry_sub = self._telemetry_sub, None
+        if tlm is not None:
+            tlm.undeclare()
         for s in self._subscribers:
             s.undeclare()
         self._subscribers.clear()
@@ -138,61 +294,6 @@ class Client:
         self.session.close()
 
     def __enter__(self) -> "Client":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
-
-
-#: What an `on_state` callback returns: None (NoCommand), a (torque_b_nm, force_b_newton) pair
-#: (Wrench), or a CommandMsg whose kind and body are sent (its header and sender are set here).
-Answer = Optional[Union[Tuple[Vec3, Vec3], CommandMsg]]
-
-
-class LockstepParticipant:
-    """A lockstep participant: subscribes to the state first, then declares its liveliness token
-    (so the server cannot publish tick 0 before it can be received), and answers every state with
-    what `on_state(state)` returns, stamped with the state's tick. `close()` stops it cleanly
-    (token first, so the server sees it leave)."""
-
-    def __init__(self, client: Client, sender_id: int,
-                 on_state: Callable[[StateMsg], Answer]) -> None:
-        self.client = client
-        self.sender_id = sender_id
-        self.on_state = on_state
-        self.answered = 0
-        self.errors: List[BaseException] = []
-        self._sub = client.subscribe_state(self._answer)
-        self._token = client.session.liveliness().declare_token(
-            proto.participant_key(client.sc_id, sender_id))
-
-    def _answer(self, state: StateMsg) -> None:
-        h = state.header
-        try:
-            a = self.on_state(state)
-            if a is None:
-                self.client.send_no_command(self.sender_id, h.tick, h.sim_time_ns)
-            elif isinstance(a, CommandMsg):
-                a.header = self.client._header(h.tick, h.sim_time_ns)
-                a.sender_id = self.sender_id
-                self.client.send(a)
-            else:
-                torque, force = a
-                self.client.send_wrench(self.sender_id, h.tick, h.sim_time_ns, torque, force)
-            self.answered += 1
-        except BaseException as e:  # reported by close(); the server then times out on us
-            self.errors.append(e)
-
-    def close(self) -> None:
-        """Undeclares the token, then the subscriber; raises the first callback error, if any."""
-        self._token.undeclare()
-        self._sub.undeclare()
-        if self._sub in self.client._subscribers:
-            self.client._subscribers.remove(self._sub)
-        if self.errors:
-            raise self.errors[0]
-
-    def __enter__(self) -> "LockstepParticipant":
         return self
 
     def __exit__(self, *exc) -> None:

@@ -1,11 +1,11 @@
-"""The flexdyn wire protocol, version 3, in pure Python.
+"""The flexdyn wire protocol, version 4, in pure Python.
 
 Every message of ``proto/README.md`` as a dataclass with ``encode()`` and ``decode(bytes)``.
 Decoding follows the README's decoder rules in the same order and raises :class:`DecodeError`
 with the same reasons as the Rust crate's ``DecodeError``:
 
 1. more than ``MAX_MESSAGE_BYTES`` -> ``TooLarge``;
-2. fewer than 2 bytes -> ``Length``; first two bytes (u16 LE) != 3 -> ``UnknownVersion``;
+2. fewer than 2 bytes -> ``Length``; first two bytes (u16 LE) != 4 -> ``UnknownVersion``;
 3. the total length from the layout (fixed; command tag at 34; walked counts, each bounded
    first) -> ``Length`` (needed = length implied by the counts read so far), ``Malformed``
    (unknown tag, count above its maximum), ``TrailingBytes``;
@@ -473,6 +473,19 @@ def command_key(sc: str, sender_id: int) -> str:
 
 def status_key(sc: str) -> str:
     return _key(sc, "status")
+
+
+def telemetry_key(sc: str) -> str:
+    """``flexdyn/<sc>/tlm/**``: the state and every sensor topic. One subscriber on it sees a
+    tick's samples in the order the server published them (proto/README.md, "Lockstep
+    protocol")."""
+    return _key(sc, "tlm/**")
+
+
+def config_key(sc: str) -> str:
+    """``flexdyn/<sc>/config``: the server's configuration queryable (a ``get`` returns UTF-8
+    JSON, not a bincode message)."""
+    return _key(sc, "config")
 
 
 def participant_key(sc: str, sender_id: int) -> str:

@@ -1,0 +1,271 @@
+"""Lockstep participation with complete ticks.
+
+The server publishes, for each tick k, the sample of every IMU and of every star tracker due
+at k, then the StateMsg of k (proto/README.md, "Lockstep protocol"). A controller that reads
+sensors must answer tick k from exactly those samples; it is then as deterministic as the
+server. :class:`LockstepParticipant` makes sure of it:
+
+- it learns from the server's configuration queryable (``flexdyn/<sc>/config``) which sensors
+  exist and at which ticks each one publishes (:class:`SensorSchedule`), instead of guessing;
+- it sees the telemetry through the client's one ``flexdyn/<sc>/tlm/**`` subscriber, in the
+  order it was published, and holds the StateMsg of tick k until every sample due at k is in;
+- only then does it call your ``on_state(state)`` (after every ``subscribe_imu`` /
+  ``subscribe_star_tracker`` callback of that tick has run) or ``on_tick(tick)`` (with the
+  samples in a :class:`Tick`), and send the answer.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+from dataclasses import dataclass, field
+from typing import Callable, Dict, List, Optional, Tuple, Union
+
+from . import proto
+from .client import Client, Vec3
+from .proto import CommandMsg, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg
+
+log = logging.getLogger("flexdyn")
+
+#: What ``on_state`` / ``on_tick`` returns: None (NoCommand), a (torque_b_nm, force_b_newton)
+#: pair (Wrench), or a CommandMsg whose kind and body are sent (its header and sender are set
+#: here).
+Answer = Optional[Union[Tuple[Vec3, Vec3], CommandMsg]]
+
+#: run_state values of a run's last StatusMsg: Finished, Failed, Stopped.
+_ENDED = (3, 4, 5)
+
+
+@dataclass(frozen=True)
+class SensorSchedule:
+    """Which sensor samples the server publishes at each tick, read from its configuration:
+    every ``[[imus]]`` entry each tick (route ``imu/<name>``), and each ``[[star_trackers]]``
+    entry on the ticks that are multiples of its period, round(``simulation.frame_hz`` /
+    ``rate_hz``) frames, from tick 0 (route ``st/<name>``)."""
+
+    imus: Tuple[str, ...]
+    #: (name, period in frames)
+    star_trackers: Tuple[Tuple[str, int], ...]
+
+    @classmethod
+    def from_config(cls, config: dict) -> "SensorSchedule":
+        """From a parsed configuration (see :meth:`flexdyn.VehicleInfo.config`)."""
+        frame_hz = float(config["simulation"]["frame_hz"])
+        trackers = []
+        for i, st in enumerate(config.get("star_trackers", [])):
+            rate_hz = float(st["rate_hz"])
+            every = round(frame_hz / rate_hz) if rate_hz > 0 and math.isfinite(rate_hz) else 0
+            if every < 1:
+                raise ValueError(f"star_trackers[{i}].rate_hz = {rate_hz}: not the frame rate "
+                                 f"({frame_hz} Hz) divided by a whole number")
+            trackers.append((str(st["name"]), every))
+        return cls(tuple(str(imu["name"]) for imu in config.get("imus", [])), tuple(trackers))
+
+    def due(self, tick: int) -> Tuple[str, ...]:
+        """The routes of the samples published at `tick` (``imu/<name>``, ``st/<name>``)."""
+        return tuple([f"imu/{n}" for n in self.imus]
+                     + [f"st/{n}" for n, every in self.star_trackers if tick % every == 0])
+
+
+@dataclass
+class Tick:
+    """One tick's telemetry: its StateMsg and the sensor samples due at it, by name."""
+
+    state: StateMsg
+    imu: Dict[str, ImuMsg] = field(default_factory=dict)
+    star_trackers: Dict[str, StarTrackerMsg] = field(default_factory=dict)
+    #: Routes of due samples that never came (``imu/<name>``, ``st/<name>``). Empty in
+    #: lockstep unless a sample was lost; see ``sensor_timeout_s``.
+    missing: Tuple[str, ...] = ()
+
+    @property
+    def tick(self) -> int:
+        return self.state.header.tick
+
+
+class LockstepParticipant:
+    """A lockstep participant that answers every tick from the tick's complete telemetry.
+
+    On creation it asks the server's configuration queryable which sensors publish when
+    (``config_timeout_s``), registers on the client's telemetry stream, and only then declares
+    its liveliness token (so the server cannot publish tick 0 before it can be received).
+    For every tick it calls exactly one of
+
+    - ``on_state(state)``: after every sample due at that tick has been delivered to the
+      client's ``subscribe_imu`` / ``subscribe_star_tracker`` callbacks, so state kept by
+      those callbacks is that tick's;
+    - ``on_tick(tick)``: with a :class:`Tick` holding the state and those samples,
+
+    and sends what it returns, stamped with the state's tick. A due sample that has not come
+    ``sensor_timeout_s`` after its state (lost; it cannot happen in lockstep unless a sample is
+    dropped) releases the tick without it, listed in ``Tick.missing`` and counted in
+    ``incomplete_ticks``. In real time, where the server drops samples under load, a later
+    tick's sample releases a waiting tick at once the same way.
+
+    :meth:`wait` blocks until the run has ended; :meth:`close` stops (token first, so the server
+    sees it leave) and raises the first error of the callback, if any.
+    """
+
+    def __init__(self, client: Client, sender_id: int,
+                 on_state: Optional[Callable[[StateMsg], Answer]] = None, *,
+                 on_tick: Optional[Callable[[Tick], Answer]] = None,
+                 sensor_timeout_s: float = 5.0, config_timeout_s: float = 30.0) -> None:
+        if (on_state is None) == (on_tick is None):
+            raise TypeError("LockstepParticipant takes exactly one of on_state and on_tick")
+        self.client = client
+        self.sender_id = sender_id
+        self.on_state = on_state
+        self.on_tick = on_tick
+        self.sensor_timeout_s = sensor_timeout_s
+        self.answered = 0
+        self.incomplete_ticks = 0
+        self.errors: List[BaseException] = []
+        self.vehicle = client.vehicle(timeout_s=config_timeout_s)
+        if self.vehicle.spacecraft_id != client.spacecraft_id:
+            raise ValueError(
+                f"the server's spacecraft_id is {self.vehicle.spacecraft_id} and the Client's "
+                f"{client.spacecraft_id}: its commands would be rejected (wrong spacecraft). "
+                f"Pass spacecraft_id={self.vehicle.spacecraft_id} to flexdyn.Client")
+        self.schedule = SensorSchedule.from_config(self.vehicle.config())
+        # The tick being assembled: its state once it has come, and samples by tick.
+        self._held: Optional[StateMsg] = None
+        self._samples: Dict[int, Dict[str, object]] = {}
+        self._last_tick = -1  # the last tick handed to the callback
+        self._timer: Optional[threading.Timer] = None
+        self._final: Optional[StatusMsg] = None
+        self._changed = threading.Condition()
+        self._status_sub = client.subscribe_status(self._on_status)
+        client.add_telemetry_tap(self._on_sample)
+        self._token = client.session.liveliness().declare_token(
+            proto.participant_key(client.sc_id, sender_id))
+
+    # -- assembling ticks (on the client's telemetry thread, one sample at a time) ------------
+
+    def _on_sample(self, route: str, msg) -> None:
+        tick = msg.header.tick
+        if tick <= self._last_tick:
+            return  # a tick already answered (a sample that came after its timeout)
+        if self._held is not None and tick > self._held.header.tick:
+            self._release()  # the held tick's missing samples will not come any more
+        if route == "state":
+            for t in [t for t in self._samples if t < tick]:
+                del self._samples[t]  # sensor samples of a state that never came (real time)
+            self._held = msg
+        else:
+            self._samples.setdefault(tick, {})[route] = msg
+        if self._held is not None:
+            if self._missing():
+                self._arm_timer(self._held.header.tick)
+            else:
+                self._release()
+
+    def _missing(self) -> Tuple[str, ...]:
+        h = self._held
+        have = self._samples.get(h.header.tick, {})
+        return tuple(r for r in self.schedule.due(h.header.tick) if r not in have)
+
+    def _arm_timer(self, tick: int) -> None:
+        if self._timer is None:
+            self._timer = threading.Timer(self.sensor_timeout_s, self._on_timeout, (tick,))
+            self._timer.daemon = True
+            self._timer.start()
+
+    def _on_timeout(self, tick: int) -> None:
+        with self.client._dispatch:
+            if self._held is not None and self._held.header.tick == tick:
+                self._timer = None
+                self._release()
+
+    def _release(self) -> None:
+        """Hands the held state and its samples to the callback and sends the answer."""
+        state, self._held = self._held, None
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+        h = state.header
+        samples = self._samples.pop(h.tick, {})
+        missing = tuple(r for r in self.schedule.due(h.tick) if r not in samples)
+        if missing:
+            self.incomplete_ticks += 1
+            if self.incomplete_ticks == 1 or self.incomplete_ticks % 100 == 0:
+                log.warning("tick %d: no sample from %s; answering without it (%d incomplete "
+                            "ticks so far)", h.tick, ", ".join(missing), self.incomplete_ticks)
+        self._last_tick = h.tick
+        try:
+            if self.on_tick is not None:
+                t = Tick(state, missing=missing)
+                for route, msg in samples.items():
+                    kind, name = route.split("/", 1)
+                    (t.imu if kind == "imu" else t.star_trackers)[name] = msg
+                self._send(h, self.on_tick(t))
+            else:
+                self._send(h, self.on_state(state))
+            self.answered += 1
+        except BaseException as e:  # reported by wait() and close(); the server times out on us
+            self.errors.append(e)
+        with self._changed:
+            self._changed.notify_all()
+
+    def _send(self, h: proto.Header, a: Answer) -> None:
+        if a is None:
+            self.client.send_no_command(self.sender_id, h.tick, h.sim_time_ns)
+        elif isinstance(a, CommandMsg):
+            a.header = self.client._header(h.tick, h.sim_time_ns)
+            a.sender_id = self.sender_id
+            self.client.send(a)
+        else:
+            torque, force = a
+            self.client.send_wrench(self.sender_id, h.tick, h.sim_time_ns, torque, force)
+
+    # -- the end of the run ------------------------------------------------------------------
+
+    def _on_status(self, status: StatusMsg) -> None:
+        if status.run_state in _ENDED:
+            with self._changed:
+                self._final = status
+                self._changed.notify_all()
+
+    @property
+    def last_tick(self) -> int:
+        """The last tick handed to the callback (-1 before the first)."""
+        return self._last_tick
+
+    def wait(self, timeout_s: Optional[float] = None) -> StatusMsg:
+        """Blocks until the run has ended: the server's last StatusMsg (run_state Finished,
+        Failed or Stopped) has come and every tick up to its tick has been handed to the
+        callback. Returns that StatusMsg. Raises the callback's first error as soon as there is
+        one, and ``TimeoutError`` after `timeout_s`."""
+        def ended() -> bool:
+            return bool(self.errors) or (self._final is not None
+                                          and self._last_tick >= self._final.header.tick)
+
+        with self._changed:
+            if not self._changed.wait_for(ended, timeout_s):
+                raise TimeoutError(
+                    f"the run did not end within {timeout_s} s (last tick answered: "
+                    f"{self._last_tick}; final status: "
+                    f"{'none yet' if self._final is None else self._final.header.tick})")
+        if self.errors:
+            raise self.errors[0]
+        return self._final
+
+    def close(self) -> None:
+        """Undeclares the token, then stops listening; raises the first callback error."""
+        self._token.undeclare()
+        self.client.remove_telemetry_tap(self._on_sample)
+        with self.client._dispatch:
+            if self._timer is not None:
+                self._timer.cancel()
+                self._timer = None
+        self._status_sub.undeclare()
+        if self._status_sub in self.client._subscribers:
+            self.client._subscribers.remove(self._status_sub)
+        if self.errors:
+            raise self.errors[0]
+
+    def __enter__(self) -> "LockstepParticipant":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

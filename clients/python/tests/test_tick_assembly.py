@@ -1,0 +1,204 @@
+"""How LockstepParticipant assembles a tick, without a server: samples are fed to it in chosen
+orders through a stand-in client, and the answers it sends are recorded."""
+
+import threading
+import time
+
+import flexdyn
+from flexdyn import proto
+from flexdyn.proto import Header, ImuMsg, StarTrackerMsg, StateMsg
+
+CONFIG_TOML = """
+[simulation]
+step_s = 0.001
+frame_hz = 100.0
+[[imus]]
+name = "hub"
+[[imus]]
+name = "bracket"
+[[star_trackers]]
+name = "st1"
+rate_hz = 10.0
+[[star_trackers]]
+name = "st2"
+rate_hz = 25.0
+"""
+
+
+class FakeClient:
+    """What LockstepParticipant uses of a Client; telemetry is fed with `feed`."""
+
+    sc_id, spacecraft_id = "sc1", 1
+
+    def __init__(self):
+        self._dispatch = threading.RLock()
+        self._subscribers = []
+        self.taps = []
+        self.sent = []  # (tick, kind)
+        outer = self
+
+        class Token:
+            def undeclare(self):
+                pass
+
+        class Liveliness:
+            def declare_token(self, key):
+                assert key == "flexdyn/sc1/participant/1"
+                return Token()
+
+        class Session:
+            def liveliness(self):
+                return Liveliness()
+
+        self.session = Session()
+        self.status_callback = None
+
+    def vehicle(self, timeout_s):
+        return flexdyn.VehicleInfo("sc1", 1, CONFIG_TOML, "", None, None)
+
+    def subscribe_status(self, callback):
+        self.status_callback = callback
+
+        class Sub:
+            def undeclare(self):
+                pass
+
+        return Sub()
+
+    def add_telemetry_tap(self, tap):
+        self.taps.append(tap)
+
+    def remove_telemetry_tap(self, tap):
+        self.taps.remove(tap)
+
+    def feed(self, route, msg):
+        with self._dispatch:
+            for tap in self.taps:
+                tap(route, msg)
+
+    def send_no_command(self, sender_id, tick, sim_time_ns):
+        self.sent.append((tick, "none"))
+
+    def send_wrench(self, sender_id, tick, sim_time_ns, torque, force):
+        self.sent.append((tick, "wrench"))
+
+
+def header(tick):
+    return Header(1, tick, tick * 10_000_000, tick)
+
+
+def state(tick):
+    return StateMsg(header(tick))
+
+
+def imu(tick, rate_x=0.0):
+    return ImuMsg(header(tick), (rate_x, 0.0, 0.0))
+
+
+def st(tick):
+    return StarTrackerMsg(header(tick), (1.0, 0.0, 0.0, 0.0), True)
+
+
+def participant(client, seen, **kw):
+    def on_tick(t):
+        seen.append(t)
+        return None
+
+    return flexdyn.LockstepParticipant(client, 1, on_tick=on_tick, **kw)
+
+
+def test_the_schedule_comes_from_the_configuration():
+    s = flexdyn.SensorSchedule.from_config(flexdyn.VehicleInfo(
+        "sc1", 1, CONFIG_TOML, "", None, None).config())
+    assert s == flexdyn.SensorSchedule(("hub", "bracket"), (("st1", 10), ("st2", 4)))
+    assert s.due(0) == ("imu/hub", "imu/bracket", "st/st1", "st/st2")
+    assert s.due(4) == ("imu/hub", "imu/bracket", "st/st2")
+    assert s.due(7) == ("imu/hub", "imu/bracket")
+    assert s.due(20) == ("imu/hub", "imu/bracket", "st/st1", "st/st2")
+
+
+def test_a_state_that_overtakes_its_samples_waits_for_them():
+    c, seen = FakeClient(), []
+    p = participant(c, seen)
+    c.feed("state", state(0))
+    c.feed("imu/hub", imu(0))
+    c.feed("st/st1", st(0))
+    c.feed("imu/bracket", imu(0))
+    assert seen == [] and c.sent == [], "tick 0 answered without st/st2"
+    c.feed("st/st2", st(0))
+    assert [t.tick for t in seen] == [0] and c.sent == [(0, "none")]
+    t = seen[0]
+    assert set(t.imu) == {"hub", "bracket"} and set(t.star_trackers) == {"st1", "st2"}
+    assert t.missing == ()
+    # Tick 1: the IMUs only (no tracker is due); in publication order it goes at once.
+    c.feed("imu/hub", imu(1, 0.5))
+    c.feed("imu/bracket", imu(1))
+    c.feed("state", state(1))
+    assert [t.tick for t in seen] == [0, 1] and seen[1].imu["hub"].omega_p_rad_s[0] == 0.5
+    p.close()
+
+
+def test_a_lost_sample_releases_its_tick_after_the_timeout():
+    c, seen = FakeClient(), []
+    p = participant(c, seen, sensor_timeout_s=0.2)
+    c.feed("imu/hub", imu(3))
+    c.feed("state", state(3))  # imu/bracket of tick 3 never comes
+    assert seen == []
+    time.sleep(0.6)
+    assert [t.tick for t in seen] == [3] and seen[0].missing == ("imu/bracket",)
+    assert p.incomplete_ticks == 1 and c.sent == [(3, "none")]
+    c.feed("imu/bracket", imu(3))  # too late: ignored, nothing is answered twice
+    assert c.sent == [(3, "none")]
+    p.close()
+
+
+def test_in_real_time_a_later_tick_releases_a_waiting_one_at_once():
+    c, seen = FakeClient(), []
+    p = participant(c, seen, sensor_timeout_s=60)
+    c.feed("imu/hub", imu(5))
+    c.feed("state", state(5))  # imu/bracket of tick 5 was dropped by the server
+    c.feed("imu/hub", imu(6))
+    assert [(t.tick, t.missing) for t in seen] == [(5, ("imu/bracket",))]
+    c.feed("imu/bracket", imu(6))
+    c.feed("state", state(6))
+    assert [(t.tick, t.missing) for t in seen] == [(5, ("imu/bracket",)), (6, ())]
+    p.close()
+
+
+def test_wait_returns_the_final_status_once_its_tick_is_answered():
+    c, seen = FakeClient(), []
+    p = participant(c, seen)
+    final = proto.StatusMsg(header(1), proto.MODE_LOCKSTEP, 3)
+    c.status_callback(final)
+    try:
+        p.wait(timeout_s=0.1)
+        raise AssertionError("wait returned before tick 1 was answered")
+    except TimeoutError:
+        pass
+    for tick in (0, 1):
+        c.feed("imu/hub", imu(tick))
+        c.feed("imu/bracket", imu(tick))
+        if tick == 0:
+            c.feed("st/st1", st(0))
+            c.feed("st/st2", st(0))
+        c.feed("state", state(tick))
+    assert p.wait(timeout_s=1) is final
+    p.close()
+
+
+def test_an_error_in_the_callback_ends_wait_and_close():
+    c = FakeClient()
+
+    def on_state(s):
+        raise RuntimeError("control law failed")
+
+    p = flexdyn.LockstepParticipant(c, 1, on_state)
+    for route in ("imu/hub", "imu/bracket", "st/st1", "st/st2"):
+        c.feed(route, imu(0) if route.startswith("imu") else st(0))
+    c.feed("state", state(0))
+    for call in (lambda: p.wait(timeout_s=5), p.close):
+        try:
+            call()
+            raise AssertionError("the error was not raised")
+        except RuntimeError as e:
+            assert str(e) == "control law failed"
