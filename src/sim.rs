@@ -1,9 +1,9 @@
 //! The shared simulation runner used by `flexdyn simulate` and by the real-time server.
 //!
-//! A [`Simulation`] owns the [`Spacecraft`], the configured external-wrench schedule and the
-//! wrench commanded by the attitude-control software. Before every RK4 step it applies
-//! `schedule(t) + command`, where `t` is the time at the start of the step; the wrench is then
-//! held constant over the step.
+//! A [`Simulation`] owns the [`Spacecraft`], the configured schedules (external wrench and
+//! effector inputs) and what the attitude-control software commands (a wrench and effector
+//! inputs). Before every RK4 step it applies `schedule(t) + command` to both, where `t` is the
+//! time at the start of the step; wrench and inputs are then held constant over the step.
 //!
 //! It also owns the IMU error models ([`crate::sensors::imu`]): [`Simulation::imu_samples_into`] closes
 //! the current IMU sample interval (every frame in the server, every log interval in
@@ -14,7 +14,7 @@ use std::num::NonZeroU64;
 use nalgebra::{Vector3, Vector4};
 
 use crate::attitude::{mrp_to_dcm, mrp_to_quat};
-use crate::config::{ConfigError, SimConfig};
+use crate::config::{ConfigError, EffectorInputSegment, SimConfig};
 use crate::dynamics::{
     Conserved, EffectorKind, HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment,
 };
@@ -35,6 +35,14 @@ pub struct Simulation {
     /// The commanded effector inputs, flat (laid out by
     /// [`Spacecraft::effector_input_ranges`]).
     inputs: Vec<f64>,
+    /// The effector-input schedule, sorted by start time.
+    input_schedule: Vec<EffectorInputSegment>,
+    /// Number of input-schedule rows already applied.
+    input_cursor: usize,
+    /// The scheduled effector inputs in effect, flat like `inputs`.
+    scheduled_inputs: Vec<f64>,
+    /// Scratch for `inputs + scheduled_inputs`, sized once.
+    applied_inputs: Vec<f64>,
     /// Scratch for [`Spacecraft::effector_outputs`], sized once.
     outputs_scratch: Vec<f64>,
     flags_scratch: Vec<u32>,
@@ -227,6 +235,10 @@ impl Simulation {
         }
         let mut sim = Self {
             inputs: vec![0.0; sc.effector_input_len()],
+            input_schedule: cfg.effector_input_schedule.clone(),
+            input_cursor: 0,
+            scheduled_inputs: vec![0.0; sc.effector_input_len()],
+            applied_inputs: vec![0.0; sc.effector_input_len()],
             outputs_scratch: vec![0.0; sc.effector_output_len()],
             flags_scratch: vec![0; sc.effectors().len()],
             frame_outputs: None,
@@ -238,7 +250,7 @@ impl Simulation {
             imus,
             star_trackers,
         };
-        sim.apply_wrench();
+        sim.apply_schedules();
         Ok(sim)
     }
 
@@ -290,12 +302,15 @@ impl Simulation {
 
     /// Sets every effector's commanded inputs from one flat vector laid out by
     /// [`Spacecraft::effector_input_ranges`] (e.g. every wheel's motor torque), held until the
-    /// next call. Fails, changing nothing, on a wrong length or a non-finite value.
+    /// next call. They are added to the scheduled inputs (`[[effector_input_schedule]]`), as the
+    /// commanded wrench is to the wrench schedule. Fails, changing nothing, on a wrong length or
+    /// a non-finite value.
     pub fn set_effector_inputs(&mut self, u: &[f64]) -> Result<(), ParamError> {
-        self.sc.set_effector_inputs(u)?;
+        self.sc.check_effector_inputs(u)?;
         if self.inputs != u {
             self.frame_outputs = None;
             self.inputs.copy_from_slice(u);
+            self.push_inputs();
         }
         Ok(())
     }
@@ -305,15 +320,56 @@ impl Simulation {
         &self.inputs
     }
 
+    /// The scheduled effector inputs in effect, flat (zero without `[[effector_input_schedule]]`).
+    pub fn scheduled_effector_inputs(&self) -> &[f64] {
+        &self.scheduled_inputs
+    }
+
+    /// Hands `command + schedule` to the effectors. Without a schedule the command goes
+    /// through untouched (bit for bit, −0.0 included). A sum beyond ±f64::MAX is held at it:
+    /// the effector clips it to its own limit anyway.
+    fn push_inputs(&mut self) {
+        let u: &[f64] = if self.input_schedule.is_empty() {
+            &self.inputs
+        } else {
+            for ((a, c), s) in self
+                .applied_inputs
+                .iter_mut()
+                .zip(&self.inputs)
+                .zip(&self.scheduled_inputs)
+            {
+                *a = (c + s).clamp(-f64::MAX, f64::MAX);
+            }
+            &self.applied_inputs
+        };
+        // Cannot fail: the length is the spacecraft's and every value is finite.
+        let _ = self.sc.set_effector_inputs(u);
+    }
+
     /// The commanded wrench.
     pub fn command_wrench(&self) -> Wrench {
         self.command
     }
 
-    /// Sets the spacecraft's wrench to schedule(t) + command for the current time t.
+    /// Applies both schedules at the current time t: the wrench schedule(t) + command, and the
+    /// effector-input rows that start at or before t (then command + schedule).
     #[inline]
-    fn apply_wrench(&mut self) {
+    fn apply_schedules(&mut self) {
         let t = self.sc.t_sim_ns();
+        let mut inputs_changed = false;
+        while let Some(row) = self
+            .input_schedule
+            .get(self.input_cursor)
+            .filter(|r| r.t_start_ns <= t)
+        {
+            let r = self.sc.effector_input_ranges()[row.effector_index].clone();
+            self.scheduled_inputs[r].copy_from_slice(&row.inputs);
+            self.input_cursor += 1;
+            inputs_changed = true;
+        }
+        if inputs_changed {
+            self.push_inputs();
+        }
         while self.cursor < self.schedule.len() && self.schedule[self.cursor].t_start_ns <= t {
             self.cursor += 1;
         }
@@ -329,7 +385,7 @@ impl Simulation {
     #[inline]
     pub fn step(&mut self) {
         self.frame_outputs = None;
-        self.apply_wrench();
+        self.apply_schedules();
         self.sc.step();
     }
 
@@ -362,7 +418,7 @@ impl Simulation {
         if let Some(o) = self.frame_outputs {
             return o;
         }
-        self.apply_wrench();
+        self.apply_schedules();
         let o = self.sc.hub_outputs();
         self.frame_outputs = Some(o);
         o

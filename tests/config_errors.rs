@@ -173,6 +173,7 @@ fn every_shipped_scenario_is_valid() {
             "j2_orbit",
             "no_gravity",
             "reference",
+            "wheel_slew",
             "wheels_star_tracker"
         ]
     );

@@ -21,6 +21,7 @@
 
 mod error;
 mod file;
+mod schedule;
 mod source_map;
 
 use std::collections::HashSet;
@@ -34,6 +35,7 @@ use crate::schema::{mat3, vec3, TableReader};
 pub use error::{At, ConfigError, Location};
 pub use file::{config_message, load_config};
 use flexdyn_proto::MAX_PANEL_PAIRS;
+pub use schedule::EffectorInputSegment;
 pub(crate) use source_map::SourceMap;
 
 use crate::dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
@@ -74,6 +76,9 @@ pub struct SimConfig {
     pub reaction_wheels: Vec<ReactionWheelParams>,
     /// Piecewise-constant external wrench on the hub, sorted by strictly increasing start time.
     pub wrench_schedule: Vec<WrenchSegment>,
+    /// Piecewise-constant effector inputs (`[[effector_input_schedule]]`), sorted by start
+    /// time (rows of equal time in file order); each row holds until the same effector's next.
+    pub effector_input_schedule: Vec<EffectorInputSegment>,
     /// The `[server]` table, uninterpreted (empty if absent); the server validates it.
     pub server: toml::Table,
     /// The IMUs (`[[imus]]`), validated, in file order (empty if absent). IMU `i` is sensor
@@ -181,7 +186,7 @@ pub fn gravity_model_name(g: &GravityModel) -> &'static str {
 /// One-line summary of a valid configuration.
 pub fn config_summary(cfg: &SimConfig) -> String {
     format!(
-        "{} panel pairs{}, {} IMUs{}{}, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows",
+        "{} panel pairs{}, {} IMUs{}{}, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows{}",
         cfg.panel_pairs.len(),
         if cfg.reaction_wheels.is_empty() {
             String::new()
@@ -209,6 +214,10 @@ pub fn config_summary(cfg: &SimConfig) -> String {
         cfg.steps_per_frame(),
         gravity_model_name(&cfg.gravity),
         cfg.wrench_schedule.len(),
+        match cfg.effector_input_schedule.len() {
+            0 => String::new(),
+            n => format!(", {n} effector input schedule rows"),
+        },
     )
 }
 
@@ -242,6 +251,7 @@ const ROOT_KEYS: &[&str] = &[
     "panel_pairs",
     "reaction_wheels",
     "wrench_schedule",
+    "effector_input_schedule",
     "server",
     "imus",
     "star_trackers",
@@ -255,6 +265,7 @@ struct RawConfig {
     panel_pairs: Vec<RawPanelPair>,
     reaction_wheels: Vec<ReactionWheelParams>,
     wrench_schedule: Vec<RawWrench>,
+    effector_input_schedule: Vec<schedule::RawInputRow>,
     server: toml::Table,
     imus: Vec<RawImu>,
     star_trackers: Vec<RawStarTracker>,
@@ -357,6 +368,12 @@ impl RawConfig {
                 })
             })
             .collect::<Result<Vec<_>, ConfigError>>()?;
+        let effector_input_schedule = root
+            .tables("effector_input_schedule", &schedule::KEYS)?
+            .unwrap_or_default()
+            .iter()
+            .map(schedule::RawInputRow::read)
+            .collect::<Result<Vec<_>, _>>()?;
         // `[server]` is read and validated by the server's own schema
         // (`flexdyn::server::settings`); here it only has to be a table. `check-config` runs
         // that schema too.
@@ -396,6 +413,7 @@ impl RawConfig {
             panel_pairs,
             reaction_wheels,
             wrench_schedule,
+            effector_input_schedule,
             server,
             imus,
             star_trackers,
@@ -510,38 +528,14 @@ impl RawConfig {
         let mut wrench_schedule = Vec::with_capacity(self.wrench_schedule.len());
         for (i, row) in self.wrench_schedule.iter().enumerate() {
             let path = format!("wrench_schedule[{i}]");
-            let t_field = format!("{path}.t_s");
-            if row.t_s < 0.0 {
-                return Err(param(ParamError::Negative {
-                    field: t_field,
-                    value: row.t_s,
-                }));
-            }
-            beyond_max_time(map, &t_field, row.t_s)?;
-            let t_start_ns = match whole_ns(row.t_s) {
-                Some(ns) if ns % step_ns == 0 => ns,
-                _ => {
-                    return Err(map.timing(
-                        &t_field,
-                        format!(
-                            "t_s = {} s is not a whole number of steps (step = {step_ns} ns)",
-                            Num(row.t_s)
-                        ),
-                    ))
-                }
-            };
-            if let Some(prev) = wrench_schedule.last().map(|w: &WrenchSegment| w.t_start_ns) {
-                if t_start_ns <= prev {
-                    return Err(map.wrench_order(
-                        &t_field,
-                        format!(
-                            "t_s = {} s is not after the previous row's ({} s): t_s must be strictly increasing",
-                            Num(row.t_s),
-                            Num(prev as f64 * 1e-9)
-                        ),
-                    ));
-                }
-            }
+            let t_start_ns = schedule::row_time_ns(
+                map,
+                &format!("{path}.t_s"),
+                row.t_s,
+                step_ns,
+                wrench_schedule.last().map(|w: &WrenchSegment| w.t_start_ns),
+                |field, problem| map.wrench_order(field, problem),
+            )?;
             let seg = WrenchSegment {
                 t_start_ns,
                 force_b_newton: vec3(&row.force_b_newton),
@@ -608,7 +602,7 @@ impl RawConfig {
             star_trackers.push(cfg);
         }
 
-        let cfg = SimConfig {
+        let mut cfg = SimConfig {
             step_ns,
             frame_ns,
             frame_hz: sim.frame_hz,
@@ -618,6 +612,8 @@ impl RawConfig {
             panel_pairs,
             reaction_wheels,
             wrench_schedule,
+            // Resolved below, against the built spacecraft's effectors.
+            effector_input_schedule: Vec::new(),
             server: self.server,
             imus,
             star_trackers,
@@ -628,6 +624,8 @@ impl RawConfig {
         check_resolved_by_step(&cfg, map)?;
         // Both remaining checks look at the built spacecraft's initial state: build it once.
         let mut sc = cfg.build_spacecraft()?;
+        cfg.effector_input_schedule =
+            schedule::resolve(&self.effector_input_schedule, &sc, step_ns, map)?;
         check_gravity_bound(&cfg, &sc, map)?;
         check_initial_outputs_finite(&cfg, &mut sc, map)?;
         Ok(cfg)

@@ -601,6 +601,18 @@ impl Spacecraft {
     /// Sets every effector's commanded inputs from one flat vector laid out by
     /// [`Self::effector_input_ranges`], held until the next call. Allocates nothing.
     pub fn set_effector_inputs(&mut self, u: &[f64]) -> Result<(), ParamError> {
+        self.check_effector_inputs(u)?;
+        for (e, r) in self.eom.effectors.iter_mut().zip(&self.eom.input_ranges) {
+            if !r.is_empty() {
+                e.set_inputs(&u[r.clone()]);
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether `u` fits [`Self::set_effector_inputs`]: [`Self::effector_input_len`] values, each
+    /// finite.
+    pub fn check_effector_inputs(&self, u: &[f64]) -> Result<(), ParamError> {
         if u.len() != self.effector_input_len() {
             return Err(ParamError::InputLength {
                 expected: self.effector_input_len(),
@@ -611,11 +623,6 @@ impl Spacecraft {
             return Err(ParamError::NotFinite {
                 field: format!("effector input {i}"),
             });
-        }
-        for (e, r) in self.eom.effectors.iter_mut().zip(&self.eom.input_ranges) {
-            if !r.is_empty() {
-                e.set_inputs(&u[r.clone()]);
-            }
         }
         Ok(())
     }

@@ -251,6 +251,20 @@ impl<'a, 'i> TableReader<'a, 'i> {
             .transpose()
     }
 
+    /// Required array of numbers of any length (its length is checked by the caller, which
+    /// knows what it must be).
+    pub(crate) fn float_list(&self, key: &str) -> Result<Vec<f64>, SchemaError> {
+        let field = self.field(key);
+        let v = self.required(key)?;
+        let DeValue::Array(a) = v.get_ref() else {
+            return Err(self.expected(field, v, "an array of numbers"));
+        };
+        a.iter()
+            .enumerate()
+            .map(|(i, e)| self.number(format!("{field}[{i}]"), e))
+            .collect()
+    }
+
     fn mat3_of(&self, field: &str, v: &Spanned<DeValue<'i>>) -> Result<[[f64; 3]; 3], SchemaError> {
         let rows = match v.get_ref() {
             DeValue::Array(a) if a.len() == 3 => a,
