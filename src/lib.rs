@@ -3,6 +3,8 @@
 //! # Layout
 //! - [`attitude`]: MRP, DCM and quaternion kernels.
 //! - [`dynamics`]: the physics core — rigid hub + dual-hinged panel pairs by back-substitution.
+//! - [`environment`]: the world around the spacecraft — ephemerides, shadow, magnetic field,
+//!   atmosphere and the facet (flat-plate) surface model.
 //! - [`schema`]: the typed TOML reader the per-model schemas use.
 //! - [`sensors`]: sensor models — [`sensors::imu`] (gyro and accelerometer).
 //! - [`logging`]: the stderr log setup shared by `flexdyn` and the tools (EPIPE-safe).
@@ -19,6 +21,7 @@ pub mod campaign;
 pub mod cli;
 pub mod config;
 pub mod dynamics;
+pub mod environment;
 pub mod logging;
 pub mod numfmt;
 pub mod schema;
