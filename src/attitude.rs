@@ -147,11 +147,25 @@ pub fn mrp_switch(sigma_bn: &mut Vector3<f64>) -> bool {
     }
 }
 
+/// Principal-axis rotation by `angle_rad` about the first axis: M1(a) = [[1, 0, 0], [0, c, s], [0, −s, c]].
+#[inline]
+pub fn m1(angle_rad: f64) -> Matrix3<f64> {
+    let (s, c) = angle_rad.sin_cos();
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, s, 0.0, -s, c)
+}
+
 /// Principal-axis rotation by `angle_rad` about the second axis: M2(a) = [[c, 0, −s], [0, 1, 0], [s, 0, c]].
 #[inline]
 pub fn m2(angle_rad: f64) -> Matrix3<f64> {
     let (s, c) = angle_rad.sin_cos();
     Matrix3::new(c, 0.0, -s, 0.0, 1.0, 0.0, s, 0.0, c)
+}
+
+/// Principal-axis rotation by `angle_rad` about the third axis: M3(a) = [[c, s, 0], [−s, c, 0], [0, 0, 1]].
+#[inline]
+pub fn m3(angle_rad: f64) -> Matrix3<f64> {
+    let (s, c) = angle_rad.sin_cos();
+    Matrix3::new(c, s, 0.0, -s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
 /// MRP error σ_BR of B relative to R, from σ_BN and σ_RN: [BR] = [BN][RN]ᵀ, returned with |σ| ≤ 1.

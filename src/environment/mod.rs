@@ -1,7 +1,41 @@
-//! The world around the spacecraft: the epoch and the environment models (fields, ephemerides,
-//! atmosphere), each in its own folder, and the [`EnvironmentSample`] they fill for the dynamic
-//! effectors ([`crate::dynamics::DynamicEffector`]) and the sensors.
+//! The world around the spacecraft: field and ephemeris models, one folder per model, and the
+//! [`EnvironmentSample`] they fill for the dynamic effectors ([`crate::dynamics::DynamicEffector`])
+//! and the sensors.
+//!
+//! Every model here is a leaf: it takes plain inputs (a time as Julian centuries of TT since
+//! J2000.0, a decimal year, or a day of year and UT seconds; positions in the frame its
+//! argument names) and imports nothing from [`crate::dynamics`], [`crate::config`] or the server.
+//! The functions the stepping loop calls allocate nothing, lock nothing and cannot panic; what can
+//! be wrong with a model's parameters is checked once, when it is built, and reported as a typed
+//! error.
+//!
+//! # Frames
+//! - **N**: the inertial frame, GCRF. The models below give their positions in the mean equator
+//!   and equinox of J2000.0 (EME2000), which differs from the GCRF by the frame bias, a fixed
+//!   rotation of 0.02″ (23 mas); every model here is at least 100 times coarser than that, so the
+//!   two are used as one.
+//! - **ECEF**: the Earth-fixed frame (ITRF); the magnetic field and the atmosphere take their
+//!   positions in it (`r_ecef_m`). The rotation from N to ECEF is the epoch/Earth-rotation model's.
+//! - **NED**: local north-east-down at a point, geodetic (WGS-84) or geocentric as the function
+//!   says.
+//! - **B**: the body frame of the hub; the facet model works in it.
+//!
+//! # Layout
+//! - [`sample`]: the [`EnvironmentSample`] the dynamic effectors and sensors read, held between
+//!   model updates.
+//! - [`geodetic`]: WGS-84 ECEF ↔ geodetic latitude, longitude and height; the NED frame.
+//! - [`ephemeris`]: Sun and Moon positions in N (Meeus, *Astronomical Algorithms*, ch. 25 and 47).
+//! - [`shadow`]: the fraction of the solar disc visible from the spacecraft (conical with
+//!   penumbra, or cylindrical).
+//! - [`magnetic`]: IGRF-14 to a chosen degree, the centred tilted dipole of its degree-1
+//!   coefficients, and the torque on a residual dipole.
+//! - [`atmosphere`]: exponential (Vallado Table 8-4) and NRLMSISE-00 densities, and the wind of a
+//!   co-rotating atmosphere.
+//! - [`facets`]: the flat-plate model of the vehicle's surfaces: drag and solar-radiation-pressure
+//!   forces and torques about B.
 
+pub mod ephemeris;
+pub mod geodetic;
 pub mod sample;
 
 pub use sample::EnvironmentSample;
