@@ -305,4 +305,3 @@ fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
     }
     assert!(checked >= 20, "only {checked} paths checked");
 }
-
