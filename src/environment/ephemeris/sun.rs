@@ -11,11 +11,11 @@ use super::{reduced_rad, EclipticOfDate, AU_M};
 pub fn sun_ecliptic_of_date(t_tt_jc: f64) -> EclipticOfDate {
     let t = t_tt_jc;
     // Eq. 25.2: geometric mean longitude L0 [deg], mean equinox of date.
-    let l0_deg = 280.46646 + t * (36_000.76983 + t * 0.000_3032);
+    let l0_deg = 280.46646 + t * (36_000.769_83 + t * 0.000_303_2);
     // Eq. 25.3: mean anomaly M [deg].
-    let m = reduced_rad(357.52911 + t * (35_999.05029 - t * 0.000_1537));
+    let m = reduced_rad(357.52911 + t * (35_999.050_29 - t * 0.000_153_7));
     // Eq. 25.4: eccentricity of the Earth's orbit e.
-    let e = 0.016_708_634 - t * (0.000_042_037 + t * 0.000_000_1267);
+    let e = 0.016_708_634 - t * (0.000_042_037 + t * 0.000_000_126_7);
     // Equation of the centre C [deg] (Meeus p. 164).
     let c_deg = (1.914_602 - t * (0.004_817 + t * 0.000_014)) * m.sin()
         + (0.019_993 - t * 0.000_101) * (2.0 * m).sin()

@@ -186,7 +186,7 @@ mod tests {
     #[test]
     fn a_sphere_feels_no_torque_and_no_force() {
         let inertia = Matrix3::from_diagonal_element(100.0);
-        let r = Vector3::new(4.1e6, -3.3e6, 4.4e6);
+        let r: Vector3<f64> = Vector3::new(4.1e6, -3.3e6, 4.4e6);
         // Zero up to the rounding of [I]R: relative to the torque scale 3μ I/R³ and the force
         // scale 3μ I/R⁴ of an unbalanced body.
         let r3 = r.norm().powi(3);
