@@ -49,6 +49,13 @@ pub struct GravityGradient {
     pub mu_m3_s2: f64,
 }
 
+/// (R², R⁵) of `r_cn_b_m`, the powers every term of GG1–GG3 divides by.
+#[inline]
+fn r2_r5(r_cn_b_m: &Vector3<f64>) -> (f64, f64) {
+    let r2 = r_cn_b_m.norm_squared();
+    (r2, r2 * r2 * r2.sqrt())
+}
+
 /// \[N·m\] GG2: the torque about C for the CoM at `r_cn_b_m` (R, B components) and the inertia
 /// about C `inertia_c_b_kg_m2` (B components): (3μ/R⁵) R × [I_C]R.
 #[inline]
@@ -57,8 +64,7 @@ pub fn torque_c_b_nm(
     r_cn_b_m: &Vector3<f64>,
     inertia_c_b_kg_m2: &Matrix3<f64>,
 ) -> Vector3<f64> {
-    let r2 = r_cn_b_m.norm_squared();
-    let r5 = r2 * r2 * r2.sqrt();
+    let (_, r5) = r2_r5(r_cn_b_m);
     r_cn_b_m.cross(&(inertia_c_b_kg_m2 * r_cn_b_m)) * (3.0 * mu_m3_s2 / r5)
 }
 
@@ -70,8 +76,7 @@ pub fn force_b_newton(
     r_cn_b_m: &Vector3<f64>,
     inertia_c_b_kg_m2: &Matrix3<f64>,
 ) -> Vector3<f64> {
-    let r2 = r_cn_b_m.norm_squared();
-    let r5 = r2 * r2 * r2.sqrt();
+    let (r2, r5) = r2_r5(r_cn_b_m);
     let i_r = inertia_c_b_kg_m2 * r_cn_b_m;
     let radial = 5.0 * r_cn_b_m.dot(&i_r) / r2 - inertia_c_b_kg_m2.trace();
     (r_cn_b_m * radial - i_r * 2.0) * (1.5 * mu_m3_s2 / r5)
@@ -83,8 +88,7 @@ pub fn potential_j(
     r_cn_b_m: &Vector3<f64>,
     inertia_c_b_kg_m2: &Matrix3<f64>,
 ) -> f64 {
-    let r2 = r_cn_b_m.norm_squared();
-    let r5 = r2 * r2 * r2.sqrt();
+    let (r2, r5) = r2_r5(r_cn_b_m);
     0.5 * mu_m3_s2 / r5
         * (3.0 * r_cn_b_m.dot(&(inertia_c_b_kg_m2 * r_cn_b_m)) - r2 * inertia_c_b_kg_m2.trace())
 }
