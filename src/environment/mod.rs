@@ -37,5 +37,6 @@
 pub mod ephemeris;
 pub mod geodetic;
 pub mod sample;
+pub mod shadow;
 
 pub use sample::EnvironmentSample;
