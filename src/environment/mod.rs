@@ -36,6 +36,7 @@
 
 pub mod ephemeris;
 pub mod geodetic;
+pub mod magnetic;
 pub mod sample;
 pub mod shadow;
 
