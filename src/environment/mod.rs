@@ -35,6 +35,7 @@
 //!   forces and torques about B.
 
 pub mod ephemeris;
+pub mod facets;
 pub mod geodetic;
 pub mod magnetic;
 pub mod sample;
