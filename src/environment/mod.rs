@@ -34,6 +34,7 @@
 //! - [`facets`]: the flat-plate model of the vehicle's surfaces: drag and solar-radiation-pressure
 //!   forces and torques about B.
 
+pub mod atmosphere;
 pub mod ephemeris;
 pub mod facets;
 pub mod geodetic;
