@@ -34,8 +34,12 @@
 //! - [`facets`]: the flat-plate model of the vehicle's surfaces: drag and solar-radiation-pressure
 //!   forces and torques about B.
 
+pub mod atmosphere;
 pub mod ephemeris;
+pub mod facets;
 pub mod geodetic;
+pub mod magnetic;
 pub mod sample;
+pub mod shadow;
 
 pub use sample::EnvironmentSample;

@@ -1,0 +1,244 @@
+//! The flat-plate (facet) model of the vehicle's surfaces: aerodynamic drag and solar radiation
+//! pressure (SRP) as forces and torques about point B.
+//!
+//! Each [`Facet`] is a one-sided flat plate: an area A, an outward unit normal n̂ in B, a centre
+//! of pressure r_cp relative to B, a drag coefficient C_D and the fractions of incident sunlight
+//! it absorbs (ρa), reflects specularly (ρs) and reflects diffusely (ρd), ρa + ρs + ρd = 1. A
+//! thin panel is two facets, one per side. A facet contributes only when its normal faces the
+//! flow (drag) or the Sun (SRP); shadowing of one facet by another and multiple reflections are
+//! neglected, which is exact for a convex body and an approximation otherwise.
+//!
+//! **Drag** (Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed., §8.6.2: the drag
+//! force −½ ρ C_D A |v_rel|² v̂_rel, applied per plate with its projected area; Montenbruck &
+//! Gill, *Satellite Orbits*, §3.5): with v the velocity of B relative to the air and
+//! cos θ = n̂·v̂ > 0,
+//!
+//! F = −½ ρ C_D A |v|² cos θ v̂,
+//!
+//! so the plate's projected area A cos θ sets the force and the force opposes the motion.
+//!
+//! **SRP** (Montenbruck & Gill §3.4.1 give absorption and specular reflection; the diffuse term
+//! follows from Lambert's law, below): with ŝ the unit vector from the spacecraft to the Sun,
+//! cos θ = n̂·ŝ > 0 and P the radiation pressure at the spacecraft,
+//!
+//! F = −P A cos θ [(ρa + ρd) ŝ + (2 ρs cos θ + ⅔ ρd) n̂].
+//!
+//! It follows from the photons' momentum: the absorbed part pushes along −ŝ; the specular part
+//! reverses the normal momentum, −2 cos θ n̂; the diffuse part is absorbed (−ŝ) and re-emitted
+//! with a cosine (Lambert) distribution, whose mean recoil is ⅔ along −n̂.
+//!
+//! **Torque** about B: τ = Σ r_cp × F over the lit or wetted facets (the moment of the facet
+//! forces; Wie, *Space Vehicle Dynamics and Control*, 2nd ed., 2008, environmental disturbance
+//! torques). B is the hub's reference point, so the lead's dynamic effector can apply the force at
+//! B and the torque as given.
+//!
+//! Checked in `tests/environment_facets.rs`: single plates at known incidence against the
+//! momentum balance above (the ⅔ by numerical integration of Lambert's law), and a closed cube
+//! giving zero torque about its centre for every flow and Sun direction.
+
+use nalgebra::Vector3;
+
+use super::ephemeris::AU_M;
+
+/// [W/m²] nominal total solar irradiance at 1 AU (IAU 2015 Resolution B3).
+pub const SOLAR_IRRADIANCE_1AU_W_M2: f64 = 1361.0;
+/// [m/s] the speed of light.
+pub const SPEED_OF_LIGHT_M_S: f64 = 299_792_458.0;
+
+/// [N/m²] the solar radiation pressure at `sun_distance_m` [m] from the Sun's centre, for a
+/// visible fraction `shadow_factor` of the solar disc: P = (Φ/c) (1 AU / r)² ν, with Φ the
+/// irradiance at 1 AU (`irradiance_1au_w_m2`, nominally [`SOLAR_IRRADIANCE_1AU_W_M2`]).
+pub fn solar_pressure_n_m2(
+    sun_distance_m: f64,
+    shadow_factor: f64,
+    irradiance_1au_w_m2: f64,
+) -> f64 {
+    let au_over_r = AU_M / sun_distance_m;
+    irradiance_1au_w_m2 / SPEED_OF_LIGHT_M_S * au_over_r * au_over_r * shadow_factor
+}
+
+/// One flat plate of the vehicle's surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Facet {
+    /// [m²] area A.
+    pub area_m2: f64,
+    /// [-] outward unit normal n̂, B components.
+    pub normal_b: Vector3<f64>,
+    /// [m] centre of pressure relative to point B, B components.
+    pub r_cp_b_m: Vector3<f64>,
+    /// [-] drag coefficient C_D (2.2 is the usual value for a flat plate in free molecular flow).
+    pub drag_coefficient: f64,
+    /// [-] absorbed fraction ρa of the incident sunlight.
+    pub absorbed: f64,
+    /// [-] specularly reflected fraction ρs.
+    pub specular: f64,
+    /// [-] diffusely (Lambertian) reflected fraction ρd.
+    pub diffuse: f64,
+}
+
+/// A force applied at point B and a torque about B, both in B components.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FacetWrench {
+    /// \[N\] force, applied at B, B components.
+    pub force_b_newton: Vector3<f64>,
+    /// [N·m] torque about B, B components.
+    pub torque_b_nm: Vector3<f64>,
+}
+
+/// A facet parameter that fails validation; names the facet and the field.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FacetError {
+    /// A field outside its range.
+    #[error("facets[{index}].{field} = {value}: expected {expected}")]
+    Invalid {
+        /// The facet's position in the list.
+        index: usize,
+        /// The field's name.
+        field: &'static str,
+        /// The value given (for a vector, its norm or the offending component).
+        value: f64,
+        /// What is accepted.
+        expected: &'static str,
+    },
+}
+
+/// [-] how far from 1 a normal's length and the optical fractions' sum may be.
+const UNIT_TOLERANCE: f64 = 1e-6;
+
+impl Facet {
+    /// Checks the facet's fields; `index` is its position, for the error.
+    pub fn validate(&self, index: usize) -> Result<(), FacetError> {
+        let invalid = |field, value, expected| FacetError::Invalid {
+            index,
+            field,
+            value,
+            expected,
+        };
+        if !(self.area_m2.is_finite() && self.area_m2 >= 0.0) {
+            return Err(invalid("area_m2", self.area_m2, "a finite area >= 0 m²"));
+        }
+        let norm = self.normal_b.norm();
+        if !(norm.is_finite() && (norm - 1.0).abs() <= UNIT_TOLERANCE) {
+            return Err(invalid("normal_b", norm, "a unit vector (length 1 ± 1e-6)"));
+        }
+        if let Some(c) = self.r_cp_b_m.iter().find(|c| !c.is_finite()) {
+            return Err(invalid("r_cp_b_m", *c, "finite components"));
+        }
+        if !(self.drag_coefficient.is_finite() && self.drag_coefficient >= 0.0) {
+            return Err(invalid(
+                "drag_coefficient",
+                self.drag_coefficient,
+                "a finite coefficient >= 0",
+            ));
+        }
+        for (field, value) in [
+            ("absorbed", self.absorbed),
+            ("specular", self.specular),
+            ("diffuse", self.diffuse),
+        ] {
+            if !(value.is_finite() && (0.0..=1.0).contains(&value)) {
+                return Err(invalid(field, value, "a fraction in [0, 1]"));
+            }
+        }
+        let sum = self.absorbed + self.specular + self.diffuse;
+        if (sum - 1.0).abs() > UNIT_TOLERANCE {
+            return Err(invalid(
+                "absorbed + specular + diffuse",
+                sum,
+                "fractions that sum to 1 (± 1e-6)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// \[N\] this facet's drag force for the velocity of B relative to the air `v_rel_b_m_s`
+    /// [m/s] and the density `density_kg_m3`; zero when the facet faces away from the flow.
+    pub fn drag_force_b_newton(
+        &self,
+        v_rel_b_m_s: &Vector3<f64>,
+        density_kg_m3: f64,
+    ) -> Vector3<f64> {
+        let speed = v_rel_b_m_s.norm();
+        if speed == 0.0 {
+            return Vector3::zeros();
+        }
+        let v_hat = v_rel_b_m_s / speed;
+        let cos_theta = self.normal_b.dot(&v_hat);
+        if cos_theta <= 0.0 {
+            return Vector3::zeros();
+        }
+        -0.5 * density_kg_m3
+            * self.drag_coefficient
+            * self.area_m2
+            * speed
+            * speed
+            * cos_theta
+            * v_hat
+    }
+
+    /// \[N\] this facet's SRP force for the unit vector to the Sun `sun_hat_b` and the radiation
+    /// pressure `pressure_n_m2` [N/m²]; zero when the facet faces away from the Sun.
+    pub fn srp_force_b_newton(&self, sun_hat_b: &Vector3<f64>, pressure_n_m2: f64) -> Vector3<f64> {
+        let cos_theta = self.normal_b.dot(sun_hat_b);
+        if cos_theta <= 0.0 {
+            return Vector3::zeros();
+        }
+        -pressure_n_m2
+            * self.area_m2
+            * cos_theta
+            * ((self.absorbed + self.diffuse) * sun_hat_b
+                + (2.0 * self.specular * cos_theta + 2.0 / 3.0 * self.diffuse) * self.normal_b)
+    }
+}
+
+/// A validated set of facets.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FacetModel {
+    facets: Vec<Facet>,
+}
+
+impl FacetModel {
+    /// The model of `facets`, each checked by [`Facet::validate`].
+    pub fn new(facets: Vec<Facet>) -> Result<Self, FacetError> {
+        for (index, facet) in facets.iter().enumerate() {
+            facet.validate(index)?;
+        }
+        Ok(FacetModel { facets })
+    }
+
+    /// The facets.
+    pub fn facets(&self) -> &[Facet] {
+        &self.facets
+    }
+
+    /// Drag on the whole model: the sum of the facet forces, applied at B, and of their moments
+    /// about B, for the velocity of B relative to the air `v_rel_b_m_s` [m/s] (B components) and
+    /// the density `density_kg_m3`. Allocation-free and panic-free.
+    pub fn drag_wrench_b(&self, v_rel_b_m_s: &Vector3<f64>, density_kg_m3: f64) -> FacetWrench {
+        self.sum(|f| f.drag_force_b_newton(v_rel_b_m_s, density_kg_m3))
+    }
+
+    /// Solar radiation pressure on the whole model for the direction from the spacecraft to the
+    /// Sun `sun_dir_b` (B components, any non-zero length) and the pressure `pressure_n_m2`
+    /// ([`solar_pressure_n_m2`], which carries the 1/r² and the shadow factor).
+    /// Allocation-free and panic-free; a zero direction gives no force.
+    pub fn srp_wrench_b(&self, sun_dir_b: &Vector3<f64>, pressure_n_m2: f64) -> FacetWrench {
+        let norm = sun_dir_b.norm();
+        if norm == 0.0 {
+            return FacetWrench::default();
+        }
+        let sun_hat_b = sun_dir_b / norm;
+        self.sum(|f| f.srp_force_b_newton(&sun_hat_b, pressure_n_m2))
+    }
+
+    fn sum(&self, force_of: impl Fn(&Facet) -> Vector3<f64>) -> FacetWrench {
+        let mut w = FacetWrench::default();
+        for facet in &self.facets {
+            let force = force_of(facet);
+            w.force_b_newton += force;
+            w.torque_b_nm += facet.r_cp_b_m.cross(&force);
+        }
+        w
+    }
+}

@@ -1,0 +1,96 @@
+//! The environment models' per-call functions allocate nothing once their models are built (the
+//! stepping loop's rule). A counting global allocator, per thread, checks it.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::hint::black_box;
+
+use flexdyn::environment::atmosphere::{
+    exponential_density_kg_m3, velocity_relative_to_air_n_m_s, Nrlmsise00Model, SpaceWeather,
+};
+use flexdyn::environment::ephemeris::{moon_position_n_m, sun_position_n_m};
+use flexdyn::environment::facets::{solar_pressure_n_m2, Facet, FacetModel};
+use flexdyn::environment::geodetic::{dcm_ned_ecef, geodetic_from_ecef};
+use flexdyn::environment::magnetic::{dipole_torque_b_nm, CentredDipole, Igrf};
+use flexdyn::environment::shadow::{shadow_factor, ShadowModel};
+use nalgebra::Vector3;
+
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        System.alloc(layout)
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        System.dealloc(ptr, layout)
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        System.realloc(ptr, layout, new_size)
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn per_call_functions_do_not_allocate() {
+    // Built once, outside the counted region.
+    let igrf = Igrf::igrf14(13).unwrap();
+    let msis = Nrlmsise00Model::new(SpaceWeather {
+        f107_sfu: 150.0,
+        f107a_sfu: 150.0,
+        ap: 15.0,
+    })
+    .unwrap();
+    let facets = FacetModel::new(
+        (0..6)
+            .map(|i| Facet {
+                area_m2: 1.0,
+                normal_b: if i % 2 == 0 { 1.0 } else { -1.0 } * Vector3::ith(i / 2, 1.0),
+                r_cp_b_m: Vector3::new(0.1, 0.2, 0.3),
+                drag_coefficient: 2.2,
+                absorbed: 0.6,
+                specular: 0.3,
+                diffuse: 0.1,
+            })
+            .collect(),
+    )
+    .unwrap();
+    let r = Vector3::new(6.0e6, 2.0e6, 3.0e6);
+    let v = Vector3::new(-2.0e3, 7.0e3, 0.5e3);
+    let omega = Vector3::new(0.0, 0.0, 7.292_115e-5);
+
+    let before = ALLOCATIONS.with(Cell::get);
+    for i in 0..100 {
+        let t = 0.25 + f64::from(i) * 1e-5;
+        let sun = sun_position_n_m(t);
+        black_box(moon_position_n_m(t));
+        let nu = shadow_factor(ShadowModel::Conical, &r, &sun);
+        black_box(shadow_factor(ShadowModel::Cylindrical, &r, &sun));
+        let c = igrf.coefficients_at(2025.3);
+        let b = c.field_ecef_t(&r);
+        black_box(igrf.field_ecef_t(2025.3, &r));
+        black_box(CentredDipole::tilted(&c).field_ecef_t(&r));
+        black_box(dipole_torque_b_nm(&Vector3::new(0.1, 0.0, 0.0), &b));
+        let g = geodetic_from_ecef(&r);
+        black_box(dcm_ned_ecef(g.lat_rad, g.lon_rad));
+        let rho =
+            exponential_density_kg_m3(g.height_m) + msis.state(100, 3600.0, &g).drag_density_kg_m3;
+        let v_rel = velocity_relative_to_air_n_m_s(&r, &v, &omega);
+        black_box(facets.drag_wrench_b(&v_rel, rho));
+        let p = solar_pressure_n_m2((sun - r).norm(), nu, 1361.0);
+        black_box(facets.srp_wrench_b(&(sun - r), p));
+    }
+    let after = ALLOCATIONS.with(Cell::get);
+    assert_eq!(
+        after - before,
+        0,
+        "allocations in the per-call environment functions"
+    );
+}
