@@ -21,6 +21,8 @@
 //! - **B**: the body frame of the hub; the facet model works in it.
 //!
 //! # Layout
+//! - [`epoch`]: the simulation epoch (hifitime) and the time scales at `epoch + t_sim_ns` (TAI,
+//!   TT, UTC with leap seconds, GPS week and seconds, UT1), and the `[epoch]` schema.
 //! - [`sample`]: the [`EnvironmentSample`] the dynamic effectors and sensors read, held between
 //!   model updates.
 //! - [`geodetic`]: WGS-84 ECEF ↔ geodetic latitude, longitude and height; the NED frame.
@@ -36,6 +38,7 @@
 
 pub mod atmosphere;
 pub mod ephemeris;
+pub mod epoch;
 pub mod facets;
 pub mod geodetic;
 pub mod magnetic;
