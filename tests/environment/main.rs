@@ -7,6 +7,7 @@
 // The references' digits are kept as published (SOFA prints 19 significant digits).
 #![allow(clippy::excessive_precision)]
 
+mod earth_rotation;
 mod epoch;
 
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
