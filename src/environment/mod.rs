@@ -28,6 +28,8 @@
 //!   TT, UTC with leap seconds, GPS week and seconds, UT1), and the `[epoch]` schema.
 //! - [`earth_rotation`]: the DCM from N to the Earth-fixed frame (IAU 2006 precession, IAU 2000B
 //!   nutation, sidereal time, optional polar motion) with its error bound, and TEME → N.
+//! - [`orbit`]: initial orbits as alternatives to r/v — classical Keplerian elements, and TLE /
+//!   CCSDS OMM mean elements propagated to the epoch with SGP4.
 //! - [`sample`]: the [`EnvironmentSample`] the dynamic effectors and sensors read, held between
 //!   model updates.
 //! - [`geodetic`]: WGS-84 ECEF ↔ geodetic latitude, longitude and height; the NED frame.
@@ -48,6 +50,7 @@ pub mod epoch;
 pub mod facets;
 pub mod geodetic;
 pub mod magnetic;
+pub mod orbit;
 pub mod sample;
 pub mod shadow;
 

@@ -9,6 +9,7 @@
 
 mod earth_rotation;
 mod epoch;
+mod kepler;
 
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
 
