@@ -10,6 +10,7 @@
 mod earth_rotation;
 mod epoch;
 mod kepler;
+mod sgp4_orbit;
 
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
 
@@ -23,4 +24,11 @@ pub fn allocations_in(f: impl FnOnce()) -> usize {
     reset_violation_count();
     assert_no_alloc(f);
     violation_count() as usize
+}
+
+/// The path of a file under `tests/data/`.
+pub fn data(path: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(path)
 }
