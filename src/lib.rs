@@ -3,9 +3,10 @@
 //! # Layout
 //! - [`attitude`]: MRP, DCM and quaternion kernels.
 //! - [`dynamics`]: the physics core — rigid hub + dual-hinged panel pairs by back-substitution.
-//! - [`environment`]: the world around the spacecraft — ephemerides, shadow, magnetic field,
-//!   atmosphere, the facet (flat-plate) surface model, and the sample the dynamic effectors and
-//!   sensors read.
+//! - [`environment`]: the world around the spacecraft — the epoch and its time scales, the
+//!   Earth's rotation, initial orbits from elements, TLE and OMM, ephemerides, shadow, magnetic
+//!   field, atmosphere, the facet (flat-plate) surface model, and the sample the dynamic
+//!   effectors and sensors read.
 //! - [`schema`]: the typed TOML reader the per-model schemas use.
 //! - [`sensors`]: sensor models — [`sensors::imu`] (gyro and accelerometer).
 //! - [`logging`]: the stderr log setup shared by `flexdyn` and the tools (EPIPE-safe).

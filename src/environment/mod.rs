@@ -15,12 +15,21 @@
 //!   rotation of 0.02″ (23 mas); every model here is at least 100 times coarser than that, so the
 //!   two are used as one.
 //! - **ECEF**: the Earth-fixed frame (ITRF); the magnetic field and the atmosphere take their
-//!   positions in it (`r_ecef_m`). The rotation from N to ECEF is the epoch/Earth-rotation model's.
+//!   positions in it (`r_ecef_m`). The rotation from N to ECEF is [`earth_rotation`]'s (which
+//!   calls it E, and carries the frame bias, so it maps from the GCRF proper).
+//! - **TEME** (true equator, mean equinox of date): the frame of SGP4's output; see
+//!   [`earth_rotation::dcm_n_teme`].
 //! - **NED**: local north-east-down at a point, geodetic (WGS-84) or geocentric as the function
 //!   says.
 //! - **B**: the body frame of the hub; the facet model works in it.
 //!
 //! # Layout
+//! - [`epoch`]: the simulation epoch (hifitime) and the time scales at `epoch + t_sim_ns` (TAI,
+//!   TT, UTC with leap seconds, GPS week and seconds, UT1), and the `[epoch]` schema.
+//! - [`earth_rotation`]: the DCM from N to the Earth-fixed frame (IAU 2006 precession, IAU 2000B
+//!   nutation, sidereal time, optional polar motion) with its error bound, and TEME → N.
+//! - [`orbit`]: initial orbits as alternatives to r/v — classical Keplerian elements, and TLE /
+//!   CCSDS OMM mean elements propagated to the epoch with SGP4.
 //! - [`sample`]: the [`EnvironmentSample`] the dynamic effectors and sensors read, held between
 //!   model updates.
 //! - [`geodetic`]: WGS-84 ECEF ↔ geodetic latitude, longitude and height; the NED frame.
@@ -35,10 +44,13 @@
 //!   forces and torques about B.
 
 pub mod atmosphere;
+pub mod earth_rotation;
 pub mod ephemeris;
+pub mod epoch;
 pub mod facets;
 pub mod geodetic;
 pub mod magnetic;
+pub mod orbit;
 pub mod sample;
 pub mod shadow;
 
