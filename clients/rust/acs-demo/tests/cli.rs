@@ -94,3 +94,59 @@ fn the_demo_stops_on_sigint_even_when_started_with_it_ignored() {
     }
 }
 
+/// The demo command that README.md's "Reaction wheels and a star tracker" shows (and the header
+/// of `scenarios/wheels_star_tracker.toml` quotes) is accepted as written: pointed at a port
+/// nobody listens on, it fails for want of a server (exit 1), not for its options (exit 2).
+#[test]
+fn the_readmes_wheels_and_star_tracker_command_parses() {
+    let readme = include_str!("../../../../README.md");
+    let from = readme
+        .find("### Reaction wheels and a star tracker")
+        .expect("the README section");
+    let mut words = Vec::new();
+    let lines = readme[from..]
+        .lines()
+        .skip_while(|l| !l.starts_with("flexdyn-acs-demo"));
+    for line in lines {
+        words.extend(
+            line.split_whitespace()
+                .filter(|w| *w != "\\")
+                .map(String::from),
+        );
+        if !line.trim_end().ends_with('\\') {
+            break;
+        }
+    }
+    assert_eq!(
+        words.first().map(String::as_str),
+        Some("flexdyn-acs-demo"),
+        "{words:?}"
+    );
+    for flag in ["--actuator", "--attitude-source", "--star-tracker", "--imu"] {
+        assert!(
+            words.iter().any(|w| w == flag),
+            "{flag} not shown: {words:?}"
+        );
+    }
+    // Point it at a free port and give up after 1 s instead of the README's 5.
+    let mut args: Vec<String> = Vec::new();
+    let mut it = words[1..].iter();
+    while let Some(w) = it.next() {
+        if w == "--connect" || w == "--idle-exit-s" {
+            it.next();
+        } else {
+            args.push(w.clone());
+        }
+    }
+    let connect = format!("tcp/127.0.0.1:{}", free_port());
+    args.extend([
+        "--connect".into(),
+        connect,
+        "--idle-exit-s".into(),
+        "1".into(),
+    ]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (c, e) = run(DEMO, &args);
+    assert_eq!(c, Some(1), "{args:?}: {e}");
+    assert!(e.contains("no answer on flexdyn/sc1/config"), "{e}");
+}
