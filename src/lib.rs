@@ -9,9 +9,10 @@
 //!   effectors and sensors read.
 //! - [`schema`]: the typed TOML reader the per-model schemas use.
 //! - [`sensors`]: sensor models — [`sensors::imu`] (gyro and accelerometer).
-//! - [`logging`]: the stderr log setup shared by `flexdyn` and the tools (EPIPE-safe).
+//! - [`logging`]: the stderr log setup shared by `flexdyn`, the tools and the demo flight code
+//!   (EPIPE-safe); `flexdyn_proto::client::logging`.
 //! - [`transport`]: the one Zenoh configuration builder (loopback, multicast scouting off),
-//!   shared by the server and the tools.
+//!   shared by the server, the tools and flight code; `flexdyn_proto::client::transport`.
 //! - [`sinks`]: recording (MCAP), replay, export, the live Foxglove view and plots.
 //! - [`campaign`]: Monte Carlo campaigns with flight code in the loop.
 //! - [`server`]: the Zenoh server (`flexdyn run`): real-time, lockstep and batch propagation.
@@ -24,7 +25,6 @@ pub mod cli;
 pub mod config;
 pub mod dynamics;
 pub mod environment;
-pub mod logging;
 pub mod numfmt;
 pub mod schema;
 pub mod sensors;
@@ -32,4 +32,5 @@ pub mod server;
 pub mod signals;
 pub mod sim;
 pub mod sinks;
-pub mod transport;
+
+pub use flexdyn_proto::client::{logging, transport};

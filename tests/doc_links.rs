@@ -172,3 +172,133 @@ fn every_relative_link_in_the_documents_resolves() {
         problems.join("\n")
     );
 }
+
+/// The comment lines that open a configuration file, joined into one line (a citation may wrap).
+fn header_text(toml: &str) -> String {
+    toml.lines()
+        .take_while(|l| l.starts_with('#'))
+        .map(|l| l.trim_start_matches('#').trim())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// The text of the README section whose heading is exactly `title`, up to the next heading of
+/// the same or a higher level; None when no heading has that text.
+fn section<'a>(readme: &'a str, title: &str) -> Option<&'a str> {
+    let lines: Vec<&str> = readme.lines().collect();
+    let level = |l: &str| l.chars().take_while(|&c| c == '#').count();
+    let start = lines.iter().position(|l| {
+        let n = level(l);
+        n > 0 && l[n..].trim() == title
+    })?;
+    let n = level(lines[start]);
+    let end = lines[start + 1..]
+        .iter()
+        .position(|l| (1..=n).contains(&level(l)) && l[level(l)..].starts_with(' '))
+        .map_or(lines.len(), |i| start + 1 + i);
+    let from = lines[..start].iter().map(|l| l.len() + 1).sum::<usize>();
+    let to = lines[..end].iter().map(|l| l.len() + 1).sum::<usize>();
+    Some(&readme[from..to.min(readme.len())])
+}
+
+/// The `flexdyn-acs-demo` command lines of a README section, each with its `\` continuations.
+fn demo_commands(section: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut lines = section.lines();
+    while let Some(line) = lines.next() {
+        if !line.contains("flexdyn-acs-demo") {
+            continue;
+        }
+        let mut command = line.to_string();
+        let mut last = line;
+        while last.trim_end().ends_with('\\') {
+            let Some(next) = lines.next() else { break };
+            command.push(' ');
+            command.push_str(next);
+            last = next;
+        }
+        out.push(command);
+    }
+    out
+}
+
+/// What a configuration file's header cites: each `(README, "Section")` must be a heading of
+/// README.md, and each `flexdyn-acs-demo …` command the header quotes must be shown, every
+/// option of it, in the cited section (so a newcomer finds the command the file promises).
+fn header_problems(file: &str, header: &str, readme: &str) -> Vec<String> {
+    let mut problems = Vec::new();
+    let mut sections = Vec::new();
+    for cite in header.split("README, \"").skip(1) {
+        let Some(title) = cite.split('"').next() else {
+            continue;
+        };
+        match section(readme, title) {
+            Some(text) => sections.push(text),
+            None => problems.push(format!(
+                "{file}: cites README section {title:?}, not a heading"
+            )),
+        }
+    }
+    for quoted in header.split('`').skip(1).step_by(2) {
+        if !quoted.starts_with("flexdyn-acs-demo") {
+            continue;
+        }
+        for flag in quoted.split_whitespace().filter(|w| w.starts_with("--")) {
+            let shown = sections
+                .iter()
+                .flat_map(|s| demo_commands(s))
+                .any(|c| c.split_whitespace().any(|w| w == flag));
+            if !shown {
+                problems.push(format!(
+                    "{file}: `{flag}` of its demo command is not in a command of the cited README section"
+                ));
+            }
+        }
+    }
+    problems
+}
+
+#[test]
+fn header_problems_are_found() {
+    let readme = "# T\n## Wheels\n```sh\nflexdyn-acs-demo --a \\\n    --b\n```\n## Other\n--c\n";
+    let ok = "# run `flexdyn-acs-demo --a --b` (README, \"Wheels\")\nx = 1\n";
+    assert_eq!(
+        header_problems("f", &header_text(ok), readme),
+        Vec::<String>::new()
+    );
+    // A section that is not a heading, and an option the section's command lacks (`--c` is in
+    // the README, but in another section and not in a command).
+    let bad =
+        "# `flexdyn-acs-demo --a --c` (README, \"Wheels\")\n# (README, \"Wheels\n# and more\")\n";
+    let p = header_problems("f", &header_text(bad), readme);
+    assert_eq!(p.len(), 2, "{p:?}");
+    assert!(p[0].contains("\"Wheels and more\""), "{p:?}");
+    assert!(p[1].contains("`--c`"), "{p:?}");
+}
+
+/// The shipped scenarios' headers cite README sections that exist and demo options the README
+/// shows there. (The header of `wheels_star_tracker.toml` once cited a section, "Reaction wheels
+/// and a star tracker", and options that the README never had.)
+#[test]
+fn scenario_headers_cite_what_the_readme_shows() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let mut problems = Vec::new();
+    let mut cited = 0;
+    for entry in std::fs::read_dir(root().join("scenarios")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let header = header_text(&std::fs::read_to_string(&path).unwrap());
+            cited += header.matches("README, \"").count();
+            problems.extend(header_problems(
+                &path.display().to_string(),
+                &header,
+                &readme,
+            ));
+        }
+    }
+    assert!(
+        cited >= 1,
+        "no scenario header cites the README: the test checks nothing"
+    );
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}

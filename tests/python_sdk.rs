@@ -7,25 +7,36 @@
 //! runs `python -m pytest clients/python` with `FLEXDYN_BIN` (this package's `flexdyn`) and
 //! `FLEXDYN_VERDICTS_BIN` (`flexdyn-decode-verdicts`, built by `cargo test --workspace`).
 //! Needs `python3` (3.9+) with the `venv` module, and PyPI the first time.
+//!
+//! `pip_install_leaves_the_checkout_clean` installs the package the other way the README
+//! mentions, `pip install clients/python` (a wheel built in the source tree), into a temporary
+//! directory, and checks that `git status` of `clients/python` has nothing new afterwards.
 
 mod py_support;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use py_support::{run, venv_python};
 
-#[test]
-fn python_sdk_pytest_suite() {
+/// The checkout, the SDK's folder and the Python of the venv that has the SDK installed
+/// (editable, with its test extras; reinstalled when `pyproject.toml` changes, its text being
+/// the stamp).
+fn sdk_venv() -> (PathBuf, PathBuf, PathBuf) {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let package = root.join("clients/python");
-    // Reinstall when pyproject.toml changes (its text is the stamp).
     let pyproject = std::fs::read_to_string(package.join("pyproject.toml")).unwrap();
     let python = venv_python(
         "python-venv",
         &["-e".into(), format!("{}[test]", package.display())],
         &pyproject,
     );
+    (root, package, python)
+}
+
+#[test]
+fn python_sdk_pytest_suite() {
+    let (_, package, python) = sdk_venv();
     let flexdyn = PathBuf::from(env!("CARGO_BIN_EXE_flexdyn"));
     let verdicts = flexdyn.with_file_name("flexdyn-decode-verdicts");
     let out = run(
@@ -40,4 +51,64 @@ fn python_sdk_pytest_suite() {
     );
     eprintln!("{out}");
     assert!(out.contains(" passed"), "{out}");
+}
+
+/// `git status --porcelain` of `clients/python`, untracked files listed one by one.
+fn git_status(root: &Path) -> String {
+    run(
+        Command::new("git")
+            .args([
+                "status",
+                "--porcelain",
+                "--untracked-files=all",
+                "--",
+                "clients/python",
+            ])
+            .current_dir(root),
+        "git status",
+    )
+}
+
+/// `pip install clients/python` builds a wheel in the source tree (`clients/python/build/`);
+/// that must not show up as an untracked directory in the checkout.
+#[test]
+fn pip_install_leaves_the_checkout_clean() {
+    let (root, package, python) = sdk_venv();
+    let build_dir = package.join("build");
+    let had_build_dir = build_dir.exists();
+    let before = git_status(&root);
+    let target = Path::new(env!("CARGO_TARGET_TMPDIR")).join("pip-install-target");
+    let _ = std::fs::remove_dir_all(&target);
+    let out = run(
+        Command::new(&python)
+            .args([
+                "-m",
+                "pip",
+                "install",
+                "--no-deps",
+                "--disable-pip-version-check",
+            ])
+            .arg("--target")
+            .arg(&target)
+            .arg(&package)
+            .env("PYTHONDONTWRITEBYTECODE", "1"),
+        "pip install clients/python",
+    );
+    assert!(
+        target.join("flexdyn/client.py").is_file(),
+        "pip installed nothing: {out}"
+    );
+    assert!(
+        build_dir.is_dir(),
+        "pip no longer builds in the tree: {out}"
+    );
+    let after = git_status(&root);
+    if !had_build_dir {
+        let _ = std::fs::remove_dir_all(&build_dir);
+    }
+    let new: Vec<&str> = after
+        .lines()
+        .filter(|l| !before.contains(l) || l.contains("clients/python/build/"))
+        .collect();
+    assert!(new.is_empty(), "pip install left untracked files: {new:?}");
 }

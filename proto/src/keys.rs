@@ -147,6 +147,17 @@ pub fn participant_wildcard_key(sc: &str) -> Result<String, KeyError> {
     Ok(format!("{KEY_ROOT}/{sc}/{PARTICIPANT_PREFIX}/*"))
 }
 
+/// Which telemetry topic a key of a spacecraft is (see [`Topics::telemetry`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Telemetry<'a> {
+    /// `flexdyn/<sc>/tlm/state`: a [`crate::StateMsg`].
+    State,
+    /// `flexdyn/<sc>/tlm/imu/<name>`: an [`crate::ImuMsg`] of the IMU `name`.
+    Imu(&'a str),
+    /// `flexdyn/<sc>/tlm/st/<name>`: a [`crate::StarTrackerMsg`] of the tracker `name`.
+    StarTracker(&'a str),
+}
+
 /// All keys of one spacecraft, validated once.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Topics {
@@ -211,6 +222,35 @@ impl Topics {
     /// `flexdyn/<sc>/config` (the server's configuration queryable).
     pub fn config(&self) -> String {
         format!("{KEY_ROOT}/{}/{CONFIG_SUFFIX}", self.sc_id)
+    }
+
+    /// `flexdyn/<sc>/tlm/**`: the state and every sensor topic. One subscriber on it receives
+    /// a tick's samples in the order the server published them (its sensor samples, then its
+    /// state); separate subscribers may be delivered on separate threads, where a state can
+    /// overtake a sensor sample of its own tick (proto/README.md, "Lockstep protocol").
+    pub fn telemetry_wildcard(&self) -> String {
+        format!("{KEY_ROOT}/{}/tlm/**", self.sc_id)
+    }
+
+    /// Which telemetry topic of this spacecraft `key` is, `None` for any other key (another
+    /// spacecraft, a command or status key, an unknown `tlm/` topic, an invalid name).
+    pub fn telemetry<'k>(&self, key: &'k str) -> Option<Telemetry<'k>> {
+        let rest = key
+            .strip_prefix(KEY_ROOT)?
+            .strip_prefix('/')?
+            .strip_prefix(self.sc_id.as_str())?
+            .strip_prefix('/')?;
+        if rest == STATE_SUFFIX {
+            return Some(Telemetry::State);
+        }
+        let named = |prefix: &str| {
+            rest.strip_prefix(prefix)?
+                .strip_prefix('/')
+                .filter(|name| validate("sensor name", name).is_ok())
+        };
+        named(IMU_PREFIX)
+            .map(Telemetry::Imu)
+            .or_else(|| named(STAR_TRACKER_PREFIX).map(Telemetry::StarTracker))
     }
 
     /// `flexdyn/<sc>/tlm/imu/*`
@@ -281,6 +321,29 @@ mod tests {
         assert_eq!(t.status(), "flexdyn/sc-1/status");
         assert_eq!(t.imu("g").unwrap(), "flexdyn/sc-1/tlm/imu/g");
         assert_eq!(t.imu_wildcard(), "flexdyn/sc-1/tlm/imu/*");
+        assert_eq!(t.telemetry_wildcard(), "flexdyn/sc-1/tlm/**");
+        assert_eq!(t.telemetry(t.state()), Some(Telemetry::State));
+        assert_eq!(
+            t.telemetry(&t.imu("hub").unwrap()),
+            Some(Telemetry::Imu("hub"))
+        );
+        assert_eq!(
+            t.telemetry(&t.star_tracker("st1").unwrap()),
+            Some(Telemetry::StarTracker("st1"))
+        );
+        for other in [
+            "flexdyn/sc-2/tlm/state",
+            "flexdyn/sc-1/tlm/state/x",
+            "flexdyn/sc-1/tlm/imu",
+            "flexdyn/sc-1/tlm/imu/",
+            "flexdyn/sc-1/tlm/imu/a/b",
+            "flexdyn/sc-1/tlm/gps/g",
+            "flexdyn/sc-1/status",
+            "flexdyn/sc-1/cmd/1",
+            "flexdyn/sc-10/tlm/state",
+        ] {
+            assert_eq!(t.telemetry(other), None, "{other}");
+        }
         assert_eq!(t.participant(7), "flexdyn/sc-1/participant/7");
         assert_eq!(participant_key("sc-1", 7).unwrap(), t.participant(7));
         assert_eq!(t.participant_wildcard(), "flexdyn/sc-1/participant/*");

@@ -1,8 +1,14 @@
 //! flexdyn wire protocol: the messages exchanged over Zenoh between the flexdyn
 //! dynamics server and flight code, their key expressions, and the one codec.
 //!
-//! This crate has no Zenoh or async dependency; it only turns messages into
-//! bytes and back. `proto/README.md` is the language-neutral specification
+//! By default this crate has no Zenoh or async dependency; it only turns messages into
+//! bytes and back. Two optional features make it the one dependency of Rust flight code
+//! (the template `flexdyn-acs-demo` uses both):
+//! - `attitude` ([`attitude`], nalgebra): the MRP, DCM and quaternion kernels the simulator
+//!   itself uses;
+//! - `client` ([`client`], Zenoh): the session rules (loopback, multicast scouting off), the
+//!   command-line conventions, the served vehicle configuration, and lockstep ticks handed
+//!   over complete ([`client::lockstep::TickReceiver`]). `proto/README.md` is the language-neutral specification
 //! (byte tables, Python example, lockstep rules) for non-Rust flight code.
 //!
 //! # Topics
@@ -67,6 +73,10 @@
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
+#[cfg(feature = "attitude")]
+pub mod attitude;
+#[cfg(feature = "client")]
+pub mod client;
 pub mod codec;
 mod error;
 pub mod keys;
@@ -81,8 +91,9 @@ pub use error::{DecodeError, KeyError};
 pub use keys::{
     cmd_key, cmd_wildcard_key, imu_key, imu_wildcard_key, participant_key,
     participant_wildcard_key, star_tracker_key, star_tracker_wildcard_key, state_key, status_key,
-    validate_imu_name, validate_sc_id, validate_star_tracker_name, Topics, CMD_PREFIX, IMU_PREFIX,
-    KEY_ROOT, MAX_ID_LEN, PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX,
+    validate_imu_name, validate_sc_id, validate_star_tracker_name, Telemetry, Topics, CMD_PREFIX,
+    IMU_PREFIX, KEY_ROOT, MAX_ID_LEN, PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX,
+    STATUS_SUFFIX,
 };
 pub use layout::{
     WireLayout, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,

@@ -11,9 +11,9 @@ use std::path::{Path, PathBuf};
 use flexdyn::campaign::execute::RunResult;
 use flexdyn::campaign::{main as campaign, CampaignCommand};
 
-fn demo() -> &'static str {
-    env!("CARGO_BIN_EXE_flexdyn-acs-demo")
-}
+#[path = "acs_demo_bin/mod.rs"]
+mod acs_demo_bin;
+use acs_demo_bin::acs_demo as demo;
 
 fn write_campaign(name: &str, runs: u32, controller: &str) -> (PathBuf, PathBuf) {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);

@@ -1,10 +1,9 @@
 //! End-to-end lockstep: the flexdyn server (in this test process, on its own loopback port) and
 //! the demo controller `flexdyn-acs-demo` (a separate process) run a closed loop.
 //!
-//! Why the server runs in-process: Cargo gives integration tests the path of their own
-//! package's binaries only (`CARGO_BIN_EXE_flexdyn-acs-demo` here), so the controller is the
-//! child process and the server is `flexdyn::server::run`, the same function `flexdyn run`
-//! calls. `tests/server_cli.rs` in the root package covers the `flexdyn` binary itself (exit
+//! Why the server runs in-process: the controller is the child process (its own package,
+//! `clients/rust/acs-demo`, found next to this test by `acs_demo_bin`) and the server is
+//! `flexdyn::server::run`, the same function `flexdyn run` calls. `tests/server_cli.rs` in the root package covers the `flexdyn` binary itself (exit
 //! code and message of a participant timeout).
 //!
 //! A second, passive participant (sender 2, in this process) records every StateMsg payload and
@@ -16,6 +15,8 @@
 //!
 //! Ports 17309–17319.
 
+#[path = "acs_demo_bin/mod.rs"]
+mod acs_demo_bin;
 mod support;
 
 use std::process::Command;
@@ -72,7 +73,7 @@ fn settings(participant_timeout_s: f64) -> ServerSettings {
 fn controller(port: u16, rate_args: &[&str]) -> ChildGuard {
     let sigma = format!("{},{},{}", SIGMA_RN[0], SIGMA_RN[1], SIGMA_RN[2]);
     ChildGuard::spawn(
-        Command::new(env!("CARGO_BIN_EXE_flexdyn-acs-demo"))
+        Command::new(acs_demo_bin::acs_demo())
             .args(["--connect", &endpoint(port), "--sender-id", "1"])
             .args(["--k-nm", &K_NM.to_string(), "--p-nms", &P_NMS.to_string()])
             .args(["--sigma-rn", &sigma, "--log-every-s", "0"])
@@ -332,7 +333,7 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
 /// updates, and the gyro rate. Nothing it uses is truth.
 ///
 /// Convergence bound: the wheel law gives the closed loop [I] ω̇ = −K σ − P ω as for the wrench
-/// (see `flexdyn_tools::acs`), so with K = 10 N·m and P = 150 N·m·s the linear settling time is
+/// (see `flexdyn_acs_demo::acs`), so with K = 10 N·m and P = 150 N·m·s the linear settling time is
 /// 8 I / P ≈ 8 · 1812 / 150 ≈ 97 s, ζ = P / √(K I) ≥ 1.1. The linear bound ignores the wheels'
 /// 0.2 N·m motor limit, which saturates the first ~120 s: the initial 0.015 rad/s tumble holds
 /// |I ω| ≈ 27 N·m·s, and the pyramid's weakest axis takes at most 4 · 0.2 · cos 30° · cos 45°
@@ -348,7 +349,6 @@ fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
     let bound_s = 2.5 * 8.0 * I_MAX_KG_M2 / P;
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenarios/wheels_star_tracker.toml");
-    let path_s = path.to_str().unwrap().to_string();
     let run = |port: u16| {
         let cfg = flexdyn::config::SimConfig::from_file(&path).expect("wheels_star_tracker.toml");
         let topics = Topics::new("sc1").unwrap();
@@ -359,10 +359,10 @@ fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
         let server = ServerHandle::start(port, settings, cfg);
         let recorder = Recorder::start(port, &topics, 2);
         let _ctrl = ChildGuard::spawn(
-            Command::new(env!("CARGO_BIN_EXE_flexdyn-acs-demo"))
+            Command::new(acs_demo_bin::acs_demo())
                 .args(["--connect", &endpoint(port), "--sender-id", "1"])
                 .args(["--k-nm", &K.to_string(), "--p-nms", &P.to_string()])
-                .args(["--log-every-s", "0", "--config", &path_s])
+                .args(["--log-every-s", "0"])
                 .args(["--actuator", "wheels", "--attitude-source", "star-tracker"])
                 .args([
                     "--star-tracker",
@@ -441,4 +441,89 @@ fn killed_controller_stops_the_run_with_a_timeout_naming_it() {
         }
         other => panic!("expected a participant timeout, got {other:?}"),
     }
+}
+
+/// Issue 25: flight code that reads sensors is deterministic in lockstep, also on a loaded
+/// machine. The demo closes its loop on sensors only (the star tracker, propagated with the
+/// `hub` gyro, and the gyro rate) and commands the four wheels of
+/// `scenarios/wheels_star_tracker.toml`; it answers tick k from the StateMsg of k and every
+/// sensor sample due at k (one `tlm/**` subscriber, the schedule from the served
+/// configuration). No wheel torque may reach its 0.2 N·m limit, checked below: a clipped torque
+/// would not depend on which sample it was computed from, and the hash would not see a wrong
+/// one. So the gains are small (K = 0.2 N·m, P = 1 N·m·s) and the wheels start at rest: the
+/// largest term is then the gyroscopic ω × [I]ω, which the wings' undamped oscillation drives
+/// (the wheel torques peak near 0.18 N·m). At the scenario's 100 rad/s the wheels' momentum,
+/// 10 N·m·s along b3, would add ω × h ≈ 0.14 N·m and clip them. Two runs, then two more with a
+/// busy-looping process per core, hash the same.
+#[test]
+fn sensor_closed_demo_runs_are_bit_identical_also_under_load() {
+    const RUN_S: f64 = 30.0;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios/wheels_star_tracker.toml");
+    let toml = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("omega_rad_s = 100.0", "omega_rad_s = 0.0");
+    let run = || {
+        let port = std::net::TcpListener::bind("127.0.0.1:0")
+            .and_then(|l| l.local_addr())
+            .expect("a free port")
+            .port();
+        let cfg = flexdyn::config::SimConfig::from_toml_str(&toml).expect("wheels at rest");
+        let topics = Topics::new("sc1").unwrap();
+        let settings = ServerSettings {
+            duration_ns: Some((RUN_S * 1e9) as u64),
+            ..settings(10.0)
+        };
+        let server = ServerHandle::start(port, settings, cfg);
+        let recorder = Recorder::start(port, &topics, 2);
+        let _ctrl = ChildGuard::spawn(
+            Command::new(acs_demo_bin::acs_demo())
+                .args(["--connect", &endpoint(port), "--sender-id", "1"])
+                .args(["--k-nm", "0.2", "--p-nms", "1", "--log-every-s", "0"])
+                .args(["--actuator", "wheels", "--attitude-source", "star-tracker"])
+                .args([
+                    "--star-tracker",
+                    "st1",
+                    "--rate-source",
+                    "gyro",
+                    "--imu",
+                    "hub",
+                ]),
+        );
+        server
+            .join(Duration::from_secs(120))
+            .expect("sensor-closed run");
+        let mut states = recorder.states.lock().unwrap().clone();
+        states.sort_by_key(|(t, _)| *t);
+        assert_eq!(states.len() as u64, (RUN_S * 100.0) as u64 + 1);
+        let mut max_u = 0.0_f64;
+        for (_, bytes) in &states {
+            let s = decode_state(bytes).unwrap();
+            for w in &s.effectors[2..] {
+                assert_eq!(
+                    w.flags & flexdyn_proto::wheel_flags::TORQUE_LIMITED,
+                    0,
+                    "a wheel torque clipped at tick {}",
+                    s.header.tick
+                );
+                max_u = max_u.max(w.outputs[0].abs());
+            }
+        }
+        assert!(max_u > 0.01, "the wheels were commanded ({max_u} N m)");
+        eprintln!("sensor-closed run: largest wheel torque {max_u} N m");
+        digest(&states)
+    };
+    let a = run();
+    assert_eq!(run(), a, "two sensor-closed runs differ");
+    let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
+    let burners: Vec<ChildGuard> = (0..cores)
+        .map(|_| ChildGuard::spawn(Command::new("sh").args(["-c", "while :; do :; done"])))
+        .collect();
+    let loaded = [run(), run()];
+    drop(burners);
+    assert_eq!(
+        loaded,
+        [a.clone(), a],
+        "a sensor-closed run on a busy machine differs"
+    );
 }

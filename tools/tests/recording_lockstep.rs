@@ -5,6 +5,8 @@
 //!
 //! Port 17380.
 
+#[path = "acs_demo_bin/mod.rs"]
+mod acs_demo_bin;
 mod support;
 
 use std::process::Command;
@@ -44,7 +46,7 @@ fn a_lockstep_recording_is_the_stream_the_participants_saw() {
     let server = ServerHandle::start(port, settings, cfg);
     let participant = Recorder::start(port, &topics, 2);
     let _ctrl = ChildGuard::spawn(
-        Command::new(env!("CARGO_BIN_EXE_flexdyn-acs-demo"))
+        Command::new(acs_demo_bin::acs_demo())
             .args(["--connect", &endpoint(port), "--sender-id", "1"])
             .args(["--rate-source", "truth", "--log-every-s", "0"]),
     );

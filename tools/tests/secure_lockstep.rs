@@ -17,6 +17,8 @@
 //!
 //! Ports 17730–17739.
 
+#[path = "acs_demo_bin/mod.rs"]
+mod acs_demo_bin;
 mod support;
 
 use std::path::PathBuf;
@@ -137,7 +139,7 @@ fn digest(states: &[(u64, Vec<u8>)]) -> String {
 }
 
 fn controller(port: u16, client_config: Option<PathBuf>) -> ChildGuard {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_flexdyn-acs-demo"));
+    let mut cmd = Command::new(acs_demo_bin::acs_demo());
     cmd.args(["--connect", &endpoint(port), "--sender-id", "1"])
         .args(["--log-every-s", "0", "--rate-source", "truth"])
         .args(["--sigma-rn", "0.1,0.2,-0.1"]);

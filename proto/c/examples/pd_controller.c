@@ -19,6 +19,11 @@
  *     // lockstep: after the subscriber, declare the liveliness token
  *     //     z_liveliness_declare_token(z_loan(s), &token, fd_participant_key(...), NULL);
  *
+ * This law reads only the state. A law that reads the IMU or a star tracker subscribes once to
+ * "flexdyn/sc1/tlm/" followed by a double star, dispatches on the sample's key, and answers
+ * tick k only when the state and every sensor sample due at tick k are in (which ones: the
+ * flexdyn/sc1/config queryable); see ../README.md, "Lockstep flight code that reads sensors".
+ *
  * zenoh-pico has the same shape (z_open, z_declare_subscriber, z_publisher_put,
  * z_liveliness_declare_token) with its own config keys (Z_CONFIG_CONNECT_KEY, and
  * Z_CONFIG_MULTICAST_SCOUTING_KEY = "false"). This project's tests do not build zenoh-c or

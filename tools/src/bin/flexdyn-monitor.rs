@@ -26,7 +26,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use clap::Parser;
-use flexdyn::transport::{frame_stamp_ns, mode_name, unix_now_ns};
+use flexdyn_proto::client::transport::{frame_stamp_ns, mode_name, unix_now_ns};
 use flexdyn_proto::{
     command_flags, decode_state, decode_status, effector_kind, wheel_flags, RunState, StatusMsg,
     NO_COMMAND,

@@ -449,11 +449,11 @@ pub fn frame_stamp_ns(sample: &Sample) -> Option<u64> {
     Some(u64::from_le_bytes(arr))
 }
 
-/// The spelling of a [`flexdyn_proto::Mode`] in settings and logs.
-pub fn mode_name(mode: flexdyn_proto::Mode) -> &'static str {
+/// The spelling of a [`crate::Mode`] in settings and logs.
+pub fn mode_name(mode: crate::Mode) -> &'static str {
     match mode {
-        flexdyn_proto::Mode::RealTime => "realtime",
-        flexdyn_proto::Mode::Lockstep => "lockstep",
-        flexdyn_proto::Mode::Batch => "batch",
+        crate::Mode::RealTime => "realtime",
+        crate::Mode::Lockstep => "lockstep",
+        crate::Mode::Batch => "batch",
     }
 }

@@ -1,44 +1,57 @@
 //! Flight-code-side building blocks of `flexdyn-acs-demo`: a reaction-wheel MRP feedback law
-//! and a star-tracker attitude estimate propagated with the gyro between updates. They read the
-//! spacecraft's geometry from the same scenario file as the server (flight code would have it
-//! in its own tables) and nothing else from flexdyn but the wire messages.
+//! and a star-tracker attitude estimate propagated with the gyro between updates. They take the
+//! spacecraft's geometry from the configuration the server serves
+//! ([`flexdyn_proto::client::vehicle::VehicleConfig`]; flight code would have it in its own tables),
+//! the attitude kernels from `flexdyn_proto::attitude` and the messages from `flexdyn-proto`.
 
 use anyhow::{bail, Context as _};
-use flexdyn::attitude::{dcm_to_mrp, mrp_switch, quat_to_dcm};
-use flexdyn::config::SimConfig;
+use flexdyn_proto::attitude::{dcm_to_mrp, mrp_rate, mrp_switch, quat_to_dcm};
+use flexdyn_proto::client::vehicle::VehicleConfig;
 use flexdyn_proto::{effector_kind, EffectorInput, StarTrackerMsg, StateMsg};
 use nalgebra::{DMatrix, Matrix3, Vector3, Vector4};
+
+/// A row-major 3×3 array of the configuration as a matrix.
+pub fn mat3(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {
+    Matrix3::from_fn(|r, c| rows[r][c])
+}
 
 /// The spacecraft's inertia about B with the wings at rest (θ = 0) and every wheel rotor: the
 /// flight code's mass-property table. Panels as rigid bodies at their rest positions
 /// (r_Sc1/B = r_H1/B − d1 ĥ1, r_Sc2/B = r_H1/B − (l1 + d2) ĥ1), rotors with J_s ĝĝᵀ +
 /// J_t (I − ĝĝᵀ), all by the parallel-axis theorem.
-pub fn inertia_about_b(cfg: &SimConfig) -> Matrix3<f64> {
+pub fn inertia_about_b(cfg: &VehicleConfig) -> anyhow::Result<Matrix3<f64>> {
     let shift = |m: f64, r: &Vector3<f64>| {
         (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose()) * m
     };
     let h = &cfg.hub;
-    let mut i = h.inertia_bc_b_kg_m2 + shift(h.mass_kg, &h.r_bcb_b_m);
-    for (p, _) in &cfg.panel_pairs {
-        let h1 = p.dcm_h1b.row(0).transpose();
+    let r_bcb = Vector3::from(h.r_bcb_b_m);
+    let mut i = mat3(&h.inertia_bc_b_kg_m2) + shift(h.mass_kg, &r_bcb);
+    for p in &cfg.panel_pairs {
+        let dcm_h1b = mat3(&p.dcm_h1b);
+        let h1 = dcm_h1b.row(0).transpose();
+        let r_h1b = Vector3::from(p.r_h1b_b_m);
+        let l1_m = p
+            .panel1
+            .l_m
+            .with_context(|| format!("panel pair `{}`: panel1 has no l_m", p.name))?;
         // At θ = 0 the panel frames are [H1 B] (θ_H2S1 turns panel 2 about ĥ2; ignored here).
-        let dcm_bs = p.dcm_h1b.transpose();
+        let dcm_bs = dcm_h1b.transpose();
         for (panel, r) in [
-            (&p.panel1, p.r_h1b_b_m - h1 * p.panel1.d_m),
-            (&p.panel2, p.r_h1b_b_m - h1 * (p.l1_m + p.panel2.d_m)),
+            (&p.panel1, r_h1b - h1 * p.panel1.d_m),
+            (&p.panel2, r_h1b - h1 * (l1_m + p.panel2.d_m)),
         ] {
-            let i_s = Matrix3::from_diagonal(&panel.inertia_s_kg_m2);
+            let i_s = Matrix3::from_diagonal(&Vector3::from(panel.inertia_s_kg_m2));
             i += dcm_bs * i_s * dcm_bs.transpose() + shift(panel.mass_kg, &r);
         }
     }
     for w in &cfg.reaction_wheels {
-        let g = w.spin_axis_b.normalize();
+        let g = Vector3::from(w.spin_axis_b).normalize();
         let ggt = g * g.transpose();
         i += ggt * w.j_s_kg_m2
             + (Matrix3::identity() - ggt) * w.j_t_kg_m2
-            + shift(w.mass_kg, &w.r_wb_b_m);
+            + shift(w.mass_kg, &Vector3::from(w.r_wb_b_m));
     }
-    i
+    Ok(i)
 }
 
 /// The wheel array as flight code sees it: each wheel's effector index on the wire, its spin
@@ -56,7 +69,7 @@ pub struct WheelArray {
 
 impl WheelArray {
     /// The wheels of `cfg`; an error if it has none or they do not span three axes.
-    pub fn from_config(cfg: &SimConfig) -> anyhow::Result<Self> {
+    pub fn from_config(cfg: &VehicleConfig) -> anyhow::Result<Self> {
         if cfg.reaction_wheels.is_empty() {
             bail!("the configuration has no [[reaction_wheels]] (needed by --actuator wheels)");
         }
@@ -64,14 +77,14 @@ impl WheelArray {
         let axes: Vec<Vector3<f64>> = cfg
             .reaction_wheels
             .iter()
-            .map(|w| w.spin_axis_b.normalize())
+            .map(|w| Vector3::from(w.spin_axis_b).normalize())
             .collect();
         let g = DMatrix::from_fn(3, n, |r, c| axes[c][r]);
         let ggt_inv = (&g * g.transpose())
             .try_inverse()
             .filter(|m| m.iter().all(|x| x.is_finite()))
             .context("the wheel spin axes do not span three axes: no torque about some axis")?;
-        let first = cfg.panel_pairs.len() as u32;
+        let first = cfg.first_wheel_index();
         Ok(Self {
             effector_index: (0..n as u32).map(|j| first + j).collect(),
             spin_axis_b: axes,
@@ -89,8 +102,8 @@ impl WheelArray {
                     Ok(e.states[0])
                 }
                 _ => bail!(
-                    "StateMsg effector {i} is not a reaction wheel: is the server running the \
-                     same --config?"
+                    "StateMsg effector {i} is not a reaction wheel, though the served \
+                     configuration says so"
                 ),
             })
             .collect()
@@ -155,20 +168,11 @@ pub struct StarTrackerAttitude {
 
 impl StarTrackerAttitude {
     /// The tracker `name` of `cfg`.
-    pub fn from_config(cfg: &SimConfig, name: &str) -> anyhow::Result<Self> {
-        let st = cfg
-            .star_trackers
-            .iter()
-            .find(|s| s.name == name)
-            .with_context(|| {
-                let names: Vec<&str> = cfg.star_trackers.iter().map(|s| s.name.as_str()).collect();
-                format!(
-                    "no [[star_trackers]] named `{name}` in the configuration (it has: {names:?})"
-                )
-            })?;
+    pub fn from_config(cfg: &VehicleConfig, name: &str) -> anyhow::Result<Self> {
+        let st = cfg.star_tracker(name)?;
         Ok(Self {
-            dcm_cb: st.dcm_cb,
-            every_frames: st.every_frames,
+            dcm_cb: mat3(&st.dcm_cb),
+            every_frames: cfg.star_tracker_period_frames(st)?,
             estimate: None,
         })
     }
@@ -193,11 +197,7 @@ impl StarTrackerAttitude {
             }
             _ => {
                 if let Some(s) = &mut self.estimate {
-                    let s2 = s.norm_squared();
-                    let b = Matrix3::identity() * (1.0 - s2)
-                        + flexdyn::attitude::tilde(s) * 2.0
-                        + *s * s.transpose() * 2.0;
-                    *s += b * omega_bn_b * (0.25 * dt_s);
+                    *s += mrp_rate(s, omega_bn_b) * dt_s;
                     mrp_switch(s);
                 }
             }
@@ -209,12 +209,12 @@ impl StarTrackerAttitude {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flexdyn::attitude::mrp_to_dcm;
+    use flexdyn_proto::attitude::{mrp_to_dcm, tilde};
 
-    fn cfg() -> SimConfig {
+    fn cfg() -> VehicleConfig {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../scenarios/wheels_star_tracker.toml");
-        SimConfig::from_file(&path).unwrap()
+            .join("../../../scenarios/wheels_star_tracker.toml");
+        VehicleConfig::from_toml(&std::fs::read_to_string(path).unwrap()).unwrap()
     }
 
     /// −[G_s] u reproduces the requested torque (the pyramid spans 3 axes), with the minimum
@@ -241,7 +241,7 @@ mod tests {
         assert_eq!(est.every_frames, 10);
         let sigma_bn = Vector3::new(0.1, -0.2, 0.05);
         let dcm_cn = est.dcm_cb * mrp_to_dcm(&sigma_bn);
-        let q = flexdyn::attitude::dcm_to_quat(&dcm_cn);
+        let q = flexdyn_proto::attitude::dcm_to_quat(&dcm_cn);
         let msg = StarTrackerMsg {
             q_cn: q.into(),
             valid: true,
@@ -258,7 +258,7 @@ mod tests {
         let next = est.update(Some(&invalid), &w, 0.01).unwrap();
         let s2 = sigma_bn.norm_squared();
         let b = Matrix3::identity() * (1.0 - s2)
-            + flexdyn::attitude::tilde(&sigma_bn) * 2.0
+            + tilde(&sigma_bn) * 2.0
             + sigma_bn * sigma_bn.transpose() * 2.0;
         assert!((next - (sigma_bn + b * w * 0.0025)).norm() < 1e-15);
         assert!(StarTrackerAttitude::from_config(&c, "nope").is_err());

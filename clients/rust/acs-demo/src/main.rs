@@ -1,0 +1,621 @@
+//! `flexdyn-acs-demo`: a demo attitude controller for the flexdyn server — and the template to
+//! copy when you attach your own flight code. It depends on `flexdyn-proto` alone: the wire,
+//! plus its `client` feature (the Zenoh rules, the served configuration, complete ticks) and
+//! its `attitude` feature (the MRP kernels), never on the simulator.
+//!
+//! # What it does
+//! Every tick the server publishes the spacecraft state (`flexdyn/<sc>/tlm/state`, one
+//! [`StateMsg`](flexdyn_proto::StateMsg) per frame) and its sensor samples. This program
+//! computes the MRP proportional-derivative control torque
+//!
+//! ```text
+//!     L = −K σ_BR − P ω_BR            (Schaub & Junkins, Analytical Mechanics of Space
+//!                                      Systems, ch. 8: MRP feedback control)
+//! ```
+//!
+//! and publishes it as a [`CommandMsg`] on `flexdyn/<sc>/cmd/<sender-id>`, stamped with the tick
+//! of the state it answers. σ_BR is the MRP attitude error of the body B relative to the target
+//! frame R (given as σ_RN with ω_RN = 0, so ω_BR = ω_BN).
+//!
+//! # Real time and lockstep: one loop
+//! The loop is the same in both server modes:
+//! - **real time**: the server never waits; it applies the latest command it has (typically the
+//!   answer to the previous frame) and flags commands that get too old;
+//! - **lockstep**: the server waits for our answer to tick k before stepping to k+1, so the run
+//!   is bit-for-bit reproducible. Three rules make that work, all followed below:
+//!   1. answer **every** state, stamped with **its** tick (send `CommandKind::NoCommand` if you
+//!      have nothing to command);
+//!   2. subscribe to the telemetry **before** declaring the liveliness token
+//!      `flexdyn/<sc>/participant/<sender-id>`: the server starts at tick 0 only once it sees
+//!      the token;
+//!   3. answer tick k from the state **and every sensor sample due at tick k**: one subscriber
+//!      on `flexdyn/<sc>/tlm/**`, and which samples are due from the server's configuration
+//!      queryable ([`TickReceiver`]). Separate subscribers can see a state before its own
+//!      tick's IMU sample, and a run then depends on thread timing.
+//!
+//! # Tuning (linearised closed loop, per principal axis with inertia I)
+//! With σ̇ ≈ ω/4 for small errors, I ω̇ = −Kσ − Pω gives σ̈ + (P/I) σ̇ + (K/4I) σ = 0:
+//! ω_n = √(K/(4I)), ζ = P/√(K I), decay rate ζ ω_n = P/(2I), 2 % settling ≈ 8 I / P.
+//! The defaults (K = 100 N·m, P = 300 N·m·s) suit the reference spacecraft
+//! (I ≈ 1100…1800 kg·m² about the centre of mass): ζ ≈ 0.7…0.9, settling ≈ 30…50 s.
+//!
+//! # The spacecraft's geometry
+//! At start the demo asks the server's `flexdyn/<sc>/config` queryable what it runs
+//! ([`Vehicle`]): the IMU mountings, the wheels and the star trackers with their rates. Real
+//! flight code has these in its own tables; the demo reads them so that it fits any scenario.
+//!
+//! # Rate feedback from the gyro
+//! Flight code reads rate gyros, not truth, so by default the rate comes from an IMU the server
+//! publishes on `flexdyn/<sc>/tlm/imu/<name>` (`ImuMsg`, one per frame, stamped with the same
+//! tick as the state): ω_B = [PB]ᵀ ω_P, with [PB] the IMU's mounting from the configuration
+//! (or `--imu-dcm-pb`). `--rate-source`:
+//! - `gyro`: use the IMU `--imu NAME` (a sample lost in real time holds the previous rate,
+//!   counted and logged);
+//! - `auto` (default): `gyro` if `--imu NAME` is given, otherwise the state message's truth
+//!   rate (said in the log). It never picks an IMU by itself;
+//! - `truth`: the state message's ω_BN.
+//!
+//! # Reaction wheels and the star tracker
+//! - `--actuator wheels` turns the torque into reaction-wheel motor torques: the law adds the
+//!   wheel-momentum gyroscopic term, L = −Kσ − Pω + ω × ([I]ω + [G_s]h_s), and u = −[G_s]⁺L is
+//!   sent as one `CommandKind::Actuators` per tick ([`flexdyn_acs_demo::acs`]);
+//! - `--attitude-source star-tracker --star-tracker NAME` takes σ_BN from that tracker's
+//!   q_CN through its mounting [CB], propagated with the rate feedback between its updates; until
+//!   its first valid sample the answer is `NoCommand`.
+//!
+//! With `--rate-source gyro --imu NAME` as well, the loop uses no truth at all.
+//!
+//! # Copying this package
+//! Keep `run`'s order (session → configuration → telemetry subscriber → publisher → token →
+//! loop). Replace [`GyroFeedback`] by your rate source and [`Controller::torque_b_nm`] by your
+//! control law. Everything on the wire comes from the `flexdyn-proto` crate (see
+//! `proto/README.md` for C and Python byte layouts).
+
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context as _};
+use clap::Parser;
+use flexdyn_acs_demo::acs::WheelArray;
+use flexdyn_acs_demo::acs::{inertia_about_b, mat3, wheel_control_torque, StarTrackerAttitude};
+use flexdyn_proto::attitude::mrp_error;
+use flexdyn_proto::client::cli::{exit_with, stop_on_signals, usage, CommonArgs};
+use flexdyn_proto::client::lockstep::{SensorSchedule, TickReceiver};
+use flexdyn_proto::client::vehicle::{Vehicle, VehicleConfig};
+use flexdyn_proto::{encode_into, CommandMsg, Header, Topics};
+use nalgebra::{Matrix3, Vector3};
+use zenoh::qos::CongestionControl;
+use zenoh::{Session, Wait};
+
+/// Demo MRP PD attitude controller: subscribes to flexdyn telemetry, publishes commands.
+#[derive(Debug, Parser)]
+#[command(name = "flexdyn-acs-demo", version)]
+struct Args {
+    #[command(flatten)]
+    common: CommonArgs,
+    /// Our sender id (must be in the server's `participants`).
+    #[arg(long, default_value_t = 1)]
+    sender_id: u32,
+    /// Attitude gain K [N·m per unit MRP].
+    #[arg(long, default_value_t = 100.0, allow_negative_numbers = true)]
+    k_nm: f64,
+    /// Rate gain P [N·m·s/rad].
+    #[arg(long, default_value_t = 300.0, allow_negative_numbers = true)]
+    p_nms: f64,
+    /// Target attitude σ_RN (MRP, three comma-separated numbers); ω_RN = 0.
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', default_values_t = [0.0, 0.0, 0.0],
+          allow_hyphen_values = true)]
+    sigma_rn: Vec<f64>,
+    /// Log a progress line every this many seconds of simulation time (0: never).
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    log_every_s: f64,
+    /// Exit after this many seconds without a state: exit 0 if states were received (the run
+    /// ended), exit 1 if none ever came (no server). It also bounds the wait for the server's
+    /// configuration at start. Default: run (and wait) until SIGINT/SIGTERM.
+    #[arg(long, allow_negative_numbers = true)]
+    idle_exit_s: Option<f64>,
+    /// Where the rate feedback comes from. `gyro`: the IMU named by --imu. `truth`: the state
+    /// message's ω_BN. `auto`: `gyro` if --imu is given, else `truth` (logged); it never picks
+    /// an IMU by itself.
+    #[arg(long, value_enum, default_value_t = RateSource::Auto)]
+    rate_source: RateSource,
+    /// The IMU whose gyro feeds the rate loop (its `[[imus]] name` in the server config).
+    #[arg(long)]
+    imu: Option<String>,
+    /// That IMU's mounting [PB] (maps B to platform P), nine comma-separated numbers,
+    /// row-major. Default: the mounting in the server's configuration.
+    #[arg(
+        long,
+        value_name = "9 NUMBERS",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    imu_dcm_pb: Option<Vec<f64>>,
+    /// Longest wait [s] for a tick's sensor samples once its state is in; then the tick is
+    /// answered without them (a lost sample: held rate, propagated attitude; logged). In
+    /// lockstep no sample is lost.
+    #[arg(
+        long,
+        visible_alias = "imu-timeout-s",
+        default_value_t = 5.0,
+        allow_negative_numbers = true
+    )]
+    sensor_timeout_s: f64,
+    /// What to command: `wrench` (a body torque) or `wheels` (reaction-wheel motor torques
+    /// through an `Actuators` command, with wheel-momentum gyroscopic compensation).
+    #[arg(long, value_enum, default_value_t = Actuator::Wrench)]
+    actuator: Actuator,
+    /// Where the attitude comes from: `truth` (the state message's σ_BN) or `star-tracker`
+    /// (the tracker named by --star-tracker, propagated with the rate feedback between its
+    /// updates; no command until its first valid measurement).
+    #[arg(long, value_enum, default_value_t = AttitudeSource::Truth)]
+    attitude_source: AttitudeSource,
+    /// The star tracker feeding the attitude (its `[[star_trackers]] name`).
+    #[arg(long)]
+    star_tracker: Option<String>,
+}
+
+/// What the controller commands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum Actuator {
+    /// A body torque (`CommandKind::Wrench`).
+    Wrench,
+    /// Reaction-wheel motor torques (`CommandKind::Actuators`).
+    Wheels,
+}
+
+/// Where the attitude comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum AttitudeSource {
+    /// The state message's σ_BN.
+    Truth,
+    /// A star tracker's q_CN, mounted as the configuration says.
+    StarTracker,
+}
+
+/// Rate feedback source.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum RateSource {
+    /// The IMU named by `--imu` if given, else (with a log line) the truth rate.
+    Auto,
+    /// The IMU named by `--imu`.
+    Gyro,
+    /// The truth rate in the state message.
+    Truth,
+}
+
+// ---------------------------------------------------------------------------------------------
+// The controller.
+
+/// MRP PD attitude controller, L = −K σ_BR − P ω_BR, with a fixed target (ω_RN = 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Controller {
+    /// K [N·m per unit MRP].
+    pub k_nm: f64,
+    /// P [N·m·s/rad].
+    pub p_nms: f64,
+    /// Target attitude σ_RN.
+    pub sigma_rn: Vector3<f64>,
+}
+
+impl Controller {
+    /// The attitude error σ_BR ([BR] = [BN][RN]ᵀ, |σ_BR| ≤ 1).
+    pub fn sigma_br(&self, sigma_bn: &Vector3<f64>) -> Vector3<f64> {
+        mrp_error(sigma_bn, &self.sigma_rn)
+    }
+
+    /// Control torque about B, B components [N·m], from the attitude σ_BN and the rate ω_BN
+    /// [rad/s, B components]. With ω_RN = 0, ω_BR = ω_BN.
+    pub fn torque_b_nm(
+        &self,
+        sigma_bn: &Vector3<f64>,
+        omega_bn_b_rad_s: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        -self.sigma_br(sigma_bn) * self.k_nm - omega_bn_b_rad_s * self.p_nms
+    }
+}
+
+/// The gyro rate feedback: the IMU `--imu`'s sample of each tick rotated to B,
+/// ω_B = [PB]ᵀ ω_P. A sample lost in real time holds the previous rate (counted and logged).
+struct GyroFeedback {
+    /// The IMU followed (`--imu`), and its index in the tick's samples.
+    name: String,
+    index: usize,
+    /// [PB].
+    dcm_pb: Matrix3<f64>,
+    /// The last rate used, held over a lost sample.
+    last_rate_b: Option<Vector3<f64>>,
+    /// Samples lost so far.
+    missed: u64,
+}
+
+impl GyroFeedback {
+    /// The rate for a tick whose sample of this IMU is `sample` (`None`: lost).
+    fn rate_for(
+        &mut self,
+        tick: u64,
+        sample: Option<&flexdyn_proto::ImuMsg>,
+    ) -> anyhow::Result<Vector3<f64>> {
+        if let Some(m) = sample {
+            let w = self.dcm_pb.transpose() * Vector3::from(m.omega_p_rad_s);
+            self.last_rate_b = Some(w);
+            return Ok(w);
+        }
+        self.missed += 1;
+        if self.missed == 1 || self.missed.is_multiple_of(100) {
+            tracing::warn!(imu = %self.name, tick, missed = self.missed,
+                "no gyro sample for this tick; holding the previous rate");
+        }
+        self.last_rate_b.with_context(|| {
+            format!(
+                "no sample from the IMU `{}` for tick {tick}, and none before",
+                self.name
+            )
+        })
+    }
+}
+
+/// A 3×3 DCM from nine row-major numbers, checked proper orthonormal within 1e-9.
+fn parse_dcm(v: &[f64]) -> anyhow::Result<Matrix3<f64>> {
+    if v.len() != 9 || v.iter().any(|x| !x.is_finite()) {
+        return Err(usage(
+            "--imu-dcm-pb takes nine finite comma-separated numbers (row-major [PB])",
+        ));
+    }
+    let c = Matrix3::from_row_slice(v);
+    let residual = c * c.transpose() - Matrix3::identity();
+    if let Some((k, d)) = residual.iter().enumerate().find(|(_, d)| d.abs() > 1e-9) {
+        // `iter` is column-major: element k is at row k % 3, column k / 3.
+        return Err(usage(format!(
+            "--imu-dcm-pb is not orthonormal within 1e-9 (rows {}, {}: {d:e})",
+            k % 3,
+            k / 3
+        )));
+    }
+    if (c.determinant() - 1.0).abs() > 1e-9 {
+        bail!("--imu-dcm-pb is a reflection (determinant -1), not a rotation");
+    }
+    Ok(c)
+}
+
+fn main() -> std::process::ExitCode {
+    let args = match flexdyn_proto::client::logging::parse_args::<Args>() {
+        Ok(a) => a,
+        Err(code) => return code,
+    };
+    flexdyn_proto::client::logging::init_tracing();
+    exit_with(run(args))
+}
+
+/// Checks the options that need no server.
+fn check(args: &Args) -> anyhow::Result<Controller> {
+    if args.sigma_rn.len() != 3 {
+        return Err(usage(
+            "--sigma-rn takes three comma-separated numbers, e.g. 0.1,0.2,-0.1",
+        ));
+    }
+    let controller = Controller {
+        k_nm: args.k_nm,
+        p_nms: args.p_nms,
+        sigma_rn: Vector3::new(args.sigma_rn[0], args.sigma_rn[1], args.sigma_rn[2]),
+    };
+    if !(controller.k_nm.is_finite() && controller.p_nms.is_finite())
+        || controller.sigma_rn.iter().any(|x| !x.is_finite())
+    {
+        return Err(usage("gains and target must be finite"));
+    }
+    if let Some(v) = &args.imu_dcm_pb {
+        parse_dcm(v)?;
+    }
+    if args.rate_source == RateSource::Gyro && args.imu.is_none() {
+        return Err(usage(
+            "--rate-source gyro needs --imu NAME (the [[imus]] name in the server config)",
+        ));
+    }
+    if args.attitude_source == AttitudeSource::StarTracker && args.star_tracker.is_none() {
+        return Err(usage(
+            "--attitude-source star-tracker needs --star-tracker NAME (its [[star_trackers]] \
+             name)",
+        ));
+    }
+    if !(args.sensor_timeout_s.is_finite() && args.sensor_timeout_s > 0.0) {
+        return Err(usage(
+            "--sensor-timeout-s must be a positive number of seconds",
+        ));
+    }
+    if let Some(s) = args.idle_exit_s {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(usage("--idle-exit-s must be a positive number of seconds"));
+        }
+    }
+    Ok(controller)
+}
+
+/// The served configuration, asked until the server answers, a stop signal, or `idle` passes.
+fn wait_for_vehicle(
+    session: &Session,
+    topics: &Topics,
+    idle: Option<Duration>,
+    stop: &std::sync::atomic::AtomicBool,
+) -> anyhow::Result<Option<Vehicle>> {
+    let started = Instant::now();
+    loop {
+        if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            return Ok(None);
+        }
+        match Vehicle::query(session, topics, Duration::from_millis(500)) {
+            Ok(v) => return Ok(Some(v)),
+            Err(flexdyn_proto::client::vehicle::VehicleError::NoAnswer { key, .. }) => {
+                if let Some(d) = idle.filter(|d| started.elapsed() >= *d) {
+                    bail!(
+                        "no answer on {key} within {} s (--idle-exit-s): no server, or it is not \
+                         reachable at the --connect endpoint",
+                        d.as_secs_f64()
+                    );
+                }
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+}
+
+/// The gyro feedback the options ask for, with the mounting from the configuration.
+fn gyro(
+    args: &Args,
+    cfg: &VehicleConfig,
+    schedule: &SensorSchedule,
+) -> anyhow::Result<Option<GyroFeedback>> {
+    let name = match (args.rate_source, &args.imu) {
+        (RateSource::Truth, _) => return Ok(None),
+        (_, Some(name)) => name.clone(),
+        (RateSource::Auto, None) => {
+            tracing::info!(
+                "--rate-source auto without --imu: rate feedback uses the truth rate from the \
+                 state message (name an IMU with --imu to close the loop on its gyro)"
+            );
+            return Ok(None);
+        }
+        (RateSource::Gyro, None) => unreachable!("checked in `check`"),
+    };
+    let imu = cfg
+        .imu(&name)
+        .map_err(|e| anyhow::anyhow!("--imu {name}: {e}"))?;
+    let dcm_pb = match &args.imu_dcm_pb {
+        Some(v) => parse_dcm(v)?,
+        None => mat3(&imu.dcm_pb),
+    };
+    let index = schedule
+        .imus()
+        .position(|n| n == name)
+        .context("the IMU is in the configuration but not in its schedule")?;
+    tracing::info!(imu = %name, "rate feedback from this IMU's gyro");
+    Ok(Some(GyroFeedback {
+        name,
+        index,
+        dcm_pb,
+        last_rate_b: None,
+        missed: 0,
+    }))
+}
+
+fn run(args: Args) -> anyhow::Result<()> {
+    let topics = args.common.topics()?;
+    let controller = check(&args)?;
+    let idle = args.idle_exit_s.map(Duration::from_secs_f64);
+    let stop = stop_on_signals()?;
+
+    // 1. Session: peer, connects to the server (tcp/127.0.0.1:7447 unless --connect says
+    //    otherwise), multicast scouting off.
+    let session = args.common.open_session()?;
+
+    // 2. What the server runs: the geometry, and which sensor samples each tick carries.
+    let Some(vehicle) = wait_for_vehicle(&session, &topics, idle, &stop)? else {
+        tracing::info!("stop signal before the server answered: closing the session");
+        return close(session);
+    };
+    let cfg = vehicle.config()?;
+    let schedule = SensorSchedule::from_config(&cfg)?;
+    let frame_s = (1e9 / cfg.simulation.frame_hz).round() * 1e-9;
+    let mut gyro = gyro(&args, &cfg, &schedule)?;
+    let wheels = match args.actuator {
+        Actuator::Wrench => None,
+        Actuator::Wheels => Some((WheelArray::from_config(&cfg)?, inertia_about_b(&cfg)?)),
+    };
+    let mut tracker = match (args.attitude_source, &args.star_tracker) {
+        (AttitudeSource::StarTracker, Some(name)) => {
+            let est = StarTrackerAttitude::from_config(&cfg, name)?;
+            let index = schedule
+                .star_trackers()
+                .position(|(n, _)| n == name)
+                .context("the star tracker is in the configuration but not in its schedule")?;
+            tracing::info!(star_tracker = %name, "attitude from this star tracker");
+            Some((est, index))
+        }
+        _ => None,
+    };
+
+    // 3. The telemetry: one subscriber on flexdyn/<sc>/tlm/**, assembled into complete ticks.
+    //    Declared before the token, so the server cannot publish tick 0 before we can receive
+    //    it. A ring buffer: in real time, if we ever fall behind, the oldest samples go.
+    let mut ticks = TickReceiver::declare(
+        &session,
+        &topics,
+        schedule,
+        256,
+        Duration::from_secs_f64(args.sensor_timeout_s),
+    )
+    .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.telemetry_wildcard()))?;
+
+    // 4. The command publisher. Block (never drop) and express (no batching: lowest latency).
+    let cmd_key = topics.cmd(args.sender_id);
+    let commands = session
+        .declare_publisher(cmd_key.clone())
+        .congestion_control(CongestionControl::Block)
+        .express(true)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot declare {cmd_key}: {e}"))?;
+
+    // 5. Announce ourselves to a lockstep server (harmless in real time).
+    let token = session
+        .liveliness()
+        .declare_token(topics.participant(args.sender_id))
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot declare the liveliness token: {e}"))?;
+    tracing::info!(
+        sender_id = args.sender_id,
+        k_nm = controller.k_nm,
+        p_nms = controller.p_nms,
+        sigma_rn = ?controller.sigma_rn.as_slice(),
+        telemetry = topics.telemetry_wildcard(),
+        commands = cmd_key,
+        "flexdyn-acs-demo running"
+    );
+
+    // 6. The loop: one command per tick, until SIGINT/SIGTERM or --idle-exit-s.
+    let log_every_ns = (args.log_every_s.max(0.0) * 1e9) as u64;
+    let mut next_log_ns = 0u64;
+    let mut seq = 0u64;
+    let mut buf = Vec::with_capacity(128);
+    let mut states_received = 0u64;
+    let mut last_state_at = Instant::now();
+    loop {
+        if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            tracing::info!(states_received, "stop signal: closing the session");
+            break;
+        }
+        if let Some(d) = idle {
+            if last_state_at.elapsed() >= d {
+                if states_received == 0 {
+                    bail!(
+                        "no state received on {} within {} s (--idle-exit-s): the server \
+                         answered but published nothing",
+                        topics.state(),
+                        d.as_secs_f64()
+                    );
+                }
+                tracing::info!(
+                    states_received,
+                    "no state for {} s; exiting",
+                    d.as_secs_f64()
+                );
+                break;
+            }
+        }
+        // Wake at least every 100 ms to notice a signal or the idle limit.
+        let Some(tick) = ticks
+            .recv_timeout(Duration::from_millis(100))
+            .map_err(|e| anyhow::anyhow!("{e}"))?
+        else {
+            continue;
+        };
+        states_received += 1;
+        last_state_at = Instant::now();
+        let state = &tick.state;
+        let h = state.header;
+
+        // The rate feedback: this tick's gyro sample, or truth.
+        let rate_b = match &mut gyro {
+            Some(g) => g.rate_for(h.tick, tick.imus[g.index].as_ref())?,
+            None => Vector3::from(state.omega_bn_b_rad_s),
+        };
+        // The attitude: truth, or the star tracker's (propagated with the rate between updates).
+        let sigma_bn = match &mut tracker {
+            Some((est, index)) => est.update(tick.star_trackers[*index].as_ref(), &rate_b, frame_s),
+            None => Some(Vector3::from(state.sigma_bn)),
+        };
+
+        // Answer with the state's spacecraft id, tick and sim time; our own sequence number.
+        let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
+        let (cmd, torque_b_nm) = match (sigma_bn, &wheels) {
+            // No attitude yet (the star tracker has not given a valid one): answer the tick.
+            (None, _) => (
+                CommandMsg::no_command(header, args.sender_id),
+                Vector3::zeros(),
+            ),
+            (Some(sigma_bn), None) => {
+                let t = controller.torque_b_nm(&sigma_bn, &rate_b);
+                (
+                    CommandMsg::wrench(header, args.sender_id, t.into(), [0.0; 3]),
+                    t,
+                )
+            }
+            (Some(sigma_bn), Some((array, inertia))) => {
+                let speeds = array.speeds(state)?;
+                let l = wheel_control_torque(
+                    controller.k_nm,
+                    controller.p_nms,
+                    &controller.sigma_br(&sigma_bn),
+                    &rate_b,
+                    inertia,
+                    &array.momentum_b(&rate_b, &speeds),
+                );
+                let u = array.motor_torques(&l);
+                let cmd = CommandMsg::actuators(
+                    header,
+                    args.sender_id,
+                    [0.0; 3],
+                    [0.0; 3],
+                    array.inputs(&u),
+                );
+                (cmd, l)
+            }
+        };
+        encode_into(&cmd, &mut buf);
+        commands
+            .put(buf.as_slice())
+            .wait()
+            .map_err(|e| anyhow::anyhow!("cannot publish the command: {e}"))
+            .context("publishing")?;
+        seq += 1;
+
+        if log_every_ns > 0 && h.sim_time_ns >= next_log_ns {
+            tracing::info!(
+                tick = h.tick,
+                t_s = h.sim_time_ns as f64 / 1e9,
+                sigma_br_norm = controller.sigma_br(&Vector3::from(state.sigma_bn)).norm(),
+                omega_norm_rad_s = Vector3::from(state.omega_bn_b_rad_s).norm(),
+                torque_b_nm = ?torque_b_nm.as_slice(),
+                "control"
+            );
+            next_log_ns = h.sim_time_ns.saturating_add(log_every_ns);
+        }
+    }
+    // Undeclare the token first (a lockstep server sees us leave), then close the session.
+    drop(token);
+    drop(commands);
+    drop(ticks);
+    close(session)
+}
+
+fn close(session: Session) -> anyhow::Result<()> {
+    session
+        .close()
+        .wait()
+        .map_err(|e| anyhow::anyhow!("closing the Zenoh session: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pd_law_signs() {
+        let c = Controller {
+            k_nm: 2.0,
+            p_nms: 3.0,
+            sigma_rn: Vector3::zeros(),
+        };
+        let t = c.torque_b_nm(&Vector3::new(0.1, 0.0, 0.0), &Vector3::zeros());
+        assert!((t - Vector3::new(-0.2, 0.0, 0.0)).norm() < 1e-15, "{t}");
+        let t = c.torque_b_nm(&Vector3::zeros(), &Vector3::new(0.0, 1.0, 0.0));
+        assert_eq!(t, Vector3::new(0.0, -3.0, 0.0));
+    }
+
+    #[test]
+    fn the_mounting_must_be_a_rotation() {
+        assert!(parse_dcm(&[0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 1.0]).is_ok());
+        let e = parse_dcm(&[-1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 2.0]).unwrap_err();
+        assert!(e.to_string().contains("rows 2, 2"), "{e}");
+        let e = parse_dcm(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0]).unwrap_err();
+        assert!(e.to_string().contains("reflection"), "{e}");
+    }
+}

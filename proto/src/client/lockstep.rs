@@ -1,0 +1,496 @@
+//! Complete ticks for flight code that reads sensors.
+//!
+//! For each tick k the server publishes the sample of every IMU and of every star tracker due at
+//! k, then the StateMsg of k (proto/README.md, "Lockstep protocol"). Flight code that answers
+//! tick k from exactly those samples is as deterministic as the server; flight code that uses
+//! whatever sample came last is not, because separate subscribers may be delivered on separate
+//! threads and a state can overtake a sample of its own tick. So:
+//!
+//! - [`SensorSchedule`] says which samples are due at a tick, from the configuration the server
+//!   serves ([`crate::client::vehicle`]), never from guessing;
+//! - [`TickAssembler`] takes the telemetry samples as they come and hands out a [`Tick`] (the
+//!   state and its due samples) once it is complete;
+//! - [`TickReceiver`] is the Zenoh side: **one** subscriber on `flexdyn/<sc>/tlm/**` (which
+//!   delivers in publication order) feeding an assembler, with a time limit for a sample that
+//!   never comes.
+
+use std::collections::{BTreeMap, VecDeque};
+use std::time::{Duration, Instant};
+
+use crate::{
+    decode_imu, decode_star_tracker, decode_state, DecodeError, ImuMsg, StarTrackerMsg, StateMsg,
+    Telemetry, Topics,
+};
+use zenoh::handlers::{RingChannel, RingChannelHandler};
+use zenoh::pubsub::Subscriber;
+use zenoh::sample::Sample;
+use zenoh::{Session, Wait};
+
+use crate::client::vehicle::{VehicleConfig, VehicleError};
+
+/// Which sensor samples the server publishes at each tick: every IMU each tick, and each star
+/// tracker on the ticks that are multiples of its period (from tick 0).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SensorSchedule {
+    imus: Vec<String>,
+    /// (name, period in frames)
+    star_trackers: Vec<(String, u64)>,
+}
+
+impl SensorSchedule {
+    /// The schedule of a served configuration.
+    pub fn from_config(cfg: &VehicleConfig) -> Result<Self, VehicleError> {
+        Ok(Self {
+            imus: cfg.imus.iter().map(|i| i.name.clone()).collect(),
+            star_trackers: cfg
+                .star_trackers
+                .iter()
+                .map(|st| Ok((st.name.clone(), cfg.star_tracker_period_frames(st)?)))
+                .collect::<Result<_, VehicleError>>()?,
+        })
+    }
+
+    /// The IMU names, in configuration order.
+    pub fn imus(&self) -> impl Iterator<Item = &str> {
+        self.imus.iter().map(String::as_str)
+    }
+
+    /// The star trackers (name, period in frames), in configuration order.
+    pub fn star_trackers(&self) -> impl Iterator<Item = (&str, u64)> {
+        self.star_trackers.iter().map(|(n, p)| (n.as_str(), *p))
+    }
+
+    fn tracker_due(&self, index: usize, tick: u64) -> bool {
+        self.star_trackers
+            .get(index)
+            .is_some_and(|(_, every)| tick.is_multiple_of(*every))
+    }
+}
+
+/// One tick's telemetry: its state and the sensor samples due at it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tick {
+    /// The StateMsg of the tick.
+    pub state: StateMsg,
+    /// The IMU samples of the tick, in configuration order (`None`: lost, see `missing`).
+    pub imus: Vec<Option<ImuMsg>>,
+    /// The star-tracker samples of the tick, in configuration order (`None`: not due at this
+    /// tick, or lost).
+    pub star_trackers: Vec<Option<StarTrackerMsg>>,
+    /// The due samples that never came, as `imu/<name>` or `st/<name>`. Empty in lockstep
+    /// unless a sample was lost.
+    pub missing: Vec<String>,
+}
+
+impl Tick {
+    /// The tick (frame index).
+    pub fn tick(&self) -> u64 {
+        self.state.header.tick
+    }
+}
+
+/// The samples of one tick so far.
+#[derive(Clone, Debug)]
+struct Partial {
+    imus: Vec<Option<ImuMsg>>,
+    star_trackers: Vec<Option<StarTrackerMsg>>,
+}
+
+/// Assembles complete [`Tick`]s from telemetry samples given in any order (see the module
+/// docs). A held state is released without its missing samples when a sample of a later tick
+/// comes (real time, where the server drops samples under load), or when the caller gives up
+/// on it ([`Self::give_up`], after its own time limit).
+#[derive(Debug)]
+pub struct TickAssembler {
+    topics: Topics,
+    schedule: SensorSchedule,
+    /// The state waiting for its samples.
+    held: Option<StateMsg>,
+    /// Samples by tick, for ticks after the last one released.
+    partial: BTreeMap<u64, Partial>,
+    /// The last tick released.
+    last: Option<u64>,
+}
+
+impl TickAssembler {
+    /// An assembler for the telemetry keys of `topics`.
+    pub fn new(topics: Topics, schedule: SensorSchedule) -> Self {
+        Self {
+            topics,
+            schedule,
+            held: None,
+            partial: BTreeMap::new(),
+            last: None,
+        }
+    }
+
+    /// The schedule it follows.
+    pub fn schedule(&self) -> &SensorSchedule {
+        &self.schedule
+    }
+
+    /// Takes one sample (its key and payload) and calls `ready` with each tick it completes, in
+    /// tick order: a key that is not telemetry of this spacecraft, a sensor not in the schedule
+    /// and a sample of a tick already released are ignored. An undecodable payload is an
+    /// error, and changes nothing.
+    pub fn push(
+        &mut self,
+        key: &str,
+        payload: &[u8],
+        mut ready: impl FnMut(Tick),
+    ) -> Result<(), DecodeError> {
+        let Some(topic) = self.topics.telemetry(key) else {
+            return Ok(());
+        };
+        enum Msg {
+            State(StateMsg),
+            Imu(usize, ImuMsg),
+            Tracker(usize, StarTrackerMsg),
+        }
+        let msg = match topic {
+            Telemetry::State => Msg::State(decode_state(payload)?),
+            Telemetry::Imu(name) => match self.schedule.imus.iter().position(|n| n == name) {
+                Some(i) => Msg::Imu(i, decode_imu(payload)?),
+                None => return Ok(()),
+            },
+            Telemetry::StarTracker(name) => {
+                match self
+                    .schedule
+                    .star_trackers
+                    .iter()
+                    .position(|(n, _)| n == name)
+                {
+                    Some(i) => Msg::Tracker(i, decode_star_tracker(payload)?),
+                    None => return Ok(()),
+                }
+            }
+        };
+        let tick = match &msg {
+            Msg::State(m) => m.header.tick,
+            Msg::Imu(_, m) => m.header.tick,
+            Msg::Tracker(_, m) => m.header.tick,
+        };
+        if self.last.is_some_and(|last| tick <= last) {
+            return Ok(()); // its tick was released already (it came after the time limit)
+        }
+        if self.held.as_ref().is_some_and(|h| tick > h.header.tick) {
+            // The held tick's missing samples will not come any more.
+            if let Some(t) = self.give_up() {
+                ready(t);
+            }
+        }
+        match msg {
+            Msg::State(state) => {
+                // Samples of ticks whose state never came (real time) are dropped.
+                self.partial.retain(|t, _| *t >= tick);
+                self.held = Some(state);
+            }
+            Msg::Imu(i, m) => self.partial_mut(tick).imus[i] = Some(m),
+            Msg::Tracker(i, m) => self.partial_mut(tick).star_trackers[i] = Some(m),
+        }
+        if self.held.is_some() && self.missing().is_empty() {
+            if let Some(t) = self.release() {
+                ready(t);
+            }
+        }
+        Ok(())
+    }
+
+    fn partial_mut(&mut self, tick: u64) -> &mut Partial {
+        let (n_imus, n_sts) = (self.schedule.imus.len(), self.schedule.star_trackers.len());
+        self.partial.entry(tick).or_insert_with(|| Partial {
+            imus: vec![None; n_imus],
+            star_trackers: vec![None; n_sts],
+        })
+    }
+
+    /// The due samples of the held tick not received yet (`imu/<name>`, `st/<name>`).
+    fn missing(&self) -> Vec<String> {
+        let Some(tick) = self.held.as_ref().map(|h| h.header.tick) else {
+            return Vec::new();
+        };
+        let part = self.partial.get(&tick);
+        let s = &self.schedule;
+        let imus = s.imus.iter().enumerate().filter_map(|(i, name)| {
+            let have = part.is_some_and(|p| p.imus[i].is_some());
+            (!have).then(|| format!("imu/{name}"))
+        });
+        let sts = s
+            .star_trackers
+            .iter()
+            .enumerate()
+            .filter_map(|(i, (name, _))| {
+                let have = part.is_some_and(|p| p.star_trackers[i].is_some());
+                (s.tracker_due(i, tick) && !have).then(|| format!("st/{name}"))
+            });
+        imus.chain(sts).collect()
+    }
+
+    /// The tick whose state is held, waiting for samples.
+    pub fn waiting(&self) -> Option<u64> {
+        self.held.as_ref().map(|h| h.header.tick)
+    }
+
+    /// Releases the held tick as it is, its missing samples listed in [`Tick::missing`].
+    pub fn give_up(&mut self) -> Option<Tick> {
+        self.release()
+    }
+
+    fn release(&mut self) -> Option<Tick> {
+        let missing = self.missing();
+        let state = self.held.take()?;
+        let tick = state.header.tick;
+        let part = self.partial.remove(&tick);
+        self.partial.retain(|t, _| *t > tick);
+        self.last = Some(tick);
+        let (imus, star_trackers) = match part {
+            Some(p) => (p.imus, p.star_trackers),
+            None => (
+                vec![None; self.schedule.imus.len()],
+                vec![None; self.schedule.star_trackers.len()],
+            ),
+        };
+        Some(Tick {
+            state,
+            imus,
+            star_trackers,
+            missing,
+        })
+    }
+}
+
+/// Complete ticks from a server: one subscriber on `flexdyn/<sc>/tlm/**` (a ring buffer of
+/// `capacity` samples: in real time, a reader that falls behind loses the oldest samples rather
+/// than queueing stale ones; in lockstep at most one tick is in flight), and a
+/// [`TickAssembler`]. A tick whose samples have not all come `sensor_timeout` after its state
+/// is handed out without them.
+pub struct TickReceiver {
+    subscriber: Subscriber<RingChannelHandler<Sample>>,
+    assembler: TickAssembler,
+    ready: VecDeque<Tick>,
+    sensor_timeout: Duration,
+    /// When the held tick started waiting.
+    waiting_since: Option<(u64, Instant)>,
+    /// Undecodable samples received.
+    pub undecodable: u64,
+    /// Ticks handed out with samples missing.
+    pub incomplete: u64,
+}
+
+impl TickReceiver {
+    /// Subscribes to the telemetry of `topics` (do it before declaring a lockstep
+    /// participant's liveliness token, so tick 0 cannot be missed).
+    pub fn declare(
+        session: &Session,
+        topics: &Topics,
+        schedule: SensorSchedule,
+        capacity: usize,
+        sensor_timeout: Duration,
+    ) -> zenoh::Result<Self> {
+        let subscriber = session
+            .declare_subscriber(topics.telemetry_wildcard())
+            .with(RingChannel::new(capacity))
+            .wait()?;
+        Ok(Self {
+            subscriber,
+            assembler: TickAssembler::new(topics.clone(), schedule),
+            ready: VecDeque::new(),
+            sensor_timeout,
+            waiting_since: None,
+            undecodable: 0,
+            incomplete: 0,
+        })
+    }
+
+    /// The schedule it follows.
+    pub fn schedule(&self) -> &SensorSchedule {
+        self.assembler.schedule()
+    }
+
+    /// The next tick, waiting at most `timeout` for it; `Ok(None)` if none is complete by then.
+    pub fn recv_timeout(&mut self, timeout: Duration) -> zenoh::Result<Option<Tick>> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if let Some(t) = self.ready.pop_front() {
+                if !t.missing.is_empty() {
+                    self.incomplete += 1;
+                    if self.incomplete == 1 || self.incomplete.is_multiple_of(100) {
+                        tracing::warn!(
+                            tick = t.tick(),
+                            missing = ?t.missing,
+                            incomplete = self.incomplete,
+                            "a tick without all its sensor samples"
+                        );
+                    }
+                }
+                return Ok(Some(t));
+            }
+            // Give up on a held tick once its samples are overdue.
+            let mut wake = deadline;
+            match (self.assembler.waiting(), self.waiting_since) {
+                (Some(t), Some((since_tick, since))) if t == since_tick => {
+                    let give_up_at = since + self.sensor_timeout;
+                    if Instant::now() >= give_up_at {
+                        self.ready.extend(self.assembler.give_up());
+                        continue;
+                    }
+                    wake = wake.min(give_up_at);
+                }
+                (Some(t), _) => {
+                    self.waiting_since = Some((t, Instant::now()));
+                    continue;
+                }
+                (None, _) => self.waiting_since = None,
+            }
+            let left = wake.saturating_duration_since(Instant::now());
+            let Some(sample) = self.subscriber.recv_timeout(left)? else {
+                if Instant::now() >= deadline {
+                    return Ok(None);
+                }
+                continue; // woken to give up on the held tick
+            };
+            let payload = sample.payload().to_bytes();
+            let ready = &mut self.ready;
+            if let Err(e) = self
+                .assembler
+                .push(sample.key_expr().as_str(), &payload, |t| ready.push_back(t))
+            {
+                self.undecodable += 1;
+                if self.undecodable == 1 || self.undecodable.is_multiple_of(100) {
+                    tracing::warn!(key = %sample.key_expr(), error = %e, "an undecodable sample");
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{encode, Header};
+
+    fn schedule() -> SensorSchedule {
+        SensorSchedule {
+            imus: vec!["hub".into(), "bracket".into()],
+            star_trackers: vec![("st1".into(), 10), ("st2".into(), 4)],
+        }
+    }
+
+    fn header(tick: u64) -> Header {
+        Header::new(1, tick, tick * 10_000_000, tick)
+    }
+
+    struct Feed {
+        a: TickAssembler,
+        out: Vec<Tick>,
+    }
+
+    impl Feed {
+        fn new() -> Self {
+            let topics = Topics::new("sc1").unwrap();
+            Self {
+                a: TickAssembler::new(topics, schedule()),
+                out: Vec::new(),
+            }
+        }
+        fn push(&mut self, key: &str, payload: Vec<u8>) {
+            let out = &mut self.out;
+            self.a.push(key, &payload, |t| out.push(t)).unwrap();
+        }
+        fn state(&mut self, tick: u64) {
+            let m = StateMsg {
+                header: header(tick),
+                ..StateMsg::default()
+            };
+            self.push("flexdyn/sc1/tlm/state", encode(&m));
+        }
+        fn imu(&mut self, name: &str, tick: u64) {
+            let m = ImuMsg {
+                header: header(tick),
+                omega_p_rad_s: [tick as f64, 0.0, 0.0],
+                ..ImuMsg::default()
+            };
+            self.push(&format!("flexdyn/sc1/tlm/imu/{name}"), encode(&m));
+        }
+        fn st(&mut self, name: &str, tick: u64) {
+            let m = StarTrackerMsg {
+                header: header(tick),
+                valid: true,
+                ..StarTrackerMsg::default()
+            };
+            self.push(&format!("flexdyn/sc1/tlm/st/{name}"), encode(&m));
+        }
+        fn ticks(&self) -> Vec<(u64, Vec<String>)> {
+            self.out
+                .iter()
+                .map(|t| (t.tick(), t.missing.clone()))
+                .collect()
+        }
+    }
+
+    #[test]
+    fn a_state_that_overtakes_its_samples_waits_for_them() {
+        let mut f = Feed::new();
+        f.state(0);
+        f.imu("hub", 0);
+        f.st("st1", 0);
+        f.imu("bracket", 0);
+        assert!(f.out.is_empty(), "tick 0 released without st/st2");
+        assert_eq!(f.a.waiting(), Some(0));
+        f.st("st2", 0);
+        assert_eq!(f.ticks(), [(0, vec![])]);
+        let t = &f.out[0];
+        assert!(t.imus.iter().all(Option::is_some) && t.star_trackers.iter().all(Option::is_some));
+        // Tick 1: no tracker is due; in publication order it is released with its state.
+        f.imu("hub", 1);
+        f.imu("bracket", 1);
+        f.state(1);
+        assert_eq!(f.ticks(), [(0, vec![]), (1, vec![])]);
+        assert_eq!(f.out[1].imus[0].as_ref().unwrap().omega_p_rad_s[0], 1.0);
+        assert_eq!(f.out[1].star_trackers, [None, None]);
+        // Tick 4: st2 (period 4) is due, st1 (period 10) is not.
+        f.imu("hub", 4);
+        f.imu("bracket", 4);
+        f.state(4);
+        assert_eq!(f.a.waiting(), Some(4));
+        f.st("st2", 4);
+        assert_eq!(f.ticks().last(), Some(&(4, vec![])));
+    }
+
+    #[test]
+    fn lost_samples_release_the_tick_when_given_up_or_overtaken() {
+        let mut f = Feed::new();
+        f.imu("hub", 3);
+        f.state(3); // imu/bracket of tick 3 never comes
+        assert!(f.out.is_empty());
+        assert_eq!(
+            f.a.give_up().map(|t| t.missing),
+            Some(vec!["imu/bracket".to_string()])
+        );
+        f.imu("bracket", 3); // too late: ignored
+        assert_eq!(f.a.waiting(), None);
+        // Real time: a sample of tick 6 gives up on tick 5 at once.
+        f.imu("hub", 5);
+        f.state(5);
+        f.imu("hub", 6);
+        assert_eq!(f.ticks(), [(5, vec!["imu/bracket".to_string()])]);
+        f.imu("bracket", 6);
+        f.state(6);
+        assert_eq!(f.ticks().last(), Some(&(6, vec![])));
+        // Keys of other spacecraft, unknown sensors and non-telemetry are ignored; garbage
+        // under a known key is an error.
+        let mut out = Vec::new();
+        let a = &mut f.a;
+        for key in [
+            "flexdyn/sc2/tlm/state",
+            "flexdyn/sc1/tlm/imu/other",
+            "flexdyn/sc1/status",
+        ] {
+            a.push(key, &[1, 2, 3], |t| out.push(t)).unwrap();
+        }
+        assert!(a
+            .push("flexdyn/sc1/tlm/state", &[4, 0, 1], |t| out.push(t))
+            .is_err());
+        assert!(out.is_empty());
+    }
+}

@@ -1,0 +1,23 @@
+//! What every program that talks to a flexdyn server shares, without the simulator: the Zenoh
+//! session rules, the command-line conventions, the served configuration, and lockstep ticks
+//! assembled complete. Flight code (the template `flexdyn-acs-demo`), the tools and the server
+//! itself use it. Behind the `client` feature (Zenoh, tokio, clap), so the wire crate alone
+//! stays serde + bincode for programs that bring their own transport.
+//!
+//! # Layout
+//! - [`transport`]: the one Zenoh configuration builder (peer, loopback defaults, multicast
+//!   scouting always off), for the server and its clients alike.
+//! - [`logging`]: stderr logging that survives a closed pipe, and the usage-error rule of every
+//!   binary (one `error:` line, exit 2).
+//! - [`cli`]: the connection options every client shares ([`cli::CommonArgs`]), its exit codes
+//!   and a clean stop on SIGINT/SIGTERM.
+//! - [`vehicle`]: the vehicle a server runs, from its `flexdyn/<sc>/config` queryable: the
+//!   geometry, wheels and sensors flight code reads.
+//! - [`lockstep`]: complete ticks — the state of tick k with every sensor sample due at k —
+//!   through one `flexdyn/<sc>/tlm/**` subscriber ([`lockstep::TickReceiver`]).
+
+pub mod cli;
+pub mod lockstep;
+pub mod logging;
+pub mod transport;
+pub mod vehicle;

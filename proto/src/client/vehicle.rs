@@ -1,0 +1,339 @@
+//! The vehicle a server runs, as its `flexdyn/<sc>/config` queryable describes it
+//! (proto/README.md, "Topics"): the reply's JSON, and the parts of the configuration TOML that
+//! flight code reads — the frame rate, the mass properties and mountings, the wheels and the
+//! sensors with their rates. The TOML keys are the server's (README, "Configuration"); every
+//! other key is ignored, and the server has validated the file before serving it.
+
+use std::time::{Duration, Instant};
+
+use crate::Topics;
+use serde::Deserialize;
+use zenoh::{Session, Wait};
+
+/// Why the vehicle description cannot be had.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum VehicleError {
+    /// No server answered the query in time.
+    #[error(
+        "no answer on {key} within {timeout_s} s: is a flexdyn server running with this sc_id \
+         at the --connect endpoint?"
+    )]
+    NoAnswer {
+        /// The queryable's key.
+        key: String,
+        /// How long it was asked [s].
+        timeout_s: f64,
+    },
+    /// Zenoh refused the query.
+    #[error("cannot query {key}: {message}")]
+    Zenoh {
+        /// The queryable's key.
+        key: String,
+        /// Zenoh's message.
+        message: String,
+    },
+    /// The reply is not a vehicle description.
+    #[error("{key}: the reply is not a flexdyn vehicle description: {message}")]
+    Reply {
+        /// The queryable's key.
+        key: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The configuration TOML lacks what flight code needs, or a value is unusable.
+    #[error("the served configuration: {0}")]
+    Config(String),
+}
+
+/// The reply of `flexdyn/<sc>/config`, the fields flight code uses.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct Vehicle {
+    /// The string spacecraft id of the keys.
+    pub sc_id: String,
+    /// The numeric spacecraft id of the headers: stamp commands with it.
+    pub spacecraft_id: u32,
+    /// The configuration file, verbatim.
+    pub config_toml: String,
+}
+
+impl Vehicle {
+    /// Parses a reply's JSON.
+    pub fn from_json(key: &str, text: &str) -> Result<Self, VehicleError> {
+        serde_json::from_str(text).map_err(|e| VehicleError::Reply {
+            key: key.to_owned(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Asks the server of `topics` what it runs, again every 50 ms until it answers or
+    /// `timeout` passes: the queryable is declared a moment after the server starts listening,
+    /// and a client may start before the server.
+    pub fn query(
+        session: &Session,
+        topics: &Topics,
+        timeout: Duration,
+    ) -> Result<Self, VehicleError> {
+        let key = topics.config();
+        let deadline = Instant::now() + timeout;
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            let replies = session
+                .get(&key)
+                .timeout(left.clamp(Duration::from_millis(100), Duration::from_secs(2)))
+                .wait()
+                .map_err(|e| VehicleError::Zenoh {
+                    key: key.clone(),
+                    message: e.to_string(),
+                })?;
+            while let Ok(reply) = replies.recv() {
+                if let Ok(sample) = reply.result() {
+                    let text =
+                        sample
+                            .payload()
+                            .try_to_string()
+                            .map_err(|e| VehicleError::Reply {
+                                key: key.clone(),
+                                message: e.to_string(),
+                            })?;
+                    return Self::from_json(&key, &text);
+                }
+            }
+            if Instant::now() >= deadline {
+                return Err(VehicleError::NoAnswer {
+                    key,
+                    timeout_s: timeout.as_secs_f64(),
+                });
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+
+    /// The parts of the configuration flight code reads.
+    pub fn config(&self) -> Result<VehicleConfig, VehicleError> {
+        VehicleConfig::from_toml(&self.config_toml)
+    }
+}
+
+/// What flight code reads of a configuration (the server's TOML keys and units).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct VehicleConfig {
+    /// `[simulation]`.
+    pub simulation: Simulation,
+    /// `[hub]`.
+    pub hub: Hub,
+    /// `[[panel_pairs]]`, in file order (effector indices 0, 1, …).
+    #[serde(default)]
+    pub panel_pairs: Vec<PanelPair>,
+    /// `[[reaction_wheels]]`, in file order (effector indices after the panel pairs).
+    #[serde(default)]
+    pub reaction_wheels: Vec<ReactionWheel>,
+    /// `[[imus]]`, in file order.
+    #[serde(default)]
+    pub imus: Vec<Imu>,
+    /// `[[star_trackers]]`, in file order.
+    #[serde(default)]
+    pub star_trackers: Vec<StarTracker>,
+}
+
+impl VehicleConfig {
+    /// Parses a configuration's TOML.
+    pub fn from_toml(text: &str) -> Result<Self, VehicleError> {
+        let cfg: Self = toml::from_str(text).map_err(|e| VehicleError::Config(e.to_string()))?;
+        if !(cfg.simulation.frame_hz.is_finite() && cfg.simulation.frame_hz > 0.0) {
+            return Err(VehicleError::Config(format!(
+                "simulation.frame_hz = {} is not a positive number",
+                cfg.simulation.frame_hz
+            )));
+        }
+        Ok(cfg)
+    }
+
+    /// The effector index of the first reaction wheel in `StateMsg::effectors` and in
+    /// `Actuators` commands (after every panel pair).
+    pub fn first_wheel_index(&self) -> u32 {
+        self.panel_pairs.len() as u32
+    }
+
+    /// The IMU `name`.
+    pub fn imu(&self, name: &str) -> Result<&Imu, VehicleError> {
+        self.imus.iter().find(|i| i.name == name).ok_or_else(|| {
+            let names: Vec<&str> = self.imus.iter().map(|i| i.name.as_str()).collect();
+            VehicleError::Config(format!("no [[imus]] named `{name}` (it has: {names:?})"))
+        })
+    }
+
+    /// The star tracker `name`.
+    pub fn star_tracker(&self, name: &str) -> Result<&StarTracker, VehicleError> {
+        self.star_trackers
+            .iter()
+            .find(|s| s.name == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = self.star_trackers.iter().map(|s| s.name.as_str()).collect();
+                VehicleError::Config(format!(
+                    "no [[star_trackers]] named `{name}` (it has: {names:?})"
+                ))
+            })
+    }
+
+    /// The period of star tracker `st` in frames: round(`frame_hz` / `rate_hz`), as the server
+    /// computes it (it accepts only rates that divide the frame rate).
+    pub fn star_tracker_period_frames(&self, st: &StarTracker) -> Result<u64, VehicleError> {
+        let ratio = self.simulation.frame_hz / st.rate_hz;
+        if !(ratio.is_finite() && ratio.round() >= 1.0) {
+            return Err(VehicleError::Config(format!(
+                "star tracker `{}`: rate_hz = {} does not divide the frame rate {} Hz",
+                st.name, st.rate_hz, self.simulation.frame_hz
+            )));
+        }
+        Ok(ratio.round() as u64)
+    }
+}
+
+/// `[simulation]`.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct Simulation {
+    /// \[Hz\] frame (tick) rate.
+    pub frame_hz: f64,
+}
+
+/// `[hub]`.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct Hub {
+    /// \[kg\]
+    pub mass_kg: f64,
+    /// \[kg·m²\] about the hub's centre of mass C_B, B components.
+    pub inertia_bc_b_kg_m2: [[f64; 3]; 3],
+    /// \[m\] hub centre of mass relative to B, B components.
+    pub r_bcb_b_m: [f64; 3],
+}
+
+/// One `[[panel_pairs]]` entry (the mass properties flight code tabulates).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct PanelPair {
+    /// Its name.
+    pub name: String,
+    /// \[m\] hinge 1 relative to B, B components.
+    pub r_h1b_b_m: [f64; 3],
+    /// [H1 B], rows ĥ1, ĥ2, ĥ3 in B; at θ = 0 a panel extends along −ĥ1.
+    pub dcm_h1b: [[f64; 3]; 3],
+    /// The inboard panel (with its length `l_m`).
+    pub panel1: Panel,
+    /// The outboard panel.
+    pub panel2: Panel,
+}
+
+/// One panel of a pair.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct Panel {
+    /// \[kg\]
+    pub mass_kg: f64,
+    /// \[kg·m²\] principal inertia about its centre of mass, panel frame.
+    pub inertia_s_kg_m2: [f64; 3],
+    /// \[m\] hinge to centre of mass.
+    pub d_m: f64,
+    /// \[m\] hinge to hinge (panel 1 only).
+    #[serde(default)]
+    pub l_m: Option<f64>,
+}
+
+/// One `[[reaction_wheels]]` entry.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct ReactionWheel {
+    /// Its name.
+    pub name: String,
+    /// Spin axis ĝ_s in B (normalised by the server).
+    pub spin_axis_b: [f64; 3],
+    /// \[m\] rotor centre of mass relative to B, B components.
+    pub r_wb_b_m: [f64; 3],
+    /// \[kg\] rotor mass.
+    pub mass_kg: f64,
+    /// \[kg·m²\] spin inertia.
+    pub j_s_kg_m2: f64,
+    /// \[kg·m²\] transverse inertia.
+    pub j_t_kg_m2: f64,
+    /// \[N·m\] motor torque limit.
+    pub max_torque_nm: f64,
+}
+
+/// One `[[imus]]` entry.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct Imu {
+    /// Its name (topic `flexdyn/<sc>/tlm/imu/<name>`).
+    pub name: String,
+    /// \[m\] sensor location relative to B, B components.
+    pub r_sb_b_m: [f64; 3],
+    /// [PB]: maps B components to the platform frame P.
+    pub dcm_pb: [[f64; 3]; 3],
+}
+
+/// One `[[star_trackers]]` entry.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct StarTracker {
+    /// Its name (topic `flexdyn/<sc>/tlm/st/<name>`).
+    pub name: String,
+    /// [CB]: maps B components to the case frame C.
+    pub dcm_cb: [[f64; 3]; 3],
+    /// \[Hz\] update rate (a whole divisor of the frame rate).
+    pub rate_hz: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TOML: &str = r#"
+[simulation]
+step_s = 0.001
+frame_hz = 100.0
+[hub]
+mass_kg = 750
+inertia_bc_b_kg_m2 = [[900.0, 0.0, 0.0], [0.0, 800.0, 0.0], [0.0, 0.0, 600.0]]
+r_bcb_b_m = [0.0, 0.0, 1.0]
+[[star_trackers]]
+name = "st1"
+dcm_cb = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]
+rate_hz = 10.0
+seed = 7
+[[star_trackers]]
+name = "slow"
+dcm_cb = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+rate_hz = 3.0
+"#;
+
+    #[test]
+    fn reads_the_reply_and_the_parts_flight_code_needs() {
+        let json = serde_json::json!({
+            "sc_id": "sc1", "spacecraft_id": 7, "config_toml": TOML,
+            "server_settings": "mode=lockstep", "flexdyn_version": "0.1.0", "git_commit": null
+        })
+        .to_string();
+        let v = Vehicle::from_json("flexdyn/sc1/config", &json).unwrap();
+        assert_eq!((v.sc_id.as_str(), v.spacecraft_id), ("sc1", 7));
+        let c = v.config().unwrap();
+        // An integer where a float is expected, as the server's own reader accepts.
+        assert_eq!(c.hub.mass_kg, 750.0);
+        assert_eq!((c.first_wheel_index(), c.imus.len()), (0, 0));
+        let st = c.star_tracker("st1").unwrap();
+        assert_eq!(c.star_tracker_period_frames(st).unwrap(), 10);
+        // 100 / 3 rounds to 33 frames (the server would refuse this rate; the rounding is its).
+        let slow = c.star_tracker("slow").unwrap();
+        assert_eq!(c.star_tracker_period_frames(slow).unwrap(), 33);
+        let e = c.star_tracker("st9").unwrap_err().to_string();
+        assert!(
+            e.contains("no [[star_trackers]] named `st9`") && e.contains("\"slow\""),
+            "{e}"
+        );
+        assert!(c.imu("hub").is_err());
+        let e = Vehicle::from_json("k", "{}").unwrap_err().to_string();
+        assert!(
+            e.starts_with("k: the reply is not a flexdyn vehicle description"),
+            "{e}"
+        );
+        let e = VehicleConfig::from_toml("[simulation]\nframe_hz = 0.0\n").unwrap_err();
+        assert!(
+            e.to_string().contains("hub") || e.to_string().contains("frame_hz"),
+            "{e}"
+        );
+    }
+}

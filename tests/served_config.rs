@@ -1,0 +1,103 @@
+//! Flight code reads the vehicle from the server's `flexdyn/<sc>/config` queryable with its own
+//! small reader (`flexdyn_proto::client::vehicle`, no simulator), and learns from it which sensor
+//! samples each tick carries (`flexdyn_proto::client::lockstep::SensorSchedule`). For every shipped
+//! scenario, that reader must agree with the server's own (`SimConfig`) on every value it reads:
+//! the frame rate, the hub, the panel pairs, the wheels, the IMUs and the star trackers with
+//! their periods in frames.
+
+use flexdyn::config::SimConfig;
+use flexdyn_proto::client::lockstep::SensorSchedule;
+use flexdyn_proto::client::vehicle::VehicleConfig;
+use nalgebra::{Matrix3, Vector3};
+
+fn m3(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {
+    Matrix3::from_fn(|r, c| rows[r][c])
+}
+
+#[test]
+fn the_clients_reader_agrees_with_the_servers_on_every_scenario() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let Ok(sim) = SimConfig::from_file(&path) else {
+            continue; // not a vehicle configuration (campaign.toml)
+        };
+        let name = path.display();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let cfg = VehicleConfig::from_toml(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(cfg.simulation.frame_hz, sim.frame_hz, "{name}");
+        assert_eq!(cfg.hub.mass_kg, sim.hub.mass_kg, "{name}");
+        assert_eq!(
+            m3(&cfg.hub.inertia_bc_b_kg_m2),
+            sim.hub.inertia_bc_b_kg_m2,
+            "{name}"
+        );
+        assert_eq!(
+            Vector3::from(cfg.hub.r_bcb_b_m),
+            sim.hub.r_bcb_b_m,
+            "{name}"
+        );
+        assert_eq!(cfg.panel_pairs.len(), sim.panel_pairs.len(), "{name}");
+        for (c, (s, _)) in cfg.panel_pairs.iter().zip(&sim.panel_pairs) {
+            assert_eq!(c.name, s.name, "{name}");
+            assert_eq!(Vector3::from(c.r_h1b_b_m), s.r_h1b_b_m, "{name}");
+            assert_eq!(m3(&c.dcm_h1b), s.dcm_h1b, "{name}");
+            assert_eq!(c.panel1.l_m, Some(s.l1_m), "{name}");
+            for (cp, sp) in [(&c.panel1, &s.panel1), (&c.panel2, &s.panel2)] {
+                assert_eq!(cp.mass_kg, sp.mass_kg, "{name}");
+                assert_eq!(
+                    Vector3::from(cp.inertia_s_kg_m2),
+                    sp.inertia_s_kg_m2,
+                    "{name}"
+                );
+                assert_eq!(cp.d_m, sp.d_m, "{name}");
+            }
+        }
+        assert_eq!(
+            cfg.first_wheel_index() as usize,
+            sim.panel_pairs.len(),
+            "{name}"
+        );
+        assert_eq!(
+            cfg.reaction_wheels.len(),
+            sim.reaction_wheels.len(),
+            "{name}"
+        );
+        for (c, s) in cfg.reaction_wheels.iter().zip(&sim.reaction_wheels) {
+            assert_eq!(c.name, s.name, "{name}");
+            let axis = Vector3::from(c.spin_axis_b).normalize();
+            assert!((axis - s.spin_axis_b.normalize()).norm() < 1e-15, "{name}");
+            assert_eq!(Vector3::from(c.r_wb_b_m), s.r_wb_b_m, "{name}");
+            assert_eq!(
+                (c.mass_kg, c.j_s_kg_m2, c.j_t_kg_m2, c.max_torque_nm),
+                (s.mass_kg, s.j_s_kg_m2, s.j_t_kg_m2, s.max_torque_nm),
+                "{name}"
+            );
+        }
+        assert_eq!(cfg.imus.len(), sim.imus.len(), "{name}");
+        for (c, s) in cfg.imus.iter().zip(&sim.imus) {
+            assert_eq!(c.name, s.name, "{name}");
+            assert_eq!(m3(&c.dcm_pb), s.dcm_pb, "{name}");
+            assert_eq!(Vector3::from(c.r_sb_b_m), s.r_sb_b_m, "{name}");
+        }
+        let schedule = SensorSchedule::from_config(&cfg).unwrap();
+        let imus: Vec<&str> = sim.imus.iter().map(|i| i.name.as_str()).collect();
+        assert_eq!(schedule.imus().collect::<Vec<_>>(), imus, "{name}");
+        let trackers: Vec<(&str, u64)> = sim
+            .star_trackers
+            .iter()
+            .map(|s| (s.name.as_str(), s.every_frames))
+            .collect();
+        assert_eq!(
+            schedule.star_trackers().collect::<Vec<_>>(),
+            trackers,
+            "{name}"
+        );
+        for (c, s) in cfg.star_trackers.iter().zip(&sim.star_trackers) {
+            assert_eq!(m3(&c.dcm_cb), s.dcm_cb, "{name}");
+        }
+        checked += 1;
+    }
+    assert!(checked >= 8, "only {checked} scenarios read");
+}
