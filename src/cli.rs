@@ -77,15 +77,10 @@ pub enum CliError {
         /// What is wrong.
         problem: String,
     },
-    /// The `[server]` table is invalid (checked by `check-config`, as `run` would).
-    #[error("{}: {source}", file.display())]
-    Settings {
-        /// The configuration file.
-        file: PathBuf,
-        /// The error; it names `server.<key>`.
-        #[source]
-        source: SettingsError,
-    },
+    /// The `[server]` table is invalid (checked by `check-config`, as `run` would); the error
+    /// names the file, `server.<key>` and its line.
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
     /// The propagated state stopped being finite; the row was not written.
     #[error(
         "the state became non-finite at step {step} (t = {} s): {quantity} is NaN or infinite; \
@@ -117,7 +112,7 @@ impl CliError {
     /// 1 for a failure while running (output not writable).
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Config { .. } | CliError::Arg { .. } | CliError::Settings { .. } => 2,
+            CliError::Config { .. } | CliError::Arg { .. } | CliError::Settings(_) => 2,
             CliError::Output { .. } | CliError::NonFinite { .. } => 1,
         }
     }
@@ -403,15 +398,7 @@ pub fn check_config(path: &Path) -> Result<String, CliError> {
         file: Some(path.to_path_buf()),
         source,
     })?;
-    let settings_err = |source| CliError::Settings {
-        file: path.to_path_buf(),
-        source,
-    };
-    let settings = ServerSettings::from_table(&cfg.server).map_err(settings_err)?;
-    settings.validate().map_err(settings_err)?;
-    settings
-        .duration_frames(cfg.frame_ns)
-        .map_err(settings_err)?;
+    ServerSettings::resolve(&cfg, Some(path), &[])?;
     Ok(format!("ok: {}: {}", path.display(), cfg.summary()))
 }
 

@@ -370,24 +370,47 @@ fn with_server(lines: &str) -> String {
 
 #[test]
 fn check_config_validates_the_server_table_as_run_does() {
+    // (the [server] lines, the message, the line of the offending key)
     let cases = [
-        ("mode = \"fast\"", "server.mode: unknown mode"),
-        ("colour = 1", "server.colour: unknown key"),
-        ("stale_after_s = -0.5", "server.stale_after_s: must be > 0"),
+        ("mode = \"fast\"", "server.mode: unknown mode", "mode"),
+        ("colour = 1", "server.colour: unknown key", "colour"),
+        (
+            "stale_after_s = -0.5",
+            "server.stale_after_s: must be > 0",
+            "stale_after_s",
+        ),
         (
             "participants = \"1,2\"",
             "server.participants: expected a list of sender ids",
+            "participants",
         ),
-        ("sc_id = \"a/b\"", "server.sc_id:"),
+        ("sc_id = \"a/b\"", "server.sc_id:", "sc_id"),
         (
             "mode = \"lockstep\"\nparticipants = []",
             "server.participants: lockstep needs at least one participant",
+            "participants",
         ),
-        ("duration_s = 0.015", "not a whole number of frames"),
+        (
+            "duration_s = 0.015",
+            "server.duration_s: 0.015 s is not a whole number of frames",
+            "duration_s",
+        ),
+        // The shortest form, not 301 digits.
+        (
+            "duration_s = 1e300",
+            "server.duration_s: 1e300 s is beyond the maximum simulation time",
+            "duration_s",
+        ),
+        (
+            "status_hz = 1e300",
+            "server.status_hz: must be <= 1000 Hz (got 1e300)",
+            "status_hz",
+        ),
     ];
-    for (i, (lines, want)) in cases.iter().enumerate() {
+    for (i, (lines, want, key)) in cases.iter().enumerate() {
         let path = scratch(&format!("server{i}.toml"));
-        std::fs::write(&path, with_server(lines)).unwrap();
+        let text = with_server(lines);
+        std::fs::write(&path, &text).unwrap();
         let p = path.to_str().unwrap();
         let check = flexdyn(&["check-config", p]);
         let err = stderr(&check);
@@ -396,11 +419,29 @@ fn check_config_validates_the_server_table_as_run_does() {
         let line = err.lines().next().unwrap();
         assert!(line.starts_with(&format!("error: {p}: ")), "{line}");
         assert!(line.contains(want), "{lines}: {line}");
+        // Like every other section's errors, it ends with the key's line and column.
+        let lines_of: Vec<&str> = text.lines().collect();
+        let key_line = 1 + lines_of.iter().rposition(|l| l.starts_with(key)).unwrap();
+        let at = format!("(line {key_line}, column ");
+        let tail = line.rsplit_once(" (line ").map(|(_, t)| t).unwrap_or("");
+        assert!(
+            line.contains(&at) && tail.ends_with(')') && tail.contains("column"),
+            "{lines}: not at {at}: {line}"
+        );
+        // Numbers in their shortest form: no run of 20 digits.
+        let longest_digits = line
+            .split(|c: char| !c.is_ascii_digit())
+            .map(str::len)
+            .max();
+        assert!(longest_digits < Some(20), "{lines}: {line}");
         assert!(stdout(&check).is_empty());
         // `run` rejects the same file the same way, before opening any session.
         let run = flexdyn(&["run", "--config", p, "--listen", "tcp/127.0.0.1:17359"]);
-        assert_eq!(run.status.code(), Some(2), "run {lines}: {}", stderr(&run));
-        assert!(stderr(&run).contains(want), "run {lines}: {}", stderr(&run));
+        let run_err = stderr(&run);
+        assert_eq!(run.status.code(), Some(2), "run {lines}: {run_err}");
+        assert!(run_err.contains(want), "run {lines}: {run_err}");
+        assert!(run_err.contains(&format!("error: {p}: ")), "run: {run_err}");
+        assert!(run_err.contains(&at), "run {lines}: not at {at}: {run_err}");
     }
     // A valid [server] table passes.
     let path = scratch("server_ok.toml");
@@ -482,3 +523,4 @@ fn the_server_stops_on_a_non_finite_state_with_exit_1() {
         "{err}"
     );
 }
+

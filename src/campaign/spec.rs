@@ -29,10 +29,10 @@ use toml::de::DeTable;
 
 use super::command::split_command;
 use crate::config::{
-    config_message, whole_ns, ConfigError, SimConfig, SourceMap, DEFAULT_CONFIG_TOML,
-    MAX_SIM_TIME_S,
+    beyond_max_time, config_message, whole_ns, ConfigError, SimConfig, SourceMap,
+    DEFAULT_CONFIG_TOML,
 };
-use crate::numfmt::{Num, Rounded};
+use crate::numfmt::Num;
 use crate::schema::reader::TableReader;
 use crate::schema::{location, At, SchemaError};
 
@@ -543,12 +543,8 @@ fn within_time(field: &str, seconds: f64) -> Result<u64, String> {
     if seconds <= 0.0 {
         return Err(format!("must be > 0, got {}", Num(seconds)));
     }
-    if seconds >= MAX_SIM_TIME_S {
-        return Err(format!(
-            "{} s is beyond the longest simulation time, {} s ≈ 584 years (2^64 − 1 ns)",
-            Num(seconds),
-            Rounded(MAX_SIM_TIME_S, 6)
-        ));
+    if let Some(problem) = beyond_max_time(seconds) {
+        return Err(problem);
     }
     whole_ns(seconds).ok_or_else(|| {
         format!(
@@ -560,13 +556,10 @@ fn within_time(field: &str, seconds: f64) -> Result<u64, String> {
 
 /// An error about `field` of the campaign file `path` (text `source`), with its position.
 fn invalid_at(source: &str, path: &Path, field: &str, problem: String) -> CampaignError {
-    let at = DeTable::parse(source)
-        .map(|doc| SourceMap::new(source, doc.get_ref()).at(field))
-        .unwrap_or_default();
     CampaignError::Invalid {
         path: path.to_owned(),
         field: field.to_owned(),
         problem,
-        at,
+        at: SourceMap::locate(source, field),
     }
 }
