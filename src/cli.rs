@@ -8,7 +8,9 @@ use std::num::NonZeroU64;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::config::{config_message, whole_ns, ConfigError, SimConfig};
+use crate::config::{
+    config_message, log_warnings, warning_message, whole_ns, ConfigError, SimConfig,
+};
 use crate::dynamics::StateEffector;
 use crate::numfmt::Num;
 use crate::sensors::imu::ImuSample;
@@ -357,6 +359,7 @@ pub fn simulate_to<W: Write>(
 /// output file or stdout. The output file is created only once everything else is valid.
 pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
     let cfg = load(args.config.as_deref())?;
+    log_warnings(&cfg, args.config.as_deref());
     // Check the options before creating (and truncating) the output file.
     whole_steps("--duration-s", args.duration_s, cfg.step_ns, true)?;
     whole_steps("--log-every-s", args.log_every_s, cfg.step_ns, false)?;
@@ -386,12 +389,13 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
     }
 }
 
-/// `flexdyn check-config FILE`: parses, validates and builds the spacecraft; returns the summary
-/// line `ok: FILE: …`.
+/// `flexdyn check-config FILE`: parses, validates and builds the spacecraft; returns one
+/// `warning: FILE: field: …` line per implausible value ([`SimConfig::warnings`]: legal, but
+/// almost surely a unit slip), then the summary line `ok: FILE: …`.
 ///
 /// It runs every check that `flexdyn run` and `flexdyn simulate` run on a file, the `[server]`
 /// table's included (keys, values, cross-setting rules, and a duration that is a whole number of
-/// frames), and says `ok` only when all pass.
+/// frames), and says `ok` only when all pass. Warnings do not make it fail.
 pub fn check_config(path: &Path) -> Result<String, CliError> {
     let cfg = load(Some(path))?;
     cfg.build_spacecraft().map_err(|source| CliError::Config {
@@ -399,7 +403,12 @@ pub fn check_config(path: &Path) -> Result<String, CliError> {
         source,
     })?;
     ServerSettings::resolve(&cfg, Some(path), &[])?;
-    Ok(format!("ok: {}: {}", path.display(), cfg.summary()))
+    let mut out = String::new();
+    for w in cfg.warnings() {
+        out.push_str(&format!("warning: {}\n", warning_message(Some(path), &w)));
+    }
+    out.push_str(&format!("ok: {}: {}", path.display(), cfg.summary()));
+    Ok(out)
 }
 
 /// Logs to stderr at `RUST_LOG` (default `info`); see [`crate::logging::init_tracing`].

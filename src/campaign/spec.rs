@@ -29,7 +29,7 @@ use toml::de::DeTable;
 
 use super::command::split_command;
 use crate::config::{
-    beyond_max_time, config_message, whole_ns, ConfigError, SimConfig, SourceMap,
+    beyond_max_time, config_message, log_warnings, whole_ns, ConfigError, SimConfig, SourceMap,
     DEFAULT_CONFIG_TOML,
 };
 use crate::numfmt::Num;
@@ -291,6 +291,7 @@ impl Campaign {
             base: base_path.clone(),
             source: Box::new(source),
         })?;
+        log_warnings(&base, base_path.as_deref());
         let runs = root.int_in("runs", 1, 1_000_000).map_err(schema)? as u32;
         let seed = root.int_in("seed", 0, i64::MAX).map_err(schema)? as u64;
         let duration_s = root.f64("duration_s").map_err(schema)?;

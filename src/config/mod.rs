@@ -23,6 +23,7 @@ mod error;
 mod file;
 mod schedule;
 mod source_map;
+mod warnings;
 
 use std::collections::HashSet;
 use std::path::Path;
@@ -37,6 +38,7 @@ pub use file::{config_message, load_config};
 use flexdyn_proto::MAX_PANEL_PAIRS;
 pub use schedule::EffectorInputSegment;
 pub(crate) use source_map::SourceMap;
+pub use warnings::{log_warnings, warning_message, ConfigWarning};
 
 use crate::dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
 use crate::dynamics::effectors::reaction_wheel;

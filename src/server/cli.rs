@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use super::error::{ServerError, SettingsError};
 use super::settings::{ServerSettings, Value};
 use super::RunReport;
-use crate::config::{load_config, SimConfig};
+use crate::config::{load_config, log_warnings, SimConfig};
 use crate::transport::{zenoh_config, Role, ZenohArgs};
 
 /// Arguments of `flexdyn run` (plain `flexdyn` runs with all defaults). Every server option
@@ -164,6 +164,7 @@ pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
         file: file.map(Path::to_path_buf),
         source,
     })?;
+    log_warnings(&cfg, file);
     let settings = args.settings(&cfg)?;
     let zcfg = zenoh_config(&args.zenoh, Role::Server)?;
     super::access::check(&zcfg, &settings)?;
