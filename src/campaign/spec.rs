@@ -303,7 +303,7 @@ impl Campaign {
                 format!(
                     "{} s is not a whole number of frames (frame = {} s at {} Hz)",
                     Num(duration_s),
-                    Num(base.frame_ns as f64 * 1e-9),
+                    Num(base.frame_ns as f64 / 1e9),
                     Num(base.frame_hz)
                 ),
             ));
