@@ -650,5 +650,6 @@ fn shipped_scenarios_give_no_warning() {
         assert!(!stdout(&out).contains("warning"), "{}", stdout(&out));
         checked += 1;
     }
-    assert_eq!(checked, 8, "every shipped spacecraft");
+    // At least the eight spacecraft shipped when this test was written (the filter works).
+    assert!(checked >= 8, "only {checked} spacecraft files checked");
 }
