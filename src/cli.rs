@@ -8,7 +8,9 @@ use std::num::NonZeroU64;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::config::{config_message, whole_ns, ConfigError, SimConfig};
+use crate::config::{
+    config_message, log_warnings, warning_message, whole_ns, ConfigError, SimConfig,
+};
 use crate::dynamics::StateEffector;
 use crate::numfmt::Num;
 use crate::sensors::imu::ImuSample;
@@ -77,15 +79,10 @@ pub enum CliError {
         /// What is wrong.
         problem: String,
     },
-    /// The `[server]` table is invalid (checked by `check-config`, as `run` would).
-    #[error("{}: {source}", file.display())]
-    Settings {
-        /// The configuration file.
-        file: PathBuf,
-        /// The error; it names `server.<key>`.
-        #[source]
-        source: SettingsError,
-    },
+    /// The `[server]` table is invalid (checked by `check-config`, as `run` would); the error
+    /// names the file, `server.<key>` and its line.
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
     /// The propagated state stopped being finite; the row was not written.
     #[error(
         "the state became non-finite at step {step} (t = {} s): {quantity} is NaN or infinite; \
@@ -117,7 +114,7 @@ impl CliError {
     /// 1 for a failure while running (output not writable).
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Config { .. } | CliError::Arg { .. } | CliError::Settings { .. } => 2,
+            CliError::Config { .. } | CliError::Arg { .. } | CliError::Settings(_) => 2,
             CliError::Output { .. } | CliError::NonFinite { .. } => 1,
         }
     }
@@ -362,6 +359,7 @@ pub fn simulate_to<W: Write>(
 /// output file or stdout. The output file is created only once everything else is valid.
 pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
     let cfg = load(args.config.as_deref())?;
+    log_warnings(&cfg, args.config.as_deref());
     // Check the options before creating (and truncating) the output file.
     whole_steps("--duration-s", args.duration_s, cfg.step_ns, true)?;
     whole_steps("--log-every-s", args.log_every_s, cfg.step_ns, false)?;
@@ -391,28 +389,26 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
     }
 }
 
-/// `flexdyn check-config FILE`: parses, validates and builds the spacecraft; returns the summary
-/// line `ok: FILE: …`.
+/// `flexdyn check-config FILE`: parses, validates and builds the spacecraft; returns one
+/// `warning: FILE: field: …` line per implausible value ([`SimConfig::warnings`]: legal, but
+/// almost surely a unit slip), then the summary line `ok: FILE: …`.
 ///
 /// It runs every check that `flexdyn run` and `flexdyn simulate` run on a file, the `[server]`
 /// table's included (keys, values, cross-setting rules, and a duration that is a whole number of
-/// frames), and says `ok` only when all pass.
+/// frames), and says `ok` only when all pass. Warnings do not make it fail.
 pub fn check_config(path: &Path) -> Result<String, CliError> {
     let cfg = load(Some(path))?;
     cfg.build_spacecraft().map_err(|source| CliError::Config {
         file: Some(path.to_path_buf()),
         source,
     })?;
-    let settings_err = |source| CliError::Settings {
-        file: path.to_path_buf(),
-        source,
-    };
-    let settings = ServerSettings::from_table(&cfg.server).map_err(settings_err)?;
-    settings.validate().map_err(settings_err)?;
-    settings
-        .duration_frames(cfg.frame_ns)
-        .map_err(settings_err)?;
-    Ok(format!("ok: {}: {}", path.display(), cfg.summary()))
+    ServerSettings::resolve(&cfg, Some(path), &[])?;
+    let mut out = String::new();
+    for w in cfg.warnings() {
+        out.push_str(&format!("warning: {}\n", warning_message(Some(path), &w)));
+    }
+    out.push_str(&format!("ok: {}: {}", path.display(), cfg.summary()));
+    Ok(out)
 }
 
 /// Logs to stderr at `RUST_LOG` (default `info`); see [`crate::logging::init_tracing`].

@@ -149,9 +149,9 @@ fn main() -> ExitCode {
         }
         Some(Command::Campaign(c)) => {
             return match flexdyn::campaign::main(&c) {
-                Ok(text) => {
-                    let _ = writeln!(std::io::stderr(), "{text}");
-                    ExitCode::SUCCESS
+                Ok(report) => {
+                    let _ = writeln!(std::io::stderr(), "{}", report.text);
+                    ExitCode::from(report.exit_code)
                 }
                 Err((code, message)) => {
                     let _ = writeln!(std::io::stderr(), "error: {message}");

@@ -370,24 +370,47 @@ fn with_server(lines: &str) -> String {
 
 #[test]
 fn check_config_validates_the_server_table_as_run_does() {
+    // (the [server] lines, the message, the line of the offending key)
     let cases = [
-        ("mode = \"fast\"", "server.mode: unknown mode"),
-        ("colour = 1", "server.colour: unknown key"),
-        ("stale_after_s = -0.5", "server.stale_after_s: must be > 0"),
+        ("mode = \"fast\"", "server.mode: unknown mode", "mode"),
+        ("colour = 1", "server.colour: unknown key", "colour"),
+        (
+            "stale_after_s = -0.5",
+            "server.stale_after_s: must be > 0",
+            "stale_after_s",
+        ),
         (
             "participants = \"1,2\"",
             "server.participants: expected a list of sender ids",
+            "participants",
         ),
-        ("sc_id = \"a/b\"", "server.sc_id:"),
+        ("sc_id = \"a/b\"", "server.sc_id:", "sc_id"),
         (
             "mode = \"lockstep\"\nparticipants = []",
             "server.participants: lockstep needs at least one participant",
+            "participants",
         ),
-        ("duration_s = 0.015", "not a whole number of frames"),
+        (
+            "duration_s = 0.015",
+            "server.duration_s: 0.015 s is not a whole number of frames",
+            "duration_s",
+        ),
+        // The shortest form, not 301 digits.
+        (
+            "duration_s = 1e300",
+            "server.duration_s: 1e300 s is beyond the maximum simulation time",
+            "duration_s",
+        ),
+        (
+            "status_hz = 1e300",
+            "server.status_hz: must be <= 1000 Hz (got 1e300)",
+            "status_hz",
+        ),
     ];
-    for (i, (lines, want)) in cases.iter().enumerate() {
+    for (i, (lines, want, key)) in cases.iter().enumerate() {
         let path = scratch(&format!("server{i}.toml"));
-        std::fs::write(&path, with_server(lines)).unwrap();
+        let text = with_server(lines);
+        std::fs::write(&path, &text).unwrap();
         let p = path.to_str().unwrap();
         let check = flexdyn(&["check-config", p]);
         let err = stderr(&check);
@@ -396,11 +419,29 @@ fn check_config_validates_the_server_table_as_run_does() {
         let line = err.lines().next().unwrap();
         assert!(line.starts_with(&format!("error: {p}: ")), "{line}");
         assert!(line.contains(want), "{lines}: {line}");
+        // Like every other section's errors, it ends with the key's line and column.
+        let lines_of: Vec<&str> = text.lines().collect();
+        let key_line = 1 + lines_of.iter().rposition(|l| l.starts_with(key)).unwrap();
+        let at = format!("(line {key_line}, column ");
+        let tail = line.rsplit_once(" (line ").map(|(_, t)| t).unwrap_or("");
+        assert!(
+            line.contains(&at) && tail.ends_with(')') && tail.contains("column"),
+            "{lines}: not at {at}: {line}"
+        );
+        // Numbers in their shortest form: no run of 20 digits.
+        let longest_digits = line
+            .split(|c: char| !c.is_ascii_digit())
+            .map(str::len)
+            .max();
+        assert!(longest_digits < Some(20), "{lines}: {line}");
         assert!(stdout(&check).is_empty());
         // `run` rejects the same file the same way, before opening any session.
         let run = flexdyn(&["run", "--config", p, "--listen", "tcp/127.0.0.1:17359"]);
-        assert_eq!(run.status.code(), Some(2), "run {lines}: {}", stderr(&run));
-        assert!(stderr(&run).contains(want), "run {lines}: {}", stderr(&run));
+        let run_err = stderr(&run);
+        assert_eq!(run.status.code(), Some(2), "run {lines}: {run_err}");
+        assert!(run_err.contains(want), "run {lines}: {run_err}");
+        assert!(run_err.contains(&format!("error: {p}: ")), "run: {run_err}");
+        assert!(run_err.contains(&at), "run {lines}: not at {at}: {run_err}");
     }
     // A valid [server] table passes.
     let path = scratch("server_ok.toml");
@@ -481,4 +522,134 @@ fn the_server_stops_on_a_non_finite_state_with_exit_1() {
         last.starts_with("error: the state became non-finite at tick 51 (t = 0.51 s): "),
         "{err}"
     );
+}
+
+/// Legal values that are almost surely a unit slip: `check-config` still says `ok` (exit 0),
+/// after one `warning:` line naming the file, the field, the likely unit and the converted
+/// value, and the value's line; `simulate` logs the same at WARN.
+#[test]
+fn check_config_warns_of_likely_unit_slips() {
+    let base = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml"),
+    )
+    .unwrap();
+    // (the scenario's line, the slip, the field, what the warning must say)
+    let cases: [(&str, &str, &str, &str); 9] = [
+        // 5″ typed as radians: the issue's example.
+        (
+            "sigma_cross_boresight_rad = 2.4241e-5",
+            "sigma_cross_boresight_rad = 5.0",
+            "star_trackers[0].sigma_cross_boresight_rad",
+            "5 rad is far above a star tracker's noise (1σ) (1e-7–0.005 rad on datasheets); \
+             is it in arcsec? 5 arcsec = 2.4241e-5 rad",
+        ),
+        (
+            "sun_exclusion_rad = 0.5236",
+            "sun_exclusion_rad = 30.0",
+            "star_trackers[0].sun_exclusion_rad",
+            "is it in deg? 30 deg = 0.5236 rad",
+        ),
+        (
+            "max_rate_rad_s = 0.0349",
+            "max_rate_rad_s = 2.0",
+            "star_trackers[0].max_rate_rad_s",
+            "is it in deg/s? 2 deg/s = 0.034907 rad/s",
+        ),
+        (
+            "max_speed_rad_s = 600.0",
+            "max_speed_rad_s = 6000.0",
+            "reaction_wheels[0].max_speed_rad_s",
+            "is it in rpm? 6000 rpm = 628.32 rad/s",
+        ),
+        (
+            "max_torque_nm = 0.2",
+            "max_torque_nm = 5.0",
+            "reaction_wheels[0].max_torque_nm",
+            "is it in mN·m? 5 mN·m = 0.005 N·m",
+        ),
+        (
+            "range_rad_s = 8.5521",
+            "range_rad_s = 490.0",
+            "imus[0].gyro.range_rad_s",
+            "is it in °/s? 490 °/s = 8.5521 rad/s",
+        ),
+        (
+            "arw_rad_s_sqrt_hz = 4.3633e-5",
+            "arw_rad_s_sqrt_hz = 0.15",
+            "imus[0].gyro.arw_rad_s_sqrt_hz",
+            "0.15 °/√h = 4.3633e-5 rad/s/√Hz",
+        ),
+        (
+            "bias_instability_sigma_m_s2 = 7.9424e-4",
+            "bias_instability_sigma_m_s2 = 50.0",
+            "imus[0].accel.bias_instability_sigma_m_s2",
+            "is it in µg? 50 µg = 0.00049033 m/s²",
+        ),
+        (
+            "range_m_s2 = 294.20",
+            "range_m_s2 = 8.0",
+            "imus[0].accel.range_m_s2",
+            "8 m/s² is below an accelerometer's full scale (9.80665–2000 m/s² on datasheets); \
+             is it in g? 8 g = 78.453 m/s²",
+        ),
+    ];
+    for (i, (from, to, field, says)) in cases.iter().enumerate() {
+        assert!(base.contains(from), "the scenario lacks {from:?}");
+        let text = base.replacen(from, to, 1);
+        let path = scratch(&format!("slip{i}.toml"));
+        std::fs::write(&path, &text).unwrap();
+        let p = path.to_str().unwrap();
+        let out = flexdyn(&["check-config", p]);
+        assert!(out.status.success(), "{to}: {}", stderr(&out));
+        let text_out = stdout(&out);
+        let lines: Vec<&str> = text_out.lines().collect();
+        assert_eq!(lines.len(), 2, "{to}: {text_out}");
+        assert!(lines[1].starts_with(&format!("ok: {p}: ")), "{text_out}");
+        let line_no = 1 + text.lines().position(|l| l.starts_with(to)).unwrap();
+        let w = lines[0];
+        assert!(
+            w.starts_with(&format!("warning: {p}: {field}: ")),
+            "{to}: {w}"
+        );
+        assert!(w.contains(says), "{to}: {w}");
+        assert!(
+            w.ends_with(&format!(
+                "(line {line_no}, column {})",
+                from.find('=').unwrap() + 3
+            )),
+            "{to}: {w}"
+        );
+    }
+    // `simulate` (and `run`) log the warning at WARN and go on.
+    let path = scratch("slip0.toml");
+    let csv = scratch("slip0.csv");
+    let (p, c) = (path.to_str().unwrap(), csv.to_str().unwrap());
+    let out = flexdyn(&["simulate", "--config", p, "--duration-s", "0.01", "-o", c]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("WARN") && err.contains("star_trackers[0].sigma_cross_boresight_rad"),
+        "{err}"
+    );
+}
+
+#[test]
+fn shipped_scenarios_give_no_warning() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let is_config = path.extension().is_some_and(|e| e == "toml")
+            && path.file_stem().is_some_and(|s| s != "campaign");
+        if !is_config {
+            continue;
+        }
+        let out = flexdyn(&["check-config", path.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert_eq!(stdout(&out).lines().count(), 1, "{}", stdout(&out));
+        assert!(!stdout(&out).contains("warning"), "{}", stdout(&out));
+        checked += 1;
+    }
+    // At least the eight spacecraft shipped when this test was written (the filter works).
+    assert!(checked >= 8, "only {checked} spacecraft files checked");
 }

@@ -220,6 +220,11 @@ fn bad_settings_exit_2_naming_the_setting() {
         "/scenarios/zenoh/secure-server.json5"
     );
     let listen = ["--listen", "tcp/127.0.0.1:17342"];
+    // After the reference text come an empty line, `[server]`, then `colour`.
+    let colour_line = flexdyn::config::DEFAULT_CONFIG_TOML.lines().count() + 3;
+    let colour =
+        format!("error: {file_s}: server.colour: unknown key (expected one of: mode, sc_id");
+    let colour_at = format!("(line {colour_line}, column ");
     let cases: [(&[&str], &str); 7] = [
         // Binding participants to subjects: the shipped ACL reserves cmd/1 for `fsw`.
         (
@@ -256,16 +261,13 @@ fn bad_settings_exit_2_naming_the_setting() {
                 listen[0],
                 listen[1],
             ],
-            "error: server.participant_subjects: sender 2 is not in server.participants [1]",
+            "error: --participant-subjects: sender 2 is not in server.participants [1]",
         ),
         (
             &["run", "--handoff", "inline", listen[0], listen[1]],
             "invalid value 'inline' for '--handoff <HANDOFF>'",
         ),
-        (
-            &["run", "--config", file_s],
-            "error: server.colour: unknown key",
-        ),
+        (&["run", "--config", file_s], &colour),
         (
             &[
                 "run",
@@ -293,6 +295,9 @@ fn bad_settings_exit_2_naming_the_setting() {
         let err = server.stderr();
         assert_eq!(status.code(), Some(2), "{args:?}: stderr:\n{err}");
         assert!(err.contains(want), "{args:?}: stderr:\n{err}");
+        if args.contains(&"--config") {
+            assert!(err.contains(&colour_at), "not at {colour_at}: {err}");
+        }
     }
     std::fs::remove_dir_all(&dir).ok();
 }

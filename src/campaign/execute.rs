@@ -7,10 +7,16 @@
 //! seeds, the SHA-256 over its StateMsg payloads in tick order, the criteria, the exit status of
 //! the server and the controller, and the wall time; with `--record`, `run-NNNN/recording.mcap`.
 //! A controller that exits before the end stops the run at once, which fails with its status.
+//!
+//! Each run comes to an [`Outcome`]: `passed`, `failed` (it ran and the flight code did not meet
+//! the campaign: a criterion, an early controller exit, a participant timeout, a non-finite
+//! state) or `not_run` (no valid draw, the controller could not be started or never joined, the
+//! server or the observer could not start): the campaign's exit code counts them
+//! ([`super::verdict`]).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -25,9 +31,10 @@ use zenoh::{Session, Wait};
 use super::command::split_command;
 use super::plan::{readback, Plan, RunPlan};
 use super::spec::{Campaign, Criterion, Quantity, Statistic};
+use super::verdict::Outcome;
 use crate::attitude::mrp_error;
 use crate::config::SimConfig;
-use crate::server::ServerSettings;
+use crate::server::{ServerError, ServerSettings};
 use crate::transport::{zenoh_config, Role, ZenohArgs};
 
 /// The observer's sender id.
@@ -67,8 +74,11 @@ pub struct RunResult {
     pub states: u64,
     /// Criteria.
     pub criteria: Vec<CriterionResult>,
-    /// Every criterion passed and the run completed.
+    /// Every criterion passed and the run completed (`outcome` is `passed`).
     pub passed: bool,
+    /// `passed`, `failed` (it ran, and the flight code did not meet the campaign) or
+    /// `not_run` (it could not be run): what the campaign's exit code counts.
+    pub outcome: Outcome,
     /// `ok`, or why the run failed (server error, controller exit, invalid draw).
     pub status: String,
     /// The controller's exit status (`exit 0`, `exit 3`, `signal 9`, `still running: stopped`).
@@ -247,22 +257,74 @@ pub fn execute(plan: &Plan, rp: &RunPlan, opts: &RunOptions) -> RunResult {
         states: 0,
         criteria: Vec::new(),
         passed: false,
+        outcome: Outcome::NotRun,
         status: String::new(),
         controller_exit: None,
         wall_s: 0.0,
         sim_s: 0.0,
     };
-    let outcome = run_inner(c, rp, opts, &run_dir, &mut result);
-    result.status = match outcome {
-        Ok(()) => "ok".into(),
-        Err(e) => e,
+    (result.status, result.outcome) = match run_inner(c, rp, opts, &run_dir, &mut result) {
+        Ok(()) if result.criteria.iter().all(|k| k.passed) => ("ok".into(), Outcome::Passed),
+        Ok(()) => ("ok".into(), Outcome::Failed),
+        Err(e) => (e.message, e.outcome),
     };
-    result.passed = result.status == "ok" && result.criteria.iter().all(|k| k.passed);
+    result.passed = result.outcome == Outcome::Passed;
     result.wall_s = started.elapsed().as_secs_f64();
     if let Ok(text) = serde_json::to_string_pretty(&result) {
         let _ = std::fs::write(run_dir.join("result.json"), text + "\n");
     }
     result
+}
+
+/// Why a run did not complete, and whether it ran (see [`Outcome`]).
+struct RunFailure {
+    outcome: Outcome,
+    message: String,
+}
+
+/// Anything that stops a run before the flight code was judged: it could not be run.
+impl From<String> for RunFailure {
+    fn from(message: String) -> Self {
+        RunFailure {
+            outcome: Outcome::NotRun,
+            message,
+        }
+    }
+}
+
+/// A server error as a run's failure: the flight code stopping to answer, or a state that
+/// became non-finite, is a verdict on the run; anything else means it could not be run.
+fn server_failure(e: ServerError) -> RunFailure {
+    let outcome = match e {
+        ServerError::ParticipantTimeout { .. } | ServerError::NonFinite { .. } => Outcome::Failed,
+        _ => Outcome::NotRun,
+    };
+    RunFailure {
+        outcome,
+        message: e.to_string(),
+    }
+}
+
+/// Starts the controller `line` of run `run`, its output to `run_dir/controller.log`.
+fn start_controller(line: &str, port: u16, run: u32, run_dir: &Path) -> Result<Child, String> {
+    let line = line
+        .replace("{endpoint}", &format!("tcp/127.0.0.1:{port}"))
+        .replace("{sc_id}", SC_ID)
+        .replace("{sender_id}", &CONTROLLER_ID.to_string())
+        .replace("{run}", &run.to_string());
+    let words = split_command(&line)?;
+    let program = words
+        .first()
+        .ok_or("the controller's command line is empty")?;
+    let log = std::fs::File::create(run_dir.join("controller.log")).map_err(|e| e.to_string())?;
+    let err = log.try_clone().map_err(|e| e.to_string())?;
+    Command::new(program)
+        .args(&words[1..])
+        .stdin(Stdio::null())
+        .stdout(log)
+        .stderr(err)
+        .spawn()
+        .map_err(|e| format!("cannot start the controller {program:?}: {e}"))
 }
 
 fn run_inner(
@@ -271,13 +333,13 @@ fn run_inner(
     opts: &RunOptions,
     run_dir: &Path,
     result: &mut RunResult,
-) -> Result<(), String> {
+) -> Result<(), RunFailure> {
     if !rp.valid {
-        return Err(format!(
+        return Err(RunFailure::from(format!(
             "invalid: no valid draw in {} tries (last: {})",
             rp.redraws,
             rp.redraw_reasons.last().map_or("", String::as_str)
-        ));
+        )));
     }
     let cfg = SimConfig::from_toml_str(&rp.config_toml).map_err(|e| format!("config: {e}"))?;
     let model = readback(&cfg).map_err(|e| format!("model: {e}"))?;
@@ -324,33 +386,29 @@ fn run_inner(
                 stop2.notified().await
             })
             .await
-            .map_err(|e| e.to_string());
+            .map_err(server_failure);
             let _ = session.close().await;
             r
         })
     });
-    let observer = Observer::start(port, &topics, OBSERVER_ID)?;
+    // Until the controller runs, a failure stops the server (it would wait for presence).
+    let abandon = |server: std::thread::JoinHandle<_>, why: String| {
+        stop.notify_one();
+        let _ = server.join();
+        RunFailure::from(why)
+    };
+    let observer = match Observer::start(port, &topics, OBSERVER_ID) {
+        Ok(o) => o,
+        Err(why) => return Err(abandon(server, why)),
+    };
     let mut child = match &c.controller {
-        Some(line) => {
-            let line = line
-                .replace("{endpoint}", &format!("tcp/127.0.0.1:{port}"))
-                .replace("{sc_id}", SC_ID)
-                .replace("{sender_id}", &CONTROLLER_ID.to_string())
-                .replace("{run}", &rp.run.to_string());
-            let words = split_command(&line)?;
-            let log =
-                std::fs::File::create(run_dir.join("controller.log")).map_err(|e| e.to_string())?;
-            let err = log.try_clone().map_err(|e| e.to_string())?;
-            Some(
-                Command::new(&words[0])
-                    .args(&words[1..])
-                    .stdin(Stdio::null())
-                    .stdout(log)
-                    .stderr(err)
-                    .spawn()
-                    .map_err(|e| format!("cannot start the controller {:?}: {e}", words[0]))?,
-            )
-        }
+        Some(line) => match start_controller(line, port, rp.run, run_dir) {
+            Ok(child) => Some(child),
+            Err(why) => {
+                let _ = observer.session.close().wait();
+                return Err(abandon(server, why));
+            }
+        },
         None => None,
     };
     // Wait for the server; a controller that exits first stops it.
@@ -389,10 +447,13 @@ fn run_inner(
         result.controller_exit = Some(status.clone());
         if let Some(s) = early_exit {
             let _ = observer.session.close().wait();
-            return Err(format!(
-                "the controller exited before the end ({}); the run stopped",
-                exit_text(s)
-            ));
+            return Err(RunFailure {
+                outcome: Outcome::Failed,
+                message: format!(
+                    "the controller exited before the end ({}); the run stopped",
+                    exit_text(s)
+                ),
+            });
         }
     }
     let report = server_result?;
@@ -405,11 +466,11 @@ fn run_inner(
     states.sort_by_key(|(t, _)| *t);
     let ticks_ok = states.iter().enumerate().all(|(i, (t, _))| *t == i as u64);
     if !ticks_ok || states.len() as u64 != report.last_tick + 1 {
-        return Err(format!(
+        return Err(RunFailure::from(format!(
             "the observer saw {} states for ticks 0..={}",
             states.len(),
             report.last_tick
-        ));
+        )));
     }
     let mut h = Sha256::new();
     for (_, p) in &states {

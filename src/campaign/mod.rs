@@ -9,6 +9,8 @@
 //!   flight code; `--jobs N` runs N at a time, `--index I` exactly one.
 //! - [`summary`]: `summary.csv`, the pass rate with its Wilson interval, worst and failed runs,
 //!   figures.
+//! - [`verdict`]: each run's outcome, and the exit code of `run` and `summarize` (0 every run
+//!   passed, 1 a run could not be run, 2 invalid input, 3 a run failed).
 
 pub mod command;
 pub mod execute;
@@ -16,6 +18,7 @@ pub mod keys;
 pub mod plan;
 pub mod spec;
 pub mod summary;
+pub mod verdict;
 
 use std::path::PathBuf;
 
@@ -30,7 +33,8 @@ pub enum CampaignCommand {
         #[arg(long, short, value_name = "DIR")]
         output: PathBuf,
     },
-    /// Run the campaign (or one run of it) and write each run's result.json.
+    /// Run the campaign (or one run of it) and write each run's result.json. Exit code: 0 every
+    /// run passed, 1 a run could not be run, 2 invalid input, 3 a run failed.
     Run {
         /// The campaign file (TOML).
         file: PathBuf,
@@ -50,16 +54,28 @@ pub enum CampaignCommand {
         #[arg(long, value_name = "PORT", default_value_t = 17_600)]
         base_port: u16,
     },
-    /// Write summary.csv, summary.txt and figures from a campaign directory.
+    /// Write summary.csv, summary.txt and figures from a campaign directory. Exit code: 0 every
+    /// planned run passed, 1 a run is missing or could not be run, 3 a run failed.
     Summarize {
         /// The output directory of `plan`/`run`.
         dir: PathBuf,
     },
 }
 
-/// Runs a `flexdyn campaign` subcommand; returns its report line(s) or an error message.
-pub fn main(cmd: &CampaignCommand) -> Result<String, (u8, String)> {
-    let bad = |e: spec::CampaignError| (2u8, e.to_string());
+/// What a `flexdyn campaign` subcommand reports: its text (for stderr) and the process exit
+/// code ([`verdict`]: 0 every run passed, 1 a run could not be run, 3 a run failed).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Report {
+    /// The report's lines; `run` and `summarize` end with the verdict line.
+    pub text: String,
+    /// The process exit code.
+    pub exit_code: u8,
+}
+
+/// Runs a `flexdyn campaign` subcommand; returns its report, or the exit code (2 for invalid
+/// input, 1 for a directory that cannot be written or read) and an error message.
+pub fn main(cmd: &CampaignCommand) -> Result<Report, (u8, String)> {
+    let bad = |e: spec::CampaignError| (verdict::EXIT_INVALID_INPUT, e.to_string());
     match cmd {
         CampaignCommand::Plan { file, output } => {
             let plan =
@@ -69,12 +85,15 @@ pub fn main(cmd: &CampaignCommand) -> Result<String, (u8, String)> {
                 .map_err(|e| (1, format!("{}: {e}", output.display())))?;
             let invalid = runs.iter().filter(|r| !r.valid).count();
             let redraws: u32 = runs.iter().map(|r| r.redraws).sum();
-            Ok(format!(
-                "planned {} runs in {} ({} redraws, {invalid} invalid); nothing launched",
-                runs.len(),
-                output.display(),
-                redraws
-            ))
+            Ok(Report {
+                text: format!(
+                    "planned {} runs in {} ({} redraws, {invalid} invalid); nothing launched",
+                    runs.len(),
+                    output.display(),
+                    redraws
+                ),
+                exit_code: verdict::EXIT_PASSED,
+            })
         }
         CampaignCommand::Run {
             file,
@@ -93,7 +112,7 @@ pub fn main(cmd: &CampaignCommand) -> Result<String, (u8, String)> {
                 Some(i) if *i < plan.campaign.runs => vec![*i],
                 Some(i) => {
                     return Err((
-                        2,
+                        verdict::EXIT_INVALID_INPUT,
                         format!(
                             "--index: {i} is not a run of this campaign (0..{})",
                             plan.campaign.runs
@@ -121,16 +140,25 @@ pub fn main(cmd: &CampaignCommand) -> Result<String, (u8, String)> {
             for r in results.iter().filter(|r| r.status != "ok") {
                 text.push_str(&format!("\nrun {}: {}", r.run, r.status));
             }
-            Ok(text)
+            let verdict = verdict::Verdict::of(results.iter().map(|r| r.outcome));
+            text.push_str(&format!("\n{}", verdict.line()));
+            Ok(Report {
+                text,
+                exit_code: verdict.exit_code(),
+            })
         }
         CampaignCommand::Summarize { dir } => {
-            let s = summary::summarize(dir).map_err(|e| (2, e))?;
-            Ok(format!(
-                "{}wrote {} and {} figures",
-                s.text,
-                dir.join("summary.csv").display(),
-                s.figures.len()
-            ))
+            let s = summary::summarize(dir).map_err(|e| (verdict::EXIT_INVALID_INPUT, e))?;
+            Ok(Report {
+                text: format!(
+                    "{}wrote {} and {} figures\n{}",
+                    s.text,
+                    dir.join("summary.csv").display(),
+                    s.figures.len(),
+                    s.verdict.line()
+                ),
+                exit_code: s.verdict.exit_code(),
+            })
         }
     }
 }

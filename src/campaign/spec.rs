@@ -29,10 +29,10 @@ use toml::de::DeTable;
 
 use super::command::split_command;
 use crate::config::{
-    config_message, whole_ns, ConfigError, SimConfig, SourceMap, DEFAULT_CONFIG_TOML,
-    MAX_SIM_TIME_S,
+    beyond_max_time, config_message, log_warnings, whole_ns, ConfigError, SimConfig, SourceMap,
+    DEFAULT_CONFIG_TOML,
 };
-use crate::numfmt::{Num, Rounded};
+use crate::numfmt::Num;
 use crate::schema::reader::TableReader;
 use crate::schema::{location, At, SchemaError};
 
@@ -291,6 +291,7 @@ impl Campaign {
             base: base_path.clone(),
             source: Box::new(source),
         })?;
+        log_warnings(&base, base_path.as_deref());
         let runs = root.int_in("runs", 1, 1_000_000).map_err(schema)? as u32;
         let seed = root.int_in("seed", 0, i64::MAX).map_err(schema)? as u64;
         let duration_s = root.f64("duration_s").map_err(schema)?;
@@ -302,7 +303,7 @@ impl Campaign {
                 format!(
                     "{} s is not a whole number of frames (frame = {} s at {} Hz)",
                     Num(duration_s),
-                    Num(base.frame_ns as f64 * 1e-9),
+                    Num(base.frame_ns as f64 / 1e9),
                     Num(base.frame_hz)
                 ),
             ));
@@ -543,12 +544,8 @@ fn within_time(field: &str, seconds: f64) -> Result<u64, String> {
     if seconds <= 0.0 {
         return Err(format!("must be > 0, got {}", Num(seconds)));
     }
-    if seconds >= MAX_SIM_TIME_S {
-        return Err(format!(
-            "{} s is beyond the longest simulation time, {} s ≈ 584 years (2^64 − 1 ns)",
-            Num(seconds),
-            Rounded(MAX_SIM_TIME_S, 6)
-        ));
+    if let Some(problem) = beyond_max_time(seconds) {
+        return Err(problem);
     }
     whole_ns(seconds).ok_or_else(|| {
         format!(
@@ -560,13 +557,10 @@ fn within_time(field: &str, seconds: f64) -> Result<u64, String> {
 
 /// An error about `field` of the campaign file `path` (text `source`), with its position.
 fn invalid_at(source: &str, path: &Path, field: &str, problem: String) -> CampaignError {
-    let at = DeTable::parse(source)
-        .map(|doc| SourceMap::new(source, doc.get_ref()).at(field))
-        .unwrap_or_default();
     CampaignError::Invalid {
         path: path.to_owned(),
         field: field.to_owned(),
         problem,
-        at,
+        at: SourceMap::locate(source, field),
     }
 }

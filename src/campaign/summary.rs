@@ -9,6 +9,7 @@ use plotters::prelude::*;
 
 use super::execute::RunResult;
 use super::plan::RunPlan;
+use super::verdict::{Outcome, Verdict};
 
 /// What `summarize` found.
 #[derive(Clone, Debug, Default)]
@@ -23,6 +24,8 @@ pub struct Summary {
     pub missing: Vec<u32>,
     /// Runs whose status is not `ok` (server error, controller exit, invalid draw).
     pub failed: Vec<(u32, String)>,
+    /// The planned runs by outcome (a missing run could not be run): the exit code.
+    pub verdict: Verdict,
     /// Wilson 95 % interval of the pass rate over the planned runs.
     pub wilson_95: (f64, f64),
     /// The report text (also `summary.txt`).
@@ -84,6 +87,12 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
             Err(_) => s.missing.push(p.run),
         }
     }
+    s.verdict = Verdict::of(
+        results
+            .iter()
+            .map(|r| r.outcome)
+            .chain(s.missing.iter().map(|_| Outcome::NotRun)),
+    );
     // summary.csv
     let mut csv = String::from("run,state_sha256,passed");
     for k in &keys {

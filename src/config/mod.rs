@@ -23,6 +23,7 @@ mod error;
 mod file;
 mod schedule;
 mod source_map;
+mod warnings;
 
 use std::collections::HashSet;
 use std::path::Path;
@@ -37,6 +38,7 @@ pub use file::{config_message, load_config};
 use flexdyn_proto::MAX_PANEL_PAIRS;
 pub use schedule::EffectorInputSegment;
 pub(crate) use source_map::SourceMap;
+pub use warnings::{log_warnings, warning_message, ConfigWarning};
 
 use crate::dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
 use crate::dynamics::effectors::reaction_wheel;
@@ -433,7 +435,7 @@ impl RawConfig {
                 value: sim.step_s,
             }));
         }
-        beyond_max_time(map, "simulation.step_s", sim.step_s)?;
+        check_max_time(map, "simulation.step_s", sim.step_s)?;
         let step_ns = match whole_ns(sim.step_s) {
             Some(ns) if ns > 0 => ns,
             _ => {
@@ -704,19 +706,24 @@ fn check_wire_capacity(
 /// The longest simulation time a `u64` count of nanoseconds holds: 2⁶⁴ − 1 ns ≈ 584.5 years.
 pub const MAX_SIM_TIME_S: f64 = u64::MAX as f64 * 1e-9;
 
+/// What is wrong with `seconds` if it is beyond [`MAX_SIM_TIME_S`]: the one message of every
+/// time in a file (configuration, `[server]`, campaign).
+pub fn beyond_max_time(seconds: f64) -> Option<String> {
+    (seconds >= MAX_SIM_TIME_S).then(|| {
+        format!(
+            "{} s is beyond the maximum simulation time ({} s ≈ 584 years, 2^64 − 1 ns)",
+            Num(seconds),
+            Rounded(MAX_SIM_TIME_S, 6)
+        )
+    })
+}
+
 /// An error naming `field` if `seconds` is beyond [`MAX_SIM_TIME_S`].
-fn beyond_max_time(map: &SourceMap, field: &str, seconds: f64) -> Result<(), ConfigError> {
-    if seconds >= MAX_SIM_TIME_S {
-        return Err(map.timing(
-            field,
-            format!(
-                "{} s is beyond the maximum simulation time ({} s ≈ 584 years, 2^64 − 1 ns)",
-                Num(seconds),
-                Rounded(MAX_SIM_TIME_S, 6)
-            ),
-        ));
+fn check_max_time(map: &SourceMap, field: &str, seconds: f64) -> Result<(), ConfigError> {
+    match beyond_max_time(seconds) {
+        Some(problem) => Err(map.timing(field, problem)),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// \[m\] Largest body-fixed distance in a spacecraft: a hub CoM offset, a hinge or sensor

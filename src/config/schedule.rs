@@ -11,7 +11,7 @@
 
 use std::collections::HashMap;
 
-use super::{beyond_max_time, whole_ns, ConfigError, SourceMap};
+use super::{check_max_time, whole_ns, ConfigError, SourceMap};
 use crate::dynamics::{ParamError, Spacecraft};
 use crate::numfmt::Num;
 use crate::schema::TableReader;
@@ -68,7 +68,7 @@ pub(super) fn row_time_ns(
             value: t_s,
         }));
     }
-    beyond_max_time(map, field, t_s)?;
+    check_max_time(map, field, t_s)?;
     let t_ns = match whole_ns(t_s) {
         Some(ns) if ns % step_ns == 0 => ns,
         _ => {

@@ -61,6 +61,25 @@ impl<'s> SourceMap<'s> {
         }
     }
 
+    /// Position of the value at `path` (or of its key) in the TOML text `source`, if it parses
+    /// and has it: for errors found after the document was read (`[server]`, campaigns).
+    pub(crate) fn locate(source: &str, path: &str) -> At {
+        DeTable::parse(source)
+            .map(|doc| SourceMap::new(source, doc.get_ref()).at(path))
+            .unwrap_or_default()
+    }
+
+    /// Position of the key at `path` in `source` (an unknown key points at itself, as the
+    /// schema reader's do).
+    pub(crate) fn locate_key(source: &str, path: &str) -> At {
+        let Ok(doc) = DeTable::parse(source) else {
+            return At::default();
+        };
+        let map = SourceMap::new(source, doc.get_ref());
+        let entry = map.entries.iter().find(|e| e.is_key && e.path == path);
+        At(entry.map(|e| location(source, e.span.start)))
+    }
+
     /// Position of the value at `path` (or of its key), if the document has it.
     pub(crate) fn at(&self, path: &str) -> At {
         let entry = self

@@ -7,6 +7,7 @@
 
 use std::fmt;
 
+pub(crate) mod plausible;
 pub(crate) mod reader;
 
 pub(crate) use reader::TableReader;

@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use super::error::{ServerError, SettingsError};
-use super::settings::{Origin, ServerSettings, Value};
+use super::settings::{ServerSettings, Value};
 use super::RunReport;
-use crate::config::{load_config, SimConfig};
+use crate::config::{load_config, log_warnings, SimConfig};
 use crate::transport::{zenoh_config, Role, ZenohArgs};
 
 /// Arguments of `flexdyn run` (plain `flexdyn` runs with all defaults). Every server option
@@ -139,14 +139,11 @@ impl RunArgs {
         out
     }
 
-    /// The settings of `cfg`'s `[server]` table with these options applied on top.
+    /// The settings of `cfg`'s `[server]` table with these options applied on top
+    /// ([`ServerSettings::resolve`]).
     pub fn settings(&self, cfg: &SimConfig) -> Result<ServerSettings, SettingsError> {
-        let mut settings = ServerSettings::from_table(&cfg.server)?;
-        for (key, value) in self.overrides() {
-            settings.apply(key, &value, Origin::Cli)?;
-        }
+        let mut settings = ServerSettings::resolve(cfg, self.config.as_deref(), &self.overrides())?;
         settings.record.clone_from(&self.record);
-        settings.validate()?;
         Ok(settings)
     }
 }
@@ -167,8 +164,8 @@ pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
         file: file.map(Path::to_path_buf),
         source,
     })?;
+    log_warnings(&cfg, file);
     let settings = args.settings(&cfg)?;
-    settings.duration_frames(cfg.frame_ns)?;
     let zcfg = zenoh_config(&args.zenoh, Role::Server)?;
     super::access::check(&zcfg, &settings)?;
     let runtime = tokio::runtime::Builder::new_multi_thread()

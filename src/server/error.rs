@@ -1,10 +1,10 @@
 //! Typed errors of the server layer (STYLE 13): settings, Zenoh configuration, and the run itself.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 pub use crate::transport::ZenohConfigError;
 
-use crate::config::{config_message, ConfigError};
+use crate::config::{config_message, At, ConfigError, SourceMap};
 
 /// An invalid server setting. The message starts with the setting's name as the user wrote it:
 /// `server.<key>` for the `[server]` TOML table, `--<flag>` for a command-line option.
@@ -27,6 +27,59 @@ pub enum SettingsError {
         /// What is wrong, with the offending value.
         problem: String,
     },
+    /// A `[server]` key of a configuration file: the error, prefixed with the file's name and
+    /// followed by the key's line and column, as every other section's errors are.
+    #[error("{}{source}{at}", file.as_ref().map_or(String::new(), |f| format!("{}: ", f.display())))]
+    InFile {
+        /// The configuration file (`None`: the embedded default).
+        file: Option<PathBuf>,
+        /// The error; it names `server.<key>`.
+        source: Box<SettingsError>,
+        /// Where the key is in the file.
+        at: At,
+    },
+}
+
+impl SettingsError {
+    /// The `[server]` key the error is about (`duration_s`), if it names one.
+    pub fn key(&self) -> Option<&str> {
+        match self {
+            SettingsError::UnknownKey { key, .. } => Some(key),
+            SettingsError::Invalid { name, .. } => name.strip_prefix("server."),
+            SettingsError::InFile { source, .. } => source.key(),
+        }
+    }
+
+    /// The error as one about the file `file` whose text is `source`: prefixed with the file's
+    /// name and followed by the position of `server.<key>`.
+    pub(crate) fn in_file(self, file: Option<&Path>, source: &str) -> Self {
+        let at = match (&self, self.key()) {
+            (SettingsError::UnknownKey { key, .. }, _) => {
+                SourceMap::locate_key(source, &format!("server.{key}"))
+            }
+            (_, Some(key)) => SourceMap::locate(source, &format!("server.{key}")),
+            (_, None) => At::default(),
+        };
+        SettingsError::InFile {
+            file: file.map(Path::to_path_buf),
+            source: Box::new(self),
+            at,
+        }
+    }
+
+    /// The error named as the command-line option `--<key>` (the user set it there).
+    pub(crate) fn into_option(self) -> Self {
+        match self {
+            SettingsError::Invalid { name, problem } => {
+                let key = name.strip_prefix("server.").unwrap_or(&name);
+                SettingsError::Invalid {
+                    name: super::settings::Origin::Cli.name(key),
+                    problem,
+                }
+            }
+            other => other,
+        }
+    }
 }
 
 /// Why a server run failed.

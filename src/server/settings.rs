@@ -8,9 +8,13 @@
 
 use std::time::Duration;
 
+use std::path::Path;
+
 use flexdyn_proto::{validate_sc_id, Mode, StalePolicy};
 
 use super::error::SettingsError;
+use crate::config::{beyond_max_time, whole_ns, SimConfig};
+use crate::numfmt::Num;
 
 /// What the real-time loop does when a frame's work ends after the next frame's deadline.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -292,7 +296,7 @@ impl Setter<'_> {
             _ => return Err(self.expected("a number")),
         };
         if !f.is_finite() {
-            return Err(self.bad(format!("must be finite (got {f})")));
+            return Err(self.bad(format!("must be finite (got {})", Num(f))));
         }
         Ok(f)
     }
@@ -300,14 +304,23 @@ impl Setter<'_> {
     fn positive(&self) -> Result<f64, SettingsError> {
         let f = self.float()?;
         if f <= 0.0 {
-            return Err(self.bad(format!("must be > 0 (got {f})")));
+            return Err(self.bad(format!("must be > 0 (got {})", Num(f))));
         }
         Ok(f)
     }
 
-    fn seconds(&self) -> Result<Duration, SettingsError> {
+    /// A positive time in seconds that a `u64` count of nanoseconds holds (as every time in a
+    /// configuration).
+    fn seconds_f64(&self) -> Result<f64, SettingsError> {
         let s = self.positive()?;
-        Duration::try_from_secs_f64(s).map_err(|_| self.bad(format!("{s} s is out of range")))
+        match beyond_max_time(s) {
+            Some(problem) => Err(self.bad(problem)),
+            None => Ok(s),
+        }
+    }
+
+    fn seconds(&self) -> Result<Duration, SettingsError> {
+        Ok(Duration::from_secs_f64(self.seconds_f64()?))
     }
 
     fn int_in(&self, lo: i64, hi: i64) -> Result<i64, SettingsError> {
@@ -337,6 +350,37 @@ impl ServerSettings {
             })?;
             s.apply(key, &value, Origin::Table)?;
         }
+        Ok(s)
+    }
+
+    /// The settings of `cfg`'s `[server]` table (read from `file`; `None`: the embedded default)
+    /// with the command-line `overrides` applied on top, checked across settings
+    /// ([`Self::validate`]) and against the frame ([`Self::duration_frames`]): what `flexdyn run`
+    /// starts with and `flexdyn check-config` checks. An error about a key of the file starts
+    /// with the file's name and ends with the key's line and column; one about a setting the
+    /// command line gave names the option (`--duration-s`).
+    pub fn resolve(
+        cfg: &SimConfig,
+        file: Option<&Path>,
+        overrides: &[(&'static str, Value)],
+    ) -> Result<Self, SettingsError> {
+        let in_file = |e: SettingsError| e.in_file(file, &cfg.source_toml);
+        let mut s = Self::from_table(&cfg.server).map_err(in_file)?;
+        for (key, value) in overrides {
+            s.apply(key, value, Origin::Cli)?;
+        }
+        let named = |e: SettingsError| {
+            let from_cli = e
+                .key()
+                .is_some_and(|k| overrides.iter().any(|(o, _)| *o == k));
+            if from_cli {
+                e.into_option()
+            } else {
+                in_file(e)
+            }
+        };
+        s.validate().map_err(named)?;
+        s.duration_frames(cfg.frame_ns).map_err(named)?;
         Ok(s)
     }
 
@@ -384,9 +428,9 @@ impl ServerSettings {
             "participant_timeout_s" => self.participant_timeout = set.seconds()?,
             "presence_timeout_s" => self.presence_timeout = set.seconds()?,
             "duration_s" => {
-                let s = set.positive()?;
-                let ns = crate::config::whole_ns(s).ok_or_else(|| {
-                    set.bad(format!("{s} s is not a whole number of nanoseconds"))
+                let s = set.seconds_f64()?;
+                let ns = whole_ns(s).ok_or_else(|| {
+                    set.bad(format!("{} s is not a whole number of nanoseconds", Num(s)))
                 })?;
                 self.duration_ns = Some(ns);
             }
@@ -418,7 +462,7 @@ impl ServerSettings {
             "status_hz" => {
                 let hz = set.positive()?;
                 if hz > 1000.0 {
-                    return Err(set.bad(format!("must be <= 1000 Hz (got {hz})")));
+                    return Err(set.bad(format!("must be <= 1000 Hz (got {})", Num(hz))));
                 }
                 self.status_hz = hz;
             }
@@ -529,11 +573,11 @@ impl ServerSettings {
             None => Ok(None),
             Some(ns) if ns % frame_ns == 0 => Ok(Some(ns / frame_ns)),
             Some(ns) => Err(SettingsError::Invalid {
-                name: "server.duration_s (or --duration-s)".into(),
+                name: "server.duration_s".into(),
                 problem: format!(
                     "{} s is not a whole number of frames (frame = {} s = {frame_ns} ns)",
-                    ns as f64 / 1e9,
-                    frame_ns as f64 / 1e9
+                    Num(ns as f64 / 1e9),
+                    Num(frame_ns as f64 / 1e9)
                 ),
             }),
         }
@@ -554,7 +598,8 @@ impl ServerSettings {
             self.participant_timeout.as_secs_f64(),
             self.presence_timeout.as_secs_f64(),
             self.duration_ns
-                .map_or("unlimited".to_owned(), |ns| format!("{}", ns as f64 / 1e9)),
+                .map_or("unlimited".to_owned(), |ns| Num(ns as f64 / 1e9)
+                    .to_string()),
             self.overrun_policy.as_str(),
             self.overrun_limit,
             self.stale_after.as_secs_f64(),
@@ -749,6 +794,34 @@ mod tests {
             .unwrap_err()
             .to_string()
             .starts_with("server.participants:"));
+    }
+
+    #[test]
+    fn huge_values_print_in_their_shortest_form() {
+        for (text, want) in [
+            (
+                "duration_s = 1e300",
+                "server.duration_s: 1e300 s is beyond the maximum simulation time",
+            ),
+            (
+                "participant_timeout_s = 1e300",
+                "server.participant_timeout_s: 1e300 s is beyond the maximum simulation time",
+            ),
+            (
+                "status_hz = 1e300",
+                "server.status_hz: must be <= 1000 Hz (got 1e300)",
+            ),
+            (
+                "stale_after_s = -1e300",
+                "server.stale_after_s: must be > 0 (got -1e300)",
+            ),
+        ] {
+            let e = ServerSettings::from_table(&table(text))
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with(want), "{text}: {e}");
+            assert!(e.len() < 160, "{text}: {} characters: {e}", e.len());
+        }
     }
 
     #[test]

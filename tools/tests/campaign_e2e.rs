@@ -2,13 +2,15 @@
 //! `flexdyn::campaign::main` (what `flexdyn campaign …` calls): 20 short runs two at a time all
 //! finish, the summary has 20 rows, the criteria evaluate and a deliberately failing one fails
 //! everywhere; a run rerun alone with `--index` has the same state hash; a controller that
-//! crashes in one run fails that run with its exit status and the campaign goes on.
+//! crashes in one run fails that run with its exit status and the campaign goes on. The exit
+//! code is the verdict: 3 when the runs ran and failed.
 //!
 //! Ports 17800–17819, 17830–17832, 17840–17859.
 
 use std::path::{Path, PathBuf};
 
 use flexdyn::campaign::execute::RunResult;
+use flexdyn::campaign::verdict::Outcome;
 use flexdyn::campaign::{main as campaign, CampaignCommand};
 
 #[path = "acs_demo_bin/mod.rs"]
@@ -91,7 +93,12 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
         base_port: 17800,
     })
     .unwrap();
-    eprintln!("{report}");
+    eprintln!("{}", report.text);
+    // Every run ran, and every run fails `impossible_pointing`.
+    assert_eq!(report.exit_code, 3, "{}", report.text);
+    assert!(report
+        .text
+        .ends_with("verdict: FAILED: 20 of 20 runs failed (exit code 3)"));
     let results: Vec<RunResult> = (0..20).map(|r| result(&out, r)).collect();
     for r in &results {
         assert_eq!(r.status, "ok", "run {}: {}", r.run, r.status);
@@ -112,6 +119,7 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
         let pointing = &r.criteria[1];
         assert!(pointing.value > 1e-6 && !pointing.passed, "{pointing:?}");
         assert!(!r.passed);
+        assert_eq!(r.outcome, Outcome::Failed, "run {}", r.run);
     }
     // Dispersed runs differ; the hashes say so.
     let mut hashes: Vec<&str> = results.iter().map(|r| r.state_sha256.as_str()).collect();
@@ -119,8 +127,10 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
     hashes.dedup();
     assert_eq!(hashes.len(), 20);
 
-    let text = campaign(&CampaignCommand::Summarize { dir: out.clone() }).unwrap();
+    let summary = campaign(&CampaignCommand::Summarize { dir: out.clone() }).unwrap();
+    let text = summary.text;
     eprintln!("{text}");
+    assert_eq!(summary.exit_code, 3);
     assert!(text.contains("0 of 20 planned runs passed"), "{text}");
     assert!(
         text.contains("criterion impossible_pointing: 20 failing"),
@@ -144,7 +154,7 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
 
     // Run 7 again, alone, in another directory and on another port: the same stream.
     let again = out.with_file_name("again");
-    campaign(&CampaignCommand::Run {
+    let alone = campaign(&CampaignCommand::Run {
         file,
         output: again.clone(),
         jobs: None,
@@ -153,6 +163,7 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
         base_port: 17840,
     })
     .unwrap();
+    assert_eq!(alone.exit_code, 3, "{}", alone.text);
     assert_eq!(result(&again, 7).state_sha256, results[7].state_sha256);
     assert!(!again.join("run-0006/result.json").exists());
 }
@@ -173,17 +184,22 @@ fn a_crashing_controller_fails_its_run_and_the_campaign_goes_on() {
         base_port: 17830,
     })
     .unwrap();
-    eprintln!("{report}");
+    eprintln!("{}", report.text);
+    // The flight code crashing in run 1 is a failed run, not one that could not be run.
+    assert_eq!(report.exit_code, 3, "{}", report.text);
     let crashed = result(&out, 1);
     assert_eq!(crashed.controller_exit.as_deref(), Some("exit 3"));
     assert!(crashed.status.contains("exit 3"), "{}", crashed.status);
     assert!(!crashed.passed && crashed.state_sha256.is_empty());
+    assert_eq!(crashed.outcome, Outcome::Failed);
     for r in [0, 2] {
         assert_eq!(result(&out, r).status, "ok");
     }
-    let text = campaign(&CampaignCommand::Summarize { dir: out }).unwrap();
+    let summary = campaign(&CampaignCommand::Summarize { dir: out }).unwrap();
     assert!(
-        text.contains("failed run 1: the controller exited"),
-        "{text}"
+        summary.text.contains("failed run 1: the controller exited"),
+        "{}",
+        summary.text
     );
+    assert_eq!(summary.exit_code, 3);
 }

@@ -68,6 +68,7 @@ use super::rng::NormalRng;
 pub use super::rng::{exp_portable, expm1_portable, ln_portable};
 
 mod bank;
+pub(crate) mod plausibility;
 pub(crate) mod schema;
 
 pub use bank::ImuBank;

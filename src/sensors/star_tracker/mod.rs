@@ -41,6 +41,7 @@ use flexdyn_proto::{star_tracker_flags, Header, StarTrackerMsg};
 
 use super::rng::NormalRng;
 
+pub(crate) mod plausibility;
 pub(crate) mod schema;
 
 /// Tolerance on |‖v‖ − 1| for the boresight and the Sun direction.

@@ -62,6 +62,7 @@ use crate::dynamics::ParamError;
 use flexdyn_proto::wheel_flags;
 
 mod params;
+pub(crate) mod plausibility;
 pub(crate) mod schema;
 
 pub use params::ReactionWheelParams;
