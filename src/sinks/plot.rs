@@ -23,9 +23,10 @@ use plotters::prelude::*;
 
 use super::error::SinkError;
 use super::reader::read_recording;
-use super::table::{row, Cell};
+use super::table::{prefixed_columns, row, Cell, Column};
 use super::topics::{classify, Decoded, TopicKind};
 use crate::attitude::mrp_error;
+use flexdyn_proto::{ImuMsg, StarTrackerMsg};
 
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
 /// The name the embedded font is registered under (see [`register_font`]).
@@ -97,15 +98,14 @@ impl Columns {
         }
     }
 
-    /// The first of `names` present.
-    fn get(&self, names: &[String]) -> Option<&Vec<f64>> {
-        names.iter().find_map(|n| self.cols.get(n))
+    /// The column `name`, if present.
+    fn get(&self, name: &str) -> Option<&Vec<f64>> {
+        self.cols.get(name)
     }
 
-    /// A 3-vector column set: `<base>_1..3` under any of `bases`.
-    fn vec3(&self, bases: &[&str]) -> Option<[&Vec<f64>; 3]> {
-        let one =
-            |i: usize| self.get(&bases.iter().map(|b| format!("{b}_{i}")).collect::<Vec<_>>());
+    /// A 3-vector column set: `<base>_1..3`.
+    fn vec3(&self, base: &str) -> Option<[&Vec<f64>; 3]> {
+        let one = |i: usize| self.get(&format!("{base}_{i}"));
         Some([one(1)?, one(2)?, one(3)?])
     }
 
@@ -120,6 +120,7 @@ struct PlotData {
     state: Columns,
     status: Columns,
     imus: BTreeMap<String, Columns>,
+    star_trackers: BTreeMap<String, Columns>,
 }
 
 fn input_err(path: &Path, problem: impl Into<String>) -> SinkError {
@@ -162,7 +163,12 @@ fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
                 .entry(topic.sensor.unwrap_or_default().to_owned())
                 .or_default()
                 .push(&cells),
-            TopicKind::StarTracker | TopicKind::Command => {}
+            TopicKind::StarTracker => data
+                .star_trackers
+                .entry(topic.sensor.unwrap_or_default().to_owned())
+                .or_default()
+                .push(&cells),
+            TopicKind::Command => {}
         }
     }
     if data.state.is_empty() {
@@ -172,6 +178,21 @@ fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
         ));
     }
     Ok(data)
+}
+
+/// A `simulate` sensor column `<kind>_<name>_<field>` (`imu_hub_omega_p_rad_s_1`,
+/// `st_st1_q_cn_0`) split into (kind, sensor name, field), for the fields of that message.
+fn sensor_column<'a>(
+    column: &'a str,
+    fields: &[(&'static str, Vec<String>)],
+) -> Option<(&'static str, &'a str, &'a str)> {
+    fields.iter().find_map(|(kind, names)| {
+        let rest = column.strip_prefix(kind)?.strip_prefix('_')?;
+        names.iter().find_map(|f| {
+            let name = rest.strip_suffix(f.as_str())?.strip_suffix('_')?;
+            (!name.is_empty()).then(|| (*kind, name, &rest[name.len() + 1..]))
+        })
+    })
 }
 
 fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
@@ -189,6 +210,14 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             "the first column must be t_s (a `flexdyn simulate` or `flexdyn export` state CSV)",
         ));
     }
+    // The sensor columns `simulate` writes beside the state: the message fields of an IMU or a
+    // star-tracker sample, prefixed `imu_<name>_` / `st_<name>_`.
+    let fields = [
+        ("imu", column_names(&ImuMsg::default())),
+        ("st", column_names(&StarTrackerMsg::default())),
+    ];
+    let place: Vec<Option<(&str, &str, &str)>> =
+        header.iter().map(|h| sensor_column(h, &fields)).collect();
     let mut data = PlotData::default();
     for (i, line) in lines.enumerate() {
         if line.is_empty() {
@@ -207,10 +236,12 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             ));
         }
         let mut state = Vec::with_capacity(fields.len());
-        let mut imu: BTreeMap<String, Vec<(String, Cell)>> = BTreeMap::new();
-        // Column 0 is t_s (checked above), so the row's time is known before any IMU column.
+        // Per sensor: its cells, and whether this row has any (a star tracker's are empty
+        // between its updates).
+        let mut sensors: BTreeMap<(&str, &str), (Vec<Column>, bool)> = BTreeMap::new();
+        // Column 0 is t_s (checked above), so the row's time is known before any sensor column.
         let mut t_s = f64::NAN;
-        for (name, f) in header.iter().zip(&fields) {
+        for ((name, f), place) in header.iter().zip(&fields).zip(&place) {
             let x = if f.is_empty() {
                 f64::NAN
             } else {
@@ -221,35 +252,42 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             if *name == "t_s" {
                 t_s = x;
             }
-            // `simulate` puts each IMU's columns in the state CSV as imu_<name>_<field>.
-            if let Some(rest) = name.strip_prefix("imu_") {
-                if let Some((imu_name, field)) = rest
-                    .split_once("_omega_p_")
-                    .map(|(n, k)| (n, format!("omega_p_{k}")))
-                    .or_else(|| {
-                        rest.split_once("_accel_p_")
-                            .map(|(n, k)| (n, format!("accel_p_{k}")))
-                    })
-                {
-                    let cells = imu.entry(imu_name.to_owned()).or_default();
+            match place {
+                Some((kind, sensor, field)) => {
+                    let (cells, any) = sensors.entry((kind, sensor)).or_default();
                     if cells.is_empty() {
                         cells.push(("t_s".into(), Cell::Num(t_s)));
                     }
-                    cells.push((field, Cell::Num(x)));
-                    continue;
+                    cells.push(((*field).to_owned(), Cell::Num(x)));
+                    *any |= !f.is_empty();
                 }
+                None => state.push(((*name).to_owned(), Cell::Num(x))),
             }
-            state.push(((*name).to_owned(), Cell::Num(x)));
         }
         data.state.push(&state);
-        for (name, cells) in imu {
-            data.imus.entry(name).or_default().push(&cells);
+        for ((kind, name), (cells, any)) in sensors {
+            let map = if kind == "imu" {
+                &mut data.imus
+            } else {
+                &mut data.star_trackers
+            };
+            if any {
+                map.entry(name.to_owned()).or_default().push(&cells);
+            }
         }
     }
     if data.state.is_empty() {
         return Err(input_err(path, "no data rows"));
     }
     Ok(data)
+}
+
+/// The column names of `msg`'s fields (no header), as in [`prefixed_columns`].
+fn column_names<T: serde::Serialize>(msg: &T) -> Vec<String> {
+    prefixed_columns("", msg)
+        .into_iter()
+        .map(|(n, _)| n)
+        .collect()
 }
 
 /// One line on a panel.
@@ -420,8 +458,8 @@ pub struct PlotReport {
     pub skipped: Vec<(String, String)>,
 }
 
-fn vec_panel(cols: &Columns, bases: &[&str], labels: [&str; 3], y_label: &str) -> Option<Panel> {
-    let v = cols.vec3(bases)?;
+fn vec_panel(cols: &Columns, base: &str, labels: [&str; 3], y_label: &str) -> Option<Panel> {
+    let v = cols.vec3(base)?;
     Some(Panel {
         y_label: y_label.to_owned(),
         log_y: false,
@@ -472,10 +510,10 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
     let mut figures: Vec<(&str, String, Vec<Panel>)> = Vec::new();
     let mut skip = |name: &str, why: &str| report.skipped.push((name.to_owned(), why.to_owned()));
 
-    match vec_panel(s, &["sigma_bn"], ["σ1", "σ2", "σ3"], "σ_BN (MRP, –)") {
+    match vec_panel(s, "sigma_bn", ["σ1", "σ2", "σ3"], "σ_BN (MRP, –)") {
         Some(sigma) => {
             let mut panels = vec![sigma];
-            if let (Some(target), Some(v)) = (target, s.vec3(&["sigma_bn"])) {
+            if let (Some(target), Some(v)) = (target, s.vec3("sigma_bn")) {
                 let err: Vec<nalgebra::Vector3<f64>> = (0..t.len())
                     .map(|k| mrp_error(&nalgebra::Vector3::new(v[0][k], v[1][k], v[2][k]), &target))
                     .collect();
@@ -505,7 +543,7 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
     }
     match vec_panel(
         s,
-        &["omega_bn_b_rad_s", "omega_bn_b"],
+        "omega_bn_b_rad_s",
         ["ω1", "ω2", "ω3"],
         "ω_BN, B components (rad/s)",
     ) {
@@ -515,8 +553,8 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
     let mut pairs = Vec::new();
     for k in 1.. {
         let (Some(th1), Some(th2)) = (
-            s.get(&[format!("pair{k}_theta1")]),
-            s.get(&[format!("pair{k}_theta2")]),
+            s.get(&format!("pair{k}_theta1")),
+            s.get(&format!("pair{k}_theta2")),
         ) else {
             break;
         };
@@ -537,17 +575,17 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
     }
     let torque = vec_panel(
         s,
-        &["wrench_applied_torque_b_nm"],
+        "wrench_applied_torque_b_nm",
         ["τ1", "τ2", "τ3"],
         "torque about B (N·m)",
     );
     let force = vec_panel(
         s,
-        &["wrench_applied_force_b_newton"],
+        "wrench_applied_force_b_newton",
         ["F1", "F2", "F3"],
         "force at B (N)",
     );
-    match (torque, force, s.get(&["command_flags".into()])) {
+    match (torque, force, s.get("command_flags")) {
         (Some(tq), Some(f), Some(flags)) => figures.push((
             "wrench.png",
             "Commanded wrench held over each frame (B components) and command flags".into(),
@@ -567,15 +605,15 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
         ),
     }
     let energy = match (
-        s.get(&["conserved_orb_energy_j".into(), "orb_energy_j".into()]),
-        s.get(&["conserved_rot_energy_j".into(), "rot_energy_j".into()]),
+        s.get("conserved_orb_energy_j"),
+        s.get("conserved_rot_energy_j"),
     ) {
         (Some(o), Some(r)) => Some(o.iter().zip(r).map(|(a, b)| a + b).collect::<Vec<f64>>()),
         _ => None,
     };
     let momentum = match (
-        s.vec3(&["conserved_orb_ang_mom_n", "orb_ang_mom_n"]),
-        s.vec3(&["conserved_rot_ang_mom_c_n", "rot_ang_mom_c_n"]),
+        s.vec3("conserved_orb_ang_mom_n"),
+        s.vec3("conserved_rot_ang_mom_c_n"),
     ) {
         (Some(o), Some(r)) => {
             let h: Vec<nalgebra::Vector3<f64>> = (0..t.len())
@@ -611,7 +649,7 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
     for (name, c) in &data.imus {
         if let Some(p) = vec_panel(
             c,
-            &["omega_p_rad_s", "omega_p"],
+            "omega_p_rad_s",
             ["ω1", "ω2", "ω3"],
             &format!("{name}: rate (rad/s)"),
         ) {
@@ -619,7 +657,7 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
         }
         if let Some(p) = vec_panel(
             c,
-            &["accel_p_m_s2", "accel_p"],
+            "accel_p_m_s2",
             ["a1", "a2", "a3"],
             &format!("{name}: specific force (m/s²)"),
         ) {
@@ -637,10 +675,10 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
     }
     let st = &data.status;
     match (
-        st.get(&["timing_lateness_p50_ns".into()]),
-        st.get(&["timing_lateness_p99_ns".into()]),
-        st.get(&["timing_lateness_max_ns".into()]),
-        st.get(&["timing_overrun_count".into()]),
+        st.get("timing_lateness_p50_ns"),
+        st.get("timing_lateness_p99_ns"),
+        st.get("timing_lateness_max_ns"),
+        st.get("timing_overrun_count"),
     ) {
         (Some(p50), Some(p99), Some(max), Some(overruns)) => {
             let us = |v: &Vec<f64>| v.iter().map(|x| x * 1e-3).collect::<Vec<_>>();
