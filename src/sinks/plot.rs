@@ -666,9 +666,12 @@ fn external_wrench_spans(s: &Columns) -> Vec<(f64, f64)> {
     spans
 }
 
+/// Figures not drawn, each with the reason.
+pub type Skipped = Vec<(String, String)>;
+
 /// Builds every figure the input has data for, without drawing: the figures, and the ones
 /// skipped with the reason.
-pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Vec<(String, String)>), SinkError> {
+pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
     let target = match &args.sigma_rn {
         None => None,
         Some(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => {
@@ -897,13 +900,11 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Vec<(String, String)>), 
     if st_panels.is_empty() {
         skip("star_tracker.png", "no star tracker");
     } else {
-        let n = st_panels.len() / 2;
-        figures.push(Figure {
-            name: "star_tracker.png",
-            title: "Star trackers: measured attitude q_CN (scalar first) and validity".into(),
-            panels: interleave_columns(st_panels, n),
-            columns: n,
-        });
+        figures.push(sensor_grid(
+            "star_tracker.png",
+            "Star trackers: measured attitude q_CN (scalar first) and validity",
+            st_panels,
+        ));
     }
     let mut imu_panels = Vec::new();
     for (name, c) in &data.imus {
@@ -929,14 +930,11 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Vec<(String, String)>), 
     if imu_panels.is_empty() {
         skip("imu.png", "no IMU");
     } else {
-        // One column per IMU, so each panel keeps the height its labels need.
-        let n = imu_panels.len() / 2;
-        figures.push(Figure {
-            name: "imu.png",
-            title: "IMU measurements (sensor frame P)".into(),
-            panels: interleave_columns(imu_panels, n),
-            columns: n,
-        });
+        figures.push(sensor_grid(
+            "imu.png",
+            "IMU measurements (sensor frame P)",
+            imu_panels,
+        ));
     }
     let st = &data.status;
     let timing = (
@@ -987,6 +985,18 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Vec<(String, String)>), 
         )),
     }
     Ok((figures, skipped))
+}
+
+/// A figure of two panels per sensor, one column per sensor, so each panel keeps the height
+/// its labels need however many sensors there are.
+fn sensor_grid(name: &'static str, title: &str, panels: Vec<Panel>) -> Figure {
+    let columns = panels.len() / 2;
+    Figure {
+        name,
+        title: title.to_owned(),
+        panels: interleave_columns(panels, columns),
+        columns,
+    }
 }
 
 /// Panels given sensor by sensor (`rows` per sensor, consecutive) reordered row by row for a
