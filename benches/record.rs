@@ -20,44 +20,24 @@ use flexdyn::sim::Simulation;
 use flexdyn::sinks::mcap_file::{
     McapSink, RecordingInfo, VehicleInfo, CHUNK_SIZE_BYTES, RAW_ENCODING,
 };
-use flexdyn_proto::{encode, EffectorState, Header, StateMsg, StatusMsg};
+use flexdyn_proto::{encode, Header, StatusMsg};
 
 const FRAMES: u64 = 20_000;
 
 fn stream(cfg: &SimConfig) -> Vec<(String, Vec<u8>, u64)> {
     let mut sim = Simulation::new(cfg).expect("scenario");
     let mut out = Vec::new();
-    let mut snap = flexdyn::sim::Snapshot::for_simulation(&sim);
+    let mut state = sim.blank_state();
     let mut imu = Vec::new();
     let mut st = Vec::new();
     for tick in 0..FRAMES {
         if tick > 0 {
             sim.step_frame();
         }
-        sim.snapshot_into(&mut snap);
+        sim.state_into(&mut state);
         let stamp = 1_700_000_000_000_000_000 + tick * cfg.frame_ns;
         let header = Header::new(1, tick, tick * cfg.frame_ns, tick);
-        let state = StateMsg {
-            header,
-            sigma_bn: snap.sigma_bn.into(),
-            q_bn: snap.q_bn.into(),
-            omega_bn_b_rad_s: snap.omega_bn_b.into(),
-            omega_dot_bn_b_rad_s2: snap.omega_dot_bn_b.into(),
-            r_bn_n_m: snap.r_bn_n.into(),
-            v_bn_n_m_s: snap.v_bn_n.into(),
-            nongrav_accel_bn_n_m_s2: snap.nongrav_accel_bn_n.into(),
-            effectors: snap
-                .effectors
-                .iter()
-                .map(|e| EffectorState {
-                    kind: e.kind.wire_tag,
-                    flags: e.flags,
-                    states: e.states.clone(),
-                    outputs: e.outputs.clone(),
-                })
-                .collect(),
-            ..StateMsg::default()
-        };
+        state.header = header;
         out.push(("flexdyn/sc1/tlm/state".to_owned(), encode(&state), stamp));
         sim.imu_samples_into(&mut imu);
         for (s, name) in imu.iter().zip(sim.imu_names()) {

@@ -2,21 +2,22 @@
 //! `print-default-config`. `src/main.rs` only parses arguments and reports errors; the work is
 //! here so tests can call it.
 
-use std::fmt::{self, Write as _};
-use std::io::{self, BufWriter, Write};
+use std::fmt;
+use std::io::{self, Write};
 use std::num::NonZeroU64;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use flexdyn_proto::{command_flags, AppliedWrench, Header, ImuMsg, StarTrackerMsg, StateMsg};
+
 use crate::config::{
     config_message, log_warnings, warning_message, whole_ns, ConfigError, SimConfig,
 };
-use crate::dynamics::StateEffector;
 use crate::numfmt::Num;
-use crate::sensors::imu::ImuSample;
 use crate::server::error::SettingsError;
 use crate::server::settings::ServerSettings;
-use crate::sim::{Simulation, Snapshot};
+use crate::sim::Simulation;
+use crate::sinks::table::{first_non_finite_column, prefixed_columns, state_row, Column, CsvTable};
 
 /// Arguments of `flexdyn simulate`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
@@ -196,97 +197,53 @@ fn whole_steps(
     }
 }
 
-/// The CSV header for a spacecraft with `effectors` (no trailing newline). Each effector adds
-/// its states and then its outputs, named `<prefix><k>_<name>` with `k` its 1-based index among
-/// effectors of its kind (`pair1_theta1`, `rw2_omega_rad_s`), and, when it has outputs, a
-/// `<prefix><k>_flags` column with its status bits.
-pub fn csv_header(effectors: &[Box<dyn StateEffector>]) -> String {
-    let mut h = String::from("t_s");
-    for base in ["sigma_bn", "omega_bn_b", "r_bn_n", "v_bn_n"] {
-        for i in 1..=3 {
-            let _ = write!(h, ",{base}_{i}");
-        }
-    }
-    for (i, e) in effectors.iter().enumerate() {
-        let kind = e.kind();
-        let k = 1 + effectors[..i].iter().filter(|o| o.kind() == kind).count();
-        for col in e.state_names().iter().chain(e.output_names()) {
-            let _ = write!(h, ",{}{k}_{col}", kind.column_prefix);
-        }
-        if !e.output_names().is_empty() {
-            let _ = write!(h, ",{}{k}_flags", kind.column_prefix);
-        }
-    }
-    h.push_str(",orb_energy_j,rot_energy_j");
-    for base in ["orb_ang_mom_n", "rot_ang_mom_c_n"] {
-        for i in 1..=3 {
-            let _ = write!(h, ",{base}_{i}");
-        }
-    }
-    h
+/// The scheduled wrench in effect at the current instant (schedule(t) alone, without the
+/// commanded wrench), for `simulate`'s `wrench_schedule_*` columns.
+fn scheduled_wrench(cfg: &SimConfig, t_ns: u64) -> AppliedWrench {
+    let seg = cfg
+        .wrench_schedule
+        .iter()
+        .take_while(|w| w.t_start_ns <= t_ns)
+        .last();
+    seg.map_or_else(AppliedWrench::default, |w| AppliedWrench {
+        torque_b_nm: w.torque_b_nm.into(),
+        force_b_newton: w.force_b_newton.into(),
+    })
 }
 
-/// The IMU columns appended to [`csv_header`], for IMUs `names` in config order: for each,
-/// `imu_<name>_omega_p_1..3`, `imu_<name>_accel_p_1..3`, `imu_<name>_dtheta_p_1..3`,
-/// `imu_<name>_dv_p_1..3` (each prefixed by a comma; empty for no IMU).
-pub fn csv_imu_header(names: &[String]) -> String {
-    let mut h = String::new();
-    for name in names {
-        for q in ["omega_p", "accel_p", "dtheta_p", "dv_p"] {
-            for i in 1..=3 {
-                let _ = write!(h, ",imu_{name}_{q}_{i}");
-            }
+/// One `simulate` row in the CSV dialect of [`crate::sinks::table`]: the state record (as
+/// `export` writes it), the scheduled wrench, each IMU's sample (`imu_names` order) and each
+/// star tracker's sample taken at this instant (`st_names` order; `None`: no update here, its
+/// cells stay empty).
+fn simulate_row(
+    state: &StateMsg,
+    wrench_schedule: &AppliedWrench,
+    imu_names: &[String],
+    imu: &[ImuMsg],
+    st_names: &[String],
+    st: &[Option<StarTrackerMsg>],
+) -> Vec<Column> {
+    let mut row = state_row(state);
+    row.extend(prefixed_columns("wrench_schedule", wrench_schedule));
+    for (name, msg) in imu_names.iter().zip(imu) {
+        row.extend(prefixed_columns(&format!("imu_{name}"), msg));
+    }
+    for (name, msg) in st_names.iter().zip(st) {
+        if let Some(msg) = msg {
+            row.extend(prefixed_columns(&format!("st_{name}"), msg));
         }
     }
-    h
-}
-
-/// Appends the IMU columns of one row (each value prefixed by a comma, in the shortest form
-/// that reads back to the same f64: [`Num`]) to `row`.
-pub fn csv_imu_row(samples: &[ImuSample], row: &mut String) {
-    for s in samples {
-        for v in [
-            &s.omega_p_rad_s,
-            &s.accel_p_m_s2,
-            &s.dtheta_p_rad,
-            &s.dv_p_m_s,
-        ] {
-            for x in v.iter() {
-                let _ = write!(row, ",{}", Num(*x));
-            }
-        }
-    }
-}
-
-/// Appends one CSV row for `s` to `row` (cleared first; no trailing newline). Floats are in the
-/// shortest form that reads back to the same f64 ([`Num`]: `0.03`, `-4020338.689621511`,
-/// `1.5e-20`), so they round-trip exactly.
-pub fn csv_row(s: &Snapshot, row: &mut String) {
-    row.clear();
-    let mut push = |v: f64| {
-        if !row.is_empty() {
-            row.push(',');
-        }
-        let _ = write!(row, "{}", Num(v));
-    };
-    push(s.t_s());
-    for v in [&s.sigma_bn, &s.omega_bn_b, &s.r_bn_n, &s.v_bn_n] {
-        v.iter().for_each(|x| push(*x));
-    }
-    for e in &s.effectors {
-        e.states.iter().chain(&e.outputs).for_each(|x| push(*x));
-        if !e.outputs.is_empty() {
-            push(f64::from(e.flags));
-        }
-    }
-    push(s.conserved.orb_energy_j);
-    push(s.conserved.rot_energy_j);
-    s.conserved.orb_ang_mom_n.iter().for_each(|x| push(*x));
-    s.conserved.rot_ang_mom_c_n.iter().for_each(|x| push(*x));
+    row
 }
 
 /// Simulates `cfg` for `duration_s`, writing a CSV row at t = 0 and every `log_every_s` to
-/// `out` (through a `BufWriter`). `target` names the output in errors.
+/// `out`. `target` names the output in errors.
+///
+/// Each row is the state record the server would publish at that instant (`tick` is the frame
+/// the instant falls in, `seq` the row number; no flight code, so `wrench_applied` is zero and
+/// `command_flags` says no command yet), then the scheduled wrench, then the IMUs (their sample
+/// interval is the log interval) and the star trackers (sampled at their update ticks, as the
+/// server does; their cells are filled in the rows that fall on an update).
 pub fn simulate_to<W: Write>(
     cfg: &SimConfig,
     duration_s: f64,
@@ -305,48 +262,100 @@ pub fn simulate_to<W: Write>(
         target: target.to_string(),
         source,
     };
+    // The server's numeric id, so a row equals the StateMsg a server run of this file
+    // publishes (`check-config` and `run` validate `[server]`; `simulate` only reads the id).
+    let spacecraft_id = ServerSettings::from_table(&cfg.server)
+        .unwrap_or_default()
+        .spacecraft_id;
+    let steps_per_frame = sim.steps_per_frame();
+    let n_trackers = sim.star_trackers().len();
 
-    let mut out = BufWriter::new(out);
-    let mut row = csv_header(sim.spacecraft().effectors());
-    row.push_str(&csv_imu_header(sim.imu_names()));
-    row.push('\n');
-    out.write_all(row.as_bytes()).map_err(io_err)?;
+    let imu_names = sim.imu_names().to_vec();
+    let st_names: Vec<String> = sim
+        .star_trackers()
+        .iter()
+        .map(|t| t.name().to_owned())
+        .collect();
+    let mut state = sim.blank_state();
+    state.command_flags = command_flags::NO_COMMAND_YET;
+    let mut imu_samples = Vec::with_capacity(imu_names.len());
+    let mut st_due = Vec::with_capacity(n_trackers);
+    // Per tracker: the step of its last update and that sample.
+    let mut st_last: Vec<Option<(u64, StarTrackerMsg)>> = vec![None; n_trackers];
+    let mut sample_trackers = |sim: &mut Simulation, step: u64, last: &mut [Option<_>]| {
+        if n_trackers > 0 && step.is_multiple_of(steps_per_frame) {
+            let tick = step / steps_per_frame;
+            sim.star_tracker_samples_into(tick, &mut st_due);
+            let header = Header::new(spacecraft_id, tick, sim.t_sim_ns(), tick);
+            for (i, sample) in &st_due {
+                last[*i] = Some((step, sample.to_msg(header)));
+            }
+        }
+    };
 
-    let mut snap = Snapshot::for_simulation(&sim);
-    let mut imu_samples = Vec::with_capacity(sim.n_imus());
+    // The header: every column a row can have (each tracker as at an update).
+    let columns: Vec<String> = simulate_row(
+        &state,
+        &AppliedWrench::default(),
+        &imu_names,
+        &vec![ImuMsg::default(); imu_names.len()],
+        &st_names,
+        &vec![Some(StarTrackerMsg::default()); n_trackers],
+    )
+    .into_iter()
+    .map(|(name, _)| name)
+    .collect();
+    let mut table = CsvTable::new(out, &columns).map_err(io_err)?;
+
     let n_logged = total_steps / log_steps;
+    let mut step = 0u64;
     let start = Instant::now();
+    sample_trackers(&mut sim, 0, &mut st_last);
     for k in 0..=n_logged {
-        if k > 0 {
-            sim.step_n(log_steps);
+        // Step to the row, stopping at each frame boundary when a tracker may update there.
+        let row_step = k * log_steps;
+        while step < row_step {
+            let next = if n_trackers > 0 {
+                row_step.min((step / steps_per_frame + 1) * steps_per_frame)
+            } else {
+                row_step
+            };
+            sim.step_n(next - step);
+            step = next;
+            sample_trackers(&mut sim, step, &mut st_last);
         }
-        sim.snapshot_into(&mut snap);
+        sim.state_into(&mut state);
+        let t_ns = state.header.sim_time_ns;
+        state.header = Header::new(spacecraft_id, t_ns / cfg.frame_ns, t_ns, k);
         sim.imu_samples_into(&mut imu_samples);
-        // Once per row, outside the stepping loop: never write a non-finite state.
-        let imu_bad = imu_samples
+        let imu: Vec<ImuMsg> = imu_samples.iter().map(|s| s.to_msg(state.header)).collect();
+        let st_now: Vec<Option<StarTrackerMsg>> = st_last
             .iter()
-            .zip(sim.imu_names())
-            .find_map(|(s, name)| {
-                s.first_non_finite()
-                    .map(|q| format!("imu_{name}_{q} (an IMU output)"))
-            });
-        if let Some(quantity) = snap.first_non_finite().or(imu_bad) {
-            out.flush().map_err(io_err)?;
+            .map(|s| s.filter(|(at, _)| *at == step).map(|(_, m)| m))
+            .collect();
+        let row = simulate_row(
+            &state,
+            &scheduled_wrench(cfg, t_ns),
+            &imu_names,
+            &imu,
+            &st_names,
+            &st_now,
+        );
+        // Once per row, outside the stepping loop: never write a non-finite state.
+        if let Some(quantity) = first_non_finite_column(&row) {
+            table.flush().map_err(io_err)?;
             return Err(CliError::NonFinite {
-                step: k * log_steps,
-                t_s: snap.t_s(),
-                quantity,
+                step,
+                t_s: t_ns as f64 / 1e9,
+                quantity: quantity.to_owned(),
             });
         }
-        csv_row(&snap, &mut row);
-        csv_imu_row(&imu_samples, &mut row);
-        row.push('\n');
-        out.write_all(row.as_bytes()).map_err(io_err)?;
+        table.write_row(&row).map_err(io_err)?;
     }
     // Steps after the last multiple of the log interval, up to the duration.
-    sim.step_n(total_steps - n_logged * log_steps);
+    sim.step_n(total_steps - step);
     let wall_s = start.elapsed().as_secs_f64();
-    out.flush().map_err(io_err)?;
+    table.flush().map_err(io_err)?;
     tracing::debug!(steps = total_steps, rows = n_logged + 1, "simulate done");
     Ok(SimulateReport {
         steps: total_steps,
@@ -429,7 +438,9 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), 12);
         let n_cols = lines[0].split(',').count();
-        assert_eq!(n_cols, 1 + 12 + 8 + 2 + 6);
+        // t_s, 5 header fields, 3 + 4 + 5·3 state, 2 + 6 conserved, 6 + 1 command, 2 pairs of
+        // 4 states and a flag, 6 scheduled wrench.
+        assert_eq!(n_cols, 1 + 5 + 22 + 8 + 7 + 2 * 5 + 6);
         assert!(lines[1..].iter().all(|l| l.split(',').count() == n_cols));
     }
 

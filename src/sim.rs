@@ -11,13 +11,11 @@
 
 use std::num::NonZeroU64;
 
-use nalgebra::{Vector3, Vector4};
+use flexdyn_proto::{EffectorState, StateMsg};
 
 use crate::attitude::{mrp_to_dcm, mrp_to_quat};
 use crate::config::{ConfigError, EffectorInputSegment, SimConfig};
-use crate::dynamics::{
-    Conserved, EffectorKind, HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment,
-};
+use crate::dynamics::{HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment};
 use crate::sensors::imu::{Imu, ImuBank, ImuSample};
 use crate::sensors::star_tracker::{StarTracker, StarTrackerSample};
 
@@ -47,7 +45,7 @@ pub struct Simulation {
     outputs_scratch: Vec<f64>,
     flags_scratch: Vec<u32>,
     /// Hub outputs at the current state with the current wrench and inputs, once evaluated:
-    /// the snapshot and every sensor share one evaluation per frame. Cleared by anything that
+    /// the state record and every sensor share one evaluation per frame. Cleared by anything that
     /// changes the state, the wrench or the inputs.
     frame_outputs: Option<HubOutputs>,
     /// The IMUs and their sample-interval bookkeeping; IMU `i` is the spacecraft's sensor
@@ -55,169 +53,6 @@ pub struct Simulation {
     imus: ImuBank,
     /// The star trackers in config order.
     star_trackers: Vec<StarTracker>,
-}
-
-/// Everything a telemetry frame or a CSV row needs, at one instant.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Snapshot {
-    /// \[ns\] simulation time.
-    pub t_sim_ns: u64,
-    /// MRP σ_B/N (|σ| ≤ 1).
-    pub sigma_bn: Vector3<f64>,
-    /// Quaternion of B relative to N, scalar first (see [`crate::attitude::mrp_to_quat`]).
-    pub q_bn: Vector4<f64>,
-    /// [rad/s] ω_B/N, B components.
-    pub omega_bn_b: Vector3<f64>,
-    /// [rad/s²] ω̇_B/N, B components, with the wrench of [`Self::force_b_newton`]/[`Self::torque_b_nm`].
-    pub omega_dot_bn_b: Vector3<f64>,
-    /// \[m\] r_B/N, N components.
-    pub r_bn_n: Vector3<f64>,
-    /// [m/s] v_B/N, N components.
-    pub v_bn_n: Vector3<f64>,
-    /// \[m/s²\] non-gravitational acceleration of point B, N components (\[NB\]·a_B).
-    pub nongrav_accel_bn_n: Vector3<f64>,
-    /// Every effector's states, outputs and flags, in effector order (panel pairs, then
-    /// reaction wheels).
-    pub effectors: Vec<EffectorSnapshot>,
-    /// Conserved quantities (N components).
-    pub conserved: Conserved,
-    /// \[N\] total external force on the hub (schedule + command), B components, applied from
-    /// this instant.
-    pub force_b_newton: Vector3<f64>,
-    /// [N·m] total external torque on the hub (schedule + command), B components.
-    pub torque_b_nm: Vector3<f64>,
-}
-
-/// One effector at one instant.
-#[derive(Debug, Clone, PartialEq)]
-pub struct EffectorSnapshot {
-    /// Its kind (wire tag, CSV prefix).
-    pub kind: EffectorKind,
-    /// Names of `states` ([`crate::dynamics::StateEffector::state_names`]).
-    pub state_names: &'static [&'static str],
-    /// Names of `outputs` ([`crate::dynamics::StateEffector::output_names`]).
-    pub output_names: &'static [&'static str],
-    /// Its integrated states.
-    pub states: Vec<f64>,
-    /// Its outputs, named by [`crate::dynamics::StateEffector::output_names`].
-    pub outputs: Vec<f64>,
-    /// Its kind's status flags (e.g. `flexdyn_proto::wheel_flags`).
-    pub flags: u32,
-}
-
-impl Snapshot {
-    /// An all-zero snapshot shaped for `sim`'s effectors, to be filled by
-    /// [`Simulation::snapshot_into`] without allocating.
-    pub fn for_simulation(sim: &Simulation) -> Self {
-        let mut s = Self::empty();
-        s.shape_for(sim.spacecraft());
-        s
-    }
-
-    /// Makes `effectors` match the spacecraft's layout (allocates only when it does not yet).
-    fn shape_for(&mut self, sc: &Spacecraft) {
-        let fits = self.effectors.len() == sc.effectors().len()
-            && self
-                .effectors
-                .iter()
-                .zip(sc.effectors())
-                .all(|(s, e)| s.kind == e.kind());
-        if !fits {
-            self.effectors = sc
-                .effectors()
-                .iter()
-                .map(|e| EffectorSnapshot {
-                    kind: e.kind(),
-                    state_names: e.state_names(),
-                    output_names: e.output_names(),
-                    states: Vec::with_capacity(e.state_len()),
-                    outputs: vec![0.0; e.output_names().len()],
-                    flags: 0,
-                })
-                .collect();
-        }
-    }
-
-    /// An all-zero snapshot with no effectors.
-    fn empty() -> Self {
-        let z = Vector3::zeros();
-        Self {
-            t_sim_ns: 0,
-            sigma_bn: z,
-            q_bn: Vector4::new(1.0, 0.0, 0.0, 0.0),
-            omega_bn_b: z,
-            omega_dot_bn_b: z,
-            r_bn_n: z,
-            v_bn_n: z,
-            nongrav_accel_bn_n: z,
-            effectors: Vec::new(),
-            conserved: Conserved {
-                orb_energy_j: 0.0,
-                rot_energy_j: 0.0,
-                orb_ang_mom_n: z,
-                rot_ang_mom_c_n: z,
-            },
-            force_b_newton: z,
-            torque_b_nm: z,
-        }
-    }
-
-    /// \[s\] simulation time.
-    pub fn t_s(&self) -> f64 {
-        self.t_sim_ns as f64 / 1e9
-    }
-
-    /// The first non-finite quantity, by its CSV column name (`omega_bn_b_2`, `pair1_theta2`,
-    /// `rw1_omega_rad_s`,
-    /// `rot_energy_j`, …), or `None` if every value is finite. Allocates only when it finds one,
-    /// so it can run once per logged row or frame.
-    pub fn first_non_finite(&self) -> Option<String> {
-        let vectors: [(&str, &[f64]); 7] = [
-            ("sigma_bn", self.sigma_bn.as_slice()),
-            ("omega_bn_b", self.omega_bn_b.as_slice()),
-            ("omega_dot_bn_b", self.omega_dot_bn_b.as_slice()),
-            ("r_bn_n", self.r_bn_n.as_slice()),
-            ("v_bn_n", self.v_bn_n.as_slice()),
-            ("nongrav_accel_bn_n", self.nongrav_accel_bn_n.as_slice()),
-            ("q_bn", self.q_bn.as_slice()),
-        ];
-        for (name, v) in vectors {
-            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-                return Some(format!("{name}_{}", i + 1));
-            }
-        }
-        for (k, e) in self.effectors.iter().enumerate() {
-            let bad_state = e.states.iter().position(|x| !x.is_finite());
-            let bad_output = e.outputs.iter().position(|x| !x.is_finite());
-            let name = match (bad_state, bad_output) {
-                (Some(i), _) => e.state_names[i],
-                (None, Some(i)) => e.output_names[i],
-                (None, None) => continue,
-            };
-            let of_kind = self.effectors[..k]
-                .iter()
-                .filter(|o| o.kind == e.kind)
-                .count();
-            return Some(format!("{}{}_{name}", e.kind.column_prefix, of_kind + 1));
-        }
-        let c = &self.conserved;
-        let scalars = [
-            ("orb_energy_j", c.orb_energy_j),
-            ("rot_energy_j", c.rot_energy_j),
-        ];
-        if let Some((name, _)) = scalars.iter().find(|(_, x)| !x.is_finite()) {
-            return Some((*name).to_string());
-        }
-        for (name, v) in [
-            ("orb_ang_mom_n", &c.orb_ang_mom_n),
-            ("rot_ang_mom_c_n", &c.rot_ang_mom_c_n),
-        ] {
-            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-                return Some(format!("{name}_{}", i + 1));
-            }
-        }
-        None
-    }
 }
 
 impl Simulation {
@@ -403,16 +238,36 @@ impl Simulation {
         }
     }
 
-    /// The current state and outputs (one derivative evaluation, with the wrench that applies
-    /// from now on: schedule(t) + command).
-    pub fn snapshot(&mut self) -> Snapshot {
-        let mut out = Snapshot::for_simulation(self);
-        self.snapshot_into(&mut out);
+    /// The current state as a new record ([`Self::state_into`] into [`Self::blank_state`]).
+    pub fn state_msg(&mut self) -> StateMsg {
+        let mut out = self.blank_state();
+        self.state_into(&mut out);
         out
     }
 
+    /// A state record shaped for this spacecraft: one [`EffectorState`] per effector (its
+    /// kind, zero states and outputs of its lengths), everything else zero, the identity
+    /// attitude. Filling
+    /// it with [`Self::state_into`] allocates nothing.
+    pub fn blank_state(&self) -> StateMsg {
+        StateMsg {
+            effectors: self
+                .sc
+                .effectors()
+                .iter()
+                .map(|e| EffectorState {
+                    kind: e.kind().wire_tag,
+                    flags: 0,
+                    states: vec![0.0; e.state_len()],
+                    outputs: vec![0.0; e.output_names().len()],
+                })
+                .collect(),
+            ..StateMsg::default()
+        }
+    }
+
     /// The hub outputs at the current state with the wrench and inputs that apply from now on:
-    /// one derivative evaluation, shared by the snapshot and every sensor until the state, the
+    /// one derivative evaluation, shared by the state record and every sensor until the state, the
     /// wrench or the inputs change.
     fn frame_outputs(&mut self) -> HubOutputs {
         if let Some(o) = self.frame_outputs {
@@ -424,39 +279,52 @@ impl Simulation {
         o
     }
 
-    /// Like [`Self::snapshot`], reusing `out` (shaped on first use; after that this allocates
-    /// nothing).
-    pub fn snapshot_into(&mut self, out: &mut Snapshot) {
-        out.shape_for(&self.sc);
+    /// Writes the current state into `out`, the one state record of flexdyn: the wire
+    /// `StateMsg` that the server publishes and that `simulate` writes as a CSV row. One
+    /// derivative evaluation, with the wrench and inputs that apply from now on (schedules +
+    /// command), gives ω̇ and the non-gravitational acceleration. Sets `header.sim_time_ns`
+    /// and every physical field; the rest of the header, `wrench_applied` and `command_flags`
+    /// are the caller's (the server's command bookkeeping). Allocates nothing once `out` has
+    /// this spacecraft's shape ([`Self::blank_state`], or a first call).
+    pub fn state_into(&mut self, out: &mut StateMsg) {
         let hub = self.frame_outputs();
         self.sc
             .effector_outputs(&mut self.outputs_scratch, &mut self.flags_scratch);
         let state = self.sc.state();
         let dcm_nb = mrp_to_dcm(&state.sigma_bn).transpose();
-        out.t_sim_ns = self.sc.t_sim_ns();
-        out.sigma_bn = state.sigma_bn;
-        out.q_bn = mrp_to_quat(&state.sigma_bn);
-        out.omega_bn_b = state.omega_bn_b;
-        out.omega_dot_bn_b = hub.omega_dot_bn_b;
-        out.r_bn_n = state.r_bn_n;
-        out.v_bn_n = state.v_bn_n;
-        out.nongrav_accel_bn_n = dcm_nb * hub.nongrav_accel_bn_b;
+        out.header.sim_time_ns = self.sc.t_sim_ns();
+        out.sigma_bn = state.sigma_bn.into();
+        out.q_bn = mrp_to_quat(&state.sigma_bn).into();
+        out.omega_bn_b_rad_s = state.omega_bn_b.into();
+        out.omega_dot_bn_b_rad_s2 = hub.omega_dot_bn_b.into();
+        out.r_bn_n_m = state.r_bn_n.into();
+        out.v_bn_n_m_s = state.v_bn_n.into();
+        out.nongrav_accel_bn_n_m_s2 = (dcm_nb * hub.nongrav_accel_bn_b).into();
+        let effectors = self.sc.effectors();
+        out.effectors
+            .resize_with(effectors.len(), EffectorState::default);
         let ranges = self
             .sc
             .effector_ranges()
             .iter()
             .zip(self.sc.effector_output_ranges())
             .zip(&self.flags_scratch);
-        for (e, ((r, o), flags)) in out.effectors.iter_mut().zip(ranges) {
-            e.states.clear();
-            e.states.extend_from_slice(&state.effectors[r.clone()]);
-            e.outputs.copy_from_slice(&self.outputs_scratch[o.clone()]);
-            e.flags = *flags;
+        for ((o, e), ((r, or), flags)) in out.effectors.iter_mut().zip(effectors).zip(ranges) {
+            o.kind = e.kind().wire_tag;
+            o.flags = *flags;
+            o.states.clear();
+            o.states.extend_from_slice(&state.effectors[r.clone()]);
+            o.outputs.clear();
+            o.outputs
+                .extend_from_slice(&self.outputs_scratch[or.clone()]);
         }
-        out.conserved = self.sc.conserved();
-        let w = self.sc.wrench();
-        out.force_b_newton = w.force_b_newton;
-        out.torque_b_nm = w.torque_b_nm;
+        let c = self.sc.conserved();
+        out.conserved = flexdyn_proto::Conserved {
+            orb_energy_j: c.orb_energy_j,
+            rot_energy_j: c.rot_energy_j,
+            orb_ang_mom_n: c.orb_ang_mom_n.into(),
+            rot_ang_mom_c_n: c.rot_ang_mom_c_n.into(),
+        };
     }
 
     /// The IMU names in config order (topic `flexdyn/<sc-id>/tlm/imu/<name>`).
@@ -494,7 +362,7 @@ impl Simulation {
     /// nothing). Then starts the next interval here.
     ///
     /// Truth (see [`crate::sensors::imu`]): rate and specific force at the current state, with the
-    /// wrench that applies from now on (schedule(t) + command, as in [`Self::snapshot_into`]);
+    /// wrench that applies from now on (schedule(t) + command, as in [`Self::state_into`]);
     /// Δθ from σ_B/N at the interval's start and now; Δv from the RK4 accumulators, which are
     /// then reset. Each IMU's error model is stepped with dt = the interval's length (0 for the
     /// first call at t = 0, whose Δθ and Δv are exactly zero).
@@ -540,6 +408,7 @@ impl Simulation {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::{Vector3, Vector4};
 
     #[test]
     fn schedule_plus_command() {
@@ -554,17 +423,22 @@ mod tests {
             force_b_newton: Vector3::new(0.0, 3.0, 0.0),
             torque_b_nm: Vector3::zeros(),
         });
-        let s = sim.snapshot();
-        assert_eq!(s.force_b_newton, Vector3::new(0.0, 3.0, 0.0));
+        // The wrench that applies from each instant on, as the state record sees it.
+        let applied = |sim: &mut Simulation| {
+            let s = sim.state_msg();
+            (s.header.sim_time_ns, sim.spacecraft().wrench())
+        };
+        let (_, w) = applied(&mut sim);
+        assert_eq!(w.force_b_newton, Vector3::new(0.0, 3.0, 0.0));
         sim.step_n(2);
-        let s = sim.snapshot();
-        assert_eq!(s.t_sim_ns, 2_000_000);
-        assert_eq!(s.force_b_newton, Vector3::new(1.0, 3.0, 0.0));
-        assert_eq!(s.torque_b_nm, Vector3::new(0.0, 0.0, 2.0));
+        let (t, w) = applied(&mut sim);
+        assert_eq!(t, 2_000_000);
+        assert_eq!(w.force_b_newton, Vector3::new(1.0, 3.0, 0.0));
+        assert_eq!(w.torque_b_nm, Vector3::new(0.0, 0.0, 2.0));
         sim.step_n(2);
-        let s = sim.snapshot();
-        assert_eq!(s.force_b_newton, Vector3::new(0.0, 3.0, 0.0));
-        assert_eq!(s.effectors.len(), 2);
+        let (_, w) = applied(&mut sim);
+        assert_eq!(w.force_b_newton, Vector3::new(0.0, 3.0, 0.0));
+        assert_eq!(sim.state_msg().effectors.len(), 2);
     }
 
     #[test]
@@ -573,9 +447,10 @@ mod tests {
         assert_eq!(sim.steps_per_frame(), 10);
         sim.step_frame();
         assert_eq!(sim.t_sim_ns(), sim.frame_ns());
-        let mut snap = Snapshot::for_simulation(&sim);
-        sim.snapshot_into(&mut snap);
-        assert_eq!(snap.t_sim_ns, 10_000_000);
-        assert!((snap.q_bn.norm() - 1.0).abs() < 1e-12);
+        let mut state = sim.blank_state();
+        sim.state_into(&mut state);
+        assert_eq!(state.header.sim_time_ns, 10_000_000);
+        let q = Vector4::from(state.q_bn);
+        assert!((q.norm() - 1.0).abs() < 1e-12);
     }
 }

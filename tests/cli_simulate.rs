@@ -30,20 +30,44 @@ fn scratch(name: &str) -> PathBuf {
     dir.join(name)
 }
 
+/// The documented columns of the reference spacecraft (README, "CSV output"), written out.
 fn expected_header() -> Vec<String> {
-    let mut h = vec!["t_s".to_string()];
-    for base in ["sigma_bn", "omega_bn_b", "r_bn_n", "v_bn_n"] {
-        h.extend((1..=3).map(|i| format!("{base}_{i}")));
+    let mut h: Vec<String> = [
+        "t_s",
+        "protocol_version",
+        "spacecraft_id",
+        "tick",
+        "sim_time_ns",
+        "seq",
+    ]
+    .map(String::from)
+    .to_vec();
+    let v3 = |h: &mut Vec<String>, base: &str| h.extend((1..=3).map(|i| format!("{base}_{i}")));
+    v3(&mut h, "sigma_bn");
+    h.extend((0..=3).map(|i| format!("q_bn_{i}")));
+    for base in [
+        "omega_bn_b_rad_s",
+        "omega_dot_bn_b_rad_s2",
+        "r_bn_n_m",
+        "v_bn_n_m_s",
+        "nongrav_accel_bn_n_m_s2",
+    ] {
+        v3(&mut h, base);
     }
+    h.push("conserved_orb_energy_j".into());
+    h.push("conserved_rot_energy_j".into());
+    v3(&mut h, "conserved_orb_ang_mom_n");
+    v3(&mut h, "conserved_rot_ang_mom_c_n");
+    v3(&mut h, "wrench_applied_torque_b_nm");
+    v3(&mut h, "wrench_applied_force_b_newton");
+    h.push("command_flags".into());
     for k in 1..=2 {
-        for c in ["theta1", "theta1_dot", "theta2", "theta2_dot"] {
+        for c in ["theta1", "theta1_dot", "theta2", "theta2_dot", "flags"] {
             h.push(format!("pair{k}_{c}"));
         }
     }
-    h.push("orb_energy_j".into());
-    h.push("rot_energy_j".into());
-    h.extend((1..=3).map(|i| format!("orb_ang_mom_n_{i}")));
-    h.extend((1..=3).map(|i| format!("rot_ang_mom_c_n_{i}")));
+    v3(&mut h, "wrench_schedule_torque_b_nm");
+    v3(&mut h, "wrench_schedule_force_b_newton");
     h
 }
 
@@ -122,9 +146,14 @@ fn simulate_writes_the_documented_csv() {
     // t = 0.03 s prints as such, not as 2.9999999999999999e-2.
     assert_eq!(rows[3][0], "0.03");
     // Row 0 is the configured initial state.
-    assert_eq!(rows[0][4].parse::<f64>().unwrap(), 0.05); // omega_bn_b_1
-    assert_eq!(rows[0][13].parse::<f64>().unwrap(), 0.08726646259971647); // pair1_theta1
-                                                                          // Exactly one stderr line: the summary.
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows[0][col("omega_bn_b_rad_s_1")], "0.05");
+    assert_eq!(rows[0][col("pair1_theta1")], "0.08726646259971647");
+    // Row k is tick k (a row per 100 Hz frame here), numbered by seq.
+    assert_eq!(rows[7][col("tick")], "7");
+    assert_eq!(rows[7][col("seq")], "7");
+    assert_eq!(rows[7][col("sim_time_ns")], "70000000");
+    // Exactly one stderr line: the summary.
     assert_eq!(err.lines().count(), 1, "stderr: {err}");
     assert_summary_line(&err);
 }
@@ -161,7 +190,8 @@ fn simulate_with_a_config_file() {
     assert!(out.status.success(), "{}", stderr(&out));
     let text = stdout(&out);
     let header = text.lines().next().unwrap();
-    assert_eq!(header.split(',').count(), 1 + 12 + 8 * 4 + 2 + 6);
+    // The reference's columns with 8 pairs of 5 instead of 2.
+    assert_eq!(header.split(',').count(), expected_header().len() + 6 * 5);
     assert!(header.contains("pair8_theta2_dot"));
     assert_eq!(text.lines().count(), 1 + 3);
 }

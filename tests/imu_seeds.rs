@@ -94,11 +94,12 @@ fn simulate_reproduces_the_lockstep_stream_bit_for_bit() {
     let (header, rows) = csv_imu_columns(&text);
     let mut expected_header = Vec::new();
     for name in ["hub", "bracket"] {
-        for q in ["omega_p", "accel_p", "dtheta_p", "dv_p"] {
+        for q in ["omega_p_rad_s", "accel_p_m_s2", "dtheta_p_rad", "dv_p_m_s"] {
             for i in 1..=3 {
                 expected_header.push(format!("imu_{name}_{q}_{i}"));
             }
         }
+        expected_header.push(format!("imu_{name}_saturation_flags"));
     }
     assert_eq!(header, expected_header);
     assert_eq!(rows.len(), 101);
@@ -117,13 +118,14 @@ fn simulate_reproduces_the_lockstep_stream_bit_for_bit() {
                 [s.omega_p_rad_s, s.accel_p_m_s2, s.dtheta_p_rad, s.dv_p_m_s]
                     .into_iter()
                     .flat_map(|v| v.iter().copied().collect::<Vec<_>>())
+                    .chain([f64::from(s.saturation_flags)])
             })
             .collect();
         assert_eq!(row, &lockstep, "row {k}");
         if k == 0 {
             // Δθ and Δv are zero in the first row (an empty interval), noise and bias included.
             for imu in 0..2 {
-                assert!(row[imu * 12 + 6..imu * 12 + 12].iter().all(|v| *v == 0.0));
+                assert!(row[imu * 13 + 6..imu * 13 + 12].iter().all(|v| *v == 0.0));
             }
         } else {
             assert!(row[6..9].iter().all(|v| *v != 0.0));
@@ -143,14 +145,21 @@ fn simulate_with_a_longer_log_interval_integrates_over_it() {
     assert_eq!(text, run(), "simulate is deterministic");
     let (_, rows) = csv_imu_columns(&text);
     assert_eq!(rows.len(), 11);
-    // σ_B/N is in columns 1..=3 of the same rows: the true Δθ over each 0.05 s log interval.
+    // σ_B/N is in the same rows (sigma_bn_1..3): the true Δθ over each 0.05 s log interval.
+    let first = text
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|h| h == "sigma_bn_1")
+        .unwrap();
     let sigma: Vec<Vector3<f64>> = text
         .lines()
         .skip(1)
         .map(|l| {
             let v: Vec<f64> = l
                 .split(',')
-                .skip(1)
+                .skip(first)
                 .take(3)
                 .map(|x| x.parse().unwrap())
                 .collect();
@@ -186,9 +195,11 @@ fn the_binary_writes_the_imu_columns() {
     );
     let text = String::from_utf8(out.stdout).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    assert_eq!(header.len(), 29 + 2 * 12);
-    assert_eq!(header[29], "imu_hub_omega_p_1");
-    assert_eq!(header[52], "imu_bracket_dv_p_3");
+    // The state columns, then 13 per IMU (README, "CSV output").
+    let first = header.iter().position(|h| h.starts_with("imu_")).unwrap();
+    assert_eq!(header.len(), first + 2 * 13);
+    assert_eq!(header[first], "imu_hub_omega_p_rad_s_1");
+    assert_eq!(header[first + 13 + 11], "imu_bracket_dv_p_m_s_3");
     let mut library = Vec::new();
     simulate_to(&tactical(), 0.05, 0.01, &mut library, "buffer").unwrap();
     assert_eq!(text.as_bytes(), library.as_slice());

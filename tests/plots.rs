@@ -1,11 +1,14 @@
 //! `flexdyn plot` from the outside: every figure of a recording and of a `simulate` CSV is a
 //! valid PNG (decoded with the `png` crate), of the documented size, and not blank; figures
 //! the input has no data for are skipped and named; bad input is an error naming the file.
-//!
-//! Port 17381.
+//! What the figures show is checked on their data ([`flexdyn::sinks::plot::figures`]): each
+//! invariant on its own scale, the intervals of external torque, the wheel and star-tracker
+//! figures, the IMU layout, and every point inside its panel's axis bounds.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+use flexdyn::sinks::plot::{draw, figures, register_font, Figure, PlotArgs, COLORS};
 
 fn flexdyn(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_flexdyn"))
@@ -72,7 +75,7 @@ fn a_recording_gives_every_figure() {
     let rec = tmp("batch.mcap");
     let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
         .args(["run", "--mode", "batch", "--duration-s", "5"])
-        .args(["--listen", "tcp/127.0.0.1:17381", "--config"])
+        .args(["--listen", "tcp/127.0.0.1:0", "--config"])
         .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml"))
         .arg("--record")
         .arg(&rec)
@@ -90,7 +93,6 @@ fn a_recording_gives_every_figure() {
     ]);
     let err = String::from_utf8_lossy(&r.stderr);
     assert!(r.status.success(), "{err}");
-    assert!(!err.contains("skipped"), "{err}");
     check_figures(
         &out,
         &[
@@ -99,10 +101,227 @@ fn a_recording_gives_every_figure() {
             "panels.png",
             "wrench.png",
             "conservation.png",
+            "wheels.png",
+            "star_tracker.png",
             "imu.png",
-            "timing.png",
         ],
     );
+    // A batch run is not paced: timing.png is skipped, and the message says why.
+    assert!(
+        err.contains("skipped timing.png: a batch run is not paced by the wall clock"),
+        "{err}"
+    );
+    assert_eq!(err.matches("skipped").count(), 1, "{err}");
+    assert!(!out.join("timing.png").exists());
+
+    let (figs, _) = figures(&args(&rec)).unwrap();
+    check_axis_bounds(&figs);
+    check_drawn_inside_axes(&figs, &out);
+    // wheels_star_tracker.toml: 4 wheels, each with a speed, a torque and a flags line.
+    let wheels = find(&figs, "wheels.png");
+    assert_eq!(wheels.panels.len(), 3);
+    for p in &wheels.panels {
+        let labels: Vec<_> = p.lines.iter().map(|l| l.label.as_str()).collect();
+        assert_eq!(labels.len(), 4, "{labels:?}");
+        assert!(labels[3].ends_with("rw4"), "{labels:?}");
+    }
+    // Limit flags are 0..=3.
+    assert!(wheels.panels[2]
+        .lines
+        .iter()
+        .flat_map(|l| &l.points)
+        .all(|(_, f)| (0.0..=3.0).contains(f)));
+    // The 10 Hz tracker over 5 s: 51 samples of a unit quaternion, and a valid flag.
+    let st = find(&figs, "star_tracker.png");
+    assert_eq!(st.panels.len(), 2);
+    let q = &st.panels[0].lines;
+    assert_eq!(q.len(), 4);
+    assert_eq!(q[0].points.len(), 51);
+    let valid = &st.panels[1].lines[0];
+    assert_eq!(valid.label, "valid (0/1)");
+    assert!(valid.points.iter().all(|(_, v)| *v == 0.0 || *v == 1.0));
+    let mut n_valid = 0;
+    for k in 0..51 {
+        if valid.points[k].1 == 1.0 {
+            n_valid += 1;
+            let n2: f64 = q.iter().map(|l| l.points[k].1.powi(2)).sum();
+            assert!((n2 - 1.0).abs() < 1e-9, "|q|² = {n2} at sample {k}");
+        }
+    }
+    assert!(n_valid > 0);
+}
+
+fn args(input: &Path) -> PlotArgs {
+    PlotArgs {
+        input: input.to_owned(),
+        output: PathBuf::new(),
+        sc_id: None,
+        sigma_rn: None,
+    }
+}
+
+fn find<'a>(figs: &'a [Figure], name: &str) -> &'a Figure {
+    figs.iter()
+        .find(|f| f.name == name)
+        .unwrap_or_else(|| panic!("no {name}"))
+}
+
+/// Every drawn point of every panel is inside the panel's axes.
+fn check_axis_bounds(figs: &[Figure]) {
+    for f in figs {
+        for (i, p) in f.panels.iter().enumerate() {
+            let ((t0, t1), (lo, hi)) = (p.t_range(), p.y_range());
+            assert!(lo < hi && t0 < t1, "{} panel {i}", f.name);
+            for l in &p.lines {
+                for (t, y) in &l.points {
+                    let drawn = !p.log_y || *y > 0.0;
+                    assert!(
+                        !drawn || ((t0..=t1).contains(t) && (lo..=hi).contains(y)),
+                        "{} panel {i} {}: ({t}, {y}) outside [{t0}, {t1}] × [{lo}, {hi}]",
+                        f.name,
+                        l.label
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Draws each figure into `dir` and counts the pixels of a line colour outside every panel's
+/// plotting area (grown by 2 px for the stroke): lines must stay inside their axes.
+fn check_drawn_inside_axes(figs: &[Figure], dir: &Path) {
+    register_font().unwrap();
+    for f in figs {
+        let path = dir.join(format!("drawn_{}", f.name));
+        let areas = draw(&path, f).unwrap();
+        assert_eq!(areas.len(), f.panels.len());
+        let decoder = png::Decoder::new(std::fs::File::open(&path).unwrap());
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        let bpp = info.line_size / info.width as usize;
+        let colours: Vec<[u8; 3]> = COLORS.iter().map(|c| [c.0, c.1, c.2]).collect();
+        let mut outside = Vec::new();
+        for (i, p) in buf[..info.buffer_size()].chunks(bpp).enumerate() {
+            if !colours.iter().any(|c| p[..3] == c[..]) {
+                continue;
+            }
+            let (x, y) = (
+                (i as u32 % info.width) as i32,
+                (i as u32 / info.width) as i32,
+            );
+            let inside = areas.iter().any(|(xs, ys)| {
+                (xs.start - 2..xs.end + 2).contains(&x) && (ys.start - 2..ys.end + 2).contains(&y)
+            });
+            if !inside {
+                outside.push((x, y));
+            }
+        }
+        assert!(
+            outside.is_empty(),
+            "{}: {} line pixels outside the axes, e.g. {:?}",
+            f.name,
+            outside.len(),
+            &outside[..outside.len().min(5)]
+        );
+    }
+}
+
+/// Simulates `config` with `extra` appended, and returns the CSV's path.
+fn simulate(name: &str, config: &str, extra: &str, duration_s: &str, log_s: &str) -> PathBuf {
+    let dir = tmp(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let base = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(config)).unwrap();
+    let cfg = dir.join("run.toml");
+    std::fs::write(&cfg, format!("{base}\n{extra}")).unwrap();
+    let csv = dir.join("run.csv");
+    let r = flexdyn(&[
+        "simulate",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--duration-s",
+        duration_s,
+        "--log-every-s",
+        log_s,
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    csv
+}
+
+#[test]
+fn conservation_shows_each_invariant_on_its_own_scale_and_marks_external_torque() {
+    // The reference spacecraft in orbit, a 1 N·m torque about z from 2 s to 4 s. A torque
+    // changes the rotational angular momentum about C by up to |τ|·2 s = 2 N·m·s, and leaves
+    // the CoM's orbit (the orbital momentum m r_C × v_C) alone; the sum of the two is
+    // dominated by the orbit (~1e13 kg·m²/s), where the change would be invisible (~1e-13).
+    let csv = simulate(
+        "torque",
+        "scenarios/reference.toml",
+        "[[wrench_schedule]]\nt_s = 2.0\nforce_b_newton = [0.0, 0.0, 0.0]\ntorque_b_nm = [0.0, 0.0, 1.0]\n\n\
+         [[wrench_schedule]]\nt_s = 4.0\nforce_b_newton = [0.0, 0.0, 0.0]\ntorque_b_nm = [0.0, 0.0, 0.0]\n",
+        "6",
+        "0.05",
+    );
+    let (figs, _) = figures(&args(&csv)).unwrap();
+    check_axis_bounds(&figs);
+    let c = find(&figs, "conservation.png");
+    assert_eq!(c.panels.len(), 2);
+    let h = &c.panels[1];
+    assert!(h.log_y && h.y_label.contains("H"), "{}", h.y_label);
+    let line = |label: &str| {
+        h.lines
+            .iter()
+            .find(|l| l.label.starts_with(label))
+            .unwrap_or_else(|| panic!("no {label} line"))
+    };
+    let max_after = |label: &str, t_min: f64, t_max: f64| {
+        line(label)
+            .points
+            .iter()
+            .filter(|(t, _)| (t_min..=t_max).contains(t))
+            .fold(0.0_f64, |m, (_, y)| m.max(*y))
+    };
+    // Before the torque: everything conserved to integration accuracy.
+    assert!(max_after("rotational H", 0.0, 2.0) < 1e-9);
+    // After: the rotational momentum changed by a visible fraction of its own scale.
+    let rot = max_after("rotational H", 4.0, 6.0);
+    assert!(rot > 1e-3 && rot <= 2.0, "rotational H change {rot}");
+    // The orbital momentum did not (the torque does not move the CoM).
+    assert!(max_after("orbital H", 0.0, 6.0) < 1e-9);
+    // The shading: exactly the torque's interval, to within a log interval.
+    assert_eq!(h.spans.len(), 1, "{:?}", h.spans);
+    let (a, b) = h.spans[0];
+    assert!(
+        (a - 2.0).abs() < 1e-9 && (b - 4.0).abs() < 0.05 + 1e-9,
+        "{a}..{b}"
+    );
+    assert_eq!(h.spans, c.panels[0].spans);
+}
+
+#[test]
+fn imu_figure_gives_each_imu_its_own_column() {
+    // Two IMUs stacked in four rows left each panel too short for its labels, which ran over
+    // the neighbouring panels. Now one column per IMU, two rows.
+    let csv = simulate("imus", "scenarios/imu_tactical.toml", "", "20", "0.01");
+    let (figs, _) = figures(&args(&csv)).unwrap();
+    check_axis_bounds(&figs);
+    // Drawn: the noisy specific force of 2001 samples per panel stays inside its axes (a 2 px
+    // polyline's mitred joins reached up to 60 px past them).
+    check_drawn_inside_axes(&figs, csv.parent().unwrap());
+    let imu = find(&figs, "imu.png");
+    assert_eq!(imu.columns, 2);
+    assert_eq!(imu.panels.len(), 4);
+    // Row-major: row 1 the rates of both IMUs, row 2 their specific forces.
+    let captions: Vec<_> = imu
+        .panels
+        .iter()
+        .map(|p| p.caption.clone().unwrap())
+        .collect();
+    assert_eq!(captions[0], captions[2]);
+    assert_ne!(captions[0], captions[1]);
+    assert!(imu.panels[0].y_label.contains("rad/s") && imu.panels[3].y_label.contains("m/s²"));
 }
 
 #[test]
@@ -129,10 +348,11 @@ fn a_simulate_csv_gives_the_state_figures_and_names_the_rest() {
             "attitude.png",
             "rates.png",
             "panels.png",
+            "wrench.png",
             "conservation.png",
         ],
     );
-    for skipped in ["wrench.png", "imu.png", "timing.png"] {
+    for skipped in ["wheels.png", "star_tracker.png", "imu.png", "timing.png"] {
         assert!(err.contains(&format!("skipped {skipped}")), "{err}");
         assert!(!dir.join(skipped).exists());
     }

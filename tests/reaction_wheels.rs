@@ -144,7 +144,7 @@ fn torque_and_speed_limits_clip_and_flag() {
     let cfg = rigid_hub(&z_wheel("max_torque_nm = 0.2\nmax_speed_rad_s = 50.0"));
     let mut sim = Simulation::new(&cfg).unwrap();
     sim.set_effector_inputs(&[0.5]).unwrap();
-    let s = sim.snapshot();
+    let s = sim.state_msg();
     let rw = &s.effectors[0];
     assert_eq!(rw.outputs[0], 0.2, "torque clipped to the limit");
     assert_eq!(rw.flags, wheel_flags::TORQUE_LIMITED);
@@ -157,7 +157,7 @@ fn torque_and_speed_limits_clip_and_flag() {
         }
     }
     let omega = wheel_omega(&sim, 0);
-    let s = sim.snapshot();
+    let s = sim.state_msg();
     let rw = &s.effectors[0];
     eprintln!("speed limit: Omega {omega} after 15 s, reached at step {first_limited:?}");
     // Held at the limit: it overshoots by at most one step's increment, u h / J_eff = 4e-3.
@@ -174,7 +174,7 @@ fn torque_and_speed_limits_clip_and_flag() {
     );
     // A torque that slows the wheel applies at once.
     sim.set_effector_inputs(&[-0.1]).unwrap();
-    let s = sim.snapshot();
+    let s = sim.state_msg();
     assert_eq!(s.effectors[0].outputs[0], -0.1);
     assert_eq!(s.effectors[0].flags, 0);
 }
@@ -186,7 +186,7 @@ fn viscous_friction_spins_down_exponentially() {
         "max_torque_nm = 1.0\nmax_speed_rad_s = 1000.0\nomega_rad_s = 100.0\nviscous_friction_nm_s_rad = {b:?}"
     )));
     let mut sim = Simulation::new(&cfg).unwrap();
-    let s = sim.snapshot();
+    let s = sim.state_msg();
     assert_eq!(s.effectors[0].outputs[1], -b * 100.0, "friction output");
     sim.step_n(10_000);
     let omega = wheel_omega(&sim, 0);

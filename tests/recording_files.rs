@@ -145,7 +145,8 @@ fn python_mcap_reads_every_channel_of_a_server_recording() {
     for (row, st) in rows.iter().zip(&states) {
         assert_eq!(
             row[c_t].parse::<f64>().unwrap(),
-            st.header.sim_time_ns as f64 * 1e-9
+            st.header.sim_time_ns as f64 / 1e9,
+            "t_s is sim_time_ns / 1e9 (README, \"CSV output\")"
         );
         assert_eq!(row[c_s2].parse::<f64>().unwrap(), st.sigma_bn[1]);
         assert_eq!(row[c_rw].parse::<f64>().unwrap(), st.effectors[5].states[0]);

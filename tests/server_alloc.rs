@@ -15,7 +15,7 @@ use flexdyn::config::SimConfig;
 use flexdyn::server::physics::Stepper;
 use flexdyn::server::shared::Frame;
 use flexdyn::server::ServerSettings;
-use flexdyn::sim::{Simulation, Snapshot};
+use flexdyn::sim::Simulation;
 use flexdyn_proto::{CommandMsg, EffectorInput, Header};
 
 #[global_allocator]
@@ -30,7 +30,7 @@ fn the_frame_path_does_not_allocate() {
     let sim = Simulation::new(&cfg).unwrap();
     assert!(sim.n_imus() > 0);
     assert!(!sim.star_trackers().is_empty());
-    let snap = Snapshot::for_simulation(&sim);
+    let shape = sim.blank_state();
     let (n_imus, n_sts) = (sim.n_imus(), sim.star_trackers().len());
     let settings = ServerSettings {
         participants: vec![1, 2],
@@ -42,7 +42,7 @@ fn the_frame_path_does_not_allocate() {
     let (full_tx, full_rx) = sync_channel::<Box<Frame>>(2);
     for _ in 0..2 {
         free_tx
-            .send(Box::new(Frame::for_snapshot(&snap, n_imus, n_sts)))
+            .send(Box::new(Frame::for_state(&shape, n_imus, n_sts)))
             .unwrap();
     }
     // Sender 2 commands the four wheels (effectors 2–5). Its Actuators commands own heap
@@ -91,7 +91,7 @@ fn the_frame_path_does_not_allocate() {
     assert_eq!(violation_count(), 0, "the frame path allocated");
     // The wheels were commanded (torques 0.01–0.04 N·m held), and the recycled commands are
     // freed here, on the "I/O side".
-    let s = w.sim.snapshot();
+    let s = w.sim.state_msg();
     assert_eq!(s.effectors[3].outputs[0], 0.02);
     assert_eq!(recycle_rx.try_iter().count(), 400);
 }

@@ -309,6 +309,12 @@ impl Plan {
             "controller": c.controller,
             "dispersed_keys": self.keys.iter().flatten().collect::<Vec<_>>(),
             "criteria": c.criteria.iter().map(|k| k.name.clone()).collect::<Vec<_>>(),
+            // The figures' axes: each criterion's unit and pass threshold (value < below).
+            "criterion_axes": c.criteria.iter().map(|k| serde_json::json!({
+                "name": k.name,
+                "unit": k.unit(),
+                "below": k.below,
+            })).collect::<Vec<_>>(),
             "run_plans": runs,
         })
     }

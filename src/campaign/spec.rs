@@ -110,6 +110,19 @@ pub struct Criterion {
     pub below: f64,
 }
 
+impl Criterion {
+    /// The unit of the criterion's value (its figures' axis): seconds for a settling time,
+    /// else the quantity's (`–` for an MRP norm).
+    pub fn unit(&self) -> &'static str {
+        match (self.statistic, self.quantity) {
+            (Statistic::SettlingTime { .. }, _) => "s",
+            (_, Quantity::Omega) => "rad/s",
+            (_, Quantity::Theta) => "rad",
+            (_, Quantity::SigmaBr | Quantity::SigmaBn) => "–",
+        }
+    }
+}
+
 /// A validated campaign.
 #[derive(Clone, Debug)]
 pub struct Campaign {

@@ -2,6 +2,7 @@
 //! its Wilson score interval, the worst runs per criterion, the runs that are missing or failed
 //! (by index, to rerun with `--index`), and histograms and scatter plots.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -65,6 +66,7 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
         .map_err(|e| io(&manifest_path, format!("dispersed_keys: {e}")))?;
     let criteria: Vec<String> = serde_json::from_value(manifest["criteria"].clone())
         .map_err(|e| io(&manifest_path, format!("criteria: {e}")))?;
+    let axes = criterion_axes(&manifest);
     let mut s = Summary {
         planned: plans.len() as u32,
         ..Summary::default()
@@ -180,15 +182,48 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
     let text_path = dir.join("summary.txt");
     std::fs::write(&text_path, &t).map_err(|e| io(&text_path, e))?;
     s.text = t;
-    s.figures = figures(dir, &results, &keys, &criteria)?;
+    s.figures = figures(dir, &results, &keys, &criteria, &axes)?;
     Ok(s)
 }
+
+/// A criterion's axis on the campaign figures: its unit and its pass threshold (a run passes
+/// when the value is below it).
+#[derive(Clone, Debug, PartialEq)]
+struct Axis {
+    unit: String,
+    below: Option<f64>,
+}
+
+/// The manifest's `criterion_axes` by criterion name (empty for a manifest written before
+/// they were recorded: the figures then have no unit or threshold line).
+fn criterion_axes(manifest: &serde_json::Value) -> BTreeMap<String, Axis> {
+    let Some(list) = manifest["criterion_axes"].as_array() else {
+        return BTreeMap::new();
+    };
+    list.iter()
+        .filter_map(|a| {
+            Some((
+                a["name"].as_str()?.to_owned(),
+                Axis {
+                    unit: a["unit"].as_str().unwrap_or("–").to_owned(),
+                    below: a["below"].as_f64().filter(|b| b.is_finite()),
+                },
+            ))
+        })
+        .collect()
+}
+
+/// The colour of a criterion's threshold line (and of nothing else on a campaign figure).
+pub const THRESHOLD_RGB: RGBColor = RGBColor(255, 0, 0);
+/// The colour of a failed run's point on a scatter figure.
+const FAILED_RGB: RGBColor = RGBColor(255, 127, 14);
 
 fn figures(
     dir: &Path,
     results: &[RunResult],
     keys: &[String],
     criteria: &[String],
+    axes: &BTreeMap<String, Axis>,
 ) -> Result<Vec<PathBuf>, String> {
     crate::sinks::plot::register_font().map_err(|e| e.to_string())?;
     let fig_dir = dir.join("figures");
@@ -209,10 +244,19 @@ fn figures(
         if values.is_empty() {
             continue;
         }
+        let axis = axes.get(c);
+        let threshold = axis.and_then(|a| a.below);
+        let label = match axis {
+            Some(a) => format!("{c} ({})", a.unit),
+            None => c.clone(),
+        };
+        // The range holds every value and the threshold, so its line is on the figure.
         let (lo, hi) = values
             .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (v, _, _)| {
-                (a.min(*v), b.max(*v))
+            .map(|(v, _, _)| *v)
+            .chain(threshold)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
             });
         let (lo, hi) = if hi > lo {
             (lo, hi)
@@ -246,7 +290,10 @@ fn figures(
                 .map_err(|e| io(&path, e))?;
             chart
                 .configure_mesh()
-                .x_desc(format!("{c} (value of the criterion's statistic)"))
+                .x_desc(match threshold {
+                    Some(b) => format!("{label}; red: the pass threshold, value < {b}"),
+                    None => label.clone(),
+                })
                 .y_desc("runs")
                 .label_style((font, 16))
                 .draw()
@@ -257,6 +304,14 @@ fn figures(
                     Rectangle::new([(x0, 0), (x0 + width, *n)], BLUE.mix(0.6).filled())
                 }))
                 .map_err(|e| io(&path, e))?;
+            if let Some(b) = threshold {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        vec![(b, 0), (b, max + 1)],
+                        THRESHOLD_RGB.stroke_width(3),
+                    )))
+                    .map_err(|e| io(&path, e))?;
+            }
             root.present().map_err(|e| io(&path, e))?;
         }
         out.push(path);
@@ -284,7 +339,10 @@ fn figures(
                 let root = BitMapBackend::new(&path, (900, 600)).into_drawing_area();
                 root.fill(&WHITE).map_err(|e| io(&path, e))?;
                 let mut chart = ChartBuilder::on(&root)
-                    .caption(format!("{c} against {k} (red: failed)"), (font, 22))
+                    .caption(
+                        format!("{c} against {k} (orange: failed; red line: threshold)"),
+                        (font, 22),
+                    )
                     .margin(15)
                     .x_label_area_size(45)
                     .y_label_area_size(80)
@@ -293,13 +351,22 @@ fn figures(
                 chart
                     .configure_mesh()
                     .x_desc(k.as_str())
-                    .y_desc(c.as_str())
+                    .y_desc(label.as_str())
                     .label_style((font, 16))
                     .draw()
                     .map_err(|e| io(&path, e))?;
+                if let Some(b) = threshold {
+                    chart
+                        .draw_series(std::iter::once(PathElement::new(
+                            vec![(xl - pad, b), (xh + pad, b)],
+                            THRESHOLD_RGB.stroke_width(3),
+                        )))
+                        .map_err(|e| io(&path, e))?;
+                }
                 chart
                     .draw_series(pts.iter().map(|(x, y, p)| {
-                        Circle::new((*x, *y), 5, if *p { BLUE.filled() } else { RED.filled() })
+                        let colour = if *p { BLUE } else { FAILED_RGB };
+                        Circle::new((*x, *y), 5, colour.filled())
                     }))
                     .map_err(|e| io(&path, e))?;
                 root.present().map_err(|e| io(&path, e))?;
@@ -325,6 +392,96 @@ fn sanitize(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Pixels of `rgb` in a PNG.
+    fn pixels_of(path: &Path, rgb: RGBColor) -> usize {
+        let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        let bpp = info.line_size / info.width as usize;
+        buf[..info.buffer_size()]
+            .chunks(bpp)
+            .filter(|p| p[..3] == [rgb.0, rgb.1, rgb.2])
+            .count()
+    }
+
+    #[test]
+    fn campaign_figures_carry_the_unit_and_the_threshold_line() {
+        // Three runs of a settling-time criterion (s) that passes below 5 s: 2 s and 4 s pass,
+        // 7 s fails. The histogram has a vertical red line at 5 s and the scatter a horizontal
+        // one; a manifest without criterion_axes (older) gets neither.
+        let dir = std::env::temp_dir().join(format!("flexdyn-summary-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let plans: Vec<serde_json::Value> = (0..3)
+            .map(|r| {
+                serde_json::json!({"run": r, "dir": format!("run-{r:04}"), "run_seed": r,
+                    "sensor_seeds": {}, "redraws": 0, "redraw_reasons": [], "valid": true,
+                    "dispersed": {"hub.mass_kg": 400.0 + 50.0 * r as f64}})
+            })
+            .collect();
+        for (r, settle) in [2.0, 4.0, 7.0].iter().enumerate() {
+            let d = dir.join(format!("run-{r:04}"));
+            std::fs::create_dir_all(&d).unwrap();
+            let result = RunResult {
+                run: r as u32,
+                run_seed: r as u64,
+                sensor_seeds: BTreeMap::new(),
+                redraws: 0,
+                applied: [("hub.mass_kg".to_owned(), 400.0 + 50.0 * r as f64)].into(),
+                state_sha256: String::new(),
+                states: 1,
+                criteria: vec![super::super::execute::CriterionResult {
+                    name: "settle".into(),
+                    value: *settle,
+                    passed: *settle < 5.0,
+                }],
+                passed: *settle < 5.0,
+                status: "ok".into(),
+                controller_exit: None,
+                wall_s: 0.0,
+                sim_s: 10.0,
+            };
+            std::fs::write(
+                d.join("result.json"),
+                serde_json::to_string(&result).unwrap(),
+            )
+            .unwrap();
+        }
+        let manifest = |axes: bool| {
+            let mut m = serde_json::json!({"run_plans": plans, "dispersed_keys": ["hub.mass_kg"],
+                "criteria": ["settle"]});
+            if axes {
+                m["criterion_axes"] =
+                    serde_json::json!([{"name": "settle", "unit": "s", "below": 5.0}]);
+            }
+            std::fs::write(dir.join("manifest.json"), m.to_string()).unwrap();
+        };
+        manifest(true);
+        let s = summarize(&dir).unwrap();
+        assert_eq!(s.figures.len(), 2, "{:?}", s.figures);
+        for f in &s.figures {
+            let red = pixels_of(f, THRESHOLD_RGB);
+            // A 3 px line across the plot area (≥ 400 px high or wide).
+            assert!(red > 1000, "{}: {red} threshold pixels", f.display());
+        }
+        assert_eq!(
+            criterion_axes(
+                &serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap())
+                    .unwrap()
+            )["settle"],
+            Axis {
+                unit: "s".into(),
+                below: Some(5.0)
+            }
+        );
+        manifest(false);
+        let s = summarize(&dir).unwrap();
+        for f in &s.figures {
+            assert_eq!(pixels_of(f, THRESHOLD_RGB), 0, "{}", f.display());
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn wilson_matches_hand_computed_values() {

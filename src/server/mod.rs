@@ -515,9 +515,9 @@ pub async fn run(
     let n_buffers = settings.telemetry_buffers;
     let (free_tx, free_rx) = sync_channel::<Box<Frame>>(n_buffers);
     let (full_tx, full_rx) = sync_channel::<Box<Frame>>(n_buffers);
-    let shape = crate::sim::Snapshot::for_simulation(&sim);
+    let shape = sim.blank_state();
     let (n_imus, n_sts) = (sim.n_imus(), sim.star_trackers().len());
-    let new_frame = || Box::new(Frame::for_snapshot(&shape, n_imus, n_sts));
+    let new_frame = || Box::new(Frame::for_state(&shape, n_imus, n_sts));
     let frame_ns = cfg.frame_ns;
     let stepper = Stepper::new(sim, &settings);
 

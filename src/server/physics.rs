@@ -28,7 +28,7 @@ use std::time::{Duration, Instant};
 
 use crate::transport::unix_now_ns;
 
-use flexdyn_proto::{CommandMsg, Header, Mode, RunState};
+use flexdyn_proto::{CommandMsg, Header, Mode, RunState, StateMsg};
 use nalgebra::Vector3;
 
 use super::commands::{CommandBook, Held, Offer};
@@ -40,7 +40,8 @@ use super::shared::{fill_state, Frame, Shared};
 use crate::dynamics::Wrench;
 use crate::sensors::imu::ImuSample;
 use crate::sensors::star_tracker::StarTrackerSample;
-use crate::sim::{Simulation, Snapshot};
+use crate::sim::Simulation;
+use crate::sinks::table::first_non_finite;
 
 /// Longest single blocking wait, so a stop request is seen quickly.
 const POLL: Duration = Duration::from_millis(50);
@@ -98,7 +99,8 @@ pub struct Stepper {
     pub book: CommandBook,
     /// The command held over the current frame.
     pub held: Held,
-    snap: Snapshot,
+    /// The state record of the last tick filled or checked.
+    state: StateMsg,
     imu: Vec<ImuSample>,
     st: Vec<(usize, StarTrackerSample)>,
     spacecraft_id: u32,
@@ -114,7 +116,7 @@ impl Stepper {
             settings.stale_policy,
             sim.spacecraft().effector_input_ranges(),
         );
-        let snap = Snapshot::for_simulation(&sim);
+        let state = sim.blank_state();
         // IMU samples close their interval every frame, published or not.
         let mut imu = Vec::with_capacity(sim.n_imus());
         let mut st = Vec::with_capacity(sim.star_trackers().len());
@@ -124,7 +126,7 @@ impl Stepper {
             sim,
             book,
             held: Held::initial(settings.stale_policy),
-            snap,
+            state,
             imu,
             st,
             spacecraft_id: settings.spacecraft_id,
@@ -133,9 +135,9 @@ impl Stepper {
 
     /// Fills the telemetry of tick `k` (the sensors were sampled at `k`).
     pub fn fill(&mut self, frame: &mut Frame, k: u64) {
-        self.sim.snapshot_into(&mut self.snap);
-        let header = Header::new(self.spacecraft_id, k, self.snap.t_sim_ns, k);
-        fill_state(&mut frame.state, &self.snap, header, &self.held);
+        self.sim.state_into(&mut self.state);
+        let header = Header::new(self.spacecraft_id, k, self.state.header.sim_time_ns, k);
+        fill_state(&mut frame.state, &self.state, header, &self.held);
         frame.command = self.held.status;
         frame.lateness_ns = 0;
         frame.published = false;
@@ -162,10 +164,10 @@ impl Stepper {
     }
 
     /// Once per frame, outside the RK4 loop: never publish a non-finite state. `filled` says
-    /// whether [`Self::fill`] already took this tick's snapshot.
+    /// whether [`Self::fill`] already took this tick's state.
     pub fn check_finite(&mut self, k: u64, filled: bool) -> Result<(), ServerError> {
         if !filled {
-            self.sim.snapshot_into(&mut self.snap);
+            self.sim.state_into(&mut self.state);
         }
         let imu_bad = self.imu.iter().find_map(|s| s.first_non_finite());
         let imu_bad = imu_bad.map(|q| format!("an IMU's {q} output"));
@@ -174,10 +176,10 @@ impl Stepper {
             .iter()
             .find_map(|(_, s)| s.first_non_finite())
             .map(|q| format!("a star tracker's {q} output"));
-        match self.snap.first_non_finite().or(imu_bad.or(st_bad)) {
+        match first_non_finite(&self.state).or(imu_bad.or(st_bad)) {
             Some(quantity) => Err(ServerError::NonFinite {
                 tick: k,
-                t_s: self.snap.t_s(),
+                t_s: self.state.header.sim_time_ns as f64 * 1e-9,
                 quantity,
             }),
             None => Ok(()),

@@ -35,27 +35,12 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// An empty frame shaped for `snap`'s effectors, with room for `n_imus` IMU samples and
+    /// An empty frame whose state has `shape`'s effector layout (see
+    /// [`crate::sim::Simulation::blank_state`]), with room for `n_imus` IMU samples and
     /// `n_star_trackers` star-tracker samples.
-    pub fn for_snapshot(
-        snap: &crate::sim::Snapshot,
-        n_imus: usize,
-        n_star_trackers: usize,
-    ) -> Self {
+    pub fn for_state(shape: &StateMsg, n_imus: usize, n_star_trackers: usize) -> Self {
         Self {
-            state: StateMsg {
-                effectors: snap
-                    .effectors
-                    .iter()
-                    .map(|e| EffectorState {
-                        kind: e.kind.wire_tag,
-                        flags: 0,
-                        states: Vec::with_capacity(e.state_names.len()),
-                        outputs: Vec::with_capacity(e.output_names.len()),
-                    })
-                    .collect(),
-                ..StateMsg::default()
-            },
+            state: shape.clone(),
             boundary_unix_ns: 0,
             lateness_ns: 0,
             command: Held::initial(flexdyn_proto::StalePolicy::Hold).status,
@@ -66,33 +51,30 @@ impl Frame {
     }
 }
 
-/// Fills `out` from a snapshot without allocating (`out` was shaped by [`Frame::for_snapshot`];
-/// its vectors keep their capacity).
+/// Copies the state record `state` (filled by [`crate::sim::Simulation::state_into`]) into
+/// `out` with the frame's `header` and the command bookkeeping of `held`, without allocating
+/// (`out` has the same effector layout: [`Frame::for_state`]).
 pub fn fill_state(
     out: &mut StateMsg,
-    snap: &crate::sim::Snapshot,
+    state: &StateMsg,
     header: flexdyn_proto::Header,
     held: &Held,
 ) {
-    out.header = header;
-    out.sigma_bn = snap.sigma_bn.into();
-    out.q_bn = snap.q_bn.into();
-    out.omega_bn_b_rad_s = snap.omega_bn_b.into();
-    out.omega_dot_bn_b_rad_s2 = snap.omega_dot_bn_b.into();
-    out.r_bn_n_m = snap.r_bn_n.into();
-    out.v_bn_n_m_s = snap.v_bn_n.into();
-    out.nongrav_accel_bn_n_m_s2 = snap.nongrav_accel_bn_n.into();
-    out.conserved.orb_energy_j = snap.conserved.orb_energy_j;
-    out.conserved.rot_energy_j = snap.conserved.rot_energy_j;
-    out.conserved.orb_ang_mom_n = snap.conserved.orb_ang_mom_n.into();
-    out.conserved.rot_ang_mom_c_n = snap.conserved.rot_ang_mom_c_n.into();
-    out.wrench_applied.torque_b_nm = held.torque_b_nm;
-    out.wrench_applied.force_b_newton = held.force_b_newton;
-    out.command_flags = held.flags;
+    let effectors = std::mem::take(&mut out.effectors);
+    *out = StateMsg {
+        header,
+        wrench_applied: flexdyn_proto::AppliedWrench {
+            torque_b_nm: held.torque_b_nm,
+            force_b_newton: held.force_b_newton,
+        },
+        command_flags: held.flags,
+        effectors,
+        ..*state
+    };
     out.effectors
-        .resize_with(snap.effectors.len(), EffectorState::default);
-    for (o, e) in out.effectors.iter_mut().zip(&snap.effectors) {
-        o.kind = e.kind.wire_tag;
+        .resize_with(state.effectors.len(), EffectorState::default);
+    for (o, e) in out.effectors.iter_mut().zip(&state.effectors) {
+        o.kind = e.kind;
         o.flags = e.flags;
         o.states.clear();
         o.states.extend_from_slice(&e.states);

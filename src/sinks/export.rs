@@ -1,15 +1,14 @@
 //! `flexdyn export FILE.mcap --csv DIR`: one CSV per recorded flexdyn topic, named after its key
-//! (`flexdyn/sc1/tlm/state` → `DIR/flexdyn_sc1_tlm_state.csv`), with the column names of
-//! [`super::table`]. A column a row does not have (an effector input one command sets and
-//! another does not) is left empty.
+//! (`flexdyn/sc1/tlm/state` → `DIR/flexdyn_sc1_tlm_state.csv`), in flexdyn's one CSV dialect
+//! ([`super::table`], the writer `simulate` uses too). A column a row does not have (an
+//! effector input one command sets and another does not) is left empty.
 
-use std::collections::{BTreeMap, HashMap};
-use std::io::{BufWriter, Write};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use super::error::SinkError;
 use super::reader::read_recording;
-use super::table::row;
+use super::table::{row, CsvTable};
 use super::topics::{classify, Decoded};
 
 /// Arguments of `flexdyn export`.
@@ -41,7 +40,8 @@ pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
     }
     std::fs::create_dir_all(&args.csv).map_err(|e| out_err(&args.csv, e))?;
     // Pass 1: each topic's columns, in first-seen order.
-    let mut columns: BTreeMap<String, (Vec<String>, HashMap<String, usize>)> = BTreeMap::new();
+    let mut columns: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    let mut seen: HashMap<String, HashSet<String>> = HashMap::new();
     let mut undecodable = 0u64;
     for s in &rec.samples {
         let Some(topic) = classify(&s.key) else {
@@ -51,10 +51,10 @@ pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
             undecodable += 1;
             continue;
         };
-        let (names, index) = columns.entry(s.key.clone()).or_default();
+        let names = columns.entry(s.key.clone()).or_default();
+        let known = seen.entry(s.key.clone()).or_default();
         for (name, _) in row(&d) {
-            if !index.contains_key(&name) {
-                index.insert(name.clone(), names.len());
+            if known.insert(name.clone()) {
                 names.push(name);
             }
         }
@@ -65,41 +65,30 @@ pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
             "samples that do not decode were left out of the CSV files"
         );
     }
-    // Pass 2: rows.
-    let mut writers = BTreeMap::new();
+    // Pass 2: rows, through the one CSV writer.
+    let mut tables = BTreeMap::new();
     let mut report = ExportReport::new();
-    for (key, (names, _)) in &columns {
+    for (key, names) in &columns {
         let path = args.csv.join(format!("{}.csv", key.replace('/', "_")));
         let f = std::fs::File::create(&path).map_err(|e| out_err(&path, e))?;
-        let mut w = BufWriter::new(f);
-        writeln!(w, "{}", names.join(",")).map_err(|e| out_err(&path, e))?;
-        writers.insert(key.clone(), (path.clone(), w));
+        let table = CsvTable::new(f, names).map_err(|e| out_err(&path, e))?;
+        tables.insert(key.clone(), (path.clone(), table));
         report.insert(path, 0);
     }
-    let mut cells: Vec<String> = Vec::new();
     for s in &rec.samples {
-        let (Some(topic), Some((names, index))) = (classify(&s.key), columns.get(&s.key)) else {
+        let (Some(topic), Some((path, table))) = (classify(&s.key), tables.get_mut(&s.key)) else {
             continue;
         };
         let Ok(d) = Decoded::decode(topic.kind, &s.payload) else {
             continue;
         };
-        cells.clear();
-        cells.resize(names.len(), String::new());
-        for (name, cell) in row(&d) {
-            if let Some(i) = index.get(&name) {
-                cells[*i] = cell.to_string();
-            }
-        }
-        if let Some((path, w)) = writers.get_mut(&s.key) {
-            writeln!(w, "{}", cells.join(",")).map_err(|e| out_err(path, e))?;
-            if let Some(n) = report.get_mut(path) {
-                *n += 1;
-            }
+        table.write_row(&row(&d)).map_err(|e| out_err(path, e))?;
+        if let Some(n) = report.get_mut(path) {
+            *n += 1;
         }
     }
-    for (_, (path, mut w)) in writers {
-        w.flush().map_err(|e| out_err(&path, e))?;
+    for (_, (path, mut table)) in tables {
+        table.flush().map_err(|e| out_err(&path, e))?;
     }
     Ok(report)
 }

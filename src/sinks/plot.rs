@@ -7,10 +7,18 @@
 //! - `rates.png`: ω_BN;
 //! - `panels.png`: θ1 and θ2 of each pair;
 //! - `wrench.png`: the commanded torque and force held over each frame, and the command flags;
-//! - `conservation.png`: relative drift of total energy and angular momentum, log axis (these
-//!   are constant only without external wrench, damping or motor torques);
-//! - `imu.png`: each IMU's measured rate and specific force;
-//! - `timing.png`: frame lateness p50/p99/max from StatusMsg and the overrun count.
+//! - `conservation.png`: each invariant on its own (orbital, rotational and total energy;
+//!   orbital, rotational and total angular momentum), as its change relative to its own scale,
+//!   log axis, with the intervals where an external wrench acts shaded (the invariants are
+//!   constant only without external wrench, damping or motor torques);
+//! - `wheels.png`: each reaction wheel's speed, applied motor torque and limit flags;
+//! - `star_tracker.png`: each star tracker's measured q_CN and its valid / status flags;
+//! - `imu.png`: each IMU's measured rate and specific force, one column per IMU;
+//! - `timing.png`: frame lateness p50/p99/max from StatusMsg and the overrun count (real time
+//!   only: a lockstep or batch run is not paced by the wall clock, so it is skipped and says so).
+//!
+//! [`figures`] builds every figure's data and axis bounds ([`Panel::y_range`]) without drawing,
+//! so tests can check what a figure shows.
 //!
 //! Text uses an embedded DejaVu Sans subset (`assets/fonts`, Bitstream Vera licence), so no
 //! system font library is needed.
@@ -23,9 +31,10 @@ use plotters::prelude::*;
 
 use super::error::SinkError;
 use super::reader::read_recording;
-use super::table::{row, Cell};
+use super::table::{prefixed_columns, row, Cell, Column};
 use super::topics::{classify, Decoded, TopicKind};
 use crate::attitude::mrp_error;
+use flexdyn_proto::{ImuMsg, StarTrackerMsg};
 
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
 /// The name the embedded font is registered under (see [`register_font`]).
@@ -37,7 +46,8 @@ pub fn register_font() -> Result<(), SinkError> {
         .map_err(|_| SinkError::Runtime("the embedded font does not load".into()))
 }
 const SIZE: (u32, u32) = (1200, 800);
-const COLORS: [RGBColor; 6] = [
+/// The lines' colours, in order (and the colours of nothing else but legend keys).
+pub const COLORS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -97,15 +107,14 @@ impl Columns {
         }
     }
 
-    /// The first of `names` present.
-    fn get(&self, names: &[String]) -> Option<&Vec<f64>> {
-        names.iter().find_map(|n| self.cols.get(n))
+    /// The column `name`, if present.
+    fn get(&self, name: &str) -> Option<&Vec<f64>> {
+        self.cols.get(name)
     }
 
-    /// A 3-vector column set: `<base>_1..3` under any of `bases`.
-    fn vec3(&self, bases: &[&str]) -> Option<[&Vec<f64>; 3]> {
-        let one =
-            |i: usize| self.get(&bases.iter().map(|b| format!("{b}_{i}")).collect::<Vec<_>>());
+    /// A 3-vector column set: `<base>_1..3`.
+    fn vec3(&self, base: &str) -> Option<[&Vec<f64>; 3]> {
+        let one = |i: usize| self.get(&format!("{base}_{i}"));
         Some([one(1)?, one(2)?, one(3)?])
     }
 
@@ -120,6 +129,9 @@ struct PlotData {
     state: Columns,
     status: Columns,
     imus: BTreeMap<String, Columns>,
+    star_trackers: BTreeMap<String, Columns>,
+    /// The pacing mode of the recorded run (from its StatusMsg; none in a CSV).
+    mode: Option<flexdyn_proto::Mode>,
 }
 
 fn input_err(path: &Path, problem: impl Into<String>) -> SinkError {
@@ -156,13 +168,23 @@ fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
         let cells = row(&d);
         match topic.kind {
             TopicKind::State => data.state.push(&cells),
-            TopicKind::Status => data.status.push(&cells),
+            TopicKind::Status => {
+                if let Decoded::Status(m) = &d {
+                    data.mode = Some(m.mode);
+                }
+                data.status.push(&cells);
+            }
             TopicKind::Imu => data
                 .imus
                 .entry(topic.sensor.unwrap_or_default().to_owned())
                 .or_default()
                 .push(&cells),
-            TopicKind::StarTracker | TopicKind::Command => {}
+            TopicKind::StarTracker => data
+                .star_trackers
+                .entry(topic.sensor.unwrap_or_default().to_owned())
+                .or_default()
+                .push(&cells),
+            TopicKind::Command => {}
         }
     }
     if data.state.is_empty() {
@@ -172,6 +194,21 @@ fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
         ));
     }
     Ok(data)
+}
+
+/// A `simulate` sensor column `<kind>_<name>_<field>` (`imu_hub_omega_p_rad_s_1`,
+/// `st_st1_q_cn_0`) split into (kind, sensor name, field), for the fields of that message.
+fn sensor_column<'a>(
+    column: &'a str,
+    fields: &[(&'static str, Vec<String>)],
+) -> Option<(&'static str, &'a str, &'a str)> {
+    fields.iter().find_map(|(kind, names)| {
+        let rest = column.strip_prefix(kind)?.strip_prefix('_')?;
+        names.iter().find_map(|f| {
+            let name = rest.strip_suffix(f.as_str())?.strip_suffix('_')?;
+            (!name.is_empty()).then(|| (*kind, name, &rest[name.len() + 1..]))
+        })
+    })
 }
 
 fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
@@ -189,6 +226,14 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             "the first column must be t_s (a `flexdyn simulate` or `flexdyn export` state CSV)",
         ));
     }
+    // The sensor columns `simulate` writes beside the state: the message fields of an IMU or a
+    // star-tracker sample, prefixed `imu_<name>_` / `st_<name>_`.
+    let fields = [
+        ("imu", column_names(&ImuMsg::default())),
+        ("st", column_names(&StarTrackerMsg::default())),
+    ];
+    let place: Vec<Option<(&str, &str, &str)>> =
+        header.iter().map(|h| sensor_column(h, &fields)).collect();
     let mut data = PlotData::default();
     for (i, line) in lines.enumerate() {
         if line.is_empty() {
@@ -207,10 +252,12 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             ));
         }
         let mut state = Vec::with_capacity(fields.len());
-        let mut imu: BTreeMap<String, Vec<(String, Cell)>> = BTreeMap::new();
-        // Column 0 is t_s (checked above), so the row's time is known before any IMU column.
+        // Per sensor: its cells, and whether this row has any (a star tracker's are empty
+        // between its updates).
+        let mut sensors: BTreeMap<(&str, &str), (Vec<Column>, bool)> = BTreeMap::new();
+        // Column 0 is t_s (checked above), so the row's time is known before any sensor column.
         let mut t_s = f64::NAN;
-        for (name, f) in header.iter().zip(&fields) {
+        for ((name, f), place) in header.iter().zip(&fields).zip(&place) {
             let x = if f.is_empty() {
                 f64::NAN
             } else {
@@ -221,29 +268,28 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             if *name == "t_s" {
                 t_s = x;
             }
-            // `simulate` puts each IMU's columns in the state CSV as imu_<name>_<field>.
-            if let Some(rest) = name.strip_prefix("imu_") {
-                if let Some((imu_name, field)) = rest
-                    .split_once("_omega_p_")
-                    .map(|(n, k)| (n, format!("omega_p_{k}")))
-                    .or_else(|| {
-                        rest.split_once("_accel_p_")
-                            .map(|(n, k)| (n, format!("accel_p_{k}")))
-                    })
-                {
-                    let cells = imu.entry(imu_name.to_owned()).or_default();
+            match place {
+                Some((kind, sensor, field)) => {
+                    let (cells, any) = sensors.entry((kind, sensor)).or_default();
                     if cells.is_empty() {
                         cells.push(("t_s".into(), Cell::Num(t_s)));
                     }
-                    cells.push((field, Cell::Num(x)));
-                    continue;
+                    cells.push(((*field).to_owned(), Cell::Num(x)));
+                    *any |= !f.is_empty();
                 }
+                None => state.push(((*name).to_owned(), Cell::Num(x))),
             }
-            state.push(((*name).to_owned(), Cell::Num(x)));
         }
         data.state.push(&state);
-        for (name, cells) in imu {
-            data.imus.entry(name).or_default().push(&cells);
+        for ((kind, name), (cells, any)) in sensors {
+            let map = if kind == "imu" {
+                &mut data.imus
+            } else {
+                &mut data.star_trackers
+            };
+            if any {
+                map.entry(name.to_owned()).or_default().push(&cells);
+            }
         }
     }
     if data.state.is_empty() {
@@ -252,17 +298,97 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
     Ok(data)
 }
 
+/// The column names of `msg`'s fields (no header), as in [`prefixed_columns`].
+fn column_names<T: serde::Serialize>(msg: &T) -> Vec<String> {
+    prefixed_columns("", msg)
+        .into_iter()
+        .map(|(n, _)| n)
+        .collect()
+}
+
 /// One line on a panel.
-struct Line {
-    label: String,
-    points: Vec<(f64, f64)>,
+#[derive(Clone, Debug)]
+pub struct Line {
+    /// Its legend entry.
+    pub label: String,
+    /// (t \[s\], y) in the panel's unit, finite only.
+    pub points: Vec<(f64, f64)>,
 }
 
 /// One chart of a figure.
-struct Panel {
-    y_label: String,
-    log_y: bool,
-    lines: Vec<Line>,
+#[derive(Clone, Debug, Default)]
+pub struct Panel {
+    /// The chart's caption (e.g. which sensor), if any.
+    pub caption: Option<String>,
+    /// The y axis label, with its unit.
+    pub y_label: String,
+    /// A logarithmic y axis (only positive values are drawn).
+    pub log_y: bool,
+    /// The lines.
+    pub lines: Vec<Line>,
+    /// \[s\] time intervals shaded behind the lines (e.g. where an external wrench acts),
+    /// with the legend entry of the shading.
+    pub spans: Vec<(f64, f64)>,
+    /// The legend entry of `spans`.
+    pub span_label: String,
+}
+
+/// One figure (one PNG file).
+#[derive(Clone, Debug)]
+pub struct Figure {
+    /// The file name (`conservation.png`).
+    pub name: &'static str,
+    /// The title over every panel.
+    pub title: String,
+    /// The panels, filled row by row into `columns` columns.
+    pub panels: Vec<Panel>,
+    /// Panels side by side (1: stacked).
+    pub columns: usize,
+}
+
+impl Panel {
+    /// The panel's x axis bounds \[s\]: the time span of its lines (±0.5 s if a single instant).
+    pub fn t_range(&self) -> (f64, f64) {
+        let (t0, t1) = self
+            .lines
+            .iter()
+            .flat_map(|l| l.points.iter())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (t, _)| {
+                (a.min(*t), b.max(*t))
+            });
+        if t1 > t0 {
+            (t0, t1)
+        } else if t0.is_finite() {
+            (t0 - 0.5, t0 + 0.5)
+        } else {
+            (0.0, 1.0)
+        }
+    }
+
+    /// The panel's y axis bounds: every drawn point lies inside, with a 5 % margin on a linear
+    /// axis and a factor of 2 on a log axis (whose lower bound is at least 1e-18).
+    pub fn y_range(&self) -> (f64, f64) {
+        let ys = self.lines.iter().flat_map(|l| l.points.iter().map(|p| p.1));
+        if self.log_y {
+            let (lo, hi) = ys
+                .filter(|y| *y > 0.0)
+                .fold((f64::INFINITY, 0.0_f64), |(a, b), y| (a.min(y), b.max(y)));
+            let lo = lo.max(1e-18);
+            let hi = hi.max(lo * 10.0);
+            return (lo * 0.5, hi * 2.0);
+        }
+        let (lo, hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
+            (a.min(y), b.max(y))
+        });
+        if !lo.is_finite() {
+            (-1.0, 1.0)
+        } else if hi - lo < 1e-12 * (lo.abs() + 1.0) {
+            (lo - 0.5 * (lo.abs() + 1e-9), hi + 0.5 * (hi.abs() + 1e-9))
+        } else {
+            let pad = 0.05 * (hi - lo);
+            (lo - pad, hi + pad)
+        }
+    }
 }
 
 fn line(label: &str, t: &[f64], y: &[f64]) -> Line {
@@ -310,18 +436,42 @@ fn draw_panel<Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueForma
         .configure_mesh()
         .x_desc("simulation time t (s)")
         .y_desc(panel.y_label.as_str())
+        .y_labels(6)
         .label_style(label_style.clone())
         .y_label_formatter(y_ticks)
         .x_label_formatter(x_ticks)
         .draw()
         .map_err(|e| e.to_string())?;
-    for (k, l) in panel.lines.iter().enumerate() {
+    if !panel.spans.is_empty() {
+        let (y0, y1) = panel.y_range();
+        let shade = RGBColor(255, 200, 0).mix(0.3);
+        chart
+            .draw_series(
+                panel
+                    .spans
+                    .iter()
+                    .map(|(a, b)| Rectangle::new([(*a, y0), (*b, y1)], shade.filled())),
+            )
+            .map_err(|e| e.to_string())?
+            .label(panel.span_label.as_str())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
+    }
+    // The first line last, on top: where lines coincide (a total dominated by one part) the
+    // first one listed stays visible.
+    for (k, l) in panel.lines.iter().enumerate().rev() {
         let c = COLORS[k % COLORS.len()];
         chart
-            .draw_series(LineSeries::new(
-                l.points.iter().filter(|(_, y)| keep(*y)).copied(),
-                c.stroke_width(2),
-            ))
+            // Segment by segment: a 2 px polyline gets mitred joins, and at the sharp turns of
+            // a noisy signal the mitres reach far outside the axes.
+            .draw_series(
+                l.points
+                    .iter()
+                    .filter(|(_, y)| keep(*y))
+                    .copied()
+                    .collect::<Vec<_>>()
+                    .windows(2)
+                    .map(|w| PathElement::new(vec![w[0], w[1]], c.stroke_width(2))),
+            )
             .map_err(|e| e.to_string())?
             .label(l.label.as_str())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
@@ -336,7 +486,12 @@ fn draw_panel<Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueForma
         .map_err(|e| e.to_string())
 }
 
-fn draw(path: &Path, title: &str, panels: &[Panel]) -> Result<(), SinkError> {
+/// The pixel rectangle (x range, y range) of a chart's plotting area.
+pub type PixelRect = (std::ops::Range<i32>, std::ops::Range<i32>);
+
+/// Draws `fig` into the PNG file `path`; returns each panel's plotting area in pixels (what
+/// lies outside is axes, labels and titles).
+pub fn draw(path: &Path, fig: &Figure) -> Result<Vec<PixelRect>, SinkError> {
     let err = |e: &dyn std::fmt::Display| SinkError::Output {
         path: path.to_owned(),
         problem: e.to_string(),
@@ -344,59 +499,38 @@ fn draw(path: &Path, title: &str, panels: &[Panel]) -> Result<(), SinkError> {
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let root = root
-        .titled(title, (FONT_NAME, 30).into_font())
+        .titled(&fig.title, (FONT_NAME, 26).into_font())
         .map_err(|e| err(&e))?;
-    let areas = root.split_evenly((panels.len(), 1));
-    for (area, panel) in areas.iter().zip(panels) {
-        let all: Vec<(f64, f64)> = panel
-            .lines
-            .iter()
-            .flat_map(|l| l.points.iter().copied())
-            .collect();
-        let (t0, t1) = all
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (t, _)| {
-                (a.min(*t), b.max(*t))
-            });
-        let (t0, t1) = if t1 > t0 {
-            (t0, t1)
-        } else {
-            (t0 - 0.5, t0 + 0.5)
-        };
+    let columns = fig.columns.max(1);
+    let rows = fig.panels.len().div_ceil(columns);
+    let areas = root.split_evenly((rows, columns));
+    let mut plotting = Vec::new();
+    for (area, panel) in areas.iter().zip(&fig.panels) {
+        let (t0, t1) = panel.t_range();
+        let (lo, hi) = panel.y_range();
         let x_ticks = move |x: &f64| tick_label(*x, t0, t1);
         let mut builder = ChartBuilder::on(area);
         builder
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(110);
+        if let Some(c) = &panel.caption {
+            builder.caption(c, (FONT_NAME, 20).into_font());
+        }
         if panel.log_y {
-            let ys: Vec<f64> = all.iter().map(|(_, y)| *y).filter(|y| *y > 0.0).collect();
-            let lo = ys.iter().copied().fold(f64::INFINITY, f64::min).max(1e-18);
-            let hi = ys.iter().copied().fold(0.0, f64::max).max(lo * 10.0);
             let mut chart = builder
-                .build_cartesian_2d(t0..t1, (lo * 0.5..hi * 2.0).log_scale())
+                .build_cartesian_2d(t0..t1, (lo..hi).log_scale())
                 .map_err(|e| err(&e))?;
+            plotting.push(chart.plotting_area().get_pixel_range());
             draw_panel(&mut chart, panel, &|y| format!("{y:.0e}"), &x_ticks, |y| {
                 y > 0.0
             })
             .map_err(|e| err(&e))?;
         } else {
-            let (lo, hi) = all
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (_, y)| {
-                    (a.min(*y), b.max(*y))
-                });
-            let (lo, hi) = if !lo.is_finite() {
-                (-1.0, 1.0)
-            } else if hi - lo < 1e-12 * (lo.abs() + 1.0) {
-                (lo - 0.5 * (lo.abs() + 1e-9), hi + 0.5 * (hi.abs() + 1e-9))
-            } else {
-                let pad = 0.05 * (hi - lo);
-                (lo - pad, hi + pad)
-            };
             let mut chart = builder
                 .build_cartesian_2d(t0..t1, lo..hi)
                 .map_err(|e| err(&e))?;
+            plotting.push(chart.plotting_area().get_pixel_range());
             draw_panel(
                 &mut chart,
                 panel,
@@ -408,7 +542,7 @@ fn draw(path: &Path, title: &str, panels: &[Panel]) -> Result<(), SinkError> {
         }
     }
     root.present().map_err(|e| err(&e))?;
-    Ok(())
+    Ok(plotting)
 }
 
 /// What `plot` wrote and skipped.
@@ -420,26 +554,124 @@ pub struct PlotReport {
     pub skipped: Vec<(String, String)>,
 }
 
-fn vec_panel(cols: &Columns, bases: &[&str], labels: [&str; 3], y_label: &str) -> Option<Panel> {
-    let v = cols.vec3(bases)?;
+fn vec_panel(cols: &Columns, base: &str, labels: [&str; 3], y_label: &str) -> Option<Panel> {
+    let v = cols.vec3(base)?;
     Some(Panel {
         y_label: y_label.to_owned(),
-        log_y: false,
         lines: (0..3).map(|i| line(labels[i], &cols.t_s, v[i])).collect(),
+        ..Panel::default()
     })
 }
 
-fn relative_drift(x: &[f64]) -> Vec<f64> {
+/// A panel of the scalar columns `<prefix><k><suffix>` for k = 1, 2, … (one line per
+/// effector or sensor), labelled `<label><k>`; `None` when there is none.
+fn numbered_panel(
+    cols: &Columns,
+    prefix: &str,
+    suffix: &str,
+    label: &str,
+    y_label: &str,
+) -> Option<Panel> {
+    let lines: Vec<Line> = (1..)
+        .map_while(|k| {
+            cols.get(&format!("{prefix}{k}{suffix}"))
+                .map(|c| line(&format!("{label}{k}"), &cols.t_s, c))
+        })
+        .collect();
+    (!lines.is_empty()).then(|| Panel {
+        y_label: y_label.to_owned(),
+        lines,
+        ..Panel::default()
+    })
+}
+
+/// |x(t) − x(0)| / scale: the change of an invariant relative to its own scale, the largest
+/// |x| over the run (so a quantity that starts at zero still has one). All NaN when x is zero
+/// throughout.
+fn relative_change(x: &[f64]) -> Vec<f64> {
     let x0 = x
         .iter()
         .copied()
         .find(|v| v.is_finite())
         .unwrap_or(f64::NAN);
-    x.iter().map(|v| ((v - x0) / x0).abs()).collect()
+    let scale = x
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0_f64, |m, v| m.max(v.abs()));
+    x.iter().map(|v| (v - x0).abs() / scale).collect()
 }
 
-/// Draws every figure the input has data for.
-pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
+/// The same for a vector: |h(t) − h(0)| / max |h|.
+fn relative_change_vec(h: &[nalgebra::Vector3<f64>]) -> Vec<f64> {
+    let h0 = h.first().copied().unwrap_or_default();
+    let scale = h.iter().fold(0.0_f64, |m, v| m.max(v.norm()));
+    h.iter().map(|v| (v - h0).norm() / scale).collect()
+}
+
+/// A line of a relative change on a log axis, which cannot show zero: when the change is
+/// exactly zero throughout, the legend says so.
+fn invariant_line(label: &str, t: &[f64], change: &[f64]) -> Line {
+    let l = line(label, t, change);
+    if !l.points.is_empty() && l.points.iter().all(|(_, y)| *y == 0.0) {
+        return Line {
+            label: format!("{label}: exactly constant"),
+            ..l
+        };
+    }
+    l
+}
+
+/// The rows of a 3-vector column set as vectors.
+fn vectors(v: [&Vec<f64>; 3]) -> Vec<nalgebra::Vector3<f64>> {
+    (0..v[0].len())
+        .map(|k| nalgebra::Vector3::new(v[0][k], v[1][k], v[2][k]))
+        .collect()
+}
+
+/// \[s\] the intervals over which an external wrench acts: the commanded wrench
+/// (`wrench_applied_*`, held over the frame that ends at a row) and the scheduled one
+/// (`wrench_schedule_*`, `simulate` only: in effect from a row on). Each non-zero row
+/// contributes the interval between its neighbours on the side where it acts.
+fn external_wrench_spans(s: &Columns) -> Vec<(f64, f64)> {
+    let t = &s.t_s;
+    let nonzero = |base: &str, k: usize| {
+        s.vec3(base)
+            .is_some_and(|v| v.iter().any(|c| c[k] != 0.0 && !c[k].is_nan()))
+    };
+    let mut spans: Vec<(f64, f64)> = Vec::new();
+    for k in 0..t.len() {
+        let held = [
+            "wrench_applied_torque_b_nm",
+            "wrench_applied_force_b_newton",
+        ]
+        .iter()
+        .any(|b| nonzero(b, k));
+        let scheduled = [
+            "wrench_schedule_torque_b_nm",
+            "wrench_schedule_force_b_newton",
+        ]
+        .iter()
+        .any(|b| nonzero(b, k));
+        let mut add = |a: f64, b: f64| match spans.last_mut() {
+            Some(last) if a <= last.1 => last.1 = last.1.max(b),
+            _ => spans.push((a, b)),
+        };
+        if held && k > 0 {
+            add(t[k - 1], t[k]);
+        }
+        if scheduled && k + 1 < t.len() {
+            add(t[k], t[k + 1]);
+        }
+    }
+    spans
+}
+
+/// Figures not drawn, each with the reason.
+pub type Skipped = Vec<(String, String)>;
+
+/// Builds every figure the input has data for, without drawing: the figures, and the ones
+/// skipped with the reason.
+pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
     let target = match &args.sigma_rn {
         None => None,
         Some(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => {
@@ -461,35 +693,39 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
     } else {
         from_csv(&args.input)?
     };
-    std::fs::create_dir_all(&args.output).map_err(|e| SinkError::Output {
-        path: args.output.clone(),
-        problem: e.to_string(),
-    })?;
-    register_font()?;
-    let mut report = PlotReport::default();
+    let mut skipped = Vec::new();
     let s = &data.state;
     let t = &s.t_s;
-    let mut figures: Vec<(&str, String, Vec<Panel>)> = Vec::new();
-    let mut skip = |name: &str, why: &str| report.skipped.push((name.to_owned(), why.to_owned()));
+    let mut figures: Vec<Figure> = Vec::new();
+    let mut skip = |name: &str, why: &str| skipped.push((name.to_owned(), why.to_owned()));
+    let mut fig = |name: &'static str, title: String, panels: Vec<Panel>| {
+        figures.push(Figure {
+            name,
+            title,
+            panels,
+            columns: 1,
+        });
+    };
 
-    match vec_panel(s, &["sigma_bn"], ["σ1", "σ2", "σ3"], "σ_BN (MRP, –)") {
+    match vec_panel(s, "sigma_bn", ["σ1", "σ2", "σ3"], "σ_BN (MRP, –)") {
         Some(sigma) => {
             let mut panels = vec![sigma];
-            if let (Some(target), Some(v)) = (target, s.vec3(&["sigma_bn"])) {
-                let err: Vec<nalgebra::Vector3<f64>> = (0..t.len())
-                    .map(|k| mrp_error(&nalgebra::Vector3::new(v[0][k], v[1][k], v[2][k]), &target))
+            if let (Some(target), Some(v)) = (target, s.vec3("sigma_bn")) {
+                let err: Vec<nalgebra::Vector3<f64>> = vectors(v)
+                    .iter()
+                    .map(|sigma| mrp_error(sigma, &target))
                     .collect();
                 let comp = |i: usize| err.iter().map(|e| e[i]).collect::<Vec<_>>();
                 let norm: Vec<f64> = err.iter().map(|e| e.norm()).collect();
                 panels.push(Panel {
                     y_label: "σ_BR (MRP, –)".into(),
-                    log_y: false,
                     lines: vec![
                         line("σ_BR,1", t, &comp(0)),
                         line("σ_BR,2", t, &comp(1)),
                         line("σ_BR,3", t, &comp(2)),
                         line("|σ_BR|", t, &norm),
                     ],
+                    ..Panel::default()
                 });
             }
             let title = match target {
@@ -499,56 +735,56 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
                 ),
                 None => "Attitude σ_BN (no target given: --sigma-rn adds σ_BR)".into(),
             };
-            figures.push(("attitude.png", title, panels));
+            fig("attitude.png", title, panels);
         }
         None => skip("attitude.png", "no sigma_bn columns"),
     }
     match vec_panel(
         s,
-        &["omega_bn_b_rad_s", "omega_bn_b"],
+        "omega_bn_b_rad_s",
         ["ω1", "ω2", "ω3"],
         "ω_BN, B components (rad/s)",
     ) {
-        Some(p) => figures.push(("rates.png", "Body angular rate ω_BN".into(), vec![p])),
-        None => skip("rates.png", "no omega_bn_b columns"),
+        Some(p) => fig("rates.png", "Body angular rate ω_BN".into(), vec![p]),
+        None => skip("rates.png", "no omega_bn_b_rad_s columns"),
     }
     let mut pairs = Vec::new();
     for k in 1.. {
         let (Some(th1), Some(th2)) = (
-            s.get(&[format!("pair{k}_theta1")]),
-            s.get(&[format!("pair{k}_theta2")]),
+            s.get(&format!("pair{k}_theta1")),
+            s.get(&format!("pair{k}_theta2")),
         ) else {
             break;
         };
         pairs.push(Panel {
             y_label: format!("pair {k} (rad)"),
-            log_y: false,
             lines: vec![line("θ1", t, th1), line("θ2", t, th2)],
+            ..Panel::default()
         });
     }
     if pairs.is_empty() {
         skip("panels.png", "no pair<k>_theta1/2 columns");
     } else {
-        figures.push((
+        fig(
             "panels.png",
             "Panel hinge angles θ1 (hub–panel 1), θ2 (panel 1–panel 2)".into(),
             pairs,
-        ));
+        );
     }
     let torque = vec_panel(
         s,
-        &["wrench_applied_torque_b_nm"],
+        "wrench_applied_torque_b_nm",
         ["τ1", "τ2", "τ3"],
         "torque about B (N·m)",
     );
     let force = vec_panel(
         s,
-        &["wrench_applied_force_b_newton"],
+        "wrench_applied_force_b_newton",
         ["F1", "F2", "F3"],
         "force at B (N)",
     );
-    match (torque, force, s.get(&["command_flags".into()])) {
-        (Some(tq), Some(f), Some(flags)) => figures.push((
+    match (torque, force, s.get("command_flags")) {
+        (Some(tq), Some(f), Some(flags)) => fig(
             "wrench.png",
             "Commanded wrench held over each frame (B components) and command flags".into(),
             vec![
@@ -556,120 +792,244 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
                 f,
                 Panel {
                     y_label: "command_flags (bits)".into(),
-                    log_y: false,
                     lines: vec![line("flags", t, flags)],
+                    ..Panel::default()
                 },
             ],
-        )),
-        _ => skip(
-            "wrench.png",
-            "no commanded-wrench columns (a simulate CSV has none)",
         ),
+        _ => skip("wrench.png", "no wrench_applied_* columns"),
     }
+    let spans = external_wrench_spans(s);
+    let invariant_panel = |y_label: &str, lines: Vec<Line>| Panel {
+        y_label: y_label.to_owned(),
+        log_y: true,
+        lines,
+        spans: spans.clone(),
+        span_label: "external wrench acts".into(),
+        caption: None,
+    };
     let energy = match (
-        s.get(&["conserved_orb_energy_j".into(), "orb_energy_j".into()]),
-        s.get(&["conserved_rot_energy_j".into(), "rot_energy_j".into()]),
+        s.get("conserved_orb_energy_j"),
+        s.get("conserved_rot_energy_j"),
     ) {
-        (Some(o), Some(r)) => Some(o.iter().zip(r).map(|(a, b)| a + b).collect::<Vec<f64>>()),
+        (Some(o), Some(r)) => {
+            let total: Vec<f64> = o.iter().zip(r).map(|(a, b)| a + b).collect();
+            Some(invariant_panel(
+                "|E − E(0)| / max|E| (–)",
+                vec![
+                    invariant_line("total energy", t, &relative_change(&total)),
+                    invariant_line("orbital energy", t, &relative_change(o)),
+                    invariant_line("rotational energy", t, &relative_change(r)),
+                ],
+            ))
+        }
         _ => None,
     };
     let momentum = match (
-        s.vec3(&["conserved_orb_ang_mom_n", "orb_ang_mom_n"]),
-        s.vec3(&["conserved_rot_ang_mom_c_n", "rot_ang_mom_c_n"]),
+        s.vec3("conserved_orb_ang_mom_n"),
+        s.vec3("conserved_rot_ang_mom_c_n"),
     ) {
         (Some(o), Some(r)) => {
-            let h: Vec<nalgebra::Vector3<f64>> = (0..t.len())
-                .map(|k| {
-                    nalgebra::Vector3::new(o[0][k] + r[0][k], o[1][k] + r[1][k], o[2][k] + r[2][k])
-                })
-                .collect();
-            let h0 = h.first().copied().unwrap_or_default();
-            Some(
-                h.iter()
-                    .map(|v| (v - h0).norm() / h0.norm())
-                    .collect::<Vec<f64>>(),
-            )
+            let (o, r) = (vectors(o), vectors(r));
+            let total: Vec<_> = o.iter().zip(&r).map(|(a, b)| a + b).collect();
+            Some(invariant_panel(
+                "|H − H(0)| / max|H| (–)",
+                vec![
+                    invariant_line("total H", t, &relative_change_vec(&total)),
+                    invariant_line("orbital H (about N)", t, &relative_change_vec(&o)),
+                    invariant_line("rotational H (about C)", t, &relative_change_vec(&r)),
+                ],
+            ))
         }
         _ => None,
     };
     match (energy, momentum) {
-        (Some(e), Some(h)) => figures.push((
+        (Some(e), Some(h)) => fig(
             "conservation.png",
-            "Conservation: relative drift of total energy and angular momentum (log)".into(),
-            vec![Panel {
-                y_label: "relative drift (–)".into(),
-                log_y: true,
-                lines: vec![
-                    line("|E − E0| / |E0|", t, &relative_drift(&e)),
-                    line("|H − H0| / |H0|", t, &h),
-                ],
-            }],
-        )),
-        _ => skip("conservation.png", "no energy and momentum columns"),
+            "Invariants, each relative to its own scale (log); shaded: an external wrench acts"
+                .into(),
+            vec![e, h],
+        ),
+        _ => skip("conservation.png", "no conserved_* columns"),
+    }
+    let wheels: Vec<Panel> = [
+        ("_omega_rad_s", "Ω", "speed Ω, rel. hub (rad/s)"),
+        ("_motor_torque_nm", "u", "motor torque applied (N·m)"),
+        ("_flags", "flags", "flags (1 torque-, 2 speed-limited)"),
+    ]
+    .iter()
+    .filter_map(|(suffix, label, y)| numbered_panel(s, "rw", suffix, &format!("{label} rw"), y))
+    .collect();
+    if wheels.is_empty() {
+        skip("wheels.png", "no rw<k>_* columns");
+    } else {
+        fig(
+            "wheels.png",
+            "Reaction wheels: speed, motor torque after the limits, limit flags".into(),
+            wheels,
+        );
+    }
+    let mut st_panels = Vec::new();
+    for (name, c) in &data.star_trackers {
+        let q: Vec<Line> = (0..4)
+            .filter_map(|i| {
+                c.get(&format!("q_cn_{i}"))
+                    .map(|v| line(&format!("q{i}"), &c.t_s, v))
+            })
+            .collect();
+        if q.is_empty() {
+            continue;
+        }
+        st_panels.push(Panel {
+            caption: Some(format!("star tracker {name}")),
+            y_label: "measured q_CN (–)".into(),
+            lines: q,
+            ..Panel::default()
+        });
+        let flags: Vec<Line> = [("valid", "valid (0/1)"), ("status_flags", "status flags")]
+            .iter()
+            .filter_map(|(col, label)| c.get(col).map(|v| line(label, &c.t_s, v)))
+            .collect();
+        st_panels.push(Panel {
+            caption: Some(format!("star tracker {name}")),
+            y_label: "valid; flags (1 Sun, 2 rate)".into(),
+            lines: flags,
+            ..Panel::default()
+        });
+    }
+    if st_panels.is_empty() {
+        skip("star_tracker.png", "no star tracker");
+    } else {
+        figures.push(sensor_grid(
+            "star_tracker.png",
+            "Star trackers: measured attitude q_CN (scalar first) and validity",
+            st_panels,
+        ));
     }
     let mut imu_panels = Vec::new();
     for (name, c) in &data.imus {
-        if let Some(p) = vec_panel(
-            c,
-            &["omega_p_rad_s", "omega_p"],
-            ["ω1", "ω2", "ω3"],
-            &format!("{name}: rate (rad/s)"),
-        ) {
-            imu_panels.push(p);
-        }
-        if let Some(p) = vec_panel(
-            c,
-            &["accel_p_m_s2", "accel_p"],
-            ["a1", "a2", "a3"],
-            &format!("{name}: specific force (m/s²)"),
-        ) {
-            imu_panels.push(p);
+        let caption = Some(format!("IMU {name}"));
+        for (base, labels, y) in [
+            ("omega_p_rad_s", ["ω1", "ω2", "ω3"], "rate, P (rad/s)"),
+            (
+                "accel_p_m_s2",
+                ["a1", "a2", "a3"],
+                "specific force, P (m/s²)",
+            ),
+        ] {
+            let p = vec_panel(c, base, labels, y).unwrap_or_else(|| Panel {
+                y_label: y.to_owned(),
+                ..Panel::default()
+            });
+            imu_panels.push(Panel {
+                caption: caption.clone(),
+                ..p
+            });
         }
     }
     if imu_panels.is_empty() {
         skip("imu.png", "no IMU");
     } else {
-        figures.push((
+        figures.push(sensor_grid(
             "imu.png",
-            "IMU measurements (sensor frame P)".into(),
+            "IMU measurements (sensor frame P)",
             imu_panels,
         ));
     }
     let st = &data.status;
-    match (
-        st.get(&["timing_lateness_p50_ns".into()]),
-        st.get(&["timing_lateness_p99_ns".into()]),
-        st.get(&["timing_lateness_max_ns".into()]),
-        st.get(&["timing_overrun_count".into()]),
-    ) {
-        (Some(p50), Some(p99), Some(max), Some(overruns)) => {
+    let timing = (
+        st.get("timing_lateness_p50_ns"),
+        st.get("timing_lateness_p99_ns"),
+        st.get("timing_lateness_max_ns"),
+        st.get("timing_overrun_count"),
+    );
+    match (data.mode, timing) {
+        (Some(mode @ (flexdyn_proto::Mode::Lockstep | flexdyn_proto::Mode::Batch)), _) => {
+            let why = format!(
+                "a {} run is not paced by the wall clock, so it has no frame lateness",
+                if mode == flexdyn_proto::Mode::Lockstep {
+                    "lockstep"
+                } else {
+                    "batch"
+                }
+            );
+            skipped.push(("timing.png".into(), why));
+        }
+        (_, (Some(p50), Some(p99), Some(max), Some(overruns))) => {
             let us = |v: &Vec<f64>| v.iter().map(|x| x * 1e-3).collect::<Vec<_>>();
-            figures.push((
-                "timing.png",
-                "Real-time frame lateness (cumulative percentiles from StatusMsg)".into(),
-                vec![
+            figures.push(Figure {
+                name: "timing.png",
+                title: "Real-time frame lateness (cumulative percentiles from StatusMsg)".into(),
+                panels: vec![
                     Panel {
                         y_label: "lateness (µs)".into(),
-                        log_y: false,
                         lines: vec![
                             line("p50", &st.t_s, &us(p50)),
                             line("p99", &st.t_s, &us(p99)),
                             line("max", &st.t_s, &us(max)),
                         ],
+                        ..Panel::default()
                     },
                     Panel {
                         y_label: "overruns (count)".into(),
-                        log_y: false,
                         lines: vec![line("overruns", &st.t_s, overruns)],
+                        ..Panel::default()
                     },
                 ],
-            ));
+                columns: 1,
+            });
         }
-        _ => skip("timing.png", "no StatusMsg (only recordings have it)"),
+        _ => skipped.push((
+            "timing.png".into(),
+            "no StatusMsg (only recordings have it)".into(),
+        )),
     }
-    for (name, title, panels) in figures {
-        let path = args.output.join(name);
-        draw(&path, &title, &panels)?;
+    Ok((figures, skipped))
+}
+
+/// A figure of two panels per sensor, one column per sensor, so each panel keeps the height
+/// its labels need however many sensors there are.
+fn sensor_grid(name: &'static str, title: &str, panels: Vec<Panel>) -> Figure {
+    let columns = panels.len() / 2;
+    Figure {
+        name,
+        title: title.to_owned(),
+        panels: interleave_columns(panels, columns),
+        columns,
+    }
+}
+
+/// Panels given sensor by sensor (`rows` per sensor, consecutive) reordered row by row for a
+/// grid of `columns` sensors side by side.
+fn interleave_columns(panels: Vec<Panel>, columns: usize) -> Vec<Panel> {
+    let rows = panels.len() / columns.max(1);
+    let mut slots: Vec<Option<Panel>> = panels.into_iter().map(Some).collect();
+    let mut out = Vec::with_capacity(slots.len());
+    for r in 0..rows {
+        for c in 0..columns {
+            if let Some(p) = slots[c * rows + r].take() {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
+/// Draws every figure the input has data for.
+pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
+    let (figures, skipped) = figures(args)?;
+    std::fs::create_dir_all(&args.output).map_err(|e| SinkError::Output {
+        path: args.output.clone(),
+        problem: e.to_string(),
+    })?;
+    register_font()?;
+    let mut report = PlotReport {
+        written: Vec::new(),
+        skipped,
+    };
+    for f in &figures {
+        let path = args.output.join(f.name);
+        draw(&path, f)?;
         report.written.push(path);
     }
     Ok(report)

@@ -78,18 +78,18 @@ fn lockstep_rate(port: u16, ticks: usize, frame_hz: f64, handoff: Handoff) -> f6
     report.last_tick as f64 / report.wall_s
 }
 
-/// \[µs\] physics cost of one frame (step_frame + snapshot), alone.
+/// \[µs\] physics cost of one frame (step_frame + state_into), alone.
 fn physics_frame_us(frame_hz: f64) -> f64 {
     let cfg = reference_config(frame_hz);
     let mut sim = Simulation::new(&cfg).unwrap();
-    let mut snap = flexdyn::sim::Snapshot::for_simulation(&sim);
+    let mut state = sim.blank_state();
     let n = 20_000;
     let t = Instant::now();
     for _ in 0..n {
         sim.step_frame();
-        sim.snapshot_into(&mut snap);
+        sim.state_into(&mut state);
     }
-    std::hint::black_box(&snap);
+    std::hint::black_box(&state);
     t.elapsed().as_secs_f64() * 1e6 / n as f64
 }
 
