@@ -1,8 +1,8 @@
 //! `flexdyn plot` from the outside: every figure of a recording and of a `simulate` CSV is a
 //! valid PNG (decoded with the `png` crate), of the documented size, and not blank; figures
 //! the input has no data for are skipped and named; bad input is an error naming the file.
-//!
-//! Port 17381.
+
+mod ports;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -72,7 +72,7 @@ fn a_recording_gives_every_figure() {
     let rec = tmp("batch.mcap");
     let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
         .args(["run", "--mode", "batch", "--duration-s", "5"])
-        .args(["--listen", "tcp/127.0.0.1:17381", "--config"])
+        .args(["--listen", &ports::free_endpoint(), "--config"])
         .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml"))
         .arg("--record")
         .arg(&rec)

@@ -2,9 +2,8 @@
 //! `replay`, `export`) and independent readers check them — Python's `mcap` package (PyPI,
 //! `tests/py/check_recording.py`, in its own venv `<target>/python-mcap-venv`) and the CSV
 //! files.
-//!
-//! Ports 17370–17374.
 
+mod ports;
 mod py_support;
 
 use std::collections::BTreeMap;
@@ -49,13 +48,13 @@ fn check_with_python(file: &Path, extra: &[&str]) -> String {
 }
 
 /// A finished batch run of the wheel scenario recorded by the server itself.
-fn batch_recording(port: u16, name: &str) -> PathBuf {
+fn batch_recording(name: &str) -> PathBuf {
     let file = tmp(name);
     let _ = std::fs::remove_file(&file);
     py_support::run(
         flexdyn()
             .args(["run", "--mode", "batch", "--duration-s", "5"])
-            .args(["--listen", &endpoint(port)])
+            .args(["--listen", &ports::free_endpoint()])
             .arg("--config")
             .arg(root().join("scenarios/wheels_star_tracker.toml"))
             .arg("--record")
@@ -115,7 +114,7 @@ fn wait_exit(child: &mut Guard, timeout: Duration) -> std::process::ExitStatus {
 
 #[test]
 fn python_mcap_reads_every_channel_of_a_server_recording() {
-    let file = batch_recording(17370, "batch.mcap");
+    let file = batch_recording("batch.mcap");
     let out = check_with_python(&file, &[]);
     eprintln!("{out}");
     assert!(out.contains("OK clean: "), "{out}");
@@ -161,7 +160,7 @@ fn python_mcap_reads_every_channel_of_a_server_recording() {
 
 #[test]
 fn a_recorder_killed_mid_run_leaves_every_finished_chunk_readable() {
-    let port = 17371;
+    let port = ports::free_port();
     let mut server = spawn(
         flexdyn()
             .args(["run", "--duration-s", "10"])
@@ -207,8 +206,8 @@ fn a_recorder_killed_mid_run_leaves_every_finished_chunk_readable() {
 
 #[test]
 fn a_replayed_recording_records_to_the_same_payloads() {
-    let original = batch_recording(17372, "original.mcap");
-    let port = 17373;
+    let original = batch_recording("original.mcap");
+    let port = ports::free_port();
     let again = tmp("again.mcap");
     let _ = std::fs::remove_file(&again);
     // The replay listens and waits 2 s for the recorder to subscribe.
@@ -257,7 +256,7 @@ fn resolve<'a>(msg: &'a serde_json::Value, fields: &str) -> Option<&'a serde_jso
 
 #[test]
 fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
-    let file = batch_recording(17374, "layout.mcap");
+    let file = batch_recording("layout.mcap");
     let bytes = std::fs::read(&file).unwrap();
     let mut first: BTreeMap<String, serde_json::Value> = BTreeMap::new();
     for m in mcap::MessageStream::new(&bytes).unwrap() {
@@ -306,3 +305,4 @@ fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
     }
     assert!(checked >= 20, "only {checked} paths checked");
 }
+

@@ -1,5 +1,5 @@
 //! Bad commands are rejected, counted by reason in StatusMsg.rejected, and the server keeps
-//! running (and still accepts good commands). Ports 17320–17329.
+//! running (and still accepts good commands).
 
 mod server_support;
 
@@ -7,14 +7,14 @@ use std::time::Duration;
 
 use flexdyn::server::{Outcome, ServerSettings};
 use flexdyn_proto::{command_flags, encode, CommandMsg, Header, RejectCounters, Topics};
-use server_support::{reference_config, wait_until, Observer, ServerHandle};
+use server_support::{free_port, reference_config, wait_until, Observer, ServerHandle};
 use zenoh::Wait;
 
 const WAIT: Duration = Duration::from_secs(20);
 
 #[test]
 fn bad_commands_are_counted_and_the_server_keeps_running() {
-    let port = 17320;
+    let port = free_port();
     let topics = Topics::new("sc1").unwrap();
     let mut server = ServerHandle::start(
         port,

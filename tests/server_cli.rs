@@ -1,6 +1,6 @@
 //! The `flexdyn run` binary as a separate process: exit codes and messages of a participant
 //! timeout, of missing participants and of bad settings; graceful SIGTERM; batch mode.
-//! Ports 17340–17349. Every wait is bounded; a child still running at the end is killed.
+//! Every wait is bounded; a child still running at the end is killed.
 
 mod server_support;
 
@@ -10,7 +10,9 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use flexdyn_proto::{decode_state, encode, CommandMsg, Header, Topics};
-use server_support::{connecting_session, endpoint, wait_until, Observer};
+use server_support::{
+    connecting_session, endpoint, free_endpoint, free_port, wait_until, Observer,
+};
 use zenoh::qos::CongestionControl;
 use zenoh::Wait;
 
@@ -113,7 +115,7 @@ impl Drop for Server {
 
 #[test]
 fn lockstep_participant_timeout_exits_nonzero_naming_participant_and_tick() {
-    let port = 17340;
+    let port = free_port();
     let ep = endpoint(port);
     let mut server = Server::spawn(&[
         "run",
@@ -167,7 +169,7 @@ fn lockstep_participant_timeout_exits_nonzero_naming_participant_and_tick() {
 
 #[test]
 fn lockstep_without_participants_gives_up_after_the_presence_timeout() {
-    let port = 17341;
+    let port = free_port();
     let ep = endpoint(port);
     let mut server = Server::spawn(&[
         "run",
@@ -219,7 +221,8 @@ fn bad_settings_exit_2_naming_the_setting() {
         env!("CARGO_MANIFEST_DIR"),
         "/scenarios/zenoh/secure-server.json5"
     );
-    let listen = ["--listen", "tcp/127.0.0.1:17342"];
+    let free = free_endpoint();
+    let listen = ["--listen", free.as_str()];
     let cases: [(&[&str], &str); 7] = [
         // Binding participants to subjects: the shipped ACL reserves cmd/1 for `fsw`.
         (
@@ -267,23 +270,11 @@ fn bad_settings_exit_2_naming_the_setting() {
             "error: server.colour: unknown key",
         ),
         (
-            &[
-                "run",
-                "--duration-s",
-                "0.015",
-                "--listen",
-                "tcp/127.0.0.1:17342",
-            ],
+            &["run", "--duration-s", "0.015", listen[0], listen[1]],
             "is not a whole number of frames",
         ),
         (
-            &[
-                "run",
-                "--stale-after-s",
-                "-1",
-                "--listen",
-                "tcp/127.0.0.1:17342",
-            ],
+            &["run", "--stale-after-s", "-1", listen[0], listen[1]],
             "error: --stale-after-s: must be > 0",
         ),
     ];
@@ -299,7 +290,7 @@ fn bad_settings_exit_2_naming_the_setting() {
 
 #[test]
 fn sigterm_stops_the_realtime_server_gracefully() {
-    let port = 17343;
+    let port = free_port();
     let ep = endpoint(port);
     let mut server = Server::spawn(&["run", "--listen", &ep]);
     let topics = Topics::new("sc1").unwrap();
@@ -351,7 +342,7 @@ fn sigterm_stops_the_realtime_server_gracefully() {
 /// rejection reason is logged at warn, naming the sender, once and then rate-limited.
 #[test]
 fn dropped_commands_reach_the_status_and_rejections_are_logged() {
-    let port = 17346;
+    let port = free_port();
     let ep = endpoint(port);
     let mut server = Server::spawn(&["run", "--listen", &ep, "--command-queue", "1"]);
     let topics = Topics::new("sc1").unwrap();
@@ -417,7 +408,7 @@ fn dropped_commands_reach_the_status_and_rejections_are_logged() {
 
 #[test]
 fn batch_mode_runs_to_the_duration() {
-    let ep = endpoint(17344);
+    let ep = free_endpoint();
     let mut server = Server::spawn(&[
         "run",
         "--mode",
@@ -465,7 +456,7 @@ fn help_lists_the_run_subcommand() {
 /// status, instead of panicking on EPIPE (exit 101/134).
 #[test]
 fn a_closed_stderr_reader_never_takes_the_server_down() {
-    let port = 17345;
+    let port = free_port();
     let ep = endpoint(port);
     // Log at debug so that writes into the closed pipe happen for sure.
     let mut server =

@@ -1,5 +1,5 @@
 //! Real-time mode runs and publishes at about the configured rate (loose counts, no tight timing
-//! assertions), stamps each frame, and handles stale commands per policy. Ports 17330–17339.
+//! assertions), stamps each frame, and handles stale commands per policy.
 
 mod server_support;
 
@@ -11,14 +11,14 @@ use flexdyn::server::{Outcome, ServerSettings};
 use flexdyn_proto::{
     command_flags, encode, CommandMsg, Header, Mode, RunState, StalePolicy, Topics,
 };
-use server_support::{reference_config, wait_until, Observer, ServerHandle};
+use server_support::{free_port, reference_config, wait_until, Observer, ServerHandle};
 use zenoh::Wait;
 
 const WAIT: Duration = Duration::from_secs(30);
 
 #[test]
 fn realtime_100hz_publishes_at_about_the_rate_and_zeroes_stale_commands() {
-    let port = 17330;
+    let port = free_port();
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start(
         port,
@@ -106,7 +106,7 @@ fn realtime_100hz_publishes_at_about_the_rate_and_zeroes_stale_commands() {
 
 #[test]
 fn realtime_1khz_runs() {
-    let port = 17331;
+    let port = free_port();
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start(
         port,
@@ -136,7 +136,7 @@ fn realtime_1khz_runs() {
 
 #[test]
 fn imu_samples_are_published_every_frame_on_their_topics() {
-    let port = 17332;
+    let port = free_port();
     let topics = Topics::new("sc1").unwrap();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/imu_tactical.toml");
     let cfg = flexdyn::config::SimConfig::from_file(&path).unwrap();

@@ -1,7 +1,7 @@
 //! Reaction-wheel commands and star-tracker telemetry through the server, in lockstep: an
 //! `Actuators` command answers the tick and drives the wheels; every malformed effector input
 //! is rejected, counted under its reason, and does not answer the tick; the star tracker
-//! publishes on its own topic at its own rate. Ports 17360–17361.
+//! publishes on its own topic at its own rate.
 
 mod server_support;
 
@@ -14,7 +14,7 @@ use flexdyn_proto::{
     decode_star_tracker, decode_state, effector_kind, encode, CommandMsg, EffectorInput, Header,
     Mode, RejectCounters, StarTrackerMsg, Topics,
 };
-use server_support::{connecting_session, wait_until, Observer, ServerHandle};
+use server_support::{connecting_session, free_port, wait_until, Observer, ServerHandle};
 use zenoh::Wait;
 
 const WAIT: Duration = Duration::from_secs(30);
@@ -35,7 +35,7 @@ fn wheels_config() -> SimConfig {
 
 #[test]
 fn actuators_drive_the_wheels_and_bad_inputs_are_counted() {
-    let port = 17360;
+    let port = free_port();
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start(
         port,

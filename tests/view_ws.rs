@@ -4,8 +4,6 @@
 //! channel advertisements, subscribes, and checks that the decoded states and the N → B frame
 //! transforms agree with the StateMsg stream it receives itself over Zenoh (live), or with the
 //! recording (`--file`, including a pause/seek through playback control).
-//!
-//! Ports 17376–17379.
 
 #[path = "server_support/mod.rs"]
 mod server_support;
@@ -22,7 +20,7 @@ use flexdyn_proto::{decode_state, StateMsg};
 use futures_util::{SinkExt, StreamExt};
 use nalgebra::Vector3;
 use serde_json::{json, Value};
-use server_support::{connecting_session, endpoint};
+use server_support::{connecting_session, endpoint, free_port};
 use tokio_tungstenite::tungstenite::client::IntoClientRequest;
 use tokio_tungstenite::tungstenite::Message;
 use zenoh::Wait;
@@ -241,7 +239,7 @@ fn check_against(seen: &Seen, reference: &HashMap<u64, StateMsg>) -> usize {
 
 #[test]
 fn a_foxglove_client_sees_the_live_state_and_its_transforms() {
-    let (zport, wport) = (17376, 17377);
+    let (zport, wport) = (free_port(), free_port());
     let _server = flexdyn(&["run", "--duration-s", "120", "--listen", &endpoint(zport)]);
     let _viewer = flexdyn(&[
         "view",
@@ -306,8 +304,8 @@ fn recording(port: u16) -> PathBuf {
 
 #[test]
 fn a_recording_plays_back_with_seek() {
-    let file = recording(17378);
-    let wport = 17379;
+    let file = recording(free_port());
+    let wport = free_port();
     let _viewer = flexdyn(&[
         "view",
         "--file",

@@ -11,6 +11,12 @@ use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::{decode_state, decode_status, StateMsg, StatusMsg, Topics};
 use zenoh::{Session, Wait};
 
+// Free ports from the OS, shared with the test files that do not use this harness.
+#[path = "../ports/mod.rs"]
+mod ports;
+#[allow(unused_imports)]
+pub use ports::{free_endpoint, free_port, free_port_range};
+
 /// `tcp/127.0.0.1:<port>`.
 pub fn endpoint(port: u16) -> String {
     format!("tcp/127.0.0.1:{port}")

@@ -3,8 +3,9 @@
 //! finish, the summary has 20 rows, the criteria evaluate and a deliberately failing one fails
 //! everywhere; a run rerun alone with `--index` has the same state hash; a controller that
 //! crashes in one run fails that run with its exit status and the campaign goes on.
-//!
-//! Ports 17800–17819, 17830–17832, 17840–17859.
+
+#[path = "../../tests/ports/mod.rs"]
+mod ports;
 
 use std::path::{Path, PathBuf};
 
@@ -88,7 +89,7 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
         jobs: Some(2),
         index: None,
         record: false,
-        base_port: 17800,
+        base_port: ports::free_port_range(20),
     })
     .unwrap();
     eprintln!("{report}");
@@ -150,7 +151,7 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
         jobs: None,
         index: Some(7),
         record: false,
-        base_port: 17840,
+        base_port: ports::free_port_range(20),
     })
     .unwrap();
     assert_eq!(result(&again, 7).state_sha256, results[7].state_sha256);
@@ -170,7 +171,7 @@ fn a_crashing_controller_fails_its_run_and_the_campaign_goes_on() {
         jobs: Some(1),
         index: None,
         record: false,
-        base_port: 17830,
+        base_port: ports::free_port_range(3),
     })
     .unwrap();
     eprintln!("{report}");

@@ -2,6 +2,9 @@
 //! backtrace, no Rust or registry paths. Negative numbers are accepted in value lists.
 //! No test here reaches a server: each command fails on its input before connecting.
 
+#[path = "../../tests/ports/mod.rs"]
+mod ports;
+
 use std::process::Command;
 
 fn run(bin: &str, args: &[&str]) -> (Option<i32>, String) {
@@ -72,7 +75,7 @@ fn no_server_is_a_failure_not_a_pass() {
     let demo = env!("CARGO_BIN_EXE_flexdyn-acs-demo");
     let (c, e) = run(
         demo,
-        &["--connect", "tcp/127.0.0.1:17391", "--idle-exit-s", "1"],
+        &["--connect", &ports::free_endpoint(), "--idle-exit-s", "1"],
     );
     assert_eq!(c, Some(1), "{e}");
     let last = e.lines().last().unwrap_or_default();
@@ -82,7 +85,7 @@ fn no_server_is_a_failure_not_a_pass() {
     );
     let monitor = env!("CARGO_BIN_EXE_flexdyn-monitor");
     let out = Command::new(monitor)
-        .args(["--connect", "tcp/127.0.0.1:17392", "--duration-s", "1.5"])
+        .args(["--connect", &ports::free_endpoint(), "--duration-s", "1.5"])
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -110,7 +113,8 @@ fn no_server_is_a_failure_not_a_pass() {
 #[test]
 fn the_demo_stops_on_sigint_even_when_started_with_it_ignored() {
     let demo = env!("CARGO_BIN_EXE_flexdyn-acs-demo");
-    for (sig, port) in [("-INT", "17393"), ("-TERM", "17394")] {
+    for sig in ["-INT", "-TERM"] {
+        let port = ports::free_port();
         let mut child = Command::new("sh")
             .args([
                 "-c",
@@ -149,7 +153,7 @@ fn the_scouting_delay_warning_is_quiet_by_default() {
     let monitor = env!("CARGO_BIN_EXE_flexdyn-monitor");
     let stderr_with = |rust_log: &str| {
         let out = Command::new(monitor)
-            .args(["--connect", "tcp/127.0.0.1:17395", "--duration-s", "1"])
+            .args(["--connect", &ports::free_endpoint(), "--duration-s", "1"])
             .env("RUST_LOG", rust_log)
             .output()
             .unwrap();

@@ -13,8 +13,6 @@
 //! The default `handoff = "direct"` (the Zenoh thread delivering a tick's last answer steps and
 //! publishes) must give the stream of `handoff = "thread"` (physics and telemetry threads) bit
 //! for bit.
-//!
-//! Ports 17309–17319.
 
 mod support;
 
@@ -26,7 +24,7 @@ use flexdyn::server::{Handoff, ServerError, ServerSettings};
 use flexdyn_proto::{decode_state, Mode, Topics};
 use nalgebra::Vector3;
 use sha2::{Digest, Sha256};
-use support::{endpoint, reference_config, signal, ChildGuard, Recorder, ServerHandle};
+use support::{endpoint, free_port, reference_config, signal, ChildGuard, Recorder, ServerHandle};
 
 /// Controller gains and target used by every run.
 const K_NM: f64 = 100.0;
@@ -191,7 +189,7 @@ fn digest(states: &[(u64, Vec<u8>)]) -> String {
 fn lockstep_converges_and_is_bit_identical_across_runs_and_pauses() {
     let n_ticks = (DURATION_S * 100.0) as u64 + 1;
 
-    let a = lockstep_run(17310, 10.0, Sabotage::None);
+    let a = lockstep_run(free_port(), 10.0, Sabotage::None);
     let report = a.result.expect("run A");
     assert_eq!(report.last_tick, n_ticks - 1);
     assert_eq!(a.states.len() as u64, n_ticks);
@@ -212,12 +210,12 @@ fn lockstep_converges_and_is_bit_identical_across_runs_and_pauses() {
     assert!(mid.wrench_applied.torque_b_nm.iter().any(|t| *t != 0.0));
     assert_eq!(mid.command_flags, 0);
 
-    let b = lockstep_run(17311, 10.0, Sabotage::None);
+    let b = lockstep_run(free_port(), 10.0, Sabotage::None);
     b.result.expect("run B");
     assert_eq!(digest(&b.states), hash_a, "two identical runs differ");
 
     let c = lockstep_run(
-        17312,
+        free_port(),
         10.0,
         Sabotage::Pause {
             at: 2000,
@@ -236,7 +234,7 @@ fn lockstep_converges_and_is_bit_identical_across_runs_and_pauses() {
         .handoff
         .is_direct(Mode::Lockstep, false));
     let d = lockstep_run_settings(
-        17309,
+        free_port(),
         ServerSettings {
             handoff: Handoff::Thread,
             ..settings(10.0)
@@ -292,7 +290,7 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
         "--imu-dcm-pb",
         "0,1,0,-1,0,0,0,0,1",
     ];
-    let a = lockstep_run_with(17314, 10.0, Sabotage::None, imu_config(), gyro);
+    let a = lockstep_run_with(free_port(), 10.0, Sabotage::None, imu_config(), gyro);
     a.result.expect("gyro run A");
     let settled = assert_converges(&a.states);
     let hash_a = digest(&a.states);
@@ -301,11 +299,11 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
         settling_bound_s()
     );
 
-    let b = lockstep_run_with(17315, 10.0, Sabotage::None, imu_config(), gyro);
+    let b = lockstep_run_with(free_port(), 10.0, Sabotage::None, imu_config(), gyro);
     b.result.expect("gyro run B");
     assert_eq!(digest(&b.states), hash_a, "two gyro-fed runs differ");
 
-    let t = lockstep_run_with(17316, 10.0, Sabotage::None, imu_config(), TRUTH_RATE);
+    let t = lockstep_run_with(free_port(), 10.0, Sabotage::None, imu_config(), TRUTH_RATE);
     t.result.expect("truth-rate run");
     assert_ne!(
         digest(&t.states),
@@ -316,7 +314,7 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
     // The default `--rate-source auto` without --imu must not guess an IMU (the rotated
     // `bracket` is first by name and would be fed back with the wrong mounting): it uses the
     // truth rate, so it converges and equals the truth-rate run bit for bit.
-    let auto = lockstep_run_with(17317, 10.0, Sabotage::None, imu_config(), &[]);
+    let auto = lockstep_run_with(free_port(), 10.0, Sabotage::None, imu_config(), &[]);
     auto.result.expect("auto run");
     assert_converges(&auto.states);
     assert_eq!(
@@ -378,7 +376,7 @@ fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
         states.sort_by_key(|(t, _)| *t);
         (report, states)
     };
-    let (report, a) = run(17318);
+    let (report, a) = run(free_port());
     let mut settled_at = None;
     let mut max_u = 0.0_f64;
     let mut saturated = 0usize;
@@ -417,13 +415,13 @@ fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
         Vector3::from(last.sigma_bn).norm() < 0.005,
         "final attitude error"
     );
-    let (_, b) = run(17319);
+    let (_, b) = run(free_port());
     assert_eq!(digest(&b), hash_a, "two wheel runs differ");
 }
 
 #[test]
 fn killed_controller_stops_the_run_with_a_timeout_naming_it() {
-    let run = lockstep_run(17313, 2.0, Sabotage::Kill { at: 300 });
+    let run = lockstep_run(free_port(), 2.0, Sabotage::Kill { at: 300 });
     let err = run.result.expect_err("the run must fail");
     let msg = err.to_string();
     match err {

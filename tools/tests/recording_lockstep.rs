@@ -2,8 +2,6 @@
 //! exactly the stream a participant received (same SHA-256 over the StateMsg payloads, one state
 //! per tick), every command each participant sent, decoded channels equal to the raw ones field
 //! by field, and the configuration in its metadata.
-//!
-//! Port 17380.
 
 mod support;
 
@@ -14,7 +12,7 @@ use flexdyn::server::ServerSettings;
 use flexdyn::sinks::reader::read_recording;
 use flexdyn_proto::{decode_command, decode_state, Mode, StateMsg, Topics};
 use sha2::{Digest, Sha256};
-use support::{endpoint, reference_config, ChildGuard, Recorder, ServerHandle};
+use support::{endpoint, free_port, reference_config, ChildGuard, Recorder, ServerHandle};
 
 const DURATION_S: f64 = 20.0;
 
@@ -28,7 +26,7 @@ fn sha(payloads: &[&[u8]]) -> String {
 
 #[test]
 fn a_lockstep_recording_is_the_stream_the_participants_saw() {
-    let port = 17380;
+    let port = free_port();
     let file = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("lockstep_record.mcap");
     let _ = std::fs::remove_file(&file);
     let settings = ServerSettings {

@@ -15,7 +15,9 @@
 //!    own key is rejected and counted under `rejected.wrong_identity`, once per impostor command,
 //!    and the trajectory is still the baseline's.
 //!
-//! Ports 17730–17739.
+//! Every peer is given its endpoint on the command line (`--listen`/`--connect`, a free port from
+//! the OS), which replaces the endpoint the shipped JSON5 files name (7447); their authentication
+//! and access control are used exactly as shipped.
 
 mod support;
 
@@ -32,7 +34,7 @@ use flexdyn_proto::{
     Topics,
 };
 use sha2::{Digest, Sha256};
-use support::{endpoint, reference_config, ChildGuard, ServerHandle};
+use support::{endpoint, free_port, reference_config, ChildGuard, ServerHandle};
 use zenoh::{Session, Wait};
 
 const TICKS: u64 = 2000;
@@ -173,9 +175,9 @@ fn baseline(port: u16) -> String {
 
 #[test]
 fn only_the_authenticated_flight_code_commands_the_spacecraft() {
-    let plain = baseline(17730);
+    let plain = baseline(free_port());
 
-    let port = 17731;
+    let port = free_port();
     let topics = Topics::new("sc1").unwrap();
     let server_file = scenario("secure-server.json5");
     let s = settings(&[(1, "fsw")], true);
@@ -328,9 +330,9 @@ fn two_participant_acl() -> PathBuf {
 
 #[test]
 fn a_participant_claiming_another_ones_sender_id_is_rejected_and_counted() {
-    let plain = baseline(17732);
+    let plain = baseline(free_port());
 
-    let port = 17733;
+    let port = free_port();
     let topics = Topics::new("sc1").unwrap();
     let acl = two_participant_acl();
     let s = settings(&[(1, "fsw"), (2, "operator")], true);
