@@ -205,8 +205,9 @@ enum FrameLoop {
 
 /// Where the command callback delivers a validated command.
 enum CommandSink {
-    /// The physics thread's bounded queue (never blocks: a full queue drops and counts).
-    Queue(Mutex<SyncSender<flexdyn_proto::CommandMsg>>),
+    /// The physics thread's bounded queue (never blocks: a full queue drops and counts),
+    /// behind the [`commands::Gate`].
+    Queue(Mutex<(SyncSender<flexdyn_proto::CommandMsg>, commands::Gate)>),
     /// Lockstep with `handoff = "direct"`: the core, stepped in this callback.
     Core(Arc<Mutex<LockstepCore>>),
 }
@@ -296,12 +297,23 @@ fn command_callback(
             return;
         }
         match &sink {
-            CommandSink::Queue(tx) => {
-                let tx = tx.lock().unwrap_or_else(|p| p.into_inner());
-                if tx.try_send(cmd).is_err() {
-                    shared
-                        .commands_dropped
-                        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            CommandSink::Queue(queue) => {
+                let mut queue = queue.lock().unwrap_or_else(|p| p.into_inner());
+                let (tx, gate) = &mut *queue;
+                let published = shared.tick.load(std::sync::atomic::Ordering::Acquire);
+                let offer = gate.check(&cmd, published);
+                if offer != commands::Offer::Accepted {
+                    physics::count_offer(&shared, offer, cmd.sender_id);
+                    return;
+                }
+                let (sender, tick) = (cmd.sender_id, cmd.header.tick);
+                match tx.try_send(cmd) {
+                    Ok(()) => gate.queued(sender, tick),
+                    Err(_) => {
+                        shared
+                            .commands_dropped
+                            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    }
                 }
             }
             CommandSink::Core(core) => core.lock().unwrap_or_else(|p| p.into_inner()).offer(&cmd),
@@ -519,6 +531,7 @@ pub async fn run(
     let (n_imus, n_sts) = (sim.n_imus(), sim.star_trackers().len());
     let new_frame = || Box::new(Frame::for_snapshot(&shape, n_imus, n_sts));
     let frame_ns = cfg.frame_ns;
+    let input_ranges = sim.spacecraft().effector_input_ranges().to_vec();
     let stepper = Stepper::new(sim, &settings);
 
     // Who steps the frames, and where the frame publishers go: the physics thread (real time,
@@ -549,7 +562,12 @@ pub async fn run(
                     .send(new_frame())
                     .map_err(|_| ServerError::Internal("telemetry pool".into()))?;
             }
-            CommandSink::Queue(Mutex::new(cmd_tx))
+            let gate = commands::Gate::new(
+                &settings.participants,
+                &input_ranges,
+                mode == Mode::Lockstep,
+            );
+            CommandSink::Queue(Mutex::new((cmd_tx, gate)))
         }
     };
 
