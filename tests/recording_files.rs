@@ -306,3 +306,211 @@ fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
     assert!(checked >= 20, "only {checked} paths checked");
 }
 
+/// `flexdyn record` of a synthetic publisher whose StateMsg sequence numbers 0..100 skip
+/// `skipped`: the exit code, the summary line, and the file's `flexdyn.recorder` metadata.
+fn record_states(name: &str, skipped: &[u64]) -> (Option<i32>, String, BTreeMap<String, String>) {
+    use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
+    use flexdyn_proto::{encode, Header, StateMsg};
+    use std::io::Read;
+    use zenoh::Wait;
+
+    let port = ports::free_port();
+    let file = tmp(name);
+    let _ = std::fs::remove_file(&file);
+    let args = ZenohArgs {
+        listen: vec![endpoint(port)],
+        ..ZenohArgs::default()
+    };
+    let session = zenoh::open(zenoh_config(&args, Role::Server).unwrap())
+        .wait()
+        .unwrap();
+    let publisher = session
+        .declare_publisher("flexdyn/gaps/tlm/state")
+        .wait()
+        .unwrap();
+    let mut recorder = Guard(
+        flexdyn()
+            .args([
+                "record",
+                "--sc-id",
+                "gaps",
+                "--connect",
+                &endpoint(port),
+                "-o",
+            ])
+            .arg(&file)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let give_up = Instant::now() + Duration::from_secs(20);
+    while !publisher.matching_status().wait().unwrap().matching() {
+        assert!(Instant::now() < give_up, "the recorder never subscribed");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    for seq in (0..100u64).filter(|s| !skipped.contains(s)) {
+        let state = StateMsg {
+            header: Header::new(7, seq, seq * 10_000_000, seq),
+            ..StateMsg::default()
+        };
+        publisher.put(encode(&state)).wait().unwrap();
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    Command::new("kill")
+        .args(["-INT", &recorder.0.id().to_string()])
+        .status()
+        .unwrap();
+    let status = wait_exit(&mut recorder, Duration::from_secs(30));
+    let mut stderr = String::new();
+    recorder
+        .0
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    let rec = read_recording(&file).unwrap();
+    let states = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == "flexdyn/gaps/tlm/state")
+        .count();
+    assert_eq!(states, 100 - skipped.len(), "{stderr}");
+    let meta = rec.metadata["flexdyn.recorder"].clone();
+    (status.code(), stderr, meta)
+}
+
+/// A recording never claims to be complete when it is not: the publisher's sequence numbers
+/// show what is missing, per key, in the metadata, the summary line and the exit code (3).
+#[test]
+fn a_recording_with_a_sequence_gap_says_it_is_incomplete() {
+    let (code, stderr, meta) = record_states("gap.mcap", &[40, 41, 42]);
+    eprintln!("{stderr}{meta:?}");
+    assert_eq!(code, Some(3), "{stderr}");
+    let last = stderr.lines().last().unwrap_or_default();
+    assert!(
+        last.ends_with(
+            "dropped 0; INCOMPLETE: 3 telemetry messages missing (sequence-number gaps: \
+             flexdyn/gaps/tlm/state 3)"
+        ),
+        "{stderr}"
+    );
+    assert_eq!(meta["missing_samples"], "3");
+    assert_eq!(meta["missing_samples.flexdyn/gaps/tlm/state"], "3");
+    assert_eq!(meta["complete"], "false");
+
+    let (code, stderr, meta) = record_states("whole.mcap", &[]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(
+        stderr
+            .lines()
+            .last()
+            .unwrap_or_default()
+            .ends_with("dropped 0; complete"),
+        "{stderr}"
+    );
+    assert_eq!(meta["missing_samples"], "0");
+    assert_eq!(meta["complete"], "true");
+}
+
+/// Under CPU load (more busy threads than cores) a recorder next to a 1 kHz real-time server
+/// reports exactly what its file misses: the gaps the test counts in the file's sequence
+/// numbers, key by key, are the metadata's, the summary's and the exit code's.
+#[test]
+fn a_recording_under_load_reports_exactly_what_it_misses() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    let config = tmp("rt_1khz.toml");
+    std::fs::write(
+        &config,
+        flexdyn::config::DEFAULT_CONFIG_TOML.replace("frame_hz = 100.0 ", "frame_hz = 1000.0 "),
+    )
+    .unwrap();
+    let port = ports::free_port();
+    let _server = spawn(
+        flexdyn()
+            .args(["run", "--duration-s", "12", "--listen", &endpoint(port)])
+            .arg("--config")
+            .arg(&config),
+    );
+    let file = tmp("loaded.mcap");
+    let _ = std::fs::remove_file(&file);
+    let mut recorder = Guard(
+        flexdyn()
+            .args(["record", "--connect", &endpoint(port), "--duration-s", "6"])
+            .arg("--output")
+            .arg(&file)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let stop = Arc::new(AtomicBool::new(false));
+    let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
+    let hogs: Vec<_> = (0..cores + 1)
+        .map(|_| {
+            let stop = stop.clone();
+            std::thread::spawn(move || {
+                let mut x = 0u64;
+                while !stop.load(Ordering::Relaxed) {
+                    x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+                }
+                x
+            })
+        })
+        .collect();
+    std::thread::sleep(Duration::from_secs(5));
+    stop.store(true, Ordering::Relaxed);
+    for h in hogs {
+        h.join().unwrap();
+    }
+    let status = wait_exit(&mut recorder, Duration::from_secs(30));
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(&mut recorder.0.stderr.take().unwrap(), &mut stderr).unwrap();
+    let rec = read_recording(&file).unwrap();
+    // The test's own count: per telemetry key, the jumps of header.seq.
+    let mut last: BTreeMap<&str, u64> = BTreeMap::new();
+    let mut gaps: BTreeMap<String, u64> = BTreeMap::new();
+    for s in &rec.samples {
+        let seq = match s.key.as_str() {
+            "flexdyn/sc1/tlm/state" => decode_state(&s.payload).unwrap().header.seq,
+            "flexdyn/sc1/status" => flexdyn_proto::decode_status(&s.payload).unwrap().header.seq,
+            _ => continue,
+        };
+        if let Some(prev) = last.insert(&s.key, seq) {
+            if seq > prev + 1 {
+                *gaps.entry(s.key.clone()).or_default() += seq - prev - 1;
+            }
+        }
+    }
+    let states = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == "flexdyn/sc1/tlm/state")
+        .count();
+    let missing: u64 = gaps.values().sum();
+    eprintln!(
+        "under load: {states} states recorded, {missing} messages missing {gaps:?}\n{stderr}"
+    );
+    // 6 s at 1 kHz, less the recorder's start.
+    assert!(states > 3000, "{stderr}");
+    let meta = &rec.metadata["flexdyn.recorder"];
+    assert_eq!(meta["missing_samples"], missing.to_string());
+    for (key, n) in &gaps {
+        assert_eq!(meta[&format!("missing_samples.{key}")], n.to_string());
+    }
+    assert_eq!(meta["complete"], (missing == 0).to_string());
+    let last_line = stderr.lines().last().unwrap_or_default();
+    if missing == 0 {
+        assert_eq!(status.code(), Some(0), "{stderr}");
+        assert!(last_line.ends_with("dropped 0; complete"), "{stderr}");
+    } else {
+        assert_eq!(status.code(), Some(3), "{stderr}");
+        assert!(
+            last_line.contains(&format!("INCOMPLETE: {missing} telemetry messages missing")),
+            "{stderr}"
+        );
+    }
+}

@@ -161,8 +161,10 @@ impl fmt::Display for RunReport {
         if let Some(r) = &self.recording {
             write!(
                 f,
-                " recorded_samples={} record_dropped={}",
-                r.stats.samples, r.dropped
+                " recorded_samples={} record_dropped={} record_missing={}",
+                r.stats.samples,
+                r.dropped,
+                r.stats.missing_total()
             )?;
         }
         if let Some(c) = &self.direct_publish {
