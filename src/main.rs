@@ -144,9 +144,18 @@ fn main() -> ExitCode {
         Some(Command::Replay(a)) => {
             return run_sink(sinks::replay::replay(&a), |r| {
                 format!(
-                    "replayed {} samples in {:.3} s{}",
+                    "replayed {} samples in {:.3} s{}{}",
                     r.published,
                     r.wall_s,
+                    if r.unheard > 0 {
+                        format!(
+                            "; {} of them while no subscriber matched their key (nobody \
+                             received those)",
+                            r.unheard
+                        )
+                    } else {
+                        String::new()
+                    },
                     r.truncated
                         .as_ref()
                         .map_or(String::new(), |why| format!(" (file ends early: {why})"))

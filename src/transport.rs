@@ -6,8 +6,9 @@
 //!    Zenoh's defaults in **peer** mode.
 //! 2. `--listen` / `--connect` (repeatable) replace the file's endpoints. Without them, and if
 //!    the file does not set them either, the role's loopback defaults apply: the server listens
-//!    on `tcp/127.0.0.1:7447` and connects nowhere; a tool listens nowhere and connects to
-//!    `tcp/127.0.0.1:7447`. (Zenoh's own peer default would listen on every interface.)
+//!    on `tcp/127.0.0.1:7447` and connects nowhere (so does `flexdyn replay`, which stands in
+//!    for it); a tool listens nowhere and connects to `tcp/127.0.0.1:7447`. (Zenoh's own peer
+//!    default would listen on every interface.)
 //! 3. The server's links queue 16 batches of data samples ([`SERVER_TX_QUEUE_BATCHES`]), not
 //!    Zenoh's 2, unless the file sets it: real-time telemetry is dropped when a queue is full.
 //! 4. Multicast scouting is **always** switched off (`scouting/multicast/enabled = false`),
@@ -31,11 +32,12 @@ pub const SERVER_TX_QUEUE_BATCHES: u32 = 16;
 #[derive(Clone, Debug, Default, PartialEq, Eq, clap::Args)]
 pub struct ZenohArgs {
     /// Zenoh endpoint to listen on, e.g. `tcp/127.0.0.1:7447` (repeatable). Default: the server
-    /// listens on tcp/127.0.0.1:7447, the tools listen nowhere.
+    /// and `flexdyn replay` (which stands in for it) listen on tcp/127.0.0.1:7447, the other
+    /// tools listen nowhere.
     #[arg(long = "listen", value_name = "ENDPOINT")]
     pub listen: Vec<String>,
-    /// Zenoh endpoint to connect to (repeatable). Default: the server connects nowhere, the
-    /// tools connect to tcp/127.0.0.1:7447.
+    /// Zenoh endpoint to connect to (repeatable). Default: the server and `flexdyn replay`
+    /// connect nowhere, the other tools connect to tcp/127.0.0.1:7447.
     #[arg(long = "connect", value_name = "ENDPOINT")]
     pub connect: Vec<String>,
     /// Standard Zenoh JSON5 configuration file; `--listen`/`--connect` override its endpoints.
@@ -285,13 +287,17 @@ pub fn zenoh_config(args: &ZenohArgs, role: Role) -> Result<zenoh::Config, Zenoh
     Ok(config)
 }
 
+/// A configuration value as JSON, for the tests that check what [`zenoh_config`] built.
+#[cfg(test)]
+pub(crate) fn config_value(c: &zenoh::Config, key: &str) -> serde_json::Value {
+    serde_json::from_str(&c.get_json(key).expect("a known key")).expect("JSON")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn get(c: &zenoh::Config, key: &str) -> serde_json::Value {
-        serde_json::from_str(&c.get_json(key).unwrap()).unwrap()
-    }
+    use super::config_value as get;
 
     #[test]
     fn defaults_are_loopback_peer_without_multicast() {

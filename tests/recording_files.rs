@@ -210,17 +210,18 @@ fn a_replayed_recording_records_to_the_same_payloads() {
     let port = ports::free_port();
     let again = tmp("again.mcap");
     let _ = std::fs::remove_file(&again);
-    // The replay listens and waits 2 s for the recorder to subscribe.
+    // The README's pair, on a free port instead of 7447: the replay listens like the server
+    // and waits for a subscriber; the recorder connects to it. (That the replay listens on
+    // 7447 by default, where the tools connect, is the `replay` module's unit test.)
     let mut replay = spawn(
         flexdyn()
             .arg("replay")
             .arg(&original)
-            .args(["--as-fast-as-possible", "--start-delay-s", "2"])
             .args(["--listen", &endpoint(port)]),
     );
     let mut recorder = spawn(
         flexdyn()
-            .args(["record", "--connect", &endpoint(port), "-o"])
+            .args(["record", "--connect", &endpoint(port), "--output"])
             .arg(&again),
     );
     assert!(wait_exit(&mut replay, Duration::from_secs(60)).success());
@@ -412,6 +413,53 @@ fn a_recording_with_a_sequence_gap_says_it_is_incomplete() {
     );
     assert_eq!(meta["missing_samples"], "0");
     assert_eq!(meta["complete"], "true");
+}
+
+/// A replay that nobody subscribes to says so and fails, instead of claiming it replayed
+/// every sample; told not to wait, it replays and counts the samples nobody received.
+#[test]
+fn a_replay_without_subscribers_says_so() {
+    let original = batch_recording("unheard.mcap");
+    let listen = ports::free_endpoint();
+    let out = flexdyn()
+        .arg("replay")
+        .arg(&original)
+        .args(["--listen", &listen, "--wait-subscriber-s", "1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    let last = err.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("error: no subscriber matched any of the recording's ")
+            && last.contains(&format!("the replay listens on {listen}")),
+        "{err}"
+    );
+    let out = flexdyn()
+        .arg("replay")
+        .arg(&original)
+        .args([
+            "--listen",
+            &ports::free_endpoint(),
+            "--wait-subscriber-s",
+            "0",
+        ])
+        .args(["--start-delay-s", "0", "--as-fast-as-possible"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let n = read_recording(&original).unwrap().samples.len();
+    assert!(
+        err.lines()
+            .last()
+            .unwrap_or_default()
+            .starts_with(&format!("replayed {n} samples in "))
+            && err.contains(&format!(
+                "; {n} of them while no subscriber matched their key (nobody received those)"
+            )),
+        "{err}"
+    );
 }
 
 /// Under CPU load (more busy threads than cores) a recorder next to a 1 kHz real-time server

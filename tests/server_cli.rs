@@ -451,6 +451,51 @@ fn help_lists_the_run_subcommand() {
     }
 }
 
+/// Every subcommand's help states each option's default once (clap adds `[default: …]` for a
+/// default value; a doc comment that says it too printed it twice).
+#[test]
+fn every_help_states_each_default_once() {
+    let help = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{args:?}");
+        String::from_utf8_lossy(&out.stdout).to_string()
+    };
+    let top = help(&["--help"]);
+    let commands: Vec<String> = top
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .map(str::to_owned)
+        .collect();
+    assert!(
+        commands.iter().any(|c| c == "replay") && commands.len() >= 9,
+        "{commands:?} from:\n{top}"
+    );
+    for c in &commands {
+        let text = help(&[c, "--help"]);
+        // An option's text runs from its `-x, --name` line to the next option's.
+        let mut options: Vec<String> = Vec::new();
+        for line in text.lines() {
+            match options.last_mut() {
+                Some(o) if !line.trim_start().starts_with('-') => o.push_str(line),
+                _ => options.push(line.to_owned()),
+            }
+        }
+        for option in options.iter().filter(|o| o.trim_start().starts_with('-')) {
+            assert!(
+                option.matches("[default: ").count() <= 1,
+                "`flexdyn {c} --help` states a default twice: {option}"
+            );
+        }
+    }
+}
+
 /// `flexdyn 2>&1 | tee log`, then Ctrl-C: the reader of stderr dies first. The server must keep
 /// running while it logs into the closed pipe, then stop on SIGTERM with exit 0 and its final
 /// status, instead of panicking on EPIPE (exit 101/134).

@@ -49,7 +49,7 @@ pub struct ViewArgs {
     /// Serve this recording instead of the live stream, with playback control.
     #[arg(long, value_name = "FILE.mcap")]
     pub file: Option<PathBuf>,
-    /// Messages each viewer's queue holds before it drops its oldest [default: 4096].
+    /// Messages each viewer's queue holds before it drops its oldest.
     #[arg(long, value_name = "N", default_value_t = 4096)]
     pub backlog: usize,
     /// Stop after this many seconds of wall time (for scripts and tests). Default: until
