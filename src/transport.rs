@@ -14,6 +14,9 @@
 //! 4. Multicast scouting is **always** switched off (`scouting/multicast/enabled = false`),
 //!    even if the file switches it on (a warning is logged): flexdyn never sends multicast, so
 //!    nothing leaves this machine unless an endpoint says so.
+//!
+//! A listening process logs where it listens ([`log_listening`]); `--listen tcp/127.0.0.1:0`
+//! lets the OS pick a free port, and that line names it.
 
 use std::path::PathBuf;
 
@@ -121,6 +124,34 @@ pub fn clean_zenoh_message(message: &str) -> String {
         s.replace_range(i..i + end, "");
     }
     s.trim_end_matches('.').trim().to_string()
+}
+
+/// The endpoints `session` listens on, with the port the OS chose where the endpoint asked for
+/// port 0 (`--listen tcp/127.0.0.1:0` → `tcp/127.0.0.1:41234`). Empty for a session that only
+/// connects.
+pub fn listening_on(session: &zenoh::Session) -> Vec<String> {
+    use zenoh::Wait;
+    session
+        .info()
+        .locators()
+        .wait()
+        .iter()
+        .map(ToString::to_string)
+        .collect()
+}
+
+/// The line a listening process logs once it is reachable: `Zenoh listening on <endpoint>, …`.
+/// With `--listen tcp/127.0.0.1:0` it is how a user, a script or a test learns the port (the
+/// tests read it back from stderr instead of guessing a free port).
+pub const LISTENING_PREFIX: &str = "Zenoh listening on ";
+
+/// Logs [`LISTENING_PREFIX`] and [`listening_on`] at `info` (nothing for a session that only
+/// connects).
+pub fn log_listening(session: &zenoh::Session) {
+    let endpoints = listening_on(session);
+    if !endpoints.is_empty() {
+        tracing::info!("{LISTENING_PREFIX}{}", endpoints.join(", "));
+    }
 }
 
 /// Checks a `--listen`/`--connect` endpoint before Zenoh sees it: `<protocol>/<address>`, and

@@ -400,7 +400,7 @@ fn check_config_validates_the_server_table_as_run_does() {
         assert!(line.contains(want), "{lines}: {line}");
         assert!(stdout(&check).is_empty());
         // `run` rejects the same file the same way, before opening any session.
-        let run = flexdyn(&["run", "--config", p, "--listen", &ports::free_endpoint()]);
+        let run = flexdyn(&["run", "--config", p, "--listen", ports::ANY_PORT]);
         assert_eq!(run.status.code(), Some(2), "run {lines}: {}", stderr(&run));
         assert!(stderr(&run).contains(want), "run {lines}: {}", stderr(&run));
     }
@@ -474,7 +474,7 @@ fn the_server_stops_on_a_non_finite_state_with_exit_1() {
         "--duration-s",
         "1",
         "--listen",
-        &ports::free_endpoint(),
+        ports::ANY_PORT,
     ]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");

@@ -72,7 +72,7 @@ fn a_recording_gives_every_figure() {
     let rec = tmp("batch.mcap");
     let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
         .args(["run", "--mode", "batch", "--duration-s", "5"])
-        .args(["--listen", &ports::free_endpoint(), "--config"])
+        .args(["--listen", ports::ANY_PORT, "--config"])
         .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml"))
         .arg("--record")
         .arg(&rec)

@@ -22,10 +22,6 @@ fn flexdyn() -> Command {
     Command::new(env!("CARGO_BIN_EXE_flexdyn"))
 }
 
-fn endpoint(port: u16) -> String {
-    format!("tcp/127.0.0.1:{port}")
-}
-
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
@@ -54,7 +50,7 @@ fn batch_recording(name: &str) -> PathBuf {
     py_support::run(
         flexdyn()
             .args(["run", "--mode", "batch", "--duration-s", "5"])
-            .args(["--listen", &ports::free_endpoint()])
+            .args(["--listen", ports::ANY_PORT])
             .arg("--config")
             .arg(root().join("scenarios/wheels_star_tracker.toml"))
             .arg("--record")
@@ -99,6 +95,13 @@ fn spawn(cmd: &mut Command) -> Guard {
             .spawn()
             .unwrap(),
     )
+}
+
+/// A `flexdyn run`/`replay` started with `--listen ANY_PORT`, and the endpoint it reports.
+fn spawn_listening(cmd: &mut Command) -> (Guard, String) {
+    let mut guard = Guard(ports::reporting(cmd).stdout(Stdio::null()).spawn().unwrap());
+    let endpoint = ports::zenoh_endpoint(&mut guard.0);
+    (guard, endpoint)
 }
 
 fn wait_exit(child: &mut Guard, timeout: Duration) -> std::process::ExitStatus {
@@ -160,17 +163,16 @@ fn python_mcap_reads_every_channel_of_a_server_recording() {
 
 #[test]
 fn a_recorder_killed_mid_run_leaves_every_finished_chunk_readable() {
-    let port = ports::free_port();
-    let mut server = spawn(
+    let (mut server, endpoint) = spawn_listening(
         flexdyn()
             .args(["run", "--duration-s", "10"])
-            .args(["--listen", &endpoint(port)]),
+            .args(["--listen", ports::ANY_PORT]),
     );
     let file = tmp("killed.mcap");
     let _ = std::fs::remove_file(&file);
     let mut recorder = spawn(
         flexdyn()
-            .args(["record", "--connect", &endpoint(port), "-o"])
+            .args(["record", "--connect", &endpoint, "-o"])
             .arg(&file),
     );
     std::thread::sleep(Duration::from_millis(3500));
@@ -207,21 +209,20 @@ fn a_recorder_killed_mid_run_leaves_every_finished_chunk_readable() {
 #[test]
 fn a_replayed_recording_records_to_the_same_payloads() {
     let original = batch_recording("original.mcap");
-    let port = ports::free_port();
     let again = tmp("again.mcap");
     let _ = std::fs::remove_file(&again);
     // The README's pair, on a free port instead of 7447: the replay listens like the server
     // and waits for a subscriber; the recorder connects to it. (That the replay listens on
     // 7447 by default, where the tools connect, is the `replay` module's unit test.)
-    let mut replay = spawn(
+    let (mut replay, endpoint) = spawn_listening(
         flexdyn()
             .arg("replay")
             .arg(&original)
-            .args(["--listen", &endpoint(port)]),
+            .args(["--listen", ports::ANY_PORT]),
     );
     let mut recorder = spawn(
         flexdyn()
-            .args(["record", "--connect", &endpoint(port), "--output"])
+            .args(["record", "--connect", &endpoint, "--output"])
             .arg(&again),
     );
     assert!(wait_exit(&mut replay, Duration::from_secs(60)).success());
@@ -315,30 +316,23 @@ fn record_states(name: &str, skipped: &[u64]) -> (Option<i32>, String, BTreeMap<
     use std::io::Read;
     use zenoh::Wait;
 
-    let port = ports::free_port();
     let file = tmp(name);
     let _ = std::fs::remove_file(&file);
     let args = ZenohArgs {
-        listen: vec![endpoint(port)],
+        listen: vec![ports::ANY_PORT.into()],
         ..ZenohArgs::default()
     };
     let session = zenoh::open(zenoh_config(&args, Role::Server).unwrap())
         .wait()
         .unwrap();
+    let endpoint = flexdyn::transport::listening_on(&session).remove(0);
     let publisher = session
         .declare_publisher("flexdyn/gaps/tlm/state")
         .wait()
         .unwrap();
     let mut recorder = Guard(
         flexdyn()
-            .args([
-                "record",
-                "--sc-id",
-                "gaps",
-                "--connect",
-                &endpoint(port),
-                "-o",
-            ])
+            .args(["record", "--sc-id", "gaps", "--connect", &endpoint, "-o"])
             .arg(&file)
             .stdout(Stdio::null())
             .stderr(Stdio::piped())
@@ -420,15 +414,18 @@ fn a_recording_with_a_sequence_gap_says_it_is_incomplete() {
 #[test]
 fn a_replay_without_subscribers_says_so() {
     let original = batch_recording("unheard.mcap");
-    let listen = ports::free_endpoint();
     let out = flexdyn()
         .arg("replay")
         .arg(&original)
-        .args(["--listen", &listen, "--wait-subscriber-s", "1"])
+        .args(["--listen", ports::ANY_PORT, "--wait-subscriber-s", "1"])
+        .env("RUST_LOG", "info")
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
+    // The error names the endpoint the replay really listened on, not the `:0` it was given.
+    let listen = ports::find_zenoh_endpoint(&err).expect("the replay reports its endpoint");
+    assert_ne!(ports::port_of(&listen), 0);
     let last = err.lines().last().unwrap_or_default();
     assert!(
         last.starts_with("error: no subscriber matched any of the recording's ")
@@ -438,12 +435,7 @@ fn a_replay_without_subscribers_says_so() {
     let out = flexdyn()
         .arg("replay")
         .arg(&original)
-        .args([
-            "--listen",
-            &ports::free_endpoint(),
-            "--wait-subscriber-s",
-            "0",
-        ])
+        .args(["--listen", ports::ANY_PORT, "--wait-subscriber-s", "0"])
         .args(["--start-delay-s", "0", "--as-fast-as-possible"])
         .output()
         .unwrap();
@@ -476,10 +468,9 @@ fn a_recording_under_load_reports_exactly_what_it_misses() {
         flexdyn::config::DEFAULT_CONFIG_TOML.replace("frame_hz = 100.0 ", "frame_hz = 1000.0 "),
     )
     .unwrap();
-    let port = ports::free_port();
-    let _server = spawn(
+    let (_server, endpoint) = spawn_listening(
         flexdyn()
-            .args(["run", "--duration-s", "12", "--listen", &endpoint(port)])
+            .args(["run", "--duration-s", "12", "--listen", ports::ANY_PORT])
             .arg("--config")
             .arg(&config),
     );
@@ -487,7 +478,7 @@ fn a_recording_under_load_reports_exactly_what_it_misses() {
     let _ = std::fs::remove_file(&file);
     let mut recorder = Guard(
         flexdyn()
-            .args(["record", "--connect", &endpoint(port), "--duration-s", "6"])
+            .args(["record", "--connect", &endpoint, "--duration-s", "6"])
             .arg("--output")
             .arg(&file)
             .stdout(Stdio::null())

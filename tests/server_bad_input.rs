@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use flexdyn::server::{Outcome, ServerSettings};
 use flexdyn_proto::{command_flags, encode, CommandMsg, Header, RejectCounters, Topics};
-use server_support::{free_port, reference_config, wait_until, Observer, ServerHandle};
+use server_support::{reference_config, wait_until, Observer, ServerHandle};
 use zenoh::Wait;
 
 const WAIT: Duration = Duration::from_secs(20);
@@ -15,8 +15,8 @@ const WAIT: Duration = Duration::from_secs(20);
 /// A real-time server of spacecraft `sc1` (the reference spacecraft at `frame_hz`) on a free
 /// port, and an observer that has seen its first states.
 fn running(settings: ServerSettings, frame_hz: f64) -> (ServerHandle, Observer) {
-    let port = free_port();
-    let server = ServerHandle::start(port, settings, reference_config(frame_hz));
+    let server = ServerHandle::start(settings, reference_config(frame_hz));
+    let port = server.port;
     let obs = Observer::start(port, &Topics::new("sc1").unwrap());
     assert!(
         wait_until(WAIT, || obs.last_tick().is_some_and(|t| t >= 2)),

@@ -10,9 +10,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use flexdyn_proto::{decode_state, encode, CommandMsg, Header, Topics};
-use server_support::{
-    connecting_session, endpoint, free_endpoint, free_port, wait_until, Observer,
-};
+use server_support::{connecting_session, port_of, ports, wait_until, Observer, ANY_PORT};
 use zenoh::qos::CongestionControl;
 use zenoh::Wait;
 
@@ -27,8 +25,8 @@ impl Server {
         Self::start(args, "info", false)
     }
 
-    /// Like [`Self::spawn`], but the stderr reader closes its end of the pipe after the first
-    /// chunk, as a killed `tee` would; later log lines go into a closed pipe.
+    /// Like [`Self::spawn`], but the stderr reader closes its end of the pipe once the server
+    /// has reported its endpoint, as a killed `tee` would; later log lines go into a closed pipe.
     fn spawn_closing_stderr(args: &[&str], rust_log: &str) -> Self {
         Self::start(args, rust_log, true)
     }
@@ -51,10 +49,9 @@ impl Server {
                 if n == 0 {
                     break;
                 }
-                sink.lock()
-                    .unwrap()
-                    .push_str(&String::from_utf8_lossy(&buf[..n]));
-                if close_after_first_read {
+                let mut text = sink.lock().unwrap();
+                text.push_str(&String::from_utf8_lossy(&buf[..n]));
+                if close_after_first_read && ports::find_zenoh_endpoint(&text).is_some() {
                     break; // drops `pipe`: the read end closes
                 }
             }
@@ -81,6 +78,22 @@ impl Server {
 
     fn stderr(&self) -> String {
         self.stderr.lock().unwrap().clone()
+    }
+
+    /// The port the server reports it listens on (it was started with `--listen ANY_PORT`).
+    fn port(&mut self) -> u16 {
+        let mut found = None;
+        let reported = wait_until(Duration::from_secs(60), || {
+            found = ports::find_zenoh_endpoint(&self.stderr());
+            found.is_some() || self.child.try_wait().unwrap().is_some()
+        });
+        match found {
+            Some(ep) if reported => port_of(&ep),
+            _ => panic!(
+                "the server reported no endpoint; stderr:\n{}",
+                self.stderr()
+            ),
+        }
     }
 
     /// Waits (30 s at most) until `obs` has seen the state of `tick`.
@@ -115,8 +128,7 @@ impl Drop for Server {
 
 #[test]
 fn lockstep_participant_timeout_exits_nonzero_naming_participant_and_tick() {
-    let port = free_port();
-    let ep = endpoint(port);
+    let ep = ANY_PORT;
     let mut server = Server::spawn(&[
         "run",
         "--mode",
@@ -126,10 +138,11 @@ fn lockstep_participant_timeout_exits_nonzero_naming_participant_and_tick() {
         "--participant-timeout-s",
         "1",
         "--listen",
-        &ep,
+        ep,
         "--duration-s",
         "100",
     ]);
+    let port = server.port();
     // A participant that answers ticks 0..=4, then goes silent.
     let topics = Topics::new("sc1").unwrap();
     let session = connecting_session(port);
@@ -169,8 +182,7 @@ fn lockstep_participant_timeout_exits_nonzero_naming_participant_and_tick() {
 
 #[test]
 fn lockstep_without_participants_gives_up_after_the_presence_timeout() {
-    let port = free_port();
-    let ep = endpoint(port);
+    let ep = ANY_PORT;
     let mut server = Server::spawn(&[
         "run",
         "--mode",
@@ -180,8 +192,9 @@ fn lockstep_without_participants_gives_up_after_the_presence_timeout() {
         "--presence-timeout-s",
         "2",
         "--listen",
-        &ep,
+        ep,
     ]);
+    let port = server.port();
     // While it waits, the status says so.
     let obs = Observer::start(port, &Topics::new("sc1").unwrap());
     assert!(
@@ -221,8 +234,7 @@ fn bad_settings_exit_2_naming_the_setting() {
         env!("CARGO_MANIFEST_DIR"),
         "/scenarios/zenoh/secure-server.json5"
     );
-    let free = free_endpoint();
-    let listen = ["--listen", free.as_str()];
+    let listen = ["--listen", ANY_PORT];
     let cases: [(&[&str], &str); 7] = [
         // Binding participants to subjects: the shipped ACL reserves cmd/1 for `fsw`.
         (
@@ -290,9 +302,9 @@ fn bad_settings_exit_2_naming_the_setting() {
 
 #[test]
 fn sigterm_stops_the_realtime_server_gracefully() {
-    let port = free_port();
-    let ep = endpoint(port);
-    let mut server = Server::spawn(&["run", "--listen", &ep]);
+    let ep = ANY_PORT;
+    let mut server = Server::spawn(&["run", "--listen", ep]);
+    let port = server.port();
     let topics = Topics::new("sc1").unwrap();
     let obs = Observer::start(port, &topics);
     server.await_tick(&obs, 10);
@@ -342,9 +354,9 @@ fn sigterm_stops_the_realtime_server_gracefully() {
 /// rejection reason is logged at warn, naming the sender, once and then rate-limited.
 #[test]
 fn dropped_commands_reach_the_status_and_rejections_are_logged() {
-    let port = free_port();
-    let ep = endpoint(port);
+    let ep = ANY_PORT;
     let mut server = Server::spawn(&["run", "--listen", &ep, "--command-queue", "1"]);
+    let port = server.port();
     let topics = Topics::new("sc1").unwrap();
     let obs = Observer::start(port, &topics);
     server.await_tick(&obs, 5);
@@ -408,7 +420,7 @@ fn dropped_commands_reach_the_status_and_rejections_are_logged() {
 
 #[test]
 fn batch_mode_runs_to_the_duration() {
-    let ep = free_endpoint();
+    let ep = ANY_PORT;
     let mut server = Server::spawn(&[
         "run",
         "--mode",
@@ -416,7 +428,7 @@ fn batch_mode_runs_to_the_duration() {
         "--duration-s",
         "20",
         "--listen",
-        &ep,
+        ep,
     ]);
     let status = server.wait(Duration::from_secs(60));
     let err = server.stderr();
@@ -501,11 +513,11 @@ fn every_help_states_each_default_once() {
 /// status, instead of panicking on EPIPE (exit 101/134).
 #[test]
 fn a_closed_stderr_reader_never_takes_the_server_down() {
-    let port = free_port();
-    let ep = endpoint(port);
+    let ep = ANY_PORT;
     // Log at debug so that writes into the closed pipe happen for sure.
     let mut server =
         Server::spawn_closing_stderr(&["--listen", &ep, "--summary-interval-s", "0.05"], "debug");
+    let port = server.port();
     let topics = Topics::new("sc1").unwrap();
     let obs = Observer::start(port, &topics);
     server.await_tick(&obs, 30);

@@ -14,7 +14,7 @@ use flexdyn_proto::{
     decode_star_tracker, decode_state, effector_kind, encode, CommandMsg, EffectorInput, Header,
     Mode, RejectCounters, StarTrackerMsg, Topics,
 };
-use server_support::{connecting_session, free_port, wait_until, Observer, ServerHandle};
+use server_support::{connecting_session, wait_until, Observer, ServerHandle};
 use zenoh::Wait;
 
 const WAIT: Duration = Duration::from_secs(30);
@@ -35,10 +35,8 @@ fn wheels_config() -> SimConfig {
 
 #[test]
 fn actuators_drive_the_wheels_and_bad_inputs_are_counted() {
-    let port = free_port();
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start(
-        port,
         ServerSettings {
             mode: Mode::Lockstep,
             participants: vec![1],
@@ -49,6 +47,7 @@ fn actuators_drive_the_wheels_and_bad_inputs_are_counted() {
         },
         wheels_config(),
     );
+    let port = server.port;
     let obs = Observer::start(port, &topics);
     let trackers: Arc<Mutex<Vec<StarTrackerMsg>>> = Arc::default();
     let t = trackers.clone();

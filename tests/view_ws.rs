@@ -20,7 +20,7 @@ use flexdyn_proto::{decode_state, StateMsg};
 use futures_util::{SinkExt, StreamExt};
 use nalgebra::Vector3;
 use serde_json::{json, Value};
-use server_support::{connecting_session, endpoint, free_port};
+use server_support::{connecting_session, port_of, reporting, ws_port, zenoh_endpoint, ANY_PORT};
 use tokio_tungstenite::tungstenite::client::IntoClientRequest;
 use tokio_tungstenite::tungstenite::Message;
 use zenoh::Wait;
@@ -34,12 +34,11 @@ impl Drop for Guard {
     }
 }
 
+/// `flexdyn ARGS` with its stderr piped, so the test can read the port it reports.
 fn flexdyn(args: &[&str]) -> Guard {
     Guard(
-        Command::new(env!("CARGO_BIN_EXE_flexdyn"))
-            .args(args)
+        reporting(Command::new(env!("CARGO_BIN_EXE_flexdyn")).args(args))
             .stdout(Stdio::null())
-            .stderr(Stdio::null())
             .spawn()
             .unwrap(),
     )
@@ -251,19 +250,20 @@ fn check_against(seen: &Seen, reference: &HashMap<u64, StateMsg>) -> usize {
 
 #[test]
 fn a_foxglove_client_sees_the_live_state_and_its_transforms() {
-    let (zport, wport) = (free_port(), free_port());
-    let _server = flexdyn(&["run", "--duration-s", "120", "--listen", &endpoint(zport)]);
-    let _viewer = flexdyn(&[
+    let mut server = flexdyn(&["run", "--duration-s", "120", "--listen", ANY_PORT]);
+    let zenoh = zenoh_endpoint(&mut server.0);
+    let mut viewer = flexdyn(&[
         "view",
         "--bind",
-        &format!("127.0.0.1:{wport}"),
+        "127.0.0.1:0",
         "--connect",
-        &endpoint(zport),
+        &zenoh,
         "--duration-s",
         "120",
     ]);
+    let wport = ws_port(&mut viewer.0);
     // Our own view of the stream, over Zenoh.
-    let session = connecting_session(zport);
+    let session = connecting_session(port_of(&zenoh));
     let states: Arc<Mutex<HashMap<u64, StateMsg>>> = Arc::default();
     let s2 = states.clone();
     let _sub = session
@@ -332,7 +332,7 @@ fn clock_keeps_up(seen: &Seen) {
     );
 }
 
-fn recording(port: u16) -> PathBuf {
+fn recording() -> PathBuf {
     let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join("view_file.mcap");
     let _ = std::fs::remove_file(&file);
     let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
@@ -343,7 +343,7 @@ fn recording(port: u16) -> PathBuf {
             "--duration-s",
             "20",
             "--listen",
-            &endpoint(port),
+            ANY_PORT,
         ])
         .arg("--record")
         .arg(&file)
@@ -357,17 +357,17 @@ fn recording(port: u16) -> PathBuf {
 
 #[test]
 fn a_recording_plays_back_with_seek() {
-    let file = recording(free_port());
-    let wport = free_port();
-    let _viewer = flexdyn(&[
+    let file = recording();
+    let mut viewer = flexdyn(&[
         "view",
         "--file",
         file.to_str().unwrap(),
         "--bind",
-        &format!("127.0.0.1:{wport}"),
+        "127.0.0.1:0",
         "--duration-s",
         "120",
     ]);
+    let wport = ws_port(&mut viewer.0);
     let rec = read_recording(&file).unwrap();
     let reference: HashMap<u64, StateMsg> = rec
         .samples

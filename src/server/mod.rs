@@ -202,6 +202,7 @@ fn prepare(
         cfg.summary()
     );
     tracing::info!("server settings: {}", settings.summary());
+    crate::transport::log_listening(session);
     if settings.mode == Mode::RealTime && settings.stale_policy == StalePolicy::Hold {
         tracing::debug!("stale commands are held (stale_policy = hold)");
     }

@@ -133,6 +133,8 @@ pub fn replay(args: &ReplayArgs) -> Result<ReplayReport, SinkError> {
         let session = zenoh::open(zcfg)
             .await
             .map_err(|e| SinkError::zenoh("open the session", e))?;
+        crate::transport::log_listening(&session);
+        let listening = crate::transport::listening_on(&session);
         // Answer each recorded vehicle's configuration query as its server did, so a recorder
         // or viewer of the replay gets the same metadata and 3D geometry.
         let mut queryables = Vec::new();
@@ -170,7 +172,7 @@ pub fn replay(args: &ReplayArgs) -> Result<ReplayReport, SinkError> {
                     return Err(SinkError::NoSubscriber {
                         keys: publishers.len(),
                         waited_s: args.wait_subscriber_s,
-                        endpoints: endpoints_text(&args.zenoh),
+                        endpoints: endpoints_text(&args.zenoh, &listening),
                     });
                 }
                 tokio::time::sleep(MATCH_POLL).await;
@@ -244,16 +246,22 @@ async fn any_matched<'a>(publishers: impl IntoIterator<Item = &'a Publisher<'a>>
 }
 
 /// Where the replay listens or connects, in words (`listens on tcp/127.0.0.1:7447`).
-fn endpoints_text(z: &ZenohArgs) -> String {
+/// `listening`: where its session really listens (the port the OS gave for `:0`), if known.
+fn endpoints_text(z: &ZenohArgs, listening: &[String]) -> String {
     let list = |v: &[String]| v.join(", ");
-    match (z.listen.is_empty(), z.connect.is_empty(), &z.zenoh_config) {
+    let listen = if listening.is_empty() {
+        &z.listen
+    } else {
+        listening
+    };
+    match (listen.is_empty(), z.connect.is_empty(), &z.zenoh_config) {
         (true, true, Some(file)) => format!("uses the endpoints of {}", file.display()),
         (true, true, None) => format!("listens on {}", crate::transport::DEFAULT_ENDPOINT),
-        (false, true, _) => format!("listens on {}", list(&z.listen)),
+        (false, true, _) => format!("listens on {}", list(listen)),
         (true, false, _) => format!("connects to {}", list(&z.connect)),
         (false, false, _) => format!(
             "listens on {} and connects to {}",
-            list(&z.listen),
+            list(listen),
             list(&z.connect)
         ),
     }
@@ -279,7 +287,7 @@ mod tests {
             "the replay connects nowhere by default"
         );
         assert_eq!(
-            endpoints_text(&ZenohArgs::default()),
+            endpoints_text(&ZenohArgs::default(), &[]),
             "listens on tcp/127.0.0.1:7447"
         );
     }

@@ -73,10 +73,8 @@ fn the_monitor_and_pingpong_reject_bad_options_in_one_line() {
 #[test]
 fn no_server_is_a_failure_not_a_pass() {
     let demo = env!("CARGO_BIN_EXE_flexdyn-acs-demo");
-    let (c, e) = run(
-        demo,
-        &["--connect", &ports::free_endpoint(), "--idle-exit-s", "1"],
-    );
+    let (nobody, _held) = ports::closed_endpoint();
+    let (c, e) = run(demo, &["--connect", &nobody, "--idle-exit-s", "1"]);
     assert_eq!(c, Some(1), "{e}");
     let last = e.lines().last().unwrap_or_default();
     assert!(
@@ -85,7 +83,7 @@ fn no_server_is_a_failure_not_a_pass() {
     );
     let monitor = env!("CARGO_BIN_EXE_flexdyn-monitor");
     let out = Command::new(monitor)
-        .args(["--connect", &ports::free_endpoint(), "--duration-s", "1.5"])
+        .args(["--connect", &nobody, "--duration-s", "1.5"])
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -114,11 +112,11 @@ fn no_server_is_a_failure_not_a_pass() {
 fn the_demo_stops_on_sigint_even_when_started_with_it_ignored() {
     let demo = env!("CARGO_BIN_EXE_flexdyn-acs-demo");
     for sig in ["-INT", "-TERM"] {
-        let port = ports::free_port();
+        let (nobody, _held) = ports::closed_endpoint();
         let mut child = Command::new("sh")
             .args([
                 "-c",
-                &format!("trap '' INT; exec {demo} --connect tcp/127.0.0.1:{port}"),
+                &format!("trap '' INT; exec {demo} --connect {nobody}"),
             ])
             .stderr(std::process::Stdio::null())
             .spawn()
@@ -151,9 +149,10 @@ fn the_demo_stops_on_sigint_even_when_started_with_it_ignored() {
 #[test]
 fn the_scouting_delay_warning_is_quiet_by_default() {
     let monitor = env!("CARGO_BIN_EXE_flexdyn-monitor");
+    let (nobody, _held) = ports::closed_endpoint();
     let stderr_with = |rust_log: &str| {
         let out = Command::new(monitor)
-            .args(["--connect", &ports::free_endpoint(), "--duration-s", "1"])
+            .args(["--connect", &nobody, "--duration-s", "1"])
             .env("RUST_LOG", rust_log)
             .output()
             .unwrap();

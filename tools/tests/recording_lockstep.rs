@@ -12,7 +12,7 @@ use flexdyn::server::ServerSettings;
 use flexdyn::sinks::reader::read_recording;
 use flexdyn_proto::{decode_command, decode_state, Mode, StateMsg, Topics};
 use sha2::{Digest, Sha256};
-use support::{endpoint, free_port, reference_config, ChildGuard, Recorder, ServerHandle};
+use support::{endpoint, reference_config, ChildGuard, Recorder, ServerHandle};
 
 const DURATION_S: f64 = 20.0;
 
@@ -26,7 +26,6 @@ fn sha(payloads: &[&[u8]]) -> String {
 
 #[test]
 fn a_lockstep_recording_is_the_stream_the_participants_saw() {
-    let port = free_port();
     let file = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("lockstep_record.mcap");
     let _ = std::fs::remove_file(&file);
     let settings = ServerSettings {
@@ -39,7 +38,8 @@ fn a_lockstep_recording_is_the_stream_the_participants_saw() {
     let cfg = reference_config(100.0);
     let config_toml = cfg.source_toml.clone();
     let topics = Topics::new("sc1").unwrap();
-    let server = ServerHandle::start(port, settings, cfg);
+    let server = ServerHandle::start(settings, cfg);
+    let port = server.port;
     let participant = Recorder::start(port, &topics, 2);
     let _ctrl = ChildGuard::spawn(
         Command::new(env!("CARGO_BIN_EXE_flexdyn-acs-demo"))
