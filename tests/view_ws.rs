@@ -89,6 +89,8 @@ struct Seen {
     state_arrivals: Vec<(Instant, u64)>,
     /// (arrival, announced time) of each `time` message.
     times: Vec<(Instant, u64)>,
+    /// Channel ids of subscriptions the server refused as unknown (see [`watch`]).
+    refused: Vec<u64>,
 }
 
 impl Seen {
@@ -98,6 +100,12 @@ impl Seen {
                 let v: Value = serde_json::from_str(&t).unwrap();
                 match v["op"].as_str() {
                     Some("serverInfo") => self.server_info = Some(v),
+                    Some("status") => {
+                        let text = v["message"].as_str().unwrap_or_default();
+                        if let Some(id) = text.strip_prefix("Unknown channel ID: ") {
+                            self.refused.push(id.trim().parse().unwrap());
+                        }
+                    }
                     Some("advertise") => {
                         for c in v["channels"].as_array().unwrap() {
                             self.channels.insert(
@@ -187,19 +195,48 @@ async fn watch(
     let (tf_id, tf_schema, _) = seen.channels[TF_TOPIC].clone();
     assert_eq!(tf_schema, "foxglove.FrameTransforms");
     assert!(seen.channels.contains_key("/flexdyn/sc1/scene"));
-    let subscribe = json!({"op": "subscribe", "subscriptions": [
-        {"id": 1, "channelId": state_id}, {"id": 2, "channelId": tf_id}]});
-    ws.send(Message::Text(subscribe.to_string().into()))
-        .await
-        .unwrap();
+    let subscription = |channel: u64| {
+        let id = if channel == state_id { 1 } else { 2 };
+        json!({"id": id, "channelId": channel})
+    };
+    let subscribe = |channels: &[u64]| {
+        let list: Vec<Value> = channels.iter().map(|c| subscription(*c)).collect();
+        Message::Text(
+            json!({"op": "subscribe", "subscriptions": list})
+                .to_string()
+                .into(),
+        )
+    };
+    ws.send(subscribe(&[state_id, tf_id])).await.unwrap();
     if let Some(request) = before_collect {
         ws.send(Message::Binary(request.into())).await.unwrap();
     }
-    pump_until(&mut ws, &mut seen, Duration::from_secs(30), |s| {
-        s.messages.get(&1).is_some_and(|m| m.len() >= enough)
-            && s.messages.get(&2).is_some_and(|m| m.len() >= enough)
-    })
-    .await;
+    // The Foxglove SDK (0.30) sends a channel's advertisement before it notes the channel as
+    // advertised to this client; a subscription that arrives in between is refused ("Unknown
+    // channel ID"). Foxglove's app shows that error; this client subscribes again, a few times
+    // at most.
+    for attempt in 0.. {
+        pump_until(&mut ws, &mut seen, Duration::from_secs(30), |s| {
+            !s.refused.is_empty()
+                || (s.messages.get(&1).is_some_and(|m| m.len() >= enough)
+                    && s.messages.get(&2).is_some_and(|m| m.len() >= enough))
+        })
+        .await;
+        if seen.refused.is_empty() {
+            break;
+        }
+        assert!(
+            attempt < 3,
+            "subscriptions refused again: {:?}",
+            seen.refused
+        );
+        eprintln!(
+            "subscriptions to channels {:?} refused as unknown; subscribing again",
+            seen.refused
+        );
+        let refused = std::mem::take(&mut seen.refused);
+        ws.send(subscribe(&refused)).await.unwrap();
+    }
     let _ = ws.close(None).await;
     seen
 }
