@@ -1,6 +1,7 @@
 //! The `flexdyn` command-line entry point: parses arguments, initialises logging and calls the
 //! library. Every error is reported as one `error: …` line on stderr with a non-zero exit code
-//! (2 for invalid input, 1 for a failure while running); nothing here panics on bad input.
+//! (2 for invalid input, 1 for a failure while running; `flexdyn record` exits 3 when the file
+//! it wrote is incomplete); nothing here panics on bad input.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -124,23 +125,37 @@ fn main() -> ExitCode {
         }),
         Some(Command::PrintDefaultConfig) => print_default_config(),
         Some(Command::Record(a)) => {
-            return run_sink(sinks::record_cmd::record(&a), |r| {
+            let result = sinks::record_cmd::record(&a);
+            let incomplete = result.as_ref().is_ok_and(|r| !r.complete());
+            let code = run_sink(result, |r| {
                 format!(
-                    "recorded {} samples ({} payload bytes, {} undecodable) to {}; dropped {}",
+                    "recorded {} samples ({} payload bytes, {} undecodable) to {}; dropped {}; {}",
                     r.stats.samples,
                     r.stats.payload_bytes,
                     r.stats.undecodable,
                     a.output.display(),
-                    r.dropped
+                    r.dropped,
+                    r.completeness()
                 )
-            })
+            });
+            // The file is written and readable, but it is not the whole stream.
+            return if incomplete { ExitCode::from(3) } else { code };
         }
         Some(Command::Replay(a)) => {
             return run_sink(sinks::replay::replay(&a), |r| {
                 format!(
-                    "replayed {} samples in {:.3} s{}",
+                    "replayed {} samples in {:.3} s{}{}",
                     r.published,
                     r.wall_s,
+                    if r.unheard > 0 {
+                        format!(
+                            "; {} of them while no subscriber matched their key (nobody \
+                             received those)",
+                            r.unheard
+                        )
+                    } else {
+                        String::new()
+                    },
                     r.truncated
                         .as_ref()
                         .map_or(String::new(), |why| format!(" (file ends early: {why})"))

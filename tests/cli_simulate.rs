@@ -1,6 +1,8 @@
 //! The `flexdyn` binary's offline subcommands, run as a user would: `simulate`, `check-config`
 //! and `print-default-config`.
 
+mod ports;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -466,7 +468,7 @@ fn check_config_validates_the_server_table_as_run_does() {
         assert!(longest_digits < Some(20), "{lines}: {line}");
         assert!(stdout(&check).is_empty());
         // `run` rejects the same file the same way, before opening any session.
-        let run = flexdyn(&["run", "--config", p, "--listen", "tcp/127.0.0.1:17359"]);
+        let run = flexdyn(&["run", "--config", p, "--listen", ports::ANY_PORT]);
         let run_err = stderr(&run);
         assert_eq!(run.status.code(), Some(2), "run {lines}: {run_err}");
         assert!(run_err.contains(want), "run {lines}: {run_err}");
@@ -543,7 +545,7 @@ fn the_server_stops_on_a_non_finite_state_with_exit_1() {
         "--duration-s",
         "1",
         "--listen",
-        "tcp/127.0.0.1:17358",
+        ports::ANY_PORT,
     ]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(1), "{err}");

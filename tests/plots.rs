@@ -5,6 +5,8 @@
 //! invariant on its own scale, the intervals of external torque, the wheel and star-tracker
 //! figures, the IMU layout, and every point inside its panel's axis bounds.
 
+mod ports;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -75,7 +77,7 @@ fn a_recording_gives_every_figure() {
     let rec = tmp("batch.mcap");
     let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
         .args(["run", "--mode", "batch", "--duration-s", "5"])
-        .args(["--listen", "tcp/127.0.0.1:0", "--config"])
+        .args(["--listen", ports::ANY_PORT, "--config"])
         .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml"))
         .arg("--record")
         .arg(&rec)

@@ -2,9 +2,8 @@
 //! `replay`, `export`) and independent readers check them — Python's `mcap` package (PyPI,
 //! `tests/py/check_recording.py`, in its own venv `<target>/python-mcap-venv`) and the CSV
 //! files.
-//!
-//! Ports 17370–17374.
 
+mod ports;
 mod py_support;
 
 use std::collections::BTreeMap;
@@ -21,10 +20,6 @@ const MCAP_PY: &str = "mcap==1.6.0";
 
 fn flexdyn() -> Command {
     Command::new(env!("CARGO_BIN_EXE_flexdyn"))
-}
-
-fn endpoint(port: u16) -> String {
-    format!("tcp/127.0.0.1:{port}")
 }
 
 fn root() -> PathBuf {
@@ -49,13 +44,13 @@ fn check_with_python(file: &Path, extra: &[&str]) -> String {
 }
 
 /// A finished batch run of the wheel scenario recorded by the server itself.
-fn batch_recording(port: u16, name: &str) -> PathBuf {
+fn batch_recording(name: &str) -> PathBuf {
     let file = tmp(name);
     let _ = std::fs::remove_file(&file);
     py_support::run(
         flexdyn()
             .args(["run", "--mode", "batch", "--duration-s", "5"])
-            .args(["--listen", &endpoint(port)])
+            .args(["--listen", ports::ANY_PORT])
             .arg("--config")
             .arg(root().join("scenarios/wheels_star_tracker.toml"))
             .arg("--record")
@@ -102,6 +97,13 @@ fn spawn(cmd: &mut Command) -> Guard {
     )
 }
 
+/// A `flexdyn run`/`replay` started with `--listen ANY_PORT`, and the endpoint it reports.
+fn spawn_listening(cmd: &mut Command) -> (Guard, String) {
+    let mut guard = Guard(ports::reporting(cmd).stdout(Stdio::null()).spawn().unwrap());
+    let endpoint = ports::zenoh_endpoint(&mut guard.0);
+    (guard, endpoint)
+}
+
 fn wait_exit(child: &mut Guard, timeout: Duration) -> std::process::ExitStatus {
     let give_up = Instant::now() + timeout;
     loop {
@@ -115,7 +117,7 @@ fn wait_exit(child: &mut Guard, timeout: Duration) -> std::process::ExitStatus {
 
 #[test]
 fn python_mcap_reads_every_channel_of_a_server_recording() {
-    let file = batch_recording(17370, "batch.mcap");
+    let file = batch_recording("batch.mcap");
     let out = check_with_python(&file, &[]);
     eprintln!("{out}");
     assert!(out.contains("OK clean: "), "{out}");
@@ -162,17 +164,16 @@ fn python_mcap_reads_every_channel_of_a_server_recording() {
 
 #[test]
 fn a_recorder_killed_mid_run_leaves_every_finished_chunk_readable() {
-    let port = 17371;
-    let mut server = spawn(
+    let (mut server, endpoint) = spawn_listening(
         flexdyn()
             .args(["run", "--duration-s", "10"])
-            .args(["--listen", &endpoint(port)]),
+            .args(["--listen", ports::ANY_PORT]),
     );
     let file = tmp("killed.mcap");
     let _ = std::fs::remove_file(&file);
     let mut recorder = spawn(
         flexdyn()
-            .args(["record", "--connect", &endpoint(port), "-o"])
+            .args(["record", "--connect", &endpoint, "-o"])
             .arg(&file),
     );
     std::thread::sleep(Duration::from_millis(3500));
@@ -208,21 +209,21 @@ fn a_recorder_killed_mid_run_leaves_every_finished_chunk_readable() {
 
 #[test]
 fn a_replayed_recording_records_to_the_same_payloads() {
-    let original = batch_recording(17372, "original.mcap");
-    let port = 17373;
+    let original = batch_recording("original.mcap");
     let again = tmp("again.mcap");
     let _ = std::fs::remove_file(&again);
-    // The replay listens and waits 2 s for the recorder to subscribe.
-    let mut replay = spawn(
+    // The README's pair, on a free port instead of 7447: the replay listens like the server
+    // and waits for a subscriber; the recorder connects to it. (That the replay listens on
+    // 7447 by default, where the tools connect, is the `replay` module's unit test.)
+    let (mut replay, endpoint) = spawn_listening(
         flexdyn()
             .arg("replay")
             .arg(&original)
-            .args(["--as-fast-as-possible", "--start-delay-s", "2"])
-            .args(["--listen", &endpoint(port)]),
+            .args(["--listen", ports::ANY_PORT]),
     );
     let mut recorder = spawn(
         flexdyn()
-            .args(["record", "--connect", &endpoint(port), "-o"])
+            .args(["record", "--connect", &endpoint, "--output"])
             .arg(&again),
     );
     assert!(wait_exit(&mut replay, Duration::from_secs(60)).success());
@@ -258,7 +259,7 @@ fn resolve<'a>(msg: &'a serde_json::Value, fields: &str) -> Option<&'a serde_jso
 
 #[test]
 fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
-    let file = batch_recording(17374, "layout.mcap");
+    let file = batch_recording("layout.mcap");
     let bytes = std::fs::read(&file).unwrap();
     let mut first: BTreeMap<String, serde_json::Value> = BTreeMap::new();
     for m in mcap::MessageStream::new(&bytes).unwrap() {
@@ -306,4 +307,250 @@ fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
         }
     }
     assert!(checked >= 20, "only {checked} paths checked");
+}
+
+/// `flexdyn record` of a synthetic publisher whose StateMsg sequence numbers 0..100 skip
+/// `skipped`: the exit code, the summary line, and the file's `flexdyn.recorder` metadata.
+fn record_states(name: &str, skipped: &[u64]) -> (Option<i32>, String, BTreeMap<String, String>) {
+    use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
+    use flexdyn_proto::{encode, Header, StateMsg};
+    use std::io::Read;
+    use zenoh::Wait;
+
+    let file = tmp(name);
+    let _ = std::fs::remove_file(&file);
+    let args = ZenohArgs {
+        listen: vec![ports::ANY_PORT.into()],
+        ..ZenohArgs::default()
+    };
+    let session = zenoh::open(zenoh_config(&args, Role::Server).unwrap())
+        .wait()
+        .unwrap();
+    let endpoint = flexdyn::transport::listening_on(&session).remove(0);
+    let publisher = session
+        .declare_publisher("flexdyn/gaps/tlm/state")
+        .wait()
+        .unwrap();
+    let mut recorder = Guard(
+        flexdyn()
+            .args(["record", "--sc-id", "gaps", "--connect", &endpoint, "-o"])
+            .arg(&file)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let give_up = Instant::now() + Duration::from_secs(20);
+    while !publisher.matching_status().wait().unwrap().matching() {
+        assert!(Instant::now() < give_up, "the recorder never subscribed");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    for seq in (0..100u64).filter(|s| !skipped.contains(s)) {
+        let state = StateMsg {
+            header: Header::new(7, seq, seq * 10_000_000, seq),
+            ..StateMsg::default()
+        };
+        publisher.put(encode(&state)).wait().unwrap();
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    Command::new("kill")
+        .args(["-INT", &recorder.0.id().to_string()])
+        .status()
+        .unwrap();
+    let status = wait_exit(&mut recorder, Duration::from_secs(30));
+    let mut stderr = String::new();
+    recorder
+        .0
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    let rec = read_recording(&file).unwrap();
+    let states = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == "flexdyn/gaps/tlm/state")
+        .count();
+    assert_eq!(states, 100 - skipped.len(), "{stderr}");
+    let meta = rec.metadata["flexdyn.recorder"].clone();
+    (status.code(), stderr, meta)
+}
+
+/// A recording never claims to be complete when it is not: the publisher's sequence numbers
+/// show what is missing, per key, in the metadata, the summary line and the exit code (3).
+#[test]
+fn a_recording_with_a_sequence_gap_says_it_is_incomplete() {
+    let (code, stderr, meta) = record_states("gap.mcap", &[40, 41, 42]);
+    eprintln!("{stderr}{meta:?}");
+    assert_eq!(code, Some(3), "{stderr}");
+    let last = stderr.lines().last().unwrap_or_default();
+    assert!(
+        last.ends_with(
+            "dropped 0; INCOMPLETE: 3 telemetry messages missing (sequence-number gaps: \
+             flexdyn/gaps/tlm/state 3)"
+        ),
+        "{stderr}"
+    );
+    assert_eq!(meta["missing_samples"], "3");
+    assert_eq!(meta["missing_samples.flexdyn/gaps/tlm/state"], "3");
+    assert_eq!(meta["complete"], "false");
+
+    let (code, stderr, meta) = record_states("whole.mcap", &[]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(
+        stderr
+            .lines()
+            .last()
+            .unwrap_or_default()
+            .ends_with("dropped 0; complete"),
+        "{stderr}"
+    );
+    assert_eq!(meta["missing_samples"], "0");
+    assert_eq!(meta["complete"], "true");
+}
+
+/// A replay that nobody subscribes to says so and fails, instead of claiming it replayed
+/// every sample; told not to wait, it replays and counts the samples nobody received.
+#[test]
+fn a_replay_without_subscribers_says_so() {
+    let original = batch_recording("unheard.mcap");
+    let out = flexdyn()
+        .arg("replay")
+        .arg(&original)
+        .args(["--listen", ports::ANY_PORT, "--wait-subscriber-s", "1"])
+        .env("RUST_LOG", "info")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    // The error names the endpoint the replay really listened on, not the `:0` it was given.
+    let listen = ports::find_zenoh_endpoint(&err).expect("the replay reports its endpoint");
+    assert_ne!(ports::port_of(&listen), 0);
+    let last = err.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("error: no subscriber matched any of the recording's ")
+            && last.contains(&format!("the replay listens on {listen}")),
+        "{err}"
+    );
+    let out = flexdyn()
+        .arg("replay")
+        .arg(&original)
+        .args(["--listen", ports::ANY_PORT, "--wait-subscriber-s", "0"])
+        .args(["--start-delay-s", "0", "--as-fast-as-possible"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let n = read_recording(&original).unwrap().samples.len();
+    assert!(
+        err.lines()
+            .last()
+            .unwrap_or_default()
+            .starts_with(&format!("replayed {n} samples in "))
+            && err.contains(&format!(
+                "; {n} of them while no subscriber matched their key (nobody received those)"
+            )),
+        "{err}"
+    );
+}
+
+/// Under CPU load (more busy threads than cores) a recorder next to a 1 kHz real-time server
+/// reports exactly what its file misses: the gaps the test counts in the file's sequence
+/// numbers, key by key, are the metadata's, the summary's and the exit code's.
+#[test]
+fn a_recording_under_load_reports_exactly_what_it_misses() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    let config = tmp("rt_1khz.toml");
+    std::fs::write(
+        &config,
+        flexdyn::config::DEFAULT_CONFIG_TOML.replace("frame_hz = 100.0 ", "frame_hz = 1000.0 "),
+    )
+    .unwrap();
+    let (_server, endpoint) = spawn_listening(
+        flexdyn()
+            .args(["run", "--duration-s", "12", "--listen", ports::ANY_PORT])
+            .arg("--config")
+            .arg(&config),
+    );
+    let file = tmp("loaded.mcap");
+    let _ = std::fs::remove_file(&file);
+    let mut recorder = Guard(
+        flexdyn()
+            .args(["record", "--connect", &endpoint, "--duration-s", "6"])
+            .arg("--output")
+            .arg(&file)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let stop = Arc::new(AtomicBool::new(false));
+    let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
+    let hogs: Vec<_> = (0..cores + 1)
+        .map(|_| {
+            let stop = stop.clone();
+            std::thread::spawn(move || {
+                let mut x = 0u64;
+                while !stop.load(Ordering::Relaxed) {
+                    x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+                }
+                x
+            })
+        })
+        .collect();
+    std::thread::sleep(Duration::from_secs(5));
+    stop.store(true, Ordering::Relaxed);
+    for h in hogs {
+        h.join().unwrap();
+    }
+    let status = wait_exit(&mut recorder, Duration::from_secs(30));
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(&mut recorder.0.stderr.take().unwrap(), &mut stderr).unwrap();
+    let rec = read_recording(&file).unwrap();
+    // The test's own count: per telemetry key, the jumps of header.seq.
+    let mut last: BTreeMap<&str, u64> = BTreeMap::new();
+    let mut gaps: BTreeMap<String, u64> = BTreeMap::new();
+    for s in &rec.samples {
+        let seq = match s.key.as_str() {
+            "flexdyn/sc1/tlm/state" => decode_state(&s.payload).unwrap().header.seq,
+            "flexdyn/sc1/status" => flexdyn_proto::decode_status(&s.payload).unwrap().header.seq,
+            _ => continue,
+        };
+        if let Some(prev) = last.insert(&s.key, seq) {
+            if seq > prev + 1 {
+                *gaps.entry(s.key.clone()).or_default() += seq - prev - 1;
+            }
+        }
+    }
+    let states = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == "flexdyn/sc1/tlm/state")
+        .count();
+    let missing: u64 = gaps.values().sum();
+    eprintln!(
+        "under load: {states} states recorded, {missing} messages missing {gaps:?}\n{stderr}"
+    );
+    // 6 s at 1 kHz, less the recorder's start.
+    assert!(states > 3000, "{stderr}");
+    let meta = &rec.metadata["flexdyn.recorder"];
+    assert_eq!(meta["missing_samples"], missing.to_string());
+    for (key, n) in &gaps {
+        assert_eq!(meta[&format!("missing_samples.{key}")], n.to_string());
+    }
+    assert_eq!(meta["complete"], (missing == 0).to_string());
+    let last_line = stderr.lines().last().unwrap_or_default();
+    if missing == 0 {
+        assert_eq!(status.code(), Some(0), "{stderr}");
+        assert!(last_line.ends_with("dropped 0; complete"), "{stderr}");
+    } else {
+        assert_eq!(status.code(), Some(3), "{stderr}");
+        assert!(
+            last_line.contains(&format!("INCOMPLETE: {missing} telemetry messages missing")),
+            "{stderr}"
+        );
+    }
 }

@@ -1,5 +1,5 @@
 //! Bad commands are rejected, counted by reason in StatusMsg.rejected, and the server keeps
-//! running (and still accepts good commands). Ports 17320–17329.
+//! running (and still accepts good commands).
 
 mod server_support;
 
@@ -12,23 +12,29 @@ use zenoh::Wait;
 
 const WAIT: Duration = Duration::from_secs(20);
 
+/// A real-time server of spacecraft `sc1` (the reference spacecraft at `frame_hz`) on a free
+/// port, and an observer that has seen its first states.
+fn running(settings: ServerSettings, frame_hz: f64) -> (ServerHandle, Observer) {
+    let server = ServerHandle::start(settings, reference_config(frame_hz));
+    let port = server.port;
+    let obs = Observer::start(port, &Topics::new("sc1").unwrap());
+    assert!(
+        wait_until(WAIT, || obs.last_tick().is_some_and(|t| t >= 2)),
+        "no telemetry"
+    );
+    (server, obs)
+}
+
 #[test]
 fn bad_commands_are_counted_and_the_server_keeps_running() {
-    let port = 17320;
     let topics = Topics::new("sc1").unwrap();
-    let mut server = ServerHandle::start(
-        port,
+    let (mut server, obs) = running(
         ServerSettings {
             participants: vec![1],
             status_hz: 50.0,
             ..ServerSettings::default()
         },
-        reference_config(100.0),
-    );
-    let obs = Observer::start(port, &topics);
-    assert!(
-        wait_until(WAIT, || obs.last_tick().is_some_and(|t| t >= 5)),
-        "no telemetry"
+        100.0,
     );
     let cmd_pub = obs.session.declare_publisher(topics.cmd(1)).wait().unwrap();
     let put = |bytes: Vec<u8>| cmd_pub.put(bytes).wait().unwrap();
@@ -134,4 +140,83 @@ fn bad_commands_are_counted_and_the_server_keeps_running() {
     let report = server.join(WAIT).expect("server run");
     assert_eq!(report.outcome, Outcome::Stopped);
     assert_eq!(report.rejected, want);
+}
+
+/// A flood of commands that cannot be applied, sent at once to a real-time server with a small
+/// command queue, is counted under its reasons; `commands_dropped` counts only valid commands
+/// that found the queue full. (Before the command callback checked ticks and effector inputs,
+/// such commands filled the queue and part of them landed in `commands_dropped`.)
+#[test]
+fn a_flood_of_bad_commands_is_counted_by_reason_not_as_dropped() {
+    const FUTURE: u64 = 3000;
+    const BAD_INPUTS: u64 = 1000;
+    const VALID: u64 = 3000;
+    const QUEUE: usize = 8;
+    let topics = Topics::new("sc1").unwrap();
+    // 10 Hz: the physics thread empties the queue every 100 ms, so a burst of valid commands
+    // larger than the queue must lose some.
+    let (mut server, obs) = running(
+        ServerSettings {
+            participants: vec![1],
+            command_queue: QUEUE,
+            status_hz: 20.0,
+            ..ServerSettings::default()
+        },
+        10.0,
+    );
+    let cmd_pub = obs.session.declare_publisher(topics.cmd(1)).wait().unwrap();
+    let put = |cmd: &CommandMsg| cmd_pub.put(encode(cmd)).wait().unwrap();
+    let seen = obs.last_tick().unwrap();
+    let wrench =
+        |tick: u64| CommandMsg::wrench(Header::new(1, tick, 0, 0), 1, [0.0, 0.0, 1e-3], [0.0; 3]);
+    // Ticks 10 s and more ahead of the last state seen: never published while they arrive.
+    for i in 0..FUTURE {
+        put(&wrench(seen + 100 + i));
+    }
+    // An input for a panel pair, which takes none.
+    for _ in 0..BAD_INPUTS {
+        put(&CommandMsg::actuators(
+            Header::new(1, seen, 0, 0),
+            1,
+            [0.0; 3],
+            [0.0; 3],
+            vec![flexdyn_proto::EffectorInput {
+                effector_index: 0,
+                values: vec![0.1],
+            }],
+        ));
+    }
+    // Valid: a tick already published, the same for all, so none is older than the last.
+    for _ in 0..VALID {
+        put(&wrench(seen));
+    }
+    // One more future tick after everything: once it is counted, the callback has seen the
+    // whole flood (one publisher, reliable and in order).
+    put(&wrench(u64::MAX));
+    let counted = wait_until(WAIT, || {
+        obs.last_status()
+            .is_some_and(|s| s.rejected.stale_tick == FUTURE + 1)
+    });
+    server.stop();
+    let report = server.join(WAIT).expect("server run");
+    eprintln!("{report}");
+    assert!(
+        counted,
+        "the status never counted every future tick: {report}"
+    );
+    assert_eq!(
+        report.rejected,
+        RejectCounters {
+            stale_tick: FUTURE + 1,
+            bad_effector_input: BAD_INPUTS,
+            ..RejectCounters::default()
+        },
+        "{report}"
+    );
+    // At most QUEUE valid commands are taken per 100 ms frame; the burst is far larger.
+    assert!(
+        report.commands_dropped > 0 && report.commands_dropped <= VALID,
+        "commands_dropped {} of {VALID} valid commands: {report}",
+        report.commands_dropped
+    );
 }

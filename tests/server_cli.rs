@@ -1,6 +1,6 @@
 //! The `flexdyn run` binary as a separate process: exit codes and messages of a participant
 //! timeout, of missing participants and of bad settings; graceful SIGTERM; batch mode.
-//! Ports 17340–17349. Every wait is bounded; a child still running at the end is killed.
+//! Every wait is bounded; a child still running at the end is killed.
 
 mod server_support;
 
@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use flexdyn_proto::{decode_state, encode, CommandMsg, Header, Topics};
-use server_support::{connecting_session, endpoint, wait_until, Observer};
+use server_support::{connecting_session, port_of, ports, wait_until, Observer, ANY_PORT};
 use zenoh::qos::CongestionControl;
 use zenoh::Wait;
 
@@ -25,8 +25,8 @@ impl Server {
         Self::start(args, "info", false)
     }
 
-    /// Like [`Self::spawn`], but the stderr reader closes its end of the pipe after the first
-    /// chunk, as a killed `tee` would; later log lines go into a closed pipe.
+    /// Like [`Self::spawn`], but the stderr reader closes its end of the pipe once the server
+    /// has reported its endpoint, as a killed `tee` would; later log lines go into a closed pipe.
     fn spawn_closing_stderr(args: &[&str], rust_log: &str) -> Self {
         Self::start(args, rust_log, true)
     }
@@ -49,10 +49,9 @@ impl Server {
                 if n == 0 {
                     break;
                 }
-                sink.lock()
-                    .unwrap()
-                    .push_str(&String::from_utf8_lossy(&buf[..n]));
-                if close_after_first_read {
+                let mut text = sink.lock().unwrap();
+                text.push_str(&String::from_utf8_lossy(&buf[..n]));
+                if close_after_first_read && ports::find_zenoh_endpoint(&text).is_some() {
                     break; // drops `pipe`: the read end closes
                 }
             }
@@ -79,6 +78,22 @@ impl Server {
 
     fn stderr(&self) -> String {
         self.stderr.lock().unwrap().clone()
+    }
+
+    /// The port the server reports it listens on (it was started with `--listen ANY_PORT`).
+    fn port(&mut self) -> u16 {
+        let mut found = None;
+        let reported = wait_until(Duration::from_secs(60), || {
+            found = ports::find_zenoh_endpoint(&self.stderr());
+            found.is_some() || self.child.try_wait().unwrap().is_some()
+        });
+        match found {
+            Some(ep) if reported => port_of(&ep),
+            _ => panic!(
+                "the server reported no endpoint; stderr:\n{}",
+                self.stderr()
+            ),
+        }
     }
 
     /// Waits (30 s at most) until `obs` has seen the state of `tick`.
@@ -113,8 +128,7 @@ impl Drop for Server {
 
 #[test]
 fn lockstep_participant_timeout_exits_nonzero_naming_participant_and_tick() {
-    let port = 17340;
-    let ep = endpoint(port);
+    let ep = ANY_PORT;
     let mut server = Server::spawn(&[
         "run",
         "--mode",
@@ -124,10 +138,11 @@ fn lockstep_participant_timeout_exits_nonzero_naming_participant_and_tick() {
         "--participant-timeout-s",
         "1",
         "--listen",
-        &ep,
+        ep,
         "--duration-s",
         "100",
     ]);
+    let port = server.port();
     // A participant that answers ticks 0..=4, then goes silent.
     let topics = Topics::new("sc1").unwrap();
     let session = connecting_session(port);
@@ -167,8 +182,7 @@ fn lockstep_participant_timeout_exits_nonzero_naming_participant_and_tick() {
 
 #[test]
 fn lockstep_without_participants_gives_up_after_the_presence_timeout() {
-    let port = 17341;
-    let ep = endpoint(port);
+    let ep = ANY_PORT;
     let mut server = Server::spawn(&[
         "run",
         "--mode",
@@ -178,8 +192,9 @@ fn lockstep_without_participants_gives_up_after_the_presence_timeout() {
         "--presence-timeout-s",
         "2",
         "--listen",
-        &ep,
+        ep,
     ]);
+    let port = server.port();
     // While it waits, the status says so.
     let obs = Observer::start(port, &Topics::new("sc1").unwrap());
     assert!(
@@ -219,7 +234,7 @@ fn bad_settings_exit_2_naming_the_setting() {
         env!("CARGO_MANIFEST_DIR"),
         "/scenarios/zenoh/secure-server.json5"
     );
-    let listen = ["--listen", "tcp/127.0.0.1:17342"];
+    let listen = ["--listen", ANY_PORT];
     // After the reference text come an empty line, `[server]`, then `colour`.
     let colour_line = flexdyn::config::DEFAULT_CONFIG_TOML.lines().count() + 3;
     let colour =
@@ -269,23 +284,11 @@ fn bad_settings_exit_2_naming_the_setting() {
         ),
         (&["run", "--config", file_s], &colour),
         (
-            &[
-                "run",
-                "--duration-s",
-                "0.015",
-                "--listen",
-                "tcp/127.0.0.1:17342",
-            ],
+            &["run", "--duration-s", "0.015", listen[0], listen[1]],
             "is not a whole number of frames",
         ),
         (
-            &[
-                "run",
-                "--stale-after-s",
-                "-1",
-                "--listen",
-                "tcp/127.0.0.1:17342",
-            ],
+            &["run", "--stale-after-s", "-1", listen[0], listen[1]],
             "error: --stale-after-s: must be > 0",
         ),
     ];
@@ -304,9 +307,9 @@ fn bad_settings_exit_2_naming_the_setting() {
 
 #[test]
 fn sigterm_stops_the_realtime_server_gracefully() {
-    let port = 17343;
-    let ep = endpoint(port);
-    let mut server = Server::spawn(&["run", "--listen", &ep]);
+    let ep = ANY_PORT;
+    let mut server = Server::spawn(&["run", "--listen", ep]);
+    let port = server.port();
     let topics = Topics::new("sc1").unwrap();
     let obs = Observer::start(port, &topics);
     server.await_tick(&obs, 10);
@@ -356,9 +359,9 @@ fn sigterm_stops_the_realtime_server_gracefully() {
 /// rejection reason is logged at warn, naming the sender, once and then rate-limited.
 #[test]
 fn dropped_commands_reach_the_status_and_rejections_are_logged() {
-    let port = 17346;
-    let ep = endpoint(port);
+    let ep = ANY_PORT;
     let mut server = Server::spawn(&["run", "--listen", &ep, "--command-queue", "1"]);
+    let port = server.port();
     let topics = Topics::new("sc1").unwrap();
     let obs = Observer::start(port, &topics);
     server.await_tick(&obs, 5);
@@ -422,7 +425,7 @@ fn dropped_commands_reach_the_status_and_rejections_are_logged() {
 
 #[test]
 fn batch_mode_runs_to_the_duration() {
-    let ep = endpoint(17344);
+    let ep = ANY_PORT;
     let mut server = Server::spawn(&[
         "run",
         "--mode",
@@ -430,7 +433,7 @@ fn batch_mode_runs_to_the_duration() {
         "--duration-s",
         "20",
         "--listen",
-        &ep,
+        ep,
     ]);
     let status = server.wait(Duration::from_secs(60));
     let err = server.stderr();
@@ -465,16 +468,61 @@ fn help_lists_the_run_subcommand() {
     }
 }
 
+/// Every subcommand's help states each option's default once (clap adds `[default: …]` for a
+/// default value; a doc comment that says it too printed it twice).
+#[test]
+fn every_help_states_each_default_once() {
+    let help = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{args:?}");
+        String::from_utf8_lossy(&out.stdout).to_string()
+    };
+    let top = help(&["--help"]);
+    let commands: Vec<String> = top
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .map(str::to_owned)
+        .collect();
+    assert!(
+        commands.iter().any(|c| c == "replay") && commands.len() >= 9,
+        "{commands:?} from:\n{top}"
+    );
+    for c in &commands {
+        let text = help(&[c, "--help"]);
+        // An option's text runs from its `-x, --name` line to the next option's.
+        let mut options: Vec<String> = Vec::new();
+        for line in text.lines() {
+            match options.last_mut() {
+                Some(o) if !line.trim_start().starts_with('-') => o.push_str(line),
+                _ => options.push(line.to_owned()),
+            }
+        }
+        for option in options.iter().filter(|o| o.trim_start().starts_with('-')) {
+            assert!(
+                option.matches("[default: ").count() <= 1,
+                "`flexdyn {c} --help` states a default twice: {option}"
+            );
+        }
+    }
+}
+
 /// `flexdyn 2>&1 | tee log`, then Ctrl-C: the reader of stderr dies first. The server must keep
 /// running while it logs into the closed pipe, then stop on SIGTERM with exit 0 and its final
 /// status, instead of panicking on EPIPE (exit 101/134).
 #[test]
 fn a_closed_stderr_reader_never_takes_the_server_down() {
-    let port = 17345;
-    let ep = endpoint(port);
+    let ep = ANY_PORT;
     // Log at debug so that writes into the closed pipe happen for sure.
     let mut server =
         Server::spawn_closing_stderr(&["--listen", &ep, "--summary-interval-s", "0.05"], "debug");
+    let port = server.port();
     let topics = Topics::new("sc1").unwrap();
     let obs = Observer::start(port, &topics);
     server.await_tick(&obs, 30);

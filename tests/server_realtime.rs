@@ -1,5 +1,5 @@
 //! Real-time mode runs and publishes at about the configured rate (loose counts, no tight timing
-//! assertions), stamps each frame, and handles stale commands per policy. Ports 17330–17339.
+//! assertions), stamps each frame, and handles stale commands per policy.
 
 mod server_support;
 
@@ -18,10 +18,8 @@ const WAIT: Duration = Duration::from_secs(30);
 
 #[test]
 fn realtime_100hz_publishes_at_about_the_rate_and_zeroes_stale_commands() {
-    let port = 17330;
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start(
-        port,
         ServerSettings {
             duration_ns: Some(3_000_000_000),
             stale_after: Duration::from_millis(50),
@@ -30,6 +28,7 @@ fn realtime_100hz_publishes_at_about_the_rate_and_zeroes_stale_commands() {
         },
         reference_config(100.0),
     );
+    let port = server.port;
     let obs = Observer::start(port, &topics);
     assert!(
         wait_until(WAIT, || obs.last_tick().is_some_and(|t| t >= 20)),
@@ -106,16 +105,15 @@ fn realtime_100hz_publishes_at_about_the_rate_and_zeroes_stale_commands() {
 
 #[test]
 fn realtime_1khz_runs() {
-    let port = 17331;
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start(
-        port,
         ServerSettings {
             duration_ns: Some(1_000_000_000),
             ..ServerSettings::default()
         },
         reference_config(1000.0),
     );
+    let port = server.port;
     let obs = Observer::start(port, &topics);
     let report = server.join(WAIT).expect("server run");
     assert_eq!(report.outcome, Outcome::Finished);
@@ -136,12 +134,10 @@ fn realtime_1khz_runs() {
 
 #[test]
 fn imu_samples_are_published_every_frame_on_their_topics() {
-    let port = 17332;
     let topics = Topics::new("sc1").unwrap();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/imu_tactical.toml");
     let cfg = flexdyn::config::SimConfig::from_file(&path).unwrap();
     let server = ServerHandle::start(
-        port,
         ServerSettings {
             // Real time (2 s) so the subscriber below is surely up before the last tick.
             duration_ns: Some(200 * cfg.frame_ns),
@@ -149,6 +145,7 @@ fn imu_samples_are_published_every_frame_on_their_topics() {
         },
         cfg,
     );
+    let port = server.port;
     let obs = Observer::start(port, &topics);
     let seen: std::sync::Arc<std::sync::Mutex<Vec<(String, u64)>>> = Default::default();
     let s = seen.clone();

@@ -1,7 +1,7 @@
 //! Reaction-wheel commands and star-tracker telemetry through the server, in lockstep: an
 //! `Actuators` command answers the tick and drives the wheels; every malformed effector input
 //! is rejected, counted under its reason, and does not answer the tick; the star tracker
-//! publishes on its own topic at its own rate. Ports 17360–17361.
+//! publishes on its own topic at its own rate.
 
 mod server_support;
 
@@ -35,10 +35,8 @@ fn wheels_config() -> SimConfig {
 
 #[test]
 fn actuators_drive_the_wheels_and_bad_inputs_are_counted() {
-    let port = 17360;
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start(
-        port,
         ServerSettings {
             mode: Mode::Lockstep,
             participants: vec![1],
@@ -49,6 +47,7 @@ fn actuators_drive_the_wheels_and_bad_inputs_are_counted() {
         },
         wheels_config(),
     );
+    let port = server.port;
     let obs = Observer::start(port, &topics);
     let trackers: Arc<Mutex<Vec<StarTrackerMsg>>> = Arc::default();
     let t = trackers.clone();

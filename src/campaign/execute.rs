@@ -94,7 +94,7 @@ pub struct RunResult {
 pub struct RunOptions {
     /// Output directory (the plan's).
     pub dir: PathBuf,
-    /// First port; run i uses `base_port + i`.
+    /// First port; run i uses `base_port + i`. 0: each run takes a free port from the OS.
     pub base_port: u16,
     /// Record each run to `run-NNNN/recording.mcap`.
     pub record: bool,
@@ -171,8 +171,8 @@ pub struct Observer {
     session: Session,
 }
 
-fn zenoh_args(port: u16, listen: bool) -> ZenohArgs {
-    let ep = format!("tcp/127.0.0.1:{port}");
+fn zenoh_args(endpoint: &str, listen: bool) -> ZenohArgs {
+    let ep = endpoint.to_owned();
     ZenohArgs {
         listen: if listen { vec![ep.clone()] } else { vec![] },
         connect: if listen { vec![] } else { vec![ep] },
@@ -181,9 +181,10 @@ fn zenoh_args(port: u16, listen: bool) -> ZenohArgs {
 }
 
 impl Observer {
-    /// Connects to the server on `127.0.0.1:port` and declares `sender_id`'s liveliness token.
-    pub fn start(port: u16, topics: &Topics, sender_id: u32) -> Result<Self, String> {
-        let cfg = zenoh_config(&zenoh_args(port, false), Role::Tool).map_err(|e| e.to_string())?;
+    /// Connects to the server at `endpoint` and declares `sender_id`'s liveliness token.
+    pub fn start(endpoint: &str, topics: &Topics, sender_id: u32) -> Result<Self, String> {
+        let cfg =
+            zenoh_config(&zenoh_args(endpoint, false), Role::Tool).map_err(|e| e.to_string())?;
         let session = zenoh::open(cfg)
             .wait()
             .map_err(|e| format!("observer session: {e}"))?;
@@ -306,9 +307,9 @@ fn server_failure(e: ServerError) -> RunFailure {
 }
 
 /// Starts the controller `line` of run `run`, its output to `run_dir/controller.log`.
-fn start_controller(line: &str, port: u16, run: u32, run_dir: &Path) -> Result<Child, String> {
+fn start_controller(line: &str, endpoint: &str, run: u32, run_dir: &Path) -> Result<Child, String> {
     let line = line
-        .replace("{endpoint}", &format!("tcp/127.0.0.1:{port}"))
+        .replace("{endpoint}", endpoint)
         .replace("{sc_id}", SC_ID)
         .replace("{sender_id}", &CONTROLLER_ID.to_string())
         .replace("{run}", &run.to_string());
@@ -348,9 +349,15 @@ fn run_inner(
         .keys()
         .filter_map(|k| model.get(k).map(|v| (k.clone(), *v)))
         .collect();
-    let port = u32::from(opts.base_port) + rp.run;
-    let port = u16::try_from(port)
-        .map_err(|_| format!("port {port} is out of range: lower --base-port"))?;
+    // Base port 0: every run's server takes a free port from the OS.
+    let port = match opts.base_port {
+        0 => 0,
+        base => {
+            let port = u32::from(base) + rp.run;
+            u16::try_from(port)
+                .map_err(|_| format!("port {port} is out of range: lower --base-port"))?
+        }
+    };
     let frame_s = cfg.frame_ns as f64 * 1e-9;
     let mut participants = vec![OBSERVER_ID];
     if c.controller.is_some() {
@@ -370,7 +377,19 @@ fn run_inner(
     let topics = Topics::new(SC_ID).map_err(|e| e.to_string())?;
     // The server, on its own runtime and thread; `stop` ends it early (controller exit).
     let stop = Arc::new(tokio::sync::Notify::new());
-    let zcfg = zenoh_config(&zenoh_args(port, true), Role::Server).map_err(|e| e.to_string())?;
+    let zcfg = zenoh_config(
+        &zenoh_args(&format!("tcp/127.0.0.1:{port}"), true),
+        Role::Server,
+    )
+    .map_err(|e| e.to_string())?;
+    // Opened here, so the observer and the controller get the endpoint it really listens on.
+    let session = zenoh::open(zcfg)
+        .wait()
+        .map_err(|e| format!("server session: {e}"))?;
+    let endpoint = crate::transport::listening_on(&session)
+        .into_iter()
+        .next()
+        .ok_or("the server session listens nowhere")?;
     let stop2 = stop.clone();
     let server = std::thread::spawn(move || {
         let rt = tokio::runtime::Builder::new_multi_thread()
@@ -379,9 +398,6 @@ fn run_inner(
             .build()
             .map_err(|e| e.to_string())?;
         rt.block_on(async move {
-            let session = zenoh::open(zcfg)
-                .await
-                .map_err(|e| format!("server session: {e}"))?;
             let r = crate::server::run(session.clone(), settings, cfg, async move {
                 stop2.notified().await
             })
@@ -397,12 +413,12 @@ fn run_inner(
         let _ = server.join();
         RunFailure::from(why)
     };
-    let observer = match Observer::start(port, &topics, OBSERVER_ID) {
+    let observer = match Observer::start(&endpoint, &topics, OBSERVER_ID) {
         Ok(o) => o,
         Err(why) => return Err(abandon(server, why)),
     };
     let mut child = match &c.controller {
-        Some(line) => match start_controller(line, port, rp.run, run_dir) {
+        Some(line) => match start_controller(line, &endpoint, rp.run, run_dir) {
             Ok(child) => Some(child),
             Err(why) => {
                 let _ = observer.session.close().wait();

@@ -50,7 +50,8 @@ pub enum CampaignCommand {
         /// Record each run to run-NNNN/recording.mcap.
         #[arg(long)]
         record: bool,
-        /// Run i's server listens on 127.0.0.1:(base-port + i).
+        /// Run i's server listens on 127.0.0.1:(base-port + i); 0: each run's server takes a
+        /// free port from the OS.
         #[arg(long, value_name = "PORT", default_value_t = 17_600)]
         base_port: u16,
     },

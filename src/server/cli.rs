@@ -68,7 +68,7 @@ pub struct RunArgs {
     /// Real time: SCHED_FIFO priority 1–99 for the physics thread, 0 = normal [default: 0].
     #[arg(long, value_name = "P", allow_negative_numbers = true)]
     pub realtime_priority: Option<i64>,
-    /// Preallocated telemetry buffers [default: 8].
+    /// Preallocated telemetry buffers [default: 64].
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub telemetry_buffers: Option<i64>,
     /// Command queue capacity [default: 1024].

@@ -13,7 +13,7 @@
 use std::ops::Range;
 
 use flexdyn_proto::{
-    command_flags, CommandKind, CommandMsg, CommandStatus, EffectorInput, StalePolicy, NO_COMMAND,
+    command_flags, CommandKind, CommandMsg, CommandStatus, StalePolicy, NO_COMMAND,
 };
 
 /// What the book did with an offered command.
@@ -82,6 +82,25 @@ impl Held {
     }
 }
 
+/// `Some(BadEffectorInput)` unless the inputs of an `Actuators` command fit the effector layout
+/// `ranges` (where each effector's inputs sit in one flat vector): known indices that take
+/// exactly that many values, each named once. `seen` is scratch, one flag per effector.
+/// Allocates nothing.
+fn check_inputs(ranges: &[Range<usize>], seen: &mut [bool], cmd: &CommandMsg) -> Option<Offer> {
+    let CommandKind::Actuators { inputs, .. } = &cmd.kind else {
+        return None;
+    };
+    seen.iter_mut().for_each(|s| *s = false);
+    for i in inputs {
+        let idx = i.effector_index as usize;
+        match (ranges.get(idx), seen.get_mut(idx)) {
+            (Some(r), Some(s)) if !r.is_empty() && r.len() == i.values.len() && !*s => *s = true,
+            _ => return Some(Offer::BadEffectorInput),
+        }
+    }
+    None
+}
+
 /// Per-participant command state, in ascending sender-id order.
 #[derive(Clone, Debug)]
 pub struct CommandBook {
@@ -134,22 +153,6 @@ impl CommandBook {
             seen: vec![false; input_ranges.len()],
             held_inputs: vec![0.0; n_inputs],
         }
-    }
-
-    /// Whether `inputs` fit the effector layout: known indices that take exactly that many
-    /// values, each named once. Allocates nothing.
-    fn inputs_fit(&mut self, inputs: &[EffectorInput]) -> bool {
-        self.seen.iter_mut().for_each(|s| *s = false);
-        for i in inputs {
-            let idx = i.effector_index as usize;
-            match self.input_ranges.get(idx) {
-                Some(r) if !r.is_empty() && r.len() == i.values.len() && !self.seen[idx] => {
-                    self.seen[idx] = true;
-                }
-                _ => return false,
-            }
-        }
-        true
     }
 
     fn slot_index(&self, sender_id: u32) -> Option<usize> {
@@ -243,12 +246,7 @@ impl CommandBook {
 
     /// `Some(BadEffectorInput)` if `cmd` carries inputs that do not fit the layout.
     fn check_inputs(&mut self, cmd: &CommandMsg) -> Option<Offer> {
-        match &cmd.kind {
-            CommandKind::Actuators { inputs, .. } if !self.inputs_fit(inputs) => {
-                Some(Offer::BadEffectorInput)
-            }
-            _ => None,
-        }
+        check_inputs(&self.input_ranges, &mut self.seen, cmd)
     }
 
     /// The summed effector inputs of the last [`Self::held`], flat.
@@ -307,6 +305,79 @@ impl CommandBook {
             out.flags |= command_flags::NO_COMMAND_YET;
         }
         out
+    }
+}
+
+/// The checks made in the Zenoh command callback, before a command is queued for the physics
+/// thread: a flood of commands that cannot be applied is counted under its reason instead of
+/// filling the queue, so `commands_dropped` counts valid commands only.
+///
+/// `published` is the last tick whose state the server has published (the physics thread notes
+/// a tick before it publishes it, so a participant answering a state always finds its tick
+/// noted). A command may be queued if
+/// - its effector inputs fit the layout (else `bad_effector_input`), and
+/// - real time and batch: its tick has been published and is not older than the sender's last
+///   queued command (else `stale_tick`);
+/// - lockstep: its tick is the one published, and the sender has not answered it yet (else
+///   `stale_tick`).
+///
+/// The book (which takes queued commands at a boundary `k ≥ published`) makes the same checks
+/// again and so never takes a command the gate refused. In lockstep the two agree exactly. In
+/// real time the gate decides a command for a tick not yet published when it arrives; without
+/// it, such a command was taken or refused depending on whether it reached the queue before or
+/// after the physics thread's next boundary, a race the gate removes.
+#[derive(Clone, Debug)]
+pub struct Gate {
+    lockstep: bool,
+    input_ranges: Vec<Range<usize>>,
+    seen: Vec<bool>,
+    /// Per participant, in ascending sender-id order: the tick of its last queued command.
+    last_queued: Vec<(u32, Option<u64>)>,
+}
+
+impl Gate {
+    /// A gate for `participants` (sorted, unique) on a spacecraft whose effectors' inputs sit at
+    /// `input_ranges`; `lockstep` selects the lockstep tick rule.
+    pub fn new(participants: &[u32], input_ranges: &[Range<usize>], lockstep: bool) -> Self {
+        Self {
+            lockstep,
+            input_ranges: input_ranges.to_vec(),
+            seen: vec![false; input_ranges.len()],
+            last_queued: participants.iter().map(|&id| (id, None)).collect(),
+        }
+    }
+
+    fn slot(&self, sender_id: u32) -> Option<usize> {
+        self.last_queued
+            .binary_search_by_key(&sender_id, |(id, _)| *id)
+            .ok()
+    }
+
+    /// Whether `cmd` may be queued now that `published` is the last tick published:
+    /// [`Offer::Accepted`], or the reason the book would reject it.
+    pub fn check(&mut self, cmd: &CommandMsg, published: u64) -> Offer {
+        let Some(i) = self.slot(cmd.sender_id) else {
+            return Offer::UnknownSender;
+        };
+        let tick = cmd.header.tick;
+        let last = self.last_queued[i].1;
+        let stale = if self.lockstep {
+            tick != published || last == Some(tick)
+        } else {
+            tick > published || last.is_some_and(|l| tick < l)
+        };
+        if stale {
+            return Offer::StaleTick;
+        }
+        check_inputs(&self.input_ranges, &mut self.seen, cmd).unwrap_or(Offer::Accepted)
+    }
+
+    /// Notes that the command of `sender_id` for `tick` (accepted by [`Self::check`]) is in the
+    /// queue.
+    pub fn queued(&mut self, sender_id: u32, tick: u64) {
+        if let Some(i) = self.slot(sender_id) {
+            self.last_queued[i].1 = Some(tick);
+        }
     }
 }
 
@@ -406,6 +477,121 @@ mod tests {
             let h = b.held(7);
             assert_eq!(h.flags, 0);
             assert_eq!(h.torque_b_nm[2], 1.0);
+        }
+    }
+
+    fn actuators(sender: u32, tick: u64, index: u32, values: usize) -> CommandMsg {
+        CommandMsg::actuators(
+            Header::new(1, tick, 0, 0),
+            sender,
+            [0.0; 3],
+            [0.0; 3],
+            vec![flexdyn_proto::EffectorInput {
+                effector_index: index,
+                values: vec![0.1; values],
+            }],
+        )
+    }
+
+    #[test]
+    fn the_gate_refuses_ticks_not_published_and_inputs_that_do_not_fit() {
+        // Effector 0 takes no input (a panel pair), effector 1 takes one (a wheel).
+        let ranges = [0..0, 0..1];
+        let mut g = Gate::new(&[1, 2], &ranges, false);
+        assert_eq!(g.check(&wrench(1, 11, 1.0), 10), Offer::StaleTick);
+        assert_eq!(g.check(&wrench(1, u64::MAX, 1.0), 10), Offer::StaleTick);
+        let ok = wrench(1, 10, 1.0);
+        assert_eq!(g.check(&ok, 10), Offer::Accepted);
+        g.queued(1, 10);
+        assert_eq!(g.check(&wrench(1, 9, 1.0), 10), Offer::StaleTick, "older");
+        assert_eq!(
+            g.check(&wrench(1, 10, 1.0), 10),
+            Offer::Accepted,
+            "same tick"
+        );
+        assert_eq!(
+            g.check(&wrench(2, 3, 1.0), 10),
+            Offer::Accepted,
+            "own order"
+        );
+        assert_eq!(g.check(&wrench(3, 10, 1.0), 10), Offer::UnknownSender);
+        assert_eq!(g.check(&actuators(1, 10, 1, 1), 10), Offer::Accepted);
+        for (index, values) in [(0, 1), (1, 2), (1, 0), (7, 1)] {
+            assert_eq!(
+                g.check(&actuators(1, 10, index, values), 10),
+                Offer::BadEffectorInput,
+                "effector {index} with {values} values"
+            );
+        }
+        let mut twice = actuators(1, 10, 1, 1);
+        if let CommandKind::Actuators { inputs, .. } = &mut twice.kind {
+            inputs.push(inputs[0].clone());
+        }
+        assert_eq!(g.check(&twice, 10), Offer::BadEffectorInput);
+
+        let mut g = Gate::new(&[1, 2], &[], true);
+        assert_eq!(g.check(&wrench(1, 4, 1.0), 5), Offer::StaleTick);
+        assert_eq!(g.check(&wrench(1, 6, 1.0), 5), Offer::StaleTick);
+        let answer = none(1, 5);
+        assert_eq!(g.check(&answer, 5), Offer::Accepted);
+        g.queued(1, 5);
+        assert_eq!(g.check(&none(1, 5), 5), Offer::StaleTick, "second answer");
+        assert_eq!(g.check(&none(2, 5), 5), Offer::Accepted);
+        assert_eq!(g.check(&none(1, 6), 6), Offer::Accepted);
+    }
+
+    proptest::proptest! {
+        /// Whatever arrives, in whatever order against the boundaries, the book takes every
+        /// command the gate let through (so the gate refuses only what cannot be applied, and a
+        /// full queue only ever drops a command that would have been applied).
+        #[test]
+        fn the_book_takes_every_command_the_gate_lets_through(
+            lockstep: bool,
+            events in proptest::collection::vec((0u8..4, 1u32..=3, -3i64..=3, 0u8..5), 1..200),
+        ) {
+            let ranges = [0..0, 0..1];
+            let participants = [1, 2];
+            let mut gate = Gate::new(&participants, &ranges, lockstep);
+            let mut book = CommandBook::new(&participants, 10, 1000, StalePolicy::Hold, &ranges);
+            let mut queue = std::collections::VecDeque::new();
+            // The physics thread is at boundary `k`; `published` is the tick it noted last
+            // (it notes `k`, then takes the queue at `k`, then steps to `k + 1`).
+            let (mut k, mut published) = (0u64, 0u64);
+            book.begin_tick();
+            for (what, sender, delta, shape) in events {
+                if what <= 1 {
+                    published = k;
+                }
+                if what == 0 {
+                    while let Some(cmd) = queue.pop_front() {
+                        let offer = if lockstep {
+                            book.offer_lockstep(&cmd, k)
+                        } else {
+                            book.offer_latest(&cmd, k)
+                        };
+                        proptest::prop_assert_eq!(offer, Offer::Accepted, "{:?} at {}", cmd, k);
+                    }
+                    if !lockstep || book.all_answered() {
+                        k += 1;
+                        book.begin_tick();
+                    }
+                }
+                if what <= 1 {
+                    continue;
+                }
+                let tick = published.saturating_add_signed(delta);
+                let cmd = match shape {
+                    0 => none(sender, tick),
+                    1 => wrench(sender, tick, 1.0),
+                    2 => actuators(sender, tick, 1, 1),
+                    3 => actuators(sender, tick, 0, 1),
+                    _ => actuators(sender, tick, 1, 3),
+                };
+                if gate.check(&cmd, published) == Offer::Accepted {
+                    gate.queued(cmd.sender_id, cmd.header.tick);
+                    queue.push_back(cmd);
+                }
+            }
         }
     }
 }

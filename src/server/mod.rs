@@ -6,18 +6,25 @@
 //! arguments, initialises tracing and calls [`cli::run_from_args`], which calls [`run`].
 //!
 //! # Layout
+//! [`run`] goes through the phases of a run, each in its own module:
+//! - `setup`: the telemetry publishers, the `flexdyn/<sc>/config` queryable, the `--record`
+//!   recorder; then the threads' channels (`Wiring`, in this file).
+//! - `intake`: the command callback (Zenoh rx): decoding, the checks, the rejection counters,
+//!   and delivery to the physics thread's queue or the lockstep core.
+//! - `presence`: lockstep participants' liveliness tokens and the wait before tick 0.
+//! - [`telemetry`], [`physics`], [`lockstep`]: the threads that run the frames (below).
+//! - `report`: the [`RunReport`], collected when every thread is done.
+//!
+//! And what they use:
 //! - [`settings`]: [`ServerSettings`], the `[server]` table and `flexdyn run` options.
 //! - [`crate::transport`]: [`zenoh_config`], the one builder of every Zenoh configuration (loopback
 //!   defaults, multicast scouting always off).
-//! - [`commands`]: per-participant command book (lockstep answers, staleness, summation).
+//! - [`commands`]: per-participant command book (lockstep answers, staleness, summation) and
+//!   the callback's gate.
 //! - [`pacing`]: absolute-deadline real-time pacing (sleep, then spin) and overrun policies.
-//! - [`physics`]: the physics thread's frame loop.
-//! - [`telemetry`]: the I/O thread that publishes status (and, with `handoff = "thread"`, the
-//!   frames) and keeps the books.
 //! - [`shared`]: lock-free counters and the preallocated telemetry buffers.
 //! - [`error`]: typed errors.
 //! - [`cli`]: `flexdyn run` arguments and the process-level wrapper (runtime, signals).
-//! - [`lockstep`]: lockstep stepped on the Zenoh thread that delivers a tick's last answer.
 //! - [`publish`]: the frame publishers (who calls them is the `handoff` setting).
 //! - [`access`]: the start-up check that the Zenoh ACL binds participants to subjects.
 //!
@@ -40,329 +47,45 @@ pub mod access;
 pub mod cli;
 pub mod commands;
 pub mod error;
+mod intake;
 pub mod lockstep;
 pub mod pacing;
 pub mod physics;
+mod presence;
 pub mod publish;
 mod reject_log;
+mod report;
 pub mod settings;
+mod setup;
 pub mod shared;
 pub mod telemetry;
 
-use std::collections::BTreeSet;
-use std::fmt;
 use std::future::Future;
 use std::sync::mpsc::{sync_channel, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use flexdyn_proto::{
-    decode_command, FrameTiming, Mode, RejectCounters, RunState, StalePolicy, Topics,
-};
+use flexdyn_proto::{Mode, RunState, StalePolicy, Topics};
 use tokio::sync::{oneshot, Notify};
-use zenoh::qos::CongestionControl;
-use zenoh::sample::SampleKind;
-use zenoh::{Session, Wait};
+use zenoh::Session;
 
 pub use crate::transport::frame_stamp_ns;
 pub use crate::transport::{zenoh_config, Role, ZenohArgs, DEFAULT_ENDPOINT};
 pub use error::{ServerError, SettingsError, ZenohConfigError};
+pub use report::{Outcome, PublishCost, RunReport};
 pub use settings::{mode_name, Handoff, OverrunPolicy, ServerSettings};
+pub use setup::RECORD_QUEUE;
 
 use crate::config::SimConfig;
 use crate::sim::Simulation;
-use crate::sinks::mcap_file::{flexdyn_version, git_commit, RecordingInfo, VehicleInfo};
-use crate::sinks::recorder::{RecordItem, RecordReport, RecordTx, Recorder};
+use crate::sinks::recorder::{RecordReport, RecordTx, Recorder};
+use intake::CommandSink;
 use lockstep::LockstepCore;
-use physics::{Ending, PhysicsCtx, Stepper};
-use publish::FramePublisher;
+use physics::{PhysicsCtx, PhysicsReport, Stepper};
+use presence::Presence;
+use setup::Endpoints;
 use shared::{Frame, Shared};
-use telemetry::{timing_of, TelemetryCtx};
-
-/// Samples the `--record` queue holds before real time drops (lockstep waits instead).
-pub const RECORD_QUEUE: usize = 65_536;
-
-/// How a run ended without error.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Outcome {
-    /// The configured duration was reached.
-    Finished,
-    /// The shutdown future completed (SIGINT/SIGTERM).
-    Stopped,
-}
-
-/// Summary of a completed run.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RunReport {
-    /// Pacing mode.
-    pub mode: Mode,
-    /// Why the run ended.
-    pub outcome: Outcome,
-    /// Last tick reached.
-    pub last_tick: u64,
-    /// \[ns\] simulation time of `last_tick`.
-    pub sim_time_ns: u64,
-    /// StateMsg samples published.
-    pub states_published: u64,
-    /// Real time: frames whose telemetry was dropped (no free buffer).
-    pub telemetry_dropped: u64,
-    /// Real time: lateness percentiles, overruns, skipped frames (zeros otherwise).
-    pub timing: FrameTiming,
-    /// Rejected commands by reason.
-    pub rejected: RejectCounters,
-    /// Valid commands dropped because the command queue was full.
-    pub commands_dropped: u64,
-    /// \[s\] wall time from the first frame to the end.
-    pub wall_s: f64,
-    /// `--record`: what the recording holds and what the recorder dropped.
-    pub recording: Option<RecordReport>,
-    /// Real time with `handoff = "direct"`: what publishing cost the physics thread, per frame.
-    pub direct_publish: Option<PublishCost>,
-}
-
-/// The time the physics thread spent publishing frames (real time, `handoff = "direct"`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PublishCost {
-    /// Frames published from the physics thread.
-    pub frames: u64,
-    /// \[ns\] mean time per frame.
-    pub mean_ns: f64,
-    /// \[ns\] largest time of one frame.
-    pub max_ns: u64,
-    /// Frames whose publication took longer than [`shared::SLOW_PUBLISH_NS`] (100 µs).
-    pub slow_frames: u64,
-}
-
-impl fmt::Display for RunReport {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "run {}: mode={} last_tick={} sim_time_s={} states_published={} telemetry_dropped={} \
-             wall_s={:.3} lateness_us p50={:.1} p99={:.1} max={:.1} overruns={} frames_skipped={} \
-             rejected={} commands_dropped={}",
-            match self.outcome {
-                Outcome::Finished => "finished",
-                Outcome::Stopped => "stopped",
-            },
-            mode_name(self.mode),
-            self.last_tick,
-            self.sim_time_ns as f64 / 1e9,
-            self.states_published,
-            self.telemetry_dropped,
-            self.wall_s,
-            self.timing.lateness_p50_ns as f64 * 1e-3,
-            self.timing.lateness_p99_ns as f64 * 1e-3,
-            self.timing.lateness_max_ns as f64 * 1e-3,
-            self.timing.overrun_count,
-            self.timing.frames_skipped,
-            self.rejected.total(),
-            self.commands_dropped,
-        )?;
-        if let Some(r) = &self.recording {
-            write!(
-                f,
-                " recorded_samples={} record_dropped={}",
-                r.stats.samples, r.dropped
-            )?;
-        }
-        if let Some(c) = &self.direct_publish {
-            write!(
-                f,
-                " direct_publish_us mean={:.1} max={:.1} slow_over_100us={}",
-                c.mean_ns * 1e-3,
-                c.max_ns as f64 * 1e-3,
-                c.slow_frames
-            )?;
-        }
-        Ok(())
-    }
-}
-
-/// Participants seen through their liveliness tokens, and a wake-up for the presence wait.
-#[derive(Default)]
-struct Presence {
-    ids: Mutex<BTreeSet<u32>>,
-    changed: Notify,
-}
-
-impl Presence {
-    fn missing(&self, wanted: &[u32]) -> Vec<u32> {
-        let ids = self.ids.lock().unwrap_or_else(|p| p.into_inner());
-        wanted
-            .iter()
-            .copied()
-            .filter(|id| !ids.contains(id))
-            .collect()
-    }
-}
-
-/// Who steps the frames: the physics thread (with the frame publishers when it publishes
-/// itself), or the lockstep core in the command callback.
-enum FrameLoop {
-    Physics(Box<Stepper>, Option<FramePublisher>),
-    Core(Arc<Mutex<LockstepCore>>),
-}
-
-/// Where the command callback delivers a validated command.
-enum CommandSink {
-    /// The physics thread's bounded queue (never blocks: a full queue drops and counts).
-    Queue(Mutex<SyncSender<flexdyn_proto::CommandMsg>>),
-    /// Lockstep with `handoff = "direct"`: the core, stepped in this callback.
-    Core(Arc<Mutex<LockstepCore>>),
-}
-
-/// The zenoh callback for `flexdyn/<sc>/cmd/*`: decode and check (spacecraft, the key's
-/// sender, the participants), count rejections, and deliver valid commands to `sink`.
-fn command_callback(
-    sink: CommandSink,
-    shared: Arc<Shared>,
-    topics: Topics,
-    spacecraft_id: u32,
-    participants: Vec<u32>,
-    record: Option<RecordTx>,
-) -> impl Fn(zenoh::sample::Sample) + Send + Sync + 'static {
-    let log = Mutex::new(reject_log::RejectLog::default());
-    let warn = move |reason: &'static str, sender: Option<u32>, detail: &dyn std::fmt::Display| {
-        log.lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .record(reason, sender, 1, detail);
-    };
-    move |sample| {
-        let bytes = sample.payload().to_bytes();
-        let key = sample.key_expr().as_str();
-        // Every command that arrives is recorded, accepted or not: the file shows what was sent.
-        if let Some(rec) = &record {
-            rec.submit(RecordItem {
-                key: Arc::from(key),
-                payload: bytes.to_vec(),
-                publish_time_ns: crate::transport::frame_stamp_ns(&sample),
-            });
-        }
-        let cmd = match decode_command(&bytes) {
-            Ok(cmd) => cmd,
-            Err(e) => {
-                let reason = match e {
-                    flexdyn_proto::DecodeError::UnknownVersion { .. } => "bad_version",
-                    flexdyn_proto::DecodeError::NonFinite { .. } => "non_finite",
-                    _ => "malformed",
-                };
-                // The sender id sits at bytes 30..34 once the header is there.
-                let sender = bytes
-                    .get(30..34)
-                    .and_then(|b| b.try_into().ok())
-                    .map(u32::from_le_bytes)
-                    .filter(|_| reason == "non_finite");
-                warn(reason, sender, &e);
-                shared.reject_decode(&e);
-                return;
-            }
-        };
-        if cmd.header.spacecraft_id != spacecraft_id {
-            warn(
-                "wrong_spacecraft",
-                Some(cmd.sender_id),
-                &format_args!(
-                    "header.spacecraft_id {} is not this server's {spacecraft_id}",
-                    cmd.header.spacecraft_id
-                ),
-            );
-            shared.reject_wrong_spacecraft();
-            return;
-        }
-        if topics.cmd_sender(key) != Some(cmd.sender_id) {
-            warn(
-                "wrong_identity",
-                Some(cmd.sender_id),
-                &format_args!(
-                    "sender_id {} arrived on `{key}`; participant {} publishes on `{}` only",
-                    cmd.sender_id,
-                    cmd.sender_id,
-                    topics.cmd(cmd.sender_id)
-                ),
-            );
-            shared.reject_wrong_identity();
-            return;
-        }
-        if participants.binary_search(&cmd.sender_id).is_err() {
-            warn(
-                "unknown_sender",
-                Some(cmd.sender_id),
-                &format_args!(
-                    "sender_id {} is not in server.participants {participants:?}",
-                    cmd.sender_id
-                ),
-            );
-            shared.reject_unknown_sender();
-            return;
-        }
-        match &sink {
-            CommandSink::Queue(tx) => {
-                let tx = tx.lock().unwrap_or_else(|p| p.into_inner());
-                if tx.try_send(cmd).is_err() {
-                    shared
-                        .commands_dropped
-                        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                }
-            }
-            CommandSink::Core(core) => core.lock().unwrap_or_else(|p| p.into_inner()).offer(&cmd),
-        }
-    }
-}
-
-/// Lockstep: waits until every participant's liveliness token is present and the state
-/// publisher has a subscriber. `Ok(true)` to start, `Ok(false)` if `shutdown` completed first.
-async fn await_presence(
-    state_pub: &zenoh::pubsub::Publisher<'static>,
-    presence: &Arc<Presence>,
-    settings: &ServerSettings,
-    topics: &Topics,
-    mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
-) -> Result<bool, ServerError> {
-    let waited_from = Instant::now();
-    let give_up = tokio::time::Instant::now() + settings.presence_timeout;
-    let p = presence.clone();
-    let _matching = state_pub
-        .matching_listener()
-        .callback(move |_| p.changed.notify_one())
-        .await
-        .map_err(|e| ServerError::zenoh("declare a matching listener", e))?;
-    tracing::info!(
-        participants = ?settings.participants,
-        key = topics.participant_wildcard(),
-        "waiting for the lockstep participants"
-    );
-    loop {
-        let missing = presence.missing(&settings.participants);
-        let matching = state_pub
-            .matching_status()
-            .await
-            .map_err(|e| ServerError::zenoh("query the state publisher's matching status", e))?
-            .matching();
-        if missing.is_empty() && matching {
-            tracing::info!("every lockstep participant is present; starting at tick 0");
-            return Ok(true);
-        }
-        tokio::select! {
-            () = shutdown.as_mut() => {
-                tracing::info!("shutdown requested before tick 0");
-                return Ok(false);
-            }
-            r = tokio::time::timeout_at(give_up, presence.changed.notified()) => {
-                if r.is_err() {
-                    return Err(ServerError::ParticipantsAbsent {
-                        missing: if missing.is_empty() {
-                            settings.participants.clone()
-                        } else {
-                            missing
-                        },
-                        sc_id: settings.sc_id.clone(),
-                        waited_s: waited_from.elapsed().as_secs_f64(),
-                    });
-                }
-            }
-        }
-    }
-}
+use telemetry::{TelemetryCtx, TelemetryReport};
 
 /// Runs the server until the configured duration is reached, `shutdown` completes, or an error
 /// stops it.
@@ -377,16 +100,99 @@ pub async fn run(
     shutdown: impl Future<Output = ()>,
 ) -> Result<RunReport, ServerError> {
     let mut shutdown = std::pin::pin!(shutdown);
+    let mode = settings.mode;
+
+    // Setup: the simulation, its telemetry publishers and configuration queryable, the
+    // recorder, and the threads' channels (who steps the frames and who publishes them).
+    let (topics, sim, total_frames) = prepare(&session, &settings, &cfg)?;
+    let endpoints = Endpoints::declare(&session, &settings, &cfg, &topics, &sim).await?;
+    let _config = setup::serve_config(&session, &topics, &endpoints.vehicle).await?;
+    let recorder = setup::start_recorder(&settings, &endpoints.vehicle)?;
+    let record_tx = recorder.as_ref().map(|(_, tx)| tx.clone());
+    let shared = Arc::new(Shared::new(&settings.participants));
+    shared.set_run_state(RunState::Starting);
+    let state_pub = endpoints.state_pub.clone();
+    let wiring = Wiring::new(
+        endpoints,
+        sim,
+        &settings,
+        total_frames,
+        &shared,
+        record_tx.clone(),
+    )?;
+
+    // zenoh rx: the command callback, into the physics thread's queue or the lockstep core.
+    let commands = intake::declare(
+        &session,
+        &topics,
+        wiring.sink,
+        shared.clone(),
+        &settings,
+        record_tx,
+    )
+    .await?;
+
+    // Presence: lockstep participants announce themselves with a liveliness token.
+    let presence = match mode {
+        Mode::Lockstep => Some(Presence::declare(&session, &topics, shared.clone()).await?),
+        _ => None,
+    };
+
+    // The telemetry thread starts first, so StatusMsg (run_state = Starting) goes out while a
+    // lockstep server waits for its participants.
+    let telemetry = spawn_telemetry(wiring.telemetry)?;
+    if let Some(presence) = &presence {
+        let ready = presence
+            .wait(&state_pub, &settings, &topics, shutdown.as_mut())
+            .await;
+        if !matches!(ready, Ok(true)) {
+            // Not starting: end the telemetry thread (it publishes a final status) first.
+            shared.set_run_state(if ready.is_ok() {
+                RunState::Stopped
+            } else {
+                RunState::Failed
+            });
+            drop(wiring.frames);
+            let _ = telemetry.await;
+            drop(commands);
+            finish_recording(recorder)?;
+            ready?;
+            return Ok(RunReport::before_tick_0(mode, shared.rejected()));
+        }
+    }
+
+    // The physics thread (or the lockstep core) to the end, then the telemetry thread's.
+    let started = Instant::now();
+    let physics = run_frames(wiring.frames, &settings, &shared, shutdown.as_mut()).await?;
+    let wall_s = started.elapsed().as_secs_f64();
+    let tlm = telemetry
+        .await
+        .map_err(|_| ServerError::Internal("the telemetry thread panicked".into()))?;
+
+    // The report: commands stop arriving, the recorder writes what it holds and closes the file.
+    drop(commands);
+    let recording = finish_recording(recorder)?;
+    let report = RunReport::collect(mode, physics?, &shared, &tlm.lateness, wall_s, recording);
+    tracing::info!("{report}");
+    Ok(report)
+}
+
+/// Validates the settings against `cfg`, builds the simulation and logs what is starting:
+/// the spacecraft's topics, the simulation and the frames to run (`None`: until stopped).
+fn prepare(
+    session: &Session,
+    settings: &ServerSettings,
+    cfg: &SimConfig,
+) -> Result<(Topics, Simulation, Option<u64>), ServerError> {
     settings.validate()?;
     let total_frames = settings.duration_frames(cfg.frame_ns)?;
     let topics = Topics::new(&settings.sc_id).map_err(|e| SettingsError::Invalid {
         name: "server.sc_id".into(),
         problem: e.to_string(),
     })?;
-    let sim = Simulation::new(&cfg).map_err(|source| ServerError::Config { file: None, source })?;
-    let mode = settings.mode;
+    let sim = Simulation::new(cfg).map_err(|source| ServerError::Config { file: None, source })?;
     tracing::info!(
-        mode = mode_name(mode),
+        mode = mode_name(settings.mode),
         zid = %session.zid(),
         state = topics.state(),
         commands = topics.cmd_wildcard(),
@@ -396,137 +202,84 @@ pub async fn run(
         cfg.summary()
     );
     tracing::info!("server settings: {}", settings.summary());
-    if mode == Mode::RealTime && settings.stale_policy == StalePolicy::Hold {
+    crate::transport::log_listening(session);
+    if settings.mode == Mode::RealTime && settings.stale_policy == StalePolicy::Hold {
         tracing::debug!("stale commands are held (stale_policy = hold)");
     }
+    Ok((topics, sim, total_frames))
+}
 
-    // Real time drops telemetry under congestion rather than delaying the frame; lockstep and
-    // batch block, so no sample of the deterministic stream is lost. Delivery is reliable
-    // (Zenoh's default `Reliability::Reliable`, over TCP); its setter is unstable in Zenoh 1.10.
-    let congestion = if mode == Mode::RealTime {
-        CongestionControl::Drop
-    } else {
-        CongestionControl::Block
-    };
-    let express = mode != Mode::Batch;
-    // The state and every sensor topic are declared alike.
-    let telemetry_pub = |key: String, what: &'static str| {
-        let declared = session
-            .declare_publisher(key)
-            .congestion_control(congestion)
-            .express(express);
-        async move { declared.await.map_err(|e| ServerError::zenoh(what, e)) }
-    };
-    let state_pub = telemetry_pub(topics.state().to_owned(), "declare the state publisher").await?;
-    let status_pub = session
-        .declare_publisher(topics.status().to_owned())
-        .congestion_control(congestion)
-        .await
-        .map_err(|e| ServerError::zenoh("declare the status publisher", e))?;
+/// What steps the frames, with the channel ends it needs.
+enum Frames {
+    /// The physics thread (with the frame publishers when it publishes them itself).
+    Physics(Box<PhysicsCtx>, Box<Stepper>),
+    /// Lockstep with `handoff = "direct"`: the core, stepped in the command callback. No frame
+    /// goes through the channel to the telemetry thread; closing `full_tx` ends that thread.
+    Core {
+        core: Arc<Mutex<LockstepCore>>,
+        events: Arc<Notify>,
+        full_tx: SyncSender<Box<Frame>>,
+    },
+}
 
-    let mut imu_pubs = Vec::with_capacity(sim.n_imus());
-    for (i, name) in sim.imu_names().iter().enumerate() {
-        let key = topics.imu(name).map_err(|e| SettingsError::Invalid {
-            name: format!("imus[{i}].name"),
-            problem: e.to_string(),
-        })?;
-        imu_pubs.push(telemetry_pub(key, "declare an IMU publisher").await?);
-    }
+/// The threads of a run, wired as in the diagram of the module docs: who steps the frames,
+/// where the command callback delivers, and the telemetry thread's side.
+struct Wiring {
+    frames: Frames,
+    sink: CommandSink,
+    telemetry: TelemetryCtx,
+}
 
-    let mut st_pubs = Vec::with_capacity(sim.star_trackers().len());
-    for (i, st) in sim.star_trackers().iter().enumerate() {
-        let key = topics
-            .star_tracker(st.name())
-            .map_err(|e| SettingsError::Invalid {
-                name: format!("star_trackers[{i}].name"),
-                problem: e.to_string(),
-            })?;
-        st_pubs.push((
-            telemetry_pub(key, "declare a star-tracker publisher").await?,
-            st.config().every_frames,
-        ));
-    }
-    let state_pub = Arc::new(state_pub);
-    let publisher = FramePublisher::new(state_pub.clone(), imu_pubs, st_pubs);
-
-    // What this server runs, for recordings and for the `flexdyn/<sc>/config` queryable.
-    let vehicle = VehicleInfo {
-        sc_id: settings.sc_id.clone(),
-        spacecraft_id: settings.spacecraft_id,
-        config_toml: cfg.source_toml.clone(),
-        server_settings: settings.summary(),
-        flexdyn_version: flexdyn_version().to_owned(),
-        git_commit: git_commit().map(str::to_owned),
-    };
-    let vehicle_json = serde_json::to_string(&vehicle)
-        .map_err(|e| ServerError::Internal(format!("vehicle description: {e}")))?;
-    let _config_queryable = session
-        .declare_queryable(topics.config())
-        .callback(move |query| {
-            let key = query.key_expr().clone();
-            if let Err(e) = query.reply(key, vehicle_json.clone()).wait() {
-                tracing::debug!(error = %e, "cannot answer a configuration query");
+impl Wiring {
+    fn new(
+        endpoints: Endpoints,
+        sim: Simulation,
+        settings: &ServerSettings,
+        total_frames: Option<u64>,
+        shared: &Arc<Shared>,
+        record: Option<RecordTx>,
+    ) -> Result<Self, ServerError> {
+        let mode = settings.mode;
+        // Who publishes the frames (see `publish`): batch always the telemetry thread.
+        let direct = settings.handoff.is_direct(mode, settings.record.is_some());
+        tracing::info!(
+            handoff = if direct { "direct" } else { "thread" },
+            "frames are published by {}",
+            match (direct, mode) {
+                (true, Mode::Lockstep) => "the Zenoh thread that delivers each tick's last answer",
+                (true, _) => "the physics thread at each frame boundary",
+                (false, _) => "the telemetry thread",
             }
-        })
-        .await
-        .map_err(|e| ServerError::zenoh("declare the configuration queryable", e))?;
+        );
+        let Endpoints {
+            status_pub,
+            frames: publisher,
+            ..
+        } = endpoints;
+        // The recorder's view of the keys, for the telemetry thread and (lockstep, direct) the
+        // core.
+        let recording = record.map(|tx| publisher.recording(tx, &status_pub));
 
-    // `--record`: the recorder thread, fed by whoever publishes the frames, the telemetry
-    // thread (status) and the command callback. Real time drops (and counts) what it cannot
-    // keep up with; lockstep and batch wait for it.
-    let recorder = match &settings.record {
-        Some(path) => {
-            let info = RecordingInfo {
-                recorder: "flexdyn run --record".into(),
-                command_line: std::env::args().collect::<Vec<_>>().join(" "),
-            };
-            let (recorder, tx) =
-                Recorder::start(path, &info, RECORD_QUEUE, mode != Mode::RealTime)?;
-            tx.describe_vehicle(vehicle.clone());
-            tracing::info!(file = %path.display(), "recording to MCAP");
-            Some((recorder, tx))
-        }
-        None => None,
-    };
-    let record_tx = recorder.as_ref().map(|(_, tx)| tx.clone());
-    // The recorder's view of the keys, for the telemetry thread and (lockstep, direct) the core.
-    let recording = record_tx
-        .clone()
-        .map(|tx| publisher.recording(tx, &status_pub));
+        let (cmd_tx, cmd_rx) = sync_channel(settings.command_queue);
+        // Consumed commands go back to the telemetry thread to be freed there: an `Actuators`
+        // command owns heap vectors, and the physics thread frees nothing.
+        let (recycle_tx, recycle_rx) = sync_channel(settings.command_queue);
+        let n_buffers = settings.telemetry_buffers;
+        let (free_tx, free_rx) = sync_channel::<Box<Frame>>(n_buffers);
+        let (full_tx, full_rx) = sync_channel::<Box<Frame>>(n_buffers);
+        let shape = sim.blank_state();
+        let (n_imus, n_sts) = (sim.n_imus(), sim.star_trackers().len());
+        let new_frame = || Box::new(Frame::for_state(&shape, n_imus, n_sts));
+        let frame_ns = sim.frame_ns();
+        let input_ranges = sim.spacecraft().effector_input_ranges().to_vec();
+        let stepper = Stepper::new(sim, settings);
 
-    // Who publishes the frames (see `publish`): batch always the telemetry thread.
-    let direct = settings.handoff.is_direct(mode, settings.record.is_some());
-    tracing::info!(
-        handoff = if direct { "direct" } else { "thread" },
-        "frames are published by {}",
-        match (direct, mode) {
-            (true, Mode::Lockstep) => "the Zenoh thread that delivers each tick's last answer",
-            (true, _) => "the physics thread at each frame boundary",
-            (false, _) => "the telemetry thread",
-        }
-    );
-
-    let shared = Arc::new(Shared::new(&settings.participants));
-    shared.set_run_state(RunState::Starting);
-    let (cmd_tx, cmd_rx) = sync_channel(settings.command_queue);
-    // Consumed commands go back to the telemetry thread to be freed there: an `Actuators`
-    // command owns heap vectors, and the physics thread frees nothing.
-    let (recycle_tx, recycle_rx) = sync_channel(settings.command_queue);
-    let n_buffers = settings.telemetry_buffers;
-    let (free_tx, free_rx) = sync_channel::<Box<Frame>>(n_buffers);
-    let (full_tx, full_rx) = sync_channel::<Box<Frame>>(n_buffers);
-    let shape = sim.blank_state();
-    let (n_imus, n_sts) = (sim.n_imus(), sim.star_trackers().len());
-    let new_frame = || Box::new(Frame::for_state(&shape, n_imus, n_sts));
-    let frame_ns = cfg.frame_ns;
-    let stepper = Stepper::new(sim, &settings);
-
-    // Who steps the frames, and where the frame publishers go: the physics thread (real time,
-    // direct), the lockstep core (lockstep, direct) or the telemetry thread (otherwise).
-    let events = Arc::new(Notify::new());
-    let (frame_loop, telemetry_publisher) = match (direct, mode) {
-        (true, Mode::Lockstep) => {
-            let core = LockstepCore::new(
+        // Who steps the frames, and where the frame publishers go: the physics thread (real
+        // time, direct), the lockstep core (lockstep, direct) or the telemetry thread
+        // (otherwise).
+        let (frames, sink, telemetry_publisher) = if direct && mode == Mode::Lockstep {
+            let events = Arc::new(Notify::new());
+            let core = Arc::new(Mutex::new(LockstepCore::new(
                 stepper,
                 new_frame(),
                 publisher,
@@ -534,140 +287,31 @@ pub async fn run(
                 shared.clone(),
                 total_frames,
                 events.clone(),
-            );
-            (FrameLoop::Core(Arc::new(Mutex::new(core))), None)
-        }
-        (true, _) => (FrameLoop::Physics(Box::new(stepper), Some(publisher)), None),
-        (false, _) => (FrameLoop::Physics(Box::new(stepper), None), Some(publisher)),
-    };
-    let sink = match &frame_loop {
-        FrameLoop::Core(core) => CommandSink::Core(core.clone()),
-        FrameLoop::Physics(..) => {
+            )));
+            let sink = CommandSink::Core(core.clone());
+            let frames = Frames::Core {
+                core,
+                events,
+                full_tx,
+            };
+            (frames, sink, None)
+        } else {
             // The telemetry pool, which only the physics thread's frames go through.
             for _ in 0..n_buffers {
                 free_tx
                     .send(new_frame())
                     .map_err(|_| ServerError::Internal("telemetry pool".into()))?;
             }
-            CommandSink::Queue(Mutex::new(cmd_tx))
-        }
-    };
-
-    let _cmd_sub = session
-        .declare_subscriber(topics.cmd_wildcard().to_owned())
-        .callback(command_callback(
-            sink,
-            shared.clone(),
-            topics.clone(),
-            settings.spacecraft_id,
-            settings.participants.clone(),
-            record_tx.clone(),
-        ))
-        .await
-        .map_err(|e| ServerError::zenoh("declare the command subscriber", e))?;
-
-    // Lockstep participants announce themselves with a liveliness token.
-    let presence = Arc::new(Presence::default());
-    let _presence_sub = if mode == Mode::Lockstep {
-        let p = presence.clone();
-        let t = topics.clone();
-        let shared_p = shared.clone();
-        Some(
-            session
-                .liveliness()
-                .declare_subscriber(topics.participant_wildcard())
-                .history(true)
-                .callback(move |sample| {
-                    let Some(id) = t.participant_id(sample.key_expr().as_str()) else {
-                        return;
-                    };
-                    let mut ids = p.ids.lock().unwrap_or_else(|e| e.into_inner());
-                    match sample.kind() {
-                        SampleKind::Put => {
-                            if ids.insert(id) {
-                                tracing::info!(participant = id, "lockstep participant present");
-                            }
-                        }
-                        SampleKind::Delete => {
-                            if ids.remove(&id) {
-                                tracing::warn!(
-                                    participant = id,
-                                    tick = shared_p.tick.load(std::sync::atomic::Ordering::Relaxed),
-                                    "lockstep participant left (liveliness token dropped)"
-                                );
-                            }
-                        }
-                    }
-                    drop(ids);
-                    p.changed.notify_one();
-                })
-                .await
-                .map_err(|e| {
-                    ServerError::zenoh("declare the participant liveliness subscriber", e)
-                })?,
-        )
-    } else {
-        None
-    };
-
-    // The telemetry thread starts first, so StatusMsg (run_state = Starting) goes out while a
-    // lockstep server waits for its participants.
-    let telemetry = TelemetryCtx {
-        publisher: telemetry_publisher,
-        status_pub,
-        full_rx,
-        free_tx,
-        recycle_rx,
-        shared: shared.clone(),
-        settings: settings.clone(),
-        frame_ns,
-        record: recording,
-    };
-    let (tlm_done_tx, tlm_done_rx) = oneshot::channel();
-    std::thread::Builder::new()
-        .name("flexdyn-telemetry".into())
-        .spawn(move || {
-            let _ = tlm_done_tx.send(telemetry.run());
-        })
-        .map_err(|e| ServerError::Internal(format!("cannot start the telemetry thread: {e}")))?;
-
-    if mode == Mode::Lockstep {
-        let ready =
-            await_presence(&state_pub, &presence, &settings, &topics, shutdown.as_mut()).await;
-        if !matches!(ready, Ok(true)) {
-            // Not starting: end the telemetry thread (it publishes a final status) first.
-            shared.set_run_state(if ready.is_ok() {
-                RunState::Stopped
+            let gate = commands::Gate::new(
+                &settings.participants,
+                &input_ranges,
+                mode == Mode::Lockstep,
+            );
+            let (direct, telemetry) = if direct {
+                (Some(publisher), None)
             } else {
-                RunState::Failed
-            });
-            drop(full_tx);
-            let _ = tlm_done_rx.await;
-            drop(_cmd_sub);
-            if let Some((recorder, tx)) = recorder {
-                recorder.finish(&tx)?;
-            }
-            ready?;
-            return Ok(RunReport {
-                mode,
-                outcome: Outcome::Stopped,
-                last_tick: 0,
-                sim_time_ns: 0,
-                states_published: 0,
-                telemetry_dropped: 0,
-                timing: FrameTiming::default(),
-                rejected: shared.rejected(),
-                commands_dropped: 0,
-                wall_s: 0.0,
-                recording: None,
-                direct_publish: None,
-            });
-        }
-    }
-
-    let started = Instant::now();
-    let physics_result = match frame_loop {
-        FrameLoop::Physics(stepper, direct) => {
+                (None, Some(publisher))
+            };
             let physics = PhysicsCtx {
                 settings: settings.clone(),
                 total_frames,
@@ -678,74 +322,79 @@ pub async fn run(
                 shared: shared.clone(),
                 direct,
             };
-            run_physics_thread(physics, *stepper, &settings, &shared, shutdown.as_mut()).await?
-        }
-        FrameLoop::Core(core) => {
-            drop((cmd_rx, recycle_tx, free_rx));
-            let r = run_lockstep_core(&core, &events, &settings, &shared, shutdown.as_mut()).await;
-            // No frame goes through the channel; closing it ends the telemetry thread.
-            drop(full_tx);
-            r
-        }
-    };
-    let wall_s = started.elapsed().as_secs_f64();
-    let tlm = tlm_done_rx
-        .await
-        .map_err(|_| ServerError::Internal("the telemetry thread panicked".into()))?;
+            let frames = Frames::Physics(Box::new(physics), Box::new(stepper));
+            (
+                frames,
+                CommandSink::Queue(Mutex::new((cmd_tx, gate))),
+                telemetry,
+            )
+        };
+        let telemetry = TelemetryCtx {
+            publisher: telemetry_publisher,
+            status_pub,
+            full_rx,
+            free_tx,
+            recycle_rx,
+            shared: shared.clone(),
+            settings: settings.clone(),
+            frame_ns,
+            record: recording,
+        };
+        Ok(Self {
+            frames,
+            sink,
+            telemetry,
+        })
+    }
+}
 
-    // Commands stop arriving, then the recorder writes what it holds and closes the file.
-    drop(_cmd_sub);
-    let recording = match recorder {
-        Some((recorder, tx)) => Some(recorder.finish(&tx)?),
-        None => None,
-    };
-    let phys = physics_result?;
-    let report = RunReport {
-        mode,
-        outcome: match phys.ending {
-            Ending::Finished => Outcome::Finished,
-            Ending::Stopped => Outcome::Stopped,
-        },
-        last_tick: phys.last_tick,
-        sim_time_ns: phys.sim_time_ns,
-        states_published: shared.published.load(std::sync::atomic::Ordering::Relaxed),
-        telemetry_dropped: shared
-            .telemetry_dropped
-            .load(std::sync::atomic::Ordering::Relaxed),
-        timing: timing_of(
-            &tlm.lateness,
-            shared.overruns.load(std::sync::atomic::Ordering::Relaxed),
-            shared
-                .frames_skipped
-                .load(std::sync::atomic::Ordering::Relaxed),
-        ),
-        rejected: shared.rejected(),
-        commands_dropped: shared
-            .commands_dropped
-            .load(std::sync::atomic::Ordering::Relaxed),
-        wall_s,
-        recording,
-        direct_publish: {
-            let n = shared
-                .direct_publishes
-                .load(std::sync::atomic::Ordering::Relaxed);
-            (n > 0).then(|| PublishCost {
-                frames: n,
-                mean_ns: shared
-                    .direct_publish_ns_total
-                    .load(std::sync::atomic::Ordering::Relaxed) as f64
-                    / n as f64,
-                max_ns: shared
-                    .direct_publish_ns_max
-                    .load(std::sync::atomic::Ordering::Relaxed),
-                slow_frames: shared
-                    .direct_publishes_slow
-                    .load(std::sync::atomic::Ordering::Relaxed),
-            })
-        },
-    };
-    tracing::info!("{report}");
-    Ok(report)
+/// Starts the telemetry thread; the receiver yields its report when it ends (an error if it
+/// panicked).
+fn spawn_telemetry(
+    telemetry: TelemetryCtx,
+) -> Result<oneshot::Receiver<TelemetryReport>, ServerError> {
+    let (done_tx, done_rx) = oneshot::channel();
+    std::thread::Builder::new()
+        .name("flexdyn-telemetry".into())
+        .spawn(move || {
+            let _ = done_tx.send(telemetry.run());
+        })
+        .map_err(|e| ServerError::Internal(format!("cannot start the telemetry thread: {e}")))?;
+    Ok(done_rx)
+}
+
+/// Steps the frames to the end (or a stop request): on the physics thread, or through the
+/// lockstep core. The outer `Err` only if the physics thread panicked.
+async fn run_frames(
+    frames: Frames,
+    settings: &ServerSettings,
+    shared: &Arc<Shared>,
+    shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
+) -> Result<Result<PhysicsReport, ServerError>, ServerError> {
+    match frames {
+        Frames::Physics(physics, stepper) => {
+            run_physics_thread(*physics, *stepper, settings, shared, shutdown).await
+        }
+        Frames::Core {
+            core,
+            events,
+            full_tx,
+        } => {
+            let r = run_lockstep_core(&core, &events, settings, shared, shutdown).await;
+            drop(full_tx);
+            Ok(r)
+        }
+    }
+}
+
+/// Closes the `--record` file once everything queued is written; what it holds.
+fn finish_recording(
+    recorder: Option<(Recorder, RecordTx)>,
+) -> Result<Option<RecordReport>, ServerError> {
+    recorder
+        .map(|(recorder, tx)| recorder.finish(&tx))
+        .transpose()
+        .map_err(ServerError::from)
 }
 
 /// Runs the physics thread to its end (or a stop request); `Err` only if it panicked.

@@ -328,6 +328,9 @@ impl PhysicsCtx {
                 }
                 0
             };
+            // Noted before the state goes out, so a participant answering it finds its tick
+            // published (the command callback refuses ticks not yet published).
+            self.shared.tick.store(k, Ordering::Release);
             let stamp = unix_now_ns();
             if let Some(mut f) = pending.take() {
                 f.boundary_unix_ns = stamp;
@@ -345,7 +348,6 @@ impl PhysicsCtx {
                     return Err(ServerError::Internal("telemetry thread ended".into()));
                 }
             }
-            self.shared.tick.store(k, Ordering::Relaxed);
             if self.total_frames == Some(k) {
                 return Ok(PhysicsReport {
                     ending: Ending::Finished,

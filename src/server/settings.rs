@@ -155,7 +155,8 @@ pub struct ServerSettings {
     /// (default 0). Needs CAP_SYS_NICE (or root); if the OS refuses, the server logs a warning
     /// and runs at normal priority.
     pub realtime_priority: u8,
-    /// Preallocated telemetry buffers between the physics and the I/O threads (default 8).
+    /// Preallocated telemetry buffers between the physics and the I/O threads (default 64:
+    /// 64 ms at 1 kHz of a telemetry thread not scheduled before a frame's telemetry is dropped).
     pub telemetry_buffers: usize,
     /// Capacity of the command queue from the I/O side to the physics thread (default 1024).
     pub command_queue: usize,
@@ -190,7 +191,7 @@ impl Default for ServerSettings {
             summary_interval: Duration::from_secs(10),
             spin: Duration::from_micros(200),
             realtime_priority: 0,
-            telemetry_buffers: 8,
+            telemetry_buffers: 64,
             command_queue: 1024,
             handoff: Handoff::Auto,
             participant_subjects: std::collections::BTreeMap::new(),

@@ -93,7 +93,7 @@ pub struct Shared {
     pub stop: AtomicBool,
     /// [`RunState`] as its wire tag.
     run_state: AtomicU8,
-    /// Last tick published (boundary reached).
+    /// The last frame boundary reached, noted before its state is published.
     pub tick: AtomicU64,
     malformed: AtomicU64,
     bad_version: AtomicU64,

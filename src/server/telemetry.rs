@@ -116,8 +116,9 @@ impl TelemetryCtx {
         }
     }
 
-    /// Warns (rate-limited) about the rejections the physics thread counted since the last
-    /// call: stale ticks, naming the participant, and effector inputs that do not fit.
+    /// Warns (rate-limited) about the tick and effector-input rejections (counted by the
+    /// command callback's gate and the command book) since the last call: stale ticks, naming
+    /// the participant, and effector inputs that do not fit.
     fn warn_physics_rejects(
         &self,
         log: &mut RejectLog,
@@ -132,8 +133,8 @@ impl TelemetryCtx {
                     Some(*id),
                     now - *last,
                     &"a command for a tick the server is not taking (lockstep: not the tick \
-                      being waited for, or a second answer; real time: a future tick, or older \
-                      than the sender's held command)",
+                      being waited for, or a second answer; real time: a tick not yet \
+                      published, or older than the sender's previous command)",
                 );
                 *last = now;
             }

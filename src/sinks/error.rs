@@ -47,6 +47,22 @@ pub enum SinkError {
         /// What Zenoh reported.
         message: String,
     },
+    /// `flexdyn replay`: no subscriber appeared for any of the recording's keys, so there was
+    /// nobody to replay to.
+    #[error(
+        "no subscriber matched any of the recording's {keys} keys within {waited_s} s \
+         (--wait-subscriber-s), so nothing was replayed: start the subscriber (`flexdyn view`, \
+         `flexdyn record`, `flexdyn-monitor`, your ground tool) on the replay's endpoint (the \
+         replay {endpoints}; the tools connect to tcp/127.0.0.1:7447 by default)"
+    )]
+    NoSubscriber {
+        /// The keys replayed.
+        keys: usize,
+        /// \[s\] how long the replay waited.
+        waited_s: f64,
+        /// Where the replay listens or connects (`listens on tcp/…`), for the message.
+        endpoints: String,
+    },
     /// Anything else that stops the command (runtime, signal handlers, the viewer server).
     #[error("{0}")]
     Runtime(String),

@@ -25,6 +25,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::gaps::SeqGaps;
 use super::scene::Geometry;
 use super::scene::{frame_transforms, frame_transforms_schema, scene_update, scene_update_schema};
 use super::topics::{classify, json_schema, wire_layout_text, Decoded, TopicKind};
@@ -169,6 +170,16 @@ pub struct SinkStats {
     pub undecodable: u64,
     /// MCAP messages written (raw, decoded, transforms and scenes).
     pub mcap_messages: u64,
+    /// Telemetry messages missing between those recorded, per key with any missing: the jumps
+    /// of the publishers' sequence numbers ([`super::gaps`]).
+    pub missing: BTreeMap<String, u64>,
+}
+
+impl SinkStats {
+    /// Telemetry messages missing between those recorded, over every key.
+    pub fn missing_total(&self) -> u64 {
+        self.missing.values().sum()
+    }
 }
 
 struct ChannelIds {
@@ -201,6 +212,7 @@ pub struct McapSink {
     vehicles: HashMap<String, Vehicle>,
     sequences: HashMap<u16, u32>,
     last_log_time_ns: u64,
+    gaps: SeqGaps,
     stats: SinkStats,
 }
 
@@ -229,6 +241,7 @@ impl McapSink {
             vehicles: HashMap::new(),
             sequences: HashMap::new(),
             last_log_time_ns: 0,
+            gaps: SeqGaps::default(),
             stats: SinkStats::default(),
         };
         let mut meta = BTreeMap::new();
@@ -450,6 +463,10 @@ impl McapSink {
         };
         let log_time = decoded.header().sim_time_ns;
         self.last_log_time_ns = log_time;
+        let gap = self.gaps.observe(key, kind, decoded.header().seq);
+        if gap > 0 {
+            *self.stats.missing.entry(key.to_owned()).or_default() += gap;
+        }
         let publish_time = match (&decoded, publish_time_ns) {
             (_, Some(t)) => t,
             (Decoded::Status(s), None) => s.wall_time_unix_ns,

@@ -5,6 +5,7 @@
 //! - [`scene`]: Foxglove frame transforms and the spacecraft's 3D boxes.
 //! - [`mcap_file`]: the MCAP recording layout (raw + decoded + 3D channels, metadata).
 //! - [`recorder`]: the recorder thread behind a bounded queue (lossless or counted drops).
+//! - [`gaps`]: what a recording misses, from the publishers' sequence numbers.
 //! - [`reader`]: reading a recording back, crash-truncated files included.
 //! - [`table`]: decoded messages as named columns (CSV export, plots).
 //! - [`record_cmd`], [`replay`], [`export`]: the `flexdyn record`, `replay` and `export`
@@ -14,6 +15,7 @@
 
 pub mod error;
 pub mod export;
+pub mod gaps;
 pub mod mcap_file;
 pub mod plot;
 pub mod reader;

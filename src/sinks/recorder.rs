@@ -8,6 +8,10 @@
 //! - **lossy** (real time): a full queue drops the sample and counts it. The count is logged,
 //!   returned in the [`RecordReport`] and written into the file's `flexdyn.recorder` metadata.
 //!
+//! Either way the file's `flexdyn.recorder` metadata says what it misses: the telemetry messages
+//! whose publishers' sequence numbers jump ([`super::gaps`]: `missing_samples`, in total and per
+//! key), what the queue dropped, and whether the recording is `complete` (neither).
+//!
 //! Chunks are flushed at least every [`FLUSH_INTERVAL`], bounding what a crash can lose.
 
 use std::collections::BTreeMap;
@@ -88,6 +92,39 @@ pub struct RecordReport {
     pub dropped: u64,
 }
 
+impl RecordReport {
+    /// Whether the file holds every sample the recorder was given and every telemetry message
+    /// between the first and the last of each key (no sequence-number gap).
+    pub fn complete(&self) -> bool {
+        self.dropped == 0 && self.stats.missing.is_empty()
+    }
+
+    /// `complete`, or `INCOMPLETE: …` saying what is missing (per key) and what was dropped.
+    pub fn completeness(&self) -> String {
+        if self.complete() {
+            return "complete".into();
+        }
+        let mut parts = Vec::new();
+        if !self.stats.missing.is_empty() {
+            let keys: Vec<String> = self
+                .stats
+                .missing
+                .iter()
+                .map(|(k, n)| format!("{k} {n}"))
+                .collect();
+            parts.push(format!(
+                "{} telemetry messages missing (sequence-number gaps: {})",
+                self.stats.missing_total(),
+                keys.join(", ")
+            ));
+        }
+        if self.dropped > 0 {
+            parts.push(format!("{} samples dropped by the recorder", self.dropped));
+        }
+        format!("INCOMPLETE: {}", parts.join("; "))
+    }
+}
+
 /// The running recorder thread.
 pub struct Recorder {
     join: JoinHandle<Result<SinkStats, RecordError>>,
@@ -147,6 +184,16 @@ fn run(
         "undecodable".to_owned(),
         sink.stats().undecodable.to_string(),
     );
+    let missing = sink.stats().missing.clone();
+    meta.insert(
+        "missing_samples".to_owned(),
+        missing.values().sum::<u64>().to_string(),
+    );
+    for (key, n) in &missing {
+        meta.insert(format!("missing_samples.{key}"), n.to_string());
+    }
+    let complete = missing.is_empty() && dropped.load(Ordering::Relaxed) == 0;
+    meta.insert("complete".to_owned(), complete.to_string());
     sink.write_metadata("flexdyn.recorder", meta)?;
     sink.finish()
 }
@@ -230,6 +277,13 @@ impl Recorder {
             tracing::warn!(
                 dropped,
                 "the recorder could not keep up and dropped samples (real-time mode drops rather than delay telemetry)"
+            );
+        }
+        if !stats.missing.is_empty() {
+            tracing::warn!(
+                missing = stats.missing_total(),
+                by_key = ?stats.missing,
+                "the recording misses telemetry messages: their publishers' sequence numbers jump"
             );
         }
         Ok(RecordReport { stats, dropped })

@@ -5,7 +5,10 @@
 //! Topics and schemas are the recording's decoded ones (`/flexdyn/<sc>/tlm/state`,
 //! `/flexdyn/<sc>/tf`, `/flexdyn/<sc>/scene`, …), so one Foxglove layout serves both. Message
 //! times are simulation time, and the server announces the current simulation time
-//! (`Capability::Time`), so Foxglove's clock runs on simulation time.
+//! (`Capability::Time`) with the data that advances it, so Foxglove's clock runs on simulation
+//! time and keeps up with the plots: live, right after a StateMsg of a later time (at most every
+//! [`CLOCK_PERIOD`], the latest time once the stream pauses); from a recording, with each batch
+//! of played messages.
 //!
 //! A slow or closed viewer never slows anything upstream: the SDK gives each client a queue of
 //! `--backlog` messages that drops its oldest; the Zenoh subscriber only decodes and enqueues,
@@ -36,6 +39,11 @@ use crate::transport::{zenoh_config, Role, ZenohArgs};
 pub const DEFAULT_BIND: &str = "127.0.0.1:8765";
 /// How often the scene is sent again, for viewers that connect later.
 const SCENE_PERIOD: Duration = Duration::from_secs(1);
+/// Shortest wall time between two live clock announcements. The SDK puts them on each viewer's
+/// control queue (`--backlog` long), which, unlike the data queue, does not drop its oldest:
+/// when full it disconnects the viewer. At most 100 a second keeps a viewer that stalls for
+/// less than `backlog / 100` seconds connected, and Foxglove's clock within 10 ms of the data.
+pub const CLOCK_PERIOD: Duration = Duration::from_millis(10);
 
 /// Arguments of `flexdyn view`.
 #[derive(Clone, Debug, PartialEq, clap::Args)]
@@ -49,7 +57,7 @@ pub struct ViewArgs {
     /// Serve this recording instead of the live stream, with playback control.
     #[arg(long, value_name = "FILE.mcap")]
     pub file: Option<PathBuf>,
-    /// Messages each viewer's queue holds before it drops its oldest [default: 4096].
+    /// Messages each viewer's queue holds before it drops its oldest.
     #[arg(long, value_name = "N", default_value_t = 4096)]
     pub backlog: usize,
     /// Stop after this many seconds of wall time (for scripts and tests). Default: until
@@ -68,6 +76,8 @@ struct Translator {
     geometry: HashMap<String, Geometry>,
     filter: Vec<String>,
     latest_time_ns: u64,
+    /// The last simulation time announced to the viewers, and when.
+    announced: Option<(u64, Instant)>,
 }
 
 impl Translator {
@@ -78,7 +88,22 @@ impl Translator {
             geometry: HashMap::new(),
             filter,
             latest_time_ns: 0,
+            announced: None,
         }
+    }
+
+    /// The simulation time to announce now, if the data has moved it since the last
+    /// announcement and [`CLOCK_PERIOD`] has passed (or `now_anyway`).
+    fn clock_due(&mut self, now_anyway: bool) -> Option<u64> {
+        let t = self.latest_time_ns;
+        let due = match self.announced {
+            None => true,
+            Some((last, at)) => t > last && (now_anyway || at.elapsed() >= CLOCK_PERIOD),
+        };
+        due.then(|| {
+            self.announced = Some((t, Instant::now()));
+            t
+        })
     }
 
     fn channel(&mut self, topic: &str, schema: impl FnOnce() -> Schema) -> Option<Arc<RawChannel>> {
@@ -371,6 +396,7 @@ pub fn view(args: &ViewArgs) -> Result<ViewReport, SinkError> {
                     let t = translator.clone();
                     let n = samples.clone();
                     let new_tx = new_tx.clone();
+                    let clock = handle.clone();
                     let sub = session
                         .declare_subscriber(format!("flexdyn/{p}/**"))
                         .callback(move |sample| {
@@ -385,7 +411,13 @@ pub fn view(args: &ViewArgs) -> Result<ViewReport, SinkError> {
                                 }
                             }
                             t.sample(key, &sample.payload().to_bytes());
+                            let announce = t.clock_due(false);
+                            drop(t);
                             n.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                            // The clock moves with the data, not once a second behind it.
+                            if let Some(time) = announce {
+                                clock.broadcast_time(time);
+                            }
                         })
                         .await
                         .map_err(|e| SinkError::zenoh("declare the subscriber", e))?;
@@ -400,7 +432,10 @@ pub fn view(args: &ViewArgs) -> Result<ViewReport, SinkError> {
                         _ = tick.tick() => {
                             let mut t = translator.lock().unwrap_or_else(|e| e.into_inner());
                             t.send_scenes();
-                            handle.broadcast_time(t.latest_time_ns);
+                            // The latest time, if the stream paused within CLOCK_PERIOD of it.
+                            if let Some(time) = t.clock_due(true) {
+                                handle.broadcast_time(time);
+                            }
                         }
                         Some(sc) = new_rx.recv() => {
                             if asked.insert(sc.clone()) {

@@ -36,11 +36,3 @@ pub fn assert_one_error_line(code: Option<i32>, err: &str, want: &str) {
         assert!(!err.contains(leak), "leaks `{leak}`: {err}");
     }
 }
-
-/// A loopback TCP port that is free now (nothing listens on it: a client finds no server).
-pub fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .expect("a free port")
-        .port()
-}

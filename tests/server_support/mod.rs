@@ -11,20 +11,34 @@ use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::{decode_state, decode_status, StateMsg, StatusMsg, Topics};
 use zenoh::{Session, Wait};
 
+// Ports the OS gave a process, read back; shared with the test files without this harness.
+#[path = "../ports/mod.rs"]
+pub mod ports;
+#[allow(unused_imports)]
+pub use ports::{port_of, reporting, ws_port, zenoh_endpoint, ANY_PORT};
+
 /// `tcp/127.0.0.1:<port>`.
 pub fn endpoint(port: u16) -> String {
     format!("tcp/127.0.0.1:{port}")
 }
 
-/// A session listening on `port`.
-pub fn listening_session(port: u16) -> Session {
+/// A session listening on a port the OS chose, and that port.
+pub fn listening_session() -> (Session, u16) {
     let args = ZenohArgs {
-        listen: vec![endpoint(port)],
+        listen: vec![ANY_PORT.into()],
         ..ZenohArgs::default()
     };
-    zenoh::open(zenoh_config(&args, Role::Server).unwrap())
+    let session = zenoh::open(zenoh_config(&args, Role::Server).unwrap())
         .wait()
-        .unwrap()
+        .unwrap();
+    let port = session_port(&session);
+    (session, port)
+}
+
+/// The port `session` listens on (its first listen endpoint).
+pub fn session_port(session: &Session) -> u16 {
+    let endpoints = flexdyn::transport::listening_on(session);
+    port_of(endpoints.first().expect("the session listens nowhere"))
 }
 
 /// A session connecting to `port`.
@@ -121,13 +135,16 @@ impl Observer {
 
 /// `server::run` on its own runtime in a background thread, with a bounded join.
 pub struct ServerHandle {
+    /// The port the server's session listens on.
+    pub port: u16,
     done: std::sync::mpsc::Receiver<Result<server::RunReport, server::ServerError>>,
     stop: Option<tokio::sync::oneshot::Sender<()>>,
 }
 
 impl ServerHandle {
-    pub fn start(port: u16, settings: server::ServerSettings, cfg: SimConfig) -> Self {
-        Self::start_with_session(listening_session(port), settings, cfg)
+    /// On a session listening on a port the OS chose ([`Self::port`]).
+    pub fn start(settings: server::ServerSettings, cfg: SimConfig) -> Self {
+        Self::start_with_session(listening_session().0, settings, cfg)
     }
 
     /// [`Self::start`] on a session the caller opened (e.g. with an authenticating config).
@@ -136,6 +153,7 @@ impl ServerHandle {
         settings: server::ServerSettings,
         cfg: SimConfig,
     ) -> Self {
+        let port = session_port(&session);
         let (done_tx, done) = std::sync::mpsc::channel();
         let (stop_tx, stop_rx) = tokio::sync::oneshot::channel::<()>();
         std::thread::spawn(move || {
@@ -155,6 +173,7 @@ impl ServerHandle {
             let _ = done_tx.send(result);
         });
         Self {
+            port,
             done,
             stop: Some(stop_tx),
         }

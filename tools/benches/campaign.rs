@@ -49,7 +49,7 @@ fn main() {
         "case", "jobs", "wall s", "runs/min", "sim s / wall s"
     );
     let dir = std::env::temp_dir().join(format!("flexdyn-bench-campaign-{}", std::process::id()));
-    let mut port = 17900u16;
+    let mut case = 0u32;
     for (name, controller) in [
         ("open loop (observer only)", None),
         ("lockstep with flexdyn-acs-demo", Some(demo.as_str())),
@@ -57,14 +57,14 @@ fn main() {
         let plan = campaign(runs, controller);
         let mut serial = 0.0;
         for jobs in [1usize, 2] {
-            let out = dir.join(format!("{port}"));
+            let out = dir.join(format!("{case}"));
             let planned = plan.write(&out).unwrap();
             let opts = RunOptions {
                 dir: out,
-                base_port: port,
+                base_port: 0,
                 record: false,
             };
-            port += runs as u16;
+            case += 1;
             let indices: Vec<u32> = (0..runs).collect();
             let t = Instant::now();
             let results = execute_many(&plan, &planned, &indices, jobs, &opts);

@@ -46,14 +46,14 @@ fn median(v: &mut [f64]) -> f64 {
 
 /// Round trips per second of `ticks` ping-pongs; the pong answers inside its Zenoh callback, or
 /// from a receive loop (`recv_loop`, the demo controller's structure).
-fn pingpong_rate(port: u16, ticks: usize, recv_loop: bool) -> f64 {
-    let rtts = pingpong_rtts(port, 1000, ticks, recv_loop);
+fn pingpong_rate(ticks: usize, recv_loop: bool) -> f64 {
+    let rtts = pingpong_rtts(1000, ticks, recv_loop);
     let total: Duration = rtts.iter().sum();
     ticks as f64 / total.as_secs_f64()
 }
 
 /// Ticks per second of a lockstep run of `ticks` frames at `frame_hz` with the demo controller.
-fn lockstep_rate(port: u16, ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
+fn lockstep_rate(ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
     let cfg = reference_config(frame_hz);
     let settings = ServerSettings {
         mode: Mode::Lockstep,
@@ -63,7 +63,8 @@ fn lockstep_rate(port: u16, ticks: usize, frame_hz: f64, handoff: Handoff) -> f6
         summary_interval: Duration::from_secs(3600),
         ..ServerSettings::default()
     };
-    let server = ServerHandle::start(port, settings, cfg);
+    let server = ServerHandle::start(settings, cfg);
+    let port = server.port;
     // The reference config has no IMU: take the rate from the state (one message each way per
     // tick, like the ping-pong) rather than letting `auto` spend a second looking for a gyro.
     let _ctrl = ChildGuard::spawn(Command::new(acs_demo_bin::acs_demo()).args([
@@ -103,12 +104,11 @@ fn main() {
     let (mut ratio1, mut ratio1l, mut ratiot, mut ratior) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for r in 0..rounds {
-        let base = 17400 + 5 * r as u16;
-        let p = pingpong_rate(base, ticks, false);
-        let pl = pingpong_rate(base + 1, ticks, true);
-        let a = lockstep_rate(base + 2, ticks, 1000.0, Handoff::Direct);
-        let t = lockstep_rate(base + 3, ticks, 1000.0, Handoff::Thread);
-        let b = lockstep_rate(base + 4, ticks / 4, 100.0, Handoff::Direct);
+        let p = pingpong_rate(ticks, false);
+        let pl = pingpong_rate(ticks, true);
+        let a = lockstep_rate(ticks, 1000.0, Handoff::Direct);
+        let t = lockstep_rate(ticks, 1000.0, Handoff::Thread);
+        let b = lockstep_rate(ticks / 4, 100.0, Handoff::Direct);
         println!(
             "round {r}: ping-pong {p:.0} rt/s (recv-loop pong {pl:.0}) | lockstep 1 step/frame: \
              direct {a:.0} ticks/s (ratio {:.2}), thread {t:.0} ticks/s (ratio {:.2}) | reference \

@@ -63,14 +63,13 @@ struct Round {
 }
 
 /// \[µs\] half the median round trip of 5000 StateMsg-sized pings (after 500 unmeasured).
-fn one_way_us(port: u16) -> f64 {
-    let mut rtts = pingpong_rtts(port, 500, 5000, false);
+fn one_way_us() -> f64 {
+    let mut rtts = pingpong_rtts(500, 5000, false);
     rtts.sort_unstable();
     rtts[rtts.len() / 2].as_secs_f64() * 1e6 / 2.0
 }
 
 fn round(
-    port: u16,
     seconds: f64,
     realtime_priority: u8,
     handoff: Handoff,
@@ -86,7 +85,8 @@ fn round(
         record,
         ..ServerSettings::default()
     };
-    let server = ServerHandle::start(port, settings, cfg);
+    let server = ServerHandle::start(settings, cfg);
+    let port = server.port;
     let topics = Topics::new("sc1").unwrap();
 
     // Observer: latency of every state sample, and whether its command was fresh.
@@ -203,32 +203,19 @@ fn main() {
     let (mut one_way, mut direct, mut thread) = (Vec::new(), Vec::new(), Vec::new());
     let (mut on, mut thread_on) = (Vec::new(), Vec::new());
     for r in 0..rounds {
-        let port = 17450 + 5 * r as u16;
-        let ow = one_way_us(port);
+        let ow = one_way_us();
         println!(
             "round {}: one-way Zenoh hop (half the median ping-pong rtt): {ow:.1} us",
             r + 1
         );
         one_way.push(ow);
         println!("round {} handoff direct, --record off:", r + 1);
-        direct.push(round(
-            port + 1,
-            seconds,
-            realtime_priority,
-            Handoff::Direct,
-            None,
-        ));
+        direct.push(round(seconds, realtime_priority, Handoff::Direct, None));
         println!("round {} handoff thread, --record off:", r + 1);
-        thread.push(round(
-            port + 2,
-            seconds,
-            realtime_priority,
-            Handoff::Thread,
-            None,
-        ));
-        for (handoff, name, out, p) in [
-            (Handoff::Direct, "direct", &mut on, port + 3),
-            (Handoff::Thread, "thread", &mut thread_on, port + 4),
+        thread.push(round(seconds, realtime_priority, Handoff::Thread, None));
+        for (handoff, name, out) in [
+            (Handoff::Direct, "direct", &mut on),
+            (Handoff::Thread, "thread", &mut thread_on),
         ] {
             let file = dir.join(format!("round{r}-{name}.mcap"));
             println!(
@@ -236,7 +223,7 @@ fn main() {
                 r + 1,
                 file.display()
             );
-            let rec = round(p, seconds, realtime_priority, handoff, Some(file.clone()));
+            let rec = round(seconds, realtime_priority, handoff, Some(file.clone()));
             if let Some((samples, dropped)) = rec.recorded {
                 let bytes = std::fs::metadata(&file).map_or(0, |m| m.len());
                 println!("  recorded {samples} samples, {dropped} dropped, file {bytes} bytes");

@@ -3,6 +3,9 @@
 //! backtrace, no Rust or registry paths. Negative numbers are accepted in value lists.
 //! No test here reaches a server: each command fails on its input before connecting.
 
+#[path = "../../tests/ports/mod.rs"]
+mod ports;
+
 use std::process::Command;
 
 #[path = "../../tests/cli_support/mod.rs"]
@@ -24,9 +27,10 @@ fn the_monitor_and_pingpong_reject_bad_options_in_one_line() {
 /// With nobody to talk to, the monitor says so and fails, instead of a false pass.
 #[test]
 fn no_server_is_a_failure_not_a_pass() {
+    let (nobody, _held) = ports::closed_endpoint();
     let monitor = env!("CARGO_BIN_EXE_flexdyn-monitor");
     let out = Command::new(monitor)
-        .args(["--connect", "tcp/127.0.0.1:17392", "--duration-s", "1.5"])
+        .args(["--connect", &nobody, "--duration-s", "1.5"])
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -55,9 +59,10 @@ fn no_server_is_a_failure_not_a_pass() {
 #[test]
 fn the_scouting_delay_warning_is_quiet_by_default() {
     let monitor = env!("CARGO_BIN_EXE_flexdyn-monitor");
+    let (nobody, _held) = ports::closed_endpoint();
     let stderr_with = |rust_log: &str| {
         let out = Command::new(monitor)
-            .args(["--connect", "tcp/127.0.0.1:17395", "--duration-s", "1"])
+            .args(["--connect", &nobody, "--duration-s", "1"])
             .env("RUST_LOG", rust_log)
             .output()
             .unwrap();

@@ -15,7 +15,7 @@ mod acs_demo_bin;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn::transport::{listening_on, zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::{decode_command, encode, CommandKind, Header, ImuMsg, StateMsg, Topics};
 use zenoh::Wait;
 
@@ -30,18 +30,18 @@ fn omega(k: u64) -> [f64; 3] {
 
 #[test]
 fn the_demo_answers_each_tick_from_its_own_imu_sample_however_late() {
-    let port = std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .expect("a free port")
-        .port();
-    let endpoint = format!("tcp/127.0.0.1:{port}");
+    // The stand-in server listens on a port the OS picks, and reports it.
     let zargs = ZenohArgs {
-        listen: vec![endpoint.clone()],
+        listen: vec!["tcp/127.0.0.1:0".to_owned()],
         ..ZenohArgs::default()
     };
     let session = zenoh::open(zenoh_config(&zargs, Role::Server).unwrap())
         .wait()
         .unwrap();
+    let endpoint = listening_on(&session)
+        .into_iter()
+        .next()
+        .expect("the stand-in server listens");
     let topics = Topics::new("sc1").unwrap();
     let scenario =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/imu_tactical.toml");

@@ -1,4 +1,4 @@
-//! End-to-end lockstep: the flexdyn server (in this test process, on its own loopback port) and
+//! End-to-end lockstep: the flexdyn server (in this test process, on a loopback port the OS chose) and
 //! the demo controller `flexdyn-acs-demo` (a separate process) run a closed loop.
 //!
 //! Why the server runs in-process: the controller is the child process (its own package,
@@ -12,8 +12,6 @@
 //! The default `handoff = "direct"` (the Zenoh thread delivering a tick's last answer steps and
 //! publishes) must give the stream of `handoff = "thread"` (physics and telemetry threads) bit
 //! for bit.
-//!
-//! Ports 17309–17319.
 
 #[path = "acs_demo_bin/mod.rs"]
 mod acs_demo_bin;
@@ -109,9 +107,8 @@ struct Run {
     states: Vec<(u64, Vec<u8>)>,
 }
 
-fn lockstep_run(port: u16, participant_timeout_s: f64, sabotage: Sabotage) -> Run {
+fn lockstep_run(participant_timeout_s: f64, sabotage: Sabotage) -> Run {
     lockstep_run_with(
-        port,
         participant_timeout_s,
         sabotage,
         reference_config(100.0),
@@ -120,30 +117,23 @@ fn lockstep_run(port: u16, participant_timeout_s: f64, sabotage: Sabotage) -> Ru
 }
 
 fn lockstep_run_with(
-    port: u16,
     participant_timeout_s: f64,
     sabotage: Sabotage,
     cfg: flexdyn::config::SimConfig,
     rate_args: &[&str],
 ) -> Run {
-    lockstep_run_settings(
-        port,
-        settings(participant_timeout_s),
-        sabotage,
-        cfg,
-        rate_args,
-    )
+    lockstep_run_settings(settings(participant_timeout_s), sabotage, cfg, rate_args)
 }
 
 fn lockstep_run_settings(
-    port: u16,
     settings: ServerSettings,
     sabotage: Sabotage,
     cfg: flexdyn::config::SimConfig,
     rate_args: &[&str],
 ) -> Run {
     let topics = Topics::new("sc1").unwrap();
-    let server = ServerHandle::start(port, settings, cfg);
+    let server = ServerHandle::start(settings, cfg);
+    let port = server.port;
     let recorder = Recorder::start(port, &topics, 2);
     let mut ctrl = controller(port, rate_args);
     match sabotage {
@@ -192,7 +182,7 @@ fn digest(states: &[(u64, Vec<u8>)]) -> String {
 fn lockstep_converges_and_is_bit_identical_across_runs_and_pauses() {
     let n_ticks = (DURATION_S * 100.0) as u64 + 1;
 
-    let a = lockstep_run(17310, 10.0, Sabotage::None);
+    let a = lockstep_run(10.0, Sabotage::None);
     let report = a.result.expect("run A");
     assert_eq!(report.last_tick, n_ticks - 1);
     assert_eq!(a.states.len() as u64, n_ticks);
@@ -213,12 +203,11 @@ fn lockstep_converges_and_is_bit_identical_across_runs_and_pauses() {
     assert!(mid.wrench_applied.torque_b_nm.iter().any(|t| *t != 0.0));
     assert_eq!(mid.command_flags, 0);
 
-    let b = lockstep_run(17311, 10.0, Sabotage::None);
+    let b = lockstep_run(10.0, Sabotage::None);
     b.result.expect("run B");
     assert_eq!(digest(&b.states), hash_a, "two identical runs differ");
 
     let c = lockstep_run(
-        17312,
         10.0,
         Sabotage::Pause {
             at: 2000,
@@ -237,7 +226,6 @@ fn lockstep_converges_and_is_bit_identical_across_runs_and_pauses() {
         .handoff
         .is_direct(Mode::Lockstep, false));
     let d = lockstep_run_settings(
-        17309,
         ServerSettings {
             handoff: Handoff::Thread,
             ..settings(10.0)
@@ -293,7 +281,7 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
         "--imu-dcm-pb",
         "0,1,0,-1,0,0,0,0,1",
     ];
-    let a = lockstep_run_with(17314, 10.0, Sabotage::None, imu_config(), gyro);
+    let a = lockstep_run_with(10.0, Sabotage::None, imu_config(), gyro);
     a.result.expect("gyro run A");
     let settled = assert_converges(&a.states);
     let hash_a = digest(&a.states);
@@ -302,11 +290,11 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
         settling_bound_s()
     );
 
-    let b = lockstep_run_with(17315, 10.0, Sabotage::None, imu_config(), gyro);
+    let b = lockstep_run_with(10.0, Sabotage::None, imu_config(), gyro);
     b.result.expect("gyro run B");
     assert_eq!(digest(&b.states), hash_a, "two gyro-fed runs differ");
 
-    let t = lockstep_run_with(17316, 10.0, Sabotage::None, imu_config(), TRUTH_RATE);
+    let t = lockstep_run_with(10.0, Sabotage::None, imu_config(), TRUTH_RATE);
     t.result.expect("truth-rate run");
     assert_ne!(
         digest(&t.states),
@@ -317,7 +305,7 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
     // The default `--rate-source auto` without --imu must not guess an IMU (the rotated
     // `bracket` is first by name and would be fed back with the wrong mounting): it uses the
     // truth rate, so it converges and equals the truth-rate run bit for bit.
-    let auto = lockstep_run_with(17317, 10.0, Sabotage::None, imu_config(), &[]);
+    let auto = lockstep_run_with(10.0, Sabotage::None, imu_config(), &[]);
     auto.result.expect("auto run");
     assert_converges(&auto.states);
     assert_eq!(
@@ -349,14 +337,15 @@ fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
     let bound_s = 2.5 * 8.0 * I_MAX_KG_M2 / P;
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenarios/wheels_star_tracker.toml");
-    let run = |port: u16| {
+    let run = || {
         let cfg = flexdyn::config::SimConfig::from_file(&path).expect("wheels_star_tracker.toml");
         let topics = Topics::new("sc1").unwrap();
         let settings = ServerSettings {
             duration_ns: Some((RUN_S * 1e9) as u64),
             ..settings(10.0)
         };
-        let server = ServerHandle::start(port, settings, cfg);
+        let server = ServerHandle::start(settings, cfg);
+        let port = server.port;
         let recorder = Recorder::start(port, &topics, 2);
         let _ctrl = ChildGuard::spawn(
             Command::new(acs_demo_bin::acs_demo())
@@ -378,7 +367,7 @@ fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
         states.sort_by_key(|(t, _)| *t);
         (report, states)
     };
-    let (report, a) = run(17318);
+    let (report, a) = run();
     let mut settled_at = None;
     let mut max_u = 0.0_f64;
     let mut saturated = 0usize;
@@ -417,13 +406,13 @@ fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
         Vector3::from(last.sigma_bn).norm() < 0.005,
         "final attitude error"
     );
-    let (_, b) = run(17319);
+    let (_, b) = run();
     assert_eq!(digest(&b), hash_a, "two wheel runs differ");
 }
 
 #[test]
 fn killed_controller_stops_the_run_with_a_timeout_naming_it() {
-    let run = lockstep_run(17313, 2.0, Sabotage::Kill { at: 300 });
+    let run = lockstep_run(2.0, Sabotage::Kill { at: 300 });
     let err = run.result.expect_err("the run must fail");
     let msg = err.to_string();
     match err {
@@ -464,17 +453,14 @@ fn sensor_closed_demo_runs_are_bit_identical_also_under_load() {
         .unwrap()
         .replace("omega_rad_s = 100.0", "omega_rad_s = 0.0");
     let run = || {
-        let port = std::net::TcpListener::bind("127.0.0.1:0")
-            .and_then(|l| l.local_addr())
-            .expect("a free port")
-            .port();
         let cfg = flexdyn::config::SimConfig::from_toml_str(&toml).expect("wheels at rest");
         let topics = Topics::new("sc1").unwrap();
         let settings = ServerSettings {
             duration_ns: Some((RUN_S * 1e9) as u64),
             ..settings(10.0)
         };
-        let server = ServerHandle::start(port, settings, cfg);
+        let server = ServerHandle::start(settings, cfg);
+        let port = server.port;
         let recorder = Recorder::start(port, &topics, 2);
         let _ctrl = ChildGuard::spawn(
             Command::new(acs_demo_bin::acs_demo())

@@ -2,8 +2,6 @@
 //! exactly the stream a participant received (same SHA-256 over the StateMsg payloads, one state
 //! per tick), every command each participant sent, decoded channels equal to the raw ones field
 //! by field, and the configuration in its metadata.
-//!
-//! Port 17380.
 
 #[path = "acs_demo_bin/mod.rs"]
 mod acs_demo_bin;
@@ -30,7 +28,6 @@ fn sha(payloads: &[&[u8]]) -> String {
 
 #[test]
 fn a_lockstep_recording_is_the_stream_the_participants_saw() {
-    let port = 17380;
     let file = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("lockstep_record.mcap");
     let _ = std::fs::remove_file(&file);
     let settings = ServerSettings {
@@ -43,7 +40,8 @@ fn a_lockstep_recording_is_the_stream_the_participants_saw() {
     let cfg = reference_config(100.0);
     let config_toml = cfg.source_toml.clone();
     let topics = Topics::new("sc1").unwrap();
-    let server = ServerHandle::start(port, settings, cfg);
+    let server = ServerHandle::start(settings, cfg);
+    let port = server.port;
     let participant = Recorder::start(port, &topics, 2);
     let _ctrl = ChildGuard::spawn(
         Command::new(acs_demo_bin::acs_demo())

@@ -15,7 +15,9 @@
 //!    own key is rejected and counted under `rejected.wrong_identity`, once per impostor command,
 //!    and the trajectory is still the baseline's.
 //!
-//! Ports 17730–17739.
+//! Every peer is given its endpoint on the command line (`--listen`/`--connect`; the server
+//! listens on port 0, takes a free port from the OS and the others connect to it), which replaces the endpoint the shipped JSON5 files name (7447); their authentication
+//! and access control are used exactly as shipped.
 
 #[path = "acs_demo_bin/mod.rs"]
 mod acs_demo_bin;
@@ -44,7 +46,7 @@ fn scenario(name: &str) -> PathBuf {
 }
 
 /// A Zenoh configuration built like every flexdyn session's, from `file` (if any), listening
-/// or connecting on `port`.
+/// or connecting on `port` (a server given port 0 listens on a free port the OS chooses).
 fn config(port: u16, role: Role, file: Option<PathBuf>) -> zenoh::Config {
     let ep = vec![endpoint(port)];
     let args = ZenohArgs {
@@ -150,13 +152,14 @@ fn controller(port: u16, client_config: Option<PathBuf>) -> ChildGuard {
 }
 
 /// The plain loopback lockstep run: the demo controller alone, no authentication.
-fn baseline(port: u16) -> String {
+fn baseline() -> String {
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start_with_session(
-        session(port, Role::Server, None),
+        session(0, Role::Server, None),
         settings(&[(1, "")], false),
         reference_config(100.0),
     );
+    let port = server.port;
     let obs = session(port, Role::Tool, None);
     let (seen, _subs) = observe(&obs, &topics);
     wait_for("a status before tick 0", Duration::from_secs(20), || {
@@ -175,16 +178,16 @@ fn baseline(port: u16) -> String {
 
 #[test]
 fn only_the_authenticated_flight_code_commands_the_spacecraft() {
-    let plain = baseline(17730);
+    let plain = baseline();
 
-    let port = 17731;
     let topics = Topics::new("sc1").unwrap();
     let server_file = scenario("secure-server.json5");
     let s = settings(&[(1, "fsw")], true);
     // The server's own start-up check (as `flexdyn run` makes it) accepts the shipped files.
-    let zcfg = config(port, Role::Server, Some(server_file));
+    let zcfg = config(0, Role::Server, Some(server_file));
     flexdyn::server::access::check(&zcfg, &s).expect("the shipped ACL binds sender 1 to fsw");
     let server = ServerHandle::start_with_session(open(zcfg), s, reference_config(100.0));
+    let port = server.port;
 
     // An authenticated operator: sees the telemetry, and tries to command as sender 1.
     let operator = session(port, Role::Tool, Some(scenario("operator-client.json5")));
@@ -330,15 +333,15 @@ fn two_participant_acl() -> PathBuf {
 
 #[test]
 fn a_participant_claiming_another_ones_sender_id_is_rejected_and_counted() {
-    let plain = baseline(17732);
+    let plain = baseline();
 
-    let port = 17733;
     let topics = Topics::new("sc1").unwrap();
     let acl = two_participant_acl();
     let s = settings(&[(1, "fsw"), (2, "operator")], true);
-    let zcfg = config(port, Role::Server, Some(acl.clone()));
+    let zcfg = config(0, Role::Server, Some(acl.clone()));
     flexdyn::server::access::check(&zcfg, &s).expect("the test ACL binds 1 to fsw, 2 to operator");
     let server = ServerHandle::start_with_session(open(zcfg), s, reference_config(100.0));
+    let port = server.port;
 
     // Participant 2 (user `operator`): for every state, first an impostor command claiming
     // sender 1 on its own key, then its real answer.

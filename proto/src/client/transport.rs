@@ -6,11 +6,17 @@
 //!    Zenoh's defaults in **peer** mode.
 //! 2. `--listen` / `--connect` (repeatable) replace the file's endpoints. Without them, and if
 //!    the file does not set them either, the role's loopback defaults apply: the server listens
-//!    on `tcp/127.0.0.1:7447` and connects nowhere; a tool listens nowhere and connects to
-//!    `tcp/127.0.0.1:7447`. (Zenoh's own peer default would listen on every interface.)
-//! 3. Multicast scouting is **always** switched off (`scouting/multicast/enabled = false`),
+//!    on `tcp/127.0.0.1:7447` and connects nowhere (so does `flexdyn replay`, which stands in
+//!    for it); a tool listens nowhere and connects to `tcp/127.0.0.1:7447`. (Zenoh's own peer
+//!    default would listen on every interface.)
+//! 3. The server's links queue 16 batches of data samples ([`SERVER_TX_QUEUE_BATCHES`]), not
+//!    Zenoh's 2, unless the file sets it: real-time telemetry is dropped when a queue is full.
+//! 4. Multicast scouting is **always** switched off (`scouting/multicast/enabled = false`),
 //!    even if the file switches it on (a warning is logged): flexdyn never sends multicast, so
 //!    nothing leaves this machine unless an endpoint says so.
+//!
+//! A listening process logs where it listens ([`log_listening`]); `--listen tcp/127.0.0.1:0`
+//! lets the OS pick a free port, and that line names it.
 
 use std::path::PathBuf;
 
@@ -19,15 +25,22 @@ use zenoh::sample::Sample;
 /// The default Zenoh endpoint of the server (`flexdyn run` listens, the tools connect).
 pub const DEFAULT_ENDPOINT: &str = "tcp/127.0.0.1:7447";
 
+/// The Zenoh setting of a link's transmission queue for data samples, in batches.
+pub const SERVER_TX_QUEUE_KEY: &str = "transport/link/tx/queue/size/data";
+/// The server's transmission queue for data samples (Zenoh's default is 2, its maximum 16);
+/// a `--zenoh-config` file that sets [`SERVER_TX_QUEUE_KEY`] keeps its own value.
+pub const SERVER_TX_QUEUE_BATCHES: u32 = 16;
+
 /// Zenoh connection options shared by `flexdyn run` and every tool (flattened with clap).
 #[derive(Clone, Debug, Default, PartialEq, Eq, clap::Args)]
 pub struct ZenohArgs {
     /// Zenoh endpoint to listen on, e.g. `tcp/127.0.0.1:7447` (repeatable). Default: the server
-    /// listens on tcp/127.0.0.1:7447, the tools listen nowhere.
+    /// and `flexdyn replay` (which stands in for it) listen on tcp/127.0.0.1:7447, the other
+    /// tools listen nowhere.
     #[arg(long = "listen", value_name = "ENDPOINT")]
     pub listen: Vec<String>,
-    /// Zenoh endpoint to connect to (repeatable). Default: the server connects nowhere, the
-    /// tools connect to tcp/127.0.0.1:7447.
+    /// Zenoh endpoint to connect to (repeatable). Default: the server and `flexdyn replay`
+    /// connect nowhere, the other tools connect to tcp/127.0.0.1:7447.
     #[arg(long = "connect", value_name = "ENDPOINT")]
     pub connect: Vec<String>,
     /// Standard Zenoh JSON5 configuration file; `--listen`/`--connect` override its endpoints.
@@ -111,6 +124,34 @@ pub fn clean_zenoh_message(message: &str) -> String {
         s.replace_range(i..i + end, "");
     }
     s.trim_end_matches('.').trim().to_string()
+}
+
+/// The endpoints `session` listens on, with the port the OS chose where the endpoint asked for
+/// port 0 (`--listen tcp/127.0.0.1:0` → `tcp/127.0.0.1:41234`). Empty for a session that only
+/// connects.
+pub fn listening_on(session: &zenoh::Session) -> Vec<String> {
+    use zenoh::Wait;
+    session
+        .info()
+        .locators()
+        .wait()
+        .iter()
+        .map(ToString::to_string)
+        .collect()
+}
+
+/// The line a listening process logs once it is reachable: `Zenoh listening on <endpoint>, …`.
+/// With `--listen tcp/127.0.0.1:0` it is how a user, a script or a test learns the port (the
+/// tests read it back from stderr instead of guessing a free port).
+pub const LISTENING_PREFIX: &str = "Zenoh listening on ";
+
+/// Logs [`LISTENING_PREFIX`] and [`listening_on`] at `info` (nothing for a session that only
+/// connects).
+pub fn log_listening(session: &zenoh::Session) {
+    let endpoints = listening_on(session);
+    if !endpoints.is_empty() {
+        tracing::info!("{LISTENING_PREFIX}{}", endpoints.join(", "));
+    }
 }
 
 /// Checks a `--listen`/`--connect` endpoint before Zenoh sees it: `<protocol>/<address>`, and
@@ -243,6 +284,22 @@ pub fn zenoh_config(args: &ZenohArgs, role: Role) -> Result<zenoh::Config, Zenoh
         )?;
     }
 
+    // Real-time telemetry goes out with congestion control "drop": a sample that finds its
+    // link's transmission queue full for 1 ms is dropped. Zenoh's default queue holds 2
+    // batches per priority and an express sample takes a batch of its own, so a subscriber
+    // whose link was not served for two samples lost them: a `flexdyn record` next to a 1 kHz
+    // server with three CPU hogs on two cores missed 2.9–7.8 % of the states. 16 batches, Zenoh's
+    // most, lost none in the same test (README, "Recording, replay and viewing"). The batches
+    // are allocated as needed, up to 16 × 64 KiB per peer.
+    if role == Role::Server && !file_sets(SERVER_TX_QUEUE_KEY) {
+        insert(
+            &mut config,
+            SERVER_TX_QUEUE_KEY,
+            &SERVER_TX_QUEUE_BATCHES.to_string(),
+            SERVER_TX_QUEUE_KEY,
+        )?;
+    }
+
     if let (Some(path), Some(doc)) = (&args.zenoh_config, &doc) {
         if json_has(doc, "scouting/multicast/enabled") == Some(serde_json::Value::Bool(true)) {
             tracing::warn!(
@@ -261,13 +318,17 @@ pub fn zenoh_config(args: &ZenohArgs, role: Role) -> Result<zenoh::Config, Zenoh
     Ok(config)
 }
 
+/// A configuration value as JSON, for the tests that check what [`zenoh_config`] built.
+#[cfg(test)]
+pub(crate) fn config_value(c: &zenoh::Config, key: &str) -> serde_json::Value {
+    serde_json::from_str(&c.get_json(key).expect("a known key")).expect("JSON")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn get(c: &zenoh::Config, key: &str) -> serde_json::Value {
-        serde_json::from_str(&c.get_json(key).unwrap()).unwrap()
-    }
+    use super::config_value as get;
 
     #[test]
     fn defaults_are_loopback_peer_without_multicast() {
@@ -292,6 +353,31 @@ mod tests {
             get(&t, "scouting/multicast/enabled"),
             serde_json::json!(false)
         );
+    }
+
+    #[test]
+    fn the_server_queues_16_batches_per_link_unless_its_file_says_otherwise() {
+        let server = zenoh_config(&ZenohArgs::default(), Role::Server).unwrap();
+        let tool = zenoh_config(&ZenohArgs::default(), Role::Tool).unwrap();
+        assert_eq!(get(&server, SERVER_TX_QUEUE_KEY), serde_json::json!(16));
+        assert_eq!(
+            get(&tool, SERVER_TX_QUEUE_KEY),
+            serde_json::json!(2),
+            "Zenoh's default"
+        );
+        let file = std::env::temp_dir().join(format!("flexdyn-txq-{}.json5", std::process::id()));
+        std::fs::write(
+            &file,
+            r#"{ transport: { link: { tx: { queue: { size: { data: 4 } } } } } }"#,
+        )
+        .unwrap();
+        let args = ZenohArgs {
+            zenoh_config: Some(file.clone()),
+            ..ZenohArgs::default()
+        };
+        let own = zenoh_config(&args, Role::Server).unwrap();
+        std::fs::remove_file(&file).ok();
+        assert_eq!(get(&own, SERVER_TX_QUEUE_KEY), serde_json::json!(4));
     }
 
     #[test]

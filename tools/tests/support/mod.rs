@@ -14,7 +14,7 @@ mod server_support;
 // Each test or bench that includes this module uses a different subset.
 #[allow(unused_imports)]
 pub use server_support::{
-    connecting_session, endpoint, listening_session, reference_config, ServerHandle,
+    connecting_session, endpoint, listening_session, ports, reference_config, ServerHandle,
 };
 
 /// Every StateMsg payload seen, with its tick.
@@ -30,7 +30,8 @@ pub struct Recorder {
 impl Recorder {
     pub fn start(port: u16, topics: &Topics, sender_id: u32) -> Self {
         let observer =
-            flexdyn::campaign::execute::Observer::start(port, topics, sender_id).unwrap();
+            flexdyn::campaign::execute::Observer::start(&endpoint(port), topics, sender_id)
+                .unwrap();
         Self {
             states: observer.states.clone(),
             _observer: observer,
@@ -96,13 +97,13 @@ impl Drop for ChildGuard {
 }
 
 /// Round-trip times of `count` StateMsg-sized pings (after `warmup` unmeasured ones) from a
-/// session listening on `port` to a `flexdyn-pingpong pong` child (reply CommandMsg-sized),
+/// session listening on a port the OS chose to a `flexdyn-pingpong pong` child (reply CommandMsg-sized),
 /// which answers inside its Zenoh callback or, with `recv_loop`, from a receive loop (the demo
 /// controller's structure). The benchmarks' yardstick.
-pub fn pingpong_rtts(port: u16, warmup: usize, count: usize, recv_loop: bool) -> Vec<Duration> {
+pub fn pingpong_rtts(warmup: usize, count: usize, recv_loop: bool) -> Vec<Duration> {
     use flexdyn_proto::{EFFECTOR_STATE_FIXED_LEN, STATE_FIXED_LEN};
     let topics = Topics::new("bench").unwrap();
-    let session = listening_session(port);
+    let (session, port) = listening_session();
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_flexdyn-pingpong"));
     cmd.args(["--connect", &endpoint(port), "--sc-id", "bench"])
         .args(["pong", "--duration-s", "300"]);

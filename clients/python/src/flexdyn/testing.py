@@ -9,8 +9,9 @@
     assert server.returncode == 0, server.log
 
 The binary is `$FLEXDYN_BIN`, else the workspace's `target/release/flexdyn` (build it with
-`cargo build --release`). The server listens on a free loopback port with multicast scouting
-off; the context waits until it accepts connections, and on exit waits for it to end (up to
+`cargo build --release`). The server listens on `tcp/127.0.0.1:0` with multicast scouting off:
+the OS gives it a free port, and the context waits until the server logs `Zenoh listening on
+ENDPOINT` and takes the endpoint from that line. On exit it waits for it to end (up to
 `timeout_s`; then it is stopped with SIGTERM, and SIGKILL if need be), then fills in
 `returncode` and the captured `log` (its stderr and stdout).
 """
@@ -20,7 +21,6 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
-import socket
 import subprocess
 import tempfile
 import time
@@ -44,11 +44,18 @@ def find_binary() -> Path:
         "no flexdyn binary: set FLEXDYN_BIN, or run `cargo build --release` in the workspace")
 
 
-def free_port() -> int:
-    """A TCP port on 127.0.0.1 that is free now."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+LISTENING = "Zenoh listening on "
+"""The start of the line the server logs once it is reachable (`flexdyn::transport::log_listening`)."""
+
+
+def reported_endpoint(log: str) -> Optional[str]:
+    """The endpoint a complete `Zenoh listening on tcp/127.0.0.1:PORT` line of `log` names."""
+    complete = log[: log.rfind("\n") + 1]
+    for line in complete.splitlines():
+        i = line.find(LISTENING)
+        if i >= 0:
+            return line[i + len(LISTENING):].split()[0].rstrip(",")
+    return None
 
 
 @dataclass
@@ -75,9 +82,9 @@ def flexdyn_server(config: Optional[str] = None, mode: str = "lockstep",
                    extra_args: Sequence[str] = (), timeout_s: float = 120.0,
                    ready_timeout_s: float = 30.0) -> Iterator[ServerRun]:
     """Runs `flexdyn run` (see the module docs)."""
-    port = free_port()
-    endpoint = f"tcp/127.0.0.1:{port}"
-    args = [str(find_binary()), "run", "--mode", mode, "--listen", endpoint,
+    # Port 0: the OS gives the server a free port and the server reports it (no port is picked
+    # here and hoped to be still free when the server binds it).
+    args = [str(find_binary()), "run", "--mode", mode, "--listen", "tcp/127.0.0.1:0",
             "--participants", ",".join(str(p) for p in participants)]
     if config is not None:
         args += ["--config", str(config)]
@@ -85,21 +92,23 @@ def flexdyn_server(config: Optional[str] = None, mode: str = "lockstep",
         args += ["--duration-s", repr(float(duration_s))]
     args += list(extra_args)
     log = tempfile.TemporaryFile()
-    proc = subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT)
-    run = ServerRun(endpoint, port, proc, args=args)
+    env = dict(os.environ, RUST_LOG="info")
+    proc = subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, env=env)
+    run = ServerRun("", 0, proc, args=args)
     try:
         deadline = time.monotonic() + ready_timeout_s
         while True:
+            log.seek(0)
+            endpoint = reported_endpoint(log.read().decode("utf-8", "replace"))
+            if endpoint is not None:
+                run.endpoint = endpoint
+                run.port = int(endpoint.rsplit(":", 1)[1])
+                break
             if proc.poll() is not None:
                 break  # ended early: the exit code and log tell why
-            try:
-                with socket.create_connection(("127.0.0.1", port), timeout=0.2):
-                    break
-            except OSError:
-                if time.monotonic() > deadline:
-                    raise TimeoutError(f"flexdyn did not listen on {endpoint} within "
-                                       f"{ready_timeout_s} s")
-                time.sleep(0.05)
+            if time.monotonic() > deadline:
+                raise TimeoutError(f"flexdyn reported no endpoint within {ready_timeout_s} s")
+            time.sleep(0.05)
         yield run
         try:
             proc.wait(timeout=timeout_s)

@@ -8,7 +8,10 @@ use std::time::{Duration, Instant};
 
 #[path = "../../../../tests/cli_support/mod.rs"]
 mod cli_support;
-use cli_support::{assert_one_error_line, free_port, run};
+use cli_support::{assert_one_error_line, run};
+#[path = "../../../../tests/ports/mod.rs"]
+#[allow(dead_code)]
+mod ports;
 
 const DEMO: &str = env!("CARGO_BIN_EXE_flexdyn-acs-demo");
 
@@ -42,7 +45,7 @@ fn the_demo_rejects_bad_options_in_one_line() {
 /// With nobody to talk to, the demo says so and fails, instead of a false pass.
 #[test]
 fn no_server_is_a_failure_not_a_pass() {
-    let connect = format!("tcp/127.0.0.1:{}", free_port());
+    let (connect, _held) = ports::closed_endpoint();
     let started = Instant::now();
     let (c, e) = run(DEMO, &["--connect", &connect, "--idle-exit-s", "1"]);
     assert_eq!(c, Some(1), "{e}");
@@ -63,7 +66,7 @@ fn no_server_is_a_failure_not_a_pass() {
 #[test]
 fn the_demo_stops_on_sigint_even_when_started_with_it_ignored() {
     for sig in ["-INT", "-TERM"] {
-        let connect = format!("tcp/127.0.0.1:{}", free_port());
+        let (connect, _held) = ports::closed_endpoint();
         let mut child = Command::new("sh")
             .args([
                 "-c",
@@ -138,7 +141,7 @@ fn the_readmes_wheels_and_star_tracker_command_parses() {
             args.push(w.clone());
         }
     }
-    let connect = format!("tcp/127.0.0.1:{}", free_port());
+    let (connect, _held) = ports::closed_endpoint();
     args.extend([
         "--connect".into(),
         connect,

@@ -1,0 +1,163 @@
+//! The command callback: the Zenoh thread that delivers a `flexdyn/<sc>/cmd/*` sample decodes
+//! and checks it (protocol, spacecraft, the key's sender, the participants, then the tick and the
+//! effector inputs through the [`Gate`]), counts each rejection under its reason, records every
+//! command that arrives, and delivers the valid ones: into the physics thread's bounded queue,
+//! or (lockstep, `handoff = "direct"`) to the [`LockstepCore`], which may step the frame there.
+
+use std::sync::mpsc::SyncSender;
+use std::sync::{Arc, Mutex};
+
+use flexdyn_proto::{decode_command, CommandMsg, Topics};
+use zenoh::pubsub::Subscriber;
+use zenoh::Session;
+
+use super::commands::{Gate, Offer};
+use super::error::ServerError;
+use super::lockstep::LockstepCore;
+use super::physics::count_offer;
+use super::reject_log::RejectLog;
+use super::settings::ServerSettings;
+use super::shared::Shared;
+use crate::sinks::recorder::{RecordItem, RecordTx};
+
+/// Where the command callback delivers a validated command.
+pub(super) enum CommandSink {
+    /// The physics thread's bounded queue (never blocks: a full queue drops and counts),
+    /// behind the [`Gate`].
+    Queue(Mutex<(SyncSender<CommandMsg>, Gate)>),
+    /// Lockstep with `handoff = "direct"`: the core, stepped in this callback.
+    Core(Arc<Mutex<LockstepCore>>),
+}
+
+/// Subscribes the command callback to `flexdyn/<sc>/cmd/*`; dropping the subscriber stops the
+/// commands.
+pub(super) async fn declare(
+    session: &Session,
+    topics: &Topics,
+    sink: CommandSink,
+    shared: Arc<Shared>,
+    settings: &ServerSettings,
+    record: Option<RecordTx>,
+) -> Result<Subscriber<()>, ServerError> {
+    session
+        .declare_subscriber(topics.cmd_wildcard().to_owned())
+        .callback(command_callback(
+            sink,
+            shared,
+            topics.clone(),
+            settings.spacecraft_id,
+            settings.participants.clone(),
+            record,
+        ))
+        .await
+        .map_err(|e| ServerError::zenoh("declare the command subscriber", e))
+}
+
+/// The zenoh callback for `flexdyn/<sc>/cmd/*`: decode and check (spacecraft, the key's
+/// sender, the participants), count rejections, and deliver valid commands to `sink`.
+fn command_callback(
+    sink: CommandSink,
+    shared: Arc<Shared>,
+    topics: Topics,
+    spacecraft_id: u32,
+    participants: Vec<u32>,
+    record: Option<RecordTx>,
+) -> impl Fn(zenoh::sample::Sample) + Send + Sync + 'static {
+    let log = Mutex::new(RejectLog::default());
+    let warn = move |reason: &'static str, sender: Option<u32>, detail: &dyn std::fmt::Display| {
+        log.lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .record(reason, sender, 1, detail);
+    };
+    move |sample| {
+        let bytes = sample.payload().to_bytes();
+        let key = sample.key_expr().as_str();
+        // Every command that arrives is recorded, accepted or not: the file shows what was sent.
+        if let Some(rec) = &record {
+            rec.submit(RecordItem {
+                key: Arc::from(key),
+                payload: bytes.to_vec(),
+                publish_time_ns: crate::transport::frame_stamp_ns(&sample),
+            });
+        }
+        let cmd = match decode_command(&bytes) {
+            Ok(cmd) => cmd,
+            Err(e) => {
+                let reason = match e {
+                    flexdyn_proto::DecodeError::UnknownVersion { .. } => "bad_version",
+                    flexdyn_proto::DecodeError::NonFinite { .. } => "non_finite",
+                    _ => "malformed",
+                };
+                // The sender id sits at bytes 30..34 once the header is there.
+                let sender = bytes
+                    .get(30..34)
+                    .and_then(|b| b.try_into().ok())
+                    .map(u32::from_le_bytes)
+                    .filter(|_| reason == "non_finite");
+                warn(reason, sender, &e);
+                shared.reject_decode(&e);
+                return;
+            }
+        };
+        if cmd.header.spacecraft_id != spacecraft_id {
+            warn(
+                "wrong_spacecraft",
+                Some(cmd.sender_id),
+                &format_args!(
+                    "header.spacecraft_id {} is not this server's {spacecraft_id}",
+                    cmd.header.spacecraft_id
+                ),
+            );
+            shared.reject_wrong_spacecraft();
+            return;
+        }
+        if topics.cmd_sender(key) != Some(cmd.sender_id) {
+            warn(
+                "wrong_identity",
+                Some(cmd.sender_id),
+                &format_args!(
+                    "sender_id {} arrived on `{key}`; participant {} publishes on `{}` only",
+                    cmd.sender_id,
+                    cmd.sender_id,
+                    topics.cmd(cmd.sender_id)
+                ),
+            );
+            shared.reject_wrong_identity();
+            return;
+        }
+        if participants.binary_search(&cmd.sender_id).is_err() {
+            warn(
+                "unknown_sender",
+                Some(cmd.sender_id),
+                &format_args!(
+                    "sender_id {} is not in server.participants {participants:?}",
+                    cmd.sender_id
+                ),
+            );
+            shared.reject_unknown_sender();
+            return;
+        }
+        match &sink {
+            CommandSink::Queue(queue) => {
+                let mut queue = queue.lock().unwrap_or_else(|p| p.into_inner());
+                let (tx, gate) = &mut *queue;
+                let published = shared.tick.load(std::sync::atomic::Ordering::Acquire);
+                let offer = gate.check(&cmd, published);
+                if offer != Offer::Accepted {
+                    count_offer(&shared, offer, cmd.sender_id);
+                    return;
+                }
+                let (sender, tick) = (cmd.sender_id, cmd.header.tick);
+                match tx.try_send(cmd) {
+                    Ok(()) => gate.queued(sender, tick),
+                    Err(_) => {
+                        shared
+                            .commands_dropped
+                            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    }
+                }
+            }
+            CommandSink::Core(core) => core.lock().unwrap_or_else(|p| p.into_inner()).offer(&cmd),
+        }
+    }
+}

@@ -1,0 +1,174 @@
+//! The run report: how a run ended and what it counted, collected once every thread is done.
+
+use std::fmt;
+use std::sync::atomic::Ordering;
+
+use flexdyn_proto::{FrameTiming, Mode, RejectCounters};
+use hdrhistogram::Histogram;
+
+use super::physics::{Ending, PhysicsReport};
+use super::settings::mode_name;
+use super::shared::Shared;
+use super::telemetry::timing_of;
+use crate::sinks::recorder::RecordReport;
+
+/// How a run ended without error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// The configured duration was reached.
+    Finished,
+    /// The shutdown future completed (SIGINT/SIGTERM).
+    Stopped,
+}
+
+/// Summary of a completed run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunReport {
+    /// Pacing mode.
+    pub mode: Mode,
+    /// Why the run ended.
+    pub outcome: Outcome,
+    /// Last tick reached.
+    pub last_tick: u64,
+    /// \[ns\] simulation time of `last_tick`.
+    pub sim_time_ns: u64,
+    /// StateMsg samples published.
+    pub states_published: u64,
+    /// Real time: frames whose telemetry was dropped (no free buffer).
+    pub telemetry_dropped: u64,
+    /// Real time: lateness percentiles, overruns, skipped frames (zeros otherwise).
+    pub timing: FrameTiming,
+    /// Rejected commands by reason.
+    pub rejected: RejectCounters,
+    /// Valid commands dropped because the command queue was full.
+    pub commands_dropped: u64,
+    /// \[s\] wall time from the first frame to the end.
+    pub wall_s: f64,
+    /// `--record`: what the recording holds and what the recorder dropped.
+    pub recording: Option<RecordReport>,
+    /// Real time with `handoff = "direct"`: what publishing cost the physics thread, per frame.
+    pub direct_publish: Option<PublishCost>,
+}
+
+/// The time the physics thread spent publishing frames (real time, `handoff = "direct"`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PublishCost {
+    /// Frames published from the physics thread.
+    pub frames: u64,
+    /// \[ns\] mean time per frame.
+    pub mean_ns: f64,
+    /// \[ns\] largest time of one frame.
+    pub max_ns: u64,
+    /// Frames whose publication took longer than [`super::shared::SLOW_PUBLISH_NS`] (100 µs).
+    pub slow_frames: u64,
+}
+
+impl fmt::Display for RunReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "run {}: mode={} last_tick={} sim_time_s={} states_published={} telemetry_dropped={} \
+             wall_s={:.3} lateness_us p50={:.1} p99={:.1} max={:.1} overruns={} frames_skipped={} \
+             rejected={} commands_dropped={}",
+            match self.outcome {
+                Outcome::Finished => "finished",
+                Outcome::Stopped => "stopped",
+            },
+            mode_name(self.mode),
+            self.last_tick,
+            self.sim_time_ns as f64 / 1e9,
+            self.states_published,
+            self.telemetry_dropped,
+            self.wall_s,
+            self.timing.lateness_p50_ns as f64 * 1e-3,
+            self.timing.lateness_p99_ns as f64 * 1e-3,
+            self.timing.lateness_max_ns as f64 * 1e-3,
+            self.timing.overrun_count,
+            self.timing.frames_skipped,
+            self.rejected.total(),
+            self.commands_dropped,
+        )?;
+        if let Some(r) = &self.recording {
+            write!(
+                f,
+                " recorded_samples={} record_dropped={} record_missing={}",
+                r.stats.samples,
+                r.dropped,
+                r.stats.missing_total()
+            )?;
+        }
+        if let Some(c) = &self.direct_publish {
+            write!(
+                f,
+                " direct_publish_us mean={:.1} max={:.1} slow_over_100us={}",
+                c.mean_ns * 1e-3,
+                c.max_ns as f64 * 1e-3,
+                c.slow_frames
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl RunReport {
+    /// The report of a run that ended: the physics thread's (or lockstep core's) ending, the
+    /// counters in `shared`, the telemetry thread's lateness histogram, the wall time from the
+    /// first frame and what the recorder wrote.
+    pub(super) fn collect(
+        mode: Mode,
+        phys: PhysicsReport,
+        shared: &Shared,
+        lateness: &Histogram<u64>,
+        wall_s: f64,
+        recording: Option<RecordReport>,
+    ) -> Self {
+        let load = |c: &std::sync::atomic::AtomicU64| c.load(Ordering::Relaxed);
+        Self {
+            mode,
+            outcome: match phys.ending {
+                Ending::Finished => Outcome::Finished,
+                Ending::Stopped => Outcome::Stopped,
+            },
+            last_tick: phys.last_tick,
+            sim_time_ns: phys.sim_time_ns,
+            states_published: load(&shared.published),
+            telemetry_dropped: load(&shared.telemetry_dropped),
+            timing: timing_of(
+                lateness,
+                load(&shared.overruns),
+                load(&shared.frames_skipped),
+            ),
+            rejected: shared.rejected(),
+            commands_dropped: load(&shared.commands_dropped),
+            wall_s,
+            recording,
+            direct_publish: {
+                let n = load(&shared.direct_publishes);
+                (n > 0).then(|| PublishCost {
+                    frames: n,
+                    mean_ns: load(&shared.direct_publish_ns_total) as f64 / n as f64,
+                    max_ns: load(&shared.direct_publish_ns_max),
+                    slow_frames: load(&shared.direct_publishes_slow),
+                })
+            },
+        }
+    }
+
+    /// The report of a lockstep run stopped before tick 0 (nothing stepped or published).
+    pub(super) fn before_tick_0(mode: Mode, rejected: RejectCounters) -> Self {
+        Self {
+            mode,
+            outcome: Outcome::Stopped,
+            last_tick: 0,
+            sim_time_ns: 0,
+            states_published: 0,
+            telemetry_dropped: 0,
+            timing: FrameTiming::default(),
+            rejected,
+            commands_dropped: 0,
+            wall_s: 0.0,
+            recording: None,
+            direct_publish: None,
+        }
+    }
+}

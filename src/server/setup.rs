@@ -1,0 +1,156 @@
+//! Setup of a run, before any of its threads starts: the telemetry publishers, the
+//! `flexdyn/<sc>/config` queryable that describes the vehicle, and the `--record` recorder.
+//!
+//! Real time publishes telemetry with congestion control "drop" (a full link queue drops the
+//! sample instead of delaying the frame); lockstep and batch with "block", so no sample of the
+//! deterministic stream is lost.
+
+use std::sync::Arc;
+
+use flexdyn_proto::{Mode, Topics};
+use zenoh::pubsub::Publisher;
+use zenoh::qos::CongestionControl;
+use zenoh::query::Queryable;
+use zenoh::{Session, Wait};
+
+use super::error::{ServerError, SettingsError};
+use super::publish::FramePublisher;
+use super::settings::ServerSettings;
+use crate::config::SimConfig;
+use crate::sim::Simulation;
+use crate::sinks::mcap_file::{flexdyn_version, git_commit, RecordingInfo, VehicleInfo};
+use crate::sinks::recorder::{RecordTx, Recorder};
+
+/// Samples the `--record` queue holds before real time drops (lockstep waits instead).
+pub const RECORD_QUEUE: usize = 65_536;
+
+/// The run's telemetry publishers and the description of the vehicle it runs.
+pub(super) struct Endpoints {
+    /// `flexdyn/<sc>/tlm/state`, also in [`Self::frames`] (the lockstep presence wait asks it
+    /// for subscribers).
+    pub state_pub: Arc<Publisher<'static>>,
+    /// `flexdyn/<sc>/status`.
+    pub status_pub: Publisher<'static>,
+    /// The per-frame publishers: state, IMUs, star trackers.
+    pub frames: FramePublisher,
+    /// What this server runs, for recordings and the configuration queryable.
+    pub vehicle: VehicleInfo,
+}
+
+impl Endpoints {
+    /// Declares the publishers of `sim`'s telemetry.
+    pub(super) async fn declare(
+        session: &Session,
+        settings: &ServerSettings,
+        cfg: &SimConfig,
+        topics: &Topics,
+        sim: &Simulation,
+    ) -> Result<Self, ServerError> {
+        // Real time drops telemetry under congestion rather than delaying the frame; lockstep
+        // and batch block, so no sample of the deterministic stream is lost. Delivery is
+        // reliable (Zenoh's default `Reliability::Reliable`, over TCP); its setter is unstable
+        // in Zenoh 1.10.
+        let congestion = if settings.mode == Mode::RealTime {
+            CongestionControl::Drop
+        } else {
+            CongestionControl::Block
+        };
+        let express = settings.mode != Mode::Batch;
+        // The state and every sensor topic are declared alike.
+        let telemetry_pub = |key: String, what: &'static str| {
+            let declared = session
+                .declare_publisher(key)
+                .congestion_control(congestion)
+                .express(express);
+            async move { declared.await.map_err(|e| ServerError::zenoh(what, e)) }
+        };
+        let state_pub =
+            telemetry_pub(topics.state().to_owned(), "declare the state publisher").await?;
+        let status_pub = session
+            .declare_publisher(topics.status().to_owned())
+            .congestion_control(congestion)
+            .await
+            .map_err(|e| ServerError::zenoh("declare the status publisher", e))?;
+
+        let mut imu_pubs = Vec::with_capacity(sim.n_imus());
+        for (i, name) in sim.imu_names().iter().enumerate() {
+            let key = topics.imu(name).map_err(|e| SettingsError::Invalid {
+                name: format!("imus[{i}].name"),
+                problem: e.to_string(),
+            })?;
+            imu_pubs.push(telemetry_pub(key, "declare an IMU publisher").await?);
+        }
+
+        let mut st_pubs = Vec::with_capacity(sim.star_trackers().len());
+        for (i, st) in sim.star_trackers().iter().enumerate() {
+            let key = topics
+                .star_tracker(st.name())
+                .map_err(|e| SettingsError::Invalid {
+                    name: format!("star_trackers[{i}].name"),
+                    problem: e.to_string(),
+                })?;
+            st_pubs.push((
+                telemetry_pub(key, "declare a star-tracker publisher").await?,
+                st.config().every_frames,
+            ));
+        }
+        let state_pub = Arc::new(state_pub);
+        let frames = FramePublisher::new(state_pub.clone(), imu_pubs, st_pubs);
+
+        let vehicle = VehicleInfo {
+            sc_id: settings.sc_id.clone(),
+            spacecraft_id: settings.spacecraft_id,
+            config_toml: cfg.source_toml.clone(),
+            server_settings: settings.summary(),
+            flexdyn_version: flexdyn_version().to_owned(),
+            git_commit: git_commit().map(str::to_owned),
+        };
+        Ok(Self {
+            state_pub,
+            status_pub,
+            frames,
+            vehicle,
+        })
+    }
+}
+
+/// The `flexdyn/<sc>/config` queryable: answers with `vehicle` (JSON) for as long as it lives.
+pub(super) async fn serve_config(
+    session: &Session,
+    topics: &Topics,
+    vehicle: &VehicleInfo,
+) -> Result<Queryable<()>, ServerError> {
+    let vehicle_json = serde_json::to_string(vehicle)
+        .map_err(|e| ServerError::Internal(format!("vehicle description: {e}")))?;
+    session
+        .declare_queryable(topics.config())
+        .callback(move |query| {
+            let key = query.key_expr().clone();
+            if let Err(e) = query.reply(key, vehicle_json.clone()).wait() {
+                tracing::debug!(error = %e, "cannot answer a configuration query");
+            }
+        })
+        .await
+        .map_err(|e| ServerError::zenoh("declare the configuration queryable", e))
+}
+
+/// `--record`: the recorder thread (with the vehicle's description already queued), fed by
+/// whoever publishes the frames, the telemetry thread (status) and the command callback. Real
+/// time drops (and counts) what it cannot keep up with; lockstep and batch wait for it.
+pub(super) fn start_recorder(
+    settings: &ServerSettings,
+    vehicle: &VehicleInfo,
+) -> Result<Option<(Recorder, RecordTx)>, ServerError> {
+    let Some(path) = &settings.record else {
+        return Ok(None);
+    };
+    let info = RecordingInfo {
+        recorder: "flexdyn run --record".into(),
+        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+    };
+    let (recorder, tx) =
+        Recorder::start(path, &info, RECORD_QUEUE, settings.mode != Mode::RealTime)?;
+    tx.describe_vehicle(vehicle.clone());
+    tracing::info!(file = %path.display(), "recording to MCAP");
+    Ok(Some((recorder, tx)))
+}
