@@ -360,7 +360,7 @@ fn sigterm_stops_the_realtime_server_gracefully() {
 #[test]
 fn dropped_commands_reach_the_status_and_rejections_are_logged() {
     let ep = ANY_PORT;
-    let mut server = Server::spawn(&["run", "--listen", &ep, "--command-queue", "1"]);
+    let mut server = Server::spawn(&["run", "--listen", ep, "--command-queue", "1"]);
     let port = server.port();
     let topics = Topics::new("sc1").unwrap();
     let obs = Observer::start(port, &topics);
@@ -521,7 +521,7 @@ fn a_closed_stderr_reader_never_takes_the_server_down() {
     let ep = ANY_PORT;
     // Log at debug so that writes into the closed pipe happen for sure.
     let mut server =
-        Server::spawn_closing_stderr(&["--listen", &ep, "--summary-interval-s", "0.05"], "debug");
+        Server::spawn_closing_stderr(&["--listen", ep, "--summary-interval-s", "0.05"], "debug");
     let port = server.port();
     let topics = Topics::new("sc1").unwrap();
     let obs = Observer::start(port, &topics);

@@ -8,8 +8,10 @@
 //!   itself uses;
 //! - `client` ([`client`], Zenoh): the session rules (loopback, multicast scouting off), the
 //!   command-line conventions, the served vehicle configuration, and lockstep ticks handed
-//!   over complete ([`client::lockstep::TickReceiver`]). `proto/README.md` is the language-neutral specification
-//! (byte tables, Python example, lockstep rules) for non-Rust flight code.
+//!   over complete ([`client::lockstep::TickReceiver`]).
+//!
+//! `proto/README.md` is the language-neutral specification (byte tables, Python example,
+//! lockstep rules) for non-Rust flight code.
 //!
 //! # Topics
 //!

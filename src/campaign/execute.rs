@@ -389,7 +389,7 @@ fn run_inner(
     let endpoint = crate::transport::listening_on(&session)
         .into_iter()
         .next()
-        .ok_or("the server session listens nowhere")?;
+        .ok_or_else(|| "the server session listens nowhere".to_owned())?;
     let stop2 = stop.clone();
     let server = std::thread::spawn(move || {
         let rt = tokio::runtime::Builder::new_multi_thread()

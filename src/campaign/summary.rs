@@ -437,6 +437,11 @@ mod tests {
                     passed: *settle < 5.0,
                 }],
                 passed: *settle < 5.0,
+                outcome: if *settle < 5.0 {
+                    Outcome::Passed
+                } else {
+                    Outcome::Failed
+                },
                 status: "ok".into(),
                 controller_exit: None,
                 wall_s: 0.0,

@@ -270,7 +270,11 @@ fn endpoints_text(z: &ZenohArgs, listening: &[String]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::transport::config_value as get;
+
+    /// A configuration value as JSON.
+    fn get(c: &zenoh::Config, key: &str) -> serde_json::Value {
+        serde_json::from_str(&c.get_json(key).expect("a known key")).expect("JSON")
+    }
 
     /// On its defaults the replay takes the server's place: it listens where the tools connect.
     #[test]

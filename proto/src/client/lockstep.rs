@@ -143,12 +143,13 @@ impl TickAssembler {
             return Ok(());
         };
         enum Msg {
-            State(StateMsg),
+            // Boxed: a state is twice the size of a sensor sample (clippy::large_enum_variant).
+            State(Box<StateMsg>),
             Imu(usize, ImuMsg),
             Tracker(usize, StarTrackerMsg),
         }
         let msg = match topic {
-            Telemetry::State => Msg::State(decode_state(payload)?),
+            Telemetry::State => Msg::State(Box::new(decode_state(payload)?)),
             Telemetry::Imu(name) => match self.schedule.imus.iter().position(|n| n == name) {
                 Some(i) => Msg::Imu(i, decode_imu(payload)?),
                 None => return Ok(()),
@@ -183,7 +184,7 @@ impl TickAssembler {
             Msg::State(state) => {
                 // Samples of ticks whose state never came (real time) are dropped.
                 self.partial.retain(|t, _| *t >= tick);
-                self.held = Some(state);
+                self.held = Some(*state);
             }
             Msg::Imu(i, m) => self.partial_mut(tick).imus[i] = Some(m),
             Msg::Tracker(i, m) => self.partial_mut(tick).star_trackers[i] = Some(m),

@@ -10,7 +10,6 @@ use std::time::{Duration, Instant};
 mod cli_support;
 use cli_support::{assert_one_error_line, run};
 #[path = "../../../../tests/ports/mod.rs"]
-#[allow(dead_code)]
 mod ports;
 
 const DEMO: &str = env!("CARGO_BIN_EXE_flexdyn-acs-demo");
