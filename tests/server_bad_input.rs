@@ -164,7 +164,14 @@ fn a_flood_of_bad_commands_is_counted_by_reason_not_as_dropped() {
         },
         10.0,
     );
-    let cmd_pub = obs.session.declare_publisher(topics.cmd(1)).wait().unwrap();
+    // Blocking congestion control: Zenoh's default (drop) may shed part of a 7,000-put burst on
+    // a busy machine, and the counts below need every command to arrive.
+    let cmd_pub = obs
+        .session
+        .declare_publisher(topics.cmd(1))
+        .congestion_control(zenoh::qos::CongestionControl::Block)
+        .wait()
+        .unwrap();
     let put = |cmd: &CommandMsg| cmd_pub.put(encode(cmd)).wait().unwrap();
     let seen = obs.last_tick().unwrap();
     let wrench =
