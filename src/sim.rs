@@ -73,13 +73,16 @@ impl Simulation {
             )?);
         }
         let environment = match (&cfg.environment, &cfg.epoch) {
-            (Some(env), Some(epoch)) => Some(EnvironmentModel::new(env, epoch).map_err(|e| {
-                crate::config::ConfigError::Invalid {
-                    field: "environment".into(),
-                    problem: e.to_string(),
-                    at: Default::default(),
-                }
-            })?),
+            // Only models that read the date fill a sample (the gravity gradient reads none).
+            (Some(env), Some(epoch)) if env.needs_epoch() => {
+                Some(EnvironmentModel::new(env, epoch).map_err(|e| {
+                    crate::config::ConfigError::Invalid {
+                        field: "environment".into(),
+                        problem: e.to_string(),
+                        at: Default::default(),
+                    }
+                })?)
+            }
             _ => None,
         };
         let mut sim = Self {

@@ -209,10 +209,16 @@ impl EnvironmentModel {
         out: &mut EnvironmentSample,
     ) {
         let times = self.epoch.times(t_sim_ns);
-        let earth = self.rotation.at(&times);
-        let r_e_m = earth.r_e(r_bn_n_m);
         *out = EnvironmentSample::NONE;
         out.t_sim_ns = t_sim_ns;
+        // The Earth's orientation (precession-nutation and sidereal time, ~1.5 µs) only for the
+        // models that work in the Earth-fixed frame.
+        if matches!(self.field, Field::Off) && matches!(self.air, Air::Off) {
+            self.fill_sun_moon(&times, r_bn_n_m, out);
+            return;
+        }
+        let earth = self.rotation.at(&times);
+        let r_e_m = earth.r_e(r_bn_n_m);
         let b_e_t = match &self.field {
             Field::Off => None,
             Field::Igrf(igrf) => {
@@ -243,6 +249,16 @@ impl EnvironmentModel {
             // Co-rotating atmosphere (Vallado §8.6.2): v_wind = ω⊕ × r, N components.
             out.wind_n_m_s = earth.omega_en_n_rad_s.cross(r_bn_n_m);
         }
+        self.fill_sun_moon(&times, r_bn_n_m, out);
+    }
+
+    /// The Sun and Moon positions relative to B and the shadow factor, into `out`.
+    fn fill_sun_moon(
+        &self,
+        times: &super::epoch::EpochTimes,
+        r_bn_n_m: &Vector3<f64>,
+        out: &mut EnvironmentSample,
+    ) {
         let t_tt_jc = times.tt_centuries_j2000();
         if self.sun {
             let r_sun_n_m = sun_position_n_m(t_tt_jc);
