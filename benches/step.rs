@@ -292,6 +292,97 @@ fn environment_summary(pair_ns: f64) {
     }
 }
 
+/// `scenarios/leo_environment.toml` with its `[environment]` table (and facets) replaced by
+/// `environment` (empty: no environment; the epoch and the OMM orbit stay).
+fn leo_simulation(environment: &str) -> flexdyn::sim::Simulation {
+    let leo = include_str!("../scenarios/leo_environment.toml");
+    let (start, end) = (
+        leo.find("[environment]").unwrap(),
+        leo.find("[hub]").unwrap(),
+    );
+    let facets = &leo[leo.find("[[environment.facets]]").unwrap()..end];
+    let env = if environment.is_empty() {
+        String::new()
+    } else {
+        format!("{environment}\n{facets}")
+    };
+    let text = format!("{}{env}{}", &leo[..start], &leo[end..]);
+    let cfg = flexdyn::config::SimConfig::from_toml_str(&text).unwrap();
+    flexdyn::sim::Simulation::new(&cfg).unwrap()
+}
+
+/// Median ns per `Simulation::step` (with its environment updates) over 15 batches of 5000.
+fn median_ns_per_sim_step(mut sim: flexdyn::sim::Simulation) -> f64 {
+    let steps = 5_000;
+    sim.step_n(steps);
+    let per_step: Vec<f64> = (0..15)
+        .map(|_| {
+            let t = Instant::now();
+            sim.step_n(steps);
+            black_box(sim.spacecraft().state().omega_bn_b);
+            t.elapsed().as_secs_f64() * 1e9 / steps as f64
+        })
+        .collect();
+    median(per_step)
+}
+
+/// Each environment model's and effector's cost per step in the LEO scenario (2 pairs, the OMM
+/// orbit), updated at every step (the worst case: `update_hz = 1000`) and, for all of them
+/// together, at the scenario's 10 Hz; against the same simulation without `[environment]`
+/// and against one panel pair (`pair_ns`, from the same run's fit).
+fn world_summary(pair_ns: f64) {
+    const WEATHER: &str = "f107_sfu = 150.0\nf107a_sfu = 150.0\nap = 15.0\n";
+    let every = |lines: &str| format!("[environment]\nupdate_hz = 1000.0\n{lines}");
+    let leo = include_str!("../scenarios/leo_environment.toml");
+    let all = &leo[leo.find("[environment]").unwrap()..leo.find("[[environment.facets]]").unwrap()];
+    let rows: Vec<(&str, String)> = vec![
+        ("igrf14 deg 13", every("magnetic = \"igrf14\"\n")),
+        ("dipole tilted", every("magnetic = \"dipole_tilted\"\n")),
+        ("exponential", every("atmosphere = \"exponential\"\n")),
+        (
+            "nrlmsise00",
+            every(&format!("atmosphere = \"nrlmsise00\"\n{WEATHER}")),
+        ),
+        ("sun + shadow", every("sun = true\nshadow = \"conical\"\n")),
+        ("moon", every("moon = true\n")),
+        ("gravity gradient", every("gravity_gradient = true\n")),
+        (
+            "expo + drag",
+            every("atmosphere = \"exponential\"\ndrag = true\n"),
+        ),
+        (
+            "sun + srp",
+            every("sun = true\nshadow = \"conical\"\nsolar_pressure = true\n"),
+        ),
+        (
+            "igrf + dipole",
+            every("magnetic = \"igrf14\"\nresidual_dipole_m_b_am2 = [0.1, 0.0, 0.0]\n"),
+        ),
+        (
+            "all @ 1000 Hz",
+            all.replace("update_hz = 10.0", "update_hz = 1000.0"),
+        ),
+        ("all @ 10 Hz", all.to_string()),
+    ];
+    let base = median_ns_per_sim_step(leo_simulation(""));
+    println!("\nSimulation::step in scenarios/leo_environment.toml, 2 pairs (median of 15 x 5000 steps):");
+    println!(
+        "{:<18} {:>14} {:>12} {:>16}",
+        "environment", "median ns/step", "added ns", "x one panel pair"
+    );
+    println!("{:<18} {:>14.1} {:>12} {:>16}", "none", base, "-", "-");
+    for (name, env) in rows {
+        let ns = median_ns_per_sim_step(leo_simulation(&env));
+        println!(
+            "{:<18} {:>14.1} {:>12.1} {:>16.3}",
+            name,
+            ns,
+            ns - base,
+            (ns - base) / pair_ns
+        );
+    }
+}
+
 fn main() {
     let mut c = Criterion::default().configure_from_args();
     bench_step(&mut c);
@@ -299,5 +390,6 @@ fn main() {
     let rows = summary();
     wheel_summary();
     environment_summary(fit(&rows).1);
+    world_summary(fit(&rows).1);
     peers(&rows);
 }

@@ -16,6 +16,7 @@ use flexdyn_proto::{EffectorState, StateMsg};
 use crate::attitude::{mrp_to_dcm, mrp_to_quat};
 use crate::config::{ConfigError, EffectorInputSegment, SimConfig};
 use crate::dynamics::{HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment};
+use crate::environment::model::EnvironmentModel;
 use crate::sensors::imu::{Imu, ImuBank, ImuSample};
 use crate::sensors::star_tracker::{StarTracker, StarTrackerSample};
 
@@ -53,6 +54,9 @@ pub struct Simulation {
     imus: ImuBank,
     /// The star trackers in config order.
     star_trackers: Vec<StarTracker>,
+    /// The environment models (`[environment]` with an `[epoch]`), updated at their rate at
+    /// step boundaries and handed to the spacecraft's dynamic effectors.
+    environment: Option<EnvironmentModel>,
 }
 
 impl Simulation {
@@ -68,7 +72,21 @@ impl Simulation {
                 &format!("star_trackers[{i}]"),
             )?);
         }
+        let environment = match (&cfg.environment, &cfg.epoch) {
+            // Only models that read the date fill a sample (the gravity gradient reads none).
+            (Some(env), Some(epoch)) if env.needs_epoch() => {
+                Some(EnvironmentModel::new(env, epoch).map_err(|e| {
+                    crate::config::ConfigError::Invalid {
+                        field: "environment".into(),
+                        problem: e.to_string(),
+                        at: Default::default(),
+                    }
+                })?)
+            }
+            _ => None,
+        };
         let mut sim = Self {
+            environment,
             inputs: vec![0.0; sc.effector_input_len()],
             input_schedule: cfg.effector_input_schedule.clone(),
             input_cursor: 0,
@@ -215,12 +233,30 @@ impl Simulation {
         self.sc.set_wrench(w);
     }
 
+    /// Refills the environment sample when its update is due (at the start of a step), and hands
+    /// it to the spacecraft; held otherwise. Allocates nothing.
+    #[inline]
+    fn update_environment(&mut self) {
+        if let Some(env) = self.environment.as_mut() {
+            let x = self.sc.state();
+            if let Some(sample) = env.update_if_due(self.sc.t_sim_ns(), &x.r_bn_n, &x.v_bn_n) {
+                self.sc.set_environment(sample);
+            }
+        }
+    }
+
+    /// The environment models, if configured.
+    pub fn environment(&self) -> Option<&EnvironmentModel> {
+        self.environment.as_ref()
+    }
+
     /// One RK4 step: total wrench = schedule(t at step start) + command, then
     /// [`Spacecraft::step`]. Allocates nothing.
     #[inline]
     pub fn step(&mut self) {
         self.frame_outputs = None;
         self.apply_schedules();
+        self.update_environment();
         self.sc.step();
     }
 

@@ -171,6 +171,7 @@ fn every_shipped_scenario_is_valid() {
             "folded_wing",
             "imu_tactical",
             "j2_orbit",
+            "leo_environment",
             "no_gravity",
             "reference",
             "wheel_slew",
@@ -1219,7 +1220,139 @@ fn cases() -> Vec<Case> {
         ),
     ];
     rows.extend(non_finite_rows());
+    rows.extend(world_rows());
     rows
+}
+
+/// `from` replaced by `to` in `scenarios/leo_environment.toml` (every world model on).
+fn leo(from: &'static str, to: impl Into<String>) -> Input {
+    Input {
+        base: "leo_environment",
+        change: Change::Replace(from, to.into()),
+    }
+}
+
+/// `[epoch]`, `[orbit]` and `[environment]`: each error names its field and its line.
+fn world_rows() -> Vec<Case> {
+    const UTC: &str = "utc = \"2026-11-24T06:00:00Z\"";
+    vec![
+        // [orbit] and [initial] r/v are alternatives.
+        rejects(
+            leo("[initial]\n", "[initial]\nr_cn_n_m = [7.0e6, 0.0, 0.0]\n"),
+            "initial.r_cn_n_m",
+            &["both [orbit] and initial.r_cn_n_m"],
+        )
+        .at_line_of("r_cn_n_m = [7.0e6", None),
+        // Dated models need [epoch].
+        rejects(
+            text("[hub]", "[environment]\nmagnetic = \"igrf14\"\n\n[hub]"),
+            "environment.magnetic",
+            &["needs a date", "[epoch]"],
+        )
+        .at_line_of("magnetic = \"igrf14\"", None),
+        rejects(
+            text(
+                "[hub]",
+                "[orbit]\naltitude_m = 500e3\neccentricity = 0.0\ninclination_deg = 97.4\n\
+                 raan_deg = 0.0\narg_perigee_deg = 0.0\ntrue_anomaly_deg = 0.0\n\n[hub]",
+            ),
+            "orbit",
+            &["needs a date", "[epoch]"],
+        )
+        .at_line_of("[orbit]", None),
+        // An epoch outside IGRF-14 (1900-2030) with the field on is an error on the epoch.
+        rejects(
+            text(
+                "[hub]",
+                "[epoch]\nutc = \"2031-06-01T00:00:00Z\"\n\n[environment]\n\
+                 magnetic = \"igrf14\"\n\n[hub]",
+            ),
+            "epoch.utc",
+            &["outside the magnetic field model", "2030"],
+        )
+        .at_line_of("utc = \"2031", None),
+        // The same epoch without the field is fine: nothing needs IGRF.
+        accepts(text(
+            "[hub]",
+            "[epoch]\nutc = \"2031-06-01T00:00:00Z\"\n\n[environment]\nsun = true\n\n[hub]",
+        )),
+        rejects(
+            leo(UTC, format!("{UTC}\ntai = \"2026-11-24T06:00:37\"")),
+            "epoch.tai",
+            &["either", "not both"],
+        ),
+        // An element set far from the epoch.
+        rejects(
+            leo(UTC, "utc = \"2027-03-01T00:00:00Z\""),
+            "orbit.elements",
+            &["days", "max_element_age_days"],
+        ),
+        // Model names and parameters.
+        rejects(
+            leo("magnetic = \"igrf14\"", "magnetic = \"igrf15\""),
+            "environment.magnetic",
+            &["unknown model \"igrf15\"", "\"igrf14\""],
+        )
+        .at_line_of("magnetic = \"igrf15\"", None),
+        rejects(
+            leo("magnetic_degree = 13", "magnetic_degree = 14"),
+            "environment.magnetic_degree",
+            &["14"],
+        )
+        .at_line_of("magnetic_degree = 14", None),
+        rejects(
+            leo("f107_sfu = 150.0", "f107_sfu = 5000.0"),
+            "environment.f107_sfu",
+            &["5000"],
+        )
+        .at_line_of("f107_sfu = 5000.0", None),
+        rejects(
+            leo("sun = true", "sun = false"),
+            "environment.shadow",
+            &["needs the Sun"],
+        ),
+        rejects(
+            leo("moon = true", "mooon = true"),
+            "environment.mooon",
+            &["unknown key"],
+        )
+        .at_line_of("mooon = true", None),
+        rejects(
+            leo("update_hz = 10.0", "update_hz = -1.0"),
+            "environment.update_hz",
+            &["> 0"],
+        )
+        .at_line_of("update_hz = -1.0", None),
+        rejects(
+            leo("area_m2 = 4.0", "area_m2 = -4.0"),
+            "environment.facets[0].area_m2",
+            &["-4"],
+        )
+        .at_line_of("area_m2 = -4.0", None),
+        // Effectors without what they read.
+        rejects(
+            text("[hub]", "[environment]\ndrag = true\n\n[hub]"),
+            "environment.drag",
+            &["needs an atmosphere"],
+        )
+        .at_line_of("drag = true", None),
+        rejects(
+            text(
+                "[hub]",
+                "[environment]\nresidual_dipole_m_b_am2 = [0.0, 0.0, 1.0]\n\n[hub]",
+            ),
+            "environment.residual_dipole_m_b_am2",
+            &["needs a magnetic field"],
+        ),
+        // Gravity gradient alone needs no date, and adds one dynamic effector.
+        accepts_and(
+            text("[hub]", "[environment]\ngravity_gradient = true\n\n[hub]"),
+            |cfg| {
+                let sc = cfg.build_spacecraft().unwrap();
+                assert_eq!(sc.dynamic_effectors().len(), 1);
+            },
+        ),
+    ]
 }
 
 #[test]

@@ -94,3 +94,32 @@ fn per_call_functions_do_not_allocate() {
         "allocations in the per-call environment functions"
     );
 }
+
+/// The stepping hot path with every environment model and dynamic effector on
+/// (`scenarios/leo_environment.toml`): 2 s of 1 ms steps, 20 environment updates (10 Hz), no
+/// allocation once built.
+#[test]
+fn stepping_with_every_model_on_allocates_nothing() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/leo_environment.toml");
+    let cfg = flexdyn::config::SimConfig::from_file(&path).unwrap();
+    let mut sim = flexdyn::sim::Simulation::new(&cfg).unwrap();
+    assert_eq!(sim.spacecraft().dynamic_effectors().len(), 4);
+    sim.step();
+    let before = ALLOCATIONS.with(Cell::get);
+    sim.step_n(2000);
+    let after = ALLOCATIONS.with(Cell::get);
+    assert_eq!(
+        after - before,
+        0,
+        "allocations while stepping with the environment on"
+    );
+    // The models did run: a field, a Sun, a density.
+    let env = sim.spacecraft().environment();
+    assert_eq!(env.t_sim_ns, 2_000_000_000);
+    assert!(env.b_field_n_t.norm() > 1e-5, "{env:?}");
+    assert!(
+        env.density_kg_m3 > 0.0 && env.r_sun_b_n_m.norm() > 1e11,
+        "{env:?}"
+    );
+}

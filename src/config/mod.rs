@@ -24,6 +24,7 @@ mod file;
 mod schedule;
 mod source_map;
 mod warnings;
+mod world;
 
 use std::collections::HashSet;
 use std::path::Path;
@@ -88,6 +89,10 @@ pub struct SimConfig {
     pub imus: Vec<ImuConfig>,
     /// The star trackers (`[[star_trackers]]`), validated, in file order (empty if absent).
     pub star_trackers: Vec<StarTrackerConfig>,
+    /// The simulation epoch (`[epoch]`), if given: t = 0 is this instant.
+    pub epoch: Option<crate::environment::epoch::SimEpoch>,
+    /// The environment (`[environment]`), if given: models and dynamic effectors.
+    pub environment: Option<crate::environment::model::EnvironmentSettings>,
     /// The configuration text this was parsed from.
     pub source_toml: String,
 }
@@ -95,6 +100,12 @@ pub struct SimConfig {
 impl SimConfig {
     /// Parses and validates a configuration. The error names the first offending field.
     pub fn from_toml_str(s: &str) -> Result<Self, ConfigError> {
+        Self::from_toml_str_in(s, Path::new("."))
+    }
+
+    /// Like [`Self::from_toml_str`], with relative paths in the file (`orbit.elements_file`)
+    /// resolved against `base_dir`.
+    pub fn from_toml_str_in(s: &str, base_dir: &Path) -> Result<Self, ConfigError> {
         let doc = DeTable::parse(s).map_err(|e| {
             let loc = e
                 .span()
@@ -107,9 +118,9 @@ impl SimConfig {
             }
         })?;
         let map = SourceMap::new(s, doc.get_ref());
-        let raw = RawConfig::read(s, doc.get_ref())?;
+        let raw = RawConfig::read(s, doc.get_ref(), &map)?;
         map.check_all_finite(doc.get_ref())?;
-        raw.into_config(s, &map)
+        raw.into_config(s, &map, base_dir)
     }
 
     /// Reads, parses and validates a configuration file. An I/O error names the path.
@@ -118,7 +129,7 @@ impl SimConfig {
             path: path.to_path_buf(),
             source,
         })?;
-        Self::from_toml_str(&text)
+        Self::from_toml_str_in(&text, path.parent().unwrap_or(Path::new(".")))
     }
 
     /// The built-in default ([`DEFAULT_CONFIG_TOML`]).
@@ -171,6 +182,9 @@ impl SimConfig {
         )?;
         for (i, imu) in self.imus.iter().enumerate() {
             sc.add_sensor_point(imu.sensor_point(), &format!("imus[{i}]"))?;
+        }
+        if let Some(env) = &self.environment {
+            world::add_dynamic_effectors(&mut sc, env, &self.gravity);
         }
         Ok(sc)
     }
@@ -257,9 +271,13 @@ const ROOT_KEYS: &[&str] = &[
     "server",
     "imus",
     "star_trackers",
+    world::ROOT_KEYS[0],
+    world::ROOT_KEYS[1],
+    world::ROOT_KEYS[2],
 ];
 
 struct RawConfig {
+    world: world::RawWorld,
     simulation: RawSimulation,
     gravity: RawGravity,
     hub: RawHub,
@@ -308,8 +326,9 @@ struct RawWrench {
 
 impl RawConfig {
     /// Pass 2: reads the whole document against the schema.
-    fn read(source: &str, doc: &DeTable<'_>) -> Result<Self, ConfigError> {
+    fn read(source: &str, doc: &DeTable<'_>, map: &SourceMap) -> Result<Self, ConfigError> {
         let root = TableReader::root(source, doc, ROOT_KEYS)?;
+        let world = world::RawWorld::read(&root, map)?;
         let sim = root.table("simulation", &["step_s", "frame_hz"])?;
         let simulation = RawSimulation {
             step_s: sim.f64("step_s")?,
@@ -408,6 +427,7 @@ impl RawConfig {
             .map(star_tracker::schema::read)
             .collect::<Result<Vec<_>, _>>()?;
         Ok(RawConfig {
+            world,
             simulation,
             gravity,
             hub,
@@ -424,7 +444,12 @@ impl RawConfig {
 }
 
 impl RawConfig {
-    fn into_config(self, source: &str, map: &SourceMap) -> Result<SimConfig, ConfigError> {
+    fn into_config(
+        self,
+        source: &str,
+        map: &SourceMap,
+        base_dir: &Path,
+    ) -> Result<SimConfig, ConfigError> {
         let param = |e: ParamError| map.param_error(e);
 
         // [simulation]
@@ -490,8 +515,14 @@ impl RawConfig {
         };
         hub.validate("hub").map_err(param)?;
 
-        // [initial]
-        let initial = self.initial.to_initial(map)?;
+        // [epoch], [orbit], [environment]
+        let has_orbit = self.world.has_orbit();
+        let world = self.world.resolve(&gravity, base_dir, map)?;
+
+        // [initial] (its position and velocity come from [orbit] when that is given)
+        let initial = self
+            .initial
+            .to_initial(map, world.orbit.as_ref(), has_orbit)?;
 
         // [[panel_pairs]]
         if self.panel_pairs.len() > MAX_PANEL_PAIRS {
@@ -619,6 +650,8 @@ impl RawConfig {
             server: self.server,
             imus,
             star_trackers,
+            epoch: world.epoch,
+            environment: world.environment,
             source_toml: source.to_string(),
         };
         check_body_extent(&cfg, map)?;
@@ -1117,7 +1150,12 @@ impl RawGravity {
 }
 
 impl RawInitial {
-    fn to_initial(&self, map: &SourceMap) -> Result<HubInitial, ConfigError> {
+    fn to_initial(
+        &self,
+        map: &SourceMap,
+        orbit: Option<&crate::environment::orbit::schema::InitialOrbit>,
+        has_orbit: bool,
+    ) -> Result<HubInitial, ConfigError> {
         let err = |field: &str, problem: String| {
             let at = map.at(field);
             ConfigError::InitialPoint {
@@ -1139,6 +1177,40 @@ impl RawInitial {
                 ),
             )
         };
+        if has_orbit {
+            let given = [
+                ("r_cn_n_m", self.r_cn_n_m.is_some()),
+                ("v_cn_n_m_s", self.v_cn_n_m_s.is_some()),
+                ("r_bn_n_m", self.r_bn_n_m.is_some()),
+                ("v_bn_n_m_s", self.v_bn_n_m_s.is_some()),
+            ];
+            if let Some((key, _)) = given.iter().find(|(_, g)| *g) {
+                return Err(err(
+                    &format!("initial.{key}"),
+                    format!(
+                        "both [orbit] and initial.{key} give the orbit: keep [orbit] and remove \
+                         initial.{key} (with [orbit], [initial] holds only sigma_bn and \
+                         omega_bn_b_rad_s)"
+                    ),
+                ));
+            }
+            // [orbit] gives the system centre of mass (the point whose motion the orbit is).
+            let translation = orbit.map_or(
+                InitialTranslation::CenterOfMass {
+                    r_cn_n_m: nalgebra::Vector3::zeros(),
+                    v_cn_n_m_s: nalgebra::Vector3::zeros(),
+                },
+                |o| InitialTranslation::CenterOfMass {
+                    r_cn_n_m: o.r_n_m,
+                    v_cn_n_m_s: o.v_n_m_s,
+                },
+            );
+            return Ok(HubInitial {
+                translation,
+                sigma_bn: vec3(&self.sigma_bn),
+                omega_bn_b_rad_s: vec3(&self.omega_bn_b_rad_s),
+            });
+        }
         if self.r_cn_n_m.is_some() && self.r_bn_n_m.is_some() {
             return Err(both("position", "r_cn_n_m", "r_bn_n_m"));
         }

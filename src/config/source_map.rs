@@ -188,6 +188,22 @@ impl<'s> SourceMap<'s> {
         }
     }
 
+    /// Position of `field`, or of its nearest enclosing table the document has (for an absent
+    /// key); a field such as `epoch.utc (or epoch.tai)` is looked up by its first word.
+    pub(crate) fn near(&self, field: &str) -> At {
+        let mut path = field.split(' ').next().unwrap_or(field);
+        loop {
+            let at = self.at(path);
+            if at.0.is_some() {
+                return at;
+            }
+            match path.rfind(['.', '[']) {
+                Some(i) => path = &path[..i],
+                None => return at,
+            }
+        }
+    }
+
     pub(crate) fn invalid(&self, field: &str, problem: String) -> ConfigError {
         ConfigError::Invalid {
             field: field.to_string(),

@@ -50,6 +50,7 @@ pub mod epoch;
 pub mod facets;
 pub mod geodetic;
 pub mod magnetic;
+pub mod model;
 pub mod orbit;
 pub mod sample;
 pub mod shadow;

@@ -19,13 +19,6 @@ use super::{EarthOrientationParams, EpochError, EpochScale, SimEpoch, RAD_PER_AR
 use crate::schema::{SchemaError, TableReader};
 
 /// The keys of `[epoch]`.
-#[cfg_attr(
-    not(test),
-    expect(
-        dead_code,
-        reason = "registered in src/config when `[epoch]` is wired in"
-    )
-)]
 pub(crate) const KEYS: [&str; 5] = [
     "utc",
     "tai",
@@ -62,13 +55,6 @@ fn date_time_text(t: &TableReader<'_, '_>, key: &str) -> Result<Option<String>, 
 }
 
 /// Reads `[epoch]` (opened with [`KEYS`]).
-#[cfg_attr(
-    not(test),
-    expect(
-        dead_code,
-        reason = "registered in src/config when `[epoch]` is wired in"
-    )
-)]
 pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawEpoch, SchemaError> {
     let utc = date_time_text(t, "utc")?;
     let tai = date_time_text(t, "tai")?;

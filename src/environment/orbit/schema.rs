@@ -123,13 +123,6 @@ pub struct InitialOrbit {
 }
 
 /// Reads the orbit table (opened with [`KEYS`]).
-#[cfg_attr(
-    not(test),
-    expect(
-        dead_code,
-        reason = "registered in src/config when the orbit table is wired in"
-    )
-)]
 pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawOrbit, SchemaError> {
     /// The value of exactly one of `a` and `b`, with `true` for `a`.
     fn one_of(

@@ -1,0 +1,313 @@
+//! The environment of a run, built once from the configuration's `[environment]` table
+//! ([`schema`]), and the [`EnvironmentModel`] that fills an [`EnvironmentSample`] from the
+//! simulation time and the hub's position and velocity.
+//!
+//! One update runs the chain (each step cites its own module):
+//! 1. the epoch's time scales at `t_sim_ns` ([`crate::environment::epoch`]);
+//! 2. the Earth's orientation, N → E ([`crate::environment::earth_rotation`]);
+//! 3. r in the Earth-fixed frame; the magnetic field there (IGRF-14 or a centred dipole),
+//!    rotated back to N ([`crate::environment::magnetic`]);
+//! 4. the density at r (exponential or NRLMSISE-00) and the co-rotating wind ω⊕ × r
+//!    ([`crate::environment::atmosphere`]);
+//! 5. the Sun and Moon positions (geocentric, N), made relative to B
+//!    ([`crate::environment::ephemeris`]), and the shadow factor ([`crate::environment::shadow`]).
+//!
+//! [`EnvironmentModel::fill`] allocates nothing, locks nothing and returns no `Result`: every
+//! parameter was checked when the model was built. [`EnvironmentModel::update_if_due`] runs it at
+//! the configured rate and holds the sample between updates (zero-order hold: see the README's
+//! "World" section for the error that costs).
+
+pub mod schema;
+
+use nalgebra::Vector3;
+
+use super::atmosphere::{exponential_density_kg_m3, Nrlmsise00Model, SpaceWeather};
+use super::earth_rotation::EarthRotation;
+use super::ephemeris::{moon_position_n_m, sun_position_n_m};
+use super::epoch::SimEpoch;
+use super::facets::Facet;
+use super::geodetic::geodetic_from_ecef;
+use super::magnetic::{CentredDipole, Igrf, MagneticError};
+use super::shadow::{shadow_factor, ShadowModel};
+use super::EnvironmentSample;
+
+/// Which magnetic-field model is on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MagneticSetting {
+    /// No field.
+    Off,
+    /// IGRF-14 to `degree` (1..=13).
+    Igrf14 {
+        /// Highest degree n.
+        degree: usize,
+    },
+    /// The centred dipole of IGRF-14's degree-1 coefficients at the epoch: tilted (g₁⁰, g₁¹,
+    /// h₁¹) or axial (g₁⁰ only).
+    Dipole {
+        /// Tilted (true) or axial (false).
+        tilted: bool,
+    },
+}
+
+/// Which atmosphere is on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AtmosphereSetting {
+    /// Vacuum.
+    Off,
+    /// Vallado's exponential bands (Table 8-4) on the geodetic height.
+    Exponential,
+    /// NRLMSISE-00 with constant space weather.
+    Nrlmsise00(SpaceWeather),
+}
+
+/// The validated `[environment]` table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnvironmentSettings {
+    /// \[ns\] interval between sample updates (a whole number of RK4 steps).
+    pub update_ns: u64,
+    /// \[Hz\] the update rate as configured.
+    pub update_hz: f64,
+    /// Magnetic field.
+    pub magnetic: MagneticSetting,
+    /// Atmosphere (with a co-rotating wind when on).
+    pub atmosphere: AtmosphereSetting,
+    /// Sun ephemeris.
+    pub sun: bool,
+    /// Moon ephemeris.
+    pub moon: bool,
+    /// Shadow geometry (needs the Sun), or none (full sunlight).
+    pub shadow: Option<ShadowModel>,
+    /// The vehicle's flat plates (`[[environment.facets]]`), B frame.
+    pub facets: Vec<Facet>,
+    /// Dynamic effector: gravity-gradient torque.
+    pub gravity_gradient: bool,
+    /// Dynamic effector: drag on the facets.
+    pub drag: bool,
+    /// Dynamic effector: solar radiation pressure on the facets.
+    pub solar_pressure: bool,
+    /// Dynamic effector: a residual dipole \[A·m²\], B components.
+    pub residual_dipole_m_b_am2: Option<Vector3<f64>>,
+}
+
+impl EnvironmentSettings {
+    /// Whether any model needs the epoch (everything but the gravity gradient and the facets).
+    pub fn needs_epoch(&self) -> bool {
+        self.magnetic != MagneticSetting::Off
+            || self.atmosphere != AtmosphereSetting::Off
+            || self.sun
+            || self.moon
+            || self.shadow.is_some()
+    }
+}
+
+/// The magnetic field, built.
+#[derive(Debug, Clone)]
+enum Field {
+    Off,
+    Igrf(Box<Igrf>),
+    Dipole(CentredDipole),
+}
+
+/// The atmosphere, built.
+#[derive(Debug, Clone)]
+enum Air {
+    Off,
+    Exponential,
+    Nrlmsise00(Nrlmsise00Model),
+}
+
+/// The environment models of a run, built once; fills samples without allocating.
+#[derive(Debug, Clone)]
+pub struct EnvironmentModel {
+    epoch: SimEpoch,
+    rotation: EarthRotation,
+    field: Field,
+    air: Air,
+    sun: bool,
+    moon: bool,
+    shadow: Option<ShadowModel>,
+    update_ns: u64,
+    /// \[ns\] time of the next due update (`None`: none yet).
+    next_update_ns: Option<u64>,
+    sample: EnvironmentSample,
+}
+
+/// A model that cannot be built for this epoch.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum EnvironmentBuildError {
+    /// The magnetic model refuses the degree or the epoch's date.
+    #[error(transparent)]
+    Magnetic(#[from] MagneticError),
+    /// The space weather is out of range.
+    #[error(transparent)]
+    Atmosphere(#[from] super::atmosphere::AtmosphereError),
+}
+
+impl EnvironmentModel {
+    /// Builds the models of `settings` for `epoch`. Fails if IGRF-14 does not cover the epoch
+    /// (1900–2030) or the degree, or if the space weather is out of range.
+    pub fn new(
+        settings: &EnvironmentSettings,
+        epoch: &SimEpoch,
+    ) -> Result<Self, EnvironmentBuildError> {
+        let year = epoch.utc_calendar(0).decimal_year();
+        let field = match settings.magnetic {
+            MagneticSetting::Off => Field::Off,
+            MagneticSetting::Igrf14 { degree } => {
+                let igrf = Igrf::igrf14(degree)?;
+                igrf.check_date(year)?;
+                Field::Igrf(Box::new(igrf))
+            }
+            MagneticSetting::Dipole { tilted } => {
+                let igrf = Igrf::igrf14(1)?;
+                igrf.check_date(year)?;
+                let c = igrf.coefficients_at(year);
+                Field::Dipole(if tilted {
+                    CentredDipole::tilted(&c)
+                } else {
+                    CentredDipole::axial(&c)
+                })
+            }
+        };
+        let air = match settings.atmosphere {
+            AtmosphereSetting::Off => Air::Off,
+            AtmosphereSetting::Exponential => Air::Exponential,
+            AtmosphereSetting::Nrlmsise00(w) => Air::Nrlmsise00(Nrlmsise00Model::new(w)?),
+        };
+        Ok(Self {
+            epoch: epoch.clone(),
+            rotation: EarthRotation::new(epoch.earth_orientation()),
+            field,
+            air,
+            sun: settings.sun,
+            moon: settings.moon,
+            shadow: settings.shadow,
+            update_ns: settings.update_ns.max(1),
+            next_update_ns: None,
+            sample: EnvironmentSample::NONE,
+        })
+    }
+
+    /// The epoch.
+    pub fn epoch(&self) -> &SimEpoch {
+        &self.epoch
+    }
+
+    /// The sample last filled by [`Self::update_if_due`].
+    pub fn sample(&self) -> &EnvironmentSample {
+        &self.sample
+    }
+
+    /// Fills `out` at `t_sim_ns` for the hub point B at `r_bn_n_m` moving at `v_bn_n_m_s` (N).
+    /// Allocation-free, lock-free, no `Result`.
+    pub fn fill(
+        &self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        _v_bn_n_m_s: &Vector3<f64>,
+        out: &mut EnvironmentSample,
+    ) {
+        let times = self.epoch.times(t_sim_ns);
+        *out = EnvironmentSample::NONE;
+        out.t_sim_ns = t_sim_ns;
+        // The Earth's orientation (precession-nutation and sidereal time, ~1.5 µs) only for the
+        // models that work in the Earth-fixed frame.
+        if matches!(self.field, Field::Off) && matches!(self.air, Air::Off) {
+            self.fill_sun_moon(&times, r_bn_n_m, out);
+            return;
+        }
+        let earth = self.rotation.at(&times);
+        let r_e_m = earth.r_e(r_bn_n_m);
+        let b_e_t = match &self.field {
+            Field::Off => None,
+            Field::Igrf(igrf) => {
+                let year = self.epoch.utc_calendar(t_sim_ns).decimal_year();
+                Some(igrf.field_ecef_t(year, &r_e_m))
+            }
+            Field::Dipole(d) => Some(d.field_ecef_t(&r_e_m)),
+        };
+        if let Some(b_e_t) = b_e_t {
+            out.b_field_n_t = earth.dcm_en.tr_mul(&b_e_t);
+        }
+        let density_kg_m3 = match &self.air {
+            Air::Off => None,
+            Air::Exponential => Some(exponential_density_kg_m3(
+                geodetic_from_ecef(&r_e_m).height_m,
+            )),
+            Air::Nrlmsise00(m) => {
+                let cal = self.epoch.utc_calendar(t_sim_ns);
+                let ut_s = f64::from(cal.hour) * 3600.0
+                    + f64::from(cal.minute) * 60.0
+                    + f64::from(cal.second.min(59))
+                    + f64::from(cal.nanosecond) * 1e-9;
+                Some(m.drag_density_kg_m3(day_of_year(cal.year, cal.month, cal.day), ut_s, &r_e_m))
+            }
+        };
+        if let Some(rho) = density_kg_m3 {
+            out.density_kg_m3 = rho;
+            // Co-rotating atmosphere (Vallado §8.6.2): v_wind = ω⊕ × r, N components.
+            out.wind_n_m_s = earth.omega_en_n_rad_s.cross(r_bn_n_m);
+        }
+        self.fill_sun_moon(&times, r_bn_n_m, out);
+    }
+
+    /// The Sun and Moon positions relative to B and the shadow factor, into `out`.
+    fn fill_sun_moon(
+        &self,
+        times: &super::epoch::EpochTimes,
+        r_bn_n_m: &Vector3<f64>,
+        out: &mut EnvironmentSample,
+    ) {
+        let t_tt_jc = times.tt_centuries_j2000();
+        if self.sun {
+            let r_sun_n_m = sun_position_n_m(t_tt_jc);
+            out.r_sun_b_n_m = r_sun_n_m - r_bn_n_m;
+            if let Some(model) = self.shadow {
+                out.shadow_factor = shadow_factor(model, r_bn_n_m, &r_sun_n_m);
+            }
+        }
+        if self.moon {
+            out.r_moon_b_n_m = moon_position_n_m(t_tt_jc) - r_bn_n_m;
+        }
+    }
+
+    /// Refills the held sample when `t_sim_ns` has reached the next update time (the first call
+    /// always updates), and returns it then; `None` while the held sample still stands.
+    pub fn update_if_due(
+        &mut self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+    ) -> Option<&EnvironmentSample> {
+        if self.next_update_ns.is_some_and(|next| t_sim_ns < next) {
+            return None;
+        }
+        let mut s = self.sample;
+        self.fill(t_sim_ns, r_bn_n_m, v_bn_n_m_s, &mut s);
+        self.sample = s;
+        self.next_update_ns = Some(t_sim_ns.saturating_add(self.update_ns));
+        Some(&self.sample)
+    }
+}
+
+/// Day of the year, 1 on 1 January (Gregorian).
+fn day_of_year(year: i32, month: u8, day: u8) -> u32 {
+    const CUM: [u32; 12] = [0, 31, 59, 90, 120, 151, 181, 212, 243, 273, 304, 334];
+    let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+    let m = usize::from(month.clamp(1, 12)) - 1;
+    CUM[m] + u32::from(leap && month > 2) + u32::from(day)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::day_of_year;
+
+    #[test]
+    fn day_of_year_counts_from_one() {
+        assert_eq!(day_of_year(2026, 1, 1), 1);
+        assert_eq!(day_of_year(2026, 11, 24), 328);
+        assert_eq!(day_of_year(2024, 12, 31), 366);
+        assert_eq!(day_of_year(2023, 3, 1), 60);
+    }
+}
