@@ -1,8 +1,9 @@
 //! The environment models' per-call functions allocate nothing once their models are built (the
 //! stepping loop's rule). A counting global allocator, per thread, checks it.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+mod alloc_counter;
+use alloc_counter::allocations;
+
 use std::hint::black_box;
 
 use flexdyn::environment::atmosphere::{
@@ -14,29 +15,6 @@ use flexdyn::environment::geodetic::{dcm_ned_ecef, geodetic_from_ecef};
 use flexdyn::environment::magnetic::{dipole_torque_b_nm, CentredDipole, Igrf};
 use flexdyn::environment::shadow::{shadow_factor, ShadowModel};
 use nalgebra::Vector3;
-
-struct Counting;
-
-thread_local! {
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        System.alloc(layout)
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        System.dealloc(ptr, layout)
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        System.realloc(ptr, layout, new_size)
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 #[test]
 fn per_call_functions_do_not_allocate() {
@@ -66,7 +44,7 @@ fn per_call_functions_do_not_allocate() {
     let v = Vector3::new(-2.0e3, 7.0e3, 0.5e3);
     let omega = Vector3::new(0.0, 0.0, 7.292_115e-5);
 
-    let before = ALLOCATIONS.with(Cell::get);
+    let before = allocations();
     for i in 0..100 {
         let t = 0.25 + f64::from(i) * 1e-5;
         let sun = sun_position_n_m(t);
@@ -87,7 +65,7 @@ fn per_call_functions_do_not_allocate() {
         let p = solar_pressure_n_m2((sun - r).norm(), nu, 1361.0);
         black_box(facets.srp_wrench_b(&(sun - r), p));
     }
-    let after = ALLOCATIONS.with(Cell::get);
+    let after = allocations();
     assert_eq!(
         after - before,
         0,
@@ -106,9 +84,9 @@ fn stepping_with_every_model_on_allocates_nothing() {
     let mut sim = flexdyn::sim::Simulation::new(&cfg).unwrap();
     assert_eq!(sim.spacecraft().dynamic_effectors().len(), 4);
     sim.step();
-    let before = ALLOCATIONS.with(Cell::get);
+    let before = allocations();
     sim.step_n(2000);
-    let after = ALLOCATIONS.with(Cell::get);
+    let after = allocations();
     assert_eq!(
         after - before,
         0,
