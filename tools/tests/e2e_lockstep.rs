@@ -315,6 +315,44 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
     );
 }
 
+/// One lockstep run of `cfg` (100 Hz frames) for `run_s` with the demo closing the loop on the
+/// wheels, star tracker `st1` and gyro `hub` at gains (K [N·m], P [N·m·s]): the server's report
+/// and every state recorded, sorted by tick.
+fn wheels_on_sensors_run(
+    cfg: flexdyn::config::SimConfig,
+    run_s: f64,
+    (k_nm, p_nms): (f64, f64),
+    timeout: Duration,
+) -> (flexdyn::server::RunReport, Vec<(u64, Vec<u8>)>) {
+    let topics = Topics::new("sc1").unwrap();
+    let settings = ServerSettings {
+        duration_ns: Some((run_s * 1e9) as u64),
+        ..settings(10.0)
+    };
+    let server = ServerHandle::start(settings, cfg);
+    let port = server.port;
+    let recorder = Recorder::start(port, &topics, 2);
+    let _ctrl = ChildGuard::spawn(
+        Command::new(acs_demo_bin::acs_demo())
+            .args(["--connect", &endpoint(port), "--sender-id", "1"])
+            .args(["--k-nm", &k_nm.to_string(), "--p-nms", &p_nms.to_string()])
+            .args(["--log-every-s", "0"])
+            .args(["--actuator", "wheels", "--attitude-source", "star-tracker"])
+            .args([
+                "--star-tracker",
+                "st1",
+                "--rate-source",
+                "gyro",
+                "--imu",
+                "hub",
+            ]),
+    );
+    let report = server.join(timeout).expect("wheels-on-sensors run");
+    let mut states = recorder.states.lock().unwrap().clone();
+    states.sort_by_key(|(t, _)| *t);
+    (report, states)
+}
+
 /// Issue 11: flight-like ACS on sensor data only. The controller commands the four reaction
 /// wheels of `scenarios/wheels_star_tracker.toml` (`Actuators` commands, one per tick) from the
 /// star tracker's attitude, propagated with the `hub` IMU's gyro between the tracker's 10 Hz
@@ -339,33 +377,7 @@ fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
         .join("../scenarios/wheels_star_tracker.toml");
     let run = || {
         let cfg = flexdyn::config::SimConfig::from_file(&path).expect("wheels_star_tracker.toml");
-        let topics = Topics::new("sc1").unwrap();
-        let settings = ServerSettings {
-            duration_ns: Some((RUN_S * 1e9) as u64),
-            ..settings(10.0)
-        };
-        let server = ServerHandle::start(settings, cfg);
-        let port = server.port;
-        let recorder = Recorder::start(port, &topics, 2);
-        let _ctrl = ChildGuard::spawn(
-            Command::new(acs_demo_bin::acs_demo())
-                .args(["--connect", &endpoint(port), "--sender-id", "1"])
-                .args(["--k-nm", &K.to_string(), "--p-nms", &P.to_string()])
-                .args(["--log-every-s", "0"])
-                .args(["--actuator", "wheels", "--attitude-source", "star-tracker"])
-                .args([
-                    "--star-tracker",
-                    "st1",
-                    "--rate-source",
-                    "gyro",
-                    "--imu",
-                    "hub",
-                ]),
-        );
-        let report = server.join(Duration::from_secs(300)).expect("wheel run");
-        let mut states = recorder.states.lock().unwrap().clone();
-        states.sort_by_key(|(t, _)| *t);
-        (report, states)
+        wheels_on_sensors_run(cfg, RUN_S, (K, P), Duration::from_secs(300))
     };
     let (report, a) = run();
     let mut settled_at = None;
@@ -454,33 +466,7 @@ fn sensor_closed_demo_runs_are_bit_identical_also_under_load() {
         .replace("omega_rad_s = 100.0", "omega_rad_s = 0.0");
     let run = || {
         let cfg = flexdyn::config::SimConfig::from_toml_str(&toml).expect("wheels at rest");
-        let topics = Topics::new("sc1").unwrap();
-        let settings = ServerSettings {
-            duration_ns: Some((RUN_S * 1e9) as u64),
-            ..settings(10.0)
-        };
-        let server = ServerHandle::start(settings, cfg);
-        let port = server.port;
-        let recorder = Recorder::start(port, &topics, 2);
-        let _ctrl = ChildGuard::spawn(
-            Command::new(acs_demo_bin::acs_demo())
-                .args(["--connect", &endpoint(port), "--sender-id", "1"])
-                .args(["--k-nm", "0.2", "--p-nms", "1", "--log-every-s", "0"])
-                .args(["--actuator", "wheels", "--attitude-source", "star-tracker"])
-                .args([
-                    "--star-tracker",
-                    "st1",
-                    "--rate-source",
-                    "gyro",
-                    "--imu",
-                    "hub",
-                ]),
-        );
-        server
-            .join(Duration::from_secs(120))
-            .expect("sensor-closed run");
-        let mut states = recorder.states.lock().unwrap().clone();
-        states.sort_by_key(|(t, _)| *t);
+        let (_, states) = wheels_on_sensors_run(cfg, RUN_S, (0.2, 1.0), Duration::from_secs(120));
         assert_eq!(states.len() as u64, (RUN_S * 100.0) as u64 + 1);
         let mut max_u = 0.0_f64;
         for (_, bytes) in &states {
