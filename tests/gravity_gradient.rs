@@ -21,6 +21,9 @@ use flexdyn::dynamics::{
 use flexdyn::environment::EnvironmentSample;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
+mod rigid_hub;
+use rigid_hub::rigid_hub;
+
 /// Earth's μ (EGM2008 / WGS 84 value), for the closed-form checks in LEO.
 const MU_EARTH: f64 = 3.986004418e14;
 /// A small body (μ = 10⁴ m³/s², a 1 km orbit) for the invariants: the orbital energy and
@@ -41,28 +44,7 @@ fn rigid(mu: f64, inertia: [f64; 3], initial: &str, step_s: f64) -> Spacecraft {
 
 /// The same rigid hub under the point mass alone.
 fn rigid_point_mass_only(mu: f64, inertia: [f64; 3], initial: &str, step_s: f64) -> Spacecraft {
-    let toml = format!(
-        r#"
-panel_pairs = []
-[simulation]
-step_s = {step_s}
-frame_hz = 1.0
-[gravity]
-model = "point_mass"
-mu_m3_s2 = {mu:?}
-[hub]
-mass_kg = 500.0
-inertia_bc_b_kg_m2 = [[{:?}, 0.0, 0.0], [0.0, {:?}, 0.0], [0.0, 0.0, {:?}]]
-r_bcb_b_m = [0.0, 0.0, 0.0]
-[initial]
-{initial}
-"#,
-        inertia[0], inertia[1], inertia[2]
-    );
-    SimConfig::from_toml_str(&toml)
-        .unwrap()
-        .build_spacecraft()
-        .unwrap()
+    rigid_hub(mu, inertia, [0.0; 3], initial, step_s)
 }
 
 /// The initial table of a tumbling body on an inclined, slightly eccentric orbit of radius `r`.

@@ -11,7 +11,6 @@
 use std::sync::{Arc, Mutex};
 
 use flexdyn::attitude::dcm_to_mrp;
-use flexdyn::config::SimConfig;
 use flexdyn::dynamics::dynamic_effectors::aero_drag::AeroDrag;
 use flexdyn::dynamics::dynamic_effectors::residual_dipole::ResidualDipole;
 use flexdyn::dynamics::dynamic_effectors::solar_pressure::SolarPressure;
@@ -22,6 +21,9 @@ use flexdyn::environment::facets::{
 };
 use flexdyn::environment::EnvironmentSample;
 use nalgebra::{Matrix3, Vector3};
+
+mod rigid_hub;
+use rigid_hub::rigid_hub;
 
 const MU_EARTH: f64 = 3.986004418e14;
 
@@ -59,32 +61,19 @@ fn box_with_wing(offset_b_m: Vector3<f64>) -> FacetModel {
 fn rigid_leo(step_s: f64) -> Spacecraft {
     let r = 6.878e6;
     let v = (MU_EARTH / r).sqrt();
-    let toml = format!(
-        r#"
-panel_pairs = []
-[simulation]
-step_s = {step_s}
-frame_hz = 1.0
-[gravity]
-model = "point_mass"
-mu_m3_s2 = {MU_EARTH:?}
-[hub]
-mass_kg = 500.0
-inertia_bc_b_kg_m2 = [[300.0, 0.0, 0.0], [0.0, 250.0, 0.0], [0.0, 0.0, 180.0]]
-r_bcb_b_m = [0.2, -0.1, 0.3]
-[initial]
-r_cn_n_m = [{r:?}, 0.0, 0.0]
-v_cn_n_m_s = [0.0, {:?}, {:?}]
-sigma_bn = [0.1, -0.2, 0.3]
-omega_bn_b_rad_s = [0.15, -0.2, 0.1]
-"#,
+    let initial = format!(
+        "r_cn_n_m = [{r:?}, 0.0, 0.0]\nv_cn_n_m_s = [0.0, {:?}, {:?}]\n\
+         sigma_bn = [0.1, -0.2, 0.3]\nomega_bn_b_rad_s = [0.15, -0.2, 0.1]",
         v * 0.98,
         v * 0.2
     );
-    SimConfig::from_toml_str(&toml)
-        .unwrap()
-        .build_spacecraft()
-        .unwrap()
+    rigid_hub(
+        MU_EARTH,
+        [300.0, 250.0, 180.0],
+        [0.2, -0.1, 0.3],
+        &initial,
+        step_s,
+    )
 }
 
 /// Work done by a wrapped effector: Σ over steps of h/6 (P₁ + 2P₂ + 2P₃ + P₄), P = F·v_B + τ·ω
