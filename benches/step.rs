@@ -276,9 +276,15 @@ fn environment_summary(pair_ns: f64) {
         median_ns_per_step(spacecraft_with_gravity_gradient()),
     )];
     println!("\nrk4_step with dynamic effectors, 2 pairs (median of 31 batches x 20000 steps):");
+    print_added_cost("effector", base, &rows, pair_ns);
+}
+
+/// One row per configuration: its median ns per step, what it adds to `base`, and that as a
+/// multiple of one panel pair (`pair_ns`).
+fn print_added_cost(label: &str, base: f64, rows: &[(&str, f64)], pair_ns: f64) {
     println!(
         "{:<18} {:>14} {:>12} {:>16}",
-        "effector", "median ns/step", "added ns", "x one panel pair"
+        label, "median ns/step", "added ns", "x one panel pair"
     );
     println!("{:<18} {:>14.1} {:>12} {:>16}", "none", base, "-", "-");
     for (name, ns) in rows {
@@ -365,22 +371,12 @@ fn world_summary(pair_ns: f64) {
         ("all @ 10 Hz", all.to_string()),
     ];
     let base = median_ns_per_sim_step(leo_simulation(""));
+    let measured: Vec<(&str, f64)> = rows
+        .iter()
+        .map(|(name, env)| (*name, median_ns_per_sim_step(leo_simulation(env))))
+        .collect();
     println!("\nSimulation::step in scenarios/leo_environment.toml, 2 pairs (median of 15 x 5000 steps):");
-    println!(
-        "{:<18} {:>14} {:>12} {:>16}",
-        "environment", "median ns/step", "added ns", "x one panel pair"
-    );
-    println!("{:<18} {:>14.1} {:>12} {:>16}", "none", base, "-", "-");
-    for (name, env) in rows {
-        let ns = median_ns_per_sim_step(leo_simulation(&env));
-        println!(
-            "{:<18} {:>14.1} {:>12.1} {:>16.3}",
-            name,
-            ns,
-            ns - base,
-            (ns - base) / pair_ns
-        );
-    }
+    print_added_cost("environment", base, &measured, pair_ns);
 }
 
 fn main() {
