@@ -163,32 +163,53 @@ impl Facet {
         if speed == 0.0 {
             return Vector3::zeros();
         }
-        let v_hat = v_rel_b_m_s / speed;
-        let cos_theta = self.normal_b.dot(&v_hat);
-        if cos_theta <= 0.0 {
-            return Vector3::zeros();
-        }
-        -0.5 * density_kg_m3
-            * self.drag_coefficient
-            * self.area_m2
-            * speed
-            * speed
-            * cos_theta
-            * v_hat
+        self.drag_force_facing(&(v_rel_b_m_s / speed), speed, density_kg_m3)
+            .unwrap_or_else(Vector3::zeros)
+    }
+
+    /// The drag force for the flow direction `v_hat` (unit) and speed `speed_m_s` > 0, or `None`
+    /// when the facet faces away. The model computes the speed and direction once for all its
+    /// facets; the product is evaluated in the same order as ever, so the force is the same to
+    /// the bit.
+    fn drag_force_facing(
+        &self,
+        v_hat: &Vector3<f64>,
+        speed_m_s: f64,
+        density_kg_m3: f64,
+    ) -> Option<Vector3<f64>> {
+        let cos_theta = self.normal_b.dot(v_hat);
+        (cos_theta > 0.0).then(|| {
+            -0.5 * density_kg_m3
+                * self.drag_coefficient
+                * self.area_m2
+                * speed_m_s
+                * speed_m_s
+                * cos_theta
+                * v_hat
+        })
     }
 
     /// \[N\] this facet's SRP force for the unit vector to the Sun `sun_hat_b` and the radiation
     /// pressure `pressure_n_m2` [N/m²]; zero when the facet faces away from the Sun.
     pub fn srp_force_b_newton(&self, sun_hat_b: &Vector3<f64>, pressure_n_m2: f64) -> Vector3<f64> {
+        self.srp_force_facing(sun_hat_b, pressure_n_m2)
+            .unwrap_or_else(Vector3::zeros)
+    }
+
+    /// The SRP force, or `None` when the facet faces away from the Sun.
+    fn srp_force_facing(
+        &self,
+        sun_hat_b: &Vector3<f64>,
+        pressure_n_m2: f64,
+    ) -> Option<Vector3<f64>> {
         let cos_theta = self.normal_b.dot(sun_hat_b);
-        if cos_theta <= 0.0 {
-            return Vector3::zeros();
-        }
-        -pressure_n_m2
-            * self.area_m2
-            * cos_theta
-            * ((self.absorbed + self.diffuse) * sun_hat_b
-                + (2.0 * self.specular * cos_theta + 2.0 / 3.0 * self.diffuse) * self.normal_b)
+        (cos_theta > 0.0).then(|| {
+            -pressure_n_m2
+                * self.area_m2
+                * cos_theta
+                * ((self.absorbed + self.diffuse) * sun_hat_b
+                    + (2.0 * self.specular * cos_theta + 2.0 / 3.0 * self.diffuse) * self.normal_b)
+        })
     }
 }
 
@@ -216,7 +237,12 @@ impl FacetModel {
     /// about B, for the velocity of B relative to the air `v_rel_b_m_s` [m/s] (B components) and
     /// the density `density_kg_m3`. Allocation-free and panic-free.
     pub fn drag_wrench_b(&self, v_rel_b_m_s: &Vector3<f64>, density_kg_m3: f64) -> FacetWrench {
-        self.sum(|f| f.drag_force_b_newton(v_rel_b_m_s, density_kg_m3))
+        let speed_m_s = v_rel_b_m_s.norm();
+        if speed_m_s == 0.0 {
+            return FacetWrench::default();
+        }
+        let v_hat = v_rel_b_m_s / speed_m_s;
+        self.sum(|f| f.drag_force_facing(&v_hat, speed_m_s, density_kg_m3))
     }
 
     /// Solar radiation pressure on the whole model for the direction from the spacecraft to the
@@ -229,15 +255,18 @@ impl FacetModel {
             return FacetWrench::default();
         }
         let sun_hat_b = sun_dir_b / norm;
-        self.sum(|f| f.srp_force_b_newton(&sun_hat_b, pressure_n_m2))
+        self.sum(|f| f.srp_force_facing(&sun_hat_b, pressure_n_m2))
     }
 
-    fn sum(&self, force_of: impl Fn(&Facet) -> Vector3<f64>) -> FacetWrench {
+    /// The sum of the forces of the facets that face the flow or the Sun, and of their moments
+    /// about B (a facet facing away adds nothing, not even a zero cross product).
+    fn sum(&self, force_of: impl Fn(&Facet) -> Option<Vector3<f64>>) -> FacetWrench {
         let mut w = FacetWrench::default();
         for facet in &self.facets {
-            let force = force_of(facet);
-            w.force_b_newton += force;
-            w.torque_b_nm += facet.r_cp_b_m.cross(&force);
+            if let Some(force) = force_of(facet) {
+                w.force_b_newton += force;
+                w.torque_b_nm += facet.r_cp_b_m.cross(&force);
+            }
         }
         w
     }
