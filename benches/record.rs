@@ -138,6 +138,7 @@ fn main() {
         server_settings: String::new(),
         flexdyn_version: "bench".into(),
         git_commit: None,
+        epoch_utc: None,
     };
     println!(
         "recorder throughput: {} samples ({:.1} MB of payload, {FRAMES} frames of the wheel \

@@ -305,7 +305,13 @@ pub fn simulate_to<W: Write>(
     .into_iter()
     .map(|(name, _)| name)
     .collect();
-    let mut table = CsvTable::new(out, &columns).map_err(io_err)?;
+    // What t_s = 0 is, when the configuration has an [epoch].
+    let comments: Vec<String> = cfg
+        .epoch
+        .iter()
+        .map(|e| format!("epoch_utc={}", e.utc_iso()))
+        .collect();
+    let mut table = CsvTable::with_comments(out, &comments, &columns).map_err(io_err)?;
 
     let n_logged = total_steps / log_steps;
     let mut step = 0u64;

@@ -104,6 +104,7 @@ impl Endpoints {
             server_settings: settings.summary(),
             flexdyn_version: flexdyn_version().to_owned(),
             git_commit: git_commit().map(str::to_owned),
+            epoch_utc: cfg.epoch.as_ref().map(|e| e.utc_iso()),
         };
         Ok(Self {
             state_pub,

@@ -66,12 +66,22 @@ pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
         );
     }
     // Pass 2: rows, through the one CSV writer.
+    let epochs: HashMap<String, String> = rec
+        .vehicles()
+        .into_iter()
+        .filter_map(|v| Some((v.sc_id, v.epoch_utc?)))
+        .collect();
     let mut tables = BTreeMap::new();
     let mut report = ExportReport::new();
     for (key, names) in &columns {
         let path = args.csv.join(format!("{}.csv", key.replace('/', "_")));
         let f = std::fs::File::create(&path).map_err(|e| out_err(&path, e))?;
-        let table = CsvTable::new(f, names).map_err(|e| out_err(&path, e))?;
+        // What t_s = 0 is, when the vehicle's configuration has an [epoch].
+        let comments: Vec<String> = classify(key)
+            .and_then(|t| epochs.get(t.sc_id))
+            .map(|e| vec![format!("epoch_utc={e}")])
+            .unwrap_or_default();
+        let table = CsvTable::with_comments(f, &comments, names).map_err(|e| out_err(&path, e))?;
         tables.insert(key.clone(), (path.clone(), table));
         report.insert(path, 0);
     }

@@ -80,6 +80,11 @@ pub struct VehicleInfo {
     pub flexdyn_version: String,
     /// The server's git commit, when known.
     pub git_commit: Option<String>,
+    /// The configuration's `[epoch]` in UTC, ISO 8601 with nanoseconds
+    /// (`2026-11-24T06:00:00.000000000Z`): simulation time 0. `None` without an `[epoch]`
+    /// (and in recordings made before it was written).
+    #[serde(default)]
+    pub epoch_utc: Option<String>,
 }
 
 impl VehicleInfo {
@@ -102,6 +107,9 @@ impl VehicleInfo {
                 .clone()
                 .unwrap_or_else(|| "unknown".to_owned()),
         );
+        if let Some(epoch) = &self.epoch_utc {
+            meta.insert("epoch_utc".to_owned(), epoch.clone());
+        }
         meta
     }
 
@@ -120,6 +128,7 @@ impl VehicleInfo {
             server_settings: get("server_settings")?,
             flexdyn_version: get("flexdyn_version")?,
             git_commit: get("git_commit").filter(|c| c != "unknown"),
+            epoch_utc: get("epoch_utc"),
         })
     }
 }

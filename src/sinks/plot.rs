@@ -214,7 +214,8 @@ fn sensor_column<'a>(
 fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
     let text =
         std::fs::read_to_string(path).map_err(|e| input_err(path, format!("cannot read: {e}")))?;
-    let mut lines = text.lines();
+    // Leading `# key=value` comments (the epoch) precede the header.
+    let mut lines = text.lines().skip_while(|l| l.starts_with('#'));
     let header: Vec<&str> = lines
         .next()
         .ok_or_else(|| input_err(path, "empty file"))?

@@ -282,7 +282,17 @@ pub struct CsvTable<W: Write> {
 impl<W: Write> CsvTable<W> {
     /// Writes the header (`columns` in order; names are unique) and returns the table.
     pub fn new(out: W, columns: &[String]) -> io::Result<Self> {
+        Self::with_comments(out, &[], columns)
+    }
+
+    /// As [`Self::new`], after one `# <comment>` line per comment (e.g. `epoch_utc=…`, what
+    /// `t_s = 0` is). Readers skip the leading `#` lines (`flexdyn plot` does; pandas:
+    /// `comment="#"`).
+    pub fn with_comments(out: W, comments: &[String], columns: &[String]) -> io::Result<Self> {
         let mut out = io::BufWriter::new(out);
+        for c in comments {
+            writeln!(out, "# {c}")?;
+        }
         writeln!(out, "{}", columns.join(","))?;
         Ok(Self {
             out,
