@@ -72,19 +72,7 @@ impl Simulation {
                 &format!("star_trackers[{i}]"),
             )?);
         }
-        let environment = match (&cfg.environment, &cfg.epoch) {
-            // Only models that read the date fill a sample (the gravity gradient reads none).
-            (Some(env), Some(epoch)) if env.needs_epoch() => {
-                Some(EnvironmentModel::new(env, epoch).map_err(|e| {
-                    crate::config::ConfigError::Invalid {
-                        field: "environment".into(),
-                        problem: e.to_string(),
-                        at: Default::default(),
-                    }
-                })?)
-            }
-            _ => None,
-        };
+        let environment = cfg.environment_model()?;
         let mut sim = Self {
             environment,
             inputs: vec![0.0; sc.effector_input_len()],

@@ -485,3 +485,91 @@ fn errors_start_with_the_file_that_holds_the_field() {
     assert!(e.starts_with(&head), "{e}");
     assert!(e.contains("(line 1, column 8)"), "{e}");
 }
+
+/// The environment's parameters (issue 19: Cd, facet areas, residual dipole, F10.7, epoch
+/// offset) are dispersed and read back from the built model like the spacecraft's: the drag
+/// and solar-pressure effectors report their facets, the residual-dipole effector its moment,
+/// NRLMSISE-00 its space weather and the epoch its offset.
+#[test]
+fn environment_parameters_are_dispersed_and_read_back_from_the_model() {
+    let base = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/leo_environment.toml");
+    // 20 days keep the OMM within its 30-day element age.
+    let offset_max_s = 20.0 * 86_400.0;
+    let plan = campaign(&format!(
+        "base = {:?}\nruns = 300\nseed = 11\nduration_s = 1.0\n
+        [[dispersions]]
+        key = \"environment.facets[*].drag_coefficient\"
+        distribution = \"uniform\"
+        low = 2.0
+        high = 2.4
+        [[dispersions]]
+        key = \"environment.facets[0].area_m2\"
+        distribution = \"normal\"
+        sigma = 0.2
+        [[dispersions]]
+        key = \"environment.residual_dipole_m_b_am2\"
+        distribution = \"normal\"
+        sigma = 0.05
+        [[dispersions]]
+        key = \"environment.f107_sfu\"
+        distribution = \"uniform\"
+        low = 70.0
+        high = 250.0
+        [[dispersions]]
+        key = \"epoch.offset_s\"
+        distribution = \"uniform\"
+        low = 0.0
+        high = {offset_max_s:?}
+        ",
+        base.display().to_string()
+    ))
+    .unwrap();
+    let n = 300;
+    let (mut f107, mut offset, mut cd0, mut area0) = (vec![], vec![], vec![], vec![]);
+    for r in 0..n {
+        let rp = plan.run(r);
+        assert!(rp.valid, "run {r}: {:?}", rp.redraw_reasons);
+        let model = readback(&SimConfig::from_toml_str(&rp.config_toml).unwrap()).unwrap();
+        for (key, written) in &rp.dispersed {
+            // The epoch is held in whole nanoseconds: ½ ns of rounding, then a few ulps of the
+            // seconds it is read back in.
+            let tol = if key == "epoch.offset_s" {
+                0.5e-9 + 4.0 * f64::EPSILON * written.abs()
+            } else {
+                0.0
+            };
+            assert!(
+                (model[key] - written).abs() <= tol,
+                "run {r}: {key} read back {} but {written} was drawn",
+                model[key]
+            );
+        }
+        f107.push(model["environment.f107_sfu"]);
+        offset.push(model["epoch.offset_s"]);
+        cd0.push(model["environment.facets[0].drag_coefficient"]);
+        area0.push(model["environment.facets[0].area_m2"]);
+        // Untouched: the 81-day mean, the other facets' areas.
+        assert_eq!(model["environment.f107a_sfu"], 150.0);
+        assert_eq!(model["environment.facets[1].area_m2"], 4.0);
+    }
+    let nf = n as f64;
+    let uniform = |name: &str, x: &[f64], a: f64, b: f64| {
+        assert!(
+            x.iter().all(|v| (a..b).contains(v)),
+            "{name}: outside [{a}, {b})"
+        );
+        let var = (b - a).powi(2) / 12.0;
+        let mu4 = (b - a).powi(4) / 80.0;
+        check(name, x, 0.5 * (a + b), var, ((mu4 - var * var) / nf).sqrt());
+    };
+    uniform("F10.7 ~ U(70, 250)", &f107, 70.0, 250.0);
+    uniform("epoch offset ~ U(0, 20 d)", &offset, 0.0, offset_max_s);
+    uniform("facet 0 Cd ~ U(2.0, 2.4)", &cd0, 2.0, 2.4);
+    check(
+        "facet 0 area ~ N(4, 0.2)",
+        &area0,
+        4.0,
+        0.04,
+        0.04 * (2.0 / (nf - 1.0)).sqrt(),
+    );
+}

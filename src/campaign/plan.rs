@@ -15,7 +15,8 @@
 //!
 //! # Read-back
 //! A dispersion key must name parameters the built model reports (hub, initial state, panel
-//! pairs, reaction wheels; see [`readback`]). Any other key is an error at load time, so a
+//! pairs, reaction wheels, environment facets, residual dipole, space weather, epoch offset;
+//! see [`readback`]). Any other key is an error at load time, so a
 //! dispersion can never be silently ignored; `result.json` then holds the values read back from
 //! each run's built model, not from its file.
 
@@ -52,8 +53,10 @@ pub fn run_seed(master: u64, run: u32) -> u64 {
 
 /// Every numeric parameter of the model built from `cfg`, by configuration path: the hub, the
 /// initial state (`initial.sigma_bn[i]`, `initial.omega_bn_b_rad_s[i]`, `initial.r_bn_n_m[i]`,
-/// `initial.v_bn_n_m_s[i]`), and each effector's [`crate::dynamics::StateEffector::parameters`]
-/// under `panel_pairs[k].` or `reaction_wheels[k].`.
+/// `initial.v_bn_n_m_s[i]`), each effector's [`crate::dynamics::StateEffector::parameters`]
+/// under `panel_pairs[k].` or `reaction_wheels[k].`, each dynamic effector's
+/// [`crate::dynamics::DynamicEffector::parameters`] (facets, residual dipole), the environment
+/// models' (space weather) and the epoch's `epoch.offset_s`.
 pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config::ConfigError> {
     let sc = cfg.build_spacecraft()?;
     let mut out = BTreeMap::new();
@@ -91,6 +94,17 @@ pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config:
         }
         *k += 1;
     }
+    let mut params = Vec::new();
+    for d in sc.dynamic_effectors() {
+        d.parameters(&mut params);
+    }
+    if let Some(epoch) = &cfg.epoch {
+        params.push(("epoch.offset_s".to_owned(), epoch.offset_s()));
+    }
+    if let Some(env) = cfg.environment_model()? {
+        env.parameters(&mut params);
+    }
+    out.extend(params);
     Ok(out)
 }
 
@@ -149,7 +163,8 @@ impl Plan {
                         &field,
                         format!(
                             "{k} is not a parameter the built model reports (the hub, initial \
-                             state, panel pairs and reaction wheels are), so its dispersion \
+                             state, panel pairs, reaction wheels, facets, residual dipole, space \
+                             weather and epoch offset are), so its dispersion \
                              could not be verified; it is refused rather than risk a silent \
                              no-op"
                         ),

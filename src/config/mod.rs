@@ -188,6 +188,25 @@ impl SimConfig {
         }
         Ok(sc)
     }
+
+    /// The environment models of `[environment]` for the `[epoch]`, when some model reads the
+    /// date (the gravity gradient alone reads none: `None`, as without `[environment]`).
+    pub fn environment_model(
+        &self,
+    ) -> Result<Option<crate::environment::model::EnvironmentModel>, ConfigError> {
+        match (&self.environment, &self.epoch) {
+            (Some(env), Some(epoch)) if env.needs_epoch() => {
+                crate::environment::model::EnvironmentModel::new(env, epoch)
+                    .map(Some)
+                    .map_err(|e| ConfigError::Invalid {
+                        field: "environment".into(),
+                        problem: e.to_string(),
+                        at: Default::default(),
+                    })
+            }
+            _ => Ok(None),
+        }
+    }
 }
 
 /// Short name of a gravity model, as in the configuration file.

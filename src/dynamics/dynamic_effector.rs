@@ -94,4 +94,8 @@ pub trait DynamicEffector: Send + std::fmt::Debug {
     /// Adds this effector's force (applied at B) and torque (about B), both in B components, at
     /// the stage `stage` in the environment `env`, into `sum`.
     fn add_force_torque(&mut self, stage: &StageState, env: &EnvironmentSample, sum: &mut Wrench);
+    /// Every numeric parameter of the built model, keyed by its full configuration path
+    /// (`environment.facets[0].area_m2`). A campaign reads dispersed values back from here, not
+    /// from the file. Not on the stepping path.
+    fn parameters(&self, _out: &mut Vec<(String, f64)>) {}
 }

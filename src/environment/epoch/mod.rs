@@ -124,6 +124,16 @@ pub enum EpochError {
         /// The text given.
         value: String,
     },
+    /// `offset_s` not finite, too large, or moving the epoch out of the span.
+    #[error("{field}: {message} (got {value})")]
+    Offset {
+        /// Field path.
+        field: String,
+        /// \[s\] the offset given.
+        value: f64,
+        /// The allowed range and why.
+        message: String,
+    },
     /// An Earth orientation parameter out of range or not finite.
     #[error("{field}: {message} (got {value})")]
     EarthOrientation {
@@ -154,7 +164,12 @@ pub struct SimEpoch {
     j2000_count_ns: i64,
     eop: EarthOrientationParams,
     leap: LeapTable,
+    /// \[ns\] the shift `[epoch] offset_s` applied to the date-time written (0 without).
+    offset_ns: i64,
 }
+
+/// \[s\] the largest `[epoch] offset_s` magnitude: about a century, far inside i64 ns.
+pub const MAX_ABS_OFFSET_S: f64 = 3.2e9;
 
 /// The time scales at one instant, as [`SimEpoch::times`] derives them (integer where exact).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -356,20 +371,7 @@ impl SimEpoch {
             EpochScale::Tai => calendar_count_ns(cal).map_err(invalid)?,
             EpochScale::Utc => tai_of_utc(&leap, cal).map_err(invalid)?,
         };
-        // Span: 1972-01-01T00:00:00Z ..< 2100-01-01T00:00:00Z, as TAI counts.
-        let first = leap.first_utc_count_ns() + 10 * NS_PER_S;
-        let end_utc = calendar_count_ns(&CalendarTime {
-            year: 2100,
-            month: 1,
-            day: 1,
-            hour: 0,
-            minute: 0,
-            second: 0,
-            nanosecond: 0,
-        })
-        .map_err(invalid)?;
-        let end = end_utc + leap.delta_at_utc(end_utc) * NS_PER_S;
-        if tai_ns < first || tai_ns >= end {
+        if !in_span(&leap, tai_ns).map_err(invalid)? {
             return Err(EpochError::OutOfSpan {
                 field: field.to_string(),
                 value: text.to_string(),
@@ -378,6 +380,57 @@ impl SimEpoch {
         Self::from_tai_count(tai_ns, scale, eop, leap, field)
     }
 
+    /// The epoch moved by `offset_s` seconds (SI, along TAI), as `[epoch] offset_s` asks (a
+    /// campaign disperses it to move a run through the year: Sun angle, eclipse season). The
+    /// Earth orientation parameters are kept. `field` is the offset's configuration path.
+    pub fn offset_by(&self, offset_s: f64, field: &str) -> Result<Self, EpochError> {
+        let bad = |message: String| EpochError::Offset {
+            field: field.to_string(),
+            value: offset_s,
+            message,
+        };
+        if !offset_s.is_finite() || offset_s.abs() > MAX_ABS_OFFSET_S {
+            return Err(bad(format!(
+                "must be finite and within ±{MAX_ABS_OFFSET_S:e} s (about a century)"
+            )));
+        }
+        let offset_ns = (offset_s * 1e9).round() as i64;
+        let tai_ns = self.tai_ns - self.offset_ns + offset_ns;
+        if !in_span(&self.leap, tai_ns).map_err(bad)? {
+            return Err(bad(
+                "moves the epoch outside 1972-01-01T00:00:00Z to 2100-01-01T00:00:00Z".to_string(),
+            ));
+        }
+        let mut shifted =
+            Self::from_tai_count(tai_ns, self.scale, self.eop, self.leap.clone(), field)?;
+        shifted.offset_ns = offset_ns;
+        Ok(shifted)
+    }
+
+    /// \[s\] the `[epoch] offset_s` this epoch was moved by (0 without).
+    pub fn offset_s(&self) -> f64 {
+        self.offset_ns as f64 * 1e-9
+    }
+}
+
+/// Whether the TAI count `tai_ns` lies in the supported span 1972-01-01T00:00:00Z ..<
+/// 2100-01-01T00:00:00Z.
+fn in_span(leap: &LeapTable, tai_ns: i64) -> Result<bool, String> {
+    let first = leap.first_utc_count_ns() + 10 * NS_PER_S;
+    let end_utc = calendar_count_ns(&CalendarTime {
+        year: 2100,
+        month: 1,
+        day: 1,
+        hour: 0,
+        minute: 0,
+        second: 0,
+        nanosecond: 0,
+    })?;
+    let end = end_utc + leap.delta_at_utc(end_utc) * NS_PER_S;
+    Ok(tai_ns >= first && tai_ns < end)
+}
+
+impl SimEpoch {
     fn from_tai_count(
         tai_ns: i64,
         scale: EpochScale,
@@ -460,6 +513,7 @@ impl SimEpoch {
             j2000_count_ns,
             eop,
             leap,
+            offset_ns: 0,
         })
     }
 

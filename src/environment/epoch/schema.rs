@@ -7,6 +7,8 @@
 //! ut1_minus_utc_s = -0.0123        # optional, IERS Bulletin A; default 0 (UT1 ≈ UTC, ≤ 0.9 s)
 //! polar_motion_x_arcsec = 0.1234   # optional, IERS Bulletin A; default 0
 //! polar_motion_y_arcsec = 0.3456   # optional, IERS Bulletin A; default 0
+//! offset_s = 0.0                   # optional: seconds added to the date-time (SI, along TAI);
+//!                                  # a campaign disperses it to move a run through the year
 //! ```
 //!
 //! The date-time may be a TOML string or a bare TOML datetime; a UTC one ends with `Z`, a TAI
@@ -19,12 +21,13 @@ use super::{EarthOrientationParams, EpochError, EpochScale, SimEpoch, RAD_PER_AR
 use crate::schema::{SchemaError, TableReader};
 
 /// The keys of `[epoch]`.
-pub(crate) const KEYS: [&str; 5] = [
+pub(crate) const KEYS: [&str; 6] = [
     "utc",
     "tai",
     "ut1_minus_utc_s",
     "polar_motion_x_arcsec",
     "polar_motion_y_arcsec",
+    "offset_s",
 ];
 
 /// `[epoch]` as written.
@@ -42,6 +45,10 @@ pub struct RawEpoch {
     pub polar_motion_x_arcsec: f64,
     /// \[arcsec\] `polar_motion_y_arcsec` (0 if absent).
     pub polar_motion_y_arcsec: f64,
+    /// \[s\] `offset_s` (0 if absent).
+    pub offset_s: f64,
+    /// TOML path of `offset_s`.
+    pub offset_field: String,
 }
 
 /// A string or a TOML datetime at `key`, as text.
@@ -86,6 +93,8 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawEpoch, SchemaError> {
         ut1_minus_utc_s: t.opt_f64("ut1_minus_utc_s")?.unwrap_or(0.0),
         polar_motion_x_arcsec: t.opt_f64("polar_motion_x_arcsec")?.unwrap_or(0.0),
         polar_motion_y_arcsec: t.opt_f64("polar_motion_y_arcsec")?.unwrap_or(0.0),
+        offset_s: t.opt_f64("offset_s")?.unwrap_or(0.0),
+        offset_field: t.field("offset_s"),
     })
 }
 
@@ -97,7 +106,11 @@ impl RawEpoch {
             polar_motion_x_rad: self.polar_motion_x_arcsec * RAD_PER_ARCSEC,
             polar_motion_y_rad: self.polar_motion_y_arcsec * RAD_PER_ARCSEC,
         };
-        SimEpoch::parse(&self.text, self.scale, eop, &self.field)
+        let epoch = SimEpoch::parse(&self.text, self.scale, eop, &self.field)?;
+        if self.offset_s == 0.0 {
+            return Ok(epoch);
+        }
+        epoch.offset_by(self.offset_s, &self.offset_field)
     }
 }
 
@@ -120,6 +133,32 @@ mod tests {
         let c = read_str("[epoch]\ntai = 2026-03-20T12:00:37\nut1_minus_utc_s = 0.1\n").unwrap();
         assert_eq!(c.field, "epoch.tai");
         assert_eq!(c.build().unwrap().tai_ns(0), a.build().unwrap().tai_ns(0));
+    }
+
+    #[test]
+    fn offset_moves_the_epoch_and_bad_offsets_name_the_field() {
+        let base = read_str("[epoch]\nutc = \"2026-03-20T12:00:00Z\"\n").unwrap();
+        let day = read_str("[epoch]\nutc = \"2026-03-20T12:00:00Z\"\noffset_s = 86400.5\n")
+            .unwrap()
+            .build()
+            .unwrap();
+        assert_eq!(
+            day.tai_ns(0) - base.build().unwrap().tai_ns(0),
+            86_400_500_000_000
+        );
+        assert_eq!(day.offset_s(), 86400.5);
+        assert_eq!(day.utc_iso(), "2026-03-21T12:00:00.500000000Z");
+        for (offset, problem) in [("1e10", "within ±3.2e9 s"), ("-2e9", "outside 1972-01-01")] {
+            let e = read_str(&format!(
+                "[epoch]\nutc = \"2026-03-20T12:00:00Z\"\noffset_s = {offset}\n"
+            ))
+            .unwrap()
+            .build()
+            .unwrap_err()
+            .to_string();
+            assert!(e.starts_with("epoch.offset_s: "), "{e}");
+            assert!(e.contains(problem), "{e}");
+        }
     }
 
     #[test]

@@ -233,6 +233,23 @@ impl FacetModel {
         &self.facets
     }
 
+    /// Every facet's numbers under `environment.facets[k].` (their configuration paths), for a
+    /// campaign's read-back.
+    pub fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        for (k, f) in self.facets.iter().enumerate() {
+            let key = |name: &str| format!("environment.facets[{k}].{name}");
+            out.push((key("area_m2"), f.area_m2));
+            out.push((key("drag_coefficient"), f.drag_coefficient));
+            out.push((key("absorbed"), f.absorbed));
+            out.push((key("specular"), f.specular));
+            out.push((key("diffuse"), f.diffuse));
+            for i in 0..3 {
+                out.push((format!("{}[{i}]", key("normal_b")), f.normal_b[i]));
+                out.push((format!("{}[{i}]", key("r_cp_b_m")), f.r_cp_b_m[i]));
+            }
+        }
+    }
+
     /// Drag on the whole model: the sum of the facet forces, applied at B, and of their moments
     /// about B, for the velocity of B relative to the air `v_rel_b_m_s` [m/s] (B components) and
     /// the density `density_kg_m3`. Allocation-free and panic-free.

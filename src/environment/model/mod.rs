@@ -194,6 +194,18 @@ impl EnvironmentModel {
         &self.epoch
     }
 
+    /// The numeric parameters of the built models, by configuration path
+    /// (`environment.f107_sfu`, `environment.f107a_sfu`, `environment.ap` with NRLMSISE-00), for
+    /// a campaign's read-back. Not on the stepping path.
+    pub fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        if let Air::Nrlmsise00(m) = &self.air {
+            let w = m.weather();
+            out.push(("environment.f107_sfu".into(), w.f107_sfu));
+            out.push(("environment.f107a_sfu".into(), w.f107a_sfu));
+            out.push(("environment.ap".into(), w.ap));
+        }
+    }
+
     /// The sample last filled by [`Self::update_if_due`].
     pub fn sample(&self) -> &EnvironmentSample {
         &self.sample

@@ -46,4 +46,8 @@ impl DynamicEffector for AeroDrag {
         sum.force_b_newton += w.force_b_newton;
         sum.torque_b_nm += w.torque_b_nm;
     }
+
+    fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        self.facets.parameters(out);
+    }
 }

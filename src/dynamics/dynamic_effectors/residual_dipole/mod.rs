@@ -33,4 +33,13 @@ impl DynamicEffector for ResidualDipole {
         let b_b_t = stage.dcm_bn * env.b_field_n_t;
         sum.torque_b_nm += dipole_torque_b_nm(&self.m_b_am2, &b_b_t);
     }
+
+    fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        for i in 0..3 {
+            out.push((
+                format!("environment.residual_dipole_m_b_am2[{i}]"),
+                self.m_b_am2[i],
+            ));
+        }
+    }
 }
