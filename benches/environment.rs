@@ -21,8 +21,8 @@ use criterion::Criterion;
 use flexdyn::dynamics::{GravityModel, Spacecraft};
 use flexdyn::environment::atmosphere::{
     exponential_density_kg_m3, velocity_relative_to_air_n_m_s, Nrlmsise00Model, SpaceWeather,
-    EARTH_ROTATION_RATE_RAD_S,
 };
+use flexdyn::environment::earth_rotation::OMEGA_EARTH_RAD_S;
 use flexdyn::environment::ephemeris::{moon_position_n_m, sun_position_n_m};
 use flexdyn::environment::facets::{solar_pressure_n_m2, Facet, FacetModel};
 use flexdyn::environment::geodetic::geodetic_from_ecef;
@@ -82,7 +82,7 @@ fn models() -> Vec<Model> {
     .expect("space weather");
     let facets = hub_facets();
     let facets_srp = facets.clone();
-    let omega = Vector3::new(0.0, 0.0, EARTH_ROTATION_RATE_RAD_S);
+    let omega = Vector3::new(0.0, 0.0, OMEGA_EARTH_RAD_S);
     let sun = sun_position_n_m(0.25);
     let per_stage = 4.0;
     vec![

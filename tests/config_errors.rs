@@ -992,6 +992,13 @@ fn cases() -> Vec<Case> {
             "wrench_schedule[1].t_s",
             &["strictly increasing"],
         ),
+        // The previous row's time in its shortest form: 0.3 s, not 0.30000000000000004 s
+        // (3e8 ns × 1e-9 rounds up; 3e8 / 1e9 is the nearest double to 0.3).
+        bad_wrenches(
+            &[(0.3, Z, Z), (0.2, Z, Z)],
+            "wrench_schedule[1].t_s",
+            &["t_s = 0.2 s is not after the previous row's (0.3 s)"],
+        ),
         bad_wrenches(&[(-1.0, Z, Z)], "wrench_schedule[0].t_s", &["must be >= 0"]),
         bad_wrenches(
             &[(0.0015, Z, Z)],

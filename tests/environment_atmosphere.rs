@@ -7,8 +7,9 @@
 
 use flexdyn::environment::atmosphere::{
     exponential_density_kg_m3, velocity_relative_to_air_n_m_s, AtmosphereError, Nrlmsise00Model,
-    SpaceWeather, EARTH_ROTATION_RATE_RAD_S, VALLADO_TABLE_8_4,
+    SpaceWeather, VALLADO_TABLE_8_4,
 };
+use flexdyn::environment::earth_rotation::OMEGA_EARTH_RAD_S;
 use flexdyn::environment::geodetic::{ecef_from_geodetic, Geodetic};
 use nalgebra::Vector3;
 
@@ -321,11 +322,12 @@ fn validate_exponential_bands_meet_at_their_boundaries() {
 
 #[test]
 fn validate_corotating_wind() {
-    let omega = Vector3::new(0.0, 0.0, EARTH_ROTATION_RATE_RAD_S);
+    let omega = Vector3::new(0.0, 0.0, OMEGA_EARTH_RAD_S);
     // A point moving with the Earth feels no wind.
     let r = Vector3::new(4.0e6, 5.0e6, 2.0e6);
     assert!(velocity_relative_to_air_n_m_s(&r, &omega.cross(&r), &omega).norm() < 1e-12);
-    // Prograde equatorial circular orbit at 7000 km: the air moves 510.4 m/s the same way.
+    // Prograde equatorial circular orbit at 7000 km: the air moves ω⊕ r = 510.448 m/s the same
+    // way (7.292115e-5 rad/s, WGS-84, × 7e6 m; the model's IERS rate differs by 2e-8).
     let v = (3.986_004_418e14_f64 / 7.0e6).sqrt();
     let rel = velocity_relative_to_air_n_m_s(
         &Vector3::new(7.0e6, 0.0, 0.0),

@@ -87,7 +87,7 @@ pub(super) fn row_time_ns(
             format!(
                 "t_s = {} s is not after the previous row's ({} s): t_s must be strictly increasing",
                 Num(t_s),
-                Num(prev as f64 * 1e-9)
+                Num(prev as f64 / 1e9)
             ),
         ));
     }

@@ -19,7 +19,7 @@ pub use exponential::{exponential_density_kg_m3, ExponentialBand, VALLADO_TABLE_
 pub use nrlmsise::{
     AtmosphereState, Composition, Nrlmsise00Model, SpaceWeather, LOWEST_THERMOSPHERE_ALTITUDE_M,
 };
-pub use wind::{corotation_wind_n_m_s, velocity_relative_to_air_n_m_s, EARTH_ROTATION_RATE_RAD_S};
+pub use wind::{corotation_wind_n_m_s, velocity_relative_to_air_n_m_s};
 
 /// An invalid atmosphere parameter. Every variant names the field.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -3,16 +3,12 @@
 //! Applications*, 4th ed., §8.6.2; Montenbruck & Gill, *Satellite Orbits*, §3.5.2).
 //!
 //! The Earth's angular velocity is an argument so that the caller can pass the true pole from its
-//! Earth-rotation model; `[0, 0, EARTH_ROTATION_RATE_RAD_S]` in N neglects precession and
+//! Earth-rotation model; `[0, 0, OMEGA_EARTH_RAD_S]` in N neglects precession and
 //! nutation of the pole (0.3° in 2025), an error of 2 m/s in a 7.7 km/s relative wind (3e-4).
 //! Winds relative to the co-rotating atmosphere (up to a few hundred m/s in the thermosphere) are
 //! not modelled.
 
 use nalgebra::Vector3;
-
-/// [rad/s] the Earth's nominal mean angular velocity ω⊕ (WGS-84, NIMA TR8350.2 Table 3.1; the
-/// IERS Conventions 2010 value).
-pub const EARTH_ROTATION_RATE_RAD_S: f64 = 7.292_115e-5;
 
 /// [m/s] the velocity of the co-rotating atmosphere at `r_n_m` [m], ω⊕ × r, in the frame of the
 /// arguments (N, with `omega_earth_n_rad_s` the Earth's angular velocity in N).
