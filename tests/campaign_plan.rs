@@ -573,3 +573,49 @@ fn environment_parameters_are_dispersed_and_read_back_from_the_model() {
         0.04 * (2.0 / (nf - 1.0)).sqrt(),
     );
 }
+
+/// A base whose orbit comes from a file next to it (`elements_file = "sat.omm"`) plans from any
+/// working directory, and each run's config.toml stands alone: the elements are inlined, so a
+/// server reading it from the run's folder finds them.
+#[test]
+fn a_relative_elements_file_is_found_and_inlined_into_each_run() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut leo: toml::Table =
+        std::fs::read_to_string(root.join("scenarios/leo_environment.toml"))
+            .unwrap()
+            .parse()
+            .unwrap();
+    let orbit = leo["orbit"].as_table_mut().unwrap();
+    let omm = orbit.remove("elements").unwrap();
+    let omm = omm.as_str().unwrap().to_owned();
+    orbit.insert("elements_file".into(), "sat.omm".into());
+    let dir = std::env::temp_dir().join(format!("flexdyn-elements-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("sat.omm"), &omm).unwrap();
+    std::fs::write(dir.join("base.toml"), toml::to_string(&leo).unwrap()).unwrap();
+    // The campaign file sits elsewhere; its `base` is an absolute path into `dir`.
+    let plan = campaign(&format!(
+        "base = {:?}\nruns = 2\nseed = 3\nduration_s = 1.0\n
+        [[dispersions]]
+        key = \"environment.f107_sfu\"
+        distribution = \"uniform\"
+        low = 100.0
+        high = 200.0
+        ",
+        dir.join("base.toml").display().to_string()
+    ))
+    .unwrap();
+    let rp = plan.run(1);
+    assert!(rp.valid, "{:?}", rp.redraw_reasons);
+    let run: toml::Table = rp.config_toml.parse().unwrap();
+    assert_eq!(run["orbit"].get("elements_file"), None);
+    assert_eq!(run["orbit"]["elements"].as_str(), Some(omm.as_str()));
+    // Read as a server reads it (relative paths against the run's own folder, here nowhere).
+    let cfg = SimConfig::from_toml_str_in(&rp.config_toml, Path::new("/nonexistent")).unwrap();
+    let direct = SimConfig::from_toml_str(
+        &std::fs::read_to_string(root.join("scenarios/leo_environment.toml")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(cfg.initial.translation, direct.initial.translation);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

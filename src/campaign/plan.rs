@@ -108,6 +108,21 @@ pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config:
     Ok(out)
 }
 
+/// Replaces `orbit.elements_file` (relative to `base_dir`) by `orbit.elements`, the file's text.
+fn inline_elements_file(doc: &mut Table, base_dir: &Path) -> Result<(), String> {
+    let Some(toml::Value::Table(orbit)) = doc.get_mut("orbit") else {
+        return Ok(());
+    };
+    let Some(toml::Value::String(file)) = orbit.remove("elements_file") else {
+        return Ok(());
+    };
+    let path = base_dir.join(&file);
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| format!("orbit.elements_file: cannot read {}: {e}", path.display()))?;
+    orbit.insert("elements".into(), toml::Value::String(text));
+    Ok(())
+}
+
 /// One planned run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunPlan {
@@ -147,10 +162,14 @@ impl Plan {
     /// Resolves every dispersion key against the base configuration and its built model.
     pub fn new(campaign: Campaign) -> Result<Self, CampaignError> {
         // Dispersion keys are the campaign file's fields; a bad base is the base file's.
-        let base: Table = toml::from_str(&campaign.base_toml)
+        let mut base: Table = toml::from_str(&campaign.base_toml)
             .map_err(|e| campaign.invalid("base", format!("not a TOML table: {e}")))?;
-        let cfg =
-            SimConfig::from_toml_str(&campaign.base_toml).map_err(|e| campaign.base_error(e))?;
+        let base_dir = campaign.base_dir();
+        let cfg = SimConfig::from_toml_str_in(&campaign.base_toml, &base_dir)
+            .map_err(|e| campaign.base_error(e))?;
+        // Each run's config.toml must stand alone (it is read from its own folder, by a server
+        // started anywhere): a relative `orbit.elements_file` becomes the elements themselves.
+        inline_elements_file(&mut base, &base_dir).map_err(|e| campaign.invalid("base", e))?;
         let model = readback(&cfg).map_err(|e| campaign.base_error(e))?;
         let mut all_keys = Vec::new();
         for (i, d) in campaign.dispersions.iter().enumerate() {

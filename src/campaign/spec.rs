@@ -236,6 +236,15 @@ const ROOT_KEYS: &[&str] = &[
 const DEFAULT_PARTICIPANT_TIMEOUT_S: f64 = 5.0;
 
 impl Campaign {
+    /// The folder relative paths in the base configuration are resolved against (its file's;
+    /// the working directory for the embedded default).
+    pub fn base_dir(&self) -> PathBuf {
+        self.base_path
+            .as_deref()
+            .and_then(Path::parent)
+            .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+    }
+
     /// Reads and validates `path`. Dispersion keys are checked against the base configuration
     /// later, by [`super::plan::Plan::new`], which also builds the model.
     pub fn from_file(path: &Path) -> Result<Self, CampaignError> {
@@ -299,10 +308,16 @@ impl Campaign {
                 .map_err(|e| invalid("base", format!("cannot read {}: {e}", p.display())))?,
             None => DEFAULT_CONFIG_TOML.to_owned(),
         };
-        let base = SimConfig::from_toml_str(&base_toml).map_err(|source| CampaignError::Base {
-            campaign: path.to_owned(),
-            base: base_path.clone(),
-            source: Box::new(source),
+        let base_dir = base_path
+            .as_deref()
+            .and_then(Path::parent)
+            .unwrap_or(Path::new("."));
+        let base = SimConfig::from_toml_str_in(&base_toml, base_dir).map_err(|source| {
+            CampaignError::Base {
+                campaign: path.to_owned(),
+                base: base_path.clone(),
+                source: Box::new(source),
+            }
         })?;
         log_warnings(&base, base_path.as_deref());
         let runs = root.int_in("runs", 1, 1_000_000).map_err(schema)? as u32;
