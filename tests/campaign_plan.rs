@@ -580,11 +580,10 @@ fn environment_parameters_are_dispersed_and_read_back_from_the_model() {
 #[test]
 fn a_relative_elements_file_is_found_and_inlined_into_each_run() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let mut leo: toml::Table =
-        std::fs::read_to_string(root.join("scenarios/leo_environment.toml"))
-            .unwrap()
-            .parse()
-            .unwrap();
+    let mut leo: toml::Table = std::fs::read_to_string(root.join("scenarios/leo_environment.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
     let orbit = leo["orbit"].as_table_mut().unwrap();
     let omm = orbit.remove("elements").unwrap();
     let omm = omm.as_str().unwrap().to_owned();

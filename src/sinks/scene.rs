@@ -65,6 +65,30 @@ pub struct Geometry {
     pub hub: Cuboid,
     /// The panel pairs, in effector order (they are effectors 0..n of every StateMsg).
     pub pairs: Vec<PairGeometry>,
+    /// The `[[environment.facets]]` plates in B (drag and solar pressure act on them): a square
+    /// of the facet's area centred on its centre of pressure, normal along its box z axis.
+    pub facets: Vec<Cuboid>,
+}
+
+/// The plate drawn for a facet of area `area_m2` at `r_cp_b_m` with outward unit normal
+/// `normal_b`: a √A × √A square, 2 % of its side thick, whose box z axis is the normal.
+pub fn facet_plate(area_m2: f64, normal_b: &Vector3<f64>, r_cp_b_m: &Vector3<f64>) -> Cuboid {
+    let n = normal_b.normalize();
+    // The B axis least aligned with n gives an in-plane axis u = (e × n)/|e × n|; v = n × u.
+    let e = (0..3)
+        .map(|i| Vector3::ith(i, 1.0))
+        .min_by(|a, b| n.dot(a).abs().total_cmp(&n.dot(b).abs()))
+        .unwrap_or_else(Vector3::x);
+    let u = e.cross(&n).normalize();
+    let v = n.cross(&u);
+    // Columns u, v, n map box components to B: [B P] = [P B]ᵀ (as for the hub box).
+    let box_to_b = Matrix3::from_columns(&[u, v, n]);
+    let side = area_m2.max(0.0).sqrt();
+    Cuboid {
+        center_m: *r_cp_b_m,
+        q_frame_box: dcm_to_quat(&box_to_b.transpose()),
+        size_m: Vector3::new(side, side, 0.02 * side),
+    }
 }
 
 /// Edge lengths (a, b, c) of the homogeneous box of mass `m` with principal moments (I1, I2, I3)
@@ -120,9 +144,16 @@ impl Geometry {
                 panel2: panel_box(&p.panel2),
             })
             .collect();
+        let facets = cfg
+            .environment
+            .iter()
+            .flat_map(|env| &env.facets)
+            .map(|f| facet_plate(f.area_m2, &f.normal_b, &f.r_cp_b_m))
+            .collect();
         Self {
             hub: hub_box,
             pairs,
+            facets,
         }
     }
 }
@@ -215,8 +246,9 @@ fn cube_entity(t_ns: u64, frame: &str, id: &str, c: &Cuboid, rgba: [f64; 4]) -> 
     })
 }
 
-/// The `foxglove.SceneUpdate` that draws the spacecraft: a grey hub box in B and a blue box per
-/// panel in its own frame, frame-locked and never expiring (lifetime 0).
+/// The `foxglove.SceneUpdate` that draws the spacecraft: a grey hub box in B, a blue box per
+/// panel in its own frame, and a translucent gold plate per facet in B, frame-locked and never
+/// expiring (lifetime 0).
 pub fn scene_update(geometry: &Geometry, prefix: &str, t_ns: u64) -> Value {
     let mut entities = vec![cube_entity(
         t_ns,
@@ -236,6 +268,15 @@ pub fn scene_update(geometry: &Geometry, prefix: &str, t_ns: u64) -> Value {
                 [0.15, 0.3, 0.8, 1.0],
             ));
         }
+    }
+    for (k, facet) in geometry.facets.iter().enumerate() {
+        entities.push(cube_entity(
+            t_ns,
+            &format!("{prefix}{FRAME_B}"),
+            &format!("{prefix}facet{k}"),
+            facet,
+            [0.85, 0.65, 0.13, 0.6],
+        ));
     }
     json!({ "deletions": [], "entities": entities })
 }
@@ -436,6 +477,40 @@ mod tests {
         let plate = Vector3::new(b * b, a * a, a * a + b * b) * (m / 12.0);
         let e = equivalent_box_m(m, &plate);
         assert!((e.z - 0.04).abs() < 1e-12, "{e}");
+    }
+
+    #[test]
+    fn each_facet_is_a_plate_of_its_area_facing_its_normal() {
+        let text = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/leo_environment.toml"),
+        )
+        .unwrap();
+        let cfg = SimConfig::from_toml_str(&text).unwrap();
+        let facets = &cfg.environment.as_ref().unwrap().facets;
+        assert!(!facets.is_empty());
+        let g = Geometry::from_config(&cfg);
+        let scene = scene_update(&g, "sc1/", 0);
+        let entities = scene["entities"].as_array().unwrap();
+        assert_eq!(entities.len(), 1 + 2 * cfg.panel_pairs.len() + facets.len());
+        for (k, f) in facets.iter().enumerate() {
+            let e = &entities[1 + 2 * cfg.panel_pairs.len() + k];
+            assert_eq!(e["frame_id"], "sc1/B");
+            let cube = &e["cubes"][0];
+            let at = |v: &Value, a: &str| v[a].as_f64().unwrap();
+            let o = &cube["pose"]["orientation"];
+            let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                at(o, "w"),
+                at(o, "x"),
+                at(o, "y"),
+                at(o, "z"),
+            ));
+            // The box's z axis, rotated into B, is the facet's normal; its face is A.
+            assert!((q * Vector3::z() - f.normal_b).norm() < 1e-12, "facet {k}");
+            let size = &cube["size"];
+            assert!((at(size, "x") * at(size, "y") - f.area_m2).abs() < 1e-12);
+            let p = &cube["pose"]["position"];
+            assert_eq!(Vector3::new(at(p, "x"), at(p, "y"), at(p, "z")), f.r_cp_b_m);
+        }
     }
 
     #[test]
