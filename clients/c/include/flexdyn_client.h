@@ -1,0 +1,191 @@
+/*
+ * flexdyn_client.h - talk to a flexdyn server from C99 or C++ flight code.
+ *
+ * Link libflexdyn_client.a (or libflexdyn_client.so), built by `cargo build --release -p
+ * flexdyn-client`. The library carries its own Zenoh (the Rust crate), so no zenoh-c is needed,
+ * and it decodes and encodes with the same Rust codec as the server. Messages come out in the
+ * structs of flexdyn_proto.h (proto/c/include): one C type per message, whichever way it was
+ * decoded. Compile with -I proto/c/include -I clients/c/include; the link line is in the
+ * top-level README, "Attaching flight code".
+ *
+ * Every function returns FLEXDYN_OK (0), FLEXDYN_EMPTY (1, a poll found nothing) or a negative
+ * FLEXDYN_ERR_* code; after an error, flexdyn_last_error(client) says what went wrong in one
+ * line. Nothing panics across the boundary: a fault inside the library is FLEXDYN_ERR_INTERNAL.
+ *
+ * Threading contract
+ *   - There is no global state: everything lives in a flexdyn_client handle.
+ *   - A handle is NOT thread-safe: call it from one thread at a time (it may move between
+ *     threads). Two handles are independent and may be used from two threads at once.
+ *   - There are no callbacks. Samples are queued inside the library by Zenoh's own threads and
+ *     handed over only when you call a poll or wait function, on your thread. Your code never
+ *     runs on a library thread, so it needs no locking.
+ *   - Each queue is a ring of `capacity` samples: if you fall behind, the oldest samples are
+ *     dropped (the header's seq shows the gap), Zenoh is never blocked. In lockstep the server
+ *     waits for your answer, so nothing is dropped.
+ *   - Every wait takes a timeout in milliseconds and returns FLEXDYN_ERR_TIMEOUT when it passes:
+ *     a lost server is an error code, never a hang.
+ *
+ * Lockstep (proto/README.md, "Lockstep protocol"): flexdyn_lockstep_join asks the server for
+ * its configuration (which sensor samples each tick carries), subscribes once to
+ * flexdyn/<sc>/tlm (all of it, so a tick's samples arrive in publication order), then declares
+ * the liveliness token. flexdyn_lockstep_wait hands out the next complete tick (the state of tick
+ * k and every sensor sample due at k); answer it with exactly one flexdyn_lockstep_answer_*.
+ */
+#ifndef FLEXDYN_CLIENT_H
+#define FLEXDYN_CLIENT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "flexdyn_proto.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------------------------ */
+/* Return codes.                                                                               */
+
+#define FLEXDYN_OK 0
+#define FLEXDYN_EMPTY 1               /* a poll found nothing waiting (not an error) */
+#define FLEXDYN_ERR_TIMEOUT (-1)      /* nothing came within the timeout: no server, or it left */
+#define FLEXDYN_ERR_ARGUMENT (-2)     /* a null pointer, a bad id or endpoint, a non-finite value */
+#define FLEXDYN_ERR_ZENOH (-3)        /* Zenoh refused (cannot open, declare or put) */
+#define FLEXDYN_ERR_DECODE (-4)       /* a sample that is not a valid message (it is dropped) */
+#define FLEXDYN_ERR_CAPACITY (-5)     /* your effectors array is too small (sample dropped) */
+#define FLEXDYN_ERR_USAGE (-6)        /* out of order: not open, not subscribed, no tick held... */
+#define FLEXDYN_ERR_CONFIG (-7)       /* the Zenoh config file or the served configuration */
+#define FLEXDYN_ERR_INTERNAL (-8)     /* a fault inside the library (caught, never a crash) */
+#define FLEXDYN_ERR_ABSENT (-9)       /* lockstep: that sensor has no sample in this tick */
+#define FLEXDYN_ERR_CLOSED (-10)      /* the session was closed under a wait */
+
+/* ------------------------------------------------------------------------------------------ */
+/* The handle.                                                                                 */
+
+typedef struct flexdyn_client flexdyn_client; /* opaque */
+
+/* How to reach the server. Zero it (memset or = {0}) and set what you need. */
+typedef struct {
+    /* String spacecraft id of the keys (flexdyn/<sc_id>/...); NULL = "sc1". */
+    const char *sc_id;
+    /* Endpoints to connect to, e.g. "tcp/127.0.0.1:7447"; none = tcp/127.0.0.1:7447. */
+    const char *const *connect;
+    size_t n_connect;
+    /* Endpoints to listen on; none = listen nowhere. */
+    const char *const *listen;
+    size_t n_listen;
+    /* A standard Zenoh JSON5 file (e.g. the lab network's user/password and ACL); NULL = none.
+     * connect/listen above replace its endpoints. Multicast scouting is always off. */
+    const char *zenoh_config_file;
+} flexdyn_options;
+
+/* A new handle, not connected yet; NULL only if memory is exhausted. */
+flexdyn_client *flexdyn_client_new(void);
+/* Closes the session if open and frees the handle (NULL is accepted). */
+void flexdyn_client_free(flexdyn_client *client);
+/* The last error of this handle, one line, "" if none; valid until the next call on it. */
+const char *flexdyn_last_error(const flexdyn_client *client);
+
+/* Opens the Zenoh session: peer mode, loopback defaults, multicast scouting off. */
+int flexdyn_open(flexdyn_client *client, const flexdyn_options *options);
+/* Closes the session: undeclares every subscription and the lockstep token. The handle can be
+ * opened again. Closing a closed handle is FLEXDYN_OK. */
+int flexdyn_close(flexdyn_client *client);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Subscriptions: poll (FLEXDYN_OK or FLEXDYN_EMPTY) or wait (FLEXDYN_OK or FLEXDYN_ERR_TIMEOUT).
+ * One subscription per kind; subscribing again replaces it. `capacity` = samples kept (>= 1). */
+
+int flexdyn_subscribe_state(flexdyn_client *client, size_t capacity);
+/* out->effectors / out->effectors_capacity are yours (FD_MAX_EFFECTORS always fits). */
+int flexdyn_poll_state(flexdyn_client *client, fd_state_msg *out);
+int flexdyn_wait_state(flexdyn_client *client, fd_state_msg *out, uint32_t timeout_ms);
+
+/* name: one IMU, or NULL for all of them (flexdyn/<sc>/tlm/imu/ + star). */
+int flexdyn_subscribe_imu(flexdyn_client *client, const char *name, size_t capacity);
+/* name_out (may be NULL) receives the IMU's name, NUL-terminated; 65 bytes always fit. */
+int flexdyn_poll_imu(flexdyn_client *client, fd_imu_msg *out, char *name_out, size_t name_cap);
+int flexdyn_wait_imu(flexdyn_client *client, fd_imu_msg *out, char *name_out, size_t name_cap,
+                     uint32_t timeout_ms);
+
+/* name: one star tracker, or NULL for all of them. */
+int flexdyn_subscribe_star_tracker(flexdyn_client *client, const char *name, size_t capacity);
+int flexdyn_poll_star_tracker(flexdyn_client *client, fd_star_tracker_msg *out, char *name_out,
+                              size_t name_cap);
+int flexdyn_wait_star_tracker(flexdyn_client *client, fd_star_tracker_msg *out, char *name_out,
+                              size_t name_cap, uint32_t timeout_ms);
+
+int flexdyn_subscribe_status(flexdyn_client *client, size_t capacity);
+int flexdyn_poll_status(flexdyn_client *client, fd_status_msg *out);
+int flexdyn_wait_status(flexdyn_client *client, fd_status_msg *out, uint32_t timeout_ms);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Commands, on flexdyn/<sc>/cmd/<sender_id>. `stamp` is the header of the state you answer
+ * (its spacecraft_id, tick and sim_time_ns are copied; its seq is ignored): the library numbers
+ * this handle's commands itself (seq 0, 1, 2, ...). Values must be finite
+ * (FLEXDYN_ERR_ARGUMENT otherwise: the server would reject them). */
+
+int flexdyn_send_wrench(flexdyn_client *client, uint32_t sender_id, const fd_header *stamp,
+                        const double torque_b_nm[3], const double force_b_newton[3]);
+int flexdyn_send_no_command(flexdyn_client *client, uint32_t sender_id, const fd_header *stamp);
+/* inputs: n_inputs entries (may be NULL when n_inputs is 0). */
+int flexdyn_send_actuators(flexdyn_client *client, uint32_t sender_id, const fd_header *stamp,
+                           const double torque_b_nm[3], const double force_b_newton[3],
+                           const fd_effector_input *inputs, size_t n_inputs);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Lockstep participant.                                                                       */
+
+/* Asks flexdyn/<sc>/config what the server runs (waiting up to timeout_ms for an answer),
+ * subscribes to flexdyn/<sc>/tlm, then declares the token flexdyn/<sc>/participant/<sender_id>. */
+int flexdyn_lockstep_join(flexdyn_client *client, uint32_t sender_id, uint32_t timeout_ms);
+/* The next complete tick: its state into *state (effectors in your array). The tick is held
+ * until the next wait; answer it once. */
+int flexdyn_lockstep_wait(flexdyn_client *client, fd_state_msg *state, uint32_t timeout_ms);
+/* The sensors each tick may carry, in configuration order (0 before a join). Names stay valid
+ * until the next join, leave or close. */
+size_t flexdyn_lockstep_imu_count(const flexdyn_client *client);
+const char *flexdyn_lockstep_imu_name(const flexdyn_client *client, size_t index);
+size_t flexdyn_lockstep_star_tracker_count(const flexdyn_client *client);
+const char *flexdyn_lockstep_star_tracker_name(const flexdyn_client *client, size_t index);
+/* The held tick's sample of sensor `index`: FLEXDYN_OK, or FLEXDYN_ERR_ABSENT (a star tracker not
+ * due at this tick, or a sample lost). */
+int flexdyn_lockstep_imu(flexdyn_client *client, size_t index, fd_imu_msg *out);
+int flexdyn_lockstep_star_tracker(flexdyn_client *client, size_t index, fd_star_tracker_msg *out);
+/* The one answer to the held tick (FLEXDYN_ERR_USAGE if there is none or it was answered). */
+int flexdyn_lockstep_answer_wrench(flexdyn_client *client, const double torque_b_nm[3],
+                                   const double force_b_newton[3]);
+int flexdyn_lockstep_answer_no_command(flexdyn_client *client);
+int flexdyn_lockstep_answer_actuators(flexdyn_client *client, const double torque_b_nm[3],
+                                      const double force_b_newton[3],
+                                      const fd_effector_input *inputs, size_t n_inputs);
+/* Drops the token and the telemetry subscription (the server logs that the participant left). */
+int flexdyn_lockstep_leave(flexdyn_client *client);
+
+/* ------------------------------------------------------------------------------------------ */
+/* The library's own decoders (the Rust codec, as on the server) into the same structs as
+ * fd_decode_*: for bytes from elsewhere, e.g. a recording. */
+
+int flexdyn_decode_state(flexdyn_client *client, const uint8_t *buf, size_t len, fd_state_msg *out);
+int flexdyn_decode_imu(flexdyn_client *client, const uint8_t *buf, size_t len, fd_imu_msg *out);
+int flexdyn_decode_star_tracker(flexdyn_client *client, const uint8_t *buf, size_t len,
+                                fd_star_tracker_msg *out);
+int flexdyn_decode_status(flexdyn_client *client, const uint8_t *buf, size_t len,
+                          fd_status_msg *out);
+
+/* sizeof the struct of a message as the library was built (FLEXDYN_STRUCT_*), to check that a
+ * program and the library agree on flexdyn_proto.h; 0 for an unknown kind. */
+#define FLEXDYN_STRUCT_HEADER 0
+#define FLEXDYN_STRUCT_STATE 1
+#define FLEXDYN_STRUCT_EFFECTOR_STATE 2
+#define FLEXDYN_STRUCT_IMU 3
+#define FLEXDYN_STRUCT_STAR_TRACKER 4
+#define FLEXDYN_STRUCT_EFFECTOR_INPUT 5
+#define FLEXDYN_STRUCT_STATUS 6
+size_t flexdyn_struct_size(int which);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* FLEXDYN_CLIENT_H */

@@ -1,0 +1,1160 @@
+//! The C ABI of `include/flexdyn_client.h`: each function checks its pointers, runs the safe
+//! [`crate::client`] call inside `catch_unwind` (no panic crosses into C), stores the error
+//! message in the handle and returns the code.
+//!
+//! Every `unsafe` block here only turns a pointer the header documents into a reference or a
+//! slice; the safety argument is the header's contract (valid, aligned, live for the call, and
+//! `capacity` elements where a capacity is given), restated at each block.
+#![allow(unsafe_code)]
+
+use std::ffi::{c_char, c_int, CStr, CString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+use std::time::Duration;
+
+use flexdyn_proto::{CommandKind, Header, MAX_ID_LEN};
+
+use crate::client::{
+    decode_imu_bytes, decode_star_tracker_bytes, decode_state_bytes, decode_status_bytes, Client,
+    Kind, Options,
+};
+use crate::ctypes::{
+    effector_input, fill_state, finite3, FdEffectorInput, FdEffectorState, FdHeader, FdImuMsg,
+    FdStarTrackerMsg, FdStateMsg, FdStatusMsg,
+};
+use crate::error::{Code, Error};
+
+/// `flexdyn_client`: the opaque handle.
+pub struct FlexdynClient {
+    client: Option<Client>,
+    last_error: CString,
+}
+
+/// `flexdyn_options`.
+#[repr(C)]
+pub struct FlexdynOptions {
+    sc_id: *const c_char,
+    connect: *const *const c_char,
+    n_connect: usize,
+    listen: *const *const c_char,
+    n_listen: usize,
+    zenoh_config_file: *const c_char,
+}
+
+impl FlexdynClient {
+    fn set_error(&mut self, message: &str) {
+        // A message never holds a NUL that would cut it short.
+        self.last_error = CString::new(message.replace('\0', " ")).unwrap_or_default();
+    }
+
+    fn client(&mut self) -> Result<&mut Client, Error> {
+        self.client.as_mut().ok_or_else(|| {
+            Error::new(
+                Code::Usage,
+                "the session is not open (call flexdyn_open first)",
+            )
+        })
+    }
+}
+
+/// What a panic carried, for the error message.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic without a message".to_owned())
+}
+
+/// Runs `f` on the handle: its error goes to `last_error`, a panic becomes
+/// [`Code::Internal`]. A null handle is [`Code::Argument`] (there is nowhere to put a message).
+fn with_handle(
+    handle: *mut FlexdynClient,
+    f: impl FnOnce(&mut FlexdynClient) -> Result<Code, Error>,
+) -> c_int {
+    // SAFETY: a non-null `handle` comes from `flexdyn_client_new` and is used by one thread at a
+    // time (the header's threading contract), so a unique reference for this call is sound.
+    let Some(h) = (unsafe { handle.as_mut() }) else {
+        return Code::Argument as c_int;
+    };
+    match catch_unwind(AssertUnwindSafe(|| f(&mut *h))) {
+        Ok(Ok(code)) => code as c_int,
+        Ok(Err(e)) => {
+            h.set_error(&e.message);
+            e.code as c_int
+        }
+        Err(payload) => {
+            h.set_error(&format!(
+                "internal error (please report it; close this handle): {}",
+                panic_message(payload.as_ref())
+            ));
+            Code::Internal as c_int
+        }
+    }
+}
+
+fn null(what: &str) -> Error {
+    Error::new(Code::Argument, format!("{what} is a null pointer"))
+}
+
+/// A C string argument (`what` names it in errors).
+///
+/// # Safety
+/// `p` is null or a NUL-terminated string live for the call.
+unsafe fn c_str<'a>(what: &str, p: *const c_char) -> Result<&'a str, Error> {
+    if p.is_null() {
+        return Err(null(what));
+    }
+    // SAFETY: non-null and NUL-terminated, by this function's contract.
+    unsafe { CStr::from_ptr(p) }
+        .to_str()
+        .map_err(|_| Error::new(Code::Argument, format!("{what} is not UTF-8")))
+}
+
+/// An optional C string argument: null is `None`.
+///
+/// # Safety
+/// As [`c_str`].
+unsafe fn opt_str<'a>(what: &str, p: *const c_char) -> Result<Option<&'a str>, Error> {
+    if p.is_null() {
+        Ok(None)
+    } else {
+        // SAFETY: forwarded contract.
+        unsafe { c_str(what, p) }.map(Some)
+    }
+}
+
+/// `n` C strings at `p` (null only when `n` is 0).
+///
+/// # Safety
+/// `p` points to `n` NUL-terminated strings live for the call.
+unsafe fn c_strs(what: &str, p: *const *const c_char, n: usize) -> Result<Vec<String>, Error> {
+    if n == 0 {
+        return Ok(Vec::new());
+    }
+    if p.is_null() {
+        return Err(null(what));
+    }
+    // SAFETY: `n` pointers at `p`, by this function's contract.
+    let ptrs = unsafe { std::slice::from_raw_parts(p, n) };
+    ptrs.iter()
+        .enumerate()
+        // SAFETY: each entry is a NUL-terminated string, by this function's contract.
+        .map(|(i, s)| unsafe { c_str(&format!("{what}[{i}]"), *s) }.map(str::to_owned))
+        .collect()
+}
+
+/// Three doubles at `p`.
+///
+/// # Safety
+/// `p` is null or points to 3 doubles.
+unsafe fn vec3(what: &str, p: *const f64) -> Result<[f64; 3], Error> {
+    if p.is_null() {
+        return Err(null(what));
+    }
+    let mut v = [0.0; 3];
+    // SAFETY: 3 doubles at `p`, by this function's contract.
+    v.copy_from_slice(unsafe { std::slice::from_raw_parts(p, 3) });
+    finite3(what, &v)?;
+    Ok(v)
+}
+
+/// The Rust header of a C stamp.
+///
+/// # Safety
+/// `p` is null or points to an `fd_header`.
+unsafe fn stamp(p: *const FdHeader) -> Result<Header, Error> {
+    // SAFETY: by this function's contract.
+    let h = unsafe { p.as_ref() }.ok_or_else(|| null("stamp"))?;
+    Ok(Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, h.seq))
+}
+
+/// The Actuators command kind of C arguments.
+///
+/// # Safety
+/// `torque` and `force` point to 3 doubles each; `inputs` to `n` `fd_effector_input`s (null
+/// only when `n` is 0).
+unsafe fn actuators(
+    torque: *const f64,
+    force: *const f64,
+    inputs: *const FdEffectorInput,
+    n: usize,
+) -> Result<CommandKind, Error> {
+    // SAFETY: forwarded contract.
+    let (torque_b_nm, force_b_newton) =
+        unsafe { (vec3("torque_b_nm", torque)?, vec3("force_b_newton", force)?) };
+    let inputs = if n == 0 {
+        Vec::new()
+    } else if inputs.is_null() {
+        return Err(null("inputs"));
+    } else {
+        // SAFETY: `n` inputs at `inputs`, by this function's contract.
+        let c = unsafe { std::slice::from_raw_parts(inputs, n) };
+        if n > flexdyn_proto::MAX_EFFECTORS {
+            return Err(Error::new(
+                Code::Argument,
+                format!("{n} inputs exceed {}", flexdyn_proto::MAX_EFFECTORS),
+            ));
+        }
+        c.iter()
+            .enumerate()
+            .map(|(i, x)| effector_input(i, x))
+            .collect::<Result<_, _>>()?
+    };
+    Ok(CommandKind::Actuators {
+        torque_b_nm,
+        force_b_newton,
+        inputs,
+    })
+}
+
+/// The wrench command kind of C arguments.
+///
+/// # Safety
+/// `torque` and `force` point to 3 doubles each.
+unsafe fn wrench(torque: *const f64, force: *const f64) -> Result<CommandKind, Error> {
+    // SAFETY: forwarded contract.
+    unsafe {
+        Ok(CommandKind::Wrench {
+            torque_b_nm: vec3("torque_b_nm", torque)?,
+            force_b_newton: vec3("force_b_newton", force)?,
+        })
+    }
+}
+
+/// Fills the caller's `fd_state_msg` from a decoded state.
+///
+/// # Safety
+/// `out` is null or points to an `fd_state_msg` whose `effectors` points to
+/// `effectors_capacity` entries (or is null with capacity 0).
+unsafe fn write_state(out: *mut FdStateMsg, m: &flexdyn_proto::StateMsg) -> Result<(), Error> {
+    // SAFETY: by this function's contract.
+    let out = unsafe { out.as_mut() }.ok_or_else(|| null("out"))?;
+    let effectors: &mut [FdEffectorState] = if out.effectors_capacity == 0 {
+        &mut []
+    } else if out.effectors.is_null() {
+        return Err(null("out->effectors (with a capacity above 0)"));
+    } else {
+        // SAFETY: `effectors_capacity` entries at `effectors`, by this function's contract;
+        // they lie outside `*out` (a separate array), so the two references do not overlap.
+        unsafe { std::slice::from_raw_parts_mut(out.effectors, out.effectors_capacity) }
+    };
+    fill_state(m, out, effectors)
+}
+
+/// Writes `value` to `out`.
+///
+/// # Safety
+/// `out` is null or points to a writable `T`.
+unsafe fn write<T>(out: *mut T, value: T) -> Result<(), Error> {
+    if out.is_null() {
+        return Err(null("out"));
+    }
+    // SAFETY: non-null and writable, by this function's contract.
+    unsafe { out.write(value) };
+    Ok(())
+}
+
+/// The longest sensor name plus its NUL.
+const NAME_CAP: usize = MAX_ID_LEN + 1;
+
+/// Checks a name buffer before a sample is taken (so a sample is never lost to it).
+fn check_name_buffer(name_out: *mut c_char, name_cap: usize) -> Result<(), Error> {
+    if !name_out.is_null() && name_cap < NAME_CAP {
+        return Err(Error::new(
+            Code::Argument,
+            format!("name_cap is {name_cap}; a name needs up to {NAME_CAP} bytes"),
+        ));
+    }
+    Ok(())
+}
+
+/// Copies `name` and its NUL into `name_out` (checked by [`check_name_buffer`]).
+///
+/// # Safety
+/// `name_out` is null or points to `NAME_CAP` writable bytes.
+unsafe fn write_name(name_out: *mut c_char, name: &str) {
+    if name_out.is_null() {
+        return;
+    }
+    let n = name.len().min(NAME_CAP - 1);
+    // SAFETY: `NAME_CAP` writable bytes, by this function's contract; `n + 1 <= NAME_CAP`.
+    unsafe {
+        std::ptr::copy_nonoverlapping(name.as_ptr().cast::<c_char>(), name_out, n);
+        *name_out.add(n) = 0;
+    }
+}
+
+fn timeout(ms: u32) -> Duration {
+    Duration::from_millis(u64::from(ms))
+}
+
+/// Takes the next sample of `kind` (poll when `wait` is `None`) and decodes it into `out`.
+fn take<T>(
+    h: &mut FlexdynClient,
+    kind: Kind,
+    wait: Option<u32>,
+    decode_into: impl FnOnce(&str, &[u8]) -> Result<T, Error>,
+) -> Result<Option<(String, T)>, Error> {
+    let client = h.client()?;
+    let Some(r) = client.receive(kind, wait.map(timeout))? else {
+        return Ok(None);
+    };
+    let key = client.key_of(kind, &r.name);
+    decode_into(&key, &r.payload).map(|m| Some((r.name, m)))
+}
+
+// ---------------------------------------------------------------------------------------------
+// The handle.
+
+/// `flexdyn_client_new`.
+#[no_mangle]
+pub extern "C" fn flexdyn_client_new() -> *mut FlexdynClient {
+    catch_unwind(|| {
+        Box::into_raw(Box::new(FlexdynClient {
+            client: None,
+            last_error: CString::default(),
+        }))
+    })
+    .unwrap_or(std::ptr::null_mut())
+}
+
+/// `flexdyn_client_free`.
+///
+/// # Safety
+/// `handle` is null or from [`flexdyn_client_new`], not freed yet, and not used afterwards.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_client_free(handle: *mut FlexdynClient) {
+    if handle.is_null() {
+        return;
+    }
+    // SAFETY: from `Box::into_raw` in `flexdyn_client_new`, freed once (this contract).
+    let h = unsafe { Box::from_raw(handle) };
+    let _ = catch_unwind(AssertUnwindSafe(move || {
+        if let Some(c) = h.client {
+            let _ = c.close();
+        }
+    }));
+}
+
+/// `flexdyn_last_error`.
+///
+/// # Safety
+/// `handle` is null or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_last_error(handle: *const FlexdynClient) -> *const c_char {
+    // SAFETY: a live handle, by this function's contract.
+    match unsafe { handle.as_ref() } {
+        Some(h) => h.last_error.as_ptr(),
+        None => c"flexdyn_last_error: the handle is a null pointer".as_ptr(),
+    }
+}
+
+/// `flexdyn_open`.
+///
+/// # Safety
+/// `handle` is a live handle; `options` null or a valid `flexdyn_options` whose strings and
+/// arrays are live for the call.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_open(
+    handle: *mut FlexdynClient,
+    options: *const FlexdynOptions,
+) -> c_int {
+    with_handle(handle, |h| {
+        if h.client.is_some() {
+            return Err(Error::new(
+                Code::Usage,
+                "the session is open already (flexdyn_close it first)",
+            ));
+        }
+        // SAFETY: by this function's contract.
+        let opts = match unsafe { options.as_ref() } {
+            None => Options::default(),
+            // SAFETY: the strings and arrays of a valid `flexdyn_options`.
+            Some(o) => unsafe {
+                Options {
+                    sc_id: opt_str("sc_id", o.sc_id)?.map(str::to_owned),
+                    connect: c_strs("connect", o.connect, o.n_connect)?,
+                    listen: c_strs("listen", o.listen, o.n_listen)?,
+                    zenoh_config_file: opt_str("zenoh_config_file", o.zenoh_config_file)?
+                        .map(PathBuf::from),
+                }
+            },
+        };
+        h.client = Some(Client::open(&opts)?);
+        Ok(Code::Ok)
+    })
+}
+
+/// `flexdyn_close`.
+///
+/// # Safety
+/// `handle` is a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_close(handle: *mut FlexdynClient) -> c_int {
+    with_handle(handle, |h| {
+        if let Some(c) = h.client.take() {
+            c.close()?;
+        }
+        Ok(Code::Ok)
+    })
+}
+
+// ---------------------------------------------------------------------------------------------
+// Subscriptions.
+
+/// # Safety
+/// `handle` is a live handle; `name` null or a NUL-terminated string.
+unsafe fn subscribe(
+    handle: *mut FlexdynClient,
+    kind: Kind,
+    name: *const c_char,
+    capacity: usize,
+) -> c_int {
+    with_handle(handle, |h| {
+        // SAFETY: forwarded contract.
+        let name = unsafe { opt_str("name", name)? };
+        h.client()?.subscribe(kind, name, capacity)?;
+        Ok(Code::Ok)
+    })
+}
+
+/// `FLEXDYN_OK` for a sample, `FLEXDYN_EMPTY` for none.
+fn got<T>(r: Option<T>) -> Code {
+    if r.is_some() {
+        Code::Ok
+    } else {
+        Code::Empty
+    }
+}
+
+/// `flexdyn_subscribe_state`.
+///
+/// # Safety
+/// `handle` is a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_subscribe_state(
+    handle: *mut FlexdynClient,
+    capacity: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { subscribe(handle, Kind::State, std::ptr::null(), capacity) }
+}
+
+/// # Safety
+/// As [`write_state`], and `handle` live.
+unsafe fn state(handle: *mut FlexdynClient, out: *mut FdStateMsg, wait: Option<u32>) -> c_int {
+    with_handle(handle, |h| {
+        if out.is_null() {
+            return Err(null("out"));
+        }
+        let r = take(h, Kind::State, wait, decode_state_bytes)?;
+        if let Some((_, m)) = &r {
+            // SAFETY: forwarded contract.
+            unsafe { write_state(out, m)? };
+        }
+        Ok(got(r))
+    })
+}
+
+/// `flexdyn_poll_state`.
+///
+/// # Safety
+/// `handle` is a live handle; `out` an `fd_state_msg` with `effectors_capacity` entries at
+/// `effectors`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_poll_state(
+    handle: *mut FlexdynClient,
+    out: *mut FdStateMsg,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { state(handle, out, None) }
+}
+
+/// `flexdyn_wait_state`.
+///
+/// # Safety
+/// As [`flexdyn_poll_state`].
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_wait_state(
+    handle: *mut FlexdynClient,
+    out: *mut FdStateMsg,
+    timeout_ms: u32,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { state(handle, out, Some(timeout_ms)) }
+}
+
+/// A sensor sample (`T` its C struct) with its name.
+///
+/// # Safety
+/// `handle` live; `out` a writable `T`; `name_out` null or `name_cap` writable bytes.
+unsafe fn sensor<T>(
+    handle: *mut FlexdynClient,
+    kind: Kind,
+    out: *mut T,
+    name_out: *mut c_char,
+    name_cap: usize,
+    wait: Option<u32>,
+    decode_into: impl FnOnce(&str, &[u8]) -> Result<T, Error>,
+) -> c_int {
+    with_handle(handle, |h| {
+        if out.is_null() {
+            return Err(null("out"));
+        }
+        check_name_buffer(name_out, name_cap)?;
+        let r = take(h, kind, wait, decode_into)?;
+        let code = got(r.as_ref());
+        if let Some((name, m)) = r {
+            // SAFETY: forwarded contract; `name_cap >= NAME_CAP` was checked.
+            unsafe {
+                write(out, m)?;
+                write_name(name_out, &name);
+            }
+        }
+        Ok(code)
+    })
+}
+
+/// `flexdyn_subscribe_imu`.
+///
+/// # Safety
+/// `handle` live; `name` null or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_subscribe_imu(
+    handle: *mut FlexdynClient,
+    name: *const c_char,
+    capacity: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { subscribe(handle, Kind::Imu, name, capacity) }
+}
+
+fn imu_c(key: &str, b: &[u8]) -> Result<FdImuMsg, Error> {
+    decode_imu_bytes(key, b).map(|m| FdImuMsg::from(&m))
+}
+
+fn star_tracker_c(key: &str, b: &[u8]) -> Result<FdStarTrackerMsg, Error> {
+    decode_star_tracker_bytes(key, b).map(|m| FdStarTrackerMsg::from(&m))
+}
+
+fn status_c(key: &str, b: &[u8]) -> Result<FdStatusMsg, Error> {
+    decode_status_bytes(key, b).map(|m| FdStatusMsg::from(&m))
+}
+
+/// `flexdyn_poll_imu`.
+///
+/// # Safety
+/// `handle` live; `out` a writable `fd_imu_msg`; `name_out` null or `name_cap` bytes.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_poll_imu(
+    handle: *mut FlexdynClient,
+    out: *mut FdImuMsg,
+    name_out: *mut c_char,
+    name_cap: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { sensor(handle, Kind::Imu, out, name_out, name_cap, None, imu_c) }
+}
+
+/// `flexdyn_wait_imu`.
+///
+/// # Safety
+/// As [`flexdyn_poll_imu`].
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_wait_imu(
+    handle: *mut FlexdynClient,
+    out: *mut FdImuMsg,
+    name_out: *mut c_char,
+    name_cap: usize,
+    timeout_ms: u32,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe {
+        sensor(
+            handle,
+            Kind::Imu,
+            out,
+            name_out,
+            name_cap,
+            Some(timeout_ms),
+            imu_c,
+        )
+    }
+}
+
+/// `flexdyn_subscribe_star_tracker`.
+///
+/// # Safety
+/// `handle` live; `name` null or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_subscribe_star_tracker(
+    handle: *mut FlexdynClient,
+    name: *const c_char,
+    capacity: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { subscribe(handle, Kind::StarTracker, name, capacity) }
+}
+
+/// `flexdyn_poll_star_tracker`.
+///
+/// # Safety
+/// `handle` live; `out` a writable `fd_star_tracker_msg`; `name_out` null or `name_cap` bytes.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_poll_star_tracker(
+    handle: *mut FlexdynClient,
+    out: *mut FdStarTrackerMsg,
+    name_out: *mut c_char,
+    name_cap: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe {
+        sensor(
+            handle,
+            Kind::StarTracker,
+            out,
+            name_out,
+            name_cap,
+            None,
+            star_tracker_c,
+        )
+    }
+}
+
+/// `flexdyn_wait_star_tracker`.
+///
+/// # Safety
+/// As [`flexdyn_poll_star_tracker`].
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_wait_star_tracker(
+    handle: *mut FlexdynClient,
+    out: *mut FdStarTrackerMsg,
+    name_out: *mut c_char,
+    name_cap: usize,
+    timeout_ms: u32,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe {
+        sensor(
+            handle,
+            Kind::StarTracker,
+            out,
+            name_out,
+            name_cap,
+            Some(timeout_ms),
+            star_tracker_c,
+        )
+    }
+}
+
+/// `flexdyn_subscribe_status`.
+///
+/// # Safety
+/// `handle` is a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_subscribe_status(
+    handle: *mut FlexdynClient,
+    capacity: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { subscribe(handle, Kind::Status, std::ptr::null(), capacity) }
+}
+
+/// `flexdyn_poll_status`.
+///
+/// # Safety
+/// `handle` live; `out` a writable `fd_status_msg`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_poll_status(
+    handle: *mut FlexdynClient,
+    out: *mut FdStatusMsg,
+) -> c_int {
+    // SAFETY: forwarded contract (the status has no name).
+    unsafe {
+        sensor(
+            handle,
+            Kind::Status,
+            out,
+            std::ptr::null_mut(),
+            0,
+            None,
+            status_c,
+        )
+    }
+}
+
+/// `flexdyn_wait_status`.
+///
+/// # Safety
+/// As [`flexdyn_poll_status`].
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_wait_status(
+    handle: *mut FlexdynClient,
+    out: *mut FdStatusMsg,
+    timeout_ms: u32,
+) -> c_int {
+    // SAFETY: forwarded contract (the status has no name).
+    unsafe {
+        sensor(
+            handle,
+            Kind::Status,
+            out,
+            std::ptr::null_mut(),
+            0,
+            Some(timeout_ms),
+            status_c,
+        )
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Commands.
+
+/// # Safety
+/// `handle` live; `header` null or an `fd_header`.
+unsafe fn send(
+    handle: *mut FlexdynClient,
+    sender_id: u32,
+    header: *const FdHeader,
+    kind: impl FnOnce() -> Result<CommandKind, Error>,
+) -> c_int {
+    with_handle(handle, |h| {
+        // SAFETY: forwarded contract.
+        let stamp = unsafe { stamp(header)? };
+        let kind = kind()?;
+        h.client()?.send(sender_id, &stamp, kind)?;
+        Ok(Code::Ok)
+    })
+}
+
+/// `flexdyn_send_wrench`.
+///
+/// # Safety
+/// `handle` live; `stamp` an `fd_header`; `torque_b_nm` and `force_b_newton` 3 doubles each.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_send_wrench(
+    handle: *mut FlexdynClient,
+    sender_id: u32,
+    stamp: *const FdHeader,
+    torque_b_nm: *const f64,
+    force_b_newton: *const f64,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe {
+        send(handle, sender_id, stamp, || {
+            wrench(torque_b_nm, force_b_newton)
+        })
+    }
+}
+
+/// `flexdyn_send_no_command`.
+///
+/// # Safety
+/// `handle` live; `stamp` an `fd_header`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_send_no_command(
+    handle: *mut FlexdynClient,
+    sender_id: u32,
+    stamp: *const FdHeader,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { send(handle, sender_id, stamp, || Ok(CommandKind::NoCommand)) }
+}
+
+/// `flexdyn_send_actuators`.
+///
+/// # Safety
+/// As [`flexdyn_send_wrench`], and `inputs` `n_inputs` entries (null only when 0).
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_send_actuators(
+    handle: *mut FlexdynClient,
+    sender_id: u32,
+    stamp: *const FdHeader,
+    torque_b_nm: *const f64,
+    force_b_newton: *const f64,
+    inputs: *const FdEffectorInput,
+    n_inputs: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe {
+        send(handle, sender_id, stamp, || {
+            actuators(torque_b_nm, force_b_newton, inputs, n_inputs)
+        })
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Lockstep.
+
+/// `flexdyn_lockstep_join`.
+///
+/// # Safety
+/// `handle` is a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_join(
+    handle: *mut FlexdynClient,
+    sender_id: u32,
+    timeout_ms: u32,
+) -> c_int {
+    with_handle(handle, |h| {
+        h.client()?.join(sender_id, timeout(timeout_ms))?;
+        Ok(Code::Ok)
+    })
+}
+
+/// `flexdyn_lockstep_wait`.
+///
+/// # Safety
+/// As [`flexdyn_poll_state`].
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_wait(
+    handle: *mut FlexdynClient,
+    state: *mut FdStateMsg,
+    timeout_ms: u32,
+) -> c_int {
+    with_handle(handle, |h| {
+        if state.is_null() {
+            return Err(null("state"));
+        }
+        let tick = h.client()?.wait_tick(timeout(timeout_ms))?;
+        // SAFETY: forwarded contract.
+        unsafe { write_state(state, &tick.state)? };
+        Ok(Code::Ok)
+    })
+}
+
+/// `f` of the sensor names of the joined run (IMUs or star trackers; none before a join).
+///
+/// # Safety
+/// `handle` null or live.
+unsafe fn with_names<R>(
+    handle: *const FlexdynClient,
+    imus: bool,
+    f: impl FnOnce(&[CString]) -> R,
+) -> R {
+    // SAFETY: by this function's contract; read-only.
+    let client = unsafe { handle.as_ref() }.and_then(|h| h.client.as_ref());
+    let (i, s) = client.map_or((&[][..], &[][..]), Client::sensor_names);
+    f(if imus { i } else { s })
+}
+
+/// The pointer to name `index` (it lives in the handle until the next join, leave or close, as
+/// the header says), null out of range.
+fn name_ptr(names: &[CString], index: usize) -> *const c_char {
+    names.get(index).map_or(std::ptr::null(), |n| n.as_ptr())
+}
+
+/// `flexdyn_lockstep_imu_count`.
+///
+/// # Safety
+/// `handle` null or live.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_imu_count(handle: *const FlexdynClient) -> usize {
+    // SAFETY: forwarded contract.
+    catch_unwind(AssertUnwindSafe(|| unsafe {
+        with_names(handle, true, <[CString]>::len)
+    }))
+    .unwrap_or(0)
+}
+
+/// `flexdyn_lockstep_imu_name`: null for an index out of range.
+///
+/// # Safety
+/// `handle` null or live.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_imu_name(
+    handle: *const FlexdynClient,
+    index: usize,
+) -> *const c_char {
+    // SAFETY: forwarded contract.
+    catch_unwind(AssertUnwindSafe(|| unsafe {
+        with_names(handle, true, |n| name_ptr(n, index))
+    }))
+    .unwrap_or(std::ptr::null())
+}
+
+/// `flexdyn_lockstep_star_tracker_count`.
+///
+/// # Safety
+/// `handle` null or live.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_star_tracker_count(
+    handle: *const FlexdynClient,
+) -> usize {
+    // SAFETY: forwarded contract.
+    catch_unwind(AssertUnwindSafe(|| unsafe {
+        with_names(handle, false, <[CString]>::len)
+    }))
+    .unwrap_or(0)
+}
+
+/// `flexdyn_lockstep_star_tracker_name`: null for an index out of range.
+///
+/// # Safety
+/// `handle` null or live.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_star_tracker_name(
+    handle: *const FlexdynClient,
+    index: usize,
+) -> *const c_char {
+    // SAFETY: forwarded contract.
+    catch_unwind(AssertUnwindSafe(|| unsafe {
+        with_names(handle, false, |n| name_ptr(n, index))
+    }))
+    .unwrap_or(std::ptr::null())
+}
+
+/// `flexdyn_lockstep_imu`.
+///
+/// # Safety
+/// `handle` live; `out` a writable `fd_imu_msg`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_imu(
+    handle: *mut FlexdynClient,
+    index: usize,
+    out: *mut FdImuMsg,
+) -> c_int {
+    with_handle(handle, |h| {
+        let tick = h.client()?.held()?;
+        let m = tick.imus.get(index).ok_or_else(|| {
+            Error::new(
+                Code::Argument,
+                format!("IMU index {index}: the run has {} IMUs", tick.imus.len()),
+            )
+        })?;
+        let Some(m) = m else {
+            return Err(Error::new(
+                Code::Absent,
+                format!("IMU {index} has no sample at tick {} (lost)", tick.tick()),
+            ));
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write(out, FdImuMsg::from(m))? };
+        Ok(Code::Ok)
+    })
+}
+
+/// `flexdyn_lockstep_star_tracker`.
+///
+/// # Safety
+/// `handle` live; `out` a writable `fd_star_tracker_msg`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_star_tracker(
+    handle: *mut FlexdynClient,
+    index: usize,
+    out: *mut FdStarTrackerMsg,
+) -> c_int {
+    with_handle(handle, |h| {
+        let tick = h.client()?.held()?;
+        let m = tick.star_trackers.get(index).ok_or_else(|| {
+            Error::new(
+                Code::Argument,
+                format!(
+                    "star tracker index {index}: the run has {} star trackers",
+                    tick.star_trackers.len()
+                ),
+            )
+        })?;
+        let Some(m) = m else {
+            return Err(Error::new(
+                Code::Absent,
+                format!(
+                    "star tracker {index} has no sample at tick {} (not due, or lost)",
+                    tick.tick()
+                ),
+            ));
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write(out, FdStarTrackerMsg::from(m))? };
+        Ok(Code::Ok)
+    })
+}
+
+/// # Safety
+/// `handle` live.
+unsafe fn answer(
+    handle: *mut FlexdynClient,
+    kind: impl FnOnce() -> Result<CommandKind, Error>,
+) -> c_int {
+    with_handle(handle, |h| {
+        let kind = kind()?;
+        h.client()?.answer(kind)?;
+        Ok(Code::Ok)
+    })
+}
+
+/// `flexdyn_lockstep_answer_wrench`.
+///
+/// # Safety
+/// `handle` live; `torque_b_nm` and `force_b_newton` 3 doubles each.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_answer_wrench(
+    handle: *mut FlexdynClient,
+    torque_b_nm: *const f64,
+    force_b_newton: *const f64,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { answer(handle, || wrench(torque_b_nm, force_b_newton)) }
+}
+
+/// `flexdyn_lockstep_answer_no_command`.
+///
+/// # Safety
+/// `handle` live.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_answer_no_command(handle: *mut FlexdynClient) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { answer(handle, || Ok(CommandKind::NoCommand)) }
+}
+
+/// `flexdyn_lockstep_answer_actuators`.
+///
+/// # Safety
+/// As [`flexdyn_lockstep_answer_wrench`], and `inputs` `n_inputs` entries (null only when 0).
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_answer_actuators(
+    handle: *mut FlexdynClient,
+    torque_b_nm: *const f64,
+    force_b_newton: *const f64,
+    inputs: *const FdEffectorInput,
+    n_inputs: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe {
+        answer(handle, || {
+            actuators(torque_b_nm, force_b_newton, inputs, n_inputs)
+        })
+    }
+}
+
+/// `flexdyn_lockstep_leave`.
+///
+/// # Safety
+/// `handle` live.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_leave(handle: *mut FlexdynClient) -> c_int {
+    with_handle(handle, |h| {
+        h.client()?.leave();
+        Ok(Code::Ok)
+    })
+}
+
+// ---------------------------------------------------------------------------------------------
+// Decoders.
+
+/// The bytes `buf`/`len`.
+///
+/// # Safety
+/// `buf` points to `len` bytes (null only when `len` is 0).
+unsafe fn bytes<'a>(buf: *const u8, len: usize) -> Result<&'a [u8], Error> {
+    if len == 0 {
+        return Ok(&[]);
+    }
+    if buf.is_null() {
+        return Err(null("buf"));
+    }
+    // SAFETY: by this function's contract.
+    Ok(unsafe { std::slice::from_raw_parts(buf, len) })
+}
+
+/// `flexdyn_decode_state`.
+///
+/// # Safety
+/// `handle` live; `buf` `len` bytes; `out` as in [`flexdyn_poll_state`].
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_decode_state(
+    handle: *mut FlexdynClient,
+    buf: *const u8,
+    len: usize,
+    out: *mut FdStateMsg,
+) -> c_int {
+    with_handle(handle, |_| {
+        // SAFETY: forwarded contract.
+        let m = decode_state_bytes("buf", unsafe { bytes(buf, len)? })?;
+        // SAFETY: forwarded contract.
+        unsafe { write_state(out, &m)? };
+        Ok(Code::Ok)
+    })
+}
+
+/// Decodes `buf` with `decode_into` and writes the result to `out`.
+///
+/// # Safety
+/// `handle` live; `buf` `len` bytes; `out` a writable `T`.
+unsafe fn decode_fixed<T>(
+    handle: *mut FlexdynClient,
+    buf: *const u8,
+    len: usize,
+    out: *mut T,
+    decode_into: impl FnOnce(&str, &[u8]) -> Result<T, Error>,
+) -> c_int {
+    with_handle(handle, |_| {
+        // SAFETY: forwarded contract.
+        let m = decode_into("buf", unsafe { bytes(buf, len)? })?;
+        // SAFETY: forwarded contract.
+        unsafe { write(out, m)? };
+        Ok(Code::Ok)
+    })
+}
+
+/// `flexdyn_decode_imu`.
+///
+/// # Safety
+/// `handle` live; `buf` `len` bytes; `out` a writable `fd_imu_msg`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_decode_imu(
+    handle: *mut FlexdynClient,
+    buf: *const u8,
+    len: usize,
+    out: *mut FdImuMsg,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { decode_fixed(handle, buf, len, out, imu_c) }
+}
+
+/// `flexdyn_decode_star_tracker`.
+///
+/// # Safety
+/// `handle` live; `buf` `len` bytes; `out` a writable `fd_star_tracker_msg`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_decode_star_tracker(
+    handle: *mut FlexdynClient,
+    buf: *const u8,
+    len: usize,
+    out: *mut FdStarTrackerMsg,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { decode_fixed(handle, buf, len, out, star_tracker_c) }
+}
+
+/// `flexdyn_decode_status`.
+///
+/// # Safety
+/// `handle` live; `buf` `len` bytes; `out` a writable `fd_status_msg`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_decode_status(
+    handle: *mut FlexdynClient,
+    buf: *const u8,
+    len: usize,
+    out: *mut FdStatusMsg,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { decode_fixed(handle, buf, len, out, status_c) }
+}
+
+/// `flexdyn_struct_size`.
+#[no_mangle]
+pub extern "C" fn flexdyn_struct_size(which: c_int) -> usize {
+    use std::mem::size_of;
+    match which {
+        0 => size_of::<FdHeader>(),
+        1 => size_of::<FdStateMsg>(),
+        2 => size_of::<FdEffectorState>(),
+        3 => size_of::<FdImuMsg>(),
+        4 => size_of::<FdStarTrackerMsg>(),
+        5 => size_of::<FdEffectorInput>(),
+        6 => size_of::<FdStatusMsg>(),
+        _ => 0,
+    }
+}

@@ -1,0 +1,30 @@
+//! flexdyn-client: the C ABI client library of the flexdyn server.
+//!
+//! C and C++ flight code includes `include/flexdyn_client.h` (which includes the wire header
+//! `proto/c/include/flexdyn_proto.h`) and links `libflexdyn_client.a` or `.so`. The library
+//! wraps the Rust `zenoh` crate, so the program needs no zenoh-c, and the Rust codec of
+//! `flexdyn-proto`, so it decodes exactly as the server encodes; decoded messages are handed
+//! over in the header's own structs (`fd_state_msg`, `fd_imu_msg`, ...).
+//!
+//! # Layout
+//! - [`error`]: the return codes and the error that carries one with its message.
+//! - [`ctypes`]: the `#[repr(C)]` mirrors of the `flexdyn_proto.h` structs and the conversions
+//!   from (and, for effector inputs, to) the Rust messages.
+//! - [`client`]: the library in safe Rust: the session, subscriptions with ring queues, commands
+//!   and the lockstep participant (built on `flexdyn_proto::client`).
+//! - `ffi`: the `extern "C"` functions. The only module with `unsafe` code: pointer checks,
+//!   `catch_unwind` around every call, and the message of the last error in the handle.
+//!
+//! The header states the threading contract: a handle is used by one thread at a time, and no
+//! callback ever runs user code on a library thread.
+#![deny(unsafe_code)]
+#![deny(unsafe_op_in_unsafe_fn)]
+#![warn(missing_docs)]
+
+pub mod client;
+pub mod ctypes;
+pub mod error;
+mod ffi;
+
+pub use client::{Client, Options};
+pub use error::{Code, Error};
