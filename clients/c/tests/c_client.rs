@@ -1,0 +1,445 @@
+//! C and C++ programs linked against `libflexdyn_client.a`, against a real `flexdyn run`.
+//!
+//! `cargo test` builds `libflexdyn_client.a` with this test; the test builds the server with
+//! `cargo build -p flexdyn --bin flexdyn` in its own profile (a no-op when it is fresh), compiles
+//! the programs with the system compilers (`$CC`, else `cc`; `$CXX`, else `g++`) and runs them:
+//! - `struct_layouts_agree`: `tests/layout.c` decodes every golden message with the header's
+//!   own decoders and through the library, field by field, and compares the struct sizes;
+//! - `lockstep_stream_is_bit_identical_across_runs_and_under_sigstop`: `examples/pd_lockstep.c`
+//!   flies 2,001 lockstep ticks of `scenarios/wheels_star_tracker.toml` twice, the second time
+//!   stopped (SIGSTOP) for 1 s mid-run; both state streams must be the same bytes, every tick
+//!   must be there, and its Actuators commands must show in the wheels' applied torque;
+//! - `cpp17_example_builds_strictly_and_runs`: `examples/lockstep_monitor.cpp` under `-std=c++17
+//!   -Wall -Wextra -Werror -pedantic`, run as a participant that polls every subscription;
+//! - `server_loss_is_an_error_code_not_a_hang`: the server is killed (SIGKILL) mid-run; the C
+//!   program must exit with its timeout code within seconds;
+//! - `no_leak_over_10000_ticks`: pd_lockstep built with AddressSanitizer (LeakSanitizer sees
+//!   every allocation, the library's Rust ones included: they go through malloc) flies 10,000
+//!   ticks, and valgrind's memcheck a 500-tick run (the leak check would take minutes under
+//!   valgrind over 10,000); neither may report a definite leak. A deliberately leaked handle
+//!   (`tests/leak.c`) must be reported, so the checker is known to see the library's memory.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use flexdyn_proto::{decode_state, effector_kind, StateMsg};
+
+#[path = "../../../tests/ports/mod.rs"]
+mod ports;
+
+/// The libraries `rustc --print native-static-libs` names for the static library on Linux
+/// (README, "Attaching flight code").
+const NATIVE_LIBS: &[&str] = &[
+    "-ldl",
+    "-lgcc_s",
+    "-lutil",
+    "-lrt",
+    "-lpthread",
+    "-lm",
+    "-ldl",
+    "-lc",
+];
+
+/// The wheel-speed damping of `examples/pd_lockstep.c` [N m s/rad].
+const C_WHEEL_NMS: f64 = 1e-4;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn tmp() -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+}
+
+/// The static library and the server.
+struct Artifacts {
+    static_lib: PathBuf,
+    flexdyn: PathBuf,
+}
+
+/// The static library that this `cargo test` built with its rlib, in this test's own directory
+/// (`target/<profile>/deps/`: cargo copies it up to `target/<profile>/` only for `cargo build`,
+/// so the copy there may be stale), and the server, built once per test binary by
+/// `cargo build -p flexdyn --bin flexdyn` (a no-op when it is fresh, as in `cargo test
+/// --workspace`). Cargo runs with the variables it set for this test removed: build scripts
+/// such as ring's rerun when `CARGO_PKG_NAME` & co. differ, and would rebuild the server's
+/// dependencies on every run.
+fn artifacts() -> &'static Artifacts {
+    static ONCE: OnceLock<Artifacts> = OnceLock::new();
+    ONCE.get_or_init(|| {
+        let this = std::env::current_exe().expect("the test's path");
+        let deps = this.parent().expect("target/<profile>/deps/<test>");
+        let static_lib = deps.join("libflexdyn_client.a");
+        assert!(
+            static_lib.is_file(),
+            "{} is missing: cargo builds it with this test",
+            static_lib.display()
+        );
+        let mut cmd = Command::new(env!("CARGO"));
+        cmd.current_dir(root()).args([
+            "build",
+            "-p",
+            "flexdyn",
+            "--bin",
+            "flexdyn",
+            "--message-format=json-render-diagnostics",
+        ]);
+        for (key, _) in std::env::vars_os() {
+            let k = key.to_string_lossy();
+            let set_for_tests = k.starts_with("CARGO_PKG_")
+                || k.starts_with("CARGO_MANIFEST_")
+                || k.starts_with("CARGO_CRATE_")
+                || k.starts_with("CARGO_BIN_")
+                || k == "CARGO_PRIMARY_PACKAGE"
+                || k == "CARGO_TARGET_TMPDIR"
+                || k == "CARGO_RUSTC_CURRENT_DIR"
+                || k == "OUT_DIR";
+            if set_for_tests {
+                cmd.env_remove(&key);
+            }
+        }
+        if !cfg!(debug_assertions) {
+            cmd.arg("--release");
+        }
+        let out = cmd.stderr(Stdio::inherit()).output().expect("run cargo");
+        assert!(out.status.success(), "cargo build -p flexdyn failed");
+        let flexdyn = String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+            .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == "flexdyn")
+            .find_map(|m| m["executable"].as_str().map(PathBuf::from))
+            .expect("cargo named no flexdyn executable");
+        Artifacts {
+            static_lib,
+            flexdyn,
+        }
+    })
+}
+
+/// Compiles and links `sources` (relative to `clients/c`) against the static library.
+fn build(
+    compiler_var: &str,
+    default: &str,
+    flags: &[&str],
+    sources: &[&str],
+    out: &str,
+) -> PathBuf {
+    let compiler = std::env::var(compiler_var).unwrap_or_else(|_| default.to_owned());
+    let exe = tmp().join(out);
+    let c_dir = root().join("clients/c");
+    let result = Command::new(&compiler)
+        .args(flags)
+        .args(["-Wall", "-Wextra", "-Werror", "-pedantic"])
+        .arg("-I")
+        .arg(root().join("proto/c/include"))
+        .arg("-I")
+        .arg(c_dir.join("include"))
+        .args(sources.iter().map(|s| c_dir.join(s)))
+        .arg(&artifacts().static_lib)
+        .args(NATIVE_LIBS)
+        .arg("-o")
+        .arg(&exe)
+        .output()
+        .unwrap_or_else(|e| {
+            panic!("no compiler: running `{compiler}` failed ({e}); install gcc/g++ or set {compiler_var}")
+        });
+    assert!(
+        result.status.success(),
+        "{compiler} failed on {sources:?}:\n{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    exe
+}
+
+fn build_c(flags: &[&str], source: &str, out: &str) -> PathBuf {
+    let mut all = vec!["-std=c99"];
+    all.extend_from_slice(flags);
+    build("CC", "cc", &all, &[source], out)
+}
+
+/// A lockstep server with participant 1 on `scenarios/wheels_star_tracker.toml`, listening on a
+/// free loopback port; killed when dropped.
+struct Server {
+    child: Child,
+    endpoint: String,
+}
+
+impl Server {
+    fn start(duration_s: &str) -> Self {
+        let mut cmd = Command::new(&artifacts().flexdyn);
+        cmd.args(["run", "--mode", "lockstep", "--participants", "1"])
+            .args(["--listen", ports::ANY_PORT, "--duration-s", duration_s])
+            .arg("--config")
+            .arg(root().join("scenarios/wheels_star_tracker.toml"))
+            .stdout(Stdio::null());
+        let mut child = ports::reporting(&mut cmd).spawn().expect("start flexdyn");
+        let endpoint = ports::zenoh_endpoint(&mut child);
+        Self { child, endpoint }
+    }
+
+    fn wait(&mut self, limit: Duration) -> Option<i32> {
+        wait_for(&mut self.child, limit).code()
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Waits for `child` at most `limit` (killed and failed after that).
+fn wait_for(child: &mut Child, limit: Duration) -> std::process::ExitStatus {
+    let give_up = Instant::now() + limit;
+    loop {
+        if let Some(s) = child.try_wait().expect("wait") {
+            return s;
+        }
+        if Instant::now() > give_up {
+            let _ = child.kill();
+            panic!("process {} still running after {limit:?}", child.id());
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+fn signal(pid: u32, sig: &str) {
+    let ok = Command::new("kill")
+        .args([sig, &pid.to_string()])
+        .status()
+        .expect("run kill");
+    assert!(ok.success(), "kill {sig} {pid}");
+}
+
+/// Starts `exe args`, stdout piped (its `tick <k>` lines), stderr to the test's.
+fn spawn(exe: &Path, args: &[&str], env: &[(&str, &str)]) -> Child {
+    Command::new(exe)
+        .args(args)
+        .envs(env.iter().copied())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("start {}: {e}", exe.display()))
+}
+
+/// Reads `child`'s stdout until a line equals `line`; the rest is kept reading on a thread.
+fn await_line(child: &mut Child, line: &str) {
+    let stdout = child.stdout.take().expect("piped stdout");
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for l in BufReader::new(stdout).lines().map_while(Result::ok) {
+            let _ = tx.send(l);
+        }
+    });
+    let give_up = Instant::now() + Duration::from_secs(60);
+    loop {
+        let left = give_up.saturating_duration_since(Instant::now());
+        match rx.recv_timeout(left) {
+            Ok(l) if l == line => return,
+            Ok(_) => {}
+            Err(e) => panic!("no `{line}` from the program: {e}"),
+        }
+    }
+}
+
+/// Runs `cmd` to its end; its stdout, after checking that it succeeded.
+fn run_ok(cmd: &mut Command) -> String {
+    let out = cmd.output().expect("run the program");
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{:?}: {}\n{stdout}{}",
+        cmd.get_program(),
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// The states a pd_lockstep `state_out` file holds (each behind its u32 LE length).
+fn states(file: &Path) -> Vec<StateMsg> {
+    let bytes = std::fs::read(file).expect("the state file");
+    let mut at = 0;
+    let mut out = Vec::new();
+    while at < bytes.len() {
+        let n = u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        out.push(decode_state(&bytes[at + 4..at + 4 + n]).expect("a state the Rust codec reads"));
+        at += 4 + n;
+    }
+    out
+}
+
+#[test]
+fn struct_layouts_agree() {
+    let exe = build_c(&["-O2"], "tests/layout.c", "layout");
+    let stdout = run_ok(Command::new(&exe).arg(root().join("proto/golden")));
+    assert!(stdout.contains("state: 2 effectors compared"), "{stdout}");
+    assert!(stdout.ends_with("all agree\n"), "{stdout}");
+}
+
+/// One pd_lockstep run of ticks 0..=2000; with `pause`, SIGSTOP for 1 s at tick 1000.
+fn fly(exe: &Path, name: &str, pause: bool) -> PathBuf {
+    let mut server = Server::start("20");
+    let file = tmp().join(name);
+    let file_arg = file.to_string_lossy().into_owned();
+    let mut pd = spawn(exe, &[&server.endpoint, "2000", &file_arg], &[]);
+    if pause {
+        await_line(&mut pd, "tick 1000");
+        signal(pd.id(), "-STOP");
+        std::thread::sleep(Duration::from_secs(1));
+        assert!(
+            server.child.try_wait().unwrap().is_none(),
+            "the server ended while its participant was stopped"
+        );
+        signal(pd.id(), "-CONT");
+    }
+    let status = wait_for(&mut pd, Duration::from_secs(60));
+    let mut err = String::new();
+    std::io::Read::read_to_string(pd.stderr.as_mut().unwrap(), &mut err).ok();
+    assert!(status.success(), "pd_lockstep: {status:?}\n{err}");
+    assert_eq!(
+        server.wait(Duration::from_secs(30)),
+        Some(0),
+        "the server's exit"
+    );
+    file
+}
+
+#[test]
+fn lockstep_stream_is_bit_identical_across_runs_and_under_sigstop() {
+    let exe = build_c(&["-O2"], "examples/pd_lockstep.c", "pd_lockstep");
+    let plain = fly(&exe, "states_plain.bin", false);
+    let paused = fly(&exe, "states_paused.bin", true);
+    let a = std::fs::read(&plain).unwrap();
+    let b = std::fs::read(&paused).unwrap();
+    assert!(
+        a == b,
+        "the state stream changed when the C program was stopped"
+    );
+
+    let states = states(&plain);
+    let ticks: Vec<u64> = states.iter().map(|s| s.header.tick).collect();
+    assert_eq!(ticks, (0..=2000).collect::<Vec<u64>>());
+    // The Actuators answer to tick k - 1 set each wheel's motor torque to -C Omega(k - 1); the
+    // state of tick k reports the torque applied over that frame (far below the 0.2 N m limit).
+    let mut wheels_checked = 0;
+    for pair in states.windows(2) {
+        let (prev, next) = (&pair[0], &pair[1]);
+        for (e_prev, e_next) in prev.effectors.iter().zip(&next.effectors) {
+            if e_prev.kind == effector_kind::REACTION_WHEEL {
+                assert_eq!(
+                    e_next.outputs[0],
+                    -C_WHEEL_NMS * e_prev.states[0],
+                    "tick {}",
+                    next.header.tick
+                );
+                wheels_checked += 1;
+            }
+        }
+    }
+    assert_eq!(
+        wheels_checked,
+        4 * 2000,
+        "four wheels on every tick after 0"
+    );
+    // The PD wrench reached the hub: the applied torque of the last tick is not zero.
+    assert!(states[2000]
+        .wrench_applied
+        .torque_b_nm
+        .iter()
+        .any(|t| *t != 0.0));
+}
+
+#[test]
+fn cpp17_example_builds_strictly_and_runs() {
+    let exe = build(
+        "CXX",
+        "g++",
+        &["-std=c++17", "-O2"],
+        &["examples/lockstep_monitor.cpp"],
+        "lockstep_monitor",
+    );
+    let mut server = Server::start("3");
+    let stdout = run_ok(Command::new(&exe).args([&server.endpoint, "300"]));
+    // Ticks 0..=300: a state and an IMU sample each, the 10 Hz tracker on every 10th tick (31),
+    // and the server's last status says Finished (3).
+    assert_eq!(
+        stdout.trim(),
+        "states=301 imus=301 star_trackers=31 run_state=3"
+    );
+    assert_eq!(server.wait(Duration::from_secs(30)), Some(0));
+}
+
+#[test]
+fn server_loss_is_an_error_code_not_a_hang() {
+    let exe = build_c(&["-O2"], "examples/pd_lockstep.c", "pd_lockstep_loss");
+    let mut server = Server::start("1000");
+    let mut pd = spawn(&exe, &[&server.endpoint, "100000", "-", "2000"], &[]);
+    await_line(&mut pd, "tick 500");
+    server.child.kill().expect("kill the server");
+    let killed_at = Instant::now();
+    let status = wait_for(&mut pd, Duration::from_secs(30));
+    let waited = killed_at.elapsed();
+    let mut err = String::new();
+    std::io::Read::read_to_string(pd.stderr.as_mut().unwrap(), &mut err).ok();
+    assert_eq!(status.code(), Some(3), "the timeout exit code: {err}");
+    assert!(
+        err.contains("no tick on flexdyn/sc1/tlm/** within 2000 ms"),
+        "{err}"
+    );
+    assert!(waited < Duration::from_secs(10), "{waited:?}");
+}
+
+#[test]
+fn no_leak_over_10000_ticks() {
+    let asan = ["-O1", "-g", "-fsanitize=address", "-fno-omit-frame-pointer"];
+    let asan_env = [("ASAN_OPTIONS", "detect_leaks=1:exitcode=23")];
+    // The checker sees a handle the program never frees.
+    let leak = build_c(&asan, "tests/leak.c", "leak_asan");
+    let out = Command::new(&leak).envs(asan_env).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(23), "{err}");
+    assert!(err.contains("flexdyn_client_new"), "{err}");
+
+    // 10,000 ticks under AddressSanitizer: no leak, no memory error.
+    let exe = build_c(&asan, "examples/pd_lockstep.c", "pd_lockstep_asan");
+    let mut server = Server::start("100");
+    let mut pd = spawn(&exe, &[&server.endpoint, "10000", "-"], &asan_env);
+    let status = wait_for(&mut pd, Duration::from_secs(120));
+    let mut err = String::new();
+    std::io::Read::read_to_string(pd.stderr.as_mut().unwrap(), &mut err).ok();
+    assert!(status.success(), "{status:?}\n{err}");
+    assert_eq!(server.wait(Duration::from_secs(30)), Some(0));
+
+    // 500 ticks under valgrind's memcheck: no definite leak, no memory error.
+    let plain = build_c(&["-O1", "-g"], "examples/pd_lockstep.c", "pd_lockstep_vg");
+    let supp = root().join("clients/c/tests/valgrind.supp");
+    let server = Server::start("100");
+    let mut vg = Command::new("valgrind")
+        .args([
+            "--leak-check=full",
+            "--errors-for-leak-kinds=definite",
+            "--error-exitcode=99",
+        ])
+        .arg(format!("--suppressions={}", supp.display()))
+        .arg(&plain)
+        .args([server.endpoint.as_str(), "500", "-", "30000"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("valgrind (Debian: apt install valgrind)");
+    let status = wait_for(&mut vg, Duration::from_secs(120));
+    let mut err = String::new();
+    std::io::Read::read_to_string(vg.stderr.as_mut().unwrap(), &mut err).ok();
+    assert!(status.success(), "{status:?}\n{err}");
+    assert!(
+        err.contains("definitely lost: 0 bytes in 0 blocks")
+            || err.contains("no leaks are possible"),
+        "{err}"
+    );
+    drop(server);
+}
