@@ -17,7 +17,8 @@
 //!   every allocation, the library's Rust ones included: they go through malloc) flies 10,000
 //!   ticks, and valgrind's memcheck a 500-tick run (the leak check would take minutes under
 //!   valgrind over 10,000); neither may report a definite leak. A deliberately leaked handle
-//!   (`tests/leak.c`) must be reported, so the checker is known to see the library's memory.
+//!   (`tests/leak.c`) must be reported, so the checker is known to see the library's memory;
+//! - `readme_link_line_builds_the_example`: the README's compile-and-link line, as written.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -442,4 +443,56 @@ fn no_leak_over_10000_ticks() {
         "{err}"
     );
     drop(server);
+}
+
+/// The README's compile-and-link line ("C and C++ flight code: libflexdyn_client") works as
+/// written, run from the checkout's root with this test's library in place of
+/// `target/release/libflexdyn_client.a`, and names the system libraries the tests link.
+#[test]
+fn readme_link_line_builds_the_example() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let from = readme
+        .find("### C and C++ flight code: libflexdyn_client")
+        .expect("the README section");
+    let mut words = Vec::new();
+    let lines = readme[from..]
+        .lines()
+        .skip_while(|l| !l.starts_with("cc -std=c99"));
+    for line in lines {
+        words.extend(
+            line.split_whitespace()
+                .filter(|w| *w != "\\")
+                .map(String::from),
+        );
+        if !line.trim_end().ends_with('\\') {
+            break;
+        }
+    }
+    assert_eq!(words.first().map(String::as_str), Some("cc"), "{words:?}");
+    let libs: Vec<&str> = words
+        .iter()
+        .map(String::as_str)
+        .filter(|w| w.starts_with("-l"))
+        .collect();
+    assert_eq!(libs, NATIVE_LIBS, "the README's system libraries");
+    let out = tmp().join("pd_lockstep_readme");
+    let args: Vec<String> = words[1..]
+        .iter()
+        .map(|w| match w.as_str() {
+            "target/release/libflexdyn_client.a" => {
+                artifacts().static_lib.to_string_lossy().into_owned()
+            }
+            "pd_lockstep" => out.to_string_lossy().into_owned(),
+            _ => w.clone(),
+        })
+        .collect();
+    assert!(
+        args.iter().any(|a| *a == out.to_string_lossy()),
+        "{words:?}"
+    );
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".to_owned());
+    run_ok(Command::new(cc).args(&args).current_dir(root()));
+    // Linked, it runs: without arguments it prints its usage and exits 2.
+    let usage = Command::new(&out).output().unwrap();
+    assert_eq!(usage.status.code(), Some(2));
 }
