@@ -18,6 +18,8 @@
 //!   ticks, and valgrind's memcheck a 500-tick run (the leak check would take minutes under
 //!   valgrind over 10,000); neither may report a definite leak. A deliberately leaked handle
 //!   (`tests/leak.c`) must be reported, so the checker is known to see the library's memory;
+//! - `commands_outside_lockstep_arrive_as_sent`: `tests/send.c` sends every kind of command,
+//!   stamped from a state it waited for, to a Zenoh peer here that decodes them;
 //! - `readme_link_line_builds_the_example`: the README's compile-and-link line, as written.
 
 use std::io::{BufRead, BufReader};
@@ -55,30 +57,28 @@ fn tmp() -> PathBuf {
     PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
 }
 
-/// The static library and the server.
-struct Artifacts {
-    static_lib: PathBuf,
-    flexdyn: PathBuf,
-}
-
 /// The static library that this `cargo test` built with its rlib, in this test's own directory
 /// (`target/<profile>/deps/`: cargo copies it up to `target/<profile>/` only for `cargo build`,
-/// so the copy there may be stale), and the server, built once per test binary by
-/// `cargo build -p flexdyn --bin flexdyn` (a no-op when it is fresh, as in `cargo test
-/// --workspace`). Cargo runs with the variables it set for this test removed: build scripts
-/// such as ring's rerun when `CARGO_PKG_NAME` & co. differ, and would rebuild the server's
-/// dependencies on every run.
-fn artifacts() -> &'static Artifacts {
-    static ONCE: OnceLock<Artifacts> = OnceLock::new();
+/// so the copy there may be stale).
+fn static_lib() -> PathBuf {
+    let this = std::env::current_exe().expect("the test's path");
+    let deps = this.parent().expect("target/<profile>/deps/<test>");
+    let lib = deps.join("libflexdyn_client.a");
+    assert!(
+        lib.is_file(),
+        "{} is missing: cargo builds it with this test",
+        lib.display()
+    );
+    lib
+}
+
+/// The server, built once per test binary by `cargo build -p flexdyn --bin flexdyn` (a no-op
+/// when it is fresh, as in `cargo test --workspace`). Cargo runs with the variables it set for
+/// this test removed: build scripts such as ring's rerun when `CARGO_PKG_NAME` & co. differ,
+/// and would rebuild the server's dependencies on every run.
+fn flexdyn_bin() -> &'static Path {
+    static ONCE: OnceLock<PathBuf> = OnceLock::new();
     ONCE.get_or_init(|| {
-        let this = std::env::current_exe().expect("the test's path");
-        let deps = this.parent().expect("target/<profile>/deps/<test>");
-        let static_lib = deps.join("libflexdyn_client.a");
-        assert!(
-            static_lib.is_file(),
-            "{} is missing: cargo builds it with this test",
-            static_lib.display()
-        );
         let mut cmd = Command::new(env!("CARGO"));
         cmd.current_dir(root()).args([
             "build",
@@ -107,16 +107,12 @@ fn artifacts() -> &'static Artifacts {
         }
         let out = cmd.stderr(Stdio::inherit()).output().expect("run cargo");
         assert!(out.status.success(), "cargo build -p flexdyn failed");
-        let flexdyn = String::from_utf8_lossy(&out.stdout)
+        String::from_utf8_lossy(&out.stdout)
             .lines()
             .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
             .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == "flexdyn")
             .find_map(|m| m["executable"].as_str().map(PathBuf::from))
-            .expect("cargo named no flexdyn executable");
-        Artifacts {
-            static_lib,
-            flexdyn,
-        }
+            .expect("cargo named no flexdyn executable")
     })
 }
 
@@ -139,7 +135,7 @@ fn build(
         .arg("-I")
         .arg(c_dir.join("include"))
         .args(sources.iter().map(|s| c_dir.join(s)))
-        .arg(&artifacts().static_lib)
+        .arg(static_lib())
         .args(NATIVE_LIBS)
         .arg("-o")
         .arg(&exe)
@@ -170,7 +166,7 @@ struct Server {
 
 impl Server {
     fn start(duration_s: &str) -> Self {
-        let mut cmd = Command::new(&artifacts().flexdyn);
+        let mut cmd = Command::new(flexdyn_bin());
         cmd.args(["run", "--mode", "lockstep", "--participants", "1"])
             .args(["--listen", ports::ANY_PORT, "--duration-s", duration_s])
             .arg("--config")
@@ -479,9 +475,7 @@ fn readme_link_line_builds_the_example() {
     let args: Vec<String> = words[1..]
         .iter()
         .map(|w| match w.as_str() {
-            "target/release/libflexdyn_client.a" => {
-                artifacts().static_lib.to_string_lossy().into_owned()
-            }
+            "target/release/libflexdyn_client.a" => static_lib().to_string_lossy().into_owned(),
             "pd_lockstep" => out.to_string_lossy().into_owned(),
             _ => w.clone(),
         })
@@ -495,4 +489,80 @@ fn readme_link_line_builds_the_example() {
     // Linked, it runs: without arguments it prints its usage and exits 2.
     let usage = Command::new(&out).output().unwrap();
     assert_eq!(usage.status.code(), Some(2));
+}
+
+/// `tests/send.c` waits for a state on an ordinary subscription, then sends a Wrench, a
+/// NoCommand and an Actuators command stamped from it; this test is the peer it connects to
+/// (a Zenoh session on a free port that publishes a state until the three commands come) and
+/// reads them back with the Rust decoder.
+#[test]
+fn commands_outside_lockstep_arrive_as_sent() {
+    use flexdyn_proto::client::transport::{listening_on, zenoh_config, Role, ZenohArgs};
+    use flexdyn_proto::{decode_command, encode, CommandKind, EffectorInput, Header};
+    use zenoh::Wait;
+
+    let exe = build_c(&["-O2"], "tests/send.c", "send");
+    let args = ZenohArgs {
+        listen: vec![ports::ANY_PORT.to_owned()],
+        ..ZenohArgs::default()
+    };
+    let session = zenoh::open(zenoh_config(&args, Role::Server).unwrap())
+        .wait()
+        .unwrap();
+    let endpoint = listening_on(&session).remove(0);
+    let commands = session
+        .declare_subscriber("flexdyn/sc1/cmd/*")
+        .wait()
+        .unwrap();
+    let mut child = spawn(&exe, &[&endpoint], &[]);
+    let state = StateMsg {
+        header: Header::new(9, 42, 420_000_000, 17),
+        ..StateMsg::default()
+    };
+    let mut got = Vec::new();
+    let give_up = Instant::now() + Duration::from_secs(30);
+    while got.len() < 3 && Instant::now() < give_up {
+        session
+            .put("flexdyn/sc1/tlm/state", encode(&state))
+            .wait()
+            .unwrap();
+        while let Ok(Some(s)) = commands.try_recv() {
+            assert_eq!(s.key_expr().as_str(), "flexdyn/sc1/cmd/7");
+            got.push(decode_command(&s.payload().to_bytes()).expect("a valid CommandMsg"));
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let status = wait_for(&mut child, Duration::from_secs(30));
+    let mut err = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).ok();
+    assert!(status.success(), "{status:?}\n{err}");
+    let (torque, force) = ([0.5, -0.25, 0.125], [1.0, 2.0, 3.0]);
+    let expected = [
+        CommandKind::Wrench {
+            torque_b_nm: torque,
+            force_b_newton: force,
+        },
+        CommandKind::NoCommand,
+        CommandKind::Actuators {
+            torque_b_nm: torque,
+            force_b_newton: force,
+            inputs: vec![
+                EffectorInput {
+                    effector_index: 3,
+                    values: vec![-0.0625],
+                },
+                EffectorInput {
+                    effector_index: 5,
+                    values: vec![1.5, 2.5],
+                },
+            ],
+        },
+    ];
+    assert_eq!(got.len(), 3, "{got:?}");
+    for (seq, (cmd, kind)) in got.iter().zip(expected).enumerate() {
+        // Stamped from the state (its spacecraft id, tick and time), numbered by the library.
+        assert_eq!(cmd.header, Header::new(9, 42, 420_000_000, seq as u64));
+        assert_eq!((cmd.sender_id, &cmd.kind), (7, &kind));
+    }
+    session.close().wait().unwrap();
 }
