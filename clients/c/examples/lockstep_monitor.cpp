@@ -48,7 +48,7 @@ bool drain(const Client &c, Counts &n, std::vector<fd_effector_state> &effectors
     while ((rc = flexdyn_poll_state(c.get(), &st)) == FLEXDYN_OK) ++n.states;
     if (rc != FLEXDYN_EMPTY) return false;
     fd_imu_msg imu{};
-    std::array<char, 65> name{};
+    std::array<char, FLEXDYN_NAME_CAP> name{};
     while ((rc = flexdyn_poll_imu(c.get(), &imu, name.data(), name.size())) == FLEXDYN_OK)
         ++n.imus;
     if (rc != FLEXDYN_EMPTY) return false;

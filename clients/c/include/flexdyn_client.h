@@ -103,7 +103,9 @@ int flexdyn_wait_state(flexdyn_client *client, fd_state_msg *out, uint32_t timeo
 
 /* name: one IMU, or NULL for all of them (flexdyn/<sc>/tlm/imu/ + star). */
 int flexdyn_subscribe_imu(flexdyn_client *client, const char *name, size_t capacity);
-/* name_out (may be NULL) receives the IMU's name, NUL-terminated; 65 bytes always fit. */
+/* name_out (may be NULL) receives the sensor's name, NUL-terminated: give it at least
+ * FLEXDYN_NAME_CAP bytes (FLEXDYN_ERR_ARGUMENT otherwise, checked before a sample is taken). */
+#define FLEXDYN_NAME_CAP 65
 int flexdyn_poll_imu(flexdyn_client *client, fd_imu_msg *out, char *name_out, size_t name_cap);
 int flexdyn_wait_imu(flexdyn_client *client, fd_imu_msg *out, char *name_out, size_t name_cap,
                      uint32_t timeout_ms);
@@ -140,7 +142,8 @@ int flexdyn_send_actuators(flexdyn_client *client, uint32_t sender_id, const fd_
  * subscribes to flexdyn/<sc>/tlm, then declares the token flexdyn/<sc>/participant/<sender_id>. */
 int flexdyn_lockstep_join(flexdyn_client *client, uint32_t sender_id, uint32_t timeout_ms);
 /* The next complete tick: its state into *state (effectors in your array). The tick is held
- * until the next wait; answer it once. */
+ * until the next wait; answer it once. A due sensor sample still missing 1 s after its state
+ * (lost: never in a healthy lockstep run) is left out, and its getter says FLEXDYN_ERR_ABSENT. */
 int flexdyn_lockstep_wait(flexdyn_client *client, fd_state_msg *state, uint32_t timeout_ms);
 /* The sensors each tick may carry, in configuration order (0 before a join). Names stay valid
  * until the next join, leave or close. */

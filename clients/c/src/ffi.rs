@@ -255,7 +255,7 @@ unsafe fn write<T>(out: *mut T, value: T) -> Result<(), Error> {
     Ok(())
 }
 
-/// The longest sensor name plus its NUL.
+/// The longest sensor name plus its NUL (`FLEXDYN_NAME_CAP` in the header).
 const NAME_CAP: usize = MAX_ID_LEN + 1;
 
 /// Checks a name buffer before a sample is taken (so a sample is never lost to it).
