@@ -15,7 +15,7 @@ use flexdyn_proto::{EffectorState, StateMsg};
 
 use crate::attitude::{mrp_to_dcm, mrp_to_quat};
 use crate::config::{ConfigError, EffectorInputSegment, SimConfig};
-use crate::dynamics::{HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment};
+use crate::dynamics::{HubOutputs, ParamError, SensorPoint, Spacecraft, Wrench, WrenchSegment};
 use crate::environment::model::EnvironmentModel;
 use crate::sensors::imu::{Imu, ImuBank, ImuSample};
 use crate::sensors::star_tracker::{StarTracker, StarTrackerSample};
@@ -245,7 +245,7 @@ impl Simulation {
         self.frame_outputs = None;
         self.apply_schedules();
         self.update_environment();
-        self.sc.step();
+        self.sc.step_with(&mut self.imus);
     }
 
     /// [`Self::steps_per_frame`] steps.
@@ -366,6 +366,11 @@ impl Simulation {
         self.imus.imus()
     }
 
+    /// Where each IMU sits (r_S/B) and how its platform is turned ([PB]), in config order.
+    pub fn imu_points(&self) -> &[SensorPoint] {
+        self.imus.points()
+    }
+
     /// \[ns\] start of the current IMU sample interval.
     pub fn imu_interval_start_ns(&self) -> u64 {
         self.imus.interval_start_ns()
@@ -387,7 +392,7 @@ impl Simulation {
     ///
     /// Truth (see [`crate::sensors::imu`]): rate and specific force at the current state, with the
     /// wrench that applies from now on (schedule(t) + command, as in [`Self::state_into`]);
-    /// Δθ from σ_B/N at the interval's start and now; Δv from the RK4 accumulators, which are
+    /// Δθ from σ_B/N at the interval's start and now; Δv integrated over the RK4 stages by the IMUs' stage hook, which is
     /// then reset. Each IMU's error model is stepped with dt = the interval's length (0 for the
     /// first call at t = 0, whose Δθ and Δv are exactly zero).
     pub fn imu_samples_into(&mut self, out: &mut Vec<ImuSample>) {
@@ -396,7 +401,7 @@ impl Simulation {
             return;
         }
         let hub = self.frame_outputs();
-        self.imus.sample_into(&mut self.sc, &hub, out);
+        self.imus.sample_into(&self.sc, &hub, out);
     }
 
     /// The star trackers, in config order (topic `flexdyn/<sc-id>/tlm/st/<name>`).
@@ -425,7 +430,7 @@ impl Simulation {
     /// accumulated so far). Call it after replacing the spacecraft state (e.g. a snapshot
     /// restore) so the next Δθ/Δv do not span the jump.
     pub fn restart_imu_interval(&mut self) {
-        self.imus.restart(&mut self.sc);
+        self.imus.restart(&self.sc);
     }
 }
 

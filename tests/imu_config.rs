@@ -290,9 +290,8 @@ fn shipped_imu_tactical_scenario() {
         assert_ne!(imu.gyro.dtheta_lsb_rad, 0.0);
         assert_ne!(imu.accel.dv_lsb_m_s, 0.0);
     }
-    let sc = cfg.build_spacecraft().unwrap();
-    assert_eq!(sc.sensor_points().len(), 2);
-    assert_eq!(sc.sensor_points()[1].r_sb_b_m, Vector3::new(0.0, 1.0, 0.5));
     let sim = Simulation::new(&cfg).unwrap();
+    assert_eq!(sim.imu_points().len(), 2);
+    assert_eq!(sim.imu_points()[1].r_sb_b_m, Vector3::new(0.0, 1.0, 0.5));
     assert_eq!(sim.imu_names(), ["hub", "bracket"]);
 }

@@ -797,7 +797,6 @@ fn library_accel(sc: &mut Spacecraft, x: &Sample) -> (DVector<f64>, V3) {
         sigma_bn: x.sigma_bn,
         omega_bn_b: x.omega_bn_b,
         effectors: x.eff.iter().chain(&x.wheel_omega).copied().collect(),
-        sensor_dv_p: Vec::new(),
     };
     let mut dx = state.clone();
     let out = sc.derivatives(&state, &mut dx);

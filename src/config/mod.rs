@@ -161,8 +161,7 @@ impl SimConfig {
 
     /// Builds the spacecraft: one [`PanelPair`] per configured pair (errors name
     /// `panel_pairs[i]…`), then one [`ReactionWheel`] per wheel (`reaction_wheels[i]…`), then
-    /// [`Spacecraft::new`], then one sensor point per IMU in file order (sensor point `i` is
-    /// `imus[i]`).
+    /// [`Spacecraft::new`], then the dynamic effectors of `[environment]`.
     pub fn build_spacecraft(&self) -> Result<Spacecraft, ConfigError> {
         let mut effectors: Vec<Box<dyn StateEffector>> = Vec::with_capacity(self.panel_pairs.len());
         for (i, (params, initial)) in self.panel_pairs.iter().enumerate() {
@@ -180,9 +179,6 @@ impl SimConfig {
             self.initial,
             self.step_ns,
         )?;
-        for (i, imu) in self.imus.iter().enumerate() {
-            sc.add_sensor_point(imu.sensor_point(), &format!("imus[{i}]"))?;
-        }
         if let Some(env) = &self.environment {
             world::add_dynamic_effectors(&mut sc, env, &self.gravity);
         }

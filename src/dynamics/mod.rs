@@ -39,6 +39,7 @@ pub mod effector;
 pub mod effectors;
 pub mod params;
 pub mod spacecraft;
+pub mod stage_hook;
 
 pub use dynamic_effector::{DynamicEffector, StageState};
 pub use effector::{

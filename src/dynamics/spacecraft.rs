@@ -13,7 +13,8 @@ use super::dynamic_effector::{DynamicEffector, StageState};
 use super::effector::{
     BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
-use super::params::{GravityModel, HubParams, SensorPoint, Wrench};
+use super::params::{GravityModel, HubParams, Wrench};
+use super::stage_hook::{rk4_combine, NoHook, StageCombine, StageHook};
 use super::ParamError;
 use crate::attitude::{mrp_rate, mrp_switch, mrp_to_dcm, tilde};
 use crate::environment::EnvironmentSample;
@@ -31,22 +32,16 @@ pub struct State {
     pub omega_bn_b: Vector3<f64>,
     /// Effector states, concatenated in effector order (for a panel pair: θ1, θ̇1, θ2, θ̇2).
     pub effectors: Vec<f64>,
-    /// [m/s] per sensor point, the velocity increment Δv_P = ∫ [PB] f_B dt accumulated since the
-    /// last [`Spacecraft::reset_sensor_dv`], f the specific force at the point (derivative: f in P
-    /// components). Integrated by the same RK4 stages as the dynamics, so it is exact to
-    /// integrator precision; it never feeds back into the dynamics.
-    pub sensor_dv_p: Vec<Vector3<f64>>,
 }
 
 impl State {
-    fn zeros(n: usize, n_sensors: usize) -> Self {
+    fn zeros(n: usize) -> Self {
         Self {
             r_bn_n: Vector3::zeros(),
             v_bn_n: Vector3::zeros(),
             sigma_bn: Vector3::zeros(),
             omega_bn_b: Vector3::zeros(),
             effectors: vec![0.0; n],
-            sensor_dv_p: vec![Vector3::zeros(); n_sensors],
         }
     }
 
@@ -64,14 +59,6 @@ impl State {
             .zip(&k.effectors)
         {
             *o = xi + h * ki;
-        }
-        for ((o, xi), ki) in self
-            .sensor_dv_p
-            .iter_mut()
-            .zip(&x.sensor_dv_p)
-            .zip(&k.sensor_dv_p)
-        {
-            *o = xi + ki * h;
         }
     }
 }
@@ -278,7 +265,6 @@ struct EquationsOfMotion {
     ranges: Vec<Range<usize>>,
     force_b_newton: Vector3<f64>,
     torque_b_nm: Vector3<f64>,
-    sensors: Vec<SensorPoint>,
     /// Indices of the effectors whose [`StateEffector::uses_begin_step`] is true.
     stepped: Vec<usize>,
     /// Range of each effector's inputs in the flat input vector of
@@ -407,11 +393,6 @@ impl EquationsOfMotion {
         dx.v_bn_n = dcm_nb * accel_b + gravity_n;
         dx.sigma_bn = mrp_rate(&x.sigma_bn, &omega);
         dx.omega_bn_b = omega_dot;
-        // Specific force at each sensor point, in its platform frame:
-        // f = a_B,nongrav + ω̇ × r_S/B + ω × (ω × r_S/B).
-        for (s, d) in self.sensors.iter().zip(dx.sensor_dv_p.iter_mut()) {
-            *d = s.dcm_pb * specific_force_b(&accel_b, &omega, &omega_dot, &s.r_sb_b_m);
-        }
         HubOutputs {
             nongrav_accel_bn_b: accel_b,
             omega_dot_bn_b: omega_dot,
@@ -479,7 +460,7 @@ impl Spacecraft {
         let r = hub.r_bcb_b_m;
         let hub_inertia_pnt_b_b = hub.inertia_bc_b_kg_m2
             + (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose()) * hub.mass_kg;
-        let zero = State::zeros(n, 0);
+        let zero = State::zeros(n);
         let mut sc = Self {
             eom: EquationsOfMotion {
                 dynamic: Vec::new(),
@@ -496,7 +477,6 @@ impl Spacecraft {
                 stepped,
                 force_b_newton: Vector3::zeros(),
                 torque_b_nm: Vector3::zeros(),
-                sensors: Vec::new(),
             },
             state: zero.clone(),
             t_sim_ns: 0,
@@ -546,12 +526,10 @@ impl Spacecraft {
 
     /// Replaces the state (e.g. to restore a snapshot). Lengths must match [`Self::state`]'s.
     pub fn set_state(&mut self, state: &State) -> Result<(), ParamError> {
-        if state.effectors.len() != self.state.effectors.len()
-            || state.sensor_dv_p.len() != self.state.sensor_dv_p.len()
-        {
+        if state.effectors.len() != self.state.effectors.len() {
             return Err(ParamError::StateLength {
-                expected: self.state.effectors.len() + 3 * self.state.sensor_dv_p.len(),
-                found: state.effectors.len() + 3 * state.sensor_dv_p.len(),
+                expected: self.state.effectors.len(),
+                found: state.effectors.len(),
             });
         }
         self.state.clone_from(state);
@@ -729,87 +707,50 @@ impl Spacecraft {
     /// (each effector's [`StateEffector::begin_step`] runs first, at the step's initial state),
     /// then switches σ to its shadow set if |σ| > 1. Allocates nothing.
     pub fn step(&mut self) {
+        self.step_with(&mut NoHook);
+    }
+
+    /// [`Self::step`], handing every stage's evaluation to `hook` and closing the step with the
+    /// RK4 combination ([`super::stage_hook`]). Allocates nothing (if `hook` allocates nothing).
+    pub fn step_with<H: StageHook + ?Sized>(&mut self, hook: &mut H) {
         self.begin_step();
         let h = self.step_ns as f64 * 1e-9;
         let t0 = self.t_sim_ns;
         let Self { eom, state, ws, .. } = self;
-        eom.eval(state, &mut ws.k1, t0, 0.0);
+        let out = eom.eval(state, &mut ws.k1, t0, 0.0);
+        hook.stage(0, state, &out);
         ws.stage.set_axpy(state, 0.5 * h, &ws.k1);
-        eom.eval(&ws.stage, &mut ws.k2, t0, 0.5 * h);
+        let out = eom.eval(&ws.stage, &mut ws.k2, t0, 0.5 * h);
+        hook.stage(1, &ws.stage, &out);
         ws.stage.set_axpy(state, 0.5 * h, &ws.k2);
-        eom.eval(&ws.stage, &mut ws.k3, t0, 0.5 * h);
+        let out = eom.eval(&ws.stage, &mut ws.k3, t0, 0.5 * h);
+        hook.stage(2, &ws.stage, &out);
         ws.stage.set_axpy(state, h, &ws.k3);
-        eom.eval(&ws.stage, &mut ws.k4, t0, h);
-        let h6 = h / 6.0;
+        let out = eom.eval(&ws.stage, &mut ws.k4, t0, h);
+        hook.stage(3, &ws.stage, &out);
         let (k1, k2, k3, k4) = (&ws.k1, &ws.k2, &ws.k3, &ws.k4);
-        state.r_bn_n += (k1.r_bn_n + (k2.r_bn_n + k3.r_bn_n) * 2.0 + k4.r_bn_n) * h6;
-        state.v_bn_n += (k1.v_bn_n + (k2.v_bn_n + k3.v_bn_n) * 2.0 + k4.v_bn_n) * h6;
-        state.sigma_bn += (k1.sigma_bn + (k2.sigma_bn + k3.sigma_bn) * 2.0 + k4.sigma_bn) * h6;
-        state.omega_bn_b +=
-            (k1.omega_bn_b + (k2.omega_bn_b + k3.omega_bn_b) * 2.0 + k4.omega_bn_b) * h6;
+        state.r_bn_n += rk4_combine(k1.r_bn_n, k2.r_bn_n, k3.r_bn_n, k4.r_bn_n, h);
+        state.v_bn_n += rk4_combine(k1.v_bn_n, k2.v_bn_n, k3.v_bn_n, k4.v_bn_n, h);
+        state.sigma_bn += rk4_combine(k1.sigma_bn, k2.sigma_bn, k3.sigma_bn, k4.sigma_bn, h);
+        state.omega_bn_b += rk4_combine(
+            k1.omega_bn_b,
+            k2.omega_bn_b,
+            k3.omega_bn_b,
+            k4.omega_bn_b,
+            h,
+        );
         for i in 0..state.effectors.len() {
-            state.effectors[i] += h6
-                * (k1.effectors[i] + 2.0 * (k2.effectors[i] + k3.effectors[i]) + k4.effectors[i]);
+            state.effectors[i] += rk4_combine(
+                k1.effectors[i],
+                k2.effectors[i],
+                k3.effectors[i],
+                k4.effectors[i],
+                h,
+            );
         }
-        for i in 0..state.sensor_dv_p.len() {
-            state.sensor_dv_p[i] += (k1.sensor_dv_p[i]
-                + (k2.sensor_dv_p[i] + k3.sensor_dv_p[i]) * 2.0
-                + k4.sensor_dv_p[i])
-                * h6;
-        }
+        hook.end_step(&StageCombine::rk4(h));
         mrp_switch(&mut state.sigma_bn);
         self.t_sim_ns += self.step_ns;
-    }
-
-    /// Adds a sensor point (an IMU location and platform frame) whose Δv is accumulated inside the
-    /// RK4 integration; returns its index. Construction-time only: it resizes the state buffers.
-    pub fn add_sensor_point(
-        &mut self,
-        point: SensorPoint,
-        path: &str,
-    ) -> Result<usize, ParamError> {
-        point.validate(path)?;
-        self.eom.sensors.push(point);
-        for s in [
-            &mut self.state,
-            &mut self.ws.k1,
-            &mut self.ws.k2,
-            &mut self.ws.k3,
-            &mut self.ws.k4,
-            &mut self.ws.stage,
-        ] {
-            s.sensor_dv_p.push(Vector3::zeros());
-        }
-        Ok(self.eom.sensors.len() - 1)
-    }
-
-    /// The sensor points, in index order.
-    pub fn sensor_points(&self) -> &[SensorPoint] {
-        &self.eom.sensors
-    }
-
-    /// [m/s] Δv accumulated at each sensor point since the last reset, platform components.
-    pub fn sensor_dv_p(&self) -> &[Vector3<f64>] {
-        &self.state.sensor_dv_p
-    }
-
-    /// Zeroes every sensor's Δv accumulator (at a frame or log boundary).
-    pub fn reset_sensor_dv(&mut self) {
-        for dv in &mut self.state.sensor_dv_p {
-            *dv = Vector3::zeros();
-        }
-    }
-
-    /// Truth at sensor point `i` given the hub outputs at the current state: ([rad/s] ω_B/N in P,
-    /// [m/s²] specific force in P).
-    pub fn sensor_truth(&self, i: usize, out: &HubOutputs) -> (Vector3<f64>, Vector3<f64>) {
-        let s = &self.eom.sensors[i];
-        let w = &self.state.omega_bn_b;
-        (
-            s.dcm_pb * w,
-            s.dcm_pb
-                * specific_force_b(&out.nongrav_accel_bn_b, w, &out.omega_dot_bn_b, &s.r_sb_b_m),
-        )
     }
 
     /// Hub accelerations at the current state with the current wrench (one derivative evaluation;

@@ -5,13 +5,13 @@
 //! At the end t1 of each sample interval \[t0, t1\] (dt = t1 − t0):
 //! - rate: ω_P = \[PB\] ω_B/N(t1);
 //! - specific force: f_P = \[PB\] (a_B,nongrav + ω̇ × r_S/B + ω × (ω × r_S/B)) at t1, from the
-//!   dynamics' own r̈ and ω̇ ([`crate::dynamics::Spacecraft::sensor_truth`]), so the panels'
+//!   dynamics' own r̈ and ω̇ ([`sensor_truth`]), so the panels'
 //!   flexing reaches the accelerometer through the hub's accelerations;
 //! - Δθ_P: the rotation vector of \[P1 P0\] = \[PB\]\[BN\](t1) (\[PB\]\[BN\](t0))ᵀ, computed exactly from
 //!   σ_BN(t0) and σ_BN(t1) ([`attitude_increment_b`]). It is an eigenvector of \[P1 P0\], so its
 //!   components are the same in P0 and P1. It requires |ω| dt < π (no aliasing);
-//! - Δv_P = ∫ f_P dt over the interval, accumulated inside the RK4 stages
-//!   ([`crate::dynamics::Spacecraft::sensor_dv_p`]).
+//! - Δv_P = ∫ f_P dt over the interval, integrated from the integrator's own stages by a
+//!   per-stage hook ([`ImuBank`], [`crate::dynamics::stage_hook`]) with the state's combination.
 //!
 //! # Error model (per triad; u = rad/s for the gyro, m/s² for the accelerometer)
 //! With G = I + diag(s) + M (s: scale-factor errors, a fraction; M: misalignment, zero diagonal,
@@ -71,7 +71,7 @@ mod bank;
 pub(crate) mod plausibility;
 pub(crate) mod schema;
 
-pub use bank::ImuBank;
+pub use bank::{sensor_truth, ImuBank};
 
 /// Largest allowed |misalignment| element \[rad\]: the model is first order in these angles.
 pub const MAX_MISALIGNMENT_RAD: f64 = 0.1;
