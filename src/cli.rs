@@ -8,12 +8,13 @@ use std::num::NonZeroU64;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use flexdyn_proto::{command_flags, AppliedWrench, Header, ImuMsg, StarTrackerMsg, StateMsg};
+use flexdyn_proto::{command_flags, AppliedWrench, Header, StateMsg};
 
 use crate::config::{
     config_message, log_warnings, warning_message, whole_ns, ConfigError, SimConfig,
 };
 use crate::numfmt::Num;
+use crate::sensors::Sensor;
 use crate::server::error::SettingsError;
 use crate::server::settings::ServerSettings;
 use crate::sim::Simulation;
@@ -212,28 +213,30 @@ fn scheduled_wrench(cfg: &SimConfig, t_ns: u64) -> AppliedWrench {
 }
 
 /// One `simulate` row in the CSV dialect of [`crate::sinks::table`]: the state record (as
-/// `export` writes it), the scheduled wrench, each IMU's sample (`imu_names` order) and each
-/// star tracker's sample taken at this instant (`st_names` order; `None`: no update here, its
-/// cells stay empty).
+/// `export` writes it), the scheduled wrench, then each sensor's columns in publication order
+/// (`None`: no sample in this row, its cells stay empty).
 fn simulate_row(
     state: &StateMsg,
     wrench_schedule: &AppliedWrench,
-    imu_names: &[String],
-    imu: &[ImuMsg],
-    st_names: &[String],
-    st: &[Option<StarTrackerMsg>],
+    sensors: impl Iterator<Item = Option<Vec<Column>>>,
 ) -> Vec<Column> {
     let mut row = state_row(state);
     row.extend(prefixed_columns("wrench_schedule", wrench_schedule));
-    for (name, msg) in imu_names.iter().zip(imu) {
-        row.extend(prefixed_columns(&format!("imu_{name}"), msg));
-    }
-    for (name, msg) in st_names.iter().zip(st) {
-        if let Some(msg) = msg {
-            row.extend(prefixed_columns(&format!("st_{name}"), msg));
-        }
-    }
+    row.extend(sensors.flatten().flatten());
     row
+}
+
+/// A sensor's CSV columns: the fields of its message without the header, prefixed
+/// `<kind>_<name>_` (`imu_hub_omega_p_rad_s_1`, `st_st1_q_cn_0`).
+fn sensor_columns(s: &dyn Sensor, header: Header, buf: &mut Vec<u8>) -> Vec<Column> {
+    s.encode(header, buf);
+    let json = (s.kind().decode)(buf).map_or(serde_json::Value::Null, |(_, json)| json);
+    prefixed_columns(&sensor_prefix(s), &json)
+}
+
+/// `<kind>_<name>`.
+fn sensor_prefix(s: &dyn Sensor) -> String {
+    format!("{}_{}", s.kind().column_prefix, s.name())
 }
 
 /// Simulates `cfg` for `duration_s`, writing a CSV row at t = 0 and every `log_every_s` to
@@ -241,9 +244,10 @@ fn simulate_row(
 ///
 /// Each row is the state record the server would publish at that instant (`tick` is the frame
 /// the instant falls in, `seq` the row number; no flight code, so `wrench_applied` is zero and
-/// `command_flags` says no command yet), then the scheduled wrench, then the IMUs (their sample
-/// interval is the log interval) and the star trackers (sampled at their update ticks, as the
-/// server does; their cells are filled in the rows that fall on an update).
+/// `command_flags` says no command yet), then the scheduled wrench, then the sensors: those
+/// that integrate over an interval (the IMUs) at every row, their interval being the log
+/// interval; the others (the star trackers) sampled at the frame boundaries where they are due,
+/// as the server does, their cells filled in the rows that fall on such a sample.
 pub fn simulate_to<W: Write>(
     cfg: &SimConfig,
     duration_s: f64,
@@ -254,9 +258,9 @@ pub fn simulate_to<W: Write>(
     let total_steps = whole_steps("--duration-s", duration_s, cfg.step_ns, true)?;
     let log_steps = whole_steps("--log-every-s", log_every_s, cfg.step_ns, false)?;
     let mut sim = Simulation::new(cfg).map_err(|source| CliError::Config { file: None, source })?;
-    // The IMU sample interval is the log interval (log_steps ≥ 1 and step_ns ≥ 1).
+    // The sensors' sample interval is the log interval (log_steps ≥ 1 and step_ns ≥ 1).
     if let Some(ns) = NonZeroU64::new(log_steps * cfg.step_ns) {
-        sim.set_imu_sample_interval_ns(ns);
+        sim.set_sensor_sample_interval_ns(ns);
     }
     let io_err = |source| CliError::Output {
         target: target.to_string(),
@@ -268,43 +272,42 @@ pub fn simulate_to<W: Write>(
         .unwrap_or_default()
         .spacecraft_id;
     let steps_per_frame = sim.steps_per_frame();
-    let n_trackers = sim.star_trackers().len();
+    let at_frames = sim.sensors().any(|s| !s.every_output());
 
-    let imu_names = sim.imu_names().to_vec();
-    let st_names: Vec<String> = sim
-        .star_trackers()
-        .iter()
-        .map(|t| t.name().to_owned())
-        .collect();
     let mut state = sim.blank_state();
     state.command_flags = command_flags::NO_COMMAND_YET;
-    let mut imu_samples = Vec::with_capacity(imu_names.len());
-    let mut st_due = Vec::with_capacity(n_trackers);
-    // Per tracker: the step of its last update and that sample.
-    let mut st_last: Vec<Option<(u64, StarTrackerMsg)>> = vec![None; n_trackers];
-    let mut sample_trackers = |sim: &mut Simulation, step: u64, last: &mut [Option<_>]| {
-        if n_trackers > 0 && step.is_multiple_of(steps_per_frame) {
-            let tick = step / steps_per_frame;
-            sim.star_tracker_samples_into(tick, &mut st_due);
-            let header = Header::new(spacecraft_id, tick, sim.t_sim_ns(), tick);
-            for (i, sample) in &st_due {
-                last[*i] = Some((step, sample.to_msg(header)));
-            }
+    let mut buf = Vec::new();
+    // Per sensor: the step of its last sample and that sample's columns.
+    let mut last: Vec<Option<(u64, Vec<Column>)>> = vec![None; sim.sensors().len()];
+    let mut take = |sim: &Simulation, step: u64, header: Header, last: &mut [Option<_>]| {
+        let bank = sim.sensors();
+        for &i in bank.sampled() {
+            last[i] = Some((
+                step,
+                sensor_columns(bank.sensors()[i].as_ref(), header, &mut buf),
+            ));
         }
     };
+    let sample_frame_sensors = |sim: &mut Simulation, step: u64| -> Option<Header> {
+        if !(at_frames && step.is_multiple_of(steps_per_frame)) {
+            return None;
+        }
+        let tick = step / steps_per_frame;
+        sim.sample_sensors(|s| !s.every_output() && s.due(tick));
+        Some(Header::new(spacecraft_id, tick, sim.t_sim_ns(), tick))
+    };
 
-    // The header: every column a row can have (each tracker as at an update).
-    let columns: Vec<String> = simulate_row(
-        &state,
-        &AppliedWrench::default(),
-        &imu_names,
-        &vec![ImuMsg::default(); imu_names.len()],
-        &st_names,
-        &vec![Some(StarTrackerMsg::default()); n_trackers],
-    )
-    .into_iter()
-    .map(|(name, _)| name)
-    .collect();
+    // The header: every column a row can have (each sensor as at a sample).
+    let all = sim.sensors().sensors().iter().map(|s| {
+        Some(prefixed_columns(
+            &sensor_prefix(s.as_ref()),
+            &(s.kind().default_json)(),
+        ))
+    });
+    let columns: Vec<String> = simulate_row(&state, &AppliedWrench::default(), all)
+        .into_iter()
+        .map(|(name, _)| name)
+        .collect();
     // What t_s = 0 is, when the configuration has an [epoch].
     let comments: Vec<String> = cfg
         .epoch
@@ -316,37 +319,35 @@ pub fn simulate_to<W: Write>(
     let n_logged = total_steps / log_steps;
     let mut step = 0u64;
     let start = Instant::now();
-    sample_trackers(&mut sim, 0, &mut st_last);
+    if let Some(header) = sample_frame_sensors(&mut sim, 0) {
+        take(&sim, 0, header, &mut last);
+    }
     for k in 0..=n_logged {
-        // Step to the row, stopping at each frame boundary when a tracker may update there.
+        // Step to the row, stopping at each frame boundary when a sensor may sample there.
         let row_step = k * log_steps;
         while step < row_step {
-            let next = if n_trackers > 0 {
+            let next = if at_frames {
                 row_step.min((step / steps_per_frame + 1) * steps_per_frame)
             } else {
                 row_step
             };
             sim.step_n(next - step);
             step = next;
-            sample_trackers(&mut sim, step, &mut st_last);
+            if let Some(header) = sample_frame_sensors(&mut sim, step) {
+                take(&sim, step, header, &mut last);
+            }
         }
         sim.state_into(&mut state);
         let t_ns = state.header.sim_time_ns;
         state.header = Header::new(spacecraft_id, t_ns / cfg.frame_ns, t_ns, k);
-        sim.imu_samples_into(&mut imu_samples);
-        let imu: Vec<ImuMsg> = imu_samples.iter().map(|s| s.to_msg(state.header)).collect();
-        let st_now: Vec<Option<StarTrackerMsg>> = st_last
-            .iter()
-            .map(|s| s.filter(|(at, _)| *at == step).map(|(_, m)| m))
-            .collect();
-        let row = simulate_row(
-            &state,
-            &scheduled_wrench(cfg, t_ns),
-            &imu_names,
-            &imu,
-            &st_names,
-            &st_now,
-        );
+        sim.sample_sensors(|s| s.every_output());
+        take(&sim, step, state.header, &mut last);
+        let now = last.iter().map(|l| {
+            l.as_ref()
+                .filter(|(at, _)| *at == step)
+                .map(|(_, cols)| cols.clone())
+        });
+        let row = simulate_row(&state, &scheduled_wrench(cfg, t_ns), now);
         // Once per row, outside the stepping loop: never write a non-finite state.
         if let Some(quantity) = first_non_finite_column(&row) {
             table.flush().map_err(io_err)?;

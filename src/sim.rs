@@ -5,9 +5,11 @@
 //! inputs). Before every RK4 step it applies `schedule(t) + command` to both, where `t` is the
 //! time at the start of the step; wrench and inputs are then held constant over the step.
 //!
-//! It also owns the IMU error models ([`crate::sensors::imu`]): [`Simulation::imu_samples_into`] closes
-//! the current IMU sample interval (every frame in the server, every log interval in
-//! `simulate`) and returns one [`ImuSample`] per configured IMU.
+//! It also owns the sensors ([`crate::sensors::SensorBank`]): [`Simulation::sample_sensors`]
+//! samples those picked (the ones due at a frame boundary in the server; in `simulate`, the
+//! interval sensors such as the IMUs at every log row and the others at their frame boundaries)
+//! from one [`Truth`], and the IMUs integrate their Δv over the integrator's stages (the bank is
+//! the step's [`crate::dynamics::stage_hook::StageHook`]).
 
 use std::num::NonZeroU64;
 
@@ -15,10 +17,9 @@ use flexdyn_proto::{EffectorState, StateMsg};
 
 use crate::attitude::{mrp_to_dcm, mrp_to_quat};
 use crate::config::{ConfigError, EffectorInputSegment, SimConfig};
-use crate::dynamics::{HubOutputs, ParamError, SensorPoint, Spacecraft, Wrench, WrenchSegment};
+use crate::dynamics::{HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment};
 use crate::environment::model::EnvironmentModel;
-use crate::sensors::imu::{Imu, ImuBank, ImuSample};
-use crate::sensors::star_tracker::{StarTracker, StarTrackerSample};
+use crate::sensors::{Sensor, SensorBank, Truth};
 
 /// A spacecraft being propagated, with its external wrench sources.
 #[derive(Debug)]
@@ -49,11 +50,8 @@ pub struct Simulation {
     /// the state record and every sensor share one evaluation per frame. Cleared by anything that
     /// changes the state, the wrench or the inputs.
     frame_outputs: Option<HubOutputs>,
-    /// The IMUs and their sample-interval bookkeeping; IMU `i` is the spacecraft's sensor
-    /// point `i`.
-    imus: ImuBank,
-    /// The star trackers in config order.
-    star_trackers: Vec<StarTracker>,
+    /// The sensors, in registry then config order; the IMUs' Δv rides the stage hook.
+    sensors: SensorBank,
     /// The environment models (`[environment]` with an `[epoch]`), updated at their rate at
     /// step boundaries and handed to the spacecraft's dynamic effectors.
     environment: Option<EnvironmentModel>,
@@ -64,14 +62,7 @@ impl Simulation {
     pub fn new(cfg: &SimConfig) -> Result<Self, ConfigError> {
         let sc = cfg.build_spacecraft()?;
         let frame_s = cfg.frame_ns as f64 * 1e-9;
-        let imus = ImuBank::new(&cfg.imus, frame_s, &sc)?;
-        let mut star_trackers = Vec::with_capacity(cfg.star_trackers.len());
-        for (i, st) in cfg.star_trackers.iter().enumerate() {
-            star_trackers.push(StarTracker::new(
-                st.clone(),
-                &format!("star_trackers[{i}]"),
-            )?);
-        }
+        let sensors = SensorBank::new(cfg, frame_s, sc.t_sim_ns(), sc.state())?;
         let environment = cfg.environment_model()?;
         let mut sim = Self {
             environment,
@@ -88,8 +79,7 @@ impl Simulation {
             schedule: cfg.wrench_schedule.clone(),
             cursor: 0,
             command: Wrench::ZERO,
-            imus,
-            star_trackers,
+            sensors,
         };
         sim.apply_schedules();
         Ok(sim)
@@ -245,7 +235,7 @@ impl Simulation {
         self.frame_outputs = None;
         self.apply_schedules();
         self.update_environment();
-        self.sc.step_with(&mut self.imus);
+        self.sc.step_with(&mut self.sensors);
     }
 
     /// [`Self::steps_per_frame`] steps.
@@ -351,86 +341,45 @@ impl Simulation {
         };
     }
 
-    /// The IMU names in config order (topic `flexdyn/<sc-id>/tlm/imu/<name>`).
-    pub fn imu_names(&self) -> &[String] {
-        self.imus.names()
+    /// The sensors, in publication order.
+    pub fn sensors(&self) -> &SensorBank {
+        &self.sensors
     }
 
-    /// Number of IMUs.
-    pub fn n_imus(&self) -> usize {
-        self.imus.imus().len()
-    }
-
-    /// The IMU error models, in config order.
-    pub fn imus(&self) -> &[Imu] {
-        self.imus.imus()
-    }
-
-    /// Where each IMU sits (r_S/B) and how its platform is turned ([PB]), in config order.
-    pub fn imu_points(&self) -> &[SensorPoint] {
-        self.imus.points()
-    }
-
-    /// \[ns\] start of the current IMU sample interval.
-    pub fn imu_interval_start_ns(&self) -> u64 {
-        self.imus.interval_start_ns()
-    }
-
-    /// Sets every IMU's nominal sample interval T_s (default: the frame period). The
-    /// instantaneous outputs carry white noise of standard deviation N/√T_s; `simulate` sets it
-    /// to the log interval. It does not change where intervals end: that is when
-    /// [`Self::imu_samples_into`] is called.
-    pub fn set_imu_sample_interval_ns(&mut self, interval_ns: NonZeroU64) {
-        // A positive whole number of ns is finite and > 0.
-        self.imus
-            .set_sample_interval_s(interval_ns.get() as f64 * 1e-9);
-    }
-
-    /// Closes the current IMU sample interval at the current time and writes one measurement per
-    /// IMU (config order) into `out` (cleared first; after the first call this allocates
-    /// nothing). Then starts the next interval here.
-    ///
-    /// Truth (see [`crate::sensors::imu`]): rate and specific force at the current state, with the
-    /// wrench that applies from now on (schedule(t) + command, as in [`Self::state_into`]);
-    /// Δθ from σ_B/N at the interval's start and now; Δv integrated over the RK4 stages by the IMUs' stage hook, which is
-    /// then reset. Each IMU's error model is stepped with dt = the interval's length (0 for the
-    /// first call at t = 0, whose Δθ and Δv are exactly zero).
-    pub fn imu_samples_into(&mut self, out: &mut Vec<ImuSample>) {
-        if self.imus.imus().is_empty() {
-            out.clear();
+    /// Samples every sensor `pick` selects at the current instant, from one truth: the state, the
+    /// frame's hub outputs (with the wrench and inputs that apply from now on, as in
+    /// [`Self::state_into`]; evaluated only if some sensor is picked, and shared with the state
+    /// record) and the environment sample. [`SensorBank::sampled`] then lists them. After the
+    /// first call this allocates nothing.
+    pub fn sample_sensors(&mut self, pick: impl Fn(&dyn Sensor) -> bool) {
+        if !self.sensors.any(&pick) {
+            self.sensors.clear_sampled();
             return;
         }
         let hub = self.frame_outputs();
-        self.imus.sample_into(&self.sc, &hub, out);
+        let truth = Truth {
+            t_sim_ns: self.sc.t_sim_ns(),
+            state: self.sc.state(),
+            hub: &hub,
+            env: self.environment.as_ref().map(|_| self.sc.environment()),
+        };
+        self.sensors.sample(&truth, pick);
     }
 
-    /// The star trackers, in config order (topic `flexdyn/<sc-id>/tlm/st/<name>`).
-    pub fn star_trackers(&self) -> &[StarTracker] {
-        &self.star_trackers
+    /// Sets every sensor's nominal sample interval (default: the frame period); `simulate`
+    /// sets it to the log interval. It does not change where intervals end: that is when the
+    /// sensor is sampled.
+    pub fn set_sensor_sample_interval_ns(&mut self, interval_ns: NonZeroU64) {
+        // A positive whole number of ns is finite and > 0.
+        self.sensors
+            .set_sample_interval_s(interval_ns.get() as f64 * 1e-9);
     }
 
-    /// Samples every star tracker due at frame boundary `tick` (see
-    /// [`StarTracker::due`]) at the current state, writing `(index, sample)` pairs into `out`
-    /// (cleared first; after the first call this allocates nothing).
-    pub fn star_tracker_samples_into(
-        &mut self,
-        tick: u64,
-        out: &mut Vec<(usize, StarTrackerSample)>,
-    ) {
-        out.clear();
-        let state = self.sc.state();
-        for (i, st) in self.star_trackers.iter_mut().enumerate() {
-            if st.due(tick) {
-                out.push((i, st.sample(&state.sigma_bn, &state.omega_bn_b)));
-            }
-        }
-    }
-
-    /// Starts a new IMU sample interval at the current state without sampling (discards the Δv
-    /// accumulated so far). Call it after replacing the spacecraft state (e.g. a snapshot
-    /// restore) so the next Δθ/Δv do not span the jump.
-    pub fn restart_imu_interval(&mut self) {
-        self.imus.restart(&self.sc);
+    /// Starts a new interval of every sensor at the current state without sampling (an IMU
+    /// discards the Δv accumulated so far). Call it after replacing the spacecraft state (e.g.
+    /// a snapshot restore) so the next Δθ/Δv do not span the jump.
+    pub fn restart_sensors(&mut self) {
+        self.sensors.restart(self.sc.t_sim_ns(), self.sc.state());
     }
 }
 

@@ -31,7 +31,7 @@ fn the_frame_path_does_not_allocate() {
     assert!(sim.n_imus() > 0);
     assert!(!sim.star_trackers().is_empty());
     let shape = sim.blank_state();
-    let (n_imus, n_sts) = (sim.n_imus(), sim.star_trackers().len());
+    let n_sensors = sim.sensors().len();
     let settings = ServerSettings {
         participants: vec![1, 2],
         ..ServerSettings::default()
@@ -42,7 +42,7 @@ fn the_frame_path_does_not_allocate() {
     let (full_tx, full_rx) = sync_channel::<Box<Frame>>(2);
     for _ in 0..2 {
         free_tx
-            .send(Box::new(Frame::for_state(&shape, n_imus, n_sts)))
+            .send(Box::new(Frame::for_state(&shape, n_sensors)))
             .unwrap();
     }
     // Sender 2 commands the four wheels (effectors 2–5). Its Actuators commands own heap

@@ -1,12 +1,167 @@
-//! Sensor models, one folder per kind. Each folder owns the kind's parameters, its
-//! configuration schema (`schema.rs`), its measurement model and its message mapping:
-//! [`imu`] (gyro and accelerometer) and [`star_tracker`] (attitude).
+//! Sensor models, one folder per kind, behind one contract ([`Sensor`]) and one registry
+//! ([`KINDS`]). Each folder owns the kind's parameters, its configuration schema
+//! (`schema.rs`), its measurement model, its message mapping and its [`SensorKind`]
+//! descriptor: [`imu`] (gyro and accelerometer) and [`star_tracker`] (attitude).
 //!
-//! Every sensor is sampled at a frame boundary from the same truth: the state and the one
+//! Every sensor is sampled at a frame boundary (or, for a sensor that integrates over an
+//! interval, at each output instant) from the same truth, a [`Truth`]: the state and the one
 //! evaluation of the hub outputs that the frame's snapshot also uses
-//! ([`crate::sim::Simulation`] caches it), so adding sensors adds no equation-of-motion
-//! evaluations.
+//! ([`crate::sim::Simulation`] caches it), plus the environment sample when there is one, so
+//! adding sensors adds no equation-of-motion evaluations. The [`SensorBank`] holds a spacecraft's
+//! sensors in registry order, then config order, which is also their publication order.
+//!
+//! Everything that handles sensors generically — the bank, the server's publishers and its
+//! recorder, `simulate`'s CSV columns, topic classification, export, plot, view and the campaign's
+//! seed keys — iterates [`KINDS`]; a new kind is its folder, its line in [`KINDS`] and its wire
+//! message (the codecs).
 
+use std::any::Any;
+
+use flexdyn_proto::keys::Topics;
+use flexdyn_proto::{DecodeError, Header, KeyError};
+
+use crate::config::{ConfigError, SimConfig};
+use crate::dynamics::stage_hook::StageCombine;
+use crate::dynamics::{HubOutputs, State};
+use crate::environment::EnvironmentSample;
+
+pub mod bank;
 pub mod imu;
 pub mod rng;
 pub mod star_tracker;
+
+pub use bank::SensorBank;
+
+/// Every sensor kind, in publication order: the registry.
+pub static KINDS: [&SensorKind; 2] = [&imu::KIND, &star_tracker::KIND];
+
+/// The truth one sample is taken from: one evaluation at the current instant.
+#[derive(Debug, Clone, Copy)]
+pub struct Truth<'a> {
+    /// \[ns\] simulation time.
+    pub t_sim_ns: u64,
+    /// The integrated state.
+    pub state: &'a State,
+    /// The hub accelerations at `state` with the wrench and inputs that apply from now on.
+    pub hub: &'a HubOutputs,
+    /// The environment sample (`[environment]` with an `[epoch]`), if any.
+    pub env: Option<&'a EnvironmentSample>,
+}
+
+/// One sensor: what the bank, the server and the sinks need of it. Every method called per
+/// frame or per stage allocates nothing, locks nothing and cannot fail.
+pub trait Sensor: std::fmt::Debug + Send {
+    /// Its kind (an entry of [`KINDS`]).
+    fn kind(&self) -> &'static SensorKind;
+
+    /// Its configured name (the last segment of its key).
+    fn name(&self) -> &str;
+
+    /// Whether it samples at frame boundary `tick`.
+    fn due(&self, tick: u64) -> bool;
+
+    /// Whether it closes an integration interval at every output instant (every frame in the
+    /// server, every row in `simulate`) rather than at the frame boundaries where it is due.
+    fn every_output(&self) -> bool {
+        false
+    }
+
+    /// Takes one sample from `truth`, kept until the next (see [`Self::encode`]).
+    fn sample(&mut self, truth: &Truth<'_>);
+
+    /// Encodes the last sample as its wire message into `buf` (cleared first), with the frame's
+    /// `header` (the sensor may set its own `seq`).
+    fn encode(&self, header: Header, buf: &mut Vec<u8>);
+
+    /// The first non-finite output of the last sample, if any.
+    fn first_non_finite(&self) -> Option<&'static str>;
+
+    /// Whether it integrates over the stages of every step ([`Self::stage`], [`Self::end_step`]).
+    fn uses_stages(&self) -> bool {
+        false
+    }
+
+    /// Stage `stage` of the current step was evaluated at `x` with hub accelerations `hub`
+    /// ([`crate::dynamics::stage_hook`]).
+    fn stage(&mut self, _stage: usize, _x: &State, _hub: &HubOutputs) {}
+
+    /// The step is complete: combine the stage values with `combine`.
+    fn end_step(&mut self, _combine: &StageCombine) {}
+
+    /// Starts a new interval at the current instant without sampling (e.g. after a state
+    /// restore).
+    fn restart(&mut self, _t_sim_ns: u64, _x: &State) {}
+
+    /// Sets the nominal sample interval \[s\] (finite, > 0) of a sensor whose noise depends on
+    /// it; others ignore it.
+    fn set_sample_interval_s(&mut self, _t_s: f64) {}
+
+    /// For the kind's own typed views ([`SensorBank::of`]).
+    fn as_any(&self) -> &dyn Any;
+}
+
+/// A figure panel of a sensor kind's plot: `(column, legend)` pairs of its message's columns.
+#[derive(Debug)]
+pub struct PanelSpec {
+    /// The y-axis label.
+    pub y_label: &'static str,
+    /// `(column of the decoded message, legend entry)`.
+    pub lines: &'static [(&'static str, &'static str)],
+}
+
+/// Builds a kind's sensors of `cfg` (config order) into `out`, with a nominal sample interval
+/// of `sample_interval_s` \[s\], their first interval starting at `t_sim_ns` and state `x`.
+pub type BuildFn = fn(
+    cfg: &SimConfig,
+    sample_interval_s: f64,
+    t_sim_ns: u64,
+    x: &State,
+    out: &mut Vec<Box<dyn Sensor>>,
+) -> Result<(), ConfigError>;
+
+/// Decodes a kind's payload into its header and its JSON.
+pub type DecodeFn = fn(&[u8]) -> Result<(Header, serde_json::Value), DecodeError>;
+
+/// A sensor kind: how it is built, keyed, decoded, and plotted. One `static` per folder.
+#[derive(Debug)]
+pub struct SensorKind {
+    /// Its name in messages, with its article (`an IMU`, `a star tracker`).
+    pub a_noun: &'static str,
+    /// The configuration array (`imus`, `star_trackers`): error paths and campaign seed keys.
+    pub config_array: &'static str,
+    /// The key prefix below `flexdyn/<sc>/` (`tlm/imu`); the key is `<prefix>/<name>`.
+    pub key_prefix: &'static str,
+    /// The prefix of its `simulate` CSV columns and the last segment of its key prefix
+    /// (`imu`, `st`).
+    pub column_prefix: &'static str,
+    /// The wire message's name, as in `proto/README.md` (`ImuMsg`).
+    pub message_name: &'static str,
+    /// Its key for spacecraft `topics` and a sensor name (validates the name).
+    pub key: fn(&Topics, &str) -> Result<String, KeyError>,
+    /// Builds the kind's sensors of a configuration.
+    pub build: BuildFn,
+    /// Decodes a payload into its header and its JSON (fields named as in the wire struct).
+    pub decode: DecodeFn,
+    /// The JSON of a default message (its column set).
+    pub default_json: fn() -> serde_json::Value,
+    /// The JSON Schema (draft 2020-12) of the decoded JSON.
+    pub json_schema: fn() -> serde_json::Value,
+    /// `flexdyn plot`: the figure's file, its title and the panels drawn per sensor.
+    pub plot: (&'static str, &'static str, &'static [PanelSpec]),
+}
+
+impl SensorKind {
+    /// Its index in [`KINDS`] (`None` for a kind not registered).
+    pub fn index(&'static self) -> Option<usize> {
+        KINDS.iter().position(|k| std::ptr::eq(*k, self))
+    }
+}
+
+/// The message `msg` as `(header, JSON)`, for [`SensorKind::decode`].
+pub fn json_of<M: serde::Serialize>(header: Header, msg: &M) -> (Header, serde_json::Value) {
+    (
+        header,
+        // Wire structs hold only numbers, bools and arrays: always representable.
+        serde_json::to_value(msg).unwrap_or(serde_json::Value::Null),
+    )
+}

@@ -197,7 +197,12 @@ fn prepare(
         state = topics.state(),
         commands = topics.cmd_wildcard(),
         status = topics.status(),
-        imus = ?sim.imu_names(),
+        sensors = ?sim
+            .sensors()
+            .sensors()
+            .iter()
+            .map(|s| format!("{}/{}", s.kind().key_prefix, s.name()))
+            .collect::<Vec<_>>(),
         "flexdyn server starting: {}",
         cfg.summary()
     );
@@ -268,8 +273,8 @@ impl Wiring {
         let (free_tx, free_rx) = sync_channel::<Box<Frame>>(n_buffers);
         let (full_tx, full_rx) = sync_channel::<Box<Frame>>(n_buffers);
         let shape = sim.blank_state();
-        let (n_imus, n_sts) = (sim.n_imus(), sim.star_trackers().len());
-        let new_frame = || Box::new(Frame::for_state(&shape, n_imus, n_sts));
+        let n_sensors = sim.sensors().len();
+        let new_frame = || Box::new(Frame::for_state(&shape, n_sensors));
         let frame_ns = sim.frame_ns();
         let input_ranges = sim.spacecraft().effector_input_ranges().to_vec();
         let stepper = Stepper::new(sim, settings);

@@ -8,9 +8,9 @@
 //! 2. takes the commands for tick `k` (real time/batch: whatever has arrived; lockstep: waits
 //!    until every participant has answered tick `k`) and holds their sum over the frame;
 //! 3. integrates the frame's RK4 steps ([`Simulation::step_frame`]);
-//! 4. samples the IMUs ([`Simulation::imu_samples_into`], closing their interval every frame)
-//!    and the star trackers that are due ([`Simulation::star_tracker_samples_into`])
-//!    and fills the state and IMU samples of tick `k + 1` into a free telemetry buffer.
+//! 4. samples the sensors due at tick `k + 1` ([`Simulation::sample_sensors`]; an IMU closes
+//!    its interval every frame) and fills the state and the sensor messages of tick `k + 1` into
+//!    a free telemetry buffer.
 //!
 //! Steps 2–4 ([`Stepper`]) never allocate, lock or do I/O: commands arrive through a bounded
 //! channel, the telemetry buffers are a fixed pool cycled through two bounded channels, and
@@ -38,8 +38,6 @@ use super::publish::FramePublisher;
 use super::settings::ServerSettings;
 use super::shared::{fill_state, Frame, Shared};
 use crate::dynamics::Wrench;
-use crate::sensors::imu::ImuSample;
-use crate::sensors::star_tracker::StarTrackerSample;
 use crate::sim::Simulation;
 use crate::sinks::table::first_non_finite;
 
@@ -101,8 +99,6 @@ pub struct Stepper {
     pub held: Held,
     /// The state record of the last tick filled or checked.
     state: StateMsg,
-    imu: Vec<ImuSample>,
-    st: Vec<(usize, StarTrackerSample)>,
     spacecraft_id: u32,
 }
 
@@ -117,18 +113,14 @@ impl Stepper {
             sim.spacecraft().effector_input_ranges(),
         );
         let state = sim.blank_state();
-        // IMU samples close their interval every frame, published or not.
-        let mut imu = Vec::with_capacity(sim.n_imus());
-        let mut st = Vec::with_capacity(sim.star_trackers().len());
-        sim.imu_samples_into(&mut imu);
-        sim.star_tracker_samples_into(0, &mut st);
+        // Sensors are sampled at every frame where they are due, published or not (an IMU
+        // closes its interval every frame).
+        sim.sample_sensors(|s| s.due(0));
         Self {
             sim,
             book,
             held: Held::initial(settings.stale_policy),
             state,
-            imu,
-            st,
             spacecraft_id: settings.spacecraft_id,
         }
     }
@@ -141,10 +133,15 @@ impl Stepper {
         frame.command = self.held.status;
         frame.lateness_ns = 0;
         frame.published = false;
-        frame.imu.clear();
-        frame.imu.extend_from_slice(&self.imu);
-        frame.star_trackers.clear();
-        frame.star_trackers.extend_from_slice(&self.st);
+        frame.sensors_sampled.clear();
+        let bank = self.sim.sensors();
+        for &i in bank.sampled() {
+            if let (Some(s), Some(buf)) = (bank.sensors().get(i), frame.sensor_payloads.get_mut(i))
+            {
+                s.encode(frame.state.header, buf);
+                frame.sensors_sampled.push(i);
+            }
+        }
     }
 
     /// Frame `k` → `k + 1`: holds the book's commands for tick `k`, integrates the frame's RK4
@@ -159,8 +156,7 @@ impl Stepper {
         // finite by the decoder.
         let _ = self.sim.set_effector_inputs(self.book.held_inputs());
         self.sim.step_frame();
-        self.sim.imu_samples_into(&mut self.imu);
-        self.sim.star_tracker_samples_into(k + 1, &mut self.st);
+        self.sim.sample_sensors(|s| s.due(k + 1));
     }
 
     /// Once per frame, outside the RK4 loop: never publish a non-finite state. `filled` says
@@ -169,14 +165,12 @@ impl Stepper {
         if !filled {
             self.sim.state_into(&mut self.state);
         }
-        let imu_bad = self.imu.iter().find_map(|s| s.first_non_finite());
-        let imu_bad = imu_bad.map(|q| format!("an IMU's {q} output"));
-        let st_bad = self
-            .st
-            .iter()
-            .find_map(|(_, s)| s.first_non_finite())
-            .map(|q| format!("a star tracker's {q} output"));
-        match first_non_finite(&self.state).or(imu_bad.or(st_bad)) {
+        let sensor_bad = self
+            .sim
+            .sensors()
+            .first_non_finite()
+            .map(|(s, q)| format!("{}'s {q} output", s.kind().a_noun));
+        match first_non_finite(&self.state).or(sensor_bad) {
             Some(quantity) => Err(ServerError::NonFinite {
                 tick: k,
                 t_s: self.state.header.sim_time_ns as f64 * 1e-9,

@@ -1,5 +1,6 @@
-//! Publishing one frame's telemetry: its IMU samples, the star-tracker samples due at its tick,
-//! then its StateMsg, in that order (a controller that waits for the state finds the sensor
+//! Publishing one frame's telemetry: the messages of the sensors sampled at its tick (in
+//! publication order: [`crate::sensors::KINDS`], then config order), then its StateMsg, in that
+//! order (a controller that waits for the state finds the sensor
 //! samples of the same tick already delivered).
 //!
 //! Which thread calls [`FramePublisher::publish`] is the `server.handoff` setting:
@@ -15,6 +16,7 @@
 //! Each sample carries the 8-byte frame-boundary stamp as its attachment
 //! ([`crate::transport::frame_stamp_ns`]).
 
+use std::fmt;
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
@@ -23,41 +25,16 @@ use zenoh::pubsub::Publisher;
 use zenoh::Wait;
 
 use super::shared::{Frame, Shared};
+use crate::sensors::SensorKind;
 use crate::sinks::recorder::{RecordItem, RecordTx};
 
-/// Which sensor a payload comes from: its index among the IMUs or the star trackers (config
-/// order).
-#[derive(Clone, Copy)]
-enum Sensor {
-    Imu(usize),
-    StarTracker(usize),
-}
-
-/// Encodes each sensor sample of `frame` into `buf`, in publication order (the IMUs, then the
-/// star trackers due at its tick), and hands it to `each`. `st_every` gives a tracker's update
-/// period in frames (`None`: no such tracker, skipped); a tracker's `seq` counts its messages,
-/// +1 per update.
-fn for_each_sensor_payload(
-    frame: &Frame,
-    st_every: impl Fn(usize) -> Option<u64>,
-    buf: &mut Vec<u8>,
-    mut each: impl FnMut(Sensor, &[u8]),
-) {
-    let header = frame.state.header;
-    for (i, sample) in frame.imu.iter().enumerate() {
-        encode_into(&sample.to_msg(header), buf);
-        each(Sensor::Imu(i), buf);
-    }
-    for (i, sample) in &frame.star_trackers {
-        let Some(every) = st_every(*i) else {
-            continue;
-        };
-        let h = flexdyn_proto::Header {
-            seq: header.tick / every,
-            ..header
-        };
-        encode_into(&sample.to_msg(h), buf);
-        each(Sensor::StarTracker(*i), buf);
+/// Hands each sensor message of `frame` to `each` with the sensor's index in the bank, in
+/// publication order.
+fn for_each_sensor_payload(frame: &Frame, mut each: impl FnMut(usize, &[u8])) {
+    for &i in &frame.sensors_sampled {
+        if let Some(payload) = frame.sensor_payloads.get(i) {
+            each(i, payload);
+        }
     }
 }
 
@@ -68,27 +45,18 @@ pub struct Recording {
     state: Arc<str>,
     /// `flexdyn/<sc>/status`.
     pub status: Arc<str>,
-    imus: Vec<Arc<str>>,
-    sts: Vec<Arc<str>>,
-    st_every: Vec<u64>,
+    /// Per sensor of the bank, its key.
+    sensors: Vec<Arc<str>>,
 }
 
 impl Recording {
-    /// The key a sensor's payloads are filed under (`None`: no such sensor).
-    fn sensor_key(&self, sensor: Sensor) -> Option<&Arc<str>> {
-        match sensor {
-            Sensor::Imu(i) => self.imus.get(i),
-            Sensor::StarTracker(i) => self.sts.get(i),
-        }
-    }
-
     /// Queues an already published `frame` (real time, `handoff = "direct"`: the physics thread
-    /// published it; the telemetry thread encodes it again for the file, in `buf`).
+    /// published it; the telemetry thread files the sensor payloads as they are and encodes the
+    /// state again for the file, in `buf`).
     pub fn record_frame(&self, frame: &Frame, buf: &mut Vec<u8>) {
         let stamp = Some(frame.boundary_unix_ns);
-        let st_every = |i: usize| self.st_every.get(i).copied();
-        for_each_sensor_payload(frame, st_every, buf, |sensor, payload| {
-            if let Some(key) = self.sensor_key(sensor) {
+        for_each_sensor_payload(frame, |i, payload| {
+            if let Some(key) = self.sensors.get(i) {
                 self.submit(key, payload, stamp);
             }
         });
@@ -106,32 +74,34 @@ impl Recording {
     }
 }
 
-/// The publishers of one spacecraft's per-frame telemetry, with their encode buffers.
+/// "an IMU sample", without allocating.
+struct SampleOf(&'static SensorKind);
+
+impl fmt::Display for SampleOf {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} sample", self.0.a_noun)
+    }
+}
+
+/// The publishers of one spacecraft's per-frame telemetry, with their encode buffer.
 pub struct FramePublisher {
     /// `flexdyn/<sc>/tlm/state` (shared with the lockstep presence wait).
     pub state_pub: Arc<Publisher<'static>>,
-    /// `flexdyn/<sc>/tlm/imu/<name>`, in IMU config order.
-    pub imu_pubs: Vec<Publisher<'static>>,
-    /// `flexdyn/<sc>/tlm/st/<name>` with the tracker's update period in frames, in
-    /// star-tracker config order.
-    pub st_pubs: Vec<(Publisher<'static>, u64)>,
+    /// Per sensor of the bank: its kind and its publisher (`flexdyn/<sc>/tlm/<kind>/<name>`).
+    pub sensor_pubs: Vec<(&'static SensorKind, Publisher<'static>)>,
     state_buf: Vec<u8>,
-    sensor_buf: Vec<u8>,
 }
 
 impl FramePublisher {
-    /// Publishers for a frame; the buffers are sized once here.
+    /// Publishers for a frame; the buffer is sized once here.
     pub fn new(
         state_pub: Arc<Publisher<'static>>,
-        imu_pubs: Vec<Publisher<'static>>,
-        st_pubs: Vec<(Publisher<'static>, u64)>,
+        sensor_pubs: Vec<(&'static SensorKind, Publisher<'static>)>,
     ) -> Self {
         Self {
             state_pub,
-            imu_pubs,
-            st_pubs,
+            sensor_pubs,
             state_buf: Vec::with_capacity(4096),
-            sensor_buf: Vec::with_capacity(256),
         }
     }
 
@@ -142,13 +112,11 @@ impl FramePublisher {
             tx,
             state: key(&self.state_pub),
             status: key(status),
-            imus: self.imu_pubs.iter().map(key).collect(),
-            sts: self.st_pubs.iter().map(|(p, _)| key(p)).collect(),
-            st_every: self.st_pubs.iter().map(|(_, every)| *every).collect(),
+            sensors: self.sensor_pubs.iter().map(|(_, p)| key(p)).collect(),
         }
     }
 
-    fn count_error(shared: &Shared, what: &str, e: &dyn std::fmt::Display) {
+    fn count_error(shared: &Shared, what: &dyn fmt::Display, e: &dyn fmt::Display) {
         let n = shared.publish_errors.fetch_add(1, Ordering::Relaxed) + 1;
         if n.is_power_of_two() {
             tracing::warn!(error = %e, errors = n, "cannot publish {what}");
@@ -160,21 +128,16 @@ impl FramePublisher {
     /// `shared.publish_errors`, and notes the frame's command bookkeeping.
     pub fn publish(&mut self, frame: &Frame, shared: &Shared, rec: Option<&Recording>) {
         let stamp = frame.boundary_unix_ns.to_le_bytes();
-        let (imu_pubs, st_pubs) = (&self.imu_pubs, &self.st_pubs);
-        let st_every = |i: usize| st_pubs.get(i).map(|(_, every)| *every);
-        for_each_sensor_payload(frame, st_every, &mut self.sensor_buf, |sensor, payload| {
-            let (publisher, what) = match sensor {
-                Sensor::Imu(i) => (imu_pubs.get(i), "an IMU sample"),
-                Sensor::StarTracker(i) => (st_pubs.get(i).map(|(p, _)| p), "a star-tracker sample"),
-            };
-            let Some(publisher) = publisher else {
+        let sensor_pubs = &self.sensor_pubs;
+        for_each_sensor_payload(frame, |i, payload| {
+            let Some((kind, publisher)) = sensor_pubs.get(i) else {
                 return;
             };
-            if let Some((r, key)) = rec.and_then(|r| Some((r, r.sensor_key(sensor)?))) {
+            if let Some((r, key)) = rec.and_then(|r| Some((r, r.sensors.get(i)?))) {
                 r.submit(key, payload, Some(frame.boundary_unix_ns));
             }
             if let Err(e) = publisher.put(payload).attachment(stamp).wait() {
-                Self::count_error(shared, what, &e);
+                Self::count_error(shared, &SampleOf(kind), &e);
             }
         });
         encode_into(&frame.state, &mut self.state_buf);
@@ -188,7 +151,7 @@ impl FramePublisher {
             Ok(()) => {
                 shared.published.fetch_add(1, Ordering::Relaxed);
             }
-            Err(e) => Self::count_error(shared, "state", &e),
+            Err(e) => Self::count_error(shared, &"state", &e),
         }
         // Queued for the recorder after the state is out: the subscriber first.
         if let Some(r) = rec {

@@ -72,30 +72,29 @@ impl Endpoints {
             .await
             .map_err(|e| ServerError::zenoh("declare the status publisher", e))?;
 
-        let mut imu_pubs = Vec::with_capacity(sim.n_imus());
-        for (i, name) in sim.imu_names().iter().enumerate() {
-            let key = topics.imu(name).map_err(|e| SettingsError::Invalid {
-                name: format!("imus[{i}].name"),
-                problem: e.to_string(),
-            })?;
-            imu_pubs.push(telemetry_pub(key, "declare an IMU publisher").await?);
-        }
-
-        let mut st_pubs = Vec::with_capacity(sim.star_trackers().len());
-        for (i, st) in sim.star_trackers().iter().enumerate() {
-            let key = topics
-                .star_tracker(st.name())
-                .map_err(|e| SettingsError::Invalid {
-                    name: format!("star_trackers[{i}].name"),
+        // One publisher per sensor, in the bank's (publication) order.
+        let sensors = sim.sensors().sensors();
+        let mut sensor_pubs = Vec::with_capacity(sensors.len());
+        for (i, s) in sensors.iter().enumerate() {
+            let kind = s.kind();
+            let key = (kind.key)(topics, s.name()).map_err(|e| {
+                // Its index among its kind's configuration entries.
+                let j = sensors[..i]
+                    .iter()
+                    .filter(|o| std::ptr::eq(o.kind(), kind))
+                    .count();
+                SettingsError::Invalid {
+                    name: format!("{}[{j}].name", kind.config_array),
                     problem: e.to_string(),
-                })?;
-            st_pubs.push((
-                telemetry_pub(key, "declare a star-tracker publisher").await?,
-                st.config().every_frames,
+                }
+            })?;
+            sensor_pubs.push((
+                kind,
+                telemetry_pub(key, "declare a sensor publisher").await?,
             ));
         }
         let state_pub = Arc::new(state_pub);
-        let frames = FramePublisher::new(state_pub.clone(), imu_pubs, st_pubs);
+        let frames = FramePublisher::new(state_pub.clone(), sensor_pubs);
 
         let vehicle = VehicleInfo {
             sc_id: settings.sc_id.clone(),

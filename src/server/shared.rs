@@ -8,8 +8,10 @@ use flexdyn_proto::{
 };
 
 use super::commands::Held;
-use crate::sensors::imu::ImuSample;
-use crate::sensors::star_tracker::StarTrackerSample;
+
+/// \[bytes\] room reserved for each sensor's encoded message (an `ImuMsg` is 127 bytes), so
+/// encoding on the stepping path does not allocate.
+pub const SENSOR_PAYLOAD_CAPACITY: usize = 512;
 
 /// One frame's telemetry, filled by the physics thread and published by the I/O thread. A
 /// fixed pool of these is allocated at start-up and cycled through two bounded channels
@@ -25,10 +27,10 @@ pub struct Frame {
     pub lateness_ns: u64,
     /// Command bookkeeping of the frame that ended at this tick.
     pub command: CommandStatus,
-    /// One IMU sample per configured IMU (config order), taken at this tick.
-    pub imu: Vec<ImuSample>,
-    /// The star trackers that updated at this tick: (config index, sample).
-    pub star_trackers: Vec<(usize, StarTrackerSample)>,
+    /// The sensors sampled at this tick, as indices into the sensor bank (publication order).
+    pub sensors_sampled: Vec<usize>,
+    /// Per sensor of the bank, its encoded message when it is in `sensors_sampled`.
+    pub sensor_payloads: Vec<Vec<u8>>,
     /// Already published by the thread that finished the frame (`handoff = "direct"`): the
     /// telemetry thread only records it and keeps the books.
     pub published: bool,
@@ -36,16 +38,19 @@ pub struct Frame {
 
 impl Frame {
     /// An empty frame whose state has `shape`'s effector layout (see
-    /// [`crate::sim::Simulation::blank_state`]), with room for `n_imus` IMU samples and
-    /// `n_star_trackers` star-tracker samples.
-    pub fn for_state(shape: &StateMsg, n_imus: usize, n_star_trackers: usize) -> Self {
+    /// [`crate::sim::Simulation::blank_state`]), with room for the messages of `n_sensors`
+    /// sensors.
+    pub fn for_state(shape: &StateMsg, n_sensors: usize) -> Self {
         Self {
             state: shape.clone(),
             boundary_unix_ns: 0,
             lateness_ns: 0,
             command: Held::initial(flexdyn_proto::StalePolicy::Hold).status,
-            imu: Vec::with_capacity(n_imus),
-            star_trackers: Vec::with_capacity(n_star_trackers),
+            sensors_sampled: Vec::with_capacity(n_sensors),
+            // Not `vec![..; n]`: a cloned Vec does not keep its capacity.
+            sensor_payloads: (0..n_sensors)
+                .map(|_| Vec::with_capacity(SENSOR_PAYLOAD_CAPACITY))
+                .collect(),
             published: false,
         }
     }

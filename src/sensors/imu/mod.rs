@@ -11,7 +11,7 @@
 //!   σ_BN(t0) and σ_BN(t1) ([`attitude_increment_b`]). It is an eigenvector of \[P1 P0\], so its
 //!   components are the same in P0 and P1. It requires |ω| dt < π (no aliasing);
 //! - Δv_P = ∫ f_P dt over the interval, integrated from the integrator's own stages by a
-//!   per-stage hook ([`ImuBank`], [`crate::dynamics::stage_hook`]) with the state's combination.
+//!   per-stage hook ([`ImuSensor`], [`crate::dynamics::stage_hook`]) with the state's combination.
 //!
 //! # Error model (per triad; u = rad/s for the gyro, m/s² for the accelerometer)
 //! With G = I + diag(s) + M (s: scale-factor errors, a fraction; M: misalignment, zero diagonal,
@@ -67,11 +67,14 @@ use flexdyn_proto::{saturation_flags, Header, ImuMsg};
 use super::rng::NormalRng;
 pub use super::rng::{exp_portable, expm1_portable, ln_portable};
 
-mod bank;
+mod kind;
 pub(crate) mod plausibility;
 pub(crate) mod schema;
+mod sensor;
+mod view;
 
-pub use bank::{sensor_truth, ImuBank};
+pub use kind::KIND;
+pub use sensor::{sensor_truth, ImuSensor};
 
 /// Largest allowed |misalignment| element \[rad\]: the model is first order in these angles.
 pub const MAX_MISALIGNMENT_RAD: f64 = 0.1;

@@ -37,12 +37,17 @@ use nalgebra::{Matrix3, Vector3, Vector4};
 use crate::attitude::{dcm_to_quat, mrp_to_dcm};
 use crate::dynamics::params::{check_dcm, check_finite, check_non_negative, check_positive, join};
 use crate::dynamics::ParamError;
-use flexdyn_proto::{star_tracker_flags, Header, StarTrackerMsg};
+use crate::sensors::{Sensor, SensorKind, Truth};
+use flexdyn_proto::{encode_into, star_tracker_flags, Header, StarTrackerMsg};
 
 use super::rng::NormalRng;
 
+mod kind;
 pub(crate) mod plausibility;
 pub(crate) mod schema;
+mod view;
+
+pub use kind::KIND;
 
 /// Tolerance on |‖v‖ − 1| for the boresight and the Sun direction.
 pub const UNIT_TOL: f64 = 1e-6;
@@ -148,6 +153,8 @@ pub struct StarTracker {
     e2_c: Vector3<f64>,
     rng: NormalRng,
     held_q_cn: Vector4<f64>,
+    /// The last update (invalid, the identity, before the first).
+    last: StarTrackerSample,
 }
 
 impl StarTracker {
@@ -167,6 +174,11 @@ impl StarTracker {
             e1_c,
             e2_c,
             held_q_cn: Vector4::new(1.0, 0.0, 0.0, 0.0),
+            last: StarTrackerSample {
+                q_cn: Vector4::new(1.0, 0.0, 0.0, 0.0),
+                valid: false,
+                status_flags: 0,
+            },
             cfg,
         })
     }
@@ -184,6 +196,11 @@ impl StarTracker {
     /// Whether the tracker updates at frame boundary `tick`.
     pub fn due(&self, tick: u64) -> bool {
         tick.is_multiple_of(self.cfg.every_frames)
+    }
+
+    /// The last update (see [`Sensor::sample`]).
+    pub fn last(&self) -> StarTrackerSample {
+        self.last
     }
 
     /// The cross-boresight axes (ê₁, ê₂) in C, for tests that project errors on them.
@@ -230,6 +247,42 @@ impl StarTracker {
             valid: true,
             status_flags: 0,
         }
+    }
+}
+
+impl Sensor for StarTracker {
+    fn kind(&self) -> &'static SensorKind {
+        &KIND
+    }
+
+    fn name(&self) -> &str {
+        &self.cfg.name
+    }
+
+    fn due(&self, tick: u64) -> bool {
+        StarTracker::due(self, tick)
+    }
+
+    /// One update at the true attitude and rate ([`StarTracker::sample`]).
+    fn sample(&mut self, truth: &Truth<'_>) {
+        self.last = StarTracker::sample(self, &truth.state.sigma_bn, &truth.state.omega_bn_b);
+    }
+
+    /// `seq` counts the tracker's updates: the frame's tick / `every_frames`.
+    fn encode(&self, header: Header, buf: &mut Vec<u8>) {
+        let header = Header {
+            seq: header.tick / self.cfg.every_frames,
+            ..header
+        };
+        encode_into(&self.last.to_msg(header), buf);
+    }
+
+    fn first_non_finite(&self) -> Option<&'static str> {
+        self.last.first_non_finite()
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }
 

@@ -1,0 +1,68 @@
+//! The IMU's entry in the sensor registry ([`crate::sensors::KINDS`]): its key
+//! (`flexdyn/<sc>/tlm/imu/<name>`), its wire message ([`ImuMsg`]), how it is built from
+//! `[[imus]]` and how `flexdyn plot` draws it.
+
+use flexdyn_proto::keys::{Topics, IMU_PREFIX};
+use flexdyn_proto::{decode_imu, ImuMsg};
+
+use super::ImuSensor;
+use crate::config::{ConfigError, SimConfig};
+use crate::dynamics::State;
+use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
+
+/// The IMU kind.
+pub static KIND: SensorKind = SensorKind {
+    a_noun: "an IMU",
+    config_array: "imus",
+    key_prefix: IMU_PREFIX,
+    column_prefix: "imu",
+    message_name: "ImuMsg",
+    key: Topics::imu,
+    build,
+    decode: |b| decode_imu(b).map(|m| json_of(m.header, &m)),
+    default_json: || json_of(Default::default(), &ImuMsg::default()).1,
+    json_schema: || schemars::schema_for!(ImuMsg).to_value(),
+    plot: (
+        "imu.png",
+        "IMU measurements (sensor frame P)",
+        &[
+            PanelSpec {
+                y_label: "rate, P (rad/s)",
+                lines: &[
+                    ("omega_p_rad_s_1", "ω1"),
+                    ("omega_p_rad_s_2", "ω2"),
+                    ("omega_p_rad_s_3", "ω3"),
+                ],
+            },
+            PanelSpec {
+                y_label: "specific force, P (m/s²)",
+                lines: &[
+                    ("accel_p_m_s2_1", "a1"),
+                    ("accel_p_m_s2_2", "a2"),
+                    ("accel_p_m_s2_3", "a3"),
+                ],
+            },
+        ],
+    ),
+};
+
+/// One [`ImuSensor`] per `[[imus]]` entry (errors name `imus[i]…`).
+fn build(
+    cfg: &SimConfig,
+    sample_interval_s: f64,
+    t_sim_ns: u64,
+    x: &State,
+    out: &mut Vec<Box<dyn Sensor>>,
+) -> Result<(), ConfigError> {
+    for (i, imu) in cfg.imus.iter().enumerate() {
+        let path = format!("imus[{i}]");
+        out.push(Box::new(ImuSensor::new(
+            imu,
+            &path,
+            sample_interval_s,
+            t_sim_ns,
+            x,
+        )?));
+    }
+    Ok(())
+}
