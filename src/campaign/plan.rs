@@ -4,7 +4,8 @@
 //! # Seeds
 //! Run `i` draws from the portable generator ([`crate::sensors::rng::NormalRng`]) seeded with
 //! `run_seed(i) = splitmix64(master_seed ⊕ splitmix64(i))`. Each sensor's `seed` key
-//! (`imus[k].seed`, `star_trackers[k].seed`) becomes `splitmix64(run_seed ⊕ fnv1a(key))`. A run
+//! (`<config array>[k].seed` of every sensor kind in [`crate::sensors::KINDS`]: `imus[k].seed`,
+//! `star_trackers[k].seed`) becomes `splitmix64(run_seed ⊕ fnv1a(key))`. A run
 //! therefore depends only on the campaign file and its index: `--index I` reproduces it alone.
 //!
 //! # Invalid draws
@@ -207,7 +208,7 @@ impl Plan {
             all_keys.push(concrete);
         }
         let mut sensor_seed_keys = Vec::new();
-        for section in ["imus", "star_trackers"] {
+        for section in crate::sensors::KINDS.iter().map(|k| k.config_array) {
             if let Some(toml::Value::Array(items)) = base.get(section) {
                 for (k, item) in items.iter().enumerate() {
                     if item.get("seed").is_some() {

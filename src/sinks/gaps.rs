@@ -27,7 +27,7 @@ impl SeqGaps {
     /// Whether messages of `kind` carry a publisher's consecutive sequence number.
     pub fn counts(kind: TopicKind) -> bool {
         match kind {
-            TopicKind::State | TopicKind::Imu | TopicKind::StarTracker | TopicKind::Status => true,
+            TopicKind::State | TopicKind::Sensor(_) | TopicKind::Status => true,
             TopicKind::Command => false,
         }
     }
@@ -51,6 +51,7 @@ impl SeqGaps {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sinks::topics::classify;
     use std::collections::BTreeMap;
 
     #[test]
@@ -69,8 +70,8 @@ mod tests {
                 TopicKind::State,
                 [500, 501, 502, 506, 507].as_slice(),
             ),
-            (imu, TopicKind::Imu, &[7, 9]),
-            (st, TopicKind::StarTracker, &[0, 1, 2, 3]),
+            (imu, classify(imu).unwrap().kind, &[7, 9]),
+            (st, classify(st).unwrap().kind, &[0, 1, 2, 3]),
             (status, TopicKind::Status, &[4, 5, 8]),
             // A server restarted under the same id: a new stream (no gap at 0), then 1 missing.
             (state, TopicKind::State, &[0, 2]),

@@ -34,7 +34,7 @@ use super::reader::read_recording;
 use super::table::{prefixed_columns, row, Cell, Column};
 use super::topics::{classify, Decoded, TopicKind};
 use crate::attitude::mrp_error;
-use flexdyn_proto::{ImuMsg, StarTrackerMsg};
+use crate::sensors::KINDS;
 
 const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
 /// The name the embedded font is registered under (see [`register_font`]).
@@ -128,8 +128,8 @@ impl Columns {
 struct PlotData {
     state: Columns,
     status: Columns,
-    imus: BTreeMap<String, Columns>,
-    star_trackers: BTreeMap<String, Columns>,
+    /// Per (index in [`KINDS`], sensor name), the sensor's columns.
+    sensors: BTreeMap<(usize, String), Columns>,
     /// The pacing mode of the recorded run (from its StatusMsg; none in a CSV).
     mode: Option<flexdyn_proto::Mode>,
 }
@@ -174,14 +174,9 @@ fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
                 }
                 data.status.push(&cells);
             }
-            TopicKind::Imu => data
-                .imus
-                .entry(topic.sensor.unwrap_or_default().to_owned())
-                .or_default()
-                .push(&cells),
-            TopicKind::StarTracker => data
-                .star_trackers
-                .entry(topic.sensor.unwrap_or_default().to_owned())
+            TopicKind::Sensor(kind) => data
+                .sensors
+                .entry((kind, topic.sensor.unwrap_or_default().to_owned()))
                 .or_default()
                 .push(&cells),
             TopicKind::Command => {}
@@ -197,18 +192,22 @@ fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
 }
 
 /// A `simulate` sensor column `<kind>_<name>_<field>` (`imu_hub_omega_p_rad_s_1`,
-/// `st_st1_q_cn_0`) split into (kind, sensor name, field), for the fields of that message.
+/// `st_st1_q_cn_0`) split into (index in [`KINDS`], sensor name, field), for the fields of that
+/// kind's message (`fields[i]`: kind `i`'s column prefix and field columns).
 fn sensor_column<'a>(
     column: &'a str,
     fields: &[(&'static str, Vec<String>)],
-) -> Option<(&'static str, &'a str, &'a str)> {
-    fields.iter().find_map(|(kind, names)| {
-        let rest = column.strip_prefix(kind)?.strip_prefix('_')?;
-        names.iter().find_map(|f| {
-            let name = rest.strip_suffix(f.as_str())?.strip_suffix('_')?;
-            (!name.is_empty()).then(|| (*kind, name, &rest[name.len() + 1..]))
+) -> Option<(usize, &'a str, &'a str)> {
+    fields
+        .iter()
+        .enumerate()
+        .find_map(|(kind, (prefix, names))| {
+            let rest = column.strip_prefix(prefix)?.strip_prefix('_')?;
+            names.iter().find_map(|f| {
+                let name = rest.strip_suffix(f.as_str())?.strip_suffix('_')?;
+                (!name.is_empty()).then(|| (kind, name, &rest[name.len() + 1..]))
+            })
         })
-    })
 }
 
 fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
@@ -227,13 +226,13 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             "the first column must be t_s (a `flexdyn simulate` or `flexdyn export` state CSV)",
         ));
     }
-    // The sensor columns `simulate` writes beside the state: the message fields of an IMU or a
-    // star-tracker sample, prefixed `imu_<name>_` / `st_<name>_`.
-    let fields = [
-        ("imu", column_names(&ImuMsg::default())),
-        ("st", column_names(&StarTrackerMsg::default())),
-    ];
-    let place: Vec<Option<(&str, &str, &str)>> =
+    // The sensor columns `simulate` writes beside the state: the message fields of each kind's
+    // sample, prefixed `<kind>_<name>_` (`imu_hub_`, `st_st1_`).
+    let fields: Vec<(&'static str, Vec<String>)> = KINDS
+        .iter()
+        .map(|k| (k.column_prefix, column_names(&(k.default_json)())))
+        .collect();
+    let place: Vec<Option<(usize, &str, &str)>> =
         header.iter().map(|h| sensor_column(h, &fields)).collect();
     let mut data = PlotData::default();
     for (i, line) in lines.enumerate() {
@@ -255,7 +254,7 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
         let mut state = Vec::with_capacity(fields.len());
         // Per sensor: its cells, and whether this row has any (a star tracker's are empty
         // between its updates).
-        let mut sensors: BTreeMap<(&str, &str), (Vec<Column>, bool)> = BTreeMap::new();
+        let mut sensors: BTreeMap<(usize, &str), (Vec<Column>, bool)> = BTreeMap::new();
         // Column 0 is t_s (checked above), so the row's time is known before any sensor column.
         let mut t_s = f64::NAN;
         for ((name, f), place) in header.iter().zip(&fields).zip(&place) {
@@ -271,7 +270,7 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             }
             match place {
                 Some((kind, sensor, field)) => {
-                    let (cells, any) = sensors.entry((kind, sensor)).or_default();
+                    let (cells, any) = sensors.entry((*kind, sensor)).or_default();
                     if cells.is_empty() {
                         cells.push(("t_s".into(), Cell::Num(t_s)));
                     }
@@ -283,13 +282,11 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
         }
         data.state.push(&state);
         for ((kind, name), (cells, any)) in sensors {
-            let map = if kind == "imu" {
-                &mut data.imus
-            } else {
-                &mut data.star_trackers
-            };
             if any {
-                map.entry(name.to_owned()).or_default().push(&cells);
+                data.sensors
+                    .entry((kind, name.to_owned()))
+                    .or_default()
+                    .push(&cells);
             }
         }
     }
@@ -870,72 +867,36 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
             wheels,
         );
     }
-    let mut st_panels = Vec::new();
-    for (name, c) in &data.star_trackers {
-        let q: Vec<Line> = (0..4)
-            .filter_map(|i| {
-                c.get(&format!("q_cn_{i}"))
-                    .map(|v| line(&format!("q{i}"), &c.t_s, v))
-            })
-            .collect();
-        if q.is_empty() {
-            continue;
+    // One figure per sensor kind, its panels side by side per sensor (`SensorKind::plot`).
+    for (i, kind) in KINDS.iter().enumerate() {
+        let (file, title, specs) = kind.plot;
+        let mut panels = Vec::new();
+        for ((_, name), c) in data
+            .sensors
+            .range((i, String::new())..(i + 1, String::new()))
+        {
+            let sensor_panels: Vec<Panel> = specs
+                .iter()
+                .map(|spec| Panel {
+                    caption: Some(format!("{} {name}", kind.noun)),
+                    y_label: spec.y_label.into(),
+                    lines: spec
+                        .lines
+                        .iter()
+                        .filter_map(|(col, label)| c.get(col).map(|v| line(label, &c.t_s, v)))
+                        .collect(),
+                    ..Panel::default()
+                })
+                .collect();
+            if sensor_panels.iter().any(|p| !p.lines.is_empty()) {
+                panels.extend(sensor_panels);
+            }
         }
-        st_panels.push(Panel {
-            caption: Some(format!("star tracker {name}")),
-            y_label: "measured q_CN (–)".into(),
-            lines: q,
-            ..Panel::default()
-        });
-        let flags: Vec<Line> = [("valid", "valid (0/1)"), ("status_flags", "status flags")]
-            .iter()
-            .filter_map(|(col, label)| c.get(col).map(|v| line(label, &c.t_s, v)))
-            .collect();
-        st_panels.push(Panel {
-            caption: Some(format!("star tracker {name}")),
-            y_label: "valid; flags (1 Sun, 2 rate)".into(),
-            lines: flags,
-            ..Panel::default()
-        });
-    }
-    if st_panels.is_empty() {
-        skip("star_tracker.png", "no star tracker");
-    } else {
-        figures.push(sensor_grid(
-            "star_tracker.png",
-            "Star trackers: measured attitude q_CN (scalar first) and validity",
-            st_panels,
-        ));
-    }
-    let mut imu_panels = Vec::new();
-    for (name, c) in &data.imus {
-        let caption = Some(format!("IMU {name}"));
-        for (base, labels, y) in [
-            ("omega_p_rad_s", ["ω1", "ω2", "ω3"], "rate, P (rad/s)"),
-            (
-                "accel_p_m_s2",
-                ["a1", "a2", "a3"],
-                "specific force, P (m/s²)",
-            ),
-        ] {
-            let p = vec_panel(c, base, labels, y).unwrap_or_else(|| Panel {
-                y_label: y.to_owned(),
-                ..Panel::default()
-            });
-            imu_panels.push(Panel {
-                caption: caption.clone(),
-                ..p
-            });
+        if panels.is_empty() {
+            skip(file, &format!("no {}", kind.noun));
+        } else {
+            figures.push(sensor_grid(file, title, panels));
         }
-    }
-    if imu_panels.is_empty() {
-        skip("imu.png", "no IMU");
-    } else {
-        figures.push(sensor_grid(
-            "imu.png",
-            "IMU measurements (sensor frame P)",
-            imu_panels,
-        ));
     }
     let st = &data.status;
     let timing = (

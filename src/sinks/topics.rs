@@ -4,23 +4,23 @@
 //! `flexdyn/<sc-id>/<suffix>` (see `proto/README.md`, "Topics") names the message type, and the
 //! payload decodes with the one `flexdyn-proto` codec.
 
-use flexdyn_proto::keys::{
-    CMD_PREFIX, IMU_PREFIX, KEY_ROOT, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX,
-};
+use flexdyn_proto::keys::{CMD_PREFIX, KEY_ROOT, STATE_SUFFIX, STATUS_SUFFIX};
 use flexdyn_proto::{
-    decode_command, decode_imu, decode_star_tracker, decode_state, decode_status, CommandMsg,
-    DecodeError, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg,
+    decode_command, decode_state, decode_status, CommandMsg, DecodeError, Header, StateMsg,
+    StatusMsg,
 };
+
+use crate::sensors::{SensorKind, KINDS};
 
 /// The message type a flexdyn key carries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum TopicKind {
     /// `flexdyn/<sc>/tlm/state`: [`StateMsg`].
     State,
-    /// `flexdyn/<sc>/tlm/imu/<name>`: [`ImuMsg`].
-    Imu,
-    /// `flexdyn/<sc>/tlm/st/<name>`: [`StarTrackerMsg`].
-    StarTracker,
+    /// `flexdyn/<sc>/<key prefix>/<name>`: the message of sensor kind `KINDS[i]`
+    /// ([`crate::sensors::KINDS`]; `tlm/imu/<name>`: `ImuMsg`, `tlm/st/<name>`:
+    /// `StarTrackerMsg`).
+    Sensor(usize),
     /// `flexdyn/<sc>/cmd/<sender_id>`: [`CommandMsg`].
     Command,
     /// `flexdyn/<sc>/status`: [`StatusMsg`].
@@ -28,21 +28,31 @@ pub enum TopicKind {
 }
 
 impl TopicKind {
-    /// Every kind, in a fixed order.
-    pub const ALL: [TopicKind; 5] = [
-        TopicKind::State,
-        TopicKind::Imu,
-        TopicKind::StarTracker,
-        TopicKind::Command,
-        TopicKind::Status,
-    ];
+    /// Every kind, in a fixed order: the state, each registered sensor kind, commands, status.
+    pub fn all() -> impl Iterator<Item = TopicKind> {
+        std::iter::once(TopicKind::State)
+            .chain((0..KINDS.len()).map(TopicKind::Sensor))
+            .chain([TopicKind::Command, TopicKind::Status])
+    }
+
+    /// The topic kind of sensor kind `kind` (`None` if it is not registered).
+    pub fn sensor(kind: &'static SensorKind) -> Option<TopicKind> {
+        kind.index().map(TopicKind::Sensor)
+    }
+
+    /// The sensor kind of a [`TopicKind::Sensor`].
+    pub fn sensor_kind(self) -> Option<&'static SensorKind> {
+        match self {
+            TopicKind::Sensor(i) => KINDS.get(i).copied(),
+            _ => None,
+        }
+    }
 
     /// The wire message's name, as in `proto/README.md` (`StateMsg`, …).
     pub fn message_name(self) -> &'static str {
         match self {
             TopicKind::State => "StateMsg",
-            TopicKind::Imu => "ImuMsg",
-            TopicKind::StarTracker => "StarTrackerMsg",
+            TopicKind::Sensor(_) => self.sensor_kind().map_or("", |k| k.message_name),
             TopicKind::Command => "CommandMsg",
             TopicKind::Status => "StatusMsg",
         }
@@ -56,8 +66,7 @@ pub struct Topic<'a> {
     pub sc_id: &'a str,
     /// The message type.
     pub kind: TopicKind,
-    /// The IMU or star-tracker name, or a command key's decimal sender id; `None` for the
-    /// other kinds.
+    /// The sensor name, or a command key's decimal sender id; `None` for the other kinds.
     pub sensor: Option<&'a str>,
 }
 
@@ -83,10 +92,12 @@ pub fn classify(key: &str) -> Option<Topic<'_>> {
         (TopicKind::Command, Some(sender))
     } else if suffix == STATUS_SUFFIX {
         (TopicKind::Status, None)
-    } else if let Some(name) = sensor(IMU_PREFIX) {
-        (TopicKind::Imu, Some(name))
-    } else if let Some(name) = sensor(STAR_TRACKER_PREFIX) {
-        (TopicKind::StarTracker, Some(name))
+    } else if let Some((i, name)) = KINDS
+        .iter()
+        .enumerate()
+        .find_map(|(i, k)| Some((i, sensor(k.key_prefix)?)))
+    {
+        (TopicKind::Sensor(i), Some(name))
     } else {
         return None;
     };
@@ -102,10 +113,16 @@ pub fn classify(key: &str) -> Option<Topic<'_>> {
 pub enum Decoded {
     /// A state.
     State(StateMsg),
-    /// An IMU sample.
-    Imu(ImuMsg),
-    /// A star-tracker sample.
-    StarTracker(StarTrackerMsg),
+    /// A sensor sample of kind `KINDS[kind]`: its header and its JSON (fields as in the wire
+    /// struct, header included).
+    Sensor {
+        /// Index in [`crate::sensors::KINDS`].
+        kind: usize,
+        /// The message header.
+        header: Header,
+        /// The message as JSON.
+        json: serde_json::Value,
+    },
     /// A command.
     Command(CommandMsg),
     /// A server status.
@@ -117,8 +134,17 @@ impl Decoded {
     pub fn decode(kind: TopicKind, payload: &[u8]) -> Result<Self, DecodeError> {
         Ok(match kind {
             TopicKind::State => Decoded::State(decode_state(payload)?),
-            TopicKind::Imu => Decoded::Imu(decode_imu(payload)?),
-            TopicKind::StarTracker => Decoded::StarTracker(decode_star_tracker(payload)?),
+            TopicKind::Sensor(i) => {
+                let Some(k) = KINDS.get(i) else {
+                    return Err(DecodeError::Malformed(format!("no sensor kind {i}")));
+                };
+                let (header, json) = (k.decode)(payload)?;
+                Decoded::Sensor {
+                    kind: i,
+                    header,
+                    json,
+                }
+            }
             TopicKind::Command => Decoded::Command(decode_command(payload)?),
             TopicKind::Status => Decoded::Status(decode_status(payload)?),
         })
@@ -128,8 +154,7 @@ impl Decoded {
     pub fn header(&self) -> &Header {
         match self {
             Decoded::State(m) => &m.header,
-            Decoded::Imu(m) => &m.header,
-            Decoded::StarTracker(m) => &m.header,
+            Decoded::Sensor { header, .. } => header,
             Decoded::Command(m) => &m.header,
             Decoded::Status(m) => &m.header,
         }
@@ -140,8 +165,7 @@ impl Decoded {
     pub fn to_json_bytes(&self) -> Vec<u8> {
         let v = match self {
             Decoded::State(m) => serde_json::to_vec(m),
-            Decoded::Imu(m) => serde_json::to_vec(m),
-            Decoded::StarTracker(m) => serde_json::to_vec(m),
+            Decoded::Sensor { json, .. } => serde_json::to_vec(json),
             Decoded::Command(m) => serde_json::to_vec(m),
             Decoded::Status(m) => serde_json::to_vec(m),
         };
@@ -152,8 +176,7 @@ impl Decoded {
     pub fn to_json(&self) -> serde_json::Value {
         let v = match self {
             Decoded::State(m) => serde_json::to_value(m),
-            Decoded::Imu(m) => serde_json::to_value(m),
-            Decoded::StarTracker(m) => serde_json::to_value(m),
+            Decoded::Sensor { json, .. } => Ok(json.clone()),
             Decoded::Command(m) => serde_json::to_value(m),
             Decoded::Status(m) => serde_json::to_value(m),
         };
@@ -166,8 +189,11 @@ impl Decoded {
 pub fn json_schema(kind: TopicKind) -> serde_json::Value {
     let schema = match kind {
         TopicKind::State => schemars::schema_for!(StateMsg),
-        TopicKind::Imu => schemars::schema_for!(ImuMsg),
-        TopicKind::StarTracker => schemars::schema_for!(StarTrackerMsg),
+        TopicKind::Sensor(_) => {
+            return kind
+                .sensor_kind()
+                .map_or(serde_json::Value::Null, |k| (k.json_schema)())
+        }
         TopicKind::Command => schemars::schema_for!(CommandMsg),
         TopicKind::Status => schemars::schema_for!(StatusMsg),
     };
@@ -206,13 +232,15 @@ mod tests {
     fn keys_classify_by_their_suffix() {
         let t = classify("flexdyn/sc1/tlm/state").unwrap();
         assert_eq!((t.sc_id, t.kind, t.sensor), ("sc1", TopicKind::State, None));
+        let imu = TopicKind::sensor(&crate::sensors::imu::KIND).unwrap();
+        let st = TopicKind::sensor(&crate::sensors::star_tracker::KIND).unwrap();
+        assert_ne!(imu, st);
         let t = classify("flexdyn/a-b/tlm/imu/hub").unwrap();
-        assert_eq!(
-            (t.sc_id, t.kind, t.sensor),
-            ("a-b", TopicKind::Imu, Some("hub"))
-        );
+        assert_eq!((t.sc_id, t.kind, t.sensor), ("a-b", imu, Some("hub")));
+        assert_eq!(imu.message_name(), "ImuMsg");
         let t = classify("flexdyn/x/tlm/st/st1").unwrap();
-        assert_eq!(t.kind, TopicKind::StarTracker);
+        assert_eq!(t.kind, st);
+        assert_eq!(st.message_name(), "StarTrackerMsg");
         let t = classify("flexdyn/x/cmd/12").unwrap();
         assert_eq!((t.kind, t.sensor), (TopicKind::Command, Some("12")));
         assert_eq!(classify("flexdyn/x/cmd/wrench"), None, "the protocol-3 key");
@@ -234,7 +262,7 @@ mod tests {
 
     #[test]
     fn the_layout_text_holds_the_message_section_and_the_version() {
-        for kind in TopicKind::ALL {
+        for kind in TopicKind::all() {
             let text = wire_layout_text(kind);
             assert!(text.contains("## Encoding rules"), "{kind:?}");
             assert!(text.contains("## Header"), "{kind:?}");

@@ -12,6 +12,7 @@ use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
 
 /// The IMU kind.
 pub static KIND: SensorKind = SensorKind {
+    noun: "IMU",
     a_noun: "an IMU",
     config_array: "imus",
     key_prefix: IMU_PREFIX,

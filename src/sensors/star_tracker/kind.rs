@@ -12,6 +12,7 @@ use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
 
 /// The star-tracker kind.
 pub static KIND: SensorKind = SensorKind {
+    noun: "star tracker",
     a_noun: "a star tracker",
     config_array: "star_trackers",
     key_prefix: STAR_TRACKER_PREFIX,
