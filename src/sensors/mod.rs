@@ -33,7 +33,7 @@ pub mod star_tracker;
 pub use bank::SensorBank;
 
 /// Every sensor kind, in publication order: the registry.
-pub static KINDS: [&SensorKind; 2] = [&imu::KIND, &star_tracker::KIND];
+pub static KINDS: &[&SensorKind] = &[&imu::KIND, &star_tracker::KIND];
 
 /// The truth one sample is taken from: one evaluation at the current instant.
 #[derive(Debug, Clone, Copy)]
