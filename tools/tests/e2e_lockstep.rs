@@ -169,6 +169,18 @@ fn lockstep_run_settings(
     Run { result, states }
 }
 
+/// Regression goldens of the two sensor-closed runs: the sha256 of the StateMsg stream of
+/// [`lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical`] (run A) and of
+/// [`lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical`] (run A). The
+/// controller closes its loop on the IMU and star-tracker samples, so a change of one bit of a
+/// sensor output changes them. Minted at main 535783c (before the sensor seam of issue 20, whose
+/// commits keep them), x86_64 Linux; re-mint from the `sha256` each test prints when the
+/// dynamics or a sensor model change on purpose, and say why in the commit.
+const GYRO_FEEDBACK_SHA256: &str =
+    "9c0c0df604c1eadb083226fa6f92438f2eb56da1eb8f10c18cec8f31e1912497";
+const WHEELS_ON_SENSORS_SHA256: &str =
+    "af7d756eeb099334c68110896cfc2f0ed5e66c1100a54da7fa696ceefe29e2e4";
+
 fn digest(states: &[(u64, Vec<u8>)]) -> String {
     let mut h = Sha256::new();
     for (i, (tick, bytes)) in states.iter().enumerate() {
@@ -290,6 +302,10 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
         settling_bound_s()
     );
 
+    assert_eq!(
+        hash_a, GYRO_FEEDBACK_SHA256,
+        "regress: the gyro-fed stream changed"
+    );
     let b = lockstep_run_with(10.0, Sabotage::None, imu_config(), gyro);
     b.result.expect("gyro run B");
     assert_eq!(digest(&b.states), hash_a, "two gyro-fed runs differ");
@@ -413,6 +429,10 @@ fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
         report.wall_s
     );
     assert!(max_u > 0.1, "the wheels were commanded");
+    assert_eq!(
+        hash_a, WHEELS_ON_SENSORS_SHA256,
+        "regress: the wheels-on-sensors stream changed"
+    );
     let last = decode_state(&a.last().unwrap().1).unwrap();
     assert!(
         Vector3::from(last.sigma_bn).norm() < 0.005,
