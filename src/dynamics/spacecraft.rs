@@ -1,4 +1,5 @@
-//! The spacecraft: a rigid hub plus any number of [`StateEffector`]s, propagated by fixed-step RK4.
+//! The spacecraft: a rigid hub plus any number of [`StateEffector`]s, propagated by a fixed-step
+//! Runge–Kutta method of [`super::integrator`] (RK4 by default).
 //!
 //! Per derivative evaluation the hub sums the effectors' mass properties and back-substitution
 //! contributions, assembles Eqs. 145–150 (with erratum E2: [C] = m_sc[c̃] + [C_contr]) and solves
@@ -13,6 +14,7 @@ use super::dynamic_effector::{DynamicEffector, StageState};
 use super::effector::{
     BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
+use super::integrator::{ButcherTableau, MAX_STAGES, RK4};
 use super::params::{GravityModel, HubParams, SensorPoint, Wrench};
 use super::ParamError;
 use crate::attitude::{mrp_rate, mrp_switch, mrp_to_dcm, tilde};
@@ -33,7 +35,7 @@ pub struct State {
     pub effectors: Vec<f64>,
     /// [m/s] per sensor point, the velocity increment Δv_P = ∫ [PB] f_B dt accumulated since the
     /// last [`Spacecraft::reset_sensor_dv`], f the specific force at the point (derivative: f in P
-    /// components). Integrated by the same RK4 stages as the dynamics, so it is exact to
+    /// components). Integrated by the same Runge–Kutta stages as the dynamics, so it is exact to
     /// integrator precision; it never feeds back into the dynamics.
     pub sensor_dv_p: Vec<Vector3<f64>>,
 }
@@ -50,28 +52,40 @@ impl State {
         }
     }
 
-    /// self = x + h·k, elementwise (no allocation; all lengths are equal by construction).
+    /// self = x + h Σ_j a_ij k_j for stage `i` of `method`, elementwise (no allocation; all
+    /// lengths are equal by construction). For RK4 this is `x + k·(a h)`, the historical
+    /// expression.
     #[inline(always)]
-    fn set_axpy(&mut self, x: &State, h: f64, k: &State) {
-        self.r_bn_n = x.r_bn_n + k.r_bn_n * h;
-        self.v_bn_n = x.v_bn_n + k.v_bn_n * h;
-        self.sigma_bn = x.sigma_bn + k.sigma_bn * h;
-        self.omega_bn_b = x.omega_bn_b + k.omega_bn_b * h;
-        for ((o, xi), ki) in self
-            .effectors
-            .iter_mut()
-            .zip(&x.effectors)
-            .zip(&k.effectors)
-        {
-            *o = xi + h * ki;
+    fn set_stage(&mut self, x: &State, method: &ButcherTableau, i: usize, k: &[State], h: f64) {
+        self.r_bn_n = x.r_bn_n + method.stage_increment(i, |j| k[j].r_bn_n, h);
+        self.v_bn_n = x.v_bn_n + method.stage_increment(i, |j| k[j].v_bn_n, h);
+        self.sigma_bn = x.sigma_bn + method.stage_increment(i, |j| k[j].sigma_bn, h);
+        self.omega_bn_b = x.omega_bn_b + method.stage_increment(i, |j| k[j].omega_bn_b, h);
+        for (n, (o, xi)) in self.effectors.iter_mut().zip(&x.effectors).enumerate() {
+            *o = xi + method.stage_increment(i, |j| k[j].effectors[n], h);
         }
-        for ((o, xi), ki) in self
-            .sensor_dv_p
-            .iter_mut()
-            .zip(&x.sensor_dv_p)
-            .zip(&k.sensor_dv_p)
-        {
-            *o = xi + ki * h;
+        for (n, (o, xi)) in self.sensor_dv_p.iter_mut().zip(&x.sensor_dv_p).enumerate() {
+            *o = xi + method.stage_increment(i, |j| k[j].sensor_dv_p[n], h);
+        }
+    }
+
+    /// self += h Σ_i b_i k_i, elementwise: the end of a step of `method`. The IMU Δv integrals go
+    /// through [`ButcherTableau::combine_vec3`].
+    #[inline(always)]
+    fn add_step(&mut self, method: &ButcherTableau, k: &[State], h: f64) {
+        self.r_bn_n += method.combine(|i| k[i].r_bn_n, h);
+        self.v_bn_n += method.combine(|i| k[i].v_bn_n, h);
+        self.sigma_bn += method.combine(|i| k[i].sigma_bn, h);
+        self.omega_bn_b += method.combine(|i| k[i].omega_bn_b, h);
+        for (n, o) in self.effectors.iter_mut().enumerate() {
+            *o += method.combine(|i| k[i].effectors[n], h);
+        }
+        let mut dv_stages = [Vector3::zeros(); MAX_STAGES];
+        for (n, o) in self.sensor_dv_p.iter_mut().enumerate() {
+            for (d, ki) in dv_stages.iter_mut().zip(k) {
+                *d = ki.sensor_dv_p[n];
+            }
+            *o += method.combine_vec3(&dv_stages[..k.len()], h);
         }
     }
 }
@@ -248,18 +262,16 @@ pub fn gravity_potential(model: &GravityModel, r_n: &Vector3<f64>) -> f64 {
     }
 }
 
-/// RK4 stage buffers, sized once at construction.
+/// Stage buffers: one derivative per stage of the integrator and the stage state, sized when
+/// the integrator is chosen (construction time), never on the stepping path.
 #[derive(Debug, Clone)]
-struct Rk4Workspace {
-    k1: State,
-    k2: State,
-    k3: State,
-    k4: State,
+struct StageWorkspace {
+    k: Vec<State>,
     stage: State,
 }
 
 /// The equations of motion: the hub, its effectors, gravity and the applied wrench. Split from
-/// the integrator state so RK4 can evaluate it while borrowing its stage buffers.
+/// the integrator state so the integrator can evaluate it while borrowing its stage buffers.
 #[derive(Debug)]
 struct EquationsOfMotion {
     /// The external forces and torques evaluated at every stage, in registration order.
@@ -288,14 +300,16 @@ struct EquationsOfMotion {
     output_ranges: Vec<Range<usize>>,
 }
 
-/// A rigid hub with appended state effectors, integrated with fixed-step RK4.
+/// A rigid hub with appended state effectors, integrated with a fixed-step Runge–Kutta method.
 #[derive(Debug)]
 pub struct Spacecraft {
     eom: EquationsOfMotion,
     state: State,
     t_sim_ns: u64,
     step_ns: u64,
-    ws: Rk4Workspace,
+    /// The fixed-step Runge–Kutta method ([`integrator`](super::integrator); RK4 by default).
+    method: &'static ButcherTableau,
+    ws: StageWorkspace,
 }
 
 impl EquationsOfMotion {
@@ -501,11 +515,9 @@ impl Spacecraft {
             state: zero.clone(),
             t_sim_ns: 0,
             step_ns,
-            ws: Rk4Workspace {
-                k1: zero.clone(),
-                k2: zero.clone(),
-                k3: zero.clone(),
-                k4: zero.clone(),
+            method: &RK4,
+            ws: StageWorkspace {
+                k: vec![zero.clone(); RK4.stages()],
                 stage: zero,
             },
         };
@@ -563,7 +575,7 @@ impl Spacecraft {
         self.t_sim_ns
     }
 
-    /// [ns] RK4 step.
+    /// [ns] integration step.
     pub fn step_ns(&self) -> u64 {
         self.step_ns
     }
@@ -667,7 +679,7 @@ impl Spacecraft {
         self.eom.begin_step(&self.state, self.t_sim_ns);
     }
 
-    /// Adds a dynamic effector (an external force and torque evaluated at every RK4 stage);
+    /// Adds a dynamic effector (an external force and torque evaluated at every integrator stage);
     /// returns its index. Construction-time only.
     pub fn add_dynamic_effector(&mut self, effector: Box<dyn DynamicEffector>) -> usize {
         if effector.uses_begin_step() {
@@ -718,51 +730,54 @@ impl Spacecraft {
 
     /// Evaluates the state derivative `dx` at state `x` with the current wrench and effector
     /// inputs (each effector's [`StateEffector::begin_step`] runs at `x` first, as at the start
-    /// of a step), and returns the hub accelerations. This is the equation-of-motion function RK4
-    /// integrates: it allocates nothing and cannot fail.
+    /// of a step), and returns the hub accelerations. This is the equation-of-motion function
+    /// the integrator integrates: it allocates nothing and cannot fail.
     pub fn derivatives(&mut self, x: &State, dx: &mut State) -> HubOutputs {
         self.eom.begin_step(x, self.t_sim_ns);
         self.eom.eval(x, dx, self.t_sim_ns, 0.0)
     }
 
-    /// Advances one RK4 step of [`Self::step_ns`] with the current wrench and effector inputs
-    /// (each effector's [`StateEffector::begin_step`] runs first, at the step's initial state),
-    /// then switches σ to its shadow set if |σ| > 1. Allocates nothing.
+    /// Advances one step of [`Self::step_ns`] with the chosen [`Self::integrator`] (RK4 by
+    /// default) and the current wrench and effector inputs (each effector's
+    /// [`StateEffector::begin_step`] runs first, at the step's initial state; stage `i` is
+    /// evaluated at t₀ + c_i h), then switches σ to its shadow set if |σ| > 1. Allocates nothing.
     pub fn step(&mut self) {
         self.begin_step();
         let h = self.step_ns as f64 * 1e-9;
         let t0 = self.t_sim_ns;
-        let Self { eom, state, ws, .. } = self;
-        eom.eval(state, &mut ws.k1, t0, 0.0);
-        ws.stage.set_axpy(state, 0.5 * h, &ws.k1);
-        eom.eval(&ws.stage, &mut ws.k2, t0, 0.5 * h);
-        ws.stage.set_axpy(state, 0.5 * h, &ws.k2);
-        eom.eval(&ws.stage, &mut ws.k3, t0, 0.5 * h);
-        ws.stage.set_axpy(state, h, &ws.k3);
-        eom.eval(&ws.stage, &mut ws.k4, t0, h);
-        let h6 = h / 6.0;
-        let (k1, k2, k3, k4) = (&ws.k1, &ws.k2, &ws.k3, &ws.k4);
-        state.r_bn_n += (k1.r_bn_n + (k2.r_bn_n + k3.r_bn_n) * 2.0 + k4.r_bn_n) * h6;
-        state.v_bn_n += (k1.v_bn_n + (k2.v_bn_n + k3.v_bn_n) * 2.0 + k4.v_bn_n) * h6;
-        state.sigma_bn += (k1.sigma_bn + (k2.sigma_bn + k3.sigma_bn) * 2.0 + k4.sigma_bn) * h6;
-        state.omega_bn_b +=
-            (k1.omega_bn_b + (k2.omega_bn_b + k3.omega_bn_b) * 2.0 + k4.omega_bn_b) * h6;
-        for i in 0..state.effectors.len() {
-            state.effectors[i] += h6
-                * (k1.effectors[i] + 2.0 * (k2.effectors[i] + k3.effectors[i]) + k4.effectors[i]);
+        let Self {
+            eom,
+            state,
+            ws,
+            method,
+            ..
+        } = self;
+        let StageWorkspace { k, stage } = ws;
+        eom.eval(state, &mut k[0], t0, 0.0);
+        for i in 1..k.len() {
+            let (done, rest) = k.split_at_mut(i);
+            stage.set_stage(state, method, i, done, h);
+            eom.eval(stage, &mut rest[0], t0, method.c[i] * h);
         }
-        for i in 0..state.sensor_dv_p.len() {
-            state.sensor_dv_p[i] += (k1.sensor_dv_p[i]
-                + (k2.sensor_dv_p[i] + k3.sensor_dv_p[i]) * 2.0
-                + k4.sensor_dv_p[i])
-                * h6;
-        }
+        state.add_step(method, k, h);
         mrp_switch(&mut state.sigma_bn);
         self.t_sim_ns += self.step_ns;
     }
 
+    /// Chooses the integration method (construction time: it resizes the stage buffers). The
+    /// state and time are kept.
+    pub fn set_integrator(&mut self, method: &'static ButcherTableau) {
+        self.method = method;
+        self.ws.k.resize(method.stages(), self.ws.stage.clone());
+    }
+
+    /// The integration method.
+    pub fn integrator(&self) -> &'static ButcherTableau {
+        self.method
+    }
+
     /// Adds a sensor point (an IMU location and platform frame) whose Δv is accumulated inside the
-    /// RK4 integration; returns its index. Construction-time only: it resizes the state buffers.
+    /// integration; returns its index. Construction-time only: it resizes the state buffers.
     pub fn add_sensor_point(
         &mut self,
         point: SensorPoint,
@@ -770,14 +785,10 @@ impl Spacecraft {
     ) -> Result<usize, ParamError> {
         point.validate(path)?;
         self.eom.sensors.push(point);
-        for s in [
-            &mut self.state,
-            &mut self.ws.k1,
-            &mut self.ws.k2,
-            &mut self.ws.k3,
-            &mut self.ws.k4,
-            &mut self.ws.stage,
-        ] {
+        for s in std::iter::once(&mut self.state)
+            .chain(std::iter::once(&mut self.ws.stage))
+            .chain(self.ws.k.iter_mut())
+        {
             s.sensor_dv_p.push(Vector3::zeros());
         }
         Ok(self.eom.sensors.len() - 1)
