@@ -14,7 +14,7 @@ use super::dynamic_effector::{DynamicEffector, StageState};
 use super::effector::{
     BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
-use super::integrator::{ButcherTableau, MAX_STAGES, RK4};
+use super::integrator::{ButcherTableau, Combine, MAX_STAGES, RK4};
 use super::params::{GravityModel, HubParams, SensorPoint, Wrench};
 use super::ParamError;
 use crate::attitude::{mrp_rate, mrp_switch, mrp_to_dcm, tilde};
@@ -52,40 +52,105 @@ impl State {
         }
     }
 
-    /// self = x + h Σ_j a_ij k_j for stage `i` of `method`, elementwise (no allocation; all
-    /// lengths are equal by construction). For RK4 this is `x + k·(a h)`, the historical
-    /// expression.
+    /// self = x + h Σ_j a_ij k_j for stage `i` of `method`, summed as
+    /// ((k_j1·(a h) + k_j2·(a h)) + …) + x over the non-zero a_ij, one whole-state pass per term
+    /// (no allocation; all lengths are equal by construction). For RK4's one-term rows this is
+    /// `x + k·(a h)`, the historical expression, bit for bit.
     #[inline(always)]
     fn set_stage(&mut self, x: &State, method: &ButcherTableau, i: usize, k: &[State], h: f64) {
-        self.r_bn_n = x.r_bn_n + method.stage_increment(i, |j| k[j].r_bn_n, h);
-        self.v_bn_n = x.v_bn_n + method.stage_increment(i, |j| k[j].v_bn_n, h);
-        self.sigma_bn = x.sigma_bn + method.stage_increment(i, |j| k[j].sigma_bn, h);
-        self.omega_bn_b = x.omega_bn_b + method.stage_increment(i, |j| k[j].omega_bn_b, h);
-        for (n, (o, xi)) in self.effectors.iter_mut().zip(&x.effectors).enumerate() {
-            *o = xi + method.stage_increment(i, |j| k[j].effectors[n], h);
+        let mut first = true;
+        for (kj, &a) in k.iter().zip(method.a[i]) {
+            if a != 0.0 {
+                self.scale_add(kj, a * h, !first);
+                first = false;
+            }
         }
-        for (n, (o, xi)) in self.sensor_dv_p.iter_mut().zip(&x.sensor_dv_p).enumerate() {
-            *o = xi + method.stage_increment(i, |j| k[j].sensor_dv_p[n], h);
+        if first {
+            self.clone_from(x);
+        } else {
+            self.add(x);
         }
     }
 
-    /// self += h Σ_i b_i k_i, elementwise: the end of a step of `method`. The IMU Δv integrals go
-    /// through [`ButcherTableau::combine_vec3`].
+    /// self = k·s (`accumulate` false) or self + k·s (true), elementwise.
     #[inline(always)]
-    fn add_step(&mut self, method: &ButcherTableau, k: &[State], h: f64) {
-        self.r_bn_n += method.combine(|i| k[i].r_bn_n, h);
-        self.v_bn_n += method.combine(|i| k[i].v_bn_n, h);
-        self.sigma_bn += method.combine(|i| k[i].sigma_bn, h);
-        self.omega_bn_b += method.combine(|i| k[i].omega_bn_b, h);
-        for (n, o) in self.effectors.iter_mut().enumerate() {
-            *o += method.combine(|i| k[i].effectors[n], h);
-        }
-        let mut dv_stages = [Vector3::zeros(); MAX_STAGES];
-        for (n, o) in self.sensor_dv_p.iter_mut().enumerate() {
-            for (d, ki) in dv_stages.iter_mut().zip(k) {
-                *d = ki.sensor_dv_p[n];
+    fn scale_add(&mut self, k: &State, s: f64, accumulate: bool) {
+        if accumulate {
+            self.r_bn_n += k.r_bn_n * s;
+            self.v_bn_n += k.v_bn_n * s;
+            self.sigma_bn += k.sigma_bn * s;
+            self.omega_bn_b += k.omega_bn_b * s;
+            for (o, ki) in self.effectors.iter_mut().zip(&k.effectors) {
+                *o += ki * s;
             }
-            *o += method.combine_vec3(&dv_stages[..k.len()], h);
+            for (o, ki) in self.sensor_dv_p.iter_mut().zip(&k.sensor_dv_p) {
+                *o += ki * s;
+            }
+        } else {
+            self.r_bn_n = k.r_bn_n * s;
+            self.v_bn_n = k.v_bn_n * s;
+            self.sigma_bn = k.sigma_bn * s;
+            self.omega_bn_b = k.omega_bn_b * s;
+            for (o, ki) in self.effectors.iter_mut().zip(&k.effectors) {
+                *o = ki * s;
+            }
+            for (o, ki) in self.sensor_dv_p.iter_mut().zip(&k.sensor_dv_p) {
+                *o = ki * s;
+            }
+        }
+    }
+
+    /// self = self + x, elementwise.
+    #[inline(always)]
+    fn add(&mut self, x: &State) {
+        self.r_bn_n += x.r_bn_n;
+        self.v_bn_n += x.v_bn_n;
+        self.sigma_bn += x.sigma_bn;
+        self.omega_bn_b += x.omega_bn_b;
+        for (o, xi) in self.effectors.iter_mut().zip(&x.effectors) {
+            *o += xi;
+        }
+        for (o, xi) in self.sensor_dv_p.iter_mut().zip(&x.sensor_dv_p) {
+            *o += xi;
+        }
+    }
+
+    /// self += h Σ_i b_i k_i, elementwise: the end of a step of `method`, with `scratch` (a
+    /// state of the same lengths) as workspace. RK4 combines each quantity in its historical
+    /// expression, the IMU Δv integrals through [`ButcherTableau::combine_vec3`]; a weighted
+    /// method sums (Σ b_i k_i) one whole-state pass per weight, then adds it times h — the same
+    /// arithmetic as [`ButcherTableau::combine`], in a cache-friendly order.
+    #[inline(always)]
+    fn add_step(&mut self, method: &ButcherTableau, k: &[State], h: f64, scratch: &mut State) {
+        match method.combine {
+            Combine::ClassicRk4 => {
+                self.r_bn_n += method.combine(|i| k[i].r_bn_n, h);
+                self.v_bn_n += method.combine(|i| k[i].v_bn_n, h);
+                self.sigma_bn += method.combine(|i| k[i].sigma_bn, h);
+                self.omega_bn_b += method.combine(|i| k[i].omega_bn_b, h);
+                for (n, o) in self.effectors.iter_mut().enumerate() {
+                    *o += method.combine(|i| k[i].effectors[n], h);
+                }
+                let mut dv_stages = [Vector3::zeros(); MAX_STAGES];
+                for (n, o) in self.sensor_dv_p.iter_mut().enumerate() {
+                    for (d, ki) in dv_stages.iter_mut().zip(k) {
+                        *d = ki.sensor_dv_p[n];
+                    }
+                    *o += method.combine_vec3(&dv_stages[..k.len()], h);
+                }
+            }
+            Combine::Weighted => {
+                let mut first = true;
+                for (ki, &b) in k.iter().zip(method.b) {
+                    if b != 0.0 {
+                        scratch.scale_add(ki, b, !first);
+                        first = false;
+                    }
+                }
+                if !first {
+                    self.scale_add(scratch, h, true);
+                }
+            }
         }
     }
 }
@@ -759,7 +824,7 @@ impl Spacecraft {
             stage.set_stage(state, method, i, done, h);
             eom.eval(stage, &mut rest[0], t0, method.c[i] * h);
         }
-        state.add_step(method, k, h);
+        state.add_step(method, k, h, stage);
         mrp_switch(&mut state.sigma_bn);
         self.t_sim_ns += self.step_ns;
     }

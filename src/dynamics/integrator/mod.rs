@@ -65,31 +65,6 @@ impl ButcherTableau {
         self.b.len()
     }
 
-    /// The stage increment h Σ_j a_ij k_j of stage `i` (≥ 1) for one quantity whose stage values
-    /// `k(j)` returns, summed term by term as `k(j)·(a_ij h)` over the non-zero a_ij. For a row
-    /// with one non-zero entry this is `k(j)·(a_ij h)`, the expression of the hand-written RK4
-    /// (`x + k·(h/2)`).
-    #[inline(always)]
-    pub fn stage_increment<T>(&self, i: usize, k: impl Fn(usize) -> T, h: f64) -> T
-    where
-        T: Copy + Add<Output = T> + Mul<f64, Output = T>,
-    {
-        let row = self.a[i];
-        let mut acc: Option<T> = None;
-        for (j, &a) in row.iter().enumerate() {
-            if a != 0.0 {
-                let term = k(j) * (a * h);
-                acc = Some(match acc {
-                    None => term,
-                    Some(s) => s + term,
-                });
-            }
-        }
-        // Every row of a registered method has a non-zero entry (unit test `rows_are_explicit`);
-        // an all-zero row would mean a stage at y₀, i.e. k(0)·0.
-        acc.unwrap_or_else(|| k(0) * 0.0)
-    }
-
     /// The step increment h Σ b_i k_i for one quantity whose stage values `k(i)` returns.
     #[inline(always)]
     pub fn combine<T>(&self, k: impl Fn(usize) -> T, h: f64) -> T
