@@ -23,10 +23,7 @@ use std::time::Instant;
 
 use criterion::{BenchmarkId, Criterion};
 use flexdyn::dynamics::dynamic_effectors::gravity_gradient::GravityGradient;
-use flexdyn::dynamics::{
-    GravityModel, PanelPair, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
-};
-use nalgebra::Vector3;
+use flexdyn::dynamics::{GravityModel, Spacecraft};
 
 const PAIR_COUNTS: [usize; 5] = [1, 2, 4, 8, 16];
 const WHEEL_COUNTS: [usize; 5] = [0, 1, 2, 4, 8];
@@ -34,33 +31,10 @@ const WHEEL_COUNTS: [usize; 5] = [0, 1, 2, 4, 8];
 /// The reference spacecraft (2 pairs) with `n` wheels: a pyramid's axes repeated, each with
 /// friction and a commanded motor torque, so every term of the wheel model is evaluated.
 fn spacecraft_with_wheels(n: usize) -> Spacecraft {
-    let mut effectors: Vec<Box<dyn StateEffector>> = common::reference_pairs(0.0)
-        .into_iter()
-        .enumerate()
-        .map(|(i, (p, init))| {
-            Box::new(PanelPair::new(p, init, &format!("panel_pairs[{i}]")).unwrap())
-                as Box<dyn StateEffector>
-        })
-        .collect();
-    let e = 30f64.to_radians();
-    for j in 0..n {
-        let az = (45.0 + 90.0 * j as f64).to_radians();
-        let axis = Vector3::new(e.cos() * az.cos(), e.cos() * az.sin(), e.sin());
-        let mut w = ReactionWheelParams::balanced(
-            &format!("rw{j}"),
-            axis,
-            Vector3::new(0.4 * az.cos(), 0.4 * az.sin(), 0.5),
-            4.0,
-            0.05,
-            0.03,
-            100.0,
-            0.2,
-            600.0,
-        );
+    let effectors = common::reference_effectors_with_wheels(n, |w| {
         w.viscous_friction_nm_s_rad = 1e-6;
         w.coulomb_friction_nm = 5e-4;
-        effectors.push(Box::new(ReactionWheel::new(w, "reaction_wheels").unwrap()));
-    }
+    });
     let mut sc = Spacecraft::new(
         common::reference_hub(),
         GravityModel::PointMass {
@@ -189,22 +163,7 @@ fn peers(flexdyn: &[(f64, f64)]) {
 
 /// Median ns per step of `sc` over 31 batches of 20,000 steps (after 20,000 warm-up steps).
 fn median_ns_per_step(mut sc: Spacecraft) -> f64 {
-    let batches = 31;
-    let steps = 20_000;
-    for _ in 0..steps {
-        sc.step();
-    }
-    let per_step: Vec<f64> = (0..batches)
-        .map(|_| {
-            let t = Instant::now();
-            for _ in 0..steps {
-                sc.step();
-            }
-            black_box(sc.state().omega_bn_b);
-            t.elapsed().as_secs_f64() * 1e9 / steps as f64
-        })
-        .collect();
-    median(per_step)
+    common::median_ns_per_step(&mut sc, 31, 20_000)
 }
 
 /// Least-squares line through (x, y): (intercept, slope).

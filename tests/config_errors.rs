@@ -930,6 +930,38 @@ fn cases() -> Vec<Case> {
                 assert_eq!(got, (500_000, 20_000_000, 40));
             },
         ),
+        // --- Integrator (README "Choosing the integrator").
+        bad(
+            "simulation.integrator",
+            s("rk5"),
+            &["unknown integrator \"rk5\"", "expected \"rk4\" or \"rk8\""],
+        )
+        .kind("Invalid"),
+        bad(
+            "simulation.integrator",
+            s("RK4"),
+            &["unknown integrator \"RK4\""],
+        ),
+        bad("simulation.integrator", f(8.0), &["string"]).kind("InvalidValue"),
+        rejects(
+            text(
+                "frame_hz = 100.0",
+                "frame_hz = 100.0\nintegrator = \"dopri\"",
+            ),
+            "simulation.integrator",
+            &["unknown integrator"],
+        )
+        .at_line_of("integrator = ", Some(14)),
+        accepts_and(edit(|_| {}), |cfg| assert_eq!(cfg.integrator.name, "rk4")),
+        accepts_and(edit(|t| put(t, "simulation.integrator", s("rk8"))), |cfg| {
+            assert_eq!(cfg.integrator.name, "rk8");
+            assert_eq!(cfg.build_spacecraft().unwrap().integrator().name, "rk8");
+            assert!(
+                cfg.summary().contains("(1000000 ns, rk8)"),
+                "{}",
+                cfg.summary()
+            );
+        }),
         // --- Initial state, gravity, wrench schedule.
         rejects(
             edit(|t| put(t, "initial.r_bn_n_m", vec_value(&[7e6, 0.0, 0.0]))),

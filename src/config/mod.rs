@@ -43,6 +43,7 @@ pub use warnings::{log_warnings, warning_message, ConfigWarning};
 
 use crate::dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
 use crate::dynamics::effectors::reaction_wheel;
+use crate::dynamics::integrator::{self, ButcherTableau, RK4};
 use crate::dynamics::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
     PanelPairParams, ParamError, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
@@ -60,8 +61,10 @@ pub const WHOLE_NS_TOL: f64 = 1e-6;
 /// A validated simulation configuration.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimConfig {
-    /// \[ns\] RK4 step.
+    /// \[ns\] integration step.
     pub step_ns: u64,
+    /// The fixed-step Runge–Kutta method (`simulation.integrator`; RK4 if absent).
+    pub integrator: &'static ButcherTableau,
     /// \[ns\] telemetry/command frame period (a whole multiple of `step_ns`).
     pub frame_ns: u64,
     /// \[Hz\] frame rate as configured.
@@ -143,7 +146,7 @@ impl SimConfig {
         config_summary(self)
     }
 
-    /// RK4 steps per frame.
+    /// Integration steps per frame.
     pub fn steps_per_frame(&self) -> u64 {
         self.frame_ns / self.step_ns
     }
@@ -179,6 +182,7 @@ impl SimConfig {
             self.initial,
             self.step_ns,
         )?;
+        sc.set_integrator(self.integrator);
         if let Some(env) = &self.environment {
             world::add_dynamic_effectors(&mut sc, env, &self.gravity);
         }
@@ -217,7 +221,7 @@ pub fn gravity_model_name(g: &GravityModel) -> &'static str {
 /// One-line summary of a valid configuration.
 pub fn config_summary(cfg: &SimConfig) -> String {
     format!(
-        "{} panel pairs{}, {} IMUs{}{}, total mass {} kg, step {} s ({} ns), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows{}",
+        "{} panel pairs{}, {} IMUs{}{}, total mass {} kg, step {} s ({} ns{}), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows{}",
         cfg.panel_pairs.len(),
         if cfg.reaction_wheels.is_empty() {
             String::new()
@@ -240,6 +244,11 @@ pub fn config_summary(cfg: &SimConfig) -> String {
         cfg.total_mass_kg(),
         cfg.step_ns as f64 * 1e-9,
         cfg.step_ns,
+        if cfg.integrator == &RK4 {
+            String::new()
+        } else {
+            format!(", {}", cfg.integrator.name)
+        },
         cfg.frame_hz,
         cfg.frame_ns,
         cfg.steps_per_frame(),
@@ -309,6 +318,7 @@ struct RawConfig {
 struct RawSimulation {
     step_s: f64,
     frame_hz: f64,
+    integrator: Option<String>,
 }
 
 struct RawGravity {
@@ -344,10 +354,14 @@ impl RawConfig {
     fn read(source: &str, doc: &DeTable<'_>, map: &SourceMap) -> Result<Self, ConfigError> {
         let root = TableReader::root(source, doc, ROOT_KEYS)?;
         let world = world::RawWorld::read(&root, map)?;
-        let sim = root.table("simulation", &["step_s", "frame_hz"])?;
+        let sim = root.table("simulation", &["step_s", "frame_hz", "integrator"])?;
         let simulation = RawSimulation {
             step_s: sim.f64("step_s")?,
             frame_hz: sim.f64("frame_hz")?,
+            integrator: match sim.get("integrator") {
+                Some(_) => Some(sim.string("integrator")?),
+                None => None,
+            },
         };
         let g = root.table("gravity", &["model", "mu_m3_s2", "j2", "r_eq_m"])?;
         let gravity = RawGravity {
@@ -518,6 +532,19 @@ impl RawConfig {
             ));
         }
 
+        let integrator = match sim.integrator.as_deref() {
+            None => &RK4,
+            Some(name) => integrator::by_name(name).ok_or_else(|| {
+                map.invalid(
+                    "simulation.integrator",
+                    format!(
+                        "unknown integrator \"{name}\" (expected {})",
+                        integrator::names_for_message()
+                    ),
+                )
+            })?,
+        };
+
         // [gravity]
         let gravity = self.gravity.to_model(map)?;
         gravity.validate("gravity").map_err(param)?;
@@ -652,6 +679,7 @@ impl RawConfig {
 
         let mut cfg = SimConfig {
             step_ns,
+            integrator,
             frame_ns,
             frame_hz: sim.frame_hz,
             hub,

@@ -37,6 +37,7 @@ pub mod dynamic_effector;
 pub mod dynamic_effectors;
 pub mod effector;
 pub mod effectors;
+pub mod integrator;
 pub mod params;
 pub mod spacecraft;
 pub mod stage_hook;

@@ -1,4 +1,5 @@
-//! The spacecraft: a rigid hub plus any number of [`StateEffector`]s, propagated by fixed-step RK4.
+//! The spacecraft: a rigid hub plus any number of [`StateEffector`]s, propagated by a fixed-step
+//! Runge–Kutta method of [`super::integrator`] (RK4 by default).
 //!
 //! Per derivative evaluation the hub sums the effectors' mass properties and back-substitution
 //! contributions, assembles Eqs. 145–150 (with erratum E2: [C] = m_sc[c̃] + [C_contr]) and solves
@@ -13,8 +14,9 @@ use super::dynamic_effector::{DynamicEffector, StageState};
 use super::effector::{
     BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
+use super::integrator::{ButcherTableau, Combine, RK4};
 use super::params::{GravityModel, HubParams, Wrench};
-use super::stage_hook::{rk4_combine, NoHook, StageCombine, StageHook};
+use super::stage_hook::{NoHook, StageCombine, StageHook};
 use super::ParamError;
 use crate::attitude::{mrp_rate, mrp_switch, mrp_to_dcm, tilde};
 use crate::environment::EnvironmentSample;
@@ -45,20 +47,89 @@ impl State {
         }
     }
 
-    /// self = x + h·k, elementwise (no allocation; all lengths are equal by construction).
+    /// self = x + h Σ_j a_ij k_j for stage `i` of `method`, summed as
+    /// ((k_j1·(a h) + k_j2·(a h)) + …) + x over the non-zero a_ij, one whole-state pass per term
+    /// (no allocation; all lengths are equal by construction). For RK4's one-term rows this is
+    /// `x + k·(a h)`, the historical expression, bit for bit.
     #[inline(always)]
-    fn set_axpy(&mut self, x: &State, h: f64, k: &State) {
-        self.r_bn_n = x.r_bn_n + k.r_bn_n * h;
-        self.v_bn_n = x.v_bn_n + k.v_bn_n * h;
-        self.sigma_bn = x.sigma_bn + k.sigma_bn * h;
-        self.omega_bn_b = x.omega_bn_b + k.omega_bn_b * h;
-        for ((o, xi), ki) in self
-            .effectors
-            .iter_mut()
-            .zip(&x.effectors)
-            .zip(&k.effectors)
-        {
-            *o = xi + h * ki;
+    fn set_stage(&mut self, x: &State, method: &ButcherTableau, i: usize, k: &[State], h: f64) {
+        let mut first = true;
+        for (kj, &a) in k.iter().zip(method.a[i]) {
+            if a != 0.0 {
+                self.scale_add(kj, a * h, !first);
+                first = false;
+            }
+        }
+        if first {
+            self.clone_from(x);
+        } else {
+            self.add(x);
+        }
+    }
+
+    /// self = k·s (`accumulate` false) or self + k·s (true), elementwise.
+    #[inline(always)]
+    fn scale_add(&mut self, k: &State, s: f64, accumulate: bool) {
+        if accumulate {
+            self.r_bn_n += k.r_bn_n * s;
+            self.v_bn_n += k.v_bn_n * s;
+            self.sigma_bn += k.sigma_bn * s;
+            self.omega_bn_b += k.omega_bn_b * s;
+            for (o, ki) in self.effectors.iter_mut().zip(&k.effectors) {
+                *o += ki * s;
+            }
+        } else {
+            self.r_bn_n = k.r_bn_n * s;
+            self.v_bn_n = k.v_bn_n * s;
+            self.sigma_bn = k.sigma_bn * s;
+            self.omega_bn_b = k.omega_bn_b * s;
+            for (o, ki) in self.effectors.iter_mut().zip(&k.effectors) {
+                *o = ki * s;
+            }
+        }
+    }
+
+    /// self = self + x, elementwise.
+    #[inline(always)]
+    fn add(&mut self, x: &State) {
+        self.r_bn_n += x.r_bn_n;
+        self.v_bn_n += x.v_bn_n;
+        self.sigma_bn += x.sigma_bn;
+        self.omega_bn_b += x.omega_bn_b;
+        for (o, xi) in self.effectors.iter_mut().zip(&x.effectors) {
+            *o += xi;
+        }
+    }
+
+    /// self += h Σ_i b_i k_i, elementwise: the end of a step of `method`, with `scratch` (a
+    /// state of the same lengths) as workspace. RK4 combines each quantity in its historical
+    /// expression ([`super::stage_hook::rk4_combine`], as the stage hooks do); a weighted
+    /// method sums (Σ b_i k_i) one whole-state pass per weight, then adds it times h — the same
+    /// arithmetic as [`ButcherTableau::combine`], in a cache-friendly order.
+    #[inline(always)]
+    fn add_step(&mut self, method: &ButcherTableau, k: &[State], h: f64, scratch: &mut State) {
+        match method.combine {
+            Combine::ClassicRk4 => {
+                self.r_bn_n += method.combine(|i| k[i].r_bn_n, h);
+                self.v_bn_n += method.combine(|i| k[i].v_bn_n, h);
+                self.sigma_bn += method.combine(|i| k[i].sigma_bn, h);
+                self.omega_bn_b += method.combine(|i| k[i].omega_bn_b, h);
+                for (n, o) in self.effectors.iter_mut().enumerate() {
+                    *o += method.combine(|i| k[i].effectors[n], h);
+                }
+            }
+            Combine::Weighted => {
+                let mut first = true;
+                for (ki, &b) in k.iter().zip(method.b) {
+                    if b != 0.0 {
+                        scratch.scale_add(ki, b, !first);
+                        first = false;
+                    }
+                }
+                if !first {
+                    self.scale_add(scratch, h, true);
+                }
+            }
         }
     }
 }
@@ -235,18 +306,16 @@ pub fn gravity_potential(model: &GravityModel, r_n: &Vector3<f64>) -> f64 {
     }
 }
 
-/// RK4 stage buffers, sized once at construction.
+/// Stage buffers: one derivative per stage of the integrator and the stage state, sized when
+/// the integrator is chosen (construction time), never on the stepping path.
 #[derive(Debug, Clone)]
-struct Rk4Workspace {
-    k1: State,
-    k2: State,
-    k3: State,
-    k4: State,
+struct StageWorkspace {
+    k: Vec<State>,
     stage: State,
 }
 
 /// The equations of motion: the hub, its effectors, gravity and the applied wrench. Split from
-/// the integrator state so RK4 can evaluate it while borrowing its stage buffers.
+/// the integrator state so the integrator can evaluate it while borrowing its stage buffers.
 #[derive(Debug)]
 struct EquationsOfMotion {
     /// The external forces and torques evaluated at every stage, in registration order.
@@ -274,14 +343,16 @@ struct EquationsOfMotion {
     output_ranges: Vec<Range<usize>>,
 }
 
-/// A rigid hub with appended state effectors, integrated with fixed-step RK4.
+/// A rigid hub with appended state effectors, integrated with a fixed-step Runge–Kutta method.
 #[derive(Debug)]
 pub struct Spacecraft {
     eom: EquationsOfMotion,
     state: State,
     t_sim_ns: u64,
     step_ns: u64,
-    ws: Rk4Workspace,
+    /// The fixed-step Runge–Kutta method ([`integrator`](super::integrator); RK4 by default).
+    method: &'static ButcherTableau,
+    ws: StageWorkspace,
 }
 
 impl EquationsOfMotion {
@@ -481,11 +552,9 @@ impl Spacecraft {
             state: zero.clone(),
             t_sim_ns: 0,
             step_ns,
-            ws: Rk4Workspace {
-                k1: zero.clone(),
-                k2: zero.clone(),
-                k3: zero.clone(),
-                k4: zero.clone(),
+            method: &RK4,
+            ws: StageWorkspace {
+                k: vec![zero.clone(); RK4.stages()],
                 stage: zero,
             },
         };
@@ -541,7 +610,7 @@ impl Spacecraft {
         self.t_sim_ns
     }
 
-    /// [ns] RK4 step.
+    /// [ns] integration step.
     pub fn step_ns(&self) -> u64 {
         self.step_ns
     }
@@ -645,7 +714,7 @@ impl Spacecraft {
         self.eom.begin_step(&self.state, self.t_sim_ns);
     }
 
-    /// Adds a dynamic effector (an external force and torque evaluated at every RK4 stage);
+    /// Adds a dynamic effector (an external force and torque evaluated at every integrator stage);
     /// returns its index. Construction-time only.
     pub fn add_dynamic_effector(&mut self, effector: Box<dyn DynamicEffector>) -> usize {
         if effector.uses_begin_step() {
@@ -696,61 +765,60 @@ impl Spacecraft {
 
     /// Evaluates the state derivative `dx` at state `x` with the current wrench and effector
     /// inputs (each effector's [`StateEffector::begin_step`] runs at `x` first, as at the start
-    /// of a step), and returns the hub accelerations. This is the equation-of-motion function RK4
-    /// integrates: it allocates nothing and cannot fail.
+    /// of a step), and returns the hub accelerations. This is the equation-of-motion function the
+    /// integrator integrates: it allocates nothing and cannot fail.
     pub fn derivatives(&mut self, x: &State, dx: &mut State) -> HubOutputs {
         self.eom.begin_step(x, self.t_sim_ns);
         self.eom.eval(x, dx, self.t_sim_ns, 0.0)
     }
 
-    /// Advances one RK4 step of [`Self::step_ns`] with the current wrench and effector inputs
-    /// (each effector's [`StateEffector::begin_step`] runs first, at the step's initial state),
-    /// then switches σ to its shadow set if |σ| > 1. Allocates nothing.
+    /// Advances one step of [`Self::step_ns`] with the chosen [`Self::integrator`] (RK4 by
+    /// default) and the current wrench and effector inputs (each effector's
+    /// [`StateEffector::begin_step`] runs first, at the step's initial state; stage `i` is
+    /// evaluated at t₀ + c_i h), then switches σ to its shadow set if |σ| > 1. Allocates nothing.
     pub fn step(&mut self) {
         self.step_with(&mut NoHook);
     }
 
     /// [`Self::step`], handing every stage's evaluation to `hook` and closing the step with the
-    /// RK4 combination ([`super::stage_hook`]). Allocates nothing (if `hook` allocates nothing).
+    /// integrator's own combination of stage values ([`super::stage_hook`]). Allocates nothing
+    /// (if `hook` allocates nothing).
     pub fn step_with<H: StageHook + ?Sized>(&mut self, hook: &mut H) {
         self.begin_step();
         let h = self.step_ns as f64 * 1e-9;
         let t0 = self.t_sim_ns;
-        let Self { eom, state, ws, .. } = self;
-        let out = eom.eval(state, &mut ws.k1, t0, 0.0);
+        let Self {
+            eom,
+            state,
+            ws,
+            method,
+            ..
+        } = self;
+        let StageWorkspace { k, stage } = ws;
+        let out = eom.eval(state, &mut k[0], t0, 0.0);
         hook.stage(0, state, &out);
-        ws.stage.set_axpy(state, 0.5 * h, &ws.k1);
-        let out = eom.eval(&ws.stage, &mut ws.k2, t0, 0.5 * h);
-        hook.stage(1, &ws.stage, &out);
-        ws.stage.set_axpy(state, 0.5 * h, &ws.k2);
-        let out = eom.eval(&ws.stage, &mut ws.k3, t0, 0.5 * h);
-        hook.stage(2, &ws.stage, &out);
-        ws.stage.set_axpy(state, h, &ws.k3);
-        let out = eom.eval(&ws.stage, &mut ws.k4, t0, h);
-        hook.stage(3, &ws.stage, &out);
-        let (k1, k2, k3, k4) = (&ws.k1, &ws.k2, &ws.k3, &ws.k4);
-        state.r_bn_n += rk4_combine(k1.r_bn_n, k2.r_bn_n, k3.r_bn_n, k4.r_bn_n, h);
-        state.v_bn_n += rk4_combine(k1.v_bn_n, k2.v_bn_n, k3.v_bn_n, k4.v_bn_n, h);
-        state.sigma_bn += rk4_combine(k1.sigma_bn, k2.sigma_bn, k3.sigma_bn, k4.sigma_bn, h);
-        state.omega_bn_b += rk4_combine(
-            k1.omega_bn_b,
-            k2.omega_bn_b,
-            k3.omega_bn_b,
-            k4.omega_bn_b,
-            h,
-        );
-        for i in 0..state.effectors.len() {
-            state.effectors[i] += rk4_combine(
-                k1.effectors[i],
-                k2.effectors[i],
-                k3.effectors[i],
-                k4.effectors[i],
-                h,
-            );
+        for i in 1..k.len() {
+            let (done, rest) = k.split_at_mut(i);
+            stage.set_stage(state, method, i, done, h);
+            let out = eom.eval(stage, &mut rest[0], t0, method.c[i] * h);
+            hook.stage(i, stage, &out);
         }
-        hook.end_step(&StageCombine::rk4(h));
+        state.add_step(method, k, h, stage);
+        hook.end_step(&StageCombine::new(method, h));
         mrp_switch(&mut state.sigma_bn);
         self.t_sim_ns += self.step_ns;
+    }
+
+    /// Chooses the integration method (construction time: it resizes the stage buffers). The
+    /// state and time are kept.
+    pub fn set_integrator(&mut self, method: &'static ButcherTableau) {
+        self.method = method;
+        self.ws.k.resize(method.stages(), self.ws.stage.clone());
+    }
+
+    /// The integration method.
+    pub fn integrator(&self) -> &'static ButcherTableau {
+        self.method
     }
 
     /// Hub accelerations at the current state with the current wrench (one derivative evaluation;

@@ -13,11 +13,11 @@ use std::ops::{Add, Mul};
 
 use nalgebra::Vector3;
 
+use super::integrator::{ButcherTableau, RK4};
 use super::spacecraft::{HubOutputs, State};
 
-/// The most stages any integrator hands a hook in one step (RK4 uses 4; room for
-/// higher-order tableaux).
-pub const MAX_STAGES: usize = 16;
+/// The most stages any integrator hands a hook in one step (RK4 uses 4, RK8 13).
+pub use super::integrator::MAX_STAGES;
 
 /// The classical RK4 combination of the stage derivatives k1…k4 over a step of `h_s` seconds
 /// (Butcher 2008, Eq. 235i): Δx = (k1 + 2 (k2 + k3) + k4) · h/6, in exactly this operation
@@ -30,31 +30,39 @@ where
     (k1 + (k2 + k3) * 2.0 + k4) * (h_s / 6.0)
 }
 
-/// How the integrator turns the stage values of one step into the step's increment.
+/// How the integrator turns the stage values of one step into the step's increment: its
+/// method's weights ([`ButcherTableau::combine_vec3`], [`rk4_combine`] for RK4), the same
+/// arithmetic as the state's.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StageCombine {
+    method: &'static ButcherTableau,
     /// \[s\] the step.
     h_s: f64,
 }
 
 impl StageCombine {
+    /// The combination of `method` over a step of `h_s` seconds.
+    pub fn new(method: &'static ButcherTableau, h_s: f64) -> Self {
+        Self { method, h_s }
+    }
+
     /// Classical RK4 over a step of `h_s` seconds.
     pub fn rk4(h_s: f64) -> Self {
-        Self { h_s }
+        Self::new(&RK4, h_s)
     }
 
     /// Number of stages a step has (the values [`Self::vec3`] reads).
     pub fn n_stages(&self) -> usize {
-        4
+        self.method.stages()
     }
 
-    /// The increment over the step of a quantity whose derivative at stage `s` is `k[s]`
-    /// ([`rk4_combine`]); zero if `k` holds fewer than [`Self::n_stages`] values.
+    /// The increment over the step of a quantity whose derivative at stage `s` is `k[s]`; zero
+    /// if `k` holds fewer than [`Self::n_stages`] values.
     #[inline]
     pub fn vec3(&self, k: &[Vector3<f64>]) -> Vector3<f64> {
-        match k {
-            [k1, k2, k3, k4, ..] => rk4_combine(*k1, *k2, *k3, *k4, self.h_s),
-            _ => Vector3::zeros(),
+        match k.get(..self.n_stages()) {
+            Some(k) => self.method.combine_vec3(k, self.h_s),
+            None => Vector3::zeros(),
         }
     }
 }

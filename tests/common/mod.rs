@@ -4,7 +4,7 @@
 
 use flexdyn::dynamics::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
-    PanelPairParams, PanelParams, Spacecraft, StateEffector,
+    PanelPairParams, PanelParams, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
 };
 use nalgebra::{Matrix3, Vector3};
 
@@ -214,4 +214,62 @@ pub fn run_drift(sc: &mut Spacecraft, n: usize) -> Drift {
         }
     }
     d
+}
+
+/// The reference spacecraft's effectors (two pairs, no damping) plus `n` frictionless wheels at
+/// 100 rad/s on a pyramid's axes (elevation 30°, azimuths 45° + 90° j, repeated), as the
+/// benches build them; `wheel` may change each wheel's parameters (friction) before it is built.
+pub fn reference_effectors_with_wheels(
+    n: usize,
+    wheel: impl Fn(&mut ReactionWheelParams),
+) -> Vec<Box<dyn StateEffector>> {
+    let mut effectors: Vec<Box<dyn StateEffector>> = reference_pairs(0.0)
+        .into_iter()
+        .enumerate()
+        .map(|(i, (p, init))| {
+            Box::new(PanelPair::new(p, init, &format!("panel_pairs[{i}]")).unwrap())
+                as Box<dyn StateEffector>
+        })
+        .collect();
+    let e = 30f64.to_radians();
+    for j in 0..n {
+        let az = (45.0 + 90.0 * j as f64).to_radians();
+        let axis = Vector3::new(e.cos() * az.cos(), e.cos() * az.sin(), e.sin());
+        let mut w = ReactionWheelParams::balanced(
+            &format!("rw{j}"),
+            axis,
+            Vector3::new(0.4 * az.cos(), 0.4 * az.sin(), 0.5),
+            4.0,
+            0.05,
+            0.03,
+            100.0,
+            0.2,
+            600.0,
+        );
+        wheel(&mut w);
+        effectors.push(Box::new(
+            ReactionWheel::new(w, &format!("reaction_wheels[{j}]")).unwrap(),
+        ));
+    }
+    effectors
+}
+
+/// Median ns per step of `sc` over `batches` batches of `steps` steps, after `steps` warm-up
+/// steps (the benches' timer).
+pub fn median_ns_per_step(sc: &mut Spacecraft, batches: usize, steps: usize) -> f64 {
+    for _ in 0..steps {
+        sc.step();
+    }
+    let mut per_step: Vec<f64> = (0..batches)
+        .map(|_| {
+            let t = std::time::Instant::now();
+            for _ in 0..steps {
+                sc.step();
+            }
+            std::hint::black_box(sc.state().omega_bn_b);
+            t.elapsed().as_secs_f64() * 1e9 / steps as f64
+        })
+        .collect();
+    per_step.sort_by(|a, b| a.total_cmp(b));
+    per_step[per_step.len() / 2]
 }

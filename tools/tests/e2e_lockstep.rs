@@ -331,6 +331,40 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
     );
 }
 
+/// Issue 24: the lockstep stream stays bit-identical across runs for every integrator
+/// (`[simulation] integrator`), with the loop closed on the IMU, whose Δv integrals run inside
+/// the method's stages; and the setting takes effect (another method, another stream). 10 s per
+/// run keeps it cheap.
+#[test]
+fn lockstep_gyro_runs_are_bit_identical_for_every_integrator() {
+    const RUN_S: f64 = 10.0;
+    let gyro: &[&str] = &["--rate-source", "gyro", "--imu", "hub"];
+    let run = |m: &'static flexdyn::dynamics::integrator::ButcherTableau| {
+        let mut cfg = imu_config();
+        cfg.integrator = m;
+        let settings = ServerSettings {
+            duration_ns: Some((RUN_S * 1e9) as u64),
+            ..settings(10.0)
+        };
+        let r = lockstep_run_settings(settings, Sabotage::None, cfg, gyro);
+        r.result.expect("integrator run");
+        assert_eq!(r.states.len() as u64, (RUN_S * 100.0) as u64 + 1);
+        digest(&r.states)
+    };
+    let mut hashes = Vec::new();
+    for m in flexdyn::dynamics::integrator::METHODS {
+        let a = run(m);
+        assert_eq!(run(m), a, "two {} lockstep runs differ", m.name);
+        eprintln!("{}: sha256 {a}", m.name);
+        assert!(
+            !hashes.contains(&a),
+            "{} gives another method's stream",
+            m.name
+        );
+        hashes.push(a);
+    }
+}
+
 /// One lockstep run of `cfg` (100 Hz frames) for `run_s` with the demo closing the loop on the
 /// wheels, star tracker `st1` and gyro `hub` at gains (K [N·m], P [N·m·s]): the server's report
 /// and every state recorded, sorted by tick.

@@ -1,0 +1,178 @@
+//! Issue 24 §2: the integrators side by side, measured in the same run.
+//!
+//! 1. Cost per step of each method (`[simulation] integrator`) on the reference spacecraft (two
+//!    panel pairs) with four reaction wheels, point-mass gravity: median of 15 batches of 2,000
+//!    steps, and the ratio to RK4.
+//! 2. Energy and angular-momentum drift of a free multibody spacecraft (the reference wings with
+//!    springs and no damping, four frictionless wheels spinning at 100 rad/s, no wrench, no
+//!    gravity) and of the same spacecraft in LEO under point-mass gravity. RK4 runs at the
+//!    default 1 ms; each other method at the step that makes its wall time per simulated second
+//!    comparable (RK8: 4 ms, 13 stages against 4 per step). The span is `FLEXDYN_DRIFT_SPAN_S`
+//!    (default 1e4 s, so the whole bench stays under ~3 minutes on one core); the printed drift is
+//!    the largest relative error seen (sampled every 10 s), and the 1e6 s figure is that number
+//!    times 1e6 / span — a linear extrapolation, which is how a fixed-step method's truncation
+//!    drift grows (the 1e3 s figure printed beside it shows whether it does). Set
+//!    `FLEXDYN_DRIFT_SPAN_S=1e6` for the full span (hours for RK4 at 1 ms).
+//!
+//! Target (issue 24): ≤ 1e-10 relative energy error over 1e6 s.
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use std::time::Instant;
+
+use flexdyn::dynamics::integrator::{ButcherTableau, METHODS};
+use flexdyn::dynamics::{GravityModel, Spacecraft};
+use nalgebra::Vector3;
+
+/// The reference wings (k > 0, c = 0) and four frictionless wheels in a pyramid at 100 rad/s.
+fn spacecraft(gravity: GravityModel, step_ns: u64, method: &'static ButcherTableau) -> Spacecraft {
+    let effectors = common::reference_effectors_with_wheels(4, |_| {});
+    let mut sc = Spacecraft::new(
+        common::reference_hub(),
+        gravity,
+        effectors,
+        common::reference_initial(),
+        step_ns,
+    )
+    .unwrap();
+    sc.set_integrator(method);
+    sc
+}
+
+fn leo() -> GravityModel {
+    GravityModel::PointMass {
+        mu_m3_s2: common::MU_EARTH,
+    }
+}
+
+/// Median ns per step of `method` over 15 batches of 2,000 steps (after 2,000 warm-up steps).
+fn ns_per_step(method: &'static ButcherTableau) -> f64 {
+    common::median_ns_per_step(&mut spacecraft(leo(), 1_000_000, method), 15, 2_000)
+}
+
+/// The step [ns] each method runs at in the drift study.
+fn drift_step_ns(method: &ButcherTableau) -> u64 {
+    match method.name {
+        "rk4" => 1_000_000,
+        "rk8" => 4_000_000,
+        other => panic!("no drift step for integrator {other}: add one"),
+    }
+}
+
+/// Largest relative drifts (rotational energy, angular momentum about C, orbital energy,
+/// orbital angular momentum) at 1e3 s and at the end, and the wall time [s].
+struct Drift {
+    at_1e3: [f64; 4],
+    end: [f64; 4],
+    wall_s: f64,
+}
+
+fn drift(gravity: GravityModel, method: &'static ButcherTableau, span_s: f64) -> Drift {
+    let step_ns = drift_step_ns(method);
+    let mut sc = spacecraft(gravity, step_ns, method);
+    let c0 = sc.conserved();
+    let rel = |a: f64, b: f64| if b == 0.0 { 0.0 } else { ((a - b) / b).abs() };
+    let relv = |a: Vector3<f64>, b: Vector3<f64>| {
+        if b.norm() == 0.0 {
+            0.0
+        } else {
+            (a - b).norm() / b.norm()
+        }
+    };
+    let per_sample = (10e9 / step_ns as f64) as u64;
+    let samples = (span_s / 10.0).round() as u64;
+    let mut worst = [0.0f64; 4];
+    let mut at_1e3 = [0.0f64; 4];
+    let t = Instant::now();
+    for k in 1..=samples {
+        for _ in 0..per_sample {
+            sc.step();
+        }
+        let c = sc.conserved();
+        let now = [
+            rel(c.rot_energy_j, c0.rot_energy_j),
+            relv(c.rot_ang_mom_c_n, c0.rot_ang_mom_c_n),
+            rel(c.orb_energy_j, c0.orb_energy_j),
+            relv(c.orb_ang_mom_n, c0.orb_ang_mom_n),
+        ];
+        for (w, n) in worst.iter_mut().zip(now) {
+            *w = w.max(n);
+        }
+        if k * 10 == 1000 {
+            at_1e3 = worst;
+        }
+    }
+    Drift {
+        at_1e3,
+        end: worst,
+        wall_s: t.elapsed().as_secs_f64(),
+    }
+}
+
+fn main() {
+    // `cargo bench` passes `--bench`; a filter argument selects nothing here.
+    println!("integrators (issue 24): cost per step, reference spacecraft + 4 wheels, LEO");
+    println!(
+        "{:>8} {:>7} {:>16} {:>12}",
+        "method", "stages", "median ns/step", "vs rk4"
+    );
+    let costs: Vec<(&ButcherTableau, f64)> = METHODS.iter().map(|m| (*m, ns_per_step(m))).collect();
+    let rk4_ns = costs[0].1;
+    for (m, ns) in &costs {
+        println!(
+            "{:>8} {:>7} {:>16.0} {:>11.2}x",
+            m.name,
+            m.stages(),
+            ns,
+            ns / rk4_ns
+        );
+    }
+
+    let span_s: f64 = std::env::var("FLEXDYN_DRIFT_SPAN_S")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1e4);
+    let scale = 1e6 / span_s;
+    for (label, gravity) in [
+        (
+            "free multibody (panels + wheels, no damping)",
+            GravityModel::None,
+        ),
+        ("LEO, point-mass gravity", leo()),
+    ] {
+        println!(
+            "\n{label}: relative drift, max over the run (sampled every 10 s), span {span_s:e} s"
+        );
+        println!(
+            "{:>8} {:>8} {:>8} {:>11} {:>11} {:>11} {:>11} {:>13} {:>11} {:>11}",
+            "method",
+            "step_s",
+            "wall_s",
+            "E_rot@1e3s",
+            "E_rot@end",
+            "H_C@end",
+            "E_orb@end",
+            "E_rot@1e6s*",
+            "H_C@1e6s*",
+            "E_orb@1e6s*"
+        );
+        for m in METHODS {
+            let d = drift(gravity, m, span_s);
+            println!(
+                "{:>8} {:>8} {:>8.1} {:>11.2e} {:>11.2e} {:>11.2e} {:>11.2e} {:>13.2e} {:>11.2e} {:>11.2e}",
+                m.name,
+                drift_step_ns(m) as f64 * 1e-9,
+                d.wall_s,
+                d.at_1e3[0],
+                d.end[0],
+                d.end[1],
+                d.end[2],
+                d.end[0] * scale,
+                d.end[1] * scale,
+                d.end[2] * scale,
+            );
+        }
+    }
+    println!("\n* extrapolated linearly from the span to 1e6 s (x{scale}); target E_rot <= 1e-10");
+}
