@@ -32,5 +32,6 @@ pub mod server;
 pub mod signals;
 pub mod sim;
 pub mod sinks;
+pub mod validate;
 
 pub use flexdyn_proto::client::{logging, transport};

@@ -2,8 +2,8 @@
 
 use std::path::PathBuf;
 
-use crate::dynamics::ParamError;
 use crate::sensors::imu::ImuParamError;
+use crate::validate::ParamError;
 
 use crate::schema::{in_table, SchemaError};
 pub use crate::schema::{At, Location};

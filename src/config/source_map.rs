@@ -6,9 +6,9 @@ use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
 use super::error::{param_field, ConfigError};
-use crate::dynamics::ParamError;
 use crate::schema::{join_key, location, At};
 use crate::sensors::imu::ImuParamError;
+use crate::validate::ParamError;
 
 struct SpanEntry {
     span: Range<usize>,

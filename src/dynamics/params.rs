@@ -1,5 +1,5 @@
-//! Validated physical parameters of the spacecraft: the hub, gravity and the forcing, and the
-//! validation helpers every effector's parameters use.
+//! Validated physical parameters of the spacecraft: the hub, gravity and the forcing (the
+//! validation helpers they use live in the leaf module [`crate::validate`]).
 //!
 //! These are plain data. They are built by [`crate::config`] (which validates them and reports
 //! errors that name the field) or directly in code, and consumed once by
@@ -100,117 +100,7 @@ impl WrenchSegment {
     }
 }
 
-use super::ParamError;
-
-/// Tolerance on ‖[C][C]ᵀ − I‖ (max element) and |det C − 1| for a DCM to count as orthonormal.
-pub const DCM_ORTHONORMAL_TOL: f64 = 1e-9;
-/// Relative tolerance on the asymmetry of an inertia matrix.
-pub const INERTIA_SYMMETRY_TOL: f64 = 1e-9;
-
-pub(crate) fn join(path: &str, field: &str) -> String {
-    if path.is_empty() {
-        field.to_string()
-    } else {
-        format!("{path}.{field}")
-    }
-}
-
-pub(crate) fn check_finite(path: &str, field: &str, values: &[f64]) -> Result<(), ParamError> {
-    if values.iter().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(ParamError::NotFinite {
-            field: join(path, field),
-        })
-    }
-}
-
-pub(crate) fn check_positive(path: &str, field: &str, v: f64) -> Result<(), ParamError> {
-    check_finite(path, field, &[v])?;
-    if v > 0.0 {
-        Ok(())
-    } else {
-        Err(ParamError::NotPositive {
-            field: join(path, field),
-            value: v,
-        })
-    }
-}
-
-pub(crate) fn check_non_negative(path: &str, field: &str, v: f64) -> Result<(), ParamError> {
-    check_finite(path, field, &[v])?;
-    if v >= 0.0 {
-        Ok(())
-    } else {
-        Err(ParamError::Negative {
-            field: join(path, field),
-            value: v,
-        })
-    }
-}
-
-/// Checks that principal moments are positive and satisfy the triangle inequality
-/// (each moment ≤ the sum of the other two), which any real mass distribution obeys.
-pub(crate) fn check_principal_moments(
-    path: &str,
-    field: &str,
-    m: &[f64; 3],
-) -> Result<(), ParamError> {
-    // Positivity first for all three, so a negative moment is never reported as a triangle
-    // violation.
-    let min = m.iter().copied().fold(f64::INFINITY, f64::min);
-    if min <= 0.0 {
-        return Err(ParamError::NotPositiveDefinite {
-            field: join(path, field),
-            min_eigenvalue: min,
-        });
-    }
-    for (i, v) in m.iter().enumerate() {
-        let others = m[(i + 1) % 3] + m[(i + 2) % 3];
-        // A small relative slack admits thin-plate limits (I3 = I1 + I2) up to round-off.
-        if *v > others * (1.0 + 1e-12) {
-            return Err(ParamError::TriangleInequality {
-                field: join(path, field),
-                moments: *m,
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Validates a full inertia matrix: finite, symmetric, positive-definite, triangle inequality on
-/// its principal moments.
-pub(crate) fn check_inertia_matrix(
-    path: &str,
-    field: &str,
-    i: &Matrix3<f64>,
-) -> Result<(), ParamError> {
-    check_finite(path, field, i.as_slice())?;
-    let scale = i.abs().max().max(f64::MIN_POSITIVE);
-    let asym = (i - i.transpose()).abs().max();
-    if asym > INERTIA_SYMMETRY_TOL * scale {
-        return Err(ParamError::NotSymmetric {
-            field: join(path, field),
-            asymmetry: asym,
-        });
-    }
-    let eig = i.symmetric_eigenvalues();
-    check_principal_moments(path, field, &[eig[0], eig[1], eig[2]])
-}
-
-/// Validates a DCM: finite, orthonormal within [`DCM_ORTHONORMAL_TOL`], proper (det = +1).
-pub(crate) fn check_dcm(path: &str, field: &str, c: &Matrix3<f64>) -> Result<(), ParamError> {
-    check_finite(path, field, c.as_slice())?;
-    let err = (c * c.transpose() - Matrix3::identity()).abs().max();
-    let det = c.determinant();
-    if err > DCM_ORTHONORMAL_TOL || (det - 1.0).abs() > DCM_ORTHONORMAL_TOL {
-        return Err(ParamError::NotOrthonormal {
-            field: join(path, field),
-            error: err.max((det - 1.0).abs()),
-        });
-    }
-    Ok(())
-}
+use crate::validate::{check_dcm, check_finite, check_inertia_matrix, check_positive, ParamError};
 
 impl HubParams {
     /// Validates the hub: positive mass, SPD inertia obeying the triangle inequality, finite offset.

@@ -17,9 +17,9 @@ use super::effector::{
 use super::integrator::{ButcherTableau, Combine, RK4};
 use super::params::{GravityModel, HubParams, Wrench};
 use super::stage_hook::{NoHook, StageCombine, StageHook};
-use super::ParamError;
 use crate::attitude::{mrp_rate, mrp_switch, mrp_to_dcm, tilde};
 use crate::environment::EnvironmentSample;
+use crate::validate::{check_finite, ParamError};
 
 /// The integrated state (also used for its time derivative).
 #[derive(Debug, Clone, PartialEq)]
@@ -484,8 +484,8 @@ impl Spacecraft {
     ) -> Result<Self, ParamError> {
         hub.validate("hub")?;
         gravity.validate("gravity")?;
-        super::params::check_finite("initial", "sigma_bn", initial.sigma_bn.as_slice())?;
-        super::params::check_finite(
+        check_finite("initial", "sigma_bn", initial.sigma_bn.as_slice())?;
+        check_finite(
             "initial",
             "omega_bn_b_rad_s",
             initial.omega_bn_b_rad_s.as_slice(),
@@ -495,15 +495,15 @@ impl Spacecraft {
                 r_bn_n_m,
                 v_bn_n_m_s,
             } => {
-                super::params::check_finite("initial", "r_bn_n_m", r_bn_n_m.as_slice())?;
-                super::params::check_finite("initial", "v_bn_n_m_s", v_bn_n_m_s.as_slice())?;
+                check_finite("initial", "r_bn_n_m", r_bn_n_m.as_slice())?;
+                check_finite("initial", "v_bn_n_m_s", v_bn_n_m_s.as_slice())?;
             }
             InitialTranslation::CenterOfMass {
                 r_cn_n_m,
                 v_cn_n_m_s,
             } => {
-                super::params::check_finite("initial", "r_cn_n_m", r_cn_n_m.as_slice())?;
-                super::params::check_finite("initial", "v_cn_n_m_s", v_cn_n_m_s.as_slice())?;
+                check_finite("initial", "r_cn_n_m", r_cn_n_m.as_slice())?;
+                check_finite("initial", "v_cn_n_m_s", v_cn_n_m_s.as_slice())?;
             }
         }
         if step_ns == 0 {

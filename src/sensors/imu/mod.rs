@@ -60,8 +60,8 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::attitude::{dcm_to_quat, mrp_to_dcm};
-use crate::dynamics::params::check_finite;
-use crate::dynamics::{ParamError, SensorPoint};
+use crate::dynamics::SensorPoint;
+use crate::validate::{check_finite, ParamError};
 use flexdyn_proto::{saturation_flags, Header, ImuMsg};
 
 use super::rng::NormalRng;

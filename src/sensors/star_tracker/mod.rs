@@ -35,9 +35,10 @@
 use nalgebra::{Matrix3, Vector3, Vector4};
 
 use crate::attitude::{dcm_to_quat, mrp_to_dcm};
-use crate::dynamics::params::{check_dcm, check_finite, check_non_negative, check_positive, join};
-use crate::dynamics::ParamError;
 use crate::sensors::{Sensor, SensorKind, Truth};
+use crate::validate::{
+    check_dcm, check_finite, check_non_negative, check_positive, join, ParamError,
+};
 use flexdyn_proto::{encode_into, star_tracker_flags, Header, StarTrackerMsg};
 
 use super::rng::NormalRng;

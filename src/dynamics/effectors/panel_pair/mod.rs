@@ -21,7 +21,7 @@ use crate::dynamics::effector::{
 mod params;
 pub(crate) mod schema;
 
-use crate::dynamics::ParamError;
+use crate::validate::ParamError;
 pub use params::{PanelPairInitial, PanelPairParams, PanelParams};
 
 /// The panel pair's kind: wire tag `effector_kind::PANEL_PAIR`, CSV columns `pair<k>_…`.

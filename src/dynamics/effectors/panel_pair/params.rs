@@ -3,10 +3,10 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::dynamics::params::{
+use crate::validate::{
     check_dcm, check_finite, check_non_negative, check_positive, check_principal_moments, join,
+    ParamError,
 };
-use crate::dynamics::ParamError;
 
 /// One rigid panel of a dual-hinged pair.
 #[derive(Debug, Clone, PartialEq)]

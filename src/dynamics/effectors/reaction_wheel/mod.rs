@@ -58,7 +58,7 @@ use crate::dynamics::effector::{
     BackSubContributions, EffectorKind, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics,
     StateEffector,
 };
-use crate::dynamics::ParamError;
+use crate::validate::ParamError;
 use flexdyn_proto::wheel_flags;
 
 mod params;

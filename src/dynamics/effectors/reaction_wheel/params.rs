@@ -3,10 +3,9 @@
 
 use nalgebra::Vector3;
 
-use crate::dynamics::params::{
-    check_finite, check_non_negative, check_positive, check_principal_moments, join,
+use crate::validate::{
+    check_finite, check_non_negative, check_positive, check_principal_moments, join, ParamError,
 };
-use crate::dynamics::ParamError;
 
 /// Tolerance on |‖ĝ_s‖ − 1| for a spin axis to count as a unit vector.
 pub const UNIT_AXIS_TOL: f64 = 1e-6;
