@@ -41,6 +41,30 @@ fn check(name: &str, x: &[f64], mu: f64, var: f64, var_se: f64) {
     );
 }
 
+/// [`check`] for draws of N(μ, σ): se(s²) = σ²√(2/(n−1)).
+fn check_normal(name: &str, x: &[f64], mu: f64, sigma: f64) {
+    let var = sigma * sigma;
+    check(
+        name,
+        x,
+        mu,
+        var,
+        var * (2.0 / (x.len() as f64 - 1.0)).sqrt(),
+    );
+}
+
+/// Every draw in [a, b), and [`check`] for U(a, b): σ² = (b−a)²/12, μ4 = (b−a)⁴/80.
+fn check_uniform(name: &str, x: &[f64], a: f64, b: f64) {
+    assert!(
+        x.iter().all(|v| (a..b).contains(v)),
+        "{name}: a draw outside [{a}, {b})"
+    );
+    let var = (b - a).powi(2) / 12.0;
+    let mu4 = (b - a).powi(4) / 80.0;
+    let n = x.len() as f64;
+    check(name, x, 0.5 * (a + b), var, ((mu4 - var * var) / n).sqrt());
+}
+
 #[test]
 fn applied_parameters_follow_the_requested_distributions() {
     let plan = campaign(&format!(
@@ -106,28 +130,9 @@ fn applied_parameters_follow_the_requested_distributions() {
         assert_eq!(model["panel_pairs[0].panel2.k_nm_rad"], 100.0);
     }
     let nf = n as f64;
-    check(
-        "inertia[0][0] ~ N(900, 45)",
-        &inertia,
-        900.0,
-        45.0f64.powi(2),
-        45.0f64.powi(2) * (2.0 / (nf - 1.0)).sqrt(),
-    );
-    let (a, b) = (80.0f64, 120.0f64);
-    let var_u = (b - a).powi(2) / 12.0;
-    let mu4 = (b - a).powi(4) / 80.0;
+    check_normal("inertia[0][0] ~ N(900, 45)", &inertia, 900.0, 45.0);
     for (p, v) in k.iter().enumerate() {
-        assert!(
-            v.iter().all(|x| (a..b).contains(x)),
-            "pair {p}: a draw outside [80, 120)"
-        );
-        check(
-            &format!("pair {p} k ~ U(80, 120)"),
-            v,
-            100.0,
-            var_u,
-            ((mu4 - var_u * var_u) / nf).sqrt(),
-        );
+        check_uniform(&format!("pair {p} k ~ U(80, 120)"), v, 80.0, 120.0);
     }
     // The two pairs are drawn independently: their correlation is within 4/√n of 0.
     let (m0, v0) = stats(&k[0]);
@@ -143,13 +148,7 @@ fn applied_parameters_follow_the_requested_distributions() {
         "pairs correlated"
     );
     for (i, v) in omega.iter().enumerate() {
-        check(
-            &format!("omega[{i}] ~ N(0, 0.01)"),
-            v,
-            0.0,
-            1e-4,
-            1e-4 * (2.0 / (nf - 1.0)).sqrt(),
-        );
+        check_normal(&format!("omega[{i}] ~ N(0, 0.01)"), v, 0.0, 0.01);
     }
     // A uniform rotation: β uniform on the half 3-sphere β0 ≥ 0. E[β_i] = 0 (i = 1..3),
     // E[β_k²] = 1/4 for all four, and E[β0] = 4/(3π) (marginal density ∝ √(1 − x²)).
@@ -552,26 +551,10 @@ fn environment_parameters_are_dispersed_and_read_back_from_the_model() {
         assert_eq!(model["environment.f107a_sfu"], 150.0);
         assert_eq!(model["environment.facets[1].area_m2"], 4.0);
     }
-    let nf = n as f64;
-    let uniform = |name: &str, x: &[f64], a: f64, b: f64| {
-        assert!(
-            x.iter().all(|v| (a..b).contains(v)),
-            "{name}: outside [{a}, {b})"
-        );
-        let var = (b - a).powi(2) / 12.0;
-        let mu4 = (b - a).powi(4) / 80.0;
-        check(name, x, 0.5 * (a + b), var, ((mu4 - var * var) / nf).sqrt());
-    };
-    uniform("F10.7 ~ U(70, 250)", &f107, 70.0, 250.0);
-    uniform("epoch offset ~ U(0, 20 d)", &offset, 0.0, offset_max_s);
-    uniform("facet 0 Cd ~ U(2.0, 2.4)", &cd0, 2.0, 2.4);
-    check(
-        "facet 0 area ~ N(4, 0.2)",
-        &area0,
-        4.0,
-        0.04,
-        0.04 * (2.0 / (nf - 1.0)).sqrt(),
-    );
+    check_uniform("F10.7 ~ U(70, 250)", &f107, 70.0, 250.0);
+    check_uniform("epoch offset ~ U(0, 20 d)", &offset, 0.0, offset_max_s);
+    check_uniform("facet 0 Cd ~ U(2.0, 2.4)", &cd0, 2.0, 2.4);
+    check_normal("facet 0 area ~ N(4, 0.2)", &area0, 4.0, 0.2);
 }
 
 /// A base whose orbit comes from a file next to it (`elements_file = "sat.omm"`) plans from any
