@@ -72,7 +72,7 @@ impl Simulation {
             scheduled_inputs: vec![0.0; sc.effector_input_len()],
             applied_inputs: vec![0.0; sc.effector_input_len()],
             outputs_scratch: vec![0.0; sc.effector_output_len()],
-            flags_scratch: vec![0; sc.effectors().len()],
+            flags_scratch: vec![0; sc.effector_count()],
             frame_outputs: None,
             sc,
             frame_ns: cfg.frame_ns,
@@ -117,9 +117,9 @@ impl Simulation {
         self.frame_ns / self.sc.step_ns()
     }
 
-    /// Number of effectors (panel pairs, then reaction wheels).
+    /// Number of effector entries (panel pairs, reaction wheels, then the actuators).
     pub fn n_effectors(&self) -> usize {
-        self.sc.effectors().len()
+        self.sc.effector_count()
     }
 
     /// Commanded wrench (from the ACS controller), added to the scheduled disturbance wrench;
@@ -267,13 +267,12 @@ impl Simulation {
         StateMsg {
             effectors: self
                 .sc
-                .effectors()
-                .iter()
+                .effector_entries()
                 .map(|e| EffectorState {
-                    kind: e.kind().wire_tag,
+                    kind: e.kind.wire_tag,
                     flags: 0,
-                    states: vec![0.0; e.state_len()],
-                    outputs: vec![0.0; e.output_names().len()],
+                    states: vec![0.0; e.state_names.len()],
+                    outputs: vec![0.0; e.output_names.len()],
                 })
                 .collect(),
             ..StateMsg::default()
@@ -314,20 +313,23 @@ impl Simulation {
         out.r_bn_n_m = state.r_bn_n.into();
         out.v_bn_n_m_s = state.v_bn_n.into();
         out.nongrav_accel_bn_n_m_s2 = (dcm_nb * hub.nongrav_accel_bn_b).into();
-        let effectors = self.sc.effectors();
         out.effectors
-            .resize_with(effectors.len(), EffectorState::default);
+            .resize_with(self.sc.effector_count(), EffectorState::default);
         let ranges = self
             .sc
-            .effector_ranges()
+            .effector_output_ranges()
             .iter()
-            .zip(self.sc.effector_output_ranges())
             .zip(&self.flags_scratch);
-        for ((o, e), ((r, or), flags)) in out.effectors.iter_mut().zip(effectors).zip(ranges) {
-            o.kind = e.kind().wire_tag;
+        for ((o, e), (or, flags)) in out
+            .effectors
+            .iter_mut()
+            .zip(self.sc.effector_entries())
+            .zip(ranges)
+        {
+            o.kind = e.kind.wire_tag;
             o.flags = *flags;
             o.states.clear();
-            o.states.extend_from_slice(&state.effectors[r.clone()]);
+            o.states.extend_from_slice(&state.effectors[e.state_range]);
             o.outputs.clear();
             o.outputs
                 .extend_from_slice(&self.outputs_scratch[or.clone()]);

@@ -104,22 +104,22 @@ pub(super) fn resolve(
     step_ns: u64,
     map: &SourceMap,
 ) -> Result<Vec<EffectorInputSegment>, ConfigError> {
-    let effectors = sc.effectors();
+    let effectors: Vec<_> = sc.effector_entries().collect();
     let mut last_ns: HashMap<usize, u64> = HashMap::new();
     let mut out = Vec::with_capacity(rows.len());
     for (i, row) in rows.iter().enumerate() {
         let path = format!("effector_input_schedule[{i}]");
         let field = format!("{path}.effector");
         let matches: Vec<usize> = (0..effectors.len())
-            .filter(|&k| effectors[k].name() == row.effector)
+            .filter(|&k| effectors[k].name == row.effector)
             .collect();
         let effector_index = match matches.as_slice() {
             [k] => *k,
             [] => {
                 let takes: Vec<String> = effectors
                     .iter()
-                    .filter(|e| e.input_len() > 0)
-                    .map(|e| format!("`{}`", e.name()))
+                    .filter(|e| !e.input_names.is_empty())
+                    .map(|e| format!("`{}`", e.name))
                     .collect();
                 let listed = if takes.is_empty() {
                     "this spacecraft has no effector that takes inputs".to_string()
@@ -132,7 +132,7 @@ pub(super) fn resolve(
                 ));
             }
             several => {
-                let kinds: Vec<&str> = several.iter().map(|k| effectors[*k].kind().name).collect();
+                let kinds: Vec<&str> = several.iter().map(|k| effectors[*k].kind.name).collect();
                 return Err(map.invalid(
                     &field,
                     format!(
@@ -144,13 +144,24 @@ pub(super) fn resolve(
             }
         };
         let e = &effectors[effector_index];
-        let names = e.input_names();
+        let names = e.input_names;
         if names.is_empty() {
+            let mut kinds: Vec<String> = effectors
+                .iter()
+                .filter(|e| !e.input_names.is_empty())
+                .map(|e| format!("{}s", e.kind.name.replace('_', " ")))
+                .collect();
+            kinds.dedup();
+            let listed = if kinds.is_empty() {
+                "this spacecraft has none that do".to_string()
+            } else {
+                format!("effectors that do: {}", kinds.join(", "))
+            };
             return Err(map.invalid(
                 &field,
                 format!(
-                    "the {} `{}` takes no inputs (effectors that do: reaction wheels)",
-                    e.kind().name.replace('_', " "),
+                    "the {} `{}` takes no inputs ({listed})",
+                    e.kind.name.replace('_', " "),
                     row.effector
                 ),
             ));
@@ -163,7 +174,7 @@ pub(super) fn resolve(
                     names.len(),
                     if names.len() == 1 { "" } else { "s" },
                     names.join(", "),
-                    e.kind().name.replace('_', " "),
+                    e.kind.name.replace('_', " "),
                     row.effector,
                     row.inputs.len()
                 ),

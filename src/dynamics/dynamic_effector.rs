@@ -33,6 +33,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::effector::EffectorKind;
 use super::params::Wrench;
 use crate::environment::EnvironmentSample;
 
@@ -98,4 +99,29 @@ pub trait DynamicEffector: Send + std::fmt::Debug {
     /// (`environment.facets[0].area_m2`). A campaign reads dispersed values back from here, not
     /// from the file. Not on the stepping path.
     fn parameters(&self, _out: &mut Vec<(String, f64)>) {}
+
+    /// An actuator (a magnetorquer, a thruster) is listed beside the appended bodies: it has an
+    /// entry in the state record's effector list under this kind, after the state effectors, and
+    /// takes its inputs from `CommandKind::Actuators` by that index. `None` (the default) for a
+    /// force nobody commands (gravity gradient, drag, solar pressure, a residual dipole).
+    fn listed_kind(&self) -> Option<EffectorKind> {
+        None
+    }
+    /// Names of the inputs flight code may command (with units); empty if none.
+    fn input_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// Sets the commanded inputs, held until the next call. `u` has `input_names().len()`
+    /// values, each finite (the caller checks both). Allocates nothing and cannot fail:
+    /// out-of-range values are clipped and flagged by the effector.
+    fn set_inputs(&mut self, _u: &[f64]) {}
+    /// Names of the outputs reported by [`Self::outputs`] (with units).
+    fn output_names(&self) -> &'static [&'static str] {
+        &[]
+    }
+    /// Writes the outputs at the current instant into `out` (length `output_names().len()`)
+    /// and returns the kind's status flags. Call after [`Self::begin_step`] at that instant.
+    fn outputs(&self, _out: &mut [f64]) -> u32 {
+        0
+    }
 }

@@ -51,8 +51,8 @@ pub use effectors::panel_pair::{PanelPair, PanelPairInitial, PanelPairParams, Pa
 pub use effectors::reaction_wheel::{ReactionWheel, ReactionWheelParams};
 pub use params::{GravityModel, HubParams, SensorPoint, Wrench, WrenchSegment};
 pub use spacecraft::{
-    gravity_accel_n, gravity_potential, specific_force_b, Conserved, HubInitial, HubOutputs,
-    InitialTranslation, Spacecraft, State,
+    gravity_accel_n, gravity_potential, specific_force_b, Conserved, EffectorEntry, HubInitial,
+    HubOutputs, InitialTranslation, Spacecraft, State,
 };
 
 pub use crate::validate::ParamError;

@@ -12,7 +12,8 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::dynamic_effector::{DynamicEffector, StageState};
 use super::effector::{
-    BackSubContributions, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics, StateEffector,
+    BackSubContributions, EffectorKind, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics,
+    StateEffector,
 };
 use super::integrator::{ButcherTableau, Combine, RK4};
 use super::params::{GravityModel, HubParams, Wrench};
@@ -322,6 +323,9 @@ struct EquationsOfMotion {
     dynamic: Vec<Box<dyn DynamicEffector>>,
     /// Indices of the dynamic effectors whose [`DynamicEffector::uses_begin_step`] is true.
     dynamic_stepped: Vec<usize>,
+    /// Indices of the listed dynamic effectors (the actuators,
+    /// [`DynamicEffector::listed_kind`]): effector entries `effectors.len()..`, in this order.
+    listed: Vec<usize>,
     /// The environment the dynamic effectors read, held until the next
     /// [`Spacecraft::set_environment`].
     env: EnvironmentSample,
@@ -336,11 +340,30 @@ struct EquationsOfMotion {
     torque_b_nm: Vector3<f64>,
     /// Indices of the effectors whose [`StateEffector::uses_begin_step`] is true.
     stepped: Vec<usize>,
-    /// Range of each effector's inputs in the flat input vector of
-    /// [`Spacecraft::set_effector_inputs`], and of its outputs in [`Spacecraft::effector_outputs`]
-    /// (cold: after the fields every evaluation reads).
+    /// Range of each effector entry's inputs in the flat input vector of
+    /// [`Spacecraft::set_effector_inputs`], and of its outputs in [`Spacecraft::effector_outputs`]:
+    /// the state effectors, then the listed dynamic effectors (cold: after the fields every
+    /// evaluation reads).
     input_ranges: Vec<Range<usize>>,
     output_ranges: Vec<Range<usize>>,
+}
+
+/// One entry of the vehicle's effector list ([`Spacecraft::effector_entries`]): an appended body
+/// or a listed dynamic effector (an actuator), as the telemetry and the commands see it.
+#[derive(Debug, Clone)]
+pub struct EffectorEntry<'a> {
+    /// Its kind (wire tag, CSV prefix).
+    pub kind: EffectorKind,
+    /// Its name from the configuration.
+    pub name: &'a str,
+    /// Its integrated states' names (empty for a dynamic effector).
+    pub state_names: &'static [&'static str],
+    /// Its states' range in [`State::effectors`] (empty for a dynamic effector).
+    pub state_range: Range<usize>,
+    /// Its inputs' names.
+    pub input_names: &'static [&'static str],
+    /// Its outputs' names.
+    pub output_names: &'static [&'static str],
 }
 
 /// A rigid hub with appended state effectors, integrated with a fixed-step Runge–Kutta method.
@@ -536,6 +559,7 @@ impl Spacecraft {
             eom: EquationsOfMotion {
                 dynamic: Vec::new(),
                 dynamic_stepped: Vec::new(),
+                listed: Vec::new(),
                 env: EnvironmentSample::NONE,
                 hub,
                 hub_first_moment_b,
@@ -649,9 +673,16 @@ impl Spacecraft {
     /// [`Self::effector_input_ranges`], held until the next call. Allocates nothing.
     pub fn set_effector_inputs(&mut self, u: &[f64]) -> Result<(), ParamError> {
         self.check_effector_inputs(u)?;
-        for (e, r) in self.eom.effectors.iter_mut().zip(&self.eom.input_ranges) {
+        let eom = &mut self.eom;
+        let (state_ranges, listed_ranges) = eom.input_ranges.split_at(eom.effectors.len());
+        for (e, r) in eom.effectors.iter_mut().zip(state_ranges) {
             if !r.is_empty() {
                 e.set_inputs(&u[r.clone()]);
+            }
+        }
+        for (&i, r) in eom.listed.iter().zip(listed_ranges) {
+            if !r.is_empty() {
+                eom.dynamic[i].set_inputs(&u[r.clone()]);
             }
         }
         Ok(())
@@ -674,12 +705,13 @@ impl Spacecraft {
         Ok(())
     }
 
-    /// Every effector's outputs at the current state into `out` (laid out by
-    /// [`Self::effector_output_ranges`]) and its status flags into `flags` (one per effector).
-    /// Extra room is left untouched; allocates nothing.
+    /// Every effector entry's outputs at the current state into `out` (laid out by
+    /// [`Self::effector_output_ranges`]) and its status flags into `flags` (one per entry,
+    /// [`Self::effector_count`]). Extra room is left untouched; allocates nothing.
     pub fn effector_outputs(&mut self, out: &mut [f64], flags: &mut [u32]) {
         self.begin_step();
         let eom = &self.eom;
+        let n = eom.effectors.len();
         for (((e, r), o), f) in eom
             .effectors
             .iter()
@@ -691,6 +723,55 @@ impl Spacecraft {
                 *f = e.outputs(&self.state.effectors[r.clone()], out);
             }
         }
+        for ((&i, o), f) in eom
+            .listed
+            .iter()
+            .zip(&eom.output_ranges[n..])
+            .zip(flags.iter_mut().skip(n))
+        {
+            if let Some(out) = out.get_mut(o.clone()) {
+                *f = eom.dynamic[i].outputs(out);
+            }
+        }
+    }
+
+    /// Number of effector entries: the state effectors, then the listed dynamic effectors (the
+    /// actuators). The state record carries one entry each, in this order.
+    pub fn effector_count(&self) -> usize {
+        self.eom.effectors.len() + self.eom.listed.len()
+    }
+
+    /// Every effector entry, in wire order: what the state record, the CSV, the input schedule
+    /// and the command checks name.
+    pub fn effector_entries(&self) -> impl Iterator<Item = EffectorEntry<'_>> + '_ {
+        let eom = &self.eom;
+        let bodies = eom
+            .effectors
+            .iter()
+            .zip(&eom.ranges)
+            .map(|(e, r)| EffectorEntry {
+                kind: e.kind(),
+                name: e.name(),
+                state_names: e.state_names(),
+                state_range: r.clone(),
+                input_names: e.input_names(),
+                output_names: e.output_names(),
+            });
+        let end = eom.ranges.last().map_or(0, |r| r.end);
+        let actuators = eom.listed.iter().map(move |&i| {
+            let e = &eom.dynamic[i];
+            EffectorEntry {
+                kind: e
+                    .listed_kind()
+                    .expect("only dynamic effectors with a listed kind are listed"),
+                name: e.name(),
+                state_names: &[],
+                state_range: end..end,
+                input_names: e.input_names(),
+                output_names: e.output_names(),
+            }
+        });
+        bodies.chain(actuators)
     }
 
     /// Each effector's own mass properties about B at the current state (pass 1 of the
@@ -719,6 +800,16 @@ impl Spacecraft {
     pub fn add_dynamic_effector(&mut self, effector: Box<dyn DynamicEffector>) -> usize {
         if effector.uses_begin_step() {
             self.eom.dynamic_stepped.push(self.eom.dynamic.len());
+        }
+        if effector.listed_kind().is_some() {
+            let eom = &mut self.eom;
+            eom.listed.push(eom.dynamic.len());
+            let append = |ranges: &mut Vec<Range<usize>>, len: usize| {
+                let start = ranges.last().map_or(0, |r| r.end);
+                ranges.push(start..start + len);
+            };
+            append(&mut eom.input_ranges, effector.input_names().len());
+            append(&mut eom.output_ranges, effector.output_names().len());
         }
         self.eom.dynamic.push(effector);
         self.eom.dynamic.len() - 1
