@@ -99,6 +99,14 @@ pub enum ParamError {
         /// The limit.
         limit: f64,
     },
+    /// A value that breaks a rule of its own, said in words.
+    #[error("{field}: {problem}")]
+    Invalid {
+        /// Field path.
+        field: String,
+        /// What is wrong.
+        problem: String,
+    },
     /// An effector-input vector of the wrong length was supplied.
     #[error("effector inputs: expected {expected} values, got {found}")]
     InputLength {
@@ -138,6 +146,27 @@ pub(crate) fn check_finite(path: &str, field: &str, values: &[f64]) -> Result<()
             field: join(path, field),
         })
     }
+}
+
+/// Tolerance on |‖â‖ − 1| for an axis (a wheel's spin axis, a rod's, a thruster's) to count as
+/// a unit vector.
+pub const UNIT_AXIS_TOL: f64 = 1e-6;
+
+/// Checks that `v` is a finite unit vector within [`UNIT_AXIS_TOL`].
+pub(crate) fn check_unit_axis(
+    path: &str,
+    field: &str,
+    v: &nalgebra::Vector3<f64>,
+) -> Result<(), ParamError> {
+    check_finite(path, field, v.as_slice())?;
+    let norm = v.norm();
+    if (norm - 1.0).abs() > UNIT_AXIS_TOL {
+        return Err(ParamError::NotUnit {
+            field: join(path, field),
+            norm,
+        });
+    }
+    Ok(())
 }
 
 pub(crate) fn check_positive(path: &str, field: &str, v: f64) -> Result<(), ParamError> {

@@ -165,6 +165,7 @@ fn every_shipped_scenario_is_valid() {
     assert_eq!(
         names,
         [
+            "acs_full",
             "campaign",
             "damped_wing",
             "eight_pairs",

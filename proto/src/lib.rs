@@ -104,10 +104,10 @@ pub use layout::{
     STAR_TRACKER_LEN, STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN,
 };
 pub use messages::{
-    command_flags, effector_kind, saturation_flags, star_tracker_flags, wheel_flags, AppliedWrench,
-    CommandKind, CommandMsg, CommandStatus, Conserved, EffectorInput, EffectorState, FrameTiming,
-    Header, ImuMsg, Mode, RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg,
-    StatusMsg, NO_COMMAND,
+    command_flags, effector_kind, magnetorquer_flags, saturation_flags, star_tracker_flags,
+    thruster_flags, wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved,
+    EffectorInput, EffectorState, FrameTiming, Header, ImuMsg, Mode, RejectCounters, RunState,
+    StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, NO_COMMAND,
 };
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.

@@ -71,6 +71,30 @@ pub mod effector_kind {
     /// imbalance); outputs `[applied motor torque N·m, friction torque N·m]`; flags
     /// [`super::wheel_flags`]; one input, the commanded motor torque (N·m).
     pub const REACTION_WHEEL: u16 = 2;
+    /// A magnetorquer rod. No states; outputs `[applied dipole A·m²]`; flags
+    /// [`super::magnetorquer_flags`]; one input, the commanded dipole (A·m²) along its axis.
+    pub const MAGNETORQUER: u16 = 3;
+    /// A thruster. No states; outputs `[thrust N, pulse count, propellant used kg, impulse N·s]`;
+    /// flags [`super::thruster_flags`]; one input, the valve-open time per frame (s) or the duty
+    /// cycle (0–1), as configured.
+    pub const THRUSTER: u16 = 4;
+}
+
+/// Bits of [`EffectorState::flags`] for a [`effector_kind::MAGNETORQUER`] entry.
+pub mod magnetorquer_flags {
+    /// Bit 0: the commanded dipole exceeded `max_dipole_am2` and was clipped.
+    pub const SATURATED: u32 = 1 << 0;
+}
+
+/// Bits of [`EffectorState::flags`] for a [`effector_kind::THRUSTER`] entry.
+pub mod thruster_flags {
+    /// Bit 0: the valve is open at this instant.
+    pub const FIRING: u32 = 1 << 0;
+    /// Bit 1: the commanded on-time is below `min_on_time_s`; the valve stays shut.
+    pub const BELOW_MIN_ON_TIME: u32 = 1 << 1;
+    /// Bit 2: the command was outside its range (on-time 0 … frame period, duty 0 … 1) and was
+    /// clipped.
+    pub const COMMAND_CLIPPED: u32 = 1 << 2;
 }
 
 /// Bits of [`EffectorState::flags`] for a [`effector_kind::REACTION_WHEEL`] entry.

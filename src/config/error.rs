@@ -189,7 +189,8 @@ pub(crate) fn param_field(e: &ParamError) -> Option<&str> {
         | ParamError::NotOrthonormal { field, .. }
         | ParamError::DExceedsLength { field, .. }
         | ParamError::NotUnit { field, .. }
-        | ParamError::Exceeds { field, .. } => Some(field),
+        | ParamError::Exceeds { field, .. }
+        | ParamError::Invalid { field, .. } => Some(field),
         _ => None,
     }
 }

@@ -19,6 +19,7 @@
 //! The built-in default is [`DEFAULT_CONFIG_TOML`], the verbatim text of
 //! `scenarios/reference.toml`. The README's "Configuration" section documents every key.
 
+mod actuators;
 mod error;
 mod file;
 mod schedule;
@@ -34,6 +35,7 @@ use toml::de::DeTable;
 use crate::numfmt::{Num, Rounded};
 use crate::schema::location;
 use crate::schema::{mat3, vec3, TableReader};
+pub use actuators::Actuators;
 pub use error::{At, ConfigError, Location};
 pub use file::{config_message, load_config};
 use flexdyn_proto::MAX_PANEL_PAIRS;
@@ -41,6 +43,8 @@ pub use schedule::EffectorInputSegment;
 pub(crate) use source_map::SourceMap;
 pub use warnings::{log_warnings, warning_message, ConfigWarning};
 
+use crate::dynamics::dynamic_effectors::magnetorquer::Magnetorquer;
+use crate::dynamics::dynamic_effectors::thruster::Thruster;
 use crate::dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
 use crate::dynamics::effectors::reaction_wheel;
 use crate::dynamics::integrator::{self, ButcherTableau, RK4};
@@ -80,6 +84,9 @@ pub struct SimConfig {
     /// Reaction wheels (`[[reaction_wheels]]`), validated, in file order (empty if absent).
     /// They follow the panel pairs in the effector order.
     pub reaction_wheels: Vec<ReactionWheelParams>,
+    /// The actuators (`[[magnetorquers]]`, `[[thrusters]]`), validated; they follow the
+    /// reaction wheels in the effector order.
+    pub actuators: Actuators,
     /// Piecewise-constant external wrench on the hub, sorted by strictly increasing start time.
     pub wrench_schedule: Vec<WrenchSegment>,
     /// Piecewise-constant effector inputs (`[[effector_input_schedule]]`), sorted by start
@@ -164,7 +171,9 @@ impl SimConfig {
 
     /// Builds the spacecraft: one [`PanelPair`] per configured pair (errors name
     /// `panel_pairs[i]…`), then one [`ReactionWheel`] per wheel (`reaction_wheels[i]…`), then
-    /// [`Spacecraft::new`], then the dynamic effectors of `[environment]`.
+    /// [`Spacecraft::new`], then the actuators (magnetorquers, then thrusters: listed dynamic
+    /// effectors, after the wheels in the effector order), then the dynamic effectors of
+    /// `[environment]`.
     pub fn build_spacecraft(&self) -> Result<Spacecraft, ConfigError> {
         let mut effectors: Vec<Box<dyn StateEffector>> = Vec::with_capacity(self.panel_pairs.len());
         for (i, (params, initial)) in self.panel_pairs.iter().enumerate() {
@@ -183,6 +192,15 @@ impl SimConfig {
             self.step_ns,
         )?;
         sc.set_integrator(self.integrator);
+        for (i, p) in self.actuators.magnetorquers.iter().enumerate() {
+            let rod = Magnetorquer::new(p.clone(), &format!("magnetorquers[{i}]"))?;
+            sc.add_dynamic_effector(Box::new(rod));
+        }
+        for (i, p) in self.actuators.thrusters.iter().enumerate() {
+            let path = format!("thrusters[{i}]");
+            let thruster = Thruster::new(p.clone(), &path, self.frame_ns, self.step_ns)?;
+            sc.add_dynamic_effector(Box::new(thruster));
+        }
         if let Some(env) = &self.environment {
             world::add_dynamic_effectors(&mut sc, env, &self.gravity);
         }
@@ -221,12 +239,25 @@ pub fn gravity_model_name(g: &GravityModel) -> &'static str {
 /// One-line summary of a valid configuration.
 pub fn config_summary(cfg: &SimConfig) -> String {
     format!(
-        "{} panel pairs{}, {} IMUs{}{}, total mass {} kg, step {} s ({} ns{}), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows{}",
+        "{} panel pairs{}{}, {} IMUs{}{}, total mass {} kg, step {} s ({} ns{}), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows{}",
         cfg.panel_pairs.len(),
         if cfg.reaction_wheels.is_empty() {
             String::new()
         } else {
             format!(", {} reaction wheels", cfg.reaction_wheels.len())
+        },
+        {
+            let a = &cfg.actuators;
+            let mut s = String::new();
+            for (n, what) in [
+                (a.magnetorquers.len(), "magnetorquers"),
+                (a.thrusters.len(), "thrusters"),
+            ] {
+                if n > 0 {
+                    s += &format!(", {n} {what}");
+                }
+            }
+            s
         },
         cfg.imus.len(),
         if cfg.imus.is_empty() {
@@ -298,6 +329,8 @@ const ROOT_KEYS: &[&str] = &[
     world::ROOT_KEYS[0],
     world::ROOT_KEYS[1],
     world::ROOT_KEYS[2],
+    actuators::ROOT_KEYS[0],
+    actuators::ROOT_KEYS[1],
 ];
 
 struct RawConfig {
@@ -308,6 +341,7 @@ struct RawConfig {
     initial: RawInitial,
     panel_pairs: Vec<RawPanelPair>,
     reaction_wheels: Vec<ReactionWheelParams>,
+    actuators: actuators::RawActuators,
     wrench_schedule: Vec<RawWrench>,
     effector_input_schedule: Vec<schedule::RawInputRow>,
     server: toml::Table,
@@ -406,6 +440,7 @@ impl RawConfig {
             .iter()
             .map(reaction_wheel::schema::read)
             .collect::<Result<Vec<_>, _>>()?;
+        let actuators = actuators::RawActuators::read(&root)?;
         let wrench_schedule = root
             .tables("wrench_schedule", &["t_s", "force_b_newton", "torque_b_nm"])?
             .unwrap_or_default()
@@ -463,6 +498,7 @@ impl RawConfig {
             initial,
             panel_pairs,
             reaction_wheels,
+            actuators,
             wrench_schedule,
             effector_input_schedule,
             server,
@@ -597,7 +633,9 @@ impl RawConfig {
             params.validate(&path).map_err(param)?;
             reaction_wheels.push(params);
         }
-        check_wire_capacity(map, panel_pairs.len(), &reaction_wheels)?;
+        // [[magnetorquers]], [[thrusters]]
+        let actuators = self.actuators.resolve(map, frame_ns)?;
+        check_wire_capacity(map, panel_pairs.len(), &reaction_wheels, &actuators)?;
 
         // [[wrench_schedule]]
         let mut wrench_schedule = Vec::with_capacity(self.wrench_schedule.len());
@@ -687,6 +725,7 @@ impl RawConfig {
             initial,
             panel_pairs,
             reaction_wheels,
+            actuators,
             wrench_schedule,
             // Resolved below, against the built spacecraft's effectors.
             effector_input_schedule: Vec::new(),
@@ -737,18 +776,20 @@ fn check_wire_capacity(
     map: &SourceMap,
     n_pairs: usize,
     wheels: &[ReactionWheelParams],
+    actuators: &Actuators,
 ) -> Result<(), ConfigError> {
     use flexdyn_proto::{
         EFFECTOR_STATE_FIXED_LEN, MAX_EFFECTORS, MAX_MESSAGE_BYTES, STATE_FIXED_LEN,
     };
-    let n = n_pairs + wheels.len();
+    let n = n_pairs + wheels.len() + actuators.len();
     if n > MAX_EFFECTORS {
         return Err(map.invalid(
             "reaction_wheels",
             format!(
-                "{n_pairs} panel pairs and {} reaction wheels make {n} effectors, more than a \
-                 StateMsg carries ({MAX_EFFECTORS}, proto/README.md)",
-                wheels.len()
+                "{n_pairs} panel pairs, {} reaction wheels and {} actuators make {n} effectors, \
+                 more than a StateMsg carries ({MAX_EFFECTORS}, proto/README.md)",
+                wheels.len(),
+                actuators.len()
             ),
         ));
     }
@@ -765,14 +806,16 @@ fn check_wire_capacity(
     };
     let bytes = STATE_FIXED_LEN
         + n_pairs * entry(panel_pair::STATE_NAMES.len(), 0)
-        + wheels.iter().map(wheel_len).sum::<usize>();
+        + wheels.iter().map(wheel_len).sum::<usize>()
+        + actuators.wire_bytes();
     if bytes > MAX_MESSAGE_BYTES {
         return Err(map.invalid(
             "reaction_wheels",
             format!(
-                "the StateMsg of {n_pairs} panel pairs and {} reaction wheels would be {bytes} \
-                 bytes, more than the {MAX_MESSAGE_BYTES}-byte message limit",
-                wheels.len()
+                "the StateMsg of {n_pairs} panel pairs, {} reaction wheels and {} actuators \
+                 would be {bytes} bytes, more than the {MAX_MESSAGE_BYTES}-byte message limit",
+                wheels.len(),
+                actuators.len()
             ),
         ));
     }

@@ -122,6 +122,27 @@ impl<'a, 'i> TableReader<'a, 'i> {
         }
     }
 
+    /// An optional string at `key` that must be one of `allowed`: its index there, or `None`
+    /// when absent. Any other string is an error that lists the choices.
+    pub(crate) fn opt_choice(
+        &self,
+        key: &str,
+        allowed: &[&str],
+    ) -> Result<Option<usize>, SchemaError> {
+        let Some(v) = self.get(key) else {
+            return Ok(None);
+        };
+        let s = self.string(key)?;
+        match allowed.iter().position(|a| *a == s) {
+            Some(i) => Ok(Some(i)),
+            None => Err(self.invalid(
+                self.field(key),
+                v,
+                format!("`{s}` is not one of: {}", allowed.join(", ")),
+            )),
+        }
+    }
+
     fn expected(&self, field: String, v: &Spanned<DeValue<'_>>, what: &str) -> SchemaError {
         let message = format!("expected {what}, got {}", describe(v.get_ref()));
         self.invalid(field, v, message)

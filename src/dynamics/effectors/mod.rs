@@ -5,9 +5,11 @@
 pub mod panel_pair;
 pub mod reaction_wheel;
 
+use super::dynamic_effectors::{magnetorquer, thruster};
 use super::EffectorKind;
 
-/// How a tool that only has the telemetry names an effector's values: its kind (CSV prefix),
+/// How a tool that only has the telemetry names an effector's values (an appended body's, or a
+/// listed actuator's, [`super::dynamic_effectors`]): its kind (CSV prefix),
 /// state names and output names, from the wire tag and the value counts of an
 /// [`flexdyn_proto::EffectorState`]. `None` for a kind this build does not know, or counts that
 /// do not match the kind (then the values have no names here).
@@ -33,6 +35,10 @@ pub fn wire_names(
             &reaction_wheel::IMBALANCED_STATE_NAMES
         };
         (reaction_wheel::KIND, states, &reaction_wheel::OUTPUT_NAMES)
+    } else if kind == magnetorquer::KIND.wire_tag {
+        (magnetorquer::KIND, &[], &magnetorquer::OUTPUT_NAMES)
+    } else if kind == thruster::KIND.wire_tag {
+        (thruster::KIND, &[], &thruster::OUTPUT_NAMES)
     } else {
         return None;
     };
@@ -43,28 +49,33 @@ pub fn wire_names(
 mod tests {
     use super::*;
     use crate::config::SimConfig;
-    use crate::dynamics::StateEffector;
 
     #[test]
     fn wire_names_match_what_each_built_effector_says() {
         let text = std::fs::read_to_string(concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/scenarios/wheels_star_tracker.toml"
+            "/scenarios/acs_full.toml"
         ))
         .unwrap();
         let sc = SimConfig::from_toml_str(&text)
             .unwrap()
             .build_spacecraft()
             .unwrap();
-        let effectors: &[Box<dyn StateEffector>] = sc.effectors();
-        assert!(effectors.len() >= 3);
-        for e in effectors {
+        assert!(sc.effector_count() >= 3);
+        let mut kinds = std::collections::BTreeSet::new();
+        for e in sc.effector_entries() {
             let (kind, states, outputs) =
-                wire_names(e.kind().wire_tag, e.state_len(), e.output_names().len()).unwrap();
-            assert_eq!(kind.column_prefix, e.kind().column_prefix);
-            assert_eq!(states, e.state_names());
-            assert_eq!(outputs, e.output_names());
+                wire_names(e.kind.wire_tag, e.state_names.len(), e.output_names.len()).unwrap();
+            assert_eq!(kind, e.kind);
+            assert_eq!(states, e.state_names);
+            assert_eq!(outputs, e.output_names);
+            kinds.insert(kind.name);
         }
+        // Every kind there is, bodies and actuators.
+        assert_eq!(
+            kinds.into_iter().collect::<Vec<_>>(),
+            ["magnetorquer", "panel_pair", "reaction_wheel", "thruster"]
+        );
         assert!(wire_names(999, 1, 0).is_none());
         assert!(wire_names(panel_pair::KIND.wire_tag, 3, 0).is_none());
     }

@@ -4,18 +4,16 @@
 use nalgebra::Vector3;
 
 use crate::validate::{
-    check_finite, check_non_negative, check_positive, check_principal_moments, join, ParamError,
+    check_finite, check_non_negative, check_positive, check_principal_moments, check_unit_axis,
+    join, ParamError,
 };
-
-/// Tolerance on |‖ĝ_s‖ − 1| for a spin axis to count as a unit vector.
-pub const UNIT_AXIS_TOL: f64 = 1e-6;
 
 /// One reaction wheel (`[[reaction_wheels]]`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReactionWheelParams {
     /// Name used in logs, messages and telemetry.
     pub name: String,
-    /// Spin axis ĝ_s in B components (a unit vector within [`UNIT_AXIS_TOL`]).
+    /// Spin axis ĝ_s in B components (a unit vector within [`crate::validate::UNIT_AXIS_TOL`]).
     pub spin_axis_b: Vector3<f64>,
     /// [m] rotor centre of mass W relative to B, B components.
     pub r_wb_b_m: Vector3<f64>,
@@ -84,14 +82,7 @@ impl ReactionWheelParams {
 
     /// Validates the wheel (`path` is e.g. `reaction_wheels[0]`).
     pub fn validate(&self, path: &str) -> Result<(), ParamError> {
-        check_finite(path, "spin_axis_b", self.spin_axis_b.as_slice())?;
-        let norm = self.spin_axis_b.norm();
-        if (norm - 1.0).abs() > UNIT_AXIS_TOL {
-            return Err(ParamError::NotUnit {
-                field: join(path, "spin_axis_b"),
-                norm,
-            });
-        }
+        check_unit_axis(path, "spin_axis_b", &self.spin_axis_b)?;
         check_finite(path, "r_wb_b_m", self.r_wb_b_m.as_slice())?;
         check_positive(path, "mass_kg", self.mass_kg)?;
         check_positive(path, "j_s_kg_m2", self.j_s_kg_m2)?;
