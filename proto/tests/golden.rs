@@ -21,11 +21,11 @@
 //! message lists field, offset, expected and actual bytes to help review).
 
 use flexdyn_proto::{
-    command_flags, decode, decode_header, effector_kind, encode, saturation_flags,
-    star_tracker_flags, wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus,
-    Conserved, EffectorInput, EffectorState, FrameTiming, Header, ImuMsg, Mode, RejectCounters,
-    RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, WireMessage,
-    COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN,
+    command_flags, decode, decode_header, effector_kind, encode, magnetorquer_flags,
+    saturation_flags, star_tracker_flags, thruster_flags, wheel_flags, AppliedWrench, CommandKind,
+    CommandMsg, CommandStatus, Conserved, EffectorInput, EffectorState, FrameTiming, Header,
+    ImuMsg, Mode, RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg,
+    WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN,
     EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, IMU_LEN, STAR_TRACKER_LEN, STATE_FIXED_LEN,
     STATUS_LEN,
 };
@@ -908,6 +908,12 @@ fn flag_bits() {
     assert_eq!(wheel_flags::SPEED_LIMITED, 0b10);
     assert_eq!(effector_kind::PANEL_PAIR, 1);
     assert_eq!(effector_kind::REACTION_WHEEL, 2);
+    assert_eq!(effector_kind::MAGNETORQUER, 3);
+    assert_eq!(effector_kind::THRUSTER, 4);
+    assert_eq!(magnetorquer_flags::SATURATED, 0b001);
+    assert_eq!(thruster_flags::FIRING, 0b001);
+    assert_eq!(thruster_flags::BELOW_MIN_ON_TIME, 0b010);
+    assert_eq!(thruster_flags::COMMAND_CLIPPED, 0b100);
 }
 
 /// The golden vectors exported for the C and Python codecs (`proto/golden/*.bin`, listed in

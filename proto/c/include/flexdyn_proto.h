@@ -85,6 +85,8 @@
 /* Effector kinds (EffectorState.kind). */
 #define FD_EFFECTOR_PANEL_PAIR 1u
 #define FD_EFFECTOR_REACTION_WHEEL 2u
+#define FD_EFFECTOR_MAGNETORQUER 3u
+#define FD_EFFECTOR_THRUSTER 4u
 
 /* StateMsg.command_flags */
 #define FD_COMMAND_FLAG_STALE 0x01u
@@ -101,6 +103,12 @@
 /* EffectorState.flags of a reaction wheel */
 #define FD_WHEEL_TORQUE_LIMITED 0x1u
 #define FD_WHEEL_SPEED_LIMITED 0x2u
+/* EffectorState.flags of a magnetorquer */
+#define FD_MAGNETORQUER_SATURATED 0x1u
+/* EffectorState.flags of a thruster */
+#define FD_THRUSTER_FIRING 0x1u
+#define FD_THRUSTER_BELOW_MIN_ON_TIME 0x2u
+#define FD_THRUSTER_COMMAND_CLIPPED 0x4u
 
 /* StatusMsg enums */
 #define FD_MODE_REAL_TIME 0u

@@ -1,0 +1,115 @@
+//! The kind tags and flag bits are written three times: in `flexdyn_proto` (Rust), in the C
+//! header's `#define`s and in the Python package's constants. This reads the other two as text
+//! and checks every mirrored constant against the Rust one, so a new kind or flag cannot reach
+//! one codec and miss another.
+
+use std::collections::HashMap;
+
+use flexdyn_proto::{
+    command_flags, effector_kind, magnetorquer_flags, saturation_flags, star_tracker_flags,
+    thruster_flags, wheel_flags,
+};
+
+/// An integer literal as both files write it: decimal or `0x…`, with an optional `u` suffix.
+fn parse_int(s: &str) -> Option<u64> {
+    let s = s.trim().trim_end_matches('u');
+    match s.strip_prefix("0x") {
+        Some(hex) => u64::from_str_radix(hex, 16).ok(),
+        None => s.parse().ok(),
+    }
+}
+
+/// `#define FD_NAME value` lines of the C header.
+fn c_defines() -> HashMap<String, u64> {
+    let text = include_str!("../c/include/flexdyn_proto.h");
+    text.lines()
+        .filter_map(|l| {
+            let mut it = l.strip_prefix("#define ")?.split_whitespace();
+            let name = it.next()?;
+            let value = parse_int(it.next()?)?;
+            Some((name.to_string(), value))
+        })
+        .collect()
+}
+
+/// `A, B = 1, 2` and `A = 1` lines of the Python package's codec.
+fn python_constants() -> HashMap<String, u64> {
+    let text = include_str!("../../clients/python/src/flexdyn/proto.py");
+    let mut out = HashMap::new();
+    for l in text.lines() {
+        let Some((names, values)) = l.split_once(" = ") else {
+            continue;
+        };
+        let names: Vec<&str> = names.split(", ").collect();
+        let values: Vec<Option<u64>> = values.split(", ").map(parse_int).collect();
+        if names.len() == values.len() && values.iter().all(Option::is_some) {
+            for (n, v) in names.iter().zip(values) {
+                out.insert(n.trim().to_string(), v.unwrap());
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn c_and_python_mirror_every_kind_and_flag() {
+    let mirrored: [(&str, u64); 22] = [
+        ("EFFECTOR_PANEL_PAIR", effector_kind::PANEL_PAIR.into()),
+        (
+            "EFFECTOR_REACTION_WHEEL",
+            effector_kind::REACTION_WHEEL.into(),
+        ),
+        ("EFFECTOR_MAGNETORQUER", effector_kind::MAGNETORQUER.into()),
+        ("EFFECTOR_THRUSTER", effector_kind::THRUSTER.into()),
+        ("COMMAND_FLAG_STALE", command_flags::STALE.into()),
+        (
+            "COMMAND_FLAG_ZEROED_BY_POLICY",
+            command_flags::ZEROED_BY_POLICY.into(),
+        ),
+        (
+            "COMMAND_FLAG_NO_COMMAND_YET",
+            command_flags::NO_COMMAND_YET.into(),
+        ),
+        ("SATURATION_GYRO_RATE", saturation_flags::GYRO_RATE.into()),
+        ("SATURATION_ACCEL", saturation_flags::ACCEL.into()),
+        ("SATURATION_DTHETA", saturation_flags::DTHETA.into()),
+        ("SATURATION_DV", saturation_flags::DV.into()),
+        (
+            "STAR_TRACKER_SUN_EXCLUSION",
+            star_tracker_flags::SUN_EXCLUSION.into(),
+        ),
+        (
+            "STAR_TRACKER_RATE_LIMIT",
+            star_tracker_flags::RATE_LIMIT.into(),
+        ),
+        ("WHEEL_TORQUE_LIMITED", wheel_flags::TORQUE_LIMITED.into()),
+        ("WHEEL_SPEED_LIMITED", wheel_flags::SPEED_LIMITED.into()),
+        (
+            "MAGNETORQUER_SATURATED",
+            magnetorquer_flags::SATURATED.into(),
+        ),
+        ("THRUSTER_FIRING", thruster_flags::FIRING.into()),
+        (
+            "THRUSTER_BELOW_MIN_ON_TIME",
+            thruster_flags::BELOW_MIN_ON_TIME.into(),
+        ),
+        (
+            "THRUSTER_COMMAND_CLIPPED",
+            thruster_flags::COMMAND_CLIPPED.into(),
+        ),
+        ("PROTOCOL_VERSION", flexdyn_proto::PROTOCOL_VERSION.into()),
+        ("MAX_EFFECTORS", flexdyn_proto::MAX_EFFECTORS as u64),
+        (
+            "MAX_EFFECTOR_VALUES",
+            flexdyn_proto::MAX_EFFECTOR_VALUES as u64,
+        ),
+    ];
+    let c = c_defines();
+    let py = python_constants();
+    for (name, rust) in mirrored {
+        // The Python package drops the `EFFECTOR_` of the kind tags.
+        let py_name = name.strip_prefix("EFFECTOR_").unwrap_or(name);
+        assert_eq!(c.get(&format!("FD_{name}")), Some(&rust), "C FD_{name}");
+        assert_eq!(py.get(py_name), Some(&rust), "Python {py_name}");
+    }
+}
