@@ -10,6 +10,10 @@
 //! the same spacecraft without it and beside the cost of one added panel pair, measured in the
 //! same run. The target: a full environment costs less than one panel pair per step.
 //!
+//! Issue 20 (actuators): the LEO scenario with all its environment on, plus 3 magnetorquer rods
+//! (commanded) or 4 thrusters (firing every frame), printed per device beside the same
+//! simulation without them and beside one panel pair.
+//!
 //! Peers in the same run: with `FLEXDYN_PEERS_PYTHON` pointing at a Python that has
 //! `mujoco==4.0.0` and `bsk==2.12.1` (see `tools/peers/README.md`), the bench then runs
 //! `tools/peers/{mujoco,basilisk}_step.py` one after the other — the same spacecraft, RK4 at 1 ms —
@@ -338,6 +342,48 @@ fn world_summary(pair_ns: f64) {
     print_added_cost("environment", base, &measured, pair_ns);
 }
 
+/// The cost per step of each actuator kind, per device, in `scenarios/leo_environment.toml`
+/// with everything on at 10 Hz: 3 rods at a commanded dipole, 4 thrusters firing 5 ms of every
+/// 10 ms frame (so the lag's closed forms run in both valve states); against the same simulation
+/// without them and against one panel pair (`pair_ns`).
+fn actuator_summary(pair_ns: f64) {
+    let leo = include_str!("../scenarios/leo_environment.toml");
+    let rod = |i: usize| {
+        let mut axis = [0.0; 3];
+        axis[i] = 1.0;
+        format!(
+            "\n[[magnetorquers]]\nname = \"mtq{i}\"\naxis_b = {axis:?}\nr_mb_b_m = [0.5, 0.0, 0.5]\n\
+             max_dipole_am2 = 400.0\n"
+        )
+    };
+    let thruster = |i: usize| {
+        let sign = if i.is_multiple_of(2) { 1.0 } else { -1.0 };
+        format!(
+            "\n[[thrusters]]\nname = \"thr{i}\"\nr_tb_b_m = [{sign:?}, 0.0, 1.0]\n\
+             force_axis_b = [0.0, {sign:?}, 0.0]\nmax_thrust_newton = 1.0\nisp_s = 220.0\n\
+             min_on_time_s = 0.002\nrise_time_constant_s = 0.015\ntail_off_time_constant_s = 0.025\n"
+        )
+    };
+    let with = |extra: String, inputs: &[f64]| {
+        let cfg = flexdyn::config::SimConfig::from_toml_str(&format!("{leo}{extra}")).unwrap();
+        let mut sim = flexdyn::sim::Simulation::new(&cfg).unwrap();
+        sim.set_effector_inputs(inputs).unwrap();
+        sim
+    };
+    let base = median_ns_per_sim_step(with(String::new(), &[]));
+    let rods = median_ns_per_sim_step(with((0..3).map(rod).collect(), &[100.0, -50.0, 20.0]));
+    let thrusters = median_ns_per_sim_step(with((0..4).map(thruster).collect(), &[0.005; 4]));
+    let per_device = [
+        ("magnetorquer", base + (rods - base) / 3.0),
+        ("thruster", base + (thrusters - base) / 4.0),
+    ];
+    println!(
+        "\nSimulation::step in scenarios/leo_environment.toml (all on @ 10 Hz), per actuator \
+         (3 rods: {rods:.1} ns/step, 4 thrusters firing: {thrusters:.1} ns/step; median of 15 x 5000 steps):"
+    );
+    print_added_cost("one device", base, &per_device, pair_ns);
+}
+
 fn main() {
     let mut c = Criterion::default().configure_from_args();
     bench_step(&mut c);
@@ -346,5 +392,6 @@ fn main() {
     wheel_summary();
     environment_summary(fit(&rows).1);
     world_summary(fit(&rows).1);
+    actuator_summary(fit(&rows).1);
     peers(&rows);
 }
