@@ -601,3 +601,47 @@ fn a_relative_elements_file_is_found_and_inlined_into_each_run() {
     assert_eq!(cfg.initial.translation, direct.initial.translation);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The actuators' parameters disperse like any other key and are read back from the built
+/// magnetorquers and thrusters (`scenarios/acs_full.toml`).
+#[test]
+fn actuator_parameters_are_dispersed_and_read_back_from_the_model() {
+    let base = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/acs_full.toml");
+    let plan = campaign(&format!(
+        "base = {:?}\nruns = 300\nseed = 5\nduration_s = 1.0\n
+        [[dispersions]]
+        key = \"thrusters[*].max_thrust_newton\"
+        distribution = \"normal\"
+        sigma = 0.05
+        [[dispersions]]
+        key = \"thrusters[1].isp_s\"
+        distribution = \"uniform\"
+        low = 200.0
+        high = 230.0
+        [[dispersions]]
+        key = \"magnetorquers[2].max_dipole_am2\"
+        distribution = \"normal\"
+        sigma = 20.0
+        ",
+        base.display().to_string()
+    ))
+    .unwrap();
+    let (mut thrust0, mut isp1, mut dipole2) = (vec![], vec![], vec![]);
+    for r in 0..300 {
+        let rp = plan.run(r);
+        assert!(rp.valid, "run {r}: {:?}", rp.redraw_reasons);
+        let model = readback(&SimConfig::from_toml_str(&rp.config_toml).unwrap()).unwrap();
+        for (key, written) in &rp.dispersed {
+            assert_eq!(model[key], *written, "run {r}: {key}");
+        }
+        thrust0.push(model["thrusters[0].max_thrust_newton"]);
+        isp1.push(model["thrusters[1].isp_s"]);
+        dipole2.push(model["magnetorquers[2].max_dipole_am2"]);
+        // Untouched.
+        assert_eq!(model["thrusters[0].isp_s"], 220.0);
+        assert_eq!(model["magnetorquers[0].max_dipole_am2"], 400.0);
+    }
+    check_normal("thruster 0 thrust ~ N(1, 0.05)", &thrust0, 1.0, 0.05);
+    check_uniform("thruster 1 Isp ~ U(200, 230)", &isp1, 200.0, 230.0);
+    check_normal("rod 2 max dipole ~ N(400, 20)", &dipole2, 400.0, 20.0);
+}
