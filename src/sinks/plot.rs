@@ -12,6 +12,8 @@
 //!   log axis, with the intervals where an external wrench acts shaded (the invariants are
 //!   constant only without external wrench, damping or motor torques);
 //! - `wheels.png`: each reaction wheel's speed, applied motor torque and limit flags;
+//! - `actuators.png`: each magnetorquer's applied dipole, and each thruster's thrust (its
+//!   firings), pulse count and propellant used;
 //! - `star_tracker.png`: each star tracker's measured q_CN and its valid / status flags;
 //! - `imu.png`: each IMU's measured rate and specific force, one column per IMU;
 //! - `timing.png`: frame lateness p50/p99/max from StatusMsg and the overrun count (real time
@@ -371,6 +373,11 @@ impl Panel {
             let (lo, hi) = ys
                 .filter(|y| *y > 0.0)
                 .fold((f64::INFINITY, 0.0_f64), |(a, b), y| (a.min(y), b.max(y)));
+            if !lo.is_finite() {
+                // Nothing positive to draw (every invariant exactly constant, or zero
+                // throughout): a fixed decade range, never an infinite one.
+                return (1e-18, 1.0);
+            }
             let lo = lo.max(1e-18);
             let hi = hi.max(lo * 10.0);
             return (lo * 0.5, hi * 2.0);
@@ -867,6 +874,29 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
             wheels,
         );
     }
+    let actuators: Vec<Panel> = [
+        ("mtq", "_dipole_am2", "m mtq", "rod dipole applied (A·m²)"),
+        ("thr", "_thrust_newton", "F thr", "thrust (N)"),
+        ("thr", "_pulse_count", "pulses thr", "pulse count"),
+        (
+            "thr",
+            "_propellant_used_kg",
+            "used thr",
+            "propellant used (kg)",
+        ),
+    ]
+    .iter()
+    .filter_map(|(prefix, suffix, label, y)| numbered_panel(s, prefix, suffix, label, y))
+    .collect();
+    if actuators.is_empty() {
+        skip("actuators.png", "no mtq<k>_* or thr<k>_* columns");
+    } else {
+        fig(
+            "actuators.png",
+            "Actuators: magnetorquer dipoles; thruster firings, pulses, propellant".into(),
+            actuators,
+        );
+    }
     // One figure per sensor kind, its panels side by side per sensor (`SensorKind::plot`).
     for (i, kind) in KINDS.iter().enumerate() {
         let (file, title, specs) = kind.plot;
@@ -995,4 +1025,28 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
         report.written.push(path);
     }
     Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A log panel with nothing positive (a vehicle at rest: every invariant zero or exactly
+    /// constant) gets finite bounds; it used to get (∞, ∞), and plotters then ran out of memory.
+    #[test]
+    fn a_log_panel_with_nothing_positive_has_finite_bounds() {
+        let panel = Panel {
+            log_y: true,
+            lines: vec![Line {
+                label: "H".into(),
+                points: vec![(0.0, 0.0), (1.0, 0.0)],
+            }],
+            ..Panel::default()
+        };
+        let (lo, hi) = panel.y_range();
+        assert!(
+            lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi,
+            "{lo} {hi}"
+        );
+    }
 }
