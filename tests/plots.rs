@@ -113,7 +113,12 @@ fn a_recording_gives_every_figure() {
         err.contains("skipped timing.png: a batch run is not paced by the wall clock"),
         "{err}"
     );
-    assert_eq!(err.matches("skipped").count(), 1, "{err}");
+    // No magnetorquers or thrusters in that scenario.
+    assert!(
+        err.contains("skipped actuators.png: no mtq<k>_* or thr<k>_* columns"),
+        "{err}"
+    );
+    assert_eq!(err.matches("skipped").count(), 2, "{err}");
     assert!(!out.join("timing.png").exists());
 
     let (figs, _) = figures(&args(&rec)).unwrap();
@@ -354,7 +359,13 @@ fn a_simulate_csv_gives_the_state_figures_and_names_the_rest() {
             "conservation.png",
         ],
     );
-    for skipped in ["wheels.png", "star_tracker.png", "imu.png", "timing.png"] {
+    for skipped in [
+        "wheels.png",
+        "actuators.png",
+        "star_tracker.png",
+        "imu.png",
+        "timing.png",
+    ] {
         assert!(err.contains(&format!("skipped {skipped}")), "{err}");
         assert!(!dir.join(skipped).exists());
     }
@@ -366,4 +377,87 @@ fn a_simulate_csv_gives_the_state_figures_and_names_the_rest() {
     let err = String::from_utf8_lossy(&r.stderr);
     assert_eq!(r.status.code(), Some(2), "{err}");
     assert!(err.contains("bad.csv") && err.contains("t_s"), "{err}");
+}
+
+/// A rod and a thruster driven by the input schedule: `actuators.png` shows the rod's dipole,
+/// the thruster's firings (1 N while the valve is open, 0.03 s of each 0.1 s frame, no lag), its
+/// pulse count (one per frame) and the propellant.
+#[test]
+fn the_actuator_figure_shows_dipoles_and_firings() {
+    let dir = tmp("actuators");
+    std::fs::create_dir_all(&dir).unwrap();
+    let config = dir.join("actuators.toml");
+    std::fs::write(
+        &config,
+        r#"panel_pairs = []
+[simulation]
+step_s = 0.001
+frame_hz = 10.0
+[gravity]
+model = "none"
+[hub]
+mass_kg = 500.0
+inertia_bc_b_kg_m2 = [[600.0, 0.0, 0.0], [0.0, 500.0, 0.0], [0.0, 0.0, 400.0]]
+r_bcb_b_m = [0.0, 0.0, 0.0]
+[initial]
+r_bn_n_m = [0.0, 0.0, 0.0]
+v_bn_n_m_s = [0.0, 0.0, 0.0]
+sigma_bn = [0.0, 0.0, 0.0]
+omega_bn_b_rad_s = [0.0, 0.0, 0.0]
+[[magnetorquers]]
+name = "mtq_x"
+axis_b = [1.0, 0.0, 0.0]
+r_mb_b_m = [0.5, 0.0, 0.0]
+max_dipole_am2 = 100.0
+[[thrusters]]
+name = "thr1"
+r_tb_b_m = [0.0, 0.0, 0.0]
+force_axis_b = [1.0, 0.0, 0.0]
+max_thrust_newton = 1.0
+isp_s = 220.0
+[[effector_input_schedule]]
+t_s = 0.0
+effector = "thr1"
+inputs = [0.03]
+[[effector_input_schedule]]
+t_s = 1.0
+effector = "mtq_x"
+inputs = [60.0]
+"#,
+    )
+    .unwrap();
+    let csv = dir.join("actuators.csv");
+    let r = flexdyn(&[
+        "simulate",
+        "--config",
+        config.to_str().unwrap(),
+        "--duration-s",
+        "2",
+        "--log-every-s",
+        "0.01",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let r = flexdyn(&["plot", csv.to_str().unwrap(), "-o", dir.to_str().unwrap()]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    check_figures(&dir, &["actuators.png"]);
+    let (figs, _) = figures(&args(&csv)).unwrap();
+    let a = find(&figs, "actuators.png");
+    let labels: Vec<&str> = a.panels.iter().map(|p| p.lines[0].label.as_str()).collect();
+    assert_eq!(labels, ["m mtq1", "F thr1", "pulses thr1", "used thr1"]);
+    let dipole = &a.panels[0].lines[0].points;
+    assert!(dipole
+        .iter()
+        .all(|&(t, m)| m == if t < 1.0 { 0.0 } else { 60.0 }));
+    // Rows every 0.01 s: the valve is open in the first 3 of each frame's 10 rows.
+    let thrust = &a.panels[1].lines[0].points;
+    let on = thrust.iter().filter(|(_, f)| *f == 1.0).count();
+    let off = thrust.iter().filter(|(_, f)| *f == 0.0).count();
+    assert_eq!((on, off, thrust.len()), (60, 141, 201), "{thrust:?}");
+    let pulses = &a.panels[2].lines[0].points;
+    assert_eq!(pulses.last().unwrap().1, 20.0);
+    let used = a.panels[3].lines[0].points.last().unwrap().1;
+    let expected = 20.0 * 0.03 / (220.0 * 9.80665);
+    assert!((used - expected).abs() < 1e-15, "{used} vs {expected}");
 }
