@@ -128,6 +128,12 @@ pub struct VehicleConfig {
     /// `[[reaction_wheels]]`, in file order (effector indices after the panel pairs).
     #[serde(default)]
     pub reaction_wheels: Vec<ReactionWheel>,
+    /// `[[magnetorquers]]`, in file order (effector indices after the wheels).
+    #[serde(default)]
+    pub magnetorquers: Vec<Magnetorquer>,
+    /// `[[thrusters]]`, in file order (effector indices after the magnetorquers).
+    #[serde(default)]
+    pub thrusters: Vec<Thruster>,
     /// `[[imus]]`, in file order.
     #[serde(default)]
     pub imus: Vec<Imu>,
@@ -153,6 +159,16 @@ impl VehicleConfig {
     /// `Actuators` commands (after every panel pair).
     pub fn first_wheel_index(&self) -> u32 {
         self.panel_pairs.len() as u32
+    }
+
+    /// The effector index of the first magnetorquer (after every wheel).
+    pub fn first_magnetorquer_index(&self) -> u32 {
+        self.first_wheel_index() + self.reaction_wheels.len() as u32
+    }
+
+    /// The effector index of the first thruster (after every magnetorquer).
+    pub fn first_thruster_index(&self) -> u32 {
+        self.first_magnetorquer_index() + self.magnetorquers.len() as u32
     }
 
     /// The IMU `name`.
@@ -254,6 +270,38 @@ pub struct ReactionWheel {
     pub j_t_kg_m2: f64,
     /// \[N·m\] motor torque limit.
     pub max_torque_nm: f64,
+}
+
+/// One `[[magnetorquers]]` entry.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct Magnetorquer {
+    /// Its name.
+    pub name: String,
+    /// The rod's axis â in B (a unit vector).
+    pub axis_b: [f64; 3],
+    /// \[m\] the rod's centre relative to B, B components.
+    pub r_mb_b_m: [f64; 3],
+    /// \[A·m²\] the largest dipole magnitude.
+    pub max_dipole_am2: f64,
+}
+
+/// One `[[thrusters]]` entry.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct Thruster {
+    /// Its name.
+    pub name: String,
+    /// \[m\] the nozzle point relative to B, B components.
+    pub r_tb_b_m: [f64; 3],
+    /// The direction the thrust pushes the vehicle, B components (a unit vector).
+    pub force_axis_b: [f64; 3],
+    /// \[N\] steady-state thrust.
+    pub max_thrust_newton: f64,
+    /// \[s\] the shortest on-time the valve executes (0 when absent).
+    #[serde(default)]
+    pub min_on_time_s: f64,
+    /// `"on_time_s"` (absent) or `"duty_cycle"`: what its one input means.
+    #[serde(default)]
+    pub command: Option<String>,
 }
 
 /// One `[[imus]]` entry.
