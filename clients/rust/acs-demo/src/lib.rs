@@ -1,8 +1,12 @@
 //! The control laws of `flexdyn-acs-demo` (the binary in `src/main.rs`), the template for Rust
-//! flight code: [`acs`], the reaction-wheel MRP law and the star-tracker attitude estimate.
+//! flight code: [`acs`], the reaction-wheel MRP law and the star-tracker attitude estimate;
+//! [`magnetic`], B-dot detumbling and magnetic momentum unloading with the rods; [`sun`], sun
+//! acquisition from coarse sun sensors.
 //! The binary's module docs say how it talks to the server and what to keep when you copy it.
 
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
 pub mod acs;
+pub mod magnetic;
+pub mod sun;
