@@ -18,6 +18,9 @@
 //! - `flags`: `S` stale command, `Z` zeroed by policy, `N` no command yet;
 //! - `wheels`: with reaction wheels, each wheel's speed [rad/s] in effector order, marked `T`
 //!   when its motor torque is being clipped and `S` when it is held at its speed limit;
+//! - `rods`: with magnetorquers, each rod's applied dipole [A·m²], marked `S` when saturated;
+//! - `thrusters`: with thrusters, how many fire now, their pulses and propellant used so far,
+//!   and `!min` when a command is below a thruster's minimum on-time;
 //! - `rejected`: the server's rejected commands by reason (`stale_tick:2,unknown_sender:1`), and
 //!   `dropped` the valid commands it dropped for a full queue.
 
@@ -28,8 +31,8 @@ use std::time::{Duration, Instant};
 use clap::Parser;
 use flexdyn_proto::client::transport::{frame_stamp_ns, mode_name, unix_now_ns};
 use flexdyn_proto::{
-    command_flags, decode_state, decode_status, effector_kind, wheel_flags, RunState, StatusMsg,
-    NO_COMMAND,
+    command_flags, decode_state, decode_status, effector_kind, magnetorquer_flags, thruster_flags,
+    wheel_flags, EffectorState, RunState, StatusMsg, NO_COMMAND,
 };
 use flexdyn_tools::{percentile, CommonArgs};
 use zenoh::Wait;
@@ -65,6 +68,8 @@ struct Window {
     flags: u8,
     /// Reaction wheels of the latest state: (speed rad/s, flags).
     wheels: Vec<(f64, u32)>,
+    /// The actuators of the latest state, as summarised for the line (empty without them).
+    actuators: String,
     /// Panel pairs of the latest state: (θ1, θ2) rad.
     thetas: Vec<(f64, f64)>,
     latencies_ns: Vec<u64>,
@@ -139,6 +144,52 @@ fn wheels_str(wheels: &[(f64, u32)]) -> String {
     format!("[{}]rad/s", parts.join(","))
 }
 
+/// ` rods=[100.0,-400.0S]Am2 thrusters=firing:2/4,pulses=84,propellant_kg=0.0123`: the rods'
+/// applied dipoles (`S` saturated) and the thrusters' state, each part only when the vehicle
+/// has that kind (empty without actuators).
+fn actuators_str(effectors: &[EffectorState]) -> String {
+    let out = |e: &EffectorState, i: usize| e.outputs.get(i).copied().unwrap_or(f64::NAN);
+    let mut s = String::new();
+    let rods: Vec<String> = effectors
+        .iter()
+        .filter(|e| e.kind == effector_kind::MAGNETORQUER)
+        .map(|e| {
+            let mark = if e.flags & magnetorquer_flags::SATURATED != 0 {
+                "S"
+            } else {
+                ""
+            };
+            format!("{:.1}{mark}", out(e, 0))
+        })
+        .collect();
+    if !rods.is_empty() {
+        s.push_str(&format!(" rods=[{}]Am2", rods.join(",")));
+    }
+    let thrusters: Vec<&EffectorState> = effectors
+        .iter()
+        .filter(|e| e.kind == effector_kind::THRUSTER)
+        .collect();
+    if !thrusters.is_empty() {
+        let firing = thrusters
+            .iter()
+            .filter(|e| e.flags & thruster_flags::FIRING != 0)
+            .count();
+        let pulses: f64 = thrusters.iter().map(|e| out(e, 1)).sum();
+        let propellant: f64 = thrusters.iter().map(|e| out(e, 2)).sum();
+        s.push_str(&format!(
+            " thrusters=firing:{firing}/{},pulses={pulses:.0},propellant_kg={propellant:.4}",
+            thrusters.len()
+        ));
+        if thrusters
+            .iter()
+            .any(|e| e.flags & thruster_flags::BELOW_MIN_ON_TIME != 0)
+        {
+            s.push_str(",!min");
+        }
+    }
+    s
+}
+
 fn run_state_name(s: RunState) -> &'static str {
     match s {
         RunState::Starting => "starting",
@@ -181,6 +232,7 @@ fn line(w: &mut Window, interval: Duration, state_topic: &str) -> String {
             if !w.wheels.is_empty() {
                 o.push_str(&format!(" wheels={}", wheels_str(&w.wheels)));
             }
+            o.push_str(&w.actuators);
             o
         }
     };
@@ -272,6 +324,7 @@ fn run(args: Args) -> anyhow::Result<()> {
                             .filter(|e| e.kind == effector_kind::REACTION_WHEEL)
                             .map(|e| (e.states.first().copied().unwrap_or(f64::NAN), e.flags)),
                     );
+                    w.actuators = actuators_str(&s.effectors);
                     w.thetas.clear();
                     w.thetas.extend(
                         s.effectors
@@ -497,5 +550,39 @@ mod tests {
             ),
         ];
         assert_eq!(wheels_str(&w), "[100.0,-52.3T,600.0TS]rad/s");
+    }
+
+    #[test]
+    fn actuator_summary_counts_firings_and_marks_saturation() {
+        let e = |kind, flags, outputs: &[f64]| EffectorState {
+            kind,
+            flags,
+            states: vec![],
+            outputs: outputs.to_vec(),
+        };
+        let effectors = [
+            e(effector_kind::REACTION_WHEEL, 0, &[0.0, 0.0]),
+            e(effector_kind::MAGNETORQUER, 0, &[100.0]),
+            e(
+                effector_kind::MAGNETORQUER,
+                magnetorquer_flags::SATURATED,
+                &[-400.0],
+            ),
+            e(
+                effector_kind::THRUSTER,
+                thruster_flags::FIRING,
+                &[1.0, 40.0, 0.01, 2.0],
+            ),
+            e(
+                effector_kind::THRUSTER,
+                thruster_flags::BELOW_MIN_ON_TIME,
+                &[0.0, 44.0, 0.0023, 1.0],
+            ),
+        ];
+        assert_eq!(
+            actuators_str(&effectors),
+            " rods=[100.0,-400.0S]Am2 thrusters=firing:1/2,pulses=84,propellant_kg=0.0123,!min"
+        );
+        assert_eq!(actuators_str(&effectors[..1]), "");
     }
 }
