@@ -261,6 +261,8 @@ fn random_panel(rng: &mut Rng, size_m: f64, ranges: Ranges) -> PanelParams {
         } else {
             rng.log_range(0.01, 100.0)
         },
+        width_m: None,
+        thickness_m: None,
     }
 }
 
@@ -1263,6 +1265,8 @@ fn trajectory_case(gravity: bool) -> (Config, Sample) {
         d_m: 1.0,
         k_nm_rad: k,
         c_nm_s_rad: c,
+        width_m: None,
+        thickness_m: None,
     };
     let pair = PanelPairParams {
         name: "wing".into(),

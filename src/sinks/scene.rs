@@ -107,7 +107,8 @@ impl Geometry {
     /// The geometry of `cfg`: the hub box from its mass and inertia about its centre of mass
     /// (along the inertia's principal axes, centred on B_c), each panel's box from its mass and
     /// principal inertia, with the panel's long edge 2·d from its hinge along −ŝ1 (so the box
-    /// centre is the panel's centre of mass, Eqs. 6–7).
+    /// centre is the panel's centre of mass, Eqs. 6–7), and its `width_m` (along ŝ2) and
+    /// `thickness_m` (along ŝ3) where the configuration gives them.
     pub fn from_config(cfg: &SimConfig) -> Self {
         let hub = &cfg.hub;
         let eig = SymmetricEigen::new(hub.inertia_bc_b_kg_m2);
@@ -125,6 +126,9 @@ impl Geometry {
         let panel_box = |p: &crate::dynamics::PanelParams| {
             let mut size = equivalent_box_m(p.mass_kg, &p.inertia_s_kg_m2);
             size.x = 2.0 * p.d_m;
+            // Real dimensions, where the configuration gives them.
+            size.y = p.width_m.unwrap_or(size.y);
+            size.z = p.thickness_m.unwrap_or(size.z);
             Cuboid {
                 center_m: Vector3::new(-p.d_m, 0.0, 0.0),
                 q_frame_box: Vector4::new(1.0, 0.0, 0.0, 0.0),
@@ -511,6 +515,32 @@ mod tests {
             let p = &cube["pose"]["position"];
             assert_eq!(Vector3::new(at(p, "x"), at(p, "y"), at(p, "z")), f.r_cp_b_m);
         }
+    }
+
+    #[test]
+    fn panels_with_real_dimensions_draw_as_plates_of_those_dimensions() {
+        let text = crate::config::DEFAULT_CONFIG_TOML.replacen(
+            "panel1 = { mass_kg = 50.0,",
+            "panel1 = { width_m = 1.5, thickness_m = 0.03, mass_kg = 50.0,",
+            1,
+        );
+        assert_ne!(text, crate::config::DEFAULT_CONFIG_TOML);
+        let g = Geometry::from_config(&SimConfig::from_toml_str(&text).unwrap());
+        let p = &g.pairs[0];
+        // Length 2 d = 1.5 m along ŝ1, then the configured width and thickness.
+        assert_eq!(p.panel1.size_m, Vector3::new(1.5, 1.5, 0.03));
+        // Panel 2 has none: the box of its inertia (the reference's 2.45 m edges, 6(25+25−50)/50
+        // floored at 2 % of the largest edge for the thickness).
+        let edge = (6.0_f64 * 50.0 / 50.0).sqrt();
+        assert!(
+            (p.panel2.size_m.y - edge).abs() < 1e-12,
+            "{:?}",
+            p.panel2.size_m
+        );
+        // A bad value names the field.
+        let bad = text.replacen("width_m = 1.5", "width_m = -1.0", 1);
+        let e = SimConfig::from_toml_str(&bad).unwrap_err().to_string();
+        assert!(e.contains("panel_pairs[0].panel1.width_m"), "{e}");
     }
 
     #[test]

@@ -26,6 +26,8 @@ pub fn reference_panel(c_nm_s_rad: f64) -> PanelParams {
         d_m: 0.75,
         k_nm_rad: 100.0,
         c_nm_s_rad,
+        width_m: None,
+        thickness_m: None,
     }
 }
 

@@ -21,6 +21,11 @@ pub struct PanelParams {
     pub k_nm_rad: f64,
     /// [N·m·s/rad] torsional damping of the panel's hinge.
     pub c_nm_s_rad: f64,
+    /// [m] the panel's width along its hinge axis ŝ2, if given: drawn (`flexdyn view`) instead
+    /// of the width of the box with the panel's inertia. Not used by the dynamics.
+    pub width_m: Option<f64>,
+    /// [m] the panel's thickness along ŝ3, if given; drawn like `width_m`.
+    pub thickness_m: Option<f64>,
 }
 
 /// A pair of dual-linked hinged panels: panel 1 hinged to the hub at H1, panel 2 hinged to the tip
@@ -76,7 +81,13 @@ impl PanelParams {
         )?;
         check_positive(path, "d_m", self.d_m)?;
         check_non_negative(path, "k_nm_rad", self.k_nm_rad)?;
-        check_non_negative(path, "c_nm_s_rad", self.c_nm_s_rad)
+        check_non_negative(path, "c_nm_s_rad", self.c_nm_s_rad)?;
+        for (field, v) in [("width_m", self.width_m), ("thickness_m", self.thickness_m)] {
+            if let Some(v) = v {
+                check_positive(path, field, v)?;
+            }
+        }
+        Ok(())
     }
 }
 

@@ -37,11 +37,13 @@ pub(crate) struct RawPanel {
     c_nm_s_rad: f64,
     theta_rad: f64,
     theta_dot_rad_s: f64,
+    width_m: Option<f64>,
+    thickness_m: Option<f64>,
 }
 
 impl RawPanelPair {
     pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<Self, SchemaError> {
-        const PANEL2: [&str; 7] = [
+        const PANEL2: [&str; 9] = [
             "mass_kg",
             "inertia_s_kg_m2",
             "d_m",
@@ -49,6 +51,8 @@ impl RawPanelPair {
             "c_nm_s_rad",
             "theta_rad",
             "theta_dot_rad_s",
+            "width_m",
+            "thickness_m",
         ];
         let panel1_keys: Vec<&str> = PANEL2.iter().copied().chain(["l_m"]).collect();
         let read_panel =
@@ -66,6 +70,8 @@ impl RawPanelPair {
                     c_nm_s_rad: p.f64("c_nm_s_rad")?,
                     theta_rad: p.f64("theta_rad")?,
                     theta_dot_rad_s: p.f64("theta_dot_rad_s")?,
+                    width_m: p.opt_f64("width_m")?,
+                    thickness_m: p.opt_f64("thickness_m")?,
                 })
             };
         Ok(RawPanelPair {
@@ -96,6 +102,8 @@ impl RawPanelPair {
                 d_m: p1.d_m,
                 k_nm_rad: p1.k_nm_rad,
                 c_nm_s_rad: p1.c_nm_s_rad,
+                width_m: p1.width_m,
+                thickness_m: p1.thickness_m,
             },
             panel2: PanelParams {
                 mass_kg: p2.mass_kg,
@@ -103,6 +111,8 @@ impl RawPanelPair {
                 d_m: p2.d_m,
                 k_nm_rad: p2.k_nm_rad,
                 c_nm_s_rad: p2.c_nm_s_rad,
+                width_m: p2.width_m,
+                thickness_m: p2.thickness_m,
             },
             motor_torque_nm: self.motor_torque_nm.unwrap_or([0.0, 0.0]),
         };
