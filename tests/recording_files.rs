@@ -45,6 +45,11 @@ fn check_with_python(file: &Path, extra: &[&str]) -> String {
 
 /// A finished batch run of the wheel scenario recorded by the server itself.
 fn batch_recording(name: &str) -> PathBuf {
+    batch_recording_of(name, "wheels_star_tracker.toml")
+}
+
+/// 5 s of `scenarios/<scenario>` in batch mode, recorded to `name`.
+fn batch_recording_of(name: &str, scenario: &str) -> PathBuf {
     let file = tmp(name);
     let _ = std::fs::remove_file(&file);
     py_support::run(
@@ -52,7 +57,7 @@ fn batch_recording(name: &str) -> PathBuf {
             .args(["run", "--mode", "batch", "--duration-s", "5"])
             .args(["--listen", ports::ANY_PORT])
             .arg("--config")
-            .arg(root().join("scenarios/wheels_star_tracker.toml"))
+            .arg(root().join("scenarios").join(scenario))
             .arg("--record")
             .arg(&file),
         "flexdyn run --mode batch --record",
@@ -259,7 +264,8 @@ fn resolve<'a>(msg: &'a serde_json::Value, fields: &str) -> Option<&'a serde_jso
 
 #[test]
 fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
-    let file = batch_recording("layout.mcap");
+    // The ACS scenario: wheels, sensors and the actuators' arrows are all recorded.
+    let file = batch_recording_of("layout.mcap", "acs_full.toml");
     let bytes = std::fs::read(&file).unwrap();
     let mut first: BTreeMap<String, serde_json::Value> = BTreeMap::new();
     for m in mcap::MessageStream::new(&bytes).unwrap() {

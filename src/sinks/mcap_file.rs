@@ -27,7 +27,9 @@ use serde::{Deserialize, Serialize};
 
 use super::gaps::SeqGaps;
 use super::scene::Geometry;
-use super::scene::{frame_transforms, frame_transforms_schema, scene_update, scene_update_schema};
+use super::scene::{
+    actuator_scene, frame_transforms, frame_transforms_schema, scene_update, scene_update_schema,
+};
 use super::topics::{classify, json_schema, wire_layout_text, Decoded, TopicKind};
 use crate::config::SimConfig;
 
@@ -50,6 +52,12 @@ pub fn tf_topic(sc_id: &str) -> String {
 /// The topic of a vehicle's `foxglove.SceneUpdate`.
 pub fn scene_topic(sc_id: &str) -> String {
     format!("/flexdyn/{sc_id}/scene")
+}
+
+/// The topic of a vehicle's actuator arrows (thruster firings, rod dipoles), a
+/// `foxglove.SceneUpdate` per state ([`super::scene::actuator_scene`]).
+pub fn actuator_topic(sc_id: &str) -> String {
+    format!("/flexdyn/{sc_id}/actuators")
 }
 /// Uncompressed bytes per chunk (Foxglove's own default is of this order).
 pub const CHUNK_SIZE_BYTES: u64 = 1 << 20;
@@ -207,6 +215,8 @@ struct Vehicle {
     described: bool,
     geometry: Option<Geometry>,
     tf: Option<u16>,
+    /// The actuator-arrow channel, once opened (vehicles with thrusters or rods).
+    actuators: Option<u16>,
     /// (log time, publish time, state) of states recorded before the description.
     pending: Vec<(u64, u64, flexdyn_proto::StateMsg)>,
     pending_overflow: bool,
@@ -322,9 +332,33 @@ impl McapSink {
             return Ok(());
         };
         let geometry = self.vehicles.get(sc_id).and_then(|v| v.geometry.as_ref());
-        if let Some(g) = geometry {
-            let json = frame_transforms(state, g, &format!("{sc_id}/")).to_string();
-            self.put(tf, log_time, publish_time, json.as_bytes())?;
+        let Some(g) = geometry else {
+            return Ok(());
+        };
+        let prefix = format!("{sc_id}/");
+        let json = frame_transforms(state, g, &prefix).to_string();
+        let arrows = actuator_scene(g, state, &prefix, state.header.sim_time_ns);
+        self.put(tf, log_time, publish_time, json.as_bytes())?;
+        if let Some(arrows) = arrows {
+            let channel = match self.vehicles.get(sc_id).and_then(|v| v.actuators) {
+                Some(c) => c,
+                None => {
+                    let schema = self.schema("foxglove.SceneUpdate", "jsonschema", &|| {
+                        scene_update_schema().to_string().into_bytes()
+                    })?;
+                    let c = self.channel(schema, &actuator_topic(sc_id), "json")?;
+                    if let Some(v) = self.vehicles.get_mut(sc_id) {
+                        v.actuators = Some(c);
+                    }
+                    c
+                }
+            };
+            self.put(
+                channel,
+                log_time,
+                publish_time,
+                arrows.to_string().as_bytes(),
+            )?;
         }
         Ok(())
     }

@@ -68,7 +68,28 @@ pub struct Geometry {
     /// The `[[environment.facets]]` plates in B (drag and solar pressure act on them): a square
     /// of the facet's area centred on its centre of pressure, normal along its box z axis.
     pub facets: Vec<Cuboid>,
+    /// The thrusters (`[[thrusters]]`), in effector order: nozzle point, the direction the
+    /// vehicle is pushed, and the full thrust \[N\].
+    pub thrusters: Vec<ArrowMount>,
+    /// The magnetorquer rods (`[[magnetorquers]]`), in effector order: centre, axis, and the
+    /// largest dipole \[A·m²\].
+    pub rods: Vec<ArrowMount>,
 }
+
+/// Where an actuator's arrow is drawn from, along which body axis, and the value of a full-length
+/// arrow.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ArrowMount {
+    /// \[m\] the arrow's origin relative to B, B components.
+    pub r_b_m: Vector3<f64>,
+    /// The axis, B components (unit).
+    pub axis_b: Vector3<f64>,
+    /// The value drawn at [`ARROW_FULL_M`].
+    pub full_scale: f64,
+}
+
+/// \[m\] length of an actuator arrow at full thrust or full dipole.
+pub const ARROW_FULL_M: f64 = 0.8;
 
 /// The plate drawn for a facet of area `area_m2` at `r_cp_b_m` with outward unit normal
 /// `normal_b`: a √A × √A square, 2 % of its side thick, whose box z axis is the normal.
@@ -154,10 +175,31 @@ impl Geometry {
             .flat_map(|env| &env.facets)
             .map(|f| facet_plate(f.area_m2, &f.normal_b, &f.r_cp_b_m))
             .collect();
+        let a = &cfg.actuators;
+        let thrusters = a
+            .thrusters
+            .iter()
+            .map(|t| ArrowMount {
+                r_b_m: t.r_tb_b_m,
+                axis_b: t.force_axis_b.normalize(),
+                full_scale: t.max_thrust_newton,
+            })
+            .collect();
+        let rods = a
+            .magnetorquers
+            .iter()
+            .map(|m| ArrowMount {
+                r_b_m: m.r_mb_b_m,
+                axis_b: m.axis_b.normalize(),
+                full_scale: m.max_dipole_am2,
+            })
+            .collect();
         Self {
             hub: hub_box,
             pairs,
             facets,
+            thrusters,
+            rods,
         }
     }
 }
@@ -248,6 +290,122 @@ fn cube_entity(t_ns: u64, frame: &str, id: &str, c: &Cuboid, rgba: [f64; 4]) -> 
         "texts": [],
         "models": [],
     })
+}
+
+/// The rotation (w, x, y, z) that turns x̂ onto the unit vector `d` (a Foxglove arrow points
+/// along its pose's +x): about x̂ × d by the angle between them, q = (1 + x̂·d, x̂ × d)
+/// normalised; about ẑ by π when d = −x̂.
+fn quat_x_to(d: &Vector3<f64>) -> Vector4<f64> {
+    let x = Vector3::x();
+    let w = 1.0 + x.dot(d);
+    if w < 1e-12 {
+        return Vector4::new(0.0, 0.0, 0.0, 1.0);
+    }
+    let v = x.cross(d);
+    Vector4::new(w, v.x, v.y, v.z).normalize()
+}
+
+/// An arrow entity in B from `from_b_m` along `dir_b` (unit) of `length_m` (no arrow when the
+/// length is 0: the entity then clears the last one).
+fn arrow_entity(
+    t_ns: u64,
+    frame: &str,
+    id: &str,
+    from_b_m: &Vector3<f64>,
+    dir_b: &Vector3<f64>,
+    length_m: f64,
+    rgba: [f64; 4],
+) -> Value {
+    let arrows = if length_m > 0.0 {
+        let head = 0.25 * length_m.max(0.2);
+        json!([{
+            "pose": {"position": vec3(from_b_m), "orientation": quat(&quat_x_to(dir_b))},
+            "shaft_length": (length_m - head).max(0.0),
+            "shaft_diameter": 0.04,
+            "head_length": head,
+            "head_diameter": 0.1,
+            "color": {"r": rgba[0], "g": rgba[1], "b": rgba[2], "a": rgba[3]},
+        }])
+    } else {
+        json!([])
+    };
+    json!({
+        "timestamp": stamp(t_ns),
+        "frame_id": frame,
+        "id": id,
+        "lifetime": {"sec": 0, "nsec": 0},
+        "frame_locked": true,
+        "metadata": [],
+        "arrows": arrows,
+        "cubes": [],
+        "spheres": [],
+        "cylinders": [],
+        "lines": [],
+        "triangles": [],
+        "texts": [],
+        "models": [],
+    })
+}
+
+/// The actuators at one state, as a `foxglove.SceneUpdate` of arrows in B, or `None` for a
+/// vehicle without them: each firing thruster's plume (from the nozzle, against the force,
+/// [`ARROW_FULL_M`] long at full thrust, orange) and each rod's dipole (from its centre along
+/// ±its axis, full length at its largest dipole, purple). A thruster that is not firing, or a
+/// rod at zero, has an empty entity, which clears its arrow. Entities follow the thrusters and
+/// rods of `state` in effector order.
+pub fn actuator_scene(
+    geometry: &Geometry,
+    state: &StateMsg,
+    prefix: &str,
+    t_ns: u64,
+) -> Option<Value> {
+    if geometry.thrusters.is_empty() && geometry.rods.is_empty() {
+        return None;
+    }
+    let frame = format!("{prefix}{FRAME_B}");
+    let of_kind = |kind: u16| {
+        state
+            .effectors
+            .iter()
+            .filter(move |e| e.kind == kind)
+            .map(|e| e.outputs.first().copied().unwrap_or(0.0))
+    };
+    let mut entities = Vec::new();
+    for (k, (mount, thrust)) in geometry
+        .thrusters
+        .iter()
+        .zip(of_kind(flexdyn_proto::effector_kind::THRUSTER))
+        .enumerate()
+    {
+        let length = ARROW_FULL_M * (thrust / mount.full_scale).clamp(0.0, 1.0);
+        entities.push(arrow_entity(
+            t_ns,
+            &frame,
+            &format!("{prefix}thruster{k}"),
+            &mount.r_b_m,
+            &-mount.axis_b,
+            length,
+            [1.0, 0.45, 0.0, 0.9],
+        ));
+    }
+    for (k, (mount, dipole)) in geometry
+        .rods
+        .iter()
+        .zip(of_kind(flexdyn_proto::effector_kind::MAGNETORQUER))
+        .enumerate()
+    {
+        let length = ARROW_FULL_M * (dipole.abs() / mount.full_scale).clamp(0.0, 1.0);
+        entities.push(arrow_entity(
+            t_ns,
+            &frame,
+            &format!("{prefix}rod{k}"),
+            &mount.r_b_m,
+            &(mount.axis_b * dipole.signum()),
+            length,
+            [0.55, 0.2, 0.75, 0.9],
+        ));
+    }
+    Some(json!({ "deletions": [], "entities": entities }))
 }
 
 /// The `foxglove.SceneUpdate` that draws the spacecraft: a grey hub box in B, a blue box per
@@ -349,7 +507,8 @@ pub fn frame_transforms_schema() -> Value {
     s
 }
 
-/// JSON Schema of `foxglove.SceneUpdate` (cube entities; the other primitive arrays are empty).
+/// JSON Schema of `foxglove.SceneUpdate` (cube and arrow entities; the other primitive arrays are
+/// empty).
 pub fn scene_update_schema() -> Value {
     let color = obj(
         &["r", "g", "b", "a"],
@@ -360,6 +519,24 @@ pub fn scene_update_schema() -> Value {
         json!({
             "pose": obj(&["position", "orientation"], json!({"position": vector3_schema(), "orientation": quaternion_schema()})),
             "size": vector3_schema(),
+            "color": color.clone(),
+        }),
+    );
+    let arrow = obj(
+        &[
+            "pose",
+            "shaft_length",
+            "shaft_diameter",
+            "head_length",
+            "head_diameter",
+            "color",
+        ],
+        json!({
+            "pose": obj(&["position", "orientation"], json!({"position": vector3_schema(), "orientation": quaternion_schema()})),
+            "shaft_length": num(),
+            "shaft_diameter": num(),
+            "head_length": num(),
+            "head_diameter": num(),
             "color": color,
         }),
     );
@@ -380,7 +557,7 @@ pub fn scene_update_schema() -> Value {
             "lifetime": time_schema(),
             "frame_locked": {"type": "boolean"},
             "metadata": empty_array,
-            "arrows": empty_array,
+            "arrows": {"type": "array", "items": arrow},
             "cubes": {"type": "array", "items": cube},
             "spheres": empty_array,
             "cylinders": empty_array,
@@ -541,6 +718,84 @@ mod tests {
         let bad = text.replacen("width_m = 1.5", "width_m = -1.0", 1);
         let e = SimConfig::from_toml_str(&bad).unwrap_err().to_string();
         assert!(e.contains("panel_pairs[0].panel1.width_m"), "{e}");
+    }
+
+    /// Thruster plumes and rod dipoles as arrows: from the nozzle against the force, from the
+    /// rod along ±its axis, scaled to the full value, cleared at zero; every key the schema
+    /// requires of an entity and an arrow is there.
+    #[test]
+    fn actuator_arrows_show_firings_and_dipoles() {
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/acs_full.toml"
+        ))
+        .unwrap();
+        let cfg = SimConfig::from_toml_str(&text).unwrap();
+        let g = Geometry::from_config(&cfg);
+        assert_eq!((g.thrusters.len(), g.rods.len()), (4, 3));
+        let mut sim = crate::sim::Simulation::new(&cfg).unwrap();
+        let mut state = sim.state_msg();
+        // thr_pz1 at half thrust; mtq_y at −200 of 400 A·m²; everything else off.
+        let kind = |k| state.effectors.iter().position(|e| e.kind == k).unwrap();
+        let (t0, r0) = (
+            kind(flexdyn_proto::effector_kind::THRUSTER),
+            kind(flexdyn_proto::effector_kind::MAGNETORQUER),
+        );
+        state.effectors[t0].outputs[0] = 0.5;
+        state.effectors[r0 + 1].outputs[0] = -200.0;
+        let scene = actuator_scene(&g, &state, "sc1/", 7).unwrap();
+        let entities = scene["entities"].as_array().unwrap();
+        assert_eq!(entities.len(), 7);
+        let arrow_of = |id: &str| {
+            let e = entities.iter().find(|e| e["id"] == id).unwrap();
+            assert_eq!(e["frame_id"], "sc1/B");
+            e["arrows"].as_array().unwrap().clone()
+        };
+        let direction = |a: &Value| {
+            let q = &a["pose"]["orientation"];
+            let q = Vector4::new(
+                q["w"].as_f64().unwrap(),
+                q["x"].as_f64().unwrap(),
+                q["y"].as_f64().unwrap(),
+                q["z"].as_f64().unwrap(),
+            );
+            active(&q) * Vector3::x()
+        };
+        let length =
+            |a: &Value| a["shaft_length"].as_f64().unwrap() + a["head_length"].as_f64().unwrap();
+        let plume = arrow_of("sc1/thruster0");
+        assert_eq!(plume.len(), 1);
+        // thr_pz1 pushes +y from (1, 0, 1): the plume points −y from there, 0.4 m long.
+        assert!((direction(&plume[0]) - Vector3::new(0.0, -1.0, 0.0)).norm() < 1e-12);
+        assert_eq!(plume[0]["pose"]["position"]["x"], 1.0);
+        assert!((length(&plume[0]) - 0.5 * ARROW_FULL_M).abs() < 1e-12);
+        assert!(arrow_of("sc1/thruster1").is_empty(), "not firing: cleared");
+        let rod = arrow_of("sc1/rod1");
+        // mtq_y (axis +y) at −200 A·m²: along −y, half length.
+        assert!((direction(&rod[0]) - Vector3::new(0.0, -1.0, 0.0)).norm() < 1e-12);
+        assert!((length(&rod[0]) - 0.5 * ARROW_FULL_M).abs() < 1e-12);
+        assert!(arrow_of("sc1/rod0").is_empty());
+        // The schema's required keys are all there.
+        let schema = scene_update_schema();
+        let entity = &schema["properties"]["entities"]["items"];
+        let arrow = &entity["properties"]["arrows"]["items"];
+        for (e, a) in entities.iter().zip(std::iter::repeat(&plume[0])) {
+            for k in entity["required"].as_array().unwrap() {
+                assert!(e.get(k.as_str().unwrap()).is_some(), "entity lacks {k}");
+            }
+            for k in arrow["required"].as_array().unwrap() {
+                assert!(a.get(k.as_str().unwrap()).is_some(), "arrow lacks {k}");
+            }
+        }
+        // A vehicle without actuators has no actuator scene; every direction maps.
+        let plain = Geometry::from_config(&SimConfig::reference());
+        assert!(actuator_scene(&plain, &state, "sc1/", 0).is_none());
+        for d in [Vector3::x(), -Vector3::x(), Vector3::new(0.0, 0.6, -0.8)] {
+            assert!(
+                (active(&quat_x_to(&d)) * Vector3::x() - d).norm() < 1e-12,
+                "{d:?}"
+            );
+        }
     }
 
     #[test]

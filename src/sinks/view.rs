@@ -27,10 +27,11 @@ use foxglove::{Context, PartialMetadata, RawChannel, Schema, WebSocketServer};
 use zenoh::sample::SampleKind;
 
 use super::error::SinkError;
-use super::mcap_file::{decoded_topic, scene_topic, tf_topic, VehicleInfo};
+use super::mcap_file::{actuator_topic, decoded_topic, scene_topic, tf_topic, VehicleInfo};
 use super::reader::{read_recording, RawSample};
 use super::scene::{
-    frame_transforms, frame_transforms_schema, scene_update, scene_update_schema, Geometry,
+    actuator_scene, frame_transforms, frame_transforms_schema, scene_update, scene_update_schema,
+    Geometry,
 };
 use super::topics::{classify, json_schema, Decoded};
 use crate::transport::{zenoh_config, Role, ZenohArgs};
@@ -189,10 +190,25 @@ impl Translator {
         }
         if let Decoded::State(state) = &decoded {
             self.latest_time_ns = self.latest_time_ns.max(t);
-            let tf = self
-                .geometry
-                .get(&sc_id)
-                .map(|g| frame_transforms(state, g, &format!("{sc_id}/")).to_string());
+            let prefix = format!("{sc_id}/");
+            let (tf, arrows) = match self.geometry.get(&sc_id) {
+                Some(g) => (
+                    Some(frame_transforms(state, g, &prefix).to_string()),
+                    actuator_scene(g, state, &prefix, t).map(|v| v.to_string()),
+                ),
+                None => (None, None),
+            };
+            if let Some(json) = arrows {
+                if let Some(c) = self.channel(&actuator_topic(&sc_id), || {
+                    Schema::new(
+                        "foxglove.SceneUpdate",
+                        "jsonschema",
+                        scene_update_schema().to_string().into_bytes(),
+                    )
+                }) {
+                    c.log_with_meta(json.as_bytes(), PartialMetadata { log_time: Some(t) });
+                }
+            }
             if let Some(json) = tf {
                 if let Some(c) = self.channel(&tf_topic(&sc_id), || {
                     Schema::new(
