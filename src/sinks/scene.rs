@@ -269,7 +269,8 @@ pub fn frame_transforms(state: &StateMsg, geometry: &Geometry, prefix: &str) -> 
     json!({ "transforms": transforms })
 }
 
-fn cube_entity(t_ns: u64, frame: &str, id: &str, c: &Cuboid, rgba: [f64; 4]) -> Value {
+/// A frame-locked, never-expiring entity (lifetime 0) of `arrows` and `cubes` in `frame`.
+fn entity(t_ns: u64, frame: &str, id: &str, arrows: Value, cubes: Value) -> Value {
     json!({
         "timestamp": stamp(t_ns),
         "frame_id": frame,
@@ -277,12 +278,8 @@ fn cube_entity(t_ns: u64, frame: &str, id: &str, c: &Cuboid, rgba: [f64; 4]) -> 
         "lifetime": {"sec": 0, "nsec": 0},
         "frame_locked": true,
         "metadata": [],
-        "arrows": [],
-        "cubes": [{
-            "pose": {"position": vec3(&c.center_m), "orientation": quat(&c.q_frame_box)},
-            "size": vec3(&c.size_m),
-            "color": {"r": rgba[0], "g": rgba[1], "b": rgba[2], "a": rgba[3]},
-        }],
+        "arrows": arrows,
+        "cubes": cubes,
         "spheres": [],
         "cylinders": [],
         "lines": [],
@@ -290,6 +287,19 @@ fn cube_entity(t_ns: u64, frame: &str, id: &str, c: &Cuboid, rgba: [f64; 4]) -> 
         "texts": [],
         "models": [],
     })
+}
+
+fn color(rgba: [f64; 4]) -> Value {
+    json!({"r": rgba[0], "g": rgba[1], "b": rgba[2], "a": rgba[3]})
+}
+
+fn cube_entity(t_ns: u64, frame: &str, id: &str, c: &Cuboid, rgba: [f64; 4]) -> Value {
+    let cubes = json!([{
+        "pose": {"position": vec3(&c.center_m), "orientation": quat(&c.q_frame_box)},
+        "size": vec3(&c.size_m),
+        "color": color(rgba),
+    }]);
+    entity(t_ns, frame, id, json!([]), cubes)
 }
 
 /// The rotation (w, x, y, z) that turns x̂ onto the unit vector `d` (a Foxglove arrow points
@@ -324,27 +334,12 @@ fn arrow_entity(
             "shaft_diameter": 0.04,
             "head_length": head,
             "head_diameter": 0.1,
-            "color": {"r": rgba[0], "g": rgba[1], "b": rgba[2], "a": rgba[3]},
+            "color": color(rgba),
         }])
     } else {
         json!([])
     };
-    json!({
-        "timestamp": stamp(t_ns),
-        "frame_id": frame,
-        "id": id,
-        "lifetime": {"sec": 0, "nsec": 0},
-        "frame_locked": true,
-        "metadata": [],
-        "arrows": arrows,
-        "cubes": [],
-        "spheres": [],
-        "cylinders": [],
-        "lines": [],
-        "triangles": [],
-        "texts": [],
-        "models": [],
-    })
+    entity(t_ns, frame, id, arrows, json!([]))
 }
 
 /// The actuators at one state, as a `foxglove.SceneUpdate` of arrows in B, or `None` for a
