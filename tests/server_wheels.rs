@@ -1,7 +1,7 @@
 //! Reaction-wheel commands and star-tracker telemetry through the server, in lockstep: an
 //! `Actuators` command answers the tick and drives the wheels; every malformed effector input
 //! is rejected, counted under its reason, and does not answer the tick; the star tracker
-//! publishes on its own topic at its own rate.
+//! publishes on its own topic at its own rate. Magnetorquers and thrusters follow the same rules.
 
 mod server_support;
 
@@ -149,4 +149,108 @@ fn actuators_drive_the_wheels_and_bad_inputs_are_counted() {
     assert!(st
         .iter()
         .all(|m| m.valid && m.header.seq == m.header.tick / 10));
+}
+
+/// Magnetorquers and thrusters take `Actuators` inputs at their indices after the wheels
+/// (`scenarios/acs_full.toml`: rods 6–8, thrusters 9–12), their telemetry follows, and their bad
+/// inputs are rejected and counted like a wheel's.
+#[test]
+fn actuators_drive_rods_and_thrusters_and_bad_inputs_are_counted() {
+    let topics = Topics::new("sc1").unwrap();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/acs_full.toml");
+    let server = ServerHandle::start(
+        ServerSettings {
+            mode: Mode::Lockstep,
+            participants: vec![1],
+            participant_timeout: Duration::from_secs(20),
+            duration_ns: Some(2_000_000_000),
+            status_hz: 50.0,
+            ..ServerSettings::default()
+        },
+        SimConfig::from_file(&path).unwrap(),
+    );
+    let port = server.port;
+    let obs = Observer::start(port, &topics);
+    let session = connecting_session(port);
+    let publisher = session.declare_publisher(topics.cmd(1)).wait().unwrap();
+    let states = session
+        .declare_subscriber(topics.state().to_owned())
+        .wait()
+        .unwrap();
+    let _token = session
+        .liveliness()
+        .declare_token(topics.participant(1))
+        .wait()
+        .unwrap();
+    // Rods at 100, −500 (saturates at 400) and 0 A·m²; thr_pz1 and thr_pz2 fire 0.05 s of every
+    // 0.1 s frame (a +z couple), the others stay shut.
+    let good = vec![
+        input(6, &[100.0]),
+        input(7, &[-500.0]),
+        input(8, &[0.0]),
+        input(9, &[0.05]),
+        input(10, &[0.05]),
+        input(11, &[0.0]),
+        input(12, &[0.0]),
+    ];
+    while let Ok(Some(sample)) = states.recv_timeout(WAIT) {
+        let s = decode_state(&sample.payload().to_bytes()).unwrap();
+        let h = Header::new(1, s.header.tick, s.header.sim_time_ns, s.header.tick);
+        let put = |c: &CommandMsg| publisher.put(encode(c)).wait().unwrap();
+        let actuators =
+            |inputs: Vec<EffectorInput>| CommandMsg::actuators(h, 1, [0.0; 3], [0.0; 3], inputs);
+        if s.header.tick == 3 {
+            put(&actuators(vec![input(9, &[0.05, 0.05])])); // a thruster takes one value
+            put(&actuators(vec![input(13, &[0.05])])); // no effector 13
+            put(&actuators(vec![input(6, &[f64::INFINITY])])); // non-finite
+            std::thread::sleep(Duration::from_millis(200));
+        }
+        put(&actuators(good.clone()));
+        if s.header.tick == 20 {
+            break;
+        }
+    }
+    let report = server.join(WAIT).expect("the run");
+    assert_eq!(report.last_tick, 20);
+    let want = RejectCounters {
+        bad_effector_input: 2,
+        non_finite: 1,
+        ..RejectCounters::default()
+    };
+    assert_eq!(report.rejected, want);
+    let seen = obs.seen.lock().unwrap();
+    let last = &seen
+        .states
+        .iter()
+        .find(|(s, _)| s.header.tick == 20)
+        .unwrap()
+        .0;
+    let e = &last.effectors;
+    assert_eq!(e.len(), 13);
+    assert_eq!(
+        (e[6].kind, e[6].outputs[0], e[6].flags),
+        (effector_kind::MAGNETORQUER, 100.0, 0)
+    );
+    assert_eq!(
+        (e[7].outputs[0], e[7].flags),
+        (-400.0, flexdyn_proto::magnetorquer_flags::SATURATED)
+    );
+    // Each answer to ticks 0..=19 fires in the frame that follows it: 20 pulses by tick 20.
+    for (k, pulses) in [(9, 20.0), (10, 20.0), (11, 0.0), (12, 0.0)] {
+        assert_eq!(e[k].kind, effector_kind::THRUSTER);
+        assert_eq!(e[k].outputs[1], pulses, "thruster {k}");
+    }
+    // The +z couple turned the hub about z.
+    let w0 = seen
+        .states
+        .iter()
+        .find(|(s, _)| s.header.tick == 0)
+        .unwrap()
+        .0
+        .omega_bn_b_rad_s[2];
+    assert!(
+        last.omega_bn_b_rad_s[2] > w0,
+        "{} vs {w0}",
+        last.omega_bn_b_rad_s[2]
+    );
 }
