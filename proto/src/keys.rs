@@ -13,6 +13,8 @@ pub const STATE_SUFFIX: &str = "tlm/state";
 pub const IMU_PREFIX: &str = "tlm/imu";
 /// Prefix of the star-tracker topics; the tracker name follows after a `/`.
 pub const STAR_TRACKER_PREFIX: &str = "tlm/st";
+/// Prefix of the magnetometer topics; the magnetometer name follows after a `/`.
+pub const MAGNETOMETER_PREFIX: &str = "tlm/mag";
 /// Prefix of the command topics; the sender's decimal `sender_id` follows after a `/`
 /// (`flexdyn/<sc>/cmd/<sender_id>`, every [`crate::CommandKind`]). One key per sender, so a
 /// Zenoh access-control list can reserve each participant's key for its authenticated subject.
@@ -94,6 +96,19 @@ pub fn star_tracker_key(sc: &str, name: &str) -> Result<String, KeyError> {
 pub fn star_tracker_wildcard_key(sc: &str) -> Result<String, KeyError> {
     validate_sc_id(sc)?;
     Ok(format!("{KEY_ROOT}/{sc}/{STAR_TRACKER_PREFIX}/*"))
+}
+
+/// Check a sensor name (the last chunk of a sensor key).
+pub fn validate_sensor_name(name: &str) -> Result<(), KeyError> {
+    validate("sensor name", name)
+}
+
+/// `flexdyn/<sc>/<prefix>/<name>`: the key of sensor `name` of a kind whose topics start with
+/// `prefix` (e.g. [`MAGNETOMETER_PREFIX`]).
+pub fn sensor_key(sc: &str, prefix: &str, name: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    validate_sensor_name(name)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{prefix}/{name}"))
 }
 
 /// `flexdyn/<sc>/cmd/<sender_id>`: where participant `sender_id` publishes its commands.
@@ -217,6 +232,11 @@ impl Topics {
     /// `flexdyn/<sc>/tlm/st/<name>`
     pub fn star_tracker(&self, name: &str) -> Result<String, KeyError> {
         star_tracker_key(&self.sc_id, name)
+    }
+
+    /// `flexdyn/<sc>/<prefix>/<name>` (see [`sensor_key`]).
+    pub fn sensor(&self, prefix: &str, name: &str) -> Result<String, KeyError> {
+        sensor_key(&self.sc_id, prefix, name)
     }
 
     /// `flexdyn/<sc>/config` (the server's configuration queryable).

@@ -5,7 +5,8 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use crate::{
-    CommandKind, CommandMsg, DecodeError, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg,
+    CommandKind, CommandMsg, DecodeError, Header, ImuMsg, MagnetometerMsg, StarTrackerMsg,
+    StateMsg, StatusMsg,
 };
 
 /// Encoded [`Header`] size (bytes).
@@ -23,6 +24,8 @@ pub const EFFECTOR_INPUT_FIXED_LEN: usize = 12;
 pub const IMU_LEN: usize = 127;
 /// Encoded [`StarTrackerMsg`] size (bytes).
 pub const STAR_TRACKER_LEN: usize = 64;
+/// Encoded [`MagnetometerMsg`] size (bytes).
+pub const MAGNETOMETER_LEN: usize = 55;
 /// Offset of the u32 [`CommandKind`] tag in a [`CommandMsg`].
 pub const COMMAND_KIND_OFFSET: usize = 34;
 /// Encoded [`CommandMsg`] size with [`CommandKind::Wrench`] (bytes).
@@ -70,10 +73,12 @@ mod sealed {
     impl Sealed for super::CommandMsg {}
     impl Sealed for super::StatusMsg {}
     impl Sealed for super::StarTrackerMsg {}
+    impl Sealed for super::MagnetometerMsg {}
 }
 
 /// A top-level message that can go on the wire. Implemented (only) by
-/// [`StateMsg`], [`ImuMsg`], [`StarTrackerMsg`], [`CommandMsg`] and [`StatusMsg`].
+/// [`StateMsg`], [`ImuMsg`], [`StarTrackerMsg`], the other sensor messages
+/// ([`MagnetometerMsg`]), [`CommandMsg`] and [`StatusMsg`].
 pub trait WireMessage: Serialize + DeserializeOwned + sealed::Sealed {
     /// Type name used in error messages.
     const NAME: &'static str;
@@ -119,6 +124,17 @@ impl WireMessage for StarTrackerMsg {
         len: STAR_TRACKER_LEN,
     };
     const MIN_LEN: usize = STAR_TRACKER_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+impl WireMessage for MagnetometerMsg {
+    const NAME: &'static str = "MagnetometerMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed {
+        len: MAGNETOMETER_LEN,
+    };
+    const MIN_LEN: usize = MAGNETOMETER_LEN;
     fn header(&self) -> &Header {
         &self.header
     }

@@ -312,6 +312,30 @@ impl Default for StarTrackerMsg {
     }
 }
 
+/// Bits of [`MagnetometerMsg::saturation_flags`]: which axes hit the range limit.
+pub mod magnetometer_flags {
+    /// Bit 0: axis 1 of `b_s_t` was clipped to ± the range.
+    pub const AXIS_1: u8 = 1 << 0;
+    /// Bit 1: axis 2 was clipped.
+    pub const AXIS_2: u8 = 1 << 1;
+    /// Bit 2: axis 3 was clipped.
+    pub const AXIS_3: u8 = 1 << 2;
+    /// Bits 3..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 = !(AXIS_1 | AXIS_2 | AXIS_3);
+}
+
+/// A three-axis magnetometer sample, topic `flexdyn/<sc-id>/tlm/mag/<name>`. 55 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct MagnetometerMsg {
+    /// Common header; `tick` is the frame at whose end the sample was taken.
+    pub header: Header,
+    /// Measured magnetic field, the sensor's frame S components (T).
+    pub b_s_t: [f64; 3],
+    /// Saturated axes, see [`magnetometer_flags`].
+    pub saturation_flags: u8,
+}
+
 /// What a [`CommandMsg`] asks for. Wire: u32 LE variant index (0 = `Wrench`,
 /// 1 = `NoCommand`, 2 = `Actuators`), then the variant's fields.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

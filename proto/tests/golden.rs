@@ -21,13 +21,13 @@
 //! message lists field, offset, expected and actual bytes to help review).
 
 use flexdyn_proto::{
-    command_flags, decode, decode_header, effector_kind, encode, magnetorquer_flags,
-    saturation_flags, star_tracker_flags, thruster_flags, wheel_flags, AppliedWrench, CommandKind,
-    CommandMsg, CommandStatus, Conserved, EffectorInput, EffectorState, FrameTiming, Header,
-    ImuMsg, Mode, RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg,
-    WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN,
-    EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, IMU_LEN, STAR_TRACKER_LEN, STATE_FIXED_LEN,
-    STATUS_LEN,
+    command_flags, decode, decode_header, effector_kind, encode, magnetometer_flags,
+    magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags, wheel_flags,
+    AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, EffectorInput, EffectorState,
+    FrameTiming, Header, ImuMsg, MagnetometerMsg, Mode, RejectCounters, RunState, StalePolicy,
+    StarTrackerMsg, StateMsg, StatusMsg, WireMessage, COMMAND_ACTUATORS_FIXED_LEN,
+    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN,
+    IMU_LEN, MAGNETOMETER_LEN, STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN,
 };
 
 type Golden = &'static [(usize, &'static str, &'static str)];
@@ -99,7 +99,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0400", "u16 header.protocol_version = 4"),
+    (0, "0500", "u16 header.protocol_version = 5"),
     (
         2,
         "44332211",
@@ -359,7 +359,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0400", "u16 header.protocol_version = 4"),
+    (0, "0500", "u16 header.protocol_version = 5"),
     (
         2,
         "44332211",
@@ -435,7 +435,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0400", "u16 header.protocol_version = 4"),
+    (0, "0500", "u16 header.protocol_version = 5"),
     (
         2,
         "44332211",
@@ -482,7 +482,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0400", "u16 header.protocol_version = 4"),
+    (0, "0500", "u16 header.protocol_version = 5"),
     (
         2,
         "44332211",
@@ -551,8 +551,39 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
         "f64 kind.inputs[1].values[0] = -0.03125 (bits 0xBFA0000000000000)",
     ),
 ];
+const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0500", "u16 header.protocol_version = 5"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "0d00000000000000", "u64 header.tick = 13"),
+    (
+        14,
+        "80a4bf0700000000",
+        "u64 header.sim_time_ns = 130000000 (0x7BFA480)",
+    ),
+    (22, "0100000000000000", "u64 header.seq = 1"),
+    (
+        30,
+        "000000000000003f",
+        "f64 b_s_t[0] = 2^-15 = 3.0517578125e-5 (bits 0x3F00000000000000)",
+    ),
+    (
+        38,
+        "000000000000f0be",
+        "f64 b_s_t[1] = -2^-16 = -1.52587890625e-5 (bits 0xBEF0000000000000)",
+    ),
+    (
+        46,
+        "0000000000000080",
+        "f64 b_s_t[2] = -0.0 (bits 0x8000000000000000)",
+    ),
+    (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
+];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0400", "u16 header.protocol_version = 4"),
+    (0, "0500", "u16 header.protocol_version = 5"),
     (
         2,
         "44332211",
@@ -589,7 +620,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
     (63, "01", "u8 status_flags = 1 (SUN_EXCLUSION)"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0400", "u16 header.protocol_version = 4"),
+    (0, "0500", "u16 header.protocol_version = 5"),
     (
         2,
         "44332211",
@@ -606,7 +637,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0400", "u16 header.protocol_version = 4"),
+    (0, "0500", "u16 header.protocol_version = 5"),
     (
         2,
         "44332211",
@@ -800,6 +831,17 @@ fn star_tracker_golden() {
 }
 
 #[test]
+fn magnetometer_golden() {
+    let msg = MagnetometerMsg {
+        header: Header::new(SC, 13, 130_000_000, 1),
+        b_s_t: [0.000_030_517_578_125, -0.000_015_258_789_062_5, -0.0],
+        saturation_flags: magnetometer_flags::AXIS_1 | magnetometer_flags::AXIS_3,
+    };
+    check("MagnetometerMsg", MAGNETOMETER_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), MAGNETOMETER_LEN);
+}
+
+#[test]
 fn command_no_command_golden() {
     let msg = CommandMsg::no_command(Header::new(SC, 43, 430_000_000, 8), 5);
     assert_eq!(msg.kind, CommandKind::NoCommand);
@@ -904,6 +946,10 @@ fn flag_bits() {
     assert_eq!(star_tracker_flags::SUN_EXCLUSION, 0b01);
     assert_eq!(star_tracker_flags::RATE_LIMIT, 0b10);
     assert_eq!(star_tracker_flags::RESERVED_MASK, 0b1111_1100);
+    assert_eq!(magnetometer_flags::AXIS_1, 0b001);
+    assert_eq!(magnetometer_flags::AXIS_2, 0b010);
+    assert_eq!(magnetometer_flags::AXIS_3, 0b100);
+    assert_eq!(magnetometer_flags::RESERVED_MASK, 0b1111_1000);
     assert_eq!(wheel_flags::TORQUE_LIMITED, 0b01);
     assert_eq!(wheel_flags::SPEED_LIMITED, 0b10);
     assert_eq!(effector_kind::PANEL_PAIR, 1);
@@ -922,7 +968,7 @@ fn flag_bits() {
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 7] = [
+    let tables: [(&str, &str, Golden, &str); 8] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -950,6 +996,12 @@ fn exported_golden_files_match_the_tables() {
             "COMMAND_NO_COMMAND_GOLDEN",
         ),
         ("status", "StatusMsg", STATUS_GOLDEN, "STATUS_GOLDEN"),
+        (
+            "magnetometer",
+            "MagnetometerMsg",
+            MAGNETOMETER_GOLDEN,
+            "MAGNETOMETER_GOLDEN",
+        ),
     ];
     let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");
     let rows: Vec<Vec<&str>> = manifest

@@ -10,7 +10,7 @@ import subprocess
 
 from flexdyn import proto
 from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState, Header,
-                           ImuMsg, StarTrackerMsg, StateMsg, StatusMsg)
+                           ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg)
 
 N = 20_000
 
@@ -55,6 +55,10 @@ def star_tracker_line(m):
     return str(Line().h(m.header).f(m.q_cn).u(m.valid, m.status_flags))
 
 
+def magnetometer_line(m):
+    return str(Line().h(m.header).f(m.b_s_t).u(m.saturation_flags))
+
+
 def command_line(m):
     l = Line().h(m.header).u(m.sender_id, m.kind)
     if m.kind != proto.NO_COMMAND_KIND:
@@ -79,7 +83,8 @@ def status_line(m):
 
 DECODERS = [
     (StateMsg.decode, state_line), (ImuMsg.decode, imu_line),
-    (StarTrackerMsg.decode, star_tracker_line), (CommandMsg.decode, command_line),
+    (StarTrackerMsg.decode, star_tracker_line), (MagnetometerMsg.decode, magnetometer_line),
+    (CommandMsg.decode, command_line),
     (StatusMsg.decode, status_line), (Header.decode, lambda h: str(Line().h(h))),
 ]
 
@@ -118,7 +123,7 @@ def gen_buffer(r):
     def header():
         return Header(r.getrandbits(32), r.getrandbits(64), r.getrandbits(64), r.getrandbits(64))
 
-    k = r.randrange(5)
+    k = r.randrange(6)
     if k == 0:
         b = StateMsg(header(), v(3), v(4), v(3), v(3), v(3), v(3), v(3), f64(), f64(), v(3), v(3),
                      v(3), v(3), r.getrandbits(8),
@@ -128,13 +133,15 @@ def gen_buffer(r):
         b = ImuMsg(header(), v(3), v(3), v(3), v(3), r.getrandbits(8)).encode()
     elif k == 2:
         b = StarTrackerMsg(header(), v(4), r.random() < 0.5, r.getrandbits(8)).encode()
+    elif k == 5:
+        b = MagnetometerMsg(header(), v(3), r.getrandbits(8)).encode()
     elif k == 3:
         g = fin if r.randrange(4) else f64
         kind = r.randrange(3)
         b = CommandMsg(header(), r.getrandbits(32), kind, v(3, g), v(3, g),
                        [EffectorInput(r.getrandbits(32), list(v(r.randrange(9), g)))
                         for _ in range(r.randrange(5))] if kind == proto.ACTUATORS else []).encode()
-    else:
+    elif k == 4:
         b = StatusMsg(header(), r.randrange(3), r.randrange(6), *(r.getrandbits(64) for _ in range(7)),
                       r.random() < 0.5, r.randrange(2), *(r.getrandbits(64) for _ in range(9))).encode()
     b = bytearray(b)
@@ -165,16 +172,16 @@ def test_python_and_rust_decoders_agree_on_20000_buffers(verdicts_bin):
     stream = b"".join(struct.pack("<I", len(b)) + b for b in buffers)
     rust = subprocess.run([str(verdicts_bin)], input=stream, capture_output=True, check=True)
     rust_lines = rust.stdout.decode().splitlines()
-    assert len(rust_lines) == 6 * N
+    assert len(rust_lines) == 7 * N
     reasons = {}
-    names = ["state", "imu", "star_tracker", "command", "status", "header"]
+    names = ["state", "imu", "star_tracker", "magnetometer", "command", "status", "header"]
     for i, b in enumerate(buffers):
         for j, got in enumerate(python_lines(b)):
-            want = rust_lines[6 * i + j]
+            want = rust_lines[7 * i + j]
             assert got == want, f"buffer {i} ({len(b)} bytes), {names[j]}: Python {got!r} vs Rust {want!r}"
             key = want.split()[1] if want.startswith("E") else "accepted"
             reasons[key] = reasons.get(key, 0) + 1
-    print(f"{N} buffers x 6 decoders: {reasons}")
+    print(f"{N} buffers x 7 decoders: {reasons}")
     for k in ("accepted", "Length", "TrailingBytes", "TooLarge", "UnknownVersion", "NonFinite",
               "Malformed"):
         assert reasons.get(k, 0) > 0, k

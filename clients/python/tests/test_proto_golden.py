@@ -8,7 +8,7 @@ import pytest
 
 from flexdyn import proto
 from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState, Header,
-                           ImuMsg, StarTrackerMsg, StateMsg, StatusMsg)
+                           ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg)
 
 SC = 0x11223344
 
@@ -20,7 +20,7 @@ def bits(x):
 def test_manifest_lists_every_file(golden_dir):
     rows = [l.split("\t") for l in (golden_dir / "MANIFEST.tsv").read_text().splitlines()
             if l and not l.startswith("#")]
-    assert len(rows) == 7
+    assert len(rows) == 8
     for name, _message, length, _source in rows:
         assert (golden_dir / f"{name}.bin").stat().st_size == int(length)
 
@@ -63,6 +63,18 @@ def test_imu_and_star_tracker(golden_dir):
     assert e.value.reason == "Malformed"
 
 
+def test_magnetometer(golden_dir):
+    m = MagnetometerMsg(Header(SC, 13, 130_000_000, 1), (2.0**-15, -(2.0**-16), -0.0),
+                        proto.MAGNETOMETER_AXIS_1 | proto.MAGNETOMETER_AXIS_3)
+    golden = (golden_dir / "magnetometer.bin").read_bytes()
+    assert m.encode() == golden
+    back = MagnetometerMsg.decode(golden)
+    assert back == m and bits(back.b_s_t) == bits(m.b_s_t)  # -0.0 keeps its sign
+    with pytest.raises(DecodeError) as e:
+        MagnetometerMsg.decode(golden[:-1])
+    assert e.value.reason == "Length"
+
+
 def test_commands(golden_dir):
     w = CommandMsg(Header(SC, 42, 420_000_000, 7), 0xDEADBEEF, proto.WRENCH,
                    (0.0625, -0.125, 0.25), (-1.0, 0.0, 0.5))
@@ -94,6 +106,7 @@ def test_versions_and_keys():
         Header.decode(b"\x02\x00" + bytes(40))
     assert (e.value.reason, e.value.info["found"]) == ("UnknownVersion", 2)
     assert proto.star_tracker_key("sc1", "st1") == "flexdyn/sc1/tlm/st/st1"
+    assert proto.magnetometer_key("sc1", "mag1") == "flexdyn/sc1/tlm/mag/mag1"
     assert proto.participant_key("sc-1", 7) == "flexdyn/sc-1/participant/7"
     assert proto.command_key("sc-1", 7) == "flexdyn/sc-1/cmd/7"
     assert proto.command_key("sc1", 4294967295) == "flexdyn/sc1/cmd/4294967295"

@@ -1,5 +1,5 @@
 /*
- * flexdyn_proto.h - the flexdyn wire protocol (version 4) for C99 and C++ flight code.
+ * flexdyn_proto.h - the flexdyn wire protocol (version 5) for C99 and C++ flight code.
  *
  * Header-only: include it and call fd_decode_* / fd_encode_*. No allocation, no I/O, no
  * global state. Bytes are assembled one by one (little-endian on the wire), never cast to a
@@ -60,7 +60,7 @@
 /* ------------------------------------------------------------------------------------------ */
 /* Constants (proto/README.md).                                                                */
 
-#define FD_PROTOCOL_VERSION 4u
+#define FD_PROTOCOL_VERSION 5u
 #define FD_HEADER_LEN 30u
 #define FD_STATE_FIXED_LEN 327u
 #define FD_STATE_EFFECTOR_COUNT_OFFSET 319u
@@ -68,6 +68,7 @@
 #define FD_EFFECTOR_INPUT_FIXED_LEN 12u
 #define FD_IMU_LEN 127u
 #define FD_STAR_TRACKER_LEN 64u
+#define FD_MAGNETOMETER_LEN 55u
 #define FD_COMMAND_KIND_OFFSET 34u
 #define FD_COMMAND_WRENCH_LEN 86u
 #define FD_COMMAND_NO_COMMAND_LEN 38u
@@ -100,6 +101,9 @@
 /* StarTrackerMsg.status_flags */
 #define FD_STAR_TRACKER_SUN_EXCLUSION 0x01u
 #define FD_STAR_TRACKER_RATE_LIMIT 0x02u
+#define FD_MAGNETOMETER_AXIS_1 0x01u
+#define FD_MAGNETOMETER_AXIS_2 0x02u
+#define FD_MAGNETOMETER_AXIS_3 0x04u
 /* EffectorState.flags of a reaction wheel */
 #define FD_WHEEL_TORQUE_LIMITED 0x1u
 #define FD_WHEEL_SPEED_LIMITED 0x2u
@@ -203,6 +207,12 @@ typedef struct {
     uint8_t valid;  /* 0 or 1 */
     uint8_t status_flags;
 } fd_star_tracker_msg;
+
+typedef struct {
+    fd_header header;
+    double b_s_t[3]; /* T, sensor frame S */
+    uint8_t saturation_flags;
+} fd_magnetometer_msg;
 
 typedef struct {
     uint32_t effector_index;
@@ -567,6 +577,26 @@ static inline size_t fd_encode_star_tracker(const fd_star_tracker_msg *m, uint8_
     return FD_STAR_TRACKER_LEN;
 }
 
+static inline fd_error fd_decode_magnetometer(const uint8_t *buf, size_t len,
+                                              fd_magnetometer_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_MAGNETOMETER_LEN);
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_MAGNETOMETER_LEN, len)).status != FD_OK) return e;
+    fd_decode_header_at(buf, &out->header);
+    fd_get_f64s(buf + 30, out->b_s_t, 3);
+    out->saturation_flags = buf[54];
+    return fd_ok();
+}
+
+static inline size_t fd_encode_magnetometer(const fd_magnetometer_msg *m, uint8_t *buf,
+                                            size_t cap) {
+    if (cap < FD_MAGNETOMETER_LEN) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_f64s(buf + 30, m->b_s_t, 3);
+    buf[54] = m->saturation_flags;
+    return FD_MAGNETOMETER_LEN;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 /* CommandMsg.                                                                                 */
 
@@ -819,6 +849,10 @@ static inline size_t fd_imu_key(char *out, size_t cap, const char *sc, const cha
 }
 static inline size_t fd_star_tracker_key(char *out, size_t cap, const char *sc, const char *name) {
     return fd_key(out, cap, sc, "tlm/st", name);
+}
+static inline size_t fd_magnetometer_key(char *out, size_t cap, const char *sc,
+                                         const char *name) {
+    return fd_key(out, cap, sc, "tlm/mag", name);
 }
 static inline size_t fd_status_key(char *out, size_t cap, const char *sc) {
     return fd_key(out, cap, sc, "status", FD_NULL);

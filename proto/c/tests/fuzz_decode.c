@@ -128,6 +128,19 @@ static void one(const uint8_t *buf, size_t len) {
         }
     }
     {
+        fd_magnetometer_msg m;
+        e = fd_decode_magnetometer(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_magnetometer(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            fs(m.b_s_t, 3);
+            u(m.saturation_flags);
+            printf("\n");
+        }
+    }
+    {
         fd_command_msg m;
         uint64_t i;
         memset(&m, 0, sizeof m);

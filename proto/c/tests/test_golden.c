@@ -202,6 +202,26 @@ static void test_imu_and_star_tracker(const char *dir) {
     printf("ImuMsg, StarTrackerMsg: decode ok\n");
 }
 
+static void test_magnetometer(const char *dir) {
+    uint8_t golden[256], enc[256];
+    size_t n = read_file(dir, "magnetometer", golden, sizeof golden);
+    fd_magnetometer_msg m, back;
+    double b[3] = {1.0 / 32768.0, -1.0 / 65536.0, -0.0};
+    fd_error e;
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 13, 130000000u, 1);
+    memcpy(m.b_s_t, b, sizeof b);
+    m.saturation_flags = FD_MAGNETOMETER_AXIS_1 | FD_MAGNETOMETER_AXIS_3;
+    check_encoded("MagnetometerMsg", golden, n, enc, fd_encode_magnetometer(&m, enc, sizeof enc));
+    e = fd_decode_magnetometer(golden, n, &back);
+    CHECK(e.status == FD_OK && same_header(&back.header, &m.header) &&
+              same_bits(back.b_s_t, b, 3) && back.saturation_flags == 0x05,
+          "MagnetometerMsg decodes to the table");
+    e = fd_decode_magnetometer(golden, n - 1, &back);
+    CHECK(e.status == FD_ERR_LENGTH && e.needed == FD_MAGNETOMETER_LEN, "MagnetometerMsg short");
+    printf("MagnetometerMsg: decode ok\n");
+}
+
 static void test_commands(const char *dir) {
     uint8_t golden[256], enc[256];
     size_t n;
@@ -341,6 +361,9 @@ static void test_keys(void) {
     CHECK(fd_star_tracker_key(key, sizeof key, "sc1", "st1") > 0 &&
               strcmp(key, "flexdyn/sc1/tlm/st/st1") == 0,
           "star tracker key");
+    CHECK(fd_magnetometer_key(key, sizeof key, "sc1", "mag1") > 0 &&
+              strcmp(key, "flexdyn/sc1/tlm/mag/mag1") == 0,
+          "magnetometer key");
     CHECK(fd_participant_key(key, sizeof key, "sc-1", 4294967295u) > 0 &&
               strcmp(key, "flexdyn/sc-1/participant/4294967295") == 0,
           "participant key");
@@ -360,6 +383,7 @@ int main(int argc, char **argv) {
     }
     test_state(argv[1]);
     test_imu_and_star_tracker(argv[1]);
+    test_magnetometer(argv[1]);
     test_commands(argv[1]);
     test_status(argv[1]);
     test_keys();

@@ -3,7 +3,8 @@
 //! `proto/c/tests/fuzz_decode.c`, the Python package's `tests/test_proto_fuzz.py`).
 //!
 //! Input (stdin): records of a u32 LE length and that many bytes. Output (stdout): per record,
-//! six lines, one per decoder (state, imu, star tracker, command, status, header):
+//! seven lines, one per decoder (state, imu, star tracker, magnetometer, command, status,
+//! header):
 //! `E <reason> [numbers or field]` for an error (the `DecodeError` variant; `Length needed
 //! actual`, `TrailingBytes expected actual`, `TooLarge actual`, `UnknownVersion found`,
 //! `NonFinite field`, `Malformed`), or `O <fields>` for a decoded message: every field in wire
@@ -13,8 +14,9 @@ use std::fmt::Write as _;
 use std::io::{Read, Write};
 
 use flexdyn_proto::{
-    decode_command, decode_header, decode_imu, decode_star_tracker, decode_state, decode_status,
-    CommandKind, CommandMsg, DecodeError, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg,
+    decode_command, decode_header, decode_imu, decode_magnetometer, decode_star_tracker,
+    decode_state, decode_status, CommandKind, CommandMsg, DecodeError, Header, ImuMsg,
+    MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg,
 };
 
 fn err_line(e: &DecodeError) -> String {
@@ -103,6 +105,12 @@ fn star_tracker_line(m: &StarTrackerMsg) -> String {
     l.0
 }
 
+fn magnetometer_line(m: &MagnetometerMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header).f(&m.b_s_t).u(m.saturation_flags.into());
+    l.0
+}
+
 fn command_line(m: &CommandMsg) -> String {
     let mut l = Line::new();
     l.h(&m.header).u(m.sender_id.into());
@@ -163,7 +171,7 @@ fn status_line(m: &StatusMsg) -> String {
     l.0
 }
 
-/// The six verdicts for one buffer, in the order of the module docs.
+/// The seven verdicts for one buffer, in the order of the module docs.
 fn rust_lines(b: &[u8]) -> Vec<String> {
     fn line<M>(r: Result<M, DecodeError>, f: impl Fn(&M) -> String) -> String {
         match r {
@@ -175,6 +183,7 @@ fn rust_lines(b: &[u8]) -> Vec<String> {
         line(decode_state(b), state_line),
         line(decode_imu(b), imu_line),
         line(decode_star_tracker(b), star_tracker_line),
+        line(decode_magnetometer(b), magnetometer_line),
         line(decode_command(b), command_line),
         line(decode_status(b), status_line),
         line(decode_header(b), |h| {

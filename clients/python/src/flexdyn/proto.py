@@ -1,4 +1,4 @@
-"""The flexdyn wire protocol, version 4, in pure Python.
+"""The flexdyn wire protocol, version 5, in pure Python.
 
 Every message of ``proto/README.md`` as a dataclass with ``encode()`` and ``decode(bytes)``.
 Decoding follows the README's decoder rules in the same order and raises :class:`DecodeError`
@@ -23,7 +23,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import ClassVar, List, Optional, Tuple
 
-PROTOCOL_VERSION = 4
+PROTOCOL_VERSION = 5
 HEADER_LEN = 30
 STATE_FIXED_LEN = 327
 STATE_EFFECTOR_COUNT_OFFSET = 319
@@ -31,6 +31,7 @@ EFFECTOR_STATE_FIXED_LEN = 22
 EFFECTOR_INPUT_FIXED_LEN = 12
 IMU_LEN = 127
 STAR_TRACKER_LEN = 64
+MAGNETOMETER_LEN = 55
 COMMAND_KIND_OFFSET = 34
 COMMAND_WRENCH_LEN = 86
 COMMAND_NO_COMMAND_LEN = 38
@@ -49,6 +50,7 @@ PANEL_PAIR, REACTION_WHEEL, MAGNETORQUER, THRUSTER = 1, 2, 3, 4
 COMMAND_FLAG_STALE, COMMAND_FLAG_ZEROED_BY_POLICY, COMMAND_FLAG_NO_COMMAND_YET = 0x1, 0x2, 0x4
 SATURATION_GYRO_RATE, SATURATION_ACCEL, SATURATION_DTHETA, SATURATION_DV = 0x1, 0x2, 0x4, 0x8
 STAR_TRACKER_SUN_EXCLUSION, STAR_TRACKER_RATE_LIMIT = 0x1, 0x2
+MAGNETOMETER_AXIS_1, MAGNETOMETER_AXIS_2, MAGNETOMETER_AXIS_3 = 0x1, 0x2, 0x4
 WHEEL_TORQUE_LIMITED, WHEEL_SPEED_LIMITED = 0x1, 0x2
 MAGNETORQUER_SATURATED = 0x1
 THRUSTER_FIRING, THRUSTER_BELOW_MIN_ON_TIME, THRUSTER_COMMAND_CLIPPED = 0x1, 0x2, 0x4
@@ -295,6 +297,25 @@ class StarTrackerMsg:
 
 
 @dataclass
+class MagnetometerMsg:
+    """Magnetometer sample (``flexdyn/<sc-id>/tlm/mag/<name>``): the field in the sensor frame S
+    (T) and the saturated axes (``MAGNETOMETER_AXIS_*``)."""
+
+    header: Header = field(default_factory=Header)
+    b_s_t: Tuple[float, float, float] = (0.0, 0.0, 0.0)
+    saturation_flags: int = 0
+
+    def encode(self) -> bytes:
+        return self.header.encode() + _pack_f(self.b_s_t) + struct.pack("<B", self.saturation_flags)
+
+    @staticmethod
+    def decode(buf: bytes) -> "MagnetometerMsg":
+        _check_size_and_version(buf, MAGNETOMETER_LEN)
+        _check_total(MAGNETOMETER_LEN, buf)
+        return MagnetometerMsg(Header.unpack(buf), _f(buf, 30, 3), buf[54])
+
+
+@dataclass
 class EffectorInput:
     """Inputs for one effector (index in StateMsg.effectors) in an Actuators command."""
 
@@ -462,6 +483,10 @@ def imu_key(sc: str, name: str) -> str:
 
 def star_tracker_key(sc: str, name: str) -> str:
     return _key(sc, "tlm/st", name)
+
+
+def magnetometer_key(sc: str, name: str) -> str:
+    return _key(sc, "tlm/mag", name)
 
 
 def command_key(sc: str, sender_id: int) -> str:
