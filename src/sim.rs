@@ -82,6 +82,9 @@ impl Simulation {
             sensors,
         };
         sim.apply_schedules();
+        // The world exists at t = 0: sensors sampled at tick 0 read it (the first step's update
+        // then finds the sample current, so the dynamics are unchanged).
+        sim.update_environment();
         Ok(sim)
     }
 

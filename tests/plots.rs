@@ -118,7 +118,12 @@ fn a_recording_gives_every_figure() {
         err.contains("skipped actuators.png: no mtq<k>_* or thr<k>_* columns"),
         "{err}"
     );
-    assert_eq!(err.matches("skipped").count(), 2, "{err}");
+    // Nor magnetometers.
+    assert!(
+        err.contains("skipped magnetometer.png: no magnetometer"),
+        "{err}"
+    );
+    assert_eq!(err.matches("skipped").count(), 3, "{err}");
     assert!(!out.join("timing.png").exists());
 
     let (figs, _) = figures(&args(&rec)).unwrap();
@@ -364,6 +369,7 @@ fn a_simulate_csv_gives_the_state_figures_and_names_the_rest() {
         "actuators.png",
         "star_tracker.png",
         "imu.png",
+        "magnetometer.png",
         "timing.png",
     ] {
         assert!(err.contains(&format!("skipped {skipped}")), "{err}");

@@ -54,6 +54,7 @@ use crate::dynamics::{
     WrenchSegment,
 };
 use crate::sensors::imu::{self, schema::RawImu, ImuConfig};
+use crate::sensors::magnetometer::{self, schema::RawMagnetometer, MagnetometerConfig};
 use crate::sensors::star_tracker::{self, schema::RawStarTracker, StarTrackerConfig};
 
 /// The built-in default configuration (the text of `scenarios/reference.toml`).
@@ -99,6 +100,8 @@ pub struct SimConfig {
     pub imus: Vec<ImuConfig>,
     /// The star trackers (`[[star_trackers]]`), validated, in file order (empty if absent).
     pub star_trackers: Vec<StarTrackerConfig>,
+    /// The magnetometers (`[[magnetometers]]`), validated, in file order (empty if absent).
+    pub magnetometers: Vec<MagnetometerConfig>,
     /// The simulation epoch (`[epoch]`), if given: t = 0 is this instant.
     pub epoch: Option<crate::environment::epoch::SimEpoch>,
     /// The environment (`[environment]`), if given: models and dynamic effectors.
@@ -239,7 +242,7 @@ pub fn gravity_model_name(g: &GravityModel) -> &'static str {
 /// One-line summary of a valid configuration.
 pub fn config_summary(cfg: &SimConfig) -> String {
     format!(
-        "{} panel pairs{}{}, {} IMUs{}{}, total mass {} kg, step {} s ({} ns{}), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows{}",
+        "{} panel pairs{}{}, {} IMUs{}{}{}, total mass {} kg, step {} s ({} ns{}), frame {} Hz ({} ns = {} steps), gravity {}, {} wrench schedule rows{}",
         cfg.panel_pairs.len(),
         if cfg.reaction_wheels.is_empty() {
             String::new()
@@ -271,6 +274,12 @@ pub fn config_summary(cfg: &SimConfig) -> String {
         } else {
             let names: Vec<&str> = cfg.star_trackers.iter().map(|s| s.name.as_str()).collect();
             format!(", {} star trackers ({})", names.len(), names.join(", "))
+        },
+        if cfg.magnetometers.is_empty() {
+            String::new()
+        } else {
+            let names: Vec<&str> = cfg.magnetometers.iter().map(|s| s.name.as_str()).collect();
+            format!(", {} magnetometers ({})", names.len(), names.join(", "))
         },
         cfg.total_mass_kg(),
         cfg.step_ns as f64 * 1e-9,
@@ -326,6 +335,7 @@ const ROOT_KEYS: &[&str] = &[
     "server",
     "imus",
     "star_trackers",
+    "magnetometers",
     world::ROOT_KEYS[0],
     world::ROOT_KEYS[1],
     world::ROOT_KEYS[2],
@@ -347,6 +357,7 @@ struct RawConfig {
     server: toml::Table,
     imus: Vec<RawImu>,
     star_trackers: Vec<RawStarTracker>,
+    magnetometers: Vec<RawMagnetometer>,
 }
 
 struct RawSimulation {
@@ -490,6 +501,12 @@ impl RawConfig {
             .iter()
             .map(star_tracker::schema::read)
             .collect::<Result<Vec<_>, _>>()?;
+        let magnetometers = root
+            .tables("magnetometers", &magnetometer::schema::KEYS)?
+            .unwrap_or_default()
+            .iter()
+            .map(magnetometer::schema::read)
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(RawConfig {
             world,
             simulation,
@@ -504,6 +521,7 @@ impl RawConfig {
             server,
             imus,
             star_trackers,
+            magnetometers,
         })
     }
 }
@@ -678,26 +696,7 @@ impl RawConfig {
             if let Err(e) = flexdyn_proto::validate_star_tracker_name(&raw.name) {
                 return Err(map.invalid(&format!("{path}.name"), e.to_string()));
             }
-            let field = format!("{path}.rate_hz");
-            if !raw.rate_hz.is_finite() || raw.rate_hz <= 0.0 {
-                return Err(param(ParamError::NotPositive {
-                    field,
-                    value: raw.rate_hz,
-                }));
-            }
-            let ratio = sim.frame_hz / raw.rate_hz;
-            let every_frames = ratio.round();
-            if every_frames < 1.0 || (ratio - every_frames).abs() > 1e-9 * ratio {
-                return Err(map.invalid(
-                    &field,
-                    format!(
-                        "{} Hz is not the frame rate ({} Hz) divided by a whole number: the \
-                         tracker updates every whole number of frames",
-                        Num(raw.rate_hz),
-                        Num(sim.frame_hz)
-                    ),
-                ));
-            }
+            let every_frames = every_frames(map, &path, raw.rate_hz, sim.frame_hz, "tracker")?;
             let cfg = StarTrackerConfig {
                 name: raw.name,
                 dcm_cb: raw.dcm_cb,
@@ -705,7 +704,7 @@ impl RawConfig {
                 sigma_cross_boresight_rad: raw.sigma_cross_boresight_rad,
                 sigma_about_boresight_rad: raw.sigma_about_boresight_rad,
                 bias_c_rad: raw.bias_c_rad,
-                every_frames: every_frames as u64,
+                every_frames,
                 seed: raw.seed,
                 sun_direction_n: raw.sun_direction_n,
                 sun_exclusion_rad: raw.sun_exclusion_rad,
@@ -713,6 +712,48 @@ impl RawConfig {
             };
             cfg.validate(&path).map_err(param)?;
             star_trackers.push(cfg);
+        }
+
+        // [[magnetometers]]
+        let mut magnetometers = Vec::with_capacity(self.magnetometers.len());
+        let mut magnetometer_names = HashSet::new();
+        for (i, raw) in self.magnetometers.into_iter().enumerate() {
+            let path = format!("magnetometers[{i}]");
+            unique_name(
+                map,
+                &path,
+                &raw.name,
+                &mut magnetometer_names,
+                "magnetometer",
+            )?;
+            if let Err(e) = flexdyn_proto::validate_sensor_name(&raw.name) {
+                return Err(map.invalid(&format!("{path}.name"), e.to_string()));
+            }
+            let every_frames = every_frames(map, &path, raw.rate_hz, sim.frame_hz, "magnetometer")?;
+            if let Some(k) = (0..3).find(|&k| raw.misalignment_rad[(k, k)] != 0.0) {
+                return Err(map.invalid(
+                    &format!("{path}.misalignment_rad"),
+                    format!(
+                        "the diagonal must be zero (element [{k}][{k}] is {}): a scale error \
+                         belongs in scale_factor",
+                        Num(raw.misalignment_rad[(k, k)])
+                    ),
+                ));
+            }
+            let cfg = MagnetometerConfig {
+                name: raw.name,
+                dcm_sb: raw.dcm_sb,
+                scale_factor: raw.scale_factor,
+                misalignment_rad: raw.misalignment_rad,
+                bias_s_t: raw.bias_s_t,
+                noise_sigma_t: raw.noise_sigma_t,
+                range_t: raw.range_t,
+                lsb_t: raw.lsb_t,
+                every_frames,
+                seed: raw.seed,
+            };
+            cfg.validate(&path).map_err(param)?;
+            magnetometers.push(cfg);
         }
 
         let mut cfg = SimConfig {
@@ -732,6 +773,7 @@ impl RawConfig {
             server: self.server,
             imus,
             star_trackers,
+            magnetometers,
             epoch: world.epoch,
             environment: world.environment,
             source_toml: source.to_string(),
@@ -747,6 +789,38 @@ impl RawConfig {
         check_initial_outputs_finite(&cfg, &mut sc, map)?;
         Ok(cfg)
     }
+}
+
+/// `frame_hz / rate_hz` as a whole number of frames ≥ 1 (`<path>.rate_hz`): a sensor that
+/// updates at `rate_hz` does so every that many frames (`what` updates …).
+fn every_frames(
+    map: &SourceMap,
+    path: &str,
+    rate_hz: f64,
+    frame_hz: f64,
+    what: &str,
+) -> Result<u64, ConfigError> {
+    let field = format!("{path}.rate_hz");
+    if !rate_hz.is_finite() || rate_hz <= 0.0 {
+        return Err(map.param_error(ParamError::NotPositive {
+            field,
+            value: rate_hz,
+        }));
+    }
+    let ratio = frame_hz / rate_hz;
+    let every_frames = ratio.round();
+    if every_frames < 1.0 || (ratio - every_frames).abs() > 1e-9 * ratio {
+        return Err(map.invalid(
+            &field,
+            format!(
+                "{} Hz is not the frame rate ({} Hz) divided by a whole number: the {what} \
+                 updates every whole number of frames",
+                Num(rate_hz),
+                Num(frame_hz)
+            ),
+        ));
+    }
+    Ok(every_frames as u64)
 }
 
 /// Checks that `<path>.name` is not blank and not already in `seen` (then adds it).

@@ -27,13 +27,14 @@ use crate::environment::EnvironmentSample;
 
 pub mod bank;
 pub mod imu;
+pub mod magnetometer;
 pub mod rng;
 pub mod star_tracker;
 
 pub use bank::SensorBank;
 
 /// Every sensor kind, in publication order: the registry.
-pub static KINDS: &[&SensorKind] = &[&imu::KIND, &star_tracker::KIND];
+pub static KINDS: &[&SensorKind] = &[&imu::KIND, &star_tracker::KIND, &magnetometer::KIND];
 
 /// The truth one sample is taken from: one evaluation at the current instant.
 #[derive(Debug, Clone, Copy)]
@@ -179,8 +180,17 @@ mod tests {
     /// decodes, with the frame's header (a star tracker's `seq` counting its updates).
     #[test]
     fn every_kind_round_trips_through_key_bank_and_codec() {
+        // Between them, these scenarios have every kind.
+        let mut seen = vec![false; KINDS.len()];
+        for scenario in ["wheels_star_tracker", "leo_environment"] {
+            round_trip(scenario, &mut seen);
+        }
+        assert!(seen.iter().all(|&s| s), "{seen:?}");
+    }
+
+    fn round_trip(scenario: &str, seen: &mut [bool]) {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scenarios/wheels_star_tracker.toml");
+            .join(format!("scenarios/{scenario}.toml"));
         let cfg = SimConfig::from_file(&path).unwrap();
         let mut sim = Simulation::new(&cfg).unwrap();
         sim.step_frame();
@@ -195,8 +205,9 @@ mod tests {
             .map(|s| s.kind().index().unwrap())
             .collect();
         assert!(kinds.windows(2).all(|w| w[0] <= w[1]), "{kinds:?}");
-        assert_eq!(kinds.first(), Some(&0));
-        assert_eq!(kinds.last(), Some(&(KINDS.len() - 1)));
+        for &k in &kinds {
+            seen[k] = true;
+        }
         let mut buf = Vec::new();
         for s in bank.sensors() {
             let kind = s.kind();
@@ -218,10 +229,10 @@ mod tests {
             };
             assert_eq!((h.tick, h.sim_time_ns), (2, sim.t_sim_ns()));
             let every = cfg.star_trackers.first().map_or(1, |c| c.every_frames);
-            let seq = if kind.noun == "star tracker" {
-                2 / every
-            } else {
-                2
+            let seq = match kind.noun {
+                "star tracker" => 2 / every,
+                "magnetometer" => 2 / cfg.magnetometers[0].every_frames,
+                _ => 2,
             };
             assert_eq!(h.seq, seq, "{key}");
             // Every field of the message, as the kind's default JSON names them.

@@ -1049,4 +1049,22 @@ mod tests {
             "{lo} {hi}"
         );
     }
+
+    /// Every column a sensor kind's plot panels name is a column of its message, so no panel
+    /// of a registered kind is silently empty.
+    #[test]
+    fn every_kind_plots_columns_of_its_message() {
+        for kind in KINDS {
+            let columns = column_names(&(kind.default_json)());
+            for spec in kind.plot.2 {
+                for (col, _) in spec.lines {
+                    assert!(
+                        columns.iter().any(|c| c == col),
+                        "{}: panel column {col} not in {columns:?}",
+                        kind.noun
+                    );
+                }
+            }
+        }
+    }
 }

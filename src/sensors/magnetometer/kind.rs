@@ -1,0 +1,55 @@
+//! The magnetometer's entry in the sensor registry ([`crate::sensors::KINDS`]): its key
+//! (`flexdyn/<sc>/tlm/mag/<name>`), its wire message ([`MagnetometerMsg`]), how it is built
+//! from `[[magnetometers]]` and how `flexdyn plot` draws it.
+
+use flexdyn_proto::keys::MAGNETOMETER_PREFIX;
+use flexdyn_proto::{decode_magnetometer, MagnetometerMsg};
+
+use super::Magnetometer;
+use crate::config::{ConfigError, SimConfig};
+use crate::dynamics::State;
+use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
+
+/// The magnetometer kind.
+pub static KIND: SensorKind = SensorKind {
+    noun: "magnetometer",
+    a_noun: "a magnetometer",
+    config_array: "magnetometers",
+    key_prefix: MAGNETOMETER_PREFIX,
+    column_prefix: "mag",
+    message_name: "MagnetometerMsg",
+    key: |t, name| t.sensor(MAGNETOMETER_PREFIX, name),
+    build,
+    decode: |b| decode_magnetometer(b).map(|m| json_of(m.header, &m)),
+    default_json: || json_of(Default::default(), &MagnetometerMsg::default()).1,
+    json_schema: || schemars::schema_for!(MagnetometerMsg).to_value(),
+    plot: (
+        "magnetometer.png",
+        "Magnetometers: measured field (sensor frame S) and saturated axes",
+        &[
+            PanelSpec {
+                y_label: "B, S (T)",
+                lines: &[("b_s_t_1", "B1"), ("b_s_t_2", "B2"), ("b_s_t_3", "B3")],
+            },
+            PanelSpec {
+                y_label: "saturated axes (bits 1, 2, 4)",
+                lines: &[("saturation_flags", "flags")],
+            },
+        ],
+    ),
+};
+
+/// One [`Magnetometer`] per `[[magnetometers]]` entry (errors name `magnetometers[i]…`).
+fn build(
+    cfg: &SimConfig,
+    _sample_interval_s: f64,
+    _t_sim_ns: u64,
+    _x: &State,
+    out: &mut Vec<Box<dyn Sensor>>,
+) -> Result<(), ConfigError> {
+    for (i, m) in cfg.magnetometers.iter().enumerate() {
+        let path = format!("magnetometers[{i}]");
+        out.push(Box::new(Magnetometer::new(m.clone(), &path)?));
+    }
+    Ok(())
+}
