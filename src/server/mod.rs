@@ -55,6 +55,7 @@ mod presence;
 pub mod publish;
 mod reject_log;
 mod report;
+pub mod rt;
 pub mod settings;
 mod setup;
 pub mod shared;
@@ -120,6 +121,9 @@ pub async fn run(
         &shared,
         record_tx.clone(),
     )?;
+    // Hard real time: after the buffers exist (mlockall faults them in), before the physics
+    // thread starts; undone when the run ends.
+    let _realtime = RealtimeHold::acquire(&settings)?;
 
     // zenoh rx: the command callback, into the physics thread's queue or the lockstep core.
     let commands = intake::declare(
@@ -172,7 +176,9 @@ pub async fn run(
     // The report: commands stop arriving, the recorder writes what it holds and closes the file.
     drop(commands);
     let recording = finish_recording(recorder)?;
-    let report = RunReport::collect(mode, physics?, &shared, &tlm.lateness, wall_s, recording);
+    let (physics, physics_thread) = physics;
+    let mut report = RunReport::collect(mode, physics?, &shared, &tlm.lateness, wall_s, recording);
+    report.physics_thread = physics_thread;
     tracing::info!("{report}");
     Ok(report)
 }
@@ -359,9 +365,20 @@ fn spawn_telemetry(
     telemetry: TelemetryCtx,
 ) -> Result<oneshot::Receiver<TelemetryReport>, ServerError> {
     let (done_tx, done_rx) = oneshot::channel();
+    let off_cpu = match telemetry.settings.mode {
+        Mode::RealTime => telemetry.settings.physics_cpu,
+        _ => None,
+    };
     std::thread::Builder::new()
         .name("flexdyn-telemetry".into())
         .spawn(move || {
+            // Off the physics thread's CPU (checked before it starts), whatever thread
+            // started this one.
+            if let Some(cpu) = off_cpu {
+                if let Err(e) = rt::keep_off_cpu(cpu) {
+                    tracing::warn!(error = %e, "telemetry thread: cannot leave CPU {cpu}");
+                }
+            }
             let _ = done_tx.send(telemetry.run());
         })
         .map_err(|e| ServerError::Internal(format!("cannot start the telemetry thread: {e}")))?;
@@ -375,7 +392,7 @@ async fn run_frames(
     settings: &ServerSettings,
     shared: &Arc<Shared>,
     shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
-) -> Result<Result<PhysicsReport, ServerError>, ServerError> {
+) -> Result<PhysicsOutcome, ServerError> {
     match frames {
         Frames::Physics(physics, stepper) => {
             run_physics_thread(*physics, *stepper, settings, shared, shutdown).await
@@ -387,7 +404,7 @@ async fn run_frames(
         } => {
             let r = run_lockstep_core(&core, &events, settings, shared, shutdown).await;
             drop(full_tx);
-            Ok(r)
+            Ok((r, None))
         }
     }
 }
@@ -402,6 +419,84 @@ fn finish_recording(
         .map_err(ServerError::from)
 }
 
+/// How the frames ended, and (real time) the physics thread's counters over them.
+type PhysicsOutcome = (Result<PhysicsReport, ServerError>, Option<rt::ThreadUsage>);
+
+/// The process-wide real-time requests of a real-time run ([`rt`]), held until the run ends.
+struct RealtimeHold {
+    locked: bool,
+    _dma: Option<rt::DmaLatency>,
+}
+
+impl RealtimeHold {
+    /// Checks `physics_cpu`, locks the memory and holds `/dev/cpu_dma_latency` as the settings
+    /// ask (real time only); an error names the setting the OS refused.
+    fn acquire(settings: &ServerSettings) -> Result<Self, ServerError> {
+        let mut hold = Self {
+            locked: false,
+            _dma: None,
+        };
+        if settings.mode != Mode::RealTime {
+            return Ok(hold);
+        }
+        let refused = |setting: &'static str| {
+            move |problem: String| ServerError::Realtime { setting, problem }
+        };
+        if let Some(cpu) = settings.physics_cpu {
+            rt::check_physics_cpu(cpu).map_err(refused("server.physics_cpu"))?;
+        }
+        if settings.cpu_dma_latency {
+            hold._dma = Some(rt::DmaLatency::hold().map_err(refused("server.cpu_dma_latency"))?);
+            tracing::info!("holding {} at 0 µs", rt::CPU_DMA_LATENCY);
+        }
+        if settings.lock_memory {
+            rt::lock_memory().map_err(refused("server.lock_memory"))?;
+            hold.locked = true;
+            tracing::info!("memory locked (mlockall MCL_CURRENT | MCL_FUTURE)");
+        }
+        Ok(hold)
+    }
+}
+
+impl Drop for RealtimeHold {
+    fn drop(&mut self) {
+        if self.locked {
+            rt::unlock_memory();
+        }
+    }
+}
+
+/// What the physics thread does before its first frame in real time: pre-fault its stack, pin
+/// itself to its CPU, go under SCHED_FIFO, as the settings ask. An error names the setting the
+/// OS refused.
+fn prepare_physics_thread(settings: &ServerSettings) -> Result<(), ServerError> {
+    if settings.mode != Mode::RealTime {
+        return Ok(());
+    }
+    if settings.lock_memory {
+        rt::prefault_stack();
+    }
+    if let Some(cpu) = settings.physics_cpu {
+        rt::pin_to_cpu(cpu).map_err(|problem| ServerError::Realtime {
+            setting: "server.physics_cpu",
+            problem,
+        })?;
+        tracing::info!(cpu, "physics thread pinned");
+    }
+    let p = settings.realtime_priority;
+    if p > 0 {
+        set_fifo_priority(p).map_err(|e| ServerError::Realtime {
+            setting: "server.realtime_priority",
+            problem: format!(
+                "cannot put the physics thread under SCHED_FIFO at priority {p}: {e} (needs \
+                 CAP_SYS_NICE, or an RLIMIT_RTPRIO (`ulimit -r`) of at least {p})"
+            ),
+        })?;
+        tracing::info!(priority = p, "physics thread runs under SCHED_FIFO");
+    }
+    Ok(())
+}
+
 /// Runs the physics thread to its end (or a stop request); `Err` only if it panicked.
 async fn run_physics_thread(
     physics: PhysicsCtx,
@@ -409,22 +504,16 @@ async fn run_physics_thread(
     settings: &ServerSettings,
     shared: &Arc<Shared>,
     mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
-) -> Result<Result<physics::PhysicsReport, ServerError>, ServerError> {
+) -> Result<PhysicsOutcome, ServerError> {
     let (phys_done_tx, mut phys_done_rx) = oneshot::channel();
-    let realtime_priority = (settings.mode == Mode::RealTime).then_some(settings.realtime_priority);
+    let thread_settings = settings.clone();
     std::thread::Builder::new()
         .name("flexdyn-physics".into())
+        .stack_size(rt::PHYSICS_STACK_BYTES)
         .spawn(move || {
-            if let Some(p) = realtime_priority.filter(|p| *p > 0) {
-                match set_fifo_priority(p) {
-                    Ok(()) => tracing::info!(priority = p, "physics thread runs under SCHED_FIFO"),
-                    Err(e) => tracing::warn!(
-                        priority = p,
-                        error = %e,
-                        "cannot put the physics thread under SCHED_FIFO (needs CAP_SYS_NICE); \
-                         running at normal priority"
-                    ),
-                }
+            if let Err(e) = prepare_physics_thread(&thread_settings) {
+                let _ = phys_done_tx.send((Err(e), None));
+                return;
             }
             let _ = phys_done_tx.send(physics.run(stepper));
         })

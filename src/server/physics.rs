@@ -35,6 +35,7 @@ use super::commands::{CommandBook, Held, Offer};
 use super::error::ServerError;
 use super::pacing::{FrameEnd, Pacer};
 use super::publish::FramePublisher;
+use super::rt::ThreadUsage;
 use super::settings::ServerSettings;
 use super::shared::{fill_state, Frame, Shared};
 use crate::dynamics::Wrench;
@@ -197,15 +198,20 @@ enum Wait {
 }
 
 impl PhysicsCtx {
-    /// Runs the loop over `w` to its end; sets the shared run state accordingly.
-    pub fn run(mut self, w: Stepper) -> Result<PhysicsReport, ServerError> {
-        let result = self.frame_loop(w);
+    /// Runs the loop over `w` to its end; sets the shared run state accordingly. In real time,
+    /// also this thread's page faults and context switches from the end of the first frame
+    /// (which warms what is lazily set up on first use, such as Zenoh's per-thread state) to
+    /// the end.
+    pub fn run(mut self, w: Stepper) -> (Result<PhysicsReport, ServerError>, Option<ThreadUsage>) {
+        let mut warm = None;
+        let result = self.frame_loop(w, &mut warm);
         self.shared.set_run_state(match &result {
             Ok(r) if r.ending == Ending::Finished => RunState::Finished,
             Ok(_) => RunState::Stopped,
             Err(_) => RunState::Failed,
         });
-        result
+        let usage = warm.map(|w: ThreadUsage| ThreadUsage::this_thread().since(&w));
+        (result, usage)
     }
 
     /// A free telemetry buffer: real time never waits (`None` = drop this frame's telemetry);
@@ -276,7 +282,11 @@ impl PhysicsCtx {
         Ok(Wait::Done)
     }
 
-    fn frame_loop(&mut self, mut w: Stepper) -> Result<PhysicsReport, ServerError> {
+    fn frame_loop(
+        &mut self,
+        mut w: Stepper,
+        warm: &mut Option<ThreadUsage>,
+    ) -> Result<PhysicsReport, ServerError> {
         let mode = self.settings.mode;
         let realtime = mode == Mode::RealTime;
         let frame_ns = w.sim.frame_ns();
@@ -373,6 +383,12 @@ impl PhysicsCtx {
                 w.fill(f, k);
             }
             w.check_finite(k, pending.is_some())?;
+            if realtime && k == 1 {
+                // Once, off the measured frames: the counters' baseline (reads /proc twice,
+                // the first read warms the reading itself).
+                ThreadUsage::this_thread();
+                *warm = Some(ThreadUsage::this_thread());
+            }
             if realtime {
                 match pacer.end_frame(k) {
                     FrameEnd::OnTime => {}

@@ -7,6 +7,7 @@ use flexdyn_proto::{FrameTiming, Mode, RejectCounters};
 use hdrhistogram::Histogram;
 
 use super::physics::{Ending, PhysicsReport};
+use super::rt::ThreadUsage;
 use super::settings::mode_name;
 use super::shared::Shared;
 use super::telemetry::timing_of;
@@ -48,6 +49,9 @@ pub struct RunReport {
     pub recording: Option<RecordReport>,
     /// Real time with `handoff = "direct"`: what publishing cost the physics thread, per frame.
     pub direct_publish: Option<PublishCost>,
+    /// Real time: the physics thread's page faults and context switches from its first frame
+    /// to its last (`lock_memory` makes the page faults 0).
+    pub physics_thread: Option<ThreadUsage>,
 }
 
 /// The time the physics thread spent publishing frames (real time, `handoff = "direct"`).
@@ -106,6 +110,15 @@ impl fmt::Display for RunReport {
                 c.slow_frames
             )?;
         }
+        if let Some(u) = &self.physics_thread {
+            write!(
+                f,
+                " physics_thread page_faults={} voluntary_switches={} involuntary_switches={}",
+                u.page_faults(),
+                u.voluntary_switches,
+                u.involuntary_switches
+            )?;
+        }
         Ok(())
     }
 }
@@ -151,6 +164,7 @@ impl RunReport {
                     slow_frames: load(&shared.direct_publishes_slow),
                 })
             },
+            physics_thread: None,
         }
     }
 
@@ -169,6 +183,7 @@ impl RunReport {
             wall_s: 0.0,
             recording: None,
             direct_publish: None,
+            physics_thread: None,
         }
     }
 }

@@ -113,6 +113,9 @@ pub const KEYS: &[&str] = &[
     "summary_interval_s",
     "spin_us",
     "realtime_priority",
+    "lock_memory",
+    "physics_cpu",
+    "cpu_dma_latency",
     "telemetry_buffers",
     "command_queue",
     "handoff",
@@ -152,9 +155,19 @@ pub struct ServerSettings {
     /// Real time: the loop sleeps until this long before a deadline, then spins (default 200 µs).
     pub spin: Duration,
     /// Real time: SCHED_FIFO priority 1–99 for the physics thread, 0 = the normal scheduler
-    /// (default 0). Needs CAP_SYS_NICE (or root); if the OS refuses, the server logs a warning
-    /// and runs at normal priority.
+    /// (default 0). Needs CAP_SYS_NICE (or root); if the OS refuses, the run stops with an
+    /// error ([`super::rt`]).
     pub realtime_priority: u8,
+    /// Real time: lock the process's memory (`mlockall`) and pre-fault the physics thread's
+    /// stack, so the frame loop takes no page fault (default off; needs CAP_IPC_LOCK or a
+    /// large enough RLIMIT_MEMLOCK).
+    pub lock_memory: bool,
+    /// Real time: the CPU the physics thread runs on alone; every other thread of the server
+    /// runs on the remaining CPUs (default `None`: no pinning).
+    pub physics_cpu: Option<usize>,
+    /// Real time: hold `/dev/cpu_dma_latency` open with 0 while running, keeping the CPUs out
+    /// of deep idle states (default off; needs write access to the device).
+    pub cpu_dma_latency: bool,
     /// Preallocated telemetry buffers between the physics and the I/O threads (default 64:
     /// 64 ms at 1 kHz of a telemetry thread not scheduled before a frame's telemetry is dropped).
     pub telemetry_buffers: usize,
@@ -191,6 +204,9 @@ impl Default for ServerSettings {
             summary_interval: Duration::from_secs(10),
             spin: Duration::from_micros(200),
             realtime_priority: 0,
+            lock_memory: false,
+            physics_cpu: None,
+            cpu_dma_latency: false,
             telemetry_buffers: 64,
             command_queue: 1024,
             handoff: Handoff::Auto,
@@ -232,6 +248,8 @@ pub enum Value {
     Ints(Vec<i64>),
     /// A table of strings (`{ "1" = "fsw" }`; on the command line `1=fsw,2=gnc`).
     Strings(Vec<(String, String)>),
+    /// A boolean.
+    Bool(bool),
 }
 
 impl Value {
@@ -242,6 +260,7 @@ impl Value {
             Value::Float(f) => format!("float {f}"),
             Value::Ints(v) => format!("list {v:?}"),
             Value::Strings(v) => format!("table {v:?}"),
+            Value::Bool(b) => format!("boolean {b}"),
         }
     }
 
@@ -251,6 +270,7 @@ impl Value {
             toml::Value::String(s) => Value::Str(s.clone()),
             toml::Value::Integer(i) => Value::Int(*i),
             toml::Value::Float(f) => Value::Float(*f),
+            toml::Value::Boolean(b) => Value::Bool(*b),
             toml::Value::Array(a) => Value::Ints(
                 a.iter()
                     .map(|x| x.as_integer())
@@ -287,6 +307,13 @@ impl Setter<'_> {
         match self.value {
             Value::Str(s) => Ok(s),
             _ => Err(self.expected("a string")),
+        }
+    }
+
+    fn boolean(&self) -> Result<bool, SettingsError> {
+        match self.value {
+            Value::Bool(b) => Ok(*b),
+            _ => Err(self.expected("true or false")),
         }
     }
 
@@ -470,6 +497,12 @@ impl ServerSettings {
             "summary_interval_s" => self.summary_interval = set.seconds()?,
             "spin_us" => self.spin = Duration::from_micros(set.int_in(0, 1_000_000)? as u64),
             "realtime_priority" => self.realtime_priority = set.int_in(0, 99)? as u8,
+            "lock_memory" => self.lock_memory = set.boolean()?,
+            // -1: no pinning (so the command line can undo the file's choice).
+            "physics_cpu" => {
+                self.physics_cpu = usize::try_from(set.int_in(-1, 4095)?).ok();
+            }
+            "cpu_dma_latency" => self.cpu_dma_latency = set.boolean()?,
             "telemetry_buffers" => self.telemetry_buffers = set.int_in(2, 1 << 16)? as usize,
             "command_queue" => self.command_queue = set.int_in(1, 1 << 20)? as usize,
             "handoff" => {
@@ -590,8 +623,9 @@ impl ServerSettings {
             "mode={} sc_id={} spacecraft_id={} participants={:?} participant_timeout_s={} \
              presence_timeout_s={} duration_s={} overrun_policy={} overrun_limit={} \
              stale_after_s={} stale_policy={} status_hz={} summary_interval_s={} spin_us={} \
-             realtime_priority={} telemetry_buffers={} command_queue={} handoff={} \
-             participant_subjects={:?} record={}",
+             realtime_priority={} lock_memory={} physics_cpu={} cpu_dma_latency={} \
+             telemetry_buffers={} command_queue={} handoff={} participant_subjects={:?} \
+             record={}",
             mode_name(self.mode),
             self.sc_id,
             self.spacecraft_id,
@@ -609,6 +643,10 @@ impl ServerSettings {
             self.summary_interval.as_secs_f64(),
             self.spin.as_micros(),
             self.realtime_priority,
+            self.lock_memory,
+            self.physics_cpu
+                .map_or("none".to_owned(), |c| c.to_string()),
+            self.cpu_dma_latency,
             self.telemetry_buffers,
             self.command_queue,
             self.handoff.as_str(),
@@ -714,6 +752,9 @@ mod tests {
             status_hz = 20
             summary_interval_s = 1
             spin_us = 50
+            lock_memory = true
+            physics_cpu = 1
+            cpu_dma_latency = true
             telemetry_buffers = 4
             command_queue = 16
             "#,
@@ -733,6 +774,9 @@ mod tests {
         assert_eq!(s.status_hz, 20.0);
         assert_eq!(s.summary_interval, Duration::from_secs(1));
         assert_eq!(s.spin, Duration::from_micros(50));
+        assert!(s.lock_memory);
+        assert_eq!(s.physics_cpu, Some(1));
+        assert!(s.cpu_dma_latency);
         assert_eq!(s.telemetry_buffers, 4);
         assert_eq!(s.command_queue, 16);
         assert_eq!(s.duration_frames(10_000_000).unwrap(), Some(1200));
@@ -774,6 +818,18 @@ mod tests {
             (
                 "realtime_priority = 100",
                 "server.realtime_priority: must be in 0..=99",
+            ),
+            (
+                "lock_memory = 1",
+                "server.lock_memory: expected true or false, got integer 1",
+            ),
+            (
+                "physics_cpu = -2",
+                "server.physics_cpu: must be in -1..=4095",
+            ),
+            (
+                "cpu_dma_latency = \"yes\"",
+                "server.cpu_dma_latency: expected true or false",
             ),
             (
                 "telemetry_buffers = 1",
