@@ -39,7 +39,7 @@
 //! boundary (`CongestionControl::Drop`) and the frame then goes the same way for the books; in
 //! lockstep the callback steps the [`lockstep::LockstepCore`] and publishes, and the telemetry
 //! thread only publishes StatusMsg. `auto` (default) is `direct` except in real time with
-//! `--record`. The per-frame work ([`physics::Stepper`]) never allocates, locks or touches the
+//! `--record` or under SCHED_FIFO. The per-frame work ([`physics::Stepper`]) never allocates, locks or touches the
 //! network; in real time the physics thread never blocks on the I/O side (a frame without a
 //! free buffer loses its telemetry, counted).
 
@@ -144,7 +144,11 @@ pub async fn run(
 
     // The telemetry thread starts first, so StatusMsg (run_state = Starting) goes out while a
     // lockstep server waits for its participants.
-    let telemetry = spawn_telemetry(wiring.telemetry)?;
+    let (telemetry, telemetry_thread) = spawn_telemetry(wiring.telemetry)?;
+    let mut wiring_frames = wiring.frames;
+    if let Frames::Physics(physics, _) = &mut wiring_frames {
+        physics.wake = Some(telemetry_thread);
+    }
     if let Some(presence) = &presence {
         let ready = presence
             .wait(&state_pub, &settings, &topics, shutdown.as_mut())
@@ -156,7 +160,7 @@ pub async fn run(
             } else {
                 RunState::Failed
             });
-            drop(wiring.frames);
+            drop(wiring_frames);
             let _ = telemetry.await;
             drop(commands);
             finish_recording(recorder)?;
@@ -167,7 +171,7 @@ pub async fn run(
 
     // The physics thread (or the lockstep core) to the end, then the telemetry thread's.
     let started = Instant::now();
-    let physics = run_frames(wiring.frames, &settings, &shared, shutdown.as_mut()).await?;
+    let physics = run_frames(wiring_frames, &settings, &shared, shutdown.as_mut()).await?;
     let wall_s = started.elapsed().as_secs_f64();
     let tlm = telemetry
         .await
@@ -252,7 +256,11 @@ impl Wiring {
     ) -> Result<Self, ServerError> {
         let mode = settings.mode;
         // Who publishes the frames (see `publish`): batch always the telemetry thread.
-        let direct = settings.handoff.is_direct(mode, settings.record.is_some());
+        let direct = settings.handoff.is_direct(
+            mode,
+            settings.record.is_some(),
+            settings.realtime_priority > 0,
+        );
         tracing::info!(
             handoff = if direct { "direct" } else { "thread" },
             "frames are published by {}",
@@ -332,6 +340,7 @@ impl Wiring {
                 full_tx,
                 shared: shared.clone(),
                 direct,
+                wake: None,
             };
             let frames = Frames::Physics(Box::new(physics), Box::new(stepper));
             (
@@ -363,13 +372,13 @@ impl Wiring {
 /// panicked).
 fn spawn_telemetry(
     telemetry: TelemetryCtx,
-) -> Result<oneshot::Receiver<TelemetryReport>, ServerError> {
+) -> Result<(oneshot::Receiver<TelemetryReport>, std::thread::Thread), ServerError> {
     let (done_tx, done_rx) = oneshot::channel();
     let off_cpu = match telemetry.settings.mode {
         Mode::RealTime => telemetry.settings.physics_cpu,
         _ => None,
     };
-    std::thread::Builder::new()
+    let handle = std::thread::Builder::new()
         .name("flexdyn-telemetry".into())
         .spawn(move || {
             // Off the physics thread's CPU (checked before it starts), whatever thread
@@ -382,7 +391,7 @@ fn spawn_telemetry(
             let _ = done_tx.send(telemetry.run());
         })
         .map_err(|e| ServerError::Internal(format!("cannot start the telemetry thread: {e}")))?;
-    Ok(done_rx)
+    Ok((done_rx, handle.thread().clone()))
 }
 
 /// Steps the frames to the end (or a stop request): on the physics thread, or through the

@@ -86,6 +86,8 @@ pub struct PhysicsCtx {
     /// (`CongestionControl::Drop`: never waits for the network), then hand it to the telemetry
     /// thread for the books. `None`: the telemetry thread publishes.
     pub direct: Option<FramePublisher>,
+    /// The telemetry thread, woken after each frame handed to it (`None` until it starts).
+    pub wake: Option<std::thread::Thread>,
 }
 
 /// The per-frame work shared by the physics thread and the lockstep core
@@ -339,17 +341,27 @@ impl PhysicsCtx {
             if let Some(mut f) = pending.take() {
                 f.boundary_unix_ns = stamp;
                 f.lateness_ns = lateness_ns;
+                // The handoff, timed (real time): the put itself with `direct`, and the
+                // channel and the telemetry thread's wake-up either way.
+                let t = Instant::now();
                 if let Some(p) = self.direct.as_mut() {
-                    let t = Instant::now();
                     p.publish(&f, &self.shared, None);
-                    self.shared.note_direct_publish(
-                        u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX),
-                    );
                     f.published = true;
                 }
-                // The full channel holds the whole pool, so this never blocks.
-                if self.full_tx.send(f).is_err() {
+                // The full channel holds the whole pool, so this never blocks; and since the
+                // telemetry thread never waits inside the channel (it parks instead, see
+                // `telemetry`), sending takes no lock: a compare-and-swap, then `unpark`
+                // (an atomic swap, and a FUTEX_WAKE only if that thread sleeps). Nothing here
+                // waits for a thread of lower priority.
+                if self.full_tx.try_send(f).is_err() {
                     return Err(ServerError::Internal("telemetry thread ended".into()));
+                }
+                if let Some(t) = &self.wake {
+                    t.unpark();
+                }
+                if realtime {
+                    self.shared
+                        .note_handoff(u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX));
                 }
             }
             if self.total_frames == Some(k) {

@@ -47,17 +47,18 @@ pub struct RunReport {
     pub wall_s: f64,
     /// `--record`: what the recording holds and what the recorder dropped.
     pub recording: Option<RecordReport>,
-    /// Real time with `handoff = "direct"`: what publishing cost the physics thread, per frame.
-    pub direct_publish: Option<PublishCost>,
+    /// Real time: what handing each frame off cost the physics thread (with
+    /// `handoff = "direct"` the put; either way the channel and the telemetry thread's wake-up).
+    pub handoff: Option<PublishCost>,
     /// Real time: the physics thread's page faults and context switches from its first frame
     /// to its last (`lock_memory` makes the page faults 0).
     pub physics_thread: Option<ThreadUsage>,
 }
 
-/// The time the physics thread spent publishing frames (real time, `handoff = "direct"`).
+/// The time the physics thread spent handing frames off (real time).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PublishCost {
-    /// Frames published from the physics thread.
+    /// Frames handed off by the physics thread.
     pub frames: u64,
     /// \[ns\] mean time per frame.
     pub mean_ns: f64,
@@ -101,10 +102,10 @@ impl fmt::Display for RunReport {
                 r.stats.missing_total()
             )?;
         }
-        if let Some(c) = &self.direct_publish {
+        if let Some(c) = &self.handoff {
             write!(
                 f,
-                " direct_publish_us mean={:.1} max={:.1} slow_over_100us={}",
+                " handoff_us mean={:.1} max={:.1} slow_over_100us={}",
                 c.mean_ns * 1e-3,
                 c.max_ns as f64 * 1e-3,
                 c.slow_frames
@@ -155,13 +156,13 @@ impl RunReport {
             commands_dropped: load(&shared.commands_dropped),
             wall_s,
             recording,
-            direct_publish: {
-                let n = load(&shared.direct_publishes);
+            handoff: {
+                let n = load(&shared.handoffs);
                 (n > 0).then(|| PublishCost {
                     frames: n,
-                    mean_ns: load(&shared.direct_publish_ns_total) as f64 / n as f64,
-                    max_ns: load(&shared.direct_publish_ns_max),
-                    slow_frames: load(&shared.direct_publishes_slow),
+                    mean_ns: load(&shared.handoff_ns_total) as f64 / n as f64,
+                    max_ns: load(&shared.handoff_ns_max),
+                    slow_frames: load(&shared.handoffs_slow),
                 })
             },
             physics_thread: None,
@@ -182,7 +183,7 @@ impl RunReport {
             commands_dropped: 0,
             wall_s: 0.0,
             recording: None,
-            direct_publish: None,
+            handoff: None,
             physics_thread: None,
         }
     }

@@ -47,10 +47,14 @@ impl OverrunPolicy {
 /// Which thread publishes a frame's telemetry (`server.handoff`, see [`super::publish`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Handoff {
-    /// `auto` (default): `direct`, except in real time with `--record`, where `thread`: the
-    /// benchmark (`tools/benches/realtime.rs`) showed the recorder's threads making the physics
-    /// thread's own puts slow (about 100 puts over 100 µs per 30 000 frames instead of about
-    /// 20) and doubling the overruns, and recording must never slow the physics thread.
+    /// `auto` (default): `direct`, except in real time with `--record` or under SCHED_FIFO
+    /// (`realtime_priority` > 0), where `thread`. With `--record`: the benchmark
+    /// (`tools/benches/realtime.rs`) showed the recorder's threads making the physics thread's
+    /// own puts slow (about 100 puts over 100 µs per 30 000 frames instead of about 20) and
+    /// doubling the overruns, and recording must never slow the physics thread. Under
+    /// SCHED_FIFO: a put takes Zenoh's locks, which Zenoh threads of normal priority also take,
+    /// so the physics thread could wait for one of them (priority inversion); the `thread`
+    /// handoff takes no lock at all (see `physics`).
     #[default]
     Auto,
     /// `direct`: the thread that finishes the frame publishes it: the physics thread at the
@@ -74,11 +78,11 @@ impl Handoff {
     }
 
     /// Whether frames are published directly (not by the telemetry thread) in `mode`, with or
-    /// without a recording.
-    pub fn is_direct(self, mode: Mode, recording: bool) -> bool {
+    /// without a recording, with or without the physics thread under SCHED_FIFO (`fifo`).
+    pub fn is_direct(self, mode: Mode, recording: bool, fifo: bool) -> bool {
         match self {
             _ if mode == Mode::Batch => false,
-            Handoff::Auto => !(mode == Mode::RealTime && recording),
+            Handoff::Auto => !(mode == Mode::RealTime && (recording || fifo)),
             Handoff::Direct => true,
             Handoff::Thread => false,
         }
@@ -673,17 +677,24 @@ mod tests {
             "server.handoff: unknown handoff \"inline\" (expected \"auto\", \"direct\" or \"thread\")"
         );
         use Mode::{Batch, Lockstep, RealTime};
-        // (handoff, mode, recording) -> direct?
-        for (h, mode, rec, want) in [
-            (Handoff::Auto, RealTime, false, true),
-            (Handoff::Auto, RealTime, true, false),
-            (Handoff::Auto, Lockstep, true, true),
-            (Handoff::Auto, Batch, false, false),
-            (Handoff::Direct, RealTime, true, true),
-            (Handoff::Direct, Batch, false, false),
-            (Handoff::Thread, Lockstep, false, false),
+        // (handoff, mode, recording, SCHED_FIFO) -> direct?
+        for (h, mode, rec, fifo, want) in [
+            (Handoff::Auto, RealTime, false, false, true),
+            (Handoff::Auto, RealTime, true, false, false),
+            (Handoff::Auto, RealTime, false, true, false),
+            (Handoff::Auto, Lockstep, true, false, true),
+            (Handoff::Auto, Lockstep, false, true, true),
+            (Handoff::Auto, Batch, false, false, false),
+            (Handoff::Direct, RealTime, true, false, true),
+            (Handoff::Direct, RealTime, false, true, true),
+            (Handoff::Direct, Batch, false, false, false),
+            (Handoff::Thread, Lockstep, false, false, false),
         ] {
-            assert_eq!(h.is_direct(mode, rec), want, "{h:?} {mode:?} record={rec}");
+            assert_eq!(
+                h.is_direct(mode, rec, fifo),
+                want,
+                "{h:?} {mode:?} record={rec} fifo={fifo}"
+            );
         }
         let s = ServerSettings::from_table(&table(
             "participants = [1, 2]\nparticipant_subjects = { \"1\" = \"fsw\", \"2\" = \"gnc\" }",
