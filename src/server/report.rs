@@ -50,6 +50,9 @@ pub struct RunReport {
     /// Real time: what handing each frame off cost the physics thread (with
     /// `handoff = "direct"` the put; either way the channel and the telemetry thread's wake-up).
     pub handoff: Option<PublishCost>,
+    /// Real time: the lateness of every published frame \[ns\] (an hdrhistogram, 3
+    /// significant digits), for percentiles beyond [`Self::timing`]'s.
+    pub lateness: Option<Histogram<u64>>,
     /// Real time: the physics thread's page faults and context switches from its first frame
     /// to its last (`lock_memory` makes the page faults 0).
     pub physics_thread: Option<ThreadUsage>,
@@ -166,6 +169,7 @@ impl RunReport {
                 })
             },
             physics_thread: None,
+            lateness: (mode == Mode::RealTime).then(|| lateness.clone()),
         }
     }
 
@@ -185,6 +189,7 @@ impl RunReport {
             recording: None,
             handoff: None,
             physics_thread: None,
+            lateness: None,
         }
     }
 }

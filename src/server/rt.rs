@@ -95,10 +95,22 @@ fn set_cpus(cpus: impl IntoIterator<Item = usize>) -> Result<(), String> {
         .map_err(|e| format!("sched_setaffinity failed: {e}"))
 }
 
-/// Checks that `cpu` can be given to the physics thread alone: it is in the calling thread's
-/// allowed set and is not the only CPU there (the other threads need one).
+/// The CPUs the process could use before [`keep_off_cpu`] first moved a thread off one (the
+/// calling thread's allowed set if it never did).
+static PROCESS_CPUS: std::sync::OnceLock<Vec<usize>> = std::sync::OnceLock::new();
+
+fn process_cpus() -> Result<Vec<usize>, String> {
+    match PROCESS_CPUS.get() {
+        Some(cpus) => Ok(cpus.clone()),
+        None => allowed_cpus(),
+    }
+}
+
+/// Checks that `cpu` can be given to the physics thread alone: it is one of the process's
+/// CPUs (before any thread was kept off it) and is not the only one (the other threads need
+/// one).
 pub fn check_physics_cpu(cpu: usize) -> Result<(), String> {
-    let allowed = allowed_cpus()?;
+    let allowed = process_cpus()?;
     if !allowed.contains(&cpu) {
         return Err(format!(
             "CPU {cpu} is not one this process may run on (allowed: {allowed:?})"
@@ -117,8 +129,9 @@ pub fn check_physics_cpu(cpu: usize) -> Result<(), String> {
 /// (`flexdyn run` does), it keeps every I/O thread off the physics thread's CPU.
 pub fn keep_off_cpu(cpu: usize) -> Result<(), String> {
     check_physics_cpu(cpu)?;
-    let rest: Vec<usize> = allowed_cpus()?.into_iter().filter(|&c| c != cpu).collect();
-    set_cpus(rest)
+    let all = process_cpus()?;
+    let _ = PROCESS_CPUS.set(all.clone());
+    set_cpus(all.into_iter().filter(|&c| c != cpu))
 }
 
 /// Pins the calling thread to `cpu` alone.
