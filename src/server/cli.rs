@@ -65,9 +65,23 @@ pub struct RunArgs {
     /// Real time: spin this many µs before each deadline instead of sleeping [default: 200].
     #[arg(long, value_name = "US", allow_negative_numbers = true)]
     pub spin_us: Option<i64>,
-    /// Real time: SCHED_FIFO priority 1–99 for the physics thread, 0 = normal [default: 0].
+    /// Real time: SCHED_FIFO priority 1–99 for the physics thread, 0 = normal; needs
+    /// CAP_SYS_NICE or `ulimit -r`, else the run does not start [default: 0].
     #[arg(long, value_name = "P", allow_negative_numbers = true)]
     pub realtime_priority: Option<i64>,
+    /// Real time: lock the process's memory (mlockall) and pre-fault the physics thread's
+    /// stack; needs CAP_IPC_LOCK or `ulimit -l` above the process size, else the run does not
+    /// start [default: false].
+    #[arg(long, value_name = "BOOL", num_args = 0..=1, default_missing_value = "true")]
+    pub lock_memory: Option<bool>,
+    /// Real time: run the physics thread alone on this CPU and every other thread on the
+    /// others; -1 = no pinning [default: -1].
+    #[arg(long, value_name = "CPU", allow_negative_numbers = true)]
+    pub physics_cpu: Option<i64>,
+    /// Real time: hold /dev/cpu_dma_latency at 0 µs while running (no deep CPU idle states);
+    /// needs write access to the device, else the run does not start [default: false].
+    #[arg(long, value_name = "BOOL", num_args = 0..=1, default_missing_value = "true")]
+    pub cpu_dma_latency: Option<bool>,
     /// Preallocated telemetry buffers [default: 64].
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub telemetry_buffers: Option<i64>,
@@ -110,7 +124,8 @@ impl RunArgs {
                     .collect(),
             )
         });
-        let pairs: [(&'static str, Option<Value>); 19] = [
+        let b = |v: &Option<bool>| v.map(Value::Bool);
+        let pairs: [(&'static str, Option<Value>); 22] = [
             ("mode", s(&self.mode)),
             ("sc_id", s(&self.sc_id)),
             ("spacecraft_id", i(&self.spacecraft_id)),
@@ -126,6 +141,9 @@ impl RunArgs {
             ("summary_interval_s", f(&self.summary_interval_s)),
             ("spin_us", i(&self.spin_us)),
             ("realtime_priority", i(&self.realtime_priority)),
+            ("lock_memory", b(&self.lock_memory)),
+            ("physics_cpu", i(&self.physics_cpu)),
+            ("cpu_dma_latency", b(&self.cpu_dma_latency)),
             ("telemetry_buffers", i(&self.telemetry_buffers)),
             ("command_queue", i(&self.command_queue)),
             ("handoff", s(&self.handoff)),
@@ -168,6 +186,14 @@ pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
     let settings = args.settings(&cfg)?;
     let zcfg = zenoh_config(&args.zenoh, Role::Server)?;
     super::access::check(&zcfg, &settings)?;
+    // Every thread started from here on (tokio's, Zenoh's, the server's) inherits this thread's
+    // CPU mask: off the physics thread's CPU.
+    if let (flexdyn_proto::Mode::RealTime, Some(cpu)) = (settings.mode, settings.physics_cpu) {
+        super::rt::keep_off_cpu(cpu).map_err(|problem| ServerError::Realtime {
+            setting: "server.physics_cpu",
+            problem,
+        })?;
+    }
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()

@@ -172,6 +172,15 @@ pub enum ServerError {
     /// `--record`: the recording could not be created or written.
     #[error(transparent)]
     Record(#[from] crate::sinks::mcap_file::RecordError),
+    /// A real-time setting the OS refused (`lock_memory`, `physics_cpu`, `cpu_dma_latency`,
+    /// `realtime_priority`): the run does not start without what it asked for.
+    #[error("{setting}: {problem}")]
+    Realtime {
+        /// The setting, `server.<key>`.
+        setting: &'static str,
+        /// What the OS refused and what the setting needs.
+        problem: String,
+    },
     /// A thread of the server could not be started or panicked.
     #[error("internal error: {0}")]
     Internal(String),

@@ -39,7 +39,7 @@
 //! boundary (`CongestionControl::Drop`) and the frame then goes the same way for the books; in
 //! lockstep the callback steps the [`lockstep::LockstepCore`] and publishes, and the telemetry
 //! thread only publishes StatusMsg. `auto` (default) is `direct` except in real time with
-//! `--record`. The per-frame work ([`physics::Stepper`]) never allocates, locks or touches the
+//! `--record` or under SCHED_FIFO. The per-frame work ([`physics::Stepper`]) never allocates, locks or touches the
 //! network; in real time the physics thread never blocks on the I/O side (a frame without a
 //! free buffer loses its telemetry, counted).
 
@@ -55,6 +55,7 @@ mod presence;
 pub mod publish;
 mod reject_log;
 mod report;
+pub mod rt;
 pub mod settings;
 mod setup;
 pub mod shared;
@@ -120,6 +121,9 @@ pub async fn run(
         &shared,
         record_tx.clone(),
     )?;
+    // Hard real time: after the buffers exist (mlockall faults them in), before the physics
+    // thread starts; undone when the run ends.
+    let _realtime = RealtimeHold::acquire(&settings)?;
 
     // zenoh rx: the command callback, into the physics thread's queue or the lockstep core.
     let commands = intake::declare(
@@ -140,7 +144,11 @@ pub async fn run(
 
     // The telemetry thread starts first, so StatusMsg (run_state = Starting) goes out while a
     // lockstep server waits for its participants.
-    let telemetry = spawn_telemetry(wiring.telemetry)?;
+    let (telemetry, telemetry_thread) = spawn_telemetry(wiring.telemetry)?;
+    let mut wiring_frames = wiring.frames;
+    if let Frames::Physics(physics, _) = &mut wiring_frames {
+        physics.wake = Some(telemetry_thread);
+    }
     if let Some(presence) = &presence {
         let ready = presence
             .wait(&state_pub, &settings, &topics, shutdown.as_mut())
@@ -152,7 +160,7 @@ pub async fn run(
             } else {
                 RunState::Failed
             });
-            drop(wiring.frames);
+            drop(wiring_frames);
             let _ = telemetry.await;
             drop(commands);
             finish_recording(recorder)?;
@@ -163,7 +171,7 @@ pub async fn run(
 
     // The physics thread (or the lockstep core) to the end, then the telemetry thread's.
     let started = Instant::now();
-    let physics = run_frames(wiring.frames, &settings, &shared, shutdown.as_mut()).await?;
+    let physics = run_frames(wiring_frames, &settings, &shared, shutdown.as_mut()).await?;
     let wall_s = started.elapsed().as_secs_f64();
     let tlm = telemetry
         .await
@@ -172,7 +180,9 @@ pub async fn run(
     // The report: commands stop arriving, the recorder writes what it holds and closes the file.
     drop(commands);
     let recording = finish_recording(recorder)?;
-    let report = RunReport::collect(mode, physics?, &shared, &tlm.lateness, wall_s, recording);
+    let (physics, physics_thread) = physics;
+    let mut report = RunReport::collect(mode, physics?, &shared, &tlm.lateness, wall_s, recording);
+    report.physics_thread = physics_thread;
     tracing::info!("{report}");
     Ok(report)
 }
@@ -246,7 +256,11 @@ impl Wiring {
     ) -> Result<Self, ServerError> {
         let mode = settings.mode;
         // Who publishes the frames (see `publish`): batch always the telemetry thread.
-        let direct = settings.handoff.is_direct(mode, settings.record.is_some());
+        let direct = settings.handoff.is_direct(
+            mode,
+            settings.record.is_some(),
+            settings.realtime_priority > 0,
+        );
         tracing::info!(
             handoff = if direct { "direct" } else { "thread" },
             "frames are published by {}",
@@ -326,6 +340,7 @@ impl Wiring {
                 full_tx,
                 shared: shared.clone(),
                 direct,
+                wake: None,
             };
             let frames = Frames::Physics(Box::new(physics), Box::new(stepper));
             (
@@ -357,15 +372,26 @@ impl Wiring {
 /// panicked).
 fn spawn_telemetry(
     telemetry: TelemetryCtx,
-) -> Result<oneshot::Receiver<TelemetryReport>, ServerError> {
+) -> Result<(oneshot::Receiver<TelemetryReport>, std::thread::Thread), ServerError> {
     let (done_tx, done_rx) = oneshot::channel();
-    std::thread::Builder::new()
+    let off_cpu = match telemetry.settings.mode {
+        Mode::RealTime => telemetry.settings.physics_cpu,
+        _ => None,
+    };
+    let handle = std::thread::Builder::new()
         .name("flexdyn-telemetry".into())
         .spawn(move || {
+            // Off the physics thread's CPU (checked before it starts), whatever thread
+            // started this one.
+            if let Some(cpu) = off_cpu {
+                if let Err(e) = rt::keep_off_cpu(cpu) {
+                    tracing::warn!(error = %e, "telemetry thread: cannot leave CPU {cpu}");
+                }
+            }
             let _ = done_tx.send(telemetry.run());
         })
         .map_err(|e| ServerError::Internal(format!("cannot start the telemetry thread: {e}")))?;
-    Ok(done_rx)
+    Ok((done_rx, handle.thread().clone()))
 }
 
 /// Steps the frames to the end (or a stop request): on the physics thread, or through the
@@ -375,7 +401,7 @@ async fn run_frames(
     settings: &ServerSettings,
     shared: &Arc<Shared>,
     shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
-) -> Result<Result<PhysicsReport, ServerError>, ServerError> {
+) -> Result<PhysicsOutcome, ServerError> {
     match frames {
         Frames::Physics(physics, stepper) => {
             run_physics_thread(*physics, *stepper, settings, shared, shutdown).await
@@ -387,7 +413,7 @@ async fn run_frames(
         } => {
             let r = run_lockstep_core(&core, &events, settings, shared, shutdown).await;
             drop(full_tx);
-            Ok(r)
+            Ok((r, None))
         }
     }
 }
@@ -402,6 +428,84 @@ fn finish_recording(
         .map_err(ServerError::from)
 }
 
+/// How the frames ended, and (real time) the physics thread's counters over them.
+type PhysicsOutcome = (Result<PhysicsReport, ServerError>, Option<rt::ThreadUsage>);
+
+/// The process-wide real-time requests of a real-time run ([`rt`]), held until the run ends.
+struct RealtimeHold {
+    locked: bool,
+    _dma: Option<rt::DmaLatency>,
+}
+
+impl RealtimeHold {
+    /// Checks `physics_cpu`, locks the memory and holds `/dev/cpu_dma_latency` as the settings
+    /// ask (real time only); an error names the setting the OS refused.
+    fn acquire(settings: &ServerSettings) -> Result<Self, ServerError> {
+        let mut hold = Self {
+            locked: false,
+            _dma: None,
+        };
+        if settings.mode != Mode::RealTime {
+            return Ok(hold);
+        }
+        let refused = |setting: &'static str| {
+            move |problem: String| ServerError::Realtime { setting, problem }
+        };
+        if let Some(cpu) = settings.physics_cpu {
+            rt::check_physics_cpu(cpu).map_err(refused("server.physics_cpu"))?;
+        }
+        if settings.cpu_dma_latency {
+            hold._dma = Some(rt::DmaLatency::hold().map_err(refused("server.cpu_dma_latency"))?);
+            tracing::info!("holding {} at 0 µs", rt::CPU_DMA_LATENCY);
+        }
+        if settings.lock_memory {
+            rt::lock_memory().map_err(refused("server.lock_memory"))?;
+            hold.locked = true;
+            tracing::info!("memory locked (mlockall MCL_CURRENT | MCL_FUTURE)");
+        }
+        Ok(hold)
+    }
+}
+
+impl Drop for RealtimeHold {
+    fn drop(&mut self) {
+        if self.locked {
+            rt::unlock_memory();
+        }
+    }
+}
+
+/// What the physics thread does before its first frame in real time: pre-fault its stack, pin
+/// itself to its CPU, go under SCHED_FIFO, as the settings ask. An error names the setting the
+/// OS refused.
+fn prepare_physics_thread(settings: &ServerSettings) -> Result<(), ServerError> {
+    if settings.mode != Mode::RealTime {
+        return Ok(());
+    }
+    if settings.lock_memory {
+        rt::prefault_stack();
+    }
+    if let Some(cpu) = settings.physics_cpu {
+        rt::pin_to_cpu(cpu).map_err(|problem| ServerError::Realtime {
+            setting: "server.physics_cpu",
+            problem,
+        })?;
+        tracing::info!(cpu, "physics thread pinned");
+    }
+    let p = settings.realtime_priority;
+    if p > 0 {
+        set_fifo_priority(p).map_err(|e| ServerError::Realtime {
+            setting: "server.realtime_priority",
+            problem: format!(
+                "cannot put the physics thread under SCHED_FIFO at priority {p}: {e} (needs \
+                 CAP_SYS_NICE, or an RLIMIT_RTPRIO (`ulimit -r`) of at least {p})"
+            ),
+        })?;
+        tracing::info!(priority = p, "physics thread runs under SCHED_FIFO");
+    }
+    Ok(())
+}
+
 /// Runs the physics thread to its end (or a stop request); `Err` only if it panicked.
 async fn run_physics_thread(
     physics: PhysicsCtx,
@@ -409,22 +513,16 @@ async fn run_physics_thread(
     settings: &ServerSettings,
     shared: &Arc<Shared>,
     mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
-) -> Result<Result<physics::PhysicsReport, ServerError>, ServerError> {
+) -> Result<PhysicsOutcome, ServerError> {
     let (phys_done_tx, mut phys_done_rx) = oneshot::channel();
-    let realtime_priority = (settings.mode == Mode::RealTime).then_some(settings.realtime_priority);
+    let thread_settings = settings.clone();
     std::thread::Builder::new()
         .name("flexdyn-physics".into())
+        .stack_size(rt::PHYSICS_STACK_BYTES)
         .spawn(move || {
-            if let Some(p) = realtime_priority.filter(|p| *p > 0) {
-                match set_fifo_priority(p) {
-                    Ok(()) => tracing::info!(priority = p, "physics thread runs under SCHED_FIFO"),
-                    Err(e) => tracing::warn!(
-                        priority = p,
-                        error = %e,
-                        "cannot put the physics thread under SCHED_FIFO (needs CAP_SYS_NICE); \
-                         running at normal priority"
-                    ),
-                }
+            if let Err(e) = prepare_physics_thread(&thread_settings) {
+                let _ = phys_done_tx.send((Err(e), None));
+                return;
             }
             let _ = phys_done_tx.send(physics.run(stepper));
         })

@@ -35,6 +35,7 @@ use super::commands::{CommandBook, Held, Offer};
 use super::error::ServerError;
 use super::pacing::{FrameEnd, Pacer};
 use super::publish::FramePublisher;
+use super::rt::ThreadUsage;
 use super::settings::ServerSettings;
 use super::shared::{fill_state, Frame, Shared};
 use crate::dynamics::Wrench;
@@ -85,6 +86,8 @@ pub struct PhysicsCtx {
     /// (`CongestionControl::Drop`: never waits for the network), then hand it to the telemetry
     /// thread for the books. `None`: the telemetry thread publishes.
     pub direct: Option<FramePublisher>,
+    /// The telemetry thread, woken after each frame handed to it (`None` until it starts).
+    pub wake: Option<std::thread::Thread>,
 }
 
 /// The per-frame work shared by the physics thread and the lockstep core
@@ -197,15 +200,20 @@ enum Wait {
 }
 
 impl PhysicsCtx {
-    /// Runs the loop over `w` to its end; sets the shared run state accordingly.
-    pub fn run(mut self, w: Stepper) -> Result<PhysicsReport, ServerError> {
-        let result = self.frame_loop(w);
+    /// Runs the loop over `w` to its end; sets the shared run state accordingly. In real time,
+    /// also this thread's page faults and context switches from the end of the first frame
+    /// (which warms what is lazily set up on first use, such as Zenoh's per-thread state) to
+    /// the end.
+    pub fn run(mut self, w: Stepper) -> (Result<PhysicsReport, ServerError>, Option<ThreadUsage>) {
+        let mut warm = None;
+        let result = self.frame_loop(w, &mut warm);
         self.shared.set_run_state(match &result {
             Ok(r) if r.ending == Ending::Finished => RunState::Finished,
             Ok(_) => RunState::Stopped,
             Err(_) => RunState::Failed,
         });
-        result
+        let usage = warm.map(|w: ThreadUsage| ThreadUsage::this_thread().since(&w));
+        (result, usage)
     }
 
     /// A free telemetry buffer: real time never waits (`None` = drop this frame's telemetry);
@@ -276,7 +284,11 @@ impl PhysicsCtx {
         Ok(Wait::Done)
     }
 
-    fn frame_loop(&mut self, mut w: Stepper) -> Result<PhysicsReport, ServerError> {
+    fn frame_loop(
+        &mut self,
+        mut w: Stepper,
+        warm: &mut Option<ThreadUsage>,
+    ) -> Result<PhysicsReport, ServerError> {
         let mode = self.settings.mode;
         let realtime = mode == Mode::RealTime;
         let frame_ns = w.sim.frame_ns();
@@ -329,17 +341,27 @@ impl PhysicsCtx {
             if let Some(mut f) = pending.take() {
                 f.boundary_unix_ns = stamp;
                 f.lateness_ns = lateness_ns;
+                // The handoff, timed (real time): the put itself with `direct`, and the
+                // channel and the telemetry thread's wake-up either way.
+                let t = Instant::now();
                 if let Some(p) = self.direct.as_mut() {
-                    let t = Instant::now();
                     p.publish(&f, &self.shared, None);
-                    self.shared.note_direct_publish(
-                        u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX),
-                    );
                     f.published = true;
                 }
-                // The full channel holds the whole pool, so this never blocks.
-                if self.full_tx.send(f).is_err() {
+                // The full channel holds the whole pool, so this never blocks; and since the
+                // telemetry thread never waits inside the channel (it parks instead, see
+                // `telemetry`), sending takes no lock: a compare-and-swap, then `unpark`
+                // (an atomic swap, and a FUTEX_WAKE only if that thread sleeps). Nothing here
+                // waits for a thread of lower priority.
+                if self.full_tx.try_send(f).is_err() {
                     return Err(ServerError::Internal("telemetry thread ended".into()));
+                }
+                if let Some(t) = &self.wake {
+                    t.unpark();
+                }
+                if realtime {
+                    self.shared
+                        .note_handoff(u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX));
                 }
             }
             if self.total_frames == Some(k) {
@@ -373,6 +395,12 @@ impl PhysicsCtx {
                 w.fill(f, k);
             }
             w.check_finite(k, pending.is_some())?;
+            if realtime && k == 1 {
+                // Once, off the measured frames: the counters' baseline (reads /proc twice,
+                // the first read warms the reading itself).
+                ThreadUsage::this_thread();
+                *warm = Some(ThreadUsage::this_thread());
+            }
             if realtime {
                 match pacer.end_frame(k) {
                     FrameEnd::OnTime => {}

@@ -7,6 +7,7 @@ use flexdyn_proto::{FrameTiming, Mode, RejectCounters};
 use hdrhistogram::Histogram;
 
 use super::physics::{Ending, PhysicsReport};
+use super::rt::ThreadUsage;
 use super::settings::mode_name;
 use super::shared::Shared;
 use super::telemetry::timing_of;
@@ -46,14 +47,21 @@ pub struct RunReport {
     pub wall_s: f64,
     /// `--record`: what the recording holds and what the recorder dropped.
     pub recording: Option<RecordReport>,
-    /// Real time with `handoff = "direct"`: what publishing cost the physics thread, per frame.
-    pub direct_publish: Option<PublishCost>,
+    /// Real time: what handing each frame off cost the physics thread (with
+    /// `handoff = "direct"` the put; either way the channel and the telemetry thread's wake-up).
+    pub handoff: Option<PublishCost>,
+    /// Real time: the lateness of every published frame \[ns\] (an hdrhistogram, 3
+    /// significant digits), for percentiles beyond [`Self::timing`]'s.
+    pub lateness: Option<Histogram<u64>>,
+    /// Real time: the physics thread's page faults and context switches from its first frame
+    /// to its last (`lock_memory` makes the page faults 0).
+    pub physics_thread: Option<ThreadUsage>,
 }
 
-/// The time the physics thread spent publishing frames (real time, `handoff = "direct"`).
+/// The time the physics thread spent handing frames off (real time).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PublishCost {
-    /// Frames published from the physics thread.
+    /// Frames handed off by the physics thread.
     pub frames: u64,
     /// \[ns\] mean time per frame.
     pub mean_ns: f64,
@@ -97,13 +105,22 @@ impl fmt::Display for RunReport {
                 r.stats.missing_total()
             )?;
         }
-        if let Some(c) = &self.direct_publish {
+        if let Some(c) = &self.handoff {
             write!(
                 f,
-                " direct_publish_us mean={:.1} max={:.1} slow_over_100us={}",
+                " handoff_us mean={:.1} max={:.1} slow_over_100us={}",
                 c.mean_ns * 1e-3,
                 c.max_ns as f64 * 1e-3,
                 c.slow_frames
+            )?;
+        }
+        if let Some(u) = &self.physics_thread {
+            write!(
+                f,
+                " physics_thread page_faults={} voluntary_switches={} involuntary_switches={}",
+                u.page_faults(),
+                u.voluntary_switches,
+                u.involuntary_switches
             )?;
         }
         Ok(())
@@ -142,15 +159,17 @@ impl RunReport {
             commands_dropped: load(&shared.commands_dropped),
             wall_s,
             recording,
-            direct_publish: {
-                let n = load(&shared.direct_publishes);
+            handoff: {
+                let n = load(&shared.handoffs);
                 (n > 0).then(|| PublishCost {
                     frames: n,
-                    mean_ns: load(&shared.direct_publish_ns_total) as f64 / n as f64,
-                    max_ns: load(&shared.direct_publish_ns_max),
-                    slow_frames: load(&shared.direct_publishes_slow),
+                    mean_ns: load(&shared.handoff_ns_total) as f64 / n as f64,
+                    max_ns: load(&shared.handoff_ns_max),
+                    slow_frames: load(&shared.handoffs_slow),
                 })
             },
+            physics_thread: None,
+            lateness: (mode == Mode::RealTime).then(|| lateness.clone()),
         }
     }
 
@@ -168,7 +187,9 @@ impl RunReport {
             commands_dropped: 0,
             wall_s: 0.0,
             recording: None,
-            direct_publish: None,
+            handoff: None,
+            physics_thread: None,
+            lateness: None,
         }
     }
 }

@@ -47,10 +47,14 @@ impl OverrunPolicy {
 /// Which thread publishes a frame's telemetry (`server.handoff`, see [`super::publish`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Handoff {
-    /// `auto` (default): `direct`, except in real time with `--record`, where `thread`: the
-    /// benchmark (`tools/benches/realtime.rs`) showed the recorder's threads making the physics
-    /// thread's own puts slow (about 100 puts over 100 µs per 30 000 frames instead of about
-    /// 20) and doubling the overruns, and recording must never slow the physics thread.
+    /// `auto` (default): `direct`, except in real time with `--record` or under SCHED_FIFO
+    /// (`realtime_priority` > 0), where `thread`. With `--record`: the benchmark
+    /// (`tools/benches/realtime.rs`) showed the recorder's threads making the physics thread's
+    /// own puts slow (about 100 puts over 100 µs per 30 000 frames instead of about 20) and
+    /// doubling the overruns, and recording must never slow the physics thread. Under
+    /// SCHED_FIFO: a put takes Zenoh's locks, which Zenoh threads of normal priority also take,
+    /// so the physics thread could wait for one of them (priority inversion); the `thread`
+    /// handoff takes no lock at all (see `physics`).
     #[default]
     Auto,
     /// `direct`: the thread that finishes the frame publishes it: the physics thread at the
@@ -74,11 +78,11 @@ impl Handoff {
     }
 
     /// Whether frames are published directly (not by the telemetry thread) in `mode`, with or
-    /// without a recording.
-    pub fn is_direct(self, mode: Mode, recording: bool) -> bool {
+    /// without a recording, with or without the physics thread under SCHED_FIFO (`fifo`).
+    pub fn is_direct(self, mode: Mode, recording: bool, fifo: bool) -> bool {
         match self {
             _ if mode == Mode::Batch => false,
-            Handoff::Auto => !(mode == Mode::RealTime && recording),
+            Handoff::Auto => !(mode == Mode::RealTime && (recording || fifo)),
             Handoff::Direct => true,
             Handoff::Thread => false,
         }
@@ -113,6 +117,9 @@ pub const KEYS: &[&str] = &[
     "summary_interval_s",
     "spin_us",
     "realtime_priority",
+    "lock_memory",
+    "physics_cpu",
+    "cpu_dma_latency",
     "telemetry_buffers",
     "command_queue",
     "handoff",
@@ -152,9 +159,19 @@ pub struct ServerSettings {
     /// Real time: the loop sleeps until this long before a deadline, then spins (default 200 µs).
     pub spin: Duration,
     /// Real time: SCHED_FIFO priority 1–99 for the physics thread, 0 = the normal scheduler
-    /// (default 0). Needs CAP_SYS_NICE (or root); if the OS refuses, the server logs a warning
-    /// and runs at normal priority.
+    /// (default 0). Needs CAP_SYS_NICE (or root); if the OS refuses, the run stops with an
+    /// error ([`super::rt`]).
     pub realtime_priority: u8,
+    /// Real time: lock the process's memory (`mlockall`) and pre-fault the physics thread's
+    /// stack, so the frame loop takes no page fault (default off; needs CAP_IPC_LOCK or a
+    /// large enough RLIMIT_MEMLOCK).
+    pub lock_memory: bool,
+    /// Real time: the CPU the physics thread runs on alone; every other thread of the server
+    /// runs on the remaining CPUs (default `None`: no pinning).
+    pub physics_cpu: Option<usize>,
+    /// Real time: hold `/dev/cpu_dma_latency` open with 0 while running, keeping the CPUs out
+    /// of deep idle states (default off; needs write access to the device).
+    pub cpu_dma_latency: bool,
     /// Preallocated telemetry buffers between the physics and the I/O threads (default 64:
     /// 64 ms at 1 kHz of a telemetry thread not scheduled before a frame's telemetry is dropped).
     pub telemetry_buffers: usize,
@@ -191,6 +208,9 @@ impl Default for ServerSettings {
             summary_interval: Duration::from_secs(10),
             spin: Duration::from_micros(200),
             realtime_priority: 0,
+            lock_memory: false,
+            physics_cpu: None,
+            cpu_dma_latency: false,
             telemetry_buffers: 64,
             command_queue: 1024,
             handoff: Handoff::Auto,
@@ -232,6 +252,8 @@ pub enum Value {
     Ints(Vec<i64>),
     /// A table of strings (`{ "1" = "fsw" }`; on the command line `1=fsw,2=gnc`).
     Strings(Vec<(String, String)>),
+    /// A boolean.
+    Bool(bool),
 }
 
 impl Value {
@@ -242,6 +264,7 @@ impl Value {
             Value::Float(f) => format!("float {f}"),
             Value::Ints(v) => format!("list {v:?}"),
             Value::Strings(v) => format!("table {v:?}"),
+            Value::Bool(b) => format!("boolean {b}"),
         }
     }
 
@@ -251,6 +274,7 @@ impl Value {
             toml::Value::String(s) => Value::Str(s.clone()),
             toml::Value::Integer(i) => Value::Int(*i),
             toml::Value::Float(f) => Value::Float(*f),
+            toml::Value::Boolean(b) => Value::Bool(*b),
             toml::Value::Array(a) => Value::Ints(
                 a.iter()
                     .map(|x| x.as_integer())
@@ -287,6 +311,13 @@ impl Setter<'_> {
         match self.value {
             Value::Str(s) => Ok(s),
             _ => Err(self.expected("a string")),
+        }
+    }
+
+    fn boolean(&self) -> Result<bool, SettingsError> {
+        match self.value {
+            Value::Bool(b) => Ok(*b),
+            _ => Err(self.expected("true or false")),
         }
     }
 
@@ -470,6 +501,12 @@ impl ServerSettings {
             "summary_interval_s" => self.summary_interval = set.seconds()?,
             "spin_us" => self.spin = Duration::from_micros(set.int_in(0, 1_000_000)? as u64),
             "realtime_priority" => self.realtime_priority = set.int_in(0, 99)? as u8,
+            "lock_memory" => self.lock_memory = set.boolean()?,
+            // -1: no pinning (so the command line can undo the file's choice).
+            "physics_cpu" => {
+                self.physics_cpu = usize::try_from(set.int_in(-1, 4095)?).ok();
+            }
+            "cpu_dma_latency" => self.cpu_dma_latency = set.boolean()?,
             "telemetry_buffers" => self.telemetry_buffers = set.int_in(2, 1 << 16)? as usize,
             "command_queue" => self.command_queue = set.int_in(1, 1 << 20)? as usize,
             "handoff" => {
@@ -590,8 +627,9 @@ impl ServerSettings {
             "mode={} sc_id={} spacecraft_id={} participants={:?} participant_timeout_s={} \
              presence_timeout_s={} duration_s={} overrun_policy={} overrun_limit={} \
              stale_after_s={} stale_policy={} status_hz={} summary_interval_s={} spin_us={} \
-             realtime_priority={} telemetry_buffers={} command_queue={} handoff={} \
-             participant_subjects={:?} record={}",
+             realtime_priority={} lock_memory={} physics_cpu={} cpu_dma_latency={} \
+             telemetry_buffers={} command_queue={} handoff={} participant_subjects={:?} \
+             record={}",
             mode_name(self.mode),
             self.sc_id,
             self.spacecraft_id,
@@ -609,6 +647,10 @@ impl ServerSettings {
             self.summary_interval.as_secs_f64(),
             self.spin.as_micros(),
             self.realtime_priority,
+            self.lock_memory,
+            self.physics_cpu
+                .map_or("none".to_owned(), |c| c.to_string()),
+            self.cpu_dma_latency,
             self.telemetry_buffers,
             self.command_queue,
             self.handoff.as_str(),
@@ -635,17 +677,24 @@ mod tests {
             "server.handoff: unknown handoff \"inline\" (expected \"auto\", \"direct\" or \"thread\")"
         );
         use Mode::{Batch, Lockstep, RealTime};
-        // (handoff, mode, recording) -> direct?
-        for (h, mode, rec, want) in [
-            (Handoff::Auto, RealTime, false, true),
-            (Handoff::Auto, RealTime, true, false),
-            (Handoff::Auto, Lockstep, true, true),
-            (Handoff::Auto, Batch, false, false),
-            (Handoff::Direct, RealTime, true, true),
-            (Handoff::Direct, Batch, false, false),
-            (Handoff::Thread, Lockstep, false, false),
+        // (handoff, mode, recording, SCHED_FIFO) -> direct?
+        for (h, mode, rec, fifo, want) in [
+            (Handoff::Auto, RealTime, false, false, true),
+            (Handoff::Auto, RealTime, true, false, false),
+            (Handoff::Auto, RealTime, false, true, false),
+            (Handoff::Auto, Lockstep, true, false, true),
+            (Handoff::Auto, Lockstep, false, true, true),
+            (Handoff::Auto, Batch, false, false, false),
+            (Handoff::Direct, RealTime, true, false, true),
+            (Handoff::Direct, RealTime, false, true, true),
+            (Handoff::Direct, Batch, false, false, false),
+            (Handoff::Thread, Lockstep, false, false, false),
         ] {
-            assert_eq!(h.is_direct(mode, rec), want, "{h:?} {mode:?} record={rec}");
+            assert_eq!(
+                h.is_direct(mode, rec, fifo),
+                want,
+                "{h:?} {mode:?} record={rec} fifo={fifo}"
+            );
         }
         let s = ServerSettings::from_table(&table(
             "participants = [1, 2]\nparticipant_subjects = { \"1\" = \"fsw\", \"2\" = \"gnc\" }",
@@ -714,6 +763,9 @@ mod tests {
             status_hz = 20
             summary_interval_s = 1
             spin_us = 50
+            lock_memory = true
+            physics_cpu = 1
+            cpu_dma_latency = true
             telemetry_buffers = 4
             command_queue = 16
             "#,
@@ -733,6 +785,9 @@ mod tests {
         assert_eq!(s.status_hz, 20.0);
         assert_eq!(s.summary_interval, Duration::from_secs(1));
         assert_eq!(s.spin, Duration::from_micros(50));
+        assert!(s.lock_memory);
+        assert_eq!(s.physics_cpu, Some(1));
+        assert!(s.cpu_dma_latency);
         assert_eq!(s.telemetry_buffers, 4);
         assert_eq!(s.command_queue, 16);
         assert_eq!(s.duration_frames(10_000_000).unwrap(), Some(1200));
@@ -774,6 +829,18 @@ mod tests {
             (
                 "realtime_priority = 100",
                 "server.realtime_priority: must be in 0..=99",
+            ),
+            (
+                "lock_memory = 1",
+                "server.lock_memory: expected true or false, got integer 1",
+            ),
+            (
+                "physics_cpu = -2",
+                "server.physics_cpu: must be in -1..=4095",
+            ),
+            (
+                "cpu_dma_latency = \"yes\"",
+                "server.cpu_dma_latency: expected true or false",
             ),
             (
                 "telemetry_buffers = 1",

@@ -125,15 +125,16 @@ pub struct Shared {
     pub frames_skipped: AtomicU64,
     /// Real time: frames whose telemetry was dropped (no free buffer).
     pub telemetry_dropped: AtomicU64,
-    /// Real time, `handoff = "direct"`: frames published from the physics thread, and the
-    /// total and largest time those publications took there (ns).
-    pub direct_publishes: AtomicU64,
-    /// See [`Self::direct_publishes`].
-    pub direct_publish_ns_total: AtomicU64,
-    /// See [`Self::direct_publishes`].
-    pub direct_publish_ns_max: AtomicU64,
-    /// Direct publications that took longer than [`SLOW_PUBLISH_NS`].
-    pub direct_publishes_slow: AtomicU64,
+    /// Real time: frames the physics thread handed off, and the total and largest time the
+    /// handoff took there (ns): with `handoff = "direct"` the put, and either way the channel
+    /// to the telemetry thread and its wake-up.
+    pub handoffs: AtomicU64,
+    /// See [`Self::handoffs`].
+    pub handoff_ns_total: AtomicU64,
+    /// See [`Self::handoffs`].
+    pub handoff_ns_max: AtomicU64,
+    /// Handoffs that took longer than [`SLOW_PUBLISH_NS`].
+    pub handoffs_slow: AtomicU64,
     /// `stale_tick` rejections per participant (sender id, count), in ascending id order, so
     /// the telemetry thread can name the sender in its warning (the physics thread only counts).
     pub stale_by_participant: Vec<(u32, AtomicU64)>,
@@ -190,15 +191,14 @@ impl Shared {
         bump(&self.bad_effector_input);
     }
 
-    /// Notes how long a publication on the physics thread took.
-    pub fn note_direct_publish(&self, ns: u64) {
-        self.direct_publishes.fetch_add(1, Ordering::Relaxed);
+    /// Notes how long a handoff on the physics thread took.
+    pub fn note_handoff(&self, ns: u64) {
+        self.handoffs.fetch_add(1, Ordering::Relaxed);
         if ns > SLOW_PUBLISH_NS {
-            self.direct_publishes_slow.fetch_add(1, Ordering::Relaxed);
+            self.handoffs_slow.fetch_add(1, Ordering::Relaxed);
         }
-        self.direct_publish_ns_total
-            .fetch_add(ns, Ordering::Relaxed);
-        self.direct_publish_ns_max.fetch_max(ns, Ordering::Relaxed);
+        self.handoff_ns_total.fetch_add(ns, Ordering::Relaxed);
+        self.handoff_ns_max.fetch_max(ns, Ordering::Relaxed);
     }
 
     /// Count a command whose `sender_id` is not the one its key names.

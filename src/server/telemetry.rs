@@ -7,7 +7,7 @@
 //! frame publishes and records it, and this thread only publishes StatusMsg and the summaries.
 
 use std::sync::atomic::Ordering;
-use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TryRecvError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -22,6 +22,10 @@ use super::publish::{FramePublisher, Recording};
 use super::reject_log::RejectLog;
 use super::settings::{mode_name, ServerSettings};
 use super::shared::{Frame, Shared};
+
+/// Longest park between two looks at the frame channel: how soon the end of the frames (the
+/// physics side dropping its end, which wakes nobody) is noticed.
+const PARK_MAX: Duration = Duration::from_millis(20);
 
 /// Largest lateness the histogram resolves (larger values are clamped): 1 hour in ns.
 const LATENESS_MAX_NS: u64 = 3_600_000_000_000;
@@ -225,7 +229,19 @@ impl TelemetryCtx {
                 .saturating_duration_since(Instant::now());
             // Free the commands the physics thread is done with.
             while self.recycle_rx.try_recv().is_ok() {}
-            match self.full_rx.recv_timeout(wait) {
+            // Never waits inside the channel: parks, and the physics thread unparks it after
+            // each frame. A receiver waiting in the channel would make the physics thread's
+            // send take the channel's waker lock, which this thread (normal priority) holds
+            // while it registers; parked, it holds nothing the physics thread needs.
+            let next = match self.full_rx.try_recv() {
+                Ok(frame) => Ok(frame),
+                Err(TryRecvError::Empty) => {
+                    std::thread::park_timeout(wait.min(PARK_MAX));
+                    Err(RecvTimeoutError::Timeout)
+                }
+                Err(TryRecvError::Disconnected) => Err(RecvTimeoutError::Disconnected),
+            };
+            match next {
                 Ok(frame) => {
                     if realtime {
                         p.lateness

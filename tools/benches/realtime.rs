@@ -146,10 +146,10 @@ fn round(
     println!(
         "  controller: {fresh} frames with a fresh command, {flagged} flagged (no command yet or stale)"
     );
-    let (direct_mean, direct_max, direct_slow) = report.direct_publish.map_or((0.0, 0.0, 0), |c| {
+    let (direct_mean, direct_max, direct_slow) = report.handoff.map_or((0.0, 0.0, 0), |c| {
         (c.mean_ns * 1e-3, c.max_ns as f64 * 1e-3, c.slow_frames)
     });
-    if report.direct_publish.is_some() {
+    if report.handoff.is_some() {
         println!(
             "  publishing on the physics thread: mean {direct_mean:.1} us, max {direct_max:.1} us \
              per frame; {direct_slow} frames over 100 us"

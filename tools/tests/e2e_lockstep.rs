@@ -238,7 +238,7 @@ fn lockstep_converges_and_is_bit_identical_across_runs_and_pauses() {
     // The previous design (physics thread + telemetry thread) gives the same stream.
     assert!(ServerSettings::default()
         .handoff
-        .is_direct(Mode::Lockstep, false));
+        .is_direct(Mode::Lockstep, false, false));
     let d = lockstep_run_settings(
         ServerSettings {
             handoff: Handoff::Thread,
