@@ -21,8 +21,8 @@
 use bincode::config::{Configuration, Fixint, Limit, LittleEndian};
 
 use crate::{
-    CommandMsg, DecodeError, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg, WireMessage,
-    HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
+    CommandMsg, DecodeError, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
+    WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
 };
 
 /// The bincode configuration of the wire format.
@@ -111,6 +111,11 @@ pub fn decode_star_tracker(bytes: &[u8]) -> Result<StarTrackerMsg, DecodeError> 
 
 /// [`decode`] for [`CommandMsg`] (rejects non-finite torque/force).
 pub fn decode_command(bytes: &[u8]) -> Result<CommandMsg, DecodeError> {
+    decode(bytes)
+}
+
+/// [`decode`] for [`TimeMsg`].
+pub fn decode_time(bytes: &[u8]) -> Result<TimeMsg, DecodeError> {
     decode(bytes)
 }
 

@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use crate::{
     CommandKind, CommandMsg, DecodeError, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg,
+    TimeMsg,
 };
 
 /// Encoded [`Header`] size (bytes).
@@ -23,6 +24,10 @@ pub const EFFECTOR_INPUT_FIXED_LEN: usize = 12;
 pub const IMU_LEN: usize = 127;
 /// Encoded [`StarTrackerMsg`] size (bytes).
 pub const STAR_TRACKER_LEN: usize = 64;
+/// Encoded [`TimeMsg`] size (bytes).
+pub const TIME_LEN: usize = 122;
+/// Offset of the 8 CCSDS CUC octets in a [`TimeMsg`].
+pub const TIME_CUC_OFFSET: usize = 98;
 /// Offset of the u32 [`CommandKind`] tag in a [`CommandMsg`].
 pub const COMMAND_KIND_OFFSET: usize = 34;
 /// Encoded [`CommandMsg`] size with [`CommandKind::Wrench`] (bytes).
@@ -70,10 +75,11 @@ mod sealed {
     impl Sealed for super::CommandMsg {}
     impl Sealed for super::StatusMsg {}
     impl Sealed for super::StarTrackerMsg {}
+    impl Sealed for super::TimeMsg {}
 }
 
 /// A top-level message that can go on the wire. Implemented (only) by
-/// [`StateMsg`], [`ImuMsg`], [`StarTrackerMsg`], [`CommandMsg`] and [`StatusMsg`].
+/// [`StateMsg`], [`ImuMsg`], [`StarTrackerMsg`], [`TimeMsg`], [`CommandMsg`] and [`StatusMsg`].
 pub trait WireMessage: Serialize + DeserializeOwned + sealed::Sealed {
     /// Type name used in error messages.
     const NAME: &'static str;
@@ -119,6 +125,15 @@ impl WireMessage for StarTrackerMsg {
         len: STAR_TRACKER_LEN,
     };
     const MIN_LEN: usize = STAR_TRACKER_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+impl WireMessage for TimeMsg {
+    const NAME: &'static str = "TimeMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed { len: TIME_LEN };
+    const MIN_LEN: usize = TIME_LEN;
     fn header(&self) -> &Header {
         &self.header
     }

@@ -17,6 +17,7 @@
 //!
 //! | key | message | direction |
 //! |---|---|---|
+//! | `flexdyn/<sc-id>/tlm/time` | [`TimeMsg`] | server → flight code, every frame, first |
 //! | `flexdyn/<sc-id>/tlm/state` | [`StateMsg`] | server → flight code, every frame |
 //! | `flexdyn/<sc-id>/tlm/imu/<name>` | [`ImuMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/tlm/st/<name>` | [`StarTrackerMsg`] | server → flight code |
@@ -45,6 +46,7 @@
 //! | [`StateMsg`] | [`STATE_FIXED_LEN`] = 327 + per effector [`EFFECTOR_STATE_FIXED_LEN`] = 22 + 8 per value (count prefix at offset 319, effectors last) |
 //! | [`ImuMsg`] | [`IMU_LEN`] = 127 |
 //! | [`StarTrackerMsg`] | [`STAR_TRACKER_LEN`] = 64 |
+//! | [`TimeMsg`] | [`TIME_LEN`] = 122 |
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
 //! | [`StatusMsg`] | [`STATUS_LEN`] = 179 |
 //!
@@ -87,7 +89,7 @@ mod messages;
 
 pub use codec::{
     decode, decode_command, decode_header, decode_imu, decode_star_tracker, decode_state,
-    decode_status, encode, encode_into,
+    decode_status, decode_time, encode, encode_into,
 };
 pub use error::{DecodeError, KeyError};
 pub use keys::{
@@ -95,23 +97,26 @@ pub use keys::{
     participant_wildcard_key, star_tracker_key, star_tracker_wildcard_key, state_key, status_key,
     validate_imu_name, validate_sc_id, validate_star_tracker_name, Telemetry, Topics, CMD_PREFIX,
     IMU_PREFIX, KEY_ROOT, MAX_ID_LEN, PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX,
-    STATUS_SUFFIX,
+    STATUS_SUFFIX, TIME_SUFFIX,
 };
 pub use layout::{
     WireLayout, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
     COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN,
     HEADER_LEN, IMU_LEN, MAX_EFFECTORS, MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES, MAX_PANEL_PAIRS,
-    STAR_TRACKER_LEN, STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN,
+    STAR_TRACKER_LEN, STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET,
+    TIME_LEN,
 };
 pub use messages::{
     command_flags, effector_kind, magnetorquer_flags, saturation_flags, star_tracker_flags,
-    thruster_flags, wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved,
-    EffectorInput, EffectorState, FrameTiming, Header, ImuMsg, Mode, RejectCounters, RunState,
-    StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, NO_COMMAND,
+    thruster_flags, time_flags, wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus,
+    Conserved, EffectorInput, EffectorState, FrameTiming, Header, ImuMsg, Mode, RejectCounters,
+    RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime,
+    CUC_PFIELD_TAI_4_3, NO_COMMAND,
 };
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
 /// Version 3: generic effector states in [`StateMsg`], [`CommandKind::Actuators`],
 /// [`StarTrackerMsg`], [`RejectCounters::bad_effector_input`]. Version 4: one command key per
-/// sender (`flexdyn/<sc-id>/cmd/<sender_id>`) and [`RejectCounters::wrong_identity`].
-pub const PROTOCOL_VERSION: u16 = 4;
+/// sender (`flexdyn/<sc-id>/cmd/<sender_id>`) and [`RejectCounters::wrong_identity`]. Version 5:
+/// the time service [`TimeMsg`] on `flexdyn/<sc-id>/tlm/time` and [`RunState::Paused`].
+pub const PROTOCOL_VERSION: u16 = 5;
