@@ -83,6 +83,10 @@ pub struct RunArgs {
     /// (comma-separated) [default: none].
     #[arg(long, value_name = "ID=USER,...", value_delimiter = ',')]
     pub participant_subjects: Option<Vec<String>>,
+    /// Real time: simulated seconds per wall-clock second, e.g. 2 (twice as fast) or 0.5
+    /// [default: 1].
+    #[arg(long, value_name = "X", allow_negative_numbers = true)]
+    pub speed: Option<f64>,
     /// Record the server's output (state, sensors, status, commands received) to this MCAP
     /// file. Lockstep and batch record every sample; real time drops (and counts) what the
     /// recorder cannot keep up with rather than delay the frame.
@@ -110,7 +114,7 @@ impl RunArgs {
                     .collect(),
             )
         });
-        let pairs: [(&'static str, Option<Value>); 19] = [
+        let pairs: [(&'static str, Option<Value>); 20] = [
             ("mode", s(&self.mode)),
             ("sc_id", s(&self.sc_id)),
             ("spacecraft_id", i(&self.spacecraft_id)),
@@ -130,6 +134,7 @@ impl RunArgs {
             ("command_queue", i(&self.command_queue)),
             ("handoff", s(&self.handoff)),
             ("participant_subjects", subjects),
+            ("speed", f(&self.speed)),
         ];
         for (k, v) in pairs {
             if let Some(v) = v {
