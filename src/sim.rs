@@ -55,6 +55,8 @@ pub struct Simulation {
     /// The environment models (`[environment]` with an `[epoch]`), updated at their rate at
     /// step boundaries and handed to the spacecraft's dynamic effectors.
     environment: Option<EnvironmentModel>,
+    /// The `[epoch]` (t = 0), if the configuration has one: the time service's calendar.
+    epoch: Option<crate::environment::epoch::SimEpoch>,
 }
 
 impl Simulation {
@@ -66,6 +68,7 @@ impl Simulation {
         let environment = cfg.environment_model()?;
         let mut sim = Self {
             environment,
+            epoch: cfg.epoch.clone(),
             inputs: vec![0.0; sc.effector_input_len()],
             input_schedule: cfg.effector_input_schedule.clone(),
             input_cursor: 0,
@@ -344,6 +347,11 @@ impl Simulation {
             orb_ang_mom_n: c.orb_ang_mom_n.into(),
             rot_ang_mom_c_n: c.rot_ang_mom_c_n.into(),
         };
+    }
+
+    /// The `[epoch]` (the instant of t = 0), if configured.
+    pub fn epoch(&self) -> Option<&crate::environment::epoch::SimEpoch> {
+        self.epoch.as_ref()
     }
 
     /// The sensors, in publication order.

@@ -523,6 +523,7 @@ fn a_recording_under_load_reports_exactly_what_it_misses() {
         let seq = match s.key.as_str() {
             "flexdyn/sc1/tlm/state" => decode_state(&s.payload).unwrap().header.seq,
             "flexdyn/sc1/status" => flexdyn_proto::decode_status(&s.payload).unwrap().header.seq,
+            "flexdyn/sc1/tlm/time" => flexdyn_proto::decode_time(&s.payload).unwrap().header.seq,
             _ => continue,
         };
         if let Some(prev) = last.insert(&s.key, seq) {

@@ -240,7 +240,7 @@ fn bad_settings_exit_2_naming_the_setting() {
     let colour =
         format!("error: {file_s}: server.colour: unknown key (expected one of: mode, sc_id");
     let colour_at = format!("(line {colour_line}, column ");
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 10] = [
         // Binding participants to subjects: the shipped ACL reserves cmd/1 for `fsw`.
         (
             &[
@@ -290,6 +290,19 @@ fn bad_settings_exit_2_naming_the_setting() {
         (
             &["run", "--stale-after-s", "-1", listen[0], listen[1]],
             "error: --stale-after-s: must be > 0",
+        ),
+        // `--speed`: finite, > 0, and within 1/1000 … 1000 × real time.
+        (
+            &["run", "--speed", "0", listen[0], listen[1]],
+            "error: --speed: must be > 0 (got 0)",
+        ),
+        (
+            &["run", "--speed", "NaN", listen[0], listen[1]],
+            "error: --speed: must be finite (got nan)",
+        ),
+        (
+            &["run", "--speed", "5000", listen[0], listen[1]],
+            "error: --speed: must be in 0.001..=1000 (× real time; got 5000)",
         ),
     ];
     for (args, want) in cases {

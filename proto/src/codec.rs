@@ -22,7 +22,7 @@ use bincode::config::{Configuration, Fixint, Limit, LittleEndian};
 
 use crate::{
     CommandMsg, DecodeError, Header, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg,
-    WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
+    TimeMsg, WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
 };
 
 /// The bincode configuration of the wire format.
@@ -116,6 +116,11 @@ pub fn decode_magnetometer(bytes: &[u8]) -> Result<MagnetometerMsg, DecodeError>
 
 /// [`decode`] for [`CommandMsg`] (rejects non-finite torque/force).
 pub fn decode_command(bytes: &[u8]) -> Result<CommandMsg, DecodeError> {
+    decode(bytes)
+}
+
+/// [`decode`] for [`TimeMsg`].
+pub fn decode_time(bytes: &[u8]) -> Result<TimeMsg, DecodeError> {
     decode(bytes)
 }
 

@@ -9,6 +9,9 @@ use crate::KeyError;
 pub const KEY_ROOT: &str = "flexdyn";
 /// Suffix of the state topic.
 pub const STATE_SUFFIX: &str = "tlm/state";
+/// Suffix of the time-service topic ([`crate::TimeMsg`], one per frame, before the frame's
+/// sensor samples and state). Protocol version 5.
+pub const TIME_SUFFIX: &str = "tlm/time";
 /// Prefix of the IMU topics; the IMU name follows after a `/`.
 pub const IMU_PREFIX: &str = "tlm/imu";
 /// Prefix of the star-tracker topics; the tracker name follows after a `/`.
@@ -167,6 +170,8 @@ pub fn participant_wildcard_key(sc: &str) -> Result<String, KeyError> {
 pub enum Telemetry<'a> {
     /// `flexdyn/<sc>/tlm/state`: a [`crate::StateMsg`].
     State,
+    /// `flexdyn/<sc>/tlm/time`: a [`crate::TimeMsg`].
+    Time,
     /// `flexdyn/<sc>/tlm/imu/<name>`: an [`crate::ImuMsg`] of the IMU `name`.
     Imu(&'a str),
     /// `flexdyn/<sc>/tlm/st/<name>`: a [`crate::StarTrackerMsg`] of the tracker `name`.
@@ -224,6 +229,11 @@ impl Topics {
         &self.status
     }
 
+    /// `flexdyn/<sc>/tlm/time`
+    pub fn time(&self) -> String {
+        format!("{KEY_ROOT}/{}/{TIME_SUFFIX}", self.sc_id)
+    }
+
     /// `flexdyn/<sc>/tlm/imu/<name>`
     pub fn imu(&self, name: &str) -> Result<String, KeyError> {
         imu_key(&self.sc_id, name)
@@ -262,6 +272,9 @@ impl Topics {
             .strip_prefix('/')?;
         if rest == STATE_SUFFIX {
             return Some(Telemetry::State);
+        }
+        if rest == TIME_SUFFIX {
+            return Some(Telemetry::Time);
         }
         let named = |prefix: &str| {
             rest.strip_prefix(prefix)?
@@ -343,6 +356,9 @@ mod tests {
         assert_eq!(t.imu_wildcard(), "flexdyn/sc-1/tlm/imu/*");
         assert_eq!(t.telemetry_wildcard(), "flexdyn/sc-1/tlm/**");
         assert_eq!(t.telemetry(t.state()), Some(Telemetry::State));
+        assert_eq!(t.time(), "flexdyn/sc-1/tlm/time");
+        assert_eq!(t.telemetry(&t.time()), Some(Telemetry::Time));
+        assert_eq!(t.telemetry("flexdyn/sc-1/tlm/time/x"), None);
         assert_eq!(
             t.telemetry(&t.imu("hub").unwrap()),
             Some(Telemetry::Imu("hub"))

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use crate::{
     CommandKind, CommandMsg, DecodeError, Header, ImuMsg, MagnetometerMsg, StarTrackerMsg,
-    StateMsg, StatusMsg,
+    StateMsg, StatusMsg, TimeMsg,
 };
 
 /// Encoded [`Header`] size (bytes).
@@ -26,6 +26,10 @@ pub const IMU_LEN: usize = 127;
 pub const STAR_TRACKER_LEN: usize = 64;
 /// Encoded [`MagnetometerMsg`] size (bytes).
 pub const MAGNETOMETER_LEN: usize = 55;
+/// Encoded [`TimeMsg`] size (bytes).
+pub const TIME_LEN: usize = 122;
+/// Offset of the 8 CCSDS CUC octets in a [`TimeMsg`].
+pub const TIME_CUC_OFFSET: usize = 98;
 /// Offset of the u32 [`CommandKind`] tag in a [`CommandMsg`].
 pub const COMMAND_KIND_OFFSET: usize = 34;
 /// Encoded [`CommandMsg`] size with [`CommandKind::Wrench`] (bytes).
@@ -74,11 +78,12 @@ mod sealed {
     impl Sealed for super::StatusMsg {}
     impl Sealed for super::StarTrackerMsg {}
     impl Sealed for super::MagnetometerMsg {}
+    impl Sealed for super::TimeMsg {}
 }
 
 /// A top-level message that can go on the wire. Implemented (only) by
 /// [`StateMsg`], [`ImuMsg`], [`StarTrackerMsg`], the other sensor messages
-/// ([`MagnetometerMsg`]), [`CommandMsg`] and [`StatusMsg`].
+/// ([`MagnetometerMsg`]), [`TimeMsg`], [`CommandMsg`] and [`StatusMsg`].
 pub trait WireMessage: Serialize + DeserializeOwned + sealed::Sealed {
     /// Type name used in error messages.
     const NAME: &'static str;
@@ -135,6 +140,15 @@ impl WireMessage for MagnetometerMsg {
         len: MAGNETOMETER_LEN,
     };
     const MIN_LEN: usize = MAGNETOMETER_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+impl WireMessage for TimeMsg {
+    const NAME: &'static str = "TimeMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed { len: TIME_LEN };
+    const MIN_LEN: usize = TIME_LEN;
     fn header(&self) -> &Header {
         &self.header
     }

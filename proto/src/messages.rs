@@ -472,6 +472,10 @@ pub enum RunState {
     /// Tag 5: ended on a stop request (SIGINT/SIGTERM or the library's shutdown future),
     /// after the last frame was published. Added in protocol version 2.
     Stopped,
+    /// Tag 6: holding at a tick on an operator's request (pause in real time, the end of a
+    /// "run N ticks" in lockstep): no time advances and no frame is published until the
+    /// operator resumes. Added in protocol version 5.
+    Paused,
 }
 
 impl Mode {
@@ -496,6 +500,7 @@ impl RunState {
             3 => Some(Self::Finished),
             4 => Some(Self::Failed),
             5 => Some(Self::Stopped),
+            6 => Some(Self::Paused),
             _ => None,
         }
     }
@@ -638,4 +643,109 @@ pub struct StatusMsg {
     /// deterministic**: the only wall-clock field in the protocol; ignore it when
     /// comparing runs.
     pub wall_time_unix_ns: u64,
+}
+
+/// Bits of [`TimeMsg::flags`].
+pub mod time_flags {
+    /// Bit 0: the configuration has an `[epoch]`, so the calendar fields (TAI, UTC, ΔAT, GPS,
+    /// CUC, time at the tone in TAI) are set. Clear: every one of them is zero (the CUC
+    /// octets too, P-field included), and only the simulation-time fields carry time.
+    pub const EPOCH_VALID: u8 = 1 << 0;
+    /// Bit 1: the 1 Hz tone. Set on the first frame at or after a whole second of the tone
+    /// scale (TAI with an epoch, simulation time without): on tick `k` when
+    /// `floor(T(k) / 1 s) > floor(T(k−1) / 1 s)`, and on tick 0 when `T(0)` is a whole second.
+    /// `tone_*` then name that whole second.
+    pub const TONE: u8 = 1 << 1;
+    /// Bit 2: the instant lies inside an inserted leap second (UTC reads 23:59:60.x).
+    pub const LEAP_SECOND: u8 = 1 << 2;
+    /// Bits 3..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 = !(EPOCH_VALID | TONE | LEAP_SECOND);
+}
+
+/// CCSDS unsegmented time code (CUC, CCSDS 301.0-B-4 §3.2) P-field of [`TimeMsg::cuc_tai`]:
+/// `0 001 11 11` = no extension, time code identification `001` (Level 1: epoch
+/// 1958-01-01T00:00:00 TAI), 4 octets of coarse time (seconds), 3 octets of fine time
+/// (units of 2⁻²⁴ s).
+pub const CUC_PFIELD_TAI_4_3: u8 = 0x1F;
+
+/// A UTC calendar reading. 11 bytes on the wire. All zero when the run has no `[epoch]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct UtcTime {
+    /// Year (e.g. 2016).
+    pub year: u16,
+    /// Month 1..=12.
+    pub month: u8,
+    /// Day of month 1..=31.
+    pub day: u8,
+    /// Hour 0..=23.
+    pub hour: u8,
+    /// Minute 0..=59.
+    pub minute: u8,
+    /// Second 0..=60 (60 only inside an inserted leap second).
+    pub second: u8,
+    /// Nanoseconds into the second, 0..=999,999,999.
+    pub nanosecond: u32,
+}
+
+/// A time in the layout of cFE's `CFE_TIME_SysTime_t`: whole seconds and subseconds in units of
+/// 2⁻³² s (`subseconds = floor(ns · 2³² / 10⁹)`). 8 bytes on the wire (little-endian here; a
+/// cFS adapter copies the two u32 into its own struct).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct SysTime {
+    /// Whole seconds.
+    pub seconds: u32,
+    /// Fraction of a second in units of 2⁻³² s.
+    pub subseconds: u32,
+}
+
+/// The time service, topic `flexdyn/<sc-id>/tlm/time`: one per frame, published **before**
+/// that frame's sensor samples and state. 122 bytes. Added in protocol version 5.
+///
+/// Deterministic (no wall clock). Flight code that runs off it (a cFS tone adapter, an
+/// F Prime rate-group driver) follows the simulation: its speed, its pauses and its steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct TimeMsg {
+    /// Common header: `tick`, `sim_time_ns` (ns since the epoch, t = 0), and `seq` (= tick: one
+    /// time message per published frame, so a pause leaves no gap).
+    pub header: Header,
+    /// Life cycle: `Running`, or `Paused` on the tick the server holds at (nothing follows
+    /// until the operator resumes), `Stopping` on the last tick of a stop request.
+    pub run_state: RunState,
+    /// Pacing mode.
+    pub mode: Mode,
+    /// See [`time_flags`].
+    pub flags: u8,
+    /// \[ns\] the frame period (the one configuration value `simulation.frame_s`): tick `k` is
+    /// at `k · frame_ns`.
+    pub frame_ns: u64,
+    /// Real time: wall-clock pacing factor (`--speed`, 1.0 = real time, 2.0 = twice as fast).
+    /// Lockstep and batch are not paced by the wall clock: 0.0.
+    pub speed: f64,
+    /// \[ns\] TAI since 1958-01-01T00:00:00 TAI (the CCSDS Level 1 epoch); 0 without an epoch.
+    pub tai_ns_1958: u64,
+    /// UTC calendar reading (23:59:60.x inside a leap second); zero without an epoch.
+    pub utc: UtcTime,
+    /// \[s\] TAI − UTC, the leap-second count ΔAT (37 from 2017-01-01); 0 without an epoch.
+    pub tai_minus_utc_s: i32,
+    /// GPS week since 1980-01-06T00:00:00 UTC (full week number, not modulo 1024); 0 without
+    /// an epoch.
+    pub gps_week: u32,
+    /// \[ns\] GPS time of week (since Sunday 00:00:00 GPS time); 0 without an epoch.
+    pub gps_ns_of_week: u64,
+    /// \[ns\] mission elapsed time: time since the epoch (simulation time zero, when the
+    /// simulated vehicle's clock starts), equal to `header.sim_time_ns`.
+    pub met_ns: u64,
+    /// TAI of this tick as a CCSDS CUC: [`CUC_PFIELD_TAI_4_3`], 4 coarse octets (seconds since
+    /// 1958) and 3 fine octets (2⁻²⁴ s, truncated), **big-endian** as CCSDS transmits them.
+    /// All zero without an epoch.
+    pub cuc_tai: [u8; 8],
+    /// Mission elapsed time at the most recent tone (whole second of the tone scale ≤ this
+    /// tick), in cFE `CFE_TIME_SysTime_t` form: what `CFE_TIME_ExternalMET` takes.
+    pub tone_met: SysTime,
+    /// TAI since 1958 at the most recent tone, `CFE_TIME_SysTime_t` form (subseconds 0: the
+    /// tone is a whole TAI second); zero without an epoch.
+    pub tone_tai: SysTime,
 }

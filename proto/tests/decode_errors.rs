@@ -2,12 +2,12 @@
 
 use flexdyn_proto::{
     decode, decode_command, decode_header, decode_imu, decode_star_tracker, decode_state,
-    decode_status, effector_kind, encode, encode_into, CommandKind, CommandMsg, DecodeError,
-    EffectorInput, EffectorState, Header, ImuMsg, RejectCounters, StarTrackerMsg, StateMsg,
-    StatusMsg, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
+    decode_status, decode_time, effector_kind, encode, encode_into, CommandKind, CommandMsg,
+    DecodeError, EffectorInput, EffectorState, Header, ImuMsg, RejectCounters, StarTrackerMsg,
+    StateMsg, StatusMsg, TimeMsg, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
     COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, EFFECTOR_STATE_FIXED_LEN, HEADER_LEN, IMU_LEN,
     MAX_EFFECTORS, MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES, STAR_TRACKER_LEN,
-    STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN,
+    STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN, TIME_LEN,
 };
 
 fn wrench(t: [f64; 3], f: [f64; 3]) -> CommandMsg {
@@ -242,6 +242,27 @@ fn huge_counts_are_rejected_without_allocating() {
 
 #[test]
 fn malformed_enum_tags_and_bools() {
+    // TimeMsg: its run state and mode tags, and its fixed length.
+    let time = encode(&TimeMsg::default());
+    assert_eq!(time.len(), TIME_LEN);
+    for (offset, value) in [(30usize, 7u8), (34, 3)] {
+        let mut b = time.clone();
+        b[offset] = value;
+        assert!(
+            matches!(decode_time(&b), Err(DecodeError::Malformed(_))),
+            "time tag at {offset}"
+        );
+    }
+    assert!(matches!(
+        decode_time(&time[..TIME_LEN - 1]),
+        Err(DecodeError::Length { .. })
+    ));
+    let mut long = time.clone();
+    long.push(0);
+    assert!(matches!(
+        decode_time(&long),
+        Err(DecodeError::TrailingBytes { .. })
+    ));
     let mut b = encode(&wrench([0.0; 3], [0.0; 3]));
     b[COMMAND_KIND_OFFSET] = 3;
     assert!(matches!(decode_command(&b), Err(DecodeError::Malformed(_))));
@@ -254,7 +275,7 @@ fn malformed_enum_tags_and_bools() {
     ));
 
     let good = encode(&StatusMsg::default());
-    for (offset, value) in [(30usize, 3u8), (34, 6), (95, 2)] {
+    for (offset, value) in [(30usize, 3u8), (34, 7), (95, 2)] {
         let mut b = good.clone();
         b[offset] = value;
         assert!(

@@ -22,12 +22,13 @@
 
 use flexdyn_proto::{
     command_flags, decode, decode_header, effector_kind, encode, magnetometer_flags,
-    magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags, wheel_flags,
-    AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, EffectorInput, EffectorState,
-    FrameTiming, Header, ImuMsg, MagnetometerMsg, Mode, RejectCounters, RunState, StalePolicy,
-    StarTrackerMsg, StateMsg, StatusMsg, WireMessage, COMMAND_ACTUATORS_FIXED_LEN,
-    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN,
-    IMU_LEN, MAGNETOMETER_LEN, STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN,
+    magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags, time_flags,
+    wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, EffectorInput,
+    EffectorState, FrameTiming, Header, ImuMsg, MagnetometerMsg, Mode, RejectCounters, RunState,
+    StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime, WireMessage,
+    COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CUC_PFIELD_TAI_4_3,
+    EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, IMU_LEN, MAGNETOMETER_LEN,
+    STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
 };
 
 type Golden = &'static [(usize, &'static str, &'static str)];
@@ -619,6 +620,86 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
     (62, "00", "bool valid = false"),
     (63, "01", "u8 status_flags = 1 (SUN_EXCLUSION)"),
 ];
+/// A time message of a run with `[epoch] utc = "2016-12-31T23:59:59.5Z"` and an 8 Hz frame at
+/// `--speed 0.5`, paused at tick 6 (t = 0.75 s): 2016-12-31T23:59:60.25 UTC, inside the leap
+/// second, so TAI − UTC is still 36 s and TAI reads 2017-01-01T00:00:36.25 TAI = 21,550 days
+/// (1958-01-01 … 2017-01-01: 59 years, 15 leap days) + 36.25 s = 1,861,920,036.25 s since 1958.
+/// GPS time = TAI − 19 s − 8,040 days (1958-01-01 … 1980-01-06) = 1,167,264,017.25 s = week
+/// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
+/// TAI …036.0 s). `src/server/clock.rs` produces exactly this message from that epoch.
+const TIME_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0500", "u16 header.protocol_version = 5"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "0600000000000000", "u64 header.tick = 6"),
+    (
+        14,
+        "8017b42c00000000",
+        "u64 header.sim_time_ns = 750000000 (0x2CB41780)",
+    ),
+    (22, "0600000000000000", "u64 header.seq = 6"),
+    (30, "06000000", "u32 run_state = 6 (Paused)"),
+    (34, "00000000", "u32 mode = 0 (RealTime)"),
+    (38, "05", "u8 flags = 5 (EPOCH_VALID | LEAP_SECOND)"),
+    (
+        39,
+        "4059730700000000",
+        "u64 frame_ns = 125000000 (0x7735940)",
+    ),
+    (
+        47,
+        "000000000000e03f",
+        "f64 speed = 0.5 (bits 0x3FE0000000000000)",
+    ),
+    (
+        55,
+        "801add7868ded619",
+        "u64 tai_ns_1958 = 1861920036250000000 (0x19D6DE6878DD1A80)",
+    ),
+    (63, "e007", "u16 utc.year = 2016 (0x07E0)"),
+    (65, "0c", "u8 utc.month = 12"),
+    (66, "1f", "u8 utc.day = 31"),
+    (67, "17", "u8 utc.hour = 23"),
+    (68, "3b", "u8 utc.minute = 59"),
+    (69, "3c", "u8 utc.second = 60"),
+    (
+        70,
+        "80b2e60e",
+        "u32 utc.nanosecond = 250000000 (0x0EE6B280)",
+    ),
+    (74, "24000000", "i32 tai_minus_utc_s = 36"),
+    (78, "8a070000", "u32 gps_week = 1930 (0x078A)"),
+    (
+        82,
+        "801c2e0404000000",
+        "u64 gps_ns_of_week = 17250000000 (0x404_2E1C80)",
+    ),
+    (
+        90,
+        "8017b42c00000000",
+        "u64 met_ns = 750000000 (0x2CB41780)",
+    ),
+    (
+        98,
+        "1f6efaa524400000",
+        "[u8; 8] cuc_tai: P-field 0x1F, coarse 0x6EFAA524 (1861920036 s), fine 0x400000 (0.25 s · 2^24), big-endian",
+    ),
+    (106, "00000000", "u32 tone_met.seconds = 0"),
+    (
+        110,
+        "00000080",
+        "u32 tone_met.subseconds = 0x80000000 (0.5 s · 2^32)",
+    ),
+    (
+        114,
+        "24a5fa6e",
+        "u32 tone_tai.seconds = 1861920036 (0x6EFAA524)",
+    ),
+    (118, "00000000", "u32 tone_tai.subseconds = 0"),
+];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (0, "0500", "u16 header.protocol_version = 5"),
     (
@@ -830,6 +911,52 @@ fn star_tracker_golden() {
     assert_eq!(encode(&msg).len(), STAR_TRACKER_LEN);
 }
 
+/// The message [`TIME_GOLDEN`] describes.
+pub fn time_golden_msg() -> TimeMsg {
+    TimeMsg {
+        header: Header::new(SC, 6, 750_000_000, 6),
+        run_state: RunState::Paused,
+        mode: Mode::RealTime,
+        flags: time_flags::EPOCH_VALID | time_flags::LEAP_SECOND,
+        frame_ns: 125_000_000,
+        speed: 0.5,
+        tai_ns_1958: 1_861_920_036_250_000_000,
+        utc: UtcTime {
+            year: 2016,
+            month: 12,
+            day: 31,
+            hour: 23,
+            minute: 59,
+            second: 60,
+            nanosecond: 250_000_000,
+        },
+        tai_minus_utc_s: 36,
+        gps_week: 1930,
+        gps_ns_of_week: 17_250_000_000,
+        met_ns: 750_000_000,
+        cuc_tai: [CUC_PFIELD_TAI_4_3, 0x6E, 0xFA, 0xA5, 0x24, 0x40, 0x00, 0x00],
+        tone_met: SysTime {
+            seconds: 0,
+            subseconds: 0x8000_0000,
+        },
+        tone_tai: SysTime {
+            seconds: 1_861_920_036,
+            subseconds: 0,
+        },
+    }
+}
+
+#[test]
+fn time_golden() {
+    let msg = time_golden_msg();
+    check("TimeMsg", TIME_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), TIME_LEN);
+    assert_eq!(
+        &encode(&msg)[TIME_CUC_OFFSET..TIME_CUC_OFFSET + 8],
+        &msg.cuc_tai
+    );
+}
+
 #[test]
 fn magnetometer_golden() {
     let msg = MagnetometerMsg {
@@ -913,6 +1040,7 @@ fn enum_tags() {
         (RunState::Finished, 3),
         (RunState::Failed, 4),
         (RunState::Stopped, 5),
+        (RunState::Paused, 6),
     ] {
         assert_eq!(
             tag_at(&status(Mode::RealTime, r, StalePolicy::Hold), 34),
@@ -921,7 +1049,16 @@ fn enum_tags() {
         );
         assert_eq!((r.tag(), RunState::from_tag(t)), (t, Some(r)), "{r:?} tag");
     }
-    assert_eq!(RunState::from_tag(6), None);
+    assert_eq!(RunState::from_tag(7), None);
+    let time = |run_state, mode| {
+        encode(&TimeMsg {
+            run_state,
+            mode,
+            ..Default::default()
+        })
+    };
+    assert_eq!(tag_at(&time(RunState::Paused, Mode::Batch), 30), 6);
+    assert_eq!(tag_at(&time(RunState::Paused, Mode::Batch), 34), 2);
     for (p, t) in [(StalePolicy::Hold, 0), (StalePolicy::Zero, 1)] {
         assert_eq!(
             tag_at(&status(Mode::RealTime, RunState::Starting, p), 95),
@@ -950,6 +1087,12 @@ fn flag_bits() {
     assert_eq!(magnetometer_flags::AXIS_2, 0b010);
     assert_eq!(magnetometer_flags::AXIS_3, 0b100);
     assert_eq!(magnetometer_flags::RESERVED_MASK, 0b1111_1000);
+    assert_eq!(time_flags::EPOCH_VALID, 0b001);
+    assert_eq!(time_flags::TONE, 0b010);
+    assert_eq!(time_flags::LEAP_SECOND, 0b100);
+    assert_eq!(time_flags::RESERVED_MASK, 0b1111_1000);
+    // 0 001 11 11: no extension, TAI 1958 (Level 1), 4 coarse octets, 3 fine octets.
+    assert_eq!(CUC_PFIELD_TAI_4_3, 0b0001_1111);
     assert_eq!(wheel_flags::TORQUE_LIMITED, 0b01);
     assert_eq!(wheel_flags::SPEED_LIMITED, 0b10);
     assert_eq!(effector_kind::PANEL_PAIR, 1);
@@ -1002,6 +1145,7 @@ fn exported_golden_files_match_the_tables() {
             MAGNETOMETER_GOLDEN,
             "MAGNETOMETER_GOLDEN",
         ),
+        ("time", "TimeMsg", TIME_GOLDEN, "TIME_GOLDEN"),
     ];
     let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");
     let rows: Vec<Vec<&str>> = manifest

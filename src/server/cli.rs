@@ -97,6 +97,10 @@ pub struct RunArgs {
     /// (comma-separated) [default: none].
     #[arg(long, value_name = "ID=USER,...", value_delimiter = ',')]
     pub participant_subjects: Option<Vec<String>>,
+    /// Real time: simulated seconds per wall-clock second, e.g. 2 (twice as fast) or 0.5
+    /// [default: 1].
+    #[arg(long, value_name = "X", allow_negative_numbers = true)]
+    pub speed: Option<f64>,
     /// Record the server's output (state, sensors, status, commands received) to this MCAP
     /// file. Lockstep and batch record every sample; real time drops (and counts) what the
     /// recorder cannot keep up with rather than delay the frame.
@@ -125,7 +129,7 @@ impl RunArgs {
             )
         });
         let b = |v: &Option<bool>| v.map(Value::Bool);
-        let pairs: [(&'static str, Option<Value>); 22] = [
+        let pairs: [(&'static str, Option<Value>); 23] = [
             ("mode", s(&self.mode)),
             ("sc_id", s(&self.sc_id)),
             ("spacecraft_id", i(&self.spacecraft_id)),
@@ -148,6 +152,7 @@ impl RunArgs {
             ("command_queue", i(&self.command_queue)),
             ("handoff", s(&self.handoff)),
             ("participant_subjects", subjects),
+            ("speed", f(&self.speed)),
         ];
         for (k, v) in pairs {
             if let Some(v) = v {

@@ -45,6 +45,7 @@
 
 pub mod access;
 pub mod cli;
+pub mod clock;
 pub mod commands;
 pub mod error;
 mod intake;

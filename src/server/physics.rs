@@ -31,6 +31,7 @@ use crate::transport::unix_now_ns;
 use flexdyn_proto::{CommandMsg, Header, Mode, RunState, StateMsg};
 use nalgebra::Vector3;
 
+use super::clock::TimeService;
 use super::commands::{CommandBook, Held, Offer};
 use super::error::ServerError;
 use super::pacing::{FrameEnd, Pacer};
@@ -103,6 +104,8 @@ pub struct Stepper {
     /// The state record of the last tick filled or checked.
     state: StateMsg,
     spacecraft_id: u32,
+    /// The time message's per-run constants.
+    pub clock: TimeService,
 }
 
 impl Stepper {
@@ -119,7 +122,15 @@ impl Stepper {
         // Sensors are sampled at every frame where they are due, published or not (an IMU
         // closes its interval every frame).
         sim.sample_sensors(|s| s.due(0));
+        let clock = TimeService::new(
+            sim.epoch().cloned(),
+            settings.spacecraft_id,
+            sim.frame_ns(),
+            settings.mode,
+            settings.speed,
+        );
         Self {
+            clock,
             sim,
             book,
             held: Held::initial(settings.stale_policy),
@@ -133,6 +144,7 @@ impl Stepper {
         self.sim.state_into(&mut self.state);
         let header = Header::new(self.spacecraft_id, k, self.state.header.sim_time_ns, k);
         fill_state(&mut frame.state, &self.state, header, &self.held);
+        frame.time = self.clock.message(k, RunState::Running);
         frame.command = self.held.status;
         frame.lateness_ns = 0;
         frame.published = false;
@@ -312,9 +324,12 @@ impl PhysicsCtx {
             w.fill(f, 0);
         }
         // Real time: boundary 0 is due one frame from now, so the I/O side is settled.
+        // `--speed`: the wall-clock period of a frame (≥ 1 ns; `speed` is bounded by
+        // `SPEED_RANGE`).
+        let wall_period_ns = ((frame_ns as f64 / self.settings.speed).round() as u64).max(1);
         let mut pacer = Pacer::new(
-            Instant::now() + Duration::from_nanos(frame_ns),
-            frame_ns,
+            Instant::now() + Duration::from_nanos(wall_period_ns),
+            wall_period_ns,
             self.settings.spin,
             self.settings.overrun_policy,
             self.settings.overrun_limit,

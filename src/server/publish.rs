@@ -1,6 +1,6 @@
-//! Publishing one frame's telemetry: the messages of the sensors sampled at its tick (in
-//! publication order: [`crate::sensors::KINDS`], then config order), then its StateMsg, in that
-//! order (a controller that waits for the state finds the sensor
+//! Publishing one frame's telemetry: its TimeMsg, then the messages of the sensors sampled at
+//! its tick (in publication order: [`crate::sensors::KINDS`], then config order), then its
+//! StateMsg, in that order (a controller that waits for the state finds the sensor
 //! samples of the same tick already delivered).
 //!
 //! Which thread calls [`FramePublisher::publish`] is the `server.handoff` setting:
@@ -42,6 +42,7 @@ fn for_each_sensor_payload(frame: &Frame, mut each: impl FnMut(usize, &[u8])) {
 #[derive(Clone)]
 pub struct Recording {
     tx: RecordTx,
+    time: Arc<str>,
     state: Arc<str>,
     /// `flexdyn/<sc>/status`.
     pub status: Arc<str>,
@@ -55,6 +56,8 @@ impl Recording {
     /// state again for the file, in `buf`).
     pub fn record_frame(&self, frame: &Frame, buf: &mut Vec<u8>) {
         let stamp = Some(frame.boundary_unix_ns);
+        encode_into(&frame.time, buf);
+        self.submit(&self.time, buf, stamp);
         for_each_sensor_payload(frame, |i, payload| {
             if let Some(key) = self.sensors.get(i) {
                 self.submit(key, payload, stamp);
@@ -85,6 +88,9 @@ impl fmt::Display for SampleOf {
 
 /// The publishers of one spacecraft's per-frame telemetry, with their encode buffer.
 pub struct FramePublisher {
+    /// `flexdyn/<sc>/tlm/time`.
+    pub time_pub: Publisher<'static>,
+    time_buf: Vec<u8>,
     /// `flexdyn/<sc>/tlm/state` (shared with the lockstep presence wait).
     pub state_pub: Arc<Publisher<'static>>,
     /// Per sensor of the bank: its kind and its publisher (`flexdyn/<sc>/tlm/<kind>/<name>`).
@@ -95,10 +101,13 @@ pub struct FramePublisher {
 impl FramePublisher {
     /// Publishers for a frame; the buffer is sized once here.
     pub fn new(
+        time_pub: Publisher<'static>,
         state_pub: Arc<Publisher<'static>>,
         sensor_pubs: Vec<(&'static SensorKind, Publisher<'static>)>,
     ) -> Self {
         Self {
+            time_pub,
+            time_buf: Vec::with_capacity(flexdyn_proto::TIME_LEN),
             state_pub,
             sensor_pubs,
             state_buf: Vec::with_capacity(4096),
@@ -110,6 +119,7 @@ impl FramePublisher {
         let key = |p: &Publisher<'static>| -> Arc<str> { p.key_expr().as_str().into() };
         Recording {
             tx,
+            time: key(&self.time_pub),
             state: key(&self.state_pub),
             status: key(status),
             sensors: self.sensor_pubs.iter().map(|(_, p)| key(p)).collect(),
@@ -123,11 +133,24 @@ impl FramePublisher {
         }
     }
 
-    /// Encodes and publishes `frame` (sensors first, then the state), queueing each payload
+    /// Encodes and publishes `frame` (its time message, its sensors, then the state), queueing
+    /// each payload
     /// for `rec` too. Counts the state in `shared.published`, failures in
     /// `shared.publish_errors`, and notes the frame's command bookkeeping.
     pub fn publish(&mut self, frame: &Frame, shared: &Shared, rec: Option<&Recording>) {
         let stamp = frame.boundary_unix_ns.to_le_bytes();
+        encode_into(&frame.time, &mut self.time_buf);
+        if let Some(r) = rec {
+            r.submit(&r.time, &self.time_buf, Some(frame.boundary_unix_ns));
+        }
+        if let Err(e) = self
+            .time_pub
+            .put(self.time_buf.as_slice())
+            .attachment(stamp)
+            .wait()
+        {
+            Self::count_error(shared, &"time", &e);
+        }
         let sensor_pubs = &self.sensor_pubs;
         for_each_sensor_payload(frame, |i, payload| {
             let Some((kind, publisher)) = sensor_pubs.get(i) else {

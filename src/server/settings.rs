@@ -124,7 +124,12 @@ pub const KEYS: &[&str] = &[
     "command_queue",
     "handoff",
     "participant_subjects",
+    "speed",
 ];
+
+/// Bounds of `speed`: slower than 1/1000 or faster than 1000 × real time is not a real-time run
+/// (a 1 ms frame would be paced every second, or every microsecond).
+pub const SPEED_RANGE: (f64, f64) = (1e-3, 1e3);
 
 /// Validated server settings. [`Default`] gives the documented defaults.
 #[derive(Clone, Debug, PartialEq)]
@@ -185,6 +190,10 @@ pub struct ServerSettings {
     /// peers and its access-control list lets only that subject put on the participant's
     /// command key ([`super::access`]).
     pub participant_subjects: std::collections::BTreeMap<u32, String>,
+    /// Real time: simulated seconds per wall-clock second (default 1.0; 2.0 runs twice as fast,
+    /// 0.5 half as fast). Frame boundary `k` is due `k · frame_ns / speed` after the start. Not
+    /// used in lockstep and batch.
+    pub speed: f64,
     /// `flexdyn run --record FILE.mcap`: record the server's own output (state, sensors, status,
     /// and every command received) to this file. Command line only (not a `[server]` key).
     pub record: Option<std::path::PathBuf>,
@@ -215,6 +224,7 @@ impl Default for ServerSettings {
             command_queue: 1024,
             handoff: Handoff::Auto,
             participant_subjects: std::collections::BTreeMap::new(),
+            speed: 1.0,
             record: None,
         }
     }
@@ -547,6 +557,19 @@ impl ServerSettings {
                 }
                 self.participant_subjects = out;
             }
+            "speed" => {
+                let x = set.positive()?;
+                let (lo, hi) = SPEED_RANGE;
+                if !(lo..=hi).contains(&x) {
+                    return Err(set.bad(format!(
+                        "must be in {}..={} (× real time; got {})",
+                        Num(lo),
+                        Num(hi),
+                        Num(x)
+                    )));
+                }
+                self.speed = x;
+            }
             other => {
                 return Err(SettingsError::UnknownKey {
                     key: other.to_owned(),
@@ -629,7 +652,7 @@ impl ServerSettings {
              stale_after_s={} stale_policy={} status_hz={} summary_interval_s={} spin_us={} \
              realtime_priority={} lock_memory={} physics_cpu={} cpu_dma_latency={} \
              telemetry_buffers={} command_queue={} handoff={} participant_subjects={:?} \
-             record={}",
+             speed={} record={}",
             mode_name(self.mode),
             self.sc_id,
             self.spacecraft_id,
@@ -655,6 +678,7 @@ impl ServerSettings {
             self.command_queue,
             self.handoff.as_str(),
             self.participant_subjects,
+            Num(self.speed),
             self.record
                 .as_ref()
                 .map_or("off".to_owned(), |p| p.display().to_string()),

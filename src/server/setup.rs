@@ -93,8 +93,9 @@ impl Endpoints {
                 telemetry_pub(key, "declare a sensor publisher").await?,
             ));
         }
+        let time_pub = telemetry_pub(topics.time(), "declare the time publisher").await?;
         let state_pub = Arc::new(state_pub);
-        let frames = FramePublisher::new(state_pub.clone(), sensor_pubs);
+        let frames = FramePublisher::new(time_pub, state_pub.clone(), sensor_pubs);
 
         let vehicle = VehicleInfo {
             sc_id: settings.sc_id.clone(),

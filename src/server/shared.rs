@@ -18,6 +18,8 @@ pub const SENSOR_PAYLOAD_CAPACITY: usize = 512;
 /// (free → physics fills → I/O publishes → free), so the stepping path never allocates.
 #[derive(Debug)]
 pub struct Frame {
+    /// The time message of this tick (published first).
+    pub time: flexdyn_proto::TimeMsg,
     /// The state message, `effectors` preallocated to the spacecraft's effector layout.
     pub state: StateMsg,
     /// \[ns since the Unix epoch\] wall clock at the frame boundary, sent as the sample's
@@ -42,6 +44,7 @@ impl Frame {
     /// sensors.
     pub fn for_state(shape: &StateMsg, n_sensors: usize) -> Self {
         Self {
+            time: flexdyn_proto::TimeMsg::default(),
             state: shape.clone(),
             boundary_unix_ns: 0,
             lateness_ns: 0,

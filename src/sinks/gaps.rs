@@ -27,7 +27,7 @@ impl SeqGaps {
     /// Whether messages of `kind` carry a publisher's consecutive sequence number.
     pub fn counts(kind: TopicKind) -> bool {
         match kind {
-            TopicKind::State | TopicKind::Sensor(_) | TopicKind::Status => true,
+            TopicKind::State | TopicKind::Sensor(_) | TopicKind::Status | TopicKind::Time => true,
             TopicKind::Command => false,
         }
     }

@@ -4,10 +4,10 @@
 //! `flexdyn/<sc-id>/<suffix>` (see `proto/README.md`, "Topics") names the message type, and the
 //! payload decodes with the one `flexdyn-proto` codec.
 
-use flexdyn_proto::keys::{CMD_PREFIX, KEY_ROOT, STATE_SUFFIX, STATUS_SUFFIX};
+use flexdyn_proto::keys::{CMD_PREFIX, KEY_ROOT, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX};
 use flexdyn_proto::{
-    decode_command, decode_state, decode_status, CommandMsg, DecodeError, Header, StateMsg,
-    StatusMsg,
+    decode_command, decode_state, decode_status, decode_time, CommandMsg, DecodeError, Header,
+    StateMsg, StatusMsg, TimeMsg,
 };
 
 use crate::sensors::{SensorKind, KINDS};
@@ -25,6 +25,8 @@ pub enum TopicKind {
     Command,
     /// `flexdyn/<sc>/status`: [`StatusMsg`].
     Status,
+    /// `flexdyn/<sc>/tlm/time`: [`TimeMsg`] (the time service).
+    Time,
 }
 
 impl TopicKind {
@@ -32,7 +34,7 @@ impl TopicKind {
     pub fn all() -> impl Iterator<Item = TopicKind> {
         std::iter::once(TopicKind::State)
             .chain((0..KINDS.len()).map(TopicKind::Sensor))
-            .chain([TopicKind::Command, TopicKind::Status])
+            .chain([TopicKind::Command, TopicKind::Status, TopicKind::Time])
     }
 
     /// The topic kind of sensor kind `kind` (`None` if it is not registered).
@@ -55,6 +57,7 @@ impl TopicKind {
             TopicKind::Sensor(_) => self.sensor_kind().map_or("", |k| k.message_name),
             TopicKind::Command => "CommandMsg",
             TopicKind::Status => "StatusMsg",
+            TopicKind::Time => "TimeMsg",
         }
     }
 }
@@ -86,6 +89,8 @@ pub fn classify(key: &str) -> Option<Topic<'_>> {
     };
     let (kind, sensor) = if suffix == STATE_SUFFIX {
         (TopicKind::State, None)
+    } else if suffix == TIME_SUFFIX {
+        (TopicKind::Time, None)
     } else if let Some(sender) =
         sensor(CMD_PREFIX).filter(|s| s.bytes().all(|b| b.is_ascii_digit()))
     {
@@ -127,6 +132,8 @@ pub enum Decoded {
     Command(CommandMsg),
     /// A server status.
     Status(StatusMsg),
+    /// A time-service message.
+    Time(TimeMsg),
 }
 
 impl Decoded {
@@ -147,6 +154,7 @@ impl Decoded {
             }
             TopicKind::Command => Decoded::Command(decode_command(payload)?),
             TopicKind::Status => Decoded::Status(decode_status(payload)?),
+            TopicKind::Time => Decoded::Time(decode_time(payload)?),
         })
     }
 
@@ -157,6 +165,7 @@ impl Decoded {
             Decoded::Sensor { header, .. } => header,
             Decoded::Command(m) => &m.header,
             Decoded::Status(m) => &m.header,
+            Decoded::Time(m) => &m.header,
         }
     }
 
@@ -168,6 +177,7 @@ impl Decoded {
             Decoded::Sensor { json, .. } => serde_json::to_vec(json),
             Decoded::Command(m) => serde_json::to_vec(m),
             Decoded::Status(m) => serde_json::to_vec(m),
+            Decoded::Time(m) => serde_json::to_vec(m),
         };
         v.unwrap_or_else(|_| b"null".to_vec())
     }
@@ -179,6 +189,7 @@ impl Decoded {
             Decoded::Sensor { json, .. } => Ok(json.clone()),
             Decoded::Command(m) => serde_json::to_value(m),
             Decoded::Status(m) => serde_json::to_value(m),
+            Decoded::Time(m) => serde_json::to_value(m),
         };
         // The wire structs hold only numbers, bools, enums and vectors: always representable.
         v.unwrap_or(serde_json::Value::Null)
@@ -196,6 +207,7 @@ pub fn json_schema(kind: TopicKind) -> serde_json::Value {
         }
         TopicKind::Command => schemars::schema_for!(CommandMsg),
         TopicKind::Status => schemars::schema_for!(StatusMsg),
+        TopicKind::Time => schemars::schema_for!(TimeMsg),
     };
     schema.to_value()
 }
@@ -248,6 +260,10 @@ mod tests {
             classify("flexdyn/x/status").unwrap().kind,
             TopicKind::Status
         );
+        let t = classify("flexdyn/x/tlm/time").unwrap();
+        assert_eq!((t.kind, t.sensor), (TopicKind::Time, None));
+        assert_eq!(TopicKind::Time.message_name(), "TimeMsg");
+        assert_eq!(classify("flexdyn/x/tlm/time/y"), None);
         for other in [
             "flexdyn/x/participant/1",
             "flexdyn/x/tlm/imu/",

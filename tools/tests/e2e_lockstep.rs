@@ -178,6 +178,10 @@ fn lockstep_run_settings(
 /// these streams is the header's version bytes: with byte 0 of every StateMsg written back as 4
 /// they hash to the 535783c values (9c0c0df6…, af7d756e…); re-mint from the `sha256` each test prints when the
 /// dynamics or a sensor model change on purpose, and say why in the commit.
+///
+/// Re-minted for protocol version 5 (the time service): each StateMsg's first byte is now 5.
+/// Hashing the new streams with that byte set back to 4 gives exactly the protocol-4 values
+/// (`9c0c0df6…1912497` and `af7d756e…e29e2e4`), so nothing else in the state stream changed.
 const GYRO_FEEDBACK_SHA256: &str =
     "8109363c67bb32e5dd10fc60e6bffeaebad5fd8ada1b3d5d1304e1cac19bb583";
 const WHEELS_ON_SENSORS_SHA256: &str =

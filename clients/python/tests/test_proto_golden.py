@@ -8,7 +8,7 @@ import pytest
 
 from flexdyn import proto
 from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState, Header,
-                           ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg)
+                           ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
 
 SC = 0x11223344
 
@@ -99,6 +99,27 @@ def test_status(golden_dir):
                   1, 2, 3, 4, 5, 6, 8, 9, 7, 1_700_000_000_123_456_789)
     golden = (golden_dir / "status.bin").read_bytes()
     assert m.encode() == golden and StatusMsg.decode(golden) == m
+
+
+def test_time(golden_dir):
+    # TIME_GOLDEN of proto/tests/golden.rs: 2016-12-31T23:59:60.25 UTC, paused at tick 6.
+    m = TimeMsg(Header(SC, 6, 750_000_000, 6), proto.RUN_STATE_PAUSED, proto.MODE_REAL_TIME,
+                proto.TIME_EPOCH_VALID | proto.TIME_LEAP_SECOND, 125_000_000, 0.5,
+                1_861_920_036_250_000_000, (2016, 12, 31, 23, 59, 60, 250_000_000), 36, 1930,
+                17_250_000_000, 750_000_000, bytes([0x1F, 0x6E, 0xFA, 0xA5, 0x24, 0x40, 0, 0]),
+                (0, 0x8000_0000), (1_861_920_036, 0))
+    golden = (golden_dir / "time.bin").read_bytes()
+    assert m.encode() == golden and TimeMsg.decode(golden) == m
+    assert m.paused and not m.tone
+    bad = bytearray(golden)
+    bad[30] = 7
+    with pytest.raises(DecodeError) as e:
+        TimeMsg.decode(bytes(bad))
+    assert e.value.reason == "Malformed"
+    with pytest.raises(DecodeError) as e:
+        TimeMsg.decode(golden[:-1])
+    assert e.value.reason == "Length"
+    assert proto.time_key("sc1") == "flexdyn/sc1/tlm/time"
 
 
 def test_versions_and_keys():

@@ -74,6 +74,8 @@
 #define FD_COMMAND_NO_COMMAND_LEN 38u
 #define FD_COMMAND_ACTUATORS_FIXED_LEN 94u
 #define FD_STATUS_LEN 179u
+#define FD_TIME_LEN 122u
+#define FD_TIME_CUC_OFFSET 98u
 #define FD_MAX_EFFECTORS 1024u
 #define FD_MAX_EFFECTOR_VALUES 8u
 #define FD_MAX_MESSAGE_BYTES 65536u
@@ -104,6 +106,12 @@
 #define FD_MAGNETOMETER_AXIS_1 0x01u
 #define FD_MAGNETOMETER_AXIS_2 0x02u
 #define FD_MAGNETOMETER_AXIS_3 0x04u
+/* TimeMsg.flags (protocol 5) */
+#define FD_TIME_EPOCH_VALID 0x01u /* calendar fields set; clear: they are all zero */
+#define FD_TIME_TONE 0x02u        /* the 1 Hz tone: first frame at or after a whole second */
+#define FD_TIME_LEAP_SECOND 0x04u /* inside an inserted leap second (UTC second = 60) */
+/* TimeMsg.cuc_tai[0]: CCSDS 301.0-B-4 CUC P-field, TAI 1958 epoch, 4 coarse + 3 fine octets. */
+#define FD_CUC_PFIELD_TAI_4_3 0x1Fu
 /* EffectorState.flags of a reaction wheel */
 #define FD_WHEEL_TORQUE_LIMITED 0x1u
 #define FD_WHEEL_SPEED_LIMITED 0x2u
@@ -124,6 +132,7 @@
 #define FD_RUN_STATE_FINISHED 3u
 #define FD_RUN_STATE_FAILED 4u
 #define FD_RUN_STATE_STOPPED 5u
+#define FD_RUN_STATE_PAUSED 6u /* since protocol 5: holding at a tick on an operator's request */
 #define FD_STALE_POLICY_HOLD 0u
 #define FD_STALE_POLICY_ZERO 1u
 /* CommandStatus.last_command_tick / command_age_ns before any command. */
@@ -207,6 +216,33 @@ typedef struct {
     uint8_t valid;  /* 0 or 1 */
     uint8_t status_flags;
 } fd_star_tracker_msg;
+
+/* A cFE CFE_TIME_SysTime_t: seconds and subseconds in units of 2^-32 s. */
+typedef struct {
+    uint32_t seconds;
+    uint32_t subseconds;
+} fd_sys_time;
+
+/* The time service, flexdyn/<sc>/tlm/time, one per frame before its sensors and state. */
+typedef struct {
+    fd_header header;     /* tick, sim_time_ns, seq (= tick) */
+    uint32_t run_state;   /* FD_RUN_STATE_RUNNING, _PAUSED (held at this tick), ... */
+    uint32_t mode;        /* FD_MODE_* */
+    uint8_t flags;        /* FD_TIME_* */
+    uint64_t frame_ns;    /* the frame period */
+    double speed;         /* real time: --speed; lockstep and batch: 0 */
+    uint64_t tai_ns_1958; /* TAI since 1958-01-01T00:00:00 TAI */
+    uint16_t utc_year;
+    uint8_t utc_month, utc_day, utc_hour, utc_minute, utc_second; /* second 60 in a leap second */
+    uint32_t utc_nanosecond;
+    int32_t tai_minus_utc_s; /* leap-second count */
+    uint32_t gps_week;
+    uint64_t gps_ns_of_week;
+    uint64_t met_ns;         /* mission elapsed time: since the epoch (sim time 0) */
+    uint8_t cuc_tai[8];      /* P-field, 4 coarse, 3 fine octets, big-endian (CCSDS order) */
+    fd_sys_time tone_met;    /* MET at the most recent tone */
+    fd_sys_time tone_tai;    /* TAI (1958) at the most recent tone */
+} fd_time_msg;
 
 typedef struct {
     fd_header header;
@@ -743,7 +779,7 @@ static inline fd_error fd_decode_status(const uint8_t *buf, size_t len, fd_statu
     if ((e = fd_check_total(FD_STATUS_LEN, len)).status != FD_OK) return e;
     /* Step 4 in wire order: mode tag, run_state tag, command_stale bool, stale_policy tag. */
     if (fd_get_u32(buf + 30) > FD_MODE_BATCH) return fd_fail(FD_ERR_MALFORMED, 0, len, "mode tag");
-    if (fd_get_u32(buf + 34) > FD_RUN_STATE_STOPPED)
+    if (fd_get_u32(buf + 34) > FD_RUN_STATE_PAUSED)
         return fd_fail(FD_ERR_MALFORMED, 0, len, "run_state tag");
     if (buf[94] > 1) return fd_fail(FD_ERR_MALFORMED, 0, len, "command_stale is not a bool");
     if (fd_get_u32(buf + 95) > FD_STALE_POLICY_ZERO)
@@ -801,6 +837,74 @@ static inline size_t fd_encode_status(const fd_status_msg *m, uint8_t *buf, size
 }
 
 /* ------------------------------------------------------------------------------------------ */
+/* TimeMsg (protocol 5).                                                                       */
+
+static inline fd_error fd_decode_time(const uint8_t *buf, size_t len, fd_time_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_TIME_LEN);
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_TIME_LEN, len)).status != FD_OK) return e;
+    if (fd_get_u32(buf + 30) > FD_RUN_STATE_PAUSED)
+        return fd_fail(FD_ERR_MALFORMED, 0, len, "run_state tag");
+    if (fd_get_u32(buf + 34) > FD_MODE_BATCH) return fd_fail(FD_ERR_MALFORMED, 0, len, "mode tag");
+    fd_decode_header_at(buf, &out->header);
+    out->run_state = fd_get_u32(buf + 30);
+    out->mode = fd_get_u32(buf + 34);
+    out->flags = buf[38];
+    out->frame_ns = fd_get_u64(buf + 39);
+    out->speed = fd_get_f64(buf + 47);
+    out->tai_ns_1958 = fd_get_u64(buf + 55);
+    out->utc_year = fd_get_u16(buf + 63);
+    out->utc_month = buf[65];
+    out->utc_day = buf[66];
+    out->utc_hour = buf[67];
+    out->utc_minute = buf[68];
+    out->utc_second = buf[69];
+    out->utc_nanosecond = fd_get_u32(buf + 70);
+    {
+        uint32_t u = fd_get_u32(buf + 74); /* two's complement, read without a signed overflow */
+        out->tai_minus_utc_s = u <= 0x7FFFFFFFu ? FD_CAST(int32_t, u)
+                                                : -FD_CAST(int32_t, ~u) - 1;
+    }
+    out->gps_week = fd_get_u32(buf + 78);
+    out->gps_ns_of_week = fd_get_u64(buf + 82);
+    out->met_ns = fd_get_u64(buf + 90);
+    memcpy(out->cuc_tai, buf + FD_TIME_CUC_OFFSET, 8);
+    out->tone_met.seconds = fd_get_u32(buf + 106);
+    out->tone_met.subseconds = fd_get_u32(buf + 110);
+    out->tone_tai.seconds = fd_get_u32(buf + 114);
+    out->tone_tai.subseconds = fd_get_u32(buf + 118);
+    return fd_ok();
+}
+
+static inline size_t fd_encode_time(const fd_time_msg *m, uint8_t *buf, size_t cap) {
+    if (cap < FD_TIME_LEN) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_u32(buf + 30, m->run_state);
+    fd_put_u32(buf + 34, m->mode);
+    buf[38] = m->flags;
+    fd_put_u64(buf + 39, m->frame_ns);
+    fd_put_f64(buf + 47, m->speed);
+    fd_put_u64(buf + 55, m->tai_ns_1958);
+    fd_put_u16(buf + 63, m->utc_year);
+    buf[65] = m->utc_month;
+    buf[66] = m->utc_day;
+    buf[67] = m->utc_hour;
+    buf[68] = m->utc_minute;
+    buf[69] = m->utc_second;
+    fd_put_u32(buf + 70, m->utc_nanosecond);
+    fd_put_u32(buf + 74, FD_CAST(uint32_t, m->tai_minus_utc_s));
+    fd_put_u32(buf + 78, m->gps_week);
+    fd_put_u64(buf + 82, m->gps_ns_of_week);
+    fd_put_u64(buf + 90, m->met_ns);
+    memcpy(buf + FD_TIME_CUC_OFFSET, m->cuc_tai, 8);
+    fd_put_u32(buf + 106, m->tone_met.seconds);
+    fd_put_u32(buf + 110, m->tone_met.subseconds);
+    fd_put_u32(buf + 114, m->tone_tai.seconds);
+    fd_put_u32(buf + 118, m->tone_tai.subseconds);
+    return FD_TIME_LEN;
+}
+
+/* ------------------------------------------------------------------------------------------ */
 /* Key expressions (proto/README.md, "Topics").                                                */
 
 /* Whether `id` is a valid key chunk: 1-64 characters from [A-Za-z0-9_-]. */
@@ -843,6 +947,9 @@ static inline size_t fd_key(char *out, size_t cap, const char *sc, const char *s
 
 static inline size_t fd_state_key(char *out, size_t cap, const char *sc) {
     return fd_key(out, cap, sc, "tlm/state", FD_NULL);
+}
+static inline size_t fd_time_key(char *out, size_t cap, const char *sc) {
+    return fd_key(out, cap, sc, "tlm/time", FD_NULL);
 }
 static inline size_t fd_imu_key(char *out, size_t cap, const char *sc, const char *name) {
     return fd_key(out, cap, sc, "tlm/imu", name);

@@ -348,10 +348,69 @@ static void test_status(const char *dir) {
               back.commands_dropped == 7 &&
               back.stale_policy == 1 && back.command_stale == 1,
           "StatusMsg decodes to the table");
-    golden[34] = 6;
+    golden[34] = FD_RUN_STATE_PAUSED;
     e = fd_decode_status(golden, n, &back);
-    CHECK(e.status == FD_ERR_MALFORMED, "run_state tag 6");
+    CHECK(e.status == FD_OK && back.run_state == 6, "run_state tag 6 (Paused) is valid");
+    golden[34] = 7;
+    e = fd_decode_status(golden, n, &back);
+    CHECK(e.status == FD_ERR_MALFORMED, "run_state tag 7");
     printf("StatusMsg: decode ok\n");
+}
+
+/* TIME_GOLDEN of proto/tests/golden.rs: 2016-12-31T23:59:60.25 UTC, paused at tick 6. */
+static void test_time(const char *dir) {
+    uint8_t golden[256], enc[256];
+    size_t n = read_file(dir, "time", golden, sizeof golden);
+    static const uint8_t cuc[8] = {0x1F, 0x6E, 0xFA, 0xA5, 0x24, 0x40, 0x00, 0x00};
+    fd_time_msg m, back;
+    fd_error e;
+    char key[64];
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 6, 750000000u, 6);
+    m.run_state = FD_RUN_STATE_PAUSED;
+    m.mode = FD_MODE_REAL_TIME;
+    m.flags = FD_TIME_EPOCH_VALID | FD_TIME_LEAP_SECOND;
+    m.frame_ns = 125000000u;
+    m.speed = 0.5;
+    m.tai_ns_1958 = 1861920036250000000u;
+    m.utc_year = 2016;
+    m.utc_month = 12;
+    m.utc_day = 31;
+    m.utc_hour = 23;
+    m.utc_minute = 59;
+    m.utc_second = 60;
+    m.utc_nanosecond = 250000000u;
+    m.tai_minus_utc_s = 36;
+    m.gps_week = 1930;
+    m.gps_ns_of_week = 17250000000u;
+    m.met_ns = 750000000u;
+    memcpy(m.cuc_tai, cuc, 8);
+    m.tone_met.subseconds = 0x80000000u;
+    m.tone_tai.seconds = 1861920036u;
+    CHECK(n == FD_TIME_LEN, "time.bin length");
+    check_encoded("TimeMsg", golden, n, enc, fd_encode_time(&m, enc, sizeof enc));
+    e = fd_decode_time(golden, n, &back);
+    CHECK(e.status == FD_OK && same_header(&back.header, &m.header) && back.run_state == 6 &&
+              back.flags == 5 && back.speed == 0.5 && back.utc_second == 60 &&
+              back.tai_minus_utc_s == 36 && back.gps_week == 1930 &&
+              back.gps_ns_of_week == m.gps_ns_of_week && back.tai_ns_1958 == m.tai_ns_1958 &&
+              memcmp(back.cuc_tai, cuc, 8) == 0 && back.tone_met.subseconds == 0x80000000u &&
+              back.tone_tai.seconds == 1861920036u,
+          "TimeMsg decodes to the table");
+    /* A negative leap-second count survives the round trip (two's complement). */
+    m.tai_minus_utc_s = -2;
+    fd_encode_time(&m, enc, sizeof enc);
+    CHECK(enc[74] == 0xFE && enc[77] == 0xFF, "i32 -2 on the wire");
+    e = fd_decode_time(enc, FD_TIME_LEN, &back);
+    CHECK(e.status == FD_OK && back.tai_minus_utc_s == -2, "i32 -2 decodes");
+    golden[30] = 7;
+    e = fd_decode_time(golden, n, &back);
+    CHECK(e.status == FD_ERR_MALFORMED, "TimeMsg run_state tag 7");
+    e = fd_decode_time(golden, n - 1, &back);
+    CHECK(e.status == FD_ERR_LENGTH && e.needed == FD_TIME_LEN, "TimeMsg short");
+    CHECK(fd_time_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/tlm/time") == 0,
+          "time key");
+    printf("TimeMsg: ok\n");
 }
 
 static void test_keys(void) {
@@ -386,6 +445,7 @@ int main(int argc, char **argv) {
     test_magnetometer(argv[1]);
     test_commands(argv[1]);
     test_status(argv[1]);
+    test_time(argv[1]);
     test_keys();
     if (failures != 0) {
         fprintf(stderr, "%d check(s) failed\n", failures);

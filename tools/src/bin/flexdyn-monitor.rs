@@ -198,6 +198,7 @@ fn run_state_name(s: RunState) -> &'static str {
         RunState::Finished => "finished",
         RunState::Failed => "failed",
         RunState::Stopped => "stopped",
+        RunState::Paused => "paused",
     }
 }
 

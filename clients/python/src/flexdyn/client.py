@@ -20,7 +20,8 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tupl
 import zenoh
 
 from . import proto
-from .proto import CommandMsg, EffectorInput, Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg
+from .proto import (CommandMsg, EffectorInput, Header, ImuMsg, StarTrackerMsg, StateMsg,
+                    StatusMsg, TimeMsg)
 
 Vec3 = Tuple[float, float, float]
 
@@ -65,7 +66,8 @@ class VehicleInfo:
 
 #: The decoder of each telemetry key kind: the part of the key after ``flexdyn/<sc>/tlm/``
 #: is ``state``, ``imu/<name>`` or ``st/<name>``.
-_DECODERS = {"state": StateMsg.decode, "imu": ImuMsg.decode, "st": StarTrackerMsg.decode}
+_DECODERS = {"state": StateMsg.decode, "imu": ImuMsg.decode, "st": StarTrackerMsg.decode,
+             "time": TimeMsg.decode}
 
 
 class Subscription:
@@ -109,6 +111,9 @@ class Client:
         self._routes: Dict[str, List[Callable]] = {}
         self._taps: List[Callable[[str, object], None]] = []
         self._telemetry_sub: Optional[object] = None
+        # The time service (now / wait_tick): the last TimeMsg and its condition, on first use.
+        self._time_cond: Optional[threading.Condition] = None
+        self._now: Optional[TimeMsg] = None
         #: Undecodable telemetry samples received (a sample that is not the message its key says).
         self.undecodable = 0
         #: Exceptions raised by telemetry callbacks (logged on the ``flexdyn`` logger; the other
@@ -194,6 +199,45 @@ class Client:
         StateMsg of its tick)."""
         key = proto.star_tracker_key(self.sc_id, name)
         return self._telemetry_add(key[len(self._tlm_prefix):], callback)
+
+    def subscribe_time(self, callback: Callable[[TimeMsg], None]) -> Subscription:
+        """Calls `callback` with every TimeMsg, the time service (``flexdyn/<sc>/tlm/time``,
+        one per frame, before the frame's sensors and state)."""
+        return self._telemetry_add("time", callback)
+
+    def _clock(self) -> threading.Condition:
+        # Under _dispatch (not _lock: a callback that sends holds _dispatch, then takes _lock).
+        with self._dispatch:
+            if self._time_cond is None:
+                self._time_cond = threading.Condition()
+                self.subscribe_time(self._on_time)
+            return self._time_cond
+
+    def _on_time(self, msg: TimeMsg) -> None:
+        cond = self._time_cond
+        with cond:
+            self._now = msg
+            cond.notify_all()
+
+    def now(self) -> Optional[TimeMsg]:
+        """The last TimeMsg received (``None`` before the first): the simulation's time, the
+        one clock flight code should follow (it stops while the run is paused and runs at the
+        server's ``--speed``). The first call subscribes."""
+        self._clock()
+        return self._now
+
+    def wait_tick(self, timeout_s: float = 10.0) -> TimeMsg:
+        """Blocks until the next TimeMsg (a tick newer than :meth:`now` at the call) and returns
+        it; ``TimeoutError`` after ``timeout_s`` s of wall time without one (the server is
+        gone, or the run is paused). A rate-group driver calls it in a loop: one call per
+        frame, ``msg.flags & proto.TIME_TONE`` on the 1 Hz tone."""
+        cond = self._clock()
+        with cond:
+            last = self._now.header.tick if self._now is not None else -1
+            if not cond.wait_for(lambda: self._now is not None and self._now.header.tick > last,
+                                 timeout_s):
+                raise TimeoutError(f"no tick after {last} within {timeout_s} s")
+            return self._now
 
     def subscribe_status(self, callback: Callable[[StatusMsg], None]) -> object:
         """Calls `callback` with every StatusMsg (its own subscriber: status is not telemetry

@@ -37,6 +37,7 @@ COMMAND_WRENCH_LEN = 86
 COMMAND_NO_COMMAND_LEN = 38
 COMMAND_ACTUATORS_FIXED_LEN = 94
 STATUS_LEN = 179
+TIME_LEN = 122
 MAX_EFFECTORS = 1024
 MAX_EFFECTOR_VALUES = 8
 MAX_MESSAGE_BYTES = 65536
@@ -56,7 +57,11 @@ MAGNETORQUER_SATURATED = 0x1
 THRUSTER_FIRING, THRUSTER_BELOW_MIN_ON_TIME, THRUSTER_COMMAND_CLIPPED = 0x1, 0x2, 0x4
 # StatusMsg enums
 MODE_REAL_TIME, MODE_LOCKSTEP, MODE_BATCH = 0, 1, 2
-RUN_STATE_NAMES = ("Starting", "Running", "Stopping", "Finished", "Failed", "Stopped")
+RUN_STATE_NAMES = ("Starting", "Running", "Stopping", "Finished", "Failed", "Stopped", "Paused")
+RUN_STATE_RUNNING, RUN_STATE_PAUSED = 1, 6
+# TimeMsg.flags and the CUC P-field of TimeMsg.cuc_tai (proto/README.md, "TimeMsg")
+TIME_EPOCH_VALID, TIME_TONE, TIME_LEAP_SECOND = 0x1, 0x2, 0x4
+CUC_PFIELD_TAI_4_3 = 0x1F
 STALE_POLICY_HOLD, STALE_POLICY_ZERO = 0, 1
 
 _HEADER = struct.Struct("<HIQQQ")
@@ -449,13 +454,66 @@ class StatusMsg:
         f = StatusMsg._BODY.unpack_from(buf, HEADER_LEN)
         if f[0] > MODE_BATCH:
             raise DecodeError("Malformed", detail="mode tag")
-        if f[1] > 5:
+        if f[1] > RUN_STATE_PAUSED:
             raise DecodeError("Malformed", detail="run_state tag")
         if f[9] > 1:
             raise DecodeError("Malformed", detail="command_stale is not a bool")
         if f[10] > STALE_POLICY_ZERO:
             raise DecodeError("Malformed", detail="stale_policy tag")
         return StatusMsg(Header.unpack(buf), *f[:9], f[9] == 1, *f[10:])
+
+
+@dataclass
+class TimeMsg:
+    """The time service (``flexdyn/<sc-id>/tlm/time``, protocol 5): one per frame, before the
+    frame's sensors and state. ``cuc_tai`` is 8 bytes, CCSDS order (big-endian); ``tone_met``
+    and ``tone_tai`` are ``(seconds, subseconds in 2**-32 s)``. Without an ``[epoch]`` the
+    ``TIME_EPOCH_VALID`` flag is clear and every calendar field is zero."""
+
+    header: Header = field(default_factory=Header)
+    run_state: int = 0
+    mode: int = MODE_REAL_TIME
+    flags: int = 0
+    frame_ns: int = 0
+    speed: float = 0.0
+    tai_ns_1958: int = 0
+    utc: Tuple[int, int, int, int, int, int, int] = (0, 0, 0, 0, 0, 0, 0)
+    tai_minus_utc_s: int = 0
+    gps_week: int = 0
+    gps_ns_of_week: int = 0
+    met_ns: int = 0
+    cuc_tai: bytes = bytes(8)
+    tone_met: Tuple[int, int] = (0, 0)
+    tone_tai: Tuple[int, int] = (0, 0)
+
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<IIBQdQH5BIiIQQ8s4I")
+
+    def encode(self) -> bytes:
+        return self.header.encode() + self._BODY.pack(
+            self.run_state, self.mode, self.flags, self.frame_ns, self.speed, self.tai_ns_1958,
+            *self.utc, self.tai_minus_utc_s, self.gps_week, self.gps_ns_of_week, self.met_ns,
+            bytes(self.cuc_tai), *self.tone_met, *self.tone_tai,
+        )
+
+    @staticmethod
+    def decode(buf: bytes) -> "TimeMsg":
+        _check_size_and_version(buf, TIME_LEN)
+        _check_total(TIME_LEN, buf)
+        f = TimeMsg._BODY.unpack_from(buf, HEADER_LEN)
+        if f[0] > RUN_STATE_PAUSED:
+            raise DecodeError("Malformed", detail="run_state tag")
+        if f[1] > MODE_BATCH:
+            raise DecodeError("Malformed", detail="mode tag")
+        return TimeMsg(Header.unpack(buf), f[0], f[1], f[2], f[3], f[4], f[5], tuple(f[6:13]),
+                       f[13], f[14], f[15], f[16], f[17], (f[18], f[19]), (f[20], f[21]))
+
+    @property
+    def paused(self) -> bool:
+        return self.run_state == RUN_STATE_PAUSED
+
+    @property
+    def tone(self) -> bool:
+        return bool(self.flags & TIME_TONE)
 
 
 # --------------------------------------------------------------------------------------------
@@ -475,6 +533,11 @@ def _key(sc: str, suffix: str, name: Optional[str] = None) -> str:
 
 def state_key(sc: str) -> str:
     return _key(sc, "tlm/state")
+
+
+def time_key(sc: str) -> str:
+    """``flexdyn/<sc>/tlm/time``: the time service (TimeMsg)."""
+    return _key(sc, "tlm/time")
 
 
 def imu_key(sc: str, name: str) -> str:
