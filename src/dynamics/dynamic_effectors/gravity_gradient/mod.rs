@@ -56,6 +56,24 @@ fn r2_r5(r_cn_b_m: &Vector3<f64>) -> (f64, f64) {
     (r2, r2 * r2 * r2.sqrt())
 }
 
+/// (GG3 force, GG2 torque about C) from R = `r_cn_b_m`, [I_C]R = `i_r` and tr[I_C] = `trace`:
+/// the only place the two formulas are written.
+#[inline]
+fn force_and_torque_c(
+    mu_m3_s2: f64,
+    r_cn_b_m: &Vector3<f64>,
+    i_r: &Vector3<f64>,
+    trace: f64,
+) -> (Vector3<f64>, Vector3<f64>) {
+    let (r2, r5) = r2_r5(r_cn_b_m);
+    let k = 1.5 * mu_m3_s2 / r5;
+    let radial = 5.0 * r_cn_b_m.dot(i_r) / r2 - trace;
+    (
+        (r_cn_b_m * radial - i_r * 2.0) * k,
+        r_cn_b_m.cross(i_r) * (2.0 * k),
+    )
+}
+
 /// \[N·m\] GG2: the torque about C for the CoM at `r_cn_b_m` (R, B components) and the inertia
 /// about C `inertia_c_b_kg_m2` (B components): (3μ/R⁵) R × [I_C]R.
 #[inline]
@@ -64,8 +82,8 @@ pub fn torque_c_b_nm(
     r_cn_b_m: &Vector3<f64>,
     inertia_c_b_kg_m2: &Matrix3<f64>,
 ) -> Vector3<f64> {
-    let (_, r5) = r2_r5(r_cn_b_m);
-    r_cn_b_m.cross(&(inertia_c_b_kg_m2 * r_cn_b_m)) * (3.0 * mu_m3_s2 / r5)
+    let i_r = inertia_c_b_kg_m2 * r_cn_b_m;
+    force_and_torque_c(mu_m3_s2, r_cn_b_m, &i_r, inertia_c_b_kg_m2.trace()).1
 }
 
 /// \[N\] GG3: the second-order force on C, B components:
@@ -76,10 +94,8 @@ pub fn force_b_newton(
     r_cn_b_m: &Vector3<f64>,
     inertia_c_b_kg_m2: &Matrix3<f64>,
 ) -> Vector3<f64> {
-    let (r2, r5) = r2_r5(r_cn_b_m);
     let i_r = inertia_c_b_kg_m2 * r_cn_b_m;
-    let radial = 5.0 * r_cn_b_m.dot(&i_r) / r2 - inertia_c_b_kg_m2.trace();
-    (r_cn_b_m * radial - i_r * 2.0) * (1.5 * mu_m3_s2 / r5)
+    force_and_torque_c(mu_m3_s2, r_cn_b_m, &i_r, inertia_c_b_kg_m2.trace()).0
 }
 
 /// \[J\] GG1: the potential beyond the point-mass term, μ/(2R⁵) (3 Rᵀ[I_C]R − R² tr[I_C]).
@@ -111,12 +127,19 @@ impl DynamicEffector for GravityGradient {
 
     fn add_force_torque(&mut self, stage: &StageState, _env: &EnvironmentSample, sum: &mut Wrench) {
         let r_cn_b = stage.dcm_bn * stage.r_cn_n_m;
-        let i_c = stage.inertia_pnt_c_b_kg_m2();
-        let force = force_b_newton(self.mu_m3_s2, &r_cn_b, &i_c);
+        // [I_C] is needed only as [I_C]R and tr[I_C]. By the parallel-axis theorem
+        // [I_C] = [I_B] − m (|c|² 𝟙 − c cᵀ) (see `StageState::inertia_pnt_c_b_kg_m2`), so
+        // [I_C]R = [I_B]R − m (|c|² R − c (c·R)) and tr[I_C] = tr[I_B] − 2 m |c|², without
+        // forming the matrix.
+        let c = &stage.r_cb_b_m;
+        let m = stage.mass_kg;
+        let c2 = c.norm_squared();
+        let i_r = stage.inertia_pnt_b_b_kg_m2 * r_cn_b - (r_cn_b * c2 - c * c.dot(&r_cn_b)) * m;
+        let trace = stage.inertia_pnt_b_b_kg_m2.trace() - 2.0 * m * c2;
+        let (force, torque_c) = force_and_torque_c(self.mu_m3_s2, &r_cn_b, &i_r, trace);
         // GG3 acts at C: at B it is the same force plus the couple c × F.
         sum.force_b_newton += force;
-        sum.torque_b_nm +=
-            torque_c_b_nm(self.mu_m3_s2, &r_cn_b, &i_c) + stage.r_cb_b_m.cross(&force);
+        sum.torque_b_nm += torque_c + c.cross(&force);
     }
 }
 
@@ -185,6 +208,41 @@ mod tests {
         }
         // R × F = −L: the pair conserves the angular momentum about the planet's centre.
         assert!((r.cross(&f) + l).norm() <= 1e-12 * l.norm());
+    }
+
+    /// The stage path forms neither [I_C] nor a second [I_C]R: it must agree with the matrix
+    /// formulas (GG2, GG3 with [I_C] from the parallel-axis theorem) and the couple c × F.
+    #[test]
+    fn the_stage_path_equals_the_matrix_formulas() {
+        let sigma = Vector3::new(0.1, -0.25, 0.3);
+        let stage = StageState {
+            t_step_ns: 0,
+            dt_stage_s: 0.0,
+            r_bn_n_m: Vector3::new(4.1e6, -3.3e6, 4.4e6),
+            v_bn_n_m_s: Vector3::zeros(),
+            sigma_bn: sigma,
+            dcm_bn: crate::attitude::mrp_to_dcm(&sigma),
+            omega_bn_b_rad_s: Vector3::zeros(),
+            mass_kg: 850.0,
+            r_cb_b_m: Vector3::new(0.4, -0.3, 1.2),
+            r_cn_n_m: Vector3::new(4.1e6 + 0.5, -3.3e6 + 0.9, 4.4e6 - 0.2),
+            inertia_pnt_b_b_kg_m2: Matrix3::new(
+                1900.0, 35.0, -20.0, 35.0, 1650.0, 44.0, -20.0, 44.0, 900.0,
+            ),
+        };
+        let mut sum = Wrench::default();
+        GravityGradient { mu_m3_s2: MU }.add_force_torque(
+            &stage,
+            &EnvironmentSample::default(),
+            &mut sum,
+        );
+        let r = stage.dcm_bn * stage.r_cn_n_m;
+        let i_c = stage.inertia_pnt_c_b_kg_m2();
+        let force = force_b_newton(MU, &r, &i_c);
+        let torque = torque_c_b_nm(MU, &r, &i_c) + stage.r_cb_b_m.cross(&force);
+        assert!((sum.force_b_newton - force).norm() <= 1e-13 * force.norm());
+        assert!((sum.torque_b_nm - torque).norm() <= 1e-13 * torque.norm());
+        assert!(torque.norm() > 0.0 && force.norm() > 0.0);
     }
 
     #[test]
