@@ -168,9 +168,7 @@ impl Facet {
     }
 
     /// The drag force for the flow direction `v_hat` (unit) and speed `speed_m_s` > 0, or `None`
-    /// when the facet faces away. The model computes the speed and direction once for all its
-    /// facets; the product is evaluated in the same order as ever, so the force is the same to
-    /// the bit.
+    /// when the facet faces away.
     fn drag_force_facing(
         &self,
         v_hat: &Vector3<f64>,
@@ -213,10 +211,46 @@ impl Facet {
     }
 }
 
-/// A validated set of facets.
+/// A validated set of facets, with the per-facet constants the whole-model sums use.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct FacetModel {
     facets: Vec<Facet>,
+    /// Per facet, in the same order: the products of its parameters that the factored sums
+    /// below need, computed once at build.
+    prepared: Vec<Prepared>,
+}
+
+/// A facet's constants for [`FacetModel::drag_wrench_b`] and [`FacetModel::srp_wrench_b`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Prepared {
+    /// [-] n̂, B components.
+    normal_b: Vector3<f64>,
+    /// [m] r_cp, B components.
+    r_cp_b_m: Vector3<f64>,
+    /// [m] r_cp × n̂, B components (the moment arm of the normal SRP term).
+    r_cp_cross_normal_b_m: Vector3<f64>,
+    /// [m²] C_D A.
+    cd_area_m2: f64,
+    /// [m²] A (ρa + ρd): the coefficient of cos θ in the ŝ term of SRP.
+    area_along_sun_m2: f64,
+    /// [m²] 2 A ρs: the coefficient of cos² θ in the n̂ term.
+    area_specular_m2: f64,
+    /// [m²] ⅔ A ρd: the coefficient of cos θ in the n̂ term.
+    area_diffuse_m2: f64,
+}
+
+impl Prepared {
+    fn of(f: &Facet) -> Self {
+        Prepared {
+            normal_b: f.normal_b,
+            r_cp_b_m: f.r_cp_b_m,
+            r_cp_cross_normal_b_m: f.r_cp_b_m.cross(&f.normal_b),
+            cd_area_m2: f.drag_coefficient * f.area_m2,
+            area_along_sun_m2: f.area_m2 * (f.absorbed + f.diffuse),
+            area_specular_m2: 2.0 * f.area_m2 * f.specular,
+            area_diffuse_m2: 2.0 / 3.0 * f.area_m2 * f.diffuse,
+        }
+    }
 }
 
 impl FacetModel {
@@ -225,7 +259,8 @@ impl FacetModel {
         for (index, facet) in facets.iter().enumerate() {
             facet.validate(index)?;
         }
-        Ok(FacetModel { facets })
+        let prepared = facets.iter().map(Prepared::of).collect();
+        Ok(FacetModel { facets, prepared })
     }
 
     /// The facets.
@@ -253,38 +288,66 @@ impl FacetModel {
     /// Drag on the whole model: the sum of the facet forces, applied at B, and of their moments
     /// about B, for the velocity of B relative to the air `v_rel_b_m_s` [m/s] (B components) and
     /// the density `density_kg_m3`. Allocation-free and panic-free.
+    ///
+    /// Every facet's drag is along −v̂, so with q = ½ ρ |v|² and w_k = C_D,k A_k cos θ_k over the
+    /// facets facing the flow, the sums factor (the same forces, one cross product in all):
+    /// F = −q (Σ w_k) v̂ and τ = Σ r_k × F_k = −q (Σ w_k r_k) × v̂.
     pub fn drag_wrench_b(&self, v_rel_b_m_s: &Vector3<f64>, density_kg_m3: f64) -> FacetWrench {
         let speed_m_s = v_rel_b_m_s.norm();
         if speed_m_s == 0.0 {
             return FacetWrench::default();
         }
-        let v_hat = v_rel_b_m_s / speed_m_s;
-        self.sum(|f| f.drag_force_facing(&v_hat, speed_m_s, density_kg_m3))
+        let v_hat = v_rel_b_m_s * speed_m_s.recip();
+        let mut w_sum_m2 = 0.0;
+        let mut w_r_sum_m3 = Vector3::zeros();
+        for p in &self.prepared {
+            let cos_theta = p.normal_b.dot(&v_hat);
+            if cos_theta > 0.0 {
+                let w_m2 = p.cd_area_m2 * cos_theta;
+                w_sum_m2 += w_m2;
+                w_r_sum_m3 += p.r_cp_b_m * w_m2;
+            }
+        }
+        let q_n_m2 = 0.5 * density_kg_m3 * speed_m_s * speed_m_s;
+        FacetWrench {
+            force_b_newton: v_hat * (-q_n_m2 * w_sum_m2),
+            torque_b_nm: w_r_sum_m3.cross(&v_hat) * -q_n_m2,
+        }
     }
 
     /// Solar radiation pressure on the whole model for the direction from the spacecraft to the
     /// Sun `sun_dir_b` (B components, any non-zero length) and the pressure `pressure_n_m2`
     /// ([`solar_pressure_n_m2`], which carries the 1/r² and the shadow factor).
     /// Allocation-free and panic-free; a zero direction gives no force.
+    ///
+    /// Each lit facet's force is −P (a_k ŝ + b_k n̂_k) with a_k = A_k cos θ_k (ρa + ρd) and
+    /// b_k = A_k cos θ_k (2 ρs cos θ_k + ⅔ ρd), so the sums factor as
+    /// F = −P [(Σ a_k) ŝ + Σ b_k n̂_k] and τ = −P [(Σ a_k r_k) × ŝ + Σ b_k (r_k × n̂_k)], with
+    /// r_k × n̂_k fixed in B and computed once.
     pub fn srp_wrench_b(&self, sun_dir_b: &Vector3<f64>, pressure_n_m2: f64) -> FacetWrench {
         let norm = sun_dir_b.norm();
         if norm == 0.0 {
             return FacetWrench::default();
         }
-        let sun_hat_b = sun_dir_b / norm;
-        self.sum(|f| f.srp_force_facing(&sun_hat_b, pressure_n_m2))
-    }
-
-    /// The sum of the forces of the facets that face the flow or the Sun, and of their moments
-    /// about B (a facet facing away adds nothing, not even a zero cross product).
-    fn sum(&self, force_of: impl Fn(&Facet) -> Option<Vector3<f64>>) -> FacetWrench {
-        let mut w = FacetWrench::default();
-        for facet in &self.facets {
-            if let Some(force) = force_of(facet) {
-                w.force_b_newton += force;
-                w.torque_b_nm += facet.r_cp_b_m.cross(&force);
+        let sun_hat_b = sun_dir_b * norm.recip();
+        let mut a_sum_m2 = 0.0;
+        let mut a_r_sum_m3 = Vector3::zeros();
+        let mut b_n_sum_m2 = Vector3::zeros();
+        let mut b_rn_sum_m3 = Vector3::zeros();
+        for p in &self.prepared {
+            let cos_theta = p.normal_b.dot(&sun_hat_b);
+            if cos_theta > 0.0 {
+                let a_m2 = p.area_along_sun_m2 * cos_theta;
+                let b_m2 = (p.area_specular_m2 * cos_theta + p.area_diffuse_m2) * cos_theta;
+                a_sum_m2 += a_m2;
+                a_r_sum_m3 += p.r_cp_b_m * a_m2;
+                b_n_sum_m2 += p.normal_b * b_m2;
+                b_rn_sum_m3 += p.r_cp_cross_normal_b_m * b_m2;
             }
         }
-        w
+        FacetWrench {
+            force_b_newton: (sun_hat_b * a_sum_m2 + b_n_sum_m2) * -pressure_n_m2,
+            torque_b_nm: (a_r_sum_m3.cross(&sun_hat_b) + b_rn_sum_m3) * -pressure_n_m2,
+        }
     }
 }
