@@ -55,7 +55,7 @@ pub fn run_seed(master: u64, run: u32) -> u64 {
 /// Every numeric parameter of the model built from `cfg`, by configuration path: the hub, the
 /// initial state (`initial.sigma_bn[i]`, `initial.omega_bn_b_rad_s[i]`, `initial.r_bn_n_m[i]`,
 /// `initial.v_bn_n_m_s[i]`), each effector's [`crate::dynamics::StateEffector::parameters`]
-/// under `panel_pairs[k].` or `reaction_wheels[k].`, each dynamic effector's
+/// under its kind's section (`panel_pairs[k].`, `reaction_wheels[k].`: [`crate::dynamics::kinds`]), each dynamic effector's
 /// [`crate::dynamics::DynamicEffector::parameters`] (facets, residual dipole), the environment
 /// models' (space weather) and the epoch's `epoch.offset_s`.
 pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config::ConfigError> {
@@ -82,11 +82,8 @@ pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config:
     let mut per_kind: BTreeMap<&str, usize> = BTreeMap::new();
     let mut params = Vec::new();
     for (e, range) in sc.effectors().iter().zip(sc.effector_ranges()) {
-        let section = match e.kind().name {
-            "panel_pair" => "panel_pairs",
-            "reaction_wheel" => "reaction_wheels",
-            other => other,
-        };
+        let section =
+            crate::dynamics::kinds::by_name(e.kind().name).map_or(e.kind().name, |k| k.section);
         let k = per_kind.entry(section).or_insert(0);
         params.clear();
         e.parameters(&x.effectors[range.clone()], &mut params);

@@ -19,7 +19,7 @@
 //! The built-in default is [`DEFAULT_CONFIG_TOML`], the verbatim text of
 //! `scenarios/reference.toml`. The README's "Configuration" section documents every key.
 
-mod actuators;
+mod components;
 mod error;
 mod file;
 mod schedule;
@@ -32,10 +32,10 @@ use std::path::Path;
 
 use toml::de::DeTable;
 
+pub use crate::dynamics::component::Components;
 use crate::numfmt::{Num, Rounded};
 use crate::schema::location;
 use crate::schema::{mat3, vec3, TableReader};
-pub use actuators::Actuators;
 pub use error::{At, ConfigError, Location};
 pub use file::{config_message, load_config};
 use flexdyn_proto::MAX_PANEL_PAIRS;
@@ -43,8 +43,7 @@ pub use schedule::EffectorInputSegment;
 pub(crate) use source_map::SourceMap;
 pub use warnings::{log_warnings, warning_message, ConfigWarning};
 
-use crate::dynamics::dynamic_effectors::magnetorquer::Magnetorquer;
-use crate::dynamics::dynamic_effectors::thruster::Thruster;
+use crate::dynamics::component::{BuiltComponent, StepTiming};
 use crate::dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
 use crate::dynamics::effectors::reaction_wheel;
 use crate::dynamics::integrator::{self, ButcherTableau, RK4};
@@ -85,9 +84,11 @@ pub struct SimConfig {
     /// Reaction wheels (`[[reaction_wheels]]`), validated, in file order (empty if absent).
     /// They follow the panel pairs in the effector order.
     pub reaction_wheels: Vec<ReactionWheelParams>,
-    /// The actuators (`[[magnetorquers]]`, `[[thrusters]]`), validated; they follow the
-    /// reaction wheels in the effector order.
-    pub actuators: Actuators,
+    /// The components of every registered kind configured through the generic list
+    /// ([`crate::dynamics::kinds::KINDS`]: `[[magnetorquers]]`, `[[thrusters]]`, …), validated,
+    /// in registry order then file order; they follow the reaction wheels in the effector order
+    /// (appended bodies among them before listed actuators).
+    pub components: Components,
     /// Piecewise-constant external wrench on the hub, sorted by strictly increasing start time.
     pub wrench_schedule: Vec<WrenchSegment>,
     /// Piecewise-constant effector inputs (`[[effector_input_schedule]]`), sorted by start
@@ -174,9 +175,9 @@ impl SimConfig {
 
     /// Builds the spacecraft: one [`PanelPair`] per configured pair (errors name
     /// `panel_pairs[i]…`), then one [`ReactionWheel`] per wheel (`reaction_wheels[i]…`), then
-    /// [`Spacecraft::new`], then the actuators (magnetorquers, then thrusters: listed dynamic
-    /// effectors, after the wheels in the effector order), then the dynamic effectors of
-    /// `[environment]`.
+    /// the appended bodies of [`Self::components`], then [`Spacecraft::new`], then its listed
+    /// actuators (magnetorquers, then thrusters, …: listed dynamic effectors, after the bodies in
+    /// the effector order), then the dynamic effectors of `[environment]`.
     pub fn build_spacecraft(&self) -> Result<Spacecraft, ConfigError> {
         let mut effectors: Vec<Box<dyn StateEffector>> = Vec::with_capacity(self.panel_pairs.len());
         for (i, (params, initial)) in self.panel_pairs.iter().enumerate() {
@@ -187,6 +188,17 @@ impl SimConfig {
             let wheel = ReactionWheel::new(params.clone(), &format!("reaction_wheels[{i}]"))?;
             effectors.push(Box::new(wheel));
         }
+        let timing = StepTiming {
+            step_ns: self.step_ns,
+            frame_ns: self.frame_ns,
+        };
+        let mut listed = Vec::new();
+        for (path, c) in self.components.with_paths() {
+            match c.build(&path, timing)? {
+                BuiltComponent::Body(body) => effectors.push(body),
+                BuiltComponent::Listed(actuator) => listed.push(actuator),
+            }
+        }
         let mut sc = Spacecraft::new(
             self.hub.clone(),
             self.gravity,
@@ -195,14 +207,8 @@ impl SimConfig {
             self.step_ns,
         )?;
         sc.set_integrator(self.integrator);
-        for (i, p) in self.actuators.magnetorquers.iter().enumerate() {
-            let rod = Magnetorquer::new(p.clone(), &format!("magnetorquers[{i}]"))?;
-            sc.add_dynamic_effector(Box::new(rod));
-        }
-        for (i, p) in self.actuators.thrusters.iter().enumerate() {
-            let path = format!("thrusters[{i}]");
-            let thruster = Thruster::new(p.clone(), &path, self.frame_ns, self.step_ns)?;
-            sc.add_dynamic_effector(Box::new(thruster));
+        for actuator in listed {
+            sc.add_dynamic_effector(actuator);
         }
         if let Some(env) = &self.environment {
             world::add_dynamic_effectors(&mut sc, env, &self.gravity);
@@ -250,14 +256,11 @@ pub fn config_summary(cfg: &SimConfig) -> String {
             format!(", {} reaction wheels", cfg.reaction_wheels.len())
         },
         {
-            let a = &cfg.actuators;
             let mut s = String::new();
-            for (n, what) in [
-                (a.magnetorquers.len(), "magnetorquers"),
-                (a.thrusters.len(), "thrusters"),
-            ] {
+            for kind in crate::dynamics::kinds::KINDS {
+                let n = cfg.components.count(kind);
                 if n > 0 {
-                    s += &format!(", {n} {what}");
+                    s += &format!(", {n} {}", kind.section);
                 }
             }
             s
@@ -339,8 +342,6 @@ const ROOT_KEYS: &[&str] = &[
     world::ROOT_KEYS[0],
     world::ROOT_KEYS[1],
     world::ROOT_KEYS[2],
-    actuators::ROOT_KEYS[0],
-    actuators::ROOT_KEYS[1],
 ];
 
 struct RawConfig {
@@ -351,7 +352,7 @@ struct RawConfig {
     initial: RawInitial,
     panel_pairs: Vec<RawPanelPair>,
     reaction_wheels: Vec<ReactionWheelParams>,
-    actuators: actuators::RawActuators,
+    components: Vec<Box<dyn crate::dynamics::component::ComponentSpec>>,
     wrench_schedule: Vec<RawWrench>,
     effector_input_schedule: Vec<schedule::RawInputRow>,
     server: toml::Table,
@@ -397,7 +398,12 @@ struct RawWrench {
 impl RawConfig {
     /// Pass 2: reads the whole document against the schema.
     fn read(source: &str, doc: &DeTable<'_>, map: &SourceMap) -> Result<Self, ConfigError> {
-        let root = TableReader::root(source, doc, ROOT_KEYS)?;
+        let root_keys: Vec<&str> = ROOT_KEYS
+            .iter()
+            .copied()
+            .chain(components::root_keys())
+            .collect();
+        let root = TableReader::root(source, doc, &root_keys)?;
         let world = world::RawWorld::read(&root, map)?;
         let sim = root.table("simulation", &["step_s", "frame_hz", "integrator"])?;
         let simulation = RawSimulation {
@@ -451,7 +457,7 @@ impl RawConfig {
             .iter()
             .map(reaction_wheel::schema::read)
             .collect::<Result<Vec<_>, _>>()?;
-        let actuators = actuators::RawActuators::read(&root)?;
+        let components = components::read(&root)?;
         let wrench_schedule = root
             .tables("wrench_schedule", &["t_s", "force_b_newton", "torque_b_nm"])?
             .unwrap_or_default()
@@ -515,7 +521,7 @@ impl RawConfig {
             initial,
             panel_pairs,
             reaction_wheels,
-            actuators,
+            components,
             wrench_schedule,
             effector_input_schedule,
             server,
@@ -651,9 +657,10 @@ impl RawConfig {
             params.validate(&path).map_err(param)?;
             reaction_wheels.push(params);
         }
-        // [[magnetorquers]], [[thrusters]]
-        let actuators = self.actuators.resolve(map, frame_ns)?;
-        check_wire_capacity(map, panel_pairs.len(), &reaction_wheels, &actuators)?;
+        // The generic sections: [[magnetorquers]], [[thrusters]], …
+        let timing = StepTiming { step_ns, frame_ns };
+        let components = components::resolve(self.components, map, timing)?;
+        check_wire_capacity(map, panel_pairs.len(), &reaction_wheels, &components)?;
 
         // [[wrench_schedule]]
         let mut wrench_schedule = Vec::with_capacity(self.wrench_schedule.len());
@@ -766,7 +773,7 @@ impl RawConfig {
             initial,
             panel_pairs,
             reaction_wheels,
-            actuators,
+            components,
             wrench_schedule,
             // Resolved below, against the built spacecraft's effectors.
             effector_input_schedule: Vec::new(),
@@ -850,20 +857,20 @@ fn check_wire_capacity(
     map: &SourceMap,
     n_pairs: usize,
     wheels: &[ReactionWheelParams],
-    actuators: &Actuators,
+    components: &Components,
 ) -> Result<(), ConfigError> {
     use flexdyn_proto::{
         EFFECTOR_STATE_FIXED_LEN, MAX_EFFECTORS, MAX_MESSAGE_BYTES, STATE_FIXED_LEN,
     };
-    let n = n_pairs + wheels.len() + actuators.len();
+    let n = n_pairs + wheels.len() + components.len();
     if n > MAX_EFFECTORS {
         return Err(map.invalid(
             "reaction_wheels",
             format!(
-                "{n_pairs} panel pairs, {} reaction wheels and {} actuators make {n} effectors, \
-                 more than a StateMsg carries ({MAX_EFFECTORS}, proto/README.md)",
+                "{n_pairs} panel pairs, {} reaction wheels and {} other components make {n} \
+                 effectors, more than a StateMsg carries ({MAX_EFFECTORS}, proto/README.md)",
                 wheels.len(),
-                actuators.len()
+                components.len()
             ),
         ));
     }
@@ -881,15 +888,16 @@ fn check_wire_capacity(
     let bytes = STATE_FIXED_LEN
         + n_pairs * entry(panel_pair::STATE_NAMES.len(), 0)
         + wheels.iter().map(wheel_len).sum::<usize>()
-        + actuators.wire_bytes();
+        + components::wire_bytes(components);
     if bytes > MAX_MESSAGE_BYTES {
         return Err(map.invalid(
             "reaction_wheels",
             format!(
-                "the StateMsg of {n_pairs} panel pairs, {} reaction wheels and {} actuators \
-                 would be {bytes} bytes, more than the {MAX_MESSAGE_BYTES}-byte message limit",
+                "the StateMsg of {n_pairs} panel pairs, {} reaction wheels and {} other \
+                 components would be {bytes} bytes, more than the {MAX_MESSAGE_BYTES}-byte \
+                 message limit",
                 wheels.len(),
-                actuators.len()
+                components.len()
             ),
         ));
     }

@@ -212,7 +212,8 @@ pub struct EffectorKind {
 /// Beyond the dynamics, an effector describes itself to every layer above it: its states'
 /// names (CSV headers, wire order), its inputs (commanded by flight code through
 /// `CommandKind::Actuators`) and its outputs and flags (telemetry). Adding a kind therefore
-/// touches only its own folder plus the one line that lists it in the configuration.
+/// touches only its own folder (with its [`super::component::ComponentKind`]) plus the one line
+/// that lists it in [`super::kinds::KINDS`] (and its `mod` line).
 pub trait StateEffector: Send + std::fmt::Debug {
     /// Name from the configuration, for logs and messages.
     fn name(&self) -> &str;

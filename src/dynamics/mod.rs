@@ -33,11 +33,13 @@
 //!   lies at −d ŝ1 from its hinge, so at θ = 0 the panel extends along −ĥ1.
 //! - Gravity acts at the system centre of mass as a uniform field.
 
+pub mod component;
 pub mod dynamic_effector;
 pub mod dynamic_effectors;
 pub mod effector;
 pub mod effectors;
 pub mod integrator;
+pub mod kinds;
 pub mod params;
 pub mod spacecraft;
 pub mod stage_hook;

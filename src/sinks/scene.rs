@@ -21,6 +21,8 @@ use serde_json::{json, Value};
 
 use crate::attitude::{dcm_to_quat, m2, mrp_to_quat};
 use crate::config::SimConfig;
+use crate::dynamics::dynamic_effectors::magnetorquer::MagnetorquerParams;
+use crate::dynamics::dynamic_effectors::thruster::ThrusterParams;
 use flexdyn_proto::StateMsg;
 
 /// Name of the inertial frame.
@@ -175,19 +177,18 @@ impl Geometry {
             .flat_map(|env| &env.facets)
             .map(|f| facet_plate(f.area_m2, &f.normal_b, &f.r_cp_b_m))
             .collect();
-        let a = &cfg.actuators;
-        let thrusters = a
-            .thrusters
-            .iter()
+        let thrusters = cfg
+            .components
+            .of::<ThrusterParams>()
             .map(|t| ArrowMount {
                 r_b_m: t.r_tb_b_m,
                 axis_b: t.force_axis_b.normalize(),
                 full_scale: t.max_thrust_newton,
             })
             .collect();
-        let rods = a
-            .magnetorquers
-            .iter()
+        let rods = cfg
+            .components
+            .of::<MagnetorquerParams>()
             .map(|m| ArrowMount {
                 r_b_m: m.r_mb_b_m,
                 axis_b: m.axis_b.normalize(),

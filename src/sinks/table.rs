@@ -23,7 +23,7 @@ use serde::Serialize;
 use serde_json::Value;
 
 use super::topics::Decoded;
-use crate::dynamics::effectors::wire_names;
+use crate::dynamics::kinds::wire_names;
 use crate::numfmt::Num;
 
 /// One cell.

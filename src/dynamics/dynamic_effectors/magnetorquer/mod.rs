@@ -14,6 +14,7 @@
 //! point dipole at `r_mb_b_m` (Griffiths eq. 5.89); the magnetometer folder reads it from
 //! [`Magnetorquer::dipole_b_am2`] and [`MagnetorquerParams::r_mb_b_m`].
 
+pub mod kind;
 pub mod schema;
 
 use nalgebra::Vector3;

@@ -37,6 +37,7 @@
 //! solved in closed form at the step boundaries, so it adds no integrated state and its impulse
 //! carries no integration error.
 
+pub mod kind;
 pub mod schema;
 
 use nalgebra::Vector3;

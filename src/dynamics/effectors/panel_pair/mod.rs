@@ -18,6 +18,7 @@ use crate::dynamics::effector::{
     BackSubContributions, EffectorKind, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics,
     StateEffector,
 };
+pub mod kind;
 mod params;
 pub(crate) mod schema;
 

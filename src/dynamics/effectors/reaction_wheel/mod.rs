@@ -61,6 +61,7 @@ use crate::dynamics::effector::{
 use crate::validate::ParamError;
 use flexdyn_proto::wheel_flags;
 
+pub mod kind;
 mod params;
 pub(crate) mod plausibility;
 pub(crate) mod schema;

@@ -1,0 +1,70 @@
+//! The sections of the kinds configured through the generic component list
+//! ([`crate::dynamics::component`]): every kind in [`crate::dynamics::kinds::KINDS`] that has a
+//! reader (`[[magnetorquers]]`, `[[thrusters]]`, …).
+//!
+//! Each kind's reader and validation live in its folder; this file reads the sections in
+//! registry order, checks names for uniqueness within a kind, validates every entry against the
+//! step and frame, and gives the capacity check their count and wire size. These components are
+//! listed after the typed appended bodies in the effector list (registry order, then file order)
+//! and take their inputs from `Actuators` commands by that index.
+
+use std::collections::HashSet;
+
+use crate::dynamics::component::{ComponentSpec, Components, StepTiming};
+use crate::dynamics::kinds::KINDS;
+use crate::schema::TableReader;
+
+use super::{unique_name, ConfigError, SourceMap};
+
+/// The root keys of the generic sections, in registry order.
+pub(super) fn root_keys() -> impl Iterator<Item = &'static str> {
+    KINDS
+        .iter()
+        .filter(|k| k.reader.is_some())
+        .map(|k| k.section)
+}
+
+/// Reads every generic section (each optional); shapes are checked, values not yet.
+pub(super) fn read(root: &TableReader<'_, '_>) -> Result<Vec<Box<dyn ComponentSpec>>, ConfigError> {
+    let mut items = Vec::new();
+    for kind in KINDS {
+        let Some(reader) = &kind.reader else {
+            continue;
+        };
+        for t in root.tables(kind.section, reader.keys)?.unwrap_or_default() {
+            items.push((reader.read)(&t)?);
+        }
+    }
+    Ok(items)
+}
+
+/// Validates every component for `timing`; errors name the entry and the field.
+pub(super) fn resolve(
+    items: Vec<Box<dyn ComponentSpec>>,
+    map: &SourceMap,
+    timing: StepTiming,
+) -> Result<Components, ConfigError> {
+    let components = Components::new(items);
+    let mut names = HashSet::new();
+    let mut section = "";
+    for (path, c) in components.with_paths() {
+        if c.kind().section != section {
+            section = c.kind().section;
+            names.clear();
+        }
+        unique_name(map, &path, c.name(), &mut names, c.kind().noun)?;
+        c.validate(&path, timing).map_err(|e| map.param_error(e))?;
+    }
+    Ok(components)
+}
+
+/// \[bytes\] their entries in the state record: the fixed part and 8 bytes per state and output.
+pub(super) fn wire_bytes(components: &Components) -> usize {
+    components
+        .iter()
+        .map(|c| {
+            let (states, outputs) = c.wire_counts();
+            flexdyn_proto::EFFECTOR_STATE_FIXED_LEN + 8 * (states + outputs)
+        })
+        .sum()
+}

@@ -1,0 +1,103 @@
+//! The registry of effector kinds: one line per kind. Everything above the dynamics that must
+//! know the kinds (configuration sections, the capacity check, the summary line, the campaign's
+//! sections, the telemetry names of CSV and MCAP) loops over [`KINDS`].
+
+use super::component::ComponentKind;
+use super::dynamic_effectors::{magnetorquer, thruster};
+use super::effectors::{panel_pair, reaction_wheel};
+use super::EffectorKind;
+
+/// Every kind, in effector-list order: the appended bodies first, then the listed actuators.
+pub static KINDS: &[&ComponentKind] = &[
+    &panel_pair::kind::COMPONENT,
+    &reaction_wheel::kind::COMPONENT,
+    &magnetorquer::kind::COMPONENT,
+    &thruster::kind::COMPONENT,
+];
+
+/// The registered kind with wire tag `wire_tag`.
+pub fn by_wire_tag(wire_tag: u16) -> Option<&'static ComponentKind> {
+    KINDS
+        .iter()
+        .copied()
+        .find(|k| k.effector.wire_tag == wire_tag)
+}
+
+/// The registered kind named `name` (`panel_pair`).
+pub fn by_name(name: &str) -> Option<&'static ComponentKind> {
+    KINDS.iter().copied().find(|k| k.effector.name == name)
+}
+
+/// How a tool that only has the telemetry names an effector's values (an appended body's, or a
+/// listed actuator's): its kind (CSV prefix), state names and output names, from the wire tag and
+/// the value counts of an [`flexdyn_proto::EffectorState`]. `None` for a kind this build does not
+/// know, or counts that do not match the kind (then the values have no names here).
+pub fn wire_names(
+    kind: u16,
+    n_states: usize,
+    n_outputs: usize,
+) -> Option<(
+    EffectorKind,
+    &'static [&'static str],
+    &'static [&'static str],
+)> {
+    let k = by_wire_tag(kind)?;
+    let (states, outputs) = (k.wire_names)(n_states, n_outputs)?;
+    (states.len() == n_states && outputs.len() == n_outputs)
+        .then_some((k.effector, states, outputs))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+
+    #[test]
+    fn wire_names_match_what_each_built_effector_says() {
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/acs_full.toml"
+        ))
+        .unwrap();
+        let sc = SimConfig::from_toml_str(&text)
+            .unwrap()
+            .build_spacecraft()
+            .unwrap();
+        assert!(sc.effector_count() >= 3);
+        let mut kinds = std::collections::BTreeSet::new();
+        for e in sc.effector_entries() {
+            let (kind, states, outputs) =
+                wire_names(e.kind.wire_tag, e.state_names.len(), e.output_names.len()).unwrap();
+            assert_eq!(kind, e.kind);
+            assert_eq!(states, e.state_names);
+            assert_eq!(outputs, e.output_names);
+            kinds.insert(kind.name);
+        }
+        // Every registered kind is in acs_full, bodies and actuators.
+        let registered: std::collections::BTreeSet<_> =
+            KINDS.iter().map(|k| k.effector.name).collect();
+        assert_eq!(kinds, registered);
+        assert!(wire_names(999, 1, 0).is_none());
+        assert!(wire_names(panel_pair::KIND.wire_tag, 3, 0).is_none());
+    }
+
+    /// Wire tags, names, sections and CSV prefixes are each unique across the registry.
+    #[test]
+    fn the_registry_has_no_duplicates() {
+        let mut tags = std::collections::HashSet::new();
+        let mut names = std::collections::HashSet::new();
+        let mut sections = std::collections::HashSet::new();
+        let mut prefixes = std::collections::HashSet::new();
+        for k in KINDS {
+            assert!(tags.insert(k.effector.wire_tag), "{}", k.effector.name);
+            assert!(names.insert(k.effector.name), "{}", k.effector.name);
+            assert!(sections.insert(k.section), "{}", k.section);
+            assert!(
+                prefixes.insert(k.effector.column_prefix),
+                "{}",
+                k.effector.name
+            );
+            assert!(std::ptr::eq(by_name(k.effector.name).unwrap(), k));
+        }
+    }
+}
