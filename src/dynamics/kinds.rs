@@ -88,7 +88,7 @@ mod tests {
         let mut names = std::collections::HashSet::new();
         let mut sections = std::collections::HashSet::new();
         let mut prefixes = std::collections::HashSet::new();
-        for k in KINDS {
+        for &k in KINDS {
             assert!(tags.insert(k.effector.wire_tag), "{}", k.effector.name);
             assert!(names.insert(k.effector.name), "{}", k.effector.name);
             assert!(sections.insert(k.section), "{}", k.section);
