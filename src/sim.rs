@@ -375,6 +375,7 @@ impl Simulation {
             state: self.sc.state(),
             hub: &hub,
             env: self.environment.as_ref().map(|_| self.sc.environment()),
+            dynamic_effectors: self.sc.dynamic_effectors(),
         };
         self.sensors.sample(&truth, pick);
     }

@@ -32,6 +32,7 @@ fn ideal(seed: u64) -> MagnetometerConfig {
         lsb_t: 0.0,
         every_frames: 1,
         seed,
+        r_sb_b_m: None,
     }
 }
 
@@ -73,6 +74,51 @@ fn zero_error_magnetometer_reads_the_truth_bit_for_bit() {
         sim.step_frame();
     }
     assert_eq!(checked, 6);
+}
+
+/// The rods' own field (`r_sb_b_m` given): two rods commanded at tick 0, one on the sensor's
+/// axis 2 m away (axial field (μ0/4π) 2m/r³ along the rod) and one 1 m broadside (−(μ0/4π) m/r³
+/// along the rod); the reading minus that of the same vehicle with the rods at zero is their sum,
+/// in S. Without `r_sb_b_m` the rods change nothing.
+#[test]
+fn magnetorquer_dipoles_add_their_closed_form_field() {
+    let rods = "[[magnetorquers]]\nname = \"axial\"\naxis_b = [0.0, 0.0, 1.0]\n\
+        r_mb_b_m = [0.0, 0.0, 1.0]\nmax_dipole_am2 = 400.0\n\n\
+        [[magnetorquers]]\nname = \"broadside\"\naxis_b = [1.0, 0.0, 0.0]\n\
+        r_mb_b_m = [0.0, -1.0, 3.0]\nmax_dipole_am2 = 400.0\n\n";
+    let read = |position: &str, dipoles: [f64; 2]| {
+        let text = leo_with(&format!("{rods}{IDEAL_BLOCK}{position}"));
+        let cfg = SimConfig::from_toml_str(&text).unwrap();
+        let mut sim = Simulation::new(&cfg).unwrap();
+        let mut u = sim.effector_inputs().to_vec();
+        let n = u.len();
+        u[n - 2..].copy_from_slice(&dipoles);
+        sim.set_effector_inputs(&u).unwrap();
+        sim.sample_sensors(|s| s.kind().noun == "magnetometer");
+        sim.magnetometers()[0].last().b_s_t
+    };
+    let (m_axial, m_broadside) = (100.0, 50.0);
+    let at = "r_sb_b_m = [0.0, 0.0, 3.0]\n";
+    let rods_on = read(at, [m_axial, m_broadside]);
+    let rods_off = read(at, [0.0, 0.0]);
+    // μ0/4π = 1e-7 T·m/A: axial 1e-7 · 2 · 100 / 2³ = 2.5 µT along +z; broadside
+    // −1e-7 · 50 / 1³ = −5 µT along +x.
+    let want_b = Vector3::new(-1e-7 * m_broadside, 0.0, 1e-7 * 2.0 * m_axial / 8.0);
+    let want_s = dcm_sb() * want_b;
+    let got = rods_on - rods_off;
+    assert!(
+        (got - want_s).norm() <= 1e-17,
+        "rods' field {got:?} T, closed form {want_s:?} T"
+    );
+    assert!(want_s.norm() > 5e-6);
+    // No position: the Earth's field alone, bit for bit.
+    let unplaced_on = read("", [m_axial, m_broadside]);
+    let unplaced_off = read("", [0.0, 0.0]);
+    assert_eq!(
+        unplaced_on.map(f64::to_bits),
+        unplaced_off.map(f64::to_bits)
+    );
+    assert_eq!(unplaced_off.map(f64::to_bits), rods_off.map(f64::to_bits));
 }
 
 fn mean_std(v: &[f64]) -> (f64, f64) {

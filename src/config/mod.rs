@@ -758,6 +758,7 @@ impl RawConfig {
                 lsb_t: raw.lsb_t,
                 every_frames,
                 seed: raw.seed,
+                r_sb_b_m: raw.r_sb_b_m,
             };
             cfg.validate(&path).map_err(param)?;
             magnetometers.push(cfg);

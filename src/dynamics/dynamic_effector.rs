@@ -100,6 +100,14 @@ pub trait DynamicEffector: Send + std::fmt::Debug {
     /// from the file. Not on the stepping path.
     fn parameters(&self, _out: &mut Vec<(String, f64)>) {}
 
+    /// A magnetic dipole this effector carries, as (its position relative to B \[m\], its moment
+    /// \[A·m²\]), both B components, as it applies from now on (after the last inputs): what a
+    /// magnetometer on the vehicle sees of it. `None` (the default) for an effector with none.
+    /// Not on the stepping path.
+    fn magnetic_dipole_b(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        None
+    }
+
     /// An actuator (a magnetorquer, a thruster) is listed beside the appended bodies: it has an
     /// entry in the state record's effector list under this kind, after the state effectors, and
     /// takes its inputs from `CommandKind::Actuators` by that index. `None` (the default) for a

@@ -22,7 +22,7 @@ use flexdyn_proto::{DecodeError, Header, KeyError};
 
 use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::stage_hook::StageCombine;
-use crate::dynamics::{HubOutputs, State};
+use crate::dynamics::{DynamicEffector, HubOutputs, State};
 use crate::environment::EnvironmentSample;
 
 pub mod bank;
@@ -47,6 +47,9 @@ pub struct Truth<'a> {
     pub hub: &'a HubOutputs,
     /// The environment sample (`[environment]` with an `[epoch]`), if any.
     pub env: Option<&'a EnvironmentSample>,
+    /// The spacecraft's dynamic effectors, with their inputs as they apply from now on (a
+    /// magnetometer adds the field of the magnetorquer dipoles among them).
+    pub dynamic_effectors: &'a [Box<dyn DynamicEffector>],
 }
 
 /// One sensor: what the bank, the server and the sinks need of it. Every method called per

@@ -49,13 +49,20 @@ impl CentredDipole {
     /// [T] the dipole's field in Earth-fixed components at `r_ecef_m` [m]:
     /// (μ0/4π) [3 (m·r̂) r̂ − m] / r³. Allocation-free; zero at the centre.
     pub fn field_ecef_t(&self, r_ecef_m: &Vector3<f64>) -> Vector3<f64> {
-        let r = r_ecef_m.norm();
-        if r == 0.0 {
-            return Vector3::zeros();
-        }
-        let r_hat = r_ecef_m / r;
-        MU0_OVER_4PI * (3.0 * self.m_ecef_am2.dot(&r_hat) * r_hat - self.m_ecef_am2) / (r * r * r)
+        dipole_field_t(&self.m_ecef_am2, r_ecef_m)
     }
+}
+
+/// [T] the field of a point dipole of moment `m_am2` [A·m²] at `r_m` [m] from it (any frame, the
+/// same for both): (μ0/4π) [3 (m·r̂) r̂ − m] / r³ (Jackson, *Classical Electrodynamics*, 3rd ed.,
+/// eq. 5.56). Allocation-free; zero at the dipole itself.
+pub fn dipole_field_t(m_am2: &Vector3<f64>, r_m: &Vector3<f64>) -> Vector3<f64> {
+    let r = r_m.norm();
+    if r == 0.0 {
+        return Vector3::zeros();
+    }
+    let r_hat = r_m / r;
+    MU0_OVER_4PI * (3.0 * m_am2.dot(&r_hat) * r_hat - m_am2) / (r * r * r)
 }
 
 /// [N·m] the torque τ = m × B on a magnetic dipole `m_b_am2` [A·m²] (a spacecraft's residual

@@ -31,7 +31,7 @@
 pub mod dipole;
 pub mod igrf;
 
-pub use dipole::{dipole_torque_b_nm, CentredDipole};
+pub use dipole::{dipole_field_t, dipole_torque_b_nm, CentredDipole};
 pub use igrf::{GaussCoefficients, Igrf, SphericalField, IGRF_MAX_DEGREE};
 
 /// An invalid magnetic-field model or a date it does not cover.

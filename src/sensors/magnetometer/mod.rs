@@ -19,9 +19,18 @@
 //! every error term zero, y_S = [SB][BN] B_N exactly (the same floating-point products).
 //!
 //! # The spacecraft's own field
-//! Flight magnetometers also see the field of the spacecraft's magnetorquers (issue 20 §3). It
-//! is additive in B: [`Magnetometer::truth_b_t`] is the one place that forms B_B, so a
-//! disturbance field from the torquer dipoles adds there. It is not modelled yet.
+//! Flight magnetometers also see the field of the spacecraft's magnetorquers (issue 20 §3). When
+//! the sensor's position `r_sb_b_m` is configured, [`Magnetometer::truth_b_t`] (the one place
+//! that forms B_B) adds the field of every dipole a dynamic effector carries (each magnetorquer
+//! rod, with the dipole it applies from now on) as a point dipole at the rod's centre:
+//! B = (μ0/4π) [3 (m·r̂) r̂ − m] / r³ with r from the rod to the sensor
+//! ([`crate::environment::magnetic::dipole_field_t`]). The point-dipole (far-field) form is
+//! accurate a few rod lengths away; nearer, a real rod's field differs and the sensor should be
+//! placed farther (as flight magnetometers are, often on a boom). A 100 A·m² rod 1 m away adds
+//! up to 20 µT, comparable to the Earth's field in LEO: B-dot laws either stop the rods while
+//! the magnetometer samples or subtract a calibrated model. Without `r_sb_b_m` the sensor sees
+//! the Earth's field alone. The residual dipole of `[environment]` has no position and is not
+//! added.
 //!
 //! # Timing and random numbers
 //! The magnetometer updates every `frame_hz / rate_hz` frames (a whole number), at the frame
@@ -33,6 +42,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::attitude::mrp_to_dcm;
+use crate::environment::magnetic::dipole_field_t;
 use crate::sensors::{Sensor, SensorKind, Truth};
 use crate::validate::{check_dcm, check_finite, check_non_negative, ParamError};
 use flexdyn_proto::{encode_into, magnetometer_flags, Header, MagnetometerMsg};
@@ -67,6 +77,9 @@ pub struct MagnetometerConfig {
     pub lsb_t: f64,
     /// Updates every this many frames (from `rate_hz`; ≥ 1).
     pub every_frames: u64,
+    /// \[m\] the sensor's position relative to B, B components; when given, the field of the
+    /// spacecraft's magnetorquer dipoles at this point adds to the Earth's (module docs).
+    pub r_sb_b_m: Option<Vector3<f64>>,
     /// RNG seed (0 ≤ seed ≤ 2⁶³ − 1 in the configuration).
     pub seed: u64,
 }
@@ -78,6 +91,9 @@ impl MagnetometerConfig {
         check_finite(path, "scale_factor", self.scale_factor.as_slice())?;
         check_finite(path, "misalignment_rad", self.misalignment_rad.as_slice())?;
         check_finite(path, "bias_s_t", self.bias_s_t.as_slice())?;
+        if let Some(r) = &self.r_sb_b_m {
+            check_finite(path, "r_sb_b_m", r.as_slice())?;
+        }
         check_non_negative(path, "noise_sigma_t", self.noise_sigma_t)?;
         check_non_negative(path, "range_t", self.range_t)?;
         check_non_negative(path, "lsb_t", self.lsb_t)
@@ -149,12 +165,23 @@ impl Magnetometer {
     }
 
     /// The field at the sensor, B components: [BN] B_N from the environment sample (zero
-    /// without one). The spacecraft's own field (magnetorquer dipoles) would add here.
-    pub fn truth_b_t(truth: &Truth<'_>) -> Vector3<f64> {
-        match truth.env {
+    /// without one), plus, when the sensor's position is configured, the field of every
+    /// magnetic dipole the spacecraft's dynamic effectors carry (module docs).
+    pub fn truth_b_t(&self, truth: &Truth<'_>) -> Vector3<f64> {
+        let mut b_b_t = match truth.env {
             Some(env) => mrp_to_dcm(&truth.state.sigma_bn) * env.b_field_n_t,
             None => Vector3::zeros(),
+        };
+        if let Some(r_sb_b_m) = &self.cfg.r_sb_b_m {
+            for (r_mb_b_m, m_b_am2) in truth
+                .dynamic_effectors
+                .iter()
+                .filter_map(|e| e.magnetic_dipole_b())
+            {
+                b_b_t += dipole_field_t(&m_b_am2, &(r_sb_b_m - r_mb_b_m));
+            }
         }
+        b_b_t
     }
 
     /// One measurement of the field `b_b_t` (B components) by the model of the module docs.
@@ -201,7 +228,7 @@ impl Sensor for Magnetometer {
     }
 
     fn sample(&mut self, truth: &Truth<'_>) {
-        let b_b_t = Self::truth_b_t(truth);
+        let b_b_t = self.truth_b_t(truth);
         self.last = self.measure(&b_b_t);
     }
 

@@ -7,7 +7,7 @@ use nalgebra::{Matrix3, Vector3};
 use crate::schema::{mat3, vec3, SchemaError, TableReader};
 
 /// The keys of one `[[magnetometers]]` entry (the first four are required).
-pub(crate) const KEYS: [&str; 10] = [
+pub(crate) const KEYS: [&str; 11] = [
     "name",
     "dcm_sb",
     "rate_hz",
@@ -18,6 +18,7 @@ pub(crate) const KEYS: [&str; 10] = [
     "noise_sigma_t",
     "range_t",
     "lsb_t",
+    "r_sb_b_m",
 ];
 
 /// One entry as written (the rate is converted to frames by the configuration).
@@ -32,6 +33,7 @@ pub(crate) struct RawMagnetometer {
     pub(crate) noise_sigma_t: f64,
     pub(crate) range_t: f64,
     pub(crate) lsb_t: f64,
+    pub(crate) r_sb_b_m: Option<Vector3<f64>>,
 }
 
 /// Reads one entry.
@@ -50,5 +52,6 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawMagnetometer, SchemaErr
         noise_sigma_t: t.opt_f64("noise_sigma_t")?.unwrap_or(0.0),
         range_t: t.opt_f64("range_t")?.unwrap_or(0.0),
         lsb_t: t.opt_f64("lsb_t")?.unwrap_or(0.0),
+        r_sb_b_m: t.opt_floats("r_sb_b_m")?.map(v3),
     })
 }

@@ -108,6 +108,10 @@ impl DynamicEffector for Magnetorquer {
         sum.torque_b_nm += dipole_torque_b_nm(&self.dipole_b_am2(), &b_b_t);
     }
 
+    fn magnetic_dipole_b(&self) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        Some((self.params.r_mb_b_m, self.dipole_b_am2()))
+    }
+
     fn parameters(&self, out: &mut Vec<(String, f64)>) {
         let p = &self.params;
         for i in 0..3 {
