@@ -20,7 +20,7 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tupl
 import zenoh
 
 from . import proto
-from .proto import (CommandMsg, CssMsg, EffectorInput, FssMsg, Header, ImuMsg, StarTrackerMsg, StateMsg,
+from .proto import (CommandMsg, EffectorInput, Header, ImuMsg, StarTrackerMsg, StateMsg,
                     StatusMsg, TimeMsg)
 
 Vec3 = Tuple[float, float, float]
@@ -65,9 +65,9 @@ class VehicleInfo:
 
 
 #: The decoder of each telemetry key kind: the part of the key after ``flexdyn/<sc>/tlm/``
-#: is ``state``, ``imu/<name>``, ``st/<name>``, ``css/<name>`` or ``fss/<name>``.
+#: is ``state``, ``imu/<name>`` or ``st/<name>``.
 _DECODERS = {"state": StateMsg.decode, "imu": ImuMsg.decode, "st": StarTrackerMsg.decode,
-             "time": TimeMsg.decode, "css": CssMsg.decode, "fss": FssMsg.decode}
+             "time": TimeMsg.decode}
 
 
 class Subscription:
