@@ -123,7 +123,11 @@ fn a_recording_gives_every_figure() {
         err.contains("skipped magnetometer.png: no magnetometer"),
         "{err}"
     );
-    assert_eq!(err.matches("skipped").count(), 3, "{err}");
+    // Nor sun sensors.
+    for fig in ["sun_sensors_coarse.png", "sun_sensors_fine.png"] {
+        assert!(err.contains(&format!("skipped {fig}")), "{err}");
+    }
+    assert_eq!(err.matches("skipped").count(), 5, "{err}");
     assert!(!out.join("timing.png").exists());
 
     let (figs, _) = figures(&args(&rec)).unwrap();
@@ -370,6 +374,8 @@ fn a_simulate_csv_gives_the_state_figures_and_names_the_rest() {
         "star_tracker.png",
         "imu.png",
         "magnetometer.png",
+        "sun_sensors_coarse.png",
+        "sun_sensors_fine.png",
         "timing.png",
     ] {
         assert!(err.contains(&format!("skipped {skipped}")), "{err}");
@@ -466,4 +472,49 @@ inputs = [60.0]
     let used = a.panels[3].lines[0].points.last().unwrap().1;
     let expected = 20.0 * 0.03 / (220.0 * 9.80665);
     assert!((used - expected).abs() < 1e-15, "{used} vs {expected}");
+}
+
+/// The LEO scenario's sun sensors (a six-detector array, a fine sensor) through `simulate` and
+/// `plot`: both figures are drawn, the array's panels hold its six detectors' columns (the
+/// unused slots 7–16 are zero) and the fine sensor's its two angles and flags.
+#[test]
+fn sun_sensor_figures_from_a_simulate_csv() {
+    let dir = tmp("sun_sensors");
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("leo.csv");
+    let config = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/leo_environment.toml"
+    );
+    let r = flexdyn(&[
+        "simulate",
+        "--config",
+        config,
+        "--duration-s",
+        "2",
+        "--log-every-s",
+        "0.1",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let r = flexdyn(&["plot", csv.to_str().unwrap(), "-o", dir.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    check_figures(&dir, &["sun_sensors_coarse.png", "sun_sensors_fine.png"]);
+    let (figs, _) = figures(&args(&csv)).unwrap();
+    let coarse = find(&figs, "sun_sensors_coarse.png");
+    assert_eq!(coarse.panels.len(), 2);
+    let lit: usize = coarse.panels[0]
+        .lines
+        .iter()
+        .filter(|s| s.points.iter().any(|p| p.1 > 0.05))
+        .count();
+    assert!((1..=3).contains(&lit), "lit faces: {lit}");
+    assert!(coarse.panels[1]
+        .lines
+        .iter()
+        .all(|s| s.points.iter().all(|p| p.1 == 0.0)));
+    let fine = find(&figs, "sun_sensors_fine.png");
+    assert_eq!(fine.panels.len(), 2);
 }

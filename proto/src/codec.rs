@@ -16,13 +16,14 @@
 //!    [`DecodeError::Malformed`] for an unknown tag or an excessive count; this
 //!    also bounds any allocation before bincode sees a length prefix;
 //! 4. bincode decodes; bad enum tags, bool bytes etc. → [`DecodeError::Malformed`];
-//! 5. [`WireMessage::validate`] (commands: finite numbers) → [`DecodeError::NonFinite`].
+//! 5. [`WireMessage::validate`] (commands: finite numbers) → [`DecodeError::NonFinite`]; a
+//!    [`crate::CssMsg`] detector count above its maximum → [`DecodeError::Malformed`].
 
 use bincode::config::{Configuration, Fixint, Limit, LittleEndian};
 
 use crate::{
-    CommandMsg, DecodeError, Header, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg,
-    TimeMsg, WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
+    CommandMsg, CssMsg, DecodeError, FssMsg, Header, ImuMsg, MagnetometerMsg, StarTrackerMsg,
+    StateMsg, StatusMsg, TimeMsg, WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
 };
 
 /// The bincode configuration of the wire format.
@@ -111,6 +112,16 @@ pub fn decode_star_tracker(bytes: &[u8]) -> Result<StarTrackerMsg, DecodeError> 
 
 /// [`decode`] for [`MagnetometerMsg`].
 pub fn decode_magnetometer(bytes: &[u8]) -> Result<MagnetometerMsg, DecodeError> {
+    decode(bytes)
+}
+
+/// [`decode`] for [`CssMsg`] (rejects a detector count above [`crate::MAX_CSS_DETECTORS`]).
+pub fn decode_css(bytes: &[u8]) -> Result<CssMsg, DecodeError> {
+    decode(bytes)
+}
+
+/// [`decode`] for [`FssMsg`].
+pub fn decode_fss(bytes: &[u8]) -> Result<FssMsg, DecodeError> {
     decode(bytes)
 }
 

@@ -18,6 +18,10 @@ pub const IMU_PREFIX: &str = "tlm/imu";
 pub const STAR_TRACKER_PREFIX: &str = "tlm/st";
 /// Prefix of the magnetometer topics; the magnetometer name follows after a `/`.
 pub const MAGNETOMETER_PREFIX: &str = "tlm/mag";
+/// Prefix of the coarse-sun-sensor array topics; the array name follows after a `/`.
+pub const CSS_PREFIX: &str = "tlm/css";
+/// Prefix of the fine-sun-sensor topics; the sensor name follows after a `/`.
+pub const FSS_PREFIX: &str = "tlm/fss";
 /// Prefix of the command topics; the sender's decimal `sender_id` follows after a `/`
 /// (`flexdyn/<sc>/cmd/<sender_id>`, every [`crate::CommandKind`]). One key per sender, so a
 /// Zenoh access-control list can reserve each participant's key for its authenticated subject.

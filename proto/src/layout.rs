@@ -5,8 +5,8 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use crate::{
-    CommandKind, CommandMsg, DecodeError, Header, ImuMsg, MagnetometerMsg, StarTrackerMsg,
-    StateMsg, StatusMsg, TimeMsg,
+    CommandKind, CommandMsg, CssMsg, DecodeError, FssMsg, Header, ImuMsg, MagnetometerMsg,
+    StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
 };
 
 /// Encoded [`Header`] size (bytes).
@@ -26,6 +26,10 @@ pub const IMU_LEN: usize = 127;
 pub const STAR_TRACKER_LEN: usize = 64;
 /// Encoded [`MagnetometerMsg`] size (bytes).
 pub const MAGNETOMETER_LEN: usize = 55;
+/// Encoded [`CssMsg`] size (bytes).
+pub const CSS_LEN: usize = 159;
+/// Encoded [`FssMsg`] size (bytes).
+pub const FSS_LEN: usize = 47;
 /// Encoded [`TimeMsg`] size (bytes).
 pub const TIME_LEN: usize = 122;
 /// Offset of the 8 CCSDS CUC octets in a [`TimeMsg`].
@@ -78,6 +82,8 @@ mod sealed {
     impl Sealed for super::StatusMsg {}
     impl Sealed for super::StarTrackerMsg {}
     impl Sealed for super::MagnetometerMsg {}
+    impl Sealed for super::CssMsg {}
+    impl Sealed for super::FssMsg {}
     impl Sealed for super::TimeMsg {}
 }
 
@@ -140,6 +146,37 @@ impl WireMessage for MagnetometerMsg {
         len: MAGNETOMETER_LEN,
     };
     const MIN_LEN: usize = MAGNETOMETER_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+impl WireMessage for CssMsg {
+    const NAME: &'static str = "CssMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed { len: CSS_LEN };
+    const MIN_LEN: usize = CSS_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+
+    /// Rejects a `detector_count` above [`crate::MAX_CSS_DETECTORS`].
+    fn validate(&self) -> Result<(), DecodeError> {
+        if usize::from(self.detector_count) > crate::MAX_CSS_DETECTORS {
+            return Err(DecodeError::Malformed(format!(
+                "detector count {} at offset {} exceeds maximum {}",
+                self.detector_count,
+                HEADER_LEN,
+                crate::MAX_CSS_DETECTORS
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl WireMessage for FssMsg {
+    const NAME: &'static str = "FssMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed { len: FSS_LEN };
+    const MIN_LEN: usize = FSS_LEN;
     fn header(&self) -> &Header {
         &self.header
     }

@@ -336,6 +336,53 @@ pub struct MagnetometerMsg {
     pub saturation_flags: u8,
 }
 
+/// Most detectors one [`CssMsg`] carries (one coarse-sun-sensor array); a configuration may
+/// not have more.
+pub const MAX_CSS_DETECTORS: usize = 16;
+
+/// A coarse-sun-sensor array sample, topic `flexdyn/<sc-id>/tlm/css/<name>`: one reading per
+/// cosine detector. 159 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct CssMsg {
+    /// Common header; `tick` is the frame at whose end the sample was taken.
+    pub header: Header,
+    /// How many detectors the array has (0..=[`MAX_CSS_DETECTORS`]; more is malformed): the
+    /// first `detector_count` entries of `readings` are theirs, the rest are 0.
+    pub detector_count: u8,
+    /// Reading of each detector in configuration order, in the array's output unit (its
+    /// `scale` at normal incidence in full sunlight; 0 outside the field of view and in umbra).
+    pub readings: [f64; MAX_CSS_DETECTORS],
+}
+
+/// Bits of [`FssMsg::flags`].
+pub mod fss_flags {
+    /// Bit 0: the angles are a measurement (the Sun is in the field of view and lit, bits 1 and
+    /// 2 both set); otherwise both angles are 0.
+    pub const VALID: u8 = 1 << 0;
+    /// Bit 1: the Sun direction is inside the field-of-view cone.
+    pub const IN_FOV: u8 = 1 << 1;
+    /// Bit 2: the shadow factor is at least the sensor's threshold (not in eclipse).
+    pub const SUNLIT: u8 = 1 << 2;
+    /// Bits 3..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 = !(VALID | IN_FOV | SUNLIT);
+}
+
+/// A fine (two-axis) sun sensor sample, topic `flexdyn/<sc-id>/tlm/fss/<name>`. 47 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct FssMsg {
+    /// Common header; `tick` is the frame at whose end the sample was taken.
+    pub header: Header,
+    /// Sun angle in the sensor's 1–3 plane (rad): atan2(s₁, s₃) of the Sun direction s in the
+    /// sensor frame F, boresight +3.
+    pub alpha_rad: f64,
+    /// Sun angle in the sensor's 2–3 plane (rad): atan2(s₂, s₃).
+    pub beta_rad: f64,
+    /// See [`fss_flags`].
+    pub flags: u8,
+}
+
 /// What a [`CommandMsg`] asks for. Wire: u32 LE variant index (0 = `Wrench`,
 /// 1 = `NoCommand`, 2 = `Actuators`), then the variant's fields.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -6,7 +6,7 @@
 //!   message from its table values and decodes the golden files (`proto/golden/`) back;
 //! - `c_and_rust_decoders_agree_on_100000_buffers`: `proto/c/tests/fuzz_decode.c` and the Rust
 //!   decoders see the same 100,000 seeded buffers (valid messages of every type, mutated,
-//!   truncated, extended, random with a valid version, oversized) through all seven decoders;
+//!   truncated, extended, random with a valid version, oversized) through all nine decoders;
 //!   (`flexdyn-decode-verdicts`, the canonical verdict printer the Python SDK's fuzz test uses
 //!   too); they must agree on accept/reject, on the reason (and its numbers or field), and on every
 //!   decoded field bit for bit. Every buffer the C side decodes it also re-encodes, and that must
@@ -24,8 +24,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use flexdyn_proto::{
-    encode, CommandKind, CommandMsg, EffectorInput, EffectorState, Header, ImuMsg, MagnetometerMsg,
-    Mode, RejectCounters, StarTrackerMsg, StateMsg, StatusMsg, MAX_MESSAGE_BYTES,
+    encode, CommandKind, CommandMsg, CssMsg, EffectorInput, EffectorState, FssMsg, Header, ImuMsg,
+    MagnetometerMsg, Mode, RejectCounters, StarTrackerMsg, StateMsg, StatusMsg, MAX_MESSAGE_BYTES,
 };
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -277,7 +277,7 @@ impl Gen {
     }
 
     fn message(&mut self) -> Vec<u8> {
-        match self.below(6) {
+        match self.below(8) {
             0 => {
                 let effectors = (0..self.below(6))
                     .map(|_| EffectorState {
@@ -323,6 +323,18 @@ impl Gen {
                 header: self.header(),
                 b_s_t: self.v(),
                 saturation_flags: self.u64() as u8,
+            }),
+            // Counts up to 17: the last is above the maximum (Malformed).
+            6 => encode(&CssMsg {
+                header: self.header(),
+                detector_count: self.below(18) as u8,
+                readings: self.v(),
+            }),
+            7 => encode(&FssMsg {
+                header: self.header(),
+                alpha_rad: self.f64(),
+                beta_rad: self.f64(),
+                flags: self.u64() as u8,
             }),
             3 => {
                 // Mostly finite (accepted), sometimes with a non-finite number (NonFinite).
@@ -468,6 +480,8 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
             "imu",
             "star_tracker",
             "magnetometer",
+            "css",
+            "fss",
             "command",
             "status",
             "header",
@@ -491,7 +505,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
     }
     assert!(c_lines.next().is_none(), "extra C output");
     eprintln!(
-        "{N} buffers x 7 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
+        "{N} buffers x 9 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
     );
     // The stream exercises every outcome.
     for r in [

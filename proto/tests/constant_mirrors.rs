@@ -6,8 +6,8 @@
 use std::collections::HashMap;
 
 use flexdyn_proto::{
-    command_flags, effector_kind, magnetorquer_flags, saturation_flags, star_tracker_flags,
-    thruster_flags, wheel_flags,
+    command_flags, effector_kind, fss_flags, magnetorquer_flags, saturation_flags,
+    star_tracker_flags, thruster_flags, wheel_flags,
 };
 
 /// An integer literal as both files write it: decimal or `0x…`, with an optional `u` suffix.
@@ -53,7 +53,7 @@ fn python_constants() -> HashMap<String, u64> {
 
 #[test]
 fn c_and_python_mirror_every_kind_and_flag() {
-    let mirrored: [(&str, u64); 22] = [
+    let mirrored: [(&str, u64); 28] = [
         ("EFFECTOR_PANEL_PAIR", effector_kind::PANEL_PAIR.into()),
         (
             "EFFECTOR_REACTION_WHEEL",
@@ -97,6 +97,13 @@ fn c_and_python_mirror_every_kind_and_flag() {
             "THRUSTER_COMMAND_CLIPPED",
             thruster_flags::COMMAND_CLIPPED.into(),
         ),
+        // The sun sensors (protocol 6).
+        ("FSS_VALID", fss_flags::VALID.into()),
+        ("FSS_IN_FOV", fss_flags::IN_FOV.into()),
+        ("FSS_SUNLIT", fss_flags::SUNLIT.into()),
+        ("MAX_CSS_DETECTORS", flexdyn_proto::MAX_CSS_DETECTORS as u64),
+        ("CSS_LEN", flexdyn_proto::CSS_LEN as u64),
+        ("FSS_LEN", flexdyn_proto::FSS_LEN as u64),
         ("PROTOCOL_VERSION", flexdyn_proto::PROTOCOL_VERSION.into()),
         ("MAX_EFFECTORS", flexdyn_proto::MAX_EFFECTORS as u64),
         (

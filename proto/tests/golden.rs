@@ -21,14 +21,15 @@
 //! message lists field, offset, expected and actual bytes to help review).
 
 use flexdyn_proto::{
-    command_flags, decode, decode_header, effector_kind, encode, magnetometer_flags,
+    command_flags, decode, decode_header, effector_kind, encode, fss_flags, magnetometer_flags,
     magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags, time_flags,
-    wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, EffectorInput,
-    EffectorState, FrameTiming, Header, ImuMsg, MagnetometerMsg, Mode, RejectCounters, RunState,
-    StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime, WireMessage,
-    COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CUC_PFIELD_TAI_4_3,
-    EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, IMU_LEN, MAGNETOMETER_LEN,
-    STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
+    wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, CssMsg,
+    DecodeError, EffectorInput, EffectorState, FrameTiming, FssMsg, Header, ImuMsg,
+    MagnetometerMsg, Mode, RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg,
+    StatusMsg, SysTime, TimeMsg, UtcTime, WireMessage, COMMAND_ACTUATORS_FIXED_LEN,
+    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CSS_LEN, CUC_PFIELD_TAI_4_3,
+    EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, FSS_LEN, IMU_LEN, MAGNETOMETER_LEN,
+    MAX_CSS_DETECTORS, STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
 };
 
 type Golden = &'static [(usize, &'static str, &'static str)];
@@ -100,7 +101,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -360,7 +361,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -436,7 +437,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -483,7 +484,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -553,7 +554,7 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -583,8 +584,71 @@ const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
     ),
     (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
 ];
+// The sun sensors' tables (protocol 6, issue 20).
+const CSS_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0600", "u16 header.protocol_version = 6"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "0d00000000000000", "u64 header.tick = 13"),
+    (
+        14,
+        "80a4bf0700000000",
+        "u64 header.sim_time_ns = 130000000 (0x7BFA480)",
+    ),
+    (22, "0100000000000000", "u64 header.seq = 1"),
+    (30, "03", "u8 detector_count = 3"),
+    (
+        31,
+        "000000000000e03f",
+        "f64 readings[0] = 0.5 (bits 0x3FE0000000000000)",
+    ),
+    (
+        39,
+        "000000000000e83f",
+        "f64 readings[1] = 0.75 (bits 0x3FE8000000000000)",
+    ),
+    (
+        47,
+        "000000000000503f",
+        "f64 readings[2] = 2^-10 = 0.0009765625 (bits 0x3F50000000000000)",
+    ),
+    (
+        55,
+        "0000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000000",
+        "f64 readings[3..16] = 0.0 (13 unused slots, 104 zero bytes)",
+    ),
+];
+const FSS_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0600", "u16 header.protocol_version = 6"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "0d00000000000000", "u64 header.tick = 13"),
+    (
+        14,
+        "80a4bf0700000000",
+        "u64 header.sim_time_ns = 130000000 (0x7BFA480)",
+    ),
+    (22, "0100000000000000", "u64 header.seq = 1"),
+    (
+        30,
+        "000000000000c03f",
+        "f64 alpha_rad = 0.125 (bits 0x3FC0000000000000)",
+    ),
+    (
+        38,
+        "000000000000b0bf",
+        "f64 beta_rad = -0.0625 (bits 0xBFB0000000000000)",
+    ),
+    (46, "07", "u8 flags = VALID | IN_FOV | SUNLIT = 0x07"),
+];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -628,7 +692,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
 /// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
 /// TAI …036.0 s). `src/server/clock.rs` produces exactly this message from that epoch.
 const TIME_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -701,7 +765,7 @@ const TIME_GOLDEN: &[(usize, &str, &str)] = &[
     (118, "00000000", "u32 tone_tai.subseconds = 0"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -718,7 +782,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -969,6 +1033,41 @@ fn magnetometer_golden() {
 }
 
 #[test]
+fn css_golden() {
+    let mut readings = [0.0; MAX_CSS_DETECTORS];
+    readings[..3].copy_from_slice(&[0.5, 0.75, 0.000_976_562_5]);
+    let msg = CssMsg {
+        header: Header::new(SC, 13, 130_000_000, 1),
+        detector_count: 3,
+        readings,
+    };
+    check("CssMsg", CSS_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), CSS_LEN);
+    // A detector count above the maximum is malformed, at the maximum it decodes.
+    let mut b = golden_bytes(CSS_GOLDEN);
+    b[30] = MAX_CSS_DETECTORS as u8;
+    assert!(decode::<CssMsg>(&b).is_ok());
+    b[30] = MAX_CSS_DETECTORS as u8 + 1;
+    assert!(
+        matches!(decode::<CssMsg>(&b), Err(DecodeError::Malformed(ref m)) if m.contains("detector count 17")),
+        "{:?}",
+        decode::<CssMsg>(&b)
+    );
+}
+
+#[test]
+fn fss_golden() {
+    let msg = FssMsg {
+        header: Header::new(SC, 13, 130_000_000, 1),
+        alpha_rad: 0.125,
+        beta_rad: -0.0625,
+        flags: fss_flags::VALID | fss_flags::IN_FOV | fss_flags::SUNLIT,
+    };
+    check("FssMsg", FSS_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), FSS_LEN);
+}
+
+#[test]
 fn command_no_command_golden() {
     let msg = CommandMsg::no_command(Header::new(SC, 43, 430_000_000, 8), 5);
     assert_eq!(msg.kind, CommandKind::NoCommand);
@@ -1087,6 +1186,10 @@ fn flag_bits() {
     assert_eq!(magnetometer_flags::AXIS_2, 0b010);
     assert_eq!(magnetometer_flags::AXIS_3, 0b100);
     assert_eq!(magnetometer_flags::RESERVED_MASK, 0b1111_1000);
+    assert_eq!(fss_flags::VALID, 0b001);
+    assert_eq!(fss_flags::IN_FOV, 0b010);
+    assert_eq!(fss_flags::SUNLIT, 0b100);
+    assert_eq!(fss_flags::RESERVED_MASK, 0b1111_1000);
     assert_eq!(time_flags::EPOCH_VALID, 0b001);
     assert_eq!(time_flags::TONE, 0b010);
     assert_eq!(time_flags::LEAP_SECOND, 0b100);
@@ -1111,7 +1214,7 @@ fn flag_bits() {
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 9] = [
+    let tables: [(&str, &str, Golden, &str); 11] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -1146,6 +1249,9 @@ fn exported_golden_files_match_the_tables() {
             "MAGNETOMETER_GOLDEN",
         ),
         ("time", "TimeMsg", TIME_GOLDEN, "TIME_GOLDEN"),
+        // Protocol 6, the sun sensors.
+        ("css", "CssMsg", CSS_GOLDEN, "CSS_GOLDEN"),
+        ("fss", "FssMsg", FSS_GOLDEN, "FSS_GOLDEN"),
     ];
     let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");
     let rows: Vec<Vec<&str>> = manifest

@@ -52,6 +52,8 @@ use crate::dynamics::{
     PanelPairParams, ParamError, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
     WrenchSegment,
 };
+use crate::sensors::coarse_sun_sensor::{self, schema::RawCoarseSunSensor, CoarseSunSensorConfig};
+use crate::sensors::fine_sun_sensor::{self, schema::RawFineSunSensor, FineSunSensorConfig};
 use crate::sensors::imu::{self, schema::RawImu, ImuConfig};
 use crate::sensors::magnetometer::{self, schema::RawMagnetometer, MagnetometerConfig};
 use crate::sensors::star_tracker::{self, schema::RawStarTracker, StarTrackerConfig};
@@ -103,6 +105,10 @@ pub struct SimConfig {
     pub star_trackers: Vec<StarTrackerConfig>,
     /// The magnetometers (`[[magnetometers]]`), validated, in file order (empty if absent).
     pub magnetometers: Vec<MagnetometerConfig>,
+    /// The coarse-sun-sensor arrays (`[[coarse_sun_sensors]]`), validated, in file order.
+    pub coarse_sun_sensors: Vec<CoarseSunSensorConfig>,
+    /// The fine sun sensors (`[[fine_sun_sensors]]`), validated, in file order.
+    pub fine_sun_sensors: Vec<FineSunSensorConfig>,
     /// The simulation epoch (`[epoch]`), if given: t = 0 is this instant.
     pub epoch: Option<crate::environment::epoch::SimEpoch>,
     /// The environment (`[environment]`), if given: models and dynamic effectors.
@@ -339,6 +345,8 @@ const ROOT_KEYS: &[&str] = &[
     "imus",
     "star_trackers",
     "magnetometers",
+    "coarse_sun_sensors",
+    "fine_sun_sensors",
     world::ROOT_KEYS[0],
     world::ROOT_KEYS[1],
     world::ROOT_KEYS[2],
@@ -359,6 +367,8 @@ struct RawConfig {
     imus: Vec<RawImu>,
     star_trackers: Vec<RawStarTracker>,
     magnetometers: Vec<RawMagnetometer>,
+    coarse_sun_sensors: Vec<RawCoarseSunSensor>,
+    fine_sun_sensors: Vec<RawFineSunSensor>,
 }
 
 struct RawSimulation {
@@ -513,6 +523,18 @@ impl RawConfig {
             .iter()
             .map(magnetometer::schema::read)
             .collect::<Result<Vec<_>, _>>()?;
+        let coarse_sun_sensors = root
+            .tables("coarse_sun_sensors", &coarse_sun_sensor::schema::KEYS)?
+            .unwrap_or_default()
+            .iter()
+            .map(coarse_sun_sensor::schema::read)
+            .collect::<Result<Vec<_>, _>>()?;
+        let fine_sun_sensors = root
+            .tables("fine_sun_sensors", &fine_sun_sensor::schema::KEYS)?
+            .unwrap_or_default()
+            .iter()
+            .map(fine_sun_sensor::schema::read)
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(RawConfig {
             world,
             simulation,
@@ -528,6 +550,8 @@ impl RawConfig {
             imus,
             star_trackers,
             magnetometers,
+            coarse_sun_sensors,
+            fine_sun_sensors,
         })
     }
 }
@@ -764,6 +788,52 @@ impl RawConfig {
             magnetometers.push(cfg);
         }
 
+        // [[coarse_sun_sensors]] and [[fine_sun_sensors]]. Like a magnetometer without a field
+        // model, a sun sensor without `[environment] sun = true` sees no Sun (it reads 0).
+        let sun_sensor = |path: &str, name: &str, seen: &mut HashSet<String>, what: &str| {
+            unique_name(map, path, name, seen, what)?;
+            flexdyn_proto::validate_sensor_name(name)
+                .map_err(|e| map.invalid(&format!("{path}.name"), e.to_string()))
+        };
+        let mut coarse_sun_sensors = Vec::with_capacity(self.coarse_sun_sensors.len());
+        let mut names = HashSet::new();
+        for (i, raw) in self.coarse_sun_sensors.into_iter().enumerate() {
+            let path = format!("coarse_sun_sensors[{i}]");
+            sun_sensor(&path, &raw.name, &mut names, "coarse sun sensor")?;
+            let cfg = CoarseSunSensorConfig {
+                every_frames: every_frames(map, &path, raw.rate_hz, sim.frame_hz, "array")?,
+                name: raw.name,
+                normals_b: raw.normals_b,
+                fov_half_angle_rad: raw.fov_half_angle_rad,
+                scale: raw.scale,
+                bias: raw.bias,
+                noise_sigma: raw.noise_sigma,
+                lsb: raw.lsb,
+                seed: raw.seed,
+            };
+            cfg.validate(&path).map_err(param)?;
+            coarse_sun_sensors.push(cfg);
+        }
+        let mut fine_sun_sensors = Vec::with_capacity(self.fine_sun_sensors.len());
+        let mut names = HashSet::new();
+        for (i, raw) in self.fine_sun_sensors.into_iter().enumerate() {
+            let path = format!("fine_sun_sensors[{i}]");
+            sun_sensor(&path, &raw.name, &mut names, "fine sun sensor")?;
+            let cfg = FineSunSensorConfig {
+                every_frames: every_frames(map, &path, raw.rate_hz, sim.frame_hz, "sensor")?,
+                name: raw.name,
+                dcm_fb: raw.dcm_fb,
+                fov_half_angle_rad: raw.fov_half_angle_rad,
+                bias_rad: raw.bias_rad,
+                noise_sigma_rad: raw.noise_sigma_rad,
+                lsb_rad: raw.lsb_rad,
+                min_shadow_factor: raw.min_shadow_factor,
+                seed: raw.seed,
+            };
+            cfg.validate(&path).map_err(param)?;
+            fine_sun_sensors.push(cfg);
+        }
+
         let mut cfg = SimConfig {
             step_ns,
             integrator,
@@ -782,6 +852,8 @@ impl RawConfig {
             imus,
             star_trackers,
             magnetometers,
+            coarse_sun_sensors,
+            fine_sun_sensors,
             epoch: world.epoch,
             environment: world.environment,
             source_toml: source.to_string(),

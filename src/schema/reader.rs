@@ -286,6 +286,20 @@ impl<'a, 'i> TableReader<'a, 'i> {
             .collect()
     }
 
+    /// Required array of 3-vectors of any length (`[[x, y, z], …]`; the caller checks the
+    /// length).
+    pub(crate) fn vec3_list(&self, key: &str) -> Result<Vec<[f64; 3]>, SchemaError> {
+        let field = self.field(key);
+        let v = self.required(key)?;
+        let DeValue::Array(a) = v.get_ref() else {
+            return Err(self.expected(field, v, "an array of [x, y, z] vectors"));
+        };
+        a.iter()
+            .enumerate()
+            .map(|(i, e)| self.floats_of::<3>(&format!("{field}[{i}]"), e))
+            .collect()
+    }
+
     fn mat3_of(&self, field: &str, v: &Spanned<DeValue<'i>>) -> Result<[[f64; 3]; 3], SchemaError> {
         let rows = match v.get_ref() {
             DeValue::Array(a) if a.len() == 3 => a,

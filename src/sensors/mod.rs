@@ -1,7 +1,9 @@
 //! Sensor models, one folder per kind, behind one contract ([`Sensor`]) and one registry
 //! ([`KINDS`]). Each folder owns the kind's parameters, its configuration schema
 //! (`schema.rs`), its measurement model, its message mapping and its [`SensorKind`]
-//! descriptor: [`imu`] (gyro and accelerometer) and [`star_tracker`] (attitude).
+//! descriptor: [`imu`] (gyro and accelerometer), [`star_tracker`] (attitude),
+//! [`magnetometer`], [`coarse_sun_sensor`] (arrays of cosine detectors) and [`fine_sun_sensor`]
+//! (two-axis).
 //!
 //! Every sensor is sampled at a frame boundary (or, for a sensor that integrates over an
 //! interval, at each output instant) from the same truth, a [`Truth`]: the state and the one
@@ -26,6 +28,8 @@ use crate::dynamics::{DynamicEffector, HubOutputs, State};
 use crate::environment::EnvironmentSample;
 
 pub mod bank;
+pub mod coarse_sun_sensor;
+pub mod fine_sun_sensor;
 pub mod imu;
 pub mod magnetometer;
 pub mod rng;
@@ -34,7 +38,13 @@ pub mod star_tracker;
 pub use bank::SensorBank;
 
 /// Every sensor kind, in publication order: the registry.
-pub static KINDS: &[&SensorKind] = &[&imu::KIND, &star_tracker::KIND, &magnetometer::KIND];
+pub static KINDS: &[&SensorKind] = &[
+    &imu::KIND,
+    &star_tracker::KIND,
+    &magnetometer::KIND,
+    &coarse_sun_sensor::KIND,
+    &fine_sun_sensor::KIND,
+];
 
 /// The truth one sample is taken from: one evaluation at the current instant.
 #[derive(Debug, Clone, Copy)]
@@ -50,6 +60,23 @@ pub struct Truth<'a> {
     /// The spacecraft's dynamic effectors, with their inputs as they apply from now on (a
     /// magnetometer adds the field of the magnetorquer dipoles among them).
     pub dynamic_effectors: &'a [Box<dyn DynamicEffector>],
+}
+
+impl Truth<'_> {
+    /// The unit Sun direction in B, [BN] (r_sun / |r_sun|) with r_sun the Sun's position from
+    /// point B in the environment sample, and the sample's shadow factor; `None` without a Sun
+    /// (no environment sample, or a zero Sun vector: no ephemeris). For the sun sensors.
+    pub fn sun_b(&self) -> Option<(nalgebra::Vector3<f64>, f64)> {
+        let env = self.env?;
+        let r = env.r_sun_b_n_m;
+        let norm = r.norm();
+        (norm > 0.0).then(|| {
+            (
+                crate::attitude::mrp_to_dcm(&self.state.sigma_bn) * (r / norm),
+                env.shadow_factor,
+            )
+        })
+    }
 }
 
 /// One sensor: what the bank, the server and the sinks need of it. Every method called per
@@ -235,6 +262,8 @@ mod tests {
             let seq = match kind.noun {
                 "star tracker" => 2 / every,
                 "magnetometer" => 2 / cfg.magnetometers[0].every_frames,
+                "coarse sun sensor" => 2 / cfg.coarse_sun_sensors[0].every_frames,
+                "fine sun sensor" => 2 / cfg.fine_sun_sensors[0].every_frames,
                 _ => 2,
             };
             assert_eq!(h.seq, seq, "{key}");

@@ -10,7 +10,8 @@ import subprocess
 
 from flexdyn import proto
 from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState, Header,
-                           ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg)
+                           ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg,
+                           CssMsg, FssMsg)
 
 N = 20_000
 
@@ -59,6 +60,14 @@ def magnetometer_line(m):
     return str(Line().h(m.header).f(m.b_s_t).u(m.saturation_flags))
 
 
+def css_line(m):
+    return str(Line().h(m.header).u(m.detector_count).f(m.readings))
+
+
+def fss_line(m):
+    return str(Line().h(m.header).f((m.alpha_rad, m.beta_rad)).u(m.flags))
+
+
 def command_line(m):
     l = Line().h(m.header).u(m.sender_id, m.kind)
     if m.kind != proto.NO_COMMAND_KIND:
@@ -84,6 +93,7 @@ def status_line(m):
 DECODERS = [
     (StateMsg.decode, state_line), (ImuMsg.decode, imu_line),
     (StarTrackerMsg.decode, star_tracker_line), (MagnetometerMsg.decode, magnetometer_line),
+    (CssMsg.decode, css_line), (FssMsg.decode, fss_line),
     (CommandMsg.decode, command_line),
     (StatusMsg.decode, status_line), (Header.decode, lambda h: str(Line().h(h))),
 ]
@@ -123,7 +133,7 @@ def gen_buffer(r):
     def header():
         return Header(r.getrandbits(32), r.getrandbits(64), r.getrandbits(64), r.getrandbits(64))
 
-    k = r.randrange(6)
+    k = r.randrange(8)
     if k == 0:
         b = StateMsg(header(), v(3), v(4), v(3), v(3), v(3), v(3), v(3), f64(), f64(), v(3), v(3),
                      v(3), v(3), r.getrandbits(8),
@@ -135,6 +145,10 @@ def gen_buffer(r):
         b = StarTrackerMsg(header(), v(4), r.random() < 0.5, r.getrandbits(8)).encode()
     elif k == 5:
         b = MagnetometerMsg(header(), v(3), r.getrandbits(8)).encode()
+    elif k == 6:  # counts up to 17: the last is above the maximum (Malformed)
+        b = CssMsg(header(), r.randrange(18), v(proto.MAX_CSS_DETECTORS)).encode()
+    elif k == 7:
+        b = FssMsg(header(), f64(), f64(), r.getrandbits(8)).encode()
     elif k == 3:
         g = fin if r.randrange(4) else f64
         kind = r.randrange(3)
@@ -172,16 +186,17 @@ def test_python_and_rust_decoders_agree_on_20000_buffers(verdicts_bin):
     stream = b"".join(struct.pack("<I", len(b)) + b for b in buffers)
     rust = subprocess.run([str(verdicts_bin)], input=stream, capture_output=True, check=True)
     rust_lines = rust.stdout.decode().splitlines()
-    assert len(rust_lines) == 7 * N
+    assert len(rust_lines) == 9 * N
     reasons = {}
-    names = ["state", "imu", "star_tracker", "magnetometer", "command", "status", "header"]
+    names = ["state", "imu", "star_tracker", "magnetometer", "css", "fss", "command", "status",
+             "header"]
     for i, b in enumerate(buffers):
         for j, got in enumerate(python_lines(b)):
-            want = rust_lines[7 * i + j]
+            want = rust_lines[9 * i + j]
             assert got == want, f"buffer {i} ({len(b)} bytes), {names[j]}: Python {got!r} vs Rust {want!r}"
             key = want.split()[1] if want.startswith("E") else "accepted"
             reasons[key] = reasons.get(key, 0) + 1
-    print(f"{N} buffers x 7 decoders: {reasons}")
+    print(f"{N} buffers x 9 decoders: {reasons}")
     for k in ("accepted", "Length", "TrailingBytes", "TooLarge", "UnknownVersion", "NonFinite",
               "Malformed"):
         assert reasons.get(k, 0) > 0, k

@@ -8,7 +8,8 @@ import pytest
 
 from flexdyn import proto
 from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState, Header,
-                           ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
+                           ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
+                           CssMsg, FssMsg)
 
 SC = 0x11223344
 
@@ -20,7 +21,7 @@ def bits(x):
 def test_manifest_lists_every_file(golden_dir):
     rows = [l.split("\t") for l in (golden_dir / "MANIFEST.tsv").read_text().splitlines()
             if l and not l.startswith("#")]
-    assert len(rows) == 9
+    assert len(rows) == 11
     for name, _message, length, _source in rows:
         assert (golden_dir / f"{name}.bin").stat().st_size == int(length)
 
@@ -73,6 +74,26 @@ def test_magnetometer(golden_dir):
     with pytest.raises(DecodeError) as e:
         MagnetometerMsg.decode(golden[:-1])
     assert e.value.reason == "Length"
+
+
+def test_sun_sensors(golden_dir):
+    c = CssMsg(Header(SC, 13, 130_000_000, 1), 3, (0.5, 0.75, 2.0**-10) + (0.0,) * 13)
+    golden = (golden_dir / "css.bin").read_bytes()
+    assert c.encode() == golden and CssMsg.decode(golden) == c
+    bad = bytearray(golden)
+    bad[30] = proto.MAX_CSS_DETECTORS + 1
+    with pytest.raises(DecodeError) as e:
+        CssMsg.decode(bytes(bad))
+    assert e.value.reason == "Malformed"
+    f = FssMsg(Header(SC, 13, 130_000_000, 1), 0.125, -0.0625,
+               proto.FSS_VALID | proto.FSS_IN_FOV | proto.FSS_SUNLIT)
+    golden = (golden_dir / "fss.bin").read_bytes()
+    assert f.encode() == golden and FssMsg.decode(golden) == f
+    with pytest.raises(DecodeError) as e:
+        FssMsg.decode(golden[:-1])
+    assert e.value.reason == "Length"
+    assert proto.css_key("sc1", "css1") == "flexdyn/sc1/tlm/css/css1"
+    assert proto.fss_key("sc1", "fss1") == "flexdyn/sc1/tlm/fss/fss1"
 
 
 def test_commands(golden_dir):

@@ -1,5 +1,5 @@
 /*
- * flexdyn_proto.h - the flexdyn wire protocol (version 5) for C99 and C++ flight code.
+ * flexdyn_proto.h - the flexdyn wire protocol (version 6) for C99 and C++ flight code.
  *
  * Header-only: include it and call fd_decode_* / fd_encode_*. No allocation, no I/O, no
  * global state. Bytes are assembled one by one (little-endian on the wire), never cast to a
@@ -60,7 +60,7 @@
 /* ------------------------------------------------------------------------------------------ */
 /* Constants (proto/README.md).                                                                */
 
-#define FD_PROTOCOL_VERSION 5u
+#define FD_PROTOCOL_VERSION 6u
 #define FD_HEADER_LEN 30u
 #define FD_STATE_FIXED_LEN 327u
 #define FD_STATE_EFFECTOR_COUNT_OFFSET 319u
@@ -75,6 +75,10 @@
 #define FD_COMMAND_ACTUATORS_FIXED_LEN 94u
 #define FD_STATUS_LEN 179u
 #define FD_TIME_LEN 122u
+/* Sun sensors (protocol 6) */
+#define FD_CSS_LEN 159u
+#define FD_FSS_LEN 47u
+#define FD_MAX_CSS_DETECTORS 16u
 #define FD_TIME_CUC_OFFSET 98u
 #define FD_MAX_EFFECTORS 1024u
 #define FD_MAX_EFFECTOR_VALUES 8u
@@ -106,6 +110,10 @@
 #define FD_MAGNETOMETER_AXIS_1 0x01u
 #define FD_MAGNETOMETER_AXIS_2 0x02u
 #define FD_MAGNETOMETER_AXIS_3 0x04u
+/* FssMsg.flags (protocol 6) */
+#define FD_FSS_VALID 0x01u  /* the angles are a measurement (IN_FOV and SUNLIT); else both 0 */
+#define FD_FSS_IN_FOV 0x02u /* the Sun is inside the field-of-view cone */
+#define FD_FSS_SUNLIT 0x04u /* the shadow factor is at least the sensor's threshold */
 /* TimeMsg.flags (protocol 5) */
 #define FD_TIME_EPOCH_VALID 0x01u /* calendar fields set; clear: they are all zero */
 #define FD_TIME_TONE 0x02u        /* the 1 Hz tone: first frame at or after a whole second */
@@ -249,6 +257,19 @@ typedef struct {
     double b_s_t[3]; /* T, sensor frame S */
     uint8_t saturation_flags;
 } fd_magnetometer_msg;
+
+typedef struct {
+    fd_header header;
+    uint8_t detector_count;                 /* K <= FD_MAX_CSS_DETECTORS */
+    double readings[FD_MAX_CSS_DETECTORS]; /* array output unit; entries K.. are 0 */
+} fd_css_msg;
+
+typedef struct {
+    fd_header header;
+    double alpha_rad; /* atan2(s1, s3), s the Sun direction in the sensor frame F */
+    double beta_rad;  /* atan2(s2, s3) */
+    uint8_t flags;    /* FD_FSS_* */
+} fd_fss_msg;
 
 typedef struct {
     uint32_t effector_index;
@@ -633,6 +654,48 @@ static inline size_t fd_encode_magnetometer(const fd_magnetometer_msg *m, uint8_
     return FD_MAGNETOMETER_LEN;
 }
 
+/* CssMsg and FssMsg (protocol 6, fixed length). */
+
+static inline fd_error fd_decode_css(const uint8_t *buf, size_t len, fd_css_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_CSS_LEN);
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_CSS_LEN, len)).status != FD_OK) return e;
+    if (buf[30] > FD_MAX_CSS_DETECTORS)
+        return fd_fail(FD_ERR_MALFORMED, 0, len, "detector count exceeds maximum");
+    fd_decode_header_at(buf, &out->header);
+    out->detector_count = buf[30];
+    fd_get_f64s(buf + 31, out->readings, FD_MAX_CSS_DETECTORS);
+    return fd_ok();
+}
+
+static inline size_t fd_encode_css(const fd_css_msg *m, uint8_t *buf, size_t cap) {
+    if (cap < FD_CSS_LEN || m->detector_count > FD_MAX_CSS_DETECTORS) return 0;
+    fd_encode_header_at(buf, &m->header);
+    buf[30] = m->detector_count;
+    fd_put_f64s(buf + 31, m->readings, FD_MAX_CSS_DETECTORS);
+    return FD_CSS_LEN;
+}
+
+static inline fd_error fd_decode_fss(const uint8_t *buf, size_t len, fd_fss_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_FSS_LEN);
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_FSS_LEN, len)).status != FD_OK) return e;
+    fd_decode_header_at(buf, &out->header);
+    fd_get_f64s(buf + 30, &out->alpha_rad, 1);
+    fd_get_f64s(buf + 38, &out->beta_rad, 1);
+    out->flags = buf[46];
+    return fd_ok();
+}
+
+static inline size_t fd_encode_fss(const fd_fss_msg *m, uint8_t *buf, size_t cap) {
+    if (cap < FD_FSS_LEN) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_f64s(buf + 30, &m->alpha_rad, 1);
+    fd_put_f64s(buf + 38, &m->beta_rad, 1);
+    buf[46] = m->flags;
+    return FD_FSS_LEN;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 /* CommandMsg.                                                                                 */
 
@@ -960,6 +1023,12 @@ static inline size_t fd_star_tracker_key(char *out, size_t cap, const char *sc, 
 static inline size_t fd_magnetometer_key(char *out, size_t cap, const char *sc,
                                          const char *name) {
     return fd_key(out, cap, sc, "tlm/mag", name);
+}
+static inline size_t fd_css_key(char *out, size_t cap, const char *sc, const char *name) {
+    return fd_key(out, cap, sc, "tlm/css", name);
+}
+static inline size_t fd_fss_key(char *out, size_t cap, const char *sc, const char *name) {
+    return fd_key(out, cap, sc, "tlm/fss", name);
 }
 static inline size_t fd_status_key(char *out, size_t cap, const char *sc) {
     return fd_key(out, cap, sc, "status", FD_NULL);

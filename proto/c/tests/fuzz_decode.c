@@ -141,6 +141,33 @@ static void one(const uint8_t *buf, size_t len) {
         }
     }
     {
+        fd_css_msg m;
+        e = fd_decode_css(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_css(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            u(m.detector_count);
+            fs(m.readings, FD_MAX_CSS_DETECTORS);
+            printf("\n");
+        }
+    }
+    {
+        fd_fss_msg m;
+        e = fd_decode_fss(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_fss(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            fs(&m.alpha_rad, 1);
+            fs(&m.beta_rad, 1);
+            u(m.flags);
+            printf("\n");
+        }
+    }
+    {
         fd_command_msg m;
         uint64_t i;
         memset(&m, 0, sizeof m);

@@ -222,6 +222,43 @@ static void test_magnetometer(const char *dir) {
     printf("MagnetometerMsg: decode ok\n");
 }
 
+static void test_sun_sensors(const char *dir) {
+    uint8_t golden[256], enc[256];
+    size_t n = read_file(dir, "css", golden, sizeof golden);
+    fd_css_msg c, cback;
+    fd_fss_msg f, fback;
+    double r[3] = {0.5, 0.75, 1.0 / 1024.0}, zero[13] = {0.0};
+    fd_error e;
+    memset(&c, 0, sizeof c);
+    c.header = fd_header_new(SC, 13, 130000000u, 1);
+    c.detector_count = 3;
+    memcpy(c.readings, r, sizeof r);
+    check_encoded("CssMsg", golden, n, enc, fd_encode_css(&c, enc, sizeof enc));
+    e = fd_decode_css(golden, n, &cback);
+    CHECK(e.status == FD_OK && same_header(&cback.header, &c.header) &&
+              cback.detector_count == 3 && same_bits(cback.readings, r, 3) &&
+              same_bits(cback.readings + 3, zero, 13),
+          "CssMsg decodes to the table");
+    e = fd_decode_css(golden, n - 1, &cback);
+    CHECK(e.status == FD_ERR_LENGTH && e.needed == FD_CSS_LEN, "CssMsg short");
+    golden[30] = FD_MAX_CSS_DETECTORS + 1u;
+    e = fd_decode_css(golden, n, &cback);
+    CHECK(e.status == FD_ERR_MALFORMED, "CssMsg detector count above the maximum");
+    n = read_file(dir, "fss", golden, sizeof golden);
+    memset(&f, 0, sizeof f);
+    f.header = fd_header_new(SC, 13, 130000000u, 1);
+    f.alpha_rad = 0.125;
+    f.beta_rad = -0.0625;
+    f.flags = FD_FSS_VALID | FD_FSS_IN_FOV | FD_FSS_SUNLIT;
+    check_encoded("FssMsg", golden, n, enc, fd_encode_fss(&f, enc, sizeof enc));
+    e = fd_decode_fss(golden, n, &fback);
+    CHECK(e.status == FD_OK && same_header(&fback.header, &f.header) &&
+              same_bits(&fback.alpha_rad, &f.alpha_rad, 1) &&
+              same_bits(&fback.beta_rad, &f.beta_rad, 1) && fback.flags == 0x07,
+          "FssMsg decodes to the table");
+    printf("CssMsg, FssMsg: decode ok\n");
+}
+
 static void test_commands(const char *dir) {
     uint8_t golden[256], enc[256];
     size_t n;
@@ -423,6 +460,12 @@ static void test_keys(void) {
     CHECK(fd_magnetometer_key(key, sizeof key, "sc1", "mag1") > 0 &&
               strcmp(key, "flexdyn/sc1/tlm/mag/mag1") == 0,
           "magnetometer key");
+    CHECK(fd_css_key(key, sizeof key, "sc1", "css1") > 0 &&
+              strcmp(key, "flexdyn/sc1/tlm/css/css1") == 0,
+          "coarse sun sensor key");
+    CHECK(fd_fss_key(key, sizeof key, "sc1", "fss1") > 0 &&
+              strcmp(key, "flexdyn/sc1/tlm/fss/fss1") == 0,
+          "fine sun sensor key");
     CHECK(fd_participant_key(key, sizeof key, "sc-1", 4294967295u) > 0 &&
               strcmp(key, "flexdyn/sc-1/participant/4294967295") == 0,
           "participant key");
@@ -443,6 +486,7 @@ int main(int argc, char **argv) {
     test_state(argv[1]);
     test_imu_and_star_tracker(argv[1]);
     test_magnetometer(argv[1]);
+    test_sun_sensors(argv[1]);
     test_commands(argv[1]);
     test_status(argv[1]);
     test_time(argv[1]);

@@ -3,7 +3,7 @@
 //! `proto/c/tests/fuzz_decode.c`, the Python package's `tests/test_proto_fuzz.py`).
 //!
 //! Input (stdin): records of a u32 LE length and that many bytes. Output (stdout): per record,
-//! seven lines, one per decoder (state, imu, star tracker, magnetometer, command, status,
+//! nine lines, one per decoder (state, imu, star tracker, magnetometer, css, fss, command, status,
 //! header):
 //! `E <reason> [numbers or field]` for an error (the `DecodeError` variant; `Length needed
 //! actual`, `TrailingBytes expected actual`, `TooLarge actual`, `UnknownVersion found`,
@@ -14,9 +14,9 @@ use std::fmt::Write as _;
 use std::io::{Read, Write};
 
 use flexdyn_proto::{
-    decode_command, decode_header, decode_imu, decode_magnetometer, decode_star_tracker,
-    decode_state, decode_status, CommandKind, CommandMsg, DecodeError, Header, ImuMsg,
-    MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg,
+    decode_command, decode_css, decode_fss, decode_header, decode_imu, decode_magnetometer,
+    decode_star_tracker, decode_state, decode_status, CommandKind, CommandMsg, DecodeError, Header,
+    ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg,
 };
 
 fn err_line(e: &DecodeError) -> String {
@@ -171,7 +171,7 @@ fn status_line(m: &StatusMsg) -> String {
     l.0
 }
 
-/// The seven verdicts for one buffer, in the order of the module docs.
+/// The nine verdicts for one buffer, in the order of the module docs.
 fn rust_lines(b: &[u8]) -> Vec<String> {
     fn line<M>(r: Result<M, DecodeError>, f: impl Fn(&M) -> String) -> String {
         match r {
@@ -184,6 +184,18 @@ fn rust_lines(b: &[u8]) -> Vec<String> {
         line(decode_imu(b), imu_line),
         line(decode_star_tracker(b), star_tracker_line),
         line(decode_magnetometer(b), magnetometer_line),
+        line(decode_css(b), |m| {
+            let mut l = Line::new();
+            l.h(&m.header).u(m.detector_count.into()).f(&m.readings);
+            l.0
+        }),
+        line(decode_fss(b), |m| {
+            let mut l = Line::new();
+            l.h(&m.header)
+                .f(&[m.alpha_rad, m.beta_rad])
+                .u(m.flags.into());
+            l.0
+        }),
         line(decode_command(b), command_line),
         line(decode_status(b), status_line),
         line(decode_header(b), |h| {

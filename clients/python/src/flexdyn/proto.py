@@ -1,16 +1,17 @@
-"""The flexdyn wire protocol, version 5, in pure Python.
+"""The flexdyn wire protocol, version 6, in pure Python.
 
 Every message of ``proto/README.md`` as a dataclass with ``encode()`` and ``decode(bytes)``.
 Decoding follows the README's decoder rules in the same order and raises :class:`DecodeError`
 with the same reasons as the Rust crate's ``DecodeError``:
 
 1. more than ``MAX_MESSAGE_BYTES`` -> ``TooLarge``;
-2. fewer than 2 bytes -> ``Length``; first two bytes (u16 LE) != 4 -> ``UnknownVersion``;
+2. fewer than 2 bytes -> ``Length``; first two bytes (u16 LE) != 6 -> ``UnknownVersion``;
 3. the total length from the layout (fixed; command tag at 34; walked counts, each bounded
    first) -> ``Length`` (needed = length implied by the counts read so far), ``Malformed``
    (unknown tag, count above its maximum), ``TrailingBytes``;
 4. fields in wire order: an enum tag out of range or a bool byte other than 0/1 -> ``Malformed``;
-5. CommandMsg: a non-finite torque, force or input value -> ``NonFinite`` naming the field.
+5. CommandMsg: a non-finite torque, force or input value -> ``NonFinite`` naming the field;
+   CssMsg: a detector count above ``MAX_CSS_DETECTORS`` -> ``Malformed``.
 
 Units are in the field names (SI; ``_nm`` newton-metres, ``_newton`` newtons); frames too
 (``_b`` body, ``_n`` inertial, ``_p`` IMU platform, ``_c`` star-tracker case).
@@ -23,7 +24,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import ClassVar, List, Optional, Tuple
 
-PROTOCOL_VERSION = 5
+PROTOCOL_VERSION = 6
 HEADER_LEN = 30
 STATE_FIXED_LEN = 327
 STATE_EFFECTOR_COUNT_OFFSET = 319
@@ -38,6 +39,10 @@ COMMAND_NO_COMMAND_LEN = 38
 COMMAND_ACTUATORS_FIXED_LEN = 94
 STATUS_LEN = 179
 TIME_LEN = 122
+# Sun sensors (protocol 6)
+CSS_LEN = 159
+FSS_LEN = 47
+MAX_CSS_DETECTORS = 16
 MAX_EFFECTORS = 1024
 MAX_EFFECTOR_VALUES = 8
 MAX_MESSAGE_BYTES = 65536
@@ -52,6 +57,8 @@ COMMAND_FLAG_STALE, COMMAND_FLAG_ZEROED_BY_POLICY, COMMAND_FLAG_NO_COMMAND_YET =
 SATURATION_GYRO_RATE, SATURATION_ACCEL, SATURATION_DTHETA, SATURATION_DV = 0x1, 0x2, 0x4, 0x8
 STAR_TRACKER_SUN_EXCLUSION, STAR_TRACKER_RATE_LIMIT = 0x1, 0x2
 MAGNETOMETER_AXIS_1, MAGNETOMETER_AXIS_2, MAGNETOMETER_AXIS_3 = 0x1, 0x2, 0x4
+# FssMsg.flags (protocol 6)
+FSS_VALID, FSS_IN_FOV, FSS_SUNLIT = 0x1, 0x2, 0x4
 WHEEL_TORQUE_LIMITED, WHEEL_SPEED_LIMITED = 0x1, 0x2
 MAGNETORQUER_SATURATED = 0x1
 THRUSTER_FIRING, THRUSTER_BELOW_MIN_ON_TIME, THRUSTER_COMMAND_CLIPPED = 0x1, 0x2, 0x4
@@ -321,6 +328,54 @@ class MagnetometerMsg:
 
 
 @dataclass
+class CssMsg:
+    """Coarse-sun-sensor array sample (``flexdyn/<sc-id>/tlm/css/<name>``): ``detector_count``
+    K and one reading per detector in the array's output unit; entries K.. of the 16 are 0."""
+
+    header: Header = field(default_factory=Header)
+    detector_count: int = 0
+    readings: Tuple[float, ...] = (0.0,) * MAX_CSS_DETECTORS
+
+    def encode(self) -> bytes:
+        if len(self.readings) != MAX_CSS_DETECTORS:
+            raise ValueError(f"readings has {len(self.readings)} entries, not {MAX_CSS_DETECTORS}")
+        return (self.header.encode() + struct.pack("<B", self.detector_count)
+                + _pack_f(self.readings))
+
+    @staticmethod
+    def decode(buf: bytes) -> "CssMsg":
+        _check_size_and_version(buf, CSS_LEN)
+        _check_total(CSS_LEN, buf)
+        if buf[30] > MAX_CSS_DETECTORS:
+            raise DecodeError("Malformed", detail=f"detector count {buf[30]} exceeds maximum "
+                              f"{MAX_CSS_DETECTORS}")
+        return CssMsg(Header.unpack(buf), buf[30], _f(buf, 31, MAX_CSS_DETECTORS))
+
+
+@dataclass
+class FssMsg:
+    """Fine (two-axis) sun sensor sample (``flexdyn/<sc-id>/tlm/fss/<name>``): alpha =
+    atan2(s1, s3), beta = atan2(s2, s3) (rad) of the Sun direction s in the sensor frame
+    (boresight +3), and ``FSS_*`` flags (angles are 0 unless ``FSS_VALID``)."""
+
+    header: Header = field(default_factory=Header)
+    alpha_rad: float = 0.0
+    beta_rad: float = 0.0
+    flags: int = 0
+
+    def encode(self) -> bytes:
+        return (self.header.encode() + _pack_f((self.alpha_rad, self.beta_rad))
+                + struct.pack("<B", self.flags))
+
+    @staticmethod
+    def decode(buf: bytes) -> "FssMsg":
+        _check_size_and_version(buf, FSS_LEN)
+        _check_total(FSS_LEN, buf)
+        alpha, beta = _f(buf, 30, 2)
+        return FssMsg(Header.unpack(buf), alpha, beta, buf[46])
+
+
+@dataclass
 class EffectorInput:
     """Inputs for one effector (index in StateMsg.effectors) in an Actuators command."""
 
@@ -550,6 +605,14 @@ def star_tracker_key(sc: str, name: str) -> str:
 
 def magnetometer_key(sc: str, name: str) -> str:
     return _key(sc, "tlm/mag", name)
+
+
+def css_key(sc: str, name: str) -> str:
+    return _key(sc, "tlm/css", name)
+
+
+def fss_key(sc: str, name: str) -> str:
+    return _key(sc, "tlm/fss", name)
 
 
 def command_key(sc: str, sender_id: int) -> str:

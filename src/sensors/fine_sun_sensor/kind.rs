@@ -1,0 +1,59 @@
+//! The fine sun sensor's entry in the sensor registry ([`crate::sensors::KINDS`]): its key
+//! (`flexdyn/<sc>/tlm/fss/<name>`), its wire message ([`FssMsg`]), how it is built from
+//! `[[fine_sun_sensors]]` and how `flexdyn plot` draws it.
+
+use flexdyn_proto::keys::FSS_PREFIX;
+use flexdyn_proto::{decode_fss, FssMsg};
+
+use super::FineSunSensor;
+use crate::config::{ConfigError, SimConfig};
+use crate::dynamics::State;
+use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
+
+/// The fine-sun-sensor kind.
+pub static KIND: SensorKind = SensorKind {
+    noun: "fine sun sensor",
+    a_noun: "a fine sun sensor",
+    config_array: "fine_sun_sensors",
+    key_prefix: FSS_PREFIX,
+    column_prefix: "fss",
+    message_name: "FssMsg",
+    key: |t, name| t.sensor(FSS_PREFIX, name),
+    build,
+    decode: |b| decode_fss(b).map(|m| json_of(m.header, &m)),
+    default_json: || json_of(Default::default(), &FssMsg::default()).1,
+    json_schema: || schemars::schema_for!(FssMsg).to_value(),
+    plot: (
+        "sun_sensors_fine.png",
+        "Fine sun sensors: Sun angles in the sensor frame F (0 when not valid) and flags",
+        &[
+            PanelSpec {
+                y_label: "angle (rad)",
+                lines: &[
+                    ("alpha_rad", "α = atan2(s1, s3)"),
+                    ("beta_rad", "β = atan2(s2, s3)"),
+                ],
+            },
+            PanelSpec {
+                y_label: "flags (1 VALID, 2 IN_FOV, 4 SUNLIT)",
+                lines: &[("flags", "flags")],
+            },
+        ],
+    ),
+};
+
+/// One [`FineSunSensor`] per `[[fine_sun_sensors]]` entry (errors name
+/// `fine_sun_sensors[i]…`).
+fn build(
+    cfg: &SimConfig,
+    _sample_interval_s: f64,
+    _t_sim_ns: u64,
+    _x: &State,
+    out: &mut Vec<Box<dyn Sensor>>,
+) -> Result<(), ConfigError> {
+    for (i, c) in cfg.fine_sun_sensors.iter().enumerate() {
+        let path = format!("fine_sun_sensors[{i}]");
+        out.push(Box::new(FineSunSensor::new(c.clone(), &path)?));
+    }
+    Ok(())
+}
