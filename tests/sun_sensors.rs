@@ -230,6 +230,7 @@ fn shadow_scales_the_coarse_array_and_invalidates_the_fine_sensor() {
             state,
             hub: &hub,
             env: Some(&env),
+            dynamic_effectors: &[],
         };
         css.sample(&truth);
         fss.sample(&truth);
@@ -256,6 +257,7 @@ fn shadow_scales_the_coarse_array_and_invalidates_the_fine_sensor() {
         state,
         hub: &hub,
         env: Some(&env),
+        dynamic_effectors: &[],
     };
     css.sample(&truth);
     fss.sample(&truth);
@@ -522,8 +524,8 @@ fn configuration_errors_name_the_file_field_and_problem() {
             "duplicate coarse sun sensor name",
         ),
         (
-            "dcm_fb = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]",
-            "dcm_fb = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]",
+            "dcm_fb = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]",
+            "dcm_fb = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]]",
             "fine_sun_sensors[0].dcm_fb",
             "orthonormal",
         ),
