@@ -61,8 +61,9 @@ use std::sync::{Arc, Mutex, Once};
 use std::time::{Duration, Instant};
 
 use flexdyn::config::SimConfig;
-use flexdyn::server::pacing::Pacer;
+use flexdyn::server::pacing::{FrameEnd, Pacer};
 use flexdyn::server::physics::{count_offer, Stepper};
+use flexdyn::server::rt::monotonic_ns;
 use flexdyn::server::settings::OverrunPolicy;
 use flexdyn::server::shared::{Frame, Shared};
 use flexdyn::server::ServerSettings;
@@ -415,13 +416,8 @@ impl Harness {
             free_rx,
             full_tx: Some(full_tx),
             pending,
-            pacer: Pacer::new(
-                Instant::now(),
-                1_000_000,
-                settings.spin,
-                OverrunPolicy::CatchUp,
-                0,
-            ),
+            // A 1 ns period: every frame overruns, so the overrun log is written every frame.
+            pacer: Pacer::new(Instant::now(), 1, settings.spin, OverrunPolicy::CatchUp, 0),
             wheel_commands,
             telemetry: Some(telemetry),
             telemetry_thread,
@@ -435,6 +431,7 @@ impl Harness {
     /// the thread handoff, without the wait for boundary `k`.
     fn frame(&mut self, k: u64, inject: Inject) {
         // 1. Boundary k: hand the filled state of tick k to the telemetry thread.
+        let frame_start_ns = monotonic_ns();
         self.shared.tick.store(k, Ordering::Release);
         let stamp = unix_now_ns();
         if let Some(mut f) = self.pending.take() {
@@ -481,7 +478,9 @@ impl Harness {
             self.w.fill(f, k + 1);
         }
         self.w.check_finite(k + 1, self.pending.is_some()).unwrap();
-        let _ = self.pacer.end_frame(k + 1);
+        if self.pacer.end_frame(k + 1) == FrameEnd::Overrun {
+            self.shared.overrun_log.note(frame_start_ns, monotonic_ns());
+        }
     }
 
     fn inject(&mut self, inject: Inject) {
