@@ -302,18 +302,25 @@ enum Inject {
 struct Holder {
     lock: Arc<Mutex<()>>,
     held: Arc<AtomicBool>,
+    /// Set by the frame just before it takes the lock.
+    wanted: Arc<AtomicBool>,
     thread: Option<std::thread::JoinHandle<()>>,
 }
 
 impl Holder {
-    /// Holds the mutex from now for `hold`.
+    /// Holds the mutex from now until `hold` after the frame asks for it (so the frame waits
+    /// whatever the machine's load).
     fn start(hold: Duration) -> Self {
         let lock = Arc::new(Mutex::new(()));
         let held = Arc::new(AtomicBool::new(false));
-        let (l, h) = (lock.clone(), held.clone());
+        let wanted = Arc::new(AtomicBool::new(false));
+        let (l, h, w) = (lock.clone(), held.clone(), wanted.clone());
         let thread = std::thread::spawn(move || {
             let guard = l.lock().unwrap();
             h.store(true, Ordering::SeqCst);
+            while !w.load(Ordering::SeqCst) {
+                std::thread::sleep(Duration::from_millis(1));
+            }
             std::thread::sleep(hold);
             drop(guard);
         });
@@ -323,6 +330,7 @@ impl Holder {
         Self {
             lock,
             held,
+            wanted,
             thread: Some(thread),
         }
     }
@@ -422,7 +430,7 @@ impl Harness {
             telemetry: Some(telemetry),
             telemetry_thread,
             holder: (inject == Inject::ContendedMutex)
-                .then(|| Holder::start(Duration::from_millis(20))),
+                .then(|| Holder::start(Duration::from_millis(10))),
             stderr: std::io::stderr(),
         }
     }
@@ -491,7 +499,8 @@ impl Harness {
             }
             Inject::ContendedMutex => {
                 let h = self.holder.as_ref().expect("holder started");
-                assert!(h.held.load(Ordering::SeqCst), "the holder let go too early");
+                assert!(h.held.load(Ordering::SeqCst), "the holder holds the lock");
+                h.wanted.store(true, Ordering::SeqCst);
                 drop(h.lock.lock());
             }
             Inject::Sleep => std::thread::sleep(Duration::from_micros(100)),
