@@ -36,7 +36,7 @@ use super::commands::{CommandBook, Held, Offer};
 use super::error::ServerError;
 use super::pacing::{FrameEnd, Pacer};
 use super::publish::FramePublisher;
-use super::rt::ThreadUsage;
+use super::rt::{monotonic_ns, ThreadUsage};
 use super::settings::ServerSettings;
 use super::shared::{fill_state, Frame, Shared};
 use crate::dynamics::Wrench;
@@ -335,6 +335,8 @@ impl PhysicsCtx {
             self.settings.overrun_limit,
         );
         self.shared.set_run_state(RunState::Running);
+        // The overrun log's clock starts before the first frame.
+        monotonic_ns();
 
         loop {
             // 1. Frame boundary k: publish the state of tick k.
@@ -349,6 +351,8 @@ impl PhysicsCtx {
                 }
                 0
             };
+            // When this frame's work starts (for the overrun log).
+            let frame_start_ns = if realtime { monotonic_ns() } else { 0 };
             // Noted before the state goes out, so a participant answering it finds its tick
             // published (the command callback refuses ticks not yet published).
             self.shared.tick.store(k, Ordering::Release);
@@ -423,6 +427,7 @@ impl PhysicsCtx {
                         self.shared
                             .overruns
                             .store(pacer.overruns, Ordering::Relaxed);
+                        self.shared.overrun_log.note(frame_start_ns, monotonic_ns());
                     }
                     FrameEnd::Abort { consecutive } => {
                         self.shared

@@ -56,6 +56,11 @@ pub struct RunReport {
     /// Real time: the physics thread's page faults and context switches from its first frame
     /// to its last (`lock_memory` makes the page faults 0).
     pub physics_thread: Option<ThreadUsage>,
+    /// Real time: start and end \[ns, [`super::rt::monotonic_ns`]\] of the overrun frames (the
+    /// first [`super::shared::OVERRUN_LOG_LEN`]), from the wake-up at the boundary before to the
+    /// end of the frame's work; for lining overruns up with other counters (the
+    /// `realtime_lateness` bench does, with the steal time and the scheduler's statistics).
+    pub overrun_frames_ns: Vec<(u64, u64)>,
 }
 
 /// The time the physics thread spent handing frames off (real time).
@@ -169,6 +174,7 @@ impl RunReport {
                 })
             },
             physics_thread: None,
+            overrun_frames_ns: shared.overrun_log.frames(),
             lateness: (mode == Mode::RealTime).then(|| lateness.clone()),
         }
     }
@@ -189,6 +195,7 @@ impl RunReport {
             recording: None,
             handoff: None,
             physics_thread: None,
+            overrun_frames_ns: Vec::new(),
             lateness: None,
         }
     }

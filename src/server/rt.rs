@@ -257,6 +257,15 @@ fn read_small<'a>(path: &Path, buf: &'a mut [u8]) -> Option<&'a str> {
     std::str::from_utf8(&buf[..n]).ok()
 }
 
+/// \[ns\] monotonic time (`Instant`, CLOCK_MONOTONIC: the vDSO, no system call) since a
+/// process-wide origin, the first call. The overrun log ([`super::shared::OverrunLog`]) is in
+/// this clock, so a bench sampling other counters meanwhile can line them up with the overruns.
+pub fn monotonic_ns() -> u64 {
+    static ORIGIN: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+    let origin = *ORIGIN.get_or_init(std::time::Instant::now);
+    u64::try_from(origin.elapsed().as_nanos()).unwrap_or(u64::MAX)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

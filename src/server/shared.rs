@@ -126,6 +126,8 @@ pub struct Shared {
     pub overruns: AtomicU64,
     /// Real time, `skip` policy: deadlines dropped.
     pub frames_skipped: AtomicU64,
+    /// Real time: when each of the first overrun frames started and ended.
+    pub overrun_log: OverrunLog,
     /// Real time: frames whose telemetry was dropped (no free buffer).
     pub telemetry_dropped: AtomicU64,
     /// Real time: frames the physics thread handed off, and the total and largest time the
@@ -141,6 +143,53 @@ pub struct Shared {
     /// `stale_tick` rejections per participant (sender id, count), in ascending id order, so
     /// the telemetry thread can name the sender in its warning (the physics thread only counts).
     pub stale_by_participant: Vec<(u32, AtomicU64)>,
+}
+
+/// Overrun frames whose times [`OverrunLog`] keeps (the first ones of a run).
+pub const OVERRUN_LOG_LEN: usize = 1024;
+
+/// Start and end \[ns, [`super::rt::monotonic_ns`]\] of the first [`OVERRUN_LOG_LEN`] overrun
+/// frames, preallocated: noting one is two atomic stores, so the physics thread can do it.
+#[derive(Debug)]
+pub struct OverrunLog {
+    start_ns: Box<[AtomicU64]>,
+    end_ns: Box<[AtomicU64]>,
+    noted: AtomicU64,
+}
+
+impl Default for OverrunLog {
+    fn default() -> Self {
+        let zeros = || (0..OVERRUN_LOG_LEN).map(|_| AtomicU64::new(0)).collect();
+        Self {
+            start_ns: zeros(),
+            end_ns: zeros(),
+            noted: AtomicU64::new(0),
+        }
+    }
+}
+
+impl OverrunLog {
+    /// Notes an overrun frame (allocation-free; past the capacity it is only counted).
+    pub fn note(&self, start_ns: u64, end_ns: u64) {
+        let i = self.noted.fetch_add(1, Ordering::Relaxed) as usize;
+        if let (Some(s), Some(e)) = (self.start_ns.get(i), self.end_ns.get(i)) {
+            s.store(start_ns, Ordering::Relaxed);
+            e.store(end_ns, Ordering::Relaxed);
+        }
+    }
+
+    /// The (start, end) of the overrun frames noted, in order (at most [`OVERRUN_LOG_LEN`]).
+    pub fn frames(&self) -> Vec<(u64, u64)> {
+        let n = (self.noted.load(Ordering::Relaxed) as usize).min(OVERRUN_LOG_LEN);
+        (0..n)
+            .map(|i| {
+                (
+                    self.start_ns[i].load(Ordering::Relaxed),
+                    self.end_ns[i].load(Ordering::Relaxed),
+                )
+            })
+            .collect()
+    }
 }
 
 fn bump(c: &AtomicU64) {
