@@ -6,7 +6,9 @@
 //! subscriber), each `FLEXDYN_RT_SPAN_S` seconds (default 60), first with the default settings
 //! (`normal`), then tuned (`tuned`: `realtime_priority = 50`, `lock_memory`, `physics_cpu` =
 //! the last allowed CPU with this process's other threads kept off it, `cpu_dma_latency`).
-//! `FLEXDYN_RT_ROUNDS` rounds (default 3). Each run prints:
+//! `FLEXDYN_RT_ROUNDS` rounds (default 3). `FLEXDYN_RT_SCENARIO=scenarios/leo_environment.toml`
+//! runs that scenario at 1 kHz instead (every environment model and its sensors on). Each run
+//! prints:
 //! - the lateness of the frame boundaries (wake-up minus deadline): p50, p90, p99, p99.9, max;
 //! - overruns (frames whose work ended after the next deadline);
 //! - page faults of the whole process during the run (minor + major, `/proc/self/stat`: what
@@ -241,9 +243,25 @@ fn cpu_ticks() -> (u64, u64) {
 /// USER_HZ: 100 on every Linux ABI flexdyn builds for.
 const TICK_MS: f64 = 10.0;
 
+/// The reference configuration at 1 kHz, or with `FLEXDYN_RT_SCENARIO` (a scenario file, e.g.
+/// `scenarios/leo_environment.toml` for every environment model and sensor on) that scenario
+/// with its `[simulation] frame_hz` set to 1000.
 fn config() -> SimConfig {
-    let text = DEFAULT_CONFIG_TOML.replace("frame_hz = 100.0 ", "frame_hz = 1000.0 ");
-    SimConfig::from_toml_str(&text).expect("reference configuration at 1 kHz")
+    let Ok(path) = std::env::var("FLEXDYN_RT_SCENARIO") else {
+        let text = DEFAULT_CONFIG_TOML.replace("frame_hz = 100.0 ", "frame_hz = 1000.0 ");
+        return SimConfig::from_toml_str(&text).expect("reference configuration at 1 kHz");
+    };
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("FLEXDYN_RT_SCENARIO {}: {e}", path.display()));
+    let mut table: toml::Table = text
+        .parse()
+        .unwrap_or_else(|e| panic!("FLEXDYN_RT_SCENARIO {}: {e}", path.display()));
+    if let Some(toml::Value::Table(sim)) = table.get_mut("simulation") {
+        sim.insert("frame_hz".into(), toml::Value::Float(1000.0));
+    }
+    SimConfig::from_toml_str_in(&table.to_string(), path.parent().unwrap())
+        .unwrap_or_else(|e| panic!("FLEXDYN_RT_SCENARIO {} at 1 kHz: {e}", path.display()))
 }
 
 /// Runs the server for `span` in a fresh thread (so a CPU mask set for the tuned run does not
@@ -376,6 +394,10 @@ fn main() {
         cpu_dma_latency: true,
         ..normal.clone()
     };
+    println!(
+        "scenario: {} at 1 kHz",
+        std::env::var("FLEXDYN_RT_SCENARIO").unwrap_or_else(|_| "scenarios/reference.toml".into())
+    );
     println!(
         "realtime_lateness: 1 kHz, 1 RK4 step per frame, {rounds} round(s) x {span_s} s per \
          configuration; tuned = SCHED_FIFO 50 + lock_memory + physics_cpu {} + cpu_dma_latency",
