@@ -24,6 +24,7 @@
 //! | `flexdyn/<sc-id>/tlm/mag/<name>` | [`MagnetometerMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/cmd/<sender-id>` | [`CommandMsg`] | flight code → server |
 //! | `flexdyn/<sc-id>/status` | [`StatusMsg`] | server → anyone |
+//! | `flexdyn/<sc-id>/operator` | [`OperatorMsg`] | operator → server |
 //! | `flexdyn/<sc-id>/participant/<sender-id>` | Zenoh liveliness token (no payload) | lockstep participant → server |
 //!
 //! Build keys with [`Topics`] or [`state_key`] & co; ids are validated
@@ -50,7 +51,8 @@
 //! | [`MagnetometerMsg`] | [`MAGNETOMETER_LEN`] = 55 |
 //! | [`TimeMsg`] | [`TIME_LEN`] = 122 |
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
-//! | [`StatusMsg`] | [`STATUS_LEN`] = 179 |
+//! | [`StatusMsg`] | [`STATUS_LEN`] = 187 |
+//! | [`OperatorMsg`] | [`OPERATOR_LEN`] = 42 |
 //!
 //! Decoders accept at most [`MAX_MESSAGE_BYTES`], [`MAX_EFFECTORS`] and
 //! [`MAX_EFFECTOR_VALUES`], reject trailing bytes, and never panic ([`DecodeError`]).
@@ -90,31 +92,32 @@ mod layout;
 mod messages;
 
 pub use codec::{
-    decode, decode_command, decode_header, decode_imu, decode_magnetometer, decode_star_tracker,
-    decode_state, decode_status, decode_time, encode, encode_into,
+    decode, decode_command, decode_header, decode_imu, decode_magnetometer, decode_operator,
+    decode_star_tracker, decode_state, decode_status, decode_time, encode, encode_into,
 };
 pub use error::{DecodeError, KeyError};
 pub use keys::{
-    cmd_key, cmd_wildcard_key, imu_key, imu_wildcard_key, participant_key,
+    cmd_key, cmd_wildcard_key, imu_key, imu_wildcard_key, operator_key, participant_key,
     participant_wildcard_key, sensor_key, star_tracker_key, star_tracker_wildcard_key, state_key,
     status_key, validate_imu_name, validate_sc_id, validate_sensor_name,
     validate_star_tracker_name, Telemetry, Topics, CMD_PREFIX, IMU_PREFIX, KEY_ROOT,
-    MAGNETOMETER_PREFIX, MAX_ID_LEN, PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX,
-    STATUS_SUFFIX, TIME_SUFFIX,
+    MAGNETOMETER_PREFIX, MAX_ID_LEN, OPERATOR_SUFFIX, PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX,
+    STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
 };
 pub use layout::{
     WireLayout, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
     COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN,
     HEADER_LEN, IMU_LEN, MAGNETOMETER_LEN, MAX_EFFECTORS, MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES,
-    MAX_PANEL_PAIRS, STAR_TRACKER_LEN, STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN,
-    TIME_CUC_OFFSET, TIME_LEN,
+    MAX_PANEL_PAIRS, OPERATOR_LEN, STAR_TRACKER_LEN, STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN,
+    STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
 };
 pub use messages::{
     command_flags, effector_kind, magnetometer_flags, magnetorquer_flags, saturation_flags,
     star_tracker_flags, thruster_flags, time_flags, wheel_flags, AppliedWrench, CommandKind,
     CommandMsg, CommandStatus, Conserved, EffectorInput, EffectorState, FrameTiming, Header,
-    ImuMsg, MagnetometerMsg, Mode, RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg,
-    StatusMsg, SysTime, TimeMsg, UtcTime, CUC_PFIELD_TAI_4_3, NO_COMMAND,
+    ImuMsg, MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters, RunState,
+    StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime,
+    CUC_PFIELD_TAI_4_3, NO_COMMAND,
 };
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
@@ -122,5 +125,7 @@ pub use messages::{
 /// [`StarTrackerMsg`], [`RejectCounters::bad_effector_input`]. Version 4: one command key per
 /// sender (`flexdyn/<sc-id>/cmd/<sender_id>`) and [`RejectCounters::wrong_identity`]. Version 5:
 /// the sensor messages of issue 20 ([`MagnetometerMsg`]), and the time service [`TimeMsg`] on
-/// `flexdyn/<sc-id>/tlm/time` with [`RunState::Paused`].
-pub const PROTOCOL_VERSION: u16 = 5;
+/// `flexdyn/<sc-id>/tlm/time` with [`RunState::Paused`]. Version 6 (issue 23, operator control):
+/// [`OperatorMsg`] on `flexdyn/<sc-id>/operator` and [`RejectCounters::operator_refused`]
+/// (StatusMsg grows to 187 bytes).
+pub const PROTOCOL_VERSION: u16 = 6;

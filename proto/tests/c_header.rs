@@ -25,7 +25,8 @@ use std::process::{Command, Stdio};
 
 use flexdyn_proto::{
     encode, CommandKind, CommandMsg, EffectorInput, EffectorState, Header, ImuMsg, MagnetometerMsg,
-    Mode, RejectCounters, StarTrackerMsg, StateMsg, StatusMsg, MAX_MESSAGE_BYTES,
+    Mode, OperatorAction, OperatorMsg, RejectCounters, RunState, StarTrackerMsg, StateMsg,
+    StatusMsg, TimeMsg, MAX_MESSAGE_BYTES,
 };
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -277,7 +278,7 @@ impl Gen {
     }
 
     fn message(&mut self) -> Vec<u8> {
-        match self.below(6) {
+        match self.below(8) {
             0 => {
                 let effectors = (0..self.below(6))
                     .map(|_| EffectorState {
@@ -319,6 +320,38 @@ impl Gen {
                 valid: self.below(2) == 1,
                 status_flags: self.u64() as u8,
             }),
+            6 => {
+                let mut m = TimeMsg {
+                    header: self.header(),
+                    run_state: RunState::from_tag(self.below(7) as u32).unwrap_or_default(),
+                    mode: [Mode::RealTime, Mode::Lockstep, Mode::Batch][self.below(3) as usize],
+                    flags: self.u64() as u8,
+                    frame_ns: self.u64(),
+                    speed: self.f64(),
+                    tai_ns_1958: self.u64(),
+                    tai_minus_utc_s: self.u64() as i32,
+                    gps_week: self.u64() as u32,
+                    gps_ns_of_week: self.u64(),
+                    met_ns: self.u64(),
+                    cuc_tai: self.u64().to_le_bytes(),
+                    ..TimeMsg::default()
+                };
+                m.utc.year = self.u64() as u16;
+                m.utc.second = self.u64() as u8;
+                m.utc.nanosecond = self.u64() as u32;
+                m.tone_met.subseconds = self.u64() as u32;
+                m.tone_tai.seconds = self.u64() as u32;
+                encode(&m)
+            }
+            7 => encode(&OperatorMsg::new(
+                self.header(),
+                [
+                    OperatorAction::Pause,
+                    OperatorAction::Resume,
+                    OperatorAction::RunTicks,
+                ][self.below(3) as usize],
+                self.u64(),
+            )),
             5 => encode(&MagnetometerMsg {
                 header: self.header(),
                 b_s_t: self.v(),
@@ -363,6 +396,7 @@ impl Gen {
                         malformed: self.u64(),
                         bad_effector_input: self.u64(),
                         wrong_identity: self.u64(),
+                        operator_refused: self.u64(),
                         ..RejectCounters::default()
                     },
                     ..StatusMsg::default()
@@ -470,6 +504,8 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
             "magnetometer",
             "command",
             "status",
+            "time",
+            "operator",
             "header",
         ] {
             let want = rust_lines.next().expect("a Rust verdict per decoder");
@@ -491,7 +527,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
     }
     assert!(c_lines.next().is_none(), "extra C output");
     eprintln!(
-        "{N} buffers x 7 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
+        "{N} buffers x 9 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
     );
     // The stream exercises every outcome.
     for r in [

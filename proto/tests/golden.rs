@@ -24,11 +24,12 @@ use flexdyn_proto::{
     command_flags, decode, decode_header, effector_kind, encode, magnetometer_flags,
     magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags, time_flags,
     wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, EffectorInput,
-    EffectorState, FrameTiming, Header, ImuMsg, MagnetometerMsg, Mode, RejectCounters, RunState,
-    StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime, WireMessage,
-    COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CUC_PFIELD_TAI_4_3,
-    EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, IMU_LEN, MAGNETOMETER_LEN,
-    STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
+    EffectorState, FrameTiming, Header, ImuMsg, MagnetometerMsg, Mode, OperatorAction, OperatorMsg,
+    RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg,
+    UtcTime, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN,
+    CUC_PFIELD_TAI_4_3, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, IMU_LEN,
+    MAGNETOMETER_LEN, OPERATOR_LEN, STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET,
+    TIME_LEN,
 };
 
 type Golden = &'static [(usize, &'static str, &'static str)];
@@ -100,7 +101,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -360,7 +361,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -436,7 +437,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -483,7 +484,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -553,7 +554,7 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -584,7 +585,7 @@ const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
     (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
 ];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -628,7 +629,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
 /// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
 /// TAI …036.0 s). `src/server/clock.rs` produces exactly this message from that epoch.
 const TIME_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -701,7 +702,7 @@ const TIME_GOLDEN: &[(usize, &str, &str)] = &[
     (118, "00000000", "u32 tone_tai.subseconds = 0"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -718,7 +719,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -774,11 +775,40 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
         "u64 rejected.bad_effector_input = 8",
     ),
     (155, "0900000000000000", "u64 rejected.wrong_identity = 9"),
-    (163, "0700000000000000", "u64 commands_dropped = 7"),
     (
-        171,
+        163,
+        "0a00000000000000",
+        "u64 rejected.operator_refused = 10",
+    ),
+    (171, "0700000000000000", "u64 commands_dropped = 7"),
+    (
+        179,
         "15cd853dfe9c9717",
         "u64 wall_time_unix_ns = 1700000000123456789 (0x17979CFE3D85CD15)",
+    ),
+];
+
+// Protocol 6 (issue 23, operator control): a `RunTicks` operator command. The tick count
+// 4294967301 = 0x1_0000_0005 has bytes on both sides of bit 32, so a u32 `ticks` would show.
+const OPERATOR_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0600", "u16 header.protocol_version = 6"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "2c00000000000000", "u64 header.tick = 44"),
+    (
+        14,
+        "00de391a00000000",
+        "u64 header.sim_time_ns = 440000000 (0x1A39DE00)",
+    ),
+    (22, "0300000000000000", "u64 header.seq = 3"),
+    (30, "02000000", "u32 action tag = 2 (RunTicks)"),
+    (
+        34,
+        "0500000001000000",
+        "u64 ticks = 4294967301 (0x100000005)",
     ),
 ];
 
@@ -1004,6 +1034,7 @@ fn status_golden() {
             unknown_sender: 6,
             bad_effector_input: 8,
             wrong_identity: 9,
+            operator_refused: 10,
         },
         commands_dropped: 7,
         wall_time_unix_ns: 1_700_000_000_123_456_789,
@@ -1013,6 +1044,30 @@ fn status_golden() {
 }
 
 /// Every enum tag, pinned: the u32 at the tag's offset for each variant.
+#[test]
+fn operator_golden() {
+    let msg = OperatorMsg::new(
+        Header::new(SC, 44, 440_000_000, 3),
+        OperatorAction::RunTicks,
+        0x1_0000_0005,
+    );
+    check("OperatorMsg", OPERATOR_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), OPERATOR_LEN);
+    for (action, tag) in [
+        (OperatorAction::Pause, 0u32),
+        (OperatorAction::Resume, 1),
+        (OperatorAction::RunTicks, 2),
+    ] {
+        let bytes = encode(&OperatorMsg::new(Header::default(), action, 0));
+        assert_eq!(
+            u32::from_le_bytes(bytes[30..34].try_into().unwrap()),
+            tag,
+            "{action:?}"
+        );
+        assert_eq!(action.tag(), tag);
+    }
+}
+
 #[test]
 fn enum_tags() {
     let tag_at = |b: &[u8], at: usize| u32::from_le_bytes(b[at..at + 4].try_into().unwrap());
@@ -1111,7 +1166,7 @@ fn flag_bits() {
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 9] = [
+    let tables: [(&str, &str, Golden, &str); 10] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -1146,6 +1201,12 @@ fn exported_golden_files_match_the_tables() {
             "MAGNETOMETER_GOLDEN",
         ),
         ("time", "TimeMsg", TIME_GOLDEN, "TIME_GOLDEN"),
+        (
+            "operator",
+            "OperatorMsg",
+            OPERATOR_GOLDEN,
+            "OPERATOR_GOLDEN",
+        ),
     ];
     let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");
     let rows: Vec<Vec<&str>> = manifest

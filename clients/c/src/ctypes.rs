@@ -116,6 +116,7 @@ pub struct FdStatusMsg {
     pub rejected_unknown_sender: u64,
     pub rejected_bad_effector_input: u64,
     pub rejected_wrong_identity: u64,
+    pub rejected_operator_refused: u64,
     pub commands_dropped: u64,
     pub wall_time_unix_ns: u64,
 }
@@ -253,6 +254,7 @@ impl From<&StatusMsg> for FdStatusMsg {
             unknown_sender,
             bad_effector_input,
             wrong_identity,
+            operator_refused,
         } = *rejected;
         Self {
             header: header.into(),
@@ -275,6 +277,7 @@ impl From<&StatusMsg> for FdStatusMsg {
             rejected_unknown_sender: unknown_sender,
             rejected_bad_effector_input: bad_effector_input,
             rejected_wrong_identity: wrong_identity,
+            rejected_operator_refused: operator_refused,
             commands_dropped: *commands_dropped,
             wall_time_unix_ns: *wall_time_unix_ns,
         }

@@ -201,6 +201,7 @@ static void check_status(flexdyn_client *c, const char *dir) {
     SAME("status", a, b, rejected_unknown_sender);
     SAME("status", a, b, rejected_bad_effector_input);
     SAME("status", a, b, rejected_wrong_identity);
+    SAME("status", a, b, rejected_operator_refused);
     SAME("status", a, b, commands_dropped);
     SAME("status", a, b, wall_time_unix_ns);
     printf("status compared\n");
