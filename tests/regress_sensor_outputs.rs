@@ -17,39 +17,40 @@ use flexdyn::cli::simulate_to;
 use flexdyn::config::SimConfig;
 use sha2::{Digest, Sha256};
 
-/// (scenario, log interval \[s\], sha256 of the CSV). Re-minted for protocol version 5: the
-/// CSV's `protocol_version` column reads 5; with it set back to 4 each CSV hashes to its
-/// protocol-4 golden, so no other value changed.
+/// (scenario, log interval \[s\], sha256 of the CSV). Re-minted for protocol version 6 (operator
+/// control): the CSV's `protocol_version` column reads 6; with it set back to 5 each CSV hashes
+/// to its protocol-5 golden (checked for the 0.05 s rows of both scenarios), so no other value
+/// changed. (Protocol 5 likewise re-minted the protocol-4 values.)
 const GOLDEN: [(&str, f64, &str); 6] = [
     (
         "imu_tactical",
         0.01,
-        "a4016a64329a6aa03b161931340209bc4c022acb74b78d9ed65d6dd8f100471f",
+        "4f78126184c8e9635f21f9019a566cc64e097b3685d29c2563f1a1d9f1653c92",
     ),
     (
         "imu_tactical",
         0.003,
-        "2e77544acc6b1d2e1f2f65b3cfbe7fcf0af046ce43dbbf7fe1d2e1cbede0c49e",
+        "4b10eb863251f139b8d2458c5cb42761ee73fde3da0e97a7ea5b75cd86124a6d",
     ),
     (
         "imu_tactical",
         0.05,
-        "2f6d566963b440e38d9ac363ecc5d3f7da2024c76cb162ed7d08304309cd7fa4",
+        "a21a5ca55215963db95d4fb18f9271e565c9e3ea9d4fd489805256867be378c9",
     ),
     (
         "wheels_star_tracker",
         0.01,
-        "fc4452c49825f22dc39892fa2e708661c87bcccc495223a907754221f4a87655",
+        "3a8e4a4a1b34bed6df6982ed9ebb5e3970cdaeb1aacd7474b882ffa1c760f72a",
     ),
     (
         "wheels_star_tracker",
         0.003,
-        "589c4e6807b43d50c88e388208865c1c58e1b35b2d3d9ad1e5bccfdd646c0126",
+        "4fd20e92b9fcf2948b00ab8389ded455d3a695335be10577e784d133a2eb865c",
     ),
     (
         "wheels_star_tracker",
         0.05,
-        "0a81cb3b40a9245b17068c68fe53a726d3a357a37e3bd9281c663b52894e047a",
+        "eb1dc9ed19abd6731c8fb36b52685d7b1a8312d89b3a945a639f1bccd620d1c5",
     ),
 ];
 
