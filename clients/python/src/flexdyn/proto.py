@@ -1,4 +1,4 @@
-"""The flexdyn wire protocol, version 5, in pure Python.
+"""The flexdyn wire protocol, version 6, in pure Python.
 
 Every message of ``proto/README.md`` as a dataclass with ``encode()`` and ``decode(bytes)``.
 Decoding follows the README's decoder rules in the same order and raises :class:`DecodeError`
