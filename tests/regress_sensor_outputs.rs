@@ -7,8 +7,9 @@
 //! --log-every-s <interval> | sha256sum` at main 535783c (before the sensor seam of issue 20),
 //! x86_64 Linux; re-minted for protocol versions 5 and 6, whose only effect on these CSVs is the
 //! `protocol_version` column: with that column written back as 5, every CSV hashes to the
-//! protocol-5 value (and, back as 4, to the 535783c value). To re-mint after an intended change of the outputs, run that command (or this
-//! test, which prints the hashes) and replace the constants, saying why in the commit. A mismatch
+//! protocol-5 value (and, back as 4, to the 535783c value). To re-mint after an intended change
+//! of the outputs, run that command (or this test, which prints the hashes) and replace the
+//! constants, saying why in the commit. A mismatch
 //! on another platform can come from its libm (`atan2`, `acos`, `tan`), not from flexdyn.
 
 use std::path::Path;
