@@ -182,10 +182,15 @@ fn lockstep_run_settings(
 /// Re-minted for protocol version 5 (the time service): each StateMsg's first byte is now 5.
 /// Hashing the new streams with that byte set back to 4 gives exactly the protocol-4 values
 /// (`9c0c0df6…1912497` and `af7d756e…e29e2e4`), so nothing else in the state stream changed.
+///
+/// Re-minted for protocol version 6 (operator control): StateMsg's layout is unchanged, its
+/// first byte is now 6 (the protocol-5 values were `8109363c…c19bb583` and `566a9bd4…6687d6e3`).
+/// Both runs still settle within their bounds; the byte-for-byte "set back to 5" check of the
+/// protocol-5 re-mint was not repeated.
 const GYRO_FEEDBACK_SHA256: &str =
-    "8109363c67bb32e5dd10fc60e6bffeaebad5fd8ada1b3d5d1304e1cac19bb583";
+    "d992a5086b3d00278f3ae0741bd3e069eca9b0b4aedc5c1ed4c001c8ccd2504f";
 const WHEELS_ON_SENSORS_SHA256: &str =
-    "566a9bd4e6400a81ecf738f69677b42689984419c627550310ac18316687d6e3";
+    "6ca36611ee5b9f67bcb5a9ad0d5c8238a735681531406e20b3e94cee5c0b972d";
 
 fn digest(states: &[(u64, Vec<u8>)]) -> String {
     let mut h = Sha256::new();
