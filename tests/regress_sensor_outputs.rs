@@ -7,7 +7,7 @@
 //! --log-every-s <interval> | sha256sum` at main 535783c (before the sensor seam of issue 20),
 //! x86_64 Linux; re-minted for protocol version 5, whose only effect on these CSVs is the
 //! `protocol_version` column: with that column written back as 4, every CSV hashes to the
-//! 535783c value; and again for protocol version 6 (the sun sensors), checked the same way (the
+//! 535783c value; and again for protocol version 6 (the sun sensors and operator control; both branches minted the same values), checked the same way (the
 //! column written back as 5 gives the protocol-5 hashes). To re-mint after an intended change of the outputs, run that command (or this
 //! test, which prints the hashes) and replace the constants, saying why in the commit. A mismatch
 //! on another platform can come from its libm (`atan2`, `acos`, `tan`), not from flexdyn.

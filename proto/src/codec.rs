@@ -22,8 +22,9 @@
 use bincode::config::{Configuration, Fixint, Limit, LittleEndian};
 
 use crate::{
-    CommandMsg, CssMsg, DecodeError, FssMsg, Header, ImuMsg, MagnetometerMsg, StarTrackerMsg,
-    StateMsg, StatusMsg, TimeMsg, WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
+    CommandMsg, CssMsg, DecodeError, FssMsg, Header, ImuMsg, MagnetometerMsg, OperatorMsg,
+    StarTrackerMsg, StateMsg, StatusMsg, TimeMsg, WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES,
+    PROTOCOL_VERSION,
 };
 
 /// The bincode configuration of the wire format.
@@ -132,6 +133,11 @@ pub fn decode_command(bytes: &[u8]) -> Result<CommandMsg, DecodeError> {
 
 /// [`decode`] for [`TimeMsg`].
 pub fn decode_time(bytes: &[u8]) -> Result<TimeMsg, DecodeError> {
+    decode(bytes)
+}
+
+/// [`decode`] for [`OperatorMsg`].
+pub fn decode_operator(bytes: &[u8]) -> Result<OperatorMsg, DecodeError> {
     decode(bytes)
 }
 

@@ -27,6 +27,9 @@ pub const FSS_PREFIX: &str = "tlm/fss";
 /// Zenoh access-control list can reserve each participant's key for its authenticated subject.
 /// Protocol version 4; versions ≤ 3 used the single key `flexdyn/<sc>/cmd/wrench`.
 pub const CMD_PREFIX: &str = "cmd";
+/// Suffix of the operator-command topic ([`crate::OperatorMsg`]: pause, resume, run N ticks).
+/// Protocol version 6.
+pub const OPERATOR_SUFFIX: &str = "operator";
 /// Suffix of the status topic.
 pub const STATUS_SUFFIX: &str = "status";
 /// Suffix of the server's configuration queryable (a `get` returns a UTF-8 JSON description
@@ -155,6 +158,12 @@ pub fn status_key(sc: &str) -> Result<String, KeyError> {
     Ok(format!("{KEY_ROOT}/{sc}/{STATUS_SUFFIX}"))
 }
 
+/// `flexdyn/<sc>/operator`: where an operator publishes [`crate::OperatorMsg`]s.
+pub fn operator_key(sc: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{OPERATOR_SUFFIX}"))
+}
+
 /// `flexdyn/<sc>/participant/<sender_id>`: the Zenoh liveliness token a lockstep
 /// participant declares once it is subscribed to the state topic, so the server
 /// knows it is present before publishing tick 0.
@@ -231,6 +240,11 @@ impl Topics {
     /// `flexdyn/<sc>/status`
     pub fn status(&self) -> &str {
         &self.status
+    }
+
+    /// `flexdyn/<sc>/operator` (operator commands).
+    pub fn operator(&self) -> String {
+        format!("{KEY_ROOT}/{}/{OPERATOR_SUFFIX}", self.sc_id)
     }
 
     /// `flexdyn/<sc>/tlm/time`
@@ -356,6 +370,11 @@ mod tests {
             assert_eq!(t.cmd_sender(bad), None, "{bad}");
         }
         assert_eq!(t.status(), "flexdyn/sc-1/status");
+        assert_eq!(t.operator(), "flexdyn/sc-1/operator");
+        assert_eq!(operator_key("sc-1").unwrap(), t.operator());
+        assert!(operator_key("a/b").is_err());
+        assert_eq!(t.cmd_sender(&t.operator()), None);
+        assert_eq!(t.telemetry(&t.operator()), None);
         assert_eq!(t.imu("g").unwrap(), "flexdyn/sc-1/tlm/imu/g");
         assert_eq!(t.imu_wildcard(), "flexdyn/sc-1/tlm/imu/*");
         assert_eq!(t.telemetry_wildcard(), "flexdyn/sc-1/tlm/**");

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use crate::{
     CommandKind, CommandMsg, CssMsg, DecodeError, FssMsg, Header, ImuMsg, MagnetometerMsg,
-    StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
+    OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
 };
 
 /// Encoded [`Header`] size (bytes).
@@ -44,7 +44,9 @@ pub const COMMAND_NO_COMMAND_LEN: usize = 38;
 /// u64 input count sits at offset 86.
 pub const COMMAND_ACTUATORS_FIXED_LEN: usize = 94;
 /// Encoded [`StatusMsg`] size (bytes).
-pub const STATUS_LEN: usize = 179;
+pub const STATUS_LEN: usize = 187;
+/// Encoded [`OperatorMsg`] size (bytes).
+pub const OPERATOR_LEN: usize = 42;
 /// Largest effector count a [`StateMsg`] (or input count a [`CommandKind::Actuators`]) may
 /// carry; decoders reject more.
 pub const MAX_EFFECTORS: usize = 1024;
@@ -85,11 +87,12 @@ mod sealed {
     impl Sealed for super::CssMsg {}
     impl Sealed for super::FssMsg {}
     impl Sealed for super::TimeMsg {}
+    impl Sealed for super::OperatorMsg {}
 }
 
 /// A top-level message that can go on the wire. Implemented (only) by
 /// [`StateMsg`], [`ImuMsg`], [`StarTrackerMsg`], the other sensor messages
-/// ([`MagnetometerMsg`]), [`TimeMsg`], [`CommandMsg`] and [`StatusMsg`].
+/// ([`MagnetometerMsg`]), [`TimeMsg`], [`CommandMsg`], [`StatusMsg`] and [`OperatorMsg`].
 pub trait WireMessage: Serialize + DeserializeOwned + sealed::Sealed {
     /// Type name used in error messages.
     const NAME: &'static str;
@@ -186,6 +189,15 @@ impl WireMessage for TimeMsg {
     const NAME: &'static str = "TimeMsg";
     const LAYOUT: WireLayout = WireLayout::Fixed { len: TIME_LEN };
     const MIN_LEN: usize = TIME_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+impl WireMessage for OperatorMsg {
+    const NAME: &'static str = "OperatorMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed { len: OPERATOR_LEN };
+    const MIN_LEN: usize = OPERATOR_LEN;
     fn header(&self) -> &Header {
         &self.header
     }

@@ -26,6 +26,7 @@
 //! | `flexdyn/<sc-id>/tlm/fss/<name>` | [`FssMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/cmd/<sender-id>` | [`CommandMsg`] | flight code → server |
 //! | `flexdyn/<sc-id>/status` | [`StatusMsg`] | server → anyone |
+//! | `flexdyn/<sc-id>/operator` | [`OperatorMsg`] | operator → server |
 //! | `flexdyn/<sc-id>/participant/<sender-id>` | Zenoh liveliness token (no payload) | lockstep participant → server |
 //!
 //! Build keys with [`Topics`] or [`state_key`] & co; ids are validated
@@ -54,7 +55,8 @@
 //! | [`FssMsg`] | [`FSS_LEN`] = 47 |
 //! | [`TimeMsg`] | [`TIME_LEN`] = 122 |
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
-//! | [`StatusMsg`] | [`STATUS_LEN`] = 179 |
+//! | [`StatusMsg`] | [`STATUS_LEN`] = 187 |
+//! | [`OperatorMsg`] | [`OPERATOR_LEN`] = 42 |
 //!
 //! Decoders accept at most [`MAX_MESSAGE_BYTES`], [`MAX_EFFECTORS`] and
 //! [`MAX_EFFECTOR_VALUES`], reject trailing bytes, and never panic ([`DecodeError`]).
@@ -95,31 +97,32 @@ mod messages;
 
 pub use codec::{
     decode, decode_command, decode_css, decode_fss, decode_header, decode_imu, decode_magnetometer,
-    decode_star_tracker, decode_state, decode_status, decode_time, encode, encode_into,
+    decode_operator, decode_star_tracker, decode_state, decode_status, decode_time, encode,
+    encode_into,
 };
 pub use error::{DecodeError, KeyError};
 pub use keys::{
-    cmd_key, cmd_wildcard_key, imu_key, imu_wildcard_key, participant_key,
+    cmd_key, cmd_wildcard_key, imu_key, imu_wildcard_key, operator_key, participant_key,
     participant_wildcard_key, sensor_key, star_tracker_key, star_tracker_wildcard_key, state_key,
     status_key, validate_imu_name, validate_sc_id, validate_sensor_name,
     validate_star_tracker_name, Telemetry, Topics, CMD_PREFIX, CSS_PREFIX, FSS_PREFIX, IMU_PREFIX,
-    KEY_ROOT, MAGNETOMETER_PREFIX, MAX_ID_LEN, PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX,
-    STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
+    KEY_ROOT, MAGNETOMETER_PREFIX, MAX_ID_LEN, OPERATOR_SUFFIX, PARTICIPANT_PREFIX,
+    STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
 };
 pub use layout::{
     WireLayout, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
     COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CSS_LEN, EFFECTOR_INPUT_FIXED_LEN,
     EFFECTOR_STATE_FIXED_LEN, FSS_LEN, HEADER_LEN, IMU_LEN, MAGNETOMETER_LEN, MAX_EFFECTORS,
-    MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES, MAX_PANEL_PAIRS, STAR_TRACKER_LEN,
+    MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES, MAX_PANEL_PAIRS, OPERATOR_LEN, STAR_TRACKER_LEN,
     STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
 };
 pub use messages::{
     command_flags, effector_kind, fss_flags, magnetometer_flags, magnetorquer_flags,
     saturation_flags, star_tracker_flags, thruster_flags, time_flags, wheel_flags, AppliedWrench,
     CommandKind, CommandMsg, CommandStatus, Conserved, CssMsg, EffectorInput, EffectorState,
-    FrameTiming, FssMsg, Header, ImuMsg, MagnetometerMsg, Mode, RejectCounters, RunState,
-    StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime,
-    CUC_PFIELD_TAI_4_3, MAX_CSS_DETECTORS, NO_COMMAND,
+    FrameTiming, FssMsg, Header, ImuMsg, MagnetometerMsg, Mode, OperatorAction, OperatorMsg,
+    RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg,
+    UtcTime, CUC_PFIELD_TAI_4_3, MAX_CSS_DETECTORS, NO_COMMAND,
 };
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
@@ -128,5 +131,7 @@ pub use messages::{
 /// sender (`flexdyn/<sc-id>/cmd/<sender_id>`) and [`RejectCounters::wrong_identity`]. Version 5:
 /// the sensor messages of issue 20 ([`MagnetometerMsg`]), and the time service [`TimeMsg`] on
 /// `flexdyn/<sc-id>/tlm/time` with [`RunState::Paused`]. Version 6: the sun sensors of issue 20
-/// ([`CssMsg`] on `tlm/css/<name>`, [`FssMsg`] on `tlm/fss/<name>`).
+/// ([`CssMsg`] on `tlm/css/<name>`, [`FssMsg`] on `tlm/fss/<name>`), and operator control of
+/// issue 23 ([`OperatorMsg`] on `flexdyn/<sc-id>/operator`, [`RejectCounters::operator_refused`];
+/// StatusMsg grows to 187 bytes).
 pub const PROTOCOL_VERSION: u16 = 6;

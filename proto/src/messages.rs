@@ -633,6 +633,12 @@ pub struct RejectCounters {
     /// list lets only the participant's authenticated subject put there. Added in protocol
     /// version 4.
     pub wrong_identity: u64,
+    /// An [`OperatorMsg`] the server would not apply: an action that does not fit the mode
+    /// (anything in batch, `RunTicks` in real time), `RunTicks` with `ticks = 0`, `Resume` with
+    /// nothing held or pending, `Pause` while already held or pending. Malformed, bad-version and
+    /// wrong-spacecraft operator messages count under those reasons. Added in protocol
+    /// version 6.
+    pub operator_refused: u64,
 }
 
 impl RejectCounters {
@@ -661,13 +667,14 @@ impl RejectCounters {
             self.unknown_sender,
             self.bad_effector_input,
             self.wrong_identity,
+            self.operator_refused,
         ]
         .iter()
         .fold(0u64, |a, &b| a.saturating_add(b))
     }
 }
 
-/// Server health, topic `flexdyn/<sc-id>/status`. 179 bytes.
+/// Server health, topic `flexdyn/<sc-id>/status`. 187 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct StatusMsg {
@@ -795,4 +802,55 @@ pub struct TimeMsg {
     /// TAI since 1958 at the most recent tone, `CFE_TIME_SysTime_t` form (subseconds 0: the
     /// tone is a whole TAI second); zero without an epoch.
     pub tone_tai: SysTime,
+}
+
+/// What an [`OperatorMsg`] asks for. Wire: u32 LE tag. Added in protocol version 6.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub enum OperatorAction {
+    /// Tag 0: hold at the next tick. Real time: the next frame boundary; lockstep: the tick
+    /// after the one published (as `RunTicks` with 1).
+    #[default]
+    Pause,
+    /// Tag 1: release a hold (or a pending one) and run freely again.
+    Resume,
+    /// Tag 2 (lockstep only): step `ticks` more frames from the tick published (or held) now,
+    /// then hold at that tick.
+    RunTicks,
+}
+
+impl OperatorAction {
+    /// The wire tag (the u32 LE variant index).
+    pub const fn tag(self) -> u32 {
+        self as u32
+    }
+}
+
+/// An operator's command, topic `flexdyn/<sc-id>/operator`: pause, resume, or run N ticks and
+/// hold. 42 bytes. Added in protocol version 6.
+///
+/// On a lab network the shipped access-control list lets only the operator's subject put on
+/// this key (`scenarios/zenoh/secure-server.json5`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct OperatorMsg {
+    /// Common header: `spacecraft_id` must be the server's; `tick` the newest tick the operator
+    /// has seen (informational), `seq` the operator's own counter.
+    pub header: Header,
+    /// The action.
+    pub action: OperatorAction,
+    /// `RunTicks`: how many frames to step before holding (at least 1). Other actions: 0
+    /// (ignored).
+    pub ticks: u64,
+}
+
+impl OperatorMsg {
+    /// An operator command with `action` and `ticks`.
+    pub fn new(header: Header, action: OperatorAction, ticks: u64) -> Self {
+        Self {
+            header,
+            action,
+            ticks,
+        }
+    }
 }

@@ -6,7 +6,7 @@
 //!   message from its table values and decodes the golden files (`proto/golden/`) back;
 //! - `c_and_rust_decoders_agree_on_100000_buffers`: `proto/c/tests/fuzz_decode.c` and the Rust
 //!   decoders see the same 100,000 seeded buffers (valid messages of every type, mutated,
-//!   truncated, extended, random with a valid version, oversized) through all nine decoders;
+//!   truncated, extended, random with a valid version, oversized) through all eleven decoders;
 //!   (`flexdyn-decode-verdicts`, the canonical verdict printer the Python SDK's fuzz test uses
 //!   too); they must agree on accept/reject, on the reason (and its numbers or field), and on every
 //!   decoded field bit for bit. Every buffer the C side decodes it also re-encodes, and that must
@@ -25,7 +25,8 @@ use std::process::{Command, Stdio};
 
 use flexdyn_proto::{
     encode, CommandKind, CommandMsg, CssMsg, EffectorInput, EffectorState, FssMsg, Header, ImuMsg,
-    MagnetometerMsg, Mode, RejectCounters, StarTrackerMsg, StateMsg, StatusMsg, MAX_MESSAGE_BYTES,
+    MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters, RunState, StarTrackerMsg,
+    StateMsg, StatusMsg, TimeMsg, MAX_MESSAGE_BYTES,
 };
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -277,7 +278,7 @@ impl Gen {
     }
 
     fn message(&mut self) -> Vec<u8> {
-        match self.below(8) {
+        match self.below(10) {
             0 => {
                 let effectors = (0..self.below(6))
                     .map(|_| EffectorState {
@@ -319,18 +320,50 @@ impl Gen {
                 valid: self.below(2) == 1,
                 status_flags: self.u64() as u8,
             }),
+            6 => {
+                let mut m = TimeMsg {
+                    header: self.header(),
+                    run_state: RunState::from_tag(self.below(7) as u32).unwrap_or_default(),
+                    mode: [Mode::RealTime, Mode::Lockstep, Mode::Batch][self.below(3) as usize],
+                    flags: self.u64() as u8,
+                    frame_ns: self.u64(),
+                    speed: self.f64(),
+                    tai_ns_1958: self.u64(),
+                    tai_minus_utc_s: self.u64() as i32,
+                    gps_week: self.u64() as u32,
+                    gps_ns_of_week: self.u64(),
+                    met_ns: self.u64(),
+                    cuc_tai: self.u64().to_le_bytes(),
+                    ..TimeMsg::default()
+                };
+                m.utc.year = self.u64() as u16;
+                m.utc.second = self.u64() as u8;
+                m.utc.nanosecond = self.u64() as u32;
+                m.tone_met.subseconds = self.u64() as u32;
+                m.tone_tai.seconds = self.u64() as u32;
+                encode(&m)
+            }
+            7 => encode(&OperatorMsg::new(
+                self.header(),
+                [
+                    OperatorAction::Pause,
+                    OperatorAction::Resume,
+                    OperatorAction::RunTicks,
+                ][self.below(3) as usize],
+                self.u64(),
+            )),
             5 => encode(&MagnetometerMsg {
                 header: self.header(),
                 b_s_t: self.v(),
                 saturation_flags: self.u64() as u8,
             }),
             // Counts up to 17: the last is above the maximum (Malformed).
-            6 => encode(&CssMsg {
+            8 => encode(&CssMsg {
                 header: self.header(),
                 detector_count: self.below(18) as u8,
                 readings: self.v(),
             }),
-            7 => encode(&FssMsg {
+            9 => encode(&FssMsg {
                 header: self.header(),
                 alpha_rad: self.f64(),
                 beta_rad: self.f64(),
@@ -375,6 +408,7 @@ impl Gen {
                         malformed: self.u64(),
                         bad_effector_input: self.u64(),
                         wrong_identity: self.u64(),
+                        operator_refused: self.u64(),
                         ..RejectCounters::default()
                     },
                     ..StatusMsg::default()
@@ -484,6 +518,8 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
             "fss",
             "command",
             "status",
+            "time",
+            "operator",
             "header",
         ] {
             let want = rust_lines.next().expect("a Rust verdict per decoder");
@@ -505,7 +541,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
     }
     assert!(c_lines.next().is_none(), "extra C output");
     eprintln!(
-        "{N} buffers x 9 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
+        "{N} buffers x 11 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
     );
     // The stream exercises every outcome.
     for r in [

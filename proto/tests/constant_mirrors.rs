@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use flexdyn_proto::{
     command_flags, effector_kind, fss_flags, magnetorquer_flags, saturation_flags,
-    star_tracker_flags, thruster_flags, wheel_flags,
+    star_tracker_flags, thruster_flags, wheel_flags, OperatorAction,
 };
 
 /// An integer literal as both files write it: decimal or `0x…`, with an optional `u` suffix.
@@ -53,7 +53,7 @@ fn python_constants() -> HashMap<String, u64> {
 
 #[test]
 fn c_and_python_mirror_every_kind_and_flag() {
-    let mirrored: [(&str, u64); 28] = [
+    let mirrored: [(&str, u64); 31] = [
         ("EFFECTOR_PANEL_PAIR", effector_kind::PANEL_PAIR.into()),
         (
             "EFFECTOR_REACTION_WHEEL",
@@ -105,6 +105,9 @@ fn c_and_python_mirror_every_kind_and_flag() {
         ("CSS_LEN", flexdyn_proto::CSS_LEN as u64),
         ("FSS_LEN", flexdyn_proto::FSS_LEN as u64),
         ("PROTOCOL_VERSION", flexdyn_proto::PROTOCOL_VERSION.into()),
+        ("OPERATOR_PAUSE", OperatorAction::Pause.tag().into()),
+        ("OPERATOR_RESUME", OperatorAction::Resume.tag().into()),
+        ("OPERATOR_RUN_TICKS", OperatorAction::RunTicks.tag().into()),
         ("MAX_EFFECTORS", flexdyn_proto::MAX_EFFECTORS as u64),
         (
             "MAX_EFFECTOR_VALUES",

@@ -1,13 +1,14 @@
 //! Decoder error behaviour on hand-made bad inputs.
 
 use flexdyn_proto::{
-    decode, decode_command, decode_header, decode_imu, decode_star_tracker, decode_state,
-    decode_status, decode_time, effector_kind, encode, encode_into, CommandKind, CommandMsg,
-    DecodeError, EffectorInput, EffectorState, Header, ImuMsg, RejectCounters, StarTrackerMsg,
-    StateMsg, StatusMsg, TimeMsg, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
-    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, EFFECTOR_STATE_FIXED_LEN, HEADER_LEN, IMU_LEN,
-    MAX_EFFECTORS, MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES, STAR_TRACKER_LEN,
-    STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN, TIME_LEN,
+    decode, decode_command, decode_header, decode_imu, decode_operator, decode_star_tracker,
+    decode_state, decode_status, decode_time, effector_kind, encode, encode_into, CommandKind,
+    CommandMsg, DecodeError, EffectorInput, EffectorState, Header, ImuMsg, OperatorAction,
+    OperatorMsg, RejectCounters, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg, WireMessage,
+    COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN,
+    EFFECTOR_STATE_FIXED_LEN, HEADER_LEN, IMU_LEN, MAX_EFFECTORS, MAX_EFFECTOR_VALUES,
+    MAX_MESSAGE_BYTES, OPERATOR_LEN, STAR_TRACKER_LEN, STATE_EFFECTOR_COUNT_OFFSET,
+    STATE_FIXED_LEN, STATUS_LEN, TIME_LEN,
 };
 
 fn wrench(t: [f64; 3], f: [f64; 3]) -> CommandMsg {
@@ -263,6 +264,46 @@ fn malformed_enum_tags_and_bools() {
         decode_time(&long),
         Err(DecodeError::TrailingBytes { .. })
     ));
+    // OperatorMsg (protocol 6): its action tag (0..=2), fixed length 42.
+    let op = encode(&OperatorMsg::new(
+        Header::new(1, 2, 3, 4),
+        OperatorAction::RunTicks,
+        5,
+    ));
+    assert_eq!(op.len(), OPERATOR_LEN);
+    for (offset, value) in [(30usize, 3u8), (33, 0x80)] {
+        let mut b = op.clone();
+        b[offset] = value;
+        assert!(
+            matches!(decode_operator(&b), Err(DecodeError::Malformed(_))),
+            "operator tag byte at {offset}"
+        );
+    }
+    assert_eq!(
+        decode_operator(&op[..OPERATOR_LEN - 1]),
+        Err(DecodeError::Length {
+            needed: OPERATOR_LEN,
+            actual: OPERATOR_LEN - 1
+        })
+    );
+    let mut long = op.clone();
+    long.push(0);
+    assert_eq!(
+        decode_operator(&long),
+        Err(DecodeError::TrailingBytes {
+            expected: OPERATOR_LEN,
+            actual: OPERATOR_LEN + 1
+        })
+    );
+    let mut old = op.clone();
+    old[0] = 5;
+    assert_eq!(
+        decode_operator(&old),
+        Err(DecodeError::UnknownVersion { found: 5 })
+    );
+    // A command is not an operator message (and vice versa): the lengths differ.
+    assert!(decode_operator(&encode(&wrench([0.0; 3], [0.0; 3]))).is_err());
+    assert!(decode_command(&op).is_err());
     let mut b = encode(&wrench([0.0; 3], [0.0; 3]));
     b[COMMAND_KIND_OFFSET] = 3;
     assert!(matches!(decode_command(&b), Err(DecodeError::Malformed(_))));
@@ -427,6 +468,8 @@ fn reject_counters_record() {
     assert_eq!(c.total(), 8);
     c.wrong_identity = 3;
     assert_eq!(c.total(), 11);
+    c.operator_refused = 4;
+    assert_eq!(c.total(), 15);
     c.stale_tick = u64::MAX;
     assert_eq!(c.total(), u64::MAX);
 }

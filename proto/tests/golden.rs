@@ -25,11 +25,12 @@ use flexdyn_proto::{
     magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags, time_flags,
     wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, CssMsg,
     DecodeError, EffectorInput, EffectorState, FrameTiming, FssMsg, Header, ImuMsg,
-    MagnetometerMsg, Mode, RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg,
-    StatusMsg, SysTime, TimeMsg, UtcTime, WireMessage, COMMAND_ACTUATORS_FIXED_LEN,
-    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CSS_LEN, CUC_PFIELD_TAI_4_3,
-    EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, FSS_LEN, IMU_LEN, MAGNETOMETER_LEN,
-    MAX_CSS_DETECTORS, STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
+    MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters, RunState, StalePolicy,
+    StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime, WireMessage,
+    COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CSS_LEN,
+    CUC_PFIELD_TAI_4_3, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, FSS_LEN, IMU_LEN,
+    MAGNETOMETER_LEN, MAX_CSS_DETECTORS, OPERATOR_LEN, STAR_TRACKER_LEN, STATE_FIXED_LEN,
+    STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
 };
 
 type Golden = &'static [(usize, &'static str, &'static str)];
@@ -838,11 +839,40 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
         "u64 rejected.bad_effector_input = 8",
     ),
     (155, "0900000000000000", "u64 rejected.wrong_identity = 9"),
-    (163, "0700000000000000", "u64 commands_dropped = 7"),
     (
-        171,
+        163,
+        "0a00000000000000",
+        "u64 rejected.operator_refused = 10",
+    ),
+    (171, "0700000000000000", "u64 commands_dropped = 7"),
+    (
+        179,
         "15cd853dfe9c9717",
         "u64 wall_time_unix_ns = 1700000000123456789 (0x17979CFE3D85CD15)",
+    ),
+];
+
+// Protocol 6 (issue 23, operator control): a `RunTicks` operator command. The tick count
+// 4294967301 = 0x1_0000_0005 has bytes on both sides of bit 32, so a u32 `ticks` would show.
+const OPERATOR_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0600", "u16 header.protocol_version = 6"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "2c00000000000000", "u64 header.tick = 44"),
+    (
+        14,
+        "00de391a00000000",
+        "u64 header.sim_time_ns = 440000000 (0x1A39DE00)",
+    ),
+    (22, "0300000000000000", "u64 header.seq = 3"),
+    (30, "02000000", "u32 action tag = 2 (RunTicks)"),
+    (
+        34,
+        "0500000001000000",
+        "u64 ticks = 4294967301 (0x100000005)",
     ),
 ];
 
@@ -1103,6 +1133,7 @@ fn status_golden() {
             unknown_sender: 6,
             bad_effector_input: 8,
             wrong_identity: 9,
+            operator_refused: 10,
         },
         commands_dropped: 7,
         wall_time_unix_ns: 1_700_000_000_123_456_789,
@@ -1112,6 +1143,30 @@ fn status_golden() {
 }
 
 /// Every enum tag, pinned: the u32 at the tag's offset for each variant.
+#[test]
+fn operator_golden() {
+    let msg = OperatorMsg::new(
+        Header::new(SC, 44, 440_000_000, 3),
+        OperatorAction::RunTicks,
+        0x1_0000_0005,
+    );
+    check("OperatorMsg", OPERATOR_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), OPERATOR_LEN);
+    for (action, tag) in [
+        (OperatorAction::Pause, 0u32),
+        (OperatorAction::Resume, 1),
+        (OperatorAction::RunTicks, 2),
+    ] {
+        let bytes = encode(&OperatorMsg::new(Header::default(), action, 0));
+        assert_eq!(
+            u32::from_le_bytes(bytes[30..34].try_into().unwrap()),
+            tag,
+            "{action:?}"
+        );
+        assert_eq!(action.tag(), tag);
+    }
+}
+
 #[test]
 fn enum_tags() {
     let tag_at = |b: &[u8], at: usize| u32::from_le_bytes(b[at..at + 4].try_into().unwrap());
@@ -1214,7 +1269,7 @@ fn flag_bits() {
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 11] = [
+    let tables: [(&str, &str, Golden, &str); 12] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -1252,6 +1307,12 @@ fn exported_golden_files_match_the_tables() {
         // Protocol 6, the sun sensors.
         ("css", "CssMsg", CSS_GOLDEN, "CSS_GOLDEN"),
         ("fss", "FssMsg", FSS_GOLDEN, "FSS_GOLDEN"),
+        (
+            "operator",
+            "OperatorMsg",
+            OPERATOR_GOLDEN,
+            "OPERATOR_GOLDEN",
+        ),
     ];
     let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");
     let rows: Vec<Vec<&str>> = manifest

@@ -2,10 +2,12 @@
 //! messages round-trip, and every truncation or extension is an error.
 
 use flexdyn_proto::{
-    decode, decode_command, decode_header, decode_imu, decode_star_tracker, decode_state,
-    decode_status, encode, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved,
-    DecodeError, EffectorInput, EffectorState, FrameTiming, Header, ImuMsg, Mode, RejectCounters,
-    RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, WireMessage, MAX_EFFECTOR_VALUES,
+    decode, decode_command, decode_header, decode_imu, decode_magnetometer, decode_operator,
+    decode_star_tracker, decode_state, decode_status, decode_time, encode, AppliedWrench,
+    CommandKind, CommandMsg, CommandStatus, Conserved, DecodeError, EffectorInput, EffectorState,
+    FrameTiming, Header, ImuMsg, Mode, OperatorAction, OperatorMsg, RejectCounters, RunState,
+    StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime, WireMessage,
+    MAX_EFFECTOR_VALUES,
 };
 use proptest::prelude::*;
 
@@ -143,6 +145,7 @@ fn status() -> impl Strategy<Value = StatusMsg> {
         Just(RunState::Finished),
         Just(RunState::Failed),
         Just(RunState::Stopped),
+        Just(RunState::Paused),
     ];
     let policy = prop_oneof![Just(StalePolicy::Hold), Just(StalePolicy::Zero)];
     (
@@ -151,7 +154,7 @@ fn status() -> impl Strategy<Value = StatusMsg> {
         run,
         (u(), u(), u(), u(), u()),
         (u(), u(), any::<bool>(), policy),
-        (u(), u(), u(), u(), u(), u(), u(), u()),
+        (u(), u(), u(), u(), u(), u(), u(), u(), u()),
         (u(), u()),
     )
         .prop_map(
@@ -181,6 +184,7 @@ fn status() -> impl Strategy<Value = StatusMsg> {
                     unknown_sender: r.5,
                     bad_effector_input: r.6,
                     wrong_identity: r.7,
+                    operator_refused: r.8,
                 },
                 commands_dropped: dropped,
                 wall_time_unix_ns: wall,
@@ -188,8 +192,69 @@ fn status() -> impl Strategy<Value = StatusMsg> {
         )
 }
 
+/// Time messages with every field drawn at random (the speed as any bit pattern).
+fn time() -> impl Strategy<Value = TimeMsg> {
+    let u = any::<u64>;
+    let run = (0u32..7).prop_map(|t| RunState::from_tag(t).unwrap_or_default());
+    let mode = prop_oneof![
+        Just(Mode::RealTime),
+        Just(Mode::Lockstep),
+        Just(Mode::Batch)
+    ];
+    (
+        header(),
+        (run, mode, any::<u8>(), u(), any_bits_f64(), u()),
+        (any::<u16>(), any::<[u8; 5]>(), any::<u32>()),
+        (any::<i32>(), any::<u32>(), u(), u(), any::<[u8; 8]>()),
+        any::<[u32; 4]>(),
+    )
+        .prop_map(|(header, a, (year, ymdhms, ns), b, tone)| TimeMsg {
+            header,
+            run_state: a.0,
+            mode: a.1,
+            flags: a.2,
+            frame_ns: a.3,
+            speed: a.4,
+            tai_ns_1958: a.5,
+            utc: UtcTime {
+                year,
+                month: ymdhms[0],
+                day: ymdhms[1],
+                hour: ymdhms[2],
+                minute: ymdhms[3],
+                second: ymdhms[4],
+                nanosecond: ns,
+            },
+            tai_minus_utc_s: b.0,
+            gps_week: b.1,
+            gps_ns_of_week: b.2,
+            met_ns: b.3,
+            cuc_tai: b.4,
+            tone_met: SysTime {
+                seconds: tone[0],
+                subseconds: tone[1],
+            },
+            tone_tai: SysTime {
+                seconds: tone[2],
+                subseconds: tone[3],
+            },
+        })
+}
+
+fn operator() -> impl Strategy<Value = OperatorMsg> {
+    let action = prop_oneof![
+        Just(OperatorAction::Pause),
+        Just(OperatorAction::Resume),
+        Just(OperatorAction::RunTicks)
+    ];
+    (header(), action, any::<u64>()).prop_map(|(h, a, n)| OperatorMsg::new(h, a, n))
+}
+
 /// Run every decoder; the only requirement is that none panics.
 fn decode_all(bytes: &[u8]) {
+    let _ = decode_time(bytes);
+    let _ = decode_operator(bytes);
+    let _ = decode_magnetometer(bytes);
     let _ = decode_state(bytes);
     let _ = decode_imu(bytes);
     let _ = decode_command(bytes);
@@ -241,13 +306,15 @@ proptest! {
     /// Random bodies of exactly the right length reach bincode: the result is a
     /// message, Malformed or NonFinite, never a panic or a length error.
     #[test]
-    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 177)) {
+    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 185)) {
         let mut b = flexdyn_proto::PROTOCOL_VERSION.to_le_bytes().to_vec();
         b.extend_from_slice(&body);
         for r in [
             decode_imu(&b[..flexdyn_proto::IMU_LEN]).map(|_| ()),
             decode_status(&b[..flexdyn_proto::STATUS_LEN]).map(|_| ()),
             decode_star_tracker(&b[..flexdyn_proto::STAR_TRACKER_LEN]).map(|_| ()),
+            decode_time(&b[..flexdyn_proto::TIME_LEN]).map(|_| ()),
+            decode_operator(&b[..flexdyn_proto::OPERATOR_LEN]).map(|_| ()),
         ] {
             prop_assert!(matches!(r, Ok(()) | Err(DecodeError::Malformed(_))), "{:?}", r);
         }
@@ -310,6 +377,49 @@ proptest! {
         let msg = StarTrackerMsg { header, q_cn: q, valid, status_flags };
         round_trip_and_truncate(&msg)?;
         prop_assert_eq!(decode_star_tracker(&encode(&msg)), Ok(msg));
+    }
+
+    #[test]
+    fn time_round_trip(msg in time()) {
+        round_trip_and_truncate(&msg)?;
+        let back = decode_time(&encode(&msg)).unwrap();
+        // Bitwise: the speed may be a NaN.
+        prop_assert_eq!(back.speed.to_bits(), msg.speed.to_bits());
+        prop_assert_eq!(TimeMsg { speed: 0.0, ..back }, TimeMsg { speed: 0.0, ..msg });
+    }
+
+    #[test]
+    fn operator_round_trip(msg in operator()) {
+        round_trip_and_truncate(&msg)?;
+        prop_assert_eq!(decode_operator(&encode(&msg)), Ok(msg));
+    }
+
+    /// Valid time and operator messages with random bytes overwritten: a message, or Malformed
+    /// (an enum tag out of range), never a panic or another error (their lengths are fixed).
+    #[test]
+    fn mutated_time_and_operator_messages(
+        t in time(),
+        o in operator(),
+        edits in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8),
+    ) {
+        let (mut bt, mut bo) = (encode(&t), encode(&o));
+        for (i, v) in &edits {
+            let at = i.index(bt.len());
+            bt[at] = *v;
+            let at = i.index(bo.len());
+            bo[at] = *v;
+        }
+        decode_all(&bt);
+        decode_all(&bo);
+        let version_ok = |b: &[u8]| b[..2] == flexdyn_proto::PROTOCOL_VERSION.to_le_bytes();
+        if version_ok(&bt) {
+            let r = decode_time(&bt).map(|_| ());
+            prop_assert!(matches!(r, Ok(()) | Err(DecodeError::Malformed(_))), "{:?}", r);
+        }
+        if version_ok(&bo) {
+            let r = decode_operator(&bo).map(|_| ());
+            prop_assert!(matches!(r, Ok(()) | Err(DecodeError::Malformed(_))), "{:?}", r);
+        }
     }
 
     #[test]

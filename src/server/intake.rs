@@ -53,6 +53,22 @@ pub(super) async fn declare(
         .map_err(|e| ServerError::zenoh("declare the command subscriber", e))
 }
 
+/// Queues a sample that arrived (a command, an operator command) for the `--record` file, as
+/// it came, accepted or not.
+pub(super) fn record_arrival(
+    record: Option<&RecordTx>,
+    sample: &zenoh::sample::Sample,
+    bytes: &[u8],
+) {
+    if let Some(rec) = record {
+        rec.submit(RecordItem {
+            key: Arc::from(sample.key_expr().as_str()),
+            payload: bytes.to_vec(),
+            publish_time_ns: crate::transport::frame_stamp_ns(sample),
+        });
+    }
+}
+
 /// The zenoh callback for `flexdyn/<sc>/cmd/*`: decode and check (spacecraft, the key's
 /// sender, the participants), count rejections, and deliver valid commands to `sink`.
 fn command_callback(
@@ -73,13 +89,7 @@ fn command_callback(
         let bytes = sample.payload().to_bytes();
         let key = sample.key_expr().as_str();
         // Every command that arrives is recorded, accepted or not: the file shows what was sent.
-        if let Some(rec) = &record {
-            rec.submit(RecordItem {
-                key: Arc::from(key),
-                payload: bytes.to_vec(),
-                publish_time_ns: crate::transport::frame_stamp_ns(&sample),
-            });
-        }
+        record_arrival(record.as_ref(), &sample, &bytes);
         let cmd = match decode_command(&bytes) {
             Ok(cmd) => cmd,
             Err(e) => {

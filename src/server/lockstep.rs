@@ -60,6 +60,9 @@ pub struct LockstepCore {
     phase: Phase,
     tick_published_at: Instant,
     events: Arc<Notify>,
+    /// Holding at tick `k` on an operator's request: its answers are taken, but frame
+    /// `k → k + 1` waits for [`Self::release_if_due`].
+    holding: bool,
 }
 
 impl LockstepCore {
@@ -84,6 +87,7 @@ impl LockstepCore {
             phase: Phase::Waiting,
             tick_published_at: Instant::now(),
             events,
+            holding: false,
         };
         core.w.book.begin_tick();
         core
@@ -96,14 +100,51 @@ impl LockstepCore {
         }
         self.shared.set_run_state(RunState::Running);
         self.w.fill(&mut self.frame, 0);
+        self.mark_hold();
         self.publish();
         if self.total_frames == Some(0) {
             self.end(Phase::Finished);
             return;
         }
         self.phase = Phase::Running;
+        self.enter_hold();
         // Answers to tick 0 that came during the presence wait.
-        if self.w.book.all_answered() {
+        if self.w.book.all_answered() && !self.holding {
+            self.advance();
+        }
+    }
+
+    /// Before publishing tick `k`: whether the operator holds the run there (never at the
+    /// run's last tick); if so its time message says `Paused`.
+    fn mark_hold(&mut self) {
+        self.holding = self.shared.holds_at(self.k) && self.total_frames != Some(self.k);
+        if self.holding {
+            self.frame.time.run_state = RunState::Paused;
+        }
+    }
+
+    /// After publishing a held tick: the status says `Paused` until released.
+    fn enter_hold(&mut self) {
+        if self.holding {
+            self.shared.held.store(true, Ordering::Release);
+            self.shared.set_run_state(RunState::Paused);
+            tracing::info!(tick = self.k, "held by the operator");
+        }
+    }
+
+    /// After the operator moved the hold target: if the held tick is no longer held, run on
+    /// (stepping at once if every participant has answered it). The participant timeout
+    /// restarts from here.
+    pub fn release_if_due(&mut self) {
+        if !self.holding || self.shared.holds_at(self.k) || self.ended() {
+            return;
+        }
+        self.holding = false;
+        self.shared.held.store(false, Ordering::Release);
+        self.shared.set_run_state(RunState::Running);
+        self.tick_published_at = Instant::now();
+        tracing::info!(tick = self.k, "released by the operator");
+        if matches!(self.phase, Phase::Running) && self.w.book.all_answered() {
             self.advance();
         }
     }
@@ -116,7 +157,7 @@ impl LockstepCore {
         }
         let offer = self.w.book.offer_lockstep(cmd, self.k);
         count_offer(&self.shared, offer, cmd.sender_id);
-        if matches!(self.phase, Phase::Running) && self.w.book.all_answered() {
+        if matches!(self.phase, Phase::Running) && self.w.book.all_answered() && !self.holding {
             self.advance();
         }
     }
@@ -137,12 +178,14 @@ impl LockstepCore {
             self.end(Phase::Failed(e));
             return;
         }
+        self.mark_hold();
         self.publish();
         if self.total_frames == Some(self.k) {
             self.end(Phase::Finished);
             return;
         }
         self.w.book.begin_tick();
+        self.enter_hold();
     }
 
     fn end(&mut self, phase: Phase) {
@@ -169,7 +212,10 @@ impl LockstepCore {
 
     /// Fails the run if the current tick has waited longer than `timeout` for its answers.
     pub fn check_timeout(&mut self, timeout: std::time::Duration) {
-        if matches!(self.phase, Phase::Running) && self.tick_published_at.elapsed() >= timeout {
+        if matches!(self.phase, Phase::Running)
+            && !self.holding
+            && self.tick_published_at.elapsed() >= timeout
+        {
             let e = ServerError::ParticipantTimeout {
                 participant: self.w.book.first_unanswered().unwrap_or_default(),
                 tick: self.k,

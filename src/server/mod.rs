@@ -12,6 +12,7 @@
 //! - `intake`: the command callback (Zenoh rx): decoding, the checks, the rejection counters,
 //!   and delivery to the physics thread's queue or the lockstep core.
 //! - `presence`: lockstep participants' liveliness tokens and the wait before tick 0.
+//! - [`operator`]: the operator's pause, resume and "run N ticks" (`flexdyn/<sc>/operator`).
 //! - [`telemetry`], [`physics`], [`lockstep`]: the threads that run the frames (below).
 //! - `report`: the [`RunReport`], collected when every thread is done.
 //!
@@ -50,6 +51,7 @@ pub mod commands;
 pub mod error;
 mod intake;
 pub mod lockstep;
+pub mod operator;
 pub mod pacing;
 pub mod physics;
 mod presence;
@@ -125,6 +127,22 @@ pub async fn run(
     // Hard real time: after the buffers exist (mlockall faults them in), before the physics
     // thread starts; undone when the run ends.
     let _realtime = RealtimeHold::acquire(&settings)?;
+
+    // zenoh rx: the operator's pause / resume / run N ticks (moves the shared hold target).
+    let core = match &wiring.frames {
+        Frames::Core { core, .. } => Some(core.clone()),
+        Frames::Physics(..) => None,
+    };
+    let _operator = operator::declare(
+        &session,
+        &topics,
+        shared.clone(),
+        mode,
+        settings.spacecraft_id,
+        core,
+        record_tx.clone(),
+    )
+    .await?;
 
     // zenoh rx: the command callback, into the physics thread's queue or the lockstep core.
     let commands = intake::declare(

@@ -119,6 +119,16 @@ impl Pacer {
         Some(u64::try_from(late.as_nanos()).unwrap_or(u64::MAX))
     }
 
+    /// After a hold at boundary `k` that ends now: moves the schedule so that boundary `k + 1`
+    /// is due one period from now (the frames missed while held are not caught up).
+    pub fn resume_after(&mut self, k: u64) {
+        let now = Instant::now();
+        let due = self.deadline(k);
+        if now > due {
+            self.t0 += now - due;
+        }
+    }
+
     /// Called when the work toward boundary `k` (commands, integration, telemetry fill) is
     /// done: an overrun if boundary `k` is already past.
     pub fn end_frame(&mut self, k: u64) -> FrameEnd {
@@ -180,6 +190,34 @@ mod tests {
         // A stop request ends a wait early.
         stop.store(true, Ordering::Relaxed);
         assert_eq!(p.wait_boundary(1_000_000, &stop), None);
+    }
+
+    #[test]
+    fn a_resume_re_anchors_the_schedule() {
+        let period_ns = 1_000_000;
+        let t0 = Instant::now();
+        let mut p = Pacer::new(t0, period_ns, Duration::ZERO, OverrunPolicy::CatchUp, 0);
+        // Held at boundary 2 for 20 periods.
+        std::thread::sleep(Duration::from_millis(22));
+        let before = Instant::now();
+        p.resume_after(2);
+        let after = Instant::now();
+        let next = p.deadline(3);
+        assert!(next >= before + Duration::from_nanos(period_ns), "{next:?}");
+        assert!(next <= after + Duration::from_nanos(period_ns), "{next:?}");
+        // Boundary 2 itself is now "now": not late.
+        assert!(p.deadline(2) >= before && p.deadline(2) <= after);
+        // Released before the deadline: the schedule stays.
+        let mut q = Pacer::new(
+            after + Duration::from_secs(1),
+            period_ns,
+            Duration::ZERO,
+            OverrunPolicy::CatchUp,
+            0,
+        );
+        let d = q.deadline(5);
+        q.resume_after(0);
+        assert_eq!(q.deadline(5), d);
     }
 
     #[test]

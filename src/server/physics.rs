@@ -46,6 +46,10 @@ use crate::sinks::table::first_non_finite;
 /// Longest single blocking wait, so a stop request is seen quickly.
 const POLL: Duration = Duration::from_millis(50);
 
+/// How often a held run looks at the operator's hold target (and the stop flag): the delay of a
+/// resume.
+const HOLD_POLL: Duration = Duration::from_millis(1);
+
 /// How the physics loop ended (errors are returned as [`ServerError`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ending {
@@ -264,6 +268,27 @@ impl PhysicsCtx {
         }
     }
 
+    /// Holds at boundary `k` (already published) until the operator's hold target moves past it
+    /// or is cleared; `false` if a stop was requested meanwhile. The status says `Paused`
+    /// meanwhile. Nothing is stepped or published here.
+    fn hold(&self, k: u64) -> bool {
+        self.shared.held.store(true, Ordering::Release);
+        self.shared.set_run_state(RunState::Paused);
+        let mut stopped = false;
+        while self.shared.holds_at(k) {
+            if self.shared.stop.load(Ordering::Relaxed) {
+                stopped = true;
+                break;
+            }
+            std::thread::sleep(HOLD_POLL);
+        }
+        self.shared.held.store(false, Ordering::Release);
+        if !stopped {
+            self.shared.set_run_state(RunState::Running);
+        }
+        !stopped
+    }
+
     /// Lockstep: wait until every participant has answered tick `k`.
     fn await_answers(&self, book: &mut CommandBook, k: u64) -> Result<Wait, ServerError> {
         book.begin_tick();
@@ -356,6 +381,12 @@ impl PhysicsCtx {
             // Noted before the state goes out, so a participant answering it finds its tick
             // published (the command callback refuses ticks not yet published).
             self.shared.tick.store(k, Ordering::Release);
+            // The operator's hold (one atomic load): this tick's time message says `Paused`,
+            // and nothing follows until the hold is released. Never at the last tick.
+            let hold = self.shared.holds_at(k) && self.total_frames != Some(k);
+            if let (true, Some(f)) = (hold, pending.as_mut()) {
+                f.time.run_state = RunState::Paused;
+            }
             let stamp = unix_now_ns();
             if let Some(mut f) = pending.take() {
                 f.boundary_unix_ns = stamp;
@@ -389,6 +420,16 @@ impl PhysicsCtx {
                     last_tick: k,
                     sim_time_ns: w.sim.t_sim_ns(),
                 });
+            }
+            if hold {
+                if !self.hold(k) {
+                    return Ok(stopped(&self.shared));
+                }
+                // Real time: boundary k + 1 is due one period after the release, not at its
+                // old deadline (no burst of catch-up frames).
+                if realtime {
+                    pacer.resume_after(k);
+                }
             }
 
             // 2. Commands for tick k, held over the frame.

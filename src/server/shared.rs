@@ -111,6 +111,13 @@ pub struct Shared {
     unknown_sender: AtomicU64,
     bad_effector_input: AtomicU64,
     wrong_identity: AtomicU64,
+    operator_refused: AtomicU64,
+    /// The operator's hold target (`flexdyn/<sc>/operator`): 0 = none, `h + 1` = hold at the
+    /// first frame boundary `k ≥ h` (see [`Self::holds_at`]). Set by the operator callback, read
+    /// by whoever steps the frames (one atomic load per frame).
+    hold_target: AtomicU64,
+    /// Whether the frames are held now, at [`Self::tick`].
+    pub held: AtomicBool,
     /// StateMsg samples published (by whichever thread publishes).
     pub published: AtomicU64,
     /// Zenoh `put` failures of telemetry samples.
@@ -253,6 +260,27 @@ impl Shared {
         self.handoff_ns_max.fetch_max(ns, Ordering::Relaxed);
     }
 
+    /// Count an operator command the server did not apply.
+    pub fn reject_operator(&self) {
+        bump(&self.operator_refused);
+    }
+
+    /// The operator's hold target: hold at the first frame boundary at or after this tick.
+    pub fn hold_target(&self) -> Option<u64> {
+        self.hold_target.load(Ordering::Acquire).checked_sub(1)
+    }
+
+    /// Sets (or, with `None`, clears) the hold target.
+    pub fn set_hold_target(&self, target: Option<u64>) {
+        let v = target.map_or(0, |h| h.saturating_add(1));
+        self.hold_target.store(v, Ordering::Release);
+    }
+
+    /// Whether the frame of tick `k` is to be held (allocation- and lock-free: one load).
+    pub fn holds_at(&self, k: u64) -> bool {
+        self.hold_target().is_some_and(|h| k >= h)
+    }
+
     /// Count a command whose `sender_id` is not the one its key names.
     pub fn reject_wrong_identity(&self) {
         bump(&self.wrong_identity);
@@ -292,12 +320,13 @@ impl Shared {
             unknown_sender: l(&self.unknown_sender),
             bad_effector_input: l(&self.bad_effector_input),
             wrong_identity: l(&self.wrong_identity),
+            operator_refused: l(&self.operator_refused),
         }
     }
 
     /// Sets the life-cycle state.
     pub fn set_run_state(&self, s: RunState) {
-        // Every tag fits a u8 (six states).
+        // Every tag fits a u8 (seven states).
         self.run_state.store(s.tag() as u8, Ordering::Release);
     }
 

@@ -28,7 +28,7 @@ impl SeqGaps {
     pub fn counts(kind: TopicKind) -> bool {
         match kind {
             TopicKind::State | TopicKind::Sensor(_) | TopicKind::Status | TopicKind::Time => true,
-            TopicKind::Command => false,
+            TopicKind::Command | TopicKind::Operator => false,
         }
     }
 

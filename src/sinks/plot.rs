@@ -181,7 +181,7 @@ fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
                 .entry((kind, topic.sensor.unwrap_or_default().to_owned()))
                 .or_default()
                 .push(&cells),
-            TopicKind::Command | TopicKind::Time => {}
+            TopicKind::Command | TopicKind::Time | TopicKind::Operator => {}
         }
     }
     if data.state.is_empty() {

@@ -4,10 +4,12 @@
 //! `flexdyn/<sc-id>/<suffix>` (see `proto/README.md`, "Topics") names the message type, and the
 //! payload decodes with the one `flexdyn-proto` codec.
 
-use flexdyn_proto::keys::{CMD_PREFIX, KEY_ROOT, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX};
+use flexdyn_proto::keys::{
+    CMD_PREFIX, KEY_ROOT, OPERATOR_SUFFIX, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
+};
 use flexdyn_proto::{
-    decode_command, decode_state, decode_status, decode_time, CommandMsg, DecodeError, Header,
-    StateMsg, StatusMsg, TimeMsg,
+    decode_command, decode_operator, decode_state, decode_status, decode_time, CommandMsg,
+    DecodeError, Header, OperatorMsg, StateMsg, StatusMsg, TimeMsg,
 };
 
 use crate::sensors::{SensorKind, KINDS};
@@ -27,6 +29,8 @@ pub enum TopicKind {
     Status,
     /// `flexdyn/<sc>/tlm/time`: [`TimeMsg`] (the time service).
     Time,
+    /// `flexdyn/<sc>/operator`: [`OperatorMsg`] (pause, resume, run N ticks).
+    Operator,
 }
 
 impl TopicKind {
@@ -34,7 +38,12 @@ impl TopicKind {
     pub fn all() -> impl Iterator<Item = TopicKind> {
         std::iter::once(TopicKind::State)
             .chain((0..KINDS.len()).map(TopicKind::Sensor))
-            .chain([TopicKind::Command, TopicKind::Status, TopicKind::Time])
+            .chain([
+                TopicKind::Command,
+                TopicKind::Status,
+                TopicKind::Time,
+                TopicKind::Operator,
+            ])
     }
 
     /// The topic kind of sensor kind `kind` (`None` if it is not registered).
@@ -58,6 +67,7 @@ impl TopicKind {
             TopicKind::Command => "CommandMsg",
             TopicKind::Status => "StatusMsg",
             TopicKind::Time => "TimeMsg",
+            TopicKind::Operator => "OperatorMsg",
         }
     }
 }
@@ -97,6 +107,8 @@ pub fn classify(key: &str) -> Option<Topic<'_>> {
         (TopicKind::Command, Some(sender))
     } else if suffix == STATUS_SUFFIX {
         (TopicKind::Status, None)
+    } else if suffix == OPERATOR_SUFFIX {
+        (TopicKind::Operator, None)
     } else if let Some((i, name)) = KINDS
         .iter()
         .enumerate()
@@ -134,6 +146,8 @@ pub enum Decoded {
     Status(StatusMsg),
     /// A time-service message.
     Time(TimeMsg),
+    /// An operator command.
+    Operator(OperatorMsg),
 }
 
 impl Decoded {
@@ -155,6 +169,7 @@ impl Decoded {
             TopicKind::Command => Decoded::Command(decode_command(payload)?),
             TopicKind::Status => Decoded::Status(decode_status(payload)?),
             TopicKind::Time => Decoded::Time(decode_time(payload)?),
+            TopicKind::Operator => Decoded::Operator(decode_operator(payload)?),
         })
     }
 
@@ -166,6 +181,7 @@ impl Decoded {
             Decoded::Command(m) => &m.header,
             Decoded::Status(m) => &m.header,
             Decoded::Time(m) => &m.header,
+            Decoded::Operator(m) => &m.header,
         }
     }
 
@@ -178,6 +194,7 @@ impl Decoded {
             Decoded::Command(m) => serde_json::to_vec(m),
             Decoded::Status(m) => serde_json::to_vec(m),
             Decoded::Time(m) => serde_json::to_vec(m),
+            Decoded::Operator(m) => serde_json::to_vec(m),
         };
         v.unwrap_or_else(|_| b"null".to_vec())
     }
@@ -190,6 +207,7 @@ impl Decoded {
             Decoded::Command(m) => serde_json::to_value(m),
             Decoded::Status(m) => serde_json::to_value(m),
             Decoded::Time(m) => serde_json::to_value(m),
+            Decoded::Operator(m) => serde_json::to_value(m),
         };
         // The wire structs hold only numbers, bools, enums and vectors: always representable.
         v.unwrap_or(serde_json::Value::Null)
@@ -208,6 +226,7 @@ pub fn json_schema(kind: TopicKind) -> serde_json::Value {
         TopicKind::Command => schemars::schema_for!(CommandMsg),
         TopicKind::Status => schemars::schema_for!(StatusMsg),
         TopicKind::Time => schemars::schema_for!(TimeMsg),
+        TopicKind::Operator => schemars::schema_for!(OperatorMsg),
     };
     schema.to_value()
 }
@@ -264,6 +283,10 @@ mod tests {
         assert_eq!((t.kind, t.sensor), (TopicKind::Time, None));
         assert_eq!(TopicKind::Time.message_name(), "TimeMsg");
         assert_eq!(classify("flexdyn/x/tlm/time/y"), None);
+        let t = classify("flexdyn/x/operator").unwrap();
+        assert_eq!((t.kind, t.sensor), (TopicKind::Operator, None));
+        assert_eq!(TopicKind::Operator.message_name(), "OperatorMsg");
+        assert_eq!(classify("flexdyn/x/operator/1"), None);
         for other in [
             "flexdyn/x/participant/1",
             "flexdyn/x/tlm/imu/",

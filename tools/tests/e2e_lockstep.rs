@@ -183,7 +183,7 @@ fn lockstep_run_settings(
 /// Hashing the new streams with that byte set back to 4 gives exactly the protocol-4 values
 /// (`9c0c0df6…1912497` and `af7d756e…e29e2e4`), so nothing else in the state stream changed.
 ///
-/// Re-minted for protocol version 6 (the sun sensors): the first byte is now 6; hashing the new
+/// Re-minted for protocol version 6 (the sun sensors and operator control, which minted the same values; StateMsg's layout is unchanged): the first byte is now 6; hashing the new
 /// streams with it set back to 5 gives exactly the protocol-5 values (`8109363c…ac19bb583` and
 /// `566a9bd4…16687d6e3`).
 const GYRO_FEEDBACK_SHA256: &str =

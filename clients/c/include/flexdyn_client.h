@@ -122,6 +122,28 @@ int flexdyn_poll_status(flexdyn_client *client, fd_status_msg *out);
 int flexdyn_wait_status(flexdyn_client *client, fd_status_msg *out, uint32_t timeout_ms);
 
 /* ------------------------------------------------------------------------------------------ */
+/* The time service, flexdyn/<sc>/tlm/time: one fd_time_msg per published frame, before the
+ * frame's sensor samples and state. Flight code driven by it (rate groups, a cFS tone adapter)
+ * follows the simulation: its speed (--speed), its pauses and its steps. Subscribe first. */
+
+int flexdyn_subscribe_time(flexdyn_client *client, size_t capacity);
+/* The next tick's time message, waiting up to timeout_ms. FLEXDYN_ERR_TIMEOUT when none came:
+ * the server is held (then flexdyn_now says FD_RUN_STATE_PAUSED: the last tick published before
+ * the hold says so), gone, or slower than the timeout. Never hangs. */
+int flexdyn_wait_tick(flexdyn_client *client, fd_time_msg *out, uint32_t timeout_ms);
+/* The newest time message received (every one queued is taken first), without waiting:
+ * FLEXDYN_OK, or FLEXDYN_EMPTY before the first. */
+int flexdyn_now(flexdyn_client *client, fd_time_msg *out);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Operator control, on flexdyn/<sc>/operator (proto/README.md, "OperatorMsg"): action
+ * FD_OPERATOR_PAUSE, _RESUME or _RUN_TICKS (lockstep: step `ticks` frames, then hold). `stamp` is
+ * the header of any message of the server (its spacecraft_id is copied). On a lab network the
+ * server's ACL lets only the operator's subject put there. */
+int flexdyn_send_operator(flexdyn_client *client, const fd_header *stamp, uint32_t action,
+                          uint64_t ticks);
+
+/* ------------------------------------------------------------------------------------------ */
 /* Commands, on flexdyn/<sc>/cmd/<sender_id>. `stamp` is the header of the state you answer
  * (its spacecraft_id, tick and sim_time_ns are copied; its seq is ignored): the library numbers
  * this handle's commands itself (seq 0, 1, 2, ...). Values must be finite
@@ -175,6 +197,7 @@ int flexdyn_decode_star_tracker(flexdyn_client *client, const uint8_t *buf, size
                                 fd_star_tracker_msg *out);
 int flexdyn_decode_status(flexdyn_client *client, const uint8_t *buf, size_t len,
                           fd_status_msg *out);
+int flexdyn_decode_time(flexdyn_client *client, const uint8_t *buf, size_t len, fd_time_msg *out);
 
 /* sizeof the struct of a message as the library was built (FLEXDYN_STRUCT_*), to check that a
  * program and the library agree on flexdyn_proto.h; 0 for an unknown kind. */
@@ -185,6 +208,7 @@ int flexdyn_decode_status(flexdyn_client *client, const uint8_t *buf, size_t len
 #define FLEXDYN_STRUCT_STAR_TRACKER 4
 #define FLEXDYN_STRUCT_EFFECTOR_INPUT 5
 #define FLEXDYN_STRUCT_STATUS 6
+#define FLEXDYN_STRUCT_TIME 7
 size_t flexdyn_struct_size(int which);
 
 #ifdef __cplusplus

@@ -12,8 +12,9 @@ use flexdyn_proto::client::lockstep::{SensorSchedule, Tick, TickReceiver};
 use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::client::vehicle::Vehicle;
 use flexdyn_proto::{
-    decode_imu, decode_star_tracker, decode_state, decode_status, encode, CommandMsg, DecodeError,
-    Header, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg, Topics,
+    decode_imu, decode_star_tracker, decode_state, decode_status, decode_time, encode, CommandMsg,
+    DecodeError, Header, ImuMsg, OperatorAction, OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg,
+    TimeMsg, Topics,
 };
 use zenoh::handlers::{RingChannel, RingChannelHandler};
 use zenoh::liveliness::LivelinessToken;
@@ -70,6 +71,9 @@ pub struct Client {
     imu: Option<Ring>,
     star_tracker: Option<Ring>,
     status: Option<Ring>,
+    time: Option<Ring>,
+    /// The newest time message taken from the `time` subscription.
+    last_time: Option<TimeMsg>,
     lockstep: Option<Lockstep>,
     /// The next command's `header.seq` (one counter for every command of this client).
     seq: u64,
@@ -86,6 +90,8 @@ pub enum Kind {
     StarTracker,
     /// `flexdyn/<sc>/status`.
     Status,
+    /// `flexdyn/<sc>/tlm/time`.
+    Time,
 }
 
 impl Kind {
@@ -95,6 +101,7 @@ impl Kind {
             Kind::Imu => "IMU",
             Kind::StarTracker => "star tracker",
             Kind::Status => "status",
+            Kind::Time => "time",
         }
     }
 }
@@ -159,6 +166,8 @@ impl Client {
             imu: None,
             star_tracker: None,
             status: None,
+            time: None,
+            last_time: None,
             lockstep: None,
             seq: 0,
         })
@@ -172,10 +181,11 @@ impl Client {
             imu,
             star_tracker,
             status,
+            time,
             lockstep,
             ..
         } = self;
-        drop((state, imu, star_tracker, status, lockstep));
+        drop((state, imu, star_tracker, status, time, lockstep));
         session
             .close()
             .wait()
@@ -188,6 +198,7 @@ impl Client {
             Kind::Imu => &mut self.imu,
             Kind::StarTracker => &mut self.star_tracker,
             Kind::Status => &mut self.status,
+            Kind::Time => &mut self.time,
         }
     }
 
@@ -206,6 +217,7 @@ impl Client {
         let key = match (kind, name) {
             (Kind::State, _) => self.topics.state().to_owned(),
             (Kind::Status, _) => self.topics.status().to_owned(),
+            (Kind::Time, _) => self.topics.time(),
             (Kind::Imu, Some(n)) => self.topics.imu(n).map_err(bad_name)?,
             (Kind::Imu, None) => self.topics.imu_wildcard(),
             (Kind::StarTracker, Some(n)) => self.topics.star_tracker(n).map_err(bad_name)?,
@@ -282,6 +294,7 @@ impl Client {
         match kind {
             Kind::State => self.topics.state().to_owned(),
             Kind::Status => self.topics.status().to_owned(),
+            Kind::Time => self.topics.time(),
             Kind::Imu => self.topics.imu(name).unwrap_or_default(),
             Kind::StarTracker => self.topics.star_tracker(name).unwrap_or_default(),
         }
@@ -306,13 +319,47 @@ impl Client {
             sender_id,
             kind,
         };
-        let key = self.topics.cmd(sender_id);
+        self.put(self.topics.cmd(sender_id), encode(&cmd))
+    }
+
+    /// Puts `payload` on `key` (blocking under congestion: a command is never dropped here).
+    fn put(&self, key: String, payload: Vec<u8>) -> Result<(), Error> {
         self.session
-            .put(key.clone(), encode(&cmd))
+            .put(key.clone(), payload)
             .congestion_control(CongestionControl::Block)
             .express(true)
             .wait()
             .map_err(|e| Error::zenoh(&format!("cannot put on {key}"), e))
+    }
+
+    /// The next time message (the next tick), waiting up to `timeout` (`None`: at once,
+    /// `Ok(None)` when there is none); it becomes [`Self::now`].
+    pub fn take_time(&mut self, timeout: Option<Duration>) -> Result<Option<TimeMsg>, Error> {
+        let Some(r) = self.receive(Kind::Time, timeout)? else {
+            return Ok(None);
+        };
+        let m = decode_as("time", &self.topics.time(), &r.payload, decode_time)?;
+        self.last_time = Some(m);
+        Ok(Some(m))
+    }
+
+    /// The newest time message received, after taking every one queued (`None` before the
+    /// first). Never waits.
+    pub fn now(&mut self) -> Result<Option<TimeMsg>, Error> {
+        while self.take_time(None)?.is_some() {}
+        Ok(self.last_time)
+    }
+
+    /// Publishes an operator command (pause, resume, run `ticks` ticks) on
+    /// `flexdyn/<sc>/operator`, stamped from `stamp` (its spacecraft id must be the server's).
+    pub fn send_operator(
+        &mut self,
+        stamp: &Header,
+        action: OperatorAction,
+        ticks: u64,
+    ) -> Result<(), Error> {
+        let msg = OperatorMsg::new(self.header(stamp), action, ticks);
+        self.put(self.topics.operator(), encode(&msg))
     }
 
     /// Joins a lockstep run as `sender_id`: asks the server's configuration (up to `timeout`),

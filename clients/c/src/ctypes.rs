@@ -9,7 +9,8 @@
 
 use flexdyn_proto::{
     CommandStatus, EffectorInput, EffectorState, FrameTiming, Header, ImuMsg, Mode, RejectCounters,
-    RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, MAX_EFFECTOR_VALUES,
+    RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg,
+    MAX_EFFECTOR_VALUES,
 };
 
 use crate::error::{Code, Error};
@@ -116,8 +117,81 @@ pub struct FdStatusMsg {
     pub rejected_unknown_sender: u64,
     pub rejected_bad_effector_input: u64,
     pub rejected_wrong_identity: u64,
+    pub rejected_operator_refused: u64,
     pub commands_dropped: u64,
     pub wall_time_unix_ns: u64,
+}
+
+/// `fd_sys_time`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FdSysTime {
+    pub seconds: u32,
+    pub subseconds: u32,
+}
+
+/// `fd_time_msg`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FdTimeMsg {
+    pub header: FdHeader,
+    pub run_state: u32,
+    pub mode: u32,
+    pub flags: u8,
+    pub frame_ns: u64,
+    pub speed: f64,
+    pub tai_ns_1958: u64,
+    pub utc_year: u16,
+    pub utc_month: u8,
+    pub utc_day: u8,
+    pub utc_hour: u8,
+    pub utc_minute: u8,
+    pub utc_second: u8,
+    pub utc_nanosecond: u32,
+    pub tai_minus_utc_s: i32,
+    pub gps_week: u32,
+    pub gps_ns_of_week: u64,
+    pub met_ns: u64,
+    pub cuc_tai: [u8; 8],
+    pub tone_met: FdSysTime,
+    pub tone_tai: FdSysTime,
+}
+
+impl From<SysTime> for FdSysTime {
+    fn from(t: SysTime) -> Self {
+        Self {
+            seconds: t.seconds,
+            subseconds: t.subseconds,
+        }
+    }
+}
+
+impl From<&TimeMsg> for FdTimeMsg {
+    fn from(m: &TimeMsg) -> Self {
+        Self {
+            header: (&m.header).into(),
+            run_state: m.run_state.tag(),
+            mode: m.mode.tag(),
+            flags: m.flags,
+            frame_ns: m.frame_ns,
+            speed: m.speed,
+            tai_ns_1958: m.tai_ns_1958,
+            utc_year: m.utc.year,
+            utc_month: m.utc.month,
+            utc_day: m.utc.day,
+            utc_hour: m.utc.hour,
+            utc_minute: m.utc.minute,
+            utc_second: m.utc.second,
+            utc_nanosecond: m.utc.nanosecond,
+            tai_minus_utc_s: m.tai_minus_utc_s,
+            gps_week: m.gps_week,
+            gps_ns_of_week: m.gps_ns_of_week,
+            met_ns: m.met_ns,
+            cuc_tai: m.cuc_tai,
+            tone_met: m.tone_met.into(),
+            tone_tai: m.tone_tai.into(),
+        }
+    }
 }
 
 impl From<&Header> for FdHeader {
@@ -253,6 +327,7 @@ impl From<&StatusMsg> for FdStatusMsg {
             unknown_sender,
             bad_effector_input,
             wrong_identity,
+            operator_refused,
         } = *rejected;
         Self {
             header: header.into(),
@@ -275,6 +350,7 @@ impl From<&StatusMsg> for FdStatusMsg {
             rejected_unknown_sender: unknown_sender,
             rejected_bad_effector_input: bad_effector_input,
             rejected_wrong_identity: wrong_identity,
+            rejected_operator_refused: operator_refused,
             commands_dropped: *commands_dropped,
             wall_time_unix_ns: *wall_time_unix_ns,
         }

@@ -12,7 +12,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 use std::time::Duration;
 
-use flexdyn_proto::{CommandKind, Header, MAX_ID_LEN};
+use flexdyn_proto::{CommandKind, Header, OperatorAction, MAX_ID_LEN};
 
 use crate::client::{
     decode_imu_bytes, decode_star_tracker_bytes, decode_state_bytes, decode_status_bytes, Client,
@@ -20,7 +20,7 @@ use crate::client::{
 };
 use crate::ctypes::{
     effector_input, fill_state, finite3, FdEffectorInput, FdEffectorState, FdHeader, FdImuMsg,
-    FdStarTrackerMsg, FdStateMsg, FdStatusMsg,
+    FdStarTrackerMsg, FdStateMsg, FdStatusMsg, FdTimeMsg,
 };
 use crate::error::{Code, Error};
 
@@ -538,6 +538,11 @@ fn star_tracker_c(key: &str, b: &[u8]) -> Result<FdStarTrackerMsg, Error> {
     decode_star_tracker_bytes(key, b).map(|m| FdStarTrackerMsg::from(&m))
 }
 
+fn time_c(key: &str, b: &[u8]) -> Result<FdTimeMsg, Error> {
+    crate::client::decode_as("time", key, b, flexdyn_proto::decode_time)
+        .map(|m| FdTimeMsg::from(&m))
+}
+
 fn status_c(key: &str, b: &[u8]) -> Result<FdStatusMsg, Error> {
     decode_status_bytes(key, b).map(|m| FdStatusMsg::from(&m))
 }
@@ -706,6 +711,98 @@ pub unsafe extern "C" fn flexdyn_wait_status(
             status_c,
         )
     }
+}
+
+/// `flexdyn_subscribe_time`.
+///
+/// # Safety
+/// `handle` is a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_subscribe_time(
+    handle: *mut FlexdynClient,
+    capacity: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { subscribe(handle, Kind::Time, std::ptr::null(), capacity) }
+}
+
+/// A time message from `get` into `out` (`FLEXDYN_EMPTY` when there is none).
+///
+/// # Safety
+/// `handle` live; `out` a writable `fd_time_msg`.
+unsafe fn time_into(
+    handle: *mut FlexdynClient,
+    out: *mut FdTimeMsg,
+    get: impl FnOnce(&mut Client) -> Result<Option<flexdyn_proto::TimeMsg>, Error>,
+) -> c_int {
+    with_handle(handle, |h| {
+        if out.is_null() {
+            return Err(null("out"));
+        }
+        let m = get(h.client()?)?;
+        let code = got(m.as_ref());
+        if let Some(m) = m {
+            // SAFETY: non-null and writable, by this function's contract.
+            unsafe { write(out, FdTimeMsg::from(&m))? };
+        }
+        Ok(code)
+    })
+}
+
+/// `flexdyn_wait_tick`: the next time message, waiting up to `timeout_ms`.
+///
+/// # Safety
+/// `handle` live; `out` a writable `fd_time_msg`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_wait_tick(
+    handle: *mut FlexdynClient,
+    out: *mut FdTimeMsg,
+    timeout_ms: u32,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { time_into(handle, out, |c| c.take_time(Some(timeout(timeout_ms)))) }
+}
+
+/// `flexdyn_now`: the newest time message received (every queued one taken), no wait.
+///
+/// # Safety
+/// `handle` live; `out` a writable `fd_time_msg`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_now(handle: *mut FlexdynClient, out: *mut FdTimeMsg) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { time_into(handle, out, Client::now) }
+}
+
+/// `flexdyn_send_operator`.
+///
+/// # Safety
+/// `handle` live; `stamp` an `fd_header`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_send_operator(
+    handle: *mut FlexdynClient,
+    stamp: *const FdHeader,
+    action: u32,
+    ticks: u64,
+) -> c_int {
+    with_handle(handle, |h| {
+        // SAFETY: forwarded contract.
+        let stamp = unsafe { self::stamp(stamp)? };
+        let action = match action {
+            0 => OperatorAction::Pause,
+            1 => OperatorAction::Resume,
+            2 => OperatorAction::RunTicks,
+            other => {
+                return Err(Error::new(
+                    Code::Argument,
+                    format!(
+                        "operator action {other} is not FD_OPERATOR_PAUSE, _RESUME or _RUN_TICKS"
+                    ),
+                ))
+            }
+        };
+        h.client()?.send_operator(&stamp, action, ticks)?;
+        Ok(Code::Ok)
+    })
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1128,6 +1225,21 @@ pub unsafe extern "C" fn flexdyn_decode_star_tracker(
     unsafe { decode_fixed(handle, buf, len, out, star_tracker_c) }
 }
 
+/// `flexdyn_decode_time`.
+///
+/// # Safety
+/// `handle` live; `buf` `len` bytes; `out` a writable `fd_time_msg`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_decode_time(
+    handle: *mut FlexdynClient,
+    buf: *const u8,
+    len: usize,
+    out: *mut FdTimeMsg,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { decode_fixed(handle, buf, len, out, time_c) }
+}
+
 /// `flexdyn_decode_status`.
 ///
 /// # Safety
@@ -1155,6 +1267,7 @@ pub extern "C" fn flexdyn_struct_size(which: c_int) -> usize {
         4 => size_of::<FdStarTrackerMsg>(),
         5 => size_of::<FdEffectorInput>(),
         6 => size_of::<FdStatusMsg>(),
+        7 => size_of::<FdTimeMsg>(),
         _ => 0,
     }
 }

@@ -20,7 +20,10 @@
 //!   (`tests/leak.c`) must be reported, so the checker is known to see the library's memory;
 //! - `commands_outside_lockstep_arrive_as_sent`: `tests/send.c` sends every kind of command,
 //!   stamped from a state it waited for, to a Zenoh peer here that decodes them;
-//! - `readme_link_line_builds_the_example`: the README's compile-and-link line, as written.
+//! - `readme_link_line_builds_the_example`: the README's compile-and-link line, as written;
+//! - `rate_groups_run_off_the_ticks_and_stop_while_paused`: `examples/rate_groups.c` drives
+//!   1/10/100 Hz groups from `flexdyn_wait_tick` against a real-time server, pauses it with
+//!   `flexdyn_send_operator`, sees no tick while it is held and resumes it.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -165,6 +168,17 @@ struct Server {
 }
 
 impl Server {
+    /// A real-time server on the embedded reference spacecraft (100 Hz), no participant.
+    fn start_realtime(duration_s: &str) -> Self {
+        let mut cmd = Command::new(flexdyn_bin());
+        cmd.args(["run", "--mode", "realtime"])
+            .args(["--listen", ports::ANY_PORT, "--duration-s", duration_s])
+            .stdout(Stdio::null());
+        let mut child = ports::reporting(&mut cmd).spawn().expect("start flexdyn");
+        let endpoint = ports::zenoh_endpoint(&mut child);
+        Self { child, endpoint }
+    }
+
     fn start(duration_s: &str) -> Self {
         let mut cmd = Command::new(flexdyn_bin());
         cmd.args(["run", "--mode", "lockstep", "--participants", "1"])
@@ -275,6 +289,7 @@ fn struct_layouts_agree() {
     let exe = build_c(&["-O2"], "tests/layout.c", "layout");
     let stdout = run_ok(Command::new(&exe).arg(root().join("proto/golden")));
     assert!(stdout.contains("state: 2 effectors compared"), "{stdout}");
+    assert!(stdout.contains("time compared"), "{stdout}");
     assert!(stdout.ends_with("all agree\n"), "{stdout}");
 }
 
@@ -565,4 +580,51 @@ fn commands_outside_lockstep_arrive_as_sent() {
         assert_eq!((cmd.sender_id, &cmd.kind), (7, &kind));
     }
     session.close().wait().unwrap();
+}
+
+/// The numbers after `name=` in `line`, in order.
+fn counts(line: &str) -> Vec<u64> {
+    line.split_whitespace()
+        .filter_map(|w| w.split_once('=').and_then(|(_, v)| v.parse().ok()))
+        .collect()
+}
+
+#[test]
+fn rate_groups_run_off_the_ticks_and_stop_while_paused() {
+    let exe = build_c(&["-O2"], "examples/rate_groups.c", "rate_groups");
+    let server = Server::start_realtime("60");
+    // 300 ticks from a 1 Hz boundary at 100 Hz; the driver pauses the server after its 150th.
+    let stdout = run_ok(Command::new(&exe).args([&server.endpoint, "300", "150"]));
+    let held: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("held at "))
+        .collect();
+    let done = stdout
+        .lines()
+        .find(|l| l.starts_with("done "))
+        .unwrap_or_else(|| panic!("no done line:\n{stdout}"));
+    // Each group ran exactly as often as K ticks give it: 300/100, 300/10, 300/1.
+    let d = counts(done);
+    assert_eq!(&d[..4], &[3, 30, 300, 300], "{done}");
+    // Three 300 ms stalls while the server was held, every one at the same tick with the same
+    // counts: the groups stopped with the simulation.
+    assert_eq!(d[4], 3, "{stdout}");
+    assert_eq!(held.len(), 3, "{stdout}");
+    assert!(held.iter().all(|l| *l == held[0]), "{stdout}");
+    let h: u64 = held[0]["held at ".len()..]
+        .split(':')
+        .next()
+        .and_then(|s| s.parse().ok())
+        .unwrap();
+    assert_eq!(d[5], h);
+    let c = counts(held[0]);
+    // Held at tick h after c100 ticks counted from a multiple of 100 (the 150th tick's pause
+    // takes effect at the next boundary): the 10 Hz and 1 Hz groups ran on the multiples of 10
+    // and 100 among them.
+    let c100 = c[2];
+    assert!((150..300).contains(&c100), "{stdout}");
+    assert_eq!(c[1], (c100 - 1) / 10 + 1, "{stdout}");
+    assert_eq!(c[0], (c100 - 1) / 100 + 1, "{stdout}");
+    assert_eq!(h % 100, (c100 - 1) % 100, "{stdout}");
+    drop(server);
 }

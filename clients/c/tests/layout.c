@@ -60,6 +60,7 @@ static void check_sizes(void) {
         {FLEXDYN_STRUCT_STAR_TRACKER, sizeof(fd_star_tracker_msg), "fd_star_tracker_msg"},
         {FLEXDYN_STRUCT_EFFECTOR_INPUT, sizeof(fd_effector_input), "fd_effector_input"},
         {FLEXDYN_STRUCT_STATUS, sizeof(fd_status_msg), "fd_status_msg"},
+        {FLEXDYN_STRUCT_TIME, sizeof(fd_time_msg), "fd_time_msg"},
     };
     size_t i;
     for (i = 0; i < sizeof sizes / sizeof sizes[0]; ++i) {
@@ -201,9 +202,35 @@ static void check_status(flexdyn_client *c, const char *dir) {
     SAME("status", a, b, rejected_unknown_sender);
     SAME("status", a, b, rejected_bad_effector_input);
     SAME("status", a, b, rejected_wrong_identity);
+    SAME("status", a, b, rejected_operator_refused);
     SAME("status", a, b, commands_dropped);
     SAME("status", a, b, wall_time_unix_ns);
     printf("status compared\n");
+}
+
+static void check_time(flexdyn_client *c, const char *dir) {
+    DECODE_BOTH(fd_time_msg, "time.bin", fd_decode_time, flexdyn_decode_time, "time");
+    SAME("time", a, b, run_state);
+    SAME("time", a, b, mode);
+    SAME("time", a, b, flags);
+    SAME("time", a, b, frame_ns);
+    SAME("time", a, b, speed);
+    SAME("time", a, b, tai_ns_1958);
+    SAME("time", a, b, utc_year);
+    SAME("time", a, b, utc_month);
+    SAME("time", a, b, utc_day);
+    SAME("time", a, b, utc_hour);
+    SAME("time", a, b, utc_minute);
+    SAME("time", a, b, utc_second);
+    SAME("time", a, b, utc_nanosecond);
+    SAME("time", a, b, tai_minus_utc_s);
+    SAME("time", a, b, gps_week);
+    SAME("time", a, b, gps_ns_of_week);
+    SAME("time", a, b, met_ns);
+    SAME("time", a, b, cuc_tai);
+    SAME("time", a, b, tone_met);
+    SAME("time", a, b, tone_tai);
+    printf("time compared\n");
 }
 
 /* Bad input is an error code with a message, never a crash. */
@@ -244,6 +271,7 @@ int main(int argc, char **argv) {
     check_imu(c, argv[1]);
     check_star_tracker(c, argv[1]);
     check_status(c, argv[1]);
+    check_time(c, argv[1]);
     check_errors(c);
     flexdyn_client_free(c);
     if (failures != 0) {

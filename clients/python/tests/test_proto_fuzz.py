@@ -10,8 +10,8 @@ import subprocess
 
 from flexdyn import proto
 from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState, Header,
-                           ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg,
-                           CssMsg, FssMsg)
+                           ImuMsg, MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg,
+                           StatusMsg, TimeMsg, CssMsg, FssMsg)
 
 N = 20_000
 
@@ -86,8 +86,18 @@ def status_line(m):
         m.command_stale, m.stale_policy, m.rejected_malformed, m.rejected_bad_version,
         m.rejected_non_finite, m.rejected_wrong_spacecraft, m.rejected_stale_tick,
         m.rejected_unknown_sender, m.rejected_bad_effector_input, m.rejected_wrong_identity,
-        m.commands_dropped,
+        m.rejected_operator_refused, m.commands_dropped,
         m.wall_time_unix_ns))
+
+
+def time_line(m):
+    return str(Line().h(m.header).u(m.run_state, m.mode, m.flags, m.frame_ns).f([m.speed])
+               .u(m.tai_ns_1958, *m.utc, m.tai_minus_utc_s & 0xFFFFFFFF, m.gps_week,
+                  m.gps_ns_of_week, m.met_ns, *m.cuc_tai, *m.tone_met, *m.tone_tai))
+
+
+def operator_line(m):
+    return str(Line().h(m.header).u(m.action, m.ticks))
 
 
 DECODERS = [
@@ -95,7 +105,8 @@ DECODERS = [
     (StarTrackerMsg.decode, star_tracker_line), (MagnetometerMsg.decode, magnetometer_line),
     (CssMsg.decode, css_line), (FssMsg.decode, fss_line),
     (CommandMsg.decode, command_line),
-    (StatusMsg.decode, status_line), (Header.decode, lambda h: str(Line().h(h))),
+    (StatusMsg.decode, status_line), (TimeMsg.decode, time_line),
+    (OperatorMsg.decode, operator_line), (Header.decode, lambda h: str(Line().h(h))),
 ]
 
 
@@ -133,7 +144,7 @@ def gen_buffer(r):
     def header():
         return Header(r.getrandbits(32), r.getrandbits(64), r.getrandbits(64), r.getrandbits(64))
 
-    k = r.randrange(8)
+    k = r.randrange(10)
     if k == 0:
         b = StateMsg(header(), v(3), v(4), v(3), v(3), v(3), v(3), v(3), f64(), f64(), v(3), v(3),
                      v(3), v(3), r.getrandbits(8),
@@ -145,9 +156,9 @@ def gen_buffer(r):
         b = StarTrackerMsg(header(), v(4), r.random() < 0.5, r.getrandbits(8)).encode()
     elif k == 5:
         b = MagnetometerMsg(header(), v(3), r.getrandbits(8)).encode()
-    elif k == 6:  # counts up to 17: the last is above the maximum (Malformed)
+    elif k == 8:  # counts up to 17: the last is above the maximum (Malformed)
         b = CssMsg(header(), r.randrange(18), v(proto.MAX_CSS_DETECTORS)).encode()
-    elif k == 7:
+    elif k == 9:
         b = FssMsg(header(), f64(), f64(), r.getrandbits(8)).encode()
     elif k == 3:
         g = fin if r.randrange(4) else f64
@@ -157,7 +168,17 @@ def gen_buffer(r):
                         for _ in range(r.randrange(5))] if kind == proto.ACTUATORS else []).encode()
     elif k == 4:
         b = StatusMsg(header(), r.randrange(3), r.randrange(6), *(r.getrandbits(64) for _ in range(7)),
-                      r.random() < 0.5, r.randrange(2), *(r.getrandbits(64) for _ in range(9))).encode()
+                      r.random() < 0.5, r.randrange(2), *(r.getrandbits(64) for _ in range(11))).encode()
+    elif k == 6:
+        b = TimeMsg(header(), r.randrange(7), r.randrange(3), r.getrandbits(8), r.getrandbits(64),
+                    f64(), r.getrandbits(64),
+                    (r.getrandbits(16), *(r.getrandbits(8) for _ in range(5)), r.getrandbits(32)),
+                    r.getrandbits(31) - 2**30, r.getrandbits(32), r.getrandbits(64),
+                    r.getrandbits(64), r.getrandbits(64).to_bytes(8, "little"),
+                    (r.getrandbits(32), r.getrandbits(32)),
+                    (r.getrandbits(32), r.getrandbits(32))).encode()
+    elif k == 7:
+        b = OperatorMsg(header(), r.randrange(3), r.getrandbits(64)).encode()
     b = bytearray(b)
     k = r.randrange(10)
     if k in (3, 4, 5):
@@ -186,17 +207,17 @@ def test_python_and_rust_decoders_agree_on_20000_buffers(verdicts_bin):
     stream = b"".join(struct.pack("<I", len(b)) + b for b in buffers)
     rust = subprocess.run([str(verdicts_bin)], input=stream, capture_output=True, check=True)
     rust_lines = rust.stdout.decode().splitlines()
-    assert len(rust_lines) == 9 * N
+    assert len(rust_lines) == 11 * N
     reasons = {}
     names = ["state", "imu", "star_tracker", "magnetometer", "css", "fss", "command", "status",
-             "header"]
+             "time", "operator", "header"]
     for i, b in enumerate(buffers):
         for j, got in enumerate(python_lines(b)):
-            want = rust_lines[9 * i + j]
+            want = rust_lines[11 * i + j]
             assert got == want, f"buffer {i} ({len(b)} bytes), {names[j]}: Python {got!r} vs Rust {want!r}"
             key = want.split()[1] if want.startswith("E") else "accepted"
             reasons[key] = reasons.get(key, 0) + 1
-    print(f"{N} buffers x 9 decoders: {reasons}")
+    print(f"{N} buffers x 11 decoders: {reasons}")
     for k in ("accepted", "Length", "TrailingBytes", "TooLarge", "UnknownVersion", "NonFinite",
               "Malformed"):
         assert reasons.get(k, 0) > 0, k

@@ -8,8 +8,8 @@ import pytest
 
 from flexdyn import proto
 from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState, Header,
-                           ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
-                           CssMsg, FssMsg)
+                           ImuMsg, MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg,
+                           StatusMsg, TimeMsg, CssMsg, FssMsg)
 
 SC = 0x11223344
 
@@ -21,7 +21,7 @@ def bits(x):
 def test_manifest_lists_every_file(golden_dir):
     rows = [l.split("\t") for l in (golden_dir / "MANIFEST.tsv").read_text().splitlines()
             if l and not l.startswith("#")]
-    assert len(rows) == 11
+    assert len(rows) == 12
     for name, _message, length, _source in rows:
         assert (golden_dir / f"{name}.bin").stat().st_size == int(length)
 
@@ -117,7 +117,7 @@ def test_commands(golden_dir):
 def test_status(golden_dir):
     m = StatusMsg(Header(SC, 0x0102030405060708, 1_500_000_000, 99), proto.MODE_LOCKSTEP, 1,
                   1000, 250_000, 3_000_000, 3, 2, 41, 1_000_000, True, proto.STALE_POLICY_ZERO,
-                  1, 2, 3, 4, 5, 6, 8, 9, 7, 1_700_000_000_123_456_789)
+                  1, 2, 3, 4, 5, 6, 8, 9, 10, 7, 1_700_000_000_123_456_789)
     golden = (golden_dir / "status.bin").read_bytes()
     assert m.encode() == golden and StatusMsg.decode(golden) == m
 
@@ -141,6 +141,23 @@ def test_time(golden_dir):
         TimeMsg.decode(golden[:-1])
     assert e.value.reason == "Length"
     assert proto.time_key("sc1") == "flexdyn/sc1/tlm/time"
+
+
+def test_operator(golden_dir):
+    # OPERATOR_GOLDEN of proto/tests/golden.rs: run 0x1_0000_0005 ticks.
+    m = OperatorMsg(Header(SC, 44, 440_000_000, 3), proto.OPERATOR_RUN_TICKS, 0x1_0000_0005)
+    golden = (golden_dir / "operator.bin").read_bytes()
+    assert len(golden) == proto.OPERATOR_LEN
+    assert m.encode() == golden and OperatorMsg.decode(golden) == m
+    bad = bytearray(golden)
+    bad[30] = 3
+    with pytest.raises(DecodeError) as e:
+        OperatorMsg.decode(bytes(bad))
+    assert e.value.reason == "Malformed"
+    with pytest.raises(DecodeError) as e:
+        OperatorMsg.decode(golden + b"\0")
+    assert e.value.reason == "TrailingBytes"
+    assert proto.operator_key("sc1") == "flexdyn/sc1/operator"
 
 
 def test_versions_and_keys():

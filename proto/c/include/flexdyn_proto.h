@@ -73,13 +73,14 @@
 #define FD_COMMAND_WRENCH_LEN 86u
 #define FD_COMMAND_NO_COMMAND_LEN 38u
 #define FD_COMMAND_ACTUATORS_FIXED_LEN 94u
-#define FD_STATUS_LEN 179u
+#define FD_STATUS_LEN 187u
 #define FD_TIME_LEN 122u
 /* Sun sensors (protocol 6) */
 #define FD_CSS_LEN 159u
 #define FD_FSS_LEN 47u
 #define FD_MAX_CSS_DETECTORS 16u
 #define FD_TIME_CUC_OFFSET 98u
+#define FD_OPERATOR_LEN 42u /* since protocol 6 */
 #define FD_MAX_EFFECTORS 1024u
 #define FD_MAX_EFFECTOR_VALUES 8u
 #define FD_MAX_MESSAGE_BYTES 65536u
@@ -143,6 +144,10 @@
 #define FD_RUN_STATE_PAUSED 6u /* since protocol 5: holding at a tick on an operator's request */
 #define FD_STALE_POLICY_HOLD 0u
 #define FD_STALE_POLICY_ZERO 1u
+/* OperatorMsg.action (since protocol 6) */
+#define FD_OPERATOR_PAUSE 0u
+#define FD_OPERATOR_RESUME 1u
+#define FD_OPERATOR_RUN_TICKS 2u
 /* CommandStatus.last_command_tick / command_age_ns before any command. */
 #define FD_NO_COMMAND UINT64_MAX
 
@@ -309,9 +314,17 @@ typedef struct {
     uint64_t rejected_unknown_sender;
     uint64_t rejected_bad_effector_input;
     uint64_t rejected_wrong_identity; /* since protocol 4: sender_id is not the one its key names */
+    uint64_t rejected_operator_refused; /* since protocol 6: an OperatorMsg not applied */
     uint64_t commands_dropped;
     uint64_t wall_time_unix_ns;
 } fd_status_msg;
+
+/* An operator's command, flexdyn/<sc>/operator (since protocol 6). */
+typedef struct {
+    fd_header header; /* spacecraft_id must be the server's; seq: the operator's counter */
+    uint32_t action;  /* FD_OPERATOR_* */
+    uint64_t ticks;   /* RUN_TICKS: frames to step before holding (>= 1); others: 0 */
+} fd_operator_msg;
 
 /* ------------------------------------------------------------------------------------------ */
 /* Byte helpers (little-endian, assembled byte by byte).                                       */
@@ -867,8 +880,9 @@ static inline fd_error fd_decode_status(const uint8_t *buf, size_t len, fd_statu
     out->rejected_unknown_sender = fd_get_u64(buf + 139);
     out->rejected_bad_effector_input = fd_get_u64(buf + 147);
     out->rejected_wrong_identity = fd_get_u64(buf + 155);
-    out->commands_dropped = fd_get_u64(buf + 163);
-    out->wall_time_unix_ns = fd_get_u64(buf + 171);
+    out->rejected_operator_refused = fd_get_u64(buf + 163);
+    out->commands_dropped = fd_get_u64(buf + 171);
+    out->wall_time_unix_ns = fd_get_u64(buf + 179);
     return fd_ok();
 }
 
@@ -894,8 +908,9 @@ static inline size_t fd_encode_status(const fd_status_msg *m, uint8_t *buf, size
     fd_put_u64(buf + 139, m->rejected_unknown_sender);
     fd_put_u64(buf + 147, m->rejected_bad_effector_input);
     fd_put_u64(buf + 155, m->rejected_wrong_identity);
-    fd_put_u64(buf + 163, m->commands_dropped);
-    fd_put_u64(buf + 171, m->wall_time_unix_ns);
+    fd_put_u64(buf + 163, m->rejected_operator_refused);
+    fd_put_u64(buf + 171, m->commands_dropped);
+    fd_put_u64(buf + 179, m->wall_time_unix_ns);
     return FD_STATUS_LEN;
 }
 
@@ -968,6 +983,29 @@ static inline size_t fd_encode_time(const fd_time_msg *m, uint8_t *buf, size_t c
 }
 
 /* ------------------------------------------------------------------------------------------ */
+/* OperatorMsg (protocol 6).                                                                   */
+
+static inline fd_error fd_decode_operator(const uint8_t *buf, size_t len, fd_operator_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_OPERATOR_LEN);
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_OPERATOR_LEN, len)).status != FD_OK) return e;
+    if (fd_get_u32(buf + 30) > FD_OPERATOR_RUN_TICKS)
+        return fd_fail(FD_ERR_MALFORMED, 0, len, "action tag");
+    fd_decode_header_at(buf, &out->header);
+    out->action = fd_get_u32(buf + 30);
+    out->ticks = fd_get_u64(buf + 34);
+    return fd_ok();
+}
+
+static inline size_t fd_encode_operator(const fd_operator_msg *m, uint8_t *buf, size_t cap) {
+    if (cap < FD_OPERATOR_LEN) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_u32(buf + 30, m->action);
+    fd_put_u64(buf + 34, m->ticks);
+    return FD_OPERATOR_LEN;
+}
+
+/* ------------------------------------------------------------------------------------------ */
 /* Key expressions (proto/README.md, "Topics").                                                */
 
 /* Whether `id` is a valid key chunk: 1-64 characters from [A-Za-z0-9_-]. */
@@ -1032,6 +1070,10 @@ static inline size_t fd_fss_key(char *out, size_t cap, const char *sc, const cha
 }
 static inline size_t fd_status_key(char *out, size_t cap, const char *sc) {
     return fd_key(out, cap, sc, "status", FD_NULL);
+}
+/* flexdyn/<sc>/operator: operator commands (since protocol 6). */
+static inline size_t fd_operator_key(char *out, size_t cap, const char *sc) {
+    return fd_key(out, cap, sc, "operator", FD_NULL);
 }
 /* Writes the decimal form of v (no leading zero) into digits[11]; returns its first char. */
 static inline const char *fd_decimal_u32(char digits[11], uint32_t v) {

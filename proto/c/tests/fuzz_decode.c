@@ -1,7 +1,7 @@
 /*
  * Differential-fuzz driver for the C decoders. Reads records from stdin, each a u32 LE length
  * and that many bytes, and writes one line per record and decoder (state, imu, star tracker,
- * command, status, header, in that order) in the canonical form that proto/tests/c_header.rs
+ * magnetometer, css, fss, command, status, time, operator, header, in that order) in the canonical form that proto/tests/c_header.rs
  * also prints from the Rust decoders:
  *
  *   E <reason> [numbers or field]     on a decode error (reason as the Rust DecodeError variant)
@@ -223,8 +223,56 @@ static void one(const uint8_t *buf, size_t len) {
             u(m.rejected_unknown_sender);
             u(m.rejected_bad_effector_input);
             u(m.rejected_wrong_identity);
+            u(m.rejected_operator_refused);
             u(m.commands_dropped);
             u(m.wall_time_unix_ns);
+            printf("\n");
+        }
+    }
+    {
+        fd_time_msg m;
+        size_t i;
+        e = fd_decode_time(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_time(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            u(m.run_state);
+            u(m.mode);
+            u(m.flags);
+            u(m.frame_ns);
+            f(m.speed);
+            u(m.tai_ns_1958);
+            u(m.utc_year);
+            u(m.utc_month);
+            u(m.utc_day);
+            u(m.utc_hour);
+            u(m.utc_minute);
+            u(m.utc_second);
+            u(m.utc_nanosecond);
+            u((uint32_t)m.tai_minus_utc_s);
+            u(m.gps_week);
+            u(m.gps_ns_of_week);
+            u(m.met_ns);
+            for (i = 0; i < 8; ++i) u(m.cuc_tai[i]);
+            u(m.tone_met.seconds);
+            u(m.tone_met.subseconds);
+            u(m.tone_tai.seconds);
+            u(m.tone_tai.subseconds);
+            printf("\n");
+        }
+    }
+    {
+        fd_operator_msg m;
+        e = fd_decode_operator(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_operator(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            u(m.action);
+            u(m.ticks);
             printf("\n");
         }
     }

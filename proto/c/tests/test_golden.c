@@ -375,6 +375,7 @@ static void test_status(const char *dir) {
     m.rejected_unknown_sender = 6;
     m.rejected_bad_effector_input = 8;
     m.rejected_wrong_identity = 9;
+    m.rejected_operator_refused = 10;
     m.commands_dropped = 7;
     m.wall_time_unix_ns = 1700000000123456789u;
     check_encoded("StatusMsg", golden, n, enc, fd_encode_status(&m, enc, sizeof enc));
@@ -382,7 +383,7 @@ static void test_status(const char *dir) {
     CHECK(e.status == FD_OK && same_header(&back.header, &m.header) &&
               back.wall_time_unix_ns == m.wall_time_unix_ns &&
               back.rejected_bad_effector_input == 8 && back.rejected_wrong_identity == 9 &&
-              back.commands_dropped == 7 &&
+              back.rejected_operator_refused == 10 && back.commands_dropped == 7 &&
               back.stale_policy == 1 && back.command_stale == 1,
           "StatusMsg decodes to the table");
     golden[34] = FD_RUN_STATE_PAUSED;
@@ -450,6 +451,33 @@ static void test_time(const char *dir) {
     printf("TimeMsg: ok\n");
 }
 
+/* OPERATOR_GOLDEN of proto/tests/golden.rs: run 0x1_0000_0005 ticks, then hold. */
+static void test_operator(const char *dir) {
+    uint8_t golden[64], enc[64];
+    size_t n = read_file(dir, "operator", golden, sizeof golden);
+    fd_operator_msg m, back;
+    fd_error e;
+    char key[64];
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 44, 440000000u, 3);
+    m.action = FD_OPERATOR_RUN_TICKS;
+    m.ticks = 0x100000005u;
+    CHECK(n == FD_OPERATOR_LEN, "operator.bin length");
+    check_encoded("OperatorMsg", golden, n, enc, fd_encode_operator(&m, enc, sizeof enc));
+    e = fd_decode_operator(golden, n, &back);
+    CHECK(e.status == FD_OK && same_header(&back.header, &m.header) && back.action == 2 &&
+              back.ticks == m.ticks,
+          "OperatorMsg decodes to the table");
+    golden[30] = 3;
+    e = fd_decode_operator(golden, n, &back);
+    CHECK(e.status == FD_ERR_MALFORMED, "OperatorMsg action tag 3");
+    e = fd_decode_operator(golden, n - 1, &back);
+    CHECK(e.status == FD_ERR_LENGTH && e.needed == FD_OPERATOR_LEN, "OperatorMsg short");
+    CHECK(fd_operator_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/operator") == 0,
+          "operator key");
+    printf("OperatorMsg: ok\n");
+}
+
 static void test_keys(void) {
     char key[128];
     CHECK(fd_state_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/tlm/state") == 0,
@@ -490,6 +518,7 @@ int main(int argc, char **argv) {
     test_commands(argv[1]);
     test_status(argv[1]);
     test_time(argv[1]);
+    test_operator(argv[1]);
     test_keys();
     if (failures != 0) {
         fprintf(stderr, "%d check(s) failed\n", failures);

@@ -3,8 +3,8 @@
 //! `proto/c/tests/fuzz_decode.c`, the Python package's `tests/test_proto_fuzz.py`).
 //!
 //! Input (stdin): records of a u32 LE length and that many bytes. Output (stdout): per record,
-//! nine lines, one per decoder (state, imu, star tracker, magnetometer, css, fss, command, status,
-//! header):
+//! eleven lines, one per decoder (state, imu, star tracker, magnetometer, css, fss, command,
+//! status, time, operator, header):
 //! `E <reason> [numbers or field]` for an error (the `DecodeError` variant; `Length needed
 //! actual`, `TrailingBytes expected actual`, `TooLarge actual`, `UnknownVersion found`,
 //! `NonFinite field`, `Malformed`), or `O <fields>` for a decoded message: every field in wire
@@ -15,8 +15,9 @@ use std::io::{Read, Write};
 
 use flexdyn_proto::{
     decode_command, decode_css, decode_fss, decode_header, decode_imu, decode_magnetometer,
-    decode_star_tracker, decode_state, decode_status, CommandKind, CommandMsg, DecodeError, Header,
-    ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg,
+    decode_operator, decode_star_tracker, decode_state, decode_status, decode_time, CommandKind,
+    CommandMsg, DecodeError, Header, ImuMsg, MagnetometerMsg, OperatorMsg, StarTrackerMsg,
+    StateMsg, StatusMsg, TimeMsg,
 };
 
 fn err_line(e: &DecodeError) -> String {
@@ -166,12 +167,50 @@ fn status_line(m: &StatusMsg) -> String {
         .u(r.unknown_sender)
         .u(r.bad_effector_input)
         .u(r.wrong_identity)
+        .u(r.operator_refused)
         .u(m.commands_dropped)
         .u(m.wall_time_unix_ns);
     l.0
 }
 
-/// The nine verdicts for one buffer, in the order of the module docs.
+fn time_line(m: &TimeMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header)
+        .u(m.run_state.tag().into())
+        .u(m.mode.tag().into())
+        .u(m.flags.into())
+        .u(m.frame_ns)
+        .f(&[m.speed])
+        .u(m.tai_ns_1958)
+        .u(m.utc.year.into())
+        .u(m.utc.month.into())
+        .u(m.utc.day.into())
+        .u(m.utc.hour.into())
+        .u(m.utc.minute.into())
+        .u(m.utc.second.into())
+        .u(m.utc.nanosecond.into())
+        // The i32 as its two's-complement bit pattern.
+        .u((m.tai_minus_utc_s as u32).into())
+        .u(m.gps_week.into())
+        .u(m.gps_ns_of_week)
+        .u(m.met_ns);
+    for b in m.cuc_tai {
+        l.u(b.into());
+    }
+    l.u(m.tone_met.seconds.into())
+        .u(m.tone_met.subseconds.into())
+        .u(m.tone_tai.seconds.into())
+        .u(m.tone_tai.subseconds.into());
+    l.0
+}
+
+fn operator_line(m: &OperatorMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header).u(m.action.tag().into()).u(m.ticks);
+    l.0
+}
+
+/// The eleven verdicts for one buffer, in the order of the module docs.
 fn rust_lines(b: &[u8]) -> Vec<String> {
     fn line<M>(r: Result<M, DecodeError>, f: impl Fn(&M) -> String) -> String {
         match r {
@@ -198,6 +237,8 @@ fn rust_lines(b: &[u8]) -> Vec<String> {
         }),
         line(decode_command(b), command_line),
         line(decode_status(b), status_line),
+        line(decode_time(b), time_line),
+        line(decode_operator(b), operator_line),
         line(decode_header(b), |h| {
             let mut l = Line::new();
             l.h(h);

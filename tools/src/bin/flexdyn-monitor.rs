@@ -92,6 +92,7 @@ fn rejected_by_reason(r: &flexdyn_proto::RejectCounters) -> String {
         ("unknown_sender", r.unknown_sender),
         ("bad_effector_input", r.bad_effector_input),
         ("wrong_identity", r.wrong_identity),
+        ("operator_refused", r.operator_refused),
     ]
     .iter()
     .filter(|(_, n)| *n > 0)

@@ -13,13 +13,14 @@ from . import proto
 from .client import Client, Subscription, VehicleInfo, session_config
 from .lockstep import Answer, LockstepParticipant, SensorSchedule, Tick
 from .proto import (CommandMsg, CssMsg, DecodeError, EffectorInput, EffectorState, FssMsg,
-                    Header, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
+                    Header, ImuMsg, MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg,
+                    StatusMsg, TimeMsg)
 
 __all__ = [
     "proto", "Client", "Subscription", "VehicleInfo", "session_config", "Answer",
     "LockstepParticipant", "SensorSchedule", "Tick", "CommandMsg", "DecodeError",
     "EffectorInput", "EffectorState", "Header", "ImuMsg", "MagnetometerMsg", "StarTrackerMsg",
     "StateMsg",
-    "StatusMsg", "TimeMsg", "CssMsg", "FssMsg",
+    "StatusMsg", "TimeMsg", "CssMsg", "FssMsg", "OperatorMsg",
 ]
 __version__ = "0.1.0"

@@ -20,8 +20,8 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tupl
 import zenoh
 
 from . import proto
-from .proto import (CommandMsg, EffectorInput, Header, ImuMsg, StarTrackerMsg, StateMsg,
-                    StatusMsg, TimeMsg)
+from .proto import (CommandMsg, EffectorInput, Header, ImuMsg, OperatorMsg, StarTrackerMsg,
+                    StateMsg, StatusMsg, TimeMsg)
 
 Vec3 = Tuple[float, float, float]
 
@@ -316,6 +316,40 @@ class Client:
         """An Actuators command: a wrench and effector inputs (e.g. wheel torques [N m])."""
         self.send(CommandMsg(self._header(tick, sim_time_ns), sender_id, proto.ACTUATORS,
                              tuple(torque_b_nm), tuple(force_b_newton), list(inputs)))
+
+    # -- operator control (protocol 6) -------------------------------------------------------
+
+    def operator(self, action: int, ticks: int = 0) -> None:
+        """Publishes an OperatorMsg on ``flexdyn/<sc>/operator``: ``proto.OPERATOR_PAUSE``,
+        ``OPERATOR_RESUME`` or ``OPERATOR_RUN_TICKS`` (proto/README.md, "OperatorMsg"). The
+        server applies it or counts it in ``StatusMsg.rejected_operator_refused``; on a lab
+        network only the operator's subject may put there."""
+        if action not in (proto.OPERATOR_PAUSE, proto.OPERATOR_RESUME, proto.OPERATOR_RUN_TICKS):
+            raise ValueError(f"unknown operator action {action!r}")
+        if not (isinstance(ticks, int) and 0 <= ticks < 2**64):
+            raise ValueError(f"ticks must be an integer 0..2**64-1, not {ticks!r}")
+        now = self._now
+        tick = now.header.tick if now is not None else 0
+        msg = OperatorMsg(self._header(tick, 0), action, ticks)
+        with self._pub_lock:
+            if self._closed:
+                raise RuntimeError("flexdyn.Client is closed")
+            self.session.put(proto.operator_key(self.sc_id), msg.encode())
+
+    def pause(self) -> None:
+        """Holds the run: real time at the next frame (its TimeMsg says paused, then nothing
+        until :meth:`resume`); lockstep at the tick after the one published."""
+        self.operator(proto.OPERATOR_PAUSE)
+
+    def resume(self) -> None:
+        """Releases a hold (real time: the schedule restarts from now, no catch-up burst)."""
+        self.operator(proto.OPERATOR_RESUME)
+
+    def run_ticks(self, n: int) -> None:
+        """Lockstep: steps `n` (>= 1) more ticks from the tick published or held, then holds."""
+        if n < 1:
+            raise ValueError("run_ticks needs n >= 1")
+        self.operator(proto.OPERATOR_RUN_TICKS, n)
 
     def close(self) -> None:
         """Undeclares everything and closes the session."""

@@ -37,12 +37,13 @@ COMMAND_KIND_OFFSET = 34
 COMMAND_WRENCH_LEN = 86
 COMMAND_NO_COMMAND_LEN = 38
 COMMAND_ACTUATORS_FIXED_LEN = 94
-STATUS_LEN = 179
+STATUS_LEN = 187
 TIME_LEN = 122
 # Sun sensors (protocol 6)
 CSS_LEN = 159
 FSS_LEN = 47
 MAX_CSS_DETECTORS = 16
+OPERATOR_LEN = 42
 MAX_EFFECTORS = 1024
 MAX_EFFECTOR_VALUES = 8
 MAX_MESSAGE_BYTES = 65536
@@ -70,6 +71,8 @@ RUN_STATE_RUNNING, RUN_STATE_PAUSED = 1, 6
 TIME_EPOCH_VALID, TIME_TONE, TIME_LEAP_SECOND = 0x1, 0x2, 0x4
 CUC_PFIELD_TAI_4_3 = 0x1F
 STALE_POLICY_HOLD, STALE_POLICY_ZERO = 0, 1
+# OperatorMsg.action (protocol 6)
+OPERATOR_PAUSE, OPERATOR_RESUME, OPERATOR_RUN_TICKS = 0, 1, 2
 
 _HEADER = struct.Struct("<HIQQQ")
 
@@ -486,10 +489,11 @@ class StatusMsg:
     rejected_unknown_sender: int = 0
     rejected_bad_effector_input: int = 0
     rejected_wrong_identity: int = 0
+    rejected_operator_refused: int = 0
     commands_dropped: int = 0
     wall_time_unix_ns: int = 0
 
-    _BODY: ClassVar[struct.Struct] = struct.Struct("<II7QBI10Q")
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<II7QBI11Q")
 
     def encode(self) -> bytes:
         return self.header.encode() + self._BODY.pack(
@@ -499,7 +503,8 @@ class StatusMsg:
             self.stale_policy, self.rejected_malformed, self.rejected_bad_version,
             self.rejected_non_finite, self.rejected_wrong_spacecraft, self.rejected_stale_tick,
             self.rejected_unknown_sender, self.rejected_bad_effector_input,
-            self.rejected_wrong_identity, self.commands_dropped, self.wall_time_unix_ns,
+            self.rejected_wrong_identity, self.rejected_operator_refused, self.commands_dropped,
+            self.wall_time_unix_ns,
         )
 
     @staticmethod
@@ -571,6 +576,31 @@ class TimeMsg:
         return bool(self.flags & TIME_TONE)
 
 
+@dataclass
+class OperatorMsg:
+    """An operator's command (``flexdyn/<sc-id>/operator``, protocol 6): ``action`` is
+    ``OPERATOR_PAUSE``, ``OPERATOR_RESUME`` or ``OPERATOR_RUN_TICKS`` (lockstep: step ``ticks``
+    frames, then hold); ``ticks`` is 0 for the other actions."""
+
+    header: Header = field(default_factory=Header)
+    action: int = OPERATOR_PAUSE
+    ticks: int = 0
+
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<IQ")
+
+    def encode(self) -> bytes:
+        return self.header.encode() + self._BODY.pack(self.action, self.ticks)
+
+    @staticmethod
+    def decode(buf: bytes) -> "OperatorMsg":
+        _check_size_and_version(buf, OPERATOR_LEN)
+        _check_total(OPERATOR_LEN, buf)
+        action, ticks = OperatorMsg._BODY.unpack_from(buf, HEADER_LEN)
+        if action > OPERATOR_RUN_TICKS:
+            raise DecodeError("Malformed", detail="action tag")
+        return OperatorMsg(Header.unpack(buf), action, ticks)
+
+
 # --------------------------------------------------------------------------------------------
 # Key expressions (proto/README.md, "Topics").
 
@@ -626,6 +656,11 @@ def command_key(sc: str, sender_id: int) -> str:
 
 def status_key(sc: str) -> str:
     return _key(sc, "status")
+
+
+def operator_key(sc: str) -> str:
+    """``flexdyn/<sc>/operator``: operator commands (OperatorMsg, protocol 6)."""
+    return _key(sc, "operator")
 
 
 def telemetry_key(sc: str) -> str:
