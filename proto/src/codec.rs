@@ -21,8 +21,8 @@
 use bincode::config::{Configuration, Fixint, Limit, LittleEndian};
 
 use crate::{
-    CommandMsg, DecodeError, Header, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, StatusMsg,
-    TimeMsg, WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
+    CommandMsg, DecodeError, EnvironmentMsg, Header, ImuMsg, MagnetometerMsg, StarTrackerMsg,
+    StateMsg, StatusMsg, TimeMsg, WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
 };
 
 /// The bincode configuration of the wire format.
@@ -106,6 +106,11 @@ pub fn decode_imu(bytes: &[u8]) -> Result<ImuMsg, DecodeError> {
 
 /// [`decode`] for [`StarTrackerMsg`].
 pub fn decode_star_tracker(bytes: &[u8]) -> Result<StarTrackerMsg, DecodeError> {
+    decode(bytes)
+}
+
+/// [`decode`] for [`EnvironmentMsg`].
+pub fn decode_environment(bytes: &[u8]) -> Result<EnvironmentMsg, DecodeError> {
     decode(bytes)
 }
 

@@ -5,8 +5,8 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use crate::{
-    CommandKind, CommandMsg, DecodeError, Header, ImuMsg, MagnetometerMsg, StarTrackerMsg,
-    StateMsg, StatusMsg, TimeMsg,
+    CommandKind, CommandMsg, DecodeError, EnvironmentMsg, Header, ImuMsg, MagnetometerMsg,
+    StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
 };
 
 /// Encoded [`Header`] size (bytes).
@@ -26,6 +26,8 @@ pub const IMU_LEN: usize = 127;
 pub const STAR_TRACKER_LEN: usize = 64;
 /// Encoded [`MagnetometerMsg`] size (bytes).
 pub const MAGNETOMETER_LEN: usize = 55;
+/// Encoded [`EnvironmentMsg`] size (bytes).
+pub const ENVIRONMENT_LEN: usize = 368;
 /// Encoded [`TimeMsg`] size (bytes).
 pub const TIME_LEN: usize = 122;
 /// Offset of the 8 CCSDS CUC octets in a [`TimeMsg`].
@@ -78,6 +80,7 @@ mod sealed {
     impl Sealed for super::StatusMsg {}
     impl Sealed for super::StarTrackerMsg {}
     impl Sealed for super::MagnetometerMsg {}
+    impl Sealed for super::EnvironmentMsg {}
     impl Sealed for super::TimeMsg {}
 }
 
@@ -140,6 +143,17 @@ impl WireMessage for MagnetometerMsg {
         len: MAGNETOMETER_LEN,
     };
     const MIN_LEN: usize = MAGNETOMETER_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+impl WireMessage for EnvironmentMsg {
+    const NAME: &'static str = "EnvironmentMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed {
+        len: ENVIRONMENT_LEN,
+    };
+    const MIN_LEN: usize = ENVIRONMENT_LEN;
     fn header(&self) -> &Header {
         &self.header
     }

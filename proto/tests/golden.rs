@@ -21,14 +21,15 @@
 //! message lists field, offset, expected and actual bytes to help review).
 
 use flexdyn_proto::{
-    command_flags, decode, decode_header, effector_kind, encode, magnetometer_flags,
-    magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags, time_flags,
-    wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, EffectorInput,
-    EffectorState, FrameTiming, Header, ImuMsg, MagnetometerMsg, Mode, RejectCounters, RunState,
-    StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime, WireMessage,
-    COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CUC_PFIELD_TAI_4_3,
-    EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, IMU_LEN, MAGNETOMETER_LEN,
-    STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
+    command_flags, decode, decode_header, eclipse, effector_kind, encode, environment_flags,
+    magnetometer_flags, magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags,
+    time_flags, wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved,
+    EffectorInput, EffectorState, EnvironmentMsg, FrameTiming, Header, ImuMsg, MagnetometerMsg,
+    Mode, RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime,
+    TimeMsg, UtcTime, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN,
+    COMMAND_WRENCH_LEN, CUC_PFIELD_TAI_4_3, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN,
+    ENVIRONMENT_LEN, IMU_LEN, MAGNETOMETER_LEN, STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN,
+    TIME_CUC_OFFSET, TIME_LEN,
 };
 
 type Golden = &'static [(usize, &'static str, &'static str)];
@@ -100,7 +101,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -360,7 +361,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -436,7 +437,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -483,7 +484,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -553,7 +554,7 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -583,8 +584,239 @@ const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
     ),
     (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
 ];
+const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0600", "u16 header.protocol_version = 6"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "1100000000000000", "u64 header.tick = 17"),
+    (
+        14,
+        "80fe210a00000000",
+        "u64 header.sim_time_ns = 170000000 (0xA21FE80)",
+    ),
+    (22, "0200000000000000", "u64 header.seq = 2"),
+    (
+        30,
+        "0807060504030201",
+        "u64 tai_ns_1958 = 0x0102030405060708",
+    ),
+    (
+        38,
+        "37",
+        "u8 flags = EPOCH_VALID | MAGNETIC | SUN | SHADOW | ATMOSPHERE = 0x37",
+    ),
+    (39, "01", "u8 eclipse = PENUMBRA = 1"),
+    (
+        40,
+        "000000000000003f",
+        "f64 b_n_t[0] = 2^-15 (bits 0x3F00000000000000)",
+    ),
+    (
+        48,
+        "000000000000f0be",
+        "f64 b_n_t[1] = -2^-16 (bits 0xBEF0000000000000)",
+    ),
+    (
+        56,
+        "000000000000e03e",
+        "f64 b_n_t[2] = 2^-17 (bits 0x3EE0000000000000)",
+    ),
+    (
+        64,
+        "0000000000000080",
+        "f64 b_b_t[0] = -0.0 (bits 0x8000000000000000)",
+    ),
+    (
+        72,
+        "000000000000103f",
+        "f64 b_b_t[1] = 2^-14 (bits 0x3F10000000000000)",
+    ),
+    (
+        80,
+        "000000000000d0be",
+        "f64 b_b_t[2] = -2^-18 (bits 0xBED0000000000000)",
+    ),
+    (
+        88,
+        "000000000000e03f",
+        "f64 sun_n[0] = 0.5 (bits 0x3FE0000000000000)",
+    ),
+    (
+        96,
+        "000000000000e0bf",
+        "f64 sun_n[1] = -0.5 (bits 0xBFE0000000000000)",
+    ),
+    (
+        104,
+        "000000000000e83f",
+        "f64 sun_n[2] = 0.75 (bits 0x3FE8000000000000)",
+    ),
+    (
+        112,
+        "000000000000d03f",
+        "f64 sun_b[0] = 0.25 (bits 0x3FD0000000000000)",
+    ),
+    (
+        120,
+        "000000000000f03f",
+        "f64 sun_b[1] = 1.0 (bits 0x3FF0000000000000)",
+    ),
+    (
+        128,
+        "000000000000c0bf",
+        "f64 sun_b[2] = -0.125 (bits 0xBFC0000000000000)",
+    ),
+    (
+        136,
+        "000000000000f0bf",
+        "f64 moon_n[0] = -1.0 (bits 0xBFF0000000000000)",
+    ),
+    (
+        144,
+        "000000000000d83f",
+        "f64 moon_n[1] = 0.375 (bits 0x3FD8000000000000)",
+    ),
+    (
+        152,
+        "000000000000b03f",
+        "f64 moon_n[2] = 0.0625 (bits 0x3FB0000000000000)",
+    ),
+    (
+        160,
+        "000000000000e43f",
+        "f64 shadow_factor = 0.625 (bits 0x3FE4000000000000)",
+    ),
+    (
+        168,
+        "000000000000703d",
+        "f64 density_kg_m3 = 2^-40 (bits 0x3D70000000000000)",
+    ),
+    (
+        176,
+        "000000000000b03e",
+        "f64 gravity_gradient.torque_b_nm[0] = 2^-20 (bits 0x3EB0000000000000)",
+    ),
+    (
+        184,
+        "000000000000a0be",
+        "f64 gravity_gradient.torque_b_nm[1] = -2^-21 (bits 0xBEA0000000000000)",
+    ),
+    (
+        192,
+        "000000000000903e",
+        "f64 gravity_gradient.torque_b_nm[2] = 2^-22 (bits 0x3E90000000000000)",
+    ),
+    (
+        200,
+        "000000000000103e",
+        "f64 gravity_gradient.force_b_newton[0] = 2^-30 (bits 0x3E10000000000000)",
+    ),
+    (
+        208,
+        "0000000000000000",
+        "f64 gravity_gradient.force_b_newton[1] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        216,
+        "00000000000000be",
+        "f64 gravity_gradient.force_b_newton[2] = -2^-31 (bits 0xBE00000000000000)",
+    ),
+    (
+        224,
+        "000000000000f83f",
+        "f64 drag.torque_b_nm[0] = 1.5 (bits 0x3FF8000000000000)",
+    ),
+    (
+        232,
+        "00000000000004c0",
+        "f64 drag.torque_b_nm[1] = -2.5 (bits 0xC004000000000000)",
+    ),
+    (
+        240,
+        "0000000000000c40",
+        "f64 drag.torque_b_nm[2] = 3.5 (bits 0x400C000000000000)",
+    ),
+    (
+        248,
+        "0000000000001040",
+        "f64 drag.force_b_newton[0] = 4.0 (bits 0x4010000000000000)",
+    ),
+    (
+        256,
+        "00000000000020c0",
+        "f64 drag.force_b_newton[1] = -8.0 (bits 0xC020000000000000)",
+    ),
+    (
+        264,
+        "0000000000003040",
+        "f64 drag.force_b_newton[2] = 16.0 (bits 0x4030000000000000)",
+    ),
+    (
+        272,
+        "000000000000703e",
+        "f64 solar_pressure.torque_b_nm[0] = 2^-24 (bits 0x3E70000000000000)",
+    ),
+    (
+        280,
+        "000000000000603e",
+        "f64 solar_pressure.torque_b_nm[1] = 2^-25 (bits 0x3E60000000000000)",
+    ),
+    (
+        288,
+        "000000000000503e",
+        "f64 solar_pressure.torque_b_nm[2] = 2^-26 (bits 0x3E50000000000000)",
+    ),
+    (
+        296,
+        "00000000000070be",
+        "f64 solar_pressure.force_b_newton[0] = -2^-24 (bits 0xBE70000000000000)",
+    ),
+    (
+        304,
+        "00000000000060be",
+        "f64 solar_pressure.force_b_newton[1] = -2^-25 (bits 0xBE60000000000000)",
+    ),
+    (
+        312,
+        "00000000000050be",
+        "f64 solar_pressure.force_b_newton[2] = -2^-26 (bits 0xBE50000000000000)",
+    ),
+    (
+        320,
+        "000000000000c03f",
+        "f64 residual_dipole.torque_b_nm[0] = 0.125 (bits 0x3FC0000000000000)",
+    ),
+    (
+        328,
+        "000000000000d0bf",
+        "f64 residual_dipole.torque_b_nm[1] = -0.25 (bits 0xBFD0000000000000)",
+    ),
+    (
+        336,
+        "000000000000803f",
+        "f64 residual_dipole.torque_b_nm[2] = 2^-7 (bits 0x3F80000000000000)",
+    ),
+    (
+        344,
+        "0000000000000000",
+        "f64 residual_dipole.force_b_newton[0] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        352,
+        "0000000000000000",
+        "f64 residual_dipole.force_b_newton[1] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        360,
+        "0000000000000000",
+        "f64 residual_dipole.force_b_newton[2] = 0.0 (bits 0x0000000000000000)",
+    ),
+];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -628,7 +860,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
 /// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
 /// TAI …036.0 s). `src/server/clock.rs` produces exactly this message from that epoch.
 const TIME_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -701,7 +933,7 @@ const TIME_GOLDEN: &[(usize, &str, &str)] = &[
     (118, "00000000", "u32 tone_tai.subseconds = 0"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -718,7 +950,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0500", "u16 header.protocol_version = 5"),
+    (0, "0600", "u16 header.protocol_version = 6"),
     (
         2,
         "44332211",
@@ -969,6 +1201,48 @@ fn magnetometer_golden() {
 }
 
 #[test]
+fn environment_golden() {
+    let msg = EnvironmentMsg {
+        header: Header::new(SC, 17, 170_000_000, 2),
+        tai_ns_1958: 0x0102_0304_0506_0708,
+        flags: environment_flags::EPOCH_VALID
+            | environment_flags::MAGNETIC
+            | environment_flags::SUN
+            | environment_flags::SHADOW
+            | environment_flags::ATMOSPHERE,
+        eclipse: eclipse::PENUMBRA,
+        b_n_t: [2f64.powi(-15), -(2f64.powi(-16)), 2f64.powi(-17)],
+        b_b_t: [-0.0, 2f64.powi(-14), -(2f64.powi(-18))],
+        sun_n: [0.5, -0.5, 0.75],
+        sun_b: [0.25, 1.0, -0.125],
+        moon_n: [-1.0, 0.375, 0.0625],
+        shadow_factor: 0.625,
+        density_kg_m3: 2f64.powi(-40),
+        gravity_gradient: AppliedWrench {
+            torque_b_nm: [2f64.powi(-20), -(2f64.powi(-21)), 2f64.powi(-22)],
+            force_b_newton: [2f64.powi(-30), 0.0, -(2f64.powi(-31))],
+        },
+        drag: AppliedWrench {
+            torque_b_nm: [1.5, -2.5, 3.5],
+            force_b_newton: [4.0, -8.0, 16.0],
+        },
+        solar_pressure: AppliedWrench {
+            torque_b_nm: [2f64.powi(-24), 2f64.powi(-25), 2f64.powi(-26)],
+            force_b_newton: [-(2f64.powi(-24)), -(2f64.powi(-25)), -(2f64.powi(-26))],
+        },
+        residual_dipole: AppliedWrench {
+            torque_b_nm: [0.125, -0.25, 2f64.powi(-7)],
+            force_b_newton: [0.0; 3],
+        },
+    };
+    check("EnvironmentMsg", ENVIRONMENT_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), ENVIRONMENT_LEN);
+    assert_eq!(eclipse::of_shadow_factor(1.0), eclipse::SUNLIT);
+    assert_eq!(eclipse::of_shadow_factor(0.5), eclipse::PENUMBRA);
+    assert_eq!(eclipse::of_shadow_factor(0.0), eclipse::UMBRA);
+}
+
+#[test]
 fn command_no_command_golden() {
     let msg = CommandMsg::no_command(Header::new(SC, 43, 430_000_000, 8), 5);
     assert_eq!(msg.kind, CommandKind::NoCommand);
@@ -1091,6 +1365,17 @@ fn flag_bits() {
     assert_eq!(time_flags::TONE, 0b010);
     assert_eq!(time_flags::LEAP_SECOND, 0b100);
     assert_eq!(time_flags::RESERVED_MASK, 0b1111_1000);
+    assert_eq!(environment_flags::EPOCH_VALID, 0b00_0001);
+    assert_eq!(environment_flags::MAGNETIC, 0b00_0010);
+    assert_eq!(environment_flags::SUN, 0b00_0100);
+    assert_eq!(environment_flags::MOON, 0b00_1000);
+    assert_eq!(environment_flags::SHADOW, 0b01_0000);
+    assert_eq!(environment_flags::ATMOSPHERE, 0b10_0000);
+    assert_eq!(environment_flags::RESERVED_MASK, 0b1100_0000);
+    assert_eq!(
+        (eclipse::SUNLIT, eclipse::PENUMBRA, eclipse::UMBRA),
+        (0, 1, 2)
+    );
     // 0 001 11 11: no extension, TAI 1958 (Level 1), 4 coarse octets, 3 fine octets.
     assert_eq!(CUC_PFIELD_TAI_4_3, 0b0001_1111);
     assert_eq!(wheel_flags::TORQUE_LIMITED, 0b01);
@@ -1111,7 +1396,7 @@ fn flag_bits() {
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 9] = [
+    let tables: [(&str, &str, Golden, &str); 10] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -1146,6 +1431,12 @@ fn exported_golden_files_match_the_tables() {
             "MAGNETOMETER_GOLDEN",
         ),
         ("time", "TimeMsg", TIME_GOLDEN, "TIME_GOLDEN"),
+        (
+            "environment",
+            "EnvironmentMsg",
+            ENVIRONMENT_GOLDEN,
+            "ENVIRONMENT_GOLDEN",
+        ),
     ];
     let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");
     let rows: Vec<Vec<&str>> = manifest
