@@ -365,9 +365,8 @@ impl Simulation {
 
     /// Writes the environment at the current instant into `out`, the environment record of
     /// flexdyn: the wire `EnvironmentMsg` the server publishes and whose fields `simulate`
-    /// writes as CSV columns. Sets `header.sim_time_ns` and every field but `tai_ns_1958` and
-    /// the rest of the header (the caller's: the server takes them from the tick's time
-    /// message).
+    /// writes as CSV columns. Sets `header.sim_time_ns` and every field; the rest of the header
+    /// is the caller's.
     ///
     /// The instant is the current state's (the end of the last step): the environment sample is
     /// the one in force from now on ([`EnvironmentModel::sample_from`]: the sample the next
@@ -409,6 +408,7 @@ impl Simulation {
             }
         }
         out.header.sim_time_ns = t;
+        out.tai_ns_1958 = self.epoch.as_ref().map_or(0, |e| e.tai_ns_1958(t));
         out.flags = flags;
         out.eclipse = eclipse::of_shadow_factor(env.shadow_factor);
         out.b_n_t = env.b_field_n_t.into();

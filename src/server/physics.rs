@@ -152,7 +152,6 @@ impl Stepper {
                 let mut env = flexdyn_proto::EnvironmentMsg::default();
                 self.sim.environment_into(&mut env);
                 env.header = Header::new(self.spacecraft_id, k, env.header.sim_time_ns, k / every);
-                env.tai_ns_1958 = frame.time.tai_ns_1958;
                 frame.environment = Some(env);
             }
         }

@@ -4,10 +4,12 @@
 //! `flexdyn/<sc-id>/<suffix>` (see `proto/README.md`, "Topics") names the message type, and the
 //! payload decodes with the one `flexdyn-proto` codec.
 
-use flexdyn_proto::keys::{CMD_PREFIX, KEY_ROOT, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX};
+use flexdyn_proto::keys::{
+    CMD_PREFIX, ENVIRONMENT_SUFFIX, KEY_ROOT, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
+};
 use flexdyn_proto::{
-    decode_command, decode_state, decode_status, decode_time, CommandMsg, DecodeError, Header,
-    StateMsg, StatusMsg, TimeMsg,
+    decode_command, decode_environment, decode_state, decode_status, decode_time, CommandMsg,
+    DecodeError, EnvironmentMsg, Header, StateMsg, StatusMsg, TimeMsg,
 };
 
 use crate::sensors::{SensorKind, KINDS};
@@ -27,6 +29,8 @@ pub enum TopicKind {
     Status,
     /// `flexdyn/<sc>/tlm/time`: [`TimeMsg`] (the time service).
     Time,
+    /// `flexdyn/<sc>/tlm/env`: [`EnvironmentMsg`] (the environment's truth).
+    Environment,
 }
 
 impl TopicKind {
@@ -34,7 +38,12 @@ impl TopicKind {
     pub fn all() -> impl Iterator<Item = TopicKind> {
         std::iter::once(TopicKind::State)
             .chain((0..KINDS.len()).map(TopicKind::Sensor))
-            .chain([TopicKind::Command, TopicKind::Status, TopicKind::Time])
+            .chain([
+                TopicKind::Command,
+                TopicKind::Status,
+                TopicKind::Time,
+                TopicKind::Environment,
+            ])
     }
 
     /// The topic kind of sensor kind `kind` (`None` if it is not registered).
@@ -58,6 +67,7 @@ impl TopicKind {
             TopicKind::Command => "CommandMsg",
             TopicKind::Status => "StatusMsg",
             TopicKind::Time => "TimeMsg",
+            TopicKind::Environment => "EnvironmentMsg",
         }
     }
 }
@@ -91,6 +101,8 @@ pub fn classify(key: &str) -> Option<Topic<'_>> {
         (TopicKind::State, None)
     } else if suffix == TIME_SUFFIX {
         (TopicKind::Time, None)
+    } else if suffix == ENVIRONMENT_SUFFIX {
+        (TopicKind::Environment, None)
     } else if let Some(sender) =
         sensor(CMD_PREFIX).filter(|s| s.bytes().all(|b| b.is_ascii_digit()))
     {
@@ -134,6 +146,8 @@ pub enum Decoded {
     Status(StatusMsg),
     /// A time-service message.
     Time(TimeMsg),
+    /// An environment message.
+    Environment(EnvironmentMsg),
 }
 
 impl Decoded {
@@ -155,6 +169,7 @@ impl Decoded {
             TopicKind::Command => Decoded::Command(decode_command(payload)?),
             TopicKind::Status => Decoded::Status(decode_status(payload)?),
             TopicKind::Time => Decoded::Time(decode_time(payload)?),
+            TopicKind::Environment => Decoded::Environment(decode_environment(payload)?),
         })
     }
 
@@ -166,6 +181,7 @@ impl Decoded {
             Decoded::Command(m) => &m.header,
             Decoded::Status(m) => &m.header,
             Decoded::Time(m) => &m.header,
+            Decoded::Environment(m) => &m.header,
         }
     }
 
@@ -178,6 +194,7 @@ impl Decoded {
             Decoded::Command(m) => serde_json::to_vec(m),
             Decoded::Status(m) => serde_json::to_vec(m),
             Decoded::Time(m) => serde_json::to_vec(m),
+            Decoded::Environment(m) => serde_json::to_vec(m),
         };
         v.unwrap_or_else(|_| b"null".to_vec())
     }
@@ -190,6 +207,7 @@ impl Decoded {
             Decoded::Command(m) => serde_json::to_value(m),
             Decoded::Status(m) => serde_json::to_value(m),
             Decoded::Time(m) => serde_json::to_value(m),
+            Decoded::Environment(m) => serde_json::to_value(m),
         };
         // The wire structs hold only numbers, bools, enums and vectors: always representable.
         v.unwrap_or(serde_json::Value::Null)
@@ -208,6 +226,7 @@ pub fn json_schema(kind: TopicKind) -> serde_json::Value {
         TopicKind::Command => schemars::schema_for!(CommandMsg),
         TopicKind::Status => schemars::schema_for!(StatusMsg),
         TopicKind::Time => schemars::schema_for!(TimeMsg),
+        TopicKind::Environment => schemars::schema_for!(EnvironmentMsg),
     };
     schema.to_value()
 }
@@ -264,6 +283,9 @@ mod tests {
         assert_eq!((t.kind, t.sensor), (TopicKind::Time, None));
         assert_eq!(TopicKind::Time.message_name(), "TimeMsg");
         assert_eq!(classify("flexdyn/x/tlm/time/y"), None);
+        let t = classify("flexdyn/x/tlm/env").unwrap();
+        assert_eq!((t.kind, t.sensor), (TopicKind::Environment, None));
+        assert_eq!(TopicKind::Environment.message_name(), "EnvironmentMsg");
         for other in [
             "flexdyn/x/participant/1",
             "flexdyn/x/tlm/imu/",
