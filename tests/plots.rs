@@ -123,7 +123,12 @@ fn a_recording_gives_every_figure() {
         err.contains("skipped magnetometer.png: no magnetometer"),
         "{err}"
     );
-    assert_eq!(err.matches("skipped").count(), 3, "{err}");
+    // Nor the environment message.
+    assert!(
+        err.contains("skipped disturbance_torques.png: no environment record"),
+        "{err}"
+    );
+    assert_eq!(err.matches("skipped").count(), 4, "{err}");
     assert!(!out.join("timing.png").exists());
 
     let (figs, _) = figures(&args(&rec)).unwrap();
