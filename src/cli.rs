@@ -8,7 +8,7 @@ use std::num::NonZeroU64;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use flexdyn_proto::{command_flags, AppliedWrench, Header, StateMsg};
+use flexdyn_proto::{command_flags, AppliedWrench, EnvironmentMsg, Header, StateMsg};
 
 use crate::config::{
     config_message, log_warnings, warning_message, whole_ns, ConfigError, SimConfig,
@@ -18,7 +18,10 @@ use crate::sensors::Sensor;
 use crate::server::error::SettingsError;
 use crate::server::settings::ServerSettings;
 use crate::sim::Simulation;
-use crate::sinks::table::{first_non_finite_column, prefixed_columns, state_row, Column, CsvTable};
+use crate::sinks::table::{
+    first_non_finite_column, prefixed_columns, state_row, Column, CsvTable,
+    ENVIRONMENT_COLUMN_PREFIX,
+};
 
 /// Arguments of `flexdyn simulate`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
@@ -218,10 +221,14 @@ fn scheduled_wrench(cfg: &SimConfig, t_ns: u64) -> AppliedWrench {
 fn simulate_row(
     state: &StateMsg,
     wrench_schedule: &AppliedWrench,
+    environment: Option<&EnvironmentMsg>,
     sensors: impl Iterator<Item = Option<Vec<Column>>>,
 ) -> Vec<Column> {
     let mut row = state_row(state);
     row.extend(prefixed_columns("wrench_schedule", wrench_schedule));
+    if let Some(env) = environment {
+        row.extend(prefixed_columns(ENVIRONMENT_COLUMN_PREFIX, env));
+    }
     row.extend(sensors.flatten().flatten());
     row
 }
@@ -247,7 +254,10 @@ fn sensor_prefix(s: &dyn Sensor) -> String {
 /// `command_flags` says no command yet), then the scheduled wrench, then the sensors: those
 /// that integrate over an interval (the IMUs) at every row, their interval being the log
 /// interval; the others (the star trackers) sampled at the frame boundaries where they are due,
-/// as the server does, their cells filled in the rows that fall on such a sample.
+/// as the server does, their cells filled in the rows that fall on such a sample. With
+/// `[environment] telemetry_rate_hz` set, every row also carries the environment record at its
+/// instant (`env_*`: the EnvironmentMsg fields, [`Simulation::environment_into`]), before the
+/// sensors.
 pub fn simulate_to<W: Write>(
     cfg: &SimConfig,
     duration_s: f64,
@@ -276,6 +286,10 @@ pub fn simulate_to<W: Write>(
 
     let mut state = sim.blank_state();
     state.command_flags = command_flags::NO_COMMAND_YET;
+    // `[environment] telemetry_rate_hz` set: the environment record at every row's instant.
+    let mut environment = sim
+        .environment_every_frames()
+        .map(|_| EnvironmentMsg::default());
     let mut buf = Vec::new();
     // Per sensor: the step of its last sample and that sample's columns.
     let mut last: Vec<Option<(u64, Vec<Column>)>> = vec![None; sim.sensors().len()];
@@ -304,10 +318,11 @@ pub fn simulate_to<W: Write>(
             &(s.kind().default_json)(),
         ))
     });
-    let columns: Vec<String> = simulate_row(&state, &AppliedWrench::default(), all)
-        .into_iter()
-        .map(|(name, _)| name)
-        .collect();
+    let columns: Vec<String> =
+        simulate_row(&state, &AppliedWrench::default(), environment.as_ref(), all)
+            .into_iter()
+            .map(|(name, _)| name)
+            .collect();
     // What t_s = 0 is, when the configuration has an [epoch].
     let comments: Vec<String> = cfg
         .epoch
@@ -347,7 +362,15 @@ pub fn simulate_to<W: Write>(
                 .filter(|(at, _)| *at == step)
                 .map(|(_, cols)| cols.clone())
         });
-        let row = simulate_row(&state, &scheduled_wrench(cfg, t_ns), now);
+        if let Some(env) = environment.as_mut() {
+            sim.environment_into(env);
+        }
+        let row = simulate_row(
+            &state,
+            &scheduled_wrench(cfg, t_ns),
+            environment.as_ref(),
+            now,
+        );
         // Once per row, outside the stepping loop: never write a non-finite state.
         if let Some(quantity) = first_non_finite_column(&row) {
             table.flush().map_err(io_err)?;

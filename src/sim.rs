@@ -17,7 +17,9 @@ use flexdyn_proto::{EffectorState, StateMsg};
 
 use crate::attitude::{mrp_to_dcm, mrp_to_quat};
 use crate::config::{ConfigError, EffectorInputSegment, SimConfig};
-use crate::dynamics::{HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment};
+use crate::dynamics::{
+    EnvironmentSource, HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment,
+};
 use crate::environment::model::EnvironmentModel;
 use crate::sensors::{Sensor, SensorBank, Truth};
 
@@ -57,6 +59,8 @@ pub struct Simulation {
     environment: Option<EnvironmentModel>,
     /// The `[epoch]` (t = 0), if the configuration has one: the time service's calendar.
     epoch: Option<crate::environment::epoch::SimEpoch>,
+    /// `[environment] telemetry_rate_hz` in frames (`None`: no environment record).
+    environment_every_frames: Option<u64>,
 }
 
 impl Simulation {
@@ -69,6 +73,10 @@ impl Simulation {
         let mut sim = Self {
             environment,
             epoch: cfg.epoch.clone(),
+            environment_every_frames: cfg
+                .environment
+                .as_ref()
+                .and_then(|e| e.telemetry_every_frames),
             inputs: vec![0.0; sc.effector_input_len()],
             input_schedule: cfg.effector_input_schedule.clone(),
             input_cursor: 0,
@@ -347,6 +355,78 @@ impl Simulation {
             orb_ang_mom_n: c.orb_ang_mom_n.into(),
             rot_ang_mom_c_n: c.rot_ang_mom_c_n.into(),
         };
+    }
+
+    /// `[environment] telemetry_rate_hz` as a whole number of frames: the environment record is
+    /// due at the ticks that are multiples of it. `None` without that setting.
+    pub fn environment_every_frames(&self) -> Option<u64> {
+        self.environment_every_frames
+    }
+
+    /// Writes the environment at the current instant into `out`, the environment record of
+    /// flexdyn: the wire `EnvironmentMsg` the server publishes and whose fields `simulate`
+    /// writes as CSV columns. Sets `header.sim_time_ns` and every field; the rest of the header
+    /// is the caller's.
+    ///
+    /// The instant is the current state's (the end of the last step): the environment sample is
+    /// the one in force from now on ([`EnvironmentModel::sample_from`]: the sample the next
+    /// step's stages read, refreshed now if its update is due now), and each source's force and
+    /// torque is its own dynamic effector's evaluation at this state with that sample
+    /// ([`Spacecraft::environment_wrenches`]), i.e. what it adds at the first stage of the next
+    /// step. Gravity itself is not a source here: it is the uniform field acting at the centre
+    /// of mass (no torque about C), in every state record already. Allocates nothing; not on
+    /// the stepping path.
+    pub fn environment_into(&mut self, out: &mut flexdyn_proto::EnvironmentMsg) {
+        use flexdyn_proto::{eclipse, environment_flags as f, AppliedWrench};
+        let t = self.sc.t_sim_ns();
+        let x = self.sc.state();
+        let (env, on) = match &self.environment {
+            Some(m) => (m.sample_from(t, &x.r_bn_n, &x.v_bn_n), m.models_on()),
+            None => (*self.sc.environment(), Default::default()),
+        };
+        let dcm_bn = mrp_to_dcm(&x.sigma_bn);
+        let unit = |v: &nalgebra::Vector3<f64>| {
+            let n = v.norm();
+            if n > 0.0 {
+                v / n
+            } else {
+                *v
+            }
+        };
+        let sun_n = unit(&env.r_sun_b_n_m);
+        let mut flags = 0;
+        for (bit, is_on) in [
+            (f::EPOCH_VALID, self.epoch.is_some()),
+            (f::MAGNETIC, on.magnetic),
+            (f::SUN, on.sun),
+            (f::MOON, on.moon),
+            (f::SHADOW, on.shadow),
+            (f::ATMOSPHERE, on.atmosphere),
+        ] {
+            if is_on {
+                flags |= bit;
+            }
+        }
+        out.header.sim_time_ns = t;
+        out.tai_ns_1958 = self.epoch.as_ref().map_or(0, |e| e.tai_ns_1958(t));
+        out.flags = flags;
+        out.eclipse = eclipse::of_shadow_factor(env.shadow_factor);
+        out.b_n_t = env.b_field_n_t.into();
+        out.b_b_t = (dcm_bn * env.b_field_n_t).into();
+        out.sun_n = sun_n.into();
+        out.sun_b = (dcm_bn * sun_n).into();
+        out.moon_n = unit(&env.r_moon_b_n_m).into();
+        out.shadow_factor = env.shadow_factor;
+        out.density_kg_m3 = env.density_kg_m3;
+        let w = self.sc.environment_wrenches(&env);
+        let wire = |w: &Wrench| AppliedWrench {
+            torque_b_nm: w.torque_b_nm.into(),
+            force_b_newton: w.force_b_newton.into(),
+        };
+        out.gravity_gradient = wire(&w[EnvironmentSource::GravityGradient as usize]);
+        out.drag = wire(&w[EnvironmentSource::Drag as usize]);
+        out.solar_pressure = wire(&w[EnvironmentSource::SolarPressure as usize]);
+        out.residual_dipole = wire(&w[EnvironmentSource::ResidualDipole as usize]);
     }
 
     /// The `[epoch]` (the instant of t = 0), if configured.

@@ -22,9 +22,9 @@
 use bincode::config::{Configuration, Fixint, Limit, LittleEndian};
 
 use crate::{
-    CommandMsg, CssMsg, DecodeError, FssMsg, Header, ImuMsg, MagnetometerMsg, OperatorMsg,
-    StarTrackerMsg, StateMsg, StatusMsg, TimeMsg, WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES,
-    PROTOCOL_VERSION,
+    CommandMsg, CssMsg, DecodeError, EnvironmentMsg, FssMsg, Header, ImuMsg, MagnetometerMsg,
+    OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg, WireMessage, HEADER_LEN,
+    MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
 };
 
 /// The bincode configuration of the wire format.
@@ -108,6 +108,11 @@ pub fn decode_imu(bytes: &[u8]) -> Result<ImuMsg, DecodeError> {
 
 /// [`decode`] for [`StarTrackerMsg`].
 pub fn decode_star_tracker(bytes: &[u8]) -> Result<StarTrackerMsg, DecodeError> {
+    decode(bytes)
+}
+
+/// [`decode`] for [`EnvironmentMsg`].
+pub fn decode_environment(bytes: &[u8]) -> Result<EnvironmentMsg, DecodeError> {
     decode(bytes)
 }
 

@@ -12,6 +12,8 @@ pub const STATE_SUFFIX: &str = "tlm/state";
 /// Suffix of the time-service topic ([`crate::TimeMsg`], one per frame, before the frame's
 /// sensor samples and state). Protocol version 5.
 pub const TIME_SUFFIX: &str = "tlm/time";
+/// Suffix of the environment topic ([`crate::EnvironmentMsg`], at the configured rate).
+pub const ENVIRONMENT_SUFFIX: &str = "tlm/env";
 /// Prefix of the IMU topics; the IMU name follows after a `/`.
 pub const IMU_PREFIX: &str = "tlm/imu";
 /// Prefix of the star-tracker topics; the tracker name follows after a `/`.
@@ -185,6 +187,8 @@ pub enum Telemetry<'a> {
     State,
     /// `flexdyn/<sc>/tlm/time`: a [`crate::TimeMsg`].
     Time,
+    /// `flexdyn/<sc>/tlm/env`: an [`crate::EnvironmentMsg`].
+    Environment,
     /// `flexdyn/<sc>/tlm/imu/<name>`: an [`crate::ImuMsg`] of the IMU `name`.
     Imu(&'a str),
     /// `flexdyn/<sc>/tlm/st/<name>`: a [`crate::StarTrackerMsg`] of the tracker `name`.
@@ -252,6 +256,11 @@ impl Topics {
         format!("{KEY_ROOT}/{}/{TIME_SUFFIX}", self.sc_id)
     }
 
+    /// `flexdyn/<sc>/tlm/env`
+    pub fn environment(&self) -> String {
+        format!("{KEY_ROOT}/{}/{ENVIRONMENT_SUFFIX}", self.sc_id)
+    }
+
     /// `flexdyn/<sc>/tlm/imu/<name>`
     pub fn imu(&self, name: &str) -> Result<String, KeyError> {
         imu_key(&self.sc_id, name)
@@ -293,6 +302,9 @@ impl Topics {
         }
         if rest == TIME_SUFFIX {
             return Some(Telemetry::Time);
+        }
+        if rest == ENVIRONMENT_SUFFIX {
+            return Some(Telemetry::Environment);
         }
         let named = |prefix: &str| {
             rest.strip_prefix(prefix)?
@@ -382,6 +394,8 @@ mod tests {
         assert_eq!(t.time(), "flexdyn/sc-1/tlm/time");
         assert_eq!(t.telemetry(&t.time()), Some(Telemetry::Time));
         assert_eq!(t.telemetry("flexdyn/sc-1/tlm/time/x"), None);
+        assert_eq!(t.environment(), "flexdyn/sc-1/tlm/env");
+        assert_eq!(t.telemetry(&t.environment()), Some(Telemetry::Environment));
         assert_eq!(
             t.telemetry(&t.imu("hub").unwrap()),
             Some(Telemetry::Imu("hub"))

@@ -5,8 +5,8 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use crate::{
-    CommandKind, CommandMsg, CssMsg, DecodeError, FssMsg, Header, ImuMsg, MagnetometerMsg,
-    OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
+    CommandKind, CommandMsg, CssMsg, DecodeError, EnvironmentMsg, FssMsg, Header, ImuMsg,
+    MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
 };
 
 /// Encoded [`Header`] size (bytes).
@@ -30,6 +30,8 @@ pub const MAGNETOMETER_LEN: usize = 55;
 pub const CSS_LEN: usize = 159;
 /// Encoded [`FssMsg`] size (bytes).
 pub const FSS_LEN: usize = 47;
+/// Encoded [`EnvironmentMsg`] size (bytes).
+pub const ENVIRONMENT_LEN: usize = 368;
 /// Encoded [`TimeMsg`] size (bytes).
 pub const TIME_LEN: usize = 122;
 /// Offset of the 8 CCSDS CUC octets in a [`TimeMsg`].
@@ -86,6 +88,7 @@ mod sealed {
     impl Sealed for super::MagnetometerMsg {}
     impl Sealed for super::CssMsg {}
     impl Sealed for super::FssMsg {}
+    impl Sealed for super::EnvironmentMsg {}
     impl Sealed for super::TimeMsg {}
     impl Sealed for super::OperatorMsg {}
 }
@@ -180,6 +183,17 @@ impl WireMessage for FssMsg {
     const NAME: &'static str = "FssMsg";
     const LAYOUT: WireLayout = WireLayout::Fixed { len: FSS_LEN };
     const MIN_LEN: usize = FSS_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+impl WireMessage for EnvironmentMsg {
+    const NAME: &'static str = "EnvironmentMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed {
+        len: ENVIRONMENT_LEN,
+    };
+    const MIN_LEN: usize = ENVIRONMENT_LEN;
     fn header(&self) -> &Header {
         &self.header
     }

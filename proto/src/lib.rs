@@ -18,6 +18,7 @@
 //! | key | message | direction |
 //! |---|---|---|
 //! | `flexdyn/<sc-id>/tlm/time` | [`TimeMsg`] | server → flight code, every frame, first |
+//! | `flexdyn/<sc-id>/tlm/env` | [`EnvironmentMsg`] | server → anyone, at `[environment] telemetry_rate_hz` |
 //! | `flexdyn/<sc-id>/tlm/state` | [`StateMsg`] | server → flight code, every frame |
 //! | `flexdyn/<sc-id>/tlm/imu/<name>` | [`ImuMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/tlm/st/<name>` | [`StarTrackerMsg`] | server → flight code |
@@ -54,6 +55,7 @@
 //! | [`CssMsg`] | [`CSS_LEN`] = 159 |
 //! | [`FssMsg`] | [`FSS_LEN`] = 47 |
 //! | [`TimeMsg`] | [`TIME_LEN`] = 122 |
+//! | [`EnvironmentMsg`] | [`ENVIRONMENT_LEN`] = 368 |
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
 //! | [`StatusMsg`] | [`STATUS_LEN`] = 187 |
 //! | [`OperatorMsg`] | [`OPERATOR_LEN`] = 42 |
@@ -96,33 +98,35 @@ mod layout;
 mod messages;
 
 pub use codec::{
-    decode, decode_command, decode_css, decode_fss, decode_header, decode_imu, decode_magnetometer,
-    decode_operator, decode_star_tracker, decode_state, decode_status, decode_time, encode,
-    encode_into,
+    decode, decode_command, decode_css, decode_environment, decode_fss, decode_header, decode_imu,
+    decode_magnetometer, decode_operator, decode_star_tracker, decode_state, decode_status,
+    decode_time, encode, encode_into,
 };
 pub use error::{DecodeError, KeyError};
 pub use keys::{
     cmd_key, cmd_wildcard_key, imu_key, imu_wildcard_key, operator_key, participant_key,
     participant_wildcard_key, sensor_key, star_tracker_key, star_tracker_wildcard_key, state_key,
     status_key, validate_imu_name, validate_sc_id, validate_sensor_name,
-    validate_star_tracker_name, Telemetry, Topics, CMD_PREFIX, CSS_PREFIX, FSS_PREFIX, IMU_PREFIX,
-    KEY_ROOT, MAGNETOMETER_PREFIX, MAX_ID_LEN, OPERATOR_SUFFIX, PARTICIPANT_PREFIX,
-    STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
+    validate_star_tracker_name, Telemetry, Topics, CMD_PREFIX, CSS_PREFIX, ENVIRONMENT_SUFFIX,
+    FSS_PREFIX, IMU_PREFIX, KEY_ROOT, MAGNETOMETER_PREFIX, MAX_ID_LEN, OPERATOR_SUFFIX,
+    PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
 };
 pub use layout::{
     WireLayout, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
     COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CSS_LEN, EFFECTOR_INPUT_FIXED_LEN,
-    EFFECTOR_STATE_FIXED_LEN, FSS_LEN, HEADER_LEN, IMU_LEN, MAGNETOMETER_LEN, MAX_EFFECTORS,
-    MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES, MAX_PANEL_PAIRS, OPERATOR_LEN, STAR_TRACKER_LEN,
-    STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
+    EFFECTOR_STATE_FIXED_LEN, ENVIRONMENT_LEN, FSS_LEN, HEADER_LEN, IMU_LEN, MAGNETOMETER_LEN,
+    MAX_EFFECTORS, MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES, MAX_PANEL_PAIRS, OPERATOR_LEN,
+    STAR_TRACKER_LEN, STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET,
+    TIME_LEN,
 };
 pub use messages::{
-    command_flags, effector_kind, fss_flags, magnetometer_flags, magnetorquer_flags,
-    saturation_flags, star_tracker_flags, thruster_flags, time_flags, wheel_flags, AppliedWrench,
-    CommandKind, CommandMsg, CommandStatus, Conserved, CssMsg, EffectorInput, EffectorState,
-    FrameTiming, FssMsg, Header, ImuMsg, MagnetometerMsg, Mode, OperatorAction, OperatorMsg,
-    RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg,
-    UtcTime, CUC_PFIELD_TAI_4_3, MAX_CSS_DETECTORS, NO_COMMAND,
+    command_flags, eclipse, effector_kind, environment_flags, fss_flags, magnetometer_flags,
+    magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags, time_flags,
+    wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, CssMsg,
+    EffectorInput, EffectorState, EnvironmentMsg, FrameTiming, FssMsg, Header, ImuMsg,
+    MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters, RunState, StalePolicy,
+    StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime, CUC_PFIELD_TAI_4_3,
+    MAX_CSS_DETECTORS, NO_COMMAND,
 };
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
@@ -133,5 +137,6 @@ pub use messages::{
 /// `flexdyn/<sc-id>/tlm/time` with [`RunState::Paused`]. Version 6: the sun sensors of issue 20
 /// ([`CssMsg`] on `tlm/css/<name>`, [`FssMsg`] on `tlm/fss/<name>`), and operator control of
 /// issue 23 ([`OperatorMsg`] on `flexdyn/<sc-id>/operator`, [`RejectCounters::operator_refused`];
-/// StatusMsg grows to 187 bytes).
+/// StatusMsg grows to 187 bytes), and the environment message [`EnvironmentMsg`] on
+/// `flexdyn/<sc-id>/tlm/env` (issue 19).
 pub const PROTOCOL_VERSION: u16 = 6;

@@ -854,3 +854,86 @@ impl OperatorMsg {
         }
     }
 }
+
+/// Bits of [`EnvironmentMsg::flags`]: which parts of the environment are modelled (a field
+/// whose model is off carries its neutral value: zero field, zero direction, full sunlight,
+/// vacuum, zero wrench).
+pub mod environment_flags {
+    /// Bit 0: the configuration has an `[epoch]`: `tai_ns_1958` is set.
+    pub const EPOCH_VALID: u8 = 1 << 0;
+    /// Bit 1: a magnetic-field model is on (`b_n_t`, `b_b_t`).
+    pub const MAGNETIC: u8 = 1 << 1;
+    /// Bit 2: the Sun ephemeris is on (`sun_n`, `sun_b`).
+    pub const SUN: u8 = 1 << 2;
+    /// Bit 3: the Moon ephemeris is on (`moon_n`).
+    pub const MOON: u8 = 1 << 3;
+    /// Bit 4: a shadow model is on (`shadow_factor`, `eclipse`).
+    pub const SHADOW: u8 = 1 << 4;
+    /// Bit 5: an atmosphere model is on (`density_kg_m3`).
+    pub const ATMOSPHERE: u8 = 1 << 5;
+    /// Bits 6..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 = !(EPOCH_VALID | MAGNETIC | SUN | MOON | SHADOW | ATMOSPHERE);
+}
+
+/// Values of [`EnvironmentMsg::eclipse`], from the shadow factor ν.
+pub mod eclipse {
+    /// ν = 1: the whole solar disc is visible (also without a shadow model).
+    pub const SUNLIT: u8 = 0;
+    /// 0 < ν < 1: part of the disc is hidden.
+    pub const PENUMBRA: u8 = 1;
+    /// ν = 0: the disc is hidden.
+    pub const UMBRA: u8 = 2;
+
+    /// The eclipse state of a shadow factor ν ∈ [0, 1].
+    pub fn of_shadow_factor(nu: f64) -> u8 {
+        if nu >= 1.0 {
+            SUNLIT
+        } else if nu <= 0.0 {
+            UMBRA
+        } else {
+            PENUMBRA
+        }
+    }
+}
+
+/// The environment at the spacecraft, truth for operators, recordings and tests: topic
+/// `flexdyn/<sc-id>/tlm/env`, at `[environment] telemetry_rate_hz`. 368 bytes.
+///
+/// Every value refers to the instant of `header.tick` (the end of that frame): the held
+/// environment sample the dynamic effectors read at that instant, and each source's force and
+/// torque evaluated by that dynamic effector itself at the tick's state.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct EnvironmentMsg {
+    /// Common header; `tick` is the frame the values refer to.
+    pub header: Header,
+    /// \[ns\] TAI since 1958-01-01T00:00:00 TAI of `header.tick` (as [`TimeMsg::tai_ns_1958`]);
+    /// 0 without an epoch.
+    pub tai_ns_1958: u64,
+    /// See [`environment_flags`].
+    pub flags: u8,
+    /// See [`eclipse`].
+    pub eclipse: u8,
+    /// \[T\] the planet's magnetic field at the spacecraft, N components.
+    pub b_n_t: [f64; 3],
+    /// \[T\] the same field, B components.
+    pub b_b_t: [f64; 3],
+    /// Unit vector from the hub point B to the Sun, N components (zero without the Sun).
+    pub sun_n: [f64; 3],
+    /// The same direction, B components.
+    pub sun_b: [f64; 3],
+    /// Unit vector from B to the Moon, N components (zero without the Moon).
+    pub moon_n: [f64; 3],
+    /// \[-\] fraction of the solar disc visible (1 sunlit, 0 umbra).
+    pub shadow_factor: f64,
+    /// \[kg/m³\] atmospheric mass density at the spacecraft.
+    pub density_kg_m3: f64,
+    /// Gravity-gradient torque about B and force at B, B components.
+    pub gravity_gradient: AppliedWrench,
+    /// Aerodynamic drag on the facets.
+    pub drag: AppliedWrench,
+    /// Solar radiation pressure on the facets.
+    pub solar_pressure: AppliedWrench,
+    /// The residual dipole's torque in the field (its force is zero: a uniform field).
+    pub residual_dipole: AppliedWrench,
+}

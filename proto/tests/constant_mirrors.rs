@@ -123,3 +123,34 @@ fn c_and_python_mirror_every_kind_and_flag() {
         assert_eq!(py.get(py_name), Some(&rust), "Python {py_name}");
     }
 }
+
+/// The environment message's length, flag bits and eclipse values (protocol 6), in their own
+/// list so other messages' mirrors merge beside it.
+#[test]
+fn c_and_python_mirror_the_environment_message() {
+    use flexdyn_proto::{eclipse, environment_flags};
+    let mirrored = [
+        ("ENVIRONMENT_LEN", flexdyn_proto::ENVIRONMENT_LEN as u64),
+        (
+            "ENVIRONMENT_EPOCH_VALID",
+            environment_flags::EPOCH_VALID.into(),
+        ),
+        ("ENVIRONMENT_MAGNETIC", environment_flags::MAGNETIC.into()),
+        ("ENVIRONMENT_SUN", environment_flags::SUN.into()),
+        ("ENVIRONMENT_MOON", environment_flags::MOON.into()),
+        ("ENVIRONMENT_SHADOW", environment_flags::SHADOW.into()),
+        (
+            "ENVIRONMENT_ATMOSPHERE",
+            environment_flags::ATMOSPHERE.into(),
+        ),
+        ("ECLIPSE_SUNLIT", eclipse::SUNLIT.into()),
+        ("ECLIPSE_PENUMBRA", eclipse::PENUMBRA.into()),
+        ("ECLIPSE_UMBRA", eclipse::UMBRA.into()),
+    ];
+    let c = c_defines();
+    let py = python_constants();
+    for (name, rust) in mirrored {
+        assert_eq!(c.get(&format!("FD_{name}")), Some(&rust), "C FD_{name}");
+        assert_eq!(py.get(name), Some(&rust), "Python {name}");
+    }
+}

@@ -21,16 +21,16 @@
 //! message lists field, offset, expected and actual bytes to help review).
 
 use flexdyn_proto::{
-    command_flags, decode, decode_header, effector_kind, encode, fss_flags, magnetometer_flags,
-    magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags, time_flags,
-    wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, CssMsg,
-    DecodeError, EffectorInput, EffectorState, FrameTiming, FssMsg, Header, ImuMsg,
-    MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters, RunState, StalePolicy,
-    StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime, WireMessage,
-    COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CSS_LEN,
-    CUC_PFIELD_TAI_4_3, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, FSS_LEN, IMU_LEN,
-    MAGNETOMETER_LEN, MAX_CSS_DETECTORS, OPERATOR_LEN, STAR_TRACKER_LEN, STATE_FIXED_LEN,
-    STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
+    command_flags, decode, decode_header, eclipse, effector_kind, encode, environment_flags,
+    fss_flags, magnetometer_flags, magnetorquer_flags, saturation_flags, star_tracker_flags,
+    thruster_flags, time_flags, wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus,
+    Conserved, CssMsg, DecodeError, EffectorInput, EffectorState, EnvironmentMsg, FrameTiming,
+    FssMsg, Header, ImuMsg, MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters,
+    RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime,
+    WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CSS_LEN,
+    CUC_PFIELD_TAI_4_3, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, ENVIRONMENT_LEN,
+    FSS_LEN, IMU_LEN, MAGNETOMETER_LEN, MAX_CSS_DETECTORS, OPERATOR_LEN, STAR_TRACKER_LEN,
+    STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
 };
 
 type Golden = &'static [(usize, &'static str, &'static str)];
@@ -585,6 +585,238 @@ const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
     ),
     (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
 ];
+const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0600", "u16 header.protocol_version = 6"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "1100000000000000", "u64 header.tick = 17"),
+    (
+        14,
+        "80fe210a00000000",
+        "u64 header.sim_time_ns = 170000000 (0xA21FE80)",
+    ),
+    (22, "0200000000000000", "u64 header.seq = 2"),
+    (
+        30,
+        "0807060504030201",
+        "u64 tai_ns_1958 = 0x0102030405060708",
+    ),
+    (
+        38,
+        "37",
+        "u8 flags = EPOCH_VALID | MAGNETIC | SUN | SHADOW | ATMOSPHERE = 0x37",
+    ),
+    (39, "01", "u8 eclipse = PENUMBRA = 1"),
+    (
+        40,
+        "000000000000003f",
+        "f64 b_n_t[0] = 2^-15 (bits 0x3F00000000000000)",
+    ),
+    (
+        48,
+        "000000000000f0be",
+        "f64 b_n_t[1] = -2^-16 (bits 0xBEF0000000000000)",
+    ),
+    (
+        56,
+        "000000000000e03e",
+        "f64 b_n_t[2] = 2^-17 (bits 0x3EE0000000000000)",
+    ),
+    (
+        64,
+        "0000000000000080",
+        "f64 b_b_t[0] = -0.0 (bits 0x8000000000000000)",
+    ),
+    (
+        72,
+        "000000000000103f",
+        "f64 b_b_t[1] = 2^-14 (bits 0x3F10000000000000)",
+    ),
+    (
+        80,
+        "000000000000d0be",
+        "f64 b_b_t[2] = -2^-18 (bits 0xBED0000000000000)",
+    ),
+    (
+        88,
+        "000000000000e03f",
+        "f64 sun_n[0] = 0.5 (bits 0x3FE0000000000000)",
+    ),
+    (
+        96,
+        "000000000000e0bf",
+        "f64 sun_n[1] = -0.5 (bits 0xBFE0000000000000)",
+    ),
+    (
+        104,
+        "000000000000e83f",
+        "f64 sun_n[2] = 0.75 (bits 0x3FE8000000000000)",
+    ),
+    (
+        112,
+        "000000000000d03f",
+        "f64 sun_b[0] = 0.25 (bits 0x3FD0000000000000)",
+    ),
+    (
+        120,
+        "000000000000f03f",
+        "f64 sun_b[1] = 1.0 (bits 0x3FF0000000000000)",
+    ),
+    (
+        128,
+        "000000000000c0bf",
+        "f64 sun_b[2] = -0.125 (bits 0xBFC0000000000000)",
+    ),
+    (
+        136,
+        "000000000000f0bf",
+        "f64 moon_n[0] = -1.0 (bits 0xBFF0000000000000)",
+    ),
+    (
+        144,
+        "000000000000d83f",
+        "f64 moon_n[1] = 0.375 (bits 0x3FD8000000000000)",
+    ),
+    (
+        152,
+        "000000000000b03f",
+        "f64 moon_n[2] = 0.0625 (bits 0x3FB0000000000000)",
+    ),
+    (
+        160,
+        "000000000000e43f",
+        "f64 shadow_factor = 0.625 (bits 0x3FE4000000000000)",
+    ),
+    (
+        168,
+        "000000000000703d",
+        "f64 density_kg_m3 = 2^-40 (bits 0x3D70000000000000)",
+    ),
+    (
+        176,
+        "000000000000b03e",
+        "f64 gravity_gradient.torque_b_nm[0] = 2^-20 (bits 0x3EB0000000000000)",
+    ),
+    (
+        184,
+        "000000000000a0be",
+        "f64 gravity_gradient.torque_b_nm[1] = -2^-21 (bits 0xBEA0000000000000)",
+    ),
+    (
+        192,
+        "000000000000903e",
+        "f64 gravity_gradient.torque_b_nm[2] = 2^-22 (bits 0x3E90000000000000)",
+    ),
+    (
+        200,
+        "000000000000103e",
+        "f64 gravity_gradient.force_b_newton[0] = 2^-30 (bits 0x3E10000000000000)",
+    ),
+    (
+        208,
+        "0000000000000000",
+        "f64 gravity_gradient.force_b_newton[1] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        216,
+        "00000000000000be",
+        "f64 gravity_gradient.force_b_newton[2] = -2^-31 (bits 0xBE00000000000000)",
+    ),
+    (
+        224,
+        "000000000000f83f",
+        "f64 drag.torque_b_nm[0] = 1.5 (bits 0x3FF8000000000000)",
+    ),
+    (
+        232,
+        "00000000000004c0",
+        "f64 drag.torque_b_nm[1] = -2.5 (bits 0xC004000000000000)",
+    ),
+    (
+        240,
+        "0000000000000c40",
+        "f64 drag.torque_b_nm[2] = 3.5 (bits 0x400C000000000000)",
+    ),
+    (
+        248,
+        "0000000000001040",
+        "f64 drag.force_b_newton[0] = 4.0 (bits 0x4010000000000000)",
+    ),
+    (
+        256,
+        "00000000000020c0",
+        "f64 drag.force_b_newton[1] = -8.0 (bits 0xC020000000000000)",
+    ),
+    (
+        264,
+        "0000000000003040",
+        "f64 drag.force_b_newton[2] = 16.0 (bits 0x4030000000000000)",
+    ),
+    (
+        272,
+        "000000000000703e",
+        "f64 solar_pressure.torque_b_nm[0] = 2^-24 (bits 0x3E70000000000000)",
+    ),
+    (
+        280,
+        "000000000000603e",
+        "f64 solar_pressure.torque_b_nm[1] = 2^-25 (bits 0x3E60000000000000)",
+    ),
+    (
+        288,
+        "000000000000503e",
+        "f64 solar_pressure.torque_b_nm[2] = 2^-26 (bits 0x3E50000000000000)",
+    ),
+    (
+        296,
+        "00000000000070be",
+        "f64 solar_pressure.force_b_newton[0] = -2^-24 (bits 0xBE70000000000000)",
+    ),
+    (
+        304,
+        "00000000000060be",
+        "f64 solar_pressure.force_b_newton[1] = -2^-25 (bits 0xBE60000000000000)",
+    ),
+    (
+        312,
+        "00000000000050be",
+        "f64 solar_pressure.force_b_newton[2] = -2^-26 (bits 0xBE50000000000000)",
+    ),
+    (
+        320,
+        "000000000000c03f",
+        "f64 residual_dipole.torque_b_nm[0] = 0.125 (bits 0x3FC0000000000000)",
+    ),
+    (
+        328,
+        "000000000000d0bf",
+        "f64 residual_dipole.torque_b_nm[1] = -0.25 (bits 0xBFD0000000000000)",
+    ),
+    (
+        336,
+        "000000000000803f",
+        "f64 residual_dipole.torque_b_nm[2] = 2^-7 (bits 0x3F80000000000000)",
+    ),
+    (
+        344,
+        "0000000000000000",
+        "f64 residual_dipole.force_b_newton[0] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        352,
+        "0000000000000000",
+        "f64 residual_dipole.force_b_newton[1] = 0.0 (bits 0x0000000000000000)",
+    ),
+    (
+        360,
+        "0000000000000000",
+        "f64 residual_dipole.force_b_newton[2] = 0.0 (bits 0x0000000000000000)",
+    ),
+];
+
 // The sun sensors' tables (protocol 6, issue 20).
 const CSS_GOLDEN: &[(usize, &str, &str)] = &[
     (0, "0600", "u16 header.protocol_version = 6"),
@@ -1263,13 +1495,55 @@ fn flag_bits() {
     assert_eq!(thruster_flags::COMMAND_CLIPPED, 0b100);
 }
 
+#[test]
+fn environment_golden() {
+    let msg = EnvironmentMsg {
+        header: Header::new(SC, 17, 170_000_000, 2),
+        tai_ns_1958: 0x0102_0304_0506_0708,
+        flags: environment_flags::EPOCH_VALID
+            | environment_flags::MAGNETIC
+            | environment_flags::SUN
+            | environment_flags::SHADOW
+            | environment_flags::ATMOSPHERE,
+        eclipse: eclipse::PENUMBRA,
+        b_n_t: [2f64.powi(-15), -(2f64.powi(-16)), 2f64.powi(-17)],
+        b_b_t: [-0.0, 2f64.powi(-14), -(2f64.powi(-18))],
+        sun_n: [0.5, -0.5, 0.75],
+        sun_b: [0.25, 1.0, -0.125],
+        moon_n: [-1.0, 0.375, 0.0625],
+        shadow_factor: 0.625,
+        density_kg_m3: 2f64.powi(-40),
+        gravity_gradient: AppliedWrench {
+            torque_b_nm: [2f64.powi(-20), -(2f64.powi(-21)), 2f64.powi(-22)],
+            force_b_newton: [2f64.powi(-30), 0.0, -(2f64.powi(-31))],
+        },
+        drag: AppliedWrench {
+            torque_b_nm: [1.5, -2.5, 3.5],
+            force_b_newton: [4.0, -8.0, 16.0],
+        },
+        solar_pressure: AppliedWrench {
+            torque_b_nm: [2f64.powi(-24), 2f64.powi(-25), 2f64.powi(-26)],
+            force_b_newton: [-(2f64.powi(-24)), -(2f64.powi(-25)), -(2f64.powi(-26))],
+        },
+        residual_dipole: AppliedWrench {
+            torque_b_nm: [0.125, -0.25, 2f64.powi(-7)],
+            force_b_newton: [0.0; 3],
+        },
+    };
+    check("EnvironmentMsg", ENVIRONMENT_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), ENVIRONMENT_LEN);
+    assert_eq!(eclipse::of_shadow_factor(1.0), eclipse::SUNLIT);
+    assert_eq!(eclipse::of_shadow_factor(0.5), eclipse::PENUMBRA);
+    assert_eq!(eclipse::of_shadow_factor(0.0), eclipse::UMBRA);
+}
+
 /// The golden vectors exported for the C and Python codecs (`proto/golden/*.bin`, listed in
 /// `proto/golden/MANIFEST.tsv`) are byte for byte the tables above, and the manifest names
 /// every table once with its message type and length.
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 12] = [
+    let tables: [(&str, &str, Golden, &str); 13] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -1306,6 +1580,12 @@ fn exported_golden_files_match_the_tables() {
         ("time", "TimeMsg", TIME_GOLDEN, "TIME_GOLDEN"),
         // Protocol 6, the sun sensors.
         ("css", "CssMsg", CSS_GOLDEN, "CSS_GOLDEN"),
+        (
+            "environment",
+            "EnvironmentMsg",
+            ENVIRONMENT_GOLDEN,
+            "ENVIRONMENT_GOLDEN",
+        ),
         ("fss", "FssMsg", FSS_GOLDEN, "FSS_GOLDEN"),
         (
             "operator",

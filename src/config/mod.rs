@@ -727,7 +727,13 @@ impl RawConfig {
             if let Err(e) = flexdyn_proto::validate_star_tracker_name(&raw.name) {
                 return Err(map.invalid(&format!("{path}.name"), e.to_string()));
             }
-            let every_frames = every_frames(map, &path, raw.rate_hz, sim.frame_hz, "tracker")?;
+            let every_frames = every_frames(
+                map,
+                &format!("{path}.rate_hz"),
+                raw.rate_hz,
+                sim.frame_hz,
+                "tracker",
+            )?;
             let cfg = StarTrackerConfig {
                 name: raw.name,
                 dcm_cb: raw.dcm_cb,
@@ -760,7 +766,13 @@ impl RawConfig {
             if let Err(e) = flexdyn_proto::validate_sensor_name(&raw.name) {
                 return Err(map.invalid(&format!("{path}.name"), e.to_string()));
             }
-            let every_frames = every_frames(map, &path, raw.rate_hz, sim.frame_hz, "magnetometer")?;
+            let every_frames = every_frames(
+                map,
+                &format!("{path}.rate_hz"),
+                raw.rate_hz,
+                sim.frame_hz,
+                "magnetometer",
+            )?;
             if let Some(k) = (0..3).find(|&k| raw.misalignment_rad[(k, k)] != 0.0) {
                 return Err(map.invalid(
                     &format!("{path}.misalignment_rad"),
@@ -834,6 +846,20 @@ impl RawConfig {
             fine_sun_sensors.push(cfg);
         }
 
+        // [environment] telemetry_rate_hz: a whole number of frames.
+        let mut environment = world.environment;
+        if let Some(env) = environment.as_mut() {
+            if let Some(hz) = env.telemetry_rate_hz {
+                env.telemetry_every_frames = Some(every_frames(
+                    map,
+                    "environment.telemetry_rate_hz",
+                    hz,
+                    sim.frame_hz,
+                    "environment message",
+                )?);
+            }
+        }
+
         let mut cfg = SimConfig {
             step_ns,
             integrator,
@@ -855,7 +881,7 @@ impl RawConfig {
             coarse_sun_sensors,
             fine_sun_sensors,
             epoch: world.epoch,
-            environment: world.environment,
+            environment,
             source_toml: source.to_string(),
         };
         check_body_extent(&cfg, map)?;
@@ -871,16 +897,16 @@ impl RawConfig {
     }
 }
 
-/// `frame_hz / rate_hz` as a whole number of frames ≥ 1 (`<path>.rate_hz`): a sensor that
-/// updates at `rate_hz` does so every that many frames (`what` updates …).
+/// `frame_hz / rate_hz` as a whole number of frames ≥ 1 (`rate_hz` read from `field`): a
+/// sensor that updates at `rate_hz` does so every that many frames (`what` updates …).
 fn every_frames(
     map: &SourceMap,
-    path: &str,
+    field: &str,
     rate_hz: f64,
     frame_hz: f64,
     what: &str,
 ) -> Result<u64, ConfigError> {
-    let field = format!("{path}.rate_hz");
+    let field = field.to_string();
     if !rate_hz.is_finite() || rate_hz <= 0.0 {
         return Err(map.param_error(ParamError::NotPositive {
             field,

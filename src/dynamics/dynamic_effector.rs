@@ -81,6 +81,45 @@ impl StageState {
     }
 }
 
+/// The environment's sources of force and torque, as the environment message reports them
+/// (`EnvironmentMsg`, `simulate`'s environment columns): one slot each, in this order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EnvironmentSource {
+    /// Gravity-gradient torque (and the gradient's small net force).
+    GravityGradient = 0,
+    /// Aerodynamic drag on the facets.
+    Drag = 1,
+    /// Solar radiation pressure on the facets.
+    SolarPressure = 2,
+    /// A residual magnetic dipole in the planet's field.
+    ResidualDipole = 3,
+}
+
+impl EnvironmentSource {
+    /// Number of sources (slots of an [`EnvironmentWrenches`]).
+    pub const COUNT: usize = 4;
+    /// Every source, in slot order.
+    pub const ALL: [EnvironmentSource; Self::COUNT] = [
+        Self::GravityGradient,
+        Self::Drag,
+        Self::SolarPressure,
+        Self::ResidualDipole,
+    ];
+
+    /// Its name in CSV columns, plots and messages (`gravity_gradient`, `drag`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::GravityGradient => "gravity_gradient",
+            Self::Drag => "drag",
+            Self::SolarPressure => "solar_pressure",
+            Self::ResidualDipole => "residual_dipole",
+        }
+    }
+}
+
+/// Per [`EnvironmentSource`] slot, its force (at B) and torque (about B), B components.
+pub type EnvironmentWrenches = [Wrench; EnvironmentSource::COUNT];
+
 /// An external force and torque on the vehicle, evaluated at every RK4 stage.
 pub trait DynamicEffector: Send + std::fmt::Debug {
     /// Name from the configuration (or the model's own), for logs, messages and telemetry.
@@ -113,6 +152,11 @@ pub trait DynamicEffector: Send + std::fmt::Debug {
     /// takes its inputs from `CommandKind::Actuators` by that index. `None` (the default) for a
     /// force nobody commands (gravity gradient, drag, solar pressure, a residual dipole).
     fn listed_kind(&self) -> Option<EffectorKind> {
+        None
+    }
+    /// Which environment source this effector is, for the environment message's per-source
+    /// force and torque (`None`, the default: not an environment source, e.g. an actuator).
+    fn environment_source(&self) -> Option<EnvironmentSource> {
         None
     }
     /// Names of the inputs flight code may command (with units); empty if none.

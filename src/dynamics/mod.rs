@@ -44,7 +44,7 @@ pub mod params;
 pub mod spacecraft;
 pub mod stage_hook;
 
-pub use dynamic_effector::{DynamicEffector, StageState};
+pub use dynamic_effector::{DynamicEffector, EnvironmentSource, EnvironmentWrenches, StageState};
 pub use effector::{
     BackSubContributions, EffectorKind, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics,
     StateEffector,

@@ -10,7 +10,9 @@ use std::ops::Range;
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::dynamic_effector::{DynamicEffector, StageState};
+use super::dynamic_effector::{
+    DynamicEffector, EnvironmentSource, EnvironmentWrenches, StageState,
+};
 use super::effector::{
     BackSubContributions, EffectorKind, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics,
     StateEffector,
@@ -378,6 +380,33 @@ pub struct Spacecraft {
     ws: StageWorkspace,
 }
 
+/// The vehicle at state `x` as the dynamic effectors see it, from the stage's summed mass
+/// properties `mp` (centre of mass `c_b` = c, r_C/N = `r_cn_n`).
+#[inline(always)]
+fn stage_state(
+    x: &State,
+    t_step_ns: u64,
+    dt_stage_s: f64,
+    dcm_nb: &Matrix3<f64>,
+    mp: &EffectorMassProps,
+    c_b: &Vector3<f64>,
+    r_cn_n: &Vector3<f64>,
+) -> StageState {
+    StageState {
+        t_step_ns,
+        dt_stage_s,
+        r_bn_n_m: x.r_bn_n,
+        v_bn_n_m_s: x.v_bn_n,
+        sigma_bn: x.sigma_bn,
+        dcm_bn: dcm_nb.transpose(),
+        omega_bn_b_rad_s: x.omega_bn_b,
+        mass_kg: mp.mass_kg,
+        r_cb_b_m: *c_b,
+        r_cn_n_m: *r_cn_n,
+        inertia_pnt_b_b_kg_m2: mp.inertia_pnt_b_b_kg_m2,
+    }
+}
+
 impl EquationsOfMotion {
     /// Runs [`StateEffector::begin_step`] at state `x`, and [`DynamicEffector::begin_step`] at
     /// the step's start time `t_step_ns`, on the effectors that use them.
@@ -427,19 +456,7 @@ impl EquationsOfMotion {
             torque_b_nm: self.torque_b_nm,
         };
         if !self.dynamic.is_empty() {
-            let stage = StageState {
-                t_step_ns,
-                dt_stage_s,
-                r_bn_n_m: x.r_bn_n,
-                v_bn_n_m_s: x.v_bn_n,
-                sigma_bn: x.sigma_bn,
-                dcm_bn: dcm_nb.transpose(),
-                omega_bn_b_rad_s: omega,
-                mass_kg: m_sc,
-                r_cb_b_m: c_b,
-                r_cn_n_m: r_cn_n,
-                inertia_pnt_b_b_kg_m2: mp.inertia_pnt_b_b_kg_m2,
-            };
+            let stage = stage_state(x, t_step_ns, dt_stage_s, &dcm_nb, &mp, &c_b, &r_cn_n);
             for e in &mut self.dynamic {
                 e.add_force_torque(&stage, &self.env, &mut ext);
             }
@@ -828,6 +845,40 @@ impl Spacecraft {
     /// The environment the dynamic effectors currently read.
     pub fn environment(&self) -> &EnvironmentSample {
         &self.eom.env
+    }
+
+    /// Each environment source's force (at B) and torque (about B), B components, evaluated by
+    /// its own dynamic effector ([`DynamicEffector::environment_source`]) at the current state
+    /// and time in `env`: what that effector adds at the first stage of a step starting now.
+    /// Two effectors of one source add into its slot; a source with no effector stays zero.
+    /// For telemetry, outside the stepping path (one mass-properties pass and one evaluation
+    /// per source); allocates nothing.
+    pub fn environment_wrenches(&mut self, env: &EnvironmentSample) -> EnvironmentWrenches {
+        let mut out = [Wrench::ZERO; EnvironmentSource::COUNT];
+        let eom = &mut self.eom;
+        if !eom.dynamic.iter().any(|e| e.environment_source().is_some()) {
+            return out;
+        }
+        let x = &self.state;
+        let mut mp = EffectorMassProps {
+            mass_kg: eom.hub.mass_kg,
+            first_moment_b_kg_m: eom.hub_first_moment_b,
+            inertia_pnt_b_b_kg_m2: eom.hub_inertia_pnt_b_b,
+            ..EffectorMassProps::default()
+        };
+        for (e, r) in eom.effectors.iter_mut().zip(&eom.ranges) {
+            e.update_mass_props(&x.effectors[r.clone()], &mut mp);
+        }
+        let c_b = mp.first_moment_b_kg_m / mp.mass_kg;
+        let dcm_nb = mrp_to_dcm(&x.sigma_bn).transpose();
+        let r_cn_n = x.r_bn_n + dcm_nb * c_b;
+        let stage = stage_state(x, self.t_sim_ns, 0.0, &dcm_nb, &mp, &c_b, &r_cn_n);
+        for e in &mut eom.dynamic {
+            if let Some(source) = e.environment_source() {
+                e.add_force_torque(&stage, env, &mut out[source as usize]);
+            }
+        }
+        out
     }
 
     /// The hub parameters.

@@ -21,10 +21,7 @@ use crate::environment::epoch::SimEpoch;
 
 const NS_PER_S: u64 = 1_000_000_000;
 
-/// \[ns\] 1958-01-01T00:00:00 TAI as a TAI count since 1900-01-01T00:00:00 TAI (hifitime's and
-/// [`SimEpoch::tai_ns`]'s reference): 58 years of which 14 leap years (1904 … 1956), so
-/// 58·365 + 14 = 21,184 days = 1,830,297,600 s. Checked against hifitime in the tests.
-pub const TAI_1958_COUNT_NS: i64 = 1_830_297_600 * 1_000_000_000;
+pub use crate::environment::epoch::TAI_1958_COUNT_NS;
 
 /// The per-run constants of the time message.
 #[derive(Clone, Debug)]
@@ -101,7 +98,7 @@ impl TimeService {
         // The tone scale's reading at this tick, in ns.
         let tone_scale_ns = match &self.epoch {
             Some(e) => {
-                let tai = u64::try_from(e.tai_ns(t_ns) - TAI_1958_COUNT_NS).unwrap_or(0);
+                let tai = e.tai_ns_1958(t_ns);
                 let times = e.times(t_ns);
                 let c = e.utc_calendar(t_ns);
                 m.flags |= time_flags::EPOCH_VALID;

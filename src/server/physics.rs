@@ -150,6 +150,15 @@ impl Stepper {
         fill_state(&mut frame.state, &self.state, header, &self.held);
         frame.time = self.clock.message(k, RunState::Running);
         frame.command = self.held.status;
+        frame.environment = None;
+        if let Some(every) = self.sim.environment_every_frames() {
+            if k.is_multiple_of(every) {
+                let mut env = flexdyn_proto::EnvironmentMsg::default();
+                self.sim.environment_into(&mut env);
+                env.header = Header::new(self.spacecraft_id, k, env.header.sim_time_ns, k / every);
+                frame.environment = Some(env);
+            }
+        }
         frame.lateness_ns = 0;
         frame.published = false;
         frame.sensors_sampled.clear();

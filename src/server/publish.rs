@@ -1,6 +1,6 @@
 //! Publishing one frame's telemetry: its TimeMsg, then the messages of the sensors sampled at
 //! its tick (in publication order: [`crate::sensors::KINDS`], then config order), then its
-//! StateMsg, in that order (a controller that waits for the state finds the sensor
+//! StateMsg, then (when due) its EnvironmentMsg, in that order (a controller that waits for the state finds the sensor
 //! samples of the same tick already delivered).
 //!
 //! Which thread calls [`FramePublisher::publish`] is the `server.handoff` setting:
@@ -44,6 +44,8 @@ pub struct Recording {
     tx: RecordTx,
     time: Arc<str>,
     state: Arc<str>,
+    /// `flexdyn/<sc>/tlm/env`, when the environment message is on.
+    environment: Option<Arc<str>>,
     /// `flexdyn/<sc>/status`.
     pub status: Arc<str>,
     /// Per sensor of the bank, its key.
@@ -65,6 +67,10 @@ impl Recording {
         });
         encode_into(&frame.state, buf);
         self.submit(&self.state, buf, stamp);
+        if let (Some(env), Some(key)) = (&frame.environment, &self.environment) {
+            encode_into(env, buf);
+            self.submit(key, buf, stamp);
+        }
     }
 
     /// Queues `payload` under `key` (see [`RecordTx::submit`] for lossless versus lossy).
@@ -96,6 +102,9 @@ pub struct FramePublisher {
     /// Per sensor of the bank: its kind and its publisher (`flexdyn/<sc>/tlm/<kind>/<name>`).
     pub sensor_pubs: Vec<(&'static SensorKind, Publisher<'static>)>,
     state_buf: Vec<u8>,
+    /// `flexdyn/<sc>/tlm/env` (`[environment] telemetry_rate_hz` set), with its buffer.
+    pub environment_pub: Option<Publisher<'static>>,
+    environment_buf: Vec<u8>,
 }
 
 impl FramePublisher {
@@ -111,6 +120,8 @@ impl FramePublisher {
             state_pub,
             sensor_pubs,
             state_buf: Vec::with_capacity(4096),
+            environment_pub: None,
+            environment_buf: Vec::with_capacity(flexdyn_proto::ENVIRONMENT_LEN),
         }
     }
 
@@ -121,6 +132,7 @@ impl FramePublisher {
             tx,
             time: key(&self.time_pub),
             state: key(&self.state_pub),
+            environment: self.environment_pub.as_ref().map(key),
             status: key(status),
             sensors: self.sensor_pubs.iter().map(|(_, p)| key(p)).collect(),
         }
@@ -179,6 +191,19 @@ impl FramePublisher {
         // Queued for the recorder after the state is out: the subscriber first.
         if let Some(r) = rec {
             r.submit(&r.state, &self.state_buf, Some(frame.boundary_unix_ns));
+        }
+        if let (Some(env), Some(publisher)) = (&frame.environment, &self.environment_pub) {
+            encode_into(env, &mut self.environment_buf);
+            if let Err(e) = publisher
+                .put(self.environment_buf.as_slice())
+                .attachment(stamp)
+                .wait()
+            {
+                Self::count_error(shared, &"environment", &e);
+            }
+            if let Some((r, key)) = rec.and_then(|r| Some((r, r.environment.as_ref()?))) {
+                r.submit(key, &self.environment_buf, Some(frame.boundary_unix_ns));
+            }
         }
     }
 }

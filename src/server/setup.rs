@@ -95,7 +95,12 @@ impl Endpoints {
         }
         let time_pub = telemetry_pub(topics.time(), "declare the time publisher").await?;
         let state_pub = Arc::new(state_pub);
-        let frames = FramePublisher::new(time_pub, state_pub.clone(), sensor_pubs);
+        let mut frames = FramePublisher::new(time_pub, state_pub.clone(), sensor_pubs);
+        if sim.environment_every_frames().is_some() {
+            frames.environment_pub = Some(
+                telemetry_pub(topics.environment(), "declare the environment publisher").await?,
+            );
+        }
 
         let vehicle = VehicleInfo {
             sc_id: settings.sc_id.clone(),

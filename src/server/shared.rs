@@ -33,6 +33,9 @@ pub struct Frame {
     pub sensors_sampled: Vec<usize>,
     /// Per sensor of the bank, its encoded message when it is in `sensors_sampled`.
     pub sensor_payloads: Vec<Vec<u8>>,
+    /// The environment message of this tick, when due (`[environment] telemetry_rate_hz`),
+    /// published after the state.
+    pub environment: Option<flexdyn_proto::EnvironmentMsg>,
     /// Already published by the thread that finished the frame (`handoff = "direct"`): the
     /// telemetry thread only records it and keeps the books.
     pub published: bool,
@@ -54,6 +57,7 @@ impl Frame {
             sensor_payloads: (0..n_sensors)
                 .map(|_| Vec::with_capacity(SENSOR_PAYLOAD_CAPACITY))
                 .collect(),
+            environment: None,
             published: false,
         }
     }

@@ -27,7 +27,11 @@ impl SeqGaps {
     /// Whether messages of `kind` carry a publisher's consecutive sequence number.
     pub fn counts(kind: TopicKind) -> bool {
         match kind {
-            TopicKind::State | TopicKind::Sensor(_) | TopicKind::Status | TopicKind::Time => true,
+            TopicKind::State
+            | TopicKind::Sensor(_)
+            | TopicKind::Status
+            | TopicKind::Time
+            | TopicKind::Environment => true,
             TopicKind::Command | TopicKind::Operator => false,
         }
     }

@@ -14,6 +14,9 @@
 //! - `wheels.png`: each reaction wheel's speed, applied motor torque and limit flags;
 //! - `actuators.png`: each magnetorquer's applied dipole, and each thruster's thrust (its
 //!   firings), pulse count and propellant used;
+//! - `disturbance_torques.png`: the environment message's torque and force of each source
+//!   (gravity gradient, drag, solar pressure, residual dipole), magnitudes on a log axis, and
+//!   the shadow factor;
 //! - `star_tracker.png`: each star tracker's measured q_CN and its valid / status flags;
 //! - `imu.png`: each IMU's measured rate and specific force, one column per IMU;
 //! - `timing.png`: frame lateness p50/p99/max from StatusMsg and the overrun count (real time
@@ -33,7 +36,7 @@ use plotters::prelude::*;
 
 use super::error::SinkError;
 use super::reader::read_recording;
-use super::table::{prefixed_columns, row, Cell, Column};
+use super::table::{prefixed_columns, row, Cell, Column, ENVIRONMENT_COLUMN_PREFIX};
 use super::topics::{classify, Decoded, TopicKind};
 use crate::attitude::mrp_error;
 use crate::sensors::KINDS;
@@ -132,6 +135,8 @@ struct PlotData {
     status: Columns,
     /// Per (index in [`KINDS`], sensor name), the sensor's columns.
     sensors: BTreeMap<(usize, String), Columns>,
+    /// The environment record's columns (EnvironmentMsg fields, no prefix).
+    environment: Columns,
     /// The pacing mode of the recorded run (from its StatusMsg; none in a CSV).
     mode: Option<flexdyn_proto::Mode>,
 }
@@ -181,6 +186,7 @@ fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
                 .entry((kind, topic.sensor.unwrap_or_default().to_owned()))
                 .or_default()
                 .push(&cells),
+            TopicKind::Environment => data.environment.push(&cells),
             TopicKind::Command | TopicKind::Time | TopicKind::Operator => {}
         }
     }
@@ -254,6 +260,8 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             ));
         }
         let mut state = Vec::with_capacity(fields.len());
+        // `simulate`'s environment columns (`env_*`), with the prefix dropped.
+        let mut environment = vec![("t_s".to_owned(), Cell::Num(f64::NAN))];
         // Per sensor: its cells, and whether this row has any (a star tracker's are empty
         // between its updates).
         let mut sensors: BTreeMap<(usize, &str), (Vec<Column>, bool)> = BTreeMap::new();
@@ -269,6 +277,14 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             };
             if *name == "t_s" {
                 t_s = x;
+                environment[0].1 = Cell::Num(x);
+            }
+            let env_field = name
+                .strip_prefix(ENVIRONMENT_COLUMN_PREFIX)
+                .and_then(|f| f.strip_prefix('_'));
+            if let Some(field) = env_field {
+                environment.push((field.to_owned(), Cell::Num(x)));
+                continue;
             }
             match place {
                 Some((kind, sensor, field)) => {
@@ -283,6 +299,9 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
             }
         }
         data.state.push(&state);
+        if environment.len() > 1 {
+            data.environment.push(&environment);
+        }
         for ((kind, name), (cells, any)) in sensors {
             if any {
                 data.sensors
@@ -897,6 +916,19 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
             actuators,
         );
     }
+    match disturbance_panels(&data.environment) {
+        Some(panels) => fig(
+            "disturbance_torques.png",
+            "Environment disturbances by source (EnvironmentMsg): |torque| about B, |force|, \
+             shadow factor"
+                .into(),
+            panels,
+        ),
+        None => skip(
+            "disturbance_torques.png",
+            "no environment record ([environment] telemetry_rate_hz unset)",
+        ),
+    }
     // One figure per sensor kind, its panels side by side per sensor (`SensorKind::plot`).
     for (i, kind) in KINDS.iter().enumerate() {
         let (file, title, specs) = kind.plot;
@@ -977,6 +1009,49 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
         )),
     }
     Ok((figures, skipped))
+}
+
+/// The disturbance figure's panels: per environment source, |τ_B| and |F_B| from its
+/// `<source>_torque_b_nm_1..3` / `<source>_force_b_newton_1..3` columns (log axes: the sources
+/// differ by orders of magnitude), and the shadow factor. `None` without the record.
+fn disturbance_panels(env: &Columns) -> Option<Vec<Panel>> {
+    if env.is_empty() {
+        return None;
+    }
+    let magnitude_panel = |what: &str, y_label: &str| {
+        let lines = crate::dynamics::EnvironmentSource::ALL
+            .iter()
+            .filter_map(|src| {
+                let v = env.vec3(&format!("{}_{what}", src.name()))?;
+                let norm: Vec<f64> = (0..env.t_s.len())
+                    .map(|i| (v[0][i].powi(2) + v[1][i].powi(2) + v[2][i].powi(2)).sqrt())
+                    .collect();
+                Some(line(src.name(), &env.t_s, &norm))
+            })
+            .collect();
+        Panel {
+            y_label: y_label.to_owned(),
+            log_y: true,
+            lines,
+            ..Panel::default()
+        }
+    };
+    let mut panels = vec![
+        magnitude_panel("torque_b_nm", "|torque about B| (N·m)"),
+        magnitude_panel("force_b_newton", "|force| (N)"),
+    ];
+    if let Some(nu) = env.get("shadow_factor") {
+        panels.push(Panel {
+            y_label: "shadow factor ν (1 sunlit, 0 umbra)".into(),
+            lines: vec![line("ν", &env.t_s, nu)],
+            ..Panel::default()
+        });
+    }
+    if panels[0].lines.is_empty() {
+        None
+    } else {
+        Some(panels)
+    }
 }
 
 /// A figure of two panels per sensor, one column per sensor, so each panel keeps the height

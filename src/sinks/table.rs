@@ -213,6 +213,10 @@ pub fn state_row(state: &StateMsg) -> Vec<Column> {
     out
 }
 
+/// Prefix of `simulate`'s environment columns (`env_b_n_t_1`, `env_drag_torque_b_nm_1`): the
+/// fields of the EnvironmentMsg without its header.
+pub const ENVIRONMENT_COLUMN_PREFIX: &str = "env";
+
 /// The fields of `msg` without its header, each column named `<prefix>_<field>`: what
 /// `simulate` writes beside the state for a sensor sample (`imu_hub_omega_p_rad_s_1`,
 /// `st_st1_valid`) or another record (`wrench_schedule_torque_b_nm_1`).

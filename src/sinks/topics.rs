@@ -5,11 +5,12 @@
 //! payload decodes with the one `flexdyn-proto` codec.
 
 use flexdyn_proto::keys::{
-    CMD_PREFIX, KEY_ROOT, OPERATOR_SUFFIX, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
+    CMD_PREFIX, ENVIRONMENT_SUFFIX, KEY_ROOT, OPERATOR_SUFFIX, STATE_SUFFIX, STATUS_SUFFIX,
+    TIME_SUFFIX,
 };
 use flexdyn_proto::{
-    decode_command, decode_operator, decode_state, decode_status, decode_time, CommandMsg,
-    DecodeError, Header, OperatorMsg, StateMsg, StatusMsg, TimeMsg,
+    decode_command, decode_environment, decode_operator, decode_state, decode_status, decode_time,
+    CommandMsg, DecodeError, EnvironmentMsg, Header, OperatorMsg, StateMsg, StatusMsg, TimeMsg,
 };
 
 use crate::sensors::{SensorKind, KINDS};
@@ -31,6 +32,8 @@ pub enum TopicKind {
     Time,
     /// `flexdyn/<sc>/operator`: [`OperatorMsg`] (pause, resume, run N ticks).
     Operator,
+    /// `flexdyn/<sc>/tlm/env`: [`EnvironmentMsg`] (the environment's truth).
+    Environment,
 }
 
 impl TopicKind {
@@ -43,6 +46,7 @@ impl TopicKind {
                 TopicKind::Status,
                 TopicKind::Time,
                 TopicKind::Operator,
+                TopicKind::Environment,
             ])
     }
 
@@ -68,6 +72,7 @@ impl TopicKind {
             TopicKind::Status => "StatusMsg",
             TopicKind::Time => "TimeMsg",
             TopicKind::Operator => "OperatorMsg",
+            TopicKind::Environment => "EnvironmentMsg",
         }
     }
 }
@@ -101,6 +106,8 @@ pub fn classify(key: &str) -> Option<Topic<'_>> {
         (TopicKind::State, None)
     } else if suffix == TIME_SUFFIX {
         (TopicKind::Time, None)
+    } else if suffix == ENVIRONMENT_SUFFIX {
+        (TopicKind::Environment, None)
     } else if let Some(sender) =
         sensor(CMD_PREFIX).filter(|s| s.bytes().all(|b| b.is_ascii_digit()))
     {
@@ -148,6 +155,8 @@ pub enum Decoded {
     Time(TimeMsg),
     /// An operator command.
     Operator(OperatorMsg),
+    /// An environment message.
+    Environment(EnvironmentMsg),
 }
 
 impl Decoded {
@@ -170,6 +179,7 @@ impl Decoded {
             TopicKind::Status => Decoded::Status(decode_status(payload)?),
             TopicKind::Time => Decoded::Time(decode_time(payload)?),
             TopicKind::Operator => Decoded::Operator(decode_operator(payload)?),
+            TopicKind::Environment => Decoded::Environment(decode_environment(payload)?),
         })
     }
 
@@ -182,6 +192,7 @@ impl Decoded {
             Decoded::Status(m) => &m.header,
             Decoded::Time(m) => &m.header,
             Decoded::Operator(m) => &m.header,
+            Decoded::Environment(m) => &m.header,
         }
     }
 
@@ -195,6 +206,7 @@ impl Decoded {
             Decoded::Status(m) => serde_json::to_vec(m),
             Decoded::Time(m) => serde_json::to_vec(m),
             Decoded::Operator(m) => serde_json::to_vec(m),
+            Decoded::Environment(m) => serde_json::to_vec(m),
         };
         v.unwrap_or_else(|_| b"null".to_vec())
     }
@@ -208,6 +220,7 @@ impl Decoded {
             Decoded::Status(m) => serde_json::to_value(m),
             Decoded::Time(m) => serde_json::to_value(m),
             Decoded::Operator(m) => serde_json::to_value(m),
+            Decoded::Environment(m) => serde_json::to_value(m),
         };
         // The wire structs hold only numbers, bools, enums and vectors: always representable.
         v.unwrap_or(serde_json::Value::Null)
@@ -227,6 +240,7 @@ pub fn json_schema(kind: TopicKind) -> serde_json::Value {
         TopicKind::Status => schemars::schema_for!(StatusMsg),
         TopicKind::Time => schemars::schema_for!(TimeMsg),
         TopicKind::Operator => schemars::schema_for!(OperatorMsg),
+        TopicKind::Environment => schemars::schema_for!(EnvironmentMsg),
     };
     schema.to_value()
 }
@@ -287,6 +301,9 @@ mod tests {
         assert_eq!((t.kind, t.sensor), (TopicKind::Operator, None));
         assert_eq!(TopicKind::Operator.message_name(), "OperatorMsg");
         assert_eq!(classify("flexdyn/x/operator/1"), None);
+        let t = classify("flexdyn/x/tlm/env").unwrap();
+        assert_eq!((t.kind, t.sensor), (TopicKind::Environment, None));
+        assert_eq!(TopicKind::Environment.message_name(), "EnvironmentMsg");
         for other in [
             "flexdyn/x/participant/1",
             "flexdyn/x/tlm/imu/",

@@ -114,6 +114,28 @@ def check_state_pair(raw, js):
         fail("effectors differ at tick %d" % raw["tick"])
 
 
+ENV_SOURCES = ("gravity_gradient", "drag", "solar_pressure", "residual_dipole")
+
+
+def decode_environment_raw(data):
+    """An EnvironmentMsg (368 bytes, proto/README.md offsets), as the JSON channel names it."""
+    if len(data) != 368:
+        fail("EnvironmentMsg of %d bytes (expected 368)" % len(data))
+    version, sc, tick, t_ns, seq = struct.unpack_from("<HIQQQ", data, 0)
+    f = lambda off, n: list(struct.unpack_from("<%dd" % n, data, off))
+    out = {
+        "header": {"protocol_version": version, "spacecraft_id": sc, "tick": tick,
+                   "sim_time_ns": t_ns, "seq": seq},
+        "tai_ns_1958": struct.unpack_from("<Q", data, 30)[0],
+        "flags": data[38], "eclipse": data[39],
+        "b_n_t": f(40, 3), "b_b_t": f(64, 3), "sun_n": f(88, 3), "sun_b": f(112, 3),
+        "moon_n": f(136, 3), "shadow_factor": f(160, 1)[0], "density_kg_m3": f(168, 1)[0],
+    }
+    for i, src in enumerate(ENV_SOURCES):
+        out[src] = {"torque_b_nm": f(176 + 48 * i, 3), "force_b_newton": f(200 + 48 * i, 3)}
+    return out
+
+
 def check_clean(path):
     with open(path, "rb") as f:
         reader = make_reader(f)
@@ -145,12 +167,15 @@ def check_clean(path):
             fail("no vehicle metadata with the configuration TOML: %r" % list(meta))
 
         raw_states, json_states, tfs, scenes, counts = {}, {}, [], 0, {}
+        raw_envs, json_envs = {}, {}
         for schema, channel, message in reader.iter_messages():
             counts[channel.topic] = counts.get(channel.topic, 0) + 1
             if channel.message_encoding == "json":
                 obj = json.loads(message.data)
                 if schema.name == "flexdyn.StateMsg":
                     json_states[obj["header"]["tick"]] = obj
+                elif schema.name == "flexdyn.EnvironmentMsg":
+                    json_envs[obj["header"]["tick"]] = obj
                 elif schema.name == "foxglove.FrameTransforms":
                     tfs.append((message.log_time, obj))
                 elif schema.name == "foxglove.SceneUpdate":
@@ -162,10 +187,20 @@ def check_clean(path):
                 if message.log_time != st["sim_time_ns"]:
                     fail("log time %d is not the sim time %d" % (message.log_time, st["sim_time_ns"]))
                 raw_states[st["tick"]] = st
+            elif channel.message_encoding == "flexdyn-proto" and schema.name == "flexdyn.EnvironmentMsg":
+                env = decode_environment_raw(message.data)
+                if message.log_time != env["header"]["sim_time_ns"]:
+                    fail("environment log time %d is not its sim time" % message.log_time)
+                raw_envs[env["header"]["tick"]] = env
         if not raw_states or set(raw_states) != set(json_states):
             fail("raw ticks %d, decoded ticks %d" % (len(raw_states), len(json_states)))
         for tick, raw in raw_states.items():
             check_state_pair(raw, json_states[tick])
+        if set(raw_envs) != set(json_envs):
+            fail("raw environment ticks %d, decoded %d" % (len(raw_envs), len(json_envs)))
+        for tick, raw in raw_envs.items():
+            if raw != json_envs[tick]:
+                fail("EnvironmentMsg at tick %d: raw %r, json %r" % (tick, raw, json_envs[tick]))
         if len(tfs) != len(raw_states) or scenes < 1:
             fail("%d transforms and %d scenes for %d states" % (len(tfs), scenes, len(raw_states)))
         by_time = {s["sim_time_ns"]: s for s in raw_states.values()}
@@ -187,6 +222,7 @@ def check_clean(path):
             fail("FrameTransform rotation differs from [BN]^T by %.3e" % worst)
         print("OK clean: %d channels, %d states, %d transforms (max |R - [BN]^T| = %.2e), topics %s"
               % (len(summary.channels), len(raw_states), len(tfs), worst, sorted(counts.items())))
+        print("environment messages: %d raw = decoded" % len(raw_envs))
 
 
 def check_truncated(path):

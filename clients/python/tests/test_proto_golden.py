@@ -21,7 +21,7 @@ def bits(x):
 def test_manifest_lists_every_file(golden_dir):
     rows = [l.split("\t") for l in (golden_dir / "MANIFEST.tsv").read_text().splitlines()
             if l and not l.startswith("#")]
-    assert len(rows) == 12
+    assert len(rows) == 13
     for name, _message, length, _source in rows:
         assert (golden_dir / f"{name}.bin").stat().st_size == int(length)
 
@@ -174,3 +174,28 @@ def test_versions_and_keys():
             proto.command_key("sc1", bad)
     with pytest.raises(ValueError):
         proto.imu_key("sc1", "a/b")
+
+
+def test_environment(golden_dir):
+    # ENVIRONMENT_GOLDEN of proto/tests/golden.rs (dyadic values, one -0.0, penumbra).
+    from flexdyn.proto import EnvironmentMsg, SourceWrench
+    m = EnvironmentMsg(
+        Header(SC, 17, 170_000_000, 2), 0x0102030405060708,
+        proto.ENVIRONMENT_EPOCH_VALID | proto.ENVIRONMENT_MAGNETIC | proto.ENVIRONMENT_SUN
+        | proto.ENVIRONMENT_SHADOW | proto.ENVIRONMENT_ATMOSPHERE, proto.ECLIPSE_PENUMBRA,
+        (2.0**-15, -(2.0**-16), 2.0**-17), (-0.0, 2.0**-14, -(2.0**-18)), (0.5, -0.5, 0.75),
+        (0.25, 1.0, -0.125), (-1.0, 0.375, 0.0625), 0.625, 2.0**-40,
+        SourceWrench((2.0**-20, -(2.0**-21), 2.0**-22), (2.0**-30, 0.0, -(2.0**-31))),
+        SourceWrench((1.5, -2.5, 3.5), (4.0, -8.0, 16.0)),
+        SourceWrench((2.0**-24, 2.0**-25, 2.0**-26), (-(2.0**-24), -(2.0**-25), -(2.0**-26))),
+        SourceWrench((0.125, -0.25, 2.0**-7), (0.0, 0.0, 0.0)))
+    golden = (golden_dir / "environment.bin").read_bytes()
+    assert len(golden) == proto.ENVIRONMENT_LEN
+    assert m.encode() == golden
+    back = EnvironmentMsg.decode(golden)
+    assert back == m and bits(back.b_b_t) == bits(m.b_b_t)  # -0.0 keeps its sign
+    assert back.eclipse_name == "penumbra"
+    assert proto.environment_key("sc1") == "flexdyn/sc1/tlm/env"
+    with pytest.raises(DecodeError) as e:
+        EnvironmentMsg.decode(golden[:-1])
+    assert e.value.reason == "Length"

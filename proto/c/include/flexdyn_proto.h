@@ -81,6 +81,7 @@
 #define FD_MAX_CSS_DETECTORS 16u
 #define FD_TIME_CUC_OFFSET 98u
 #define FD_OPERATOR_LEN 42u /* since protocol 6 */
+#define FD_ENVIRONMENT_LEN 368u
 #define FD_MAX_EFFECTORS 1024u
 #define FD_MAX_EFFECTOR_VALUES 8u
 #define FD_MAX_MESSAGE_BYTES 65536u
@@ -121,6 +122,17 @@
 #define FD_TIME_LEAP_SECOND 0x04u /* inside an inserted leap second (UTC second = 60) */
 /* TimeMsg.cuc_tai[0]: CCSDS 301.0-B-4 CUC P-field, TAI 1958 epoch, 4 coarse + 3 fine octets. */
 #define FD_CUC_PFIELD_TAI_4_3 0x1Fu
+/* EnvironmentMsg.flags (protocol 6): which models are on */
+#define FD_ENVIRONMENT_EPOCH_VALID 0x01u /* tai_ns_1958 set */
+#define FD_ENVIRONMENT_MAGNETIC 0x02u    /* b_n_t, b_b_t */
+#define FD_ENVIRONMENT_SUN 0x04u         /* sun_n, sun_b */
+#define FD_ENVIRONMENT_MOON 0x08u        /* moon_n */
+#define FD_ENVIRONMENT_SHADOW 0x10u      /* shadow_factor, eclipse */
+#define FD_ENVIRONMENT_ATMOSPHERE 0x20u  /* density_kg_m3 */
+/* EnvironmentMsg.eclipse */
+#define FD_ECLIPSE_SUNLIT 0u
+#define FD_ECLIPSE_PENUMBRA 1u
+#define FD_ECLIPSE_UMBRA 2u
 /* EffectorState.flags of a reaction wheel */
 #define FD_WHEEL_TORQUE_LIMITED 0x1u
 #define FD_WHEEL_SPEED_LIMITED 0x2u
@@ -256,6 +268,29 @@ typedef struct {
     fd_sys_time tone_met;    /* MET at the most recent tone */
     fd_sys_time tone_tai;    /* TAI (1958) at the most recent tone */
 } fd_time_msg;
+
+/* One environment source's torque about B and force at B, B components (torque first). */
+typedef struct {
+    double torque_b_nm[3];
+    double force_b_newton[3];
+} fd_source_wrench;
+
+/* The environment at the spacecraft, flexdyn/<sc>/tlm/env, at [environment] telemetry_rate_hz
+ * (protocol 6). Every value refers to header.tick. */
+typedef struct {
+    fd_header header;
+    uint64_t tai_ns_1958; /* 0 without an epoch */
+    uint8_t flags;        /* FD_ENVIRONMENT_* */
+    uint8_t eclipse;      /* FD_ECLIPSE_* */
+    double b_n_t[3];      /* T, N components */
+    double b_b_t[3];      /* T, B components */
+    double sun_n[3];      /* unit vector B -> Sun, N components */
+    double sun_b[3];      /* the same, B components */
+    double moon_n[3];     /* unit vector B -> Moon, N components */
+    double shadow_factor; /* visible fraction of the solar disc */
+    double density_kg_m3;
+    fd_source_wrench gravity_gradient, drag, solar_pressure, residual_dipole;
+} fd_environment_msg;
 
 typedef struct {
     fd_header header;
@@ -1005,6 +1040,64 @@ static inline size_t fd_encode_operator(const fd_operator_msg *m, uint8_t *buf, 
     return FD_OPERATOR_LEN;
 }
 
+/* EnvironmentMsg (protocol 6).                                                                */
+
+static inline fd_error fd_decode_environment(const uint8_t *buf, size_t len,
+                                             fd_environment_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_ENVIRONMENT_LEN);
+    fd_source_wrench *src[4];
+    size_t i;
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_ENVIRONMENT_LEN, len)).status != FD_OK) return e;
+    fd_decode_header_at(buf, &out->header);
+    out->tai_ns_1958 = fd_get_u64(buf + 30);
+    out->flags = buf[38];
+    out->eclipse = buf[39];
+    fd_get_f64s(buf + 40, out->b_n_t, 3);
+    fd_get_f64s(buf + 64, out->b_b_t, 3);
+    fd_get_f64s(buf + 88, out->sun_n, 3);
+    fd_get_f64s(buf + 112, out->sun_b, 3);
+    fd_get_f64s(buf + 136, out->moon_n, 3);
+    out->shadow_factor = fd_get_f64(buf + 160);
+    out->density_kg_m3 = fd_get_f64(buf + 168);
+    src[0] = &out->gravity_gradient;
+    src[1] = &out->drag;
+    src[2] = &out->solar_pressure;
+    src[3] = &out->residual_dipole;
+    for (i = 0; i < 4; ++i) {
+        fd_get_f64s(buf + 176 + 48 * i, src[i]->torque_b_nm, 3);
+        fd_get_f64s(buf + 200 + 48 * i, src[i]->force_b_newton, 3);
+    }
+    return fd_ok();
+}
+
+static inline size_t fd_encode_environment(const fd_environment_msg *m, uint8_t *buf,
+                                           size_t cap) {
+    const fd_source_wrench *src[4];
+    size_t i;
+    if (cap < FD_ENVIRONMENT_LEN) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_u64(buf + 30, m->tai_ns_1958);
+    buf[38] = m->flags;
+    buf[39] = m->eclipse;
+    fd_put_f64s(buf + 40, m->b_n_t, 3);
+    fd_put_f64s(buf + 64, m->b_b_t, 3);
+    fd_put_f64s(buf + 88, m->sun_n, 3);
+    fd_put_f64s(buf + 112, m->sun_b, 3);
+    fd_put_f64s(buf + 136, m->moon_n, 3);
+    fd_put_f64(buf + 160, m->shadow_factor);
+    fd_put_f64(buf + 168, m->density_kg_m3);
+    src[0] = &m->gravity_gradient;
+    src[1] = &m->drag;
+    src[2] = &m->solar_pressure;
+    src[3] = &m->residual_dipole;
+    for (i = 0; i < 4; ++i) {
+        fd_put_f64s(buf + 176 + 48 * i, src[i]->torque_b_nm, 3);
+        fd_put_f64s(buf + 200 + 48 * i, src[i]->force_b_newton, 3);
+    }
+    return FD_ENVIRONMENT_LEN;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 /* Key expressions (proto/README.md, "Topics").                                                */
 
@@ -1051,6 +1144,9 @@ static inline size_t fd_state_key(char *out, size_t cap, const char *sc) {
 }
 static inline size_t fd_time_key(char *out, size_t cap, const char *sc) {
     return fd_key(out, cap, sc, "tlm/time", FD_NULL);
+}
+static inline size_t fd_environment_key(char *out, size_t cap, const char *sc) {
+    return fd_key(out, cap, sc, "tlm/env", FD_NULL);
 }
 static inline size_t fd_imu_key(char *out, size_t cap, const char *sc, const char *name) {
     return fd_key(out, cap, sc, "tlm/imu", name);

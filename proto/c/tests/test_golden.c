@@ -478,6 +478,65 @@ static void test_operator(const char *dir) {
     printf("OperatorMsg: ok\n");
 }
 
+static void test_environment(const char *dir) {
+    uint8_t golden[512], enc[512];
+    size_t n = read_file(dir, "environment", golden, sizeof golden);
+    fd_environment_msg m, back;
+    /* The EnvironmentMsg table of proto/tests/golden.rs (dyadic values, one -0.0). */
+    static const double b_n[3] = {1.0 / 32768.0, -1.0 / 65536.0, 1.0 / 131072.0};
+    static const double b_b[3] = {-0.0, 1.0 / 16384.0, -1.0 / 262144.0};
+    static const double sun_n[3] = {0.5, -0.5, 0.75}, sun_b[3] = {0.25, 1.0, -0.125};
+    static const double moon_n[3] = {-1.0, 0.375, 0.0625};
+    static const double gg_t[3] = {1.0 / 1048576.0, -1.0 / 2097152.0, 1.0 / 4194304.0};
+    static const double gg_f[3] = {1.0 / 1073741824.0, 0.0, -1.0 / 2147483648.0};
+    static const double drag_t[3] = {1.5, -2.5, 3.5}, drag_f[3] = {4.0, -8.0, 16.0};
+    static const double srp_t[3] = {1.0 / 16777216.0, 1.0 / 33554432.0, 1.0 / 67108864.0};
+    static const double srp_f[3] = {-1.0 / 16777216.0, -1.0 / 33554432.0, -1.0 / 67108864.0};
+    static const double dip_t[3] = {0.125, -0.25, 1.0 / 128.0}, zero[3] = {0.0, 0.0, 0.0};
+    fd_error e;
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 17, 170000000u, 2);
+    m.tai_ns_1958 = 0x0102030405060708ull;
+    m.flags = FD_ENVIRONMENT_EPOCH_VALID | FD_ENVIRONMENT_MAGNETIC | FD_ENVIRONMENT_SUN |
+              FD_ENVIRONMENT_SHADOW | FD_ENVIRONMENT_ATMOSPHERE;
+    m.eclipse = FD_ECLIPSE_PENUMBRA;
+    memcpy(m.b_n_t, b_n, sizeof b_n);
+    memcpy(m.b_b_t, b_b, sizeof b_b);
+    memcpy(m.sun_n, sun_n, sizeof sun_n);
+    memcpy(m.sun_b, sun_b, sizeof sun_b);
+    memcpy(m.moon_n, moon_n, sizeof moon_n);
+    m.shadow_factor = 0.625;
+    m.density_kg_m3 = 1.0 / 1099511627776.0; /* 2^-40 */
+    memcpy(m.gravity_gradient.torque_b_nm, gg_t, sizeof gg_t);
+    memcpy(m.gravity_gradient.force_b_newton, gg_f, sizeof gg_f);
+    memcpy(m.drag.torque_b_nm, drag_t, sizeof drag_t);
+    memcpy(m.drag.force_b_newton, drag_f, sizeof drag_f);
+    memcpy(m.solar_pressure.torque_b_nm, srp_t, sizeof srp_t);
+    memcpy(m.solar_pressure.force_b_newton, srp_f, sizeof srp_f);
+    memcpy(m.residual_dipole.torque_b_nm, dip_t, sizeof dip_t);
+    memcpy(m.residual_dipole.force_b_newton, zero, sizeof zero);
+    check_encoded("EnvironmentMsg", golden, n, enc, fd_encode_environment(&m, enc, sizeof enc));
+    e = fd_decode_environment(golden, n, &back);
+    CHECK(e.status == FD_OK && same_header(&back.header, &m.header) &&
+              back.tai_ns_1958 == m.tai_ns_1958 && back.flags == 0x37 && back.eclipse == 1 &&
+              same_bits(back.b_n_t, b_n, 3) && same_bits(back.b_b_t, b_b, 3) &&
+              same_bits(back.sun_n, sun_n, 3) && same_bits(back.sun_b, sun_b, 3) &&
+              same_bits(back.moon_n, moon_n, 3) && same_bits(&back.shadow_factor, &m.shadow_factor, 1) &&
+              same_bits(&back.density_kg_m3, &m.density_kg_m3, 1) &&
+              same_bits(back.gravity_gradient.torque_b_nm, gg_t, 3) &&
+              same_bits(back.gravity_gradient.force_b_newton, gg_f, 3) &&
+              same_bits(back.drag.torque_b_nm, drag_t, 3) &&
+              same_bits(back.drag.force_b_newton, drag_f, 3) &&
+              same_bits(back.solar_pressure.torque_b_nm, srp_t, 3) &&
+              same_bits(back.solar_pressure.force_b_newton, srp_f, 3) &&
+              same_bits(back.residual_dipole.torque_b_nm, dip_t, 3) &&
+              same_bits(back.residual_dipole.force_b_newton, zero, 3),
+          "EnvironmentMsg decodes to the table");
+    e = fd_decode_environment(golden, n - 1, &back);
+    CHECK(e.status == FD_ERR_LENGTH && e.needed == FD_ENVIRONMENT_LEN, "EnvironmentMsg short");
+    printf("EnvironmentMsg: decode ok\n");
+}
+
 static void test_keys(void) {
     char key[128];
     CHECK(fd_state_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/tlm/state") == 0,
@@ -485,6 +544,9 @@ static void test_keys(void) {
     CHECK(fd_star_tracker_key(key, sizeof key, "sc1", "st1") > 0 &&
               strcmp(key, "flexdyn/sc1/tlm/st/st1") == 0,
           "star tracker key");
+    CHECK(fd_environment_key(key, sizeof key, "sc1") > 0 &&
+              strcmp(key, "flexdyn/sc1/tlm/env") == 0,
+          "environment key");
     CHECK(fd_magnetometer_key(key, sizeof key, "sc1", "mag1") > 0 &&
               strcmp(key, "flexdyn/sc1/tlm/mag/mag1") == 0,
           "magnetometer key");
@@ -519,6 +581,7 @@ int main(int argc, char **argv) {
     test_status(argv[1]);
     test_time(argv[1]);
     test_operator(argv[1]);
+    test_environment(argv[1]);
     test_keys();
     if (failures != 0) {
         fprintf(stderr, "%d check(s) failed\n", failures);

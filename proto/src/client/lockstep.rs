@@ -151,6 +151,8 @@ impl TickAssembler {
         let msg = match topic {
             // The time service is not part of a tick's samples (wait for it separately).
             Telemetry::Time => return Ok(()),
+            // Nor is the environment message (truth for operators, after the state).
+            Telemetry::Environment => return Ok(()),
             Telemetry::State => Msg::State(Box::new(decode_state(payload)?)),
             Telemetry::Imu(name) => match self.schedule.imus.iter().position(|n| n == name) {
                 Some(i) => Msg::Imu(i, decode_imu(payload)?),

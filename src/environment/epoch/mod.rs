@@ -146,6 +146,12 @@ pub enum EpochError {
     },
 }
 
+/// \[ns\] 1958-01-01T00:00:00 TAI as a TAI count since 1900-01-01T00:00:00 TAI (hifitime's and
+/// [`SimEpoch::tai_ns`]'s reference): 58 years of which 14 leap years (1904 … 1956), so
+/// 58·365 + 14 = 21,184 days = 1,830,297,600 s. Checked against hifitime in the server clock's
+/// tests.
+pub const TAI_1958_COUNT_NS: i64 = 1_830_297_600 * 1_000_000_000;
+
 /// The simulation epoch: the instant where `t_sim_ns = 0`, with everything needed to derive
 /// the time scales at `epoch + t_sim_ns` without allocating.
 #[derive(Debug, Clone, PartialEq)]
@@ -530,6 +536,12 @@ impl SimEpoch {
     /// The Earth orientation parameters given with the epoch.
     pub fn earth_orientation(&self) -> &EarthOrientationParams {
         &self.eop
+    }
+
+    /// \[ns\] TAI since 1958-01-01T00:00:00 TAI (the CCSDS Level 1 epoch) at `t_sim_ns`, as
+    /// the time and environment messages carry it (0 before 1958, outside any accepted epoch).
+    pub fn tai_ns_1958(&self, t_sim_ns: u64) -> u64 {
+        u64::try_from(self.tai_ns(t_sim_ns) - TAI_1958_COUNT_NS).unwrap_or(0)
     }
 
     /// \[ns\] the TAI count (since 1900-01-01T00:00:00 TAI) at `t_sim_ns`; saturates past

@@ -67,6 +67,12 @@ pub struct EnvironmentSettings {
     pub update_ns: u64,
     /// \[Hz\] the update rate as configured.
     pub update_hz: f64,
+    /// \[Hz\] `telemetry_rate_hz`: the rate of the environment message (`tlm/env`) and of
+    /// `simulate`'s environment columns; `None` (the default): neither.
+    pub telemetry_rate_hz: Option<f64>,
+    /// `telemetry_rate_hz` as a whole number of frames (set by the configuration, which knows
+    /// the frame rate).
+    pub telemetry_every_frames: Option<u64>,
     /// Magnetic field.
     pub magnetic: MagneticSetting,
     /// Atmosphere (with a co-rotating wind when on).
@@ -142,6 +148,21 @@ pub enum EnvironmentBuildError {
     /// The space weather is out of range.
     #[error(transparent)]
     Atmosphere(#[from] super::atmosphere::AtmosphereError),
+}
+
+/// Which environment models are on ([`EnvironmentModel::models_on`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ModelsOn {
+    /// A magnetic field (IGRF or a dipole).
+    pub magnetic: bool,
+    /// The Sun ephemeris.
+    pub sun: bool,
+    /// The Moon ephemeris.
+    pub moon: bool,
+    /// A shadow model.
+    pub shadow: bool,
+    /// An atmosphere.
+    pub atmosphere: bool,
 }
 
 impl EnvironmentModel {
@@ -281,6 +302,34 @@ impl EnvironmentModel {
         }
         if self.moon {
             out.r_moon_b_n_m = moon_position_n_m(t_tt_jc) - r_bn_n_m;
+        }
+    }
+
+    /// The sample in force from `t_sim_ns` on, without touching the update schedule: the one
+    /// [`Self::update_if_due`] would hold after a call at `t_sim_ns` (filled afresh if an update
+    /// is due then, else the held one). For telemetry at an instant where the next step's update
+    /// has not run yet. Allocation-free.
+    pub fn sample_from(
+        &self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+    ) -> EnvironmentSample {
+        let mut s = self.sample;
+        if self.next_update_ns.is_none_or(|next| t_sim_ns >= next) {
+            self.fill(t_sim_ns, r_bn_n_m, v_bn_n_m_s, &mut s);
+        }
+        s
+    }
+
+    /// Which models are on: (magnetic field, Sun, Moon, shadow, atmosphere).
+    pub fn models_on(&self) -> ModelsOn {
+        ModelsOn {
+            magnetic: !matches!(self.field, Field::Off),
+            sun: self.sun,
+            moon: self.moon,
+            shadow: self.shadow.is_some(),
+            atmosphere: !matches!(self.air, Air::Off),
         }
     }
 

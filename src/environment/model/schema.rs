@@ -3,6 +3,7 @@
 //! ```toml
 //! [environment]
 //! update_hz = 10.0            # sample rate; held between updates (default 10 Hz)
+//! telemetry_rate_hz = 10.0    # the environment message (tlm/env) and CSV columns; default off
 //! magnetic = "igrf14"         # "igrf14", "dipole_tilted", "dipole_axial" or "off" (default)
 //! magnetic_degree = 13        # igrf14 only, 1..=13 (default 13)
 //! atmosphere = "nrlmsise00"   # "exponential", "nrlmsise00" or "off" (default)
@@ -40,8 +41,9 @@ use crate::environment::shadow::ShadowModel;
 use crate::schema::{At, SchemaError, TableReader};
 
 /// The keys of `[environment]`.
-pub(crate) const KEYS: [&str; 15] = [
+pub(crate) const KEYS: [&str; 16] = [
     "update_hz",
+    "telemetry_rate_hz",
     "magnetic",
     "magnetic_degree",
     "atmosphere",
@@ -121,6 +123,8 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, Schem
         ));
     }
     let update_ns = (1e9 / update_hz).round() as u64;
+    // Checked against the frame rate (a whole number of frames) by the configuration.
+    let telemetry_rate_hz = t.opt_f64("telemetry_rate_hz")?;
     let magnetic = match choice(
         t,
         "magnetic",
@@ -278,6 +282,8 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, Schem
     Ok(EnvironmentSettings {
         update_ns,
         update_hz,
+        telemetry_rate_hz,
+        telemetry_every_frames: None,
         magnetic,
         atmosphere,
         sun,

@@ -12,14 +12,14 @@
 from . import proto
 from .client import Client, Subscription, VehicleInfo, session_config
 from .lockstep import Answer, LockstepParticipant, SensorSchedule, Tick
-from .proto import (CommandMsg, CssMsg, DecodeError, EffectorInput, EffectorState, FssMsg,
-                    Header, ImuMsg, MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg,
-                    StatusMsg, TimeMsg)
+from .proto import (CommandMsg, CssMsg, DecodeError, EffectorInput, EffectorState,
+                    EnvironmentMsg, FssMsg, Header, ImuMsg, MagnetometerMsg, OperatorMsg,
+                    StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
 
 __all__ = [
     "proto", "Client", "Subscription", "VehicleInfo", "session_config", "Answer",
     "LockstepParticipant", "SensorSchedule", "Tick", "CommandMsg", "DecodeError",
-    "EffectorInput", "EffectorState", "Header", "ImuMsg", "MagnetometerMsg", "StarTrackerMsg",
+    "EffectorInput", "EffectorState", "EnvironmentMsg", "Header", "ImuMsg", "MagnetometerMsg", "StarTrackerMsg",
     "StateMsg",
     "StatusMsg", "TimeMsg", "CssMsg", "FssMsg", "OperatorMsg",
 ]

@@ -20,8 +20,8 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tupl
 import zenoh
 
 from . import proto
-from .proto import (CommandMsg, EffectorInput, Header, ImuMsg, OperatorMsg, StarTrackerMsg,
-                    StateMsg, StatusMsg, TimeMsg)
+from .proto import (CommandMsg, EffectorInput, EnvironmentMsg, Header, ImuMsg, OperatorMsg,
+                    StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
 
 Vec3 = Tuple[float, float, float]
 
@@ -67,7 +67,7 @@ class VehicleInfo:
 #: The decoder of each telemetry key kind: the part of the key after ``flexdyn/<sc>/tlm/``
 #: is ``state``, ``imu/<name>`` or ``st/<name>``.
 _DECODERS = {"state": StateMsg.decode, "imu": ImuMsg.decode, "st": StarTrackerMsg.decode,
-             "time": TimeMsg.decode}
+             "time": TimeMsg.decode, "env": EnvironmentMsg.decode}
 
 
 class Subscription:
@@ -204,6 +204,11 @@ class Client:
         """Calls `callback` with every TimeMsg, the time service (``flexdyn/<sc>/tlm/time``,
         one per frame, before the frame's sensors and state)."""
         return self._telemetry_add("time", callback)
+
+    def subscribe_environment(self, callback: Callable[[EnvironmentMsg], None]) -> Subscription:
+        """Calls `callback` with every EnvironmentMsg (``flexdyn/<sc>/tlm/env``, truth at the
+        configured ``[environment] telemetry_rate_hz``)."""
+        return self._telemetry_add("env", callback)
 
     def _clock(self) -> threading.Condition:
         # Under _dispatch (not _lock: a callback that sends holds _dispatch, then takes _lock).

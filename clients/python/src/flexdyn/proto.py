@@ -44,6 +44,7 @@ CSS_LEN = 159
 FSS_LEN = 47
 MAX_CSS_DETECTORS = 16
 OPERATOR_LEN = 42
+ENVIRONMENT_LEN = 368
 MAX_EFFECTORS = 1024
 MAX_EFFECTOR_VALUES = 8
 MAX_MESSAGE_BYTES = 65536
@@ -73,6 +74,10 @@ CUC_PFIELD_TAI_4_3 = 0x1F
 STALE_POLICY_HOLD, STALE_POLICY_ZERO = 0, 1
 # OperatorMsg.action (protocol 6)
 OPERATOR_PAUSE, OPERATOR_RESUME, OPERATOR_RUN_TICKS = 0, 1, 2
+# EnvironmentMsg.flags (models on) and EnvironmentMsg.eclipse (protocol 6)
+ENVIRONMENT_EPOCH_VALID, ENVIRONMENT_MAGNETIC, ENVIRONMENT_SUN = 0x1, 0x2, 0x4
+ENVIRONMENT_MOON, ENVIRONMENT_SHADOW, ENVIRONMENT_ATMOSPHERE = 0x8, 0x10, 0x20
+ECLIPSE_SUNLIT, ECLIPSE_PENUMBRA, ECLIPSE_UMBRA = 0, 1, 2
 
 _HEADER = struct.Struct("<HIQQQ")
 
@@ -601,6 +606,66 @@ class OperatorMsg:
         return OperatorMsg(Header.unpack(buf), action, ticks)
 
 
+Vec3 = Tuple[float, float, float]
+
+
+@dataclass
+class SourceWrench:
+    """One environment source's torque about B (N·m) and force at B (N), B components."""
+
+    torque_b_nm: Vec3 = (0.0, 0.0, 0.0)
+    force_b_newton: Vec3 = (0.0, 0.0, 0.0)
+
+
+@dataclass
+class EnvironmentMsg:
+    """The environment at the spacecraft (``flexdyn/<sc-id>/tlm/env``, protocol 6), at
+    ``[environment] telemetry_rate_hz``; every value refers to ``header.tick``. ``flags`` says
+    which models are on (``ENVIRONMENT_*``), ``eclipse`` is ``ECLIPSE_SUNLIT``, ``_PENUMBRA`` or
+    ``_UMBRA``. The four sources are each dynamic effector's own evaluation at that tick."""
+
+    header: Header = field(default_factory=Header)
+    tai_ns_1958: int = 0
+    flags: int = 0
+    eclipse: int = ECLIPSE_SUNLIT
+    b_n_t: Vec3 = (0.0, 0.0, 0.0)
+    b_b_t: Vec3 = (0.0, 0.0, 0.0)
+    sun_n: Vec3 = (0.0, 0.0, 0.0)
+    sun_b: Vec3 = (0.0, 0.0, 0.0)
+    moon_n: Vec3 = (0.0, 0.0, 0.0)
+    shadow_factor: float = 1.0
+    density_kg_m3: float = 0.0
+    gravity_gradient: SourceWrench = field(default_factory=SourceWrench)
+    drag: SourceWrench = field(default_factory=SourceWrench)
+    solar_pressure: SourceWrench = field(default_factory=SourceWrench)
+    residual_dipole: SourceWrench = field(default_factory=SourceWrench)
+
+    SOURCES: ClassVar[Tuple[str, ...]] = ("gravity_gradient", "drag", "solar_pressure",
+                                          "residual_dipole")
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<QBB15d2d24d")
+
+    def encode(self) -> bytes:
+        wrenches = [v for s in self.SOURCES for w in (getattr(self, s),)
+                    for v in (*w.torque_b_nm, *w.force_b_newton)]
+        return self.header.encode() + self._BODY.pack(
+            self.tai_ns_1958, self.flags, self.eclipse, *self.b_n_t, *self.b_b_t, *self.sun_n,
+            *self.sun_b, *self.moon_n, self.shadow_factor, self.density_kg_m3, *wrenches)
+
+    @staticmethod
+    def decode(buf: bytes) -> "EnvironmentMsg":
+        _check_size_and_version(buf, ENVIRONMENT_LEN)
+        _check_total(ENVIRONMENT_LEN, buf)
+        f = EnvironmentMsg._BODY.unpack_from(buf, HEADER_LEN)
+        v = lambda i: tuple(f[i:i + 3])  # noqa: E731
+        w = [SourceWrench(v(20 + 6 * k), v(23 + 6 * k)) for k in range(4)]
+        return EnvironmentMsg(Header.unpack(buf), f[0], f[1], f[2], v(3), v(6), v(9), v(12),
+                              v(15), f[18], f[19], *w)
+
+    @property
+    def eclipse_name(self) -> str:
+        return ("sunlit", "penumbra", "umbra")[self.eclipse] if self.eclipse <= 2 else "?"
+
+
 # --------------------------------------------------------------------------------------------
 # Key expressions (proto/README.md, "Topics").
 
@@ -618,6 +683,11 @@ def _key(sc: str, suffix: str, name: Optional[str] = None) -> str:
 
 def state_key(sc: str) -> str:
     return _key(sc, "tlm/state")
+
+
+def environment_key(sc: str) -> str:
+    """``flexdyn/<sc>/tlm/env``: the environment message (EnvironmentMsg)."""
+    return _key(sc, "tlm/env")
 
 
 def time_key(sc: str) -> str:

@@ -20,7 +20,7 @@
 //! is F·v_B + τ·ω_B/N exactly; `tests/surface_forces.rs` checks that the energy lost equals that
 //! work.
 
-use crate::dynamics::dynamic_effector::{DynamicEffector, StageState};
+use crate::dynamics::dynamic_effector::{DynamicEffector, EnvironmentSource, StageState};
 use crate::dynamics::params::Wrench;
 use crate::environment::facets::FacetModel;
 use crate::environment::EnvironmentSample;
@@ -35,6 +35,10 @@ pub struct AeroDrag {
 impl DynamicEffector for AeroDrag {
     fn name(&self) -> &str {
         "aero_drag"
+    }
+
+    fn environment_source(&self) -> Option<EnvironmentSource> {
+        Some(EnvironmentSource::Drag)
     }
 
     fn add_force_torque(&mut self, stage: &StageState, env: &EnvironmentSample, sum: &mut Wrench) {

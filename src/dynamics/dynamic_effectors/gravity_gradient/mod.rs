@@ -38,7 +38,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::dynamics::dynamic_effector::{DynamicEffector, StageState};
+use crate::dynamics::dynamic_effector::{DynamicEffector, EnvironmentSource, StageState};
 use crate::dynamics::params::Wrench;
 use crate::environment::EnvironmentSample;
 
@@ -123,6 +123,10 @@ impl GravityGradient {
 impl DynamicEffector for GravityGradient {
     fn name(&self) -> &str {
         "gravity_gradient"
+    }
+
+    fn environment_source(&self) -> Option<EnvironmentSource> {
+        Some(EnvironmentSource::GravityGradient)
     }
 
     fn add_force_torque(&mut self, stage: &StageState, _env: &EnvironmentSample, sum: &mut Wrench) {

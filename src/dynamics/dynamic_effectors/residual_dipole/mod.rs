@@ -12,7 +12,7 @@
 
 use nalgebra::Vector3;
 
-use crate::dynamics::dynamic_effector::{DynamicEffector, StageState};
+use crate::dynamics::dynamic_effector::{DynamicEffector, EnvironmentSource, StageState};
 use crate::dynamics::params::Wrench;
 use crate::environment::magnetic::dipole_torque_b_nm;
 use crate::environment::EnvironmentSample;
@@ -27,6 +27,10 @@ pub struct ResidualDipole {
 impl DynamicEffector for ResidualDipole {
     fn name(&self) -> &str {
         "residual_dipole"
+    }
+
+    fn environment_source(&self) -> Option<EnvironmentSource> {
+        Some(EnvironmentSource::ResidualDipole)
     }
 
     fn add_force_torque(&mut self, stage: &StageState, env: &EnvironmentSample, sum: &mut Wrench) {

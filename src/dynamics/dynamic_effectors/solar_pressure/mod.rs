@@ -13,7 +13,7 @@
 //! environment update (the sample is held: 10⁻⁷ rad per second of orbit motion at 1 AU). No Sun
 //! configured (a zero vector) gives no force.
 
-use crate::dynamics::dynamic_effector::{DynamicEffector, StageState};
+use crate::dynamics::dynamic_effector::{DynamicEffector, EnvironmentSource, StageState};
 use crate::dynamics::params::Wrench;
 use crate::environment::facets::{solar_pressure_n_m2, FacetModel};
 use crate::environment::EnvironmentSample;
@@ -31,6 +31,10 @@ pub struct SolarPressure {
 impl DynamicEffector for SolarPressure {
     fn name(&self) -> &str {
         "solar_pressure"
+    }
+
+    fn environment_source(&self) -> Option<EnvironmentSource> {
+        Some(EnvironmentSource::SolarPressure)
     }
 
     fn add_force_torque(&mut self, stage: &StageState, env: &EnvironmentSample, sum: &mut Wrench) {
