@@ -813,7 +813,13 @@ impl RawConfig {
             let path = format!("coarse_sun_sensors[{i}]");
             sun_sensor(&path, &raw.name, &mut names, "coarse sun sensor")?;
             let cfg = CoarseSunSensorConfig {
-                every_frames: every_frames(map, &path, raw.rate_hz, sim.frame_hz, "array")?,
+                every_frames: every_frames(
+                    map,
+                    &format!("{path}.rate_hz"),
+                    raw.rate_hz,
+                    sim.frame_hz,
+                    "array",
+                )?,
                 name: raw.name,
                 normals_b: raw.normals_b,
                 fov_half_angle_rad: raw.fov_half_angle_rad,
@@ -832,7 +838,13 @@ impl RawConfig {
             let path = format!("fine_sun_sensors[{i}]");
             sun_sensor(&path, &raw.name, &mut names, "fine sun sensor")?;
             let cfg = FineSunSensorConfig {
-                every_frames: every_frames(map, &path, raw.rate_hz, sim.frame_hz, "sensor")?,
+                every_frames: every_frames(
+                    map,
+                    &format!("{path}.rate_hz"),
+                    raw.rate_hz,
+                    sim.frame_hz,
+                    "sensor",
+                )?,
                 name: raw.name,
                 dcm_fb: raw.dcm_fb,
                 fov_half_angle_rad: raw.fov_half_angle_rad,
