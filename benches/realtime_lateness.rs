@@ -9,7 +9,8 @@
 //! `FLEXDYN_RT_ROUNDS` rounds (default 3). `FLEXDYN_RT_SCENARIO=scenarios/leo_environment.toml`
 //! runs that scenario at 1 kHz instead (every environment model and its sensors on). Each run
 //! prints:
-//! - the lateness of the frame boundaries (wake-up minus deadline): p50, p90, p99, p99.9, max;
+//! - the lateness of the frame boundaries (wake-up minus deadline): p50, p90, p99, p99.9, max,
+//!   and the histogram coarsened to buckets (line `histogram:`);
 //! - overruns (frames whose work ended after the next deadline);
 //! - page faults of the whole process during the run (minor + major, `/proc/self/stat`: what
 //!   `getrusage(RUSAGE_SELF)` sums), and of the physics thread after its first frame;
@@ -51,6 +52,8 @@ use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
 struct Figures {
     /// \[µs\] lateness p50, p90, p99, p99.9, max.
     lateness_us: [f64; 5],
+    /// Frames per lateness bucket of [`BUCKETS_US`] (the histogram, coarsened).
+    histogram: [u64; BUCKETS_US.len()],
     overruns: u64,
     process_faults: u64,
     physics_faults: u64,
@@ -301,6 +304,9 @@ fn run(
     .map_err(|_| "the run panicked".to_string())?
 }
 
+/// \[µs\] lower edges of the printed lateness buckets; the last is open-ended.
+const BUCKETS_US: [u64; 7] = [0, 1, 10, 50, 100, 500, 1000];
+
 fn measure(settings: ServerSettings, keep_off: Option<usize>) -> Result<Figures, String> {
     let faults_before = rt::ThreadUsage::this_process();
     let (steal0, total0) = cpu_ticks();
@@ -313,6 +319,11 @@ fn measure(settings: ServerSettings, keep_off: Option<usize>) -> Result<Figures,
     let physics = report.physics_thread.unwrap_or_default();
     Ok(Figures {
         lateness_us: [us(0.5), us(0.9), us(0.99), us(0.999), h.max() as f64 * 1e-3],
+        histogram: std::array::from_fn(|k| {
+            let low_ns = BUCKETS_US[k] * 1000;
+            let high_ns = BUCKETS_US.get(k + 1).map_or(u64::MAX, |&e| e * 1000 - 1);
+            h.count_between(low_ns, high_ns.min(h.max().max(low_ns)))
+        }),
         overruns: report.timing.overrun_count,
         process_faults: faults.page_faults(),
         physics_faults: physics.page_faults(),
@@ -321,6 +332,19 @@ fn measure(settings: ServerSettings, keep_off: Option<usize>) -> Result<Figures,
         cpu_ms: total1.saturating_sub(total0) as f64 * TICK_MS,
         blame: attribute(&report.overrun_frames_ns, &samples, physics_cpu),
     })
+}
+
+/// The histogram line under a run's row: frames per lateness bucket.
+fn print_histogram(f: &Figures) {
+    let cells: Vec<String> = BUCKETS_US
+        .iter()
+        .enumerate()
+        .map(|(k, low)| match BUCKETS_US.get(k + 1) {
+            Some(high) => format!("{low}-{high} µs {}", f.histogram[k]),
+            None => format!(">= {low} µs {}", f.histogram[k]),
+        })
+        .collect();
+    println!("        histogram: {}", cells.join(" | "));
 }
 
 fn print_row(name: &str, f: &Figures) {
@@ -429,9 +453,11 @@ fn main() {
             }
         };
         print_row("normal", &n);
+        print_histogram(&n);
         let t = match measure(tuned.clone(), cpu) {
             Ok(f) => {
                 print_row("tuned", &f);
+                print_histogram(&f);
                 Some(f)
             }
             Err(e) => {
