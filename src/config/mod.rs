@@ -461,12 +461,11 @@ impl RawConfig {
             .iter()
             .map(RawPanelPair::read)
             .collect::<Result<Vec<_>, _>>()?;
-        let reaction_wheels = root
-            .tables("reaction_wheels", &reaction_wheel::schema::KEYS)?
-            .unwrap_or_default()
-            .iter()
-            .map(reaction_wheel::schema::read)
-            .collect::<Result<Vec<_>, _>>()?;
+        let reaction_wheels = root.read_tables(
+            "reaction_wheels",
+            &reaction_wheel::schema::KEYS,
+            reaction_wheel::schema::read,
+        )?;
         let components = components::read(&root)?;
         let wrench_schedule = root
             .tables("wrench_schedule", &["t_s", "force_b_newton", "torque_b_nm"])?
@@ -480,12 +479,11 @@ impl RawConfig {
                 })
             })
             .collect::<Result<Vec<_>, ConfigError>>()?;
-        let effector_input_schedule = root
-            .tables("effector_input_schedule", &schedule::KEYS)?
-            .unwrap_or_default()
-            .iter()
-            .map(schedule::RawInputRow::read)
-            .collect::<Result<Vec<_>, _>>()?;
+        let effector_input_schedule = root.read_tables(
+            "effector_input_schedule",
+            &schedule::KEYS,
+            schedule::RawInputRow::read,
+        )?;
         // `[server]` is read and validated by the server's own schema
         // (`flexdyn::server::settings`); here it only has to be a table. `check-config` runs
         // that schema too.
@@ -505,36 +503,27 @@ impl RawConfig {
         } else {
             toml::Table::new()
         };
-        let imus = root
-            .tables("imus", &imu::schema::KEYS)?
-            .unwrap_or_default()
-            .iter()
-            .map(RawImu::read)
-            .collect::<Result<Vec<_>, _>>()?;
-        let star_trackers = root
-            .tables("star_trackers", &star_tracker::schema::KEYS)?
-            .unwrap_or_default()
-            .iter()
-            .map(star_tracker::schema::read)
-            .collect::<Result<Vec<_>, _>>()?;
-        let magnetometers = root
-            .tables("magnetometers", &magnetometer::schema::KEYS)?
-            .unwrap_or_default()
-            .iter()
-            .map(magnetometer::schema::read)
-            .collect::<Result<Vec<_>, _>>()?;
-        let coarse_sun_sensors = root
-            .tables("coarse_sun_sensors", &coarse_sun_sensor::schema::KEYS)?
-            .unwrap_or_default()
-            .iter()
-            .map(coarse_sun_sensor::schema::read)
-            .collect::<Result<Vec<_>, _>>()?;
-        let fine_sun_sensors = root
-            .tables("fine_sun_sensors", &fine_sun_sensor::schema::KEYS)?
-            .unwrap_or_default()
-            .iter()
-            .map(fine_sun_sensor::schema::read)
-            .collect::<Result<Vec<_>, _>>()?;
+        let imus = root.read_tables("imus", &imu::schema::KEYS, RawImu::read)?;
+        let star_trackers = root.read_tables(
+            "star_trackers",
+            &star_tracker::schema::KEYS,
+            star_tracker::schema::read,
+        )?;
+        let magnetometers = root.read_tables(
+            "magnetometers",
+            &magnetometer::schema::KEYS,
+            magnetometer::schema::read,
+        )?;
+        let coarse_sun_sensors = root.read_tables(
+            "coarse_sun_sensors",
+            &coarse_sun_sensor::schema::KEYS,
+            coarse_sun_sensor::schema::read,
+        )?;
+        let fine_sun_sensors = root.read_tables(
+            "fine_sun_sensors",
+            &fine_sun_sensor::schema::KEYS,
+            fine_sun_sensor::schema::read,
+        )?;
         Ok(RawConfig {
             world,
             simulation,

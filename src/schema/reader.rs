@@ -416,6 +416,21 @@ impl<'a, 'i> TableReader<'a, 'i> {
             .map(Some)
     }
 
+    /// An optional array of tables, each entry read by `read`, in file order (empty if absent):
+    /// the shape of every optional `[[section]]` of the configuration.
+    pub(crate) fn read_tables<T, E: From<SchemaError>>(
+        &self,
+        key: &str,
+        allowed: &[&str],
+        read: impl Fn(&TableReader<'a, 'i>) -> Result<T, E>,
+    ) -> Result<Vec<T>, E> {
+        self.tables(key, allowed)?
+            .unwrap_or_default()
+            .iter()
+            .map(read)
+            .collect()
+    }
+
     /// A required array of tables (may be empty: `key = []`).
     pub(crate) fn req_tables(
         &self,
