@@ -10,7 +10,10 @@
 //!   `flexdyn.<Message>` (`jsonschema`, derived from the wire structs): readable by any MCAP tool.
 //! - **3D**: `/flexdyn/<sc>/tf` (`foxglove.FrameTransforms`) for every state and
 //!   `/flexdyn/<sc>/scene` (`foxglove.SceneUpdate`) once per vehicle, when the vehicle's
-//!   configuration is known ([`VehicleInfo`]).
+//!   configuration is known ([`VehicleInfo`]); `/flexdyn/<sc>/actuators` (thruster and rod
+//!   arrows, [`actuator_topic`]) for every state of a vehicle that has them; and
+//!   `/flexdyn/<sc>/environment` (the Sun and magnetic-field arrows, [`environment_topic`]) for
+//!   every EnvironmentMsg.
 //!
 //! Log time is the message's simulation time (`header.sim_time_ns`); publish time is the
 //! wall-clock stamp of the sample (its Zenoh attachment, or StatusMsg's `wall_time_unix_ns`, or
@@ -28,7 +31,8 @@ use serde::{Deserialize, Serialize};
 use super::gaps::SeqGaps;
 use super::scene::Geometry;
 use super::scene::{
-    actuator_scene, frame_transforms, frame_transforms_schema, scene_update, scene_update_schema,
+    actuator_scene, environment_scene, frame_transforms, frame_transforms_schema, scene_update,
+    scene_update_schema,
 };
 use super::topics::{classify, json_schema, wire_layout_text, Decoded, TopicKind};
 use crate::config::SimConfig;
@@ -52,6 +56,12 @@ pub fn tf_topic(sc_id: &str) -> String {
 /// The topic of a vehicle's `foxglove.SceneUpdate`.
 pub fn scene_topic(sc_id: &str) -> String {
     format!("/flexdyn/{sc_id}/scene")
+}
+
+/// The topic of a vehicle's Sun and magnetic-field arrows, a `foxglove.SceneUpdate` per
+/// EnvironmentMsg ([`super::scene::environment_scene`]).
+pub fn environment_topic(sc_id: &str) -> String {
+    format!("/flexdyn/{sc_id}/environment")
 }
 
 /// The topic of a vehicle's actuator arrows (thruster firings, rod dipoles), a
@@ -215,8 +225,6 @@ struct Vehicle {
     described: bool,
     geometry: Option<Geometry>,
     tf: Option<u16>,
-    /// The actuator-arrow channel, once opened (vehicles with thrusters or rods).
-    actuators: Option<u16>,
     /// (log time, publish time, state) of states recorded before the description.
     pending: Vec<(u64, u64, flexdyn_proto::StateMsg)>,
     pending_overflow: bool,
@@ -229,6 +237,8 @@ pub struct McapSink {
     schemas: HashMap<String, u16>,
     channels: HashMap<String, ChannelIds>,
     vehicles: HashMap<String, Vehicle>,
+    /// Arrow channels by topic ([`Self::scene_update_channel`]).
+    scene_channels: HashMap<String, u16>,
     sequences: HashMap<u16, u32>,
     last_log_time_ns: u64,
     gaps: SeqGaps,
@@ -258,6 +268,7 @@ impl McapSink {
             schemas: HashMap::new(),
             channels: HashMap::new(),
             vehicles: HashMap::new(),
+            scene_channels: HashMap::new(),
             sequences: HashMap::new(),
             last_log_time_ns: 0,
             gaps: SeqGaps::default(),
@@ -340,19 +351,7 @@ impl McapSink {
         let arrows = actuator_scene(g, state, &prefix, state.header.sim_time_ns);
         self.put(tf, log_time, publish_time, json.as_bytes())?;
         if let Some(arrows) = arrows {
-            let channel = match self.vehicles.get(sc_id).and_then(|v| v.actuators) {
-                Some(c) => c,
-                None => {
-                    let schema = self.schema("foxglove.SceneUpdate", "jsonschema", &|| {
-                        scene_update_schema().to_string().into_bytes()
-                    })?;
-                    let c = self.channel(schema, &actuator_topic(sc_id), "json")?;
-                    if let Some(v) = self.vehicles.get_mut(sc_id) {
-                        v.actuators = Some(c);
-                    }
-                    c
-                }
-            };
+            let channel = self.scene_update_channel(&actuator_topic(sc_id))?;
             self.put(
                 channel,
                 log_time,
@@ -443,6 +442,20 @@ impl McapSink {
             .map_err(|e| self.err(e))
     }
 
+    /// The `foxglove.SceneUpdate` channel on `topic`, opened on first use (the actuator and
+    /// environment arrows: only vehicles that have them get the channel).
+    fn scene_update_channel(&mut self, topic: &str) -> Result<u16, RecordError> {
+        if let Some(c) = self.scene_channels.get(topic) {
+            return Ok(*c);
+        }
+        let schema = self.schema("foxglove.SceneUpdate", "jsonschema", &|| {
+            scene_update_schema().to_string().into_bytes()
+        })?;
+        let c = self.channel(schema, topic, "json")?;
+        self.scene_channels.insert(topic.to_owned(), c);
+        Ok(c)
+    }
+
     fn vehicle_channels(&mut self, sc_id: &str, t_ns: u64) -> Result<Option<u16>, RecordError> {
         let Some(v) = self.vehicles.get(sc_id) else {
             return Ok(None);
@@ -519,6 +532,11 @@ impl McapSink {
         if let Some(channel) = decoded_channel {
             let json = decoded.to_json_bytes();
             self.put(channel, log_time, publish_time, &json)?;
+        }
+        if let Decoded::Environment(env) = &decoded {
+            let channel = self.scene_update_channel(&environment_topic(&sc_id))?;
+            let arrows = environment_scene(env, &format!("{sc_id}/"), log_time).to_string();
+            self.put(channel, log_time, publish_time, arrows.as_bytes())?;
         }
         if let Decoded::State(state) = decoded {
             let v = self.vehicles.entry(sc_id.clone()).or_default();

@@ -23,7 +23,7 @@ use crate::attitude::{dcm_to_quat, m2, mrp_to_quat};
 use crate::config::SimConfig;
 use crate::dynamics::dynamic_effectors::magnetorquer::MagnetorquerParams;
 use crate::dynamics::dynamic_effectors::thruster::ThrusterParams;
-use flexdyn_proto::StateMsg;
+use flexdyn_proto::{EnvironmentMsg, StateMsg};
 
 /// Name of the inertial frame.
 pub const FRAME_N: &str = "N";
@@ -404,6 +404,59 @@ pub fn actuator_scene(
     Some(json!({ "deletions": [], "entities": entities }))
 }
 
+/// \[m\] length of the Sun arrow, and of the field arrow at [`B_FULL_T`].
+pub const ENV_ARROW_M: f64 = 2.0;
+/// \[T\] the field drawn at [`ENV_ARROW_M`]: about the largest |B| at the surface (the IGRF
+/// dipole's polar field is 2·B0 ≈ 60 µT), so every LEO field fits.
+pub const B_FULL_T: f64 = 60e-6;
+
+/// The environment at one sample, as a `foxglove.SceneUpdate` of two arrows in B from its
+/// origin: the unit Sun direction `sun_b` ([`ENV_ARROW_M`] long; yellow in sunlight, its opacity
+/// the shadow factor ν with a 0.2 floor, so the arrow stays visible, grey, in umbra) and the
+/// field `b_b_t` (cyan, |B| / [`B_FULL_T`] of [`ENV_ARROW_M`], capped). An arrow whose model is
+/// off (its [`environment_flags`] bit clear, or a zero vector) is an empty entity, which clears
+/// it.
+///
+/// [`environment_flags`]: flexdyn_proto::environment_flags
+pub fn environment_scene(env: &EnvironmentMsg, prefix: &str, t_ns: u64) -> Value {
+    use flexdyn_proto::environment_flags::{MAGNETIC, SUN};
+    let frame = format!("{prefix}{FRAME_B}");
+    let origin = Vector3::zeros();
+    let sun_b = Vector3::from(env.sun_b);
+    let on = |bit: u8, v: &Vector3<f64>| env.flags & bit != 0 && v.norm() > 0.0;
+    let nu = env.shadow_factor.clamp(0.0, 1.0);
+    let sun_rgba = if nu > 0.0 {
+        [1.0, 0.85, 0.1, nu.max(0.2)]
+    } else {
+        [0.5, 0.5, 0.5, 0.2]
+    };
+    let unit = |v: &Vector3<f64>| v.try_normalize(0.0).unwrap_or_else(Vector3::x);
+    let sun = arrow_entity(
+        t_ns,
+        &frame,
+        &format!("{prefix}sun"),
+        &origin,
+        &unit(&sun_b),
+        if on(SUN, &sun_b) { ENV_ARROW_M } else { 0.0 },
+        sun_rgba,
+    );
+    let b_b_t = Vector3::from(env.b_b_t);
+    let field = arrow_entity(
+        t_ns,
+        &frame,
+        &format!("{prefix}b_field"),
+        &origin,
+        &unit(&b_b_t),
+        if on(MAGNETIC, &b_b_t) {
+            ENV_ARROW_M * (b_b_t.norm() / B_FULL_T).min(1.0)
+        } else {
+            0.0
+        },
+        [0.1, 0.8, 0.9, 0.9],
+    );
+    json!({ "deletions": [], "entities": [sun, field] })
+}
+
 /// The `foxglove.SceneUpdate` that draws the spacecraft: a grey hub box in B, a blue box per
 /// panel in its own frame, and a translucent gold plate per facet in B, frame-locked and never
 /// expiring (lifetime 0).
@@ -588,6 +641,23 @@ mod tests {
 
     /// Active rotation matrix of a Hamilton quaternion (w, x, y, z), written out independently
     /// of `attitude`: R = (w² − |v|²) I + 2 v vᵀ + 2 w [ṽ].
+    /// The direction an arrow points (its pose's +x).
+    fn direction(a: &Value) -> Vector3<f64> {
+        let q = &a["pose"]["orientation"];
+        let q = Vector4::new(
+            q["w"].as_f64().unwrap(),
+            q["x"].as_f64().unwrap(),
+            q["y"].as_f64().unwrap(),
+            q["z"].as_f64().unwrap(),
+        );
+        active(&q) * Vector3::x()
+    }
+
+    /// An arrow's whole length, shaft and head.
+    fn length(a: &Value) -> f64 {
+        a["shaft_length"].as_f64().unwrap() + a["head_length"].as_f64().unwrap()
+    }
+
     fn active(q: &Vector4<f64>) -> Matrix3<f64> {
         let (w, v) = (q[0], Vector3::new(q[1], q[2], q[3]));
         let vt = Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0);
@@ -747,18 +817,6 @@ mod tests {
             assert_eq!(e["frame_id"], "sc1/B");
             e["arrows"].as_array().unwrap().clone()
         };
-        let direction = |a: &Value| {
-            let q = &a["pose"]["orientation"];
-            let q = Vector4::new(
-                q["w"].as_f64().unwrap(),
-                q["x"].as_f64().unwrap(),
-                q["y"].as_f64().unwrap(),
-                q["z"].as_f64().unwrap(),
-            );
-            active(&q) * Vector3::x()
-        };
-        let length =
-            |a: &Value| a["shaft_length"].as_f64().unwrap() + a["head_length"].as_f64().unwrap();
         let plume = arrow_of("sc1/thruster0");
         assert_eq!(plume.len(), 1);
         // thr_pz1 pushes +y from (1, 0, 1): the plume points −y from there, 0.4 m long.
@@ -791,6 +849,51 @@ mod tests {
                 (active(&quat_x_to(&d)) * Vector3::x() - d).norm() < 1e-12,
                 "{d:?}"
             );
+        }
+    }
+
+    /// The Sun and field arrows of the LEO scenario's first environment sample point along the
+    /// message's `sun_b` and `b_b_t`, the field's length is |B| / B_FULL_T of the full arrow,
+    /// the Sun arrow greys out in umbra, and a model that is off clears its arrow.
+    #[test]
+    fn environment_arrows_follow_the_sun_and_the_field() {
+        let cfg = SimConfig::from_file(std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/leo_environment.toml"
+        )))
+        .unwrap();
+        let mut sim = crate::sim::Simulation::new(&cfg).unwrap();
+        let mut env = EnvironmentMsg::default();
+        sim.environment_into(&mut env);
+        let scene = environment_scene(&env, "sc1/", 3);
+        let entities = scene["entities"].as_array().unwrap();
+        let arrow = |id: &str| {
+            let e = entities.iter().find(|e| e["id"] == id).unwrap();
+            assert_eq!(e["frame_id"], "sc1/B");
+            e["arrows"].as_array().unwrap().clone()
+        };
+        let sun = arrow("sc1/sun");
+        assert!((direction(&sun[0]) - Vector3::from(env.sun_b)).norm() < 1e-12);
+        assert!((length(&sun[0]) - ENV_ARROW_M).abs() < 1e-12);
+        let b = Vector3::from(env.b_b_t);
+        // LEO: 20–60 µT, so the arrow is between a third of and the full length.
+        assert!((20e-6..60e-6).contains(&b.norm()), "{b:?}");
+        let field = arrow("sc1/b_field");
+        assert!((direction(&field[0]) - b.normalize()).norm() < 1e-12);
+        assert!((length(&field[0]) - ENV_ARROW_M * b.norm() / B_FULL_T).abs() < 1e-12);
+        // Umbra: the Sun arrow stays, grey and faint.
+        env.shadow_factor = 0.0;
+        let dark = environment_scene(&env, "sc1/", 3);
+        let dark_sun = &dark["entities"][0]["arrows"][0]["color"];
+        assert_eq!(
+            (dark_sun["r"].as_f64(), dark_sun["a"].as_f64()),
+            (Some(0.5), Some(0.2))
+        );
+        // Models off: both entities are there, empty (they clear the arrows).
+        env.flags = 0;
+        let off = environment_scene(&env, "sc1/", 3);
+        for e in off["entities"].as_array().unwrap() {
+            assert!(e["arrows"].as_array().unwrap().is_empty(), "{e}");
         }
     }
 

@@ -27,11 +27,13 @@ use foxglove::{Context, PartialMetadata, RawChannel, Schema, WebSocketServer};
 use zenoh::sample::SampleKind;
 
 use super::error::SinkError;
-use super::mcap_file::{actuator_topic, decoded_topic, scene_topic, tf_topic, VehicleInfo};
+use super::mcap_file::{
+    actuator_topic, decoded_topic, environment_topic, scene_topic, tf_topic, VehicleInfo,
+};
 use super::reader::{read_recording, RawSample};
 use super::scene::{
-    actuator_scene, frame_transforms, frame_transforms_schema, scene_update, scene_update_schema,
-    Geometry,
+    actuator_scene, environment_scene, frame_transforms, frame_transforms_schema, scene_update,
+    scene_update_schema, Geometry,
 };
 use super::topics::{classify, json_schema, Decoded};
 use crate::transport::{zenoh_config, Role, ZenohArgs};
@@ -154,13 +156,7 @@ impl Translator {
             })
             .collect();
         for (topic, json) in scenes {
-            if let Some(c) = self.channel(&topic, || {
-                Schema::new(
-                    "foxglove.SceneUpdate",
-                    "jsonschema",
-                    scene_update_schema().to_string().into_bytes(),
-                )
-            }) {
+            if let Some(c) = self.channel(&topic, scene_update_channel_schema) {
                 c.log_with_meta(json.as_bytes(), PartialMetadata { log_time: Some(t) });
             }
         }
@@ -188,6 +184,12 @@ impl Translator {
             let json = decoded.to_json_bytes();
             c.log_with_meta(&json, PartialMetadata { log_time: Some(t) });
         }
+        if let Decoded::Environment(env) = &decoded {
+            let json = environment_scene(env, &format!("{sc_id}/"), t).to_string();
+            if let Some(c) = self.channel(&environment_topic(&sc_id), scene_update_channel_schema) {
+                c.log_with_meta(json.as_bytes(), PartialMetadata { log_time: Some(t) });
+            }
+        }
         if let Decoded::State(state) = &decoded {
             self.latest_time_ns = self.latest_time_ns.max(t);
             let prefix = format!("{sc_id}/");
@@ -199,13 +201,8 @@ impl Translator {
                 None => (None, None),
             };
             if let Some(json) = arrows {
-                if let Some(c) = self.channel(&actuator_topic(&sc_id), || {
-                    Schema::new(
-                        "foxglove.SceneUpdate",
-                        "jsonschema",
-                        scene_update_schema().to_string().into_bytes(),
-                    )
-                }) {
+                if let Some(c) = self.channel(&actuator_topic(&sc_id), scene_update_channel_schema)
+                {
                     c.log_with_meta(json.as_bytes(), PartialMetadata { log_time: Some(t) });
                 }
             }
@@ -222,6 +219,15 @@ impl Translator {
             }
         }
     }
+}
+
+/// The schema of every `foxglove.SceneUpdate` channel (the scenes and the arrows).
+fn scene_update_channel_schema() -> Schema {
+    Schema::new(
+        "foxglove.SceneUpdate",
+        "jsonschema",
+        scene_update_schema().to_string().into_bytes(),
+    )
 }
 
 fn split_bind(bind: &str) -> Result<(String, u16), SinkError> {
