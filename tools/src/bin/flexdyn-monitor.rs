@@ -1,8 +1,8 @@
 //! `flexdyn-monitor`: the live telemetry and the server status, for operators.
 //!
 //! In a terminal it is a full-screen UI (ratatui): the summary below, split over lines, and
-//! sparklines of |σ_BN|, |ω_BN|, each panel angle |θ1|, |θ2| and the server's p99 frame
-//! lateness (`q`, Esc or Ctrl-C quits). With `--plain`, or when standard output is not a
+//! sparklines of |σ_BN|, |ω_BN|, each panel angle |θ1|, |θ2|, the shadow factor (with an
+//! environment message) and the server's p99 frame lateness (`q`, Esc or Ctrl-C quits). With `--plain`, or when standard output is not a
 //! terminal (a pipe, a log file, CI), it prints one line per interval instead:
 //!
 //! ```text
@@ -21,6 +21,11 @@
 //! - `rods`: with magnetorquers, each rod's applied dipole [A·m²], marked `S` when saturated;
 //! - `thrusters`: with thrusters, how many fire now, their pulses and propellant used so far,
 //!   and `!min` when a command is below a thruster's minimum on-time;
+//! - `env`: with an `[environment]` that publishes its message (`tlm/env`), the eclipse state
+//!   (`sunlit`, `penumbra`, `umbra`) with the shadow factor ν, |B| [µT] and the density
+//!   [kg/m³], each only when its model is on;
+//! - `sensors`: every sensor message heard in the interval (`flexdyn/<sc>/tlm/<kind>/<name>`),
+//!   as `<kind>/<name>=<messages per second>`;
 //! - `rejected`: the server's rejected commands by reason (`stale_tick:2,unknown_sender:1`), and
 //!   `dropped` the valid commands it dropped for a full queue.
 
@@ -31,8 +36,9 @@ use std::time::{Duration, Instant};
 use clap::Parser;
 use flexdyn_proto::client::transport::{frame_stamp_ns, mode_name, unix_now_ns};
 use flexdyn_proto::{
-    command_flags, decode_state, decode_status, effector_kind, magnetorquer_flags, thruster_flags,
-    wheel_flags, EffectorState, RunState, StatusMsg, NO_COMMAND,
+    command_flags, decode_environment, decode_state, decode_status, eclipse, effector_kind,
+    environment_flags, magnetorquer_flags, thruster_flags, wheel_flags, EffectorState,
+    EnvironmentMsg, RunState, StatusMsg, NO_COMMAND,
 };
 use flexdyn_tools::{percentile, CommonArgs};
 use zenoh::Wait;
@@ -75,6 +81,10 @@ struct Window {
     latencies_ns: Vec<u64>,
     undecodable: u64,
     status: Option<StatusMsg>,
+    /// The latest EnvironmentMsg (None: none heard).
+    environment: Option<EnvironmentMsg>,
+    /// Sensor messages heard in the interval, by `<kind>/<name>`.
+    sensors: std::collections::BTreeMap<String, u64>,
     /// When the last StateMsg arrived (None: never).
     last_state_at: Option<Instant>,
     /// When the last StatusMsg arrived (None: never).
@@ -128,6 +138,43 @@ fn flags_str(f: u8) -> String {
 
 /// `[100.0,-52.3T,600.0S]rad/s`: each wheel's speed with `T` (torque-limited) and `S`
 /// (speed-limited) marks.
+/// The environment segment: the eclipse state with ν, |B| and the density, each only when the
+/// message's flags say its model is on.
+fn environment_str(env: &EnvironmentMsg) -> String {
+    let mut out = String::from(" env");
+    if env.flags & environment_flags::SHADOW != 0 {
+        let state = match env.eclipse {
+            eclipse::SUNLIT => "sunlit",
+            eclipse::PENUMBRA => "penumbra",
+            eclipse::UMBRA => "umbra",
+            _ => "eclipse?",
+        };
+        out.push_str(&format!(" {state} nu={:.3}", env.shadow_factor));
+    }
+    if env.flags & environment_flags::MAGNETIC != 0 {
+        out.push_str(&format!(" |B|={:.1}uT", norm(env.b_b_t) * 1e6));
+    }
+    if env.flags & environment_flags::ATMOSPHERE != 0 {
+        out.push_str(&format!(" rho={:.2e}kg/m3", env.density_kg_m3));
+    }
+    if out.len() == " env".len() {
+        out.push_str(" (no models on)");
+    }
+    out
+}
+
+/// The sensor segment: each sensor heard in the interval with its message rate.
+fn sensors_str(counts: &std::collections::BTreeMap<String, u64>, interval: Duration) -> String {
+    if counts.is_empty() {
+        return String::new();
+    }
+    let rates: Vec<String> = counts
+        .iter()
+        .map(|(k, n)| format!("{k}={:.1}/s", *n as f64 / interval.as_secs_f64()))
+        .collect();
+    format!(" sensors {}", rates.join(","))
+}
+
 fn wheels_str(wheels: &[(f64, u32)]) -> String {
     let parts: Vec<String> = wheels
         .iter()
@@ -241,6 +288,15 @@ fn line(w: &mut Window, interval: Duration, state_topic: &str) -> String {
     if w.undecodable > 0 {
         out.push_str(&format!(" undecodable={}", w.undecodable));
     }
+    if let Some(env) = &w.environment {
+        out.push_str(" |");
+        out.push_str(&environment_str(env));
+    }
+    let sensors = sensors_str(&w.sensors, interval);
+    if !sensors.is_empty() {
+        out.push_str(" |");
+        out.push_str(&sensors);
+    }
     match &w.status {
         None => out.push_str(" | no status yet"),
         Some(s) => {
@@ -281,6 +337,7 @@ fn line(w: &mut Window, interval: Duration, state_topic: &str) -> String {
     w.states = 0;
     w.gaps = 0;
     w.undecodable = 0;
+    w.sensors.clear();
     out
 }
 
@@ -360,6 +417,38 @@ fn run(args: Args) -> anyhow::Result<()> {
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.status()))?;
 
+    let w = window.clone();
+    let env_key = topics.environment();
+    let _environment = session
+        .declare_subscriber(env_key.as_str())
+        .callback(move |sample| {
+            if let Ok(e) = decode_environment(&sample.payload().to_bytes()) {
+                w.lock().unwrap_or_else(|p| p.into_inner()).environment = Some(e);
+            }
+        })
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot subscribe to {env_key}: {e}"))?;
+    let w = window.clone();
+    // Every sensor key is `flexdyn/<sc>/tlm/<kind>/<name>`: two segments below `tlm`, which
+    // the state (`tlm/state`) and environment (`tlm/env`) keys do not have.
+    let sensor_keys = format!("flexdyn/{}/tlm/*/*", topics.sc_id());
+    let tlm_prefix = format!("flexdyn/{}/tlm/", topics.sc_id());
+    let _sensors = session
+        .declare_subscriber(sensor_keys.as_str())
+        .callback(move |sample| {
+            let key = sample.key_expr().as_str();
+            let name = key.strip_prefix(tlm_prefix.as_str()).unwrap_or(key);
+            let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
+            match w.sensors.get_mut(name) {
+                Some(n) => *n += 1,
+                None => {
+                    w.sensors.insert(name.to_owned(), 1);
+                }
+            }
+        })
+        .wait()
+        .map_err(|e| anyhow::anyhow!("cannot subscribe to {sensor_keys}: {e}"))?;
+
     tracing::info!(
         state = topics.state(),
         status = topics.status(),
@@ -370,8 +459,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let tui = !args.plain && std::io::stdout().is_terminal();
     if tui {
         let result = run_tui(&window, &stop, interval, &args, topics.state());
-        drop(_states);
-        drop(_status);
+        drop((_states, _status, _environment, _sensors));
         let _ = session.close().wait();
         return result;
     }
@@ -416,8 +504,7 @@ fn run(args: Args) -> anyhow::Result<()> {
             break;
         }
     }
-    drop(_states);
-    drop(_status);
+    drop((_states, _status, _environment, _sensors));
     session
         .close()
         .wait()
@@ -471,19 +558,28 @@ fn run_tui(
                 .as_ref()
                 .map_or(f64::NAN, |s| s.timing.lateness_p99_ns as f64 * 1e-3);
             screen.series[2].push(p99);
-            // One sparkline per panel angle, added as pairs appear.
+            // One sparkline per panel angle, added as pairs appear, and the shadow factor once
+            // an environment message with a shadow model arrives.
+            let mut push =
+                |title: String, v: f64| match screen.series.iter_mut().find(|s| s.title == title) {
+                    Some(s) => s.push(v),
+                    None => {
+                        let mut s = Series::new(title);
+                        s.push(v);
+                        screen.series.push(s);
+                    }
+                };
             for (k, (th1, th2)) in w.thetas.clone().into_iter().enumerate() {
                 for (j, th) in [(1, th1), (2, th2)] {
-                    let title = format!("pair{} |θ{j}| (rad)", k + 1);
-                    match screen.series.iter_mut().find(|s| s.title == title) {
-                        Some(s) => s.push(th.abs()),
-                        None => {
-                            let mut s = Series::new(title);
-                            s.push(th.abs());
-                            screen.series.push(s);
-                        }
-                    }
+                    push(format!("pair{} |θ{j}| (rad)", k + 1), th.abs());
                 }
+            }
+            if let Some(env) = w
+                .environment
+                .as_ref()
+                .filter(|e| e.flags & environment_flags::SHADOW != 0)
+            {
+                push("shadow factor ν (1 sunlit)".to_owned(), env.shadow_factor);
             }
             if Instant::now() >= next_summary {
                 next_summary += interval;
@@ -539,6 +635,42 @@ mod tests {
             ..none
         };
         assert_eq!(rejected_by_reason(&some), "malformed:2,wrong_identity:7");
+    }
+
+    /// The eclipse state follows the message's `eclipse` code, and each quantity shows only
+    /// with its model's flag.
+    #[test]
+    fn environment_summary_names_the_eclipse_state() {
+        let mut env = EnvironmentMsg {
+            flags: environment_flags::SHADOW | environment_flags::MAGNETIC,
+            eclipse: eclipse::PENUMBRA,
+            shadow_factor: 0.4321,
+            b_b_t: [3e-6, 0.0, -4e-6],
+            density_kg_m3: 1e-12,
+            ..Default::default()
+        };
+        assert_eq!(environment_str(&env), " env penumbra nu=0.432 |B|=5.0uT");
+        env.eclipse = eclipse::UMBRA;
+        env.shadow_factor = 0.0;
+        env.flags |= environment_flags::ATMOSPHERE;
+        assert_eq!(
+            environment_str(&env),
+            " env umbra nu=0.000 |B|=5.0uT rho=1.00e-12kg/m3"
+        );
+        env.flags = 0;
+        assert_eq!(environment_str(&env), " env (no models on)");
+    }
+
+    #[test]
+    fn sensor_summary_gives_each_sensor_its_rate() {
+        let counts = [("css/css".to_owned(), 20), ("imu/hub".to_owned(), 200)]
+            .into_iter()
+            .collect();
+        assert_eq!(
+            sensors_str(&counts, Duration::from_secs(2)),
+            " sensors css/css=10.0/s,imu/hub=100.0/s"
+        );
+        assert_eq!(sensors_str(&Default::default(), Duration::from_secs(1)), "");
     }
 
     #[test]

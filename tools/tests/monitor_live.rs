@@ -1,0 +1,75 @@
+//! `flexdyn-monitor --plain` against a real-time server on the LEO scenario (in this process, on
+//! a loopback port the OS chose): the line shows the eclipse state, |B| and the density from the
+//! environment message, and every sensor with its rate.
+
+mod support;
+
+use std::process::Command;
+use std::time::Duration;
+
+use flexdyn::config::SimConfig;
+use flexdyn::server::ServerSettings;
+use flexdyn::sim::Simulation;
+use flexdyn_proto::{eclipse, EnvironmentMsg};
+use support::{endpoint, ServerHandle};
+
+#[test]
+fn the_monitor_shows_the_eclipse_state_the_field_and_the_sensors() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/leo_environment.toml");
+    let cfg = SimConfig::from_file(&path).unwrap();
+    // The truth at the start, in this process: the eclipse state the monitor must name. The
+    // scenario's first seconds are far from a shadow boundary (checked: ν is exactly 0 or 1).
+    let mut env = EnvironmentMsg::default();
+    Simulation::new(&cfg).unwrap().environment_into(&mut env);
+    assert!(env.shadow_factor == 0.0 || env.shadow_factor == 1.0);
+    let expected = match env.eclipse {
+        eclipse::SUNLIT => "sunlit",
+        _ => "umbra",
+    };
+    let mut server = ServerHandle::start(ServerSettings::default(), cfg);
+    let out = Command::new(env!("CARGO_BIN_EXE_flexdyn-monitor"))
+        .args(["--connect", &endpoint(server.port), "--plain"])
+        .args(["--interval-s", "1", "--duration-s", "3.5"])
+        .output()
+        .unwrap();
+    server.stop();
+    server.join(Duration::from_secs(10)).unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    // The last full interval: every stream has been heard for a whole second.
+    let line = stdout.lines().last().unwrap();
+    let env_part = line
+        .split(" | ")
+        .find(|p| p.starts_with("env "))
+        .unwrap_or_else(|| panic!("no env segment: {line}"));
+    assert!(
+        env_part.starts_with(&format!("env {expected} nu=")),
+        "{line}"
+    );
+    // |B| at 500 km: between the dipole's equatorial and polar values scaled by (R/r)³,
+    // 30 µT·0.80 ≈ 24 µT and 60 µT·0.80 ≈ 48 µT (IGRF's non-dipole terms add a few µT).
+    let b_ut: f64 = env_part
+        .split("|B|=")
+        .nth(1)
+        .and_then(|s| s.split("uT").next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no |B|: {line}"));
+    assert!((18.0..55.0).contains(&b_ut), "{line}");
+    assert!(env_part.contains(" rho="), "{line}");
+    // The scenario's three sensors at their configured 10 Hz (±1 message for the interval's
+    // edges).
+    let sensors = line
+        .split(" | ")
+        .find(|p| p.starts_with("sensors "))
+        .unwrap_or_else(|| panic!("no sensors segment: {line}"));
+    for name in ["mag/mag1", "css/css", "fss/fss"] {
+        let rate: f64 = sensors
+            .split(&format!("{name}="))
+            .nth(1)
+            .and_then(|s| s.split("/s").next())
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(|| panic!("no {name}: {line}"));
+        assert!((9.0..=11.0).contains(&rate), "{name}: {line}");
+    }
+}
