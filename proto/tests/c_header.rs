@@ -6,7 +6,7 @@
 //!   message from its table values and decodes the golden files (`proto/golden/`) back;
 //! - `c_and_rust_decoders_agree_on_100000_buffers`: `proto/c/tests/fuzz_decode.c` and the Rust
 //!   decoders see the same 100,000 seeded buffers (valid messages of every type, mutated,
-//!   truncated, extended, random with a valid version, oversized) through all eleven decoders;
+//!   truncated, extended, random with a valid version, oversized) through all twelve decoders;
 //!   (`flexdyn-decode-verdicts`, the canonical verdict printer the Python SDK's fuzz test uses
 //!   too); they must agree on accept/reject, on the reason (and its numbers or field), and on every
 //!   decoded field bit for bit. Every buffer the C side decodes it also re-encodes, and that must
@@ -24,9 +24,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use flexdyn_proto::{
-    encode, CommandKind, CommandMsg, CssMsg, EffectorInput, EffectorState, FssMsg, Header, ImuMsg,
-    MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters, RunState, StarTrackerMsg,
-    StateMsg, StatusMsg, TimeMsg, MAX_MESSAGE_BYTES,
+    encode, AppliedWrench, CommandKind, CommandMsg, CssMsg, EffectorInput, EffectorState,
+    EnvironmentMsg, FssMsg, Header, ImuMsg, MagnetometerMsg, Mode, OperatorAction, OperatorMsg,
+    RejectCounters, RunState, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg, MAX_MESSAGE_BYTES,
 };
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -277,8 +277,15 @@ impl Gen {
             .collect()
     }
 
+    fn wrench(&mut self) -> AppliedWrench {
+        AppliedWrench {
+            torque_b_nm: self.v(),
+            force_b_newton: self.v(),
+        }
+    }
+
     fn message(&mut self) -> Vec<u8> {
-        match self.below(10) {
+        match self.below(11) {
             0 => {
                 let effectors = (0..self.below(6))
                     .map(|_| EffectorState {
@@ -368,6 +375,23 @@ impl Gen {
                 alpha_rad: self.f64(),
                 beta_rad: self.f64(),
                 flags: self.u64() as u8,
+            }),
+            10 => encode(&EnvironmentMsg {
+                header: self.header(),
+                tai_ns_1958: self.u64(),
+                flags: self.u64() as u8,
+                eclipse: self.u64() as u8,
+                b_n_t: self.v(),
+                b_b_t: self.v(),
+                sun_n: self.v(),
+                sun_b: self.v(),
+                moon_n: self.v(),
+                shadow_factor: self.f64(),
+                density_kg_m3: self.f64(),
+                gravity_gradient: self.wrench(),
+                drag: self.wrench(),
+                solar_pressure: self.wrench(),
+                residual_dipole: self.wrench(),
             }),
             3 => {
                 // Mostly finite (accepted), sometimes with a non-finite number (NonFinite).
@@ -516,6 +540,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
             "magnetometer",
             "css",
             "fss",
+            "environment",
             "command",
             "status",
             "time",
@@ -541,7 +566,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
     }
     assert!(c_lines.next().is_none(), "extra C output");
     eprintln!(
-        "{N} buffers x 11 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
+        "{N} buffers x 12 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
     );
     // The stream exercises every outcome.
     for r in [

@@ -11,7 +11,7 @@ import subprocess
 from flexdyn import proto
 from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState, Header,
                            ImuMsg, MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg,
-                           StatusMsg, TimeMsg, CssMsg, FssMsg)
+                           StatusMsg, TimeMsg, CssMsg, FssMsg, EnvironmentMsg, SourceWrench)
 
 N = 20_000
 
@@ -68,6 +68,15 @@ def fss_line(m):
     return str(Line().h(m.header).f((m.alpha_rad, m.beta_rad)).u(m.flags))
 
 
+def environment_line(m):
+    l = Line().h(m.header).u(m.tai_ns_1958, m.flags, m.eclipse)
+    l.f(m.b_n_t).f(m.b_b_t).f(m.sun_n).f(m.sun_b).f(m.moon_n).f((m.shadow_factor, m.density_kg_m3))
+    for s in EnvironmentMsg.SOURCES:
+        w = getattr(m, s)
+        l.f(w.torque_b_nm).f(w.force_b_newton)
+    return str(l)
+
+
 def command_line(m):
     l = Line().h(m.header).u(m.sender_id, m.kind)
     if m.kind != proto.NO_COMMAND_KIND:
@@ -104,7 +113,7 @@ DECODERS = [
     (StateMsg.decode, state_line), (ImuMsg.decode, imu_line),
     (StarTrackerMsg.decode, star_tracker_line), (MagnetometerMsg.decode, magnetometer_line),
     (CssMsg.decode, css_line), (FssMsg.decode, fss_line),
-    (CommandMsg.decode, command_line),
+    (EnvironmentMsg.decode, environment_line), (CommandMsg.decode, command_line),
     (StatusMsg.decode, status_line), (TimeMsg.decode, time_line),
     (OperatorMsg.decode, operator_line), (Header.decode, lambda h: str(Line().h(h))),
 ]
@@ -144,7 +153,7 @@ def gen_buffer(r):
     def header():
         return Header(r.getrandbits(32), r.getrandbits(64), r.getrandbits(64), r.getrandbits(64))
 
-    k = r.randrange(10)
+    k = r.randrange(11)
     if k == 0:
         b = StateMsg(header(), v(3), v(4), v(3), v(3), v(3), v(3), v(3), f64(), f64(), v(3), v(3),
                      v(3), v(3), r.getrandbits(8),
@@ -179,6 +188,12 @@ def gen_buffer(r):
                     (r.getrandbits(32), r.getrandbits(32))).encode()
     elif k == 7:
         b = OperatorMsg(header(), r.randrange(3), r.getrandbits(64)).encode()
+    elif k == 10:
+        def wrench():
+            return SourceWrench(v(3), v(3))
+        b = EnvironmentMsg(header(), r.getrandbits(64), r.getrandbits(8), r.getrandbits(8), v(3),
+                           v(3), v(3), v(3), v(3), f64(), f64(), wrench(), wrench(), wrench(),
+                           wrench()).encode()
     b = bytearray(b)
     k = r.randrange(10)
     if k in (3, 4, 5):
@@ -207,17 +222,17 @@ def test_python_and_rust_decoders_agree_on_20000_buffers(verdicts_bin):
     stream = b"".join(struct.pack("<I", len(b)) + b for b in buffers)
     rust = subprocess.run([str(verdicts_bin)], input=stream, capture_output=True, check=True)
     rust_lines = rust.stdout.decode().splitlines()
-    assert len(rust_lines) == 11 * N
+    assert len(rust_lines) == 12 * N
     reasons = {}
-    names = ["state", "imu", "star_tracker", "magnetometer", "css", "fss", "command", "status",
-             "time", "operator", "header"]
+    names = ["state", "imu", "star_tracker", "magnetometer", "css", "fss", "environment",
+             "command", "status", "time", "operator", "header"]
     for i, b in enumerate(buffers):
         for j, got in enumerate(python_lines(b)):
-            want = rust_lines[11 * i + j]
+            want = rust_lines[12 * i + j]
             assert got == want, f"buffer {i} ({len(b)} bytes), {names[j]}: Python {got!r} vs Rust {want!r}"
             key = want.split()[1] if want.startswith("E") else "accepted"
             reasons[key] = reasons.get(key, 0) + 1
-    print(f"{N} buffers x 11 decoders: {reasons}")
+    print(f"{N} buffers x 12 decoders: {reasons}")
     for k in ("accepted", "Length", "TrailingBytes", "TooLarge", "UnknownVersion", "NonFinite",
               "Malformed"):
         assert reasons.get(k, 0) > 0, k

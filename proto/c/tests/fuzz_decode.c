@@ -1,7 +1,7 @@
 /*
  * Differential-fuzz driver for the C decoders. Reads records from stdin, each a u32 LE length
  * and that many bytes, and writes one line per record and decoder (state, imu, star tracker,
- * magnetometer, css, fss, command, status, time, operator, header, in that order) in the canonical form that proto/tests/c_header.rs
+ * magnetometer, css, fss, environment, command, status, time, operator, header, in that order) in the canonical form that proto/tests/c_header.rs
  * also prints from the Rust decoders:
  *
  *   E <reason> [numbers or field]     on a decode error (reason as the Rust DecodeError variant)
@@ -164,6 +164,37 @@ static void one(const uint8_t *buf, size_t len) {
             fs(&m.alpha_rad, 1);
             fs(&m.beta_rad, 1);
             u(m.flags);
+            printf("\n");
+        }
+    }
+    {
+        fd_environment_msg m;
+        const fd_source_wrench *src[4];
+        int i;
+        e = fd_decode_environment(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_environment(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            u(m.tai_ns_1958);
+            u(m.flags);
+            u(m.eclipse);
+            fs(m.b_n_t, 3);
+            fs(m.b_b_t, 3);
+            fs(m.sun_n, 3);
+            fs(m.sun_b, 3);
+            fs(m.moon_n, 3);
+            f(m.shadow_factor);
+            f(m.density_kg_m3);
+            src[0] = &m.gravity_gradient;
+            src[1] = &m.drag;
+            src[2] = &m.solar_pressure;
+            src[3] = &m.residual_dipole;
+            for (i = 0; i < 4; ++i) {
+                fs(src[i]->torque_b_nm, 3);
+                fs(src[i]->force_b_newton, 3);
+            }
             printf("\n");
         }
     }

@@ -3,8 +3,8 @@
 //! `proto/c/tests/fuzz_decode.c`, the Python package's `tests/test_proto_fuzz.py`).
 //!
 //! Input (stdin): records of a u32 LE length and that many bytes. Output (stdout): per record,
-//! eleven lines, one per decoder (state, imu, star tracker, magnetometer, css, fss, command,
-//! status, time, operator, header):
+//! twelve lines, one per decoder (state, imu, star tracker, magnetometer, css, fss, environment,
+//! command, status, time, operator, header):
 //! `E <reason> [numbers or field]` for an error (the `DecodeError` variant; `Length needed
 //! actual`, `TrailingBytes expected actual`, `TooLarge actual`, `UnknownVersion found`,
 //! `NonFinite field`, `Malformed`), or `O <fields>` for a decoded message: every field in wire
@@ -14,10 +14,10 @@ use std::fmt::Write as _;
 use std::io::{Read, Write};
 
 use flexdyn_proto::{
-    decode_command, decode_css, decode_fss, decode_header, decode_imu, decode_magnetometer,
-    decode_operator, decode_star_tracker, decode_state, decode_status, decode_time, CommandKind,
-    CommandMsg, DecodeError, Header, ImuMsg, MagnetometerMsg, OperatorMsg, StarTrackerMsg,
-    StateMsg, StatusMsg, TimeMsg,
+    decode_command, decode_css, decode_environment, decode_fss, decode_header, decode_imu,
+    decode_magnetometer, decode_operator, decode_star_tracker, decode_state, decode_status,
+    decode_time, CommandKind, CommandMsg, DecodeError, EnvironmentMsg, Header, ImuMsg,
+    MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
 };
 
 fn err_line(e: &DecodeError) -> String {
@@ -109,6 +109,29 @@ fn star_tracker_line(m: &StarTrackerMsg) -> String {
 fn magnetometer_line(m: &MagnetometerMsg) -> String {
     let mut l = Line::new();
     l.h(&m.header).f(&m.b_s_t).u(m.saturation_flags.into());
+    l.0
+}
+
+fn environment_line(m: &EnvironmentMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header)
+        .u(m.tai_ns_1958)
+        .u(m.flags.into())
+        .u(m.eclipse.into())
+        .f(&m.b_n_t)
+        .f(&m.b_b_t)
+        .f(&m.sun_n)
+        .f(&m.sun_b)
+        .f(&m.moon_n)
+        .f(&[m.shadow_factor, m.density_kg_m3]);
+    for w in [
+        &m.gravity_gradient,
+        &m.drag,
+        &m.solar_pressure,
+        &m.residual_dipole,
+    ] {
+        l.f(&w.torque_b_nm).f(&w.force_b_newton);
+    }
     l.0
 }
 
@@ -210,7 +233,7 @@ fn operator_line(m: &OperatorMsg) -> String {
     l.0
 }
 
-/// The eleven verdicts for one buffer, in the order of the module docs.
+/// The twelve verdicts for one buffer, in the order of the module docs.
 fn rust_lines(b: &[u8]) -> Vec<String> {
     fn line<M>(r: Result<M, DecodeError>, f: impl Fn(&M) -> String) -> String {
         match r {
@@ -235,6 +258,7 @@ fn rust_lines(b: &[u8]) -> Vec<String> {
                 .u(m.flags.into());
             l.0
         }),
+        line(decode_environment(b), environment_line),
         line(decode_command(b), command_line),
         line(decode_status(b), status_line),
         line(decode_time(b), time_line),
