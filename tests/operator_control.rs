@@ -303,14 +303,18 @@ fn lockstep_run_n_ticks_holds_exactly_at_n_thread() {
 
 #[test]
 fn operator_commands_do_not_apply_to_a_batch_run() {
+    // The batch run is far longer than the test: it must still be stepping when the operator
+    // commands arrive (a 60 s batch finished before they did on a fast CI host, and nothing
+    // was refused). The test waits for the server to count both refusals in its StatusMsg,
+    // checks that it kept stepping afterwards (a pause would have held it), then stops it.
     let topics = Topics::new("sc1").unwrap();
     let settings = ServerSettings {
         mode: Mode::Batch,
         participants: vec![],
-        duration_ns: Some(60_000_000_000),
+        duration_ns: Some(1_000_000 * 1_000_000_000),
         ..ServerSettings::default()
     };
-    let server = ServerHandle::start(settings, reference_config(100.0));
+    let mut server = ServerHandle::start(settings, reference_config(100.0));
     let obs = Observer::start(server.port, &topics);
     let op = connecting_session(server.port);
     assert!(wait_until(Duration::from_secs(20), || obs
@@ -318,8 +322,22 @@ fn operator_commands_do_not_apply_to_a_batch_run() {
         .is_some()));
     operator(&op, &topics, OperatorAction::Pause, 0);
     operator(&op, &topics, OperatorAction::RunTicks, 2);
+    assert!(
+        wait_until(Duration::from_secs(20), || obs
+            .last_status()
+            .is_some_and(|s| s.rejected.operator_refused == 2)),
+        "the batch server never counted the two operator commands as refused"
+    );
+    let tick_at_refusal = obs.last_tick().expect("a state was seen");
+    assert!(
+        wait_until(Duration::from_secs(20), || obs
+            .last_tick()
+            .is_some_and(|t| t > tick_at_refusal + 100)),
+        "the batch run stopped stepping after the operator commands (held at {tick_at_refusal})"
+    );
+    server.stop();
     let report = server.join(Duration::from_secs(60)).expect("the run ends");
-    assert_eq!(report.last_tick, 6000);
+    assert!(report.last_tick > tick_at_refusal + 100);
     assert_eq!(report.rejected.operator_refused, 2);
 }
 
