@@ -237,6 +237,16 @@ impl Simulation {
         }
     }
 
+    /// Moves the environment models' updates to a worker thread
+    /// ([`EnvironmentModel::offload`]): the physics thread then only picks up each sample. The
+    /// run's output is bit-identical either way. Without `[environment]`, nothing to do.
+    pub fn offload_environment(&mut self) -> std::io::Result<()> {
+        match self.environment.as_mut() {
+            Some(env) => env.offload(),
+            None => Ok(()),
+        }
+    }
+
     /// The environment models, if configured.
     pub fn environment(&self) -> Option<&EnvironmentModel> {
         self.environment.as_ref()

@@ -101,3 +101,29 @@ fn stepping_with_every_model_on_allocates_nothing() {
         "{env:?}"
     );
 }
+
+/// The same with the updates offloaded to the environment worker (the server's default): the
+/// stepping thread posts requests and takes answers without allocating (the worker's own
+/// allocations, if any, are on its thread and not counted here).
+#[test]
+fn stepping_with_offloaded_updates_allocates_nothing() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/leo_environment.toml");
+    let cfg = flexdyn::config::SimConfig::from_file(&path).unwrap();
+    let mut sim = flexdyn::sim::Simulation::new(&cfg).unwrap();
+    sim.offload_environment().unwrap();
+    sim.step();
+    let before = allocations();
+    for _ in 0..20 {
+        sim.step_n(100);
+        // Give the worker time to answer, so the answer path is the one counted.
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    let after = allocations();
+    assert_eq!(after - before, 0, "allocations while stepping, offloaded");
+    let taken = sim.environment().unwrap().prefetched_samples();
+    assert!(
+        taken >= 10,
+        "only {taken} of 20 updates came from the worker"
+    );
+}

@@ -32,6 +32,7 @@ use flexdyn::environment::ephemeris::sun_position_n_m;
 use flexdyn::environment::facets::{FacetModel, SOLAR_IRRADIANCE_1AU_W_M2};
 use flexdyn::environment::magnetic::Igrf;
 use flexdyn::environment::model::EnvironmentModel;
+use flexdyn::environment::prefetch::Request;
 use flexdyn::environment::EnvironmentSample;
 use flexdyn::server::ServerSettings;
 use flexdyn::sim::Simulation;
@@ -176,6 +177,7 @@ fn environment_message_at_its_rate_agrees_with_independent_models() {
         cfg.hub.inertia_bc_b_kg_m2,
     );
     let mut saw_torque = [false; 4];
+    let mut checked = 0;
     for m in &seen.envs {
         let k = m.header.tick;
         let t = m.header.sim_time_ns;
@@ -183,6 +185,24 @@ fn environment_message_at_its_rate_agrees_with_independent_models() {
         let r_n = v(st.r_bn_n_m);
         let v_n = v(st.v_bn_n_m_s);
         let dcm_bn = mrp_to_dcm(&v(st.sigma_bn));
+        // Where the models were evaluated: at the state itself for the first update (t = 0),
+        // else at the position predicted from the state of the update before, 10 ticks earlier
+        // (`environment::prefetch::Request::predicted`). Without that state (the subscriber
+        // joined late), this message is skipped.
+        let r_model_n = if k == 0 {
+            r_n
+        } else {
+            match seen.states.get(&(k - 10)) {
+                Some(p) => {
+                    let t0 = (k - 10) * frame_ns;
+                    Request::predicted(t0, &v(p.r_bn_n_m), &v(p.v_bn_n_m_s), t).r_bn_n_m
+                }
+                None => continue,
+            }
+        };
+        // A rigid hub: the prediction is the state to ½|J2|Δ² ≤ 1.2e-4 m.
+        assert!((r_model_n - r_n).norm() < 1.2e-4, "tick {k}");
+        checked += 1;
         assert_eq!(
             m.flags,
             environment_flags::EPOCH_VALID
@@ -198,14 +218,14 @@ fn environment_message_at_its_rate_agrees_with_independent_models() {
         let times = epoch.times(t);
         let earth = rotation.at(&times);
         let year = epoch.utc_calendar(t).decimal_year();
-        let b_n = earth.dcm_ne() * igrf.field_ecef_t(year, &earth.r_e(&r_n));
+        let b_n = earth.dcm_ne() * igrf.field_ecef_t(year, &earth.r_e(&r_model_n));
         close(v(m.b_n_t), b_n, 1e-12, "B in N");
         close(v(m.b_b_t), dcm_bn * v(m.b_n_t), 1e-14, "B in B");
         let b_ut = b_n.norm() * 1e6;
         assert!((18.0..54.0).contains(&b_ut), "|B| = {b_ut} µT at 500 km");
 
         // The Sun direction from the published position.
-        let sun_n = (sun_position_n_m(times.tt_centuries_j2000()) - r_n).normalize();
+        let sun_n = (sun_position_n_m(times.tt_centuries_j2000()) - r_model_n).normalize();
         close(v(m.sun_n), sun_n, 1e-14, "Sun in N");
         close(v(m.sun_b), dcm_bn * sun_n, 1e-14, "Sun in B");
         assert!((v(m.moon_n).norm() - 1.0).abs() < 1e-14);
@@ -232,7 +252,7 @@ fn environment_message_at_its_rate_agrees_with_independent_models() {
         // Drag and solar pressure: the effectors at the published state, in a sample filled
         // afresh here (every message's tick is an update instant of the 10 Hz sample).
         let mut sample = EnvironmentSample::NONE;
-        model.fill(t, &r_n, &v_n, &mut sample);
+        model.fill(t, &r_model_n, &v_n, &mut sample);
         let stage = StageState {
             t_step_ns: t,
             dt_stage_s: 0.0,
@@ -298,6 +318,10 @@ fn environment_message_at_its_rate_agrees_with_independent_models() {
     }
     // Every source acted at some point (none of the checks above passed on zeros alone) — SRP
     // only if the run was in sunlight.
+    assert!(
+        checked >= 9,
+        "only {checked} messages had the state of the update before"
+    );
     let sunlit = seen.envs.iter().any(|m| m.shadow_factor > 0.0);
     assert_eq!(saw_torque, [true, true, sunlit, true]);
 }

@@ -9,6 +9,7 @@ use flexdyn::config::SimConfig;
 use flexdyn::environment::earth_rotation::EarthRotation;
 use flexdyn::environment::facets::FacetModel;
 use flexdyn::environment::magnetic::Igrf;
+use flexdyn::environment::prefetch::Request;
 use flexdyn::sim::Simulation;
 use nalgebra::Vector3;
 
@@ -37,10 +38,17 @@ fn residual_dipole_torque_is_m_cross_bn_b_at_the_sampled_field() {
          residual_dipole_m_b_am2 = [0.3, -0.2, 0.5]\n",
     );
     let mut sim = Simulation::new(&cfg).unwrap();
-    // 1.2 s of 1 ms steps; the next step starts with an update at t = 1.2 s, from this state.
-    sim.step_n(1200);
-    let t_ns = sim.t_sim_ns();
-    let r_bn_n_m = sim.spacecraft().state().r_bn_n;
+    // 1.1 s of 1 ms steps: the update at t = 1.1 s predicts the position for the next one, at
+    // 1.2 s, from this state (`environment::prefetch::Request::predicted`); 0.1 s later the
+    // next step starts with that update.
+    sim.step_n(1100);
+    let x = sim.spacecraft().state();
+    let t_ns = 1_200_000_000;
+    let r_bn_n_m = Request::predicted(sim.t_sim_ns(), &x.r_bn_n, &x.v_bn_n, t_ns).r_bn_n_m;
+    sim.step_n(100);
+    assert_eq!(sim.t_sim_ns(), t_ns);
+    // The prediction is the actual position to ½|J2|Δ² ≤ 1.2e-4 m (a rigid hub, no panels).
+    assert!((r_bn_n_m - sim.spacecraft().state().r_bn_n).norm() < 1.2e-4);
     sim.step();
     let sample = *sim.spacecraft().environment();
     assert_eq!(sample.t_sim_ns, t_ns);
@@ -63,7 +71,7 @@ fn residual_dipole_torque_is_m_cross_bn_b_at_the_sampled_field() {
     let b_ut = sample.b_field_n_t.norm() * 1e6;
     assert!((18.0..54.0).contains(&b_ut), "|B| = {b_ut} µT");
     // The held sample is not the field at the moved spacecraft: the rotation was done with
-    // the state of t = 1.2 s, and the sample keeps it (zero-order hold).
+    // the position predicted for t = 1.2 s, and the sample keeps it (zero-order hold).
 
     // Torque: ω̇ with the field minus ω̇ with no field, at the same state, is I⁻¹ (m × [BN]B)
     // (a pure couple on a rigid body: no ω × Iω difference, no translation coupling).

@@ -230,7 +230,7 @@ impl SimConfig {
         match (&self.environment, &self.epoch) {
             (Some(env), Some(epoch)) if env.needs_epoch() => {
                 crate::environment::model::EnvironmentModel::new(env, epoch)
-                    .map(Some)
+                    .map(|m| Some(m.on_step_grid(self.step_ns)))
                     .map_err(|e| ConfigError::Invalid {
                         field: "environment".into(),
                         problem: e.to_string(),

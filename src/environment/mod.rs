@@ -30,6 +30,8 @@
 //!   nutation, sidereal time, optional polar motion) with its error bound, and TEME → N.
 //! - [`orbit`]: initial orbits as alternatives to r/v — classical Keplerian elements, and TLE /
 //!   CCSDS OMM mean elements propagated to the epoch with SGP4.
+//! - [`prefetch`]: the worker thread that evaluates the next update ahead of time, so the models
+//!   stay off the physics thread, with bit-identical samples.
 //! - [`sample`]: the [`EnvironmentSample`] the dynamic effectors and sensors read, held between
 //!   model updates.
 //! - [`geodetic`]: WGS-84 ECEF ↔ geodetic latitude, longitude and height; the NED frame.
@@ -52,6 +54,7 @@ pub mod geodetic;
 pub mod magnetic;
 pub mod model;
 pub mod orbit;
+pub mod prefetch;
 pub mod sample;
 pub mod shadow;
 

@@ -219,7 +219,13 @@ fn prepare(
         name: "server.sc_id".into(),
         problem: e.to_string(),
     })?;
-    let sim = Simulation::new(cfg).map_err(|source| ServerError::Config { file: None, source })?;
+    let mut sim =
+        Simulation::new(cfg).map_err(|source| ServerError::Config { file: None, source })?;
+    // The environment models run on their own thread, never on the physics thread; the
+    // samples are the same bits either way, so a failed spawn only costs time.
+    if let Err(e) = sim.offload_environment() {
+        tracing::warn!(error = %e, "environment updates stay on the physics thread");
+    }
     tracing::info!(
         mode = mode_name(settings.mode),
         zid = %session.zid(),

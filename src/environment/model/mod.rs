@@ -15,9 +15,13 @@
 //! [`EnvironmentModel::fill`] allocates nothing, locks nothing and returns no `Result`: every
 //! parameter was checked when the model was built. [`EnvironmentModel::update_if_due`] runs it at
 //! the configured rate and holds the sample between updates (zero-order hold: see the README's
-//! "World" section for the error that costs).
+//! "World" section for the error that costs). Each update after the first is evaluated for the
+//! position predicted from the update before, so that [`EnvironmentModel::offload`] can move the
+//! evaluation to a worker thread without changing a bit ([`super::prefetch`]).
 
 pub mod schema;
+
+use std::sync::Arc;
 
 use nalgebra::Vector3;
 
@@ -28,6 +32,7 @@ use super::epoch::SimEpoch;
 use super::facets::Facet;
 use super::geodetic::geodetic_from_ecef;
 use super::magnetic::{CentredDipole, Igrf, MagneticError};
+use super::prefetch::{Prefetcher, Request};
 use super::shadow::{shadow_factor, ShadowModel};
 use super::EnvironmentSample;
 
@@ -122,9 +127,16 @@ enum Air {
     Nrlmsise00(Nrlmsise00Model),
 }
 
-/// The environment models of a run, built once; fills samples without allocating.
-#[derive(Debug, Clone)]
-pub struct EnvironmentModel {
+/// \[m\] how far the actual position at an update may be from the predicted one before the
+/// prediction counts as stale (the state was set from outside, e.g. a test placing the
+/// spacecraft) and the update is evaluated at the actual state instead. The prediction's own
+/// error is ½·|a_p|·Δ² ([`super::prefetch`]): 2e-4 m at 10 Hz in LEO, 10 m only at Δ ≈ 30 s.
+/// Either way the choice depends only on the states, so the run stays deterministic.
+pub const STALE_PREDICTION_M: f64 = 10.0;
+
+/// The models proper, shared with the prefetch worker ([`super::prefetch`]).
+#[derive(Debug)]
+struct Models {
     epoch: SimEpoch,
     rotation: EarthRotation,
     field: Field,
@@ -132,10 +144,44 @@ pub struct EnvironmentModel {
     sun: bool,
     moon: bool,
     shadow: Option<ShadowModel>,
+}
+
+/// The environment models of a run, built once; fills samples without allocating.
+///
+/// Update schedule: the first update (at the first call of [`Self::update_if_due`]) evaluates
+/// the models at the actual state; every later one at the instant it comes into force, for the
+/// position predicted from the state of the update before ([`Request::predicted`]), which lets a
+/// worker thread evaluate it ahead of time ([`Self::offload`]) with bit-identical results.
+#[derive(Debug)]
+pub struct EnvironmentModel {
+    models: Arc<Models>,
     update_ns: u64,
+    /// \[ns\] the step of the simulation time grid: an update due at `t` happens at the first
+    /// multiple of it at or after `t`.
+    step_ns: u64,
     /// \[ns\] time of the next due update (`None`: none yet).
     next_update_ns: Option<u64>,
     sample: EnvironmentSample,
+    /// What the next update evaluates, when it falls on the step grid as predicted.
+    next: Option<Request>,
+    /// The worker that evaluates `next` ahead of time ([`Self::offload`]).
+    prefetch: Option<Prefetcher>,
+}
+
+impl Clone for EnvironmentModel {
+    /// A copy of the models and the schedule, without the worker thread (its results are the
+    /// same without it).
+    fn clone(&self) -> Self {
+        Self {
+            models: self.models.clone(),
+            update_ns: self.update_ns,
+            step_ns: self.step_ns,
+            next_update_ns: self.next_update_ns,
+            sample: self.sample,
+            next: self.next,
+            prefetch: None,
+        }
+    }
 }
 
 /// A model that cannot be built for this epoch.
@@ -197,29 +243,68 @@ impl EnvironmentModel {
             AtmosphereSetting::Nrlmsise00(w) => Air::Nrlmsise00(Nrlmsise00Model::new(w)?),
         };
         Ok(Self {
-            epoch: epoch.clone(),
-            rotation: EarthRotation::new(epoch.earth_orientation()),
-            field,
-            air,
-            sun: settings.sun,
-            moon: settings.moon,
-            shadow: settings.shadow,
+            models: Arc::new(Models {
+                epoch: epoch.clone(),
+                rotation: EarthRotation::new(epoch.earth_orientation()),
+                field,
+                air,
+                sun: settings.sun,
+                moon: settings.moon,
+                shadow: settings.shadow,
+            }),
             update_ns: settings.update_ns.max(1),
+            step_ns: 1,
             next_update_ns: None,
             sample: EnvironmentSample::NONE,
+            next: None,
+            prefetch: None,
         })
+    }
+
+    /// The same models on a simulation stepping by `step_ns`: updates then happen at multiples
+    /// of it, which is where the next update's request is predicted for.
+    pub fn on_step_grid(mut self, step_ns: u64) -> Self {
+        self.step_ns = step_ns.max(1);
+        self
+    }
+
+    /// Starts a worker thread that evaluates each update ahead of time, so the models no longer
+    /// run on the caller's (physics) thread; the samples are bit-identical with or without it
+    /// ([`super::prefetch`]). Call it before stepping; an error (the thread could not be
+    /// spawned) leaves the updates on the caller's thread.
+    pub fn offload(&mut self) -> std::io::Result<()> {
+        let models = self.models.clone();
+        let prefetch = Prefetcher::spawn(move |req, out| {
+            models.fill(req.t_sim_ns, &req.r_bn_n_m, &req.v_bn_n_m_s, out)
+        })?;
+        if let Some(req) = &self.next {
+            prefetch.post(req);
+        }
+        self.prefetch = Some(prefetch);
+        Ok(())
+    }
+
+    /// Whether a worker evaluates the updates ([`Self::offload`]).
+    pub fn is_offloaded(&self) -> bool {
+        self.prefetch.is_some()
+    }
+
+    /// How many samples (updates and telemetry reads) came from the worker's answers, not from
+    /// the caller's own evaluation (0 without a worker).
+    pub fn prefetched_samples(&self) -> u64 {
+        self.prefetch.as_ref().map_or(0, Prefetcher::answers_taken)
     }
 
     /// The epoch.
     pub fn epoch(&self) -> &SimEpoch {
-        &self.epoch
+        &self.models.epoch
     }
 
     /// The numeric parameters of the built models, by configuration path
     /// (`environment.f107_sfu`, `environment.f107a_sfu`, `environment.ap` with NRLMSISE-00), for
     /// a campaign's read-back. Not on the stepping path.
     pub fn parameters(&self, out: &mut Vec<(String, f64)>) {
-        if let Air::Nrlmsise00(m) = &self.air {
+        if let Air::Nrlmsise00(m) = &self.models.air {
             let w = m.weather();
             out.push(("environment.f107_sfu".into(), w.f107_sfu));
             out.push(("environment.f107a_sfu".into(), w.f107a_sfu));
@@ -235,6 +320,100 @@ impl EnvironmentModel {
     /// Fills `out` at `t_sim_ns` for the hub point B at `r_bn_n_m` moving at `v_bn_n_m_s` (N).
     /// Allocation-free, lock-free, no `Result`.
     pub fn fill(
+        &self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+        out: &mut EnvironmentSample,
+    ) {
+        self.models.fill(t_sim_ns, r_bn_n_m, v_bn_n_m_s, out);
+    }
+
+    /// The sample in force from `t_sim_ns` on, without touching the update schedule: the one
+    /// [`Self::update_if_due`] would hold after a call at `t_sim_ns` (evaluated if an update is
+    /// due then, else the held one). For telemetry at an instant where the next step's update
+    /// has not run yet. Allocation-free.
+    pub fn sample_from(
+        &self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+    ) -> EnvironmentSample {
+        if self.next_update_ns.is_none_or(|next| t_sim_ns >= next) {
+            self.evaluate_update(t_sim_ns, r_bn_n_m, v_bn_n_m_s)
+        } else {
+            self.sample
+        }
+    }
+
+    /// Which models are on: (magnetic field, Sun, Moon, shadow, atmosphere).
+    pub fn models_on(&self) -> ModelsOn {
+        let m = &self.models;
+        ModelsOn {
+            magnetic: !matches!(m.field, Field::Off),
+            sun: m.sun,
+            moon: m.moon,
+            shadow: m.shadow.is_some(),
+            atmosphere: !matches!(m.air, Air::Off),
+        }
+    }
+
+    /// Refills the held sample when `t_sim_ns` has reached the next update time (the first call
+    /// always updates), and returns it then; `None` while the held sample still stands.
+    pub fn update_if_due(
+        &mut self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+    ) -> Option<&EnvironmentSample> {
+        if self.next_update_ns.is_some_and(|next| t_sim_ns < next) {
+            return None;
+        }
+        self.sample = self.evaluate_update(t_sim_ns, r_bn_n_m, v_bn_n_m_s);
+        let due_ns = t_sim_ns.saturating_add(self.update_ns);
+        self.next_update_ns = Some(due_ns);
+        // The next update happens at the first step boundary at or after `due_ns`.
+        let at_ns = due_ns.div_ceil(self.step_ns).saturating_mul(self.step_ns);
+        let req = Request::predicted(t_sim_ns, r_bn_n_m, v_bn_n_m_s, at_ns);
+        if let Some(p) = &self.prefetch {
+            p.post(&req);
+        }
+        self.next = Some(req);
+        Some(&self.sample)
+    }
+
+    /// The sample of an update at `t_sim_ns`: the predicted request's (from the worker if it
+    /// has answered, else evaluated here: the same bits), or, for the first update, one off the
+    /// predicted instant and one whose state is more than [`STALE_PREDICTION_M`] from the
+    /// prediction (a state set from outside), the models at the actual state.
+    fn evaluate_update(
+        &self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+    ) -> EnvironmentSample {
+        let mut s = EnvironmentSample::NONE;
+        match &self.next {
+            Some(req)
+                if req.t_sim_ns == t_sim_ns
+                    && (req.r_bn_n_m - r_bn_n_m).norm_squared()
+                        <= STALE_PREDICTION_M * STALE_PREDICTION_M =>
+            {
+                match self.prefetch.as_ref().and_then(|p| p.answer(req)) {
+                    Some(answer) => s = answer,
+                    None => self.fill(req.t_sim_ns, &req.r_bn_n_m, &req.v_bn_n_m_s, &mut s),
+                }
+            }
+            _ => self.fill(t_sim_ns, r_bn_n_m, v_bn_n_m_s, &mut s),
+        }
+        s
+    }
+}
+
+impl Models {
+    /// Fills `out` at `t_sim_ns` for the hub point B at `r_bn_n_m` moving at `v_bn_n_m_s` (N).
+    /// Allocation-free, lock-free, no `Result`.
+    fn fill(
         &self,
         t_sim_ns: u64,
         r_bn_n_m: &Vector3<f64>,
@@ -303,52 +482,6 @@ impl EnvironmentModel {
         if self.moon {
             out.r_moon_b_n_m = moon_position_n_m(t_tt_jc) - r_bn_n_m;
         }
-    }
-
-    /// The sample in force from `t_sim_ns` on, without touching the update schedule: the one
-    /// [`Self::update_if_due`] would hold after a call at `t_sim_ns` (filled afresh if an update
-    /// is due then, else the held one). For telemetry at an instant where the next step's update
-    /// has not run yet. Allocation-free.
-    pub fn sample_from(
-        &self,
-        t_sim_ns: u64,
-        r_bn_n_m: &Vector3<f64>,
-        v_bn_n_m_s: &Vector3<f64>,
-    ) -> EnvironmentSample {
-        let mut s = self.sample;
-        if self.next_update_ns.is_none_or(|next| t_sim_ns >= next) {
-            self.fill(t_sim_ns, r_bn_n_m, v_bn_n_m_s, &mut s);
-        }
-        s
-    }
-
-    /// Which models are on: (magnetic field, Sun, Moon, shadow, atmosphere).
-    pub fn models_on(&self) -> ModelsOn {
-        ModelsOn {
-            magnetic: !matches!(self.field, Field::Off),
-            sun: self.sun,
-            moon: self.moon,
-            shadow: self.shadow.is_some(),
-            atmosphere: !matches!(self.air, Air::Off),
-        }
-    }
-
-    /// Refills the held sample when `t_sim_ns` has reached the next update time (the first call
-    /// always updates), and returns it then; `None` while the held sample still stands.
-    pub fn update_if_due(
-        &mut self,
-        t_sim_ns: u64,
-        r_bn_n_m: &Vector3<f64>,
-        v_bn_n_m_s: &Vector3<f64>,
-    ) -> Option<&EnvironmentSample> {
-        if self.next_update_ns.is_some_and(|next| t_sim_ns < next) {
-            return None;
-        }
-        let mut s = self.sample;
-        self.fill(t_sim_ns, r_bn_n_m, v_bn_n_m_s, &mut s);
-        self.sample = s;
-        self.next_update_ns = Some(t_sim_ns.saturating_add(self.update_ns));
-        Some(&self.sample)
     }
 }
 

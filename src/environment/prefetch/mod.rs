@@ -1,0 +1,451 @@
+//! The next environment sample, computed ahead of time on a worker thread, so that the
+//! environment models (IGRF, NRLMSISE-00, the ephemerides, the Earth's orientation: about 15 µs
+//! per update) never run on the physics thread — and with output bit-identical to computing it
+//! there.
+//!
+//! # Why the result cannot depend on the worker's timing
+//! The sample that comes into force at update instant `t₁` is, by definition, the environment
+//! at `t₁` for the hub position **predicted** from the state at the previous update `t₀`
+//! ([`Request::predicted`]), not for the state actually reached at `t₁`. That request is known at
+//! `t₀`, so the physics thread hands it to the worker then and picks the answer up at `t₁`. If
+//! the answer is not there yet (a lockstep or batch run faster than the worker, a worker that was
+//! descheduled, no worker at all), the physics thread evaluates the **same request** with the
+//! same function itself. Both paths run identical floating-point code on identical inputs, so
+//! the sample, and every state after it, is the same bit for bit whichever path ran: the worker
+//! is only a cache. `tests/environment_prefetch.rs` checks this on the LEO scenario.
+//!
+//! # What the prediction costs
+//! [`Request::predicted`] propagates the point-mass Kepler motion by its Taylor series to the
+//! third order in Δ = t₁ − t₀ (position, velocity, acceleration and jerk of the two-body
+//! problem; Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed., §2.3, eq. 2-3 and
+//! its time derivative). What it leaves out is every other acceleration `a_p` of the hub point
+//! B: J2 (up to 2.4e-2 m/s² at 500 km), B's own motion about the centre of mass as the panels
+//! vibrate, drag and solar pressure (below 1e-6 m/s²), a commanded force (F/m). The predicted
+//! position is then off by at most ½·max|a_p|·Δ² plus the two-body remainder (n⁴·r·Δ⁴/24,
+//! 4e-11 m at Δ = 0.1 s in LEO). On the LEO scenario at its 10 Hz update, max|a_p| is
+//! 3.7e-2 m/s² and the worst position error 1.8e-4 m (`tests/environment_prefetch.rs`). The
+//! fields change over kilometres (|∇B| ≈ 3|B|/r ≈ 2e-11 T/m, a density scale height of
+//! ≥ 20 km), so the prediction moves B by ~2e-15 T and the density by ~1.5e-9 of itself —
+//! against the zero-order hold's own error over the same 100 ms, ~1e-8 T for B (760 m of
+//! flight).
+//!
+//! # The hand-off
+//! One request and one answer, in a slot of atomics (no lock, no allocation): the physics thread
+//! writes a request and marks it `REQUESTED`, then unparks the worker (one `futex` wake); the
+//! worker claims it (`WORKING`), evaluates it, writes the sample and marks it `DONE`. The physics
+//! thread reads a `DONE` answer whose time and position match its request; anything else
+//! (`REQUESTED`, `WORKING`, a stale answer) means "evaluate it here". A request the worker has
+//! not claimed is withdrawn then, so it does no useless work; while it is `WORKING` on a stale
+//! request, the next one is evaluated on the physics thread too, and nothing waits.
+
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
+use std::sync::Arc;
+use std::thread::{JoinHandle, Thread};
+
+use nalgebra::Vector3;
+
+use super::EnvironmentSample;
+
+/// \[m³/s²\] the Earth's gravitational parameter for the prediction (EGM-96 / WGS-84 value,
+/// NIMA TR8350.2, Table 3.4). Only the prediction's third-order term depends on its exact value.
+const MU_EARTH_M3_S2: f64 = 3.986_004_418e14;
+
+/// What an update evaluates: the environment at `t_sim_ns` for a hub at `r_bn_n_m` moving at
+/// `v_bn_n_m_s` (N).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Request {
+    /// \[ns\] simulation time of the sample.
+    pub t_sim_ns: u64,
+    /// \[m\] position of the hub point B, N components.
+    pub r_bn_n_m: Vector3<f64>,
+    /// \[m/s\] velocity of B, N components.
+    pub v_bn_n_m_s: Vector3<f64>,
+}
+
+impl Request {
+    /// The request for `t_to_ns` predicted from the state (`r_bn_n_m`, `v_bn_n_m_s`) at
+    /// `t_from_ns`: two-body Taylor series to third order in Δ (module docs for its error).
+    pub fn predicted(
+        t_from_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+        t_to_ns: u64,
+    ) -> Self {
+        let dt_s = t_to_ns.saturating_sub(t_from_ns) as f64 * 1e-9;
+        let r2 = r_bn_n_m.norm_squared();
+        let (a, j) = if r2 > 0.0 {
+            // a = −μ r / r³; j = da/dt = −μ/r³ (v − 3 (r·v)/r² r).
+            let mu_r3 = MU_EARTH_M3_S2 / (r2 * r2.sqrt());
+            let a = -mu_r3 * r_bn_n_m;
+            let j = -mu_r3 * (v_bn_n_m_s - 3.0 * r_bn_n_m.dot(v_bn_n_m_s) / r2 * r_bn_n_m);
+            (a, j)
+        } else {
+            (Vector3::zeros(), Vector3::zeros())
+        };
+        let dt2 = dt_s * dt_s;
+        Self {
+            t_sim_ns: t_to_ns,
+            r_bn_n_m: r_bn_n_m + v_bn_n_m_s * dt_s + a * (0.5 * dt2) + j * (dt2 * dt_s / 6.0),
+            v_bn_n_m_s: v_bn_n_m_s + a * dt_s + j * (0.5 * dt2),
+        }
+    }
+
+    fn to_words(self) -> [u64; REQUEST_WORDS] {
+        let (r, v) = (self.r_bn_n_m, self.v_bn_n_m_s);
+        [
+            self.t_sim_ns,
+            r.x.to_bits(),
+            r.y.to_bits(),
+            r.z.to_bits(),
+            v.x.to_bits(),
+            v.y.to_bits(),
+            v.z.to_bits(),
+        ]
+    }
+
+    fn from_words(w: &[u64; REQUEST_WORDS]) -> Self {
+        let f = |i: usize| f64::from_bits(w[i]);
+        Self {
+            t_sim_ns: w[0],
+            r_bn_n_m: Vector3::new(f(1), f(2), f(3)),
+            v_bn_n_m_s: Vector3::new(f(4), f(5), f(6)),
+        }
+    }
+}
+
+const REQUEST_WORDS: usize = 7;
+/// The answer: the request it answers, then the sample.
+const ANSWER_WORDS: usize = REQUEST_WORDS + SAMPLE_WORDS;
+const SAMPLE_WORDS: usize = 15;
+
+fn sample_to_words(s: &EnvironmentSample) -> [u64; SAMPLE_WORDS] {
+    let b = |x: f64| x.to_bits();
+    let (bf, sun, moon, wind) = (s.b_field_n_t, s.r_sun_b_n_m, s.r_moon_b_n_m, s.wind_n_m_s);
+    [
+        s.t_sim_ns,
+        b(bf.x),
+        b(bf.y),
+        b(bf.z),
+        b(sun.x),
+        b(sun.y),
+        b(sun.z),
+        b(moon.x),
+        b(moon.y),
+        b(moon.z),
+        b(s.shadow_factor),
+        b(s.density_kg_m3),
+        b(wind.x),
+        b(wind.y),
+        b(wind.z),
+    ]
+}
+
+fn sample_from_words(w: &[u64]) -> EnvironmentSample {
+    let f = |i: usize| f64::from_bits(w[i]);
+    let v = |i: usize| Vector3::new(f(i), f(i + 1), f(i + 2));
+    EnvironmentSample {
+        t_sim_ns: w[0],
+        b_field_n_t: v(1),
+        r_sun_b_n_m: v(4),
+        r_moon_b_n_m: v(7),
+        shadow_factor: f(10),
+        density_kg_m3: f(11),
+        wind_n_m_s: v(12),
+    }
+}
+
+/// No request outstanding (the slot's request words are the physics thread's to write).
+const IDLE: u8 = 0;
+/// A request is written and not yet claimed.
+const REQUESTED: u8 = 1;
+/// The worker is evaluating the request.
+const WORKING: u8 = 2;
+/// The answer words hold the answer to the request.
+const DONE: u8 = 3;
+
+/// The slot shared by the physics thread and the worker.
+struct Slot {
+    state: AtomicU8,
+    /// Answers the physics thread took from the worker (a statistic).
+    taken: AtomicU64,
+    stop: AtomicBool,
+    request: [AtomicU64; REQUEST_WORDS],
+    answer: [AtomicU64; ANSWER_WORDS],
+}
+
+impl Slot {
+    fn new() -> Self {
+        Self {
+            state: AtomicU8::new(IDLE),
+            taken: AtomicU64::new(0),
+            stop: AtomicBool::new(false),
+            request: std::array::from_fn(|_| AtomicU64::new(0)),
+            answer: std::array::from_fn(|_| AtomicU64::new(0)),
+        }
+    }
+
+    /// Physics thread: publishes `req` unless the worker is busy with an older one (then the
+    /// physics thread will evaluate `req` itself). Returns whether it was published.
+    fn post(&self, req: &Request) -> bool {
+        let cur = self.state.load(Ordering::Acquire);
+        if cur == WORKING
+            || (cur == REQUESTED
+                && self
+                    .state
+                    .compare_exchange(REQUESTED, IDLE, Ordering::AcqRel, Ordering::Acquire)
+                    .is_err())
+        {
+            return false;
+        }
+        // IDLE or DONE (a stale answer nobody will read): the request words are ours.
+        for (cell, w) in self.request.iter().zip(req.to_words()) {
+            cell.store(w, Ordering::Relaxed);
+        }
+        self.state.store(REQUESTED, Ordering::Release);
+        true
+    }
+
+    /// Physics thread: the worker's answer to `req` if it is ready; withdraws `req` if the
+    /// worker has not claimed it yet.
+    fn answer(&self, req: &Request) -> Option<EnvironmentSample> {
+        match self.state.load(Ordering::Acquire) {
+            DONE => {
+                let mut w = [0u64; ANSWER_WORDS];
+                for (x, cell) in w.iter_mut().zip(&self.answer) {
+                    *x = cell.load(Ordering::Relaxed);
+                }
+                (w[..REQUEST_WORDS] == req.to_words())
+                    .then(|| sample_from_words(&w[REQUEST_WORDS..]))
+            }
+            REQUESTED => {
+                let _ = self.state.compare_exchange(
+                    REQUESTED,
+                    IDLE,
+                    Ordering::AcqRel,
+                    Ordering::Acquire,
+                );
+                None
+            }
+            _ => None,
+        }
+    }
+
+    /// Worker: evaluates the outstanding request with `fill`, if there is one. Returns whether
+    /// it did.
+    fn serve(&self, fill: &impl Fn(&Request, &mut EnvironmentSample)) -> bool {
+        if self
+            .state
+            .compare_exchange(REQUESTED, WORKING, Ordering::AcqRel, Ordering::Acquire)
+            .is_err()
+        {
+            return false;
+        }
+        let mut w = [0u64; REQUEST_WORDS];
+        for (x, cell) in w.iter_mut().zip(&self.request) {
+            *x = cell.load(Ordering::Relaxed);
+        }
+        let req = Request::from_words(&w);
+        let mut sample = EnvironmentSample::NONE;
+        fill(&req, &mut sample);
+        for (cell, x) in self
+            .answer
+            .iter()
+            .zip(req.to_words().into_iter().chain(sample_to_words(&sample)))
+        {
+            cell.store(x, Ordering::Relaxed);
+        }
+        self.state.store(DONE, Ordering::Release);
+        true
+    }
+}
+
+/// A worker thread that evaluates the next environment sample ahead of time (module docs).
+/// Dropping it stops and joins the thread.
+pub struct Prefetcher {
+    slot: Arc<Slot>,
+    thread: Thread,
+    handle: Option<JoinHandle<()>>,
+}
+
+impl std::fmt::Debug for Prefetcher {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Prefetcher")
+            .field("thread", &self.thread.name())
+            .finish_non_exhaustive()
+    }
+}
+
+impl Prefetcher {
+    /// Starts the worker thread `flexdyn-environment`, which evaluates requests with `fill`.
+    pub fn spawn(
+        fill: impl Fn(&Request, &mut EnvironmentSample) + Send + 'static,
+    ) -> std::io::Result<Self> {
+        let slot = Arc::new(Slot::new());
+        let worker_slot = slot.clone();
+        let handle = std::thread::Builder::new()
+            .name("flexdyn-environment".into())
+            .spawn(move || {
+                while !worker_slot.stop.load(Ordering::Acquire) {
+                    if !worker_slot.serve(&fill) {
+                        std::thread::park();
+                    }
+                }
+            })?;
+        Ok(Self {
+            slot,
+            thread: handle.thread().clone(),
+            handle: Some(handle),
+        })
+    }
+
+    /// Hands `req` to the worker (physics thread; no allocation, no lock: atomics and one
+    /// `futex` wake).
+    #[inline]
+    pub fn post(&self, req: &Request) {
+        if self.slot.post(req) {
+            self.thread.unpark();
+        }
+    }
+
+    /// The worker's answer to `req`, if it is ready (physics thread; `None`: evaluate it here).
+    #[inline]
+    pub fn answer(&self, req: &Request) -> Option<EnvironmentSample> {
+        let a = self.slot.answer(req);
+        if a.is_some() {
+            self.slot.taken.fetch_add(1, Ordering::Relaxed);
+        }
+        a
+    }
+
+    /// How many answers [`Self::answer`] has returned (the rest were evaluated by the caller).
+    pub fn answers_taken(&self) -> u64 {
+        self.slot.taken.load(Ordering::Relaxed)
+    }
+}
+
+impl Drop for Prefetcher {
+    fn drop(&mut self) {
+        self.slot.stop.store(true, Ordering::Release);
+        self.thread.unpark();
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A deterministic stand-in for the models: every field a function of the request.
+    fn fill(req: &Request, out: &mut EnvironmentSample) {
+        *out = EnvironmentSample::NONE;
+        out.t_sim_ns = req.t_sim_ns;
+        out.b_field_n_t = req.r_bn_n_m * 1e-12;
+        out.density_kg_m3 = req.v_bn_n_m_s.norm() * 1e-15;
+        out.shadow_factor = 0.5;
+    }
+
+    fn request(t: u64) -> Request {
+        Request {
+            t_sim_ns: t,
+            r_bn_n_m: Vector3::new(7.0e6, 1.0, 2.0),
+            v_bn_n_m_s: Vector3::new(3.0, 7.5e3, 4.0),
+        }
+    }
+
+    fn direct(req: &Request) -> EnvironmentSample {
+        let mut s = EnvironmentSample::NONE;
+        fill(req, &mut s);
+        s
+    }
+
+    #[test]
+    fn a_served_request_is_answered_with_exactly_what_the_physics_thread_would_compute() {
+        let slot = Slot::new();
+        let req = request(100);
+        assert!(slot.post(&req));
+        assert!(slot.serve(&fill));
+        assert_eq!(slot.answer(&req), Some(direct(&req)));
+        // Read twice (telemetry, then the update): the same answer.
+        assert_eq!(slot.answer(&req), Some(direct(&req)));
+    }
+
+    #[test]
+    fn an_answer_to_another_request_is_never_taken() {
+        let slot = Slot::new();
+        assert!(slot.post(&request(100)));
+        assert!(slot.serve(&fill));
+        assert_eq!(slot.answer(&request(200)), None);
+        let mut moved = request(100);
+        moved.r_bn_n_m.x += 1e-9;
+        assert_eq!(slot.answer(&moved), None);
+    }
+
+    #[test]
+    fn an_unclaimed_request_is_withdrawn_and_never_served() {
+        let slot = Slot::new();
+        let req = request(100);
+        assert!(slot.post(&req));
+        assert_eq!(slot.answer(&req), None, "not served yet: evaluate here");
+        assert!(!slot.serve(&fill), "withdrawn");
+        // The next request goes out normally.
+        assert!(slot.post(&request(200)));
+        assert!(slot.serve(&fill));
+        assert_eq!(slot.answer(&request(200)), Some(direct(&request(200))));
+    }
+
+    #[test]
+    fn a_busy_worker_is_not_given_a_new_request() {
+        let slot = Slot::new();
+        assert!(slot.post(&request(100)));
+        slot.state.store(WORKING, Ordering::Release); // claimed, still evaluating
+        assert!(!slot.post(&request(200)));
+        assert_eq!(slot.answer(&request(200)), None);
+    }
+
+    #[test]
+    fn the_prediction_follows_a_circular_orbit_to_its_truncation_error() {
+        // A circular orbit of radius r: x = r cos(n t), y = r sin(n t); n = sqrt(μ/r³).
+        let r = 6_878_137.0;
+        let n = (MU_EARTH_M3_S2 / (r * r * r)).sqrt();
+        let dt_s = 0.1;
+        let req = Request::predicted(
+            0,
+            &Vector3::new(r, 0.0, 0.0),
+            &Vector3::new(0.0, r * n, 0.0),
+            100_000_000,
+        );
+        let truth = Vector3::new(r * (n * dt_s).cos(), r * (n * dt_s).sin(), 0.0);
+        // The first neglected term, r·(n·Δ)⁴/24, is 5e-11 m; allow the rounding of r (1e-9 m).
+        let bound = r * (n * dt_s).powi(4) / 24.0 + 1e-8;
+        assert!(bound < 1e-7);
+        assert!(
+            (req.r_bn_n_m - truth).norm() <= bound,
+            "{} m",
+            (req.r_bn_n_m - truth).norm()
+        );
+        // The third-order term matters: without it the error is r (nΔ)³/6, 1e-6 m.
+        let second = r * (n * dt_s).powi(3) / 6.0;
+        assert!(second > 10.0 * bound);
+    }
+
+    #[test]
+    fn the_worker_thread_answers_and_stops_when_dropped() {
+        let p = Prefetcher::spawn(fill).unwrap();
+        let req = request(5);
+        p.post(&req);
+        let t0 = std::time::Instant::now();
+        let mut got = None;
+        while got.is_none() && t0.elapsed() < std::time::Duration::from_secs(10) {
+            got = p.answer(&req);
+            // `answer` withdraws a request the worker has not claimed yet; post it again.
+            if got.is_none() {
+                p.post(&req);
+                std::thread::sleep(std::time::Duration::from_millis(1));
+            }
+        }
+        assert_eq!(got, Some(direct(&req)));
+        drop(p); // joins: the test would hang here if the worker ignored the stop
+    }
+}
