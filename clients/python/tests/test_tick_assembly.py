@@ -202,3 +202,54 @@ def test_an_error_in_the_callback_ends_wait_and_close():
             raise AssertionError("the error was not raised")
         except RuntimeError as e:
             assert str(e) == "control law failed"
+
+
+ENV_SENSORS_TOML = """
+[simulation]
+step_s = 0.001
+frame_hz = 100.0
+[[imus]]
+name = "hub"
+[[magnetometers]]
+name = "mag1"
+rate_hz = 10.0
+[[coarse_sun_sensors]]
+name = "css"
+rate_hz = 20.0
+[[fine_sun_sensors]]
+name = "fss"
+rate_hz = 25.0
+"""
+
+
+def test_magnetometers_and_sun_sensors_are_scheduled_and_delivered_in_the_tick():
+    # Periods: round(100 / 10) = 10, round(100 / 20) = 5, round(100 / 25) = 4 frames.
+    s = flexdyn.SensorSchedule.from_config(flexdyn.VehicleInfo(
+        "sc1", 1, ENV_SENSORS_TOML, "", None, None).config())
+    assert s.others == (("mag/mag1", 10), ("css/css", 5), ("fss/fss", 4))
+    assert s.due(0) == ("imu/hub", "mag/mag1", "css/css", "fss/fss")
+    assert s.due(5) == ("imu/hub", "css/css")
+    assert s.due(8) == ("imu/hub", "fss/fss")
+    assert s.due(10) == ("imu/hub", "mag/mag1", "css/css")
+
+    c, seen = FakeClient(), []
+    c.vehicle = lambda timeout_s: flexdyn.VehicleInfo("sc1", 1, ENV_SENSORS_TOML, "", None, None)
+    p = participant(c, seen)
+    c.feed("imu/hub", imu(0))
+    c.feed("mag/mag1", flexdyn.MagnetometerMsg(header(0), (1e-5, 2e-5, 3e-5)))
+    c.feed("css/css", flexdyn.CssMsg(header(0), 6, (0.5,) * proto.MAX_CSS_DETECTORS))
+    c.feed("state", state(0))
+    assert seen == [], "tick 0 answered without fss/fss"
+    c.feed("fss/fss", flexdyn.FssMsg(header(0), 0.1, -0.2, 1))
+    assert [t.tick for t in seen] == [0] and c.sent == [(0, "none")]
+    t = seen[0]
+    assert t.magnetometers["mag1"].b_s_t == (1e-5, 2e-5, 3e-5)
+    assert t.coarse_sun_sensors["css"].detector_count == 6
+    assert t.fine_sun_sensors["fss"].beta_rad == -0.2
+    assert set(t.samples) == {"imu/hub", "mag/mag1", "css/css", "fss/fss"}
+    assert t.missing == ()
+    # Tick 1: the IMU only.
+    c.feed("imu/hub", imu(1))
+    c.feed("state", state(1))
+    assert [t.tick for t in seen] == [0, 1] and seen[1].magnetometers == {}
+    p.close()

@@ -20,8 +20,8 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tupl
 import zenoh
 
 from . import proto
-from .proto import (CommandMsg, EffectorInput, EnvironmentMsg, Header, ImuMsg, OperatorMsg,
-                    StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
+from .proto import (CommandMsg, CssMsg, EffectorInput, EnvironmentMsg, FssMsg, Header, ImuMsg,
+                    MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
 
 Vec3 = Tuple[float, float, float]
 
@@ -65,8 +65,10 @@ class VehicleInfo:
 
 
 #: The decoder of each telemetry key kind: the part of the key after ``flexdyn/<sc>/tlm/``
-#: is ``state``, ``imu/<name>`` or ``st/<name>``.
+#: is ``state``, ``time``, ``env`` or ``<kind>/<name>`` for a sensor (``imu``, ``st``, ``mag``,
+#: ``css``, ``fss``; proto/README.md, "Keys").
 _DECODERS = {"state": StateMsg.decode, "imu": ImuMsg.decode, "st": StarTrackerMsg.decode,
+             "mag": MagnetometerMsg.decode, "css": CssMsg.decode, "fss": FssMsg.decode,
              "time": TimeMsg.decode, "env": EnvironmentMsg.decode}
 
 
@@ -198,6 +200,27 @@ class Client:
         """Calls `callback` with every measurement of the star tracker `name` (before the
         StateMsg of its tick)."""
         key = proto.star_tracker_key(self.sc_id, name)
+        return self._telemetry_add(key[len(self._tlm_prefix):], callback)
+
+    def subscribe_magnetometer(self, name: str,
+                               callback: Callable[[MagnetometerMsg], None]) -> Subscription:
+        """Calls `callback` with every sample of the magnetometer `name` (before the StateMsg
+        of its tick)."""
+        key = proto.magnetometer_key(self.sc_id, name)
+        return self._telemetry_add(key[len(self._tlm_prefix):], callback)
+
+    def subscribe_coarse_sun_sensor(self, name: str,
+                                    callback: Callable[[CssMsg], None]) -> Subscription:
+        """Calls `callback` with every sample of the coarse-sun-sensor array `name` (before
+        the StateMsg of its tick)."""
+        key = proto.css_key(self.sc_id, name)
+        return self._telemetry_add(key[len(self._tlm_prefix):], callback)
+
+    def subscribe_fine_sun_sensor(self, name: str,
+                                  callback: Callable[[FssMsg], None]) -> Subscription:
+        """Calls `callback` with every sample of the fine sun sensor `name` (before the
+        StateMsg of its tick)."""
+        key = proto.fss_key(self.sc_id, name)
         return self._telemetry_add(key[len(self._tlm_prefix):], callback)
 
     def subscribe_time(self, callback: Callable[[TimeMsg], None]) -> Subscription:

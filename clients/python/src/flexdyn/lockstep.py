@@ -1,7 +1,7 @@
 """Lockstep participation with complete ticks.
 
-The server publishes, for each tick k, the sample of every IMU and of every star tracker due
-at k, then the StateMsg of k (proto/README.md, "Lockstep protocol"). A controller that reads
+The server publishes, for each tick k, the sample of every sensor due at k (IMUs, star
+trackers, magnetometers, sun sensors), then the StateMsg of k (proto/README.md, "Lockstep protocol"). A controller that reads
 sensors must answer tick k from exactly those samples; it is then as deterministic as the
 server. :class:`LockstepParticipant` makes sure of it:
 
@@ -24,7 +24,8 @@ from typing import Callable, Dict, List, Optional, Tuple, Union
 
 from . import proto
 from .client import Client, Vec3
-from .proto import CommandMsg, ImuMsg, StarTrackerMsg, StateMsg, StatusMsg
+from .proto import (CommandMsg, CssMsg, FssMsg, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg,
+                    StatusMsg)
 
 log = logging.getLogger("flexdyn")
 
@@ -37,51 +38,86 @@ Answer = Optional[Union[Tuple[Vec3, Vec3], CommandMsg]]
 _ENDED = (3, 4, 5)
 
 
+#: The sensor kinds that publish at a rate: (configuration array, key kind, Tick attribute).
+#: Each entry of the array publishes on the ticks that are multiples of round(frame_hz /
+#: rate_hz), from tick 0, under ``flexdyn/<sc>/tlm/<kind>/<name>``.
+PERIODIC_KINDS: Tuple[Tuple[str, str, str], ...] = (
+    ("star_trackers", "st", "star_trackers"),
+    ("magnetometers", "mag", "magnetometers"),
+    ("coarse_sun_sensors", "css", "coarse_sun_sensors"),
+    ("fine_sun_sensors", "fss", "fine_sun_sensors"),
+)
+
+
+def _periods(config: dict, array: str, frame_hz: float) -> Tuple[Tuple[str, int], ...]:
+    out = []
+    for i, entry in enumerate(config.get(array, [])):
+        rate_hz = float(entry["rate_hz"])
+        every = round(frame_hz / rate_hz) if rate_hz > 0 and math.isfinite(rate_hz) else 0
+        if every < 1:
+            raise ValueError(f"{array}[{i}].rate_hz = {rate_hz}: not the frame rate "
+                             f"({frame_hz} Hz) divided by a whole number")
+        out.append((str(entry["name"]), every))
+    return tuple(out)
+
+
 @dataclass(frozen=True)
 class SensorSchedule:
     """Which sensor samples the server publishes at each tick, read from its configuration:
-    every ``[[imus]]`` entry each tick (route ``imu/<name>``), and each ``[[star_trackers]]``
-    entry on the ticks that are multiples of its period, round(``simulation.frame_hz`` /
-    ``rate_hz``) frames, from tick 0 (route ``st/<name>``)."""
+    every ``[[imus]]`` entry each tick (route ``imu/<name>``), each ``[[star_trackers]]`` entry
+    on the ticks that are multiples of its period, round(``simulation.frame_hz`` /
+    ``rate_hz``) frames, from tick 0 (route ``st/<name>``), and the same for the other
+    rate-driven kinds of :data:`PERIODIC_KINDS` (``mag/<name>``, ``css/<name>``,
+    ``fss/<name>``)."""
 
     imus: Tuple[str, ...]
     #: (name, period in frames)
     star_trackers: Tuple[Tuple[str, int], ...]
+    #: (route, period in frames) of the magnetometers and sun sensors
+    others: Tuple[Tuple[str, int], ...] = ()
 
     @classmethod
     def from_config(cls, config: dict) -> "SensorSchedule":
         """From a parsed configuration (see :meth:`flexdyn.VehicleInfo.config`)."""
         frame_hz = float(config["simulation"]["frame_hz"])
-        trackers = []
-        for i, st in enumerate(config.get("star_trackers", [])):
-            rate_hz = float(st["rate_hz"])
-            every = round(frame_hz / rate_hz) if rate_hz > 0 and math.isfinite(rate_hz) else 0
-            if every < 1:
-                raise ValueError(f"star_trackers[{i}].rate_hz = {rate_hz}: not the frame rate "
-                                 f"({frame_hz} Hz) divided by a whole number")
-            trackers.append((str(st["name"]), every))
-        return cls(tuple(str(imu["name"]) for imu in config.get("imus", [])), tuple(trackers))
+        others = tuple((f"{kind}/{name}", every)
+                       for array, kind, _ in PERIODIC_KINDS[1:]
+                       for name, every in _periods(config, array, frame_hz))
+        return cls(tuple(str(imu["name"]) for imu in config.get("imus", [])),
+                   _periods(config, "star_trackers", frame_hz), others)
 
     def due(self, tick: int) -> Tuple[str, ...]:
-        """The routes of the samples published at `tick` (``imu/<name>``, ``st/<name>``)."""
+        """The routes of the samples published at `tick` (``imu/<name>``, ``st/<name>``,
+        ``mag/<name>``, ...)."""
         return tuple([f"imu/{n}" for n in self.imus]
-                     + [f"st/{n}" for n, every in self.star_trackers if tick % every == 0])
+                     + [f"st/{n}" for n, every in self.star_trackers if tick % every == 0]
+                     + [r for r, every in self.others if tick % every == 0])
 
 
 @dataclass
 class Tick:
-    """One tick's telemetry: its StateMsg and the sensor samples due at it, by name."""
+    """One tick's telemetry: its StateMsg and the sensor samples due at it, by kind and name."""
 
     state: StateMsg
     imu: Dict[str, ImuMsg] = field(default_factory=dict)
     star_trackers: Dict[str, StarTrackerMsg] = field(default_factory=dict)
-    #: Routes of due samples that never came (``imu/<name>``, ``st/<name>``). Empty in
+    magnetometers: Dict[str, MagnetometerMsg] = field(default_factory=dict)
+    coarse_sun_sensors: Dict[str, CssMsg] = field(default_factory=dict)
+    fine_sun_sensors: Dict[str, FssMsg] = field(default_factory=dict)
+    #: Every sample of the tick by route (``<kind>/<name>``), also of kinds without a field
+    #: above.
+    samples: Dict[str, object] = field(default_factory=dict)
+    #: Routes of due samples that never came (``imu/<name>``, ``st/<name>``, ...). Empty in
     #: lockstep unless a sample was lost; see ``sensor_timeout_s``.
     missing: Tuple[str, ...] = ()
 
     @property
     def tick(self) -> int:
         return self.state.header.tick
+
+
+#: The Tick attribute of each sensor key kind.
+_TICK_FIELD = {"imu": "imu", **{kind: attr for _, kind, attr in PERIODIC_KINDS}}
 
 
 class LockstepParticipant:
@@ -196,10 +232,11 @@ class LockstepParticipant:
         self._last_tick = h.tick
         try:
             if self.on_tick is not None:
-                t = Tick(state, missing=missing)
+                t = Tick(state, missing=missing, samples=dict(samples))
                 for route, msg in samples.items():
                     kind, name = route.split("/", 1)
-                    (t.imu if kind == "imu" else t.star_trackers)[name] = msg
+                    if kind in _TICK_FIELD:
+                        getattr(t, _TICK_FIELD[kind])[name] = msg
                 self._send(h, self.on_tick(t))
             else:
                 self._send(h, self.on_state(state))
