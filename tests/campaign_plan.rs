@@ -557,6 +557,74 @@ fn environment_parameters_are_dispersed_and_read_back_from_the_model() {
     check_normal("facet 0 area ~ N(4, 0.2)", &area0, 4.0, 0.2);
 }
 
+/// Run `r`'s model as built, after checking it is valid and reads back every dispersed value
+/// exactly as drawn.
+fn read_back_exactly(plan: &Plan, r: u32) -> std::collections::BTreeMap<String, f64> {
+    let rp = plan.run(r);
+    assert!(rp.valid, "run {r}: {:?}", rp.redraw_reasons);
+    let model = readback(&SimConfig::from_toml_str(&rp.config_toml).unwrap()).unwrap();
+    for (key, written) in &rp.dispersed {
+        assert_eq!(model[key], *written, "run {r}: {key}");
+    }
+    model
+}
+
+/// The sensors' error parameters (issue 20: magnetometer, coarse and fine sun sensors) are
+/// dispersed and read back from the built sensors, like the spacecraft's; a key the sensor does
+/// not report (its `rate_hz`, which sets the schedule, not the model) is a load error.
+#[test]
+fn sensor_parameters_are_dispersed_and_read_back_from_the_built_sensors() {
+    let base = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/leo_environment.toml");
+    let head = format!(
+        "base = {:?}\nruns = 300\nseed = 5\nduration_s = 1.0\n",
+        base.display().to_string()
+    );
+    let plan = campaign(&format!(
+        "{head}
+        [[dispersions]]
+        key = \"magnetometers[0].bias_s_t\"
+        distribution = \"normal\"
+        sigma = 1e-7
+        [[dispersions]]
+        key = \"magnetometers[0].noise_sigma_t\"
+        distribution = \"uniform\"
+        low = 1e-8
+        high = 1e-7
+        [[dispersions]]
+        key = \"coarse_sun_sensors[0].scale\"
+        distribution = \"normal\"
+        sigma = 0.02
+        [[dispersions]]
+        key = \"fine_sun_sensors[0].bias_rad[1]\"
+        distribution = \"normal\"
+        sigma = 1e-4
+        "
+    ))
+    .unwrap();
+    let (mut bias_x, mut noise, mut scale, mut fss_beta) = (vec![], vec![], vec![], vec![]);
+    for r in 0..300 {
+        let model = read_back_exactly(&plan, r);
+        bias_x.push(model["magnetometers[0].bias_s_t[0]"]);
+        noise.push(model["magnetometers[0].noise_sigma_t"]);
+        scale.push(model["coarse_sun_sensors[0].scale"]);
+        fss_beta.push(model["fine_sun_sensors[0].bias_rad[1]"]);
+        // Untouched: the scenario's values.
+        assert_eq!(model["magnetometers[0].lsb_t"], 1e-8);
+        assert_eq!(model["fine_sun_sensors[0].bias_rad[0]"], 1.0e-4);
+    }
+    // Normal dispersions are centred on the base value (scenario: 2e-7 T, 1.0, -5e-5 rad).
+    check_normal("magnetometer bias x ~ N(2e-7, 1e-7)", &bias_x, 2e-7, 1e-7);
+    check_uniform("magnetometer noise ~ U(1e-8, 1e-7)", &noise, 1e-8, 1e-7);
+    check_normal("CSS scale ~ N(1, 0.02)", &scale, 1.0, 0.02);
+    check_normal("FSS bias beta ~ N(-5e-5, 1e-4)", &fss_beta, -5e-5, 1e-4);
+
+    let e = campaign(&format!(
+        "{head}[[dispersions]]\nkey = \"magnetometers[0].rate_hz\"\ndistribution = \"normal\"\nsigma = 1.0\n"
+    ))
+    .unwrap_err();
+    assert!(e.contains("dispersions[0].key"), "{e}");
+}
+
 /// A base whose orbit comes from a file next to it (`elements_file = "sat.omm"`) plans from any
 /// working directory, and each run's config.toml stands alone: the elements are inlined, so a
 /// server reading it from the run's folder finds them.
@@ -628,12 +696,7 @@ fn actuator_parameters_are_dispersed_and_read_back_from_the_model() {
     .unwrap();
     let (mut thrust0, mut isp1, mut dipole2) = (vec![], vec![], vec![]);
     for r in 0..300 {
-        let rp = plan.run(r);
-        assert!(rp.valid, "run {r}: {:?}", rp.redraw_reasons);
-        let model = readback(&SimConfig::from_toml_str(&rp.config_toml).unwrap()).unwrap();
-        for (key, written) in &rp.dispersed {
-            assert_eq!(model[key], *written, "run {r}: {key}");
-        }
+        let model = read_back_exactly(&plan, r);
         thrust0.push(model["thrusters[0].max_thrust_newton"]);
         isp1.push(model["thrusters[1].isp_s"]);
         dipole2.push(model["magnetorquers[2].max_dipole_am2"]);

@@ -16,8 +16,9 @@
 //!
 //! # Read-back
 //! A dispersion key must name parameters the built model reports (hub, initial state, panel
-//! pairs, reaction wheels, environment facets, residual dipole, space weather, epoch offset;
-//! see [`readback`]). Any other key is an error at load time, so a
+//! pairs, reaction wheels, magnetorquers, thrusters, environment facets, residual dipole, space
+//! weather, epoch offset, and the magnetometers', sun sensors' and star trackers' error
+//! parameters; see [`readback`]). Any other key is an error at load time, so a
 //! dispersion can never be silently ignored; `result.json` then holds the values read back from
 //! each run's built model, not from its file.
 
@@ -87,6 +88,19 @@ pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config:
         let k = per_kind.entry(section).or_insert(0);
         params.clear();
         e.parameters(&x.effectors[range.clone()], &mut params);
+        for (key, v) in &params {
+            out.insert(format!("{section}[{k}].{key}"), *v);
+        }
+        *k += 1;
+    }
+    // The sensors as built, each kind's entries counted in file order.
+    let bank = crate::sensors::SensorBank::new(cfg, cfg.frame_ns as f64 * 1e-9, 0, x)?;
+    let mut per_array: BTreeMap<&str, usize> = BTreeMap::new();
+    for s in bank.sensors() {
+        let section = s.kind().config_array;
+        let k = per_array.entry(section).or_insert(0);
+        params.clear();
+        s.parameters(&mut params);
         for (key, v) in &params {
             out.insert(format!("{section}[{k}].{key}"), *v);
         }

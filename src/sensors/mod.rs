@@ -127,6 +127,12 @@ pub trait Sensor: std::fmt::Debug + Send {
     /// it; others ignore it.
     fn set_sample_interval_s(&mut self, _t_s: f64) {}
 
+    /// Its numeric parameters as built, by key relative to its configuration entry
+    /// (`noise_sigma_t`, `bias_s_t[0]`), for a campaign's read-back of dispersed values
+    /// ([`crate::campaign::plan::readback`]). Not on the stepping path. None by default: a
+    /// kind that lists none cannot be dispersed (the campaign rejects its keys at load time).
+    fn parameters(&self, _out: &mut Vec<(String, f64)>) {}
+
     /// For the kind's own typed views ([`SensorBank::of`]).
     fn as_any(&self) -> &dyn Any;
 }

@@ -216,6 +216,15 @@ impl Sensor for CoarseSunSensor {
         &self.cfg.name
     }
 
+    fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        let c = &self.cfg;
+        out.push(("fov_half_angle_rad".into(), c.fov_half_angle_rad));
+        out.push(("scale".into(), c.scale));
+        out.push(("bias".into(), c.bias));
+        out.push(("noise_sigma".into(), c.noise_sigma));
+        out.push(("lsb".into(), c.lsb));
+    }
+
     fn due(&self, tick: u64) -> bool {
         tick.is_multiple_of(self.cfg.every_frames)
     }

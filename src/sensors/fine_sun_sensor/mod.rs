@@ -224,6 +224,17 @@ impl Sensor for FineSunSensor {
         &self.cfg.name
     }
 
+    fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        let c = &self.cfg;
+        out.push(("fov_half_angle_rad".into(), c.fov_half_angle_rad));
+        for i in 0..2 {
+            out.push((format!("bias_rad[{i}]"), c.bias_rad[i]));
+        }
+        out.push(("noise_sigma_rad".into(), c.noise_sigma_rad));
+        out.push(("lsb_rad".into(), c.lsb_rad));
+        out.push(("min_shadow_factor".into(), c.min_shadow_factor));
+    }
+
     fn due(&self, tick: u64) -> bool {
         tick.is_multiple_of(self.cfg.every_frames)
     }

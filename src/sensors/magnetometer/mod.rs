@@ -223,6 +223,23 @@ impl Sensor for Magnetometer {
         &self.cfg.name
     }
 
+    fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        let c = &self.cfg;
+        for i in 0..3 {
+            out.push((format!("scale_factor[{i}]"), c.scale_factor[i]));
+            out.push((format!("bias_s_t[{i}]"), c.bias_s_t[i]));
+            for j in 0..3 {
+                out.push((
+                    format!("misalignment_rad[{i}][{j}]"),
+                    c.misalignment_rad[(i, j)],
+                ));
+            }
+        }
+        out.push(("noise_sigma_t".into(), c.noise_sigma_t));
+        out.push(("range_t".into(), c.range_t));
+        out.push(("lsb_t".into(), c.lsb_t));
+    }
+
     fn due(&self, tick: u64) -> bool {
         tick.is_multiple_of(self.cfg.every_frames)
     }

@@ -260,6 +260,23 @@ impl Sensor for StarTracker {
         &self.cfg.name
     }
 
+    fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        let c = &self.cfg;
+        out.push((
+            "sigma_cross_boresight_rad".into(),
+            c.sigma_cross_boresight_rad,
+        ));
+        out.push((
+            "sigma_about_boresight_rad".into(),
+            c.sigma_about_boresight_rad,
+        ));
+        for i in 0..3 {
+            out.push((format!("bias_c_rad[{i}]"), c.bias_c_rad[i]));
+        }
+        out.push(("sun_exclusion_rad".into(), c.sun_exclusion_rad));
+        out.push(("max_rate_rad_s".into(), c.max_rate_rad_s));
+    }
+
     fn due(&self, tick: u64) -> bool {
         StarTracker::due(self, tick)
     }
