@@ -5,11 +5,10 @@
 //! act on one another (no contact or plume forces), so the order does not change any vehicle's
 //! state: each vehicle's stream is what it would be alone, bit for bit.
 //!
-//! The environment is evaluated per vehicle. Density and B depend on the position, so they are
-//! per vehicle anyway; the epoch's time scales and the Sun/Moon directions are common but are
-//! still evaluated once per vehicle (each vehicle's `EnvironmentModel` holds its own cached
-//! sample, refreshed at `[environment] rate_hz`, not at every step, so this is a small cost;
-//! sharing it would mean splitting `EnvironmentModel` into a world part and a vehicle part).
+//! The environment is evaluated per vehicle, by each vehicle's own models (on its prefetch
+//! worker where the server offloads them). The epoch, the Earth's orientation, the Sun and the
+//! Moon are common to all vehicles and could be evaluated once for the world; that is not done
+//! yet (each update costs ~15 µs per vehicle at `[environment] update_hz`, not per step).
 
 use crate::sim::Simulation;
 
@@ -35,6 +34,8 @@ pub struct World {
     vehicles: Vec<Vehicle>,
     /// (chief, deputy) index pairs: every vehicle given relative to a chief.
     pairs: Vec<(usize, usize)>,
+    /// RK4 steps per frame (the same for every vehicle: the fleet file checks it).
+    steps_per_frame: u64,
 }
 
 impl World {
@@ -58,7 +59,12 @@ impl World {
                 sim,
             });
         }
-        Ok(Self { vehicles, pairs })
+        let steps_per_frame = vehicles.first().map_or(0, |v| v.sim.steps_per_frame());
+        Ok(Self {
+            vehicles,
+            pairs,
+            steps_per_frame,
+        })
     }
 
     /// The vehicles, in fleet order.
@@ -78,8 +84,15 @@ impl World {
 
     /// One frame of every vehicle. Allocates nothing.
     pub fn step_frame(&mut self) {
+        for _ in 0..self.steps_per_frame {
+            self.step();
+        }
+    }
+
+    /// One RK4 step of every vehicle. Allocates nothing.
+    pub fn step(&mut self) {
         for v in &mut self.vehicles {
-            v.sim.step_frame();
+            v.sim.step();
         }
     }
 
