@@ -19,7 +19,7 @@ use std::time::Instant;
 use flexdyn::world::{FleetConfig, World};
 
 const SIZES: [usize; 5] = [1, 2, 4, 8, 16];
-const FRAMES: u32 = 100;
+const FRAMES: u32 = 1000;
 const ROUNDS: usize = 5;
 
 fn fleet(n: usize) -> FleetConfig {
