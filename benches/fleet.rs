@@ -6,9 +6,8 @@
 //! This is the physics alone, on one thread: no server, no Zenoh, no controllers (the
 //! lockstep benchmark with one controller process per vehicle needs the server's fleet mode,
 //! which is not built yet). It prints, per fleet size, the median over `ROUNDS` runs of
-//! `FRAMES` frames: frames/s, the ratio to the 1-vehicle rate, the physics time per vehicle
-//! per frame, and the shared environment evaluations per frame (one per update instant,
-//! whatever the size). With the physics linear in the vehicle count the ratio is 1/N; the
+//! `FRAMES` frames: frames/s, the ratio to the 1-vehicle rate and the physics time per vehicle
+//! per frame. With the physics linear in the vehicle count the ratio is 1/N; the
 //! issue's lockstep target (≥ 0.5 × at 8 vehicles) holds only if the frame is mostly waiting
 //! for the controllers, not stepping.
 //!
@@ -39,28 +38,25 @@ fn fleet(n: usize) -> FleetConfig {
 fn main() {
     // `cargo bench` passes `--bench` (and maybe a filter); this bench has one measurement.
     let mut base_frames_per_s = None;
-    println!("vehicles  frames/s  ratio_to_1  physics_us_per_vehicle_frame  shared_env_per_frame");
+    println!("vehicles  frames/s  ratio_to_1  physics_us_per_vehicle_frame");
     for n in SIZES {
         let cfg = fleet(n);
         let mut rates = Vec::with_capacity(ROUNDS);
-        let mut shared_per_frame = 0.0;
         for _ in 0..ROUNDS {
             let mut world = World::new(&cfg).expect("world");
             world.step_frame(); // warm the caches
-            let before = world.shared_evaluations();
             let start = Instant::now();
             for _ in 0..FRAMES {
                 world.step_frame();
             }
             let s = start.elapsed().as_secs_f64();
             rates.push(f64::from(FRAMES) / s);
-            shared_per_frame = (world.shared_evaluations() - before) as f64 / f64::from(FRAMES);
         }
         rates.sort_by(f64::total_cmp);
         let frames_per_s = rates[ROUNDS / 2];
         let base = *base_frames_per_s.get_or_insert(frames_per_s);
         println!(
-            "{n:8}  {frames_per_s:8.1}  {:10.3}  {:28.1}  {shared_per_frame:20.2}",
+            "{n:8}  {frames_per_s:8.1}  {:10.3}  {:28.1}",
             frames_per_s / base,
             1e6 / (frames_per_s * n as f64)
         );
