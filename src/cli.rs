@@ -170,7 +170,7 @@ fn load(path: Option<&Path>) -> Result<SimConfig, CliError> {
 }
 
 /// A duration option as a whole number of steps.
-fn whole_steps(
+pub(crate) fn whole_steps(
     flag: &'static str,
     seconds: f64,
     step_ns: u64,

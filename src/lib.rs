@@ -33,5 +33,6 @@ pub mod signals;
 pub mod sim;
 pub mod sinks;
 pub mod validate;
+pub mod world;
 
 pub use flexdyn_proto::client::{logging, transport};

@@ -41,6 +41,9 @@ enum Command {
     Run(Box<RunArgs>),
     /// Propagate a configuration offline and write the state history as CSV.
     Simulate(SimulateArgs),
+    /// Propagate a fleet file (several spacecraft, one tick) offline: states and relative
+    /// states as CSV.
+    Fleet(flexdyn::world::run::FleetArgs),
     /// Validate a configuration file and print a one-line summary (exit 2 if invalid).
     CheckConfig {
         /// The configuration file (TOML).
@@ -204,6 +207,24 @@ fn main() -> ExitCode {
                     .collect::<Vec<_>>()
                     .join("\n")
             })
+        }
+        Some(Command::Fleet(a)) => {
+            return match flexdyn::world::run::fleet(&a) {
+                Ok(r) => {
+                    let _ = writeln!(
+                        std::io::stderr(),
+                        "propagated {} vehicles for {} steps; wrote {} rows",
+                        r.vehicles,
+                        r.steps,
+                        r.rows
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    print_error(&e);
+                    ExitCode::from(e.exit_code())
+                }
+            }
         }
         Some(Command::Run(a)) => return run_server(&a),
         // No subcommand: `flexdyn run` with the options given.

@@ -1,0 +1,187 @@
+//! `flexdyn fleet`: propagates a fleet file offline and writes one CSV of every vehicle's
+//! centre-of-mass state and every (chief, deputy) pair's relative state.
+//!
+//! Columns (a row at t = 0 and every `--log-every-s`):
+//! - `t_s`;
+//! - per vehicle `<id>`: `<id>_r_cn_n_m_{1,2,3}`, `<id>_v_cn_n_m_s_{1,2,3}` (its system centre
+//!   of mass C in N);
+//! - per deputy `<d>` given relative to chief `<c>`: `<d>_in_<c>_r_h_m_{1,2,3}` and
+//!   `<d>_in_<c>_v_h_m_s_{1,2,3}` (the deputy relative to the chief in the chief's Hill frame:
+//!   radial, along-track, cross-track; the rate seen in that frame), `<d>_in_<c>_range_m` and
+//!   `<d>_in_<c>_range_rate_m_s` ([`super::relative`]).
+
+use std::fmt::Write as _;
+use std::io::{self, Write};
+use std::path::PathBuf;
+
+use nalgebra::Vector3;
+
+use super::fleet::{FleetConfig, FleetError};
+use super::relative::com_state_n;
+use super::step::World;
+use crate::cli::{whole_steps, CliError};
+
+/// Arguments of `flexdyn fleet`.
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+pub struct FleetArgs {
+    /// The fleet file (TOML): `[[vehicles]]` entries (README, "Several spacecraft").
+    pub fleet: PathBuf,
+    /// Simulated duration in seconds; must be a whole number of RK4 steps.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 10.0,
+        allow_negative_numbers = true
+    )]
+    pub duration_s: f64,
+    /// Interval between CSV rows in seconds; must be a whole number of RK4 steps. A row is also
+    /// written at t = 0.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
+    pub log_every_s: f64,
+    /// CSV output file; `-` (or no option) writes to standard output.
+    #[arg(long, short, value_name = "FILE.csv")]
+    pub output: Option<PathBuf>,
+}
+
+/// An error of `flexdyn fleet`.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FleetRunError {
+    /// The fleet file (or a vehicle's spacecraft configuration) is invalid.
+    #[error(transparent)]
+    Fleet(#[from] FleetError),
+    /// An option or the output.
+    #[error(transparent)]
+    Cli(#[from] CliError),
+}
+
+impl FleetRunError {
+    /// 2 for invalid input, 1 for a failure while running.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Fleet(_) => 2,
+            Self::Cli(e) => e.exit_code(),
+        }
+    }
+}
+
+/// What `fleet` did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FleetReport {
+    /// Vehicles propagated.
+    pub vehicles: usize,
+    /// RK4 steps of each vehicle.
+    pub steps: u64,
+    /// CSV rows written.
+    pub rows: u64,
+}
+
+/// Runs `flexdyn fleet`.
+pub fn fleet(args: &FleetArgs) -> Result<FleetReport, FleetRunError> {
+    let fleet = FleetConfig::from_file(&args.fleet)?;
+    match args.output.as_deref() {
+        None => fleet_to(&fleet, args, "stdout", io::stdout().lock()),
+        Some(p) if p.as_os_str() == "-" => fleet_to(&fleet, args, "stdout", io::stdout().lock()),
+        Some(p) => {
+            let target = p.display().to_string();
+            let file = std::fs::File::create(p).map_err(|source| output_err(&target, source))?;
+            fleet_to(&fleet, args, &target, io::BufWriter::new(file))
+        }
+    }
+}
+
+fn output_err(target: &str, source: io::Error) -> FleetRunError {
+    FleetRunError::Cli(CliError::Output {
+        target: target.to_string(),
+        source,
+    })
+}
+
+/// Propagates `fleet` for `args.duration_s`, writing the CSV to `out`.
+pub fn fleet_to<W: Write>(
+    fleet: &FleetConfig,
+    args: &FleetArgs,
+    target: &str,
+    mut out: W,
+) -> Result<FleetReport, FleetRunError> {
+    let mut world = World::new(fleet)?;
+    let step_ns = fleet.vehicles[0].cfg.step_ns;
+    let steps = whole_steps("--duration-s", args.duration_s, step_ns, true)?;
+    let every = whole_steps("--log-every-s", args.log_every_s, step_ns, false)?;
+    let mut line = String::from("t_s");
+    for v in world.vehicles() {
+        for q in ["r_cn_n_m", "v_cn_n_m_s"] {
+            for k in 1..=3 {
+                let _ = write!(line, ",{}_{q}_{k}", v.id);
+            }
+        }
+    }
+    for &(c, d) in world.relative_pairs() {
+        let pair = format!("{}_in_{}", world.vehicles()[d].id, world.vehicles()[c].id);
+        for q in ["r_h_m", "v_h_m_s"] {
+            for k in 1..=3 {
+                let _ = write!(line, ",{pair}_{q}_{k}");
+            }
+        }
+        let _ = write!(line, ",{pair}_range_m,{pair}_range_rate_m_s");
+    }
+    line.push('\n');
+    out.write_all(line.as_bytes())
+        .map_err(|e| output_err(target, e))?;
+    let mut rows = 0;
+    let mut step = 0;
+    loop {
+        line.clear();
+        row(&world, &mut line);
+        out.write_all(line.as_bytes())
+            .map_err(|e| output_err(target, e))?;
+        rows += 1;
+        if step >= steps {
+            break;
+        }
+        for _ in 0..every.min(steps - step) {
+            world.step();
+        }
+        step += every.min(steps - step);
+    }
+    out.flush().map_err(|e| output_err(target, e))?;
+    Ok(FleetReport {
+        vehicles: world.vehicles().len(),
+        steps,
+        rows,
+    })
+}
+
+/// One CSV row of the world's current state.
+fn row(world: &World, line: &mut String) {
+    let _ = write!(line, "{}", world.t_sim_ns() as f64 * 1e-9);
+    for v in world.vehicles() {
+        let (r, v) = com_state_n(v.sim.spacecraft());
+        push(line, &r);
+        push(line, &v);
+    }
+    for &(c, d) in world.relative_pairs() {
+        match world.relative_state(c, d) {
+            Some(rel) => {
+                push(line, &rel.r_dc_h_m);
+                push(line, &rel.v_dc_h_m_s);
+                let _ = write!(line, ",{},{}", rel.range_m, rel.range_rate_m_s);
+            }
+            // A chief without an orbit plane has no Hill frame: empty cells.
+            None => line.push_str(",,,,,,,,"),
+        }
+    }
+    line.push('\n');
+}
+
+/// `,x1,x2,x3`.
+fn push(line: &mut String, x: &Vector3<f64>) {
+    for c in x.iter() {
+        let _ = write!(line, ",{c}");
+    }
+}

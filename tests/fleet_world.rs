@@ -1,0 +1,203 @@
+//! The world of vehicles (issue 22): each vehicle's motion in a [`World`] is the motion it has
+//! alone, bit for bit; and the fleet file's errors name the vehicle and the field.
+
+use std::path::Path;
+
+use flexdyn::sim::Simulation;
+use flexdyn::world::{FleetConfig, World};
+
+const SCENARIOS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
+
+/// The LEO scenario (every environment model on, `update_hz = 10`) as the chief, and a deputy
+/// 100 m behind it along-track, 20 m below.
+const LEO_PAIR: &str = "[[vehicles]]\nid = \"chief\"\nspacecraft_file = \"leo_environment.toml\"\n\
+    participants = [1]\n\n[[vehicles]]\nid = \"deputy\"\nspacecraft_file = \
+    \"leo_environment.toml\"\nparticipants = [2]\n[vehicles.relative]\nchief = \"chief\"\n\
+    hill_position_m = [-20.0, -100.0, 0.0]\nhill_velocity_m_s = [0.0, 0.0, 0.01]\n";
+
+#[test]
+fn each_vehicle_moves_as_it_would_alone() {
+    let fleet = FleetConfig::from_toml_str_in(LEO_PAIR, Path::new(SCENARIOS)).unwrap();
+    let mut world = World::new(&fleet).unwrap();
+    let mut alone: Vec<Simulation> = fleet
+        .vehicles
+        .iter()
+        .map(|v| Simulation::new(&v.cfg).unwrap())
+        .collect();
+    // 1.5 s of 100 Hz frames (1 ms steps).
+    for _ in 0..150 {
+        world.step_frame();
+        for sim in &mut alone {
+            sim.step_frame();
+        }
+    }
+    for (v, sim) in world.vehicles().iter().zip(&alone) {
+        assert_eq!(v.sim.t_sim_ns(), 1_500_000_000);
+        assert_eq!(
+            v.sim.spacecraft().state(),
+            sim.spacecraft().state(),
+            "{}",
+            v.id
+        );
+        assert_eq!(
+            v.sim.spacecraft().environment(),
+            sim.spacecraft().environment(),
+            "{}",
+            v.id
+        );
+        // The sample is a real one (the Sun, B and the density are on), not a blank.
+        let env = v.sim.spacecraft().environment();
+        assert_eq!(env.t_sim_ns, 1_400_000_000);
+        assert!(env.density_kg_m3 > 0.0 && env.b_field_n_t.norm() > 1e-5);
+    }
+    // The two vehicles differ (the deputy is where the fleet file put it, not on the chief).
+    let rel = world.relative_state(0, 1).unwrap();
+    assert!((rel.range_m - 102.0).abs() < 1.0, "{rel:?}");
+}
+
+/// The error of `text` (spacecraft files relative to the scenarios folder).
+fn error_of(text: &str) -> String {
+    match FleetConfig::from_toml_str_in(text, Path::new(SCENARIOS)) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn fleet_errors_name_the_vehicle_and_the_field() {
+    let deputy = |extra: &str| {
+        format!(
+            "[[vehicles]]\nid = \"chief\"\nspacecraft_file = \"leo_environment.toml\"\n\n\
+             [[vehicles]]\nid = \"deputy\"\n{extra}"
+        )
+    };
+    let cases: [(String, &str); 8] = [
+        (
+            deputy("spacecraft_file = \"leo_environment.toml\"\ncolour = 3\n"),
+            "vehicles[1] (\"deputy\").colour: unknown key",
+        ),
+        (
+            deputy("spacecraft_file = \"no_such_file.toml\"\n"),
+            "vehicles[1] (\"deputy\").spacecraft_file `",
+        ),
+        (
+            deputy(""),
+            "vehicles[1] (\"deputy\").spacecraft_file: missing",
+        ),
+        (
+            deputy(
+                "spacecraft_file = \"leo_environment.toml\"\n[vehicles.relative]\nchief = \
+                 \"mothership\"\n",
+            ),
+            "vehicles[1] (\"deputy\").relative.chief: \"mothership\" is not the id of an \
+             earlier vehicle",
+        ),
+        (
+            deputy(
+                "spacecraft_file = \"leo_environment.toml\"\n[vehicles.relative]\nchief = \
+                 \"chief\"\nhill_position_m = [1.0, 2.0]\n",
+            ),
+            "vehicles[1] (\"deputy\").relative.hill_position_m: must be an array of 3 finite",
+        ),
+        (
+            deputy("spacecraft_file = \"leo_environment.toml\"\nparticipants = [2, 2]\n")
+                .replace("id = \"deputy\"", "id = \"chief\""),
+            "vehicles[1] (\"chief\").id: \"chief\" is already the id of vehicles[0]",
+        ),
+        (
+            deputy("spacecraft_file = \"leo_environment.toml\"\nparticipants = [2, 2]\n"),
+            "vehicles[1] (\"deputy\").participants: sender id 2 is listed twice",
+        ),
+        (
+            // An inline spacecraft configuration without its [gravity] table: the vehicle, then
+            // the configuration's own field.
+            deputy("[vehicles.spacecraft]\nsimulation = { step_s = 0.001, frame_hz = 100.0 }\n"),
+            "vehicles[1] (\"deputy\").spacecraft: ",
+        ),
+    ];
+    for (text, expected) in &cases {
+        let msg = error_of(text);
+        assert!(
+            msg.starts_with(expected),
+            "expected `{expected}…`, got `{msg}`"
+        );
+    }
+    // The inline configuration's own error names its field.
+    let msg = error_of(&cases[7].0);
+    assert!(msg.contains("gravity: missing required key"), "{msg}");
+}
+
+#[test]
+fn vehicles_that_cannot_share_a_tick_are_refused() {
+    let leo = std::fs::read_to_string(format!("{SCENARIOS}/leo_environment.toml")).unwrap();
+    let dir = std::env::temp_dir().join(format!("flexdyn-fleet-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("a.toml"), &leo).unwrap();
+    std::fs::write(
+        dir.join("b.toml"),
+        leo.replace("frame_hz = 100.0", "frame_hz = 50.0"),
+    )
+    .unwrap();
+    let fleet_path = dir.join("fleet.toml");
+    std::fs::write(
+        &fleet_path,
+        "[[vehicles]]\nid = \"a\"\nspacecraft_file = \"a.toml\"\n\n[[vehicles]]\nid = \"b\"\n\
+         spacecraft_file = \"b.toml\"\n",
+    )
+    .unwrap();
+    let err = FleetConfig::from_file(&fleet_path).unwrap_err().to_string();
+    assert!(
+        err.starts_with("vehicles[1] (\"b\").spacecraft.simulation.frame_hz: the frame period"),
+        "{err}"
+    );
+    // The same files with one frame rate: read by path, relative to the fleet file's folder.
+    std::fs::write(dir.join("b.toml"), &leo).unwrap();
+    let fleet = FleetConfig::from_file(&fleet_path).unwrap();
+    assert_eq!(fleet.vehicles.len(), 2);
+    assert_eq!(fleet.vehicles[1].spacecraft_id, 2);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn fleet_csv_holds_each_vehicle_and_the_relative_state() {
+    use flexdyn::world::run::{fleet_to, FleetArgs};
+    let fleet = FleetConfig::from_toml_str_in(LEO_PAIR, Path::new(SCENARIOS)).unwrap();
+    let args = FleetArgs {
+        fleet: "unused.toml".into(),
+        duration_s: 0.5,
+        log_every_s: 0.1,
+        output: None,
+    };
+    let mut csv = Vec::new();
+    let report = fleet_to(&fleet, &args, "memory", &mut csv).unwrap();
+    // Rows at t = 0, 0.1, …, 0.5 s; 1 ms steps.
+    assert_eq!((report.vehicles, report.steps, report.rows), (2, 500, 6));
+    let text = String::from_utf8(csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 7);
+    let header: Vec<&str> = lines[0].split(',').collect();
+    // t, 2 vehicles × 6, one pair × 8.
+    assert_eq!(header.len(), 1 + 12 + 8);
+    assert_eq!(header[1], "chief_r_cn_n_m_1");
+    assert_eq!(header[13], "deputy_in_chief_r_h_m_1");
+    assert_eq!(header[20], "deputy_in_chief_range_rate_m_s");
+    let last: Vec<f64> = lines[6].split(',').map(|c| c.parse().unwrap()).collect();
+    assert_eq!(last[0], 0.5);
+    // The same world stepped 500 times: the same numbers (Display of f64 round-trips).
+    let mut world = World::new(&fleet).unwrap();
+    for _ in 0..500 {
+        world.step();
+    }
+    let rel = world.relative_state(0, 1).unwrap();
+    assert_eq!(&last[13..16], rel.r_dc_h_m.as_slice());
+    assert_eq!(&last[16..19], rel.v_dc_h_m_s.as_slice());
+    assert_eq!((last[19], last[20]), (rel.range_m, rel.range_rate_m_s));
+    // A duration that is not a whole number of steps is refused, naming the option.
+    let bad = FleetArgs {
+        duration_s: 0.0005,
+        ..args
+    };
+    let err = fleet_to(&fleet, &bad, "memory", Vec::new()).unwrap_err();
+    assert!(err.to_string().starts_with("--duration-s: "), "{err}");
+    assert_eq!(err.exit_code(), 2);
+}
