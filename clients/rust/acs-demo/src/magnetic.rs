@@ -69,6 +69,18 @@ impl RodArray {
         mu.iter().map(|m| m / over).collect()
     }
 
+    /// Rod dipoles from the minimum-norm allocation of `m_b_am2`, each clipped to its own limit
+    /// on its own (the direction may change). For B-dot with rods along the body axes the
+    /// allocation is m's components, and a clip that keeps each sign keeps every
+    /// m_j (ω × B)_j ≥ 0: the law stays dissipative, with more torque than [`Self::dipoles`].
+    pub fn dipoles_clipped(&self, m_b_am2: &Vector3<f64>) -> Vec<f64> {
+        let mu = &self.pinv * DVector::from_column_slice(m_b_am2.as_slice());
+        mu.iter()
+            .zip(&self.max_dipole_am2)
+            .map(|(m, max)| m.clamp(-max, *max))
+            .collect()
+    }
+
     /// The body dipole the rods make with dipoles `mu`.
     pub fn body_dipole(&self, mu: &[f64]) -> Vector3<f64> {
         self.axis_b.iter().zip(mu).map(|(a, m)| a * *m).sum()
@@ -210,6 +222,10 @@ mod tests {
         assert!(mu.iter().map(|x| x.abs()).fold(0.0, f64::max) <= 100.0 + 1e-9);
         assert!(made.normalize().dot(&big.normalize()) > 1.0 - 1e-12);
         assert_eq!(r.inputs(&mu)[2].effector_index, 2);
+        // Clipped rod by rod: the small component is kept, the others stop at the limit.
+        let ortho = rods(&[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], 100.0);
+        let mu = ortho.dipoles_clipped(&Vector3::new(500.0, -50.0, -300.0));
+        assert_eq!(mu, [100.0, -50.0, -100.0]);
         // Two rods cannot make every dipole.
         let cfg = "[simulation]\nframe_hz = 10.0\n[hub]\nmass_kg = 1.0\ninertia_bc_b_kg_m2 = \
                    [[1.0,0.0,0.0],[0.0,1.0,0.0],[0.0,0.0,1.0]]\nr_bcb_b_m = [0.0,0.0,0.0]\n\
