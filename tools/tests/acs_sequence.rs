@@ -280,12 +280,17 @@ fn the_whole_acs_sequence_flies_in_lockstep_and_is_bit_identical() {
     );
     // Final pointing, and the figures over fine pointing after it settled (both fine-pointing
     // phases and the unloading between them).
-    let errors: Vec<f64> = (settled..n_ticks).map(|t| pointing_deg(&state(t))).collect();
+    let errors: Vec<f64> = (settled..n_ticks)
+        .map(|t| pointing_deg(&state(t)))
+        .collect();
     let rms_deg = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
     let max_deg = errors.iter().cloned().fold(0.0, f64::max);
     let final_deg = *errors.last().unwrap();
     assert!(final_deg < 0.05, "final pointing error {final_deg}°");
-    assert!(max_deg < 0.1, "pointing error up to {max_deg}° in fine pointing");
+    assert!(
+        max_deg < 0.1,
+        "pointing error up to {max_deg}° in fine pointing"
+    );
     let sun_final_deg = a.sun_b[&(n_ticks - 1)].angle(&panel_b).to_degrees();
 
     let times: Vec<String> = a

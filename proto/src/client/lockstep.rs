@@ -88,7 +88,9 @@ impl SensorSchedule {
 
     /// The coarse-sun-sensor arrays (name, period in frames), in configuration order.
     pub fn coarse_sun_sensors(&self) -> impl Iterator<Item = (&str, u64)> {
-        self.coarse_sun_sensors.iter().map(|(n, p)| (n.as_str(), *p))
+        self.coarse_sun_sensors
+            .iter()
+            .map(|(n, p)| (n.as_str(), *p))
     }
 }
 
@@ -106,9 +108,8 @@ fn missing_due<'a>(
 ) -> impl Iterator<Item = String> + 'a {
     list.iter()
         .enumerate()
-        .filter_map(move |(i, (name, every))| {
-            (tick.is_multiple_of(*every) && !have(i)).then(|| format!("{prefix}/{name}"))
-        })
+        .filter(move |(i, (_, every))| tick.is_multiple_of(*every) && !have(*i))
+        .map(move |(_, (name, _))| format!("{prefix}/{name}"))
 }
 
 /// One tick's telemetry: its state and the sensor samples due at it.
@@ -528,7 +529,10 @@ mod tests {
         assert!(f.out.is_empty(), "tick 0 released without st/st2");
         assert_eq!(f.a.waiting(), Some(0));
         f.st("st2", 0);
-        assert!(f.out.is_empty(), "tick 0 released without mag/mag1 and css/css");
+        assert!(
+            f.out.is_empty(),
+            "tick 0 released without mag/mag1 and css/css"
+        );
         f.mag(0);
         f.css(0);
         assert_eq!(f.ticks(), [(0, vec![])]);
@@ -542,7 +546,10 @@ mod tests {
         assert_eq!(f.ticks(), [(0, vec![]), (1, vec![])]);
         assert_eq!(f.out[1].imus[0].as_ref().unwrap().omega_p_rad_s[0], 1.0);
         assert_eq!(f.out[1].star_trackers, [None, None]);
-        assert_eq!((f.out[1].magnetometers[0], f.out[1].coarse_sun_sensors[0]), (None, None));
+        assert_eq!(
+            (f.out[1].magnetometers[0], f.out[1].coarse_sun_sensors[0]),
+            (None, None)
+        );
         // Tick 4: st2 (period 4) and mag1 (period 2) are due, st1 (period 10) and css (5) are
         // not.
         f.imu("hub", 4);

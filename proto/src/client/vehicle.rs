@@ -436,7 +436,11 @@ seed = 41
         assert!(c.imu("hub").is_err());
         // The attitude sensors of the ACS sequence: their schedule and the array's normals.
         let mag = c.magnetometer("mag1").unwrap();
-        assert_eq!(c.period_frames("magnetometer", "mag1", mag.rate_hz).unwrap(), 2);
+        assert_eq!(
+            c.period_frames("magnetometer", "mag1", mag.rate_hz)
+                .unwrap(),
+            2
+        );
         let css = c.coarse_sun_sensor("css").unwrap();
         assert_eq!(css.normals_b[1], [-1.0, 0.0, 0.0]);
         let e = c

@@ -128,6 +128,21 @@ impl Bdot {
     }
 }
 
+/// The gyro-aided B-dot dipole m = k_ω (ω × B)/|B|², all in B: its torque m × B = −k_ω ω_⊥,
+/// the rate across the field damped with the gain k_ω \[N·m·s\] (`crate::sequence`'s docs:
+/// why the gyro and not a finite difference of B). Zero in a zero field.
+pub fn gyro_bdot_dipole_b_am2(
+    gain_nms: f64,
+    omega_bn_b_rad_s: &Vector3<f64>,
+    b_b_t: &Vector3<f64>,
+) -> Vector3<f64> {
+    let b2 = b_b_t.norm_squared();
+    if b2 == 0.0 {
+        return Vector3::zeros();
+    }
+    omega_bn_b_rad_s.cross(b_b_t) * (gain_nms / b2)
+}
+
 /// The rod dipole for the cross-product unloading law: m = (B × τ_d)/|B|² with
 /// τ_d = −k (h_w − h_ref), all in B. Zero in a zero field.
 pub fn unloading_dipole_b_am2(
@@ -172,6 +187,28 @@ mod tests {
         assert!(
             (rate - closed).abs() < 1e-6 * closed.abs(),
             "{rate} vs {closed}"
+        );
+    }
+
+    /// (ω × B) × B = B (ω·B) − ω |B|², so m × B = k [(ω·b̂) b̂ − ω] = −k ω_⊥: the torque damps
+    /// exactly the rate across the field and leaves the rate along it.
+    #[test]
+    fn gyro_bdot_torque_is_minus_the_gain_times_the_rate_across_the_field() {
+        let omega = Vector3::new(0.03, -0.02, 0.05);
+        let b = Vector3::new(2.0e-5, -1.0e-5, 3.0e-5);
+        let k = 4.9;
+        let tau = gyro_bdot_dipole_b_am2(k, &omega, &b).cross(&b);
+        let across = omega - b * (omega.dot(&b) / b.norm_squared());
+        assert!(
+            (tau + across * k).norm() < 1e-15,
+            "{tau:?} vs {:?}",
+            -across * k
+        );
+        // A rate along the field gets no torque.
+        assert!(gyro_bdot_dipole_b_am2(k, &(b * 1e3), &b).norm() < 1e-9);
+        assert_eq!(
+            gyro_bdot_dipole_b_am2(k, &omega, &Vector3::zeros()),
+            Vector3::zeros()
         );
     }
 

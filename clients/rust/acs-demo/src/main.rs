@@ -419,7 +419,12 @@ fn print_sequence_events(out: &flexdyn_acs_demo::sequence::Output) {
             t.to.name(),
             out.wheel_momentum_b_nms.norm()
         );
-        tracing::info!(tick = t.tick, from = t.from.name(), to = t.to.name(), "mode transition");
+        tracing::info!(
+            tick = t.tick,
+            from = t.from.name(),
+            to = t.to.name(),
+            "mode transition"
+        );
     }
     if let Some(s) = &out.new_target_sigma_rn {
         println!("fine-pointing-target sigma_rn={},{},{}", s[0], s[1], s[2]);

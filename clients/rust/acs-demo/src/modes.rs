@@ -304,6 +304,9 @@ mod tests {
     /// condition first holds), the eclipse wait, and the unloading pass with its duration.
     #[test]
     fn the_sequence_runs_in_order_with_dwell_and_eclipse_wait() {
+        // The default dwell is the 100 ticks this test counts.
+        assert_eq!(settings().dwell_ns, DWELL_NS);
+        assert_eq!(DWELL_NS / FRAME_NS, 100);
         let mut m = ModeManager::new(settings(), 0);
         let mut t = 0;
         // Tumbling at 3°/s: stays.

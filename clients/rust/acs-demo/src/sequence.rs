@@ -57,7 +57,7 @@ use flexdyn_proto::EffectorInput;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 use crate::acs::{inertia_about_b, mat3, wheel_control_torque, StarTrackerAttitude, WheelArray};
-use crate::magnetic::{unloading_dipole_b_am2, RodArray};
+use crate::magnetic::{gyro_bdot_dipole_b_am2, unloading_dipole_b_am2, RodArray};
 use crate::modes::{Mode, ModeManager, ModeSettings, Observation, Transition};
 use crate::sun::{angle_to_sun_rad, sun_acquisition_torque_b_nm, sun_direction_b};
 
@@ -184,7 +184,11 @@ impl AcsSequence {
         }
         Ok(Self {
             wheels: WheelArray::from_config(cfg)?,
-            wheel_max_torque_nm: cfg.reaction_wheels.iter().map(|w| w.max_torque_nm).collect(),
+            wheel_max_torque_nm: cfg
+                .reaction_wheels
+                .iter()
+                .map(|w| w.max_torque_nm)
+                .collect(),
             rods: RodArray::from_config(cfg)?,
             inertia_b_kg_m2: inertia_about_b(cfg)?,
             frame_s: (1e9 / cfg.simulation.frame_hz).round() * 1e-9,
@@ -269,7 +273,11 @@ impl AcsSequence {
             .last_rate_b
             .with_context(|| format!("no gyro sample from `{}` yet", self.setup.imu))?;
         // The field, B components (held between samples).
-        if let Some(m) = tick.magnetometers.get(self.mag_index).and_then(Option::as_ref) {
+        if let Some(m) = tick
+            .magnetometers
+            .get(self.mag_index)
+            .and_then(Option::as_ref)
+        {
             self.last_b_b_t = Some(self.dcm_sb.transpose() * Vector3::from(m.b_s_t));
         }
         // The Sun direction (none in eclipse); held between samples.
@@ -329,8 +337,7 @@ impl AcsSequence {
         let gyroscopic = rate_b.cross(&(self.inertia_b_kg_m2 * rate_b + h_w));
         let g = self.setup.gains;
         let sun_torque = |sun: Option<&Vector3<f64>>| {
-            sun_acquisition_torque_b_nm(g.sun_kp_nm, g.sun_kd_nms, &n_b, sun, &rate_b)
-                + gyroscopic
+            sun_acquisition_torque_b_nm(g.sun_kp_nm, g.sun_kd_nms, &n_b, sun, &rate_b) + gyroscopic
         };
         let (wheel_torque_b, dipole) = match mode {
             Mode::Detumble => (None, self.detumble_dipoles(&rate_b)),
@@ -386,17 +393,80 @@ impl AcsSequence {
         let Some(b) = self.last_b_b_t.filter(|b| b.norm_squared() > 0.0) else {
             return self.rods_off();
         };
-        let m = rate_b.cross(&b) * (self.setup.gains.detumble_nms / b.norm_squared());
-        self.rods.dipoles_clipped(&m)
+        self.rods.dipoles_clipped(&gyro_bdot_dipole_b_am2(
+            self.setup.gains.detumble_nms,
+            rate_b,
+            &b,
+        ))
     }
 
     /// u = −[G_s]⁺ L, scaled down as a whole so that no wheel exceeds its torque limit.
     fn limited_motor_torques(&self, torque_b_nm: &Vector3<f64>) -> Vec<f64> {
-        let u = self.wheels.motor_torques(torque_b_nm);
-        let over = u
-            .iter()
-            .zip(&self.wheel_max_torque_nm)
-            .fold(1.0_f64, |s, (u, max)| s.max(u.abs() / max));
-        u.iter().map(|x| x / over).collect()
+        scaled_to_limits(
+            &self.wheels.motor_torques(torque_b_nm),
+            &self.wheel_max_torque_nm,
+        )
+    }
+}
+
+/// `u` scaled down as a whole (direction kept) so that no |u_j| exceeds `max[j]`; unchanged
+/// when it fits.
+pub fn scaled_to_limits(u: &[f64], max: &[f64]) -> Vec<f64> {
+    let over = u
+        .iter()
+        .zip(max)
+        .fold(1.0_f64, |s, (u, max)| s.max(u.abs() / max));
+    u.iter().map(|x| x / over).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The target puts the panel normal exactly on the Sun: in R the Sun's components are the
+    /// panel normal's, s_R = [RN] [NB] s_B = n̂. And it is the nearest such attitude: the
+    /// rotation from B to R is the angle between n̂ and ŝ, not more.
+    #[test]
+    fn the_sun_pointing_target_puts_the_panel_normal_on_the_sun_by_the_smallest_turn() {
+        let cases = [
+            (
+                Vector3::new(0.1, -0.2, 0.3),
+                Vector3::z(),
+                Vector3::new(0.3, 0.4, 0.5),
+            ),
+            (
+                Vector3::new(-0.4, 0.05, 0.2),
+                Vector3::new(1.0, 1.0, 0.0),
+                Vector3::new(0.0, -1.0, 0.2),
+            ),
+            (Vector3::zeros(), Vector3::z(), Vector3::z()),
+        ];
+        for (sigma_bn, n_b, sun_b) in cases {
+            let sigma_rn = AcsSequence::sun_pointing_target(&sigma_bn, &n_b, &sun_b);
+            let dcm_bn = mrp_to_dcm(&sigma_bn);
+            let sun_r = mrp_to_dcm(&sigma_rn) * dcm_bn.transpose() * sun_b.normalize();
+            assert!(
+                (sun_r - n_b.normalize()).norm() < 1e-12,
+                "{sun_r:?} vs {n_b:?}"
+            );
+            let turn_rad = 4.0 * mrp_error(&sigma_bn, &sigma_rn).norm().atan();
+            assert!((turn_rad - n_b.angle(&sun_b)).abs() < 1e-12, "{turn_rad}");
+        }
+    }
+
+    /// Too large a request is scaled as a whole: the largest wheel sits at its limit and the
+    /// ratios (so the body torque's direction) are kept; a request within the limits is kept.
+    #[test]
+    fn motor_torques_are_scaled_as_a_whole_to_the_limits() {
+        let max = [0.2, 0.2, 0.1];
+        let u = [0.3, -0.1, 0.1];
+        let s = scaled_to_limits(&u, &max);
+        // The worst ratio is 0.3/0.2 = 1.5 (wheel 0): it ends at its limit, the rest in
+        // proportion.
+        for (x, want) in s.iter().zip([0.2, -0.1 / 1.5, 0.1 / 1.5]) {
+            assert!((x - want).abs() < 1e-15, "{s:?}");
+        }
+        let fits = [0.1, -0.2, 0.05];
+        assert_eq!(scaled_to_limits(&fits, &max), fits);
     }
 }
