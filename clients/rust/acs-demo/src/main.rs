@@ -408,16 +408,31 @@ fn sequence(
     Ok(Some(AcsSequence::new(cfg, schedule, setup)?))
 }
 
+/// The estimates behind a tick's decisions as `key=value` words: the gyro rate, the Sun's
+/// angle from the panel normal (coarse sun sensors; `none` in eclipse), the pointing error
+/// (star tracker; `none` before a target), the wheel momentum.
+fn sequence_estimates(out: &flexdyn_acs_demo::sequence::Output) -> String {
+    let o = &out.observation;
+    let deg = |a: Option<f64>| a.map_or("none".to_owned(), |a| a.to_degrees().to_string());
+    format!(
+        "rate_deg_s={} sun_angle_deg={} pointing_error_deg={} wheel_momentum_nms={}",
+        o.omega_bn_b_rad_s.norm().to_degrees(),
+        deg(o.sun_angle_rad),
+        deg(o.pointing_error_rad),
+        out.wheel_momentum_b_nms.norm()
+    )
+}
+
 /// Prints what a tick of the sequence changed (stdout, one line each: the record of the run).
 fn print_sequence_events(out: &flexdyn_acs_demo::sequence::Output) {
     if let Some(t) = &out.transition {
         println!(
-            "mode-transition tick={} t_s={} from={} to={} wheel_momentum_nms={}",
+            "mode-transition tick={} t_s={} from={} to={} {}",
             t.tick,
             t.t_ns as f64 * 1e-9,
             t.from.name(),
             t.to.name(),
-            out.wheel_momentum_b_nms.norm()
+            sequence_estimates(out)
         );
         tracing::info!(
             tick = t.tick,
@@ -431,11 +446,24 @@ fn print_sequence_events(out: &flexdyn_acs_demo::sequence::Output) {
     }
 }
 
-/// The time in each mode, printed when the run ends.
-fn print_sequence_summary(seq: &AcsSequence, t_end_ns: u64) {
+/// The time in each mode and the last tick's estimates, printed when the run ends.
+fn print_sequence_summary(
+    seq: &AcsSequence,
+    last: Option<&flexdyn_acs_demo::sequence::Output>,
+    t_end_ns: u64,
+) {
     let times = seq.modes().time_in_modes_ns(0, t_end_ns);
     for (mode, t) in Mode::ALL.iter().zip(times) {
         println!("time-in-mode mode={} s={}", mode.name(), t as f64 * 1e-9);
+    }
+    if let Some(out) = last {
+        println!(
+            "final tick={} t_s={} mode={} {}",
+            out.observation.tick,
+            out.observation.t_ns as f64 * 1e-9,
+            out.mode.name(),
+            sequence_estimates(out)
+        );
     }
 }
 
@@ -588,6 +616,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let mut buf = Vec::with_capacity(128);
     let mut states_received = 0u64;
     let mut last_state_at = Instant::now();
+    let mut last_sequence_output = None;
     loop {
         if stop.load(std::sync::atomic::Ordering::Relaxed) {
             tracing::info!(states_received, "stop signal: closing the session");
@@ -630,8 +659,10 @@ fn run(args: Args) -> anyhow::Result<()> {
         if let Some(fsw) = &mut sequence {
             let out = fsw.step(&tick)?;
             print_sequence_events(&out);
+            let out = last_sequence_output.insert(out);
             let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
-            let cmd = CommandMsg::actuators(header, args.sender_id, [0.0; 3], [0.0; 3], out.inputs);
+            let inputs = std::mem::take(&mut out.inputs);
+            let cmd = CommandMsg::actuators(header, args.sender_id, [0.0; 3], [0.0; 3], inputs);
             encode_into(&cmd, &mut buf);
             commands
                 .put(buf.as_slice())
@@ -719,7 +750,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     if let Some(fsw) = &sequence {
-        print_sequence_summary(fsw, last_t_ns);
+        print_sequence_summary(fsw, last_sequence_output.as_ref(), last_t_ns);
     }
     // Undeclare the token first (a lockstep server sees us leave), then close the session.
     drop(token);

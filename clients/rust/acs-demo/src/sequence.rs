@@ -130,6 +130,9 @@ pub struct Output {
     pub inputs: Vec<EffectorInput>,
     /// \[N·m·s\] the wheel momentum h_w about B, B components, from this tick's wheel speeds.
     pub wheel_momentum_b_nms: Vector3<f64>,
+    /// What the mode logic saw at this tick (the sensors' estimates: rate, Sun angle, pointing
+    /// error).
+    pub observation: Observation,
 }
 
 /// The flight software of the sequence (module docs).
@@ -376,6 +379,7 @@ impl AcsSequence {
             new_target_sigma_rn: new_target,
             inputs,
             wheel_momentum_b_nms: h_w,
+            observation: obs,
         })
     }
 
