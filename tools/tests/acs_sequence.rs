@@ -46,10 +46,11 @@ use zenoh::Wait;
 /// Momentum management's duration in the test [s] (module docs); `FLEXDYN_ACS_UNLOAD_S`
 /// overrides it.
 const UNLOAD_S: f64 = 1500.0;
-/// Simulated time before momentum management ends, less its duration [s]: detumble (~5960 s),
-/// sun acquisition (~590 s) and fine pointing's settling (~70 s) fit with room to spare, and
-/// fine pointing then runs ~280 s after the unloading.
+/// A run's simulated time less the unloading's [s]: detumble (~5960 s), sun acquisition
+/// (~590 s) and fine pointing until settled (~70 s) take ~6620 s; fine pointing then runs
+/// ~280 s after the unloading.
 const BEFORE_UNLOAD_S: f64 = 6900.0;
+const FRAME_S: f64 = 0.1;
 
 /// Momentum management's duration [s]: `FLEXDYN_ACS_UNLOAD_S`, or [`UNLOAD_S`].
 fn unload_s() -> f64 {
@@ -62,7 +63,7 @@ fn unload_s() -> f64 {
             })
     })
 }
-const FRAME_S: f64 = 0.1;
+
 /// The mode manager's dwell: each exit condition holds this many ticks before its transition.
 const DWELL_TICKS: u64 = 100;
 
