@@ -193,6 +193,11 @@ pub enum Telemetry<'a> {
     Imu(&'a str),
     /// `flexdyn/<sc>/tlm/st/<name>`: a [`crate::StarTrackerMsg`] of the tracker `name`.
     StarTracker(&'a str),
+    /// `flexdyn/<sc>/tlm/mag/<name>`: a [`crate::MagnetometerMsg`] of the magnetometer `name`.
+    Magnetometer(&'a str),
+    /// `flexdyn/<sc>/tlm/css/<name>`: a [`crate::CssMsg`] of the coarse-sun-sensor array
+    /// `name`.
+    Css(&'a str),
 }
 
 /// All keys of one spacecraft, validated once.
@@ -314,6 +319,8 @@ impl Topics {
         named(IMU_PREFIX)
             .map(Telemetry::Imu)
             .or_else(|| named(STAR_TRACKER_PREFIX).map(Telemetry::StarTracker))
+            .or_else(|| named(MAGNETOMETER_PREFIX).map(Telemetry::Magnetometer))
+            .or_else(|| named(CSS_PREFIX).map(Telemetry::Css))
     }
 
     /// `flexdyn/<sc>/tlm/imu/*`
@@ -403,6 +410,14 @@ mod tests {
         assert_eq!(
             t.telemetry(&t.star_tracker("st1").unwrap()),
             Some(Telemetry::StarTracker("st1"))
+        );
+        assert_eq!(
+            t.telemetry(&t.sensor(MAGNETOMETER_PREFIX, "mag1").unwrap()),
+            Some(Telemetry::Magnetometer("mag1"))
+        );
+        assert_eq!(
+            t.telemetry("flexdyn/sc-1/tlm/css/css"),
+            Some(Telemetry::Css("css"))
         );
         for other in [
             "flexdyn/sc-2/tlm/state",

@@ -1,7 +1,7 @@
 //! Complete ticks for flight code that reads sensors.
 //!
-//! For each tick k the server publishes the sample of every IMU and of every star tracker due at
-//! k, then the StateMsg of k (proto/README.md, "Lockstep protocol"). Flight code that answers
+//! For each tick k the server publishes the sample of every IMU, and of every star tracker,
+//! magnetometer and coarse-sun-sensor array due at k, then the StateMsg of k (proto/README.md, "Lockstep protocol"). Flight code that answers
 //! tick k from exactly those samples is as deterministic as the server; flight code that uses
 //! whatever sample came last is not, because separate subscribers may be delivered on separate
 //! threads and a state can overtake a sample of its own tick. So:
@@ -18,8 +18,8 @@ use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
 use crate::{
-    decode_imu, decode_star_tracker, decode_state, DecodeError, ImuMsg, StarTrackerMsg, StateMsg,
-    Telemetry, Topics,
+    decode_css, decode_imu, decode_magnetometer, decode_star_tracker, decode_state, CssMsg,
+    DecodeError, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, Telemetry, Topics,
 };
 use zenoh::handlers::{RingChannel, RingChannelHandler};
 use zenoh::pubsub::Subscriber;
@@ -29,12 +29,17 @@ use zenoh::{Session, Wait};
 use crate::client::vehicle::{VehicleConfig, VehicleError};
 
 /// Which sensor samples the server publishes at each tick: every IMU each tick, and each star
-/// tracker on the ticks that are multiples of its period (from tick 0).
+/// tracker, magnetometer and coarse-sun-sensor array on the ticks that are multiples of its
+/// period (from tick 0).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SensorSchedule {
     imus: Vec<String>,
     /// (name, period in frames)
     star_trackers: Vec<(String, u64)>,
+    /// (name, period in frames)
+    magnetometers: Vec<(String, u64)>,
+    /// (name, period in frames)
+    coarse_sun_sensors: Vec<(String, u64)>,
 }
 
 impl SensorSchedule {
@@ -46,6 +51,22 @@ impl SensorSchedule {
                 .star_trackers
                 .iter()
                 .map(|st| Ok((st.name.clone(), cfg.star_tracker_period_frames(st)?)))
+                .collect::<Result<_, VehicleError>>()?,
+            magnetometers: cfg
+                .magnetometers
+                .iter()
+                .map(|m| {
+                    let every = cfg.period_frames("magnetometer", &m.name, m.rate_hz)?;
+                    Ok((m.name.clone(), every))
+                })
+                .collect::<Result<_, VehicleError>>()?,
+            coarse_sun_sensors: cfg
+                .coarse_sun_sensors
+                .iter()
+                .map(|c| {
+                    let every = cfg.period_frames("coarse sun sensor", &c.name, c.rate_hz)?;
+                    Ok((c.name.clone(), every))
+                })
                 .collect::<Result<_, VehicleError>>()?,
         })
     }
@@ -60,11 +81,35 @@ impl SensorSchedule {
         self.star_trackers.iter().map(|(n, p)| (n.as_str(), *p))
     }
 
-    fn tracker_due(&self, index: usize, tick: u64) -> bool {
-        self.star_trackers
-            .get(index)
-            .is_some_and(|(_, every)| tick.is_multiple_of(*every))
+    /// The magnetometers (name, period in frames), in configuration order.
+    pub fn magnetometers(&self) -> impl Iterator<Item = (&str, u64)> {
+        self.magnetometers.iter().map(|(n, p)| (n.as_str(), *p))
     }
+
+    /// The coarse-sun-sensor arrays (name, period in frames), in configuration order.
+    pub fn coarse_sun_sensors(&self) -> impl Iterator<Item = (&str, u64)> {
+        self.coarse_sun_sensors
+            .iter()
+            .map(|(n, p)| (n.as_str(), *p))
+    }
+}
+
+/// The index of `name` in a periodic list.
+fn position(list: &[(String, u64)], name: &str) -> Option<usize> {
+    list.iter().position(|(n, _)| n == name)
+}
+
+/// `<prefix>/<name>` of each sensor of a periodic list due at `tick` whose sample `have` lacks.
+fn missing_due<'a>(
+    list: &'a [(String, u64)],
+    prefix: &'a str,
+    tick: u64,
+    have: impl Fn(usize) -> bool + 'a,
+) -> impl Iterator<Item = String> + 'a {
+    list.iter()
+        .enumerate()
+        .filter(move |(i, (_, every))| tick.is_multiple_of(*every) && !have(*i))
+        .map(move |(_, (name, _))| format!("{prefix}/{name}"))
 }
 
 /// One tick's telemetry: its state and the sensor samples due at it.
@@ -77,8 +122,13 @@ pub struct Tick {
     /// The star-tracker samples of the tick, in configuration order (`None`: not due at this
     /// tick, or lost).
     pub star_trackers: Vec<Option<StarTrackerMsg>>,
-    /// The due samples that never came, as `imu/<name>` or `st/<name>`. Empty in lockstep
-    /// unless a sample was lost.
+    /// The magnetometer samples of the tick, in configuration order (`None`: not due, or lost).
+    pub magnetometers: Vec<Option<MagnetometerMsg>>,
+    /// The coarse-sun-sensor array samples of the tick, in configuration order (`None`: not
+    /// due, or lost).
+    pub coarse_sun_sensors: Vec<Option<CssMsg>>,
+    /// The due samples that never came, as `imu/<name>`, `st/<name>`, `mag/<name>` or
+    /// `css/<name>`. Empty in lockstep unless a sample was lost.
     pub missing: Vec<String>,
 }
 
@@ -94,6 +144,19 @@ impl Tick {
 struct Partial {
     imus: Vec<Option<ImuMsg>>,
     star_trackers: Vec<Option<StarTrackerMsg>>,
+    magnetometers: Vec<Option<MagnetometerMsg>>,
+    coarse_sun_sensors: Vec<Option<CssMsg>>,
+}
+
+impl Partial {
+    fn empty(s: &SensorSchedule) -> Self {
+        Self {
+            imus: vec![None; s.imus.len()],
+            star_trackers: vec![None; s.star_trackers.len()],
+            magnetometers: vec![None; s.magnetometers.len()],
+            coarse_sun_sensors: vec![None; s.coarse_sun_sensors.len()],
+        }
+    }
 }
 
 /// Assembles complete [`Tick`]s from telemetry samples given in any order (see the module
@@ -147,33 +210,39 @@ impl TickAssembler {
             State(Box<StateMsg>),
             Imu(usize, ImuMsg),
             Tracker(usize, StarTrackerMsg),
+            Mag(usize, MagnetometerMsg),
+            Css(usize, CssMsg),
         }
+        let s = &self.schedule;
         let msg = match topic {
             // The time service is not part of a tick's samples (wait for it separately).
             Telemetry::Time => return Ok(()),
             // Nor is the environment message (truth for operators, after the state).
             Telemetry::Environment => return Ok(()),
             Telemetry::State => Msg::State(Box::new(decode_state(payload)?)),
-            Telemetry::Imu(name) => match self.schedule.imus.iter().position(|n| n == name) {
+            Telemetry::Imu(name) => match s.imus.iter().position(|n| n == name) {
                 Some(i) => Msg::Imu(i, decode_imu(payload)?),
                 None => return Ok(()),
             },
-            Telemetry::StarTracker(name) => {
-                match self
-                    .schedule
-                    .star_trackers
-                    .iter()
-                    .position(|(n, _)| n == name)
-                {
-                    Some(i) => Msg::Tracker(i, decode_star_tracker(payload)?),
-                    None => return Ok(()),
-                }
-            }
+            Telemetry::StarTracker(name) => match position(&s.star_trackers, name) {
+                Some(i) => Msg::Tracker(i, decode_star_tracker(payload)?),
+                None => return Ok(()),
+            },
+            Telemetry::Magnetometer(name) => match position(&s.magnetometers, name) {
+                Some(i) => Msg::Mag(i, decode_magnetometer(payload)?),
+                None => return Ok(()),
+            },
+            Telemetry::Css(name) => match position(&s.coarse_sun_sensors, name) {
+                Some(i) => Msg::Css(i, decode_css(payload)?),
+                None => return Ok(()),
+            },
         };
         let tick = match &msg {
             Msg::State(m) => m.header.tick,
             Msg::Imu(_, m) => m.header.tick,
             Msg::Tracker(_, m) => m.header.tick,
+            Msg::Mag(_, m) => m.header.tick,
+            Msg::Css(_, m) => m.header.tick,
         };
         if self.last.is_some_and(|last| tick <= last) {
             return Ok(()); // its tick was released already (it came after the time limit)
@@ -192,6 +261,8 @@ impl TickAssembler {
             }
             Msg::Imu(i, m) => self.partial_mut(tick).imus[i] = Some(m),
             Msg::Tracker(i, m) => self.partial_mut(tick).star_trackers[i] = Some(m),
+            Msg::Mag(i, m) => self.partial_mut(tick).magnetometers[i] = Some(m),
+            Msg::Css(i, m) => self.partial_mut(tick).coarse_sun_sensors[i] = Some(m),
         }
         if self.held.is_some() && self.missing().is_empty() {
             if let Some(t) = self.release() {
@@ -202,14 +273,14 @@ impl TickAssembler {
     }
 
     fn partial_mut(&mut self, tick: u64) -> &mut Partial {
-        let (n_imus, n_sts) = (self.schedule.imus.len(), self.schedule.star_trackers.len());
-        self.partial.entry(tick).or_insert_with(|| Partial {
-            imus: vec![None; n_imus],
-            star_trackers: vec![None; n_sts],
-        })
+        let s = &self.schedule;
+        self.partial
+            .entry(tick)
+            .or_insert_with(|| Partial::empty(s))
     }
 
-    /// The due samples of the held tick not received yet (`imu/<name>`, `st/<name>`).
+    /// The due samples of the held tick not received yet (`imu/<name>`, `st/<name>`,
+    /// `mag/<name>`, `css/<name>`).
     fn missing(&self) -> Vec<String> {
         let Some(tick) = self.held.as_ref().map(|h| h.header.tick) else {
             return Vec::new();
@@ -220,15 +291,16 @@ impl TickAssembler {
             let have = part.is_some_and(|p| p.imus[i].is_some());
             (!have).then(|| format!("imu/{name}"))
         });
-        let sts = s
-            .star_trackers
-            .iter()
-            .enumerate()
-            .filter_map(|(i, (name, _))| {
-                let have = part.is_some_and(|p| p.star_trackers[i].is_some());
-                (s.tracker_due(i, tick) && !have).then(|| format!("st/{name}"))
-            });
-        imus.chain(sts).collect()
+        let sts = missing_due(&s.star_trackers, "st", tick, |i| {
+            part.is_some_and(|p| p.star_trackers[i].is_some())
+        });
+        let mags = missing_due(&s.magnetometers, "mag", tick, |i| {
+            part.is_some_and(|p| p.magnetometers[i].is_some())
+        });
+        let css = missing_due(&s.coarse_sun_sensors, "css", tick, |i| {
+            part.is_some_and(|p| p.coarse_sun_sensors[i].is_some())
+        });
+        imus.chain(sts).chain(mags).chain(css).collect()
     }
 
     /// The tick whose state is held, waiting for samples.
@@ -248,17 +320,13 @@ impl TickAssembler {
         let part = self.partial.remove(&tick);
         self.partial.retain(|t, _| *t > tick);
         self.last = Some(tick);
-        let (imus, star_trackers) = match part {
-            Some(p) => (p.imus, p.star_trackers),
-            None => (
-                vec![None; self.schedule.imus.len()],
-                vec![None; self.schedule.star_trackers.len()],
-            ),
-        };
+        let p = part.unwrap_or_else(|| Partial::empty(&self.schedule));
         Some(Tick {
             state,
-            imus,
-            star_trackers,
+            imus: p.imus,
+            star_trackers: p.star_trackers,
+            magnetometers: p.magnetometers,
+            coarse_sun_sensors: p.coarse_sun_sensors,
             missing,
         })
     }
@@ -378,6 +446,8 @@ mod tests {
         SensorSchedule {
             imus: vec!["hub".into(), "bracket".into()],
             star_trackers: vec![("st1".into(), 10), ("st2".into(), 4)],
+            magnetometers: vec![("mag1".into(), 2)],
+            coarse_sun_sensors: vec![("css".into(), 5)],
         }
     }
 
@@ -425,6 +495,22 @@ mod tests {
             };
             self.push(&format!("flexdyn/sc1/tlm/st/{name}"), encode(&m));
         }
+        fn mag(&mut self, tick: u64) {
+            let m = MagnetometerMsg {
+                header: header(tick),
+                b_s_t: [tick as f64, 0.0, 0.0],
+                ..MagnetometerMsg::default()
+            };
+            self.push("flexdyn/sc1/tlm/mag/mag1", encode(&m));
+        }
+        fn css(&mut self, tick: u64) {
+            let m = CssMsg {
+                header: header(tick),
+                detector_count: 1,
+                ..CssMsg::default()
+            };
+            self.push("flexdyn/sc1/tlm/css/css", encode(&m));
+        }
         fn ticks(&self) -> Vec<(u64, Vec<String>)> {
             self.out
                 .iter()
@@ -443,9 +529,16 @@ mod tests {
         assert!(f.out.is_empty(), "tick 0 released without st/st2");
         assert_eq!(f.a.waiting(), Some(0));
         f.st("st2", 0);
+        assert!(
+            f.out.is_empty(),
+            "tick 0 released without mag/mag1 and css/css"
+        );
+        f.mag(0);
+        f.css(0);
         assert_eq!(f.ticks(), [(0, vec![])]);
         let t = &f.out[0];
         assert!(t.imus.iter().all(Option::is_some) && t.star_trackers.iter().all(Option::is_some));
+        assert!(t.magnetometers[0].is_some() && t.coarse_sun_sensors[0].is_some());
         // Tick 1: no tracker is due; in publication order it is released with its state.
         f.imu("hub", 1);
         f.imu("bracket", 1);
@@ -453,13 +546,21 @@ mod tests {
         assert_eq!(f.ticks(), [(0, vec![]), (1, vec![])]);
         assert_eq!(f.out[1].imus[0].as_ref().unwrap().omega_p_rad_s[0], 1.0);
         assert_eq!(f.out[1].star_trackers, [None, None]);
-        // Tick 4: st2 (period 4) is due, st1 (period 10) is not.
+        assert_eq!(
+            (f.out[1].magnetometers[0], f.out[1].coarse_sun_sensors[0]),
+            (None, None)
+        );
+        // Tick 4: st2 (period 4) and mag1 (period 2) are due, st1 (period 10) and css (5) are
+        // not.
         f.imu("hub", 4);
         f.imu("bracket", 4);
         f.state(4);
         assert_eq!(f.a.waiting(), Some(4));
         f.st("st2", 4);
+        assert_eq!(f.a.waiting(), Some(4));
+        f.mag(4);
         assert_eq!(f.ticks().last(), Some(&(4, vec![])));
+        assert_eq!(f.out[2].magnetometers[0].unwrap().b_s_t[0], 4.0);
     }
 
     #[test]
@@ -478,8 +579,12 @@ mod tests {
         f.imu("hub", 5);
         f.state(5);
         f.imu("hub", 6);
-        assert_eq!(f.ticks(), [(5, vec!["imu/bracket".to_string()])]);
+        assert_eq!(
+            f.ticks(),
+            [(5, vec!["imu/bracket".to_string(), "css/css".to_string()])]
+        );
         f.imu("bracket", 6);
+        f.mag(6);
         f.state(6);
         assert_eq!(f.ticks().last(), Some(&(6, vec![])));
         // Keys of other spacecraft, unknown sensors and non-telemetry are ignored; garbage

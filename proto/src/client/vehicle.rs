@@ -140,6 +140,12 @@ pub struct VehicleConfig {
     /// `[[star_trackers]]`, in file order.
     #[serde(default)]
     pub star_trackers: Vec<StarTracker>,
+    /// `[[magnetometers]]`, in file order.
+    #[serde(default)]
+    pub magnetometers: Vec<Magnetometer>,
+    /// `[[coarse_sun_sensors]]`, in file order.
+    #[serde(default)]
+    pub coarse_sun_sensors: Vec<CoarseSunSensor>,
 }
 
 impl VehicleConfig {
@@ -173,37 +179,60 @@ impl VehicleConfig {
 
     /// The IMU `name`.
     pub fn imu(&self, name: &str) -> Result<&Imu, VehicleError> {
-        self.imus.iter().find(|i| i.name == name).ok_or_else(|| {
-            let names: Vec<&str> = self.imus.iter().map(|i| i.name.as_str()).collect();
-            VehicleError::Config(format!("no [[imus]] named `{name}` (it has: {names:?})"))
-        })
+        find_named(&self.imus, "imus", name, |i| &i.name)
     }
 
     /// The star tracker `name`.
     pub fn star_tracker(&self, name: &str) -> Result<&StarTracker, VehicleError> {
-        self.star_trackers
-            .iter()
-            .find(|s| s.name == name)
-            .ok_or_else(|| {
-                let names: Vec<&str> = self.star_trackers.iter().map(|s| s.name.as_str()).collect();
-                VehicleError::Config(format!(
-                    "no [[star_trackers]] named `{name}` (it has: {names:?})"
-                ))
-            })
+        find_named(&self.star_trackers, "star_trackers", name, |s| &s.name)
     }
 
     /// The period of star tracker `st` in frames: round(`frame_hz` / `rate_hz`), as the server
     /// computes it (it accepts only rates that divide the frame rate).
     pub fn star_tracker_period_frames(&self, st: &StarTracker) -> Result<u64, VehicleError> {
-        let ratio = self.simulation.frame_hz / st.rate_hz;
+        self.period_frames("star tracker", &st.name, st.rate_hz)
+    }
+
+    /// The magnetometer `name`.
+    pub fn magnetometer(&self, name: &str) -> Result<&Magnetometer, VehicleError> {
+        find_named(&self.magnetometers, "magnetometers", name, |m| &m.name)
+    }
+
+    /// The coarse-sun-sensor array `name`.
+    pub fn coarse_sun_sensor(&self, name: &str) -> Result<&CoarseSunSensor, VehicleError> {
+        find_named(&self.coarse_sun_sensors, "coarse_sun_sensors", name, |c| {
+            &c.name
+        })
+    }
+
+    /// The period in frames of a sensor `what` `name` updating at `rate_hz`:
+    /// round(`frame_hz` / `rate_hz`), as the server computes it (it accepts only rates that
+    /// divide the frame rate).
+    pub fn period_frames(&self, what: &str, name: &str, rate_hz: f64) -> Result<u64, VehicleError> {
+        let ratio = self.simulation.frame_hz / rate_hz;
         if !(ratio.is_finite() && ratio.round() >= 1.0) {
             return Err(VehicleError::Config(format!(
-                "star tracker `{}`: rate_hz = {} does not divide the frame rate {} Hz",
-                st.name, st.rate_hz, self.simulation.frame_hz
+                "{what} `{name}`: rate_hz = {rate_hz} does not divide the frame rate {} Hz",
+                self.simulation.frame_hz
             )));
         }
         Ok(ratio.round() as u64)
     }
+}
+
+/// The entry of `list` (the `[[section]]` entries) whose name is `name`.
+fn find_named<'a, T>(
+    list: &'a [T],
+    section: &str,
+    name: &str,
+    name_of: impl Fn(&T) -> &String,
+) -> Result<&'a T, VehicleError> {
+    list.iter().find(|e| name_of(e) == name).ok_or_else(|| {
+        let names: Vec<&str> = list.iter().map(|e| name_of(e).as_str()).collect();
+        VehicleError::Config(format!(
+            "no [[{section}]] named `{name}` (it has: {names:?})"
+        ))
+    })
 }
 
 /// `[simulation]`.
@@ -326,6 +355,28 @@ pub struct StarTracker {
     pub rate_hz: f64,
 }
 
+/// One `[[magnetometers]]` entry.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct Magnetometer {
+    /// Its name (topic `flexdyn/<sc>/tlm/mag/<name>`).
+    pub name: String,
+    /// [SB]: maps B components to the sensor frame S.
+    pub dcm_sb: [[f64; 3]; 3],
+    /// \[Hz\] update rate (a whole divisor of the frame rate).
+    pub rate_hz: f64,
+}
+
+/// One `[[coarse_sun_sensors]]` entry (an array of cosine detectors).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct CoarseSunSensor {
+    /// Its name (topic `flexdyn/<sc>/tlm/css/<name>`).
+    pub name: String,
+    /// Each detector's normal in B, in reading order.
+    pub normals_b: Vec<[f64; 3]>,
+    /// \[Hz\] update rate (a whole divisor of the frame rate).
+    pub rate_hz: f64,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -347,6 +398,16 @@ seed = 7
 name = "slow"
 dcm_cb = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
 rate_hz = 3.0
+[[magnetometers]]
+name = "mag1"
+dcm_sb = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+rate_hz = 50.0
+seed = 31
+[[coarse_sun_sensors]]
+name = "css"
+normals_b = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]]
+rate_hz = 0.0
+seed = 41
 "#;
 
     #[test]
@@ -373,6 +434,25 @@ rate_hz = 3.0
             "{e}"
         );
         assert!(c.imu("hub").is_err());
+        // The attitude sensors of the ACS sequence: their schedule and the array's normals.
+        let mag = c.magnetometer("mag1").unwrap();
+        assert_eq!(
+            c.period_frames("magnetometer", "mag1", mag.rate_hz)
+                .unwrap(),
+            2
+        );
+        let css = c.coarse_sun_sensor("css").unwrap();
+        assert_eq!(css.normals_b[1], [-1.0, 0.0, 0.0]);
+        let e = c
+            .period_frames("coarse sun sensor", "css", css.rate_hz)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("coarse sun sensor `css`: rate_hz = 0 does not divide"),
+            "{e}"
+        );
+        let e = c.magnetometer("nope").unwrap_err().to_string();
+        assert!(e.contains("no [[magnetometers]] named `nope`"), "{e}");
         let e = Vehicle::from_json("k", "{}").unwrap_err().to_string();
         assert!(
             e.starts_with("k: the reply is not a flexdyn vehicle description"),

@@ -69,6 +69,18 @@ impl RodArray {
         mu.iter().map(|m| m / over).collect()
     }
 
+    /// Rod dipoles from the minimum-norm allocation of `m_b_am2`, each clipped to its own limit
+    /// on its own (the direction may change). For B-dot with rods along the body axes the
+    /// allocation is m's components, and a clip that keeps each sign keeps every
+    /// m_j (ω × B)_j ≥ 0: the law stays dissipative, with more torque than [`Self::dipoles`].
+    pub fn dipoles_clipped(&self, m_b_am2: &Vector3<f64>) -> Vec<f64> {
+        let mu = &self.pinv * DVector::from_column_slice(m_b_am2.as_slice());
+        mu.iter()
+            .zip(&self.max_dipole_am2)
+            .map(|(m, max)| m.clamp(-max, *max))
+            .collect()
+    }
+
     /// The body dipole the rods make with dipoles `mu`.
     pub fn body_dipole(&self, mu: &[f64]) -> Vector3<f64> {
         self.axis_b.iter().zip(mu).map(|(a, m)| a * *m).sum()
@@ -116,6 +128,21 @@ impl Bdot {
     }
 }
 
+/// The gyro-aided B-dot dipole m = k_ω (ω × B)/|B|², all in B: its torque m × B = −k_ω ω_⊥,
+/// the rate across the field damped with the gain k_ω \[N·m·s\] (`crate::sequence`'s docs:
+/// why the gyro and not a finite difference of B). Zero in a zero field.
+pub fn gyro_bdot_dipole_b_am2(
+    gain_nms: f64,
+    omega_bn_b_rad_s: &Vector3<f64>,
+    b_b_t: &Vector3<f64>,
+) -> Vector3<f64> {
+    let b2 = b_b_t.norm_squared();
+    if b2 == 0.0 {
+        return Vector3::zeros();
+    }
+    omega_bn_b_rad_s.cross(b_b_t) * (gain_nms / b2)
+}
+
 /// The rod dipole for the cross-product unloading law: m = (B × τ_d)/|B|² with
 /// τ_d = −k (h_w − h_ref), all in B. Zero in a zero field.
 pub fn unloading_dipole_b_am2(
@@ -160,6 +187,28 @@ mod tests {
         assert!(
             (rate - closed).abs() < 1e-6 * closed.abs(),
             "{rate} vs {closed}"
+        );
+    }
+
+    /// (ω × B) × B = B (ω·B) − ω |B|², so m × B = k [(ω·b̂) b̂ − ω] = −k ω_⊥: the torque damps
+    /// exactly the rate across the field and leaves the rate along it.
+    #[test]
+    fn gyro_bdot_torque_is_minus_the_gain_times_the_rate_across_the_field() {
+        let omega = Vector3::new(0.03, -0.02, 0.05);
+        let b = Vector3::new(2.0e-5, -1.0e-5, 3.0e-5);
+        let k = 4.9;
+        let tau = gyro_bdot_dipole_b_am2(k, &omega, &b).cross(&b);
+        let across = omega - b * (omega.dot(&b) / b.norm_squared());
+        assert!(
+            (tau + across * k).norm() < 1e-15,
+            "{tau:?} vs {:?}",
+            -across * k
+        );
+        // A rate along the field gets no torque.
+        assert!(gyro_bdot_dipole_b_am2(k, &(b * 1e3), &b).norm() < 1e-9);
+        assert_eq!(
+            gyro_bdot_dipole_b_am2(k, &omega, &Vector3::zeros()),
+            Vector3::zeros()
         );
     }
 
@@ -210,6 +259,10 @@ mod tests {
         assert!(mu.iter().map(|x| x.abs()).fold(0.0, f64::max) <= 100.0 + 1e-9);
         assert!(made.normalize().dot(&big.normalize()) > 1.0 - 1e-12);
         assert_eq!(r.inputs(&mu)[2].effector_index, 2);
+        // Clipped rod by rod: the small component is kept, the others stop at the limit.
+        let ortho = rods(&[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], 100.0);
+        let mu = ortho.dipoles_clipped(&Vector3::new(500.0, -50.0, -300.0));
+        assert_eq!(mu, [100.0, -50.0, -100.0]);
         // Two rods cannot make every dipole.
         let cfg = "[simulation]\nframe_hz = 10.0\n[hub]\nmass_kg = 1.0\ninertia_bc_b_kg_m2 = \
                    [[1.0,0.0,0.0],[0.0,1.0,0.0],[0.0,0.0,1.0]]\nr_bcb_b_m = [0.0,0.0,0.0]\n\

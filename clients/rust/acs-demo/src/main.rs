@@ -77,6 +77,8 @@ use anyhow::{bail, Context as _};
 use clap::Parser;
 use flexdyn_acs_demo::acs::WheelArray;
 use flexdyn_acs_demo::acs::{inertia_about_b, mat3, wheel_control_torque, StarTrackerAttitude};
+use flexdyn_acs_demo::modes::{Mode, ModeSettings};
+use flexdyn_acs_demo::sequence::{AcsSequence, Gains, SequenceSetup};
 use flexdyn_proto::attitude::mrp_error;
 use flexdyn_proto::client::cli::{exit_with, stop_on_signals, usage, CommonArgs};
 use flexdyn_proto::client::lockstep::{SensorSchedule, TickReceiver};
@@ -152,6 +154,27 @@ struct Args {
     /// The star tracker feeding the attitude (its `[[star_trackers]] name`).
     #[arg(long)]
     star_tracker: Option<String>,
+    /// Run the whole ACS sequence instead of the single controller: detumble (B-dot on
+    /// --magnetometer and the rods), sun acquisition (--css, the gyro --imu and the wheels),
+    /// fine pointing (--star-tracker, the gyro and the wheels) and momentum management (the
+    /// rods unload the wheels while fine pointing continues). Each transition is printed on
+    /// standard output as `mode-transition tick=… t_s=… from=… to=…`.
+    #[arg(long)]
+    mode_manager: bool,
+    /// The magnetometer of the mode manager (its `[[magnetometers]] name`).
+    #[arg(long)]
+    magnetometer: Option<String>,
+    /// The coarse-sun-sensor array of the mode manager (its `[[coarse_sun_sensors]] name`).
+    #[arg(long)]
+    css: Option<String>,
+    /// The solar-panel normal in B that sun acquisition turns onto the Sun.
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', default_values_t = [0.0, 0.0, 1.0],
+          allow_hyphen_values = true)]
+    panel_normal_b: Vec<f64>,
+    /// Mode manager: seconds of momentum management (default: one 95-minute orbit; the
+    /// cross-product law needs the field to turn to reach every axis).
+    #[arg(long, default_value_t = 5700.0, allow_negative_numbers = true)]
+    unload_s: f64,
 }
 
 /// What the controller commands.
@@ -327,7 +350,121 @@ fn check(args: &Args) -> anyhow::Result<Controller> {
             return Err(usage("--idle-exit-s must be a positive number of seconds"));
         }
     }
+    if args.mode_manager {
+        for (flag, given) in [
+            ("--imu", args.imu.is_some()),
+            ("--star-tracker", args.star_tracker.is_some()),
+            ("--magnetometer", args.magnetometer.is_some()),
+            ("--css", args.css.is_some()),
+        ] {
+            if !given {
+                return Err(usage(format!(
+                    "--mode-manager needs {flag} NAME (its name in the server config)"
+                )));
+            }
+        }
+        if args.panel_normal_b.len() != 3
+            || !args.panel_normal_b.iter().all(|x| x.is_finite())
+            || args.panel_normal_b.iter().all(|x| *x == 0.0)
+        {
+            return Err(usage(
+                "--panel-normal-b takes three finite comma-separated numbers, not all zero",
+            ));
+        }
+        if !(args.unload_s.is_finite() && args.unload_s > 0.0) {
+            return Err(usage("--unload-s must be a positive number of seconds"));
+        }
+    }
     Ok(controller)
+}
+
+/// The ACS sequence of `--mode-manager` (checked by `check`).
+fn sequence(
+    args: &Args,
+    cfg: &VehicleConfig,
+    schedule: &SensorSchedule,
+) -> anyhow::Result<Option<AcsSequence>> {
+    if !args.mode_manager {
+        return Ok(None);
+    }
+    let name = |o: &Option<String>| o.clone().unwrap_or_default();
+    let p = &args.panel_normal_b;
+    let setup = SequenceSetup {
+        imu: name(&args.imu),
+        star_tracker: name(&args.star_tracker),
+        magnetometer: name(&args.magnetometer),
+        coarse_sun_sensor: name(&args.css),
+        panel_normal_b: Vector3::new(p[0], p[1], p[2]),
+        target_sigma_rn: None,
+        // 10 σ of the scenario's 0.005 detector noise.
+        css_threshold: 0.05,
+        modes: ModeSettings {
+            unload_duration_ns: (args.unload_s * 1e9).round() as u64,
+            ..ModeSettings::default()
+        },
+        gains: Gains::default(),
+    };
+    tracing::info!(?setup, "ACS mode manager");
+    Ok(Some(AcsSequence::new(cfg, schedule, setup)?))
+}
+
+/// The estimates behind a tick's decisions as `key=value` words: the gyro rate, the Sun's
+/// angle from the panel normal (coarse sun sensors; `none` in eclipse), the pointing error
+/// (star tracker; `none` before a target), the wheel momentum.
+fn sequence_estimates(out: &flexdyn_acs_demo::sequence::Output) -> String {
+    let o = &out.observation;
+    let deg = |a: Option<f64>| a.map_or("none".to_owned(), |a| a.to_degrees().to_string());
+    format!(
+        "rate_deg_s={} sun_angle_deg={} pointing_error_deg={} wheel_momentum_nms={}",
+        o.omega_bn_b_rad_s.norm().to_degrees(),
+        deg(o.sun_angle_rad),
+        deg(o.pointing_error_rad),
+        out.wheel_momentum_b_nms.norm()
+    )
+}
+
+/// Prints what a tick of the sequence changed (stdout, one line each: the record of the run).
+fn print_sequence_events(out: &flexdyn_acs_demo::sequence::Output) {
+    if let Some(t) = &out.transition {
+        println!(
+            "mode-transition tick={} t_s={} from={} to={} {}",
+            t.tick,
+            t.t_ns as f64 * 1e-9,
+            t.from.name(),
+            t.to.name(),
+            sequence_estimates(out)
+        );
+        tracing::info!(
+            tick = t.tick,
+            from = t.from.name(),
+            to = t.to.name(),
+            "mode transition"
+        );
+    }
+    if let Some(s) = &out.new_target_sigma_rn {
+        println!("fine-pointing-target sigma_rn={},{},{}", s[0], s[1], s[2]);
+    }
+}
+
+/// The time in each mode and the last tick's estimates, printed when the run ends.
+fn print_sequence_summary(
+    seq: &AcsSequence,
+    last: Option<&flexdyn_acs_demo::sequence::Output>,
+    t_end_ns: u64,
+) {
+    let times = seq.modes().time_in_modes_ns(0, t_end_ns);
+    for (mode, t) in Mode::ALL.iter().zip(times) {
+        println!("time-in-mode mode={} s={}", mode.name(), t as f64 * 1e-9);
+    }
+    if let Some(out) = last {
+        println!(
+            "final tick={} t_s={} mode={} {}",
+            out.observation.tick,
+            out.observation.t_ns as f64 * 1e-9,
+            out.mode.name(),
+            sequence_estimates(out)
+        );
+    }
 }
 
 /// The served configuration, asked until the server answers, a stop signal, or `idle` passes.
@@ -420,6 +557,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         Actuator::Wrench => None,
         Actuator::Wheels => Some((WheelArray::from_config(&cfg)?, inertia_about_b(&cfg)?)),
     };
+    let mut sequence = sequence(&args, &cfg, &schedule)?;
+    let mut last_t_ns = 0u64;
     let mut tracker = match (args.attitude_source, &args.star_tracker) {
         (AttitudeSource::StarTracker, Some(name)) => {
             let est = StarTrackerAttitude::from_config(&cfg, name)?;
@@ -477,6 +616,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let mut buf = Vec::with_capacity(128);
     let mut states_received = 0u64;
     let mut last_state_at = Instant::now();
+    let mut last_sequence_output = None;
     loop {
         if stop.load(std::sync::atomic::Ordering::Relaxed) {
             tracing::info!(states_received, "stop signal: closing the session");
@@ -513,6 +653,36 @@ fn run(args: Args) -> anyhow::Result<()> {
         let h = state.header;
 
         // The rate feedback: this tick's gyro sample, or truth.
+        last_t_ns = h.sim_time_ns;
+
+        // The whole ACS sequence: its own sensors, modes and actuators.
+        if let Some(fsw) = &mut sequence {
+            let out = fsw.step(&tick)?;
+            print_sequence_events(&out);
+            let out = last_sequence_output.insert(out);
+            let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
+            let inputs = std::mem::take(&mut out.inputs);
+            let cmd = CommandMsg::actuators(header, args.sender_id, [0.0; 3], [0.0; 3], inputs);
+            encode_into(&cmd, &mut buf);
+            commands
+                .put(buf.as_slice())
+                .wait()
+                .map_err(|e| anyhow::anyhow!("cannot publish the command: {e}"))?;
+            seq += 1;
+            if log_every_ns > 0 && h.sim_time_ns >= next_log_ns {
+                tracing::info!(
+                    tick = h.tick,
+                    t_s = h.sim_time_ns as f64 / 1e9,
+                    mode = out.mode.name(),
+                    omega_deg_s = Vector3::from(state.omega_bn_b_rad_s).norm().to_degrees(),
+                    wheel_momentum_nms = out.wheel_momentum_b_nms.norm(),
+                    "sequence"
+                );
+                next_log_ns = h.sim_time_ns.saturating_add(log_every_ns);
+            }
+            continue;
+        }
+
         let rate_b = match &mut gyro {
             Some(g) => g.rate_for(h.tick, tick.imus[g.index].as_ref())?,
             None => Vector3::from(state.omega_bn_b_rad_s),
@@ -578,6 +748,9 @@ fn run(args: Args) -> anyhow::Result<()> {
             );
             next_log_ns = h.sim_time_ns.saturating_add(log_every_ns);
         }
+    }
+    if let Some(fsw) = &sequence {
+        print_sequence_summary(fsw, last_sequence_output.as_ref(), last_t_ns);
     }
     // Undeclare the token first (a lockstep server sees us leave), then close the session.
     drop(token);

@@ -39,6 +39,26 @@ fn the_demo_rejects_bad_options_in_one_line() {
     assert_one_error_line(c, &e, "needs --star-tracker NAME");
     let (c, e) = run(DEMO, &["--rate-source", "gyro"]);
     assert_one_error_line(c, &e, "--rate-source gyro needs --imu NAME");
+    // The mode manager names the first sensor it lacks, and checks its own values.
+    let all = [
+        "--mode-manager",
+        "--imu",
+        "hub",
+        "--star-tracker",
+        "st1",
+        "--magnetometer",
+        "mag1",
+        "--css",
+        "css",
+    ];
+    let (c, e) = run(DEMO, &all[..7]);
+    assert_one_error_line(c, &e, "--mode-manager needs --css NAME");
+    let (c, e) = run(DEMO, &["--mode-manager", "--imu", "hub"]);
+    assert_one_error_line(c, &e, "--mode-manager needs --star-tracker NAME");
+    let (c, e) = run(DEMO, &[&all[..], &["--unload-s", "0"]].concat());
+    assert_one_error_line(c, &e, "--unload-s must be a positive number");
+    let (c, e) = run(DEMO, &[&all[..], &["--panel-normal-b", "0,0,0"]].concat());
+    assert_one_error_line(c, &e, "--panel-normal-b takes three finite");
 }
 
 /// With nobody to talk to, the demo says so and fails, instead of a false pass.
