@@ -6,7 +6,7 @@
 //! - [`targets`]: their load-time resolution (unknown targets, modes a kind does not take,
 //!   parameters out of range are configuration errors naming the field);
 //! - [`modes`]: the modes and the documented transform of each;
-//! - [`window`]: when a fault is active (start, duration or until cleared, period); a random
+//! - [`window`]: when a fault is active (start, duration or open-ended, period); a random
 //!   fault (`mtbf_s`) starts at a time to failure drawn from its seed at load
 //!   ([`failure_delay_ns`]);
 //! - [`ports`]: the per-vehicle runtime ([`Faults`]) that [`crate::sim::Simulation`] calls at its

@@ -23,7 +23,7 @@
 //! outcome). Units are the channel's own (rad/s for a gyro, T for a magnetometer…).
 //!
 //! Actuator modes transform the effector's input (command + schedule) before it reaches the
-//! model; the models themselves are untouched (see [`super::actuators`] for the physics of each).
+//! model; the models themselves are untouched (see [`super::ports`] for the physics of each).
 
 /// A fault mode with its parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]

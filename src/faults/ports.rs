@@ -237,7 +237,12 @@ fn actuator(
         })?;
     let kind = entry.kind;
     let a = if kind == reaction_wheel::KIND {
-        let w = effector - cfg.panel_pairs.len();
+        // Its index among the wheels (the configuration's order).
+        let w = sc
+            .effector_entries()
+            .take(effector)
+            .filter(|e| e.kind == reaction_wheel::KIND)
+            .count();
         let path = format!("reaction_wheels[{w}]");
         Actuator::Wheel {
             wheel: Box::new(ReactionWheel::new(cfg.reaction_wheels[w].clone(), &path)?),

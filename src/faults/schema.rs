@@ -8,7 +8,7 @@
 //! mode = "bias_step"         # see faults::modes
 //! value = 0.01               # the mode's parameters
 //! start_s = 2.0              # default 0
-//! duration_s = 1.0           # default: until cleared
+//! duration_s = 1.0           # default: to the end of the run
 //! period_s = 5.0             # default: once
 //! axes = [1, 3]              # 1-based; default: every axis
 //! seed = 7                   # noise, spikes and mtbf_s; default: the entry's index

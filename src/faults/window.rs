@@ -1,13 +1,12 @@
-//! When a fault is active: from `start_ns`, for `duration_ns` (or until cleared), repeating every
-//! `period_ns` if given. All in integer nanoseconds of simulation time.
+//! When a fault is active: from `start_ns`, for `duration_ns` (or to the end of the run),
+//! repeating every `period_ns` if given. All in integer nanoseconds of simulation time.
 
 /// A fault's activity window.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FaultWindow {
     /// \[ns\] first activation.
     pub start_ns: u64,
-    /// \[ns\] length of each activation; `None`: until cleared (a live clear command or the end
-    /// of the run).
+    /// \[ns\] length of each activation; `None`: until the end of the run.
     pub duration_ns: Option<u64>,
     /// \[ns\] repetition period (> duration); `None`: one activation.
     pub period_ns: Option<u64>,
