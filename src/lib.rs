@@ -25,6 +25,7 @@ pub mod cli;
 pub mod config;
 pub mod dynamics;
 pub mod environment;
+pub mod faults;
 pub mod numfmt;
 pub mod schema;
 pub mod sensors;

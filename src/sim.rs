@@ -21,6 +21,7 @@ use crate::dynamics::{
     EnvironmentSource, HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment,
 };
 use crate::environment::model::EnvironmentModel;
+use crate::faults::Faults;
 use crate::sensors::{Sensor, SensorBank, Truth};
 
 /// A spacecraft being propagated, with its external wrench sources.
@@ -61,6 +62,8 @@ pub struct Simulation {
     epoch: Option<crate::environment::epoch::SimEpoch>,
     /// `[environment] telemetry_rate_hz` in frames (`None`: no environment record).
     environment_every_frames: Option<u64>,
+    /// The faults at the sensor and actuator ports ([`crate::faults`]).
+    faults: Faults,
 }
 
 impl Simulation {
@@ -70,7 +73,9 @@ impl Simulation {
         let frame_s = cfg.frame_ns as f64 * 1e-9;
         let sensors = SensorBank::new(cfg, frame_s, sc.t_sim_ns(), sc.state())?;
         let environment = cfg.environment_model()?;
+        let faults = Faults::new(cfg, &sc)?;
         let mut sim = Self {
+            faults,
             environment,
             epoch: cfg.epoch.clone(),
             environment_every_frames: cfg
@@ -170,11 +175,12 @@ impl Simulation {
         &self.scheduled_inputs
     }
 
-    /// Hands `command + schedule` to the effectors. Without a schedule the command goes
-    /// through untouched (bit for bit, −0.0 included). A sum beyond ±f64::MAX is held at it:
-    /// the effector clips it to its own limit anyway.
+    /// Hands `command + schedule` to the effectors, through the actuator faults' port. Without
+    /// a schedule or an actuator fault the command goes through untouched (bit for bit, −0.0
+    /// included). A sum beyond ±f64::MAX is held at it: the effector clips it to its own limit
+    /// anyway.
     fn push_inputs(&mut self) {
-        let u: &[f64] = if self.input_schedule.is_empty() {
+        let u: &[f64] = if self.input_schedule.is_empty() && !self.faults.has_actuator_faults() {
             &self.inputs
         } else {
             for ((a, c), s) in self
@@ -185,6 +191,11 @@ impl Simulation {
             {
                 *a = (c + s).clamp(-f64::MAX, f64::MAX);
             }
+            self.faults.at_input_port(
+                self.sc.t_sim_ns(),
+                self.sc.state(),
+                &mut self.applied_inputs,
+            );
             &self.applied_inputs
         };
         // Cannot fail: the length is the spacecraft's and every value is finite.
@@ -258,6 +269,10 @@ impl Simulation {
     pub fn step(&mut self) {
         self.frame_outputs = None;
         self.apply_schedules();
+        if self.faults.has_actuator_faults() {
+            // The actuator faults see the time and state of every step's start.
+            self.push_inputs();
+        }
         self.update_environment();
         self.sc.step_with(&mut self.sensors);
     }
@@ -444,6 +459,11 @@ impl Simulation {
         self.epoch.as_ref()
     }
 
+    /// The faults at the ports.
+    pub fn faults(&self) -> &Faults {
+        &self.faults
+    }
+
     /// The sensors, in publication order.
     pub fn sensors(&self) -> &SensorBank {
         &self.sensors
@@ -468,6 +488,8 @@ impl Simulation {
             dynamic_effectors: self.sc.dynamic_effectors(),
         };
         self.sensors.sample(&truth, pick);
+        self.faults
+            .at_sensor_port(self.sc.t_sim_ns(), &mut self.sensors);
     }
 
     /// Sets every sensor's nominal sample interval (default: the frame period); `simulate`

@@ -708,3 +708,37 @@ fn actuator_parameters_are_dispersed_and_read_back_from_the_model() {
     check_uniform("thruster 1 Isp ~ U(200, 230)", &isp1, 200.0, 230.0);
     check_normal("rod 2 max dipole ~ N(400, 20)", &dipole2, 400.0, 20.0);
 }
+
+/// A random fault (`mtbf_s`, no `seed` in the base) gets a seed per run, written into the run's
+/// configuration, so each run samples its own failure time: the built model's start is
+/// `start_s` + the time to failure drawn from the planned seed, and the runs differ.
+#[test]
+fn random_faults_get_a_seed_per_run_and_their_failure_time_from_it() {
+    let base = include_str!("../scenarios/wheels_star_tracker.toml").to_string()
+        + "\n[[faults]]\ntarget = \"reaction_wheels.rw2\"\nmode = \"seized\"\nstart_s = 1.0\nmtbf_s = 20.0\n";
+    let path =
+        std::env::temp_dir().join(format!("flexdyn-random-fault-{}.toml", std::process::id()));
+    std::fs::write(&path, base).unwrap();
+    let plan = campaign(&format!(
+        "base = {:?}\nruns = 5\nseed = 9\nduration_s = 1.0\n",
+        path.display().to_string()
+    ));
+    std::fs::remove_file(&path).unwrap();
+    let plan = plan.unwrap();
+    let mut starts = Vec::new();
+    for r in 0..5 {
+        let rp = plan.run(r);
+        let seed = rp.sensor_seeds["faults[0].seed"];
+        let cfg = SimConfig::from_toml_str(&rp.config_toml).unwrap();
+        let start = cfg.faults[0].window.start_ns;
+        assert_eq!(
+            start,
+            1_000_000_000 + flexdyn::faults::failure_delay_ns(20.0, seed)
+        );
+        assert_eq!(cfg.faults[0].seed, seed);
+        starts.push(start);
+    }
+    starts.sort_unstable();
+    starts.dedup();
+    assert_eq!(starts.len(), 5, "every run fails at its own time");
+}

@@ -21,13 +21,62 @@ use flexdyn_proto::{CommandMsg, EffectorInput, Header};
 #[global_allocator]
 static ALLOC: AllocDisabler = AllocDisabler;
 
+/// The reference spacecraft with four reaction wheels, an IMU and a star tracker.
+const WHEELS: &str = include_str!("../scenarios/wheels_star_tracker.toml");
+
 #[test]
 fn the_frame_path_does_not_allocate() {
-    // The reference spacecraft with four reaction wheels, an IMU and a star tracker.
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml");
-    let cfg = SimConfig::from_file(&path).unwrap();
-    let sim = Simulation::new(&cfg).unwrap();
+    frame_path_does_not_allocate(&SimConfig::from_toml_str(WHEELS).unwrap());
+}
+
+/// With faults at both ports, active over most of the measured frames (frames of 10 ms, from
+/// 0.5 s): sensor value modes with and without draws, a repeating dropout, validity off, and
+/// wheel faults that read the state (friction) and that replace the command (on rw1, which the
+/// final check does not look at).
+#[test]
+fn the_frame_path_does_not_allocate_with_faults() {
+    let text = format!(
+        "{WHEELS}
+[[faults]]
+target = \"imus.hub.gyro\"
+mode = \"noise\"
+sigma = 0.001
+start_s = 0.5
+[[faults]]
+target = \"imus.hub\"
+mode = \"stuck_current\"
+start_s = 0.5
+duration_s = 0.3
+period_s = 0.5
+[[faults]]
+target = \"star_trackers.st1\"
+mode = \"dropout\"
+start_s = 0.5
+duration_s = 0.05
+period_s = 0.2
+[[faults]]
+target = \"star_trackers.st1\"
+mode = \"validity_off\"
+start_s = 1.0
+[[faults]]
+target = \"reaction_wheels.rw1\"
+mode = \"friction_scale\"
+factor = 3.0
+start_s = 0.5
+[[faults]]
+target = \"reaction_wheels.rw1\"
+mode = \"torque_limit\"
+fraction = 0.5
+start_s = 1.0
+"
+    );
+    let cfg = SimConfig::from_toml_str(&text).unwrap();
+    assert_eq!(cfg.faults.len(), 6);
+    frame_path_does_not_allocate(&cfg);
+}
+
+fn frame_path_does_not_allocate(cfg: &SimConfig) {
+    let sim = Simulation::new(cfg).unwrap();
     assert!(sim.n_imus() > 0);
     assert!(!sim.star_trackers().is_empty());
     let shape = sim.blank_state();

@@ -5,7 +5,8 @@
 //! Run `i` draws from the portable generator ([`crate::sensors::rng::NormalRng`]) seeded with
 //! `run_seed(i) = splitmix64(master_seed ⊕ splitmix64(i))`. Each sensor's `seed` key
 //! (`<config array>[k].seed` of every sensor kind in [`crate::sensors::KINDS`]: `imus[k].seed`,
-//! `star_trackers[k].seed`) becomes `splitmix64(run_seed ⊕ fnv1a(key))`. A run
+//! `star_trackers[k].seed`), and `faults[k].seed` of every random fault (one with `mtbf_s`,
+//! written in if absent), becomes `splitmix64(run_seed ⊕ fnv1a(key))`. A run
 //! therefore depends only on the campaign file and its index: `--index I` reproduces it alone.
 //!
 //! # Invalid draws
@@ -225,6 +226,15 @@ impl Plan {
                     if item.get("seed").is_some() {
                         sensor_seed_keys.push(format!("{section}[{k}].seed"));
                     }
+                }
+            }
+        }
+        // A random fault (`mtbf_s`) gets a seed of its own per run, written in if absent, so
+        // every run samples its own failure time.
+        if let Some(toml::Value::Array(items)) = base.get("faults") {
+            for (k, item) in items.iter().enumerate() {
+                if item.get("mtbf_s").is_some() {
+                    sensor_seed_keys.push(format!("faults[{k}].seed"));
                 }
             }
         }

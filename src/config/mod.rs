@@ -23,7 +23,7 @@ mod components;
 mod error;
 mod file;
 mod schedule;
-mod source_map;
+pub(crate) mod source_map;
 mod warnings;
 mod world;
 
@@ -113,6 +113,9 @@ pub struct SimConfig {
     pub epoch: Option<crate::environment::epoch::SimEpoch>,
     /// The environment (`[environment]`), if given: models and dynamic effectors.
     pub environment: Option<crate::environment::model::EnvironmentSettings>,
+    /// The faults (`[[faults]]`), resolved against the spacecraft and its sensors, in file
+    /// order (empty if absent).
+    pub faults: Vec<crate::faults::FaultSpec>,
     /// The configuration text this was parsed from.
     pub source_toml: String,
 }
@@ -347,6 +350,7 @@ const ROOT_KEYS: &[&str] = &[
     "magnetometers",
     "coarse_sun_sensors",
     "fine_sun_sensors",
+    "faults",
     world::ROOT_KEYS[0],
     world::ROOT_KEYS[1],
     world::ROOT_KEYS[2],
@@ -369,6 +373,7 @@ struct RawConfig {
     magnetometers: Vec<RawMagnetometer>,
     coarse_sun_sensors: Vec<RawCoarseSunSensor>,
     fine_sun_sensors: Vec<RawFineSunSensor>,
+    faults: Vec<crate::faults::schema::RawFault>,
 }
 
 struct RawSimulation {
@@ -524,7 +529,13 @@ impl RawConfig {
             &fine_sun_sensor::schema::KEYS,
             fine_sun_sensor::schema::read,
         )?;
+        let faults = root.read_tables(
+            "faults",
+            &crate::faults::schema::KEYS,
+            crate::faults::schema::read,
+        )?;
         Ok(RawConfig {
+            faults,
             world,
             simulation,
             gravity,
@@ -883,6 +894,8 @@ impl RawConfig {
             fine_sun_sensors,
             epoch: world.epoch,
             environment,
+            // Resolved below, against the built spacecraft and sensors.
+            faults: Vec::new(),
             source_toml: source.to_string(),
         };
         check_body_extent(&cfg, map)?;
@@ -894,6 +907,7 @@ impl RawConfig {
             schedule::resolve(&self.effector_input_schedule, &sc, step_ns, map)?;
         check_gravity_bound(&cfg, &sc, map)?;
         check_initial_outputs_finite(&cfg, &mut sc, map)?;
+        cfg.faults = crate::faults::targets::resolve(&self.faults, &cfg, &sc, map)?;
         Ok(cfg)
     }
 }

@@ -45,6 +45,9 @@ pub struct ComponentKind {
     pub wire_names: WireNames,
     /// How one `[[section]]` entry is read, for kinds configured through the generic list.
     pub reader: Option<ComponentReader>,
+    /// The `[[faults]]` modes it takes ([`crate::faults::modes`]; none for a body without an
+    /// input).
+    pub fault_modes: &'static [&'static str],
 }
 
 /// The schema of one configuration entry of a kind.

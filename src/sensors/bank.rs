@@ -79,6 +79,17 @@ impl SensorBank {
         }
     }
 
+    /// Sensor `i`, mutably (the fault port, [`crate::faults`]).
+    pub fn sensor_mut(&mut self, i: usize) -> &mut dyn Sensor {
+        self.sensors[i].as_mut()
+    }
+
+    /// Removes sensor `i` from the last sample's list: it publishes nothing this time (a
+    /// `dropout` fault).
+    pub fn unsample(&mut self, i: usize) {
+        self.sampled.retain(|&k| k != i);
+    }
+
     /// Notes that nothing was sampled.
     pub fn clear_sampled(&mut self) {
         self.sampled.clear();

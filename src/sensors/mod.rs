@@ -135,6 +135,31 @@ pub trait Sensor: std::fmt::Debug + Send {
 
     /// For the kind's own typed views ([`SensorBank::of`]).
     fn as_any(&self) -> &dyn Any;
+
+    /// The output channels a fault can transform ([`crate::faults`]), by name (`gyro`): the
+    /// kind's statement of where its value modes apply. None by default (then only `dropout`,
+    /// and `validity_off` with [`Self::has_validity`], apply).
+    fn fault_channels(&self) -> &'static [&'static str] {
+        &[]
+    }
+
+    /// The number of axes of fault channel `channel` (0 for none).
+    fn fault_axes(&self, _channel: usize) -> usize {
+        0
+    }
+
+    /// Fault channel `channel` of the last sample, mutably (empty for none).
+    fn fault_channel(&mut self, _channel: usize) -> &mut [f64] {
+        &mut []
+    }
+
+    /// Whether its message carries a validity flag (`validity_off` applies).
+    fn has_validity(&self) -> bool {
+        false
+    }
+
+    /// Marks the last sample invalid (a `validity_off` fault).
+    fn force_invalid(&mut self) {}
 }
 
 /// A figure panel of a sensor kind's plot: `(column, legend)` pairs of its message's columns.

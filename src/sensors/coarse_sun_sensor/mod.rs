@@ -249,4 +249,25 @@ impl Sensor for CoarseSunSensor {
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }
+
+    /// `readings` (one axis per detector, in the output unit).
+    fn fault_channels(&self) -> &'static [&'static str] {
+        &["readings"]
+    }
+
+    fn fault_axes(&self, channel: usize) -> usize {
+        if channel == 0 {
+            usize::from(self.last.detector_count)
+        } else {
+            0
+        }
+    }
+
+    fn fault_channel(&mut self, channel: usize) -> &mut [f64] {
+        let k = usize::from(self.last.detector_count);
+        match channel {
+            0 => &mut self.last.readings[..k],
+            _ => &mut [],
+        }
+    }
 }

@@ -265,4 +265,30 @@ impl Sensor for FineSunSensor {
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }
+
+    /// `alpha` and `beta` (rad).
+    fn fault_channels(&self) -> &'static [&'static str] {
+        &["alpha", "beta"]
+    }
+
+    fn fault_axes(&self, channel: usize) -> usize {
+        usize::from(channel < 2)
+    }
+
+    fn fault_channel(&mut self, channel: usize) -> &mut [f64] {
+        match channel {
+            0 => std::slice::from_mut(&mut self.last.alpha_rad),
+            1 => std::slice::from_mut(&mut self.last.beta_rad),
+            _ => &mut [],
+        }
+    }
+
+    fn has_validity(&self) -> bool {
+        true
+    }
+
+    /// Clears the `VALID` flag (the angles as measured).
+    fn force_invalid(&mut self) {
+        self.last.flags &= !fss_flags::VALID;
+    }
 }

@@ -166,6 +166,31 @@ impl Sensor for ImuSensor {
     fn as_any(&self) -> &dyn Any {
         self
     }
+
+    /// `gyro` (ω, rad/s), `accel` (specific force, m/s²), `dtheta` (Δθ, rad), `dv` (Δv, m/s),
+    /// each in P.
+    fn fault_channels(&self) -> &'static [&'static str] {
+        &["gyro", "accel", "dtheta", "dv"]
+    }
+
+    fn fault_axes(&self, channel: usize) -> usize {
+        if channel < 4 {
+            3
+        } else {
+            0
+        }
+    }
+
+    fn fault_channel(&mut self, channel: usize) -> &mut [f64] {
+        let s = &mut self.last;
+        match channel {
+            0 => s.omega_p_rad_s.as_mut_slice(),
+            1 => s.accel_p_m_s2.as_mut_slice(),
+            2 => s.dtheta_p_rad.as_mut_slice(),
+            3 => s.dv_p_m_s.as_mut_slice(),
+            _ => &mut [],
+        }
+    }
 }
 
 /// Truth at the IMU at `point` given the state `x` and its hub outputs `hub`: (\[rad/s\] ω_B/N

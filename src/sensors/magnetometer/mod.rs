@@ -265,4 +265,24 @@ impl Sensor for Magnetometer {
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }
+
+    /// `field` (B in S, T).
+    fn fault_channels(&self) -> &'static [&'static str] {
+        &["field"]
+    }
+
+    fn fault_axes(&self, channel: usize) -> usize {
+        if channel == 0 {
+            3
+        } else {
+            0
+        }
+    }
+
+    fn fault_channel(&mut self, channel: usize) -> &mut [f64] {
+        match channel {
+            0 => self.last.b_s_t.as_mut_slice(),
+            _ => &mut [],
+        }
+    }
 }

@@ -302,6 +302,35 @@ impl Sensor for StarTracker {
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }
+
+    /// `q` (q_CN, scalar first; a fault's transform is not renormalised).
+    fn fault_channels(&self) -> &'static [&'static str] {
+        &["q"]
+    }
+
+    fn fault_axes(&self, channel: usize) -> usize {
+        if channel == 0 {
+            4
+        } else {
+            0
+        }
+    }
+
+    fn fault_channel(&mut self, channel: usize) -> &mut [f64] {
+        match channel {
+            0 => self.last.q_cn.as_mut_slice(),
+            _ => &mut [],
+        }
+    }
+
+    fn has_validity(&self) -> bool {
+        true
+    }
+
+    /// `valid = false` (the quaternion and the status flags as measured).
+    fn force_invalid(&mut self) {
+        self.last.valid = false;
+    }
 }
 
 /// The frame rotation [C̃C] by the rotation vector `theta` (through its MRP, exact).

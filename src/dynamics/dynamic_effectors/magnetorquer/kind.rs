@@ -18,6 +18,7 @@ pub static COMPONENT: ComponentKind = ComponentKind {
         keys: &schema::KEYS,
         read: |t| read_boxed(t, schema::read),
     }),
+    fault_modes: &["dead", "dipole_scale"],
 };
 
 impl ComponentParams for MagnetorquerParams {

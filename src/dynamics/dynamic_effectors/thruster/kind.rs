@@ -18,6 +18,7 @@ pub static COMPONENT: ComponentKind = ComponentKind {
         keys: &schema::KEYS,
         read: |t| read_boxed(t, schema::read),
     }),
+    fault_modes: &["stuck_on", "stuck_off", "thrust_scale"],
 };
 
 impl ComponentParams for ThrusterParams {

@@ -12,4 +12,5 @@ pub static COMPONENT: ComponentKind = ComponentKind {
     noun: "panel pair",
     wire_names: |_, _| Some((&STATE_NAMES, &[])),
     reader: None,
+    fault_modes: &[],
 };

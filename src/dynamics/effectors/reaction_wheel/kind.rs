@@ -20,4 +20,10 @@ pub static COMPONENT: ComponentKind = ComponentKind {
         Some((states, &OUTPUT_NAMES))
     },
     reader: None,
+    fault_modes: &[
+        "friction_scale",
+        "torque_limit",
+        "seized",
+        "command_ignored",
+    ],
 };

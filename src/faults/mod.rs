@@ -1,0 +1,67 @@
+//! Fault injection at the ports: a fault wraps a sensor's output as it leaves the
+//! [`crate::sensors::SensorBank`], or an actuator's input as it enters the spacecraft; the
+//! physics models are untouched.
+//!
+//! - [`schema`]: the `[[faults]]` entries as written;
+//! - [`targets`]: their load-time resolution (unknown targets, modes a kind does not take,
+//!   parameters out of range are configuration errors naming the field);
+//! - [`modes`]: the modes and the documented transform of each;
+//! - [`window`]: when a fault is active (start, duration or open-ended, period); a random
+//!   fault (`mtbf_s`) starts at a time to failure drawn from its seed at load
+//!   ([`failure_delay_ns`]);
+//! - [`ports`]: the per-vehicle runtime ([`Faults`]) that [`crate::sim::Simulation`] calls at its
+//!   two ports; it allocates nothing, locks nothing and cannot fail.
+//!
+//! Which modes apply is stated by each kind: a sensor through
+//! [`crate::sensors::Sensor::fault_channels`] and [`crate::sensors::Sensor::has_validity`], an
+//! effector kind through [`crate::dynamics::component::ComponentKind::fault_modes`].
+
+pub mod modes;
+pub mod ports;
+pub(crate) mod schema;
+pub(crate) mod targets;
+pub mod window;
+
+pub use modes::FaultMode;
+pub use ports::Faults;
+pub use targets::failure_delay_ns;
+pub use window::FaultWindow;
+
+/// Most axes a sensor channel may expose to faults (a coarse-sun-sensor array's detectors).
+pub const MAX_AXES: usize = flexdyn_proto::MAX_CSS_DETECTORS;
+/// Most fault channels a sensor may expose.
+pub const MAX_CHANNELS: usize = 4;
+
+/// A resolved fault: what, how and when.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FaultSpec {
+    /// The target as written (`imus.hub.gyro`).
+    pub target: String,
+    /// The mode and its parameters.
+    pub mode: FaultMode,
+    /// When it is active.
+    pub window: FaultWindow,
+    /// Selected axes, bit `a` for 1-based axis `a + 1`; 0: every axis.
+    pub axes: u32,
+    /// Seed of its generator (`noise`, `spikes`).
+    pub seed: u64,
+    /// Where it sits.
+    pub port: Port,
+}
+
+/// Where a fault sits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Port {
+    /// A sensor's output: index in the sensor bank, and one of its channels (all if `None`).
+    Sensor {
+        /// Index in [`crate::sensors::SensorBank::sensors`].
+        sensor: usize,
+        /// Index in the sensor's [`crate::sensors::Sensor::fault_channels`].
+        channel: Option<usize>,
+    },
+    /// An actuator's input: its index in the effector list.
+    Actuator {
+        /// Index in [`crate::dynamics::Spacecraft::effector_entries`].
+        effector: usize,
+    },
+}
