@@ -32,6 +32,7 @@ pub mod coarse_sun_sensor;
 pub mod fine_sun_sensor;
 pub mod imu;
 pub mod magnetometer;
+pub mod params;
 pub mod rng;
 pub mod star_tracker;
 
@@ -162,6 +163,8 @@ pub struct SensorKind {
     pub a_noun: &'static str,
     /// The configuration array (`imus`, `star_trackers`): error paths and campaign seed keys.
     pub config_array: &'static str,
+    /// How one `[[<config_array>]]` entry is read and validated.
+    pub config: params::SensorConfigReader,
     /// The key prefix below `flexdyn/<sc>/` (`tlm/imu`); the key is `<prefix>/<name>`.
     pub key_prefix: &'static str,
     /// The prefix of its `simulate` CSV columns and the last segment of its key prefix
@@ -258,12 +261,37 @@ mod tests {
                 panic!("{key} did not decode as a sensor");
             };
             assert_eq!((h.tick, h.sim_time_ns), (2, sim.t_sim_ns()));
-            let every = cfg.star_trackers.first().map_or(1, |c| c.every_frames);
+            let every = |e: Option<u64>| e.unwrap();
+            let s = &cfg.sensors;
             let seq = match kind.noun {
-                "star tracker" => 2 / every,
-                "magnetometer" => 2 / cfg.magnetometers[0].every_frames,
-                "coarse sun sensor" => 2 / cfg.coarse_sun_sensors[0].every_frames,
-                "fine sun sensor" => 2 / cfg.fine_sun_sensors[0].every_frames,
+                "star tracker" => {
+                    2 / every(
+                        s.of::<star_tracker::StarTrackerConfig>()
+                            .next()
+                            .map(|c| c.every_frames),
+                    )
+                }
+                "magnetometer" => {
+                    2 / every(
+                        s.of::<magnetometer::MagnetometerConfig>()
+                            .next()
+                            .map(|c| c.every_frames),
+                    )
+                }
+                "coarse sun sensor" => {
+                    2 / every(
+                        s.of::<coarse_sun_sensor::CoarseSunSensorConfig>()
+                            .next()
+                            .map(|c| c.every_frames),
+                    )
+                }
+                "fine sun sensor" => {
+                    2 / every(
+                        s.of::<fine_sun_sensor::FineSunSensorConfig>()
+                            .next()
+                            .map(|c| c.every_frames),
+                    )
+                }
                 _ => 2,
             };
             assert_eq!(h.seq, seq, "{key}");
