@@ -2,8 +2,8 @@
 //! ([`KINDS`]). Each folder owns the kind's parameters, its configuration schema
 //! (`schema.rs`), its measurement model, its message mapping and its [`SensorKind`]
 //! descriptor: [`imu`] (gyro and accelerometer), [`star_tracker`] (attitude),
-//! [`magnetometer`], [`coarse_sun_sensor`] (arrays of cosine detectors) and [`fine_sun_sensor`]
-//! (two-axis).
+//! [`magnetometer`], [`coarse_sun_sensor`] (arrays of cosine detectors), [`fine_sun_sensor`]
+//! (two-axis) and [`gps`] (a receiver with a latency).
 //!
 //! Every sensor is sampled at a frame boundary (or, for a sensor that integrates over an
 //! interval, at each output instant) from the same truth, a [`Truth`]: the state and the one
@@ -30,6 +30,7 @@ use crate::environment::EnvironmentSample;
 pub mod bank;
 pub mod coarse_sun_sensor;
 pub mod fine_sun_sensor;
+pub mod gps;
 pub mod imu;
 pub mod magnetometer;
 pub mod params;
@@ -45,6 +46,7 @@ pub static KINDS: &[&SensorKind] = &[
     &magnetometer::KIND,
     &coarse_sun_sensor::KIND,
     &fine_sun_sensor::KIND,
+    &gps::KIND,
 ];
 
 /// The truth one sample is taken from: one evaluation at the current instant.
@@ -100,6 +102,12 @@ pub trait Sensor: std::fmt::Debug + Send {
 
     /// Takes one sample from `truth`, kept until the next (see [`Self::encode`]).
     fn sample(&mut self, truth: &Truth<'_>);
+
+    /// Whether the last [`Self::sample`] left a message to publish (a sensor with a latency
+    /// also samples at instants where it only stores a measurement; default: always).
+    fn has_output(&self) -> bool {
+        true
+    }
 
     /// Encodes the last sample as its wire message into `buf` (cleared first), with the frame's
     /// `header` (the sensor may set its own `seq`).
