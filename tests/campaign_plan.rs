@@ -302,7 +302,11 @@ fn sensor_seeds_are_derived_per_run_and_reach_the_model() {
         let rp = plan.run(r);
         assert_eq!(rp.sensor_seeds.len(), 2, "{:?}", rp.sensor_seeds);
         let cfg = SimConfig::from_toml_str(&rp.config_toml).unwrap();
-        let built: Vec<u64> = cfg.imus.iter().map(|i| i.seed).collect();
+        let built: Vec<u64> = cfg
+            .sensors
+            .of::<flexdyn::sensors::imu::ImuConfig>()
+            .map(|i| i.seed)
+            .collect();
         let planned: Vec<u64> = rp.sensor_seeds.values().copied().collect();
         assert_eq!(
             built, planned,

@@ -129,7 +129,7 @@ fn reference_parses_to_the_documented_values() {
     }
     assert!(cfg.wrench_schedule.is_empty());
     assert!(cfg.server.is_empty());
-    assert!(cfg.imus.is_empty());
+    assert!(cfg.sensors.is_empty());
     assert_eq!(cfg.source_toml, DEFAULT_CONFIG_TOML);
     assert_eq!(cfg.total_mass_kg(), 950.0);
 }
@@ -308,8 +308,8 @@ fn optional_keys_are_mapped() {
     assert_eq!(cfg.server, server);
     // An IMU without [imus.gyro] / [imus.accel] tables has every error term zero.
     assert_eq!(
-        cfg.imus,
-        vec![flexdyn::sensors::imu::ImuConfig::ideal(
+        cfg.sensors.all::<flexdyn::sensors::imu::ImuConfig>(),
+        vec![&flexdyn::sensors::imu::ImuConfig::ideal(
             "imu0",
             Vector3::new(0.2, 0.1, 1.2),
             Matrix3::identity(),
@@ -1101,7 +1101,10 @@ fn cases() -> Vec<Case> {
         // IMU seeds: 2^63 − 1 is accepted; 2^63 and 2^64 − 1 are outside TOML's integers; −1
         // is below the range.
         accepts_and(text("seed = 1", "seed = 9223372036854775807"), |cfg| {
-            assert_eq!(cfg.imus[0].seed, i64::MAX as u64);
+            assert_eq!(
+                cfg.sensors.all::<flexdyn::sensors::imu::ImuConfig>()[0].seed,
+                i64::MAX as u64
+            );
         })
         .on("imu_tactical"),
         rejects(

@@ -6,7 +6,7 @@ mod imu_support;
 use std::path::Path;
 
 use flexdyn::config::{ConfigError, SimConfig};
-use flexdyn::sensors::imu::{AccelErrors, GyroErrors};
+use flexdyn::sensors::imu::{AccelErrors, GyroErrors, ImuConfig};
 use flexdyn::sim::Simulation;
 use imu_support::*;
 use nalgebra::{Matrix3, Vector3};
@@ -253,13 +253,16 @@ fn absent_tables_and_keys_default_to_zero() {
     set_imus(&mut t, vec![imu]);
     let cfg = parse(&t);
     assert_eq!(
-        cfg.imus[0].gyro,
+        cfg.sensors.all::<ImuConfig>()[0].gyro,
         GyroErrors {
             arw_rad_s_sqrt_hz: 1e-5,
             ..GyroErrors::default()
         }
     );
-    assert_eq!(cfg.imus[0].accel, AccelErrors::default());
+    assert_eq!(
+        cfg.sensors.all::<ImuConfig>()[0].accel,
+        AccelErrors::default()
+    );
     assert_eq!(AccelErrors::default().misalignment_rad, Matrix3::zeros());
 }
 
@@ -272,11 +275,11 @@ fn shipped_imu_tactical_scenario() {
     assert_eq!(cfg.hub, reference.hub);
     assert_eq!(cfg.panel_pairs, reference.panel_pairs);
     assert_eq!(cfg.initial, reference.initial);
-    assert_eq!(cfg.imus.len(), 2);
-    assert_eq!(cfg.imus[0].name, "hub");
-    assert_eq!(cfg.imus[1].name, "bracket");
+    assert_eq!(cfg.sensors.all::<ImuConfig>().len(), 2);
+    assert_eq!(cfg.sensors.all::<ImuConfig>()[0].name, "hub");
+    assert_eq!(cfg.sensors.all::<ImuConfig>()[1].name, "bracket");
     let deg = std::f64::consts::PI / 180.0;
-    for imu in &cfg.imus {
+    for imu in cfg.sensors.of::<ImuConfig>() {
         // The README's conversions of the tactical-grade datasheet values.
         assert!((imu.gyro.arw_rad_s_sqrt_hz / (0.15 * deg / 60.0) - 1.0).abs() < 1e-4);
         assert!(

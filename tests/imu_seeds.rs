@@ -49,7 +49,12 @@ fn regress_same_seed_gives_identical_bytes() {
 fn a_different_seed_changes_only_that_imus_noise() {
     let cfg = tactical();
     let mut other = cfg.clone();
-    other.imus[0].seed = 12345;
+    other
+        .sensors
+        .of_mut::<flexdyn::sensors::imu::ImuConfig>()
+        .next()
+        .unwrap()
+        .seed = 12345;
     let a = imu_streams(&cfg, 100);
     let b = imu_streams(&other, 100);
     assert_eq!(a[1], b[1], "imus[1] keeps its own stream");

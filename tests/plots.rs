@@ -132,7 +132,9 @@ fn a_recording_gives_every_figure() {
         err.contains("skipped disturbance_torques.png: no environment record"),
         "{err}"
     );
-    assert_eq!(err.matches("skipped").count(), 6, "{err}");
+    // Nor a GPS receiver (issue 20: the generic sensor loop skips its figure by name).
+    assert!(err.contains("skipped gps.png: no GPS receiver"), "{err}");
+    assert_eq!(err.matches("skipped").count(), 7, "{err}");
     assert!(!out.join("timing.png").exists());
 
     let (figs, _) = figures(&args(&rec)).unwrap();

@@ -596,4 +596,34 @@ fn python_mcap_decodes_the_environment_channel() {
         assert!(header.split(',').any(|h| h == col), "{col} in {header}");
     }
     assert_eq!(lines.count(), 51);
+
+    // The scenario's GPS receiver (issue 20) goes through the same generic sensor loop: 1 Hz
+    // with 0.2 s latency, so in 5 s (ticks 0..=500) it publishes at ticks 20, 120, …, 420,
+    // each carrying the solution valid 0.2 s earlier.
+    let csv = std::fs::read_to_string(dir.join("flexdyn_sc1_tlm_gps_gps1.csv")).unwrap();
+    let mut lines = csv.lines().skip_while(|l| l.starts_with('#'));
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("{name} in {header:?}"))
+    };
+    let (tick, sim_t, valid, week, flags) = (
+        col("tick"),
+        col("sim_time_ns"),
+        col("valid_sim_time_ns"),
+        col("gps_week"),
+        col("flags"),
+    );
+    col("r_be_e_m_1");
+    col("v_bn_n_m_s_3");
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let ticks: Vec<&str> = rows.iter().map(|r| r[tick]).collect();
+    assert_eq!(ticks, ["20", "120", "220", "320", "420"]);
+    for r in &rows {
+        let (t, v): (u64, u64) = (r[sim_t].parse().unwrap(), r[valid].parse().unwrap());
+        assert_eq!(t - v, 200_000_000);
+        assert_eq!((r[week], r[flags]), ("2446", "7"));
+    }
 }

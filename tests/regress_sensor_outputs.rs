@@ -8,7 +8,9 @@
 //! x86_64 Linux; re-minted for protocol version 5, whose only effect on these CSVs is the
 //! `protocol_version` column: with that column written back as 4, every CSV hashes to the
 //! 535783c value; and again for protocol version 6 (the sun sensors and operator control; both branches minted the same values), checked the same way (the
-//! column written back as 5 gives the protocol-5 hashes). To re-mint after an intended change of the outputs, run that command (or this
+//! column written back as 5 gives the protocol-5 hashes); and again for protocol version 7 (the GPS
+//! receiver, issue 20): every CSV with its `protocol_version` column written back as 6 hashes to
+//! its protocol-6 value. To re-mint after an intended change of the outputs, run that command (or this
 //! test, which prints the hashes) and replace the constants, saying why in the commit. A mismatch
 //! on another platform can come from its libm (`atan2`, `acos`, `tan`), not from flexdyn.
 
@@ -18,39 +20,39 @@ use flexdyn::cli::simulate_to;
 use flexdyn::config::SimConfig;
 use sha2::{Digest, Sha256};
 
-/// (scenario, log interval \[s\], sha256 of the CSV). Re-minted for protocol version 6: the
-/// CSV's `protocol_version` column reads 6; with it set back to 5 each CSV hashes to its
-/// protocol-5 golden (and back to 4, to its protocol-4 one), so no other value changed.
+/// (scenario, log interval \[s\], sha256 of the CSV). Re-minted for protocol version 7: the
+/// CSV's `protocol_version` column reads 7; with it set back to 6 each CSV hashes to its
+/// protocol-6 golden (and back to 5, 4, to the older ones), so no other value changed.
 const GOLDEN: [(&str, f64, &str); 6] = [
     (
         "imu_tactical",
         0.01,
-        "4f78126184c8e9635f21f9019a566cc64e097b3685d29c2563f1a1d9f1653c92",
+        "4040d2094841695a8c33ba4e75a0e843e56cbde714de0f271d196d679d833f2d",
     ),
     (
         "imu_tactical",
         0.003,
-        "4b10eb863251f139b8d2458c5cb42761ee73fde3da0e97a7ea5b75cd86124a6d",
+        "f75f24f2ddd4cf3cb0851d5d94e1d26b50ca0876e9f5a672fa47af2c14bdd18c",
     ),
     (
         "imu_tactical",
         0.05,
-        "a21a5ca55215963db95d4fb18f9271e565c9e3ea9d4fd489805256867be378c9",
+        "a97b65e808e945f8cb20a7104d4ed5caa2d089c8b4c44b07753b860801213b35",
     ),
     (
         "wheels_star_tracker",
         0.01,
-        "3a8e4a4a1b34bed6df6982ed9ebb5e3970cdaeb1aacd7474b882ffa1c760f72a",
+        "0966d204909fa5366d20252bdf6e6d53b4468c281732a429873675ed688e5874",
     ),
     (
         "wheels_star_tracker",
         0.003,
-        "4fd20e92b9fcf2948b00ab8389ded455d3a695335be10577e784d133a2eb865c",
+        "31f65834d3e87c375e24f42c6965e84561261477427f979bbc2b9eac3e144c3c",
     ),
     (
         "wheels_star_tracker",
         0.05,
-        "eb1dc9ed19abd6731c8fb36b52685d7b1a8312d89b3a945a639f1bccd620d1c5",
+        "4dd5da53da6fd8fa573bd2d2066678ba974c1e86602004609045081eb435734a",
     ),
 ];
 

@@ -6,6 +6,8 @@
 //! their periods in frames.
 
 use flexdyn::config::SimConfig;
+use flexdyn::sensors::imu::ImuConfig;
+use flexdyn::sensors::star_tracker::StarTrackerConfig;
 use flexdyn_proto::client::lockstep::SensorSchedule;
 use flexdyn_proto::client::vehicle::VehicleConfig;
 use nalgebra::{Matrix3, Vector3};
@@ -75,17 +77,18 @@ fn the_clients_reader_agrees_with_the_servers_on_every_scenario() {
                 "{name}"
             );
         }
-        assert_eq!(cfg.imus.len(), sim.imus.len(), "{name}");
-        for (c, s) in cfg.imus.iter().zip(&sim.imus) {
+        let sim_imus = sim.sensors.all::<ImuConfig>();
+        assert_eq!(cfg.imus.len(), sim_imus.len(), "{name}");
+        for (c, s) in cfg.imus.iter().zip(&sim_imus) {
             assert_eq!(c.name, s.name, "{name}");
             assert_eq!(m3(&c.dcm_pb), s.dcm_pb, "{name}");
             assert_eq!(Vector3::from(c.r_sb_b_m), s.r_sb_b_m, "{name}");
         }
         let schedule = SensorSchedule::from_config(&cfg).unwrap();
-        let imus: Vec<&str> = sim.imus.iter().map(|i| i.name.as_str()).collect();
+        let imus: Vec<&str> = sim_imus.iter().map(|i| i.name.as_str()).collect();
         assert_eq!(schedule.imus().collect::<Vec<_>>(), imus, "{name}");
-        let trackers: Vec<(&str, u64)> = sim
-            .star_trackers
+        let sim_trackers = sim.sensors.all::<StarTrackerConfig>();
+        let trackers: Vec<(&str, u64)> = sim_trackers
             .iter()
             .map(|s| (s.name.as_str(), s.every_frames))
             .collect();
@@ -94,7 +97,7 @@ fn the_clients_reader_agrees_with_the_servers_on_every_scenario() {
             trackers,
             "{name}"
         );
-        for (c, s) in cfg.star_trackers.iter().zip(&sim.star_trackers) {
+        for (c, s) in cfg.star_trackers.iter().zip(&sim_trackers) {
             assert_eq!(m3(&c.dcm_cb), s.dcm_cb, "{name}");
         }
         checked += 1;

@@ -154,7 +154,7 @@ fn zero_error_fine_sensor_reads_the_truth_bit_for_bit() {
         rows.join(", ")
     );
     let cfg = SimConfig::from_toml_str(&leo_with(&block)).unwrap();
-    let dcm_fb = cfg.fine_sun_sensors[0].dcm_fb;
+    let dcm_fb = cfg.sensors.all::<FineSunSensorConfig>()[0].dcm_fb;
     let mut sim = Simulation::new(&cfg).unwrap();
     let mut checked = 0;
     for tick in 0..60u64 {

@@ -126,6 +126,11 @@ pub fn decode_css(bytes: &[u8]) -> Result<CssMsg, DecodeError> {
     decode(bytes)
 }
 
+/// [`decode`] for [`crate::GpsMsg`].
+pub fn decode_gps(bytes: &[u8]) -> Result<crate::GpsMsg, DecodeError> {
+    decode(bytes)
+}
+
 /// [`decode`] for [`FssMsg`].
 pub fn decode_fss(bytes: &[u8]) -> Result<FssMsg, DecodeError> {
     decode(bytes)

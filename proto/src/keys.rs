@@ -24,6 +24,8 @@ pub const MAGNETOMETER_PREFIX: &str = "tlm/mag";
 pub const CSS_PREFIX: &str = "tlm/css";
 /// Prefix of the fine-sun-sensor topics; the sensor name follows after a `/`.
 pub const FSS_PREFIX: &str = "tlm/fss";
+/// Prefix of the GPS receiver topics; the receiver name follows after a `/`.
+pub const GPS_PREFIX: &str = "tlm/gps";
 /// Prefix of the command topics; the sender's decimal `sender_id` follows after a `/`
 /// (`flexdyn/<sc>/cmd/<sender_id>`, every [`crate::CommandKind`]). One key per sender, so a
 /// Zenoh access-control list can reserve each participant's key for its authenticated subject.

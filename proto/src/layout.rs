@@ -30,6 +30,8 @@ pub const MAGNETOMETER_LEN: usize = 55;
 pub const CSS_LEN: usize = 159;
 /// Encoded [`FssMsg`] size (bytes).
 pub const FSS_LEN: usize = 47;
+/// Encoded [`crate::GpsMsg`] size (bytes).
+pub const GPS_LEN: usize = 147;
 /// Encoded [`EnvironmentMsg`] size (bytes).
 pub const ENVIRONMENT_LEN: usize = 368;
 /// Encoded [`TimeMsg`] size (bytes).
@@ -88,6 +90,7 @@ mod sealed {
     impl Sealed for super::MagnetometerMsg {}
     impl Sealed for super::CssMsg {}
     impl Sealed for super::FssMsg {}
+    impl Sealed for crate::GpsMsg {}
     impl Sealed for super::EnvironmentMsg {}
     impl Sealed for super::TimeMsg {}
     impl Sealed for super::OperatorMsg {}
@@ -183,6 +186,15 @@ impl WireMessage for FssMsg {
     const NAME: &'static str = "FssMsg";
     const LAYOUT: WireLayout = WireLayout::Fixed { len: FSS_LEN };
     const MIN_LEN: usize = FSS_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+impl WireMessage for crate::GpsMsg {
+    const NAME: &'static str = "GpsMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed { len: GPS_LEN };
+    const MIN_LEN: usize = GPS_LEN;
     fn header(&self) -> &Header {
         &self.header
     }

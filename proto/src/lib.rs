@@ -25,6 +25,7 @@
 //! | `flexdyn/<sc-id>/tlm/mag/<name>` | [`MagnetometerMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/tlm/css/<name>` | [`CssMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/tlm/fss/<name>` | [`FssMsg`] | server → flight code |
+//! | `flexdyn/<sc-id>/tlm/gps/<name>` | [`GpsMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/cmd/<sender-id>` | [`CommandMsg`] | flight code → server |
 //! | `flexdyn/<sc-id>/status` | [`StatusMsg`] | server → anyone |
 //! | `flexdyn/<sc-id>/operator` | [`OperatorMsg`] | operator → server |
@@ -54,6 +55,7 @@
 //! | [`MagnetometerMsg`] | [`MAGNETOMETER_LEN`] = 55 |
 //! | [`CssMsg`] | [`CSS_LEN`] = 159 |
 //! | [`FssMsg`] | [`FSS_LEN`] = 47 |
+//! | [`GpsMsg`] | [`GPS_LEN`] = 147 |
 //! | [`TimeMsg`] | [`TIME_LEN`] = 122 |
 //! | [`EnvironmentMsg`] | [`ENVIRONMENT_LEN`] = 368 |
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
@@ -103,6 +105,9 @@ pub use codec::{
     decode_time, encode, encode_into,
 };
 pub use error::{DecodeError, KeyError};
+// The GPS receiver (issue 20, protocol 7).
+pub use codec::decode_gps;
+pub use keys::GPS_PREFIX;
 pub use keys::{
     cmd_key, cmd_wildcard_key, imu_key, imu_wildcard_key, operator_key, participant_key,
     participant_wildcard_key, sensor_key, star_tracker_key, star_tracker_wildcard_key, state_key,
@@ -111,6 +116,7 @@ pub use keys::{
     FSS_PREFIX, IMU_PREFIX, KEY_ROOT, MAGNETOMETER_PREFIX, MAX_ID_LEN, OPERATOR_SUFFIX,
     PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
 };
+pub use layout::GPS_LEN;
 pub use layout::{
     WireLayout, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
     COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CSS_LEN, EFFECTOR_INPUT_FIXED_LEN,
@@ -128,6 +134,7 @@ pub use messages::{
     StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime, CUC_PFIELD_TAI_4_3,
     MAX_CSS_DETECTORS, NO_COMMAND,
 };
+pub use messages::{gps_flags, GpsMsg};
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
 /// Version 3: generic effector states in [`StateMsg`], [`CommandKind::Actuators`],
@@ -139,4 +146,5 @@ pub use messages::{
 /// issue 23 ([`OperatorMsg`] on `flexdyn/<sc-id>/operator`, [`RejectCounters::operator_refused`];
 /// StatusMsg grows to 187 bytes), and the environment message [`EnvironmentMsg`] on
 /// `flexdyn/<sc-id>/tlm/env` (issue 19).
-pub const PROTOCOL_VERSION: u16 = 6;
+/// Version 7: the GPS receiver of issue 20 ([`GpsMsg`] on `tlm/gps/<name>`).
+pub const PROTOCOL_VERSION: u16 = 7;

@@ -383,6 +383,45 @@ pub struct FssMsg {
     pub flags: u8,
 }
 
+/// Bits of [`GpsMsg::flags`].
+pub mod gps_flags {
+    /// Bit 0: the receiver has a fix; the time and the configured frames' fields are a
+    /// measurement. Without it every number of the message is 0.
+    pub const FIX: u8 = 1 << 0;
+    /// Bit 1: the ECEF fields (`r_be_e_m`, `v_be_e_m_s`) are configured output.
+    pub const ECEF: u8 = 1 << 1;
+    /// Bit 2: the inertial fields (`r_bn_n_m`, `v_bn_n_m_s`) are configured output.
+    pub const INERTIAL: u8 = 1 << 2;
+    /// Bits 3..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 = !(FIX | ECEF | INERTIAL);
+}
+
+/// A GPS receiver's navigation solution, topic `flexdyn/<sc-id>/tlm/gps/<name>`. 147 bytes.
+/// The message published at `header.sim_time_ns` carries the measurement valid at
+/// `valid_sim_time_ns` (earlier by the receiver's latency).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct GpsMsg {
+    /// Common header; `tick` is the frame at whose end the message is published.
+    pub header: Header,
+    /// \[ns\] simulation time at which the measurement is valid (publication − latency).
+    pub valid_sim_time_ns: u64,
+    /// GPS week of the measurement (since 1980-01-06, not modulo 1024); 0 without a fix.
+    pub gps_week: u32,
+    /// \[s\] GPS seconds of week of the measurement; 0 without a fix.
+    pub gps_seconds_of_week: f64,
+    /// \[m\] position of point B relative to the Earth's centre, ECEF (ITRF) components.
+    pub r_be_e_m: [f64; 3],
+    /// \[m/s\] velocity of B relative to the Earth-fixed frame, ECEF components.
+    pub v_be_e_m_s: [f64; 3],
+    /// \[m\] position of B in the inertial frame N.
+    pub r_bn_n_m: [f64; 3],
+    /// \[m/s\] inertial velocity of B, N components.
+    pub v_bn_n_m_s: [f64; 3],
+    /// See [`gps_flags`].
+    pub flags: u8,
+}
+
 /// What a [`CommandMsg`] asks for. Wire: u32 LE variant index (0 = `Wrench`,
 /// 1 = `NoCommand`, 2 = `Actuators`), then the variant's fields.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -6,7 +6,7 @@
 //!   message from its table values and decodes the golden files (`proto/golden/`) back;
 //! - `c_and_rust_decoders_agree_on_100000_buffers`: `proto/c/tests/fuzz_decode.c` and the Rust
 //!   decoders see the same 100,000 seeded buffers (valid messages of every type, mutated,
-//!   truncated, extended, random with a valid version, oversized) through all twelve decoders;
+//!   truncated, extended, random with a valid version, oversized) through all thirteen decoders;
 //!   (`flexdyn-decode-verdicts`, the canonical verdict printer the Python SDK's fuzz test uses
 //!   too); they must agree on accept/reject, on the reason (and its numbers or field), and on every
 //!   decoded field bit for bit. Every buffer the C side decodes it also re-encodes, and that must
@@ -28,6 +28,8 @@ use flexdyn_proto::{
     EnvironmentMsg, FssMsg, Header, ImuMsg, MagnetometerMsg, Mode, OperatorAction, OperatorMsg,
     RejectCounters, RunState, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg, MAX_MESSAGE_BYTES,
 };
+// The GPS receiver (protocol 7): generator arm 11, the thirteenth decoder.
+use flexdyn_proto::GpsMsg;
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
@@ -285,7 +287,7 @@ impl Gen {
     }
 
     fn message(&mut self) -> Vec<u8> {
-        match self.below(11) {
+        match self.below(12) {
             0 => {
                 let effectors = (0..self.below(6))
                     .map(|_| EffectorState {
@@ -392,6 +394,17 @@ impl Gen {
                 drag: self.wrench(),
                 solar_pressure: self.wrench(),
                 residual_dipole: self.wrench(),
+            }),
+            11 => encode(&GpsMsg {
+                header: self.header(),
+                valid_sim_time_ns: self.u64(),
+                gps_week: self.u64() as u32,
+                gps_seconds_of_week: self.f64(),
+                r_be_e_m: self.v(),
+                v_be_e_m_s: self.v(),
+                r_bn_n_m: self.v(),
+                v_bn_n_m_s: self.v(),
+                flags: self.u64() as u8,
             }),
             3 => {
                 // Mostly finite (accepted), sometimes with a non-finite number (NonFinite).
@@ -546,6 +559,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
             "time",
             "operator",
             "header",
+            "gps",
         ] {
             let want = rust_lines.next().expect("a Rust verdict per decoder");
             let got = c_lines.next().unwrap_or("<missing>");
@@ -566,7 +580,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
     }
     assert!(c_lines.next().is_none(), "extra C output");
     eprintln!(
-        "{N} buffers x 12 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
+        "{N} buffers x 13 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
     );
     // The stream exercises every outcome.
     for r in [

@@ -154,3 +154,22 @@ fn c_and_python_mirror_the_environment_message() {
         assert_eq!(py.get(name), Some(&rust), "Python {name}");
     }
 }
+
+/// The GPS message's length and flag bits (protocol 7), in their own list so other messages'
+/// mirrors merge beside it.
+#[test]
+fn c_and_python_mirror_the_gps_message() {
+    use flexdyn_proto::gps_flags;
+    let mirrored = [
+        ("GPS_LEN", flexdyn_proto::GPS_LEN as u64),
+        ("GPS_FIX", gps_flags::FIX.into()),
+        ("GPS_ECEF", gps_flags::ECEF.into()),
+        ("GPS_INERTIAL", gps_flags::INERTIAL.into()),
+    ];
+    let c = c_defines();
+    let py = python_constants();
+    for (name, rust) in mirrored {
+        assert_eq!(c.get(&format!("FD_{name}")), Some(&rust), "C FD_{name}");
+        assert_eq!(py.get(name), Some(&rust), "Python {name}");
+    }
+}

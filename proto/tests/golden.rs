@@ -102,7 +102,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -362,7 +362,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -438,7 +438,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -485,7 +485,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -555,7 +555,7 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -586,7 +586,7 @@ const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
     (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
 ];
 const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -819,7 +819,7 @@ const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
 
 // The sun sensors' tables (protocol 6, issue 20).
 const CSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -855,7 +855,7 @@ const CSS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const FSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -881,7 +881,7 @@ const FSS_GOLDEN: &[(usize, &str, &str)] = &[
     (46, "07", "u8 flags = VALID | IN_FOV | SUNLIT = 0x07"),
 ];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -925,7 +925,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
 /// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
 /// TAI …036.0 s). `src/server/clock.rs` produces exactly this message from that epoch.
 const TIME_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -998,7 +998,7 @@ const TIME_GOLDEN: &[(usize, &str, &str)] = &[
     (118, "00000000", "u32 tone_tai.subseconds = 0"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -1015,7 +1015,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -1087,7 +1087,7 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
 // Protocol 6 (issue 23, operator control): a `RunTicks` operator command. The tick count
 // 4294967301 = 0x1_0000_0005 has bytes on both sides of bit 32, so a u32 `ticks` would show.
 const OPERATOR_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0600", "u16 header.protocol_version = 6"),
+    (0, "0700", "u16 header.protocol_version = 7"),
     (
         2,
         "44332211",
@@ -1317,6 +1317,80 @@ fn css_golden() {
     );
 }
 
+// ---- GpsMsg (protocol 7, issue 20): a self-contained block. ----
+/// GpsMsg, hand-derived from proto/README.md (147 bytes).
+const GPS_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0700", "u16 header.protocol_version = 7"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "0d00000000000000", "u64 header.tick = 13"),
+    (
+        14,
+        "80a4bf0700000000",
+        "u64 header.sim_time_ns = 130000000 (0x7BFA480)",
+    ),
+    (22, "0100000000000000", "u64 header.seq = 1"),
+    (
+        30,
+        "80c3c90100000000",
+        "u64 valid_sim_time_ns = 30000000 (0x1C9C380)",
+    ),
+    (38, "5a090000", "u32 gps_week = 2394 (0x095A)"),
+    (
+        42,
+        "000000000818f540",
+        "f64 gps_seconds_of_week = 86400.5 (0x40F5180800000000)",
+    ),
+    (50, "000000000000f83f", "f64 r_be_e_m[0] = 1.5"),
+    (58, "00000000000000c0", "f64 r_be_e_m[1] = -2.0"),
+    (66, "000000000000d03f", "f64 r_be_e_m[2] = 0.25"),
+    (74, "000000000000e03f", "f64 v_be_e_m_s[0] = 0.5"),
+    (
+        82,
+        "0000000000000080",
+        "f64 v_be_e_m_s[1] = -0.0 (sign bit)",
+    ),
+    (90, "0000000000001040", "f64 v_be_e_m_s[2] = 4.0"),
+    (98, "0000000000002040", "f64 r_bn_n_m[0] = 8.0"),
+    (106, "000000000000c03f", "f64 r_bn_n_m[1] = 0.125"),
+    (114, "000000000000f0bf", "f64 r_bn_n_m[2] = -1.0"),
+    (122, "0000000000000840", "f64 v_bn_n_m_s[0] = 3.0"),
+    (130, "000000000000e0bf", "f64 v_bn_n_m_s[1] = -0.5"),
+    (
+        138,
+        "0000000000009040",
+        "f64 v_bn_n_m_s[2] = 1024.0 (0x4090000000000000)",
+    ),
+    (146, "07", "u8 flags = FIX | ECEF | INERTIAL"),
+];
+
+#[test]
+fn gps_golden() {
+    use flexdyn_proto::{gps_flags, GpsMsg, GPS_LEN};
+    let msg = GpsMsg {
+        header: Header::new(SC, 13, 130_000_000, 1),
+        valid_sim_time_ns: 30_000_000,
+        gps_week: 2394,
+        gps_seconds_of_week: 86_400.5,
+        r_be_e_m: [1.5, -2.0, 0.25],
+        v_be_e_m_s: [0.5, -0.0, 4.0],
+        r_bn_n_m: [8.0, 0.125, -1.0],
+        v_bn_n_m_s: [3.0, -0.5, 1024.0],
+        flags: gps_flags::FIX | gps_flags::ECEF | gps_flags::INERTIAL,
+    };
+    check("GpsMsg", GPS_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), GPS_LEN);
+    assert_eq!(
+        (gps_flags::FIX, gps_flags::ECEF, gps_flags::INERTIAL),
+        (0b001, 0b010, 0b100)
+    );
+    assert_eq!(gps_flags::RESERVED_MASK, 0b1111_1000);
+}
+// ---- end GpsMsg ----
+
 #[test]
 fn fss_golden() {
     let msg = FssMsg {
@@ -1543,7 +1617,7 @@ fn environment_golden() {
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 13] = [
+    let tables: [(&str, &str, Golden, &str); 14] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -1587,6 +1661,8 @@ fn exported_golden_files_match_the_tables() {
             "ENVIRONMENT_GOLDEN",
         ),
         ("fss", "FssMsg", FSS_GOLDEN, "FSS_GOLDEN"),
+        // Protocol 7, the GPS receiver.
+        ("gps", "GpsMsg", GPS_GOLDEN, "GPS_GOLDEN"),
         (
             "operator",
             "OperatorMsg",

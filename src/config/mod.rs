@@ -23,6 +23,7 @@ mod components;
 mod error;
 mod file;
 mod schedule;
+mod sensors;
 pub(crate) mod source_map;
 mod warnings;
 mod world;
@@ -52,11 +53,11 @@ use crate::dynamics::{
     PanelPairParams, ParamError, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
     WrenchSegment,
 };
-use crate::sensors::coarse_sun_sensor::{self, schema::RawCoarseSunSensor, CoarseSunSensorConfig};
-use crate::sensors::fine_sun_sensor::{self, schema::RawFineSunSensor, FineSunSensorConfig};
-use crate::sensors::imu::{self, schema::RawImu, ImuConfig};
-use crate::sensors::magnetometer::{self, schema::RawMagnetometer, MagnetometerConfig};
-use crate::sensors::star_tracker::{self, schema::RawStarTracker, StarTrackerConfig};
+use crate::sensors::imu::ImuConfig;
+use crate::sensors::magnetometer::MagnetometerConfig;
+pub use crate::sensors::params::SensorConfigs;
+use crate::sensors::star_tracker::StarTrackerConfig;
+pub(crate) use sensors::SensorContext;
 
 /// The built-in default configuration (the text of `scenarios/reference.toml`).
 pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../scenarios/reference.toml");
@@ -98,17 +99,10 @@ pub struct SimConfig {
     pub effector_input_schedule: Vec<EffectorInputSegment>,
     /// The `[server]` table, uninterpreted (empty if absent); the server validates it.
     pub server: toml::Table,
-    /// The IMUs (`[[imus]]`), validated, in file order (empty if absent). IMU `i` is sensor
-    /// point `i` of the spacecraft built by [`Self::build_spacecraft`].
-    pub imus: Vec<ImuConfig>,
-    /// The star trackers (`[[star_trackers]]`), validated, in file order (empty if absent).
-    pub star_trackers: Vec<StarTrackerConfig>,
-    /// The magnetometers (`[[magnetometers]]`), validated, in file order (empty if absent).
-    pub magnetometers: Vec<MagnetometerConfig>,
-    /// The coarse-sun-sensor arrays (`[[coarse_sun_sensors]]`), validated, in file order.
-    pub coarse_sun_sensors: Vec<CoarseSunSensorConfig>,
-    /// The fine sun sensors (`[[fine_sun_sensors]]`), validated, in file order.
-    pub fine_sun_sensors: Vec<FineSunSensorConfig>,
+    /// The sensors of every registered kind ([`crate::sensors::KINDS`]: `[[imus]]`,
+    /// `[[star_trackers]]`, …), validated, in registry order then file order; typed access by
+    /// kind: `cfg.sensors.of::<ImuConfig>()`.
+    pub sensors: SensorConfigs,
     /// The simulation epoch (`[epoch]`), if given: t = 0 is this instant.
     pub epoch: Option<crate::environment::epoch::SimEpoch>,
     /// The environment (`[environment]`), if given: models and dynamic effectors.
@@ -274,24 +268,30 @@ pub fn config_summary(cfg: &SimConfig) -> String {
             }
             s
         },
-        cfg.imus.len(),
-        if cfg.imus.is_empty() {
-            String::new()
-        } else {
-            let names: Vec<&str> = cfg.imus.iter().map(|i| i.name.as_str()).collect();
-            format!(" ({})", names.join(", "))
+        cfg.sensors.of::<ImuConfig>().count(),
+        {
+            let names: Vec<&str> = cfg.sensors.of::<ImuConfig>().map(|i| i.name.as_str()).collect();
+            if names.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", names.join(", "))
+            }
         },
-        if cfg.star_trackers.is_empty() {
-            String::new()
-        } else {
-            let names: Vec<&str> = cfg.star_trackers.iter().map(|s| s.name.as_str()).collect();
-            format!(", {} star trackers ({})", names.len(), names.join(", "))
+        {
+            let names: Vec<&str> = cfg.sensors.of::<StarTrackerConfig>().map(|s| s.name.as_str()).collect();
+            if names.is_empty() {
+                String::new()
+            } else {
+                format!(", {} star trackers ({})", names.len(), names.join(", "))
+            }
         },
-        if cfg.magnetometers.is_empty() {
-            String::new()
-        } else {
-            let names: Vec<&str> = cfg.magnetometers.iter().map(|s| s.name.as_str()).collect();
-            format!(", {} magnetometers ({})", names.len(), names.join(", "))
+        {
+            let names: Vec<&str> = cfg.sensors.of::<MagnetometerConfig>().map(|s| s.name.as_str()).collect();
+            if names.is_empty() {
+                String::new()
+            } else {
+                format!(", {} magnetometers ({})", names.len(), names.join(", "))
+            }
         },
         cfg.total_mass_kg(),
         cfg.step_ns as f64 * 1e-9,
@@ -345,15 +345,7 @@ const ROOT_KEYS: &[&str] = &[
     "wrench_schedule",
     "effector_input_schedule",
     "server",
-    "imus",
-    "star_trackers",
-    "magnetometers",
-    "coarse_sun_sensors",
-    "fine_sun_sensors",
     "faults",
-    world::ROOT_KEYS[0],
-    world::ROOT_KEYS[1],
-    world::ROOT_KEYS[2],
 ];
 
 struct RawConfig {
@@ -368,11 +360,7 @@ struct RawConfig {
     wrench_schedule: Vec<RawWrench>,
     effector_input_schedule: Vec<schedule::RawInputRow>,
     server: toml::Table,
-    imus: Vec<RawImu>,
-    star_trackers: Vec<RawStarTracker>,
-    magnetometers: Vec<RawMagnetometer>,
-    coarse_sun_sensors: Vec<RawCoarseSunSensor>,
-    fine_sun_sensors: Vec<RawFineSunSensor>,
+    sensors: sensors::RawSensors,
     faults: Vec<crate::faults::schema::RawFault>,
 }
 
@@ -416,6 +404,8 @@ impl RawConfig {
         let root_keys: Vec<&str> = ROOT_KEYS
             .iter()
             .copied()
+            .chain(sensors::root_keys())
+            .chain(world::ROOT_KEYS.iter().copied())
             .chain(components::root_keys())
             .collect();
         let root = TableReader::root(source, doc, &root_keys)?;
@@ -508,27 +498,7 @@ impl RawConfig {
         } else {
             toml::Table::new()
         };
-        let imus = root.read_tables("imus", &imu::schema::KEYS, RawImu::read)?;
-        let star_trackers = root.read_tables(
-            "star_trackers",
-            &star_tracker::schema::KEYS,
-            star_tracker::schema::read,
-        )?;
-        let magnetometers = root.read_tables(
-            "magnetometers",
-            &magnetometer::schema::KEYS,
-            magnetometer::schema::read,
-        )?;
-        let coarse_sun_sensors = root.read_tables(
-            "coarse_sun_sensors",
-            &coarse_sun_sensor::schema::KEYS,
-            coarse_sun_sensor::schema::read,
-        )?;
-        let fine_sun_sensors = root.read_tables(
-            "fine_sun_sensors",
-            &fine_sun_sensor::schema::KEYS,
-            fine_sun_sensor::schema::read,
-        )?;
+        let sensors = sensors::read(&root)?;
         let faults = root.read_tables(
             "faults",
             &crate::faults::schema::KEYS,
@@ -547,11 +517,7 @@ impl RawConfig {
             wrench_schedule,
             effector_input_schedule,
             server,
-            imus,
-            star_trackers,
-            magnetometers,
-            coarse_sun_sensors,
-            fine_sun_sensors,
+            sensors,
         })
     }
 }
@@ -707,156 +673,8 @@ impl RawConfig {
             wrench_schedule.push(seg);
         }
 
-        // [[imus]]
-        let mut imus = Vec::with_capacity(self.imus.len());
-        let mut imu_names = HashSet::new();
-        for (i, raw) in self.imus.into_iter().enumerate() {
-            let path = format!("imus[{i}]");
-            let imu = raw.into_config();
-            imu.validate(&path).map_err(|e| map.imu_error(e))?;
-            unique_name(map, &path, &imu.name, &mut imu_names, "IMU")?;
-            imus.push(imu);
-        }
-
-        // [[star_trackers]]
-        let mut star_trackers = Vec::with_capacity(self.star_trackers.len());
-        let mut tracker_names = HashSet::new();
-        for (i, raw) in self.star_trackers.into_iter().enumerate() {
-            let path = format!("star_trackers[{i}]");
-            unique_name(map, &path, &raw.name, &mut tracker_names, "star tracker")?;
-            if let Err(e) = flexdyn_proto::validate_star_tracker_name(&raw.name) {
-                return Err(map.invalid(&format!("{path}.name"), e.to_string()));
-            }
-            let every_frames = every_frames(
-                map,
-                &format!("{path}.rate_hz"),
-                raw.rate_hz,
-                sim.frame_hz,
-                "tracker",
-            )?;
-            let cfg = StarTrackerConfig {
-                name: raw.name,
-                dcm_cb: raw.dcm_cb,
-                boresight_c: raw.boresight_c,
-                sigma_cross_boresight_rad: raw.sigma_cross_boresight_rad,
-                sigma_about_boresight_rad: raw.sigma_about_boresight_rad,
-                bias_c_rad: raw.bias_c_rad,
-                every_frames,
-                seed: raw.seed,
-                sun_direction_n: raw.sun_direction_n,
-                sun_exclusion_rad: raw.sun_exclusion_rad,
-                max_rate_rad_s: raw.max_rate_rad_s,
-            };
-            cfg.validate(&path).map_err(param)?;
-            star_trackers.push(cfg);
-        }
-
-        // [[magnetometers]]
-        let mut magnetometers = Vec::with_capacity(self.magnetometers.len());
-        let mut magnetometer_names = HashSet::new();
-        for (i, raw) in self.magnetometers.into_iter().enumerate() {
-            let path = format!("magnetometers[{i}]");
-            unique_name(
-                map,
-                &path,
-                &raw.name,
-                &mut magnetometer_names,
-                "magnetometer",
-            )?;
-            if let Err(e) = flexdyn_proto::validate_sensor_name(&raw.name) {
-                return Err(map.invalid(&format!("{path}.name"), e.to_string()));
-            }
-            let every_frames = every_frames(
-                map,
-                &format!("{path}.rate_hz"),
-                raw.rate_hz,
-                sim.frame_hz,
-                "magnetometer",
-            )?;
-            if let Some(k) = (0..3).find(|&k| raw.misalignment_rad[(k, k)] != 0.0) {
-                return Err(map.invalid(
-                    &format!("{path}.misalignment_rad"),
-                    format!(
-                        "the diagonal must be zero (element [{k}][{k}] is {}): a scale error \
-                         belongs in scale_factor",
-                        Num(raw.misalignment_rad[(k, k)])
-                    ),
-                ));
-            }
-            let cfg = MagnetometerConfig {
-                name: raw.name,
-                dcm_sb: raw.dcm_sb,
-                scale_factor: raw.scale_factor,
-                misalignment_rad: raw.misalignment_rad,
-                bias_s_t: raw.bias_s_t,
-                noise_sigma_t: raw.noise_sigma_t,
-                range_t: raw.range_t,
-                lsb_t: raw.lsb_t,
-                every_frames,
-                seed: raw.seed,
-                r_sb_b_m: raw.r_sb_b_m,
-            };
-            cfg.validate(&path).map_err(param)?;
-            magnetometers.push(cfg);
-        }
-
-        // [[coarse_sun_sensors]] and [[fine_sun_sensors]]. Like a magnetometer without a field
-        // model, a sun sensor without `[environment] sun = true` sees no Sun (it reads 0).
-        let sun_sensor = |path: &str, name: &str, seen: &mut HashSet<String>, what: &str| {
-            unique_name(map, path, name, seen, what)?;
-            flexdyn_proto::validate_sensor_name(name)
-                .map_err(|e| map.invalid(&format!("{path}.name"), e.to_string()))
-        };
-        let mut coarse_sun_sensors = Vec::with_capacity(self.coarse_sun_sensors.len());
-        let mut names = HashSet::new();
-        for (i, raw) in self.coarse_sun_sensors.into_iter().enumerate() {
-            let path = format!("coarse_sun_sensors[{i}]");
-            sun_sensor(&path, &raw.name, &mut names, "coarse sun sensor")?;
-            let cfg = CoarseSunSensorConfig {
-                every_frames: every_frames(
-                    map,
-                    &format!("{path}.rate_hz"),
-                    raw.rate_hz,
-                    sim.frame_hz,
-                    "array",
-                )?,
-                name: raw.name,
-                normals_b: raw.normals_b,
-                fov_half_angle_rad: raw.fov_half_angle_rad,
-                scale: raw.scale,
-                bias: raw.bias,
-                noise_sigma: raw.noise_sigma,
-                lsb: raw.lsb,
-                seed: raw.seed,
-            };
-            cfg.validate(&path).map_err(param)?;
-            coarse_sun_sensors.push(cfg);
-        }
-        let mut fine_sun_sensors = Vec::with_capacity(self.fine_sun_sensors.len());
-        let mut names = HashSet::new();
-        for (i, raw) in self.fine_sun_sensors.into_iter().enumerate() {
-            let path = format!("fine_sun_sensors[{i}]");
-            sun_sensor(&path, &raw.name, &mut names, "fine sun sensor")?;
-            let cfg = FineSunSensorConfig {
-                every_frames: every_frames(
-                    map,
-                    &format!("{path}.rate_hz"),
-                    raw.rate_hz,
-                    sim.frame_hz,
-                    "sensor",
-                )?,
-                name: raw.name,
-                dcm_fb: raw.dcm_fb,
-                fov_half_angle_rad: raw.fov_half_angle_rad,
-                bias_rad: raw.bias_rad,
-                noise_sigma_rad: raw.noise_sigma_rad,
-                lsb_rad: raw.lsb_rad,
-                min_shadow_factor: raw.min_shadow_factor,
-                seed: raw.seed,
-            };
-            cfg.validate(&path).map_err(param)?;
-            fine_sun_sensors.push(cfg);
-        }
+        // [[imus]], [[star_trackers]], …: every sensor kind, in registry order.
+        let sensors = sensors::resolve(self.sensors, map, sim.frame_hz)?;
 
         // [environment] telemetry_rate_hz: a whole number of frames.
         let mut environment = world.environment;
@@ -887,11 +705,7 @@ impl RawConfig {
             // Resolved below, against the built spacecraft's effectors.
             effector_input_schedule: Vec::new(),
             server: self.server,
-            imus,
-            star_trackers,
-            magnetometers,
-            coarse_sun_sensors,
-            fine_sun_sensors,
+            sensors,
             epoch: world.epoch,
             environment,
             // Resolved below, against the built spacecraft and sensors.
@@ -1071,7 +885,7 @@ fn check_body_extent(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError
         check(&format!("{path}.panel1.d_m"), p.panel1.d_m)?;
         check(&format!("{path}.panel2.d_m"), p.panel2.d_m)?;
     }
-    for (i, imu) in cfg.imus.iter().enumerate() {
+    for (i, imu) in cfg.sensors.of::<ImuConfig>().enumerate() {
         check(&format!("imus[{i}].r_sb_b_m"), imu.r_sb_b_m.norm())?;
     }
     for (i, w) in cfg.reaction_wheels.iter().enumerate() {
@@ -1153,7 +967,7 @@ pub const MAX_IMU_TERM_SI: f64 = 1e6;
 /// Rejects IMU error terms beyond [`MAX_IMU_TERM_SI`] (the correlation times are not bounded:
 /// a long τ only makes the bias steadier).
 fn check_imu_magnitudes(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError> {
-    for (i, imu) in cfg.imus.iter().enumerate() {
+    for (i, imu) in cfg.sensors.of::<ImuConfig>().enumerate() {
         let g = &imu.gyro;
         let a = &imu.accel;
         let terms: [(&str, f64); 14] = [

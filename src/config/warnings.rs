@@ -13,7 +13,6 @@ use toml::de::DeTable;
 use super::{At, SimConfig, SourceMap};
 use crate::dynamics::effectors::reaction_wheel;
 use crate::schema::plausible::Implausible;
-use crate::sensors::{imu, magnetometer, star_tracker};
 
 /// One implausible value: its field, what is implausible and the likely intended unit, and its
 /// position in the file.
@@ -34,21 +33,16 @@ impl fmt::Display for ConfigWarning {
 }
 
 impl SimConfig {
-    /// The plausibility warnings (module docs): the IMUs', the reaction wheels', the star
-    /// trackers' and the magnetometers', in file order within each.
+    /// The plausibility warnings (module docs): the reaction wheels', then every sensor kind's
+    /// ([`crate::sensors::params::SensorParams::implausible`], registry order), in file order
+    /// within each.
     pub fn warnings(&self) -> Vec<ConfigWarning> {
         let mut found: Vec<Implausible> = Vec::new();
-        for (i, x) in self.imus.iter().enumerate() {
-            imu::plausibility::check(x, &format!("imus[{i}]"), &mut found);
-        }
         for (i, x) in self.reaction_wheels.iter().enumerate() {
             reaction_wheel::plausibility::check(x, &format!("reaction_wheels[{i}]"), &mut found);
         }
-        for (i, x) in self.star_trackers.iter().enumerate() {
-            star_tracker::plausibility::check(x, &format!("star_trackers[{i}]"), &mut found);
-        }
-        for (i, x) in self.magnetometers.iter().enumerate() {
-            magnetometer::plausibility::check(x, &format!("magnetometers[{i}]"), &mut found);
+        for (path, x) in self.sensors.with_paths() {
+            x.implausible(&path, &mut found);
         }
         if found.is_empty() {
             return Vec::new();

@@ -74,7 +74,9 @@ impl SensorBank {
         for (i, s) in self.sensors.iter_mut().enumerate() {
             if pick(s.as_ref()) {
                 s.sample(truth);
-                self.sampled.push(i);
+                if s.has_output() {
+                    self.sampled.push(i);
+                }
             }
         }
     }
@@ -95,7 +97,8 @@ impl SensorBank {
         self.sampled.clear();
     }
 
-    /// Indices of the sensors the last [`Self::sample`] sampled, in order.
+    /// Indices of the sensors the last [`Self::sample`] sampled and that have a message to
+    /// publish ([`super::Sensor::has_output`]), in order.
     pub fn sampled(&self) -> &[usize] {
         &self.sampled
     }

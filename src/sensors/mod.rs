@@ -2,8 +2,8 @@
 //! ([`KINDS`]). Each folder owns the kind's parameters, its configuration schema
 //! (`schema.rs`), its measurement model, its message mapping and its [`SensorKind`]
 //! descriptor: [`imu`] (gyro and accelerometer), [`star_tracker`] (attitude),
-//! [`magnetometer`], [`coarse_sun_sensor`] (arrays of cosine detectors) and [`fine_sun_sensor`]
-//! (two-axis).
+//! [`magnetometer`], [`coarse_sun_sensor`] (arrays of cosine detectors), [`fine_sun_sensor`]
+//! (two-axis) and [`gps`] (a receiver with a latency).
 //!
 //! Every sensor is sampled at a frame boundary (or, for a sensor that integrates over an
 //! interval, at each output instant) from the same truth, a [`Truth`]: the state and the one
@@ -30,8 +30,10 @@ use crate::environment::EnvironmentSample;
 pub mod bank;
 pub mod coarse_sun_sensor;
 pub mod fine_sun_sensor;
+pub mod gps;
 pub mod imu;
 pub mod magnetometer;
+pub mod params;
 pub mod rng;
 pub mod star_tracker;
 
@@ -44,6 +46,7 @@ pub static KINDS: &[&SensorKind] = &[
     &magnetometer::KIND,
     &coarse_sun_sensor::KIND,
     &fine_sun_sensor::KIND,
+    &gps::KIND,
 ];
 
 /// The truth one sample is taken from: one evaluation at the current instant.
@@ -99,6 +102,12 @@ pub trait Sensor: std::fmt::Debug + Send {
 
     /// Takes one sample from `truth`, kept until the next (see [`Self::encode`]).
     fn sample(&mut self, truth: &Truth<'_>);
+
+    /// Whether the last [`Self::sample`] left a message to publish (a sensor with a latency
+    /// also samples at instants where it only stores a measurement; default: always).
+    fn has_output(&self) -> bool {
+        true
+    }
 
     /// Encodes the last sample as its wire message into `buf` (cleared first), with the frame's
     /// `header` (the sensor may set its own `seq`).
@@ -193,6 +202,8 @@ pub struct SensorKind {
     pub a_noun: &'static str,
     /// The configuration array (`imus`, `star_trackers`): error paths and campaign seed keys.
     pub config_array: &'static str,
+    /// How one `[[<config_array>]]` entry is read and validated.
+    pub config: params::SensorConfigReader,
     /// The key prefix below `flexdyn/<sc>/` (`tlm/imu`); the key is `<prefix>/<name>`.
     pub key_prefix: &'static str,
     /// The prefix of its `simulate` CSV columns and the last segment of its key prefix
@@ -289,12 +300,37 @@ mod tests {
                 panic!("{key} did not decode as a sensor");
             };
             assert_eq!((h.tick, h.sim_time_ns), (2, sim.t_sim_ns()));
-            let every = cfg.star_trackers.first().map_or(1, |c| c.every_frames);
+            let every = |e: Option<u64>| e.unwrap();
+            let s = &cfg.sensors;
             let seq = match kind.noun {
-                "star tracker" => 2 / every,
-                "magnetometer" => 2 / cfg.magnetometers[0].every_frames,
-                "coarse sun sensor" => 2 / cfg.coarse_sun_sensors[0].every_frames,
-                "fine sun sensor" => 2 / cfg.fine_sun_sensors[0].every_frames,
+                "star tracker" => {
+                    2 / every(
+                        s.of::<star_tracker::StarTrackerConfig>()
+                            .next()
+                            .map(|c| c.every_frames),
+                    )
+                }
+                "magnetometer" => {
+                    2 / every(
+                        s.of::<magnetometer::MagnetometerConfig>()
+                            .next()
+                            .map(|c| c.every_frames),
+                    )
+                }
+                "coarse sun sensor" => {
+                    2 / every(
+                        s.of::<coarse_sun_sensor::CoarseSunSensorConfig>()
+                            .next()
+                            .map(|c| c.every_frames),
+                    )
+                }
+                "fine sun sensor" => {
+                    2 / every(
+                        s.of::<fine_sun_sensor::FineSunSensorConfig>()
+                            .next()
+                            .map(|c| c.every_frames),
+                    )
+                }
                 _ => 2,
             };
             assert_eq!(h.seq, seq, "{key}");

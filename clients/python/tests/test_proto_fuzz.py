@@ -12,6 +12,7 @@ from flexdyn import proto
 from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState, Header,
                            ImuMsg, MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg,
                            StatusMsg, TimeMsg, CssMsg, FssMsg, EnvironmentMsg, SourceWrench)
+from flexdyn.proto import GpsMsg  # protocol 7: the thirteenth decoder, generator arm 11
 
 N = 20_000
 
@@ -109,6 +110,11 @@ def operator_line(m):
     return str(Line().h(m.header).u(m.action, m.ticks))
 
 
+def gps_line(m):
+    return str(Line().h(m.header).u(m.valid_sim_time_ns, m.gps_week).f([m.gps_seconds_of_week])
+               .f(m.r_be_e_m).f(m.v_be_e_m_s).f(m.r_bn_n_m).f(m.v_bn_n_m_s).u(m.flags))
+
+
 DECODERS = [
     (StateMsg.decode, state_line), (ImuMsg.decode, imu_line),
     (StarTrackerMsg.decode, star_tracker_line), (MagnetometerMsg.decode, magnetometer_line),
@@ -116,6 +122,7 @@ DECODERS = [
     (EnvironmentMsg.decode, environment_line), (CommandMsg.decode, command_line),
     (StatusMsg.decode, status_line), (TimeMsg.decode, time_line),
     (OperatorMsg.decode, operator_line), (Header.decode, lambda h: str(Line().h(h))),
+    (GpsMsg.decode, gps_line),
 ]
 
 
@@ -153,7 +160,7 @@ def gen_buffer(r):
     def header():
         return Header(r.getrandbits(32), r.getrandbits(64), r.getrandbits(64), r.getrandbits(64))
 
-    k = r.randrange(11)
+    k = r.randrange(12)
     if k == 0:
         b = StateMsg(header(), v(3), v(4), v(3), v(3), v(3), v(3), v(3), f64(), f64(), v(3), v(3),
                      v(3), v(3), r.getrandbits(8),
@@ -194,6 +201,9 @@ def gen_buffer(r):
         b = EnvironmentMsg(header(), r.getrandbits(64), r.getrandbits(8), r.getrandbits(8), v(3),
                            v(3), v(3), v(3), v(3), f64(), f64(), wrench(), wrench(), wrench(),
                            wrench()).encode()
+    elif k == 11:
+        b = GpsMsg(header(), r.getrandbits(64), r.getrandbits(32), f64(), v(3), v(3), v(3), v(3),
+                   r.getrandbits(8)).encode()
     b = bytearray(b)
     k = r.randrange(10)
     if k in (3, 4, 5):
@@ -222,17 +232,17 @@ def test_python_and_rust_decoders_agree_on_20000_buffers(verdicts_bin):
     stream = b"".join(struct.pack("<I", len(b)) + b for b in buffers)
     rust = subprocess.run([str(verdicts_bin)], input=stream, capture_output=True, check=True)
     rust_lines = rust.stdout.decode().splitlines()
-    assert len(rust_lines) == 12 * N
+    assert len(rust_lines) == 13 * N
     reasons = {}
     names = ["state", "imu", "star_tracker", "magnetometer", "css", "fss", "environment",
-             "command", "status", "time", "operator", "header"]
+             "command", "status", "time", "operator", "header", "gps"]
     for i, b in enumerate(buffers):
         for j, got in enumerate(python_lines(b)):
-            want = rust_lines[12 * i + j]
+            want = rust_lines[13 * i + j]
             assert got == want, f"buffer {i} ({len(b)} bytes), {names[j]}: Python {got!r} vs Rust {want!r}"
             key = want.split()[1] if want.startswith("E") else "accepted"
             reasons[key] = reasons.get(key, 0) + 1
-    print(f"{N} buffers x 12 decoders: {reasons}")
+    print(f"{N} buffers x 13 decoders: {reasons}")
     for k in ("accepted", "Length", "TrailingBytes", "TooLarge", "UnknownVersion", "NonFinite",
               "Malformed"):
         assert reasons.get(k, 0) > 0, k

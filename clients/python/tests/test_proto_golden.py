@@ -21,7 +21,7 @@ def bits(x):
 def test_manifest_lists_every_file(golden_dir):
     rows = [l.split("\t") for l in (golden_dir / "MANIFEST.tsv").read_text().splitlines()
             if l and not l.startswith("#")]
-    assert len(rows) == 13
+    assert len(rows) == 14
     for name, _message, length, _source in rows:
         assert (golden_dir / f"{name}.bin").stat().st_size == int(length)
 
@@ -198,4 +198,22 @@ def test_environment(golden_dir):
     assert proto.environment_key("sc1") == "flexdyn/sc1/tlm/env"
     with pytest.raises(DecodeError) as e:
         EnvironmentMsg.decode(golden[:-1])
+    assert e.value.reason == "Length"
+
+
+def test_gps(golden_dir):
+    # GPS_GOLDEN of proto/tests/golden.rs (protocol 7; dyadic values, one -0.0).
+    from flexdyn.proto import GpsMsg
+    m = GpsMsg(Header(SC, 13, 130_000_000, 1), 30_000_000, 2394, 86_400.5, (1.5, -2.0, 0.25),
+               (0.5, -0.0, 4.0), (8.0, 0.125, -1.0), (3.0, -0.5, 1024.0),
+               proto.GPS_FIX | proto.GPS_ECEF | proto.GPS_INERTIAL)
+    golden = (golden_dir / "gps.bin").read_bytes()
+    assert len(golden) == proto.GPS_LEN == 147
+    assert m.encode() == golden
+    back = GpsMsg.decode(golden)
+    assert back == m and bits(back.v_be_e_m_s) == bits(m.v_be_e_m_s)  # -0.0 keeps its sign
+    assert back.flags == 0x07
+    assert proto.gps_key("sc1", "gps1") == "flexdyn/sc1/tlm/gps/gps1"
+    with pytest.raises(DecodeError) as e:
+        GpsMsg.decode(golden[:-1])
     assert e.value.reason == "Length"

@@ -1,5 +1,5 @@
 /*
- * flexdyn_proto.h - the flexdyn wire protocol (version 6) for C99 and C++ flight code.
+ * flexdyn_proto.h - the flexdyn wire protocol (version 7) for C99 and C++ flight code.
  *
  * Header-only: include it and call fd_decode_* / fd_encode_*. No allocation, no I/O, no
  * global state. Bytes are assembled one by one (little-endian on the wire), never cast to a
@@ -60,7 +60,7 @@
 /* ------------------------------------------------------------------------------------------ */
 /* Constants (proto/README.md).                                                                */
 
-#define FD_PROTOCOL_VERSION 6u
+#define FD_PROTOCOL_VERSION 7u
 #define FD_HEADER_LEN 30u
 #define FD_STATE_FIXED_LEN 327u
 #define FD_STATE_EFFECTOR_COUNT_OFFSET 319u
@@ -82,6 +82,7 @@
 #define FD_TIME_CUC_OFFSET 98u
 #define FD_OPERATOR_LEN 42u /* since protocol 6 */
 #define FD_ENVIRONMENT_LEN 368u
+#define FD_GPS_LEN 147u /* since protocol 7 */
 #define FD_MAX_EFFECTORS 1024u
 #define FD_MAX_EFFECTOR_VALUES 8u
 #define FD_MAX_MESSAGE_BYTES 65536u
@@ -133,6 +134,10 @@
 #define FD_ECLIPSE_SUNLIT 0u
 #define FD_ECLIPSE_PENUMBRA 1u
 #define FD_ECLIPSE_UMBRA 2u
+/* GpsMsg.flags (protocol 7) */
+#define FD_GPS_FIX 0x01u      /* a fix: the time and the configured frames' fields are measured */
+#define FD_GPS_ECEF 0x02u     /* r_be_e_m, v_be_e_m_s are configured output */
+#define FD_GPS_INERTIAL 0x04u /* r_bn_n_m, v_bn_n_m_s are configured output */
 /* EffectorState.flags of a reaction wheel */
 #define FD_WHEEL_TORQUE_LIMITED 0x1u
 #define FD_WHEEL_SPEED_LIMITED 0x2u
@@ -291,6 +296,21 @@ typedef struct {
     double density_kg_m3;
     fd_source_wrench gravity_gradient, drag, solar_pressure, residual_dipole;
 } fd_environment_msg;
+
+/* A GPS receiver's solution, flexdyn/<sc>/tlm/gps/<name> (protocol 7). header.sim_time_ns is
+ * the publication time; the measurement is valid at valid_sim_time_ns (the latency earlier).
+ * Without FD_GPS_FIX every number is 0; each frame's fields are 0 unless its flag is set. */
+typedef struct {
+    fd_header header;
+    uint64_t valid_sim_time_ns;
+    uint32_t gps_week;          /* since 1980-01-06, not modulo 1024 */
+    double gps_seconds_of_week; /* s, GPS = TAI - 19 s */
+    double r_be_e_m[3];         /* m, position of B from the Earth's centre, ECEF */
+    double v_be_e_m_s[3];       /* m/s, velocity relative to ECEF, ECEF components */
+    double r_bn_n_m[3];         /* m, position in N */
+    double v_bn_n_m_s[3];       /* m/s, inertial velocity, N components */
+    uint8_t flags;              /* FD_GPS_* */
+} fd_gps_msg;
 
 typedef struct {
     fd_header header;
@@ -1098,6 +1118,38 @@ static inline size_t fd_encode_environment(const fd_environment_msg *m, uint8_t 
     return FD_ENVIRONMENT_LEN;
 }
 
+/* GpsMsg (protocol 7, fixed length).                                                          */
+
+static inline fd_error fd_decode_gps(const uint8_t *buf, size_t len, fd_gps_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_GPS_LEN);
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_GPS_LEN, len)).status != FD_OK) return e;
+    fd_decode_header_at(buf, &out->header);
+    out->valid_sim_time_ns = fd_get_u64(buf + 30);
+    out->gps_week = fd_get_u32(buf + 38);
+    out->gps_seconds_of_week = fd_get_f64(buf + 42);
+    fd_get_f64s(buf + 50, out->r_be_e_m, 3);
+    fd_get_f64s(buf + 74, out->v_be_e_m_s, 3);
+    fd_get_f64s(buf + 98, out->r_bn_n_m, 3);
+    fd_get_f64s(buf + 122, out->v_bn_n_m_s, 3);
+    out->flags = buf[146];
+    return fd_ok();
+}
+
+static inline size_t fd_encode_gps(const fd_gps_msg *m, uint8_t *buf, size_t cap) {
+    if (cap < FD_GPS_LEN) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_u64(buf + 30, m->valid_sim_time_ns);
+    fd_put_u32(buf + 38, m->gps_week);
+    fd_put_f64(buf + 42, m->gps_seconds_of_week);
+    fd_put_f64s(buf + 50, m->r_be_e_m, 3);
+    fd_put_f64s(buf + 74, m->v_be_e_m_s, 3);
+    fd_put_f64s(buf + 98, m->r_bn_n_m, 3);
+    fd_put_f64s(buf + 122, m->v_bn_n_m_s, 3);
+    buf[146] = m->flags;
+    return FD_GPS_LEN;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 /* Key expressions (proto/README.md, "Topics").                                                */
 
@@ -1163,6 +1215,9 @@ static inline size_t fd_css_key(char *out, size_t cap, const char *sc, const cha
 }
 static inline size_t fd_fss_key(char *out, size_t cap, const char *sc, const char *name) {
     return fd_key(out, cap, sc, "tlm/fss", name);
+}
+static inline size_t fd_gps_key(char *out, size_t cap, const char *sc, const char *name) {
+    return fd_key(out, cap, sc, "tlm/gps", name);
 }
 static inline size_t fd_status_key(char *out, size_t cap, const char *sc) {
     return fd_key(out, cap, sc, "status", FD_NULL);

@@ -1,7 +1,7 @@
 /*
  * Differential-fuzz driver for the C decoders. Reads records from stdin, each a u32 LE length
  * and that many bytes, and writes one line per record and decoder (state, imu, star tracker,
- * magnetometer, css, fss, environment, command, status, time, operator, header, in that order) in the canonical form that proto/tests/c_header.rs
+ * magnetometer, css, fss, environment, command, status, time, operator, header, gps, in that order) in the canonical form that proto/tests/c_header.rs
  * also prints from the Rust decoders:
  *
  *   E <reason> [numbers or field]     on a decode error (reason as the Rust DecodeError variant)
@@ -315,6 +315,25 @@ static void one(const uint8_t *buf, size_t len) {
         } else {
             printf("O");
             h(&m);
+            printf("\n");
+        }
+    }
+    {
+        fd_gps_msg m; /* the thirteenth decoder (protocol 7) */
+        e = fd_decode_gps(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_gps(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            u(m.valid_sim_time_ns);
+            u(m.gps_week);
+            f(m.gps_seconds_of_week);
+            fs(m.r_be_e_m, 3);
+            fs(m.v_be_e_m_s, 3);
+            fs(m.r_bn_n_m, 3);
+            fs(m.v_bn_n_m_s, 3);
+            u(m.flags);
             printf("\n");
         }
     }

@@ -537,6 +537,42 @@ static void test_environment(const char *dir) {
     printf("EnvironmentMsg: decode ok\n");
 }
 
+/* GpsMsg (protocol 7): the GPS_GOLDEN table of proto/tests/golden.rs. */
+static void test_gps(const char *dir) {
+    uint8_t golden[256], enc[256];
+    size_t n = read_file(dir, "gps", golden, sizeof golden);
+    fd_gps_msg m, back;
+    static const double r_e[3] = {1.5, -2.0, 0.25}, v_e[3] = {0.5, -0.0, 4.0};
+    static const double r_n[3] = {8.0, 0.125, -1.0}, v_n[3] = {3.0, -0.5, 1024.0};
+    char key[128];
+    fd_error e;
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 13, 130000000u, 1);
+    m.valid_sim_time_ns = 30000000u;
+    m.gps_week = 2394u;
+    m.gps_seconds_of_week = 86400.5;
+    memcpy(m.r_be_e_m, r_e, sizeof r_e);
+    memcpy(m.v_be_e_m_s, v_e, sizeof v_e);
+    memcpy(m.r_bn_n_m, r_n, sizeof r_n);
+    memcpy(m.v_bn_n_m_s, v_n, sizeof v_n);
+    m.flags = FD_GPS_FIX | FD_GPS_ECEF | FD_GPS_INERTIAL;
+    check_encoded("GpsMsg", golden, n, enc, fd_encode_gps(&m, enc, sizeof enc));
+    e = fd_decode_gps(golden, n, &back);
+    CHECK(e.status == FD_OK && same_header(&back.header, &m.header) &&
+              back.valid_sim_time_ns == 30000000u && back.gps_week == 2394u &&
+              same_bits(&back.gps_seconds_of_week, &m.gps_seconds_of_week, 1) &&
+              same_bits(back.r_be_e_m, r_e, 3) && same_bits(back.v_be_e_m_s, v_e, 3) &&
+              same_bits(back.r_bn_n_m, r_n, 3) && same_bits(back.v_bn_n_m_s, v_n, 3) &&
+              back.flags == 0x07,
+          "GpsMsg decodes to the table");
+    e = fd_decode_gps(golden, n - 1, &back);
+    CHECK(e.status == FD_ERR_LENGTH && e.needed == FD_GPS_LEN, "GpsMsg short");
+    CHECK(fd_gps_key(key, sizeof key, "sc1", "gps1") > 0 &&
+              strcmp(key, "flexdyn/sc1/tlm/gps/gps1") == 0,
+          "GPS key");
+    printf("GpsMsg: decode ok\n");
+}
+
 static void test_keys(void) {
     char key[128];
     CHECK(fd_state_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/tlm/state") == 0,
@@ -582,6 +618,7 @@ int main(int argc, char **argv) {
     test_time(argv[1]);
     test_operator(argv[1]);
     test_environment(argv[1]);
+    test_gps(argv[1]);
     test_keys();
     if (failures != 0) {
         fprintf(stderr, "%d check(s) failed\n", failures);

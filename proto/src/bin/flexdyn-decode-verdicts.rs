@@ -3,8 +3,8 @@
 //! `proto/c/tests/fuzz_decode.c`, the Python package's `tests/test_proto_fuzz.py`).
 //!
 //! Input (stdin): records of a u32 LE length and that many bytes. Output (stdout): per record,
-//! twelve lines, one per decoder (state, imu, star tracker, magnetometer, css, fss, environment,
-//! command, status, time, operator, header):
+//! thirteen lines, one per decoder (state, imu, star tracker, magnetometer, css, fss,
+//! environment, command, status, time, operator, header, gps):
 //! `E <reason> [numbers or field]` for an error (the `DecodeError` variant; `Length needed
 //! actual`, `TrailingBytes expected actual`, `TooLarge actual`, `UnknownVersion found`,
 //! `NonFinite field`, `Malformed`), or `O <fields>` for a decoded message: every field in wire
@@ -19,6 +19,8 @@ use flexdyn_proto::{
     decode_time, CommandKind, CommandMsg, DecodeError, EnvironmentMsg, Header, ImuMsg,
     MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
 };
+// The GPS receiver (protocol 7), the thirteenth decoder.
+use flexdyn_proto::{decode_gps, GpsMsg};
 
 fn err_line(e: &DecodeError) -> String {
     match e {
@@ -233,7 +235,21 @@ fn operator_line(m: &OperatorMsg) -> String {
     l.0
 }
 
-/// The twelve verdicts for one buffer, in the order of the module docs.
+fn gps_line(m: &GpsMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header)
+        .u(m.valid_sim_time_ns)
+        .u(m.gps_week.into())
+        .f(&[m.gps_seconds_of_week])
+        .f(&m.r_be_e_m)
+        .f(&m.v_be_e_m_s)
+        .f(&m.r_bn_n_m)
+        .f(&m.v_bn_n_m_s)
+        .u(m.flags.into());
+    l.0
+}
+
+/// The thirteen verdicts for one buffer, in the order of the module docs.
 fn rust_lines(b: &[u8]) -> Vec<String> {
     fn line<M>(r: Result<M, DecodeError>, f: impl Fn(&M) -> String) -> String {
         match r {
@@ -268,6 +284,7 @@ fn rust_lines(b: &[u8]) -> Vec<String> {
             l.h(h);
             l.0
         }),
+        line(decode_gps(b), gps_line),
     ]
 }
 

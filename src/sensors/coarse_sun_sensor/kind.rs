@@ -5,9 +5,10 @@
 use flexdyn_proto::keys::CSS_PREFIX;
 use flexdyn_proto::{decode_css, CssMsg};
 
-use super::CoarseSunSensor;
+use super::{schema, CoarseSunSensor, CoarseSunSensorConfig};
 use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::State;
+use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
 use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
 
 /// The coarse-sun-sensor array kind.
@@ -15,6 +16,10 @@ pub static KIND: SensorKind = SensorKind {
     noun: "coarse sun sensor",
     a_noun: "a coarse sun sensor",
     config_array: "coarse_sun_sensors",
+    config: SensorConfigReader {
+        keys: &schema::KEYS,
+        read: |t| read_boxed(t, schema::read),
+    },
     key_prefix: CSS_PREFIX,
     column_prefix: "css",
     message_name: "CssMsg",
@@ -66,9 +71,18 @@ fn build(
     _x: &State,
     out: &mut Vec<Box<dyn Sensor>>,
 ) -> Result<(), ConfigError> {
-    for (i, c) in cfg.coarse_sun_sensors.iter().enumerate() {
+    for (i, c) in cfg.sensors.of::<CoarseSunSensorConfig>().enumerate() {
         let path = format!("coarse_sun_sensors[{i}]");
         out.push(Box::new(CoarseSunSensor::new(c.clone(), &path)?));
     }
     Ok(())
+}
+
+impl SensorParams for CoarseSunSensorConfig {
+    fn sensor_kind() -> &'static SensorKind {
+        &KIND
+    }
+    fn name(&self) -> &str {
+        &self.name
+    }
 }

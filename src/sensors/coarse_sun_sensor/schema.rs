@@ -2,7 +2,10 @@
 //! ([`crate::schema`]); values by [`super::CoarseSunSensorConfig::validate`] and the
 //! configuration (the rate must divide the frame rate).
 
+use super::CoarseSunSensorConfig;
+use crate::config::{ConfigError, SensorContext};
 use crate::schema::{vec3, SchemaError, TableReader};
+use crate::sensors::params::{RawSensorConfig, SensorSpec};
 use nalgebra::Vector3;
 
 /// The keys of one `[[coarse_sun_sensors]]` entry (the first four are required).
@@ -47,4 +50,32 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawCoarseSunSensor, Schema
         noise_sigma: t.opt_f64("noise_sigma")?.unwrap_or(0.0),
         lsb: t.opt_f64("lsb")?.unwrap_or(0.0),
     })
+}
+
+impl RawSensorConfig for RawCoarseSunSensor {
+    /// Checks the name, converts the rate to frames and validates the values
+    /// ([`CoarseSunSensorConfig::validate`]). Like a magnetometer without a field model, a sun
+    /// sensor without `[environment] sun = true` sees no Sun (it reads 0).
+    fn resolve(
+        self: Box<Self>,
+        ctx: &mut SensorContext<'_>,
+        path: &str,
+    ) -> Result<Box<dyn SensorSpec>, ConfigError> {
+        let raw = *self;
+        ctx.unique_name(path, &raw.name, "coarse sun sensor")?;
+        ctx.sensor_name(path, &raw.name)?;
+        let cfg = CoarseSunSensorConfig {
+            every_frames: ctx.every_frames(&format!("{path}.rate_hz"), raw.rate_hz, "array")?,
+            name: raw.name,
+            normals_b: raw.normals_b,
+            fov_half_angle_rad: raw.fov_half_angle_rad,
+            scale: raw.scale,
+            bias: raw.bias,
+            noise_sigma: raw.noise_sigma,
+            lsb: raw.lsb,
+            seed: raw.seed,
+        };
+        cfg.validate(path).map_err(|e| ctx.param(e))?;
+        Ok(Box::new(cfg))
+    }
 }

@@ -5,9 +5,10 @@
 use flexdyn_proto::keys::FSS_PREFIX;
 use flexdyn_proto::{decode_fss, FssMsg};
 
-use super::FineSunSensor;
+use super::{schema, FineSunSensor, FineSunSensorConfig};
 use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::State;
+use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
 use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
 
 /// The fine-sun-sensor kind.
@@ -15,6 +16,10 @@ pub static KIND: SensorKind = SensorKind {
     noun: "fine sun sensor",
     a_noun: "a fine sun sensor",
     config_array: "fine_sun_sensors",
+    config: SensorConfigReader {
+        keys: &schema::KEYS,
+        read: |t| read_boxed(t, schema::read),
+    },
     key_prefix: FSS_PREFIX,
     column_prefix: "fss",
     message_name: "FssMsg",
@@ -51,9 +56,18 @@ fn build(
     _x: &State,
     out: &mut Vec<Box<dyn Sensor>>,
 ) -> Result<(), ConfigError> {
-    for (i, c) in cfg.fine_sun_sensors.iter().enumerate() {
+    for (i, c) in cfg.sensors.of::<FineSunSensorConfig>().enumerate() {
         let path = format!("fine_sun_sensors[{i}]");
         out.push(Box::new(FineSunSensor::new(c.clone(), &path)?));
     }
     Ok(())
+}
+
+impl SensorParams for FineSunSensorConfig {
+    fn sensor_kind() -> &'static SensorKind {
+        &KIND
+    }
+    fn name(&self) -> &str {
+        &self.name
+    }
 }

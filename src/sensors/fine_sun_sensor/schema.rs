@@ -4,7 +4,10 @@
 
 use nalgebra::{Matrix3, Vector2};
 
+use super::FineSunSensorConfig;
+use crate::config::{ConfigError, SensorContext};
 use crate::schema::{mat3, SchemaError, TableReader};
+use crate::sensors::params::{RawSensorConfig, SensorSpec};
 
 /// The keys of one `[[fine_sun_sensors]]` entry (the first five are required).
 pub(crate) const KEYS: [&str; 9] = [
@@ -48,4 +51,31 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawFineSunSensor, SchemaEr
         lsb_rad: t.opt_f64("lsb_rad")?.unwrap_or(0.0),
         min_shadow_factor: t.opt_f64("min_shadow_factor")?.unwrap_or(0.5),
     })
+}
+
+impl RawSensorConfig for RawFineSunSensor {
+    /// Checks the name, converts the rate to frames and validates the values
+    /// ([`FineSunSensorConfig::validate`]).
+    fn resolve(
+        self: Box<Self>,
+        ctx: &mut SensorContext<'_>,
+        path: &str,
+    ) -> Result<Box<dyn SensorSpec>, ConfigError> {
+        let raw = *self;
+        ctx.unique_name(path, &raw.name, "fine sun sensor")?;
+        ctx.sensor_name(path, &raw.name)?;
+        let cfg = FineSunSensorConfig {
+            every_frames: ctx.every_frames(&format!("{path}.rate_hz"), raw.rate_hz, "sensor")?,
+            name: raw.name,
+            dcm_fb: raw.dcm_fb,
+            fov_half_angle_rad: raw.fov_half_angle_rad,
+            bias_rad: raw.bias_rad,
+            noise_sigma_rad: raw.noise_sigma_rad,
+            lsb_rad: raw.lsb_rad,
+            min_shadow_factor: raw.min_shadow_factor,
+            seed: raw.seed,
+        };
+        cfg.validate(path).map_err(|e| ctx.param(e))?;
+        Ok(Box::new(cfg))
+    }
 }

@@ -5,9 +5,11 @@
 use flexdyn_proto::keys::{Topics, IMU_PREFIX};
 use flexdyn_proto::{decode_imu, ImuMsg};
 
-use super::ImuSensor;
+use super::{schema, ImuConfig, ImuSensor};
 use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::State;
+use crate::schema::plausible::Implausible;
+use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
 use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
 
 /// The IMU kind.
@@ -15,6 +17,10 @@ pub static KIND: SensorKind = SensorKind {
     noun: "IMU",
     a_noun: "an IMU",
     config_array: "imus",
+    config: SensorConfigReader {
+        keys: &schema::KEYS,
+        read: |t| read_boxed(t, schema::RawImu::read),
+    },
     key_prefix: IMU_PREFIX,
     column_prefix: "imu",
     message_name: "ImuMsg",
@@ -55,7 +61,7 @@ fn build(
     x: &State,
     out: &mut Vec<Box<dyn Sensor>>,
 ) -> Result<(), ConfigError> {
-    for (i, imu) in cfg.imus.iter().enumerate() {
+    for (i, imu) in cfg.sensors.of::<ImuConfig>().enumerate() {
         let path = format!("imus[{i}]");
         out.push(Box::new(ImuSensor::new(
             imu,
@@ -66,4 +72,16 @@ fn build(
         )?));
     }
     Ok(())
+}
+
+impl SensorParams for ImuConfig {
+    fn sensor_kind() -> &'static SensorKind {
+        &KIND
+    }
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn implausible(&self, path: &str, out: &mut Vec<Implausible>) {
+        super::plausibility::check(self, path, out);
+    }
 }

@@ -3,7 +3,9 @@
 //! [`super::Imu::new`] and the configuration's magnitude bounds.
 
 use super::{AccelErrors, GyroErrors, ImuConfig};
+use crate::config::{ConfigError, SensorContext};
 use crate::schema::{mat3, vec3, SchemaError, TableReader};
+use crate::sensors::params::{RawSensorConfig, SensorSpec};
 
 /// The keys of one `[[imus]]` entry.
 pub(crate) const KEYS: [&str; 6] = ["name", "r_sb_b_m", "dcm_pb", "seed", "gyro", "accel"];
@@ -131,5 +133,19 @@ impl RawImu {
                 dv_lsb_m_s: a.increment_lsb,
             },
         }
+    }
+}
+
+impl RawSensorConfig for RawImu {
+    /// Validates the terms ([`ImuConfig::validate`]), then the name's uniqueness.
+    fn resolve(
+        self: Box<Self>,
+        ctx: &mut SensorContext<'_>,
+        path: &str,
+    ) -> Result<Box<dyn SensorSpec>, ConfigError> {
+        let imu = self.into_config();
+        imu.validate(path).map_err(|e| ctx.imu_error(e))?;
+        ctx.unique_name(path, &imu.name, "IMU")?;
+        Ok(Box::new(imu))
     }
 }

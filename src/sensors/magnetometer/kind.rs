@@ -5,9 +5,11 @@
 use flexdyn_proto::keys::MAGNETOMETER_PREFIX;
 use flexdyn_proto::{decode_magnetometer, MagnetometerMsg};
 
-use super::Magnetometer;
+use super::{schema, Magnetometer, MagnetometerConfig};
 use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::State;
+use crate::schema::plausible::Implausible;
+use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
 use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
 
 /// The magnetometer kind.
@@ -15,6 +17,10 @@ pub static KIND: SensorKind = SensorKind {
     noun: "magnetometer",
     a_noun: "a magnetometer",
     config_array: "magnetometers",
+    config: SensorConfigReader {
+        keys: &schema::KEYS,
+        read: |t| read_boxed(t, schema::read),
+    },
     key_prefix: MAGNETOMETER_PREFIX,
     column_prefix: "mag",
     message_name: "MagnetometerMsg",
@@ -47,9 +53,21 @@ fn build(
     _x: &State,
     out: &mut Vec<Box<dyn Sensor>>,
 ) -> Result<(), ConfigError> {
-    for (i, m) in cfg.magnetometers.iter().enumerate() {
+    for (i, m) in cfg.sensors.of::<MagnetometerConfig>().enumerate() {
         let path = format!("magnetometers[{i}]");
         out.push(Box::new(Magnetometer::new(m.clone(), &path)?));
     }
     Ok(())
+}
+
+impl SensorParams for MagnetometerConfig {
+    fn sensor_kind() -> &'static SensorKind {
+        &KIND
+    }
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn implausible(&self, path: &str, out: &mut Vec<Implausible>) {
+        super::plausibility::check(self, path, out);
+    }
 }

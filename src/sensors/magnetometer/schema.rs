@@ -4,7 +4,11 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::MagnetometerConfig;
+use crate::config::{ConfigError, SensorContext};
+use crate::numfmt::Num;
 use crate::schema::{mat3, vec3, SchemaError, TableReader};
+use crate::sensors::params::{RawSensorConfig, SensorSpec};
 
 /// The keys of one `[[magnetometers]]` entry (the first four are required).
 pub(crate) const KEYS: [&str; 11] = [
@@ -54,4 +58,45 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawMagnetometer, SchemaErr
         lsb_t: t.opt_f64("lsb_t")?.unwrap_or(0.0),
         r_sb_b_m: t.opt_floats("r_sb_b_m")?.map(v3),
     })
+}
+
+impl RawSensorConfig for RawMagnetometer {
+    /// Checks the name, converts the rate to frames, rejects a misalignment with a non-zero
+    /// diagonal and validates the values ([`MagnetometerConfig::validate`]).
+    fn resolve(
+        self: Box<Self>,
+        ctx: &mut SensorContext<'_>,
+        path: &str,
+    ) -> Result<Box<dyn SensorSpec>, ConfigError> {
+        let raw = *self;
+        ctx.unique_name(path, &raw.name, "magnetometer")?;
+        ctx.sensor_name(path, &raw.name)?;
+        let every_frames =
+            ctx.every_frames(&format!("{path}.rate_hz"), raw.rate_hz, "magnetometer")?;
+        if let Some(k) = (0..3).find(|&k| raw.misalignment_rad[(k, k)] != 0.0) {
+            return Err(ctx.invalid(
+                &format!("{path}.misalignment_rad"),
+                format!(
+                    "the diagonal must be zero (element [{k}][{k}] is {}): a scale error \
+                     belongs in scale_factor",
+                    Num(raw.misalignment_rad[(k, k)])
+                ),
+            ));
+        }
+        let cfg = MagnetometerConfig {
+            name: raw.name,
+            dcm_sb: raw.dcm_sb,
+            scale_factor: raw.scale_factor,
+            misalignment_rad: raw.misalignment_rad,
+            bias_s_t: raw.bias_s_t,
+            noise_sigma_t: raw.noise_sigma_t,
+            range_t: raw.range_t,
+            lsb_t: raw.lsb_t,
+            every_frames,
+            seed: raw.seed,
+            r_sb_b_m: raw.r_sb_b_m,
+        };
+        cfg.validate(path).map_err(|e| ctx.param(e))?;
+        Ok(Box::new(cfg))
+    }
 }

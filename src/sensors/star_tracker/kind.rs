@@ -5,9 +5,11 @@
 use flexdyn_proto::keys::{Topics, STAR_TRACKER_PREFIX};
 use flexdyn_proto::{decode_star_tracker, StarTrackerMsg};
 
-use super::StarTracker;
+use super::{schema, StarTracker, StarTrackerConfig};
 use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::State;
+use crate::schema::plausible::Implausible;
+use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
 use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
 
 /// The star-tracker kind.
@@ -15,6 +17,10 @@ pub static KIND: SensorKind = SensorKind {
     noun: "star tracker",
     a_noun: "a star tracker",
     config_array: "star_trackers",
+    config: SensorConfigReader {
+        keys: &schema::KEYS,
+        read: |t| read_boxed(t, schema::read),
+    },
     key_prefix: STAR_TRACKER_PREFIX,
     column_prefix: "st",
     message_name: "StarTrackerMsg",
@@ -52,9 +58,21 @@ fn build(
     _x: &State,
     out: &mut Vec<Box<dyn Sensor>>,
 ) -> Result<(), ConfigError> {
-    for (i, st) in cfg.star_trackers.iter().enumerate() {
+    for (i, st) in cfg.sensors.of::<StarTrackerConfig>().enumerate() {
         let path = format!("star_trackers[{i}]");
         out.push(Box::new(StarTracker::new(st.clone(), &path)?));
     }
     Ok(())
+}
+
+impl SensorParams for StarTrackerConfig {
+    fn sensor_kind() -> &'static SensorKind {
+        &KIND
+    }
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn implausible(&self, path: &str, out: &mut Vec<Implausible>) {
+        super::plausibility::check(self, path, out);
+    }
 }

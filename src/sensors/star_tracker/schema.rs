@@ -4,7 +4,10 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::StarTrackerConfig;
+use crate::config::{ConfigError, SensorContext};
 use crate::schema::{mat3, vec3, SchemaError, TableReader};
+use crate::sensors::params::{RawSensorConfig, SensorSpec};
 
 /// The keys of one `[[star_trackers]]` entry (the first six are required).
 pub(crate) const KEYS: [&str; 11] = [
@@ -53,4 +56,36 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawStarTracker, SchemaErro
         sun_exclusion_rad: t.opt_f64("sun_exclusion_rad")?.unwrap_or(0.0),
         max_rate_rad_s: t.opt_f64("max_rate_rad_s")?.unwrap_or(f64::INFINITY),
     })
+}
+
+impl RawSensorConfig for RawStarTracker {
+    /// Checks the name, converts the rate to frames and validates the values
+    /// ([`StarTrackerConfig::validate`]).
+    fn resolve(
+        self: Box<Self>,
+        ctx: &mut SensorContext<'_>,
+        path: &str,
+    ) -> Result<Box<dyn SensorSpec>, ConfigError> {
+        let raw = *self;
+        ctx.unique_name(path, &raw.name, "star tracker")?;
+        if let Err(e) = flexdyn_proto::validate_star_tracker_name(&raw.name) {
+            return Err(ctx.invalid(&format!("{path}.name"), e.to_string()));
+        }
+        let every_frames = ctx.every_frames(&format!("{path}.rate_hz"), raw.rate_hz, "tracker")?;
+        let cfg = StarTrackerConfig {
+            name: raw.name,
+            dcm_cb: raw.dcm_cb,
+            boresight_c: raw.boresight_c,
+            sigma_cross_boresight_rad: raw.sigma_cross_boresight_rad,
+            sigma_about_boresight_rad: raw.sigma_about_boresight_rad,
+            bias_c_rad: raw.bias_c_rad,
+            every_frames,
+            seed: raw.seed,
+            sun_direction_n: raw.sun_direction_n,
+            sun_exclusion_rad: raw.sun_exclusion_rad,
+            max_rate_rad_s: raw.max_rate_rad_s,
+        };
+        cfg.validate(path).map_err(|e| ctx.param(e))?;
+        Ok(Box::new(cfg))
+    }
 }

@@ -15,12 +15,13 @@ from .lockstep import Answer, LockstepParticipant, SensorSchedule, Tick
 from .proto import (CommandMsg, CssMsg, DecodeError, EffectorInput, EffectorState,
                     EnvironmentMsg, FssMsg, Header, ImuMsg, MagnetometerMsg, OperatorMsg,
                     StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
+from .proto import GpsMsg  # protocol 7
 
 __all__ = [
     "proto", "Client", "Subscription", "VehicleInfo", "session_config", "Answer",
     "LockstepParticipant", "SensorSchedule", "Tick", "CommandMsg", "DecodeError",
     "EffectorInput", "EffectorState", "EnvironmentMsg", "Header", "ImuMsg", "MagnetometerMsg", "StarTrackerMsg",
     "StateMsg",
-    "StatusMsg", "TimeMsg", "CssMsg", "FssMsg", "OperatorMsg",
+    "StatusMsg", "TimeMsg", "CssMsg", "FssMsg", "OperatorMsg", "GpsMsg",
 ]
 __version__ = "0.1.0"

@@ -70,6 +70,7 @@ class VehicleInfo:
 _DECODERS = {"state": StateMsg.decode, "imu": ImuMsg.decode, "st": StarTrackerMsg.decode,
              "mag": MagnetometerMsg.decode, "css": CssMsg.decode, "fss": FssMsg.decode,
              "time": TimeMsg.decode, "env": EnvironmentMsg.decode}
+_DECODERS["gps"] = proto.GpsMsg.decode  # protocol 7: tlm/gps/<name>
 
 
 class Subscription:
@@ -232,6 +233,12 @@ class Client:
         """Calls `callback` with every EnvironmentMsg (``flexdyn/<sc>/tlm/env``, truth at the
         configured ``[environment] telemetry_rate_hz``)."""
         return self._telemetry_add("env", callback)
+
+    def subscribe_gps(self, name: str, callback: Callable[[proto.GpsMsg], None]) -> Subscription:
+        """Calls `callback` with every solution of the GPS receiver `name`
+        (``flexdyn/<sc>/tlm/gps/<name>``, published its latency after the instant it is valid)."""
+        key = proto.gps_key(self.sc_id, name)
+        return self._telemetry_add(key[len(self._tlm_prefix):], callback)
 
     def _clock(self) -> threading.Condition:
         # Under _dispatch (not _lock: a callback that sends holds _dispatch, then takes _lock).

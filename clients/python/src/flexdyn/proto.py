@@ -1,11 +1,11 @@
-"""The flexdyn wire protocol, version 6, in pure Python.
+"""The flexdyn wire protocol, version 7, in pure Python.
 
 Every message of ``proto/README.md`` as a dataclass with ``encode()`` and ``decode(bytes)``.
 Decoding follows the README's decoder rules in the same order and raises :class:`DecodeError`
 with the same reasons as the Rust crate's ``DecodeError``:
 
 1. more than ``MAX_MESSAGE_BYTES`` -> ``TooLarge``;
-2. fewer than 2 bytes -> ``Length``; first two bytes (u16 LE) != 6 -> ``UnknownVersion``;
+2. fewer than 2 bytes -> ``Length``; first two bytes (u16 LE) != 7 -> ``UnknownVersion``;
 3. the total length from the layout (fixed; command tag at 34; walked counts, each bounded
    first) -> ``Length`` (needed = length implied by the counts read so far), ``Malformed``
    (unknown tag, count above its maximum), ``TrailingBytes``;
@@ -24,7 +24,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import ClassVar, List, Optional, Tuple
 
-PROTOCOL_VERSION = 6
+PROTOCOL_VERSION = 7
 HEADER_LEN = 30
 STATE_FIXED_LEN = 327
 STATE_EFFECTOR_COUNT_OFFSET = 319
@@ -45,6 +45,8 @@ FSS_LEN = 47
 MAX_CSS_DETECTORS = 16
 OPERATOR_LEN = 42
 ENVIRONMENT_LEN = 368
+# GPS receiver (protocol 7)
+GPS_LEN = 147
 MAX_EFFECTORS = 1024
 MAX_EFFECTOR_VALUES = 8
 MAX_MESSAGE_BYTES = 65536
@@ -78,6 +80,8 @@ OPERATOR_PAUSE, OPERATOR_RESUME, OPERATOR_RUN_TICKS = 0, 1, 2
 ENVIRONMENT_EPOCH_VALID, ENVIRONMENT_MAGNETIC, ENVIRONMENT_SUN = 0x1, 0x2, 0x4
 ENVIRONMENT_MOON, ENVIRONMENT_SHADOW, ENVIRONMENT_ATMOSPHERE = 0x8, 0x10, 0x20
 ECLIPSE_SUNLIT, ECLIPSE_PENUMBRA, ECLIPSE_UMBRA = 0, 1, 2
+# GpsMsg.flags (protocol 7)
+GPS_FIX, GPS_ECEF, GPS_INERTIAL = 0x1, 0x2, 0x4
 
 _HEADER = struct.Struct("<HIQQQ")
 
@@ -666,6 +670,40 @@ class EnvironmentMsg:
         return ("sunlit", "penumbra", "umbra")[self.eclipse] if self.eclipse <= 2 else "?"
 
 
+@dataclass
+class GpsMsg:
+    """A GPS receiver's solution (``flexdyn/<sc-id>/tlm/gps/<name>``, protocol 7), published
+    at ``header.sim_time_ns`` and valid at ``valid_sim_time_ns`` (the receiver's latency
+    earlier). ``flags``: ``GPS_FIX`` (else every number is 0), ``GPS_ECEF`` and ``GPS_INERTIAL``
+    (which frames' fields are output; the others are 0). ECEF: position of B from the Earth's
+    centre (m) and velocity relative to the Earth-fixed frame (m/s); N: inertial."""
+
+    header: Header = field(default_factory=Header)
+    valid_sim_time_ns: int = 0
+    gps_week: int = 0
+    gps_seconds_of_week: float = 0.0
+    r_be_e_m: Vec3 = (0.0, 0.0, 0.0)
+    v_be_e_m_s: Vec3 = (0.0, 0.0, 0.0)
+    r_bn_n_m: Vec3 = (0.0, 0.0, 0.0)
+    v_bn_n_m_s: Vec3 = (0.0, 0.0, 0.0)
+    flags: int = 0
+
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<QId12dB")
+
+    def encode(self) -> bytes:
+        return self.header.encode() + self._BODY.pack(
+            self.valid_sim_time_ns, self.gps_week, self.gps_seconds_of_week, *self.r_be_e_m,
+            *self.v_be_e_m_s, *self.r_bn_n_m, *self.v_bn_n_m_s, self.flags)
+
+    @staticmethod
+    def decode(buf: bytes) -> "GpsMsg":
+        _check_size_and_version(buf, GPS_LEN)
+        _check_total(GPS_LEN, buf)
+        f = GpsMsg._BODY.unpack_from(buf, HEADER_LEN)
+        v = lambda i: tuple(f[i:i + 3])  # noqa: E731
+        return GpsMsg(Header.unpack(buf), f[0], f[1], f[2], v(3), v(6), v(9), v(12), f[15])
+
+
 # --------------------------------------------------------------------------------------------
 # Key expressions (proto/README.md, "Topics").
 
@@ -713,6 +751,11 @@ def css_key(sc: str, name: str) -> str:
 
 def fss_key(sc: str, name: str) -> str:
     return _key(sc, "tlm/fss", name)
+
+
+def gps_key(sc: str, name: str) -> str:
+    """``flexdyn/<sc>/tlm/gps/<name>``: a GPS receiver (GpsMsg, protocol 7)."""
+    return _key(sc, "tlm/gps", name)
 
 
 def command_key(sc: str, sender_id: int) -> str:
