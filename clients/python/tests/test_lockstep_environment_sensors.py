@@ -1,5 +1,5 @@
-"""A Python lockstep participant gets the magnetometer and sun-sensor samples of each tick in
-its ``Tick`` (``scenarios/leo_environment.toml``: a magnetometer, a coarse-sun-sensor array and
+"""A Python lockstep participant gets the magnetometer, sun-sensor and GPS samples of each tick
+in its ``Tick`` (``scenarios/leo_environment.toml``: a magnetometer, a coarse-sun-sensor array and
 a fine sun sensor at 10 Hz), every due sample present, and each reads what its documented model
 says of the environment truth the server publishes at the same tick (``tlm/env``)."""
 
@@ -42,6 +42,17 @@ def test_a_lockstep_tick_carries_the_magnetometer_and_sun_sensors():
     assert all(set(t.coarse_sun_sensors) == {"css"} and set(t.fine_sun_sensors) == {"fss"}
                for t in with_mag)
     assert all(not t.coarse_sun_sensors for t in ticks if t.tick % 10)
+    # The GPS receiver (1 Hz, 0.2 s latency = 20 frames) measures at ticks 0 and 100 and
+    # publishes at 20 and 120; its solution says when it was valid.
+    gps = CONFIG["gps_receivers"][0]
+    latency = round(gps["latency_s"] * CONFIG["simulation"]["frame_hz"])
+    with_gps = [t for t in ticks if t.gps]
+    assert [t.tick for t in with_gps] == [latency, 100 + latency]
+    frame_ns = round(1e9 / CONFIG["simulation"]["frame_hz"])
+    for t in with_gps:
+        g = t.gps[gps["name"]]
+        assert g.valid_sim_time_ns == (t.tick - latency) * frame_ns
+        assert t.samples[f"gps/{gps['name']}"] is g
 
     mag = CONFIG["magnetometers"][0]
     css = CONFIG["coarse_sun_sensors"][0]

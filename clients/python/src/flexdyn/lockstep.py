@@ -104,6 +104,9 @@ class Tick:
     magnetometers: Dict[str, MagnetometerMsg] = field(default_factory=dict)
     coarse_sun_sensors: Dict[str, CssMsg] = field(default_factory=dict)
     fine_sun_sensors: Dict[str, FssMsg] = field(default_factory=dict)
+    #: GPS solutions published at this tick (not awaited: a receiver with latency publishes on
+    #: ticks of its own; in lockstep they still come before the state, so they are here).
+    gps: Dict[str, proto.GpsMsg] = field(default_factory=dict)
     #: Every sample of the tick by route (``<kind>/<name>``), also of kinds without a field
     #: above.
     samples: Dict[str, object] = field(default_factory=dict)
@@ -117,7 +120,8 @@ class Tick:
 
 
 #: The Tick attribute of each sensor key kind.
-_TICK_FIELD = {"imu": "imu", **{kind: attr for _, kind, attr in PERIODIC_KINDS}}
+_TICK_FIELD = {"imu": "imu", "gps": "gps",
+               **{kind: attr for _, kind, attr in PERIODIC_KINDS}}
 
 
 class LockstepParticipant:
