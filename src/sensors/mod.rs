@@ -265,8 +265,13 @@ mod tests {
             .join(format!("scenarios/{scenario}.toml"));
         let cfg = SimConfig::from_file(&path).unwrap();
         let mut sim = Simulation::new(&cfg).unwrap();
-        sim.step_frame();
-        sim.step_frame();
+        // Tick 20: every 10 Hz sensor is due at it (100 Hz frames), and the 1 Hz GPS receiver
+        // with 0.2 s latency publishes there what it measured at tick 0.
+        let tick: u64 = 20;
+        for k in 0..tick {
+            sim.sample_sensors(|s| s.due(k));
+            sim.step_frame();
+        }
         sim.sample_sensors(|_| true);
         let topics = Topics::new("sc1").unwrap();
         let bank = sim.sensors();
@@ -291,7 +296,7 @@ mod tests {
             let topic = classify(&key).unwrap();
             assert_eq!(topic.kind, TopicKind::sensor(kind).unwrap());
             assert_eq!(topic.kind.message_name(), kind.message_name);
-            let header = Header::new(1, 2, sim.t_sim_ns(), 2);
+            let header = Header::new(1, tick, sim.t_sim_ns(), tick);
             s.encode(header, &mut buf);
             let Decoded::Sensor {
                 header: h, json, ..
@@ -299,39 +304,43 @@ mod tests {
             else {
                 panic!("{key} did not decode as a sensor");
             };
-            assert_eq!((h.tick, h.sim_time_ns), (2, sim.t_sim_ns()));
+            assert_eq!((h.tick, h.sim_time_ns), (tick, sim.t_sim_ns()));
             let every = |e: Option<u64>| e.unwrap();
             let s = &cfg.sensors;
             let seq = match kind.noun {
                 "star tracker" => {
-                    2 / every(
+                    tick / every(
                         s.of::<star_tracker::StarTrackerConfig>()
                             .next()
                             .map(|c| c.every_frames),
                     )
                 }
                 "magnetometer" => {
-                    2 / every(
+                    tick / every(
                         s.of::<magnetometer::MagnetometerConfig>()
                             .next()
                             .map(|c| c.every_frames),
                     )
                 }
                 "coarse sun sensor" => {
-                    2 / every(
+                    tick / every(
                         s.of::<coarse_sun_sensor::CoarseSunSensorConfig>()
                             .next()
                             .map(|c| c.every_frames),
                     )
                 }
+                "GPS receiver" => {
+                    let g = s.of::<gps::GpsConfig>().next().unwrap();
+                    (tick - g.latency_frames) / g.every_frames
+                }
                 "fine sun sensor" => {
-                    2 / every(
+                    tick / every(
                         s.of::<fine_sun_sensor::FineSunSensorConfig>()
                             .next()
                             .map(|c| c.every_frames),
                     )
                 }
-                _ => 2,
+                _ => tick,
             };
             assert_eq!(h.seq, seq, "{key}");
             // Every field of the message, as the kind's default JSON names them.
