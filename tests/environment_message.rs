@@ -41,7 +41,7 @@ use flexdyn_proto::{
     Mode, StateMsg, TimeMsg, Topics,
 };
 use nalgebra::{Matrix3, Vector3};
-use server_support::{connecting_session, wait_until, ServerHandle};
+use server_support::{connecting_session, listening_session, wait_until, ServerHandle};
 use zenoh::Wait;
 
 const MU_M3_S2: f64 = 3.986_004_418e14;
@@ -81,8 +81,11 @@ fn run(cfg: SimConfig, duration_s: f64) -> Seen {
         ..ServerSettings::default()
     };
     let topics = Topics::new(&settings.sc_id).unwrap();
-    let mut server = ServerHandle::start(settings, cfg);
-    let session = connecting_session(server.port);
+    // The subscriber is declared before the run starts: a 1 s run at speed 2 lasts 0.5 s, and a
+    // subscriber that joined after the server had started missed every message but the last
+    // (CI: "first environment message at tick 100").
+    let (server_session, port) = listening_session();
+    let session = connecting_session(port);
     let seen: Arc<Mutex<Seen>> = Arc::default();
     let s = seen.clone();
     let (env_key, state_key, time_key) = (
@@ -116,6 +119,14 @@ fn run(cfg: SimConfig, duration_s: f64) -> Seen {
         })
         .wait()
         .unwrap();
+    let connected = || {
+        let info = session.info();
+        info.peers_zid().wait().count() + info.routers_zid().wait().count() > 0
+    };
+    assert!(wait_until(Duration::from_secs(10), connected));
+    // A margin for the subscription's declaration to reach the server's session.
+    std::thread::sleep(Duration::from_millis(300));
+    let mut server = ServerHandle::start_with_session(server_session, settings, cfg);
     let report = server.join(Duration::from_secs(60));
     server.stop();
     report.expect("the run ends normally");
