@@ -162,6 +162,19 @@ fn rw2_speeds(text: &str, frames: u64) -> Vec<f64> {
         .collect()
 }
 
+/// `text` with rw2's initial speed and bearing lines (from `omega_rad_s` through
+/// `coulomb_friction_nm`) replaced by `bearing`.
+fn with_rw2_bearing(text: &str, bearing: &str) -> String {
+    let rw2 = text.find("name = \"rw2\"").expect("acs_full has rw2");
+    let start = rw2 + text[rw2..].find("omega_rad_s = ").expect("rw2 omega_rad_s");
+    let coulomb = start
+        + text[start..]
+            .find("coulomb_friction_nm = ")
+            .expect("rw2 coulomb");
+    let end = coulomb + text[coulomb..].find('\n').expect("a line end");
+    format!("{}{bearing}{}", &text[..start], &text[end..])
+}
+
 /// `friction_scale` k adds (k − 1) τ_f(Ω) at each step's start to the motor torque: the wheel
 /// then spins down as a healthy wheel whose viscous and Coulomb coefficients are k times larger
 /// (W3: J_s Ω̇ = u + τ_f). Here the fault is on from t = 0 for 1.5 s, so both start alike. The
@@ -173,25 +186,30 @@ fn rw2_speeds(text: &str, frames: u64) -> Vec<f64> {
 /// less per second.
 #[test]
 fn wheel_friction_scale_is_a_k_times_rougher_bearing() {
-    let faulted = rw2_speeds(
-        &format!(
-            "{ACS_FULL}\n[[faults]]\ntarget = \"reaction_wheels.rw2\"\nmode = \"friction_scale\"\n\
-             factor = 10.0\nduration_s = 1.5\n"
-        ),
-        FRAMES,
-    );
     let bearing =
         "omega_rad_s = 100.0\nviscous_friction_nm_s_rad = 1.0e-6\ncoulomb_friction_nm = 5.0e-4";
     let rough =
         "omega_rad_s = 100.0\nviscous_friction_nm_s_rad = 1.0e-5\ncoulomb_friction_nm = 5.0e-3";
-    // rw2's bearing is the second of its kind in the file.
-    let at = ACS_FULL.match_indices(bearing).nth(1).unwrap().0;
-    let rough = format!(
-        "{}{rough}{}",
-        &ACS_FULL[..at],
-        &ACS_FULL[at + bearing.len()..]
+    // rw2 at the 100 rad/s, and steps of the 1 ms, the bound is derived for, whatever acs_full
+    // uses.
+    let (step, derived) = (
+        ACS_FULL
+            .lines()
+            .find(|l| l.starts_with("step_s = "))
+            .unwrap(),
+        "step_s = 0.001",
     );
-    let healthy = rw2_speeds(ACS_FULL, FRAMES);
+    let acs = ACS_FULL.replacen(step, derived, 1);
+    let base = with_rw2_bearing(&acs, bearing);
+    let faulted = rw2_speeds(
+        &format!(
+            "{base}\n[[faults]]\ntarget = \"reaction_wheels.rw2\"\nmode = \"friction_scale\"\n\
+             factor = 10.0\nduration_s = 1.5\n"
+        ),
+        FRAMES,
+    );
+    let rough = with_rw2_bearing(&acs, rough);
+    let healthy = rw2_speeds(&base, FRAMES);
     let reference = rw2_speeds(&rough, FRAMES);
     let per_step = 9.0 * 1e-6 * 0.12 * 1e-6 / (2.0 * 0.05);
     for (k, (f, r)) in faulted.iter().zip(&reference).take(15).enumerate() {
