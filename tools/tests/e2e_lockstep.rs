@@ -186,10 +186,15 @@ fn lockstep_run_settings(
 /// Re-minted for protocol version 6 (the sun sensors and operator control, which minted the same values; StateMsg's layout is unchanged): the first byte is now 6; hashing the new
 /// streams with it set back to 5 gives exactly the protocol-5 values (`8109363c…ac19bb583` and
 /// `566a9bd4…16687d6e3`).
+///
+/// Re-minted for protocol version 7 (the GPS receiver; StateMsg's layout is unchanged): the
+/// first byte is now 7; hashing the new streams with it set back to 6 gives exactly the
+/// protocol-6 values (`d992a508…cd2504f` and `6ca36611…e0b972d`), checked
+/// by running both tests with the byte rewritten before this re-mint.
 const GYRO_FEEDBACK_SHA256: &str =
-    "d992a5086b3d00278f3ae0741bd3e069eca9b0b4aedc5c1ed4c001c8ccd2504f";
+    "ca97b58575339f7ff6085e24795a85e2ba64c0eef03979480774559139f09efa";
 const WHEELS_ON_SENSORS_SHA256: &str =
-    "6ca36611ee5b9f67bcb5a9ad0d5c8238a735681531406e20b3e94cee5c0b972d";
+    "8fc9e7c7503f2f148b79464af8cb0db9befac50bc032b480def8257b61e64f37";
 
 fn digest(states: &[(u64, Vec<u8>)]) -> String {
     let mut h = Sha256::new();
