@@ -280,24 +280,45 @@ fn leo_simulation(environment: &str) -> flexdyn::sim::Simulation {
     flexdyn::sim::Simulation::new(&cfg).unwrap()
 }
 
-/// Median ns per `Simulation::step` (with its environment updates) over 15 batches of 5000.
-fn median_ns_per_sim_step(mut sim: flexdyn::sim::Simulation) -> f64 {
-    median_ns_per_sim_step_keeping(&mut sim)
-}
-
-/// [`median_ns_per_sim_step`] on a simulation the caller keeps.
-fn median_ns_per_sim_step_keeping(sim: &mut flexdyn::sim::Simulation) -> f64 {
+/// One batch of 5000 `Simulation::step`s (with their environment updates); returns the steps.
+fn step_batch(sim: &mut flexdyn::sim::Simulation) -> u64 {
     let steps = 5_000;
     sim.step_n(steps);
-    let per_step: Vec<f64> = (0..15)
-        .map(|_| {
+    steps
+}
+
+/// One batch of 50 frames of the server's frame loop: `step_frame`, then the sensors due at
+/// the next tick sampled, as `src/server/physics.rs` does; returns the steps.
+fn frame_batch(sim: &mut flexdyn::sim::Simulation) -> u64 {
+    let frames = 500;
+    for _ in 0..frames {
+        sim.step_frame();
+        let tick = sim.t_sim_ns() / sim.frame_ns();
+        sim.sample_sensors(|s| s.due(tick));
+    }
+    frames * sim.steps_per_frame()
+}
+
+/// Median ns per step of each simulation over 15 rounds, each round one warm batch of every
+/// simulation in turn: the rows of a table are measured interleaved, so a burst of load on the
+/// shared machine falls on all of them alike instead of on one row.
+fn interleaved_ns_per_step(
+    sims: &mut [flexdyn::sim::Simulation],
+    batch: fn(&mut flexdyn::sim::Simulation) -> u64,
+) -> Vec<f64> {
+    for sim in sims.iter_mut() {
+        batch(sim);
+    }
+    let mut per_step = vec![Vec::with_capacity(15); sims.len()];
+    for _ in 0..15 {
+        for (sim, samples) in sims.iter_mut().zip(per_step.iter_mut()) {
             let t = Instant::now();
-            sim.step_n(steps);
+            let steps = batch(sim);
             black_box(sim.spacecraft().state().omega_bn_b);
-            t.elapsed().as_secs_f64() * 1e9 / steps as f64
-        })
-        .collect();
-    median(per_step)
+            samples.push(t.elapsed().as_secs_f64() * 1e9 / steps as f64);
+        }
+    }
+    per_step.into_iter().map(median).collect()
 }
 
 /// Each environment model's and effector's cost per step in the LEO scenario (2 pairs, the OMM
@@ -338,19 +359,30 @@ fn world_summary(pair_ns: f64) {
         ),
         ("all @ 10 Hz", all.to_string()),
     ];
-    let base = median_ns_per_sim_step(leo_simulation(""));
-    let mut measured: Vec<(&str, f64)> = rows
-        .iter()
-        .map(|(name, env)| (*name, median_ns_per_sim_step(leo_simulation(env))))
-        .collect();
-    // The server's way: the model updates on the environment worker thread, the stepping
-    // thread only picks up each sample (`Simulation::offload_environment`; bit-identical).
+    // The last row is the server's way: the models update on the environment worker thread,
+    // the stepping thread only picks up each sample (`Simulation::offload_environment`;
+    // bit-identical).
     let mut offloaded = leo_simulation(all);
     offloaded.offload_environment().unwrap();
-    let ns = median_ns_per_sim_step_keeping(&mut offloaded);
-    let taken = offloaded.environment().unwrap().prefetched_samples();
-    measured.push(("all @ 10 Hz, offloaded", ns));
-    println!("\nSimulation::step in scenarios/leo_environment.toml, 2 pairs (median of 15 x 5000 steps):");
+    let mut sims: Vec<_> = std::iter::once(leo_simulation(""))
+        .chain(rows.iter().map(|(_, env)| leo_simulation(env)))
+        .chain(std::iter::once(offloaded))
+        .collect();
+    let ns = interleaved_ns_per_step(&mut sims, step_batch);
+    let taken = sims
+        .last()
+        .unwrap()
+        .environment()
+        .unwrap()
+        .prefetched_samples();
+    let base = ns[0];
+    let measured: Vec<(&str, f64)> = rows
+        .iter()
+        .map(|(name, _)| *name)
+        .chain(std::iter::once("all @ 10 Hz, offloaded"))
+        .zip(ns[1..].iter().copied())
+        .collect();
+    println!("\nSimulation::step in scenarios/leo_environment.toml, 2 pairs (median of 15 interleaved x 5000 steps):");
     print_added_cost("environment", base, &measured, pair_ns);
     println!("  (offloaded: {taken} of the updates came from the worker, the rest were evaluated on the stepping thread)");
 }
@@ -383,18 +415,65 @@ fn actuator_summary(pair_ns: f64) {
         sim.set_effector_inputs(inputs).unwrap();
         sim
     };
-    let base = median_ns_per_sim_step(with(String::new(), &[]));
-    let rods = median_ns_per_sim_step(with((0..3).map(rod).collect(), &[100.0, -50.0, 20.0]));
-    let thrusters = median_ns_per_sim_step(with((0..4).map(thruster).collect(), &[0.005; 4]));
+    let mut sims = [
+        with(String::new(), &[]),
+        with((0..3).map(rod).collect(), &[100.0, -50.0, 20.0]),
+        with((0..4).map(thruster).collect(), &[0.005; 4]),
+    ];
+    let [base, rods, thrusters] = interleaved_ns_per_step(&mut sims, step_batch)[..] else {
+        unreachable!("three simulations")
+    };
     let per_device = [
         ("magnetorquer", base + (rods - base) / 3.0),
         ("thruster", base + (thrusters - base) / 4.0),
     ];
     println!(
         "\nSimulation::step in scenarios/leo_environment.toml (all on @ 10 Hz), per actuator \
-         (3 rods: {rods:.1} ns/step, 4 thrusters firing: {thrusters:.1} ns/step; median of 15 x 5000 steps):"
+         (3 rods: {rods:.1} ns/step, 4 thrusters firing: {thrusters:.1} ns/step; median of 15 interleaved x 5000 steps):"
     );
     print_added_cost("one device", base, &per_device, pair_ns);
+}
+
+/// The cost per step of each sensor kind added with the environment (issue 20), one device each,
+/// in `scenarios/leo_environment.toml` (everything on at 10 Hz) with its own sensor entries:
+/// the frame loop with that one sensor against the same loop with none, and against one panel
+/// pair (`pair_ns`).
+fn sensor_summary(pair_ns: f64) {
+    let leo = include_str!("../scenarios/leo_environment.toml");
+    let start = leo.find("[[magnetometers]]").unwrap();
+    let sections = &leo[start..];
+    let section = |header: &str| {
+        let from = sections.find(header).unwrap();
+        let rest = &sections[from + header.len()..];
+        let to = rest.find("\n[[").map_or(rest.len(), |i| i + 1);
+        format!("{header}{}", &rest[..to])
+    };
+    let with = |extra: &str| {
+        let text = format!("{}\n{extra}", &leo[..start]);
+        let cfg = flexdyn::config::SimConfig::from_toml_str(&text).unwrap();
+        flexdyn::sim::Simulation::new(&cfg).unwrap()
+    };
+    let kinds = [
+        ("magnetometer", "[[magnetometers]]"),
+        ("coarse sun (6)", "[[coarse_sun_sensors]]"),
+        ("fine sun", "[[fine_sun_sensors]]"),
+        ("gps receiver", "[[gps_receivers]]"),
+    ];
+    let mut sims: Vec<_> = std::iter::once(with(""))
+        .chain(kinds.iter().map(|(_, header)| with(&section(header))))
+        .collect();
+    let ns = interleaved_ns_per_step(&mut sims, frame_batch);
+    let base = ns[0];
+    let rows: Vec<(&str, f64)> = kinds
+        .iter()
+        .map(|(name, _)| *name)
+        .zip(ns[1..].iter().copied())
+        .collect();
+    println!(
+        "\nframe loop in scenarios/leo_environment.toml (all on @ 10 Hz), per sensor, each at its \
+         scenario rate (median of 15 interleaved x 500 frames):"
+    );
+    print_added_cost("one device", base, &rows, pair_ns);
 }
 
 fn main() {
@@ -406,5 +485,6 @@ fn main() {
     environment_summary(fit(&rows).1);
     world_summary(fit(&rows).1);
     actuator_summary(fit(&rows).1);
+    sensor_summary(fit(&rows).1);
     peers(&rows);
 }
