@@ -331,3 +331,43 @@ fn validity_off_clears_only_the_flag() {
     );
     assert!(n > 0, "the healthy sun sensor is valid in the window");
 }
+
+/// LEO with its GPS receiver at 10 Hz (every 10th frame; the 0.2 s latency stays 20 frames),
+/// so the 1 s window holds 10 of its messages.
+fn leo_gps_10_hz() -> String {
+    let from = "rate_hz = 1.0\nseed = 51";
+    assert!(LEO.contains(from));
+    LEO.replacen(from, "rate_hz = 10.0\nseed = 51", 1)
+}
+
+#[test]
+fn bias_step_on_a_gps_position_moves_only_that_frame() {
+    let fault = "target = \"gps_receivers.gps1.position_e\"\nmode = \"bias_step\"\nvalue = 25.0";
+    compare(
+        &leo_gps_10_hz(),
+        fault,
+        "gps_receivers.gps1",
+        &["r_be_e_m"],
+        |_, _, _, x, _| Some(x + 25.0),
+    );
+}
+
+#[test]
+fn validity_off_makes_a_gps_message_a_no_fix_one() {
+    let n = validity_off(
+        &leo_gps_10_hz(),
+        "gps_receivers.gps1",
+        |m| {
+            // The module docs: FIX (bit 0) cleared and every number 0; the valid time and the
+            // frame flags stay.
+            m["flags"] = Value::from(m["flags"].as_u64().unwrap() & !1);
+            m["gps_week"] = Value::from(0);
+            m["gps_seconds_of_week"] = Value::from(0.0);
+            for key in ["r_be_e_m", "v_be_e_m_s", "r_bn_n_m", "v_bn_n_m_s"] {
+                m[key] = serde_json::json!([0.0, 0.0, 0.0]);
+            }
+        },
+        |m| m["flags"].as_u64().unwrap() & 1 == 1,
+    );
+    assert!(n >= 10, "{n} healthy GPS messages with a fix in the window");
+}

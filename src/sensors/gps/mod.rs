@@ -39,6 +39,13 @@
 //! Its normals come from the sensors' portable ChaCha8 + Marsaglia-polar generator
 //! ([`super::rng`]) seeded with `seed`: six per measurement (z_r then z_v), drawn whether or not
 //! there is a fix, so a seed reproduces the stream bit for bit in lockstep and offline.
+//!
+//! # Faults
+//! A `[[faults]]` entry on `gps_receivers.<name>` acts on the published message (the measurement
+//! leaving the latency ring, [`crate::faults`]): the value modes on the channels `position_e`,
+//! `velocity_e`, `position_n`, `velocity_n` (3 axes each; only the configured frames, only with a
+//! fix), `dropout`, and `validity_off`, which makes the message a no-fix one (`FIX` cleared,
+//! every number 0).
 
 use nalgebra::Vector3;
 
@@ -327,5 +334,49 @@ impl Sensor for Gps {
 
     fn as_any(&self) -> &dyn std::any::Any {
         self
+    }
+
+    /// The solution's vectors, each in the frame its name ends with; a channel whose frame is
+    /// not configured output, or a sample without a fix, exposes no axes (there is no solution
+    /// to corrupt, and a message without `FIX` keeps every number 0).
+    fn fault_channels(&self) -> &'static [&'static str] {
+        &["position_e", "velocity_e", "position_n", "velocity_n"]
+    }
+
+    fn fault_axes(&self, channel: usize) -> usize {
+        if channel < 4 {
+            3
+        } else {
+            0
+        }
+    }
+
+    fn fault_channel(&mut self, channel: usize) -> &mut [f64] {
+        let (c, s) = (&self.cfg, &mut self.last);
+        if !s.fix() {
+            return &mut [];
+        }
+        match channel {
+            0 if c.ecef => s.r_be_e_m.as_mut_slice(),
+            1 if c.ecef => s.v_be_e_m_s.as_mut_slice(),
+            2 if c.inertial => s.r_bn_n_m.as_mut_slice(),
+            3 if c.inertial => s.v_bn_n_m_s.as_mut_slice(),
+            _ => &mut [],
+        }
+    }
+
+    /// `FIX` is the validity flag.
+    fn has_validity(&self) -> bool {
+        true
+    }
+
+    /// The receiver reports no solution: `FIX` cleared and, as in any message without it,
+    /// every number 0 (the valid time and the frame flags stay).
+    fn force_invalid(&mut self) {
+        self.last = GpsSample {
+            valid_sim_time_ns: self.last.valid_sim_time_ns,
+            flags: self.last.flags & !gps_flags::FIX,
+            ..GpsSample::default()
+        };
     }
 }
