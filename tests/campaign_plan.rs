@@ -602,25 +602,40 @@ fn sensor_parameters_are_dispersed_and_read_back_from_the_built_sensors() {
         key = \"fine_sun_sensors[0].bias_rad[1]\"
         distribution = \"normal\"
         sigma = 1e-4
+        [[dispersions]]
+        key = \"gps_receivers[0].position_bias_e_m[2]\"
+        distribution = \"normal\"
+        sigma = 2.0
+        [[dispersions]]
+        key = \"gps_receivers[0].position_sigma_m\"
+        distribution = \"uniform\"
+        low = 1.0
+        high = 5.0
         "
     ))
     .unwrap();
     let (mut bias_x, mut noise, mut scale, mut fss_beta) = (vec![], vec![], vec![], vec![]);
+    let (mut gps_bias_z, mut gps_sigma) = (vec![], vec![]);
     for r in 0..300 {
         let model = read_back_exactly(&plan, r);
         bias_x.push(model["magnetometers[0].bias_s_t[0]"]);
         noise.push(model["magnetometers[0].noise_sigma_t"]);
         scale.push(model["coarse_sun_sensors[0].scale"]);
         fss_beta.push(model["fine_sun_sensors[0].bias_rad[1]"]);
+        gps_bias_z.push(model["gps_receivers[0].position_bias_e_m[2]"]);
+        gps_sigma.push(model["gps_receivers[0].position_sigma_m"]);
         // Untouched: the scenario's values.
         assert_eq!(model["magnetometers[0].lsb_t"], 1e-8);
         assert_eq!(model["fine_sun_sensors[0].bias_rad[0]"], 1.0e-4);
+        assert_eq!(model["gps_receivers[0].position_bias_e_m[0]"], 0.5);
     }
     // Normal dispersions are centred on the base value (scenario: 2e-7 T, 1.0, -5e-5 rad).
     check_normal("magnetometer bias x ~ N(2e-7, 1e-7)", &bias_x, 2e-7, 1e-7);
     check_uniform("magnetometer noise ~ U(1e-8, 1e-7)", &noise, 1e-8, 1e-7);
     check_normal("CSS scale ~ N(1, 0.02)", &scale, 1.0, 0.02);
     check_normal("FSS bias beta ~ N(-5e-5, 1e-4)", &fss_beta, -5e-5, 1e-4);
+    check_normal("GPS bias z ~ N(0.8, 2)", &gps_bias_z, 0.8, 2.0);
+    check_uniform("GPS position sigma ~ U(1, 5)", &gps_sigma, 1.0, 5.0);
 
     let e = campaign(&format!(
         "{head}[[dispersions]]\nkey = \"magnetometers[0].rate_hz\"\ndistribution = \"normal\"\nsigma = 1.0\n"

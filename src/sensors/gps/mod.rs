@@ -286,6 +286,21 @@ impl Sensor for Gps {
         &self.cfg.name
     }
 
+    /// The error terms (a campaign disperses them); the rate, latency and acquisition shape the
+    /// latency ring and the timing, so they are not dispersed.
+    fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        let c = &self.cfg;
+        out.push(("position_sigma_m".into(), c.position_sigma_m));
+        out.push(("velocity_sigma_m_s".into(), c.velocity_sigma_m_s));
+        for i in 0..3 {
+            out.push((format!("position_bias_e_m[{i}]"), c.position_bias_e_m[i]));
+            out.push((
+                format!("velocity_bias_e_m_s[{i}]"),
+                c.velocity_bias_e_m_s[i],
+            ));
+        }
+    }
+
     fn due(&self, tick: u64) -> bool {
         self.measures_at(tick) || self.publishes_at(tick)
     }
