@@ -200,6 +200,10 @@ pub enum Telemetry<'a> {
     /// `flexdyn/<sc>/tlm/css/<name>`: a [`crate::CssMsg`] of the coarse-sun-sensor array
     /// `name`.
     Css(&'a str),
+    /// `flexdyn/<sc>/tlm/fss/<name>`: an [`crate::FssMsg`] of the fine sun sensor `name`.
+    Fss(&'a str),
+    /// `flexdyn/<sc>/tlm/gps/<name>`: a [`crate::GpsMsg`] of the GPS receiver `name`.
+    Gps(&'a str),
 }
 
 /// All keys of one spacecraft, validated once.
@@ -323,6 +327,8 @@ impl Topics {
             .or_else(|| named(STAR_TRACKER_PREFIX).map(Telemetry::StarTracker))
             .or_else(|| named(MAGNETOMETER_PREFIX).map(Telemetry::Magnetometer))
             .or_else(|| named(CSS_PREFIX).map(Telemetry::Css))
+            .or_else(|| named(FSS_PREFIX).map(Telemetry::Fss))
+            .or_else(|| named(GPS_PREFIX).map(Telemetry::Gps))
     }
 
     /// `flexdyn/<sc>/tlm/imu/*`
@@ -421,13 +427,22 @@ mod tests {
             t.telemetry("flexdyn/sc-1/tlm/css/css"),
             Some(Telemetry::Css("css"))
         );
+        assert_eq!(
+            t.telemetry("flexdyn/sc-1/tlm/fss/fss"),
+            Some(Telemetry::Fss("fss"))
+        );
+        assert_eq!(
+            t.telemetry("flexdyn/sc-1/tlm/gps/g"),
+            Some(Telemetry::Gps("g"))
+        );
         for other in [
             "flexdyn/sc-2/tlm/state",
             "flexdyn/sc-1/tlm/state/x",
             "flexdyn/sc-1/tlm/imu",
             "flexdyn/sc-1/tlm/imu/",
             "flexdyn/sc-1/tlm/imu/a/b",
-            "flexdyn/sc-1/tlm/gps/g",
+            "flexdyn/sc-1/tlm/gps/a/b",
+            "flexdyn/sc-1/tlm/rel/g",
             "flexdyn/sc-1/status",
             "flexdyn/sc-1/cmd/1",
             "flexdyn/sc-10/tlm/state",

@@ -1,7 +1,9 @@
 //! Complete ticks for flight code that reads sensors.
 //!
-//! For each tick k the server publishes the sample of every IMU, and of every star tracker,
-//! magnetometer and coarse-sun-sensor array due at k, then the StateMsg of k (proto/README.md, "Lockstep protocol"). Flight code that answers
+//! For each tick k the server publishes the sample of every IMU, of every star tracker,
+//! magnetometer, coarse-sun-sensor array and fine sun sensor due at k, and of every GPS receiver
+//! whose solution is published at k, then the StateMsg of k (proto/README.md, "Lockstep
+//! protocol"). Flight code that answers
 //! tick k from exactly those samples is as deterministic as the server; flight code that uses
 //! whatever sample came last is not, because separate subscribers may be delivered on separate
 //! threads and a state can overtake a sample of its own tick. So:
@@ -18,8 +20,9 @@ use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
 use crate::{
-    decode_css, decode_imu, decode_magnetometer, decode_star_tracker, decode_state, CssMsg,
-    DecodeError, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, Telemetry, Topics,
+    decode_css, decode_fss, decode_gps, decode_imu, decode_magnetometer, decode_star_tracker,
+    decode_state, CssMsg, DecodeError, FssMsg, GpsMsg, ImuMsg, MagnetometerMsg, StarTrackerMsg,
+    StateMsg, Telemetry, Topics,
 };
 use zenoh::handlers::{RingChannel, RingChannelHandler};
 use zenoh::pubsub::Subscriber;
@@ -28,44 +31,76 @@ use zenoh::{Session, Wait};
 
 use crate::client::vehicle::{VehicleConfig, VehicleError};
 
-/// Which sensor samples the server publishes at each tick: every IMU each tick, and each star
-/// tracker, magnetometer and coarse-sun-sensor array on the ticks that are multiples of its
-/// period (from tick 0).
+/// A sensor that publishes on the ticks `offset + n · every` (n ≥ 0).
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct Periodic {
+    name: String,
+    /// \[frames\] its period.
+    every: u64,
+    /// \[frames\] its first publication (a GPS receiver's latency; 0 for the others).
+    offset: u64,
+}
+
+impl Periodic {
+    fn due(&self, tick: u64) -> bool {
+        tick >= self.offset && (tick - self.offset).is_multiple_of(self.every)
+    }
+}
+
+/// Which sensor samples the server publishes at each tick: every IMU each tick; each star
+/// tracker, magnetometer, coarse-sun-sensor array and fine sun sensor on the ticks that are
+/// multiples of its period (from tick 0); each GPS receiver on the ticks `latency + n · period`
+/// (its solutions, each published its latency after the instant it is valid).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SensorSchedule {
     imus: Vec<String>,
-    /// (name, period in frames)
-    star_trackers: Vec<(String, u64)>,
-    /// (name, period in frames)
-    magnetometers: Vec<(String, u64)>,
-    /// (name, period in frames)
-    coarse_sun_sensors: Vec<(String, u64)>,
+    star_trackers: Vec<Periodic>,
+    magnetometers: Vec<Periodic>,
+    coarse_sun_sensors: Vec<Periodic>,
+    fine_sun_sensors: Vec<Periodic>,
+    gps_receivers: Vec<Periodic>,
 }
 
 impl SensorSchedule {
     /// The schedule of a served configuration.
     pub fn from_config(cfg: &VehicleConfig) -> Result<Self, VehicleError> {
+        let periodic = |what: &str, name: &str, rate_hz: f64| {
+            Ok(Periodic {
+                name: name.to_owned(),
+                every: cfg.period_frames(what, name, rate_hz)?,
+                offset: 0,
+            })
+        };
         Ok(Self {
             imus: cfg.imus.iter().map(|i| i.name.clone()).collect(),
             star_trackers: cfg
                 .star_trackers
                 .iter()
-                .map(|st| Ok((st.name.clone(), cfg.star_tracker_period_frames(st)?)))
+                .map(|st| periodic("star tracker", &st.name, st.rate_hz))
                 .collect::<Result<_, VehicleError>>()?,
             magnetometers: cfg
                 .magnetometers
                 .iter()
-                .map(|m| {
-                    let every = cfg.period_frames("magnetometer", &m.name, m.rate_hz)?;
-                    Ok((m.name.clone(), every))
-                })
+                .map(|m| periodic("magnetometer", &m.name, m.rate_hz))
                 .collect::<Result<_, VehicleError>>()?,
             coarse_sun_sensors: cfg
                 .coarse_sun_sensors
                 .iter()
-                .map(|c| {
-                    let every = cfg.period_frames("coarse sun sensor", &c.name, c.rate_hz)?;
-                    Ok((c.name.clone(), every))
+                .map(|c| periodic("coarse sun sensor", &c.name, c.rate_hz))
+                .collect::<Result<_, VehicleError>>()?,
+            fine_sun_sensors: cfg
+                .fine_sun_sensors
+                .iter()
+                .map(|f| periodic("fine sun sensor", &f.name, f.rate_hz))
+                .collect::<Result<_, VehicleError>>()?,
+            gps_receivers: cfg
+                .gps_receivers
+                .iter()
+                .map(|g| {
+                    Ok(Periodic {
+                        offset: cfg.gps_latency_frames(g)?,
+                        ..periodic("GPS receiver", &g.name, g.rate_hz)?
+                    })
                 })
                 .collect::<Result<_, VehicleError>>()?,
         })
@@ -78,38 +113,53 @@ impl SensorSchedule {
 
     /// The star trackers (name, period in frames), in configuration order.
     pub fn star_trackers(&self) -> impl Iterator<Item = (&str, u64)> {
-        self.star_trackers.iter().map(|(n, p)| (n.as_str(), *p))
+        periods(&self.star_trackers)
     }
 
     /// The magnetometers (name, period in frames), in configuration order.
     pub fn magnetometers(&self) -> impl Iterator<Item = (&str, u64)> {
-        self.magnetometers.iter().map(|(n, p)| (n.as_str(), *p))
+        periods(&self.magnetometers)
     }
 
     /// The coarse-sun-sensor arrays (name, period in frames), in configuration order.
     pub fn coarse_sun_sensors(&self) -> impl Iterator<Item = (&str, u64)> {
-        self.coarse_sun_sensors
+        periods(&self.coarse_sun_sensors)
+    }
+
+    /// The fine sun sensors (name, period in frames), in configuration order.
+    pub fn fine_sun_sensors(&self) -> impl Iterator<Item = (&str, u64)> {
+        periods(&self.fine_sun_sensors)
+    }
+
+    /// The GPS receivers (name, period in frames, latency in frames), in configuration order.
+    pub fn gps_receivers(&self) -> impl Iterator<Item = (&str, u64, u64)> {
+        self.gps_receivers
             .iter()
-            .map(|(n, p)| (n.as_str(), *p))
+            .map(|p| (p.name.as_str(), p.every, p.offset))
     }
 }
 
+/// (name, period) of each entry of a periodic list.
+fn periods(list: &[Periodic]) -> impl Iterator<Item = (&str, u64)> {
+    list.iter().map(|p| (p.name.as_str(), p.every))
+}
+
 /// The index of `name` in a periodic list.
-fn position(list: &[(String, u64)], name: &str) -> Option<usize> {
-    list.iter().position(|(n, _)| n == name)
+fn position(list: &[Periodic], name: &str) -> Option<usize> {
+    list.iter().position(|p| p.name == name)
 }
 
 /// `<prefix>/<name>` of each sensor of a periodic list due at `tick` whose sample `have` lacks.
 fn missing_due<'a>(
-    list: &'a [(String, u64)],
+    list: &'a [Periodic],
     prefix: &'a str,
     tick: u64,
     have: impl Fn(usize) -> bool + 'a,
 ) -> impl Iterator<Item = String> + 'a {
     list.iter()
         .enumerate()
-        .filter(move |(i, (_, every))| tick.is_multiple_of(*every) && !have(*i))
-        .map(move |(_, (name, _))| format!("{prefix}/{name}"))
+        .filter(move |(i, p)| p.due(tick) && !have(*i))
+        .map(move |(_, p)| format!("{prefix}/{}", p.name))
 }
 
 /// One tick's telemetry: its state and the sensor samples due at it.
@@ -127,8 +177,14 @@ pub struct Tick {
     /// The coarse-sun-sensor array samples of the tick, in configuration order (`None`: not
     /// due, or lost).
     pub coarse_sun_sensors: Vec<Option<CssMsg>>,
-    /// The due samples that never came, as `imu/<name>`, `st/<name>`, `mag/<name>` or
-    /// `css/<name>`. Empty in lockstep unless a sample was lost.
+    /// The fine-sun-sensor samples of the tick, in configuration order (`None`: not due, or
+    /// lost).
+    pub fine_sun_sensors: Vec<Option<FssMsg>>,
+    /// The GPS solutions published at the tick, in configuration order (`None`: none published
+    /// at this tick, or lost); each is valid its receiver's latency before the tick.
+    pub gps_receivers: Vec<Option<GpsMsg>>,
+    /// The due samples that never came, as `imu/<name>`, `st/<name>`, `mag/<name>`,
+    /// `css/<name>`, `fss/<name>` or `gps/<name>`. Empty in lockstep unless a sample was lost.
     pub missing: Vec<String>,
 }
 
@@ -146,6 +202,8 @@ struct Partial {
     star_trackers: Vec<Option<StarTrackerMsg>>,
     magnetometers: Vec<Option<MagnetometerMsg>>,
     coarse_sun_sensors: Vec<Option<CssMsg>>,
+    fine_sun_sensors: Vec<Option<FssMsg>>,
+    gps_receivers: Vec<Option<GpsMsg>>,
 }
 
 impl Partial {
@@ -155,6 +213,8 @@ impl Partial {
             star_trackers: vec![None; s.star_trackers.len()],
             magnetometers: vec![None; s.magnetometers.len()],
             coarse_sun_sensors: vec![None; s.coarse_sun_sensors.len()],
+            fine_sun_sensors: vec![None; s.fine_sun_sensors.len()],
+            gps_receivers: vec![None; s.gps_receivers.len()],
         }
     }
 }
@@ -212,6 +272,8 @@ impl TickAssembler {
             Tracker(usize, StarTrackerMsg),
             Mag(usize, MagnetometerMsg),
             Css(usize, CssMsg),
+            Fss(usize, FssMsg),
+            Gps(usize, GpsMsg),
         }
         let s = &self.schedule;
         let msg = match topic {
@@ -236,6 +298,14 @@ impl TickAssembler {
                 Some(i) => Msg::Css(i, decode_css(payload)?),
                 None => return Ok(()),
             },
+            Telemetry::Fss(name) => match position(&s.fine_sun_sensors, name) {
+                Some(i) => Msg::Fss(i, decode_fss(payload)?),
+                None => return Ok(()),
+            },
+            Telemetry::Gps(name) => match position(&s.gps_receivers, name) {
+                Some(i) => Msg::Gps(i, decode_gps(payload)?),
+                None => return Ok(()),
+            },
         };
         let tick = match &msg {
             Msg::State(m) => m.header.tick,
@@ -243,6 +313,8 @@ impl TickAssembler {
             Msg::Tracker(_, m) => m.header.tick,
             Msg::Mag(_, m) => m.header.tick,
             Msg::Css(_, m) => m.header.tick,
+            Msg::Fss(_, m) => m.header.tick,
+            Msg::Gps(_, m) => m.header.tick,
         };
         if self.last.is_some_and(|last| tick <= last) {
             return Ok(()); // its tick was released already (it came after the time limit)
@@ -263,6 +335,8 @@ impl TickAssembler {
             Msg::Tracker(i, m) => self.partial_mut(tick).star_trackers[i] = Some(m),
             Msg::Mag(i, m) => self.partial_mut(tick).magnetometers[i] = Some(m),
             Msg::Css(i, m) => self.partial_mut(tick).coarse_sun_sensors[i] = Some(m),
+            Msg::Fss(i, m) => self.partial_mut(tick).fine_sun_sensors[i] = Some(m),
+            Msg::Gps(i, m) => self.partial_mut(tick).gps_receivers[i] = Some(m),
         }
         if self.held.is_some() && self.missing().is_empty() {
             if let Some(t) = self.release() {
@@ -280,7 +354,7 @@ impl TickAssembler {
     }
 
     /// The due samples of the held tick not received yet (`imu/<name>`, `st/<name>`,
-    /// `mag/<name>`, `css/<name>`).
+    /// `mag/<name>`, `css/<name>`, `fss/<name>`, `gps/<name>`).
     fn missing(&self) -> Vec<String> {
         let Some(tick) = self.held.as_ref().map(|h| h.header.tick) else {
             return Vec::new();
@@ -300,7 +374,18 @@ impl TickAssembler {
         let css = missing_due(&s.coarse_sun_sensors, "css", tick, |i| {
             part.is_some_and(|p| p.coarse_sun_sensors[i].is_some())
         });
-        imus.chain(sts).chain(mags).chain(css).collect()
+        let fss = missing_due(&s.fine_sun_sensors, "fss", tick, |i| {
+            part.is_some_and(|p| p.fine_sun_sensors[i].is_some())
+        });
+        let gps = missing_due(&s.gps_receivers, "gps", tick, |i| {
+            part.is_some_and(|p| p.gps_receivers[i].is_some())
+        });
+        imus.chain(sts)
+            .chain(mags)
+            .chain(css)
+            .chain(fss)
+            .chain(gps)
+            .collect()
     }
 
     /// The tick whose state is held, waiting for samples.
@@ -327,6 +412,8 @@ impl TickAssembler {
             star_trackers: p.star_trackers,
             magnetometers: p.magnetometers,
             coarse_sun_sensors: p.coarse_sun_sensors,
+            fine_sun_sensors: p.fine_sun_sensors,
+            gps_receivers: p.gps_receivers,
             missing,
         })
     }
@@ -443,11 +530,39 @@ mod tests {
     use crate::{encode, Header};
 
     fn schedule() -> SensorSchedule {
+        let every = |name: &str, every| Periodic {
+            name: name.into(),
+            every,
+            offset: 0,
+        };
         SensorSchedule {
             imus: vec!["hub".into(), "bracket".into()],
-            star_trackers: vec![("st1".into(), 10), ("st2".into(), 4)],
-            magnetometers: vec![("mag1".into(), 2)],
-            coarse_sun_sensors: vec![("css".into(), 5)],
+            star_trackers: vec![every("st1", 10), every("st2", 4)],
+            magnetometers: vec![every("mag1", 2)],
+            coarse_sun_sensors: vec![every("css", 5)],
+            fine_sun_sensors: vec![],
+            gps_receivers: vec![],
+        }
+    }
+
+    /// A fine sun sensor every 5 frames and a GPS receiver every 10 frames with a latency of 3:
+    /// its solutions are due at ticks 3, 13, 23, …, never at 0.
+    fn sun_and_gps_schedule() -> SensorSchedule {
+        SensorSchedule {
+            imus: vec![],
+            star_trackers: vec![],
+            magnetometers: vec![],
+            coarse_sun_sensors: vec![],
+            fine_sun_sensors: vec![Periodic {
+                name: "fss".into(),
+                every: 5,
+                offset: 0,
+            }],
+            gps_receivers: vec![Periodic {
+                name: "gps1".into(),
+                every: 10,
+                offset: 3,
+            }],
         }
     }
 
@@ -510,6 +625,22 @@ mod tests {
                 ..CssMsg::default()
             };
             self.push("flexdyn/sc1/tlm/css/css", encode(&m));
+        }
+        fn fss(&mut self, tick: u64) {
+            let m = FssMsg {
+                header: header(tick),
+                alpha_rad: tick as f64,
+                ..FssMsg::default()
+            };
+            self.push("flexdyn/sc1/tlm/fss/fss", encode(&m));
+        }
+        fn gps(&mut self, tick: u64, latency: u64) {
+            let m = GpsMsg {
+                header: header(tick),
+                valid_sim_time_ns: (tick - latency) * 10_000_000,
+                ..GpsMsg::default()
+            };
+            self.push("flexdyn/sc1/tlm/gps/gps1", encode(&m));
         }
         fn ticks(&self) -> Vec<(u64, Vec<String>)> {
             self.out
@@ -602,5 +733,36 @@ mod tests {
             .push("flexdyn/sc1/tlm/state", &[4, 0, 1], |t| out.push(t))
             .is_err());
         assert!(out.is_empty());
+    }
+
+    #[test]
+    fn fine_sun_and_gps_samples_are_awaited_at_their_own_ticks() {
+        let mut f = Feed::new();
+        f.a = TickAssembler::new(Topics::new("sc1").unwrap(), sun_and_gps_schedule());
+        // Tick 0: the sun sensor is due, the GPS receiver (latency 3) is not.
+        f.state(0);
+        assert_eq!(f.a.waiting(), Some(0));
+        f.fss(0);
+        assert_eq!(f.ticks(), [(0, vec![])]);
+        assert_eq!(f.out[0].fine_sun_sensors[0].unwrap().alpha_rad, 0.0);
+        assert_eq!(f.out[0].gps_receivers, [None]);
+        // Ticks 1, 2: nothing due.
+        f.state(1);
+        f.state(2);
+        assert_eq!(f.ticks().len(), 3);
+        // Tick 3: the first solution (valid at tick 0) is due.
+        f.state(3);
+        assert_eq!(f.a.waiting(), Some(3), "tick 3 released without gps/gps1");
+        f.gps(3, 3);
+        assert_eq!(f.ticks().last(), Some(&(3, vec![])));
+        assert_eq!(f.out[3].gps_receivers[0].unwrap().valid_sim_time_ns, 0);
+        // Tick 5: the sun sensor again; tick 13: the GPS again, lost, then given up.
+        f.state(5);
+        f.fss(5);
+        f.state(13);
+        assert_eq!(
+            f.a.give_up().map(|t| t.missing),
+            Some(vec!["gps/gps1".to_string()])
+        );
     }
 }

@@ -146,6 +146,12 @@ pub struct VehicleConfig {
     /// `[[coarse_sun_sensors]]`, in file order.
     #[serde(default)]
     pub coarse_sun_sensors: Vec<CoarseSunSensor>,
+    /// `[[fine_sun_sensors]]`, in file order.
+    #[serde(default)]
+    pub fine_sun_sensors: Vec<FineSunSensor>,
+    /// `[[gps_receivers]]`, in file order.
+    #[serde(default)]
+    pub gps_receivers: Vec<GpsReceiver>,
 }
 
 impl VehicleConfig {
@@ -203,6 +209,31 @@ impl VehicleConfig {
         find_named(&self.coarse_sun_sensors, "coarse_sun_sensors", name, |c| {
             &c.name
         })
+    }
+
+    /// The fine sun sensor `name`.
+    pub fn fine_sun_sensor(&self, name: &str) -> Result<&FineSunSensor, VehicleError> {
+        find_named(&self.fine_sun_sensors, "fine_sun_sensors", name, |f| {
+            &f.name
+        })
+    }
+
+    /// The GPS receiver `name`.
+    pub fn gps_receiver(&self, name: &str) -> Result<&GpsReceiver, VehicleError> {
+        find_named(&self.gps_receivers, "gps_receivers", name, |g| &g.name)
+    }
+
+    /// The latency of GPS receiver `gps` in frames: `latency_s` · `frame_hz`, which the server
+    /// accepts only as a whole number.
+    pub fn gps_latency_frames(&self, gps: &GpsReceiver) -> Result<u64, VehicleError> {
+        let frames = gps.latency_s * self.simulation.frame_hz;
+        if !(frames.is_finite() && frames >= 0.0 && (frames - frames.round()).abs() < 1e-9) {
+            return Err(VehicleError::Config(format!(
+                "GPS receiver `{}`: latency_s = {} is not a whole number of frames at {} Hz",
+                gps.name, gps.latency_s, self.simulation.frame_hz
+            )));
+        }
+        Ok(frames.round() as u64)
     }
 
     /// The period in frames of a sensor `what` `name` updating at `rate_hz`:
@@ -366,6 +397,30 @@ pub struct Magnetometer {
     pub rate_hz: f64,
 }
 
+/// One `[[fine_sun_sensors]]` entry.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct FineSunSensor {
+    /// Its name (topic `flexdyn/<sc>/tlm/fss/<name>`).
+    pub name: String,
+    /// [FB]: maps B components to the sensor frame F (boresight +z_F).
+    pub dcm_fb: [[f64; 3]; 3],
+    /// \[Hz\] update rate (a whole divisor of the frame rate).
+    pub rate_hz: f64,
+}
+
+/// One `[[gps_receivers]]` entry.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct GpsReceiver {
+    /// Its name (topic `flexdyn/<sc>/tlm/gps/<name>`).
+    pub name: String,
+    /// \[Hz\] solution rate (a whole divisor of the frame rate).
+    pub rate_hz: f64,
+    /// \[s\] from the instant a solution is valid to its publication (a whole number of
+    /// frames; 0 by default, as the server reads it).
+    #[serde(default)]
+    pub latency_s: f64,
+}
+
 /// One `[[coarse_sun_sensors]]` entry (an array of cosine detectors).
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 pub struct CoarseSunSensor {
@@ -408,6 +463,18 @@ name = "css"
 normals_b = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]]
 rate_hz = 0.0
 seed = 41
+[[fine_sun_sensors]]
+name = "fss"
+dcm_fb = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+rate_hz = 20.0
+[[gps_receivers]]
+name = "gps1"
+rate_hz = 1.0
+latency_s = 0.2
+[[gps_receivers]]
+name = "late"
+rate_hz = 1.0
+latency_s = 0.125
 "#;
 
     #[test]
@@ -449,6 +516,26 @@ seed = 41
             .to_string();
         assert!(
             e.contains("coarse sun sensor `css`: rate_hz = 0 does not divide"),
+            "{e}"
+        );
+        let fss = c.fine_sun_sensor("fss").unwrap();
+        assert_eq!(
+            (
+                fss.dcm_fb[1],
+                c.period_frames("fine sun sensor", "fss", fss.rate_hz)
+                    .unwrap()
+            ),
+            ([-1.0, 0.0, 0.0], 5)
+        );
+        // 0.2 s at 100 Hz is 20 frames; 0.125 s is 12.5, which the server refuses.
+        let gps = c.gps_receiver("gps1").unwrap();
+        assert_eq!(c.gps_latency_frames(gps).unwrap(), 20);
+        let e = c
+            .gps_latency_frames(c.gps_receiver("late").unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`late`: latency_s = 0.125 is not a whole number of frames"),
             "{e}"
         );
         let e = c.magnetometer("nope").unwrap_err().to_string();
