@@ -46,6 +46,7 @@ def test_a_lockstep_tick_carries_the_magnetometer_and_sun_sensors():
     # publishes at 20 and 120; its solution says when it was valid.
     gps = CONFIG["gps_receivers"][0]
     latency = round(gps["latency_s"] * CONFIG["simulation"]["frame_hz"])
+    assert schedule.delayed == ((f"gps/{gps['name']}", 100, latency),)
     with_gps = [t for t in ticks if t.gps]
     assert [t.tick for t in with_gps] == [latency, 100 + latency]
     frame_ns = round(1e9 / CONFIG["simulation"]["frame_hz"])

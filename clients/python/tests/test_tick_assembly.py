@@ -219,6 +219,10 @@ rate_hz = 20.0
 [[fine_sun_sensors]]
 name = "fss"
 rate_hz = 25.0
+[[gps_receivers]]
+name = "gps1"
+rate_hz = 10.0
+latency_s = 0.03
 """
 
 
@@ -227,9 +231,13 @@ def test_magnetometers_and_sun_sensors_are_scheduled_and_delivered_in_the_tick()
     s = flexdyn.SensorSchedule.from_config(flexdyn.VehicleInfo(
         "sc1", 1, ENV_SENSORS_TOML, "", None, None).config())
     assert s.others == (("mag/mag1", 10), ("css/css", 5), ("fss/fss", 4))
+    # The GPS receiver: every 10 frames, published 0.03 s · 100 Hz = 3 frames late (3, 13, …).
+    assert s.delayed == (("gps/gps1", 10, 3),)
     assert s.due(0) == ("imu/hub", "mag/mag1", "css/css", "fss/fss")
+    assert s.due(3) == ("imu/hub", "gps/gps1")
     assert s.due(5) == ("imu/hub", "css/css")
     assert s.due(8) == ("imu/hub", "fss/fss")
+    assert s.due(13) == ("imu/hub", "gps/gps1")
     assert s.due(10) == ("imu/hub", "mag/mag1", "css/css")
 
     c, seen = FakeClient(), []
@@ -252,4 +260,11 @@ def test_magnetometers_and_sun_sensors_are_scheduled_and_delivered_in_the_tick()
     c.feed("imu/hub", imu(1))
     c.feed("state", state(1))
     assert [t.tick for t in seen] == [0, 1] and seen[1].magnetometers == {}
+    # Tick 3: the GPS solution valid at tick 0 is awaited.
+    c.feed("imu/hub", imu(3))
+    c.feed("state", state(3))
+    assert [t.tick for t in seen] == [0, 1], "tick 3 answered without gps/gps1"
+    c.feed("gps/gps1", flexdyn.GpsMsg(header(3), valid_sim_time_ns=0, flags=1))
+    assert [t.tick for t in seen] == [0, 1, 3]
+    assert seen[2].gps["gps1"].valid_sim_time_ns == 0 and seen[2].missing == ()
     p.close()

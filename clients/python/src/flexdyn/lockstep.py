@@ -1,7 +1,7 @@
 """Lockstep participation with complete ticks.
 
 The server publishes, for each tick k, the sample of every sensor due at k (IMUs, star
-trackers, magnetometers, sun sensors), then the StateMsg of k (proto/README.md, "Lockstep protocol"). A controller that reads
+trackers, magnetometers, sun sensors, GPS solutions), then the StateMsg of k (proto/README.md, "Lockstep protocol"). A controller that reads
 sensors must answer tick k from exactly those samples; it is then as deterministic as the
 server. :class:`LockstepParticipant` makes sure of it:
 
@@ -68,13 +68,17 @@ class SensorSchedule:
     on the ticks that are multiples of its period, round(``simulation.frame_hz`` /
     ``rate_hz``) frames, from tick 0 (route ``st/<name>``), and the same for the other
     rate-driven kinds of :data:`PERIODIC_KINDS` (``mag/<name>``, ``css/<name>``,
-    ``fss/<name>``)."""
+    ``fss/<name>``); each ``[[gps_receivers]]`` entry on the ticks latency + n · period
+    (route ``gps/<name>``; latency = ``latency_s`` · ``frame_hz`` frames, 0 when absent: each
+    solution is published that long after the instant it is valid)."""
 
     imus: Tuple[str, ...]
     #: (name, period in frames)
     star_trackers: Tuple[Tuple[str, int], ...]
     #: (route, period in frames) of the magnetometers and sun sensors
     others: Tuple[Tuple[str, int], ...] = ()
+    #: (route, period in frames, latency in frames) of the GPS receivers
+    delayed: Tuple[Tuple[str, int, int], ...] = ()
 
     @classmethod
     def from_config(cls, config: dict) -> "SensorSchedule":
@@ -83,15 +87,26 @@ class SensorSchedule:
         others = tuple((f"{kind}/{name}", every)
                        for array, kind, _ in PERIODIC_KINDS[1:]
                        for name, every in _periods(config, array, frame_hz))
+        delayed = []
+        for (name, every), gps in zip(_periods(config, "gps_receivers", frame_hz),
+                                      config.get("gps_receivers", [])):
+            latency = float(gps.get("latency_s", 0.0)) * frame_hz
+            if not (math.isfinite(latency) and latency >= 0
+                    and abs(latency - round(latency)) < 1e-9):
+                raise ValueError(f"gps_receivers `{name}`.latency_s = {gps.get('latency_s')}: "
+                                 f"not a whole number of frames at {frame_hz} Hz")
+            delayed.append((f"gps/{name}", every, round(latency)))
         return cls(tuple(str(imu["name"]) for imu in config.get("imus", [])),
-                   _periods(config, "star_trackers", frame_hz), others)
+                   _periods(config, "star_trackers", frame_hz), others, tuple(delayed))
 
     def due(self, tick: int) -> Tuple[str, ...]:
         """The routes of the samples published at `tick` (``imu/<name>``, ``st/<name>``,
         ``mag/<name>``, ...)."""
         return tuple([f"imu/{n}" for n in self.imus]
                      + [f"st/{n}" for n, every in self.star_trackers if tick % every == 0]
-                     + [r for r, every in self.others if tick % every == 0])
+                     + [r for r, every in self.others if tick % every == 0]
+                     + [r for r, every, latency in self.delayed
+                        if tick >= latency and (tick - latency) % every == 0])
 
 
 @dataclass
@@ -104,8 +119,8 @@ class Tick:
     magnetometers: Dict[str, MagnetometerMsg] = field(default_factory=dict)
     coarse_sun_sensors: Dict[str, CssMsg] = field(default_factory=dict)
     fine_sun_sensors: Dict[str, FssMsg] = field(default_factory=dict)
-    #: GPS solutions published at this tick (not awaited: a receiver with latency publishes on
-    #: ticks of its own; in lockstep they still come before the state, so they are here).
+    #: GPS solutions published at this tick (a receiver with latency publishes on ticks of its
+    #: own, see :class:`SensorSchedule`; each says when it was valid).
     gps: Dict[str, proto.GpsMsg] = field(default_factory=dict)
     #: Every sample of the tick by route (``<kind>/<name>``), also of kinds without a field
     #: above.
