@@ -73,3 +73,64 @@ fn the_monitor_shows_the_eclipse_state_the_field_and_the_sensors() {
         assert!((9.0..=11.0).contains(&rate), "{name}: {line}");
     }
 }
+
+/// `--vehicles a,b`: two real-time servers (two vehicles, each on its own port, reached with two
+/// `--connect`s) give one line per vehicle each interval, prefixed with its id, each with that
+/// vehicle's own data: the reference spacecraft with no sensors, and the LEO scenario with its
+/// environment and sensors.
+#[test]
+fn the_monitor_gives_each_vehicle_its_own_line() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let leo = SimConfig::from_file(&root.join("scenarios/leo_environment.toml")).unwrap();
+    let reference = SimConfig::from_file(&root.join("scenarios/reference.toml")).unwrap();
+    let settings = |sc_id: &str| ServerSettings {
+        sc_id: sc_id.into(),
+        ..ServerSettings::default()
+    };
+    let mut a = ServerHandle::start(settings("chief"), reference);
+    let mut b = ServerHandle::start(settings("deputy"), leo);
+    let out = Command::new(env!("CARGO_BIN_EXE_flexdyn-monitor"))
+        .args([
+            "--connect",
+            &endpoint(a.port),
+            "--connect",
+            &endpoint(b.port),
+        ])
+        .args(["--vehicles", "chief,deputy", "--plain"])
+        .args(["--interval-s", "1", "--duration-s", "3.5"])
+        .output()
+        .unwrap();
+    for s in [&mut a, &mut b] {
+        s.stop();
+        s.join(Duration::from_secs(10)).unwrap();
+    }
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    // Three whole intervals, two lines each, in the order given.
+    assert!(lines.len() >= 6 && lines.len().is_multiple_of(2), "{stdout}");
+    let (chief, deputy) = (lines[lines.len() - 2], lines[lines.len() - 1]);
+    assert!(chief.starts_with("[chief] t="), "{chief}");
+    assert!(deputy.starts_with("[deputy] t="), "{deputy}");
+    // Each line is its own vehicle's: only the LEO vehicle has an environment and sensors.
+    assert!(
+        !chief.contains(" | env ") && !chief.contains(" | sensors "),
+        "{chief}"
+    );
+    assert!(
+        deputy.contains(" | env ") && deputy.contains("mag/mag1="),
+        "{deputy}"
+    );
+    for l in [chief, deputy] {
+        assert!(l.contains(" realtime running "), "{l}");
+    }
+
+    // An id listed twice is a usage error naming it.
+    let out = Command::new(env!("CARGO_BIN_EXE_flexdyn-monitor"))
+        .args(["--vehicles", "chief,chief", "--plain", "--duration-s", "0"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("\"chief\" is listed twice"), "{stderr}");
+}

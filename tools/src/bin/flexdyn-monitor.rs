@@ -9,6 +9,9 @@
 //! t=12.340s tick=1234 states/s=100.0 gaps=0 |sigma_bn|=0.1234 |omega|=0.0456rad/s flags=- latency_ms p50=0.120 p99=0.410 | realtime running lateness_us p50=3.1 p99=21.0 max=118.2 overruns=0 skipped=0 cmd_age_ms=10.0 stale=no rejected=0 dropped=0
 //! ```
 //!
+//! With `--vehicles a,b,…` it watches several vehicles (a fleet server's, or several servers'):
+//! one such line per vehicle each interval, prefixed `[<id>] `.
+//!
 //! Before any state arrives it prints `no data: no StateMsg on … yet`, and once states stop it
 //! prefixes `no data for N s; last:` and shows the server's final run state (`stopped`,
 //! `finished`, `failed`), or `running (no status for N s: server gone?)` if the server died.
@@ -60,6 +63,11 @@ struct Args {
     /// terminal UI. Implied when standard output is not a terminal.
     #[arg(long)]
     plain: bool,
+    /// Watch several vehicles (a fleet server's ids, or the ids of several servers reached
+    /// with repeated --connect), comma-separated: one summary per vehicle each interval, each
+    /// prefixed `[<id>]`. Default: the --sc-id vehicle alone.
+    #[arg(long, value_name = "SC_ID,...", value_delimiter = ',')]
+    vehicles: Vec<String>,
 }
 
 #[derive(Default)]
@@ -341,6 +349,134 @@ fn line(w: &mut Window, interval: Duration, state_topic: &str) -> String {
     out
 }
 
+/// One watched vehicle: its keys, what was heard in the current interval, and the subscribers
+/// feeding it (undeclared when it is dropped).
+struct Watch {
+    topics: flexdyn_proto::Topics,
+    window: Arc<Mutex<Window>>,
+    _subscribers: [zenoh::pubsub::Subscriber<()>; 4],
+}
+
+impl Watch {
+    /// Subscribes to the vehicle's state, status, environment and sensor keys.
+    fn declare(session: &zenoh::Session, topics: flexdyn_proto::Topics) -> anyhow::Result<Self> {
+        let window = Arc::new(Mutex::new(Window::default()));
+        let w = window.clone();
+        let _states = session
+            .declare_subscriber(topics.state())
+            .callback(move |sample| {
+                let received = unix_now_ns();
+                let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
+                match decode_state(&sample.payload().to_bytes()) {
+                    Ok(s) => {
+                        if let Some(last) = w.last_seq {
+                            w.gaps += s.header.seq.saturating_sub(last + 1);
+                        }
+                        w.last_seq = Some(s.header.seq);
+                        w.states += 1;
+                        w.tick = s.header.tick;
+                        w.sim_time_ns = s.header.sim_time_ns;
+                        w.sigma_norm = norm(s.sigma_bn);
+                        w.omega_norm = norm(s.omega_bn_b_rad_s);
+                        w.flags = s.command_flags;
+                        w.wheels.clear();
+                        w.wheels.extend(
+                            s.effectors
+                                .iter()
+                                .filter(|e| e.kind == effector_kind::REACTION_WHEEL)
+                                .map(|e| (e.states.first().copied().unwrap_or(f64::NAN), e.flags)),
+                        );
+                        w.actuators = actuators_str(&s.effectors);
+                        w.thetas.clear();
+                        w.thetas.extend(
+                            s.effectors
+                                .iter()
+                                .filter(|e| e.kind == effector_kind::PANEL_PAIR)
+                                .map(|e| {
+                                    let th =
+                                        |i: usize| e.states.get(i).copied().unwrap_or(f64::NAN);
+                                    (th(0), th(2))
+                                }),
+                        );
+                        w.last_state_at = Some(Instant::now());
+                        if let Some(stamp) = frame_stamp_ns(&sample) {
+                            w.latencies_ns.push(received.saturating_sub(stamp));
+                        }
+                    }
+                    Err(_) => w.undecodable += 1,
+                }
+            })
+            .wait()
+            .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.state()))?;
+        let w = window.clone();
+        let _status = session
+            .declare_subscriber(topics.status())
+            .callback(move |sample| {
+                if let Ok(s) = decode_status(&sample.payload().to_bytes()) {
+                    let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
+                    w.status = Some(s);
+                    w.last_status_at = Some(Instant::now());
+                }
+            })
+            .wait()
+            .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.status()))?;
+
+        let w = window.clone();
+        let env_key = topics.environment();
+        let _environment = session
+            .declare_subscriber(env_key.as_str())
+            .callback(move |sample| {
+                if let Ok(e) = decode_environment(&sample.payload().to_bytes()) {
+                    w.lock().unwrap_or_else(|p| p.into_inner()).environment = Some(e);
+                }
+            })
+            .wait()
+            .map_err(|e| anyhow::anyhow!("cannot subscribe to {env_key}: {e}"))?;
+        let w = window.clone();
+        // Every sensor key is `flexdyn/<sc>/tlm/<kind>/<name>`: two segments below `tlm`, which
+        // the state (`tlm/state`) and environment (`tlm/env`) keys do not have.
+        let sensor_keys = format!("flexdyn/{}/tlm/*/*", topics.sc_id());
+        let tlm_prefix = format!("flexdyn/{}/tlm/", topics.sc_id());
+        let _sensors = session
+            .declare_subscriber(sensor_keys.as_str())
+            .callback(move |sample| {
+                let key = sample.key_expr().as_str();
+                let name = key.strip_prefix(tlm_prefix.as_str()).unwrap_or(key);
+                let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
+                match w.sensors.get_mut(name) {
+                    Some(n) => *n += 1,
+                    None => {
+                        w.sensors.insert(name.to_owned(), 1);
+                    }
+                }
+            })
+            .wait()
+            .map_err(|e| anyhow::anyhow!("cannot subscribe to {sensor_keys}: {e}"))?;
+        Ok(Self {
+            topics,
+            window,
+            _subscribers: [_states, _status, _environment, _sensors],
+        })
+    }
+
+    /// Whether a state or a status was ever heard.
+    fn any_data(&self) -> bool {
+        let w = self.window.lock().unwrap_or_else(|p| p.into_inner());
+        w.last_state_at.is_some() || w.status.is_some()
+    }
+
+    /// The interval's summary line (see [`line`]), prefixed `[<id>] ` when `prefixed`.
+    fn line(&self, interval: Duration, prefixed: bool) -> String {
+        let mut w = self.window.lock().unwrap_or_else(|p| p.into_inner());
+        let text = line(&mut w, interval, self.topics.state());
+        if prefixed {
+            format!("[{}] {text}", self.topics.sc_id())
+        } else {
+            text
+        }
+    }
+}
+
 fn main() -> std::process::ExitCode {
     let args = match flexdyn_tools::parse_args::<Args>() {
         Ok(a) => a,
@@ -354,112 +490,43 @@ fn run(args: Args) -> anyhow::Result<()> {
     if !(args.interval_s.is_finite() && args.interval_s > 0.0) {
         return Err(flexdyn_tools::usage("--interval-s must be > 0"));
     }
-    let topics = args.common.topics()?;
+    let ids = if args.vehicles.is_empty() {
+        vec![args.common.sc_id.clone()]
+    } else {
+        args.vehicles.clone()
+    };
+    let mut topics = Vec::with_capacity(ids.len());
+    for id in &ids {
+        let t = flexdyn_proto::Topics::new(id)
+            .map_err(|e| flexdyn_tools::usage(format!("--vehicles {id:?}: {e}")))?;
+        if topics
+            .iter()
+            .any(|o: &flexdyn_proto::Topics| o.sc_id() == id)
+        {
+            return Err(flexdyn_tools::usage(format!(
+                "--vehicles: {id:?} is listed twice"
+            )));
+        }
+        topics.push(t);
+    }
     let session = args.common.open_session()?;
-    let window = Arc::new(Mutex::new(Window::default()));
-
-    let w = window.clone();
-    let _states = session
-        .declare_subscriber(topics.state())
-        .callback(move |sample| {
-            let received = unix_now_ns();
-            let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
-            match decode_state(&sample.payload().to_bytes()) {
-                Ok(s) => {
-                    if let Some(last) = w.last_seq {
-                        w.gaps += s.header.seq.saturating_sub(last + 1);
-                    }
-                    w.last_seq = Some(s.header.seq);
-                    w.states += 1;
-                    w.tick = s.header.tick;
-                    w.sim_time_ns = s.header.sim_time_ns;
-                    w.sigma_norm = norm(s.sigma_bn);
-                    w.omega_norm = norm(s.omega_bn_b_rad_s);
-                    w.flags = s.command_flags;
-                    w.wheels.clear();
-                    w.wheels.extend(
-                        s.effectors
-                            .iter()
-                            .filter(|e| e.kind == effector_kind::REACTION_WHEEL)
-                            .map(|e| (e.states.first().copied().unwrap_or(f64::NAN), e.flags)),
-                    );
-                    w.actuators = actuators_str(&s.effectors);
-                    w.thetas.clear();
-                    w.thetas.extend(
-                        s.effectors
-                            .iter()
-                            .filter(|e| e.kind == effector_kind::PANEL_PAIR)
-                            .map(|e| {
-                                let th = |i: usize| e.states.get(i).copied().unwrap_or(f64::NAN);
-                                (th(0), th(2))
-                            }),
-                    );
-                    w.last_state_at = Some(Instant::now());
-                    if let Some(stamp) = frame_stamp_ns(&sample) {
-                        w.latencies_ns.push(received.saturating_sub(stamp));
-                    }
-                }
-                Err(_) => w.undecodable += 1,
-            }
-        })
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.state()))?;
-    let w = window.clone();
-    let _status = session
-        .declare_subscriber(topics.status())
-        .callback(move |sample| {
-            if let Ok(s) = decode_status(&sample.payload().to_bytes()) {
-                let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
-                w.status = Some(s);
-                w.last_status_at = Some(Instant::now());
-            }
-        })
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.status()))?;
-
-    let w = window.clone();
-    let env_key = topics.environment();
-    let _environment = session
-        .declare_subscriber(env_key.as_str())
-        .callback(move |sample| {
-            if let Ok(e) = decode_environment(&sample.payload().to_bytes()) {
-                w.lock().unwrap_or_else(|p| p.into_inner()).environment = Some(e);
-            }
-        })
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot subscribe to {env_key}: {e}"))?;
-    let w = window.clone();
-    // Every sensor key is `flexdyn/<sc>/tlm/<kind>/<name>`: two segments below `tlm`, which
-    // the state (`tlm/state`) and environment (`tlm/env`) keys do not have.
-    let sensor_keys = format!("flexdyn/{}/tlm/*/*", topics.sc_id());
-    let tlm_prefix = format!("flexdyn/{}/tlm/", topics.sc_id());
-    let _sensors = session
-        .declare_subscriber(sensor_keys.as_str())
-        .callback(move |sample| {
-            let key = sample.key_expr().as_str();
-            let name = key.strip_prefix(tlm_prefix.as_str()).unwrap_or(key);
-            let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
-            match w.sensors.get_mut(name) {
-                Some(n) => *n += 1,
-                None => {
-                    w.sensors.insert(name.to_owned(), 1);
-                }
-            }
-        })
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot subscribe to {sensor_keys}: {e}"))?;
-
-    tracing::info!(
-        state = topics.state(),
-        status = topics.status(),
-        "flexdyn-monitor watching (Ctrl-C to stop)"
-    );
+    let mut watches = Vec::with_capacity(topics.len());
+    for t in topics {
+        watches.push(Watch::declare(&session, t)?);
+    }
+    for w in &watches {
+        tracing::info!(
+            state = w.topics.state(),
+            status = w.topics.status(),
+            "flexdyn-monitor watching (Ctrl-C to stop)"
+        );
+    }
     let stop = flexdyn_tools::stop_on_signals()?;
     let interval = Duration::from_secs_f64(args.interval_s);
     let tui = !args.plain && std::io::stdout().is_terminal();
     if tui {
-        let result = run_tui(&window, &stop, interval, &args, topics.state());
-        drop((_states, _status, _environment, _sensors));
+        let result = run_tui(&watches, &stop, interval, &args);
+        drop(watches);
         let _ = session.close().wait();
         return result;
     }
@@ -473,13 +540,15 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
         let now = Instant::now();
         if end.is_some_and(|end| now >= end) {
-            let w = window.lock().unwrap_or_else(|p| p.into_inner());
-            if w.last_state_at.is_none() && w.status.is_none() {
+            if !watches.iter().any(Watch::any_data) {
+                let keys: Vec<String> = watches
+                    .iter()
+                    .map(|w| format!("{} or {}", w.topics.state(), w.topics.status()))
+                    .collect();
                 anyhow::bail!(
-                    "no data: nothing received on {} or {} during --duration-s: no server, or it \
-                     is not reachable at the --connect endpoint",
-                    topics.state(),
-                    topics.status()
+                    "no data: nothing received on {} during --duration-s: no server, or it is \
+                     not reachable at the --connect endpoint",
+                    keys.join(", nor on ")
                 );
             }
             break;
@@ -493,18 +562,18 @@ fn run(args: Args) -> anyhow::Result<()> {
             continue;
         }
         next += interval;
-        let text = line(
-            &mut window.lock().unwrap_or_else(|p| p.into_inner()),
-            interval,
-            topics.state(),
-        );
+        let several = watches.len() > 1;
+        let text: Vec<String> = watches.iter().map(|w| w.line(interval, several)).collect();
         let mut out = std::io::stdout().lock();
-        if writeln!(out, "{text}").and_then(|()| out.flush()).is_err() {
+        if writeln!(out, "{}", text.join("\n"))
+            .and_then(|()| out.flush())
+            .is_err()
+        {
             // The reader went away (a closed pipe): stop quietly.
             break;
         }
     }
-    drop((_states, _status, _environment, _sensors));
+    drop(watches);
     session
         .close()
         .wait()
@@ -513,13 +582,13 @@ fn run(args: Args) -> anyhow::Result<()> {
 }
 
 /// The terminal UI loop: sparkline samples and a redraw every 100 ms, the summary text every
-/// `interval`; ends on q/Esc/Ctrl-C, a signal, or `--duration-s`.
+/// `interval`; ends on q/Esc/Ctrl-C, a signal, or `--duration-s`. With several vehicles each
+/// summary segment and sparkline title carries its vehicle's id.
 fn run_tui(
-    window: &Arc<Mutex<Window>>,
+    watches: &[Watch],
     stop: &std::sync::atomic::AtomicBool,
     interval: Duration,
     args: &Args,
-    state_topic: &str,
 ) -> anyhow::Result<()> {
     use flexdyn_tools::monitor_tui::{render, Screen, Series};
     use ratatui::crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers};
@@ -529,14 +598,22 @@ fn run_tui(
     let end = args
         .duration_s
         .map(|s| Instant::now() + Duration::from_secs_f64(s.max(0.0)));
+    let several = watches.len() > 1;
+    let ids: Vec<&str> = watches.iter().map(|w| w.topics.sc_id()).collect();
+    let tag = |i: usize, title: &str| {
+        if several {
+            format!("{} {title}", ids[i])
+        } else {
+            title.to_owned()
+        }
+    };
     let mut screen = Screen {
-        title: format!("flexdyn-monitor {}", args.common.sc_id),
-        summary: vec![format!("waiting for {state_topic} …")],
-        series: vec![
-            Series::new("|σ_BN| (–)"),
-            Series::new("|ω_BN| (rad/s)"),
-            Series::new("frame lateness p99 (µs)"),
-        ],
+        title: format!("flexdyn-monitor {}", ids.join(", ")),
+        summary: watches
+            .iter()
+            .map(|w| format!("waiting for {} …", w.topics.state()))
+            .collect(),
+        series: Vec::new(),
     };
     let mut next_summary = Instant::now() + interval;
     let mut any_data = false;
@@ -546,20 +623,17 @@ fn run_tui(
         {
             break Ok(());
         }
-        {
-            let mut w = window.lock().unwrap_or_else(|p| p.into_inner());
+        let summary_due = Instant::now() >= next_summary;
+        if summary_due {
+            next_summary += interval;
+            screen.summary.clear();
+        }
+        for (i, watch) in watches.iter().enumerate() {
+            let mut w = watch.window.lock().unwrap_or_else(|p| p.into_inner());
             any_data |= w.last_state_at.is_some() || w.status.is_some();
-            if w.last_state_at.is_some() {
-                screen.series[0].push(w.sigma_norm);
-                screen.series[1].push(w.omega_norm);
-            }
-            let p99 = w
-                .status
-                .as_ref()
-                .map_or(f64::NAN, |s| s.timing.lateness_p99_ns as f64 * 1e-3);
-            screen.series[2].push(p99);
-            // One sparkline per panel angle, added as pairs appear, and the shadow factor once
-            // an environment message with a shadow model arrives.
+            // One sparkline per quantity (and vehicle), added as its data appears: |σ_BN|,
+            // |ω_BN|, the p99 lateness, each panel angle, and the shadow factor once an
+            // environment message with a shadow model arrives.
             let mut push =
                 |title: String, v: f64| match screen.series.iter_mut().find(|s| s.title == title) {
                     Some(s) => s.push(v),
@@ -569,9 +643,19 @@ fn run_tui(
                         screen.series.push(s);
                     }
                 };
+            if w.last_state_at.is_some() {
+                push(tag(i, "|σ_BN| (–)"), w.sigma_norm);
+                push(tag(i, "|ω_BN| (rad/s)"), w.omega_norm);
+            }
+            if let Some(s) = &w.status {
+                push(
+                    tag(i, "frame lateness p99 (µs)"),
+                    s.timing.lateness_p99_ns as f64 * 1e-3,
+                );
+            }
             for (k, (th1, th2)) in w.thetas.clone().into_iter().enumerate() {
                 for (j, th) in [(1, th1), (2, th2)] {
-                    push(format!("pair{} |θ{j}| (rad)", k + 1), th.abs());
+                    push(tag(i, &format!("pair{} |θ{j}| (rad)", k + 1)), th.abs());
                 }
             }
             if let Some(env) = w
@@ -579,16 +663,23 @@ fn run_tui(
                 .as_ref()
                 .filter(|e| e.flags & environment_flags::SHADOW != 0)
             {
-                push("shadow factor ν (1 sunlit)".to_owned(), env.shadow_factor);
+                push(tag(i, "shadow factor ν (1 sunlit)"), env.shadow_factor);
             }
-            if Instant::now() >= next_summary {
-                next_summary += interval;
-                let text = line(&mut w, interval, state_topic);
-                screen.summary = text.split(" | ").map(str::to_owned).collect();
-                if let Some(s) = &w.status {
+            if summary_due {
+                let text = line(&mut w, interval, watch.topics.state());
+                let mut segments = text.split(" | ").map(str::to_owned);
+                if let Some(first) = segments.next() {
+                    screen.summary.push(if several {
+                        format!("[{}] {first}", ids[i])
+                    } else {
+                        first
+                    });
+                }
+                screen.summary.extend(segments);
+                if let (false, Some(s)) = (several, &w.status) {
                     screen.title = format!(
                         "flexdyn-monitor {} — {} {}",
-                        args.common.sc_id,
+                        ids[i],
                         mode_name(s.mode),
                         run_state_name(s.run_state)
                     );
