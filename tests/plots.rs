@@ -180,6 +180,7 @@ fn args(input: &Path) -> PlotArgs {
         output: PathBuf::new(),
         sc_id: None,
         sigma_rn: None,
+        relative_to: None,
     }
 }
 
@@ -524,4 +525,114 @@ fn sun_sensor_figures_from_a_simulate_csv() {
         .all(|s| s.points.iter().all(|p| p.1 == 0.0)));
     let fine = find(&figs, "sun_sensors_fine.png");
     assert_eq!(fine.panels.len(), 2);
+}
+
+/// `--relative-to`: a recording of two vehicles written here, the chief on a circular orbit of
+/// radius R and the deputy held at a fixed offset ρ_H = (30, 100, −20) m in the chief's Hill
+/// frame (its inertial state from `deputy_state_n`, the frame's own inverse). The figure must
+/// show that offset, a zero rate seen in H and the constant range |ρ_H|, at every recorded
+/// instant; then the bad uses are errors naming the flag or the file.
+#[test]
+fn relative_motion_shows_the_deputy_in_the_chiefs_hill_frame() {
+    use flexdyn::sinks::mcap_file::{McapSink, RecordingInfo};
+    use flexdyn::world::relative::deputy_state_n;
+    use flexdyn_proto::{encode, Header, StateMsg};
+    use nalgebra::Vector3;
+
+    let rec = tmp("pair.mcap");
+    let info = RecordingInfo {
+        recorder: "tests/plots.rs".into(),
+        command_line: String::new(),
+    };
+    let mut sink = McapSink::create(&rec, &info).unwrap();
+    let (r_m, mu): (f64, f64) = (7.0e6, 3.986004418e14);
+    let n = (mu / (r_m * r_m * r_m)).sqrt();
+    let offset_h = Vector3::new(30.0, 100.0, -20.0);
+    for k in 0..50u64 {
+        let t_ns = k * 10_000_000_000;
+        let th = n * t_ns as f64 * 1e-9;
+        let rc = Vector3::new(r_m * th.cos(), r_m * th.sin(), 0.0);
+        let vc = Vector3::new(-r_m * n * th.sin(), r_m * n * th.cos(), 0.0);
+        let (rd, vd) = deputy_state_n(&rc, &vc, &offset_h, &Vector3::zeros()).unwrap();
+        for (id, num, r, v) in [("chief", 1, rc, vc), ("deputy", 2, rd, vd)] {
+            let m = StateMsg {
+                header: Header::new(num, k, t_ns, k),
+                r_bn_n_m: r.into(),
+                v_bn_n_m_s: v.into(),
+                ..StateMsg::default()
+            };
+            let key = format!("flexdyn/{id}/tlm/state");
+            sink.write(&key, &encode(&m), None, t_ns).unwrap();
+        }
+    }
+    sink.finish().unwrap();
+
+    let mut a = args(&rec);
+    a.sc_id = Some("deputy".into());
+    a.relative_to = Some("chief".into());
+    let (figs, _) = figures(&a).unwrap();
+    let f = find(&figs, "relative_motion.png");
+    let [pos, rate, range, range_rate] = &f.panels[..] else {
+        panic!("four panels, got {}", f.panels.len())
+    };
+    for (k, want) in offset_h.iter().enumerate() {
+        let pts = &pos.lines[k].points;
+        assert_eq!(pts.len(), 50);
+        for (t, x) in pts {
+            assert!(
+                (x - want).abs() < 1e-6,
+                "axis {k} at {t} s: {x} m, want {want}"
+            );
+        }
+        // ρ' = C_HN (v_d − v_c) − ω × ρ: zero for a fixed offset, up to rounding of 7e3 m/s.
+        assert!(rate.lines[k].points.iter().all(|(_, v)| v.abs() < 1e-8));
+    }
+    let norm = offset_h.norm();
+    assert!(range.lines[0]
+        .points
+        .iter()
+        .all(|(_, r)| (r - norm).abs() < 1e-6));
+    assert!(range_rate.lines[0]
+        .points
+        .iter()
+        .all(|(_, v)| v.abs() < 1e-8));
+    check_axis_bounds(std::slice::from_ref(f));
+
+    // Without --relative-to there is no such figure; the CLI draws it with.
+    let (figs, _) = figures(&args(&rec)).unwrap();
+    assert!(figs.iter().all(|f| f.name != "relative_motion.png"));
+    let out = tmp("relative_png");
+    let r = flexdyn(&[
+        "plot",
+        rec.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--sc-id",
+        "deputy",
+        "--relative-to",
+        "chief",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    check_figures(&out, &["relative_motion.png"]);
+
+    // Errors: the plotted vehicle itself, a vehicle not in the file, a CSV.
+    a.relative_to = Some("deputy".into());
+    let e = figures(&a).err().unwrap().to_string();
+    assert!(
+        e.contains("--relative-to") && e.contains("the plotted vehicle itself"),
+        "{e}"
+    );
+    a.relative_to = Some("nobody".into());
+    let e = figures(&a).err().unwrap().to_string();
+    assert!(
+        e.contains("pair.mcap") && e.contains("no StateMsg of spacecraft \"nobody\""),
+        "{e}"
+    );
+    let mut c = args(Path::new("x.csv"));
+    c.relative_to = Some("chief".into());
+    let e = figures(&c).err().unwrap().to_string();
+    assert!(
+        e.contains("--relative-to") && e.contains("needs a recording"),
+        "{e}"
+    );
 }

@@ -19,6 +19,9 @@
 //!   the shadow factor;
 //! - `star_tracker.png`: each star tracker's measured q_CN and its valid / status flags;
 //! - `imu.png`: each IMU's measured rate and specific force, one column per IMU;
+//! - `relative_motion.png` (with `--relative-to CHIEF`, from a recording of several vehicles):
+//!   the plotted vehicle's hub point B relative to CHIEF's in CHIEF's Hill frame, its rate seen
+//!   in that frame, range and range rate;
 //! - `timing.png`: frame lateness p50/p99/max from StatusMsg and the overrun count (real time
 //!   only: a lockstep or batch run is not paced by the wall clock, so it is skipped and says so).
 //!
@@ -81,6 +84,10 @@ pub struct PlotArgs {
         allow_hyphen_values = true
     )]
     pub sigma_rn: Option<Vec<f64>>,
+    /// With a recording of several vehicles: adds `relative_motion.png`, the plotted vehicle's
+    /// hub point B relative to vehicle CHIEF's, in CHIEF's Hill frame.
+    #[arg(long = "relative-to", value_name = "CHIEF")]
+    pub relative_to: Option<String>,
 }
 
 /// Named columns over time.
@@ -139,6 +146,8 @@ struct PlotData {
     environment: Columns,
     /// The pacing mode of the recorded run (from its StatusMsg; none in a CSV).
     mode: Option<flexdyn_proto::Mode>,
+    /// `--relative-to`: the chief's id and its state columns.
+    chief: Option<(String, Columns)>,
 }
 
 fn input_err(path: &Path, problem: impl Into<String>) -> SinkError {
@@ -148,7 +157,11 @@ fn input_err(path: &Path, problem: impl Into<String>) -> SinkError {
     }
 }
 
-fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
+fn from_mcap(
+    path: &Path,
+    sc_id: Option<&str>,
+    relative_to: Option<&str>,
+) -> Result<PlotData, SinkError> {
     let rec = read_recording(path)?;
     if let Some(why) = &rec.truncated {
         tracing::warn!(file = %path.display(), reason = %why, "the recording ends early; plotting what it holds");
@@ -161,11 +174,28 @@ fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
             .find_map(|s| classify(&s.key).map(|t| t.sc_id.to_owned()))
             .ok_or_else(|| input_err(path, "holds no flexdyn channel"))?,
     };
-    let mut data = PlotData::default();
+    if relative_to == Some(sc.as_str()) {
+        return Err(SinkError::Arg {
+            flag: "--relative-to",
+            problem: format!("{sc:?} is the plotted vehicle itself (choose it with --sc-id)"),
+        });
+    }
+    let mut data = PlotData {
+        chief: relative_to.map(|c| (c.to_owned(), Columns::default())),
+        ..PlotData::default()
+    };
     for s in &rec.samples {
         let Some(topic) = classify(&s.key) else {
             continue;
         };
+        if let Some((chief, states)) = &mut data.chief {
+            if topic.sc_id == chief.as_str() && topic.kind == TopicKind::State {
+                if let Ok(d) = Decoded::decode(topic.kind, &s.payload) {
+                    states.push(&row(&d));
+                }
+                continue;
+            }
+        }
         if topic.sc_id != sc {
             continue;
         }
@@ -195,6 +225,14 @@ fn from_mcap(path: &Path, sc_id: Option<&str>) -> Result<PlotData, SinkError> {
             path,
             format!("holds no StateMsg of spacecraft {sc:?}"),
         ));
+    }
+    if let Some((chief, states)) = &data.chief {
+        if states.is_empty() {
+            return Err(input_err(
+                path,
+                format!("holds no StateMsg of spacecraft {chief:?} (--relative-to)"),
+            ));
+        }
     }
     Ok(data)
 }
@@ -713,7 +751,16 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mcap"));
     let data = if is_mcap {
-        from_mcap(&args.input, args.sc_id.as_deref())?
+        from_mcap(
+            &args.input,
+            args.sc_id.as_deref(),
+            args.relative_to.as_deref(),
+        )?
+    } else if args.relative_to.is_some() {
+        return Err(SinkError::Arg {
+            flag: "--relative-to",
+            problem: "needs a recording (.mcap) of several vehicles; a CSV holds one".into(),
+        });
     } else {
         from_csv(&args.input)?
     };
@@ -771,6 +818,23 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
     ) {
         Some(p) => fig("rates.png", "Body angular rate ω_BN".into(), vec![p]),
         None => skip("rates.png", "no omega_bn_b_rad_s columns"),
+    }
+    if let Some((chief, states)) = &data.chief {
+        match relative_motion(s, states) {
+            Some(panels) => fig(
+                "relative_motion.png",
+                format!(
+                    "Hub point B relative to {chief}'s, in {chief}'s Hill frame \
+                     (x radial, y along-track, z orbit normal)"
+                ),
+                panels,
+            ),
+            None => skip(
+                "relative_motion.png",
+                "no instant with both vehicles' r_bn_n_m and v_bn_n_m_s, or the chief has no \
+                 orbit plane",
+            ),
+        }
     }
     let mut pairs = Vec::new();
     for k in 1.. {
@@ -1014,6 +1078,79 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
 /// The disturbance figure's panels: per environment source, |τ_B| and |F_B| from its
 /// `<source>_torque_b_nm_1..3` / `<source>_force_b_newton_1..3` columns (log axes: the sources
 /// differ by orders of magnitude), and the shadow factor. `None` without the record.
+/// The deputy's hub point B relative to the chief's, at the instants both were recorded, in the
+/// chief's Hill frame ([`crate::world::relative_state_hill`], with the hub points standing in
+/// for the centres of mass: the relative state of the points the StateMsg carries): position,
+/// its rate seen in that frame, range and range rate.
+fn relative_motion(deputy: &Columns, chief: &Columns) -> Option<Vec<Panel>> {
+    let (rd, vd) = (deputy.vec3("r_bn_n_m")?, deputy.vec3("v_bn_n_m_s")?);
+    let (rc, vc) = (chief.vec3("r_bn_n_m")?, chief.vec3("v_bn_n_m_s")?);
+    // Recorded instants are whole nanoseconds: match them exactly.
+    let ns = |t: f64| (t * 1e9).round() as i64;
+    let at: BTreeMap<i64, usize> = chief
+        .t_s
+        .iter()
+        .enumerate()
+        .map(|(j, t)| (ns(*t), j))
+        .collect();
+    let v3 = |c: [&Vec<f64>; 3], k: usize| nalgebra::Vector3::new(c[0][k], c[1][k], c[2][k]);
+    let (mut t, mut r_h, mut v_h) = (
+        Vec::new(),
+        [vec![], vec![], vec![]],
+        [vec![], vec![], vec![]],
+    );
+    let (mut range, mut range_rate) = (Vec::new(), Vec::new());
+    for (i, td) in deputy.t_s.iter().enumerate() {
+        let Some(&j) = at.get(&ns(*td)) else {
+            continue;
+        };
+        let Some(rel) =
+            crate::world::relative_state_hill(&v3(rc, j), &v3(vc, j), &v3(rd, i), &v3(vd, i))
+        else {
+            continue;
+        };
+        t.push(*td);
+        for k in 0..3 {
+            r_h[k].push(rel.r_dc_h_m[k]);
+            v_h[k].push(rel.v_dc_h_m_s[k]);
+        }
+        range.push(rel.range_m);
+        range_rate.push(rel.range_rate_m_s);
+    }
+    if t.is_empty() {
+        return None;
+    }
+    let xyz = |c: &[Vec<f64>; 3], unit: &str| {
+        vec![
+            line(&format!("x radial ({unit})"), &t, &c[0]),
+            line(&format!("y along-track ({unit})"), &t, &c[1]),
+            line(&format!("z normal ({unit})"), &t, &c[2]),
+        ]
+    };
+    Some(vec![
+        Panel {
+            y_label: "position in H (m)".into(),
+            lines: xyz(&r_h, "m"),
+            ..Panel::default()
+        },
+        Panel {
+            y_label: "rate seen in H (m/s)".into(),
+            lines: xyz(&v_h, "m/s"),
+            ..Panel::default()
+        },
+        Panel {
+            y_label: "range (m)".into(),
+            lines: vec![line("range", &t, &range)],
+            ..Panel::default()
+        },
+        Panel {
+            y_label: "range rate (m/s)".into(),
+            lines: vec![line("range rate", &t, &range_rate)],
+            ..Panel::default()
+        },
+    ])
+}
+
 fn disturbance_panels(env: &Columns) -> Option<Vec<Panel>> {
     if env.is_empty() {
         return None;
