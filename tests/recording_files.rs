@@ -627,3 +627,99 @@ fn python_mcap_decodes_the_environment_channel() {
         assert_eq!((r[week], r[flags]), ("2446", "7"));
     }
 }
+
+/// Several vehicles in one recording (issue 22: `record` must handle them): two servers, each a
+/// vehicle under its own id on its own port, recorded by one `flexdyn record` connected to both.
+/// The file describes both vehicles, holds each one's contiguous state stream with its own
+/// spacecraft id, and `plot --relative-to` draws one relative to the other from it.
+#[test]
+fn one_recording_holds_several_vehicles() {
+    let scenario = |name: &str| root().join("scenarios").join(name);
+    let (mut chief, e1) = spawn_listening(
+        flexdyn()
+            .args([
+                "run",
+                "--duration-s",
+                "8",
+                "--sc-id",
+                "chief",
+                "--spacecraft-id",
+                "1",
+            ])
+            .args(["--listen", ports::ANY_PORT, "--config"])
+            .arg(scenario("reference.toml")),
+    );
+    let (mut deputy, e2) = spawn_listening(
+        flexdyn()
+            .args([
+                "run",
+                "--duration-s",
+                "8",
+                "--sc-id",
+                "deputy",
+                "--spacecraft-id",
+                "2",
+            ])
+            .args(["--listen", ports::ANY_PORT, "--config"])
+            .arg(scenario("leo_environment.toml")),
+    );
+    let file = tmp("two_vehicles.mcap");
+    let _ = std::fs::remove_file(&file);
+    let status = flexdyn()
+        .args([
+            "record",
+            "--connect",
+            &e1,
+            "--connect",
+            &e2,
+            "--duration-s",
+            "3",
+            "-o",
+        ])
+        .arg(&file)
+        .stdout(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success());
+    for server in [&mut chief, &mut deputy] {
+        server.0.kill().unwrap();
+        let _ = server.0.wait();
+    }
+    let rec = read_recording(&file).unwrap();
+    assert!(rec.truncated.is_none(), "{:?}", rec.truncated);
+    let mut described: Vec<String> = rec.vehicles().into_iter().map(|v| v.sc_id).collect();
+    described.sort();
+    assert_eq!(described, ["chief", "deputy"]);
+    for (sc, id) in [("chief", 1), ("deputy", 2)] {
+        let key = format!("flexdyn/{sc}/tlm/state");
+        let states: Vec<_> = rec
+            .samples
+            .iter()
+            .filter(|s| s.key == key)
+            .map(|s| decode_state(&s.payload).unwrap())
+            .collect();
+        // About 3 s at 100 Hz, each stream contiguous and stamped with its vehicle's id.
+        assert!(states.len() >= 150, "{sc}: {} states", states.len());
+        assert!(states
+            .windows(2)
+            .all(|w| w[1].header.tick == w[0].header.tick + 1));
+        assert!(states.iter().all(|s| s.header.spacecraft_id == id), "{sc}");
+    }
+    // Both scenarios step 100 Hz frames from t = 0, so the recorded instants coincide.
+    let out = tmp("two_vehicles_plots");
+    let r = flexdyn()
+        .arg("plot")
+        .arg(&file)
+        .args([
+            "-o",
+            out.to_str().unwrap(),
+            "--sc-id",
+            "deputy",
+            "--relative-to",
+            "chief",
+        ])
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(out.join("relative_motion.png").is_file());
+}
