@@ -441,3 +441,82 @@ fn a_recording_plays_back_with_seek() {
         seen.messages[&1].len()
     );
 }
+
+/// Several vehicles in one view (issue 22: `view` must handle them): two servers, each a
+/// vehicle under its own id on its own port, and one viewer connected to both. The viewer
+/// advertises each vehicle's state, transforms and scene, and each vehicle's transforms name
+/// only frames under its own id, so the two share one 3D scene without clashing.
+#[test]
+fn the_viewer_shows_every_vehicle_it_hears() {
+    let mut chief = flexdyn(&[
+        "run",
+        "--duration-s",
+        "60",
+        "--sc-id",
+        "chief",
+        "--listen",
+        ANY_PORT,
+    ]);
+    let e1 = zenoh_endpoint(&mut chief.0);
+    let mut deputy = flexdyn(&[
+        "run",
+        "--duration-s",
+        "60",
+        "--sc-id",
+        "deputy",
+        "--spacecraft-id",
+        "2",
+        "--listen",
+        ANY_PORT,
+    ]);
+    let e2 = zenoh_endpoint(&mut deputy.0);
+    let mut viewer = flexdyn(&[
+        "view",
+        "--bind",
+        "127.0.0.1:0",
+        "--connect",
+        &e1,
+        "--connect",
+        &e2,
+        "--duration-s",
+        "60",
+    ]);
+    let wport = ws_port(&mut viewer.0);
+    let topic = |sc: &str, suffix: &str| format!("/flexdyn/{sc}/{suffix}");
+    let rt = tokio::runtime::Runtime::new().unwrap();
+    let seen = rt.block_on(async {
+        let mut ws = connect(wport, "foxglove.websocket.v1").await;
+        let mut seen = Seen::default();
+        pump_until(&mut ws, &mut seen, Duration::from_secs(30), |s| {
+            ["chief", "deputy"].iter().all(|sc| {
+                ["tlm/state", "tf", "scene"]
+                    .iter()
+                    .all(|x| s.channels.contains_key(&topic(sc, x)))
+            })
+        })
+        .await;
+        let subscriptions: Vec<Value> = ["chief", "deputy"]
+            .iter()
+            .enumerate()
+            .map(|(i, sc)| json!({"id": 10 + i, "channelId": seen.channels[&topic(sc, "tf")].0}))
+            .collect();
+        let msg = json!({"op": "subscribe", "subscriptions": subscriptions}).to_string();
+        ws.send(Message::Text(msg.into())).await.unwrap();
+        pump_until(&mut ws, &mut seen, Duration::from_secs(30), |s| {
+            (10..12).all(|id| s.messages.get(&id).is_some_and(|m| m.len() >= 5))
+        })
+        .await;
+        let _ = ws.close(None).await;
+        seen
+    });
+    for (id, sc) in [(10, "chief"), (11, "deputy")] {
+        for (_, tf) in &seen.messages[&id] {
+            let transforms = tf["transforms"].as_array().unwrap();
+            assert!(!transforms.is_empty(), "{sc}: {tf}");
+            for t in transforms {
+                let child = t["child_frame_id"].as_str().unwrap();
+                assert!(child.starts_with(&format!("{sc}/")), "{sc}: {tf}");
+            }
+        }
+    }
+}
