@@ -116,6 +116,12 @@ pub struct Shared {
     bad_effector_input: AtomicU64,
     wrong_identity: AtomicU64,
     operator_refused: AtomicU64,
+    fault_refused: AtomicU64,
+    /// The faults active at the last frame published: their count and the bits of indices
+    /// 0–255 ([`flexdyn_proto::StatusMsg::faults_active_bits`]), stored by whoever publishes
+    /// the frame (atomics: the physics side never waits for StatusMsg).
+    faults_active: AtomicU64,
+    faults_active_bits: [AtomicU64; 4],
     /// The operator's hold target (`flexdyn/<sc>/operator`): 0 = none, `h + 1` = hold at the
     /// first frame boundary `k ≥ h` (see [`Self::holds_at`]). Set by the operator callback, read
     /// by whoever steps the frames (one atomic load per frame).
@@ -269,6 +275,33 @@ impl Shared {
         bump(&self.operator_refused);
     }
 
+    /// Count a fault command the server did not apply.
+    pub fn reject_fault(&self) {
+        bump(&self.fault_refused);
+    }
+
+    /// Notes the faults active at the frame just published (allocation- and lock-free).
+    pub fn set_faults_active(&self, count: u64, bits: &[u64; 4]) {
+        self.faults_active.store(count, Ordering::Relaxed);
+        for (a, b) in self.faults_active_bits.iter().zip(bits) {
+            a.store(*b, Ordering::Relaxed);
+        }
+    }
+
+    /// The faults active at the last frame published: (count, bits), as StatusMsg carries them.
+    pub fn faults_active(&self) -> (u64, [u64; 4]) {
+        let l = |c: &AtomicU64| c.load(Ordering::Relaxed);
+        (
+            l(&self.faults_active),
+            [
+                l(&self.faults_active_bits[0]),
+                l(&self.faults_active_bits[1]),
+                l(&self.faults_active_bits[2]),
+                l(&self.faults_active_bits[3]),
+            ],
+        )
+    }
+
     /// The operator's hold target: hold at the first frame boundary at or after this tick.
     pub fn hold_target(&self) -> Option<u64> {
         self.hold_target.load(Ordering::Acquire).checked_sub(1)
@@ -325,6 +358,7 @@ impl Shared {
             bad_effector_input: l(&self.bad_effector_input),
             wrong_identity: l(&self.wrong_identity),
             operator_refused: l(&self.operator_refused),
+            fault_refused: l(&self.fault_refused),
         }
     }
 

@@ -90,6 +90,7 @@ struct Publishing {
 impl TelemetryCtx {
     fn publish_status(&self, p: &mut Publishing, buf: &mut Vec<u8>, rec: Option<&Recording>) {
         let tick = self.shared.tick.load(Ordering::Relaxed);
+        let (faults_active, faults_active_bits) = self.shared.faults_active();
         let msg = StatusMsg {
             header: Header::new(
                 self.settings.spacecraft_id,
@@ -108,6 +109,8 @@ impl TelemetryCtx {
             rejected: self.shared.rejected(),
             commands_dropped: self.shared.commands_dropped.load(Ordering::Relaxed),
             wall_time_unix_ns: unix_now_ns(),
+            faults_active,
+            faults_active_bits,
         };
         p.status_seq += 1;
         encode_into(&msg, buf);
