@@ -39,6 +39,12 @@ pub struct Frame {
     /// Already published by the thread that finished the frame (`handoff = "direct"`): the
     /// telemetry thread only records it and keeps the books.
     pub published: bool,
+    /// The fault activations and clearances seen up to this tick and not yet published
+    /// (FaultEventMsg, after the state), within the capacity reserved
+    /// ([`Self::with_fault_events`]); more wait for the next frame.
+    pub fault_events: Vec<flexdyn_proto::FaultEventMsg>,
+    /// The faults active at this tick: count and the bits of indices 0–255 (StatusMsg).
+    pub faults_active: (u64, [u64; 4]),
 }
 
 impl Frame {
@@ -59,7 +65,16 @@ impl Frame {
                 .collect(),
             environment: None,
             published: false,
+            fault_events: Vec::new(),
+            faults_active: (0, [0; 4]),
         }
+    }
+
+    /// Room for `n` fault events per frame (the simulation's
+    /// [`crate::faults::Faults::event_capacity`]), so filling them does not allocate.
+    pub fn with_fault_events(mut self, n: usize) -> Self {
+        self.fault_events = Vec::with_capacity(n);
+        self
     }
 }
 
@@ -117,6 +132,11 @@ pub struct Shared {
     wrong_identity: AtomicU64,
     operator_refused: AtomicU64,
     fault_refused: AtomicU64,
+    /// Fault requests the physics side refused ([`crate::faults::ports::INSTALL_REFUSALS`]),
+    /// and the code of the last one, for the telemetry thread's log.
+    pub faults_refused_physics: AtomicU64,
+    /// See [`Self::faults_refused_physics`].
+    pub last_fault_refusal: AtomicU8,
     /// The faults active at the last frame published: their count and the bits of indices
     /// 0–255 ([`flexdyn_proto::StatusMsg::faults_active_bits`]), stored by whoever publishes
     /// the frame (atomics: the physics side never waits for StatusMsg).
@@ -277,6 +297,14 @@ impl Shared {
 
     /// Count a fault command the server did not apply.
     pub fn reject_fault(&self) {
+        bump(&self.fault_refused);
+    }
+
+    /// Count a fault request the physics side refused, with its reason's code
+    /// (allocation- and lock-free).
+    pub fn reject_fault_physics(&self, code: u8) {
+        self.last_fault_refusal.store(code, Ordering::Relaxed);
+        bump(&self.faults_refused_physics);
         bump(&self.fault_refused);
     }
 
