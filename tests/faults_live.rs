@@ -16,9 +16,9 @@ use std::time::Duration;
 use flexdyn::config::SimConfig;
 use flexdyn::server::{Handoff, ServerSettings};
 use flexdyn_proto::{
-    decode_fault_event, decode_imu, decode_state, encode, CommandMsg, FaultAction,
-    FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget, Header, Mode, OperatorAction,
-    OperatorMsg, RunState, Topics,
+    decode_fault_event, decode_imu, decode_state, encode, CommandMsg, FaultAction, FaultCommandMsg,
+    FaultEventMsg, FaultSource, FaultTarget, Header, Mode, OperatorAction, OperatorMsg, RunState,
+    Topics,
 };
 use server_support::{connecting_session, wait_until, Observer, ServerHandle};
 use zenoh::{Session, Wait};
@@ -207,7 +207,10 @@ fn live_fault_lands_at_its_tick(handoff: Handoff) {
     // Active while held at K + 2, cleared by the end.
     let held = held.unwrap();
     assert_eq!(held.header.tick, K + 2);
-    assert_eq!((held.faults_active, held.faults_active_bits), (1, [1, 0, 0, 0]));
+    assert_eq!(
+        (held.faults_active, held.faults_active_bits),
+        (1, [1, 0, 0, 0])
+    );
     assert_eq!((last.faults_active, last.faults_active_bits), (0, [0; 4]));
     // The three bad commands were counted, and never applied (the samples above).
     assert_eq!(rejected.fault_refused, 3);
