@@ -464,6 +464,12 @@ impl Simulation {
         &self.faults
     }
 
+    /// The faults at the ports, mutably: live faults are installed here, and the server notes
+    /// each frame boundary ([`Faults::note_boundary`]).
+    pub fn faults_mut(&mut self) -> &mut Faults {
+        &mut self.faults
+    }
+
     /// The sensors, in publication order.
     pub fn sensors(&self) -> &SensorBank {
         &self.sensors

@@ -12,11 +12,12 @@ use std::sync::mpsc::sync_channel;
 
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
 use flexdyn::config::SimConfig;
+use flexdyn::faults::ports::{Installed, LiveRequest};
 use flexdyn::server::physics::Stepper;
 use flexdyn::server::shared::Frame;
 use flexdyn::server::ServerSettings;
 use flexdyn::sim::Simulation;
-use flexdyn_proto::{CommandMsg, EffectorInput, Header};
+use flexdyn_proto::{CommandMsg, EffectorInput, FaultAction, FaultCommandMsg, FaultTarget, Header};
 
 #[global_allocator]
 static ALLOC: AllocDisabler = AllocDisabler;
@@ -75,12 +76,79 @@ start_s = 1.0
     frame_path_does_not_allocate(&cfg);
 }
 
+/// Live faults (protocol 8): requests resolved off the measured region (as the fault callback
+/// does on the Zenoh thread), installed on the stepping path into the reserved slots (a gyro
+/// bias, a seized wheel, then clears of a configured and a live fault), their boxes handed to
+/// the recycle channel; the events they and the configured faults cause are noted and moved
+/// into the frames, all inside the measured region.
+#[test]
+fn installing_live_faults_and_noting_their_events_does_not_allocate() {
+    let text = format!(
+        "{WHEELS}
+[[faults]]
+target = \"star_trackers.st1\"
+mode = \"dropout\"
+start_s = 0.5
+duration_s = 0.05
+period_s = 0.2
+"
+    );
+    let cfg = SimConfig::from_toml_str(&text).unwrap();
+    let resolver = flexdyn::faults::live::LiveResolver::new(&cfg).unwrap();
+    let cmd = |action, at_tick, target: &str, mode, params, index| FaultCommandMsg {
+        header: Header::new(1, 0, 0, 0),
+        action,
+        at_tick,
+        fault_index: index,
+        mode,
+        params,
+        axes: 0,
+        duration_ns: 0,
+        seed: 3,
+        target: FaultTarget::new(target).unwrap(),
+    };
+    let live = vec![
+        (
+            20,
+            cmd(FaultAction::Inject, 30, "imus.hub.gyro", 2, [0.1, 0.0], 0),
+        ),
+        (
+            40,
+            cmd(
+                FaultAction::Inject,
+                41,
+                "reaction_wheels.rw1",
+                11,
+                [0.0; 2],
+                0,
+            ),
+        ),
+        (90, cmd(FaultAction::Clear, 95, "", 0, [0.0; 2], 0)),
+        (100, cmd(FaultAction::Clear, 120, "", 0, [0.0; 2], 1)),
+    ];
+    let requests = live
+        .into_iter()
+        .map(|(k, c)| (k, resolver.resolve(&c).unwrap()))
+        .collect();
+    frame_path_with_live_faults(&cfg, requests);
+}
+
 fn frame_path_does_not_allocate(cfg: &SimConfig) {
+    frame_path_with_live_faults(cfg, Vec::new());
+}
+
+/// The frame path over 200 frames, installing each live request before stepping its frame.
+fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)>) {
     let sim = Simulation::new(cfg).unwrap();
     assert!(sim.n_imus() > 0);
     assert!(!sim.star_trackers().is_empty());
     let shape = sim.blank_state();
     let n_sensors = sim.sensors().len();
+    let n_events = sim.faults().event_capacity();
+    let live_count = live.len();
+    live.reverse();
+    let (fault_recycle_tx, fault_recycle_rx) = sync_channel::<Installed>(16);
+    let mut events_seen = 0usize;
     let settings = ServerSettings {
         participants: vec![1, 2],
         ..ServerSettings::default()
@@ -91,7 +159,9 @@ fn frame_path_does_not_allocate(cfg: &SimConfig) {
     let (full_tx, full_rx) = sync_channel::<Box<Frame>>(2);
     for _ in 0..2 {
         free_tx
-            .send(Box::new(Frame::for_state(&shape, n_sensors)))
+            .send(Box::new(
+                Frame::for_state(&shape, n_sensors).with_fault_events(n_events),
+            ))
             .unwrap();
     }
     // Sender 2 commands the four wheels (effectors 2–5). Its Actuators commands own heap
@@ -121,9 +191,15 @@ fn frame_path_does_not_allocate(cfg: &SimConfig) {
             recycle_tx.try_send(cmd).unwrap();
         }
         assert!(w.book.all_answered());
+        while live.last().is_some_and(|(at, _)| *at == k) {
+            let (_, req) = live.pop().unwrap();
+            let installed = w.install_fault(req, k).unwrap();
+            fault_recycle_tx.try_send(installed).unwrap();
+        }
         w.step(k);
         let mut f = free_rx.try_recv().unwrap();
         w.fill(&mut f, k + 1);
+        events_seen += f.fault_events.len();
         w.check_finite(k + 1, true).unwrap();
         full_tx.try_send(f).unwrap();
         // The I/O side returns the buffer.
@@ -143,4 +219,11 @@ fn frame_path_does_not_allocate(cfg: &SimConfig) {
     let s = w.sim.state_msg();
     assert_eq!(s.effectors[3].outputs[0], 0.02);
     assert_eq!(recycle_rx.try_iter().count(), 400);
+    assert_eq!(fault_recycle_rx.try_iter().count(), live_count);
+    if live_count > 0 {
+        // The dropout's activations and clearances, the two live faults' activations and
+        // their clears: all noted on the measured path.
+        assert!(events_seen >= 8, "{events_seen} events");
+        assert_eq!(w.sim.faults().events_lost, 0);
+    }
 }

@@ -151,6 +151,16 @@ pub fn decode_operator(bytes: &[u8]) -> Result<OperatorMsg, DecodeError> {
     decode(bytes)
 }
 
+/// [`decode`] for [`crate::FaultEventMsg`].
+pub fn decode_fault_event(bytes: &[u8]) -> Result<crate::FaultEventMsg, DecodeError> {
+    decode(bytes)
+}
+
+/// [`decode`] for [`crate::FaultCommandMsg`] (rejects non-finite parameters).
+pub fn decode_fault_command(bytes: &[u8]) -> Result<crate::FaultCommandMsg, DecodeError> {
+    decode(bytes)
+}
+
 /// [`decode`] for [`StatusMsg`].
 pub fn decode_status(bytes: &[u8]) -> Result<StatusMsg, DecodeError> {
     decode(bytes)

@@ -34,6 +34,10 @@ pub const CMD_PREFIX: &str = "cmd";
 /// Suffix of the operator-command topic ([`crate::OperatorMsg`]: pause, resume, run N ticks).
 /// Protocol version 6.
 pub const OPERATOR_SUFFIX: &str = "operator";
+/// Suffix of the fault-event topic ([`crate::FaultEventMsg`]). Protocol version 8.
+pub const FAULT_EVENT_SUFFIX: &str = "tlm/fault";
+/// Suffix of the live fault-command topic ([`crate::FaultCommandMsg`]). Protocol version 8.
+pub const FAULT_SUFFIX: &str = "fault";
 /// Suffix of the status topic.
 pub const STATUS_SUFFIX: &str = "status";
 /// Suffix of the server's configuration queryable (a `get` returns a UTF-8 JSON description
@@ -260,6 +264,16 @@ impl Topics {
     /// `flexdyn/<sc>/operator` (operator commands).
     pub fn operator(&self) -> String {
         format!("{KEY_ROOT}/{}/{OPERATOR_SUFFIX}", self.sc_id)
+    }
+
+    /// `flexdyn/<sc>/fault` (live fault commands).
+    pub fn fault(&self) -> String {
+        format!("{KEY_ROOT}/{}/{FAULT_SUFFIX}", self.sc_id)
+    }
+
+    /// `flexdyn/<sc>/tlm/fault` (fault activations and clearances).
+    pub fn fault_events(&self) -> String {
+        format!("{KEY_ROOT}/{}/{FAULT_EVENT_SUFFIX}", self.sc_id)
     }
 
     /// `flexdyn/<sc>/tlm/time`

@@ -8,6 +8,7 @@ use crate::{
     CommandKind, CommandMsg, CssMsg, DecodeError, EnvironmentMsg, FssMsg, Header, ImuMsg,
     MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
 };
+use crate::{FaultCommandMsg, FaultEventMsg};
 
 /// Encoded [`Header`] size (bytes).
 pub const HEADER_LEN: usize = 30;
@@ -48,9 +49,13 @@ pub const COMMAND_NO_COMMAND_LEN: usize = 38;
 /// u64 input count sits at offset 86.
 pub const COMMAND_ACTUATORS_FIXED_LEN: usize = 94;
 /// Encoded [`StatusMsg`] size (bytes).
-pub const STATUS_LEN: usize = 187;
+pub const STATUS_LEN: usize = 235;
 /// Encoded [`OperatorMsg`] size (bytes).
 pub const OPERATOR_LEN: usize = 42;
+/// Encoded [`FaultEventMsg`] size (bytes). Protocol version 8.
+pub const FAULT_EVENT_LEN: usize = 199;
+/// Encoded [`FaultCommandMsg`] size (bytes). Protocol version 8.
+pub const FAULT_COMMAND_LEN: usize = 214;
 /// Largest effector count a [`StateMsg`] (or input count a [`CommandKind::Actuators`]) may
 /// carry; decoders reject more.
 pub const MAX_EFFECTORS: usize = 1024;
@@ -94,6 +99,8 @@ mod sealed {
     impl Sealed for super::EnvironmentMsg {}
     impl Sealed for super::TimeMsg {}
     impl Sealed for super::OperatorMsg {}
+    impl Sealed for super::FaultEventMsg {}
+    impl Sealed for super::FaultCommandMsg {}
 }
 
 /// A top-level message that can go on the wire. Implemented (only) by
@@ -226,6 +233,38 @@ impl WireMessage for OperatorMsg {
     const MIN_LEN: usize = OPERATOR_LEN;
     fn header(&self) -> &Header {
         &self.header
+    }
+}
+
+impl WireMessage for FaultEventMsg {
+    const NAME: &'static str = "FaultEventMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed {
+        len: FAULT_EVENT_LEN,
+    };
+    const MIN_LEN: usize = FAULT_EVENT_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+impl WireMessage for FaultCommandMsg {
+    const NAME: &'static str = "FaultCommandMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed {
+        len: FAULT_COMMAND_LEN,
+    };
+    const MIN_LEN: usize = FAULT_COMMAND_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
+
+    /// Rejects non-finite parameters with [`DecodeError::NonFinite`].
+    fn validate(&self) -> Result<(), DecodeError> {
+        for (field, v) in ["params[0]", "params[1]"].into_iter().zip(self.params) {
+            if !v.is_finite() {
+                return Err(DecodeError::NonFinite { field });
+            }
+        }
+        Ok(())
     }
 }
 

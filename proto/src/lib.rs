@@ -135,6 +135,14 @@ pub use messages::{
     MAX_CSS_DETECTORS, NO_COMMAND,
 };
 pub use messages::{gps_flags, GpsMsg};
+// Fault injection (issue 21, protocol 8).
+pub use codec::{decode_fault_command, decode_fault_event};
+pub use keys::{FAULT_EVENT_SUFFIX, FAULT_SUFFIX};
+pub use layout::{FAULT_COMMAND_LEN, FAULT_EVENT_LEN};
+pub use messages::{
+    FaultAction, FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget, AT_NEXT_TICK,
+    FAULT_TARGET_LEN, MAX_STATUS_FAULTS,
+};
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
 /// Version 3: generic effector states in [`StateMsg`], [`CommandKind::Actuators`],
@@ -147,4 +155,7 @@ pub use messages::{gps_flags, GpsMsg};
 /// StatusMsg grows to 187 bytes), and the environment message [`EnvironmentMsg`] on
 /// `flexdyn/<sc-id>/tlm/env` (issue 19).
 /// Version 7: the GPS receiver of issue 20 ([`GpsMsg`] on `tlm/gps/<name>`).
-pub const PROTOCOL_VERSION: u16 = 7;
+/// Version 8: fault injection of issue 21 ([`FaultEventMsg`] on `tlm/fault`, the live
+/// [`FaultCommandMsg`] on `flexdyn/<sc-id>/fault`, [`RejectCounters::fault_refused`] and the
+/// active faults in StatusMsg, which grows to 235 bytes).
+pub const PROTOCOL_VERSION: u16 = 8;

@@ -678,6 +678,12 @@ pub struct RejectCounters {
     /// wrong-spacecraft operator messages count under those reasons. Added in protocol
     /// version 6.
     pub operator_refused: u64,
+    /// A [`FaultCommandMsg`] the server did not apply: an unknown target, a mode the target
+    /// does not take, parameters out of range, a target that is not UTF-8, a tick already
+    /// stepped past, a clear naming no fault, or no live-fault slot left. Malformed,
+    /// bad-version and wrong-spacecraft fault commands count under those reasons. Added in
+    /// protocol version 8.
+    pub fault_refused: u64,
 }
 
 impl RejectCounters {
@@ -707,13 +713,14 @@ impl RejectCounters {
             self.bad_effector_input,
             self.wrong_identity,
             self.operator_refused,
+            self.fault_refused,
         ]
         .iter()
         .fold(0u64, |a, &b| a.saturating_add(b))
     }
 }
 
-/// Server health, topic `flexdyn/<sc-id>/status`. 187 bytes.
+/// Server health, topic `flexdyn/<sc-id>/status`. 235 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct StatusMsg {
@@ -736,6 +743,13 @@ pub struct StatusMsg {
     /// deterministic**: the only wall-clock field in the protocol; ignore it when
     /// comparing runs.
     pub wall_time_unix_ns: u64,
+    /// How many faults are active at `header.tick` (configured, random and live). Added in
+    /// protocol version 8.
+    pub faults_active: u64,
+    /// Which: bit `i % 64` of word `i / 64` is set while fault index `i` (as in
+    /// [`FaultEventMsg::fault_index`]) is active; indices from [`MAX_STATUS_FAULTS`] on are
+    /// only counted in `faults_active`. Added in protocol version 8.
+    pub faults_active_bits: [u64; 4],
 }
 
 /// Bits of [`TimeMsg::flags`].
@@ -975,4 +989,233 @@ pub struct EnvironmentMsg {
     pub solar_pressure: AppliedWrench,
     /// The residual dipole's torque in the field (its force is zero: a uniform field).
     pub residual_dipole: AppliedWrench,
+}
+
+/// Largest fault index StatusMsg's [`StatusMsg::faults_active_bits`] can show (bits 0–255); a
+/// fault beyond it is counted in [`StatusMsg::faults_active`] only. Protocol version 8.
+pub const MAX_STATUS_FAULTS: usize = 256;
+/// Bytes of a [`FaultTarget`]. Protocol version 8.
+pub const FAULT_TARGET_LEN: usize = 128;
+/// [`FaultCommandMsg::at_tick`] for "at the next frame boundary". Protocol version 8.
+pub const AT_NEXT_TICK: u64 = u64::MAX;
+
+/// A fault's target as written in a configuration (`imus.hub.gyro`, `reaction_wheels.rw2`):
+/// [`FAULT_TARGET_LEN`] bytes of UTF-8, padded with NUL bytes (no length prefix on the wire; in
+/// JSON, a string).
+/// Protocol version 8.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct FaultTarget(pub [u8; FAULT_TARGET_LEN]);
+
+impl FaultTarget {
+    /// `target` padded with NULs; `None` if longer than [`FAULT_TARGET_LEN`] bytes or holding a
+    /// NUL.
+    pub fn new(target: &str) -> Option<Self> {
+        let b = target.as_bytes();
+        if b.len() > FAULT_TARGET_LEN || b.contains(&0) {
+            return None;
+        }
+        let mut out = [0u8; FAULT_TARGET_LEN];
+        out[..b.len()].copy_from_slice(b);
+        Some(Self(out))
+    }
+
+    /// The bytes up to the first NUL, as UTF-8 (`None` if they are not).
+    pub fn as_str(&self) -> Option<&str> {
+        let n = self
+            .0
+            .iter()
+            .position(|&b| b == 0)
+            .unwrap_or(FAULT_TARGET_LEN);
+        std::str::from_utf8(&self.0[..n]).ok()
+    }
+
+    /// `target` truncated to [`FAULT_TARGET_LEN`] bytes at a character boundary (for an event
+    /// whose target is longer; the fault index stays exact).
+    pub fn truncated(target: &str) -> Self {
+        let mut end = target.len().min(FAULT_TARGET_LEN);
+        while !target.is_char_boundary(end) {
+            end -= 1;
+        }
+        let mut out = [0u8; FAULT_TARGET_LEN];
+        for (o, b) in out.iter_mut().zip(&target.as_bytes()[..end]) {
+            *o = if *b == 0 { b'?' } else { *b };
+        }
+        Self(out)
+    }
+}
+
+impl Default for FaultTarget {
+    fn default() -> Self {
+        Self([0; FAULT_TARGET_LEN])
+    }
+}
+
+impl std::fmt::Debug for FaultTarget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.as_str() {
+            Some(s) => write!(f, "FaultTarget({s:?})"),
+            None => write!(f, "FaultTarget(<not UTF-8>)"),
+        }
+    }
+}
+
+impl Serialize for FaultTarget {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeTuple;
+        // JSON (recordings, viewers): the text, bytes that are not UTF-8 replaced.
+        if s.is_human_readable() {
+            let n = self
+                .0
+                .iter()
+                .position(|&b| b == 0)
+                .unwrap_or(FAULT_TARGET_LEN);
+            return s.serialize_str(&String::from_utf8_lossy(&self.0[..n]));
+        }
+        // A tuple: the bytes in order, no length prefix (as `[u8; N]` for N ≤ 32).
+        let mut t = s.serialize_tuple(FAULT_TARGET_LEN)?;
+        for b in &self.0 {
+            t.serialize_element(b)?;
+        }
+        t.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for FaultTarget {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Bytes;
+        impl<'de> serde::de::Visitor<'de> for Bytes {
+            type Value = FaultTarget;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "{FAULT_TARGET_LEN} bytes")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut a: A,
+            ) -> Result<Self::Value, A::Error> {
+                let mut out = [0u8; FAULT_TARGET_LEN];
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = a
+                        .next_element()?
+                        .ok_or_else(|| serde::de::Error::invalid_length(i, &self))?;
+                }
+                Ok(FaultTarget(out))
+            }
+        }
+        if d.is_human_readable() {
+            let text = String::deserialize(d)?;
+            return FaultTarget::new(&text)
+                .ok_or_else(|| serde::de::Error::custom("a fault target of at most 128 bytes"));
+        }
+        d.deserialize_tuple(FAULT_TARGET_LEN, Bytes)
+    }
+}
+
+#[cfg(feature = "json-schema")]
+impl schemars::JsonSchema for FaultTarget {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "FaultTarget".into()
+    }
+    fn json_schema(g: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        <String>::json_schema(g)
+    }
+}
+
+/// Where a fault came from. Wire: u32 LE tag. Protocol version 8.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub enum FaultSource {
+    /// Tag 0: a `[[faults]]` entry of the configuration (a schedule).
+    #[default]
+    Config,
+    /// Tag 1: a live [`FaultCommandMsg`].
+    Live,
+    /// Tag 2: a `[[faults]]` entry with `mtbf_s` (its start drawn from its seed).
+    Random,
+}
+
+impl FaultSource {
+    /// The wire tag (the u32 LE variant index).
+    pub const fn tag(self) -> u32 {
+        self as u32
+    }
+}
+
+/// A fault's activation or clearance, topic `flexdyn/<sc-id>/tlm/fault`. 199 bytes. Protocol
+/// version 8.
+///
+/// Published at the frame boundary where the server sees the change: `header.tick` is that
+/// boundary (the first tick whose sensor samples and actuation carry the change), `header.seq`
+/// counts fault events from 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct FaultEventMsg {
+    /// Common header.
+    pub header: Header,
+    /// The fault's index: its position in the configuration's `[[faults]]` (from 0), or, for a
+    /// live fault, the number of configured faults plus the live fault's order of acceptance.
+    pub fault_index: u32,
+    /// Where it came from.
+    pub source: FaultSource,
+    /// Its mode: the index in the server's mode table (`proto/README.md`, "Fault modes").
+    pub mode: u32,
+    /// `true`: activated at this tick; `false`: cleared.
+    pub active: bool,
+    /// \[ns\] simulation time the activation began or the clearance took effect (≤
+    /// `header.sim_time_ns`; earlier when the window's edge lies inside the frame).
+    pub edge_ns: u64,
+    /// Selected axes, bit `a` for 1-based axis `a + 1`; 0: every axis.
+    pub axes: u32,
+    /// The mode's parameters in the order of its table row (unused: 0).
+    pub params: [f64; 2],
+    /// Its target as written (truncated to [`FAULT_TARGET_LEN`] bytes).
+    pub target: FaultTarget,
+}
+
+/// What a [`FaultCommandMsg`] asks for. Wire: u32 LE tag. Protocol version 8.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub enum FaultAction {
+    /// Tag 0: inject the fault the message describes.
+    #[default]
+    Inject,
+    /// Tag 1: clear fault `fault_index` (configured or live) for the rest of the run.
+    Clear,
+}
+
+impl FaultAction {
+    /// The wire tag (the u32 LE variant index).
+    pub const fn tag(self) -> u32 {
+        self as u32
+    }
+}
+
+/// A live fault command, topic `flexdyn/<sc-id>/fault`: inject a fault, or clear one. 214
+/// bytes. Protocol version 8.
+///
+/// On a lab network the shipped access-control list lets only the operator's subject put on
+/// this key (`scenarios/zenoh/secure-server.json5`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct FaultCommandMsg {
+    /// Common header: `spacecraft_id` must be the server's; `tick` the newest tick the sender
+    /// has seen (informational); `seq` the sender's counter.
+    pub header: Header,
+    /// Inject or clear.
+    pub action: FaultAction,
+    /// The frame boundary at which it takes effect; [`AT_NEXT_TICK`]: the next one.
+    pub at_tick: u64,
+    /// `Clear`: the fault to clear. `Inject`: 0 (ignored).
+    pub fault_index: u32,
+    /// `Inject`: the mode (index in the mode table).
+    pub mode: u32,
+    /// `Inject`: the mode's parameters in its table row's order (unused: 0).
+    pub params: [f64; 2],
+    /// `Inject`: selected axes, bit `a` for 1-based axis `a + 1`; 0: every axis.
+    pub axes: u32,
+    /// `Inject`: \[ns\] how long it lasts; 0: until cleared.
+    pub duration_ns: u64,
+    /// `Inject`: the seed of its generator (`noise`, `spikes`).
+    pub seed: u64,
+    /// `Inject`: the target, as in `[[faults]]` (`imus.hub.gyro`).
+    pub target: FaultTarget,
 }

@@ -28,6 +28,7 @@ use flexdyn_proto::{
     EnvironmentMsg, FssMsg, Header, ImuMsg, MagnetometerMsg, Mode, OperatorAction, OperatorMsg,
     RejectCounters, RunState, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg, MAX_MESSAGE_BYTES,
 };
+use flexdyn_proto::{FaultAction, FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget};
 // The GPS receiver (protocol 7): generator arm 11, the thirteenth decoder.
 use flexdyn_proto::GpsMsg;
 use rand_chacha::ChaCha8Rng;
@@ -287,7 +288,7 @@ impl Gen {
     }
 
     fn message(&mut self) -> Vec<u8> {
-        match self.below(12) {
+        match self.below(14) {
             0 => {
                 let effectors = (0..self.below(6))
                     .map(|_| EffectorState {
@@ -406,6 +407,36 @@ impl Gen {
                 v_bn_n_m_s: self.v(),
                 flags: self.u64() as u8,
             }),
+            // Protocol 8: fault events (any tag and bool byte: edits make them malformed) and
+            // fault commands (sometimes a non-finite parameter).
+            12 => encode(&FaultEventMsg {
+                header: self.header(),
+                fault_index: self.u64() as u32,
+                source: [FaultSource::Config, FaultSource::Live, FaultSource::Random]
+                    [self.below(3) as usize],
+                mode: self.below(18) as u32,
+                active: self.below(2) == 1,
+                edge_ns: self.u64(),
+                axes: self.u64() as u32,
+                params: self.v(),
+                target: FaultTarget(std::array::from_fn(|_| self.u64() as u8)),
+            }),
+            13 => encode(&FaultCommandMsg {
+                header: self.header(),
+                action: [FaultAction::Inject, FaultAction::Clear][self.below(2) as usize],
+                at_tick: self.u64(),
+                fault_index: self.u64() as u32,
+                mode: self.below(18) as u32,
+                params: if self.below(4) == 0 {
+                    self.v()
+                } else {
+                    [self.finite(), self.finite()]
+                },
+                axes: self.u64() as u32,
+                duration_ns: self.u64(),
+                seed: self.u64(),
+                target: FaultTarget::new("imus.hub.gyro").unwrap_or_default(),
+            }),
             3 => {
                 // Mostly finite (accepted), sometimes with a non-finite number (NonFinite).
                 let finite = self.below(4) != 0;
@@ -446,8 +477,11 @@ impl Gen {
                         bad_effector_input: self.u64(),
                         wrong_identity: self.u64(),
                         operator_refused: self.u64(),
+                        fault_refused: self.u64(),
                         ..RejectCounters::default()
                     },
+                    faults_active: self.u64(),
+                    faults_active_bits: [self.u64(), 0, self.u64(), 1],
                     ..StatusMsg::default()
                 };
                 m.mode = [Mode::RealTime, Mode::Lockstep, Mode::Batch][self.below(3) as usize];
@@ -560,6 +594,8 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
             "operator",
             "header",
             "gps",
+            "fault_event",
+            "fault_command",
         ] {
             let want = rust_lines.next().expect("a Rust verdict per decoder");
             let got = c_lines.next().unwrap_or("<missing>");
@@ -580,7 +616,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
     }
     assert!(c_lines.next().is_none(), "extra C output");
     eprintln!(
-        "{N} buffers x 13 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
+        "{N} buffers x 15 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
     );
     // The stream exercises every outcome.
     for r in [

@@ -32,6 +32,10 @@ use flexdyn_proto::{
     FSS_LEN, IMU_LEN, MAGNETOMETER_LEN, MAX_CSS_DETECTORS, OPERATOR_LEN, STAR_TRACKER_LEN,
     STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
 };
+use flexdyn_proto::{
+    FaultAction, FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget, FAULT_COMMAND_LEN,
+    FAULT_EVENT_LEN, FAULT_TARGET_LEN,
+};
 
 type Golden = &'static [(usize, &'static str, &'static str)];
 
@@ -102,7 +106,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -362,7 +366,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -438,7 +442,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -485,7 +489,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -555,7 +559,7 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -586,7 +590,7 @@ const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
     (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
 ];
 const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -819,7 +823,7 @@ const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
 
 // The sun sensors' tables (protocol 6, issue 20).
 const CSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -855,7 +859,7 @@ const CSS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const FSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -881,7 +885,7 @@ const FSS_GOLDEN: &[(usize, &str, &str)] = &[
     (46, "07", "u8 flags = VALID | IN_FOV | SUNLIT = 0x07"),
 ];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -925,7 +929,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
 /// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
 /// TAI …036.0 s). `src/server/clock.rs` produces exactly this message from that epoch.
 const TIME_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -998,7 +1002,7 @@ const TIME_GOLDEN: &[(usize, &str, &str)] = &[
     (118, "00000000", "u32 tone_tai.subseconds = 0"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -1015,7 +1019,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -1076,18 +1080,141 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
         "0a00000000000000",
         "u64 rejected.operator_refused = 10",
     ),
-    (171, "0700000000000000", "u64 commands_dropped = 7"),
     (
-        179,
+        171,
+        "0b00000000000000",
+        "u64 rejected.fault_refused = 11 (protocol 8)",
+    ),
+    (179, "0700000000000000", "u64 commands_dropped = 7"),
+    (
+        187,
         "15cd853dfe9c9717",
         "u64 wall_time_unix_ns = 1700000000123456789 (0x17979CFE3D85CD15)",
+    ),
+    (
+        195,
+        "0300000000000000",
+        "u64 faults_active = 3 (protocol 8)",
+    ),
+    (
+        203,
+        "0500000000000000",
+        "u64 faults_active_bits[0] = 0b101: faults 0 and 2",
+    ),
+    (211, "0000000000000000", "u64 faults_active_bits[1] = 0"),
+    (219, "0000000000000000", "u64 faults_active_bits[2] = 0"),
+    (
+        227,
+        "0000000000000080",
+        "u64 faults_active_bits[3] = 1 << 63: fault 255",
+    ),
+];
+
+// Protocol 8 (issue 21, fault injection): live fault 3 (after three configured faults, its
+// first live one) activated at tick 44: `bias_step` (mode 2) of 0.25 rad/s on axes 1 and 3 of
+// `imus.hub.gyro`, at 0.44 s exactly (edge = the boundary).
+const FAULT_EVENT_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0800", "u16 header.protocol_version = 8"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "2c00000000000000", "u64 header.tick = 44"),
+    (
+        14,
+        "00de391a00000000",
+        "u64 header.sim_time_ns = 440000000 (0x1A39DE00)",
+    ),
+    (22, "0100000000000000", "u64 header.seq = 1"),
+    (30, "03000000", "u32 fault_index = 3"),
+    (34, "01000000", "u32 source tag = 1 (Live)"),
+    (38, "02000000", "u32 mode = 2 (bias_step)"),
+    (42, "01", "bool active = true"),
+    (
+        43,
+        "00de391a00000000",
+        "u64 edge_ns = 440000000 (0x1A39DE00)",
+    ),
+    (51, "05000000", "u32 axes = 0b101 (axes 1 and 3)"),
+    (
+        55,
+        "000000000000d03f",
+        "f64 params[0] = 0.25 (0x3FD0000000000000)",
+    ),
+    (63, "0000000000000000", "f64 params[1] = 0 (unused)"),
+    (
+        71,
+        "696d75732e6875622e6779726f",
+        "u8[13] target = \"imus.hub.gyro\" (UTF-8)",
+    ),
+    (
+        84,
+        "0000000000000000000000000000000000000000000000000000000000000000\
+         0000000000000000000000000000000000000000000000000000000000000000\
+         0000000000000000000000000000000000000000000000000000000000000000\
+         00000000000000000000000000000000000000",
+        "u8[115] target padding: NUL",
+    ),
+];
+
+// Protocol 8 (issue 21): a live fault command, `torque_limit` (mode 10) to a fraction of 0.5 on
+// `reaction_wheels.rw2`, at tick 0x1_0000_0005 (bytes on both sides of bit 32), for 2 s, seed
+// 7.
+const FAULT_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0800", "u16 header.protocol_version = 8"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "2c00000000000000", "u64 header.tick = 44"),
+    (
+        14,
+        "00de391a00000000",
+        "u64 header.sim_time_ns = 440000000 (0x1A39DE00)",
+    ),
+    (22, "0200000000000000", "u64 header.seq = 2"),
+    (30, "00000000", "u32 action tag = 0 (Inject)"),
+    (
+        34,
+        "0500000001000000",
+        "u64 at_tick = 4294967301 (0x100000005)",
+    ),
+    (42, "00000000", "u32 fault_index = 0 (ignored for Inject)"),
+    (46, "0a000000", "u32 mode = 10 (torque_limit)"),
+    (
+        50,
+        "000000000000e03f",
+        "f64 params[0] = 0.5 (0x3FE0000000000000)",
+    ),
+    (58, "0000000000000000", "f64 params[1] = 0 (unused)"),
+    (66, "00000000", "u32 axes = 0 (every axis)"),
+    (
+        70,
+        "0094357700000000",
+        "u64 duration_ns = 2000000000 (0x77359400)",
+    ),
+    (78, "0700000000000000", "u64 seed = 7"),
+    (
+        86,
+        "7265616374696f6e5f776865656c732e727732",
+        "u8[19] target = \"reaction_wheels.rw2\" (UTF-8)",
+    ),
+    (
+        105,
+        "0000000000000000000000000000000000000000000000000000000000000000\
+         0000000000000000000000000000000000000000000000000000000000000000\
+         0000000000000000000000000000000000000000000000000000000000000000\
+         00000000000000000000000000",
+        "u8[109] target padding: NUL",
     ),
 ];
 
 // Protocol 6 (issue 23, operator control): a `RunTicks` operator command. The tick count
 // 4294967301 = 0x1_0000_0005 has bytes on both sides of bit 32, so a u32 `ticks` would show.
 const OPERATOR_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -1320,7 +1447,7 @@ fn css_golden() {
 // ---- GpsMsg (protocol 7, issue 20): a self-contained block. ----
 /// GpsMsg, hand-derived from proto/README.md (147 bytes).
 const GPS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0700", "u16 header.protocol_version = 7"),
+    (0, "0800", "u16 header.protocol_version = 8"),
     (
         2,
         "44332211",
@@ -1440,9 +1567,12 @@ fn status_golden() {
             bad_effector_input: 8,
             wrong_identity: 9,
             operator_refused: 10,
+            fault_refused: 11,
         },
         commands_dropped: 7,
         wall_time_unix_ns: 1_700_000_000_123_456_789,
+        faults_active: 3,
+        faults_active_bits: [0b101, 0, 0, 1 << 63],
     };
     check("StatusMsg", STATUS_GOLDEN, &msg);
     assert_eq!(encode(&msg).len(), STATUS_LEN);
@@ -1471,6 +1601,75 @@ fn operator_golden() {
         );
         assert_eq!(action.tag(), tag);
     }
+}
+
+/// Protocol 8: a fault event; every [`FaultSource`] tag pinned.
+#[test]
+fn fault_event_golden() {
+    let msg = FaultEventMsg {
+        header: Header::new(SC, 44, 440_000_000, 1),
+        fault_index: 3,
+        source: FaultSource::Live,
+        mode: 2,
+        active: true,
+        edge_ns: 440_000_000,
+        axes: 0b101,
+        params: [0.25, 0.0],
+        target: FaultTarget::new("imus.hub.gyro").unwrap(),
+    };
+    check("FaultEventMsg", FAULT_EVENT_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), FAULT_EVENT_LEN);
+    for (source, tag) in [
+        (FaultSource::Config, 0u32),
+        (FaultSource::Live, 1),
+        (FaultSource::Random, 2),
+    ] {
+        let bytes = encode(&FaultEventMsg { source, ..msg });
+        assert_eq!(u32::from_le_bytes(bytes[34..38].try_into().unwrap()), tag);
+        assert_eq!(source.tag(), tag);
+    }
+    assert_eq!(msg.target.as_str(), Some("imus.hub.gyro"));
+}
+
+/// Protocol 8: a live fault command; both [`FaultAction`] tags pinned, and a non-finite
+/// parameter is rejected like a command's.
+#[test]
+fn fault_command_golden() {
+    let msg = FaultCommandMsg {
+        header: Header::new(SC, 44, 440_000_000, 2),
+        action: FaultAction::Inject,
+        at_tick: 0x1_0000_0005,
+        fault_index: 0,
+        mode: 10,
+        params: [0.5, 0.0],
+        axes: 0,
+        duration_ns: 2_000_000_000,
+        seed: 7,
+        target: FaultTarget::new("reaction_wheels.rw2").unwrap(),
+    };
+    check("FaultCommandMsg", FAULT_COMMAND_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), FAULT_COMMAND_LEN);
+    for (action, tag) in [(FaultAction::Inject, 0u32), (FaultAction::Clear, 1)] {
+        let bytes = encode(&FaultCommandMsg { action, ..msg });
+        assert_eq!(u32::from_le_bytes(bytes[30..34].try_into().unwrap()), tag);
+        assert_eq!(action.tag(), tag);
+    }
+    let mut bad = encode(&msg);
+    bad[58..66].copy_from_slice(&f64::NAN.to_le_bytes());
+    assert!(matches!(
+        decode::<FaultCommandMsg>(&bad),
+        Err(flexdyn_proto::DecodeError::NonFinite { field: "params[1]" })
+    ));
+    // A target longer than the field, or holding a NUL, is refused when built.
+    assert!(FaultTarget::new(&"x".repeat(FAULT_TARGET_LEN + 1)).is_none());
+    assert!(FaultTarget::new("a\0b").is_none());
+    assert_eq!(
+        FaultTarget::truncated(&"é".repeat(100))
+            .as_str()
+            .unwrap()
+            .len(),
+        128
+    );
 }
 
 #[test]
@@ -1617,7 +1816,7 @@ fn environment_golden() {
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 14] = [
+    let tables: [(&str, &str, Golden, &str); 16] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -1668,6 +1867,19 @@ fn exported_golden_files_match_the_tables() {
             "OperatorMsg",
             OPERATOR_GOLDEN,
             "OPERATOR_GOLDEN",
+        ),
+        // Protocol 8, fault injection.
+        (
+            "fault_event",
+            "FaultEventMsg",
+            FAULT_EVENT_GOLDEN,
+            "FAULT_EVENT_GOLDEN",
+        ),
+        (
+            "fault_command",
+            "FaultCommandMsg",
+            FAULT_COMMAND_GOLDEN,
+            "FAULT_COMMAND_GOLDEN",
         ),
     ];
     let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");

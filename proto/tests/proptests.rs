@@ -155,10 +155,18 @@ fn status() -> impl Strategy<Value = StatusMsg> {
         (u(), u(), u(), u(), u()),
         (u(), u(), any::<bool>(), policy),
         (u(), u(), u(), u(), u(), u(), u(), u(), u()),
-        (u(), u()),
+        (u(), u(), u(), u(), u(), u(), u()),
     )
         .prop_map(
-            |(header, mode, run_state, t, c, r, (dropped, wall))| StatusMsg {
+            |(
+                header,
+                mode,
+                run_state,
+                t,
+                c,
+                r,
+                (dropped, wall, fault_refused, active, b0, b1, b2),
+            )| StatusMsg {
                 header,
                 mode,
                 run_state,
@@ -185,9 +193,12 @@ fn status() -> impl Strategy<Value = StatusMsg> {
                     bad_effector_input: r.6,
                     wrong_identity: r.7,
                     operator_refused: r.8,
+                    fault_refused,
                 },
                 commands_dropped: dropped,
                 wall_time_unix_ns: wall,
+                faults_active: active,
+                faults_active_bits: [b0, b1, b2, !b0],
             },
         )
 }
@@ -261,6 +272,8 @@ fn decode_all(bytes: &[u8]) {
     let _ = decode_status(bytes);
     let _ = decode_star_tracker(bytes);
     let _ = decode_header(bytes);
+    let _ = flexdyn_proto::decode_fault_event(bytes);
+    let _ = flexdyn_proto::decode_fault_command(bytes);
 }
 
 /// encode → decode → encode gives the same bytes (bitwise, so NaN payloads
@@ -306,7 +319,7 @@ proptest! {
     /// Random bodies of exactly the right length reach bincode: the result is a
     /// message, Malformed or NonFinite, never a panic or a length error.
     #[test]
-    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 185)) {
+    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 233)) {
         let mut b = flexdyn_proto::PROTOCOL_VERSION.to_le_bytes().to_vec();
         b.extend_from_slice(&body);
         for r in [
@@ -315,6 +328,7 @@ proptest! {
             decode_star_tracker(&b[..flexdyn_proto::STAR_TRACKER_LEN]).map(|_| ()),
             decode_time(&b[..flexdyn_proto::TIME_LEN]).map(|_| ()),
             decode_operator(&b[..flexdyn_proto::OPERATOR_LEN]).map(|_| ()),
+            flexdyn_proto::decode_fault_event(&b[..flexdyn_proto::FAULT_EVENT_LEN]).map(|_| ()),
         ] {
             prop_assert!(matches!(r, Ok(()) | Err(DecodeError::Malformed(_))), "{:?}", r);
         }

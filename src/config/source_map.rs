@@ -204,6 +204,14 @@ impl<'s> SourceMap<'s> {
         }
     }
 
+    /// A map of no document (errors then carry no position): a live fault command's checks.
+    pub(crate) fn empty() -> SourceMap<'static> {
+        SourceMap {
+            source: "",
+            entries: Vec::new(),
+        }
+    }
+
     pub(crate) fn invalid(&self, field: &str, problem: String) -> ConfigError {
         ConfigError::Invalid {
             field: field.to_string(),

@@ -10,12 +10,16 @@
 //!   fault (`mtbf_s`) starts at a time to failure drawn from its seed at load
 //!   ([`failure_delay_ns`]);
 //! - [`ports`]: the per-vehicle runtime ([`Faults`]) that [`crate::sim::Simulation`] calls at its
-//!   two ports; it allocates nothing, locks nothing and cannot fail.
+//!   two ports; it allocates nothing, locks nothing and cannot fail. It also notes each fault's
+//!   activation and clearance at the frame boundaries (the server's FaultEventMsg);
+//! - [`live`]: live faults (`flexdyn/<sc>/fault`), checked off the physics thread by the same
+//!   resolution as `[[faults]]` and handed over ready-made.
 //!
 //! Which modes apply is stated by each kind: a sensor through
 //! [`crate::sensors::Sensor::fault_channels`] and [`crate::sensors::Sensor::has_validity`], an
 //! effector kind through [`crate::dynamics::component::ComponentKind::fault_modes`].
 
+pub mod live;
 pub mod modes;
 pub mod ports;
 pub(crate) mod schema;
@@ -31,6 +35,9 @@ pub use window::FaultWindow;
 pub const MAX_AXES: usize = flexdyn_proto::MAX_CSS_DETECTORS;
 /// Most fault channels a sensor may expose.
 pub const MAX_CHANNELS: usize = 4;
+/// Most live faults one run accepts ([`live`]): their slots are reserved when the server
+/// starts, so the physics thread never allocates one.
+pub const MAX_LIVE_FAULTS: usize = 64;
 
 /// A resolved fault: what, how and when.
 #[derive(Debug, Clone, PartialEq)]
@@ -47,6 +54,8 @@ pub struct FaultSpec {
     pub seed: u64,
     /// Where it sits.
     pub port: Port,
+    /// Where it came from: a schedule, a random failure (`mtbf_s`) or a live command.
+    pub source: flexdyn_proto::FaultSource,
 }
 
 /// Where a fault sits.

@@ -214,6 +214,25 @@ impl FaultMode {
         }
     }
 
+    /// Its parameters in the order of its [`MODES`] row, unused ones 0 (the wire's `params`).
+    pub fn params(&self) -> [f64; 2] {
+        match *self {
+            Self::StuckValue { value } | Self::BiasStep { value } => [value, 0.0],
+            Self::BiasRamp { rate_per_s } => [rate_per_s, 0.0],
+            Self::Scale { factor }
+            | Self::FrictionScale { factor }
+            | Self::ThrustScale { factor }
+            | Self::DipoleScale { factor } => [factor, 0.0],
+            Self::Noise { sigma } => [sigma, 0.0],
+            Self::Spikes {
+                probability,
+                amplitude,
+            } => [probability, amplitude],
+            Self::TorqueLimit { fraction } => [fraction, 0.0],
+            _ => [0.0, 0.0],
+        }
+    }
+
     /// The first parameter out of its range, as `(key, problem)`.
     pub fn check(&self) -> Option<(&'static str, &'static str)> {
         let nonneg = |v: f64| v >= 0.0;

@@ -24,8 +24,10 @@
 //! - magnetorquer (input: dipole \[A·m²\]): `dead` = 0; `dipole_scale` k: the input × k (before the
 //!   rod's ±`max_dipole_am2` clip).
 
+use flexdyn_proto::{FaultEventMsg, FaultTarget, Header, AT_NEXT_TICK};
+
 use super::modes::{sensor_value, Draws, FaultMode};
-use super::{FaultSpec, Port, MAX_AXES, MAX_CHANNELS};
+use super::{FaultSpec, Port, MAX_AXES, MAX_CHANNELS, MAX_LIVE_FAULTS};
 use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::effectors::reaction_wheel::ReactionWheel;
 use crate::dynamics::{Spacecraft, State};
@@ -48,10 +50,16 @@ enum Actuator {
     Magnetorquer,
 }
 
-/// One configured fault and its state.
+/// One fault (configured or live) and its state.
 #[derive(Debug, Clone)]
-struct Live {
+pub(super) struct Live {
     spec: FaultSpec,
+    /// Its target as the wire carries it (built off the stepping path).
+    target: FaultTarget,
+    /// \[ns\] from here on it is cleared (a live `Clear`); `u64::MAX`: never.
+    cleared_from_ns: u64,
+    /// The activation in force at the last boundary noted ([`Faults::note_boundary`]).
+    reported: Option<u64>,
     rng: NormalRng,
     /// The start \[ns\] of the activation in force at the last evaluation.
     on: Option<u64>,
@@ -62,11 +70,98 @@ struct Live {
     actuator: Option<(usize, Actuator)>,
 }
 
+/// A live fault request, checked and built off the stepping path ([`super::live`]), for
+/// [`Faults::install`].
+#[derive(Debug)]
+pub struct LiveRequest {
+    pub(super) kind: RequestKind,
+    /// The boundary it applies at ([`AT_NEXT_TICK`]: the next one).
+    pub(super) at_tick: u64,
+}
+
+#[derive(Debug)]
+pub(super) enum RequestKind {
+    Inject(Box<Live>),
+    Clear(u32),
+}
+
+impl LiveRequest {
+    /// The fault a `Clear` names, `None` for an injection.
+    pub fn clears(&self) -> Option<u32> {
+        match self.kind {
+            RequestKind::Clear(i) => Some(i),
+            RequestKind::Inject(_) => None,
+        }
+    }
+}
+
+/// Why [`Faults::install`] refused a request (a code, so the physics thread can store it in an
+/// atomic): index into [`INSTALL_REFUSALS`].
+pub const REFUSED_LATE: u8 = 0;
+/// See [`REFUSED_LATE`].
+pub const REFUSED_NO_SLOT: u8 = 1;
+/// See [`REFUSED_LATE`].
+pub const REFUSED_NO_INDEX: u8 = 2;
+/// The reasons of [`Faults::install`]'s refusals, by code.
+pub const INSTALL_REFUSALS: [&str; 3] = [
+    "its at_tick had already been stepped past when the server took it (lockstep: put it \
+     before the answer to the tick before at_tick)",
+    "no live-fault slot left (64 per run)",
+    "a clear naming no fault (fault_index beyond the configured and live faults)",
+];
+
+/// A request's remains once installed: the injected fault's box (its contents moved into a
+/// reserved slot), to be freed off the stepping path.
+#[derive(Debug)]
+pub struct Installed(#[allow(dead_code)] Option<Box<Live>>);
+
+/// Fault events kept for the next frame that is filled: two per fault (a clearance and an
+/// activation between two boundaries), for the configured faults and every live slot.
+fn event_capacity(configured: usize) -> usize {
+    2 * (configured + MAX_LIVE_FAULTS)
+}
+
 /// The faults of one vehicle.
 #[derive(Debug, Clone, Default)]
 pub struct Faults {
     live: Vec<Live>,
     any_actuator: bool,
+    /// How many of `live` come from the configuration (the live ones follow).
+    configured: usize,
+    /// \[ns\] the frame period (live faults start at boundaries).
+    frame_ns: u64,
+    /// Activations and clearances noted and not yet taken ([`Self::take_events`]).
+    events: Vec<FaultEventMsg>,
+    /// Events dropped because `events` was full (frames whose telemetry was dropped).
+    pub events_lost: u64,
+    event_seq: u64,
+    active_count: u64,
+    active_bits: [u64; 4],
+}
+
+impl Live {
+    /// A fault of `spec` on the spacecraft `sc` built from `cfg`.
+    pub(super) fn new(
+        spec: FaultSpec,
+        cfg: &SimConfig,
+        sc: &Spacecraft,
+    ) -> Result<Self, ConfigError> {
+        let actuator = match spec.port {
+            Port::Sensor { .. } => None,
+            Port::Actuator { effector } => Some(actuator(cfg, sc, effector)?),
+        };
+        Ok(Live {
+            rng: NormalRng::new(spec.seed),
+            target: FaultTarget::truncated(&spec.target),
+            spec,
+            cleared_from_ns: u64::MAX,
+            reported: None,
+            on: None,
+            held: [[0.0; MAX_AXES]; MAX_CHANNELS],
+            held_set: false,
+            actuator,
+        })
+    }
 }
 
 impl Faults {
@@ -74,23 +169,141 @@ impl Faults {
     pub fn new(cfg: &SimConfig, sc: &Spacecraft) -> Result<Self, ConfigError> {
         let mut live = Vec::with_capacity(cfg.faults.len());
         for spec in &cfg.faults {
-            let actuator = match spec.port {
-                Port::Sensor { .. } => None,
-                Port::Actuator { effector } => Some(actuator(cfg, sc, effector)?),
-            };
-            live.push(Live {
-                rng: NormalRng::new(spec.seed),
-                spec: spec.clone(),
-                on: None,
-                held: [[0.0; MAX_AXES]; MAX_CHANNELS],
-                held_set: false,
-                actuator,
-            });
+            live.push(Live::new(spec.clone(), cfg, sc)?);
         }
         Ok(Self {
             any_actuator: live.iter().any(|l| l.actuator.is_some()),
+            configured: live.len(),
+            frame_ns: cfg.frame_ns,
             live,
+            ..Self::default()
         })
+    }
+
+    /// Reserves the live-fault slots ([`MAX_LIVE_FAULTS`]) and the event buffer, so that
+    /// [`Self::install`] and [`Self::note_boundary`] never allocate (the server, at start).
+    pub fn reserve_live(&mut self) {
+        self.live.reserve_exact(MAX_LIVE_FAULTS);
+        self.events = Vec::with_capacity(event_capacity(self.configured));
+    }
+
+    /// Most events [`Self::take_events`] can hand out at once (size a frame's buffer with it).
+    pub fn event_capacity(&self) -> usize {
+        event_capacity(self.configured)
+    }
+
+    /// Installs a live request at the boundary the next frame reaches, `next_tick` (the fault
+    /// is active from `at_tick`, the clearance takes effect there). Allocation- and lock-free:
+    /// the fault moves into a reserved slot ([`Self::reserve_live`]) and its box is handed
+    /// back to be freed elsewhere. Refused (with the reason's code, [`INSTALL_REFUSALS`]): a
+    /// tick already stepped past, no slot left, a clear naming no fault.
+    pub fn install(
+        &mut self,
+        req: LiveRequest,
+        next_tick: u64,
+    ) -> Result<Installed, (u8, Installed)> {
+        let tick = if req.at_tick == AT_NEXT_TICK {
+            next_tick
+        } else {
+            req.at_tick
+        };
+        let at_ns = tick.saturating_mul(self.frame_ns);
+        match req.kind {
+            RequestKind::Inject(b) => {
+                if tick < next_tick {
+                    return Err((REFUSED_LATE, Installed(Some(b))));
+                }
+                if self.live.len() >= self.configured + MAX_LIVE_FAULTS
+                    || self.live.len() == self.live.capacity()
+                {
+                    return Err((REFUSED_NO_SLOT, Installed(Some(b))));
+                }
+                let mut b = b;
+                let mut l = std::mem::replace(&mut *b, Live::placeholder());
+                l.spec.window.start_ns = at_ns;
+                self.any_actuator |= l.actuator.is_some();
+                self.live.push(l);
+                Ok(Installed(Some(b)))
+            }
+            RequestKind::Clear(i) => {
+                if tick < next_tick {
+                    return Err((REFUSED_LATE, Installed(None)));
+                }
+                let Some(l) = self.live.get_mut(i as usize) else {
+                    return Err((REFUSED_NO_INDEX, Installed(None)));
+                };
+                l.cleared_from_ns = l.cleared_from_ns.min(at_ns);
+                Ok(Installed(None))
+            }
+        }
+    }
+
+    /// Notes each fault's state at the boundary of tick `k` (time `t_ns`): an event for every
+    /// activation and clearance since the last boundary noted (a re-activation of a repeating
+    /// fault in between gives both), and the active set. Allocation-free once
+    /// [`Self::reserve_live`] has run (a full event buffer drops and counts).
+    pub fn note_boundary(&mut self, k: u64, t_ns: u64) {
+        self.active_count = 0;
+        self.active_bits = [0; 4];
+        for (i, l) in self.live.iter_mut().enumerate() {
+            let now = l.state_at(t_ns);
+            let mut emit = |active: bool, edge_ns: u64, l: &Live| {
+                let ev = FaultEventMsg {
+                    header: Header::new(0, k, t_ns, self.event_seq),
+                    fault_index: i as u32,
+                    source: l.spec.source,
+                    mode: l.spec.mode.index() as u32,
+                    active,
+                    edge_ns,
+                    axes: l.spec.axes,
+                    params: l.spec.mode.params(),
+                    target: l.target,
+                };
+                if self.events.len() < self.events.capacity() {
+                    self.events.push(ev);
+                    self.event_seq += 1;
+                } else {
+                    self.events_lost += 1;
+                }
+            };
+            match (l.reported, now) {
+                (None, Some(start)) => emit(true, start, l),
+                (Some(prev), None) => emit(false, l.end_of(prev, t_ns), l),
+                (Some(prev), Some(start)) if prev != start => {
+                    emit(false, l.end_of(prev, t_ns), l);
+                    emit(true, start, l);
+                }
+                _ => {}
+            }
+            l.reported = now;
+            if now.is_some() {
+                self.active_count += 1;
+                if let Some(w) = self.active_bits.get_mut(i / 64) {
+                    *w |= 1 << (i % 64);
+                }
+            }
+        }
+    }
+
+    /// Moves the events noted (oldest first) into `out` as far as its spare capacity goes,
+    /// with `spacecraft_id` in their headers; the rest wait for the next call. Allocation-free.
+    pub fn take_events_into(&mut self, spacecraft_id: u32, out: &mut Vec<FaultEventMsg>) {
+        let n = self.events.len().min(out.capacity() - out.len());
+        for mut e in self.events.drain(..n) {
+            e.header.spacecraft_id = spacecraft_id;
+            out.push(e);
+        }
+    }
+
+    /// The faults active at the last boundary noted: their count and the bits of indices
+    /// 0–255 (StatusMsg).
+    pub fn active(&self) -> (u64, [u64; 4]) {
+        (self.active_count, self.active_bits)
+    }
+
+    /// How many faults come from the configuration (live ones are indexed after them).
+    pub fn configured(&self) -> usize {
+        self.configured
     }
 
     /// Whether there is none.
@@ -170,10 +383,53 @@ impl Faults {
 }
 
 impl Live {
+    /// An empty fault, left in a live request's box when its contents move into a slot.
+    fn placeholder() -> Self {
+        Live {
+            spec: FaultSpec {
+                target: String::new(),
+                mode: FaultMode::Dropout,
+                window: super::FaultWindow::from(u64::MAX),
+                axes: 0,
+                seed: 0,
+                port: Port::Actuator { effector: 0 },
+                source: flexdyn_proto::FaultSource::Live,
+            },
+            target: FaultTarget::default(),
+            cleared_from_ns: 0,
+            reported: None,
+            rng: NormalRng::new(0),
+            on: None,
+            held: [[0.0; MAX_AXES]; MAX_CHANNELS],
+            held_set: false,
+            actuator: None,
+        }
+    }
+
+    /// The activation in force at `t_ns` (its start), a clearance included; no side effects.
+    #[inline]
+    fn state_at(&self, t_ns: u64) -> Option<u64> {
+        if t_ns >= self.cleared_from_ns {
+            return None;
+        }
+        self.spec.window.activation_at(t_ns)
+    }
+
+    /// \[ns\] when the activation that began at `start_ns` ended, seen at `t_ns`: its
+    /// duration's end or its clearance, whichever came first (at most `t_ns`).
+    fn end_of(&self, start_ns: u64, t_ns: u64) -> u64 {
+        let by_window = self
+            .spec
+            .window
+            .duration_ns
+            .map_or(u64::MAX, |d| start_ns.saturating_add(d));
+        by_window.min(self.cleared_from_ns).min(t_ns)
+    }
+
     /// The activation in force at `t_ns` (a new one forgets the held values).
     #[inline]
     fn activation(&mut self, t_ns: u64) -> Option<u64> {
-        let on = self.spec.window.activation_at(t_ns);
+        let on = self.state_at(t_ns);
         if on != self.on {
             self.on = on;
             self.held_set = false;

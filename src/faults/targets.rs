@@ -29,7 +29,7 @@ pub(crate) fn resolve(
         .collect()
 }
 
-fn resolve_one(
+pub(super) fn resolve_one(
     index: usize,
     r: &RawFault,
     bank: &SensorBank,
@@ -267,6 +267,11 @@ fn resolve_one(
         axes,
         seed,
         port,
+        source: if r.mtbf_s.is_some() {
+            flexdyn_proto::FaultSource::Random
+        } else {
+            flexdyn_proto::FaultSource::Config
+        },
     })
 }
 

@@ -149,6 +149,19 @@ impl LockstepCore {
         }
     }
 
+    /// A live fault request from the fault callback, installed before frame `k → k + 1` is
+    /// stepped (so at boundary `k + 1` at the earliest); `Err` with the refusal's code
+    /// ([`crate::faults::ports::INSTALL_REFUSALS`]).
+    pub fn install_fault(&mut self, req: crate::faults::ports::LiveRequest) -> Result<(), u8> {
+        if self.ended() {
+            return Err(crate::faults::ports::REFUSED_LATE);
+        }
+        self.w
+            .install_fault(req, self.k)
+            .map(drop)
+            .map_err(|(code, _)| code)
+    }
+
     /// A validated command from the Zenoh callback: offered for the current tick; the last
     /// answer steps the frame and publishes the next state.
     pub fn offer(&mut self, cmd: &CommandMsg) {

@@ -49,6 +49,7 @@ pub mod cli;
 pub mod clock;
 pub mod commands;
 pub mod error;
+pub mod fault_cmd;
 mod intake;
 pub mod lockstep;
 pub mod operator;
@@ -140,6 +141,20 @@ pub async fn run(
         mode,
         settings.spacecraft_id,
         core,
+        record_tx.clone(),
+    )
+    .await?;
+
+    // zenoh rx: live faults (resolved there, installed by whoever steps the frames).
+    let resolver = crate::faults::live::LiveResolver::new(&cfg)
+        .map_err(|source| ServerError::Config { file: None, source })?;
+    let _faults = fault_cmd::declare(
+        &session,
+        &topics,
+        resolver,
+        wiring.fault_sink,
+        shared.clone(),
+        settings.spacecraft_id,
         record_tx.clone(),
     )
     .await?;
@@ -267,6 +282,7 @@ enum Frames {
 struct Wiring {
     frames: Frames,
     sink: CommandSink,
+    fault_sink: fault_cmd::FaultSink,
     telemetry: TelemetryCtx,
 }
 
@@ -311,9 +327,15 @@ impl Wiring {
         let n_buffers = settings.telemetry_buffers;
         let (free_tx, free_rx) = sync_channel::<Box<Frame>>(n_buffers);
         let (full_tx, full_rx) = sync_channel::<Box<Frame>>(n_buffers);
+        // Live faults: resolved requests in (one queue slot per live-fault slot), their boxes
+        // back to be freed by the telemetry thread.
+        let (fault_tx, fault_rx) = sync_channel(crate::faults::MAX_LIVE_FAULTS);
+        let (fault_recycle_tx, fault_recycle_rx) = sync_channel(2 * crate::faults::MAX_LIVE_FAULTS);
         let shape = sim.blank_state();
         let n_sensors = sim.sensors().len();
-        let new_frame = || Box::new(Frame::for_state(&shape, n_sensors));
+        let n_events = sim.faults().event_capacity();
+        let new_frame =
+            || Box::new(Frame::for_state(&shape, n_sensors).with_fault_events(n_events));
         let frame_ns = sim.frame_ns();
         let input_ranges = sim.spacecraft().effector_input_ranges().to_vec();
         let stepper = Stepper::new(sim, settings);
@@ -321,7 +343,7 @@ impl Wiring {
         // Who steps the frames, and where the frame publishers go: the physics thread (real
         // time, direct), the lockstep core (lockstep, direct) or the telemetry thread
         // (otherwise).
-        let (frames, sink, telemetry_publisher) = if direct && mode == Mode::Lockstep {
+        let (frames, sink, fault_sink, telemetry_publisher) = if direct && mode == Mode::Lockstep {
             let events = Arc::new(Notify::new());
             let core = Arc::new(Mutex::new(LockstepCore::new(
                 stepper,
@@ -333,12 +355,13 @@ impl Wiring {
                 events.clone(),
             )));
             let sink = CommandSink::Core(core.clone());
+            let fault_sink = fault_cmd::FaultSink::Core(core.clone());
             let frames = Frames::Core {
                 core,
                 events,
                 full_tx,
             };
-            (frames, sink, None)
+            (frames, sink, fault_sink, None)
         } else {
             // The telemetry pool, which only the physics thread's frames go through.
             for _ in 0..n_buffers {
@@ -361,6 +384,8 @@ impl Wiring {
                 total_frames,
                 cmd_rx,
                 recycle_tx,
+                fault_rx,
+                fault_recycle_tx,
                 free_rx,
                 full_tx,
                 shared: shared.clone(),
@@ -371,6 +396,7 @@ impl Wiring {
             (
                 frames,
                 CommandSink::Queue(Mutex::new((cmd_tx, gate))),
+                fault_cmd::FaultSink::Queue(fault_tx),
                 telemetry,
             )
         };
@@ -380,6 +406,7 @@ impl Wiring {
             full_rx,
             free_tx,
             recycle_rx,
+            fault_recycle_rx,
             shared: shared.clone(),
             settings: settings.clone(),
             frame_ns,
@@ -388,6 +415,7 @@ impl Wiring {
         Ok(Self {
             frames,
             sink,
+            fault_sink,
             telemetry,
         })
     }

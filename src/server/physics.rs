@@ -81,6 +81,10 @@ pub struct PhysicsCtx {
     /// Consumed commands, handed back to be freed off this thread (when the channel is full the
     /// command is freed here instead; never blocks).
     pub recycle_tx: SyncSender<CommandMsg>,
+    /// Live fault requests, resolved by the fault callback ([`super::fault_cmd`]).
+    pub fault_rx: Receiver<crate::faults::ports::LiveRequest>,
+    /// Installed requests' boxes, handed back to be freed off this thread.
+    pub fault_recycle_tx: SyncSender<crate::faults::ports::Installed>,
     /// Free telemetry buffers returned by the I/O thread.
     pub free_rx: Receiver<Box<Frame>>,
     /// Filled telemetry buffers to publish.
@@ -123,9 +127,13 @@ impl Stepper {
             sim.spacecraft().effector_input_ranges(),
         );
         let state = sim.blank_state();
+        // Live faults go into slots reserved here (the stepping path never allocates one).
+        sim.faults_mut().reserve_live();
         // Sensors are sampled at every frame where they are due, published or not (an IMU
         // closes its interval every frame).
         sim.sample_sensors(|s| s.due(0));
+        let t0 = sim.t_sim_ns();
+        sim.faults_mut().note_boundary(0, t0);
         let clock = TimeService::new(
             sim.epoch().cloned(),
             settings.spacecraft_id,
@@ -161,6 +169,10 @@ impl Stepper {
         }
         frame.lateness_ns = 0;
         frame.published = false;
+        frame.fault_events.clear();
+        let faults = self.sim.faults_mut();
+        faults.take_events_into(self.spacecraft_id, &mut frame.fault_events);
+        frame.faults_active = faults.active();
         frame.sensors_sampled.clear();
         let bank = self.sim.sensors();
         for &i in bank.sampled() {
@@ -185,6 +197,19 @@ impl Stepper {
         let _ = self.sim.set_effector_inputs(self.book.held_inputs());
         self.sim.step_frame();
         self.sim.sample_sensors(|s| s.due(k + 1));
+        let t = self.sim.t_sim_ns();
+        self.sim.faults_mut().note_boundary(k + 1, t);
+    }
+
+    /// Installs a live fault request before frame `k → k + 1` is stepped (it takes effect at
+    /// boundary `k + 1` at the earliest). Allocation- and lock-free; the request's box comes
+    /// back to be freed off the stepping path, refused or not.
+    pub fn install_fault(
+        &mut self,
+        req: crate::faults::ports::LiveRequest,
+        k: u64,
+    ) -> Result<crate::faults::ports::Installed, (u8, crate::faults::ports::Installed)> {
+        self.sim.faults_mut().install(req, k + 1)
     }
 
     /// Once per frame, outside the RK4 loop: never publish a non-finite state. `filled` says
@@ -274,6 +299,21 @@ impl PhysicsCtx {
         while let Ok(cmd) = self.cmd_rx.try_recv() {
             count_offer(&self.shared, book.offer_latest(&cmd, k), cmd.sender_id);
             let _ = self.recycle_tx.try_send(cmd);
+        }
+    }
+
+    /// Installs the live faults that have arrived, before frame `k → k + 1` is stepped; counts
+    /// the refused ones. Allocation- and lock-free (the boxes go back to the telemetry thread).
+    fn drain_faults(&self, w: &mut Stepper, k: u64) {
+        while let Ok(req) = self.fault_rx.try_recv() {
+            let installed = match w.install_fault(req, k) {
+                Ok(i) => i,
+                Err((code, i)) => {
+                    self.shared.reject_fault_physics(code);
+                    i
+                }
+            };
+            let _ = self.fault_recycle_tx.try_send(installed);
         }
     }
 
@@ -451,7 +491,8 @@ impl PhysicsCtx {
                 Mode::RealTime | Mode::Batch => self.drain_commands(&mut w.book, k),
             }
 
-            // 3. Integrate the frame.
+            // Live faults for boundary k + 1 on, then 3. integrate the frame.
+            self.drain_faults(&mut w, k);
             w.step(k);
             k += 1;
 

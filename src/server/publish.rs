@@ -1,6 +1,7 @@
 //! Publishing one frame's telemetry: its TimeMsg, then the messages of the sensors sampled at
 //! its tick (in publication order: [`crate::sensors::KINDS`], then config order), then its
-//! StateMsg, then (when due) its EnvironmentMsg, in that order (a controller that waits for the state finds the sensor
+//! StateMsg, then (when due) its EnvironmentMsg, then its fault events (FaultEventMsg), in that
+//! order (a controller that waits for the state finds the sensor
 //! samples of the same tick already delivered).
 //!
 //! Which thread calls [`FramePublisher::publish`] is the `server.handoff` setting:
@@ -46,6 +47,8 @@ pub struct Recording {
     state: Arc<str>,
     /// `flexdyn/<sc>/tlm/env`, when the environment message is on.
     environment: Option<Arc<str>>,
+    /// `flexdyn/<sc>/tlm/fault`, when fault events are published.
+    fault_events: Option<Arc<str>>,
     /// `flexdyn/<sc>/status`.
     pub status: Arc<str>,
     /// Per sensor of the bank, its key.
@@ -70,6 +73,12 @@ impl Recording {
         if let (Some(env), Some(key)) = (&frame.environment, &self.environment) {
             encode_into(env, buf);
             self.submit(key, buf, stamp);
+        }
+        if let Some(key) = &self.fault_events {
+            for ev in &frame.fault_events {
+                encode_into(ev, buf);
+                self.submit(key, buf, stamp);
+            }
         }
     }
 
@@ -105,6 +114,9 @@ pub struct FramePublisher {
     /// `flexdyn/<sc>/tlm/env` (`[environment] telemetry_rate_hz` set), with its buffer.
     pub environment_pub: Option<Publisher<'static>>,
     environment_buf: Vec<u8>,
+    /// `flexdyn/<sc>/tlm/fault` (fault activations and clearances), with its buffer.
+    pub fault_pub: Option<Publisher<'static>>,
+    fault_buf: Vec<u8>,
 }
 
 impl FramePublisher {
@@ -122,6 +134,8 @@ impl FramePublisher {
             state_buf: Vec::with_capacity(4096),
             environment_pub: None,
             environment_buf: Vec::with_capacity(flexdyn_proto::ENVIRONMENT_LEN),
+            fault_pub: None,
+            fault_buf: Vec::with_capacity(flexdyn_proto::FAULT_EVENT_LEN),
         }
     }
 
@@ -133,6 +147,7 @@ impl FramePublisher {
             time: key(&self.time_pub),
             state: key(&self.state_pub),
             environment: self.environment_pub.as_ref().map(key),
+            fault_events: self.fault_pub.as_ref().map(key),
             status: key(status),
             sensors: self.sensor_pubs.iter().map(|(_, p)| key(p)).collect(),
         }
@@ -177,6 +192,7 @@ impl FramePublisher {
         });
         encode_into(&frame.state, &mut self.state_buf);
         shared.set_last_command(&frame.command);
+        shared.set_faults_active(frame.faults_active.0, &frame.faults_active.1);
         match self
             .state_pub
             .put(self.state_buf.as_slice())
@@ -203,6 +219,21 @@ impl FramePublisher {
             }
             if let Some((r, key)) = rec.and_then(|r| Some((r, r.environment.as_ref()?))) {
                 r.submit(key, &self.environment_buf, Some(frame.boundary_unix_ns));
+            }
+        }
+        if let Some(publisher) = &self.fault_pub {
+            for ev in &frame.fault_events {
+                encode_into(ev, &mut self.fault_buf);
+                if let Err(e) = publisher
+                    .put(self.fault_buf.as_slice())
+                    .attachment(stamp)
+                    .wait()
+                {
+                    Self::count_error(shared, &"fault event", &e);
+                }
+                if let Some((r, key)) = rec.and_then(|r| Some((r, r.fault_events.as_ref()?))) {
+                    r.submit(key, &self.fault_buf, Some(frame.boundary_unix_ns));
+                }
             }
         }
     }

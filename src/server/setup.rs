@@ -101,6 +101,9 @@ impl Endpoints {
                 telemetry_pub(topics.environment(), "declare the environment publisher").await?,
             );
         }
+        // Fault events: configured faults, and live ones may come at any time.
+        frames.fault_pub =
+            Some(telemetry_pub(topics.fault_events(), "declare the fault-event publisher").await?);
 
         let vehicle = VehicleInfo {
             sc_id: settings.sc_id.clone(),

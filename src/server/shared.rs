@@ -39,6 +39,12 @@ pub struct Frame {
     /// Already published by the thread that finished the frame (`handoff = "direct"`): the
     /// telemetry thread only records it and keeps the books.
     pub published: bool,
+    /// The fault activations and clearances seen up to this tick and not yet published
+    /// (FaultEventMsg, after the state), within the capacity reserved
+    /// ([`Self::with_fault_events`]); more wait for the next frame.
+    pub fault_events: Vec<flexdyn_proto::FaultEventMsg>,
+    /// The faults active at this tick: count and the bits of indices 0–255 (StatusMsg).
+    pub faults_active: (u64, [u64; 4]),
 }
 
 impl Frame {
@@ -59,7 +65,16 @@ impl Frame {
                 .collect(),
             environment: None,
             published: false,
+            fault_events: Vec::new(),
+            faults_active: (0, [0; 4]),
         }
+    }
+
+    /// Room for `n` fault events per frame (the simulation's
+    /// [`crate::faults::Faults::event_capacity`]), so filling them does not allocate.
+    pub fn with_fault_events(mut self, n: usize) -> Self {
+        self.fault_events = Vec::with_capacity(n);
+        self
     }
 }
 
@@ -116,6 +131,17 @@ pub struct Shared {
     bad_effector_input: AtomicU64,
     wrong_identity: AtomicU64,
     operator_refused: AtomicU64,
+    fault_refused: AtomicU64,
+    /// Fault requests the physics side refused ([`crate::faults::ports::INSTALL_REFUSALS`]),
+    /// and the code of the last one, for the telemetry thread's log.
+    pub faults_refused_physics: AtomicU64,
+    /// See [`Self::faults_refused_physics`].
+    pub last_fault_refusal: AtomicU8,
+    /// The faults active at the last frame published: their count and the bits of indices
+    /// 0–255 ([`flexdyn_proto::StatusMsg::faults_active_bits`]), stored by whoever publishes
+    /// the frame (atomics: the physics side never waits for StatusMsg).
+    faults_active: AtomicU64,
+    faults_active_bits: [AtomicU64; 4],
     /// The operator's hold target (`flexdyn/<sc>/operator`): 0 = none, `h + 1` = hold at the
     /// first frame boundary `k ≥ h` (see [`Self::holds_at`]). Set by the operator callback, read
     /// by whoever steps the frames (one atomic load per frame).
@@ -269,6 +295,41 @@ impl Shared {
         bump(&self.operator_refused);
     }
 
+    /// Count a fault command the server did not apply.
+    pub fn reject_fault(&self) {
+        bump(&self.fault_refused);
+    }
+
+    /// Count a fault request the physics side refused, with its reason's code
+    /// (allocation- and lock-free).
+    pub fn reject_fault_physics(&self, code: u8) {
+        self.last_fault_refusal.store(code, Ordering::Relaxed);
+        bump(&self.faults_refused_physics);
+        bump(&self.fault_refused);
+    }
+
+    /// Notes the faults active at the frame just published (allocation- and lock-free).
+    pub fn set_faults_active(&self, count: u64, bits: &[u64; 4]) {
+        self.faults_active.store(count, Ordering::Relaxed);
+        for (a, b) in self.faults_active_bits.iter().zip(bits) {
+            a.store(*b, Ordering::Relaxed);
+        }
+    }
+
+    /// The faults active at the last frame published: (count, bits), as StatusMsg carries them.
+    pub fn faults_active(&self) -> (u64, [u64; 4]) {
+        let l = |c: &AtomicU64| c.load(Ordering::Relaxed);
+        (
+            l(&self.faults_active),
+            [
+                l(&self.faults_active_bits[0]),
+                l(&self.faults_active_bits[1]),
+                l(&self.faults_active_bits[2]),
+                l(&self.faults_active_bits[3]),
+            ],
+        )
+    }
+
     /// The operator's hold target: hold at the first frame boundary at or after this tick.
     pub fn hold_target(&self) -> Option<u64> {
         self.hold_target.load(Ordering::Acquire).checked_sub(1)
@@ -325,6 +386,7 @@ impl Shared {
             bad_effector_input: l(&self.bad_effector_input),
             wrong_identity: l(&self.wrong_identity),
             operator_refused: l(&self.operator_refused),
+            fault_refused: l(&self.fault_refused),
         }
     }
 

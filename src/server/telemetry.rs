@@ -71,6 +71,8 @@ pub struct TelemetryCtx {
     pub free_tx: SyncSender<Box<Frame>>,
     /// Commands the physics thread has consumed, freed here.
     pub recycle_rx: Receiver<flexdyn_proto::CommandMsg>,
+    /// Live fault requests the physics thread has installed (their boxes), freed here.
+    pub fault_recycle_rx: Receiver<crate::faults::ports::Installed>,
     /// Counters.
     pub shared: Arc<Shared>,
     /// Settings (mode, ids, rates).
@@ -90,6 +92,7 @@ struct Publishing {
 impl TelemetryCtx {
     fn publish_status(&self, p: &mut Publishing, buf: &mut Vec<u8>, rec: Option<&Recording>) {
         let tick = self.shared.tick.load(Ordering::Relaxed);
+        let (faults_active, faults_active_bits) = self.shared.faults_active();
         let msg = StatusMsg {
             header: Header::new(
                 self.settings.spacecraft_id,
@@ -108,6 +111,8 @@ impl TelemetryCtx {
             rejected: self.shared.rejected(),
             commands_dropped: self.shared.commands_dropped.load(Ordering::Relaxed),
             wall_time_unix_ns: unix_now_ns(),
+            faults_active,
+            faults_active_bits,
         };
         p.status_seq += 1;
         encode_into(&msg, buf);
@@ -128,6 +133,7 @@ impl TelemetryCtx {
         log: &mut RejectLog,
         seen: &mut [u64],
         bad_inputs_seen: &mut u64,
+        faults_seen: &mut u64,
     ) {
         for ((id, count), last) in self.shared.stale_by_participant.iter().zip(seen) {
             let now = count.load(Ordering::Relaxed);
@@ -142,6 +148,22 @@ impl TelemetryCtx {
                 );
                 *last = now;
             }
+        }
+        let now = self.shared.faults_refused_physics.load(Ordering::Relaxed);
+        if now > *faults_seen {
+            let code = self.shared.last_fault_refusal.load(Ordering::Relaxed);
+            log.record(
+                "fault_refused",
+                None,
+                now - *faults_seen,
+                &format_args!(
+                    "live fault command(s) refused; the last: {}",
+                    crate::faults::ports::INSTALL_REFUSALS
+                        .get(usize::from(code))
+                        .unwrap_or(&"")
+                ),
+            );
+            *faults_seen = now;
         }
         let now = self.shared.rejected().bad_effector_input;
         if now > *bad_inputs_seen {
@@ -207,10 +229,16 @@ impl TelemetryCtx {
         let mut rejects = RejectLog::default();
         let mut stale_seen = vec![0u64; self.shared.stale_by_participant.len()];
         let mut bad_inputs_seen = 0u64;
+        let mut faults_seen = 0u64;
         loop {
             let now = Instant::now();
             if now >= next_status {
-                self.warn_physics_rejects(&mut rejects, &mut stale_seen, &mut bad_inputs_seen);
+                self.warn_physics_rejects(
+                    &mut rejects,
+                    &mut stale_seen,
+                    &mut bad_inputs_seen,
+                    &mut faults_seen,
+                );
                 self.publish_status(&mut p, &mut status_buf, rec.as_ref());
                 next_status += status_period;
                 if next_status < now {
@@ -227,8 +255,9 @@ impl TelemetryCtx {
             let wait = next_status
                 .min(next_summary)
                 .saturating_duration_since(Instant::now());
-            // Free the commands the physics thread is done with.
+            // Free the commands and fault requests the physics thread is done with.
             while self.recycle_rx.try_recv().is_ok() {}
+            while self.fault_recycle_rx.try_recv().is_ok() {}
             // Never waits inside the channel: parks, and the physics thread unparks it after
             // each frame. A receiver waiting in the channel would make the physics thread's
             // send take the channel's waker lock, which this thread (normal priority) holds
@@ -263,7 +292,12 @@ impl TelemetryCtx {
                 Err(RecvTimeoutError::Disconnected) => break,
             }
         }
-        self.warn_physics_rejects(&mut rejects, &mut stale_seen, &mut bad_inputs_seen);
+        self.warn_physics_rejects(
+            &mut rejects,
+            &mut stale_seen,
+            &mut bad_inputs_seen,
+            &mut faults_seen,
+        );
         self.publish_status(&mut p, &mut status_buf, rec.as_ref());
         TelemetryReport {
             lateness: p.lateness,

@@ -31,8 +31,9 @@ impl SeqGaps {
             | TopicKind::Sensor(_)
             | TopicKind::Status
             | TopicKind::Time
-            | TopicKind::Environment => true,
-            TopicKind::Command | TopicKind::Operator => false,
+            | TopicKind::Environment
+            | TopicKind::FaultEvent => true,
+            TopicKind::Command | TopicKind::Operator | TopicKind::FaultCommand => false,
         }
     }
 

@@ -217,7 +217,11 @@ fn from_mcap(
                 .or_default()
                 .push(&cells),
             TopicKind::Environment => data.environment.push(&cells),
-            TopicKind::Command | TopicKind::Time | TopicKind::Operator => {}
+            TopicKind::Command
+            | TopicKind::Time
+            | TopicKind::Operator
+            | TopicKind::FaultEvent
+            | TopicKind::FaultCommand => {}
         }
     }
     if data.state.is_empty() {

@@ -12,6 +12,11 @@ use flexdyn_proto::{
     decode_command, decode_environment, decode_operator, decode_state, decode_status, decode_time,
     CommandMsg, DecodeError, EnvironmentMsg, Header, OperatorMsg, StateMsg, StatusMsg, TimeMsg,
 };
+// Fault injection (protocol 8).
+use flexdyn_proto::{
+    decode_fault_command, decode_fault_event, FaultCommandMsg, FaultEventMsg, FAULT_EVENT_SUFFIX,
+    FAULT_SUFFIX,
+};
 
 use crate::sensors::{SensorKind, KINDS};
 
@@ -34,6 +39,10 @@ pub enum TopicKind {
     Operator,
     /// `flexdyn/<sc>/tlm/env`: [`EnvironmentMsg`] (the environment's truth).
     Environment,
+    /// `flexdyn/<sc>/tlm/fault`: [`FaultEventMsg`] (a fault's activation or clearance).
+    FaultEvent,
+    /// `flexdyn/<sc>/fault`: [`FaultCommandMsg`] (a live fault command).
+    FaultCommand,
 }
 
 impl TopicKind {
@@ -47,6 +56,8 @@ impl TopicKind {
                 TopicKind::Time,
                 TopicKind::Operator,
                 TopicKind::Environment,
+                TopicKind::FaultEvent,
+                TopicKind::FaultCommand,
             ])
     }
 
@@ -73,6 +84,8 @@ impl TopicKind {
             TopicKind::Time => "TimeMsg",
             TopicKind::Operator => "OperatorMsg",
             TopicKind::Environment => "EnvironmentMsg",
+            TopicKind::FaultEvent => "FaultEventMsg",
+            TopicKind::FaultCommand => "FaultCommandMsg",
         }
     }
 }
@@ -108,6 +121,10 @@ pub fn classify(key: &str) -> Option<Topic<'_>> {
         (TopicKind::Time, None)
     } else if suffix == ENVIRONMENT_SUFFIX {
         (TopicKind::Environment, None)
+    } else if suffix == FAULT_EVENT_SUFFIX {
+        (TopicKind::FaultEvent, None)
+    } else if suffix == FAULT_SUFFIX {
+        (TopicKind::FaultCommand, None)
     } else if let Some(sender) =
         sensor(CMD_PREFIX).filter(|s| s.bytes().all(|b| b.is_ascii_digit()))
     {
@@ -157,6 +174,10 @@ pub enum Decoded {
     Operator(OperatorMsg),
     /// An environment message.
     Environment(EnvironmentMsg),
+    /// A fault event.
+    FaultEvent(FaultEventMsg),
+    /// A live fault command.
+    FaultCommand(FaultCommandMsg),
 }
 
 impl Decoded {
@@ -180,6 +201,8 @@ impl Decoded {
             TopicKind::Time => Decoded::Time(decode_time(payload)?),
             TopicKind::Operator => Decoded::Operator(decode_operator(payload)?),
             TopicKind::Environment => Decoded::Environment(decode_environment(payload)?),
+            TopicKind::FaultEvent => Decoded::FaultEvent(decode_fault_event(payload)?),
+            TopicKind::FaultCommand => Decoded::FaultCommand(decode_fault_command(payload)?),
         })
     }
 
@@ -193,6 +216,8 @@ impl Decoded {
             Decoded::Time(m) => &m.header,
             Decoded::Operator(m) => &m.header,
             Decoded::Environment(m) => &m.header,
+            Decoded::FaultEvent(m) => &m.header,
+            Decoded::FaultCommand(m) => &m.header,
         }
     }
 
@@ -207,6 +232,8 @@ impl Decoded {
             Decoded::Time(m) => serde_json::to_vec(m),
             Decoded::Operator(m) => serde_json::to_vec(m),
             Decoded::Environment(m) => serde_json::to_vec(m),
+            Decoded::FaultEvent(m) => serde_json::to_vec(m),
+            Decoded::FaultCommand(m) => serde_json::to_vec(m),
         };
         v.unwrap_or_else(|_| b"null".to_vec())
     }
@@ -221,6 +248,8 @@ impl Decoded {
             Decoded::Time(m) => serde_json::to_value(m),
             Decoded::Operator(m) => serde_json::to_value(m),
             Decoded::Environment(m) => serde_json::to_value(m),
+            Decoded::FaultEvent(m) => serde_json::to_value(m),
+            Decoded::FaultCommand(m) => serde_json::to_value(m),
         };
         // The wire structs hold only numbers, bools, enums and vectors: always representable.
         v.unwrap_or(serde_json::Value::Null)
@@ -241,6 +270,8 @@ pub fn json_schema(kind: TopicKind) -> serde_json::Value {
         TopicKind::Time => schemars::schema_for!(TimeMsg),
         TopicKind::Operator => schemars::schema_for!(OperatorMsg),
         TopicKind::Environment => schemars::schema_for!(EnvironmentMsg),
+        TopicKind::FaultEvent => schemars::schema_for!(FaultEventMsg),
+        TopicKind::FaultCommand => schemars::schema_for!(FaultCommandMsg),
     };
     schema.to_value()
 }

@@ -118,8 +118,11 @@ pub struct FdStatusMsg {
     pub rejected_bad_effector_input: u64,
     pub rejected_wrong_identity: u64,
     pub rejected_operator_refused: u64,
+    pub rejected_fault_refused: u64,
     pub commands_dropped: u64,
     pub wall_time_unix_ns: u64,
+    pub faults_active: u64,
+    pub faults_active_bits: [u64; 4],
 }
 
 /// `fd_sys_time`.
@@ -304,6 +307,8 @@ impl From<&StatusMsg> for FdStatusMsg {
             rejected,
             commands_dropped,
             wall_time_unix_ns,
+            faults_active,
+            faults_active_bits,
         } = m;
         let FrameTiming {
             lateness_p50_ns,
@@ -328,6 +333,7 @@ impl From<&StatusMsg> for FdStatusMsg {
             bad_effector_input,
             wrong_identity,
             operator_refused,
+            fault_refused,
         } = *rejected;
         Self {
             header: header.into(),
@@ -351,8 +357,11 @@ impl From<&StatusMsg> for FdStatusMsg {
             rejected_bad_effector_input: bad_effector_input,
             rejected_wrong_identity: wrong_identity,
             rejected_operator_refused: operator_refused,
+            rejected_fault_refused: fault_refused,
             commands_dropped: *commands_dropped,
             wall_time_unix_ns: *wall_time_unix_ns,
+            faults_active: *faults_active,
+            faults_active_bits: *faults_active_bits,
         }
     }
 }

@@ -203,8 +203,12 @@ static void check_status(flexdyn_client *c, const char *dir) {
     SAME("status", a, b, rejected_bad_effector_input);
     SAME("status", a, b, rejected_wrong_identity);
     SAME("status", a, b, rejected_operator_refused);
+    SAME("status", a, b, rejected_fault_refused);
     SAME("status", a, b, commands_dropped);
     SAME("status", a, b, wall_time_unix_ns);
+    SAME("status", a, b, faults_active);
+    SAME("status", a, b, faults_active_bits[0]);
+    SAME("status", a, b, faults_active_bits[3]);
     printf("status compared\n");
 }
 

@@ -13,6 +13,7 @@ from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState
                            ImuMsg, MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg,
                            StatusMsg, TimeMsg, CssMsg, FssMsg, EnvironmentMsg, SourceWrench)
 from flexdyn.proto import GpsMsg  # protocol 7: the thirteenth decoder, generator arm 11
+from flexdyn.proto import FaultCommandMsg, FaultEventMsg  # protocol 8: decoders 14-15, arms 12-13
 
 N = 20_000
 
@@ -96,8 +97,8 @@ def status_line(m):
         m.command_stale, m.stale_policy, m.rejected_malformed, m.rejected_bad_version,
         m.rejected_non_finite, m.rejected_wrong_spacecraft, m.rejected_stale_tick,
         m.rejected_unknown_sender, m.rejected_bad_effector_input, m.rejected_wrong_identity,
-        m.rejected_operator_refused, m.commands_dropped,
-        m.wall_time_unix_ns))
+        m.rejected_operator_refused, m.rejected_fault_refused, m.commands_dropped,
+        m.wall_time_unix_ns, m.faults_active, *m.faults_active_bits))
 
 
 def time_line(m):
@@ -115,6 +116,16 @@ def gps_line(m):
                .f(m.r_be_e_m).f(m.v_be_e_m_s).f(m.r_bn_n_m).f(m.v_bn_n_m_s).u(m.flags))
 
 
+def fault_event_line(m):
+    return str(Line().h(m.header).u(m.fault_index, m.source, m.mode, m.active, m.edge_ns, m.axes)
+               .f(m.params).u(*m.target))
+
+
+def fault_command_line(m):
+    return str(Line().h(m.header).u(m.action, m.at_tick, m.fault_index, m.mode).f(m.params)
+               .u(m.axes, m.duration_ns, m.seed, *m.target))
+
+
 DECODERS = [
     (StateMsg.decode, state_line), (ImuMsg.decode, imu_line),
     (StarTrackerMsg.decode, star_tracker_line), (MagnetometerMsg.decode, magnetometer_line),
@@ -123,6 +134,7 @@ DECODERS = [
     (StatusMsg.decode, status_line), (TimeMsg.decode, time_line),
     (OperatorMsg.decode, operator_line), (Header.decode, lambda h: str(Line().h(h))),
     (GpsMsg.decode, gps_line),
+    (FaultEventMsg.decode, fault_event_line), (FaultCommandMsg.decode, fault_command_line),
 ]
 
 
@@ -160,7 +172,7 @@ def gen_buffer(r):
     def header():
         return Header(r.getrandbits(32), r.getrandbits(64), r.getrandbits(64), r.getrandbits(64))
 
-    k = r.randrange(12)
+    k = r.randrange(14)
     if k == 0:
         b = StateMsg(header(), v(3), v(4), v(3), v(3), v(3), v(3), v(3), f64(), f64(), v(3), v(3),
                      v(3), v(3), r.getrandbits(8),
@@ -184,7 +196,8 @@ def gen_buffer(r):
                         for _ in range(r.randrange(5))] if kind == proto.ACTUATORS else []).encode()
     elif k == 4:
         b = StatusMsg(header(), r.randrange(3), r.randrange(6), *(r.getrandbits(64) for _ in range(7)),
-                      r.random() < 0.5, r.randrange(2), *(r.getrandbits(64) for _ in range(11))).encode()
+                      r.random() < 0.5, r.randrange(2), *(r.getrandbits(64) for _ in range(13)),
+                      tuple(r.getrandbits(64) for _ in range(4))).encode()
     elif k == 6:
         b = TimeMsg(header(), r.randrange(7), r.randrange(3), r.getrandbits(8), r.getrandbits(64),
                     f64(), r.getrandbits(64),
@@ -204,6 +217,15 @@ def gen_buffer(r):
     elif k == 11:
         b = GpsMsg(header(), r.getrandbits(64), r.getrandbits(32), f64(), v(3), v(3), v(3), v(3),
                    r.getrandbits(8)).encode()
+    elif k == 12:
+        b = FaultEventMsg(header(), r.getrandbits(32), r.randrange(3), r.randrange(18),
+                          r.random() < 0.5, r.getrandbits(64), r.getrandbits(32), v(2),
+                          r.getrandbits(1024).to_bytes(128, "little")).encode()
+    elif k == 13:
+        g = fin if r.randrange(4) else f64
+        b = FaultCommandMsg(header(), r.randrange(2), r.getrandbits(64), r.getrandbits(32),
+                            r.randrange(18), v(2, g), r.getrandbits(32), r.getrandbits(64),
+                            r.getrandbits(64), b"imus.hub.gyro" + bytes(115)).encode()
     b = bytearray(b)
     k = r.randrange(10)
     if k in (3, 4, 5):
@@ -232,17 +254,18 @@ def test_python_and_rust_decoders_agree_on_20000_buffers(verdicts_bin):
     stream = b"".join(struct.pack("<I", len(b)) + b for b in buffers)
     rust = subprocess.run([str(verdicts_bin)], input=stream, capture_output=True, check=True)
     rust_lines = rust.stdout.decode().splitlines()
-    assert len(rust_lines) == 13 * N
+    assert len(rust_lines) == 15 * N
     reasons = {}
     names = ["state", "imu", "star_tracker", "magnetometer", "css", "fss", "environment",
-             "command", "status", "time", "operator", "header", "gps"]
+             "command", "status", "time", "operator", "header", "gps", "fault_event",
+             "fault_command"]
     for i, b in enumerate(buffers):
         for j, got in enumerate(python_lines(b)):
-            want = rust_lines[13 * i + j]
+            want = rust_lines[15 * i + j]
             assert got == want, f"buffer {i} ({len(b)} bytes), {names[j]}: Python {got!r} vs Rust {want!r}"
             key = want.split()[1] if want.startswith("E") else "accepted"
             reasons[key] = reasons.get(key, 0) + 1
-    print(f"{N} buffers x 13 decoders: {reasons}")
+    print(f"{N} buffers x 15 decoders: {reasons}")
     for k in ("accepted", "Length", "TrailingBytes", "TooLarge", "UnknownVersion", "NonFinite",
               "Malformed"):
         assert reasons.get(k, 0) > 0, k

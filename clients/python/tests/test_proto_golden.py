@@ -21,7 +21,7 @@ def bits(x):
 def test_manifest_lists_every_file(golden_dir):
     rows = [l.split("\t") for l in (golden_dir / "MANIFEST.tsv").read_text().splitlines()
             if l and not l.startswith("#")]
-    assert len(rows) == 14
+    assert len(rows) == 16
     for name, _message, length, _source in rows:
         assert (golden_dir / f"{name}.bin").stat().st_size == int(length)
 
@@ -117,9 +117,12 @@ def test_commands(golden_dir):
 def test_status(golden_dir):
     m = StatusMsg(Header(SC, 0x0102030405060708, 1_500_000_000, 99), proto.MODE_LOCKSTEP, 1,
                   1000, 250_000, 3_000_000, 3, 2, 41, 1_000_000, True, proto.STALE_POLICY_ZERO,
-                  1, 2, 3, 4, 5, 6, 8, 9, 10, 7, 1_700_000_000_123_456_789)
+                  1, 2, 3, 4, 5, 6, 8, 9, 10, 11, 7, 1_700_000_000_123_456_789,
+                  3, (0b101, 0, 0, 1 << 63))
     golden = (golden_dir / "status.bin").read_bytes()
     assert m.encode() == golden and StatusMsg.decode(golden) == m
+    assert len(golden) == proto.STATUS_LEN == 235
+    assert [i for i in range(300) if m.fault_active(i)] == [0, 2, 255]
 
 
 def test_time(golden_dir):
@@ -217,3 +220,35 @@ def test_gps(golden_dir):
     with pytest.raises(DecodeError) as e:
         GpsMsg.decode(golden[:-1])
     assert e.value.reason == "Length"
+
+
+def test_fault_event_and_command(golden_dir):
+    # FAULT_EVENT_GOLDEN and FAULT_COMMAND_GOLDEN of proto/tests/golden.rs (protocol 8).
+    from flexdyn.proto import FaultCommandMsg, FaultEventMsg
+    ev = FaultEventMsg(Header(SC, 44, 440_000_000, 1), 3, proto.FAULT_SOURCE_LIVE, 2, True,
+                       440_000_000, 0b101, (0.25, 0.0), b"imus.hub.gyro" + bytes(115))
+    golden = (golden_dir / "fault_event.bin").read_bytes()
+    assert len(golden) == proto.FAULT_EVENT_LEN == 199
+    assert ev.encode() == golden and FaultEventMsg.decode(golden) == ev
+    assert ev.target_str == "imus.hub.gyro" and ev.mode_name == "bias_step"
+    bad = bytearray(golden)
+    bad[42] = 2
+    with pytest.raises(DecodeError) as e:
+        FaultEventMsg.decode(bytes(bad))
+    assert e.value.reason == "Malformed"
+    # The SDK's builder gives the golden command from names.
+    cmd = proto.fault_command(SC, "reaction_wheels.rw2", "torque_limit", at_tick=0x1_0000_0005,
+                              duration_ns=2_000_000_000, seed=7, seq=2, tick=44, fraction=0.5)
+    cmd.header.sim_time_ns = 440_000_000
+    golden = (golden_dir / "fault_command.bin").read_bytes()
+    assert len(golden) == proto.FAULT_COMMAND_LEN == 214
+    assert cmd.encode() == golden and FaultCommandMsg.decode(golden) == cmd
+    bad = bytearray(golden)
+    bad[58:66] = struct.pack("<d", float("nan"))
+    with pytest.raises(DecodeError) as e:
+        FaultCommandMsg.decode(bytes(bad))
+    assert e.value.reason == "NonFinite" and e.value.canonical() == "E NonFinite params[1]"
+    with pytest.raises(ValueError):
+        proto.fault_command(SC, "imus.hub.gyro", "bias_step", value=1.0, factor=2.0)
+    assert proto.fault_key("sc1") == "flexdyn/sc1/fault"
+    assert proto.fault_event_key("sc1") == "flexdyn/sc1/tlm/fault"

@@ -1,5 +1,5 @@
 /*
- * flexdyn_proto.h - the flexdyn wire protocol (version 7) for C99 and C++ flight code.
+ * flexdyn_proto.h - the flexdyn wire protocol (version 8) for C99 and C++ flight code.
  *
  * Header-only: include it and call fd_decode_* / fd_encode_*. No allocation, no I/O, no
  * global state. Bytes are assembled one by one (little-endian on the wire), never cast to a
@@ -18,6 +18,7 @@
  *   4. fields in wire order: an enum tag out of range or a bool byte other than 0/1
  *                                                           -> FD_ERR_MALFORMED
  *   5. CommandMsg: a non-finite torque, force or input value (in that order)
+ *      FaultCommandMsg: a non-finite params value (since protocol 8)
  *                                                           -> FD_ERR_NON_FINITE (field named)
  *
  * Decoders write into caller storage; a StateMsg's effectors and an Actuators command's inputs
@@ -60,7 +61,7 @@
 /* ------------------------------------------------------------------------------------------ */
 /* Constants (proto/README.md).                                                                */
 
-#define FD_PROTOCOL_VERSION 7u
+#define FD_PROTOCOL_VERSION 8u
 #define FD_HEADER_LEN 30u
 #define FD_STATE_FIXED_LEN 327u
 #define FD_STATE_EFFECTOR_COUNT_OFFSET 319u
@@ -73,7 +74,7 @@
 #define FD_COMMAND_WRENCH_LEN 86u
 #define FD_COMMAND_NO_COMMAND_LEN 38u
 #define FD_COMMAND_ACTUATORS_FIXED_LEN 94u
-#define FD_STATUS_LEN 187u
+#define FD_STATUS_LEN 235u
 #define FD_TIME_LEN 122u
 /* Sun sensors (protocol 6) */
 #define FD_CSS_LEN 159u
@@ -83,6 +84,11 @@
 #define FD_OPERATOR_LEN 42u /* since protocol 6 */
 #define FD_ENVIRONMENT_LEN 368u
 #define FD_GPS_LEN 147u /* since protocol 7 */
+/* Fault injection (protocol 8) */
+#define FD_FAULT_EVENT_LEN 199u
+#define FD_FAULT_COMMAND_LEN 214u
+#define FD_FAULT_TARGET_LEN 128u
+#define FD_MAX_STATUS_FAULTS 256u
 #define FD_MAX_EFFECTORS 1024u
 #define FD_MAX_EFFECTOR_VALUES 8u
 #define FD_MAX_MESSAGE_BYTES 65536u
@@ -165,6 +171,15 @@
 #define FD_OPERATOR_PAUSE 0u
 #define FD_OPERATOR_RESUME 1u
 #define FD_OPERATOR_RUN_TICKS 2u
+/* FaultEventMsg.source (since protocol 8) */
+#define FD_FAULT_SOURCE_CONFIG 0u
+#define FD_FAULT_SOURCE_LIVE 1u
+#define FD_FAULT_SOURCE_RANDOM 2u
+/* FaultCommandMsg.action (since protocol 8) */
+#define FD_FAULT_INJECT 0u
+#define FD_FAULT_CLEAR 1u
+/* FaultCommandMsg.at_tick: at the next frame boundary. */
+#define FD_AT_NEXT_TICK UINT64_MAX
 /* CommandStatus.last_command_tick / command_age_ns before any command. */
 #define FD_NO_COMMAND UINT64_MAX
 
@@ -370,9 +385,39 @@ typedef struct {
     uint64_t rejected_bad_effector_input;
     uint64_t rejected_wrong_identity; /* since protocol 4: sender_id is not the one its key names */
     uint64_t rejected_operator_refused; /* since protocol 6: an OperatorMsg not applied */
+    uint64_t rejected_fault_refused; /* since protocol 8: a FaultCommandMsg not applied */
     uint64_t commands_dropped;
     uint64_t wall_time_unix_ns;
+    uint64_t faults_active;          /* since protocol 8: faults active at header.tick */
+    uint64_t faults_active_bits[4];  /* bit i%64 of word i/64: fault index i active (i < 256) */
 } fd_status_msg;
+
+/* A fault's activation or clearance, flexdyn/<sc>/tlm/fault (since protocol 8). */
+typedef struct {
+    fd_header header;   /* tick: the boundary where the change is seen; seq: event counter */
+    uint32_t fault_index; /* [[faults]] entry, or configured count + live order */
+    uint32_t source;    /* FD_FAULT_SOURCE_* */
+    uint32_t mode;      /* the mode code, proto/README.md "Fault modes" */
+    uint8_t active;     /* 1 activated, 0 cleared */
+    uint64_t edge_ns;   /* sim time the activation began / the clearance took effect */
+    uint32_t axes;      /* bit a: 1-based axis a + 1; 0: every axis */
+    double params[2];   /* the mode's parameters in its row's order */
+    uint8_t target[FD_FAULT_TARGET_LEN]; /* UTF-8, NUL-padded */
+} fd_fault_event_msg;
+
+/* A live fault command, flexdyn/<sc>/fault (since protocol 8). */
+typedef struct {
+    fd_header header;   /* spacecraft_id must be the server's; seq: the sender's counter */
+    uint32_t action;    /* FD_FAULT_INJECT or FD_FAULT_CLEAR */
+    uint64_t at_tick;   /* boundary at which it applies; FD_AT_NEXT_TICK: the next one */
+    uint32_t fault_index; /* CLEAR: the fault to clear; INJECT: 0 */
+    uint32_t mode;      /* INJECT: the mode code */
+    double params[2];   /* INJECT: the mode's parameters (finite) */
+    uint32_t axes;      /* INJECT: bit a: 1-based axis a + 1; 0: every axis */
+    uint64_t duration_ns; /* INJECT: 0 until cleared */
+    uint64_t seed;      /* INJECT: generator seed (noise, spikes) */
+    uint8_t target[FD_FAULT_TARGET_LEN]; /* INJECT: "imus.hub.gyro", UTF-8, NUL-padded */
+} fd_fault_command_msg;
 
 /* An operator's command, flexdyn/<sc>/operator (since protocol 6). */
 typedef struct {
@@ -936,8 +981,14 @@ static inline fd_error fd_decode_status(const uint8_t *buf, size_t len, fd_statu
     out->rejected_bad_effector_input = fd_get_u64(buf + 147);
     out->rejected_wrong_identity = fd_get_u64(buf + 155);
     out->rejected_operator_refused = fd_get_u64(buf + 163);
-    out->commands_dropped = fd_get_u64(buf + 171);
-    out->wall_time_unix_ns = fd_get_u64(buf + 179);
+    out->rejected_fault_refused = fd_get_u64(buf + 171);
+    out->commands_dropped = fd_get_u64(buf + 179);
+    out->wall_time_unix_ns = fd_get_u64(buf + 187);
+    out->faults_active = fd_get_u64(buf + 195);
+    out->faults_active_bits[0] = fd_get_u64(buf + 203);
+    out->faults_active_bits[1] = fd_get_u64(buf + 211);
+    out->faults_active_bits[2] = fd_get_u64(buf + 219);
+    out->faults_active_bits[3] = fd_get_u64(buf + 227);
     return fd_ok();
 }
 
@@ -964,8 +1015,14 @@ static inline size_t fd_encode_status(const fd_status_msg *m, uint8_t *buf, size
     fd_put_u64(buf + 147, m->rejected_bad_effector_input);
     fd_put_u64(buf + 155, m->rejected_wrong_identity);
     fd_put_u64(buf + 163, m->rejected_operator_refused);
-    fd_put_u64(buf + 171, m->commands_dropped);
-    fd_put_u64(buf + 179, m->wall_time_unix_ns);
+    fd_put_u64(buf + 171, m->rejected_fault_refused);
+    fd_put_u64(buf + 179, m->commands_dropped);
+    fd_put_u64(buf + 187, m->wall_time_unix_ns);
+    fd_put_u64(buf + 195, m->faults_active);
+    fd_put_u64(buf + 203, m->faults_active_bits[0]);
+    fd_put_u64(buf + 211, m->faults_active_bits[1]);
+    fd_put_u64(buf + 219, m->faults_active_bits[2]);
+    fd_put_u64(buf + 227, m->faults_active_bits[3]);
     return FD_STATUS_LEN;
 }
 
@@ -1150,6 +1207,87 @@ static inline size_t fd_encode_gps(const fd_gps_msg *m, uint8_t *buf, size_t cap
     return FD_GPS_LEN;
 }
 
+/* FaultEventMsg and FaultCommandMsg (protocol 8, fixed length).                             */
+
+static inline fd_error fd_decode_fault_event(const uint8_t *buf, size_t len,
+                                             fd_fault_event_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_FAULT_EVENT_LEN);
+    size_t i;
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_FAULT_EVENT_LEN, len)).status != FD_OK) return e;
+    /* Step 4 in wire order: the source tag, the active bool. */
+    if (fd_get_u32(buf + 34) > FD_FAULT_SOURCE_RANDOM)
+        return fd_fail(FD_ERR_MALFORMED, 0, len, "source tag");
+    if (buf[42] > 1) return fd_fail(FD_ERR_MALFORMED, 0, len, "active is not a bool");
+    fd_decode_header_at(buf, &out->header);
+    out->fault_index = fd_get_u32(buf + 30);
+    out->source = fd_get_u32(buf + 34);
+    out->mode = fd_get_u32(buf + 38);
+    out->active = buf[42];
+    out->edge_ns = fd_get_u64(buf + 43);
+    out->axes = fd_get_u32(buf + 51);
+    fd_get_f64s(buf + 55, out->params, 2);
+    for (i = 0; i < FD_FAULT_TARGET_LEN; ++i) out->target[i] = buf[71 + i];
+    return fd_ok();
+}
+
+static inline size_t fd_encode_fault_event(const fd_fault_event_msg *m, uint8_t *buf,
+                                           size_t cap) {
+    size_t i;
+    if (cap < FD_FAULT_EVENT_LEN || m->active > 1) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_u32(buf + 30, m->fault_index);
+    fd_put_u32(buf + 34, m->source);
+    fd_put_u32(buf + 38, m->mode);
+    buf[42] = m->active;
+    fd_put_u64(buf + 43, m->edge_ns);
+    fd_put_u32(buf + 51, m->axes);
+    fd_put_f64s(buf + 55, m->params, 2);
+    for (i = 0; i < FD_FAULT_TARGET_LEN; ++i) buf[71 + i] = m->target[i];
+    return FD_FAULT_EVENT_LEN;
+}
+
+static inline fd_error fd_decode_fault_command(const uint8_t *buf, size_t len,
+                                               fd_fault_command_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_FAULT_COMMAND_LEN);
+    size_t i;
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_FAULT_COMMAND_LEN, len)).status != FD_OK) return e;
+    if (fd_get_u32(buf + 30) > FD_FAULT_CLEAR)
+        return fd_fail(FD_ERR_MALFORMED, 0, len, "action tag");
+    /* Step 5: the parameters finite. */
+    if (!fd_is_finite(fd_get_f64(buf + 50))) return fd_fail(FD_ERR_NON_FINITE, 0, len, "params[0]");
+    if (!fd_is_finite(fd_get_f64(buf + 58))) return fd_fail(FD_ERR_NON_FINITE, 0, len, "params[1]");
+    fd_decode_header_at(buf, &out->header);
+    out->action = fd_get_u32(buf + 30);
+    out->at_tick = fd_get_u64(buf + 34);
+    out->fault_index = fd_get_u32(buf + 42);
+    out->mode = fd_get_u32(buf + 46);
+    fd_get_f64s(buf + 50, out->params, 2);
+    out->axes = fd_get_u32(buf + 66);
+    out->duration_ns = fd_get_u64(buf + 70);
+    out->seed = fd_get_u64(buf + 78);
+    for (i = 0; i < FD_FAULT_TARGET_LEN; ++i) out->target[i] = buf[86 + i];
+    return fd_ok();
+}
+
+static inline size_t fd_encode_fault_command(const fd_fault_command_msg *m, uint8_t *buf,
+                                             size_t cap) {
+    size_t i;
+    if (cap < FD_FAULT_COMMAND_LEN) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_u32(buf + 30, m->action);
+    fd_put_u64(buf + 34, m->at_tick);
+    fd_put_u32(buf + 42, m->fault_index);
+    fd_put_u32(buf + 46, m->mode);
+    fd_put_f64s(buf + 50, m->params, 2);
+    fd_put_u32(buf + 66, m->axes);
+    fd_put_u64(buf + 70, m->duration_ns);
+    fd_put_u64(buf + 78, m->seed);
+    for (i = 0; i < FD_FAULT_TARGET_LEN; ++i) buf[86 + i] = m->target[i];
+    return FD_FAULT_COMMAND_LEN;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 /* Key expressions (proto/README.md, "Topics").                                                */
 
@@ -1225,6 +1363,14 @@ static inline size_t fd_status_key(char *out, size_t cap, const char *sc) {
 /* flexdyn/<sc>/operator: operator commands (since protocol 6). */
 static inline size_t fd_operator_key(char *out, size_t cap, const char *sc) {
     return fd_key(out, cap, sc, "operator", FD_NULL);
+}
+/* flexdyn/<sc>/fault: live fault commands (since protocol 8). */
+static inline size_t fd_fault_key(char *out, size_t cap, const char *sc) {
+    return fd_key(out, cap, sc, "fault", FD_NULL);
+}
+/* flexdyn/<sc>/tlm/fault: fault activations and clearances (since protocol 8). */
+static inline size_t fd_fault_event_key(char *out, size_t cap, const char *sc) {
+    return fd_key(out, cap, sc, "tlm/fault", FD_NULL);
 }
 /* Writes the decimal form of v (no leading zero) into digits[11]; returns its first char. */
 static inline const char *fd_decimal_u32(char digits[11], uint32_t v) {

@@ -255,8 +255,14 @@ static void one(const uint8_t *buf, size_t len) {
             u(m.rejected_bad_effector_input);
             u(m.rejected_wrong_identity);
             u(m.rejected_operator_refused);
+            u(m.rejected_fault_refused);
             u(m.commands_dropped);
             u(m.wall_time_unix_ns);
+            u(m.faults_active);
+            u(m.faults_active_bits[0]);
+            u(m.faults_active_bits[1]);
+            u(m.faults_active_bits[2]);
+            u(m.faults_active_bits[3]);
             printf("\n");
         }
     }
@@ -334,6 +340,47 @@ static void one(const uint8_t *buf, size_t len) {
             fs(m.r_bn_n_m, 3);
             fs(m.v_bn_n_m_s, 3);
             u(m.flags);
+            printf("\n");
+        }
+    }
+    {
+        fd_fault_event_msg m; /* the fourteenth decoder (protocol 8) */
+        size_t i;
+        e = fd_decode_fault_event(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_fault_event(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            u(m.fault_index);
+            u(m.source);
+            u(m.mode);
+            u(m.active);
+            u(m.edge_ns);
+            u(m.axes);
+            fs(m.params, 2);
+            for (i = 0; i < FD_FAULT_TARGET_LEN; ++i) u(m.target[i]);
+            printf("\n");
+        }
+    }
+    {
+        fd_fault_command_msg m; /* the fifteenth decoder (protocol 8) */
+        size_t i;
+        e = fd_decode_fault_command(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_fault_command(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            u(m.action);
+            u(m.at_tick);
+            u(m.fault_index);
+            u(m.mode);
+            fs(m.params, 2);
+            u(m.axes);
+            u(m.duration_ns);
+            u(m.seed);
+            for (i = 0; i < FD_FAULT_TARGET_LEN; ++i) u(m.target[i]);
             printf("\n");
         }
     }

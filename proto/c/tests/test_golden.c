@@ -376,15 +376,22 @@ static void test_status(const char *dir) {
     m.rejected_bad_effector_input = 8;
     m.rejected_wrong_identity = 9;
     m.rejected_operator_refused = 10;
+    m.rejected_fault_refused = 11;
     m.commands_dropped = 7;
     m.wall_time_unix_ns = 1700000000123456789u;
+    m.faults_active = 3;
+    m.faults_active_bits[0] = 5u;
+    m.faults_active_bits[3] = 0x8000000000000000u;
     check_encoded("StatusMsg", golden, n, enc, fd_encode_status(&m, enc, sizeof enc));
     e = fd_decode_status(golden, n, &back);
     CHECK(e.status == FD_OK && same_header(&back.header, &m.header) &&
               back.wall_time_unix_ns == m.wall_time_unix_ns &&
               back.rejected_bad_effector_input == 8 && back.rejected_wrong_identity == 9 &&
               back.rejected_operator_refused == 10 && back.commands_dropped == 7 &&
-              back.stale_policy == 1 && back.command_stale == 1,
+              back.stale_policy == 1 && back.command_stale == 1 &&
+              back.rejected_fault_refused == 11 && back.faults_active == 3 &&
+              back.faults_active_bits[0] == 5u && back.faults_active_bits[1] == 0u &&
+              back.faults_active_bits[3] == 0x8000000000000000u,
           "StatusMsg decodes to the table");
     golden[34] = FD_RUN_STATE_PAUSED;
     e = fd_decode_status(golden, n, &back);
@@ -476,6 +483,74 @@ static void test_operator(const char *dir) {
     CHECK(fd_operator_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/operator") == 0,
           "operator key");
     printf("OperatorMsg: ok\n");
+}
+
+/* FAULT_EVENT_GOLDEN and FAULT_COMMAND_GOLDEN of proto/tests/golden.rs (protocol 8). */
+static void test_faults(const char *dir) {
+    uint8_t golden[256], enc[256];
+    size_t n = read_file(dir, "fault_event", golden, sizeof golden);
+    fd_fault_event_msg ev, ev_back;
+    fd_fault_command_msg cmd, cmd_back;
+    fd_error e;
+    char key[64];
+    const char *gyro = "imus.hub.gyro", *rw2 = "reaction_wheels.rw2";
+    memset(&ev, 0, sizeof ev);
+    ev.header = fd_header_new(SC, 44, 440000000u, 1);
+    ev.fault_index = 3;
+    ev.source = FD_FAULT_SOURCE_LIVE;
+    ev.mode = 2;
+    ev.active = 1;
+    ev.edge_ns = 440000000u;
+    ev.axes = 5;
+    ev.params[0] = 0.25;
+    memcpy(ev.target, gyro, strlen(gyro));
+    CHECK(n == FD_FAULT_EVENT_LEN, "fault_event.bin length");
+    check_encoded("FaultEventMsg", golden, n, enc, fd_encode_fault_event(&ev, enc, sizeof enc));
+    e = fd_decode_fault_event(golden, n, &ev_back);
+    CHECK(e.status == FD_OK && same_header(&ev_back.header, &ev.header) &&
+              ev_back.fault_index == 3 && ev_back.source == 1 && ev_back.mode == 2 &&
+              ev_back.active == 1 && ev_back.edge_ns == 440000000u && ev_back.axes == 5 &&
+              ev_back.params[0] == 0.25 && memcmp(ev_back.target, ev.target, FD_FAULT_TARGET_LEN) == 0,
+          "FaultEventMsg decodes to the table");
+    golden[34] = 3;
+    CHECK(fd_decode_fault_event(golden, n, &ev_back).status == FD_ERR_MALFORMED, "source tag 3");
+    golden[34] = 1;
+    golden[42] = 2;
+    CHECK(fd_decode_fault_event(golden, n, &ev_back).status == FD_ERR_MALFORMED, "active = 2");
+
+    n = read_file(dir, "fault_command", golden, sizeof golden);
+    memset(&cmd, 0, sizeof cmd);
+    cmd.header = fd_header_new(SC, 44, 440000000u, 2);
+    cmd.action = FD_FAULT_INJECT;
+    cmd.at_tick = 0x100000005u;
+    cmd.mode = 10;
+    cmd.params[0] = 0.5;
+    cmd.duration_ns = 2000000000u;
+    cmd.seed = 7;
+    memcpy(cmd.target, rw2, strlen(rw2));
+    CHECK(n == FD_FAULT_COMMAND_LEN, "fault_command.bin length");
+    check_encoded("FaultCommandMsg", golden, n, enc,
+                  fd_encode_fault_command(&cmd, enc, sizeof enc));
+    e = fd_decode_fault_command(golden, n, &cmd_back);
+    CHECK(e.status == FD_OK && same_header(&cmd_back.header, &cmd.header) &&
+              cmd_back.action == 0 && cmd_back.at_tick == 0x100000005u && cmd_back.mode == 10 &&
+              cmd_back.params[0] == 0.5 && cmd_back.duration_ns == 2000000000u &&
+              cmd_back.seed == 7 && memcmp(cmd_back.target, cmd.target, FD_FAULT_TARGET_LEN) == 0,
+          "FaultCommandMsg decodes to the table");
+    golden[30] = 2;
+    CHECK(fd_decode_fault_command(golden, n, &cmd_back).status == FD_ERR_MALFORMED,
+          "action tag 2");
+    golden[30] = 0;
+    golden[65] = 0x7f;
+    golden[64] = 0xf0; /* params[1] = +inf */
+    e = fd_decode_fault_command(golden, n, &cmd_back);
+    CHECK(e.status == FD_ERR_NON_FINITE && strcmp(e.field, "params[1]") == 0, "params[1] inf");
+    CHECK(fd_fault_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/fault") == 0,
+          "fault key");
+    CHECK(fd_fault_event_key(key, sizeof key, "sc1") > 0 &&
+              strcmp(key, "flexdyn/sc1/tlm/fault") == 0,
+          "fault event key");
+    printf("FaultEventMsg, FaultCommandMsg: ok\n");
 }
 
 static void test_environment(const char *dir) {
@@ -620,6 +695,7 @@ int main(int argc, char **argv) {
     test_environment(argv[1]);
     test_gps(argv[1]);
     test_keys();
+    test_faults(argv[1]);
     if (failures != 0) {
         fprintf(stderr, "%d check(s) failed\n", failures);
         return 1;

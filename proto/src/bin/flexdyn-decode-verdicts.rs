@@ -3,8 +3,8 @@
 //! `proto/c/tests/fuzz_decode.c`, the Python package's `tests/test_proto_fuzz.py`).
 //!
 //! Input (stdin): records of a u32 LE length and that many bytes. Output (stdout): per record,
-//! thirteen lines, one per decoder (state, imu, star tracker, magnetometer, css, fss,
-//! environment, command, status, time, operator, header, gps):
+//! fifteen lines, one per decoder (state, imu, star tracker, magnetometer, css, fss,
+//! environment, command, status, time, operator, header, gps, fault event, fault command):
 //! `E <reason> [numbers or field]` for an error (the `DecodeError` variant; `Length needed
 //! actual`, `TrailingBytes expected actual`, `TooLarge actual`, `UnknownVersion found`,
 //! `NonFinite field`, `Malformed`), or `O <fields>` for a decoded message: every field in wire
@@ -21,6 +21,8 @@ use flexdyn_proto::{
 };
 // The GPS receiver (protocol 7), the thirteenth decoder.
 use flexdyn_proto::{decode_gps, GpsMsg};
+// Fault injection (protocol 8), the fourteenth and fifteenth decoders.
+use flexdyn_proto::{decode_fault_command, decode_fault_event, FaultCommandMsg, FaultEventMsg};
 
 fn err_line(e: &DecodeError) -> String {
     match e {
@@ -193,8 +195,13 @@ fn status_line(m: &StatusMsg) -> String {
         .u(r.bad_effector_input)
         .u(r.wrong_identity)
         .u(r.operator_refused)
+        .u(r.fault_refused)
         .u(m.commands_dropped)
-        .u(m.wall_time_unix_ns);
+        .u(m.wall_time_unix_ns)
+        .u(m.faults_active);
+    for w in m.faults_active_bits {
+        l.u(w);
+    }
     l.0
 }
 
@@ -249,7 +256,40 @@ fn gps_line(m: &GpsMsg) -> String {
     l.0
 }
 
-/// The thirteen verdicts for one buffer, in the order of the module docs.
+fn fault_event_line(m: &FaultEventMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header)
+        .u(m.fault_index.into())
+        .u(m.source.tag().into())
+        .u(m.mode.into())
+        .u(m.active.into())
+        .u(m.edge_ns)
+        .u(m.axes.into())
+        .f(&m.params);
+    for b in m.target.0 {
+        l.u(b.into());
+    }
+    l.0
+}
+
+fn fault_command_line(m: &FaultCommandMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header)
+        .u(m.action.tag().into())
+        .u(m.at_tick)
+        .u(m.fault_index.into())
+        .u(m.mode.into())
+        .f(&m.params)
+        .u(m.axes.into())
+        .u(m.duration_ns)
+        .u(m.seed);
+    for b in m.target.0 {
+        l.u(b.into());
+    }
+    l.0
+}
+
+/// The fifteen verdicts for one buffer, in the order of the module docs.
 fn rust_lines(b: &[u8]) -> Vec<String> {
     fn line<M>(r: Result<M, DecodeError>, f: impl Fn(&M) -> String) -> String {
         match r {
@@ -285,6 +325,8 @@ fn rust_lines(b: &[u8]) -> Vec<String> {
             l.0
         }),
         line(decode_gps(b), gps_line),
+        line(decode_fault_event(b), fault_event_line),
+        line(decode_fault_command(b), fault_command_line),
     ]
 }
 

@@ -16,6 +16,7 @@ from .proto import (CommandMsg, CssMsg, DecodeError, EffectorInput, EffectorStat
                     EnvironmentMsg, FssMsg, Header, ImuMsg, MagnetometerMsg, OperatorMsg,
                     StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
 from .proto import GpsMsg  # protocol 7
+from .proto import FaultCommandMsg, FaultEventMsg  # protocol 8
 
 __all__ = [
     "proto", "Client", "Subscription", "VehicleInfo", "session_config", "Answer",
@@ -23,5 +24,6 @@ __all__ = [
     "EffectorInput", "EffectorState", "EnvironmentMsg", "Header", "ImuMsg", "MagnetometerMsg", "StarTrackerMsg",
     "StateMsg",
     "StatusMsg", "TimeMsg", "CssMsg", "FssMsg", "OperatorMsg", "GpsMsg",
+    "FaultCommandMsg", "FaultEventMsg",
 ]
 __version__ = "0.1.0"

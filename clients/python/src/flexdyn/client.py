@@ -71,6 +71,7 @@ _DECODERS = {"state": StateMsg.decode, "imu": ImuMsg.decode, "st": StarTrackerMs
              "mag": MagnetometerMsg.decode, "css": CssMsg.decode, "fss": FssMsg.decode,
              "time": TimeMsg.decode, "env": EnvironmentMsg.decode}
 _DECODERS["gps"] = proto.GpsMsg.decode  # protocol 7: tlm/gps/<name>
+_DECODERS["fault"] = proto.FaultEventMsg.decode  # protocol 8: tlm/fault
 
 
 class Subscription:
@@ -240,6 +241,12 @@ class Client:
         key = proto.gps_key(self.sc_id, name)
         return self._telemetry_add(key[len(self._tlm_prefix):], callback)
 
+    def subscribe_fault_events(self, callback: Callable[[proto.FaultEventMsg], None]
+                               ) -> Subscription:
+        """Calls `callback` with every FaultEventMsg (``flexdyn/<sc>/tlm/fault``): a fault's
+        activation or clearance, at the frame boundary where it takes effect (protocol 8)."""
+        return self._telemetry_add("fault", callback)
+
     def _clock(self) -> threading.Condition:
         # Under _dispatch (not _lock: a callback that sends holds _dispatch, then takes _lock).
         with self._dispatch:
@@ -385,6 +392,44 @@ class Client:
         if n < 1:
             raise ValueError("run_ticks needs n >= 1")
         self.operator(proto.OPERATOR_RUN_TICKS, n)
+
+    # -- live faults (protocol 8) -------------------------------------------------------------
+
+    def send_fault(self, msg: proto.FaultCommandMsg) -> None:
+        """Publishes a FaultCommandMsg on ``flexdyn/<sc>/fault`` as it is. The server applies it
+        at ``at_tick`` or counts it in ``StatusMsg.rejected_fault_refused`` (with the reason in
+        its log); on a lab network only the operator's subject may put there."""
+        payload = msg.encode()
+        with self._pub_lock:
+            if self._closed:
+                raise RuntimeError("flexdyn.Client is closed")
+            self.session.put(proto.fault_key(self.sc_id), payload)
+
+    def inject_fault(self, target: str, mode: str, at_tick: int = proto.AT_NEXT_TICK,
+                     duration_s: float = 0.0, axes: Sequence[int] = (), seed: int = 0,
+                     **params: float) -> None:
+        """Injects a live fault, written as a ``[[faults]]`` entry: ``inject_fault(
+        "imus.hub.gyro", "bias_step", at_tick=40, value=0.01, axes=(3,), duration_s=0.5)``.
+        It takes effect at boundary `at_tick` (default: the next one): the sensor samples of
+        that tick carry it. In lockstep, call it before answering tick ``at_tick - 1`` (from
+        this client, so it reaches the server before the answer). ``duration_s`` 0: until
+        cleared (:meth:`clear_fault`). Its FaultEventMsg (:meth:`subscribe_fault_events`) gives
+        its ``fault_index``."""
+        duration_ns = round(duration_s * 1e9)
+        if duration_ns < 0:
+            raise ValueError("duration_s must be >= 0")
+        now = self._now
+        header = self._header(now.header.tick if now is not None else 0, 0)
+        msg = proto.fault_command(self.spacecraft_id, target, mode, at_tick, duration_ns, axes,
+                                  seed, header.seq, header.tick, **params)
+        self.send_fault(msg)
+
+    def clear_fault(self, fault_index: int, at_tick: int = proto.AT_NEXT_TICK) -> None:
+        """Clears fault `fault_index` (configured or live) from boundary `at_tick` on."""
+        now = self._now
+        header = self._header(now.header.tick if now is not None else 0, 0)
+        self.send_fault(proto.fault_clear(self.spacecraft_id, fault_index, at_tick, header.seq,
+                                          header.tick))
 
     def close(self) -> None:
         """Undeclares everything and closes the session."""

@@ -198,8 +198,8 @@ class LockstepParticipant:
     # -- assembling ticks (on the client's telemetry thread, one sample at a time) ------------
 
     def _on_sample(self, route: str, msg) -> None:
-        if route in ("time", "env"):
-            return  # the time service and the environment truth are not the tick's samples
+        if route in ("time", "env", "fault"):
+            return  # the time service, environment truth and fault events are not sensor samples
         tick = msg.header.tick
         if tick <= self._last_tick:
             return  # a tick already answered (a sample that came after its timeout)

@@ -24,7 +24,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import ClassVar, List, Optional, Tuple
 
-PROTOCOL_VERSION = 7
+PROTOCOL_VERSION = 8
 HEADER_LEN = 30
 STATE_FIXED_LEN = 327
 STATE_EFFECTOR_COUNT_OFFSET = 319
@@ -37,7 +37,7 @@ COMMAND_KIND_OFFSET = 34
 COMMAND_WRENCH_LEN = 86
 COMMAND_NO_COMMAND_LEN = 38
 COMMAND_ACTUATORS_FIXED_LEN = 94
-STATUS_LEN = 187
+STATUS_LEN = 235
 TIME_LEN = 122
 # Sun sensors (protocol 6)
 CSS_LEN = 159
@@ -47,6 +47,26 @@ OPERATOR_LEN = 42
 ENVIRONMENT_LEN = 368
 # GPS receiver (protocol 7)
 GPS_LEN = 147
+# Fault injection (protocol 8).
+FAULT_EVENT_LEN = 199
+FAULT_COMMAND_LEN = 214
+FAULT_TARGET_LEN = 128
+MAX_STATUS_FAULTS = 256
+FAULT_SOURCE_CONFIG = 0
+FAULT_SOURCE_LIVE = 1
+FAULT_SOURCE_RANDOM = 2
+FAULT_INJECT = 0
+FAULT_CLEAR = 1
+AT_NEXT_TICK = 2**64 - 1
+# The fault modes by code (proto/README.md, "Fault modes"): name and parameter names.
+FAULT_MODES = (
+    ("stuck_current", ()), ("stuck_value", ("value",)), ("bias_step", ("value",)),
+    ("bias_ramp", ("rate_per_s",)), ("scale", ("factor",)), ("noise", ("sigma",)),
+    ("spikes", ("probability", "amplitude")), ("dropout", ()), ("validity_off", ()),
+    ("friction_scale", ("factor",)), ("torque_limit", ("fraction",)), ("seized", ()),
+    ("command_ignored", ()), ("stuck_on", ()), ("stuck_off", ()), ("thrust_scale", ("factor",)),
+    ("dead", ()), ("dipole_scale", ("factor",)),
+)
 MAX_EFFECTORS = 1024
 MAX_EFFECTOR_VALUES = 8
 MAX_MESSAGE_BYTES = 65536
@@ -499,10 +519,18 @@ class StatusMsg:
     rejected_bad_effector_input: int = 0
     rejected_wrong_identity: int = 0
     rejected_operator_refused: int = 0
+    rejected_fault_refused: int = 0
     commands_dropped: int = 0
     wall_time_unix_ns: int = 0
+    faults_active: int = 0
+    faults_active_bits: Tuple[int, int, int, int] = (0, 0, 0, 0)
 
-    _BODY: ClassVar[struct.Struct] = struct.Struct("<II7QBI11Q")
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<II7QBI17Q")
+
+    def fault_active(self, index: int) -> bool:
+        """Whether fault ``index`` is active (indices below ``MAX_STATUS_FAULTS``)."""
+        return 0 <= index < MAX_STATUS_FAULTS and bool(
+            self.faults_active_bits[index // 64] >> (index % 64) & 1)
 
     def encode(self) -> bytes:
         return self.header.encode() + self._BODY.pack(
@@ -512,8 +540,9 @@ class StatusMsg:
             self.stale_policy, self.rejected_malformed, self.rejected_bad_version,
             self.rejected_non_finite, self.rejected_wrong_spacecraft, self.rejected_stale_tick,
             self.rejected_unknown_sender, self.rejected_bad_effector_input,
-            self.rejected_wrong_identity, self.rejected_operator_refused, self.commands_dropped,
-            self.wall_time_unix_ns,
+            self.rejected_wrong_identity, self.rejected_operator_refused,
+            self.rejected_fault_refused, self.commands_dropped, self.wall_time_unix_ns,
+            self.faults_active, *self.faults_active_bits,
         )
 
     @staticmethod
@@ -529,7 +558,7 @@ class StatusMsg:
             raise DecodeError("Malformed", detail="command_stale is not a bool")
         if f[10] > STALE_POLICY_ZERO:
             raise DecodeError("Malformed", detail="stale_policy tag")
-        return StatusMsg(Header.unpack(buf), *f[:9], f[9] == 1, *f[10:])
+        return StatusMsg(Header.unpack(buf), *f[:9], f[9] == 1, *f[10:24], tuple(f[24:28]))
 
 
 @dataclass
@@ -704,6 +733,136 @@ class GpsMsg:
         return GpsMsg(Header.unpack(buf), f[0], f[1], f[2], v(3), v(6), v(9), v(12), f[15])
 
 
+def _target_bytes(target: str) -> bytes:
+    b = target.encode("utf-8")
+    if len(b) > FAULT_TARGET_LEN or b"\0" in b:
+        raise ValueError(f"fault target {target!r}: at most {FAULT_TARGET_LEN} bytes, no NUL")
+    return b + bytes(FAULT_TARGET_LEN - len(b))
+
+
+def _target_str(b: bytes) -> str:
+    return b.split(b"\0", 1)[0].decode("utf-8", errors="replace")
+
+
+@dataclass
+class FaultEventMsg:
+    """A fault's activation (``active``) or clearance (``flexdyn/<sc-id>/tlm/fault``, protocol
+    8): ``fault_index`` (configured entry, or configured count + live order), ``source``
+    (``FAULT_SOURCE_*``), ``mode`` (code in ``FAULT_MODES``), ``edge_ns`` (when the window's edge
+    fell), ``axes`` (bit a: axis a + 1; 0 every axis), ``params`` and ``target`` (raw 128 bytes;
+    ``target_str`` decodes them)."""
+
+    header: Header = field(default_factory=Header)
+    fault_index: int = 0
+    source: int = FAULT_SOURCE_CONFIG
+    mode: int = 0
+    active: bool = False
+    edge_ns: int = 0
+    axes: int = 0
+    params: Tuple[float, float] = (0.0, 0.0)
+    target: bytes = bytes(FAULT_TARGET_LEN)
+
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<IIIBQI2d128s")
+
+    @property
+    def target_str(self) -> str:
+        return _target_str(self.target)
+
+    @property
+    def mode_name(self) -> str:
+        return FAULT_MODES[self.mode][0] if self.mode < len(FAULT_MODES) else f"mode {self.mode}"
+
+    def encode(self) -> bytes:
+        return self.header.encode() + self._BODY.pack(
+            self.fault_index, self.source, self.mode, 1 if self.active else 0, self.edge_ns,
+            self.axes, *self.params, bytes(self.target))
+
+    @staticmethod
+    def decode(buf: bytes) -> "FaultEventMsg":
+        _check_size_and_version(buf, FAULT_EVENT_LEN)
+        _check_total(FAULT_EVENT_LEN, buf)
+        f = FaultEventMsg._BODY.unpack_from(buf, HEADER_LEN)
+        if f[1] > FAULT_SOURCE_RANDOM:
+            raise DecodeError("Malformed", detail="source tag")
+        if f[3] > 1:
+            raise DecodeError("Malformed", detail="active is not a bool")
+        return FaultEventMsg(Header.unpack(buf), f[0], f[1], f[2], f[3] == 1, f[4], f[5],
+                             (f[6], f[7]), f[8])
+
+
+@dataclass
+class FaultCommandMsg:
+    """A live fault command (``flexdyn/<sc-id>/fault``, protocol 8): ``FAULT_INJECT`` the fault
+    described (``target``, ``mode``, ``params``, ``axes``, ``duration_ns`` 0 = until cleared,
+    ``seed``) at boundary ``at_tick`` (``AT_NEXT_TICK``: the next one), or ``FAULT_CLEAR`` fault
+    ``fault_index`` from ``at_tick`` on."""
+
+    header: Header = field(default_factory=Header)
+    action: int = FAULT_INJECT
+    at_tick: int = AT_NEXT_TICK
+    fault_index: int = 0
+    mode: int = 0
+    params: Tuple[float, float] = (0.0, 0.0)
+    axes: int = 0
+    duration_ns: int = 0
+    seed: int = 0
+    target: bytes = bytes(FAULT_TARGET_LEN)
+
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<IQII2dIQQ128s")
+
+    @property
+    def target_str(self) -> str:
+        return _target_str(self.target)
+
+    def encode(self) -> bytes:
+        return self.header.encode() + self._BODY.pack(
+            self.action, self.at_tick, self.fault_index, self.mode, *self.params, self.axes,
+            self.duration_ns, self.seed, bytes(self.target))
+
+    @staticmethod
+    def decode(buf: bytes) -> "FaultCommandMsg":
+        _check_size_and_version(buf, FAULT_COMMAND_LEN)
+        _check_total(FAULT_COMMAND_LEN, buf)
+        f = FaultCommandMsg._BODY.unpack_from(buf, HEADER_LEN)
+        if f[0] > FAULT_CLEAR:
+            raise DecodeError("Malformed", detail="action tag")
+        for i in (0, 1):
+            if not math.isfinite(f[4 + i]):
+                raise DecodeError("NonFinite", field=f"params[{i}]")
+        return FaultCommandMsg(Header.unpack(buf), f[0], f[1], f[2], f[3], (f[4], f[5]), f[6],
+                               f[7], f[8], f[9])
+
+
+def fault_command(spacecraft_id: int, target: str, mode: str, at_tick: int = AT_NEXT_TICK,
+                  duration_ns: int = 0, axes=(), seed: int = 0, seq: int = 0, tick: int = 0,
+                  **params: float) -> FaultCommandMsg:
+    """An ``Inject`` FaultCommandMsg from a mode name and its parameters by name (as in
+    ``[[faults]]``): ``fault_command(1, "imus.hub.gyro", "bias_step", at_tick=40, value=0.01,
+    axes=(1, 3))``."""
+    codes = [m[0] for m in FAULT_MODES]
+    if mode not in codes:
+        raise ValueError(f"unknown fault mode {mode!r} (expected one of {', '.join(codes)})")
+    code = codes.index(mode)
+    names = FAULT_MODES[code][1]
+    if set(params) != set(names):
+        raise ValueError(f"mode {mode!r} takes {', '.join(names) or 'no parameters'}, "
+                         f"got {', '.join(params) or 'none'}")
+    values = [float(params[n]) for n in names] + [0.0] * (2 - len(names))
+    bits = 0
+    for a in axes:
+        bits |= 1 << (int(a) - 1)
+    return FaultCommandMsg(Header(spacecraft_id, tick, 0, seq), FAULT_INJECT,
+                           at_tick, 0, code, (values[0], values[1]), bits, duration_ns, seed,
+                           _target_bytes(target))
+
+
+def fault_clear(spacecraft_id: int, fault_index: int, at_tick: int = AT_NEXT_TICK, seq: int = 0,
+                tick: int = 0) -> FaultCommandMsg:
+    """A ``Clear`` FaultCommandMsg for fault ``fault_index``."""
+    return FaultCommandMsg(Header(spacecraft_id, tick, 0, seq), FAULT_CLEAR,
+                           at_tick, fault_index)
+
+
 # --------------------------------------------------------------------------------------------
 # Key expressions (proto/README.md, "Topics").
 
@@ -774,6 +933,16 @@ def status_key(sc: str) -> str:
 def operator_key(sc: str) -> str:
     """``flexdyn/<sc>/operator``: operator commands (OperatorMsg, protocol 6)."""
     return _key(sc, "operator")
+
+
+def fault_key(sc: str) -> str:
+    """``flexdyn/<sc>/fault``: live fault commands (FaultCommandMsg, protocol 8)."""
+    return _key(sc, "fault")
+
+
+def fault_event_key(sc: str) -> str:
+    """``flexdyn/<sc>/tlm/fault``: fault activations and clearances (FaultEventMsg, protocol 8)."""
+    return _key(sc, "tlm/fault")
 
 
 def telemetry_key(sc: str) -> str:
