@@ -10,12 +10,15 @@
 //!   fault (`mtbf_s`) starts at a time to failure drawn from its seed at load
 //!   ([`failure_delay_ns`]);
 //! - [`ports`]: the per-vehicle runtime ([`Faults`]) that [`crate::sim::Simulation`] calls at its
-//!   two ports; it allocates nothing, locks nothing and cannot fail.
+//!   two ports; it allocates nothing, locks nothing and cannot fail;
+//! - [`link`]: command-link faults (`links.<sender id>`), applied where the server takes a
+//!   participant's commands in ([`crate::server::commands::CommandBook`]).
 //!
 //! Which modes apply is stated by each kind: a sensor through
 //! [`crate::sensors::Sensor::fault_channels`] and [`crate::sensors::Sensor::has_validity`], an
 //! effector kind through [`crate::dynamics::component::ComponentKind::fault_modes`].
 
+pub mod link;
 pub mod modes;
 pub mod ports;
 pub(crate) mod schema;
@@ -63,5 +66,10 @@ pub enum Port {
     Actuator {
         /// Index in [`crate::dynamics::Spacecraft::effector_entries`].
         effector: usize,
+    },
+    /// A participant's command link: its sender id (one of `server.participants`).
+    Link {
+        /// The participant's sender id.
+        sender_id: u32,
     },
 }

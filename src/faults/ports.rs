@@ -75,7 +75,8 @@ impl Faults {
         let mut live = Vec::with_capacity(cfg.faults.len());
         for spec in &cfg.faults {
             let actuator = match spec.port {
-                Port::Sensor { .. } => None,
+                // Applied by the server's command book (`super::link`).
+                Port::Sensor { .. } | Port::Link { .. } => None,
                 Port::Actuator { effector } => Some(actuator(cfg, sc, effector)?),
             };
             live.push(Live {

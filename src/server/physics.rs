@@ -115,13 +115,15 @@ pub struct Stepper {
 impl Stepper {
     /// A stepper at t = 0 with the sensors sampled at tick 0.
     pub fn new(mut sim: Simulation, settings: &ServerSettings) -> Self {
+        let links = crate::faults::link::LinkFaults::new(sim.faults().specs(), sim.frame_ns());
         let book = CommandBook::new(
             &settings.participants,
             sim.frame_ns(),
             u64::try_from(settings.stale_after.as_nanos()).unwrap_or(u64::MAX),
             settings.stale_policy,
             sim.spacecraft().effector_input_ranges(),
-        );
+        )
+        .with_links(links, settings.spacecraft_id);
         let state = sim.blank_state();
         // Sensors are sampled at every frame where they are due, published or not (an IMU
         // closes its interval every frame).
@@ -187,6 +189,14 @@ impl Stepper {
         self.sim.sample_sensors(|s| s.due(k + 1));
     }
 
+    /// Copies what the command-link faults did into `shared` (a few atomic stores; nothing
+    /// without link faults).
+    pub fn note_links(&self, shared: &Shared) {
+        if !self.book.links().is_empty() {
+            shared.note_link_stats(&self.book.link_stats());
+        }
+    }
+
     /// Once per frame, outside the RK4 loop: never publish a non-finite state. `filled` says
     /// whether [`Self::fill`] already took this tick's state.
     pub fn check_finite(&mut self, k: u64, filled: bool) -> Result<(), ServerError> {
@@ -216,6 +226,9 @@ pub fn count_offer(shared: &Shared, offer: Offer, sender_id: u32) {
         Offer::StaleTick => shared.reject_stale_tick_from(sender_id),
         Offer::UnknownSender => shared.reject_unknown_sender(),
         Offer::BadEffectorInput => shared.reject_bad_effector_input(),
+        // Counted in the book's link statistics.
+        Offer::LinkDropped => {}
+        Offer::LinkCorrupted(why) => shared.reject_damaged(why, sender_id),
     }
 }
 
@@ -300,7 +313,7 @@ impl PhysicsCtx {
 
     /// Lockstep: wait until every participant has answered tick `k`.
     fn await_answers(&self, book: &mut CommandBook, k: u64) -> Result<Wait, ServerError> {
-        book.begin_tick();
+        book.begin_tick(k);
         let timeout = self.settings.participant_timeout;
         let give_up = Instant::now() + timeout;
         while !book.all_answered() {
@@ -453,6 +466,7 @@ impl PhysicsCtx {
 
             // 3. Integrate the frame.
             w.step(k);
+            w.note_links(&self.shared);
             k += 1;
 
             // 4. Fill the state of tick k.
