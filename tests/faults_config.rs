@@ -148,6 +148,62 @@ fn errors_name_the_field_and_the_problem() {
             "faults[1].mtbf_s",
             "> 0",
         ),
+        // Command links: a participant of server.participants (default [1]), link modes only.
+        (
+            "target = \"links.7\"\nmode = \"dropped\"",
+            "faults[1].target",
+            "participant 7 is not in server.participants [1]",
+        ),
+        (
+            "target = \"links.01\"\nmode = \"dropped\"",
+            "faults[1].target",
+            "links.<sender id>",
+        ),
+        (
+            "target = \"links.1.cmd\"\nmode = \"dropped\"",
+            "faults[1].target",
+            "links.<sender id>",
+        ),
+        (
+            "target = \"links\"\nmode = \"dropped\"",
+            "faults[1].target",
+            "links.<sender id>",
+        ),
+        (
+            "target = \"links.1\"\nmode = \"dropout\"",
+            "faults[1].mode",
+            "does not apply to a command link (it takes dropped, delayed, corrupted)",
+        ),
+        (
+            "target = \"imus.hub\"\nmode = \"dropped\"",
+            "faults[1].mode",
+            "does not apply",
+        ),
+        (
+            "target = \"reaction_wheels.rw2\"\nmode = \"delayed\"\nframes = 2.0",
+            "faults[1].mode",
+            "does not apply",
+        ),
+        (
+            "target = \"links.1\"\nmode = \"delayed\"",
+            "faults[1].frames",
+            "missing",
+        ),
+        (
+            "target = \"links.1\"\nmode = \"delayed\"\nframes = 2.5",
+            "faults[1].frames",
+            "whole number of frames from 1 to 10000",
+        ),
+        (
+            "target = \"links.1\"\nmode = \"delayed\"\nframes = 0.0",
+            "faults[1].frames",
+            "whole number of frames from 1 to 10000",
+        ),
+        (
+            "target = \"links.1\"\nmode = \"corrupted\"\nprobability = -0.1",
+            "faults[1].probability",
+            "[0, 1]",
+        ),
     ] {
         let e = SimConfig::from_toml_str(&with_faults(&[ok, entry])).unwrap_err();
         let msg = e.to_string();
@@ -233,4 +289,27 @@ fn random_faults_draw_an_exponential_failure_time_from_their_seed() {
     assert!((mean - 500.0).abs() < 0.063 * 500.0, "mean {mean}");
     let below = draws.iter().filter(|t| **t < 500.0).count() as f64 / n as f64;
     assert!((below - (1.0 - (-1.0_f64).exp())).abs() < 0.031, "{below}");
+}
+
+/// A command-link target resolves to the participant's sender id, checked against the file's
+/// `server.participants`; the server checks it again against its final participants (the
+/// command line may change them), naming the same field.
+#[test]
+fn a_link_target_is_a_participant_of_the_server() {
+    let text = with_faults(&["target = \"links.2\"\nmode = \"delayed\"\nframes = 3.0"]).replace(
+        "[simulation]",
+        "[server]\nparticipants = [1, 2]\n\n[simulation]",
+    );
+    let cfg = SimConfig::from_toml_str(&text).unwrap();
+    assert_eq!(cfg.faults[0].port, Port::Link { sender_id: 2 });
+    assert_eq!(cfg.faults[0].mode, FaultMode::Delayed { frames: 3.0 });
+    let mut settings = flexdyn::server::ServerSettings::from_table(&cfg.server).unwrap();
+    settings.check_link_faults(&cfg).unwrap();
+    settings.participants = vec![1];
+    let e = settings.check_link_faults(&cfg).unwrap_err().to_string();
+    assert!(e.contains("faults[0].target"), "{e}");
+    assert!(
+        e.contains("participant 2 is not in server.participants [1]"),
+        "{e}"
+    );
 }

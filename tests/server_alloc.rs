@@ -185,7 +185,7 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
         let wrench = CommandMsg::wrench(Header::new(1, k, 0, k), 1, [0.0, 0.0, 0.01], [0.0; 3]);
         cmd_tx.try_send(wrench).unwrap();
         cmd_tx.try_send(wheel_commands.pop().unwrap()).unwrap();
-        w.book.begin_tick();
+        w.book.begin_tick(k);
         while let Ok(cmd) = cmd_rx.try_recv() {
             w.book.offer_lockstep(&cmd, k);
             recycle_tx.try_send(cmd).unwrap();

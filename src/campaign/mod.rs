@@ -32,6 +32,10 @@ pub enum CampaignCommand {
         /// Output directory.
         #[arg(long, short, value_name = "DIR")]
         output: PathBuf,
+        /// Remove the base configuration's random faults (`[[faults]]` with `mtbf_s`): the
+        /// same runs without them, to compare pass rates.
+        #[arg(long)]
+        without_random_faults: bool,
     },
     /// Run the campaign (or one run of it) and write each run's result.json. Exit code: 0 every
     /// run passed, 1 a run could not be run, 2 invalid input, 3 a run failed.
@@ -54,6 +58,10 @@ pub enum CampaignCommand {
         /// free port from the OS.
         #[arg(long, value_name = "PORT", default_value_t = 17_600)]
         base_port: u16,
+        /// Remove the base configuration's random faults (`[[faults]]` with `mtbf_s`): the
+        /// same runs without them, to compare pass rates.
+        #[arg(long)]
+        without_random_faults: bool,
     },
     /// Write summary.csv, summary.txt and figures from a campaign directory. Exit code: 0 every
     /// planned run passed, 1 a run is missing or could not be run, 3 a run failed.
@@ -73,14 +81,30 @@ pub struct Report {
     pub exit_code: u8,
 }
 
+/// The campaign in `file`, without its base's random faults if `without_random_faults`.
+fn load(
+    file: &std::path::Path,
+    without_random_faults: bool,
+) -> Result<spec::Campaign, spec::CampaignError> {
+    let mut c = spec::Campaign::from_file(file)?;
+    if without_random_faults {
+        c.without_random_faults()?;
+    }
+    Ok(c)
+}
+
 /// Runs a `flexdyn campaign` subcommand; returns its report, or the exit code (2 for invalid
 /// input, 1 for a directory that cannot be written or read) and an error message.
 pub fn main(cmd: &CampaignCommand) -> Result<Report, (u8, String)> {
     let bad = |e: spec::CampaignError| (verdict::EXIT_INVALID_INPUT, e.to_string());
     match cmd {
-        CampaignCommand::Plan { file, output } => {
+        CampaignCommand::Plan {
+            file,
+            output,
+            without_random_faults,
+        } => {
             let plan =
-                plan::Plan::new(spec::Campaign::from_file(file).map_err(bad)?).map_err(bad)?;
+                plan::Plan::new(load(file, *without_random_faults).map_err(bad)?).map_err(bad)?;
             let runs = plan
                 .write(output)
                 .map_err(|e| (1, format!("{}: {e}", output.display())))?;
@@ -103,9 +127,10 @@ pub fn main(cmd: &CampaignCommand) -> Result<Report, (u8, String)> {
             index,
             record,
             base_port,
+            without_random_faults,
         } => {
             let plan =
-                plan::Plan::new(spec::Campaign::from_file(file).map_err(bad)?).map_err(bad)?;
+                plan::Plan::new(load(file, *without_random_faults).map_err(bad)?).map_err(bad)?;
             let runs = plan
                 .write(output)
                 .map_err(|e| (1, format!("{}: {e}", output.display())))?;

@@ -155,6 +155,11 @@ pub struct RunPlan {
     pub valid: bool,
     /// The values written into its configuration file, by concrete key.
     pub dispersed: BTreeMap<String, f64>,
+    /// \[ns\] the first activation of each random fault (`faults[k]` with `mtbf_s`): its
+    /// `start_s` plus the time to failure drawn from the run's seed
+    /// ([`crate::faults::failure_delay_ns`]), whether or not it falls within the run.
+    #[serde(default)]
+    pub random_failures_ns: BTreeMap<String, u64>,
     /// The full configuration, TOML (not in the manifest; written as `config.toml`).
     #[serde(skip)]
     pub config_toml: String,
@@ -169,6 +174,8 @@ pub struct Plan {
     pub keys: Vec<Vec<String>>,
     base: Table,
     sensor_seed_keys: Vec<String>,
+    /// The indices of the random faults (`faults[k]` with `mtbf_s`).
+    random_faults: Vec<usize>,
 }
 
 impl Plan {
@@ -231,10 +238,12 @@ impl Plan {
         }
         // A random fault (`mtbf_s`) gets a seed of its own per run, written in if absent, so
         // every run samples its own failure time.
+        let mut random_faults = Vec::new();
         if let Some(toml::Value::Array(items)) = base.get("faults") {
             for (k, item) in items.iter().enumerate() {
                 if item.get("mtbf_s").is_some() {
                     sensor_seed_keys.push(format!("faults[{k}].seed"));
+                    random_faults.push(k);
                 }
             }
         }
@@ -243,6 +252,7 @@ impl Plan {
             keys: all_keys,
             base,
             sensor_seed_keys,
+            random_faults,
         })
     }
 
@@ -317,10 +327,19 @@ impl Plan {
                 }
             };
             let check =
-                SimConfig::from_toml_str(&text).and_then(|cfg| cfg.build_spacecraft().map(|_| ()));
+                SimConfig::from_toml_str(&text).and_then(|cfg| cfg.build_spacecraft().map(|_| cfg));
             match check {
-                Ok(()) => {
+                Ok(cfg) => {
+                    let random_failures_ns = self
+                        .random_faults
+                        .iter()
+                        .filter_map(|&k| {
+                            let f = cfg.faults.get(k)?;
+                            Some((format!("faults[{k}]"), f.window.start_ns))
+                        })
+                        .collect();
                     return RunPlan {
+                        random_failures_ns,
                         run,
                         dir: run_dir(run),
                         run_seed: seed,
@@ -330,7 +349,7 @@ impl Plan {
                         valid: true,
                         dispersed,
                         config_toml: text,
-                    }
+                    };
                 }
                 Err(e) => reasons.push(e.to_string()),
             }
@@ -344,6 +363,7 @@ impl Plan {
             redraw_reasons: reasons,
             valid: false,
             dispersed: BTreeMap::new(),
+            random_failures_ns: BTreeMap::new(),
             config_toml: String::new(),
         }
     }
@@ -362,6 +382,8 @@ impl Plan {
             "runs": c.runs,
             "seed": c.seed,
             "duration_s": c.duration_s,
+            // false: `--without-random-faults` removed the base's random faults.
+            "random_faults": !c.random_faults_removed,
             "controller": c.controller,
             "dispersed_keys": self.keys.iter().flatten().collect::<Vec<_>>(),
             "criteria": c.criteria.iter().map(|k| k.name.clone()).collect::<Vec<_>>(),

@@ -154,6 +154,9 @@ pub struct Campaign {
     pub dispersions: Vec<Dispersion>,
     /// The criteria.
     pub criteria: Vec<Criterion>,
+    /// The base configuration's random faults (`[[faults]]` with `mtbf_s`) were removed
+    /// ([`Self::without_random_faults`]): the same campaign without them, for comparison.
+    pub random_faults_removed: bool,
 }
 
 /// Why a campaign file is not usable. Every message starts with the name of the file that
@@ -243,6 +246,31 @@ impl Campaign {
             .as_deref()
             .and_then(Path::parent)
             .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+    }
+
+    /// Removes the base configuration's random faults (`[[faults]]` entries with `mtbf_s`), so
+    /// the same campaign runs without them (`--without-random-faults`). Every run keeps its
+    /// dispersions and sensor seeds: those are drawn from streams of their own, so run i with
+    /// and without the faults differ by the faults only (a paired comparison). Returns how many
+    /// were removed.
+    pub fn without_random_faults(&mut self) -> Result<usize, CampaignError> {
+        let mut base: toml::Table = toml::from_str(&self.base_toml)
+            .map_err(|e| self.invalid("base", format!("not a TOML table: {e}")))?;
+        let mut removed = 0;
+        if let Some(toml::Value::Array(items)) = base.get_mut("faults") {
+            let before = items.len();
+            items.retain(|f| f.get("mtbf_s").is_none());
+            removed = before - items.len();
+            if items.is_empty() {
+                base.remove("faults");
+            }
+        }
+        if removed > 0 {
+            self.base_toml = toml::to_string(&base)
+                .map_err(|e| self.invalid("base", format!("cannot write TOML: {e}")))?;
+        }
+        self.random_faults_removed = true;
+        Ok(removed)
     }
 
     /// Reads and validates `path`. Dispersion keys are checked against the base configuration
@@ -563,6 +591,7 @@ impl Campaign {
             participant_timeout_s,
             dispersions,
             criteria,
+            random_faults_removed: false,
         })
     }
 }

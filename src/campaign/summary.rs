@@ -29,10 +29,38 @@ pub struct Summary {
     pub verdict: Verdict,
     /// Wilson 95 % interval of the pass rate over the planned runs.
     pub wilson_95: (f64, f64),
+    /// With random faults (`[[faults]]` with `mtbf_s`): the pass rate of the runs in which one
+    /// activated, and of the others.
+    pub random_failures: Option<FailureSplit>,
     /// The report text (also `summary.txt`).
     pub text: String,
     /// Figures written.
     pub figures: Vec<PathBuf>,
+}
+
+/// The pass rates of a campaign with random faults, split by whether a random fault activated
+/// within the run (its first activation at or before `duration_s`): `(passed, runs)` of each
+/// group, planned runs (a missing run counts as not passed, as in the overall rate).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FailureSplit {
+    /// Runs in which a random fault activated.
+    pub with_failure: (u32, u32),
+    /// Runs in which none did.
+    pub without_failure: (u32, u32),
+}
+
+/// The 95 % normal quantile z = Φ⁻¹(0.975).
+pub const Z_95: f64 = 1.959_963_984_540_054;
+
+/// `k of n passed (x %); Wilson 95 % interval lo %–hi %`.
+fn rate_line(k: u32, n: u32) -> String {
+    let (lo, hi) = wilson(k, n, Z_95);
+    format!(
+        "{k} of {n} passed ({:.1} %); Wilson 95 % interval {:.1} %–{:.1} %",
+        100.0 * f64::from(k) / f64::from(n.max(1)),
+        100.0 * lo,
+        100.0 * hi
+    )
 }
 
 /// Wilson score interval for `k` successes in `n` trials at z (Wilson 1927): centre
@@ -47,6 +75,14 @@ pub fn wilson(k: u32, n: u32, z: f64) -> (f64, f64) {
     let centre = (p + z * z / (2.0 * n)) / d;
     let half = z / d * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt();
     ((centre - half).max(0.0), (centre + half).min(1.0))
+}
+
+/// `k` of `faults[k]` (for ordering the columns).
+fn fault_index(key: &str) -> usize {
+    key.trim_start_matches("faults[")
+        .trim_end_matches(']')
+        .parse()
+        .unwrap_or(usize::MAX)
 }
 
 fn io(path: &Path, e: impl std::fmt::Display) -> String {
@@ -103,6 +139,28 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
     for c in &criteria {
         write!(csv, ",{c},{c}_passed").ok();
     }
+    // The random faults' first activation per run (empty when after the run's end).
+    let duration_ns = manifest["duration_s"]
+        .as_f64()
+        .map_or(u64::MAX, |d| (d * 1e9).round() as u64);
+    let random_faults: Vec<String> = {
+        let mut v: Vec<String> = plans
+            .iter()
+            .flat_map(|p| p.random_failures_ns.keys().cloned())
+            .collect();
+        v.sort_by_key(|k| fault_index(k));
+        v.dedup();
+        v
+    };
+    let failure_in_run = |p: &RunPlan, k: &str| {
+        p.random_failures_ns
+            .get(k)
+            .copied()
+            .filter(|t| *t <= duration_ns)
+    };
+    for k in &random_faults {
+        write!(csv, ",{k}.failure_s").ok();
+    }
     csv.push_str(",status\n");
     for p in &plans {
         let r = results.iter().find(|r| r.run == p.run);
@@ -127,12 +185,21 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
                 None => write!(csv, ",,").ok(),
             };
         }
+        for k in &random_faults {
+            match failure_in_run(p, k) {
+                // Exact: whole seconds and nine decimals of the integer nanoseconds.
+                Some(t_ns) => {
+                    write!(csv, ",{}.{:09}", t_ns / 1_000_000_000, t_ns % 1_000_000_000).ok()
+                }
+                None => write!(csv, ",").ok(),
+            };
+        }
         writeln!(csv, ",{status}").ok();
     }
     let csv_path = dir.join("summary.csv");
     std::fs::write(&csv_path, csv).map_err(|e| io(&csv_path, e))?;
 
-    s.wilson_95 = wilson(s.passed, s.planned, 1.959_963_984_540_054);
+    s.wilson_95 = wilson(s.passed, s.planned, Z_95);
     let mut t = String::new();
     writeln!(
         t,
@@ -144,6 +211,47 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
         100.0 * s.wilson_95.1
     )
     .ok();
+    if !random_faults.is_empty() {
+        let mut split = FailureSplit::default();
+        for p in &plans {
+            let passed = u32::from(results.iter().any(|r| r.run == p.run && r.passed));
+            let group = if random_faults.iter().any(|k| failure_in_run(p, k).is_some()) {
+                &mut split.with_failure
+            } else {
+                &mut split.without_failure
+            };
+            group.0 += passed;
+            group.1 += 1;
+        }
+        writeln!(
+            t,
+            "random faults ({}): a failure within the run in {} of {} runs",
+            random_faults.join(", "),
+            split.with_failure.1,
+            s.planned
+        )
+        .ok();
+        writeln!(
+            t,
+            "  runs with a random failure: {}",
+            rate_line(split.with_failure.0, split.with_failure.1)
+        )
+        .ok();
+        writeln!(
+            t,
+            "  runs without: {}",
+            rate_line(split.without_failure.0, split.without_failure.1)
+        )
+        .ok();
+        s.random_failures = Some(split);
+    } else if manifest["random_faults"] == serde_json::Value::Bool(false) {
+        writeln!(
+            t,
+            "random faults removed (--without-random-faults): compare with the same campaign run \
+             with them"
+        )
+        .ok();
+    }
     if !s.missing.is_empty() {
         writeln!(
             t,
@@ -502,5 +610,29 @@ mod tests {
         let (lo, hi) = wilson(0, 10, 1.96);
         assert_eq!(lo, 0.0);
         assert!(hi > 0.2 && hi < 0.35, "{hi}");
+    }
+
+    /// Closed forms of Wilson's interval (Wilson 1927, JASA 22:209): with p̂ = 0 the centre and
+    /// the half-width are both z²/(2(n + z²)), so the interval is [0, z²/(n + z²)]; with p̂ = 1,
+    /// by symmetry, [n/(n + z²), 1]; with p̂ = ½ the centre is ½ and the half-width
+    /// z/(1 + z²/n)·√(1/(4n) + z²/(4n²)) = z n/(n + z²)·√(n + z²)/(2n) = z/(2√(n + z²)),
+    /// which at n = 10, z = Z_95 (z² = 3.841459) is 1.959964/(2·3.720411) = 0.263407:
+    /// (0.236593, 0.763407).
+    #[test]
+    fn wilson_closed_forms_at_the_extremes_and_at_one_half() {
+        let z2 = Z_95 * Z_95;
+        for n in [1u32, 4, 8, 50] {
+            let nf = f64::from(n);
+            let (lo, hi) = wilson(0, n, Z_95);
+            assert_eq!(lo, 0.0);
+            assert!((hi - z2 / (nf + z2)).abs() < 1e-12, "0 of {n}: {hi}");
+            let (lo, hi) = wilson(n, n, Z_95);
+            assert!((lo - nf / (nf + z2)).abs() < 1e-12, "{n} of {n}: {lo}");
+            assert!((hi - 1.0).abs() < 1e-12);
+        }
+        let half = Z_95 / (2.0 * (10.0 + z2).sqrt());
+        assert!((half - 0.263407).abs() < 1e-6, "{half}");
+        let (lo, hi) = wilson(5, 10, Z_95);
+        assert!((lo - (0.5 - half)).abs() < 1e-12 && (hi - (0.5 + half)).abs() < 1e-12);
     }
 }

@@ -91,9 +91,19 @@ impl LiveResolver {
             mtbf_s: None,
             params: keys.iter().copied().zip(cmd.params).collect(),
         };
+        // Participants: none, so a command-link target is refused below (resolution accepts
+        // any sender id when it has no list).
         let mut spec =
-            super::targets::resolve_one(0, &raw, &self.bank, &self.sc, &SourceMap::empty())
+            super::targets::resolve_one(0, &raw, &self.bank, &self.sc, None, &SourceMap::empty())
                 .map_err(|e| e.to_string())?;
+        if let super::Port::Link { .. } = spec.port {
+            // The command book builds its link faults at start; a live one would never apply.
+            return Err(format!(
+                "fault.target: \"{}\": a command-link fault is configured in [[faults]], not \
+                 injected live",
+                spec.target
+            ));
+        }
         spec.window.duration_ns = (cmd.duration_ns != 0).then_some(cmd.duration_ns);
         spec.source = flexdyn_proto::FaultSource::Live;
         let live = Live::new(spec, &self.cfg, &self.sc).map_err(|e| e.to_string())?;

@@ -13,12 +13,15 @@
 //!   two ports; it allocates nothing, locks nothing and cannot fail. It also notes each fault's
 //!   activation and clearance at the frame boundaries (the server's FaultEventMsg);
 //! - [`live`]: live faults (`flexdyn/<sc>/fault`), checked off the physics thread by the same
-//!   resolution as `[[faults]]` and handed over ready-made.
+//!   resolution as `[[faults]]` and handed over ready-made;
+//! - [`link`]: command-link faults (`links.<sender id>`), applied where the server takes a
+//!   participant's commands in ([`crate::server::commands::CommandBook`]).
 //!
 //! Which modes apply is stated by each kind: a sensor through
 //! [`crate::sensors::Sensor::fault_channels`] and [`crate::sensors::Sensor::has_validity`], an
 //! effector kind through [`crate::dynamics::component::ComponentKind::fault_modes`].
 
+pub mod link;
 pub mod live;
 pub mod modes;
 pub mod ports;
@@ -72,5 +75,10 @@ pub enum Port {
     Actuator {
         /// Index in [`crate::dynamics::Spacecraft::effector_entries`].
         effector: usize,
+    },
+    /// A participant's command link: its sender id (one of `server.participants`).
+    Link {
+        /// The participant's sender id.
+        sender_id: u32,
     },
 }

@@ -24,6 +24,10 @@
 //!
 //! Actuator modes transform the effector's input (command + schedule) before it reaches the
 //! model; the models themselves are untouched (see [`super::ports`] for the physics of each).
+//!
+//! Command-link modes act on a participant's commands where the server takes them in (see
+//! [`super::link`]): `dropped` (never arrive), `delayed` by `frames` frames, `corrupted` (each
+//! bit of the payload flipped with `probability`).
 
 /// A fault mode with its parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -96,7 +100,24 @@ pub enum FaultMode {
         /// The scale factor.
         factor: f64,
     },
+    /// Command link: the participant's commands never arrive.
+    Dropped,
+    /// Command link: the participant's command applied at tick k is the one it sent for
+    /// k − `frames`.
+    Delayed {
+        /// The delay \[frames\], a whole number in 1..=[`MAX_DELAY_FRAMES`].
+        frames: f64,
+    },
+    /// Command link: each bit of each command's payload flipped with `probability` (the bit
+    /// error rate), from the fault's seed and the tick.
+    Corrupted {
+        /// In [0, 1].
+        probability: f64,
+    },
 }
+
+/// The longest link delay \[frames\] (the delay line holds that many commands per participant).
+pub const MAX_DELAY_FRAMES: f64 = 10_000.0;
 
 /// Every mode's configuration name and its parameter keys, in the order of [`FaultMode`].
 pub const MODES: &[(&str, &[&str])] = &[
@@ -118,7 +139,13 @@ pub const MODES: &[(&str, &[&str])] = &[
     ("thrust_scale", &["factor"]),
     ("dead", &[]),
     ("dipole_scale", &["factor"]),
+    ("dropped", &[]),
+    ("delayed", &["frames"]),
+    ("corrupted", &["probability"]),
 ];
+
+/// The modes a command link (`links.<sender id>`) takes.
+pub const LINK_MODES: &[&str] = &["dropped", "delayed", "corrupted"];
 
 /// The modes every sensor kind takes (`validity_off` only where [`crate::sensors::Sensor::has_validity`]).
 pub const SENSOR_MODES: &[&str] = &[
@@ -181,6 +208,13 @@ impl FaultMode {
             "dipole_scale" => Self::DipoleScale {
                 factor: param("factor"),
             },
+            "dropped" => Self::Dropped,
+            "delayed" => Self::Delayed {
+                frames: param("frames"),
+            },
+            "corrupted" => Self::Corrupted {
+                probability: param("probability"),
+            },
             _ => return None,
         })
     }
@@ -211,6 +245,9 @@ impl FaultMode {
             Self::ThrustScale { .. } => 15,
             Self::Dead => 16,
             Self::DipoleScale { .. } => 17,
+            Self::Dropped => 18,
+            Self::Delayed { .. } => 19,
+            Self::Corrupted { .. } => 20,
         }
     }
 
@@ -229,6 +266,8 @@ impl FaultMode {
                 amplitude,
             } => [probability, amplitude],
             Self::TorqueLimit { fraction } => [fraction, 0.0],
+            Self::Delayed { frames } => [frames, 0.0],
+            Self::Corrupted { probability } => [probability, 0.0],
             _ => [0.0, 0.0],
         }
     }
@@ -238,8 +277,15 @@ impl FaultMode {
         let nonneg = |v: f64| v >= 0.0;
         match *self {
             Self::Noise { sigma } if !nonneg(sigma) => Some(("sigma", "must be ≥ 0")),
-            Self::Spikes { probability, .. } if !(0.0..=1.0).contains(&probability) => {
+            Self::Spikes { probability, .. } | Self::Corrupted { probability }
+                if !(0.0..=1.0).contains(&probability) =>
+            {
                 Some(("probability", "must be in [0, 1]"))
+            }
+            Self::Delayed { frames }
+                if !(frames.fract() == 0.0 && (1.0..=MAX_DELAY_FRAMES).contains(&frames)) =>
+            {
+                Some(("frames", "must be a whole number of frames from 1 to 10000"))
             }
             Self::FrictionScale { factor } | Self::ThrustScale { factor } if !nonneg(factor) => {
                 Some(("factor", "must be ≥ 0"))

@@ -147,7 +147,8 @@ impl Live {
         sc: &Spacecraft,
     ) -> Result<Self, ConfigError> {
         let actuator = match spec.port {
-            Port::Sensor { .. } => None,
+            // A link fault is applied by the server's command book (`super::link`).
+            Port::Sensor { .. } | Port::Link { .. } => None,
             Port::Actuator { effector } => Some(actuator(cfg, sc, effector)?),
         };
         Ok(Live {

@@ -4,7 +4,7 @@
 //!
 //! ```toml
 //! [[faults]]
-//! target = "imus.hub.gyro"   # <section>.<name>[.<channel>]
+//! target = "imus.hub.gyro"   # <section>.<name>[.<channel>], or links.<sender id>
 //! mode = "bias_step"         # see faults::modes
 //! value = 0.01               # the mode's parameters
 //! start_s = 2.0              # default 0
@@ -19,7 +19,7 @@ use crate::schema::{SchemaError, TableReader};
 
 /// The keys of one `[[faults]]` entry (`target` and `mode` are required): the general ones,
 /// then [`PARAM_KEYS`].
-pub(crate) const KEYS: [&str; 15] = {
+pub(crate) const KEYS: [&str; 16] = {
     let general = [
         "target",
         "mode",
@@ -30,7 +30,7 @@ pub(crate) const KEYS: [&str; 15] = {
         "seed",
         "mtbf_s",
     ];
-    let mut keys = [""; 15];
+    let mut keys = [""; 16];
     let mut i = 0;
     while i < keys.len() {
         keys[i] = if i < general.len() {
@@ -44,7 +44,7 @@ pub(crate) const KEYS: [&str; 15] = {
 };
 
 /// The parameter keys (a mode takes some of them: [`super::modes::MODES`]).
-pub(crate) const PARAM_KEYS: [&str; 7] = [
+pub(crate) const PARAM_KEYS: [&str; 8] = [
     "value",
     "rate_per_s",
     "factor",
@@ -52,6 +52,7 @@ pub(crate) const PARAM_KEYS: [&str; 7] = [
     "probability",
     "amplitude",
     "fraction",
+    "frames",
 ];
 
 /// One entry as written.

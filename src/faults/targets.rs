@@ -1,9 +1,11 @@
 //! Load-time resolution of `[[faults]]`: each target must name a sensor (and optionally one of
 //! its channels) or an actuator that exists, the mode must be one the kind states it takes, the
 //! mode's parameters must be exactly its own and in range, and the window must be whole
-//! nanoseconds. Every error names the entry's field; nothing is silently ignored.
+//! nanoseconds. Every error names the entry's field; nothing is silently ignored. A command
+//! link (`links.<sender id>`) must be one of the file's `server.participants` (default `[1]`);
+//! the server checks again against its final participants (command-line overrides included).
 
-use super::modes::{FaultMode, MODES, SENSOR_MODES, VALUE_MODES};
+use super::modes::{FaultMode, LINK_MODES, MODES, SENSOR_MODES, VALUE_MODES};
 use super::schema::RawFault;
 use super::window::FaultWindow;
 use super::{FaultSpec, Port, MAX_AXES};
@@ -23,10 +25,24 @@ pub(crate) fn resolve(
         return Ok(Vec::new());
     }
     let bank = SensorBank::new(cfg, cfg.frame_ns as f64 * 1e-9, 0, sc.state())?;
+    let participants = file_participants(&cfg.server);
     raw.iter()
         .enumerate()
-        .map(|(i, r)| resolve_one(i, r, &bank, sc, map))
+        .map(|(i, r)| resolve_one(i, r, &bank, sc, participants.as_deref(), map))
         .collect()
+}
+
+/// `server.participants` as the file gives it (the server's default `[1]` when absent); `None`
+/// if it is not a list of sender ids (the server's own schema reports that).
+fn file_participants(server: &toml::Table) -> Option<Vec<u32>> {
+    match server.get("participants") {
+        None => Some(vec![1]),
+        Some(toml::Value::Array(ids)) => ids
+            .iter()
+            .map(|v| v.as_integer().and_then(|i| u32::try_from(i).ok()))
+            .collect(),
+        Some(_) => None,
+    }
 }
 
 pub(super) fn resolve_one(
@@ -34,6 +50,7 @@ pub(super) fn resolve_one(
     r: &RawFault,
     bank: &SensorBank,
     sc: &Spacecraft,
+    participants: Option<&[u32]>,
     map: &SourceMap,
 ) -> Result<FaultSpec, ConfigError> {
     let field = |key: &str| format!("{}.{key}", r.path);
@@ -218,6 +235,36 @@ pub(super) fn resolve_one(
                 return Err(not_applicable(&bad, mode_name, kind.noun, kind.fault_modes));
             }
             (Port::Actuator { effector }, 0)
+        } else if parts[0] == super::link::SECTION {
+            let name = parts.get(1).copied().unwrap_or("");
+            let Some(sender_id) = super::link::sender_of(name).filter(|_| parts.len() == 2) else {
+                return Err(bad(
+                    "target",
+                    format!(
+                        "\"{}\": a command-link target is links.<sender id> (a participant's id, \
+                         as server.participants lists it)",
+                        r.target
+                    ),
+                ));
+            };
+            if let Some(ids) = participants.filter(|ids| !ids.contains(&sender_id)) {
+                return Err(bad(
+                    "target",
+                    format!(
+                        "\"{}\": participant {sender_id} is not in server.participants {ids:?}",
+                        r.target
+                    ),
+                ));
+            }
+            if !LINK_MODES.contains(&mode_name) {
+                return Err(not_applicable(
+                    &bad,
+                    mode_name,
+                    "a command link",
+                    LINK_MODES,
+                ));
+            }
+            (Port::Link { sender_id }, 0)
         } else {
             let mut sections: Vec<&str> = SENSOR_KINDS.iter().map(|k| k.config_array).collect();
             sections.extend(
@@ -226,6 +273,7 @@ pub(super) fn resolve_one(
                     .filter(|k| !k.fault_modes.is_empty())
                     .map(|k| k.section),
             );
+            sections.push(super::link::SECTION);
             return Err(bad(
                 "target",
                 format!(

@@ -9,12 +9,17 @@
 //! `Actuators` command replaces the wrench and the inputs of the effectors it lists; the others
 //! keep that participant's previous inputs. The inputs applied are the participants' summed in
 //! ascending sender-id order, like the wrench, and the stale policy treats both alike.
+//!
+//! Command-link faults ([`crate::faults::link`]: dropped, delayed, corrupted) act here, at the
+//! tick a command answers, so their effect is a function of the tick as well.
 
 use std::ops::Range;
 
 use flexdyn_proto::{
-    command_flags, CommandKind, CommandMsg, CommandStatus, StalePolicy, NO_COMMAND,
+    command_flags, CommandKind, CommandMsg, CommandStatus, DecodeError, StalePolicy, NO_COMMAND,
 };
+
+use crate::faults::link::{damage, LinkFaults, LinkStats};
 
 /// What the book did with an offered command.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -30,6 +35,52 @@ pub enum Offer {
     /// inputs, gives the wrong number of values, or names an effector twice
     /// (`rejected.bad_effector_input`). In lockstep it does not answer the tick.
     BadEffectorInput,
+    /// Discarded: the sender's command link is `dropped` ([`crate::faults::link`]); counted in
+    /// [`LinkStats::commands_dropped`].
+    LinkDropped,
+    /// The sender's command link is `corrupted` and the damaged command failed a check: counted
+    /// under `rejected.<reason>`. In lockstep it answers the tick with nothing.
+    LinkCorrupted(Damaged),
+}
+
+/// Why a damaged command ([`Offer::LinkCorrupted`]) was rejected: its `rejected.*` counter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Damaged {
+    /// `rejected.malformed`.
+    Malformed,
+    /// `rejected.bad_version`.
+    BadVersion,
+    /// `rejected.non_finite`.
+    NonFinite,
+    /// `rejected.wrong_spacecraft`.
+    WrongSpacecraft,
+    /// `rejected.wrong_identity`: its sender id is not its link's.
+    WrongIdentity,
+    /// `rejected.stale_tick`.
+    StaleTick,
+    /// `rejected.bad_effector_input`.
+    BadEffectorInput,
+}
+
+impl Damaged {
+    fn of_decode(e: &DecodeError) -> Self {
+        match e {
+            DecodeError::UnknownVersion { .. } => Self::BadVersion,
+            DecodeError::NonFinite { .. } => Self::NonFinite,
+            _ => Self::Malformed,
+        }
+    }
+}
+
+/// A `delayed` link's delay line: the participant's slot as it was at each of the last
+/// `ring.len()` ticks held (index `k mod len`), preallocated.
+#[derive(Clone, Debug)]
+struct DelayLine {
+    /// The participant's slot index.
+    slot: usize,
+    ring: Vec<Slot>,
+    /// The tick each entry was taken at.
+    ticks: Vec<Option<u64>>,
 }
 
 #[derive(Clone, Debug)]
@@ -101,6 +152,18 @@ fn check_inputs(ranges: &[Range<usize>], seen: &mut [bool], cmd: &CommandMsg) ->
     None
 }
 
+/// Copies slot `from` into `to` (same input layout) without allocating.
+fn copy_slot(to: &mut Slot, from: &Slot) {
+    to.sender_id = from.sender_id;
+    to.torque_b_nm = from.torque_b_nm;
+    to.force_b_newton = from.force_b_newton;
+    to.inputs.copy_from_slice(&from.inputs);
+    to.has_command = from.has_command;
+    to.last_tick = from.last_tick;
+    to.received_tick = from.received_tick;
+    to.answered = from.answered;
+}
+
 /// Per-participant command state, in ascending sender-id order.
 #[derive(Clone, Debug)]
 pub struct CommandBook {
@@ -115,6 +178,18 @@ pub struct CommandBook {
     seen: Vec<bool>,
     /// The summed inputs of the last [`CommandBook::held`].
     held_inputs: Vec<f64>,
+    /// The command-link faults (none by default).
+    links: LinkFaults,
+    /// The spacecraft id a damaged command must still carry.
+    spacecraft_id: u32,
+    /// One per participant with a `delayed` link fault.
+    delay: Vec<DelayLine>,
+    /// A participant's slot with nothing held (before its first command).
+    empty: Slot,
+    /// Scratch for a damaged command's bytes.
+    scratch: Vec<u8>,
+    /// What the link faults did.
+    stats: LinkStats,
 }
 
 impl CommandBook {
@@ -131,20 +206,24 @@ impl CommandBook {
         ids.sort_unstable();
         ids.dedup();
         let n_inputs = input_ranges.last().map_or(0, |r| r.end);
+        let empty = |sender_id| Slot {
+            sender_id,
+            torque_b_nm: [0.0; 3],
+            force_b_newton: [0.0; 3],
+            inputs: vec![0.0; n_inputs],
+            has_command: false,
+            last_tick: 0,
+            received_tick: 0,
+            answered: false,
+        };
         Self {
-            slots: ids
-                .into_iter()
-                .map(|sender_id| Slot {
-                    sender_id,
-                    torque_b_nm: [0.0; 3],
-                    force_b_newton: [0.0; 3],
-                    inputs: vec![0.0; n_inputs],
-                    has_command: false,
-                    last_tick: 0,
-                    received_tick: 0,
-                    answered: false,
-                })
-                .collect(),
+            slots: ids.into_iter().map(empty).collect(),
+            links: LinkFaults::default(),
+            spacecraft_id: 0,
+            delay: Vec::new(),
+            empty: empty(0),
+            scratch: Vec::new(),
+            stats: LinkStats::default(),
             frame_ns,
             stale_after_ns,
             policy,
@@ -190,12 +269,50 @@ impl CommandBook {
         slot.received_tick = k;
     }
 
-    /// Lockstep: start waiting for the answers to a new tick.
-    pub fn begin_tick(&mut self) {
-        for s in &mut self.slots {
-            s.answered = false;
-        }
+    /// The book with the command-link faults `links` on the spacecraft `spacecraft_id` (a
+    /// damaged command must still carry it). Allocates the delay lines.
+    pub fn with_links(mut self, links: LinkFaults, spacecraft_id: u32) -> Self {
+        self.delay = self
+            .slots
+            .iter()
+            .enumerate()
+            .filter_map(|(slot, s)| {
+                let n = links.max_delay_frames(s.sender_id)? as usize + 1;
+                Some(DelayLine {
+                    slot,
+                    ring: vec![s.clone(); n],
+                    ticks: vec![None; n],
+                })
+            })
+            .collect();
+        self.scratch = Vec::with_capacity(flexdyn_proto::MAX_MESSAGE_BYTES);
+        self.links = links;
+        self.spacecraft_id = spacecraft_id;
+        self
+    }
+
+    /// What the command-link faults did so far.
+    pub fn link_stats(&self) -> LinkStats {
+        self.stats
+    }
+
+    /// The command-link faults (with which are active at the last tick evaluated).
+    pub fn links(&self) -> &LinkFaults {
+        &self.links
+    }
+
+    /// Lockstep: start waiting for the answers to tick `k`. A participant whose link is
+    /// `dropped` at `k` counts as answered with nothing: the barrier does not wait for it.
+    pub fn begin_tick(&mut self, k: u64) {
+        self.links.at_tick(k);
         self.answered = 0;
+        for s in &mut self.slots {
+            s.answered = !self.links.is_empty() && self.links.dropped(s.sender_id);
+            if s.answered {
+                self.answered += 1;
+                self.stats.empty_answers += 1;
+            }
+        }
     }
 
     /// Lockstep: whether every participant has answered the current tick.
@@ -214,8 +331,22 @@ impl CommandBook {
         let Some(i) = self.slot_index(cmd.sender_id) else {
             return Offer::UnknownSender;
         };
+        if !self.links.is_empty() {
+            self.links.at_tick(k);
+            if self.links.dropped(cmd.sender_id) {
+                self.stats.commands_dropped += 1;
+                return Offer::LinkDropped;
+            }
+        }
         if cmd.header.tick != k || self.slots[i].answered {
             return Offer::StaleTick;
+        }
+        if let Some((seed, p)) = self.corruption(cmd.sender_id) {
+            // The damaged command answers the tick whatever the checks say (no run waits for a
+            // command its link cannot deliver).
+            self.slots[i].answered = true;
+            self.answered += 1;
+            return self.offer_damaged(i, cmd, k, seed, p, true);
         }
         if let Some(offer) = self.check_inputs(cmd) {
             return offer;
@@ -227,12 +358,75 @@ impl CommandBook {
         Offer::Accepted
     }
 
+    /// `(seed, probability)` if `sender_id`'s link is corrupted at the tick evaluated.
+    fn corruption(&self, sender_id: u32) -> Option<(u64, f64)> {
+        if self.links.is_empty() {
+            return None;
+        }
+        self.links.corruption(sender_id)
+    }
+
+    /// Slot `i`'s command `cmd` at tick `k` through a corrupted link ([`crate::faults::link`]):
+    /// its encoding damaged, decoded and checked like any command (`lockstep` selects the tick
+    /// rule), and taken if it passes.
+    fn offer_damaged(
+        &mut self,
+        i: usize,
+        cmd: &CommandMsg,
+        k: u64,
+        seed: u64,
+        probability: f64,
+        lockstep: bool,
+    ) -> Offer {
+        self.stats.commands_corrupted += 1;
+        flexdyn_proto::encode_into(cmd, &mut self.scratch);
+        damage(&mut self.scratch, seed, k, probability);
+        let slot = &self.slots[i];
+        let reject = match flexdyn_proto::decode_command(&self.scratch) {
+            Err(e) => Err(Damaged::of_decode(&e)),
+            Ok(d) if d.header.spacecraft_id != self.spacecraft_id => Err(Damaged::WrongSpacecraft),
+            Ok(d) if d.sender_id != slot.sender_id => Err(Damaged::WrongIdentity),
+            Ok(d)
+                if (lockstep && d.header.tick != k)
+                    || (!lockstep
+                        && (d.header.tick > k
+                            || (slot.has_command && d.header.tick < slot.last_tick))) =>
+            {
+                Err(Damaged::StaleTick)
+            }
+            Ok(d) => match check_inputs(&self.input_ranges, &mut self.seen, &d) {
+                Some(_) => Err(Damaged::BadEffectorInput),
+                None => Ok(d),
+            },
+        };
+        match reject {
+            Ok(d) => {
+                Self::take(&mut self.slots[i], &self.input_ranges, &d, k);
+                Offer::Accepted
+            }
+            Err(why) => {
+                self.stats.corrupted_rejected += 1;
+                Offer::LinkCorrupted(why)
+            }
+        }
+    }
+
     /// Real time / batch: offer a command at frame boundary `k`. Accepted unless its tick is in
     /// the future (`> k`) or older than the sender's held command (re-ordered or replayed).
     pub fn offer_latest(&mut self, cmd: &CommandMsg, k: u64) -> Offer {
         let Some(i) = self.slot_index(cmd.sender_id) else {
             return Offer::UnknownSender;
         };
+        if !self.links.is_empty() {
+            self.links.at_tick(k);
+            if self.links.dropped(cmd.sender_id) {
+                self.stats.commands_dropped += 1;
+                return Offer::LinkDropped;
+            }
+            if let Some((seed, p)) = self.links.corruption(cmd.sender_id) {
+                return self.offer_damaged(i, cmd, k, seed, p, false);
+            }
+        }
         let slot = &self.slots[i];
         if cmd.header.tick > k || (slot.has_command && cmd.header.tick < slot.last_tick) {
             return Offer::StaleTick;
@@ -258,8 +452,20 @@ impl CommandBook {
     /// ascending sender-id order. A command taken more than `stale_after` (simulation time) ago
     /// is stale; with [`StalePolicy::Zero`] it contributes zero. The effector inputs are summed
     /// the same way into [`Self::held_inputs`].
+    ///
+    /// A participant whose link is `delayed` by N frames at `k` contributes its slot as it was
+    /// at tick k − N (nothing before tick N): [`crate::faults::link`].
     pub fn held(&mut self, k: u64) -> Held {
         self.held_inputs.iter_mut().for_each(|u| *u = 0.0);
+        if !self.delay.is_empty() {
+            self.links.at_tick(k);
+            for d in &mut self.delay {
+                let n = d.ring.len();
+                let at = (k % n as u64) as usize;
+                copy_slot(&mut d.ring[at], &self.slots[d.slot]);
+                d.ticks[at] = Some(k);
+            }
+        }
         let mut out = Held {
             torque_b_nm: [0.0; 3],
             force_b_newton: [0.0; 3],
@@ -272,7 +478,26 @@ impl CommandBook {
             },
         };
         let mut any = false;
-        for s in self.slots.iter().filter(|s| s.has_command) {
+        for (i, s) in self.slots.iter().enumerate() {
+            let s = match self.delay.iter().find(|d| d.slot == i) {
+                Some(d) => match self.links.delay_frames(s.sender_id) {
+                    Some(n) => {
+                        self.stats.delayed_frames += 1;
+                        let back = k.checked_sub(n);
+                        let at = back.map_or(0, |b| (b % d.ring.len() as u64) as usize);
+                        if back.is_some() && d.ticks[at] == back {
+                            &d.ring[at]
+                        } else {
+                            &self.empty
+                        }
+                    }
+                    None => s,
+                },
+                None => s,
+            };
+            if !s.has_command {
+                continue;
+            }
             let age_ns = k
                 .saturating_sub(s.received_tick)
                 .saturating_mul(self.frame_ns);
@@ -402,7 +627,7 @@ mod tests {
     #[test]
     fn lockstep_needs_every_participant_once() {
         let mut b = CommandBook::new(&[2, 1], 10, 100, StalePolicy::Hold, &[]);
-        b.begin_tick();
+        b.begin_tick(0);
         assert_eq!(b.first_unanswered(), Some(1));
         assert_eq!(b.offer_lockstep(&wrench(2, 5, 1.0), 5), Offer::Accepted);
         assert_eq!(b.offer_lockstep(&wrench(2, 5, 9.0), 5), Offer::StaleTick);
@@ -423,7 +648,7 @@ mod tests {
         assert_eq!(h.status.last_command_tick, 5);
         assert_eq!(h.status.command_age_ns, 0);
         // NoCommand keeps the previous wrench.
-        b.begin_tick();
+        b.begin_tick(0);
         assert_eq!(b.offer_lockstep(&none(1, 6), 6), Offer::Accepted);
         assert_eq!(b.offer_lockstep(&wrench(2, 6, 2.0), 6), Offer::Accepted);
         assert_eq!(b.held(6).torque_b_nm, [0.0, 0.0, 2.5]);
@@ -557,7 +782,7 @@ mod tests {
             // The physics thread is at boundary `k`; `published` is the tick it noted last
             // (it notes `k`, then takes the queue at `k`, then steps to `k + 1`).
             let (mut k, mut published) = (0u64, 0u64);
-            book.begin_tick();
+            book.begin_tick(0);
             for (what, sender, delta, shape) in events {
                 if what <= 1 {
                     published = k;
@@ -573,7 +798,7 @@ mod tests {
                     }
                     if !lockstep || book.all_answered() {
                         k += 1;
-                        book.begin_tick();
+                        book.begin_tick(k);
                     }
                 }
                 if what <= 1 {

@@ -89,7 +89,7 @@ impl LockstepCore {
             events,
             holding: false,
         };
-        core.w.book.begin_tick();
+        core.w.book.begin_tick(0);
         core
     }
 
@@ -183,22 +183,34 @@ impl LockstepCore {
         self.tick_published_at = Instant::now();
     }
 
+    /// Steps the answered tick, publishes the next, and goes on stepping while a tick needs no
+    /// answer (every participant's command link `dropped`: [`crate::faults::link`]), until one
+    /// does, a hold, the end, or a stop request.
     fn advance(&mut self) {
-        self.w.step(self.k);
-        self.k += 1;
-        self.w.fill(&mut self.frame, self.k);
-        if let Err(e) = self.w.check_finite(self.k, true) {
-            self.end(Phase::Failed(e));
-            return;
+        loop {
+            self.w.step(self.k);
+            self.w.note_links(&self.shared);
+            self.k += 1;
+            self.w.fill(&mut self.frame, self.k);
+            if let Err(e) = self.w.check_finite(self.k, true) {
+                self.end(Phase::Failed(e));
+                return;
+            }
+            self.mark_hold();
+            self.publish();
+            if self.total_frames == Some(self.k) {
+                self.end(Phase::Finished);
+                return;
+            }
+            self.w.book.begin_tick(self.k);
+            self.enter_hold();
+            if !self.w.book.all_answered()
+                || self.holding
+                || self.shared.stop.load(Ordering::Relaxed)
+            {
+                return;
+            }
         }
-        self.mark_hold();
-        self.publish();
-        if self.total_frames == Some(self.k) {
-            self.end(Phase::Finished);
-            return;
-        }
-        self.w.book.begin_tick();
-        self.enter_hold();
     }
 
     fn end(&mut self, phase: Phase) {

@@ -229,6 +229,7 @@ fn prepare(
     cfg: &SimConfig,
 ) -> Result<(Topics, Simulation, Option<u64>), ServerError> {
     settings.validate()?;
+    settings.check_link_faults(cfg)?;
     let total_frames = settings.duration_frames(cfg.frame_ns)?;
     let topics = Topics::new(&settings.sc_id).map_err(|e| SettingsError::Invalid {
         name: "server.sc_id".into(),

@@ -119,13 +119,15 @@ pub struct Stepper {
 impl Stepper {
     /// A stepper at t = 0 with the sensors sampled at tick 0.
     pub fn new(mut sim: Simulation, settings: &ServerSettings) -> Self {
+        let links = crate::faults::link::LinkFaults::new(sim.faults().specs(), sim.frame_ns());
         let book = CommandBook::new(
             &settings.participants,
             sim.frame_ns(),
             u64::try_from(settings.stale_after.as_nanos()).unwrap_or(u64::MAX),
             settings.stale_policy,
             sim.spacecraft().effector_input_ranges(),
-        );
+        )
+        .with_links(links, settings.spacecraft_id);
         let state = sim.blank_state();
         // Live faults go into slots reserved here (the stepping path never allocates one).
         sim.faults_mut().reserve_live();
@@ -212,6 +214,14 @@ impl Stepper {
         self.sim.faults_mut().install(req, k + 1)
     }
 
+    /// Copies what the command-link faults did into `shared` (a few atomic stores; nothing
+    /// without link faults).
+    pub fn note_links(&self, shared: &Shared) {
+        if !self.book.links().is_empty() {
+            shared.note_link_stats(&self.book.link_stats());
+        }
+    }
+
     /// Once per frame, outside the RK4 loop: never publish a non-finite state. `filled` says
     /// whether [`Self::fill`] already took this tick's state.
     pub fn check_finite(&mut self, k: u64, filled: bool) -> Result<(), ServerError> {
@@ -241,6 +251,9 @@ pub fn count_offer(shared: &Shared, offer: Offer, sender_id: u32) {
         Offer::StaleTick => shared.reject_stale_tick_from(sender_id),
         Offer::UnknownSender => shared.reject_unknown_sender(),
         Offer::BadEffectorInput => shared.reject_bad_effector_input(),
+        // Counted in the book's link statistics.
+        Offer::LinkDropped => {}
+        Offer::LinkCorrupted(why) => shared.reject_damaged(why, sender_id),
     }
 }
 
@@ -340,7 +353,7 @@ impl PhysicsCtx {
 
     /// Lockstep: wait until every participant has answered tick `k`.
     fn await_answers(&self, book: &mut CommandBook, k: u64) -> Result<Wait, ServerError> {
-        book.begin_tick();
+        book.begin_tick(k);
         let timeout = self.settings.participant_timeout;
         let give_up = Instant::now() + timeout;
         while !book.all_answered() {
@@ -494,6 +507,7 @@ impl PhysicsCtx {
             // Live faults for boundary k + 1 on, then 3. integrate the frame.
             self.drain_faults(&mut w, k);
             w.step(k);
+            w.note_links(&self.shared);
             k += 1;
 
             // 4. Fill the state of tick k.

@@ -43,6 +43,8 @@ pub struct RunReport {
     pub rejected: RejectCounters,
     /// Valid commands dropped because the command queue was full.
     pub commands_dropped: u64,
+    /// What the command-link faults (`links.<sender id>`) did.
+    pub link_faults: crate::faults::link::LinkStats,
     /// \[s\] wall time from the first frame to the end.
     pub wall_s: f64,
     /// `--record`: what the recording holds and what the recorder dropped.
@@ -101,6 +103,19 @@ impl fmt::Display for RunReport {
             self.rejected.total(),
             self.commands_dropped,
         )?;
+        let l = &self.link_faults;
+        if !l.is_zero() {
+            write!(
+                f,
+                " link_faults dropped={} empty_answers={} delayed_frames={} corrupted={} \
+                 corrupted_rejected={}",
+                l.commands_dropped,
+                l.empty_answers,
+                l.delayed_frames,
+                l.commands_corrupted,
+                l.corrupted_rejected
+            )?;
+        }
         if let Some(r) = &self.recording {
             write!(
                 f,
@@ -162,6 +177,7 @@ impl RunReport {
             ),
             rejected: shared.rejected(),
             commands_dropped: load(&shared.commands_dropped),
+            link_faults: shared.link_stats(),
             wall_s,
             recording,
             handoff: {
@@ -191,6 +207,7 @@ impl RunReport {
             timing: FrameTiming::default(),
             rejected,
             commands_dropped: 0,
+            link_faults: Default::default(),
             wall_s: 0.0,
             recording: None,
             handoff: None,

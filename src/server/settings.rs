@@ -375,6 +375,15 @@ impl Setter<'_> {
 }
 
 impl ServerSettings {
+    /// Every command-link fault of `cfg` (`links.<sender id>`) must name one of these
+    /// participants (the file's were checked at load; the command line may change them).
+    pub fn check_link_faults(&self, cfg: &SimConfig) -> Result<(), SettingsError> {
+        match crate::faults::link::unknown_participant(&cfg.faults, &self.participants) {
+            Some((name, problem)) => Err(SettingsError::Invalid { name, problem }),
+            None => Ok(()),
+        }
+    }
+
     /// The settings of a configuration's `[server]` table (empty table: the defaults).
     /// Unknown keys and bad values are errors naming `server.<key>`.
     pub fn from_table(table: &toml::Table) -> Result<Self, SettingsError> {
@@ -422,6 +431,7 @@ impl ServerSettings {
             }
         };
         s.validate().map_err(named)?;
+        s.check_link_faults(cfg).map_err(named)?;
         s.duration_frames(cfg.frame_ns).map_err(named)?;
         Ok(s)
     }

@@ -180,6 +180,10 @@ pub struct Shared {
     /// `stale_tick` rejections per participant (sender id, count), in ascending id order, so
     /// the telemetry thread can name the sender in its warning (the physics thread only counts).
     pub stale_by_participant: Vec<(u32, AtomicU64)>,
+    /// What the command-link faults did ([`crate::faults::link::LinkStats`], copied from the
+    /// command book after each frame): dropped, empty answers, delayed frames, corrupted,
+    /// corrupted and rejected.
+    link_stats: [AtomicU64; 5],
 }
 
 /// Overrun frames whose times [`OverrunLog`] keeps (the first ones of a run).
@@ -262,6 +266,46 @@ impl Shared {
             DecodeError::UnknownVersion { .. } => bump(&self.bad_version),
             DecodeError::NonFinite { .. } => bump(&self.non_finite),
             _ => bump(&self.malformed),
+        }
+    }
+
+    /// Count a damaged command (a `corrupted` command link) under the reason it was rejected.
+    pub fn reject_damaged(&self, why: super::commands::Damaged, sender_id: u32) {
+        use super::commands::Damaged;
+        match why {
+            Damaged::Malformed => bump(&self.malformed),
+            Damaged::BadVersion => bump(&self.bad_version),
+            Damaged::NonFinite => bump(&self.non_finite),
+            Damaged::WrongSpacecraft => bump(&self.wrong_spacecraft),
+            Damaged::WrongIdentity => bump(&self.wrong_identity),
+            Damaged::StaleTick => self.reject_stale_tick_from(sender_id),
+            Damaged::BadEffectorInput => bump(&self.bad_effector_input),
+        }
+    }
+
+    /// Notes what the command-link faults did so far (allocation-free).
+    pub fn note_link_stats(&self, s: &crate::faults::link::LinkStats) {
+        let v = [
+            s.commands_dropped,
+            s.empty_answers,
+            s.delayed_frames,
+            s.commands_corrupted,
+            s.corrupted_rejected,
+        ];
+        for (c, v) in self.link_stats.iter().zip(v) {
+            c.store(v, Ordering::Relaxed);
+        }
+    }
+
+    /// What the command-link faults did so far.
+    pub fn link_stats(&self) -> crate::faults::link::LinkStats {
+        let l = |i: usize| self.link_stats[i].load(Ordering::Relaxed);
+        crate::faults::link::LinkStats {
+            commands_dropped: l(0),
+            empty_answers: l(1),
+            delayed_frames: l(2),
+            commands_corrupted: l(3),
+            corrupted_rejected: l(4),
         }
     }
 

@@ -89,6 +89,7 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
         index: None,
         record: false,
         base_port: 0,
+        without_random_faults: false,
     })
     .unwrap();
     eprintln!("{}", report.text);
@@ -159,6 +160,7 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
         index: Some(7),
         record: false,
         base_port: 0,
+        without_random_faults: false,
     })
     .unwrap();
     assert_eq!(alone.exit_code, 3, "{}", alone.text);
@@ -180,6 +182,7 @@ fn a_crashing_controller_fails_its_run_and_the_campaign_goes_on() {
         index: None,
         record: false,
         base_port: 0,
+        without_random_faults: false,
     })
     .unwrap();
     eprintln!("{}", report.text);

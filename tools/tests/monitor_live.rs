@@ -108,7 +108,10 @@ fn the_monitor_gives_each_vehicle_its_own_line() {
     assert!(out.status.success(), "{stdout}");
     let lines: Vec<&str> = stdout.lines().collect();
     // Three whole intervals, two lines each, in the order given.
-    assert!(lines.len() >= 6 && lines.len().is_multiple_of(2), "{stdout}");
+    assert!(
+        lines.len() >= 6 && lines.len().is_multiple_of(2),
+        "{stdout}"
+    );
     let (chief, deputy) = (lines[lines.len() - 2], lines[lines.len() - 1]);
     assert!(chief.starts_with("[chief] t="), "{chief}");
     assert!(deputy.starts_with("[deputy] t="), "{deputy}");

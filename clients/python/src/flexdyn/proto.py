@@ -66,6 +66,8 @@ FAULT_MODES = (
     ("friction_scale", ("factor",)), ("torque_limit", ("fraction",)), ("seized", ()),
     ("command_ignored", ()), ("stuck_on", ()), ("stuck_off", ()), ("thrust_scale", ("factor",)),
     ("dead", ()), ("dipole_scale", ("factor",)),
+    # Command links: configuration only (a live fault command with these codes is refused).
+    ("dropped", ()), ("delayed", ("frames",)), ("corrupted", ("probability",)),
 )
 MAX_EFFECTORS = 1024
 MAX_EFFECTOR_VALUES = 8

@@ -1,0 +1,177 @@
+//! Command-link faults in lockstep (`links.<sender id>`: `src/faults/link.rs`). A scripted
+//! participant answers tick k with the torque f(k) = (0, 0, 10⁻⁴ (k + 1)) N·m, a different value
+//! every tick, so the wrench the server applied over frame k → k + 1 (the `wrench_applied` of
+//! the state of tick k + 1) names the command it came from. Each faulty run is compared, tick by
+//! tick, with a healthy run of the same configuration:
+//! - `dropped` over ticks [20, 40): the participant's commands are not applied (its last one, of
+//!   tick 19, stays held: `stale_policy = "hold"`), and the run still reaches its last tick: a
+//!   dropped link is answered with nothing, once per tick of the window;
+//! - `delayed` by N = 5 frames over [20, 40): the command applied at tick k is the healthy run's
+//!   of tick k − 5 inside the window, and the healthy run's outside it;
+//! - `corrupted` with bit error rate 1 over [20, 40): every bit of each command inverted, so
+//!   its version byte 7 becomes 0xF8 and every one is rejected as `bad_version` (20 of them),
+//!   counted, answering its tick with nothing; no panic, no hang.
+//!
+//! The windows: frames at 100 Hz, start_s = 0.2 and duration_s = 0.2 are ticks 20 to 39.
+
+mod server_support;
+
+use std::time::Duration;
+
+use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
+use flexdyn::faults::link::LinkStats;
+use flexdyn::server::{RunReport, ServerSettings};
+use flexdyn_proto::{decode_state, encode, CommandMsg, Header, Mode, RejectCounters, Topics};
+use server_support::{connecting_session, ServerHandle};
+use zenoh::Wait;
+
+const WAIT: Duration = Duration::from_secs(30);
+const LAST_TICK: u64 = 60;
+const WINDOW: std::ops::Range<u64> = 20..40;
+
+/// The participant's torque for tick `k` \[N·m\].
+fn f(k: u64) -> f64 {
+    1e-4 * (k + 1) as f64
+}
+
+/// The reference spacecraft (100 Hz frames) with `faults` appended.
+fn config(faults: &str) -> SimConfig {
+    let text = format!("{DEFAULT_CONFIG_TOML}\n{faults}\n");
+    SimConfig::from_toml_str(&text).unwrap()
+}
+
+/// A lockstep run to tick 60 with participant 1 answering every state with f(tick): the
+/// applied torque z of each tick 0..=60 and the report.
+fn run(faults: &str) -> (Vec<f64>, RunReport) {
+    let topics = Topics::new("sc1").unwrap();
+    let server = ServerHandle::start(
+        ServerSettings {
+            mode: Mode::Lockstep,
+            participants: vec![1],
+            participant_timeout: Duration::from_secs(20),
+            duration_ns: Some(LAST_TICK * 10_000_000),
+            ..ServerSettings::default()
+        },
+        config(faults),
+    );
+    let session = connecting_session(server.port);
+    let publisher = session.declare_publisher(topics.cmd(1)).wait().unwrap();
+    let states = session
+        .declare_subscriber(topics.state().to_owned())
+        .wait()
+        .unwrap();
+    let _token = session
+        .liveliness()
+        .declare_token(topics.participant(1))
+        .wait()
+        .unwrap();
+    let mut applied = vec![f64::NAN; LAST_TICK as usize + 1];
+    while let Ok(Some(sample)) = states.recv_timeout(WAIT) {
+        let s = decode_state(&sample.payload().to_bytes()).unwrap();
+        let k = s.header.tick;
+        applied[k as usize] = s.wrench_applied.torque_b_nm[2];
+        let h = Header::new(1, k, s.header.sim_time_ns, k);
+        let cmd = CommandMsg::wrench(h, 1, [0.0, 0.0, f(k)], [0.0; 3]);
+        publisher.put(encode(&cmd)).wait().unwrap();
+        if k == LAST_TICK {
+            break;
+        }
+    }
+    let report = server.join(WAIT).expect("the run");
+    assert_eq!(report.last_tick, LAST_TICK, "the run reached its end");
+    assert!(applied.iter().all(|a| a.is_finite()), "every tick seen");
+    (applied, report)
+}
+
+fn window(mode: &str) -> String {
+    format!("[[faults]]\ntarget = \"links.1\"\nstart_s = 0.2\nduration_s = 0.2\n{mode}")
+}
+
+/// The healthy run: the state of tick k + 1 carries f(k) (tick 0 precedes any command).
+fn healthy() -> Vec<f64> {
+    let (applied, report) = run("");
+    assert_eq!(applied[0], 0.0);
+    for k in 0..LAST_TICK {
+        assert_eq!(applied[k as usize + 1], f(k), "healthy tick {}", k + 1);
+    }
+    assert!(report.link_faults.is_zero());
+    applied
+}
+
+#[test]
+fn a_dropped_link_is_not_applied_and_the_run_goes_on() {
+    let ok = healthy();
+    let (got, report) = run(&window("mode = \"dropped\""));
+    for k in 0..LAST_TICK {
+        let want = if WINDOW.contains(&k) {
+            ok[WINDOW.start as usize] // f(19), held
+        } else {
+            ok[k as usize + 1]
+        };
+        assert_eq!(got[k as usize + 1], want, "command applied over frame {k}");
+    }
+    assert_eq!(report.link_faults.empty_answers, 20, "{report}");
+    // Each of the 20 commands sent for a dropped tick is discarded, or, if it arrives after
+    // the server stepped past the window on its own, refused as stale.
+    assert_eq!(
+        report.link_faults.commands_dropped + report.rejected.stale_tick,
+        20,
+        "{report}"
+    );
+    assert!(
+        report.to_string().contains("link_faults dropped="),
+        "{report}"
+    );
+}
+
+#[test]
+fn a_delayed_link_applies_the_command_of_n_frames_before() {
+    let ok = healthy();
+    let (got, report) = run(&window("mode = \"delayed\"\nframes = 5.0"));
+    for k in 0..LAST_TICK {
+        let t = k as usize + 1;
+        let want = if WINDOW.contains(&k) {
+            ok[t - 5]
+        } else {
+            ok[t]
+        };
+        assert_eq!(got[t], want, "command applied over frame {k}");
+    }
+    assert_eq!(
+        report.link_faults,
+        LinkStats {
+            delayed_frames: 20,
+            ..LinkStats::default()
+        }
+    );
+    assert_eq!(report.rejected, RejectCounters::default());
+}
+
+#[test]
+fn a_corrupted_link_is_rejected_counted_and_answers_its_tick() {
+    let ok = healthy();
+    let (got, report) = run(&window("mode = \"corrupted\"\nprobability = 1.0"));
+    for k in 0..LAST_TICK {
+        let want = if WINDOW.contains(&k) {
+            ok[WINDOW.start as usize]
+        } else {
+            ok[k as usize + 1]
+        };
+        assert_eq!(got[k as usize + 1], want, "command applied over frame {k}");
+    }
+    assert_eq!(
+        report.rejected,
+        RejectCounters {
+            bad_version: 20,
+            ..RejectCounters::default()
+        }
+    );
+    assert_eq!(
+        report.link_faults,
+        LinkStats {
+            commands_corrupted: 20,
+            corrupted_rejected: 20,
+            ..LinkStats::default()
+        }
+    );
+}
