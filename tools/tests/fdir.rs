@@ -11,6 +11,8 @@
 //! - **seized wheel** (`reaction_wheels.rw2`, `seized` at 60 s): the speed residual declares it
 //!   after exactly [`PERSISTENCE`] frames (the braking torque shows in the first); the
 //!   allocation moves to rw1, rw3, rw4;
+//! - **both gyros stuck** (imu_b's gyro too, the same fault): both declared at once, the rate
+//!   feedback moves to the star-tracker-derived rate;
 //! - **healthy**: no detection at all (no false alarm); the largest statistics (1 = the
 //!   threshold) are printed as the margins.
 //!
@@ -320,4 +322,34 @@ fn a_healthy_run_raises_no_alarm() {
     let settled = worst_after(&pointing_deg(&a.states), SETTLE_S);
     eprintln!("healthy, FDIR on: worst error from {SETTLE_S} s {settled:.4} deg");
     assert!(settled < POINTING_BOUND_DEG, "{settled} deg");
+}
+
+#[test]
+fn both_gyros_stuck_fall_back_to_star_tracker_rates() {
+    // The scenario with imu_b's gyro stuck at the same time as imu_a's.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/fdir.toml");
+    let text = std::fs::read_to_string(&path).unwrap()
+        + "\n[[faults]]\ntarget = \"imus.imu_b.gyro\"\nmode = \"stuck_current\"\nstart_s = 3.0\n";
+    let both = flexdyn::config::SimConfig::from_toml_str(&text)
+        .unwrap()
+        .faults;
+    let faults: Vec<FaultSpec> = both
+        .into_iter()
+        .filter(|f| f.target.contains("gyro"))
+        .collect();
+    assert_eq!(faults.len(), 2);
+    let a = run(&faults, true);
+    let tick = (GYRO_FAULT_S / FRAME_S).round() as u64 + PERSISTENCE;
+    let detections = lines(&a.transcript, "fdir-detect");
+    assert_eq!(detections.len(), 2, "{}", a.transcript);
+    for (d, unit) in detections.iter().zip(["imu_a", "imu_b"]) {
+        assert_eq!(field(d, "unit"), unit, "{d}");
+        assert_eq!(field(d, "test"), "frozen", "{d}");
+        assert_eq!(field(d, "tick"), tick.to_string(), "{d}");
+    }
+    let switch = lines(&a.transcript, "fdir-rate-source");
+    assert_eq!(switch.len(), 1, "{}", a.transcript);
+    assert_eq!(field(switch[0], "source"), "star-tracker");
+    let off = run(&faults, false);
+    check_recovery("both gyros stuck", tick, &a, &off);
 }
