@@ -65,6 +65,15 @@
 //!
 //! With `--rate-source gyro --imu NAME` as well, the loop uses no truth at all.
 //!
+//! # Fault detection, isolation and recovery
+//! `--fdir` (with the wheels, the star tracker and `--imu`) watches every IMU's gyro (a frozen
+//! output; consistency with the star tracker over `--fdir-window-s`) and every wheel (its speed
+//! against its command), moves the rate feedback off a failed gyro (to another IMU, or to the
+//! tracker's rate) and drops a failed wheel from the allocation
+//! ([`flexdyn_acs_demo::fdir`], which derives each threshold). Every detection and
+//! reconfiguration is a line on standard output (`fdir-detect`, `fdir-rate-source`,
+//! `fdir-wheels`), the largest statistics one at the end (`fdir-summary`).
+//!
 //! # Copying this package
 //! Keep `run`'s order (session → configuration → telemetry subscriber → publisher → token →
 //! loop). Replace [`GyroFeedback`] by your rate source and [`Controller::torque_b_nm`] by your
