@@ -29,7 +29,6 @@ mod acs_demo_bin;
 mod support;
 
 use std::collections::BTreeMap;
-use std::io::Read as _;
 use std::process::{Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -39,8 +38,7 @@ use flexdyn::server::ServerSettings;
 use flexdyn_proto::client::vehicle::VehicleConfig;
 use flexdyn_proto::{decode_environment, decode_state, Mode, StateMsg, Topics};
 use nalgebra::Vector3;
-use sha2::{Digest, Sha256};
-use support::{connecting_session, endpoint, ChildGuard, Recorder, ServerHandle};
+use support::{connecting_session, digest, endpoint, ChildGuard, Recorder, ServerHandle};
 use zenoh::Wait;
 
 /// Momentum management's duration in the test [s] (module docs); `FLEXDYN_ACS_UNLOAD_S`
@@ -144,17 +142,7 @@ fn sequence_run(unload_s: f64) -> Run {
         .expect("the lockstep run");
     let wall_s = started.elapsed().as_secs_f64();
     assert_eq!(report.last_tick, (duration_s / FRAME_S).round() as u64);
-    let status = demo
-        .wait_timeout(Duration::from_secs(20))
-        .expect("the demo did not exit after the run");
-    assert!(status.success(), "flexdyn-acs-demo failed: {status}");
-    let mut transcript = String::new();
-    demo.0
-        .stdout
-        .take()
-        .unwrap()
-        .read_to_string(&mut transcript)
-        .unwrap();
+    let transcript = support::finish_demo(&mut demo);
     let mut states = recorder.states.lock().unwrap().clone();
     states.sort_by_key(|(t, _)| *t);
     let sun_b = sun_b.lock().unwrap().clone();
@@ -164,15 +152,6 @@ fn sequence_run(unload_s: f64) -> Run {
         transcript,
         wall_s,
     }
-}
-
-fn digest(states: &[(u64, Vec<u8>)]) -> String {
-    let mut h = Sha256::new();
-    for (i, (tick, bytes)) in states.iter().enumerate() {
-        assert_eq!(*tick, i as u64, "ticks are not contiguous from 0");
-        h.update(bytes);
-    }
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// `key=value` of a transcript line.

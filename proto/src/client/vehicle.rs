@@ -330,6 +330,19 @@ pub struct ReactionWheel {
     pub j_t_kg_m2: f64,
     /// \[N·m\] motor torque limit.
     pub max_torque_nm: f64,
+    /// \[rad/s\] the speed beyond which the motor stops accelerating (infinite when absent).
+    #[serde(default = "infinite")]
+    pub max_speed_rad_s: f64,
+    /// \[N·m·s/rad\] viscous bearing friction (0 when absent).
+    #[serde(default)]
+    pub viscous_friction_nm_s_rad: f64,
+    /// \[N·m\] Coulomb bearing friction (0 when absent).
+    #[serde(default)]
+    pub coulomb_friction_nm: f64,
+}
+
+fn infinite() -> f64 {
+    f64::INFINITY
 }
 
 /// One `[[magnetorquers]]` entry.
@@ -373,6 +386,27 @@ pub struct Imu {
     pub r_sb_b_m: [f64; 3],
     /// [PB]: maps B components to the platform frame P.
     pub dcm_pb: [[f64; 3]; 3],
+    /// `[imus.<name>.gyro]`: the gyro's error specification (an ideal gyro when absent).
+    #[serde(default)]
+    pub gyro: GyroSpec,
+}
+
+/// The error specification of a gyro triad (`[imus.gyro]`), the part flight code's fault
+/// detection needs; absent keys are 0.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+pub struct GyroSpec {
+    /// \[rad/s/√Hz\] angle random walk N.
+    #[serde(default)]
+    pub arw_rad_s_sqrt_hz: f64,
+    /// \[rad/s\] the constant bias, P components.
+    #[serde(default)]
+    pub bias_rad_s: [f64; 3],
+    /// \[rad/s\] the steady-state σ of the Gauss–Markov bias instability.
+    #[serde(default)]
+    pub bias_instability_sigma_rad_s: f64,
+    /// \[rad/s\] the rate output's quantum (0: not quantised).
+    #[serde(default)]
+    pub lsb_rad_s: f64,
 }
 
 /// One `[[star_trackers]]` entry.
@@ -384,6 +418,19 @@ pub struct StarTracker {
     pub dcm_cb: [[f64; 3]; 3],
     /// \[Hz\] update rate (a whole divisor of the frame rate).
     pub rate_hz: f64,
+    /// \[rad\] 1σ noise about the two axes across the boresight (0 when absent).
+    #[serde(default)]
+    pub sigma_cross_boresight_rad: f64,
+    /// \[rad\] 1σ noise about the boresight (0 when absent).
+    #[serde(default)]
+    pub sigma_about_boresight_rad: f64,
+    /// The boresight in C (+z_C when absent).
+    #[serde(default = "plus_z")]
+    pub boresight_c: [f64; 3],
+}
+
+fn plus_z() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
 }
 
 /// One `[[magnetometers]]` entry.

@@ -96,6 +96,35 @@ impl Drop for ChildGuard {
     }
 }
 
+/// Waits (20 s at most) for a demo whose standard output is piped to exit after its run,
+/// checks it succeeded, and returns that output.
+pub fn finish_demo(demo: &mut ChildGuard) -> String {
+    use std::io::Read as _;
+    let status = demo
+        .wait_timeout(Duration::from_secs(20))
+        .expect("the demo did not exit after the run");
+    assert!(status.success(), "the demo failed: {status}");
+    let mut transcript = String::new();
+    demo.0
+        .stdout
+        .take()
+        .expect("the demo's stdout is piped")
+        .read_to_string(&mut transcript)
+        .unwrap();
+    transcript
+}
+
+/// The sha256 (hex) of a run's StateMsg payloads in tick order, checked contiguous from 0.
+pub fn digest(states: &[(u64, Vec<u8>)]) -> String {
+    use sha2::{Digest as _, Sha256};
+    let mut h = Sha256::new();
+    for (i, (tick, bytes)) in states.iter().enumerate() {
+        assert_eq!(*tick, i as u64, "ticks are not contiguous from 0");
+        h.update(bytes);
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
 /// Round-trip times of `count` StateMsg-sized pings (after `warmup` unmeasured ones) from a
 /// session listening on a port the OS chose to a `flexdyn-pingpong pong` child (reply CommandMsg-sized),
 /// which answers inside its Zenoh callback or, with `recv_loop`, from a receive loop (the demo

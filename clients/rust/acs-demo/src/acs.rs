@@ -79,18 +79,37 @@ impl WheelArray {
             .iter()
             .map(|w| Vector3::from(w.spin_axis_b).normalize())
             .collect();
-        let g = DMatrix::from_fn(3, n, |r, c| axes[c][r]);
-        let ggt_inv = (&g * g.transpose())
-            .try_inverse()
-            .filter(|m| m.iter().all(|x| x.is_finite()))
-            .context("the wheel spin axes do not span three axes: no torque about some axis")?;
         let first = cfg.first_wheel_index();
-        Ok(Self {
+        let mut array = Self {
             effector_index: (0..n as u32).map(|j| first + j).collect(),
             spin_axis_b: axes,
             j_s_kg_m2: cfg.reaction_wheels.iter().map(|w| w.j_s_kg_m2).collect(),
-            pinv: g.transpose() * ggt_inv,
-        })
+            pinv: DMatrix::zeros(n, 3),
+        };
+        array.set_allocation(&vec![false; n])?;
+        Ok(array)
+    }
+
+    /// Sets the allocation [G_s']⁺ = [G_s']ᵀ([G_s'][G_s']ᵀ)⁻¹ of the wheels not `excluded`:
+    /// [G_s'] is [G_s] with the excluded wheels' columns zero, so they get u = 0.
+    pub(crate) fn set_allocation(&mut self, excluded: &[bool]) -> anyhow::Result<()> {
+        let axes = &self.spin_axis_b;
+        let g = DMatrix::from_fn(3, axes.len(), |r, c| {
+            if excluded.get(c).copied().unwrap_or(false) {
+                0.0
+            } else {
+                axes[c][r]
+            }
+        });
+        let ggt = &g * g.transpose();
+        // Rank 3: the smallest eigenvalue of the (symmetric) [G][G]ᵀ is not round-off.
+        let eig = nalgebra::SymmetricEigen::new(Matrix3::from_fn(|r, c| ggt[(r, c)])).eigenvalues;
+        let ggt_inv = ggt
+            .try_inverse()
+            .filter(|m| m.iter().all(|x| x.is_finite()) && eig.min() > 1e-9 * eig.max())
+            .context("the wheel spin axes do not span three axes: no torque about some axis")?;
+        self.pinv = g.transpose() * ggt_inv;
+        Ok(())
     }
 
     /// Wheel speeds Ω_j [rad/s] from a state message (its wheel telemetry).

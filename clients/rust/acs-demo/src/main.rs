@@ -65,6 +65,15 @@
 //!
 //! With `--rate-source gyro --imu NAME` as well, the loop uses no truth at all.
 //!
+//! # Fault detection, isolation and recovery
+//! `--fdir` (with the wheels, the star tracker and `--imu`) watches every IMU's gyro (a frozen
+//! output; consistency with the star tracker over `--fdir-window-s`) and every wheel (its speed
+//! against its command), moves the rate feedback off a failed gyro (to another IMU, or to the
+//! tracker's rate) and drops a failed wheel from the allocation
+//! ([`flexdyn_acs_demo::fdir`], which derives each threshold). Every detection and
+//! reconfiguration is a line on standard output (`fdir-detect`, `fdir-rate-source`,
+//! `fdir-wheels`), the largest statistics one at the end (`fdir-summary`).
+//!
 //! # Copying this package
 //! Keep `run`'s order (session → configuration → telemetry subscriber → publisher → token →
 //! loop). Replace [`GyroFeedback`] by your rate source and [`Controller::torque_b_nm`] by your
@@ -77,6 +86,7 @@ use anyhow::{bail, Context as _};
 use clap::Parser;
 use flexdyn_acs_demo::acs::WheelArray;
 use flexdyn_acs_demo::acs::{inertia_about_b, mat3, wheel_control_torque, StarTrackerAttitude};
+use flexdyn_acs_demo::fdir::{Event, GyroFdir, WheelFdir};
 use flexdyn_acs_demo::modes::{Mode, ModeSettings};
 use flexdyn_acs_demo::sequence::{AcsSequence, Gains, SequenceSetup};
 use flexdyn_proto::attitude::mrp_error;
@@ -175,6 +185,19 @@ struct Args {
     /// cross-product law needs the field to turn to reach every axis).
     #[arg(long, default_value_t = 5700.0, allow_negative_numbers = true)]
     unload_s: f64,
+    /// Fault detection, isolation and recovery (`flexdyn_acs_demo::fdir`): every IMU's gyro is
+    /// checked against the star tracker and a failed one is replaced by a healthy IMU (or by
+    /// star-tracker-derived rates); every wheel's speed is checked against its command and a
+    /// failed wheel is dropped from the allocation. Needs `--actuator wheels
+    /// --attitude-source star-tracker --star-tracker NAME --imu NAME` (the first rate source).
+    /// Detections and reconfigurations are printed on standard output (`fdir-detect …`,
+    /// `fdir-rate-source …`, `fdir-wheels …`), the largest statistics at the end
+    /// (`fdir-summary …`).
+    #[arg(long)]
+    fdir: bool,
+    /// The gyro monitor's window W [s] (rounded to whole star-tracker periods).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    fdir_window_s: f64,
 }
 
 /// What the controller commands.
@@ -350,6 +373,24 @@ fn check(args: &Args) -> anyhow::Result<Controller> {
             return Err(usage("--idle-exit-s must be a positive number of seconds"));
         }
     }
+    if args.fdir {
+        if args.mode_manager
+            || args.actuator != Actuator::Wheels
+            || args.attitude_source != AttitudeSource::StarTracker
+            || args.imu.is_none()
+            || args.rate_source == RateSource::Truth
+        {
+            return Err(usage(
+                "--fdir needs --actuator wheels --attitude-source star-tracker --star-tracker \
+                 NAME --imu NAME (not --rate-source truth, not --mode-manager)",
+            ));
+        }
+        if !(args.fdir_window_s.is_finite() && args.fdir_window_s > 0.0) {
+            return Err(usage(
+                "--fdir-window-s must be a positive number of seconds",
+            ));
+        }
+    }
     if args.mode_manager {
         for (flag, given) in [
             ("--imu", args.imu.is_some()),
@@ -467,6 +508,63 @@ fn print_sequence_summary(
     }
 }
 
+/// The FDIR of `--fdir`: the gyro and wheel monitors, and the events of the current tick.
+struct Fdir {
+    gyro: GyroFdir,
+    wheels: WheelFdir,
+    events: Vec<Event>,
+}
+
+/// Prints (stdout, one line each) and logs what the FDIR did at this tick, and forgets it.
+fn print_fdir_events(tick: u64, t_ns: u64, events: &mut Vec<Event>) {
+    let t_s = t_ns as f64 * 1e-9;
+    for e in events.drain(..) {
+        match e {
+            Event::Detected {
+                what,
+                test,
+                unit,
+                statistic,
+                threshold,
+            } => {
+                println!(
+                    "fdir-detect tick={tick} t_s={t_s} what={what} unit={unit} test={test} \
+                     statistic={statistic} threshold={threshold}"
+                );
+                tracing::warn!(tick, what, unit, statistic, "FDIR: failure detected");
+            }
+            Event::RateSource { source } => {
+                println!("fdir-rate-source tick={tick} t_s={t_s} source={source}");
+                tracing::warn!(tick, source, "FDIR: rate feedback reconfigured");
+            }
+            Event::Wheels { active } => {
+                let active = active.join(",");
+                println!("fdir-wheels tick={tick} t_s={t_s} active={active}");
+                tracing::warn!(tick, active, "FDIR: wheel allocation reconfigured");
+            }
+        }
+    }
+}
+
+/// The largest test statistic of each monitored unit (1 is the threshold), printed when the
+/// run ends: the margins a healthy run kept.
+fn print_fdir_summary(f: &Fdir) {
+    let list = |names: Vec<&str>, s: &[f64]| -> String {
+        names
+            .iter()
+            .zip(s)
+            .map(|(n, s)| format!("{n}:{s}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    let wheel_names = f.wheels.names().iter().map(String::as_str).collect();
+    println!(
+        "fdir-summary gyro_max_statistic={} wheel_max_statistic={}",
+        list(f.gyro.names(), &f.gyro.max_statistic),
+        list(wheel_names, &f.wheels.max_statistic)
+    );
+}
+
 /// The served configuration, asked until the server answers, a stop signal, or `idle` passes.
 fn wait_for_vehicle(
     session: &Session,
@@ -553,7 +651,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let schedule = SensorSchedule::from_config(&cfg)?;
     let frame_s = (1e9 / cfg.simulation.frame_hz).round() * 1e-9;
     let mut gyro = gyro(&args, &cfg, &schedule)?;
-    let wheels = match args.actuator {
+    let mut wheels = match args.actuator {
         Actuator::Wrench => None,
         Actuator::Wheels => Some((WheelArray::from_config(&cfg)?, inertia_about_b(&cfg)?)),
     };
@@ -571,6 +669,23 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
         _ => None,
     };
+
+    let mut fdir = match (args.fdir, &args.imu, &args.star_tracker) {
+        (true, Some(imu), Some(st)) => Some(Fdir {
+            gyro: GyroFdir::new(&cfg, &schedule, imu, st, args.fdir_window_s)?,
+            wheels: WheelFdir::new(&cfg)?,
+            events: Vec::new(),
+        }),
+        _ => None,
+    };
+    if let Some(f) = &fdir {
+        tracing::info!(
+            window_s = f.gyro.window_s(),
+            gyros = ?f.gyro.names(),
+            wheels = ?f.wheels.names(),
+            "FDIR on"
+        );
+    }
 
     // 3. The telemetry: one subscriber on flexdyn/<sc>/tlm/**, assembled into complete ticks.
     //    Declared before the token, so the server cannot publish tick 0 before we can receive
@@ -683,9 +798,13 @@ fn run(args: Args) -> anyhow::Result<()> {
             continue;
         }
 
-        let rate_b = match &mut gyro {
-            Some(g) => g.rate_for(h.tick, tick.imus[g.index].as_ref())?,
-            None => Vector3::from(state.omega_bn_b_rad_s),
+        let rate_b = match (&mut fdir, &mut gyro) {
+            (Some(f), _) => f
+                .gyro
+                .update(&tick, &mut f.events)
+                .with_context(|| format!("no gyro rate for tick {} (no sample yet)", h.tick))?,
+            (None, Some(g)) => g.rate_for(h.tick, tick.imus[g.index].as_ref())?,
+            (None, None) => Vector3::from(state.omega_bn_b_rad_s),
         };
         // The attitude: truth, or the star tracker's (propagated with the rate between updates).
         let sigma_bn = match &mut tracker {
@@ -695,12 +814,17 @@ fn run(args: Args) -> anyhow::Result<()> {
 
         // Answer with the state's spacecraft id, tick and sim time; our own sequence number.
         let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
-        let (cmd, torque_b_nm) = match (sigma_bn, &wheels) {
+        let (cmd, torque_b_nm) = match (sigma_bn, &mut wheels) {
             // No attitude yet (the star tracker has not given a valid one): answer the tick.
-            (None, _) => (
-                CommandMsg::no_command(header, args.sender_id),
-                Vector3::zeros(),
-            ),
+            (None, _) => {
+                if let Some(f) = &mut fdir {
+                    f.wheels.uncommanded();
+                }
+                (
+                    CommandMsg::no_command(header, args.sender_id),
+                    Vector3::zeros(),
+                )
+            }
             (Some(sigma_bn), None) => {
                 let t = controller.torque_b_nm(&sigma_bn, &rate_b);
                 (
@@ -710,6 +834,14 @@ fn run(args: Args) -> anyhow::Result<()> {
             }
             (Some(sigma_bn), Some((array, inertia))) => {
                 let speeds = array.speeds(state)?;
+                if let Some(f) = &mut fdir {
+                    if f.wheels.check(&speeds, &mut f.events).is_some() {
+                        *array = array.without(&f.wheels.failed_list())?;
+                        f.events.push(Event::Wheels {
+                            active: f.wheels.active_names(),
+                        });
+                    }
+                }
                 let l = wheel_control_torque(
                     controller.k_nm,
                     controller.p_nms,
@@ -719,6 +851,9 @@ fn run(args: Args) -> anyhow::Result<()> {
                     &array.momentum_b(&rate_b, &speeds),
                 );
                 let u = array.motor_torques(&l);
+                if let Some(f) = &mut fdir {
+                    f.wheels.commanded(&speeds, &u);
+                }
                 let cmd = CommandMsg::actuators(
                     header,
                     args.sender_id,
@@ -736,6 +871,9 @@ fn run(args: Args) -> anyhow::Result<()> {
             .map_err(|e| anyhow::anyhow!("cannot publish the command: {e}"))
             .context("publishing")?;
         seq += 1;
+        if let Some(f) = &mut fdir {
+            print_fdir_events(h.tick, h.sim_time_ns, &mut f.events);
+        }
 
         if log_every_ns > 0 && h.sim_time_ns >= next_log_ns {
             tracing::info!(
@@ -751,6 +889,9 @@ fn run(args: Args) -> anyhow::Result<()> {
     }
     if let Some(fsw) = &sequence {
         print_sequence_summary(fsw, last_sequence_output.as_ref(), last_t_ns);
+    }
+    if let Some(f) = &fdir {
+        print_fdir_summary(f);
     }
     // Undeclare the token first (a lockstep server sees us leave), then close the session.
     drop(token);
