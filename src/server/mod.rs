@@ -49,6 +49,7 @@ pub mod cli;
 pub mod clock;
 pub mod commands;
 pub mod error;
+pub mod fleet;
 mod intake;
 pub mod lockstep;
 pub mod operator;
