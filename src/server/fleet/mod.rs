@@ -60,6 +60,11 @@ pub struct FleetReport {
     /// \[ns\] wall time the physics thread spent stepping and filling the frames of every
     /// vehicle (not the waits, not the publications).
     pub physics_ns: u64,
+    /// \[ns\] wall time the physics thread spent publishing every vehicle's frames.
+    pub publish_ns: u64,
+    /// \[ns\] wall time the physics thread spent waiting for commands (lockstep: the barrier,
+    /// which holds the participants' own time and the network's).
+    pub wait_ns: u64,
 }
 
 impl FleetReport {
@@ -281,6 +286,8 @@ pub async fn run(
                     .collect(),
                 frames: 0,
                 physics_ns: 0,
+                publish_ns: 0,
+                wait_ns: 0,
             });
         }
     }
@@ -322,6 +329,8 @@ pub async fn run(
         vehicles,
         frames: physics.frames,
         physics_ns: physics.physics_ns,
+        publish_ns: physics.publish_ns,
+        wait_ns: physics.wait_ns,
     };
     tracing::info!("{report}");
     Ok(report)

@@ -62,6 +62,23 @@ pub struct FleetPhysicsReport {
     /// \[ns\] wall time spent stepping and filling the frames (every vehicle), without the
     /// waits and the publications.
     pub physics_ns: u64,
+    /// \[ns\] wall time spent publishing the frames (every vehicle's puts).
+    pub publish_ns: u64,
+    /// \[ns\] wall time spent waiting for the commands (lockstep: the barrier).
+    pub wait_ns: u64,
+}
+
+/// Where the physics thread's time went: frames, physics, publications, waits (ns).
+#[derive(Default)]
+struct Spent {
+    frames: u64,
+    physics_ns: u64,
+    publish_ns: u64,
+    wait_ns: u64,
+}
+
+fn ns_since(t: Instant) -> u64 {
+    u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX)
 }
 
 enum Wait {
@@ -79,7 +96,7 @@ impl FleetPhysics {
     /// Runs the loop to its end; sets every vehicle's run state accordingly.
     pub fn run(self, mut f: FleetStepper) -> Result<FleetPhysicsReport, ServerError> {
         let mut this = self;
-        let mut acc = (0u64, 0u64);
+        let mut acc = Spent::default();
         let result = this.frame_loop(&mut f, &mut acc);
         this.set_run_state(match &result {
             Ok(r) if r.ending == Ending::Finished => RunState::Finished,
@@ -88,8 +105,10 @@ impl FleetPhysics {
         });
         result.map(|physics| FleetPhysicsReport {
             physics,
-            frames: acc.0,
-            physics_ns: acc.1,
+            frames: acc.frames,
+            physics_ns: acc.physics_ns,
+            publish_ns: acc.publish_ns,
+            wait_ns: acc.wait_ns,
         })
     }
 
@@ -152,7 +171,7 @@ impl FleetPhysics {
     fn frame_loop(
         &mut self,
         f: &mut FleetStepper,
-        acc: &mut (u64, u64),
+        acc: &mut Spent,
     ) -> Result<PhysicsReport, ServerError> {
         let mode = self.settings.mode;
         let realtime = mode == Mode::RealTime;
@@ -191,6 +210,7 @@ impl FleetPhysics {
                 sh.tick.store(k, Ordering::Release);
             }
             let stamp = unix_now_ns();
+            let t = Instant::now();
             for ((v, p), sh) in f
                 .vehicles
                 .iter_mut()
@@ -201,6 +221,7 @@ impl FleetPhysics {
                 v.frame.lateness_ns = lateness_ns;
                 p.publish(&v.frame, sh, None);
             }
+            acc.publish_ns += ns_since(t);
             if self.total_frames == Some(k) {
                 return Ok(PhysicsReport {
                     ending: Ending::Finished,
@@ -210,6 +231,7 @@ impl FleetPhysics {
             }
 
             // 2. Commands for tick k.
+            let t = Instant::now();
             match mode {
                 Mode::Lockstep => {
                     if let Wait::Stopped = self.await_answers(f, k)? {
@@ -218,14 +240,15 @@ impl FleetPhysics {
                 }
                 Mode::RealTime | Mode::Batch => self.drain_commands(f, k),
             }
+            acc.wait_ns += ns_since(t);
 
             // 3. Every vehicle's frame, and its telemetry of tick k + 1.
             let t = Instant::now();
             f.step(k);
             k += 1;
             f.fill(k)?;
-            acc.0 += 1;
-            acc.1 += u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX);
+            acc.frames += 1;
+            acc.physics_ns += ns_since(t);
             if realtime {
                 match pacer.end_frame(k) {
                     FrameEnd::OnTime => {}
