@@ -10,6 +10,7 @@
 #![forbid(unsafe_code)]
 
 pub mod acs;
+pub mod formation;
 pub mod magnetic;
 pub mod modes;
 pub mod sequence;
