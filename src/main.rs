@@ -93,6 +93,15 @@ fn print_default_config() -> Result<(), CliError> {
 /// `flexdyn run`: the server until its duration, a signal or an error. Exit code 0 on success,
 /// 2 for invalid settings or configuration, 1 for a failure while running.
 fn run_server(args: &RunArgs) -> ExitCode {
+    if let Some(fleet) = &args.fleet {
+        return match flexdyn::server::fleet::run_from_args(args, fleet) {
+            Ok(_report) => ExitCode::SUCCESS,
+            Err(e) => {
+                print_error(&e);
+                ExitCode::from(e.exit_code())
+            }
+        };
+    }
     match run_from_args(args) {
         Ok(_report) => ExitCode::SUCCESS,
         Err(e) => {

@@ -227,3 +227,74 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
         assert_eq!(w.sim.faults().events_lost, 0);
     }
 }
+
+/// Fleet mode: one physics thread steps every vehicle ([`FleetStepper`]), with one barrier over
+/// every participant of every vehicle. Three vehicles (the wheel scenario twice, the second 100 m
+/// behind the first; the reference spacecraft), sender 9 answering all three: the per-frame
+/// work (offers, step, fill, finite check) allocates nothing.
+#[test]
+fn the_fleet_frame_path_does_not_allocate() {
+    use flexdyn::server::fleet::stepper::FleetStepper;
+    use flexdyn::world::{FleetConfig, World};
+    let fleet = FleetConfig::from_toml_str_in(
+        r#"
+[[vehicles]]
+id = "a"
+spacecraft_file = "scenarios/wheels_star_tracker.toml"
+participants = [1, 9]
+[[vehicles]]
+id = "b"
+spacecraft_file = "scenarios/wheels_star_tracker.toml"
+participants = [2, 9]
+[vehicles.relative]
+chief = "a"
+hill_position_m = [0.0, -100.0, 0.0]
+[[vehicles]]
+id = "c"
+spacecraft_file = "scenarios/reference.toml"
+participants = [9]
+"#,
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")),
+    )
+    .unwrap();
+    let settings: Vec<ServerSettings> = fleet
+        .vehicles
+        .iter()
+        .map(|v| ServerSettings {
+            participants: v.participants.clone(),
+            spacecraft_id: v.spacecraft_id,
+            ..ServerSettings::default()
+        })
+        .collect();
+    let mut f = FleetStepper::new(World::new(&fleet).unwrap().into_vehicles(), &settings);
+    let (cmd_tx, cmd_rx) = sync_channel::<(usize, CommandMsg)>(16);
+    let mut frame_once = |k: u64| {
+        for (v, senders) in [(0usize, [1u32, 9]), (1, [2, 9]), (2, [9, 9])] {
+            for s in senders.iter().take(if v == 2 { 1 } else { 2 }) {
+                let id = u32::try_from(v + 1).unwrap();
+                let cmd =
+                    CommandMsg::wrench(Header::new(id, k, 0, k), *s, [0.0, 0.0, 0.01], [0.0; 3]);
+                cmd_tx.try_send((v, cmd)).unwrap();
+            }
+        }
+        f.begin_tick(k);
+        while let Ok((v, cmd)) = cmd_rx.try_recv() {
+            f.offer_lockstep(v, &cmd, k);
+        }
+        assert!(f.all_answered(), "tick {k}: {:?}", f.first_unanswered());
+        f.step(k);
+        f.fill(k + 1).unwrap();
+    };
+    frame_once(0);
+    reset_violation_count();
+    assert_no_alloc(|| {
+        for k in 1..200 {
+            frame_once(k);
+        }
+    });
+    assert_eq!(violation_count(), 0, "the fleet frame path allocated");
+    // Every vehicle stepped 200 frames.
+    for v in &f.vehicles {
+        assert_eq!(v.frame.state.header.tick, 200, "{}", v.id);
+    }
+}

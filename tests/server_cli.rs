@@ -613,3 +613,94 @@ fn plain_flexdyn_takes_the_run_options_and_usage_errors_are_one_line() {
     assert!(err.contains("DEBUG"), "a debug line was logged: {err}");
     assert!(!err.contains('\u{1b}'), "colour codes in a pipe: {err:?}");
 }
+
+/// A fleet file in a fresh temporary folder, its `spacecraft_file`s pointing at the repo's
+/// scenarios.
+fn fleet_file(name: &str, body: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("flexdyn-fleet-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("fleet.toml");
+    let scenarios = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
+    std::fs::write(&path, body.replace("SCENARIOS", scenarios)).unwrap();
+    path
+}
+
+#[test]
+fn run_fleet_serves_every_vehicle_and_names_the_vehicle_of_a_bad_field() {
+    let pair = fleet_file(
+        "pair",
+        r#"
+[[vehicles]]
+id = "chief"
+spacecraft_file = "SCENARIOS/reference.toml"
+[[vehicles]]
+id = "deputy"
+spacecraft_file = "SCENARIOS/reference.toml"
+[vehicles.relative]
+chief = "chief"
+hill_position_m = [0.0, -100.0, 0.0]
+"#,
+    );
+    let pair_s = pair.to_str().unwrap();
+    let mut server = Server::spawn(&[
+        "run",
+        "--fleet",
+        pair_s,
+        "--mode",
+        "batch",
+        "--duration-s",
+        "2",
+        "--listen",
+        ANY_PORT,
+    ]);
+    let status = server.wait(Duration::from_secs(60));
+    let err = server.stderr();
+    assert_eq!(status.code(), Some(0), "stderr:\n{err}");
+    for line in [
+        "fleet of 2: frames=200",
+        "chief: run finished: mode=batch last_tick=200",
+        "deputy: run finished: mode=batch last_tick=200",
+    ] {
+        assert!(err.contains(line), "no `{line}` in stderr:\n{err}");
+    }
+
+    let bad = fleet_file(
+        "bad",
+        r#"
+[[vehicles]]
+id = "chief"
+spacecraft_file = "SCENARIOS/reference.toml"
+[[vehicles]]
+id = "deputy"
+spacecraft_file = "SCENARIOS/reference.toml"
+participants = ["two"]
+"#,
+    );
+    let mut server = Server::spawn(&[
+        "run",
+        "--fleet",
+        bad.to_str().unwrap(),
+        "--listen",
+        ANY_PORT,
+    ]);
+    let status = server.wait(Duration::from_secs(60));
+    let err = server.stderr();
+    assert_eq!(status.code(), Some(2), "stderr:\n{err}");
+    assert!(
+        err.contains("vehicles[1] (\"deputy\").participants: must be a list of sender ids"),
+        "stderr:\n{err}"
+    );
+
+    // The ids and participants are the fleet file's.
+    let mut server = Server::spawn(&["run", "--fleet", pair_s, "--sc-id", "x"]);
+    let status = server.wait(Duration::from_secs(60));
+    let err = server.stderr();
+    assert_eq!(status.code(), Some(2), "stderr:\n{err}");
+    assert!(
+        err.contains("--sc-id") && err.contains("--fleet"),
+        "stderr:\n{err}"
+    );
+    for p in [pair, bad] {
+        let _ = std::fs::remove_dir_all(p.parent().unwrap());
+    }
+}

@@ -15,8 +15,15 @@ use crate::transport::{zenoh_config, Role, ZenohArgs};
 pub struct RunArgs {
     /// Configuration file (TOML). Default: the embedded reference spacecraft
     /// (`flexdyn print-default-config`).
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", conflicts_with = "fleet")]
     pub config: Option<PathBuf>,
+    /// Serve every vehicle of this fleet file (`[[vehicles]]`, README "Fleet in the server"),
+    /// each under its own id `flexdyn/<id>/…`, on one tick and (lockstep) one barrier. The
+    /// settings are the first vehicle's `[server]` table with these options on top; ids and
+    /// participants come from the fleet file.
+    #[arg(long, value_name = "FLEET.toml",
+          conflicts_with_all = ["sc_id", "spacecraft_id", "participants", "record"])]
+    pub fleet: Option<PathBuf>,
     /// Pacing mode [default: realtime].
     #[arg(long, value_parser = ["realtime", "lockstep", "batch"])]
     pub mode: Option<String>,
@@ -199,6 +206,21 @@ pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
             problem,
         })?;
     }
+    serve(zcfg, move |session, shutdown| {
+        super::run(session, settings, cfg, shutdown)
+    })
+}
+
+/// Starts the server's tokio runtime, opens the Zenoh session, runs `run(session, shutdown on
+/// SIGINT/SIGTERM)` and closes the session (which flushes the last samples).
+pub(super) fn serve<R, F, Fut>(zcfg: zenoh::Config, run: F) -> Result<R, ServerError>
+where
+    F: FnOnce(
+        zenoh::Session,
+        std::pin::Pin<Box<dyn std::future::Future<Output = ()> + Send>>,
+    ) -> Fut,
+    Fut: std::future::Future<Output = Result<R, ServerError>>,
+{
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
@@ -206,11 +228,11 @@ pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
         .build()
         .map_err(|e| ServerError::Internal(format!("cannot start the tokio runtime: {e}")))?;
     runtime.block_on(async move {
-        let shutdown = shutdown_signal().await?;
+        let shutdown = Box::pin(shutdown_signal().await?);
         let session = zenoh::open(zcfg)
             .await
             .map_err(|e| ServerError::zenoh("open the session", e))?;
-        let result = super::run(session.clone(), settings, cfg, shutdown).await;
+        let result = run(session.clone(), shutdown).await;
         if let Err(e) = session.close().await {
             tracing::warn!(error = %e, "closing the Zenoh session failed");
         }

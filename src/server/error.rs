@@ -140,6 +140,19 @@ pub enum ServerError {
         /// \[s\] the configured timeout.
         timeout_s: f64,
     },
+    /// Fleet mode (`flexdyn run --fleet`): what went wrong, and with which vehicle (a
+    /// participant timeout names the vehicle and the participant).
+    #[error("vehicle {vehicle:?}: {source}")]
+    Vehicle {
+        /// The vehicle's id (`flexdyn/<id>/…`).
+        vehicle: String,
+        /// What went wrong.
+        #[source]
+        source: Box<ServerError>,
+    },
+    /// The fleet file (or a vehicle's spacecraft configuration) is invalid.
+    #[error(transparent)]
+    Fleet(#[from] crate::world::FleetError),
     /// Real time with `overrun_policy = "abort"`: too many consecutive overruns.
     #[error(
         "aborting: {consecutive} consecutive frame overruns at tick {tick} exceed \
@@ -207,9 +220,11 @@ impl ServerError {
     /// while running (participant timeout, overrun abort, Zenoh failure).
     pub fn exit_code(&self) -> u8 {
         match self {
-            ServerError::Settings(_) | ServerError::Config { .. } | ServerError::ZenohConfig(_) => {
-                2
-            }
+            ServerError::Settings(_)
+            | ServerError::Config { .. }
+            | ServerError::ZenohConfig(_)
+            | ServerError::Fleet(_) => 2,
+            ServerError::Vehicle { source, .. } => source.exit_code(),
             _ => 1,
         }
     }

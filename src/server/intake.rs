@@ -27,6 +27,14 @@ pub(super) enum CommandSink {
     Queue(Mutex<(SyncSender<CommandMsg>, Gate)>),
     /// Lockstep with `handoff = "direct"`: the core, stepped in this callback.
     Core(Arc<Mutex<LockstepCore>>),
+    /// Fleet mode: the one physics thread's bounded queue, each command tagged with the index
+    /// of the vehicle it arrived for (never blocks: a full queue drops and counts).
+    Fleet {
+        /// The vehicle's index in the fleet.
+        vehicle: usize,
+        /// The queue, behind this vehicle's [`Gate`].
+        queue: Mutex<(SyncSender<(usize, CommandMsg)>, Gate)>,
+    },
 }
 
 /// Subscribes the command callback to `flexdyn/<sc>/cmd/*`; dropping the subscriber stops the
@@ -151,23 +159,40 @@ fn command_callback(
             CommandSink::Queue(queue) => {
                 let mut queue = queue.lock().unwrap_or_else(|p| p.into_inner());
                 let (tx, gate) = &mut *queue;
-                let published = shared.tick.load(std::sync::atomic::Ordering::Acquire);
-                let offer = gate.check(&cmd, published);
-                if offer != Offer::Accepted {
-                    count_offer(&shared, offer, cmd.sender_id);
-                    return;
-                }
-                let (sender, tick) = (cmd.sender_id, cmd.header.tick);
-                match tx.try_send(cmd) {
-                    Ok(()) => gate.queued(sender, tick),
-                    Err(_) => {
-                        shared
-                            .commands_dropped
-                            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    }
-                }
+                gated_send(gate, &shared, cmd, |cmd| tx.try_send(cmd).is_ok());
+            }
+            CommandSink::Fleet { vehicle, queue } => {
+                let mut queue = queue.lock().unwrap_or_else(|p| p.into_inner());
+                let (tx, gate) = &mut *queue;
+                gated_send(gate, &shared, cmd, |cmd| {
+                    tx.try_send((*vehicle, cmd)).is_ok()
+                });
             }
             CommandSink::Core(core) => core.lock().unwrap_or_else(|p| p.into_inner()).offer(&cmd),
         }
+    }
+}
+
+/// Checks `cmd` against the published tick through `gate` and hands it to `send` (which never
+/// blocks: `false` = the queue is full, the command is dropped and counted).
+fn gated_send(
+    gate: &mut Gate,
+    shared: &Shared,
+    cmd: CommandMsg,
+    send: impl FnOnce(CommandMsg) -> bool,
+) {
+    let published = shared.tick.load(std::sync::atomic::Ordering::Acquire);
+    let offer = gate.check(&cmd, published);
+    if offer != Offer::Accepted {
+        count_offer(shared, offer, cmd.sender_id);
+        return;
+    }
+    let (sender, tick) = (cmd.sender_id, cmd.header.tick);
+    if send(cmd) {
+        gate.queued(sender, tick);
+    } else {
+        shared
+            .commands_dropped
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     }
 }

@@ -50,6 +50,7 @@ pub mod clock;
 pub mod commands;
 pub mod error;
 pub mod fault_cmd;
+pub mod fleet;
 mod intake;
 pub mod lockstep;
 pub mod operator;

@@ -72,6 +72,12 @@ impl World {
         &self.vehicles
     }
 
+    /// The vehicles, taken out of the world (the server steps each with its own command book
+    /// and telemetry, on one physics thread: `crate::server::fleet`).
+    pub fn into_vehicles(self) -> Vec<Vehicle> {
+        self.vehicles
+    }
+
     /// The vehicles, mutably (to command them).
     pub fn vehicles_mut(&mut self) -> &mut [Vehicle] {
         &mut self.vehicles

@@ -133,26 +133,30 @@ impl Observer {
     }
 }
 
-/// `server::run` on its own runtime in a background thread, with a bounded join.
-pub struct ServerHandle {
+/// A server run on its own runtime in a background thread, with a bounded join: `R` is its
+/// report ([`ServerHandle`]: `server::run`; [`FleetServerHandle`]: `server::fleet::run`).
+pub struct Handle<R> {
     /// The port the server's session listens on.
     pub port: u16,
-    done: std::sync::mpsc::Receiver<Result<server::RunReport, server::ServerError>>,
+    done: std::sync::mpsc::Receiver<Result<R, server::ServerError>>,
     stop: Option<tokio::sync::oneshot::Sender<()>>,
 }
 
-impl ServerHandle {
-    /// On a session listening on a port the OS chose ([`Self::port`]).
-    pub fn start(settings: server::ServerSettings, cfg: SimConfig) -> Self {
-        Self::start_with_session(listening_session().0, settings, cfg)
-    }
+/// `server::run` in the background.
+pub type ServerHandle = Handle<server::RunReport>;
+/// `server::fleet::run` in the background.
+pub type FleetServerHandle = Handle<server::fleet::FleetReport>;
 
-    /// [`Self::start`] on a session the caller opened (e.g. with an authenticating config).
-    pub fn start_with_session(
-        session: Session,
-        settings: server::ServerSettings,
-        cfg: SimConfig,
-    ) -> Self {
+/// The shutdown future a [`Handle`] hands its server.
+pub type Shutdown = std::pin::Pin<Box<dyn std::future::Future<Output = ()> + Send>>;
+
+impl<R: Send + 'static> Handle<R> {
+    /// Runs `run(session, shutdown)` on a runtime of its own, then closes the session.
+    fn spawn<F, Fut>(session: Session, run: F) -> Self
+    where
+        F: FnOnce(Session, Shutdown) -> Fut + Send + 'static,
+        Fut: std::future::Future<Output = Result<R, server::ServerError>>,
+    {
         let port = session_port(&session);
         let (done_tx, done) = std::sync::mpsc::channel();
         let (stop_tx, stop_rx) = tokio::sync::oneshot::channel::<()>();
@@ -163,10 +167,10 @@ impl ServerHandle {
                 .build()
                 .unwrap();
             let result = rt.block_on(async {
-                let shutdown = async {
+                let shutdown: Shutdown = Box::pin(async {
                     let _ = stop_rx.await;
-                };
-                let r = server::run(session.clone(), settings, cfg, shutdown).await;
+                });
+                let r = run(session.clone(), shutdown).await;
                 let _ = session.close().await;
                 r
             });
@@ -187,9 +191,36 @@ impl ServerHandle {
     }
 
     /// The run's result, waiting at most `timeout`.
-    pub fn join(&self, timeout: Duration) -> Result<server::RunReport, server::ServerError> {
+    pub fn join(&self, timeout: Duration) -> Result<R, server::ServerError> {
         self.done
             .recv_timeout(timeout)
             .expect("the server did not finish in time")
+    }
+}
+
+impl ServerHandle {
+    /// On a session listening on a port the OS chose ([`Self::port`]).
+    pub fn start(settings: server::ServerSettings, cfg: SimConfig) -> Self {
+        Self::start_with_session(listening_session().0, settings, cfg)
+    }
+
+    /// [`Self::start`] on a session the caller opened (e.g. with an authenticating config).
+    pub fn start_with_session(
+        session: Session,
+        settings: server::ServerSettings,
+        cfg: SimConfig,
+    ) -> Self {
+        Self::spawn(session, move |session, shutdown| {
+            server::run(session, settings, cfg, shutdown)
+        })
+    }
+}
+
+impl FleetServerHandle {
+    /// On a session listening on a port the OS chose ([`Self::port`]).
+    pub fn start(settings: server::ServerSettings, fleet: flexdyn::world::FleetConfig) -> Self {
+        Self::spawn(listening_session().0, move |session, shutdown| {
+            server::fleet::run(session, settings, fleet, shutdown)
+        })
     }
 }

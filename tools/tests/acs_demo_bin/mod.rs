@@ -32,13 +32,24 @@ fn newest(dir: &Path) -> SystemTime {
 
 /// The path of `flexdyn-acs-demo`, checked present and built after its sources.
 pub fn acs_demo() -> String {
+    demo_bin("flexdyn-acs-demo")
+}
+
+/// The path of `flexdyn-formation-demo` (the same package), checked like [`acs_demo`].
+pub fn formation_demo() -> String {
+    demo_bin("flexdyn-formation-demo")
+}
+
+/// The path of the acs-demo package's binary `name`, checked present and built after its
+/// sources.
+fn demo_bin(name: &str) -> String {
     let exe = std::env::current_exe().expect("the test's path");
     // <target>/<profile>/deps/<test>: the binaries are in <target>/<profile>.
     let bin: PathBuf = exe
         .parent()
         .and_then(Path::parent)
         .expect("the profile directory")
-        .join("flexdyn-acs-demo");
+        .join(name);
     let build = "build it with `cargo build --release -p flexdyn-acs-demo` (`cargo test \
                  --workspace --release` does)";
     let built = std::fs::metadata(&bin)

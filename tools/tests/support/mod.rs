@@ -14,7 +14,8 @@ mod server_support;
 // Each test or bench that includes this module uses a different subset.
 #[allow(unused_imports)]
 pub use server_support::{
-    connecting_session, endpoint, listening_session, ports, reference_config, ServerHandle,
+    connecting_session, endpoint, listening_session, ports, reference_config, FleetServerHandle,
+    ServerHandle,
 };
 
 /// Every StateMsg payload seen, with its tick.

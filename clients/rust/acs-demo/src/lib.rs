@@ -12,6 +12,7 @@
 
 pub mod acs;
 pub mod fdir;
+pub mod formation;
 pub mod magnetic;
 pub mod modes;
 pub mod sequence;

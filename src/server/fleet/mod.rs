@@ -1,0 +1,404 @@
+//! Fleet mode: `flexdyn run --fleet FLEET.toml` serves every vehicle of a fleet file
+//! ([`crate::world::fleet`]) from one process, on one tick.
+//!
+//! - **Keys.** Each vehicle publishes and takes commands under its own id, exactly as a
+//!   single-vehicle server with `sc_id = <id>` does: `flexdyn/<id>/tlm/…`, `flexdyn/<id>/cmd/*`,
+//!   `flexdyn/<id>/status`, and its `flexdyn/<id>/config` queryable describes that vehicle. A
+//!   controller written for one vehicle (`flexdyn-acs-demo --sc-id <id>`) runs unchanged.
+//! - **One physics thread** steps the whole world ([`physics`], [`stepper`]); the command
+//!   callbacks and one telemetry (status) thread per vehicle are the I/O side.
+//! - **Lockstep.** One barrier covers every participant of every vehicle: tick `k + 1` is
+//!   computed when all have answered tick `k`. A participant listed for several vehicles (a
+//!   formation controller) answers each of them on its key `flexdyn/<id>/cmd/<sender>` and
+//!   declares its liveliness token under each. The no-hang timeout names the vehicle and the
+//!   participant.
+//! - **Real time** keeps its rule: the physics thread never waits for the network (telemetry
+//!   goes out with `CongestionControl::Drop`, commands are taken as they have arrived).
+//! - **Settings**: the first vehicle's `[server]` table with the command-line options on top;
+//!   the ids and participants are the fleet file's (`--sc-id`, `--spacecraft-id`,
+//!   `--participants` are refused with `--fleet`). Not in fleet mode yet: `--record`, the
+//!   operator's pause/resume (`flexdyn/<id>/operator`), real-time lateness in StatusMsg.
+
+mod physics;
+pub mod stepper;
+
+use std::future::Future;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::sync_channel;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use flexdyn_proto::{Mode, RunState, Topics};
+use tokio::sync::oneshot;
+use zenoh::Session;
+
+use super::cli::RunArgs;
+use super::commands::Gate;
+use super::error::{ServerError, SettingsError};
+use super::intake::{self, CommandSink};
+use super::presence::Presence;
+use super::report::RunReport;
+use super::settings::{mode_name, ServerSettings};
+use super::setup::{self, Endpoints};
+use super::shared::{Frame, Shared};
+use super::telemetry::TelemetryCtx;
+use crate::config::log_warnings;
+use crate::transport::{zenoh_config, Role};
+use crate::world::{FleetConfig, World};
+use physics::{FleetPhysics, FleetPhysicsReport};
+use stepper::FleetStepper;
+
+/// What a fleet run did: each vehicle's report, and what the physics cost.
+#[derive(Clone, Debug)]
+pub struct FleetReport {
+    /// Per vehicle, in fleet order: its id and its report (its own counters; the ending, the
+    /// last tick and the wall time are the fleet's).
+    pub vehicles: Vec<(String, RunReport)>,
+    /// Frames stepped (every vehicle).
+    pub frames: u64,
+    /// \[ns\] wall time the physics thread spent stepping and filling the frames of every
+    /// vehicle (not the waits, not the publications).
+    pub physics_ns: u64,
+    /// \[ns\] wall time the physics thread spent publishing every vehicle's frames.
+    pub publish_ns: u64,
+    /// \[ns\] wall time the physics thread spent waiting for commands (lockstep: the barrier,
+    /// which holds the participants' own time and the network's).
+    pub wait_ns: u64,
+}
+
+impl FleetReport {
+    /// \[ns\] physics time per vehicle and frame.
+    pub fn physics_ns_per_vehicle_frame(&self) -> f64 {
+        let n = (self.frames as f64) * (self.vehicles.len().max(1) as f64);
+        if n == 0.0 {
+            0.0
+        } else {
+            self.physics_ns as f64 / n
+        }
+    }
+}
+
+impl std::fmt::Display for FleetReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "fleet of {}: frames={} physics_us_per_vehicle_frame={:.2}",
+            self.vehicles.len(),
+            self.frames,
+            self.physics_ns_per_vehicle_frame() * 1e-3
+        )?;
+        for (id, r) in &self.vehicles {
+            write!(f, "\n  {id}: {r}")?;
+        }
+        Ok(())
+    }
+}
+
+/// Vehicle `v`'s settings: the fleet's, with its ids and participants.
+fn vehicle_settings(base: &ServerSettings, v: &crate::world::VehicleConfig) -> ServerSettings {
+    let mut participants = v.participants.clone();
+    participants.sort_unstable();
+    ServerSettings {
+        sc_id: v.id.clone(),
+        spacecraft_id: v.spacecraft_id,
+        participants,
+        ..base.clone()
+    }
+}
+
+/// The fleet's settings, checked: every participant of every vehicle (for the
+/// `participant_subjects` check), and no option fleet mode does not have.
+fn check_settings(base: &ServerSettings, fleet: &FleetConfig) -> Result<(), ServerError> {
+    if base.record.is_some() {
+        return Err(SettingsError::Invalid {
+            name: "--record".into(),
+            problem: "not available with --fleet yet (record the vehicles with `flexdyn record`)"
+                .into(),
+        }
+        .into());
+    }
+    let mut all: Vec<u32> = fleet
+        .vehicles
+        .iter()
+        .flat_map(|v| v.participants.iter().copied())
+        .collect();
+    all.sort_unstable();
+    all.dedup();
+    if base.mode == Mode::Lockstep && all.is_empty() {
+        return Err(SettingsError::Invalid {
+            name: "vehicles[].participants".into(),
+            problem: "lockstep needs at least one participant in the fleet file".into(),
+        }
+        .into());
+    }
+    let union = ServerSettings {
+        participants: all,
+        ..base.clone()
+    };
+    union.validate()?;
+    Ok(())
+}
+
+/// Runs the fleet server until the configured duration is reached, `shutdown` completes, or an
+/// error stops it (an error about one vehicle names it: [`ServerError::Vehicle`]).
+///
+/// `settings` are the fleet's (mode, timeouts, pacing); each vehicle's ids and participants
+/// come from `fleet`. The session is used as given and not closed.
+pub async fn run(
+    session: Session,
+    settings: ServerSettings,
+    fleet: FleetConfig,
+    shutdown: impl Future<Output = ()>,
+) -> Result<FleetReport, ServerError> {
+    let mut shutdown = std::pin::pin!(shutdown);
+    let mode = settings.mode;
+    check_settings(&settings, &fleet)?;
+    let vsettings: Vec<ServerSettings> = fleet
+        .vehicles
+        .iter()
+        .map(|v| vehicle_settings(&settings, v))
+        .collect();
+    let world = World::new(&fleet)?;
+    let frame_ns = world.vehicles().first().map_or(1, |v| v.sim.frame_ns());
+    let total_frames = settings.duration_frames(frame_ns)?;
+    let mut vehicles = world.into_vehicles();
+    for v in &mut vehicles {
+        if let Err(e) = v.sim.offload_environment() {
+            tracing::warn!(vehicle = %v.id, error = %e, "environment updates stay on the physics thread");
+        }
+    }
+    tracing::info!(
+        mode = mode_name(mode),
+        zid = %session.zid(),
+        vehicles = ?vehicles.iter().map(|v| v.id.as_str()).collect::<Vec<_>>(),
+        "flexdyn fleet server starting"
+    );
+    tracing::info!("server settings: {}", settings.summary());
+    crate::transport::log_listening(&session);
+
+    // Per vehicle: its publishers, configuration queryable, counters, command callback, status
+    // thread and (lockstep) presence.
+    let (cmd_tx, cmd_rx) = sync_channel(settings.command_queue);
+    let stop = Arc::new(AtomicBool::new(false));
+    let mut publishers = Vec::with_capacity(vehicles.len());
+    let mut shared = Vec::with_capacity(vehicles.len());
+    let mut recycle = Vec::with_capacity(vehicles.len());
+    let mut alive = Vec::with_capacity(vehicles.len());
+    let mut keep = Vec::with_capacity(vehicles.len());
+    let mut telemetry = Vec::with_capacity(vehicles.len());
+    let mut presences = Vec::new();
+    for (i, (v, vs)) in vehicles.iter().zip(&vsettings).enumerate() {
+        let named = |e: ServerError| ServerError::Vehicle {
+            vehicle: v.id.clone(),
+            source: Box::new(e),
+        };
+        let topics = Topics::new(&v.id).map_err(|e| {
+            named(
+                SettingsError::Invalid {
+                    name: "id".into(),
+                    problem: e.to_string(),
+                }
+                .into(),
+            )
+        })?;
+        let cfg = &fleet.vehicles[i].cfg;
+        log_warnings(cfg, None);
+        let endpoints = Endpoints::declare(&session, vs, cfg, &topics, &v.sim)
+            .await
+            .map_err(named)?;
+        let config = setup::serve_config(&session, &topics, &endpoints.vehicle)
+            .await
+            .map_err(named)?;
+        let sh = Arc::new(Shared::new(&vs.participants));
+        sh.set_run_state(RunState::Starting);
+        let gate = Gate::new(
+            &vs.participants,
+            v.sim.spacecraft().effector_input_ranges(),
+            mode == Mode::Lockstep,
+        );
+        let sink = CommandSink::Fleet {
+            vehicle: i,
+            queue: Mutex::new((cmd_tx.clone(), gate)),
+        };
+        let commands = intake::declare(&session, &topics, sink, sh.clone(), vs, None)
+            .await
+            .map_err(named)?;
+        if mode == Mode::Lockstep {
+            let presence = Presence::declare(&session, &topics, sh.clone())
+                .await
+                .map_err(named)?;
+            presences.push((presence, endpoints.state_pub.clone(), topics.clone()));
+        }
+        let (recycle_tx, recycle_rx) = sync_channel(settings.command_queue);
+        let (full_tx, full_rx) = sync_channel::<Box<Frame>>(1);
+        let (free_tx, _free_rx) = sync_channel::<Box<Frame>>(1);
+        // Fleet mode takes no live fault commands: nothing is installed, nothing comes back.
+        let (_fault_recycle_tx, fault_recycle_rx) = sync_channel(1);
+        let ctx = TelemetryCtx {
+            publisher: None,
+            status_pub: endpoints.status_pub,
+            full_rx,
+            free_tx,
+            recycle_rx,
+            fault_recycle_rx,
+            shared: sh.clone(),
+            settings: vs.clone(),
+            frame_ns,
+            record: None,
+        };
+        telemetry.push(super::spawn_telemetry(ctx).map_err(named)?.0);
+        publishers.push(endpoints.frames);
+        shared.push(sh);
+        recycle.push(recycle_tx);
+        alive.push(full_tx);
+        keep.push((config, commands));
+    }
+    drop(cmd_tx);
+    let _realtime = super::RealtimeHold::acquire(&settings)?;
+
+    // Lockstep: tick 0 waits for every participant of every vehicle.
+    for ((presence, state_pub, topics), (vs, v)) in
+        presences.iter().zip(vsettings.iter().zip(&vehicles))
+    {
+        let ready = presence
+            .wait(state_pub, vs, topics, shutdown.as_mut())
+            .await
+            .map_err(|e| ServerError::Vehicle {
+                vehicle: v.id.clone(),
+                source: Box::new(e),
+            });
+        if !matches!(ready, Ok(true)) {
+            for sh in &shared {
+                sh.set_run_state(if ready.is_ok() {
+                    RunState::Stopped
+                } else {
+                    RunState::Failed
+                });
+            }
+            drop(alive);
+            for t in telemetry {
+                let _ = t.await;
+            }
+            ready?;
+            return Ok(FleetReport {
+                vehicles: vehicles
+                    .iter()
+                    .zip(&shared)
+                    .map(|(v, sh)| (v.id.clone(), RunReport::before_tick_0(mode, sh.rejected())))
+                    .collect(),
+                frames: 0,
+                physics_ns: 0,
+                publish_ns: 0,
+                wait_ns: 0,
+            });
+        }
+    }
+
+    let ids: Vec<String> = vehicles.iter().map(|v| v.id.clone()).collect();
+    let stepper = FleetStepper::new(vehicles, &vsettings);
+    let physics = FleetPhysics {
+        settings: settings.clone(),
+        total_frames,
+        cmd_rx,
+        recycle,
+        publishers,
+        shared: shared.clone(),
+        stop: stop.clone(),
+        _telemetry_alive: alive,
+    };
+    let started = Instant::now();
+    let result = run_physics_thread(physics, stepper, &settings, &shared, &stop, shutdown).await;
+    let wall_s = started.elapsed().as_secs_f64();
+    let mut lateness = Vec::with_capacity(telemetry.len());
+    for t in telemetry {
+        let tlm = t
+            .await
+            .map_err(|_| ServerError::Internal("a telemetry thread panicked".into()))?;
+        lateness.push(tlm.lateness);
+    }
+    drop(keep);
+    let physics = result?;
+    let vehicles = ids
+        .into_iter()
+        .zip(&shared)
+        .zip(&lateness)
+        .map(|((id, sh), h)| {
+            let r = RunReport::collect(mode, physics.physics, sh, h, wall_s, None);
+            (id, r)
+        })
+        .collect();
+    let report = FleetReport {
+        vehicles,
+        frames: physics.frames,
+        physics_ns: physics.physics_ns,
+        publish_ns: physics.publish_ns,
+        wait_ns: physics.wait_ns,
+    };
+    tracing::info!("{report}");
+    Ok(report)
+}
+
+/// Runs the fleet's physics thread to its end (or a stop request).
+async fn run_physics_thread(
+    physics: FleetPhysics,
+    stepper: FleetStepper,
+    settings: &ServerSettings,
+    shared: &[Arc<Shared>],
+    stop: &AtomicBool,
+    mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
+) -> Result<FleetPhysicsReport, ServerError> {
+    let (done_tx, mut done_rx) = oneshot::channel();
+    let thread_settings = settings.clone();
+    std::thread::Builder::new()
+        .name("flexdyn-physics".into())
+        .stack_size(super::rt::PHYSICS_STACK_BYTES)
+        .spawn(move || {
+            if let Err(e) = super::prepare_physics_thread(&thread_settings) {
+                let _ = done_tx.send(Err(e));
+                return;
+            }
+            let _ = done_tx.send(physics.run(stepper));
+        })
+        .map_err(|e| ServerError::Internal(format!("cannot start the physics thread: {e}")))?;
+    tokio::select! {
+        r = &mut done_rx => r,
+        () = &mut shutdown => {
+            tracing::info!("shutdown requested; stopping at the next frame boundary");
+            for sh in shared {
+                sh.set_run_state(RunState::Stopping);
+            }
+            stop.store(true, Ordering::Relaxed);
+            done_rx.await
+        }
+    }
+    .map_err(|_| ServerError::Internal("the physics thread panicked".into()))?
+}
+
+/// `flexdyn run --fleet FILE`: the fleet file, the settings (the first vehicle's `[server]`
+/// table and the options), a tokio runtime, the Zenoh session, SIGINT/SIGTERM.
+pub fn run_from_args(args: &RunArgs, fleet_file: &Path) -> Result<FleetReport, ServerError> {
+    let fleet = FleetConfig::from_file(fleet_file)?;
+    let settings = args.settings(&fleet.vehicles[0].cfg)?;
+    let zcfg = zenoh_config(&args.zenoh, Role::Server)?;
+    super::access::check(
+        &zcfg,
+        &ServerSettings {
+            participants: fleet
+                .vehicles
+                .iter()
+                .flat_map(|v| v.participants.iter().copied())
+                .collect(),
+            ..settings.clone()
+        },
+    )?;
+    if let (Mode::RealTime, Some(cpu)) = (settings.mode, settings.physics_cpu) {
+        super::rt::keep_off_cpu(cpu).map_err(|problem| ServerError::Realtime {
+            setting: "server.physics_cpu",
+            problem,
+        })?;
+    }
+    super::cli::serve(zcfg, move |session, shutdown| {
+        run(session, settings, fleet, shutdown)
+    })
+}

@@ -1,0 +1,274 @@
+//! The fleet's physics thread: one frame loop for every vehicle.
+//!
+//! At frame boundary `k` the loop
+//! 1. (real time) waits for the deadline `t0 + k·period`, then publishes the already filled
+//!    telemetry of tick `k` of every vehicle, in fleet order (real time with
+//!    `CongestionControl::Drop`: the put never waits for the network);
+//! 2. takes the commands for tick `k`: lockstep waits until every participant of every vehicle
+//!    has answered (one barrier for the whole fleet; a participant listed for several vehicles
+//!    answers each of them on its own key); real time and batch take whatever has arrived;
+//! 3. steps every vehicle's frame and fills its telemetry of tick `k + 1`
+//!    ([`FleetStepper`], allocation-free).
+//!
+//! The commands arrive through one bounded channel tagged with the vehicle's index; a consumed
+//! command goes back to that vehicle's telemetry thread to be freed there.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use flexdyn_proto::{CommandMsg, Mode, RunState};
+
+use super::super::error::ServerError;
+use super::super::pacing::{FrameEnd, Pacer};
+use super::super::physics::{count_offer, Ending, PhysicsReport};
+use super::super::publish::FramePublisher;
+use super::super::settings::ServerSettings;
+use super::super::shared::{Frame, Shared};
+use super::stepper::FleetStepper;
+use crate::transport::unix_now_ns;
+
+/// Longest single blocking wait, so a stop request is seen quickly.
+const POLL: Duration = Duration::from_millis(50);
+
+/// Everything the fleet's physics thread owns besides the [`FleetStepper`] it runs.
+pub(super) struct FleetPhysics {
+    /// The fleet's settings (mode, timeouts, pacing).
+    pub settings: ServerSettings,
+    /// Frames to run (`None`: until stopped).
+    pub total_frames: Option<u64>,
+    /// Validated commands, tagged with their vehicle's index.
+    pub cmd_rx: Receiver<(usize, CommandMsg)>,
+    /// Per vehicle: consumed commands, back to its telemetry thread to be freed (never blocks).
+    pub recycle: Vec<SyncSender<CommandMsg>>,
+    /// Per vehicle: its frame publishers.
+    pub publishers: Vec<FramePublisher>,
+    /// Per vehicle: its counters (its StatusMsg reads them).
+    pub shared: Vec<Arc<Shared>>,
+    /// Set to stop at the next frame boundary.
+    pub stop: Arc<AtomicBool>,
+    /// Per vehicle: the channel its telemetry thread ends on when this is dropped.
+    pub _telemetry_alive: Vec<SyncSender<Box<Frame>>>,
+}
+
+/// How the fleet's frames ended, and what the physics cost.
+#[derive(Clone, Copy, Debug)]
+pub struct FleetPhysicsReport {
+    /// The ending, the last tick, its simulation time.
+    pub physics: PhysicsReport,
+    /// Frames stepped.
+    pub frames: u64,
+    /// \[ns\] wall time spent stepping and filling the frames (every vehicle), without the
+    /// waits and the publications.
+    pub physics_ns: u64,
+    /// \[ns\] wall time spent publishing the frames (every vehicle's puts).
+    pub publish_ns: u64,
+    /// \[ns\] wall time spent waiting for the commands (lockstep: the barrier).
+    pub wait_ns: u64,
+}
+
+/// Where the physics thread's time went: frames, physics, publications, waits (ns).
+#[derive(Default)]
+struct Spent {
+    frames: u64,
+    physics_ns: u64,
+    publish_ns: u64,
+    wait_ns: u64,
+}
+
+fn ns_since(t: Instant) -> u64 {
+    u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX)
+}
+
+enum Wait {
+    Done,
+    Stopped,
+}
+
+impl FleetPhysics {
+    fn set_run_state(&self, s: RunState) {
+        for sh in &self.shared {
+            sh.set_run_state(s);
+        }
+    }
+
+    /// Runs the loop to its end; sets every vehicle's run state accordingly.
+    pub fn run(self, mut f: FleetStepper) -> Result<FleetPhysicsReport, ServerError> {
+        let mut this = self;
+        let mut acc = Spent::default();
+        let result = this.frame_loop(&mut f, &mut acc);
+        this.set_run_state(match &result {
+            Ok(r) if r.ending == Ending::Finished => RunState::Finished,
+            Ok(_) => RunState::Stopped,
+            Err(_) => RunState::Failed,
+        });
+        result.map(|physics| FleetPhysicsReport {
+            physics,
+            frames: acc.frames,
+            physics_ns: acc.physics_ns,
+            publish_ns: acc.publish_ns,
+            wait_ns: acc.wait_ns,
+        })
+    }
+
+    /// Lockstep: waits until every participant of every vehicle has answered tick `k`.
+    fn await_answers(&self, f: &mut FleetStepper, k: u64) -> Result<Wait, ServerError> {
+        f.begin_tick(k);
+        let timeout = self.settings.participant_timeout;
+        let give_up = Instant::now() + timeout;
+        while !f.all_answered() {
+            let now = Instant::now();
+            if now >= give_up {
+                let (v, participant) = f.first_unanswered().unwrap_or_default();
+                return Err(ServerError::Vehicle {
+                    vehicle: f.vehicles.get(v).map(|v| v.id.clone()).unwrap_or_default(),
+                    source: Box::new(ServerError::ParticipantTimeout {
+                        participant,
+                        tick: k,
+                        timeout_s: timeout.as_secs_f64(),
+                    }),
+                });
+            }
+            match self.cmd_rx.recv_timeout((give_up - now).min(POLL)) {
+                Ok((v, cmd)) => {
+                    if let Some(sh) = self.shared.get(v) {
+                        count_offer(sh, f.offer_lockstep(v, &cmd, k), cmd.sender_id);
+                    }
+                    self.recycle_command(v, cmd);
+                }
+                Err(RecvTimeoutError::Timeout) => {
+                    if self.stop.load(Ordering::Relaxed) {
+                        return Ok(Wait::Stopped);
+                    }
+                }
+                Err(RecvTimeoutError::Disconnected) => {
+                    return Err(ServerError::Internal("command channel closed".into()))
+                }
+            }
+        }
+        Ok(Wait::Done)
+    }
+
+    /// Real time / batch: takes every command that has arrived.
+    fn drain_commands(&self, f: &mut FleetStepper, k: u64) {
+        while let Ok((v, cmd)) = self.cmd_rx.try_recv() {
+            if let Some(sh) = self.shared.get(v) {
+                count_offer(sh, f.offer_latest(v, &cmd, k), cmd.sender_id);
+            }
+            self.recycle_command(v, cmd);
+        }
+    }
+
+    /// Hands a consumed command back to be freed off this thread (freed here only if that
+    /// vehicle's channel is full; never blocks).
+    fn recycle_command(&self, v: usize, cmd: CommandMsg) {
+        if let Some(tx) = self.recycle.get(v) {
+            let _ = tx.try_send(cmd);
+        }
+    }
+
+    fn frame_loop(
+        &mut self,
+        f: &mut FleetStepper,
+        acc: &mut Spent,
+    ) -> Result<PhysicsReport, ServerError> {
+        let mode = self.settings.mode;
+        let realtime = mode == Mode::RealTime;
+        let frame_ns = f.frame_ns();
+        let stopped = |k: u64| PhysicsReport {
+            ending: Ending::Stopped,
+            last_tick: k,
+            sim_time_ns: k.saturating_mul(frame_ns),
+        };
+        let mut k: u64 = 0;
+        f.fill(0)?;
+        let wall_period_ns = ((frame_ns as f64 / self.settings.speed).round() as u64).max(1);
+        let mut pacer = Pacer::new(
+            Instant::now() + Duration::from_nanos(wall_period_ns),
+            wall_period_ns,
+            self.settings.spin,
+            self.settings.overrun_policy,
+            self.settings.overrun_limit,
+        );
+        self.set_run_state(RunState::Running);
+        loop {
+            // 1. Frame boundary k: publish every vehicle's tick k.
+            let lateness_ns = if realtime {
+                match pacer.wait_boundary(k, &self.stop) {
+                    Some(l) => l,
+                    None => return Ok(stopped(k.saturating_sub(1))),
+                }
+            } else {
+                if self.stop.load(Ordering::Relaxed) {
+                    return Ok(stopped(k));
+                }
+                0
+            };
+            // Noted before the states go out, so an answer finds its tick published.
+            for sh in &self.shared {
+                sh.tick.store(k, Ordering::Release);
+            }
+            let stamp = unix_now_ns();
+            let t = Instant::now();
+            for ((v, p), sh) in f
+                .vehicles
+                .iter_mut()
+                .zip(&mut self.publishers)
+                .zip(&self.shared)
+            {
+                v.frame.boundary_unix_ns = stamp;
+                v.frame.lateness_ns = lateness_ns;
+                p.publish(&v.frame, sh, None);
+            }
+            acc.publish_ns += ns_since(t);
+            if self.total_frames == Some(k) {
+                return Ok(PhysicsReport {
+                    ending: Ending::Finished,
+                    last_tick: k,
+                    sim_time_ns: k.saturating_mul(frame_ns),
+                });
+            }
+
+            // 2. Commands for tick k.
+            let t = Instant::now();
+            match mode {
+                Mode::Lockstep => {
+                    if let Wait::Stopped = self.await_answers(f, k)? {
+                        return Ok(stopped(k));
+                    }
+                }
+                Mode::RealTime | Mode::Batch => self.drain_commands(f, k),
+            }
+            acc.wait_ns += ns_since(t);
+
+            // 3. Every vehicle's frame, and its telemetry of tick k + 1.
+            let t = Instant::now();
+            f.step(k);
+            k += 1;
+            f.fill(k)?;
+            acc.frames += 1;
+            acc.physics_ns += ns_since(t);
+            if realtime {
+                match pacer.end_frame(k) {
+                    FrameEnd::OnTime => {}
+                    FrameEnd::Overrun => {
+                        for sh in &self.shared {
+                            sh.overruns.store(pacer.overruns, Ordering::Relaxed);
+                        }
+                    }
+                    FrameEnd::Abort { consecutive } => {
+                        return Err(ServerError::OverrunLimit {
+                            tick: k,
+                            consecutive,
+                            limit: self.settings.overrun_limit,
+                        });
+                    }
+                }
+                for sh in &self.shared {
+                    sh.frames_skipped.store(pacer.skipped, Ordering::Relaxed);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,121 @@
+//! The per-frame work of a fleet: every vehicle's [`Stepper`] (its simulation, command book and
+//! held command) and its telemetry buffer, stepped on one tick. Nothing here allocates after
+//! [`FleetStepper::new`] (checked in `tests/server_alloc.rs`).
+//!
+//! The vehicles do not act on one another ([`crate::world::step`]), so each vehicle's stream
+//! is the one it would have alone, bit for bit, whatever the fleet's order or size.
+
+use flexdyn_proto::CommandMsg;
+
+use super::super::commands::Offer;
+use super::super::error::ServerError;
+use super::super::physics::Stepper;
+use super::super::settings::ServerSettings;
+use super::super::shared::Frame;
+use crate::world::Vehicle;
+
+/// One vehicle of the running fleet.
+pub struct FleetVehicle {
+    /// Its id (`flexdyn/<id>/…`).
+    pub id: String,
+    /// Its simulation, command book and held command.
+    pub stepper: Stepper,
+    /// The telemetry of its last tick filled.
+    pub frame: Box<Frame>,
+}
+
+/// Every vehicle of the fleet, stepped together.
+pub struct FleetStepper {
+    /// The vehicles, in fleet order.
+    pub vehicles: Vec<FleetVehicle>,
+}
+
+impl FleetStepper {
+    /// Steppers at t = 0 (sensors sampled at tick 0); `settings[i]` are vehicle `i`'s (its
+    /// participants and spacecraft id).
+    pub fn new(vehicles: Vec<Vehicle>, settings: &[ServerSettings]) -> Self {
+        let vehicles = vehicles
+            .into_iter()
+            .zip(settings)
+            .map(|(v, s)| {
+                let frame = Box::new(Frame::for_state(
+                    &v.sim.blank_state(),
+                    v.sim.sensors().len(),
+                ));
+                FleetVehicle {
+                    id: v.id,
+                    stepper: Stepper::new(v.sim, s),
+                    frame,
+                }
+            })
+            .collect();
+        Self { vehicles }
+    }
+
+    /// Lockstep: tick `k` begins; every participant of every vehicle owes an answer (a
+    /// participant whose command link is faulted `dropped` counts as answered with nothing).
+    pub fn begin_tick(&mut self, k: u64) {
+        for v in &mut self.vehicles {
+            v.stepper.book.begin_tick(k);
+        }
+    }
+
+    /// Whether every participant of every vehicle has answered the current tick.
+    pub fn all_answered(&self) -> bool {
+        self.vehicles.iter().all(|v| v.stepper.book.all_answered())
+    }
+
+    /// The first vehicle (index) with a participant that has not answered, and that
+    /// participant's sender id.
+    pub fn first_unanswered(&self) -> Option<(usize, u32)> {
+        self.vehicles
+            .iter()
+            .enumerate()
+            .find_map(|(i, v)| v.stepper.book.first_unanswered().map(|p| (i, p)))
+    }
+
+    /// Lockstep: offers `cmd` to vehicle `vehicle`'s book as its answer to tick `k`.
+    pub fn offer_lockstep(&mut self, vehicle: usize, cmd: &CommandMsg, k: u64) -> Offer {
+        match self.vehicles.get_mut(vehicle) {
+            Some(v) => v.stepper.book.offer_lockstep(cmd, k),
+            None => Offer::UnknownSender,
+        }
+    }
+
+    /// Real time / batch: offers `cmd` to vehicle `vehicle`'s book as its latest command.
+    pub fn offer_latest(&mut self, vehicle: usize, cmd: &CommandMsg, k: u64) -> Offer {
+        match self.vehicles.get_mut(vehicle) {
+            Some(v) => v.stepper.book.offer_latest(cmd, k),
+            None => Offer::UnknownSender,
+        }
+    }
+
+    /// Frame `k → k + 1` of every vehicle (each holds its own book's commands for tick `k`).
+    pub fn step(&mut self, k: u64) {
+        for v in &mut self.vehicles {
+            v.stepper.step(k);
+        }
+    }
+
+    /// Fills every vehicle's telemetry of tick `k` and checks it finite; an error names the
+    /// vehicle.
+    pub fn fill(&mut self, k: u64) -> Result<(), ServerError> {
+        for v in &mut self.vehicles {
+            v.stepper.fill(&mut v.frame, k);
+            if let Err(e) = v.stepper.check_finite(k, true) {
+                return Err(ServerError::Vehicle {
+                    vehicle: v.id.clone(),
+                    source: Box::new(e),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// \[ns\] the frame period (every vehicle's: the fleet file checks it).
+    pub fn frame_ns(&self) -> u64 {
+        self.vehicles
+            .first()
+            .map_or(1, |v| v.stepper.sim.frame_ns())
+    }
+}
