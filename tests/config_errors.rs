@@ -169,6 +169,7 @@ fn every_shipped_scenario_is_valid() {
             "campaign",
             "damped_wing",
             "eight_pairs",
+            "fdir",
             "folded_wing",
             "imu_tactical",
             "j2_orbit",
