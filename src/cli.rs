@@ -258,6 +258,10 @@ fn sensor_prefix(s: &dyn Sensor) -> String {
 /// `[environment] telemetry_rate_hz` set, every row also carries the environment record at its
 /// instant (`env_*`: the EnvironmentMsg fields, [`Simulation::environment_into`]), before the
 /// sensors.
+///
+/// Comment lines before the header: `epoch_utc=…` with an `[epoch]`, and one
+/// `fault=<index>,<start_ns>,<duration_ns>,<period_ns>,<mode>,<target>` per `[[faults]]`
+/// entry, its window as resolved at load ([`crate::sinks::fault_spans`]).
 pub fn simulate_to<W: Write>(
     cfg: &SimConfig,
     duration_s: f64,
@@ -323,11 +327,18 @@ pub fn simulate_to<W: Write>(
             .into_iter()
             .map(|(name, _)| name)
             .collect();
-    // What t_s = 0 is, when the configuration has an [epoch].
+    // What t_s = 0 is, when the configuration has an [epoch]; then each fault's resolved
+    // window (`flexdyn plot` shades it).
     let comments: Vec<String> = cfg
         .epoch
         .iter()
         .map(|e| format!("epoch_utc={}", e.utc_iso()))
+        .chain(
+            cfg.faults
+                .iter()
+                .enumerate()
+                .map(|(i, f)| crate::sinks::fault_spans::csv_comment(i, f)),
+        )
         .collect();
     let mut table = CsvTable::with_comments(out, &comments, &columns).map_err(io_err)?;
 

@@ -636,3 +636,206 @@ fn relative_motion_shows_the_deputy_in_the_chiefs_hill_frame() {
         "{e}"
     );
 }
+
+/// Fault 0: the IMU's gyro biased from 0.5 s for 0.3 s; fault 1: wheel rw2 seized from 0.7 s
+/// to the end (`scenarios/wheels_star_tracker.toml`: IMU `hub`, wheels rw1–rw4).
+const FAULTS: &str = "[[faults]]\ntarget = \"imus.hub.gyro\"\nmode = \"bias_step\"\nvalue = 0.25\n\
+                      start_s = 0.5\nduration_s = 0.3\n\n\
+                      [[faults]]\ntarget = \"reaction_wheels.rw2\"\nmode = \"seized\"\nstart_s = 0.7\n";
+
+/// The panels of `figs` with fault shading, as (figure, caption or y label, [(label, spans)]).
+type Shaded<'a> = Vec<(&'a str, String, Vec<(&'a str, &'a [(f64, f64)])>)>;
+fn shaded(figs: &[Figure]) -> Shaded<'_> {
+    figs.iter()
+        .flat_map(|f| {
+            f.panels.iter().filter(|p| !p.faults.is_empty()).map(|p| {
+                (
+                    f.name,
+                    p.caption.clone().unwrap_or_else(|| p.y_label.clone()),
+                    p.faults
+                        .iter()
+                        .map(|s| (s.label.as_str(), s.spans.as_slice()))
+                        .collect(),
+                )
+            })
+        })
+        .collect()
+}
+
+/// Checks that exactly the IMU's two panels carry `gyro` and the three wheel panels `wheel`,
+/// and nothing else is shaded.
+fn check_fault_panels(figs: &[Figure], gyro: &[(f64, f64)], wheel: &[(f64, f64)]) {
+    let got = shaded(figs);
+    let want_gyro = ("fault 0: imus.hub.gyro bias_step", gyro);
+    let want_wheel = ("fault 1: reaction_wheels.rw2 seized", wheel);
+    let imu: Vec<_> = got.iter().filter(|g| g.0 == "imu.png").collect();
+    assert_eq!(imu.len(), 2, "{got:?}");
+    for g in &imu {
+        assert_eq!(g.1, "IMU hub");
+        assert_eq!(g.2, vec![want_gyro], "{got:?}");
+    }
+    let wheels: Vec<_> = got.iter().filter(|g| g.0 == "wheels.png").collect();
+    assert_eq!(wheels.len(), 3, "{got:?}");
+    for g in &wheels {
+        assert_eq!(g.2, vec![want_wheel], "{got:?}");
+    }
+    // Nothing else: the truth (attitude, rates, panels, invariants), the commanded wrench and
+    // the star tracker show neither component.
+    assert_eq!(got.len(), 5, "{got:?}");
+}
+
+/// The pixels of fault 0's shading over the white background (fault colour at its alpha), as
+/// the x extent (first, last column) in the lower part of panel `area`.
+fn shading_columns(path: &Path, area: &(std::ops::Range<i32>, std::ops::Range<i32>)) -> (i32, i32) {
+    use flexdyn::sinks::plot::{fault_color, FAULT_ALPHA};
+    let c = fault_color(0);
+    let blend = |v: u8| 255.0 * (1.0 - FAULT_ALPHA) + f64::from(v) * FAULT_ALPHA;
+    let want = [blend(c.0), blend(c.1), blend(c.2)];
+    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let bpp = info.line_size / info.width as usize;
+    let (mut lo, mut hi) = (i32::MAX, i32::MIN);
+    for (i, p) in buf[..info.buffer_size()].chunks(bpp).enumerate() {
+        let (x, y) = (
+            (i as u32 % info.width) as i32,
+            (i as u32 / info.width) as i32,
+        );
+        // The bottom fifth of the plotting area: clear of the legend (upper right), whose key
+        // has the shading's colour too.
+        let bottom = area.1.end - (area.1.end - area.1.start) / 5..area.1.end;
+        if !(area.0.contains(&x) && bottom.contains(&y)) {
+            continue;
+        }
+        if (0..3).all(|k| (f64::from(p[k]) - want[k]).abs() <= 2.0) {
+            lo = lo.min(x);
+            hi = hi.max(x);
+        }
+    }
+    (lo, hi)
+}
+
+/// `flexdyn simulate` writes each fault's window as a `# fault=` line; `plot` shades, on the
+/// faulted components' panels only, exactly the configured intervals, and draws them where the
+/// panel's time axis puts them.
+#[test]
+fn a_simulate_csv_shades_each_fault_on_its_components_panels() {
+    let csv = simulate(
+        "faults_csv",
+        "scenarios/wheels_star_tracker.toml",
+        FAULTS,
+        "1.2",
+        "0.01",
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let comments: Vec<&str> = text.lines().take_while(|l| l.starts_with('#')).collect();
+    assert_eq!(
+        comments,
+        [
+            "# fault=0,500000000,300000000,,bias_step,imus.hub.gyro",
+            "# fault=1,700000000,,,seized,reaction_wheels.rw2"
+        ]
+    );
+    let (figs, _) = figures(&args(&csv)).unwrap();
+    check_fault_panels(&figs, &[(0.5, 0.8)], &[(0.7, 1.2)]);
+
+    // Drawn: the shading's pixels span [0.5 s, 0.8 s] of the IMU rate panel's time axis.
+    let imu = find(&figs, "imu.png");
+    let dir = csv.parent().unwrap();
+    register_font().unwrap();
+    let areas = draw(&dir.join("imu.png"), imu).unwrap();
+    let (t0, t1) = imu.panels[0].t_range();
+    let xs = &areas[0].0;
+    let px = |t: f64| xs.start as f64 + (t - t0) / (t1 - t0) * f64::from(xs.end - xs.start - 1);
+    let (lo, hi) = shading_columns(&dir.join("imu.png"), &areas[0]);
+    assert!(
+        (f64::from(lo) - px(0.5)).abs() <= 2.0 && (f64::from(hi) - px(0.8)).abs() <= 2.0,
+        "shading at columns {lo}..{hi}, expected {:.1}..{:.1}",
+        px(0.5),
+        px(0.8)
+    );
+    // And the figures through the command line.
+    let out = dir.join("figures");
+    let r = flexdyn(&["plot", csv.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    check_figures(&out, &["imu.png", "wheels.png"]);
+
+    // A damaged fault line is an error naming the file and the line.
+    let bad = dir.join("bad.csv");
+    std::fs::write(
+        &bad,
+        text.replacen("# fault=0,500000000", "# fault=0,-5", 1),
+    )
+    .unwrap();
+    let e = figures(&args(&bad)).err().unwrap().to_string();
+    assert!(
+        e.contains("bad.csv") && e.contains("line 1") && e.contains("start_ns"),
+        "{e}"
+    );
+}
+
+/// A recording: the shading comes from the fault events (a repeating gyro fault and a wheel
+/// seized to the end of the run), on the same panels as from a CSV.
+#[test]
+fn a_recording_shades_each_fault_from_its_events() {
+    let dir = tmp("faults_mcap");
+    std::fs::create_dir_all(&dir).unwrap();
+    let base = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml"),
+    )
+    .unwrap();
+    // The gyro fault repeats: on at 0.1 s for 0.05 s, every 0.2 s.
+    let faults = FAULTS
+        .replace(
+            "start_s = 0.5\nduration_s = 0.3",
+            "start_s = 0.1\nduration_s = 0.05\nperiod_s = 0.2",
+        )
+        .replace("start_s = 0.7", "start_s = 0.25");
+    let cfg = dir.join("run.toml");
+    std::fs::write(&cfg, format!("{base}\n{faults}")).unwrap();
+    let rec = dir.join("run.mcap");
+    let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args(["run", "--mode", "batch", "--duration-s", "0.6"])
+        .args(["--listen", ports::ANY_PORT, "--config"])
+        .arg(&cfg)
+        .arg("--record")
+        .arg(&rec)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let (figs, _) = figures(&args(&rec)).unwrap();
+    // The last activation (0.5 s) is cleared at 0.55 s; the wheel stays seized to the last
+    // state, at 0.6 s.
+    check_fault_panels(
+        &figs,
+        &[(0.1, 0.15), (0.3, 0.35), (0.5, 0.55)],
+        &[(0.25, 0.6)],
+    );
+    let out = dir.join("figures");
+    let r = flexdyn(&["plot", rec.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    check_figures(&out, &["imu.png", "wheels.png"]);
+    // `flexdyn export` carries the events into the state CSV (`# fault=` lines, one per
+    // activation): the same shading from it, with the IMU's columns absent (wheels only).
+    let csv_dir = dir.join("csv");
+    let r = flexdyn(&[
+        "export",
+        rec.to_str().unwrap(),
+        "--csv",
+        csv_dir.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let (figs, _) = figures(&args(&csv_dir.join("flexdyn_sc1_tlm_state.csv"))).unwrap();
+    let wheels: Vec<_> = shaded(&figs)
+        .into_iter()
+        .filter(|g| g.0 == "wheels.png")
+        .collect();
+    assert_eq!(wheels.len(), 3);
+    for g in &wheels {
+        assert_eq!(
+            g.2,
+            vec![("fault 1: reaction_wheels.rw2 seized", &[(0.25, 0.6)][..])]
+        );
+    }
+}

@@ -1,15 +1,18 @@
 //! `flexdyn export FILE.mcap --csv DIR`: one CSV per recorded flexdyn topic, named after its key
 //! (`flexdyn/sc1/tlm/state` → `DIR/flexdyn_sc1_tlm_state.csv`), in flexdyn's one CSV dialect
 //! ([`super::table`], the writer `simulate` uses too). A column a row does not have (an
-//! effector input one command sets and another does not) is left empty.
+//! effector input one command sets and another does not) is left empty. A vehicle's state CSV
+//! starts with one `# fault=` line per fault activation its fault events record
+//! ([`super::fault_spans::event_comments`]), so `flexdyn plot` shades them from the CSV too.
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use super::error::SinkError;
+use super::fault_spans;
 use super::reader::read_recording;
 use super::table::{row, CsvTable};
-use super::topics::{classify, Decoded};
+use super::topics::{classify, Decoded, TopicKind};
 
 /// Arguments of `flexdyn export`.
 #[derive(Clone, Debug, PartialEq, clap::Args)]
@@ -65,6 +68,32 @@ pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
             "samples that do not decode were left out of the CSV files"
         );
     }
+    // Each vehicle's fault events, as `# fault=` lines of its state CSV (`plot` shades them).
+    let mut fault_lines: HashMap<String, Vec<String>> = HashMap::new();
+    {
+        let mut events: HashMap<&str, Vec<flexdyn_proto::FaultEventMsg>> = HashMap::new();
+        let mut first_ns: HashMap<&str, u64> = HashMap::new();
+        for s in &rec.samples {
+            let Some(topic) = classify(&s.key) else {
+                continue;
+            };
+            let Ok(d) = Decoded::decode(topic.kind, &s.payload) else {
+                continue;
+            };
+            let t = d.header().sim_time_ns;
+            first_ns
+                .entry(topic.sc_id)
+                .and_modify(|f| *f = (*f).min(t))
+                .or_insert(t);
+            if let Decoded::FaultEvent(e) = d {
+                events.entry(topic.sc_id).or_default().push(e);
+            }
+        }
+        for (sc, ev) in events {
+            let first = first_ns.get(sc).copied().unwrap_or(0);
+            fault_lines.insert(sc.to_owned(), fault_spans::event_comments(&ev, first));
+        }
+    }
     // Pass 2: rows, through the one CSV writer.
     let epochs: HashMap<String, String> = rec
         .vehicles()
@@ -77,10 +106,14 @@ pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
         let path = args.csv.join(format!("{}.csv", key.replace('/', "_")));
         let f = std::fs::File::create(&path).map_err(|e| out_err(&path, e))?;
         // What t_s = 0 is, when the vehicle's configuration has an [epoch].
-        let comments: Vec<String> = classify(key)
+        let mut comments: Vec<String> = classify(key)
             .and_then(|t| epochs.get(t.sc_id))
             .map(|e| vec![format!("epoch_utc={e}")])
             .unwrap_or_default();
+        // The state CSV also carries the vehicle's faults.
+        if let Some(t) = classify(key).filter(|t| t.kind == TopicKind::State) {
+            comments.extend(fault_lines.get(t.sc_id).into_iter().flatten().cloned());
+        }
         let table = CsvTable::with_comments(f, &comments, names).map_err(|e| out_err(&path, e))?;
         tables.insert(key.clone(), (path.clone(), table));
         report.insert(path, 0);

@@ -10,11 +10,13 @@
 //! - [`table`]: decoded messages as named columns (CSV export, plots).
 //! - [`record_cmd`], [`replay`], [`export`]: the `flexdyn record`, `replay` and `export`
 //!   subcommands.
-//! - [`plot`]: `flexdyn plot`, PNG figures of a recording or a CSV.
+//! - [`plot`]: `flexdyn plot`, PNG figures of a recording or a CSV; [`fault_spans`]: the
+//!   intervals its figures shade where a fault was active.
 //! - [`view`]: `flexdyn view`, the live (or recorded) Foxglove WebSocket view.
 
 pub mod error;
 pub mod export;
+pub mod fault_spans;
 pub mod gaps;
 pub mod mcap_file;
 pub mod plot;

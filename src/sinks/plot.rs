@@ -25,6 +25,13 @@
 //! - `timing.png`: frame lateness p50/p99/max from StatusMsg and the overrun count (real time
 //!   only: a lockstep or batch run is not paced by the wall clock, so it is skipped and says so).
 //!
+//! Every fault (`[[faults]]`, random or live) is shaded over the intervals it was active, with a
+//! legend entry naming it, on each panel that shows the faulted component: a sensor's panels
+//! (`imus.hub.gyro` on IMU hub's), the wheel panels for a wheel, the magnetorquer or thruster
+//! panels of `actuators.png`, the commanded wrench for a command link
+//! ([`super::fault_spans`]: from the recording's fault events, or the `# fault=` lines of a
+//! `simulate` CSV).
+//!
 //! [`figures`] builds every figure's data and axis bounds ([`Panel::y_range`]) without drawing,
 //! so tests can check what a figure shows.
 //!
@@ -38,6 +45,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::error::SinkError;
+use super::fault_spans::{self, FaultShading};
 use super::reader::read_recording;
 use super::table::{prefixed_columns, row, Cell, Column, ENVIRONMENT_COLUMN_PREFIX};
 use super::topics::{classify, Decoded, TopicKind};
@@ -63,6 +71,22 @@ pub const COLORS: [RGBColor; 6] = [
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
 ];
+
+/// The shading colours of faults (by fault index, cycling), drawn at [`FAULT_ALPHA`] over the
+/// background: distinct from the lines' and from the external-wrench shading.
+pub const FAULT_COLORS: [RGBColor; 4] = [
+    RGBColor(220, 20, 60),
+    RGBColor(0, 128, 128),
+    RGBColor(128, 0, 128),
+    RGBColor(90, 90, 90),
+];
+/// The opacity of a fault's shading.
+pub const FAULT_ALPHA: f64 = 0.2;
+
+/// The shading colour of fault `index`.
+pub fn fault_color(index: u32) -> RGBColor {
+    FAULT_COLORS[index as usize % FAULT_COLORS.len()]
+}
 
 /// Arguments of `flexdyn plot`.
 #[derive(Clone, Debug, PartialEq, clap::Args)]
@@ -148,6 +172,20 @@ struct PlotData {
     mode: Option<flexdyn_proto::Mode>,
     /// `--relative-to`: the chief's id and its state columns.
     chief: Option<(String, Columns)>,
+    /// When each fault was active.
+    faults: Vec<FaultShading>,
+}
+
+/// \[s\] the first and last instant of `c` (0, 0 when empty).
+fn time_span(c: &Columns) -> (f64, f64) {
+    let first = c.t_s.iter().copied().find(|t| t.is_finite()).unwrap_or(0.0);
+    let last = c
+        .t_s
+        .iter()
+        .copied()
+        .rfind(|t| t.is_finite())
+        .unwrap_or(first);
+    (first, last)
 }
 
 fn input_err(path: &Path, problem: impl Into<String>) -> SinkError {
@@ -184,6 +222,7 @@ fn from_mcap(
         chief: relative_to.map(|c| (c.to_owned(), Columns::default())),
         ..PlotData::default()
     };
+    let mut fault_events = Vec::new();
     for s in &rec.samples {
         let Some(topic) = classify(&s.key) else {
             continue;
@@ -217,13 +256,19 @@ fn from_mcap(
                 .or_default()
                 .push(&cells),
             TopicKind::Environment => data.environment.push(&cells),
+            TopicKind::FaultEvent => {
+                if let Decoded::FaultEvent(m) = d {
+                    fault_events.push(m);
+                }
+            }
             TopicKind::Command
             | TopicKind::Time
             | TopicKind::Operator
-            | TopicKind::FaultEvent
             | TopicKind::FaultCommand => {}
         }
     }
+    let (first, last) = time_span(&data.state);
+    data.faults = fault_spans::from_events(&fault_events, first, last);
     if data.state.is_empty() {
         return Err(input_err(
             path,
@@ -263,7 +308,21 @@ fn sensor_column<'a>(
 fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
     let text =
         std::fs::read_to_string(path).map_err(|e| input_err(path, format!("cannot read: {e}")))?;
-    // Leading `# key=value` comments (the epoch) precede the header.
+    // Leading `# key=value` comments (the epoch, the faults' windows) precede the header.
+    let mut windows = Vec::new();
+    for (n, comment) in text.lines().map_while(|l| l.strip_prefix('#')).enumerate() {
+        let Some(value) = comment
+            .trim_start()
+            .strip_prefix(fault_spans::CSV_KEY)
+            .and_then(|v| v.strip_prefix('='))
+        else {
+            continue;
+        };
+        windows.push(
+            fault_spans::parse_csv_comment(value)
+                .map_err(|e| input_err(path, format!("line {}: {e}", n + 1)))?,
+        );
+    }
     let mut lines = text.lines().skip_while(|l| l.starts_with('#'));
     let header: Vec<&str> = lines
         .next()
@@ -356,6 +415,15 @@ fn from_csv(path: &Path) -> Result<PlotData, SinkError> {
     if data.state.is_empty() {
         return Err(input_err(path, "no data rows"));
     }
+    let (first, last) = time_span(&data.state);
+    // One shading per fault: `export` writes a line per activation.
+    for (i, w, mode, target) in &windows {
+        let f = fault_spans::from_window(*i, w, mode, target, first, last);
+        match data.faults.iter_mut().find(|s| s.fault_index == *i) {
+            Some(s) => s.spans.extend(f.spans),
+            None => data.faults.push(f),
+        }
+    }
     Ok(data)
 }
 
@@ -392,6 +460,11 @@ pub struct Panel {
     pub spans: Vec<(f64, f64)>,
     /// The legend entry of `spans`.
     pub span_label: String,
+    /// The components whose values it shows, for shading their faults: a component
+    /// (`imus.hub`) or a whole section whose every member it draws (`reaction_wheels`).
+    pub components: Vec<String>,
+    /// The faults of those components, each shaded over the intervals it was active.
+    pub faults: Vec<FaultShading>,
 }
 
 /// One figure (one PNG file).
@@ -522,6 +595,19 @@ fn draw_panel<Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueForma
             .label(panel.span_label.as_str())
             .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
     }
+    for f in &panel.faults {
+        let (y0, y1) = panel.y_range();
+        let shade = fault_color(f.fault_index).mix(FAULT_ALPHA);
+        chart
+            .draw_series(
+                f.spans
+                    .iter()
+                    .map(|(a, b)| Rectangle::new([(*a, y0), (*b, y1)], shade.filled())),
+            )
+            .map_err(|e| e.to_string())?
+            .label(f.label.as_str())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
+    }
     // The first line last, on top: where lines coincide (a total dominated by one part) the
     // first one listed stays visible.
     for (k, l) in panel.lines.iter().enumerate().rev() {
@@ -644,9 +730,16 @@ fn numbered_panel(
                 .map(|c| line(&format!("{label}{k}"), &cols.t_s, c))
         })
         .collect();
+    // The kind whose effectors these columns are (`rw` → `reaction_wheels`): the panel shows
+    // every one of them.
+    let section = crate::dynamics::kinds::KINDS
+        .iter()
+        .find(|k| k.effector.column_prefix == prefix)
+        .map(|k| k.section.to_owned());
     (!lines.is_empty()).then(|| Panel {
         y_label: y_label.to_owned(),
         lines,
+        components: section.into_iter().collect(),
         ..Panel::default()
     })
 }
@@ -730,6 +823,21 @@ fn external_wrench_spans(s: &Columns) -> Vec<(f64, f64)> {
         }
     }
     spans
+}
+
+/// Adds each fault's shading to every panel showing its target ([`fault_spans::shows`]).
+fn shade_faults(figures: &mut [Figure], faults: &[FaultShading]) {
+    for panel in figures.iter_mut().flat_map(|f| f.panels.iter_mut()) {
+        for f in faults.iter().filter(|f| !f.spans.is_empty()) {
+            if panel
+                .components
+                .iter()
+                .any(|c| fault_spans::shows(c, &f.target))
+            {
+                panel.faults.push(f.clone());
+            }
+        }
+    }
 }
 
 /// Figures not drawn, each with the reason.
@@ -879,7 +987,8 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
         (Some(tq), Some(f), Some(flags)) => fig(
             "wrench.png",
             "Commanded wrench held over each frame (B components) and command flags".into(),
-            vec![
+            // What the participants command: their command links' faults show here.
+            [
                 tq,
                 f,
                 Panel {
@@ -887,7 +996,13 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
                     lines: vec![line("flags", t, flags)],
                     ..Panel::default()
                 },
-            ],
+            ]
+            .into_iter()
+            .map(|p| Panel {
+                components: vec![crate::faults::link::SECTION.to_owned()],
+                ..p
+            })
+            .collect(),
         ),
         _ => skip("wrench.png", "no wrench_applied_* columns"),
     }
@@ -898,7 +1013,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
         lines,
         spans: spans.clone(),
         span_label: "external wrench acts".into(),
-        caption: None,
+        ..Panel::default()
     };
     let energy = match (
         s.get("conserved_orb_energy_j"),
@@ -1009,6 +1124,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
                 .iter()
                 .map(|spec| Panel {
                     caption: Some(format!("{} {name}", kind.noun)),
+                    components: vec![format!("{}.{name}", kind.config_array)],
                     y_label: spec.y_label.into(),
                     lines: spec
                         .lines
@@ -1076,6 +1192,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
             "no StatusMsg (only recordings have it)".into(),
         )),
     }
+    shade_faults(&mut figures, &data.faults);
     Ok((figures, skipped))
 }
 
