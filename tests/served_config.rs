@@ -20,6 +20,7 @@ fn m3(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {
 fn the_clients_reader_agrees_with_the_servers_on_every_scenario() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
     let mut checked = 0;
+    let mut with_faults = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
         let Ok(sim) = SimConfig::from_file(&path) else {
@@ -100,7 +101,24 @@ fn the_clients_reader_agrees_with_the_servers_on_every_scenario() {
         for (c, s) in cfg.star_trackers.iter().zip(&sim_trackers) {
             assert_eq!(m3(&c.dcm_cb), s.dcm_cb, "{name}");
         }
+        // The faults, by index (the monitor names FaultEventMsg/StatusMsg indices with them).
+        let faults: Vec<(&str, &str)> = cfg
+            .faults
+            .iter()
+            .map(|f| (f.target.as_str(), f.mode.as_str()))
+            .collect();
+        let sim_faults: Vec<(&str, &str)> = sim
+            .faults
+            .iter()
+            .map(|f| (f.target.as_str(), f.mode.name()))
+            .collect();
+        assert_eq!(faults, sim_faults, "{name}");
+        with_faults += usize::from(!faults.is_empty());
         checked += 1;
     }
     assert!(checked >= 8, "only {checked} scenarios read");
+    assert!(
+        with_faults >= 1,
+        "no scenario with [[faults]] (scenarios/fdir.toml has some)"
+    );
 }

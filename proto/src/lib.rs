@@ -141,7 +141,7 @@ pub use keys::{FAULT_EVENT_SUFFIX, FAULT_SUFFIX};
 pub use layout::{FAULT_COMMAND_LEN, FAULT_EVENT_LEN};
 pub use messages::{
     FaultAction, FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget, AT_NEXT_TICK,
-    FAULT_TARGET_LEN, MAX_STATUS_FAULTS,
+    FAULT_MODE_NAMES, FAULT_TARGET_LEN, MAX_STATUS_FAULTS,
 };
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.

@@ -994,6 +994,32 @@ pub struct EnvironmentMsg {
 /// Largest fault index StatusMsg's [`StatusMsg::faults_active_bits`] can show (bits 0–255); a
 /// fault beyond it is counted in [`StatusMsg::faults_active`] only. Protocol version 8.
 pub const MAX_STATUS_FAULTS: usize = 256;
+/// The fault modes' names by code (the `mode` of [`FaultEventMsg`] and [`FaultCommandMsg`]):
+/// `proto/README.md`, "Fault modes"; the names a configuration's `[[faults]]` use.
+pub const FAULT_MODE_NAMES: [&str; 21] = [
+    "stuck_current",
+    "stuck_value",
+    "bias_step",
+    "bias_ramp",
+    "scale",
+    "noise",
+    "spikes",
+    "dropout",
+    "validity_off",
+    "friction_scale",
+    "torque_limit",
+    "seized",
+    "command_ignored",
+    "stuck_on",
+    "stuck_off",
+    "thrust_scale",
+    "dead",
+    "dipole_scale",
+    "dropped",
+    "delayed",
+    "corrupted",
+];
+
 /// Bytes of a [`FaultTarget`]. Protocol version 8.
 pub const FAULT_TARGET_LEN: usize = 128;
 /// [`FaultCommandMsg::at_tick`] for "at the next frame boundary". Protocol version 8.

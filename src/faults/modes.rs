@@ -372,6 +372,14 @@ mod tests {
         assert!(FaultMode::from_name("melted", |_| 0.0).is_none());
     }
 
+    /// The clients' table of mode names by wire code (`flexdyn_proto::FAULT_MODE_NAMES`, which
+    /// the monitor names faults with) is this one.
+    #[test]
+    fn the_clients_mode_names_are_the_table() {
+        let names: Vec<&str> = MODES.iter().map(|(n, _)| *n).collect();
+        assert_eq!(names, flexdyn_proto::FAULT_MODE_NAMES);
+    }
+
     #[test]
     fn value_transforms_follow_the_table() {
         let d = Draws {

@@ -137,3 +137,75 @@ fn the_monitor_gives_each_vehicle_its_own_line() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("\"chief\" is listed twice"), "{stderr}");
 }
+
+/// The fault segment (issue 21): a real-time server on the wheel scenario with three
+/// configured faults — #0 the gyro biased from the start (activated before the monitor
+/// listens: only the served configuration names it), #1 a wheel seized at 1000 s (never active
+/// here), #2 another wheel torque-limited from 0.5 s — and a live fault put on
+/// `flexdyn/sc1/fault` while the monitor runs (#3, named only by its fault event). The last
+/// line lists exactly the active ones, by index, target and mode.
+#[test]
+fn the_monitor_names_the_active_faults() {
+    use flexdyn_proto::{encode, FaultAction, FaultCommandMsg, FaultTarget, Header, AT_NEXT_TICK};
+    use zenoh::Wait;
+
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let scenario =
+        std::fs::read_to_string(root.join("scenarios/wheels_star_tracker.toml")).unwrap();
+    let fault = |target: &str, mode: &str, start_s: f64| {
+        format!("\n[[faults]]\ntarget = \"{target}\"\n{mode}\nstart_s = {start_s}\n")
+    };
+    let cfg = SimConfig::from_toml_str(&format!(
+        "{scenario}{}{}{}",
+        fault("imus.hub.gyro", "mode = \"bias_step\"\nvalue = 0.1", 0.0),
+        fault("reaction_wheels.rw2", "mode = \"seized\"", 1000.0),
+        fault(
+            "reaction_wheels.rw3",
+            "mode = \"torque_limit\"\nfraction = 0.5",
+            0.5
+        ),
+    ))
+    .unwrap();
+    let mut server = ServerHandle::start(ServerSettings::default(), cfg);
+    let monitor = Command::new(env!("CARGO_BIN_EXE_flexdyn-monitor"))
+        .args(["--connect", &endpoint(server.port), "--plain"])
+        .args(["--interval-s", "1", "--duration-s", "4.5"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let operator = support::connecting_session(server.port);
+    let live = FaultCommandMsg {
+        header: Header::new(1, 0, 0, 0),
+        action: FaultAction::Inject,
+        at_tick: AT_NEXT_TICK,
+        fault_index: 0,
+        mode: 4, // scale
+        params: [2.0, 0.0],
+        axes: 0,
+        duration_ns: 0,
+        seed: 0,
+        target: FaultTarget::new("imus.hub.accel").unwrap(),
+    };
+    operator
+        .put("flexdyn/sc1/fault", encode(&live))
+        .wait()
+        .unwrap();
+    let out = monitor.wait_with_output().unwrap();
+    let _ = operator.close().wait();
+    server.stop();
+    server.join(Duration::from_secs(10)).unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    let line = stdout.lines().last().unwrap();
+    let faults = line
+        .split(" | ")
+        .find(|p| p.starts_with("faults "))
+        .unwrap_or_else(|| panic!("no faults segment: {line}"));
+    assert_eq!(
+        faults,
+        "faults active=3 [#0 imus.hub.gyro bias_step; #2 reaction_wheels.rw3 torque_limit; \
+         #3 imus.hub.accel scale]",
+        "{line}"
+    );
+}

@@ -152,6 +152,10 @@ pub struct VehicleConfig {
     /// `[[gps_receivers]]`, in file order.
     #[serde(default)]
     pub gps_receivers: Vec<GpsReceiver>,
+    /// `[[faults]]`, in file order: fault index `i` of FaultEventMsg and StatusMsg is entry
+    /// `i` (live faults follow them).
+    #[serde(default)]
+    pub faults: Vec<Fault>,
 }
 
 impl VehicleConfig {
@@ -431,6 +435,16 @@ pub struct StarTracker {
 
 fn plus_z() -> [f64; 3] {
     [0.0, 0.0, 1.0]
+}
+
+/// One `[[faults]]` entry: what it breaks and how (its window and parameters are the
+/// server's business; FaultEventMsg reports them as they take effect).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct Fault {
+    /// The target as written (`imus.hub.gyro`, `reaction_wheels.rw2`, `links.1`).
+    pub target: String,
+    /// The mode's name (`bias_step`; `proto/README.md`, "Fault modes").
+    pub mode: String,
 }
 
 /// One `[[magnetometers]]` entry.

@@ -30,7 +30,12 @@
 //! - `sensors`: every sensor message heard in the interval (`flexdyn/<sc>/tlm/<kind>/<name>`),
 //!   as `<kind>/<name>=<messages per second>`;
 //! - `rejected`: the server's rejected commands by reason (`stale_tick:2,unknown_sender:1`), and
-//!   `dropped` the valid commands it dropped for a full queue.
+//!   `dropped` the valid commands it dropped for a full queue;
+//! - `faults`: with faults configured or heard of, how many are active (StatusMsg
+//!   `faults_active`) and which, by index, target and mode (`faults active=1 [#0 imus.hub.gyro
+//!   bias_step]`): the active set is StatusMsg's `faults_active_bits`, the names come from the
+//!   served configuration's `[[faults]]` (`flexdyn/<sc>/config`, asked once at start) and from
+//!   every fault event heard (`tlm/fault`, live faults included).
 
 use std::io::{IsTerminal as _, Write as _};
 use std::sync::{Arc, Mutex};
@@ -39,9 +44,9 @@ use std::time::{Duration, Instant};
 use clap::Parser;
 use flexdyn_proto::client::transport::{frame_stamp_ns, mode_name, unix_now_ns};
 use flexdyn_proto::{
-    command_flags, decode_environment, decode_state, decode_status, eclipse, effector_kind,
-    environment_flags, magnetorquer_flags, thruster_flags, wheel_flags, EffectorState,
-    EnvironmentMsg, RunState, StatusMsg, NO_COMMAND,
+    command_flags, decode_environment, decode_fault_event, decode_state, decode_status, eclipse,
+    effector_kind, environment_flags, magnetorquer_flags, thruster_flags, wheel_flags,
+    EffectorState, EnvironmentMsg, RunState, StatusMsg, NO_COMMAND,
 };
 use flexdyn_tools::{percentile, CommonArgs};
 use zenoh::Wait;
@@ -97,6 +102,43 @@ struct Window {
     last_state_at: Option<Instant>,
     /// When the last StatusMsg arrived (None: never).
     last_status_at: Option<Instant>,
+    /// Fault names (`<target> <mode>`) by fault index: the served configuration's
+    /// `[[faults]]`, and each fault event heard.
+    fault_names: std::collections::BTreeMap<u32, String>,
+}
+
+/// A fault's name: `<target> <mode>` (the mode's code when this build does not know it).
+fn fault_name(target: &str, mode: u32) -> String {
+    match flexdyn_proto::FAULT_MODE_NAMES.get(mode as usize) {
+        Some(m) => format!("{target} {m}"),
+        None => format!("{target} mode {mode}"),
+    }
+}
+
+/// The fault segment: how many faults are active and which (`#<index> <name>`, `#<index>`
+/// alone when no name is known), from StatusMsg's active set; those beyond the set's 256 bits
+/// are only counted. Empty when no fault is active or known of.
+fn faults_str(s: &StatusMsg, names: &std::collections::BTreeMap<u32, String>) -> String {
+    if s.faults_active == 0 && names.is_empty() {
+        return String::new();
+    }
+    let active: Vec<String> = (0..flexdyn_proto::MAX_STATUS_FAULTS as u32)
+        .filter(|i| s.faults_active_bits[*i as usize / 64] & (1 << (i % 64)) != 0)
+        .map(|i| match names.get(&i) {
+            Some(n) => format!("#{i} {n}"),
+            None => format!("#{i}"),
+        })
+        .collect();
+    let mut out = format!(" faults active={}", s.faults_active);
+    if !active.is_empty() {
+        let beyond = s.faults_active.saturating_sub(active.len() as u64);
+        out.push_str(&format!(" [{}", active.join("; ")));
+        if beyond > 0 {
+            out.push_str(&format!("; +{beyond} beyond index 255"));
+        }
+        out.push(']');
+    }
+    out
 }
 
 /// The rejection counters by reason, only the non-zero ones (`0` if none).
@@ -340,6 +382,11 @@ fn line(w: &mut Window, interval: Duration, state_topic: &str) -> String {
                 rejected_by_reason(&s.rejected),
                 s.commands_dropped,
             ));
+            let faults = faults_str(s, &w.fault_names);
+            if !faults.is_empty() {
+                out.push_str(" |");
+                out.push_str(&faults);
+            }
         }
     }
     w.states = 0;
@@ -354,11 +401,13 @@ fn line(w: &mut Window, interval: Duration, state_topic: &str) -> String {
 struct Watch {
     topics: flexdyn_proto::Topics,
     window: Arc<Mutex<Window>>,
-    _subscribers: [zenoh::pubsub::Subscriber<()>; 4],
+    _subscribers: [zenoh::pubsub::Subscriber<()>; 5],
 }
 
 impl Watch {
-    /// Subscribes to the vehicle's state, status, environment and sensor keys.
+    /// Subscribes to the vehicle's state, status, environment, sensor and fault-event keys, and
+    /// asks its server for the configured faults' names (in the background: the server may
+    /// start later).
     fn declare(session: &zenoh::Session, topics: flexdyn_proto::Topics) -> anyhow::Result<Self> {
         let window = Arc::new(Mutex::new(Window::default()));
         let w = window.clone();
@@ -452,10 +501,41 @@ impl Watch {
             })
             .wait()
             .map_err(|e| anyhow::anyhow!("cannot subscribe to {sensor_keys}: {e}"))?;
+        let w = window.clone();
+        let fault_key = topics.fault_events();
+        let _faults = session
+            .declare_subscriber(fault_key.as_str())
+            .callback(move |sample| {
+                if let Ok(e) = decode_fault_event(&sample.payload().to_bytes()) {
+                    let name = fault_name(e.target.as_str().unwrap_or("?"), e.mode);
+                    let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
+                    w.fault_names.insert(e.fault_index, name);
+                }
+            })
+            .wait()
+            .map_err(|e| anyhow::anyhow!("cannot subscribe to {fault_key}: {e}"))?;
+        let (w, s, t) = (window.clone(), session.clone(), topics.clone());
+        std::thread::spawn(move || {
+            use flexdyn_proto::client::vehicle::Vehicle;
+            let faults = Vehicle::query(&s, &t, Duration::from_secs(60))
+                .and_then(|v| v.config())
+                .map(|c| c.faults);
+            match faults {
+                Ok(faults) => {
+                    let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
+                    for (i, f) in faults.iter().enumerate() {
+                        w.fault_names
+                            .entry(i as u32)
+                            .or_insert_with(|| format!("{} {}", f.target, f.mode));
+                    }
+                }
+                Err(e) => tracing::debug!(error = %e, "no fault names from the configuration"),
+            }
+        });
         Ok(Self {
             topics,
             window,
-            _subscribers: [_states, _status, _environment, _sensors],
+            _subscribers: [_states, _status, _environment, _sensors, _faults],
         })
     }
 
@@ -762,6 +842,34 @@ mod tests {
             " sensors css/css=10.0/s,imu/hub=100.0/s"
         );
         assert_eq!(sensors_str(&Default::default(), Duration::from_secs(1)), "");
+    }
+
+    /// The active set names each active fault by index; unknown names show the index alone,
+    /// and faults beyond the set's 256 bits are counted.
+    #[test]
+    fn fault_summary_names_the_active_faults() {
+        let names = [
+            (0, fault_name("imus.hub.gyro", 2)),
+            (1, fault_name("reaction_wheels.rw2", 11)),
+            (2, fault_name("links.1", 99)),
+        ]
+        .into_iter()
+        .collect();
+        let mut s = StatusMsg::default();
+        assert_eq!(faults_str(&s, &Default::default()), "");
+        assert_eq!(faults_str(&s, &names), " faults active=0");
+        s.faults_active = 2;
+        s.faults_active_bits[0] = 0b101;
+        assert_eq!(
+            faults_str(&s, &names),
+            " faults active=2 [#0 imus.hub.gyro bias_step; #2 links.1 mode 99]"
+        );
+        s.faults_active = 4;
+        s.faults_active_bits = [0b10, 0, 0, 1 << 63];
+        assert_eq!(
+            faults_str(&s, &names),
+            " faults active=4 [#1 reaction_wheels.rw2 seized; #255; +2 beyond index 255]"
+        );
     }
 
     #[test]
