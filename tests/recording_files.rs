@@ -264,8 +264,19 @@ fn resolve<'a>(msg: &'a serde_json::Value, fields: &str) -> Option<&'a serde_jso
 
 #[test]
 fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
-    // The ACS scenario: wheels, sensors and the actuators' arrows are all recorded.
-    let file = batch_recording_of("layout.mcap", "acs_full.toml");
+    // The ACS scenario: wheels, sensors and the actuators' arrows are all recorded; with a
+    // fault, so are its events (`tlm/fault`) and the active set in StatusMsg.
+    let config = tmp("layout.toml");
+    let scenario = std::fs::read_to_string(root().join("scenarios/acs_full.toml")).unwrap();
+    std::fs::write(
+        &config,
+        format!(
+            "{scenario}\n[[faults]]\ntarget = \"imus.hub.gyro\"\nmode = \"bias_step\"\n\
+             value = 0.01\nstart_s = 1.0\nduration_s = 1.0\n"
+        ),
+    )
+    .unwrap();
+    let file = batch_recording_of("layout.mcap", config.to_str().unwrap());
     let bytes = std::fs::read(&file).unwrap();
     let mut first: BTreeMap<String, serde_json::Value> = BTreeMap::new();
     for m in mcap::MessageStream::new(&bytes).unwrap() {
@@ -313,6 +324,11 @@ fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
         }
     }
     assert!(checked >= 20, "only {checked} paths checked");
+    // The fault panels are among them (a layout without them fails here).
+    for panel in ["RawMessages!faults", "StateTransitions!faults"] {
+        assert!(layout["configById"].get(panel).is_some(), "no {panel}");
+    }
+    assert!(first.contains_key("/flexdyn/sc1/tlm/fault"));
 }
 
 /// `flexdyn record` of a synthetic publisher whose StateMsg sequence numbers 0..100 skip

@@ -285,9 +285,12 @@ fn check_against(seen: &Seen, reference: &HashMap<u64, StateMsg>) -> usize {
     compared
 }
 
-#[test]
-fn a_foxglove_client_sees_the_live_state_and_its_transforms() {
-    let mut server = flexdyn(&["run", "--duration-s", "120", "--listen", ANY_PORT]);
+/// A server (`flexdyn run --duration-s 120` with `extra` options) and a viewer connected to it:
+/// both processes, the server's Zenoh endpoint and the viewer's WebSocket port.
+fn serve_and_view(extra: &[&str]) -> (Guard, Guard, String, u16) {
+    let mut args = vec!["run", "--duration-s", "120", "--listen", ANY_PORT];
+    args.extend_from_slice(extra);
+    let mut server = flexdyn(&args);
     let zenoh = zenoh_endpoint(&mut server.0);
     let mut viewer = flexdyn(&[
         "view",
@@ -299,6 +302,12 @@ fn a_foxglove_client_sees_the_live_state_and_its_transforms() {
         "120",
     ]);
     let wport = ws_port(&mut viewer.0);
+    (server, viewer, zenoh, wport)
+}
+
+#[test]
+fn a_foxglove_client_sees_the_live_state_and_its_transforms() {
+    let (_server, _viewer, zenoh, wport) = serve_and_view(&[]);
     // Our own view of the stream, over Zenoh.
     let session = connecting_session(port_of(&zenoh));
     let states: Arc<Mutex<HashMap<u64, StateMsg>>> = Arc::default();
@@ -539,5 +548,95 @@ fn the_viewer_shows_every_vehicle_it_hears() {
                 assert!(child.starts_with(&format!("{sc}/")), "{sc}: {tf}");
             }
         }
+    }
+}
+
+/// Fault events reach a Foxglove client decoded (issue 21): a real-time server with a gyro
+/// fault on at 1 s + n·1 s for 0.5 s, and a viewer. The viewer advertises
+/// `/flexdyn/sc1/tlm/fault` (JSON, schema `flexdyn.FaultEventMsg`, as recorded), and each
+/// event it relays is one the configuration implies: fault 0, its target and mode, activations
+/// at whole seconds and clearances half a second later, stamped with simulation time.
+#[test]
+fn the_viewer_relays_fault_events_decoded() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("view_faults");
+    std::fs::create_dir_all(&dir).unwrap();
+    let config = dir.join("faults.toml");
+    let scenario = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml"),
+    )
+    .unwrap();
+    std::fs::write(
+        &config,
+        format!(
+            "{scenario}\n[[faults]]\ntarget = \"imus.hub.gyro\"\nmode = \"bias_step\"\n\
+             value = 0.25\nstart_s = 1.0\nduration_s = 0.5\nperiod_s = 1.0\n"
+        ),
+    )
+    .unwrap();
+    let (_server, _viewer, _, wport) = serve_and_view(&["--config", config.to_str().unwrap()]);
+    const FAULT_TOPIC: &str = "/flexdyn/sc1/tlm/fault";
+    let rt = tokio::runtime::Runtime::new().unwrap();
+    let seen = rt.block_on(async {
+        let mut ws = connect(wport, "foxglove.websocket.v1").await;
+        let mut seen = Seen::default();
+        pump_until(&mut ws, &mut seen, Duration::from_secs(30), |s| {
+            s.channels.contains_key(FAULT_TOPIC)
+        })
+        .await;
+        let channel = seen.channels[FAULT_TOPIC].0;
+        // As in `watch`: a refused subscription is sent again, a few times at most.
+        for attempt in 0.. {
+            let msg =
+                json!({"op": "subscribe", "subscriptions": [{"id": 7, "channelId": channel}]});
+            ws.send(Message::Text(msg.to_string().into()))
+                .await
+                .unwrap();
+            pump_until(&mut ws, &mut seen, Duration::from_secs(30), |s| {
+                !s.refused.is_empty() || s.messages.get(&7).is_some_and(|m| m.len() >= 3)
+            })
+            .await;
+            if seen.refused.is_empty() {
+                break;
+            }
+            assert!(attempt < 3, "subscription refused again");
+            seen.refused.clear();
+        }
+        let _ = ws.close(None).await;
+        seen
+    });
+    let (_, schema, encoding) = &seen.channels[FAULT_TOPIC];
+    assert_eq!(
+        (schema.as_str(), encoding.as_str()),
+        ("flexdyn.FaultEventMsg", "json")
+    );
+    let events = &seen.messages[&7];
+    for (t, v) in events {
+        let sim_time_ns = v["header"]["sim_time_ns"].as_u64().unwrap();
+        assert_eq!(*t, sim_time_ns, "message time is simulation time: {v}");
+        assert_eq!(v["fault_index"], 0, "{v}");
+        assert_eq!(v["target"], "imus.hub.gyro", "{v}");
+        assert_eq!(v["mode"], 2, "{v}"); // bias_step
+        assert_eq!(v["source"], "Config", "{v}");
+        assert_eq!(v["params"][0], 0.25, "{v}");
+        let edge_ns = v["edge_ns"].as_u64().unwrap();
+        let phase = if v["active"].as_bool().unwrap() {
+            0
+        } else {
+            500_000_000
+        };
+        assert!(
+            edge_ns >= 1_000_000_000 && edge_ns % 1_000_000_000 == phase,
+            "edge {edge_ns} ns of {v}"
+        );
+        // The boundary it is published at: the edge's frame (100 Hz), at or after the edge.
+        assert_eq!(
+            sim_time_ns,
+            edge_ns.div_ceil(10_000_000) * 10_000_000,
+            "{v}"
+        );
+    }
+    // Activations and clearances alternate.
+    for w in events.windows(2) {
+        assert_ne!(w[0].1["active"], w[1].1["active"], "{:?}", w);
     }
 }
