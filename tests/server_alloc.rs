@@ -230,17 +230,33 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
 
 /// Fleet mode: one physics thread steps every vehicle ([`FleetStepper`]), with one barrier over
 /// every participant of every vehicle. Three vehicles (the wheel scenario twice, the second 100 m
-/// behind the first; the reference spacecraft), sender 9 answering all three: the per-frame
-/// work (offers, step, fill, finite check) allocates nothing.
+/// behind the first, the first with a repeating gyro fault and a wheel fault whose events each
+/// frame carries; the reference spacecraft), sender 9 answering all three: the per-frame work
+/// (offers, step, fill with the fault events, finite check) allocates nothing.
 #[test]
 fn the_fleet_frame_path_does_not_allocate() {
     use flexdyn::server::fleet::stepper::FleetStepper;
     use flexdyn::world::{FleetConfig, World};
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let faulty =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("server_alloc_fleet_a.toml");
+    std::fs::write(
+        &faulty,
+        format!(
+            "{}\n[[faults]]\ntarget = \"imus.hub.gyro\"\nmode = \"noise\"\nsigma = 0.01\n\
+             start_s = 0.3\nduration_s = 0.2\nperiod_s = 0.5\n\n[[faults]]\n\
+             target = \"reaction_wheels.rw1\"\nmode = \"friction_scale\"\nfactor = 3.0\n\
+             start_s = 0.7\nduration_s = 0.4\n",
+            std::fs::read_to_string(root.join("scenarios/wheels_star_tracker.toml")).unwrap()
+        ),
+    )
+    .unwrap();
     let fleet = FleetConfig::from_toml_str_in(
-        r#"
+        &format!(
+            r#"
 [[vehicles]]
 id = "a"
-spacecraft_file = "scenarios/wheels_star_tracker.toml"
+spacecraft_file = "{}"
 participants = [1, 9]
 [[vehicles]]
 id = "b"
@@ -254,7 +270,9 @@ id = "c"
 spacecraft_file = "scenarios/reference.toml"
 participants = [9]
 "#,
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")),
+            faulty.display()
+        ),
+        root,
     )
     .unwrap();
     let settings: Vec<ServerSettings> = fleet
@@ -268,7 +286,7 @@ participants = [9]
         .collect();
     let mut f = FleetStepper::new(World::new(&fleet).unwrap().into_vehicles(), &settings);
     let (cmd_tx, cmd_rx) = sync_channel::<(usize, CommandMsg)>(16);
-    let mut frame_once = |k: u64| {
+    let mut frame_once = |f: &mut FleetStepper, k: u64| {
         for (v, senders) in [(0usize, [1u32, 9]), (1, [2, 9]), (2, [9, 9])] {
             for s in senders.iter().take(if v == 2 { 1 } else { 2 }) {
                 let id = u32::try_from(v + 1).unwrap();
@@ -285,14 +303,25 @@ participants = [9]
         f.step(k);
         f.fill(k + 1).unwrap();
     };
-    frame_once(0);
+    frame_once(&mut f, 0);
+    // Vehicle a's active-fault count at ticks 40, 90, 120, and the events its frames carried.
+    let (mut active_at, mut events) = ([u64::MAX; 3], 0);
     reset_violation_count();
     assert_no_alloc(|| {
         for k in 1..200 {
-            frame_once(k);
+            frame_once(&mut f, k);
+            let a = &f.vehicles[0].frame;
+            events += a.fault_events.len();
+            if let Some(i) = [40, 90, 120].iter().position(|t| *t == k + 1) {
+                active_at[i] = a.faults_active.0;
+            }
         }
     });
     assert_eq!(violation_count(), 0, "the fleet frame path allocated");
+    // The faults came and went meanwhile: the gyro on [0.3, 0.5) s every 0.5 s (4 activations
+    // and 4 clearances by 2 s), the wheel on [0.7, 1.1) s.
+    assert_eq!(active_at, [1, 2, 0], "active faults at ticks 40, 90, 120");
+    assert_eq!(events, 10, "fault events filled into vehicle a's frames");
     // Every vehicle stepped 200 frames.
     for v in &f.vehicles {
         assert_eq!(v.frame.state.header.tick, 200, "{}", v.id);

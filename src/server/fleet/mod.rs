@@ -12,6 +12,11 @@
 //!   formation controller) answers each of them on its key `flexdyn/<id>/cmd/<sender>` and
 //!   declares its liveliness token under each. The no-hang timeout names the vehicle and the
 //!   participant.
+//! - **Faults** are each vehicle's own: its `[[faults]]` (fault indices from 0 in its own file),
+//!   its live fault commands on `flexdyn/<id>/fault` (resolved against that vehicle, installed
+//!   by the physics thread before the next frame is stepped, as in a single-vehicle server
+//!   with `handoff = "queue"`), its fault events on `flexdyn/<id>/tlm/fault` and its active set
+//!   in its StatusMsg.
 //! - **Real time** keeps its rule: the physics thread never waits for the network (telemetry
 //!   goes out with `CongestionControl::Drop`, commands are taken as they have arrived).
 //! - **Settings**: the first vehicle's `[server]` table with the command-line options on top;
@@ -188,6 +193,7 @@ pub async fn run(
     let mut keep = Vec::with_capacity(vehicles.len());
     let mut telemetry = Vec::with_capacity(vehicles.len());
     let mut presences = Vec::new();
+    let mut faults = Vec::with_capacity(vehicles.len());
     for (i, (v, vs)) in vehicles.iter().zip(&vsettings).enumerate() {
         let named = |e: ServerError| ServerError::Vehicle {
             vehicle: v.id.clone(),
@@ -204,6 +210,7 @@ pub async fn run(
         })?;
         let cfg = &fleet.vehicles[i].cfg;
         log_warnings(cfg, None);
+        vs.check_link_faults(cfg).map_err(|e| named(e.into()))?;
         let endpoints = Endpoints::declare(&session, vs, cfg, &topics, &v.sim)
             .await
             .map_err(named)?;
@@ -224,6 +231,24 @@ pub async fn run(
         let commands = intake::declare(&session, &topics, sink, sh.clone(), vs, None)
             .await
             .map_err(named)?;
+        // Live faults: resolved on the Zenoh thread against this vehicle, installed by the
+        // physics thread before the next frame; their boxes freed by its telemetry thread.
+        let (fault_tx, fault_rx) = sync_channel(crate::faults::MAX_LIVE_FAULTS);
+        let (fault_recycle_tx, fault_recycle_rx) = sync_channel(2 * crate::faults::MAX_LIVE_FAULTS);
+        let resolver = crate::faults::live::LiveResolver::new(cfg)
+            .map_err(|source| named(ServerError::Config { file: None, source }))?;
+        let fault_commands = super::fault_cmd::declare(
+            &session,
+            &topics,
+            resolver,
+            super::fault_cmd::FaultSink::Queue(fault_tx),
+            sh.clone(),
+            vs.spacecraft_id,
+            None,
+        )
+        .await
+        .map_err(named)?;
+        faults.push((fault_rx, fault_recycle_tx));
         if mode == Mode::Lockstep {
             let presence = Presence::declare(&session, &topics, sh.clone())
                 .await
@@ -233,8 +258,6 @@ pub async fn run(
         let (recycle_tx, recycle_rx) = sync_channel(settings.command_queue);
         let (full_tx, full_rx) = sync_channel::<Box<Frame>>(1);
         let (free_tx, _free_rx) = sync_channel::<Box<Frame>>(1);
-        // Fleet mode takes no live fault commands: nothing is installed, nothing comes back.
-        let (_fault_recycle_tx, fault_recycle_rx) = sync_channel(1);
         let ctx = TelemetryCtx {
             publisher: None,
             status_pub: endpoints.status_pub,
@@ -252,7 +275,7 @@ pub async fn run(
         shared.push(sh);
         recycle.push(recycle_tx);
         alive.push(full_tx);
-        keep.push((config, commands));
+        keep.push((config, commands, fault_commands));
     }
     drop(cmd_tx);
     let _realtime = super::RealtimeHold::acquire(&settings)?;
@@ -303,6 +326,7 @@ pub async fn run(
         cmd_rx,
         recycle,
         publishers,
+        faults,
         shared: shared.clone(),
         stop: stop.clone(),
         _telemetry_alive: alive,

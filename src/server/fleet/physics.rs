@@ -7,8 +7,9 @@
 //! 2. takes the commands for tick `k`: lockstep waits until every participant of every vehicle
 //!    has answered (one barrier for the whole fleet; a participant listed for several vehicles
 //!    answers each of them on its own key); real time and batch take whatever has arrived;
-//! 3. steps every vehicle's frame and fills its telemetry of tick `k + 1`
-//!    ([`FleetStepper`], allocation-free).
+//! 3. installs each vehicle's live faults that have arrived (from its own fault queue), steps
+//!    every vehicle's frame and fills its telemetry of tick `k + 1` ([`FleetStepper`],
+//!    allocation-free).
 //!
 //! The commands arrive through one bounded channel tagged with the vehicle's index; a consumed
 //! command goes back to that vehicle's telemetry thread to be freed there.
@@ -27,6 +28,7 @@ use super::super::publish::FramePublisher;
 use super::super::settings::ServerSettings;
 use super::super::shared::{Frame, Shared};
 use super::stepper::FleetStepper;
+use crate::faults::ports::{Installed, LiveRequest};
 use crate::transport::unix_now_ns;
 
 /// Longest single blocking wait, so a stop request is seen quickly.
@@ -44,6 +46,9 @@ pub(super) struct FleetPhysics {
     pub recycle: Vec<SyncSender<CommandMsg>>,
     /// Per vehicle: its frame publishers.
     pub publishers: Vec<FramePublisher>,
+    /// Per vehicle: its live fault requests (resolved by its fault callback), and the channel
+    /// their boxes go back on, to its telemetry thread (never blocks).
+    pub faults: Vec<(Receiver<LiveRequest>, SyncSender<Installed>)>,
     /// Per vehicle: its counters (its StatusMsg reads them).
     pub shared: Vec<Arc<Shared>>,
     /// Set to stop at the next frame boundary.
@@ -160,6 +165,23 @@ impl FleetPhysics {
         }
     }
 
+    /// Installs each vehicle's live faults that have arrived, before frame `k → k + 1` is
+    /// stepped; counts the refused ones under the vehicle. Allocation- and lock-free.
+    fn drain_faults(&self, f: &mut FleetStepper, k: u64) {
+        for ((v, (rx, recycle)), sh) in f.vehicles.iter_mut().zip(&self.faults).zip(&self.shared) {
+            while let Ok(req) = rx.try_recv() {
+                let installed = match v.stepper.install_fault(req, k) {
+                    Ok(i) => i,
+                    Err((code, i)) => {
+                        sh.reject_fault_physics(code);
+                        i
+                    }
+                };
+                let _ = recycle.try_send(installed);
+            }
+        }
+    }
+
     /// Hands a consumed command back to be freed off this thread (freed here only if that
     /// vehicle's channel is full; never blocks).
     fn recycle_command(&self, v: usize, cmd: CommandMsg) {
@@ -242,8 +264,10 @@ impl FleetPhysics {
             }
             acc.wait_ns += ns_since(t);
 
-            // 3. Every vehicle's frame, and its telemetry of tick k + 1.
+            // 3. Live faults for boundary k + 1 on, every vehicle's frame, and its telemetry of
+            //    tick k + 1.
             let t = Instant::now();
+            self.drain_faults(f, k);
             f.step(k);
             k += 1;
             f.fill(k)?;

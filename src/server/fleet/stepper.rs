@@ -38,10 +38,11 @@ impl FleetStepper {
             .into_iter()
             .zip(settings)
             .map(|(v, s)| {
-                let frame = Box::new(Frame::for_state(
-                    &v.sim.blank_state(),
-                    v.sim.sensors().len(),
-                ));
+                // Room for the fault events a frame can carry (its configured and live slots).
+                let frame = Box::new(
+                    Frame::for_state(&v.sim.blank_state(), v.sim.sensors().len())
+                        .with_fault_events(v.sim.faults().event_capacity()),
+                );
                 FleetVehicle {
                     id: v.id,
                     stepper: Stepper::new(v.sim, s),
