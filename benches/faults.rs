@@ -70,10 +70,14 @@ fn main() {
          (least of 5 interleaved medians of 15 x 200 frames):"
     );
     println!(
-        "{:<16} {:>14} {:>12}",
-        "faults", "median ns/step", "added ns"
+        "{:<16} {:>14} {:>12} {:>18}",
+        "faults", "median ns/step", "added ns", "ratio to no faults"
     );
     for ((name, _), ns) in rows.iter().zip(best) {
-        println!("{name:<16} {ns:>14.1} {:>12.1}", ns - best[0]);
+        println!(
+            "{name:<16} {ns:>14.1} {:>12.1} {:>18.3}",
+            ns - best[0],
+            ns / best[0]
+        );
     }
 }
