@@ -286,7 +286,7 @@ participants = [9]
         .collect();
     let mut f = FleetStepper::new(World::new(&fleet).unwrap().into_vehicles(), &settings);
     let (cmd_tx, cmd_rx) = sync_channel::<(usize, CommandMsg)>(16);
-    let mut frame_once = |f: &mut FleetStepper, k: u64| {
+    let frame_once = |f: &mut FleetStepper, k: u64| {
         for (v, senders) in [(0usize, [1u32, 9]), (1, [2, 9]), (2, [9, 9])] {
             for s in senders.iter().take(if v == 2 { 1 } else { 2 }) {
                 let id = u32::try_from(v + 1).unwrap();
