@@ -114,16 +114,24 @@ fn stepping_with_offloaded_updates_allocates_nothing() {
     sim.offload_environment().unwrap();
     sim.step();
     let before = allocations();
-    for _ in 0..20 {
+    for update in 0..20 {
+        // Wait for the worker's answer to the request posted at the last update, so the answer
+        // path is the one counted (a fixed sleep is not enough on a loaded machine).
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+        while !sim.environment().unwrap().prefetch_answer_ready() {
+            assert!(
+                std::time::Instant::now() < deadline,
+                "the worker did not answer the request before update {update} within 10 s"
+            );
+            std::thread::sleep(std::time::Duration::from_micros(200));
+        }
+        // 100 steps of 1 ms: exactly one 10 Hz update (at the last of them, t = 100 ms · (update + 1)).
         sim.step_n(100);
-        // Give the worker time to answer, so the answer path is the one counted.
-        std::thread::sleep(std::time::Duration::from_millis(1));
     }
     let after = allocations();
     assert_eq!(after - before, 0, "allocations while stepping, offloaded");
+    // Every one of the 20 updates took the worker's answer (the first update, in `sim.step()`
+    // above, was evaluated at the actual state: it has no prediction).
     let taken = sim.environment().unwrap().prefetched_samples();
-    assert!(
-        taken >= 10,
-        "only {taken} of 20 updates came from the worker"
-    );
+    assert_eq!(taken, 20, "{taken} of 20 updates came from the worker");
 }

@@ -287,10 +287,10 @@ fn environment_message_at_its_rate_agrees_with_independent_models() {
         let drag = direct(&mut AeroDrag {
             facets: facets.clone(),
         });
-        let srp = direct(&mut SolarPressure {
-            facets: facets.clone(),
-            irradiance_1au_w_m2: SOLAR_IRRADIANCE_1AU_W_M2,
-        });
+        let srp = direct(&mut SolarPressure::new(
+            facets.clone(),
+            SOLAR_IRRADIANCE_1AU_W_M2,
+        ));
         close(
             v(m.drag.torque_b_nm),
             drag.torque_b_nm,

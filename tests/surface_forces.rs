@@ -238,7 +238,11 @@ fn drag_on_one_plate_at_known_incidence() {
         (force_n - expected_n).norm() < 1e-12 * magnitude,
         "{force_n}"
     );
-    assert!((w.torque_b_nm - r_cp.cross(&w.force_b_newton)).norm() < 1e-20);
+    // τ = r_cp × F up to round-off: a few ulps of |r_cp| |F| (the model sums C_D A (n̂·v) r_cp
+    // and crosses with v, a different order of the same products).
+    let moment_nm = r_cp.norm() * w.force_b_newton.norm();
+    assert!((w.torque_b_nm - r_cp.cross(&w.force_b_newton)).norm() < 1e-15 * moment_nm);
+    assert!(moment_nm > 0.0);
     // Turned past 90°, the plate faces away from the flow: no force.
     let away = wrench_of(
         &mut drag,
@@ -264,10 +268,10 @@ fn solar_pressure_on_one_plate_at_known_incidence_and_in_shadow() {
     // cos θ = cos 45°. Half the disc is visible (penumbra).
     let angle = 45_f64.to_radians();
     let dcm_bn = dcm_bn_about_z(angle);
-    let mut srp = SolarPressure {
-        facets: FacetModel::new(vec![plate(Vector3::x(), Vector3::zeros(), 2.0)]).unwrap(),
-        irradiance_1au_w_m2: SOLAR_IRRADIANCE_1AU_W_M2,
-    };
+    let mut srp = SolarPressure::new(
+        FacetModel::new(vec![plate(Vector3::x(), Vector3::zeros(), 2.0)]).unwrap(),
+        SOLAR_IRRADIANCE_1AU_W_M2,
+    );
     let env = EnvironmentSample {
         r_sun_b_n_m: Vector3::new(AU_M, 0.0, 0.0),
         shadow_factor: 0.5,
@@ -293,6 +297,17 @@ fn solar_pressure_on_one_plate_at_known_incidence_and_in_shadow() {
     };
     let w_far = wrench_of(&mut srp, &stage(dcm_bn, Vector3::zeros()), &far);
     assert!((w_far.force_b_newton * 4.0 - w.force_b_newton).norm() < 1e-12 * expected_n.norm());
+    // The effector holds P and ŝ per environment sample; a changed irradiance (a campaign's
+    // dispersed value set on a built effector) must not reuse them: twice Φ, twice the force.
+    srp.irradiance_1au_w_m2 *= 2.0;
+    let w_bright = wrench_of(&mut srp, &stage(dcm_bn, Vector3::zeros()), &env);
+    assert!(
+        (w_bright.force_b_newton - w.force_b_newton * 2.0).norm() < 1e-12 * expected_n.norm(),
+        "{} vs 2 × {}",
+        w_bright.force_b_newton,
+        w.force_b_newton
+    );
+    srp.irradiance_1au_w_m2 /= 2.0;
     // Umbra, and no Sun configured: nothing.
     for dark in [
         EnvironmentSample {

@@ -240,10 +240,10 @@ pub(super) fn add_dynamic_effectors(
         sc.add_dynamic_effector(Box::new(AeroDrag { facets: facets() }));
     }
     if env.solar_pressure {
-        sc.add_dynamic_effector(Box::new(SolarPressure {
-            facets: facets(),
-            irradiance_1au_w_m2: SOLAR_IRRADIANCE_1AU_W_M2,
-        }));
+        sc.add_dynamic_effector(Box::new(SolarPressure::new(
+            facets(),
+            SOLAR_IRRADIANCE_1AU_W_M2,
+        )));
     }
     if let Some(m_b_am2) = env.residual_dipole_m_b_am2 {
         sc.add_dynamic_effector(Box::new(ResidualDipole { m_b_am2 }));

@@ -291,27 +291,26 @@ impl FacetModel {
     ///
     /// Every facet's drag is along −v̂, so with q = ½ ρ |v|² and w_k = C_D,k A_k cos θ_k over the
     /// facets facing the flow, the sums factor (the same forces, one cross product in all):
-    /// F = −q (Σ w_k) v̂ and τ = Σ r_k × F_k = −q (Σ w_k r_k) × v̂.
+    /// F = −q (Σ w_k) v̂ and τ = Σ r_k × F_k = −q (Σ w_k r_k) × v̂. With cos θ_k = n̂_k·v / |v|
+    /// the speed cancels: q w_k v̂ = ½ ρ C_D,k A_k (n̂_k·v) v, so
+    /// F = −½ ρ (Σ u_k) v and τ = −½ ρ (Σ u_k r_k) × v with u_k = C_D,k A_k (n̂_k·v) over the
+    /// facets with n̂_k·v > 0: no square root and no division at a stage. At rest every n̂_k·v
+    /// is 0 and the wrench is zero.
     pub fn drag_wrench_b(&self, v_rel_b_m_s: &Vector3<f64>, density_kg_m3: f64) -> FacetWrench {
-        let speed_m_s = v_rel_b_m_s.norm();
-        if speed_m_s == 0.0 {
-            return FacetWrench::default();
-        }
-        let v_hat = v_rel_b_m_s * speed_m_s.recip();
-        let mut w_sum_m2 = 0.0;
-        let mut w_r_sum_m3 = Vector3::zeros();
+        let mut u_sum_m3_s = 0.0;
+        let mut u_r_sum_m4_s = Vector3::zeros();
         for p in &self.prepared {
-            let cos_theta = p.normal_b.dot(&v_hat);
-            if cos_theta > 0.0 {
-                let w_m2 = p.cd_area_m2 * cos_theta;
-                w_sum_m2 += w_m2;
-                w_r_sum_m3 += p.r_cp_b_m * w_m2;
+            let n_dot_v_m_s = p.normal_b.dot(v_rel_b_m_s);
+            if n_dot_v_m_s > 0.0 {
+                let u_m3_s = p.cd_area_m2 * n_dot_v_m_s;
+                u_sum_m3_s += u_m3_s;
+                u_r_sum_m4_s += p.r_cp_b_m * u_m3_s;
             }
         }
-        let q_n_m2 = 0.5 * density_kg_m3 * speed_m_s * speed_m_s;
+        let minus_half_rho_kg_m3 = -0.5 * density_kg_m3;
         FacetWrench {
-            force_b_newton: v_hat * (-q_n_m2 * w_sum_m2),
-            torque_b_nm: w_r_sum_m3.cross(&v_hat) * -q_n_m2,
+            force_b_newton: v_rel_b_m_s * (minus_half_rho_kg_m3 * u_sum_m3_s),
+            torque_b_nm: u_r_sum_m4_s.cross(v_rel_b_m_s) * minus_half_rho_kg_m3,
         }
     }
 
@@ -329,13 +328,19 @@ impl FacetModel {
         if norm == 0.0 {
             return FacetWrench::default();
         }
-        let sun_hat_b = sun_dir_b * norm.recip();
+        self.srp_wrench_unit_b(&(sun_dir_b * norm.recip()), pressure_n_m2)
+    }
+
+    /// [`Self::srp_wrench_b`] for a direction to the Sun `sun_hat_b` already of unit length (the
+    /// stage path: the solar-pressure effector normalises the held Sun direction once per
+    /// environment sample, in N, and only rotates it at a stage).
+    pub fn srp_wrench_unit_b(&self, sun_hat_b: &Vector3<f64>, pressure_n_m2: f64) -> FacetWrench {
         let mut a_sum_m2 = 0.0;
         let mut a_r_sum_m3 = Vector3::zeros();
         let mut b_n_sum_m2 = Vector3::zeros();
         let mut b_rn_sum_m3 = Vector3::zeros();
         for p in &self.prepared {
-            let cos_theta = p.normal_b.dot(&sun_hat_b);
+            let cos_theta = p.normal_b.dot(sun_hat_b);
             if cos_theta > 0.0 {
                 let a_m2 = p.area_along_sun_m2 * cos_theta;
                 let b_m2 = (p.area_specular_m2 * cos_theta + p.area_diffuse_m2) * cos_theta;
@@ -347,7 +352,7 @@ impl FacetModel {
         }
         FacetWrench {
             force_b_newton: (sun_hat_b * a_sum_m2 + b_n_sum_m2) * -pressure_n_m2,
-            torque_b_nm: (a_r_sum_m3.cross(&sun_hat_b) + b_rn_sum_m3) * -pressure_n_m2,
+            torque_b_nm: (a_r_sum_m3.cross(sun_hat_b) + b_rn_sum_m3) * -pressure_n_m2,
         }
     }
 }

@@ -295,6 +295,13 @@ impl EnvironmentModel {
         self.prefetch.as_ref().map_or(0, Prefetcher::answers_taken)
     }
 
+    /// Whether the worker has answered the request posted at the last update, so the next
+    /// update will take its answer (false without a worker). Tests and benchmarks use it to wait
+    /// for the worker deterministically; the stepping path never waits.
+    pub fn prefetch_answer_ready(&self) -> bool {
+        self.prefetch.as_ref().is_some_and(Prefetcher::answer_ready)
+    }
+
     /// The epoch.
     pub fn epoch(&self) -> &SimEpoch {
         &self.models.epoch

@@ -317,6 +317,12 @@ impl Prefetcher {
         a
     }
 
+    /// Whether an answer is waiting to be taken (it may still be stale: [`Self::answer`]
+    /// checks it against the request).
+    pub fn answer_ready(&self) -> bool {
+        self.slot.state.load(Ordering::Acquire) == DONE
+    }
+
     /// How many answers [`Self::answer`] has returned (the rest were evaluated by the caller).
     pub fn answers_taken(&self) -> u64 {
         self.slot.taken.load(Ordering::Relaxed)

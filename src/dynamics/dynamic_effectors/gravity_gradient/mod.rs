@@ -65,9 +65,10 @@ fn force_and_torque_c(
     i_r: &Vector3<f64>,
     trace: f64,
 ) -> (Vector3<f64>, Vector3<f64>) {
-    let (r2, r5) = r2_r5(r_cn_b_m);
-    let k = 1.5 * mu_m3_s2 / r5;
-    let radial = 5.0 * r_cn_b_m.dot(i_r) / r2 - trace;
+    // One division and one square root: 1/R² and 1/R⁵ = (1/R²)² √(1/R²).
+    let inv_r2 = r_cn_b_m.norm_squared().recip();
+    let k = 1.5 * mu_m3_s2 * (inv_r2 * inv_r2 * inv_r2.sqrt());
+    let radial = 5.0 * r_cn_b_m.dot(i_r) * inv_r2 - trace;
     (
         (r_cn_b_m * radial - i_r * 2.0) * k,
         r_cn_b_m.cross(i_r) * (2.0 * k),
