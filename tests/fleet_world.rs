@@ -15,36 +15,48 @@ const LEO_PAIR: &str = "[[vehicles]]\nid = \"chief\"\nspacecraft_file = \"leo_en
     \"leo_environment.toml\"\nparticipants = [2]\n[vehicles.relative]\nchief = \"chief\"\n\
     hill_position_m = [-20.0, -100.0, 0.0]\nhill_velocity_m_s = [0.0, 0.0, 0.01]\n";
 
-#[test]
-fn each_vehicle_moves_as_it_would_alone() {
+/// The LEO pair flown `frames` 100 Hz frames (1 ms steps) as a [`World`], each vehicle's
+/// environment on its own prefetch worker if `offload` (the server's way), beside each vehicle
+/// flown alone; asserts that every vehicle's state and environment sample are the ones it has
+/// alone, bit for bit, and returns the world.
+fn fly_beside_alone(offload: bool, frames: usize) -> World {
     let fleet = FleetConfig::from_toml_str_in(LEO_PAIR, Path::new(SCENARIOS)).unwrap();
     let mut world = World::new(&fleet).unwrap();
+    if offload {
+        for v in world.vehicles_mut() {
+            v.sim.offload_environment().unwrap();
+        }
+    }
     let mut alone: Vec<Simulation> = fleet
         .vehicles
         .iter()
         .map(|v| Simulation::new(&v.cfg).unwrap())
         .collect();
-    // 1.5 s of 100 Hz frames (1 ms steps).
-    for _ in 0..150 {
+    for _ in 0..frames {
         world.step_frame();
         for sim in &mut alone {
             sim.step_frame();
         }
     }
     for (v, sim) in world.vehicles().iter().zip(&alone) {
-        assert_eq!(v.sim.t_sim_ns(), 1_500_000_000);
+        assert_eq!(v.sim.t_sim_ns(), frames as u64 * 10_000_000);
+        let (in_world, flown_alone) = (v.sim.spacecraft(), sim.spacecraft());
+        assert_eq!(in_world.state(), flown_alone.state(), "{}", v.id);
         assert_eq!(
-            v.sim.spacecraft().state(),
-            sim.spacecraft().state(),
+            in_world.environment(),
+            flown_alone.environment(),
             "{}",
             v.id
         );
-        assert_eq!(
-            v.sim.spacecraft().environment(),
-            sim.spacecraft().environment(),
-            "{}",
-            v.id
-        );
+    }
+    world
+}
+
+#[test]
+fn each_vehicle_moves_as_it_would_alone() {
+    // 1.5 s.
+    let world = fly_beside_alone(false, 150);
+    for v in world.vehicles() {
         // The sample is a real one (the Sun, B and the density are on), not a blank.
         let env = v.sim.spacecraft().environment();
         assert_eq!(env.t_sim_ns, 1_400_000_000);
@@ -53,6 +65,24 @@ fn each_vehicle_moves_as_it_would_alone() {
     // The two vehicles differ (the deputy is where the fleet file put it, not on the chief).
     let rel = world.relative_state(0, 1).unwrap();
     assert!((rel.range_m - 102.0).abs() < 1.0, "{rel:?}");
+    // The Earth's orientation, the Sun and the Moon were evaluated once per update instant for
+    // both: the 14 updates after t = 0 (at 100 ms … 1400 ms; the one at t = 0 is made as each
+    // vehicle is built, before the world shares) each missed once (the chief, first in fleet
+    // order) and hit once (the deputy). The states above are still each vehicle's alone.
+    assert_eq!(world.common_environment_counts(), Some((14, 14)));
+}
+
+/// The same with every vehicle's environment on its own prefetch worker (the server's way):
+/// the workers race for the shared part, and the states stay each vehicle's alone, bit for bit.
+#[test]
+fn sharing_the_environment_between_workers_changes_no_bit() {
+    // 3 s.
+    let world = fly_beside_alone(true, 300);
+    // 29 update instants (100 ms … 2900 ms), each asked for by two vehicles at least once (by a
+    // worker, or by the physics thread when a worker had not answered yet).
+    let (hits, misses) = world.common_environment_counts().unwrap();
+    assert!(hits + misses >= 58, "{hits} hits, {misses} misses");
+    assert!(misses >= 29, "{hits} hits, {misses} misses");
 }
 
 /// The error of `text` (spacecraft files relative to the scenarios folder).

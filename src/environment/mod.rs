@@ -30,6 +30,8 @@
 //!   nutation, sidereal time, optional polar motion) with its error bound, and TEME → N.
 //! - [`orbit`]: initial orbits as alternatives to r/v — classical Keplerian elements, and TLE /
 //!   CCSDS OMM mean elements propagated to the epoch with SGP4.
+//! - [`common`]: the position-independent part of an update (the Earth's orientation, the Sun
+//!   and the Moon), evaluated once per instant for every vehicle of a world.
 //! - [`prefetch`]: the worker thread that evaluates the next update ahead of time, so the models
 //!   stay off the physics thread, with bit-identical samples.
 //! - [`sample`]: the [`EnvironmentSample`] the dynamic effectors and sensors read, held between
@@ -46,6 +48,7 @@
 //!   forces and torques about B.
 
 pub mod atmosphere;
+pub mod common;
 pub mod earth_rotation;
 pub mod ephemeris;
 pub mod epoch;

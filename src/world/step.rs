@@ -6,10 +6,15 @@
 //! state: each vehicle's stream is what it would be alone, bit for bit.
 //!
 //! The environment is evaluated per vehicle, by each vehicle's own models (on its prefetch
-//! worker where the server offloads them). The epoch, the Earth's orientation, the Sun and the
-//! Moon are common to all vehicles and could be evaluated once for the world; that is not done
-//! yet (each update costs ~15 µs per vehicle at `[environment] update_hz`, not per step).
+//! worker where the server offloads them), for its own position. What does not depend on the
+//! position, the Earth's orientation, the Sun and the Moon at an update instant (the fleet file
+//! gives every vehicle the same epoch), is evaluated once for the world: the vehicles' models
+//! share one [`CommonCache`], and the first vehicle to reach an instant fills it for the others
+//! ([`crate::environment::common`]; the samples are the same bits either way).
 
+use std::sync::Arc;
+
+use crate::environment::common::CommonCache;
 use crate::sim::Simulation;
 
 use super::fleet::{FleetConfig, FleetError};
@@ -36,6 +41,8 @@ pub struct World {
     pairs: Vec<(usize, usize)>,
     /// RK4 steps per frame (the same for every vehicle: the fleet file checks it).
     steps_per_frame: u64,
+    /// The environment's shared part, when two or more vehicles have an environment.
+    common: Option<Arc<CommonCache>>,
 }
 
 impl World {
@@ -60,11 +67,29 @@ impl World {
             });
         }
         let steps_per_frame = vehicles.first().map_or(0, |v| v.sim.steps_per_frame());
+        let models: Vec<_> = vehicles
+            .iter()
+            .filter_map(|v| v.sim.environment())
+            .collect();
+        let common = (models.len() > 1).then(|| {
+            let cache = Arc::new(CommonCache::new());
+            for m in &models {
+                m.share_common(cache.clone());
+            }
+            cache
+        });
         Ok(Self {
             vehicles,
             pairs,
             steps_per_frame,
+            common,
         })
+    }
+
+    /// (hits, misses) of the shared environment part ([`CommonCache::counts`]); `None` when
+    /// fewer than two vehicles have an environment.
+    pub fn common_environment_counts(&self) -> Option<(u64, u64)> {
+        self.common.as_ref().map(|c| c.counts())
     }
 
     /// The vehicles, in fleet order.

@@ -21,11 +21,12 @@
 
 pub mod schema;
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::Vector3;
 
 use super::atmosphere::{exponential_density_kg_m3, Nrlmsise00Model, SpaceWeather};
+use super::common::{Common, CommonCache, Parts};
 use super::earth_rotation::EarthRotation;
 use super::ephemeris::{moon_position_n_m, sun_position_n_m};
 use super::epoch::SimEpoch;
@@ -144,6 +145,9 @@ struct Models {
     sun: bool,
     moon: bool,
     shadow: Option<ShadowModel>,
+    /// The world's memo of the position-independent parts, when the vehicle is one of several
+    /// ([`EnvironmentModel::share_common`]); set once, before any update.
+    common: OnceLock<Arc<CommonCache>>,
 }
 
 /// The environment models of a run, built once; fills samples without allocating.
@@ -251,6 +255,7 @@ impl EnvironmentModel {
                 sun: settings.sun,
                 moon: settings.moon,
                 shadow: settings.shadow,
+                common: OnceLock::new(),
             }),
             update_ns: settings.update_ns.max(1),
             step_ns: 1,
@@ -282,6 +287,14 @@ impl EnvironmentModel {
         }
         self.prefetch = Some(prefetch);
         Ok(())
+    }
+
+    /// Shares `cache` with the other vehicles of a world: the Earth's orientation, the Sun and
+    /// the Moon at an update instant are evaluated by the first vehicle that needs them and read
+    /// by the others ([`super::common`]; the samples are the same bits either way). Returns
+    /// false, changing nothing, if a cache was already shared.
+    pub fn share_common(&self, cache: Arc<CommonCache>) -> bool {
+        self.models.common.set(cache).is_ok()
     }
 
     /// Whether a worker evaluates the updates ([`Self::offload`]).
@@ -427,68 +440,87 @@ impl Models {
         _v_bn_n_m_s: &Vector3<f64>,
         out: &mut EnvironmentSample,
     ) {
-        let times = self.epoch.times(t_sim_ns);
         *out = EnvironmentSample::NONE;
         out.t_sim_ns = t_sim_ns;
         // The Earth's orientation (precession-nutation and sidereal time, ~1.5 µs) only for the
         // models that work in the Earth-fixed frame.
-        if matches!(self.field, Field::Off) && matches!(self.air, Air::Off) {
-            self.fill_sun_moon(&times, r_bn_n_m, out);
-            return;
-        }
-        let earth = self.rotation.at(&times);
-        let r_e_m = earth.r_e(r_bn_n_m);
-        let b_e_t = match &self.field {
-            Field::Off => None,
-            Field::Igrf(igrf) => {
-                let year = self.epoch.utc_calendar(t_sim_ns).decimal_year();
-                Some(igrf.field_ecef_t(year, &r_e_m))
-            }
-            Field::Dipole(d) => Some(d.field_ecef_t(&r_e_m)),
+        let parts = Parts {
+            earth: !(matches!(self.field, Field::Off) && matches!(self.air, Air::Off)),
+            sun: self.sun,
+            moon: self.moon,
         };
-        if let Some(b_e_t) = b_e_t {
-            out.b_field_n_t = earth.dcm_en.tr_mul(&b_e_t);
-        }
-        let density_kg_m3 = match &self.air {
-            Air::Off => None,
-            Air::Exponential => Some(exponential_density_kg_m3(
-                geodetic_from_ecef(&r_e_m).height_m,
-            )),
-            Air::Nrlmsise00(m) => {
-                let cal = self.epoch.utc_calendar(t_sim_ns);
-                let ut_s = f64::from(cal.hour) * 3600.0
-                    + f64::from(cal.minute) * 60.0
-                    + f64::from(cal.second.min(59))
-                    + f64::from(cal.nanosecond) * 1e-9;
-                Some(m.drag_density_kg_m3(day_of_year(cal.year, cal.month, cal.day), ut_s, &r_e_m))
+        let common = match self.common.get() {
+            Some(cache) => {
+                cache.get_or_evaluate(t_sim_ns, parts, || self.common_at(t_sim_ns, parts))
             }
+            None => self.common_at(t_sim_ns, parts),
         };
-        if let Some(rho) = density_kg_m3 {
-            out.density_kg_m3 = rho;
-            // Co-rotating atmosphere (Vallado §8.6.2): v_wind = ω⊕ × r, N components.
-            out.wind_n_m_s = earth.omega_en_n_rad_s.cross(r_bn_n_m);
+        if parts.earth {
+            let earth = &common.earth;
+            let r_e_m = earth.r_e(r_bn_n_m);
+            let b_e_t = match &self.field {
+                Field::Off => None,
+                Field::Igrf(igrf) => {
+                    let year = self.epoch.utc_calendar(t_sim_ns).decimal_year();
+                    Some(igrf.field_ecef_t(year, &r_e_m))
+                }
+                Field::Dipole(d) => Some(d.field_ecef_t(&r_e_m)),
+            };
+            if let Some(b_e_t) = b_e_t {
+                out.b_field_n_t = earth.dcm_en.tr_mul(&b_e_t);
+            }
+            let density_kg_m3 = match &self.air {
+                Air::Off => None,
+                Air::Exponential => Some(exponential_density_kg_m3(
+                    geodetic_from_ecef(&r_e_m).height_m,
+                )),
+                Air::Nrlmsise00(m) => {
+                    let cal = self.epoch.utc_calendar(t_sim_ns);
+                    let ut_s = f64::from(cal.hour) * 3600.0
+                        + f64::from(cal.minute) * 60.0
+                        + f64::from(cal.second.min(59))
+                        + f64::from(cal.nanosecond) * 1e-9;
+                    Some(m.drag_density_kg_m3(
+                        day_of_year(cal.year, cal.month, cal.day),
+                        ut_s,
+                        &r_e_m,
+                    ))
+                }
+            };
+            if let Some(rho) = density_kg_m3 {
+                out.density_kg_m3 = rho;
+                // Co-rotating atmosphere (Vallado §8.6.2): v_wind = ω⊕ × r, N components.
+                out.wind_n_m_s = earth.omega_en_n_rad_s.cross(r_bn_n_m);
+            }
         }
-        self.fill_sun_moon(&times, r_bn_n_m, out);
-    }
-
-    /// The Sun and Moon positions relative to B and the shadow factor, into `out`.
-    fn fill_sun_moon(
-        &self,
-        times: &super::epoch::EpochTimes,
-        r_bn_n_m: &Vector3<f64>,
-        out: &mut EnvironmentSample,
-    ) {
-        let t_tt_jc = times.tt_centuries_j2000();
+        // The Sun and Moon positions relative to B and the shadow factor.
         if self.sun {
-            let r_sun_n_m = sun_position_n_m(t_tt_jc);
-            out.r_sun_b_n_m = r_sun_n_m - r_bn_n_m;
+            out.r_sun_b_n_m = common.r_sun_n_m - r_bn_n_m;
             if let Some(model) = self.shadow {
-                out.shadow_factor = shadow_factor(model, r_bn_n_m, &r_sun_n_m);
+                out.shadow_factor = shadow_factor(model, r_bn_n_m, &common.r_sun_n_m);
             }
         }
         if self.moon {
-            out.r_moon_b_n_m = moon_position_n_m(t_tt_jc) - r_bn_n_m;
+            out.r_moon_b_n_m = common.r_moon_n_m - r_bn_n_m;
         }
+    }
+
+    /// The position-independent `parts` at `t_sim_ns`: what a world's vehicles share
+    /// ([`super::common`]).
+    fn common_at(&self, t_sim_ns: u64, parts: Parts) -> Common {
+        let times = self.epoch.times(t_sim_ns);
+        let t_tt_jc = times.tt_centuries_j2000();
+        let mut c = Common::zero();
+        if parts.earth {
+            c.earth = self.rotation.at(&times);
+        }
+        if parts.sun {
+            c.r_sun_n_m = sun_position_n_m(t_tt_jc);
+        }
+        if parts.moon {
+            c.r_moon_n_m = moon_position_n_m(t_tt_jc);
+        }
+        c
     }
 }
 
