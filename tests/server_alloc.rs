@@ -231,7 +231,7 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
 /// Fleet mode: one physics thread steps every vehicle ([`FleetStepper`]), with one barrier over
 /// every participant of every vehicle. Three vehicles (the wheel scenario twice, the second 100 m
 /// behind the first; the reference spacecraft), sender 9 answering all three: the per-frame
-/// work (offers, step, fill, finite check) allocates nothing.
+/// work (offers, step, fill with the pair's relative state, finite check) allocates nothing.
 #[test]
 fn the_fleet_frame_path_does_not_allocate() {
     use flexdyn::server::fleet::stepper::FleetStepper;
@@ -266,7 +266,11 @@ participants = [9]
             ..ServerSettings::default()
         })
         .collect();
-    let mut f = FleetStepper::new(World::new(&fleet).unwrap().into_vehicles(), &settings);
+    // With the (a, b) pair's relative state, filled with the frames.
+    let world = World::new(&fleet).unwrap();
+    let pairs = world.relative_pairs().to_vec();
+    assert_eq!(pairs, [(0, 1)]);
+    let mut f = FleetStepper::new(world.into_vehicles(), &settings).with_relative_pairs(&pairs);
     let (cmd_tx, cmd_rx) = sync_channel::<(usize, CommandMsg)>(16);
     let mut frame_once = |k: u64| {
         for (v, senders) in [(0usize, [1u32, 9]), (1, [2, 9]), (2, [9, 9])] {
@@ -297,4 +301,8 @@ participants = [9]
     for v in &f.vehicles {
         assert_eq!(v.frame.state.header.tick, 200, "{}", v.id);
     }
+    // And the pair's relative state is that of tick 200 (b started 100 m behind a).
+    let rel = &f.pairs[0].msg;
+    assert_eq!((rel.header.tick, rel.chief_spacecraft_id), (200, 1));
+    assert!(rel.range_m > 50.0 && rel.range_m < 150.0, "{rel:?}");
 }

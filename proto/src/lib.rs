@@ -143,6 +143,11 @@ pub use messages::{
     FaultAction, FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget, AT_NEXT_TICK,
     FAULT_TARGET_LEN, MAX_STATUS_FAULTS,
 };
+// A fleet deputy's state relative to its chief (issue 22, protocol 9).
+pub use codec::decode_relative_state;
+pub use keys::{relative_state_key, RELATIVE_STATE_PREFIX};
+pub use layout::RELATIVE_STATE_LEN;
+pub use messages::RelativeStateMsg;
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
 /// Version 3: generic effector states in [`StateMsg`], [`CommandKind::Actuators`],
@@ -158,4 +163,6 @@ pub use messages::{
 /// Version 8: fault injection of issue 21 ([`FaultEventMsg`] on `tlm/fault`, the live
 /// [`FaultCommandMsg`] on `flexdyn/<sc-id>/fault`, [`RejectCounters::fault_refused`] and the
 /// active faults in StatusMsg, which grows to 235 bytes).
-pub const PROTOCOL_VERSION: u16 = 8;
+/// Version 9: a fleet deputy's state relative to its chief (issue 22, [`RelativeStateMsg`] on
+/// `flexdyn/<deputy>/tlm/rel/<chief>`).
+pub const PROTOCOL_VERSION: u16 = 9;

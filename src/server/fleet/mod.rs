@@ -20,6 +20,7 @@
 //!   operator's pause/resume (`flexdyn/<id>/operator`), real-time lateness in StatusMsg.
 
 mod physics;
+mod relative;
 pub mod stepper;
 
 use std::future::Future;
@@ -160,6 +161,7 @@ pub async fn run(
         .map(|v| vehicle_settings(&settings, v))
         .collect();
     let world = World::new(&fleet)?;
+    let pairs = world.relative_pairs().to_vec();
     let frame_ns = world.vehicles().first().map_or(1, |v| v.sim.frame_ns());
     let total_frames = settings.duration_frames(frame_ns)?;
     let mut vehicles = world.into_vehicles();
@@ -255,6 +257,20 @@ pub async fn run(
         keep.push((config, commands));
     }
     drop(cmd_tx);
+    // Each deputy's relative state, on its own key (`flexdyn/<deputy>/tlm/rel/<chief>`).
+    let mut relative = Vec::with_capacity(pairs.len());
+    for &(c, d) in &pairs {
+        let deputy = &vehicles[d].id;
+        let topics = Topics::new(deputy)
+            .map_err(|e| ServerError::Internal(format!("vehicle id {deputy:?}: {e}")))?;
+        let rp = relative::RelativePublisher::declare(&session, mode, &topics, &vehicles[c].id)
+            .await
+            .map_err(|e| ServerError::Vehicle {
+                vehicle: deputy.clone(),
+                source: Box::new(e),
+            })?;
+        relative.push(rp);
+    }
     let _realtime = super::RealtimeHold::acquire(&settings)?;
 
     // Lockstep: tick 0 waits for every participant of every vehicle.
@@ -296,13 +312,14 @@ pub async fn run(
     }
 
     let ids: Vec<String> = vehicles.iter().map(|v| v.id.clone()).collect();
-    let stepper = FleetStepper::new(vehicles, &vsettings);
+    let stepper = FleetStepper::new(vehicles, &vsettings).with_relative_pairs(&pairs);
     let physics = FleetPhysics {
         settings: settings.clone(),
         total_frames,
         cmd_rx,
         recycle,
         publishers,
+        relative,
         shared: shared.clone(),
         stop: stop.clone(),
         _telemetry_alive: alive,

@@ -26,6 +26,7 @@ use super::super::physics::{count_offer, Ending, PhysicsReport};
 use super::super::publish::FramePublisher;
 use super::super::settings::ServerSettings;
 use super::super::shared::{Frame, Shared};
+use super::relative::RelativePublisher;
 use super::stepper::FleetStepper;
 use crate::transport::unix_now_ns;
 
@@ -44,6 +45,9 @@ pub(super) struct FleetPhysics {
     pub recycle: Vec<SyncSender<CommandMsg>>,
     /// Per vehicle: its frame publishers.
     pub publishers: Vec<FramePublisher>,
+    /// Per (chief, deputy) pair of the stepper ([`FleetStepper::pairs`], same order): its
+    /// relative-state publisher.
+    pub relative: Vec<RelativePublisher>,
     /// Per vehicle: its counters (its StatusMsg reads them).
     pub shared: Vec<Arc<Shared>>,
     /// Set to stop at the next frame boundary.
@@ -211,15 +215,22 @@ impl FleetPhysics {
             }
             let stamp = unix_now_ns();
             let t = Instant::now();
-            for ((v, p), sh) in f
+            for (i, ((v, p), sh)) in f
                 .vehicles
                 .iter_mut()
                 .zip(&mut self.publishers)
                 .zip(&self.shared)
+                .enumerate()
             {
                 v.frame.boundary_unix_ns = stamp;
                 v.frame.lateness_ns = lateness_ns;
                 p.publish(&v.frame, sh, None);
+                // Its relative states, after its frame.
+                for (pair, rp) in f.pairs.iter().zip(&mut self.relative) {
+                    if pair.deputy == i {
+                        rp.publish(pair, stamp, sh, None);
+                    }
+                }
             }
             acc.publish_ns += ns_since(t);
             if self.total_frames == Some(k) {
