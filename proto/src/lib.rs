@@ -26,6 +26,7 @@
 //! | `flexdyn/<sc-id>/tlm/css/<name>` | [`CssMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/tlm/fss/<name>` | [`FssMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/tlm/gps/<name>` | [`GpsMsg`] | server → flight code |
+//! | `flexdyn/<deputy-id>/tlm/rel/<chief-id>` | [`RelativeStateMsg`] | fleet server → anyone, every frame |
 //! | `flexdyn/<sc-id>/cmd/<sender-id>` | [`CommandMsg`] | flight code → server |
 //! | `flexdyn/<sc-id>/status` | [`StatusMsg`] | server → anyone |
 //! | `flexdyn/<sc-id>/operator` | [`OperatorMsg`] | operator → server |
@@ -59,8 +60,9 @@
 //! | [`TimeMsg`] | [`TIME_LEN`] = 122 |
 //! | [`EnvironmentMsg`] | [`ENVIRONMENT_LEN`] = 368 |
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
-//! | [`StatusMsg`] | [`STATUS_LEN`] = 187 |
+//! | [`StatusMsg`] | [`STATUS_LEN`] = 235 |
 //! | [`OperatorMsg`] | [`OPERATOR_LEN`] = 42 |
+//! | [`RelativeStateMsg`] | [`RELATIVE_STATE_LEN`] = 102 |
 //!
 //! Decoders accept at most [`MAX_MESSAGE_BYTES`], [`MAX_EFFECTORS`] and
 //! [`MAX_EFFECTOR_VALUES`], reject trailing bytes, and never panic ([`DecodeError`]).
