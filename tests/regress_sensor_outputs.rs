@@ -20,7 +20,10 @@ use flexdyn::cli::simulate_to;
 use flexdyn::config::SimConfig;
 use sha2::{Digest, Sha256};
 
-/// (scenario, log interval \[s\], sha256 of the CSV). Re-minted for protocol version 8 (fault
+/// (scenario, log interval \[s\], sha256 of the CSV). Re-minted for protocol version 9 (the
+/// fleet's relative-state message, issue 22): with the CSV's `protocol_version` column set back
+/// to 8, all six were checked to hash to their protocol-8 values. Re-minted for protocol
+/// version 8 (fault
 /// events, issue 21): with the CSV's `protocol_version` column set back to 7, two of them
 /// (imu_tactical at 0.01 s, wheels_star_tracker at 0.05 s) were checked to hash to their
 /// protocol-7 values. Re-minted for protocol version 7: the
@@ -30,32 +33,32 @@ const GOLDEN: [(&str, f64, &str); 6] = [
     (
         "imu_tactical",
         0.01,
-        "bb5b96896e55c2659b974794207e9f36ab18262deba787875b544dbdaee5f0a2",
+        "3a5653423600ea73d79a7acd13b7efd1233f889e2a2c3900948d890642a6cce7",
     ),
     (
         "imu_tactical",
         0.003,
-        "4f377a984fc3bd46c82bc2cb29e3dfa9f6f080a61c457392b51805eaf9dc2647",
+        "61753dd0a960addb4d8aa3db0ca4ee0d594dd614e31397f4bca6824fe538a593",
     ),
     (
         "imu_tactical",
         0.05,
-        "f88b98744d682d0779cb75d5dc94eb58fc6d578be34f5272355e472a2d9e051e",
+        "cbcf3ce84c76158e3bf656874972761a967bae5be92c2e3027b253265008010a",
     ),
     (
         "wheels_star_tracker",
         0.01,
-        "5d33b36dfe18894e7edd003665aae161839969081c16d38981751c972f09386f",
+        "91b8bcc5e6eb258aa9f6cb6a26fd7ab4a6f215715419ab8bf040e6c2e32de9be",
     ),
     (
         "wheels_star_tracker",
         0.003,
-        "120d16f8cf965c4c036118e259830857ce3ece77ad42ff2edd8b4ccc54fcb684",
+        "6d889fc6084b6351748047db85459ebf860a845e46a4dd29b77556fd5d9cba9c",
     ),
     (
         "wheels_star_tracker",
         0.05,
-        "fc4d835e5f31584c1dfbf9d9b324e80565aeb444c25522f91f77cea9abad5aa4",
+        "25405636113c1b52d6326e7c5843182ee62f3975fbdbdd5d58cd7a82ac84ed45",
     ),
 ];
 

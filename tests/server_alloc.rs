@@ -232,7 +232,8 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
 /// every participant of every vehicle. Three vehicles (the wheel scenario twice, the second 100 m
 /// behind the first, the first with a repeating gyro fault and a wheel fault whose events each
 /// frame carries; the reference spacecraft), sender 9 answering all three: the per-frame work
-/// (offers, step, fill with the fault events, finite check) allocates nothing.
+/// (offers, step, fill with the fault events and the pair's relative state, finite check)
+/// allocates nothing.
 #[test]
 fn the_fleet_frame_path_does_not_allocate() {
     use flexdyn::server::fleet::stepper::FleetStepper;
@@ -284,7 +285,11 @@ participants = [9]
             ..ServerSettings::default()
         })
         .collect();
-    let mut f = FleetStepper::new(World::new(&fleet).unwrap().into_vehicles(), &settings);
+    // With the (a, b) pair's relative state, filled with the frames.
+    let world = World::new(&fleet).unwrap();
+    let pairs = world.relative_pairs().to_vec();
+    assert_eq!(pairs, [(0, 1)]);
+    let mut f = FleetStepper::new(world.into_vehicles(), &settings).with_relative_pairs(&pairs);
     let (cmd_tx, cmd_rx) = sync_channel::<(usize, CommandMsg)>(16);
     let frame_once = |f: &mut FleetStepper, k: u64| {
         for (v, senders) in [(0usize, [1u32, 9]), (1, [2, 9]), (2, [9, 9])] {
@@ -326,4 +331,8 @@ participants = [9]
     for v in &f.vehicles {
         assert_eq!(v.frame.state.header.tick, 200, "{}", v.id);
     }
+    // And the pair's relative state is that of tick 200 (b started 100 m behind a).
+    let rel = &f.pairs[0].msg;
+    assert_eq!((rel.header.tick, rel.chief_spacecraft_id), (200, 1));
+    assert!(rel.range_m > 50.0 && rel.range_m < 150.0, "{rel:?}");
 }

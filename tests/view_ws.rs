@@ -547,6 +547,14 @@ fn the_viewer_shows_every_vehicle_it_hears() {
                 let child = t["child_frame_id"].as_str().unwrap();
                 assert!(child.starts_with(&format!("{sc}/")), "{sc}: {tf}");
             }
+            // Both trees hang from the common N (identity), so both vehicles are drawn in one
+            // scene whichever vehicle's frame is the display frame.
+            assert!(
+                transforms.iter().any(
+                    |t| t["parent_frame_id"] == "N" && t["child_frame_id"] == format!("{sc}/N")
+                ),
+                "{sc}: {tf}"
+            );
         }
     }
 }

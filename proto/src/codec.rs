@@ -161,6 +161,11 @@ pub fn decode_fault_command(bytes: &[u8]) -> Result<crate::FaultCommandMsg, Deco
     decode(bytes)
 }
 
+/// [`decode`] for [`crate::RelativeStateMsg`].
+pub fn decode_relative_state(bytes: &[u8]) -> Result<crate::RelativeStateMsg, DecodeError> {
+    decode(bytes)
+}
+
 /// [`decode`] for [`StatusMsg`].
 pub fn decode_status(bytes: &[u8]) -> Result<StatusMsg, DecodeError> {
     decode(bytes)

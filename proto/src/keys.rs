@@ -26,6 +26,9 @@ pub const CSS_PREFIX: &str = "tlm/css";
 pub const FSS_PREFIX: &str = "tlm/fss";
 /// Prefix of the GPS receiver topics; the receiver name follows after a `/`.
 pub const GPS_PREFIX: &str = "tlm/gps";
+/// Prefix of a fleet deputy's relative-state topic ([`crate::RelativeStateMsg`]); the chief's
+/// string id follows after a `/` (`flexdyn/<deputy>/tlm/rel/<chief>`). Protocol version 9.
+pub const RELATIVE_STATE_PREFIX: &str = "tlm/rel";
 /// Prefix of the command topics; the sender's decimal `sender_id` follows after a `/`
 /// (`flexdyn/<sc>/cmd/<sender_id>`, every [`crate::CommandKind`]). One key per sender, so a
 /// Zenoh access-control list can reserve each participant's key for its authenticated subject.
@@ -129,6 +132,16 @@ pub fn sensor_key(sc: &str, prefix: &str, name: &str) -> Result<String, KeyError
     Ok(format!("{KEY_ROOT}/{sc}/{prefix}/{name}"))
 }
 
+/// `flexdyn/<deputy>/tlm/rel/<chief>`: deputy `deputy`'s state relative to vehicle `chief`
+/// ([`crate::RelativeStateMsg`], protocol 9).
+pub fn relative_state_key(deputy: &str, chief: &str) -> Result<String, KeyError> {
+    validate_sc_id(deputy)?;
+    validate_sc_id(chief)?;
+    Ok(format!(
+        "{KEY_ROOT}/{deputy}/{RELATIVE_STATE_PREFIX}/{chief}"
+    ))
+}
+
 /// `flexdyn/<sc>/cmd/<sender_id>`: where participant `sender_id` publishes its commands.
 pub fn cmd_key(sc: &str, sender_id: u32) -> Result<String, KeyError> {
     validate_sc_id(sc)?;
@@ -208,6 +221,9 @@ pub enum Telemetry<'a> {
     Fss(&'a str),
     /// `flexdyn/<sc>/tlm/gps/<name>`: a [`crate::GpsMsg`] of the GPS receiver `name`.
     Gps(&'a str),
+    /// `flexdyn/<sc>/tlm/rel/<chief>`: a [`crate::RelativeStateMsg`] of this vehicle relative
+    /// to vehicle `chief` (protocol 9).
+    Relative(&'a str),
 }
 
 /// All keys of one spacecraft, validated once.
@@ -286,6 +302,11 @@ impl Topics {
         format!("{KEY_ROOT}/{}/{ENVIRONMENT_SUFFIX}", self.sc_id)
     }
 
+    /// `flexdyn/<sc>/tlm/rel/<chief>` (this vehicle's state relative to vehicle `chief`).
+    pub fn relative_state(&self, chief: &str) -> Result<String, KeyError> {
+        relative_state_key(&self.sc_id, chief)
+    }
+
     /// `flexdyn/<sc>/tlm/imu/<name>`
     pub fn imu(&self, name: &str) -> Result<String, KeyError> {
         imu_key(&self.sc_id, name)
@@ -343,6 +364,7 @@ impl Topics {
             .or_else(|| named(CSS_PREFIX).map(Telemetry::Css))
             .or_else(|| named(FSS_PREFIX).map(Telemetry::Fss))
             .or_else(|| named(GPS_PREFIX).map(Telemetry::Gps))
+            .or_else(|| named(RELATIVE_STATE_PREFIX).map(Telemetry::Relative))
     }
 
     /// `flexdyn/<sc>/tlm/imu/*`
@@ -449,6 +471,15 @@ mod tests {
             t.telemetry("flexdyn/sc-1/tlm/gps/g"),
             Some(Telemetry::Gps("g"))
         );
+        assert_eq!(
+            t.telemetry(&t.relative_state("chief").unwrap()),
+            Some(Telemetry::Relative("chief"))
+        );
+        assert_eq!(
+            relative_state_key("dep", "chief").unwrap(),
+            "flexdyn/dep/tlm/rel/chief"
+        );
+        assert!(relative_state_key("dep", "a/b").is_err());
         for other in [
             "flexdyn/sc-2/tlm/state",
             "flexdyn/sc-1/tlm/state/x",
@@ -456,7 +487,8 @@ mod tests {
             "flexdyn/sc-1/tlm/imu/",
             "flexdyn/sc-1/tlm/imu/a/b",
             "flexdyn/sc-1/tlm/gps/a/b",
-            "flexdyn/sc-1/tlm/rel/g",
+            "flexdyn/sc-1/tlm/xyz/g",
+            "flexdyn/sc-1/tlm/rel/a/b",
             "flexdyn/sc-1/status",
             "flexdyn/sc-1/cmd/1",
             "flexdyn/sc-10/tlm/state",

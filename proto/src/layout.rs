@@ -9,6 +9,8 @@ use crate::{
     MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg,
 };
 use crate::{FaultCommandMsg, FaultEventMsg};
+// The relative state of a fleet's deputy (protocol 9).
+use crate::RelativeStateMsg;
 
 /// Encoded [`Header`] size (bytes).
 pub const HEADER_LEN: usize = 30;
@@ -56,6 +58,8 @@ pub const OPERATOR_LEN: usize = 42;
 pub const FAULT_EVENT_LEN: usize = 199;
 /// Encoded [`FaultCommandMsg`] size (bytes). Protocol version 8.
 pub const FAULT_COMMAND_LEN: usize = 214;
+/// Encoded [`RelativeStateMsg`] size (bytes). Protocol version 9.
+pub const RELATIVE_STATE_LEN: usize = 102;
 /// Largest effector count a [`StateMsg`] (or input count a [`CommandKind::Actuators`]) may
 /// carry; decoders reject more.
 pub const MAX_EFFECTORS: usize = 1024;
@@ -100,6 +104,7 @@ mod sealed {
     impl Sealed for super::TimeMsg {}
     impl Sealed for super::OperatorMsg {}
     impl Sealed for super::FaultEventMsg {}
+    impl Sealed for super::RelativeStateMsg {}
     impl Sealed for super::FaultCommandMsg {}
 }
 
@@ -443,4 +448,15 @@ fn read_u64_le(bytes: &[u8], at: usize) -> Option<u64> {
 fn read_u32_le(bytes: &[u8], at: usize) -> Option<u32> {
     let b: [u8; 4] = bytes.get(at..at.checked_add(4)?)?.try_into().ok()?;
     Some(u32::from_le_bytes(b))
+}
+
+impl WireMessage for RelativeStateMsg {
+    const NAME: &'static str = "RelativeStateMsg";
+    const LAYOUT: WireLayout = WireLayout::Fixed {
+        len: RELATIVE_STATE_LEN,
+    };
+    const MIN_LEN: usize = RELATIVE_STATE_LEN;
+    fn header(&self) -> &Header {
+        &self.header
+    }
 }

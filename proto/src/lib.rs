@@ -26,6 +26,7 @@
 //! | `flexdyn/<sc-id>/tlm/css/<name>` | [`CssMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/tlm/fss/<name>` | [`FssMsg`] | server → flight code |
 //! | `flexdyn/<sc-id>/tlm/gps/<name>` | [`GpsMsg`] | server → flight code |
+//! | `flexdyn/<deputy-id>/tlm/rel/<chief-id>` | [`RelativeStateMsg`] | fleet server → anyone, every frame |
 //! | `flexdyn/<sc-id>/cmd/<sender-id>` | [`CommandMsg`] | flight code → server |
 //! | `flexdyn/<sc-id>/status` | [`StatusMsg`] | server → anyone |
 //! | `flexdyn/<sc-id>/operator` | [`OperatorMsg`] | operator → server |
@@ -59,8 +60,9 @@
 //! | [`TimeMsg`] | [`TIME_LEN`] = 122 |
 //! | [`EnvironmentMsg`] | [`ENVIRONMENT_LEN`] = 368 |
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
-//! | [`StatusMsg`] | [`STATUS_LEN`] = 187 |
+//! | [`StatusMsg`] | [`STATUS_LEN`] = 235 |
 //! | [`OperatorMsg`] | [`OPERATOR_LEN`] = 42 |
+//! | [`RelativeStateMsg`] | [`RELATIVE_STATE_LEN`] = 102 |
 //!
 //! Decoders accept at most [`MAX_MESSAGE_BYTES`], [`MAX_EFFECTORS`] and
 //! [`MAX_EFFECTOR_VALUES`], reject trailing bytes, and never panic ([`DecodeError`]).
@@ -143,6 +145,11 @@ pub use messages::{
     FaultAction, FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget, AT_NEXT_TICK,
     FAULT_MODE_NAMES, FAULT_TARGET_LEN, MAX_STATUS_FAULTS,
 };
+// A fleet deputy's state relative to its chief (issue 22, protocol 9).
+pub use codec::decode_relative_state;
+pub use keys::{relative_state_key, RELATIVE_STATE_PREFIX};
+pub use layout::RELATIVE_STATE_LEN;
+pub use messages::RelativeStateMsg;
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
 /// Version 3: generic effector states in [`StateMsg`], [`CommandKind::Actuators`],
@@ -158,4 +165,6 @@ pub use messages::{
 /// Version 8: fault injection of issue 21 ([`FaultEventMsg`] on `tlm/fault`, the live
 /// [`FaultCommandMsg`] on `flexdyn/<sc-id>/fault`, [`RejectCounters::fault_refused`] and the
 /// active faults in StatusMsg, which grows to 235 bytes).
-pub const PROTOCOL_VERSION: u16 = 8;
+/// Version 9: a fleet deputy's state relative to its chief (issue 22, [`RelativeStateMsg`] on
+/// `flexdyn/<deputy>/tlm/rel/<chief>`).
+pub const PROTOCOL_VERSION: u16 = 9;

@@ -1245,3 +1245,33 @@ pub struct FaultCommandMsg {
     /// `Inject`: the target, as in `[[faults]]` (`imus.hub.gyro`).
     pub target: FaultTarget,
 }
+
+/// A deputy's motion relative to its chief, topic `flexdyn/<deputy-id>/tlm/rel/<chief-id>`.
+/// 102 bytes. Protocol version 9 (issue 22).
+///
+/// Published by a fleet server (`flexdyn run --fleet`) every frame for each vehicle whose fleet
+/// entry has a `[vehicles.relative]` table naming a chief, after the deputy's StateMsg of the
+/// same tick. Both vehicles are taken at that tick and at their system centres of mass C
+/// (for a vehicle whose centre of mass is its hub point B, StateMsg's `r_bn_n_m`, `v_bn_n_m_s`).
+/// H is the chief's Hill frame: x̂ along the chief's position, ẑ along its orbital angular
+/// momentum r × v, ŷ = ẑ × x̂ (along-track); it turns at (|r × v| / |r|²) ẑ.
+/// `header.spacecraft_id` is the deputy's; `header.seq` counts the messages from 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
+pub struct RelativeStateMsg {
+    /// Common header: the deputy's `spacecraft_id`; `tick` and `sim_time_ns` of the two
+    /// vehicles' states.
+    pub header: Header,
+    /// The chief's numeric id (its messages' `header.spacecraft_id`).
+    pub chief_spacecraft_id: u32,
+    /// The deputy's numeric id (as `header.spacecraft_id`).
+    pub deputy_spacecraft_id: u32,
+    /// \[m\] r_Cd/Cc: the deputy's centre of mass relative to the chief's, H components.
+    pub r_dc_h_m: [f64; 3],
+    /// \[m/s\] its rate of change seen in the rotating frame H, H components.
+    pub v_dc_h_m_s: [f64; 3],
+    /// \[m\] |r_Cd/Cc|.
+    pub range_m: f64,
+    /// \[m/s\] d|r_Cd/Cc|/dt (the same in every frame).
+    pub range_rate_m_s: f64,
+}

@@ -288,7 +288,7 @@ impl Gen {
     }
 
     fn message(&mut self) -> Vec<u8> {
-        match self.below(14) {
+        match self.below(15) {
             0 => {
                 let effectors = (0..self.below(6))
                     .map(|_| EffectorState {
@@ -420,6 +420,16 @@ impl Gen {
                 axes: self.u64() as u32,
                 params: self.v(),
                 target: FaultTarget(std::array::from_fn(|_| self.u64() as u8)),
+            }),
+            // Protocol 9: a fleet deputy's relative state (fixed length, plain numbers).
+            14 => encode(&flexdyn_proto::RelativeStateMsg {
+                header: self.header(),
+                chief_spacecraft_id: self.u64() as u32,
+                deputy_spacecraft_id: self.u64() as u32,
+                r_dc_h_m: self.v(),
+                v_dc_h_m_s: self.v(),
+                range_m: self.f64(),
+                range_rate_m_s: self.f64(),
             }),
             13 => encode(&FaultCommandMsg {
                 header: self.header(),
@@ -596,6 +606,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
             "gps",
             "fault_event",
             "fault_command",
+            "relative_state",
         ] {
             let want = rust_lines.next().expect("a Rust verdict per decoder");
             let got = c_lines.next().unwrap_or("<missing>");
@@ -616,7 +627,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
     }
     assert!(c_lines.next().is_none(), "extra C output");
     eprintln!(
-        "{N} buffers x 15 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
+        "{N} buffers x 16 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
     );
     // The stream exercises every outcome.
     for r in [

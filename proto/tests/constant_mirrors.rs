@@ -173,3 +173,22 @@ fn c_and_python_mirror_the_gps_message() {
         assert_eq!(py.get(name), Some(&rust), "Python {name}");
     }
 }
+
+/// A fleet deputy's relative-state message length (protocol 9), in its own list so other
+/// messages' mirrors merge beside it.
+#[test]
+fn c_and_python_mirror_the_relative_state_message() {
+    let c = c_defines();
+    let py = python_constants();
+    let rust = flexdyn_proto::RELATIVE_STATE_LEN as u64;
+    assert_eq!(
+        c.get("FD_RELATIVE_STATE_LEN"),
+        Some(&rust),
+        "C FD_RELATIVE_STATE_LEN"
+    );
+    assert_eq!(
+        py.get("RELATIVE_STATE_LEN"),
+        Some(&rust),
+        "Python RELATIVE_STATE_LEN"
+    );
+}

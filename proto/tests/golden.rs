@@ -36,6 +36,7 @@ use flexdyn_proto::{
     FaultAction, FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget, FAULT_COMMAND_LEN,
     FAULT_EVENT_LEN, FAULT_TARGET_LEN,
 };
+use flexdyn_proto::{RelativeStateMsg, RELATIVE_STATE_LEN};
 
 type Golden = &'static [(usize, &'static str, &'static str)];
 
@@ -106,7 +107,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -366,7 +367,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -442,7 +443,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -489,7 +490,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -559,7 +560,7 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -590,7 +591,7 @@ const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
     (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
 ];
 const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -823,7 +824,7 @@ const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
 
 // The sun sensors' tables (protocol 6, issue 20).
 const CSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -859,7 +860,7 @@ const CSS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const FSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -885,7 +886,7 @@ const FSS_GOLDEN: &[(usize, &str, &str)] = &[
     (46, "07", "u8 flags = VALID | IN_FOV | SUNLIT = 0x07"),
 ];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -929,7 +930,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
 /// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
 /// TAI …036.0 s). `src/server/clock.rs` produces exactly this message from that epoch.
 const TIME_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -1002,7 +1003,7 @@ const TIME_GOLDEN: &[(usize, &str, &str)] = &[
     (118, "00000000", "u32 tone_tai.subseconds = 0"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -1019,7 +1020,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -1114,7 +1115,7 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
 // first live one) activated at tick 44: `bias_step` (mode 2) of 0.25 rad/s on axes 1 and 3 of
 // `imus.hub.gyro`, at 0.44 s exactly (edge = the boundary).
 const FAULT_EVENT_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -1162,7 +1163,7 @@ const FAULT_EVENT_GOLDEN: &[(usize, &str, &str)] = &[
 // `reaction_wheels.rw2`, at tick 0x1_0000_0005 (bytes on both sides of bit 32), for 2 s, seed
 // 7.
 const FAULT_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -1214,7 +1215,7 @@ const FAULT_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
 // Protocol 6 (issue 23, operator control): a `RunTicks` operator command. The tick count
 // 4294967301 = 0x1_0000_0005 has bytes on both sides of bit 32, so a u32 `ticks` would show.
 const OPERATOR_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -1447,7 +1448,7 @@ fn css_golden() {
 // ---- GpsMsg (protocol 7, issue 20): a self-contained block. ----
 /// GpsMsg, hand-derived from proto/README.md (147 bytes).
 const GPS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0800", "u16 header.protocol_version = 8"),
+    (0, "0900", "u16 header.protocol_version = 9"),
     (
         2,
         "44332211",
@@ -1816,7 +1817,7 @@ fn environment_golden() {
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 16] = [
+    let tables: [(&str, &str, Golden, &str); 17] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -1881,6 +1882,13 @@ fn exported_golden_files_match_the_tables() {
             FAULT_COMMAND_GOLDEN,
             "FAULT_COMMAND_GOLDEN",
         ),
+        // Protocol 9, a fleet deputy's relative state.
+        (
+            "relative_state",
+            "RelativeStateMsg",
+            RELATIVE_STATE_GOLDEN,
+            "RELATIVE_STATE_GOLDEN",
+        ),
     ];
     let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");
     let rows: Vec<Vec<&str>> = manifest
@@ -1907,3 +1915,87 @@ fn exported_golden_files_match_the_tables() {
         );
     }
 }
+
+// ---- RelativeStateMsg (protocol 9, issue 22): a self-contained block. ----
+/// RelativeStateMsg, hand-derived from proto/README.md (102 bytes): deputy 0x11223344 at
+/// tick 1000 (t = 10 s) relative to chief 1.
+const RELATIVE_STATE_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0900", "u16 header.protocol_version = 9"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344), the deputy",
+    ),
+    (6, "e803000000000000", "u64 header.tick = 1000 (0x3E8)"),
+    (
+        14,
+        "00e40b5402000000",
+        "u64 header.sim_time_ns = 10000000000 (0x2540BE400)",
+    ),
+    (22, "e803000000000000", "u64 header.seq = 1000"),
+    (30, "01000000", "u32 chief_spacecraft_id = 1"),
+    (
+        34,
+        "44332211",
+        "u32 deputy_spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (
+        38,
+        "000000000000e03f",
+        "f64 r_dc_h_m[0] = 0.5 (0x3FE0000000000000)",
+    ),
+    (
+        46,
+        "00000000000059c0",
+        "f64 r_dc_h_m[1] = -100.0 (-1.5625 · 2^6: 0xC059000000000000)",
+    ),
+    (
+        54,
+        "0000000000000240",
+        "f64 r_dc_h_m[2] = 2.25 (0x4002000000000000)",
+    ),
+    (
+        62,
+        "000000000000c03f",
+        "f64 v_dc_h_m_s[0] = 0.125 (0x3FC0000000000000)",
+    ),
+    (
+        70,
+        "0000000000000080",
+        "f64 v_dc_h_m_s[1] = -0.0 (sign bit)",
+    ),
+    (
+        78,
+        "0000000000000cc0",
+        "f64 v_dc_h_m_s[2] = -3.5 (-1.75 · 2^1: 0xC00C000000000000)",
+    ),
+    (
+        86,
+        "0000000000025940",
+        "f64 range_m = 100.03125 = (1 + 0x9020000000000 / 2^52) · 2^6 (0x4059020000000000)",
+    ),
+    (
+        94,
+        "000000000000d0bf",
+        "f64 range_rate_m_s = -0.25 (0xBFD0000000000000)",
+    ),
+];
+
+#[test]
+fn relative_state_golden() {
+    let msg = RelativeStateMsg {
+        header: Header::new(SC, 1000, 10_000_000_000, 1000),
+        chief_spacecraft_id: 1,
+        deputy_spacecraft_id: SC,
+        r_dc_h_m: [0.5, -100.0, 2.25],
+        v_dc_h_m_s: [0.125, -0.0, -3.5],
+        range_m: 100.031_25,
+        range_rate_m_s: -0.25,
+    };
+    check("RelativeStateMsg", RELATIVE_STATE_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), RELATIVE_STATE_LEN);
+    assert_eq!(RELATIVE_STATE_LEN, 102);
+    let back = flexdyn_proto::decode_relative_state(&golden_bytes(RELATIVE_STATE_GOLDEN)).unwrap();
+    assert!(back.v_dc_h_m_s[1].is_sign_negative(), "-0.0 keeps its sign");
+}
+// ---- end RelativeStateMsg ----

@@ -22,7 +22,7 @@ pub struct RunArgs {
     /// settings are the first vehicle's `[server]` table with these options on top; ids and
     /// participants come from the fleet file.
     #[arg(long, value_name = "FLEET.toml",
-          conflicts_with_all = ["sc_id", "spacecraft_id", "participants", "record"])]
+          conflicts_with_all = ["sc_id", "spacecraft_id", "participants"])]
     pub fleet: Option<PathBuf>,
     /// Pacing mode [default: realtime].
     #[arg(long, value_parser = ["realtime", "lockstep", "batch"])]

@@ -143,6 +143,7 @@ pub async fn run(
         settings.spacecraft_id,
         core,
         record_tx.clone(),
+        shared.clone(),
     )
     .await?;
 
@@ -474,7 +475,7 @@ async fn run_frames(
 }
 
 /// Closes the `--record` file once everything queued is written; what it holds.
-fn finish_recording(
+pub(super) fn finish_recording(
     recorder: Option<(Recorder, RecordTx)>,
 ) -> Result<Option<RecordReport>, ServerError> {
     recorder

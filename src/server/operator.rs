@@ -58,7 +58,13 @@ pub fn decide(
 
 /// Subscribes the operator callback to `flexdyn/<sc>/operator`; dropping the subscriber stops
 /// it. `core` is the lockstep core when the commands' callback steps the frames (lockstep,
-/// `handoff = "direct"`): a release steps the held frame there at once.
+/// `handoff = "direct"`): a release steps the held frame there at once. Refusals count in
+/// `shared`; the hold target (and the tick it is decided against) is `hold`'s: the vehicle's
+/// own `shared` for one vehicle, one for the whole fleet in fleet mode (any vehicle's operator
+/// key pauses, resumes or runs the fleet).
+// Eight: the run's keys, counters, hold, mode and ids, the lockstep core and the recorder are
+// each what one caller has and the other does not (one vehicle, or a fleet).
+#[allow(clippy::too_many_arguments)]
 pub(super) async fn declare(
     session: &Session,
     topics: &Topics,
@@ -67,6 +73,7 @@ pub(super) async fn declare(
     spacecraft_id: u32,
     core: Option<Arc<Mutex<LockstepCore>>>,
     record: Option<RecordTx>,
+    hold: Arc<Shared>,
 ) -> Result<Subscriber<()>, ServerError> {
     let log = Mutex::new(RejectLog::default());
     // Serialises decisions (read the target, write it back) between concurrent deliveries.
@@ -107,10 +114,10 @@ pub(super) async fn declare(
         let mut core_guard = core
             .as_ref()
             .map(|c| c.lock().unwrap_or_else(|p| p.into_inner()));
-        let tick = shared.tick.load(std::sync::atomic::Ordering::Acquire);
-        match decide(mode, msg.action, msg.ticks, shared.hold_target(), tick) {
+        let tick = hold.tick.load(std::sync::atomic::Ordering::Acquire);
+        match decide(mode, msg.action, msg.ticks, hold.hold_target(), tick) {
             Ok(target) => {
-                shared.set_hold_target(target);
+                hold.set_hold_target(target);
                 tracing::info!(
                     action = ?msg.action,
                     ticks = msg.ticks,

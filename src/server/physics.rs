@@ -48,7 +48,7 @@ const POLL: Duration = Duration::from_millis(50);
 
 /// How often a held run looks at the operator's hold target (and the stop flag): the delay of a
 /// resume.
-const HOLD_POLL: Duration = Duration::from_millis(1);
+pub(super) const HOLD_POLL: Duration = Duration::from_millis(1);
 
 /// How the physics loop ended (errors are returned as [`ServerError`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

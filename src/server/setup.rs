@@ -150,6 +150,18 @@ pub(super) fn start_recorder(
     settings: &ServerSettings,
     vehicle: &VehicleInfo,
 ) -> Result<Option<(Recorder, RecordTx)>, ServerError> {
+    let recorder = open_recorder(settings)?;
+    if let Some((_, tx)) = &recorder {
+        tx.describe_vehicle(vehicle.clone());
+    }
+    Ok(recorder)
+}
+
+/// The `--record` recorder thread with no vehicle described yet (fleet mode describes each
+/// vehicle as its endpoints are declared).
+pub(super) fn open_recorder(
+    settings: &ServerSettings,
+) -> Result<Option<(Recorder, RecordTx)>, ServerError> {
     let Some(path) = &settings.record else {
         return Ok(None);
     };
@@ -159,7 +171,6 @@ pub(super) fn start_recorder(
     };
     let (recorder, tx) =
         Recorder::start(path, &info, RECORD_QUEUE, settings.mode != Mode::RealTime)?;
-    tx.describe_vehicle(vehicle.clone());
     tracing::info!(file = %path.display(), "recording to MCAP");
     Ok(Some((recorder, tx)))
 }

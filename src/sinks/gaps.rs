@@ -32,7 +32,8 @@ impl SeqGaps {
             | TopicKind::Status
             | TopicKind::Time
             | TopicKind::Environment
-            | TopicKind::FaultEvent => true,
+            | TopicKind::FaultEvent
+            | TopicKind::RelativeState => true,
             TopicKind::Command | TopicKind::Operator | TopicKind::FaultCommand => false,
         }
     }

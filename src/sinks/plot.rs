@@ -20,8 +20,10 @@
 //! - `star_tracker.png`: each star tracker's measured q_CN and its valid / status flags;
 //! - `imu.png`: each IMU's measured rate and specific force, one column per IMU;
 //! - `relative_motion.png` (with `--relative-to CHIEF`, from a recording of several vehicles):
-//!   the plotted vehicle's hub point B relative to CHIEF's in CHIEF's Hill frame, its rate seen
-//!   in that frame, range and range rate;
+//!   the plotted vehicle relative to CHIEF in CHIEF's Hill frame, its rate seen in that frame,
+//!   range and range rate: the recorded RelativeStateMsg (centres of mass) when the recording
+//!   holds it (a fleet server publishes it for each deputy), else computed from the two
+//!   vehicles' recorded StateMsgs (hub points B);
 //! - `timing.png`: frame lateness p50/p99/max from StatusMsg and the overrun count (real time
 //!   only: a lockstep or batch run is not paced by the wall clock, so it is skipped and says so).
 //!
@@ -108,8 +110,9 @@ pub struct PlotArgs {
         allow_hyphen_values = true
     )]
     pub sigma_rn: Option<Vec<f64>>,
-    /// With a recording of several vehicles: adds `relative_motion.png`, the plotted vehicle's
-    /// hub point B relative to vehicle CHIEF's, in CHIEF's Hill frame.
+    /// With a recording of several vehicles: adds `relative_motion.png`, the plotted vehicle
+    /// relative to vehicle CHIEF, in CHIEF's Hill frame (its recorded RelativeStateMsg when
+    /// present, else from the two vehicles' StateMsgs).
     #[arg(long = "relative-to", value_name = "CHIEF")]
     pub relative_to: Option<String>,
 }
@@ -174,6 +177,9 @@ struct PlotData {
     chief: Option<(String, Columns)>,
     /// When each fault was active.
     faults: Vec<FaultShading>,
+    /// `--relative-to`: the plotted vehicle's recorded RelativeStateMsg relative to the chief
+    /// (`flexdyn/<sc>/tlm/rel/<chief>`), when the recording holds it.
+    relative: Columns,
 }
 
 /// \[s\] the first and last instant of `c` (0, 0 when empty).
@@ -265,6 +271,11 @@ fn from_mcap(
             | TopicKind::Time
             | TopicKind::Operator
             | TopicKind::FaultCommand => {}
+            TopicKind::RelativeState => {
+                if data.chief.as_ref().map(|(c, _)| c.as_str()) == topic.sensor {
+                    data.relative.push(&cells);
+                }
+            }
         }
     }
     let (first, last) = time_span(&data.state);
@@ -276,10 +287,13 @@ fn from_mcap(
         ));
     }
     if let Some((chief, states)) = &data.chief {
-        if states.is_empty() {
+        if states.is_empty() && data.relative.is_empty() {
             return Err(input_err(
                 path,
-                format!("holds no StateMsg of spacecraft {chief:?} (--relative-to)"),
+                format!(
+                    "holds no StateMsg of spacecraft {chief:?} and no RelativeStateMsg of \
+                     {sc:?} relative to it (--relative-to)"
+                ),
             ));
         }
     }
@@ -931,7 +945,19 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
         Some(p) => fig("rates.png", "Body angular rate ω_BN".into(), vec![p]),
         None => skip("rates.png", "no omega_bn_b_rad_s columns"),
     }
-    if let Some((chief, states)) = &data.chief {
+    if let Some((chief, _)) = &data.chief {
+        if let Some(panels) = recorded_relative_motion(&data.relative) {
+            fig(
+                "relative_motion.png",
+                format!(
+                    "Centre of mass relative to {chief}'s, in {chief}'s Hill frame \
+                     (x radial, y along-track, z orbit normal; recorded RelativeStateMsg)"
+                ),
+                panels,
+            );
+        }
+    }
+    if let (Some((chief, states)), true) = (&data.chief, data.relative.is_empty()) {
         match relative_motion(s, states) {
             Some(panels) => fig(
                 "relative_motion.png",
@@ -1241,35 +1267,65 @@ fn relative_motion(deputy: &Columns, chief: &Columns) -> Option<Vec<Panel>> {
     if t.is_empty() {
         return None;
     }
+    Some(relative_panels(&t, &r_h, &v_h, &range, &range_rate))
+}
+
+/// The relative-motion panels from the recorded RelativeStateMsg columns (`r_dc_h_m_1..3`,
+/// `v_dc_h_m_s_1..3`, `range_m`, `range_rate_m_s`), as the server computed them at the
+/// centres of mass. `None` without them.
+fn recorded_relative_motion(rel: &Columns) -> Option<Vec<Panel>> {
+    if rel.is_empty() {
+        return None;
+    }
+    let (r, v) = (rel.vec3("r_dc_h_m")?, rel.vec3("v_dc_h_m_s")?);
+    let (range, range_rate) = (rel.get("range_m")?, rel.get("range_rate_m_s")?);
+    let own = |c: [&Vec<f64>; 3]| [c[0].clone(), c[1].clone(), c[2].clone()];
+    Some(relative_panels(
+        &rel.t_s,
+        &own(r),
+        &own(v),
+        range,
+        range_rate,
+    ))
+}
+
+/// Position and rate in H, range and range rate against time.
+fn relative_panels(
+    t: &[f64],
+    r_h: &[Vec<f64>; 3],
+    v_h: &[Vec<f64>; 3],
+    range: &[f64],
+    range_rate: &[f64],
+) -> Vec<Panel> {
     let xyz = |c: &[Vec<f64>; 3], unit: &str| {
         vec![
-            line(&format!("x radial ({unit})"), &t, &c[0]),
-            line(&format!("y along-track ({unit})"), &t, &c[1]),
-            line(&format!("z normal ({unit})"), &t, &c[2]),
+            line(&format!("x radial ({unit})"), t, &c[0]),
+            line(&format!("y along-track ({unit})"), t, &c[1]),
+            line(&format!("z normal ({unit})"), t, &c[2]),
         ]
     };
-    Some(vec![
+    vec![
         Panel {
             y_label: "position in H (m)".into(),
-            lines: xyz(&r_h, "m"),
+            lines: xyz(r_h, "m"),
             ..Panel::default()
         },
         Panel {
             y_label: "rate seen in H (m/s)".into(),
-            lines: xyz(&v_h, "m/s"),
+            lines: xyz(v_h, "m/s"),
             ..Panel::default()
         },
         Panel {
             y_label: "range (m)".into(),
-            lines: vec![line("range", &t, &range)],
+            lines: vec![line("range", t, range)],
             ..Panel::default()
         },
         Panel {
             y_label: "range rate (m/s)".into(),
-            lines: vec![line("range rate", &t, &range_rate)],
+            lines: vec![line("range rate", t, range_rate)],
             ..Panel::default()
         },
-    ])
+    ]
 }
 
 fn disturbance_panels(env: &Columns) -> Option<Vec<Panel>> {

@@ -233,7 +233,11 @@ fn transform(t_ns: u64, parent: &str, child: &str, r: &Vector3<f64>, q: &Vector4
 
 /// The `foxglove.FrameTransforms` of one state: N → B, then B → panel 1 and panel 1 → panel 2
 /// of each pair whose effector is in the message. `prefix` is prepended to every frame id
-/// (e.g. `sc1/`), so several vehicles can share one scene.
+/// (e.g. `sc1/`), so several vehicles can share one scene; with a prefix, the last transform
+/// is the identity from the common `N` to the vehicle's `<prefix>N` (every vehicle's inertial
+/// frame is the same frame), which joins the vehicles' frame trees into one: Foxglove's 3D
+/// panel draws only the frames connected to its display frame, so with `chief/B` as the display
+/// frame the deputy appears at its place beside the chief.
 pub fn frame_transforms(state: &StateMsg, geometry: &Geometry, prefix: &str) -> Value {
     let t = state.header.sim_time_ns;
     let sigma = Vector3::from(state.sigma_bn);
@@ -265,6 +269,15 @@ pub fn frame_transforms(state: &StateMsg, geometry: &Geometry, prefix: &str) -> 
             &p2,
             &Vector3::new(-pair.l1_m, 0.0, 0.0),
             &dcm_to_quat(&m2(theta2 + pair.theta_h2s1_rad)),
+        ));
+    }
+    if !prefix.is_empty() {
+        transforms.push(transform(
+            t,
+            FRAME_N,
+            &n,
+            &Vector3::zeros(),
+            &Vector4::new(1.0, 0.0, 0.0, 0.0),
         ));
     }
     json!({ "transforms": transforms })
@@ -662,6 +675,33 @@ mod tests {
         let (w, v) = (q[0], Vector3::new(q[1], q[2], q[3]));
         let vt = Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0);
         Matrix3::identity() * (w * w - v.norm_squared()) + v * v.transpose() * 2.0 + vt * (2.0 * w)
+    }
+
+    #[test]
+    fn a_prefixed_vehicle_hangs_from_the_common_inertial_frame() {
+        // Two vehicles' trees join at N: chief/N and deputy/N are N itself (identity), so a
+        // point fixed in deputy/B is at r_BN(deputy) − r_BN(chief) seen from chief/N.
+        let geometry = Geometry::from_config(&SimConfig::reference());
+        let state = StateMsg {
+            r_bn_n_m: [7.0e6, -100.0, 0.0],
+            ..StateMsg::default()
+        };
+        let plain = frame_transforms(&state, &geometry, "");
+        let plain = plain["transforms"].as_array().unwrap();
+        assert!(plain
+            .iter()
+            .all(|t| t["parent_frame_id"] != "N" || t["child_frame_id"] == "B"));
+        let tf = frame_transforms(&state, &geometry, "deputy/");
+        let list = tf["transforms"].as_array().unwrap();
+        assert_eq!(list.len(), plain.len() + 1);
+        let last = list.last().unwrap();
+        assert_eq!(last["parent_frame_id"], "N");
+        assert_eq!(last["child_frame_id"], "deputy/N");
+        assert_eq!(q_of(&last["rotation"]), Vector4::new(1.0, 0.0, 0.0, 0.0));
+        for axis in ["x", "y", "z"] {
+            assert_eq!(last["translation"][axis], 0.0);
+        }
+        assert_eq!(list[0]["parent_frame_id"], "deputy/N");
     }
 
     #[test]

@@ -17,6 +17,8 @@ use flexdyn_proto::{
     decode_fault_command, decode_fault_event, FaultCommandMsg, FaultEventMsg, FAULT_EVENT_SUFFIX,
     FAULT_SUFFIX,
 };
+// A fleet deputy's relative state (protocol 9).
+use flexdyn_proto::{decode_relative_state, RelativeStateMsg, RELATIVE_STATE_PREFIX};
 
 use crate::sensors::{SensorKind, KINDS};
 
@@ -43,6 +45,9 @@ pub enum TopicKind {
     FaultEvent,
     /// `flexdyn/<sc>/fault`: [`FaultCommandMsg`] (a live fault command).
     FaultCommand,
+    /// `flexdyn/<deputy>/tlm/rel/<chief>`: [`RelativeStateMsg`] (a fleet deputy relative to
+    /// its chief; the chief's id is the topic's `sensor`).
+    RelativeState,
 }
 
 impl TopicKind {
@@ -58,6 +63,7 @@ impl TopicKind {
                 TopicKind::Environment,
                 TopicKind::FaultEvent,
                 TopicKind::FaultCommand,
+                TopicKind::RelativeState,
             ])
     }
 
@@ -86,6 +92,7 @@ impl TopicKind {
             TopicKind::Environment => "EnvironmentMsg",
             TopicKind::FaultEvent => "FaultEventMsg",
             TopicKind::FaultCommand => "FaultCommandMsg",
+            TopicKind::RelativeState => "RelativeStateMsg",
         }
     }
 }
@@ -97,7 +104,8 @@ pub struct Topic<'a> {
     pub sc_id: &'a str,
     /// The message type.
     pub kind: TopicKind,
-    /// The sensor name, or a command key's decimal sender id; `None` for the other kinds.
+    /// The sensor name, a command key's decimal sender id, or a relative state's chief id;
+    /// `None` for the other kinds.
     pub sensor: Option<&'a str>,
 }
 
@@ -129,6 +137,8 @@ pub fn classify(key: &str) -> Option<Topic<'_>> {
         sensor(CMD_PREFIX).filter(|s| s.bytes().all(|b| b.is_ascii_digit()))
     {
         (TopicKind::Command, Some(sender))
+    } else if let Some(chief) = sensor(RELATIVE_STATE_PREFIX) {
+        (TopicKind::RelativeState, Some(chief))
     } else if suffix == STATUS_SUFFIX {
         (TopicKind::Status, None)
     } else if suffix == OPERATOR_SUFFIX {
@@ -178,6 +188,8 @@ pub enum Decoded {
     FaultEvent(FaultEventMsg),
     /// A live fault command.
     FaultCommand(FaultCommandMsg),
+    /// A fleet deputy's state relative to its chief.
+    RelativeState(RelativeStateMsg),
 }
 
 impl Decoded {
@@ -203,6 +215,7 @@ impl Decoded {
             TopicKind::Environment => Decoded::Environment(decode_environment(payload)?),
             TopicKind::FaultEvent => Decoded::FaultEvent(decode_fault_event(payload)?),
             TopicKind::FaultCommand => Decoded::FaultCommand(decode_fault_command(payload)?),
+            TopicKind::RelativeState => Decoded::RelativeState(decode_relative_state(payload)?),
         })
     }
 
@@ -218,6 +231,7 @@ impl Decoded {
             Decoded::Environment(m) => &m.header,
             Decoded::FaultEvent(m) => &m.header,
             Decoded::FaultCommand(m) => &m.header,
+            Decoded::RelativeState(m) => &m.header,
         }
     }
 
@@ -234,6 +248,7 @@ impl Decoded {
             Decoded::Environment(m) => serde_json::to_vec(m),
             Decoded::FaultEvent(m) => serde_json::to_vec(m),
             Decoded::FaultCommand(m) => serde_json::to_vec(m),
+            Decoded::RelativeState(m) => serde_json::to_vec(m),
         };
         v.unwrap_or_else(|_| b"null".to_vec())
     }
@@ -250,6 +265,7 @@ impl Decoded {
             Decoded::Environment(m) => serde_json::to_value(m),
             Decoded::FaultEvent(m) => serde_json::to_value(m),
             Decoded::FaultCommand(m) => serde_json::to_value(m),
+            Decoded::RelativeState(m) => serde_json::to_value(m),
         };
         // The wire structs hold only numbers, bools, enums and vectors: always representable.
         v.unwrap_or(serde_json::Value::Null)
@@ -272,6 +288,7 @@ pub fn json_schema(kind: TopicKind) -> serde_json::Value {
         TopicKind::Environment => schemars::schema_for!(EnvironmentMsg),
         TopicKind::FaultEvent => schemars::schema_for!(FaultEventMsg),
         TopicKind::FaultCommand => schemars::schema_for!(FaultCommandMsg),
+        TopicKind::RelativeState => schemars::schema_for!(RelativeStateMsg),
     };
     schema.to_value()
 }
@@ -335,6 +352,12 @@ mod tests {
         let t = classify("flexdyn/x/tlm/env").unwrap();
         assert_eq!((t.kind, t.sensor), (TopicKind::Environment, None));
         assert_eq!(TopicKind::Environment.message_name(), "EnvironmentMsg");
+        let t = classify("flexdyn/deputy/tlm/rel/chief").unwrap();
+        assert_eq!(
+            (t.sc_id, t.kind, t.sensor),
+            ("deputy", TopicKind::RelativeState, Some("chief"))
+        );
+        assert_eq!(classify("flexdyn/deputy/tlm/rel/a/b"), None);
         for other in [
             "flexdyn/x/participant/1",
             "flexdyn/x/tlm/imu/",

@@ -14,6 +14,7 @@ from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState
                            StatusMsg, TimeMsg, CssMsg, FssMsg, EnvironmentMsg, SourceWrench)
 from flexdyn.proto import GpsMsg  # protocol 7: the thirteenth decoder, generator arm 11
 from flexdyn.proto import FaultCommandMsg, FaultEventMsg  # protocol 8: decoders 14-15, arms 12-13
+from flexdyn.proto import RelativeStateMsg  # protocol 9: decoder 16, arm 14
 
 N = 20_000
 
@@ -126,6 +127,11 @@ def fault_command_line(m):
                .u(m.axes, m.duration_ns, m.seed, *m.target))
 
 
+def relative_state_line(m):
+    return str(Line().h(m.header).u(m.chief_spacecraft_id, m.deputy_spacecraft_id)
+               .f(m.r_dc_h_m).f(m.v_dc_h_m_s).f((m.range_m, m.range_rate_m_s)))
+
+
 DECODERS = [
     (StateMsg.decode, state_line), (ImuMsg.decode, imu_line),
     (StarTrackerMsg.decode, star_tracker_line), (MagnetometerMsg.decode, magnetometer_line),
@@ -135,6 +141,7 @@ DECODERS = [
     (OperatorMsg.decode, operator_line), (Header.decode, lambda h: str(Line().h(h))),
     (GpsMsg.decode, gps_line),
     (FaultEventMsg.decode, fault_event_line), (FaultCommandMsg.decode, fault_command_line),
+    (RelativeStateMsg.decode, relative_state_line),
 ]
 
 
@@ -172,7 +179,7 @@ def gen_buffer(r):
     def header():
         return Header(r.getrandbits(32), r.getrandbits(64), r.getrandbits(64), r.getrandbits(64))
 
-    k = r.randrange(14)
+    k = r.randrange(15)
     if k == 0:
         b = StateMsg(header(), v(3), v(4), v(3), v(3), v(3), v(3), v(3), f64(), f64(), v(3), v(3),
                      v(3), v(3), r.getrandbits(8),
@@ -226,6 +233,9 @@ def gen_buffer(r):
         b = FaultCommandMsg(header(), r.randrange(2), r.getrandbits(64), r.getrandbits(32),
                             r.randrange(18), v(2, g), r.getrandbits(32), r.getrandbits(64),
                             r.getrandbits(64), b"imus.hub.gyro" + bytes(115)).encode()
+    elif k == 14:
+        b = RelativeStateMsg(header(), r.getrandbits(32), r.getrandbits(32), v(3), v(3), f64(),
+                             f64()).encode()
     b = bytearray(b)
     k = r.randrange(10)
     if k in (3, 4, 5):
@@ -254,18 +264,18 @@ def test_python_and_rust_decoders_agree_on_20000_buffers(verdicts_bin):
     stream = b"".join(struct.pack("<I", len(b)) + b for b in buffers)
     rust = subprocess.run([str(verdicts_bin)], input=stream, capture_output=True, check=True)
     rust_lines = rust.stdout.decode().splitlines()
-    assert len(rust_lines) == 15 * N
+    assert len(rust_lines) == 16 * N
     reasons = {}
     names = ["state", "imu", "star_tracker", "magnetometer", "css", "fss", "environment",
              "command", "status", "time", "operator", "header", "gps", "fault_event",
-             "fault_command"]
+             "fault_command", "relative_state"]
     for i, b in enumerate(buffers):
         for j, got in enumerate(python_lines(b)):
-            want = rust_lines[15 * i + j]
+            want = rust_lines[16 * i + j]
             assert got == want, f"buffer {i} ({len(b)} bytes), {names[j]}: Python {got!r} vs Rust {want!r}"
             key = want.split()[1] if want.startswith("E") else "accepted"
             reasons[key] = reasons.get(key, 0) + 1
-    print(f"{N} buffers x 15 decoders: {reasons}")
+    print(f"{N} buffers x 16 decoders: {reasons}")
     for k in ("accepted", "Length", "TrailingBytes", "TooLarge", "UnknownVersion", "NonFinite",
               "Malformed"):
         assert reasons.get(k, 0) > 0, k

@@ -21,7 +21,7 @@ def bits(x):
 def test_manifest_lists_every_file(golden_dir):
     rows = [l.split("\t") for l in (golden_dir / "MANIFEST.tsv").read_text().splitlines()
             if l and not l.startswith("#")]
-    assert len(rows) == 16
+    assert len(rows) == 17
     for name, _message, length, _source in rows:
         assert (golden_dir / f"{name}.bin").stat().st_size == int(length)
 
@@ -252,3 +252,22 @@ def test_fault_event_and_command(golden_dir):
         proto.fault_command(SC, "imus.hub.gyro", "bias_step", value=1.0, factor=2.0)
     assert proto.fault_key("sc1") == "flexdyn/sc1/fault"
     assert proto.fault_event_key("sc1") == "flexdyn/sc1/tlm/fault"
+
+
+def test_relative_state(golden_dir):
+    # RELATIVE_STATE_GOLDEN of proto/tests/golden.rs (protocol 9; dyadic values, one -0.0).
+    from flexdyn.proto import RelativeStateMsg
+    m = RelativeStateMsg(Header(SC, 1000, 10_000_000_000, 1000), 1, SC, (0.5, -100.0, 2.25),
+                         (0.125, -0.0, -3.5), 100.03125, -0.25)
+    golden = (golden_dir / "relative_state.bin").read_bytes()
+    assert len(golden) == proto.RELATIVE_STATE_LEN == 102
+    assert m.encode() == golden
+    back = RelativeStateMsg.decode(golden)
+    assert back == m and bits(back.v_dc_h_m_s) == bits(m.v_dc_h_m_s)  # -0.0 keeps its sign
+    assert proto.relative_state_key("deputy", "chief") == "flexdyn/deputy/tlm/rel/chief"
+    with pytest.raises(DecodeError) as e:
+        RelativeStateMsg.decode(golden[:-1])
+    assert e.value.reason == "Length"
+    with pytest.raises(DecodeError) as e:
+        RelativeStateMsg.decode(b"\x08\x00" + golden[2:])
+    assert e.value.reason == "UnknownVersion"

@@ -1,5 +1,5 @@
 /*
- * flexdyn_proto.h - the flexdyn wire protocol (version 8) for C99 and C++ flight code.
+ * flexdyn_proto.h - the flexdyn wire protocol (version 9) for C99 and C++ flight code.
  *
  * Header-only: include it and call fd_decode_* / fd_encode_*. No allocation, no I/O, no
  * global state. Bytes are assembled one by one (little-endian on the wire), never cast to a
@@ -61,7 +61,7 @@
 /* ------------------------------------------------------------------------------------------ */
 /* Constants (proto/README.md).                                                                */
 
-#define FD_PROTOCOL_VERSION 8u
+#define FD_PROTOCOL_VERSION 9u
 #define FD_HEADER_LEN 30u
 #define FD_STATE_FIXED_LEN 327u
 #define FD_STATE_EFFECTOR_COUNT_OFFSET 319u
@@ -89,6 +89,7 @@
 #define FD_FAULT_COMMAND_LEN 214u
 #define FD_FAULT_TARGET_LEN 128u
 #define FD_MAX_STATUS_FAULTS 256u
+#define FD_RELATIVE_STATE_LEN 102u /* since protocol 9 */
 #define FD_MAX_EFFECTORS 1024u
 #define FD_MAX_EFFECTOR_VALUES 8u
 #define FD_MAX_MESSAGE_BYTES 65536u
@@ -404,6 +405,19 @@ typedef struct {
     double params[2];   /* the mode's parameters in its row's order */
     uint8_t target[FD_FAULT_TARGET_LEN]; /* UTF-8, NUL-padded */
 } fd_fault_event_msg;
+
+/* A fleet deputy's state relative to its chief, flexdyn/<deputy>/tlm/rel/<chief> (since
+ * protocol 9). Both at their centres of mass; H is the chief's Hill frame (x radial, z along
+ * the orbit normal, y along-track). header.spacecraft_id is the deputy's; seq = tick. */
+typedef struct {
+    fd_header header;
+    uint32_t chief_spacecraft_id;
+    uint32_t deputy_spacecraft_id;
+    double r_dc_h_m[3];   /* m, deputy relative to chief, H components */
+    double v_dc_h_m_s[3]; /* m/s, its rate seen in H, H components */
+    double range_m;       /* m */
+    double range_rate_m_s; /* m/s, negative while closing */
+} fd_relative_state_msg;
 
 /* A live fault command, flexdyn/<sc>/fault (since protocol 8). */
 typedef struct {
@@ -1288,6 +1302,36 @@ static inline size_t fd_encode_fault_command(const fd_fault_command_msg *m, uint
     return FD_FAULT_COMMAND_LEN;
 }
 
+/* RelativeStateMsg (protocol 9, fixed length).                                               */
+
+static inline fd_error fd_decode_relative_state(const uint8_t *buf, size_t len,
+                                                fd_relative_state_msg *out) {
+    fd_error e = fd_check_size_and_version(buf, len, FD_RELATIVE_STATE_LEN);
+    if (e.status != FD_OK) return e;
+    if ((e = fd_check_total(FD_RELATIVE_STATE_LEN, len)).status != FD_OK) return e;
+    fd_decode_header_at(buf, &out->header);
+    out->chief_spacecraft_id = fd_get_u32(buf + 30);
+    out->deputy_spacecraft_id = fd_get_u32(buf + 34);
+    fd_get_f64s(buf + 38, out->r_dc_h_m, 3);
+    fd_get_f64s(buf + 62, out->v_dc_h_m_s, 3);
+    out->range_m = fd_get_f64(buf + 86);
+    out->range_rate_m_s = fd_get_f64(buf + 94);
+    return fd_ok();
+}
+
+static inline size_t fd_encode_relative_state(const fd_relative_state_msg *m, uint8_t *buf,
+                                              size_t cap) {
+    if (cap < FD_RELATIVE_STATE_LEN) return 0;
+    fd_encode_header_at(buf, &m->header);
+    fd_put_u32(buf + 30, m->chief_spacecraft_id);
+    fd_put_u32(buf + 34, m->deputy_spacecraft_id);
+    fd_put_f64s(buf + 38, m->r_dc_h_m, 3);
+    fd_put_f64s(buf + 62, m->v_dc_h_m_s, 3);
+    fd_put_f64(buf + 86, m->range_m);
+    fd_put_f64(buf + 94, m->range_rate_m_s);
+    return FD_RELATIVE_STATE_LEN;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 /* Key expressions (proto/README.md, "Topics").                                                */
 
@@ -1371,6 +1415,12 @@ static inline size_t fd_fault_key(char *out, size_t cap, const char *sc) {
 /* flexdyn/<sc>/tlm/fault: fault activations and clearances (since protocol 8). */
 static inline size_t fd_fault_event_key(char *out, size_t cap, const char *sc) {
     return fd_key(out, cap, sc, "tlm/fault", FD_NULL);
+}
+/* flexdyn/<deputy>/tlm/rel/<chief>: a fleet deputy's state relative to its chief (since
+ * protocol 9). */
+static inline size_t fd_relative_state_key(char *out, size_t cap, const char *deputy,
+                                           const char *chief) {
+    return fd_key(out, cap, deputy, "tlm/rel", chief);
 }
 /* Writes the decimal form of v (no leading zero) into digits[11]; returns its first char. */
 static inline const char *fd_decimal_u32(char digits[11], uint32_t v) {

@@ -384,6 +384,23 @@ static void one(const uint8_t *buf, size_t len) {
             printf("\n");
         }
     }
+    {
+        fd_relative_state_msg m; /* the sixteenth decoder (protocol 9) */
+        e = fd_decode_relative_state(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_relative_state(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            u(m.chief_spacecraft_id);
+            u(m.deputy_spacecraft_id);
+            fs(m.r_dc_h_m, 3);
+            fs(m.v_dc_h_m_s, 3);
+            fs(&m.range_m, 1);
+            fs(&m.range_rate_m_s, 1);
+            printf("\n");
+        }
+    }
 }
 
 int main(void) {

@@ -648,6 +648,40 @@ static void test_gps(const char *dir) {
     printf("GpsMsg: decode ok\n");
 }
 
+/* RelativeStateMsg (protocol 9): the RELATIVE_STATE_GOLDEN table of proto/tests/golden.rs. */
+static void test_relative_state(const char *dir) {
+    uint8_t golden[256], enc[256];
+    size_t n = read_file(dir, "relative_state", golden, sizeof golden);
+    fd_relative_state_msg m, back;
+    static const double r[3] = {0.5, -100.0, 2.25}, v[3] = {0.125, -0.0, -3.5};
+    char key[128];
+    fd_error e;
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 1000u, 10000000000ull, 1000u);
+    m.chief_spacecraft_id = 1u;
+    m.deputy_spacecraft_id = SC;
+    memcpy(m.r_dc_h_m, r, sizeof r);
+    memcpy(m.v_dc_h_m_s, v, sizeof v);
+    m.range_m = 100.03125;
+    m.range_rate_m_s = -0.25;
+    check_encoded("RelativeStateMsg", golden, n, enc,
+                  fd_encode_relative_state(&m, enc, sizeof enc));
+    e = fd_decode_relative_state(golden, n, &back);
+    CHECK(e.status == FD_OK && same_header(&back.header, &m.header) &&
+              back.chief_spacecraft_id == 1u && back.deputy_spacecraft_id == SC &&
+              same_bits(back.r_dc_h_m, r, 3) && same_bits(back.v_dc_h_m_s, v, 3) &&
+              same_bits(&back.range_m, &m.range_m, 1) &&
+              same_bits(&back.range_rate_m_s, &m.range_rate_m_s, 1),
+          "RelativeStateMsg decodes to the table");
+    e = fd_decode_relative_state(golden, n - 1, &back);
+    CHECK(e.status == FD_ERR_LENGTH && e.needed == FD_RELATIVE_STATE_LEN,
+          "RelativeStateMsg short");
+    CHECK(fd_relative_state_key(key, sizeof key, "deputy", "chief") > 0 &&
+              strcmp(key, "flexdyn/deputy/tlm/rel/chief") == 0,
+          "relative state key");
+    printf("RelativeStateMsg: decode ok\n");
+}
+
 static void test_keys(void) {
     char key[128];
     CHECK(fd_state_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/tlm/state") == 0,
@@ -696,6 +730,7 @@ int main(int argc, char **argv) {
     test_gps(argv[1]);
     test_keys();
     test_faults(argv[1]);
+    test_relative_state(argv[1]);
     if (failures != 0) {
         fprintf(stderr, "%d check(s) failed\n", failures);
         return 1;

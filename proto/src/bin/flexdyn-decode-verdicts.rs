@@ -3,8 +3,9 @@
 //! `proto/c/tests/fuzz_decode.c`, the Python package's `tests/test_proto_fuzz.py`).
 //!
 //! Input (stdin): records of a u32 LE length and that many bytes. Output (stdout): per record,
-//! fifteen lines, one per decoder (state, imu, star tracker, magnetometer, css, fss,
-//! environment, command, status, time, operator, header, gps, fault event, fault command):
+//! sixteen lines, one per decoder (state, imu, star tracker, magnetometer, css, fss,
+//! environment, command, status, time, operator, header, gps, fault event, fault command,
+//! relative state):
 //! `E <reason> [numbers or field]` for an error (the `DecodeError` variant; `Length needed
 //! actual`, `TrailingBytes expected actual`, `TooLarge actual`, `UnknownVersion found`,
 //! `NonFinite field`, `Malformed`), or `O <fields>` for a decoded message: every field in wire
@@ -23,6 +24,8 @@ use flexdyn_proto::{
 use flexdyn_proto::{decode_gps, GpsMsg};
 // Fault injection (protocol 8), the fourteenth and fifteenth decoders.
 use flexdyn_proto::{decode_fault_command, decode_fault_event, FaultCommandMsg, FaultEventMsg};
+// A fleet deputy's relative state (protocol 9), the sixteenth decoder.
+use flexdyn_proto::{decode_relative_state, RelativeStateMsg};
 
 fn err_line(e: &DecodeError) -> String {
     match e {
@@ -289,7 +292,18 @@ fn fault_command_line(m: &FaultCommandMsg) -> String {
     l.0
 }
 
-/// The fifteen verdicts for one buffer, in the order of the module docs.
+fn relative_state_line(m: &RelativeStateMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header)
+        .u(m.chief_spacecraft_id.into())
+        .u(m.deputy_spacecraft_id.into())
+        .f(&m.r_dc_h_m)
+        .f(&m.v_dc_h_m_s)
+        .f(&[m.range_m, m.range_rate_m_s]);
+    l.0
+}
+
+/// The sixteen verdicts for one buffer, in the order of the module docs.
 fn rust_lines(b: &[u8]) -> Vec<String> {
     fn line<M>(r: Result<M, DecodeError>, f: impl Fn(&M) -> String) -> String {
         match r {
@@ -327,6 +341,7 @@ fn rust_lines(b: &[u8]) -> Vec<String> {
         line(decode_gps(b), gps_line),
         line(decode_fault_event(b), fault_event_line),
         line(decode_fault_command(b), fault_command_line),
+        line(decode_relative_state(b), relative_state_line),
     ]
 }
 

@@ -281,6 +281,8 @@ impl TickAssembler {
             Telemetry::Time => return Ok(()),
             // Nor is the environment message (truth for operators, after the state).
             Telemetry::Environment => return Ok(()),
+            // Nor is a fleet deputy's relative state (after the state; Client::subscribe).
+            Telemetry::Relative(_) => return Ok(()),
             Telemetry::State => Msg::State(Box::new(decode_state(payload)?)),
             Telemetry::Imu(name) => match s.imus.iter().position(|n| n == name) {
                 Some(i) => Msg::Imu(i, decode_imu(payload)?),

@@ -21,10 +21,19 @@
 //!   goes out with `CongestionControl::Drop`, commands are taken as they have arrived).
 //! - **Settings**: the first vehicle's `[server]` table with the command-line options on top;
 //!   the ids and participants are the fleet file's (`--sc-id`, `--spacecraft-id`,
-//!   `--participants` are refused with `--fleet`). Not in fleet mode yet: `--record`, the
-//!   operator's pause/resume (`flexdyn/<id>/operator`), real-time lateness in StatusMsg.
+//!   `--participants` are refused with `--fleet`). Not in fleet mode yet: real-time lateness
+//!   in StatusMsg.
+//! - **`--record`**: one MCAP file holds every vehicle (each described by its configuration),
+//!   its frames, statuses and commands, and each deputy's relative states. The physics thread
+//!   queues what it publishes (lockstep and batch wait for the recorder; real time drops and
+//!   counts what the recorder cannot take, and never waits).
+//! - **Operator**: an OperatorMsg on any vehicle's `flexdyn/<id>/operator` pauses, resumes or
+//!   (lockstep) runs N ticks of the whole fleet: one hold target for the fleet, every vehicle's
+//!   StatusMsg says `Paused` while held and its TimeMsg of the held tick too. A refusal counts
+//!   in that vehicle's `rejected.operator_refused`.
 
 mod physics;
+mod relative;
 pub mod stepper;
 
 use std::future::Future;
@@ -42,6 +51,7 @@ use super::cli::RunArgs;
 use super::commands::Gate;
 use super::error::{ServerError, SettingsError};
 use super::intake::{self, CommandSink};
+use super::operator;
 use super::presence::Presence;
 use super::report::RunReport;
 use super::settings::{mode_name, ServerSettings};
@@ -70,6 +80,8 @@ pub struct FleetReport {
     /// \[ns\] wall time the physics thread spent waiting for commands (lockstep: the barrier,
     /// which holds the participants' own time and the network's).
     pub wait_ns: u64,
+    /// `--record`: what the file holds.
+    pub recording: Option<crate::sinks::recorder::RecordReport>,
 }
 
 impl FleetReport {
@@ -115,14 +127,6 @@ fn vehicle_settings(base: &ServerSettings, v: &crate::world::VehicleConfig) -> S
 /// The fleet's settings, checked: every participant of every vehicle (for the
 /// `participant_subjects` check), and no option fleet mode does not have.
 fn check_settings(base: &ServerSettings, fleet: &FleetConfig) -> Result<(), ServerError> {
-    if base.record.is_some() {
-        return Err(SettingsError::Invalid {
-            name: "--record".into(),
-            problem: "not available with --fleet yet (record the vehicles with `flexdyn record`)"
-                .into(),
-        }
-        .into());
-    }
     let mut all: Vec<u32> = fleet
         .vehicles
         .iter()
@@ -165,6 +169,7 @@ pub async fn run(
         .map(|v| vehicle_settings(&settings, v))
         .collect();
     let world = World::new(&fleet)?;
+    let pairs = world.relative_pairs().to_vec();
     let frame_ns = world.vehicles().first().map_or(1, |v| v.sim.frame_ns());
     let total_frames = settings.duration_frames(frame_ns)?;
     let mut vehicles = world.into_vehicles();
@@ -194,6 +199,13 @@ pub async fn run(
     let mut telemetry = Vec::with_capacity(vehicles.len());
     let mut presences = Vec::new();
     let mut faults = Vec::with_capacity(vehicles.len());
+    // `--record`: one file for the fleet; each vehicle is described as it is declared.
+    let recorder = setup::open_recorder(&settings)?;
+    let record_tx = recorder.as_ref().map(|(_, tx)| tx.clone());
+    let mut recordings = Vec::with_capacity(vehicles.len());
+    // The operator's hold target, one for the fleet.
+    let hold = Arc::new(Shared::default());
+    let mut operators = Vec::with_capacity(vehicles.len());
     for (i, (v, vs)) in vehicles.iter().zip(&vsettings).enumerate() {
         let named = |e: ServerError| ServerError::Vehicle {
             vehicle: v.id.clone(),
@@ -217,6 +229,12 @@ pub async fn run(
         let config = setup::serve_config(&session, &topics, &endpoints.vehicle)
             .await
             .map_err(named)?;
+        let recording = record_tx.as_ref().map(|tx| {
+            tx.describe_vehicle(endpoints.vehicle.clone());
+            endpoints
+                .frames
+                .recording(tx.clone(), &endpoints.status_pub)
+        });
         let sh = Arc::new(Shared::new(&vs.participants));
         sh.set_run_state(RunState::Starting);
         let gate = Gate::new(
@@ -228,7 +246,7 @@ pub async fn run(
             vehicle: i,
             queue: Mutex::new((cmd_tx.clone(), gate)),
         };
-        let commands = intake::declare(&session, &topics, sink, sh.clone(), vs, None)
+        let commands = intake::declare(&session, &topics, sink, sh.clone(), vs, record_tx.clone())
             .await
             .map_err(named)?;
         // Live faults: resolved on the Zenoh thread against this vehicle, installed by the
@@ -249,6 +267,20 @@ pub async fn run(
         .await
         .map_err(named)?;
         faults.push((fault_rx, fault_recycle_tx));
+        operators.push(
+            operator::declare(
+                &session,
+                &topics,
+                sh.clone(),
+                mode,
+                v.spacecraft_id,
+                None,
+                record_tx.clone(),
+                hold.clone(),
+            )
+            .await
+            .map_err(named)?,
+        );
         if mode == Mode::Lockstep {
             let presence = Presence::declare(&session, &topics, sh.clone())
                 .await
@@ -268,16 +300,31 @@ pub async fn run(
             shared: sh.clone(),
             settings: vs.clone(),
             frame_ns,
-            record: None,
+            record: recording.clone(),
         };
         telemetry.push(super::spawn_telemetry(ctx).map_err(named)?.0);
         publishers.push(endpoints.frames);
         shared.push(sh);
         recycle.push(recycle_tx);
         alive.push(full_tx);
+        recordings.push(recording);
         keep.push((config, commands, fault_commands));
     }
     drop(cmd_tx);
+    // Each deputy's relative state, on its own key (`flexdyn/<deputy>/tlm/rel/<chief>`).
+    let mut relative = Vec::with_capacity(pairs.len());
+    for &(c, d) in &pairs {
+        let deputy = &vehicles[d].id;
+        let topics = Topics::new(deputy)
+            .map_err(|e| ServerError::Internal(format!("vehicle id {deputy:?}: {e}")))?;
+        let rp = relative::RelativePublisher::declare(&session, mode, &topics, &vehicles[c].id)
+            .await
+            .map_err(|e| ServerError::Vehicle {
+                vehicle: deputy.clone(),
+                source: Box::new(e),
+            })?;
+        relative.push(rp);
+    }
     let _realtime = super::RealtimeHold::acquire(&settings)?;
 
     // Lockstep: tick 0 waits for every participant of every vehicle.
@@ -303,6 +350,9 @@ pub async fn run(
             for t in telemetry {
                 let _ = t.await;
             }
+            drop(keep);
+            drop(operators);
+            let recording = super::finish_recording(recorder)?;
             ready?;
             return Ok(FleetReport {
                 vehicles: vehicles
@@ -314,12 +364,13 @@ pub async fn run(
                 physics_ns: 0,
                 publish_ns: 0,
                 wait_ns: 0,
+                recording,
             });
         }
     }
 
     let ids: Vec<String> = vehicles.iter().map(|v| v.id.clone()).collect();
-    let stepper = FleetStepper::new(vehicles, &vsettings);
+    let stepper = FleetStepper::new(vehicles, &vsettings).with_relative_pairs(&pairs);
     let physics = FleetPhysics {
         settings: settings.clone(),
         total_frames,
@@ -327,6 +378,9 @@ pub async fn run(
         recycle,
         publishers,
         faults,
+        relative,
+        recordings,
+        hold,
         shared: shared.clone(),
         stop: stop.clone(),
         _telemetry_alive: alive,
@@ -341,7 +395,10 @@ pub async fn run(
             .map_err(|_| ServerError::Internal("a telemetry thread panicked".into()))?;
         lateness.push(tlm.lateness);
     }
+    // Commands stop arriving; the recorder writes what it holds and closes the file.
     drop(keep);
+    drop(operators);
+    let recording = super::finish_recording(recorder)?;
     let physics = result?;
     let vehicles = ids
         .into_iter()
@@ -358,6 +415,7 @@ pub async fn run(
         physics_ns: physics.physics_ns,
         publish_ns: physics.publish_ns,
         wait_ns: physics.wait_ns,
+        recording,
     };
     tracing::info!("{report}");
     Ok(report)

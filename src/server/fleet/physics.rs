@@ -23,10 +23,12 @@ use flexdyn_proto::{CommandMsg, Mode, RunState};
 
 use super::super::error::ServerError;
 use super::super::pacing::{FrameEnd, Pacer};
-use super::super::physics::{count_offer, Ending, PhysicsReport};
+use super::super::physics::{count_offer, Ending, PhysicsReport, HOLD_POLL};
 use super::super::publish::FramePublisher;
+use super::super::publish::Recording;
 use super::super::settings::ServerSettings;
 use super::super::shared::{Frame, Shared};
+use super::relative::RelativePublisher;
 use super::stepper::FleetStepper;
 use crate::faults::ports::{Installed, LiveRequest};
 use crate::transport::unix_now_ns;
@@ -49,6 +51,14 @@ pub(super) struct FleetPhysics {
     /// Per vehicle: its live fault requests (resolved by its fault callback), and the channel
     /// their boxes go back on, to its telemetry thread (never blocks).
     pub faults: Vec<(Receiver<LiveRequest>, SyncSender<Installed>)>,
+    /// Per (chief, deputy) pair of the stepper ([`FleetStepper::pairs`], same order): its
+    /// relative-state publisher.
+    pub relative: Vec<RelativePublisher>,
+    /// Per vehicle: the recorder's view of its keys (`--record`).
+    pub recordings: Vec<Option<Recording>>,
+    /// The fleet's operator hold target (and the tick published, which the operator decides
+    /// against): set by any vehicle's operator callback.
+    pub hold: Arc<Shared>,
     /// Per vehicle: its counters (its StatusMsg reads them).
     pub shared: Vec<Arc<Shared>>,
     /// Set to stop at the next frame boundary.
@@ -115,6 +125,31 @@ impl FleetPhysics {
             publish_ns: acc.publish_ns,
             wait_ns: acc.wait_ns,
         })
+    }
+
+    /// Holds the fleet at boundary `k` (already published) until the operator's hold target
+    /// moves past it or is cleared; `false` if a stop was requested meanwhile. Every vehicle's
+    /// status says `Paused` meanwhile; nothing is stepped or published here.
+    fn hold_fleet(&self, k: u64) -> bool {
+        for sh in &self.shared {
+            sh.held.store(true, Ordering::Release);
+        }
+        self.set_run_state(RunState::Paused);
+        let mut stopped = false;
+        while self.hold.holds_at(k) {
+            if self.stop.load(Ordering::Relaxed) {
+                stopped = true;
+                break;
+            }
+            std::thread::sleep(HOLD_POLL);
+        }
+        for sh in &self.shared {
+            sh.held.store(false, Ordering::Release);
+        }
+        if !stopped {
+            self.set_run_state(RunState::Running);
+        }
+        !stopped
     }
 
     /// Lockstep: waits until every participant of every vehicle has answered tick `k`.
@@ -231,17 +266,34 @@ impl FleetPhysics {
             for sh in &self.shared {
                 sh.tick.store(k, Ordering::Release);
             }
+            self.hold.tick.store(k, Ordering::Release);
+            // The operator's hold (one atomic load): this tick's time messages say `Paused`,
+            // and nothing follows until the hold is released. Never at the last tick.
+            let holding = self.hold.holds_at(k) && self.total_frames != Some(k);
+            if holding {
+                for v in &mut f.vehicles {
+                    v.frame.time.run_state = RunState::Paused;
+                }
+            }
             let stamp = unix_now_ns();
             let t = Instant::now();
-            for ((v, p), sh) in f
+            for (i, ((v, p), sh)) in f
                 .vehicles
                 .iter_mut()
                 .zip(&mut self.publishers)
                 .zip(&self.shared)
+                .enumerate()
             {
                 v.frame.boundary_unix_ns = stamp;
                 v.frame.lateness_ns = lateness_ns;
-                p.publish(&v.frame, sh, None);
+                let rec = self.recordings.get(i).and_then(Option::as_ref);
+                p.publish(&v.frame, sh, rec);
+                // Its relative states, after its frame.
+                for (pair, rp) in f.pairs.iter().zip(&mut self.relative) {
+                    if pair.deputy == i {
+                        rp.publish(pair, stamp, sh, rec);
+                    }
+                }
             }
             acc.publish_ns += ns_since(t);
             if self.total_frames == Some(k) {
@@ -250,6 +302,15 @@ impl FleetPhysics {
                     last_tick: k,
                     sim_time_ns: k.saturating_mul(frame_ns),
                 });
+            }
+            if holding {
+                if !self.hold_fleet(k) {
+                    return Ok(stopped(k));
+                }
+                // Real time: boundary k + 1 is due one period after the release.
+                if realtime {
+                    pacer.resume_after(k);
+                }
             }
 
             // 2. Commands for tick k.

@@ -4,14 +4,19 @@
 //!
 //! The vehicles do not act on one another ([`crate::world::step`]), so each vehicle's stream
 //! is the one it would have alone, bit for bit, whatever the fleet's order or size.
+//!
+//! Each (chief, deputy) pair of the fleet file ([`crate::world::World::relative_pairs`]) gets
+//! its [`RelativeStateMsg`] filled with the frames, from the two vehicles' states of the same
+//! tick ([`crate::world::relative`]): a few dozen flops per pair, no allocation.
 
-use flexdyn_proto::CommandMsg;
+use flexdyn_proto::{CommandMsg, Header, RelativeStateMsg};
 
 use super::super::commands::Offer;
 use super::super::error::ServerError;
 use super::super::physics::Stepper;
 use super::super::settings::ServerSettings;
 use super::super::shared::Frame;
+use crate::world::relative::{com_state_n, relative_state_hill};
 use crate::world::Vehicle;
 
 /// One vehicle of the running fleet.
@@ -24,10 +29,23 @@ pub struct FleetVehicle {
     pub frame: Box<Frame>,
 }
 
+/// A (chief, deputy) pair of the running fleet and its relative state of the last tick filled.
+pub struct RelativePair {
+    /// The chief's index in [`FleetStepper::vehicles`].
+    pub chief: usize,
+    /// The deputy's index (listed after its chief).
+    pub deputy: usize,
+    /// The deputy's state relative to the chief at the last tick filled (published on
+    /// `flexdyn/<deputy>/tlm/rel/<chief>` after the deputy's frame).
+    pub msg: RelativeStateMsg,
+}
+
 /// Every vehicle of the fleet, stepped together.
 pub struct FleetStepper {
     /// The vehicles, in fleet order.
     pub vehicles: Vec<FleetVehicle>,
+    /// The (chief, deputy) pairs, in the deputies' fleet order.
+    pub pairs: Vec<RelativePair>,
 }
 
 impl FleetStepper {
@@ -50,7 +68,27 @@ impl FleetStepper {
                 }
             })
             .collect();
-        Self { vehicles }
+        Self {
+            vehicles,
+            pairs: Vec::new(),
+        }
+    }
+
+    /// With the relative states of these (chief, deputy) index pairs
+    /// ([`crate::world::World::relative_pairs`]); a pair naming a vehicle out of range is left
+    /// out.
+    pub fn with_relative_pairs(mut self, pairs: &[(usize, usize)]) -> Self {
+        let n = self.vehicles.len();
+        self.pairs = pairs
+            .iter()
+            .filter(|&&(c, d)| c < n && d < n && c != d)
+            .map(|&(chief, deputy)| RelativePair {
+                chief,
+                deputy,
+                msg: RelativeStateMsg::default(),
+            })
+            .collect();
+        self
     }
 
     /// Lockstep: tick `k` begins; every participant of every vehicle owes an answer (a
@@ -110,6 +148,13 @@ impl FleetStepper {
                 });
             }
         }
+        for p in &mut self.pairs {
+            let (Some(c), Some(d)) = (self.vehicles.get(p.chief), self.vehicles.get(p.deputy))
+            else {
+                continue;
+            };
+            p.msg = relative_msg(c, d, k);
+        }
         Ok(())
     }
 
@@ -119,4 +164,36 @@ impl FleetStepper {
             .first()
             .map_or(1, |v| v.stepper.sim.frame_ns())
     }
+}
+
+/// The deputy `d`'s state relative to the chief `c` at tick `k` (both just filled), with the
+/// deputy's header (`seq` = `k`: one message per frame). A chief without an orbit plane (its
+/// position and velocity parallel) has no Hill frame: the H fields are then 0, the range and
+/// its rate still computed.
+fn relative_msg(c: &FleetVehicle, d: &FleetVehicle, k: u64) -> RelativeStateMsg {
+    let (r_c, v_c) = com_state_n(c.stepper.sim.spacecraft());
+    let (r_d, v_d) = com_state_n(d.stepper.sim.spacecraft());
+    let header = &d.frame.state.header;
+    let mut msg = RelativeStateMsg {
+        header: Header::new(header.spacecraft_id, k, header.sim_time_ns, k),
+        chief_spacecraft_id: c.frame.state.header.spacecraft_id,
+        deputy_spacecraft_id: header.spacecraft_id,
+        ..RelativeStateMsg::default()
+    };
+    match relative_state_hill(&r_c, &v_c, &r_d, &v_d) {
+        Some(rel) => {
+            msg.r_dc_h_m = rel.r_dc_h_m.into();
+            msg.v_dc_h_m_s = rel.v_dc_h_m_s.into();
+            msg.range_m = rel.range_m;
+            msg.range_rate_m_s = rel.range_rate_m_s;
+        }
+        None => {
+            let (dr, dv) = (r_d - r_c, v_d - v_c);
+            msg.range_m = dr.norm();
+            if msg.range_m > 0.0 {
+                msg.range_rate_m_s = dr.dot(&dv) / msg.range_m;
+            }
+        }
+    }
+    msg
 }

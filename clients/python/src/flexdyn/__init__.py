@@ -17,6 +17,7 @@ from .proto import (CommandMsg, CssMsg, DecodeError, EffectorInput, EffectorStat
                     StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
 from .proto import GpsMsg  # protocol 7
 from .proto import FaultCommandMsg, FaultEventMsg  # protocol 8
+from .proto import RelativeStateMsg  # protocol 9
 
 __all__ = [
     "proto", "Client", "Subscription", "VehicleInfo", "session_config", "Answer",
@@ -24,6 +25,6 @@ __all__ = [
     "EffectorInput", "EffectorState", "EnvironmentMsg", "Header", "ImuMsg", "MagnetometerMsg", "StarTrackerMsg",
     "StateMsg",
     "StatusMsg", "TimeMsg", "CssMsg", "FssMsg", "OperatorMsg", "GpsMsg",
-    "FaultCommandMsg", "FaultEventMsg",
+    "FaultCommandMsg", "FaultEventMsg", "RelativeStateMsg",
 ]
 __version__ = "0.1.0"

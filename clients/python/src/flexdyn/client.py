@@ -72,6 +72,7 @@ _DECODERS = {"state": StateMsg.decode, "imu": ImuMsg.decode, "st": StarTrackerMs
              "time": TimeMsg.decode, "env": EnvironmentMsg.decode}
 _DECODERS["gps"] = proto.GpsMsg.decode  # protocol 7: tlm/gps/<name>
 _DECODERS["fault"] = proto.FaultEventMsg.decode  # protocol 8: tlm/fault
+_DECODERS["rel"] = proto.RelativeStateMsg.decode  # protocol 9: tlm/rel/<chief>
 
 
 class Subscription:
@@ -246,6 +247,15 @@ class Client:
         """Calls `callback` with every FaultEventMsg (``flexdyn/<sc>/tlm/fault``): a fault's
         activation or clearance, at the frame boundary where it takes effect (protocol 8)."""
         return self._telemetry_add("fault", callback)
+
+    def subscribe_relative_state(self, chief: str,
+                                 callback: Callable[[proto.RelativeStateMsg], None]
+                                 ) -> Subscription:
+        """Calls `callback` with every RelativeStateMsg of this vehicle (a fleet deputy)
+        relative to vehicle `chief` (``flexdyn/<sc>/tlm/rel/<chief>``, every frame after the
+        StateMsg; protocol 9)."""
+        key = proto.relative_state_key(self.sc_id, chief)
+        return self._telemetry_add(key[len(self._tlm_prefix):], callback)
 
     def _clock(self) -> threading.Condition:
         # Under _dispatch (not _lock: a callback that sends holds _dispatch, then takes _lock).

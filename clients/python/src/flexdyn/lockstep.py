@@ -198,8 +198,10 @@ class LockstepParticipant:
     # -- assembling ticks (on the client's telemetry thread, one sample at a time) ------------
 
     def _on_sample(self, route: str, msg) -> None:
-        if route in ("time", "env", "fault"):
-            return  # the time service, environment truth and fault events are not sensor samples
+        if route in ("time", "env", "fault") or route.startswith("rel/"):
+            # The time service, environment truth, fault events and a fleet deputy's relative
+            # state are not sensor samples.
+            return
         tick = msg.header.tick
         if tick <= self._last_tick:
             return  # a tick already answered (a sample that came after its timeout)

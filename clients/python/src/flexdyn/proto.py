@@ -24,7 +24,7 @@ import struct
 from dataclasses import dataclass, field
 from typing import ClassVar, List, Optional, Tuple
 
-PROTOCOL_VERSION = 8
+PROTOCOL_VERSION = 9
 HEADER_LEN = 30
 STATE_FIXED_LEN = 327
 STATE_EFFECTOR_COUNT_OFFSET = 319
@@ -49,6 +49,8 @@ ENVIRONMENT_LEN = 368
 GPS_LEN = 147
 # Fault injection (protocol 8).
 FAULT_EVENT_LEN = 199
+# A fleet deputy's relative state (protocol 9)
+RELATIVE_STATE_LEN = 102
 FAULT_COMMAND_LEN = 214
 FAULT_TARGET_LEN = 128
 MAX_STATUS_FAULTS = 256
@@ -793,6 +795,38 @@ class FaultEventMsg:
 
 
 @dataclass
+class RelativeStateMsg:
+    """A fleet deputy's state relative to its chief (``flexdyn/<deputy>/tlm/rel/<chief>``,
+    protocol 9), every frame after the deputy's StateMsg. Both vehicles at their centres of
+    mass; H is the chief's Hill frame (x radial, z along the orbit normal, y along-track):
+    ``r_dc_h_m`` (m), ``v_dc_h_m_s`` (its rate seen in H, m/s), ``range_m``,
+    ``range_rate_m_s`` (negative while closing). ``header.spacecraft_id`` is the deputy's."""
+
+    header: Header = field(default_factory=Header)
+    chief_spacecraft_id: int = 0
+    deputy_spacecraft_id: int = 0
+    r_dc_h_m: Vec3 = (0.0, 0.0, 0.0)
+    v_dc_h_m_s: Vec3 = (0.0, 0.0, 0.0)
+    range_m: float = 0.0
+    range_rate_m_s: float = 0.0
+
+    _BODY: ClassVar[struct.Struct] = struct.Struct("<II8d")
+
+    def encode(self) -> bytes:
+        return self.header.encode() + self._BODY.pack(
+            self.chief_spacecraft_id, self.deputy_spacecraft_id, *self.r_dc_h_m,
+            *self.v_dc_h_m_s, self.range_m, self.range_rate_m_s)
+
+    @staticmethod
+    def decode(buf: bytes) -> "RelativeStateMsg":
+        _check_size_and_version(buf, RELATIVE_STATE_LEN)
+        _check_total(RELATIVE_STATE_LEN, buf)
+        f = RelativeStateMsg._BODY.unpack_from(buf, HEADER_LEN)
+        return RelativeStateMsg(Header.unpack(buf), f[0], f[1], tuple(f[2:5]), tuple(f[5:8]),
+                                f[8], f[9])
+
+
+@dataclass
 class FaultCommandMsg:
     """A live fault command (``flexdyn/<sc-id>/fault``, protocol 8): ``FAULT_INJECT`` the fault
     described (``target``, ``mode``, ``params``, ``axes``, ``duration_ns`` 0 = until cleared,
@@ -945,6 +979,12 @@ def fault_key(sc: str) -> str:
 def fault_event_key(sc: str) -> str:
     """``flexdyn/<sc>/tlm/fault``: fault activations and clearances (FaultEventMsg, protocol 8)."""
     return _key(sc, "tlm/fault")
+
+
+def relative_state_key(deputy: str, chief: str) -> str:
+    """``flexdyn/<deputy>/tlm/rel/<chief>``: a fleet deputy's state relative to its chief
+    (RelativeStateMsg, protocol 9)."""
+    return _key(deputy, "tlm/rel", chief)
 
 
 def telemetry_key(sc: str) -> str:
