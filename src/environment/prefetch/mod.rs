@@ -31,16 +31,27 @@
 //!
 //! # The hand-off
 //! One request and one answer, in a slot of atomics (no lock, no allocation): the physics thread
-//! writes a request and marks it `REQUESTED`, then unparks the worker (one `futex` wake); the
-//! worker claims it (`WORKING`), evaluates it, writes the sample and marks it `DONE`. The physics
+//! writes a request and marks it `REQUESTED`; the worker claims it (`WORKING`), evaluates it,
+//! writes the sample and marks it `DONE`. The physics
 //! thread reads a `DONE` answer whose time and position match its request; anything else
 //! (`REQUESTED`, `WORKING`, a stale answer) means "evaluate it here". A request the worker has
 //! not claimed is withdrawn then, so it does no useless work; while it is `WORKING` on a stale
 //! request, the next one is evaluated on the physics thread too, and nothing waits.
+//!
+//! # Nobody wakes the worker: it polls
+//! The physics thread makes no system call. Waking a parked thread is a `futex` wake, which on
+//! this project's 2-vCPU VM costs several microseconds (an inter-processor interrupt through the
+//! hypervisor): at a 10 Hz update of a 1 kHz step that was ~70 ns per step, so offloading the
+//! models cost the stepping thread more than evaluating them there (`benches/step.rs`, "all @
+//! 10 Hz, offloaded"). Instead the worker sleeps between looks at the slot for an eighth of the
+//! wall time between the physics thread's recent requests ([`poll_period`]: 20 µs to 5 ms), so it
+//! claims a request within about an eighth of the time the answer has before it is needed, and
+//! costs ~200 short wake-ups a second in a real-time run (10 Hz updates).
 
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
 use std::sync::Arc;
 use std::thread::{JoinHandle, Thread};
+use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
 
@@ -168,6 +179,8 @@ struct Slot {
     state: AtomicU8,
     /// Answers the physics thread took from the worker (a statistic).
     taken: AtomicU64,
+    /// Requests posted by the physics thread (the worker paces its polling by their rate).
+    posted: AtomicU64,
     stop: AtomicBool,
     request: [AtomicU64; REQUEST_WORDS],
     answer: [AtomicU64; ANSWER_WORDS],
@@ -178,6 +191,7 @@ impl Slot {
         Self {
             state: AtomicU8::new(IDLE),
             taken: AtomicU64::new(0),
+            posted: AtomicU64::new(0),
             stop: AtomicBool::new(false),
             request: std::array::from_fn(|_| AtomicU64::new(0)),
             answer: std::array::from_fn(|_| AtomicU64::new(0)),
@@ -259,6 +273,58 @@ impl Slot {
     }
 }
 
+/// \[s\] the bounds of the worker's polling period: below 20 µs a sleep is mostly the kernel's
+/// timer slack (50 µs by default); above 5 ms a run whose requests slow down (a lockstep run
+/// held by its participant) waits at most that long for its first answers at the new pace.
+const POLL_MIN: Duration = Duration::from_micros(20);
+const POLL_MAX: Duration = Duration::from_millis(5);
+/// \[s\] how long without a request before the worker starts polling less often.
+const IDLE_BACKOFF: Duration = Duration::from_secs(1);
+
+/// The worker's polling period: an eighth of the wall time between the requests posted since its
+/// last look ([`poll_period`]), kept while none arrive.
+#[derive(Debug, Clone, Copy)]
+struct Pace {
+    /// The posted count and the time of the last look at which it had changed.
+    seen: (u64, Instant),
+    poll: Duration,
+}
+
+impl Pace {
+    fn new(now: Instant) -> Self {
+        Pace {
+            seen: (0, now),
+            poll: Duration::from_millis(1),
+        }
+    }
+
+    /// The sleep before the next look, having seen `posted` requests in all at `now`. Quick to
+    /// shorten, slow to lengthen: a new rate's period is taken at once if shorter, and at most
+    /// doubles the last one if longer, so a pause between bursts of requests (a batch run
+    /// between other work, a lockstep run waiting a moment for its participant) does not leave
+    /// the worker asleep when the next burst starts. After [`IDLE_BACKOFF`] without a request
+    /// the period doubles at every look, up to [`POLL_MAX`]: a paused run costs the worker ~200
+    /// wake-ups a second.
+    fn next_poll(&mut self, posted: u64, now: Instant) -> Duration {
+        let (before, at) = self.seen;
+        let since = now.saturating_duration_since(at);
+        if posted != before {
+            self.poll = poll_period(since, posted.wrapping_sub(before)).min(self.poll * 2);
+            self.seen = (posted, now);
+        } else if since > IDLE_BACKOFF {
+            self.poll = (self.poll * 2).min(POLL_MAX);
+        }
+        self.poll
+    }
+}
+
+/// An eighth of the mean wall time between `n` requests that came within `elapsed`, within
+/// [`POLL_MIN`]..=[`POLL_MAX`].
+fn poll_period(elapsed: Duration, n: u64) -> Duration {
+    let per_request = elapsed / u32::try_from(n).unwrap_or(u32::MAX).max(1);
+    (per_request / 8).clamp(POLL_MIN, POLL_MAX)
+}
+
 /// A worker thread that evaluates the next environment sample ahead of time (module docs).
 /// Dropping it stops and joins the thread.
 pub struct Prefetcher {
@@ -285,9 +351,11 @@ impl Prefetcher {
         let handle = std::thread::Builder::new()
             .name("flexdyn-environment".into())
             .spawn(move || {
+                let mut pace = Pace::new(Instant::now());
                 while !worker_slot.stop.load(Ordering::Acquire) {
                     if !worker_slot.serve(&fill) {
-                        std::thread::park();
+                        let posted = worker_slot.posted.load(Ordering::Relaxed);
+                        std::thread::park_timeout(pace.next_poll(posted, Instant::now()));
                     }
                 }
             })?;
@@ -298,13 +366,12 @@ impl Prefetcher {
         })
     }
 
-    /// Hands `req` to the worker (physics thread; no allocation, no lock: atomics and one
-    /// `futex` wake).
+    /// Hands `req` to the worker (physics thread; no allocation, no lock, no system call:
+    /// atomics only; the worker polls, see the module docs).
     #[inline]
     pub fn post(&self, req: &Request) {
-        if self.slot.post(req) {
-            self.thread.unpark();
-        }
+        self.slot.post(req);
+        self.slot.posted.fetch_add(1, Ordering::Relaxed);
     }
 
     /// The worker's answer to `req`, if it is ready (physics thread; `None`: evaluate it here).
@@ -434,6 +501,42 @@ mod tests {
         // The third-order term matters: without it the error is r (nΔ)³/6, 1e-6 m.
         let second = r * (n * dt_s).powi(3) / 6.0;
         assert!(second > 10.0 * bound);
+    }
+
+    #[test]
+    fn the_worker_polls_at_an_eighth_of_the_request_interval_within_bounds() {
+        let ms = Duration::from_millis;
+        // 100 ms between requests (10 Hz updates in real time): capped at 5 ms.
+        assert_eq!(poll_period(ms(200), 2), POLL_MAX);
+        // 1.6 ms between requests: 200 µs.
+        assert_eq!(poll_period(ms(16), 10), Duration::from_micros(200));
+        // 80 µs between requests (a batch run): 10 µs, raised to 20 µs.
+        assert_eq!(poll_period(Duration::from_micros(800), 10), POLL_MIN);
+        // The pace: 1 ms at first; a faster rate is followed at once, a slower one at most
+        // doubles the period per look; idle for over 1 s, it doubles per look up to 5 ms.
+        let us = Duration::from_micros;
+        let t0 = Instant::now();
+        let mut pace = Pace::new(t0);
+        assert_eq!(pace.next_poll(0, t0 + ms(10)), ms(1));
+        // 4 requests since t0, 13.2 ms ago: 3.3 ms each, an eighth is 412.5 µs.
+        assert_eq!(
+            pace.next_poll(4, t0 + us(13_200)),
+            us(412) + Duration::from_nanos(500)
+        );
+        // 8 in the next 800 µs: 100 µs each, 20 µs at once.
+        assert_eq!(pace.next_poll(12, t0 + us(14_000)), POLL_MIN);
+        // One after a 100 ms gap: an eighth would be 12.5 ms; at most 40 µs now.
+        assert_eq!(pace.next_poll(13, t0 + us(114_000)), us(40));
+        // Quiet for 1 s: kept; then doubled per look.
+        assert_eq!(pace.next_poll(13, t0 + us(1_114_000)), us(40));
+        assert_eq!(pace.next_poll(13, t0 + us(1_114_001)), us(80));
+        let looks: Vec<Duration> = (2..8)
+            .map(|k| pace.next_poll(13, t0 + us(1_114_000 + k)))
+            .collect();
+        assert_eq!(
+            looks,
+            [us(160), us(320), us(640), us(1280), us(2560), POLL_MAX]
+        );
     }
 
     #[test]
