@@ -52,6 +52,7 @@ pub mod error;
 pub mod fault_cmd;
 pub mod fleet;
 mod intake;
+mod lateness_ring;
 pub mod lockstep;
 pub mod operator;
 pub mod pacing;
@@ -414,6 +415,7 @@ impl Wiring {
             settings: settings.clone(),
             frame_ns,
             record: recording,
+            lateness_ring: None,
         };
         Ok(Self {
             frames,

@@ -18,6 +18,7 @@ use hdrhistogram::Histogram;
 use zenoh::pubsub::Publisher;
 use zenoh::Wait;
 
+use super::lateness_ring::LatenessRing;
 use super::publish::{FramePublisher, Recording};
 use super::reject_log::RejectLog;
 use super::settings::{mode_name, ServerSettings};
@@ -48,6 +49,18 @@ pub fn timing_of(h: &Histogram<u64>, overruns: u64, skipped: u64) -> FrameTiming
         lateness_max_ns: max,
         overrun_count: overruns,
         frames_skipped: skipped,
+    }
+}
+
+/// Records the lateness values new in `ring` into `h`; a value the ring overwrote before this
+/// thread woke (4 s of 1 kHz frames late) is logged, not invented.
+fn drain_lateness(ring: &LatenessRing, next: &mut u64, h: &mut Histogram<u64>) {
+    let missed = ring.drain(next, |ns| h.saturating_record(ns.min(LATENESS_MAX_NS)));
+    if missed > 0 {
+        tracing::warn!(
+            missed,
+            "frame lateness values overwritten before they were read"
+        );
     }
 }
 
@@ -82,6 +95,9 @@ pub struct TelemetryCtx {
     /// The recorder's queue (`flexdyn run --record`) for the frames that come here and the
     /// status.
     pub record: Option<Recording>,
+    /// Fleet mode, real time: the frames' lateness, from the fleet's physics thread (the
+    /// frames do not come here), with this thread's read position.
+    pub lateness_ring: Option<(Arc<LatenessRing>, u64)>,
 }
 
 struct Publishing {
@@ -255,6 +271,9 @@ impl TelemetryCtx {
             let wait = next_status
                 .min(next_summary)
                 .saturating_duration_since(Instant::now());
+            if let Some((ring, next)) = &mut self.lateness_ring {
+                drain_lateness(ring, next, &mut p.lateness);
+            }
             // Free the commands and fault requests the physics thread is done with.
             while self.recycle_rx.try_recv().is_ok() {}
             while self.fault_recycle_rx.try_recv().is_ok() {}
@@ -291,6 +310,9 @@ impl TelemetryCtx {
                 Err(RecvTimeoutError::Timeout) => {}
                 Err(RecvTimeoutError::Disconnected) => break,
             }
+        }
+        if let Some((ring, next)) = &mut self.lateness_ring {
+            drain_lateness(ring, next, &mut p.lateness);
         }
         self.warn_physics_rejects(
             &mut rejects,

@@ -21,8 +21,11 @@
 //!   goes out with `CongestionControl::Drop`, commands are taken as they have arrived).
 //! - **Settings**: the first vehicle's `[server]` table with the command-line options on top;
 //!   the ids and participants are the fleet file's (`--sc-id`, `--spacecraft-id`,
-//!   `--participants` are refused with `--fleet`). Not in fleet mode yet: real-time lateness
-//!   in StatusMsg.
+//!   `--participants` are refused with `--fleet`).
+//! - **Lateness** (real time): the fleet has one frame boundary, so one lateness per frame; the
+//!   physics thread hands it to every vehicle's telemetry thread through a ring of atomics
+//!   ([`super::lateness_ring`]), and each vehicle's StatusMsg and report carry its p50, p99 and
+//!   maximum, as a one-vehicle server's do.
 //! - **`--record`**: one MCAP file holds every vehicle (each described by its configuration),
 //!   its frames, statuses and commands, and each deputy's relative states. The physics thread
 //!   queues what it publishes (lockstep and batch wait for the recorder; real time drops and
@@ -51,6 +54,7 @@ use super::cli::RunArgs;
 use super::commands::Gate;
 use super::error::{ServerError, SettingsError};
 use super::intake::{self, CommandSink};
+use super::lateness_ring::LatenessRing;
 use super::operator;
 use super::presence::Presence;
 use super::report::RunReport;
@@ -205,6 +209,8 @@ pub async fn run(
     let mut recordings = Vec::with_capacity(vehicles.len());
     // The operator's hold target, one for the fleet.
     let hold = Arc::new(Shared::default());
+    // Real time: each frame boundary's lateness, for every vehicle's StatusMsg.
+    let lateness = Arc::new(LatenessRing::default());
     let mut operators = Vec::with_capacity(vehicles.len());
     for (i, (v, vs)) in vehicles.iter().zip(&vsettings).enumerate() {
         let named = |e: ServerError| ServerError::Vehicle {
@@ -301,6 +307,7 @@ pub async fn run(
             settings: vs.clone(),
             frame_ns,
             record: recording.clone(),
+            lateness_ring: Some((lateness.clone(), 0)),
         };
         telemetry.push(super::spawn_telemetry(ctx).map_err(named)?.0);
         publishers.push(endpoints.frames);
@@ -381,6 +388,7 @@ pub async fn run(
         relative,
         recordings,
         hold,
+        lateness,
         shared: shared.clone(),
         stop: stop.clone(),
         _telemetry_alive: alive,

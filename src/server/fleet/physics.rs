@@ -22,6 +22,7 @@ use std::time::{Duration, Instant};
 use flexdyn_proto::{CommandMsg, Mode, RunState};
 
 use super::super::error::ServerError;
+use super::super::lateness_ring::LatenessRing;
 use super::super::pacing::{FrameEnd, Pacer};
 use super::super::physics::{count_offer, Ending, PhysicsReport, HOLD_POLL};
 use super::super::publish::FramePublisher;
@@ -59,6 +60,8 @@ pub(super) struct FleetPhysics {
     /// The fleet's operator hold target (and the tick published, which the operator decides
     /// against): set by any vehicle's operator callback.
     pub hold: Arc<Shared>,
+    /// Real time: every frame boundary's lateness, for the vehicles' telemetry threads.
+    pub lateness: Arc<LatenessRing>,
     /// Per vehicle: its counters (its StatusMsg reads them).
     pub shared: Vec<Arc<Shared>>,
     /// Set to stop at the next frame boundary.
@@ -253,7 +256,10 @@ impl FleetPhysics {
             // 1. Frame boundary k: publish every vehicle's tick k.
             let lateness_ns = if realtime {
                 match pacer.wait_boundary(k, &self.stop) {
-                    Some(l) => l,
+                    Some(l) => {
+                        self.lateness.push(l);
+                        l
+                    }
                     None => return Ok(stopped(k.saturating_sub(1))),
                 }
             } else {
