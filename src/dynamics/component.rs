@@ -21,6 +21,7 @@ use std::fmt::Debug;
 
 use super::dynamic_effector::DynamicEffector;
 use super::effector::{EffectorKind, StateEffector};
+use crate::schema::kind_list::{list_entry, KindList};
 use crate::schema::{SchemaError, TableReader};
 use crate::validate::ParamError;
 
@@ -110,9 +111,9 @@ pub trait ComponentSpec: Debug + Send + Sync {
     fn box_clone(&self) -> Box<dyn ComponentSpec>;
     /// Whether `other` is the same kind with equal parameters.
     fn same_as(&self, other: &dyn ComponentSpec) -> bool;
-    /// For typed access ([`Components::of`]).
+    /// For typed access ([`KindList::of`]).
     fn as_any(&self) -> &dyn Any;
-    /// For typed access ([`Components::of_mut`]).
+    /// For typed access ([`KindList::of_mut`]).
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
 
@@ -156,86 +157,6 @@ pub(crate) fn read_boxed<P: ComponentParams>(
 
 /// The components configured through the generic list, grouped by kind in registry order and in
 /// file order within a kind (the order of the effector list after the typed bodies).
-#[derive(Debug, Default)]
-pub struct Components {
-    items: Vec<Box<dyn ComponentSpec>>,
-}
+pub type Components = KindList<dyn ComponentSpec>;
 
-impl Clone for Components {
-    fn clone(&self) -> Self {
-        Self {
-            items: self.items.iter().map(|c| c.box_clone()).collect(),
-        }
-    }
-}
-
-impl PartialEq for Components {
-    fn eq(&self, other: &Self) -> bool {
-        self.items.len() == other.items.len()
-            && self
-                .items
-                .iter()
-                .zip(&other.items)
-                .all(|(a, b)| a.same_as(b.as_ref()))
-    }
-}
-
-impl Components {
-    /// The list as given (the caller keeps registry order, then file order).
-    pub fn new(items: Vec<Box<dyn ComponentSpec>>) -> Self {
-        Self { items }
-    }
-
-    /// Every component, in effector order.
-    pub fn iter(&self) -> impl Iterator<Item = &dyn ComponentSpec> {
-        self.items.iter().map(|c| c.as_ref())
-    }
-
-    /// Each component with its configuration path (`thrusters[1]`: its index within its kind).
-    pub fn with_paths(&self) -> impl Iterator<Item = (String, &dyn ComponentSpec)> {
-        let mut index_in_kind = 0;
-        let mut last: Option<&'static str> = None;
-        self.items.iter().map(move |c| {
-            let section = c.kind().section;
-            if last != Some(section) {
-                last = Some(section);
-                index_in_kind = 0;
-            }
-            let path = format!("{section}[{index_in_kind}]");
-            index_in_kind += 1;
-            (path, c.as_ref())
-        })
-    }
-
-    /// The components of kind `P`, in file order.
-    pub fn of<P: ComponentParams>(&self) -> impl Iterator<Item = &P> {
-        self.items
-            .iter()
-            .filter_map(|c| c.as_any().downcast_ref::<P>())
-    }
-
-    /// The components of kind `P`, mutable (tests and campaigns that edit a built config).
-    pub fn of_mut<P: ComponentParams>(&mut self) -> impl Iterator<Item = &mut P> {
-        self.items
-            .iter_mut()
-            .filter_map(|c| c.as_any_mut().downcast_mut::<P>())
-    }
-
-    /// How many components of `kind` there are.
-    pub fn count(&self, kind: &ComponentKind) -> usize {
-        self.items
-            .iter()
-            .filter(|c| std::ptr::eq(c.kind(), kind))
-            .count()
-    }
-
-    /// Number of components (their effector entries).
-    pub fn len(&self) -> usize {
-        self.items.len()
-    }
-
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.items.is_empty()
-    }
-}
+list_entry!(dyn ComponentSpec, ComponentKind, section);

@@ -7,6 +7,7 @@
 
 use std::fmt;
 
+pub mod kind_list;
 pub(crate) mod plausible;
 pub(crate) mod reader;
 

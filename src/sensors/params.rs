@@ -12,6 +12,7 @@ use std::fmt::Debug;
 
 use super::SensorKind;
 use crate::config::{ConfigError, SensorContext};
+use crate::schema::kind_list::{list_entry, KindList};
 use crate::schema::plausible::Implausible;
 use crate::schema::{SchemaError, TableReader};
 
@@ -67,9 +68,9 @@ pub trait SensorSpec: Debug + Send + Sync {
     fn box_clone(&self) -> Box<dyn SensorSpec>;
     /// Whether `other` is the same kind with equal parameters.
     fn same_as(&self, other: &dyn SensorSpec) -> bool;
-    /// For typed access ([`SensorConfigs::of`]).
+    /// For typed access ([`KindList::of`]).
     fn as_any(&self) -> &dyn Any;
-    /// For typed access ([`SensorConfigs::of_mut`]).
+    /// For typed access ([`KindList::of_mut`]).
     fn as_any_mut(&mut self) -> &mut dyn Any;
 }
 
@@ -98,91 +99,6 @@ impl<P: SensorParams> SensorSpec for P {
 }
 
 /// Every configured sensor's parameters, in registry order then file order (the bank's order).
-#[derive(Debug, Default)]
-pub struct SensorConfigs {
-    items: Vec<Box<dyn SensorSpec>>,
-}
+pub type SensorConfigs = KindList<dyn SensorSpec>;
 
-impl Clone for SensorConfigs {
-    fn clone(&self) -> Self {
-        Self {
-            items: self.items.iter().map(|c| c.box_clone()).collect(),
-        }
-    }
-}
-
-impl PartialEq for SensorConfigs {
-    fn eq(&self, other: &Self) -> bool {
-        self.items.len() == other.items.len()
-            && self
-                .items
-                .iter()
-                .zip(&other.items)
-                .all(|(a, b)| a.same_as(b.as_ref()))
-    }
-}
-
-impl SensorConfigs {
-    /// The list as given (the caller keeps registry order, then file order).
-    pub fn new(items: Vec<Box<dyn SensorSpec>>) -> Self {
-        Self { items }
-    }
-
-    /// Every sensor, in bank order.
-    pub fn iter(&self) -> impl Iterator<Item = &dyn SensorSpec> {
-        self.items.iter().map(|c| c.as_ref())
-    }
-
-    /// Each sensor with its configuration path (`magnetometers[1]`: its index within its kind).
-    pub fn with_paths(&self) -> impl Iterator<Item = (String, &dyn SensorSpec)> {
-        let mut index_in_kind = 0;
-        let mut last: Option<&'static str> = None;
-        self.items.iter().map(move |c| {
-            let array = c.kind().config_array;
-            if last != Some(array) {
-                last = Some(array);
-                index_in_kind = 0;
-            }
-            let path = format!("{array}[{index_in_kind}]");
-            index_in_kind += 1;
-            (path, c.as_ref())
-        })
-    }
-
-    /// The sensors of kind `P`, in file order.
-    pub fn of<P: SensorParams>(&self) -> impl Iterator<Item = &P> {
-        self.items
-            .iter()
-            .filter_map(|c| c.as_any().downcast_ref::<P>())
-    }
-
-    /// The sensors of kind `P`, in file order, collected.
-    pub fn all<P: SensorParams>(&self) -> Vec<&P> {
-        self.of().collect()
-    }
-
-    /// The sensors of kind `P`, mutable (tests and campaigns that edit a built config).
-    pub fn of_mut<P: SensorParams>(&mut self) -> impl Iterator<Item = &mut P> {
-        self.items
-            .iter_mut()
-            .filter_map(|c| c.as_any_mut().downcast_mut::<P>())
-    }
-
-    /// How many sensors of `kind` there are.
-    pub fn count(&self, kind: &SensorKind) -> usize {
-        self.items
-            .iter()
-            .filter(|c| std::ptr::eq(c.kind(), kind))
-            .count()
-    }
-
-    /// Number of sensors.
-    pub fn len(&self) -> usize {
-        self.items.len()
-    }
-
-    /// Whether there are none.
-    pub fn is_empty(&self) -> bool {
-        self.items.is_empty()
-    }
-}
+list_entry!(dyn SensorSpec, SensorKind, config_array);
