@@ -476,3 +476,27 @@ fn fleet_campaign_errors_name_the_file_the_field_and_its_line() {
         "names the campaign too: {e}"
     );
 }
+
+/// A controller that commands several vehicles is one `[[controllers]]` entry whose sender id
+/// the fleet file lists for each of them (here sender 3 for both): it covers every vehicle's
+/// participant, so no other entry is needed, and without `sender_id` a vehicle with its one
+/// participant gets it by default.
+#[test]
+fn one_controller_may_command_several_vehicles() {
+    let dir = fleet_dir("campaign_fleet_shared_controller");
+    let fleet = std::fs::read_to_string(dir.join("fleet.toml"))
+        .unwrap()
+        .replace("participants = [1]", "participants = [3]")
+        .replace("participants = [2]", "participants = [3]");
+    std::fs::write(dir.join("fleet.toml"), fleet).unwrap();
+    let plan = plan_in(
+        &dir,
+        "fleet = \"fleet.toml\"\nruns = 2\nseed = 1\nduration_s = 1.0\n[[controllers]]\n\
+         vehicle = \"deputy\"\ncommand = \"formation-controller --sender-id {sender_id}\"\n",
+    )
+    .unwrap();
+    let c = &plan.campaign.controllers;
+    assert_eq!(c.len(), 1);
+    assert_eq!((c[0].vehicle.as_str(), c[0].sender_id), ("deputy", 3));
+    assert!(plan.run(0).valid);
+}
