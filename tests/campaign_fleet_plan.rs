@@ -500,3 +500,57 @@ fn one_controller_may_command_several_vehicles() {
     assert_eq!((c[0].vehicle.as_str(), c[0].sender_id), ("deputy", 3));
     assert!(plan.run(0).valid);
 }
+
+/// A random fault of one vehicle (`mtbf_s`) gets a seed per run keyed with that vehicle's id,
+/// and its failure time from it; `--without-random-faults` removes it and changes nothing else
+/// (the other seeds and the dispersions stay).
+#[test]
+fn a_vehicles_random_fault_is_seeded_per_vehicle_and_can_be_removed() {
+    let dir = fleet_dir("campaign_fleet_random_fault");
+    let mut fleet: toml::Table = std::fs::read_to_string(dir.join("fleet.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let fault: toml::Table = "target = \"imus.hub.gyro\"\nmode = \"dropout\"\nstart_s = 1.0\n\
+                              mtbf_s = 20.0\n"
+        .parse()
+        .unwrap();
+    fleet["vehicles"][1]["spacecraft"]
+        .as_table_mut()
+        .unwrap()
+        .insert("faults".into(), toml::Value::Array(vec![fault.into()]));
+    std::fs::write(dir.join("fleet.toml"), toml::to_string(&fleet).unwrap()).unwrap();
+    let text = format!(
+        "fleet = \"fleet.toml\"\nruns = 3\nseed = 5\nduration_s = 1.0\n{CONTROLLERS}\
+         [[dispersions]]\nvehicle = \"chief\"\nkey = \"hub.mass_kg\"\ndistribution = \
+         \"normal\"\nsigma = 10.0\n"
+    );
+    let with = plan_in(&dir, &text).unwrap();
+    let mut without = Campaign::from_str_at(&text, &dir.join("test-campaign.toml")).unwrap();
+    assert_eq!(without.without_random_faults().unwrap(), 1);
+    let without = Plan::new(without).unwrap();
+    for r in 0..3 {
+        let rp = with.run(r);
+        let seed = rp.sensor_seeds["deputy.faults[0].seed"];
+        assert_eq!(
+            seed,
+            splitmix64(rp.run_seed ^ fnv1a("deputy.faults[0].seed")) >> 1
+        );
+        let deputy = &rp.fleet().unwrap().vehicles[1].cfg;
+        assert_eq!(
+            rp.random_failures_ns["deputy.faults[0]"],
+            1_000_000_000 + flexdyn::faults::failure_delay_ns(20.0, seed)
+        );
+        assert_eq!(
+            deputy.faults[0].window.start_ns,
+            rp.random_failures_ns["deputy.faults[0]"]
+        );
+        let alone = without.run(r);
+        assert!(alone.fleet().unwrap().vehicles[1].cfg.faults.is_empty());
+        assert!(alone.random_failures_ns.is_empty());
+        let mut seeds = rp.sensor_seeds.clone();
+        seeds.remove("deputy.faults[0].seed");
+        assert_eq!(alone.sensor_seeds, seeds, "run {r}");
+        assert_eq!(alone.dispersed, rp.dispersed, "run {r}");
+    }
+}
