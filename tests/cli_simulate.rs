@@ -671,8 +671,14 @@ fn shipped_scenarios_give_no_warning() {
     let mut checked = 0;
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
+        // Not a campaign, and not a fleet file (`[[vehicles]]`): a spacecraft.
         let is_config = path.extension().is_some_and(|e| e == "toml")
-            && path.file_stem().is_some_and(|s| s != "campaign");
+            && path
+                .file_stem()
+                .is_some_and(|s| !s.to_string_lossy().ends_with("campaign"))
+            && !std::fs::read_to_string(&path)
+                .unwrap()
+                .contains("[[vehicles]]");
         if !is_config {
             continue;
         }

@@ -145,14 +145,37 @@ fn every_shipped_scenario_is_valid() {
     let mut names = Vec::new();
     for entry in std::fs::read_dir(scenarios_dir()).unwrap() {
         let path = entry.unwrap().path();
-        if path.file_stem().is_some_and(|s| s == "campaign") {
-            // A Monte Carlo campaign over the reference spacecraft, not a spacecraft: it must
-            // load and plan (every dispersion key resolved and read back from the model).
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let is_fleet = path.extension().is_some_and(|e| e == "toml")
+            && std::fs::read_to_string(&path)
+                .unwrap()
+                .contains("[[vehicles]]");
+        if stem.ends_with("campaign") {
+            // A Monte Carlo campaign (over the reference spacecraft, or over a fleet), not a
+            // spacecraft: it must load and plan (every dispersion key resolved and read back
+            // from the model) and draw a valid first run.
             let c = flexdyn::campaign::spec::Campaign::from_file(&path)
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-            flexdyn::campaign::plan::Plan::new(c)
+            let plan = flexdyn::campaign::plan::Plan::new(c)
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-            names.push("campaign".to_owned());
+            let first = plan.run(0);
+            assert!(
+                first.valid,
+                "{}: {:?}",
+                path.display(),
+                first.redraw_reasons
+            );
+            names.push(stem);
+        } else if is_fleet {
+            // A fleet file: every vehicle's configuration valid, and the world builds.
+            let fleet = flexdyn::world::FleetConfig::from_file(&path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            flexdyn::world::World::new(&fleet)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            names.push(stem);
         } else if path.extension().is_some_and(|e| e == "toml") {
             let cfg =
                 SimConfig::from_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -171,6 +194,8 @@ fn every_shipped_scenario_is_valid() {
             "eight_pairs",
             "fdir",
             "folded_wing",
+            "formation",
+            "formation_campaign",
             "imu_tactical",
             "j2_orbit",
             "leo_environment",

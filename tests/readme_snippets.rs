@@ -164,7 +164,13 @@ fn sandbox() -> PathBuf {
     std::fs::create_dir(dir.join("tests")).unwrap();
     std::os::unix::fs::symlink(root().join("tests/readme"), dir.join("tests/readme")).unwrap();
     let script = root().join("tests/readme/stand_in.sh");
-    for name in ["cargo", "flexdyn", "flexdyn-acs-demo", "flexdyn-monitor"] {
+    for name in [
+        "cargo",
+        "flexdyn",
+        "flexdyn-acs-demo",
+        "flexdyn-formation-demo",
+        "flexdyn-monitor",
+    ] {
         std::os::unix::fs::symlink(&script, stand_ins.join(name)).unwrap();
     }
     dir

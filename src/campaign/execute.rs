@@ -13,6 +13,15 @@
 //! state) or `not_run` (no valid draw, the controller could not be started or never joined, the
 //! server or the observer could not start): the campaign's exit code counts them
 //! ([`super::verdict`]).
+//!
+//! Over a fleet (`fleet` in the campaign file), a run is the fleet server
+//! ([`crate::server::fleet::run`], what `flexdyn run --fleet` runs) with the run's fleet: the
+//! observer answers every vehicle's ticks as sender 9 (added to each vehicle's participants),
+//! and each `[[controllers]]` entry is a process with its own sender id and its log
+//! `controller-<vehicle>-<sender>.log`. `result.json` then holds a hash per vehicle
+//! (`vehicle_state_sha256`, by id; `state_sha256` is empty) and each controller's exit status
+//! (`controller_exits`, by `<vehicle>/<sender>`); `applied` keys start with the vehicle's id.
+//! A `range` criterion reads the deputy's RelativeStateMsg stream, recorded by the observer.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -30,15 +39,15 @@ use zenoh::{Session, Wait};
 
 use super::command::split_command;
 use super::plan::{readback, Plan, RunPlan};
+use super::readback::fleet_readback;
+pub use super::spec::OBSERVER_ID;
 use super::spec::{Campaign, Criterion, Quantity, Statistic};
 use super::verdict::Outcome;
 use crate::attitude::mrp_error;
 use crate::config::SimConfig;
 use crate::server::{ServerError, ServerSettings};
 use crate::transport::{zenoh_config, Role, ZenohArgs};
-
-/// The observer's sender id.
-pub const OBSERVER_ID: u32 = 9;
+use crate::world::FleetConfig;
 /// The flight code's sender id (`{sender_id}`).
 pub const CONTROLLER_ID: u32 = 1;
 /// The spacecraft id of every run (`{sc_id}`); runs are separated by port.
@@ -68,9 +77,14 @@ pub struct RunResult {
     pub redraws: u32,
     /// Dispersed parameters as read back from the built model, by key.
     pub applied: BTreeMap<String, f64>,
-    /// SHA-256 over the StateMsg payloads, ticks 0..=N in order (empty if the run failed).
+    /// SHA-256 over the StateMsg payloads, ticks 0..=N in order (empty if the run failed, and
+    /// over a fleet).
     pub state_sha256: String,
-    /// States received.
+    /// Over a fleet: the SHA-256 over each vehicle's StateMsg payloads, ticks 0..=N in order,
+    /// by vehicle id (empty if the run failed).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub vehicle_state_sha256: BTreeMap<String, String>,
+    /// States received (over a fleet: of each vehicle).
     pub states: u64,
     /// Criteria.
     pub criteria: Vec<CriterionResult>,
@@ -83,6 +97,9 @@ pub struct RunResult {
     pub status: String,
     /// The controller's exit status (`exit 0`, `exit 3`, `signal 9`, `still running: stopped`).
     pub controller_exit: Option<String>,
+    /// Over a fleet: each controller's exit status, by `<vehicle>/<sender_id>`.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub controller_exits: BTreeMap<String, String>,
     /// \[s\] wall time of the run.
     pub wall_s: f64,
     /// \[s\] simulated time reached.
@@ -112,6 +129,8 @@ fn quantity(q: Quantity, s: &StateMsg, sigma_rn: &Vector3<f64>) -> f64 {
             .flat_map(|e| [e.states.first(), e.states.get(2)])
             .flatten()
             .fold(0.0f64, |m, x| m.max(x.abs())),
+        // Not in a StateMsg: read from the deputy's RelativeStateMsg stream instead.
+        Quantity::Range => f64::NAN,
     }
 }
 
@@ -132,6 +151,11 @@ pub fn evaluate(
             )
         })
         .collect();
+    reduce(c, &series, frame_s)
+}
+
+/// `c`'s statistic over `series` ((t \[s\], value) in time order) and whether it passes.
+pub fn reduce(c: &Criterion, series: &[(f64, f64)], frame_s: f64) -> CriterionResult {
     let value = match c.statistic {
         Statistic::Final => series.last().map_or(f64::NAN, |(_, v)| *v),
         Statistic::Max => series
@@ -166,7 +190,11 @@ pub type Received = Arc<Mutex<Vec<(u64, Vec<u8>)>>>;
 pub struct Observer {
     /// Every (tick, payload) received, in arrival order.
     pub states: Received,
+    /// Every (tick, RelativeStateMsg payload) of each key given to
+    /// [`Self::start_with_relative`], in arrival order.
+    pub relative: Vec<Received>,
     _sub: zenoh::pubsub::Subscriber<()>,
+    _relative_subs: Vec<zenoh::pubsub::Subscriber<()>>,
     _token: zenoh::liveliness::LivelinessToken,
     session: Session,
 }
@@ -183,6 +211,17 @@ fn zenoh_args(endpoint: &str, listen: bool) -> ZenohArgs {
 impl Observer {
     /// Connects to the server at `endpoint` and declares `sender_id`'s liveliness token.
     pub fn start(endpoint: &str, topics: &Topics, sender_id: u32) -> Result<Self, String> {
+        Self::start_with_relative(endpoint, topics, sender_id, &[])
+    }
+
+    /// [`Self::start`], recording the relative-state keys `relative` too (subscribed before
+    /// the token is declared, so from tick 0).
+    pub fn start_with_relative(
+        endpoint: &str,
+        topics: &Topics,
+        sender_id: u32,
+        relative: &[String],
+    ) -> Result<Self, String> {
         let cfg =
             zenoh_config(&zenoh_args(endpoint, false), Role::Tool).map_err(|e| e.to_string())?;
         let session = zenoh::open(cfg)
@@ -217,6 +256,26 @@ impl Observer {
             })
             .wait()
             .map_err(|e| format!("observer subscriber: {e}"))?;
+        let mut relative_states = Vec::with_capacity(relative.len());
+        let mut relative_subs = Vec::with_capacity(relative.len());
+        for key in relative {
+            let received: Received = Arc::default();
+            let rec = received.clone();
+            let sub = session
+                .declare_subscriber(key.clone())
+                .callback(move |sample| {
+                    let bytes = sample.payload().to_bytes().into_owned();
+                    if let Ok(m) = flexdyn_proto::decode_relative_state(&bytes) {
+                        rec.lock()
+                            .unwrap_or_else(|e| e.into_inner())
+                            .push((m.header.tick, bytes));
+                    }
+                })
+                .wait()
+                .map_err(|e| format!("observer subscriber {key}: {e}"))?;
+            relative_states.push(received);
+            relative_subs.push(sub);
+        }
         let token = session
             .liveliness()
             .declare_token(topics.participant(sender_id))
@@ -224,7 +283,9 @@ impl Observer {
             .map_err(|e| format!("observer token: {e}"))?;
         Ok(Self {
             states,
+            relative: relative_states,
             _sub: sub,
+            _relative_subs: relative_subs,
             _token: token,
             session,
         })
@@ -255,12 +316,14 @@ pub fn execute(plan: &Plan, rp: &RunPlan, opts: &RunOptions) -> RunResult {
         redraws: rp.redraws,
         applied: BTreeMap::new(),
         state_sha256: String::new(),
+        vehicle_state_sha256: BTreeMap::new(),
         states: 0,
         criteria: Vec::new(),
         passed: false,
         outcome: Outcome::NotRun,
         status: String::new(),
         controller_exit: None,
+        controller_exits: BTreeMap::new(),
         wall_s: 0.0,
         sim_s: 0.0,
     };
@@ -298,6 +361,14 @@ impl From<String> for RunFailure {
 fn server_failure(e: ServerError) -> RunFailure {
     let outcome = match e {
         ServerError::ParticipantTimeout { .. } | ServerError::NonFinite { .. } => Outcome::Failed,
+        ServerError::Vehicle { ref source, .. }
+            if matches!(
+                **source,
+                ServerError::ParticipantTimeout { .. } | ServerError::NonFinite { .. }
+            ) =>
+        {
+            Outcome::Failed
+        }
         _ => Outcome::NotRun,
     };
     RunFailure {
@@ -306,18 +377,37 @@ fn server_failure(e: ServerError) -> RunFailure {
     }
 }
 
-/// Starts the controller `line` of run `run`, its output to `run_dir/controller.log`.
-fn start_controller(line: &str, endpoint: &str, run: u32, run_dir: &Path) -> Result<Child, String> {
+/// A flight-code process of a run.
+struct Launch {
+    /// Its command line, every `{…}` but `{endpoint}` substituted.
+    line: String,
+    /// Its log file (stdout and stderr) in the run's folder.
+    log: String,
+    /// How a failure names it (`the controller`).
+    who: String,
+}
+
+/// `line` with `{sc_id}`, `{sender_id}` and `{run}` substituted (and `{vehicle}`, over a
+/// fleet); `{endpoint}` is substituted once the server listens.
+fn substitute(line: &str, sc_id: &str, sender_id: u32, run: u32, vehicle: Option<&str>) -> String {
     let line = line
-        .replace("{endpoint}", endpoint)
-        .replace("{sc_id}", SC_ID)
-        .replace("{sender_id}", &CONTROLLER_ID.to_string())
+        .replace("{sc_id}", sc_id)
+        .replace("{sender_id}", &sender_id.to_string())
         .replace("{run}", &run.to_string());
+    match vehicle {
+        Some(v) => line.replace("{vehicle}", v),
+        None => line,
+    }
+}
+
+/// Starts the controller `l` with the server's `endpoint`, its output to its log.
+fn start_controller(l: &Launch, endpoint: &str, run_dir: &Path) -> Result<Child, String> {
+    let line = l.line.replace("{endpoint}", endpoint);
     let words = split_command(&line)?;
     let program = words
         .first()
         .ok_or("the controller's command line is empty")?;
-    let log = std::fs::File::create(run_dir.join("controller.log")).map_err(|e| e.to_string())?;
+    let log = std::fs::File::create(run_dir.join(&l.log)).map_err(|e| e.to_string())?;
     let err = log.try_clone().map_err(|e| e.to_string())?;
     Command::new(program)
         .args(&words[1..])
@@ -328,53 +418,93 @@ fn start_controller(line: &str, endpoint: &str, run: u32, run_dir: &Path) -> Res
         .map_err(|e| format!("cannot start the controller {program:?}: {e}"))
 }
 
-fn run_inner(
-    c: &Campaign,
-    rp: &RunPlan,
-    opts: &RunOptions,
-    run_dir: &Path,
-    result: &mut RunResult,
-) -> Result<(), RunFailure> {
-    if !rp.valid {
-        return Err(RunFailure::from(format!(
-            "invalid: no valid draw in {} tries (last: {})",
-            rp.redraws,
-            rp.redraw_reasons.last().map_or("", String::as_str)
-        )));
-    }
-    let cfg = SimConfig::from_toml_str(&rp.config_toml).map_err(|e| format!("config: {e}"))?;
-    let model = readback(&cfg).map_err(|e| format!("model: {e}"))?;
-    result.applied = rp
-        .dispersed
-        .keys()
-        .filter_map(|k| model.get(k).map(|v| (k.clone(), *v)))
-        .collect();
-    // Base port 0: every run's server takes a free port from the OS.
-    let port = match opts.base_port {
-        0 => 0,
+/// The lockstep server of a run: one spacecraft, or a fleet.
+enum Server {
+    Single(ServerSettings, Box<SimConfig>),
+    Fleet(ServerSettings, Box<FleetConfig>),
+}
+
+/// (tick, payload) for ticks 0..=N in order.
+type Stream = Vec<(u64, Vec<u8>)>;
+
+/// What the observer saw of a completed run.
+struct Observed {
+    /// Per observed vehicle, its StateMsg stream.
+    states: Vec<Stream>,
+    /// Per observed vehicle, the stream of each relative-state key it records.
+    relative: Vec<Vec<Stream>>,
+    /// \[ns\] simulated time reached.
+    sim_time_ns: u64,
+}
+
+/// The port run `run` listens on (0: one from the OS).
+fn run_port(opts: &RunOptions, run: u32) -> Result<u16, String> {
+    match opts.base_port {
+        0 => Ok(0),
         base => {
-            let port = u32::from(base) + rp.run;
+            let port = u32::from(base) + run;
             u16::try_from(port)
-                .map_err(|_| format!("port {port} is out of range: lower --base-port"))?
+                .map_err(|_| format!("port {port} is out of range: lower --base-port"))
         }
-    };
-    let frame_s = cfg.frame_ns as f64 * 1e-9;
-    let mut participants = vec![OBSERVER_ID];
-    if c.controller.is_some() {
-        participants.insert(0, CONTROLLER_ID);
     }
-    let settings = ServerSettings {
+}
+
+/// The lockstep settings every run shares (a single spacecraft adds its ids and participants).
+fn lockstep_settings(c: &Campaign, opts: &RunOptions, run_dir: &Path) -> ServerSettings {
+    ServerSettings {
         mode: Mode::Lockstep,
-        sc_id: SC_ID.into(),
-        participants,
         participant_timeout: Duration::from_secs_f64(c.participant_timeout_s),
         presence_timeout: Duration::from_secs_f64(c.participant_timeout_s.max(10.0)),
         duration_ns: Some(c.duration_ns),
         summary_interval: Duration::from_secs(3600),
         record: opts.record.then(|| run_dir.join("recording.mcap")),
         ..ServerSettings::default()
-    };
-    let topics = Topics::new(SC_ID).map_err(|e| e.to_string())?;
+    }
+}
+
+/// SHA-256 (hex) over the payloads, in order.
+fn sha256_hex(states: &[(u64, Vec<u8>)]) -> String {
+    let mut h = Sha256::new();
+    for (_, p) in states {
+        h.update(p);
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// `r`'s samples, sorted by tick.
+fn sorted(r: &Received) -> Vec<(u64, Vec<u8>)> {
+    let mut s = r.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    s.sort_by_key(|(t, _)| *t);
+    s
+}
+
+/// Whether `s` holds ticks 0..=`last` exactly once each, in order.
+fn complete(s: &[(u64, Vec<u8>)], last: u64) -> bool {
+    s.len() as u64 == last + 1 && s.iter().enumerate().all(|(i, (t, _))| *t == i as u64)
+}
+
+fn close(observers: &[Observer]) {
+    for o in observers {
+        let _ = o.session.close().wait();
+    }
+}
+
+/// Runs `server` to its end in lockstep with an observer per vehicle of `observe` (its id and
+/// the relative-state keys to record) and the `controllers`; each controller's exit status is
+/// pushed to `exits`, in order, whatever the outcome. A controller that exits before the end
+/// stops the run at once.
+fn run_lockstep(
+    server: Server,
+    observe: &[(String, Vec<String>)],
+    controllers: &[Launch],
+    port: u16,
+    run_dir: &Path,
+    exits: &mut Vec<String>,
+) -> Result<Observed, RunFailure> {
+    let topics = observe
+        .iter()
+        .map(|(id, _)| Topics::new(id).map_err(|e| e.to_string()))
+        .collect::<Result<Vec<_>, _>>()?;
     // The server, on its own runtime and thread; `stop` ends it early (controller exit).
     let stop = Arc::new(tokio::sync::Notify::new());
     let zcfg = zenoh_config(
@@ -398,42 +528,69 @@ fn run_inner(
             .build()
             .map_err(|e| e.to_string())?;
         rt.block_on(async move {
-            let r = crate::server::run(session.clone(), settings, cfg, async move {
-                stop2.notified().await
-            })
-            .await
+            let stopped = async move { stop2.notified().await };
+            // (last tick, simulated time): a fleet's are every vehicle's.
+            let r = match server {
+                Server::Single(settings, cfg) => {
+                    crate::server::run(session.clone(), settings, *cfg, stopped)
+                        .await
+                        .map(|r| (r.last_tick, r.sim_time_ns))
+                }
+                Server::Fleet(settings, fleet) => {
+                    crate::server::fleet::run(session.clone(), settings, *fleet, stopped)
+                        .await
+                        .map(|r| {
+                            r.vehicles
+                                .first()
+                                .map_or((0, 0), |(_, v)| (v.last_tick, v.sim_time_ns))
+                        })
+                }
+            }
             .map_err(server_failure);
             let _ = session.close().await;
             r
         })
     });
-    // Until the controller runs, a failure stops the server (it would wait for presence).
+    // Until the controllers run, a failure stops the server (it would wait for presence).
     let abandon = |server: std::thread::JoinHandle<_>, why: String| {
         stop.notify_one();
         let _ = server.join();
         RunFailure::from(why)
     };
-    let observer = match Observer::start(&endpoint, &topics, OBSERVER_ID) {
-        Ok(o) => o,
-        Err(why) => return Err(abandon(server, why)),
-    };
-    let mut child = match &c.controller {
-        Some(line) => match start_controller(line, &endpoint, rp.run, run_dir) {
-            Ok(child) => Some(child),
+    let mut observers = Vec::with_capacity(observe.len());
+    for ((_, relative), t) in observe.iter().zip(&topics) {
+        match Observer::start_with_relative(&endpoint, t, OBSERVER_ID, relative) {
+            Ok(o) => observers.push(o),
             Err(why) => {
-                let _ = observer.session.close().wait();
+                close(&observers);
                 return Err(abandon(server, why));
             }
-        },
-        None => None,
-    };
+        }
+    }
+    let mut children = Vec::with_capacity(controllers.len());
+    for l in controllers {
+        match start_controller(l, &endpoint, run_dir) {
+            Ok(child) => children.push(child),
+            Err(why) => {
+                for ch in &mut children {
+                    let _ = ch.kill();
+                    let _ = ch.wait();
+                }
+                close(&observers);
+                return Err(abandon(server, why));
+            }
+        }
+    }
     // Wait for the server; a controller that exits first stops it.
-    let mut early_exit = None;
+    let mut early_exit: Option<(usize, std::process::ExitStatus)> = None;
     while !server.is_finished() {
-        if let (Some(ch), None) = (child.as_mut(), &early_exit) {
-            if let Ok(Some(status)) = ch.try_wait() {
-                early_exit = Some(status);
-                stop.notify_one();
+        if early_exit.is_none() {
+            for (k, ch) in children.iter_mut().enumerate() {
+                if let Ok(Some(status)) = ch.try_wait() {
+                    early_exit = Some((k, status));
+                    stop.notify_one();
+                    break;
+                }
             }
         }
         std::thread::sleep(Duration::from_millis(5));
@@ -441,68 +598,271 @@ fn run_inner(
     let server_result = server
         .join()
         .map_err(|_| "the server thread panicked".to_owned())?;
-    if let Some(mut ch) = child {
+    // The run is over: give the controllers a moment to leave, then stop them.
+    let give_up = Instant::now() + Duration::from_secs(2);
+    for (k, ch) in children.iter_mut().enumerate() {
         let status = match early_exit {
-            Some(s) => exit_text(s),
-            None => {
-                // The run is over: give the controller a moment to leave, then stop it.
-                let give_up = Instant::now() + Duration::from_secs(2);
-                loop {
-                    if let Ok(Some(s)) = ch.try_wait() {
-                        break exit_text(s);
-                    }
-                    if Instant::now() >= give_up {
-                        let _ = ch.kill();
-                        let _ = ch.wait();
-                        break "still running at the end: stopped".into();
-                    }
-                    std::thread::sleep(Duration::from_millis(10));
+            Some((j, s)) if j == k => exit_text(s),
+            _ => loop {
+                if let Ok(Some(s)) = ch.try_wait() {
+                    break exit_text(s);
                 }
-            }
+                if Instant::now() >= give_up {
+                    let _ = ch.kill();
+                    let _ = ch.wait();
+                    break "still running at the end: stopped".into();
+                }
+                std::thread::sleep(Duration::from_millis(10));
+            },
         };
-        result.controller_exit = Some(status.clone());
-        if let Some(s) = early_exit {
-            let _ = observer.session.close().wait();
-            return Err(RunFailure {
-                outcome: Outcome::Failed,
-                message: format!(
-                    "the controller exited before the end ({}); the run stopped",
-                    exit_text(s)
-                ),
-            });
+        exits.push(status);
+    }
+    if let Some((k, s)) = early_exit {
+        close(&observers);
+        return Err(RunFailure {
+            outcome: Outcome::Failed,
+            message: format!(
+                "{} exited before the end ({}); the run stopped",
+                controllers[k].who,
+                exit_text(s)
+            ),
+        });
+    }
+    let (last_tick, sim_time_ns) = match server_result {
+        Ok(r) => r,
+        Err(e) => {
+            close(&observers);
+            return Err(e);
         }
+    };
+    // The server ends on the answers to the last tick; a relative state published after that
+    // tick's state may still be on its way: wait for it, briefly.
+    let give_up = Instant::now() + Duration::from_secs(2);
+    let arrived = |o: &Observer| {
+        let n = |r: &Received| r.lock().unwrap_or_else(|e| e.into_inner()).len() as u64;
+        n(&o.states) > last_tick && o.relative.iter().all(|r| n(r) > last_tick)
+    };
+    while !observers.iter().all(&arrived) && Instant::now() < give_up {
+        std::thread::sleep(Duration::from_millis(5));
     }
-    let report = server_result?;
-    let mut states = observer
-        .states
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .clone();
-    let _ = observer.session.close().wait();
-    states.sort_by_key(|(t, _)| *t);
-    let ticks_ok = states.iter().enumerate().all(|(i, (t, _))| *t == i as u64);
-    if !ticks_ok || states.len() as u64 != report.last_tick + 1 {
-        return Err(RunFailure::from(format!(
-            "the observer saw {} states for ticks 0..={}",
-            states.len(),
-            report.last_tick
-        )));
+    let mut out = Observed {
+        states: Vec::with_capacity(observers.len()),
+        relative: Vec::with_capacity(observers.len()),
+        sim_time_ns,
+    };
+    for (o, (id, _)) in observers.iter().zip(observe) {
+        // One spacecraft's message names no vehicle.
+        let of = if observe.len() > 1 {
+            format!(" of {id:?}")
+        } else {
+            String::new()
+        };
+        let states = sorted(&o.states);
+        if !complete(&states, last_tick) {
+            close(&observers);
+            return Err(RunFailure::from(format!(
+                "the observer saw {} states{of} for ticks 0..={last_tick}",
+                states.len(),
+            )));
+        }
+        let relative: Vec<_> = o.relative.iter().map(sorted).collect();
+        if let Some(r) = relative.iter().find(|r| !complete(r, last_tick)) {
+            close(&observers);
+            return Err(RunFailure::from(format!(
+                "the observer saw {} relative states{of} for ticks 0..={last_tick}",
+                r.len(),
+            )));
+        }
+        out.states.push(states);
+        out.relative.push(relative);
     }
-    let mut h = Sha256::new();
-    for (_, p) in &states {
-        h.update(p);
-    }
-    result.state_sha256 = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
-    result.states = states.len() as u64;
-    result.sim_s = report.sim_time_ns as f64 * 1e-9;
-    let decoded: Vec<StateMsg> = states
+    close(&observers);
+    Ok(out)
+}
+
+/// The dispersed parameters of `rp` as the built `model` has them.
+fn applied(rp: &RunPlan, model: &BTreeMap<String, f64>) -> BTreeMap<String, f64> {
+    rp.dispersed
+        .keys()
+        .filter_map(|k| model.get(k).map(|v| (k.clone(), *v)))
+        .collect()
+}
+
+fn decode_states(states: &[(u64, Vec<u8>)]) -> Vec<StateMsg> {
+    states
         .iter()
         .filter_map(|(_, p)| decode_state(p).ok())
+        .collect()
+}
+
+fn run_inner(
+    c: &Campaign,
+    rp: &RunPlan,
+    opts: &RunOptions,
+    run_dir: &Path,
+    result: &mut RunResult,
+) -> Result<(), RunFailure> {
+    if !rp.valid {
+        return Err(RunFailure::from(format!(
+            "invalid: no valid draw in {} tries (last: {})",
+            rp.redraws,
+            rp.redraw_reasons.last().map_or("", String::as_str)
+        )));
+    }
+    if c.fleet.is_some() {
+        return run_fleet(c, rp, opts, run_dir, result);
+    }
+    let cfg = SimConfig::from_toml_str(&rp.config_toml).map_err(|e| format!("config: {e}"))?;
+    let model = readback(&cfg).map_err(|e| format!("model: {e}"))?;
+    result.applied = applied(rp, &model);
+    // Base port 0: every run's server takes a free port from the OS.
+    let port = run_port(opts, rp.run)?;
+    let frame_s = cfg.frame_ns as f64 * 1e-9;
+    let mut participants = vec![OBSERVER_ID];
+    if c.controller.is_some() {
+        participants.insert(0, CONTROLLER_ID);
+    }
+    let settings = ServerSettings {
+        sc_id: SC_ID.into(),
+        participants,
+        ..lockstep_settings(c, opts, run_dir)
+    };
+    let controllers: Vec<Launch> = c
+        .controller
+        .iter()
+        .map(|line| Launch {
+            line: substitute(line, SC_ID, CONTROLLER_ID, rp.run, None),
+            log: "controller.log".into(),
+            who: "the controller".into(),
+        })
         .collect();
+    let mut exits = Vec::new();
+    let observed = run_lockstep(
+        Server::Single(settings, Box::new(cfg)),
+        &[(SC_ID.to_owned(), Vec::new())],
+        &controllers,
+        port,
+        run_dir,
+        &mut exits,
+    );
+    result.controller_exit = exits.into_iter().next();
+    let observed = observed?;
+    let states = &observed.states[0];
+    result.state_sha256 = sha256_hex(states);
+    result.states = states.len() as u64;
+    result.sim_s = observed.sim_time_ns as f64 * 1e-9;
+    let decoded = decode_states(states);
     result.criteria = c
         .criteria
         .iter()
         .map(|k| evaluate(k, &decoded, c.sigma_rn, frame_s))
+        .collect();
+    Ok(())
+}
+
+/// [`run_inner`] over a fleet.
+fn run_fleet(
+    c: &Campaign,
+    rp: &RunPlan,
+    opts: &RunOptions,
+    run_dir: &Path,
+    result: &mut RunResult,
+) -> Result<(), RunFailure> {
+    let mut fleet = rp.fleet().map_err(|e| format!("config: {e}"))?;
+    let model = fleet_readback(&fleet).map_err(|e| format!("model: {e}"))?;
+    result.applied = applied(rp, &model);
+    let port = run_port(opts, rp.run)?;
+    let frame_s = fleet.vehicles[0].cfg.frame_ns as f64 * 1e-9;
+    // Each vehicle: its id and, for a deputy judged on its range, its relative-state key.
+    let mut observe = Vec::with_capacity(fleet.vehicles.len());
+    for v in &fleet.vehicles {
+        let mut relative = Vec::new();
+        let ranged = c
+            .criteria
+            .iter()
+            .any(|k| k.quantity == Quantity::Range && k.vehicle.as_deref() == Some(&v.id));
+        if let (Some(ci), true) = (v.chief, ranged) {
+            let key = Topics::new(&v.id)
+                .and_then(|t| t.relative_state(&fleet.vehicles[ci].id))
+                .map_err(|e| e.to_string())?;
+            relative.push(key);
+        }
+        observe.push((v.id.clone(), relative));
+    }
+    // The observer answers every vehicle's ticks.
+    for v in &mut fleet.vehicles {
+        if !v.participants.contains(&OBSERVER_ID) {
+            v.participants.push(OBSERVER_ID);
+        }
+    }
+    let controllers: Vec<Launch> = c
+        .controllers
+        .iter()
+        .map(|k| Launch {
+            line: substitute(
+                &k.command,
+                &k.vehicle,
+                k.sender_id,
+                rp.run,
+                Some(k.vehicle.as_str()),
+            ),
+            log: format!("controller-{}-{}.log", k.vehicle, k.sender_id),
+            who: format!("the controller of {:?} (sender {})", k.vehicle, k.sender_id),
+        })
+        .collect();
+    let mut exits = Vec::new();
+    let observed = run_lockstep(
+        Server::Fleet(lockstep_settings(c, opts, run_dir), Box::new(fleet)),
+        &observe,
+        &controllers,
+        port,
+        run_dir,
+        &mut exits,
+    );
+    result.controller_exits = c
+        .controllers
+        .iter()
+        .zip(exits)
+        .map(|(k, s)| (format!("{}/{}", k.vehicle, k.sender_id), s))
+        .collect();
+    let observed = observed?;
+    result.states = observed.states.first().map_or(0, |s| s.len() as u64);
+    result.sim_s = observed.sim_time_ns as f64 * 1e-9;
+    let mut decoded = BTreeMap::new();
+    let mut ranges = BTreeMap::new();
+    for (((id, _), states), relative) in
+        observe.iter().zip(&observed.states).zip(&observed.relative)
+    {
+        result
+            .vehicle_state_sha256
+            .insert(id.clone(), sha256_hex(states));
+        decoded.insert(id.as_str(), decode_states(states));
+        if let Some(r) = relative.first() {
+            let series: Vec<(f64, f64)> = r
+                .iter()
+                .filter_map(|(_, p)| flexdyn_proto::decode_relative_state(p).ok())
+                .map(|m| (m.header.sim_time_ns as f64 * 1e-9, m.range_m))
+                .collect();
+            ranges.insert(id.as_str(), series);
+        }
+    }
+    result.criteria = c
+        .criteria
+        .iter()
+        .map(|k| {
+            let id = k.vehicle.as_deref().unwrap_or_default();
+            match k.quantity {
+                Quantity::Range => {
+                    reduce(k, ranges.get(id).map_or(&[][..], Vec::as_slice), frame_s)
+                }
+                _ => evaluate(
+                    k,
+                    decoded.get(id).map_or(&[][..], Vec::as_slice),
+                    c.sigma_rn,
+                    frame_s,
+                ),
+            }
+        })
         .collect();
     Ok(())
 }
@@ -568,6 +928,7 @@ mod tests {
             statistic,
             after_s,
             below,
+            vehicle: None,
         };
         let r = evaluate(&c(Statistic::Final, 0.0, 0.01), &states, [0.0; 3], 1.0);
         assert_eq!((r.value, r.passed), (0.005, true));

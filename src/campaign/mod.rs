@@ -3,10 +3,14 @@
 //! - [`spec`]: the campaign file, validated with field-named errors.
 //! - [`command`]: the controller's command line, split into words without a shell.
 //! - [`keys`]: TOML paths into a configuration (`panel_pairs[*].panel1.k_nm_rad`).
-//! - [`plan`]: per-run draws from the master seed, redraws of invalid draws, sensor seeds, the
-//!   manifest, and the read-back of parameters from the built model.
-//! - [`execute`]: one run = a lockstep server on its own port, an observer participant and the
-//!   flight code; `--jobs N` runs N at a time, `--index I` exactly one.
+//! - [`fleet`]: a campaign over a fleet file (`fleet` in place of `base`): each vehicle's
+//!   document to disperse, and a run's fleet file and vehicle configurations.
+//! - [`readback`]: the parameters of the built model, of one spacecraft or of every vehicle.
+//! - [`plan`]: per-run draws from the master seed, redraws of invalid draws, sensor seeds and
+//!   the manifest.
+//! - [`execute`]: one run = a lockstep server on its own port (the fleet server over a fleet),
+//!   an observer participant and the flight code (a controller per `[[controllers]]` entry
+//!   over a fleet); `--jobs N` runs N at a time, `--index I` exactly one.
 //! - [`summary`]: `summary.csv`, the pass rate with its Wilson interval, worst and failed runs,
 //!   figures.
 //! - [`verdict`]: each run's outcome, and the exit code of `run` and `summarize` (0 every run
@@ -14,8 +18,10 @@
 
 pub mod command;
 pub mod execute;
+pub mod fleet;
 pub mod keys;
 pub mod plan;
+pub mod readback;
 pub mod spec;
 pub mod summary;
 pub mod verdict;

@@ -8,6 +8,16 @@
 //! `star_trackers[k].seed`), and `faults[k].seed` of every random fault (one with `mtbf_s`,
 //! written in if absent), becomes `splitmix64(run_seed ⊕ fnv1a(key))`. A run
 //! therefore depends only on the campaign file and its index: `--index I` reproduces it alone.
+//! Over a fleet, the hashed key starts with the vehicle's id (`deputy.imus[0].seed`), so every
+//! vehicle's sensors and random faults get seeds of their own, in every run.
+//!
+//! # Fleets
+//! With `fleet` in place of `base`, each vehicle's document ([`super::fleet`]: its spacecraft
+//! configuration plus a deputy's `relative` Hill offsets) is dispersed by the entries that
+//! name it, from the one stream of the run, in file order. Keys in the manifest, the results
+//! and `summary.csv` start with the vehicle's id (`deputy.hub.mass_kg`). A draw is valid when
+//! the whole fleet is ([`super::fleet::from_run`]: the fleet file's rules, and every vehicle's
+//! spacecraft builds). A run writes `fleet.toml` and `config-<id>.toml` per vehicle.
 //!
 //! # Invalid draws
 //! A draw whose configuration fails validation (for example an inertia that breaks the
@@ -19,7 +29,8 @@
 //! A dispersion key must name parameters the built model reports (hub, initial state, panel
 //! pairs, reaction wheels, magnetorquers, thrusters, environment facets, residual dipole, space
 //! weather, epoch offset, and the magnetometers', sun sensors' and star trackers' error
-//! parameters; see [`readback`]). Any other key is an error at load time, so a
+//! parameters; see [`readback`]; over a fleet, a deputy's Hill offsets, see
+//! [`super::readback::fleet_readback`]). Any other key is an error at load time, so a
 //! dispersion can never be silently ignored; `result.json` then holds the values read back from
 //! each run's built model, not from its file.
 
@@ -30,7 +41,10 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use toml::Table;
 
+use super::fleet::{offsets_table, FleetBase};
 use super::keys;
+use super::readback::fleet_readback;
+pub use super::readback::readback;
 use super::spec::{Campaign, CampaignError, Distribution};
 use crate::config::SimConfig;
 use crate::sensors::rng::NormalRng;
@@ -43,7 +57,8 @@ pub fn splitmix64(x: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-fn fnv1a(s: &str) -> u64 {
+/// FNV-1a, 64 bits (Fowler, Noll & Vo): the hash of a seed's key.
+pub fn fnv1a(s: &str) -> u64 {
     s.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
         (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
     })
@@ -52,73 +67,6 @@ fn fnv1a(s: &str) -> u64 {
 /// The seed of run `run`.
 pub fn run_seed(master: u64, run: u32) -> u64 {
     splitmix64(master ^ splitmix64(u64::from(run)))
-}
-
-/// Every numeric parameter of the model built from `cfg`, by configuration path: the hub, the
-/// initial state (`initial.sigma_bn[i]`, `initial.omega_bn_b_rad_s[i]`, `initial.r_bn_n_m[i]`,
-/// `initial.v_bn_n_m_s[i]`), each effector's [`crate::dynamics::StateEffector::parameters`]
-/// under its kind's section (`panel_pairs[k].`, `reaction_wheels[k].`: [`crate::dynamics::kinds`]), each dynamic effector's
-/// [`crate::dynamics::DynamicEffector::parameters`] (facets, residual dipole), the environment
-/// models' (space weather) and the epoch's `epoch.offset_s`.
-pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config::ConfigError> {
-    let sc = cfg.build_spacecraft()?;
-    let mut out = BTreeMap::new();
-    let hub = sc.hub();
-    out.insert("hub.mass_kg".to_owned(), hub.mass_kg);
-    for i in 0..3 {
-        out.insert(format!("hub.r_bcb_b_m[{i}]"), hub.r_bcb_b_m[i]);
-        for j in 0..3 {
-            out.insert(
-                format!("hub.inertia_bc_b_kg_m2[{i}][{j}]"),
-                hub.inertia_bc_b_kg_m2[(i, j)],
-            );
-        }
-    }
-    let x = sc.state();
-    for i in 0..3 {
-        out.insert(format!("initial.sigma_bn[{i}]"), x.sigma_bn[i]);
-        out.insert(format!("initial.omega_bn_b_rad_s[{i}]"), x.omega_bn_b[i]);
-        out.insert(format!("initial.r_bn_n_m[{i}]"), x.r_bn_n[i]);
-        out.insert(format!("initial.v_bn_n_m_s[{i}]"), x.v_bn_n[i]);
-    }
-    let mut per_kind: BTreeMap<&str, usize> = BTreeMap::new();
-    let mut params = Vec::new();
-    for (e, range) in sc.effectors().iter().zip(sc.effector_ranges()) {
-        let section =
-            crate::dynamics::kinds::by_name(e.kind().name).map_or(e.kind().name, |k| k.section);
-        let k = per_kind.entry(section).or_insert(0);
-        params.clear();
-        e.parameters(&x.effectors[range.clone()], &mut params);
-        for (key, v) in &params {
-            out.insert(format!("{section}[{k}].{key}"), *v);
-        }
-        *k += 1;
-    }
-    // The sensors as built, each kind's entries counted in file order.
-    let bank = crate::sensors::SensorBank::new(cfg, cfg.frame_ns as f64 * 1e-9, 0, x)?;
-    let mut per_array: BTreeMap<&str, usize> = BTreeMap::new();
-    for s in bank.sensors() {
-        let section = s.kind().config_array;
-        let k = per_array.entry(section).or_insert(0);
-        params.clear();
-        s.parameters(&mut params);
-        for (key, v) in &params {
-            out.insert(format!("{section}[{k}].{key}"), *v);
-        }
-        *k += 1;
-    }
-    let mut params = Vec::new();
-    for d in sc.dynamic_effectors() {
-        d.parameters(&mut params);
-    }
-    if let Some(epoch) = &cfg.epoch {
-        params.push(("epoch.offset_s".to_owned(), epoch.offset_s()));
-    }
-    if let Some(env) = cfg.environment_model()? {
-        env.parameters(&mut params);
-    }
-    out.extend(params);
-    Ok(out)
 }
 
 /// Replaces `orbit.elements_file` (relative to `base_dir`) by `orbit.elements`, the file's text.
@@ -160,9 +108,74 @@ pub struct RunPlan {
     /// ([`crate::faults::failure_delay_ns`]), whether or not it falls within the run.
     #[serde(default)]
     pub random_failures_ns: BTreeMap<String, u64>,
-    /// The full configuration, TOML (not in the manifest; written as `config.toml`).
+    /// The full configuration, TOML (not in the manifest; written as `config.toml`); over a
+    /// fleet, the run's fleet file (written as `fleet.toml`).
     #[serde(skip)]
     pub config_toml: String,
+    /// Over a fleet: each vehicle's id and resolved configuration (written as
+    /// `config-<id>.toml`, which `config_toml` names). Empty for one spacecraft.
+    #[serde(skip)]
+    pub vehicle_configs: Vec<(String, String)>,
+}
+
+impl RunPlan {
+    /// The fleet of a fleet run, as its folder reads ([`super::fleet::from_run`]).
+    pub fn fleet(&self) -> Result<crate::world::FleetConfig, String> {
+        super::fleet::from_run(&self.config_toml, &self.vehicle_configs)
+    }
+}
+
+/// One configuration the dispersions write into: the base, or one vehicle of a fleet.
+#[derive(Clone, Debug)]
+struct Unit {
+    /// The prefix of its keys in the manifest, the results and the seeds' hashed keys: empty
+    /// for one spacecraft, `<id>.` for a vehicle.
+    prefix: String,
+    /// The document (a vehicle's: its configuration and, for a deputy, `relative`).
+    base: Table,
+    /// Its sensor and random-fault seed keys (`imus[0].seed`, `faults[1].seed`).
+    seed_keys: Vec<String>,
+    /// The indices of its random faults (`faults[k]` with `mtbf_s`).
+    random_faults: Vec<usize>,
+}
+
+impl Unit {
+    fn new(prefix: String, base: Table) -> Self {
+        let mut seed_keys = Vec::new();
+        for section in crate::sensors::KINDS.iter().map(|k| k.config_array) {
+            if let Some(toml::Value::Array(items)) = base.get(section) {
+                for (k, item) in items.iter().enumerate() {
+                    if item.get("seed").is_some() {
+                        seed_keys.push(format!("{section}[{k}].seed"));
+                    }
+                }
+            }
+        }
+        // A random fault (`mtbf_s`) gets a seed of its own per run, written in if absent, so
+        // every run samples its own failure time.
+        let mut random_faults = Vec::new();
+        if let Some(toml::Value::Array(items)) = base.get("faults") {
+            for (k, item) in items.iter().enumerate() {
+                if item.get("mtbf_s").is_some() {
+                    seed_keys.push(format!("faults[{k}].seed"));
+                    random_faults.push(k);
+                }
+            }
+        }
+        Self {
+            prefix,
+            base,
+            seed_keys,
+            random_faults,
+        }
+    }
+}
+
+/// A run's resolved configuration: its text(s) and its random faults' first activations.
+struct Resolved {
+    config_toml: String,
+    vehicle_configs: Vec<(String, String)>,
+    random_failures_ns: BTreeMap<String, u64>,
 }
 
 /// A campaign's plan: the resolved dispersion keys and every run.
@@ -170,40 +183,67 @@ pub struct RunPlan {
 pub struct Plan {
     /// The campaign.
     pub campaign: Campaign,
-    /// For each dispersion, the concrete keys it names.
+    /// For each dispersion, the concrete keys it names (over a fleet, `<vehicle>.<key>`).
     pub keys: Vec<Vec<String>>,
-    base: Table,
-    sensor_seed_keys: Vec<String>,
-    /// The indices of the random faults (`faults[k]` with `mtbf_s`).
-    random_faults: Vec<usize>,
+    units: Vec<Unit>,
+    /// For each dispersion, its unit and its concrete keys in that unit's document.
+    targets: Vec<(usize, Vec<String>)>,
 }
 
 impl Plan {
-    /// Resolves every dispersion key against the base configuration and its built model.
+    /// Resolves every dispersion key against the base configuration (or each vehicle's) and
+    /// its built model.
     pub fn new(campaign: Campaign) -> Result<Self, CampaignError> {
-        // Dispersion keys are the campaign file's fields; a bad base is the base file's.
-        let mut base: Table = toml::from_str(&campaign.base_toml)
-            .map_err(|e| campaign.invalid("base", format!("not a TOML table: {e}")))?;
-        let base_dir = campaign.base_dir();
-        let cfg = SimConfig::from_toml_str_in(&campaign.base_toml, &base_dir)
-            .map_err(|e| campaign.base_error(e))?;
-        // Each run's config.toml must stand alone (it is read from its own folder, by a server
-        // started anywhere): a relative `orbit.elements_file` becomes the elements themselves.
-        inline_elements_file(&mut base, &base_dir).map_err(|e| campaign.invalid("base", e))?;
-        let model = readback(&cfg).map_err(|e| campaign.base_error(e))?;
-        let mut all_keys = Vec::new();
+        let (units, model) = match &campaign.fleet {
+            Some(fleet) => fleet_units(&campaign, fleet)?,
+            None => {
+                // Dispersion keys are the campaign file's fields; a bad base is the base file's.
+                let mut base: Table = toml::from_str(&campaign.base_toml)
+                    .map_err(|e| campaign.invalid("base", format!("not a TOML table: {e}")))?;
+                let base_dir = campaign.base_dir();
+                let cfg = SimConfig::from_toml_str_in(&campaign.base_toml, &base_dir)
+                    .map_err(|e| campaign.base_error(e))?;
+                // Each run's config.toml must stand alone (it is read from its own folder, by a
+                // server started anywhere): a relative `orbit.elements_file` becomes the
+                // elements themselves.
+                inline_elements_file(&mut base, &base_dir)
+                    .map_err(|e| campaign.invalid("base", e))?;
+                let model = readback(&cfg).map_err(|e| campaign.base_error(e))?;
+                (vec![Unit::new(String::new(), base)], model)
+            }
+        };
+        let mut all_keys: Vec<Vec<String>> = Vec::new();
+        let mut targets = Vec::new();
         for (i, d) in campaign.dispersions.iter().enumerate() {
             let field = format!("dispersions[{i}].key");
-            let concrete = keys::expand(&base, &d.key)
-                .map_err(|e| campaign.invalid(&field, format!("{:?}: {e}", d.key)))?;
+            let u = match &d.vehicle {
+                Some(id) => units
+                    .iter()
+                    .position(|u| u.prefix == format!("{id}."))
+                    .ok_or_else(|| campaign.invalid(&field, format!("no vehicle {id:?}")))?,
+                None => 0,
+            };
+            // Over a fleet, the problem names the vehicle whose configuration the key is in.
+            let whose = d
+                .vehicle
+                .as_ref()
+                .map_or(String::new(), |id| format!("vehicle {id:?}: "));
+            if let (Some(id), Some(fleet)) = (&d.vehicle, &campaign.fleet) {
+                check_fleet_key(fleet, id, &d.key)
+                    .map_err(|e| campaign.invalid(&field, format!("{whose}{:?}: {e}", d.key)))?;
+            }
+            let local = keys::expand(&units[u].base, &d.key)
+                .map_err(|e| campaign.invalid(&field, format!("{whose}{:?}: {e}", d.key)))?;
+            let prefix = &units[u].prefix;
+            let concrete: Vec<String> = local.iter().map(|k| format!("{prefix}{k}")).collect();
             for k in &concrete {
                 if !model.contains_key(k) {
                     return Err(campaign.invalid(
                         &field,
                         format!(
-                            "{k} is not a parameter the built model reports (the hub, initial \
-                             state, panel pairs, reaction wheels, facets, residual dipole, space \
-                             weather and epoch offset are), so its dispersion \
+                            "{whose}{k} is not a parameter the built model reports (the hub, \
+                             initial state, panel pairs, reaction wheels, facets, residual \
+                             dipole, space weather and epoch offset are), so its dispersion \
                              could not be verified; it is refused rather than risk a silent \
                              no-op"
                         ),
@@ -225,34 +265,13 @@ impl Plan {
                 return Err(campaign.invalid(&field, format!("{prev} is dispersed twice")));
             }
             all_keys.push(concrete);
-        }
-        let mut sensor_seed_keys = Vec::new();
-        for section in crate::sensors::KINDS.iter().map(|k| k.config_array) {
-            if let Some(toml::Value::Array(items)) = base.get(section) {
-                for (k, item) in items.iter().enumerate() {
-                    if item.get("seed").is_some() {
-                        sensor_seed_keys.push(format!("{section}[{k}].seed"));
-                    }
-                }
-            }
-        }
-        // A random fault (`mtbf_s`) gets a seed of its own per run, written in if absent, so
-        // every run samples its own failure time.
-        let mut random_faults = Vec::new();
-        if let Some(toml::Value::Array(items)) = base.get("faults") {
-            for (k, item) in items.iter().enumerate() {
-                if item.get("mtbf_s").is_some() {
-                    sensor_seed_keys.push(format!("faults[{k}].seed"));
-                    random_faults.push(k);
-                }
-            }
+            targets.push((u, local));
         }
         Ok(Self {
             campaign,
             keys: all_keys,
-            base,
-            sensor_seed_keys,
-            random_faults,
+            units,
+            targets,
         })
     }
 
@@ -264,23 +283,25 @@ impl Plan {
         let mut sensor_seeds = BTreeMap::new();
         let mut reasons = Vec::new();
         for attempt in 0..=c.max_redraws {
-            let mut doc = self.base.clone();
+            let mut docs: Vec<Table> = self.units.iter().map(|u| u.base.clone()).collect();
             let mut dispersed = BTreeMap::new();
-            for (d, concrete) in c.dispersions.iter().zip(&self.keys) {
+            for (d, (u, concrete)) in c.dispersions.iter().zip(&self.targets) {
+                let (base, prefix) = (&self.units[*u].base, &self.units[*u].prefix);
+                let doc = &mut docs[*u];
+                let mut put = |k: &String, x: f64| {
+                    keys::set(&mut *doc, k, x);
+                    dispersed.insert(format!("{prefix}{k}"), x);
+                };
                 match &d.distribution {
                     Distribution::Normal { mean, sigma } => {
                         for k in concrete {
-                            let m = mean.unwrap_or_else(|| keys::get(&self.base, k).unwrap_or(0.0));
-                            let x = m + sigma * rng.normal();
-                            keys::set(&mut doc, k, x);
-                            dispersed.insert(k.clone(), x);
+                            let m = mean.unwrap_or_else(|| keys::get(base, k).unwrap_or(0.0));
+                            put(k, m + sigma * rng.normal());
                         }
                     }
                     Distribution::Uniform { low, high } => {
                         for k in concrete {
-                            let x = low + (high - low) * rng.uniform01();
-                            keys::set(&mut doc, k, x);
-                            dispersed.insert(k.clone(), x);
+                            put(k, low + (high - low) * rng.uniform01());
                         }
                     }
                     Distribution::UniformAttitude => {
@@ -296,50 +317,34 @@ impl Plan {
                         let s = if q[0] < 0.0 { -1.0 / n } else { 1.0 / n };
                         let b0 = q[0] * s;
                         for (i, k) in concrete.iter().enumerate() {
-                            let x = q[i + 1] * s / (1.0 + b0);
-                            keys::set(&mut doc, k, x);
-                            dispersed.insert(k.clone(), x);
+                            put(k, q[i + 1] * s / (1.0 + b0));
                         }
                     }
                 }
             }
             sensor_seeds.clear();
-            for k in &self.sensor_seed_keys {
-                let s = splitmix64(seed ^ fnv1a(k)) >> 1; // TOML integers are signed
-                let (section, rest) = k.split_once('[').unwrap_or((k, ""));
-                let idx: usize = rest
-                    .split(']')
-                    .next()
-                    .and_then(|i| i.parse().ok())
-                    .unwrap_or(0);
-                if let Some(toml::Value::Array(items)) = doc.get_mut(section) {
-                    if let Some(toml::Value::Table(t)) = items.get_mut(idx) {
-                        t.insert("seed".into(), toml::Value::Integer(s as i64));
+            for (unit, doc) in self.units.iter().zip(docs.iter_mut()) {
+                for k in &unit.seed_keys {
+                    let name = format!("{}{k}", unit.prefix);
+                    let s = splitmix64(seed ^ fnv1a(&name)) >> 1; // TOML integers are signed
+                    let (section, rest) = k.split_once('[').unwrap_or((k, ""));
+                    let idx: usize = rest
+                        .split(']')
+                        .next()
+                        .and_then(|i| i.parse().ok())
+                        .unwrap_or(0);
+                    if let Some(toml::Value::Array(items)) = doc.get_mut(section) {
+                        if let Some(toml::Value::Table(t)) = items.get_mut(idx) {
+                            t.insert("seed".into(), toml::Value::Integer(s as i64));
+                        }
                     }
+                    sensor_seeds.insert(name, s);
                 }
-                sensor_seeds.insert(k.clone(), s);
             }
-            let text = match toml::to_string(&doc) {
-                Ok(t) => t,
-                Err(e) => {
-                    reasons.push(format!("cannot write TOML: {e}"));
-                    continue;
-                }
-            };
-            let check =
-                SimConfig::from_toml_str(&text).and_then(|cfg| cfg.build_spacecraft().map(|_| cfg));
-            match check {
-                Ok(cfg) => {
-                    let random_failures_ns = self
-                        .random_faults
-                        .iter()
-                        .filter_map(|&k| {
-                            let f = cfg.faults.get(k)?;
-                            Some((format!("faults[{k}]"), f.window.start_ns))
-                        })
-                        .collect();
+            match self.resolve(&docs) {
+                Ok(r) => {
                     return RunPlan {
-                        random_failures_ns,
+                        random_failures_ns: r.random_failures_ns,
                         run,
                         dir: run_dir(run),
                         run_seed: seed,
@@ -348,10 +353,11 @@ impl Plan {
                         redraw_reasons: reasons,
                         valid: true,
                         dispersed,
-                        config_toml: text,
+                        config_toml: r.config_toml,
+                        vehicle_configs: r.vehicle_configs,
                     };
                 }
-                Err(e) => reasons.push(e.to_string()),
+                Err(e) => reasons.push(e),
             }
         }
         RunPlan {
@@ -365,7 +371,45 @@ impl Plan {
             dispersed: BTreeMap::new(),
             random_failures_ns: BTreeMap::new(),
             config_toml: String::new(),
+            vehicle_configs: Vec::new(),
         }
+    }
+
+    /// The run's configuration from its dispersed documents, if it is valid (else why not).
+    fn resolve(&self, docs: &[Table]) -> Result<Resolved, String> {
+        let failures = |prefix: &str, unit: &Unit, cfg: &SimConfig| {
+            unit.random_faults
+                .iter()
+                .filter_map(|&k| {
+                    let f = cfg.faults.get(k)?;
+                    Some((format!("{prefix}faults[{k}]"), f.window.start_ns))
+                })
+                .collect::<Vec<_>>()
+        };
+        let Some(fleet) = &self.campaign.fleet else {
+            let text = toml::to_string(&docs[0]).map_err(|e| format!("cannot write TOML: {e}"))?;
+            let cfg = SimConfig::from_toml_str(&text)
+                .and_then(|cfg| cfg.build_spacecraft().map(|_| cfg))
+                .map_err(|e| e.to_string())?;
+            return Ok(Resolved {
+                random_failures_ns: failures("", &self.units[0], &cfg).into_iter().collect(),
+                config_toml: text,
+                vehicle_configs: Vec::new(),
+            });
+        };
+        let (config_toml, vehicle_configs) = super::fleet::run_files(fleet, docs)?;
+        let built = super::fleet::from_run(&config_toml, &vehicle_configs)?;
+        let random_failures_ns = self
+            .units
+            .iter()
+            .zip(&built.vehicles)
+            .flat_map(|(u, v)| failures(&u.prefix, u, &v.cfg))
+            .collect();
+        Ok(Resolved {
+            config_toml,
+            vehicle_configs,
+            random_failures_ns,
+        })
     }
 
     /// The manifest (JSON) of `runs`.
@@ -375,7 +419,7 @@ impl Plan {
             .iter()
             .map(|b| format!("{b:02x}"))
             .collect();
-        serde_json::json!({
+        let mut m = serde_json::json!({
             "campaign_sha256": sha,
             "flexdyn_version": env!("CARGO_PKG_VERSION"),
             "base": c.base_path.as_ref().map_or("(embedded default)".to_owned(), |p| p.display().to_string()),
@@ -394,11 +438,44 @@ impl Plan {
                 "below": k.below,
             })).collect::<Vec<_>>(),
             "run_plans": runs,
-        })
+        });
+        if let (Some(fleet), Some(obj)) = (&c.fleet, m.as_object_mut()) {
+            // Over a fleet: the fleet file instead of a base, a controller per vehicle, and the
+            // vehicles (their order is summary.csv's hash columns').
+            obj.remove("base");
+            obj.remove("controller");
+            obj.insert("fleet".into(), fleet.path.display().to_string().into());
+            obj.insert(
+                "vehicles".into(),
+                fleet.vehicles.iter().map(|v| v.id.clone()).collect(),
+            );
+            obj.insert(
+                "controllers".into(),
+                c.controllers
+                    .iter()
+                    .map(|k| {
+                        serde_json::json!({
+                            "vehicle": k.vehicle,
+                            "sender_id": k.sender_id,
+                            "command": k.command,
+                        })
+                    })
+                    .collect(),
+            );
+            obj.insert(
+                "criterion_vehicles".into(),
+                c.criteria
+                    .iter()
+                    .map(|k| k.vehicle.clone().unwrap_or_default())
+                    .collect(),
+            );
+        }
+        m
     }
 
     /// Writes `DIR/campaign.toml`, `DIR/manifest.json` and `DIR/run-NNNN/config.toml` for every
-    /// run; returns the plans.
+    /// run (over a fleet, `DIR/run-NNNN/fleet.toml` and `config-<id>.toml` per vehicle);
+    /// returns the plans.
     pub fn write(&self, dir: &Path) -> Result<Vec<RunPlan>, std::io::Error> {
         let runs: Vec<RunPlan> = (0..self.campaign.runs).map(|r| self.run(r)).collect();
         std::fs::create_dir_all(dir)?;
@@ -406,7 +483,15 @@ impl Plan {
         for r in &runs {
             let d = dir.join(&r.dir);
             std::fs::create_dir_all(&d)?;
-            if r.valid {
+            if !r.valid {
+                continue;
+            }
+            if self.campaign.fleet.is_some() {
+                std::fs::write(d.join("fleet.toml"), &r.config_toml)?;
+                for (id, text) in &r.vehicle_configs {
+                    std::fs::write(d.join(super::fleet::vehicle_file(id)), text)?;
+                }
+            } else {
                 std::fs::write(d.join("config.toml"), &r.config_toml)?;
             }
         }
@@ -414,6 +499,61 @@ impl Plan {
             serde_json::to_string_pretty(&self.manifest(&runs)).map_err(std::io::Error::other)?;
         std::fs::write(dir.join("manifest.json"), text + "\n")?;
         Ok(runs)
+    }
+}
+
+/// The units of a campaign over `fleet` (each vehicle's document: its configuration with its
+/// elements file inlined, and a deputy's `relative` offsets) and the base fleet's read-back.
+fn fleet_units(
+    campaign: &Campaign,
+    fleet: &FleetBase,
+) -> Result<(Vec<Unit>, BTreeMap<String, f64>), CampaignError> {
+    let mut units = Vec::with_capacity(fleet.vehicles.len());
+    for v in &fleet.vehicles {
+        let bad = |e: String| campaign.invalid("fleet", format!("vehicle {:?}: {e}", v.id));
+        let mut doc: Table =
+            toml::from_str(&v.base_toml).map_err(|e| bad(format!("not a TOML table: {e}")))?;
+        inline_elements_file(&mut doc, &v.base_dir).map_err(bad)?;
+        if v.chief.is_some() {
+            doc.insert(
+                "relative".into(),
+                toml::Value::Table(offsets_table(&v.offsets)),
+            );
+        }
+        units.push(Unit::new(format!("{}.", v.id), doc));
+    }
+    // The base fleet as a run would build it, read back.
+    let docs: Vec<Table> = units.iter().map(|u| u.base.clone()).collect();
+    let model = super::fleet::run_files(fleet, &docs)
+        .and_then(|(text, configs)| super::fleet::from_run(&text, &configs))
+        .and_then(|built| fleet_readback(&built))
+        .map_err(|e| campaign.invalid("fleet", e))?;
+    Ok((units, model))
+}
+
+/// What a dispersion key of vehicle `id` may not name: `relative.…` of a vehicle without a
+/// chief, and the initial position or velocity of one with a chief (its `relative` offsets
+/// replace them, so a dispersion of either would not reach the model).
+fn check_fleet_key(fleet: &FleetBase, id: &str, key: &str) -> Result<(), String> {
+    let Some(v) = fleet.vehicle(id) else {
+        return Ok(());
+    };
+    match &v.chief {
+        None if key.starts_with("relative") => Err(format!(
+            "vehicle {id:?} has no [vehicles.relative] in {}: only a deputy's Hill offsets \
+             (relative.hill_position_m, relative.hill_velocity_m_s) can be dispersed",
+            fleet.path.display()
+        )),
+        Some(chief)
+            if key.starts_with("initial.r_bn_n_m") || key.starts_with("initial.v_bn_n_m_s") =>
+        {
+            Err(format!(
+                "vehicle {id:?} starts at an offset from {chief:?} ([vehicles.relative]), which \
+                 replaces its own position and velocity: disperse relative.hill_position_m or \
+                 relative.hill_velocity_m_s instead"
+            ))
+        }
+        _ => Ok(()),
     }
 }
 

@@ -22,12 +22,36 @@
 //! statistic = "final"            # final | max | settling_time
 //! below = 0.01
 //! ```
+//!
+//! Over a fleet (README, "Campaigns over a fleet"): `fleet = "formation.toml"` replaces `base`,
+//! every dispersion and criterion names its `vehicle`, and `[[controllers]]` (one per vehicle,
+//! or one for several) replaces `controller`:
+//!
+//! ```toml
+//! fleet = "formation.toml"
+//! [[controllers]]
+//! vehicle = "deputy"             # {vehicle} and {sc_id}
+//! sender_id = 2                  # default: the vehicle's one participant (besides 9)
+//! command = "flexdyn-formation-demo --connect {endpoint} --sc-id {sc_id} --chief chief --sender-id {sender_id}"
+//! [[dispersions]]
+//! vehicle = "deputy"
+//! key = "relative.hill_position_m"   # or any key of its spacecraft configuration
+//! distribution = "normal"
+//! sigma = 1.0
+//! [[criteria]]
+//! vehicle = "deputy"
+//! name = "range"
+//! quantity = "range"             # |r_dc| to its chief, from the RelativeStateMsg
+//! statistic = "max"
+//! below = 150.0
+//! ```
 
 use std::path::{Path, PathBuf};
 
 use toml::de::DeTable;
 
 use super::command::split_command;
+use super::fleet::FleetBase;
 use crate::config::{
     beyond_max_time, config_message, log_warnings, whole_ns, ConfigError, SimConfig, SourceMap,
     DEFAULT_CONFIG_TOML,
@@ -65,6 +89,8 @@ pub struct Dispersion {
     pub key: String,
     /// Its distribution.
     pub distribution: Distribution,
+    /// The vehicle whose configuration it writes into (a fleet campaign's; `None` otherwise).
+    pub vehicle: Option<String>,
 }
 
 /// What a criterion measures at each state.
@@ -78,6 +104,8 @@ pub enum Quantity {
     Omega,
     /// The largest |θ1|, |θ2| over every panel pair (rad).
     Theta,
+    /// A fleet deputy's range to its chief (m), from the RelativeStateMsg the server publishes.
+    Range,
 }
 
 /// How a criterion reduces the quantity over time.
@@ -108,6 +136,8 @@ pub struct Criterion {
     pub after_s: f64,
     /// Pass if the statistic is strictly below this.
     pub below: f64,
+    /// The vehicle whose states it judges (a fleet campaign's; `None` otherwise).
+    pub vehicle: Option<String>,
 }
 
 impl Criterion {
@@ -118,6 +148,7 @@ impl Criterion {
             (Statistic::SettlingTime { .. }, _) => "s",
             (_, Quantity::Omega) => "rad/s",
             (_, Quantity::Theta) => "rad",
+            (_, Quantity::Range) => "m",
             (_, Quantity::SigmaBr | Quantity::SigmaBn) => "–",
         }
     }
@@ -157,7 +188,28 @@ pub struct Campaign {
     /// The base configuration's random faults (`[[faults]]` with `mtbf_s`) were removed
     /// ([`Self::without_random_faults`]): the same campaign without them, for comparison.
     pub random_faults_removed: bool,
+    /// `fleet`: the fleet the campaign runs over, in place of `base` (`base_path` is then
+    /// `None` and `base_toml` empty; each vehicle has its own).
+    pub fleet: Option<FleetBase>,
+    /// `[[controllers]]` of a fleet campaign.
+    pub controllers: Vec<Controller>,
 }
+
+/// One `[[controllers]]` entry of a fleet campaign: a flight-code process per run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Controller {
+    /// The vehicle it runs for: `{vehicle}` and `{sc_id}` in its command.
+    pub vehicle: String,
+    /// Its lockstep sender id (`{sender_id}`), a participant of `vehicle` in the fleet file
+    /// (and of every other vehicle it commands).
+    pub sender_id: u32,
+    /// Its command line (`{endpoint}`, `{sc_id}`, `{vehicle}`, `{sender_id}`, `{run}`).
+    pub command: String,
+}
+
+/// The sender id of the campaign's observer: it answers every tick of every vehicle with
+/// `NoCommand` and records the states, so no controller may use it.
+pub const OBSERVER_ID: u32 = 9;
 
 /// Why a campaign file is not usable. Every message starts with the name of the file that
 /// holds the offending field: the campaign file, or its base configuration.
@@ -204,6 +256,20 @@ pub enum CampaignError {
         /// Where the field is.
         at: At,
     },
+    /// The fleet file (`fleet`) is invalid: the message is the fleet file's own (it names the
+    /// vehicle and the field), with its position in that file, then names the campaign.
+    #[error("{}: {source}{at} (the fleet of {})", fleet.display(), campaign.display())]
+    Fleet {
+        /// The campaign file.
+        campaign: PathBuf,
+        /// The fleet file.
+        fleet: PathBuf,
+        /// The fleet file's error.
+        #[source]
+        source: Box<crate::world::FleetError>,
+        /// Where the field is in the fleet file.
+        at: At,
+    },
     /// The base configuration (`base`) is invalid: the message is the configuration's own,
     /// starting with the base file's name, then names the campaign.
     #[error(
@@ -224,6 +290,8 @@ pub enum CampaignError {
 
 const ROOT_KEYS: &[&str] = &[
     "base",
+    "fleet",
+    "controllers",
     "runs",
     "seed",
     "duration_s",
@@ -254,20 +322,25 @@ impl Campaign {
     /// and without the faults differ by the faults only (a paired comparison). Returns how many
     /// were removed.
     pub fn without_random_faults(&mut self) -> Result<usize, CampaignError> {
-        let mut base: toml::Table = toml::from_str(&self.base_toml)
-            .map_err(|e| self.invalid("base", format!("not a TOML table: {e}")))?;
         let mut removed = 0;
-        if let Some(toml::Value::Array(items)) = base.get_mut("faults") {
-            let before = items.len();
-            items.retain(|f| f.get("mtbf_s").is_none());
-            removed = before - items.len();
-            if items.is_empty() {
-                base.remove("faults");
+        if let Some(fleet) = &mut self.fleet {
+            for v in &mut fleet.vehicles {
+                let (text, n) = remove_random_faults(&v.base_toml).map_err(|e| {
+                    invalid_at(
+                        &self.source,
+                        &self.path,
+                        "fleet",
+                        format!("vehicle {:?}: {e}", v.id),
+                    )
+                })?;
+                v.base_toml = text;
+                removed += n;
             }
-        }
-        if removed > 0 {
-            self.base_toml = toml::to_string(&base)
-                .map_err(|e| self.invalid("base", format!("cannot write TOML: {e}")))?;
+        } else {
+            let (text, n) =
+                remove_random_faults(&self.base_toml).map_err(|e| self.invalid("base", e))?;
+            self.base_toml = text;
+            removed = n;
         }
         self.random_faults_removed = true;
         Ok(removed)
@@ -320,47 +393,81 @@ impl Campaign {
                 at,
             });
         }
-        let base_path = match root.get("base") {
-            Some(_) => {
-                let rel = PathBuf::from(root.string("base").map_err(schema)?);
-                Some(if rel.is_absolute() {
-                    rel
-                } else {
-                    path.parent().unwrap_or(Path::new(".")).join(rel)
-                })
+        // `base` and `fleet` are relative to the campaign file.
+        let file_field = |key: &str| -> Result<Option<PathBuf>, CampaignError> {
+            if root.get(key).is_none() {
+                return Ok(None);
+            }
+            let rel = PathBuf::from(root.string(key).map_err(schema)?);
+            Ok(Some(if rel.is_absolute() {
+                rel
+            } else {
+                path.parent().unwrap_or(Path::new(".")).join(rel)
+            }))
+        };
+        let base_path = file_field("base")?;
+        let fleet_path = file_field("fleet")?;
+        if base_path.is_some() && fleet_path.is_some() {
+            return Err(invalid(
+                "fleet",
+                "give either base (one spacecraft configuration) or fleet (a fleet file), not \
+                 both"
+                    .into(),
+            ));
+        }
+        let fleet = match &fleet_path {
+            Some(p) => {
+                let text = std::fs::read_to_string(p)
+                    .map_err(|e| invalid("fleet", format!("cannot read {}: {e}", p.display())))?;
+                let fleet = FleetBase::new(p, &text).map_err(|e| fleet_error(path, p, &text, e))?;
+                for v in &fleet.config.vehicles {
+                    log_warnings(&v.cfg, None);
+                }
+                Some(fleet)
             }
             None => None,
         };
-        let base_toml = match &base_path {
-            Some(p) => std::fs::read_to_string(p)
-                .map_err(|e| invalid("base", format!("cannot read {}: {e}", p.display())))?,
-            None => DEFAULT_CONFIG_TOML.to_owned(),
-        };
-        let base_dir = base_path
-            .as_deref()
-            .and_then(Path::parent)
-            .unwrap_or(Path::new("."));
-        let base = SimConfig::from_toml_str_in(&base_toml, base_dir).map_err(|source| {
-            CampaignError::Base {
-                campaign: path.to_owned(),
-                base: base_path.clone(),
-                source: Box::new(source),
+        // The frame every run is a whole number of (a fleet's vehicles share theirs).
+        let (base_toml, frame_ns, frame_hz) = match &fleet {
+            Some(f) => {
+                let first = &f.config.vehicles[0].cfg;
+                (String::new(), first.frame_ns, first.frame_hz)
             }
-        })?;
-        log_warnings(&base, base_path.as_deref());
+            None => {
+                let base_toml = match &base_path {
+                    Some(p) => std::fs::read_to_string(p).map_err(|e| {
+                        invalid("base", format!("cannot read {}: {e}", p.display()))
+                    })?,
+                    None => DEFAULT_CONFIG_TOML.to_owned(),
+                };
+                let base_dir = base_path
+                    .as_deref()
+                    .and_then(Path::parent)
+                    .unwrap_or(Path::new("."));
+                let base = SimConfig::from_toml_str_in(&base_toml, base_dir).map_err(|source| {
+                    CampaignError::Base {
+                        campaign: path.to_owned(),
+                        base: base_path.clone(),
+                        source: Box::new(source),
+                    }
+                })?;
+                log_warnings(&base, base_path.as_deref());
+                (base_toml, base.frame_ns, base.frame_hz)
+            }
+        };
         let runs = root.int_in("runs", 1, 1_000_000).map_err(schema)? as u32;
         let seed = root.int_in("seed", 0, i64::MAX).map_err(schema)? as u64;
         let duration_s = root.f64("duration_s").map_err(schema)?;
         let duration_ns =
             within_time("duration_s", duration_s).map_err(|p| invalid("duration_s", p))?;
-        if duration_ns % base.frame_ns != 0 {
+        if duration_ns % frame_ns != 0 {
             return Err(invalid(
                 "duration_s",
                 format!(
                     "{} s is not a whole number of frames (frame = {} s at {} Hz)",
                     Num(duration_s),
-                    Num(base.frame_ns as f64 / 1e9),
-                    Num(base.frame_hz)
+                    Num(frame_ns as f64 / 1e9),
+                    Num(frame_hz)
                 ),
             ));
         }
@@ -369,11 +476,31 @@ impl Campaign {
             None => None,
         };
         if let Some(c) = &controller {
+            if fleet.is_some() {
+                return Err(invalid(
+                    "controller",
+                    "a campaign over a fleet starts a controller per vehicle: use \
+                     [[controllers]] (vehicle, command) instead"
+                        .into(),
+                ));
+            }
             let words = split_command(c).map_err(|e| invalid("controller", e))?;
             if words.is_empty() {
                 return Err(invalid("controller", "is empty".into()));
             }
         }
+        let controllers = match &fleet {
+            Some(f) => read_controllers(&root, f, source, path)?,
+            None if root.get("controllers").is_some() => {
+                return Err(invalid(
+                    "controllers",
+                    "applies only to a campaign over a fleet (fleet = \"…\"); with one \
+                     spacecraft, use controller"
+                        .into(),
+                ))
+            }
+            None => Vec::new(),
+        };
         let sigma_rn = root
             .opt_floats::<3>("sigma_rn")
             .map_err(schema)?
@@ -393,7 +520,15 @@ impl Campaign {
         let tables = root
             .tables(
                 "dispersions",
-                &["key", "distribution", "mean", "sigma", "low", "high"],
+                &[
+                    "key",
+                    "distribution",
+                    "mean",
+                    "sigma",
+                    "low",
+                    "high",
+                    "vehicle",
+                ],
             )
             .map_err(schema)?
             .unwrap_or_default();
@@ -401,6 +536,14 @@ impl Campaign {
             let field = |k: &str| format!("dispersions[{i}].{k}");
             let key = t.string("key").map_err(schema)?;
             super::keys::parse(&key).map_err(|e| invalid(&field("key"), e))?;
+            let vehicle = entry_vehicle(
+                t,
+                fleet.as_ref(),
+                &format!("dispersions[{i}]"),
+                "key",
+                source,
+                path,
+            )?;
             let kind = t.string("distribution").map_err(schema)?;
             let only = |allowed: &[&str]| -> Result<(), CampaignError> {
                 for k in ["mean", "sigma", "low", "high"] {
@@ -465,7 +608,11 @@ impl Campaign {
                     ))
                 }
             };
-            dispersions.push(Dispersion { key, distribution });
+            dispersions.push(Dispersion {
+                key,
+                distribution,
+                vehicle,
+            });
         }
 
         let mut criteria: Vec<Criterion> = Vec::new();
@@ -479,6 +626,7 @@ impl Campaign {
                     "after_s",
                     "below",
                     "threshold",
+                    "vehicle",
                 ],
             )
             .map_err(schema)?
@@ -495,20 +643,50 @@ impl Campaign {
             if criteria.iter().any(|c| c.name == name) {
                 return Err(invalid(&field("name"), format!("{name:?} is used twice")));
             }
+            let vehicle = entry_vehicle(
+                t,
+                fleet.as_ref(),
+                &format!("criteria[{i}]"),
+                "name",
+                source,
+                path,
+            )?;
             let quantity = match t.string("quantity").map_err(schema)?.as_str() {
                 "sigma_br" => Quantity::SigmaBr,
                 "sigma_bn" => Quantity::SigmaBn,
                 "omega" => Quantity::Omega,
                 "theta" => Quantity::Theta,
+                "range" => Quantity::Range,
                 other => {
                     return Err(invalid(
                         &field("quantity"),
                         format!(
-                        "{other:?} is not one of \"sigma_br\", \"sigma_bn\", \"omega\", \"theta\""
-                    ),
+                            "{other:?} is not one of \"sigma_br\", \"sigma_bn\", \"omega\", \
+                             \"theta\", \"range\" (a fleet's deputy)"
+                        ),
                     ))
                 }
             };
+            if quantity == Quantity::Range {
+                // A deputy's distance to its chief: only a vehicle given relative to one has it.
+                let deputy = fleet
+                    .as_ref()
+                    .zip(vehicle.as_deref())
+                    .and_then(|(f, id)| f.vehicle(id))
+                    .is_some_and(|v| v.chief.is_some());
+                if !deputy {
+                    return Err(invalid(
+                        &field("quantity"),
+                        format!(
+                            "range is a fleet deputy's distance to its chief, and {} has no chief \
+                             ([vehicles.relative] in the fleet file)",
+                            vehicle
+                                .as_ref()
+                                .map_or("a single spacecraft".to_owned(), |v| format!("{v:?}"))
+                        ),
+                    ));
+                }
+            }
             let stat = t.string("statistic").map_err(schema)?;
             let threshold = t.opt_f64("threshold").map_err(schema)?;
             let statistic = match (stat.as_str(), threshold) {
@@ -574,6 +752,7 @@ impl Campaign {
                 statistic,
                 after_s,
                 below,
+                vehicle,
             });
         }
         Ok(Self {
@@ -592,8 +771,242 @@ impl Campaign {
             dispersions,
             criteria,
             random_faults_removed: false,
+            fleet,
+            controllers,
         })
     }
+}
+
+/// The `vehicle` of the `[[dispersions]]` or `[[criteria]]` entry `entry` (`dispersions[2]`):
+/// required with a fleet, refused without one, and one of the fleet's ids. A missing one is
+/// located at the entry's `near` key.
+fn entry_vehicle(
+    t: &TableReader<'_, '_>,
+    fleet: Option<&FleetBase>,
+    entry: &str,
+    near: &str,
+    source: &str,
+    path: &Path,
+) -> Result<Option<String>, CampaignError> {
+    let field = format!("{entry}.vehicle");
+    let vehicle = match t.get("vehicle") {
+        Some(_) => Some(
+            t.string("vehicle")
+                .map_err(|source| CampaignError::Schema {
+                    path: path.to_owned(),
+                    source,
+                })?,
+        ),
+        None => None,
+    };
+    match (fleet, &vehicle) {
+        (None, None) => Ok(None),
+        (None, Some(_)) => Err(invalid_at(
+            source,
+            path,
+            &field,
+            "applies only to a campaign over a fleet (fleet = \"…\"); this one has a single \
+             spacecraft"
+                .into(),
+        )),
+        (Some(f), None) => Err(CampaignError::Invalid {
+            path: path.to_owned(),
+            field,
+            problem: format!(
+                "missing: over a fleet, every entry names its vehicle (one of {})",
+                f.ids()
+            ),
+            at: SourceMap::locate(source, &format!("{entry}.{near}")),
+        }),
+        (Some(f), Some(id)) if f.vehicle(id).is_none() => Err(invalid_at(
+            source,
+            path,
+            &field,
+            format!(
+                "{id:?} is not a vehicle of {} (its vehicles: {})",
+                f.path.display(),
+                f.ids()
+            ),
+        )),
+        (Some(_), Some(_)) => Ok(vehicle),
+    }
+}
+
+/// The `[[controllers]]` of a campaign over `fleet`: each a vehicle of the fleet, a command, and
+/// a sender id that vehicle lists as a participant (default: its one participant besides the
+/// observer); no two with one sender id; and every participant the fleet file lists, besides
+/// the observer, run by one of them (else every tick would wait for it).
+fn read_controllers(
+    root: &TableReader<'_, '_>,
+    fleet: &FleetBase,
+    source: &str,
+    path: &Path,
+) -> Result<Vec<Controller>, CampaignError> {
+    let schema = |source: SchemaError| CampaignError::Schema {
+        path: path.to_owned(),
+        source,
+    };
+    let invalid = |field: &str, problem: String| invalid_at(source, path, field, problem);
+    let tables = root
+        .tables("controllers", &["vehicle", "sender_id", "command"])
+        .map_err(schema)?
+        .unwrap_or_default();
+    let mut out: Vec<Controller> = Vec::new();
+    for (i, t) in tables.iter().enumerate() {
+        let field = |k: &str| format!("controllers[{i}].{k}");
+        let vehicle = t.string("vehicle").map_err(schema)?;
+        let v = fleet.vehicle(&vehicle).ok_or_else(|| {
+            invalid(
+                &field("vehicle"),
+                format!(
+                    "{vehicle:?} is not a vehicle of {} (its vehicles: {})",
+                    fleet.path.display(),
+                    fleet.ids()
+                ),
+            )
+        })?;
+        let command = t.string("command").map_err(schema)?;
+        let words = split_command(&command).map_err(|e| invalid(&field("command"), e))?;
+        if words.is_empty() {
+            return Err(invalid(&field("command"), "is empty".into()));
+        }
+        let sender_id = match t.get("sender_id") {
+            Some(_) => t
+                .int_in("sender_id", 0, i64::from(u32::MAX))
+                .map_err(schema)? as u32,
+            None => {
+                let own: Vec<u32> = v
+                    .participants
+                    .iter()
+                    .copied()
+                    .filter(|p| *p != OBSERVER_ID)
+                    .collect();
+                match own.as_slice() {
+                    [one] => *one,
+                    _ => {
+                        return Err(CampaignError::Invalid {
+                            path: path.to_owned(),
+                            field: field("sender_id"),
+                            problem: format!(
+                                "missing: vehicle {vehicle:?} lists {} participants {:?} in {} \
+                                 (besides the observer, {OBSERVER_ID}): say which one this \
+                                 controller answers as",
+                                if own.is_empty() { "no" } else { "several" },
+                                own,
+                                fleet.path.display()
+                            ),
+                            at: SourceMap::locate(source, &field("vehicle")),
+                        })
+                    }
+                }
+            }
+        };
+        if sender_id == OBSERVER_ID {
+            return Err(invalid(
+                &field("sender_id"),
+                format!(
+                    "{OBSERVER_ID} is the campaign's observer (it answers every vehicle's ticks \
+                     and records them): give the controller another sender id"
+                ),
+            ));
+        }
+        if !v.participants.contains(&sender_id) {
+            return Err(invalid(
+                &field("sender_id"),
+                format!(
+                    "{sender_id} is not a participant of vehicle {vehicle:?} in {} (its \
+                     participants: {:?}): the server would refuse its commands",
+                    fleet.path.display(),
+                    v.participants
+                ),
+            ));
+        }
+        if let Some(j) = out.iter().position(|c| c.sender_id == sender_id) {
+            return Err(invalid(
+                &field("sender_id"),
+                format!(
+                    "sender {sender_id} is already controllers[{j}]'s: two processes cannot \
+                     answer as one participant"
+                ),
+            ));
+        }
+        out.push(Controller {
+            vehicle,
+            sender_id,
+            command,
+        });
+    }
+    for (i, v) in fleet.vehicles.iter().enumerate() {
+        if let Some(p) = v
+            .participants
+            .iter()
+            .find(|p| **p != OBSERVER_ID && !out.iter().any(|c| c.sender_id == **p))
+        {
+            return Err(CampaignError::Invalid {
+                path: path.to_owned(),
+                field: "controllers".into(),
+                problem: format!(
+                    "vehicles[{i}] ({:?}) of {} lists participant {p}, and no [[controllers]] \
+                     entry answers as sender {p}: every lockstep tick would wait for it",
+                    v.id,
+                    fleet.path.display()
+                ),
+                at: match SourceMap::locate(source, "controllers") {
+                    At(None) => SourceMap::locate(source, "fleet"),
+                    at => at,
+                },
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The error of the fleet file `fleet` (text `text`) of the campaign `campaign`, with the
+/// position of the field it names (`vehicles[1] ("deputy").relative.chief` is the TOML path
+/// `vehicles[1].relative.chief`).
+fn fleet_error(
+    campaign: &Path,
+    fleet: &Path,
+    text: &str,
+    e: crate::world::FleetError,
+) -> CampaignError {
+    let at = match &e {
+        crate::world::FleetError::Field { field, .. } => {
+            let toml_path = match (field.find(" (\""), field.find("\")")) {
+                (Some(a), Some(b)) if b > a => format!("{}{}", &field[..a], &field[b + 2..]),
+                _ => field.clone(),
+            };
+            SourceMap::locate(text, &toml_path)
+        }
+        _ => At(None),
+    };
+    CampaignError::Fleet {
+        campaign: campaign.to_owned(),
+        fleet: fleet.to_owned(),
+        source: Box::new(e),
+        at,
+    }
+}
+
+/// `text` (a configuration) without its random faults (`[[faults]]` entries with `mtbf_s`), and
+/// how many there were; unchanged when there were none.
+fn remove_random_faults(text: &str) -> Result<(String, usize), String> {
+    let mut base: toml::Table =
+        toml::from_str(text).map_err(|e| format!("not a TOML table: {e}"))?;
+    let mut removed = 0;
+    if let Some(toml::Value::Array(items)) = base.get_mut("faults") {
+        let before = items.len();
+        items.retain(|f| f.get("mtbf_s").is_none());
+        removed = before - items.len();
+        if items.is_empty() {
+            base.remove("faults");
+        }
+    }
+    if removed == 0 {
+        return Ok((text.to_owned(), 0));
+    }
+    let text = toml::to_string(&base).map_err(|e| format!("cannot write TOML: {e}"))?;
+    Ok((text, removed))
 }
 
 /// `seconds` as a whole number of nanoseconds that a `u64` holds, or why not.

@@ -77,12 +77,15 @@ pub fn wilson(k: u32, n: u32, z: f64) -> (f64, f64) {
     ((centre - half).max(0.0), (centre + half).min(1.0))
 }
 
-/// `k` of `faults[k]` (for ordering the columns).
-fn fault_index(key: &str) -> usize {
-    key.trim_start_matches("faults[")
+/// The vehicle and `k` of `faults[k]` or `<vehicle>.faults[k]` (for ordering the columns).
+fn fault_index(key: &str) -> (&str, usize) {
+    let (vehicle, fault) = key.rsplit_once('.').unwrap_or(("", key));
+    let k = fault
+        .trim_start_matches("faults[")
         .trim_end_matches(']')
         .parse()
-        .unwrap_or(usize::MAX)
+        .unwrap_or(usize::MAX);
+    (vehicle, k)
 }
 
 fn io(path: &Path, e: impl std::fmt::Display) -> String {
@@ -131,8 +134,24 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
             .map(|r| r.outcome)
             .chain(s.missing.iter().map(|_| Outcome::NotRun)),
     );
+    // Over a fleet, one hash column per vehicle (`<id>.state_sha256`), in fleet order.
+    let vehicles: Vec<String> = manifest["vehicles"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .filter_map(|v| v.as_str().map(str::to_owned))
+                .collect()
+        })
+        .unwrap_or_default();
     // summary.csv
-    let mut csv = String::from("run,state_sha256,passed");
+    let mut csv = String::from("run");
+    if vehicles.is_empty() {
+        csv.push_str(",state_sha256");
+    }
+    for v in &vehicles {
+        write!(csv, ",{v}.state_sha256").ok();
+    }
+    csv.push_str(",passed");
     for k in &keys {
         write!(csv, ",{k}").ok();
     }
@@ -148,7 +167,7 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
             .iter()
             .flat_map(|p| p.random_failures_ns.keys().cloned())
             .collect();
-        v.sort_by_key(|k| fault_index(k));
+        v.sort_by(|a, b| fault_index(a).cmp(&fault_index(b)));
         v.dedup();
         v
     };
@@ -165,14 +184,15 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
     for p in &plans {
         let r = results.iter().find(|r| r.run == p.run);
         let status = r.map_or("missing".to_owned(), |r| r.status.replace([',', '\n'], ";"));
-        write!(
-            csv,
-            "{},{},{}",
-            p.run,
-            r.map_or("", |r| r.state_sha256.as_str()),
-            r.is_some_and(|r| r.passed),
-        )
-        .ok();
+        write!(csv, "{}", p.run).ok();
+        if vehicles.is_empty() {
+            write!(csv, ",{}", r.map_or("", |r| r.state_sha256.as_str())).ok();
+        }
+        for v in &vehicles {
+            let hash = r.and_then(|r| r.vehicle_state_sha256.get(v));
+            write!(csv, ",{}", hash.map_or("", String::as_str)).ok();
+        }
+        write!(csv, ",{}", r.is_some_and(|r| r.passed)).ok();
         for k in &keys {
             match r.and_then(|r| r.applied.get(k)) {
                 Some(v) => write!(csv, ",{v}").ok(),
@@ -538,6 +558,7 @@ mod tests {
                 redraws: 0,
                 applied: [("hub.mass_kg".to_owned(), 400.0 + 50.0 * r as f64)].into(),
                 state_sha256: String::new(),
+                vehicle_state_sha256: BTreeMap::new(),
                 states: 1,
                 criteria: vec![super::super::execute::CriterionResult {
                     name: "settle".into(),
@@ -552,6 +573,7 @@ mod tests {
                 },
                 status: "ok".into(),
                 controller_exit: None,
+                controller_exits: BTreeMap::new(),
                 wall_s: 0.0,
                 sim_s: 10.0,
             };

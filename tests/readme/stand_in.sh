@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Stands in for `cargo`, `flexdyn`, `flexdyn-acs-demo` and `flexdyn-monitor` while
-# tests/readme_snippets.rs runs the README's shell blocks (it links this file under each name in
-# the sandbox's `target/release`, which is first on the PATH). Each block runs in its own network
-# namespace, so the README's ports are used as written and collide with nothing.
+# Stands in for `cargo`, `flexdyn`, `flexdyn-acs-demo`, `flexdyn-formation-demo` and
+# `flexdyn-monitor` while tests/readme_snippets.rs runs the README's shell blocks (it links this
+# file under each name in the sandbox's `target/release`, which is first on the PATH). Each block
+# runs in its own network namespace, so the README's ports are used as written and collide with
+# nothing.
 #
 # - `cargo run --release [-p PKG] [--bin BIN] [-- ARGS]` runs the binary the suite built, as
 #   cargo would after its (no-op) build; `cargo build --release --workspace` checks that every
@@ -52,7 +53,7 @@ flexdyn)
     run) has --duration-s || forever=1 ;;
     record | view) forever=1 ;;
     esac ;;
-flexdyn-acs-demo) has --idle-exit-s || forever=1 ;;
+flexdyn-acs-demo | flexdyn-formation-demo) has --idle-exit-s || forever=1 ;;
 flexdyn-monitor) has --duration-s || forever=1 ;;
 esac
 if ((forever)) && [[ -n ${README_STOP_S:-} ]]; then
