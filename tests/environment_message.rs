@@ -41,7 +41,9 @@ use flexdyn_proto::{
     Mode, StateMsg, TimeMsg, Topics,
 };
 use nalgebra::{Matrix3, Vector3};
-use server_support::{connecting_session, listening_session, wait_until, ServerHandle};
+use server_support::{
+    connecting_session, listening_session, wait_for_subscriber, wait_until, ServerHandle,
+};
 use zenoh::Wait;
 
 const MU_M3_S2: f64 = 3.986_004_418e14;
@@ -119,13 +121,7 @@ fn run(cfg: SimConfig, duration_s: f64) -> Seen {
         })
         .wait()
         .unwrap();
-    let connected = || {
-        let info = session.info();
-        info.peers_zid().wait().count() + info.routers_zid().wait().count() > 0
-    };
-    assert!(wait_until(Duration::from_secs(10), connected));
-    // A margin for the subscription's declaration to reach the server's session.
-    std::thread::sleep(Duration::from_millis(300));
+    wait_for_subscriber(&server_session, &topics.environment());
     let mut server = ServerHandle::start_with_session(server_session, settings, cfg);
     let report = server.join(Duration::from_secs(60));
     server.stop();

@@ -12,7 +12,10 @@ use std::time::Duration;
 use flexdyn::config::SimConfig;
 use flexdyn::server::{self, ServerSettings};
 use flexdyn_proto::{decode_header, decode_time, time_flags, Mode, RunState, TimeMsg, Topics};
-use server_support::{connecting_session, reference_config, wait_until, ServerHandle};
+use server_support::{
+    connecting_session, listening_session, reference_config, wait_for_subscriber, wait_until,
+    ServerHandle,
+};
 use zenoh::Wait;
 
 const S: u64 = 1_000_000_000;
@@ -34,11 +37,13 @@ type Sample = (String, u64, Option<TimeMsg>, Option<u64>);
 
 fn run_and_collect(settings: ServerSettings, cfg: SimConfig) -> Vec<Sample> {
     let topics = Topics::new(&settings.sc_id).unwrap();
-    let mut server = ServerHandle::start(settings, cfg);
-    let session = connecting_session(server.port);
+    // Subscribed before the run starts: the tests expect every tick from 0.
+    let (server_session, port) = listening_session();
+    let session = connecting_session(port);
     let seen: Arc<Mutex<Vec<Sample>>> = Arc::default();
     let s = seen.clone();
     let time_key = topics.time();
+    let time_key_probe = time_key.clone();
     let _sub = session
         .declare_subscriber(topics.telemetry_wildcard())
         .callback(move |sample| {
@@ -51,6 +56,8 @@ fn run_and_collect(settings: ServerSettings, cfg: SimConfig) -> Vec<Sample> {
         })
         .wait()
         .unwrap();
+    wait_for_subscriber(&server_session, &time_key_probe);
+    let mut server = ServerHandle::start_with_session(server_session, settings, cfg);
     let report = server.join(Duration::from_secs(60));
     server.stop();
     report.expect("the run ends normally");

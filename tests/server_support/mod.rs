@@ -35,6 +35,24 @@ pub fn listening_session() -> (Session, u16) {
     (session, port)
 }
 
+/// Waits until `server_session` routes `key` to a subscriber (one declared on a session
+/// connected to it): a real-time run starts publishing at once, and a subscription that reaches
+/// the server later misses the first frames (CI saw a stream start at tick 10 of 40). Zenoh's
+/// matching status of a probe publisher on the server's own session says when it is there.
+pub fn wait_for_subscriber(server_session: &Session, key: &str) {
+    let probe = server_session
+        .declare_publisher(key.to_owned())
+        .wait()
+        .unwrap();
+    assert!(
+        wait_until(Duration::from_secs(10), || probe
+            .matching_status()
+            .wait()
+            .is_ok_and(|m| m.matching())),
+        "no subscriber on {key} reached the server"
+    );
+}
+
 /// The port `session` listens on (its first listen endpoint).
 pub fn session_port(session: &Session) -> u16 {
     let endpoints = flexdyn::transport::listening_on(session);
