@@ -144,21 +144,15 @@ pub const MODES: &[(&str, &[&str])] = &[
     ("corrupted", &["probability"]),
 ];
 
-/// The modes a command link (`links.<sender id>`) takes.
-pub const LINK_MODES: &[&str] = &["dropped", "delayed", "corrupted"];
+/// The modes a command link (`links.<sender id>`) takes: the last three wire codes
+/// (`dropped`, `delayed`, `corrupted`; the table is [`flexdyn_proto::FAULT_MODE_NAMES`], which
+/// the tests below check [`MODES`] against).
+pub const LINK_MODES: &[&str] = flexdyn_proto::FAULT_MODE_NAMES.split_at(18).1;
 
-/// The modes every sensor kind takes (`validity_off` only where [`crate::sensors::Sensor::has_validity`]).
-pub const SENSOR_MODES: &[&str] = &[
-    "stuck_current",
-    "stuck_value",
-    "bias_step",
-    "bias_ramp",
-    "scale",
-    "noise",
-    "spikes",
-    "dropout",
-    "validity_off",
-];
+/// The modes every sensor kind takes (`validity_off` only where
+/// [`crate::sensors::Sensor::has_validity`]): the first nine wire codes, `stuck_current` …
+/// `validity_off`.
+pub const SENSOR_MODES: &[&str] = flexdyn_proto::FAULT_MODE_NAMES.split_at(9).0;
 
 /// The sensor modes that transform values (all but `dropout` and `validity_off`, the first
 /// seven of [`SENSOR_MODES`]): they need a channel with axes.
@@ -378,6 +372,17 @@ mod tests {
     fn the_clients_mode_names_are_the_table() {
         let names: Vec<&str> = MODES.iter().map(|(n, _)| *n).collect();
         assert_eq!(names, flexdyn_proto::FAULT_MODE_NAMES);
+    }
+
+    /// The sensor and link modes are slices of the wire table by position: these are the
+    /// boundaries (issue 21's sensor modes, and the three link modes).
+    #[test]
+    fn the_sensor_and_link_modes_are_their_wire_codes() {
+        let sensor = "stuck_current stuck_value bias_step bias_ramp scale noise spikes dropout \
+                      validity_off";
+        assert_eq!(SENSOR_MODES, sensor.split_whitespace().collect::<Vec<_>>());
+        assert_eq!(LINK_MODES, ["dropped", "delayed", "corrupted"]);
+        assert_eq!(VALUE_MODES, &SENSOR_MODES[..7]);
     }
 
     #[test]
