@@ -113,6 +113,12 @@ fn errors_name_the_field_and_the_problem() {
             "longer than duration_s",
         ),
         (
+            // acs_full.toml steps at 10 ms: a 5 ms period would alias.
+            "target = \"imus.hub\"\nmode = \"dropout\"\nperiod_s = 0.005\nduration_s = 0.001",
+            "faults[1].period_s",
+            "at least the integration step (10000000 ns)",
+        ),
+        (
             "target = \"imus.hub\"\nmode = \"dropout\"\nduration_s = 0.0",
             "faults[1].duration_s",
             "> 0",

@@ -115,10 +115,19 @@ pub const INSTALL_REFUSALS: [&str; 3] = [
 #[derive(Debug)]
 pub struct Installed(#[allow(dead_code)] Option<Box<Live>>);
 
-/// Fault events kept for the next frame that is filled: two per fault (a clearance and an
-/// activation between two boundaries), for the configured faults and every live slot.
-fn event_capacity(configured: usize) -> usize {
-    2 * (configured + MAX_LIVE_FAULTS)
+/// Fault events kept for the next frame that is filled: for one boundary, at most a clearance
+/// and an activation per one-shot fault (the configured ones and every live slot), and for a
+/// repeating fault the clearance of the activation reported last plus an activation and a
+/// clearance for each activation that can begin within a frame (at most ⌊frame/period⌋ + 1).
+fn event_capacity(live: &[Live], frame_ns: u64) -> usize {
+    let configured: usize = live
+        .iter()
+        .map(|l| match l.spec.window.period_ns {
+            Some(p) => 1 + 2 * (frame_ns / p.max(1) + 1) as usize,
+            None => 2,
+        })
+        .sum();
+    configured + 2 * MAX_LIVE_FAULTS
 }
 
 /// The faults of one vehicle.
@@ -135,6 +144,8 @@ pub struct Faults {
     /// Events dropped because `events` was full (frames whose telemetry was dropped).
     pub events_lost: u64,
     event_seq: u64,
+    /// \[ns\] the boundary noted last (`None` before the first).
+    last_boundary_ns: Option<u64>,
     active_count: u64,
     active_bits: [u64; 4],
 }
@@ -185,12 +196,12 @@ impl Faults {
     /// [`Self::install`] and [`Self::note_boundary`] never allocate (the server, at start).
     pub fn reserve_live(&mut self) {
         self.live.reserve_exact(MAX_LIVE_FAULTS);
-        self.events = Vec::with_capacity(event_capacity(self.configured));
+        self.events = Vec::with_capacity(self.event_capacity());
     }
 
     /// Most events [`Self::take_events`] can hand out at once (size a frame's buffer with it).
     pub fn event_capacity(&self) -> usize {
-        event_capacity(self.configured)
+        event_capacity(&self.live[..self.configured], self.frame_ns)
     }
 
     /// Installs a live request at the boundary the next frame reaches, `next_tick` (the fault
@@ -240,10 +251,13 @@ impl Faults {
     }
 
     /// Notes each fault's state at the boundary of tick `k` (time `t_ns`): an event for every
-    /// activation and clearance since the last boundary noted (a re-activation of a repeating
-    /// fault in between gives both), and the active set. Allocation-free once
-    /// [`Self::reserve_live`] has run (a full event buffer drops and counts).
+    /// activation and clearance since the last boundary noted, in time order, and the active
+    /// set. Every activation is reported, also one that began and ended between two boundaries
+    /// (a window shorter than a frame, or a repeating fault's activations in between): its
+    /// activation and its clearance come together, at the boundary after it. Allocation-free
+    /// once [`Self::reserve_live`] has run (a full event buffer drops and counts).
     pub fn note_boundary(&mut self, k: u64, t_ns: u64) {
+        let since = self.last_boundary_ns.replace(t_ns);
         self.active_count = 0;
         self.active_bits = [0; 4];
         for (i, l) in self.live.iter_mut().enumerate() {
@@ -267,14 +281,29 @@ impl Faults {
                     self.events_lost += 1;
                 }
             };
-            match (l.reported, now) {
-                (None, Some(start)) => emit(true, start, l),
-                (Some(prev), None) => emit(false, l.end_of(prev, t_ns), l),
-                (Some(prev), Some(start)) if prev != start => {
-                    emit(false, l.end_of(prev, t_ns), l);
+            // The activation reported at the last boundary, if it has ended since.
+            if let Some(prev) = l.reported.filter(|&prev| now != Some(prev)) {
+                emit(false, l.end_of(prev, t_ns), l);
+            }
+            // An activation in force that began at or before the last boundary without being
+            // reported there: the first boundary, or a live fault installed at the last one.
+            let unreported = |s: u64| l.reported != Some(s) && since.is_none_or(|b| s <= b);
+            if let Some(start) = now.filter(|&s| unreported(s)) {
+                emit(true, start, l);
+            }
+            // Every activation that began since the last boundary (none at the first), and its
+            // clearance if it has ended by now. A clearance stops the later ones.
+            if let Some(b) = since {
+                let cleared_from_ns = l.cleared_from_ns;
+                for start in l.spec.window.starts_in(b, t_ns) {
+                    if start >= cleared_from_ns {
+                        break;
+                    }
                     emit(true, start, l);
+                    if now != Some(start) {
+                        emit(false, l.end_of(start, t_ns), l);
+                    }
                 }
-                _ => {}
             }
             l.reported = now;
             if now.is_some() {
@@ -524,4 +553,123 @@ fn actuator(
         });
     };
     Ok((input, a))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::faults::FaultWindow;
+
+    /// A fault on sensor 0 with `window`, cleared from `cleared_from_ns`.
+    fn fault(window: FaultWindow, cleared_from_ns: u64) -> Live {
+        let mut l = Live::placeholder();
+        l.spec.window = window;
+        l.spec.port = Port::Sensor {
+            sensor: 0,
+            channel: None,
+        };
+        l.cleared_from_ns = cleared_from_ns;
+        l
+    }
+
+    /// Every activation and clearance is reported at the first boundary at or after it, with
+    /// its own edge, whatever the frame: checked against the edges found by looking at each
+    /// fault every nanosecond.
+    #[test]
+    fn every_edge_is_reported_at_the_boundary_after_it() {
+        let frame_ns = 10;
+        let live = vec![
+            // Begins and ends inside one frame.
+            fault(
+                FaultWindow {
+                    start_ns: 12,
+                    duration_ns: Some(3),
+                    period_ns: None,
+                },
+                u64::MAX,
+            ),
+            // Repeats several times per frame.
+            fault(
+                FaultWindow {
+                    start_ns: 1,
+                    duration_ns: Some(1),
+                    period_ns: Some(4),
+                },
+                u64::MAX,
+            ),
+            // Spans two boundaries.
+            fault(
+                FaultWindow {
+                    start_ns: 5,
+                    duration_ns: Some(20),
+                    period_ns: None,
+                },
+                u64::MAX,
+            ),
+            // Repeats, and is cleared inside an activation at 23.
+            fault(
+                FaultWindow {
+                    start_ns: 0,
+                    duration_ns: Some(2),
+                    period_ns: Some(3),
+                },
+                23,
+            ),
+            // Open from the first boundary on.
+            fault(FaultWindow::from(0), u64::MAX),
+        ];
+        let mut faults = Faults {
+            any_actuator: false,
+            configured: live.len(),
+            frame_ns,
+            live,
+            ..Faults::default()
+        };
+        faults.reserve_live();
+        let end_tick = 5;
+        // The oracle: each fault's edges, looked at every nanosecond, in the order the
+        // boundaries report them (boundary, fault index, time).
+        let mut want = Vec::new();
+        for k in 0..=end_tick {
+            let t = k * frame_ns;
+            for (i, l) in faults.live.iter().enumerate() {
+                if k == 0 {
+                    if let Some(s) = l.state_at(0) {
+                        want.push((k, i as u32, true, s));
+                    }
+                    continue;
+                }
+                for ns in t - frame_ns + 1..=t {
+                    let (before, now) = (l.state_at(ns - 1), l.state_at(ns));
+                    if before != now {
+                        if before.is_some() {
+                            want.push((k, i as u32, false, ns));
+                        }
+                        if let Some(s) = now {
+                            want.push((k, i as u32, true, s));
+                        }
+                    }
+                }
+            }
+        }
+        let mut got = Vec::new();
+        let mut out = Vec::with_capacity(faults.event_capacity());
+        for k in 0..=end_tick {
+            faults.note_boundary(k, k * frame_ns);
+            faults.take_events_into(7, &mut out);
+            for e in out.drain(..) {
+                assert_eq!(e.header.tick, k);
+                assert_eq!(e.header.spacecraft_id, 7);
+                got.push((k, e.fault_index, e.active, e.edge_ns));
+            }
+        }
+        assert_eq!(faults.events_lost, 0);
+        assert_eq!(got, want);
+        // The frame-long windows inside the frame are there: fault 0 at 12–15 and fault 1's
+        // three activations of the first frame.
+        assert!(got.contains(&(2, 0, true, 12)) && got.contains(&(2, 0, false, 15)));
+        assert_eq!(got.iter().filter(|e| e.0 == 1 && e.1 == 1).count(), 6);
+        // The active set at the last boundary (50 ns): only the open-ended fault 4.
+        assert_eq!(faults.active(), (1, [1 << 4, 0, 0, 0]));
+    }
 }

@@ -28,7 +28,21 @@ pub(crate) fn resolve(
     let participants = file_participants(&cfg.server);
     raw.iter()
         .enumerate()
-        .map(|(i, r)| resolve_one(i, r, &bank, sc, participants.as_deref(), map))
+        .map(|(i, r)| {
+            let spec = resolve_one(i, r, &bank, sc, participants.as_deref(), map)?;
+            match spec.window.period_ns {
+                // The stepping looks at a fault once per step: a shorter period would alias.
+                Some(p) if p < cfg.step_ns => Err(map.invalid(
+                    &format!("{}.period_s", r.path),
+                    format!(
+                        "must be at least the integration step ({} ns), got {p} ns: the \
+                         stepping looks at a fault once per step",
+                        cfg.step_ns
+                    ),
+                )),
+                _ => Ok(spec),
+            }
+        })
         .collect()
 }
 

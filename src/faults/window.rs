@@ -37,6 +37,31 @@ impl FaultWindow {
             _ => Some(self.start_ns + n * self.period_ns.unwrap_or(0)),
         }
     }
+
+    /// The starts \[ns\] of the activations that begin in `(after_ns, upto_ns]`, in order:
+    /// `start + n·period` for n = 0, 1, … (n = 0 only without a period). A window shorter than
+    /// the gap between two looks, or a repeating fault's activations in between, are all here.
+    pub fn starts_in(&self, after_ns: u64, upto_ns: u64) -> impl Iterator<Item = u64> {
+        let (start, period) = (self.start_ns, self.period_ns);
+        // The first n with start + n·period > after_ns.
+        let n_first = match (after_ns.checked_sub(start), period) {
+            (None, _) => 0,
+            (Some(_), None) => 1, // the single activation began at or before after_ns
+            (Some(since), Some(p)) => since / p + 1,
+        };
+        // The last n with start + n·period ≤ upto_ns (none if the window opens later).
+        let n_last = match (upto_ns.checked_sub(start), period) {
+            (None, _) => None,
+            (Some(_), None) => Some(0),
+            (Some(since), Some(p)) => Some(since / p),
+        };
+        let range = match n_last {
+            Some(last) if last >= n_first => n_first..=last,
+            #[allow(clippy::reversed_empty_ranges)]
+            _ => 1..=0,
+        };
+        range.map(move |n| start + n * period.unwrap_or(0))
+    }
 }
 
 #[cfg(test)]
@@ -63,5 +88,46 @@ mod tests {
         assert_eq!(rep.activation_at(35), None);
         assert_eq!(rep.activation_at(50), Some(50));
         assert_eq!(FaultWindow::from(7).activation_at(u64::MAX), Some(7));
+    }
+
+    /// The starts in a span agree with `activation_at` looked at every nanosecond: a start is
+    /// where the activation in force changes to a new one.
+    #[test]
+    fn starts_in_a_span_are_the_activations_that_begin_there() {
+        let windows = [
+            FaultWindow {
+                start_ns: 10,
+                duration_ns: Some(5),
+                period_ns: None,
+            },
+            FaultWindow {
+                start_ns: 10,
+                duration_ns: Some(3),
+                period_ns: Some(7),
+            },
+            FaultWindow::from(0),
+            FaultWindow::from(25),
+        ];
+        for w in windows {
+            for after in 0..40u64 {
+                for upto in after..60u64 {
+                    let got: Vec<u64> = w.starts_in(after, upto).collect();
+                    let mut want = Vec::new();
+                    let mut prev = w.activation_at(after);
+                    for t in after + 1..=upto {
+                        let now = w.activation_at(t);
+                        if let Some(s) = now {
+                            if prev != now {
+                                want.push(s);
+                            }
+                        }
+                        prev = now;
+                    }
+                    assert_eq!(got, want, "{w:?} in ({after}, {upto}]");
+                }
+            }
+        }
+        // A window opening at 0 begins in no span after it (it began at the first look).
+        assert_eq!(FaultWindow::from(0).starts_in(0, 100).count(), 0);
     }
 }
