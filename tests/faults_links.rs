@@ -12,6 +12,9 @@
 //!   its version byte 7 becomes 0xF8 and every one is rejected as `bad_version` (20 of them),
 //!   counted, answering its tick with nothing; no panic, no hang.
 //!
+//! - `dropped` from tick 20 on, cleared live at tick 30 by a FaultCommandMsg (put before the
+//!   answer to tick 0): applied as dropped over [20, 30) only, healthy again from tick 30.
+//!
 //! The windows: frames at 100 Hz, start_s = 0.2 and duration_s = 0.2 are ticks 20 to 39.
 
 mod server_support;
@@ -21,7 +24,10 @@ use std::time::Duration;
 use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
 use flexdyn::faults::link::LinkStats;
 use flexdyn::server::{RunReport, ServerSettings};
-use flexdyn_proto::{decode_state, encode, CommandMsg, Header, Mode, RejectCounters, Topics};
+use flexdyn_proto::{
+    decode_state, encode, CommandMsg, FaultAction, FaultCommandMsg, FaultTarget, Header, Mode,
+    RejectCounters, Topics,
+};
 use server_support::{connecting_session, ServerHandle};
 use zenoh::Wait;
 
@@ -43,6 +49,11 @@ fn config(faults: &str) -> SimConfig {
 /// A lockstep run to tick 60 with participant 1 answering every state with f(tick): the
 /// applied torque z of each tick 0..=60 and the report.
 fn run(faults: &str) -> (Vec<f64>, RunReport) {
+    run_with(faults, None)
+}
+
+/// [`run`], with a live clear of fault 0 at tick `clear_at` put before the answer to tick 0.
+fn run_with(faults: &str, clear_at: Option<u64>) -> (Vec<f64>, RunReport) {
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start(
         ServerSettings {
@@ -70,6 +81,21 @@ fn run(faults: &str) -> (Vec<f64>, RunReport) {
         let s = decode_state(&sample.payload().to_bytes()).unwrap();
         let k = s.header.tick;
         applied[k as usize] = s.wrench_applied.torque_b_nm[2];
+        if let (0, Some(at_tick)) = (k, clear_at) {
+            let clear = FaultCommandMsg {
+                header: Header::new(1, 0, 0, 0),
+                action: FaultAction::Clear,
+                at_tick,
+                fault_index: 0,
+                mode: 0,
+                params: [0.0; 2],
+                axes: 0,
+                duration_ns: 0,
+                seed: 0,
+                target: FaultTarget::default(),
+            };
+            session.put(topics.fault(), encode(&clear)).wait().unwrap();
+        }
         let h = Header::new(1, k, s.header.sim_time_ns, k);
         let cmd = CommandMsg::wrench(h, 1, [0.0, 0.0, f(k)], [0.0; 3]);
         publisher.put(encode(&cmd)).wait().unwrap();
@@ -174,4 +200,26 @@ fn a_corrupted_link_is_rejected_counted_and_answers_its_tick() {
             ..LinkStats::default()
         }
     );
+}
+
+#[test]
+fn a_live_clear_restores_a_dropped_link_at_its_tick() {
+    const CLEARED: u64 = 30;
+    let ok = healthy();
+    let open_ended = "[[faults]]\ntarget = \"links.1\"\nstart_s = 0.2\nmode = \"dropped\"";
+    let (got, report) = run_with(open_ended, Some(CLEARED));
+    for k in 0..LAST_TICK {
+        let want = if (WINDOW.start..CLEARED).contains(&k) {
+            ok[WINDOW.start as usize] // f(19), held
+        } else {
+            ok[k as usize + 1]
+        };
+        assert_eq!(got[k as usize + 1], want, "command applied over frame {k}");
+    }
+    assert_eq!(
+        report.link_faults.empty_answers,
+        CLEARED - WINDOW.start,
+        "{report}"
+    );
+    assert_eq!(report.rejected.fault_refused, 0, "{report}");
 }

@@ -59,6 +59,8 @@ impl LinkStats {
 /// One command-link fault.
 #[derive(Debug, Clone)]
 pub struct LinkFault {
+    /// Its index among the configuration's faults (the FaultEventMsg's `fault_index`).
+    pub fault_index: u32,
     /// Its entry (`faults[2]`).
     pub field: String,
     /// The target as written (`links.1`).
@@ -71,6 +73,8 @@ pub struct LinkFault {
     pub window: FaultWindow,
     /// Seed of the damage (`corrupted`).
     pub seed: u64,
+    /// \[ns\] cleared from here on (a live clear, [`LinkFaults::clear`]); `u64::MAX`: never.
+    pub cleared_from_ns: u64,
     /// Active at the last tick evaluated.
     pub active: bool,
 }
@@ -92,12 +96,14 @@ impl LinkFaults {
             .enumerate()
             .filter_map(|(i, s)| match s.port {
                 Port::Link { sender_id } => Some(LinkFault {
+                    fault_index: i as u32,
                     field: format!("faults[{i}]"),
                     target: s.target.clone(),
                     sender_id,
                     mode: s.mode,
                     window: s.window,
                     seed: s.seed,
+                    cleared_from_ns: u64::MAX,
                     active: false,
                 }),
                 _ => None,
@@ -133,6 +139,21 @@ impl LinkFaults {
             .max()
     }
 
+    /// A live clear of fault `fault_index` from `from_ns` on (the same clear the fault's events
+    /// and the active set show, [`crate::faults::Faults::install`]); nothing if that fault is
+    /// not a link fault. Allocation-free.
+    pub fn clear(&mut self, fault_index: u32, from_ns: u64) {
+        for f in self
+            .faults
+            .iter_mut()
+            .filter(|f| f.fault_index == fault_index)
+        {
+            f.cleared_from_ns = f.cleared_from_ns.min(from_ns);
+            // The tick evaluated last may be the clear's own: look again.
+            self.evaluated = None;
+        }
+    }
+
     /// Evaluates every window at tick `k` (once per tick; allocation-free unless it logs an
     /// activation or a clearance).
     pub fn at_tick(&mut self, k: u64) {
@@ -142,7 +163,7 @@ impl LinkFaults {
         self.evaluated = Some(k);
         let t_ns = k.saturating_mul(self.frame_ns);
         for f in &mut self.faults {
-            let active = f.window.activation_at(t_ns).is_some();
+            let active = t_ns < f.cleared_from_ns && f.window.activation_at(t_ns).is_some();
             if active != f.active {
                 f.active = active;
                 if active {

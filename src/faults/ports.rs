@@ -86,6 +86,15 @@ pub(super) enum RequestKind {
 }
 
 impl LiveRequest {
+    /// The tick it applies at, given the boundary the next frame reaches, `next_tick`.
+    pub fn applies_at(&self, next_tick: u64) -> u64 {
+        if self.at_tick == AT_NEXT_TICK {
+            next_tick
+        } else {
+            self.at_tick
+        }
+    }
+
     /// The fault a `Clear` names, `None` for an injection.
     pub fn clears(&self) -> Option<u32> {
         match self.kind {
@@ -214,11 +223,7 @@ impl Faults {
         req: LiveRequest,
         next_tick: u64,
     ) -> Result<Installed, (u8, Installed)> {
-        let tick = if req.at_tick == AT_NEXT_TICK {
-            next_tick
-        } else {
-            req.at_tick
-        };
+        let tick = req.applies_at(next_tick);
         let at_ns = tick.saturating_mul(self.frame_ns);
         match req.kind {
             RequestKind::Inject(b) => {

@@ -296,6 +296,12 @@ impl CommandBook {
         self.stats
     }
 
+    /// A live clear of fault `fault_index` from `from_ns` on, if it is a command-link fault
+    /// ([`LinkFaults::clear`]).
+    pub fn clear_link_fault(&mut self, fault_index: u32, from_ns: u64) {
+        self.links.clear(fault_index, from_ns);
+    }
+
     /// The command-link faults (with which are active at the last tick evaluated).
     pub fn links(&self) -> &LinkFaults {
         &self.links

@@ -211,7 +211,14 @@ impl Stepper {
         req: crate::faults::ports::LiveRequest,
         k: u64,
     ) -> Result<crate::faults::ports::Installed, (u8, crate::faults::ports::Installed)> {
-        self.sim.faults_mut().install(req, k + 1)
+        // A clear of a command-link fault also reaches the command book, where it acts.
+        let clears = req.clears();
+        let at_ns = req.applies_at(k + 1).saturating_mul(self.sim.frame_ns());
+        let installed = self.sim.faults_mut().install(req, k + 1)?;
+        if let Some(i) = clears {
+            self.book.clear_link_fault(i, at_ns);
+        }
+        Ok(installed)
     }
 
     /// Copies what the command-link faults did into `shared` (a few atomic stores; nothing
