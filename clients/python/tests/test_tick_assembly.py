@@ -268,3 +268,38 @@ def test_magnetometers_and_sun_sensors_are_scheduled_and_delivered_in_the_tick()
     assert [t.tick for t in seen] == [0, 1, 3]
     assert seen[2].gps["gps1"].valid_sim_time_ns == 0 and seen[2].missing == ()
     p.close()
+
+
+def fault(index, mode, target, active, tick, edge_tick):
+    code = [m[0] for m in proto.FAULT_MODES].index(mode)
+    return proto.FaultEventMsg(header(tick), fault_index=index, mode=code, active=active,
+                               edge_ns=edge_tick * 10_000_000,
+                               target=proto._target_bytes(target))
+
+
+def test_a_dropout_fault_event_stops_the_wait_for_the_samples_it_withholds():
+    # Ticks 1, 3, 7, 9: only the IMUs are due (st1 every 10 ticks, st2 every 4).
+    c, seen = FakeClient(), []
+    p = participant(c, seen, sensor_timeout_s=3600)
+    c.feed("imu/hub", imu(3))
+    c.feed("state", state(3))  # imu/bracket of tick 3 is withheld from tick 3 on
+    c.feed("fault", fault(0, "bias_step", "imus.hub.gyro", True, 3, 3))
+    assert seen == [], "a bias withholds nothing"
+    c.feed("fault", fault(1, "dropout", "imus.nowhere", True, 3, 3))
+    assert seen == [], "not a sensor of the schedule"
+    c.feed("fault", fault(2, "dropout", "imus.bracket", True, 3, 3))
+    assert [(t.tick, t.missing) for t in seen] == [(3, ("imu/bracket",))]
+    c.feed("imu/hub", imu(7))
+    c.feed("state", state(7))  # released with its state
+    assert [(t.tick, t.missing) for t in seen][1:] == [(7, ("imu/bracket",))]
+    # Cleared at tick 9 (its event after the state of 9): tick 9's sample is there again.
+    c.feed("imu/hub", imu(9))
+    c.feed("imu/bracket", imu(9))
+    c.feed("state", state(9))
+    c.feed("fault", fault(2, "dropout", "imus.bracket", False, 9, 9))
+    assert [(t.tick, t.missing) for t in seen][2:] == [(9, ())]
+    c.feed("imu/hub", imu(11))
+    c.feed("state", state(11))
+    assert len(seen) == 3, "no dropout any more: imu/bracket of tick 11 is waited for"
+    assert p.incomplete_ticks == 2 and [s[0] for s in c.sent] == [3, 7, 9]
+    p.close()

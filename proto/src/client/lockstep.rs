@@ -15,14 +15,21 @@
 //! - [`TickReceiver`] is the Zenoh side: **one** subscriber on `flexdyn/<sc>/tlm/**` (which
 //!   delivers in publication order) feeding an assembler, with a time limit for a sample that
 //!   never comes.
+//!
+//! A sensor in a `dropout` fault publishes nothing, by design, so its due samples will not
+//! come: the assembler learns each dropout's interval from the fault events on
+//! `flexdyn/<sc>/tlm/fault` (activation and clearance edges, [`crate::FaultEventMsg`]) and does
+//! not wait for a sample the server withheld. The events of boundary k follow the state of k, so
+//! a tick is released at most one message after its state, not after the time limit; the
+//! withheld samples are still listed in [`Tick::missing`].
 
 use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
 use crate::{
-    decode_css, decode_fss, decode_gps, decode_imu, decode_magnetometer, decode_star_tracker,
-    decode_state, CssMsg, DecodeError, FssMsg, GpsMsg, ImuMsg, MagnetometerMsg, StarTrackerMsg,
-    StateMsg, Telemetry, Topics,
+    decode_css, decode_fault_event, decode_fss, decode_gps, decode_imu, decode_magnetometer,
+    decode_star_tracker, decode_state, CssMsg, DecodeError, FaultEventMsg, FssMsg, GpsMsg, ImuMsg,
+    MagnetometerMsg, StarTrackerMsg, StateMsg, Telemetry, Topics, FAULT_MODE_NAMES,
 };
 use zenoh::handlers::{RingChannel, RingChannelHandler};
 use zenoh::pubsub::Subscriber;
@@ -184,7 +191,8 @@ pub struct Tick {
     /// at this tick, or lost); each is valid its receiver's latency before the tick.
     pub gps_receivers: Vec<Option<GpsMsg>>,
     /// The due samples that never came, as `imu/<name>`, `st/<name>`, `mag/<name>`,
-    /// `css/<name>`, `fss/<name>` or `gps/<name>`. Empty in lockstep unless a sample was lost.
+    /// `css/<name>`, `fss/<name>` or `gps/<name>`. Empty in lockstep unless a sample was lost
+    /// or withheld by a `dropout` fault.
     pub missing: Vec<String>,
 }
 
@@ -219,6 +227,39 @@ impl Partial {
     }
 }
 
+/// A sensor's samples withheld by a `dropout` fault over `[from_ns, until_ns)` (the fault
+/// events' edges; `until_ns` is `u64::MAX` until its clearance comes).
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct Withheld {
+    fault_index: u32,
+    /// `imu/<name>`, `st/<name>`, … (as in [`Tick::missing`]).
+    route: String,
+    from_ns: u64,
+    until_ns: u64,
+}
+
+/// The configuration sections of the sensor kinds and their telemetry route prefixes.
+const SENSOR_SECTIONS: [(&str, &str); 6] = [
+    ("imus", "imu"),
+    ("star_trackers", "st"),
+    ("magnetometers", "mag"),
+    ("coarse_sun_sensors", "css"),
+    ("fine_sun_sensors", "fss"),
+    ("gps_receivers", "gps"),
+];
+
+/// The route (`imu/hub`) of a sensor fault's target (`imus.hub` or `imus.hub.gyro`), `None` for
+/// any other target.
+fn sensor_route(target: &str) -> Option<String> {
+    let mut parts = target.split('.');
+    let (section, name) = (parts.next()?, parts.next()?);
+    let prefix = SENSOR_SECTIONS
+        .iter()
+        .find(|(s, _)| *s == section)
+        .map(|(_, p)| p)?;
+    Some(format!("{prefix}/{name}"))
+}
+
 /// Assembles complete [`Tick`]s from telemetry samples given in any order (see the module
 /// docs). A held state is released without its missing samples when a sample of a later tick
 /// comes (real time, where the server drops samples under load), or when the caller gives up
@@ -226,6 +267,10 @@ impl Partial {
 #[derive(Debug)]
 pub struct TickAssembler {
     topics: Topics,
+    /// `flexdyn/<sc>/tlm/fault`.
+    fault_key: String,
+    /// The dropout intervals the fault events told of, oldest first.
+    withheld: Vec<Withheld>,
     schedule: SensorSchedule,
     /// The state waiting for its samples.
     held: Option<StateMsg>,
@@ -239,7 +284,9 @@ impl TickAssembler {
     /// An assembler for the telemetry keys of `topics`.
     pub fn new(topics: Topics, schedule: SensorSchedule) -> Self {
         Self {
+            fault_key: topics.fault_events(),
             topics,
+            withheld: Vec::new(),
             schedule,
             held: None,
             partial: BTreeMap::new(),
@@ -262,6 +309,15 @@ impl TickAssembler {
         payload: &[u8],
         mut ready: impl FnMut(Tick),
     ) -> Result<(), DecodeError> {
+        if key == self.fault_key {
+            self.note_fault(&decode_fault_event(payload)?);
+            if self.held.is_some() && self.awaited().is_empty() {
+                if let Some(t) = self.release() {
+                    ready(t);
+                }
+            }
+            return Ok(());
+        }
         let Some(topic) = self.topics.telemetry(key) else {
             return Ok(());
         };
@@ -340,12 +396,52 @@ impl TickAssembler {
             Msg::Fss(i, m) => self.partial_mut(tick).fine_sun_sensors[i] = Some(m),
             Msg::Gps(i, m) => self.partial_mut(tick).gps_receivers[i] = Some(m),
         }
-        if self.held.is_some() && self.missing().is_empty() {
+        if self.held.is_some() && self.awaited().is_empty() {
             if let Some(t) = self.release() {
                 ready(t);
             }
         }
         Ok(())
+    }
+
+    /// Notes a `dropout` fault's activation or clearance (other faults change no schedule).
+    fn note_fault(&mut self, ev: &FaultEventMsg) {
+        if FAULT_MODE_NAMES.get(ev.mode as usize) != Some(&"dropout") {
+            return;
+        }
+        let Some(route) = ev.target.as_str().and_then(sensor_route) else {
+            return;
+        };
+        if ev.active {
+            self.withheld.push(Withheld {
+                fault_index: ev.fault_index,
+                route,
+                from_ns: ev.edge_ns,
+                until_ns: u64::MAX,
+            });
+        } else if let Some(w) = self
+            .withheld
+            .iter_mut()
+            .rev()
+            .find(|w| w.fault_index == ev.fault_index && w.until_ns == u64::MAX)
+        {
+            w.until_ns = ev.edge_ns;
+        }
+    }
+
+    /// The missing samples of the held tick still to wait for: those no dropout withheld.
+    fn awaited(&self) -> Vec<String> {
+        let Some(t_ns) = self.held.as_ref().map(|h| h.header.sim_time_ns) else {
+            return Vec::new();
+        };
+        let mut missing = self.missing();
+        missing.retain(|route| {
+            !self
+                .withheld
+                .iter()
+                .any(|w| w.route == *route && (w.from_ns..w.until_ns).contains(&t_ns))
+        });
+        missing
     }
 
     fn partial_mut(&mut self, tick: u64) -> &mut Partial {
@@ -404,6 +500,8 @@ impl TickAssembler {
         let missing = self.missing();
         let state = self.held.take()?;
         let tick = state.header.tick;
+        let t_ns = state.header.sim_time_ns;
+        self.withheld.retain(|w| w.until_ns > t_ns);
         let part = self.partial.remove(&tick);
         self.partial.retain(|t, _| *t > tick);
         self.last = Some(tick);
@@ -425,7 +523,8 @@ impl TickAssembler {
 /// `capacity` samples: in real time, a reader that falls behind loses the oldest samples rather
 /// than queueing stale ones; in lockstep at most one tick is in flight), and a
 /// [`TickAssembler`]. A tick whose samples have not all come `sensor_timeout` after its state
-/// is handed out without them.
+/// is handed out without them; one whose missing samples a `dropout` fault withheld is handed
+/// out as soon as the fault event says so (module docs).
 pub struct TickReceiver {
     subscriber: Subscriber<RingChannelHandler<Sample>>,
     assembler: TickAssembler,
@@ -644,12 +743,82 @@ mod tests {
             };
             self.push("flexdyn/sc1/tlm/gps/gps1", encode(&m));
         }
+        /// A fault event of fault `index` (`mode` by name) on `target` with its edge at
+        /// tick-time `edge_tick`, reported at boundary `tick`.
+        fn fault(&mut self, index: u32, mode: &str, target: &str, active: bool, at: (u64, u64)) {
+            let (tick, edge_tick) = at;
+            let m = FaultEventMsg {
+                header: header(tick),
+                fault_index: index,
+                mode: FAULT_MODE_NAMES.iter().position(|n| *n == mode).unwrap() as u32,
+                active,
+                edge_ns: edge_tick * 10_000_000,
+                target: crate::FaultTarget::new(target).unwrap(),
+                ..FaultEventMsg::default()
+            };
+            self.push("flexdyn/sc1/tlm/fault", encode(&m));
+        }
         fn ticks(&self) -> Vec<(u64, Vec<String>)> {
             self.out
                 .iter()
                 .map(|t| (t.tick(), t.missing.clone()))
                 .collect()
         }
+    }
+
+    /// In publication order (samples, state, then the boundary's fault events): a dropout's
+    /// activation event releases the tick its state is waiting with, the next ticks go with
+    /// their states, and after its clearance the sensor is waited for again. Other faults, and
+    /// dropouts of sensors not in the schedule, change nothing.
+    #[test]
+    fn a_dropout_fault_event_stops_the_wait_for_the_samples_it_withholds() {
+        // Only the IMUs are due at odd ticks that are not multiples of 5 (schedule()).
+        let mut f = Feed::new();
+        f.imu("hub", 1);
+        f.imu("bracket", 1);
+        f.state(1);
+        assert_eq!(f.ticks(), [(1, vec![])]);
+        // Tick 3: imus.bracket drops out from tick 3; a bias on imus.hub is no dropout.
+        f.imu("hub", 3);
+        f.state(3);
+        f.fault(0, "bias_step", "imus.hub.gyro", true, (3, 3));
+        assert_eq!(f.a.waiting(), Some(3), "a bias withholds nothing");
+        f.fault(1, "dropout", "imus.nowhere", true, (3, 3));
+        assert_eq!(f.a.waiting(), Some(3), "not a sensor of the schedule");
+        f.fault(2, "dropout", "imus.bracket", true, (3, 3));
+        let bracket = || vec!["imu/bracket".to_owned()];
+        assert_eq!(f.ticks()[1..], [(3, bracket())]);
+        // Tick 7: released with its state.
+        f.imu("hub", 7);
+        f.state(7);
+        assert_eq!(f.ticks()[2..], [(7, bracket())]);
+        // Cleared at tick 9 (reported at boundary 9, after its state): tick 9's sample is
+        // published again and awaited.
+        f.imu("hub", 9);
+        f.imu("bracket", 9);
+        f.state(9);
+        f.fault(2, "dropout", "imus.bracket", false, (9, 9));
+        assert_eq!(f.ticks()[3..], [(9, vec![])]);
+        f.imu("hub", 11);
+        f.state(11);
+        assert_eq!(
+            f.a.waiting(),
+            Some(11),
+            "no dropout any more: wait for imu/bracket"
+        );
+        f.imu("bracket", 11);
+        assert_eq!(f.ticks()[4..], [(11, vec![])]);
+        // A dropout that began and ended inside frame 12 → 13 withheld no sample (the IMUs
+        // publish at boundaries): it is reported after tick 13, and tick 17 waits as before.
+        f.imu("hub", 13);
+        f.imu("bracket", 13);
+        f.state(13);
+        f.fault(3, "dropout", "imus.bracket", true, (13, 12));
+        f.fault(3, "dropout", "imus.bracket", false, (13, 12));
+        assert_eq!(f.ticks()[5..], [(13, vec![])]);
+        f.imu("hub", 17);
+        f.state(17);
+        assert_eq!(f.a.waiting(), Some(17));
     }
 
     #[test]

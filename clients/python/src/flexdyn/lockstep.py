@@ -61,6 +61,12 @@ def _periods(config: dict, array: str, frame_hz: float) -> Tuple[Tuple[str, int]
     return tuple(out)
 
 
+#: The configuration sections of the sensor kinds and their telemetry route prefixes.
+_SENSOR_SECTIONS = {"imus": "imu", "star_trackers": "st", "magnetometers": "mag",
+                    "coarse_sun_sensors": "css", "fine_sun_sensors": "fss",
+                    "gps_receivers": "gps"}
+
+
 @dataclass(frozen=True)
 class SensorSchedule:
     """Which sensor samples the server publishes at each tick, read from its configuration:
@@ -152,10 +158,12 @@ class LockstepParticipant:
       those callbacks is that tick's;
     - ``on_tick(tick)``: with a :class:`Tick` holding the state and those samples,
 
-    and sends what it returns, stamped with the state's tick. A due sample that has not come
-    ``sensor_timeout_s`` after its state (lost; it cannot happen in lockstep unless a sample is
-    dropped) releases the tick without it, listed in ``Tick.missing`` and counted in
-    ``incomplete_ticks``. In real time, where the server drops samples under load, a later
+    and sends what it returns, stamped with the state's tick. A sensor in a ``dropout`` fault
+    publishes nothing: the fault events (``flexdyn/<sc>/tlm/fault``, after the state of their
+    boundary) say so, and its samples are not waited for; the tick goes without them, listed in
+    ``Tick.missing`` and counted in ``incomplete_ticks``. Any other due sample that has not come
+    ``sensor_timeout_s`` after its state (lost; it cannot happen in lockstep) releases the tick
+    the same way. In real time, where the server drops samples under load, a later
     tick's sample releases a waiting tick at once the same way.
 
     :meth:`wait` blocks until the run has ended; :meth:`close` stops (token first, so the server
@@ -186,6 +194,8 @@ class LockstepParticipant:
         # The tick being assembled: its state once it has come, and samples by tick.
         self._held: Optional[StateMsg] = None
         self._samples: Dict[int, Dict[str, object]] = {}
+        # Dropout intervals from the fault events: [fault index, route, from ns, until ns|None].
+        self._withheld: List[list] = []
         self._last_tick = -1  # the last tick handed to the callback
         self._timer: Optional[threading.Timer] = None
         self._final: Optional[StatusMsg] = None
@@ -198,9 +208,16 @@ class LockstepParticipant:
     # -- assembling ticks (on the client's telemetry thread, one sample at a time) ------------
 
     def _on_sample(self, route: str, msg) -> None:
-        if route in ("time", "env", "fault") or route.startswith("rel/"):
-            # The time service, environment truth, fault events and a fleet deputy's relative
-            # state are not sensor samples.
+        if route == "fault":
+            # Not a sensor sample, but a dropout fault's edges say which samples the server
+            # withholds: those are not waited for.
+            self._note_fault(msg)
+            if self._held is not None and not self._awaited():
+                self._release()
+            return
+        if route in ("time", "env") or route.startswith("rel/"):
+            # The time service, environment truth and a fleet deputy's relative state are not
+            # sensor samples.
             return
         tick = msg.header.tick
         if tick <= self._last_tick:
@@ -214,7 +231,7 @@ class LockstepParticipant:
         else:
             self._samples.setdefault(tick, {})[route] = msg
         if self._held is not None:
-            if self._missing():
+            if self._awaited():
                 self._arm_timer(self._held.header.tick)
             else:
                 self._release()
@@ -223,6 +240,31 @@ class LockstepParticipant:
         h = self._held
         have = self._samples.get(h.header.tick, {})
         return tuple(r for r in self.schedule.due(h.header.tick) if r not in have)
+
+    def _note_fault(self, ev: proto.FaultEventMsg) -> None:
+        """Notes a ``dropout`` fault's activation or clearance on a sensor (``imus.hub``)."""
+        if ev.mode_name != "dropout":
+            return
+        parts = ev.target_str.split(".")
+        prefix = _SENSOR_SECTIONS.get(parts[0])
+        if prefix is None or len(parts) < 2:
+            return
+        if ev.active:
+            self._withheld.append([ev.fault_index, f"{prefix}/{parts[1]}", ev.edge_ns, None])
+            return
+        for w in reversed(self._withheld):
+            if w[0] == ev.fault_index and w[3] is None:
+                w[3] = ev.edge_ns
+                break
+
+    def _awaited(self) -> Tuple[str, ...]:
+        """The held tick's missing samples still to wait for: those no dropout withholds."""
+        t = self._held.header.sim_time_ns
+
+        def withheld(route: str) -> bool:
+            return any(r == route and start <= t and (end is None or t < end)
+                       for _, r, start, end in self._withheld)
+        return tuple(r for r in self._missing() if not withheld(r))
 
     def _arm_timer(self, tick: int) -> None:
         if self._timer is None:
@@ -243,6 +285,7 @@ class LockstepParticipant:
             self._timer.cancel()
             self._timer = None
         h = state.header
+        self._withheld = [w for w in self._withheld if w[3] is None or w[3] > h.sim_time_ns]
         samples = self._samples.pop(h.tick, {})
         missing = tuple(r for r in self.schedule.due(h.tick) if r not in samples)
         if missing:
