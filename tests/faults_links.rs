@@ -12,6 +12,11 @@
 //!   its version byte 7 becomes 0xF8 and every one is rejected as `bad_version` (20 of them),
 //!   counted, answering its tick with nothing; no panic, no hang.
 //!
+//! - `corrupted` with bit error rate 2·10⁻³ over [20, 40): each command's encoding damaged by
+//!   [`damage`] (pinned by its own unit test) and then judged as the documented checks say,
+//!   re-stated here: a decode error by its reason, then the spacecraft, the sender and the tick;
+//!   a damaged command that passes is applied as damaged (its wrench, or NoCommand's hold), a
+//!   rejected one leaves the last applied wrench held. Both outcomes occur in the window.
 //! - `dropped` from tick 20 on, cleared live at tick 30 by a FaultCommandMsg (put before the
 //!   answer to tick 0): applied as dropped over [20, 30) only, healthy again from tick 30.
 //!
@@ -22,11 +27,11 @@ mod server_support;
 use std::time::Duration;
 
 use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
-use flexdyn::faults::link::LinkStats;
+use flexdyn::faults::link::{damage, LinkStats};
 use flexdyn::server::{RunReport, ServerSettings};
 use flexdyn_proto::{
-    decode_state, encode, CommandMsg, FaultAction, FaultCommandMsg, FaultTarget, Header, Mode,
-    RejectCounters, Topics,
+    decode_command, decode_state, encode, CommandKind, CommandMsg, DecodeError, FaultAction,
+    FaultCommandMsg, FaultTarget, Header, Mode, RejectCounters, Topics,
 };
 use server_support::{connecting_session, ServerHandle};
 use zenoh::Wait;
@@ -54,6 +59,12 @@ fn run(faults: &str) -> (Vec<f64>, RunReport) {
 
 /// [`run`], with a live clear of fault 0 at tick `clear_at` put before the answer to tick 0.
 fn run_with(faults: &str, clear_at: Option<u64>) -> (Vec<f64>, RunReport) {
+    let (applied, report) = run_full(faults, clear_at);
+    (applied.iter().map(|w| w[2]).collect(), report)
+}
+
+/// [`run_with`], with the whole applied wrench of each tick: torque about B, then force \[SI\].
+fn run_full(faults: &str, clear_at: Option<u64>) -> (Vec<[f64; 6]>, RunReport) {
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start(
         ServerSettings {
@@ -76,11 +87,13 @@ fn run_with(faults: &str, clear_at: Option<u64>) -> (Vec<f64>, RunReport) {
         .declare_token(topics.participant(1))
         .wait()
         .unwrap();
-    let mut applied = vec![f64::NAN; LAST_TICK as usize + 1];
+    let mut applied = vec![[f64::NAN; 6]; LAST_TICK as usize + 1];
     while let Ok(Some(sample)) = states.recv_timeout(WAIT) {
         let s = decode_state(&sample.payload().to_bytes()).unwrap();
         let k = s.header.tick;
-        applied[k as usize] = s.wrench_applied.torque_b_nm[2];
+        let w = &s.wrench_applied;
+        let (t, n) = (w.torque_b_nm, w.force_b_newton);
+        applied[k as usize] = [t[0], t[1], t[2], n[0], n[1], n[2]];
         if let (0, Some(at_tick)) = (k, clear_at) {
             let clear = FaultCommandMsg {
                 header: Header::new(1, 0, 0, 0),
@@ -105,7 +118,10 @@ fn run_with(faults: &str, clear_at: Option<u64>) -> (Vec<f64>, RunReport) {
     }
     let report = server.join(WAIT).expect("the run");
     assert_eq!(report.last_tick, LAST_TICK, "the run reached its end");
-    assert!(applied.iter().all(|a| a.is_finite()), "every tick seen");
+    assert!(
+        applied.iter().flatten().all(|a| a.is_finite()),
+        "every tick seen"
+    );
     (applied, report)
 }
 
@@ -222,4 +238,72 @@ fn a_live_clear_restores_a_dropped_link_at_its_tick() {
         "{report}"
     );
     assert_eq!(report.rejected.fault_refused, 0, "{report}");
+}
+
+#[test]
+fn a_corrupted_link_at_a_low_bit_error_rate_applies_what_passes_the_checks() {
+    const P: f64 = 2e-3;
+    let (healthy, _) = run_full("", None);
+    let (got, report) = run_full(
+        &window(&format!("mode = \"corrupted\"\nprobability = {P}")),
+        None,
+    );
+    // The expectation, tick by tick: the command the participant sent for tick k (the run's
+    // f(k) wrench, stamped with the state's tick and time), damaged with the fault's seed (its
+    // index, 0) and the tick, then the checks in the order the README gives them.
+    let mut want = healthy.clone();
+    let mut rejected = RejectCounters::default();
+    let (mut accepted, mut refused) = (0, 0);
+    for k in WINDOW {
+        let h = Header::new(1, k, k * 10_000_000, k);
+        let mut bytes = encode(&CommandMsg::wrench(h, 1, [0.0, 0.0, f(k)], [0.0; 3]));
+        damage(&mut bytes, 0, k, P);
+        let held = want[k as usize];
+        let applied = match decode_command(&bytes) {
+            Err(DecodeError::UnknownVersion { .. }) => Err(&mut rejected.bad_version),
+            Err(DecodeError::NonFinite { .. }) => Err(&mut rejected.non_finite),
+            Err(_) => Err(&mut rejected.malformed),
+            Ok(d) if d.header.spacecraft_id != 1 => Err(&mut rejected.wrong_spacecraft),
+            Ok(d) if d.sender_id != 1 => Err(&mut rejected.wrong_identity),
+            Ok(d) if d.header.tick != k => Err(&mut rejected.stale_tick),
+            Ok(d) => match d.kind {
+                CommandKind::Wrench {
+                    torque_b_nm: t,
+                    force_b_newton: n,
+                } => Ok([t[0], t[1], t[2], n[0], n[1], n[2]]),
+                CommandKind::NoCommand => Ok(held),
+                // The reference spacecraft has no effectors: any input is refused.
+                CommandKind::Actuators { .. } => Err(&mut rejected.bad_effector_input),
+            },
+        };
+        want[k as usize + 1] = match applied {
+            Ok(w) => {
+                accepted += 1;
+                w
+            }
+            Err(counter) => {
+                *counter += 1;
+                refused += 1;
+                held
+            }
+        };
+    }
+    eprintln!("p = {P}: {accepted} applied as damaged, {refused} refused ({rejected:?})");
+    assert!(
+        accepted > 0 && refused > 0,
+        "both outcomes: {accepted} applied, {refused} refused"
+    );
+    for k in 0..LAST_TICK {
+        let t = k as usize + 1;
+        assert_eq!(got[t], want[t], "wrench applied over frame {k}");
+    }
+    assert_eq!(report.rejected, rejected, "{report}");
+    assert_eq!(
+        report.link_faults,
+        LinkStats {
+            commands_corrupted: 20,
+            corrupted_rejected: refused,
+            ..LinkStats::default()
+        }
+    );
 }
