@@ -65,8 +65,8 @@ impl FaultWindow {
 
     /// The start \[ns\] of the last activation that began at or before `t_ns`, whether or not
     /// it is still active then (`None` before the first): [`Self::activation_at`] wherever that
-    /// is `Some`. For a reader that knows the fault was active at some instant it saw, up to a
-    /// frame before `t_ns` (the plots' [`crate::sinks::prior_faults`]).
+    /// is `Some`. For a reader that knows the fault was active up to a frame before `t_ns`
+    /// (a recording's StatusMsg active set, which may lag its tick).
     pub fn last_start_at(&self, t_ns: u64) -> Option<u64> {
         let since = t_ns.checked_sub(self.start_ns)?;
         Some(self.start_ns + self.period_ns.map_or(0, |p| since / p * p))

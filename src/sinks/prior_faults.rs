@@ -5,10 +5,11 @@
 //! [`fault_events`] rebuilds the activation event each such fault would have had, so that
 //! `plot` and `export` ([`super::fault_spans`]) shade and list it like a recorded one.
 //!
-//! Fault `i` was active before the recording when a StatusMsg of time `t` shows bit `i` set
-//! while no event of `i` at or before `t` is recorded, or when the first recorded event of `i`
-//! is a clearance (of edge `e`: active at `e − 1` ns). The earliest such instant is the
-//! evidence; then:
+//! Fault `i` was active before the recording when a StatusMsg of tick `k` (time `t`) shows bit
+//! `i` set while the first recorded event of `i` (if any) comes at a tick after `k + 1` (the
+//! active set is read just after the tick, so it may already hold frame `k + 1`'s activations),
+//! or when the first recorded event of `i` is a clearance (of edge `e`: active at `e − 1` ns).
+//! The earliest such instant is the evidence; then:
 //! - a configured fault (index below the number of `[[faults]]` the recorded configuration
 //!   resolves to, in the server's order: [`crate::config::SimConfig::faults`], a random
 //!   `mtbf_s` fault's start drawn from its seed as the server drew it): its activation began at
@@ -50,13 +51,16 @@ pub struct VehicleFaults {
     pub first_state_ns: u64,
 }
 
+/// A StatusMsg's tick, time \[ns\] and active set.
+type Status = (u64, u64, [u64; 4]);
+
 /// What the samples of one vehicle say about its faults, before any rebuilding.
 #[derive(Default)]
 struct Seen {
     /// The recorded events, in file order.
     events: Vec<FaultEventMsg>,
-    /// Each StatusMsg's time and active set, in file order.
-    statuses: Vec<(u64, [u64; 4])>,
+    /// Each StatusMsg's tick, time and active set, in file order.
+    statuses: Vec<Status>,
     first_state_ns: Option<u64>,
 }
 
@@ -82,9 +86,10 @@ pub fn fault_events(rec: &Recording) -> BTreeMap<String, VehicleFaults> {
             Ok(Decoded::State(m)) => {
                 v.first_state_ns.get_or_insert(m.header.sim_time_ns);
             }
-            Ok(Decoded::Status(m)) => v
-                .statuses
-                .push((m.header.sim_time_ns, m.faults_active_bits)),
+            Ok(Decoded::Status(m)) => {
+                v.statuses
+                    .push((m.header.tick, m.header.sim_time_ns, m.faults_active_bits))
+            }
             Ok(Decoded::FaultEvent(m)) => v.events.push(m),
             _ => {}
         }
@@ -117,7 +122,7 @@ pub fn fault_events(rec: &Recording) -> BTreeMap<String, VehicleFaults> {
 
 /// Per fault index active before the recording, the earliest instant \[ns\] it is seen active
 /// with no activation of it recorded at or before then (see the module's rule).
-fn active_before(statuses: &[(u64, [u64; 4])], events: &[FaultEventMsg]) -> BTreeMap<u32, u64> {
+fn active_before(statuses: &[Status], events: &[FaultEventMsg]) -> BTreeMap<u32, u64> {
     let mut out: BTreeMap<u32, u64> = BTreeMap::new();
     let mut note = |index: u32, t: u64| {
         out.entry(index)
@@ -134,12 +139,16 @@ fn active_before(statuses: &[(u64, [u64; 4])], events: &[FaultEventMsg]) -> BTre
             note(index, e.edge_ns.saturating_sub(1));
         }
     }
-    for &(t, bits) in statuses {
+    for &(tick, t, bits) in statuses {
         for index in 0..MAX_STATUS_FAULTS as u32 {
             let set = bits
                 .get(index as usize / 64)
                 .is_some_and(|w| w >> (index % 64) & 1 == 1);
-            if set && first.get(&index).is_none_or(|e| e.edge_ns > t) {
+            if set
+                && first
+                    .get(&index)
+                    .is_none_or(|e| e.header.tick > tick.saturating_add(1))
+            {
                 note(index, t);
             }
         }
@@ -207,9 +216,14 @@ fn rebuild(
 mod tests {
     use super::*;
 
+    /// \[ns\] the frame of these tests.
+    const FRAME_NS: u64 = 10;
+
+    /// An event at the boundary after `edge_ns` (its tick).
     fn event(index: u32, active: bool, edge_ns: u64) -> FaultEventMsg {
+        let tick = edge_ns.div_ceil(FRAME_NS);
         FaultEventMsg {
-            header: Header::new(1, 0, edge_ns, 0),
+            header: Header::new(1, tick, tick * FRAME_NS, 0),
             fault_index: index,
             active,
             edge_ns,
@@ -217,23 +231,30 @@ mod tests {
         }
     }
 
-    fn bits(indices: &[usize]) -> [u64; 4] {
+    /// A status at `tick` showing `indices` active.
+    fn status(tick: u64, indices: &[usize]) -> Status {
         let mut b = [0; 4];
         for i in indices {
             b[i / 64] |= 1 << (i % 64);
         }
-        b
+        (tick, tick * FRAME_NS, b)
     }
 
     /// Seen active before any activation of it (a status, or a first event that is a
-    /// clearance), at the earliest such instant; an activation recorded at or before a status
-    /// explains that status's bit.
+    /// clearance), at the earliest such instant; an activation recorded up to a frame after a
+    /// status explains that status's bit.
     #[test]
     fn evidence_is_an_active_bit_or_a_clearance_with_no_activation_before_it() {
-        let statuses = [(300, bits(&[0, 2, 70])), (400, bits(&[0, 1, 2, 70, 255]))];
+        let statuses = [
+            status(30, &[0, 2, 4, 70]),
+            status(40, &[0, 1, 2, 4, 70, 255]),
+        ];
         let events = [
             // 1: activated at 350, before the status at 400 that shows it.
             event(1, true, 350),
+            // 4: activated in the frame after the first status, whose active set already
+            // holds it (read just after its tick): not active before.
+            event(4, true, 305),
             // 2: cleared at 380 (active before), then a new activation.
             event(2, false, 380),
             event(2, true, 390),
@@ -247,6 +268,6 @@ mod tests {
             got,
             BTreeMap::from([(0, 300), (2, 300), (3, 499), (70, 300), (255, 400)])
         );
-        assert!(active_before(&[(0, [0; 4])], &[event(1, true, 0)]).is_empty());
+        assert!(active_before(&[status(0, &[])], &[event(1, true, 0)]).is_empty());
     }
 }
