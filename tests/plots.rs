@@ -644,7 +644,7 @@ const FAULTS: &str = "[[faults]]\ntarget = \"imus.hub.gyro\"\nmode = \"bias_step
                       [[faults]]\ntarget = \"reaction_wheels.rw2\"\nmode = \"seized\"\nstart_s = 0.7\n";
 
 /// The panels of `figs` with fault shading, as (figure, caption or y label, [(label, spans)]).
-type Shaded<'a> = Vec<(&'a str, String, Vec<(&'a str, &'a [(f64, f64)])>)>;
+type Shaded<'a> = Vec<(&'a str, String, PanelShading<'a>)>;
 fn shaded(figs: &[Figure]) -> Shaded<'_> {
     figs.iter()
         .flat_map(|f| {
@@ -684,11 +684,15 @@ fn check_fault_panels(figs: &[Figure], gyro: &[(f64, f64)], wheel: &[(f64, f64)]
     assert_eq!(got.len(), 5, "{got:?}");
 }
 
-/// The pixels of fault 0's shading over the white background (fault colour at its alpha), as
-/// the x extent (first, last column) in the lower part of panel `area`.
-fn shading_columns(path: &Path, area: &(std::ops::Range<i32>, std::ops::Range<i32>)) -> (i32, i32) {
+/// The pixels of fault `index`'s shading over the white background (fault colour at its
+/// alpha), as the x extent (first, last column) in the lower part of panel `area`.
+fn shading_columns(
+    path: &Path,
+    area: &(std::ops::Range<i32>, std::ops::Range<i32>),
+    index: u32,
+) -> (i32, i32) {
     use flexdyn::sinks::plot::{fault_color, FAULT_ALPHA};
-    let c = fault_color(0);
+    let c = fault_color(index);
     let blend = |v: u8| 255.0 * (1.0 - FAULT_ALPHA) + f64::from(v) * FAULT_ALPHA;
     let want = [blend(c.0), blend(c.1), blend(c.2)];
     let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
@@ -748,7 +752,7 @@ fn a_simulate_csv_shades_each_fault_on_its_components_panels() {
     let (t0, t1) = imu.panels[0].t_range();
     let xs = &areas[0].0;
     let px = |t: f64| xs.start as f64 + (t - t0) / (t1 - t0) * f64::from(xs.end - xs.start - 1);
-    let (lo, hi) = shading_columns(&dir.join("imu.png"), &areas[0]);
+    let (lo, hi) = shading_columns(&dir.join("imu.png"), &areas[0], 0);
     assert!(
         (f64::from(lo) - px(0.5)).abs() <= 2.0 && (f64::from(hi) - px(0.8)).abs() <= 2.0,
         "shading at columns {lo}..{hi}, expected {:.1}..{:.1}",
@@ -780,11 +784,6 @@ fn a_simulate_csv_shades_each_fault_on_its_components_panels() {
 #[test]
 fn a_recording_shades_each_fault_from_its_events() {
     let dir = tmp("faults_mcap");
-    std::fs::create_dir_all(&dir).unwrap();
-    let base = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml"),
-    )
-    .unwrap();
     // The gyro fault repeats: on at 0.1 s for 0.05 s, every 0.2 s.
     let faults = FAULTS
         .replace(
@@ -792,18 +791,7 @@ fn a_recording_shades_each_fault_from_its_events() {
             "start_s = 0.1\nduration_s = 0.05\nperiod_s = 0.2",
         )
         .replace("start_s = 0.7", "start_s = 0.25");
-    let cfg = dir.join("run.toml");
-    std::fs::write(&cfg, format!("{base}\n{faults}")).unwrap();
-    let rec = dir.join("run.mcap");
-    let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
-        .args(["run", "--mode", "batch", "--duration-s", "0.6"])
-        .args(["--listen", ports::ANY_PORT, "--config"])
-        .arg(&cfg)
-        .arg("--record")
-        .arg(&rec)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let rec = record_faulty_run(&dir, &faults);
     let (figs, _) = figures(&args(&rec)).unwrap();
     // The last activation (0.5 s) is cleared at 0.55 s; the wheel stays seized to the last
     // state, at 0.6 s.
@@ -818,15 +806,7 @@ fn a_recording_shades_each_fault_from_its_events() {
     check_figures(&out, &["imu.png", "wheels.png"]);
     // `flexdyn export` carries the events into the state CSV (`# fault=` lines, one per
     // activation): the same shading from it, with the IMU's columns absent (wheels only).
-    let csv_dir = dir.join("csv");
-    let r = flexdyn(&[
-        "export",
-        rec.to_str().unwrap(),
-        "--csv",
-        csv_dir.to_str().unwrap(),
-    ]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let (figs, _) = figures(&args(&csv_dir.join("flexdyn_sc1_tlm_state.csv"))).unwrap();
+    let (figs, _) = figures(&args(&export_state_csv(&rec, &dir.join("csv")))).unwrap();
     let wheels: Vec<_> = shaded(&figs)
         .into_iter()
         .filter(|g| g.0 == "wheels.png")
@@ -838,4 +818,210 @@ fn a_recording_shades_each_fault_from_its_events() {
             vec![("fault 1: reaction_wheels.rw2 seized", &[(0.25, 0.6)][..])]
         );
     }
+}
+
+/// A 0.6 s batch run of `scenarios/wheels_star_tracker.toml` with `faults` appended, recorded
+/// (`flexdyn run --record`) into `dir/run.mcap`, which is returned.
+fn record_faulty_run(dir: &Path, faults: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let base = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/wheels_star_tracker.toml"),
+    )
+    .unwrap();
+    let cfg = dir.join("run.toml");
+    std::fs::write(&cfg, format!("{base}\n{faults}")).unwrap();
+    let rec = dir.join("run.mcap");
+    let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args(["run", "--mode", "batch", "--duration-s", "0.6"])
+        .args(["--listen", ports::ANY_PORT, "--config"])
+        .arg(&cfg)
+        .arg("--record")
+        .arg(&rec)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    rec
+}
+
+/// `flexdyn export REC --csv DIR`; returns the path of vehicle sc1's state CSV.
+fn export_state_csv(rec: &Path, dir: &Path) -> PathBuf {
+    let r = flexdyn(&[
+        "export",
+        rec.to_str().unwrap(),
+        "--csv",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    dir.join("flexdyn_sc1_tlm_state.csv")
+}
+
+/// What `flexdyn record` started at `from_ns` into the recorded run `rec` would have written
+/// into `out`: each vehicle's description (its configuration replaced by `config` of it), then
+/// every sample from `from_ns` on, through the recorder's own writer.
+fn record_from(rec: &Path, from_ns: u64, out: &Path, config: impl Fn(&str) -> String) {
+    use flexdyn::sinks::mcap_file::{McapSink, RecordingInfo};
+    let r = flexdyn::sinks::reader::read_recording(rec).unwrap();
+    assert!(r.truncated.is_none());
+    let info = RecordingInfo {
+        recorder: "flexdyn record".into(),
+        command_line: format!("(the samples of {} from {from_ns} ns on)", rec.display()),
+    };
+    let mut sink = McapSink::create(out, &info).unwrap();
+    let vehicles = r.vehicles();
+    assert!(!vehicles.is_empty());
+    for mut v in vehicles {
+        v.config_toml = config(&v.config_toml);
+        sink.describe_vehicle(&v).unwrap();
+    }
+    for s in r.samples.iter().filter(|s| s.log_time_ns >= from_ns) {
+        sink.write(
+            &s.key,
+            &s.payload,
+            Some(s.publish_time_ns),
+            s.publish_time_ns,
+        )
+        .unwrap();
+    }
+    sink.finish().unwrap();
+}
+
+/// A panel's shading: its faults' (label, spans).
+type PanelShading<'a> = Vec<(&'a str, &'a [(f64, f64)])>;
+
+/// The shaded panels of figure `name`: (caption or y label, its shading).
+fn shaded_in<'a>(figs: &'a [Figure], name: &str) -> Vec<(String, PanelShading<'a>)> {
+    shaded(figs)
+        .into_iter()
+        .filter(|g| g.0 == name)
+        .map(|g| (g.1, g.2))
+        .collect()
+}
+
+/// A recording started at 0.3 s, after three configured faults fired: the gyro bias of
+/// [0.1 s, 0.5 s), a star-tracker fault repeating on [0.05 s + k·0.4 s, +0.3 s), and wheel
+/// rw2 seized from 0.2 s on. The recorder saw none of their activations (only the gyro's and
+/// the current star-tracker activation's clearances, the next star-tracker activation, and
+/// StatusMsg's active set), yet `plot` shades each from its window's true start — to its
+/// clearance, or to the end of the data — on its own panels only, and `export` writes the same
+/// intervals, which `plot` shades again from the CSV. Without the inference the gyro and
+/// star-tracker intervals start at 0.3 s and the wheel is not shaded at all.
+#[test]
+fn faults_active_before_the_recording_are_shaded_from_their_true_start() {
+    let dir = tmp("faults_before_recording");
+    let wheel_fault =
+        "[[faults]]\ntarget = \"reaction_wheels.rw2\"\nmode = \"seized\"\nstart_s = 0.2\n";
+    let faults = format!(
+        "[[faults]]\ntarget = \"imus.hub.gyro\"\nmode = \"bias_step\"\nvalue = 0.25\n\
+         start_s = 0.1\nduration_s = 0.4\n\n\
+         [[faults]]\ntarget = \"star_trackers.st1\"\nmode = \"validity_off\"\n\
+         start_s = 0.05\nduration_s = 0.3\nperiod_s = 0.4\n\n{wheel_fault}"
+    );
+    let full = record_faulty_run(&dir, &faults);
+    let late = dir.join("late.mcap");
+    record_from(&full, 300_000_000, &late, str::to_owned);
+
+    // From the recording: the data span [0.3 s, 0.6 s]; each fault from its window's start.
+    let (figs, _) = figures(&args(&late)).unwrap();
+    let gyro = (
+        "fault 0: imus.hub.gyro bias_step (on since 0.1 s, before the data)",
+        &[(0.1, 0.5)][..],
+    );
+    let st = (
+        "fault 1: star_trackers.st1 validity_off (on since 0.05 s, before the data)",
+        &[(0.05, 0.35), (0.45, 0.6)][..],
+    );
+    let wheel = (
+        "fault 2: reaction_wheels.rw2 seized (on since 0.2 s, before the data)",
+        &[(0.2, 0.6)][..],
+    );
+    let got = shaded(&figs);
+    let imu = shaded_in(&figs, "imu.png");
+    assert_eq!(imu.len(), 2, "{got:?}");
+    assert!(
+        imu.iter().all(|g| g.0 == "IMU hub" && g.1 == [gyro]),
+        "{got:?}"
+    );
+    let trackers = shaded_in(&figs, "star_tracker.png");
+    assert!(!trackers.is_empty(), "{got:?}");
+    assert!(trackers.iter().all(|g| g.1 == [st]), "{got:?}");
+    let wheels = shaded_in(&figs, "wheels.png");
+    assert_eq!(wheels.len(), 3, "{got:?}");
+    assert!(wheels.iter().all(|g| g.1 == [wheel]), "{got:?}");
+    assert_eq!(
+        got.len(),
+        5 + trackers.len(),
+        "nothing else is shaded: {got:?}"
+    );
+
+    // `export`: one line per activation, the missed ones with their inferred starts.
+    let state_csv = export_state_csv(&late, &dir.join("csv"));
+    let text = std::fs::read_to_string(&state_csv).unwrap();
+    let lines: Vec<&str> = text
+        .lines()
+        .take_while(|l| l.starts_with('#'))
+        .filter(|l| l.starts_with("# fault="))
+        .collect();
+    assert_eq!(
+        lines,
+        [
+            "# fault=1,50000000,300000000,,validity_off,star_trackers.st1",
+            "# fault=0,100000000,400000000,,bias_step,imus.hub.gyro",
+            "# fault=1,450000000,,,validity_off,star_trackers.st1",
+            "# fault=2,200000000,,,seized,reaction_wheels.rw2",
+        ]
+    );
+    // The state CSV has the wheels (not the sensors): the same wheel shading from it.
+    let (figs, _) = figures(&args(&state_csv)).unwrap();
+    let got = shaded(&figs);
+    let wheels = shaded_in(&figs, "wheels.png");
+    assert_eq!(wheels.len(), 3, "{got:?}");
+    assert!(wheels.iter().all(|g| g.1 == [wheel]), "{got:?}");
+    assert_eq!(got.len(), 3, "{got:?}");
+
+    // Drawn from the axis' start: the wheel speed panel's shading covers [0.3 s, 0.6 s].
+    let w = find(&figs, "wheels.png");
+    register_font().unwrap();
+    let png = dir.join("wheels.png");
+    let areas = draw(&png, w).unwrap();
+    let (t0, t1) = w.panels[0].t_range();
+    assert_eq!((t0, t1), (0.3, 0.6));
+    let (lo, hi) = shading_columns(&png, &areas[0], 2);
+    let xs = &areas[0].0;
+    assert!(
+        (lo - xs.start).abs() <= 2 && (hi - (xs.end - 1)).abs() <= 2,
+        "shading at columns {lo}..{hi}, the axis spans {xs:?}"
+    );
+
+    // The same recording, described by a configuration without the wheel's entry: fault 2
+    // is then a live fault injected before the recording, and no event of it names its
+    // target. It is shaded from the first state on the attitude figure only, as unknown.
+    let live = dir.join("live.mcap");
+    record_from(&full, 300_000_000, &live, |c| {
+        let cut = c.rfind(wheel_fault).expect("the wheel's entry");
+        c[..cut].to_owned()
+    });
+    let unknown = (
+        "fault 2: live, injected before the recording (target unknown)",
+        &[(0.3, 0.6)][..],
+    );
+    let (figs, _) = figures(&args(&live)).unwrap();
+    let got = shaded(&figs);
+    assert!(shaded_in(&figs, "wheels.png").is_empty(), "{got:?}");
+    assert_eq!(
+        shaded_in(&figs, "attitude.png"),
+        [("σ_BN (MRP, –)".to_owned(), vec![unknown])]
+    );
+    assert_eq!(got.len(), 3 + trackers.len(), "{got:?}");
+    let state_csv = export_state_csv(&live, &dir.join("csv_live"));
+    let text = std::fs::read_to_string(&state_csv).unwrap();
+    assert!(
+        text.contains("\n# fault=2,300000000,,,live,\n"),
+        "{text:.600}"
+    );
+    let (figs, _) = figures(&args(&state_csv)).unwrap();
+    assert_eq!(
+        shaded_in(&figs, "attitude.png"),
+        [("σ_BN (MRP, –)".to_owned(), vec![unknown])]
+    );
+    assert_eq!(shaded(&figs).len(), 1);
 }

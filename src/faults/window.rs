@@ -62,6 +62,15 @@ impl FaultWindow {
         };
         range.map(move |n| start + n * period.unwrap_or(0))
     }
+
+    /// The start \[ns\] of the last activation that began at or before `t_ns`, whether or not
+    /// it is still active then (`None` before the first): [`Self::activation_at`] wherever that
+    /// is `Some`. For a reader that knows the fault was active up to a frame before `t_ns`
+    /// (a recording's StatusMsg active set, which may lag its tick).
+    pub fn last_start_at(&self, t_ns: u64) -> Option<u64> {
+        let since = t_ns.checked_sub(self.start_ns)?;
+        Some(self.start_ns + self.period_ns.map_or(0, |p| since / p * p))
+    }
 }
 
 #[cfg(test)]
@@ -129,5 +138,32 @@ mod tests {
         }
         // A window opening at 0 begins in no span after it (it began at the first look).
         assert_eq!(FaultWindow::from(0).starts_in(0, 100).count(), 0);
+    }
+
+    /// The last start agrees with the activation in force wherever there is one, and between
+    /// activations names the one just ended.
+    #[test]
+    fn the_last_start_is_the_activation_in_force_or_the_one_just_ended() {
+        let once = FaultWindow {
+            start_ns: 10,
+            duration_ns: Some(5),
+            period_ns: None,
+        };
+        let rep = FaultWindow {
+            period_ns: Some(20),
+            ..once
+        };
+        for w in [once, rep, FaultWindow::from(7)] {
+            for t in 0..100 {
+                if let Some(s) = w.activation_at(t) {
+                    assert_eq!(w.last_start_at(t), Some(s), "{w:?} at {t}");
+                }
+            }
+        }
+        assert_eq!(once.last_start_at(9), None);
+        assert_eq!(once.last_start_at(500), Some(10));
+        // [30, 35) ended at 35; the next starts at 50.
+        assert_eq!(rep.last_start_at(40), Some(30));
+        assert_eq!(rep.last_start_at(50), Some(50));
     }
 }

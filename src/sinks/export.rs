@@ -3,13 +3,16 @@
 //! ([`super::table`], the writer `simulate` uses too). A column a row does not have (an
 //! effector input one command sets and another does not) is left empty. A vehicle's state CSV
 //! starts with one `# fault=` line per fault activation its fault events record
-//! ([`super::fault_spans::event_comments`]), so `flexdyn plot` shades them from the CSV too.
+//! ([`super::fault_spans::event_comments`]), so `flexdyn plot` shades them from the CSV too;
+//! a fault already active when the recording began gets the line of the activation the
+//! recording missed ([`super::prior_faults`]: its inferred start, before the first row).
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use super::error::SinkError;
 use super::fault_spans;
+use super::prior_faults;
 use super::reader::read_recording;
 use super::table::{row, CsvTable};
 use super::topics::{classify, Decoded, TopicKind};
@@ -68,32 +71,15 @@ pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
             "samples that do not decode were left out of the CSV files"
         );
     }
-    // Each vehicle's fault events, as `# fault=` lines of its state CSV (`plot` shades them).
-    let mut fault_lines: HashMap<String, Vec<String>> = HashMap::new();
-    {
-        let mut events: HashMap<&str, Vec<flexdyn_proto::FaultEventMsg>> = HashMap::new();
-        let mut first_ns: HashMap<&str, u64> = HashMap::new();
-        for s in &rec.samples {
-            let Some(topic) = classify(&s.key) else {
-                continue;
-            };
-            let Ok(d) = Decoded::decode(topic.kind, &s.payload) else {
-                continue;
-            };
-            let t = d.header().sim_time_ns;
-            first_ns
-                .entry(topic.sc_id)
-                .and_modify(|f| *f = (*f).min(t))
-                .or_insert(t);
-            if let Decoded::FaultEvent(e) = d {
-                events.entry(topic.sc_id).or_default().push(e);
-            }
-        }
-        for (sc, ev) in events {
-            let first = first_ns.get(sc).copied().unwrap_or(0);
-            fault_lines.insert(sc.to_owned(), fault_spans::event_comments(&ev, first));
-        }
-    }
+    // Each vehicle's fault events, as `# fault=` lines of its state CSV (`plot` shades them),
+    // with the faults already active when the recording began.
+    let fault_lines: HashMap<String, Vec<String>> = prior_faults::fault_events(&rec)
+        .into_iter()
+        .map(|(sc, v)| {
+            let lines = fault_spans::event_comments(&v.events, v.first_state_ns);
+            (sc, lines)
+        })
+        .collect();
     // Pass 2: rows, through the one CSV writer.
     let epochs: HashMap<String, String> = rec
         .vehicles()

@@ -13,9 +13,16 @@
 //!   duration: until the end of the run; an empty period: once). Lossless: the activations
 //!   are [`FaultWindow::activation_at`]'s, expanded over the rows' time span.
 //!
+//! - A fault already active when the recording began: [`super::prior_faults`] rebuilds the
+//!   activation event the recorder missed, placed before the recorded events, so both readings
+//!   above take it like any other (a configured fault from its window, so its interval starts
+//!   before the data; a live fault with no event in the recording has an unknown target,
+//!   [`UNKNOWN_TARGET`], and starts at the recording's first state).
+//!
 //! A panel names the components it shows ([`super::plot::Panel::components`]: a component
 //! `imus.hub`, or a whole section `reaction_wheels` when one panel draws every wheel); a fault
-//! is shaded on the panels whose components its target lies in ([`shows`]).
+//! is shaded on the panels whose components its target lies in ([`shows`]). The intervals are
+//! when the fault was active, not clipped to the data (the drawing clips them to the axes).
 
 use flexdyn_proto::FaultEventMsg;
 
@@ -24,6 +31,16 @@ use crate::faults::{FaultSpec, FaultWindow};
 
 /// The comment key of a fault's window in a `simulate` CSV.
 pub const CSV_KEY: &str = "fault";
+
+/// The target of a fault the recording does not name: a live fault injected before the
+/// recording began and neither cleared nor re-activated in it ([`super::prior_faults`]). Its
+/// `# fault=` line has this (empty) target and the mode [`UNKNOWN_TARGET_MODE`]; `plot` shades
+/// it on the panels whose components include it (the attitude figure's), never on a
+/// component's.
+pub const UNKNOWN_TARGET: &str = "";
+/// The mode field of a fault with [`UNKNOWN_TARGET`]: its mode is unknown too, its source is
+/// not.
+pub const UNKNOWN_TARGET_MODE: &str = "live";
 
 /// Most activations of one fault drawn one by one; a repeating fault with more in the plotted
 /// span is shaded as one interval from its first activation on (said in the log).
@@ -55,7 +72,22 @@ fn seconds(ns: u64) -> f64 {
 }
 
 fn label(index: u32, target: &str, mode: &str) -> String {
-    format!("fault {index}: {target} {mode}")
+    if target == UNKNOWN_TARGET {
+        format!("fault {index}: live, injected before the recording (target unknown)")
+    } else {
+        format!("fault {index}: {target} {mode}")
+    }
+}
+
+/// An event's target and mode name ([`UNKNOWN_TARGET_MODE`] when its target is unknown).
+fn target_and_mode(e: &FaultEventMsg) -> (String, String) {
+    let target = e.target.as_str().unwrap_or_default().to_owned();
+    let mode = if target == UNKNOWN_TARGET {
+        UNKNOWN_TARGET_MODE.to_owned()
+    } else {
+        mode_name(e.mode)
+    };
+    (target, mode)
 }
 
 /// Whether a panel showing `component` (`imus.hub`, or a section such as `reaction_wheels`)
@@ -75,14 +107,14 @@ pub fn from_events(events: &[FaultEventMsg], t_first_s: f64, t_last_s: f64) -> V
     // Per fault index: the start [s] of the activation in force.
     let mut open: std::collections::BTreeMap<u32, f64> = Default::default();
     for e in events {
-        let target = e.target.as_str().unwrap_or_default().to_owned();
+        let (target, mode) = target_and_mode(e);
         let at = seconds(e.edge_ns);
         let i = match out.iter().position(|s| s.fault_index == e.fault_index) {
             Some(i) => i,
             None => {
                 out.push(FaultShading {
                     fault_index: e.fault_index,
-                    label: label(e.fault_index, &target, &mode_name(e.mode)),
+                    label: label(e.fault_index, &target, &mode),
                     target,
                     spans: Vec::new(),
                 });
@@ -126,14 +158,13 @@ pub fn event_comments(events: &[FaultEventMsg], first_ns: u64) -> Vec<String> {
     let mut open: std::collections::BTreeMap<u32, &FaultEventMsg> = Default::default();
     let mut out = Vec::new();
     let line = |e: &FaultEventMsg, start_ns: u64, end_ns: Option<u64>| {
+        let (target, mode) = target_and_mode(e);
         format!(
-            "{CSV_KEY}={},{start_ns},{},,{},{}",
+            "{CSV_KEY}={},{start_ns},{},,{mode},{target}",
             e.fault_index,
             end_ns.map_or(String::new(), |end| end
                 .saturating_sub(start_ns)
                 .to_string()),
-            mode_name(e.mode),
-            e.target.as_str().unwrap_or_default()
         )
     };
     for e in events {
@@ -177,7 +208,8 @@ pub fn parse_csv_comment(value: &str) -> Result<(u32, FaultWindow, String, Strin
 }
 
 /// The activations of `window` \[s\] over data spanning `[t_first_s, t_last_s]`: each
-/// `[start, end]` clipped to the span, the open-ended one ending at `t_last_s`.
+/// `[start, end]` that reaches into the span, its end clipped to `t_last_s` (the open-ended one
+/// ends there); a start before the data is kept (the fault was active from then on).
 pub fn window_spans(window: &FaultWindow, t_first_s: f64, t_last_s: f64) -> Vec<(f64, f64)> {
     let s = seconds;
     let last_ns = (t_last_s * 1e9).round().max(0.0) as u64;
@@ -188,7 +220,7 @@ pub fn window_spans(window: &FaultWindow, t_first_s: f64, t_last_s: f64) -> Vec<
             .duration_ns
             .map_or(t_last_s, |d| s(start_ns.saturating_add(d)).min(t_last_s));
         if end >= t_first_s {
-            out.push((s(start_ns).max(t_first_s), end));
+            out.push((s(start_ns), end));
         }
         let Some(p) = window.period_ns else { break };
         if out.len() == MAX_INTERVALS {

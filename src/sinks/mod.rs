@@ -11,7 +11,8 @@
 //! - [`record_cmd`], [`replay`], [`export`]: the `flexdyn record`, `replay` and `export`
 //!   subcommands.
 //! - [`plot`]: `flexdyn plot`, PNG figures of a recording or a CSV; [`fault_spans`]: the
-//!   intervals its figures shade where a fault was active.
+//!   intervals its figures shade where a fault was active; [`prior_faults`]: the faults already
+//!   active when a recording began.
 //! - [`view`]: `flexdyn view`, the live (or recorded) Foxglove WebSocket view.
 
 pub mod error;
@@ -20,6 +21,7 @@ pub mod fault_spans;
 pub mod gaps;
 pub mod mcap_file;
 pub mod plot;
+pub mod prior_faults;
 pub mod reader;
 pub mod record_cmd;
 pub mod recorder;

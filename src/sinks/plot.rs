@@ -32,7 +32,10 @@
 //! (`imus.hub.gyro` on IMU hub's), the wheel panels for a wheel, the magnetorquer or thruster
 //! panels of `actuators.png`, the commanded wrench for a command link
 //! ([`super::fault_spans`]: from the recording's fault events, or the `# fault=` lines of a
-//! `simulate` CSV).
+//! `simulate` CSV). A fault already active when the recording began is shaded too
+//! ([`super::prior_faults`]): a configured one from its window's activation (its legend says
+//! since when, before the data), a live one whose target the recording does not name on
+//! `attitude.png`, from the first state, labelled as such.
 //!
 //! [`figures`] builds every figure's data and axis bounds ([`Panel::y_range`]) without drawing,
 //! so tests can check what a figure shows.
@@ -48,6 +51,7 @@ use plotters::prelude::*;
 
 use super::error::SinkError;
 use super::fault_spans::{self, FaultShading};
+use super::prior_faults;
 use super::reader::read_recording;
 use super::table::{prefixed_columns, row, Cell, Column, ENVIRONMENT_COLUMN_PREFIX};
 use super::topics::{classify, Decoded, TopicKind};
@@ -228,7 +232,6 @@ fn from_mcap(
         chief: relative_to.map(|c| (c.to_owned(), Columns::default())),
         ..PlotData::default()
     };
-    let mut fault_events = Vec::new();
     for s in &rec.samples {
         let Some(topic) = classify(&s.key) else {
             continue;
@@ -262,12 +265,9 @@ fn from_mcap(
                 .or_default()
                 .push(&cells),
             TopicKind::Environment => data.environment.push(&cells),
-            TopicKind::FaultEvent => {
-                if let Decoded::FaultEvent(m) = d {
-                    fault_events.push(m);
-                }
-            }
-            TopicKind::Command
+            // Read with the faults active before the recording, below.
+            TopicKind::FaultEvent
+            | TopicKind::Command
             | TopicKind::Time
             | TopicKind::Operator
             | TopicKind::FaultCommand => {}
@@ -279,7 +279,11 @@ fn from_mcap(
         }
     }
     let (first, last) = time_span(&data.state);
-    data.faults = fault_spans::from_events(&fault_events, first, last);
+    let events = prior_faults::fault_events(&rec)
+        .remove(&sc)
+        .map(|v| v.events)
+        .unwrap_or_default();
+    data.faults = fault_spans::from_events(&events, first, last);
     if data.state.is_empty() {
         return Err(input_err(
             path,
@@ -611,12 +615,16 @@ fn draw_panel<Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueForma
     }
     for f in &panel.faults {
         let (y0, y1) = panel.y_range();
+        // A fault active from before the data is drawn from the axis' start.
+        let (t0, t1) = panel.t_range();
         let shade = fault_color(f.fault_index).mix(FAULT_ALPHA);
         chart
             .draw_series(
                 f.spans
                     .iter()
-                    .map(|(a, b)| Rectangle::new([(*a, y0), (*b, y1)], shade.filled())),
+                    .map(|(a, b)| (a.clamp(t0, t1), b.clamp(t0, t1)))
+                    .filter(|(a, b)| a < b)
+                    .map(|(a, b)| Rectangle::new([(a, y0), (b, y1)], shade.filled())),
             )
             .map_err(|e| e.to_string())?
             .label(f.label.as_str())
@@ -839,10 +847,23 @@ fn external_wrench_spans(s: &Columns) -> Vec<(f64, f64)> {
     spans
 }
 
-/// Adds each fault's shading to every panel showing its target ([`fault_spans::shows`]).
-fn shade_faults(figures: &mut [Figure], faults: &[FaultShading]) {
+/// Adds each fault's shading to every panel showing its target ([`fault_spans::shows`]). A
+/// fault active from before the data's first instant `t_first_s` (a recording started after
+/// it fired) says since when in its legend entry, as the axes do not reach back there.
+fn shade_faults(figures: &mut [Figure], faults: &[FaultShading], t_first_s: f64) {
+    let faults: Vec<FaultShading> = faults
+        .iter()
+        .filter(|f| !f.spans.is_empty())
+        .map(|f| match f.spans.first() {
+            Some(&(start, _)) if start < t_first_s => FaultShading {
+                label: format!("{} (on since {start} s, before the data)", f.label),
+                ..f.clone()
+            },
+            _ => f.clone(),
+        })
+        .collect();
     for panel in figures.iter_mut().flat_map(|f| f.panels.iter_mut()) {
-        for f in faults.iter().filter(|f| !f.spans.is_empty()) {
+        for f in &faults {
             if panel
                 .components
                 .iter()
@@ -904,9 +925,14 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
         });
     };
 
+    // The vehicle as a whole: where a fault the recording does not name is shaded.
+    let whole_vehicle = || vec![fault_spans::UNKNOWN_TARGET.to_owned()];
     match vec_panel(s, "sigma_bn", ["σ1", "σ2", "σ3"], "σ_BN (MRP, –)") {
         Some(sigma) => {
-            let mut panels = vec![sigma];
+            let mut panels = vec![Panel {
+                components: whole_vehicle(),
+                ..sigma
+            }];
             if let (Some(target), Some(v)) = (target, s.vec3("sigma_bn")) {
                 let err: Vec<nalgebra::Vector3<f64>> = vectors(v)
                     .iter()
@@ -922,6 +948,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
                         line("σ_BR,3", t, &comp(2)),
                         line("|σ_BR|", t, &norm),
                     ],
+                    components: whole_vehicle(),
                     ..Panel::default()
                 });
             }
@@ -1218,7 +1245,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
             "no StatusMsg (only recordings have it)".into(),
         )),
     }
-    shade_faults(&mut figures, &data.faults);
+    shade_faults(&mut figures, &data.faults, time_span(s).0);
     Ok((figures, skipped))
 }
 
