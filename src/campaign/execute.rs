@@ -4,8 +4,10 @@
 //! has a `controller`. Open-loop runs have the observer only.
 //!
 //! A run writes `run-NNNN/result.json`: the parameters read back from its built model, its
-//! seeds, the SHA-256 over its StateMsg payloads in tick order, the criteria, the exit status of
-//! the server and the controller, and the wall time; with `--record`, `run-NNNN/recording.mcap`.
+//! seeds, the SHA-256 over its StateMsg payloads in tick order, the criteria, each fault's first
+//! activation as the server published it (the observer subscribes to the fault events too), the
+//! exit status of the server and the controller, and the wall time; with `--record`,
+//! `run-NNNN/recording.mcap`.
 //! A controller that exits before the end stops the run at once, which fails with its status.
 //!
 //! Each run comes to an [`Outcome`]: `passed`, `failed` (it ran and the flight code did not meet
@@ -86,6 +88,11 @@ pub struct RunResult {
     pub vehicle_state_sha256: BTreeMap<String, String>,
     /// States received (over a fleet: of each vehicle).
     pub states: u64,
+    /// \[ns\] each fault's first activation as the run published it (the `edge_ns` of its
+    /// first FaultEventMsg with `active`), by `faults[k]` (over a fleet `<vehicle>.faults[k]`);
+    /// a fault that never activated is absent.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub fault_activations_ns: BTreeMap<String, u64>,
     /// Criteria.
     pub criteria: Vec<CriterionResult>,
     /// Every criterion passed and the run completed (`outcome` is `passed`).
@@ -186,14 +193,19 @@ pub fn reduce(c: &Criterion, series: &[(f64, f64)], frame_s: f64) -> CriterionRe
 pub type Received = Arc<Mutex<Vec<(u64, Vec<u8>)>>>;
 
 /// A passive lockstep participant: records every state payload and answers it with
-/// `NoCommand` as its sender id, so it sees every tick from 0. Also the tests' recorder.
+/// `NoCommand` as its sender id, so it sees every tick from 0, and records every fault event.
+/// Also the tests' recorder.
 pub struct Observer {
     /// Every (tick, payload) received, in arrival order.
     pub states: Received,
+    /// Every (tick, FaultEventMsg payload) received, in arrival order (the server publishes a
+    /// tick's events after its state, before it waits for the answers).
+    pub faults: Received,
     /// Every (tick, RelativeStateMsg payload) of each key given to
     /// [`Self::start_with_relative`], in arrival order.
     pub relative: Vec<Received>,
     _sub: zenoh::pubsub::Subscriber<()>,
+    _fault_sub: zenoh::pubsub::Subscriber<()>,
     _relative_subs: Vec<zenoh::pubsub::Subscriber<()>>,
     _token: zenoh::liveliness::LivelinessToken,
     session: Session,
@@ -256,23 +268,19 @@ impl Observer {
             })
             .wait()
             .map_err(|e| format!("observer subscriber: {e}"))?;
+        let (faults, fault_sub) = record_key(&session, topics.fault_events(), |b| {
+            flexdyn_proto::decode_fault_event(b)
+                .ok()
+                .map(|m| m.header.tick)
+        })?;
         let mut relative_states = Vec::with_capacity(relative.len());
         let mut relative_subs = Vec::with_capacity(relative.len());
         for key in relative {
-            let received: Received = Arc::default();
-            let rec = received.clone();
-            let sub = session
-                .declare_subscriber(key.clone())
-                .callback(move |sample| {
-                    let bytes = sample.payload().to_bytes().into_owned();
-                    if let Ok(m) = flexdyn_proto::decode_relative_state(&bytes) {
-                        rec.lock()
-                            .unwrap_or_else(|e| e.into_inner())
-                            .push((m.header.tick, bytes));
-                    }
-                })
-                .wait()
-                .map_err(|e| format!("observer subscriber {key}: {e}"))?;
+            let (received, sub) = record_key(&session, key.clone(), |b| {
+                flexdyn_proto::decode_relative_state(b)
+                    .ok()
+                    .map(|m| m.header.tick)
+            })?;
             relative_states.push(received);
             relative_subs.push(sub);
         }
@@ -283,13 +291,38 @@ impl Observer {
             .map_err(|e| format!("observer token: {e}"))?;
         Ok(Self {
             states,
+            faults,
             relative: relative_states,
             _sub: sub,
+            _fault_sub: fault_sub,
             _relative_subs: relative_subs,
             _token: token,
             session,
         })
     }
+}
+
+/// A subscriber on `key` that records (tick, payload) of every sample `tick_of` decodes.
+fn record_key(
+    session: &Session,
+    key: String,
+    tick_of: fn(&[u8]) -> Option<u64>,
+) -> Result<(Received, zenoh::pubsub::Subscriber<()>), String> {
+    let received: Received = Arc::default();
+    let rec = received.clone();
+    let sub = session
+        .declare_subscriber(key.clone())
+        .callback(move |sample| {
+            let bytes = sample.payload().to_bytes().into_owned();
+            if let Some(tick) = tick_of(&bytes) {
+                rec.lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push((tick, bytes));
+            }
+        })
+        .wait()
+        .map_err(|e| format!("observer subscriber {key}: {e}"))?;
+    Ok((received, sub))
 }
 
 fn exit_text(s: std::process::ExitStatus) -> String {
@@ -318,6 +351,7 @@ pub fn execute(plan: &Plan, rp: &RunPlan, opts: &RunOptions) -> RunResult {
         state_sha256: String::new(),
         vehicle_state_sha256: BTreeMap::new(),
         states: 0,
+        fault_activations_ns: BTreeMap::new(),
         criteria: Vec::new(),
         passed: false,
         outcome: Outcome::NotRun,
@@ -433,6 +467,8 @@ struct Observed {
     states: Vec<Stream>,
     /// Per observed vehicle, the stream of each relative-state key it records.
     relative: Vec<Vec<Stream>>,
+    /// Per observed vehicle, its fault events (tick order; a tick's in publication order).
+    faults: Vec<Stream>,
     /// \[ns\] simulated time reached.
     sim_time_ns: u64,
 }
@@ -648,6 +684,7 @@ fn run_lockstep(
     let mut out = Observed {
         states: Vec::with_capacity(observers.len()),
         relative: Vec::with_capacity(observers.len()),
+        faults: Vec::with_capacity(observers.len()),
         sim_time_ns,
     };
     for (o, (id, _)) in observers.iter().zip(observe) {
@@ -675,6 +712,7 @@ fn run_lockstep(
         }
         out.states.push(states);
         out.relative.push(relative);
+        out.faults.push(sorted(&o.faults));
     }
     close(&observers);
     Ok(out)
@@ -686,6 +724,22 @@ fn applied(rp: &RunPlan, model: &BTreeMap<String, f64>) -> BTreeMap<String, f64>
         .keys()
         .filter_map(|k| model.get(k).map(|v| (k.clone(), *v)))
         .collect()
+}
+
+/// \[ns\] each fault's first activation in `events` (its first FaultEventMsg with `active`:
+/// `edge_ns`), by `<prefix>faults[k]`.
+fn first_activations(prefix: &str, events: &[(u64, Vec<u8>)]) -> BTreeMap<String, u64> {
+    let mut first = BTreeMap::new();
+    for m in events
+        .iter()
+        .filter_map(|(_, p)| flexdyn_proto::decode_fault_event(p).ok())
+        .filter(|m| m.active)
+    {
+        first
+            .entry(format!("{prefix}faults[{}]", m.fault_index))
+            .or_insert(m.edge_ns);
+    }
+    first
 }
 
 fn decode_states(states: &[(u64, Vec<u8>)]) -> Vec<StateMsg> {
@@ -750,6 +804,7 @@ fn run_inner(
     let states = &observed.states[0];
     result.state_sha256 = sha256_hex(states);
     result.states = states.len() as u64;
+    result.fault_activations_ns = first_activations("", &observed.faults[0]);
     result.sim_s = observed.sim_time_ns as f64 * 1e-9;
     let decoded = decode_states(states);
     result.criteria = c
@@ -830,12 +885,18 @@ fn run_fleet(
     result.sim_s = observed.sim_time_ns as f64 * 1e-9;
     let mut decoded = BTreeMap::new();
     let mut ranges = BTreeMap::new();
-    for (((id, _), states), relative) in
-        observe.iter().zip(&observed.states).zip(&observed.relative)
+    for ((((id, _), states), relative), faults) in observe
+        .iter()
+        .zip(&observed.states)
+        .zip(&observed.relative)
+        .zip(&observed.faults)
     {
         result
             .vehicle_state_sha256
             .insert(id.clone(), sha256_hex(states));
+        result
+            .fault_activations_ns
+            .extend(first_activations(&format!("{id}."), faults));
         decoded.insert(id.as_str(), decode_states(states));
         if let Some(r) = relative.first() {
             let series: Vec<(f64, f64)> = r

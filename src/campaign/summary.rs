@@ -178,8 +178,12 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
             .filter(|t| *t <= duration_ns)
     };
     for k in &random_faults {
-        write!(csv, ",{k}.failure_s").ok();
+        write!(csv, ",{k}.failure_s,{k}.observed_s").ok();
     }
+    // Exact: whole seconds and nine decimals of the integer nanoseconds.
+    let seconds = |t_ns: u64| format!("{}.{:09}", t_ns / 1_000_000_000, t_ns % 1_000_000_000);
+    // Runs whose published first activation is not the planned one (both within the run).
+    let mut disagree = Vec::new();
     csv.push_str(",status\n");
     for p in &plans {
         let r = results.iter().find(|r| r.run == p.run);
@@ -206,13 +210,13 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
             };
         }
         for k in &random_faults {
-            match failure_in_run(p, k) {
-                // Exact: whole seconds and nine decimals of the integer nanoseconds.
-                Some(t_ns) => {
-                    write!(csv, ",{}.{:09}", t_ns / 1_000_000_000, t_ns % 1_000_000_000).ok()
-                }
-                None => write!(csv, ",").ok(),
-            };
+            let planned = failure_in_run(p, k);
+            let observed = r.and_then(|r| r.fault_activations_ns.get(k).copied());
+            if r.is_some_and(|r| r.status == "ok") && planned != observed {
+                disagree.push((p.run, k, planned, observed));
+            }
+            let cell = |t: Option<u64>| t.map(seconds).unwrap_or_default();
+            write!(csv, ",{},{}", cell(planned), cell(observed)).ok();
         }
         writeln!(csv, ",{status}").ok();
     }
@@ -263,6 +267,16 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
             rate_line(split.without_failure.0, split.without_failure.1)
         )
         .ok();
+        for (run, k, planned, observed) in &disagree {
+            let at = |t: &Option<u64>| t.map_or("never".to_owned(), |t| seconds(t) + " s");
+            writeln!(
+                t,
+                "  run {run}: {k} planned at {}, published at {}",
+                at(planned),
+                at(observed)
+            )
+            .ok();
+        }
         s.random_failures = Some(split);
     } else if manifest["random_faults"] == serde_json::Value::Bool(false) {
         writeln!(
@@ -560,6 +574,7 @@ mod tests {
                 state_sha256: String::new(),
                 vehicle_state_sha256: BTreeMap::new(),
                 states: 1,
+                fault_activations_ns: BTreeMap::new(),
                 criteria: vec![super::super::execute::CriterionResult {
                     name: "settle".into(),
                     value: *settle,

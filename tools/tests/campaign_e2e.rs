@@ -3,13 +3,16 @@
 //! finish, the summary has 20 rows, the criteria evaluate and a deliberately failing one fails
 //! everywhere; a run rerun alone with `--index` has the same state hash; a controller that
 //! crashes in one run fails that run with its exit status and the campaign goes on. The exit
-//! code is the verdict: 3 when the runs ran and failed.
+//! code is the verdict: 3 when the runs ran and failed. Random wheel seizures under the demo
+//! without FDIR fail exactly the runs they strike, the summary splits the pass rate accordingly,
+//! and each run's published failure time is the planned one to the nanosecond.
 
 use std::path::{Path, PathBuf};
 
 use flexdyn::campaign::execute::RunResult;
 use flexdyn::campaign::verdict::Outcome;
 use flexdyn::campaign::{main as campaign, CampaignCommand};
+use flexdyn::faults::failure_delay_ns;
 
 #[path = "acs_demo_bin/mod.rs"]
 mod acs_demo_bin;
@@ -203,4 +206,232 @@ fn a_crashing_controller_fails_its_run_and_the_campaign_goes_on() {
         summary.text
     );
     assert_eq!(summary.exit_code, 3);
+}
+
+/// `scenarios/fdir.toml` without its own faults, plus a random seizure of rw2 from
+/// [`SEIZE_FROM_S`] with an MTBF of [`MTBF_S`], flown by the demo without `--fdir` on the star
+/// tracker and true rates (so no gyro bias sets a pointing floor).
+const SEIZE_FROM_S: f64 = 30.0;
+const MTBF_S: f64 = 36.0;
+const SEIZURE_RUNS: u32 = 8;
+const SEIZURE_DURATION_S: f64 = 60.0;
+/// Campaign seed 1 puts four of the eight failures within the run and none in the last
+/// [`BREAK_S`] of it (the test checks this from the seeds).
+const SEIZURE_SEED: u32 = 1;
+/// The pointing bound of `tools/tests/fdir.rs`, 0.05°, from [`SEIZE_FROM_S`] on (the criterion's
+/// `after_s`): the healthy runs settle from the initial 3e-4 rad/s under it by 30 s (their
+/// largest error from there, 0.017°, is the tail of that transient). As |σ_BR| (what `sigma_br`
+/// measures) it is tan(θ/4).
+const BOUND_DEG: f64 = 0.05;
+/// A seizure breaks the bound within this time: the brake dumps rw2's 1.5 N·m·s into the hub at
+/// 0.2 N·m (7.5 s) and the 4-wheel allocation keeps asking the seized wheel; without FDIR the
+/// error peaks at 0.33° (README, "FDIR demo"). Seizures 5.4 s before the end were measured to
+/// break it (0.11°), 2.9 s before the end not (0.04°); 10 s is the margin. A failure later than
+/// this before the end could go either way: the chosen seed has none.
+const BREAK_S: f64 = 10.0;
+
+fn seizure_campaign() -> (PathBuf, PathBuf) {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("campaign_seizures");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = include_str!("../../scenarios/fdir.toml");
+    let own_faults = scenario.find("\n[[faults]]").expect("fdir.toml's faults");
+    let base = format!(
+        "{}\n[[faults]]\ntarget = \"reaction_wheels.rw2\"\nmode = \"seized\"\n\
+         start_s = {SEIZE_FROM_S:?}\nmtbf_s = {MTBF_S:?}\n",
+        &scenario[..own_faults]
+    );
+    std::fs::write(dir.join("base.toml"), base).unwrap();
+    let bound = (BOUND_DEG.to_radians() / 4.0).tan();
+    let file = dir.join("campaign.toml");
+    std::fs::write(
+        &file,
+        format!(
+            r#"base = "base.toml"
+runs = {SEIZURE_RUNS}
+seed = {SEIZURE_SEED}
+duration_s = {SEIZURE_DURATION_S:?}
+participant_timeout_s = 10.0
+controller = '''{} --connect {{endpoint}} --sc-id {{sc_id}} --sender-id {{sender_id}} --actuator wheels --attitude-source star-tracker --star-tracker st1 --rate-source truth --log-every-s 0 --idle-exit-s 1'''
+
+[[criteria]]
+name = "pointing"
+quantity = "sigma_br"
+statistic = "max"
+after_s = {SEIZE_FROM_S:?}
+below = {bound:e}
+"#,
+            demo()
+        ),
+    )
+    .unwrap();
+    (file, dir)
+}
+
+/// The Wilson score interval, solved here as the roots of (p̂ − p)² = z² p (1 − p)/n (Wilson
+/// 1927), a quadratic in p: (1 + z²/n) p² − (2p̂ + z²/n) p + p̂² = 0.
+fn wilson_roots(k: u32, n: u32) -> (f64, f64) {
+    let z = 1.959_963_984_540_054_f64; // Φ⁻¹(0.975)
+    let (p, n) = (f64::from(k) / f64::from(n), f64::from(n));
+    let (a, b, c) = (1.0 + z * z / n, -(2.0 * p + z * z / n), p * p);
+    let root = (b * b - 4.0 * a * c).max(0.0).sqrt();
+    ((-b - root) / (2.0 * a), (-b + root) / (2.0 * a))
+}
+
+fn rate_line(k: u32, n: u32) -> String {
+    let (lo, hi) = wilson_roots(k, n);
+    format!(
+        "{k} of {n} passed ({:.1} %); Wilson 95 % interval {:.1} %–{:.1} %",
+        100.0 * f64::from(k) / f64::from(n),
+        100.0 * lo,
+        100.0 * hi
+    )
+}
+
+/// `s.nnnnnnnnn` (or empty) as nanoseconds.
+fn cell_ns(cell: &str) -> Option<u64> {
+    let (s, ns) = cell.split_once('.')?;
+    assert_eq!(ns.len(), 9, "{cell}");
+    Some(s.parse::<u64>().unwrap() * 1_000_000_000 + ns.parse::<u64>().unwrap())
+}
+
+/// The StateMsg payloads of a run's `recording.mcap` (its raw channel), in tick order.
+fn recorded_states(out: &Path, run: usize) -> Vec<Vec<u8>> {
+    let bytes = std::fs::read(out.join(format!("run-{run:04}/recording.mcap"))).unwrap();
+    let topic = flexdyn_proto::Topics::new("sc1")
+        .unwrap()
+        .state()
+        .to_owned();
+    let mut states: Vec<(u64, Vec<u8>)> = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(Result::unwrap)
+        .filter(|m| m.channel.topic == topic)
+        .map(|m| {
+            let tick = flexdyn_proto::decode_state(&m.data).unwrap().header.tick;
+            (tick, m.data.into_owned())
+        })
+        .collect();
+    states.sort_by_key(|(t, _)| *t);
+    states.into_iter().map(|(_, p)| p).collect()
+}
+
+fn run_seizures(file: &Path, out: &Path, without_random_faults: bool) -> u8 {
+    let report = campaign(&CampaignCommand::Run {
+        file: file.to_owned(),
+        output: out.to_owned(),
+        jobs: Some(2),
+        index: None,
+        record: true,
+        base_port: 0,
+        without_random_faults,
+    })
+    .unwrap();
+    eprintln!("{}", report.text);
+    report.exit_code
+}
+
+#[test]
+fn random_wheel_seizures_fail_the_runs_they_strike() {
+    let (file, dir) = seizure_campaign();
+    let out = dir.join("with");
+    let code = run_seizures(&file, &out, false);
+    let end_ns = (SEIZURE_DURATION_S * 1e9) as u64;
+    let break_ns = ((SEIZURE_DURATION_S - BREAK_S) * 1e9) as u64;
+    // Each run's failure time, from the seed the plan wrote into its configuration.
+    let mut step_frame_ns = (0, 0);
+    let failure_ns: Vec<u64> = (0..SEIZURE_RUNS)
+        .map(|run| {
+            let path = out.join(format!("run-{run:04}/config.toml"));
+            let cfg =
+                flexdyn::config::SimConfig::from_toml_str(&std::fs::read_to_string(path).unwrap())
+                    .unwrap();
+            step_frame_ns = (cfg.step_ns, cfg.frame_ns);
+            (SEIZE_FROM_S * 1e9) as u64 + failure_delay_ns(MTBF_S, cfg.faults[0].seed)
+        })
+        .collect();
+    let struck: Vec<bool> = failure_ns.iter().map(|t| *t <= end_ns).collect();
+    for (run, t) in failure_ns.iter().enumerate() {
+        assert!(
+            *t <= break_ns || *t > end_ns,
+            "run {run} seizes at {t} ns, too close to the end to say: choose another seed"
+        );
+    }
+    let k = struck.iter().filter(|s| **s).count() as u32;
+    let m = SEIZURE_RUNS - k;
+    assert!(k > 0 && m > 0, "both groups: {failure_ns:?}");
+    assert_eq!(code, 3, "the struck runs fail");
+
+    let summary = campaign(&CampaignCommand::Summarize { dir: out.clone() }).unwrap();
+    let text = summary.text;
+    eprintln!("{text}");
+    let csv = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+    let mut lines = csv.lines().map(|l| l.split(',').collect::<Vec<&str>>());
+    let header = lines.next().unwrap();
+    let rows: Vec<Vec<&str>> = lines.collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (planned, observed) = (col("faults[0].failure_s"), col("faults[0].observed_s"));
+    let results: Vec<RunResult> = (0..SEIZURE_RUNS).map(|r| result(&out, r)).collect();
+    for (run, r) in results.iter().enumerate() {
+        assert_eq!(r.status, "ok", "run {run}");
+        let want = struck[run].then_some(failure_ns[run]);
+        // The seizure breaks the pointing; without it the run holds it.
+        let outcome = if struck[run] {
+            Outcome::Failed
+        } else {
+            Outcome::Passed
+        };
+        assert_eq!(r.outcome, outcome, "run {run}: {:?}", r.criteria);
+        // The server published the activation at the planned nanosecond, and only then.
+        assert_eq!(
+            r.fault_activations_ns,
+            want.map(|t| ("faults[0]".to_owned(), t))
+                .into_iter()
+                .collect(),
+            "run {run}"
+        );
+        assert_eq!(cell_ns(rows[run][planned]), want, "run {run}");
+        assert_eq!(cell_ns(rows[run][observed]), want, "run {run}");
+    }
+    let within = format!("a failure within the run in {k} of {SEIZURE_RUNS} runs");
+    assert!(text.contains(&within), "{text}");
+    // Every struck run failed, every other passed: 0 of k, and m of m.
+    let with = format!("runs with a random failure: {}\n", rate_line(0, k));
+    assert!(text.contains(&with), "{text}");
+    let without = format!("runs without: {}\n", rate_line(m, m));
+    assert!(text.contains(&without), "{text}");
+    assert!(!text.contains("published at"), "{text}");
+
+    // Without the random faults every run passes, and the runs no seizure struck are the same
+    // runs bit for bit: the faults are the only difference.
+    let healthy = dir.join("without");
+    assert_eq!(run_seizures(&file, &healthy, true), 0);
+    let (step_ns, frame_ns) = step_frame_ns;
+    for (run, with) in results.iter().enumerate() {
+        let without = result(&healthy, run as u32);
+        assert!(without.passed, "run {run}: {:?}", without.criteria);
+        assert!(without.fault_activations_ns.is_empty());
+        let same = without.state_sha256 == with.state_sha256;
+        assert_eq!(same, !struck[run], "run {run}");
+        if !struck[run] {
+            continue;
+        }
+        // The physics departs from the healthy twin where the brake starts: the wheel port
+        // applies the seizure from the first step starting at or after the failure time
+        // (src/faults/ports.rs), so the first state to differ is the one ending that step's
+        // frame. Recorded by the server, independently of the observer.
+        let (a, b) = (recorded_states(&out, run), recorded_states(&healthy, run));
+        assert_eq!(
+            (a.len(), b.len()),
+            (with.states as usize, with.states as usize)
+        );
+        let first_differing = a.iter().zip(&b).position(|(x, y)| x != y);
+        let first_step_ns = failure_ns[run].div_ceil(step_ns) * step_ns;
+        let want = first_step_ns / frame_ns + 1;
+        assert_eq!(first_differing, Some(want as usize), "run {run}");
+    }
+    let text = campaign(&CampaignCommand::Summarize { dir: healthy })
+        .unwrap()
+        .text;
+    let all = format!("{SEIZURE_RUNS} of {SEIZURE_RUNS} planned runs passed");
+    assert!(text.contains(&all), "{text}");
 }
