@@ -76,6 +76,47 @@ start_s = 1.0
     frame_path_does_not_allocate(&cfg);
 }
 
+/// Command-link faults, active over part of the measured frames (frames of 10 ms): sender 2's
+/// wheel `Actuators` commands through a `corrupted` link over ticks 50–99 (at this bit error
+/// rate most are damaged; those that pass the checks are read in place and taken, the others
+/// refused), sender 1's wrench through a `delayed` link over ticks 30–79 and a `dropped` one
+/// over ticks 120–139; and a spiking gyro. The corrupted window ends before the final check.
+#[test]
+fn the_frame_path_does_not_allocate_with_link_faults() {
+    let text = format!(
+        "{WHEELS}
+[server]
+participants = [1, 2]
+[[faults]]
+target = \"links.2\"
+mode = \"corrupted\"
+probability = 0.002
+start_s = 0.5
+duration_s = 0.5
+[[faults]]
+target = \"links.1\"
+mode = \"delayed\"
+frames = 3.0
+start_s = 0.3
+duration_s = 0.5
+[[faults]]
+target = \"links.1\"
+mode = \"dropped\"
+start_s = 1.2
+duration_s = 0.2
+[[faults]]
+target = \"imus.hub.gyro\"
+mode = \"spikes\"
+probability = 0.2
+amplitude = 0.01
+start_s = 0.2
+"
+    );
+    let cfg = SimConfig::from_toml_str(&text).unwrap();
+    assert_eq!(cfg.faults.len(), 4);
+    frame_path_does_not_allocate(&cfg);
+}
+
 /// Live faults (protocol 8): requests resolved off the measured region (as the fault callback
 /// does on the Zenoh thread), installed on the stepping path into the reserved slots (a gyro
 /// bias, a seized wheel, then clears of a configured and a live fault), their boxes handed to
@@ -214,6 +255,12 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
         }
     });
     assert_eq!(violation_count(), 0, "the frame path allocated");
+    let links = w.book.link_stats();
+    if w.book.links().faults().iter().any(|f| f.target == "links.2") {
+        // The corrupted window did damage commands, and some of them passed the checks.
+        assert_eq!(links.commands_corrupted, 50, "{links:?}");
+        assert!(links.corrupted_rejected < 50, "{links:?}");
+    }
     // The wheels were commanded (torques 0.01–0.04 N·m held), and the recycled commands are
     // freed here, on the "I/O side".
     let s = w.sim.state_msg();

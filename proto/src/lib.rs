@@ -100,6 +100,7 @@ mod error;
 pub mod keys;
 mod layout;
 mod messages;
+pub mod view;
 
 pub use codec::{
     decode, decode_command, decode_css, decode_environment, decode_fss, decode_header, decode_imu,

@@ -473,3 +473,96 @@ proptest! {
         prop_assert!(matches!(r, Err(DecodeError::NonFinite { .. })), "{:?}", r);
     }
 }
+
+/// `view_command` (the allocation-free reading of a command) against `decode_command`: the same
+/// command for the bytes `decode_command` accepts, the same class of error for the others.
+fn view_agrees(bytes: &[u8]) -> Result<(), TestCaseError> {
+    use flexdyn_proto::view::{view_command, ViewError};
+    match (decode_command(bytes), view_command(bytes)) {
+        (Ok(m), Ok(v)) => prop_assert_eq!(v.to_owned_msg(), m),
+        (Err(e), Err(v)) => prop_assert_eq!(v, ViewError::of(&e), "{}", e),
+        (d, v) => prop_assert!(false, "decode {:?} but view {:?}", d, v),
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2048))]
+
+    #[test]
+    fn the_command_view_agrees_with_the_decoder_on_arbitrary_bytes(
+        bytes in prop::collection::vec(any::<u8>(), 0..300)
+    ) {
+        view_agrees(&bytes)?;
+    }
+
+    /// Commands of every kind (any bit pattern in the numbers: NaN, infinities), then damaged
+    /// as a `corrupted` link damages them (a bit flipped with probability p, p from 10⁻⁴ to 1/2),
+    /// then truncated or extended.
+    #[test]
+    fn the_command_view_agrees_with_the_decoder_on_damaged_commands(
+        msg in command_any_bits(),
+        seed in any::<u64>(),
+        p in prop_oneof![Just(0.0), 1e-4..0.5f64],
+        cut in 0usize..8,
+    ) {
+        let mut bytes = encode(&msg);
+        view_agrees(&bytes)?;
+        let mut s = seed | 1;
+        for b in bytes.iter_mut() {
+            for bit in 0..8 {
+                // xorshift64*: a uniform u in [0, 1) per bit.
+                s ^= s >> 12;
+                s ^= s << 25;
+                s ^= s >> 27;
+                let u = (s.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64;
+                if u < p {
+                    *b ^= 1 << bit;
+                }
+            }
+        }
+        view_agrees(&bytes)?;
+        let short = bytes.len().saturating_sub(cut);
+        view_agrees(&bytes[..short])?;
+        bytes.extend(std::iter::repeat_n(0u8, cut));
+        view_agrees(&bytes)?;
+    }
+}
+
+/// [`command`] with any bit pattern in every number (NaN and infinities included).
+fn command_any_bits() -> impl Strategy<Value = CommandMsg> {
+    let kind = prop_oneof![
+        (v3(any_bits_f64()), v3(any_bits_f64())).prop_map(|(t, fo)| CommandKind::Wrench {
+            torque_b_nm: t,
+            force_b_newton: fo
+        }),
+        Just(CommandKind::NoCommand),
+        (
+            v3(any_bits_f64()),
+            v3(any_bits_f64()),
+            prop::collection::vec(
+                (
+                    any::<u32>(),
+                    prop::collection::vec(any_bits_f64(), 0..=MAX_EFFECTOR_VALUES)
+                ),
+                0..6
+            )
+        )
+            .prop_map(|(t, fo, inputs)| CommandKind::Actuators {
+                torque_b_nm: t,
+                force_b_newton: fo,
+                inputs: inputs
+                    .into_iter()
+                    .map(|(effector_index, values)| EffectorInput {
+                        effector_index,
+                        values
+                    })
+                    .collect(),
+            }),
+    ];
+    (header(), any::<u32>(), kind).prop_map(|(header, sender_id, kind)| CommandMsg {
+        header,
+        sender_id,
+        kind,
+    })
+}

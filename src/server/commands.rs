@@ -15,8 +15,9 @@
 
 use std::ops::Range;
 
+use flexdyn_proto::view::{view_command, CommandView, CommandViewKind, ViewError};
 use flexdyn_proto::{
-    command_flags, CommandKind, CommandMsg, CommandStatus, DecodeError, StalePolicy, NO_COMMAND,
+    command_flags, CommandKind, CommandMsg, CommandStatus, StalePolicy, NO_COMMAND,
 };
 
 use crate::faults::link::{damage, LinkFaults, LinkStats};
@@ -63,11 +64,11 @@ pub enum Damaged {
 }
 
 impl Damaged {
-    fn of_decode(e: &DecodeError) -> Self {
+    fn of_view(e: ViewError) -> Self {
         match e {
-            DecodeError::UnknownVersion { .. } => Self::BadVersion,
-            DecodeError::NonFinite { .. } => Self::NonFinite,
-            _ => Self::Malformed,
+            ViewError::UnknownVersion { .. } => Self::BadVersion,
+            ViewError::NonFinite => Self::NonFinite,
+            ViewError::Malformed => Self::Malformed,
         }
     }
 }
@@ -141,11 +142,36 @@ fn check_inputs(ranges: &[Range<usize>], seen: &mut [bool], cmd: &CommandMsg) ->
     let CommandKind::Actuators { inputs, .. } = &cmd.kind else {
         return None;
     };
+    check_input_sizes(
+        ranges,
+        seen,
+        inputs.iter().map(|i| (i.effector_index, i.values.len())),
+    )
+}
+
+/// [`check_inputs`] for a command read in place (a damaged one).
+fn check_view_inputs(
+    ranges: &[Range<usize>],
+    seen: &mut [bool],
+    cmd: &CommandView<'_>,
+) -> Option<Offer> {
+    let CommandViewKind::Actuators { inputs, .. } = cmd.kind else {
+        return None;
+    };
+    check_input_sizes(ranges, seen, inputs.iter().map(|(i, v)| (i, v.len())))
+}
+
+/// [`check_inputs`] on each input's effector index and value count.
+fn check_input_sizes(
+    ranges: &[Range<usize>],
+    seen: &mut [bool],
+    inputs: impl Iterator<Item = (u32, usize)>,
+) -> Option<Offer> {
     seen.iter_mut().for_each(|s| *s = false);
-    for i in inputs {
-        let idx = i.effector_index as usize;
+    for (index, len) in inputs {
+        let idx = index as usize;
         match (ranges.get(idx), seen.get_mut(idx)) {
-            (Some(r), Some(s)) if !r.is_empty() && r.len() == i.values.len() && !*s => *s = true,
+            (Some(r), Some(s)) if !r.is_empty() && r.len() == len && !*s => *s = true,
             _ => return Some(Offer::BadEffectorInput),
         }
     }
@@ -256,7 +282,7 @@ impl CommandBook {
             } => {
                 slot.torque_b_nm = *torque_b_nm;
                 slot.force_b_newton = *force_b_newton;
-                // Checked by `inputs_fit` before.
+                // Checked by `check_inputs` before.
                 for i in inputs {
                     let r = ranges[i.effector_index as usize].clone();
                     slot.inputs[r].copy_from_slice(&i.values);
@@ -264,8 +290,44 @@ impl CommandBook {
             }
             CommandKind::NoCommand => {}
         }
+        Self::stamp(slot, cmd.header.tick, k);
+    }
+
+    /// [`Self::take`] for a command read in place (a damaged one).
+    fn take_view(slot: &mut Slot, ranges: &[Range<usize>], cmd: &CommandView<'_>, k: u64) {
+        match cmd.kind {
+            CommandViewKind::Wrench {
+                torque_b_nm,
+                force_b_newton,
+            } => {
+                slot.torque_b_nm = torque_b_nm;
+                slot.force_b_newton = force_b_newton;
+            }
+            CommandViewKind::Actuators {
+                torque_b_nm,
+                force_b_newton,
+                inputs,
+            } => {
+                slot.torque_b_nm = torque_b_nm;
+                slot.force_b_newton = force_b_newton;
+                // Checked by `check_view_inputs` before.
+                for (index, values) in inputs.iter() {
+                    let r = ranges[index as usize].clone();
+                    slot.inputs[r]
+                        .iter_mut()
+                        .zip(values.iter())
+                        .for_each(|(to, v)| *to = v);
+                }
+            }
+            CommandViewKind::NoCommand => {}
+        }
+        Self::stamp(slot, cmd.header.tick, k);
+    }
+
+    /// Marks `slot` as holding the command of tick `tick`, taken at boundary `k`.
+    fn stamp(slot: &mut Slot, tick: u64, k: u64) {
         slot.has_command = true;
-        slot.last_tick = cmd.header.tick;
+        slot.last_tick = tick;
         slot.received_tick = k;
     }
 
@@ -388,8 +450,10 @@ impl CommandBook {
         flexdyn_proto::encode_into(cmd, &mut self.scratch);
         damage(&mut self.scratch, seed, k, probability);
         let slot = &self.slots[i];
-        let reject = match flexdyn_proto::decode_command(&self.scratch) {
-            Err(e) => Err(Damaged::of_decode(&e)),
+        // Read in place: decoding a damaged Actuators command would allocate its inputs here,
+        // on the stepping thread.
+        let reject = match view_command(&self.scratch) {
+            Err(e) => Err(Damaged::of_view(e)),
             Ok(d) if d.header.spacecraft_id != self.spacecraft_id => Err(Damaged::WrongSpacecraft),
             Ok(d) if d.sender_id != slot.sender_id => Err(Damaged::WrongIdentity),
             Ok(d)
@@ -400,14 +464,14 @@ impl CommandBook {
             {
                 Err(Damaged::StaleTick)
             }
-            Ok(d) => match check_inputs(&self.input_ranges, &mut self.seen, &d) {
+            Ok(d) => match check_view_inputs(&self.input_ranges, &mut self.seen, &d) {
                 Some(_) => Err(Damaged::BadEffectorInput),
                 None => Ok(d),
             },
         };
         match reject {
             Ok(d) => {
-                Self::take(&mut self.slots[i], &self.input_ranges, &d, k);
+                Self::take_view(&mut self.slots[i], &self.input_ranges, &d, k);
                 Offer::Accepted
             }
             Err(why) => {
