@@ -6,6 +6,12 @@
 //! refused commands (an unknown target, a tick already stepped past, a clear naming no fault)
 //! are never applied and are counted in `rejected.fault_refused`. Both handoffs: the lockstep
 //! core (direct) and the physics thread (thread).
+//!
+//! A live `Clear` stops the effect: a fault injected at K until cleared, cleared at K + 5, is
+//! healthy before K, transformed on [K, K + 5) and healthy again from K + 5, sample by sample,
+//! with its activation and clearance events at those edges. Malformed, bad-version,
+//! non-finite and wrong-spacecraft fault commands put beside it are counted under those
+//! reasons (`src/server/fault_cmd.rs`) and never applied.
 
 mod server_support;
 
@@ -17,8 +23,8 @@ use flexdyn::config::SimConfig;
 use flexdyn::server::{Handoff, ServerSettings};
 use flexdyn_proto::{
     decode_fault_event, decode_imu, decode_state, encode, CommandMsg, FaultAction, FaultCommandMsg,
-    FaultEventMsg, FaultSource, FaultTarget, Header, Mode, OperatorAction, OperatorMsg, RunState,
-    Topics,
+    FaultEventMsg, FaultSource, FaultTarget, Header, Mode, OperatorAction, OperatorMsg,
+    RejectCounters, RunState, Topics, PROTOCOL_VERSION,
 };
 use server_support::{connecting_session, wait_until, Observer, ServerHandle};
 use zenoh::{Session, Wait};
@@ -55,10 +61,35 @@ fn fault(action: FaultAction, at_tick: u64, target: &str, index: u32) -> FaultCo
     }
 }
 
-/// A lockstep participant (sender 1) answering every state with NoCommand; with `inject`, it
-/// puts the live fault for tick K (and the refused ones) before its answer to tick K − 1, from
-/// the same session.
-fn participant(port: u16, topics: &Topics, inject: bool) -> (Session, Vec<Box<dyn std::any::Any>>) {
+/// What a participant puts on the fault key before its answer to tick k: `script(k)`.
+type Script = fn(u64) -> Vec<Vec<u8>>;
+
+/// No fault commands.
+fn none(_: u64) -> Vec<Vec<u8>> {
+    Vec::new()
+}
+
+/// The live fault for tick K and the refused ones, before the answer to tick K − 1.
+fn inject_and_refused(k: u64) -> Vec<Vec<u8>> {
+    if k != K - 1 {
+        return Vec::new();
+    }
+    vec![
+        encode(&fault(FaultAction::Inject, K, "imus.hub.gyro", 0)),
+        // Refused: no such IMU; a tick already stepped past; no fault 9.
+        encode(&fault(FaultAction::Inject, K, "imus.nope.gyro", 0)),
+        encode(&fault(FaultAction::Inject, 3, "imus.hub.gyro", 0)),
+        encode(&fault(FaultAction::Clear, K, "", 9)),
+    ]
+}
+
+/// A lockstep participant (sender 1) answering every state with NoCommand; before its answer
+/// to tick k it puts `script(k)` on the fault key, from the same session.
+fn participant(
+    port: u16,
+    topics: &Topics,
+    script: Script,
+) -> (Session, Vec<Box<dyn std::any::Any>>) {
     let s = connecting_session(port);
     let (p, key, fault_key) = (s.clone(), topics.cmd(1), topics.fault());
     let sub = s
@@ -66,13 +97,8 @@ fn participant(port: u16, topics: &Topics, inject: bool) -> (Session, Vec<Box<dy
         .callback(move |sample| {
             let st = decode_state(&sample.payload().to_bytes()).unwrap();
             let k = st.header.tick;
-            if inject && k == K - 1 {
-                let put = |m: &FaultCommandMsg| p.put(fault_key.as_str(), encode(m)).wait();
-                put(&fault(FaultAction::Inject, K, "imus.hub.gyro", 0)).unwrap();
-                // Refused: no such IMU; a tick already stepped past; no fault 9.
-                put(&fault(FaultAction::Inject, K, "imus.nope.gyro", 0)).unwrap();
-                put(&fault(FaultAction::Inject, 3, "imus.hub.gyro", 0)).unwrap();
-                put(&fault(FaultAction::Clear, K, "", 9)).unwrap();
+            for payload in script(k) {
+                p.put(fault_key.as_str(), payload).wait().unwrap();
             }
             let h = Header::new(1, k, st.header.sim_time_ns, k);
             let _ = p
@@ -89,12 +115,13 @@ fn participant(port: u16, topics: &Topics, inject: bool) -> (Session, Vec<Box<dy
     (s, vec![Box::new(sub), Box::new(token)])
 }
 
-/// One lockstep run of TICKS ticks; with `inject`, the live fault, and a hold at K + 2 where
-/// the status is read. Returns what was seen, the status while held (if injected) and the last
-/// status, and the run's reject counters.
+/// One lockstep run of TICKS ticks with the participant's fault commands `script`; with
+/// `hold`, a hold at K + 2 where the status is read. Returns what was seen, the status while
+/// held (if held) and the last status, and the run's reject counters.
 fn run(
     handoff: Handoff,
-    inject: bool,
+    script: Script,
+    hold: bool,
 ) -> (
     Seen,
     Option<flexdyn_proto::StatusMsg>,
@@ -139,13 +166,13 @@ fn run(
         let m = OperatorMsg::new(Header::new(1, 0, 0, 0), action, ticks);
         op.put(topics.operator(), encode(&m)).wait().unwrap();
     };
-    if inject {
+    if hold {
         operator(OperatorAction::RunTicks, K + 2);
         std::thread::sleep(Duration::from_millis(200));
     }
-    let (_p, _keep) = participant(server.port, &topics, inject);
+    let (_p, _keep) = participant(server.port, &topics, script);
     let mut held = None;
-    if inject {
+    if hold {
         assert!(
             wait_until(Duration::from_secs(20), || obs.last_status().is_some_and(
                 |st| st.run_state == RunState::Paused && st.header.tick == K + 2
@@ -175,12 +202,12 @@ fn run(
     (seen, held, last, report.rejected)
 }
 
-fn live_fault_lands_at_its_tick(handoff: Handoff) {
-    let (healthy, _, healthy_last, _) = run(handoff, false);
-    let (faulty, held, last, rejected) = run(handoff, true);
+/// Sample by sample: the faulted gyro is healthy before K and from K + LEN on, healthy + BIAS
+/// on [K, K + LEN); its events: activated at K, cleared at K + LEN, each edge at its boundary;
+/// index 0 (the configuration has none).
+fn biased_on_k_to_k_plus_len(healthy: &Seen, faulty: &Seen) {
     assert_eq!(healthy.gyro.len() as u64, TICKS + 1);
     assert_eq!(faulty.gyro.len() as u64, TICKS + 1);
-    // Sample by sample: healthy before K and from K + LEN on, healthy + BIAS on [K, K + LEN).
     for (k, h) in &healthy.gyro {
         let f = faulty.gyro[k];
         if (K..K + LEN).contains(k) {
@@ -189,9 +216,6 @@ fn live_fault_lands_at_its_tick(handoff: Handoff) {
             assert_eq!(f, *h, "tick {k}: healthy");
         }
     }
-    assert!(healthy.events.is_empty());
-    assert_eq!(healthy_last.faults_active, 0);
-    // Its events: activated at K, cleared at K + LEN; index 0 (the configuration has none).
     let ev = |tick: u64, active: bool, seq: u64| FaultEventMsg {
         header: Header::new(1, tick, tick * FRAME_NS, seq),
         fault_index: 0,
@@ -204,6 +228,14 @@ fn live_fault_lands_at_its_tick(handoff: Handoff) {
         target: FaultTarget::new("imus.hub.gyro").unwrap(),
     };
     assert_eq!(faulty.events, vec![ev(K, true, 0), ev(K + LEN, false, 1)]);
+}
+
+fn live_fault_lands_at_its_tick(handoff: Handoff) {
+    let (healthy, _, healthy_last, _) = run(handoff, none, false);
+    let (faulty, held, last, rejected) = run(handoff, inject_and_refused, true);
+    biased_on_k_to_k_plus_len(&healthy, &faulty);
+    assert!(healthy.events.is_empty());
+    assert_eq!(healthy_last.faults_active, 0);
     // Active while held at K + 2, cleared by the end.
     let held = held.unwrap();
     assert_eq!(held.header.tick, K + 2);
@@ -225,4 +257,65 @@ fn a_live_fault_lands_at_its_tick_in_lockstep_direct() {
 #[test]
 fn a_live_fault_lands_at_its_tick_in_lockstep_thread() {
     live_fault_lands_at_its_tick(Handoff::Thread);
+}
+
+/// The bias until cleared, injected at K and cleared at K + LEN, with four bad commands beside
+/// the injection that the server must count and never apply: the same injection truncated
+/// (malformed), with the next protocol version (bad version), a NaN parameter (non-finite), and
+/// for spacecraft 2 with a bias of 100 rad/s (wrong spacecraft).
+fn inject_then_clear(k: u64) -> Vec<Vec<u8>> {
+    let until_cleared = FaultCommandMsg {
+        duration_ns: 0,
+        ..fault(FaultAction::Inject, K, "imus.hub.gyro", 0)
+    };
+    if k == K - 1 {
+        let good = encode(&until_cleared);
+        let truncated = good[..good.len() - 1].to_vec();
+        let mut next_version = good.clone();
+        next_version[..2].copy_from_slice(&(PROTOCOL_VERSION + 1).to_le_bytes());
+        let non_finite = encode(&FaultCommandMsg {
+            params: [f64::NAN, 0.0],
+            ..until_cleared
+        });
+        let other_spacecraft = encode(&FaultCommandMsg {
+            header: Header::new(2, 0, 0, 0),
+            params: [100.0, 0.0],
+            ..until_cleared
+        });
+        vec![good, truncated, next_version, non_finite, other_spacecraft]
+    } else if k == K + LEN - 1 {
+        vec![encode(&fault(FaultAction::Clear, K + LEN, "", 0))]
+    } else {
+        Vec::new()
+    }
+}
+
+fn a_live_clear_stops_the_effect(handoff: Handoff) {
+    let (healthy, _, _, healthy_rejected) = run(handoff, none, false);
+    let (faulty, _, last, rejected) = run(handoff, inject_then_clear, false);
+    // The fault itself has no duration: the clearance ends it at K + LEN, the boundary it
+    // takes effect at (the clearance event's edge).
+    biased_on_k_to_k_plus_len(&healthy, &faulty);
+    assert_eq!((last.faults_active, last.faults_active_bits), (0, [0; 4]));
+    // Each bad command counted once under its reason, in the report and in StatusMsg.
+    let want = RejectCounters {
+        malformed: 1,
+        bad_version: 1,
+        non_finite: 1,
+        wrong_spacecraft: 1,
+        ..healthy_rejected
+    };
+    assert_eq!(healthy_rejected, RejectCounters::default());
+    assert_eq!(rejected, want);
+    assert_eq!(last.rejected, want);
+}
+
+#[test]
+fn a_live_clear_stops_the_effect_direct() {
+    a_live_clear_stops_the_effect(Handoff::Direct);
+}
+
+#[test]
+fn a_live_clear_stops_the_effect_thread() {
+    a_live_clear_stops_the_effect(Handoff::Thread);
 }

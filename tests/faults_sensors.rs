@@ -9,48 +9,22 @@
 //! random draws come from the documented generator (`NormalRng` seeded with the fault's seed,
 //! drawn per sample and axis in order).
 
-use std::collections::BTreeMap;
+mod sensor_faults_support;
 
-use flexdyn::attitude::mrp_to_dcm;
-use flexdyn::config::SimConfig;
 use flexdyn::sensors::rng::NormalRng;
-use flexdyn::sim::Simulation;
-use flexdyn_proto::Header;
-use nalgebra::Vector3;
+use sensor_faults_support::{
+    acs_full_fss_at_the_sun, floats, gps_fix, gps_no_fix, split, without, Published, ACS_FULL,
+};
 use serde_json::Value;
 
-const ACS_FULL: &str = include_str!("../scenarios/acs_full.toml");
 const LEO: &str = include_str!("../scenarios/leo_environment.toml");
 /// Both scenarios run frames of 0.1 s (acs_full) or 0.01 s (leo, sensors at 10 Hz).
 const START_S: f64 = 0.5;
 const DURATION_S: f64 = 1.0;
 const END_S: f64 = 2.0;
 
-/// Every published sensor message of a run, per sample instant: `[t_ns] → {sensor → JSON}`.
-type Published = BTreeMap<u64, BTreeMap<String, Value>>;
-
 fn run(text: &str) -> Published {
-    let cfg = SimConfig::from_toml_str(text).unwrap_or_else(|e| panic!("{e}"));
-    let mut sim = Simulation::new(&cfg).unwrap();
-    let frames = (END_S * 1e9) as u64 / cfg.frame_ns;
-    let mut out = Published::new();
-    let mut buf = Vec::new();
-    for k in 0..=frames {
-        if k > 0 {
-            sim.step_frame();
-        }
-        sim.sample_sensors(|s| s.due(k));
-        let t = sim.t_sim_ns();
-        let bank = sim.sensors();
-        let row = out.entry(t).or_default();
-        for &i in bank.sampled() {
-            let s = &bank.sensors()[i];
-            s.encode(Header::new(1, k, t, k), &mut buf);
-            let (_, json) = (s.kind().decode)(&buf).unwrap();
-            row.insert(format!("{}.{}", s.kind().config_array, s.name()), json);
-        }
-    }
-    out
+    sensor_faults_support::run(text, END_S)
 }
 
 fn with_fault(base: &str, fault: &str) -> String {
@@ -60,13 +34,6 @@ fn with_fault(base: &str, fault: &str) -> String {
 fn active(t_ns: u64) -> bool {
     let t = t_ns as f64 * 1e-9;
     (START_S..START_S + DURATION_S).contains(&(t + 1e-12))
-}
-
-fn floats(v: &Value) -> Vec<f64> {
-    match v {
-        Value::Array(a) => a.iter().map(|x| x.as_f64().unwrap()).collect(),
-        x => vec![x.as_f64().unwrap()],
-    }
 }
 
 /// Compares a faulted run with the healthy one for `sensor`: `expect(t_on_s, field, axis, x,
@@ -82,24 +49,25 @@ fn compare(
 ) -> usize {
     let healthy = run(base);
     let faulted = run(&with_fault(base, fault));
-    assert_eq!(healthy.len(), faulted.len());
     let first_on = healthy
         .iter()
         .find(|(t, row)| active(**t) && row.contains_key(sensor))
         .map(|(_, row)| row[sensor].clone())
         .expect("the sensor samples inside the window");
+    let start_ns = (START_S * 1e9) as u64;
     let mut inside = 0;
-    for ((t, h), (_, f)) in healthy.iter().zip(&faulted) {
-        if !active(*t) {
-            assert_eq!(h, f, "outside the window at t = {t} ns");
-            continue;
-        }
-        let (Some(h), Some(f)) = (h.get(sensor), f.get(sensor)) else {
-            continue;
+    for (t, _, h, f) in split(&healthy, &faulted, sensor, |t| {
+        active(t).then_some(start_ns)
+    }) {
+        // A sample the healthy run published is published faulted, and none is added.
+        let (h, f) = match (h, f) {
+            (Some(h), Some(f)) => (h, f),
+            (None, None) => continue,
+            (h, f) => panic!("{sensor} at t = {t} ns: published in one run only ({h:?} / {f:?})"),
         };
         inside += 1;
         // Whole nanoseconds since the activation, then seconds.
-        let t_on_s = (*t - (START_S * 1e9) as u64) as f64 * 1e-9;
+        let t_on_s = (t - start_ns) as f64 * 1e-9;
         for (key, hv) in h.as_object().unwrap() {
             let fv = &f[key];
             if !fields.contains(&key.as_str()) {
@@ -251,9 +219,7 @@ fn dropout_publishes_nothing_in_the_window() {
             assert!(!f.contains_key("star_trackers.st1"), "t = {t}");
             dropped += 1;
             // The other sensors are untouched.
-            let mut h = h.clone();
-            h.remove("star_trackers.st1");
-            assert_eq!(&h, f);
+            assert_eq!(without(h, "star_trackers.st1"), *f);
         } else {
             assert_eq!(h, f);
         }
@@ -300,31 +266,9 @@ fn validity_off_clears_only_the_flag() {
         |m| m["valid"] == Value::Bool(true),
     );
     assert!(n > 0, "the healthy tracker is valid in the window");
-    // acs_full's sun sensor looks 90° from the Sun; this one looks at the Sun's direction in
-    // B at t = 0 (ŝ_B = [BN] r̂_sun; the body turns 3°/s, well inside the ±60° field of view
-    // over the window): [FB] rows x_F, y_F ⊥ ŝ_B, z_F = ŝ_B.
-    let sim = Simulation::new(&SimConfig::from_toml_str(ACS_FULL).unwrap()).unwrap();
-    let r = sim.spacecraft().environment().r_sun_b_n_m;
-    let s0 = mrp_to_dcm(&sim.spacecraft().state().sigma_bn) * (r / r.norm());
-    let x = s0.cross(&Vector3::new(0.3, 0.5, 0.8)).normalize();
-    let y = s0.cross(&x);
-    let row = |v: Vector3<f64>| format!("[{:?}, {:?}, {:?}]", v[0], v[1], v[2]);
-    let fss =
-        "name = \"fss\"\n# [FB] = I: boresight +z_F along +z_B, the wings' solar-cell normal.\n\
-               dcm_fb = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]";
-    assert!(ACS_FULL.contains(fss));
-    let toward_sun = ACS_FULL.replacen(
-        fss,
-        &format!(
-            "name = \"fss\"\ndcm_fb = [{}, {}, {}]",
-            row(x),
-            row(y),
-            row(s0)
-        ),
-        1,
-    );
+    // acs_full's sun sensor looks 90° from the Sun; this one looks at it.
     let n = validity_off(
-        &toward_sun,
+        &acs_full_fss_at_the_sun(),
         "fine_sun_sensors.fss",
         |m| m["flags"] = Value::from(m["flags"].as_u64().unwrap() & !1),
         |m| m["flags"].as_u64().unwrap() & 1 == 1,
@@ -354,20 +298,6 @@ fn bias_step_on_a_gps_position_moves_only_that_frame() {
 
 #[test]
 fn validity_off_makes_a_gps_message_a_no_fix_one() {
-    let n = validity_off(
-        &leo_gps_10_hz(),
-        "gps_receivers.gps1",
-        |m| {
-            // The module docs: FIX (bit 0) cleared and every number 0; the valid time and the
-            // frame flags stay.
-            m["flags"] = Value::from(m["flags"].as_u64().unwrap() & !1);
-            m["gps_week"] = Value::from(0);
-            m["gps_seconds_of_week"] = Value::from(0.0);
-            for key in ["r_be_e_m", "v_be_e_m_s", "r_bn_n_m", "v_bn_n_m_s"] {
-                m[key] = serde_json::json!([0.0, 0.0, 0.0]);
-            }
-        },
-        |m| m["flags"].as_u64().unwrap() & 1 == 1,
-    );
+    let n = validity_off(&leo_gps_10_hz(), "gps_receivers.gps1", gps_no_fix, gps_fix);
     assert!(n >= 10, "{n} healthy GPS messages with a fix in the window");
 }
