@@ -497,8 +497,6 @@ fn a_repeating_fault_re_arms_at_each_activation() {
 /// never publish a position the receiver did not measure. The GPS acquires at 0.95 s (with the
 /// 0.2 s latency: messages with a fix from 1.2 s), inside the window [0.55, 1.55).
 #[test]
-#[ignore = "fails: src/faults/ports.rs marks the held values set on a GPS sample without a fix, \
-            so the later samples with a fix publish a position of [0, 0, 0] m (reported)"]
 fn stuck_current_on_gps_holds_the_first_position_of_the_activation() {
     let from = "acquisition_s = 0.0";
     assert!(scenario().contains(from));

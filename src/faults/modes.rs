@@ -3,7 +3,8 @@
 //! Sensor modes transform each selected axis `x` of a sample's output channel (the healthy
 //! value the sensor model produced) into the published value `y`; `t_on_s` is the time since the
 //! fault's current activation began (\[s\]), `x_on` the healthy value at the first sample of
-//! that activation:
+//! that activation that carries a measurement ([`crate::sensors::Sensor::is_valid`]: a GPS
+//! receiver's samples without a fix go out as measured until the first with one):
 //!
 //! | mode | parameters | y |
 //! |---|---|---|
@@ -32,7 +33,7 @@
 /// A fault mode with its parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FaultMode {
-    /// Sensor: held at the healthy value of the activation's first sample.
+    /// Sensor: held at the healthy value of the activation's first valid sample.
     StuckCurrent,
     /// Sensor: held at `value`.
     StuckValue {

@@ -378,6 +378,10 @@ impl Faults {
                 FaultMode::ValidityOff => bank.sensor_mut(sensor).force_invalid(),
                 _ => {
                     let s = bank.sensor_mut(sensor);
+                    if mode == FaultMode::StuckCurrent && !l.held_set && !s.is_valid() {
+                        // Nothing to hold yet (a GPS without a fix): published as it is.
+                        continue;
+                    }
                     let (first, end) = match channel {
                         Some(c) => (c, c + 1),
                         None => (0, s.fault_channels().len()),

@@ -169,6 +169,13 @@ pub trait Sensor: std::fmt::Debug + Send {
 
     /// Marks the last sample invalid (a `validity_off` fault).
     fn force_invalid(&mut self) {}
+
+    /// Whether the last sample carries a measurement: its validity flag set (a GPS fix, a valid
+    /// star-tracker attitude or sun-sensor angle pair); always, for a kind without one. A
+    /// `stuck_current` fault holds the first valid sample of its activation.
+    fn is_valid(&self) -> bool {
+        true
+    }
 }
 
 /// A figure panel of a sensor kind's plot: `(column, legend)` pairs of its message's columns.

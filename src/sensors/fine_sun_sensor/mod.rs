@@ -287,6 +287,10 @@ impl Sensor for FineSunSensor {
         true
     }
 
+    fn is_valid(&self) -> bool {
+        self.last.flags & fss_flags::VALID != 0
+    }
+
     /// Clears the `VALID` flag (the angles as measured).
     fn force_invalid(&mut self) {
         self.last.flags &= !fss_flags::VALID;

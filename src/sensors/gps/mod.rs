@@ -385,6 +385,10 @@ impl Sensor for Gps {
         true
     }
 
+    fn is_valid(&self) -> bool {
+        self.last.flags & gps_flags::FIX != 0
+    }
+
     /// The receiver reports no solution: `FIX` cleared and, as in any message without it,
     /// every number 0 (the valid time and the frame flags stay).
     fn force_invalid(&mut self) {

@@ -327,6 +327,10 @@ impl Sensor for StarTracker {
         true
     }
 
+    fn is_valid(&self) -> bool {
+        self.last.valid
+    }
+
     /// `valid = false` (the quaternion and the status flags as measured).
     fn force_invalid(&mut self) {
         self.last.valid = false;
