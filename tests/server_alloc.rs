@@ -256,7 +256,12 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
     });
     assert_eq!(violation_count(), 0, "the frame path allocated");
     let links = w.book.link_stats();
-    if w.book.links().faults().iter().any(|f| f.target == "links.2") {
+    if w.book
+        .links()
+        .faults()
+        .iter()
+        .any(|f| f.target == "links.2")
+    {
         // The corrupted window did damage commands, and some of them passed the checks.
         assert_eq!(links.commands_corrupted, 50, "{links:?}");
         assert!(links.corrupted_rejected < 50, "{links:?}");
