@@ -135,7 +135,7 @@ period_s = 0.2
 "
     );
     let cfg = SimConfig::from_toml_str(&text).unwrap();
-    let resolver = flexdyn::faults::live::LiveResolver::new(&cfg).unwrap();
+    let resolver = cfg.live_fault_resolver().unwrap();
     let cmd = |action, at_tick, target: &str, mode, params, index| FaultCommandMsg {
         header: Header::new(1, 0, 0, 0),
         action,

@@ -52,7 +52,7 @@ pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config:
         *k += 1;
     }
     // The sensors as built, each kind's entries counted in file order.
-    let bank = crate::sensors::SensorBank::new(cfg, cfg.frame_ns as f64 * 1e-9, 0, x)?;
+    let bank = cfg.frame_sensor_bank(x)?;
     let mut per_array: BTreeMap<&str, usize> = BTreeMap::new();
     for s in bank.sensors() {
         let section = s.kind().config_array;

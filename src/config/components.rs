@@ -68,3 +68,44 @@ pub(super) fn wire_bytes(components: &Components) -> usize {
         })
         .sum()
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::config::SimConfig;
+    use crate::dynamics::kinds;
+
+    /// The effector registry's wire names agree with what each effector built from a
+    /// configuration says of itself (a test of the configuration, which builds them).
+    #[test]
+    fn wire_names_match_what_each_built_effector_says() {
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/acs_full.toml"
+        ))
+        .unwrap();
+        let sc = SimConfig::from_toml_str(&text)
+            .unwrap()
+            .build_spacecraft()
+            .unwrap();
+        assert!(sc.effector_count() >= 3);
+        let mut kinds = std::collections::BTreeSet::new();
+        for e in sc.effector_entries() {
+            let (kind, states, outputs) =
+                kinds::wire_names(e.kind.wire_tag, e.state_names.len(), e.output_names.len())
+                    .unwrap();
+            assert_eq!(kind, e.kind);
+            assert_eq!(states, e.state_names);
+            assert_eq!(outputs, e.output_names);
+            kinds.insert(kind.name);
+        }
+        // Every registered kind is in acs_full, bodies and actuators.
+        let registered: std::collections::BTreeSet<_> =
+            kinds::KINDS.iter().map(|k| k.effector.name).collect();
+        assert_eq!(kinds, registered);
+        assert!(kinds::wire_names(999, 1, 0).is_none());
+        assert!(
+            kinds::wire_names(crate::dynamics::effectors::panel_pair::KIND.wire_tag, 3, 0)
+                .is_none()
+        );
+    }
+}

@@ -20,11 +20,10 @@
 //! `scenarios/reference.toml`. The README's "Configuration" section documents every key.
 
 mod components;
-mod error;
+mod faults;
 mod file;
 mod schedule;
 mod sensors;
-pub(crate) mod source_map;
 mod warnings;
 mod world;
 
@@ -35,13 +34,16 @@ use toml::de::DeTable;
 
 pub use crate::dynamics::component::Components;
 use crate::numfmt::{Num, Rounded};
+use crate::schema::checks::{every_frames, round_ns, unique_name};
+pub use crate::schema::checks::{whole_ns, WHOLE_NS_TOL};
+pub use crate::schema::config_error::ConfigError;
 use crate::schema::location;
+pub(crate) use crate::schema::source_map::SourceMap;
 use crate::schema::{mat3, vec3, TableReader};
-pub use error::{At, ConfigError, Location};
+pub use crate::schema::{At, Location};
 pub use file::{config_message, load_config};
 use flexdyn_proto::MAX_PANEL_PAIRS;
 pub use schedule::EffectorInputSegment;
-pub(crate) use source_map::SourceMap;
 pub use warnings::{log_warnings, warning_message, ConfigWarning};
 
 use crate::dynamics::component::{BuiltComponent, StepTiming};
@@ -57,13 +59,10 @@ use crate::sensors::imu::ImuConfig;
 use crate::sensors::magnetometer::MagnetometerConfig;
 pub use crate::sensors::params::SensorConfigs;
 use crate::sensors::star_tracker::StarTrackerConfig;
-pub(crate) use sensors::SensorContext;
+use crate::sensors::{SensorBank, SensorBuild};
 
 /// The built-in default configuration (the text of `scenarios/reference.toml`).
 pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../scenarios/reference.toml");
-
-/// Largest allowed distance of `seconds · 1e9` from a whole number of nanoseconds.
-pub const WHOLE_NS_TOL: f64 = 1e-6;
 
 /// A validated simulation configuration.
 #[derive(Debug, Clone, PartialEq)]
@@ -174,6 +173,31 @@ impl SimConfig {
                 .map(|(p, _)| p.panel1.mass_kg + p.panel2.mass_kg)
                 .sum::<f64>()
             + self.reaction_wheels.iter().map(|w| w.mass_kg).sum::<f64>()
+    }
+
+    /// What the vehicle's sensors are built from ([`SensorBank::new`]): their parameters, the
+    /// frame period and the epoch of this configuration, with a nominal sample interval of
+    /// `sample_interval_s` \[s\] and the first interval starting at `t_sim_ns` in state `x`.
+    pub fn sensor_build<'a>(
+        &'a self,
+        sample_interval_s: f64,
+        t_sim_ns: u64,
+        x: &'a crate::dynamics::State,
+    ) -> SensorBuild<'a> {
+        SensorBuild {
+            sensors: &self.sensors,
+            frame_ns: self.frame_ns,
+            epoch: self.epoch.as_ref(),
+            sample_interval_s,
+            t_sim_ns,
+            x,
+        }
+    }
+
+    /// The sensor bank of this configuration at t = 0 in state `x`, sampled at the frame period:
+    /// what `[[faults]]` targets and live faults are checked against.
+    pub fn frame_sensor_bank(&self, x: &crate::dynamics::State) -> Result<SensorBank, ConfigError> {
+        SensorBank::new(&self.sensor_build(self.frame_ns as f64 * 1e-9, 0, x))
     }
 
     /// Builds the spacecraft: one [`PanelPair`] per configured pair (errors name
@@ -311,23 +335,6 @@ pub fn config_summary(cfg: &SimConfig) -> String {
             n => format!(", {n} effector input schedule rows"),
         },
     )
-}
-
-/// Converts seconds to a whole number of nanoseconds: `None` unless `seconds` is finite, ≥ 0,
-/// representable in `u64` nanoseconds and within [`WHOLE_NS_TOL`] (or 4 ulp of the product for
-/// long durations) of a whole number.
-pub fn whole_ns(seconds: f64) -> Option<u64> {
-    round_ns(seconds * 1e9)
-}
-
-/// `ns` as a whole number of nanoseconds, with the tolerance of [`whole_ns`].
-fn round_ns(ns: f64) -> Option<u64> {
-    if !ns.is_finite() || ns < 0.0 || ns >= u64::MAX as f64 {
-        return None;
-    }
-    let rounded = ns.round();
-    let tol = WHOLE_NS_TOL.max(ns * 4.0 * f64::EPSILON);
-    ((ns - rounded).abs() <= tol).then_some(rounded as u64)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -721,62 +728,9 @@ impl RawConfig {
             schedule::resolve(&self.effector_input_schedule, &sc, step_ns, map)?;
         check_gravity_bound(&cfg, &sc, map)?;
         check_initial_outputs_finite(&cfg, &mut sc, map)?;
-        cfg.faults = crate::faults::targets::resolve(&self.faults, &cfg, &sc, map)?;
+        cfg.faults = self::faults::resolve(&self.faults, &cfg, &sc, map)?;
         Ok(cfg)
     }
-}
-
-/// `frame_hz / rate_hz` as a whole number of frames ≥ 1 (`rate_hz` read from `field`): a
-/// sensor that updates at `rate_hz` does so every that many frames (`what` updates …).
-fn every_frames(
-    map: &SourceMap,
-    field: &str,
-    rate_hz: f64,
-    frame_hz: f64,
-    what: &str,
-) -> Result<u64, ConfigError> {
-    let field = field.to_string();
-    if !rate_hz.is_finite() || rate_hz <= 0.0 {
-        return Err(map.param_error(ParamError::NotPositive {
-            field,
-            value: rate_hz,
-        }));
-    }
-    let ratio = frame_hz / rate_hz;
-    let every_frames = ratio.round();
-    if every_frames < 1.0 || (ratio - every_frames).abs() > 1e-9 * ratio {
-        return Err(map.invalid(
-            &field,
-            format!(
-                "{} Hz is not the frame rate ({} Hz) divided by a whole number: the {what} \
-                 updates every whole number of frames",
-                Num(rate_hz),
-                Num(frame_hz)
-            ),
-        ));
-    }
-    Ok(every_frames as u64)
-}
-
-/// Checks that `<path>.name` is not blank and not already in `seen` (then adds it).
-fn unique_name(
-    map: &SourceMap,
-    path: &str,
-    name: &str,
-    seen: &mut HashSet<String>,
-    what: &str,
-) -> Result<(), ConfigError> {
-    let field = format!("{path}.name");
-    if name.trim().is_empty() {
-        return Err(map.invalid(&field, "must not be empty".into()));
-    }
-    if !seen.insert(name.to_string()) {
-        return Err(map.invalid(
-            &field,
-            format!("duplicate {what} name `{name}` (names must be unique)"),
-        ));
-    }
-    Ok(())
 }
 
 /// Checks that every effector fits one StateMsg: at most [`flexdyn_proto::MAX_EFFECTORS`]
@@ -1382,16 +1336,5 @@ mod tests {
         assert_eq!(cfg.source_toml, DEFAULT_CONFIG_TOML);
         assert_eq!(SimConfig::reference(), cfg);
         cfg.build_spacecraft().expect("reference spacecraft builds");
-    }
-
-    #[test]
-    fn whole_ns_tolerance() {
-        assert_eq!(whole_ns(0.001), Some(1_000_000));
-        assert_eq!(whole_ns(1e-9), Some(1));
-        assert_eq!(whole_ns(0.01), Some(10_000_000));
-        assert_eq!(whole_ns(1.5e-9), None);
-        assert_eq!(whole_ns(-1.0), None);
-        assert_eq!(whole_ns(f64::NAN), None);
-        assert_eq!(whole_ns(86_400.0 * 365.0), Some(31_536_000_000_000_000));
     }
 }

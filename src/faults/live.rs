@@ -8,19 +8,20 @@
 use flexdyn_proto::{FaultAction, FaultCommandMsg};
 
 use super::modes::MODES;
-use super::ports::{Live, LiveRequest, RequestKind};
+use super::ports::{FaultHost, Live, LiveRequest, RequestKind};
 use super::schema::RawFault;
-use crate::config::source_map::SourceMap;
-use crate::config::{ConfigError, SimConfig};
+use crate::dynamics::effectors::reaction_wheel::ReactionWheelParams;
 use crate::dynamics::Spacecraft;
+use crate::schema::source_map::SourceMap;
 use crate::sensors::SensorBank;
 
-/// What a live fault is checked against: the configuration, a spacecraft built from it and its
-/// sensors (built once, when the server starts).
+/// What a live fault is checked against: the vehicle's spacecraft and its sensors (built once,
+/// when the server starts), its frame period and its wheels' parameters.
 pub struct LiveResolver {
-    cfg: SimConfig,
     sc: Spacecraft,
     bank: SensorBank,
+    frame_ns: u64,
+    reaction_wheels: Vec<ReactionWheelParams>,
 }
 
 impl std::fmt::Debug for LiveResolver {
@@ -30,15 +31,20 @@ impl std::fmt::Debug for LiveResolver {
 }
 
 impl LiveResolver {
-    /// A resolver for the vehicle of `cfg`.
-    pub fn new(cfg: &SimConfig) -> Result<Self, ConfigError> {
-        let sc = cfg.build_spacecraft()?;
-        let bank = SensorBank::new(cfg, cfg.frame_ns as f64 * 1e-9, 0, sc.state())?;
-        Ok(Self {
-            cfg: cfg.clone(),
+    /// A resolver for the vehicle with spacecraft `sc`, sensors `bank`, frame period
+    /// `frame_ns` and wheels `reaction_wheels` (configuration order).
+    pub fn new(
+        sc: Spacecraft,
+        bank: SensorBank,
+        frame_ns: u64,
+        reaction_wheels: Vec<ReactionWheelParams>,
+    ) -> Self {
+        Self {
             sc,
             bank,
-        })
+            frame_ns,
+            reaction_wheels,
+        }
     }
 
     /// The request `cmd` asks for, or why it cannot be applied (the problem, naming the
@@ -106,7 +112,12 @@ impl LiveResolver {
         }
         spec.window.duration_ns = (cmd.duration_ns != 0).then_some(cmd.duration_ns);
         spec.source = flexdyn_proto::FaultSource::Live;
-        let live = Live::new(spec, &self.cfg, &self.sc).map_err(|e| e.to_string())?;
+        let host = FaultHost {
+            sc: &self.sc,
+            frame_ns: self.frame_ns,
+            reaction_wheels: &self.reaction_wheels,
+        };
+        let live = Live::new(spec, &host).map_err(|e| e.to_string())?;
         Ok(LiveRequest {
             kind: RequestKind::Inject(Box::new(live)),
             at_tick: cmd.at_tick,

@@ -28,11 +28,23 @@ use flexdyn_proto::{FaultEventMsg, FaultTarget, Header, AT_NEXT_TICK};
 
 use super::modes::{sensor_value, Draws, FaultMode};
 use super::{FaultSpec, Port, MAX_AXES, MAX_CHANNELS, MAX_LIVE_FAULTS};
-use crate::config::{ConfigError, SimConfig};
-use crate::dynamics::effectors::reaction_wheel::ReactionWheel;
+use crate::dynamics::effectors::reaction_wheel::{ReactionWheel, ReactionWheelParams};
 use crate::dynamics::{Spacecraft, State};
+use crate::schema::config_error::ConfigError;
 use crate::sensors::rng::NormalRng;
 use crate::sensors::SensorBank;
+
+/// The vehicle a fault sits on: what an actuator fault needs of it.
+#[derive(Debug, Clone, Copy)]
+pub struct FaultHost<'a> {
+    /// The spacecraft (its effector list and step).
+    pub sc: &'a Spacecraft,
+    /// \[ns\] the frame period (a thruster's full-open on-time, the fault events' boundaries).
+    pub frame_ns: u64,
+    /// The reaction wheels' parameters, in configuration order (a wheel fault's friction law
+    /// and J_s).
+    pub reaction_wheels: &'a [ReactionWheelParams],
+}
 
 /// What an actuator fault needs of its effector.
 #[derive(Debug, Clone)]
@@ -160,16 +172,12 @@ pub struct Faults {
 }
 
 impl Live {
-    /// A fault of `spec` on the spacecraft `sc` built from `cfg`.
-    pub(super) fn new(
-        spec: FaultSpec,
-        cfg: &SimConfig,
-        sc: &Spacecraft,
-    ) -> Result<Self, ConfigError> {
+    /// A fault of `spec` on the vehicle `host`.
+    pub(super) fn new(spec: FaultSpec, host: &FaultHost<'_>) -> Result<Self, ConfigError> {
         let actuator = match spec.port {
             // A link fault is applied by the server's command book (`super::link`).
             Port::Sensor { .. } | Port::Link { .. } => None,
-            Port::Actuator { effector } => Some(actuator(cfg, sc, effector)?),
+            Port::Actuator { effector } => Some(actuator(host, effector)?),
         };
         Ok(Live {
             rng: NormalRng::new(spec.seed),
@@ -186,16 +194,16 @@ impl Live {
 }
 
 impl Faults {
-    /// The faults of `cfg` (resolved at load) for the spacecraft `sc` built from it.
-    pub fn new(cfg: &SimConfig, sc: &Spacecraft) -> Result<Self, ConfigError> {
-        let mut live = Vec::with_capacity(cfg.faults.len());
-        for spec in &cfg.faults {
-            live.push(Live::new(spec.clone(), cfg, sc)?);
+    /// The faults `specs` (resolved at load) on the vehicle `host`.
+    pub fn new(specs: &[FaultSpec], host: &FaultHost<'_>) -> Result<Self, ConfigError> {
+        let mut live = Vec::with_capacity(specs.len());
+        for spec in specs {
+            live.push(Live::new(spec.clone(), host)?);
         }
         Ok(Self {
             any_actuator: live.iter().any(|l| l.actuator.is_some()),
             configured: live.len(),
-            frame_ns: cfg.frame_ns,
+            frame_ns: host.frame_ns,
             live,
             ..Self::default()
         })
@@ -514,11 +522,8 @@ fn actuator_input(mode: &FaultMode, actuator: &Actuator, x: &State, u: f64) -> f
 }
 
 /// What a fault on effector `effector` needs (its kind was checked at load).
-fn actuator(
-    cfg: &SimConfig,
-    sc: &Spacecraft,
-    effector: usize,
-) -> Result<(usize, Actuator), ConfigError> {
+fn actuator(host: &FaultHost<'_>, effector: usize) -> Result<(usize, Actuator), ConfigError> {
+    let sc = host.sc;
     use crate::dynamics::dynamic_effectors::{magnetorquer, thruster};
     use crate::dynamics::effectors::reaction_wheel;
     let input = sc.effector_input_ranges()[effector].start;
@@ -540,14 +545,14 @@ fn actuator(
             .count();
         let path = format!("reaction_wheels[{w}]");
         Actuator::Wheel {
-            wheel: Box::new(ReactionWheel::new(cfg.reaction_wheels[w].clone(), &path)?),
+            wheel: Box::new(ReactionWheel::new(host.reaction_wheels[w].clone(), &path)?),
             omega_index: entry.state_range.start,
             step_s: sc.step_ns() as f64 * 1e-9,
         }
     } else if kind == thruster::KIND {
         Actuator::Thruster {
             full_open: if entry.input_names == thruster::ON_TIME_INPUT {
-                cfg.frame_ns as f64 * 1e-9
+                host.frame_ns as f64 * 1e-9
             } else {
                 1.0
             },

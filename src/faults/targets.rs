@@ -4,62 +4,22 @@
 //! nanoseconds. Every error names the entry's field; nothing is silently ignored. A command
 //! link (`links.<sender id>`) must be one of the file's `server.participants` (default `[1]`);
 //! the server checks again against its final participants (command-line overrides included).
+//! The configuration (`crate::config`) calls [`resolve_one`] for each entry with the vehicle it
+//! built.
 
 use super::modes::{FaultMode, LINK_MODES, MODES, SENSOR_MODES, VALUE_MODES};
 use super::schema::RawFault;
 use super::window::FaultWindow;
 use super::{FaultSpec, Port, MAX_AXES};
-use crate::config::source_map::SourceMap;
-use crate::config::{whole_ns, ConfigError, SimConfig};
 use crate::dynamics::Spacecraft;
+use crate::schema::checks::whole_ns;
+use crate::schema::config_error::ConfigError;
+use crate::schema::source_map::SourceMap;
 use crate::sensors::{SensorBank, KINDS as SENSOR_KINDS};
 
-/// Resolves every entry against `cfg`'s sensors and the spacecraft `sc` built from it.
-pub(crate) fn resolve(
-    raw: &[RawFault],
-    cfg: &SimConfig,
-    sc: &Spacecraft,
-    map: &SourceMap,
-) -> Result<Vec<FaultSpec>, ConfigError> {
-    if raw.is_empty() {
-        return Ok(Vec::new());
-    }
-    let bank = SensorBank::new(cfg, cfg.frame_ns as f64 * 1e-9, 0, sc.state())?;
-    let participants = file_participants(&cfg.server);
-    raw.iter()
-        .enumerate()
-        .map(|(i, r)| {
-            let spec = resolve_one(i, r, &bank, sc, participants.as_deref(), map)?;
-            match spec.window.period_ns {
-                // The stepping looks at a fault once per step: a shorter period would alias.
-                Some(p) if p < cfg.step_ns => Err(map.invalid(
-                    &format!("{}.period_s", r.path),
-                    format!(
-                        "must be at least the integration step ({} ns), got {p} ns: the \
-                         stepping looks at a fault once per step",
-                        cfg.step_ns
-                    ),
-                )),
-                _ => Ok(spec),
-            }
-        })
-        .collect()
-}
-
-/// `server.participants` as the file gives it (the server's default `[1]` when absent); `None`
-/// if it is not a list of sender ids (the server's own schema reports that).
-fn file_participants(server: &toml::Table) -> Option<Vec<u32>> {
-    match server.get("participants") {
-        None => Some(vec![1]),
-        Some(toml::Value::Array(ids)) => ids
-            .iter()
-            .map(|v| v.as_integer().and_then(|i| u32::try_from(i).ok()))
-            .collect(),
-        Some(_) => None,
-    }
-}
-
-pub(super) fn resolve_one(
+/// Resolves entry `index` (`r`) against the sensors `bank` and the spacecraft `sc`; a command
+/// link must be one of `participants` (any, if `None`).
+pub(crate) fn resolve_one(
     index: usize,
     r: &RawFault,
     bank: &SensorBank,

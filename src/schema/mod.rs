@@ -1,15 +1,20 @@
 //! The typed TOML reader every configuration schema uses, and its error type.
 //!
-//! A leaf module (it imports nothing else of this crate but [`crate::numfmt`]), so a model's schema
-//! can live beside the model (`src/dynamics/effectors/<kind>/schema.rs`,
-//! `src/sensors/<kind>/schema.rs`) without an import cycle through [`crate::config`], which
-//! assembles the schemas and validates the whole document.
+//! A leaf module (it imports nothing else of this crate but [`crate::numfmt`] and
+//! [`crate::validate`]), so a model's schema can live beside the model
+//! (`src/dynamics/effectors/<kind>/schema.rs`, `src/sensors/<kind>/schema.rs`) and report a
+//! located [`config_error::ConfigError`] without an import cycle through [`crate::config`],
+//! which assembles the schemas and validates the whole document. The [`source_map`] locates a
+//! TOML path in the text, and [`checks`] holds the checks every schema shares.
 
 use std::fmt;
 
+pub mod checks;
+pub mod config_error;
 pub mod kind_list;
 pub(crate) mod plausible;
 pub(crate) mod reader;
+pub(crate) mod source_map;
 
 pub(crate) use reader::TableReader;
 

@@ -1,11 +1,11 @@
 //! The sensors of one spacecraft, in registry order ([`super::KINDS`]) then config order: built
-//! from the configuration through each kind's [`super::SensorKind::build`], sampled together
+//! from a [`SensorBuild`] through each kind's [`super::SensorKind::build`], sampled together
 //! from one [`Truth`], and the integrator's stage hook for those that integrate over the stages.
 
-use super::{Sensor, Truth, KINDS};
-use crate::config::{ConfigError, SimConfig};
+use super::{Sensor, SensorBuild, Truth, KINDS};
 use crate::dynamics::stage_hook::{StageCombine, StageHook};
 use crate::dynamics::{HubOutputs, State};
+use crate::schema::config_error::ConfigError;
 
 /// The sensors and which of them the last [`Self::sample`] sampled.
 #[derive(Debug)]
@@ -18,17 +18,11 @@ pub struct SensorBank {
 }
 
 impl SensorBank {
-    /// Every registered kind's sensors of `cfg`, with a nominal sample interval of
-    /// `sample_interval_s`, their first interval starting at `t_sim_ns` and state `x`.
-    pub fn new(
-        cfg: &SimConfig,
-        sample_interval_s: f64,
-        t_sim_ns: u64,
-        x: &State,
-    ) -> Result<Self, ConfigError> {
+    /// Every registered kind's sensors of `ctx` ([`SensorBuild`]).
+    pub fn new(ctx: &SensorBuild<'_>) -> Result<Self, ConfigError> {
         let mut sensors = Vec::new();
         for kind in KINDS {
-            (kind.build)(cfg, sample_interval_s, t_sim_ns, x, &mut sensors)?;
+            (kind.build)(ctx, &mut sensors)?;
         }
         let staged = (0..sensors.len())
             .filter(|&i| sensors[i].uses_stages())

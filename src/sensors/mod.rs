@@ -22,10 +22,11 @@ use std::any::Any;
 use flexdyn_proto::keys::Topics;
 use flexdyn_proto::{DecodeError, Header, KeyError};
 
-use crate::config::{ConfigError, SimConfig};
 use crate::dynamics::stage_hook::StageCombine;
 use crate::dynamics::{DynamicEffector, HubOutputs, State};
+use crate::environment::epoch::SimEpoch;
 use crate::environment::EnvironmentSample;
+use crate::schema::config_error::ConfigError;
 
 pub mod bank;
 pub mod coarse_sun_sensor;
@@ -187,15 +188,28 @@ pub struct PanelSpec {
     pub lines: &'static [(&'static str, &'static str)],
 }
 
-/// Builds a kind's sensors of `cfg` (config order) into `out`, with a nominal sample interval
-/// of `sample_interval_s` \[s\], their first interval starting at `t_sim_ns` and state `x`.
-pub type BuildFn = fn(
-    cfg: &SimConfig,
-    sample_interval_s: f64,
-    t_sim_ns: u64,
-    x: &State,
-    out: &mut Vec<Box<dyn Sensor>>,
-) -> Result<(), ConfigError>;
+/// What a vehicle's sensors are built from: their validated parameters and the little of the
+/// vehicle they depend on. Never the whole configuration, so that the sensors sit below it.
+#[derive(Debug, Clone, Copy)]
+pub struct SensorBuild<'a> {
+    /// Every configured sensor's parameters (registry order, then file order).
+    pub sensors: &'a params::SensorConfigs,
+    /// \[ns\] the frame period (a GPS receiver's latency ring counts frames).
+    pub frame_ns: u64,
+    /// The `[epoch]` (t = 0), if any (a GPS receiver's week and time of week).
+    pub epoch: Option<&'a SimEpoch>,
+    /// \[s\] the nominal sample interval (finite, > 0) of a sensor whose noise depends on it.
+    pub sample_interval_s: f64,
+    /// \[ns\] where the first integration interval starts.
+    pub t_sim_ns: u64,
+    /// The state at `t_sim_ns`.
+    pub x: &'a State,
+}
+
+/// Builds a kind's sensors of `ctx.sensors` (config order) into `out`; errors name the entry's
+/// field (`imus[0]…`).
+pub type BuildFn =
+    fn(ctx: &SensorBuild<'_>, out: &mut Vec<Box<dyn Sensor>>) -> Result<(), ConfigError>;
 
 /// Decodes a kind's payload into its header and its JSON.
 pub type DecodeFn = fn(&[u8]) -> Result<(Header, serde_json::Value), DecodeError>;
@@ -220,7 +234,7 @@ pub struct SensorKind {
     pub message_name: &'static str,
     /// Its key for spacecraft `topics` and a sensor name (validates the name).
     pub key: fn(&Topics, &str) -> Result<String, KeyError>,
-    /// Builds the kind's sensors of a configuration.
+    /// Builds the kind's sensors of a vehicle.
     pub build: BuildFn,
     /// Decodes a payload into its header and its JSON (fields named as in the wire struct).
     pub decode: DecodeFn,
@@ -246,115 +260,4 @@ pub fn json_of<M: serde::Serialize>(header: Header, msg: &M) -> (Header, serde_j
         // Wire structs hold only numbers, bools and arrays: always representable.
         serde_json::to_value(msg).unwrap_or(serde_json::Value::Null),
     )
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::sim::Simulation;
-    use crate::sinks::topics::{classify, Decoded, TopicKind};
-
-    /// Every registered kind round-trips through the generic paths: its key classifies back to
-    /// it, its sensors sit in registry then config order, and what a sensor encodes its kind
-    /// decodes, with the frame's header (a star tracker's `seq` counting its updates).
-    #[test]
-    fn every_kind_round_trips_through_key_bank_and_codec() {
-        // Between them, these scenarios have every kind.
-        let mut seen = vec![false; KINDS.len()];
-        for scenario in ["wheels_star_tracker", "leo_environment"] {
-            round_trip(scenario, &mut seen);
-        }
-        assert!(seen.iter().all(|&s| s), "{seen:?}");
-    }
-
-    fn round_trip(scenario: &str, seen: &mut [bool]) {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join(format!("scenarios/{scenario}.toml"));
-        let cfg = SimConfig::from_file(&path).unwrap();
-        let mut sim = Simulation::new(&cfg).unwrap();
-        // Tick 20: every 10 Hz sensor is due at it (100 Hz frames), and the 1 Hz GPS receiver
-        // with 0.2 s latency publishes there what it measured at tick 0.
-        let tick: u64 = 20;
-        for k in 0..tick {
-            sim.sample_sensors(|s| s.due(k));
-            sim.step_frame();
-        }
-        sim.sample_sensors(|_| true);
-        let topics = Topics::new("sc1").unwrap();
-        let bank = sim.sensors();
-        assert_eq!(bank.sampled().len(), bank.len());
-        let kinds: Vec<usize> = bank
-            .sensors()
-            .iter()
-            .map(|s| s.kind().index().unwrap())
-            .collect();
-        assert!(kinds.windows(2).all(|w| w[0] <= w[1]), "{kinds:?}");
-        for &k in &kinds {
-            seen[k] = true;
-        }
-        let mut buf = Vec::new();
-        for s in bank.sensors() {
-            let kind = s.kind();
-            let key = (kind.key)(&topics, s.name()).unwrap();
-            assert_eq!(key, format!("flexdyn/sc1/{}/{}", kind.key_prefix, s.name()));
-            assert!(kind
-                .key_prefix
-                .ends_with(&format!("/{}", kind.column_prefix)));
-            let topic = classify(&key).unwrap();
-            assert_eq!(topic.kind, TopicKind::sensor(kind).unwrap());
-            assert_eq!(topic.kind.message_name(), kind.message_name);
-            let header = Header::new(1, tick, sim.t_sim_ns(), tick);
-            s.encode(header, &mut buf);
-            let Decoded::Sensor {
-                header: h, json, ..
-            } = Decoded::decode(topic.kind, &buf).unwrap()
-            else {
-                panic!("{key} did not decode as a sensor");
-            };
-            assert_eq!((h.tick, h.sim_time_ns), (tick, sim.t_sim_ns()));
-            let every = |e: Option<u64>| e.unwrap();
-            let s = &cfg.sensors;
-            let seq = match kind.noun {
-                "star tracker" => {
-                    tick / every(
-                        s.of::<star_tracker::StarTrackerConfig>()
-                            .next()
-                            .map(|c| c.every_frames),
-                    )
-                }
-                "magnetometer" => {
-                    tick / every(
-                        s.of::<magnetometer::MagnetometerConfig>()
-                            .next()
-                            .map(|c| c.every_frames),
-                    )
-                }
-                "coarse sun sensor" => {
-                    tick / every(
-                        s.of::<coarse_sun_sensor::CoarseSunSensorConfig>()
-                            .next()
-                            .map(|c| c.every_frames),
-                    )
-                }
-                "GPS receiver" => {
-                    let g = s.of::<gps::GpsConfig>().next().unwrap();
-                    (tick - g.latency_frames) / g.every_frames
-                }
-                "fine sun sensor" => {
-                    tick / every(
-                        s.of::<fine_sun_sensor::FineSunSensorConfig>()
-                            .next()
-                            .map(|c| c.every_frames),
-                    )
-                }
-                _ => tick,
-            };
-            assert_eq!(h.seq, seq, "{key}");
-            // Every field of the message, as the kind's default JSON names them.
-            let fields = |v: &serde_json::Value| -> Vec<String> {
-                v.as_object().unwrap().keys().cloned().collect()
-            };
-            assert_eq!(fields(&json), fields(&(kind.default_json)()), "{key}");
-        }
-    }
 }

@@ -8,13 +8,18 @@
 //! This mirrors the effectors' [`crate::dynamics::component`] contract.
 
 use std::any::Any;
+use std::collections::HashSet;
 use std::fmt::Debug;
 
+use super::imu::ImuParamError;
 use super::SensorKind;
-use crate::config::{ConfigError, SensorContext};
+use crate::schema::checks::{every_frames, unique_name};
+use crate::schema::config_error::ConfigError;
 use crate::schema::kind_list::{list_entry, KindList};
 use crate::schema::plausible::Implausible;
+use crate::schema::source_map::SourceMap;
 use crate::schema::{SchemaError, TableReader};
+use crate::validate::ParamError;
 
 /// How one `[[<config array>]]` entry of a kind is read (pass 2: shape only) and resolved
 /// (pass 4: values, names, rates).
@@ -102,3 +107,81 @@ impl<P: SensorParams> SensorSpec for P {
 pub type SensorConfigs = KindList<dyn SensorSpec>;
 
 list_entry!(dyn SensorSpec, SensorKind, config_array);
+
+/// What a kind's resolver may ask of the configuration: the frame rate, the document's
+/// positions for errors, and the names already taken within the kind.
+pub(crate) struct SensorContext<'a> {
+    map: &'a SourceMap<'a>,
+    /// \[Hz\] the frame rate.
+    pub(crate) frame_hz: f64,
+    names: HashSet<String>,
+}
+
+impl<'a> SensorContext<'a> {
+    /// A context for one kind's entries of the document mapped by `map`, at `frame_hz`.
+    pub(crate) fn new(map: &'a SourceMap<'a>, frame_hz: f64) -> Self {
+        Self {
+            map,
+            frame_hz,
+            names: HashSet::new(),
+        }
+    }
+
+    /// Checks that `<path>.name` is not blank and not taken by another sensor of the kind
+    /// (`what` names the kind in the message).
+    pub(crate) fn unique_name(
+        &mut self,
+        path: &str,
+        name: &str,
+        what: &str,
+    ) -> Result<(), ConfigError> {
+        unique_name(self.map, path, name, &mut self.names, what)
+    }
+
+    /// `frame_hz / rate_hz` as a whole number of frames ≥ 1, `rate_hz` read from `field`
+    /// (`what` updates every whole number of frames).
+    pub(crate) fn every_frames(
+        &self,
+        field: &str,
+        rate_hz: f64,
+        what: &str,
+    ) -> Result<u64, ConfigError> {
+        every_frames(self.map, field, rate_hz, self.frame_hz, what)
+    }
+
+    /// A value error, located.
+    pub(crate) fn param(&self, e: ParamError) -> ConfigError {
+        self.map.param_error(e)
+    }
+
+    /// An IMU value error, located: an absent key (e.g. a missing time constant) points at
+    /// its table.
+    pub(crate) fn imu_error(&self, e: ImuParamError) -> ConfigError {
+        match e {
+            ImuParamError::Param(p) => self.map.param_error(p),
+            ImuParamError::Invalid { field, problem } => {
+                let mut at = self.map.at(&field);
+                let mut parent = field.as_str();
+                while at.0.is_none() {
+                    match parent.rfind('.') {
+                        Some(i) => parent = &parent[..i],
+                        None => break,
+                    }
+                    at = self.map.at(parent);
+                }
+                ConfigError::Invalid { field, problem, at }
+            }
+        }
+    }
+
+    /// `field` is invalid because of `problem`, located.
+    pub(crate) fn invalid(&self, field: &str, problem: String) -> ConfigError {
+        self.map.invalid(field, problem)
+    }
+
+    /// Checks that `<path>.name` may be a key segment.
+    pub(crate) fn sensor_name(&self, path: &str, name: &str) -> Result<(), ConfigError> {
+        flexdyn_proto::validate_sensor_name(name)
+            .map_err(|e| self.invalid(&format!("{path}.name"), e.to_string()))
+    }
+}

@@ -149,7 +149,8 @@ pub async fn run(
     .await?;
 
     // zenoh rx: live faults (resolved there, installed by whoever steps the frames).
-    let resolver = crate::faults::live::LiveResolver::new(&cfg)
+    let resolver = cfg
+        .live_fault_resolver()
         .map_err(|source| ServerError::Config { file: None, source })?;
     let _faults = fault_cmd::declare(
         &session,

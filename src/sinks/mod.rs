@@ -19,6 +19,8 @@ pub mod error;
 pub mod export;
 pub mod fault_spans;
 pub mod gaps;
+#[cfg(test)]
+mod kind_round_trip;
 pub mod mcap_file;
 pub mod plot;
 pub mod prior_faults;

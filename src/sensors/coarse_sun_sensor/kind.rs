@@ -6,10 +6,9 @@ use flexdyn_proto::keys::CSS_PREFIX;
 use flexdyn_proto::{decode_css, CssMsg};
 
 use super::{schema, CoarseSunSensor, CoarseSunSensorConfig};
-use crate::config::{ConfigError, SimConfig};
-use crate::dynamics::State;
+use crate::schema::config_error::ConfigError;
 use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
-use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
+use crate::sensors::{json_of, PanelSpec, Sensor, SensorBuild, SensorKind};
 
 /// The coarse-sun-sensor array kind.
 pub static KIND: SensorKind = SensorKind {
@@ -64,14 +63,8 @@ pub static KIND: SensorKind = SensorKind {
 
 /// One [`CoarseSunSensor`] per `[[coarse_sun_sensors]]` entry (errors name
 /// `coarse_sun_sensors[i]…`).
-fn build(
-    cfg: &SimConfig,
-    _sample_interval_s: f64,
-    _t_sim_ns: u64,
-    _x: &State,
-    out: &mut Vec<Box<dyn Sensor>>,
-) -> Result<(), ConfigError> {
-    for (i, c) in cfg.sensors.of::<CoarseSunSensorConfig>().enumerate() {
+fn build(ctx: &SensorBuild<'_>, out: &mut Vec<Box<dyn Sensor>>) -> Result<(), ConfigError> {
+    for (i, c) in ctx.sensors.of::<CoarseSunSensorConfig>().enumerate() {
         let path = format!("coarse_sun_sensors[{i}]");
         out.push(Box::new(CoarseSunSensor::new(c.clone(), &path)?));
     }

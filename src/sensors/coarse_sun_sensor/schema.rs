@@ -3,8 +3,9 @@
 //! configuration (the rate must divide the frame rate).
 
 use super::CoarseSunSensorConfig;
-use crate::config::{ConfigError, SensorContext};
+use crate::schema::config_error::ConfigError;
 use crate::schema::{vec3, SchemaError, TableReader};
+use crate::sensors::params::SensorContext;
 use crate::sensors::params::{RawSensorConfig, SensorSpec};
 use nalgebra::Vector3;
 

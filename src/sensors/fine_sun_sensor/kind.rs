@@ -6,10 +6,9 @@ use flexdyn_proto::keys::FSS_PREFIX;
 use flexdyn_proto::{decode_fss, FssMsg};
 
 use super::{schema, FineSunSensor, FineSunSensorConfig};
-use crate::config::{ConfigError, SimConfig};
-use crate::dynamics::State;
+use crate::schema::config_error::ConfigError;
 use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
-use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
+use crate::sensors::{json_of, PanelSpec, Sensor, SensorBuild, SensorKind};
 
 /// The fine-sun-sensor kind.
 pub static KIND: SensorKind = SensorKind {
@@ -49,14 +48,8 @@ pub static KIND: SensorKind = SensorKind {
 
 /// One [`FineSunSensor`] per `[[fine_sun_sensors]]` entry (errors name
 /// `fine_sun_sensors[i]…`).
-fn build(
-    cfg: &SimConfig,
-    _sample_interval_s: f64,
-    _t_sim_ns: u64,
-    _x: &State,
-    out: &mut Vec<Box<dyn Sensor>>,
-) -> Result<(), ConfigError> {
-    for (i, c) in cfg.sensors.of::<FineSunSensorConfig>().enumerate() {
+fn build(ctx: &SensorBuild<'_>, out: &mut Vec<Box<dyn Sensor>>) -> Result<(), ConfigError> {
+    for (i, c) in ctx.sensors.of::<FineSunSensorConfig>().enumerate() {
         let path = format!("fine_sun_sensors[{i}]");
         out.push(Box::new(FineSunSensor::new(c.clone(), &path)?));
     }

@@ -5,8 +5,9 @@
 use nalgebra::{Matrix3, Vector2};
 
 use super::FineSunSensorConfig;
-use crate::config::{ConfigError, SensorContext};
+use crate::schema::config_error::ConfigError;
 use crate::schema::{mat3, SchemaError, TableReader};
+use crate::sensors::params::SensorContext;
 use crate::sensors::params::{RawSensorConfig, SensorSpec};
 
 /// The keys of one `[[fine_sun_sensors]]` entry (the first five are required).

@@ -5,10 +5,9 @@
 use flexdyn_proto::{decode_gps, GpsMsg, GPS_PREFIX};
 
 use super::{schema, Gps, GpsConfig};
-use crate::config::{ConfigError, SimConfig};
-use crate::dynamics::State;
+use crate::schema::config_error::ConfigError;
 use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
-use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
+use crate::sensors::{json_of, PanelSpec, Sensor, SensorBuild, SensorKind};
 
 /// The GPS receiver kind.
 pub static KIND: SensorKind = SensorKind {
@@ -56,20 +55,14 @@ pub static KIND: SensorKind = SensorKind {
 };
 
 /// One [`Gps`] per `[[gps_receivers]]` entry (errors name `gps_receivers[i]…`).
-fn build(
-    cfg: &SimConfig,
-    _sample_interval_s: f64,
-    _t_sim_ns: u64,
-    _x: &State,
-    out: &mut Vec<Box<dyn Sensor>>,
-) -> Result<(), ConfigError> {
-    for (i, g) in cfg.sensors.of::<GpsConfig>().enumerate() {
+fn build(ctx: &SensorBuild<'_>, out: &mut Vec<Box<dyn Sensor>>) -> Result<(), ConfigError> {
+    for (i, g) in ctx.sensors.of::<GpsConfig>().enumerate() {
         let path = format!("gps_receivers[{i}]");
         out.push(Box::new(Gps::new(
             g.clone(),
             &path,
-            cfg.frame_ns,
-            cfg.epoch.as_ref(),
+            ctx.frame_ns,
+            ctx.epoch,
         )?));
     }
     Ok(())

@@ -59,7 +59,6 @@ use super::rng::NormalRng;
 
 mod kind;
 pub(crate) mod schema;
-mod view;
 
 pub use kind::KIND;
 

@@ -5,9 +5,11 @@
 use nalgebra::Vector3;
 
 use super::GpsConfig;
-use crate::config::{whole_ns, ConfigError, SensorContext};
 use crate::numfmt::Num;
+use crate::schema::checks::whole_ns;
+use crate::schema::config_error::ConfigError;
 use crate::schema::{vec3, SchemaError, TableReader};
+use crate::sensors::params::SensorContext;
 use crate::sensors::params::{RawSensorConfig, SensorSpec};
 use crate::validate::ParamError;
 

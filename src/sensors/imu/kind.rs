@@ -6,11 +6,10 @@ use flexdyn_proto::keys::{Topics, IMU_PREFIX};
 use flexdyn_proto::{decode_imu, ImuMsg};
 
 use super::{schema, ImuConfig, ImuSensor};
-use crate::config::{ConfigError, SimConfig};
-use crate::dynamics::State;
+use crate::schema::config_error::ConfigError;
 use crate::schema::plausible::Implausible;
 use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
-use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
+use crate::sensors::{json_of, PanelSpec, Sensor, SensorBuild, SensorKind};
 
 /// The IMU kind.
 pub static KIND: SensorKind = SensorKind {
@@ -54,21 +53,15 @@ pub static KIND: SensorKind = SensorKind {
 };
 
 /// One [`ImuSensor`] per `[[imus]]` entry (errors name `imus[i]…`).
-fn build(
-    cfg: &SimConfig,
-    sample_interval_s: f64,
-    t_sim_ns: u64,
-    x: &State,
-    out: &mut Vec<Box<dyn Sensor>>,
-) -> Result<(), ConfigError> {
-    for (i, imu) in cfg.sensors.of::<ImuConfig>().enumerate() {
+fn build(ctx: &SensorBuild<'_>, out: &mut Vec<Box<dyn Sensor>>) -> Result<(), ConfigError> {
+    for (i, imu) in ctx.sensors.of::<ImuConfig>().enumerate() {
         let path = format!("imus[{i}]");
         out.push(Box::new(ImuSensor::new(
             imu,
             &path,
-            sample_interval_s,
-            t_sim_ns,
-            x,
+            ctx.sample_interval_s,
+            ctx.t_sim_ns,
+            ctx.x,
         )?));
     }
     Ok(())

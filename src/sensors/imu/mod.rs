@@ -71,7 +71,6 @@ mod kind;
 pub(crate) mod plausibility;
 pub(crate) mod schema;
 mod sensor;
-mod view;
 
 pub use kind::KIND;
 pub use sensor::{sensor_truth, ImuSensor};
@@ -95,6 +94,19 @@ pub enum ImuParamError {
         /// What is wrong.
         problem: String,
     },
+}
+
+impl From<ImuParamError> for crate::schema::config_error::ConfigError {
+    fn from(e: ImuParamError) -> Self {
+        match e {
+            ImuParamError::Param(source) => source.into(),
+            ImuParamError::Invalid { field, problem } => Self::Invalid {
+                field,
+                problem,
+                at: crate::schema::At(None),
+            },
+        }
+    }
 }
 
 /// Gyro error terms; every term is zero (off) by default.

@@ -3,8 +3,9 @@
 //! [`super::Imu::new`] and the configuration's magnitude bounds.
 
 use super::{AccelErrors, GyroErrors, ImuConfig};
-use crate::config::{ConfigError, SensorContext};
+use crate::schema::config_error::ConfigError;
 use crate::schema::{mat3, vec3, SchemaError, TableReader};
+use crate::sensors::params::SensorContext;
 use crate::sensors::params::{RawSensorConfig, SensorSpec};
 
 /// The keys of one `[[imus]]` entry.

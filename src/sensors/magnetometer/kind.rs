@@ -6,11 +6,10 @@ use flexdyn_proto::keys::MAGNETOMETER_PREFIX;
 use flexdyn_proto::{decode_magnetometer, MagnetometerMsg};
 
 use super::{schema, Magnetometer, MagnetometerConfig};
-use crate::config::{ConfigError, SimConfig};
-use crate::dynamics::State;
+use crate::schema::config_error::ConfigError;
 use crate::schema::plausible::Implausible;
 use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
-use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
+use crate::sensors::{json_of, PanelSpec, Sensor, SensorBuild, SensorKind};
 
 /// The magnetometer kind.
 pub static KIND: SensorKind = SensorKind {
@@ -46,14 +45,8 @@ pub static KIND: SensorKind = SensorKind {
 };
 
 /// One [`Magnetometer`] per `[[magnetometers]]` entry (errors name `magnetometers[i]…`).
-fn build(
-    cfg: &SimConfig,
-    _sample_interval_s: f64,
-    _t_sim_ns: u64,
-    _x: &State,
-    out: &mut Vec<Box<dyn Sensor>>,
-) -> Result<(), ConfigError> {
-    for (i, m) in cfg.sensors.of::<MagnetometerConfig>().enumerate() {
+fn build(ctx: &SensorBuild<'_>, out: &mut Vec<Box<dyn Sensor>>) -> Result<(), ConfigError> {
+    for (i, m) in ctx.sensors.of::<MagnetometerConfig>().enumerate() {
         let path = format!("magnetometers[{i}]");
         out.push(Box::new(Magnetometer::new(m.clone(), &path)?));
     }

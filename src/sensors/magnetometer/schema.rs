@@ -5,9 +5,10 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::MagnetometerConfig;
-use crate::config::{ConfigError, SensorContext};
 use crate::numfmt::Num;
+use crate::schema::config_error::ConfigError;
 use crate::schema::{mat3, vec3, SchemaError, TableReader};
+use crate::sensors::params::SensorContext;
 use crate::sensors::params::{RawSensorConfig, SensorSpec};
 
 /// The keys of one `[[magnetometers]]` entry (the first four are required).

@@ -6,11 +6,10 @@ use flexdyn_proto::keys::{Topics, STAR_TRACKER_PREFIX};
 use flexdyn_proto::{decode_star_tracker, StarTrackerMsg};
 
 use super::{schema, StarTracker, StarTrackerConfig};
-use crate::config::{ConfigError, SimConfig};
-use crate::dynamics::State;
+use crate::schema::config_error::ConfigError;
 use crate::schema::plausible::Implausible;
 use crate::sensors::params::{read_boxed, SensorConfigReader, SensorParams};
-use crate::sensors::{json_of, PanelSpec, Sensor, SensorKind};
+use crate::sensors::{json_of, PanelSpec, Sensor, SensorBuild, SensorKind};
 
 /// The star-tracker kind.
 pub static KIND: SensorKind = SensorKind {
@@ -51,14 +50,8 @@ pub static KIND: SensorKind = SensorKind {
 };
 
 /// One [`StarTracker`] per `[[star_trackers]]` entry (errors name `star_trackers[i]…`).
-fn build(
-    cfg: &SimConfig,
-    _sample_interval_s: f64,
-    _t_sim_ns: u64,
-    _x: &State,
-    out: &mut Vec<Box<dyn Sensor>>,
-) -> Result<(), ConfigError> {
-    for (i, st) in cfg.sensors.of::<StarTrackerConfig>().enumerate() {
+fn build(ctx: &SensorBuild<'_>, out: &mut Vec<Box<dyn Sensor>>) -> Result<(), ConfigError> {
+    for (i, st) in ctx.sensors.of::<StarTrackerConfig>().enumerate() {
         let path = format!("star_trackers[{i}]");
         out.push(Box::new(StarTracker::new(st.clone(), &path)?));
     }

@@ -46,7 +46,6 @@ use super::rng::NormalRng;
 mod kind;
 pub(crate) mod plausibility;
 pub(crate) mod schema;
-mod view;
 
 pub use kind::KIND;
 

@@ -5,8 +5,9 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::StarTrackerConfig;
-use crate::config::{ConfigError, SensorContext};
+use crate::schema::config_error::ConfigError;
 use crate::schema::{mat3, vec3, SchemaError, TableReader};
+use crate::sensors::params::SensorContext;
 use crate::sensors::params::{RawSensorConfig, SensorSpec};
 
 /// The keys of one `[[star_trackers]]` entry (the first six are required).

@@ -259,7 +259,8 @@ pub async fn run(
         // physics thread before the next frame; their boxes freed by its telemetry thread.
         let (fault_tx, fault_rx) = sync_channel(crate::faults::MAX_LIVE_FAULTS);
         let (fault_recycle_tx, fault_recycle_rx) = sync_channel(2 * crate::faults::MAX_LIVE_FAULTS);
-        let resolver = crate::faults::live::LiveResolver::new(cfg)
+        let resolver = cfg
+            .live_fault_resolver()
             .map_err(|source| named(ServerError::Config { file: None, source }))?;
         let fault_commands = super::fault_cmd::declare(
             &session,

@@ -5,9 +5,8 @@ use std::ops::Range;
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
-use super::error::{param_field, ConfigError};
-use crate::schema::{join_key, location, At};
-use crate::sensors::imu::ImuParamError;
+use super::config_error::{param_field, ConfigError};
+use super::{join_key, location, At};
 use crate::validate::ParamError;
 
 struct SpanEntry {
@@ -166,25 +165,6 @@ impl<'s> SourceMap<'s> {
             field: field.to_string(),
             problem,
             at: self.at(field),
-        }
-    }
-
-    pub(crate) fn imu_error(&self, e: ImuParamError) -> ConfigError {
-        match e {
-            ImuParamError::Param(p) => self.param_error(p),
-            ImuParamError::Invalid { field, problem } => {
-                // An absent key (e.g. a missing time constant) points at its table.
-                let mut at = self.at(&field);
-                let mut parent = field.as_str();
-                while at.0.is_none() {
-                    match parent.rfind('.') {
-                        Some(i) => parent = &parent[..i],
-                        None => break,
-                    }
-                    at = self.at(parent);
-                }
-                ConfigError::Invalid { field, problem, at }
-            }
         }
     }
 

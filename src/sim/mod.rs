@@ -11,6 +11,8 @@
 //! from one [`Truth`], and the IMUs integrate their Δv over the integrator's stages (the bank is
 //! the step's [`crate::dynamics::stage_hook::StageHook`]).
 
+mod sensor_views;
+
 use std::num::NonZeroU64;
 
 use flexdyn_proto::{EffectorState, StateMsg};
@@ -21,6 +23,7 @@ use crate::dynamics::{
     EnvironmentSource, HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment,
 };
 use crate::environment::model::EnvironmentModel;
+use crate::faults::ports::FaultHost;
 use crate::faults::Faults;
 use crate::sensors::{Sensor, SensorBank, Truth};
 
@@ -71,9 +74,14 @@ impl Simulation {
     pub fn new(cfg: &SimConfig) -> Result<Self, ConfigError> {
         let sc = cfg.build_spacecraft()?;
         let frame_s = cfg.frame_ns as f64 * 1e-9;
-        let sensors = SensorBank::new(cfg, frame_s, sc.t_sim_ns(), sc.state())?;
+        let sensors = SensorBank::new(&cfg.sensor_build(frame_s, sc.t_sim_ns(), sc.state()))?;
         let environment = cfg.environment_model()?;
-        let faults = Faults::new(cfg, &sc)?;
+        let host = FaultHost {
+            sc: &sc,
+            frame_ns: cfg.frame_ns,
+            reaction_wheels: &cfg.reaction_wheels,
+        };
+        let faults = Faults::new(&cfg.faults, &host)?;
         let mut sim = Self {
             faults,
             environment,

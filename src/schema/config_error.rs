@@ -1,12 +1,12 @@
-//! The configuration's error type and the text positions it points to.
+//! The configuration's error type. It lives beside the schema reader, below every model, so that
+//! a model's own schema (`<kind>/schema.rs`) reports a located error without naming the
+//! configuration that assembles it.
 
 use std::path::PathBuf;
 
-use crate::sensors::imu::ImuParamError;
 use crate::validate::ParamError;
 
-use crate::schema::{in_table, SchemaError};
-pub use crate::schema::{At, Location};
+use super::{in_table, At, SchemaError};
 
 /// A configuration that cannot be used. The message always starts with the TOML path of the
 /// offending field (except for I/O and syntax errors, which name the file or the line).
@@ -160,19 +160,6 @@ impl From<ParamError> for ConfigError {
         ConfigError::Param {
             source,
             at: At(None),
-        }
-    }
-}
-
-impl From<ImuParamError> for ConfigError {
-    fn from(e: ImuParamError) -> Self {
-        match e {
-            ImuParamError::Param(source) => source.into(),
-            ImuParamError::Invalid { field, problem } => ConfigError::Invalid {
-                field,
-                problem,
-                at: At(None),
-            },
         }
     }
 }
