@@ -19,21 +19,21 @@
 
 #![warn(missing_docs)]
 
-pub mod attitude;
 pub mod campaign;
 pub mod cli;
 pub mod config;
-pub mod dynamics;
-pub mod environment;
-pub mod faults;
-pub mod numfmt;
-pub mod schema;
-pub mod sensors;
 pub mod server;
 pub mod signals;
 pub mod sim;
 pub mod sinks;
-pub mod validate;
 pub mod world;
 
 pub use flexdyn_proto::client::{logging, transport};
+
+// The model layers are crates of their own (`crates/`); their old paths stay re-exported here
+// while the layers above them move into crates too.
+pub use flexdyn_dynamics as dynamics;
+pub use flexdyn_environment as environment;
+pub use flexdyn_faults as faults;
+pub use flexdyn_kernel::{attitude, numfmt, schema, validate};
+pub use flexdyn_sensors as sensors;

@@ -1,0 +1,546 @@
+//! The environment of a run, built once from the configuration's `[environment]` table
+//! ([`schema`]), and the [`EnvironmentModel`] that fills an [`EnvironmentSample`] from the
+//! simulation time and the hub's position and velocity.
+//!
+//! One update runs the chain (each step cites its own module):
+//! 1. the epoch's time scales at `t_sim_ns` ([`crate::epoch`]);
+//! 2. the Earth's orientation, N → E ([`crate::earth_rotation`]);
+//! 3. r in the Earth-fixed frame; the magnetic field there (IGRF-14 or a centred dipole),
+//!    rotated back to N ([`crate::magnetic`]);
+//! 4. the density at r (exponential or NRLMSISE-00) and the co-rotating wind ω⊕ × r
+//!    ([`crate::atmosphere`]);
+//! 5. the Sun and Moon positions (geocentric, N), made relative to B
+//!    ([`crate::ephemeris`]), and the shadow factor ([`crate::shadow`]).
+//!
+//! [`EnvironmentModel::fill`] allocates nothing, locks nothing and returns no `Result`: every
+//! parameter was checked when the model was built. [`EnvironmentModel::update_if_due`] runs it at
+//! the configured rate and holds the sample between updates (zero-order hold: see the README's
+//! "World" section for the error that costs). Each update after the first is evaluated for the
+//! position predicted from the update before, so that [`EnvironmentModel::offload`] can move the
+//! evaluation to a worker thread without changing a bit ([`super::prefetch`]).
+
+pub mod schema;
+
+use std::sync::{Arc, OnceLock};
+
+use nalgebra::Vector3;
+
+use super::atmosphere::{exponential_density_kg_m3, Nrlmsise00Model, SpaceWeather};
+use super::common::{Common, CommonCache, Parts};
+use super::earth_rotation::EarthRotation;
+use super::ephemeris::{moon_position_n_m, sun_position_n_m};
+use super::epoch::SimEpoch;
+use super::facets::Facet;
+use super::geodetic::geodetic_from_ecef;
+use super::magnetic::{CentredDipole, Igrf, MagneticError};
+use super::prefetch::{Prefetcher, Request};
+use super::shadow::{shadow_factor, ShadowModel};
+use super::EnvironmentSample;
+
+/// Which magnetic-field model is on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MagneticSetting {
+    /// No field.
+    Off,
+    /// IGRF-14 to `degree` (1..=13).
+    Igrf14 {
+        /// Highest degree n.
+        degree: usize,
+    },
+    /// The centred dipole of IGRF-14's degree-1 coefficients at the epoch: tilted (g₁⁰, g₁¹,
+    /// h₁¹) or axial (g₁⁰ only).
+    Dipole {
+        /// Tilted (true) or axial (false).
+        tilted: bool,
+    },
+}
+
+/// Which atmosphere is on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AtmosphereSetting {
+    /// Vacuum.
+    Off,
+    /// Vallado's exponential bands (Table 8-4) on the geodetic height.
+    Exponential,
+    /// NRLMSISE-00 with constant space weather.
+    Nrlmsise00(SpaceWeather),
+}
+
+/// The validated `[environment]` table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnvironmentSettings {
+    /// \[ns\] interval between sample updates (a whole number of RK4 steps).
+    pub update_ns: u64,
+    /// \[Hz\] the update rate as configured.
+    pub update_hz: f64,
+    /// \[Hz\] `telemetry_rate_hz`: the rate of the environment message (`tlm/env`) and of
+    /// `simulate`'s environment columns; `None` (the default): neither.
+    pub telemetry_rate_hz: Option<f64>,
+    /// `telemetry_rate_hz` as a whole number of frames (set by the configuration, which knows
+    /// the frame rate).
+    pub telemetry_every_frames: Option<u64>,
+    /// Magnetic field.
+    pub magnetic: MagneticSetting,
+    /// Atmosphere (with a co-rotating wind when on).
+    pub atmosphere: AtmosphereSetting,
+    /// Sun ephemeris.
+    pub sun: bool,
+    /// Moon ephemeris.
+    pub moon: bool,
+    /// Shadow geometry (needs the Sun), or none (full sunlight).
+    pub shadow: Option<ShadowModel>,
+    /// The vehicle's flat plates (`[[environment.facets]]`), B frame.
+    pub facets: Vec<Facet>,
+    /// Dynamic effector: gravity-gradient torque.
+    pub gravity_gradient: bool,
+    /// Dynamic effector: drag on the facets.
+    pub drag: bool,
+    /// Dynamic effector: solar radiation pressure on the facets.
+    pub solar_pressure: bool,
+    /// Dynamic effector: a residual dipole \[A·m²\], B components.
+    pub residual_dipole_m_b_am2: Option<Vector3<f64>>,
+}
+
+impl EnvironmentSettings {
+    /// Whether any model needs the epoch (everything but the gravity gradient and the facets).
+    pub fn needs_epoch(&self) -> bool {
+        self.magnetic != MagneticSetting::Off
+            || self.atmosphere != AtmosphereSetting::Off
+            || self.sun
+            || self.moon
+            || self.shadow.is_some()
+    }
+}
+
+/// The magnetic field, built.
+#[derive(Debug, Clone)]
+enum Field {
+    Off,
+    Igrf(Box<Igrf>),
+    Dipole(CentredDipole),
+}
+
+/// The atmosphere, built.
+#[derive(Debug, Clone)]
+enum Air {
+    Off,
+    Exponential,
+    Nrlmsise00(Nrlmsise00Model),
+}
+
+/// \[m\] how far the actual position at an update may be from the predicted one before the
+/// prediction counts as stale (the state was set from outside, e.g. a test placing the
+/// spacecraft) and the update is evaluated at the actual state instead. The prediction's own
+/// error is ½·|a_p|·Δ² ([`super::prefetch`]): 2e-4 m at 10 Hz in LEO, 10 m only at Δ ≈ 30 s.
+/// Either way the choice depends only on the states, so the run stays deterministic.
+pub const STALE_PREDICTION_M: f64 = 10.0;
+
+/// The models proper, shared with the prefetch worker ([`super::prefetch`]).
+#[derive(Debug)]
+struct Models {
+    epoch: SimEpoch,
+    rotation: EarthRotation,
+    field: Field,
+    air: Air,
+    sun: bool,
+    moon: bool,
+    shadow: Option<ShadowModel>,
+    /// The world's memo of the position-independent parts, when the vehicle is one of several
+    /// ([`EnvironmentModel::share_common`]); set once, before any update.
+    common: OnceLock<Arc<CommonCache>>,
+}
+
+/// The environment models of a run, built once; fills samples without allocating.
+///
+/// Update schedule: the first update (at the first call of [`Self::update_if_due`]) evaluates
+/// the models at the actual state; every later one at the instant it comes into force, for the
+/// position predicted from the state of the update before ([`Request::predicted`]), which lets a
+/// worker thread evaluate it ahead of time ([`Self::offload`]) with bit-identical results.
+#[derive(Debug)]
+pub struct EnvironmentModel {
+    models: Arc<Models>,
+    update_ns: u64,
+    /// \[ns\] the step of the simulation time grid: an update due at `t` happens at the first
+    /// multiple of it at or after `t`.
+    step_ns: u64,
+    /// \[ns\] time of the next due update (`None`: none yet).
+    next_update_ns: Option<u64>,
+    sample: EnvironmentSample,
+    /// What the next update evaluates, when it falls on the step grid as predicted.
+    next: Option<Request>,
+    /// The worker that evaluates `next` ahead of time ([`Self::offload`]).
+    prefetch: Option<Prefetcher>,
+}
+
+impl Clone for EnvironmentModel {
+    /// A copy of the models and the schedule, without the worker thread (its results are the
+    /// same without it).
+    fn clone(&self) -> Self {
+        Self {
+            models: self.models.clone(),
+            update_ns: self.update_ns,
+            step_ns: self.step_ns,
+            next_update_ns: self.next_update_ns,
+            sample: self.sample,
+            next: self.next,
+            prefetch: None,
+        }
+    }
+}
+
+/// A model that cannot be built for this epoch.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum EnvironmentBuildError {
+    /// The magnetic model refuses the degree or the epoch's date.
+    #[error(transparent)]
+    Magnetic(#[from] MagneticError),
+    /// The space weather is out of range.
+    #[error(transparent)]
+    Atmosphere(#[from] super::atmosphere::AtmosphereError),
+}
+
+/// Which environment models are on ([`EnvironmentModel::models_on`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ModelsOn {
+    /// A magnetic field (IGRF or a dipole).
+    pub magnetic: bool,
+    /// The Sun ephemeris.
+    pub sun: bool,
+    /// The Moon ephemeris.
+    pub moon: bool,
+    /// A shadow model.
+    pub shadow: bool,
+    /// An atmosphere.
+    pub atmosphere: bool,
+}
+
+impl EnvironmentModel {
+    /// Builds the models of `settings` for `epoch`. Fails if IGRF-14 does not cover the epoch
+    /// (1900–2030) or the degree, or if the space weather is out of range.
+    pub fn new(
+        settings: &EnvironmentSettings,
+        epoch: &SimEpoch,
+    ) -> Result<Self, EnvironmentBuildError> {
+        let year = epoch.utc_calendar(0).decimal_year();
+        let field = match settings.magnetic {
+            MagneticSetting::Off => Field::Off,
+            MagneticSetting::Igrf14 { degree } => {
+                let igrf = Igrf::igrf14(degree)?;
+                igrf.check_date(year)?;
+                Field::Igrf(Box::new(igrf))
+            }
+            MagneticSetting::Dipole { tilted } => {
+                let igrf = Igrf::igrf14(1)?;
+                igrf.check_date(year)?;
+                let c = igrf.coefficients_at(year);
+                Field::Dipole(if tilted {
+                    CentredDipole::tilted(&c)
+                } else {
+                    CentredDipole::axial(&c)
+                })
+            }
+        };
+        let air = match settings.atmosphere {
+            AtmosphereSetting::Off => Air::Off,
+            AtmosphereSetting::Exponential => Air::Exponential,
+            AtmosphereSetting::Nrlmsise00(w) => Air::Nrlmsise00(Nrlmsise00Model::new(w)?),
+        };
+        Ok(Self {
+            models: Arc::new(Models {
+                epoch: epoch.clone(),
+                rotation: EarthRotation::new(epoch.earth_orientation()),
+                field,
+                air,
+                sun: settings.sun,
+                moon: settings.moon,
+                shadow: settings.shadow,
+                common: OnceLock::new(),
+            }),
+            update_ns: settings.update_ns.max(1),
+            step_ns: 1,
+            next_update_ns: None,
+            sample: EnvironmentSample::NONE,
+            next: None,
+            prefetch: None,
+        })
+    }
+
+    /// The same models on a simulation stepping by `step_ns`: updates then happen at multiples
+    /// of it, which is where the next update's request is predicted for.
+    pub fn on_step_grid(mut self, step_ns: u64) -> Self {
+        self.step_ns = step_ns.max(1);
+        self
+    }
+
+    /// Starts a worker thread that evaluates each update ahead of time, so the models no longer
+    /// run on the caller's (physics) thread; the samples are bit-identical with or without it
+    /// ([`super::prefetch`]). Call it before stepping; an error (the thread could not be
+    /// spawned) leaves the updates on the caller's thread.
+    pub fn offload(&mut self) -> std::io::Result<()> {
+        let models = self.models.clone();
+        let prefetch = Prefetcher::spawn(move |req, out| {
+            models.fill(req.t_sim_ns, &req.r_bn_n_m, &req.v_bn_n_m_s, out)
+        })?;
+        if let Some(req) = &self.next {
+            prefetch.post(req);
+        }
+        self.prefetch = Some(prefetch);
+        Ok(())
+    }
+
+    /// Shares `cache` with the other vehicles of a world: the Earth's orientation, the Sun and
+    /// the Moon at an update instant are evaluated by the first vehicle that needs them and read
+    /// by the others ([`super::common`]; the samples are the same bits either way). Returns
+    /// false, changing nothing, if a cache was already shared.
+    pub fn share_common(&self, cache: Arc<CommonCache>) -> bool {
+        self.models.common.set(cache).is_ok()
+    }
+
+    /// Whether a worker evaluates the updates ([`Self::offload`]).
+    pub fn is_offloaded(&self) -> bool {
+        self.prefetch.is_some()
+    }
+
+    /// How many samples (updates and telemetry reads) came from the worker's answers, not from
+    /// the caller's own evaluation (0 without a worker).
+    pub fn prefetched_samples(&self) -> u64 {
+        self.prefetch.as_ref().map_or(0, Prefetcher::answers_taken)
+    }
+
+    /// Whether the worker has answered the request posted at the last update, so the next
+    /// update will take its answer (false without a worker). Tests and benchmarks use it to wait
+    /// for the worker deterministically; the stepping path never waits.
+    pub fn prefetch_answer_ready(&self) -> bool {
+        self.prefetch.as_ref().is_some_and(Prefetcher::answer_ready)
+    }
+
+    /// The epoch.
+    pub fn epoch(&self) -> &SimEpoch {
+        &self.models.epoch
+    }
+
+    /// The numeric parameters of the built models, by configuration path
+    /// (`environment.f107_sfu`, `environment.f107a_sfu`, `environment.ap` with NRLMSISE-00), for
+    /// a campaign's read-back. Not on the stepping path.
+    pub fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        if let Air::Nrlmsise00(m) = &self.models.air {
+            let w = m.weather();
+            out.push(("environment.f107_sfu".into(), w.f107_sfu));
+            out.push(("environment.f107a_sfu".into(), w.f107a_sfu));
+            out.push(("environment.ap".into(), w.ap));
+        }
+    }
+
+    /// The sample last filled by [`Self::update_if_due`].
+    pub fn sample(&self) -> &EnvironmentSample {
+        &self.sample
+    }
+
+    /// Fills `out` at `t_sim_ns` for the hub point B at `r_bn_n_m` moving at `v_bn_n_m_s` (N).
+    /// Allocation-free, lock-free, no `Result`.
+    pub fn fill(
+        &self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+        out: &mut EnvironmentSample,
+    ) {
+        self.models.fill(t_sim_ns, r_bn_n_m, v_bn_n_m_s, out);
+    }
+
+    /// The sample in force from `t_sim_ns` on, without touching the update schedule: the one
+    /// [`Self::update_if_due`] would hold after a call at `t_sim_ns` (evaluated if an update is
+    /// due then, else the held one). For telemetry at an instant where the next step's update
+    /// has not run yet. Allocation-free.
+    pub fn sample_from(
+        &self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+    ) -> EnvironmentSample {
+        if self.next_update_ns.is_none_or(|next| t_sim_ns >= next) {
+            self.evaluate_update(t_sim_ns, r_bn_n_m, v_bn_n_m_s)
+        } else {
+            self.sample
+        }
+    }
+
+    /// Which models are on: (magnetic field, Sun, Moon, shadow, atmosphere).
+    pub fn models_on(&self) -> ModelsOn {
+        let m = &self.models;
+        ModelsOn {
+            magnetic: !matches!(m.field, Field::Off),
+            sun: m.sun,
+            moon: m.moon,
+            shadow: m.shadow.is_some(),
+            atmosphere: !matches!(m.air, Air::Off),
+        }
+    }
+
+    /// Refills the held sample when `t_sim_ns` has reached the next update time (the first call
+    /// always updates), and returns it then; `None` while the held sample still stands.
+    pub fn update_if_due(
+        &mut self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+    ) -> Option<&EnvironmentSample> {
+        if self.next_update_ns.is_some_and(|next| t_sim_ns < next) {
+            return None;
+        }
+        self.sample = self.evaluate_update(t_sim_ns, r_bn_n_m, v_bn_n_m_s);
+        let due_ns = t_sim_ns.saturating_add(self.update_ns);
+        self.next_update_ns = Some(due_ns);
+        // The next update happens at the first step boundary at or after `due_ns`.
+        let at_ns = due_ns.div_ceil(self.step_ns).saturating_mul(self.step_ns);
+        let req = Request::predicted(t_sim_ns, r_bn_n_m, v_bn_n_m_s, at_ns);
+        if let Some(p) = &self.prefetch {
+            p.post(&req);
+        }
+        self.next = Some(req);
+        Some(&self.sample)
+    }
+
+    /// The sample of an update at `t_sim_ns`: the predicted request's (from the worker if it
+    /// has answered, else evaluated here: the same bits), or, for the first update, one off the
+    /// predicted instant and one whose state is more than [`STALE_PREDICTION_M`] from the
+    /// prediction (a state set from outside), the models at the actual state.
+    fn evaluate_update(
+        &self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+    ) -> EnvironmentSample {
+        let mut s = EnvironmentSample::NONE;
+        match &self.next {
+            Some(req)
+                if req.t_sim_ns == t_sim_ns
+                    && (req.r_bn_n_m - r_bn_n_m).norm_squared()
+                        <= STALE_PREDICTION_M * STALE_PREDICTION_M =>
+            {
+                match self.prefetch.as_ref().and_then(|p| p.answer(req)) {
+                    Some(answer) => s = answer,
+                    None => self.fill(req.t_sim_ns, &req.r_bn_n_m, &req.v_bn_n_m_s, &mut s),
+                }
+            }
+            _ => self.fill(t_sim_ns, r_bn_n_m, v_bn_n_m_s, &mut s),
+        }
+        s
+    }
+}
+
+impl Models {
+    /// Fills `out` at `t_sim_ns` for the hub point B at `r_bn_n_m` moving at `v_bn_n_m_s` (N).
+    /// Allocation-free, lock-free, no `Result`.
+    fn fill(
+        &self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        _v_bn_n_m_s: &Vector3<f64>,
+        out: &mut EnvironmentSample,
+    ) {
+        *out = EnvironmentSample::NONE;
+        out.t_sim_ns = t_sim_ns;
+        // The Earth's orientation (precession-nutation and sidereal time, ~1.5 µs) only for the
+        // models that work in the Earth-fixed frame.
+        let parts = Parts {
+            earth: !(matches!(self.field, Field::Off) && matches!(self.air, Air::Off)),
+            sun: self.sun,
+            moon: self.moon,
+        };
+        let common = match self.common.get() {
+            Some(cache) => {
+                cache.get_or_evaluate(t_sim_ns, parts, || self.common_at(t_sim_ns, parts))
+            }
+            None => self.common_at(t_sim_ns, parts),
+        };
+        if parts.earth {
+            let earth = &common.earth;
+            let r_e_m = earth.r_e(r_bn_n_m);
+            let b_e_t = match &self.field {
+                Field::Off => None,
+                Field::Igrf(igrf) => {
+                    let year = self.epoch.utc_calendar(t_sim_ns).decimal_year();
+                    Some(igrf.field_ecef_t(year, &r_e_m))
+                }
+                Field::Dipole(d) => Some(d.field_ecef_t(&r_e_m)),
+            };
+            if let Some(b_e_t) = b_e_t {
+                out.b_field_n_t = earth.dcm_en.tr_mul(&b_e_t);
+            }
+            let density_kg_m3 = match &self.air {
+                Air::Off => None,
+                Air::Exponential => Some(exponential_density_kg_m3(
+                    geodetic_from_ecef(&r_e_m).height_m,
+                )),
+                Air::Nrlmsise00(m) => {
+                    let cal = self.epoch.utc_calendar(t_sim_ns);
+                    let ut_s = f64::from(cal.hour) * 3600.0
+                        + f64::from(cal.minute) * 60.0
+                        + f64::from(cal.second.min(59))
+                        + f64::from(cal.nanosecond) * 1e-9;
+                    Some(m.drag_density_kg_m3(
+                        day_of_year(cal.year, cal.month, cal.day),
+                        ut_s,
+                        &r_e_m,
+                    ))
+                }
+            };
+            if let Some(rho) = density_kg_m3 {
+                out.density_kg_m3 = rho;
+                // Co-rotating atmosphere (Vallado §8.6.2): v_wind = ω⊕ × r, N components.
+                out.wind_n_m_s = earth.omega_en_n_rad_s.cross(r_bn_n_m);
+            }
+        }
+        // The Sun and Moon positions relative to B and the shadow factor.
+        if self.sun {
+            out.r_sun_b_n_m = common.r_sun_n_m - r_bn_n_m;
+            if let Some(model) = self.shadow {
+                out.shadow_factor = shadow_factor(model, r_bn_n_m, &common.r_sun_n_m);
+            }
+        }
+        if self.moon {
+            out.r_moon_b_n_m = common.r_moon_n_m - r_bn_n_m;
+        }
+    }
+
+    /// The position-independent `parts` at `t_sim_ns`: what a world's vehicles share
+    /// ([`super::common`]).
+    fn common_at(&self, t_sim_ns: u64, parts: Parts) -> Common {
+        let times = self.epoch.times(t_sim_ns);
+        let t_tt_jc = times.tt_centuries_j2000();
+        let mut c = Common::zero();
+        if parts.earth {
+            c.earth = self.rotation.at(&times);
+        }
+        if parts.sun {
+            c.r_sun_n_m = sun_position_n_m(t_tt_jc);
+        }
+        if parts.moon {
+            c.r_moon_n_m = moon_position_n_m(t_tt_jc);
+        }
+        c
+    }
+}
+
+/// Day of the year, 1 on 1 January (Gregorian).
+fn day_of_year(year: i32, month: u8, day: u8) -> u32 {
+    const CUM: [u32; 12] = [0, 31, 59, 90, 120, 151, 181, 212, 243, 273, 304, 334];
+    let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+    let m = usize::from(month.clamp(1, 12)) - 1;
+    CUM[m] + u32::from(leap && month > 2) + u32::from(day)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::day_of_year;
+
+    #[test]
+    fn day_of_year_counts_from_one() {
+        assert_eq!(day_of_year(2026, 1, 1), 1);
+        assert_eq!(day_of_year(2026, 11, 24), 328);
+        assert_eq!(day_of_year(2024, 12, 31), 366);
+        assert_eq!(day_of_year(2023, 3, 1), 60);
+    }
+}

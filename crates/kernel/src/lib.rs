@@ -1,0 +1,22 @@
+//! flexdyn's kernel: what every layer above it shares and nothing of the physics.
+//!
+//! - [`attitude`]: the MRP, DCM and quaternion kernels (those of `flexdyn_proto::attitude`, which
+//!   flight code uses without linking the simulator);
+//! - [`numfmt`]: numbers formatted for messages and files;
+//! - [`validate`]: parameter checks and their error, [`validate::ParamError`];
+//! - [`schema`]: the typed TOML reader every model's schema uses, the configuration's error
+//!   ([`schema::config_error::ConfigError`]), the source map that locates a TOML path in the
+//!   text, and the checks every schema shares (whole nanoseconds, rates, unique names).
+//!
+//! # Layer
+//! The bottom of the workspace. It depends on the wire crate (`flexdyn-proto`, for its attitude
+//! kernels), `nalgebra`, `toml` and `thiserror` only. It must never depend on another flexdyn
+//! crate, nor on any I/O stack (`zenoh`, `tokio`, `foxglove`, `plotters`, `mcap`): `.ci/run`
+//! checks the dependency graph.
+
+#![warn(missing_docs)]
+
+pub mod attitude;
+pub mod numfmt;
+pub mod schema;
+pub mod validate;

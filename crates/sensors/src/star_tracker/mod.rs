@@ -1,0 +1,357 @@
+//! A star tracker: the attitude of its case frame C relative to N, with noise, a bias and
+//! validity conditions, published as `StarTrackerMsg` on `flexdyn/<sc-id>/tlm/st/<name>`.
+//!
+//! # Measurement model
+//! The tracker is mounted with the fixed DCM [CB]; its boresight b̂ is a unit vector in C
+//! (default +ẑ_C). At each update the true attitude is [CN] = [CB][BN], and the measurement is
+//!
+//! [C̃N] = R(δθ) [CN],  δθ = β + σ_x n₁ ê₁ + σ_x n₂ ê₂ + σ_b n₃ b̂   (C components),
+//!
+//! where (ê₁, ê₂, b̂) is a right-handed orthonormal triad in C (ê₁ is the unit vector of b̂ × x̂_C,
+//! or of b̂ × ŷ_C when b̂ ∥ x̂_C), n₁…n₃ are independent standard normals, σ_x is the
+//! cross-boresight and σ_b the about-boresight noise (1σ, rad), β the constant bias (a small
+//! rotation vector in C, rad), and R(δθ) the frame rotation by the rotation vector δθ, built
+//! exactly through its MRP tan(|δθ|/4) δθ/|δθ|. The reported quaternion is that of [C̃N], scalar
+//! first with q₀ ≥ 0. Star trackers are typically specified in arcseconds: 1″ = 4.8481e-6 rad.
+//!
+//! # Validity
+//! A measurement is invalid (`valid = false`, the quaternion held at the last valid one, the
+//! identity before the first) when
+//! - the boresight in N, [NC] b̂, is within `sun_exclusion_rad` of the configured Sun direction
+//!   `sun_direction_n` (flag `SUN_EXCLUSION`), or
+//! - |ω_B/N| exceeds `max_rate_rad_s` (flag `RATE_LIMIT`; the tracker cannot match smeared star
+//!   images).
+//!
+//! Both use the true attitude and rate at the sample. The noise is drawn at every update, valid or
+//! not, so the noise stream does not depend on the validity history.
+//!
+//! # Timing and random numbers
+//! The tracker updates every `frame_hz / rate_hz` frames (a whole number), at the frame
+//! boundaries whose tick is a multiple of it, starting at tick 0. Its normals come from the same
+//! portable ChaCha8 + Marsaglia-polar generator as the IMU's, seeded with `seed`, three per update
+//! (n₁, n₂, n₃, then one discarded to keep the pairs aligned), so a seed reproduces the stream
+//! bit for bit on every platform.
+
+use nalgebra::{Matrix3, Vector3, Vector4};
+
+use crate::{Sensor, SensorKind, Truth};
+use flexdyn_kernel::attitude::{dcm_to_quat, mrp_to_dcm};
+use flexdyn_kernel::validate::{
+    check_dcm, check_finite, check_non_negative, check_positive, join, ParamError,
+};
+use flexdyn_proto::{encode_into, star_tracker_flags, Header, StarTrackerMsg};
+
+use super::rng::NormalRng;
+
+mod kind;
+pub(crate) mod plausibility;
+pub(crate) mod schema;
+
+pub use kind::KIND;
+
+/// Tolerance on |‖v‖ − 1| for the boresight and the Sun direction.
+pub const UNIT_TOL: f64 = 1e-6;
+
+/// A star tracker's configuration (`[[star_trackers]]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StarTrackerConfig {
+    /// Name: the last chunk of its topic key.
+    pub name: String,
+    /// Mounting DCM [CB]: maps B components to case-frame C components.
+    pub dcm_cb: Matrix3<f64>,
+    /// Boresight b̂ in C components (unit).
+    pub boresight_c: Vector3<f64>,
+    /// [rad] 1σ noise about each cross-boresight axis.
+    pub sigma_cross_boresight_rad: f64,
+    /// [rad] 1σ noise about the boresight.
+    pub sigma_about_boresight_rad: f64,
+    /// [rad] constant bias, a small rotation vector in C components.
+    pub bias_c_rad: Vector3<f64>,
+    /// Updates every this many frames (from `rate_hz`; ≥ 1).
+    pub every_frames: u64,
+    /// RNG seed (0 ≤ seed ≤ 2⁶³ − 1 in the configuration).
+    pub seed: u64,
+    /// Unit Sun direction in N.
+    pub sun_direction_n: Vector3<f64>,
+    /// [rad] Sun exclusion half-angle about the boresight (0: no exclusion).
+    pub sun_exclusion_rad: f64,
+    /// [rad/s] largest |ω_B/N| at which the tracker still reports (∞: no limit).
+    pub max_rate_rad_s: f64,
+}
+
+impl StarTrackerConfig {
+    /// Validates the values (`path` is e.g. `star_trackers[0]`).
+    pub fn validate(&self, path: &str) -> Result<(), ParamError> {
+        check_dcm(path, "dcm_cb", &self.dcm_cb)?;
+        for (field, v) in [
+            ("boresight_c", &self.boresight_c),
+            ("sun_direction_n", &self.sun_direction_n),
+        ] {
+            check_finite(path, field, v.as_slice())?;
+            if (v.norm() - 1.0).abs() > UNIT_TOL {
+                return Err(ParamError::NotUnit {
+                    field: join(path, field),
+                    norm: v.norm(),
+                });
+            }
+        }
+        check_non_negative(
+            path,
+            "sigma_cross_boresight_rad",
+            self.sigma_cross_boresight_rad,
+        )?;
+        check_non_negative(
+            path,
+            "sigma_about_boresight_rad",
+            self.sigma_about_boresight_rad,
+        )?;
+        check_finite(path, "bias_c_rad", self.bias_c_rad.as_slice())?;
+        check_non_negative(path, "sun_exclusion_rad", self.sun_exclusion_rad)?;
+        if self.max_rate_rad_s.is_nan() {
+            return Err(ParamError::NotFinite {
+                field: join(path, "max_rate_rad_s"),
+            });
+        }
+        check_positive(path, "max_rate_rad_s", self.max_rate_rad_s.min(f64::MAX))
+    }
+}
+
+/// One star-tracker output.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StarTrackerSample {
+    /// Measured q_CN, scalar first, q₀ ≥ 0 (held while invalid).
+    pub q_cn: Vector4<f64>,
+    /// Whether `q_cn` is a fresh measurement.
+    pub valid: bool,
+    /// Why not (`flexdyn_proto::star_tracker_flags`), 0 when valid.
+    pub status_flags: u8,
+}
+
+impl StarTrackerSample {
+    /// The wire message with `header`.
+    pub fn to_msg(&self, header: Header) -> StarTrackerMsg {
+        StarTrackerMsg {
+            header,
+            q_cn: self.q_cn.into(),
+            valid: self.valid,
+            status_flags: self.status_flags,
+        }
+    }
+
+    /// The first non-finite component's name, if any.
+    pub fn first_non_finite(&self) -> Option<&'static str> {
+        (!self.q_cn.iter().all(|v| v.is_finite())).then_some("q_cn")
+    }
+}
+
+/// A star tracker with its noise generator and held output.
+#[derive(Debug, Clone)]
+pub struct StarTracker {
+    cfg: StarTrackerConfig,
+    /// ê₁, ê₂ of the module docs (C components).
+    e1_c: Vector3<f64>,
+    e2_c: Vector3<f64>,
+    rng: NormalRng,
+    held_q_cn: Vector4<f64>,
+    /// The last update (invalid, the identity, before the first).
+    last: StarTrackerSample,
+}
+
+impl StarTracker {
+    /// A tracker from a validated configuration.
+    pub fn new(cfg: StarTrackerConfig, path: &str) -> Result<Self, ParamError> {
+        cfg.validate(path)?;
+        let b = cfg.boresight_c;
+        let helper = if b.cross(&Vector3::x()).norm() > 0.5 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        };
+        let e1_c = b.cross(&helper).normalize();
+        let e2_c = b.cross(&e1_c);
+        Ok(Self {
+            rng: NormalRng::new(cfg.seed),
+            e1_c,
+            e2_c,
+            held_q_cn: Vector4::new(1.0, 0.0, 0.0, 0.0),
+            last: StarTrackerSample {
+                q_cn: Vector4::new(1.0, 0.0, 0.0, 0.0),
+                valid: false,
+                status_flags: 0,
+            },
+            cfg,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &StarTrackerConfig {
+        &self.cfg
+    }
+
+    /// The name.
+    pub fn name(&self) -> &str {
+        &self.cfg.name
+    }
+
+    /// Whether the tracker updates at frame boundary `tick`.
+    pub fn due(&self, tick: u64) -> bool {
+        tick.is_multiple_of(self.cfg.every_frames)
+    }
+
+    /// The last update (see [`Sensor::sample`]).
+    pub fn last(&self) -> StarTrackerSample {
+        self.last
+    }
+
+    /// The cross-boresight axes (ê₁, ê₂) in C, for tests that project errors on them.
+    pub fn cross_axes_c(&self) -> (Vector3<f64>, Vector3<f64>) {
+        (self.e1_c, self.e2_c)
+    }
+
+    /// One update at the true attitude `sigma_bn` and rate `omega_bn_b` (allocates nothing).
+    pub fn sample(
+        &mut self,
+        sigma_bn: &Vector3<f64>,
+        omega_bn_b: &Vector3<f64>,
+    ) -> StarTrackerSample {
+        let (n1, n2) = self.rng.normal_pair();
+        let (n3, _) = self.rng.normal_pair();
+        let c = &self.cfg;
+        let dcm_cn = c.dcm_cb * mrp_to_dcm(sigma_bn);
+        let mut flags = 0;
+        let boresight_n = dcm_cn.transpose() * c.boresight_c;
+        if c.sun_exclusion_rad > 0.0
+            && boresight_n.dot(&c.sun_direction_n).clamp(-1.0, 1.0).acos() < c.sun_exclusion_rad
+        {
+            flags |= star_tracker_flags::SUN_EXCLUSION;
+        }
+        if omega_bn_b.norm() > c.max_rate_rad_s {
+            flags |= star_tracker_flags::RATE_LIMIT;
+        }
+        if flags != 0 {
+            return StarTrackerSample {
+                q_cn: self.held_q_cn,
+                valid: false,
+                status_flags: flags,
+            };
+        }
+        let dtheta_c = c.bias_c_rad
+            + self.e1_c * (c.sigma_cross_boresight_rad * n1)
+            + self.e2_c * (c.sigma_cross_boresight_rad * n2)
+            + c.boresight_c * (c.sigma_about_boresight_rad * n3);
+        let q = dcm_to_quat(&(rotation(&dtheta_c) * dcm_cn));
+        let q = if q[0] < 0.0 { -q } else { q };
+        self.held_q_cn = q;
+        StarTrackerSample {
+            q_cn: q,
+            valid: true,
+            status_flags: 0,
+        }
+    }
+}
+
+impl Sensor for StarTracker {
+    fn kind(&self) -> &'static SensorKind {
+        &KIND
+    }
+
+    fn name(&self) -> &str {
+        &self.cfg.name
+    }
+
+    fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        let c = &self.cfg;
+        out.push((
+            "sigma_cross_boresight_rad".into(),
+            c.sigma_cross_boresight_rad,
+        ));
+        out.push((
+            "sigma_about_boresight_rad".into(),
+            c.sigma_about_boresight_rad,
+        ));
+        for i in 0..3 {
+            out.push((format!("bias_c_rad[{i}]"), c.bias_c_rad[i]));
+        }
+        out.push(("sun_exclusion_rad".into(), c.sun_exclusion_rad));
+        out.push(("max_rate_rad_s".into(), c.max_rate_rad_s));
+    }
+
+    fn due(&self, tick: u64) -> bool {
+        StarTracker::due(self, tick)
+    }
+
+    /// One update at the true attitude and rate ([`StarTracker::sample`]).
+    fn sample(&mut self, truth: &Truth<'_>) {
+        self.last = StarTracker::sample(self, &truth.state.sigma_bn, &truth.state.omega_bn_b);
+    }
+
+    /// `seq` counts the tracker's updates: the frame's tick / `every_frames`.
+    fn encode(&self, header: Header, buf: &mut Vec<u8>) {
+        let header = Header {
+            seq: header.tick / self.cfg.every_frames,
+            ..header
+        };
+        encode_into(&self.last.to_msg(header), buf);
+    }
+
+    fn first_non_finite(&self) -> Option<&'static str> {
+        self.last.first_non_finite()
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    /// `q` (q_CN, scalar first; a fault's transform is not renormalised).
+    fn fault_channels(&self) -> &'static [&'static str] {
+        &["q"]
+    }
+
+    fn fault_axes(&self, channel: usize) -> usize {
+        if channel == 0 {
+            4
+        } else {
+            0
+        }
+    }
+
+    fn fault_channel(&mut self, channel: usize) -> &mut [f64] {
+        match channel {
+            0 => self.last.q_cn.as_mut_slice(),
+            _ => &mut [],
+        }
+    }
+
+    fn has_validity(&self) -> bool {
+        true
+    }
+
+    fn is_valid(&self) -> bool {
+        self.last.valid
+    }
+
+    /// `valid = false` (the quaternion and the status flags as measured).
+    fn force_invalid(&mut self) {
+        self.last.valid = false;
+    }
+}
+
+/// The frame rotation [C̃C] by the rotation vector `theta` (through its MRP, exact).
+fn rotation(theta: &Vector3<f64>) -> Matrix3<f64> {
+    let angle = theta.norm();
+    if angle == 0.0 {
+        return Matrix3::identity();
+    }
+    mrp_to_dcm(&(theta * ((angle / 4.0).tan() / angle)))
+}
+
+/// The rotation vector of a proper DCM (the inverse of the frame rotation used for the noise),
+/// for tests and tools that compare a measurement with the truth: [C̃C] = R(δθ) ⇒ δθ.
+pub fn rotation_vector(dcm: &Matrix3<f64>) -> Vector3<f64> {
+    let sigma = flexdyn_kernel::attitude::dcm_to_mrp(dcm);
+    let s = sigma.norm();
+    if s == 0.0 {
+        return Vector3::zeros();
+    }
+    sigma * (4.0 * s.atan() / s)
+}
