@@ -1,39 +1,45 @@
 //! flexdyn: a real-time flight-software-in-the-loop dynamics server.
 //!
 //! # Layout
-//! - [`attitude`]: MRP, DCM and quaternion kernels.
-//! - [`dynamics`]: the physics core — rigid hub + dual-hinged panel pairs by back-substitution.
-//! - [`environment`]: the world around the spacecraft — the epoch and its time scales, the
-//!   Earth's rotation, initial orbits from elements, TLE and OMM, ephemerides, shadow, magnetic
-//!   field, atmosphere, the facet (flat-plate) surface model, and the sample the dynamic
-//!   effectors and sensors read.
-//! - [`schema`]: the typed TOML reader the per-model schemas use.
-//! - [`sensors`]: sensor models — [`sensors::imu`] (gyro and accelerometer).
-//! - [`logging`]: the stderr log setup shared by `flexdyn`, the tools and the demo flight code
-//!   (EPIPE-safe); `flexdyn_proto::client::logging`.
-//! - [`transport`]: the one Zenoh configuration builder (loopback, multicast scouting off),
-//!   shared by the server, the tools and flight code; `flexdyn_proto::client::transport`.
-//! - [`sinks`]: recording (MCAP), replay, export, the live Foxglove view and plots.
-//! - [`campaign`]: Monte Carlo campaigns with flight code in the loop.
-//! - [`server`]: the Zenoh server (`flexdyn run`): real-time, lockstep and batch propagation.
+//! The workspace is cut into crates along its layers, bottom up (each depends only on those below
+//! it; `.ci/layers` checks it from cargo's dependency graph):
+//! - `flexdyn-proto` (`proto/`): the wire;
+//! - `flexdyn-kernel`: [`attitude`], [`numfmt`], [`validate`] and the typed TOML [`schema`]
+//!   reader;
+//! - `flexdyn-environment` ([`environment`]): the epoch and its time scales, the Earth's
+//!   rotation, orbits from elements, TLE and OMM, ephemerides, shadow, magnetic field,
+//!   atmosphere, facets, and the sample the dynamic effectors and sensors read;
+//! - `flexdyn-dynamics` ([`dynamics`]): the hub, state effectors by back-substitution, dynamic
+//!   effectors, integrators;
+//! - `flexdyn-sensors` ([`sensors`]) and `flexdyn-faults` ([`faults`]);
+//! - `flexdyn-vehicle`: the [`config`]uration file, one vehicle ([`sim`]) and the world of
+//!   vehicles ([`world`]).
+//!
+//! This crate re-exports them under their old paths and holds what sits above them, for now:
+//! - [`logging`], [`transport`]: the stderr log setup and the one Zenoh configuration builder
+//!   (loopback, multicast scouting off), shared with the tools and flight code
+//!   (`flexdyn_proto::client`);
+//! - [`sinks`]: recording (MCAP), replay, export, the live Foxglove view and plots;
+//! - [`campaign`]: Monte Carlo campaigns with flight code in the loop;
+//! - [`server`]: the Zenoh server (`flexdyn run`): real-time, lockstep and batch propagation;
+//! - [`cli`] and [`world::run`]: the offline front ends `flexdyn simulate` and `flexdyn fleet`.
 
 #![warn(missing_docs)]
 
 pub mod campaign;
 pub mod cli;
-pub mod config;
 pub mod server;
 pub mod signals;
-pub mod sim;
 pub mod sinks;
 pub mod world;
 
 pub use flexdyn_proto::client::{logging, transport};
 
-// The model layers are crates of their own (`crates/`); their old paths stay re-exported here
-// while the layers above them move into crates too.
+// The model and vehicle layers are crates of their own (`crates/`); their old paths stay
+// re-exported here while the layers above them move into crates too.
 pub use flexdyn_dynamics as dynamics;
 pub use flexdyn_environment as environment;
 pub use flexdyn_faults as faults;
 pub use flexdyn_kernel::{attitude, numfmt, schema, validate};
 pub use flexdyn_sensors as sensors;
+pub use flexdyn_vehicle::{config, sim};

@@ -1,5 +1,5 @@
 //! The sections of the kinds configured through the generic component list
-//! ([`crate::dynamics::component`]): every kind in [`crate::dynamics::kinds::KINDS`] that has a
+//! ([`flexdyn_dynamics::component`]): every kind in [`flexdyn_dynamics::kinds::KINDS`] that has a
 //! reader (`[[magnetorquers]]`, `[[thrusters]]`, …).
 //!
 //! Each kind's reader and validation live in its folder; this file reads the sections in
@@ -10,9 +10,9 @@
 
 use std::collections::HashSet;
 
-use crate::dynamics::component::{ComponentSpec, Components, StepTiming};
-use crate::dynamics::kinds::KINDS;
-use crate::schema::TableReader;
+use flexdyn_dynamics::component::{ComponentSpec, Components, StepTiming};
+use flexdyn_dynamics::kinds::KINDS;
+use flexdyn_kernel::schema::TableReader;
 
 use super::{unique_name, ConfigError, SourceMap};
 
@@ -72,7 +72,7 @@ pub(super) fn wire_bytes(components: &Components) -> usize {
 #[cfg(test)]
 mod tests {
     use crate::config::SimConfig;
-    use crate::dynamics::kinds;
+    use flexdyn_dynamics::kinds;
 
     /// The effector registry's wire names agree with what each effector built from a
     /// configuration says of itself (a test of the configuration, which builds them).
@@ -80,7 +80,7 @@ mod tests {
     fn wire_names_match_what_each_built_effector_says() {
         let text = std::fs::read_to_string(concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/scenarios/acs_full.toml"
+            "/../../scenarios/acs_full.toml"
         ))
         .unwrap();
         let sc = SimConfig::from_toml_str(&text)
@@ -104,7 +104,7 @@ mod tests {
         assert_eq!(kinds, registered);
         assert!(kinds::wire_names(999, 1, 0).is_none());
         assert!(
-            kinds::wire_names(crate::dynamics::effectors::panel_pair::KIND.wire_tag, 3, 0)
+            kinds::wire_names(flexdyn_dynamics::effectors::panel_pair::KIND.wire_tag, 3, 0)
                 .is_none()
         );
     }

@@ -3,12 +3,10 @@
 //! - [`fleet`]: the fleet file (vehicles, their spacecraft configurations, initial orbits
 //!   absolute or relative to a chief, participants).
 //! - [`step`]: the [`World`] that steps N [`Vehicle`]s (each a [`crate::sim::Simulation`]).
-//! - [`run`]: `flexdyn fleet`, the offline propagation of a fleet file to CSV.
 //! - [`relative`]: a deputy's position and velocity in its chief's Hill frame, range, range rate.
 
 pub mod fleet;
 pub mod relative;
-pub mod run;
 pub mod step;
 
 pub use fleet::{FleetConfig, FleetError, VehicleConfig};

@@ -17,7 +17,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::dynamics::Spacecraft;
+use flexdyn_dynamics::Spacecraft;
 
 /// The deputy's state relative to the chief, both taken at their centres of mass.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -105,7 +105,7 @@ pub fn deputy_state_n(
 pub fn com_state_n(sc: &Spacecraft) -> (Vector3<f64>, Vector3<f64>) {
     let (_, c_b, c_dot_b) = sc.center_of_mass();
     let x = sc.state();
-    let dcm_nb = crate::attitude::mrp_to_dcm(&x.sigma_bn).transpose();
+    let dcm_nb = flexdyn_kernel::attitude::mrp_to_dcm(&x.sigma_bn).transpose();
     (x.r_bn_n + dcm_nb * c_b, x.v_bn_n + dcm_nb * c_dot_b)
 }
 

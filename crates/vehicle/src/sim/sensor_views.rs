@@ -4,18 +4,18 @@
 
 use std::num::NonZeroU64;
 
-use crate::dynamics::SensorPoint;
-use crate::sensors::coarse_sun_sensor::CoarseSunSensor;
-use crate::sensors::fine_sun_sensor::FineSunSensor;
-use crate::sensors::gps::Gps;
-use crate::sensors::imu::{Imu, ImuSample, ImuSensor};
-use crate::sensors::magnetometer::Magnetometer;
-use crate::sensors::star_tracker::{StarTracker, StarTrackerSample};
-use crate::sensors::Sensor;
+use flexdyn_dynamics::SensorPoint;
+use flexdyn_sensors::coarse_sun_sensor::CoarseSunSensor;
+use flexdyn_sensors::fine_sun_sensor::FineSunSensor;
+use flexdyn_sensors::gps::Gps;
+use flexdyn_sensors::imu::{Imu, ImuSample, ImuSensor};
+use flexdyn_sensors::magnetometer::Magnetometer;
+use flexdyn_sensors::star_tracker::{StarTracker, StarTrackerSample};
+use flexdyn_sensors::Sensor;
 
 use super::Simulation;
 
-// `crate::sensors::imu`
+// `flexdyn_sensors::imu`
 impl Simulation {
     /// The IMUs, in config order.
     pub fn imu_sensors(&self) -> impl Iterator<Item = &ImuSensor> {
@@ -60,7 +60,7 @@ impl Simulation {
     }
 }
 
-// `crate::sensors::star_tracker`
+// `flexdyn_sensors::star_tracker`
 impl Simulation {
     /// The star trackers, in config order (topic `flexdyn/<sc-id>/tlm/st/<name>`).
     pub fn star_trackers(&self) -> Vec<&StarTracker> {
@@ -91,7 +91,7 @@ impl Simulation {
     }
 }
 
-// `crate::sensors::magnetometer`
+// `flexdyn_sensors::magnetometer`
 impl Simulation {
     /// The magnetometers, in config order (topic `flexdyn/<sc-id>/tlm/mag/<name>`).
     pub fn magnetometers(&self) -> Vec<&Magnetometer> {
@@ -99,7 +99,7 @@ impl Simulation {
     }
 }
 
-// `crate::sensors::coarse_sun_sensor`
+// `flexdyn_sensors::coarse_sun_sensor`
 impl Simulation {
     /// The coarse-sun-sensor arrays, in config order (topic `flexdyn/<sc-id>/tlm/css/<name>`).
     pub fn coarse_sun_sensors(&self) -> Vec<&CoarseSunSensor> {
@@ -107,7 +107,7 @@ impl Simulation {
     }
 }
 
-// `crate::sensors::fine_sun_sensor`
+// `flexdyn_sensors::fine_sun_sensor`
 impl Simulation {
     /// The fine sun sensors, in config order (topic `flexdyn/<sc-id>/tlm/fss/<name>`).
     pub fn fine_sun_sensors(&self) -> Vec<&FineSunSensor> {
@@ -115,7 +115,7 @@ impl Simulation {
     }
 }
 
-// `crate::sensors::gps`
+// `flexdyn_sensors::gps`
 impl Simulation {
     /// The GPS receivers, in config order (topic `flexdyn/<sc-id>/tlm/gps/<name>`).
     pub fn gps_receivers(&self) -> Vec<&Gps> {

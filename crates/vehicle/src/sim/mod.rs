@@ -5,11 +5,11 @@
 //! inputs). Before every RK4 step it applies `schedule(t) + command` to both, where `t` is the
 //! time at the start of the step; wrench and inputs are then held constant over the step.
 //!
-//! It also owns the sensors ([`crate::sensors::SensorBank`]): [`Simulation::sample_sensors`]
+//! It also owns the sensors ([`flexdyn_sensors::SensorBank`]): [`Simulation::sample_sensors`]
 //! samples those picked (the ones due at a frame boundary in the server; in `simulate`, the
 //! interval sensors such as the IMUs at every log row and the others at their frame boundaries)
 //! from one [`Truth`], and the IMUs integrate their Δv over the integrator's stages (the bank is
-//! the step's [`crate::dynamics::stage_hook::StageHook`]).
+//! the step's [`flexdyn_dynamics::stage_hook::StageHook`]).
 
 mod sensor_views;
 
@@ -17,15 +17,15 @@ use std::num::NonZeroU64;
 
 use flexdyn_proto::{EffectorState, StateMsg};
 
-use crate::attitude::{mrp_to_dcm, mrp_to_quat};
 use crate::config::{ConfigError, EffectorInputSegment, SimConfig};
-use crate::dynamics::{
+use flexdyn_dynamics::{
     EnvironmentSource, HubOutputs, ParamError, Spacecraft, Wrench, WrenchSegment,
 };
-use crate::environment::model::EnvironmentModel;
-use crate::faults::ports::FaultHost;
-use crate::faults::Faults;
-use crate::sensors::{Sensor, SensorBank, Truth};
+use flexdyn_environment::model::EnvironmentModel;
+use flexdyn_faults::ports::FaultHost;
+use flexdyn_faults::Faults;
+use flexdyn_kernel::attitude::{mrp_to_dcm, mrp_to_quat};
+use flexdyn_sensors::{Sensor, SensorBank, Truth};
 
 /// A spacecraft being propagated, with its external wrench sources.
 #[derive(Debug)]
@@ -62,10 +62,10 @@ pub struct Simulation {
     /// step boundaries and handed to the spacecraft's dynamic effectors.
     environment: Option<EnvironmentModel>,
     /// The `[epoch]` (t = 0), if the configuration has one: the time service's calendar.
-    epoch: Option<crate::environment::epoch::SimEpoch>,
+    epoch: Option<flexdyn_environment::epoch::SimEpoch>,
     /// `[environment] telemetry_rate_hz` in frames (`None`: no environment record).
     environment_every_frames: Option<u64>,
-    /// The faults at the sensor and actuator ports ([`crate::faults`]).
+    /// The faults at the sensor and actuator ports ([`flexdyn_faults`]).
     faults: Faults,
 }
 
@@ -463,7 +463,7 @@ impl Simulation {
     }
 
     /// The `[epoch]` (the instant of t = 0), if configured.
-    pub fn epoch(&self) -> Option<&crate::environment::epoch::SimEpoch> {
+    pub fn epoch(&self) -> Option<&flexdyn_environment::epoch::SimEpoch> {
         self.epoch.as_ref()
     }
 

@@ -12,9 +12,9 @@
 use std::collections::HashMap;
 
 use super::{check_max_time, whole_ns, ConfigError, SourceMap};
-use crate::dynamics::{ParamError, Spacecraft};
-use crate::numfmt::Num;
-use crate::schema::TableReader;
+use flexdyn_dynamics::{ParamError, Spacecraft};
+use flexdyn_kernel::numfmt::Num;
+use flexdyn_kernel::schema::TableReader;
 
 /// Keys of an `[[effector_input_schedule]]` row.
 pub(super) const KEYS: [&str; 3] = ["t_s", "effector", "inputs"];
@@ -45,7 +45,7 @@ pub struct EffectorInputSegment {
     /// The effector's index in the spacecraft's effector order (panel pairs, then reaction
     /// wheels), as in `StateMsg.effectors` and `Actuators` commands.
     pub effector_index: usize,
-    /// Its inputs, one per [`crate::dynamics::StateEffector::input_names`] (a wheel: the motor
+    /// Its inputs, one per [`flexdyn_dynamics::StateEffector::input_names`] (a wheel: the motor
     /// torque, N·m, about +ĝ_s).
     pub inputs: Vec<f64>,
 }

@@ -8,17 +8,17 @@
 
 use std::path::Path;
 
-use crate::dynamics::GravityModel;
-use crate::environment::epoch::schema::{self as epoch_schema, RawEpoch};
-use crate::environment::epoch::SimEpoch;
-use crate::environment::geodetic::WGS84_A_M;
-use crate::environment::model::schema as env_schema;
-use crate::environment::model::{
+use flexdyn_dynamics::GravityModel;
+use flexdyn_environment::epoch::schema::{self as epoch_schema, RawEpoch};
+use flexdyn_environment::epoch::SimEpoch;
+use flexdyn_environment::geodetic::WGS84_A_M;
+use flexdyn_environment::model::schema as env_schema;
+use flexdyn_environment::model::{
     AtmosphereSetting, EnvironmentBuildError, EnvironmentModel, EnvironmentSettings,
     MagneticSetting,
 };
-use crate::environment::orbit::schema::{self as orbit_schema, InitialOrbit, RawOrbit};
-use crate::schema::{SchemaError, TableReader};
+use flexdyn_environment::orbit::schema::{self as orbit_schema, InitialOrbit, RawOrbit};
+use flexdyn_kernel::schema::{SchemaError, TableReader};
 
 use super::{ConfigError, SourceMap};
 
@@ -219,15 +219,15 @@ impl RawWorld {
 /// drag, solar pressure, residual dipole. The settings were validated when read (facets, a
 /// central body, the models each effector reads), so this cannot fail.
 pub(super) fn add_dynamic_effectors(
-    sc: &mut crate::dynamics::Spacecraft,
+    sc: &mut flexdyn_dynamics::Spacecraft,
     env: &EnvironmentSettings,
     gravity: &GravityModel,
 ) {
-    use crate::dynamics::dynamic_effectors::{
+    use flexdyn_dynamics::dynamic_effectors::{
         aero_drag::AeroDrag, gravity_gradient::GravityGradient, residual_dipole::ResidualDipole,
         solar_pressure::SolarPressure,
     };
-    use crate::environment::facets::{FacetModel, SOLAR_IRRADIANCE_1AU_W_M2};
+    use flexdyn_environment::facets::{FacetModel, SOLAR_IRRADIANCE_1AU_W_M2};
     let facets = || FacetModel::new(env.facets.clone()).unwrap_or_default();
     if env.gravity_gradient {
         let mu_m3_s2 = match *gravity {

@@ -10,12 +10,12 @@
 //! position, the Earth's orientation, the Sun and the Moon at an update instant (the fleet file
 //! gives every vehicle the same epoch), is evaluated once for the world: the vehicles' models
 //! share one [`CommonCache`], and the first vehicle to reach an instant fills it for the others
-//! ([`crate::environment::common`]; the samples are the same bits either way).
+//! ([`flexdyn_environment::common`]; the samples are the same bits either way).
 
 use std::sync::Arc;
 
-use crate::environment::common::CommonCache;
 use crate::sim::Simulation;
+use flexdyn_environment::common::CommonCache;
 
 use super::fleet::{FleetConfig, FleetError};
 use super::relative::{com_state_n, relative_state_hill, RelativeState};
@@ -98,7 +98,7 @@ impl World {
     }
 
     /// The vehicles, taken out of the world (the server steps each with its own command book
-    /// and telemetry, on one physics thread: `crate::server::fleet`).
+    /// and telemetry, on one physics thread: `flexdyn::server::fleet`).
     pub fn into_vehicles(self) -> Vec<Vehicle> {
         self.vehicles
     }

@@ -31,7 +31,7 @@ use std::path::{Path, PathBuf};
 use nalgebra::Vector3;
 
 use crate::config::{ConfigError, SimConfig};
-use crate::dynamics::InitialTranslation;
+use flexdyn_dynamics::InitialTranslation;
 
 /// A fleet file that cannot be used. The message names the vehicle and the field.
 #[derive(Debug, thiserror::Error)]

@@ -11,8 +11,8 @@ use std::path::Path;
 use toml::de::DeTable;
 
 use super::{At, SimConfig, SourceMap};
-use crate::dynamics::effectors::reaction_wheel;
-use crate::schema::plausible::Implausible;
+use flexdyn_dynamics::effectors::reaction_wheel;
+use flexdyn_kernel::schema::plausible::Implausible;
 
 /// One implausible value: its field, what is implausible and the likely intended unit, and its
 /// position in the file.
@@ -34,7 +34,7 @@ impl fmt::Display for ConfigWarning {
 
 impl SimConfig {
     /// The plausibility warnings (module docs): the reaction wheels', then every sensor kind's
-    /// ([`crate::sensors::params::SensorParams::implausible`], registry order), in file order
+    /// ([`flexdyn_sensors::params::SensorParams::implausible`], registry order), in file order
     /// within each.
     pub fn warnings(&self) -> Vec<ConfigWarning> {
         let mut found: Vec<Implausible> = Vec::new();

@@ -1,14 +1,14 @@
 //! `[[faults]]` against the vehicle this configuration builds: each entry is resolved by the
-//! fault layer's [`crate::faults::targets`] rules against the built spacecraft and sensor
+//! fault layer's [`flexdyn_faults::targets`] rules against the built spacecraft and sensor
 //! bank, and a period shorter than the integration step is refused here. Live faults are checked
 //! by the same rules through the [`LiveResolver`] this configuration builds.
 
 use super::{ConfigError, SimConfig, SourceMap};
-use crate::dynamics::Spacecraft;
-use crate::faults::live::LiveResolver;
-use crate::faults::schema::RawFault;
-use crate::faults::targets::resolve_one;
-use crate::faults::FaultSpec;
+use flexdyn_dynamics::Spacecraft;
+use flexdyn_faults::live::LiveResolver;
+use flexdyn_faults::schema::RawFault;
+use flexdyn_faults::targets::resolve_one;
+use flexdyn_faults::FaultSpec;
 
 /// Resolves every entry against `cfg`'s sensors and the spacecraft `sc` built from it.
 pub(crate) fn resolve(

@@ -32,37 +32,37 @@ use std::path::Path;
 
 use toml::de::DeTable;
 
-pub use crate::dynamics::component::Components;
-use crate::numfmt::{Num, Rounded};
-use crate::schema::checks::{every_frames, round_ns, unique_name};
-pub use crate::schema::checks::{whole_ns, WHOLE_NS_TOL};
-pub use crate::schema::config_error::ConfigError;
-use crate::schema::location;
-pub(crate) use crate::schema::source_map::SourceMap;
-use crate::schema::{mat3, vec3, TableReader};
-pub use crate::schema::{At, Location};
 pub use file::{config_message, load_config};
+pub use flexdyn_dynamics::component::Components;
+use flexdyn_kernel::numfmt::{Num, Rounded};
+use flexdyn_kernel::schema::checks::{every_frames, round_ns, unique_name};
+pub use flexdyn_kernel::schema::checks::{whole_ns, WHOLE_NS_TOL};
+pub use flexdyn_kernel::schema::config_error::ConfigError;
+use flexdyn_kernel::schema::location;
+pub use flexdyn_kernel::schema::source_map::SourceMap;
+use flexdyn_kernel::schema::{mat3, vec3, TableReader};
+pub use flexdyn_kernel::schema::{At, Location};
 use flexdyn_proto::MAX_PANEL_PAIRS;
 pub use schedule::EffectorInputSegment;
 pub use warnings::{log_warnings, warning_message, ConfigWarning};
 
-use crate::dynamics::component::{BuiltComponent, StepTiming};
-use crate::dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
-use crate::dynamics::effectors::reaction_wheel;
-use crate::dynamics::integrator::{self, ButcherTableau, RK4};
-use crate::dynamics::{
+use flexdyn_dynamics::component::{BuiltComponent, StepTiming};
+use flexdyn_dynamics::effectors::panel_pair::{self, schema::RawPanelPair};
+use flexdyn_dynamics::effectors::reaction_wheel;
+use flexdyn_dynamics::integrator::{self, ButcherTableau, RK4};
+use flexdyn_dynamics::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
     PanelPairParams, ParamError, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
     WrenchSegment,
 };
-use crate::sensors::imu::ImuConfig;
-use crate::sensors::magnetometer::MagnetometerConfig;
-pub use crate::sensors::params::SensorConfigs;
-use crate::sensors::star_tracker::StarTrackerConfig;
-use crate::sensors::{SensorBank, SensorBuild};
+use flexdyn_sensors::imu::ImuConfig;
+use flexdyn_sensors::magnetometer::MagnetometerConfig;
+pub use flexdyn_sensors::params::SensorConfigs;
+use flexdyn_sensors::star_tracker::StarTrackerConfig;
+use flexdyn_sensors::{SensorBank, SensorBuild};
 
 /// The built-in default configuration (the text of `scenarios/reference.toml`).
-pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../scenarios/reference.toml");
+pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../../../scenarios/reference.toml");
 
 /// A validated simulation configuration.
 #[derive(Debug, Clone, PartialEq)]
@@ -87,7 +87,7 @@ pub struct SimConfig {
     /// They follow the panel pairs in the effector order.
     pub reaction_wheels: Vec<ReactionWheelParams>,
     /// The components of every registered kind configured through the generic list
-    /// ([`crate::dynamics::kinds::KINDS`]: `[[magnetorquers]]`, `[[thrusters]]`, …), validated,
+    /// ([`flexdyn_dynamics::kinds::KINDS`]: `[[magnetorquers]]`, `[[thrusters]]`, …), validated,
     /// in registry order then file order; they follow the reaction wheels in the effector order
     /// (appended bodies among them before listed actuators).
     pub components: Components,
@@ -98,17 +98,17 @@ pub struct SimConfig {
     pub effector_input_schedule: Vec<EffectorInputSegment>,
     /// The `[server]` table, uninterpreted (empty if absent); the server validates it.
     pub server: toml::Table,
-    /// The sensors of every registered kind ([`crate::sensors::KINDS`]: `[[imus]]`,
+    /// The sensors of every registered kind ([`flexdyn_sensors::KINDS`]: `[[imus]]`,
     /// `[[star_trackers]]`, …), validated, in registry order then file order; typed access by
     /// kind: `cfg.sensors.of::<ImuConfig>()`.
     pub sensors: SensorConfigs,
     /// The simulation epoch (`[epoch]`), if given: t = 0 is this instant.
-    pub epoch: Option<crate::environment::epoch::SimEpoch>,
+    pub epoch: Option<flexdyn_environment::epoch::SimEpoch>,
     /// The environment (`[environment]`), if given: models and dynamic effectors.
-    pub environment: Option<crate::environment::model::EnvironmentSettings>,
+    pub environment: Option<flexdyn_environment::model::EnvironmentSettings>,
     /// The faults (`[[faults]]`), resolved against the spacecraft and its sensors, in file
     /// order (empty if absent).
-    pub faults: Vec<crate::faults::FaultSpec>,
+    pub faults: Vec<flexdyn_faults::FaultSpec>,
     /// The configuration text this was parsed from.
     pub source_toml: String,
 }
@@ -182,7 +182,7 @@ impl SimConfig {
         &'a self,
         sample_interval_s: f64,
         t_sim_ns: u64,
-        x: &'a crate::dynamics::State,
+        x: &'a flexdyn_dynamics::State,
     ) -> SensorBuild<'a> {
         SensorBuild {
             sensors: &self.sensors,
@@ -196,7 +196,10 @@ impl SimConfig {
 
     /// The sensor bank of this configuration at t = 0 in state `x`, sampled at the frame period:
     /// what `[[faults]]` targets and live faults are checked against.
-    pub fn frame_sensor_bank(&self, x: &crate::dynamics::State) -> Result<SensorBank, ConfigError> {
+    pub fn frame_sensor_bank(
+        &self,
+        x: &flexdyn_dynamics::State,
+    ) -> Result<SensorBank, ConfigError> {
         SensorBank::new(&self.sensor_build(self.frame_ns as f64 * 1e-9, 0, x))
     }
 
@@ -247,10 +250,10 @@ impl SimConfig {
     /// date (the gravity gradient alone reads none: `None`, as without `[environment]`).
     pub fn environment_model(
         &self,
-    ) -> Result<Option<crate::environment::model::EnvironmentModel>, ConfigError> {
+    ) -> Result<Option<flexdyn_environment::model::EnvironmentModel>, ConfigError> {
         match (&self.environment, &self.epoch) {
             (Some(env), Some(epoch)) if env.needs_epoch() => {
-                crate::environment::model::EnvironmentModel::new(env, epoch)
+                flexdyn_environment::model::EnvironmentModel::new(env, epoch)
                     .map(|m| Some(m.on_step_grid(self.step_ns)))
                     .map_err(|e| ConfigError::Invalid {
                         field: "environment".into(),
@@ -284,7 +287,7 @@ pub fn config_summary(cfg: &SimConfig) -> String {
         },
         {
             let mut s = String::new();
-            for kind in crate::dynamics::kinds::KINDS {
+            for kind in flexdyn_dynamics::kinds::KINDS {
                 let n = cfg.components.count(kind);
                 if n > 0 {
                     s += &format!(", {n} {}", kind.section);
@@ -363,12 +366,12 @@ struct RawConfig {
     initial: RawInitial,
     panel_pairs: Vec<RawPanelPair>,
     reaction_wheels: Vec<ReactionWheelParams>,
-    components: Vec<Box<dyn crate::dynamics::component::ComponentSpec>>,
+    components: Vec<Box<dyn flexdyn_dynamics::component::ComponentSpec>>,
     wrench_schedule: Vec<RawWrench>,
     effector_input_schedule: Vec<schedule::RawInputRow>,
     server: toml::Table,
     sensors: sensors::RawSensors,
-    faults: Vec<crate::faults::schema::RawFault>,
+    faults: Vec<flexdyn_faults::schema::RawFault>,
 }
 
 struct RawSimulation {
@@ -508,8 +511,8 @@ impl RawConfig {
         let sensors = sensors::read(&root)?;
         let faults = root.read_tables(
             "faults",
-            &crate::faults::schema::KEYS,
-            crate::faults::schema::read,
+            &flexdyn_faults::schema::KEYS,
+            flexdyn_faults::schema::read,
         )?;
         Ok(RawConfig {
             faults,
@@ -1119,7 +1122,7 @@ fn check_gravity_bound(
     };
     let (_, r_cb_b_m, _) = sc.center_of_mass();
     let x = sc.state();
-    let dcm_nb = crate::attitude::mrp_to_dcm(&x.sigma_bn).transpose();
+    let dcm_nb = flexdyn_kernel::attitude::mrp_to_dcm(&x.sigma_bn).transpose();
     let r_cn_n_m = x.r_bn_n + dcm_nb * r_cb_b_m;
     let r_m = r_cn_n_m.norm();
     if let Some(r_eq_m) = r_eq_m {
@@ -1203,7 +1206,7 @@ impl RawInitial {
     fn to_initial(
         &self,
         map: &SourceMap,
-        orbit: Option<&crate::environment::orbit::schema::InitialOrbit>,
+        orbit: Option<&flexdyn_environment::orbit::schema::InitialOrbit>,
         has_orbit: bool,
     ) -> Result<HubInitial, ConfigError> {
         let err = |field: &str, problem: String| {

@@ -1,13 +1,13 @@
 //! The sensor sections (`[[imus]]`, `[[star_trackers]]`, …): every kind in
-//! [`crate::sensors::KINDS`], read through its [`crate::sensors::params::SensorConfigReader`].
+//! [`flexdyn_sensors::KINDS`], read through its [`flexdyn_sensors::params::SensorConfigReader`].
 //!
 //! Each kind's reader and value checks live in its folder; this file reads the sections in
 //! registry order (pass 2), then resolves every entry (pass 4) with a [`SensorContext`] that
 //! checks names for uniqueness within a kind and converts rates to whole numbers of frames.
 
-use crate::schema::TableReader;
-use crate::sensors::params::{RawSensorConfig, SensorConfigs, SensorContext};
-use crate::sensors::KINDS;
+use flexdyn_kernel::schema::TableReader;
+use flexdyn_sensors::params::{RawSensorConfig, SensorConfigs, SensorContext};
+use flexdyn_sensors::KINDS;
 
 use super::{ConfigError, SourceMap};
 
