@@ -16,7 +16,7 @@
 //!
 //! Target (issue 24): ≤ 1e-10 relative energy error over 1e6 s.
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../crates/dynamics/tests/common.rs"]
 mod common;
 
 use std::time::Instant;

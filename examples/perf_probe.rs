@@ -1,6 +1,6 @@
 //! Steps the reference spacecraft (or `N` ring pairs) `STEPS` times, for `perf stat` cycle counts:
 //! `cargo build --release --example perf_probe && perf stat -e cycles:u,instructions:u target/release/examples/perf_probe 2 200000`.
-#[path = "../tests/common/mod.rs"]
+#[path = "../crates/dynamics/tests/common.rs"]
 mod common;
 
 fn main() {

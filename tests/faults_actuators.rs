@@ -1,4 +1,4 @@
-//! Actuator fault modes against the documented transforms (`src/faults/ports.rs`, "Actuator
+//! Actuator fault modes against the documented transforms (`crates/faults/src/ports.rs`, "Actuator
 //! modes, physically"). The input modes are checked by equivalence: a run with the fault and a
 //! healthy run of the same configuration whose flight code commands, inside the window, the
 //! documented transform of the command (outside it, the command itself) give bit-identical

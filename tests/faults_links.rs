@@ -1,4 +1,4 @@
-//! Command-link faults in lockstep (`links.<sender id>`: `src/faults/link.rs`). A scripted
+//! Command-link faults in lockstep (`links.<sender id>`: `crates/faults/src/link.rs`). A scripted
 //! participant answers tick k with the torque f(k) = (0, 0, 10⁻⁴ (k + 1)) N·m, a different value
 //! every tick, so the wrench the server applied over frame k → k + 1 (the `wrench_applied` of
 //! the state of tick k + 1) names the command it came from. Each faulty run is compared, tick by

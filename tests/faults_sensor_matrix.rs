@@ -1,5 +1,5 @@
 //! Every sensor fault mode on every sensor kind and every fault channel it exposes, against the
-//! documented transforms (`src/faults/modes.rs`, the README's fault table), sample by sample.
+//! documented transforms (`crates/faults/src/modes.rs`, the README's fault table), sample by sample.
 //!
 //! One scenario carries every sensor kind: `scenarios/acs_full.toml` (IMU, star tracker,
 //! magnetometer, coarse and fine sun sensors, all at the 10 Hz frame rate) with its fine sun
@@ -15,11 +15,11 @@
 //!   calling the production transform);
 //! - `dropout`: the target publishes nothing inside the window, and every other message of the
 //!   run is the healthy one. An IMU's Δθ and Δv are increments over the interval since its last
-//!   *sample*, and a fault acts on the published sample only (`src/faults/ports.rs`: after the
+//!   *sample*, and a fault acts on the published sample only (`crates/faults/src/ports.rs`: after the
 //!   bank samples), so the first message after a dropout carries its own interval, as in the
 //!   healthy run, not the dropped ones' sum; a `stuck_current` Δθ holds the first increment of
 //!   the window. A GPS fault acts on the message leaving the latency ring
-//!   (`src/sensors/gps/mod.rs`, "Faults"): the value published at t, measured at t − latency;
+//!   (`crates/sensors/src/gps/mod.rs`, "Faults"): the value published at t, measured at t − latency;
 //! - `validity_off` (the kinds with a validity flag): the flag cleared as each kind documents
 //!   (the README's table), nothing else changed.
 //!
@@ -54,7 +54,7 @@ const ONCE: Window = Window {
 /// \[s\] the run's length (20 frames).
 const END_S: f64 = 2.0;
 
-/// A fault's window, re-derived from `src/faults/window.rs`: active on
+/// A fault's window, re-derived from `crates/faults/src/window.rs`: active on
 /// [start + n·period, start + n·period + duration), n = 0, 1, … (n = 0 only without a period).
 #[derive(Clone, Copy)]
 struct Window {
@@ -454,7 +454,7 @@ fn validity_off_on_every_kind_with_a_flag() {
     validity_cell("gps_receivers.gps1", gps_no_fix, gps_fix);
 }
 
-/// A repeating fault re-arms at each activation (`src/faults/modes.rs`: x_on is the healthy
+/// A repeating fault re-arms at each activation (`crates/faults/src/modes.rs`: x_on is the healthy
 /// value at the first sample of the *current* activation, t_on the time since it began):
 /// `stuck_current` holds a new value each time, `bias_ramp` starts again from 0. Activations
 /// on [0.25, 0.55), [0.85, 1.15), [1.45, 1.75) s: samples at ticks 3–5, 9–11, 15–17.

@@ -1,4 +1,4 @@
-//! Sensor fault modes against the documented transforms (`src/faults/modes.rs`): a run with one
+//! Sensor fault modes against the documented transforms (`crates/faults/src/modes.rs`): a run with one
 //! `[[faults]]` entry and a healthy run of the same configuration (same seeds) are sampled at
 //! every frame; outside the fault's window every published message is identical, inside it the
 //! faulted fields equal the transform of the healthy ones, sample by sample, and every other

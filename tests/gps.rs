@@ -1,4 +1,4 @@
-//! The GPS receiver against its documented model (`src/sensors/gps/mod.rs`): a zero-error
+//! The GPS receiver against its documented model (`crates/sensors/src/gps/mod.rs`): a zero-error
 //! receiver reads the truth bit for bit (N from the state, ECEF through the environment's Earth
 //! rotation) and its velocities are the time derivatives of its positions; ECEF and N agree
 //! through the documented rotation, whose angle matches an independent sidereal time; the GPS

@@ -1,4 +1,4 @@
-//! The magnetometer against its documented model (`src/sensors/magnetometer/mod.rs`): a
+//! The magnetometer against its documented model (`crates/sensors/src/magnetometer/mod.rs`): a
 //! zero-error sensor reads [SB][BN] B_N bit for bit, bias / noise / quantisation are recovered
 //! within their standard errors, scale factor, misalignment and saturation act as documented,
 //! the stream is reproducible, and configuration errors name the file, the field and the problem.

@@ -1,5 +1,5 @@
 //! The coarse and fine sun sensors against their documented models
-//! (`src/sensors/coarse_sun_sensor/mod.rs`, `src/sensors/fine_sun_sensor/mod.rs`): zero-error
+//! (`crates/sensors/src/coarse_sun_sensor/mod.rs`, `crates/sensors/src/fine_sun_sensor/mod.rs`): zero-error
 //! sensors read the closed-form truth bit for bit (and agree with independent forms of it), the
 //! shadow factor and the field-of-view edges act as documented, bias / noise / quantisation are
 //! recovered within their standard errors, two runs give the same bytes, and configuration

@@ -85,7 +85,7 @@ pub fn acs_full_fss_at_the_sun() -> String {
     )
 }
 
-/// A GPS message made a no-fix one, as `validity_off` documents (`src/sensors/gps/mod.rs`,
+/// A GPS message made a no-fix one, as `validity_off` documents (`crates/sensors/src/gps/mod.rs`,
 /// "Faults"): FIX (bit 0) cleared and every number 0; the valid time and the frame flags stay.
 pub fn gps_no_fix(m: &mut Value) {
     m["flags"] = Value::from(m["flags"].as_u64().unwrap() & !1);

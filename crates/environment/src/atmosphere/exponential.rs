@@ -2,7 +2,7 @@
 //! Applications*, 4th ed. (2013), §8.6.2, Table 8-4: ρ(h) = ρ0 exp(−(h − h0)/H) with the band
 //! (h0, ρ0, H) whose base is the highest one at or below h (Vallado takes the values from the
 //! U.S. Standard Atmosphere 1976 and CIRA-72). The scale heights make the bands
-//! meet to 1e-4 (1.4e-3 at 25 km), which `tests/environment_atmosphere.rs` checks as the
+//! meet to 1e-4 (1.4e-3 at 25 km), which `crates/environment/tests/atmosphere.rs` checks as the
 //! transcription's invariant.
 //!
 //! It has no time, solar or geomagnetic dependence: a mean, not a forecast (the true density at

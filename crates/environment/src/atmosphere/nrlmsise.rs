@@ -15,7 +15,7 @@
 //! # What `tobari` 0.2.0 gets wrong, and what is done about it
 //! Checked against the 15 test cases of the reference C release (D. Brodowski's C version of the
 //! NRL model, release 20041227, whose documented output equals the official FORTRAN's) in
-//! `tests/environment_atmosphere.rs`:
+//! `crates/environment/tests/atmosphere.rs`:
 //! 1. **Anomalous oxygen below 550 km** is not attenuated: `tobari` sets it to the diffusive
 //!    profile `dd` when `alt < zmho`, a branch NRL's `gts7` does not have (there
 //!    `d[8] = dd exp(−zsht/zsho (exp(−(z − zmho)/zsht) − 1))` at every altitude). At 400 km it is

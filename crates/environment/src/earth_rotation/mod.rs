@@ -34,7 +34,7 @@
 //!   it. Over a run, UT1 − TAI drifts by ≤ 3 ms per day (45 mas per day).
 //! - Polar motion not configured: + up to |(x_p, y_p)| ≈ 0.6″ (3 µrad: 20 m at 7,000 km).
 //!
-//! `tests/environment/earth_rotation.rs` checks each piece against the IAU SOFA validation
+//! `crates/environment/tests/earth_rotation.rs` checks each piece against the IAU SOFA validation
 //! values and the whole chain against Vallado's worked example (Vallado, Fundamentals of
 //! Astrodynamics and Applications, 4th ed., Example 3-14; Vallado et al. 2006, AIAA 2006-6753,
 //! Appendix C).

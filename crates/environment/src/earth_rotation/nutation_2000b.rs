@@ -6,7 +6,7 @@
 //! IERS Conventions (2010) Tables 5.3a/5.3b), with the fixed offsets −0.135 mas (Δψ) and
 //! +0.388 mas (Δε) that stand in for the planetary terms in the "rigorous" bias–precession–
 //! nutation method used here. The coefficients were transcribed from the IAU SOFA routine
-//! `NUT00B`; `tests/environment/earth_rotation.rs` checks the whole series against SOFA's own
+//! `NUT00B`; `crates/environment/tests/earth_rotation.rs` checks the whole series against SOFA's own
 //! validation value (t_sofa_c, `iauNut00b` at MJD 53736.0 TT) to 1e-13 rad.
 //!
 //! Each row: multipliers of (l, l', F, D, Ω), then in units of 0.1 µas:

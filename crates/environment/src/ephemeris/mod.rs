@@ -12,7 +12,7 @@
 //! `(JD_TT − 2451545.0) / 36525` (Meeus eq. 22.1, with TD = TT). The positions are geometric (no
 //! light time, no aberration), which is what a dynamics model wants.
 //!
-//! # Accuracy (measured in `tests/environment_ephemeris.rs`)
+//! # Accuracy (measured in `crates/environment/tests/ephemeris.rs`)
 //! - Sun: the worked Example 25.a to its printed precision; over the whole of 2024 (every 6 h)
 //!   the direction is within 21″ and the distance within 6 800 km (4.5e-5 relative) of the
 //!   VSOP87 series of Meeus Appendix III (accurate to about 1″), itself checked against Meeus

@@ -4,7 +4,7 @@
 //! `D·d + M·m + M′·m′ + F·f`, then the coefficients.
 //!
 //! Transcription checked by Meeus Example 47.a, which prints the three sums to the unit
-//! (Σl = −1 127 527, Σb = −3 229 126, Σr = −16 590 875), in `tests/environment_ephemeris.rs`.
+//! (Σl = −1 127 527, Σb = −3 229 126, Σr = −16 590 875), in `crates/environment/tests/ephemeris.rs`.
 
 /// Table 47.A: `[D, M, M′, F, Σl coefficient (1e-6 deg, sine), Σr coefficient (1e-3 km, cosine)]`.
 #[rustfmt::skip]

@@ -12,7 +12,7 @@
 //!   rotations, [`m1`]–[`m3`] of [`flexdyn_kernel::attitude`]), so [J2000 ← date] is its transpose.
 //!
 //! Checked against Meeus Example 21.b (θ Persei, J2000.0 → 2028 Nov 13.19 TD) in
-//! `tests/environment_ephemeris.rs`.
+//! `crates/environment/tests/ephemeris.rs`.
 
 use nalgebra::Matrix3;
 

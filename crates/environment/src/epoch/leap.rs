@@ -14,7 +14,7 @@
 //! The second question is why flexdyn does not call `Epoch::to_gregorian_utc`: hifitime 4.3
 //! looks ΔAT up with the TAI count itself, so for the ΔAT seconds before each leap second
 //! (2016-12-31T23:59:24–23:59:60 UTC, for the last one) it returns a UTC one second early, and it
-//! cannot show 23:59:60 (`tests/environment/epoch.rs` shows both).
+//! cannot show 23:59:60 (`crates/environment/tests/epoch.rs` shows both).
 
 use hifitime::leap_seconds::LatestLeapSeconds;
 

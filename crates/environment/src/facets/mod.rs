@@ -32,7 +32,7 @@
 //! torques). B is the hub's reference point, so the lead's dynamic effector can apply the force at
 //! B and the torque as given.
 //!
-//! Checked in `tests/environment_facets.rs`: single plates at known incidence against the
+//! Checked in `crates/environment/tests/facets.rs`: single plates at known incidence against the
 //! momentum balance above (the ⅔ by numerical integration of Lambert's law), and a closed cube
 //! giving zero torque about its centre for every flow and Sun direction.
 

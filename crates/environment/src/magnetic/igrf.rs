@@ -24,7 +24,7 @@
 //! the evaluation itself clamps the date to the span so it can never fail on the hot path.
 //!
 //! Checked against the IGRF-14 test values of the IAGA reference program (12 positions and dates,
-//! 1900–2030) to 0.01 nT in `tests/environment_magnetic.rs`.
+//! 1900–2030) to 0.01 nT in `crates/environment/tests/magnetic.rs`.
 
 use nalgebra::Vector3;
 

@@ -13,7 +13,7 @@
 //! # Why not through `tobari`
 //! The brief names `tobari` 0.2.0 (MIT) for IGRF-14, and it was tried first. Its synthesis
 //! fails the IAGA test values by up to 29,534 nT (the same 12 cases as
-//! `tests/environment_magnetic.rs`, run through `tobari::magnetic::Igrf` with its own geodetic
+//! `crates/environment/tests/magnetic.rs`, run through `tobari::magnetic::Igrf` with its own geodetic
 //! input). Two defects explain it, both visible in its `magnetic/igrf/mod.rs`:
 //! - the east component has the wrong sign: its degree-1 field at r = 7000 km on the x axis is
 //!   (−2126.7, **+3427.3**, 22129.8) nT for 2025.0, where the dipole closed form of its own

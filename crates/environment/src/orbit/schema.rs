@@ -432,8 +432,7 @@ mod tests {
     }
 
     fn data_dir() -> std::path::PathBuf {
-        // The shared test data of the workspace root.
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/omm")
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/omm")
     }
 
     #[test]

@@ -7,7 +7,7 @@
 //!   two circles, and ν = 1 − A/(π a²). It has a penumbra (a ring about 0.5° wide seen from the
 //!   Earth) and the annular case. The discs are treated as plane circles on the sky; against the
 //!   exact spherical geometry (the limb of the Earth is a small circle of angular radius b), the
-//!   error in ν is below 1e-3 in low orbit (measured in `tests/environment_shadow.rs`).
+//!   error in ν is below 1e-3 in low orbit (measured in `crates/environment/tests/shadow.rs`).
 //! - [`ShadowModel::Cylindrical`]: Montenbruck & Gill §3.4.2 ("Cylindrical shadow model"): the
 //!   umbra is a cylinder of radius R⊕ behind the Earth, ν ∈ {0, 1}.
 //!

@@ -22,7 +22,7 @@
 //! (`iau_epoch_to_sidereal_time`), the corrected Lyddane choice (`Constants::propagate`), and the
 //! element epoch as a Julian date in one `f64` as Vallado's `jday` forms it. That is the
 //! configuration whose output is the published verification file `tcppver.out`, which
-//! `tests/environment/sgp4_orbit.rs` reproduces to 0.2 mm over all 33 cases. (The crate's
+//! `crates/environment/tests/sgp4_orbit.rs` reproduces to 0.2 mm over all 33 cases. (The crate's
 //! "AFSPC compatibility" mode differs from that file by 0.9 km for the Lyddane deep-space case
 //! 23599 after 420 min; its default mode uses WGS-84 constants.) A position inside the Earth
 //! is an error, as Vallado's error 6 ("decayed"), which the crate itself does not report.

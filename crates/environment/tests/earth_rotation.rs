@@ -7,12 +7,12 @@
 //! (IAU 2000B against 2000A, the equation of the equinoxes) the tolerance is the stated bound of
 //! the truncation.
 
-use flexdyn::environment::earth_rotation::{
+use flexdyn_environment::earth_rotation::{
     dcm_n_teme, earth_rotation_angle_rad, equation_of_equinoxes_rad, fw_matrix, gmst06_rad,
     gmst82_rad, mean_obliquity06_rad, nutation_2000b, polar_motion_dcm, precession_fw06, r3,
     CelestialPole, EarthRotation, OMEGA_EARTH_RAD_S,
 };
-use flexdyn::environment::epoch::{
+use flexdyn_environment::epoch::{
     EarthOrientationParams, EpochScale, EpochTimes, SimEpoch, NS_PER_DAY, RAD_PER_ARCSEC,
 };
 use nalgebra::{Matrix3, Vector3};

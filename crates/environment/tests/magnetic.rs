@@ -5,9 +5,9 @@
 //! independently against igrf.f"); the SHA-256 of the published coefficient file; the closed form
 //! of a dipole's field.
 
-use flexdyn::environment::geodetic::dcm_ned_ecef;
-use flexdyn::environment::magnetic::igrf::{IGRF14_SHC, IGRF_REFERENCE_RADIUS_M};
-use flexdyn::environment::magnetic::{
+use flexdyn_environment::geodetic::dcm_ned_ecef;
+use flexdyn_environment::magnetic::igrf::{IGRF14_SHC, IGRF_REFERENCE_RADIUS_M};
+use flexdyn_environment::magnetic::{
     decimal_year, dipole_torque_b_nm, CentredDipole, Igrf, MagneticError,
 };
 use nalgebra::Vector3;

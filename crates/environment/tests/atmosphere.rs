@@ -5,12 +5,12 @@
 //! its DOCUMENTATION file, which equals the official FORTRAN's); Vallado (2013) Table 8-4 and the
 //! continuity its scale heights were derived for; the kinematics of a co-rotating atmosphere.
 
-use flexdyn::environment::atmosphere::{
+use flexdyn_environment::atmosphere::{
     exponential_density_kg_m3, velocity_relative_to_air_n_m_s, AtmosphereError, Nrlmsise00Model,
     SpaceWeather, VALLADO_TABLE_8_4,
 };
-use flexdyn::environment::earth_rotation::OMEGA_EARTH_RAD_S;
-use flexdyn::environment::geodetic::{ecef_from_geodetic, Geodetic};
+use flexdyn_environment::earth_rotation::OMEGA_EARTH_RAD_S;
+use flexdyn_environment::geodetic::{ecef_from_geodetic, Geodetic};
 use nalgebra::Vector3;
 
 /// The inputs of one reference case: day of year, UT [s], altitude [km], geodetic latitude and
@@ -90,7 +90,7 @@ const EXPECTED: [[f64; 11]; 15] = [
 /// precision is 5e-7; `tobari` 0.2.0 uses exact π/180, 2π/365.25 and π/12 where NRL's code uses
 /// its rounded DGTR, DR and HR, which moves its output by up to 3.3e-3 (at 100 km; 1.9e-3 at
 /// 400 km). With the three constants patched, cases 1–10 match to 4.8e-7 (see
-/// `src/environment/atmosphere/nrlmsise.rs`).
+/// `crates/environment/src/atmosphere/nrlmsise.rs`).
 const TOBARI_RELATIVE: f64 = 3.5e-3;
 /// The same for the temperatures (worst 1.8e-4, at 100 km).
 const TOBARI_TEMPERATURE_RELATIVE: f64 = 2e-4;

@@ -13,8 +13,8 @@
 //! weighted linear least-squares fit of those basis functions (τ known) to the overlapping Allan
 //! variance of the integrated output Σ Δθ (or Σ Δv), weights ∝ the number of clusters L/T.
 
-use flexdyn::sensors::imu::{AccelErrors, GyroErrors, Imu, ImuConfig, ImuSample, ImuTruth};
 use flexdyn_proto::saturation_flags;
+use flexdyn_sensors::imu::{AccelErrors, GyroErrors, Imu, ImuConfig, ImuSample, ImuTruth};
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 
 const DEG: f64 = std::f64::consts::PI / 180.0;

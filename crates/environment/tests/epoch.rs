@@ -1,6 +1,6 @@
 //! The simulation epoch's time scales against published conversions.
 
-use flexdyn::environment::epoch::{
+use flexdyn_environment::epoch::{
     CalendarTime, EarthOrientationParams, EpochScale, SimEpoch, NS_PER_DAY, NS_PER_S,
 };
 use hifitime::{Duration, Epoch};

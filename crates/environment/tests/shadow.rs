@@ -2,8 +2,8 @@
 //! found by tracing rays from the spacecraft to a grid of points on the Sun's disc and testing
 //! each against the Earth's sphere (exact spherical geometry, uniform disc brightness).
 
-use flexdyn::environment::ephemeris::{AU_M, SUN_RADIUS_M};
-use flexdyn::environment::shadow::{shadow_factor, ShadowModel, EARTH_SHADOW_RADIUS_M};
+use flexdyn_environment::ephemeris::{AU_M, SUN_RADIUS_M};
+use flexdyn_environment::shadow::{shadow_factor, ShadowModel, EARTH_SHADOW_RADIUS_M};
 use nalgebra::Vector3;
 
 /// The Sun at 1 AU on +x.

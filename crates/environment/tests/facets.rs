@@ -1,7 +1,7 @@
 //! The facet model against the momentum balance of single plates, and a closed cube's symmetry.
 
-use flexdyn::environment::ephemeris::AU_M;
-use flexdyn::environment::facets::{
+use flexdyn_environment::ephemeris::AU_M;
+use flexdyn_environment::facets::{
     solar_pressure_n_m2, Facet, FacetError, FacetModel, SOLAR_IRRADIANCE_1AU_W_M2,
     SPEED_OF_LIGHT_M_S,
 };

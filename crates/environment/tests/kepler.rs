@@ -1,7 +1,7 @@
 //! Kepler's equation and the element conversions, against Vallado's worked examples and the
 //! two-body closed forms.
 
-use flexdyn::environment::orbit::keplerian::{
+use flexdyn_environment::orbit::keplerian::{
     eccentric_anomaly_rad, mean_of_true_rad, rv_to_elements, true_of_eccentric_rad, Anomaly,
     KeplerianElements,
 };

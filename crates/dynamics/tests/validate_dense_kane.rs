@@ -1,6 +1,6 @@
 //! Independent cross-check of the back-substitution dynamics against a dense Kane formulation.
 //!
-//! The library (`flexdyn::dynamics`) solves the hub + dual-hinged-panel equations by the
+//! The library (`flexdyn_dynamics`) solves the hub + dual-hinged-panel equations by the
 //! back-substitution of Section V of Allard & Schaub (citation in `docs/errata.md`). This file
 //! re-derives the same dynamics from first principles with Kane's method (Section IV of the
 //! paper, corrected as `docs/errata.md` lists), builds the
@@ -70,8 +70,8 @@
 //! Eq. 120 with erratum E1 applied (ω̇ coefficient I_s22 ŝ22ᵀ − m2 d2 ŝ23ᵀ[r̃_Sc2/B]). The solution
 //! q̈ is the same either way; only the dense matrix here is the symmetric (Kane) one.
 
-use flexdyn::dynamics::integrator::{ButcherTableau, METHODS, RK8};
-use flexdyn::dynamics::{
+use flexdyn_dynamics::integrator::{ButcherTableau, METHODS, RK8};
+use flexdyn_dynamics::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
     PanelPairParams, PanelParams, ReactionWheel, ReactionWheelParams, Spacecraft, State,
     StateEffector,
@@ -786,7 +786,7 @@ fn build_library_with_step(cfg: &Config, step_ns: u64) -> Spacecraft {
     };
     let mut sc = Spacecraft::new(cfg.hub.clone(), gravity, effectors, initial, step_ns)
         .expect("valid random spacecraft");
-    sc.set_wrench(flexdyn::dynamics::Wrench {
+    sc.set_wrench(flexdyn_dynamics::Wrench {
         force_b_newton: cfg.force_b,
         torque_b_nm: cfg.torque_b,
     });

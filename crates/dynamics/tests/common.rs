@@ -2,7 +2,7 @@
 //! built in code so each test can vary one thing (gravity, damping, pair count, hub mass).
 #![allow(dead_code)]
 
-use flexdyn::dynamics::{
+use flexdyn_dynamics::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
     PanelPairParams, PanelParams, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
 };

@@ -15,10 +15,10 @@
 //! the nonlinear frequency shift is ~1e-10) and the frequency is measured from the zero crossings
 //! of θ1 over many periods.
 
-mod common;
+use crate::common;
 
 use common::*;
-use flexdyn::dynamics::{
+use flexdyn_dynamics::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPairInitial, PanelPairParams,
 };
 use nalgebra::{Matrix3, Vector3};

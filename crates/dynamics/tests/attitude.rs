@@ -5,10 +5,10 @@
 //! - the MRP kinematic equation against the DCM kinematics d[BN]/dt = −[ω̃][BN];
 //! - shadow-set switching keeps |σ| ≤ 1 while the attitude stays continuous.
 
-mod common;
+use crate::common;
 
-use flexdyn::attitude::*;
-use flexdyn::dynamics::{GravityModel, PanelPair, PanelPairInitial};
+use flexdyn_dynamics::{GravityModel, PanelPair, PanelPairInitial};
+use flexdyn_kernel::attitude::*;
 use nalgebra::{Matrix3, Rotation3, Unit, UnitQuaternion, Vector3, Vector4};
 use proptest::prelude::*;
 

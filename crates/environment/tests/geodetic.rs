@@ -1,7 +1,7 @@
 //! WGS-84 geodetic conversions: the iterative inverse against the closed-form forward map, and
 //! the NED frame against its definition.
 
-use flexdyn::environment::geodetic::{
+use flexdyn_environment::geodetic::{
     dcm_ned_ecef, ecef_from_geodetic, geodetic_from_ecef, Geodetic, WGS84_A_M, WGS84_F,
 };
 use nalgebra::Vector3;

@@ -6,7 +6,7 @@
 //!
 //! Used only by the tests, as the higher-precision reference for the Sun (about 1″, Meeus
 //! ch. 32). The transcription is checked against Meeus Example 25.b, which prints L, B and R to
-//! 1e-8, and against a JPL Horizons DE441 position (`tests/environment_ephemeris.rs`).
+//! 1e-8, and against a JPL Horizons DE441 position (`crates/environment/tests/ephemeris.rs`).
 
 #![allow(dead_code)]
 // Published coefficients: a phase of 3.14 or 3.142 is data from the table, not an approximation of π.

@@ -3,16 +3,15 @@
 //! Oracles (each a `validate_*` test):
 //! - Meeus, *Astronomical Algorithms*, 2nd ed., worked Examples 21.b (precession), 25.a (Sun) and
 //!   47.a (Moon), to their printed precision;
-//! - the VSOP87 Earth series of Meeus Appendix III (`environment_support/vsop87_earth.rs`, about
+//! - the VSOP87 Earth series of Meeus Appendix III (`ephemeris/vsop87_earth.rs`, about
 //!   1″), itself checked against Example 25.b and JPL Horizons (DE441), as the year-long reference
 //!   for the Sun;
 //! - JPL Horizons (DE441) astrometric positions of the Moon over 2026-01-21…28, as the reference
 //!   for the Moon (how to regenerate them is beside the table).
 
-#[path = "environment_support/vsop87_earth.rs"]
 mod vsop87_earth;
 
-use flexdyn::environment::ephemeris::{
+use flexdyn_environment::ephemeris::{
     julian_centuries_tt, moon_ecliptic_of_date, moon_position_n_m, precession,
     sun_ecliptic_of_date, sun_position_n_m, AU_M,
 };

@@ -1,0 +1,18 @@
+//! The dynamics layer checked against invariants and independent references, in one test
+//! executable that links the model crates only (no configuration file, server or I/O stack):
+//!
+//! - [`attitude`]: the attitude kernels and frame directions against nalgebra's own rotations;
+//! - [`conservation`]: energy and angular momentum of the free spacecraft;
+//! - [`analytic_limit`]: a pair on a near-fixed hub against the linearised eigenproblem;
+//! - [`validate_dense_kane`]: back-substitution against a dense Kane formulation;
+//! - [`gravity_vs_sgp4`]: the point-mass and J2 gravity against SGP4's propagation.
+//!
+//! [`common`] builds the reference spacecraft of `scenarios/reference.toml` in code.
+
+mod common;
+
+mod analytic_limit;
+mod attitude;
+mod conservation;
+mod gravity_vs_sgp4;
+mod validate_dense_kane;
