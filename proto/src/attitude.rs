@@ -4,7 +4,7 @@
 //! One implementation for the simulator (`flexdyn::attitude` re-exports this module) and for
 //! flight code (the demo controller `flexdyn-acs-demo`), which needs the same kernels without
 //! linking the simulator. Behind the `attitude` feature (nalgebra). The property tests of the
-//! kernels against nalgebra's independent rotation code are in the workspace's `tests/attitude.rs`.
+//! kernels against nalgebra's independent rotation code are in the workspace's `crates/dynamics/tests/attitude.rs`.
 //!
 //! Conventions (Schaub & Junkins, *Analytical Mechanics of Space Systems*):
 //! - `sigma_bn` is the MRP set of frame B relative to N: σ = ê tan(Φ/4).

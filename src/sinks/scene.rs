@@ -6,7 +6,7 @@
 //! # Frames (Allard & Schaub, Sec. II, Eqs. 1–7)
 //! - `N` inertial; `B` hub body frame at point B: translation r_BN (N components), rotation [NB].
 //! - `<pair>/panel1`: origin at hinge H1 (r_H1B in B), axes S1 with [S1 B] = M2(θ1) [H1 B]
-//!   (ŝ11 = ĥ11 cos θ1 − ĥ13 sin θ1, `src/dynamics/effectors/panel_pair/mod.rs`, `frames`).
+//!   (ŝ11 = ĥ11 cos θ1 − ĥ13 sin θ1, `crates/dynamics/src/effectors/panel_pair/mod.rs`, `frames`).
 //! - `<pair>/panel2`: origin at hinge H2 = H1 − l1 ŝ11 (S1 components (−l1, 0, 0)), axes S2 with
 //!   [S2 S1] = M2(θ2 + θ_H2S1).
 //!

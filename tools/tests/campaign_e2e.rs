@@ -417,7 +417,7 @@ fn random_wheel_seizures_fail_the_runs_they_strike() {
         }
         // The physics departs from the healthy twin where the brake starts: the wheel port
         // applies the seizure from the first step starting at or after the failure time
-        // (src/faults/ports.rs), so the first state to differ is the one ending that step's
+        // (crates/faults/src/ports.rs), so the first state to differ is the one ending that step's
         // frame. Recorded by the server, independently of the observer.
         let (a, b) = (recorded_states(&out, run), recorded_states(&healthy, run));
         assert_eq!(

@@ -15,7 +15,7 @@
 //! Only the window's two end samples of the tracker enter (the tracker noise of the samples in
 //! between cancels), while a fault's effect grows with W.
 //!
-//! Healthy, e_C is the sum of (the sensor models in `src/sensors/`):
+//! Healthy, e_C is the sum of (the sensor models in `crates/sensors/src/`):
 //! - the tracker noise of the two end samples: per sample σ_x about each axis across the
 //!   boresight b̂ and σ_b about it, independent, so √2 σ per axis of the difference;
 //! - the gyro's white noise integrated over W: the instantaneous samples carry N/√Δt (N the

@@ -2,7 +2,7 @@
 //!
 //! A leaf module (it imports nothing else of this crate but [`crate::numfmt`] and
 //! [`crate::validate`]), so a model's schema can live beside the model
-//! (`src/dynamics/effectors/<kind>/schema.rs`, `src/sensors/<kind>/schema.rs`) and report a
+//! (`crates/dynamics/src/effectors/<kind>/schema.rs`, `crates/sensors/src/<kind>/schema.rs`) and report a
 //! located [`config_error::ConfigError`] without an import cycle through `flexdyn::config`,
 //! which assembles the schemas and validates the whole document. The [`source_map`] locates a
 //! TOML path in the text, and [`checks`] holds the checks every schema shares.
