@@ -1,7 +1,10 @@
 //! The server's frame loop on `scenarios/leo_environment.toml` (everything on at 10 Hz), for
 //! `perf`: `cargo build --release --example frame_probe && perf record target/release/examples/frame_probe 20000`.
 fn main() {
-    let frames: u64 = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(20_000);
+    let frames: u64 = std::env::args()
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20_000);
     let text = include_str!("../scenarios/leo_environment.toml");
     let start = text.find("[[magnetometers]]").unwrap();
     let cfg = flexdyn::config::SimConfig::from_toml_str(&text[..start]).unwrap();
