@@ -36,9 +36,9 @@
 //! # Layer
 //! Above `flexdyn-kernel` and `flexdyn-environment` (the sample the dynamic effectors read). A
 //! library user can depend on this crate alone (with the environment if wanted) and step a
-//! spacecraft in their own program. It must never depend on the sensors, the faults, the
-//! vehicle's configuration or anything above them, nor on any I/O stack (`zenoh`, `tokio`,
-//! `foxglove`, `plotters`, `mcap`): `.ci/run` checks the dependency graph.
+//! spacecraft in their own program. It must never depend on the sensors, the faults, the vehicle's
+//! configuration or anything above them, nor on any I/O stack (`zenoh`, `tokio`, `foxglove`,
+//! `plotters`, `mcap`): `.ci/layers` (run by `.ci/run`) checks the dependency graph.
 
 #![warn(missing_docs)]
 

@@ -49,9 +49,10 @@
 //!
 //! # Layer
 //! Above `flexdyn-kernel`. It depends on the kernel, `nalgebra`, and the field's own crates
-//! (`hifitime` for time scales, `sgp4` for mean elements, `tobari` for NRLMSISE-00). It must
-//! never depend on the dynamics, the sensors or anything above them, nor on any I/O stack
-//! (`zenoh`, `tokio`, `foxglove`, `plotters`, `mcap`): `.ci/run` checks the dependency graph.
+//! (`hifitime` for time scales, `sgp4` for mean elements, `tobari` for NRLMSISE-00). It must never
+//! depend on the dynamics, the sensors or anything above them, nor on any I/O stack (`zenoh`,
+//! `tokio`, `foxglove`, `plotters`, `mcap`): `.ci/layers` (run by `.ci/run`) checks the dependency
+//! graph.
 
 #![warn(missing_docs)]
 

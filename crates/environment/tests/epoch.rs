@@ -92,7 +92,7 @@ fn validate_leap_second_2016_utc_fields() {
 /// TAI → UTC conversion (`to_gregorian_utc`) is one second early, and at 23:59:60 it cannot
 /// say 60 — the reason `SimEpoch` derives UTC itself from hifitime's table. This test pins
 /// that behaviour of hifitime: if it fails, hifitime has changed and flexdyn's workaround
-/// (`environment/epoch/leap.rs`) can be revisited. flexdyn's calendar is checked beside it.
+/// (`crates/environment/src/epoch/leap.rs`) can be revisited. flexdyn's calendar is checked beside it.
 #[test]
 fn hifitime_to_gregorian_utc_is_a_second_off_before_a_leap_second() {
     let e = utc("2016-12-31T23:59:30Z");

@@ -22,11 +22,12 @@
 //! effector kind through [`flexdyn_dynamics::component::ComponentKind::fault_modes`].
 //!
 //! # Layer
-//! Above the kernel, the dynamics and the sensors: a fault wraps their ports. Resolution against
-//! a configuration (`[[faults]]`, the live-fault resolver a configuration builds) lives in the
+//! Above the kernel, the dynamics and the sensors: a fault wraps their ports. Resolution against a
+//! configuration (`[[faults]]`, the live-fault resolver a configuration builds) lives in the
 //! vehicle layer above; this crate resolves against a built spacecraft and sensor bank only. It
 //! must never depend on the vehicle, the server or the sinks, nor on any I/O stack (`zenoh`,
-//! `tokio`, `foxglove`, `plotters`, `mcap`): `.ci/run` checks the dependency graph.
+//! `tokio`, `foxglove`, `plotters`, `mcap`): `.ci/layers` (run by `.ci/run`) checks the dependency
+//! graph.
 
 #![warn(missing_docs)]
 

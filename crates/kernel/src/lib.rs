@@ -10,9 +10,9 @@
 //!
 //! # Layer
 //! The bottom of the workspace. It depends on the wire crate (`flexdyn-proto`, for its attitude
-//! kernels), `nalgebra`, `toml` and `thiserror` only. It must never depend on another flexdyn
-//! crate, nor on any I/O stack (`zenoh`, `tokio`, `foxglove`, `plotters`, `mcap`): `.ci/run`
-//! checks the dependency graph.
+//! kernels), `nalgebra`, `toml` and `thiserror` only. It must never depend on a flexdyn crate but
+//! `flexdyn-proto`, nor on any I/O stack (`zenoh`, `tokio`, `foxglove`, `plotters`, `mcap`):
+//! `.ci/layers` (run by `.ci/run`) checks the dependency graph.
 
 #![warn(missing_docs)]
 

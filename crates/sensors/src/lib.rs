@@ -21,8 +21,8 @@
 //! Above the kernel, the environment and the dynamics (a sensor samples the hub's truth and the
 //! environment sample). Sensors are built from a small [`SensorBuild`] context, never from the
 //! vehicle's whole configuration. This crate must never depend on the faults, the vehicle or
-//! anything above them, nor on any I/O stack (`zenoh`, `tokio`, `foxglove`, `plotters`,
-//! `mcap`): `.ci/run` checks the dependency graph.
+//! anything above them, nor on any I/O stack (`zenoh`, `tokio`, `foxglove`, `plotters`, `mcap`):
+//! `.ci/layers` (run by `.ci/run`) checks the dependency graph.
 
 #![warn(missing_docs)]
 

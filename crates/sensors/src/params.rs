@@ -43,7 +43,7 @@ pub trait RawSensorConfig {
 }
 
 /// Reads one entry with `read` and boxes it: the usual [`SensorConfigReader::read`].
-pub fn read_boxed<R: RawSensorConfig + 'static>(
+pub(crate) fn read_boxed<R: RawSensorConfig + 'static>(
     t: &TableReader<'_, '_>,
     read: fn(&TableReader<'_, '_>) -> Result<R, SchemaError>,
 ) -> Result<Box<dyn RawSensorConfig>, SchemaError> {
@@ -113,7 +113,7 @@ list_entry!(dyn SensorSpec, SensorKind, config_array);
 pub struct SensorContext<'a> {
     map: &'a SourceMap<'a>,
     /// \[Hz\] the frame rate.
-    pub frame_hz: f64,
+    pub(crate) frame_hz: f64,
     names: HashSet<String>,
 }
 
@@ -129,24 +129,34 @@ impl<'a> SensorContext<'a> {
 
     /// Checks that `<path>.name` is not blank and not taken by another sensor of the kind
     /// (`what` names the kind in the message).
-    pub fn unique_name(&mut self, path: &str, name: &str, what: &str) -> Result<(), ConfigError> {
+    pub(crate) fn unique_name(
+        &mut self,
+        path: &str,
+        name: &str,
+        what: &str,
+    ) -> Result<(), ConfigError> {
         unique_name(self.map, path, name, &mut self.names, what)
     }
 
     /// `frame_hz / rate_hz` as a whole number of frames ≥ 1, `rate_hz` read from `field`
     /// (`what` updates every whole number of frames).
-    pub fn every_frames(&self, field: &str, rate_hz: f64, what: &str) -> Result<u64, ConfigError> {
+    pub(crate) fn every_frames(
+        &self,
+        field: &str,
+        rate_hz: f64,
+        what: &str,
+    ) -> Result<u64, ConfigError> {
         every_frames(self.map, field, rate_hz, self.frame_hz, what)
     }
 
     /// A value error, located.
-    pub fn param(&self, e: ParamError) -> ConfigError {
+    pub(crate) fn param(&self, e: ParamError) -> ConfigError {
         self.map.param_error(e)
     }
 
     /// An IMU value error, located: an absent key (e.g. a missing time constant) points at
     /// its table.
-    pub fn imu_error(&self, e: ImuParamError) -> ConfigError {
+    pub(crate) fn imu_error(&self, e: ImuParamError) -> ConfigError {
         match e {
             ImuParamError::Param(p) => self.map.param_error(p),
             ImuParamError::Invalid { field, problem } => {
@@ -165,12 +175,12 @@ impl<'a> SensorContext<'a> {
     }
 
     /// `field` is invalid because of `problem`, located.
-    pub fn invalid(&self, field: &str, problem: String) -> ConfigError {
+    pub(crate) fn invalid(&self, field: &str, problem: String) -> ConfigError {
         self.map.invalid(field, problem)
     }
 
     /// Checks that `<path>.name` may be a key segment.
-    pub fn sensor_name(&self, path: &str, name: &str) -> Result<(), ConfigError> {
+    pub(crate) fn sensor_name(&self, path: &str, name: &str) -> Result<(), ConfigError> {
         flexdyn_proto::validate_sensor_name(name)
             .map_err(|e| self.invalid(&format!("{path}.name"), e.to_string()))
     }

@@ -10,11 +10,10 @@
 //!   states in a chief's Hill frame).
 //!
 //! # Layer
-//! Above every model crate (kernel, environment, dynamics, sensors, faults), which it
-//! assembles; the server, the sinks, the campaigns and the command line sit above it. It must
-//! never depend on them, nor on any I/O stack (`zenoh`, `tokio`, `foxglove`, `plotters`,
-//! `mcap`): `.ci/layers` checks the dependency graph. Reading a configuration file is its only
-//! I/O.
+//! Above every model crate (kernel, environment, dynamics, sensors, faults), which it assembles;
+//! the server, the sinks, the campaigns and the command line sit above it. It must never depend on
+//! them, nor on any I/O stack (`zenoh`, `tokio`, `foxglove`, `plotters`, `mcap`): `.ci/layers`
+//! checks the dependency graph. Reading a configuration file is its only I/O.
 
 #![warn(missing_docs)]
 

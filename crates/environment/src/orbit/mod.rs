@@ -15,7 +15,7 @@
 //! they are its estimate of the *osculating* state) as the initial condition. From then on
 //! flexdyn's own gravity propagates the orbit, which differs from SGP4's theory (SGP4 has drag,
 //! J3, J4 and first-order J2; flexdyn's J2 acts about N's z axis), so the two drift apart. For
-//! CBERS 2 (`crates/environment/tests/sgp4_orbit.rs`), started from SGP4's state: 0.21 km after one
+//! CBERS 2 (`crates/dynamics/tests/gravity_vs_sgp4.rs`), started from SGP4's state: 0.21 km after one
 //! orbit and 2.5 km after one day under flexdyn's J2 gravity; 32 km and 444 km under a point
 //! mass. An element set is also only as good as its age: SGP4's own error grows by ~1–3 km
 //! per day from the element epoch, so propagate from a recent set

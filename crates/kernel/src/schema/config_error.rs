@@ -165,7 +165,7 @@ impl From<ParamError> for ConfigError {
 }
 
 /// The field path a [`ParamError`] names, if any.
-pub fn param_field(e: &ParamError) -> Option<&str> {
+pub(crate) fn param_field(e: &ParamError) -> Option<&str> {
     match e {
         ParamError::NotFinite { field }
         | ParamError::NotPositive { field, .. }

@@ -51,7 +51,7 @@ impl fmt::Display for At {
 }
 
 /// A document whose shape does not match a schema: an unknown or missing key, or a value of the
-/// wrong type or length. `flexdyn::config::ConfigError` has the same three variants.
+/// wrong type or length. [`config_error::ConfigError`] has the same three variants.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SchemaError {
     /// A key that the schema does not have.
@@ -102,7 +102,7 @@ fn is_bare_key(k: &str) -> bool {
 }
 
 /// `path.key` as a TOML path, the key quoted unless it is bare (`a.b`, `a."b c"`).
-pub fn join_key(path: &str, key: &str) -> String {
+pub(crate) fn join_key(path: &str, key: &str) -> String {
     let key = if is_bare_key(key) {
         key.to_string()
     } else {
@@ -116,7 +116,7 @@ pub fn join_key(path: &str, key: &str) -> String {
 }
 
 /// ` (in the table at line L, column C)`, or nothing when the table's position is unknown.
-pub fn in_table(at: &At) -> String {
+pub(crate) fn in_table(at: &At) -> String {
     match at.0 {
         Some(l) => format!(" (in the table at line {}, column {})", l.line, l.column),
         None => String::new(),

@@ -22,7 +22,7 @@ use toml::Spanned;
 use super::{join_key, location, At, SchemaError};
 
 /// A TOML value as this reader describes it in messages ("a string", "an array of 5 elements").
-pub fn describe(v: &DeValue<'_>) -> String {
+pub(crate) fn describe(v: &DeValue<'_>) -> String {
     match v {
         DeValue::String(s) => format!("a string ({s:?})"),
         DeValue::Integer(i) => format!("an integer ({i})"),

@@ -6,7 +6,7 @@
 //!
 //! 1. TOML syntax ([`ConfigError::Syntax`]);
 //! 2. structure: unknown keys, missing keys, wrong types and wrong array lengths, by the typed
-//!    reader of `reader.rs` ([`ConfigError::UnknownKey`], [`ConfigError::MissingKey`],
+//!    reader of `crates/kernel/src/schema/reader.rs` ([`ConfigError::UnknownKey`], [`ConfigError::MissingKey`],
 //!    [`ConfigError::InvalidValue`]), whose messages speak TOML (tables, keys, numbers,
 //!    datetimes), never Rust types;
 //! 3. every float in the document must be finite — TOML accepts `nan` and `inf` literals
