@@ -1,7 +1,7 @@
 //! The `flexdyn` binary's offline subcommands, run as a user would: `simulate`, `check-config`
 //! and `print-default-config`.
 
-mod ports;
+use flexdyn_testkit::ports;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

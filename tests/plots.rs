@@ -5,7 +5,7 @@
 //! invariant on its own scale, the intervals of external torque, the wheel and star-tracker
 //! figures, the IMU layout, and every point inside its panel's axis bounds.
 
-mod ports;
+use flexdyn_testkit::ports;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

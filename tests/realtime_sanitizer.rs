@@ -51,7 +51,15 @@
     any(target_arch = "x86_64", target_arch = "aarch64")
 ))]
 
-mod alloc_counter;
+#[global_allocator]
+static GLOBAL: flexdyn_testkit::alloc_counter::Counting = flexdyn_testkit::alloc_counter::Counting;
+use flexdyn_testkit::alloc_counter;
+
+/// Without a counting allocator the "allocates nothing" check here would pass for nothing.
+#[test]
+fn the_allocation_counter_is_installed() {
+    alloc_counter::assert_installed();
+}
 
 use std::collections::BTreeMap;
 use std::io::Write;

@@ -5,7 +5,7 @@
 //! schema `flexdyn.FaultEventMsg`); the JSON, read as plain JSON, carries the events the
 //! configuration implies, and equals the raw payloads decoded, field by field.
 
-mod ports;
+use flexdyn_testkit::ports;
 mod py_support;
 
 use std::path::Path;

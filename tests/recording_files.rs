@@ -3,7 +3,7 @@
 //! `tests/py/check_recording.py`, in its own venv `<target>/python-mcap-venv`) and the CSV
 //! files.
 
-mod ports;
+use flexdyn_testkit::ports;
 mod py_support;
 
 use std::collections::BTreeMap;

@@ -122,3 +122,34 @@ fn the_clients_reader_agrees_with_the_servers_on_every_scenario() {
         "no scenario with [[faults]] (scenarios/fdir.toml has some)"
     );
 }
+
+/// What flight code reads of the served configuration names the same effector indices the
+/// server lists: the rods after the wheels, the thrusters after the rods, in file order.
+#[test]
+fn flight_code_finds_the_actuators_at_the_servers_indices() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/acs_full.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let vehicle = flexdyn_proto::client::vehicle::VehicleConfig::from_toml(&text).unwrap();
+    let sc = SimConfig::from_toml_str(&text)
+        .unwrap()
+        .build_spacecraft()
+        .unwrap();
+    let entries: Vec<_> = sc.effector_entries().collect();
+    let first_rod = vehicle.first_magnetorquer_index() as usize;
+    let first_thruster = vehicle.first_thruster_index() as usize;
+    for (k, rod) in vehicle.magnetorquers.iter().enumerate() {
+        let e = &entries[first_rod + k];
+        assert_eq!((e.kind.name, e.name), ("magnetorquer", rod.name.as_str()));
+    }
+    for (k, t) in vehicle.thrusters.iter().enumerate() {
+        let e = &entries[first_thruster + k];
+        assert_eq!((e.kind.name, e.name), ("thruster", t.name.as_str()));
+        assert_eq!(t.command, None);
+        assert_eq!(t.min_on_time_s, 0.02);
+    }
+    assert_eq!(first_thruster + vehicle.thrusters.len(), entries.len());
+    assert_eq!(
+        (vehicle.magnetorquers.len(), vehicle.thrusters.len()),
+        (3, 4)
+    );
+}

@@ -185,3 +185,63 @@ fn push(line: &mut String, x: &Vector3<f64>) {
         let _ = write!(line, ",{c}");
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{fleet_to, FleetArgs};
+    use flexdyn_vehicle::world::{FleetConfig, World};
+    use std::path::Path;
+
+    const SCENARIOS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
+
+    /// The LEO scenario (every environment model on, `update_hz = 10`) as the chief, and a deputy
+    /// 100 m behind it along-track, 20 m below.
+    const LEO_PAIR: &str =
+        "[[vehicles]]\nid = \"chief\"\nspacecraft_file = \"leo_environment.toml\"\n\
+        participants = [1]\n\n[[vehicles]]\nid = \"deputy\"\nspacecraft_file = \
+        \"leo_environment.toml\"\nparticipants = [2]\n[vehicles.relative]\nchief = \"chief\"\n\
+        hill_position_m = [-20.0, -100.0, 0.0]\nhill_velocity_m_s = [0.0, 0.0, 0.01]\n";
+
+    #[test]
+    fn fleet_csv_holds_each_vehicle_and_the_relative_state() {
+        let fleet = FleetConfig::from_toml_str_in(LEO_PAIR, Path::new(SCENARIOS)).unwrap();
+        let args = FleetArgs {
+            fleet: "unused.toml".into(),
+            duration_s: 0.5,
+            log_every_s: 0.1,
+            output: None,
+        };
+        let mut csv = Vec::new();
+        let report = fleet_to(&fleet, &args, "memory", &mut csv).unwrap();
+        // Rows at t = 0, 0.1, …, 0.5 s; 1 ms steps.
+        assert_eq!((report.vehicles, report.steps, report.rows), (2, 500, 6));
+        let text = String::from_utf8(csv).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 7);
+        let header: Vec<&str> = lines[0].split(',').collect();
+        // t, 2 vehicles × 6, one pair × 8.
+        assert_eq!(header.len(), 1 + 12 + 8);
+        assert_eq!(header[1], "chief_r_cn_n_m_1");
+        assert_eq!(header[13], "deputy_in_chief_r_h_m_1");
+        assert_eq!(header[20], "deputy_in_chief_range_rate_m_s");
+        let last: Vec<f64> = lines[6].split(',').map(|c| c.parse().unwrap()).collect();
+        assert_eq!(last[0], 0.5);
+        // The same world stepped 500 times: the same numbers (Display of f64 round-trips).
+        let mut world = World::new(&fleet).unwrap();
+        for _ in 0..500 {
+            world.step();
+        }
+        let rel = world.relative_state(0, 1).unwrap();
+        assert_eq!(&last[13..16], rel.r_dc_h_m.as_slice());
+        assert_eq!(&last[16..19], rel.v_dc_h_m_s.as_slice());
+        assert_eq!((last[19], last[20]), (rel.range_m, rel.range_rate_m_s));
+        // A duration that is not a whole number of steps is refused, naming the option.
+        let bad = FleetArgs {
+            duration_s: 0.0005,
+            ..args
+        };
+        let err = fleet_to(&fleet, &bad, "memory", Vec::new()).unwrap_err();
+        assert!(err.to_string().starts_with("--duration-s: "), "{err}");
+        assert_eq!(err.exit_code(), 2);
+    }
+}

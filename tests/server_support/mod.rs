@@ -12,8 +12,7 @@ use flexdyn_proto::{decode_state, decode_status, StateMsg, StatusMsg, Topics};
 use zenoh::{Session, Wait};
 
 // Ports the OS gave a process, read back; shared with the test files without this harness.
-#[path = "../ports/mod.rs"]
-pub mod ports;
+pub use flexdyn_testkit::ports;
 #[allow(unused_imports)]
 pub use ports::{port_of, reporting, ws_port, zenoh_endpoint, ANY_PORT};
 

@@ -5,8 +5,7 @@
 //! `cargo bench -p flexdyn-tools --bench campaign`; environment `FLEXDYN_BENCH_CAMPAIGN_RUNS`
 //! (default 8 runs of 10 s each). Ports 17900–17999.
 
-#[path = "../tests/acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 
 use std::path::Path;
 use std::time::Instant;
@@ -41,7 +40,7 @@ fn main() {
     let demo = format!(
         "{} --connect {{endpoint}} --sc-id {{sc_id}} --sender-id {{sender_id}} \
          --sigma-rn 0.1,0.2,-0.1 --rate-source truth --log-every-s 0 --idle-exit-s 1",
-        acs_demo_bin::acs_demo()
+        demo_bin::acs_demo()
     );
     println!("campaign throughput: {runs} runs of 10 s simulated (100 Hz, reference spacecraft), 2-core machine");
     println!(

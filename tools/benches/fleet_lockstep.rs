@@ -14,8 +14,7 @@
 //! (default 2000 ticks per measurement), `FLEXDYN_BENCH_ROUNDS` (default 3),
 //! `FLEXDYN_BENCH_FLEETS` (default `1,2,4,8,16`). Ports: the OS's.
 
-#[path = "../tests/acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 #[path = "../tests/support/mod.rs"]
 mod support;
 
@@ -84,7 +83,7 @@ fn fleet_rate(n: usize, ticks: usize) -> Measured {
     let port = server.port;
     let _ctrls: Vec<ChildGuard> = (0..n)
         .map(|i| {
-            ChildGuard::spawn(Command::new(acs_demo_bin::acs_demo()).args([
+            ChildGuard::spawn(Command::new(demo_bin::acs_demo()).args([
                 "--connect",
                 &endpoint(port),
                 "--sc-id",

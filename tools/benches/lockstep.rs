@@ -19,8 +19,7 @@
 //! (default 10000 ticks per measurement), `FLEXDYN_BENCH_ROUNDS` (default 9, at most 11).
 //! Ports 17400–17459.
 
-#[path = "../tests/acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 #[path = "../tests/support/mod.rs"]
 mod support;
 
@@ -67,7 +66,7 @@ fn lockstep_rate(ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
     let port = server.port;
     // The reference config has no IMU: take the rate from the state (one message each way per
     // tick, like the ping-pong) rather than letting `auto` spend a second looking for a gyro.
-    let _ctrl = ChildGuard::spawn(Command::new(acs_demo_bin::acs_demo()).args([
+    let _ctrl = ChildGuard::spawn(Command::new(demo_bin::acs_demo()).args([
         "--connect",
         &endpoint(port),
         "--log-every-s",

@@ -29,8 +29,7 @@
 //! scheduling; e.g. 50 puts the physics thread under SCHED_FIFO, which needs CAP_SYS_NICE).
 //! Ports 17450–17489.
 
-#[path = "../tests/acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 #[path = "../tests/support/mod.rs"]
 mod support;
 
@@ -108,7 +107,7 @@ fn round(
         })
         .wait()
         .unwrap();
-    let _ctrl = ChildGuard::spawn(Command::new(acs_demo_bin::acs_demo()).args([
+    let _ctrl = ChildGuard::spawn(Command::new(demo_bin::acs_demo()).args([
         "--connect",
         &endpoint(port),
         "--log-every-s",

@@ -24,8 +24,7 @@
 //! It prints the closing note's figures: the time in each mode, the pointing error in fine
 //! pointing (RMS and max), the wheel momentum before and after unloading.
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 mod support;
 
 use std::collections::BTreeMap;
@@ -125,7 +124,7 @@ fn sequence_run(unload_s: f64) -> Run {
     let recorder = Recorder::start(port, &topics, 2);
     let started = Instant::now();
     let mut demo = ChildGuard(
-        Command::new(acs_demo_bin::acs_demo())
+        Command::new(demo_bin::acs_demo())
             .args(["--connect", &endpoint(port), "--sender-id", "1"])
             .args(["--mode-manager", "--imu", "hub", "--star-tracker", "st1"])
             .args(["--magnetometer", "mag1", "--css", "css"])

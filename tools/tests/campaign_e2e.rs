@@ -14,9 +14,8 @@ use flexdyn::campaign::verdict::Outcome;
 use flexdyn::campaign::{main as campaign, CampaignCommand};
 use flexdyn::faults::failure_delay_ns;
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
-use acs_demo_bin::acs_demo as demo;
+use demo_bin::acs_demo as demo;
+use flexdyn_testkit::demo_bin;
 
 fn write_campaign(name: &str, runs: u32, controller: &str) -> (PathBuf, PathBuf) {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);

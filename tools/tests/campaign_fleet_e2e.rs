@@ -20,8 +20,7 @@ use std::path::{Path, PathBuf};
 use flexdyn::campaign::execute::RunResult;
 use flexdyn::campaign::{main as campaign, CampaignCommand};
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 
 const RUNS: u32 = 4;
 
@@ -109,8 +108,8 @@ quantity = "range"
 statistic = "final"
 below = 1.0
 "#,
-            acs = acs_demo_bin::acs_demo(),
-            formation = acs_demo_bin::formation_demo(),
+            acs = demo_bin::acs_demo(),
+            formation = demo_bin::formation_demo(),
         ),
     )
     .unwrap();

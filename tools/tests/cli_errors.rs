@@ -3,14 +3,12 @@
 //! backtrace, no Rust or registry paths. Negative numbers are accepted in value lists.
 //! No test here reaches a server: each command fails on its input before connecting.
 
-#[path = "../../tests/ports/mod.rs"]
-mod ports;
+use flexdyn_testkit::ports;
 
 use std::process::Command;
 
-#[path = "../../tests/cli_support/mod.rs"]
-mod cli_support;
-use cli_support::{assert_one_error_line, run};
+use cli_errors::{assert_one_error_line, run};
+use flexdyn_testkit::cli_errors;
 
 #[test]
 fn the_monitor_and_pingpong_reject_bad_options_in_one_line() {

@@ -9,8 +9,7 @@
 //! identity, so every answer must be exactly −(the gyro rate of its own tick). The previous
 //! demo waited at most 50 ms for a sample, then held the previous tick's rate: it failed here.
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -73,7 +72,7 @@ fn the_demo_answers_each_tick_from_its_own_imu_sample_however_late() {
         })
         .collect();
 
-    let mut demo = Command::new(acs_demo_bin::acs_demo())
+    let mut demo = Command::new(demo_bin::acs_demo())
         .args([
             "--connect",
             &endpoint,

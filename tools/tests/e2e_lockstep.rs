@@ -13,8 +13,7 @@
 //! publishes) must give the stream of `handoff = "thread"` (physics and telemetry threads) bit
 //! for bit.
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 mod support;
 
 use std::process::Command;
@@ -71,7 +70,7 @@ fn settings(participant_timeout_s: f64) -> ServerSettings {
 fn controller(port: u16, rate_args: &[&str]) -> ChildGuard {
     let sigma = format!("{},{},{}", SIGMA_RN[0], SIGMA_RN[1], SIGMA_RN[2]);
     ChildGuard::spawn(
-        Command::new(acs_demo_bin::acs_demo())
+        Command::new(demo_bin::acs_demo())
             .args(["--connect", &endpoint(port), "--sender-id", "1"])
             .args(["--k-nm", &K_NM.to_string(), "--p-nms", &P_NMS.to_string()])
             .args(["--sigma-rn", &sigma, "--log-every-s", "0"])
@@ -409,7 +408,7 @@ fn wheels_on_sensors_run(
     let port = server.port;
     let recorder = Recorder::start(port, &topics, 2);
     let _ctrl = ChildGuard::spawn(
-        Command::new(acs_demo_bin::acs_demo())
+        Command::new(demo_bin::acs_demo())
             .args(["--connect", &endpoint(port), "--sender-id", "1"])
             .args(["--k-nm", &k_nm.to_string(), "--p-nms", &p_nms.to_string()])
             .args(["--log-every-s", "0"])

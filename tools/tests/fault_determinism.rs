@@ -11,8 +11,7 @@
 //! - A run with another seed gives another stream, and identical to the first up to the earlier
 //!   of the two failure times ([`failure_delay_ns`]): the difference is the random fault's.
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 mod support;
 
 use std::process::Command;
@@ -103,7 +102,7 @@ fn run(seed: u64) -> (flexdyn::server::RunReport, Vec<(u64, Vec<u8>)>) {
     let port = server.port;
     let recorder = Recorder::start(port, &topics, 2);
     let _ctrl = ChildGuard::spawn(
-        Command::new(acs_demo_bin::acs_demo())
+        Command::new(demo_bin::acs_demo())
             .args(["--connect", &endpoint(port), "--sender-id", "1"])
             .args(["--k-nm", "10", "--p-nms", "150", "--log-every-s", "0"])
             .args(["--actuator", "wheels", "--attitude-source", "star-tracker"])

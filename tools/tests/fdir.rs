@@ -22,8 +22,7 @@
 //!
 //! Each run is 120 s of simulation at 10 Hz, 1200 lockstep ticks (about a second of wall time).
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 mod support;
 
 use std::process::{Command, Stdio};
@@ -99,7 +98,7 @@ fn run(faults: &[FaultSpec], fdir: bool) -> Run {
     );
     let port = server.port;
     let recorder = Recorder::start(port, &topics, 2);
-    let mut cmd = Command::new(acs_demo_bin::acs_demo());
+    let mut cmd = Command::new(demo_bin::acs_demo());
     cmd.args(["--connect", &endpoint(port), "--sender-id", "1"])
         .args(["--actuator", "wheels"])
         .args(["--attitude-source", "star-tracker", "--star-tracker", "st1"])

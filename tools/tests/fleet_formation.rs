@@ -10,8 +10,7 @@
 //! library's own centre of mass and Hill frame (`flexdyn::world::relative`), and checks that
 //! both runs' streams are the same bits.
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 mod support;
 
 use std::path::Path;
@@ -69,7 +68,7 @@ fn formation_run() -> Run {
     let chief_rec = Recorder::start(port, &Topics::new("chief").unwrap(), 9);
     let deputy_rec = Recorder::start(port, &Topics::new("deputy").unwrap(), 9);
     let ep = endpoint(port);
-    let _chief = ChildGuard::spawn(Command::new(acs_demo_bin::acs_demo()).args([
+    let _chief = ChildGuard::spawn(Command::new(demo_bin::acs_demo()).args([
         "--connect",
         &ep,
         "--sc-id",
@@ -82,7 +81,7 @@ fn formation_run() -> Run {
         "0",
     ]));
     let station = format!("{},{},{}", STATION_M[0], STATION_M[1], STATION_M[2]);
-    let _deputy = ChildGuard::spawn(Command::new(acs_demo_bin::formation_demo()).args([
+    let _deputy = ChildGuard::spawn(Command::new(demo_bin::formation_demo()).args([
         "--connect",
         &ep,
         "--sc-id",

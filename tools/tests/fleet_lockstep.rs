@@ -7,8 +7,7 @@
 //! process records every StateMsg payload and answers `NoCommand`. So one barrier covers three
 //! (vehicle, participant) pairs, and one sender id answers two vehicles.
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 mod support;
 
 use std::path::Path;
@@ -56,7 +55,7 @@ fn settings(participant_timeout_s: f64) -> ServerSettings {
 }
 
 fn controller(port: u16, sc_id: &str, sender: u32, sigma_rn: &str) -> ChildGuard {
-    ChildGuard::spawn(Command::new(acs_demo_bin::acs_demo()).args([
+    ChildGuard::spawn(Command::new(demo_bin::acs_demo()).args([
         "--connect",
         &endpoint(port),
         "--sc-id",

@@ -3,8 +3,7 @@
 //! per tick), every command each participant sent, decoded channels equal to the raw ones field
 //! by field, and the configuration in its metadata.
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 mod support;
 
 use std::process::Command;
@@ -44,7 +43,7 @@ fn a_lockstep_recording_is_the_stream_the_participants_saw() {
     let port = server.port;
     let participant = Recorder::start(port, &topics, 2);
     let _ctrl = ChildGuard::spawn(
-        Command::new(acs_demo_bin::acs_demo())
+        Command::new(demo_bin::acs_demo())
             .args(["--connect", &endpoint(port), "--sender-id", "1"])
             .args(["--rate-source", "truth", "--log-every-s", "0"]),
     );

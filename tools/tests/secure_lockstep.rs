@@ -19,8 +19,7 @@
 //! listens on port 0, takes a free port from the OS and the others connect to it), which replaces the endpoint the shipped JSON5 files name (7447); their authentication
 //! and access control are used exactly as shipped.
 
-#[path = "acs_demo_bin/mod.rs"]
-mod acs_demo_bin;
+use flexdyn_testkit::demo_bin;
 mod support;
 
 use std::path::PathBuf;
@@ -141,7 +140,7 @@ fn digest(states: &[(u64, Vec<u8>)]) -> String {
 }
 
 fn controller(port: u16, client_config: Option<PathBuf>) -> ChildGuard {
-    let mut cmd = Command::new(acs_demo_bin::acs_demo());
+    let mut cmd = Command::new(demo_bin::acs_demo());
     cmd.args(["--connect", &endpoint(port), "--sender-id", "1"])
         .args(["--log-every-s", "0", "--rate-source", "truth"])
         .args(["--sigma-rn", "0.1,0.2,-0.1"]);

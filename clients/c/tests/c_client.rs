@@ -33,8 +33,7 @@ use std::time::{Duration, Instant};
 
 use flexdyn_proto::{decode_state, effector_kind, StateMsg};
 
-#[path = "../../../tests/ports/mod.rs"]
-mod ports;
+use flexdyn_testkit::ports;
 
 /// The libraries `rustc --print native-static-libs` names for the static library on Linux
 /// (README, "Attaching flight code").

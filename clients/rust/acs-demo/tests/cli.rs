@@ -6,11 +6,9 @@
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-#[path = "../../../../tests/cli_support/mod.rs"]
-mod cli_support;
-use cli_support::{assert_one_error_line, run};
-#[path = "../../../../tests/ports/mod.rs"]
-mod ports;
+use cli_errors::{assert_one_error_line, run};
+use flexdyn_testkit::cli_errors;
+use flexdyn_testkit::ports;
 
 const DEMO: &str = env!("CARGO_BIN_EXE_flexdyn-acs-demo");
 

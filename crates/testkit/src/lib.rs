@@ -1,0 +1,16 @@
+//! What flexdyn's tests and benchmarks share, in place of modules each test used to include by
+//! path:
+//! - [`ports`]: free loopback ports without a race, read back from the process that listens;
+//! - [`demo_bin`]: where the demo flight code binaries are, checked built after their sources;
+//! - [`cli_errors`]: the error rules every flexdyn binary follows on bad input;
+//! - [`alloc_counter`]: a counting global allocator, for the tests that prove a hot path
+//!   allocates nothing.
+//!
+//! It depends on the standard library only, so a model crate's tests link no layer through it,
+//! and it must never depend on a flexdyn crate: helpers that need the simulator stay with the
+//! crate whose tests use them.
+
+pub mod alloc_counter;
+pub mod cli_errors;
+pub mod demo_bin;
+pub mod ports;
