@@ -22,7 +22,7 @@
 //!   path, it traps, and that is a real finding: every frame reads the clock.
 //!   `FUTEX_WAKE` is allowed because it never blocks: it is how the frame hands its telemetry
 //!   to a parked telemetry thread (`Thread::unpark`, once per frame at most).
-//! - **Allocations.** The counting global allocator of `tests/alloc_counter` (allocations,
+//! - **Allocations.** The counting global allocator of `crates/testkit/src/alloc_counter.rs` (allocations,
 //!   reallocations) on the checked thread: most allocations make no system call, so the filter
 //!   alone would miss them. (`tests/server_alloc.rs` keeps checking the same with
 //!   `assert_no_alloc`.)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The README's FDIR demo (section "FDIR demo"): the server runs scenarios/fdir.toml in lockstep
-# and flexdyn-acs-demo --fdir flies it; prints the demo's record. Run by tests/readme_snippets.rs,
+# and flexdyn-acs-demo --fdir flies it; prints the demo's record. Run by tests/cli/readme_snippets.rs,
 # which compares the README's lines with what this prints (numbers vary).
 set -eu
 flexdyn run --config scenarios/fdir.toml --mode lockstep --participants 1 \

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Stands in for `cargo`, `flexdyn`, `flexdyn-acs-demo`, `flexdyn-formation-demo` and
-# `flexdyn-monitor` while tests/readme_snippets.rs runs the README's shell blocks (it links this
+# `flexdyn-monitor` while tests/cli/readme_snippets.rs runs the README's shell blocks (it links this
 # file under each name in the sandbox's `target/release`, which is first on the PATH). Each block
 # runs in its own network namespace, so the README's ports are used as written and collide with
 # nothing.

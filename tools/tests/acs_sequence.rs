@@ -25,19 +25,18 @@
 //! pointing (RMS and max), the wheel momentum before and after unloading.
 
 use flexdyn_testkit::demo_bin;
-mod support;
 
 use std::collections::BTreeMap;
 use std::process::{Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use crate::support::{connecting_session, digest, endpoint, ChildGuard, Recorder, ServerHandle};
 use flexdyn::attitude::mrp_error;
 use flexdyn::server::ServerSettings;
 use flexdyn_proto::client::vehicle::VehicleConfig;
 use flexdyn_proto::{decode_environment, decode_state, Mode, StateMsg, Topics};
 use nalgebra::Vector3;
-use support::{connecting_session, digest, endpoint, ChildGuard, Recorder, ServerHandle};
 use zenoh::Wait;
 
 /// Momentum management's duration in the test [s] (module docs); `FLEXDYN_ACS_UNLOAD_S`
@@ -141,7 +140,7 @@ fn sequence_run(unload_s: f64) -> Run {
         .expect("the lockstep run");
     let wall_s = started.elapsed().as_secs_f64();
     assert_eq!(report.last_tick, (duration_s / FRAME_S).round() as u64);
-    let transcript = support::finish_demo(&mut demo);
+    let transcript = crate::support::finish_demo(&mut demo);
     let mut states = recorder.states.lock().unwrap().clone();
     states.sort_by_key(|(t, _)| *t);
     let sun_b = sun_b.lock().unwrap().clone();

@@ -3,7 +3,7 @@
 //!
 //! Why the server runs in-process: the controller is the child process (its own package,
 //! `clients/rust/acs-demo`, found next to this test by `acs_demo_bin`) and the server is
-//! `flexdyn::server::run`, the same function `flexdyn run` calls. `tests/server_cli.rs` in the root package covers the `flexdyn` binary itself (exit
+//! `flexdyn::server::run`, the same function `flexdyn run` calls. `tests/server/server_cli.rs` in the root package covers the `flexdyn` binary itself (exit
 //! code and message of a participant timeout).
 //!
 //! A second, passive participant (sender 2, in this process) records every StateMsg payload and
@@ -14,17 +14,16 @@
 //! for bit.
 
 use flexdyn_testkit::demo_bin;
-mod support;
 
 use std::process::Command;
 use std::time::Duration;
 
+use crate::support::{endpoint, reference_config, signal, ChildGuard, Recorder, ServerHandle};
 use flexdyn::attitude::mrp_error;
 use flexdyn::server::{Handoff, ServerError, ServerSettings};
 use flexdyn_proto::{decode_state, Mode, Topics};
 use nalgebra::Vector3;
 use sha2::{Digest, Sha256};
-use support::{endpoint, reference_config, signal, ChildGuard, Recorder, ServerHandle};
 
 /// Controller gains and target used by every run.
 const K_NM: f64 = 100.0;

@@ -12,16 +12,15 @@
 //!   of the two failure times ([`failure_delay_ns`]): the difference is the random fault's.
 
 use flexdyn_testkit::demo_bin;
-mod support;
 
 use std::process::Command;
 use std::time::Duration;
 
+use crate::support::{endpoint, ChildGuard, Recorder, ServerHandle};
 use flexdyn::faults::failure_delay_ns;
 use flexdyn::server::ServerSettings;
 use flexdyn_proto::{Mode, Topics};
 use sha2::{Digest, Sha256};
-use support::{endpoint, ChildGuard, Recorder, ServerHandle};
 
 const RUN_S: f64 = 10.0;
 const MTBF_S: f64 = 4.0;

@@ -23,16 +23,15 @@
 //! Each run is 120 s of simulation at 10 Hz, 1200 lockstep ticks (about a second of wall time).
 
 use flexdyn_testkit::demo_bin;
-mod support;
 
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
+use crate::support::{digest, endpoint, ChildGuard, Recorder, ServerHandle};
 use flexdyn::faults::{FaultMode, FaultSpec};
 use flexdyn::server::ServerSettings;
 use flexdyn_proto::{decode_state, Mode, Topics};
 use nalgebra::Vector3;
-use support::{digest, endpoint, ChildGuard, Recorder, ServerHandle};
 
 const FRAME_S: f64 = 0.1;
 const DURATION_S: f64 = 120.0;
@@ -118,7 +117,7 @@ fn run(faults: &[FaultSpec], fdir: bool) -> Run {
         .join(Duration::from_secs(300))
         .expect("the lockstep run");
     assert_eq!(report.last_tick, (DURATION_S / FRAME_S).round() as u64);
-    let transcript = support::finish_demo(&mut demo);
+    let transcript = crate::support::finish_demo(&mut demo);
     let mut states = recorder.states.lock().unwrap().clone();
     states.sort_by_key(|(t, _)| *t);
     Run { states, transcript }

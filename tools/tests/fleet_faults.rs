@@ -14,20 +14,18 @@
 //! tick 80 the two IMU streams are identical except where the deputy's faults act, by exactly
 //! the bias (a healthy-versus-faulted comparison, sample by sample).
 
-mod support;
-
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use crate::support::{connecting_session, FleetServerHandle, Recorder};
 use flexdyn::server::ServerSettings;
 use flexdyn::world::FleetConfig;
 use flexdyn_proto::{
     decode_fault_event, decode_imu, decode_status, encode, FaultAction, FaultCommandMsg,
     FaultEventMsg, FaultSource, FaultTarget, Header, Mode, RunState, StatusMsg, Topics,
 };
-use support::{connecting_session, FleetServerHandle, Recorder};
 use zenoh::Wait;
 
 /// \[s\] simulated (100 Hz frames).

@@ -11,19 +11,18 @@
 //! both runs' streams are the same bits.
 
 use flexdyn_testkit::demo_bin;
-mod support;
 
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
 
+use crate::support::{endpoint, ChildGuard, FleetServerHandle, Recorder};
 use flexdyn::attitude::mrp_to_dcm;
 use flexdyn::server::ServerSettings;
 use flexdyn::world::{relative_state_hill, FleetConfig};
 use flexdyn_proto::{decode_state, Mode, StateMsg, Topics};
 use nalgebra::Vector3;
 use sha2::{Digest, Sha256};
-use support::{endpoint, ChildGuard, FleetServerHandle, Recorder};
 
 const DURATION_S: f64 = 150.0;
 const STATION_M: [f64; 3] = [0.0, -100.0, 0.0];

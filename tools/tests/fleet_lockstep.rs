@@ -8,17 +8,16 @@
 //! (vehicle, participant) pairs, and one sender id answers two vehicles.
 
 use flexdyn_testkit::demo_bin;
-mod support;
 
 use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
 
+use crate::support::{endpoint, signal, ChildGuard, FleetServerHandle, Recorder};
 use flexdyn::server::{ServerError, ServerSettings};
 use flexdyn::world::FleetConfig;
 use flexdyn_proto::{decode_state, Mode, Topics};
 use sha2::{Digest, Sha256};
-use support::{endpoint, signal, ChildGuard, FleetServerHandle, Recorder};
 
 /// Simulated duration [s] (100 Hz frames).
 const DURATION_S: f64 = 20.0;

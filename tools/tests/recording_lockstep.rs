@@ -4,16 +4,15 @@
 //! by field, and the configuration in its metadata.
 
 use flexdyn_testkit::demo_bin;
-mod support;
 
 use std::process::Command;
 use std::time::Duration;
 
+use crate::support::{endpoint, reference_config, ChildGuard, Recorder, ServerHandle};
 use flexdyn::server::ServerSettings;
 use flexdyn::sinks::reader::read_recording;
 use flexdyn_proto::{decode_command, decode_state, Mode, StateMsg, Topics};
 use sha2::{Digest, Sha256};
-use support::{endpoint, reference_config, ChildGuard, Recorder, ServerHandle};
 
 const DURATION_S: f64 = 20.0;
 

@@ -20,7 +20,6 @@
 //! and access control are used exactly as shipped.
 
 use flexdyn_testkit::demo_bin;
-mod support;
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -28,6 +27,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use crate::support::{endpoint, reference_config, ChildGuard, ServerHandle};
 use flexdyn::server::{ServerSettings, ZenohArgs};
 use flexdyn::transport::{zenoh_config, Role};
 use flexdyn_proto::{
@@ -35,7 +35,6 @@ use flexdyn_proto::{
     Topics,
 };
 use sha2::{Digest, Sha256};
-use support::{endpoint, reference_config, ChildGuard, ServerHandle};
 use zenoh::{Session, Wait};
 
 const TICKS: u64 = 2000;

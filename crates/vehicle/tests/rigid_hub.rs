@@ -1,5 +1,5 @@
 //! A rigid hub about a point mass, built from a configuration text: the vehicle of the
-//! dynamic-effector tests (`tests/gravity_gradient.rs`, `tests/surface_forces.rs`).
+//! dynamic-effector tests (`crates/vehicle/tests/gravity_gradient.rs`, `crates/vehicle/tests/surface_forces.rs`).
 
 use flexdyn_dynamics::Spacecraft;
 use flexdyn_vehicle::config::SimConfig;

@@ -6,7 +6,7 @@
 //! both gave the same hash, which then also covered the IMU Δv integrals kept in the state. The
 //! sensor seam moved those out of the state (into the IMU, fed by the step's stage hook), so the
 //! hash now covers the state alone and was re-derived on the merge of both changes; the state's
-//! bits did not change there: `tests/regress_sensor_outputs.rs` (CSV hashes of whole `simulate`
+//! bits did not change there: `tests/cli/regress_sensor_outputs.rs` (CSV hashes of whole `simulate`
 //! runs, state and sensor columns, pinned on 535783c) and the lockstep hashes of
 //! `tools/tests/e2e_lockstep.rs` pass on it. Any change to RK4's floating-point expressions (stage sums, the
 //! `(k1 + (k2 + k3)·2 + k4)·(h/6)` combination, the order of the effector passes) changes it.

@@ -169,7 +169,7 @@ fn energy_lost_equals_the_work_done_by_drag() {
     );
     assert!(w < -1e3, "drag must take energy out: W = {w}");
     // The mismatch is round-off of the orbital energy (1.5e10 J: one ulp is 2e-6 J) plus RK4
-    // truncation; the allowance is 8 ulp of it per step, as in tests/gravity_gradient.rs.
+    // truncation; the allowance is 8 ulp of it per step, as in crates/vehicle/tests/gravity_gradient.rs.
     assert!(
         err <= allowance,
         "|ΔE − W| = {err} J, allowance {allowance} J"

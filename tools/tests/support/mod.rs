@@ -9,7 +9,7 @@ use flexdyn_proto::Topics;
 
 // The server harness (sessions on the test's own loopback port, the reference config with
 // another frame rate, `server::run` in a background thread) is the root package's.
-#[path = "../../../tests/server_support/mod.rs"]
+#[path = "../../../tests/server/server_support.rs"]
 mod server_support;
 // Each test or bench that includes this module uses a different subset.
 #[allow(unused_imports)]

@@ -12,7 +12,7 @@
 //! descheduled, no worker at all), the physics thread evaluates the **same request** with the
 //! same function itself. Both paths run identical floating-point code on identical inputs, so
 //! the sample, and every state after it, is the same bit for bit whichever path ran: the worker
-//! is only a cache. `tests/environment_prefetch.rs` checks this on the LEO scenario.
+//! is only a cache. `crates/vehicle/tests/environment_prefetch.rs` checks this on the LEO scenario.
 //!
 //! # What the prediction costs
 //! [`Request::predicted`] propagates the point-mass Kepler motion by its Taylor series to the
@@ -23,7 +23,7 @@
 //! vibrate, drag and solar pressure (below 1e-6 m/s²), a commanded force (F/m). The predicted
 //! position is then off by at most ½·max|a_p|·Δ² plus the two-body remainder (n⁴·r·Δ⁴/24,
 //! 4e-11 m at Δ = 0.1 s in LEO). On the LEO scenario at its 10 Hz update, max|a_p| is
-//! 3.7e-2 m/s² and the worst position error 1.8e-4 m (`tests/environment_prefetch.rs`). The
+//! 3.7e-2 m/s² and the worst position error 1.8e-4 m (`crates/vehicle/tests/environment_prefetch.rs`). The
 //! fields change over kilometres (|∇B| ≈ 3|B|/r ≈ 2e-11 T/m, a density scale height of
 //! ≥ 20 km), so the prediction moves B by ~2e-15 T and the density by ~1.5e-9 of itself —
 //! against the zero-order hold's own error over the same 100 ms, ~1e-8 T for B (760 m of

@@ -17,7 +17,7 @@
 //! - The density and the wind are held between environment updates (the sample's rate).
 //!
 //! Because the force is applied at B and the torque about B, the power it puts into the vehicle
-//! is F·v_B + τ·ω_B/N exactly; `tests/surface_forces.rs` checks that the energy lost equals that
+//! is F·v_B + τ·ω_B/N exactly; `crates/vehicle/tests/surface_forces.rs` checks that the energy lost equals that
 //! work.
 
 use crate::dynamic_effector::{DynamicEffector, EnvironmentSource, StageState};

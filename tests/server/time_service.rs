@@ -4,7 +4,7 @@
 //! The calendar expectations are derived by hand in `src/server/clock.rs` and
 //! `proto/README.md` ("TimeMsg"); here they are checked on the stream a real run publishes.
 
-mod server_support;
+use crate::server_support;
 
 use std::sync::{Arc, Mutex};
 use std::time::Duration;

@@ -2,7 +2,7 @@
 //! timeout, of missing participants and of bad settings; graceful SIGTERM; batch mode.
 //! Every wait is bounded; a child still running at the end is killed.
 
-mod server_support;
+use crate::server_support;
 
 use std::io::Read;
 use std::process::{Child, Command, ExitStatus, Stdio};

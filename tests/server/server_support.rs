@@ -1,6 +1,5 @@
 //! Harness for the server tests: loopback sessions built with the one config builder
 //! (multicast scouting off), an in-process server with a bounded join, and condition waits.
-#![allow(dead_code)]
 
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};

@@ -10,7 +10,7 @@ use flexdyn::campaign::plan::{readback, Plan};
 use flexdyn::campaign::spec::Campaign;
 use flexdyn::config::SimConfig;
 
-mod campaign_support;
+use crate::campaign_support;
 use campaign_support::{check_normal, check_uniform, stats};
 
 fn campaign(text: &str) -> Result<Plan, String> {
@@ -689,7 +689,7 @@ fn actuator_parameters_are_dispersed_and_read_back_from_the_model() {
 /// `start_s` + the time to failure drawn from the planned seed, and the runs differ.
 #[test]
 fn random_faults_get_a_seed_per_run_and_their_failure_time_from_it() {
-    let base = include_str!("../scenarios/wheels_star_tracker.toml").to_string()
+    let base = include_str!("../../scenarios/wheels_star_tracker.toml").to_string()
         + "\n[[faults]]\ntarget = \"reaction_wheels.rw2\"\nmode = \"seized\"\nstart_s = 1.0\nmtbf_s = 20.0\n";
     let path =
         std::env::temp_dir().join(format!("flexdyn-random-fault-{}.toml", std::process::id()));

@@ -12,7 +12,7 @@
 //! mentions, `pip install clients/python` (a wheel built in the source tree), into a temporary
 //! directory, and checks that `git status` of `clients/python` has nothing new afterwards.
 
-mod py_support;
+use crate::py_support;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -20,8 +20,9 @@ use std::process::Command;
 use py_support::{run, venv_python};
 
 /// The checkout, the SDK's folder and the Python of the venv that has the SDK installed
-/// (editable, with its test extras; reinstalled when `pyproject.toml` changes, its text being
-/// the stamp).
+/// (editable, with its test extras; reinstalled when `pyproject.toml` or the checkout's path
+/// changes, the two being the stamp: an editable install points into one checkout, and a
+/// target directory reused by another checkout or worktree must not import the old one).
 fn sdk_venv() -> (PathBuf, PathBuf, PathBuf) {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let package = root.join("clients/python");
@@ -29,7 +30,7 @@ fn sdk_venv() -> (PathBuf, PathBuf, PathBuf) {
     let python = venv_python(
         "python-venv",
         &["-e".into(), format!("{}[test]", package.display())],
-        &pyproject,
+        &format!("{}\n{pyproject}", package.display()),
     );
     (root, package, python)
 }

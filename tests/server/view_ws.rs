@@ -5,8 +5,7 @@
 //! transforms agree with the StateMsg stream it receives itself over Zenoh (live), or with the
 //! recording (`--file`, including a pause/seek through playback control).
 
-#[path = "server_support/mod.rs"]
-mod server_support;
+use crate::server_support;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

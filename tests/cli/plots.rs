@@ -541,7 +541,7 @@ fn relative_motion_shows_the_deputy_in_the_chiefs_hill_frame() {
 
     let rec = tmp("pair.mcap");
     let info = RecordingInfo {
-        recorder: "tests/plots.rs".into(),
+        recorder: "tests/cli/plots.rs".into(),
         command_line: String::new(),
     };
     let mut sink = McapSink::create(&rec, &info).unwrap();

@@ -13,7 +13,7 @@
 //! non-finite and wrong-spacecraft fault commands put beside it are counted under those
 //! reasons (`src/server/fault_cmd.rs`) and never applied.
 
-mod server_support;
+use crate::server_support;
 
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
@@ -29,7 +29,7 @@ use flexdyn_proto::{
 use server_support::{connecting_session, wait_until, Observer, ServerHandle};
 use zenoh::{Session, Wait};
 
-const WHEELS: &str = include_str!("../scenarios/wheels_star_tracker.toml");
+const WHEELS: &str = include_str!("../../scenarios/wheels_star_tracker.toml");
 const TICKS: u64 = 40;
 /// The tick the live fault starts at, and its length in frames.
 const K: u64 = 12;

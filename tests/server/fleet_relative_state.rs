@@ -13,7 +13,7 @@
 //!   C, tumbling) misses by far more, which the test also checks, so it can fail.
 //! - **Determinism.** Two runs publish bit-identical relative-state streams, one per tick.
 
-mod server_support;
+use crate::server_support;
 
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};

@@ -3,7 +3,7 @@
 //! is rejected, counted under its reason, and does not answer the tick; the star tracker
 //! publishes on its own topic at its own rate. Magnetorquers and thrusters follow the same rules.
 
-mod server_support;
+use crate::server_support;
 
 use std::sync::{Arc, Mutex};
 use std::time::Duration;

@@ -6,7 +6,7 @@
 use flexdyn::config::SimConfig;
 use flexdyn::faults::{failure_delay_ns, FaultMode, FaultWindow, Port};
 
-const ACS_FULL: &str = include_str!("../scenarios/acs_full.toml");
+const ACS_FULL: &str = include_str!("../../scenarios/acs_full.toml");
 
 fn with_faults(entries: &[&str]) -> String {
     let mut text = ACS_FULL.to_string();

@@ -35,7 +35,7 @@ fn campaign_file() -> (PathBuf, PathBuf) {
     let base = format!(
         "{}\n[[faults]]\ntarget = \"reaction_wheels.rw1\"\nmode = \"seized\"\nstart_s = 0.25\n\
          mtbf_s = {MTBF_S:?}\n",
-        include_str!("../scenarios/acs_full.toml")
+        include_str!("../../scenarios/acs_full.toml")
     );
     std::fs::write(dir.join("base.toml"), base).unwrap();
     let text = format!(

@@ -1,7 +1,7 @@
 //! Real-time mode runs and publishes at about the configured rate (loose counts, no tight timing
 //! assertions), stamps each frame, and handles stale commands per policy.
 
-mod server_support;
+use crate::server_support;
 
 use std::time::Duration;
 

@@ -6,7 +6,7 @@
 //! - the operator's pause and resume (`flexdyn/<id>/operator`) hold and release the whole fleet,
 //!   whichever vehicle's key they arrive on.
 
-mod server_support;
+use crate::server_support;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

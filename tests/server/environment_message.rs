@@ -15,7 +15,7 @@
 //! The umbra check uses the simulation directly: the spacecraft placed behind the Earth on the
 //! anti-Sun line reads shadow factor 0 and eclipse UMBRA, on the Sun side 1 and SUNLIT.
 
-mod server_support;
+use crate::server_support;
 
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};

@@ -4,7 +4,7 @@
 //!
 //! - Dispersions on both vehicles, read back per vehicle from the built models (1000 draws),
 //!   follow their distributions (the mean within 4 standard errors, the sample variance within
-//!   4 of its standard errors, as `tests/campaign_plan.rs`), equal what the plan wrote, and
+//!   4 of its standard errors, as `tests/cli/campaign_plan.rs`), equal what the plan wrote, and
 //!   leave what they do not name at its nominal value, on the other vehicle too. A deputy's
 //!   Hill offsets are read back by an independent path: the two built spacecraft's centres of
 //!   mass, through `relative_state_hill`.
@@ -23,7 +23,7 @@ use flexdyn::campaign::spec::Campaign;
 use flexdyn::sensors::imu::ImuConfig;
 use flexdyn::world::FleetConfig;
 
-mod campaign_support;
+use crate::campaign_support;
 use campaign_support::{check_normal, check_uniform};
 
 fn root() -> PathBuf {

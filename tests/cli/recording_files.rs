@@ -3,8 +3,8 @@
 //! `tests/py/check_recording.py`, in its own venv `<target>/python-mcap-venv`) and the CSV
 //! files.
 
+use crate::py_support;
 use flexdyn_testkit::ports;
-mod py_support;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -22,7 +22,7 @@
 //!
 //! The windows: frames at 100 Hz, start_s = 0.2 and duration_s = 0.2 are ticks 20 to 39.
 
-mod server_support;
+use crate::server_support;
 
 use std::time::Duration;
 

@@ -1,7 +1,6 @@
-//! The statistical checks of the campaign planning tests (`tests/campaign_plan.rs`,
-//! `tests/campaign_fleet_plan.rs`): a sample's mean and variance against the distribution it
+//! The statistical checks of the campaign planning tests (`tests/cli/campaign_plan.rs`,
+//! `tests/cli/campaign_fleet_plan.rs`): a sample's mean and variance against the distribution it
 //! was drawn from, within 4 standard errors.
-#![allow(dead_code)]
 
 pub fn stats(x: &[f64]) -> (f64, f64) {
     let n = x.len() as f64;

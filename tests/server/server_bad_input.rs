@@ -1,7 +1,7 @@
 //! Bad commands are rejected, counted by reason in StatusMsg.rejected, and the server keeps
 //! running (and still accepts good commands).
 
-mod server_support;
+use crate::server_support;
 
 use std::time::Duration;
 

@@ -6,7 +6,7 @@
 //! with its TimeMsg saying `Paused`, then no TimeMsg, sensor sample or StateMsg until the
 //! release; the stream then continues with the next tick, so no `seq` has a gap.
 
-mod server_support;
+use crate::server_support;
 
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};

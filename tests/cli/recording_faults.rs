@@ -5,8 +5,8 @@
 //! schema `flexdyn.FaultEventMsg`); the JSON, read as plain JSON, carries the events the
 //! configuration implies, and equals the raw payloads decoded, field by field.
 
+use crate::py_support;
 use flexdyn_testkit::ports;
-mod py_support;
 
 use std::path::Path;
 use std::process::Command;

@@ -7,7 +7,7 @@
 //! Each vehicle's last StatusMsg is published after its telemetry thread has read the last
 //! value, so it equals that vehicle's report exactly.
 
-mod server_support;
+use crate::server_support;
 
 use std::path::PathBuf;
 use std::time::Duration;

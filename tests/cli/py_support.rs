@@ -1,7 +1,6 @@
 //! Python for the tests that check flexdyn against independent Python readers: a virtual
 //! environment under the target directory, made the first time and reinstalled when what it
 //! should hold changes. Needs `python3` (3.9+) with the `venv` module, and PyPI the first time.
-#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

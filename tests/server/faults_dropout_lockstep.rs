@@ -5,7 +5,7 @@
 //! last tick if each withheld sample is known as withheld; each tick of the window is handed out
 //! with `imu/hub` missing, every other one complete.
 
-mod server_support;
+use crate::server_support;
 
 use std::time::Duration;
 
@@ -17,7 +17,7 @@ use flexdyn_proto::{encode, CommandMsg, Header, Mode, Topics};
 use server_support::{connecting_session, ServerHandle};
 use zenoh::Wait;
 
-const WHEELS: &str = include_str!("../scenarios/wheels_star_tracker.toml");
+const WHEELS: &str = include_str!("../../scenarios/wheels_star_tracker.toml");
 const TICKS: u64 = 40;
 /// \[ns\] the frame period of the configuration (100 Hz).
 const FRAME_NS: u64 = 10_000_000;
