@@ -233,11 +233,10 @@ fn simulate_row(
     row
 }
 
-/// A sensor's CSV columns: the fields of its message without the header, prefixed
-/// `<kind>_<name>_` (`imu_hub_omega_p_rad_s_1`, `st_st1_q_cn_0`).
-fn sensor_columns(s: &dyn Sensor, header: Header, buf: &mut Vec<u8>) -> Vec<Column> {
-    s.encode(header, buf);
-    let json = (s.kind().decode)(buf).map_or(serde_json::Value::Null, |(_, json)| json);
+/// A sensor's CSV columns from its encoded message `bytes`: the fields without the header,
+/// prefixed `<kind>_<name>_` (`imu_hub_omega_p_rad_s_1`, `st_st1_q_cn_0`).
+fn sensor_columns(s: &dyn Sensor, bytes: &[u8]) -> Vec<Column> {
+    let json = (s.kind().decode)(bytes).map_or(serde_json::Value::Null, |(_, json)| json);
     prefixed_columns(&sensor_prefix(s), &json)
 }
 
@@ -294,18 +293,19 @@ pub fn simulate_to<W: Write>(
     let mut environment = sim
         .environment_every_frames()
         .map(|_| EnvironmentMsg::default());
-    let mut buf = Vec::new();
-    // Per sensor: the step of its last sample and that sample's columns.
-    let mut last: Vec<Option<(u64, Vec<Column>)>> = vec![None; sim.sensors().len()];
-    let mut take = |sim: &Simulation, step: u64, header: Header, last: &mut [Option<_>]| {
-        let bank = sim.sensors();
-        for &i in bank.sampled() {
-            last[i] = Some((
-                step,
-                sensor_columns(bank.sensors()[i].as_ref(), header, &mut buf),
-            ));
-        }
-    };
+    // Per sensor: the step of its last sample and that sample's message, encoded when it was
+    // taken. It becomes CSV columns (a decode into JSON, then text) only if a row falls on that
+    // step: a 10 Hz sensor logged every second is encoded ten times and formatted once.
+    let mut last: Vec<(Option<u64>, Vec<u8>)> = vec![(None, Vec::new()); sim.sensors().len()];
+    let take =
+        |sim: &Simulation, step: u64, header: Header, last: &mut [(Option<u64>, Vec<u8>)]| {
+            let bank = sim.sensors();
+            for &i in bank.sampled() {
+                let (at, bytes) = &mut last[i];
+                bank.sensors()[i].encode(header, bytes);
+                *at = Some(step);
+            }
+        };
     let sample_frame_sensors = |sim: &mut Simulation, step: u64| -> Option<Header> {
         if !(at_frames && step.is_multiple_of(steps_per_frame)) {
             return None;
@@ -368,14 +368,14 @@ pub fn simulate_to<W: Write>(
         state.header = Header::new(spacecraft_id, t_ns / cfg.frame_ns, t_ns, k);
         sim.sample_sensors(|s| s.every_output());
         take(&sim, step, state.header, &mut last);
-        let now = last.iter().map(|l| {
-            l.as_ref()
-                .filter(|(at, _)| *at == step)
-                .map(|(_, cols)| cols.clone())
-        });
         if let Some(env) = environment.as_mut() {
             sim.environment_into(env);
         }
+        let bank = sim.sensors().sensors();
+        let now = last
+            .iter()
+            .zip(bank)
+            .map(|((at, bytes), s)| (*at == Some(step)).then(|| sensor_columns(s.as_ref(), bytes)));
         let row = simulate_row(
             &state,
             &scheduled_wrench(cfg, t_ns),
