@@ -3,7 +3,7 @@
 //! with `--jobs 2` against the serial baseline (`--jobs 1`) measured in the same process.
 //!
 //! `cargo bench -p flexdyn-tools --bench campaign`; environment `FLEXDYN_BENCH_CAMPAIGN_RUNS`
-//! (default 8 runs of 10 s each). Ports 17900–17999.
+//! (default 8 runs of 10 s each). Every run listens on a port the OS chose (`base_port = 0`).
 
 use flexdyn_testkit::demo_bin;
 

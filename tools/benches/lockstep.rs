@@ -17,7 +17,7 @@
 //!
 //! `cargo bench -p flexdyn-tools --bench lockstep`; environment: `FLEXDYN_BENCH_TICKS`
 //! (default 10000 ticks per measurement), `FLEXDYN_BENCH_ROUNDS` (default 9, at most 11).
-//! Ports 17400–17459.
+//! Every process listens on a port the OS chose (port 0) and reports it.
 
 use flexdyn_testkit::demo_bin;
 #[path = "../tests/support/mod.rs"]

@@ -27,7 +27,7 @@
 //! (default 30 s per run), `FLEXDYN_BENCH_RT_ROUNDS` (default 3, at most 8),
 //! `FLEXDYN_BENCH_RT_PRIORITY` (the server's `realtime_priority`, default 0: normal
 //! scheduling; e.g. 50 puts the physics thread under SCHED_FIFO, which needs CAP_SYS_NICE).
-//! Ports 17450–17489.
+//! Every process listens on a port the OS chose (port 0) and reports it.
 
 use flexdyn_testkit::demo_bin;
 #[path = "../tests/support/mod.rs"]
