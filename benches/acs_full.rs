@@ -1,0 +1,234 @@
+//! The full ACS scenario (`scenarios/acs_full.toml`: hub, two dual-hinged pairs, four wheels,
+//! rods, thrusters, facets, gravity gradient, drag, SRP, the field, and every sensor kind),
+//! offline, in two cases:
+//! - **shipped**: the file as it is (10 ms RK4 step, 10 Hz frames and sensors);
+//! - **1 ms + GPS**: a 1 ms step and a 1 Hz GPS receiver added.
+//!
+//! Each case is timed two ways, per RK4 step:
+//! - `vehicle`: the vehicle runtime alone, frame by frame as the server steps it
+//!   (`Simulation::step_frame` with the environment, then the sensors due at the next tick);
+//! - `simulate`: the `flexdyn simulate` loop writing a row every second into a sink, so the
+//!   cost of the front end shows beside the runtime's.
+//!
+//! Issue 41's goal is the full scenario at ≥ 20× Basilisk's same scenario, measured in the same
+//! run. With `FLEXDYN_PEERS_PYTHON` (a Python with `bsk==2.12.1` and numpy) and
+//! `FLEXDYN_PEER_BSK_ACS` (the path of `bsk_acs_full.py`, Basilisk's closest equivalent of
+//! this file, kept outside the project) set, each round also runs Basilisk on the same case,
+//! alternating with flexdyn (A B A B) so that a change in machine load hits both alike, and the
+//! summary prints Basilisk's median beside flexdyn's with the speed-up. Without them the peer
+//! columns say so.
+//!
+//! `cargo bench --bench acs_full`; environment `FLEXDYN_BENCH_ROUNDS` (default 5).
+
+use std::hint::black_box;
+use std::io;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+use flexdyn::cli::simulate_to;
+use flexdyn::config::SimConfig;
+use flexdyn::sim::Simulation;
+
+const ACS_FULL: &str = include_str!("../scenarios/acs_full.toml");
+/// Simulated seconds per timed span (flexdyn and Basilisk alike).
+const SPAN_S: f64 = 10.0;
+
+/// A 1 Hz GPS receiver, as `scenarios/leo_environment.toml` has one.
+const GPS: &str = "
+[[gps_receivers]]
+name = \"gps1\"
+rate_hz = 1.0
+seed = 51
+frames = \"both\"
+latency_s = 0.2
+acquisition_s = 0.0
+position_sigma_m = 3.0
+velocity_sigma_m_s = 0.05
+position_bias_e_m = [0.5, -0.3, 0.8]
+velocity_bias_e_m_s = [0.0, 0.0, 0.0]
+";
+
+struct Case {
+    label: &'static str,
+    toml: String,
+    /// What Basilisk's script is given for the same case.
+    peer_args: &'static [&'static str],
+}
+
+fn cases() -> Vec<Case> {
+    let one_ms = ACS_FULL.replacen("step_s = 0.01\n", "step_s = 0.001\n", 1);
+    assert_ne!(
+        one_ms, ACS_FULL,
+        "acs_full.toml no longer says `step_s = 0.01`"
+    );
+    vec![
+        Case {
+            label: "shipped (10 ms)",
+            toml: ACS_FULL.to_owned(),
+            peer_args: &["--step-ms", "10"],
+        },
+        Case {
+            label: "1 ms + GPS",
+            toml: format!("{one_ms}{GPS}"),
+            peer_args: &["--step-ms", "1", "--gps"],
+        },
+    ]
+}
+
+fn config(case: &Case) -> SimConfig {
+    SimConfig::from_toml_str_in(&case.toml, Path::new(env!("CARGO_MANIFEST_DIR")))
+        .unwrap_or_else(|e| panic!("{}: {e}", case.label))
+}
+
+/// ns per RK4 step of the vehicle's frame as the server runs it (`step_frame`, then the sensors
+/// due at the next tick sampled) over one span, after a one-second warm-up.
+fn time_vehicle(cfg: &SimConfig) -> f64 {
+    let mut sim = Simulation::new(cfg).expect("the scenario builds");
+    let frames_per_s = (1e9 / cfg.frame_ns as f64).round() as u64;
+    let mut tick = 0u64;
+    let mut frame = |sim: &mut Simulation| {
+        sim.step_frame();
+        tick += 1;
+        sim.sample_sensors(|s| s.due(tick));
+    };
+    for _ in 0..frames_per_s {
+        frame(&mut sim);
+    }
+    let frames = (SPAN_S * frames_per_s as f64) as u64;
+    let t = Instant::now();
+    for _ in 0..frames {
+        frame(&mut sim);
+    }
+    let ns = t.elapsed().as_nanos() as f64;
+    black_box(sim.t_sim_ns());
+    ns / (frames * sim.steps_per_frame()) as f64
+}
+
+/// ns per RK4 step of the `simulate` loop writing a row every second into a sink.
+fn time_simulate(cfg: &SimConfig) -> f64 {
+    let report = simulate_to(cfg, SPAN_S, 1.0, io::sink(), "sink").expect("simulate runs");
+    report.wall_s * 1e9 / report.steps as f64
+}
+
+/// Basilisk's median ns per step for `case`, from its `median_ns_per_step=` field.
+fn time_peer(python: &str, script: &Path, init_csv: &Path, case: &Case) -> Result<f64, String> {
+    let out = Command::new(python)
+        .arg(script)
+        .args(["--init-csv", &init_csv.to_string_lossy()])
+        .args(case.peer_args)
+        .args(["--sim-s", &SPAN_S.to_string(), "--reps", "3"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stderr(Stdio::inherit())
+        .output()
+        .map_err(|e| format!("cannot run {python} {}: {e}", script.display()))?;
+    if !out.status.success() {
+        return Err(format!("{} exited with {}", script.display(), out.status));
+    }
+    String::from_utf8_lossy(&out.stdout)
+        .split_whitespace()
+        .find_map(|kv| kv.strip_prefix("median_ns_per_step="))
+        .and_then(|v| v.parse().ok())
+        .ok_or_else(|| format!("{} printed no median_ns_per_step=", script.display()))
+}
+
+/// The peer's Python and script, when both are given.
+fn peer() -> Option<(String, PathBuf)> {
+    let python = std::env::var("FLEXDYN_PEERS_PYTHON").ok()?;
+    let script = PathBuf::from(std::env::var("FLEXDYN_PEER_BSK_ACS").ok()?);
+    Some((python, script))
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+fn main() {
+    // `cargo bench` passes `--bench`; a plain `cargo test` build of the benches runs nothing.
+    if !std::env::args().any(|a| a == "--bench") {
+        return;
+    }
+    let rounds: usize = std::env::var("FLEXDYN_BENCH_ROUNDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(5)
+        .max(1);
+    let peer = peer();
+    let scratch = std::env::temp_dir().join(format!("flexdyn-bench-acs-{}", std::process::id()));
+    std::fs::create_dir_all(&scratch).expect("a scratch folder");
+    println!("acs_full: {rounds} rounds of {SPAN_S} s simulated per case and measurement");
+    let mut summary = Vec::new();
+    for case in cases() {
+        let cfg = config(&case);
+        // Basilisk starts from flexdyn's own t = 0 state: the first row of a simulate CSV.
+        let init_csv = scratch.join("t0.csv");
+        let file = std::fs::File::create(&init_csv).expect("the t = 0 CSV");
+        simulate_to(
+            &cfg,
+            cfg.step_ns as f64 * 1e-9,
+            cfg.step_ns as f64 * 1e-9,
+            file,
+            "t0.csv",
+        )
+        .expect("the t = 0 row");
+        let (mut vehicle, mut simulate, mut basilisk) = (Vec::new(), Vec::new(), Vec::new());
+        for round in 0..rounds {
+            vehicle.push(time_vehicle(&cfg));
+            simulate.push(time_simulate(&cfg));
+            let peer_ns = peer
+                .as_ref()
+                .map(|(python, script)| time_peer(python, script, &init_csv, &case));
+            match &peer_ns {
+                Some(Ok(ns)) => basilisk.push(*ns),
+                Some(Err(e)) => println!("  basilisk: {e}"),
+                None => {}
+            }
+            println!(
+                "{:<16} round {round}: vehicle {:>8.0} ns/step, simulate {:>8.0} ns/step{}",
+                case.label,
+                vehicle[round],
+                simulate[round],
+                match peer_ns {
+                    Some(Ok(ns)) => format!(", basilisk {ns:>9.0} ns/step"),
+                    _ => String::new(),
+                }
+            );
+        }
+        summary.push((
+            case.label,
+            median(vehicle),
+            median(simulate),
+            (!basilisk.is_empty()).then(|| median(basilisk)),
+        ));
+    }
+    let _ = std::fs::remove_dir_all(&scratch);
+    println!(
+        "\n{:<16} {:>16} {:>16} {:>18} {:>12} {:>12}",
+        "case",
+        "vehicle ns/step",
+        "simulate ns/step",
+        "basilisk ns/step",
+        "× (vehicle)",
+        "× (simulate)"
+    );
+    for (label, v, s, b) in summary {
+        match b {
+            Some(b) => println!(
+                "{label:<16} {v:>16.0} {s:>16.0} {b:>18.0} {:>12.1} {:>12.1}",
+                b / v,
+                b / s
+            ),
+            None => println!(
+                "{label:<16} {v:>16.0} {s:>16.0} {:>18} {:>12} {:>12}",
+                "(no peer)", "-", "-"
+            ),
+        }
+    }
+    if peer.is_none() {
+        println!(
+            "\nbasilisk: skipped (set FLEXDYN_PEERS_PYTHON and FLEXDYN_PEER_BSK_ACS; \
+             see the README, \"Performance\")"
+        );
+    }
+}
