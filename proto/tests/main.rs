@@ -1,0 +1,9 @@
+//! The wire crate's tests, one executable: the golden byte vectors, the decoders on bad input,
+//! property tests of the codec, the C header compiled against the Rust codec, and the constants
+//! every mirror repeats.
+
+mod c_header;
+mod constant_mirrors;
+mod decode_errors;
+mod golden;
+mod proptests;
