@@ -6,7 +6,6 @@
 //!
 //! `monitor_live.rs` watches a real-time server on the wall clock and is its own executable.
 
-#[allow(dead_code)]
 mod support;
 
 mod acs_sequence;
