@@ -28,7 +28,7 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-/// The colour of every figure's first line (`src/sinks/plot.rs`, `COLORS[0]`).
+/// The colour of every figure's first line (`crates/sinks/src/plot.rs`, `COLORS[0]`).
 const FIRST_LINE_RGB: [u8; 3] = [31, 119, 180];
 
 /// Decodes `path` and returns (width, height, fraction of non-white pixels, distinct colours,

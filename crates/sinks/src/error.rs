@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use super::mcap_file::RecordError;
-use crate::transport::ZenohConfigError;
+use flexdyn_proto::client::transport::ZenohConfigError;
 
 /// Why a sink subcommand failed. Every variant names the file, option or operation.
 #[derive(Debug, thiserror::Error)]
@@ -80,7 +80,7 @@ impl SinkError {
     pub(crate) fn zenoh(what: &'static str, e: impl std::fmt::Display) -> Self {
         SinkError::Zenoh {
             what,
-            message: crate::transport::clean_zenoh_message(&e.to_string()),
+            message: flexdyn_proto::client::transport::clean_zenoh_message(&e.to_string()),
         }
     }
 }

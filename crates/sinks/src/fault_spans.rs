@@ -26,8 +26,8 @@
 
 use flexdyn_proto::FaultEventMsg;
 
-use crate::faults::modes::MODES;
-use crate::faults::{FaultSpec, FaultWindow};
+use flexdyn_faults::modes::MODES;
+use flexdyn_faults::{FaultSpec, FaultWindow};
 
 /// The comment key of a fault's window in a `simulate` CSV.
 pub const CSV_KEY: &str = "fault";
@@ -337,7 +337,7 @@ mod tests {
     fn a_csv_comment_round_trips_and_expands_to_the_windows_activations() {
         let spec = FaultSpec {
             target: "imus.hub.gyro".into(),
-            mode: crate::faults::FaultMode::BiasStep { value: 0.1 },
+            mode: flexdyn_faults::FaultMode::BiasStep { value: 0.1 },
             window: FaultWindow {
                 start_ns: 100_000_000,
                 duration_ns: Some(50_000_000),
@@ -345,7 +345,7 @@ mod tests {
             },
             axes: 0,
             seed: 0,
-            port: crate::faults::Port::Link { sender_id: 1 },
+            port: flexdyn_faults::Port::Link { sender_id: 1 },
             source: flexdyn_proto::FaultSource::Config,
         };
         let c = csv_comment(3, &spec);

@@ -57,7 +57,7 @@ impl SeqGaps {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sinks::topics::classify;
+    use crate::topics::classify;
     use std::collections::BTreeMap;
 
     #[test]

@@ -5,10 +5,10 @@
 use flexdyn_proto::keys::Topics;
 use flexdyn_proto::Header;
 
-use crate::config::SimConfig;
-use crate::sensors::{coarse_sun_sensor, fine_sun_sensor, gps, magnetometer, star_tracker, KINDS};
-use crate::sim::Simulation;
-use crate::sinks::topics::{classify, Decoded, TopicKind};
+use crate::topics::{classify, Decoded, TopicKind};
+use flexdyn_sensors::{coarse_sun_sensor, fine_sun_sensor, gps, magnetometer, star_tracker, KINDS};
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 
 /// Every registered kind round-trips through the generic paths: its key classifies back to
 /// it, its sensors sit in registry then config order, and what a sensor encodes its kind
@@ -24,8 +24,8 @@ fn every_kind_round_trips_through_key_bank_and_codec() {
 }
 
 fn round_trip(scenario: &str, seen: &mut [bool]) {
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenarios/{scenario}.toml"));
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(format!("../../scenarios/{scenario}.toml"));
     let cfg = SimConfig::from_file(&path).unwrap();
     let mut sim = Simulation::new(&cfg).unwrap();
     // Tick 20: every 10 Hz sensor is due at it (100 Hz frames), and the 1 Hz GPS receiver

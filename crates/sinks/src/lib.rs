@@ -14,6 +14,16 @@
 //!   intervals its figures shade where a fault was active; [`prior_faults`]: the faults already
 //!   active when a recording began.
 //! - [`view`]: `flexdyn view`, the live (or recorded) Foxglove WebSocket view.
+//!
+//! A crate of its own (`flexdyn-sinks`) above the vehicle layer: it depends on the wire
+//! (`flexdyn-proto` with its client transport), the model crates and `flexdyn-vehicle` (a
+//! recording's scene and a CSV's columns are built from the configuration), and on the I/O
+//! stacks it exists for (Zenoh, tokio, MCAP, Foxglove, plotters). It must never depend on the
+//! server, the campaigns or the command line: they use it, and `.ci/layers` checks the order.
+//! [`signals`] (SIGINT and SIGTERM for the long-running commands) lives here, the lowest crate
+//! with tokio, so the server shares it.
+
+#![warn(missing_docs)]
 
 pub mod error;
 pub mod export;
@@ -29,6 +39,7 @@ pub mod record_cmd;
 pub mod recorder;
 pub mod replay;
 pub mod scene;
+pub mod signals;
 pub mod table;
 pub mod topics;
 pub mod view;

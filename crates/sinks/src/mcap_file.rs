@@ -35,7 +35,7 @@ use super::scene::{
     scene_update_schema,
 };
 use super::topics::{classify, json_schema, wire_layout_text, Decoded, TopicKind};
-use crate::config::SimConfig;
+use flexdyn_vehicle::config::SimConfig;
 
 /// `message_encoding` of the raw channels.
 pub const RAW_ENCODING: &str = "flexdyn-proto";
@@ -132,7 +132,7 @@ impl VehicleInfo {
     }
 
     /// The 3D geometry of the configuration this vehicle runs.
-    pub fn geometry(&self) -> Result<Geometry, crate::config::ConfigError> {
+    pub fn geometry(&self) -> Result<Geometry, flexdyn_vehicle::config::ConfigError> {
         SimConfig::from_toml_str(&self.config_toml).map(|cfg| Geometry::from_config(&cfg))
     }
 

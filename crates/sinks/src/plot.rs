@@ -55,10 +55,10 @@ use super::prior_faults;
 use super::reader::read_recording;
 use super::table::{prefixed_columns, row, Cell, Column, ENVIRONMENT_COLUMN_PREFIX};
 use super::topics::{classify, Decoded, TopicKind};
-use crate::attitude::mrp_error;
-use crate::sensors::KINDS;
+use flexdyn_kernel::attitude::mrp_error;
+use flexdyn_sensors::KINDS;
 
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
+const FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans-subset.ttf");
 /// The name the embedded font is registered under (see [`register_font`]).
 pub const FONT_NAME: &str = "flexdyn-sans";
 
@@ -754,7 +754,7 @@ fn numbered_panel(
         .collect();
     // The kind whose effectors these columns are (`rw` → `reaction_wheels`): the panel shows
     // every one of them.
-    let section = crate::dynamics::kinds::KINDS
+    let section = flexdyn_dynamics::kinds::KINDS
         .iter()
         .find(|k| k.effector.column_prefix == prefix)
         .map(|k| k.section.to_owned());
@@ -1052,7 +1052,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
             ]
             .into_iter()
             .map(|p| Panel {
-                components: vec![crate::faults::link::SECTION.to_owned()],
+                components: vec![flexdyn_faults::link::SECTION.to_owned()],
                 ..p
             })
             .collect(),
@@ -1253,7 +1253,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
 /// `<source>_torque_b_nm_1..3` / `<source>_force_b_newton_1..3` columns (log axes: the sources
 /// differ by orders of magnitude), and the shadow factor. `None` without the record.
 /// The deputy's hub point B relative to the chief's, at the instants both were recorded, in the
-/// chief's Hill frame ([`crate::world::relative_state_hill`], with the hub points standing in
+/// chief's Hill frame ([`flexdyn_vehicle::world::relative_state_hill`], with the hub points standing in
 /// for the centres of mass: the relative state of the points the StateMsg carries): position,
 /// its rate seen in that frame, range and range rate.
 fn relative_motion(deputy: &Columns, chief: &Columns) -> Option<Vec<Panel>> {
@@ -1278,9 +1278,12 @@ fn relative_motion(deputy: &Columns, chief: &Columns) -> Option<Vec<Panel>> {
         let Some(&j) = at.get(&ns(*td)) else {
             continue;
         };
-        let Some(rel) =
-            crate::world::relative_state_hill(&v3(rc, j), &v3(vc, j), &v3(rd, i), &v3(vd, i))
-        else {
+        let Some(rel) = flexdyn_vehicle::world::relative_state_hill(
+            &v3(rc, j),
+            &v3(vc, j),
+            &v3(rd, i),
+            &v3(vd, i),
+        ) else {
             continue;
         };
         t.push(*td);
@@ -1360,7 +1363,7 @@ fn disturbance_panels(env: &Columns) -> Option<Vec<Panel>> {
         return None;
     }
     let magnitude_panel = |what: &str, y_label: &str| {
-        let lines = crate::dynamics::EnvironmentSource::ALL
+        let lines = flexdyn_dynamics::EnvironmentSource::ALL
             .iter()
             .filter_map(|src| {
                 let v = env.vec3(&format!("{}_{what}", src.name()))?;

@@ -11,11 +11,11 @@
 //! or when the first recorded event of `i` is a clearance (of edge `e`: active at `e − 1` ns).
 //! The earliest such instant is the evidence; then:
 //! - a configured fault (index below the number of `[[faults]]` the recorded configuration
-//!   resolves to, in the server's order: [`crate::config::SimConfig::faults`], a random
+//!   resolves to, in the server's order: [`flexdyn_vehicle::config::SimConfig::faults`], a random
 //!   `mtbf_s` fault's start drawn from its seed as the server drew it): its activation began at
 //!   its window's last start at or before the evidence
-//!   ([`crate::faults::FaultWindow::last_start_at`]: the window's own
-//!   [`crate::faults::FaultWindow::activation_at`] where the fault is active then, and still the
+//!   ([`flexdyn_faults::FaultWindow::last_start_at`]: the window's own
+//!   [`flexdyn_faults::FaultWindow::activation_at`] where the fault is active then, and still the
 //!   right start when StatusMsg's active set lags its tick by a frame), with the
 //!   configuration's target and mode (a window not yet begun then, which only a configuration
 //!   other than the one that ran can give: the recording's first state). Its interval ends at
@@ -37,8 +37,8 @@ use flexdyn_proto::{FaultEventMsg, FaultSource, FaultTarget, Header, MAX_STATUS_
 use super::fault_spans::UNKNOWN_TARGET;
 use super::reader::Recording;
 use super::topics::{classify, Decoded, TopicKind};
-use crate::config::SimConfig;
-use crate::faults::FaultSpec;
+use flexdyn_faults::FaultSpec;
+use flexdyn_vehicle::config::SimConfig;
 
 /// One vehicle's faults as a recording holds them.
 #[derive(Clone, Debug, Default, PartialEq)]

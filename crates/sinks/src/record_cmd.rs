@@ -17,7 +17,7 @@ use super::error::SinkError;
 use super::mcap_file::{RecordingInfo, VehicleInfo};
 use super::recorder::{RecordItem, RecordReport, RecordTx, Recorder};
 use super::topics::classify;
-use crate::transport::{frame_stamp_ns, zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::client::transport::{frame_stamp_ns, zenoh_config, Role, ZenohArgs};
 
 /// Samples the recorder queue holds; the subscriber waits when it is full (nothing is lost).
 const QUEUE: usize = 65_536;

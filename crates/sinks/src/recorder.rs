@@ -22,7 +22,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use crate::transport::unix_now_ns;
+use flexdyn_proto::client::transport::unix_now_ns;
 
 use super::mcap_file::{McapSink, RecordError, RecordingInfo, SinkStats, VehicleInfo};
 

@@ -23,7 +23,7 @@ use zenoh::Wait;
 use super::error::SinkError;
 use super::reader::read_recording;
 use super::topics::classify;
-use crate::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
 
 /// How long the replay stays connected after its last sample.
 const LINGER: Duration = Duration::from_secs(1);
@@ -133,8 +133,8 @@ pub fn replay(args: &ReplayArgs) -> Result<ReplayReport, SinkError> {
         let session = zenoh::open(zcfg)
             .await
             .map_err(|e| SinkError::zenoh("open the session", e))?;
-        crate::transport::log_listening(&session);
-        let listening = crate::transport::listening_on(&session);
+        flexdyn_proto::client::transport::log_listening(&session);
+        let listening = flexdyn_proto::client::transport::listening_on(&session);
         // Answer each recorded vehicle's configuration query as its server did, so a recorder
         // or viewer of the replay gets the same metadata and 3D geometry.
         let mut queryables = Vec::new();
@@ -256,7 +256,10 @@ fn endpoints_text(z: &ZenohArgs, listening: &[String]) -> String {
     };
     match (listen.is_empty(), z.connect.is_empty(), &z.zenoh_config) {
         (true, true, Some(file)) => format!("uses the endpoints of {}", file.display()),
-        (true, true, None) => format!("listens on {}", crate::transport::DEFAULT_ENDPOINT),
+        (true, true, None) => format!(
+            "listens on {}",
+            flexdyn_proto::client::transport::DEFAULT_ENDPOINT
+        ),
         (false, true, _) => format!("listens on {}", list(listen)),
         (true, false, _) => format!("connects to {}", list(&z.connect)),
         (false, false, _) => format!(

@@ -14,16 +14,16 @@
 //! the rotation that takes child components to parent components, i.e. [PC] = [CP]ᵀ. For a
 //! passive DCM [CP] with Euler parameters β (scalar first), that active rotation is the Hamilton
 //! quaternion (w, x, y, z) = (β0, β1, β2, β3) (Schaub & Junkins, Sec. 3.5), which is what
-//! [`crate::attitude::dcm_to_quat`] and [`crate::attitude::mrp_to_quat`] return.
+//! [`flexdyn_kernel::attitude::dcm_to_quat`] and [`flexdyn_kernel::attitude::mrp_to_quat`] return.
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3, Vector4};
 use serde_json::{json, Value};
 
-use crate::attitude::{dcm_to_quat, m2, mrp_to_quat};
-use crate::config::SimConfig;
-use crate::dynamics::dynamic_effectors::magnetorquer::MagnetorquerParams;
-use crate::dynamics::dynamic_effectors::thruster::ThrusterParams;
+use flexdyn_dynamics::dynamic_effectors::magnetorquer::MagnetorquerParams;
+use flexdyn_dynamics::dynamic_effectors::thruster::ThrusterParams;
+use flexdyn_kernel::attitude::{dcm_to_quat, m2, mrp_to_quat};
 use flexdyn_proto::{EnvironmentMsg, StateMsg};
+use flexdyn_vehicle::config::SimConfig;
 
 /// Name of the inertial frame.
 pub const FRAME_N: &str = "N";
@@ -146,7 +146,7 @@ impl Geometry {
             q_frame_box: dcm_to_quat(&axes.transpose()),
             size_m: equivalent_box_m(hub.mass_kg, &eig.eigenvalues),
         };
-        let panel_box = |p: &crate::dynamics::PanelParams| {
+        let panel_box = |p: &flexdyn_dynamics::PanelParams| {
             let mut size = equivalent_box_m(p.mass_kg, &p.inertia_s_kg_m2);
             size.x = 2.0 * p.d_m;
             // Real dimensions, where the configuration gives them.
@@ -645,7 +645,7 @@ pub fn scene_update_schema() -> Value {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::attitude::{mrp_to_dcm, quat_to_dcm};
+    use flexdyn_kernel::attitude::{mrp_to_dcm, quat_to_dcm};
 
     fn q_of(v: &Value) -> Vector4<f64> {
         let f = |k: &str| v[k].as_f64().unwrap();
@@ -769,7 +769,8 @@ mod tests {
     #[test]
     fn each_facet_is_a_plate_of_its_area_facing_its_normal() {
         let text = std::fs::read_to_string(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/leo_environment.toml"),
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../scenarios/leo_environment.toml"),
         )
         .unwrap();
         let cfg = SimConfig::from_toml_str(&text).unwrap();
@@ -802,12 +803,12 @@ mod tests {
 
     #[test]
     fn panels_with_real_dimensions_draw_as_plates_of_those_dimensions() {
-        let text = crate::config::DEFAULT_CONFIG_TOML.replacen(
+        let text = flexdyn_vehicle::config::DEFAULT_CONFIG_TOML.replacen(
             "panel1 = { mass_kg = 50.0,",
             "panel1 = { width_m = 1.5, thickness_m = 0.03, mass_kg = 50.0,",
             1,
         );
-        assert_ne!(text, crate::config::DEFAULT_CONFIG_TOML);
+        assert_ne!(text, flexdyn_vehicle::config::DEFAULT_CONFIG_TOML);
         let g = Geometry::from_config(&SimConfig::from_toml_str(&text).unwrap());
         let p = &g.pairs[0];
         // Length 2 d = 1.5 m along ŝ1, then the configured width and thickness.
@@ -833,13 +834,13 @@ mod tests {
     fn actuator_arrows_show_firings_and_dipoles() {
         let text = std::fs::read_to_string(concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/scenarios/acs_full.toml"
+            "/../../scenarios/acs_full.toml"
         ))
         .unwrap();
         let cfg = SimConfig::from_toml_str(&text).unwrap();
         let g = Geometry::from_config(&cfg);
         assert_eq!((g.thrusters.len(), g.rods.len()), (4, 3));
-        let mut sim = crate::sim::Simulation::new(&cfg).unwrap();
+        let mut sim = flexdyn_vehicle::sim::Simulation::new(&cfg).unwrap();
         let mut state = sim.state_msg();
         // thr_pz1 at half thrust; mtq_y at −200 of 400 A·m²; everything else off.
         let kind = |k| state.effectors.iter().position(|e| e.kind == k).unwrap();
@@ -899,10 +900,10 @@ mod tests {
     fn environment_arrows_follow_the_sun_and_the_field() {
         let cfg = SimConfig::from_file(std::path::Path::new(concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/scenarios/leo_environment.toml"
+            "/../../scenarios/leo_environment.toml"
         )))
         .unwrap();
-        let mut sim = crate::sim::Simulation::new(&cfg).unwrap();
+        let mut sim = flexdyn_vehicle::sim::Simulation::new(&cfg).unwrap();
         let mut env = EnvironmentMsg::default();
         sim.environment_into(&mut env);
         let scene = environment_scene(&env, "sc1/", 3);

@@ -23,8 +23,8 @@ use serde::Serialize;
 use serde_json::Value;
 
 use super::topics::Decoded;
-use crate::dynamics::kinds::wire_names;
-use crate::numfmt::Num;
+use flexdyn_dynamics::kinds::wire_names;
+use flexdyn_kernel::numfmt::Num;
 
 /// One cell.
 #[derive(Clone, Debug, PartialEq)]

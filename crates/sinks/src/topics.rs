@@ -20,7 +20,7 @@ use flexdyn_proto::{
 // A fleet deputy's relative state (protocol 9).
 use flexdyn_proto::{decode_relative_state, RelativeStateMsg, RELATIVE_STATE_PREFIX};
 
-use crate::sensors::{SensorKind, KINDS};
+use flexdyn_sensors::{SensorKind, KINDS};
 
 /// The message type a flexdyn key carries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -28,7 +28,7 @@ pub enum TopicKind {
     /// `flexdyn/<sc>/tlm/state`: [`StateMsg`].
     State,
     /// `flexdyn/<sc>/<key prefix>/<name>`: the message of sensor kind `KINDS[i]`
-    /// ([`crate::sensors::KINDS`]; `tlm/imu/<name>`: `ImuMsg`, `tlm/st/<name>`:
+    /// ([`flexdyn_sensors::KINDS`]; `tlm/imu/<name>`: `ImuMsg`, `tlm/st/<name>`:
     /// `StarTrackerMsg`).
     Sensor(usize),
     /// `flexdyn/<sc>/cmd/<sender_id>`: [`CommandMsg`].
@@ -167,7 +167,7 @@ pub enum Decoded {
     /// A sensor sample of kind `KINDS[kind]`: its header and its JSON (fields as in the wire
     /// struct, header included).
     Sensor {
-        /// Index in [`crate::sensors::KINDS`].
+        /// Index in [`flexdyn_sensors::KINDS`].
         kind: usize,
         /// The message header.
         header: Header,
@@ -296,7 +296,7 @@ pub fn json_schema(kind: TopicKind) -> serde_json::Value {
 /// The section of `proto/README.md` that specifies the wire layout of `kind`, after the
 /// encoding rules and the header: what a raw recording channel's schema holds.
 pub fn wire_layout_text(kind: TopicKind) -> String {
-    const README: &str = include_str!("../../proto/README.md");
+    const README: &str = include_str!("../../../proto/README.md");
     let section = |starts: &str| -> &str {
         let Some(begin) = README.find(starts) else {
             return "";
@@ -325,8 +325,8 @@ mod tests {
     fn keys_classify_by_their_suffix() {
         let t = classify("flexdyn/sc1/tlm/state").unwrap();
         assert_eq!((t.sc_id, t.kind, t.sensor), ("sc1", TopicKind::State, None));
-        let imu = TopicKind::sensor(&crate::sensors::imu::KIND).unwrap();
-        let st = TopicKind::sensor(&crate::sensors::star_tracker::KIND).unwrap();
+        let imu = TopicKind::sensor(&flexdyn_sensors::imu::KIND).unwrap();
+        let st = TopicKind::sensor(&flexdyn_sensors::star_tracker::KIND).unwrap();
         assert_ne!(imu, st);
         let t = classify("flexdyn/a-b/tlm/imu/hub").unwrap();
         assert_eq!((t.sc_id, t.kind, t.sensor), ("a-b", imu, Some("hub")));

@@ -36,7 +36,7 @@ use super::scene::{
     scene_update_schema, Geometry,
 };
 use super::topics::{classify, json_schema, Decoded};
-use crate::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
 
 /// Default address of the viewer (Foxglove's default connection is `ws://localhost:8765`).
 pub const DEFAULT_BIND: &str = "127.0.0.1:8765";
