@@ -288,7 +288,7 @@ fn step_batch(sim: &mut flexdyn::sim::Simulation) -> u64 {
 }
 
 /// One batch of 50 frames of the server's frame loop: `step_frame`, then the sensors due at
-/// the next tick sampled, as `src/server/physics.rs` does; returns the steps.
+/// the next tick sampled, as `crates/server/src/physics.rs` does; returns the steps.
 fn frame_batch(sim: &mut flexdyn::sim::Simulation) -> u64 {
     let frames = 500;
     for _ in 0..frames {

@@ -15,21 +15,21 @@
 //! - `flexdyn-vehicle`: the [`config`]uration file, one vehicle ([`sim`]) and the world of
 //!   vehicles ([`world`]);
 //! - `flexdyn-sinks` ([`sinks`], and [`signals`]): recording (MCAP), replay, export, the live
-//!   Foxglove view and plots; the first layer with an I/O stack.
+//!   Foxglove view and plots; the first layer with an I/O stack;
+//! - `flexdyn-server` ([`server`]): the Zenoh server (`flexdyn run`): real-time, lockstep and
+//!   batch propagation.
 //!
 //! This crate re-exports them under their old paths and holds what sits above them, for now:
 //! - [`logging`], [`transport`]: the stderr log setup and the one Zenoh configuration builder
 //!   (loopback, multicast scouting off), shared with the tools and flight code
 //!   (`flexdyn_proto::client`);
 //! - [`campaign`]: Monte Carlo campaigns with flight code in the loop;
-//! - [`server`]: the Zenoh server (`flexdyn run`): real-time, lockstep and batch propagation;
 //! - [`cli`] and [`world::run`]: the offline front ends `flexdyn simulate` and `flexdyn fleet`.
 
 #![warn(missing_docs)]
 
 pub mod campaign;
 pub mod cli;
-pub mod server;
 pub mod world;
 
 pub use flexdyn_proto::client::{logging, transport};
@@ -41,6 +41,7 @@ pub use flexdyn_environment as environment;
 pub use flexdyn_faults as faults;
 pub use flexdyn_kernel::{attitude, numfmt, schema, validate};
 pub use flexdyn_sensors as sensors;
+pub use flexdyn_server as server;
 pub use flexdyn_sinks as sinks;
 pub use flexdyn_sinks::signals;
 pub use flexdyn_vehicle::{config, sim};

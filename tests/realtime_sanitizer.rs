@@ -32,10 +32,10 @@
 //! this check sees a lock only when it is contended (the `futex` wait, which it fails; see
 //! `a_contended_mutex_fails_the_check`). An uncontended lock on the frame path would pass here
 //! and is left to review; the frame path takes none by design (bounded channels' `try_send` /
-//! `try_recv`, atomics; see `src/server/physics.rs`), and whether a lock is *ever* contended is
+//! `try_recv`, atomics; see `crates/server/src/physics.rs`), and whether a lock is *ever* contended is
 //! what decides if the physics thread waits.
 //!
-//! The path checked is the loop of `src/server/physics.rs` for real time with the telemetry
+//! The path checked is the loop of `crates/server/src/physics.rs` for real time with the telemetry
 //! handed to the telemetry thread (`handoff = "thread"`, what `auto` picks under SCHED_FIFO):
 //! the boundary's handoff (`try_send` of the filled frame, `unpark`), the command intake from
 //! the bounded channel and the recycling of consumed commands, the server's own
@@ -346,7 +346,7 @@ impl Holder {
 
 /// The physics thread's per-frame work and the I/O side it talks to: a stepper, the bounded
 /// command channel, a fixed pool of telemetry buffers cycled through two bounded channels, a
-/// telemetry thread that parks between frames (as `src/server/telemetry.rs` does), the shared
+/// telemetry thread that parks between frames (as `crates/server/src/telemetry.rs` does), the shared
 /// counters and the overrun bookkeeping.
 struct Harness {
     w: Stepper,

@@ -928,7 +928,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
 /// (1958-01-01 … 2017-01-01: 59 years, 15 leap days) + 36.25 s = 1,861,920,036.25 s since 1958.
 /// GPS time = TAI − 19 s − 8,040 days (1958-01-01 … 1980-01-06) = 1,167,264,017.25 s = week
 /// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
-/// TAI …036.0 s). `src/server/clock.rs` produces exactly this message from that epoch.
+/// TAI …036.0 s). `crates/server/src/clock.rs` produces exactly this message from that epoch.
 const TIME_GOLDEN: &[(usize, &str, &str)] = &[
     (0, "0900", "u16 header.protocol_version = 9"),
     (

@@ -11,7 +11,7 @@
 //! healthy before K, transformed on [K, K + 5) and healthy again from K + 5, sample by sample,
 //! with its activation and clearance events at those edges. Malformed, bad-version,
 //! non-finite and wrong-spacecraft fault commands put beside it are counted under those
-//! reasons (`src/server/fault_cmd.rs`) and never applied.
+//! reasons (`crates/server/src/fault_cmd.rs`) and never applied.
 
 use crate::server_support;
 

@@ -1,7 +1,7 @@
 //! The time service (`flexdyn/<sc>/tlm/time`) of a real server: published every frame before the
 //! frame's sensors and state, consistent with itself, leap-second aware, and paced by `--speed`.
 //!
-//! The calendar expectations are derived by hand in `src/server/clock.rs` and
+//! The calendar expectations are derived by hand in `crates/server/src/clock.rs` and
 //! `proto/README.md` ("TimeMsg"); here they are checked on the stream a real run publishes.
 
 use crate::server_support;

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use super::error::{ServerError, SettingsError};
 use super::settings::{ServerSettings, Value};
 use super::RunReport;
-use crate::config::{load_config, log_warnings, SimConfig};
-use crate::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_vehicle::config::{load_config, log_warnings, SimConfig};
 
 /// Arguments of `flexdyn run` (plain `flexdyn` runs with all defaults). Every server option
 /// overrides the same key of the configuration's `[server]` table.
@@ -178,9 +178,9 @@ impl RunArgs {
     }
 }
 
-/// [`crate::signals::shutdown_signal`], its failure as a [`ServerError::Signal`].
+/// [`flexdyn_sinks::signals::shutdown_signal`], its failure as a [`ServerError::Signal`].
 async fn shutdown_signal() -> Result<impl std::future::Future<Output = ()>, ServerError> {
-    crate::signals::shutdown_signal()
+    flexdyn_sinks::signals::shutdown_signal()
         .await
         .map_err(|(signal, source)| ServerError::Signal { signal, source })
 }

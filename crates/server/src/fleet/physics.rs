@@ -31,8 +31,8 @@ use super::super::settings::ServerSettings;
 use super::super::shared::{Frame, Shared};
 use super::relative::RelativePublisher;
 use super::stepper::FleetStepper;
-use crate::faults::ports::{Installed, LiveRequest};
-use crate::transport::unix_now_ns;
+use flexdyn_faults::ports::{Installed, LiveRequest};
+use flexdyn_proto::client::transport::unix_now_ns;
 
 /// Longest single blocking wait, so a stop request is seen quickly.
 const POLL: Duration = Duration::from_millis(50);

@@ -18,7 +18,7 @@ use super::physics::count_offer;
 use super::reject_log::RejectLog;
 use super::settings::ServerSettings;
 use super::shared::Shared;
-use crate::sinks::recorder::{RecordItem, RecordTx};
+use flexdyn_sinks::recorder::{RecordItem, RecordTx};
 
 /// Where the command callback delivers a validated command.
 pub(super) enum CommandSink {
@@ -72,7 +72,7 @@ pub(super) fn record_arrival(
         rec.submit(RecordItem {
             key: Arc::from(sample.key_expr().as_str()),
             payload: bytes.to_vec(),
-            publish_time_ns: crate::transport::frame_stamp_ns(sample),
+            publish_time_ns: flexdyn_proto::client::transport::frame_stamp_ns(sample),
         });
     }
 }

@@ -26,7 +26,7 @@ use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TryRecvError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::transport::unix_now_ns;
+use flexdyn_proto::client::transport::unix_now_ns;
 
 use flexdyn_proto::{CommandMsg, Header, Mode, RunState, StateMsg};
 use nalgebra::Vector3;
@@ -39,9 +39,9 @@ use super::publish::FramePublisher;
 use super::rt::{monotonic_ns, ThreadUsage};
 use super::settings::ServerSettings;
 use super::shared::{fill_state, Frame, Shared};
-use crate::dynamics::Wrench;
-use crate::sim::Simulation;
-use crate::sinks::table::first_non_finite;
+use flexdyn_dynamics::Wrench;
+use flexdyn_sinks::table::first_non_finite;
+use flexdyn_vehicle::sim::Simulation;
 
 /// Longest single blocking wait, so a stop request is seen quickly.
 const POLL: Duration = Duration::from_millis(50);
@@ -82,9 +82,9 @@ pub struct PhysicsCtx {
     /// command is freed here instead; never blocks).
     pub recycle_tx: SyncSender<CommandMsg>,
     /// Live fault requests, resolved by the fault callback ([`super::fault_cmd`]).
-    pub fault_rx: Receiver<crate::faults::ports::LiveRequest>,
+    pub fault_rx: Receiver<flexdyn_faults::ports::LiveRequest>,
     /// Installed requests' boxes, handed back to be freed off this thread.
-    pub fault_recycle_tx: SyncSender<crate::faults::ports::Installed>,
+    pub fault_recycle_tx: SyncSender<flexdyn_faults::ports::Installed>,
     /// Free telemetry buffers returned by the I/O thread.
     pub free_rx: Receiver<Box<Frame>>,
     /// Filled telemetry buffers to publish.
@@ -119,7 +119,7 @@ pub struct Stepper {
 impl Stepper {
     /// A stepper at t = 0 with the sensors sampled at tick 0.
     pub fn new(mut sim: Simulation, settings: &ServerSettings) -> Self {
-        let links = crate::faults::link::LinkFaults::new(sim.faults().specs(), sim.frame_ns());
+        let links = flexdyn_faults::link::LinkFaults::new(sim.faults().specs(), sim.frame_ns());
         let book = CommandBook::new(
             &settings.participants,
             sim.frame_ns(),
@@ -208,9 +208,9 @@ impl Stepper {
     /// back to be freed off the stepping path, refused or not.
     pub fn install_fault(
         &mut self,
-        req: crate::faults::ports::LiveRequest,
+        req: flexdyn_faults::ports::LiveRequest,
         k: u64,
-    ) -> Result<crate::faults::ports::Installed, (u8, crate::faults::ports::Installed)> {
+    ) -> Result<flexdyn_faults::ports::Installed, (u8, flexdyn_faults::ports::Installed)> {
         // A clear of a command-link fault also reaches the command book, where it acts.
         let clears = req.clears();
         let at_ns = req.applies_at(k + 1).saturating_mul(self.sim.frame_ns());

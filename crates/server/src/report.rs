@@ -11,7 +11,7 @@ use super::rt::ThreadUsage;
 use super::settings::mode_name;
 use super::shared::Shared;
 use super::telemetry::timing_of;
-use crate::sinks::recorder::RecordReport;
+use flexdyn_sinks::recorder::RecordReport;
 
 /// How a run ended without error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,7 +44,7 @@ pub struct RunReport {
     /// Valid commands dropped because the command queue was full.
     pub commands_dropped: u64,
     /// What the command-link faults (`links.<sender id>`) did.
-    pub link_faults: crate::faults::link::LinkStats,
+    pub link_faults: flexdyn_faults::link::LinkStats,
     /// \[s\] wall time from the first frame to the end.
     pub wall_s: f64,
     /// `--record`: what the recording holds and what the recorder dropped.

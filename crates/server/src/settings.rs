@@ -13,8 +13,8 @@ use std::path::Path;
 use flexdyn_proto::{validate_sc_id, Mode, StalePolicy};
 
 use super::error::SettingsError;
-use crate::config::{beyond_max_time, whole_ns, SimConfig};
-use crate::numfmt::Num;
+use flexdyn_kernel::numfmt::Num;
+use flexdyn_vehicle::config::{beyond_max_time, whole_ns, SimConfig};
 
 /// What the real-time loop does when a frame's work ends after the next frame's deadline.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -89,7 +89,7 @@ impl Handoff {
     }
 }
 
-pub use crate::transport::mode_name;
+pub use flexdyn_proto::client::transport::mode_name;
 
 /// The spelling of a [`StalePolicy`] in settings and logs.
 pub fn stale_policy_name(p: StalePolicy) -> &'static str {
@@ -378,7 +378,7 @@ impl ServerSettings {
     /// Every command-link fault of `cfg` (`links.<sender id>`) must name one of these
     /// participants (the file's were checked at load; the command line may change them).
     pub fn check_link_faults(&self, cfg: &SimConfig) -> Result<(), SettingsError> {
-        match crate::faults::link::unknown_participant(&cfg.faults, &self.participants) {
+        match flexdyn_faults::link::unknown_participant(&cfg.faults, &self.participants) {
             Some((name, problem)) => Err(SettingsError::Invalid { name, problem }),
             None => Ok(()),
         }

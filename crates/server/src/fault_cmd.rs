@@ -12,7 +12,7 @@
 //! samples in order on one thread, and this callback hands the request over before it returns.
 //!
 //! Refused commands count in `rejected.fault_refused` (the resolution's error, or the physics
-//! side's [`crate::faults::ports::INSTALL_REFUSALS`]) and are logged with the reason;
+//! side's [`flexdyn_faults::ports::INSTALL_REFUSALS`]) and are logged with the reason;
 //! undecodable or wrong-spacecraft ones count like commands. Who may put on the key is Zenoh's
 //! access-control list (the shipped `scenarios/zenoh/secure-server.json5` lets only user
 //! `operator`).
@@ -29,9 +29,9 @@ use super::intake::record_arrival;
 use super::lockstep::LockstepCore;
 use super::reject_log::RejectLog;
 use super::shared::Shared;
-use crate::faults::live::LiveResolver;
-use crate::faults::ports::{LiveRequest, INSTALL_REFUSALS};
-use crate::sinks::recorder::RecordTx;
+use flexdyn_faults::live::LiveResolver;
+use flexdyn_faults::ports::{LiveRequest, INSTALL_REFUSALS};
+use flexdyn_sinks::recorder::RecordTx;
 
 /// Where a resolved live fault goes.
 pub(super) enum FaultSink {
@@ -147,7 +147,7 @@ fn describe(cmd: &FaultCommandMsg) -> String {
         flexdyn_proto::FaultAction::Clear => format!("clear fault {}", cmd.fault_index),
         flexdyn_proto::FaultAction::Inject => format!(
             "inject {} on {}",
-            crate::faults::modes::MODES
+            flexdyn_faults::modes::MODES
                 .get(cmd.mode as usize)
                 .map_or("?", |m| m.0),
             cmd.target.as_str().unwrap_or("?")

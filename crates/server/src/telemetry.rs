@@ -11,7 +11,7 @@ use std::sync::mpsc::{Receiver, RecvTimeoutError, SyncSender, TryRecvError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::transport::unix_now_ns;
+use flexdyn_proto::client::transport::unix_now_ns;
 
 use flexdyn_proto::{encode_into, FrameTiming, Header, Mode, StatusMsg};
 use hdrhistogram::Histogram;
@@ -85,7 +85,7 @@ pub struct TelemetryCtx {
     /// Commands the physics thread has consumed, freed here.
     pub recycle_rx: Receiver<flexdyn_proto::CommandMsg>,
     /// Live fault requests the physics thread has installed (their boxes), freed here.
-    pub fault_recycle_rx: Receiver<crate::faults::ports::Installed>,
+    pub fault_recycle_rx: Receiver<flexdyn_faults::ports::Installed>,
     /// Counters.
     pub shared: Arc<Shared>,
     /// Settings (mode, ids, rates).
@@ -174,7 +174,7 @@ impl TelemetryCtx {
                 now - *faults_seen,
                 &format_args!(
                     "live fault command(s) refused; the last: {}",
-                    crate::faults::ports::INSTALL_REFUSALS
+                    flexdyn_faults::ports::INSTALL_REFUSALS
                         .get(usize::from(code))
                         .unwrap_or(&"")
                 ),

@@ -10,7 +10,7 @@
 //! keep that participant's previous inputs. The inputs applied are the participants' summed in
 //! ascending sender-id order, like the wrench, and the stale policy treats both alike.
 //!
-//! Command-link faults ([`crate::faults::link`]: dropped, delayed, corrupted) act here, at the
+//! Command-link faults ([`flexdyn_faults::link`]: dropped, delayed, corrupted) act here, at the
 //! tick a command answers, so their effect is a function of the tick as well.
 
 use std::ops::Range;
@@ -20,7 +20,7 @@ use flexdyn_proto::{
     command_flags, CommandKind, CommandMsg, CommandStatus, StalePolicy, NO_COMMAND,
 };
 
-use crate::faults::link::{damage, LinkFaults, LinkStats};
+use flexdyn_faults::link::{damage, LinkFaults, LinkStats};
 
 /// What the book did with an offered command.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,7 +36,7 @@ pub enum Offer {
     /// inputs, gives the wrong number of values, or names an effector twice
     /// (`rejected.bad_effector_input`). In lockstep it does not answer the tick.
     BadEffectorInput,
-    /// Discarded: the sender's command link is `dropped` ([`crate::faults::link`]); counted in
+    /// Discarded: the sender's command link is `dropped` ([`flexdyn_faults::link`]); counted in
     /// [`LinkStats::commands_dropped`].
     LinkDropped,
     /// The sender's command link is `corrupted` and the damaged command failed a check: counted
@@ -434,7 +434,7 @@ impl CommandBook {
         self.links.corruption(sender_id)
     }
 
-    /// Slot `i`'s command `cmd` at tick `k` through a corrupted link ([`crate::faults::link`]):
+    /// Slot `i`'s command `cmd` at tick `k` through a corrupted link ([`flexdyn_faults::link`]):
     /// its encoding damaged, decoded and checked like any command (`lockstep` selects the tick
     /// rule), and taken if it passes.
     fn offer_damaged(
@@ -524,7 +524,7 @@ impl CommandBook {
     /// the same way into [`Self::held_inputs`].
     ///
     /// A participant whose link is `delayed` by N frames at `k` contributes its slot as it was
-    /// at tick k − N (nothing before tick N): [`crate::faults::link`].
+    /// at tick k − N (nothing before tick N): [`flexdyn_faults::link`].
     pub fn held(&mut self, k: u64) -> Held {
         self.held_inputs.iter_mut().for_each(|u| *u = 0.0);
         if !self.delay.is_empty() {

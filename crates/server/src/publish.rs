@@ -1,5 +1,5 @@
 //! Publishing one frame's telemetry: its TimeMsg, then the messages of the sensors sampled at
-//! its tick (in publication order: [`crate::sensors::KINDS`], then config order), then its
+//! its tick (in publication order: [`flexdyn_sensors::KINDS`], then config order), then its
 //! StateMsg, then (when due) its EnvironmentMsg, then its fault events (FaultEventMsg), in that
 //! order (a controller that waits for the state finds the sensor
 //! samples of the same tick already delivered).
@@ -15,7 +15,7 @@
 //!   always uses it, since there it overlaps publishing with the next frames' physics).
 //!
 //! Each sample carries the 8-byte frame-boundary stamp as its attachment
-//! ([`crate::transport::frame_stamp_ns`]).
+//! ([`flexdyn_proto::client::transport::frame_stamp_ns`]).
 
 use std::fmt;
 use std::sync::atomic::Ordering;
@@ -26,8 +26,8 @@ use zenoh::pubsub::Publisher;
 use zenoh::Wait;
 
 use super::shared::{Frame, Shared};
-use crate::sensors::SensorKind;
-use crate::sinks::recorder::{RecordItem, RecordTx};
+use flexdyn_sensors::SensorKind;
+use flexdyn_sinks::recorder::{RecordItem, RecordTx};
 
 /// Hands each sensor message of `frame` to `each` with the sensor's index in the bank, in
 /// publication order.

@@ -24,7 +24,7 @@ use super::intake::record_arrival;
 use super::lockstep::LockstepCore;
 use super::reject_log::RejectLog;
 use super::shared::Shared;
-use crate::sinks::recorder::RecordTx;
+use flexdyn_sinks::recorder::RecordTx;
 
 /// What the hold target becomes when an operator asks for `action` (with `ticks`), in `mode`,
 /// with the hold target `target` and the frames published up to (or held at) tick `tick`; or

@@ -2,7 +2,7 @@
 //! time, in lockstep or in batch.
 //!
 //! [`run`] is the whole server as a library function with its I/O injected (a Zenoh session, the
-//! settings, the simulation configuration and a shutdown future); `src/main.rs` only parses
+//! settings, the simulation configuration and a shutdown future); the `flexdyn` binary only parses
 //! arguments, initialises tracing and calls [`cli::run_from_args`], which calls [`run`].
 //!
 //! # Layout
@@ -18,7 +18,7 @@
 //!
 //! And what they use:
 //! - [`settings`]: [`ServerSettings`], the `[server]` table and `flexdyn run` options.
-//! - [`crate::transport`]: [`zenoh_config`], the one builder of every Zenoh configuration (loopback
+//! - [`flexdyn_proto::client::transport`]: [`zenoh_config`], the one builder of every Zenoh configuration (loopback
 //!   defaults, multicast scouting always off).
 //! - [`commands`]: per-participant command book (lockstep answers, staleness, summation) and
 //!   the callback's gate.
@@ -43,6 +43,13 @@
 //! `--record` or under SCHED_FIFO. The per-frame work ([`physics::Stepper`]) never allocates, locks or touches the
 //! network; in real time the physics thread never blocks on the I/O side (a frame without a
 //! free buffer loses its telemetry, counted).
+//!
+//! # Place in the workspace
+//! A crate of its own (`flexdyn-server`): it depends on the wire (`flexdyn-proto` with its client
+//! transport), the model crates, `flexdyn-vehicle` (the configuration, one vehicle, the world of
+//! vehicles) and `flexdyn-sinks` (the `--record` recorder, the shutdown signals), and on Zenoh and
+//! tokio. It must never depend on the campaigns or the command line, which use it; `.ci/layers`
+//! checks the order.
 
 pub mod access;
 pub mod cli;
@@ -76,16 +83,16 @@ use flexdyn_proto::{Mode, RunState, StalePolicy, Topics};
 use tokio::sync::{oneshot, Notify};
 use zenoh::Session;
 
-pub use crate::transport::frame_stamp_ns;
-pub use crate::transport::{zenoh_config, Role, ZenohArgs, DEFAULT_ENDPOINT};
 pub use error::{ServerError, SettingsError, ZenohConfigError};
+pub use flexdyn_proto::client::transport::frame_stamp_ns;
+pub use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs, DEFAULT_ENDPOINT};
 pub use report::{Outcome, PublishCost, RunReport};
 pub use settings::{mode_name, Handoff, OverrunPolicy, ServerSettings};
 pub use setup::RECORD_QUEUE;
 
-use crate::config::SimConfig;
-use crate::sim::Simulation;
-use crate::sinks::recorder::{RecordReport, RecordTx, Recorder};
+use flexdyn_sinks::recorder::{RecordReport, RecordTx, Recorder};
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 use intake::CommandSink;
 use lockstep::LockstepCore;
 use physics::{PhysicsCtx, PhysicsReport, Stepper};
@@ -262,7 +269,7 @@ fn prepare(
         cfg.summary()
     );
     tracing::info!("server settings: {}", settings.summary());
-    crate::transport::log_listening(session);
+    flexdyn_proto::client::transport::log_listening(session);
     if settings.mode == Mode::RealTime && settings.stale_policy == StalePolicy::Hold {
         tracing::debug!("stale commands are held (stale_policy = hold)");
     }
@@ -334,8 +341,9 @@ impl Wiring {
         let (full_tx, full_rx) = sync_channel::<Box<Frame>>(n_buffers);
         // Live faults: resolved requests in (one queue slot per live-fault slot), their boxes
         // back to be freed by the telemetry thread.
-        let (fault_tx, fault_rx) = sync_channel(crate::faults::MAX_LIVE_FAULTS);
-        let (fault_recycle_tx, fault_recycle_rx) = sync_channel(2 * crate::faults::MAX_LIVE_FAULTS);
+        let (fault_tx, fault_rx) = sync_channel(flexdyn_faults::MAX_LIVE_FAULTS);
+        let (fault_recycle_tx, fault_recycle_rx) =
+            sync_channel(2 * flexdyn_faults::MAX_LIVE_FAULTS);
         let shape = sim.blank_state();
         let n_sensors = sim.sensors().len();
         let n_events = sim.faults().event_capacity();
@@ -478,7 +486,7 @@ async fn run_frames(
 }
 
 /// Closes the `--record` file once everything queued is written; what it holds.
-pub(super) fn finish_recording(
+pub(crate) fn finish_recording(
     recorder: Option<(Recorder, RecordTx)>,
 ) -> Result<Option<RecordReport>, ServerError> {
     recorder

@@ -1,5 +1,5 @@
 //! Fleet mode: `flexdyn run --fleet FLEET.toml` serves every vehicle of a fleet file
-//! ([`crate::world::fleet`]) from one process, on one tick.
+//! ([`flexdyn_vehicle::world::fleet`]) from one process, on one tick.
 //!
 //! - **Keys.** Each vehicle publishes and takes commands under its own id, exactly as a
 //!   single-vehicle server with `sc_id = <id>` does: `flexdyn/<id>/tlm/…`, `flexdyn/<id>/cmd/*`,
@@ -62,9 +62,9 @@ use super::settings::{mode_name, ServerSettings};
 use super::setup::{self, Endpoints};
 use super::shared::{Frame, Shared};
 use super::telemetry::TelemetryCtx;
-use crate::config::log_warnings;
-use crate::transport::{zenoh_config, Role};
-use crate::world::{FleetConfig, World};
+use flexdyn_proto::client::transport::{zenoh_config, Role};
+use flexdyn_vehicle::config::log_warnings;
+use flexdyn_vehicle::world::{FleetConfig, World};
 use physics::{FleetPhysics, FleetPhysicsReport};
 use stepper::FleetStepper;
 
@@ -85,7 +85,7 @@ pub struct FleetReport {
     /// which holds the participants' own time and the network's).
     pub wait_ns: u64,
     /// `--record`: what the file holds.
-    pub recording: Option<crate::sinks::recorder::RecordReport>,
+    pub recording: Option<flexdyn_sinks::recorder::RecordReport>,
 }
 
 impl FleetReport {
@@ -117,7 +117,10 @@ impl std::fmt::Display for FleetReport {
 }
 
 /// Vehicle `v`'s settings: the fleet's, with its ids and participants.
-fn vehicle_settings(base: &ServerSettings, v: &crate::world::VehicleConfig) -> ServerSettings {
+fn vehicle_settings(
+    base: &ServerSettings,
+    v: &flexdyn_vehicle::world::VehicleConfig,
+) -> ServerSettings {
     let mut participants = v.participants.clone();
     participants.sort_unstable();
     ServerSettings {
@@ -189,7 +192,7 @@ pub async fn run(
         "flexdyn fleet server starting"
     );
     tracing::info!("server settings: {}", settings.summary());
-    crate::transport::log_listening(&session);
+    flexdyn_proto::client::transport::log_listening(&session);
 
     // Per vehicle: its publishers, configuration queryable, counters, command callback, status
     // thread and (lockstep) presence.
@@ -257,8 +260,9 @@ pub async fn run(
             .map_err(named)?;
         // Live faults: resolved on the Zenoh thread against this vehicle, installed by the
         // physics thread before the next frame; their boxes freed by its telemetry thread.
-        let (fault_tx, fault_rx) = sync_channel(crate::faults::MAX_LIVE_FAULTS);
-        let (fault_recycle_tx, fault_recycle_rx) = sync_channel(2 * crate::faults::MAX_LIVE_FAULTS);
+        let (fault_tx, fault_rx) = sync_channel(flexdyn_faults::MAX_LIVE_FAULTS);
+        let (fault_recycle_tx, fault_recycle_rx) =
+            sync_channel(2 * flexdyn_faults::MAX_LIVE_FAULTS);
         let resolver = cfg
             .live_fault_resolver()
             .map_err(|source| named(ServerError::Config { file: None, source }))?;

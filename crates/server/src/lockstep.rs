@@ -151,10 +151,10 @@ impl LockstepCore {
 
     /// A live fault request from the fault callback, installed before frame `k → k + 1` is
     /// stepped (so at boundary `k + 1` at the earliest); `Err` with the refusal's code
-    /// ([`crate::faults::ports::INSTALL_REFUSALS`]).
-    pub fn install_fault(&mut self, req: crate::faults::ports::LiveRequest) -> Result<(), u8> {
+    /// ([`flexdyn_faults::ports::INSTALL_REFUSALS`]).
+    pub fn install_fault(&mut self, req: flexdyn_faults::ports::LiveRequest) -> Result<(), u8> {
         if self.ended() {
-            return Err(crate::faults::ports::REFUSED_LATE);
+            return Err(flexdyn_faults::ports::REFUSED_LATE);
         }
         self.w
             .install_fault(req, self.k)
@@ -176,7 +176,7 @@ impl LockstepCore {
     }
 
     fn publish(&mut self) {
-        self.frame.boundary_unix_ns = crate::transport::unix_now_ns();
+        self.frame.boundary_unix_ns = flexdyn_proto::client::transport::unix_now_ns();
         self.publisher
             .publish(&self.frame, &self.shared, self.record.as_ref());
         self.shared.tick.store(self.k, Ordering::Relaxed);
@@ -184,7 +184,7 @@ impl LockstepCore {
     }
 
     /// Steps the answered tick, publishes the next, and goes on stepping while a tick needs no
-    /// answer (every participant's command link `dropped`: [`crate::faults::link`]), until one
+    /// answer (every participant's command link `dropped`: [`flexdyn_faults::link`]), until one
     /// does, a hold, the end, or a stop request.
     fn advance(&mut self) {
         loop {

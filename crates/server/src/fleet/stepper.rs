@@ -2,12 +2,12 @@
 //! held command) and its telemetry buffer, stepped on one tick. Nothing here allocates after
 //! [`FleetStepper::new`] (checked in `tests/server_alloc.rs`).
 //!
-//! The vehicles do not act on one another ([`crate::world::step`]), so each vehicle's stream
+//! The vehicles do not act on one another ([`flexdyn_vehicle::world::step`]), so each vehicle's stream
 //! is the one it would have alone, bit for bit, whatever the fleet's order or size.
 //!
-//! Each (chief, deputy) pair of the fleet file ([`crate::world::World::relative_pairs`]) gets
+//! Each (chief, deputy) pair of the fleet file ([`flexdyn_vehicle::world::World::relative_pairs`]) gets
 //! its [`RelativeStateMsg`] filled with the frames, from the two vehicles' states of the same
-//! tick ([`crate::world::relative`]): a few dozen flops per pair, no allocation.
+//! tick ([`flexdyn_vehicle::world::relative`]): a few dozen flops per pair, no allocation.
 
 use flexdyn_proto::{CommandMsg, Header, RelativeStateMsg};
 
@@ -16,8 +16,8 @@ use super::super::error::ServerError;
 use super::super::physics::Stepper;
 use super::super::settings::ServerSettings;
 use super::super::shared::Frame;
-use crate::world::relative::{com_state_n, relative_state_hill};
-use crate::world::Vehicle;
+use flexdyn_vehicle::world::relative::{com_state_n, relative_state_hill};
+use flexdyn_vehicle::world::Vehicle;
 
 /// One vehicle of the running fleet.
 pub struct FleetVehicle {
@@ -75,7 +75,7 @@ impl FleetStepper {
     }
 
     /// With the relative states of these (chief, deputy) index pairs
-    /// ([`crate::world::World::relative_pairs`]); a pair naming a vehicle out of range is left
+    /// ([`flexdyn_vehicle::world::World::relative_pairs`]); a pair naming a vehicle out of range is left
     /// out.
     pub fn with_relative_pairs(mut self, pairs: &[(usize, usize)]) -> Self {
         let n = self.vehicles.len();

@@ -49,7 +49,7 @@ pub struct Frame {
 
 impl Frame {
     /// An empty frame whose state has `shape`'s effector layout (see
-    /// [`crate::sim::Simulation::blank_state`]), with room for the messages of `n_sensors`
+    /// [`flexdyn_vehicle::sim::Simulation::blank_state`]), with room for the messages of `n_sensors`
     /// sensors.
     pub fn for_state(shape: &StateMsg, n_sensors: usize) -> Self {
         Self {
@@ -71,14 +71,14 @@ impl Frame {
     }
 
     /// Room for `n` fault events per frame (the simulation's
-    /// [`crate::faults::Faults::event_capacity`]), so filling them does not allocate.
+    /// [`flexdyn_faults::Faults::event_capacity`]), so filling them does not allocate.
     pub fn with_fault_events(mut self, n: usize) -> Self {
         self.fault_events = Vec::with_capacity(n);
         self
     }
 }
 
-/// Copies the state record `state` (filled by [`crate::sim::Simulation::state_into`]) into
+/// Copies the state record `state` (filled by [`flexdyn_vehicle::sim::Simulation::state_into`]) into
 /// `out` with the frame's `header` and the command bookkeeping of `held`, without allocating
 /// (`out` has the same effector layout: [`Frame::for_state`]).
 pub fn fill_state(
@@ -132,7 +132,7 @@ pub struct Shared {
     wrong_identity: AtomicU64,
     operator_refused: AtomicU64,
     fault_refused: AtomicU64,
-    /// Fault requests the physics side refused ([`crate::faults::ports::INSTALL_REFUSALS`]),
+    /// Fault requests the physics side refused ([`flexdyn_faults::ports::INSTALL_REFUSALS`]),
     /// and the code of the last one, for the telemetry thread's log.
     pub faults_refused_physics: AtomicU64,
     /// See [`Self::faults_refused_physics`].
@@ -180,7 +180,7 @@ pub struct Shared {
     /// `stale_tick` rejections per participant (sender id, count), in ascending id order, so
     /// the telemetry thread can name the sender in its warning (the physics thread only counts).
     pub stale_by_participant: Vec<(u32, AtomicU64)>,
-    /// What the command-link faults did ([`crate::faults::link::LinkStats`], copied from the
+    /// What the command-link faults did ([`flexdyn_faults::link::LinkStats`], copied from the
     /// command book after each frame): dropped, empty answers, delayed frames, corrupted,
     /// corrupted and rejected.
     link_stats: [AtomicU64; 5],
@@ -284,7 +284,7 @@ impl Shared {
     }
 
     /// Notes what the command-link faults did so far (allocation-free).
-    pub fn note_link_stats(&self, s: &crate::faults::link::LinkStats) {
+    pub fn note_link_stats(&self, s: &flexdyn_faults::link::LinkStats) {
         let v = [
             s.commands_dropped,
             s.empty_answers,
@@ -298,9 +298,9 @@ impl Shared {
     }
 
     /// What the command-link faults did so far.
-    pub fn link_stats(&self) -> crate::faults::link::LinkStats {
+    pub fn link_stats(&self) -> flexdyn_faults::link::LinkStats {
         let l = |i: usize| self.link_stats[i].load(Ordering::Relaxed);
-        crate::faults::link::LinkStats {
+        flexdyn_faults::link::LinkStats {
             commands_dropped: l(0),
             empty_answers: l(1),
             delayed_frames: l(2),

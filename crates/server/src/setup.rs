@@ -16,10 +16,10 @@ use zenoh::{Session, Wait};
 use super::error::{ServerError, SettingsError};
 use super::publish::FramePublisher;
 use super::settings::ServerSettings;
-use crate::config::SimConfig;
-use crate::sim::Simulation;
-use crate::sinks::mcap_file::{flexdyn_version, git_commit, RecordingInfo, VehicleInfo};
-use crate::sinks::recorder::{RecordTx, Recorder};
+use flexdyn_sinks::mcap_file::{flexdyn_version, git_commit, RecordingInfo, VehicleInfo};
+use flexdyn_sinks::recorder::{RecordTx, Recorder};
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 
 /// Samples the `--record` queue holds before real time drops (lockstep waits instead).
 pub const RECORD_QUEUE: usize = 65_536;

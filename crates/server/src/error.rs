@@ -2,9 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-pub use crate::transport::ZenohConfigError;
+pub use flexdyn_proto::client::transport::ZenohConfigError;
 
-use crate::config::{config_message, At, ConfigError, SourceMap};
+use flexdyn_vehicle::config::{config_message, At, ConfigError, SourceMap};
 
 /// An invalid server setting. The message starts with the setting's name as the user wrote it:
 /// `server.<key>` for the `[server]` TOML table, `--<flag>` for a command-line option.
@@ -116,7 +116,7 @@ pub enum ServerError {
          start the flight code and check it connects to this server and declares its \
          liveliness token flexdyn/{sc_id}/participant/<id>",
         list_ids(missing),
-        crate::numfmt::Rounded(*waited_s, 3)
+        flexdyn_kernel::numfmt::Rounded(*waited_s, 3)
     )]
     ParticipantsAbsent {
         /// Sender ids whose token (or state subscriber) was not seen.
@@ -130,7 +130,7 @@ pub enum ServerError {
     #[error(
         "lockstep participant {participant} did not answer tick {tick} within {} s \
          (server.participant_timeout_s); stopping the run",
-        crate::numfmt::Rounded(*timeout_s, 4)
+        flexdyn_kernel::numfmt::Rounded(*timeout_s, 4)
     )]
     ParticipantTimeout {
         /// Sender id of the first participant that has not answered.
@@ -152,7 +152,7 @@ pub enum ServerError {
     },
     /// The fleet file (or a vehicle's spacecraft configuration) is invalid.
     #[error(transparent)]
-    Fleet(#[from] crate::world::FleetError),
+    Fleet(#[from] flexdyn_vehicle::world::FleetError),
     /// Real time with `overrun_policy = "abort"`: too many consecutive overruns.
     #[error(
         "aborting: {consecutive} consecutive frame overruns at tick {tick} exceed \
@@ -172,7 +172,7 @@ pub enum ServerError {
         "the state became non-finite at tick {tick} (t = {} s): {quantity} is NaN or \
          infinite; stopping the run without publishing it (check the configuration's rates, \
          stiffnesses and wrenches for values the step cannot resolve)",
-        crate::numfmt::Num(*t_s)
+        flexdyn_kernel::numfmt::Num(*t_s)
     )]
     NonFinite {
         /// The tick whose state is not finite.
@@ -184,7 +184,7 @@ pub enum ServerError {
     },
     /// `--record`: the recording could not be created or written.
     #[error(transparent)]
-    Record(#[from] crate::sinks::mcap_file::RecordError),
+    Record(#[from] flexdyn_sinks::mcap_file::RecordError),
     /// A real-time setting the OS refused (`lock_memory`, `physics_cpu`, `cpu_dma_latency`,
     /// `realtime_priority`): the run does not start without what it asked for.
     #[error("{setting}: {problem}")]
@@ -233,7 +233,7 @@ impl ServerError {
     pub(crate) fn zenoh(what: &'static str, e: impl std::fmt::Display) -> Self {
         ServerError::Zenoh {
             what,
-            message: crate::transport::clean_zenoh_message(&e.to_string()),
+            message: flexdyn_proto::client::transport::clean_zenoh_message(&e.to_string()),
         }
     }
 }

@@ -17,11 +17,11 @@ use flexdyn_proto::{
     time_flags, Header, Mode, RunState, SysTime, TimeMsg, UtcTime, CUC_PFIELD_TAI_4_3,
 };
 
-use crate::environment::epoch::SimEpoch;
+use flexdyn_environment::epoch::SimEpoch;
 
 const NS_PER_S: u64 = 1_000_000_000;
 
-pub use crate::environment::epoch::TAI_1958_COUNT_NS;
+pub use flexdyn_environment::epoch::TAI_1958_COUNT_NS;
 
 /// The per-run constants of the time message.
 #[derive(Clone, Debug)]
@@ -148,7 +148,7 @@ impl TimeService {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::environment::epoch::{EarthOrientationParams, EpochScale};
+    use flexdyn_environment::epoch::{EarthOrientationParams, EpochScale};
 
     const S: u64 = NS_PER_S;
 
@@ -287,7 +287,7 @@ mod tests {
             0.5,
         );
         let golden = std::fs::read(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("proto/golden/time.bin"),
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../proto/golden/time.bin"),
         )
         .unwrap();
         assert_eq!(
