@@ -17,18 +17,17 @@
 //! - `flexdyn-sinks` ([`sinks`], and [`signals`]): recording (MCAP), replay, export, the live
 //!   Foxglove view and plots; the first layer with an I/O stack;
 //! - `flexdyn-server` ([`server`]): the Zenoh server (`flexdyn run`): real-time, lockstep and
-//!   batch propagation.
+//!   batch propagation;
+//! - `flexdyn-campaign` ([`campaign`]): Monte Carlo campaigns with flight code in the loop.
 //!
 //! This crate re-exports them under their old paths and holds what sits above them, for now:
 //! - [`logging`], [`transport`]: the stderr log setup and the one Zenoh configuration builder
 //!   (loopback, multicast scouting off), shared with the tools and flight code
 //!   (`flexdyn_proto::client`);
-//! - [`campaign`]: Monte Carlo campaigns with flight code in the loop;
 //! - [`cli`] and [`world::run`]: the offline front ends `flexdyn simulate` and `flexdyn fleet`.
 
 #![warn(missing_docs)]
 
-pub mod campaign;
 pub mod cli;
 pub mod world;
 
@@ -36,6 +35,7 @@ pub use flexdyn_proto::client::{logging, transport};
 
 // The model and vehicle layers are crates of their own (`crates/`); their old paths stay
 // re-exported here while the layers above them move into crates too.
+pub use flexdyn_campaign as campaign;
 pub use flexdyn_dynamics as dynamics;
 pub use flexdyn_environment as environment;
 pub use flexdyn_faults as faults;

@@ -51,6 +51,8 @@
 //! tokio. It must never depend on the campaigns or the command line, which use it; `.ci/layers`
 //! checks the order.
 
+#![warn(missing_docs)]
+
 pub mod access;
 pub mod cli;
 pub mod clock;

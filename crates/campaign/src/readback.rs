@@ -7,17 +7,19 @@
 
 use std::collections::BTreeMap;
 
-use crate::config::SimConfig;
-use crate::world::relative::com_state_n;
-use crate::world::{relative_state_hill, FleetConfig};
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::world::relative::com_state_n;
+use flexdyn_vehicle::world::{relative_state_hill, FleetConfig};
 
 /// Every numeric parameter of the model built from `cfg`, by configuration path: the hub, the
 /// initial state (`initial.sigma_bn[i]`, `initial.omega_bn_b_rad_s[i]`, `initial.r_bn_n_m[i]`,
-/// `initial.v_bn_n_m_s[i]`), each effector's [`crate::dynamics::StateEffector::parameters`]
-/// under its kind's section (`panel_pairs[k].`, `reaction_wheels[k].`: [`crate::dynamics::kinds`]), each dynamic effector's
-/// [`crate::dynamics::DynamicEffector::parameters`] (facets, residual dipole), the environment
+/// `initial.v_bn_n_m_s[i]`), each effector's [`flexdyn_dynamics::StateEffector::parameters`]
+/// under its kind's section (`panel_pairs[k].`, `reaction_wheels[k].`: [`flexdyn_dynamics::kinds`]), each dynamic effector's
+/// [`flexdyn_dynamics::DynamicEffector::parameters`] (facets, residual dipole), the environment
 /// models' (space weather) and the epoch's `epoch.offset_s`.
-pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config::ConfigError> {
+pub fn readback(
+    cfg: &SimConfig,
+) -> Result<BTreeMap<String, f64>, flexdyn_vehicle::config::ConfigError> {
     let sc = cfg.build_spacecraft()?;
     let mut out = BTreeMap::new();
     let hub = sc.hub();
@@ -42,7 +44,7 @@ pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config:
     let mut params = Vec::new();
     for (e, range) in sc.effectors().iter().zip(sc.effector_ranges()) {
         let section =
-            crate::dynamics::kinds::by_name(e.kind().name).map_or(e.kind().name, |k| k.section);
+            flexdyn_dynamics::kinds::by_name(e.kind().name).map_or(e.kind().name, |k| k.section);
         let k = per_kind.entry(section).or_insert(0);
         params.clear();
         e.parameters(&x.effectors[range.clone()], &mut params);
@@ -82,14 +84,14 @@ pub fn readback(cfg: &SimConfig) -> Result<BTreeMap<String, f64>, crate::config:
 /// to a chief its initial offset in the chief's Hill frame as the two built spacecraft have it:
 /// `<id>.relative.hill_position_m[i]` and `<id>.relative.hill_velocity_m_s[i]`, from their
 /// centres of mass ([`com_state_n`]) through [`relative_state_hill`]. That is an independent
-/// reader of what [`crate::world::fleet`] wrote into the deputy's initial state: the offset
+/// reader of what [`flexdyn_vehicle::world::fleet`] wrote into the deputy's initial state: the offset
 /// goes to N and comes back, so it equals the dispersed value to the rounding of positions of
 /// about 7e6 m (≈ 1e-9 m), not bit for bit. An error names the vehicle.
 pub fn fleet_readback(fleet: &FleetConfig) -> Result<BTreeMap<String, f64>, String> {
     let mut out = BTreeMap::new();
     let mut built = Vec::with_capacity(fleet.vehicles.len());
     for v in &fleet.vehicles {
-        let named = |e: crate::config::ConfigError| format!("vehicle {:?}: {e}", v.id);
+        let named = |e: flexdyn_vehicle::config::ConfigError| format!("vehicle {:?}: {e}", v.id);
         for (k, x) in readback(&v.cfg).map_err(named)? {
             out.insert(format!("{}.{k}", v.id), x);
         }

@@ -17,7 +17,7 @@
 //! ([`super::verdict`]).
 //!
 //! Over a fleet (`fleet` in the campaign file), a run is the fleet server
-//! ([`crate::server::fleet::run`], what `flexdyn run --fleet` runs) with the run's fleet: the
+//! ([`flexdyn_server::fleet::run`], what `flexdyn run --fleet` runs) with the run's fleet: the
 //! observer answers every vehicle's ticks as sender 9 (added to each vehicle's participants),
 //! and each `[[controllers]]` entry is a process with its own sender id and its log
 //! `controller-<vehicle>-<sender>.log`. `result.json` then holds a hash per vehicle
@@ -45,11 +45,11 @@ use super::readback::fleet_readback;
 pub use super::spec::OBSERVER_ID;
 use super::spec::{Campaign, Criterion, Quantity, Statistic};
 use super::verdict::Outcome;
-use crate::attitude::mrp_error;
-use crate::config::SimConfig;
-use crate::server::{ServerError, ServerSettings};
-use crate::transport::{zenoh_config, Role, ZenohArgs};
-use crate::world::FleetConfig;
+use flexdyn_kernel::attitude::mrp_error;
+use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_server::{ServerError, ServerSettings};
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::world::FleetConfig;
 /// The flight code's sender id (`{sender_id}`).
 pub const CONTROLLER_ID: u32 = 1;
 /// The spacecraft id of every run (`{sc_id}`); runs are separated by port.
@@ -552,7 +552,7 @@ fn run_lockstep(
     let session = zenoh::open(zcfg)
         .wait()
         .map_err(|e| format!("server session: {e}"))?;
-    let endpoint = crate::transport::listening_on(&session)
+    let endpoint = flexdyn_proto::client::transport::listening_on(&session)
         .into_iter()
         .next()
         .ok_or_else(|| "the server session listens nowhere".to_owned())?;
@@ -568,12 +568,12 @@ fn run_lockstep(
             // (last tick, simulated time): a fleet's are every vehicle's.
             let r = match server {
                 Server::Single(settings, cfg) => {
-                    crate::server::run(session.clone(), settings, *cfg, stopped)
+                    flexdyn_server::run(session.clone(), settings, *cfg, stopped)
                         .await
                         .map(|r| (r.last_tick, r.sim_time_ns))
                 }
                 Server::Fleet(settings, fleet) => {
-                    crate::server::fleet::run(session.clone(), settings, *fleet, stopped)
+                    flexdyn_server::fleet::run(session.clone(), settings, *fleet, stopped)
                         .await
                         .map(|r| {
                             r.vehicles

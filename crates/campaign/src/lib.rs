@@ -15,6 +15,14 @@
 //!   figures.
 //! - [`verdict`]: each run's outcome, and the exit code of `run` and `summarize` (0 every run
 //!   passed, 1 a run could not be run, 2 invalid input, 3 a run failed).
+//!
+//! A crate of its own (`flexdyn-campaign`), above the server: a run is a server (in this
+//! process) with the flight code as a child process, so it depends on `flexdyn-server`, the
+//! vehicle layer (the configuration each run disperses), the sinks (the summary's figures) and
+//! the model crates. It must never depend on the command line, which uses it; `.ci/layers`
+//! checks the order.
+
+#![warn(missing_docs)]
 
 pub mod command;
 pub mod execute;

@@ -367,11 +367,11 @@ fn figures(
     criteria: &[String],
     axes: &BTreeMap<String, Axis>,
 ) -> Result<Vec<PathBuf>, String> {
-    crate::sinks::plot::register_font().map_err(|e| e.to_string())?;
+    flexdyn_sinks::plot::register_font().map_err(|e| e.to_string())?;
     let fig_dir = dir.join("figures");
     std::fs::create_dir_all(&fig_dir).map_err(|e| io(&fig_dir, e))?;
     let mut out = Vec::new();
-    let font = crate::sinks::plot::FONT_NAME;
+    let font = flexdyn_sinks::plot::FONT_NAME;
     for (ci, c) in criteria.iter().enumerate() {
         let values: Vec<(f64, bool, &RunResult)> = results
             .iter()

@@ -2,9 +2,9 @@
 //! and a manifest, with nothing launched.
 //!
 //! # Seeds
-//! Run `i` draws from the portable generator ([`crate::sensors::rng::NormalRng`]) seeded with
+//! Run `i` draws from the portable generator ([`flexdyn_sensors::rng::NormalRng`]) seeded with
 //! `run_seed(i) = splitmix64(master_seed ⊕ splitmix64(i))`. Each sensor's `seed` key
-//! (`<config array>[k].seed` of every sensor kind in [`crate::sensors::KINDS`]: `imus[k].seed`,
+//! (`<config array>[k].seed` of every sensor kind in [`flexdyn_sensors::KINDS`]: `imus[k].seed`,
 //! `star_trackers[k].seed`), and `faults[k].seed` of every random fault (one with `mtbf_s`,
 //! written in if absent), becomes `splitmix64(run_seed ⊕ fnv1a(key))`. A run
 //! therefore depends only on the campaign file and its index: `--index I` reproduces it alone.
@@ -46,8 +46,8 @@ use super::keys;
 use super::readback::fleet_readback;
 pub use super::readback::readback;
 use super::spec::{Campaign, CampaignError, Distribution};
-use crate::config::SimConfig;
-use crate::sensors::rng::NormalRng;
+use flexdyn_sensors::rng::NormalRng;
+use flexdyn_vehicle::config::SimConfig;
 
 /// SplitMix64's finaliser (Steele, Lea & Flood 2014): a bijective 64-bit mix.
 pub fn splitmix64(x: u64) -> u64 {
@@ -105,7 +105,7 @@ pub struct RunPlan {
     pub dispersed: BTreeMap<String, f64>,
     /// \[ns\] the first activation of each random fault (`faults[k]` with `mtbf_s`): its
     /// `start_s` plus the time to failure drawn from the run's seed
-    /// ([`crate::faults::failure_delay_ns`]), whether or not it falls within the run.
+    /// ([`flexdyn_faults::failure_delay_ns`]), whether or not it falls within the run.
     #[serde(default)]
     pub random_failures_ns: BTreeMap<String, u64>,
     /// The full configuration, TOML (not in the manifest; written as `config.toml`); over a
@@ -120,7 +120,7 @@ pub struct RunPlan {
 
 impl RunPlan {
     /// The fleet of a fleet run, as its folder reads ([`super::fleet::from_run`]).
-    pub fn fleet(&self) -> Result<crate::world::FleetConfig, String> {
+    pub fn fleet(&self) -> Result<flexdyn_vehicle::world::FleetConfig, String> {
         super::fleet::from_run(&self.config_toml, &self.vehicle_configs)
     }
 }
@@ -142,7 +142,7 @@ struct Unit {
 impl Unit {
     fn new(prefix: String, base: Table) -> Self {
         let mut seed_keys = Vec::new();
-        for section in crate::sensors::KINDS.iter().map(|k| k.config_array) {
+        for section in flexdyn_sensors::KINDS.iter().map(|k| k.config_array) {
             if let Some(toml::Value::Array(items)) = base.get(section) {
                 for (k, item) in items.iter().enumerate() {
                     if item.get("seed").is_some() {

@@ -52,13 +52,13 @@ use toml::de::DeTable;
 
 use super::command::split_command;
 use super::fleet::FleetBase;
-use crate::config::{
+use flexdyn_kernel::numfmt::Num;
+use flexdyn_kernel::schema::reader::TableReader;
+use flexdyn_kernel::schema::{location, At, SchemaError};
+use flexdyn_vehicle::config::{
     beyond_max_time, config_message, log_warnings, whole_ns, ConfigError, SimConfig, SourceMap,
     DEFAULT_CONFIG_TOML,
 };
-use crate::numfmt::Num;
-use crate::schema::reader::TableReader;
-use crate::schema::{location, At, SchemaError};
 
 /// A distribution of a dispersion.
 #[derive(Clone, Debug, PartialEq)]
@@ -266,7 +266,7 @@ pub enum CampaignError {
         fleet: PathBuf,
         /// The fleet file's error.
         #[source]
-        source: Box<crate::world::FleetError>,
+        source: Box<flexdyn_vehicle::world::FleetError>,
         /// Where the field is in the fleet file.
         at: At,
     },
@@ -968,10 +968,10 @@ fn fleet_error(
     campaign: &Path,
     fleet: &Path,
     text: &str,
-    e: crate::world::FleetError,
+    e: flexdyn_vehicle::world::FleetError,
 ) -> CampaignError {
     let at = match &e {
-        crate::world::FleetError::Field { field, .. } => {
+        flexdyn_vehicle::world::FleetError::Field { field, .. } => {
             let toml_path = match (field.find(" (\""), field.find("\")")) {
                 (Some(a), Some(b)) if b > a => format!("{}{}", &field[..a], &field[b + 2..]),
                 _ => field.clone(),

@@ -1,6 +1,6 @@
 //! A campaign over a fleet: `fleet = "formation.toml"` in the campaign file in place of `base`.
 //!
-//! - [`FleetBase`]: the fleet file, read by [`crate::world::fleet`] (so it is exactly what
+//! - [`FleetBase`]: the fleet file, read by [`flexdyn_vehicle::world::fleet`] (so it is exactly what
 //!   `flexdyn run --fleet` accepts), and for each vehicle the document its dispersions write
 //!   into: its spacecraft configuration (inline or by path) plus, for a vehicle given relative
 //!   to a chief, a `relative` table with its Hill-frame offsets `hill_position_m` and
@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use toml::{Table, Value};
 
-use crate::world::{FleetConfig, FleetError};
+use flexdyn_vehicle::world::{FleetConfig, FleetError};
 
 /// The keys of a deputy's `relative` table a dispersion may name.
 pub const RELATIVE_OFFSETS: [&str; 2] = ["hill_position_m", "hill_velocity_m_s"];
