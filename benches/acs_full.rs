@@ -20,6 +20,7 @@
 //!
 //! `cargo bench --bench acs_full`; environment `FLEXDYN_BENCH_ROUNDS` (default 5).
 
+use flexdyn_testkit::median;
 use std::hint::black_box;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -34,20 +35,18 @@ const ACS_FULL: &str = include_str!("../scenarios/acs_full.toml");
 /// Simulated seconds per timed span (flexdyn and Basilisk alike).
 const SPAN_S: f64 = 10.0;
 
-/// A 1 Hz GPS receiver, as `scenarios/leo_environment.toml` has one.
-const GPS: &str = "
-[[gps_receivers]]
-name = \"gps1\"
-rate_hz = 1.0
-seed = 51
-frames = \"both\"
-latency_s = 0.2
-acquisition_s = 0.0
-position_sigma_m = 3.0
-velocity_sigma_m_s = 0.05
-position_bias_e_m = [0.5, -0.3, 0.8]
-velocity_bias_e_m_s = [0.0, 0.0, 0.0]
-";
+/// The LEO scenario, whose 1 Hz GPS receiver the "1 ms + GPS" case adds.
+const LEO: &str = include_str!("../scenarios/leo_environment.toml");
+
+/// The `[[gps_receivers]]` table of `scenarios/leo_environment.toml`, up to the next table.
+fn leo_gps_receiver() -> &'static str {
+    let start = LEO
+        .find("\n[[gps_receivers]]\n")
+        .expect("leo_environment.toml has a [[gps_receivers]] table");
+    let rest = &LEO[start + 1..];
+    let end = rest[1..].find("\n[").map_or(rest.len(), |i| i + 2);
+    &rest[..end]
+}
 
 struct Case {
     label: &'static str,
@@ -70,7 +69,7 @@ fn cases() -> Vec<Case> {
         },
         Case {
             label: "1 ms + GPS",
-            toml: format!("{one_ms}{GPS}"),
+            toml: format!("{one_ms}\n{}", leo_gps_receiver()),
             peer_args: &["--step-ms", "1", "--gps"],
         },
     ]
@@ -137,11 +136,6 @@ fn peer() -> Option<(String, PathBuf)> {
     let python = std::env::var("FLEXDYN_PEERS_PYTHON").ok()?;
     let script = PathBuf::from(std::env::var("FLEXDYN_PEER_BSK_ACS").ok()?);
     Some((python, script))
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v[v.len() / 2]
 }
 
 fn main() {

@@ -14,6 +14,7 @@
 #[path = "../crates/dynamics/tests/common.rs"]
 mod common;
 
+use flexdyn_testkit::median;
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -209,11 +210,6 @@ fn models() -> Vec<Model> {
             }),
         },
     ]
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v[v.len() / 2]
 }
 
 /// Median ns per call over `BATCHES` batches of `BATCH` calls (after one warm-up batch).

@@ -10,6 +10,7 @@
 //!
 //! `cargo bench --bench record`; environment `FLEXDYN_BENCH_RECORD_ROUNDS` (default 7).
 
+use flexdyn_testkit::median;
 use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::Path;
@@ -114,11 +115,6 @@ fn raw_mcap(path: &Path, msgs: &[(String, Vec<u8>, u64)]) -> u64 {
     }
     w.finish().unwrap();
     msgs.len() as u64
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn main() {

@@ -22,6 +22,7 @@
 #[path = "../crates/dynamics/tests/common.rs"]
 mod common;
 
+use flexdyn_testkit::median;
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -101,11 +102,6 @@ fn bench_step(c: &mut Criterion) {
         );
     }
     group.finish();
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v[v.len() / 2]
 }
 
 /// Runs a peer script; returns (pairs, median ns per step) from its `peer=… pairs=N median_ns_per_step=x` lines.

@@ -15,6 +15,7 @@
 //! `FLEXDYN_BENCH_FLEETS` (default `1,2,4,8,16`). Ports: the OS's.
 
 use flexdyn_testkit::demo_bin;
+use flexdyn_testkit::median_mut;
 #[path = "../tests/support/mod.rs"]
 mod support;
 
@@ -32,11 +33,6 @@ fn env_usize(name: &str, default: usize) -> usize {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(default)
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v[v.len() / 2]
 }
 
 /// `n` reference spacecraft, `v1 … v<n-1>` 50 m apart behind `v0`.
@@ -149,7 +145,7 @@ fn main() {
             }
         }
     }
-    let base = median(&mut rates[0].clone());
+    let base = median_mut(&mut rates[0].clone());
     println!(
         "| vehicles | ticks/s (median) | ratio to {} | physics us per vehicle frame | wall time: \
          physics / publishing / waiting for answers |",
@@ -157,15 +153,15 @@ fn main() {
     );
     println!("|---|---|---|---|---|");
     for (j, &n) in sizes.iter().enumerate() {
-        let rate = median(&mut rates[j]);
+        let rate = median_mut(&mut rates[j]);
         let [a, b, c] = &mut shares[j];
         println!(
             "| {n} | {rate:.0} | {:.3} | {:.1} | {:.0} % / {:.0} % / {:.0} % |",
             rate / base,
-            median(&mut phys[j]),
-            median(a) * 100.0,
-            median(b) * 100.0,
-            median(c) * 100.0
+            median_mut(&mut phys[j]),
+            median_mut(a) * 100.0,
+            median_mut(b) * 100.0,
+            median_mut(c) * 100.0
         );
     }
 }

@@ -20,6 +20,7 @@
 //! Every process listens on a port the OS chose (port 0) and reports it.
 
 use flexdyn_testkit::demo_bin;
+use flexdyn_testkit::median_mut;
 #[path = "../tests/support/mod.rs"]
 mod support;
 
@@ -36,11 +37,6 @@ fn env_usize(name: &str, default: usize) -> usize {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(default)
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v[v.len() / 2]
 }
 
 /// Round trips per second of `ticks` ping-pongs; the pong answers inside its Zenoh callback, or
@@ -126,8 +122,12 @@ fn main() {
         lst.push(t);
         lsr.push(b);
     }
-    let (p, pl) = (median(&mut pp), median(&mut ppl));
-    let (a, t, b) = (median(&mut ls1), median(&mut lst), median(&mut lsr));
+    let (p, pl) = (median_mut(&mut pp), median_mut(&mut ppl));
+    let (a, t, b) = (
+        median_mut(&mut ls1),
+        median_mut(&mut lst),
+        median_mut(&mut lsr),
+    );
     let phys1 = physics_frame_us(1000.0);
     let phys10 = physics_frame_us(100.0);
     println!(
@@ -137,10 +137,10 @@ fn main() {
         1e6 / pl
     );
     let (r1, r1l, rt, rr) = (
-        median(&mut ratio1),
-        median(&mut ratio1l),
-        median(&mut ratiot),
-        median(&mut ratior),
+        median_mut(&mut ratio1),
+        median_mut(&mut ratio1l),
+        median_mut(&mut ratiot),
+        median_mut(&mut ratior),
     );
     println!(
         "median lockstep ticks/s, 1 RK4 step per frame, handoff direct: {a:.0} ({:.1} us/tick); \

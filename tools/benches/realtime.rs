@@ -30,6 +30,7 @@
 //! Every process listens on a port the OS chose (port 0) and reports it.
 
 use flexdyn_testkit::demo_bin;
+use flexdyn_testkit::median;
 #[path = "../tests/support/mod.rs"]
 mod support;
 
@@ -167,11 +168,6 @@ fn round(
         direct_publish_max_us: direct_max,
         direct_publish_slow: direct_slow,
     }
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn main() {

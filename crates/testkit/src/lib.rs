@@ -4,7 +4,8 @@
 //! - [`demo_bin`]: where the demo flight code binaries are, checked built after their sources;
 //! - [`cli_errors`]: the error rules every flexdyn binary follows on bad input;
 //! - [`alloc_counter`]: a counting global allocator, for the tests that prove a hot path
-//!   allocates nothing.
+//!   allocates nothing;
+//! - [`median`] and [`median_mut`]: the figure the benchmarks print.
 //!
 //! It depends on the standard library only, so a model crate's tests link no layer through it,
 //! and it must never depend on a flexdyn crate: helpers that need the simulator stay with the
@@ -14,3 +15,15 @@ pub mod alloc_counter;
 pub mod cli_errors;
 pub mod demo_bin;
 pub mod ports;
+
+/// The median of `v` as the benchmarks print it: the upper median (`v[len / 2]` once sorted by
+/// `f64::total_cmp`) for an even count. Panics on an empty `v`.
+pub fn median(mut v: Vec<f64>) -> f64 {
+    median_mut(&mut v)
+}
+
+/// [`median`], sorting `v` in place.
+pub fn median_mut(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
