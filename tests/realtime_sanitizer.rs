@@ -70,10 +70,10 @@ use std::time::{Duration, Instant};
 
 use flexdyn::config::SimConfig;
 use flexdyn::server::pacing::{FrameEnd, Pacer};
-use flexdyn::server::physics::{count_offer, Stepper};
 use flexdyn::server::rt::monotonic_ns;
 use flexdyn::server::settings::OverrunPolicy;
 use flexdyn::server::shared::{Frame, Shared};
+use flexdyn::server::stepper::{count_offer, Stepper};
 use flexdyn::server::ServerSettings;
 use flexdyn::sim::Simulation;
 use flexdyn::transport::unix_now_ns;

@@ -13,8 +13,8 @@ use std::sync::mpsc::sync_channel;
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
 use flexdyn::config::SimConfig;
 use flexdyn::faults::ports::{Installed, LiveRequest};
-use flexdyn::server::physics::Stepper;
 use flexdyn::server::shared::Frame;
+use flexdyn::server::stepper::Stepper;
 use flexdyn::server::ServerSettings;
 use flexdyn::sim::Simulation;
 use flexdyn_proto::{CommandMsg, EffectorInput, FaultAction, FaultCommandMsg, FaultTarget, Header};
@@ -280,7 +280,7 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
     }
 }
 
-/// Fleet mode: one physics thread steps every vehicle ([`FleetStepper`]), with one barrier over
+/// Fleet mode: one physics thread steps every vehicle ([`WorldStepper`]), with one barrier over
 /// every participant of every vehicle. Three vehicles (the wheel scenario twice, the second 100 m
 /// behind the first, the first with a repeating gyro fault and a wheel fault whose events each
 /// frame carries; the reference spacecraft), sender 9 answering all three: the per-frame work
@@ -288,7 +288,7 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
 /// allocates nothing.
 #[test]
 fn the_fleet_frame_path_does_not_allocate() {
-    use flexdyn::server::fleet::stepper::FleetStepper;
+    use flexdyn::server::world::WorldStepper;
     use flexdyn::world::{FleetConfig, World};
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let faulty =
@@ -341,9 +341,9 @@ participants = [9]
     let world = World::new(&fleet).unwrap();
     let pairs = world.relative_pairs().to_vec();
     assert_eq!(pairs, [(0, 1)]);
-    let mut f = FleetStepper::new(world.into_vehicles(), &settings).with_relative_pairs(&pairs);
+    let mut f = WorldStepper::new(world.into_vehicles(), &settings).with_relative_pairs(&pairs);
     let (cmd_tx, cmd_rx) = sync_channel::<(usize, CommandMsg)>(16);
-    let frame_once = |f: &mut FleetStepper, k: u64| {
+    let frame_once = |f: &mut WorldStepper, k: u64| {
         for (v, senders) in [(0usize, [1u32, 9]), (1, [2, 9]), (2, [9, 9])] {
             for s in senders.iter().take(if v == 2 { 1 } else { 2 }) {
                 let id = u32::try_from(v + 1).unwrap();
@@ -367,7 +367,10 @@ participants = [9]
     assert_no_alloc(|| {
         for k in 1..200 {
             frame_once(&mut f, k);
-            let a = &f.vehicles[0].frame;
+            let a = f.vehicles[0]
+                .frame
+                .as_deref()
+                .expect("a fleet vehicle's own buffer");
             events += a.fault_events.len();
             if let Some(i) = [40, 90, 120].iter().position(|t| *t == k + 1) {
                 active_at[i] = a.faults_active.0;
@@ -381,7 +384,8 @@ participants = [9]
     assert_eq!(events, 10, "fault events filled into vehicle a's frames");
     // Every vehicle stepped 200 frames.
     for v in &f.vehicles {
-        assert_eq!(v.frame.state.header.tick, 200, "{}", v.id);
+        let frame = v.frame.as_deref().expect("a fleet vehicle's own buffer");
+        assert_eq!(frame.state.header.tick, 200, "{}", v.id);
     }
     // And the pair's relative state is that of tick 200 (b started 100 m behind a).
     let rel = &f.pairs[0].msg;

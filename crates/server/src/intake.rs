@@ -14,27 +14,25 @@ use zenoh::Session;
 use super::commands::{Gate, Offer};
 use super::error::ServerError;
 use super::lockstep::LockstepCore;
-use super::physics::count_offer;
 use super::reject_log::RejectLog;
 use super::settings::ServerSettings;
 use super::shared::Shared;
+use super::stepper::count_offer;
 use flexdyn_sinks::recorder::{RecordItem, RecordTx};
 
 /// Where the command callback delivers a validated command.
 pub(super) enum CommandSink {
-    /// The physics thread's bounded queue (never blocks: a full queue drops and counts),
-    /// behind the [`Gate`].
-    Queue(Mutex<(SyncSender<CommandMsg>, Gate)>),
-    /// Lockstep with `handoff = "direct"`: the core, stepped in this callback.
-    Core(Arc<Mutex<LockstepCore>>),
-    /// Fleet mode: the one physics thread's bounded queue, each command tagged with the index
-    /// of the vehicle it arrived for (never blocks: a full queue drops and counts).
-    Fleet {
-        /// The vehicle's index in the fleet.
+    /// The physics thread's bounded queue, each command tagged with the index of the vehicle
+    /// it arrived for (never blocks: a full queue drops and counts), behind that vehicle's
+    /// [`Gate`].
+    Queue {
+        /// The vehicle's index in the world (0 for one spacecraft).
         vehicle: usize,
         /// The queue, behind this vehicle's [`Gate`].
         queue: Mutex<(SyncSender<(usize, CommandMsg)>, Gate)>,
     },
+    /// Lockstep with `handoff = "direct"`: the core, stepped in this callback.
+    Core(Arc<Mutex<LockstepCore>>),
 }
 
 /// Subscribes the command callback to `flexdyn/<sc>/cmd/*`; dropping the subscriber stops the
@@ -156,12 +154,7 @@ fn command_callback(
             return;
         }
         match &sink {
-            CommandSink::Queue(queue) => {
-                let mut queue = queue.lock().unwrap_or_else(|p| p.into_inner());
-                let (tx, gate) = &mut *queue;
-                gated_send(gate, &shared, cmd, |cmd| tx.try_send(cmd).is_ok());
-            }
-            CommandSink::Fleet { vehicle, queue } => {
+            CommandSink::Queue { vehicle, queue } => {
                 let mut queue = queue.lock().unwrap_or_else(|p| p.into_inner());
                 let (tx, gate) = &mut *queue;
                 gated_send(gate, &shared, cmd, |cmd| {

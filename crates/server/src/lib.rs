@@ -14,6 +14,9 @@
 //! - `presence`: lockstep participants' liveliness tokens and the wait before tick 0.
 //! - [`operator`]: the operator's pause, resume and "run N ticks" (`flexdyn/<sc>/operator`).
 //! - [`telemetry`], [`physics`], [`lockstep`]: the threads that run the frames (below).
+//!   [`physics`] is the one frame loop, over a world of one spacecraft or of a fleet
+//!   ([`world::WorldStepper`]; [`fleet`] only sets a fleet up); each vehicle's per-frame work is
+//!   a [`stepper::Stepper`], which the direct lockstep core steps as well.
 //! - `report`: the [`RunReport`], collected when every thread is done.
 //!
 //! And what they use:
@@ -40,8 +43,8 @@
 //! boundary (`CongestionControl::Drop`) and the frame then goes the same way for the books; in
 //! lockstep the callback steps the [`lockstep::LockstepCore`] and publishes, and the telemetry
 //! thread only publishes StatusMsg. `auto` (default) is `direct` except in real time with
-//! `--record` or under SCHED_FIFO. The per-frame work ([`physics::Stepper`]) never allocates, locks or touches the
-//! network; in real time the physics thread never blocks on the I/O side (a frame without a
+//! `--record` or under SCHED_FIFO. The per-frame work ([`stepper::Stepper`]) never allocates, locks or
+//! touches the network; in real time the physics thread never blocks on the I/O side (a frame without a
 //! free buffer loses its telemetry, counted).
 //!
 //! # Place in the workspace
@@ -69,12 +72,15 @@ pub mod physics;
 mod presence;
 pub mod publish;
 mod reject_log;
+mod relative;
 mod report;
 pub mod rt;
 pub mod settings;
 mod setup;
 pub mod shared;
+pub mod stepper;
 pub mod telemetry;
+pub mod world;
 
 use std::future::Future;
 use std::sync::mpsc::{sync_channel, SyncSender};
@@ -97,11 +103,13 @@ use flexdyn_vehicle::config::SimConfig;
 use flexdyn_vehicle::sim::Simulation;
 use intake::CommandSink;
 use lockstep::LockstepCore;
-use physics::{PhysicsCtx, PhysicsReport, Stepper};
+use physics::{Lane, Outlet, PhysicsCtx, PhysicsOutcome, PhysicsReport};
 use presence::Presence;
 use setup::Endpoints;
 use shared::{Frame, Shared};
+use stepper::Stepper;
 use telemetry::{TelemetryCtx, TelemetryReport};
+use world::WorldStepper;
 
 /// Runs the server until the configured duration is reached, `shutdown` completes, or an error
 /// stops it.
@@ -194,7 +202,7 @@ pub async fn run(
     let (telemetry, telemetry_thread) = spawn_telemetry(wiring.telemetry)?;
     let mut wiring_frames = wiring.frames;
     if let Frames::Physics(physics, _) = &mut wiring_frames {
-        physics.wake = Some(telemetry_thread);
+        physics.set_wake(telemetry_thread);
     }
     if let Some(presence) = &presence {
         let ready = presence
@@ -227,9 +235,15 @@ pub async fn run(
     // The report: commands stop arriving, the recorder writes what it holds and closes the file.
     drop(commands);
     let recording = finish_recording(recorder)?;
-    let (physics, physics_thread) = physics;
-    let mut report = RunReport::collect(mode, physics?, &shared, &tlm.lateness, wall_s, recording);
-    report.physics_thread = physics_thread;
+    let mut report = RunReport::collect(
+        mode,
+        physics.result?,
+        &shared,
+        &tlm.lateness,
+        wall_s,
+        recording,
+    );
+    report.physics_thread = physics.usage;
     tracing::info!("{report}");
     Ok(report)
 }
@@ -281,7 +295,7 @@ fn prepare(
 /// What steps the frames, with the channel ends it needs.
 enum Frames {
     /// The physics thread (with the frame publishers when it publishes them itself).
-    Physics(Box<PhysicsCtx>, Box<Stepper>),
+    Physics(Box<PhysicsCtx>, Box<WorldStepper>),
     /// Lockstep with `handoff = "direct"`: the core, stepped in the command callback. No frame
     /// goes through the channel to the telemetry thread; closing `full_tx` ends that thread.
     Core {
@@ -394,23 +408,36 @@ impl Wiring {
             } else {
                 (None, Some(publisher))
             };
+            let lane = Lane {
+                shared: shared.clone(),
+                recycle_tx,
+                fault_rx,
+                fault_recycle_tx,
+                outlet: Outlet::Pool {
+                    free_rx,
+                    full_tx,
+                    direct,
+                    wake: None,
+                },
+            };
             let physics = PhysicsCtx {
                 settings: settings.clone(),
                 total_frames,
                 cmd_rx,
-                recycle_tx,
-                fault_rx,
-                fault_recycle_tx,
-                free_rx,
-                full_tx,
-                shared: shared.clone(),
-                direct,
-                wake: None,
+                lanes: vec![lane],
+                control: shared.clone(),
+                lateness: None,
+                relative: Vec::new(),
+                name_vehicles: false,
             };
-            let frames = Frames::Physics(Box::new(physics), Box::new(stepper));
+            let world = WorldStepper::one(settings.sc_id.clone(), stepper);
+            let frames = Frames::Physics(Box::new(physics), Box::new(world));
             (
                 frames,
-                CommandSink::Queue(Mutex::new((cmd_tx, gate))),
+                CommandSink::Queue {
+                    vehicle: 0,
+                    queue: Mutex::new((cmd_tx, gate)),
+                },
                 fault_cmd::FaultSink::Queue(fault_tx),
                 telemetry,
             )
@@ -472,17 +499,28 @@ async fn run_frames(
     shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
 ) -> Result<PhysicsOutcome, ServerError> {
     match frames {
-        Frames::Physics(physics, stepper) => {
-            run_physics_thread(*physics, *stepper, settings, shared, shutdown).await
+        Frames::Physics(physics, world) => {
+            run_physics_thread(
+                *physics,
+                *world,
+                settings,
+                std::slice::from_ref(shared),
+                shutdown,
+            )
+            .await
         }
         Frames::Core {
             core,
             events,
             full_tx,
         } => {
-            let r = run_lockstep_core(&core, &events, settings, shared, shutdown).await;
+            let result = run_lockstep_core(&core, &events, settings, shared, shutdown).await;
             drop(full_tx);
-            Ok((r, None))
+            Ok(PhysicsOutcome {
+                result,
+                spent: physics::Spent::default(),
+                usage: None,
+            })
         }
     }
 }
@@ -496,9 +534,6 @@ pub(crate) fn finish_recording(
         .transpose()
         .map_err(ServerError::from)
 }
-
-/// How the frames ended, and (real time) the physics thread's counters over them.
-type PhysicsOutcome = (Result<PhysicsReport, ServerError>, Option<rt::ThreadUsage>);
 
 /// The process-wide real-time requests of a real-time run ([`rt`]), held until the run ends.
 struct RealtimeHold {
@@ -575,35 +610,44 @@ fn prepare_physics_thread(settings: &ServerSettings) -> Result<(), ServerError> 
     Ok(())
 }
 
-/// Runs the physics thread to its end (or a stop request); `Err` only if it panicked.
+/// Runs the physics thread over `world` to its end (or a stop request: `shared` are every
+/// vehicle's counters, which say `Stopping` meanwhile; the stop flag is `physics.control`'s).
+/// `Err` only if the thread panicked.
 async fn run_physics_thread(
     physics: PhysicsCtx,
-    stepper: Stepper,
+    world: WorldStepper,
     settings: &ServerSettings,
-    shared: &Arc<Shared>,
+    shared: &[Arc<Shared>],
     mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
 ) -> Result<PhysicsOutcome, ServerError> {
-    let (phys_done_tx, mut phys_done_rx) = oneshot::channel();
+    let (done_tx, mut done_rx) = oneshot::channel();
+    let control = physics.control.clone();
     let thread_settings = settings.clone();
     std::thread::Builder::new()
         .name("flexdyn-physics".into())
         .stack_size(rt::PHYSICS_STACK_BYTES)
         .spawn(move || {
             if let Err(e) = prepare_physics_thread(&thread_settings) {
-                let _ = phys_done_tx.send((Err(e), None));
+                let _ = done_tx.send(PhysicsOutcome {
+                    result: Err(e),
+                    spent: physics::Spent::default(),
+                    usage: None,
+                });
                 return;
             }
-            let _ = phys_done_tx.send(physics.run(stepper));
+            let _ = done_tx.send(physics.run(world));
         })
         .map_err(|e| ServerError::Internal(format!("cannot start the physics thread: {e}")))?;
 
     tokio::select! {
-        r = &mut phys_done_rx => r,
+        r = &mut done_rx => r,
         () = &mut shutdown => {
             tracing::info!("shutdown requested; stopping at the next frame boundary");
-            shared.set_run_state(RunState::Stopping);
-            shared.stop.store(true, std::sync::atomic::Ordering::Relaxed);
-            phys_done_rx.await
+            for sh in shared {
+                sh.set_run_state(RunState::Stopping);
+            }
+            control.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            done_rx.await
         }
     }
     .map_err(|_| ServerError::Internal("the physics thread panicked".into()))
@@ -617,7 +661,7 @@ async fn run_lockstep_core(
     settings: &ServerSettings,
     shared: &Arc<Shared>,
     mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
-) -> Result<physics::PhysicsReport, ServerError> {
+) -> Result<PhysicsReport, ServerError> {
     let lock = || core.lock().unwrap_or_else(|p| p.into_inner());
     lock().start();
     loop {

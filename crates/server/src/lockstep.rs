@@ -29,9 +29,10 @@ use flexdyn_proto::{CommandMsg, RunState};
 use tokio::sync::Notify;
 
 use super::error::ServerError;
-use super::physics::{count_offer, Ending, PhysicsReport, Stepper};
+use super::physics::{Ending, PhysicsReport};
 use super::publish::{FramePublisher, Recording};
 use super::shared::{Frame, Shared};
+use super::stepper::{count_offer, Stepper};
 
 /// Where a direct lockstep run is.
 #[derive(Debug)]

@@ -5,8 +5,10 @@
 //!   single-vehicle server with `sc_id = <id>` does: `flexdyn/<id>/tlm/…`, `flexdyn/<id>/cmd/*`,
 //!   `flexdyn/<id>/status`, and its `flexdyn/<id>/config` queryable describes that vehicle. A
 //!   controller written for one vehicle (`flexdyn-acs-demo --sc-id <id>`) runs unchanged.
-//! - **One physics thread** steps the whole world ([`physics`], [`stepper`]); the command
-//!   callbacks and one telemetry (status) thread per vehicle are the I/O side.
+//! - **One physics thread** steps the whole world, in the frame loop a one-spacecraft server
+//!   runs too ([`super::physics`] over a [`super::world::WorldStepper`]); each vehicle publishes
+//!   in place from that thread ([`super::physics::Outlet::InPlace`]). The command callbacks and
+//!   one telemetry (status) thread per vehicle are the I/O side.
 //! - **Lockstep.** One barrier covers every participant of every vehicle: tick `k + 1` is
 //!   computed when all have answered tick `k`. A participant listed for several vehicles (a
 //!   formation controller) answers each of them on its key `flexdyn/<id>/cmd/<sender>` and
@@ -35,19 +37,13 @@
 //!   StatusMsg says `Paused` while held and its TimeMsg of the held tick too. A refusal counts
 //!   in that vehicle's `rejected.operator_refused`.
 
-mod physics;
-mod relative;
-pub mod stepper;
-
 use std::future::Future;
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::sync_channel;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use flexdyn_proto::{Mode, RunState, Topics};
-use tokio::sync::oneshot;
 use zenoh::Session;
 
 use super::cli::RunArgs;
@@ -56,17 +52,18 @@ use super::error::{ServerError, SettingsError};
 use super::intake::{self, CommandSink};
 use super::lateness_ring::LatenessRing;
 use super::operator;
+use super::physics::{Lane, Outlet, PhysicsCtx};
 use super::presence::Presence;
+use super::relative::RelativePublisher;
 use super::report::RunReport;
 use super::settings::{mode_name, ServerSettings};
 use super::setup::{self, Endpoints};
 use super::shared::{Frame, Shared};
 use super::telemetry::TelemetryCtx;
+use super::world::WorldStepper;
 use flexdyn_proto::client::transport::{zenoh_config, Role};
 use flexdyn_vehicle::config::log_warnings;
 use flexdyn_vehicle::world::{FleetConfig, World};
-use physics::{FleetPhysics, FleetPhysicsReport};
-use stepper::FleetStepper;
 
 /// What a fleet run did: each vehicle's report, and what the physics cost.
 #[derive(Clone, Debug)]
@@ -197,20 +194,15 @@ pub async fn run(
     // Per vehicle: its publishers, configuration queryable, counters, command callback, status
     // thread and (lockstep) presence.
     let (cmd_tx, cmd_rx) = sync_channel(settings.command_queue);
-    let stop = Arc::new(AtomicBool::new(false));
-    let mut publishers = Vec::with_capacity(vehicles.len());
+    let mut lanes = Vec::with_capacity(vehicles.len());
     let mut shared = Vec::with_capacity(vehicles.len());
-    let mut recycle = Vec::with_capacity(vehicles.len());
-    let mut alive = Vec::with_capacity(vehicles.len());
     let mut keep = Vec::with_capacity(vehicles.len());
     let mut telemetry = Vec::with_capacity(vehicles.len());
     let mut presences = Vec::new();
-    let mut faults = Vec::with_capacity(vehicles.len());
     // `--record`: one file for the fleet; each vehicle is described as it is declared.
     let recorder = setup::open_recorder(&settings)?;
     let record_tx = recorder.as_ref().map(|(_, tx)| tx.clone());
-    let mut recordings = Vec::with_capacity(vehicles.len());
-    // The operator's hold target, one for the fleet.
+    // The operator's hold target and the stop flag, one for the fleet.
     let hold = Arc::new(Shared::default());
     // Real time: each frame boundary's lateness, for every vehicle's StatusMsg.
     let lateness = Arc::new(LatenessRing::default());
@@ -251,7 +243,7 @@ pub async fn run(
             v.sim.spacecraft().effector_input_ranges(),
             mode == Mode::Lockstep,
         );
-        let sink = CommandSink::Fleet {
+        let sink = CommandSink::Queue {
             vehicle: i,
             queue: Mutex::new((cmd_tx.clone(), gate)),
         };
@@ -277,7 +269,6 @@ pub async fn run(
         )
         .await
         .map_err(named)?;
-        faults.push((fault_rx, fault_recycle_tx));
         operators.push(
             operator::declare(
                 &session,
@@ -315,11 +306,18 @@ pub async fn run(
             lateness_ring: Some((lateness.clone(), 0)),
         };
         telemetry.push(super::spawn_telemetry(ctx).map_err(named)?.0);
-        publishers.push(endpoints.frames);
+        lanes.push(Lane {
+            shared: sh.clone(),
+            recycle_tx,
+            fault_rx,
+            fault_recycle_tx,
+            outlet: Outlet::InPlace {
+                publisher: endpoints.frames,
+                recording,
+                telemetry_alive: full_tx,
+            },
+        });
         shared.push(sh);
-        recycle.push(recycle_tx);
-        alive.push(full_tx);
-        recordings.push(recording);
         keep.push((config, commands, fault_commands));
     }
     drop(cmd_tx);
@@ -329,7 +327,7 @@ pub async fn run(
         let deputy = &vehicles[d].id;
         let topics = Topics::new(deputy)
             .map_err(|e| ServerError::Internal(format!("vehicle id {deputy:?}: {e}")))?;
-        let rp = relative::RelativePublisher::declare(&session, mode, &topics, &vehicles[c].id)
+        let rp = RelativePublisher::declare(&session, mode, &topics, &vehicles[c].id)
             .await
             .map_err(|e| ServerError::Vehicle {
                 vehicle: deputy.clone(),
@@ -358,7 +356,7 @@ pub async fn run(
                     RunState::Failed
                 });
             }
-            drop(alive);
+            drop(lanes);
             for t in telemetry {
                 let _ = t.await;
             }
@@ -382,24 +380,20 @@ pub async fn run(
     }
 
     let ids: Vec<String> = vehicles.iter().map(|v| v.id.clone()).collect();
-    let stepper = FleetStepper::new(vehicles, &vsettings).with_relative_pairs(&pairs);
-    let physics = FleetPhysics {
+    let world = WorldStepper::new(vehicles, &vsettings).with_relative_pairs(&pairs);
+    let physics = PhysicsCtx {
         settings: settings.clone(),
         total_frames,
         cmd_rx,
-        recycle,
-        publishers,
-        faults,
+        lanes,
+        control: hold,
+        lateness: Some(lateness),
         relative,
-        recordings,
-        hold,
-        lateness,
-        shared: shared.clone(),
-        stop: stop.clone(),
-        _telemetry_alive: alive,
+        name_vehicles: true,
     };
     let started = Instant::now();
-    let result = run_physics_thread(physics, stepper, &settings, &shared, &stop, shutdown).await;
+    let outcome =
+        super::run_physics_thread(physics, world, &settings, &shared, shutdown.as_mut()).await;
     let wall_s = started.elapsed().as_secs_f64();
     let mut lateness = Vec::with_capacity(telemetry.len());
     for t in telemetry {
@@ -412,62 +406,27 @@ pub async fn run(
     drop(keep);
     drop(operators);
     let recording = super::finish_recording(recorder)?;
-    let physics = result?;
+    let outcome = outcome?;
+    let (physics, spent) = (outcome.result?, outcome.spent);
     let vehicles = ids
         .into_iter()
         .zip(&shared)
         .zip(&lateness)
         .map(|((id, sh), h)| {
-            let r = RunReport::collect(mode, physics.physics, sh, h, wall_s, None);
+            let r = RunReport::collect(mode, physics, sh, h, wall_s, None);
             (id, r)
         })
         .collect();
     let report = FleetReport {
         vehicles,
-        frames: physics.frames,
-        physics_ns: physics.physics_ns,
-        publish_ns: physics.publish_ns,
-        wait_ns: physics.wait_ns,
+        frames: spent.frames,
+        physics_ns: spent.physics_ns,
+        publish_ns: spent.publish_ns,
+        wait_ns: spent.wait_ns,
         recording,
     };
     tracing::info!("{report}");
     Ok(report)
-}
-
-/// Runs the fleet's physics thread to its end (or a stop request).
-async fn run_physics_thread(
-    physics: FleetPhysics,
-    stepper: FleetStepper,
-    settings: &ServerSettings,
-    shared: &[Arc<Shared>],
-    stop: &AtomicBool,
-    mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
-) -> Result<FleetPhysicsReport, ServerError> {
-    let (done_tx, mut done_rx) = oneshot::channel();
-    let thread_settings = settings.clone();
-    std::thread::Builder::new()
-        .name("flexdyn-physics".into())
-        .stack_size(super::rt::PHYSICS_STACK_BYTES)
-        .spawn(move || {
-            if let Err(e) = super::prepare_physics_thread(&thread_settings) {
-                let _ = done_tx.send(Err(e));
-                return;
-            }
-            let _ = done_tx.send(physics.run(stepper));
-        })
-        .map_err(|e| ServerError::Internal(format!("cannot start the physics thread: {e}")))?;
-    tokio::select! {
-        r = &mut done_rx => r,
-        () = &mut shutdown => {
-            tracing::info!("shutdown requested; stopping at the next frame boundary");
-            for sh in shared {
-                sh.set_run_state(RunState::Stopping);
-            }
-            stop.store(true, Ordering::Relaxed);
-            done_rx.await
-        }
-    }
-    .map_err(|_| ServerError::Internal("the physics thread panicked".into()))?
 }
 
 /// `flexdyn run --fleet FILE`: the fleet file, the settings (the first vehicle's `[server]`

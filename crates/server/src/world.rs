@@ -1,37 +1,41 @@
-//! The per-frame work of a fleet: every vehicle's [`Stepper`] (its simulation, command book and
-//! held command) and its telemetry buffer, stepped on one tick. Nothing here allocates after
-//! [`FleetStepper::new`] (checked in `tests/server_alloc.rs`).
+//! The per-frame work of a world: every vehicle's [`Stepper`] (its simulation, command book and
+//! held command) and the telemetry buffer it fills, stepped on one tick. One spacecraft is a
+//! world of one; a fleet file is a world of many. Nothing here allocates after
+//! [`WorldStepper::new`] (checked in `tests/server_alloc.rs`).
 //!
-//! The vehicles do not act on one another ([`flexdyn_vehicle::world::step`]), so each vehicle's stream
-//! is the one it would have alone, bit for bit, whatever the fleet's order or size.
+//! The vehicles do not act on one another ([`flexdyn_vehicle::world::step`]), so each vehicle's
+//! stream is the one it would have alone, bit for bit, whatever the world's order or size.
 //!
-//! Each (chief, deputy) pair of the fleet file ([`flexdyn_vehicle::world::World::relative_pairs`]) gets
-//! its [`RelativeStateMsg`] filled with the frames, from the two vehicles' states of the same
-//! tick ([`flexdyn_vehicle::world::relative`]): a few dozen flops per pair, no allocation.
+//! Each (chief, deputy) pair of a fleet file ([`flexdyn_vehicle::world::World::relative_pairs`])
+//! gets its [`RelativeStateMsg`] filled with the frames, from the two vehicles' states of the
+//! same tick ([`flexdyn_vehicle::world::relative`]): a few dozen flops per pair, no allocation.
 
 use flexdyn_proto::{CommandMsg, Header, RelativeStateMsg};
 
-use super::super::commands::Offer;
-use super::super::error::ServerError;
-use super::super::physics::Stepper;
-use super::super::settings::ServerSettings;
-use super::super::shared::Frame;
+use super::commands::Offer;
+use super::error::ServerError;
+use super::settings::ServerSettings;
+use super::shared::Frame;
+use super::stepper::Stepper;
 use flexdyn_vehicle::world::relative::{com_state_n, relative_state_hill};
 use flexdyn_vehicle::world::Vehicle;
 
-/// One vehicle of the running fleet.
-pub struct FleetVehicle {
+/// One vehicle of the running world.
+pub struct WorldVehicle {
     /// Its id (`flexdyn/<id>/…`).
     pub id: String,
     /// Its simulation, command book and held command.
     pub stepper: Stepper,
-    /// The telemetry of its last tick filled.
-    pub frame: Box<Frame>,
+    /// The telemetry buffer of its last tick filled. A vehicle that publishes in place (a
+    /// fleet's) always has one; a vehicle whose buffers cycle through a telemetry thread (one
+    /// spacecraft's server) has one between the fill and the frame boundary, and none when real
+    /// time found no free buffer (that tick's telemetry is dropped and counted).
+    pub frame: Option<Box<Frame>>,
 }
 
-/// A (chief, deputy) pair of the running fleet and its relative state of the last tick filled.
+/// A (chief, deputy) pair of the running world and its relative state of the last tick filled.
 pub struct RelativePair {
-    /// The chief's index in [`FleetStepper::vehicles`].
+    /// The chief's index in [`WorldStepper::vehicles`].
     pub chief: usize,
     /// The deputy's index (listed after its chief).
     pub deputy: usize,
@@ -40,31 +44,41 @@ pub struct RelativePair {
     pub msg: RelativeStateMsg,
 }
 
-/// Every vehicle of the fleet, stepped together.
-pub struct FleetStepper {
-    /// The vehicles, in fleet order.
-    pub vehicles: Vec<FleetVehicle>,
-    /// The (chief, deputy) pairs, in the deputies' fleet order.
+/// Every vehicle of the world, stepped together.
+pub struct WorldStepper {
+    /// The vehicles, in world order.
+    pub vehicles: Vec<WorldVehicle>,
+    /// The (chief, deputy) pairs, in the deputies' world order.
     pub pairs: Vec<RelativePair>,
 }
 
-impl FleetStepper {
-    /// Steppers at t = 0 (sensors sampled at tick 0); `settings[i]` are vehicle `i`'s (its
-    /// participants and spacecraft id).
+/// A telemetry buffer shaped for `stepper`'s state, sensors and fault events.
+pub fn frame_for(stepper: &Stepper) -> Box<Frame> {
+    frame_for_sim(&stepper.sim)
+}
+
+/// A telemetry buffer shaped for `sim`'s state, sensors and fault events (room for the events
+/// a frame can carry: its configured and live slots).
+pub fn frame_for_sim(sim: &flexdyn_vehicle::sim::Simulation) -> Box<Frame> {
+    Box::new(
+        Frame::for_state(&sim.blank_state(), sim.sensors().len())
+            .with_fault_events(sim.faults().event_capacity()),
+    )
+}
+
+impl WorldStepper {
+    /// Steppers at t = 0 (sensors sampled at tick 0), each with its own telemetry buffer;
+    /// `settings[i]` are vehicle `i`'s (its participants and spacecraft id).
     pub fn new(vehicles: Vec<Vehicle>, settings: &[ServerSettings]) -> Self {
         let vehicles = vehicles
             .into_iter()
             .zip(settings)
             .map(|(v, s)| {
-                // Room for the fault events a frame can carry (its configured and live slots).
-                let frame = Box::new(
-                    Frame::for_state(&v.sim.blank_state(), v.sim.sensors().len())
-                        .with_fault_events(v.sim.faults().event_capacity()),
-                );
-                FleetVehicle {
+                let stepper = Stepper::new(v.sim, s);
+                WorldVehicle {
                     id: v.id,
-                    stepper: Stepper::new(v.sim, s),
-                    frame,
+                    frame: Some(frame_for(&stepper)),
+                    stepper,
                 }
             })
             .collect();
@@ -74,9 +88,22 @@ impl FleetStepper {
         }
     }
 
+    /// A world of one spacecraft whose telemetry buffers come from a pool (the physics loop
+    /// takes one before each fill).
+    pub fn one(id: String, stepper: Stepper) -> Self {
+        Self {
+            vehicles: vec![WorldVehicle {
+                id,
+                stepper,
+                frame: None,
+            }],
+            pairs: Vec::new(),
+        }
+    }
+
     /// With the relative states of these (chief, deputy) index pairs
-    /// ([`flexdyn_vehicle::world::World::relative_pairs`]); a pair naming a vehicle out of range is left
-    /// out.
+    /// ([`flexdyn_vehicle::world::World::relative_pairs`]); a pair naming a vehicle out of
+    /// range is left out.
     pub fn with_relative_pairs(mut self, pairs: &[(usize, usize)]) -> Self {
         let n = self.vehicles.len();
         self.pairs = pairs
@@ -136,24 +163,26 @@ impl FleetStepper {
         }
     }
 
-    /// Fills every vehicle's telemetry of tick `k` and checks it finite; an error names the
-    /// vehicle.
-    pub fn fill(&mut self, k: u64) -> Result<(), ServerError> {
-        for v in &mut self.vehicles {
-            v.stepper.fill(&mut v.frame, k);
-            if let Err(e) = v.stepper.check_finite(k, true) {
-                return Err(ServerError::Vehicle {
-                    vehicle: v.id.clone(),
-                    source: Box::new(e),
-                });
-            }
+    /// Fills every vehicle's telemetry buffer (those that have one) with tick `k`, checks every
+    /// vehicle's state and sensors finite, and fills the pairs' relative states. An error
+    /// comes with the index of the vehicle it is about.
+    pub fn fill(&mut self, k: u64) -> Result<(), (usize, ServerError)> {
+        for (i, v) in self.vehicles.iter_mut().enumerate() {
+            let filled = match v.frame.as_mut() {
+                Some(f) => {
+                    v.stepper.fill(f, k);
+                    true
+                }
+                None => false,
+            };
+            v.stepper.check_finite(k, filled).map_err(|e| (i, e))?;
         }
         for p in &mut self.pairs {
             let (Some(c), Some(d)) = (self.vehicles.get(p.chief), self.vehicles.get(p.deputy))
             else {
                 continue;
             };
-            p.msg = relative_msg(c, d, k);
+            p.msg = relative_msg(&c.stepper, &d.stepper, k);
         }
         Ok(())
     }
@@ -164,20 +193,26 @@ impl FleetStepper {
             .first()
             .map_or(1, |v| v.stepper.sim.frame_ns())
     }
+
+    /// \[ns\] the simulation time reached (every vehicle's).
+    pub fn sim_time_ns(&self) -> u64 {
+        self.vehicles
+            .first()
+            .map_or(0, |v| v.stepper.sim.t_sim_ns())
+    }
 }
 
 /// The deputy `d`'s state relative to the chief `c` at tick `k` (both just filled), with the
 /// deputy's header (`seq` = `k`: one message per frame). A chief without an orbit plane (its
 /// position and velocity parallel) has no Hill frame: the H fields are then 0, the range and
 /// its rate still computed.
-fn relative_msg(c: &FleetVehicle, d: &FleetVehicle, k: u64) -> RelativeStateMsg {
-    let (r_c, v_c) = com_state_n(c.stepper.sim.spacecraft());
-    let (r_d, v_d) = com_state_n(d.stepper.sim.spacecraft());
-    let header = &d.frame.state.header;
+fn relative_msg(c: &Stepper, d: &Stepper, k: u64) -> RelativeStateMsg {
+    let (r_c, v_c) = com_state_n(c.sim.spacecraft());
+    let (r_d, v_d) = com_state_n(d.sim.spacecraft());
     let mut msg = RelativeStateMsg {
-        header: Header::new(header.spacecraft_id, k, header.sim_time_ns, k),
-        chief_spacecraft_id: c.frame.state.header.spacecraft_id,
-        deputy_spacecraft_id: header.spacecraft_id,
+        header: Header::new(d.spacecraft_id(), k, d.filled_sim_time_ns(), k),
+        chief_spacecraft_id: c.spacecraft_id(),
+        deputy_spacecraft_id: d.spacecraft_id(),
         ..RelativeStateMsg::default()
     };
     match relative_state_hill(&r_c, &v_c, &r_d, &v_d) {

@@ -1,7 +1,7 @@
 //! Publishing each fleet deputy's [`flexdyn_proto::RelativeStateMsg`] on
 //! `flexdyn/<deputy>/tlm/rel/<chief>`, every frame, right after the deputy's frame (its StateMsg
 //! and what follows it), from the thread that publishes the frames. The message itself is
-//! filled with the frames ([`super::stepper::FleetStepper::fill`]); here it is only encoded into
+//! filled with the frames ([`super::world::WorldStepper::fill`]); here it is only encoded into
 //! a buffer sized once and put, with the deputy's congestion control (real time: `Drop`, so the
 //! put never waits for the network).
 
@@ -12,10 +12,10 @@ use zenoh::pubsub::Publisher;
 use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
 
-use super::super::error::{ServerError, SettingsError};
-use super::super::publish::Recording;
-use super::super::shared::Shared;
-use super::stepper::RelativePair;
+use super::error::{ServerError, SettingsError};
+use super::publish::Recording;
+use super::shared::Shared;
+use super::world::RelativePair;
 
 /// The publisher of one (chief, deputy) pair, with its encode buffer.
 pub struct RelativePublisher {
@@ -27,7 +27,7 @@ pub struct RelativePublisher {
 
 impl RelativePublisher {
     /// Declares `flexdyn/<deputy>/tlm/rel/<chief>` as the deputy's telemetry is declared
-    /// ([`super::super::setup::Endpoints::declare`]).
+    /// ([`super::setup::Endpoints::declare`]).
     pub async fn declare(
         session: &Session,
         mode: Mode,
