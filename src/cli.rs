@@ -22,6 +22,7 @@ use crate::sinks::table::{
     first_non_finite_column, prefixed_columns, state_row, Column, CsvTable,
     ENVIRONMENT_COLUMN_PREFIX,
 };
+use flexdyn_vehicle::world::{walk, RowPlan, RowSink, World};
 
 /// Arguments of `flexdyn simulate`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
@@ -281,40 +282,17 @@ pub fn simulate_to<W: Write>(
     };
     // The server's numeric id, so a row equals the StateMsg a server run of this file
     // publishes (`check-config` and `run` validate `[server]`; `simulate` only reads the id).
-    let spacecraft_id = ServerSettings::from_table(&cfg.server)
-        .unwrap_or_default()
-        .spacecraft_id;
+    let settings = ServerSettings::from_table(&cfg.server).unwrap_or_default();
+    let spacecraft_id = settings.spacecraft_id;
     let steps_per_frame = sim.steps_per_frame();
     let at_frames = sim.sensors().any(|s| !s.every_output());
 
     let mut state = sim.blank_state();
     state.command_flags = command_flags::NO_COMMAND_YET;
     // `[environment] telemetry_rate_hz` set: the environment record at every row's instant.
-    let mut environment = sim
+    let environment = sim
         .environment_every_frames()
         .map(|_| EnvironmentMsg::default());
-    // Per sensor: the step of its last sample and that sample's message, encoded when it was
-    // taken. It becomes CSV columns (a decode into JSON, then text) only if a row falls on that
-    // step: a 10 Hz sensor logged every second is encoded ten times and formatted once.
-    let mut last: Vec<(Option<u64>, Vec<u8>)> = vec![(None, Vec::new()); sim.sensors().len()];
-    let take =
-        |sim: &Simulation, step: u64, header: Header, last: &mut [(Option<u64>, Vec<u8>)]| {
-            let bank = sim.sensors();
-            for &i in bank.sampled() {
-                let (at, bytes) = &mut last[i];
-                bank.sensors()[i].encode(header, bytes);
-                *at = Some(step);
-            }
-        };
-    let sample_frame_sensors = |sim: &mut Simulation, step: u64| -> Option<Header> {
-        if !(at_frames && step.is_multiple_of(steps_per_frame)) {
-            return None;
-        }
-        let tick = step / steps_per_frame;
-        sim.sample_sensors(|s| !s.every_output() && s.due(tick));
-        Some(Header::new(spacecraft_id, tick, sim.t_sim_ns(), tick))
-    };
-
     // The header: every column a row can have (each sensor as at a sample).
     let all = sim.sensors().sensors().iter().map(|s| {
         Some(prefixed_columns(
@@ -340,69 +318,120 @@ pub fn simulate_to<W: Write>(
                 .map(|(i, f)| crate::sinks::fault_spans::csv_comment(i, f)),
         )
         .collect();
-    let mut table = CsvTable::with_comments(out, &comments, &columns).map_err(io_err)?;
-
-    let n_logged = total_steps / log_steps;
-    let mut step = 0u64;
+    let table = CsvTable::with_comments(out, &comments, &columns).map_err(io_err)?;
+    let mut rows = SimulateRows {
+        cfg,
+        spacecraft_id,
+        steps_per_frame,
+        state,
+        environment,
+        last: vec![(None, Vec::new()); sim.sensors().len()],
+        table,
+        target,
+    };
+    // A world of one, stepped by the offline loop every front end shares.
+    let mut world = World::of_one(settings.sc_id, spacecraft_id, sim);
+    let plan = RowPlan {
+        total_steps,
+        log_steps,
+        frame_stops: at_frames,
+    };
     let start = Instant::now();
-    if let Some(header) = sample_frame_sensors(&mut sim, 0) {
-        take(&sim, 0, header, &mut last);
-    }
-    for k in 0..=n_logged {
-        // Step to the row, stopping at each frame boundary when a sensor may sample there.
-        let row_step = k * log_steps;
-        while step < row_step {
-            let next = if at_frames {
-                row_step.min((step / steps_per_frame + 1) * steps_per_frame)
-            } else {
-                row_step
-            };
-            sim.step_n(next - step);
-            step = next;
-            if let Some(header) = sample_frame_sensors(&mut sim, step) {
-                take(&sim, step, header, &mut last);
-            }
+    let written = walk(&mut world, plan, &mut rows)?;
+    let wall_s = start.elapsed().as_secs_f64();
+    rows.table.flush().map_err(io_err)?;
+    tracing::debug!(steps = total_steps, rows = written, "simulate done");
+    Ok(SimulateReport {
+        steps: total_steps,
+        rows: written,
+        wall_s,
+    })
+}
+
+/// `simulate`'s rows, written as the offline loop ([`walk`]) reaches them.
+struct SimulateRows<'a, W: Write> {
+    cfg: &'a SimConfig,
+    spacecraft_id: u32,
+    steps_per_frame: u64,
+    /// The state record, reused row to row.
+    state: StateMsg,
+    /// `[environment] telemetry_rate_hz` set: the environment record, reused row to row.
+    environment: Option<EnvironmentMsg>,
+    /// Per sensor: the step of its last sample and that sample's message, encoded when it was
+    /// taken. It becomes CSV columns (a decode into JSON, then text) only if a row falls on that
+    /// step: a 10 Hz sensor logged every second is encoded ten times and formatted once.
+    last: Vec<(Option<u64>, Vec<u8>)>,
+    table: CsvTable<W>,
+    target: &'a str,
+}
+
+impl<W: Write> SimulateRows<'_, W> {
+    /// Encodes the samples the sensors just took, noting their step.
+    fn take(&mut self, sim: &Simulation, step: u64, header: Header) {
+        let bank = sim.sensors();
+        for &i in bank.sampled() {
+            let (at, bytes) = &mut self.last[i];
+            bank.sensors()[i].encode(header, bytes);
+            *at = Some(step);
         }
-        sim.state_into(&mut state);
-        let t_ns = state.header.sim_time_ns;
-        state.header = Header::new(spacecraft_id, t_ns / cfg.frame_ns, t_ns, k);
+    }
+}
+
+impl<W: Write> RowSink for SimulateRows<'_, W> {
+    type Error = CliError;
+
+    /// A frame boundary: the sensors sampled there (not those that integrate over a row) take
+    /// their samples where a server's would.
+    fn frame(&mut self, world: &mut World, step: u64) {
+        let Some(v) = world.vehicles_mut().first_mut() else {
+            return;
+        };
+        let tick = step / self.steps_per_frame;
+        v.sim.sample_sensors(|s| !s.every_output() && s.due(tick));
+        let header = Header::new(self.spacecraft_id, tick, v.sim.t_sim_ns(), tick);
+        self.take(&v.sim, step, header);
+    }
+
+    fn row(&mut self, world: &mut World, k: u64, step: u64) -> Result<(), CliError> {
+        let io_err = |source| CliError::Output {
+            target: self.target.to_string(),
+            source,
+        };
+        let Some(v) = world.vehicles_mut().first_mut() else {
+            return Ok(());
+        };
+        let sim = &mut v.sim;
+        sim.state_into(&mut self.state);
+        let t_ns = self.state.header.sim_time_ns;
+        self.state.header = Header::new(self.spacecraft_id, t_ns / self.cfg.frame_ns, t_ns, k);
         sim.sample_sensors(|s| s.every_output());
-        take(&sim, step, state.header, &mut last);
-        if let Some(env) = environment.as_mut() {
+        let header = self.state.header;
+        self.take(sim, step, header);
+        if let Some(env) = self.environment.as_mut() {
             sim.environment_into(env);
         }
         let bank = sim.sensors().sensors();
-        let now = last
-            .iter()
-            .zip(bank)
-            .map(|((at, bytes), s)| (*at == Some(step)).then(|| sensor_columns(s.as_ref(), bytes)));
+        let now =
+            self.last.iter().zip(bank).map(|((at, bytes), s)| {
+                (*at == Some(step)).then(|| sensor_columns(s.as_ref(), bytes))
+            });
         let row = simulate_row(
-            &state,
-            &scheduled_wrench(cfg, t_ns),
-            environment.as_ref(),
+            &self.state,
+            &scheduled_wrench(self.cfg, t_ns),
+            self.environment.as_ref(),
             now,
         );
         // Once per row, outside the stepping loop: never write a non-finite state.
         if let Some(quantity) = first_non_finite_column(&row) {
-            table.flush().map_err(io_err)?;
+            self.table.flush().map_err(io_err)?;
             return Err(CliError::NonFinite {
                 step,
                 t_s: t_ns as f64 / 1e9,
                 quantity: quantity.to_owned(),
             });
         }
-        table.write_row(&row).map_err(io_err)?;
+        self.table.write_row(&row).map_err(io_err)
     }
-    // Steps after the last multiple of the log interval, up to the duration.
-    sim.step_n(total_steps - step);
-    let wall_s = start.elapsed().as_secs_f64();
-    table.flush().map_err(io_err)?;
-    tracing::debug!(steps = total_steps, rows = n_logged + 1, "simulate done");
-    Ok(SimulateReport {
-        steps: total_steps,
-        rows: n_logged + 1,
-        wall_s,
-    })
 }
 
 /// `flexdyn simulate`: loads the configuration, checks the options, and writes the CSV to the

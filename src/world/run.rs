@@ -20,6 +20,7 @@ use super::fleet::{FleetConfig, FleetError};
 use super::relative::com_state_n;
 use super::step::World;
 use crate::cli::{whole_steps, CliError};
+use flexdyn_vehicle::world::{walk, RowPlan, RowSink};
 
 /// Arguments of `flexdyn fleet`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
@@ -133,28 +134,41 @@ pub fn fleet_to<W: Write>(
     line.push('\n');
     out.write_all(line.as_bytes())
         .map_err(|e| output_err(target, e))?;
-    let mut rows = 0;
-    let mut step = 0;
-    loop {
-        line.clear();
-        row(&world, &mut line);
-        out.write_all(line.as_bytes())
-            .map_err(|e| output_err(target, e))?;
-        rows += 1;
-        if step >= steps {
-            break;
-        }
-        for _ in 0..every.min(steps - step) {
-            world.step();
-        }
-        step += every.min(steps - step);
-    }
-    out.flush().map_err(|e| output_err(target, e))?;
+    // The offline loop every front end shares: a row at t = 0 and at every whole log
+    // interval, the steps after the last one stepped without a row.
+    let plan = RowPlan {
+        total_steps: steps,
+        log_steps: every,
+        frame_stops: false,
+    };
+    let mut sink = FleetRows { out, line, target };
+    let rows = walk(&mut world, plan, &mut sink)?;
+    sink.out.flush().map_err(|e| output_err(target, e))?;
     Ok(FleetReport {
         vehicles: world.vehicles().len(),
         steps,
         rows,
     })
+}
+
+/// `fleet`'s rows, written as the offline loop ([`walk`]) reaches them.
+struct FleetRows<'a, W: Write> {
+    out: W,
+    /// The row's text, reused row to row.
+    line: String,
+    target: &'a str,
+}
+
+impl<W: Write> RowSink for FleetRows<'_, W> {
+    type Error = FleetRunError;
+
+    fn row(&mut self, world: &mut World, _k: u64, _step: u64) -> Result<(), FleetRunError> {
+        self.line.clear();
+        row(world, &mut self.line);
+        self.out
+            .write_all(self.line.as_bytes())
+            .map_err(|e| output_err(self.target, e))
+    }
 }
 
 /// One CSV row of the world's current state.
