@@ -173,7 +173,9 @@ impl<W: Write> RowSink for FleetRows<'_, W> {
 
 /// One CSV row of the world's current state.
 fn row(world: &World, line: &mut String) {
-    let _ = write!(line, "{}", world.t_sim_ns() as f64 * 1e-9);
+    // Integer nanoseconds divided once (correctly rounded), as every other CSV's `t_s`: 15 s
+    // prints `15`, where `ns * 1e-9` printed `15.000000000000002`.
+    let _ = write!(line, "{}", world.t_sim_ns() as f64 / 1e9);
     for v in world.vehicles() {
         let (r, v) = com_state_n(v.sim.spacecraft());
         push(line, &r);
@@ -238,6 +240,9 @@ mod tests {
         assert_eq!(header[1], "chief_r_cn_n_m_1");
         assert_eq!(header[13], "deputy_in_chief_r_h_m_1");
         assert_eq!(header[20], "deputy_in_chief_range_rate_m_s");
+        // Times as written: integer nanoseconds divided once.
+        let times: Vec<&str> = lines[1..].iter().map(|l| &l[..l.find(',').unwrap()]).collect();
+        assert_eq!(times, ["0", "0.1", "0.2", "0.3", "0.4", "0.5"]);
         let last: Vec<f64> = lines[6].split(',').map(|c| c.parse().unwrap()).collect();
         assert_eq!(last[0], 0.5);
         // The same world stepped 500 times: the same numbers (Display of f64 round-trips).
