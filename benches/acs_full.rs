@@ -28,8 +28,8 @@ use std::process::{Command, Stdio};
 use std::time::Instant;
 
 use flexdyn::cli::simulate_to;
-use flexdyn::config::SimConfig;
-use flexdyn::sim::Simulation;
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 
 const ACS_FULL: &str = include_str!("../scenarios/acs_full.toml");
 /// Simulated seconds per timed span (flexdyn and Basilisk alike).

@@ -19,16 +19,16 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use criterion::Criterion;
-use flexdyn::dynamics::{GravityModel, Spacecraft};
-use flexdyn::environment::atmosphere::{
+use flexdyn_dynamics::{GravityModel, Spacecraft};
+use flexdyn_environment::atmosphere::{
     exponential_density_kg_m3, velocity_relative_to_air_n_m_s, Nrlmsise00Model, SpaceWeather,
 };
-use flexdyn::environment::earth_rotation::OMEGA_EARTH_RAD_S;
-use flexdyn::environment::ephemeris::{moon_position_n_m, sun_position_n_m};
-use flexdyn::environment::facets::{solar_pressure_n_m2, Facet, FacetModel};
-use flexdyn::environment::geodetic::geodetic_from_ecef;
-use flexdyn::environment::magnetic::{dipole_torque_b_nm, CentredDipole, Igrf};
-use flexdyn::environment::shadow::{shadow_factor, ShadowModel};
+use flexdyn_environment::earth_rotation::OMEGA_EARTH_RAD_S;
+use flexdyn_environment::ephemeris::{moon_position_n_m, sun_position_n_m};
+use flexdyn_environment::facets::{solar_pressure_n_m2, Facet, FacetModel};
+use flexdyn_environment::geodetic::geodetic_from_ecef;
+use flexdyn_environment::magnetic::{dipole_torque_b_nm, CentredDipole, Igrf};
+use flexdyn_environment::shadow::{shadow_factor, ShadowModel};
 use nalgebra::Vector3;
 
 const BATCH: u32 = 2_000;

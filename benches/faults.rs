@@ -15,8 +15,8 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use flexdyn::config::SimConfig;
-use flexdyn::sim::Simulation;
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 
 const WHEELS: &str = include_str!("../scenarios/wheels_star_tracker.toml");
 

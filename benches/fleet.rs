@@ -15,7 +15,7 @@
 
 use std::time::Instant;
 
-use flexdyn::world::{FleetConfig, World};
+use flexdyn_vehicle::world::{FleetConfig, World};
 
 const SIZES: [usize; 5] = [1, 2, 4, 8, 16];
 const FRAMES: u32 = 1000;

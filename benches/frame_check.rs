@@ -10,9 +10,9 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use flexdyn::config::SimConfig;
-use flexdyn::sim::Simulation;
-use flexdyn::sinks::table::first_non_finite;
+use flexdyn_sinks::table::first_non_finite;
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 
 const BATCHES: usize = 31;
 const FRAMES: usize = 2_000;

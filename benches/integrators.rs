@@ -21,8 +21,8 @@ mod common;
 
 use std::time::Instant;
 
-use flexdyn::dynamics::integrator::{ButcherTableau, METHODS};
-use flexdyn::dynamics::{GravityModel, Spacecraft};
+use flexdyn_dynamics::integrator::{ButcherTableau, METHODS};
+use flexdyn_dynamics::{GravityModel, Spacecraft};
 use nalgebra::Vector3;
 
 /// The reference wings (k > 0, c = 0) and four frictionless wheels in a pyramid at 100 rad/s.

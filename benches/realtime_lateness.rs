@@ -1,7 +1,7 @@
 //! Frame lateness at 1 kHz: the normal scheduler against the hard real-time settings
 //! (SCHED_FIFO + `lock_memory` + `physics_cpu` + `cpu_dma_latency`), measured in the same run.
 //!
-//! Per round, two runs of the server in this process (`flexdyn::server::run`, real time, the
+//! Per round, two runs of the server in this process (`flexdyn_server::run`, real time, the
 //! reference spacecraft at 1 kHz: one RK4 step per frame, a loopback Zenoh session with no
 //! subscriber), each `FLEXDYN_RT_SPAN_S` seconds (default 60), first with the default settings
 //! (`normal`), then tuned (`tuned`: `realtime_priority = 50`, `lock_memory`, `physics_cpu` =
@@ -43,9 +43,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
-use flexdyn::server::{self, rt, RunReport, ServerSettings};
-use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_server::{self as server, rt, RunReport, ServerSettings};
+use flexdyn_vehicle::config::{SimConfig, DEFAULT_CONFIG_TOML};
 
 /// One run's figures.
 #[derive(Clone, Copy, Debug, Default)]

@@ -16,12 +16,12 @@ use std::io::BufWriter;
 use std::path::Path;
 use std::time::Instant;
 
-use flexdyn::config::SimConfig;
-use flexdyn::sim::Simulation;
-use flexdyn::sinks::mcap_file::{
+use flexdyn_proto::{encode, Header, StatusMsg};
+use flexdyn_sinks::mcap_file::{
     McapSink, RecordingInfo, VehicleInfo, CHUNK_SIZE_BYTES, RAW_ENCODING,
 };
-use flexdyn_proto::{encode, Header, StatusMsg};
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 
 const FRAMES: u64 = 20_000;
 

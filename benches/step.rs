@@ -27,8 +27,8 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use criterion::{BenchmarkId, Criterion};
-use flexdyn::dynamics::dynamic_effectors::gravity_gradient::GravityGradient;
-use flexdyn::dynamics::{GravityModel, Spacecraft};
+use flexdyn_dynamics::dynamic_effectors::gravity_gradient::GravityGradient;
+use flexdyn_dynamics::{GravityModel, Spacecraft};
 
 const PAIR_COUNTS: [usize; 5] = [1, 2, 4, 8, 16];
 const WHEEL_COUNTS: [usize; 5] = [0, 1, 2, 4, 8];
@@ -259,7 +259,7 @@ fn print_added_cost(label: &str, base: f64, rows: &[(&str, f64)], pair_ns: f64) 
 
 /// `scenarios/leo_environment.toml` with its `[environment]` table (and facets) replaced by
 /// `environment` (empty: no environment; the epoch and the OMM orbit stay).
-fn leo_simulation(environment: &str) -> flexdyn::sim::Simulation {
+fn leo_simulation(environment: &str) -> flexdyn_vehicle::sim::Simulation {
     let leo = include_str!("../scenarios/leo_environment.toml");
     let (start, end) = (
         leo.find("[environment]").unwrap(),
@@ -272,12 +272,12 @@ fn leo_simulation(environment: &str) -> flexdyn::sim::Simulation {
         format!("{environment}\n{facets}")
     };
     let text = format!("{}{env}{}", &leo[..start], &leo[end..]);
-    let cfg = flexdyn::config::SimConfig::from_toml_str(&text).unwrap();
-    flexdyn::sim::Simulation::new(&cfg).unwrap()
+    let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(&text).unwrap();
+    flexdyn_vehicle::sim::Simulation::new(&cfg).unwrap()
 }
 
 /// One batch of 5000 `Simulation::step`s (with their environment updates); returns the steps.
-fn step_batch(sim: &mut flexdyn::sim::Simulation) -> u64 {
+fn step_batch(sim: &mut flexdyn_vehicle::sim::Simulation) -> u64 {
     let steps = 5_000;
     sim.step_n(steps);
     steps
@@ -285,7 +285,7 @@ fn step_batch(sim: &mut flexdyn::sim::Simulation) -> u64 {
 
 /// One batch of 50 frames of the server's frame loop: `step_frame`, then the sensors due at
 /// the next tick sampled, as `crates/server/src/physics.rs` does; returns the steps.
-fn frame_batch(sim: &mut flexdyn::sim::Simulation) -> u64 {
+fn frame_batch(sim: &mut flexdyn_vehicle::sim::Simulation) -> u64 {
     let frames = 500;
     for _ in 0..frames {
         sim.step_frame();
@@ -299,8 +299,8 @@ fn frame_batch(sim: &mut flexdyn::sim::Simulation) -> u64 {
 /// simulation in turn: the rows of a table are measured interleaved, so a burst of load on the
 /// shared machine falls on all of them alike instead of on one row.
 fn interleaved_ns_per_step(
-    sims: &mut [flexdyn::sim::Simulation],
-    batch: fn(&mut flexdyn::sim::Simulation) -> u64,
+    sims: &mut [flexdyn_vehicle::sim::Simulation],
+    batch: fn(&mut flexdyn_vehicle::sim::Simulation) -> u64,
 ) -> Vec<f64> {
     for sim in sims.iter_mut() {
         batch(sim);
@@ -406,8 +406,9 @@ fn actuator_summary(pair_ns: f64) {
         )
     };
     let with = |extra: String, inputs: &[f64]| {
-        let cfg = flexdyn::config::SimConfig::from_toml_str(&format!("{leo}{extra}")).unwrap();
-        let mut sim = flexdyn::sim::Simulation::new(&cfg).unwrap();
+        let cfg =
+            flexdyn_vehicle::config::SimConfig::from_toml_str(&format!("{leo}{extra}")).unwrap();
+        let mut sim = flexdyn_vehicle::sim::Simulation::new(&cfg).unwrap();
         sim.set_effector_inputs(inputs).unwrap();
         sim
     };
@@ -446,8 +447,8 @@ fn sensor_summary(pair_ns: f64) {
     };
     let with = |extra: &str| {
         let text = format!("{}\n{extra}", &leo[..start]);
-        let cfg = flexdyn::config::SimConfig::from_toml_str(&text).unwrap();
-        flexdyn::sim::Simulation::new(&cfg).unwrap()
+        let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(&text).unwrap();
+        flexdyn_vehicle::sim::Simulation::new(&cfg).unwrap()
     };
     let kinds = [
         ("magnetometer", "[[magnetometers]]"),

@@ -17,9 +17,9 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use criterion::Criterion;
-use flexdyn::dynamics::GravityModel;
-use flexdyn::environment::earth_rotation::{CelestialPole, EarthRotation};
-use flexdyn::environment::epoch::{EarthOrientationParams, EpochScale, SimEpoch};
+use flexdyn_dynamics::GravityModel;
+use flexdyn_environment::earth_rotation::{CelestialPole, EarthRotation};
+use flexdyn_environment::epoch::{EarthOrientationParams, EpochScale, SimEpoch};
 
 const BATCHES: usize = 31;
 const CALLS: usize = 20_000;
@@ -42,8 +42,8 @@ fn median_ns(mut f: impl FnMut(u64)) -> f64 {
 fn epoch() -> SimEpoch {
     let eop = EarthOrientationParams {
         ut1_minus_utc_s: 0.05,
-        polar_motion_x_rad: 0.1 * flexdyn::environment::epoch::RAD_PER_ARCSEC,
-        polar_motion_y_rad: 0.3 * flexdyn::environment::epoch::RAD_PER_ARCSEC,
+        polar_motion_x_rad: 0.1 * flexdyn_environment::epoch::RAD_PER_ARCSEC,
+        polar_motion_y_rad: 0.3 * flexdyn_environment::epoch::RAD_PER_ARCSEC,
     };
     SimEpoch::parse("2026-03-20T12:00:00Z", EpochScale::Utc, eop, "epoch.utc").unwrap()
 }

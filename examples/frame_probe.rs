@@ -7,8 +7,8 @@ fn main() {
         .unwrap_or(20_000);
     let text = include_str!("../scenarios/leo_environment.toml");
     let start = text.find("[[magnetometers]]").unwrap();
-    let cfg = flexdyn::config::SimConfig::from_toml_str(&text[..start]).unwrap();
-    let mut sim = flexdyn::sim::Simulation::new(&cfg).unwrap();
+    let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(&text[..start]).unwrap();
+    let mut sim = flexdyn_vehicle::sim::Simulation::new(&cfg).unwrap();
     let t0 = std::time::Instant::now();
     for _ in 0..frames {
         sim.step_frame();

@@ -7,7 +7,7 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let pairs: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(2);
     let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(200_000);
-    let gravity = flexdyn::dynamics::GravityModel::PointMass {
+    let gravity = flexdyn_dynamics::GravityModel::PointMass {
         mu_m3_s2: common::MU_EARTH,
     };
     let pp = if pairs == 2 {

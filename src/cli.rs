@@ -10,18 +10,18 @@ use std::time::Instant;
 
 use flexdyn_proto::{command_flags, AppliedWrench, EnvironmentMsg, Header, StateMsg};
 
-use crate::config::{
-    config_message, log_warnings, warning_message, whole_ns, ConfigError, SimConfig,
-};
-use crate::numfmt::Num;
-use crate::sensors::Sensor;
-use crate::server::error::SettingsError;
-use crate::server::settings::ServerSettings;
-use crate::sim::Simulation;
-use crate::sinks::table::{
+use flexdyn_kernel::numfmt::Num;
+use flexdyn_sensors::Sensor;
+use flexdyn_server::error::SettingsError;
+use flexdyn_server::settings::ServerSettings;
+use flexdyn_sinks::table::{
     first_non_finite_column, prefixed_columns, state_row, Column, CsvTable,
     ENVIRONMENT_COLUMN_PREFIX,
 };
+use flexdyn_vehicle::config::{
+    config_message, log_warnings, warning_message, whole_ns, ConfigError, SimConfig,
+};
+use flexdyn_vehicle::sim::Simulation;
 use flexdyn_vehicle::world::{walk, RowPlan, RowSink, World};
 
 /// Arguments of `flexdyn simulate`.
@@ -162,9 +162,9 @@ impl fmt::Display for SimulateReport {
     }
 }
 
-/// [`crate::config::load_config`], its error as a [`CliError::Config`] naming the file.
+/// [`flexdyn_vehicle::config::load_config`], its error as a [`CliError::Config`] naming the file.
 fn load(path: Option<&Path>) -> Result<SimConfig, CliError> {
-    crate::config::load_config(path).map_err(|source| CliError::Config {
+    flexdyn_vehicle::config::load_config(path).map_err(|source| CliError::Config {
         file: path.map(Path::to_path_buf),
         source,
     })
@@ -216,7 +216,7 @@ fn scheduled_wrench(cfg: &SimConfig, t_ns: u64) -> AppliedWrench {
     })
 }
 
-/// One `simulate` row in the CSV dialect of [`crate::sinks::table`]: the state record (as
+/// One `simulate` row in the CSV dialect of [`flexdyn_sinks::table`]: the state record (as
 /// `export` writes it), the scheduled wrench, then each sensor's columns in publication order
 /// (`None`: no sample in this row, its cells stay empty).
 fn simulate_row(
@@ -261,7 +261,7 @@ fn sensor_prefix(s: &dyn Sensor) -> String {
 ///
 /// Comment lines before the header: `epoch_utc=…` with an `[epoch]`, and one
 /// `fault=<index>,<start_ns>,<duration_ns>,<period_ns>,<mode>,<target>` per `[[faults]]`
-/// entry, its window as resolved at load ([`crate::sinks::fault_spans`]).
+/// entry, its window as resolved at load ([`flexdyn_sinks::fault_spans`]).
 pub fn simulate_to<W: Write>(
     cfg: &SimConfig,
     duration_s: f64,
@@ -315,7 +315,7 @@ pub fn simulate_to<W: Write>(
             cfg.faults
                 .iter()
                 .enumerate()
-                .map(|(i, f)| crate::sinks::fault_spans::csv_comment(i, f)),
+                .map(|(i, f)| flexdyn_sinks::fault_spans::csv_comment(i, f)),
         )
         .collect();
     let table = CsvTable::with_comments(out, &comments, &columns).map_err(io_err)?;
@@ -490,8 +490,8 @@ pub fn check_config(path: &Path) -> Result<String, CliError> {
     Ok(out)
 }
 
-/// Logs to stderr at `RUST_LOG` (default `info`); see [`crate::logging::init_tracing`].
-pub use crate::logging::init_tracing;
+/// Logs to stderr at `RUST_LOG` (default `info`); see [`flexdyn_proto::client::logging::init_tracing`].
+pub use flexdyn_proto::client::logging::init_tracing;
 
 #[cfg(test)]
 mod tests {

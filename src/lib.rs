@@ -20,28 +20,16 @@
 //!   batch propagation;
 //! - `flexdyn-campaign` ([`campaign`]): Monte Carlo campaigns with flight code in the loop.
 //!
-//! This crate re-exports them under their old paths and holds what sits above them, for now:
-//! - [`logging`], [`transport`]: the stderr log setup and the one Zenoh configuration builder
-//!   (loopback, multicast scouting off), shared with the tools and flight code
-//!   (`flexdyn_proto::client`);
-//! - [`cli`] and [`world::run`]: the offline front ends `flexdyn simulate` and `flexdyn fleet`.
+//! This crate is the `flexdyn` binary's library half: what sits above the layers.
+//! - [`cli`]: the offline front end `flexdyn simulate` (and `check-config`);
+//! - [`world::run`]: the offline front end `flexdyn fleet`.
+//!
+//! Both step through the vehicle layer's one offline loop
+//! (`flexdyn_vehicle::world::offline::walk`) and only format rows. Use the layers by their own
+//! crate names (`flexdyn_server::run`, `flexdyn_vehicle::config::SimConfig`, …): the old
+//! `flexdyn::<layer>` paths were re-exports while the crates were cut, and are gone.
 
 #![warn(missing_docs)]
 
 pub mod cli;
 pub mod world;
-
-pub use flexdyn_proto::client::{logging, transport};
-
-// The model and vehicle layers are crates of their own (`crates/`); their old paths stay
-// re-exported here while the layers above them move into crates too.
-pub use flexdyn_campaign as campaign;
-pub use flexdyn_dynamics as dynamics;
-pub use flexdyn_environment as environment;
-pub use flexdyn_faults as faults;
-pub use flexdyn_kernel::{attitude, numfmt, schema, validate};
-pub use flexdyn_sensors as sensors;
-pub use flexdyn_server as server;
-pub use flexdyn_sinks as sinks;
-pub use flexdyn_sinks::signals;
-pub use flexdyn_vehicle::{config, sim};

@@ -9,10 +9,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use flexdyn::cli::{self, CliError, SimulateArgs};
-use flexdyn::config::DEFAULT_CONFIG_TOML;
-use flexdyn::logging::print_error;
-use flexdyn::server::cli::{run_from_args, RunArgs};
-use flexdyn::sinks::{self, SinkError};
+use flexdyn_proto::client::logging::print_error;
+use flexdyn_server::cli::{run_from_args, RunArgs};
+use flexdyn_sinks::{self as sinks, SinkError};
+use flexdyn_vehicle::config::DEFAULT_CONFIG_TOML;
 
 /// Real-time flight-software-in-the-loop spacecraft dynamics: rigid hub + dual-hinged panels.
 ///
@@ -63,7 +63,7 @@ enum Command {
     Plot(sinks::plot::PlotArgs),
     /// Monte Carlo campaigns: plan, run (locally or one index at a time), summarize.
     #[command(subcommand)]
-    Campaign(flexdyn::campaign::CampaignCommand),
+    Campaign(flexdyn_campaign::CampaignCommand),
 }
 
 /// Runs a sink subcommand and prints its one-line summary on stderr.
@@ -94,7 +94,7 @@ fn print_default_config() -> Result<(), CliError> {
 /// 2 for invalid settings or configuration, 1 for a failure while running.
 fn run_server(args: &RunArgs) -> ExitCode {
     if let Some(fleet) = &args.fleet {
-        return match flexdyn::server::fleet::run_from_args(args, fleet) {
+        return match flexdyn_server::fleet::run_from_args(args, fleet) {
             Ok(_report) => ExitCode::SUCCESS,
             Err(e) => {
                 print_error(&e);
@@ -112,13 +112,13 @@ fn run_server(args: &RunArgs) -> ExitCode {
 }
 
 fn main() -> ExitCode {
-    let args = match flexdyn::logging::parse_args::<Cli>() {
+    let args = match flexdyn_proto::client::logging::parse_args::<Cli>() {
         Ok(a) => a,
         Err(code) => return code,
     };
     if matches!(args.command, Some(Command::Campaign(_))) {
         // Each run's server would log its start and end at info: keep the progress bar readable.
-        flexdyn::logging::init_tracing_at("warn");
+        flexdyn_proto::client::logging::init_tracing_at("warn");
     } else {
         flexdyn::cli::init_tracing();
     }
@@ -175,7 +175,7 @@ fn main() -> ExitCode {
             })
         }
         Some(Command::Campaign(c)) => {
-            return match flexdyn::campaign::main(&c) {
+            return match flexdyn_campaign::main(&c) {
                 Ok(report) => {
                     let _ = writeln!(std::io::stderr(), "{}", report.text);
                     ExitCode::from(report.exit_code)

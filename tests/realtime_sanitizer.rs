@@ -68,16 +68,16 @@ use std::sync::mpsc::{sync_channel, Receiver, SyncSender, TryRecvError};
 use std::sync::{Arc, Mutex, Once};
 use std::time::{Duration, Instant};
 
-use flexdyn::config::SimConfig;
-use flexdyn::server::pacing::{FrameEnd, Pacer};
-use flexdyn::server::rt::monotonic_ns;
-use flexdyn::server::settings::OverrunPolicy;
-use flexdyn::server::shared::{Frame, Shared};
-use flexdyn::server::stepper::{count_offer, Stepper};
-use flexdyn::server::ServerSettings;
-use flexdyn::sim::Simulation;
-use flexdyn::transport::unix_now_ns;
+use flexdyn_proto::client::transport::unix_now_ns;
 use flexdyn_proto::{CommandMsg, EffectorInput, Header};
+use flexdyn_server::pacing::{FrameEnd, Pacer};
+use flexdyn_server::rt::monotonic_ns;
+use flexdyn_server::settings::OverrunPolicy;
+use flexdyn_server::shared::{Frame, Shared};
+use flexdyn_server::stepper::{count_offer, Stepper};
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 use seccompiler::{
     BpfProgram, SeccompAction, SeccompCmpArgLen, SeccompCmpOp, SeccompCondition, SeccompFilter,
     SeccompRule, TargetArch,

@@ -11,13 +11,13 @@
 use std::sync::mpsc::sync_channel;
 
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
-use flexdyn::config::SimConfig;
-use flexdyn::faults::ports::{Installed, LiveRequest};
-use flexdyn::server::shared::Frame;
-use flexdyn::server::stepper::Stepper;
-use flexdyn::server::ServerSettings;
-use flexdyn::sim::Simulation;
+use flexdyn_faults::ports::{Installed, LiveRequest};
 use flexdyn_proto::{CommandMsg, EffectorInput, FaultAction, FaultCommandMsg, FaultTarget, Header};
+use flexdyn_server::shared::Frame;
+use flexdyn_server::stepper::Stepper;
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 
 #[global_allocator]
 static ALLOC: AllocDisabler = AllocDisabler;
@@ -288,8 +288,8 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
 /// allocates nothing.
 #[test]
 fn the_fleet_frame_path_does_not_allocate() {
-    use flexdyn::server::world::WorldStepper;
-    use flexdyn::world::{FleetConfig, World};
+    use flexdyn_server::world::WorldStepper;
+    use flexdyn_vehicle::world::{FleetConfig, World};
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let faulty =
         std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("server_alloc_fleet_a.toml");

@@ -1,7 +1,7 @@
 //! Attitude kinematics: modified Rodrigues parameters (MRP), direction cosine matrices and
 //! quaternions.
 //!
-//! One implementation for the simulator (`flexdyn::attitude` re-exports this module) and for
+//! One implementation for the simulator (`flexdyn_kernel::attitude` re-exports this module) and for
 //! flight code (the demo controller `flexdyn-acs-demo`), which needs the same kernels without
 //! linking the simulator. Behind the `attitude` feature (nalgebra). The property tests of the
 //! kernels against nalgebra's independent rotation code are in the workspace's `crates/dynamics/tests/attitude.rs`.

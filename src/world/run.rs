@@ -16,11 +16,9 @@ use std::path::PathBuf;
 
 use nalgebra::Vector3;
 
-use super::fleet::{FleetConfig, FleetError};
-use super::relative::com_state_n;
-use super::step::World;
 use crate::cli::{whole_steps, CliError};
-use flexdyn_vehicle::world::{walk, RowPlan, RowSink};
+use flexdyn_vehicle::world::relative::com_state_n;
+use flexdyn_vehicle::world::{walk, FleetConfig, FleetError, RowPlan, RowSink, World};
 
 /// Arguments of `flexdyn fleet`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
@@ -241,7 +239,10 @@ mod tests {
         assert_eq!(header[13], "deputy_in_chief_r_h_m_1");
         assert_eq!(header[20], "deputy_in_chief_range_rate_m_s");
         // Times as written: integer nanoseconds divided once.
-        let times: Vec<&str> = lines[1..].iter().map(|l| &l[..l.find(',').unwrap()]).collect();
+        let times: Vec<&str> = lines[1..]
+            .iter()
+            .map(|l| &l[..l.find(',').unwrap()])
+            .collect();
         assert_eq!(times, ["0", "0.1", "0.2", "0.3", "0.4", "0.5"]);
         let last: Vec<f64> = lines[6].split(',').map(|c| c.parse().unwrap()).collect();
         assert_eq!(last[0], 0.5);

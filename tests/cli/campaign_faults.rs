@@ -10,8 +10,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use flexdyn::campaign::summary::{wilson, Z_95};
-use flexdyn::faults::failure_delay_ns;
+use flexdyn_campaign::summary::{wilson, Z_95};
+use flexdyn_faults::failure_delay_ns;
 
 const RUNS: u32 = 8;
 /// \[s\] the wheel's MTBF and the run's length: P(failure within a run) = 1 − e^(−1/2) ≈ 0.39.

@@ -17,11 +17,11 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use flexdyn::campaign::plan::{fnv1a, splitmix64, Plan, RunPlan};
-use flexdyn::campaign::readback::fleet_readback;
-use flexdyn::campaign::spec::Campaign;
-use flexdyn::sensors::imu::ImuConfig;
-use flexdyn::world::FleetConfig;
+use flexdyn_campaign::plan::{fnv1a, splitmix64, Plan, RunPlan};
+use flexdyn_campaign::readback::fleet_readback;
+use flexdyn_campaign::spec::Campaign;
+use flexdyn_sensors::imu::ImuConfig;
+use flexdyn_vehicle::world::FleetConfig;
 
 use crate::campaign_support;
 use campaign_support::{check_normal, check_uniform};
@@ -539,7 +539,7 @@ fn a_vehicles_random_fault_is_seeded_per_vehicle_and_can_be_removed() {
         let deputy = &rp.fleet().unwrap().vehicles[1].cfg;
         assert_eq!(
             rp.random_failures_ns["deputy.faults[0]"],
-            1_000_000_000 + flexdyn::faults::failure_delay_ns(20.0, seed)
+            1_000_000_000 + flexdyn_faults::failure_delay_ns(20.0, seed)
         );
         assert_eq!(
             deputy.faults[0].window.start_ns,

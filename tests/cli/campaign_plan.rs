@@ -6,9 +6,9 @@
 
 use std::path::{Path, PathBuf};
 
-use flexdyn::campaign::plan::{readback, Plan};
-use flexdyn::campaign::spec::Campaign;
-use flexdyn::config::SimConfig;
+use flexdyn_campaign::plan::{readback, Plan};
+use flexdyn_campaign::spec::Campaign;
+use flexdyn_vehicle::config::SimConfig;
 
 use crate::campaign_support;
 use campaign_support::{check_normal, check_uniform, stats};
@@ -260,7 +260,7 @@ fn sensor_seeds_are_derived_per_run_and_reach_the_model() {
         let cfg = SimConfig::from_toml_str(&rp.config_toml).unwrap();
         let built: Vec<u64> = cfg
             .sensors
-            .of::<flexdyn::sensors::imu::ImuConfig>()
+            .of::<flexdyn_sensors::imu::ImuConfig>()
             .map(|i| i.seed)
             .collect();
         let planned: Vec<u64> = rp.sensor_seeds.values().copied().collect();
@@ -708,7 +708,7 @@ fn random_faults_get_a_seed_per_run_and_their_failure_time_from_it() {
         let start = cfg.faults[0].window.start_ns;
         assert_eq!(
             start,
-            1_000_000_000 + flexdyn::faults::failure_delay_ns(20.0, seed)
+            1_000_000_000 + flexdyn_faults::failure_delay_ns(20.0, seed)
         );
         assert_eq!(cfg.faults[0].seed, seed);
         starts.push(start);

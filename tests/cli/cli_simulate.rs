@@ -6,7 +6,7 @@ use flexdyn_testkit::ports;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
+use flexdyn_vehicle::config::{SimConfig, DEFAULT_CONFIG_TOML};
 
 fn flexdyn(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_flexdyn"))

@@ -10,8 +10,8 @@
 
 use std::path::{Path, PathBuf};
 
-use flexdyn::config::{ConfigError, SimConfig, DEFAULT_CONFIG_TOML};
-use flexdyn::dynamics::{GravityModel, InitialTranslation};
+use flexdyn_dynamics::{GravityModel, InitialTranslation};
+use flexdyn_vehicle::config::{ConfigError, SimConfig, DEFAULT_CONFIG_TOML};
 use nalgebra::{Matrix3, Vector3};
 use toml::{Table, Value};
 
@@ -157,9 +157,9 @@ fn every_shipped_scenario_is_valid() {
             // A Monte Carlo campaign (over the reference spacecraft, or over a fleet), not a
             // spacecraft: it must load and plan (every dispersion key resolved and read back
             // from the model) and draw a valid first run.
-            let c = flexdyn::campaign::spec::Campaign::from_file(&path)
+            let c = flexdyn_campaign::spec::Campaign::from_file(&path)
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-            let plan = flexdyn::campaign::plan::Plan::new(c)
+            let plan = flexdyn_campaign::plan::Plan::new(c)
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
             let first = plan.run(0);
             assert!(
@@ -171,9 +171,9 @@ fn every_shipped_scenario_is_valid() {
             names.push(stem);
         } else if is_fleet {
             // A fleet file: every vehicle's configuration valid, and the world builds.
-            let fleet = flexdyn::world::FleetConfig::from_file(&path)
+            let fleet = flexdyn_vehicle::world::FleetConfig::from_file(&path)
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-            flexdyn::world::World::new(&fleet)
+            flexdyn_vehicle::world::World::new(&fleet)
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
             names.push(stem);
         } else if path.extension().is_some_and(|e| e == "toml") {
@@ -255,7 +255,7 @@ fn r_cn_sets_the_centre_of_mass() {
     let sc = cfg.build_spacecraft().unwrap();
     let (mass, c_b, c_dot_b) = sc.center_of_mass();
     assert_eq!(mass, 950.0);
-    let dcm_nb = flexdyn::attitude::mrp_to_dcm(&sc.state().sigma_bn).transpose();
+    let dcm_nb = flexdyn_kernel::attitude::mrp_to_dcm(&sc.state().sigma_bn).transpose();
     let r_c = sc.state().r_bn_n + dcm_nb * c_b;
     // `c_dot_b` is the inertial rate of c (it includes ω × c), B components.
     let v_c = sc.state().v_bn_n + dcm_nb * c_dot_b;
@@ -334,8 +334,8 @@ fn optional_keys_are_mapped() {
     assert_eq!(cfg.server, server);
     // An IMU without [imus.gyro] / [imus.accel] tables has every error term zero.
     assert_eq!(
-        cfg.sensors.all::<flexdyn::sensors::imu::ImuConfig>(),
-        vec![&flexdyn::sensors::imu::ImuConfig::ideal(
+        cfg.sensors.all::<flexdyn_sensors::imu::ImuConfig>(),
+        vec![&flexdyn_sensors::imu::ImuConfig::ideal(
             "imu0",
             Vector3::new(0.2, 0.1, 1.2),
             Matrix3::identity(),
@@ -1128,7 +1128,7 @@ fn cases() -> Vec<Case> {
         // is below the range.
         accepts_and(text("seed = 1", "seed = 9223372036854775807"), |cfg| {
             assert_eq!(
-                cfg.sensors.all::<flexdyn::sensors::imu::ImuConfig>()[0].seed,
+                cfg.sensors.all::<flexdyn_sensors::imu::ImuConfig>()[0].seed,
                 i64::MAX as u64
             );
         })

@@ -10,8 +10,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use flexdyn::sinks::export::{export, ExportArgs};
-use flexdyn::sinks::reader::read_recording;
+use flexdyn_sinks::export::{export, ExportArgs};
+use flexdyn_sinks::reader::read_recording;
 
 const LEO: &str = "scenarios/leo_environment.toml";
 const LEO_EPOCH: &str = "2026-11-24T06:00:00.000000000Z";

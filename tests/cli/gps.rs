@@ -7,14 +7,14 @@
 //! runs give the same bytes; configuration errors name the file, the field and the problem; and
 //! `flexdyn plot` draws the receiver through the generic sensor loop.
 
-use flexdyn::config::SimConfig;
-use flexdyn::dynamics::spacecraft::{HubOutputs, State};
-use flexdyn::environment::earth_rotation::{EarthFrame, EarthRotation};
-use flexdyn::environment::epoch::SimEpoch;
-use flexdyn::sensors::gps::{Gps, GpsConfig, GpsSample};
-use flexdyn::sensors::{Sensor, Truth};
-use flexdyn::sim::Simulation;
+use flexdyn_dynamics::spacecraft::{HubOutputs, State};
+use flexdyn_environment::earth_rotation::{EarthFrame, EarthRotation};
+use flexdyn_environment::epoch::SimEpoch;
 use flexdyn_proto::{decode_gps, gps_flags, Header};
+use flexdyn_sensors::gps::{Gps, GpsConfig, GpsSample};
+use flexdyn_sensors::{Sensor, Truth};
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 use nalgebra::Vector3;
 
 const LEO: &str = concat!(

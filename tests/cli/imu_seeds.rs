@@ -5,10 +5,10 @@
 use std::path::Path;
 
 use flexdyn::cli::simulate_to;
-use flexdyn::config::SimConfig;
-use flexdyn::sensors::imu::{attitude_increment_b, ImuSample};
-use flexdyn::sim::Simulation;
 use flexdyn_proto::{encode, Header, ImuMsg};
+use flexdyn_sensors::imu::{attitude_increment_b, ImuSample};
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 use nalgebra::Vector3;
 
 fn tactical() -> SimConfig {
@@ -51,7 +51,7 @@ fn a_different_seed_changes_only_that_imus_noise() {
     let mut other = cfg.clone();
     other
         .sensors
-        .of_mut::<flexdyn::sensors::imu::ImuConfig>()
+        .of_mut::<flexdyn_sensors::imu::ImuConfig>()
         .next()
         .unwrap()
         .seed = 12345;

@@ -3,11 +3,11 @@
 //! within their standard errors, scale factor, misalignment and saturation act as documented,
 //! the stream is reproducible, and configuration errors name the file, the field and the problem.
 
-use flexdyn::attitude::mrp_to_dcm;
-use flexdyn::config::SimConfig;
-use flexdyn::sensors::magnetometer::{Magnetometer, MagnetometerConfig};
-use flexdyn::sim::Simulation;
+use flexdyn_kernel::attitude::mrp_to_dcm;
 use flexdyn_proto::magnetometer_flags;
+use flexdyn_sensors::magnetometer::{Magnetometer, MagnetometerConfig};
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 use nalgebra::{Matrix3, Vector3};
 
 const LEO: &str = concat!(

@@ -1,7 +1,7 @@
 //! `flexdyn plot` from the outside: every figure of a recording and of a `simulate` CSV is a
 //! valid PNG (decoded with the `png` crate), of the documented size, and not blank; figures
 //! the input has no data for are skipped and named; bad input is an error naming the file.
-//! What the figures show is checked on their data ([`flexdyn::sinks::plot::figures`]): each
+//! What the figures show is checked on their data ([`flexdyn_sinks::plot::figures`]): each
 //! invariant on its own scale, the intervals of external torque, the wheel and star-tracker
 //! figures, the IMU layout, and every point inside its panel's axis bounds.
 
@@ -10,7 +10,7 @@ use flexdyn_testkit::ports;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use flexdyn::sinks::plot::{draw, figures, register_font, Figure, PlotArgs, COLORS};
+use flexdyn_sinks::plot::{draw, figures, register_font, Figure, PlotArgs, COLORS};
 
 fn flexdyn(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_flexdyn"))
@@ -534,9 +534,9 @@ fn sun_sensor_figures_from_a_simulate_csv() {
 /// instant; then the bad uses are errors naming the flag or the file.
 #[test]
 fn relative_motion_shows_the_deputy_in_the_chiefs_hill_frame() {
-    use flexdyn::sinks::mcap_file::{McapSink, RecordingInfo};
-    use flexdyn::world::relative::deputy_state_n;
     use flexdyn_proto::{encode, Header, StateMsg};
+    use flexdyn_sinks::mcap_file::{McapSink, RecordingInfo};
+    use flexdyn_vehicle::world::relative::deputy_state_n;
     use nalgebra::Vector3;
 
     let rec = tmp("pair.mcap");
@@ -691,7 +691,7 @@ fn shading_columns(
     area: &(std::ops::Range<i32>, std::ops::Range<i32>),
     index: u32,
 ) -> (i32, i32) {
-    use flexdyn::sinks::plot::{fault_color, FAULT_ALPHA};
+    use flexdyn_sinks::plot::{fault_color, FAULT_ALPHA};
     let c = fault_color(index);
     let blend = |v: u8| 255.0 * (1.0 - FAULT_ALPHA) + f64::from(v) * FAULT_ALPHA;
     let want = [blend(c.0), blend(c.1), blend(c.2)];
@@ -859,8 +859,8 @@ fn export_state_csv(rec: &Path, dir: &Path) -> PathBuf {
 /// into `out`: each vehicle's description (its configuration replaced by `config` of it), then
 /// every sample from `from_ns` on, through the recorder's own writer.
 fn record_from(rec: &Path, from_ns: u64, out: &Path, config: impl Fn(&str) -> String) {
-    use flexdyn::sinks::mcap_file::{McapSink, RecordingInfo};
-    let r = flexdyn::sinks::reader::read_recording(rec).unwrap();
+    use flexdyn_sinks::mcap_file::{McapSink, RecordingInfo};
+    let r = flexdyn_sinks::reader::read_recording(rec).unwrap();
     assert!(r.truncated.is_none());
     let info = RecordingInfo {
         recorder: "flexdyn record".into(),

@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use flexdyn::sinks::reader::read_recording;
 use flexdyn_proto::decode_state;
+use flexdyn_sinks::reader::read_recording;
 use sha2::{Digest, Sha256};
 
 /// The pinned independent reader (with its zstd and lz4 dependencies).
@@ -334,7 +334,7 @@ fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
 /// `flexdyn record` of a synthetic publisher whose StateMsg sequence numbers 0..100 skip
 /// `skipped`: the exit code, the summary line, and the file's `flexdyn.recorder` metadata.
 fn record_states(name: &str, skipped: &[u64]) -> (Option<i32>, String, BTreeMap<String, String>) {
-    use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
+    use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
     use flexdyn_proto::{encode, Header, StateMsg};
     use std::io::Read;
     use zenoh::Wait;
@@ -348,7 +348,7 @@ fn record_states(name: &str, skipped: &[u64]) -> (Option<i32>, String, BTreeMap<
     let session = zenoh::open(zenoh_config(&args, Role::Server).unwrap())
         .wait()
         .unwrap();
-    let endpoint = flexdyn::transport::listening_on(&session).remove(0);
+    let endpoint = flexdyn_proto::client::transport::listening_on(&session).remove(0);
     let publisher = session
         .declare_publisher("flexdyn/gaps/tlm/state")
         .wait()
@@ -488,7 +488,8 @@ fn a_recording_under_load_reports_exactly_what_it_misses() {
     let config = tmp("rt_1khz.toml");
     std::fs::write(
         &config,
-        flexdyn::config::DEFAULT_CONFIG_TOML.replace("frame_hz = 100.0 ", "frame_hz = 1000.0 "),
+        flexdyn_vehicle::config::DEFAULT_CONFIG_TOML
+            .replace("frame_hz = 100.0 ", "frame_hz = 1000.0 "),
     )
     .unwrap();
     let (_server, endpoint) = spawn_listening(

@@ -17,7 +17,7 @@
 use std::path::Path;
 
 use flexdyn::cli::simulate_to;
-use flexdyn::config::SimConfig;
+use flexdyn_vehicle::config::SimConfig;
 use sha2::{Digest, Sha256};
 
 /// (scenario, log interval \[s\], sha256 of the CSV). Re-minted for protocol version 9 (the

@@ -5,11 +5,11 @@
 //! the frame rate, the hub, the panel pairs, the wheels, the IMUs and the star trackers with
 //! their periods in frames.
 
-use flexdyn::config::SimConfig;
-use flexdyn::sensors::imu::ImuConfig;
-use flexdyn::sensors::star_tracker::StarTrackerConfig;
 use flexdyn_proto::client::lockstep::SensorSchedule;
 use flexdyn_proto::client::vehicle::VehicleConfig;
+use flexdyn_sensors::imu::ImuConfig;
+use flexdyn_sensors::star_tracker::StarTrackerConfig;
+use flexdyn_vehicle::config::SimConfig;
 use nalgebra::{Matrix3, Vector3};
 
 fn m3(rows: &[[f64; 3]; 3]) -> Matrix3<f64> {

@@ -7,15 +7,15 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use flexdyn::attitude::mrp_to_dcm;
-use flexdyn::config::SimConfig;
-use flexdyn::dynamics::spacecraft::HubOutputs;
-use flexdyn::environment::EnvironmentSample;
-use flexdyn::sensors::coarse_sun_sensor::{CoarseSunSensor, CoarseSunSensorConfig};
-use flexdyn::sensors::fine_sun_sensor::{FineSunSensor, FineSunSensorConfig};
-use flexdyn::sensors::{Sensor, Truth};
-use flexdyn::sim::Simulation;
+use flexdyn_dynamics::spacecraft::HubOutputs;
+use flexdyn_environment::EnvironmentSample;
+use flexdyn_kernel::attitude::mrp_to_dcm;
 use flexdyn_proto::{fss_flags, Header};
+use flexdyn_sensors::coarse_sun_sensor::{CoarseSunSensor, CoarseSunSensorConfig};
+use flexdyn_sensors::fine_sun_sensor::{FineSunSensor, FineSunSensorConfig};
+use flexdyn_sensors::{Sensor, Truth};
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 const LEO: &str = concat!(

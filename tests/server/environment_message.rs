@@ -21,25 +21,25 @@ use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use flexdyn::attitude::mrp_to_dcm;
-use flexdyn::config::SimConfig;
-use flexdyn::dynamics::dynamic_effectors::{
+use flexdyn_dynamics::dynamic_effectors::{
     aero_drag::AeroDrag, gravity_gradient, solar_pressure::SolarPressure,
 };
-use flexdyn::dynamics::{DynamicEffector, StageState, Wrench};
-use flexdyn::environment::earth_rotation::EarthRotation;
-use flexdyn::environment::ephemeris::sun_position_n_m;
-use flexdyn::environment::facets::{FacetModel, SOLAR_IRRADIANCE_1AU_W_M2};
-use flexdyn::environment::magnetic::Igrf;
-use flexdyn::environment::model::EnvironmentModel;
-use flexdyn::environment::prefetch::Request;
-use flexdyn::environment::EnvironmentSample;
-use flexdyn::server::ServerSettings;
-use flexdyn::sim::Simulation;
+use flexdyn_dynamics::{DynamicEffector, StageState, Wrench};
+use flexdyn_environment::earth_rotation::EarthRotation;
+use flexdyn_environment::ephemeris::sun_position_n_m;
+use flexdyn_environment::facets::{FacetModel, SOLAR_IRRADIANCE_1AU_W_M2};
+use flexdyn_environment::magnetic::Igrf;
+use flexdyn_environment::model::EnvironmentModel;
+use flexdyn_environment::prefetch::Request;
+use flexdyn_environment::EnvironmentSample;
+use flexdyn_kernel::attitude::mrp_to_dcm;
 use flexdyn_proto::{
     decode_environment, decode_state, decode_time, eclipse, environment_flags, EnvironmentMsg,
     Mode, StateMsg, TimeMsg, Topics,
 };
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 use nalgebra::{Matrix3, Vector3};
 use server_support::{
     connecting_session, listening_session, wait_for_subscriber, wait_until, ServerHandle,

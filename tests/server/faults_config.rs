@@ -3,8 +3,8 @@
 //! bad axis is a configuration error naming the entry's field, never a silent no-op. And a
 //! valid entry resolves to the documented port, window, axes and seed.
 
-use flexdyn::config::SimConfig;
-use flexdyn::faults::{failure_delay_ns, FaultMode, FaultWindow, Port};
+use flexdyn_faults::{failure_delay_ns, FaultMode, FaultWindow, Port};
+use flexdyn_vehicle::config::SimConfig;
 
 const ACS_FULL: &str = include_str!("../../scenarios/acs_full.toml");
 
@@ -256,7 +256,7 @@ fn a_valid_entry_resolves_to_its_port_window_axes_and_seed() {
     let Port::Actuator { effector } = w.port else {
         panic!("{:?}", w.port)
     };
-    let names: Vec<String> = flexdyn::sim::Simulation::new(&cfg)
+    let names: Vec<String> = flexdyn_vehicle::sim::Simulation::new(&cfg)
         .unwrap()
         .spacecraft()
         .effector_entries()
@@ -309,7 +309,7 @@ fn a_link_target_is_a_participant_of_the_server() {
     let cfg = SimConfig::from_toml_str(&text).unwrap();
     assert_eq!(cfg.faults[0].port, Port::Link { sender_id: 2 });
     assert_eq!(cfg.faults[0].mode, FaultMode::Delayed { frames: 3.0 });
-    let mut settings = flexdyn::server::ServerSettings::from_table(&cfg.server).unwrap();
+    let mut settings = flexdyn_server::ServerSettings::from_table(&cfg.server).unwrap();
     settings.check_link_faults(&cfg).unwrap();
     settings.participants = vec![1];
     let e = settings.check_link_faults(&cfg).unwrap_err().to_string();

@@ -9,11 +9,11 @@ use crate::server_support;
 
 use std::time::Duration;
 
-use flexdyn::config::SimConfig;
-use flexdyn::server::ServerSettings;
 use flexdyn_proto::client::lockstep::{SensorSchedule, TickReceiver};
 use flexdyn_proto::client::vehicle::VehicleConfig;
 use flexdyn_proto::{encode, CommandMsg, Header, Mode, Topics};
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::config::SimConfig;
 use server_support::{connecting_session, ServerHandle};
 use zenoh::Wait;
 

@@ -26,13 +26,13 @@ use crate::server_support;
 
 use std::time::Duration;
 
-use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
-use flexdyn::faults::link::{damage, LinkStats};
-use flexdyn::server::{RunReport, ServerSettings};
+use flexdyn_faults::link::{damage, LinkStats};
 use flexdyn_proto::{
     decode_command, decode_state, encode, CommandKind, CommandMsg, DecodeError, FaultAction,
     FaultCommandMsg, FaultTarget, Header, Mode, RejectCounters, Topics,
 };
+use flexdyn_server::{RunReport, ServerSettings};
+use flexdyn_vehicle::config::{SimConfig, DEFAULT_CONFIG_TOML};
 use server_support::{connecting_session, ServerHandle};
 use zenoh::Wait;
 

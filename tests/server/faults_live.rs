@@ -19,13 +19,13 @@ use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use flexdyn::config::SimConfig;
-use flexdyn::server::{Handoff, ServerSettings};
 use flexdyn_proto::{
     decode_fault_event, decode_imu, decode_state, encode, CommandMsg, FaultAction, FaultCommandMsg,
     FaultEventMsg, FaultSource, FaultTarget, Header, Mode, OperatorAction, OperatorMsg,
     RejectCounters, RunState, Topics, PROTOCOL_VERSION,
 };
+use flexdyn_server::{Handoff, ServerSettings};
+use flexdyn_vehicle::config::SimConfig;
 use server_support::{connecting_session, wait_until, Observer, ServerHandle};
 use zenoh::{Session, Wait};
 

@@ -12,9 +12,9 @@ use crate::server_support;
 use std::path::PathBuf;
 use std::time::Duration;
 
-use flexdyn::server::ServerSettings;
-use flexdyn::world::FleetConfig;
 use flexdyn_proto::{Mode, Topics};
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::world::FleetConfig;
 use server_support::{wait_until, FleetServerHandle, Observer};
 
 /// Two reference spacecraft (100 Hz frames), the deputy 100 m behind the chief.

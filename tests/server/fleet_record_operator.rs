@@ -12,14 +12,14 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use flexdyn::campaign::execute::Observer;
-use flexdyn::server::ServerSettings;
-use flexdyn::sinks::plot::{figures, PlotArgs};
-use flexdyn::sinks::reader::read_recording;
-use flexdyn::world::FleetConfig;
+use flexdyn_campaign::execute::Observer;
 use flexdyn_proto::{
     decode_relative_state, decode_state, encode, Header, Mode, OperatorAction, OperatorMsg, Topics,
 };
+use flexdyn_server::ServerSettings;
+use flexdyn_sinks::plot::{figures, PlotArgs};
+use flexdyn_sinks::reader::read_recording;
+use flexdyn_vehicle::world::FleetConfig;
 use server_support::{connecting_session, endpoint, FleetServerHandle, ANY_PORT};
 use zenoh::Wait;
 

@@ -18,10 +18,10 @@ use crate::server_support;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use flexdyn::campaign::execute::Observer;
-use flexdyn::server::ServerSettings;
-use flexdyn::world::{relative_state_hill, FleetConfig};
+use flexdyn_campaign::execute::Observer;
 use flexdyn_proto::{decode_relative_state, decode_state, Mode, StateMsg, Topics};
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::world::{relative_state_hill, FleetConfig};
 use nalgebra::Vector3;
 use server_support::{connecting_session, endpoint, FleetServerHandle};
 use sha2::{Digest, Sha256};
@@ -84,7 +84,7 @@ struct Run {
 /// (key, payload) of every relative-state sample, in arrival order.
 type Samples = Arc<Mutex<Vec<(String, Vec<u8>)>>>;
 
-fn sorted(r: &flexdyn::campaign::execute::Received) -> Vec<(u64, Vec<u8>)> {
+fn sorted(r: &flexdyn_campaign::execute::Received) -> Vec<(u64, Vec<u8>)> {
     let mut s = r.lock().unwrap().clone();
     s.sort_by_key(|(t, _)| *t);
     s
@@ -135,7 +135,7 @@ fn run() -> Run {
 
 /// r_C, v_C in N from a rigid hub's StateMsg (centre of mass fixed at `C_B_M` in B).
 fn com_from_state(s: &StateMsg) -> (Vector3<f64>, Vector3<f64>) {
-    let dcm_nb = flexdyn::attitude::mrp_to_dcm(&Vector3::from(s.sigma_bn)).transpose();
+    let dcm_nb = flexdyn_kernel::attitude::mrp_to_dcm(&Vector3::from(s.sigma_bn)).transpose();
     let c_b = Vector3::from(C_B_M);
     let omega = Vector3::from(s.omega_bn_b_rad_s);
     (

@@ -12,12 +12,12 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use flexdyn::server::{Handoff, ServerSettings, ZenohArgs};
-use flexdyn::transport::{zenoh_config, Role};
+use flexdyn_proto::client::transport::{zenoh_config, Role};
 use flexdyn_proto::{
     decode_header, decode_state, decode_time, encode, CommandMsg, Header, Mode, OperatorAction,
     OperatorMsg, RejectCounters, RunState, Topics,
 };
+use flexdyn_server::{Handoff, ServerSettings, ZenohArgs};
 use server_support::{connecting_session, reference_config, wait_until, Observer, ServerHandle};
 use zenoh::{Session, Wait};
 

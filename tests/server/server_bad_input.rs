@@ -5,8 +5,8 @@ use crate::server_support;
 
 use std::time::Duration;
 
-use flexdyn::server::{Outcome, ServerSettings};
 use flexdyn_proto::{command_flags, encode, CommandMsg, Header, RejectCounters, Topics};
+use flexdyn_server::{Outcome, ServerSettings};
 use server_support::{reference_config, wait_until, Observer, ServerHandle};
 use zenoh::Wait;
 

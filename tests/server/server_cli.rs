@@ -225,7 +225,7 @@ fn bad_settings_exit_2_naming_the_setting() {
         &file,
         format!(
             "{}\n[server]\ncolour = \"blue\"\n",
-            flexdyn::config::DEFAULT_CONFIG_TOML
+            flexdyn_vehicle::config::DEFAULT_CONFIG_TOML
         ),
     )
     .unwrap();
@@ -236,7 +236,7 @@ fn bad_settings_exit_2_naming_the_setting() {
     );
     let listen = ["--listen", ANY_PORT];
     // After the reference text come an empty line, `[server]`, then `colour`.
-    let colour_line = flexdyn::config::DEFAULT_CONFIG_TOML.lines().count() + 3;
+    let colour_line = flexdyn_vehicle::config::DEFAULT_CONFIG_TOML.lines().count() + 3;
     let colour =
         format!("error: {file_s}: server.colour: unknown key (expected one of: mode, sc_id");
     let colour_at = format!("(line {colour_line}, column ");

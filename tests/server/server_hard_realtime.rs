@@ -7,7 +7,7 @@ mod server_support;
 
 use std::time::Duration;
 
-use flexdyn::server::{rt, Outcome, ServerError, ServerSettings};
+use flexdyn_server::{rt, Outcome, ServerError, ServerSettings};
 use server_support::{reference_config, ServerHandle};
 
 const WAIT: Duration = Duration::from_secs(30);

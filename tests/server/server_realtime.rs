@@ -5,12 +5,12 @@ use crate::server_support;
 
 use std::time::Duration;
 
-use flexdyn::transport::unix_now_ns;
+use flexdyn_proto::client::transport::unix_now_ns;
 
-use flexdyn::server::{Outcome, ServerSettings};
 use flexdyn_proto::{
     command_flags, encode, CommandMsg, Header, Mode, RunState, StalePolicy, Topics,
 };
+use flexdyn_server::{Outcome, ServerSettings};
 use server_support::{reference_config, wait_until, Observer, ServerHandle};
 use zenoh::Wait;
 
@@ -136,7 +136,7 @@ fn realtime_1khz_runs() {
 fn imu_samples_are_published_every_frame_on_their_topics() {
     let topics = Topics::new("sc1").unwrap();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/imu_tactical.toml");
-    let cfg = flexdyn::config::SimConfig::from_file(&path).unwrap();
+    let cfg = flexdyn_vehicle::config::SimConfig::from_file(&path).unwrap();
     let server = ServerHandle::start(
         ServerSettings {
             // Real time (2 s) so the subscriber below is surely up before the last tick.

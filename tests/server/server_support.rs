@@ -4,10 +4,10 @@
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use flexdyn::config::{SimConfig, DEFAULT_CONFIG_TOML};
-use flexdyn::server;
-use flexdyn::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::{decode_state, decode_status, StateMsg, StatusMsg, Topics};
+use flexdyn_server as server;
+use flexdyn_vehicle::config::{SimConfig, DEFAULT_CONFIG_TOML};
 use zenoh::{Session, Wait};
 
 // Ports the OS gave a process, read back; shared with the test files without this harness.
@@ -53,7 +53,7 @@ pub fn wait_for_subscriber(server_session: &Session, key: &str) {
 
 /// The port `session` listens on (its first listen endpoint).
 pub fn session_port(session: &Session) -> u16 {
-    let endpoints = flexdyn::transport::listening_on(session);
+    let endpoints = flexdyn_proto::client::transport::listening_on(session);
     port_of(endpoints.first().expect("the session listens nowhere"))
 }
 
@@ -234,7 +234,10 @@ impl ServerHandle {
 
 impl FleetServerHandle {
     /// On a session listening on a port the OS chose ([`Self::port`]).
-    pub fn start(settings: server::ServerSettings, fleet: flexdyn::world::FleetConfig) -> Self {
+    pub fn start(
+        settings: server::ServerSettings,
+        fleet: flexdyn_vehicle::world::FleetConfig,
+    ) -> Self {
         Self::spawn(listening_session().0, move |session, shutdown| {
             server::fleet::run(session, settings, fleet, shutdown)
         })

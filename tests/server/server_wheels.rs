@@ -8,12 +8,12 @@ use crate::server_support;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use flexdyn::config::SimConfig;
-use flexdyn::server::ServerSettings;
 use flexdyn_proto::{
     decode_star_tracker, decode_state, effector_kind, encode, CommandMsg, EffectorInput, Header,
     Mode, RejectCounters, StarTrackerMsg, Topics,
 };
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::config::SimConfig;
 use server_support::{connecting_session, wait_until, Observer, ServerHandle};
 use zenoh::Wait;
 

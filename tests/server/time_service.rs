@@ -9,9 +9,9 @@ use crate::server_support;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use flexdyn::config::SimConfig;
-use flexdyn::server::{self, ServerSettings};
 use flexdyn_proto::{decode_header, decode_time, time_flags, Mode, RunState, TimeMsg, Topics};
+use flexdyn_server::{self as server, ServerSettings};
+use flexdyn_vehicle::config::SimConfig;
 use server_support::{
     connecting_session, listening_session, reference_config, wait_for_subscriber, wait_until,
     ServerHandle,

@@ -13,9 +13,9 @@ use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use flexdyn::attitude::mrp_to_quat;
-use flexdyn::sinks::reader::read_recording;
+use flexdyn_kernel::attitude::mrp_to_quat;
 use flexdyn_proto::{decode_state, StateMsg};
+use flexdyn_sinks::reader::read_recording;
 use futures_util::{SinkExt, StreamExt};
 use nalgebra::Vector3;
 use serde_json::{json, Value};

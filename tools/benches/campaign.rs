@@ -10,9 +10,9 @@ use flexdyn_testkit::demo_bin;
 use std::path::Path;
 use std::time::Instant;
 
-use flexdyn::campaign::execute::{execute_many, RunOptions};
-use flexdyn::campaign::plan::Plan;
-use flexdyn::campaign::spec::Campaign;
+use flexdyn_campaign::execute::{execute_many, RunOptions};
+use flexdyn_campaign::plan::Plan;
+use flexdyn_campaign::spec::Campaign;
 
 fn campaign(runs: u32, controller: Option<&str>) -> Plan {
     let c = controller.map_or(String::new(), |c| format!("controller = '''{c}'''\n"));

@@ -23,9 +23,9 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
 
-use flexdyn::server::ServerSettings;
-use flexdyn::world::FleetConfig;
 use flexdyn_proto::Mode;
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::world::FleetConfig;
 use support::{endpoint, ChildGuard, FleetServerHandle};
 
 fn env_usize(name: &str, default: usize) -> usize {

@@ -27,9 +27,9 @@ mod support;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use flexdyn::server::{Handoff, ServerSettings};
-use flexdyn::sim::Simulation;
 use flexdyn_proto::Mode;
+use flexdyn_server::{Handoff, ServerSettings};
+use flexdyn_vehicle::sim::Simulation;
 use support::{endpoint, pingpong_rtts, reference_config, ChildGuard, ServerHandle};
 
 fn env_usize(name: &str, default: usize) -> usize {

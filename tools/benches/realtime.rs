@@ -38,9 +38,9 @@ use std::process::Command;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use flexdyn::server::{frame_stamp_ns, Handoff, ServerSettings};
-use flexdyn::transport::unix_now_ns;
+use flexdyn_proto::client::transport::unix_now_ns;
 use flexdyn_proto::{decode_state, Topics};
+use flexdyn_server::{frame_stamp_ns, Handoff, ServerSettings};
 use flexdyn_tools::percentile;
 use support::{
     connecting_session, endpoint, pingpong_rtts, reference_config, ChildGuard, ServerHandle,

@@ -32,10 +32,10 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use crate::support::{connecting_session, digest, endpoint, ChildGuard, Recorder, ServerHandle};
-use flexdyn::attitude::mrp_error;
-use flexdyn::server::ServerSettings;
+use flexdyn_kernel::attitude::mrp_error;
 use flexdyn_proto::client::vehicle::VehicleConfig;
 use flexdyn_proto::{decode_environment, decode_state, Mode, StateMsg, Topics};
+use flexdyn_server::ServerSettings;
 use nalgebra::Vector3;
 use zenoh::Wait;
 
@@ -93,7 +93,8 @@ struct Run {
 fn sequence_run(unload_s: f64) -> Run {
     let duration_s = BEFORE_UNLOAD_S + unload_s;
     let topics = Topics::new("sc1").unwrap();
-    let cfg = flexdyn::config::SimConfig::from_file(&scenario_path()).expect("acs_full.toml");
+    let cfg =
+        flexdyn_vehicle::config::SimConfig::from_file(&scenario_path()).expect("acs_full.toml");
     let server = ServerHandle::start(
         ServerSettings {
             mode: Mode::Lockstep,

@@ -1,5 +1,5 @@
 //! End-to-end campaigns with `flexdyn-acs-demo` as the flight code, through
-//! `flexdyn::campaign::main` (what `flexdyn campaign …` calls): 20 short runs two at a time all
+//! `flexdyn_campaign::main` (what `flexdyn campaign …` calls): 20 short runs two at a time all
 //! finish, the summary has 20 rows, the criteria evaluate and a deliberately failing one fails
 //! everywhere; a run rerun alone with `--index` has the same state hash; a controller that
 //! crashes in one run fails that run with its exit status and the campaign goes on. The exit
@@ -9,10 +9,10 @@
 
 use std::path::{Path, PathBuf};
 
-use flexdyn::campaign::execute::RunResult;
-use flexdyn::campaign::verdict::Outcome;
-use flexdyn::campaign::{main as campaign, CampaignCommand};
-use flexdyn::faults::failure_delay_ns;
+use flexdyn_campaign::execute::RunResult;
+use flexdyn_campaign::verdict::Outcome;
+use flexdyn_campaign::{main as campaign, CampaignCommand};
+use flexdyn_faults::failure_delay_ns;
 
 use demo_bin::acs_demo as demo;
 use flexdyn_testkit::demo_bin;
@@ -341,9 +341,10 @@ fn random_wheel_seizures_fail_the_runs_they_strike() {
     let failure_ns: Vec<u64> = (0..SEIZURE_RUNS)
         .map(|run| {
             let path = out.join(format!("run-{run:04}/config.toml"));
-            let cfg =
-                flexdyn::config::SimConfig::from_toml_str(&std::fs::read_to_string(path).unwrap())
-                    .unwrap();
+            let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(
+                &std::fs::read_to_string(path).unwrap(),
+            )
+            .unwrap();
             step_frame_ns = (cfg.step_ns, cfg.frame_ns);
             (SEIZE_FROM_S * 1e9) as u64 + failure_delay_ns(MTBF_S, cfg.faults[0].seed)
         })

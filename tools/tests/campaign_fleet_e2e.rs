@@ -1,5 +1,5 @@
 //! A campaign over a fleet, end to end (issue 22, "campaigns disperse per-vehicle keys"),
-//! through `flexdyn::campaign::main` (what `flexdyn campaign …` calls): the fleet server, the
+//! through `flexdyn_campaign::main` (what `flexdyn campaign …` calls): the fleet server, the
 //! observer on both vehicles, and a controller process per vehicle, `flexdyn-acs-demo` for the
 //! chief (sender 1) and `flexdyn-formation-demo` for the deputy (sender 2). Four short runs two
 //! at a time:
@@ -17,8 +17,8 @@
 
 use std::path::{Path, PathBuf};
 
-use flexdyn::campaign::execute::RunResult;
-use flexdyn::campaign::{main as campaign, CampaignCommand};
+use flexdyn_campaign::execute::RunResult;
+use flexdyn_campaign::{main as campaign, CampaignCommand};
 
 use flexdyn_testkit::demo_bin;
 
@@ -126,7 +126,7 @@ fn run(
     out: &Path,
     jobs: Option<usize>,
     index: Option<u32>,
-) -> flexdyn::campaign::Report {
+) -> flexdyn_campaign::Report {
     let report = campaign(&CampaignCommand::Run {
         file: file.to_owned(),
         output: out.to_owned(),

@@ -14,7 +14,7 @@ use flexdyn_testkit::demo_bin;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use flexdyn::transport::{listening_on, zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::client::transport::{listening_on, zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::{decode_command, encode, CommandKind, Header, ImuMsg, StateMsg, Topics};
 use zenoh::Wait;
 

@@ -3,7 +3,7 @@
 //!
 //! Why the server runs in-process: the controller is the child process (its own package,
 //! `clients/rust/acs-demo`, found next to this test by `acs_demo_bin`) and the server is
-//! `flexdyn::server::run`, the same function `flexdyn run` calls. `tests/server/server_cli.rs` in the root package covers the `flexdyn` binary itself (exit
+//! `flexdyn_server::run`, the same function `flexdyn run` calls. `tests/server/server_cli.rs` in the root package covers the `flexdyn` binary itself (exit
 //! code and message of a participant timeout).
 //!
 //! A second, passive participant (sender 2, in this process) records every StateMsg payload and
@@ -19,9 +19,9 @@ use std::process::Command;
 use std::time::Duration;
 
 use crate::support::{endpoint, reference_config, signal, ChildGuard, Recorder, ServerHandle};
-use flexdyn::attitude::mrp_error;
-use flexdyn::server::{Handoff, ServerError, ServerSettings};
+use flexdyn_kernel::attitude::mrp_error;
 use flexdyn_proto::{decode_state, Mode, Topics};
+use flexdyn_server::{Handoff, ServerError, ServerSettings};
 use nalgebra::Vector3;
 use sha2::{Digest, Sha256};
 
@@ -81,10 +81,10 @@ fn controller(port: u16, rate_args: &[&str]) -> ChildGuard {
 const TRUTH_RATE: &[&str] = &["--rate-source", "truth"];
 
 /// `scenarios/imu_tactical.toml`: the reference spacecraft with two tactical-grade IMUs.
-fn imu_config() -> flexdyn::config::SimConfig {
+fn imu_config() -> flexdyn_vehicle::config::SimConfig {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/imu_tactical.toml");
-    flexdyn::config::SimConfig::from_file(&path).expect("imu_tactical.toml")
+    flexdyn_vehicle::config::SimConfig::from_file(&path).expect("imu_tactical.toml")
 }
 
 enum Sabotage {
@@ -101,7 +101,7 @@ enum Sabotage {
 }
 
 struct Run {
-    result: Result<flexdyn::server::RunReport, ServerError>,
+    result: Result<flexdyn_server::RunReport, ServerError>,
     states: Vec<(u64, Vec<u8>)>,
 }
 
@@ -117,7 +117,7 @@ fn lockstep_run(participant_timeout_s: f64, sabotage: Sabotage) -> Run {
 fn lockstep_run_with(
     participant_timeout_s: f64,
     sabotage: Sabotage,
-    cfg: flexdyn::config::SimConfig,
+    cfg: flexdyn_vehicle::config::SimConfig,
     rate_args: &[&str],
 ) -> Run {
     lockstep_run_settings(settings(participant_timeout_s), sabotage, cfg, rate_args)
@@ -126,7 +126,7 @@ fn lockstep_run_with(
 fn lockstep_run_settings(
     settings: ServerSettings,
     sabotage: Sabotage,
-    cfg: flexdyn::config::SimConfig,
+    cfg: flexdyn_vehicle::config::SimConfig,
     rate_args: &[&str],
 ) -> Run {
     let topics = Topics::new("sc1").unwrap();
@@ -363,7 +363,7 @@ fn lockstep_with_gyro_rate_feedback_converges_and_is_bit_identical() {
 fn lockstep_gyro_runs_are_bit_identical_for_every_integrator() {
     const RUN_S: f64 = 10.0;
     let gyro: &[&str] = &["--rate-source", "gyro", "--imu", "hub"];
-    let run = |m: &'static flexdyn::dynamics::integrator::ButcherTableau| {
+    let run = |m: &'static flexdyn_dynamics::integrator::ButcherTableau| {
         let mut cfg = imu_config();
         cfg.integrator = m;
         let settings = ServerSettings {
@@ -376,7 +376,7 @@ fn lockstep_gyro_runs_are_bit_identical_for_every_integrator() {
         digest(&r.states)
     };
     let mut hashes = Vec::new();
-    for m in flexdyn::dynamics::integrator::METHODS {
+    for m in flexdyn_dynamics::integrator::METHODS {
         let a = run(m);
         assert_eq!(run(m), a, "two {} lockstep runs differ", m.name);
         eprintln!("{}: sha256 {a}", m.name);
@@ -393,11 +393,11 @@ fn lockstep_gyro_runs_are_bit_identical_for_every_integrator() {
 /// wheels, star tracker `st1` and gyro `hub` at gains (K [N·m], P [N·m·s]): the server's report
 /// and every state recorded, sorted by tick.
 fn wheels_on_sensors_run(
-    cfg: flexdyn::config::SimConfig,
+    cfg: flexdyn_vehicle::config::SimConfig,
     run_s: f64,
     (k_nm, p_nms): (f64, f64),
     timeout: Duration,
-) -> (flexdyn::server::RunReport, Vec<(u64, Vec<u8>)>) {
+) -> (flexdyn_server::RunReport, Vec<(u64, Vec<u8>)>) {
     let topics = Topics::new("sc1").unwrap();
     let settings = ServerSettings {
         duration_ns: Some((run_s * 1e9) as u64),
@@ -450,7 +450,8 @@ fn lockstep_wheels_on_star_tracker_and_gyro_converge_and_are_bit_identical() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenarios/wheels_star_tracker.toml");
     let run = || {
-        let cfg = flexdyn::config::SimConfig::from_file(&path).expect("wheels_star_tracker.toml");
+        let cfg =
+            flexdyn_vehicle::config::SimConfig::from_file(&path).expect("wheels_star_tracker.toml");
         wheels_on_sensors_run(cfg, RUN_S, (K, P), Duration::from_secs(300))
     };
     let (report, a) = run();
@@ -543,7 +544,7 @@ fn sensor_closed_demo_runs_are_bit_identical_also_under_load() {
         .unwrap()
         .replace("omega_rad_s = 100.0", "omega_rad_s = 0.0");
     let run = || {
-        let cfg = flexdyn::config::SimConfig::from_toml_str(&toml).expect("wheels at rest");
+        let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(&toml).expect("wheels at rest");
         let (_, states) = wheels_on_sensors_run(cfg, RUN_S, (0.2, 1.0), Duration::from_secs(120));
         assert_eq!(states.len() as u64, (RUN_S * 100.0) as u64 + 1);
         let mut max_u = 0.0_f64;

@@ -17,9 +17,9 @@ use std::process::Command;
 use std::time::Duration;
 
 use crate::support::{endpoint, ChildGuard, Recorder, ServerHandle};
-use flexdyn::faults::failure_delay_ns;
-use flexdyn::server::ServerSettings;
+use flexdyn_faults::failure_delay_ns;
 use flexdyn_proto::{Mode, Topics};
+use flexdyn_server::ServerSettings;
 use sha2::{Digest, Sha256};
 
 const RUN_S: f64 = 10.0;
@@ -27,7 +27,7 @@ const MTBF_S: f64 = 4.0;
 const FRAME_NS: u64 = 10_000_000;
 
 /// The scenario with every fault; `seed` is the random fault's.
-fn config(seed: u64) -> flexdyn::config::SimConfig {
+fn config(seed: u64) -> flexdyn_vehicle::config::SimConfig {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenarios/wheels_star_tracker.toml");
     let faults = format!(
@@ -82,12 +82,12 @@ seed = {seed}
 "#
     );
     let text = std::fs::read_to_string(&path).unwrap() + &faults;
-    flexdyn::config::SimConfig::from_toml_str(&text).expect("the faulty scenario")
+    flexdyn_vehicle::config::SimConfig::from_toml_str(&text).expect("the faulty scenario")
 }
 
 /// One lockstep run (participants: the demo controller 1 and the recorder 2): the report and
 /// every state, sorted by tick.
-fn run(seed: u64) -> (flexdyn::server::RunReport, Vec<(u64, Vec<u8>)>) {
+fn run(seed: u64) -> (flexdyn_server::RunReport, Vec<(u64, Vec<u8>)>) {
     let topics = Topics::new("sc1").unwrap();
     let settings = ServerSettings {
         mode: Mode::Lockstep,

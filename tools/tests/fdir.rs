@@ -28,9 +28,9 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 use crate::support::{digest, endpoint, ChildGuard, Recorder, ServerHandle};
-use flexdyn::faults::{FaultMode, FaultSpec};
-use flexdyn::server::ServerSettings;
+use flexdyn_faults::{FaultMode, FaultSpec};
 use flexdyn_proto::{decode_state, Mode, Topics};
+use flexdyn_server::ServerSettings;
 use nalgebra::Vector3;
 
 const FRAME_S: f64 = 0.1;
@@ -64,9 +64,9 @@ struct Run {
     transcript: String,
 }
 
-fn scenario() -> flexdyn::config::SimConfig {
+fn scenario() -> flexdyn_vehicle::config::SimConfig {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/fdir.toml");
-    flexdyn::config::SimConfig::from_file(&path).expect("fdir.toml")
+    flexdyn_vehicle::config::SimConfig::from_file(&path).expect("fdir.toml")
 }
 
 /// The scenario's fault on `target`.
@@ -328,7 +328,7 @@ fn both_gyros_stuck_fall_back_to_star_tracker_rates() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/fdir.toml");
     let text = std::fs::read_to_string(&path).unwrap()
         + "\n[[faults]]\ntarget = \"imus.imu_b.gyro\"\nmode = \"stuck_current\"\nstart_s = 3.0\n";
-    let both = flexdyn::config::SimConfig::from_toml_str(&text)
+    let both = flexdyn_vehicle::config::SimConfig::from_toml_str(&text)
         .unwrap()
         .faults;
     let faults: Vec<FaultSpec> = both

@@ -20,12 +20,12 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use crate::support::{connecting_session, FleetServerHandle, Recorder};
-use flexdyn::server::ServerSettings;
-use flexdyn::world::FleetConfig;
 use flexdyn_proto::{
     decode_fault_event, decode_imu, decode_status, encode, FaultAction, FaultCommandMsg,
     FaultEventMsg, FaultSource, FaultTarget, Header, Mode, RunState, StatusMsg, Topics,
 };
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::world::FleetConfig;
 use zenoh::Wait;
 
 /// \[s\] simulated (100 Hz frames).

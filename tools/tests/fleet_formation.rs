@@ -7,7 +7,7 @@
 //!
 //! The deputy starts (3, +5, 2) m off its station, at rest in the Hill frame. The test measures
 //! the station error and the pointing error from the recorded states, with the dynamics
-//! library's own centre of mass and Hill frame (`flexdyn::world::relative`), and checks that
+//! library's own centre of mass and Hill frame (`flexdyn_vehicle::world::relative`), and checks that
 //! both runs' streams are the same bits.
 
 use flexdyn_testkit::demo_bin;
@@ -17,10 +17,10 @@ use std::process::Command;
 use std::time::Duration;
 
 use crate::support::{endpoint, ChildGuard, FleetServerHandle, Recorder};
-use flexdyn::attitude::mrp_to_dcm;
-use flexdyn::server::ServerSettings;
-use flexdyn::world::{relative_state_hill, FleetConfig};
+use flexdyn_kernel::attitude::mrp_to_dcm;
 use flexdyn_proto::{decode_state, Mode, StateMsg, Topics};
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::world::{relative_state_hill, FleetConfig};
 use nalgebra::Vector3;
 use sha2::{Digest, Sha256};
 
@@ -49,7 +49,7 @@ hill_position_m = [3.0, -95.0, 2.0]
 }
 
 struct Run {
-    result: Result<flexdyn::server::fleet::FleetReport, flexdyn::server::ServerError>,
+    result: Result<flexdyn_server::fleet::FleetReport, flexdyn_server::ServerError>,
     chief: Vec<(u64, Vec<u8>)>,
     deputy: Vec<(u64, Vec<u8>)>,
 }

@@ -14,9 +14,9 @@ use std::process::Command;
 use std::time::Duration;
 
 use crate::support::{endpoint, signal, ChildGuard, FleetServerHandle, Recorder};
-use flexdyn::server::{ServerError, ServerSettings};
-use flexdyn::world::FleetConfig;
 use flexdyn_proto::{decode_state, Mode, Topics};
+use flexdyn_server::{ServerError, ServerSettings};
+use flexdyn_vehicle::world::FleetConfig;
 use sha2::{Digest, Sha256};
 
 /// Simulated duration [s] (100 Hz frames).
@@ -82,7 +82,7 @@ enum Sabotage {
 }
 
 struct Run {
-    result: Result<flexdyn::server::fleet::FleetReport, ServerError>,
+    result: Result<flexdyn_server::fleet::FleetReport, ServerError>,
     chief: Vec<(u64, Vec<u8>)>,
     deputy: Vec<(u64, Vec<u8>)>,
 }
@@ -150,7 +150,7 @@ fn assert_complete(states: &[(u64, Vec<u8>)], spacecraft_id: u32) {
 /// |σ_BR| with the target σ_RN of the vehicle's controller.
 fn pointing_error(payload: &[u8], sigma_rn: [f64; 3]) -> f64 {
     let s = decode_state(payload).unwrap();
-    let e = flexdyn::attitude::mrp_error(
+    let e = flexdyn_kernel::attitude::mrp_error(
         &nalgebra::Vector3::from(s.sigma_bn),
         &nalgebra::Vector3::from(sigma_rn),
     );

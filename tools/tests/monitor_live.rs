@@ -7,10 +7,10 @@ mod support;
 use std::process::Command;
 use std::time::Duration;
 
-use flexdyn::config::SimConfig;
-use flexdyn::server::ServerSettings;
-use flexdyn::sim::Simulation;
 use flexdyn_proto::{eclipse, EnvironmentMsg};
+use flexdyn_server::ServerSettings;
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
 use support::{endpoint, ServerHandle};
 
 #[test]

@@ -9,9 +9,9 @@ use std::process::Command;
 use std::time::Duration;
 
 use crate::support::{endpoint, reference_config, ChildGuard, Recorder, ServerHandle};
-use flexdyn::server::ServerSettings;
-use flexdyn::sinks::reader::read_recording;
 use flexdyn_proto::{decode_command, decode_state, Mode, StateMsg, Topics};
+use flexdyn_server::ServerSettings;
+use flexdyn_sinks::reader::read_recording;
 use sha2::{Digest, Sha256};
 
 const DURATION_S: f64 = 20.0;

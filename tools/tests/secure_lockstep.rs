@@ -28,12 +28,12 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use crate::support::{endpoint, reference_config, ChildGuard, ServerHandle};
-use flexdyn::server::{ServerSettings, ZenohArgs};
-use flexdyn::transport::{zenoh_config, Role};
+use flexdyn_proto::client::transport::{zenoh_config, Role};
 use flexdyn_proto::{
     decode_state, decode_status, encode, CommandMsg, Header, Mode, RejectCounters, StatusMsg,
     Topics,
 };
+use flexdyn_server::{ServerSettings, ZenohArgs};
 use sha2::{Digest, Sha256};
 use zenoh::{Session, Wait};
 
@@ -183,7 +183,7 @@ fn only_the_authenticated_flight_code_commands_the_spacecraft() {
     let s = settings(&[(1, "fsw")], true);
     // The server's own start-up check (as `flexdyn run` makes it) accepts the shipped files.
     let zcfg = config(0, Role::Server, Some(server_file));
-    flexdyn::server::access::check(&zcfg, &s).expect("the shipped ACL binds sender 1 to fsw");
+    flexdyn_server::access::check(&zcfg, &s).expect("the shipped ACL binds sender 1 to fsw");
     let server = ServerHandle::start_with_session(open(zcfg), s, reference_config(100.0));
     let port = server.port;
 
@@ -337,7 +337,7 @@ fn a_participant_claiming_another_ones_sender_id_is_rejected_and_counted() {
     let acl = two_participant_acl();
     let s = settings(&[(1, "fsw"), (2, "operator")], true);
     let zcfg = config(0, Role::Server, Some(acl.clone()));
-    flexdyn::server::access::check(&zcfg, &s).expect("the test ACL binds 1 to fsw, 2 to operator");
+    flexdyn_server::access::check(&zcfg, &s).expect("the test ACL binds 1 to fsw, 2 to operator");
     let server = ServerHandle::start_with_session(open(zcfg), s, reference_config(100.0));
     let port = server.port;
 

@@ -11,7 +11,7 @@
 //!
 //! The two original appended bodies (panel pairs, reaction wheels) are listed in the registry for
 //! every generic use (telemetry names, campaign sections, CSV) but keep their typed fields in
-//! `flexdyn::config::SimConfig` (`panel_pairs`, `reaction_wheels`): their plausibility checks
+//! `flexdyn_vehicle::config::SimConfig` (`panel_pairs`, `reaction_wheels`): their plausibility checks
 //! compare them with the hub and the step across kinds (mass ratios, hinge frequencies) and
 //! every test of the paper's system reads them by type. Their [`ComponentKind::reader`] is
 //! `None`.

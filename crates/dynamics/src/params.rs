@@ -1,7 +1,7 @@
 //! Validated physical parameters of the spacecraft: the hub, gravity and the forcing (the
 //! validation helpers they use live in the leaf module [`flexdyn_kernel::validate`]).
 //!
-//! These are plain data. They are built by `flexdyn::config` (which validates them and reports
+//! These are plain data. They are built by `flexdyn_vehicle::config` (which validates them and reports
 //! errors that name the field) or directly in code, and consumed once by
 //! [`crate::Spacecraft::new`], which validates them again (cheaply) so a hand-built
 //! parameter set can never reach the stepping hot path unchecked.

@@ -4,7 +4,7 @@
 //!
 //! Every model here is a leaf: it takes plain inputs (a time as Julian centuries of TT since
 //! J2000.0, a decimal year, or a day of year and UT seconds; positions in the frame its
-//! argument names) and imports nothing from `flexdyn_dynamics`, `flexdyn::config` or the server.
+//! argument names) and imports nothing from `flexdyn_dynamics`, `flexdyn_vehicle::config` or the server.
 //! The functions the stepping loop calls allocate nothing, lock nothing and cannot panic; what can
 //! be wrong with a model's parameters is checked once, when it is built, and reported as a typed
 //! error.

@@ -9,13 +9,13 @@
 //! - [`window`]: when a fault is active (start, duration or open-ended, period); a random
 //!   fault (`mtbf_s`) starts at a time to failure drawn from its seed at load
 //!   ([`failure_delay_ns`]);
-//! - [`ports`]: the per-vehicle runtime ([`Faults`]) that `flexdyn::sim::Simulation` calls at its
+//! - [`ports`]: the per-vehicle runtime ([`Faults`]) that `flexdyn_vehicle::sim::Simulation` calls at its
 //!   two ports; it allocates nothing, locks nothing and cannot fail. It also notes each fault's
 //!   activation and clearance at the frame boundaries (the server's FaultEventMsg);
 //! - [`live`]: live faults (`flexdyn/<sc>/fault`), checked off the physics thread by the same
 //!   resolution as `[[faults]]` and handed over ready-made;
 //! - [`link`]: command-link faults (`links.<sender id>`), applied where the server takes a
-//!   participant's commands in (`flexdyn::server::commands::CommandBook`).
+//!   participant's commands in (`flexdyn_server::commands::CommandBook`).
 //!
 //! Which modes apply is stated by each kind: a sensor through
 //! [`flexdyn_sensors::Sensor::fault_channels`] and [`flexdyn_sensors::Sensor::has_validity`], an

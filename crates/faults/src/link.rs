@@ -1,6 +1,6 @@
 //! Command-link faults: `[[faults]]` entries whose target is `links.<sender id>`, a participant
 //! of `server.participants`. They sit where the server takes that participant's commands in (the
-//! command book, `flexdyn::server::commands::CommandBook`), never in the physics, and are evaluated
+//! command book, `flexdyn_server::commands::CommandBook`), never in the physics, and are evaluated
 //! at the tick a command answers (t = k · frame period), so in lockstep they act on the same
 //! ticks run after run.
 //!

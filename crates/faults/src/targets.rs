@@ -4,7 +4,7 @@
 //! nanoseconds. Every error names the entry's field; nothing is silently ignored. A command
 //! link (`links.<sender id>`) must be one of the file's `server.participants` (default `[1]`);
 //! the server checks again against its final participants (command-line overrides included).
-//! The configuration (`flexdyn::config`) calls [`resolve_one`] for each entry with the vehicle it
+//! The configuration (`flexdyn_vehicle::config`) calls [`resolve_one`] for each entry with the vehicle it
 //! built.
 
 use super::modes::{FaultMode, LINK_MODES, MODES, SENSOR_MODES, VALUE_MODES};

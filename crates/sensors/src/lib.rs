@@ -8,7 +8,7 @@
 //! Every sensor is sampled at a frame boundary (or, for a sensor that integrates over an
 //! interval, at each output instant) from the same truth, a [`Truth`]: the state and the one
 //! evaluation of the hub outputs that the frame's snapshot also uses
-//! (`flexdyn::sim::Simulation` caches it), plus the environment sample when there is one, so
+//! (`flexdyn_vehicle::sim::Simulation` caches it), plus the environment sample when there is one, so
 //! adding sensors adds no equation-of-motion evaluations. The [`SensorBank`] holds a spacecraft's
 //! sensors in registry order, then config order, which is also their publication order.
 //!
@@ -148,7 +148,7 @@ pub trait Sensor: std::fmt::Debug + Send {
 
     /// Its numeric parameters as built, by key relative to its configuration entry
     /// (`noise_sigma_t`, `bias_s_t[0]`), for a campaign's read-back of dispersed values
-    /// (`flexdyn::campaign::plan::readback`). Not on the stepping path. None by default: a
+    /// (`flexdyn_campaign::plan::readback`). Not on the stepping path. None by default: a
     /// kind that lists none cannot be dispersed (the campaign rejects its keys at load time).
     fn parameters(&self, _out: &mut Vec<(String, f64)>) {}
 

@@ -4,7 +4,7 @@
 //! a released `127.0.0.1:0` socket can be taken meanwhile, e.g. as the ephemeral source port of
 //! some other connection).
 //!
-//! - In-process Zenoh sessions read their port back with `flexdyn::transport::listening_on`.
+//! - In-process Zenoh sessions read their port back with `flexdyn_proto::client::transport::listening_on`.
 //! - `flexdyn run` and `flexdyn replay` log `Zenoh listening on tcp/127.0.0.1:PORT`
 //!   ([`zenoh_endpoint`]); `flexdyn view` logs `… on ws://127.0.0.1:PORT` ([`ws_port`]). Both are
 //!   `info` lines on stderr, so [`reporting`] pipes stderr and sets `RUST_LOG=info`.

@@ -19,20 +19,19 @@ pub use server_support::{
 };
 
 /// Every StateMsg payload seen, with its tick.
-pub type Recorded = flexdyn::campaign::execute::Received;
+pub type Recorded = flexdyn_campaign::execute::Received;
 
 /// A passive lockstep participant living in the test process: records every state payload and
 /// answers it with `NoCommand` as `sender_id` (the campaign's observer). Keep it alive.
 pub struct Recorder {
     pub states: Recorded,
-    _observer: flexdyn::campaign::execute::Observer,
+    _observer: flexdyn_campaign::execute::Observer,
 }
 
 impl Recorder {
     pub fn start(port: u16, topics: &Topics, sender_id: u32) -> Self {
         let observer =
-            flexdyn::campaign::execute::Observer::start(&endpoint(port), topics, sender_id)
-                .unwrap();
+            flexdyn_campaign::execute::Observer::start(&endpoint(port), topics, sender_id).unwrap();
         Self {
             states: observer.states.clone(),
             _observer: observer,

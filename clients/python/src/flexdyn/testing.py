@@ -45,7 +45,7 @@ def find_binary() -> Path:
 
 
 LISTENING = "Zenoh listening on "
-"""The start of the line the server logs once it is reachable (`flexdyn::transport::log_listening`)."""
+"""The start of the line the server logs once it is reachable (`flexdyn_proto::client::transport::log_listening`)."""
 
 
 def reported_endpoint(log: str) -> Optional[str]:

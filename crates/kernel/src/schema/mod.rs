@@ -3,7 +3,7 @@
 //! A leaf module (it imports nothing else of this crate but [`crate::numfmt`] and
 //! [`crate::validate`]), so a model's schema can live beside the model
 //! (`crates/dynamics/src/effectors/<kind>/schema.rs`, `crates/sensors/src/<kind>/schema.rs`) and report a
-//! located [`config_error::ConfigError`] without an import cycle through `flexdyn::config`,
+//! located [`config_error::ConfigError`] without an import cycle through `flexdyn_vehicle::config`,
 //! which assembles the schemas and validates the whole document. The [`source_map`] locates a
 //! TOML path in the text, and [`checks`] holds the checks every schema shares.
 

@@ -14,7 +14,7 @@
 //! - integers outside TOML's 64-bit range are named as such.
 //!
 //! Non-finite floats (`nan`, `inf`) are read as such; the whole-document finiteness pass that
-//! runs after the structure pass reports them (see the module docs of `flexdyn::config`).
+//! runs after the structure pass reports them (see the module docs of `flexdyn_vehicle::config`).
 
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;

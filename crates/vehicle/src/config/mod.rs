@@ -490,7 +490,7 @@ impl RawConfig {
             schedule::RawInputRow::read,
         )?;
         // `[server]` is read and validated by the server's own schema
-        // (`flexdyn::server::settings`); here it only has to be a table. `check-config` runs
+        // (`flexdyn_server::settings`); here it only has to be a table. `check-config` runs
         // that schema too.
         let server = if root.is_table("server")? {
             let full: toml::Table =

@@ -120,7 +120,7 @@ impl World {
     }
 
     /// The vehicles, taken out of the world (the server steps each with its own command book
-    /// and telemetry, on one physics thread: `flexdyn::server::fleet`).
+    /// and telemetry, on one physics thread: `flexdyn_server::fleet`).
     pub fn into_vehicles(self) -> Vec<Vehicle> {
         self.vehicles
     }
