@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
-use flexdyn::cli::simulate_to;
+use flexdyn::commands::simulate::simulate_to;
 use flexdyn_vehicle::config::SimConfig;
 use flexdyn_vehicle::sim::Simulation;
 

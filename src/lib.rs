@@ -20,16 +20,16 @@
 //!   batch propagation;
 //! - `flexdyn-campaign` ([`campaign`]): Monte Carlo campaigns with flight code in the loop.
 //!
-//! This crate is the `flexdyn` binary's library half: what sits above the layers.
-//! - [`cli`]: the offline front end `flexdyn simulate` (and `check-config`);
-//! - [`world::run`]: the offline front end `flexdyn fleet`.
+//! This crate is the `flexdyn` binary's library half: [`commands`], one file per subcommand
+//! (`run`, `simulate`, `fleet`, `check-config`, `record`, `replay`, `export`, `view`, `plot`,
+//! `campaign`, …), each a thin front end over the layer that does the work. `simulate` and
+//! `fleet` step through the vehicle layer's one offline loop
+//! (`flexdyn_vehicle::world::offline::walk`) and only format rows.
 //!
-//! Both step through the vehicle layer's one offline loop
-//! (`flexdyn_vehicle::world::offline::walk`) and only format rows. Use the layers by their own
-//! crate names (`flexdyn_server::run`, `flexdyn_vehicle::config::SimConfig`, …): the old
-//! `flexdyn::<layer>` paths were re-exports while the crates were cut, and are gone.
+//! Use the layers by their own crate names (`flexdyn_server::run`,
+//! `flexdyn_vehicle::config::SimConfig`, …): the old `flexdyn::<layer>` paths were re-exports
+//! while the crates were cut, and are gone.
 
 #![warn(missing_docs)]
 
-pub mod cli;
-pub mod world;
+pub mod commands;

@@ -1,18 +1,16 @@
-//! The `flexdyn` command-line entry point: parses arguments, initialises logging and calls the
-//! library. Every error is reported as one `error: …` line on stderr with a non-zero exit code
-//! (2 for invalid input, 1 for a failure while running; `flexdyn record` exits 3 when the file
-//! it wrote is incomplete); nothing here panics on bad input.
+//! The `flexdyn` command-line entry point: parses the arguments, sets up logging and calls the
+//! subcommand's `main` (one file per subcommand under `src/commands/`), which prints its summary
+//! or its one `error: …` line and returns the exit code (2 for invalid input, 1 for a failure
+//! while running; `flexdyn record` exits 3 when the file it wrote is incomplete). Nothing here
+//! panics on bad input.
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use flexdyn::cli::{self, CliError, SimulateArgs};
-use flexdyn_proto::client::logging::print_error;
-use flexdyn_server::cli::{run_from_args, RunArgs};
-use flexdyn_sinks::{self as sinks, SinkError};
-use flexdyn_vehicle::config::DEFAULT_CONFIG_TOML;
+use flexdyn::commands;
+use flexdyn_server::cli::RunArgs;
+use flexdyn_sinks::{export, plot, record_cmd, replay, view};
 
 /// Real-time flight-software-in-the-loop spacecraft dynamics: rigid hub + dual-hinged panels.
 ///
@@ -40,10 +38,10 @@ enum Command {
     /// flight code over Zenoh, in real time, lockstep or batch.
     Run(Box<RunArgs>),
     /// Propagate a configuration offline and write the state history as CSV.
-    Simulate(SimulateArgs),
+    Simulate(commands::simulate::SimulateArgs),
     /// Propagate a fleet file (several spacecraft, one tick) offline: states and relative
     /// states as CSV.
-    Fleet(flexdyn::world::run::FleetArgs),
+    Fleet(commands::fleet::FleetArgs),
     /// Validate a configuration file and print a one-line summary (exit 2 if invalid).
     CheckConfig {
         /// The configuration file (TOML).
@@ -52,63 +50,18 @@ enum Command {
     /// Print the embedded default configuration (scenarios/reference.toml) verbatim.
     PrintDefaultConfig,
     /// Record every sample of flexdyn/<sc-id>/** (all vehicles by default) to an MCAP file.
-    Record(sinks::record_cmd::RecordArgs),
+    Record(record_cmd::RecordArgs),
     /// Republish a recording's raw channels to Zenoh with the recorded spacing.
-    Replay(sinks::replay::ReplayArgs),
+    Replay(replay::ReplayArgs),
     /// Write one CSV per topic of a recording.
-    Export(sinks::export::ExportArgs),
+    Export(export::ExportArgs),
     /// Serve the live stream (or a recording) to Foxglove over its WebSocket protocol.
-    View(sinks::view::ViewArgs),
+    View(view::ViewArgs),
     /// Draw PNG figures of a recording or a simulate/export CSV.
-    Plot(sinks::plot::PlotArgs),
+    Plot(plot::PlotArgs),
     /// Monte Carlo campaigns: plan, run (locally or one index at a time), summarize.
     #[command(subcommand)]
     Campaign(flexdyn_campaign::CampaignCommand),
-}
-
-/// Runs a sink subcommand and prints its one-line summary on stderr.
-fn run_sink<T>(result: Result<T, SinkError>, summary: impl FnOnce(&T) -> String) -> ExitCode {
-    match result {
-        Ok(r) => {
-            let _ = writeln!(std::io::stderr(), "{}", summary(&r));
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            print_error(&e);
-            ExitCode::from(e.exit_code())
-        }
-    }
-}
-
-fn print_default_config() -> Result<(), CliError> {
-    let mut out = std::io::stdout().lock();
-    out.write_all(DEFAULT_CONFIG_TOML.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(|source| CliError::Output {
-            target: "stdout".into(),
-            source,
-        })
-}
-
-/// `flexdyn run`: the server until its duration, a signal or an error. Exit code 0 on success,
-/// 2 for invalid settings or configuration, 1 for a failure while running.
-fn run_server(args: &RunArgs) -> ExitCode {
-    if let Some(fleet) = &args.fleet {
-        return match flexdyn_server::fleet::run_from_args(args, fleet) {
-            Ok(_report) => ExitCode::SUCCESS,
-            Err(e) => {
-                print_error(&e);
-                ExitCode::from(e.exit_code())
-            }
-        };
-    }
-    match run_from_args(args) {
-        Ok(_report) => ExitCode::SUCCESS,
-        Err(e) => {
-            print_error(&e);
-            ExitCode::from(e.exit_code())
-        }
-    }
 }
 
 fn main() -> ExitCode {
@@ -120,130 +73,21 @@ fn main() -> ExitCode {
         // Each run's server would log its start and end at info: keep the progress bar readable.
         flexdyn_proto::client::logging::init_tracing_at("warn");
     } else {
-        flexdyn::cli::init_tracing();
+        flexdyn_proto::client::logging::init_tracing();
     }
-    let result = match args.command {
-        Some(Command::Simulate(a)) => cli::simulate(&a).map(|report| {
-            let _ = writeln!(std::io::stderr(), "{report}");
-        }),
-        Some(Command::CheckConfig { file }) => cli::check_config(&file).and_then(|summary| {
-            let mut out = std::io::stdout().lock();
-            writeln!(out, "{summary}")
-                .and_then(|()| out.flush())
-                .map_err(|source| CliError::Output {
-                    target: "stdout".into(),
-                    source,
-                })
-        }),
-        Some(Command::PrintDefaultConfig) => print_default_config(),
-        Some(Command::Record(a)) => {
-            let result = sinks::record_cmd::record(&a);
-            let incomplete = result.as_ref().is_ok_and(|r| !r.complete());
-            let code = run_sink(result, |r| {
-                format!(
-                    "recorded {} samples ({} payload bytes, {} undecodable) to {}; dropped {}; {}",
-                    r.stats.samples,
-                    r.stats.payload_bytes,
-                    r.stats.undecodable,
-                    a.output.display(),
-                    r.dropped,
-                    r.completeness()
-                )
-            });
-            // The file is written and readable, but it is not the whole stream.
-            return if incomplete { ExitCode::from(3) } else { code };
-        }
-        Some(Command::Replay(a)) => {
-            return run_sink(sinks::replay::replay(&a), |r| {
-                format!(
-                    "replayed {} samples in {:.3} s{}{}",
-                    r.published,
-                    r.wall_s,
-                    if r.unheard > 0 {
-                        format!(
-                            "; {} of them while no subscriber matched their key (nobody \
-                             received those)",
-                            r.unheard
-                        )
-                    } else {
-                        String::new()
-                    },
-                    r.truncated
-                        .as_ref()
-                        .map_or(String::new(), |why| format!(" (file ends early: {why})"))
-                )
-            })
-        }
-        Some(Command::Campaign(c)) => {
-            return match flexdyn_campaign::main(&c) {
-                Ok(report) => {
-                    let _ = writeln!(std::io::stderr(), "{}", report.text);
-                    ExitCode::from(report.exit_code)
-                }
-                Err((code, message)) => {
-                    let _ = writeln!(std::io::stderr(), "error: {message}");
-                    ExitCode::from(code)
-                }
-            }
-        }
-        Some(Command::Plot(a)) => {
-            return run_sink(sinks::plot::plot(&a), |r| {
-                let mut lines: Vec<String> = r
-                    .written
-                    .iter()
-                    .map(|p| format!("wrote {}", p.display()))
-                    .collect();
-                lines.extend(
-                    r.skipped
-                        .iter()
-                        .map(|(f, why)| format!("skipped {f}: {why}")),
-                );
-                lines.join("\n")
-            })
-        }
-        Some(Command::View(a)) => {
-            return run_sink(sinks::view::view(&a), |r| {
-                format!(
-                    "viewer on port {} stopped after {} samples",
-                    r.port, r.samples
-                )
-            })
-        }
-        Some(Command::Export(a)) => {
-            return run_sink(sinks::export::export(&a), |r| {
-                r.iter()
-                    .map(|(p, n)| format!("{}: {n} rows", p.display()))
-                    .collect::<Vec<_>>()
-                    .join("\n")
-            })
-        }
-        Some(Command::Fleet(a)) => {
-            return match flexdyn::world::run::fleet(&a) {
-                Ok(r) => {
-                    let _ = writeln!(
-                        std::io::stderr(),
-                        "propagated {} vehicles for {} steps; wrote {} rows",
-                        r.vehicles,
-                        r.steps,
-                        r.rows
-                    );
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    print_error(&e);
-                    ExitCode::from(e.exit_code())
-                }
-            }
-        }
-        Some(Command::Run(a)) => return run_server(&a),
+    match args.command {
+        Some(Command::Run(a)) => commands::run::main(&a),
         // No subcommand: `flexdyn run` with the options given.
-        None => return run_server(&args.run),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            print_error(&e);
-            ExitCode::from(e.exit_code())
-        }
+        None => commands::run::main(&args.run),
+        Some(Command::Simulate(a)) => commands::simulate::main(&a),
+        Some(Command::Fleet(a)) => commands::fleet::main(&a),
+        Some(Command::CheckConfig { file }) => commands::check_config::main(&file),
+        Some(Command::PrintDefaultConfig) => commands::print_default_config::main(),
+        Some(Command::Record(a)) => commands::record::main(&a),
+        Some(Command::Replay(a)) => commands::replay::main(&a),
+        Some(Command::Export(a)) => commands::export::main(&a),
+        Some(Command::View(a)) => commands::view::main(&a),
+        Some(Command::Plot(a)) => commands::plot::main(&a),
+        Some(Command::Campaign(c)) => commands::campaign::main(&c),
     }
 }

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use flexdyn::cli::simulate_to;
+use flexdyn::commands::simulate::simulate_to;
 use flexdyn_proto::{encode, Header, ImuMsg};
 use flexdyn_sensors::imu::{attitude_increment_b, ImuSample};
 use flexdyn_vehicle::config::SimConfig;

@@ -16,7 +16,7 @@
 
 use std::path::Path;
 
-use flexdyn::cli::simulate_to;
+use flexdyn::commands::simulate::simulate_to;
 use flexdyn_vehicle::config::SimConfig;
 use sha2::{Digest, Sha256};
 

@@ -387,7 +387,7 @@ fn telemetry_rate_errors_name_the_field() {
 fn simulate_writes_consistent_environment_columns() {
     let cfg = rigid_leo();
     let mut out = Vec::new();
-    flexdyn::cli::simulate_to(&cfg, 1.0, 0.1, &mut out, "test").unwrap();
+    flexdyn::commands::simulate::simulate_to(&cfg, 1.0, 0.1, &mut out, "test").unwrap();
     let text = String::from_utf8(out).unwrap();
     let mut lines = text.lines().skip_while(|l| l.starts_with('#'));
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -439,7 +439,7 @@ fn simulate_writes_consistent_environment_columns() {
     let plain =
         SimConfig::from_toml_str(&cfg.source_toml.replace("telemetry_rate_hz = 10.0", "")).unwrap();
     let mut out = Vec::new();
-    flexdyn::cli::simulate_to(&plain, 0.1, 0.1, &mut out, "test").unwrap();
+    flexdyn::commands::simulate::simulate_to(&plain, 0.1, 0.1, &mut out, "test").unwrap();
     let text = String::from_utf8(out).unwrap();
     assert!(
         !text.contains("env_"),

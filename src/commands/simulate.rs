@@ -1,26 +1,24 @@
-//! The offline subcommands of the `flexdyn` binary: `simulate`, `check-config` and
-//! `print-default-config`. `src/main.rs` only parses arguments and reports errors; the work is
-//! here so tests can call it.
+//! `flexdyn simulate`: propagates a configuration offline through the vehicle layer's offline
+//! loop ([`walk`], a world of one) and writes the state history, the scheduled wrench, the
+//! environment record and the sensors as CSV.
 
 use std::fmt;
 use std::io::{self, Write};
 use std::num::NonZeroU64;
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::time::Instant;
 
 use flexdyn_proto::{command_flags, AppliedWrench, EnvironmentMsg, Header, StateMsg};
 
-use flexdyn_kernel::numfmt::Num;
+use super::{exit, load, summary, whole_steps, CliError};
 use flexdyn_sensors::Sensor;
-use flexdyn_server::error::SettingsError;
 use flexdyn_server::settings::ServerSettings;
 use flexdyn_sinks::table::{
     first_non_finite_column, prefixed_columns, state_row, Column, CsvTable,
     ENVIRONMENT_COLUMN_PREFIX,
 };
-use flexdyn_vehicle::config::{
-    config_message, log_warnings, warning_message, whole_ns, ConfigError, SimConfig,
-};
+use flexdyn_vehicle::config::{log_warnings, SimConfig};
 use flexdyn_vehicle::sim::Simulation;
 use flexdyn_vehicle::world::{walk, RowPlan, RowSink, World};
 
@@ -64,68 +62,6 @@ impl Default for SimulateArgs {
     }
 }
 
-/// An error of an offline subcommand.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum CliError {
-    /// The configuration is invalid or unreadable.
-    #[error("{}", config_message(file.as_deref(), source))]
-    Config {
-        /// The file, or `None` for the embedded default.
-        file: Option<PathBuf>,
-        /// The error; it names the field.
-        #[source]
-        source: ConfigError,
-    },
-    /// A command-line value is invalid.
-    #[error("{flag}: {problem}")]
-    Arg {
-        /// The option, e.g. `--log-every-s`.
-        flag: &'static str,
-        /// What is wrong.
-        problem: String,
-    },
-    /// The `[server]` table is invalid (checked by `check-config`, as `run` would); the error
-    /// names the file, `server.<key>` and its line.
-    #[error(transparent)]
-    Settings(#[from] SettingsError),
-    /// The propagated state stopped being finite; the row was not written.
-    #[error(
-        "the state became non-finite at step {step} (t = {} s): {quantity} is NaN or infinite; \
-         stopping without writing that row (check the configuration's rates, stiffnesses and \
-         wrenches for values the step cannot resolve)",
-        Num(*t_s)
-    )]
-    NonFinite {
-        /// The RK4 step count at the row.
-        step: u64,
-        /// \[s\] simulation time of the row.
-        t_s: f64,
-        /// The first non-finite quantity, by its CSV column name.
-        quantity: String,
-    },
-    /// Writing the output failed.
-    #[error("cannot write {target}: {source}")]
-    Output {
-        /// Where the output was going.
-        target: String,
-        /// The I/O error.
-        #[source]
-        source: io::Error,
-    },
-}
-
-impl CliError {
-    /// The process exit code for this error: 2 for invalid input (configuration or arguments),
-    /// 1 for a failure while running (output not writable).
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            CliError::Config { .. } | CliError::Arg { .. } | CliError::Settings(_) => 2,
-            CliError::Output { .. } | CliError::NonFinite { .. } => 1,
-        }
-    }
-}
-
 /// What `simulate` did.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SimulateReport {
@@ -159,46 +95,6 @@ impl fmt::Display for SimulateReport {
             self.wall_s,
             self.steps_per_s()
         )
-    }
-}
-
-/// [`flexdyn_vehicle::config::load_config`], its error as a [`CliError::Config`] naming the file.
-fn load(path: Option<&Path>) -> Result<SimConfig, CliError> {
-    flexdyn_vehicle::config::load_config(path).map_err(|source| CliError::Config {
-        file: path.map(Path::to_path_buf),
-        source,
-    })
-}
-
-/// A duration option as a whole number of steps.
-pub(crate) fn whole_steps(
-    flag: &'static str,
-    seconds: f64,
-    step_ns: u64,
-    allow_zero: bool,
-) -> Result<u64, CliError> {
-    let step_s = step_ns as f64 * 1e-9;
-    if !seconds.is_finite() {
-        return Err(CliError::Arg {
-            flag,
-            problem: format!("must be finite (got {seconds})"),
-        });
-    }
-    if seconds < 0.0 || (!allow_zero && seconds == 0.0) {
-        let bound = if allow_zero { ">= 0" } else { "> 0" };
-        return Err(CliError::Arg {
-            flag,
-            problem: format!("must be {bound} (got {seconds})"),
-        });
-    }
-    match whole_ns(seconds) {
-        Some(ns) if ns % step_ns == 0 => Ok(ns / step_ns),
-        _ => Err(CliError::Arg {
-            flag,
-            problem: format!(
-                "{seconds} s is not a whole number of RK4 steps (step = {step_s} s = {step_ns} ns)"
-            ),
-        }),
     }
 }
 
@@ -468,30 +364,16 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
     }
 }
 
-/// `flexdyn check-config FILE`: parses, validates and builds the spacecraft; returns one
-/// `warning: FILE: field: …` line per implausible value ([`SimConfig::warnings`]: legal, but
-/// almost surely a unit slip), then the summary line `ok: FILE: …`.
-///
-/// It runs every check that `flexdyn run` and `flexdyn simulate` run on a file, the `[server]`
-/// table's included (keys, values, cross-setting rules, and a duration that is a whole number of
-/// frames), and says `ok` only when all pass. Warnings do not make it fail.
-pub fn check_config(path: &Path) -> Result<String, CliError> {
-    let cfg = load(Some(path))?;
-    cfg.build_spacecraft().map_err(|source| CliError::Config {
-        file: Some(path.to_path_buf()),
-        source,
-    })?;
-    ServerSettings::resolve(&cfg, Some(path), &[])?;
-    let mut out = String::new();
-    for w in cfg.warnings() {
-        out.push_str(&format!("warning: {}\n", warning_message(Some(path), &w)));
+/// `flexdyn simulate`: the CSV, then `steps=… wall_s=… steps_per_s=…` on stderr.
+pub fn main(args: &SimulateArgs) -> ExitCode {
+    match exit(simulate(args), CliError::exit_code) {
+        Ok(report) => {
+            summary(report);
+            ExitCode::SUCCESS
+        }
+        Err(code) => code,
     }
-    out.push_str(&format!("ok: {}: {}", path.display(), cfg.summary()));
-    Ok(out)
 }
-
-/// Logs to stderr at `RUST_LOG` (default `info`); see [`flexdyn_proto::client::logging::init_tracing`].
-pub use flexdyn_proto::client::logging::init_tracing;
 
 #[cfg(test)]
 mod tests {

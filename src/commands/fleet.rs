@@ -16,7 +16,9 @@ use std::path::PathBuf;
 
 use nalgebra::Vector3;
 
-use crate::cli::{whole_steps, CliError};
+use std::process::ExitCode;
+
+use super::{exit, summary, whole_steps, CliError};
 use flexdyn_vehicle::world::relative::com_state_n;
 use flexdyn_vehicle::world::{walk, FleetConfig, FleetError, RowPlan, RowSink, World};
 
@@ -197,6 +199,20 @@ fn row(world: &World, line: &mut String) {
 fn push(line: &mut String, x: &Vector3<f64>) {
     for c in x.iter() {
         let _ = write!(line, ",{c}");
+    }
+}
+
+/// `flexdyn fleet`: the CSV, then what was propagated on stderr.
+pub fn main(args: &FleetArgs) -> ExitCode {
+    match exit(fleet(args), FleetRunError::exit_code) {
+        Ok(r) => {
+            summary(format_args!(
+                "propagated {} vehicles for {} steps; wrote {} rows",
+                r.vehicles, r.steps, r.rows
+            ));
+            ExitCode::SUCCESS
+        }
+        Err(code) => code,
     }
 }
 
