@@ -6,9 +6,8 @@
 //! The real-time suites, which measure pacing on the wall clock, are their own executable
 //! (`realtime.rs` in this folder), so that nothing here runs beside them.
 
-// Shared with `realtime.rs`.
-#[allow(dead_code)]
-mod server_support;
+// The end-to-end harness, shared with the other suites (`crates/testkit-server`).
+use flexdyn_testkit_server::server as server_support;
 
 mod environment_message;
 mod faults_config;

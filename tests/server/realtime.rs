@@ -3,8 +3,7 @@
 //! the heavier lockstep suites of `main.rs`. The hard real-time settings
 //! (`server_hard_realtime.rs`) are a third executable: `mlockall` is process-wide.
 
-#[allow(dead_code)]
-mod server_support;
+use flexdyn_testkit_server::server as server_support;
 
 mod fleet_realtime;
 mod server_realtime;

@@ -2,8 +2,7 @@
 //! `realtime_priority`) do what they say on a real run, and a setting the OS refuses stops the
 //! run at start naming the setting. Its own test binary: `mlockall` is process-wide.
 
-#[allow(dead_code)]
-mod server_support;
+use flexdyn_testkit_server::server as server_support;
 
 use std::time::Duration;
 

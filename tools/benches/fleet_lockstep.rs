@@ -16,8 +16,7 @@
 
 use flexdyn_testkit::demo_bin;
 use flexdyn_testkit::median_mut;
-#[path = "../tests/support/mod.rs"]
-mod support;
+use flexdyn_testkit_server as support;
 
 use std::path::Path;
 use std::process::Command;

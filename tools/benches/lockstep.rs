@@ -21,8 +21,7 @@
 
 use flexdyn_testkit::demo_bin;
 use flexdyn_testkit::median_mut;
-#[path = "../tests/support/mod.rs"]
-mod support;
+use flexdyn_testkit_server as support;
 
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -30,7 +29,7 @@ use std::time::{Duration, Instant};
 use flexdyn_proto::Mode;
 use flexdyn_server::{Handoff, ServerSettings};
 use flexdyn_vehicle::sim::Simulation;
-use support::{endpoint, pingpong_rtts, reference_config, ChildGuard, ServerHandle};
+use support::{endpoint, reference_config, ChildGuard, ServerHandle};
 
 fn env_usize(name: &str, default: usize) -> usize {
     std::env::var(name)
@@ -158,4 +157,11 @@ fn main() {
         1e6 / b
     );
     println!("physics alone per frame: {phys1:.1} us (1 step), {phys10:.1} us (10 steps)");
+}
+
+/// Round-trip times of `count` StateMsg-sized pings after `warmup` ones, against a
+/// `flexdyn-pingpong pong` child ([`flexdyn_tools::pingpong::round_trips`]).
+fn pingpong_rtts(warmup: usize, count: usize, recv_loop: bool) -> Vec<Duration> {
+    let pong = std::path::Path::new(env!("CARGO_BIN_EXE_flexdyn-pingpong"));
+    flexdyn_tools::pingpong::round_trips(pong, warmup, count, recv_loop).expect("ping-pong")
 }

@@ -31,8 +31,7 @@
 
 use flexdyn_testkit::demo_bin;
 use flexdyn_testkit::median;
-#[path = "../tests/support/mod.rs"]
-mod support;
+use flexdyn_testkit_server as support;
 
 use std::process::Command;
 use std::sync::{Arc, Mutex};
@@ -42,9 +41,7 @@ use flexdyn_proto::client::transport::unix_now_ns;
 use flexdyn_proto::{decode_state, Topics};
 use flexdyn_server::{frame_stamp_ns, Handoff, ServerSettings};
 use flexdyn_tools::percentile;
-use support::{
-    connecting_session, endpoint, pingpong_rtts, reference_config, ChildGuard, ServerHandle,
-};
+use support::{connecting_session, endpoint, reference_config, ChildGuard, ServerHandle};
 use zenoh::Wait;
 
 /// What one real-time round measured.
@@ -288,4 +285,11 @@ fn main() {
         .map(|(_, d)| d)
         .sum();
     println!("recorder drops over all rounds: {dropped}");
+}
+
+/// Round-trip times of `count` StateMsg-sized pings after `warmup` ones, against a
+/// `flexdyn-pingpong pong` child ([`flexdyn_tools::pingpong::round_trips`]).
+fn pingpong_rtts(warmup: usize, count: usize, recv_loop: bool) -> Vec<Duration> {
+    let pong = std::path::Path::new(env!("CARGO_BIN_EXE_flexdyn-pingpong"));
+    flexdyn_tools::pingpong::round_trips(pong, warmup, count, recv_loop).expect("ping-pong")
 }

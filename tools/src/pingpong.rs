@@ -170,3 +170,62 @@ pub fn ping(
     }
     Ok(rtts)
 }
+
+/// Round-trip times of `count` StateMsg-sized pings (after `warmup` unmeasured ones) from a
+/// session listening on a loopback port the OS chose to a `flexdyn-pingpong pong` child
+/// (`pong_exe`; reply CommandMsg-sized), which answers inside its Zenoh callback or, with
+/// `recv_loop`, from a receive loop (the demo controller's structure). The benchmarks'
+/// yardstick. The child is killed when the pings are done, whatever happened.
+pub fn round_trips(
+    pong_exe: &std::path::Path,
+    warmup: usize,
+    count: usize,
+    recv_loop: bool,
+) -> anyhow::Result<Vec<Duration>> {
+    use flexdyn_proto::client::transport::{listening_on, zenoh_config, Role, ZenohArgs};
+    use flexdyn_proto::{EFFECTOR_STATE_FIXED_LEN, STATE_FIXED_LEN};
+    use std::process::{Command, Stdio};
+
+    /// Kills the pong child on every way out.
+    struct Killed(std::process::Child);
+    impl Drop for Killed {
+        fn drop(&mut self) {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+        }
+    }
+
+    let topics = Topics::new("bench").context("bench topics")?;
+    let args = ZenohArgs {
+        listen: vec!["tcp/127.0.0.1:0".into()],
+        ..ZenohArgs::default()
+    };
+    let session = zenoh::open(zenoh_config(&args, Role::Server)?)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("open the ping session: {e}"))?;
+    let endpoint = listening_on(&session)
+        .into_iter()
+        .next()
+        .context("the ping session listens nowhere")?;
+    let mut cmd = Command::new(pong_exe);
+    cmd.args(["--connect", &endpoint, "--sc-id", "bench"])
+        .args(["pong", "--duration-s", "300"]);
+    if recv_loop {
+        cmd.arg("--recv-loop");
+    }
+    let _pong = Killed(
+        cmd.stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .with_context(|| format!("spawn {}", pong_exe.display()))?,
+    );
+    ping(
+        &session,
+        &topics,
+        STATE_FIXED_LEN + 2 * (EFFECTOR_STATE_FIXED_LEN + 32),
+        warmup,
+        count,
+        Duration::from_secs(30),
+    )
+}
