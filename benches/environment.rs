@@ -11,8 +11,7 @@
 //! (ephemerides, magnetic coefficients, NRLMSISE-00) at 1 Hz, the field and shadow at 10 Hz, the
 //! surface forces at every RK4 stage (4 per step).
 
-#[path = "../crates/dynamics/tests/common.rs"]
-mod common;
+use flexdyn_dynamics::reference as common;
 
 use flexdyn_testkit::median;
 use std::hint::black_box;

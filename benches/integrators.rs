@@ -16,8 +16,7 @@
 //!
 //! Target (issue 24): ≤ 1e-10 relative energy error over 1e6 s.
 
-#[path = "../crates/dynamics/tests/common.rs"]
-mod common;
+use flexdyn_dynamics::reference as common;
 
 use std::time::Instant;
 

@@ -19,8 +19,7 @@
 //! `tools/peers/{mujoco,basilisk}_step.py` one after the other — the same spacecraft, RK4 at 1 ms —
 //! and prints each peer's median next to flexdyn's, with the ratio.
 
-#[path = "../crates/dynamics/tests/common.rs"]
-mod common;
+use flexdyn_dynamics::reference as common;
 
 use flexdyn_testkit::median;
 use std::hint::black_box;

@@ -10,8 +10,7 @@
 //! After criterion's report this prints the medians of 31 batches of 20,000 calls and each
 //! one's ratio to the RK4 step.
 
-#[path = "../crates/dynamics/tests/common.rs"]
-mod common;
+use flexdyn_dynamics::reference as common;
 
 use std::hint::black_box;
 use std::time::Instant;

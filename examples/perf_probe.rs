@@ -1,7 +1,6 @@
 //! Steps the reference spacecraft (or `N` ring pairs) `STEPS` times, for `perf stat` cycle counts:
 //! `cargo build --release --example perf_probe && perf stat -e cycles:u,instructions:u target/release/examples/perf_probe 2 200000`.
-#[path = "../crates/dynamics/tests/common.rs"]
-mod common;
+use flexdyn_dynamics::reference as common;
 
 fn main() {
     let mut args = std::env::args().skip(1);

@@ -1,7 +1,9 @@
 //! Rigid hub + appended bodies (dual-hinged panel pairs, reaction wheels), by back-substitution.
 //!
 //! Every appended body is a [`StateEffector`] in its own folder under [`effectors`]; the hub
-//! ([`spacecraft`]) only sees their summed mass properties and contributions.
+//! ([`spacecraft`]) only sees their summed mass properties and contributions. [`reference`]
+//! builds the reference spacecraft in code and measures how well a run conserves energy and
+//! angular momentum.
 //!
 //! The equations are those of Allard & Schaub, "Spacecraft Dynamical Model with Dual-Connected
 //! Hinged Rigid Bodies" (citation in `docs/errata.md`), Sections III and V, with the two
@@ -50,6 +52,7 @@ pub mod effectors;
 pub mod integrator;
 pub mod kinds;
 pub mod params;
+pub mod reference;
 pub mod spacecraft;
 pub mod stage_hook;
 

@@ -9,7 +9,8 @@
 //!
 //! [`common`] builds the reference spacecraft of `scenarios/reference.toml` in code.
 
-mod common;
+// The reference spacecraft built in code, and the conservation measure.
+use flexdyn_dynamics::reference as common;
 
 mod analytic_limit;
 mod attitude;

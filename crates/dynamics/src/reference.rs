@@ -1,8 +1,13 @@
-//! Shared fixtures for the physics tests: the reference spacecraft of `scenarios/reference.toml`,
-//! built in code so each test can vary one thing (gravity, damping, pair count, hub mass).
-#![allow(dead_code)]
+//! The reference spacecraft of `scenarios/reference.toml` (a 750 kg hub with two dual-hinged
+//! wings), built in code so a program, a test or a benchmark can vary one thing (gravity,
+//! damping, pair count, hub mass, wheels), and the conservation measure the physics is checked
+//! with: the largest relative drift of the rotational and orbital energy and angular momentum
+//! over a run ([`run_drift`]).
+//!
+//! The physics tests (`tests/`), the root package's benchmarks and the examples use it, instead
+//! of each carrying a copy.
 
-use flexdyn_dynamics::{
+use crate::{
     GravityModel, HubInitial, HubParams, InitialTranslation, PanelPair, PanelPairInitial,
     PanelPairParams, PanelParams, ReactionWheel, ReactionWheelParams, Spacecraft, StateEffector,
 };
@@ -11,6 +16,8 @@ use nalgebra::{Matrix3, Vector3};
 /// μ of the Earth [m³/s²], as in the reference config.
 pub const MU_EARTH: f64 = 3.986004415e14;
 
+/// The hub: 750 kg, inertia diag(900, 800, 600) kg m² about its centre of mass, which lies 1 m
+/// along +b3 from point B.
 pub fn reference_hub() -> HubParams {
     HubParams {
         mass_kg: 750.0,
@@ -19,6 +26,8 @@ pub fn reference_hub() -> HubParams {
     }
 }
 
+/// One panel: 50 kg, 0.75 m from its hinge, hinge stiffness 100 N m/rad and damping
+/// `c_nm_s_rad`.
 pub fn reference_panel(c_nm_s_rad: f64) -> PanelParams {
     PanelParams {
         mass_kg: 50.0,
@@ -31,6 +40,8 @@ pub fn reference_panel(c_nm_s_rad: f64) -> PanelParams {
     }
 }
 
+/// A dual-hinged pair of two reference panels (1.5 m apart) hinged at `r_h1b_b_m` with hinge
+/// frame `dcm_h1b` and damping `c` \[N m s/rad\].
 pub fn pair_params(
     name: &str,
     r_h1b_b_m: Vector3<f64>,
@@ -109,6 +120,8 @@ pub fn ring_pairs(n: usize, c: f64) -> Vec<(PanelPairParams, PanelPairInitial)> 
         .collect()
 }
 
+/// The reference spacecraft's initial state: the system centre of mass on a ~10 000 km orbit,
+/// attitude N, tumbling at (0.05, −0.05, 0.05) rad/s.
 pub fn reference_initial() -> HubInitial {
     HubInitial {
         translation: InitialTranslation::CenterOfMass {
@@ -120,6 +133,10 @@ pub fn reference_initial() -> HubInitial {
     }
 }
 
+/// A spacecraft of `hub` and `pairs` (hinge names `panel_pairs[i]`).
+///
+/// # Panics
+/// If a pair or the spacecraft is invalid: the fixtures here are valid by construction.
 pub fn build(
     hub: HubParams,
     gravity: GravityModel,
@@ -152,15 +169,19 @@ pub fn reference(gravity: GravityModel, c: f64) -> Spacecraft {
 /// Largest relative drift max_t |x(t) − x(0)| / |x(0)| of scalars and vectors.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct Drift {
+    /// Rotational + spring energy.
     pub rot_energy: f64,
+    /// Angular momentum about the system's centre of mass C.
     pub rot_ang_mom: f64,
+    /// Orbital energy (0 when the initial one is 0).
     pub orb_energy: f64,
+    /// Orbital angular momentum (0 when the initial one is 0).
     pub orb_ang_mom: f64,
 }
 
 impl Drift {
     /// Asserts the rotational + spring energy and the angular momentum about C each drifted by at
-    /// most `bound`. The energy is checked on its own: summed with the orbital energy, erratum E1
+    /// most `bound` (a test's check: it panics, naming the quantity, when one did not). The energy is checked on its own: summed with the orbital energy, erratum E1
     /// would hide at the 1e-11 level (ERRATA.md).
     pub fn assert_rotational(&self, bound: f64) {
         assert!(
