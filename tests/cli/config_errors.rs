@@ -11,6 +11,7 @@
 use std::path::{Path, PathBuf};
 
 use flexdyn_dynamics::{GravityModel, InitialTranslation};
+use flexdyn_kernel::schema::SchemaError;
 use flexdyn_vehicle::config::{ConfigError, SimConfig, DEFAULT_CONFIG_TOML};
 use nalgebra::{Matrix3, Vector3};
 use toml::{Table, Value};
@@ -476,9 +477,9 @@ fn kind(e: &ConfigError) -> &'static str {
     match e {
         ConfigError::Io { .. } => "Io",
         ConfigError::Syntax { .. } => "Syntax",
-        ConfigError::UnknownKey { .. } => "UnknownKey",
-        ConfigError::MissingKey { .. } => "MissingKey",
-        ConfigError::InvalidValue { .. } => "InvalidValue",
+        ConfigError::Schema(SchemaError::UnknownKey { .. }) => "UnknownKey",
+        ConfigError::Schema(SchemaError::MissingKey { .. }) => "MissingKey",
+        ConfigError::Schema(SchemaError::InvalidValue { .. }) => "InvalidValue",
         ConfigError::Param { .. } => "Param",
         ConfigError::Timing { .. } => "Timing",
         ConfigError::InitialPoint { .. } => "InitialPoint",

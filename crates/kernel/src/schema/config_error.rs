@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use crate::validate::ParamError;
 
-use super::{in_table, At, SchemaError};
+use super::{At, SchemaError};
 
 /// A configuration that cannot be used. The message always starts with the TOML path of the
 /// offending field (except for I/O and syntax errors, which name the file or the line).
@@ -32,34 +32,10 @@ pub enum ConfigError {
         /// What the TOML parser reported.
         message: String,
     },
-    /// A key that the schema does not have.
-    #[error("{field}: unknown key ({message}){at}")]
-    UnknownKey {
-        /// TOML path of the unknown key.
-        field: String,
-        /// What the TOML parser reported (lists the expected keys).
-        message: String,
-        /// Position of the key.
-        at: At,
-    },
-    /// A required key is absent.
-    #[error("{field}: missing required key{}", in_table(at))]
-    MissingKey {
-        /// TOML path of the missing key.
-        field: String,
-        /// Position of the table that lacks it.
-        at: At,
-    },
-    /// A value of the wrong type or shape (e.g. a string for a number, 2 elements for 3).
-    #[error("{field}: invalid value: {message}{at}")]
-    InvalidValue {
-        /// TOML path of the value.
-        field: String,
-        /// What the TOML parser reported.
-        message: String,
-        /// Position of the value.
-        at: At,
-    },
+    /// The document's shape does not match the schema: an unknown or missing key, or a value of
+    /// the wrong type or length (the schema reader's own error, with its message).
+    #[error(transparent)]
+    Schema(#[from] SchemaError),
     /// A parameter rejected by the dynamics' validation (non-finite, non-positive, inertia,
     /// DCM, panel geometry, …).
     #[error("{source}{at}")]
@@ -128,29 +104,13 @@ impl ConfigError {
     pub fn field(&self) -> Option<&str> {
         match self {
             ConfigError::Io { .. } | ConfigError::Syntax { .. } => None,
-            ConfigError::UnknownKey { field, .. }
-            | ConfigError::MissingKey { field, .. }
-            | ConfigError::InvalidValue { field, .. }
-            | ConfigError::Timing { field, .. }
+            ConfigError::Schema(e) => Some(e.field()),
+            ConfigError::Timing { field, .. }
             | ConfigError::InitialPoint { field, .. }
             | ConfigError::Gravity { field, .. }
             | ConfigError::WrenchSchedule { field, .. }
             | ConfigError::Invalid { field, .. } => Some(field),
             ConfigError::Param { source, .. } => param_field(source),
-        }
-    }
-}
-
-impl From<SchemaError> for ConfigError {
-    fn from(e: SchemaError) -> Self {
-        match e {
-            SchemaError::UnknownKey { field, message, at } => {
-                ConfigError::UnknownKey { field, message, at }
-            }
-            SchemaError::MissingKey { field, at } => ConfigError::MissingKey { field, at },
-            SchemaError::InvalidValue { field, message, at } => {
-                ConfigError::InvalidValue { field, message, at }
-            }
         }
     }
 }

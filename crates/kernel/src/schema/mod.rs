@@ -51,7 +51,7 @@ impl fmt::Display for At {
 }
 
 /// A document whose shape does not match a schema: an unknown or missing key, or a value of the
-/// wrong type or length. [`config_error::ConfigError`] has the same three variants.
+/// wrong type or length. A configuration carries it as [`config_error::ConfigError::Schema`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SchemaError {
     /// A key that the schema does not have.
@@ -82,6 +82,17 @@ pub enum SchemaError {
         /// Position of the value.
         at: At,
     },
+}
+
+impl SchemaError {
+    /// The TOML path of the key or value the error is about.
+    pub fn field(&self) -> &str {
+        match self {
+            SchemaError::UnknownKey { field, .. }
+            | SchemaError::MissingKey { field, .. }
+            | SchemaError::InvalidValue { field, .. } => field,
+        }
+    }
 }
 
 /// 1-based line and column of byte `offset` in `s`.

@@ -6,8 +6,8 @@
 //!
 //! 1. TOML syntax ([`ConfigError::Syntax`]);
 //! 2. structure: unknown keys, missing keys, wrong types and wrong array lengths, by the typed
-//!    reader of `crates/kernel/src/schema/reader.rs` ([`ConfigError::UnknownKey`], [`ConfigError::MissingKey`],
-//!    [`ConfigError::InvalidValue`]), whose messages speak TOML (tables, keys, numbers,
+//!    reader of `crates/kernel/src/schema/reader.rs` ([`ConfigError::Schema`]: an unknown or missing key, a value
+//!    of the wrong type), whose messages speak TOML (tables, keys, numbers,
 //!    datetimes), never Rust types;
 //! 3. every float in the document must be finite — TOML accepts `nan` and `inf` literals
 //!    ([`ConfigError::Param`] wrapping [`ParamError::NotFinite`]);
@@ -40,7 +40,7 @@ pub use flexdyn_kernel::schema::checks::{whole_ns, WHOLE_NS_TOL};
 pub use flexdyn_kernel::schema::config_error::ConfigError;
 use flexdyn_kernel::schema::location;
 pub use flexdyn_kernel::schema::source_map::SourceMap;
-use flexdyn_kernel::schema::{mat3, vec3, TableReader};
+use flexdyn_kernel::schema::{mat3, vec3, SchemaError, TableReader};
 pub use flexdyn_kernel::schema::{At, Location};
 use flexdyn_proto::MAX_PANEL_PAIRS;
 pub use schedule::EffectorInputSegment;
@@ -1162,9 +1162,11 @@ fn check_gravity_bound(
 impl RawGravity {
     fn to_model(&self, map: &SourceMap) -> Result<GravityModel, ConfigError> {
         let needs = |key: &str, v: Option<f64>| -> Result<f64, ConfigError> {
-            v.ok_or_else(|| ConfigError::MissingKey {
-                field: format!("gravity.{key}"),
-                at: map.at("gravity"),
+            v.ok_or_else(|| {
+                ConfigError::Schema(SchemaError::MissingKey {
+                    field: format!("gravity.{key}"),
+                    at: map.at("gravity"),
+                })
             })
         };
         let forbid = |key: &str, v: Option<f64>| -> Result<(), ConfigError> {

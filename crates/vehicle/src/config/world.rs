@@ -50,21 +50,22 @@ fn invalid_near(map: &SourceMap, field: &str, problem: String) -> ConfigError {
 
 /// A reader error with its position looked up (the world readers leave it to the caller).
 fn located(map: &SourceMap, e: SchemaError) -> ConfigError {
-    match ConfigError::from(e) {
-        ConfigError::UnknownKey { field, message, at } if at.0.is_none() => {
+    let e = match e {
+        SchemaError::UnknownKey { field, message, at } if at.0.is_none() => {
             let at = map.near(&field);
-            ConfigError::UnknownKey { field, message, at }
+            SchemaError::UnknownKey { field, message, at }
         }
-        ConfigError::MissingKey { field, at } if at.0.is_none() => {
+        SchemaError::MissingKey { field, at } if at.0.is_none() => {
             let at = map.near(&field);
-            ConfigError::MissingKey { field, at }
+            SchemaError::MissingKey { field, at }
         }
-        ConfigError::InvalidValue { field, message, at } if at.0.is_none() => {
+        SchemaError::InvalidValue { field, message, at } if at.0.is_none() => {
             let at = map.near(&field);
-            ConfigError::InvalidValue { field, message, at }
+            SchemaError::InvalidValue { field, message, at }
         }
         other => other,
-    }
+    };
+    ConfigError::Schema(e)
 }
 
 impl RawWorld {
