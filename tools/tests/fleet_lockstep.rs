@@ -15,7 +15,7 @@ use std::time::Duration;
 
 use crate::support::{endpoint, signal, ChildGuard, FleetServerHandle, Recorder};
 use flexdyn_proto::{decode_state, Mode, Topics};
-use flexdyn_server::{ServerError, ServerSettings};
+use flexdyn_server::{Handoff, ServerError, ServerSettings};
 use flexdyn_vehicle::world::FleetConfig;
 use sha2::{Digest, Sha256};
 
@@ -43,9 +43,10 @@ hill_position_m = [0.0, -100.0, 0.0]
     FleetConfig::from_toml_str_in(text, &root).unwrap()
 }
 
-fn settings(participant_timeout_s: f64) -> ServerSettings {
+fn settings(participant_timeout_s: f64, handoff: Handoff) -> ServerSettings {
     ServerSettings {
         mode: Mode::Lockstep,
+        handoff,
         participant_timeout: Duration::from_secs_f64(participant_timeout_s),
         presence_timeout: Duration::from_secs(30),
         duration_ns: Some((DURATION_S * 1e9) as u64),
@@ -87,8 +88,8 @@ struct Run {
     deputy: Vec<(u64, Vec<u8>)>,
 }
 
-fn fleet_run(participant_timeout_s: f64, sabotage: Sabotage) -> Run {
-    let server = FleetServerHandle::start(settings(participant_timeout_s), fleet());
+fn fleet_run(participant_timeout_s: f64, sabotage: Sabotage, handoff: Handoff) -> Run {
+    let server = FleetServerHandle::start(settings(participant_timeout_s, handoff), fleet());
     let port = server.port;
     let chief_topics = Topics::new("chief").unwrap();
     let deputy_topics = Topics::new("deputy").unwrap();
@@ -159,13 +160,16 @@ fn pointing_error(payload: &[u8], sigma_rn: [f64; 3]) -> f64 {
 
 #[test]
 fn fleet_lockstep_streams_are_bit_identical_across_runs_and_a_stopped_controller() {
-    let a = fleet_run(10.0, Sabotage::None);
+    // The lockstep core steps run a (`handoff = "direct"`, what `auto` gives), the physics
+    // thread's frame loop steps run b: the same world, two drivers, the same bits.
+    let a = fleet_run(10.0, Sabotage::None, Handoff::Direct);
     let b = fleet_run(
         10.0,
         Sabotage::PauseDeputy {
             at: 300,
             pause: Duration::from_millis(1500),
         },
+        Handoff::Thread,
     );
     for run in [&a, &b] {
         let report = run.result.as_ref().expect("the fleet run failed");
@@ -201,23 +205,26 @@ fn fleet_lockstep_streams_are_bit_identical_across_runs_and_a_stopped_controller
 
 #[test]
 fn a_killed_controller_stops_the_fleet_with_a_timeout_naming_vehicle_and_participant() {
-    let run = fleet_run(1.0, Sabotage::KillDeputy { at: 100 });
-    let err = run.result.expect_err("the run must fail");
-    let msg = err.to_string();
-    assert!(
-        matches!(
-            &err,
-            ServerError::Vehicle { vehicle, source }
-                if vehicle == "deputy"
-                    && matches!(**source, ServerError::ParticipantTimeout { participant: 2, .. })
-        ),
-        "{msg}"
-    );
-    assert!(
-        msg.contains("\"deputy\"") && msg.contains("participant 2"),
-        "{msg}"
-    );
-    // Neither vehicle went past the tick the deputy's controller did not answer.
-    let last = |s: &[(u64, Vec<u8>)]| s.last().map(|(t, _)| *t);
-    assert_eq!(last(&run.chief), last(&run.deputy));
+    // Under either driver: the lockstep core's timeout check and the physics thread's barrier.
+    for handoff in [Handoff::Direct, Handoff::Thread] {
+        let run = fleet_run(1.0, Sabotage::KillDeputy { at: 100 }, handoff);
+        let err = run.result.expect_err("the run must fail");
+        let msg = err.to_string();
+        assert!(
+            matches!(
+                &err,
+                ServerError::Vehicle { vehicle, source }
+                    if vehicle == "deputy"
+                        && matches!(**source, ServerError::ParticipantTimeout { participant: 2, .. })
+            ),
+            "{handoff:?}: {msg}"
+        );
+        assert!(
+            msg.contains("\"deputy\"") && msg.contains("participant 2"),
+            "{handoff:?}: {msg}"
+        );
+        // Neither vehicle went past the tick the deputy's controller did not answer.
+        let last = |s: &[(u64, Vec<u8>)]| s.last().map(|(t, _)| *t);
+        assert_eq!(last(&run.chief), last(&run.deputy), "{handoff:?}");
+    }
 }

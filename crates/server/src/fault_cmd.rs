@@ -38,7 +38,12 @@ pub(super) enum FaultSink {
     /// The physics thread's bounded queue, drained before each frame is stepped.
     Queue(SyncSender<LiveRequest>),
     /// Lockstep with `handoff = "direct"`: the core, installed under its lock.
-    Core(Arc<Mutex<LockstepCore>>),
+    Core {
+        /// The vehicle's index in the world (0 for one spacecraft).
+        vehicle: usize,
+        /// The world's core.
+        core: Arc<Mutex<LockstepCore>>,
+    },
 }
 
 /// Subscribes the live-fault callback to `flexdyn/<sc>/fault`; dropping the subscriber stops it.
@@ -114,9 +119,9 @@ pub(super) async fn declare(
                     tracing::info!(at_tick = cmd.at_tick, "fault command queued: {what}");
                 }
             }
-            FaultSink::Core(core) => {
+            FaultSink::Core { vehicle, core } => {
                 let mut core = core.lock().unwrap_or_else(|p| p.into_inner());
-                match core.install_fault(req) {
+                match core.install_fault(*vehicle, req) {
                     Ok(()) => {
                         tracing::info!(at_tick = cmd.at_tick, "fault command applied: {what}")
                     }

@@ -32,7 +32,12 @@ pub(super) enum CommandSink {
         queue: Mutex<(SyncSender<(usize, CommandMsg)>, Gate)>,
     },
     /// Lockstep with `handoff = "direct"`: the core, stepped in this callback.
-    Core(Arc<Mutex<LockstepCore>>),
+    Core {
+        /// The vehicle's index in the world (0 for one spacecraft).
+        vehicle: usize,
+        /// The world's core.
+        core: Arc<Mutex<LockstepCore>>,
+    },
 }
 
 /// Subscribes the command callback to `flexdyn/<sc>/cmd/*`; dropping the subscriber stops the
@@ -161,7 +166,10 @@ fn command_callback(
                     tx.try_send((*vehicle, cmd)).is_ok()
                 });
             }
-            CommandSink::Core(core) => core.lock().unwrap_or_else(|p| p.into_inner()).offer(&cmd),
+            CommandSink::Core { vehicle, core } => core
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .offer(*vehicle, &cmd),
         }
     }
 }

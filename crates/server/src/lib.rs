@@ -103,7 +103,7 @@ use flexdyn_vehicle::config::SimConfig;
 use flexdyn_vehicle::sim::Simulation;
 use intake::CommandSink;
 use lockstep::LockstepCore;
-use physics::{Lane, Outlet, PhysicsCtx, PhysicsOutcome, PhysicsReport};
+use physics::{Lane, Outlet, PhysicsCtx, PhysicsOutcome};
 use presence::Presence;
 use setup::Endpoints;
 use shared::{Frame, Shared};
@@ -325,11 +325,7 @@ impl Wiring {
     ) -> Result<Self, ServerError> {
         let mode = settings.mode;
         // Who publishes the frames (see `publish`): batch always the telemetry thread.
-        let direct = settings.handoff.is_direct(
-            mode,
-            settings.record.is_some(),
-            settings.realtime_priority > 0,
-        );
+        let direct = settings.direct_handoff();
         tracing::info!(
             handoff = if direct { "direct" } else { "thread" },
             "frames are published by {}",
@@ -374,17 +370,32 @@ impl Wiring {
         // (otherwise).
         let (frames, sink, fault_sink, telemetry_publisher) = if direct && mode == Mode::Lockstep {
             let events = Arc::new(Notify::new());
-            let core = Arc::new(Mutex::new(LockstepCore::new(
-                stepper,
-                new_frame(),
+            let mut world = WorldStepper::one(settings.sc_id.clone(), stepper);
+            for v in &mut world.vehicles {
+                v.frame = Some(new_frame());
+            }
+            let lane = lockstep::CoreLane {
                 publisher,
-                recording.clone(),
+                record: recording.clone(),
+                shared: shared.clone(),
+            };
+            let core = Arc::new(Mutex::new(LockstepCore::new(
+                world,
+                vec![lane],
+                Vec::new(),
                 shared.clone(),
+                false,
                 total_frames,
                 events.clone(),
             )));
-            let sink = CommandSink::Core(core.clone());
-            let fault_sink = fault_cmd::FaultSink::Core(core.clone());
+            let sink = CommandSink::Core {
+                vehicle: 0,
+                core: core.clone(),
+            };
+            let fault_sink = fault_cmd::FaultSink::Core {
+                vehicle: 0,
+                core: core.clone(),
+            };
             let frames = Frames::Core {
                 core,
                 events,
@@ -514,13 +525,17 @@ async fn run_frames(
             events,
             full_tx,
         } => {
-            let result = run_lockstep_core(&core, &events, settings, shared, shutdown).await;
+            let outcome = run_lockstep_core(
+                &core,
+                &events,
+                settings,
+                std::slice::from_ref(shared),
+                shared,
+                shutdown,
+            )
+            .await;
             drop(full_tx);
-            Ok(PhysicsOutcome {
-                result,
-                spent: physics::Spent::default(),
-                usage: None,
-            })
+            Ok(outcome)
         }
     }
 }
@@ -654,14 +669,16 @@ async fn run_physics_thread(
 }
 
 /// Lockstep with `handoff = "direct"`: starts the core (publishes tick 0) and waits for it to
-/// end, checking the participant timeout every 50 ms; a stop request ends it at once.
+/// end, checking the participant timeout every 50 ms; a stop request ends it at once (`shared`
+/// are every vehicle's counters, which say `Stopping` meanwhile; the stop flag is `control`'s).
 async fn run_lockstep_core(
     core: &Arc<Mutex<LockstepCore>>,
     events: &Notify,
     settings: &ServerSettings,
-    shared: &Arc<Shared>,
+    shared: &[Arc<Shared>],
+    control: &Shared,
     mut shutdown: std::pin::Pin<&mut impl Future<Output = ()>>,
-) -> Result<PhysicsReport, ServerError> {
+) -> PhysicsOutcome {
     let lock = || core.lock().unwrap_or_else(|p| p.into_inner());
     lock().start();
     loop {
@@ -675,13 +692,20 @@ async fn run_lockstep_core(
             }
             () = &mut shutdown => {
                 tracing::info!("shutdown requested; stopping at the current tick");
-                shared.set_run_state(RunState::Stopping);
-                shared.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+                for sh in shared {
+                    sh.set_run_state(RunState::Stopping);
+                }
+                control.stop.store(true, std::sync::atomic::Ordering::Relaxed);
                 lock().stop();
             }
         }
     }
-    lock().outcome()
+    let mut core = lock();
+    PhysicsOutcome {
+        result: core.outcome(),
+        spent: core.spent(),
+        usage: None,
+    }
 }
 
 /// Puts the calling thread under SCHED_FIFO at `priority` (1–99); the error says why the OS

@@ -20,6 +20,12 @@
 //!
 //! The run loop in [`super::run`] keeps the no-hang rules: it wakes every 50 ms to check the
 //! participant timeout (no new tick within `participant_timeout_s`) and a stop request.
+//!
+//! The core steps a world ([`WorldStepper`]), as the physics thread's loop does: one spacecraft
+//! is a world of one, and a fleet's core takes every vehicle's answers (each vehicle's command
+//! callback offers to it with the vehicle's index), steps every vehicle once all have answered,
+//! and publishes every vehicle's frame in fleet order, each deputy's relative states after its
+//! frame. Each vehicle's stream is the one the physics thread would publish, bit for bit.
 
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
@@ -29,10 +35,12 @@ use flexdyn_proto::{CommandMsg, RunState};
 use tokio::sync::Notify;
 
 use super::error::ServerError;
-use super::physics::{Ending, PhysicsReport};
+use super::physics::{Ending, PhysicsReport, Spent};
 use super::publish::{FramePublisher, Recording};
-use super::shared::{Frame, Shared};
-use super::stepper::{count_offer, Stepper};
+use super::relative::RelativePublisher;
+use super::shared::Shared;
+use super::stepper::count_offer;
+use super::world::WorldStepper;
 
 /// Where a direct lockstep run is.
 #[derive(Debug)]
@@ -49,13 +57,27 @@ pub enum Phase {
     Failed(ServerError),
 }
 
-/// The lockstep state machine, driven by the Zenoh command callback.
+/// One vehicle's outlet in the core: its publishers, its recorder view and its counters.
+pub struct CoreLane {
+    /// Its frame publishers.
+    pub publisher: FramePublisher,
+    /// The recorder's view of its keys (`--record`).
+    pub record: Option<Recording>,
+    /// Its counters (its StatusMsg reads them).
+    pub shared: Arc<Shared>,
+}
+
+/// The lockstep state machine, driven by the Zenoh command callbacks.
 pub struct LockstepCore {
-    w: Stepper,
-    frame: Box<Frame>,
-    publisher: FramePublisher,
-    record: Option<Recording>,
-    shared: Arc<Shared>,
+    world: WorldStepper,
+    lanes: Vec<CoreLane>,
+    /// Per (chief, deputy) pair of the world, same order: its relative-state publisher.
+    relative: Vec<RelativePublisher>,
+    /// The world's stop flag, operator hold target and published tick (one spacecraft: its own
+    /// counters).
+    control: Arc<Shared>,
+    /// Whether an error about one vehicle names it (a fleet's).
+    name_vehicles: bool,
     k: u64,
     total_frames: Option<u64>,
     phase: Phase,
@@ -64,34 +86,60 @@ pub struct LockstepCore {
     /// Holding at tick `k` on an operator's request: its answers are taken, but frame
     /// `k → k + 1` waits for [`Self::release_if_due`].
     holding: bool,
+    spent: Spent,
 }
 
 impl LockstepCore {
-    /// A core at tick 0, not yet started; `events` is notified when the run ends.
+    /// A core at tick 0, not yet started; every vehicle of `world` has its own telemetry buffer
+    /// and `lanes[i]` is vehicle `i`'s; `events` is notified when the run ends.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
-        w: Stepper,
-        frame: Box<Frame>,
-        publisher: FramePublisher,
-        record: Option<Recording>,
-        shared: Arc<Shared>,
+        world: WorldStepper,
+        lanes: Vec<CoreLane>,
+        relative: Vec<RelativePublisher>,
+        control: Arc<Shared>,
+        name_vehicles: bool,
         total_frames: Option<u64>,
         events: Arc<Notify>,
     ) -> Self {
         let mut core = Self {
-            w,
-            frame,
-            publisher,
-            record,
-            shared,
+            world,
+            lanes,
+            relative,
+            control,
+            name_vehicles,
             k: 0,
             total_frames,
             phase: Phase::Waiting,
             tick_published_at: Instant::now(),
             events,
             holding: false,
+            spent: Spent::default(),
         };
-        core.w.book.begin_tick(0);
+        core.world.begin_tick(0);
         core
+    }
+
+    fn set_run_state(&self, s: RunState) {
+        for lane in &self.lanes {
+            lane.shared.set_run_state(s);
+        }
+    }
+
+    /// `e`, naming vehicle `v` in a fleet.
+    fn named(&self, v: usize, e: ServerError) -> ServerError {
+        if !self.name_vehicles {
+            return e;
+        }
+        ServerError::Vehicle {
+            vehicle: self
+                .world
+                .vehicles
+                .get(v)
+                .map(|v| v.id.clone())
+                .unwrap_or_default(),
+            source: Box::new(e),
+        }
     }
 
     /// Publishes tick 0 and starts stepping (after every participant is present).
@@ -99,8 +147,12 @@ impl LockstepCore {
         if !matches!(self.phase, Phase::Waiting) {
             return;
         }
-        self.shared.set_run_state(RunState::Running);
-        self.w.fill(&mut self.frame, 0);
+        self.set_run_state(RunState::Running);
+        if let Err((v, e)) = self.world.fill(0) {
+            let e = self.named(v, e);
+            self.end(Phase::Failed(e));
+            return;
+        }
         self.mark_hold();
         self.publish();
         if self.total_frames == Some(0) {
@@ -110,25 +162,34 @@ impl LockstepCore {
         self.phase = Phase::Running;
         self.enter_hold();
         // Answers to tick 0 that came during the presence wait.
-        if self.w.book.all_answered() && !self.holding {
+        if self.world.all_answered() && !self.holding {
             self.advance();
         }
     }
 
     /// Before publishing tick `k`: whether the operator holds the run there (never at the
-    /// run's last tick); if so its time message says `Paused`.
+    /// run's last tick); if so every time message says `Paused`.
     fn mark_hold(&mut self) {
-        self.holding = self.shared.holds_at(self.k) && self.total_frames != Some(self.k);
+        self.holding = self.control.holds_at(self.k) && self.total_frames != Some(self.k);
         if self.holding {
-            self.frame.time.run_state = RunState::Paused;
+            for f in self
+                .world
+                .vehicles
+                .iter_mut()
+                .filter_map(|v| v.frame.as_mut())
+            {
+                f.time.run_state = RunState::Paused;
+            }
         }
     }
 
-    /// After publishing a held tick: the status says `Paused` until released.
+    /// After publishing a held tick: every status says `Paused` until released.
     fn enter_hold(&mut self) {
         if self.holding {
-            self.shared.held.store(true, Ordering::Release);
-            self.shared.set_run_state(RunState::Paused);
+            for lane in &self.lanes {
+                lane.shared.held.store(true, Ordering::Release);
+            }
+            self.set_run_state(RunState::Paused);
             tracing::info!(tick = self.k, "held by the operator");
         }
     }
@@ -137,51 +198,87 @@ impl LockstepCore {
     /// (stepping at once if every participant has answered it). The participant timeout
     /// restarts from here.
     pub fn release_if_due(&mut self) {
-        if !self.holding || self.shared.holds_at(self.k) || self.ended() {
+        if !self.holding || self.control.holds_at(self.k) || self.ended() {
             return;
         }
         self.holding = false;
-        self.shared.held.store(false, Ordering::Release);
-        self.shared.set_run_state(RunState::Running);
+        for lane in &self.lanes {
+            lane.shared.held.store(false, Ordering::Release);
+        }
+        self.set_run_state(RunState::Running);
         self.tick_published_at = Instant::now();
         tracing::info!(tick = self.k, "released by the operator");
-        if matches!(self.phase, Phase::Running) && self.w.book.all_answered() {
+        if matches!(self.phase, Phase::Running) && self.world.all_answered() {
             self.advance();
         }
     }
 
-    /// A live fault request from the fault callback, installed before frame `k → k + 1` is
-    /// stepped (so at boundary `k + 1` at the earliest); `Err` with the refusal's code
-    /// ([`flexdyn_faults::ports::INSTALL_REFUSALS`]).
-    pub fn install_fault(&mut self, req: flexdyn_faults::ports::LiveRequest) -> Result<(), u8> {
+    /// A live fault request for vehicle `vehicle` from its fault callback, installed before
+    /// frame `k → k + 1` is stepped (so at boundary `k + 1` at the earliest); `Err` with the
+    /// refusal's code ([`flexdyn_faults::ports::INSTALL_REFUSALS`]).
+    pub fn install_fault(
+        &mut self,
+        vehicle: usize,
+        req: flexdyn_faults::ports::LiveRequest,
+    ) -> Result<(), u8> {
         if self.ended() {
             return Err(flexdyn_faults::ports::REFUSED_LATE);
         }
-        self.w
-            .install_fault(req, self.k)
-            .map(drop)
-            .map_err(|(code, _)| code)
+        let k = self.k;
+        match self.world.vehicles.get_mut(vehicle) {
+            Some(v) => v
+                .stepper
+                .install_fault(req, k)
+                .map(drop)
+                .map_err(|(code, _)| code),
+            None => Err(flexdyn_faults::ports::REFUSED_LATE),
+        }
     }
 
-    /// A validated command from the Zenoh callback: offered for the current tick; the last
-    /// answer steps the frame and publishes the next state.
-    pub fn offer(&mut self, cmd: &CommandMsg) {
+    /// A validated command for vehicle `vehicle` from its command callback: offered for the
+    /// current tick; the last answer of the world steps the frame and publishes the next state.
+    pub fn offer(&mut self, vehicle: usize, cmd: &CommandMsg) {
         if !matches!(self.phase, Phase::Waiting | Phase::Running) {
             return;
         }
-        let offer = self.w.book.offer_lockstep(cmd, self.k);
-        count_offer(&self.shared, offer, cmd.sender_id);
-        if matches!(self.phase, Phase::Running) && self.w.book.all_answered() && !self.holding {
+        let offer = self.world.offer_lockstep(vehicle, cmd, self.k);
+        if let Some(lane) = self.lanes.get(vehicle) {
+            count_offer(&lane.shared, offer, cmd.sender_id);
+        }
+        if matches!(self.phase, Phase::Running) && self.world.all_answered() && !self.holding {
             self.advance();
         }
     }
 
+    /// Every vehicle's frame of tick `k`, in world order, each deputy's relative states after
+    /// its frame; then tick `k` counts as published.
     fn publish(&mut self) {
-        self.frame.boundary_unix_ns = flexdyn_proto::client::transport::unix_now_ns();
-        self.publisher
-            .publish(&self.frame, &self.shared, self.record.as_ref());
-        self.shared.tick.store(self.k, Ordering::Relaxed);
+        let started = Instant::now();
+        let stamp = flexdyn_proto::client::transport::unix_now_ns();
+        for (i, (v, lane)) in self
+            .world
+            .vehicles
+            .iter_mut()
+            .zip(&mut self.lanes)
+            .enumerate()
+        {
+            if let Some(f) = v.frame.as_mut() {
+                f.boundary_unix_ns = stamp;
+                lane.publisher
+                    .publish(f, &lane.shared, lane.record.as_ref());
+            }
+            for (pair, rp) in self.world.pairs.iter().zip(&mut self.relative) {
+                if pair.deputy == i {
+                    rp.publish(pair, stamp, &lane.shared, lane.record.as_ref());
+                }
+            }
+        }
+        for lane in &self.lanes {
+            lane.shared.tick.store(self.k, Ordering::Relaxed);
+        }
+        self.control.tick.store(self.k, Ordering::Relaxed);
         self.tick_published_at = Instant::now();
+        self.spent.publish_ns += ns_between(started, self.tick_published_at);
     }
 
     /// Steps the answered tick, publishes the next, and goes on stepping while a tick needs no
@@ -189,11 +286,18 @@ impl LockstepCore {
     /// does, a hold, the end, or a stop request.
     fn advance(&mut self) {
         loop {
-            self.w.step(self.k);
-            self.w.note_links(&self.shared);
+            let started = Instant::now();
+            self.spent.wait_ns += ns_between(self.tick_published_at, started);
+            self.world.step(self.k);
+            for (v, lane) in self.world.vehicles.iter().zip(&self.lanes) {
+                v.stepper.note_links(&lane.shared);
+            }
             self.k += 1;
-            self.w.fill(&mut self.frame, self.k);
-            if let Err(e) = self.w.check_finite(self.k, true) {
+            let filled = self.world.fill(self.k);
+            self.spent.frames += 1;
+            self.spent.physics_ns += ns_between(started, Instant::now());
+            if let Err((v, e)) = filled {
+                let e = self.named(v, e);
                 self.end(Phase::Failed(e));
                 return;
             }
@@ -203,11 +307,11 @@ impl LockstepCore {
                 self.end(Phase::Finished);
                 return;
             }
-            self.w.book.begin_tick(self.k);
+            self.world.begin_tick(self.k);
             self.enter_hold();
-            if !self.w.book.all_answered()
+            if !self.world.all_answered()
                 || self.holding
-                || self.shared.stop.load(Ordering::Relaxed)
+                || self.control.stop.load(Ordering::Relaxed)
             {
                 return;
             }
@@ -215,7 +319,7 @@ impl LockstepCore {
     }
 
     fn end(&mut self, phase: Phase) {
-        self.shared.set_run_state(match &phase {
+        self.set_run_state(match &phase {
             Phase::Finished => RunState::Finished,
             Phase::Stopped => RunState::Stopped,
             _ => RunState::Failed,
@@ -242,13 +346,20 @@ impl LockstepCore {
             && !self.holding
             && self.tick_published_at.elapsed() >= timeout
         {
+            let (v, participant) = self.world.first_unanswered().unwrap_or_default();
             let e = ServerError::ParticipantTimeout {
-                participant: self.w.book.first_unanswered().unwrap_or_default(),
+                participant,
                 tick: self.k,
                 timeout_s: timeout.as_secs_f64(),
             };
+            let e = self.named(v, e);
             self.end(Phase::Failed(e));
         }
+    }
+
+    /// Where the core's time went: stepping and filling, publishing, and waiting for answers.
+    pub fn spent(&self) -> Spent {
+        self.spent
     }
 
     /// The outcome once [`Self::ended`]: the last tick published and its simulation time, or
@@ -257,7 +368,7 @@ impl LockstepCore {
         let report = |ending| PhysicsReport {
             ending,
             last_tick: self.k,
-            sim_time_ns: self.k.saturating_mul(self.w.sim.frame_ns()),
+            sim_time_ns: self.k.saturating_mul(self.world.frame_ns()),
         };
         match std::mem::replace(&mut self.phase, Phase::Stopped) {
             Phase::Finished => Ok(report(Ending::Finished)),
@@ -265,4 +376,8 @@ impl LockstepCore {
             _ => Ok(report(Ending::Stopped)),
         }
     }
+}
+
+fn ns_between(a: Instant, b: Instant) -> u64 {
+    u64::try_from(b.saturating_duration_since(a).as_nanos()).unwrap_or(u64::MAX)
 }

@@ -375,6 +375,14 @@ impl Setter<'_> {
 }
 
 impl ServerSettings {
+    /// Whether this run's frames are published directly (by whoever steps them) rather than by
+    /// a telemetry thread ([`Handoff::is_direct`] for these settings' mode, `--record` and
+    /// SCHED_FIFO priority).
+    pub fn direct_handoff(&self) -> bool {
+        self.handoff
+            .is_direct(self.mode, self.record.is_some(), self.realtime_priority > 0)
+    }
+
     /// Every command-link fault of `cfg` (`links.<sender id>`) must name one of these
     /// participants (the file's were checked at load; the command line may change them).
     pub fn check_link_faults(&self, cfg: &SimConfig) -> Result<(), SettingsError> {

@@ -44,13 +44,16 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use flexdyn_proto::{Mode, RunState, Topics};
+use tokio::sync::Notify;
 use zenoh::Session;
 
 use super::cli::RunArgs;
 use super::commands::Gate;
 use super::error::{ServerError, SettingsError};
+use super::fault_cmd::FaultSink;
 use super::intake::{self, CommandSink};
 use super::lateness_ring::LatenessRing;
+use super::lockstep::{CoreLane, LockstepCore};
 use super::operator;
 use super::physics::{Lane, Outlet, PhysicsCtx};
 use super::presence::Presence;
@@ -191,12 +194,30 @@ pub async fn run(
     tracing::info!("server settings: {}", settings.summary());
     flexdyn_proto::client::transport::log_listening(&session);
 
-    // Per vehicle: its publishers, configuration queryable, counters, command callback, status
-    // thread and (lockstep) presence.
+    // Who steps the frames: the physics thread, or (lockstep with `handoff = "direct"`, what
+    // `auto` gives in lockstep) the lockstep core, in the command callback that delivers the
+    // last answer of a tick, as for one spacecraft.
+    let direct = mode == Mode::Lockstep && settings.direct_handoff();
+    tracing::info!(
+        handoff = if direct { "direct" } else { "thread" },
+        "the fleet's frames are stepped and published by {}",
+        if direct {
+            "the Zenoh thread that delivers each tick's last answer"
+        } else {
+            "the physics thread"
+        }
+    );
+
+    // Per vehicle: its publishers, configuration queryable, counters, status thread and
+    // (lockstep) presence. Its command, fault and operator callbacks come once the world is
+    // built, since the lockstep core is what they deliver to.
     let (cmd_tx, cmd_rx) = sync_channel(settings.command_queue);
-    let mut lanes = Vec::with_capacity(vehicles.len());
+    let mut parts = Vec::with_capacity(vehicles.len());
+    // Per vehicle: its frame publishers, recorder view and telemetry thread's channel (the
+    // outlet of whichever steps the frames), and its physics-thread channels.
+    let mut outlets = Vec::with_capacity(vehicles.len());
+    let mut thread_side = Vec::with_capacity(vehicles.len());
     let mut shared = Vec::with_capacity(vehicles.len());
-    let mut keep = Vec::with_capacity(vehicles.len());
     let mut telemetry = Vec::with_capacity(vehicles.len());
     let mut presences = Vec::new();
     // `--record`: one file for the fleet; each vehicle is described as it is declared.
@@ -206,12 +227,8 @@ pub async fn run(
     let hold = Arc::new(Shared::default());
     // Real time: each frame boundary's lateness, for every vehicle's StatusMsg.
     let lateness = Arc::new(LatenessRing::default());
-    let mut operators = Vec::with_capacity(vehicles.len());
     for (i, (v, vs)) in vehicles.iter().zip(&vsettings).enumerate() {
-        let named = |e: ServerError| ServerError::Vehicle {
-            vehicle: v.id.clone(),
-            source: Box::new(e),
-        };
+        let named = |e: ServerError| named(&v.id, e);
         let topics = Topics::new(&v.id).map_err(|e| {
             named(
                 SettingsError::Invalid {
@@ -243,52 +260,20 @@ pub async fn run(
             v.sim.spacecraft().effector_input_ranges(),
             mode == Mode::Lockstep,
         );
-        let sink = CommandSink::Queue {
-            vehicle: i,
-            queue: Mutex::new((cmd_tx.clone(), gate)),
-        };
-        let commands = intake::declare(&session, &topics, sink, sh.clone(), vs, record_tx.clone())
-            .await
-            .map_err(named)?;
-        // Live faults: resolved on the Zenoh thread against this vehicle, installed by the
-        // physics thread before the next frame; their boxes freed by its telemetry thread.
-        let (fault_tx, fault_rx) = sync_channel(flexdyn_faults::MAX_LIVE_FAULTS);
-        let (fault_recycle_tx, fault_recycle_rx) =
-            sync_channel(2 * flexdyn_faults::MAX_LIVE_FAULTS);
         let resolver = cfg
             .live_fault_resolver()
             .map_err(|source| named(ServerError::Config { file: None, source }))?;
-        let fault_commands = super::fault_cmd::declare(
-            &session,
-            &topics,
-            resolver,
-            super::fault_cmd::FaultSink::Queue(fault_tx),
-            sh.clone(),
-            vs.spacecraft_id,
-            None,
-        )
-        .await
-        .map_err(named)?;
-        operators.push(
-            operator::declare(
-                &session,
-                &topics,
-                sh.clone(),
-                mode,
-                v.spacecraft_id,
-                None,
-                record_tx.clone(),
-                hold.clone(),
-            )
-            .await
-            .map_err(named)?,
-        );
         if mode == Mode::Lockstep {
             let presence = Presence::declare(&session, &topics, sh.clone())
                 .await
                 .map_err(named)?;
             presences.push((presence, endpoints.state_pub.clone(), topics.clone()));
         }
+        // Live faults (physics thread): resolved on the Zenoh thread against this vehicle,
+        // installed before the next frame; their boxes freed by its telemetry thread.
+        let (fault_tx, fault_rx) = sync_channel(flexdyn_faults::MAX_LIVE_FAULTS);
+        let (fault_recycle_tx, fault_recycle_rx) =
+            sync_channel(2 * flexdyn_faults::MAX_LIVE_FAULTS);
         let (recycle_tx, recycle_rx) = sync_channel(settings.command_queue);
         let (full_tx, full_rx) = sync_channel::<Box<Frame>>(1);
         let (free_tx, _free_rx) = sync_channel::<Box<Frame>>(1);
@@ -306,21 +291,17 @@ pub async fn run(
             lateness_ring: Some((lateness.clone(), 0)),
         };
         telemetry.push(super::spawn_telemetry(ctx).map_err(named)?.0);
-        lanes.push(Lane {
-            shared: sh.clone(),
-            recycle_tx,
-            fault_rx,
-            fault_recycle_tx,
-            outlet: Outlet::InPlace {
-                publisher: endpoints.frames,
-                recording,
-                telemetry_alive: full_tx,
-            },
+        parts.push(VehicleParts {
+            topics,
+            gate,
+            resolver,
+            fault_tx,
+            config,
         });
+        outlets.push((endpoints.frames, recording, full_tx));
+        thread_side.push((recycle_tx, fault_rx, fault_recycle_tx));
         shared.push(sh);
-        keep.push((config, commands, fault_commands));
     }
-    drop(cmd_tx);
     // Each deputy's relative state, on its own key (`flexdyn/<deputy>/tlm/rel/<chief>`).
     let mut relative = Vec::with_capacity(pairs.len());
     for &(c, d) in &pairs {
@@ -329,25 +310,134 @@ pub async fn run(
             .map_err(|e| ServerError::Internal(format!("vehicle id {deputy:?}: {e}")))?;
         let rp = RelativePublisher::declare(&session, mode, &topics, &vehicles[c].id)
             .await
-            .map_err(|e| ServerError::Vehicle {
-                vehicle: deputy.clone(),
-                source: Box::new(e),
-            })?;
+            .map_err(|e| named(deputy, e))?;
         relative.push(rp);
     }
+
+    // The world, and what steps it.
+    let ids: Vec<String> = vehicles.iter().map(|v| v.id.clone()).collect();
+    let world = WorldStepper::new(vehicles, &vsettings).with_relative_pairs(&pairs);
+    let mut keep = Vec::with_capacity(parts.len());
+    let mut alive = Vec::new();
+    let mut lanes = Vec::new();
+    let mut engine = if direct {
+        let mut core_lanes = Vec::with_capacity(outlets.len());
+        for ((publisher, record, telemetry_alive), sh) in outlets.into_iter().zip(&shared) {
+            core_lanes.push(CoreLane {
+                publisher,
+                record,
+                shared: sh.clone(),
+            });
+            alive.push(telemetry_alive);
+        }
+        let events = Arc::new(Notify::new());
+        let core = LockstepCore::new(
+            world,
+            core_lanes,
+            relative,
+            hold.clone(),
+            true,
+            total_frames,
+            events.clone(),
+        );
+        Engine::Core {
+            core: Arc::new(Mutex::new(core)),
+            events,
+        }
+    } else {
+        for (
+            ((publisher, recording, telemetry_alive), (recycle_tx, fault_rx, fault_recycle_tx)),
+            sh,
+        ) in outlets.into_iter().zip(thread_side).zip(&shared)
+        {
+            lanes.push(Lane {
+                shared: sh.clone(),
+                recycle_tx,
+                fault_rx,
+                fault_recycle_tx,
+                outlet: Outlet::InPlace {
+                    publisher,
+                    recording,
+                    telemetry_alive,
+                },
+            });
+        }
+        Engine::Thread {
+            world: Box::new(world),
+            relative,
+        }
+    };
+    let core = match &engine {
+        Engine::Core { core, .. } => Some(core.clone()),
+        Engine::Thread { .. } => None,
+    };
+    // Per vehicle: its command, fault and operator callbacks, into the physics thread's queues
+    // or the core.
+    let mut operators = Vec::with_capacity(parts.len());
+    for (i, (p, vs)) in parts.into_iter().zip(&vsettings).enumerate() {
+        let named = |e: ServerError| named(&ids[i], e);
+        let sh = shared[i].clone();
+        let (sink, fault_sink) = match &core {
+            Some(core) => (
+                CommandSink::Core {
+                    vehicle: i,
+                    core: core.clone(),
+                },
+                FaultSink::Core {
+                    vehicle: i,
+                    core: core.clone(),
+                },
+            ),
+            None => (
+                CommandSink::Queue {
+                    vehicle: i,
+                    queue: Mutex::new((cmd_tx.clone(), p.gate)),
+                },
+                FaultSink::Queue(p.fault_tx),
+            ),
+        };
+        let commands =
+            intake::declare(&session, &p.topics, sink, sh.clone(), vs, record_tx.clone())
+                .await
+                .map_err(named)?;
+        let fault_commands = super::fault_cmd::declare(
+            &session,
+            &p.topics,
+            p.resolver,
+            fault_sink,
+            sh.clone(),
+            vs.spacecraft_id,
+            None,
+        )
+        .await
+        .map_err(named)?;
+        operators.push(
+            operator::declare(
+                &session,
+                &p.topics,
+                sh.clone(),
+                mode,
+                vs.spacecraft_id,
+                core.clone(),
+                record_tx.clone(),
+                hold.clone(),
+            )
+            .await
+            .map_err(named)?,
+        );
+        keep.push((p.config, commands, fault_commands));
+    }
+    drop(cmd_tx);
     let _realtime = super::RealtimeHold::acquire(&settings)?;
 
     // Lockstep: tick 0 waits for every participant of every vehicle.
-    for ((presence, state_pub, topics), (vs, v)) in
-        presences.iter().zip(vsettings.iter().zip(&vehicles))
+    for ((presence, state_pub, topics), (vs, id)) in
+        presences.iter().zip(vsettings.iter().zip(&ids))
     {
         let ready = presence
             .wait(state_pub, vs, topics, shutdown.as_mut())
             .await
-            .map_err(|e| ServerError::Vehicle {
-                vehicle: v.id.clone(),
-                source: Box::new(e),
-            });
+            .map_err(|e| named(id, e));
         if !matches!(ready, Ok(true)) {
             for sh in &shared {
                 sh.set_run_state(if ready.is_ok() {
@@ -357,18 +447,21 @@ pub async fn run(
                 });
             }
             drop(lanes);
+            drop(alive);
+            drop(engine);
             for t in telemetry {
                 let _ = t.await;
             }
             drop(keep);
             drop(operators);
+            drop(core);
             let recording = super::finish_recording(recorder)?;
             ready?;
             return Ok(FleetReport {
-                vehicles: vehicles
+                vehicles: ids
                     .iter()
                     .zip(&shared)
-                    .map(|(v, sh)| (v.id.clone(), RunReport::before_tick_0(mode, sh.rejected())))
+                    .map(|(id, sh)| (id.clone(), RunReport::before_tick_0(mode, sh.rejected())))
                     .collect(),
                 frames: 0,
                 physics_ns: 0,
@@ -379,22 +472,43 @@ pub async fn run(
         }
     }
 
-    let ids: Vec<String> = vehicles.iter().map(|v| v.id.clone()).collect();
-    let world = WorldStepper::new(vehicles, &vsettings).with_relative_pairs(&pairs);
-    let physics = PhysicsCtx {
-        settings: settings.clone(),
-        total_frames,
-        cmd_rx,
-        lanes,
-        control: hold,
-        lateness: Some(lateness),
-        relative,
-        name_vehicles: true,
-    };
     let started = Instant::now();
-    let outcome =
-        super::run_physics_thread(physics, world, &settings, &shared, shutdown.as_mut()).await;
+    let outcome = match &mut engine {
+        Engine::Core { core, events } => Ok(super::run_lockstep_core(
+            core,
+            events,
+            &settings,
+            &shared,
+            &hold,
+            shutdown.as_mut(),
+        )
+        .await),
+        Engine::Thread { world, relative } => {
+            let world = std::mem::replace(
+                world.as_mut(),
+                WorldStepper {
+                    vehicles: Vec::new(),
+                    pairs: Vec::new(),
+                },
+            );
+            let physics = PhysicsCtx {
+                settings: settings.clone(),
+                total_frames,
+                cmd_rx,
+                lanes: std::mem::take(&mut lanes),
+                control: hold.clone(),
+                lateness: Some(lateness),
+                relative: std::mem::take(relative),
+                name_vehicles: true,
+            };
+            super::run_physics_thread(physics, world, &settings, &shared, shutdown.as_mut()).await
+        }
+    };
     let wall_s = started.elapsed().as_secs_f64();
+    // The core's telemetry threads end when their channels close; the physics thread's when
+    // it drops its lanes.
+    drop(alive);
+    drop(lanes);
     let mut lateness = Vec::with_capacity(telemetry.len());
     for t in telemetry {
         let tlm = t
@@ -405,6 +519,8 @@ pub async fn run(
     // Commands stop arriving; the recorder writes what it holds and closes the file.
     drop(keep);
     drop(operators);
+    drop(core);
+    drop(engine);
     let recording = super::finish_recording(recorder)?;
     let outcome = outcome?;
     let (physics, spent) = (outcome.result?, outcome.spent);
@@ -427,6 +543,41 @@ pub async fn run(
     };
     tracing::info!("{report}");
     Ok(report)
+}
+
+/// `e`, naming vehicle `id`.
+fn named(id: &str, e: ServerError) -> ServerError {
+    ServerError::Vehicle {
+        vehicle: id.to_owned(),
+        source: Box::new(e),
+    }
+}
+
+/// What steps a fleet's frames.
+enum Engine {
+    /// The physics thread's frame loop ([`super::physics`]), over this world, publishing the
+    /// relative states with these publishers.
+    Thread {
+        world: Box<WorldStepper>,
+        relative: Vec<RelativePublisher>,
+    },
+    /// Lockstep with `handoff = "direct"`: the core, stepped in the command callbacks.
+    Core {
+        core: Arc<Mutex<LockstepCore>>,
+        events: Arc<Notify>,
+    },
+}
+
+/// One vehicle's pieces between its declaration and its callbacks'.
+struct VehicleParts {
+    topics: Topics,
+    /// The command gate (physics thread's queue).
+    gate: Gate,
+    resolver: flexdyn_faults::live::LiveResolver,
+    /// Live faults into the physics thread's queue.
+    fault_tx: std::sync::mpsc::SyncSender<flexdyn_faults::ports::LiveRequest>,
+    /// Its `flexdyn/<id>/config` queryable, kept for the run.
+    config: zenoh::query::Queryable<()>,
 }
 
 /// `flexdyn run --fleet FILE`: the fleet file, the settings (the first vehicle's `[server]`
