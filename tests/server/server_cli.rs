@@ -704,3 +704,35 @@ participants = ["two"]
         let _ = std::fs::remove_dir_all(p.parent().unwrap());
     }
 }
+
+/// The log names each configured fault once at start, and each activation as it happens
+/// (`scenarios/fdir.toml`: imu_a's gyro stuck from 3 s, rw2 seized from 60 s), in batch mode.
+#[test]
+fn the_log_names_each_fault_at_start_and_when_it_activates() {
+    let mut server = Server::spawn(&[
+        "run",
+        "--config",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/fdir.toml"),
+        "--mode",
+        "batch",
+        "--duration-s",
+        "65",
+        "--listen",
+        ANY_PORT,
+    ]);
+    let status = server.wait(Duration::from_secs(120));
+    let err = server.stderr();
+    assert_eq!(status.code(), Some(0), "stderr:\n{err}");
+    let gyro = "stuck_current on imus.imu_a.gyro, from 3 s";
+    let wheel = "seized on reaction_wheels.rw2, from 60 s";
+    for line in [
+        format!("fault 0 configured: {gyro}"),
+        format!("fault 1 configured: {wheel}"),
+        format!("fault 0 active: {gyro} (t = 3 s)"),
+        format!("fault 1 active: {wheel} (t = 60 s)"),
+    ] {
+        assert_eq!(err.matches(&line).count(), 1, "{line:?} once in:\n{err}");
+    }
+    // Neither fault ever clears (no duration).
+    assert!(!err.contains("cleared"), "stderr:\n{err}");
+}

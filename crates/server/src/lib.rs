@@ -62,6 +62,7 @@ pub mod clock;
 pub mod commands;
 pub mod error;
 pub mod fault_cmd;
+pub mod fault_log;
 pub mod fleet;
 mod intake;
 mod lateness_ring;
@@ -285,6 +286,7 @@ fn prepare(
         cfg.summary()
     );
     tracing::info!("server settings: {}", settings.summary());
+    fault_log::log_configured(sim.faults().specs(), None);
     flexdyn_proto::client::transport::log_listening(session);
     if settings.mode == Mode::RealTime && settings.stale_policy == StalePolicy::Hold {
         tracing::debug!("stale commands are held (stale_policy = hold)");
@@ -363,6 +365,7 @@ impl Wiring {
             || Box::new(Frame::for_state(&shape, n_sensors).with_fault_events(n_events));
         let frame_ns = sim.frame_ns();
         let input_ranges = sim.spacecraft().effector_input_ranges().to_vec();
+        let fault_log = fault_log::FaultLog::new(sim.faults().specs());
         let stepper = Stepper::new(sim, settings);
 
         // Who steps the frames, and where the frame publishers go: the physics thread (real
@@ -465,6 +468,7 @@ impl Wiring {
             frame_ns,
             record: recording,
             lateness_ring: None,
+            fault_log,
         };
         Ok(Self {
             frames,

@@ -263,6 +263,7 @@ impl LockstepCore {
             .enumerate()
         {
             if let Some(f) = v.frame.as_mut() {
+                lane.shared.fault_edges.note(&f.fault_events);
                 f.boundary_unix_ns = stamp;
                 lane.publisher
                     .publish(f, &lane.shared, lane.record.as_ref());

@@ -388,6 +388,7 @@ impl PhysicsCtx {
                     let Some(mut f) = v.frame.take() else {
                         continue;
                     };
+                    lane.shared.fault_edges.note(&f.fault_events);
                     f.boundary_unix_ns = stamp;
                     f.lateness_ns = lateness_ns;
                     // The handoff, timed (real time): the put itself with `direct`, and the
@@ -418,6 +419,7 @@ impl PhysicsCtx {
                     ..
                 } => {
                     if let Some(f) = v.frame.as_mut() {
+                        lane.shared.fault_edges.note(&f.fault_events);
                         f.boundary_unix_ns = stamp;
                         f.lateness_ns = lateness_ns;
                         publisher.publish(f, &lane.shared, recording.as_ref());

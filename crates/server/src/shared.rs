@@ -118,6 +118,8 @@ pub const SLOW_PUBLISH_NS: u64 = 100_000;
 pub struct Shared {
     /// Set to ask the physics loop to stop at the next frame boundary.
     pub stop: AtomicBool,
+    /// Every fault activation and clearance handed out, per fault index (for the log).
+    pub fault_edges: super::fault_log::FaultEdges,
     /// [`RunState`] as its wire tag.
     run_state: AtomicU8,
     /// The last frame boundary reached, noted before its state is published.

@@ -98,6 +98,8 @@ pub struct TelemetryCtx {
     /// Fleet mode, real time: the frames' lateness, from the fleet's physics thread (the
     /// frames do not come here), with this thread's read position.
     pub lateness_ring: Option<(Arc<LatenessRing>, u64)>,
+    /// The log of the vehicle's fault activations and clearances.
+    pub fault_log: super::fault_log::FaultLog,
 }
 
 struct Publishing {
@@ -247,6 +249,7 @@ impl TelemetryCtx {
         let mut bad_inputs_seen = 0u64;
         let mut faults_seen = 0u64;
         loop {
+            self.fault_log.catch_up(&self.shared.fault_edges);
             let now = Instant::now();
             if now >= next_status {
                 self.warn_physics_rejects(
@@ -314,6 +317,7 @@ impl TelemetryCtx {
         if let Some((ring, next)) = &mut self.lateness_ring {
             drain_lateness(ring, next, &mut p.lateness);
         }
+        self.fault_log.catch_up(&self.shared.fault_edges);
         self.warn_physics_rejects(
             &mut rejects,
             &mut stale_seen,

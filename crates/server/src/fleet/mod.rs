@@ -51,6 +51,7 @@ use super::cli::RunArgs;
 use super::commands::Gate;
 use super::error::{ServerError, SettingsError};
 use super::fault_cmd::FaultSink;
+use super::fault_log::FaultLog;
 use super::intake::{self, CommandSink};
 use super::lateness_ring::LatenessRing;
 use super::lockstep::{CoreLane, LockstepCore};
@@ -240,6 +241,7 @@ pub async fn run(
         })?;
         let cfg = &fleet.vehicles[i].cfg;
         log_warnings(cfg, None);
+        super::fault_log::log_configured(v.sim.faults().specs(), Some(&v.id));
         vs.check_link_faults(cfg).map_err(|e| named(e.into()))?;
         let endpoints = Endpoints::declare(&session, vs, cfg, &topics, &v.sim)
             .await
@@ -289,6 +291,7 @@ pub async fn run(
             frame_ns,
             record: recording.clone(),
             lateness_ring: Some((lateness.clone(), 0)),
+            fault_log: FaultLog::new(v.sim.faults().specs()).for_vehicle(&v.id),
         };
         telemetry.push(super::spawn_telemetry(ctx).map_err(named)?.0);
         parts.push(VehicleParts {
