@@ -4,7 +4,7 @@
 //! command that arrives, and delivers the valid ones: into the physics thread's bounded queue,
 //! or (lockstep, `handoff = "direct"`) to the [`LockstepCore`], which may step the frame there.
 
-use std::sync::mpsc::SyncSender;
+use std::sync::mpsc::{SyncSender, TrySendError};
 use std::sync::{Arc, Mutex};
 
 use flexdyn_proto::{decode_command, CommandMsg, Topics};
@@ -163,7 +163,11 @@ fn command_callback(
                 let mut queue = queue.lock().unwrap_or_else(|p| p.into_inner());
                 let (tx, gate) = &mut *queue;
                 gated_send(gate, &shared, cmd, |cmd| {
-                    tx.try_send((*vehicle, cmd)).is_ok()
+                    match tx.try_send((*vehicle, cmd)) {
+                        Ok(()) => Sent::Queued,
+                        Err(TrySendError::Full(_)) => Sent::Full,
+                        Err(TrySendError::Disconnected(_)) => Sent::RunOver,
+                    }
                 });
             }
             CommandSink::Core { vehicle, core } => core
@@ -174,13 +178,24 @@ fn command_callback(
     }
 }
 
-/// Checks `cmd` against the published tick through `gate` and hands it to `send` (which never
-/// blocks: `false` = the queue is full, the command is dropped and counted).
+/// What became of a command handed to the physics thread's queue.
+enum Sent {
+    /// Queued.
+    Queued,
+    /// The queue was full: dropped, and counted in `commands_dropped`.
+    Full,
+    /// The physics thread has ended (the run reached its duration or stopped): an answer to
+    /// the last tick published, which nothing would step. Not a drop.
+    RunOver,
+}
+
+/// Checks `cmd` against the published tick through `gate` and hands it to `send`, which never
+/// blocks.
 fn gated_send(
     gate: &mut Gate,
     shared: &Shared,
     cmd: CommandMsg,
-    send: impl FnOnce(CommandMsg) -> bool,
+    send: impl FnOnce(CommandMsg) -> Sent,
 ) {
     let published = shared.tick.load(std::sync::atomic::Ordering::Acquire);
     let offer = gate.check(&cmd, published);
@@ -189,11 +204,13 @@ fn gated_send(
         return;
     }
     let (sender, tick) = (cmd.sender_id, cmd.header.tick);
-    if send(cmd) {
-        gate.queued(sender, tick);
-    } else {
-        shared
-            .commands_dropped
-            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    match send(cmd) {
+        Sent::Queued => gate.queued(sender, tick),
+        Sent::Full => {
+            shared
+                .commands_dropped
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
+        Sent::RunOver => {}
     }
 }
