@@ -11,14 +11,12 @@ and a threshold of 0.02 on |sigma|.
 import hashlib
 import math
 import threading
-from pathlib import Path
 
 import flexdyn
 from flexdyn.testing import flexdyn_server
 
 K_NM, P_NMS = 100.0, 300.0
 DURATION_S = 80.0
-SCENARIO = Path(__file__).resolve().parents[3] / "scenarios" / "reference.toml"
 
 
 def pd(state: flexdyn.StateMsg):
@@ -39,7 +37,10 @@ def run_once():
             done.set()
         return pd(state)
 
-    with flexdyn_server(config=SCENARIO, mode="lockstep", participants=[1],
+    # No `config`: the server's embedded default, the reference spacecraft of
+    # scenarios/reference.toml, so this file runs wherever it is copied. Pass
+    # `config="path/to/your.toml"` for your own vehicle.
+    with flexdyn_server(mode="lockstep", participants=[1],
                         duration_s=DURATION_S) as server:
         with flexdyn.Client(server.endpoint) as client:
             with flexdyn.LockstepParticipant(client, sender_id=1, on_state=on_state):

@@ -14,6 +14,10 @@ the OS gives it a free port, and the context waits until the server logs `Zenoh 
 ENDPOINT` and takes the endpoint from that line. On exit it waits for it to end (up to
 `timeout_s`; then it is stopped with SIGTERM, and SIGKILL if need be), then fills in
 `returncode` and the captured `log` (its stderr and stdout).
+
+A server that exits before it is reachable (a bad configuration path, a bad setting) raises
+`ServerFailed` with the server's own `error: …` line, its exit code and its whole log, instead
+of handing the test an endpoint that nothing listens on.
 """
 
 from __future__ import annotations
@@ -56,6 +60,18 @@ def reported_endpoint(log: str) -> Optional[str]:
         if i >= 0:
             return line[i + len(LISTENING):].split()[0].rstrip(",")
     return None
+
+
+class ServerFailed(RuntimeError):
+    """The server exited before it was reachable. `str()` is the server's own error line;
+    `returncode` and `log` are its exit code and everything it wrote."""
+
+    def __init__(self, returncode: Optional[int], log: str):
+        errors = [line for line in log.splitlines() if line.startswith("error: ")]
+        message = errors[-1] if errors else f"flexdyn exited with {returncode} before listening"
+        super().__init__(f"{message} (exit code {returncode})")
+        self.returncode = returncode
+        self.log = log
 
 
 @dataclass
@@ -105,7 +121,9 @@ def flexdyn_server(config: Optional[str] = None, mode: str = "lockstep",
                 run.port = int(endpoint.rsplit(":", 1)[1])
                 break
             if proc.poll() is not None:
-                break  # ended early: the exit code and log tell why
+                # Ended before it was reachable: its own error, not a connection failure later.
+                log.seek(0)
+                raise ServerFailed(proc.returncode, log.read().decode("utf-8", "replace"))
             if time.monotonic() > deadline:
                 raise TimeoutError(f"flexdyn reported no endpoint within {ready_timeout_s} s")
             time.sleep(0.05)
