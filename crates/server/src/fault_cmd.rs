@@ -26,7 +26,7 @@ use zenoh::Session;
 
 use super::error::ServerError;
 use super::intake::record_arrival;
-use super::lockstep::LockstepCore;
+use super::lockstep::VehicleCore;
 use super::reject_log::RejectLog;
 use super::shared::Shared;
 use flexdyn_faults::live::LiveResolver;
@@ -38,12 +38,7 @@ pub(super) enum FaultSink {
     /// The physics thread's bounded queue, drained before each frame is stepped.
     Queue(SyncSender<LiveRequest>),
     /// Lockstep with `handoff = "direct"`: the core, installed under its lock.
-    Core {
-        /// The vehicle's index in the world (0 for one spacecraft).
-        vehicle: usize,
-        /// The world's core.
-        core: Arc<Mutex<LockstepCore>>,
-    },
+    Core(VehicleCore),
 }
 
 /// Subscribes the live-fault callback to `flexdyn/<sc>/fault`; dropping the subscriber stops it.
@@ -119,24 +114,21 @@ pub(super) async fn declare(
                     tracing::info!(at_tick = cmd.at_tick, "fault command queued: {what}");
                 }
             }
-            FaultSink::Core { vehicle, core } => {
-                let mut core = core.lock().unwrap_or_else(|p| p.into_inner());
-                match core.install_fault(*vehicle, req) {
-                    Ok(()) => {
-                        tracing::info!(at_tick = cmd.at_tick, "fault command applied: {what}")
-                    }
-                    Err(code) => {
-                        warn(
-                            "fault_refused",
-                            &format_args!(
-                                "fault command refused ({what}): {}",
-                                INSTALL_REFUSALS.get(usize::from(code)).unwrap_or(&"")
-                            ),
-                        );
-                        shared.reject_fault();
-                    }
+            FaultSink::Core(core) => match core.install_fault(req) {
+                Ok(()) => {
+                    tracing::info!(at_tick = cmd.at_tick, "fault command applied: {what}")
                 }
-            }
+                Err(code) => {
+                    warn(
+                        "fault_refused",
+                        &format_args!(
+                            "fault command refused ({what}): {}",
+                            INSTALL_REFUSALS.get(usize::from(code)).unwrap_or(&"")
+                        ),
+                    );
+                    shared.reject_fault();
+                }
+            },
         }
     };
     session

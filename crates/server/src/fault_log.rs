@@ -2,9 +2,9 @@
 //! activation and clearance as it happens, under every driver (physics thread, lockstep core,
 //! fleet).
 //!
-//! Whoever hands a frame out notes its fault events in the vehicle's [`FaultEdges`] (a few
-//! atomic adds per event: nothing that can slow the physics thread, and nothing at all in a
-//! frame without events). The vehicle's telemetry thread, which wakes every frame or every
+//! Whoever publishes a frame notes its fault events in the vehicle's [`FaultEdges`]
+//! ([`super::publish::FramePublisher::publish`], beside the active-fault set: a few atomic adds
+//! per event, nothing at all in a frame without events). The vehicle's telemetry thread, which wakes every frame or every
 //! 20 ms, sees the count move and writes the log lines ([`FaultLog`]). A fault that activates
 //! and clears between two looks is logged with both edges, and a repeated one with its count.
 

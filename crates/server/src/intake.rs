@@ -13,7 +13,7 @@ use zenoh::Session;
 
 use super::commands::{Gate, Offer};
 use super::error::ServerError;
-use super::lockstep::LockstepCore;
+use super::lockstep::VehicleCore;
 use super::reject_log::RejectLog;
 use super::settings::ServerSettings;
 use super::shared::Shared;
@@ -32,12 +32,7 @@ pub(super) enum CommandSink {
         queue: Mutex<(SyncSender<(usize, CommandMsg)>, Gate)>,
     },
     /// Lockstep with `handoff = "direct"`: the core, stepped in this callback.
-    Core {
-        /// The vehicle's index in the world (0 for one spacecraft).
-        vehicle: usize,
-        /// The world's core.
-        core: Arc<Mutex<LockstepCore>>,
-    },
+    Core(VehicleCore),
 }
 
 /// Subscribes the command callback to `flexdyn/<sc>/cmd/*`; dropping the subscriber stops the
@@ -170,10 +165,7 @@ fn command_callback(
                     }
                 });
             }
-            CommandSink::Core { vehicle, core } => core
-                .lock()
-                .unwrap_or_else(|p| p.into_inner())
-                .offer(*vehicle, &cmd),
+            CommandSink::Core(core) => core.offer(&cmd),
         }
     }
 }

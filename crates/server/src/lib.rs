@@ -391,14 +391,12 @@ impl Wiring {
                 total_frames,
                 events.clone(),
             )));
-            let sink = CommandSink::Core {
+            let seat = lockstep::VehicleCore {
                 vehicle: 0,
                 core: core.clone(),
             };
-            let fault_sink = fault_cmd::FaultSink::Core {
-                vehicle: 0,
-                core: core.clone(),
-            };
+            let sink = CommandSink::Core(seat.clone());
+            let fault_sink = fault_cmd::FaultSink::Core(seat);
             let frames = Frames::Core {
                 core,
                 events,

@@ -37,7 +37,7 @@ use tokio::sync::Notify;
 use super::error::ServerError;
 use super::physics::{Ending, PhysicsReport, Spent};
 use super::publish::{FramePublisher, Recording};
-use super::relative::RelativePublisher;
+use super::relative::{publish_deputy, RelativePublisher};
 use super::shared::Shared;
 use super::stepper::count_offer;
 use super::world::WorldStepper;
@@ -65,6 +65,33 @@ pub struct CoreLane {
     pub record: Option<Recording>,
     /// Its counters (its StatusMsg reads them).
     pub shared: Arc<Shared>,
+}
+
+/// One vehicle's way into the world's core: what its command and fault callbacks hold in
+/// lockstep with `handoff = "direct"`. Each call takes the core's lock and passes the vehicle's
+/// index along.
+#[derive(Clone)]
+pub struct VehicleCore {
+    /// The vehicle's index in the world (0 for one spacecraft).
+    pub vehicle: usize,
+    /// The world's core.
+    pub core: Arc<std::sync::Mutex<LockstepCore>>,
+}
+
+impl VehicleCore {
+    fn lock(&self) -> std::sync::MutexGuard<'_, LockstepCore> {
+        self.core.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// [`LockstepCore::offer`] for this vehicle.
+    pub fn offer(&self, cmd: &CommandMsg) {
+        self.lock().offer(self.vehicle, cmd);
+    }
+
+    /// [`LockstepCore::install_fault`] for this vehicle.
+    pub fn install_fault(&self, req: flexdyn_faults::ports::LiveRequest) -> Result<(), u8> {
+        self.lock().install_fault(self.vehicle, req)
+    }
 }
 
 /// The lockstep state machine, driven by the Zenoh command callbacks.
@@ -263,16 +290,18 @@ impl LockstepCore {
             .enumerate()
         {
             if let Some(f) = v.frame.as_mut() {
-                lane.shared.fault_edges.note(&f.fault_events);
                 f.boundary_unix_ns = stamp;
                 lane.publisher
                     .publish(f, &lane.shared, lane.record.as_ref());
             }
-            for (pair, rp) in self.world.pairs.iter().zip(&mut self.relative) {
-                if pair.deputy == i {
-                    rp.publish(pair, stamp, &lane.shared, lane.record.as_ref());
-                }
-            }
+            publish_deputy(
+                i,
+                &self.world.pairs,
+                &mut self.relative,
+                stamp,
+                &lane.shared,
+                lane.record.as_ref(),
+            );
         }
         for lane in &self.lanes {
             lane.shared.tick.store(self.k, Ordering::Relaxed);

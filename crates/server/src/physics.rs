@@ -40,7 +40,7 @@ use super::error::ServerError;
 use super::lateness_ring::LatenessRing;
 use super::pacing::{FrameEnd, Pacer};
 use super::publish::{FramePublisher, Recording};
-use super::relative::RelativePublisher;
+use super::relative::{publish_deputy, RelativePublisher};
 use super::rt::{monotonic_ns, ThreadUsage};
 use super::settings::ServerSettings;
 use super::shared::{Frame, Shared};
@@ -388,7 +388,6 @@ impl PhysicsCtx {
                     let Some(mut f) = v.frame.take() else {
                         continue;
                     };
-                    lane.shared.fault_edges.note(&f.fault_events);
                     f.boundary_unix_ns = stamp;
                     f.lateness_ns = lateness_ns;
                     // The handoff, timed (real time): the put itself with `direct`, and the
@@ -419,17 +418,19 @@ impl PhysicsCtx {
                     ..
                 } => {
                     if let Some(f) = v.frame.as_mut() {
-                        lane.shared.fault_edges.note(&f.fault_events);
                         f.boundary_unix_ns = stamp;
                         f.lateness_ns = lateness_ns;
                         publisher.publish(f, &lane.shared, recording.as_ref());
                     }
                     // Its relative states, after its frame.
-                    for (pair, rp) in world.pairs.iter().zip(&mut self.relative) {
-                        if pair.deputy == i {
-                            rp.publish(pair, stamp, &lane.shared, recording.as_ref());
-                        }
-                    }
+                    publish_deputy(
+                        i,
+                        &world.pairs,
+                        &mut self.relative,
+                        stamp,
+                        &lane.shared,
+                        recording.as_ref(),
+                    );
                 }
             }
         }

@@ -163,7 +163,8 @@ impl FramePublisher {
     /// Encodes and publishes `frame` (its time message, its sensors, then the state), queueing
     /// each payload
     /// for `rec` too. Counts the state in `shared.published`, failures in
-    /// `shared.publish_errors`, and notes the frame's command bookkeeping.
+    /// `shared.publish_errors`, and notes the frame's command bookkeeping, its active faults
+    /// and its fault events (for the log: [`super::fault_log`]).
     pub fn publish(&mut self, frame: &Frame, shared: &Shared, rec: Option<&Recording>) {
         let stamp = frame.boundary_unix_ns.to_le_bytes();
         encode_into(&frame.time, &mut self.time_buf);
@@ -193,6 +194,7 @@ impl FramePublisher {
         encode_into(&frame.state, &mut self.state_buf);
         shared.set_last_command(&frame.command);
         shared.set_faults_active(frame.faults_active.0, &frame.faults_active.1);
+        shared.fault_edges.note(&frame.fault_events);
         match self
             .state_pub
             .put(self.state_buf.as_slice())

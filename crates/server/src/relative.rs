@@ -84,3 +84,21 @@ impl RelativePublisher {
         }
     }
 }
+
+/// Vehicle `deputy`'s relative states, right after its frame: every pair of `pairs` whose
+/// deputy it is, each with its publisher (`publishers[j]` is `pairs[j]`'s), counted in the
+/// deputy's `shared` and queued for its `rec`.
+pub fn publish_deputy(
+    deputy: usize,
+    pairs: &[RelativePair],
+    publishers: &mut [RelativePublisher],
+    stamp_ns: u64,
+    shared: &Shared,
+    rec: Option<&Recording>,
+) {
+    for (pair, rp) in pairs.iter().zip(publishers) {
+        if pair.deputy == deputy {
+            rp.publish(pair, stamp_ns, shared, rec);
+        }
+    }
+}

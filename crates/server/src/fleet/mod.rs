@@ -54,7 +54,7 @@ use super::fault_cmd::FaultSink;
 use super::fault_log::FaultLog;
 use super::intake::{self, CommandSink};
 use super::lateness_ring::LatenessRing;
-use super::lockstep::{CoreLane, LockstepCore};
+use super::lockstep::{CoreLane, LockstepCore, VehicleCore};
 use super::operator;
 use super::physics::{Lane, Outlet, PhysicsCtx};
 use super::presence::Presence;
@@ -381,16 +381,13 @@ pub async fn run(
         let named = |e: ServerError| named(&ids[i], e);
         let sh = shared[i].clone();
         let (sink, fault_sink) = match &core {
-            Some(core) => (
-                CommandSink::Core {
+            Some(core) => {
+                let seat = VehicleCore {
                     vehicle: i,
                     core: core.clone(),
-                },
-                FaultSink::Core {
-                    vehicle: i,
-                    core: core.clone(),
-                },
-            ),
+                };
+                (CommandSink::Core(seat.clone()), FaultSink::Core(seat))
+            }
             None => (
                 CommandSink::Queue {
                     vehicle: i,
