@@ -5,6 +5,10 @@
 //! heading text, drop every character that is not a letter, a digit, a space, `-` or `_`,
 //! turn each space into `-`, and suffix `-1`, `-2`, … to repeats. Inline code and emphasis
 //! markers are dropped with the punctuation. Links inside fenced code blocks are not links.
+//!
+//! The documents are the READMEs below and every page of the book, as `docs/SUMMARY.md` lists
+//! them (`crate::readme_snippets::book_pages`, which also refuses a page under `docs/` that
+//! SUMMARY.md does not list); SUMMARY.md's own links are checked too.
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -14,8 +18,14 @@ const DOCUMENTS: &[&str] = &[
     "proto/README.md",
     "proto/c/README.md",
     "clients/python/README.md",
-    "docs/errata.md",
+    "docs/SUMMARY.md",
 ];
+
+/// The READMEs, SUMMARY.md and every page of the book.
+fn documents() -> Vec<PathBuf> {
+    let pages = crate::readme_snippets::book_pages().unwrap_or_else(|p| panic!("{}", p.join("\n")));
+    DOCUMENTS.iter().map(PathBuf::from).chain(pages).collect()
+}
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -162,7 +172,9 @@ fn broken_links_are_found() {
 
 #[test]
 fn every_relative_link_in_the_documents_resolves() {
-    let problems: Vec<String> = DOCUMENTS
+    let documents = documents();
+    assert!(documents.len() > DOCUMENTS.len(), "the book has no pages");
+    let problems: Vec<String> = documents
         .iter()
         .flat_map(|d| broken_links(&root().join(d)))
         .collect();
@@ -278,10 +290,17 @@ fn header_problems_are_found() {
 
 /// The shipped scenarios' headers cite README sections that exist and demo options the README
 /// shows there. (The header of `wheels_star_tracker.toml` once cited a section, "Reaction wheels
-/// and a star tracker", and options that the README never had.)
+/// and a star tracker", and options that the README never had.) Since the README became a short
+/// README and a book (issue 36), a section cited as the README's is a heading of README.md or of
+/// a page of the book.
 #[test]
 fn scenario_headers_cite_what_the_readme_shows() {
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let readme = documents()
+        .iter()
+        .filter(|d| !DOCUMENTS[1..].contains(&d.to_str().unwrap()))
+        .map(|d| std::fs::read_to_string(root().join(d)).unwrap())
+        .collect::<Vec<_>>()
+        .join("\n");
     let mut problems = Vec::new();
     let mut cited = 0;
     for entry in std::fs::read_dir(root().join("scenarios")).unwrap() {

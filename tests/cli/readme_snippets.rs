@@ -1,11 +1,23 @@
-//! Every fenced block of README.md runs here, or is marked as what it is (issue 25: "every
-//! snippet in the README runs in a test, or is marked as an excerpt of a file that does").
+//! Every fenced block of README.md and of the book under `docs/` runs here, or is marked as what
+//! it is (issue 25: "every snippet in the README runs in a test, or is marked as an excerpt of a
+//! file that does"; issue 36 cut the README into a short README and a book).
+//!
+//! The documents are README.md, then every page that `docs/SUMMARY.md` lists, in its order
+//! ([`book_pages`]). A Markdown file under `docs/` that SUMMARY.md does not list, or a listed page
+//! that does not exist, is an error: a page nobody reaches is a page nobody checks.
+//!
+//! **One sandbox, in book order.** The pages are not self-contained: a block may use what an
+//! earlier block wrote (`my_craft.toml` from the Simulate guide in the lockstep-in-CI guide,
+//! `pair.toml` from "Several spacecraft" in "Fleet in the server"), exactly as a reader who
+//! follows the README and then the book in order has it. So every shell block runs in the same
+//! sandbox directory, README first, then the pages in SUMMARY order; moving a page in SUMMARY.md
+//! moves its blocks.
 //!
 //! The line before each block is a marker, `<!-- snippet: KIND -->`:
 //!
 //! | KIND | the block | what this test does |
 //! |---|---|---|
-//! | `run` | shell | runs it with bash (`-e`), in README order, in one sandbox directory; it must exit 0 |
+//! | `run` | shell | runs it with bash (`-e`), in book order, in one sandbox directory; it must exit 0 |
 //! | `run (Ctrl-C after N s)` | shell | the same; a command that runs until Ctrl-C gets SIGINT after N s and must exit 0 |
 //! | `terminals (Ctrl-C after N s)` | shell | each command in its own terminal, started in order 1 s apart; likewise |
 //! | `config` / `config onto PATH` | TOML | its tables replace those of the embedded default (or of PATH); `flexdyn check-config` must accept the result |
@@ -16,14 +28,21 @@
 //! | `install (WHY)` | shell | nothing: installs on the user's machine; WHY says what does the same |
 //! | `elsewhere (WHY)` | any | nothing: needs what this machine lacks (a cluster, a lab network); WHY names the test that runs the same command, and the file must exist |
 //!
+//! Paths in markers (`config onto PATH`, `excerpt of PATH`, the files an `elsewhere` names) are
+//! relative to the repository's root, whichever page the block is on.
+//!
 //! Python blocks are checked by `clients/python/tests/test_readme_snippets.py`.
 //!
 //! Shell blocks run in the sandbox (`target/<profile>/readme-sandbox`), with `scenarios/` linked
 //! in and `target/release/` holding stand-ins (`tests/readme/stand_in.sh`) for `cargo` and the
-//! binaries, first on the PATH. Each block runs in its own network namespace (`unshare -rn`,
-//! loopback up), so the README's ports (7447, 17500, 8765) are used as written and can collide
-//! with nothing outside; no test here picks a port on the host.
+//! binaries, first on the PATH. The `cargo` stand-in picks the binary of `cargo run` as cargo
+//! does, from the workspace's packages as `cargo metadata` reports them (written once into the
+//! sandbox's `packages.txt`; [`write_packages`]), so a command real cargo refuses fails here too.
+//! Each block runs in its own network namespace (`unshare -rn`, loopback up), so the documents'
+//! ports (7447, 17500, 8765) are used as written and can collide with nothing outside; no test
+//! here picks a port on the host.
 
+use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -163,6 +182,7 @@ fn sandbox() -> PathBuf {
     // The scripts that `output of` blocks run.
     std::fs::create_dir(dir.join("tests")).unwrap();
     std::os::unix::fs::symlink(root().join("tests/readme"), dir.join("tests/readme")).unwrap();
+    write_packages(&dir.join(PACKAGES)).unwrap();
     let script = root().join("tests/readme/stand_in.sh");
     for name in [
         "cargo",
@@ -174,6 +194,68 @@ fn sandbox() -> PathBuf {
         std::os::unix::fs::symlink(&script, stand_ins.join(name)).unwrap();
     }
     dir
+}
+
+/// The sandbox's list of the workspace's packages, which the `cargo` stand-in reads.
+const PACKAGES: &str = "packages.txt";
+
+/// Writes, for every package of the workspace, `name|default-run|bin,bin,…` (the root package's
+/// line first), from `cargo metadata`: the cargo that runs this test (`$CARGO`) reads the
+/// manifests, so the stand-in resolves `cargo run` from the same facts as cargo. (`cargo run` or
+/// `cargo build` from here would wait forever for the build directory, which `cargo test` holds.)
+fn write_packages(file: &Path) -> Result<(), String> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let out = Command::new(cargo)
+        .args([
+            "metadata",
+            "--no-deps",
+            "--format-version",
+            "1",
+            "--offline",
+        ])
+        .current_dir(root())
+        .output()
+        .map_err(|e| format!("cargo metadata: {e}"))?;
+    if !out.status.success() {
+        return Err(format!("cargo metadata: {}", shown(&out)));
+    }
+    let meta: serde_json::Value =
+        serde_json::from_slice(&out.stdout).map_err(|e| format!("cargo metadata: {e}"))?;
+    let root_manifest = root().join("Cargo.toml");
+    let mut lines = Vec::new();
+    for pkg in meta["packages"]
+        .as_array()
+        .ok_or("cargo metadata: no packages")?
+    {
+        let name = pkg["name"]
+            .as_str()
+            .ok_or("cargo metadata: a package without a name")?;
+        let bins: Vec<&str> = pkg["targets"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .filter(|t| {
+                t["kind"]
+                    .as_array()
+                    .is_some_and(|k| k.iter().any(|k| k == "bin"))
+            })
+            .filter_map(|t| t["name"].as_str())
+            .collect();
+        let line = format!(
+            "{name}|{}|{}",
+            pkg["default_run"].as_str().unwrap_or(""),
+            bins.join(",")
+        );
+        let is_root = pkg["manifest_path"]
+            .as_str()
+            .is_some_and(|m| Path::new(m) == root_manifest);
+        if is_root {
+            lines.insert(0, line);
+        } else {
+            lines.push(line);
+        }
+    }
+    std::fs::write(file, lines.join("\n") + "\n").map_err(|e| format!("{}: {e}", file.display()))
 }
 
 /// Runs `script` (bash) in the sandbox, in a network namespace of its own with loopback up,
@@ -196,6 +278,7 @@ fn run_in_sandbox(sandbox: &Path, script: &str, stop_s: Option<u32>) -> Output {
     .current_dir(sandbox)
     .env("PATH", path)
     .env("README_BIN_DIR", bin_dir())
+    .env("README_PACKAGES", sandbox.join(PACKAGES))
     .env_remove("README_STOP_S")
     .stdin(Stdio::null())
     .stdout(Stdio::piped())
@@ -466,61 +549,271 @@ fn package_dir(package: &str) -> Option<PathBuf> {
         })
 }
 
+/// The book's pages, in the order `docs/SUMMARY.md` lists them (its `- [Title](path.md)` items),
+/// relative to the repository's root. Errors: a listed page that does not exist, a page listed
+/// twice, and a Markdown file under `docs/` (but SUMMARY.md itself) that SUMMARY.md does not
+/// list.
+pub(crate) fn book_pages() -> Result<Vec<PathBuf>, Vec<String>> {
+    let docs = root().join("docs");
+    let summary = std::fs::read_to_string(docs.join("SUMMARY.md"))
+        .map_err(|e| vec![format!("docs/SUMMARY.md: {e}")])?;
+    let mut problems = Vec::new();
+    let mut pages: Vec<PathBuf> = Vec::new();
+    for (n, line) in summary.lines().enumerate() {
+        let item = line.trim_start();
+        if !(item.starts_with("- [") || item.starts_with("* [")) {
+            continue;
+        }
+        let Some(target) = item
+            .split_once("](")
+            .and_then(|(_, rest)| rest.split_once(')'))
+            .map(|(t, _)| t)
+        else {
+            problems.push(format!("docs/SUMMARY.md:{}: an item without a link", n + 1));
+            continue;
+        };
+        let page = PathBuf::from("docs").join(target);
+        if !root().join(&page).is_file() {
+            problems.push(format!(
+                "docs/SUMMARY.md:{}: {} does not exist",
+                n + 1,
+                page.display()
+            ));
+        } else if pages.contains(&page) {
+            problems.push(format!(
+                "docs/SUMMARY.md:{}: {} is listed twice",
+                n + 1,
+                page.display()
+            ));
+        } else {
+            pages.push(page);
+        }
+    }
+    let mut stack = vec![docs.clone()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "md") {
+                let rel = path.strip_prefix(root()).unwrap().to_path_buf();
+                if rel != Path::new("docs/SUMMARY.md") && !pages.contains(&rel) {
+                    problems.push(format!(
+                        "{}: not listed in docs/SUMMARY.md, so no reader finds it and no test runs it",
+                        rel.display()
+                    ));
+                }
+            }
+        }
+    }
+    if problems.is_empty() {
+        Ok(pages)
+    } else {
+        Err(problems)
+    }
+}
+
+/// README.md, then the book's pages in SUMMARY order: the documents whose blocks run here.
+pub(crate) fn documents() -> Result<Vec<PathBuf>, Vec<String>> {
+    let mut docs = vec![PathBuf::from("README.md")];
+    docs.extend(book_pages()?);
+    Ok(docs)
+}
+
 #[test]
-fn every_readme_block_runs_or_is_marked() {
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+fn every_block_of_the_readme_and_the_book_runs_or_is_marked() {
+    let documents = documents().unwrap_or_else(|p| panic!("\n{}", p.join("\n")));
     let sandbox = sandbox();
     let mut problems = Vec::new();
     let mut counts = std::collections::BTreeMap::<String, usize>::new();
-    for block in blocks(&readme).iter().filter(|b| b.lang != "python") {
-        let where_ = format!("README.md:{} ({})", block.line, block.lang);
-        let Some(marker) = &block.marker else {
-            problems.push(format!("{where_}: no <!-- snippet: ... --> marker"));
-            continue;
-        };
-        let kind = match parse_kind(marker) {
-            Ok(k) => k,
-            Err(e) => {
-                problems.push(format!("{where_}: {e}"));
-                continue;
-            }
-        };
-        let shell = matches!(block.lang.as_str(), "sh" | "bash");
-        let fits = match &kind {
-            Kind::Run { .. } | Kind::Terminals { .. } | Kind::Bench | Kind::Install => shell,
-            Kind::Config { .. } => block.lang == "toml",
-            Kind::Output(..) | Kind::Synopsis => block.lang == "text",
-            Kind::Excerpt(_) | Kind::Elsewhere(_) => true,
-        };
-        if !fits {
-            problems.push(format!(
-                "{where_}: `{marker}` does not apply to a {} block",
-                block.lang
-            ));
-            continue;
-        }
-        let started = Instant::now();
-        let verdict = check(block, &kind, &sandbox);
-        eprintln!(
-            "{where_}: {marker}: {} in {:.1} s",
-            if verdict.is_ok() { "ok" } else { "FAILED" },
-            started.elapsed().as_secs_f64()
-        );
-        *counts
-            .entry(
-                format!("{kind:?}")
-                    .split([' ', '('])
-                    .next()
-                    .unwrap()
-                    .to_owned(),
-            )
-            .or_default() += 1;
-        if let Err(e) = verdict {
-            problems.push(format!("{where_}: `{marker}`: {e}"));
+    for doc in &documents {
+        let text = std::fs::read_to_string(root().join(doc)).unwrap();
+        for block in blocks(&text).iter().filter(|b| b.lang != "python") {
+            let where_ = format!("{}:{} ({})", doc.display(), block.line, block.lang);
+            check_block(block, &where_, &sandbox, &mut problems, &mut counts);
         }
     }
     eprintln!("blocks by kind: {counts:?}");
     assert!(problems.is_empty(), "\n{}", problems.join("\n\n"));
+    // 62 blocks when the README was cut into the book (issue 36): far fewer means pages are gone.
+    assert!(
+        counts.values().sum::<usize>() > 50,
+        "only {} blocks: are the book's pages there?",
+        counts.values().sum::<usize>()
+    );
+}
+
+/// Checks one block of a document; a problem goes into `problems`, and the block is counted by
+/// kind.
+fn check_block(
+    block: &Block,
+    where_: &str,
+    sandbox: &Path,
+    problems: &mut Vec<String>,
+    counts: &mut std::collections::BTreeMap<String, usize>,
+) {
+    let Some(marker) = &block.marker else {
+        problems.push(format!("{where_}: no <!-- snippet: ... --> marker"));
+        return;
+    };
+    let kind = match parse_kind(marker) {
+        Ok(k) => k,
+        Err(e) => {
+            problems.push(format!("{where_}: {e}"));
+            return;
+        }
+    };
+    let shell = matches!(block.lang.as_str(), "sh" | "bash");
+    let fits = match &kind {
+        Kind::Run { .. } | Kind::Terminals { .. } | Kind::Bench | Kind::Install => shell,
+        Kind::Config { .. } => block.lang == "toml",
+        Kind::Output(..) | Kind::Synopsis => block.lang == "text",
+        Kind::Excerpt(_) | Kind::Elsewhere(_) => true,
+    };
+    if !fits {
+        problems.push(format!(
+            "{where_}: `{marker}` does not apply to a {} block",
+            block.lang
+        ));
+        return;
+    }
+    let started = Instant::now();
+    let verdict = check(block, &kind, sandbox);
+    eprintln!(
+        "{where_}: {marker}: {} in {:.1} s",
+        if verdict.is_ok() { "ok" } else { "FAILED" },
+        started.elapsed().as_secs_f64()
+    );
+    *counts
+        .entry(
+            format!("{kind:?}")
+                .split([' ', '('])
+                .next()
+                .unwrap()
+                .to_owned(),
+        )
+        .or_default() += 1;
+    if let Err(e) = verdict {
+        problems.push(format!("{where_}: `{marker}`: {e}"));
+    }
+}
+
+/// The `cargo` stand-in refuses what cargo refuses. `cargo run --release -p flexdyn-acs-demo`,
+/// in the Quick start, failed under real cargo ("could not determine which binary to run": the
+/// package has two binaries and had no `default-run`) while the old stand-in, which took the
+/// package's name for the binary's, ran it. Here the stand-in gets a package list like the old
+/// one and must exit 101 with cargo's message; with the workspace's own list (from `cargo
+/// metadata`, so the `default-run` line is really there) it must run the demo.
+#[test]
+fn the_cargo_stand_in_picks_the_binary_as_cargo_does() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("readme_stand_in");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::os::unix::fs::symlink(root().join("tests/readme/stand_in.sh"), dir.join("cargo")).unwrap();
+    for bin in ["flexdyn", "flexdyn-acs-demo", "flexdyn-formation-demo"] {
+        let fake = dir.join(bin);
+        std::fs::write(&fake, format!("#!/bin/sh\necho \"ran {bin} $*\"\n")).unwrap();
+        std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    let run = |packages: &str, args: &[&str]| -> Output {
+        let list = dir.join("packages.txt");
+        std::fs::write(&list, packages).unwrap();
+        Command::new(dir.join("cargo"))
+            .args(args)
+            .env("README_PACKAGES", &list)
+            .env("README_BIN_DIR", &dir)
+            .output()
+            .unwrap()
+    };
+    let quick_start = [
+        "run",
+        "--release",
+        "-p",
+        "flexdyn-acs-demo",
+        "--",
+        "--sigma-rn",
+        "0.1,0.2,-0.1",
+    ];
+    // The package as it was: two binaries, no default-run.
+    let old = "flexdyn|flexdyn|flexdyn\nflexdyn-acs-demo||flexdyn-acs-demo,flexdyn-formation-demo\nflexdyn-kernel||\n";
+    let out = run(old, &quick_start);
+    assert_eq!(out.status.code(), Some(101), "{}", shown(&out));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains(
+            "error: `cargo run` could not determine which binary to run. Use the `--bin` option \
+             to specify a binary, or the `default-run` manifest key."
+        ),
+        "{}",
+        shown(&out)
+    );
+    // --bin picks among the package's binaries only; a package without any runs nothing.
+    let out = run(
+        old,
+        &[
+            "run",
+            "--release",
+            "-p",
+            "flexdyn-acs-demo",
+            "--bin",
+            "flexdyn-formation-demo",
+        ],
+    );
+    assert!(out.status.success(), "{}", shown(&out));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "ran flexdyn-formation-demo \n"
+    );
+    let out = run(
+        old,
+        &[
+            "run",
+            "--release",
+            "-p",
+            "flexdyn-acs-demo",
+            "--bin",
+            "flexdyn",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(101), "{}", shown(&out));
+    let out = run(old, &["run", "--release", "-p", "flexdyn-kernel"]);
+    assert_eq!(out.status.code(), Some(101), "{}", shown(&out));
+    let out = run(old, &["run", "--release", "-p", "no-such-package"]);
+    assert_eq!(out.status.code(), Some(101), "{}", shown(&out));
+    // Without -p: the root package, through its default-run.
+    let out = run(old, &["run", "--release", "--", "simulate"]);
+    assert!(out.status.success(), "{}", shown(&out));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "ran flexdyn simulate\n"
+    );
+    // The workspace as it is.
+    let list = dir.join("workspace.txt");
+    write_packages(&list).unwrap();
+    let workspace = std::fs::read_to_string(&list).unwrap();
+    assert!(
+        workspace.starts_with("flexdyn|flexdyn|"),
+        "the root package first: {workspace}"
+    );
+    let demo: Vec<&str> = workspace
+        .lines()
+        .find(|l| l.starts_with("flexdyn-acs-demo|"))
+        .expect("the demo's package")
+        .split('|')
+        .collect();
+    assert_eq!(demo[1], "flexdyn-acs-demo", "its default-run: {workspace}");
+    let mut bins: Vec<&str> = demo[2].split(',').collect();
+    bins.sort_unstable();
+    assert_eq!(
+        bins,
+        ["flexdyn-acs-demo", "flexdyn-formation-demo"],
+        "{workspace}"
+    );
+    let out = run(&workspace, &quick_start);
+    assert!(out.status.success(), "{}", shown(&out));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "ran flexdyn-acs-demo --sigma-rn 0.1,0.2,-0.1\n"
+    );
 }
 
 #[test]

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The README's "Errors" example (section "Configuration"): one mistake at a time in a copy of the
+# The "Errors" example of docs/guides/configuration.md: one mistake at a time in a copy of the
 # embedded default, `my_craft.toml`, each checked with `flexdyn check-config`. Run by
-# tests/cli/readme_snippets.rs, which compares the README's lines with what this prints.
+# tests/cli/readme_snippets.rs, which compares the page's lines with what this prints.
 set -u
 # In a directory of its own, so that a my_craft.toml of the reader's is left alone.
 here=$PWD

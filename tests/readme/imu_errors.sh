@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The README's IMU error examples (section "IMU"): one mistake at a time in a copy of
+# The IMU error examples of docs/models/imu.md ("Keys"): one mistake at a time in a copy of
 # scenarios/imu_tactical.toml, `my_craft.toml`, each checked with `flexdyn check-config`. Run by
-# tests/cli/readme_snippets.rs, which compares the README's lines with what this prints.
+# tests/cli/readme_snippets.rs, which compares the page's lines with what this prints.
 set -u
 # In a directory of its own, so that a my_craft.toml of the reader's is left alone.
 here=$PWD

@@ -1,7 +1,9 @@
-"""The code in the READMEs runs. Every fenced block of clients/python/README.md, and every Python
-block of README.md and proto/README.md, carries a marker on the line before it:
+"""The code in the READMEs and the book runs. Every fenced block of clients/python/README.md, and
+every Python block of README.md, of proto/README.md and of every page of the book (the pages
+docs/SUMMARY.md lists, as tests/cli/readme_snippets.rs reads them), carries a marker on the line
+before it:
 
-- ``<!-- snippet: run -->``: a test here runs it (below, one per README);
+- ``<!-- snippet: run -->``: a test here runs it (below, one per document that has one);
 - ``<!-- snippet: excerpt of PATH -->``: its lines appear, in order, in PATH (a file a test runs);
 - ``<!-- snippet: install (...) -->``: shell commands that install from PyPI, which no test can
   run offline; the reason names what does the same.
@@ -24,9 +26,25 @@ from flexdyn.testing import find_binary, flexdyn_server
 
 WORKSPACE = Path(__file__).resolve().parents[3]
 SDK_README = WORKSPACE / "clients" / "python" / "README.md"
-# README -> the languages whose blocks must be marked (None: all).
+# The book's page that holds the Zenoh session snippet (README.md's until issue 36).
+FLIGHT_CODE = WORKSPACE / "docs" / "guides" / "flight-code.md"
+
+
+def book_pages():
+    """The pages docs/SUMMARY.md lists (``- [Title](path.md)``), in its order."""
+    docs = WORKSPACE / "docs"
+    pages = []
+    for line in (docs / "SUMMARY.md").read_text().splitlines():
+        m = re.match(r"^\s*[-*] \[[^\]]*\]\(([^)]+\.md)\)", line)
+        if m:
+            pages.append(docs / m.group(1))
+    return pages
+
+
+# Document -> the languages whose blocks must be marked (None: all).
 COVERED = {SDK_README: None, WORKSPACE / "README.md": {"python"},
-           WORKSPACE / "proto" / "README.md": {"python"}}
+           WORKSPACE / "proto" / "README.md": {"python"},
+           **{page: {"python"} for page in book_pages()}}
 MARKER = re.compile(r"^<!-- snippet: (run|excerpt of (\S+)|install \(.+\)) -->$")
 
 
@@ -74,10 +92,10 @@ def test_every_covered_snippet_is_run_or_an_excerpt():
             elif m.group(1).startswith("install") and lang != "sh":
                 problems.append(f"{where}: only shell blocks can be install commands")
     assert not problems, "\n".join(problems)
-    # Each README's run blocks are the ones the tests below run.
-    assert len(marked(SDK_README)) == 2
-    assert len(marked(WORKSPACE / "README.md")) == 1
-    assert len(marked(WORKSPACE / "proto" / "README.md")) == 1
+    # Each document's run blocks are the ones the tests below run, and no other has one.
+    assert FLIGHT_CODE in COVERED, "docs/SUMMARY.md does not list the flight-code guide"
+    runs = {p: len(marked(p)) for p in COVERED if marked(p)}
+    assert runs == {SDK_README: 2, FLIGHT_CODE: 1, WORKSPACE / "proto" / "README.md": 1}, runs
 
 
 @pytest.mark.parametrize("index", [0, 1])
@@ -91,8 +109,9 @@ def test_sdk_readme_snippets_run_as_written(index):
 
 
 def test_the_zenoh_session_snippet_receives_the_state():
-    """README.md's session options, pointed at a test server (it names the default port)."""
-    (code,) = marked(WORKSPACE / "README.md")
+    """The flight-code guide's session options, pointed at a test server (it names the default
+    port)."""
+    (code,) = marked(FLIGHT_CODE)
     assert '"tcp/127.0.0.1:7447"' in code
     got = threading.Event()
     with flexdyn_server(mode="realtime", duration_s=3.0) as server:
@@ -101,7 +120,7 @@ def test_the_zenoh_session_snippet_receives_the_state():
         session = ns["session"]
         try:
             sub = session.declare_subscriber(proto.state_key("sc1"), lambda s: got.set())
-            assert got.wait(30), "no StateMsg through the README's session"
+            assert got.wait(30), "no StateMsg through the guide's session"
             sub.undeclare()
         finally:
             session.close()
