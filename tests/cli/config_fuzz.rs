@@ -1,7 +1,8 @@
 //! A property test over configurations, run through the `flexdyn` binary as a user would.
 //!
-//! Start from a shipped configuration (the reference, and the IMU scenario with a `[server]`
-//! table), apply 1–3 random edits — delete a key or element, change a value's type, extend or
+//! Start from a shipped configuration (the reference, the IMU scenario with a `[server]`
+//! table, the LEO environment scenario with every other sensor kind, and the wheels with a star
+//! tracker), apply 1–3 random edits — delete a key or element, change a value's type, extend or
 //! truncate an array, insert an unknown key, set an extreme or non-finite number — and check:
 //!
 //! - either `check-config` accepts the file, and then `simulate` runs it for 1 s, exits 0 and
@@ -30,7 +31,8 @@ fn env_u64(name: &str, default: u64) -> u64 {
         .unwrap_or(default)
 }
 
-fn flexdyn(args: &[&str]) -> Output {
+/// Runs the `flexdyn` binary with `args` (warnings only in the log).
+pub(crate) fn flexdyn(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_flexdyn"))
         .args(args)
         .env("RUST_LOG", "warn")
@@ -38,9 +40,9 @@ fn flexdyn(args: &[&str]) -> Output {
         .expect("runs the flexdyn binary")
 }
 
-fn scratch() -> PathBuf {
-    let dir =
-        Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("config_fuzz-{}", std::process::id()));
+/// A scratch directory for the test `name`, kept after the run (failing files stay to read).
+pub(crate) fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
@@ -53,7 +55,16 @@ fn bases() -> Vec<Table> {
         "{imu}\n[server]\nmode = \"lockstep\"\nparticipants = [1, 2]\nduration_s = 10.0\n\
          stale_after_s = 0.2\nsc_id = \"craft-1\"\n"
     );
-    vec![reference.parse().unwrap(), imu_server.parse().unwrap()]
+    // Every sensor kind, the world's environment and wheels (each number of each sensor kind is
+    // also set systematically in `sensor_bounds.rs`).
+    let sensors = std::fs::read_to_string(root.join("leo_environment.toml")).unwrap();
+    let wheels = std::fs::read_to_string(root.join("wheels_star_tracker.toml")).unwrap();
+    vec![
+        reference.parse().unwrap(),
+        imu_server.parse().unwrap(),
+        sensors.parse().unwrap(),
+        wheels.parse().unwrap(),
+    ]
 }
 
 /// A path to a value: keys for tables, indices for arrays.
@@ -212,9 +223,26 @@ fn names_file_and_field(line: &str, file: &str) -> bool {
     is_path || rest.contains("line ")
 }
 
+/// Every number `simulate` wrote is finite: `Err` names the first that is not. Lines starting
+/// with `#` are the file's metadata (the epoch), the next is the header; an empty field is a
+/// sensor that did not sample on that row.
+pub(crate) fn all_finite(stdout: &[u8]) -> Result<(), String> {
+    let text = String::from_utf8_lossy(stdout);
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<&str> = lines.next().ok_or("no header")?.split(',').collect();
+    for (row, line) in lines.enumerate() {
+        for (column, field) in header.iter().zip(line.split(',')) {
+            if !field.is_empty() && !field.parse::<f64>().is_ok_and(f64::is_finite) {
+                return Err(format!("`{field}` in column {column} of row {row}"));
+            }
+        }
+    }
+    Ok(())
+}
+
 #[test]
 fn random_edits_are_accepted_and_run_finite_or_rejected_in_one_clear_line() {
-    let dir = scratch();
+    let dir = scratch("config_fuzz");
     let bases = bases();
     let cases = env_u64("FLEXDYN_FUZZ_CASES", CASES as u64) as usize;
     let mut rng = ChaCha8Rng::seed_from_u64(env_u64("FLEXDYN_FUZZ_SEED", 0x00f1_e0d1));
@@ -255,12 +283,8 @@ fn random_edits_are_accepted_and_run_finite_or_rejected_in_one_clear_line() {
                     "accepted but simulate failed: {serr}\n{}",
                     context()
                 );
-                let csv = String::from_utf8_lossy(&sim.stdout);
-                for row in csv.lines().skip(1) {
-                    for f in row.split(',') {
-                        let v: f64 = f.parse().unwrap();
-                        assert!(v.is_finite(), "non-finite `{f}` written\n{}", context());
-                    }
+                if let Err(e) = all_finite(&sim.stdout) {
+                    panic!("non-finite {e} written\n{}", context());
                 }
             }
             Some(2) => {

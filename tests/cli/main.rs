@@ -32,5 +32,6 @@ mod readme_snippets;
 mod recording_faults;
 mod recording_files;
 mod regress_sensor_outputs;
+mod sensor_bounds;
 mod served_config;
 mod sun_sensors;

@@ -101,7 +101,7 @@ impl WrenchSegment {
 }
 
 use flexdyn_kernel::validate::{
-    check_dcm, check_finite, check_inertia_matrix, check_positive, ParamError,
+    check_dcm, check_finite, check_inertia_matrix, check_positive, join, ParamError,
 };
 
 impl HubParams {
@@ -126,6 +126,18 @@ impl GravityModel {
             } => {
                 check_positive(path, "mu_m3_s2", mu_m3_s2)?;
                 check_finite(path, "j2", &[j2])?;
+                // J2 = (C − A)/(M R²) (Vallado, 4th ed., Eq. 8-19 with the moments of inertia,
+                // MacCullagh's formula). The expansion holds outside the body, so its mass lies
+                // within R = r_eq_m, where 0 ≤ A, C ≤ M R²: |J2| ≤ 1. Earth's is 1.08e-3.
+                if j2.abs() > 1.0 {
+                    return Err(ParamError::Invalid {
+                        field: join(path, "j2"),
+                        problem: format!(
+                            "|{j2}| exceeds 1: J2 = (C − A)/(M r_eq²) of a body within r_eq is \
+                             at most 1 in magnitude (Earth's is 1.08e-3)"
+                        ),
+                    });
+                }
                 check_positive(path, "r_eq_m", r_eq_m)
             }
         }

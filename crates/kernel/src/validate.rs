@@ -150,6 +150,80 @@ pub fn check_finite(path: &str, field: &str, values: &[f64]) -> Result<(), Param
     }
 }
 
+/// Largest magnitude of a sensor's error term (a noise σ, a bias, a range, an output LSB), in
+/// its unit (rad/s, m/s², T, rad, m, …; a coarse sun sensor's output unit). No sensor errs by a
+/// million of its units: such a value is a unit slip. The bound also keeps every output finite:
+/// near the float range, σ·z or a sum with the truth overflows (a star tracker with
+/// σ = 1e155 rad turned its quaternion into NaN at the first sample).
+pub const MAX_SENSOR_TERM_SI: f64 = 1e6;
+
+/// Checks that every value of the error term `field` (at `path`) is finite and within
+/// ±[`MAX_SENSOR_TERM_SI`]; with `non_negative`, also ≥ 0 (a σ, a range, an LSB).
+pub fn check_sensor_term(
+    path: &str,
+    field: &str,
+    values: &[f64],
+    non_negative: bool,
+) -> Result<(), ParamError> {
+    check_finite(path, field, values)?;
+    for (i, &v) in values.iter().enumerate() {
+        let at = || {
+            if values.len() == 1 {
+                join(path, field)
+            } else {
+                format!("{}[{i}]", join(path, field))
+            }
+        };
+        if non_negative && v < 0.0 {
+            return Err(ParamError::Negative {
+                field: at(),
+                value: v,
+            });
+        }
+        if v.abs() > MAX_SENSOR_TERM_SI {
+            return Err(ParamError::Invalid {
+                field: at(),
+                problem: format!(
+                    "{} is beyond {} (in its unit): no sensor errs by this much; check the units",
+                    Num(v),
+                    Num(MAX_SENSOR_TERM_SI)
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// \[A·m²\] Largest magnetic dipole a spacecraft carries (a torque rod's or a residual): flown
+/// torque rods reach a few hundred A·m²; 1e4 leaves a margin and keeps m × B finite and resolved.
+pub const MAX_DIPOLE_AM2: f64 = 1e4;
+
+/// \[N\] Largest thrust of one thruster: the largest rocket engine flown (the F-1) made about
+/// 6.8e6 N; 1e8 N is a unit slip, and near the float range the force overflows.
+pub const MAX_THRUST_NEWTON: f64 = 1e8;
+
+/// Checks that `v` (at `path.field`) is at most `max` in magnitude (`what` names the bound).
+pub fn check_at_most(
+    path: &str,
+    field: &str,
+    v: f64,
+    max: f64,
+    what: &str,
+) -> Result<(), ParamError> {
+    check_finite(path, field, &[v])?;
+    if v.abs() > max {
+        return Err(ParamError::Invalid {
+            field: join(path, field),
+            problem: format!(
+                "{} is beyond {} ({what}): check the units",
+                Num(v),
+                Num(max)
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// Tolerance on |‖â‖ − 1| for an axis (a wheel's spin axis, a rod's, a thruster's) to count as
 /// a unit vector.
 pub const UNIT_AXIS_TOL: f64 = 1e-6;

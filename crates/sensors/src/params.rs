@@ -29,6 +29,11 @@ pub struct SensorConfigReader {
     pub keys: &'static [&'static str],
     /// Reads an entry's shape.
     pub read: fn(&TableReader<'_, '_>) -> Result<Box<dyn RawSensorConfig>, SchemaError>,
+    /// Its error terms (noise σ, biases, ranges, LSBs) with their lengths (1 for a scalar):
+    /// the keys bounded by [`flexdyn_kernel::validate::MAX_SENSOR_TERM_SI`] (checked by the
+    /// kind's `validate` with [`flexdyn_kernel::validate::check_sensor_term`]; the list
+    /// documents them and drives `tests/cli/sensor_bounds.rs`). A dotted key is in a sub-table.
+    pub error_terms: &'static [(&'static str, usize)],
 }
 
 /// One entry as written, before its values are checked.

@@ -125,11 +125,14 @@ impl Facet {
         if let Some(c) = self.r_cp_b_m.iter().find(|c| !c.is_finite()) {
             return Err(invalid("r_cp_b_m", *c, "finite components"));
         }
-        if !(self.drag_coefficient.is_finite() && self.drag_coefficient >= 0.0) {
+        // A plate's free-molecular drag coefficient is at most 4 (every molecule reflected
+        // straight back at normal incidence: twice the incoming momentum, over q·A = ½ρv²A);
+        // 10 leaves room for conventions that fold other factors in.
+        if !(self.drag_coefficient.is_finite() && (0.0..=10.0).contains(&self.drag_coefficient)) {
             return Err(invalid(
                 "drag_coefficient",
                 self.drag_coefficient,
-                "a finite coefficient >= 0",
+                "a coefficient in [0, 10] (a flat plate's is at most 4)",
             ));
         }
         for (field, value) in [

@@ -38,7 +38,9 @@ use crate::atmosphere::SpaceWeather;
 use crate::facets::{Facet, FacetError};
 use crate::magnetic::IGRF_MAX_DEGREE;
 use crate::shadow::ShadowModel;
+use flexdyn_kernel::numfmt::Num;
 use flexdyn_kernel::schema::{At, SchemaError, TableReader};
+use flexdyn_kernel::validate::MAX_DIPOLE_AM2;
 
 /// The keys of `[environment]`.
 pub const KEYS: [&str; 16] = [
@@ -268,6 +270,18 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
                 ),
             ));
         }
+    }
+    if let Some(m) = residual_dipole_m_b_am2.filter(|m| m.norm() > MAX_DIPOLE_AM2) {
+        return Err(invalid(
+            t,
+            "residual_dipole_m_b_am2",
+            format!(
+                "|m| = {} A·m² is beyond the largest dipole flexdyn accepts ({} A·m²; a \
+                 spacecraft's residual is typically below 1): check the units",
+                Num(m.norm()),
+                Num(MAX_DIPOLE_AM2)
+            ),
+        ));
     }
     if residual_dipole_m_b_am2.is_some() && magnetic == MagneticSetting::Off {
         return Err(invalid(

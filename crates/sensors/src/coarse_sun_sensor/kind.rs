@@ -18,6 +18,7 @@ pub static KIND: SensorKind = SensorKind {
     config: SensorConfigReader {
         keys: &schema::KEYS,
         read: |t| read_boxed(t, schema::read),
+        error_terms: &[("scale", 1), ("bias", 1), ("noise_sigma", 1), ("lsb", 1)],
     },
     key_prefix: CSS_PREFIX,
     column_prefix: "css",

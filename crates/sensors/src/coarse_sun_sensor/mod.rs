@@ -43,7 +43,7 @@
 use nalgebra::Vector3;
 
 use crate::{Sensor, SensorKind, Truth};
-use flexdyn_kernel::validate::{check_finite, check_non_negative, check_unit_axis, ParamError};
+use flexdyn_kernel::validate::{check_finite, check_sensor_term, check_unit_axis, ParamError};
 use flexdyn_proto::{encode_into, CssMsg, Header, MAX_CSS_DETECTORS};
 
 use super::rng::NormalRng;
@@ -105,9 +105,10 @@ impl CoarseSunSensorConfig {
             });
         }
         flexdyn_kernel::validate::check_positive(path, "scale", self.scale)?;
-        check_finite(path, "bias", &[self.bias])?;
-        check_non_negative(path, "noise_sigma", self.noise_sigma)?;
-        check_non_negative(path, "lsb", self.lsb)
+        check_sensor_term(path, "scale", &[self.scale], true)?;
+        check_sensor_term(path, "bias", &[self.bias], false)?;
+        check_sensor_term(path, "noise_sigma", &[self.noise_sigma], true)?;
+        check_sensor_term(path, "lsb", &[self.lsb], true)
     }
 }
 

@@ -18,6 +18,7 @@ pub static KIND: SensorKind = SensorKind {
     config: SensorConfigReader {
         keys: &schema::KEYS,
         read: |t| read_boxed(t, schema::read),
+        error_terms: &[("bias_rad", 2), ("noise_sigma_rad", 1), ("lsb_rad", 1)],
     },
     key_prefix: FSS_PREFIX,
     column_prefix: "fss",

@@ -41,7 +41,7 @@
 use nalgebra::{Matrix3, Vector2, Vector3};
 
 use crate::{Sensor, SensorKind, Truth};
-use flexdyn_kernel::validate::{check_dcm, check_finite, check_non_negative, ParamError};
+use flexdyn_kernel::validate::{check_dcm, check_finite, check_sensor_term, ParamError};
 use flexdyn_proto::{encode_into, fss_flags, FssMsg, Header};
 
 use super::rng::NormalRng;
@@ -90,9 +90,9 @@ impl FineSunSensorConfig {
                 ),
             });
         }
-        check_finite(path, "bias_rad", self.bias_rad.as_slice())?;
-        check_non_negative(path, "noise_sigma_rad", self.noise_sigma_rad)?;
-        check_non_negative(path, "lsb_rad", self.lsb_rad)?;
+        check_sensor_term(path, "bias_rad", self.bias_rad.as_slice(), false)?;
+        check_sensor_term(path, "noise_sigma_rad", &[self.noise_sigma_rad], true)?;
+        check_sensor_term(path, "lsb_rad", &[self.lsb_rad], true)?;
         check_finite(path, "min_shadow_factor", &[self.min_shadow_factor])?;
         if !(self.min_shadow_factor > 0.0 && self.min_shadow_factor <= 1.0) {
             return Err(ParamError::Invalid {

@@ -17,6 +17,12 @@ pub static KIND: SensorKind = SensorKind {
     config: SensorConfigReader {
         keys: &schema::KEYS,
         read: |t| read_boxed(t, schema::read),
+        error_terms: &[
+            ("position_sigma_m", 1),
+            ("velocity_sigma_m_s", 1),
+            ("position_bias_e_m", 3),
+            ("velocity_bias_e_m_s", 3),
+        ],
     },
     key_prefix: GPS_PREFIX,
     column_prefix: "gps",

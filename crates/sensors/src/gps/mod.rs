@@ -52,7 +52,7 @@ use nalgebra::Vector3;
 use crate::{Sensor, SensorKind, Truth};
 use flexdyn_environment::earth_rotation::EarthRotation;
 use flexdyn_environment::epoch::SimEpoch;
-use flexdyn_kernel::validate::{check_finite, check_non_negative, ParamError};
+use flexdyn_kernel::validate::{check_sensor_term, ParamError};
 use flexdyn_proto::{encode_into, gps_flags, GpsMsg, Header};
 
 use super::rng::NormalRng;
@@ -94,13 +94,19 @@ pub struct GpsConfig {
 impl GpsConfig {
     /// Validates the values (`path` is e.g. `gps_receivers[0]`).
     pub fn validate(&self, path: &str) -> Result<(), ParamError> {
-        check_non_negative(path, "position_sigma_m", self.position_sigma_m)?;
-        check_non_negative(path, "velocity_sigma_m_s", self.velocity_sigma_m_s)?;
-        check_finite(path, "position_bias_e_m", self.position_bias_e_m.as_slice())?;
-        check_finite(
+        check_sensor_term(path, "position_sigma_m", &[self.position_sigma_m], true)?;
+        check_sensor_term(path, "velocity_sigma_m_s", &[self.velocity_sigma_m_s], true)?;
+        check_sensor_term(
+            path,
+            "position_bias_e_m",
+            self.position_bias_e_m.as_slice(),
+            false,
+        )?;
+        check_sensor_term(
             path,
             "velocity_bias_e_m_s",
             self.velocity_bias_e_m_s.as_slice(),
+            false,
         )
     }
 

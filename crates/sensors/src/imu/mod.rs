@@ -61,7 +61,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use flexdyn_dynamics::SensorPoint;
 use flexdyn_kernel::attitude::{dcm_to_quat, mrp_to_dcm};
-use flexdyn_kernel::validate::{check_finite, ParamError};
+use flexdyn_kernel::validate::{check_finite, check_non_negative, check_sensor_term, ParamError};
 use flexdyn_proto::{saturation_flags, Header, ImuMsg};
 
 use super::rng::NormalRng;
@@ -310,26 +310,20 @@ impl TriadParams {
     fn validate(&self, path: &str, k: &TriadKeys) -> Result<(), ImuParamError> {
         let t = format!("{path}.{}", k.table);
         let field = |key: &str| format!("{t}.{key}");
-        check_finite(&t, k.bias, self.bias.as_slice())?;
+        check_sensor_term(&t, k.bias, self.bias.as_slice(), false)?;
         check_finite(&t, "scale_factor", self.scale_factor.as_slice())?;
         check_finite(&t, "misalignment_rad", self.misalignment.as_slice())?;
+        // The correlation time is not an error term: a long τ only makes the bias steadier.
+        check_non_negative(&t, "bias_instability_tau_s", self.gm_tau_s)?;
         for (key, v) in [
             (k.white, self.white),
             (k.gm_sigma, self.gm_sigma),
-            ("bias_instability_tau_s", self.gm_tau_s),
             (k.rrw, self.rrw),
             (k.range, self.range),
             (k.lsb, self.lsb),
             (k.incr_lsb, self.incr_lsb),
         ] {
-            check_finite(&t, key, &[v])?;
-            if v < 0.0 {
-                return Err(ParamError::Negative {
-                    field: field(key),
-                    value: v,
-                }
-                .into());
-            }
+            check_sensor_term(&t, key, &[v], true)?;
         }
         if self.gm_sigma > 0.0 && self.gm_tau_s <= 0.0 {
             return Err(ImuParamError::Invalid {

@@ -19,6 +19,12 @@ pub static KIND: SensorKind = SensorKind {
     config: SensorConfigReader {
         keys: &schema::KEYS,
         read: |t| read_boxed(t, schema::read),
+        error_terms: &[
+            ("bias_s_t", 3),
+            ("noise_sigma_t", 1),
+            ("range_t", 1),
+            ("lsb_t", 1),
+        ],
     },
     key_prefix: MAGNETOMETER_PREFIX,
     column_prefix: "mag",

@@ -44,7 +44,7 @@ use nalgebra::{Matrix3, Vector3};
 use crate::{Sensor, SensorKind, Truth};
 use flexdyn_environment::magnetic::dipole_field_t;
 use flexdyn_kernel::attitude::mrp_to_dcm;
-use flexdyn_kernel::validate::{check_dcm, check_finite, check_non_negative, ParamError};
+use flexdyn_kernel::validate::{check_dcm, check_finite, check_sensor_term, ParamError};
 use flexdyn_proto::{encode_into, magnetometer_flags, Header, MagnetometerMsg};
 
 use super::rng::NormalRng;
@@ -89,13 +89,13 @@ impl MagnetometerConfig {
         check_dcm(path, "dcm_sb", &self.dcm_sb)?;
         check_finite(path, "scale_factor", self.scale_factor.as_slice())?;
         check_finite(path, "misalignment_rad", self.misalignment_rad.as_slice())?;
-        check_finite(path, "bias_s_t", self.bias_s_t.as_slice())?;
+        check_sensor_term(path, "bias_s_t", self.bias_s_t.as_slice(), false)?;
         if let Some(r) = &self.r_sb_b_m {
             check_finite(path, "r_sb_b_m", r.as_slice())?;
         }
-        check_non_negative(path, "noise_sigma_t", self.noise_sigma_t)?;
-        check_non_negative(path, "range_t", self.range_t)?;
-        check_non_negative(path, "lsb_t", self.lsb_t)
+        check_sensor_term(path, "noise_sigma_t", &[self.noise_sigma_t], true)?;
+        check_sensor_term(path, "range_t", &[self.range_t], true)?;
+        check_sensor_term(path, "lsb_t", &[self.lsb_t], true)
     }
 }
 

@@ -19,6 +19,11 @@ pub static KIND: SensorKind = SensorKind {
     config: SensorConfigReader {
         keys: &schema::KEYS,
         read: |t| read_boxed(t, schema::read),
+        error_terms: &[
+            ("sigma_cross_boresight_rad", 1),
+            ("sigma_about_boresight_rad", 1),
+            ("bias_c_rad", 3),
+        ],
     },
     key_prefix: STAR_TRACKER_PREFIX,
     column_prefix: "st",

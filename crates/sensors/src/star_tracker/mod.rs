@@ -37,7 +37,8 @@ use nalgebra::{Matrix3, Vector3, Vector4};
 use crate::{Sensor, SensorKind, Truth};
 use flexdyn_kernel::attitude::{dcm_to_quat, mrp_to_dcm};
 use flexdyn_kernel::validate::{
-    check_dcm, check_finite, check_non_negative, check_positive, join, ParamError,
+    check_dcm, check_finite, check_non_negative, check_positive, check_sensor_term, join,
+    ParamError,
 };
 use flexdyn_proto::{encode_into, star_tracker_flags, Header, StarTrackerMsg};
 
@@ -95,17 +96,19 @@ impl StarTrackerConfig {
                 });
             }
         }
-        check_non_negative(
+        check_sensor_term(
             path,
             "sigma_cross_boresight_rad",
-            self.sigma_cross_boresight_rad,
+            &[self.sigma_cross_boresight_rad],
+            true,
         )?;
-        check_non_negative(
+        check_sensor_term(
             path,
             "sigma_about_boresight_rad",
-            self.sigma_about_boresight_rad,
+            &[self.sigma_about_boresight_rad],
+            true,
         )?;
-        check_finite(path, "bias_c_rad", self.bias_c_rad.as_slice())?;
+        check_sensor_term(path, "bias_c_rad", self.bias_c_rad.as_slice(), false)?;
         check_non_negative(path, "sun_exclusion_rad", self.sun_exclusion_rad)?;
         if self.max_rate_rad_s.is_nan() {
             return Err(ParamError::NotFinite {

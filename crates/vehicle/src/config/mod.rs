@@ -723,7 +723,6 @@ impl RawConfig {
             source_toml: source.to_string(),
         };
         check_body_extent(&cfg, map)?;
-        check_imu_magnitudes(&cfg, map)?;
         check_resolved_by_step(&cfg, map)?;
         // Both remaining checks look at the built spacecraft's initial state: build it once.
         let mut sc = cfg.build_spacecraft()?;
@@ -848,6 +847,29 @@ fn check_body_extent(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError
     for (i, w) in cfg.reaction_wheels.iter().enumerate() {
         check(&format!("reaction_wheels[{i}].r_wb_b_m"), w.r_wb_b_m.norm())?;
     }
+    for (i, m) in cfg.sensors.of::<MagnetometerConfig>().enumerate() {
+        if let Some(r) = &m.r_sb_b_m {
+            check(&format!("magnetometers[{i}].r_sb_b_m"), r.norm())?;
+        }
+    }
+    if let Some(env) = &cfg.environment {
+        for (i, f) in env.facets.iter().enumerate() {
+            let path = format!("environment.facets[{i}]");
+            check(&format!("{path}.r_cp_b_m"), f.r_cp_b_m.norm())?;
+            // A plate within the body's extent is at most that extent squared.
+            if f.area_m2 > MAX_BODY_EXTENT_M * MAX_BODY_EXTENT_M {
+                return Err(map.invalid(
+                    &format!("{path}.area_m2"),
+                    format!(
+                        "{} m² is beyond the largest plate flexdyn accepts ({} m², the \
+                         largest body-fixed distance squared): check the units",
+                        Rounded(f.area_m2, 4),
+                        Num(MAX_BODY_EXTENT_M * MAX_BODY_EXTENT_M)
+                    ),
+                ));
+            }
+        }
+    }
     // Mass and inertia ratios: the hub's 3×3 Schur complement (Eqs. 151–153) subtracts the
     // panels' contributions from the hub's; beyond MAX_MASS_RATIO the difference loses the
     // digits the back-substitution needs (the dense-Kane cross-check measured κ ≈ 3.5e3 for a
@@ -915,55 +937,6 @@ fn check_body_extent(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError
 /// Largest ratio between a panel's mass and the hub's (either way), and between a panel's
 /// largest principal moment and the hub's smallest.
 pub const MAX_MASS_RATIO: f64 = 1e6;
-
-/// Largest magnitude of an IMU error term or range, in its SI unit (rad/s, m/s², …). No gyro
-/// or accelerometer errs by a million SI units; such a value is a unit slip, and values near the
-/// float range would overflow the noise (σ·z) to infinity.
-pub const MAX_IMU_TERM_SI: f64 = 1e6;
-
-/// Rejects IMU error terms beyond [`MAX_IMU_TERM_SI`] (the correlation times are not bounded:
-/// a long τ only makes the bias steadier).
-fn check_imu_magnitudes(cfg: &SimConfig, map: &SourceMap) -> Result<(), ConfigError> {
-    for (i, imu) in cfg.sensors.of::<ImuConfig>().enumerate() {
-        let g = &imu.gyro;
-        let a = &imu.accel;
-        let terms: [(&str, f64); 14] = [
-            ("gyro.arw_rad_s_sqrt_hz", g.arw_rad_s_sqrt_hz),
-            (
-                "gyro.bias_instability_sigma_rad_s",
-                g.bias_instability_sigma_rad_s,
-            ),
-            ("gyro.rrw_rad_s2_sqrt_hz", g.rrw_rad_s2_sqrt_hz),
-            ("gyro.bias_rad_s", g.bias_rad_s.amax()),
-            ("gyro.range_rad_s", g.range_rad_s),
-            ("gyro.lsb_rad_s", g.lsb_rad_s),
-            ("gyro.dtheta_lsb_rad", g.dtheta_lsb_rad),
-            ("accel.vrw_m_s2_sqrt_hz", a.vrw_m_s2_sqrt_hz),
-            (
-                "accel.bias_instability_sigma_m_s2",
-                a.bias_instability_sigma_m_s2,
-            ),
-            ("accel.rrw_m_s3_sqrt_hz", a.rrw_m_s3_sqrt_hz),
-            ("accel.bias_m_s2", a.bias_m_s2.amax()),
-            ("accel.range_m_s2", a.range_m_s2),
-            ("accel.lsb_m_s2", a.lsb_m_s2),
-            ("accel.dv_lsb_m_s", a.dv_lsb_m_s),
-        ];
-        for (key, v) in terms {
-            if v.abs() > MAX_IMU_TERM_SI {
-                return Err(map.invalid(
-                    &format!("imus[{i}].{key}"),
-                    format!(
-                        "{} is beyond {} (SI units): no sensor errs by this much; check the units",
-                        Num(v),
-                        Num(MAX_IMU_TERM_SI)
-                    ),
-                ));
-            }
-        }
-    }
-    Ok(())
-}
 
 /// Largest product of a rate and the RK4 step that a configuration may start with or build in:
 /// a hinge's natural frequency √(k/I) or damping rate c/I, or an initial angular rate, times the

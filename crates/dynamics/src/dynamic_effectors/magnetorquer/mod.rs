@@ -24,7 +24,9 @@ use crate::effector::EffectorKind;
 use crate::params::Wrench;
 use flexdyn_environment::magnetic::dipole_torque_b_nm;
 use flexdyn_environment::EnvironmentSample;
-use flexdyn_kernel::validate::{check_finite, check_positive, check_unit_axis, ParamError};
+use flexdyn_kernel::validate::{
+    check_at_most, check_finite, check_positive, check_unit_axis, ParamError, MAX_DIPOLE_AM2,
+};
 
 /// Wire tag, configuration section and CSV prefix.
 pub const KIND: EffectorKind = EffectorKind {
@@ -60,7 +62,14 @@ impl MagnetorquerParams {
     pub fn validate(&self, path: &str) -> Result<(), ParamError> {
         check_unit_axis(path, "axis_b", &self.axis_b)?;
         check_finite(path, "r_mb_b_m", self.r_mb_b_m.as_slice())?;
-        check_positive(path, "max_dipole_am2", self.max_dipole_am2)
+        check_positive(path, "max_dipole_am2", self.max_dipole_am2)?;
+        check_at_most(
+            path,
+            "max_dipole_am2",
+            self.max_dipole_am2,
+            MAX_DIPOLE_AM2,
+            "the largest dipole flexdyn accepts, in A·m²; flown rods make a few hundred",
+        )
     }
 }
 

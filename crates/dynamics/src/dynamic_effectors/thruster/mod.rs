@@ -47,7 +47,8 @@ use crate::effector::EffectorKind;
 use crate::params::Wrench;
 use flexdyn_environment::EnvironmentSample;
 use flexdyn_kernel::validate::{
-    check_finite, check_non_negative, check_positive, check_unit_axis, join, ParamError,
+    check_at_most, check_finite, check_non_negative, check_positive, check_unit_axis, join,
+    ParamError, MAX_THRUST_NEWTON,
 };
 
 /// Wire tag, configuration section and CSV prefix.
@@ -132,6 +133,13 @@ impl ThrusterParams {
         check_finite(path, "r_tb_b_m", self.r_tb_b_m.as_slice())?;
         check_unit_axis(path, "force_axis_b", &self.force_axis_b)?;
         check_positive(path, "max_thrust_newton", self.max_thrust_newton)?;
+        check_at_most(
+            path,
+            "max_thrust_newton",
+            self.max_thrust_newton,
+            MAX_THRUST_NEWTON,
+            "the largest thrust flexdyn accepts, in N; the F-1 engine made 6.8e6",
+        )?;
         check_positive(path, "isp_s", self.isp_s)?;
         check_non_negative(path, "min_on_time_s", self.min_on_time_s)?;
         let frame_s = frame_ns as f64 * 1e-9;
