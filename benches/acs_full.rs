@@ -222,7 +222,7 @@ fn main() {
     if peer.is_none() {
         println!(
             "\nbasilisk: skipped (set FLEXDYN_PEERS_PYTHON and FLEXDYN_PEER_BSK_ACS; \
-             see the README, \"Performance\")"
+             see docs/developer/benchmarks.md, \"Performance\")"
         );
     }
 }

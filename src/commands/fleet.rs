@@ -25,7 +25,7 @@ use flexdyn_vehicle::world::{walk, FleetConfig, FleetError, RowPlan, RowSink, Wo
 /// Arguments of `flexdyn fleet`.
 #[derive(Debug, Clone, PartialEq, clap::Args)]
 pub struct FleetArgs {
-    /// The fleet file (TOML): `[[vehicles]]` entries (README, "Several spacecraft").
+    /// The fleet file (TOML): `[[vehicles]]` entries (docs/guides/fleets.md).
     pub fleet: PathBuf,
     /// Simulated duration in seconds; must be a whole number of RK4 steps.
     #[arg(

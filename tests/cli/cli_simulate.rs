@@ -32,7 +32,7 @@ fn scratch(name: &str) -> PathBuf {
     dir.join(name)
 }
 
-/// The documented columns of the reference spacecraft (README, "CSV output"), written out.
+/// The documented columns of the reference spacecraft (docs/guides/configuration.md, "CSV output"), written out.
 fn expected_header() -> Vec<String> {
     let mut h: Vec<String> = [
         "t_s",

@@ -958,7 +958,7 @@ fn cases() -> Vec<Case> {
                 assert_eq!(got, (500_000, 20_000_000, 40));
             },
         ),
-        // --- Integrator (README "Choosing the integrator").
+        // --- Integrator (docs/models/verification.md, "Choosing the integrator").
         bad(
             "simulation.integrator",
             s("rk5"),

@@ -234,20 +234,20 @@ fn demo_commands(section: &str) -> Vec<String> {
     out
 }
 
-/// What a configuration file's header cites: each `(README, "Section")` must be a heading of
-/// README.md, and each `flexdyn-acs-demo …` command the header quotes must be shown, every
+/// What a configuration file's header cites: each `(book, "Section")` must be a heading of
+/// README.md or of a page of the book, and each `flexdyn-acs-demo …` command the header quotes must be shown, every
 /// option of it, in the cited section (so a newcomer finds the command the file promises).
 fn header_problems(file: &str, header: &str, readme: &str) -> Vec<String> {
     let mut problems = Vec::new();
     let mut sections = Vec::new();
-    for cite in header.split("README, \"").skip(1) {
+    for cite in header.split("book, \"").skip(1) {
         let Some(title) = cite.split('"').next() else {
             continue;
         };
         match section(readme, title) {
             Some(text) => sections.push(text),
             None => problems.push(format!(
-                "{file}: cites README section {title:?}, not a heading"
+                "{file}: cites book section {title:?}, not a heading"
             )),
         }
     }
@@ -262,7 +262,7 @@ fn header_problems(file: &str, header: &str, readme: &str) -> Vec<String> {
                 .any(|c| c.split_whitespace().any(|w| w == flag));
             if !shown {
                 problems.push(format!(
-                    "{file}: `{flag}` of its demo command is not in a command of the cited README section"
+                    "{file}: `{flag}` of its demo command is not in a command of the cited book section"
                 ));
             }
         }
@@ -273,15 +273,14 @@ fn header_problems(file: &str, header: &str, readme: &str) -> Vec<String> {
 #[test]
 fn header_problems_are_found() {
     let readme = "# T\n## Wheels\n```sh\nflexdyn-acs-demo --a \\\n    --b\n```\n## Other\n--c\n";
-    let ok = "# run `flexdyn-acs-demo --a --b` (README, \"Wheels\")\nx = 1\n";
+    let ok = "# run `flexdyn-acs-demo --a --b` (book, \"Wheels\")\nx = 1\n";
     assert_eq!(
         header_problems("f", &header_text(ok), readme),
         Vec::<String>::new()
     );
     // A section that is not a heading, and an option the section's command lacks (`--c` is in
     // the README, but in another section and not in a command).
-    let bad =
-        "# `flexdyn-acs-demo --a --c` (README, \"Wheels\")\n# (README, \"Wheels\n# and more\")\n";
+    let bad = "# `flexdyn-acs-demo --a --c` (book, \"Wheels\")\n# (book, \"Wheels\n# and more\")\n";
     let p = header_problems("f", &header_text(bad), readme);
     assert_eq!(p.len(), 2, "{p:?}");
     assert!(p[0].contains("\"Wheels and more\""), "{p:?}");
@@ -307,7 +306,7 @@ fn scenario_headers_cite_what_the_readme_shows() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
             let header = header_text(&std::fs::read_to_string(&path).unwrap());
-            cited += header.matches("README, \"").count();
+            cited += header.matches("book, \"").count();
             problems.extend(header_problems(
                 &path.display().to_string(),
                 &header,

@@ -200,7 +200,7 @@ fn the_binary_writes_the_imu_columns() {
     );
     let text = String::from_utf8(out.stdout).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    // The state columns, then 13 per IMU (README, "CSV output").
+    // The state columns, then 13 per IMU (docs/guides/configuration.md, "CSV output").
     let first = header.iter().position(|h| h.starts_with("imu_")).unwrap();
     assert_eq!(header.len(), first + 2 * 13);
     assert_eq!(header[first], "imu_hub_omega_p_rad_s_1");

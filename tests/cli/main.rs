@@ -2,7 +2,7 @@
 //! subcommands run as a user runs them (`simulate`, `check-config`, `campaign`, `plot`,
 //! `export`, recordings written and replayed), checked against independent readers (Python's
 //! `mcap` and pandas, a PNG decoder) and the sensors' documented models; the goldens of the
-//! sensor outputs; and the Markdown documents (every link resolves, every README block runs).
+//! sensor outputs; and the Markdown documents (every link resolves, every block of the README and the book runs).
 //!
 //! The vehicle layer's own tests are in `crates/vehicle/tests/`; those that need a server are in
 //! `tests/server/`.

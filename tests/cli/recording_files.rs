@@ -153,7 +153,7 @@ fn python_mcap_reads_every_channel_of_a_server_recording() {
         assert_eq!(
             row[c_t].parse::<f64>().unwrap(),
             st.header.sim_time_ns as f64 / 1e9,
-            "t_s is sim_time_ns / 1e9 (README, \"CSV output\")"
+            "t_s is sim_time_ns / 1e9 (docs/guides/configuration.md, \"CSV output\")"
         );
         assert_eq!(row[c_s2].parse::<f64>().unwrap(), st.sigma_bn[1]);
         assert_eq!(row[c_rw].parse::<f64>().unwrap(), st.effectors[5].states[0]);
@@ -217,7 +217,7 @@ fn a_replayed_recording_records_to_the_same_payloads() {
     let original = batch_recording("original.mcap");
     let again = tmp("again.mcap");
     let _ = std::fs::remove_file(&again);
-    // The README's pair, on a free port instead of 7447: the replay listens like the server
+    // The book's pair (docs/guides/recording.md), on a free port instead of 7447: the replay listens like the server
     // and waits for a subscriber; the recorder connects to it. (That the replay listens on
     // 7447 by default, where the tools connect, is the `replay` module's unit test.)
     let (mut replay, endpoint) = spawn_listening(

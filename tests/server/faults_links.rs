@@ -250,7 +250,7 @@ fn a_corrupted_link_at_a_low_bit_error_rate_applies_what_passes_the_checks() {
     );
     // The expectation, tick by tick: the command the participant sent for tick k (the run's
     // f(k) wrench, stamped with the state's tick and time), damaged with the fault's seed (its
-    // index, 0) and the tick, then the checks in the order the README gives them.
+    // index, 0) and the tick, then the checks in the order docs/guides/server.md gives them.
     let mut want = healthy.clone();
     let mut rejected = RejectCounters::default();
     let (mut accepted, mut refused) = (0, 0);

@@ -19,7 +19,7 @@
 //! unloading law (`flexdyn_acs_demo::sequence`: 1/(⅔ k_u) = 1250 s), enough to show the drop.
 //! A run is 6900 s ([`BEFORE_UNLOAD_S`]) + 1500 s = 8400 s of simulation, 84 000 lockstep
 //! ticks. `FLEXDYN_ACS_UNLOAD_S=5700` unloads for the whole orbit instead (12 600 s a run; the
-//! README's figures come from that).
+//! figures of docs/guides/acs-sequence.md come from that).
 //!
 //! It prints the closing note's figures: the time in each mode, the pointing error in fine
 //! pointing (RMS and max), the wheel momentum before and after unloading.

@@ -224,7 +224,7 @@ const SEIZURE_SEED: u32 = 1;
 const BOUND_DEG: f64 = 0.05;
 /// A seizure breaks the bound within this time: the brake dumps rw2's 1.5 N·m·s into the hub at
 /// 0.2 N·m (7.5 s) and the 4-wheel allocation keeps asking the seized wheel; without FDIR the
-/// error peaks at 0.33° (README, "FDIR demo"). Seizures 5.4 s before the end were measured to
+/// error peaks at 0.33° (docs/guides/faults.md, "FDIR demo"). Seizures 5.4 s before the end were measured to
 /// break it (0.11°), 2.9 s before the end not (0.04°); 10 s is the margin. A failure later than
 /// this before the end could go either way: the chosen seed has none.
 const BREAK_S: f64 = 10.0;

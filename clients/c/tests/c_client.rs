@@ -20,7 +20,7 @@
 //!   (`tests/leak.c`) must be reported, so the checker is known to see the library's memory;
 //! - `commands_outside_lockstep_arrive_as_sent`: `tests/send.c` sends every kind of command,
 //!   stamped from a state it waited for, to a Zenoh peer here that decodes them;
-//! - `readme_link_line_builds_the_example`: the README's compile-and-link line, as written;
+//! - `readme_link_line_builds_the_example`: the book's compile-and-link line (docs/guides/flight-code.md), as written;
 //! - `rate_groups_run_off_the_ticks_and_stop_while_paused`: `examples/rate_groups.c` drives
 //!   1/10/100 Hz groups from `flexdyn_wait_tick` against a real-time server, pauses it with
 //!   `flexdyn_send_operator`, sees no tick while it is held and resumes it.
@@ -36,7 +36,7 @@ use flexdyn_proto::{decode_state, effector_kind, StateMsg};
 use flexdyn_testkit::ports;
 
 /// The libraries `rustc --print native-static-libs` names for the static library on Linux
-/// (README, "Attaching flight code").
+/// (docs/guides/flight-code.md).
 const NATIVE_LIBS: &[&str] = &[
     "-ldl",
     "-lgcc_s",
@@ -485,7 +485,7 @@ fn readme_link_line_builds_the_example() {
         .map(String::as_str)
         .filter(|w| w.starts_with("-l"))
         .collect();
-    assert_eq!(libs, NATIVE_LIBS, "the README's system libraries");
+    assert_eq!(libs, NATIVE_LIBS, "the book's system libraries");
     let out = tmp().join("pd_lockstep_readme");
     let args: Vec<String> = words[1..]
         .iter()

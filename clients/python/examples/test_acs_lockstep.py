@@ -4,7 +4,7 @@ copy into your own CI. Run it with `pytest examples/test_acs_lockstep.py` (it fi
 
 Control law (Schaub & Junkins, ch. 8): L = -K sigma_BN - P omega_BN, target sigma_RN = 0. The
 reference spacecraft (about 1100-1800 kg m^2 about its centre of mass) with K = 100 N m and
-P = 300 N m s settles within 8 I / P ~ 48 s (README, "Lockstep in CI"); the test allows 60 s
+P = 300 N m s settles within 8 I / P ~ 48 s (docs/guides/lockstep-ci.md); the test allows 60 s
 and a threshold of 0.02 on |sigma|.
 """
 

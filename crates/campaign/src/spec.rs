@@ -23,7 +23,7 @@
 //! below = 0.01
 //! ```
 //!
-//! Over a fleet (README, "Campaigns over a fleet"): `fleet = "formation.toml"` replaces `base`,
+//! Over a fleet (docs/guides/campaigns.md, "Campaigns over a fleet"): `fleet = "formation.toml"` replaces `base`,
 //! every dispersion and criterion names its `vehicle`, and `[[controllers]]` (one per vehicle,
 //! or one for several) replaces `controller`:
 //!

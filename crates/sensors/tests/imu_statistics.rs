@@ -80,7 +80,7 @@ fn fit2(
 
 #[test]
 fn validate_allan_deviation_recovers_arw_bias_instability_vrw_and_rrw() {
-    // A tactical-grade gyro (the README example): ARW 0.15 °/√h; bias instability 1 °/h read as
+    // A tactical-grade gyro (the example of docs/models/imu.md): ARW 0.15 °/√h; bias instability 1 °/h read as
     // the Allan floor, i.e. σ_GM = (1 °/h) / 0.6174, τ = 300 s. Accelerometer: VRW 0.05 m/s/√h
     // and an acceleration random walk K = 1e-5 m/s³/√Hz.
     let arw = 0.15 * DEG / 60.0;

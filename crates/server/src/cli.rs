@@ -17,7 +17,7 @@ pub struct RunArgs {
     /// (`flexdyn print-default-config`).
     #[arg(long, value_name = "FILE", conflicts_with = "fleet")]
     pub config: Option<PathBuf>,
-    /// Serve every vehicle of this fleet file (`[[vehicles]]`, README "Fleet in the server"),
+    /// Serve every vehicle of this fleet file (`[[vehicles]]`, docs/guides/fleets.md, "Fleet in the server"),
     /// each under its own id `flexdyn/<id>/…`, on one tick and (lockstep) one barrier. The
     /// settings are the first vehicle's `[server]` table with these options on top; ids and
     /// participants come from the fleet file.

@@ -1,5 +1,5 @@
 //! Hard real time: what the process and the physics thread do, when asked, so that the frame
-//! loop is never kept waiting by the kernel (README, "Hard real time").
+//! loop is never kept waiting by the kernel (docs/guides/server.md, "Hard real time").
 //!
 //! Each piece is off unless its setting asks for it, and each one the OS refuses stops the
 //! server at start with an error naming the setting, what the OS said and what it needs: a

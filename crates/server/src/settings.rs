@@ -4,7 +4,7 @@
 //! Every setting has one TOML key `x_y` and one option `--x-y`; both go through
 //! [`ServerSettings::apply`], so they accept the same values and report errors the same way,
 //! naming the setting as the user wrote it (`server.x_y` or `--x-y`). [`KEYS`] lists them; the
-//! README's "Server settings" table documents each one and its default.
+//! book's "Server settings" table (docs/guides/server.md) documents each one and its default.
 
 use std::time::Duration;
 

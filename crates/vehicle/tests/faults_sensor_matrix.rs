@@ -1,5 +1,5 @@
 //! Every sensor fault mode on every sensor kind and every fault channel it exposes, against the
-//! documented transforms (`crates/faults/src/modes.rs`, the README's fault table), sample by sample.
+//! documented transforms (`crates/faults/src/modes.rs`, the fault table of docs/guides/faults.md), sample by sample.
 //!
 //! One scenario carries every sensor kind: `scenarios/acs_full.toml` (IMU, star tracker,
 //! magnetometer, coarse and fine sun sensors, all at the 10 Hz frame rate) with its fine sun
@@ -21,7 +21,7 @@
 //!   the window. A GPS fault acts on the message leaving the latency ring
 //!   (`crates/sensors/src/gps/mod.rs`, "Faults"): the value published at t, measured at t − latency;
 //! - `validity_off` (the kinds with a validity flag): the flag cleared as each kind documents
-//!   (the README's table), nothing else changed.
+//!   (that table), nothing else changed.
 //!
 //! The window opens between two frames (at 0.55 s, for 1 s: samples at 0.6 … 1.5 s), so
 //! `bias_ramp`'s t_on (time since the activation began) and `stuck_current`'s x_on (the healthy

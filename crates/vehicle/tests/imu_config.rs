@@ -278,7 +278,7 @@ fn shipped_imu_tactical_scenario() {
     assert_eq!(cfg.sensors.all::<ImuConfig>()[1].name, "bracket");
     let deg = std::f64::consts::PI / 180.0;
     for imu in cfg.sensors.of::<ImuConfig>() {
-        // The README's conversions of the tactical-grade datasheet values.
+        // The conversions (docs/models/imu.md) of the tactical-grade datasheet values.
         assert!((imu.gyro.arw_rad_s_sqrt_hz / (0.15 * deg / 60.0) - 1.0).abs() < 1e-4);
         assert!(
             (imu.gyro.bias_instability_sigma_rad_s * 0.617_364 / (deg / 3600.0) - 1.0).abs() < 1e-4

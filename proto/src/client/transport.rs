@@ -289,7 +289,7 @@ pub fn zenoh_config(args: &ZenohArgs, role: Role) -> Result<zenoh::Config, Zenoh
     // batches per priority and an express sample takes a batch of its own, so a subscriber
     // whose link was not served for two samples lost them: a `flexdyn record` next to a 1 kHz
     // server with three CPU hogs on two cores missed 2.9–7.8 % of the states. 16 batches, Zenoh's
-    // most, lost none in the same test (README, "Recording, replay and viewing"). The batches
+    // most, lost none in the same test (docs/guides/recording.md). The batches
     // are allocated as needed, up to 16 × 64 KiB per peer.
     if role == Role::Server && !file_sets(SERVER_TX_QUEUE_KEY) {
         insert(

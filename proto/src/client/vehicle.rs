@@ -1,7 +1,7 @@
 //! The vehicle a server runs, as its `flexdyn/<sc>/config` queryable describes it
 //! (proto/README.md, "Topics"): the reply's JSON, and the parts of the configuration TOML that
 //! flight code reads — the frame rate, the mass properties and mountings, the wheels and the
-//! sensors with their rates. The TOML keys are the server's (README, "Configuration"); every
+//! sensors with their rates. The TOML keys are the server's (docs/guides/configuration.md); every
 //! other key is ignored, and the server has validated the file before serving it.
 
 use std::time::{Duration, Instant};

@@ -32,8 +32,8 @@ def session_config(endpoints: Sequence[str], zenoh_config: Optional[str] = None)
     """Peer mode, connect to `endpoints`, listen nowhere, multicast scouting off.
 
     ``zenoh_config`` is a Zenoh JSON5 file to start from instead of the defaults, e.g. one with
-    ``transport/auth/usrpwd`` credentials for a server on a lab network (see the README's
-    "Running on a lab network"); the endpoints and the scouting rule still apply."""
+    ``transport/auth/usrpwd`` credentials for a server on a lab network (see
+    docs/guides/lab-network.md); the endpoints and the scouting rule still apply."""
     conf = zenoh.Config.from_file(zenoh_config) if zenoh_config else zenoh.Config()
     conf.insert_json5("mode", '"peer"')
     conf.insert_json5("connect/endpoints", json.dumps(list(endpoints)))

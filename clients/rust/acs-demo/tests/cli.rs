@@ -149,7 +149,7 @@ fn the_readmes_wheels_and_star_tracker_command_parses() {
             "{flag} not shown: {words:?}"
         );
     }
-    // Point it at a free port and give up after 1 s instead of the README's 5.
+    // Point it at a free port and give up after 1 s instead of the book's 5.
     let mut args: Vec<String> = Vec::new();
     let mut it = words[1..].iter();
     while let Some(w) = it.next() {

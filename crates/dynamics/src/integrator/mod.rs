@@ -6,7 +6,7 @@
 //! method, so a frame stays a whole number of steps; the MRP shadow switch happens after each
 //! full step. Every state effector and dynamic effector sees the stage times `c_i h`.
 //!
-//! No symplectic or energy-preserving scheme is offered: see the README section
+//! No symplectic or energy-preserving scheme is offered: see the book section
 //! "Choosing the integrator" for why (damping, motor and friction torques, the MRP switch and the
 //! back-substituted, non-separable equations of motion).
 

@@ -14,8 +14,8 @@
 //!
 //! [`EnvironmentModel::fill`] allocates nothing, locks nothing and returns no `Result`: every
 //! parameter was checked when the model was built. [`EnvironmentModel::update_if_due`] runs it at
-//! the configured rate and holds the sample between updates (zero-order hold: see the README's
-//! "World" section for the error that costs). Each update after the first is evaluated for the
+//! the configured rate and holds the sample between updates (zero-order hold: see
+//! docs/models/world-environment.md for the error that costs). Each update after the first is evaluated for the
 //! position predicted from the update before, so that [`EnvironmentModel::offload`] can move the
 //! evaluation to a worker thread without changing a bit ([`super::prefetch`]).
 

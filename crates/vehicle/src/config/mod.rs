@@ -17,7 +17,7 @@
 //!    ([`ImuConfig::validate`], unique names).
 //!
 //! The built-in default is [`DEFAULT_CONFIG_TOML`], the verbatim text of
-//! `scenarios/reference.toml`. The README's "Configuration" section documents every key.
+//! `scenarios/reference.toml`. docs/guides/configuration.md documents every key.
 
 mod components;
 mod faults;

@@ -1,5 +1,5 @@
 //! `flexdyn-formation-demo`: the deputy's flight code of a two-spacecraft formation served by
-//! `flexdyn run --fleet` (README, "Fleet in the server").
+//! `flexdyn run --fleet` (docs/guides/fleets.md, "Fleet in the server").
 //!
 //! It answers the deputy's ticks (`--sc-id`, as sender `--sender-id`) and reads the chief's
 //! state too (`--chief`): for each tick it waits for both states of that tick, then commands

@@ -1,6 +1,6 @@
 //! Dual-linked hinged rigid panels: the state effector of Allard & Schaub, Sections III.C and V.
 //!
-//! Geometry (README "Physics and conventions"; docs/errata.md):
+//! Geometry (docs/models/physics.md; docs/errata.md):
 //! - [S1 B] = M2(θ1) [H1 B];  [S2 B] = M2(θ2) M2(θ_H2S1) [S1 B]  (θ2 is relative to panel 1);
 //! - the hinge axes coincide: ŝ12 = ŝ22 = ĥ12;
 //! - r_Sc1/B = r_H1/B − d1 ŝ11 (Eq. 6);  r_Sc2/B = r_H1/B − l1 ŝ11 − d2 ŝ21 (Eq. 7).
