@@ -360,6 +360,75 @@ pub const THRESHOLD_RGB: RGBColor = RGBColor(255, 0, 0);
 /// The colour of a failed run's point on a scatter figure.
 const FAILED_RGB: RGBColor = RGBColor(255, 127, 14);
 
+/// A criterion's histogram: the bins and the x axis.
+#[derive(Clone, Debug, PartialEq)]
+struct Histogram {
+    /// The first bin's lower edge.
+    lo: f64,
+    /// The bins' width.
+    width: f64,
+    /// Runs per bin.
+    counts: Vec<u32>,
+    /// The x axis' range.
+    axis: (f64, f64),
+    /// Where the threshold line is drawn: at the threshold, or at the axis' edge when the
+    /// threshold lies far off the data (`true`).
+    threshold_at: Option<(f64, bool)>,
+}
+
+/// How much of the x axis the data must keep: an axis stretched to a threshold further off
+/// would squeeze the data (issue 36: every run in one bar).
+const DATA_SHARE_MIN: f64 = 0.4;
+
+/// The histogram of `values` (finite, at least one) in `bins` bins spanning the data. The
+/// axis holds the data with a 5 % margin, and the threshold when that keeps at least
+/// [`DATA_SHARE_MIN`] of it for the data; a threshold further off is marked at the axis' edge
+/// on its side (its value is in the axis label).
+fn histogram(values: &[f64], threshold: Option<f64>, bins: usize) -> Histogram {
+    let (lo, hi) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    let (lo, hi) = if hi > lo {
+        (lo, hi)
+    } else {
+        (
+            lo - 0.5 * lo.abs().max(1e-12),
+            hi + 0.5 * hi.abs().max(1e-12),
+        )
+    };
+    let width = (hi - lo) / bins as f64;
+    let mut counts = vec![0u32; bins];
+    for v in values {
+        let b = (((v - lo) / width).max(0.0) as usize).min(bins - 1);
+        counts[b] += 1;
+    }
+    let pad = 0.05 * (hi - lo);
+    let (mut a0, mut a1) = (lo - pad, hi + pad);
+    let threshold_at = threshold.map(|t| {
+        let (t0, t1) = (a0.min(t - pad), a1.max(t + pad));
+        if (t0..=t1).contains(&t) && (hi - lo) >= DATA_SHARE_MIN * (t1 - t0) {
+            (a0, a1) = (t0, t1);
+            (t, false)
+        } else if t > hi {
+            // Room at the right for the line, inside the axis.
+            a1 = hi + 3.0 * pad;
+            (hi + 2.0 * pad, true)
+        } else {
+            a0 = lo - 3.0 * pad;
+            (lo - 2.0 * pad, true)
+        }
+    });
+    Histogram {
+        lo,
+        width,
+        counts,
+        axis: (a0, a1),
+        threshold_at,
+    }
+}
+
 fn figures(
     dir: &Path,
     results: &[RunResult],
@@ -392,29 +461,13 @@ fn figures(
             Some(a) => format!("{c} ({})", a.unit),
             None => c.clone(),
         };
-        // The range holds every value and the threshold, so its line is on the figure.
-        let (lo, hi) = values
-            .iter()
-            .map(|(v, _, _)| *v)
-            .chain(threshold)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            });
-        let (lo, hi) = if hi > lo {
-            (lo, hi)
-        } else {
-            (
-                lo - 0.5 * lo.abs().max(1e-12),
-                hi + 0.5 * hi.abs().max(1e-12),
-            )
-        };
-        let bins = 12usize;
-        let width = (hi - lo) / bins as f64;
-        let mut counts = vec![0u32; bins];
-        for (v, _, _) in &values {
-            let b = (((v - lo) / width) as usize).min(bins - 1);
-            counts[b] += 1;
-        }
+        let h = histogram(
+            &values.iter().map(|(v, _, _)| *v).collect::<Vec<_>>(),
+            threshold,
+            12,
+        );
+        let (lo, hi) = h.axis;
+        let (counts, width) = (&h.counts, h.width);
         let path = fig_dir.join(format!("hist_{ci}_{}.png", sanitize(c)));
         {
             let root = BitMapBackend::new(&path, (900, 600)).into_drawing_area();
@@ -432,9 +485,12 @@ fn figures(
                 .map_err(|e| io(&path, e))?;
             chart
                 .configure_mesh()
-                .x_desc(match threshold {
-                    Some(b) => format!("{label}; red: the pass threshold, value < {b}"),
-                    None => label.clone(),
+                .x_desc(match (threshold, h.threshold_at) {
+                    (Some(b), Some((_, true))) => format!(
+                        "{label}; red, at the edge: the pass threshold, value < {b} (off the scale)"
+                    ),
+                    (Some(b), _) => format!("{label}; red: the pass threshold, value < {b}"),
+                    _ => label.clone(),
                 })
                 .y_desc("runs")
                 .label_style((font, 16))
@@ -442,11 +498,11 @@ fn figures(
                 .map_err(|e| io(&path, e))?;
             chart
                 .draw_series(counts.iter().enumerate().map(|(i, n)| {
-                    let x0 = lo + i as f64 * width;
+                    let x0 = h.lo + i as f64 * width;
                     Rectangle::new([(x0, 0), (x0 + width, *n)], BLUE.mix(0.6).filled())
                 }))
                 .map_err(|e| io(&path, e))?;
-            if let Some(b) = threshold {
+            if let Some((b, _)) = h.threshold_at {
                 chart
                     .draw_series(std::iter::once(PathElement::new(
                         vec![(b, 0), (b, max + 1)],
@@ -471,7 +527,7 @@ fn figures(
                     (a.min(*x), b.max(*x))
                 });
             let pad = ((xh - xl) * 0.05).max(1e-12 * xl.abs().max(1.0));
-            let ypad = (hi - lo) * 0.05;
+            let ypad = 0.0;
             let path = fig_dir.join(format!(
                 "scatter_{ci}_{ki}_{}_vs_{}.png",
                 sanitize(c),
@@ -482,7 +538,13 @@ fn figures(
                 root.fill(&WHITE).map_err(|e| io(&path, e))?;
                 let mut chart = ChartBuilder::on(&root)
                     .caption(
-                        format!("{c} against {k} (orange: failed; red line: threshold)"),
+                        match h.threshold_at {
+                            Some((_, true)) => format!(
+                                "{c} against {k} (orange: failed; red line: threshold {}, off the scale)",
+                                threshold.unwrap_or_default()
+                            ),
+                            _ => format!("{c} against {k} (orange: failed; red line: threshold)"),
+                        },
                         (font, 22),
                     )
                     .margin(15)
@@ -497,7 +559,7 @@ fn figures(
                     .label_style((font, 16))
                     .draw()
                     .map_err(|e| io(&path, e))?;
-                if let Some(b) = threshold {
+                if let Some((b, _)) = h.threshold_at {
                     chart
                         .draw_series(std::iter::once(PathElement::new(
                             vec![(xl - pad, b), (xh + pad, b)],
@@ -631,6 +693,35 @@ mod tests {
             assert_eq!(pixels_of(f, THRESHOLD_RGB), 0, "{}", f.display());
         }
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Issue 36: `scenarios/campaign.toml`'s 20 final pointing errors lie far below the
+    /// threshold (0.01); an axis stretched to the threshold put every run in one bar. 20 values
+    /// spread over [1e-4, 1e-3) and a threshold 100× beyond the largest: the bins span the data
+    /// (at least 5 of 12 hold a run), the axis stops well short of the threshold, which is
+    /// marked at its edge.
+    #[test]
+    fn a_far_threshold_does_not_crush_the_histogram_into_one_bin() {
+        let values: Vec<f64> = (0..20).map(|i| 1e-4 + 4.5e-5 * i as f64).collect();
+        let top = values[19];
+        for threshold in [100.0 * top, -100.0 * top] {
+            let h = histogram(&values, Some(threshold), 12);
+            let filled = h.counts.iter().filter(|n| **n > 0).count();
+            assert!(
+                filled >= 5,
+                "{threshold}: {filled} non-empty bins {:?}",
+                h.counts
+            );
+            assert_eq!(h.counts.iter().sum::<u32>(), 20);
+            let (at, off) = h.threshold_at.unwrap();
+            assert!(off && h.axis.0 < at && at < h.axis.1, "{threshold}: {h:?}");
+            let span = h.axis.1 - h.axis.0;
+            assert!(
+                span < 2.0 * (top - values[0]),
+                "{threshold}: axis {:?}",
+                h.axis
+            );
+        }
     }
 
     #[test]
