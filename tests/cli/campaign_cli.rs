@@ -104,3 +104,36 @@ fn a_missing_run_makes_summarize_exit_1_and_bad_input_exits_2() {
     let run = flexdyn(&["campaign", "run", bad.to_str().unwrap(), "--output", o]);
     assert_eq!(run.status.code(), Some(2));
 }
+
+/// Issue 36: with stderr not a terminal (CI, here a pipe) the campaign prints plain progress
+/// lines as runs finish, the count of done runs rising to the total, instead of nothing until
+/// the end (an invisible bar).
+#[test]
+fn progress_is_printed_as_plain_lines_when_stderr_is_not_a_terminal() {
+    let (file, out) = campaign("progress", RATE_BELOW_1);
+    let text = std::fs::read_to_string(&file)
+        .unwrap()
+        .replace("runs = 1", "runs = 3");
+    std::fs::write(&file, text).unwrap();
+    let (f, o) = (file.to_str().unwrap(), out.to_str().unwrap());
+    let run = flexdyn(&["campaign", "run", f, "--output", o, "--base-port", "0"]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{err}");
+    let done: Vec<u32> = err
+        .lines()
+        .filter_map(|l| {
+            l.strip_prefix("campaign: ")?
+                .split_once("/3 runs done (")
+                .map(|(k, _)| k.parse().unwrap())
+        })
+        .collect();
+    assert!(!done.is_empty(), "no progress line in: {err}");
+    assert!(done.windows(2).all(|w| w[0] <= w[1]), "{done:?}");
+    assert_eq!(done.last(), Some(&3), "{err}");
+    assert!(
+        err.contains("campaign: 3/3 runs done (3 pass, 0 fail, 0 could not run), "),
+        "{err}"
+    );
+    // No carriage-return bar.
+    assert!(!err.contains('\r'), "{err:?}");
+}

@@ -928,8 +928,8 @@ fn run_fleet(
     Ok(())
 }
 
-/// Runs `indices` of `plan`, `jobs` at a time, with a progress bar on stderr; returns the
-/// results in index order.
+/// Runs `indices` of `plan`, `jobs` at a time, with progress on stderr: a bar on a terminal,
+/// else (CI, a pipe, a file) plain [`Progress`] lines; returns the results in index order.
 pub fn execute_many(
     plan: &Plan,
     runs: &[RunPlan],
@@ -937,9 +937,15 @@ pub fn execute_many(
     jobs: usize,
     opts: &RunOptions,
 ) -> Vec<RunResult> {
+    use std::io::IsTerminal as _;
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<RunResult>> = Mutex::new(Vec::new());
-    let bar = indicatif::ProgressBar::new(indices.len() as u64);
+    let terminal = std::io::stderr().is_terminal();
+    let bar = if terminal {
+        indicatif::ProgressBar::new(indices.len() as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
     bar.set_style(
         indicatif::ProgressStyle::with_template(
             "{bar:40} {pos}/{len} runs, {elapsed} elapsed, ETA {eta} {msg}",
@@ -947,9 +953,13 @@ pub fn execute_many(
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let failed = AtomicUsize::new(0);
+    let (done_tx, done_rx) = std::sync::mpsc::channel::<Outcome>();
+    let started = Instant::now();
     std::thread::scope(|s| {
         for _ in 0..jobs.max(1) {
-            s.spawn(|| loop {
+            let done_tx = done_tx.clone();
+            let (next, results, failed, bar) = (&next, &results, &failed, &bar);
+            s.spawn(move || loop {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(&index) = indices.get(i) else { break };
                 let r = execute(plan, &runs[index as usize], opts);
@@ -958,8 +968,26 @@ pub fn execute_many(
                 }
                 bar.set_message(format!("({} not passed)", failed.load(Ordering::Relaxed)));
                 bar.inc(1);
+                let _ = done_tx.send(r.outcome);
                 results.lock().unwrap_or_else(|e| e.into_inner()).push(r);
             });
+        }
+        drop(done_tx);
+        if !terminal {
+            // Plain lines for a log: each run's outcome as it arrives, a line at least every
+            // PROGRESS_EVERY, until every worker has finished.
+            let mut p = Progress::new(indices.len(), started);
+            loop {
+                let wait = p.next_due().saturating_duration_since(Instant::now());
+                let line = match done_rx.recv_timeout(wait) {
+                    Ok(outcome) => p.record(outcome, Instant::now()),
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => p.tick(Instant::now()),
+                    Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => break,
+                };
+                if let Some(line) = line {
+                    eprintln!("{line}");
+                }
+            }
         }
     });
     bar.finish();
@@ -968,9 +996,109 @@ pub fn execute_many(
     out
 }
 
+/// The longest a campaign that is not on a terminal stays silent.
+pub const PROGRESS_EVERY: Duration = Duration::from_secs(5);
+
+/// A campaign's progress as plain lines (for a log, where a bar's carriage returns do not
+/// show): `campaign: 7/20 runs done (3 pass, 4 fail, 0 could not run), 12.3 s elapsed`, at
+/// every tenth of the runs, at the last one, and every [`PROGRESS_EVERY`] in between.
+#[derive(Clone, Debug)]
+pub struct Progress {
+    total: usize,
+    done: usize,
+    passed: usize,
+    failed: usize,
+    not_run: usize,
+    started: Instant,
+    last_line: Instant,
+    last_done: usize,
+}
+
+impl Progress {
+    /// Progress over `total` runs started at `started`.
+    pub fn new(total: usize, started: Instant) -> Self {
+        Progress {
+            total,
+            done: 0,
+            passed: 0,
+            failed: 0,
+            not_run: 0,
+            started,
+            last_line: started,
+            last_done: 0,
+        }
+    }
+
+    /// When the next line is due if no run finishes before.
+    pub fn next_due(&self) -> Instant {
+        self.last_line + PROGRESS_EVERY
+    }
+
+    /// A run finished with `outcome` at `now`: the line to print, if one is due (a tenth of
+    /// the runs since the last line, the last run, or [`PROGRESS_EVERY`] since the last line).
+    pub fn record(&mut self, outcome: Outcome, now: Instant) -> Option<String> {
+        self.done += 1;
+        match outcome {
+            Outcome::Passed => self.passed += 1,
+            Outcome::Failed => self.failed += 1,
+            Outcome::NotRun => self.not_run += 1,
+        }
+        let step = self.total.div_ceil(10).max(1);
+        if self.done == self.total || self.done >= self.last_done + step || now >= self.next_due() {
+            Some(self.line(now))
+        } else {
+            None
+        }
+    }
+
+    /// No run finished: the line to print if [`PROGRESS_EVERY`] has passed since the last.
+    pub fn tick(&mut self, now: Instant) -> Option<String> {
+        (now >= self.next_due()).then(|| self.line(now))
+    }
+
+    fn line(&mut self, now: Instant) -> String {
+        self.last_line = now;
+        self.last_done = self.done;
+        format!(
+            "campaign: {}/{} runs done ({} pass, {} fail, {} could not run), {:.1} s elapsed",
+            self.done,
+            self.total,
+            self.passed,
+            self.failed,
+            self.not_run,
+            now.saturating_duration_since(self.started).as_secs_f64()
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 36: without a terminal the progress is plain lines, at every tenth of the runs,
+    /// at the last, and every 5 s while nothing finishes.
+    #[test]
+    fn plain_progress_lines_come_at_a_steady_rate() {
+        let t0 = Instant::now();
+        let at = |s: f64| t0 + Duration::from_secs_f64(s);
+        let mut p = Progress::new(20, t0);
+        assert_eq!(p.tick(at(1.0)), None);
+        assert_eq!(
+            p.tick(at(5.0)).as_deref(),
+            Some("campaign: 0/20 runs done (0 pass, 0 fail, 0 could not run), 5.0 s elapsed")
+        );
+        assert_eq!(p.record(Outcome::Passed, at(6.0)), None);
+        assert_eq!(
+            p.record(Outcome::Failed, at(6.5)).as_deref(),
+            Some("campaign: 2/20 runs done (1 pass, 1 fail, 0 could not run), 6.5 s elapsed")
+        );
+        assert_eq!(p.record(Outcome::NotRun, at(7.0)), None);
+        assert!(p.record(Outcome::Passed, at(12.0)).is_some());
+        for k in 5..=20 {
+            let line = p.record(Outcome::Passed, at(12.0 + f64::from(k) * 0.01));
+            assert_eq!(line.is_some(), k % 2 == 0 || k == 20, "{k}: {line:?}");
+        }
+    }
 
     #[test]
     fn statistics_follow_their_definitions() {
