@@ -69,7 +69,28 @@ fn check_figures(dir: &Path, names: &[&str]) {
         assert!(colours >= 8, "{name} has only {colours} colours");
         // The data itself: the first series is drawn (a 2 px line across the plot width).
         assert!(line >= 500, "{name}: the first line has only {line} pixels");
+        // The title fits the width (issue 36: relative_motion.png's ran off both edges): no
+        // ink in the title band within 6 px of either edge.
+        let clipped = title_edge_ink(&path);
+        assert_eq!(clipped, 0, "{name}: the title reaches the image's edge");
     }
+}
+
+/// Non-white pixels within 6 px of the left or right edge in the top 30 rows (the title band).
+fn title_edge_ink(path: &Path) -> usize {
+    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let bpp = info.line_size / info.width as usize;
+    let w = info.width as usize;
+    (0..30)
+        .flat_map(|row| (0..6).chain(w - 6..w).map(move |col| (row, col)))
+        .filter(|(row, col)| {
+            let at = row * info.line_size + col * bpp;
+            buf[at..at + 3] != [255, 255, 255]
+        })
+        .count()
 }
 
 #[test]
@@ -483,8 +504,8 @@ inputs = [60.0]
 }
 
 /// The LEO scenario's sun sensors (a six-detector array, a fine sensor) through `simulate` and
-/// `plot`: both figures are drawn, the array's panels hold its six detectors' columns (the
-/// unused slots 7–16 are zero) and the fine sensor's its two angles and flags.
+/// `plot`: both figures are drawn, the array's panel holds its six detectors' columns (not
+/// the message's unused slots 7–16) and the fine sensor's its two angles and flags.
 #[test]
 fn sun_sensor_figures_from_a_simulate_csv() {
     let dir = tmp("sun_sensors");
@@ -511,18 +532,22 @@ fn sun_sensor_figures_from_a_simulate_csv() {
     assert!(r.status.success(), "{err}");
     check_figures(&dir, &["sun_sensors_coarse.png", "sun_sensors_fine.png"]);
     let (figs, _) = figures(&args(&csv)).unwrap();
+    // Issue 36: only the array's own six detectors (its detector_count), not the 10 unused
+    // slots of the message.
     let coarse = find(&figs, "sun_sensors_coarse.png");
-    assert_eq!(coarse.panels.len(), 2);
+    assert_eq!(coarse.panels.len(), 1);
+    let labels: Vec<&str> = coarse.panels[0]
+        .lines
+        .iter()
+        .map(|l| l.label.as_str())
+        .collect();
+    assert_eq!(labels, ["1", "2", "3", "4", "5", "6"]);
     let lit: usize = coarse.panels[0]
         .lines
         .iter()
         .filter(|s| s.points.iter().any(|p| p.1 > 0.05))
         .count();
     assert!((1..=3).contains(&lit), "lit faces: {lit}");
-    assert!(coarse.panels[1]
-        .lines
-        .iter()
-        .all(|s| s.points.iter().all(|p| p.1 == 0.0)));
     let fine = find(&figs, "sun_sensors_fine.png");
     assert_eq!(fine.panels.len(), 2);
 }
@@ -635,6 +660,69 @@ fn relative_motion_shows_the_deputy_in_the_chiefs_hill_frame() {
         e.contains("--relative-to") && e.contains("needs a recording"),
         "{e}"
     );
+}
+
+/// Issue 36: the title of `relative_motion.png` from a fleet recording (its RelativeStateMsg)
+/// ran off both edges of the image. A recording of the deputy's RelativeStateMsg relative to
+/// the chief (and the chief's states) is plotted, and the title band has no ink at either edge
+/// ([`check_figures`]).
+#[test]
+fn the_recorded_relative_motion_title_fits_the_figure() {
+    use flexdyn_proto::{encode, Header, RelativeStateMsg, StateMsg};
+    use flexdyn_sinks::mcap_file::{McapSink, RecordingInfo};
+
+    let rec = tmp("rel_recorded.mcap");
+    let info = RecordingInfo {
+        recorder: "tests/cli/plots.rs".into(),
+        command_line: String::new(),
+    };
+    let mut sink = McapSink::create(&rec, &info).unwrap();
+    for k in 0..50u64 {
+        let t_ns = k * 10_000_000_000;
+        for id in ["chief", "deputy"] {
+            let m = StateMsg {
+                header: Header::new(1, k, t_ns, k),
+                r_bn_n_m: [7.0e6, 0.0, 0.0],
+                v_bn_n_m_s: [0.0, 7.5e3, 0.0],
+                ..StateMsg::default()
+            };
+            sink.write(&format!("flexdyn/{id}/tlm/state"), &encode(&m), None, t_ns)
+                .unwrap();
+        }
+        let rel = RelativeStateMsg {
+            header: Header::new(2, k, t_ns, k),
+            r_dc_h_m: [30.0, 100.0 + k as f64, -20.0],
+            v_dc_h_m_s: [0.0, 0.1, 0.0],
+            range_m: 100.0 + k as f64,
+            range_rate_m_s: 0.1,
+            ..RelativeStateMsg::default()
+        };
+        sink.write("flexdyn/deputy/tlm/rel/chief", &encode(&rel), None, t_ns)
+            .unwrap();
+    }
+    sink.finish().unwrap();
+    let out = tmp("rel_recorded_png");
+    let r = flexdyn(&[
+        "plot",
+        rec.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--sc-id",
+        "deputy",
+        "--relative-to",
+        "chief",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    check_figures(&out, &["relative_motion.png"]);
+    let mut a = args(&rec);
+    a.sc_id = Some("deputy".into());
+    a.relative_to = Some("chief".into());
+    let (figs, _) = figures(&a).unwrap();
+    let title = &find(&figs, "relative_motion.png").title;
+    register_font().unwrap();
+    let px = flexdyn_sinks::plot::title_font_px(title);
+    let width = flexdyn_sinks::plot::text_width_px(title, px);
+    assert!(width <= 1200 - 20, "{title:?}: {width} px at {px} px");
 }
 
 /// Fault 0: the IMU's gyro biased from 0.5 s for 0.3 s; fault 1: wheel rw2 seized from 0.7 s

@@ -663,6 +663,33 @@ fn draw_panel<Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueForma
 /// The pixel rectangle (x range, y range) of a chart's plotting area.
 pub type PixelRect = (std::ops::Range<i32>, std::ops::Range<i32>);
 
+/// \[px\] the title's font size: [`TITLE_PX`], or smaller (not below [`TITLE_MIN_PX`]) until
+/// the title fits the figure's width less [`TITLE_SIDE_PX`] on each side (plotters centres it
+/// and cuts what overflows).
+pub fn title_font_px(title: &str) -> u32 {
+    let room = SIZE.0 - 2 * TITLE_SIDE_PX;
+    (TITLE_MIN_PX..=TITLE_PX)
+        .rev()
+        .find(|px| text_width_px(title, *px) <= room)
+        .unwrap_or(TITLE_MIN_PX)
+}
+
+/// \[px\] the width of `text` in the embedded font at `px` (plotters' own estimate, as it
+/// lays the text out; the font must be registered, [`register_font`]).
+pub fn text_width_px(text: &str, px: u32) -> u32 {
+    (FONT_NAME, f64::from(px))
+        .into_font()
+        .box_size(text)
+        .map_or(u32::MAX, |(w, _)| w)
+}
+
+/// \[px\] a figure title's font size when it fits.
+pub const TITLE_PX: u32 = 26;
+/// \[px\] the smallest title font size.
+pub const TITLE_MIN_PX: u32 = 14;
+/// \[px\] the room kept free of the title at each side of a figure.
+pub const TITLE_SIDE_PX: u32 = 10;
+
 /// Draws `fig` into the PNG file `path`; returns each panel's plotting area in pixels (what
 /// lies outside is axes, labels and titles).
 pub fn draw(path: &Path, fig: &Figure) -> Result<Vec<PixelRect>, SinkError> {
@@ -673,7 +700,10 @@ pub fn draw(path: &Path, fig: &Figure) -> Result<Vec<PixelRect>, SinkError> {
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let root = root
-        .titled(&fig.title, (FONT_NAME, 26).into_font())
+        .titled(
+            &fig.title,
+            (FONT_NAME, title_font_px(&fig.title)).into_font(),
+        )
         .map_err(|e| err(&e))?;
     let columns = fig.columns.max(1);
     let rows = fig.panels.len().div_ceil(columns);
@@ -976,10 +1006,8 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
         if let Some(panels) = recorded_relative_motion(&data.relative) {
             fig(
                 "relative_motion.png",
-                format!(
-                    "Centre of mass relative to {chief}'s, in {chief}'s Hill frame \
-                     (x radial, y along-track, z orbit normal; recorded RelativeStateMsg)"
-                ),
+                // The legends name the axes (x radial, y along-track, z normal).
+                format!("Centre of mass relative to {chief}'s, in its Hill frame (recorded)"),
                 panels,
             );
         }
@@ -988,10 +1016,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
         match relative_motion(s, states) {
             Some(panels) => fig(
                 "relative_motion.png",
-                format!(
-                    "Hub point B relative to {chief}'s, in {chief}'s Hill frame \
-                     (x radial, y along-track, z orbit normal)"
-                ),
+                format!("Hub point B relative to {chief}'s, in its Hill frame"),
                 panels,
             ),
             None => skip(
@@ -1168,7 +1193,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
     // One figure per sensor kind, its panels side by side per sensor (`SensorKind::plot`).
     for (i, kind) in KINDS.iter().enumerate() {
         let (file, title, specs) = kind.plot;
-        let mut panels = Vec::new();
+        let mut sensors: Vec<Vec<Panel>> = Vec::new();
         for ((_, name), c) in data
             .sensors
             .range((i, String::new())..(i + 1, String::new()))
@@ -1182,19 +1207,34 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
                     lines: spec
                         .lines
                         .iter()
+                        .filter(|(col, _)| plotted_column(c, col))
                         .filter_map(|(col, label)| c.get(col).map(|v| line(label, &c.t_s, v)))
                         .collect(),
                     ..Panel::default()
                 })
                 .collect();
             if sensor_panels.iter().any(|p| !p.lines.is_empty()) {
-                panels.extend(sensor_panels);
+                sensors.push(sensor_panels);
             }
         }
+        // A panel no sensor of the kind has a line on (a coarse array's detectors 7–16 when
+        // none has more than 6) is left out for all of them, so the grid stays regular.
+        let kept: Vec<usize> = (0..specs.len())
+            .filter(|k| sensors.iter().any(|p| !p[*k].lines.is_empty()))
+            .collect();
+        let rows = kept.len();
+        let panels: Vec<Panel> = sensors
+            .into_iter()
+            .flat_map(|mut p| {
+                kept.iter()
+                    .map(|k| std::mem::take(&mut p[*k]))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
         if panels.is_empty() {
             skip(file, &format!("no {}", kind.noun));
         } else {
-            figures.push(sensor_grid(file, title, panels));
+            figures.push(sensor_grid(file, title, panels, rows));
         }
     }
     let st = &data.status;
@@ -1247,6 +1287,25 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
     }
     shade_faults(&mut figures, &data.faults, time_span(s).0);
     Ok((figures, skipped))
+}
+
+/// Whether a sensor's column `col` is one of its own: a coarse array's `readings_<k>` only
+/// for k up to its `detector_count` (the CssMsg's slots beyond are 0 and no detector's).
+fn plotted_column(c: &Columns, col: &str) -> bool {
+    let Some(k) = col
+        .strip_prefix("readings_")
+        .and_then(|k| k.parse::<f64>().ok())
+    else {
+        return true;
+    };
+    c.get("detector_count").is_none_or(|n| {
+        let count = n
+            .iter()
+            .copied()
+            .filter(|x| x.is_finite())
+            .fold(0.0, f64::max);
+        k <= count
+    })
 }
 
 /// The disturbance figure's panels: per environment source, |τ_B| and |F_B| from its
@@ -1398,10 +1457,10 @@ fn disturbance_panels(env: &Columns) -> Option<Vec<Panel>> {
     }
 }
 
-/// A figure of two panels per sensor, one column per sensor, so each panel keeps the height
-/// its labels need however many sensors there are.
-fn sensor_grid(name: &'static str, title: &str, panels: Vec<Panel>) -> Figure {
-    let columns = panels.len() / 2;
+/// A figure of `rows` panels per sensor (given sensor by sensor), one column per sensor, so
+/// each panel keeps the height its labels need however many sensors there are.
+fn sensor_grid(name: &'static str, title: &str, panels: Vec<Panel>, rows: usize) -> Figure {
+    let columns = panels.len() / rows.max(1);
     Figure {
         name,
         title: title.to_owned(),
@@ -1467,6 +1526,22 @@ mod tests {
             lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi,
             "{lo} {hi}"
         );
+    }
+
+    /// Issue 36: a title too wide for the figure at the usual size is set smaller until it
+    /// fits (plotters centres it and cuts both ends otherwise); a short one keeps the size.
+    #[test]
+    fn titles_fit_the_figure_width() {
+        register_font().unwrap();
+        let room = SIZE.0 - 2 * TITLE_SIDE_PX;
+        let short = "Body angular rate ω_BN";
+        assert_eq!(title_font_px(short), TITLE_PX);
+        // The title relative_motion.png had before (issue 36), with formation.toml's chief.
+        let long = "Centre of mass relative to chief's, in chief's Hill frame (x radial, \
+                    y along-track, z orbit normal; recorded RelativeStateMsg)";
+        assert!(text_width_px(long, TITLE_PX) > room);
+        let px = title_font_px(long);
+        assert!(px < TITLE_PX && text_width_px(long, px) <= room, "{px}");
     }
 
     /// Every column a sensor kind's plot panels name is a column of its message, so no panel
