@@ -3,16 +3,15 @@
 use std::process::ExitCode;
 
 use super::{exit, summary};
-use flexdyn_sinks::plot::{plot, PlotArgs};
+use flexdyn_sinks::plot::{plot_with, PlotArgs};
 use flexdyn_sinks::SinkError;
 
-/// Draws the figures; each file written and each figure skipped (and why) on stderr.
+/// Draws the figures; the reading progress, each file as it is written and each figure
+/// skipped (and why) on stderr.
 pub fn main(args: &PlotArgs) -> ExitCode {
-    match exit(plot(args), SinkError::exit_code) {
+    let mut written = |p: &std::path::Path| summary(format_args!("wrote {}", p.display()));
+    match exit(plot_with(args, &mut written), SinkError::exit_code) {
         Ok(r) => {
-            for p in &r.written {
-                summary(format_args!("wrote {}", p.display()));
-            }
             for (figure, why) in &r.skipped {
                 summary(format_args!("skipped {figure}: {why}"));
             }

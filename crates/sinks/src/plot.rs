@@ -52,11 +52,12 @@ use plotters::prelude::*;
 use super::error::SinkError;
 use super::fault_spans::{self, FaultShading};
 use super::prior_faults;
-use super::reader::read_recording;
 use super::table::{prefixed_columns, row, Cell, Column, ENVIRONMENT_COLUMN_PREFIX};
 use super::topics::{classify, Decoded, TopicKind};
 use flexdyn_kernel::attitude::mrp_error;
 use flexdyn_sensors::KINDS;
+
+pub mod read;
 
 const FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans-subset.ttf");
 /// The name the embedded font is registered under (see [`register_font`]).
@@ -210,18 +211,12 @@ fn from_mcap(
     sc_id: Option<&str>,
     relative_to: Option<&str>,
 ) -> Result<PlotData, SinkError> {
-    let rec = read_recording(path)?;
+    // Only the plotted vehicle's channels and the chief's states, streamed with progress.
+    let (rec, sc) = read::read_for_plot(path, sc_id, relative_to)?;
     if let Some(why) = &rec.truncated {
         tracing::warn!(file = %path.display(), reason = %why, "the recording ends early; plotting what it holds");
     }
-    let sc = match sc_id {
-        Some(s) => s.to_owned(),
-        None => rec
-            .samples
-            .iter()
-            .find_map(|s| classify(&s.key).map(|t| t.sc_id.to_owned()))
-            .ok_or_else(|| input_err(path, "holds no flexdyn channel"))?,
-    };
+    let sc = sc.ok_or_else(|| input_err(path, "holds no flexdyn channel"))?;
     if relative_to == Some(sc.as_str()) {
         return Err(SinkError::Arg {
             flag: "--relative-to",
@@ -232,7 +227,11 @@ fn from_mcap(
         chief: relative_to.map(|c| (c.to_owned(), Columns::default())),
         ..PlotData::default()
     };
-    for s in &rec.samples {
+    let mut progress = read::ReadProgress::decoding(rec.samples.len() as u64);
+    for (i, s) in rec.samples.iter().enumerate() {
+        if i % 4096 == 0 {
+            progress.update(i as u64);
+        }
         let Some(topic) = classify(&s.key) else {
             continue;
         };
@@ -278,6 +277,7 @@ fn from_mcap(
             }
         }
     }
+    progress.finish(rec.samples.len() as u64);
     let (first, last) = time_span(&data.state);
     let events = prior_faults::fault_events(&rec)
         .remove(&sc)
@@ -1487,6 +1487,12 @@ fn interleave_columns(panels: Vec<Panel>, columns: usize) -> Vec<Panel> {
 
 /// Draws every figure the input has data for.
 pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
+    plot_with(args, &mut |_| {})
+}
+
+/// [`plot`], calling `written` with each figure's path as soon as it is written (reading a
+/// recording prints its progress on stderr, [`read::ReadProgress`]).
+pub fn plot_with(args: &PlotArgs, written: &mut dyn FnMut(&Path)) -> Result<PlotReport, SinkError> {
     let (figures, skipped) = figures(args)?;
     std::fs::create_dir_all(&args.output).map_err(|e| SinkError::Output {
         path: args.output.clone(),
@@ -1500,6 +1506,7 @@ pub fn plot(args: &PlotArgs) -> Result<PlotReport, SinkError> {
     for f in &figures {
         let path = args.output.join(f.name);
         draw(&path, f)?;
+        written(&path);
         report.written.push(path);
     }
     Ok(report)
