@@ -577,6 +577,12 @@ impl RunState {
         self as u32
     }
 
+    /// Whether the run is over: `Finished`, `Failed` or `Stopped` (the last status a server
+    /// publishes; every client stops on it).
+    pub const fn ended(self) -> bool {
+        matches!(self, Self::Finished | Self::Failed | Self::Stopped)
+    }
+
     /// The state of wire tag `tag`, `None` for an unknown tag.
     pub const fn from_tag(tag: u32) -> Option<Self> {
         match tag {

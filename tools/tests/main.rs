@@ -20,4 +20,5 @@ mod fleet_faults;
 mod fleet_formation;
 mod fleet_lockstep;
 mod recording_lockstep;
+mod run_end;
 mod secure_lockstep;

@@ -55,6 +55,10 @@ pub const CONTROLLER_ID: u32 = 1;
 /// The spacecraft id of every run (`{sc_id}`); runs are separated by port.
 pub const SC_ID: &str = "sc1";
 
+/// How long after a controller exits 0 the server may still take to end by itself: a
+/// controller that stops on the end-of-run status exits while the server closes its session.
+const EXIT_GRACE: Duration = Duration::from_secs(2);
+
 /// One criterion's outcome.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CriterionResult {
@@ -617,19 +621,36 @@ fn run_lockstep(
             }
         }
     }
-    // Wait for the server; a controller that exits first stops it.
+    // Wait for the server; a controller that exits first stops it. One that exits 0 may have
+    // stopped on the server's end-of-run status, which is published before the server thread
+    // returns: it counts as early only if the server has not ended by itself EXIT_GRACE later.
     let mut early_exit: Option<(usize, std::process::ExitStatus)> = None;
+    let mut grace_until = None;
+    let mut stopped_early = false;
     while !server.is_finished() {
         if early_exit.is_none() {
             for (k, ch) in children.iter_mut().enumerate() {
                 if let Ok(Some(status)) = ch.try_wait() {
                     early_exit = Some((k, status));
-                    stop.notify_one();
+                    if status.success() {
+                        grace_until = Some(Instant::now() + EXIT_GRACE);
+                    } else {
+                        stop.notify_one();
+                        stopped_early = true;
+                    }
                     break;
                 }
             }
         }
+        if grace_until.is_some_and(|g| Instant::now() >= g) {
+            stop.notify_one();
+            stopped_early = true;
+            grace_until = None;
+        }
         std::thread::sleep(Duration::from_millis(5));
+    }
+    if !stopped_early {
+        early_exit = None;
     }
     let server_result = server
         .join()

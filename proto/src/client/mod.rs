@@ -13,11 +13,13 @@
 //!   and a clean stop on SIGINT/SIGTERM.
 //! - [`vehicle`]: the vehicle a server runs, from its `flexdyn/<sc>/config` queryable: the
 //!   geometry, wheels and sensors flight code reads.
+//! - [`run_end`]: the end of a run (the server's last status), so every client stops at once.
 //! - [`lockstep`]: complete ticks — the state of tick k with every sensor sample due at k —
 //!   through one `flexdyn/<sc>/tlm/**` subscriber ([`lockstep::TickReceiver`]).
 
 pub mod cli;
 pub mod lockstep;
 pub mod logging;
+pub mod run_end;
 pub mod transport;
 pub mod vehicle;

@@ -13,8 +13,11 @@
 //! one such line per vehicle each interval, prefixed `[<id>] `.
 //!
 //! Before any state arrives it prints `no data: no StateMsg on … yet`, and once states stop it
-//! prefixes `no data for N s; last:` and shows the server's final run state (`stopped`,
-//! `finished`, `failed`), or `running (no status for N s: server gone?)` if the server died.
+//! prefixes `no data for N s; last:`, or `running (no status for N s: server gone?)` if the
+//! server died. When the server's last status says the run ended (`finished`, `stopped`,
+//! `failed`; of every watched vehicle), it prints that interval's line at once, then
+//! `run ended: finished at tick N`, and exits 0 (the terminal UI likewise, after restoring
+//! the terminal).
 //!
 //! - `gaps`: StateMsg sequence numbers missing in the interval (lost or dropped frames);
 //! - `latency_ms`: frame boundary (the sample's attachment) to receipt here, wall clock;
@@ -545,6 +548,15 @@ impl Watch {
         w.last_state_at.is_some() || w.status.is_some()
     }
 
+    /// How the run ended (the server's last status: finished, stopped or failed) and its last
+    /// tick, once the server said so.
+    fn ended(&self) -> Option<(RunState, u64)> {
+        let w = self.window.lock().unwrap_or_else(|p| p.into_inner());
+        w.status
+            .filter(|s| s.run_state.ended())
+            .map(|s| (s.run_state, s.header.tick))
+    }
+
     /// The interval's summary line (see [`line`]), prefixed `[<id>] ` when `prefixed`.
     fn line(&self, interval: Duration, prefixed: bool) -> String {
         let mut w = self.window.lock().unwrap_or_else(|p| p.into_inner());
@@ -633,12 +645,13 @@ fn run(args: Args) -> anyhow::Result<()> {
             }
             break;
         }
-        // Sleep in short slices so a signal is noticed promptly.
+        // Sleep in short slices so a signal or the end of the run is noticed promptly.
         std::thread::sleep(
             next.saturating_duration_since(now)
-                .min(Duration::from_millis(100)),
+                .min(Duration::from_millis(20)),
         );
-        if Instant::now() < next {
+        let all_ended = watches.iter().all(|w| w.ended().is_some());
+        if Instant::now() < next && !all_ended {
             continue;
         }
         next += interval;
@@ -652,6 +665,10 @@ fn run(args: Args) -> anyhow::Result<()> {
             // The reader went away (a closed pipe): stop quietly.
             break;
         }
+        if all_ended {
+            let _ = writeln!(out, "{}", ended_line(&watches));
+            break;
+        }
     }
     drop(watches);
     session
@@ -659,6 +676,26 @@ fn run(args: Args) -> anyhow::Result<()> {
         .wait()
         .map_err(|e| anyhow::anyhow!("closing the Zenoh session: {e}"))?;
     Ok(())
+}
+
+/// `run ended: finished at tick 6000` (one vehicle), or `run ended: [a] finished at tick 6000,
+/// [b] failed at tick 12` (several): what the monitor prints last when every watched server
+/// said its run ended.
+fn ended_line(watches: &[Watch]) -> String {
+    let several = watches.len() > 1;
+    let parts: Vec<String> = watches
+        .iter()
+        .filter_map(|w| {
+            let (state, tick) = w.ended()?;
+            let text = format!("{} at tick {tick}", run_state_name(state));
+            Some(if several {
+                format!("[{}] {text}", w.topics.sc_id())
+            } else {
+                text
+            })
+        })
+        .collect();
+    format!("run ended: {}", parts.join(", "))
 }
 
 /// The terminal UI loop: sparkline samples and a redraw every 100 ms, the summary text every
@@ -702,6 +739,11 @@ fn run_tui(
             || end.is_some_and(|e| Instant::now() >= e)
         {
             break Ok(());
+        }
+        if watches.iter().all(|w| w.ended().is_some()) {
+            ratatui::restore();
+            println!("{}", ended_line(watches));
+            return Ok(());
         }
         let summary_due = Instant::now() >= next_summary;
         if summary_due {

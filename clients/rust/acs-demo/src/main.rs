@@ -33,6 +33,10 @@
 //!      queryable ([`TickReceiver`]). Separate subscribers can see a state before its own
 //!      tick's IMU sample, and a run then depends on thread timing.
 //!
+//! # The end of the run
+//! The demo stops as soon as the server's last status says the run `finished`, `stopped` or
+//! `failed` ([`RunEnd`]), after the frames still queued: exit 0, or 1 if the run failed.
+//!
 //! # Tuning (linearised closed loop, per principal axis with inertia I)
 //! With σ̇ ≈ ω/4 for small errors, I ω̇ = −Kσ − Pω gives σ̈ + (P/I) σ̇ + (K/4I) σ = 0:
 //! ω_n = √(K/(4I)), ζ = P/√(K I), decay rate ζ ω_n = P/(2I), 2 % settling ≈ 8 I / P.
@@ -92,8 +96,9 @@ use flexdyn_acs_demo::sequence::{AcsSequence, Gains, SequenceSetup};
 use flexdyn_proto::attitude::mrp_error;
 use flexdyn_proto::client::cli::{exit_with, stop_on_signals, usage, CommonArgs};
 use flexdyn_proto::client::lockstep::{SensorSchedule, TickReceiver};
+use flexdyn_proto::client::run_end::RunEnd;
 use flexdyn_proto::client::vehicle::{Vehicle, VehicleConfig};
-use flexdyn_proto::{encode_into, CommandMsg, Header, Topics};
+use flexdyn_proto::{encode_into, CommandMsg, Header, RunState, Topics};
 use nalgebra::{Matrix3, Vector3};
 use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
@@ -120,9 +125,11 @@ struct Args {
     /// Log a progress line every this many seconds of simulation time (0: never).
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
     log_every_s: f64,
-    /// Exit after this many seconds without a state: exit 0 if states were received (the run
-    /// ended), exit 1 if none ever came (no server). It also bounds the wait for the server's
-    /// configuration at start. Default: run (and wait) until SIGINT/SIGTERM.
+    /// Exit after this many seconds without a state: exit 0 if states were received, exit 1 if
+    /// none ever came (no server). It also bounds the wait for the server's configuration at
+    /// start. The demo stops without it when the server says the run ended; this bounds the wait
+    /// for a server that dies without saying so. Default: wait until the run ends or
+    /// SIGINT/SIGTERM.
     #[arg(long, allow_negative_numbers = true)]
     idle_exit_s: Option<f64>,
     /// Where the rate feedback comes from. `gyro`: the IMU named by --imu. `truth`: the state
@@ -687,9 +694,11 @@ fn run(args: Args) -> anyhow::Result<()> {
         );
     }
 
-    // 3. The telemetry: one subscriber on flexdyn/<sc>/tlm/**, assembled into complete ticks.
+    // 3. The end of the run (the server's last status), then the telemetry: one subscriber on flexdyn/<sc>/tlm/**, assembled into complete ticks.
     //    Declared before the token, so the server cannot publish tick 0 before we can receive
     //    it. A ring buffer: in real time, if we ever fall behind, the oldest samples go.
+    let run_end = RunEnd::declare(&session, &topics)
+        .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.status()))?;
     let mut ticks = TickReceiver::declare(
         &session,
         &topics,
@@ -724,7 +733,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         "flexdyn-acs-demo running"
     );
 
-    // 6. The loop: one command per tick, until SIGINT/SIGTERM or --idle-exit-s.
+    // 6. The loop: one command per tick, until the server ends the run, SIGINT/SIGTERM or
+    //    --idle-exit-s.
     let log_every_ns = (args.log_every_s.max(0.0) * 1e9) as u64;
     let mut next_log_ns = 0u64;
     let mut seq = 0u64;
@@ -732,6 +742,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let mut states_received = 0u64;
     let mut last_state_at = Instant::now();
     let mut last_sequence_output = None;
+    let mut ended = None;
     loop {
         if stop.load(std::sync::atomic::Ordering::Relaxed) {
             tracing::info!(states_received, "stop signal: closing the session");
@@ -755,11 +766,24 @@ fn run(args: Args) -> anyhow::Result<()> {
                 break;
             }
         }
-        // Wake at least every 100 ms to notice a signal or the idle limit.
+        // Wake every 20 ms to notice the end of the run, a signal or the idle limit. Once the
+        // server has said the run ended, every frame it published is on its way: take what is
+        // still queued, then stop when nothing more comes within that slice.
         let Some(tick) = ticks
-            .recv_timeout(Duration::from_millis(100))
+            .recv_timeout(Duration::from_millis(20))
             .map_err(|e| anyhow::anyhow!("{e}"))?
         else {
+            if let Some(end) = run_end.ended() {
+                tracing::info!(
+                    states_received,
+                    tick = end.tick,
+                    after_ms = end.heard_at.elapsed().as_secs_f64() * 1e3,
+                    "the server reports the run {}: exiting",
+                    end.word()
+                );
+                ended = Some(end);
+                break;
+            }
             continue;
         };
         states_received += 1;
@@ -897,7 +921,15 @@ fn run(args: Args) -> anyhow::Result<()> {
     drop(token);
     drop(commands);
     drop(ticks);
-    close(session)
+    drop(run_end);
+    close(session)?;
+    match ended {
+        Some(end) if end.run_state == RunState::Failed => bail!(
+            "the server reports that the run failed at tick {} (its log says why)",
+            end.tick
+        ),
+        _ => Ok(()),
+    }
 }
 
 fn close(session: Session) -> anyhow::Result<()> {

@@ -18,8 +18,9 @@ use flexdyn_acs_demo::formation::{
     com_offset_b, com_state_n, pointing_errors, relative_hill, station_force_b, StationGains,
 };
 use flexdyn_proto::client::cli::{exit_with, stop_on_signals, CommonArgs};
+use flexdyn_proto::client::run_end::RunEnd;
 use flexdyn_proto::client::vehicle::Vehicle;
-use flexdyn_proto::{decode_state, encode_into, CommandMsg, Header, StateMsg, Topics};
+use flexdyn_proto::{decode_state, encode_into, CommandMsg, Header, RunState, StateMsg, Topics};
 use nalgebra::Vector3;
 use zenoh::qos::CongestionControl;
 use zenoh::Wait;
@@ -53,7 +54,8 @@ struct Args {
     /// Pointing rate gain P \[N·m·s/rad\].
     #[arg(long, default_value_t = 300.0, allow_negative_numbers = true)]
     p_nms: f64,
-    /// Exit after this many seconds without a state (0 if states came, 1 if none).
+    /// Exit after this many seconds without a state (0 if states came, 1 if none). Without it
+    /// the demo stops when the server says the run ended (1 if it failed).
     #[arg(long, allow_negative_numbers = true)]
     idle_exit_s: Option<f64>,
 }
@@ -95,7 +97,10 @@ fn run(args: Args) -> anyhow::Result<()> {
     let (mass_kg, r_cb_deputy) = mass_properties(&session, &deputy, idle)?;
     let (_, r_cb_chief) = mass_properties(&session, &chief, idle)?;
 
-    // Both states, tagged (true: the chief's), through one channel.
+    // The end of the run (the deputy's server's last status), then both states, tagged (true:
+    // the chief's), through one channel.
+    let run_end = RunEnd::declare(&session, &deputy)
+        .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", deputy.status()))?;
     let (tx, rx) = mpsc::channel::<(bool, StateMsg)>();
     let mut subs = Vec::new();
     for (is_chief, key) in [(true, chief.state()), (false, deputy.state())] {
@@ -131,6 +136,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let mut seq = 0u64;
     let mut received = 0u64;
     let mut last_at = Instant::now();
+    let mut ended = None;
     while !stop.load(std::sync::atomic::Ordering::Relaxed) {
         if last_at.elapsed() >= idle {
             if received == 0 {
@@ -138,7 +144,18 @@ fn run(args: Args) -> anyhow::Result<()> {
             }
             break;
         }
-        let Ok((is_chief, st)) = rx.recv_timeout(Duration::from_millis(100)) else {
+        // Every 20 ms: once the server said the run ended, the queued states are taken and
+        // the demo stops when no more come.
+        let Ok((is_chief, st)) = rx.recv_timeout(Duration::from_millis(20)) else {
+            if let Some(end) = run_end.ended() {
+                tracing::info!(
+                    tick = end.tick,
+                    "the server reports the run {}: exiting",
+                    end.word()
+                );
+                ended = Some(end);
+                break;
+            }
             continue;
         };
         received += 1;
@@ -197,10 +214,18 @@ fn run(args: Args) -> anyhow::Result<()> {
     }
     drop(token);
     drop(subs);
+    drop(run_end);
     session
         .close()
         .wait()
-        .map_err(|e| anyhow::anyhow!("closing the session: {e}"))
+        .map_err(|e| anyhow::anyhow!("closing the session: {e}"))?;
+    match ended {
+        Some(end) if end.run_state == RunState::Failed => bail!(
+            "the server reports that the run failed at tick {} (its log says why)",
+            end.tick
+        ),
+        _ => Ok(()),
+    }
 }
 
 fn main() -> std::process::ExitCode {
