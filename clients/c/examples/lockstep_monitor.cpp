@@ -1,7 +1,9 @@
 // lockstep_monitor.cpp - C++17 flight code through libflexdyn_client: a lockstep participant
 // that answers every tick with NoCommand, while separate subscriptions to the state, every
 // IMU, every star tracker and the status are drained with the poll API (no callbacks, no
-// threads of ours). When its last tick is answered it waits for the server's last status.
+// threads of ours). It answers until flexdyn_lockstep_wait returns FLEXDYN_ENDED (the server's
+// last status said the run ended and every tick was handed out), checks that the last tick was
+// <last_tick> and that its own status subscription saw the same end as flexdyn_run_ended.
 //
 // Usage: lockstep_monitor <endpoint> <last_tick>
 // Prints "states=<n> imus=<n> star_trackers=<n> run_state=<tag>" and exits 0, or prints the
@@ -89,21 +91,35 @@ int main(int argc, char **argv) {
     tick.effectors = effectors.data();
     tick.effectors_capacity = effectors.size();
     Counts n;
-    for (std::uint64_t k = 0; k <= last; ++k) {
-        if ((rc = flexdyn_lockstep_wait(c.get(), &tick, 5000)) != FLEXDYN_OK)
-            return fail(c, "wait", rc);
+    std::uint64_t answered = 0, last_seen = 0;
+    while ((rc = flexdyn_lockstep_wait(c.get(), &tick, 5000)) == FLEXDYN_OK) {
+        last_seen = tick.header.tick;
         if ((rc = flexdyn_lockstep_answer_no_command(c.get())) != FLEXDYN_OK)
             return fail(c, "answer", rc);
+        ++answered;
         if (!drain(c, n, effectors)) return fail(c, "poll", -1);
     }
-    // The run ends with the tick just answered: its last status says how.
+    if (rc != FLEXDYN_ENDED) return fail(c, "wait", rc);
+    // The run is over: how it ended, and the same from the status subscription (its last one).
+    std::int32_t ended_state = 0;
+    std::uint64_t ended_tick = 0;
+    if (flexdyn_run_ended(c.get(), &ended_state, &ended_tick) != 1)
+        return fail(c, "FLEXDYN_ENDED without an end of run", rc);
+    if (answered != last + 1 || last_seen != last || ended_tick != last) {
+        std::fprintf(stderr, "lockstep_monitor: %llu ticks up to %llu, the run ended at %llu\n",
+                     static_cast<unsigned long long>(answered),
+                     static_cast<unsigned long long>(last_seen),
+                     static_cast<unsigned long long>(ended_tick));
+        return 1;
+    }
     fd_status_msg status{};
     std::uint32_t run_state = FD_RUN_STATE_RUNNING;
-    while (run_state == FD_RUN_STATE_STARTING || run_state == FD_RUN_STATE_RUNNING ||
-           run_state == FD_RUN_STATE_STOPPING) {
-        if ((rc = flexdyn_wait_status(c.get(), &status, 5000)) != FLEXDYN_OK)
-            return fail(c, "status", rc);
-        run_state = status.run_state;
+    while ((rc = flexdyn_poll_status(c.get(), &status)) == FLEXDYN_OK) run_state = status.run_state;
+    if (rc != FLEXDYN_EMPTY) return fail(c, "status", rc);
+    if (run_state != static_cast<std::uint32_t>(ended_state)) {
+        std::fprintf(stderr, "lockstep_monitor: the last status says %u, flexdyn_run_ended %d\n",
+                     run_state, static_cast<int>(ended_state));
+        return 1;
     }
     if (!drain(c, n, effectors)) return fail(c, "poll", -1);
     if ((rc = flexdyn_close(c.get())) != FLEXDYN_OK) return fail(c, "close", rc);

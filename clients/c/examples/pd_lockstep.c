@@ -9,14 +9,22 @@
  * scenarios/wheels_star_tracker.toml). Star-tracker samples are checked to be there on the ticks
  * they are due.
  *
- * Usage: pd_lockstep <endpoint> <last_tick> <state_out|-> [timeout_ms]
+ * The loop runs until the server ends the run: flexdyn_lockstep_wait hands out every tick
+ * received, then returns FLEXDYN_ENDED, and flexdyn_run_ended says how the run ended (the
+ * server's last StatusMsg). No timeout is involved in stopping.
+ *
+ * Usage: pd_lockstep <endpoint> <last_tick|-> <state_out|-> [timeout_ms]
  *   endpoint   the server's Zenoh endpoint, e.g. tcp/127.0.0.1:7447
- *   last_tick  answer ticks 0..last_tick, then close and exit 0
+ *   last_tick  "-": answer every tick until the run ends; a number: also leave (close, exit 0)
+ *              after answering that tick if the run goes on
  *   state_out  a file that receives every state, re-encoded with fd_encode_state, each behind
  *              its u32 little-endian length ("-": none)
- *   timeout_ms how long to wait for a tick before giving up (default 5000)
- * Prints "tick <k>" every 500 ticks. Exit codes: 0 done, 2 usage, 3 no tick within the timeout
- * (the server is gone), 4 any other error.
+ *   timeout_ms how long to wait for a tick before giving up on a server that vanished without
+ *              ending the run (default 5000)
+ * Prints "tick <k>" every 500 ticks, and at the end "run ended: <finished|stopped|failed> at
+ * tick <n>, <m> ticks answered" (or "left after tick <n>, <m> ticks answered"). Exit codes:
+ * 0 done (the run finished or was stopped, or last_tick was reached), 1 the server says the run
+ * failed, 2 usage, 3 no tick within the timeout (the server is gone), 4 any other error.
  *
  * Build (README, "Attaching flight code"):
  *   cc -std=c99 -Wall -Wextra -I proto/c/include -I clients/c/include \
@@ -88,19 +96,32 @@ static int fail(flexdyn_client *c, const char *what, int rc) {
     return rc == FLEXDYN_ERR_TIMEOUT ? 3 : 4;
 }
 
+/* The word of an ended run's state. */
+static const char *ended_word(int32_t run_state) {
+    switch (run_state) {
+    case (int32_t)FD_RUN_STATE_FINISHED: return "finished";
+    case (int32_t)FD_RUN_STATE_STOPPED: return "stopped";
+    default: return "failed";
+    }
+}
+
 int main(int argc, char **argv) {
     flexdyn_options opts;
     flexdyn_client *c;
     fd_state_msg st;
     FILE *out = NULL;
-    unsigned long long last, k;
+    unsigned long long last = 0, k;
     unsigned long timeout_ms = 5000;
-    int rc;
+    int rc, bounded, ended = 0;
+    int32_t run_state = (int32_t)FD_RUN_STATE_RUNNING;
+    uint64_t end_tick = 0;
     if (argc < 4 || argc > 5) {
-        fprintf(stderr, "usage: %s <endpoint> <last_tick> <state_out|-> [timeout_ms]\n", argv[0]);
+        fprintf(stderr, "usage: %s <endpoint> <last_tick|-> <state_out|-> [timeout_ms]\n",
+                argv[0]);
         return 2;
     }
-    last = strtoull(argv[2], NULL, 10);
+    bounded = strcmp(argv[2], "-") != 0;
+    if (bounded) last = strtoull(argv[2], NULL, 10);
     if (argc == 5) timeout_ms = strtoul(argv[4], NULL, 10);
 
     c = flexdyn_client_new();
@@ -121,8 +142,19 @@ int main(int argc, char **argv) {
     memset(&st, 0, sizeof st);
     st.effectors = effectors;
     st.effectors_capacity = FD_MAX_EFFECTORS;
-    for (k = 0; k <= last; ++k) {
+    for (k = 0; !bounded || k <= last; ++k) {
         rc = flexdyn_lockstep_wait(c, &st, (uint32_t)timeout_ms);
+        if (rc == FLEXDYN_ENDED) {
+            /* Every tick the server published was handed out: the run is over. */
+            if (flexdyn_run_ended(c, &run_state, &end_tick) != 1) {
+                fprintf(stderr, "pd_lockstep: FLEXDYN_ENDED without an end of run\n");
+                if (out != NULL) fclose(out);
+                flexdyn_client_free(c);
+                return 4;
+            }
+            ended = 1;
+            break;
+        }
         if (rc != FLEXDYN_OK) {
             if (out != NULL) fclose(out);
             return fail(c, "wait", rc);
@@ -157,6 +189,11 @@ int main(int argc, char **argv) {
     rc = flexdyn_close(c);
     if (rc != FLEXDYN_OK) return fail(c, "close", rc);
     flexdyn_client_free(c);
-    printf("answered %llu ticks\n", last + 1);
+    if (ended) {
+        printf("run ended: %s at tick %llu, %llu ticks answered\n", ended_word(run_state),
+               (unsigned long long)end_tick, k);
+        return run_state == (int32_t)FD_RUN_STATE_FAILED ? 1 : 0;
+    }
+    printf("left after tick %llu, %llu ticks answered\n", last, last + 1);
     return 0;
 }

@@ -13,8 +13,11 @@
  *   With P, the driver asks the server (flexdyn_send_operator) to pause after its P-th tick,
  *   notes every 300 ms without a tick while the server says Paused ("held ..." lines, with the
  *   groups' counts: they do not move), and resumes it after three such stalls.
- * Prints "done 1Hz=<n> 10Hz=<n> 100Hz=<n> ticks=<K> stalls=<n> held_at=<tick>" and exits 0;
- * a gap in the ticks, a stall of a running server, or any error exits 1.
+ * Prints "done 1Hz=<n> 10Hz=<n> 100Hz=<n> ticks=<K> stalls=<n> held_at=<tick>" and exits 0.
+ * If the server ends the run first, flexdyn_wait_tick returns FLEXDYN_ENDED once every tick
+ * received is taken: the driver prints "run ended: <finished|stopped|failed> at tick <n>", then
+ * the done line with the ticks it counted, and exits 0 (1 if the run failed). A gap in the
+ * ticks, a stall of a running server, or any error exits 1.
  *
  * Build (C99), on one line:
  *   cc -std=c99 -Wall -Wextra -Werror -pedantic -I proto/c/include -I clients/c/include
@@ -43,7 +46,7 @@ int main(int argc, char **argv) {
     fd_time_msg t, now;
     uint64_t period[N_GROUPS], count[N_GROUPS] = {0, 0, 0};
     uint64_t ticks, pause_after = 0, done = 0, prev = 0, held_at = 0;
-    int rc, g, started = 0, stalls = 0, pause_sent = 0;
+    int rc, g, started = 0, stalls = 0, pause_sent = 0, failed = 0;
     if (argc < 3) {
         fprintf(stderr, "usage: rate_groups <endpoint> <ticks> [pause_after]\n");
         return 2;
@@ -59,6 +62,19 @@ int main(int argc, char **argv) {
 
     while (done < ticks) {
         rc = flexdyn_wait_tick(c, &t, 300);
+        if (rc == FLEXDYN_ENDED) {
+            /* The server ended the run and every tick it published was taken. */
+            int32_t run_state = 0;
+            uint64_t end_tick = 0;
+            if (flexdyn_run_ended(c, &run_state, &end_tick) != 1)
+                return fail(c, "FLEXDYN_ENDED without an end of run", rc);
+            failed = run_state == (int32_t)FD_RUN_STATE_FAILED;
+            printf("run ended: %s at tick %llu\n",
+                   failed ? "failed"
+                          : run_state == (int32_t)FD_RUN_STATE_STOPPED ? "stopped" : "finished",
+                   (unsigned long long)end_tick);
+            break;
+        }
         if (rc == FLEXDYN_ERR_TIMEOUT) {
             /* No tick for 300 ms: only a held server may do that. */
             if (flexdyn_now(c, &now) != FLEXDYN_OK || now.run_state != FD_RUN_STATE_PAUSED)
@@ -107,5 +123,5 @@ int main(int argc, char **argv) {
            (unsigned long long)held_at);
     flexdyn_close(c);
     flexdyn_client_free(c);
-    return 0;
+    return failed;
 }

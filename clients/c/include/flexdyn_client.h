@@ -8,9 +8,20 @@
  * decoded. Compile with -I proto/c/include -I clients/c/include; the link line is in the
  * top-level README, "Attaching flight code".
  *
- * Every function returns FLEXDYN_OK (0), FLEXDYN_EMPTY (1, a poll found nothing) or a negative
- * FLEXDYN_ERR_* code; after an error, flexdyn_last_error(client) says what went wrong in one
- * line. Nothing panics across the boundary: a fault inside the library is FLEXDYN_ERR_INTERNAL.
+ * Every function returns FLEXDYN_OK (0), FLEXDYN_EMPTY (1, a poll found nothing), FLEXDYN_ENDED
+ * (2, a wait found nothing because the run is over) or a negative FLEXDYN_ERR_* code; after an
+ * error, flexdyn_last_error(client) says what went wrong in one line. Nothing panics across the
+ * boundary: a fault inside the library is FLEXDYN_ERR_INTERNAL.
+ *
+ * The end of a run (proto/README.md, "StatusMsg"): once its last frame is out, the server
+ * publishes a last StatusMsg on flexdyn/<sc>/status whose run_state is FD_RUN_STATE_FINISHED,
+ * _FAILED or _STOPPED. flexdyn_open subscribes to that key (its own subscription, separate from
+ * flexdyn_subscribe_status) and remembers the first end it hears until flexdyn_close. From then
+ * on every wait (flexdyn_lockstep_wait, flexdyn_wait_state, _imu, _star_tracker, _status,
+ * flexdyn_wait_tick) still hands out what is queued, frames received before the end first, and
+ * returns FLEXDYN_ENDED as soon as nothing more is queued (it looks every 20 ms and waits one
+ * more 20 ms slice for a frame still in delivery), instead of waiting for its timeout. A flight loop ends on FLEXDYN_ENDED; flexdyn_run_ended says how the
+ * run ended. Polls keep returning FLEXDYN_EMPTY.
  *
  * Threading contract
  *   - There is no global state: everything lives in a flexdyn_client handle.
@@ -23,7 +34,7 @@
  *     dropped (the header's seq shows the gap), Zenoh is never blocked. In lockstep the server
  *     waits for your answer, so nothing is dropped.
  *   - Every wait takes a timeout in milliseconds and returns FLEXDYN_ERR_TIMEOUT when it passes:
- *     a lost server is an error code, never a hang.
+ *     a lost server is an error code, never a hang. A run that ended is FLEXDYN_ENDED, at once.
  *
  * Lockstep (proto/README.md, "Lockstep protocol"): flexdyn_lockstep_join asks the server for
  * its configuration (which sensor samples each tick carries), subscribes once to
@@ -48,6 +59,8 @@ extern "C" {
 
 #define FLEXDYN_OK 0
 #define FLEXDYN_EMPTY 1               /* a poll found nothing waiting (not an error) */
+#define FLEXDYN_ENDED 2               /* a wait: the run ended and nothing more is queued (not an
+                                       * error; flexdyn_run_ended says how) */
 #define FLEXDYN_ERR_TIMEOUT (-1)      /* nothing came within the timeout: no server, or it left */
 #define FLEXDYN_ERR_ARGUMENT (-2)     /* a null pointer, a bad id or endpoint, a non-finite value */
 #define FLEXDYN_ERR_ZENOH (-3)        /* Zenoh refused (cannot open, declare or put) */
@@ -92,9 +105,17 @@ int flexdyn_open(flexdyn_client *client, const flexdyn_options *options);
  * opened again. Closing a closed handle is FLEXDYN_OK. */
 int flexdyn_close(flexdyn_client *client);
 
+/* Whether the server has said that the run ended (its last StatusMsg, heard by the subscription
+ * every open makes): 1 once it has, and then *run_state_out = FD_RUN_STATE_FINISHED, _FAILED or
+ * _STOPPED and *tick_out = the last tick the server stepped (either pointer may be NULL); 0
+ * before, or when the session is not open; FLEXDYN_ERR_ARGUMENT for a NULL client. The first end
+ * heard is kept until flexdyn_close. Never waits. */
+int flexdyn_run_ended(flexdyn_client *client, int32_t *run_state_out, uint64_t *tick_out);
+
 /* ------------------------------------------------------------------------------------------ */
-/* Subscriptions: poll (FLEXDYN_OK or FLEXDYN_EMPTY) or wait (FLEXDYN_OK or FLEXDYN_ERR_TIMEOUT).
- * One subscription per kind; subscribing again replaces it. `capacity` = samples kept (>= 1). */
+/* Subscriptions: poll (FLEXDYN_OK or FLEXDYN_EMPTY) or wait (FLEXDYN_OK, FLEXDYN_ENDED once the
+ * run has ended and nothing of that kind is queued, or FLEXDYN_ERR_TIMEOUT). One subscription
+ * per kind; subscribing again replaces it. `capacity` = samples kept (>= 1). */
 
 int flexdyn_subscribe_state(flexdyn_client *client, size_t capacity);
 /* out->effectors / out->effectors_capacity are yours (FD_MAX_EFFECTORS always fits). */
@@ -127,9 +148,10 @@ int flexdyn_wait_status(flexdyn_client *client, fd_status_msg *out, uint32_t tim
  * follows the simulation: its speed (--speed), its pauses and its steps. Subscribe first. */
 
 int flexdyn_subscribe_time(flexdyn_client *client, size_t capacity);
-/* The next tick's time message, waiting up to timeout_ms. FLEXDYN_ERR_TIMEOUT when none came:
- * the server is held (then flexdyn_now says FD_RUN_STATE_PAUSED: the last tick published before
- * the hold says so), gone, or slower than the timeout. Never hangs. */
+/* The next tick's time message, waiting up to timeout_ms. FLEXDYN_ENDED once the run has ended
+ * and none is queued. FLEXDYN_ERR_TIMEOUT when none came: the server is held (then flexdyn_now
+ * says FD_RUN_STATE_PAUSED: the last tick published before the hold says so), gone, or slower
+ * than the timeout. Never hangs. */
 int flexdyn_wait_tick(flexdyn_client *client, fd_time_msg *out, uint32_t timeout_ms);
 /* The newest time message received (every one queued is taken first), without waiting:
  * FLEXDYN_OK, or FLEXDYN_EMPTY before the first. */
@@ -165,7 +187,10 @@ int flexdyn_send_actuators(flexdyn_client *client, uint32_t sender_id, const fd_
 int flexdyn_lockstep_join(flexdyn_client *client, uint32_t sender_id, uint32_t timeout_ms);
 /* The next complete tick: its state into *state (effectors in your array). The tick is held
  * until the next wait; answer it once. A due sensor sample still missing 1 s after its state
- * (lost: never in a healthy lockstep run) is left out, and its getter says FLEXDYN_ERR_ABSENT. */
+ * (lost: never in a healthy lockstep run) is left out, and its getter says FLEXDYN_ERR_ABSENT.
+ * FLEXDYN_ENDED (no tick held, *state untouched) once the server has said the run ended and
+ * every tick received before is handed out: leave the loop, flexdyn_run_ended says how it ended.
+ * The last tick of a run (duration_s * frame_hz) needs no answer; an answer to it is ignored. */
 int flexdyn_lockstep_wait(flexdyn_client *client, fd_state_msg *state, uint32_t timeout_ms);
 /* The sensors each tick may carry, in configuration order (0 before a join). Names stay valid
  * until the next join, leave or close. */

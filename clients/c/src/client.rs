@@ -6,9 +6,10 @@
 
 use std::ffi::CString;
 use std::path::PathBuf;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use flexdyn_proto::client::lockstep::{SensorSchedule, Tick, TickReceiver};
+use flexdyn_proto::client::run_end::{Ended, RunEnd};
 use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::client::vehicle::Vehicle;
 use flexdyn_proto::{
@@ -35,6 +36,34 @@ const SENSOR_TIMEOUT: Duration = Duration::from_secs(1);
 
 /// Samples kept by the lockstep telemetry subscriber (at most one tick is in flight).
 const LOCKSTEP_CAPACITY: usize = 256;
+
+/// How often a blocking wait looks whether the run has ended, and how long it still waits for
+/// a sample once the end was heard before it says [`Taken::Ended`] (as the Rust demo does).
+/// The server publishes its last status after its last frame, so by then every frame is
+/// queued; the slice only covers delivery on another Zenoh thread.
+const END_SLICE: Duration = Duration::from_millis(20);
+
+/// What a poll or a wait found.
+pub enum Taken<T> {
+    /// A sample (or a tick).
+    Got(T),
+    /// Nothing: a poll found nothing queued ([`Code::Empty`]), or (inside a wait) nothing came
+    /// within the timeout and no end of run was heard (the wait makes it [`Code::Timeout`]).
+    Empty,
+    /// The server said the run ended and nothing more is queued ([`Code::Ended`]; waits only).
+    Ended,
+}
+
+impl<T> Taken<T> {
+    /// `f` of the value, if any.
+    pub fn map<U>(self, f: impl FnOnce(T) -> U) -> Taken<U> {
+        match self {
+            Taken::Got(x) => Taken::Got(f(x)),
+            Taken::Empty => Taken::Empty,
+            Taken::Ended => Taken::Ended,
+        }
+    }
+}
 
 /// How to reach the server (`flexdyn_options`).
 #[derive(Clone, Debug, Default)]
@@ -67,6 +96,9 @@ struct Lockstep {
 pub struct Client {
     session: Session,
     topics: Topics,
+    /// The end of the run: subscribed to `flexdyn/<sc>/status` from open, before anything
+    /// else, so the end cannot be heard before the frames it follows are subscribed to.
+    run_end: RunEnd,
     state: Option<Ring>,
     imu: Option<Ring>,
     star_tracker: Option<Ring>,
@@ -159,9 +191,12 @@ impl Client {
         let session = zenoh::open(config)
             .wait()
             .map_err(|e| Error::zenoh("cannot open the Zenoh session", e))?;
+        let run_end = RunEnd::declare(&session, &topics)
+            .map_err(|e| Error::zenoh(&format!("cannot subscribe to {}", topics.status()), e))?;
         Ok(Self {
             session,
             topics,
+            run_end,
             state: None,
             imu: None,
             star_tracker: None,
@@ -177,6 +212,7 @@ impl Client {
     pub fn close(self) -> Result<(), Error> {
         let Self {
             session,
+            run_end,
             state,
             imu,
             star_tracker,
@@ -185,7 +221,7 @@ impl Client {
             lockstep,
             ..
         } = self;
-        drop((state, imu, star_tracker, status, time, lockstep));
+        drop((state, imu, star_tracker, status, time, lockstep, run_end));
         session
             .close()
             .wait()
@@ -238,46 +274,49 @@ impl Client {
         Ok(())
     }
 
-    /// The next sample of `kind`: at once (`timeout` `None`: `Ok(None)` when there is none) or
-    /// waiting up to `timeout` ([`Code::Timeout`]).
-    pub fn receive(
-        &mut self,
-        kind: Kind,
-        timeout: Option<Duration>,
-    ) -> Result<Option<Received>, Error> {
-        let Some(sub) = self.slot(kind).as_ref() else {
-            return Err(Error::new(
-                Code::Usage,
-                format!(
-                    "not subscribed to {} (call the subscribe function first)",
-                    kind.what()
-                ),
-            ));
-        };
-        let closed = |e| {
-            Error::new(
-                Code::Closed,
-                format!("the {} subscription ended: {e}", kind.what()),
-            )
-        };
-        let sample = match timeout {
-            None => sub.try_recv().map_err(closed)?,
-            Some(t) => match sub.recv_timeout(t).map_err(closed)? {
-                Some(s) => Some(s),
-                None => {
-                    return Err(Error::new(
-                        Code::Timeout,
-                        format!(
-                            "no {} sample on {} within {} ms",
-                            kind.what(),
-                            sub.key_expr(),
-                            t.as_millis()
-                        ),
-                    ))
-                }
-            },
-        };
-        Ok(sample.map(|s| Received {
+    /// How the run ended, once the server's last status said so (`Finished`, `Failed` or
+    /// `Stopped`); remembered from open until close.
+    pub fn ended(&self) -> Option<Ended> {
+        self.run_end.ended()
+    }
+
+    /// Waits up to `timeout` with `once`, in slices of [`END_SLICE`], and stops early once the
+    /// run has ended and a slice found nothing more (what was queued is still handed out
+    /// first). The end is looked at before each slice, so the slice that says
+    /// [`Taken::Ended`] began after the end was heard.
+    fn wait_sliced<T>(
+        run_end: &RunEnd,
+        timeout: Duration,
+        mut once: impl FnMut(Duration) -> Result<Option<T>, Error>,
+    ) -> Result<Taken<T>, Error> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let ended = run_end.ended().is_some();
+            let left = deadline.saturating_duration_since(Instant::now());
+            if let Some(x) = once(left.min(END_SLICE))? {
+                return Ok(Taken::Got(x));
+            }
+            if ended {
+                return Ok(Taken::Ended);
+            }
+            if Instant::now() >= deadline {
+                return Ok(Taken::Empty);
+            }
+        }
+    }
+
+    fn not_subscribed(kind: Kind) -> Error {
+        Error::new(
+            Code::Usage,
+            format!(
+                "not subscribed to {} (call the subscribe function first)",
+                kind.what()
+            ),
+        )
+    }
+
+    fn received(s: Sample) -> Received {
+        Received {
             name: s
                 .key_expr()
                 .as_str()
@@ -286,7 +325,81 @@ impl Client {
                 .unwrap_or_default()
                 .to_owned(),
             payload: s.payload().to_bytes().into_owned(),
-        }))
+        }
+    }
+
+    /// The next sample of `kind` at once (`Ok(None)` when there is none).
+    pub fn poll(&mut self, kind: Kind) -> Result<Taken<Received>, Error> {
+        let Some(sub) = self.slot(kind).as_ref() else {
+            return Err(Self::not_subscribed(kind));
+        };
+        let sample = sub.try_recv().map_err(|e| {
+            Error::new(
+                Code::Closed,
+                format!("the {} subscription ended: {e}", kind.what()),
+            )
+        })?;
+        Ok(match sample {
+            Some(s) => Taken::Got(Self::received(s)),
+            None => Taken::Empty,
+        })
+    }
+
+    /// The next sample of `kind`, waiting up to `timeout` ([`Code::Timeout`]); once the run
+    /// has ended, [`Taken::Ended`] as soon as nothing more is queued.
+    pub fn wait(&mut self, kind: Kind, timeout: Duration) -> Result<Taken<Received>, Error> {
+        let Self {
+            run_end,
+            state,
+            imu,
+            star_tracker,
+            status,
+            time,
+            ..
+        } = self;
+        let slot = match kind {
+            Kind::State => state,
+            Kind::Imu => imu,
+            Kind::StarTracker => star_tracker,
+            Kind::Status => status,
+            Kind::Time => time,
+        };
+        let Some(sub) = slot.as_ref() else {
+            return Err(Self::not_subscribed(kind));
+        };
+        let waited = Self::wait_sliced(run_end, timeout, |slice| {
+            sub.recv_timeout(slice).map_err(|e| {
+                Error::new(
+                    Code::Closed,
+                    format!("the {} subscription ended: {e}", kind.what()),
+                )
+            })
+        })?;
+        match waited {
+            Taken::Got(s) => Ok(Taken::Got(Self::received(s))),
+            Taken::Ended => Ok(Taken::Ended),
+            Taken::Empty => Err(Error::new(
+                Code::Timeout,
+                format!(
+                    "no {} sample on {} within {} ms",
+                    kind.what(),
+                    sub.key_expr(),
+                    timeout.as_millis()
+                ),
+            )),
+        }
+    }
+
+    /// [`Self::poll`] when `timeout` is `None`, else [`Self::wait`].
+    pub fn receive(
+        &mut self,
+        kind: Kind,
+        timeout: Option<Duration>,
+    ) -> Result<Taken<Received>, Error> {
+        match timeout {
+            None => self.poll(kind),
+            Some(t) => self.wait(kind, t),
+        }
     }
 
     /// The key of a received sample of `kind` named `name`, for messages.
@@ -333,20 +446,23 @@ impl Client {
     }
 
     /// The next time message (the next tick), waiting up to `timeout` (`None`: at once,
-    /// `Ok(None)` when there is none); it becomes [`Self::now`].
-    pub fn take_time(&mut self, timeout: Option<Duration>) -> Result<Option<TimeMsg>, Error> {
-        let Some(r) = self.receive(Kind::Time, timeout)? else {
-            return Ok(None);
+    /// [`Taken::Empty`] when there is none; a wait says [`Taken::Ended`] once the run has
+    /// ended and none is queued); it becomes [`Self::now`].
+    pub fn take_time(&mut self, timeout: Option<Duration>) -> Result<Taken<TimeMsg>, Error> {
+        let r = match self.receive(Kind::Time, timeout)? {
+            Taken::Got(r) => r,
+            Taken::Empty => return Ok(Taken::Empty),
+            Taken::Ended => return Ok(Taken::Ended),
         };
         let m = decode_as("time", &self.topics.time(), &r.payload, decode_time)?;
         self.last_time = Some(m);
-        Ok(Some(m))
+        Ok(Taken::Got(m))
     }
 
     /// The newest time message received, after taking every one queued (`None` before the
     /// first). Never waits.
     pub fn now(&mut self) -> Result<Option<TimeMsg>, Error> {
-        while self.take_time(None)?.is_some() {}
+        while let Taken::Got(_) = self.take_time(None)? {}
         Ok(self.last_time)
     }
 
@@ -434,37 +550,47 @@ impl Client {
         self.lockstep = None;
     }
 
+    fn not_participant() -> Error {
+        Error::new(
+            Code::Usage,
+            "not a lockstep participant (call flexdyn_lockstep_join first)",
+        )
+    }
+
     fn lockstep(&mut self) -> Result<&mut Lockstep, Error> {
-        self.lockstep.as_mut().ok_or_else(|| {
-            Error::new(
-                Code::Usage,
-                "not a lockstep participant (call flexdyn_lockstep_join first)",
-            )
-        })
+        self.lockstep.as_mut().ok_or_else(Self::not_participant)
     }
 
     /// The next complete tick, waiting up to `timeout`; it is held until the next call.
-    pub fn wait_tick(&mut self, timeout: Duration) -> Result<&Tick, Error> {
+    /// [`Taken::Ended`] (nothing held) once the run has ended and no tick is queued; never
+    /// [`Taken::Empty`] (a timeout is [`Code::Timeout`]).
+    pub fn wait_tick(&mut self, timeout: Duration) -> Result<Taken<&Tick>, Error> {
         let telemetry = self.topics.telemetry_wildcard();
-        let ls = self.lockstep()?;
+        let Self {
+            run_end, lockstep, ..
+        } = self;
+        let ls = lockstep.as_mut().ok_or_else(Self::not_participant)?;
         ls.held = None;
-        let tick = ls
-            .receiver
-            .recv_timeout(timeout)
-            .map_err(|e| {
+        let receiver = &mut ls.receiver;
+        let waited = Self::wait_sliced(run_end, timeout, |slice| {
+            receiver.recv_timeout(slice).map_err(|e| {
                 Error::new(
                     Code::Closed,
                     format!("the telemetry subscription ended: {e}"),
                 )
-            })?
-            .ok_or_else(|| {
-                Error::new(
-                    Code::Timeout,
-                    format!("no tick on {telemetry} within {} ms", timeout.as_millis()),
-                )
-            })?;
-        ls.answered = false;
-        Ok(ls.held.insert(tick))
+            })
+        })?;
+        match waited {
+            Taken::Got(tick) => {
+                ls.answered = false;
+                Ok(Taken::Got(ls.held.insert(tick)))
+            }
+            Taken::Ended => Ok(Taken::Ended),
+            Taken::Empty => Err(Error::new(
+                Code::Timeout,
+                format!("no tick on {telemetry} within {} ms", timeout.as_millis()),
+            )),
+        }
     }
 
     /// The sensor names of the joined run (IMUs, then star trackers).

@@ -8,6 +8,8 @@ pub enum Code {
     Ok = 0,
     /// `FLEXDYN_EMPTY`: a poll found nothing.
     Empty = 1,
+    /// `FLEXDYN_ENDED`: a wait found nothing queued and the server has said the run ended.
+    Ended = 2,
     /// `FLEXDYN_ERR_TIMEOUT`.
     Timeout = -1,
     /// `FLEXDYN_ERR_ARGUMENT`.

@@ -16,7 +16,7 @@ use flexdyn_proto::{CommandKind, Header, OperatorAction, MAX_ID_LEN};
 
 use crate::client::{
     decode_imu_bytes, decode_star_tracker_bytes, decode_state_bytes, decode_status_bytes, Client,
-    Kind, Options,
+    Kind, Options, Taken,
 };
 use crate::ctypes::{
     effector_input, fill_state, finite3, FdEffectorInput, FdEffectorState, FdHeader, FdImuMsg,
@@ -72,13 +72,21 @@ fn with_handle(
     handle: *mut FlexdynClient,
     f: impl FnOnce(&mut FlexdynClient) -> Result<Code, Error>,
 ) -> c_int {
+    with_handle_int(handle, |h| f(h).map(|code| code as c_int))
+}
+
+/// [`with_handle`] for a function that returns a plain value on success.
+fn with_handle_int(
+    handle: *mut FlexdynClient,
+    f: impl FnOnce(&mut FlexdynClient) -> Result<c_int, Error>,
+) -> c_int {
     // SAFETY: a non-null `handle` comes from `flexdyn_client_new` and is used by one thread at a
     // time (the header's threading contract), so a unique reference for this call is sound.
     let Some(h) = (unsafe { handle.as_mut() }) else {
         return Code::Argument as c_int;
     };
     match catch_unwind(AssertUnwindSafe(|| f(&mut *h))) {
-        Ok(Ok(code)) => code as c_int,
+        Ok(Ok(value)) => value,
         Ok(Err(e)) => {
             h.set_error(&e.message);
             e.code as c_int
@@ -289,19 +297,21 @@ fn timeout(ms: u32) -> Duration {
     Duration::from_millis(u64::from(ms))
 }
 
-/// Takes the next sample of `kind` (poll when `wait` is `None`) and decodes it into `out`.
+/// Takes the next sample of `kind` (poll when `wait` is `None`) and decodes it.
 fn take<T>(
     h: &mut FlexdynClient,
     kind: Kind,
     wait: Option<u32>,
     decode_into: impl FnOnce(&str, &[u8]) -> Result<T, Error>,
-) -> Result<Option<(String, T)>, Error> {
+) -> Result<Taken<(String, T)>, Error> {
     let client = h.client()?;
-    let Some(r) = client.receive(kind, wait.map(timeout))? else {
-        return Ok(None);
+    let r = match client.receive(kind, wait.map(timeout))? {
+        Taken::Got(r) => r,
+        Taken::Empty => return Ok(Taken::Empty),
+        Taken::Ended => return Ok(Taken::Ended),
     };
     let key = client.key_of(kind, &r.name);
-    decode_into(&key, &r.payload).map(|m| Some((r.name, m)))
+    decode_into(&key, &r.payload).map(|m| Taken::Got((r.name, m)))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -400,6 +410,35 @@ pub unsafe extern "C" fn flexdyn_close(handle: *mut FlexdynClient) -> c_int {
     })
 }
 
+/// `flexdyn_run_ended`: 1 (and the outputs filled) once the server's last status said the run
+/// ended, 0 before (or when the session is not open), `FLEXDYN_ERR_ARGUMENT` for a null handle.
+///
+/// # Safety
+/// `handle` is a live handle; `run_state_out` and `tick_out` null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_run_ended(
+    handle: *mut FlexdynClient,
+    run_state_out: *mut i32,
+    tick_out: *mut u64,
+) -> c_int {
+    with_handle_int(handle, |h| {
+        let Some(end) = h.client.as_ref().and_then(Client::ended) else {
+            return Ok(0);
+        };
+        if !run_state_out.is_null() {
+            // The wire tag: 3, 4 or 5 (FD_RUN_STATE_FINISHED, _FAILED, _STOPPED).
+            let tag = i32::try_from(end.run_state.tag()).unwrap_or(i32::MAX);
+            // SAFETY: non-null and writable, by this function's contract.
+            unsafe { run_state_out.write(tag) };
+        }
+        if !tick_out.is_null() {
+            // SAFETY: non-null and writable, by this function's contract.
+            unsafe { tick_out.write(end.tick) };
+        }
+        Ok(1)
+    })
+}
+
 // ---------------------------------------------------------------------------------------------
 // Subscriptions.
 
@@ -419,12 +458,12 @@ unsafe fn subscribe(
     })
 }
 
-/// `FLEXDYN_OK` for a sample, `FLEXDYN_EMPTY` for none.
-fn got<T>(r: Option<T>) -> Code {
-    if r.is_some() {
-        Code::Ok
-    } else {
-        Code::Empty
+/// `FLEXDYN_OK` for a sample, `FLEXDYN_EMPTY` for none, `FLEXDYN_ENDED` after the run.
+fn got<T>(r: &Taken<T>) -> Code {
+    match r {
+        Taken::Got(_) => Code::Ok,
+        Taken::Empty => Code::Empty,
+        Taken::Ended => Code::Ended,
     }
 }
 
@@ -449,11 +488,11 @@ unsafe fn state(handle: *mut FlexdynClient, out: *mut FdStateMsg, wait: Option<u
             return Err(null("out"));
         }
         let r = take(h, Kind::State, wait, decode_state_bytes)?;
-        if let Some((_, m)) = &r {
+        if let Taken::Got((_, m)) = &r {
             // SAFETY: forwarded contract.
             unsafe { write_state(out, m)? };
         }
-        Ok(got(r))
+        Ok(got(&r))
     })
 }
 
@@ -504,8 +543,8 @@ unsafe fn sensor<T>(
         }
         check_name_buffer(name_out, name_cap)?;
         let r = take(h, kind, wait, decode_into)?;
-        let code = got(r.as_ref());
-        if let Some((name, m)) = r {
+        let code = got(&r);
+        if let Taken::Got((name, m)) = r {
             // SAFETY: forwarded contract; `name_cap >= NAME_CAP` was checked.
             unsafe {
                 write(out, m)?;
@@ -733,15 +772,15 @@ pub unsafe extern "C" fn flexdyn_subscribe_time(
 unsafe fn time_into(
     handle: *mut FlexdynClient,
     out: *mut FdTimeMsg,
-    get: impl FnOnce(&mut Client) -> Result<Option<flexdyn_proto::TimeMsg>, Error>,
+    get: impl FnOnce(&mut Client) -> Result<Taken<flexdyn_proto::TimeMsg>, Error>,
 ) -> c_int {
     with_handle(handle, |h| {
         if out.is_null() {
             return Err(null("out"));
         }
         let m = get(h.client()?)?;
-        let code = got(m.as_ref());
-        if let Some(m) = m {
+        let code = got(&m);
+        if let Taken::Got(m) = m {
             // SAFETY: non-null and writable, by this function's contract.
             unsafe { write(out, FdTimeMsg::from(&m))? };
         }
@@ -770,7 +809,14 @@ pub unsafe extern "C" fn flexdyn_wait_tick(
 #[no_mangle]
 pub unsafe extern "C" fn flexdyn_now(handle: *mut FlexdynClient, out: *mut FdTimeMsg) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe { time_into(handle, out, Client::now) }
+    unsafe {
+        time_into(handle, out, |c| {
+            Ok(match c.now()? {
+                Some(m) => Taken::Got(m),
+                None => Taken::Empty,
+            })
+        })
+    }
 }
 
 /// `flexdyn_send_operator`.
@@ -914,7 +960,9 @@ pub unsafe extern "C" fn flexdyn_lockstep_wait(
         if state.is_null() {
             return Err(null("state"));
         }
-        let tick = h.client()?.wait_tick(timeout(timeout_ms))?;
+        let Taken::Got(tick) = h.client()?.wait_tick(timeout(timeout_ms))? else {
+            return Ok(Code::Ended);
+        };
         // SAFETY: forwarded contract.
         unsafe { write_state(state, &tick.state)? };
         Ok(Code::Ok)

@@ -13,6 +13,9 @@
 //!   -Wall -Wextra -Werror -pedantic`, run as a participant that polls every subscription;
 //! - `server_loss_is_an_error_code_not_a_hang`: the server is killed (SIGKILL) mid-run; the C
 //!   program must exit with its timeout code within seconds;
+//! - `the_flight_loop_stops_when_the_server_ends_the_run`: pd_lockstep with a 60 s wait
+//!   timeout, so only `FLEXDYN_ENDED` can end it in time, must exit 0 soon after a 300-tick
+//!   lockstep server finishes (issue 36; issue 37 §4), every tick answered;
 //! - `no_leak_over_10000_ticks`: pd_lockstep built with AddressSanitizer (LeakSanitizer sees
 //!   every allocation, the library's Rust ones included: they go through malloc) flies 10,000
 //!   ticks, and valgrind's memcheck a 500-tick run (the leak check would take minutes under
@@ -292,12 +295,14 @@ fn struct_layouts_agree() {
     assert!(stdout.ends_with("all agree\n"), "{stdout}");
 }
 
-/// One pd_lockstep run of ticks 0..=2000; with `pause`, SIGSTOP for 1 s at tick 1000.
+/// One pd_lockstep run of ticks 0..=2000, to the server's end of run; with `pause`, SIGSTOP
+/// for 1 s at tick 1000.
 fn fly(exe: &Path, name: &str, pause: bool) -> PathBuf {
     let mut server = Server::start("20");
     let file = tmp().join(name);
     let file_arg = file.to_string_lossy().into_owned();
-    let mut pd = spawn(exe, &[&server.endpoint, "2000", &file_arg], &[]);
+    // "-": until the server ends the run (FLEXDYN_ENDED) after tick 2000.
+    let mut pd = spawn(exe, &[&server.endpoint, "-", &file_arg], &[]);
     if pause {
         await_line(&mut pd, "tick 1000");
         signal(pd.id(), "-STOP");
@@ -318,6 +323,50 @@ fn fly(exe: &Path, name: &str, pause: bool) -> PathBuf {
         "the server's exit"
     );
     file
+}
+
+/// Far above any delivery time, far below the program's 60 s wait timeout.
+const EXIT_BOUND: Duration = Duration::from_secs(10);
+
+#[test]
+fn the_flight_loop_stops_when_the_server_ends_the_run() {
+    let exe = build_c(&["-O2"], "examples/pd_lockstep.c", "pd_lockstep_end");
+    let mut server = Server::start("3");
+    let file = tmp().join("states_end.bin");
+    let file_arg = file.to_string_lossy().into_owned();
+    // "-": no tick limit; a 60 s wait timeout: a timeout cannot be what ends it in time.
+    let mut pd = spawn(&exe, &[&server.endpoint, "-", &file_arg, "60000"], &[]);
+    assert_eq!(
+        server.wait(Duration::from_secs(60)),
+        Some(0),
+        "the server's exit"
+    );
+    let server_done = Instant::now();
+    let give_up = server_done + EXIT_BOUND;
+    let status = loop {
+        if let Some(s) = pd.try_wait().expect("wait") {
+            break s;
+        }
+        if Instant::now() > give_up {
+            let _ = pd.kill();
+            panic!("pd_lockstep still running {EXIT_BOUND:?} after the server ended");
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    };
+    let exit_ms = server_done.elapsed().as_secs_f64() * 1e3;
+    let mut out = String::new();
+    let mut err = String::new();
+    std::io::Read::read_to_string(pd.stdout.as_mut().unwrap(), &mut out).ok();
+    std::io::Read::read_to_string(pd.stderr.as_mut().unwrap(), &mut err).ok();
+    assert!(status.success(), "pd_lockstep: {status:?}\n{out}{err}");
+    assert_eq!(
+        out.lines().last(),
+        Some("run ended: finished at tick 300, 301 ticks answered"),
+        "{out}"
+    );
+    let ticks: Vec<u64> = states(&file).iter().map(|s| s.header.tick).collect();
+    assert_eq!(ticks, (0..=300).collect::<Vec<u64>>());
+    eprintln!("pd_lockstep exited {exit_ms:.1} ms after the server's exit (FLEXDYN_ENDED)");
 }
 
 #[test]
@@ -419,7 +468,8 @@ fn no_leak_over_10000_ticks() {
     // 10,000 ticks under AddressSanitizer: no leak, no memory error.
     let exe = build_c(&asan, "examples/pd_lockstep.c", "pd_lockstep_asan");
     let mut server = Server::start("100");
-    let mut pd = spawn(&exe, &[&server.endpoint, "10000", "-"], &asan_env);
+    // "-": until the server ends the run after tick 10,000 (the FLEXDYN_ENDED path included).
+    let mut pd = spawn(&exe, &[&server.endpoint, "-", "-"], &asan_env);
     let status = wait_for(&mut pd, Duration::from_secs(120));
     let mut err = String::new();
     std::io::Read::read_to_string(pd.stderr.as_mut().unwrap(), &mut err).ok();
