@@ -25,6 +25,7 @@
 
 #![warn(missing_docs)]
 
+pub mod columns;
 pub mod error;
 pub mod export;
 pub mod fault_spans;

@@ -141,7 +141,11 @@ impl Columns {
             if name == "t_s" {
                 self.t_s.push(x);
             } else {
-                let c = self.cols.entry(name.clone()).or_default();
+                // Look up before inserting: the name is cloned once per column, not per row.
+                let c = match self.cols.get_mut(name.as_str()) {
+                    Some(c) => c,
+                    None => self.cols.entry(name.clone()).or_default(),
+                };
                 c.resize(n, f64::NAN);
                 c.push(x);
             }

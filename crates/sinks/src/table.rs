@@ -22,6 +22,7 @@ use flexdyn_proto::StateMsg;
 use serde::Serialize;
 use serde_json::Value;
 
+use super::columns::push_columns;
 use super::topics::Decoded;
 use flexdyn_dynamics::kinds::wire_names;
 use flexdyn_kernel::numfmt::Num;
@@ -63,7 +64,7 @@ pub type Column = (String, Cell);
 
 /// Appends the columns of `v` named under `prefix`. An array is numbered from 1, or from 0
 /// when it is a quaternion (its field name starts with `q_`: scalar first, `q_bn_0` = β0).
-fn push_value(prefix: &str, v: &Value, out: &mut Vec<Column>) {
+pub(crate) fn push_value(prefix: &str, v: &Value, out: &mut Vec<Column>) {
     match v {
         // serde_json writes a non-finite f64 as null (the wire structs have no optional
         // field): keep the column, as NaN.
@@ -194,7 +195,20 @@ pub fn row(decoded: &Decoded) -> Vec<Column> {
         }
         _ => {
             let mut out = vec![t_s_cell(decoded.header().sim_time_ns)];
-            push_value("", &decoded.to_json(), &mut out);
+            match decoded {
+                // A sensor sample is decoded to JSON by its kind.
+                Decoded::Sensor { json, .. } => push_value("", json, &mut out),
+                Decoded::Status(m) => push_columns("", m, &[], &mut out),
+                Decoded::Time(m) => push_columns("", m, &[], &mut out),
+                Decoded::Operator(m) => push_columns("", m, &[], &mut out),
+                Decoded::Environment(m) => push_columns("", m, &[], &mut out),
+                Decoded::FaultEvent(m) => push_columns("", m, &[], &mut out),
+                Decoded::FaultCommand(m) => push_columns("", m, &[], &mut out),
+                Decoded::RelativeState(m) => push_columns("", m, &[], &mut out),
+                Decoded::State(_) | Decoded::Command(_) => {
+                    push_value("", &decoded.to_json(), &mut out)
+                }
+            }
             out
         }
     }
@@ -204,11 +218,7 @@ pub fn row(decoded: &Decoded) -> Vec<Column> {
 /// then the effectors.
 pub fn state_row(state: &StateMsg) -> Vec<Column> {
     let mut out = vec![t_s_cell(state.header.sim_time_ns)];
-    let mut json = serde_json::to_value(state).unwrap_or(Value::Null);
-    if let Value::Object(map) = &mut json {
-        map.shift_remove("effectors");
-    }
-    push_value("", &json, &mut out);
+    push_columns("", state, &["effectors"], &mut out);
     push_effectors(&state.effectors, &mut out);
     out
 }
@@ -221,12 +231,8 @@ pub const ENVIRONMENT_COLUMN_PREFIX: &str = "env";
 /// `simulate` writes beside the state for a sensor sample (`imu_hub_omega_p_rad_s_1`,
 /// `st_st1_valid`) or another record (`wrench_schedule_torque_b_nm_1`).
 pub fn prefixed_columns<T: Serialize>(prefix: &str, msg: &T) -> Vec<Column> {
-    let mut json = serde_json::to_value(msg).unwrap_or(Value::Null);
-    if let Value::Object(map) = &mut json {
-        map.shift_remove("header");
-    }
     let mut out = Vec::new();
-    push_value(prefix, &json, &mut out);
+    push_columns(prefix, msg, &["header"], &mut out);
     out
 }
 

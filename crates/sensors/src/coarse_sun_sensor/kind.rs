@@ -33,7 +33,7 @@ pub static KIND: SensorKind = SensorKind {
         "Coarse sun sensors: each detector's reading (0 outside its field of view and in umbra)",
         &[
             PanelSpec {
-                y_label: "detectors 1-6",
+                y_label: "reading (output unit)",
                 lines: &[
                     ("readings_1", "1"),
                     ("readings_2", "2"),
@@ -44,7 +44,7 @@ pub static KIND: SensorKind = SensorKind {
                 ],
             },
             PanelSpec {
-                y_label: "detectors 7-16",
+                y_label: "reading, detectors 7-16",
                 lines: &[
                     ("readings_7", "7"),
                     ("readings_8", "8"),
