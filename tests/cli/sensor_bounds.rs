@@ -236,3 +236,30 @@ fn every_error_term_at_its_bound_is_accepted_and_runs_finite() {
         }
     }
 }
+
+/// Every error term of every sensor kind can be dispersed by a campaign: the built model reports
+/// it by its configuration path (`imus[0].gyro.bias_rad_s[2]`), so a dispersion of it is read
+/// back and verified (`result.json`'s `applied`). A new user found `imus[0].gyro.bias_rad_s`
+/// refused although the documentation said IMU parameters could be dispersed.
+#[test]
+fn every_error_term_of_every_sensor_kind_is_read_back_for_a_campaign() {
+    for kind in flexdyn_sensors::KINDS {
+        let array = kind.config_array;
+        let (scenario, _) = scenario_with(array).expect("a scenario (see the first test)");
+        let cfg = flexdyn_vehicle::config::SimConfig::from_file(&scenario).unwrap();
+        let model = flexdyn_campaign::readback::readback(&cfg).unwrap();
+        for &(term, len) in kind.config.error_terms {
+            let keys: Vec<String> = match len {
+                1 => vec![format!("{array}[0].{term}")],
+                n => (0..n).map(|i| format!("{array}[0].{term}[{i}]")).collect(),
+            };
+            for key in keys {
+                assert!(
+                    model.contains_key(&key),
+                    "{key} is not read back, so a campaign refuses to disperse it ({})",
+                    scenario.display()
+                );
+            }
+        }
+    }
+}

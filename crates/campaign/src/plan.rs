@@ -243,7 +243,8 @@ impl Plan {
                         format!(
                             "{whose}{k} is not a parameter the built model reports (the hub, \
                              initial state, panel pairs, reaction wheels, facets, residual \
-                             dipole, space weather and epoch offset are), so its dispersion \
+                             dipole, every sensor's error terms, space weather and epoch \
+                             offset are; `flexdyn campaign plan` lists them), so its dispersion \
                              could not be verified; it is refused rather than risk a silent \
                              no-op"
                         ),

@@ -439,6 +439,35 @@ struct TriadOut {
     incr_saturated: bool,
 }
 
+impl TriadParams {
+    /// Its parameters as built, keyed `<table>.<key>` as in the configuration (`gyro.bias_rad_s[0]`,
+    /// `accel.misalignment_rad[0][1]`), for a campaign's read-back.
+    fn parameters(&self, k: &TriadKeys, out: &mut Vec<(String, f64)>) {
+        let t = k.table;
+        for (key, v) in [
+            (k.white, self.white),
+            (k.gm_sigma, self.gm_sigma),
+            ("bias_instability_tau_s", self.gm_tau_s),
+            (k.rrw, self.rrw),
+            (k.range, self.range),
+            (k.lsb, self.lsb),
+            (k.incr_lsb, self.incr_lsb),
+        ] {
+            out.push((format!("{t}.{key}"), v));
+        }
+        for i in 0..3 {
+            out.push((format!("{t}.{}[{i}]", k.bias), self.bias[i]));
+            out.push((format!("{t}.scale_factor[{i}]"), self.scale_factor[i]));
+            for j in 0..3 {
+                out.push((
+                    format!("{t}.misalignment_rad[{i}][{j}]"),
+                    self.misalignment[(i, j)],
+                ));
+            }
+        }
+    }
+}
+
 impl Triad {
     fn new(p: TriadParams, z_gm0: &[f64]) -> Self {
         let gain = p.gain();
@@ -616,6 +645,13 @@ impl Imu {
             gyro: Triad::new(TriadParams::from(&cfg.gyro), &z0[0..3]),
             accel: Triad::new(TriadParams::from(&cfg.accel), &z0[3..6]),
         })
+    }
+
+    /// Its error terms as built, keyed as in the configuration entry (`gyro.bias_rad_s[0]`,
+    /// `accel.vrw_m_s2_sqrt_hz`): what a campaign reads back after dispersing them.
+    pub fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        self.gyro.p.parameters(&GYRO_KEYS, out);
+        self.accel.p.parameters(&ACCEL_KEYS, out);
     }
 
     /// Sets the nominal sample interval T_s \[s\] (finite, > 0): the instantaneous outputs carry

@@ -92,6 +92,14 @@ impl Sensor for ImuSensor {
         self.imu.name()
     }
 
+    /// The error terms ([`Imu::parameters`]) and the position `r_sb_b_m[i]`.
+    fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        self.imu.parameters(out);
+        for i in 0..3 {
+            out.push((format!("r_sb_b_m[{i}]"), self.point.r_sb_b_m[i]));
+        }
+    }
+
     /// Every frame (it closes its interval whenever it is sampled).
     fn due(&self, _tick: u64) -> bool {
         true
