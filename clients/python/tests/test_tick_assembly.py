@@ -165,24 +165,78 @@ def test_in_real_time_a_later_tick_releases_a_waiting_one_at_once():
     p.close()
 
 
-def test_wait_returns_the_final_status_once_its_tick_is_answered():
+def feed_tick(c, tick):
+    c.feed("imu/hub", imu(tick))
+    c.feed("imu/bracket", imu(tick))
+    if tick % 10 == 0:
+        c.feed("st/st1", st(tick))
+    if tick % 4 == 0:
+        c.feed("st/st2", st(tick))
+    c.feed("state", state(tick))
+
+
+def test_wait_hands_out_the_queued_ticks_then_returns_the_final_status():
+    # The end of the run is heard while ticks 0..2 are still on their way (issue 36): wait
+    # returns only once the status's tick is answered, and says how the run ended.
     c, seen = FakeClient(), []
     p = participant(c, seen)
-    final = proto.StatusMsg(header(1), proto.MODE_LOCKSTEP, 3)
+    assert p.ended is None and p.final_status is None
+    final = proto.StatusMsg(header(2), proto.MODE_LOCKSTEP, 3)
     c.status_callback(final)
+
+    def late_ticks():
+        for tick in (0, 1, 2):
+            time.sleep(0.005)
+            feed_tick(c, tick)
+
+    feeder = threading.Thread(target=late_ticks)
+    feeder.start()
+    assert p.wait(timeout_s=5) is final
+    feeder.join()
+    assert [t.tick for t in seen] == [0, 1, 2] and p.last_tick == 2
+    assert p.ended == ("finished", 2)
+    p.close()
+
+
+def test_wait_returns_on_an_end_whose_tick_never_comes():
+    # A run stopped before tick 0 (its last status names tick 0, no state was published): wait
+    # returns by itself, without a timeout, and says so.
+    c, seen = FakeClient(), []
+    p = participant(c, seen)
+    c.status_callback(proto.StatusMsg(header(0), proto.MODE_LOCKSTEP, 5))
+    t0 = time.monotonic()
+    assert p.wait().run_state == 5
+    assert time.monotonic() - t0 < 1.0
+    assert p.ended == ("stopped", 0) and seen == [] and p.last_tick == -1
+    p.close()
+
+
+def test_wait_hands_out_a_tick_held_for_a_sample_when_the_run_ends():
+    # Tick 1's state is in, one of its IMU samples is not (lost); then the server fails at
+    # tick 2. wait hands tick 1 out without the sample, then returns.
+    c, seen = FakeClient(), []
+    p = participant(c, seen)
+    feed_tick(c, 0)
+    c.feed("imu/hub", imu(1))
+    c.feed("state", state(1))
+    assert [t.tick for t in seen] == [0]
+    c.status_callback(proto.StatusMsg(header(2), proto.MODE_LOCKSTEP, 4))
+    assert p.wait(timeout_s=5).run_state == 4
+    assert [(t.tick, t.missing) for t in seen] == [(0, ()), (1, ("imu/bracket",))]
+    assert p.ended == ("failed", 2)
+    p.close()
+
+
+def test_wait_times_out_without_an_end_of_run():
+    c, seen = FakeClient(), []
+    p = participant(c, seen)
+    feed_tick(c, 0)
     try:
         p.wait(timeout_s=0.1)
-        raise AssertionError("wait returned before tick 1 was answered")
+        raise AssertionError("wait returned without an end of run")
     except TimeoutError:
         pass
-    for tick in (0, 1):
-        c.feed("imu/hub", imu(tick))
-        c.feed("imu/bracket", imu(tick))
-        if tick == 0:
-            c.feed("st/st1", st(0))
-            c.feed("st/st2", st(0))
-        c.feed("state", state(tick))
-    assert p.wait(timeout_s=1) is final
+    assert p.ended is None
     p.close()
 
 

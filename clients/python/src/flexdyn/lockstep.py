@@ -19,6 +19,7 @@ from __future__ import annotations
 import logging
 import math
 import threading
+import time
 from dataclasses import dataclass, field
 from typing import Callable, Dict, List, Optional, Tuple, Union
 
@@ -34,8 +35,12 @@ log = logging.getLogger("flexdyn")
 #: here).
 Answer = Optional[Union[Tuple[Vec3, Vec3], CommandMsg]]
 
-#: run_state values of a run's last StatusMsg: Finished, Failed, Stopped.
-_ENDED = (3, 4, 5)
+#: run_state values of a run's last StatusMsg: Finished, Failed, Stopped, and their words.
+_ENDED = {3: "finished", 4: "failed", 5: "stopped"}
+
+#: Once the end of the run is heard, :meth:`LockstepParticipant.wait` returns as soon as a slice
+#: this long passes with no tick handed out (the frames still queued go first).
+_END_SLICE_S = 0.02
 
 
 #: The sensor kinds that publish at a rate: (configuration array, key kind, Tick attribute).
@@ -166,8 +171,13 @@ class LockstepParticipant:
     the same way. In real time, where the server drops samples under load, a later
     tick's sample releases a waiting tick at once the same way.
 
-    :meth:`wait` blocks until the run has ended; :meth:`close` stops (token first, so the server
-    sees it leave) and raises the first error of the callback, if any.
+    The end of the run: the server's last StatusMsg on ``flexdyn/<sc>/status`` (run_state
+    Finished, Failed or Stopped; proto/README.md, "StatusMsg"), heard on a subscription the
+    participant declares before its telemetry. :meth:`wait` blocks until it has come and every
+    tick received before it has been handed to the callback, then returns it; :attr:`ended`
+    says how the run ended (``None`` before, then e.g. ``("finished", 300)``). :meth:`close`
+    stops (token first, so the server sees it leave) and raises the first error of the
+    callback, if any.
     """
 
     def __init__(self, client: Client, sender_id: int,
@@ -326,7 +336,8 @@ class LockstepParticipant:
     def _on_status(self, status: StatusMsg) -> None:
         if status.run_state in _ENDED:
             with self._changed:
-                self._final = status
+                if self._final is None:  # the first end heard
+                    self._final = status
                 self._changed.notify_all()
 
     @property
@@ -334,21 +345,62 @@ class LockstepParticipant:
         """The last tick handed to the callback (-1 before the first)."""
         return self._last_tick
 
+    @property
+    def ended(self) -> Optional[Tuple[str, int]]:
+        """How the run ended, once the server's last StatusMsg said so: ``("finished", tick)``,
+        ``("failed", tick)`` or ``("stopped", tick)`` with the last tick the server stepped;
+        ``None`` before. (:attr:`final_status` is the whole message.)"""
+        final = self._final
+        if final is None:
+            return None
+        return _ENDED[final.run_state], final.header.tick
+
+    @property
+    def final_status(self) -> Optional[StatusMsg]:
+        """The server's last StatusMsg (Finished, Failed or Stopped), ``None`` before."""
+        return self._final
+
     def wait(self, timeout_s: Optional[float] = None) -> StatusMsg:
-        """Blocks until the run has ended: the server's last StatusMsg (run_state Finished,
-        Failed or Stopped) has come and every tick up to its tick has been handed to the
-        callback. Returns that StatusMsg. Raises the callback's first error as soon as there is
-        one, and ``TimeoutError`` after `timeout_s`."""
-        def ended() -> bool:
+        """Blocks until the run has ended and returns the server's last StatusMsg (run_state
+        Finished, Failed or Stopped; :attr:`ended` says the same in words). Every tick received
+        before it is handed to the callback first: `wait` returns once the tick of that status
+        has been answered, or else (a run that ended before its tick was published, e.g.
+        stopped before tick 0) as soon as 20 ms pass with no tick handed out after the status
+        came; a tick still held for a sensor sample then goes out without it. Raises the
+        callback's first error as soon as there is one, and ``TimeoutError`` after `timeout_s`
+        without an end of run."""
+        def done() -> bool:
             return bool(self.errors) or (self._final is not None
                                           and self._last_tick >= self._final.header.tick)
 
+        deadline = None if timeout_s is None else time.monotonic() + timeout_s
         with self._changed:
-            if not self._changed.wait_for(ended, timeout_s):
-                raise TimeoutError(
-                    f"the run did not end within {timeout_s} s (last tick answered: "
-                    f"{self._last_tick}; final status: "
-                    f"{'none yet' if self._final is None else self._final.header.tick})")
+            while not done():
+                if self._final is not None:
+                    # The end was heard but not its tick: wait a slice for the ticks still
+                    # queued, then (no callback running: it holds the client's dispatch lock)
+                    # hand out a tick still held for a sample, or stop.
+                    before = self._last_tick
+                    if self._changed.wait_for(done, _END_SLICE_S) or self._last_tick != before:
+                        continue
+                    self._changed.release()
+                    try:
+                        with self.client._dispatch:
+                            progressed = self._last_tick != before
+                            if not progressed and self._held is not None:
+                                self._release()  # as the sensor timeout would, but now
+                                progressed = True
+                    finally:
+                        self._changed.acquire()
+                    if progressed:
+                        continue
+                    break  # nothing queued, nothing held: the run is over
+                left = None if deadline is None else deadline - time.monotonic()
+                if left is not None and left <= 0:
+                    raise TimeoutError(
+                        f"the run did not end within {timeout_s} s (last tick answered: "
+                        f"{self._last_tick}; no final status yet)")
+                self._changed.wait(left)
         if self.errors:
             raise self.errors[0]
         return self._final
