@@ -35,3 +35,4 @@ mod regress_sensor_outputs;
 mod sensor_bounds;
 mod served_config;
 mod sun_sensors;
+mod web_view;

@@ -1,6 +1,8 @@
 //! `flexdyn view`: a Foxglove WebSocket server (`foxglove.websocket.v1`, through the `foxglove`
 //! SDK) with the decoded channels, the frame transforms and the 3D scene, live from Zenoh or
 //! from a recording (`--file`, with the protocol's playback control: play, pause, speed, seek).
+//! The same port serves a web page to a plain HTTP GET ([`super::ws_names::web`]): a client of
+//! that same protocol, so a browser shows a live run and a replay alike, with nothing installed.
 //!
 //! Topics and schemas are the recording's decoded ones (`/flexdyn/<sc>/tlm/state`,
 //! `/flexdyn/<sc>/tf`, `/flexdyn/<sc>/scene`, …), so one Foxglove layout serves both. Message
@@ -51,7 +53,7 @@ pub const CLOCK_PERIOD: Duration = Duration::from_millis(10);
 /// Arguments of `flexdyn view`.
 #[derive(Clone, Debug, PartialEq, clap::Args)]
 pub struct ViewArgs {
-    /// Address of the WebSocket server (loopback by default).
+    /// Address of the WebSocket server and the web page, one port (loopback by default).
     #[arg(long, value_name = "HOST:PORT", default_value = DEFAULT_BIND)]
     pub bind: String,
     /// Show only this spacecraft (repeatable). Default: every vehicle heard (or recorded).
@@ -358,8 +360,15 @@ pub fn view(args: &ViewArgs) -> Result<ViewReport, SinkError> {
         );
         let upstream = std::net::SocketAddr::from(([127, 0, 0, 1], handle.port()));
         let relay = tokio::spawn(super::ws_names::serve(public, upstream));
+        // Once, with the port in use (`--bind HOST:0` picks one): the page and the protocol
+        // share it (`ws_names`).
+        let url_host = if host.contains(':') {
+            format!("[{host}]")
+        } else {
+            host.clone()
+        };
         tracing::info!(
-            "Foxglove WebSocket server on ws://{host}:{bound} (open it in Foxglove: Open connection → Foxglove WebSocket)"
+            "view: open http://{url_host}:{bound}/ in a browser, or connect Foxglove to ws://{url_host}:{bound}"
         );
         let translator = Arc::new(Mutex::new(Translator::new(ctx.clone(), args.sc_id.clone())));
         let samples = Arc::new(std::sync::atomic::AtomicU64::new(0));

@@ -9,9 +9,16 @@
 //! server listening on an ephemeral loopback port. Clients offering the new name pass through
 //! untouched. The `Sec-WebSocket-Accept` digest covers the key only, so the rename is invisible
 //! to the WebSocket handshake.
+//!
+//! A request without `Upgrade: websocket` (a browser opening `http://HOST:PORT/`) gets the web
+//! page of [`web`] instead, from this same port: a Foxglove-WebSocket client that connects back
+//! here (issue 36).
 
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::net::{TcpListener, TcpStream};
+
+#[path = "web/mod.rs"]
+pub mod web;
 
 /// The protocol's original name.
 pub const LEGACY: &str = "foxglove.websocket.v1";
@@ -98,6 +105,14 @@ pub fn server_head(head: &str) -> String {
 
 async fn relay(mut client: TcpStream, upstream: std::net::SocketAddr) -> std::io::Result<()> {
     let (head, rest) = read_head(&mut client).await?;
+    if !web::is_upgrade(&head) {
+        if let Some(wait) = web::hold(&head) {
+            tokio::time::sleep(wait).await;
+        }
+        client.write_all(&web::respond(&head)).await?;
+        client.shutdown().await?;
+        return Ok(());
+    }
     let (head, legacy) = client_head(&head);
     let mut server = TcpStream::connect(upstream).await?;
     server.set_nodelay(true)?;

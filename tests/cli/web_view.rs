@@ -1,0 +1,216 @@
+//! `flexdyn view`'s web page in a real browser (issue 36): a recording made offline is served
+//! with `flexdyn view --file` on a port the OS picks, and Debian's Chromium, headless, opens
+//! `http://127.0.0.1:PORT/`. The page is a Foxglove-WebSocket client of that same port; the
+//! test reads the page's own state from its DOM (`--dump-dom`: the latest tick shown, the run
+//! state, the eclipse) and checks a screenshot of it (`--screenshot`) is not blank.
+//!
+//! Chromium comes from `tests/web/install_chromium.sh` (`apt-get install -y chromium` as root)
+//! when `/usr/bin/chromium` is missing; without it the test fails saying what to install.
+
+use flexdyn_testkit::ports;
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::Instant;
+
+use flexdyn_proto::{decode_state, decode_status};
+use flexdyn_sinks::reader::read_recording;
+
+const CHROMIUM: &str = "/usr/bin/chromium";
+/// Seconds of simulation recorded (played back at 1×).
+const RECORDED_S: &str = "4";
+/// Real time the page holds its load event (`?hold=MS`): longer than the replay plus a restart,
+/// so the page sees the replay's end whenever it connects.
+const HOLD_MS: u64 = 7000;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("web_view");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+struct Guard(Child);
+
+impl Drop for Guard {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// `/usr/bin/chromium`, installed through `tests/web/install_chromium.sh` when missing.
+fn chromium() -> &'static Path {
+    let path = Path::new(CHROMIUM);
+    if !path.exists() {
+        let script = root().join("tests/web/install_chromium.sh");
+        let status = Command::new("sh").arg(&script).status();
+        eprintln!("{}: {status:?}", script.display());
+    }
+    assert!(
+        path.exists(),
+        "this test needs Debian's Chromium at {CHROMIUM}: install it with \
+         `apt-get install chromium` (as root: tests/web/install_chromium.sh does it)"
+    );
+    path
+}
+
+/// What an element `<TAG id="ID" …>TEXT<` of the dumped DOM holds.
+fn element_text<'a>(dom: &'a str, id: &str) -> Option<&'a str> {
+    let at = dom.find(&format!("id=\"{id}\""))?;
+    let rest = &dom[at..];
+    let start = rest.find('>')? + 1;
+    let end = rest[start..].find('<')? + start;
+    Some(&rest[start..end])
+}
+
+#[test]
+fn a_browser_shows_a_replay_on_the_viewers_own_port() {
+    let browser = chromium();
+    let started = Instant::now();
+    // A recording made offline, as tests/cli/recording_files.rs makes them: the LEO scenario
+    // (panels, the Sun, the magnetic field, the eclipse).
+    let file = tmp("leo.mcap");
+    let _ = std::fs::remove_file(&file);
+    let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args(["run", "--mode", "batch", "--duration-s", RECORDED_S])
+        .args(["--listen", ports::ANY_PORT])
+        .arg("--config")
+        .arg(root().join("scenarios/leo_environment.toml"))
+        .arg("--record")
+        .arg(&file)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .unwrap();
+    assert!(status.success(), "flexdyn run --record: {status}");
+    let rec = read_recording(&file).unwrap();
+    let ticks: HashSet<u64> = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == "flexdyn/sc1/tlm/state")
+        .map(|s| decode_state(&s.payload).unwrap().header.tick)
+        .collect();
+    let last_tick = *ticks.iter().max().expect("states in the recording");
+    let run_states: Vec<String> = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == "flexdyn/sc1/status")
+        .map(|s| {
+            let status = decode_status(&s.payload).unwrap();
+            serde_json::to_value(status.run_state)
+                .unwrap()
+                .as_str()
+                .expect("a run state serializes as its name")
+                .to_owned()
+        })
+        .collect();
+    let final_run_state = run_states
+        .last()
+        .expect("a StatusMsg in the recording")
+        .clone();
+
+    // The viewer on a port the OS picks; its one log line names the page and the protocol.
+    let mut viewer = Guard(
+        ports::reporting(
+            Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+                .args(["view", "--file"])
+                .arg(&file)
+                .args(["--bind", "127.0.0.1:0", "--duration-s", "60"]),
+        )
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap(),
+    );
+    let marker = "view: open http://127.0.0.1:";
+    let reported = ports::reported(&mut viewer.0, marker);
+    let port: u16 = reported[marker.len()..]
+        .strip_suffix('/')
+        .and_then(|p| p.parse().ok())
+        .unwrap_or_else(|| panic!("no port in {reported:?}"));
+    assert_ne!(port, 0);
+
+    // One headless run: the DOM on stdout, the screenshot to a file.
+    let shot = tmp("page.png");
+    let _ = std::fs::remove_file(&shot);
+    let profile = tmp("chromium-profile");
+    let url = format!("http://127.0.0.1:{port}/?hold={HOLD_MS}");
+    let out = Command::new(browser)
+        .args([
+            "--headless=new",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--virtual-time-budget=2000",
+            "--window-size=1200,800",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg("--dump-dom")
+        .arg(&url)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && dom.contains("<canvas id=\"scene\""),
+        "chromium {url}: {}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    // The page's own state: connected, the latest tick it drew is the recording's last one
+    // (it saw the replay's end), and the run state is the recording's last StatusMsg's.
+    assert_eq!(element_text(&dom, "conn"), Some("connected"), "{dom}");
+    let tick_text = element_text(&dom, "tick").unwrap_or_default();
+    let tick: u64 = tick_text
+        .parse()
+        .unwrap_or_else(|_| panic!("the page shows no tick ({tick_text:?}):\n{dom}"));
+    assert!(ticks.contains(&tick), "tick {tick} is not in the recording");
+    assert_eq!(tick, last_tick, "the page did not reach the replay's end");
+    assert_eq!(
+        element_text(&dom, "run-state"),
+        Some(final_run_state.as_str())
+    );
+    let eclipse = element_text(&dom, "eclipse").unwrap_or_default();
+    assert!(
+        ["sunlit", "penumbra", "umbra"]
+            .iter()
+            .any(|e| eclipse.starts_with(e)),
+        "eclipse: {eclipse:?}"
+    );
+    assert_eq!(element_text(&dom, "faults"), Some("none"));
+
+    // The screenshot: 1200×800 and far from blank.
+    let decoder =
+        png::Decoder::new(std::fs::File::open(&shot).expect("chromium wrote no screenshot"));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let channels = info.color_type.samples();
+    assert!(channels >= 3, "{:?}", info.color_type);
+    let pixels = &buf[..info.buffer_size()];
+    let colours: HashSet<[u8; 3]> = pixels
+        .chunks_exact(channels)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    eprintln!(
+        "web view: tick {tick} (last {last_tick}), run state {final_run_state}, eclipse {eclipse}; \
+         screenshot {}x{}, {} distinct colours; {:.1} s",
+        info.width,
+        info.height,
+        colours.len(),
+        started.elapsed().as_secs_f64()
+    );
+    assert_eq!((info.width, info.height), (1200, 800));
+    assert!(
+        colours.len() >= 200,
+        "a nearly blank page: {} colours",
+        colours.len()
+    );
+    drop(viewer);
+}
