@@ -293,49 +293,28 @@ impl Items<'_> {
     }
 }
 
-impl ser::SerializeSeq for Items<'_> {
-    type Ok = ();
-    type Error = Unsupported;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Unsupported> {
-        self.item(v)
-    }
-    fn end(self) -> Result<(), Unsupported> {
-        Ok(())
-    }
+/// The four array-like serde traits, each handing its items to [`Items::item`].
+macro_rules! items {
+    ($($trait:ident :: $method:ident),*) => {$(
+        impl ser::$trait for Items<'_> {
+            type Ok = ();
+            type Error = Unsupported;
+            fn $method<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Unsupported> {
+                self.item(v)
+            }
+            fn end(self) -> Result<(), Unsupported> {
+                Ok(())
+            }
+        }
+    )*};
 }
 
-impl ser::SerializeTuple for Items<'_> {
-    type Ok = ();
-    type Error = Unsupported;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Unsupported> {
-        self.item(v)
-    }
-    fn end(self) -> Result<(), Unsupported> {
-        Ok(())
-    }
-}
-
-impl ser::SerializeTupleStruct for Items<'_> {
-    type Ok = ();
-    type Error = Unsupported;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Unsupported> {
-        self.item(v)
-    }
-    fn end(self) -> Result<(), Unsupported> {
-        Ok(())
-    }
-}
-
-impl ser::SerializeTupleVariant for Items<'_> {
-    type Ok = ();
-    type Error = Unsupported;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Unsupported> {
-        self.item(v)
-    }
-    fn end(self) -> Result<(), Unsupported> {
-        Ok(())
-    }
-}
+items!(
+    SerializeSeq::serialize_element,
+    SerializeTuple::serialize_element,
+    SerializeTupleStruct::serialize_field,
+    SerializeTupleVariant::serialize_field
+);
 
 impl ser::SerializeStruct for Fields<'_, '_> {
     type Ok = ();
@@ -395,6 +374,10 @@ impl ser::SerializeMap for Fields<'_, '_> {
 /// A map key as text (JSON's rule: strings, and numbers written out).
 struct KeyName;
 
+fn not_text() -> Unsupported {
+    Unsupported("a map key that is not text".into())
+}
+
 impl ser::Serializer for KeyName {
     type Ok = String;
     type Error = Unsupported;
@@ -452,28 +435,28 @@ impl ser::Serializer for KeyName {
         value.serialize(self)
     }
     fn serialize_bool(self, _v: bool) -> Result<String, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_f32(self, _v: f32) -> Result<String, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_f64(self, _v: f64) -> Result<String, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_bytes(self, _v: &[u8]) -> Result<String, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_none(self) -> Result<String, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_some<T: Serialize + ?Sized>(self, _v: &T) -> Result<String, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_unit(self) -> Result<String, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_unit_struct(self, _name: &'static str) -> Result<String, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_newtype_variant<T: Serialize + ?Sized>(
         self,
@@ -482,20 +465,20 @@ impl ser::Serializer for KeyName {
         _variant: &'static str,
         _value: &T,
     ) -> Result<String, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_seq(self, _len: Option<usize>) -> Result<Self::SerializeSeq, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_tuple(self, _len: usize) -> Result<Self::SerializeTuple, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_tuple_struct(
         self,
         _name: &'static str,
         _len: usize,
     ) -> Result<Self::SerializeTupleStruct, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_tuple_variant(
         self,
@@ -504,17 +487,17 @@ impl ser::Serializer for KeyName {
         _variant: &'static str,
         _len: usize,
     ) -> Result<Self::SerializeTupleVariant, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_map(self, _len: Option<usize>) -> Result<Self::SerializeMap, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_struct(
         self,
         _name: &'static str,
         _len: usize,
     ) -> Result<Self::SerializeStruct, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
     fn serialize_struct_variant(
         self,
@@ -523,7 +506,7 @@ impl ser::Serializer for KeyName {
         _variant: &'static str,
         _len: usize,
     ) -> Result<Self::SerializeStructVariant, Unsupported> {
-        Err(Unsupported("a map key that is not text".into()))
+        Err(not_text())
     }
 }
 
