@@ -1,5 +1,5 @@
 //! `flexdyn view`: the live stream (or a recording) served to Foxglove over its WebSocket
-//! protocol.
+//! protocol, and to a browser as a web page on the same port (a client of that protocol).
 
 use std::process::ExitCode;
 
