@@ -18,7 +18,7 @@ use nalgebra::Vector3;
 
 use std::process::ExitCode;
 
-use super::{exit, summary, whole_steps, CliError};
+use super::{exit, summary, whole_steps, CliError, OfflineRun};
 use flexdyn_vehicle::world::relative::com_state_n;
 use flexdyn_vehicle::world::{walk, FleetConfig, FleetError, RowPlan, RowSink, World};
 
@@ -27,14 +27,9 @@ use flexdyn_vehicle::world::{walk, FleetConfig, FleetError, RowPlan, RowSink, Wo
 pub struct FleetArgs {
     /// The fleet file (TOML): `[[vehicles]]` entries (docs/guides/fleets.md).
     pub fleet: PathBuf,
-    /// Simulated duration in seconds; must be a whole number of RK4 steps.
-    #[arg(
-        long,
-        value_name = "SECONDS",
-        default_value_t = 10.0,
-        allow_negative_numbers = true
-    )]
-    pub duration_s: f64,
+    /// How long, and where the CSV goes.
+    #[command(flatten)]
+    pub run: OfflineRun,
     /// Interval between CSV rows in seconds; must be a whole number of RK4 steps. A row is also
     /// written at t = 0.
     #[arg(
@@ -44,9 +39,6 @@ pub struct FleetArgs {
         allow_negative_numbers = true
     )]
     pub log_every_s: f64,
-    /// CSV output file; `-` (or no option) writes to standard output.
-    #[arg(long, short, value_name = "FILE.csv")]
-    pub output: Option<PathBuf>,
 }
 
 /// An error of `flexdyn fleet`.
@@ -85,15 +77,8 @@ pub struct FleetReport {
 /// Runs `flexdyn fleet`.
 pub fn fleet(args: &FleetArgs) -> Result<FleetReport, FleetRunError> {
     let fleet = FleetConfig::from_file(&args.fleet)?;
-    match args.output.as_deref() {
-        None => fleet_to(&fleet, args, "stdout", io::stdout().lock()),
-        Some(p) if p.as_os_str() == "-" => fleet_to(&fleet, args, "stdout", io::stdout().lock()),
-        Some(p) => {
-            let target = p.display().to_string();
-            let file = std::fs::File::create(p).map_err(|source| output_err(&target, source))?;
-            fleet_to(&fleet, args, &target, io::BufWriter::new(file))
-        }
-    }
+    let (out, target) = args.run.open_csv().map_err(FleetRunError::Cli)?;
+    fleet_to(&fleet, args, &target, io::BufWriter::new(out))
 }
 
 fn output_err(target: &str, source: io::Error) -> FleetRunError {
@@ -103,7 +88,7 @@ fn output_err(target: &str, source: io::Error) -> FleetRunError {
     })
 }
 
-/// Propagates `fleet` for `args.duration_s`, writing the CSV to `out`.
+/// Propagates `fleet` for `args.run.duration_s`, writing the CSV to `out`.
 pub fn fleet_to<W: Write>(
     fleet: &FleetConfig,
     args: &FleetArgs,
@@ -112,7 +97,7 @@ pub fn fleet_to<W: Write>(
 ) -> Result<FleetReport, FleetRunError> {
     let mut world = World::new(fleet)?;
     let step_ns = fleet.vehicles[0].cfg.step_ns;
-    let steps = whole_steps("--duration-s", args.duration_s, step_ns, true)?;
+    let steps = whole_steps("--duration-s", args.run.duration_s, step_ns, true)?;
     let every = whole_steps("--log-every-s", args.log_every_s, step_ns, false)?;
     let mut line = String::from("t_s");
     for v in world.vehicles() {
@@ -218,28 +203,23 @@ pub fn main(args: &FleetArgs) -> ExitCode {
 
 #[cfg(test)]
 mod tests {
-    use super::{fleet_to, FleetArgs};
+    use super::{fleet_to, FleetArgs, OfflineRun};
+    use flexdyn_testkit::fleets::LEO_PAIR;
     use flexdyn_vehicle::world::{FleetConfig, World};
     use std::path::Path;
 
     const SCENARIOS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
-
-    /// The LEO scenario (every environment model on, `update_hz = 10`) as the chief, and a deputy
-    /// 100 m behind it along-track, 20 m below.
-    const LEO_PAIR: &str =
-        "[[vehicles]]\nid = \"chief\"\nspacecraft_file = \"leo_environment.toml\"\n\
-        participants = [1]\n\n[[vehicles]]\nid = \"deputy\"\nspacecraft_file = \
-        \"leo_environment.toml\"\nparticipants = [2]\n[vehicles.relative]\nchief = \"chief\"\n\
-        hill_position_m = [-20.0, -100.0, 0.0]\nhill_velocity_m_s = [0.0, 0.0, 0.01]\n";
 
     #[test]
     fn fleet_csv_holds_each_vehicle_and_the_relative_state() {
         let fleet = FleetConfig::from_toml_str_in(LEO_PAIR, Path::new(SCENARIOS)).unwrap();
         let args = FleetArgs {
             fleet: "unused.toml".into(),
-            duration_s: 0.5,
+            run: OfflineRun {
+                duration_s: 0.5,
+                output: None,
+            },
             log_every_s: 0.1,
-            output: None,
         };
         let mut csv = Vec::new();
         let report = fleet_to(&fleet, &args, "memory", &mut csv).unwrap();
@@ -273,7 +253,10 @@ mod tests {
         assert_eq!((last[19], last[20]), (rel.range_m, rel.range_rate_m_s));
         // A duration that is not a whole number of steps is refused, naming the option.
         let bad = FleetArgs {
-            duration_s: 0.0005,
+            run: OfflineRun {
+                duration_s: 0.0005,
+                output: None,
+            },
             ..args
         };
         let err = fleet_to(&fleet, &bad, "memory", Vec::new()).unwrap_err();

@@ -28,6 +28,51 @@ pub mod run;
 pub mod simulate;
 pub mod view;
 
+/// The options `simulate` and `fleet` share: how long to fly, and where the CSV goes.
+#[derive(Debug, Clone, PartialEq, clap::Args)]
+pub struct OfflineRun {
+    /// Simulated duration in seconds; must be a whole number of RK4 steps.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 10.0,
+        allow_negative_numbers = true
+    )]
+    pub duration_s: f64,
+    /// CSV output file; `-` (or no option) writes to standard output.
+    #[arg(long, short, value_name = "FILE.csv")]
+    pub output: Option<PathBuf>,
+}
+
+impl Default for OfflineRun {
+    fn default() -> Self {
+        Self {
+            duration_s: 10.0,
+            output: None,
+        }
+    }
+}
+
+impl OfflineRun {
+    /// Opens the CSV destination (creating, and truncating, the file) and names it for errors:
+    /// `stdout`, or ``CSV output `FILE` ``.
+    pub fn open_csv(&self) -> Result<(Box<dyn io::Write>, String), CliError> {
+        match self.output.as_deref() {
+            None => Ok((Box::new(io::stdout().lock()), "stdout".to_owned())),
+            Some(p) if p == Path::new("-") => {
+                Ok((Box::new(io::stdout().lock()), "stdout".to_owned()))
+            }
+            Some(p) => {
+                let target = format!("CSV output `{}`", p.display());
+                match std::fs::File::create(p) {
+                    Ok(file) => Ok((Box::new(file), target)),
+                    Err(source) => Err(CliError::Output { target, source }),
+                }
+            }
+        }
+    }
+}
+
 /// An error of an offline subcommand.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]

@@ -3,15 +3,15 @@
 //! environment record and the sensors as CSV.
 
 use std::fmt;
-use std::io::{self, Write};
+use std::io::Write;
 use std::num::NonZeroU64;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
 use flexdyn_proto::{command_flags, AppliedWrench, EnvironmentMsg, Header, StateMsg};
 
-use super::{exit, load, summary, whole_steps, CliError};
+use super::{exit, load, summary, whole_steps, CliError, OfflineRun};
 use flexdyn_sensors::Sensor;
 use flexdyn_server::settings::ServerSettings;
 use flexdyn_sinks::table::{
@@ -29,14 +29,9 @@ pub struct SimulateArgs {
     /// (`flexdyn print-default-config`).
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// Simulated duration in seconds; must be a whole number of RK4 steps.
-    #[arg(
-        long,
-        value_name = "SECONDS",
-        default_value_t = 10.0,
-        allow_negative_numbers = true
-    )]
-    pub duration_s: f64,
+    /// How long, and where the CSV goes.
+    #[command(flatten)]
+    pub run: OfflineRun,
     /// Interval between CSV rows in seconds; must be a whole number of RK4 steps. A row is also written
     /// at t = 0.
     #[arg(
@@ -46,18 +41,14 @@ pub struct SimulateArgs {
         allow_negative_numbers = true
     )]
     pub log_every_s: f64,
-    /// CSV output file; `-` (or no option) writes to standard output.
-    #[arg(long, short, value_name = "FILE.csv")]
-    pub output: Option<PathBuf>,
 }
 
 impl Default for SimulateArgs {
     fn default() -> Self {
         Self {
             config: None,
-            duration_s: 10.0,
+            run: OfflineRun::default(),
             log_every_s: 0.01,
-            output: None,
         }
     }
 }
@@ -336,32 +327,10 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
     let cfg = load(args.config.as_deref())?;
     log_warnings(&cfg, args.config.as_deref());
     // Check the options before creating (and truncating) the output file.
-    whole_steps("--duration-s", args.duration_s, cfg.step_ns, true)?;
+    whole_steps("--duration-s", args.run.duration_s, cfg.step_ns, true)?;
     whole_steps("--log-every-s", args.log_every_s, cfg.step_ns, false)?;
-    match args.output.as_deref() {
-        None => simulate_to(
-            &cfg,
-            args.duration_s,
-            args.log_every_s,
-            io::stdout().lock(),
-            "stdout",
-        ),
-        Some(p) if p == Path::new("-") => simulate_to(
-            &cfg,
-            args.duration_s,
-            args.log_every_s,
-            io::stdout().lock(),
-            "stdout",
-        ),
-        Some(p) => {
-            let target = format!("CSV output `{}`", p.display());
-            let file = std::fs::File::create(p).map_err(|source| CliError::Output {
-                target: target.clone(),
-                source,
-            })?;
-            simulate_to(&cfg, args.duration_s, args.log_every_s, file, &target)
-        }
-    }
+    let (out, target) = args.run.open_csv()?;
+    simulate_to(&cfg, args.run.duration_s, args.log_every_s, out, &target)
 }
 
 /// `flexdyn simulate`: the CSV, then `steps=… wall_s=… steps_per_s=…` on stderr.

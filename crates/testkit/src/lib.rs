@@ -3,6 +3,7 @@
 //! - [`ports`]: free loopback ports without a race, read back from the process that listens;
 //! - [`demo_bin`]: where the demo flight code binaries are, checked built after their sources;
 //! - [`cli_errors`]: the error rules every flexdyn binary follows on bad input;
+//! - [`fleets`]: fleet files the tests fly (text only: the tests parse them);
 //! - [`alloc_counter`]: a counting global allocator, for the tests that prove a hot path
 //!   allocates nothing;
 //! - [`median`] and [`median_mut`]: the figure the benchmarks print.
@@ -14,6 +15,7 @@
 pub mod alloc_counter;
 pub mod cli_errors;
 pub mod demo_bin;
+pub mod fleets;
 pub mod ports;
 
 /// The median of `v` as the benchmarks print it: the upper median (`v[len / 2]` once sorted by

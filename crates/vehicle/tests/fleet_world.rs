@@ -3,17 +3,11 @@
 
 use std::path::Path;
 
+use flexdyn_testkit::fleets::LEO_PAIR;
 use flexdyn_vehicle::sim::Simulation;
 use flexdyn_vehicle::world::{FleetConfig, World};
 
 const SCENARIOS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios");
-
-/// The LEO scenario (every environment model on, `update_hz = 10`) as the chief, and a deputy
-/// 100 m behind it along-track, 20 m below.
-const LEO_PAIR: &str = "[[vehicles]]\nid = \"chief\"\nspacecraft_file = \"leo_environment.toml\"\n\
-    participants = [1]\n\n[[vehicles]]\nid = \"deputy\"\nspacecraft_file = \
-    \"leo_environment.toml\"\nparticipants = [2]\n[vehicles.relative]\nchief = \"chief\"\n\
-    hill_position_m = [-20.0, -100.0, 0.0]\nhill_velocity_m_s = [0.0, 0.0, 0.01]\n";
 
 /// The LEO pair flown `frames` 100 Hz frames (1 ms steps) as a [`World`], each vehicle's
 /// environment on its own prefetch worker if `offload` (the server's way), beside each vehicle
