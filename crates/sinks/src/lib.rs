@@ -44,6 +44,7 @@ pub mod signals;
 pub mod table;
 pub mod topics;
 pub mod view;
+pub mod web;
 pub mod ws_names;
 
 pub use error::SinkError;

@@ -1,7 +1,7 @@
 //! `flexdyn view`: a Foxglove WebSocket server (`foxglove.websocket.v1`, through the `foxglove`
 //! SDK) with the decoded channels, the frame transforms and the 3D scene, live from Zenoh or
 //! from a recording (`--file`, with the protocol's playback control: play, pause, speed, seek).
-//! The same port serves a web page to a plain HTTP GET ([`super::ws_names::web`]): a client of
+//! The same port serves a web page to a plain HTTP GET ([`super::web`]): a client of
 //! that same protocol, so a browser shows a live run and a replay alike, with nothing installed.
 //!
 //! Topics and schemas are the recording's decoded ones (`/flexdyn/<sc>/tlm/state`,

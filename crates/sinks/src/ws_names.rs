@@ -11,14 +11,13 @@
 //! to the WebSocket handshake.
 //!
 //! A request without `Upgrade: websocket` (a browser opening `http://HOST:PORT/`) gets the web
-//! page of [`web`] instead, from this same port: a Foxglove-WebSocket client that connects back
+//! page of [`crate::web`] instead, from this same port: a Foxglove-WebSocket client that connects back
 //! here (issue 36).
 
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::net::{TcpListener, TcpStream};
 
-#[path = "web/mod.rs"]
-pub mod web;
+use crate::web;
 
 /// The protocol's original name.
 pub const LEGACY: &str = "foxglove.websocket.v1";
