@@ -595,8 +595,10 @@ mod tests {
             );
         }
         same("", &EnvironmentMsg::default(), &[]);
-        let mut event = FaultEventMsg::default();
-        event.target = FaultTarget::new("imus.hub.gyro").unwrap();
+        let event = FaultEventMsg {
+            target: FaultTarget::new("imus.hub.gyro").unwrap(),
+            ..FaultEventMsg::default()
+        };
         same("", &event, &[]);
         same("", &FaultCommandMsg::default(), &[]);
         same("", &RelativeStateMsg::default(), &[]);
