@@ -68,6 +68,81 @@ fn element_text<'a>(dom: &'a str, id: &str) -> Option<&'a str> {
     Some(&rest[start..end])
 }
 
+/// One headless Chromium run on the page at `port` held `hold_ms` (`?hold=`): the DOM it
+/// dumps, and the screenshot written to `shot`. Panics if Chromium fails or the page is not
+/// there.
+fn browse(browser: &Path, port: u16, hold_ms: u64, shot: &Path) -> String {
+    let _ = std::fs::remove_file(shot);
+    let profile = tmp(&format!("chromium-profile-{port}"));
+    let url = format!("http://127.0.0.1:{port}/?hold={hold_ms}");
+    let out = Command::new(browser)
+        .args([
+            "--headless=new",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--virtual-time-budget=2000",
+            "--window-size=1200,800",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg("--dump-dom")
+        .arg(&url)
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success() && dom.contains("<canvas id=\"scene\""),
+        "chromium {url}: {}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    dom
+}
+
+/// The port of the `view: open http://127.0.0.1:PORT/` line `child` logs (stderr piped with
+/// [`ports::reporting`]).
+fn page_port(child: &mut Child) -> u16 {
+    let marker = "view: open http://127.0.0.1:";
+    let reported = ports::reported(child, marker);
+    let port: u16 = reported[marker.len()..]
+        .strip_suffix('/')
+        .and_then(|p| p.parse().ok())
+        .unwrap_or_else(|| panic!("no port in {reported:?}"));
+    assert_ne!(port, 0);
+    port
+}
+
+/// `flexdyn run --view` serves the same page for its own live run (issue 36: "and from the
+/// server when asked"): a real-time run of the LEO scenario, the page held 2.5 s, shows a tick
+/// of the run (> 0: data came) and the run state `Running`.
+#[test]
+fn the_server_serves_the_page_of_its_own_run_when_asked() {
+    let browser = chromium();
+    let mut server = Guard(
+        ports::reporting(
+            Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+                .args(["run", "--duration-s", "30", "--listen", ports::ANY_PORT])
+                .args(["--view", "127.0.0.1:0", "--config"])
+                .arg(root().join("scenarios/leo_environment.toml")),
+        )
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap(),
+    );
+    let port = page_port(&mut server.0);
+    let dom = browse(browser, port, 2500, &tmp("live.png"));
+    assert_eq!(element_text(&dom, "conn"), Some("connected"), "{dom}");
+    let tick: u64 = element_text(&dom, "tick")
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("the page shows no tick:\n{dom}"));
+    assert!(tick > 0, "no data reached the page");
+    assert_eq!(element_text(&dom, "run-state"), Some("Running"), "{dom}");
+    eprintln!("flexdyn run --view: the page showed tick {tick}, Running");
+    drop(server);
+}
+
 #[test]
 fn a_browser_shows_a_replay_on_the_viewers_own_port() {
     let browser = chromium();
@@ -126,42 +201,10 @@ fn a_browser_shows_a_replay_on_the_viewers_own_port() {
         .spawn()
         .unwrap(),
     );
-    let marker = "view: open http://127.0.0.1:";
-    let reported = ports::reported(&mut viewer.0, marker);
-    let port: u16 = reported[marker.len()..]
-        .strip_suffix('/')
-        .and_then(|p| p.parse().ok())
-        .unwrap_or_else(|| panic!("no port in {reported:?}"));
-    assert_ne!(port, 0);
+    let port = page_port(&mut viewer.0);
 
-    // One headless run: the DOM on stdout, the screenshot to a file.
     let shot = tmp("page.png");
-    let _ = std::fs::remove_file(&shot);
-    let profile = tmp("chromium-profile");
-    let url = format!("http://127.0.0.1:{port}/?hold={HOLD_MS}");
-    let out = Command::new(browser)
-        .args([
-            "--headless=new",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--no-first-run",
-            "--virtual-time-budget=2000",
-            "--window-size=1200,800",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg(format!("--screenshot={}", shot.display()))
-        .arg("--dump-dom")
-        .arg(&url)
-        .stdin(Stdio::null())
-        .output()
-        .unwrap();
-    let dom = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success() && dom.contains("<canvas id=\"scene\""),
-        "chromium {url}: {}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let dom = browse(browser, port, HOLD_MS, &shot);
 
     // The page's own state: connected, the latest tick it drew is the recording's last one
     // (it saw the replay's end), and the run state is the recording's last StatusMsg's.

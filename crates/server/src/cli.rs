@@ -113,6 +113,17 @@ pub struct RunArgs {
     /// recorder cannot keep up with rather than delay the frame.
     #[arg(long, value_name = "FILE.mcap")]
     pub record: Option<PathBuf>,
+    /// Also serve the live view of this run on HOST:PORT: the web page for a browser and the
+    /// Foxglove protocol, as `flexdyn view` beside the server would (in this process, on its
+    /// own thread and Zenoh session, connected to the server like any tool) [default without a
+    /// value: 127.0.0.1:8765].
+    #[arg(
+        long,
+        value_name = "HOST:PORT",
+        num_args = 0..=1,
+        default_missing_value = flexdyn_sinks::view::DEFAULT_BIND
+    )]
+    pub view: Option<String>,
     /// Zenoh endpoints and configuration file.
     #[command(flatten)]
     pub zenoh: ZenohArgs,
@@ -206,9 +217,62 @@ pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
             problem,
         })?;
     }
+    check_view(args)?;
+    let view = args.view.clone();
     serve(zcfg, move |session, shutdown| {
+        if let Some(bind) = &view {
+            start_view(bind, &session);
+        }
         super::run(session, settings, cfg, shutdown)
     })
+}
+
+/// `--view` connects to the server as a tool with the default configuration: with a Zenoh
+/// configuration file (a lab network's credentials and access rules) it could not, so it is
+/// refused rather than left unable to see anything.
+pub(super) fn check_view(args: &RunArgs) -> Result<(), ServerError> {
+    if let (Some(_), Some(file)) = (&args.view, &args.zenoh.zenoh_config) {
+        return Err(SettingsError::Invalid {
+            name: "--view".into(),
+            problem: format!(
+                "the in-process view connects without a Zenoh configuration file, and this \
+                 server uses {}: run `flexdyn view --zenoh-config <a tool's file>` beside it \
+                 instead",
+                file.display()
+            ),
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// Starts `--view`'s viewer ([`flexdyn_sinks::view::view`]) on its own thread with its own
+/// Zenoh session, connected to the endpoints `session` listens on: the server's threads publish
+/// to it over loopback as to any subscriber, so viewing costs the physics thread nothing. It
+/// runs until the process ends or a signal; an error (the port is taken) is logged, and the run
+/// goes on.
+pub(super) fn start_view(bind: &str, session: &zenoh::Session) {
+    let args = flexdyn_sinks::view::ViewArgs {
+        bind: bind.to_owned(),
+        sc_id: Vec::new(),
+        file: None,
+        backlog: 4096,
+        duration_s: None,
+        zenoh: ZenohArgs {
+            connect: flexdyn_proto::client::transport::listening_on(session),
+            ..ZenohArgs::default()
+        },
+    };
+    let spawned = std::thread::Builder::new()
+        .name("flexdyn-view".into())
+        .spawn(move || {
+            if let Err(e) = flexdyn_sinks::view::view(&args) {
+                tracing::error!("--view: {e}");
+            }
+        });
+    if let Err(e) = spawned {
+        tracing::error!("--view: cannot start its thread: {e}");
+    }
 }
 
 /// Starts the server's tokio runtime, opens the Zenoh session, runs `run(session, shutdown on

@@ -603,7 +603,12 @@ pub fn run_from_args(args: &RunArgs, fleet_file: &Path) -> Result<FleetReport, S
             problem,
         })?;
     }
+    super::cli::check_view(args)?;
+    let view = args.view.clone();
     super::cli::serve(zcfg, move |session, shutdown| {
+        if let Some(bind) = &view {
+            super::cli::start_view(bind, &session);
+        }
         run(session, settings, fleet, shutdown)
     })
 }
