@@ -26,6 +26,7 @@ mod epoch_metadata;
 mod gps;
 mod imu_seeds;
 mod magnetometer;
+mod model_pages;
 mod plots;
 mod python_sdk;
 mod readme_snippets;
