@@ -120,8 +120,10 @@ fn a_fleet_run_records_every_vehicle_and_the_relative_states() {
         .iter()
         .find(|f| f.name == "relative_motion.png")
         .expect("relative_motion.png");
+    // The title says the figure is the recorded RelativeStateMsg's (the other source, two
+    // StateMsgs' hub points, is titled "Hub point B relative to …").
     assert!(
-        fig.title.contains("recorded RelativeStateMsg"),
+        fig.title.starts_with("Centre of mass") && fig.title.ends_with("(recorded)"),
         "{}",
         fig.title
     );
