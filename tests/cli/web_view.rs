@@ -4,7 +4,7 @@
 //! test reads the page's own state from its DOM (`--dump-dom`: the latest tick shown, the run
 //! state, the eclipse) and checks a screenshot of it (`--screenshot`) is not blank.
 //!
-//! Chromium comes from `tests/web/install_chromium.sh` (`apt-get install -y chromium` as root)
+//! Chromium comes from `tests/deps/debian_package.sh` (`apt-get install -y chromium` as root)
 //! when `/usr/bin/chromium` is missing; without it the test fails saying what to install.
 
 use flexdyn_testkit::ports;
@@ -43,18 +43,21 @@ impl Drop for Guard {
     }
 }
 
-/// `/usr/bin/chromium`, installed through `tests/web/install_chromium.sh` when missing.
+/// `/usr/bin/chromium`, installed through `tests/deps/debian_package.sh` when missing.
 fn chromium() -> &'static Path {
     let path = Path::new(CHROMIUM);
     if !path.exists() {
-        let script = root().join("tests/web/install_chromium.sh");
-        let status = Command::new("sh").arg(&script).status();
+        let script = root().join("tests/deps/debian_package.sh");
+        let status = Command::new("sh")
+            .arg(&script)
+            .args([CHROMIUM, "chromium"])
+            .status();
         eprintln!("{}: {status:?}", script.display());
     }
     assert!(
         path.exists(),
         "this test needs Debian's Chromium at {CHROMIUM}: install it with \
-         `apt-get install chromium` (as root: tests/web/install_chromium.sh does it)"
+         `apt-get install chromium` (as root: tests/deps/debian_package.sh does it)"
     );
     path
 }

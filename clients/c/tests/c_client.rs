@@ -480,6 +480,15 @@ fn no_leak_over_10000_ticks() {
     let plain = build_c(&["-O1", "-g"], "examples/pd_lockstep.c", "pd_lockstep_vg");
     let supp = root().join("clients/c/tests/valgrind.supp");
     let server = Server::start("100");
+    // A fresh machine may lack it: the project's script installs Debian's package (as root).
+    let installed = Command::new("sh")
+        .arg(root().join("tests/deps/debian_package.sh"))
+        .args(["valgrind", "valgrind"])
+        .status();
+    assert!(
+        installed.as_ref().is_ok_and(|s| s.success()),
+        "valgrind is needed (Debian: apt-get install valgrind): {installed:?}"
+    );
     let mut vg = Command::new("valgrind")
         .args([
             "--leak-check=full",
