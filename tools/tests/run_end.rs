@@ -38,6 +38,23 @@ fn the_demo_and_the_monitor_stop_when_the_server_finishes() {
             .spawn()
             .unwrap(),
     );
+    // The monitor prints its first line once its subscribers are declared: only then may the
+    // run start (the demo is the participant the lockstep server waits for). A monitor that
+    // subscribes after the run ended cannot hear its end; on a loaded CI machine it once did.
+    let (tx, lines) = std::sync::mpsc::channel::<String>();
+    let stdout = monitor.0.stdout.take().unwrap();
+    std::thread::spawn(move || {
+        for line in std::io::BufRead::lines(std::io::BufReader::new(stdout)) {
+            let Ok(line) = line else { break };
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let first = lines
+        .recv_timeout(Duration::from_secs(30))
+        .expect("the monitor printed nothing within 30 s");
+    let mut out = vec![first];
     let mut demo = ChildGuard::spawn(
         Command::new(demo_bin::acs_demo())
             .args(["--connect", &connect, "--sender-id", "1"])
@@ -57,10 +74,10 @@ fn the_demo_and_the_monitor_stop_when_the_server_finishes() {
         .expect("the monitor did not stop after the server finished");
     let monitor_ms = server_done.elapsed().as_secs_f64() * 1e3;
     assert!(status.success(), "the monitor: {status}");
-    let mut out = String::new();
-    std::io::Read::read_to_string(&mut monitor.0.stdout.take().unwrap(), &mut out).unwrap();
-    let last = out.lines().last().unwrap_or_default();
-    assert_eq!(last, "run ended: finished at tick 300", "{out}");
+    // Its stdout closed with its exit: every line is in the channel.
+    out.extend(lines.try_iter());
+    let last = out.last().map(String::as_str).unwrap_or_default();
+    assert_eq!(last, "run ended: finished at tick 300", "{out:?}");
     eprintln!(
         "from the server's return: the demo exited after {demo_ms:.1} ms, the monitor (checked \
          second) after {monitor_ms:.1} ms"
