@@ -626,19 +626,7 @@ fn relative_motion_shows_the_deputy_in_the_chiefs_hill_frame() {
     // Without --relative-to there is no such figure; the CLI draws it with.
     let (figs, _) = figures(&args(&rec)).unwrap();
     assert!(figs.iter().all(|f| f.name != "relative_motion.png"));
-    let out = tmp("relative_png");
-    let r = flexdyn(&[
-        "plot",
-        rec.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--sc-id",
-        "deputy",
-        "--relative-to",
-        "chief",
-    ]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    check_figures(&out, &["relative_motion.png"]);
+    plot_relative_motion(&rec, "relative_png");
 
     // Errors: the plotted vehicle itself, a vehicle not in the file, a CSV.
     a.relative_to = Some("deputy".into());
@@ -701,19 +689,7 @@ fn the_recorded_relative_motion_title_fits_the_figure() {
             .unwrap();
     }
     sink.finish().unwrap();
-    let out = tmp("rel_recorded_png");
-    let r = flexdyn(&[
-        "plot",
-        rec.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--sc-id",
-        "deputy",
-        "--relative-to",
-        "chief",
-    ]);
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    check_figures(&out, &["relative_motion.png"]);
+    plot_relative_motion(&rec, "rel_recorded_png");
     let mut a = args(&rec);
     a.sc_id = Some("deputy".into());
     a.relative_to = Some("chief".into());
@@ -1112,4 +1088,22 @@ fn faults_active_before_the_recording_are_shaded_from_their_true_start() {
         [("σ_BN (MRP, –)".to_owned(), vec![unknown])]
     );
     assert_eq!(shaded(&figs).len(), 1);
+}
+
+/// `flexdyn plot REC -o <tmp OUT> --sc-id deputy --relative-to chief` succeeds and writes a
+/// well-formed `relative_motion.png` ([`check_figures`]).
+fn plot_relative_motion(rec: &Path, out: &str) {
+    let out = tmp(out);
+    let r = flexdyn(&[
+        "plot",
+        rec.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--sc-id",
+        "deputy",
+        "--relative-to",
+        "chief",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    check_figures(&out, &["relative_motion.png"]);
 }
