@@ -1399,6 +1399,144 @@ fn world_rows() -> Vec<Case> {
             &["-4"],
         )
         .at_line_of("area_m2 = -4.0", None),
+        // The models' constants (environment::model::constants).
+        rejects(
+            leo(
+                "magnetic = \"igrf14\"\nmagnetic_degree = 13",
+                "magnetic = \"dipole\"",
+            ),
+            "environment.magnetic",
+            &["needs its dipole", "dipole_g10_nt", "dipole_moment_am2"],
+        ),
+        rejects(
+            leo(
+                "magnetic = \"igrf14\"\nmagnetic_degree = 13",
+                "magnetic = \"dipole\"\ndipole_g10_nt = -29350.0\ndipole_moment_am2 = 7.7e22\n\
+                 dipole_axis_e = [0.0, 0.0, -1.0]",
+            ),
+            "environment.dipole_moment_am2",
+            &["not both"],
+        ),
+        rejects(
+            leo(
+                "magnetic_degree = 13",
+                "magnetic_degree = 13\ndipole_g10_nt = -29350.0",
+            ),
+            "environment.dipole_g10_nt",
+            &["only used by magnetic = \"dipole\""],
+        )
+        .at_line_of("dipole_g10_nt", None),
+        rejects(
+            leo(
+                "magnetic = \"igrf14\"\nmagnetic_degree = 13",
+                "magnetic = \"dipole\"\ndipole_g10_nt = -2.935e13",
+            ),
+            "environment.dipole_g10_nt",
+            &["nT", "check the units"],
+        ),
+        rejects(
+            leo(
+                "magnetic = \"igrf14\"\nmagnetic_degree = 13",
+                "magnetic = \"dipole\"\ndipole_moment_am2 = 7.7e22\n\
+                 dipole_axis_e = [0.0, 1.0, -1.0]",
+            ),
+            "environment.dipole_axis_e",
+            &["unit vector", "1.414"],
+        ),
+        rejects(
+            leo(
+                "atmosphere = \"nrlmsise00\"\nf107_sfu = 150.0\nf107a_sfu = 150.0\nap = 15.0",
+                "atmosphere = \"exponential\"\nexponential_base_density_kg_m3 = 1.217",
+            ),
+            "environment.exponential_scale_height_m",
+            &["missing"],
+        ),
+        rejects(
+            leo(
+                "atmosphere = \"nrlmsise00\"\nf107_sfu = 150.0\nf107a_sfu = 150.0\nap = 15.0",
+                "atmosphere = \"exponential\"\nexponential_radius_m = 6378137.0",
+            ),
+            "environment.exponential_radius_m",
+            &["only used by exponential_altitude = \"spherical\""],
+        ),
+        rejects(
+            leo(
+                "atmosphere = \"nrlmsise00\"\nf107_sfu = 150.0\nf107a_sfu = 150.0\nap = 15.0",
+                "atmosphere = \"exponential\"\nexponential_altitude = \"ellipsoidal\"",
+            ),
+            "environment.exponential_altitude",
+            &["\"ellipsoidal\"", "\"spherical\""],
+        ),
+        rejects(
+            leo(
+                "atmosphere = \"nrlmsise00\"\nf107_sfu = 150.0\nf107a_sfu = 150.0\nap = 15.0",
+                "atmosphere = \"exponential\"\nexponential_base_density_kg_m3 = -1.0\n\
+                 exponential_scale_height_m = 8500.0",
+            ),
+            "environment.exponential_base_density_kg_m3",
+            &["-1", "> 0"],
+        ),
+        rejects(
+            text("[hub]", "[environment]\ncorotating_wind = false\n\n[hub]"),
+            "environment.corotating_wind",
+            &["only used by an atmosphere"],
+        ),
+        rejects(
+            leo("moon = true", "moon = true\nearth_rotation = \"itrf\""),
+            "environment.earth_rotation",
+            &["unknown model \"itrf\"", "\"uniform\""],
+        ),
+        rejects(
+            leo(
+                "moon = true",
+                "moon = true\nearth_rotation_rate_rad_s = 7.29e-5",
+            ),
+            "environment.earth_rotation_rate_rad_s",
+            &["only used by earth_rotation = \"uniform\""],
+        ),
+        rejects(
+            leo(
+                "moon = true",
+                "moon = true\nsun_direction_n = [1.0, 1.0, 0.0]",
+            ),
+            "environment.sun_direction_n",
+            &["unit vector"],
+        ),
+        rejects(
+            leo("moon = true", "moon = true\nshadow_sun_radius_m = -1.0"),
+            "environment.shadow_sun_radius_m",
+            &["-1", "> 0"],
+        ),
+        rejects(
+            leo(
+                "moon = true",
+                "moon = true\nsolar_irradiance_1au_w_m2 = 0.0",
+            ),
+            "environment.solar_irradiance_1au_w_m2",
+            &["> 0"],
+        ),
+        rejects(
+            leo(
+                "moon = true",
+                "moon = true\nsolar_pressure_model = \"cannonball\"",
+            ),
+            "environment.cannonball_area_m2",
+            &["missing"],
+        ),
+        rejects(
+            leo(
+                "moon = true",
+                "moon = true\nsolar_pressure_model = \"cannonball\"\ncannonball_area_m2 = 4.0\n\
+                 cannonball_reflectivity_coefficient = 3.0",
+            ),
+            "environment.cannonball_reflectivity_coefficient",
+            &["3", "from 0 to 2"],
+        ),
+        rejects(
+            leo("moon = true", "moon = true\ncannonball_area_m2 = 4.0"),
+            "environment.cannonball_area_m2",
+            &["only used by solar_pressure_model = \"cannonball\""],
+        ),
         // Effectors without what they read.
         rejects(
             text("[hub]", "[environment]\ndrag = true\n\n[hub]"),

@@ -8,7 +8,7 @@
 //! `flexdyn plot` draws the receiver through the generic sensor loop.
 
 use flexdyn_dynamics::spacecraft::{HubOutputs, State};
-use flexdyn_environment::earth_rotation::{EarthFrame, EarthRotation};
+use flexdyn_environment::earth_rotation::{EarthFrame, EarthOrientationModel, EarthRotation};
 use flexdyn_environment::epoch::SimEpoch;
 use flexdyn_proto::{decode_gps, gps_flags, Header};
 use flexdyn_sensors::gps::{Gps, GpsConfig, GpsSample};
@@ -109,7 +109,14 @@ fn zero_error_receiver_reads_the_truth_bit_for_bit() {
 fn receiver(cfg: GpsConfig) -> (SimEpoch, Gps) {
     let leo = SimConfig::from_toml_str(&leo_text()).unwrap();
     let epoch = leo.epoch.clone().unwrap();
-    let gps = Gps::new(cfg, "gps_receivers[0]", leo.frame_ns, Some(&epoch)).unwrap();
+    let gps = Gps::new(
+        cfg,
+        "gps_receivers[0]",
+        leo.frame_ns,
+        Some(&epoch),
+        EarthOrientationModel::Iau2006,
+    )
+    .unwrap();
     (epoch, gps)
 }
 

@@ -44,6 +44,8 @@
 //!   coefficients, and the torque on a residual dipole.
 //! - [`atmosphere`]: exponential (Vallado Table 8-4) and NRLMSISE-00 densities, and the wind of a
 //!   co-rotating atmosphere.
+//! - [`cannonball`]: the cannonball model of solar radiation pressure (a sphere of area A and
+//!   coefficient C_R).
 //! - [`facets`]: the flat-plate model of the vehicle's surfaces: drag and solar-radiation-pressure
 //!   forces and torques about B.
 //!
@@ -57,6 +59,7 @@
 #![warn(missing_docs)]
 
 pub mod atmosphere;
+pub mod cannonball;
 pub mod common;
 pub mod earth_rotation;
 pub mod ephemeris;

@@ -217,3 +217,36 @@ fn decimal_year_convention() {
     assert!((decimal_year(2023, 365, 86_400.0) - 2024.0).abs() < 1e-12);
     assert!((decimal_year(1900, 366 - 1, 43_200.0) - (1900.0 + 364.5 / 365.0)).abs() < 1e-12);
 }
+
+/// A dipole given by its Gauss coefficients (`magnetic = "dipole"`) is the IGRF dipole of the
+/// same coefficients to the bit, and its axis is where the IGRF-13 paper puts the geomagnetic
+/// pole: Alken et al. (2021), *Earth Planets Space* 73:49, Table 4, north geomagnetic pole
+/// 1900.0 at 78.68° N 68.79° W and 1925.0 at 78.62° N 68.27° W (geodetic latitude, WGS-84).
+#[test]
+fn validate_given_dipole_against_the_published_geomagnetic_poles() {
+    let igrf = Igrf::igrf14(1).unwrap();
+    for (year, lat_deg, lon_deg) in [(1900.0, 78.68, -68.79), (1925.0, 78.62, -68.27)] {
+        let c = igrf.coefficients_at(year);
+        let k_nt = Vector3::new(c.g_nt[1][1], c.h_nt[1][1], c.g_nt[1][0]);
+        let given = CentredDipole::from_coefficients_nt(k_nt, IGRF_REFERENCE_RADIUS_M);
+        assert_eq!(given, CentredDipole::tilted(&c), "{year}");
+        // The moment points to the southern hemisphere; the north geomagnetic pole is −m̂.
+        let pole = -given.m_ecef_am2.normalize();
+        let lat_gc = pole.z.asin();
+        // Geocentric → geodetic latitude on the WGS-84 surface: tan φd = tan φc / (1 − e²).
+        let e2 = 6.694_379_990_14e-3;
+        let lat_gd_deg = (lat_gc.tan() / (1.0 - e2)).atan().to_degrees();
+        let lon_pole_deg = pole.y.atan2(pole.x).to_degrees();
+        // The table prints two decimals (it appears to truncate: 78.628 → 78.62).
+        assert!((lat_gd_deg - lat_deg).abs() < 0.01, "{year}: {lat_gd_deg}");
+        assert!(
+            (lon_pole_deg - lon_deg).abs() < 0.01,
+            "{year}: {lon_pole_deg}"
+        );
+        // The moment form of the same dipole gives the same field.
+        let m = CentredDipole::from_moment(given.m_ecef_am2.norm(), -pole);
+        let r = Vector3::new(3e6, -4e6, 5e6);
+        let (a, b) = (given.field_ecef_t(&r), m.field_ecef_t(&r));
+        assert!((a - b).norm() <= 1e-14 * a.norm());
+    }
+}

@@ -207,6 +207,9 @@ pub struct SensorBuild<'a> {
     pub frame_ns: u64,
     /// The `[epoch]` (t = 0), if any (a GPS receiver's week and time of week).
     pub epoch: Option<&'a SimEpoch>,
+    /// The environment's model of the Earth's orientation (a GPS receiver's Earth-fixed
+    /// outputs rotate with it; the IAU 2006 chain without `[environment]`).
+    pub earth_orientation: flexdyn_environment::earth_rotation::EarthOrientationModel,
     /// \[s\] the nominal sample interval (finite, > 0) of a sensor whose noise depends on it.
     pub sample_interval_s: f64,
     /// \[ns\] where the first integration interval starts.

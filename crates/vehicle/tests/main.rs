@@ -29,6 +29,7 @@ mod actuators;
 mod dynamic_effector;
 mod effector_input_schedule;
 mod environment_alloc;
+mod environment_constants;
 mod environment_prefetch;
 mod environment_world;
 mod faults_actuators;

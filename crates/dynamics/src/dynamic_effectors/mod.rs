@@ -8,6 +8,7 @@
 //! ([`DynamicEffector::listed_kind`](super::DynamicEffector::listed_kind)).
 
 pub mod aero_drag;
+pub mod cannonball_srp;
 pub mod gravity_gradient;
 pub mod magnetorquer;
 pub mod residual_dipole;

@@ -70,3 +70,90 @@ pub fn exponential_density_kg_m3(altitude_m: f64) -> f64 {
     let b = &VALLADO_TABLE_8_4[i];
     b.density_kg_m3 * (-(altitude_m - b.base_altitude_m) / b.scale_height_m).exp()
 }
+
+/// What "altitude" means for the exponential atmosphere (`environment.exponential_altitude`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AltitudeDefinition {
+    /// The height above the WGS-84 ellipsoid ([`crate::geodetic`]): the default, and what
+    /// Vallado's table is tabulated against.
+    Geodetic,
+    /// |r| − R over a sphere of radius R (the definition of simpler tools, e.g. a spherical
+    /// planet of equatorial radius). Needs no Earth orientation.
+    Spherical {
+        /// \[m\] the sphere's radius R.
+        radius_m: f64,
+    },
+}
+
+/// The exponential atmosphere as configured: Vallado's bands or one given band, over the
+/// chosen altitude.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExponentialAtmosphere {
+    /// One band ρ = ρ0 exp(−(h − h0)/H) for every altitude (`exponential_base_altitude_m`,
+    /// `exponential_base_density_kg_m3`, `exponential_scale_height_m`), or `None`: the bands of
+    /// [`VALLADO_TABLE_8_4`].
+    pub band: Option<ExponentialBand>,
+    /// The altitude h the density is a function of.
+    pub altitude: AltitudeDefinition,
+}
+
+impl ExponentialAtmosphere {
+    /// Vallado's bands on the geodetic height (the model without options).
+    pub const VALLADO: Self = Self {
+        band: None,
+        altitude: AltitudeDefinition::Geodetic,
+    };
+
+    /// [kg/m³] the density at altitude `altitude_m` \[m\] (already in this model's
+    /// definition). Allocation-free and panic-free.
+    pub fn density_at_altitude_kg_m3(&self, altitude_m: f64) -> f64 {
+        match &self.band {
+            None => exponential_density_kg_m3(altitude_m),
+            Some(b) => {
+                b.density_kg_m3 * (-(altitude_m - b.base_altitude_m) / b.scale_height_m).exp()
+            }
+        }
+    }
+
+    /// Checks a given band (`None` is always valid); the error names the key.
+    pub fn validate(&self) -> Result<(), super::AtmosphereError> {
+        let invalid = |field, value, expected| super::AtmosphereError::Invalid {
+            field,
+            value,
+            expected,
+        };
+        if let Some(b) = &self.band {
+            if !(b.density_kg_m3 > 0.0 && b.density_kg_m3 <= 100.0) {
+                return Err(invalid(
+                    "exponential_base_density_kg_m3",
+                    b.density_kg_m3,
+                    "a density > 0 and <= 100 kg/m³ (sea level is 1.225)",
+                ));
+            }
+            if !(b.scale_height_m >= 1.0 && b.scale_height_m <= 1e7) {
+                return Err(invalid(
+                    "exponential_scale_height_m",
+                    b.scale_height_m,
+                    "a scale height from 1 m to 1e7 m (the Earth's is 6–300 km)",
+                ));
+            }
+            if b.base_altitude_m.is_nan() || b.base_altitude_m.abs() > 1e8 {
+                return Err(invalid(
+                    "exponential_base_altitude_m",
+                    b.base_altitude_m,
+                    "an altitude within ±1e8 m",
+                ));
+            }
+        }
+        if let AltitudeDefinition::Spherical { radius_m } = self.altitude {
+            if !(radius_m > 0.0 && radius_m <= 1e8) {
+                return Err(invalid(
+                    "exponential_radius_m",
+                    radius_m,
+                    "a radius > 0 and <= 1e8 m (the Earth's equatorial radius is 6378137 m)",
+                ));
+            }
+        }
+        Ok(())
+    }
+}

@@ -6,7 +6,8 @@
 //!   wrong and how it is corrected or bounded.
 //! - [`wind`]: v_rel = v − ω⊕ × r.
 //!
-//! Densities take the geodetic height ([`crate::geodetic`]); NRLMSISE-00 also the
+//! Densities take the geodetic height ([`crate::geodetic`]; the exponential model optionally a
+//! spherical altitude, [`AltitudeDefinition`]); NRLMSISE-00 also the
 //! day of year and UT. Both are slow fields in time, but the density changes by a factor e over
 //! one scale height (60 km at 500 km), so along a low orbit it is evaluated at the environment
 //! sample's rate, not held for long.
@@ -15,7 +16,10 @@ pub mod exponential;
 pub mod nrlmsise;
 pub mod wind;
 
-pub use exponential::{exponential_density_kg_m3, ExponentialBand, VALLADO_TABLE_8_4};
+pub use exponential::{
+    exponential_density_kg_m3, AltitudeDefinition, ExponentialAtmosphere, ExponentialBand,
+    VALLADO_TABLE_8_4,
+};
 pub use nrlmsise::{
     AtmosphereState, Composition, Nrlmsise00Model, SpaceWeather, LOWEST_THERMOSPHERE_ALTITUDE_M,
 };

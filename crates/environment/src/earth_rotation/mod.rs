@@ -46,6 +46,9 @@
 //! bench prints both costs.
 
 mod nutation_2000b;
+mod uniform;
+
+pub use uniform::UniformRotation;
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -342,6 +345,50 @@ impl EarthRotation {
             dcm_en: self.dcm_e_tirs * r3(gast) * pole.dcm_tod_n,
             omega_en_n_rad_s: pole.cip_n() * OMEGA_EARTH_RAD_S,
             gast_rad: gast,
+        }
+    }
+}
+
+/// Which model gives `[E N]` (`environment.earth_rotation`): the IAU 2006/2000B chain of this
+/// module (the default), or a [`UniformRotation`] about N's third axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EarthOrientationModel {
+    /// [`EarthRotation`]: IAU 2006 precession, IAU 2000B nutation, sidereal time, polar motion.
+    Iau2006,
+    /// A uniform rotation at a given rate from a given angle.
+    Uniform(UniformRotation),
+}
+
+/// The Earth's orientation for a run, built: what the environment and the GPS receiver both
+/// rotate with, so that they agree to the bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EarthOrientation {
+    /// The IAU chain with the epoch's polar motion.
+    Iau2006(EarthRotation),
+    /// A uniform rotation (the date never enters).
+    Uniform(UniformRotation),
+}
+
+impl EarthOrientation {
+    /// `model` for a run whose epoch has the orientation parameters `eop`.
+    pub fn new(model: EarthOrientationModel, eop: &EarthOrientationParams) -> Self {
+        match model {
+            EarthOrientationModel::Iau2006 => Self::Iau2006(EarthRotation::new(eop)),
+            EarthOrientationModel::Uniform(u) => Self::Uniform(u),
+        }
+    }
+
+    /// Whether the frame depends on the date's time scales (the IAU chain) or only on the
+    /// simulation time (a uniform rotation).
+    pub fn is_dated(&self) -> bool {
+        matches!(self, Self::Iau2006(_))
+    }
+
+    /// The Earth-fixed frame at `t_sim_ns`, whose time scales are `times`. Allocation-free.
+    pub fn at(&self, times: &EpochTimes, t_sim_ns: u64) -> EarthFrame {
+        match self {
+            Self::Iau2006(r) => r.at(times),
+            Self::Uniform(u) => u.at(t_sim_ns),
         }
     }
 }

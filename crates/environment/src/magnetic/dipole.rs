@@ -40,9 +40,25 @@ impl CentredDipole {
     }
 
     fn from_k_nt(k_nt: Vector3<f64>) -> Self {
-        let a3 = IGRF_REFERENCE_RADIUS_M.powi(3);
+        Self::from_coefficients_nt(k_nt, IGRF_REFERENCE_RADIUS_M)
+    }
+
+    /// The dipole of given degree-1 Gauss coefficients `k_nt` = (g₁¹, h₁¹, g₁⁰) \[nT\] at the
+    /// reference radius `radius_m` \[m\]: m = (4π/μ0) a³ k (module docs). With IGRF's
+    /// a = 6371.2 km and its coefficients at a date this is [`Self::tilted`]'s dipole to the bit.
+    pub fn from_coefficients_nt(k_nt: Vector3<f64>, radius_m: f64) -> Self {
+        let a3 = radius_m.powi(3);
         CentredDipole {
             m_ecef_am2: k_nt * 1e-9 * a3 / MU0_OVER_4PI,
+        }
+    }
+
+    /// The dipole of moment `moment_am2` \[A·m²\] along the Earth-fixed unit vector `axis_e`
+    /// (the direction of **m**, which for the Earth points to the southern hemisphere: the
+    /// field lines leave the Earth in the south).
+    pub fn from_moment(moment_am2: f64, axis_e: Vector3<f64>) -> Self {
+        CentredDipole {
+            m_ecef_am2: axis_e * moment_am2,
         }
     }
 

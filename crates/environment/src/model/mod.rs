@@ -19,22 +19,24 @@
 //! position predicted from the update before, so that [`EnvironmentModel::offload`] can move the
 //! evaluation to a worker thread without changing a bit ([`super::prefetch`]).
 
+pub mod constants;
 pub mod schema;
 
 use std::sync::{Arc, OnceLock};
 
 use nalgebra::Vector3;
 
-use super::atmosphere::{exponential_density_kg_m3, Nrlmsise00Model, SpaceWeather};
+use super::atmosphere::{AltitudeDefinition, ExponentialAtmosphere, Nrlmsise00Model, SpaceWeather};
+use super::cannonball::Cannonball;
 use super::common::{Common, CommonCache, Parts};
-use super::earth_rotation::EarthRotation;
+use super::earth_rotation::{EarthOrientation, EarthOrientationModel};
 use super::ephemeris::{moon_position_n_m, sun_position_n_m};
 use super::epoch::SimEpoch;
 use super::facets::Facet;
 use super::geodetic::geodetic_from_ecef;
 use super::magnetic::{CentredDipole, Igrf, MagneticError};
 use super::prefetch::{Prefetcher, Request};
-use super::shadow::{shadow_factor, ShadowModel};
+use super::shadow::{ShadowGeometry, ShadowModel};
 use super::EnvironmentSample;
 
 /// Which magnetic-field model is on.
@@ -53,6 +55,9 @@ pub enum MagneticSetting {
         /// Tilted (true) or axial (false).
         tilted: bool,
     },
+    /// A centred dipole given outright (`magnetic = "dipole"`: Gauss coefficients and a
+    /// reference radius, or a moment and an axis): the date does not enter.
+    GivenDipole(CentredDipole),
 }
 
 /// Which atmosphere is on.
@@ -60,8 +65,9 @@ pub enum MagneticSetting {
 pub enum AtmosphereSetting {
     /// Vacuum.
     Off,
-    /// Vallado's exponential bands (Table 8-4) on the geodetic height.
-    Exponential,
+    /// An exponential atmosphere: Vallado's bands (Table 8-4) on the geodetic height by
+    /// default, or one given band over the chosen altitude.
+    Exponential(ExponentialAtmosphere),
     /// NRLMSISE-00 with constant space weather.
     Nrlmsise00(SpaceWeather),
 }
@@ -83,20 +89,37 @@ pub struct EnvironmentSettings {
     pub magnetic: MagneticSetting,
     /// Atmosphere (with a co-rotating wind when on).
     pub atmosphere: AtmosphereSetting,
-    /// Sun ephemeris.
+    /// The Sun (from the ephemeris unless [`Self::sun_fixed_n_m`] is set).
     pub sun: bool,
+    /// \[m\] a fixed geocentric Sun position in N (`sun_direction_n` × `sun_distance_m`)
+    /// instead of the ephemeris.
+    pub sun_fixed_n_m: Option<Vector3<f64>>,
+    /// The model of the Earth's orientation, `[E N]` (IAU 2006/2000B by default).
+    pub earth_rotation: EarthOrientationModel,
+    /// Whether the atmosphere co-rotates with the Earth (`corotating_wind`, default true): the
+    /// wind ω⊕ × r; false: still air in N.
+    pub corotating_wind: bool,
     /// Moon ephemeris.
     pub moon: bool,
     /// Shadow geometry (needs the Sun), or none (full sunlight).
     pub shadow: Option<ShadowModel>,
+    /// \[m\] the occulting Earth's radius for the shadow (default WGS-84 a).
+    pub shadow_earth_radius_m: f64,
+    /// \[m\] the Sun's radius for the shadow (default the IAU 2015 nominal radius).
+    pub shadow_sun_radius_m: f64,
     /// The vehicle's flat plates (`[[environment.facets]]`), B frame.
     pub facets: Vec<Facet>,
     /// Dynamic effector: gravity-gradient torque.
     pub gravity_gradient: bool,
     /// Dynamic effector: drag on the facets.
     pub drag: bool,
-    /// Dynamic effector: solar radiation pressure on the facets.
+    /// Dynamic effector: solar radiation pressure, on the facets or on a cannonball.
     pub solar_pressure: bool,
+    /// `None`: the facets (the default); `Some`: a cannonball.
+    pub cannonball: Option<Cannonball>,
+    /// \[W/m²\] total solar irradiance at 1 AU (default
+    /// [`crate::facets::SOLAR_IRRADIANCE_1AU_W_M2`]).
+    pub solar_irradiance_1au_w_m2: f64,
     /// Dynamic effector: a residual dipole \[A·m²\], B components.
     pub residual_dipole_m_b_am2: Option<Vector3<f64>>,
 }
@@ -124,7 +147,7 @@ enum Field {
 #[derive(Debug, Clone)]
 enum Air {
     Off,
-    Exponential,
+    Exponential(ExponentialAtmosphere),
     Nrlmsise00(Nrlmsise00Model),
 }
 
@@ -139,12 +162,14 @@ pub const STALE_PREDICTION_M: f64 = 10.0;
 #[derive(Debug)]
 struct Models {
     epoch: SimEpoch,
-    rotation: EarthRotation,
+    rotation: EarthOrientation,
     field: Field,
     air: Air,
+    corotating_wind: bool,
     sun: bool,
+    sun_fixed_n_m: Option<Vector3<f64>>,
     moon: bool,
-    shadow: Option<ShadowModel>,
+    shadow: Option<ShadowGeometry>,
     /// The world's memo of the position-independent parts, when the vehicle is one of several
     /// ([`EnvironmentModel::share_common`]); set once, before any update.
     common: OnceLock<Arc<CommonCache>>,
@@ -230,6 +255,7 @@ impl EnvironmentModel {
                 igrf.check_date(year)?;
                 Field::Igrf(Box::new(igrf))
             }
+            MagneticSetting::GivenDipole(d) => Field::Dipole(d),
             MagneticSetting::Dipole { tilted } => {
                 let igrf = Igrf::igrf14(1)?;
                 igrf.check_date(year)?;
@@ -243,18 +269,24 @@ impl EnvironmentModel {
         };
         let air = match settings.atmosphere {
             AtmosphereSetting::Off => Air::Off,
-            AtmosphereSetting::Exponential => Air::Exponential,
+            AtmosphereSetting::Exponential(e) => Air::Exponential(e),
             AtmosphereSetting::Nrlmsise00(w) => Air::Nrlmsise00(Nrlmsise00Model::new(w)?),
         };
         Ok(Self {
             models: Arc::new(Models {
                 epoch: epoch.clone(),
-                rotation: EarthRotation::new(epoch.earth_orientation()),
+                rotation: EarthOrientation::new(settings.earth_rotation, epoch.earth_orientation()),
                 field,
                 air,
+                corotating_wind: settings.corotating_wind,
                 sun: settings.sun,
+                sun_fixed_n_m: settings.sun_fixed_n_m,
                 moon: settings.moon,
-                shadow: settings.shadow,
+                shadow: settings.shadow.map(|model| ShadowGeometry {
+                    model,
+                    earth_radius_m: settings.shadow_earth_radius_m,
+                    sun_radius_m: settings.shadow_sun_radius_m,
+                }),
                 common: OnceLock::new(),
             }),
             update_ns: settings.update_ns.max(1),
@@ -442,11 +474,23 @@ impl Models {
     ) {
         *out = EnvironmentSample::NONE;
         out.t_sim_ns = t_sim_ns;
-        // The Earth's orientation (precession-nutation and sidereal time, ~1.5 µs) only for the
-        // models that work in the Earth-fixed frame.
+        let field_on = !matches!(self.field, Field::Off);
+        let air_on = !matches!(self.air, Air::Off);
+        // The Earth's orientation for the models that work in the Earth-fixed frame: the field,
+        // a geodetic altitude and the co-rotating wind. The IAU chain (precession-nutation and
+        // sidereal time, ~1.5 µs) is position-independent and shared ([`super::common`]); a
+        // uniform rotation is evaluated here.
+        let air_needs_frame = match &self.air {
+            Air::Off => false,
+            Air::Exponential(e) => {
+                self.corotating_wind || e.altitude == AltitudeDefinition::Geodetic
+            }
+            Air::Nrlmsise00(_) => true,
+        };
+        let need_frame = field_on || air_needs_frame;
         let parts = Parts {
-            earth: !(matches!(self.field, Field::Off) && matches!(self.air, Air::Off)),
-            sun: self.sun,
+            earth: need_frame && self.rotation.is_dated(),
+            sun: self.sun && self.sun_fixed_n_m.is_none(),
             moon: self.moon,
         };
         let common = match self.common.get() {
@@ -455,9 +499,16 @@ impl Models {
             }
             None => self.common_at(t_sim_ns, parts),
         };
-        if parts.earth {
-            let earth = &common.earth;
-            let r_e_m = earth.r_e(r_bn_n_m);
+        let earth = match &self.rotation {
+            EarthOrientation::Uniform(u) if need_frame => u.at(t_sim_ns),
+            _ => common.earth,
+        };
+        if need_frame || air_on {
+            let r_e_m = if need_frame {
+                earth.r_e(r_bn_n_m)
+            } else {
+                Vector3::zeros()
+            };
             let b_e_t = match &self.field {
                 Field::Off => None,
                 Field::Igrf(igrf) => {
@@ -471,9 +522,14 @@ impl Models {
             }
             let density_kg_m3 = match &self.air {
                 Air::Off => None,
-                Air::Exponential => Some(exponential_density_kg_m3(
-                    geodetic_from_ecef(&r_e_m).height_m,
-                )),
+                Air::Exponential(e) => {
+                    let altitude_m = match e.altitude {
+                        AltitudeDefinition::Geodetic => geodetic_from_ecef(&r_e_m).height_m,
+                        // |r| is the same in every frame: no Earth orientation needed.
+                        AltitudeDefinition::Spherical { radius_m } => r_bn_n_m.norm() - radius_m,
+                    };
+                    Some(e.density_at_altitude_kg_m3(altitude_m))
+                }
                 Air::Nrlmsise00(m) => {
                     let cal = self.epoch.utc_calendar(t_sim_ns);
                     let ut_s = f64::from(cal.hour) * 3600.0
@@ -489,15 +545,19 @@ impl Models {
             };
             if let Some(rho) = density_kg_m3 {
                 out.density_kg_m3 = rho;
-                // Co-rotating atmosphere (Vallado §8.6.2): v_wind = ω⊕ × r, N components.
-                out.wind_n_m_s = earth.omega_en_n_rad_s.cross(r_bn_n_m);
+                // Co-rotating atmosphere (Vallado §8.6.2): v_wind = ω⊕ × r, N components; or
+                // still air in N when `corotating_wind = false`.
+                if self.corotating_wind {
+                    out.wind_n_m_s = earth.omega_en_n_rad_s.cross(r_bn_n_m);
+                }
             }
         }
         // The Sun and Moon positions relative to B and the shadow factor.
         if self.sun {
-            out.r_sun_b_n_m = common.r_sun_n_m - r_bn_n_m;
-            if let Some(model) = self.shadow {
-                out.shadow_factor = shadow_factor(model, r_bn_n_m, &common.r_sun_n_m);
+            let r_sun_n_m = self.sun_fixed_n_m.unwrap_or(common.r_sun_n_m);
+            out.r_sun_b_n_m = r_sun_n_m - r_bn_n_m;
+            if let Some(geometry) = &self.shadow {
+                out.shadow_factor = geometry.factor(r_bn_n_m, &r_sun_n_m);
             }
         }
         if self.moon {
@@ -512,7 +572,7 @@ impl Models {
         let t_tt_jc = times.tt_centuries_j2000();
         let mut c = Common::zero();
         if parts.earth {
-            c.earth = self.rotation.at(&times);
+            c.earth = self.rotation.at(&times, t_sim_ns);
         }
         if parts.sun {
             c.r_sun_n_m = sun_position_n_m(t_tt_jc);

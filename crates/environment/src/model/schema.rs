@@ -4,7 +4,7 @@
 //! [environment]
 //! update_hz = 10.0            # sample rate; held between updates (default 10 Hz)
 //! telemetry_rate_hz = 10.0    # the environment message (tlm/env) and CSV columns; default off
-//! magnetic = "igrf14"         # "igrf14", "dipole_tilted", "dipole_axial" or "off" (default)
+//! magnetic = "igrf14"         # "igrf14", "dipole_tilted", "dipole_axial", "dipole" or "off"
 //! magnetic_degree = 13        # igrf14 only, 1..=13 (default 13)
 //! atmosphere = "nrlmsise00"   # "exponential", "nrlmsise00" or "off" (default)
 //! f107_sfu = 150.0            # nrlmsise00 only (required there)
@@ -28,11 +28,17 @@
 //! diffuse = 0.1
 //! ```
 //!
+//! The keys that set each model's constants (a given dipole, the exponential atmosphere's band
+//! and altitude, the wind, the Earth's rotation, a fixed Sun, the shadow's radii, the
+//! irradiance, a cannonball) are read by [`super::constants`], which lists them with their
+//! defaults.
+//!
 //! The reader checks keys, types, names and each facet; the cross-checks that need the rest of
 //! the configuration (an epoch, a gravity model, the step) are the configuration's.
 
 use nalgebra::Vector3;
 
+use super::constants;
 use super::{AtmosphereSetting, EnvironmentSettings, MagneticSetting};
 use crate::atmosphere::SpaceWeather;
 use crate::facets::{Facet, FacetError};
@@ -43,7 +49,7 @@ use flexdyn_kernel::schema::{At, SchemaError, TableReader};
 use flexdyn_kernel::validate::MAX_DIPOLE_AM2;
 
 /// The keys of `[environment]`.
-pub const KEYS: [&str; 16] = [
+pub const KEYS: [&str; 40] = [
     "update_hz",
     "telemetry_rate_hz",
     "magnetic",
@@ -60,6 +66,31 @@ pub const KEYS: [&str; 16] = [
     "solar_pressure",
     "residual_dipole_m_b_am2",
     "facets",
+    // The constants of each model (constants::KEYS, in that order).
+    "dipole_g10_nt",
+    "dipole_g11_nt",
+    "dipole_h11_nt",
+    "dipole_radius_m",
+    "dipole_moment_am2",
+    "dipole_axis_e",
+    "exponential_base_altitude_m",
+    "exponential_base_density_kg_m3",
+    "exponential_scale_height_m",
+    "exponential_altitude",
+    "exponential_radius_m",
+    "corotating_wind",
+    "earth_rotation",
+    "earth_rotation_rate_rad_s",
+    "earth_rotation_angle_rad",
+    "sun_direction_n",
+    "sun_distance_m",
+    "shadow_earth_radius_m",
+    "shadow_sun_radius_m",
+    "solar_irradiance_1au_w_m2",
+    "solar_pressure_model",
+    "cannonball_area_m2",
+    "cannonball_reflectivity_coefficient",
+    "cannonball_r_cp_b_m",
 ];
 
 /// The keys of each `[[environment.facets]]`.
@@ -76,7 +107,7 @@ pub(crate) const FACET_KEYS: [&str; 7] = [
 /// \[Hz\] default `update_hz`.
 pub const DEFAULT_UPDATE_HZ: f64 = 10.0;
 
-fn invalid(t: &TableReader<'_, '_>, key: &str, message: String) -> SchemaError {
+pub(super) fn invalid(t: &TableReader<'_, '_>, key: &str, message: String) -> SchemaError {
     SchemaError::InvalidValue {
         field: t.field(key),
         message,
@@ -84,7 +115,7 @@ fn invalid(t: &TableReader<'_, '_>, key: &str, message: String) -> SchemaError {
     }
 }
 
-fn opt_bool(t: &TableReader<'_, '_>, key: &str) -> Result<bool, SchemaError> {
+pub(super) fn opt_bool(t: &TableReader<'_, '_>, key: &str) -> Result<bool, SchemaError> {
     match t.get(key).map(|v| v.get_ref()) {
         None => Ok(false),
         Some(toml::de::DeValue::Boolean(b)) => Ok(*b),
@@ -130,7 +161,7 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
     let magnetic = match choice(
         t,
         "magnetic",
-        &["igrf14", "dipole_tilted", "dipole_axial", "off"],
+        &["igrf14", "dipole_tilted", "dipole_axial", "dipole", "off"],
     )? {
         "igrf14" => MagneticSetting::Igrf14 {
             degree: match t.get("magnetic_degree") {
@@ -149,6 +180,7 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
                 ));
             }
             match other {
+                "dipole" => MagneticSetting::GivenDipole(constants::given_dipole(t)?),
                 "dipole_tilted" => MagneticSetting::Dipole { tilted: true },
                 "dipole_axial" => MagneticSetting::Dipole { tilted: false },
                 _ => MagneticSetting::Off,
@@ -186,12 +218,22 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
                 ));
             }
             if other == "exponential" {
-                AtmosphereSetting::Exponential
+                AtmosphereSetting::Exponential(constants::exponential(t)?)
             } else {
                 AtmosphereSetting::Off
             }
         }
     };
+    if !matches!(magnetic, MagneticSetting::GivenDipole(_)) {
+        constants::refuse_unused(t, &constants::DIPOLE_KEYS, "magnetic = \"dipole\"")?;
+    }
+    if !matches!(atmosphere, AtmosphereSetting::Exponential(_)) {
+        constants::refuse_unused(
+            t,
+            &constants::EXPONENTIAL_KEYS,
+            "atmosphere = \"exponential\"",
+        )?;
+    }
     let sun = opt_bool(t, "sun")?;
     let moon = opt_bool(t, "moon")?;
     let shadow = match choice(t, "shadow", &["conical", "cylindrical", "off"])? {
@@ -206,6 +248,11 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
             format!("a shadow needs the Sun: set {} = true", t.field("sun")),
         ));
     }
+    let corotating_wind = constants::corotating_wind(t, atmosphere != AtmosphereSetting::Off)?;
+    let earth_rotation = constants::earth_rotation(t)?;
+    let sun_fixed_n_m = constants::sun_fixed(t, sun)?;
+    let (shadow_earth_radius_m, shadow_sun_radius_m) =
+        constants::shadow_radii(t, shadow.is_some())?;
     let facets = t
         .tables("facets", &FACET_KEYS)?
         .unwrap_or_default()
@@ -239,6 +286,8 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
     let gravity_gradient = opt_bool(t, "gravity_gradient")?;
     let drag = opt_bool(t, "drag")?;
     let solar_pressure = opt_bool(t, "solar_pressure")?;
+    let solar_irradiance_1au_w_m2 = constants::irradiance(t, solar_pressure)?;
+    let cannonball = constants::cannonball(t, solar_pressure)?;
     let residual_dipole_m_b_am2 = t
         .opt_floats::<3>("residual_dipole_m_b_am2")?
         .map(Vector3::from);
@@ -259,7 +308,10 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
             ),
         ));
     }
-    for (on, key) in [(drag, "drag"), (solar_pressure, "solar_pressure")] {
+    for (on, key) in [
+        (drag, "drag"),
+        (solar_pressure && cannonball.is_none(), "solar_pressure"),
+    ] {
         if on && facets.is_empty() {
             return Err(invalid(
                 t,
@@ -301,12 +353,19 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
         magnetic,
         atmosphere,
         sun,
+        sun_fixed_n_m,
+        earth_rotation,
+        corotating_wind,
         moon,
         shadow,
+        shadow_earth_radius_m,
+        shadow_sun_radius_m,
         facets,
         gravity_gradient,
         drag,
         solar_pressure,
+        cannonball,
+        solar_irradiance_1au_w_m2,
         residual_dipole_m_b_am2,
     })
 }

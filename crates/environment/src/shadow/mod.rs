@@ -11,7 +11,9 @@
 //! - [`ShadowModel::Cylindrical`]: Montenbruck & Gill §3.4.2 ("Cylindrical shadow model"): the
 //!   umbra is a cylinder of radius R⊕ behind the Earth, ν ∈ {0, 1}.
 //!
-//! The Earth is a sphere of its equatorial radius (WGS-84 a); its flattening moves the shadow
+//! The Earth is a sphere of its equatorial radius (WGS-84 a, 6378137 m) and the Sun one of
+//! the IAU 2015 nominal radius (695 700 km), unless `shadow_earth_radius_m` and
+//! `shadow_sun_radius_m` set others ([`ShadowGeometry`]); its flattening moves the shadow
 //! boundary by at most 21 km of height, about 3 s of a low orbit's eclipse entry. Eclipses by the
 //! Moon are not modelled.
 
@@ -40,24 +42,61 @@ pub fn shadow_factor(
     r_sat_n_m: &Vector3<f64>,
     r_sun_n_m: &Vector3<f64>,
 ) -> f64 {
-    match model {
-        ShadowModel::Conical => conical(r_sat_n_m, r_sun_n_m),
-        ShadowModel::Cylindrical => cylindrical(r_sat_n_m, r_sun_n_m),
+    ShadowGeometry::new(model).factor(r_sat_n_m, r_sun_n_m)
+}
+
+/// A shadow model with the radii of its two bodies (`environment.shadow_earth_radius_m`,
+/// `environment.shadow_sun_radius_m`; by default [`EARTH_SHADOW_RADIUS_M`] and
+/// [`SUN_RADIUS_M`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowGeometry {
+    /// Conical or cylindrical.
+    pub model: ShadowModel,
+    /// \[m\] the occulting Earth's radius R⊕ (a sphere).
+    pub earth_radius_m: f64,
+    /// \[m\] the Sun's radius (the conical model's apparent solar disc).
+    pub sun_radius_m: f64,
+}
+
+impl ShadowGeometry {
+    /// `model` with the default radii.
+    pub const fn new(model: ShadowModel) -> Self {
+        Self {
+            model,
+            earth_radius_m: EARTH_SHADOW_RADIUS_M,
+            sun_radius_m: SUN_RADIUS_M,
+        }
+    }
+
+    /// [-] ν ∈ [0, 1] for the spacecraft at `r_sat_n_m` and the Sun at `r_sun_n_m` (both
+    /// geocentric, N), as [`shadow_factor`]. Allocation-free and panic-free.
+    pub fn factor(&self, r_sat_n_m: &Vector3<f64>, r_sun_n_m: &Vector3<f64>) -> f64 {
+        match self.model {
+            ShadowModel::Conical => {
+                conical(r_sat_n_m, r_sun_n_m, self.earth_radius_m, self.sun_radius_m)
+            }
+            ShadowModel::Cylindrical => cylindrical(r_sat_n_m, r_sun_n_m, self.earth_radius_m),
+        }
     }
 }
 
 /// Montenbruck & Gill §3.4.2, conical model.
-fn conical(r_sat_n_m: &Vector3<f64>, r_sun_n_m: &Vector3<f64>) -> f64 {
+fn conical(
+    r_sat_n_m: &Vector3<f64>,
+    r_sun_n_m: &Vector3<f64>,
+    earth_radius_m: f64,
+    sun_radius_m: f64,
+) -> f64 {
     let s_sat_sun = r_sun_n_m - r_sat_n_m;
     let d_sun = s_sat_sun.norm();
     let d_earth = r_sat_n_m.norm();
-    if d_earth <= EARTH_SHADOW_RADIUS_M {
+    if d_earth <= earth_radius_m {
         // Inside the Earth: no sunlight (keeps asin's argument in range).
         return 0.0;
     }
     // Apparent radii of the Sun (a) and of the Earth (b), and their apparent separation (c).
-    let a = (SUN_RADIUS_M / d_sun).min(1.0).asin();
-    let b = (EARTH_SHADOW_RADIUS_M / d_earth).asin();
+    let a = (sun_radius_m / d_sun).min(1.0).asin();
+    let b = (earth_radius_m / d_earth).asin();
     let cos_c = (-r_sat_n_m.dot(&s_sat_sun) / (d_earth * d_sun)).clamp(-1.0, 1.0);
     let c = cos_c.acos();
     if c >= a + b {
@@ -82,11 +121,11 @@ fn conical(r_sat_n_m: &Vector3<f64>, r_sun_n_m: &Vector3<f64>) -> f64 {
 
 /// Cylindrical umbra: in shadow when behind the Earth's terminator plane and within R⊕ of the
 /// Earth–Sun line.
-fn cylindrical(r_sat_n_m: &Vector3<f64>, r_sun_n_m: &Vector3<f64>) -> f64 {
+fn cylindrical(r_sat_n_m: &Vector3<f64>, r_sun_n_m: &Vector3<f64>, earth_radius_m: f64) -> f64 {
     let sun_dir = r_sun_n_m.normalize();
     let along = r_sat_n_m.dot(&sun_dir);
     let across = (r_sat_n_m - along * sun_dir).norm();
-    if along < 0.0 && across < EARTH_SHADOW_RADIUS_M {
+    if along < 0.0 && across < earth_radius_m {
         0.0
     } else {
         1.0

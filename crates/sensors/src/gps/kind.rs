@@ -69,6 +69,7 @@ fn build(ctx: &SensorBuild<'_>, out: &mut Vec<Box<dyn Sensor>>) -> Result<(), Co
             &path,
             ctx.frame_ns,
             ctx.epoch,
+            ctx.earth_orientation,
         )?));
     }
     Ok(())

@@ -7,7 +7,7 @@
 //!
 //! ```text
 //! times  = epoch.times(t)                         GPS week, seconds of week (GPS = TAI − 19 s)
-//! [EN]   = EarthRotation::at(times)               the environment's own rotation (IERS 2010)
+//! [EN]   = EarthOrientation::at(times, t)         the environment's own rotation (IERS 2010 or uniform)
 //! r_E    = [EN] r_BN_N                            ECEF position of B
 //! v_E    = [EN] (v_BN_N − ω_E/N × r_BN_N)         velocity relative to E (transport theorem)
 //! δr_E   = b_r + σ_r z_r,  δv_E = b_v + σ_v z_v   the receiver's solution error, ECEF
@@ -19,7 +19,7 @@
 //! z_r, z_v are three standard normals each. The N output is the ECEF solution carried to N
 //! (r_N = [EN]ᵀ r_E, v_N = [EN]ᵀ v_E + ω × r_N, linear in the error), written as truth plus
 //! the rotated error so that with every error term zero each frame's output is its truth bit
-//! for bit: N straight from the state, ECEF from [`EarthRotation`]. The antenna is at B (no
+//! for bit: N straight from the state, ECEF from [`EarthOrientation`]. The antenna is at B (no
 //! lever arm) and the receiver clock is perfect.
 //!
 //! # Fix
@@ -50,7 +50,7 @@
 use nalgebra::Vector3;
 
 use crate::{Sensor, SensorKind, Truth};
-use flexdyn_environment::earth_rotation::EarthRotation;
+use flexdyn_environment::earth_rotation::{EarthOrientation, EarthOrientationModel};
 use flexdyn_environment::epoch::SimEpoch;
 use flexdyn_kernel::validate::{check_sensor_term, ParamError};
 use flexdyn_proto::{encode_into, gps_flags, GpsMsg, Header};
@@ -177,7 +177,7 @@ impl GpsSample {
 pub struct Gps {
     cfg: GpsConfig,
     /// The epoch and the Earth's rotation (`None` without an `[epoch]`: never a fix).
-    world: Option<(SimEpoch, EarthRotation)>,
+    world: Option<(SimEpoch, EarthOrientation)>,
     /// \[ns\] the frame period (ticks from simulation time).
     frame_ns: u64,
     /// Whether any error term is non-zero (otherwise the outputs are the truths exactly).
@@ -191,12 +191,14 @@ pub struct Gps {
 
 impl Gps {
     /// A receiver from a configuration (validated, errors name `path.<field>`), for frames of
-    /// `frame_ns` and the run's `epoch`.
+    /// `frame_ns`, the run's `epoch` and the environment's Earth orientation model `earth` (the
+    /// same `[E N]` as the magnetic field and the atmosphere).
     pub fn new(
         cfg: GpsConfig,
         path: &str,
         frame_ns: u64,
         epoch: Option<&SimEpoch>,
+        earth: EarthOrientationModel,
     ) -> Result<Self, ParamError> {
         cfg.validate(path)?;
         let has_errors = cfg.position_sigma_m != 0.0
@@ -205,7 +207,12 @@ impl Gps {
             || cfg.velocity_bias_e_m_s != Vector3::zeros();
         let slots = (cfg.latency_frames / cfg.every_frames.max(1) + 1) as usize;
         Ok(Self {
-            world: epoch.map(|e| (e.clone(), EarthRotation::new(e.earth_orientation()))),
+            world: epoch.map(|e| {
+                (
+                    e.clone(),
+                    EarthOrientation::new(earth, e.earth_orientation()),
+                )
+            }),
             frame_ns: frame_ns.max(1),
             has_errors,
             rng: NormalRng::new(cfg.seed),
@@ -254,7 +261,7 @@ impl Gps {
             return s;
         }
         let times = epoch.times(t_ns);
-        let frame = rotation.at(&times);
+        let frame = rotation.at(&times, t_ns);
         let (r_n, v_n) = (&truth.state.r_bn_n, &truth.state.v_bn_n);
         s.flags |= gps_flags::FIX;
         s.gps_week = times.gps_week;

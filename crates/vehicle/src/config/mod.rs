@@ -34,6 +34,7 @@ use toml::de::DeTable;
 
 pub use file::{config_message, load_config};
 pub use flexdyn_dynamics::component::Components;
+use flexdyn_environment::earth_rotation::EarthOrientationModel;
 use flexdyn_kernel::numfmt::{Num, Rounded};
 use flexdyn_kernel::schema::checks::{every_frames, round_ns, unique_name};
 pub use flexdyn_kernel::schema::checks::{whole_ns, WHOLE_NS_TOL};
@@ -188,6 +189,10 @@ impl SimConfig {
             sensors: &self.sensors,
             frame_ns: self.frame_ns,
             epoch: self.epoch.as_ref(),
+            earth_orientation: self
+                .environment
+                .as_ref()
+                .map_or(EarthOrientationModel::Iau2006, |e| e.earth_rotation),
             sample_interval_s,
             t_sim_ns,
             x,

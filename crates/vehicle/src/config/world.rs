@@ -225,10 +225,10 @@ pub(super) fn add_dynamic_effectors(
     gravity: &GravityModel,
 ) {
     use flexdyn_dynamics::dynamic_effectors::{
-        aero_drag::AeroDrag, gravity_gradient::GravityGradient, residual_dipole::ResidualDipole,
-        solar_pressure::SolarPressure,
+        aero_drag::AeroDrag, cannonball_srp::CannonballSrp, gravity_gradient::GravityGradient,
+        residual_dipole::ResidualDipole, solar_pressure::SolarPressure,
     };
-    use flexdyn_environment::facets::{FacetModel, SOLAR_IRRADIANCE_1AU_W_M2};
+    use flexdyn_environment::facets::FacetModel;
     let facets = || FacetModel::new(env.facets.clone()).unwrap_or_default();
     if env.gravity_gradient {
         let mu_m3_s2 = match *gravity {
@@ -241,10 +241,16 @@ pub(super) fn add_dynamic_effectors(
         sc.add_dynamic_effector(Box::new(AeroDrag { facets: facets() }));
     }
     if env.solar_pressure {
-        sc.add_dynamic_effector(Box::new(SolarPressure::new(
-            facets(),
-            SOLAR_IRRADIANCE_1AU_W_M2,
-        )));
+        match env.cannonball {
+            None => sc.add_dynamic_effector(Box::new(SolarPressure::new(
+                facets(),
+                env.solar_irradiance_1au_w_m2,
+            ))),
+            Some(ball) => sc.add_dynamic_effector(Box::new(CannonballSrp {
+                ball,
+                irradiance_1au_w_m2: env.solar_irradiance_1au_w_m2,
+            })),
+        };
     }
     if let Some(m_b_am2) = env.residual_dipole_m_b_am2 {
         sc.add_dynamic_effector(Box::new(ResidualDipole { m_b_am2 }));
