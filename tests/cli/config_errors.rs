@@ -202,6 +202,7 @@ fn every_shipped_scenario_is_valid() {
             "leo_environment",
             "no_gravity",
             "reference",
+            "srp_cannonball_basilisk",
             "wheel_slew",
             "wheels_star_tracker"
         ]

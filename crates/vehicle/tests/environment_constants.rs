@@ -241,21 +241,17 @@ fn a_fixed_sun_and_the_shadow_radii() {
 }
 
 /// Basilisk's `RadiationPressure` cannonball unit test (`test_radiationPressure.py`, as of
-/// 2026-07): spacecraft, Sun, area, C_R and the expected force in N, with Φ = 1361 W/m².
+/// 2026-07): spacecraft, Sun, area, C_R and the expected force in N, with Φ = 1361 W/m², as
+/// `scenarios/srp_cannonball_basilisk.toml` sets them.
 #[test]
 fn cannonball_srp_matches_basilisks_unit_test_case() {
-    let r_sc = [-16937711153.5, -138435806556.0, -60051616256.6];
+    // The shipped scenario sets the case up (its Sun is Basilisk's sun_r_N as a unit vector and
+    // a distance, B starts at Basilisk's r_N with the identity attitude).
+    let path = format!("{}/scenarios/srp_cannonball_basilisk.toml", crate::REPO);
+    let cfg = SimConfig::from_toml_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     let r_sun: Vector3<f64> = Vector3::new(507128401.716, 22652490.9092, -14854379.6232);
-    let d = r_sun.norm();
-    let u = r_sun / d;
-    let env = format!(
-        "[environment]\nsun = true\nsun_direction_n = [{:e}, {:e}, {:e}]\n\
-         sun_distance_m = {d:e}\nsolar_pressure = true\nsolar_pressure_model = \"cannonball\"\n\
-         cannonball_area_m2 = 4.0\ncannonball_reflectivity_coefficient = 1.2\n\
-         solar_irradiance_1au_w_m2 = 1361.0\n",
-        u.x, u.y, u.z
-    );
-    let cfg = config(r_sc, &env);
+    let want_sun_n_m = cfg.environment.as_ref().unwrap().sun_fixed_n_m.unwrap();
+    assert!(close(&want_sun_n_m, &r_sun, 1e-15), "{want_sun_n_m:?}");
     let mut sim = Simulation::new(&cfg).unwrap();
     sim.step();
     let sample = *sim.spacecraft().environment();
