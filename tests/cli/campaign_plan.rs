@@ -446,9 +446,10 @@ fn errors_start_with_the_file_that_holds_the_field() {
 }
 
 /// The environment's parameters (issue 19: Cd, facet areas, residual dipole, F10.7, epoch
-/// offset) are dispersed and read back from the built model like the spacecraft's: the drag
-/// and solar-pressure effectors report their facets, the residual-dipole effector its moment,
-/// NRLMSISE-00 its space weather and the epoch its offset.
+/// offset; issue 39: the solar irradiance) are dispersed and read back from the built model
+/// like the spacecraft's: the drag and solar-pressure effectors report their facets and the
+/// irradiance, the residual-dipole effector its moment, NRLMSISE-00 its space weather and the
+/// epoch its offset.
 #[test]
 fn environment_parameters_are_dispersed_and_read_back_from_the_model() {
     let base = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/leo_environment.toml");
@@ -479,6 +480,11 @@ fn environment_parameters_are_dispersed_and_read_back_from_the_model() {
         distribution = \"uniform\"
         low = 0.0
         high = {offset_max_s:?}
+        [[dispersions]]
+        key = \"environment.solar_irradiance_1au_w_m2\"
+        distribution = \"uniform\"
+        low = 1321.0
+        high = 1401.0
         ",
         base.display().to_string()
     ))
@@ -716,4 +722,69 @@ fn random_faults_get_a_seed_per_run_and_their_failure_time_from_it() {
     starts.sort_unstable();
     starts.dedup();
     assert_eq!(starts.len(), 5, "every run fails at its own time");
+}
+
+/// An exponential atmosphere's given band and a cannonball's area and C_R (issue 39) are
+/// dispersed and read back from the built model: the environment model reports its band, the
+/// cannonball effector its parameters.
+#[test]
+fn model_constants_are_dispersed_and_read_back_from_the_model() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("campaign_model_constants");
+    std::fs::create_dir_all(&dir).unwrap();
+    let base = dir.join("base.toml");
+    let leo = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/leo_environment.toml"),
+    )
+    .unwrap();
+    // The scenario with its [environment] table (not its facets) replaced.
+    let head = &leo[..leo.find("[environment]").unwrap()];
+    let tail = &leo[leo.find("[[environment.facets]]").unwrap()..];
+    std::fs::write(
+        &base,
+        format!(
+            "{head}[environment]\natmosphere = \"exponential\"\n\
+             exponential_base_density_kg_m3 = 1.217\nexponential_scale_height_m = 8500.0\n\
+             sun = true\nsolar_pressure = true\nsolar_pressure_model = \"cannonball\"\n\
+             cannonball_area_m2 = 4.0\ncannonball_reflectivity_coefficient = 1.2\n\n{tail}"
+        ),
+    )
+    .unwrap();
+    let plan = campaign(&format!(
+        "base = {:?}\nruns = 20\nseed = 3\nduration_s = 1.0\n
+        [[dispersions]]
+        key = \"environment.exponential_base_density_kg_m3\"
+        distribution = \"uniform\"
+        low = 0.6
+        high = 1.8
+        [[dispersions]]
+        key = \"environment.exponential_scale_height_m\"
+        distribution = \"normal\"
+        sigma = 500.0
+        [[dispersions]]
+        key = \"environment.cannonball_area_m2\"
+        distribution = \"uniform\"
+        low = 3.0
+        high = 5.0
+        [[dispersions]]
+        key = \"environment.cannonball_reflectivity_coefficient\"
+        distribution = \"uniform\"
+        low = 1.0
+        high = 1.5
+        ",
+        base.display().to_string()
+    ))
+    .unwrap();
+    let mut densities = vec![];
+    for r in 0..20 {
+        let rp = plan.run(r);
+        assert!(rp.valid, "run {r}: {:?}", rp.redraw_reasons);
+        let model = readback(&SimConfig::from_toml_str(&rp.config_toml).unwrap()).unwrap();
+        assert_eq!(rp.dispersed.len(), 4);
+        for (key, written) in &rp.dispersed {
+            assert_eq!(model[key], *written, "run {r}: {key}");
+        }
+        densities.push(model["environment.exponential_base_density_kg_m3"]);
+    }
+    // Twenty uniform draws on [0.6, 1.8] are not all alike.
+    assert!(densities.iter().any(|d| (d - densities[0]).abs() > 0.01));
 }

@@ -1510,8 +1510,8 @@ fn world_rows() -> Vec<Case> {
         ),
         rejects(
             leo(
-                "moon = true",
-                "moon = true\nsolar_irradiance_1au_w_m2 = 0.0",
+                "solar_irradiance_1au_w_m2 = 1361.0",
+                "solar_irradiance_1au_w_m2 = 0.0",
             ),
             "environment.solar_irradiance_1au_w_m2",
             &["> 0"],

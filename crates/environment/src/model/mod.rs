@@ -353,9 +353,24 @@ impl EnvironmentModel {
     }
 
     /// The numeric parameters of the built models, by configuration path
-    /// (`environment.f107_sfu`, `environment.f107a_sfu`, `environment.ap` with NRLMSISE-00), for
-    /// a campaign's read-back. Not on the stepping path.
+    /// (`environment.f107_sfu`, `environment.f107a_sfu`, `environment.ap` with NRLMSISE-00; the
+    /// `environment.exponential_*` band of an exponential atmosphere given one), for a
+    /// campaign's read-back. Not on the stepping path.
     pub fn parameters(&self, out: &mut Vec<(String, f64)>) {
+        if let Air::Exponential(ExponentialAtmosphere { band: Some(b), .. }) = &self.models.air {
+            out.push((
+                "environment.exponential_base_altitude_m".into(),
+                b.base_altitude_m,
+            ));
+            out.push((
+                "environment.exponential_base_density_kg_m3".into(),
+                b.density_kg_m3,
+            ));
+            out.push((
+                "environment.exponential_scale_height_m".into(),
+                b.scale_height_m,
+            ));
+        }
         if let Air::Nrlmsise00(m) = &self.models.air {
             let w = m.weather();
             out.push(("environment.f107_sfu".into(), w.f107_sfu));

@@ -49,5 +49,9 @@ impl DynamicEffector for CannonballSrp {
             "environment.cannonball_reflectivity_coefficient".into(),
             self.ball.reflectivity_coefficient,
         ));
+        out.push((
+            "environment.solar_irradiance_1au_w_m2".into(),
+            self.irradiance_1au_w_m2,
+        ));
     }
 }

@@ -114,5 +114,9 @@ impl DynamicEffector for SolarPressure {
 
     fn parameters(&self, out: &mut Vec<(String, f64)>) {
         self.facets.parameters(out);
+        out.push((
+            "environment.solar_irradiance_1au_w_m2".into(),
+            self.irradiance_1au_w_m2,
+        ));
     }
 }
