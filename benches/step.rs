@@ -348,6 +348,28 @@ fn world_summary(pair_ns: f64) {
             "igrf + dipole",
             every("magnetic = \"igrf14\"\nresidual_dipole_m_b_am2 = [0.1, 0.0, 0.0]\n"),
         ),
+        // The constants that match a reference tool (environment::model::constants).
+        (
+            "sun + cannonball",
+            every(
+                "sun = true\nshadow = \"conical\"\nsolar_pressure = true\n\
+                 solar_pressure_model = \"cannonball\"\ncannonball_area_m2 = 4.0\n\
+                 cannonball_reflectivity_coefficient = 1.2\n",
+            ),
+        ),
+        (
+            "dipole, uniform",
+            every(
+                "magnetic = \"dipole\"\ndipole_g10_nt = -29350.0\nearth_rotation = \"uniform\"\n",
+            ),
+        ),
+        (
+            "expo sphere still",
+            every(
+                "atmosphere = \"exponential\"\nexponential_altitude = \"spherical\"\n\
+                 corotating_wind = false\n",
+            ),
+        ),
         (
             "all @ 1000 Hz",
             all.replace("update_hz = 10.0", "update_hz = 1000.0"),
