@@ -24,6 +24,7 @@ fn tracker(seed: u64) -> StarTrackerConfig {
         every_frames: 1,
         seed,
         sun_direction_n: Vector3::x(),
+        sun_from_environment: false,
         sun_exclusion_rad: 0.5,
         max_rate_rad_s: 0.05,
     }
@@ -225,4 +226,74 @@ fn configuration_errors_name_the_field() {
         assert!(msg.starts_with(field), "{to}: {msg}");
         assert!(msg.contains(words), "{to}: {msg}");
     }
+}
+
+/// `sun_from_environment = true`: the Sun exclusion follows the environment's Sun (here a fixed
+/// Sun of `[environment]`, so the geometry is known): a boresight on the Sun is excluded, one
+/// away from it is not, and without a Sun in the environment nothing is excluded. The Sun seen
+/// from B is off the geocentric direction by |r_B| / 1 au ≈ 7e-5 rad, far inside 30°.
+#[test]
+fn sun_exclusion_follows_the_environments_sun() {
+    let path = std::path::Path::new(crate::REPO).join("scenarios/wheels_star_tracker.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.contains("sun_direction_n = [1.0, 0.0, 0.0]"));
+    let tracked = text.replacen(
+        "sun_direction_n = [1.0, 0.0, 0.0]",
+        "sun_from_environment = true",
+        1,
+    );
+    // The boresight in N at t = 0, from the configuration: [NC] b̂ with [CN] = [CB][BN].
+    let cfg = SimConfig::from_toml_str(&tracked).unwrap();
+    let st = cfg
+        .sensors
+        .of::<StarTrackerConfig>()
+        .next()
+        .unwrap()
+        .clone();
+    let sim = Simulation::new(&cfg).unwrap();
+    let dcm_bn = mrp_to_dcm(&sim.spacecraft().state().sigma_bn);
+    let b_n = (st.dcm_cb * dcm_bn).transpose() * st.boresight_c;
+    let first = |environment: String| {
+        let cfg = SimConfig::from_toml_str(&format!("{tracked}\n{environment}")).unwrap();
+        let mut sim = Simulation::new(&cfg).unwrap();
+        let mut out = Vec::new();
+        sim.star_tracker_samples_into(0, &mut out);
+        out[0].1
+    };
+    let sun_along = |d: Vector3<f64>| {
+        format!(
+            "[epoch]\nutc = \"2026-11-24T06:00:00Z\"\n[environment]\nsun = true\n\
+             sun_direction_n = [{:e}, {:e}, {:e}]\n",
+            d.x, d.y, d.z
+        )
+    };
+    let on_sun = first(sun_along(b_n));
+    assert!(!on_sun.valid);
+    assert_eq!(on_sun.status_flags, star_tracker_flags::SUN_EXCLUSION);
+    let away = first(sun_along(-b_n));
+    assert!(away.valid, "{away:?}");
+    // No Sun in the environment: no exclusion, wherever the boresight points.
+    let no_sun = first("[environment]\ngravity_gradient = true\n".to_string());
+    assert!(no_sun.valid, "{no_sun:?}");
+    // The same boresight with the fixed direction of the configuration instead: excluded.
+    let fixed = SimConfig::from_toml_str(&text.replacen(
+        "sun_direction_n = [1.0, 0.0, 0.0]",
+        &format!("sun_direction_n = [{:e}, {:e}, {:e}]", b_n.x, b_n.y, b_n.z),
+        1,
+    ))
+    .unwrap();
+    let mut sim = Simulation::new(&fixed).unwrap();
+    let mut out = Vec::new();
+    sim.star_tracker_samples_into(0, &mut out);
+    assert_eq!(out[0].1.status_flags, star_tracker_flags::SUN_EXCLUSION);
+    // Both at once is an error that names them.
+    let e = SimConfig::from_toml_str(&text.replacen(
+        "sun_direction_n = [1.0, 0.0, 0.0]",
+        "sun_direction_n = [1.0, 0.0, 0.0]\nsun_from_environment = true",
+        1,
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(e.starts_with("star_trackers[0].sun_direction_n"), "{e}");
+    assert!(e.contains("not both"), "{e}");
 }

@@ -200,6 +200,17 @@ impl<'a, 'i> TableReader<'a, 'i> {
             .transpose()
     }
 
+    /// Optional boolean.
+    pub fn opt_bool(&self, key: &str) -> Result<Option<bool>, SchemaError> {
+        match self.get(key) {
+            None => Ok(None),
+            Some(v) => match v.get_ref() {
+                DeValue::Boolean(b) => Ok(Some(*b)),
+                _ => Err(self.expected(self.field(key), v, "true or false")),
+            },
+        }
+    }
+
     /// Required integer within `lo..=hi`.
     pub fn int_in(&self, key: &str, lo: i64, hi: i64) -> Result<i64, SchemaError> {
         let v = self.required(key)?;

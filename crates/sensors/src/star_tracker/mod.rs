@@ -17,8 +17,10 @@
 //! # Validity
 //! A measurement is invalid (`valid = false`, the quaternion held at the last valid one, the
 //! identity before the first) when
-//! - the boresight in N, [NC] b̂, is within `sun_exclusion_rad` of the configured Sun direction
-//!   `sun_direction_n` (flag `SUN_EXCLUSION`), or
+//! - the boresight in N, [NC] b̂, is within `sun_exclusion_rad` of the Sun direction (flag
+//!   `SUN_EXCLUSION`): the configured `sun_direction_n`, or with `sun_from_environment = true`
+//!   the direction of the environment sample's r_Sun/B at the update (no exclusion while the
+//!   sample has no Sun), or
 //! - |ω_B/N| exceeds `max_rate_rad_s` (flag `RATE_LIMIT`; the tracker cannot match smeared star
 //!   images).
 //!
@@ -72,8 +74,12 @@ pub struct StarTrackerConfig {
     pub every_frames: u64,
     /// RNG seed (0 ≤ seed ≤ 2⁶³ − 1 in the configuration).
     pub seed: u64,
-    /// Unit Sun direction in N.
+    /// Unit Sun direction in N (used unless [`Self::sun_from_environment`]).
     pub sun_direction_n: Vector3<f64>,
+    /// Whether the Sun exclusion takes the Sun's direction from the environment sample at
+    /// each update (`sun_from_environment = true`: the ephemeris or the configured fixed Sun,
+    /// seen from B) instead of [`Self::sun_direction_n`].
+    pub sun_from_environment: bool,
     /// [rad] Sun exclusion half-angle about the boresight (0: no exclusion).
     pub sun_exclusion_rad: f64,
     /// [rad/s] largest |ω_B/N| at which the tracker still reports (∞: no limit).
@@ -211,11 +217,24 @@ impl StarTracker {
         (self.e1_c, self.e2_c)
     }
 
-    /// One update at the true attitude `sigma_bn` and rate `omega_bn_b` (allocates nothing).
+    /// One update at the true attitude `sigma_bn` and rate `omega_bn_b`, with the configured
+    /// Sun direction (allocates nothing).
     pub fn sample(
         &mut self,
         sigma_bn: &Vector3<f64>,
         omega_bn_b: &Vector3<f64>,
+    ) -> StarTrackerSample {
+        let sun_n = self.cfg.sun_direction_n;
+        self.sample_with_sun(sigma_bn, omega_bn_b, Some(&sun_n))
+    }
+
+    /// One update with the unit Sun direction `sun_n` in N for the exclusion (`None`: no Sun,
+    /// no exclusion). Allocates nothing.
+    pub fn sample_with_sun(
+        &mut self,
+        sigma_bn: &Vector3<f64>,
+        omega_bn_b: &Vector3<f64>,
+        sun_n: Option<&Vector3<f64>>,
     ) -> StarTrackerSample {
         let (n1, n2) = self.rng.normal_pair();
         let (n3, _) = self.rng.normal_pair();
@@ -223,10 +242,10 @@ impl StarTracker {
         let dcm_cn = c.dcm_cb * mrp_to_dcm(sigma_bn);
         let mut flags = 0;
         let boresight_n = dcm_cn.transpose() * c.boresight_c;
-        if c.sun_exclusion_rad > 0.0
-            && boresight_n.dot(&c.sun_direction_n).clamp(-1.0, 1.0).acos() < c.sun_exclusion_rad
-        {
-            flags |= star_tracker_flags::SUN_EXCLUSION;
+        if let Some(sun_n) = sun_n.filter(|_| c.sun_exclusion_rad > 0.0) {
+            if boresight_n.dot(sun_n).clamp(-1.0, 1.0).acos() < c.sun_exclusion_rad {
+                flags |= star_tracker_flags::SUN_EXCLUSION;
+            }
         }
         if omega_bn_b.norm() > c.max_rate_rad_s {
             flags |= star_tracker_flags::RATE_LIMIT;
@@ -283,9 +302,24 @@ impl Sensor for StarTracker {
         StarTracker::due(self, tick)
     }
 
-    /// One update at the true attitude and rate ([`StarTracker::sample`]).
+    /// One update at the true attitude and rate ([`StarTracker::sample_with_sun`]), with the
+    /// configured Sun direction or the environment's.
     fn sample(&mut self, truth: &Truth<'_>) {
-        self.last = StarTracker::sample(self, &truth.state.sigma_bn, &truth.state.omega_bn_b);
+        let sun_n = if self.cfg.sun_from_environment {
+            truth.env.and_then(|env| {
+                let r = env.r_sun_b_n_m;
+                let norm = r.norm();
+                (norm > 0.0).then(|| r / norm)
+            })
+        } else {
+            Some(self.cfg.sun_direction_n)
+        };
+        self.last = StarTracker::sample_with_sun(
+            self,
+            &truth.state.sigma_bn,
+            &truth.state.omega_bn_b,
+            sun_n.as_ref(),
+        );
     }
 
     /// `seq` counts the tracker's updates: the frame's tick / `every_frames`.

@@ -11,7 +11,7 @@ use flexdyn_kernel::schema::config_error::ConfigError;
 use flexdyn_kernel::schema::{mat3, vec3, SchemaError, TableReader};
 
 /// The keys of one `[[star_trackers]]` entry (the first six are required).
-pub(crate) const KEYS: [&str; 11] = [
+pub(crate) const KEYS: [&str; 12] = [
     "name",
     "dcm_cb",
     "sigma_cross_boresight_rad",
@@ -21,6 +21,7 @@ pub(crate) const KEYS: [&str; 11] = [
     "boresight_c",
     "bias_c_rad",
     "sun_direction_n",
+    "sun_from_environment",
     "sun_exclusion_rad",
     "max_rate_rad_s",
 ];
@@ -36,6 +37,7 @@ pub(crate) struct RawStarTracker {
     pub(crate) boresight_c: Vector3<f64>,
     pub(crate) bias_c_rad: Vector3<f64>,
     pub(crate) sun_direction_n: Vector3<f64>,
+    pub(crate) sun_from_environment: bool,
     pub(crate) sun_exclusion_rad: f64,
     pub(crate) max_rate_rad_s: f64,
 }
@@ -43,6 +45,18 @@ pub(crate) struct RawStarTracker {
 /// Reads one entry.
 pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawStarTracker, SchemaError> {
     let v3 = |a: [f64; 3]| vec3(&a);
+    let sun_from_environment = t.opt_bool("sun_from_environment")?.unwrap_or(false);
+    if sun_from_environment && t.get("sun_direction_n").is_some() {
+        return Err(SchemaError::InvalidValue {
+            field: t.field("sun_direction_n"),
+            message: format!(
+                "give either sun_direction_n (a fixed Sun) or {} = true (the environment's \
+                 Sun at each update), not both",
+                t.field("sun_from_environment")
+            ),
+            at: flexdyn_kernel::schema::At(None),
+        });
+    }
     Ok(RawStarTracker {
         name: t.string("name")?,
         dcm_cb: mat3(&t.mat3("dcm_cb")?),
@@ -54,6 +68,7 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawStarTracker, SchemaErro
         boresight_c: t.opt_floats("boresight_c")?.map_or(Vector3::z(), v3),
         bias_c_rad: t.opt_floats("bias_c_rad")?.map_or(Vector3::zeros(), v3),
         sun_direction_n: t.opt_floats("sun_direction_n")?.map_or(Vector3::x(), v3),
+        sun_from_environment,
         sun_exclusion_rad: t.opt_f64("sun_exclusion_rad")?.unwrap_or(0.0),
         max_rate_rad_s: t.opt_f64("max_rate_rad_s")?.unwrap_or(f64::INFINITY),
     })
@@ -83,6 +98,7 @@ impl RawSensorConfig for RawStarTracker {
             every_frames,
             seed: raw.seed,
             sun_direction_n: raw.sun_direction_n,
+            sun_from_environment: raw.sun_from_environment,
             sun_exclusion_rad: raw.sun_exclusion_rad,
             max_rate_rad_s: raw.max_rate_rad_s,
         };
