@@ -17,7 +17,7 @@
 
 use nalgebra::Vector3;
 
-use super::schema::{invalid, opt_bool};
+use super::schema::invalid;
 use crate::atmosphere::{
     AltitudeDefinition, AtmosphereError, ExponentialAtmosphere, ExponentialBand,
 };
@@ -30,21 +30,16 @@ use crate::magnetic::igrf::IGRF_REFERENCE_RADIUS_M;
 use crate::magnetic::CentredDipole;
 use crate::shadow::EARTH_SHADOW_RADIUS_M;
 use flexdyn_kernel::numfmt::Num;
-use flexdyn_kernel::schema::{SchemaError, TableReader};
+use flexdyn_kernel::schema::{concat_keys, SchemaError, TableReader};
 
-/// The keys this file reads (each also in [`super::schema::KEYS`]).
-pub const KEYS: [&str; 24] = [
-    "dipole_g10_nt",
-    "dipole_g11_nt",
-    "dipole_h11_nt",
-    "dipole_radius_m",
-    "dipole_moment_am2",
-    "dipole_axis_e",
-    "exponential_base_altitude_m",
-    "exponential_base_density_kg_m3",
-    "exponential_scale_height_m",
-    "exponential_altitude",
-    "exponential_radius_m",
+/// The keys this file reads (the tail of [`super::schema::KEYS`]).
+pub const KEYS: [&str; 24] = concat_keys(
+    concat_keys::<6, 5, 11>(DIPOLE_KEYS, EXPONENTIAL_KEYS),
+    OTHER_KEYS,
+);
+
+/// The keys of the wind, the Earth's rotation, the Sun, the shadow and solar pressure.
+const OTHER_KEYS: [&str; 13] = [
     "corotating_wind",
     "earth_rotation",
     "earth_rotation_rate_rad_s",
@@ -70,14 +65,7 @@ const DIPOLE_COEFFICIENT_KEYS: [&str; 4] = [
 /// The moment keys of `magnetic = "dipole"`.
 const DIPOLE_MOMENT_KEYS: [&str; 2] = ["dipole_moment_am2", "dipole_axis_e"];
 /// Every `dipole_*` key.
-pub(super) const DIPOLE_KEYS: [&str; 6] = [
-    "dipole_g10_nt",
-    "dipole_g11_nt",
-    "dipole_h11_nt",
-    "dipole_radius_m",
-    "dipole_moment_am2",
-    "dipole_axis_e",
-];
+pub(super) const DIPOLE_KEYS: [&str; 6] = concat_keys(DIPOLE_COEFFICIENT_KEYS, DIPOLE_MOMENT_KEYS);
 /// Every `exponential_*` key.
 pub(super) const EXPONENTIAL_KEYS: [&str; 5] = [
     "exponential_base_altitude_m",
@@ -286,10 +274,7 @@ pub(super) fn corotating_wind(
         refuse_unused(t, &["corotating_wind"], "an atmosphere")?;
         return Ok(true);
     }
-    if t.get("corotating_wind").is_none() {
-        return Ok(true);
-    }
-    opt_bool(t, "corotating_wind")
+    Ok(t.opt_bool("corotating_wind")?.unwrap_or(true))
 }
 
 /// `earth_rotation`: `"iau2006"` (default) or `"uniform"` with its rate and angle.

@@ -45,11 +45,11 @@ use crate::facets::{Facet, FacetError};
 use crate::magnetic::IGRF_MAX_DEGREE;
 use crate::shadow::ShadowModel;
 use flexdyn_kernel::numfmt::Num;
-use flexdyn_kernel::schema::{At, SchemaError, TableReader};
+use flexdyn_kernel::schema::{concat_keys, At, SchemaError, TableReader};
 use flexdyn_kernel::validate::MAX_DIPOLE_AM2;
 
-/// The keys of `[environment]`.
-pub const KEYS: [&str; 40] = [
+/// The keys of `[environment]` that switch the models on and give their parameters.
+const SWITCH_KEYS: [&str; 16] = [
     "update_hz",
     "telemetry_rate_hz",
     "magnetic",
@@ -66,32 +66,11 @@ pub const KEYS: [&str; 40] = [
     "solar_pressure",
     "residual_dipole_m_b_am2",
     "facets",
-    // The constants of each model (constants::KEYS, in that order).
-    "dipole_g10_nt",
-    "dipole_g11_nt",
-    "dipole_h11_nt",
-    "dipole_radius_m",
-    "dipole_moment_am2",
-    "dipole_axis_e",
-    "exponential_base_altitude_m",
-    "exponential_base_density_kg_m3",
-    "exponential_scale_height_m",
-    "exponential_altitude",
-    "exponential_radius_m",
-    "corotating_wind",
-    "earth_rotation",
-    "earth_rotation_rate_rad_s",
-    "earth_rotation_angle_rad",
-    "sun_direction_n",
-    "sun_distance_m",
-    "shadow_earth_radius_m",
-    "shadow_sun_radius_m",
-    "solar_irradiance_1au_w_m2",
-    "solar_pressure_model",
-    "cannonball_area_m2",
-    "cannonball_reflectivity_coefficient",
-    "cannonball_r_cp_b_m",
 ];
+
+/// The keys of `[environment]`: the switches, then the models' constants
+/// ([`constants::KEYS`]).
+pub const KEYS: [&str; 40] = concat_keys(SWITCH_KEYS, constants::KEYS);
 
 /// The keys of each `[[environment.facets]]`.
 pub(crate) const FACET_KEYS: [&str; 7] = [
@@ -112,14 +91,6 @@ pub(super) fn invalid(t: &TableReader<'_, '_>, key: &str, message: String) -> Sc
         field: t.field(key),
         message,
         at: At(None),
-    }
-}
-
-pub(super) fn opt_bool(t: &TableReader<'_, '_>, key: &str) -> Result<bool, SchemaError> {
-    match t.get(key).map(|v| v.get_ref()) {
-        None => Ok(false),
-        Some(toml::de::DeValue::Boolean(b)) => Ok(*b),
-        Some(_) => Err(invalid(t, key, "expected true or false".into())),
     }
 }
 
@@ -234,8 +205,8 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
             "atmosphere = \"exponential\"",
         )?;
     }
-    let sun = opt_bool(t, "sun")?;
-    let moon = opt_bool(t, "moon")?;
+    let sun = t.opt_bool("sun")?.unwrap_or(false);
+    let moon = t.opt_bool("moon")?.unwrap_or(false);
     let shadow = match choice(t, "shadow", &["conical", "cylindrical", "off"])? {
         "conical" => Some(ShadowModel::Conical),
         "cylindrical" => Some(ShadowModel::Cylindrical),
@@ -283,9 +254,9 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
             Ok(facet)
         })
         .collect::<Result<Vec<_>, SchemaError>>()?;
-    let gravity_gradient = opt_bool(t, "gravity_gradient")?;
-    let drag = opt_bool(t, "drag")?;
-    let solar_pressure = opt_bool(t, "solar_pressure")?;
+    let gravity_gradient = t.opt_bool("gravity_gradient")?.unwrap_or(false);
+    let drag = t.opt_bool("drag")?.unwrap_or(false);
+    let solar_pressure = t.opt_bool("solar_pressure")?.unwrap_or(false);
     let solar_irradiance_1au_w_m2 = constants::irradiance(t, solar_pressure)?;
     let cannonball = constants::cannonball(t, solar_pressure)?;
     let residual_dipole_m_b_am2 = t

@@ -18,6 +18,28 @@ pub mod source_map;
 
 pub use reader::TableReader;
 
+/// The keys `a` then `b` as one array, at compile time: a table whose keys are read by two
+/// modules lists each key once, in the module that reads it. `N` must be `A + B` (checked when
+/// the constant is evaluated).
+pub const fn concat_keys<const A: usize, const B: usize, const N: usize>(
+    a: [&'static str; A],
+    b: [&'static str; B],
+) -> [&'static str; N] {
+    assert!(A + B == N, "concat_keys: N must be A + B");
+    let mut out = [""; N];
+    let mut i = 0;
+    while i < A {
+        out[i] = a[i];
+        i += 1;
+    }
+    let mut j = 0;
+    while j < B {
+        out[A + j] = b[j];
+        j += 1;
+    }
+    out
+}
+
 /// A 3×3 matrix from the rows the reader returns (`TableReader::mat3`).
 pub fn mat3(rows: &[[f64; 3]; 3]) -> nalgebra::Matrix3<f64> {
     nalgebra::Matrix3::from_fn(|i, j| rows[i][j])
