@@ -80,15 +80,19 @@ impl Truth<'_> {
     /// point B in the environment sample, and the sample's shadow factor; `None` without a Sun
     /// (no environment sample, or a zero Sun vector: no ephemeris). For the sun sensors.
     pub fn sun_b(&self) -> Option<(nalgebra::Vector3<f64>, f64)> {
-        let env = self.env?;
-        let r = env.r_sun_b_n_m;
+        let sun_n = self.sun_n()?;
+        Some((
+            flexdyn_kernel::attitude::mrp_to_dcm(&self.state.sigma_bn) * sun_n,
+            self.env?.shadow_factor,
+        ))
+    }
+
+    /// The unit Sun direction from point B in N, r_sun / |r_sun|; `None` without a Sun (no
+    /// environment sample, or a zero Sun vector). For the star tracker's Sun exclusion.
+    pub fn sun_n(&self) -> Option<nalgebra::Vector3<f64>> {
+        let r = self.env?.r_sun_b_n_m;
         let norm = r.norm();
-        (norm > 0.0).then(|| {
-            (
-                flexdyn_kernel::attitude::mrp_to_dcm(&self.state.sigma_bn) * (r / norm),
-                env.shadow_factor,
-            )
-        })
+        (norm > 0.0).then(|| r / norm)
     }
 }
 

@@ -19,6 +19,13 @@ pub struct ExponentialBand {
     pub scale_height_m: f64,
 }
 
+impl ExponentialBand {
+    /// [kg/m³] ρ0 exp(−(h − h0)/H) at `altitude_m` \[m\]. Allocation-free and panic-free.
+    pub fn density_at_kg_m3(&self, altitude_m: f64) -> f64 {
+        self.density_kg_m3 * (-(altitude_m - self.base_altitude_m) / self.scale_height_m).exp()
+    }
+}
+
 const fn band(base_km: f64, density_kg_m3: f64, scale_height_km: f64) -> ExponentialBand {
     ExponentialBand {
         base_altitude_m: base_km * 1e3,
@@ -67,8 +74,7 @@ pub fn exponential_density_kg_m3(altitude_m: f64) -> f64 {
     let i = VALLADO_TABLE_8_4
         .partition_point(|b| b.base_altitude_m <= altitude_m)
         .saturating_sub(1);
-    let b = &VALLADO_TABLE_8_4[i];
-    b.density_kg_m3 * (-(altitude_m - b.base_altitude_m) / b.scale_height_m).exp()
+    VALLADO_TABLE_8_4[i].density_at_kg_m3(altitude_m)
 }
 
 /// What "altitude" means for the exponential atmosphere (`environment.exponential_altitude`).
@@ -109,9 +115,7 @@ impl ExponentialAtmosphere {
     pub fn density_at_altitude_kg_m3(&self, altitude_m: f64) -> f64 {
         match &self.band {
             None => exponential_density_kg_m3(altitude_m),
-            Some(b) => {
-                b.density_kg_m3 * (-(altitude_m - b.base_altitude_m) / b.scale_height_m).exp()
-            }
+            Some(b) => b.density_at_kg_m3(altitude_m),
         }
     }
 

@@ -306,11 +306,7 @@ impl Sensor for StarTracker {
     /// configured Sun direction or the environment's.
     fn sample(&mut self, truth: &Truth<'_>) {
         let sun_n = if self.cfg.sun_from_environment {
-            truth.env.and_then(|env| {
-                let r = env.r_sun_b_n_m;
-                let norm = r.norm();
-                (norm > 0.0).then(|| r / norm)
-            })
+            truth.sun_n()
         } else {
             Some(self.cfg.sun_direction_n)
         };

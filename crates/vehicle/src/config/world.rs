@@ -246,10 +246,10 @@ pub(super) fn add_dynamic_effectors(
                 facets(),
                 env.solar_irradiance_1au_w_m2,
             ))),
-            Some(ball) => sc.add_dynamic_effector(Box::new(CannonballSrp {
+            Some(ball) => sc.add_dynamic_effector(Box::new(CannonballSrp::new(
                 ball,
-                irradiance_1au_w_m2: env.solar_irradiance_1au_w_m2,
-            })),
+                env.solar_irradiance_1au_w_m2,
+            ))),
         };
     }
     if let Some(m_b_am2) = env.residual_dipole_m_b_am2 {

@@ -6,10 +6,10 @@
 //! a configuration has one solar-pressure model or the other. No Sun configured (a zero vector)
 //! or the umbra gives no force.
 
+use super::solar_pressure::HeldSun;
 use crate::dynamic_effector::{DynamicEffector, EnvironmentSource, StageState};
 use crate::params::Wrench;
 use flexdyn_environment::cannonball::Cannonball;
-use flexdyn_environment::facets::solar_pressure_n_m2;
 use flexdyn_environment::EnvironmentSample;
 
 /// Cannonball solar radiation pressure.
@@ -19,6 +19,19 @@ pub struct CannonballSrp {
     pub ball: Cannonball,
     /// \[W/m²\] total solar irradiance at 1 AU.
     pub irradiance_1au_w_m2: f64,
+    /// The held Sun direction and pressure, per environment update (as the facet model's).
+    held: HeldSun,
+}
+
+impl CannonballSrp {
+    /// The effector on `ball` at the irradiance `irradiance_1au_w_m2` \[W/m²\] at 1 AU.
+    pub fn new(ball: Cannonball, irradiance_1au_w_m2: f64) -> Self {
+        Self {
+            ball,
+            irradiance_1au_w_m2,
+            held: HeldSun::default(),
+        }
+    }
 }
 
 impl DynamicEffector for CannonballSrp {
@@ -31,14 +44,12 @@ impl DynamicEffector for CannonballSrp {
     }
 
     fn add_force_torque(&mut self, stage: &StageState, env: &EnvironmentSample, sum: &mut Wrench) {
-        let distance_m = env.r_sun_b_n_m.norm();
-        if distance_m == 0.0 || env.shadow_factor == 0.0 {
+        let held = *self.held.refresh(env, self.irradiance_1au_w_m2);
+        if held.pressure_n_m2 == 0.0 {
             return;
         }
-        let pressure_n_m2 =
-            solar_pressure_n_m2(distance_m, env.shadow_factor, self.irradiance_1au_w_m2);
-        let sun_hat_b = stage.dcm_bn * (env.r_sun_b_n_m / distance_m);
-        let w = self.ball.wrench_unit_b(&sun_hat_b, pressure_n_m2);
+        let sun_hat_b = stage.dcm_bn * held.sun_hat_n;
+        let w = self.ball.wrench_unit_b(&sun_hat_b, held.pressure_n_m2);
         sum.force_b_newton += w.force_b_newton;
         sum.torque_b_nm += w.torque_b_nm;
     }

@@ -33,9 +33,10 @@ pub struct SolarPressure {
     held: HeldSun,
 }
 
-/// The solar-pressure inputs of one held [`EnvironmentSample`].
+/// The solar-pressure inputs of one held [`EnvironmentSample`] (shared with the cannonball,
+/// [`super::cannonball_srp`]).
 #[derive(Debug, Clone, Copy, Default)]
-struct HeldSun {
+pub(crate) struct HeldSun {
     /// \[m\] the sample's r_Sun/B (N components) these were computed from.
     r_sun_b_n_m: Vector3<f64>,
     /// \[-\] the sample's shadow factor they were computed with.
@@ -43,9 +44,9 @@ struct HeldSun {
     /// \[W/m²\] the irradiance at 1 AU they were computed with.
     irradiance_1au_w_m2: f64,
     /// \[-\] r̂_Sun/B, N components (zero when the sample has no Sun).
-    sun_hat_n: Vector3<f64>,
+    pub(crate) sun_hat_n: Vector3<f64>,
     /// \[N/m²\] the radiation pressure P (zero in umbra or without a Sun).
-    pressure_n_m2: f64,
+    pub(crate) pressure_n_m2: f64,
 }
 
 impl SolarPressure {
@@ -58,34 +59,42 @@ impl SolarPressure {
         }
     }
 
-    /// The held Sun direction and pressure for `env`, recomputed only when its Sun or its shadow
-    /// factor (an environment update) or the irradiance changed: the norm and the division by it are per update,
-    /// not per stage.
+    /// The held Sun direction and pressure for `env` ([`HeldSun::refresh`]).
     #[inline]
     fn held_for(&mut self, env: &EnvironmentSample) -> &HeldSun {
-        if env.r_sun_b_n_m != self.held.r_sun_b_n_m
-            || env.shadow_factor != self.held.shadow_factor
-            || self.irradiance_1au_w_m2 != self.held.irradiance_1au_w_m2
+        self.held.refresh(env, self.irradiance_1au_w_m2)
+    }
+}
+
+impl HeldSun {
+    /// These inputs for `env` at the irradiance `irradiance_1au_w_m2`, recomputed only when its
+    /// Sun or its shadow factor (an environment update) or the irradiance changed: the norm and
+    /// the division by it are per update, not per stage.
+    #[inline]
+    pub(crate) fn refresh(&mut self, env: &EnvironmentSample, irradiance_1au_w_m2: f64) -> &Self {
+        if env.r_sun_b_n_m != self.r_sun_b_n_m
+            || env.shadow_factor != self.shadow_factor
+            || irradiance_1au_w_m2 != self.irradiance_1au_w_m2
         {
             let distance_m = env.r_sun_b_n_m.norm();
             let lit = distance_m > 0.0 && env.shadow_factor != 0.0;
-            self.held = HeldSun {
+            *self = HeldSun {
                 r_sun_b_n_m: env.r_sun_b_n_m,
                 shadow_factor: env.shadow_factor,
-                irradiance_1au_w_m2: self.irradiance_1au_w_m2,
+                irradiance_1au_w_m2,
                 sun_hat_n: if lit {
                     env.r_sun_b_n_m / distance_m
                 } else {
                     Vector3::zeros()
                 },
                 pressure_n_m2: if lit {
-                    solar_pressure_n_m2(distance_m, env.shadow_factor, self.irradiance_1au_w_m2)
+                    solar_pressure_n_m2(distance_m, env.shadow_factor, irradiance_1au_w_m2)
                 } else {
                     0.0
                 },
             };
         }
-        &self.held
+        self
     }
 }
 
