@@ -1092,7 +1092,7 @@ fn faults_active_before_the_recording_are_shaded_from_their_true_start() {
 
 /// `flexdyn plot REC -o <tmp OUT> --sc-id deputy --relative-to chief` succeeds and writes a
 /// well-formed `relative_motion.png` ([`check_figures`]).
-fn plot_relative_motion(rec: &Path, out: &str) {
+pub(crate) fn plot_relative_motion(rec: &Path, out: &str) {
     let out = tmp(out);
     let r = flexdyn(&[
         "plot",

@@ -723,20 +723,5 @@ fn one_recording_holds_several_vehicles() {
         assert!(states.iter().all(|s| s.header.spacecraft_id == id), "{sc}");
     }
     // Both scenarios step 100 Hz frames from t = 0, so the recorded instants coincide.
-    let out = tmp("two_vehicles_plots");
-    let r = flexdyn()
-        .arg("plot")
-        .arg(&file)
-        .args([
-            "-o",
-            out.to_str().unwrap(),
-            "--sc-id",
-            "deputy",
-            "--relative-to",
-            "chief",
-        ])
-        .output()
-        .unwrap();
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    assert!(out.join("relative_motion.png").is_file());
+    crate::plots::plot_relative_motion(&file, "two_vehicles_plots");
 }
