@@ -1,0 +1,74 @@
+//! flexdyn-wiregen: every mirror of the wire protocol, written from one table,
+//! `proto/schema/messages.toml` ([`table`]).
+//!
+//! [`mirrors`] returns each generated file's path and text; the binary writes them
+//! (`cargo run -p flexdyn-wiregen`) and the tests fail when a file in the tree differs
+//! (`cargo test -p flexdyn-wiregen`), so a mirror cannot lag behind the table.
+//!
+//! | mirror | module |
+//! |---|---|
+//! | the byte tables of `proto/README.md` (between markers) | [`readme`] |
+//! | the C client library's typed calls, `clients/c/include/flexdyn_client_messages.h` | [`c_client`] |
+//! | the C client library's message kinds, `clients/c/src/kinds.rs` | [`c_client`] |
+
+pub mod c_client;
+pub mod readme;
+pub mod table;
+
+use std::path::{Path, PathBuf};
+
+pub use table::{Table, TableError, TABLE_PATH};
+
+/// The README whose byte tables are generated.
+pub const README_PATH: &str = "proto/README.md";
+/// The C client library's generated header.
+pub const C_HEADER_PATH: &str = "clients/c/include/flexdyn_client_messages.h";
+/// The C client library's generated kind table.
+pub const KINDS_PATH: &str = "clients/c/src/kinds.rs";
+
+/// A generated file: its path under the repository root and its whole text.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Mirror {
+    /// Path relative to the repository root.
+    pub path: PathBuf,
+    /// The file's text.
+    pub text: String,
+}
+
+/// Reads the table under `root` (the repository).
+pub fn read_table(root: &Path) -> Result<Table, String> {
+    let path = root.join(TABLE_PATH);
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    Table::parse(TABLE_PATH, &text).map_err(|e| e.to_string())
+}
+
+/// Every mirror of the table under `root`. The README is read to keep its prose.
+pub fn mirrors(root: &Path) -> Result<Vec<Mirror>, String> {
+    let table = read_table(root)?;
+    let readme_path = root.join(README_PATH);
+    let readme = std::fs::read_to_string(&readme_path)
+        .map_err(|e| format!("{}: {e}", readme_path.display()))?;
+    Ok(vec![
+        Mirror {
+            path: README_PATH.into(),
+            text: readme::splice(&table, README_PATH, &readme)?,
+        },
+        Mirror {
+            path: C_HEADER_PATH.into(),
+            text: c_client::header(&table),
+        },
+        Mirror {
+            path: KINDS_PATH.into(),
+            text: c_client::kinds_rs(&table),
+        },
+    ])
+}
+
+/// The mirrors under `root` whose file differs from the table's text.
+pub fn stale(root: &Path) -> Result<Vec<PathBuf>, String> {
+    Ok(mirrors(root)?
+        .into_iter()
+        .filter(|m| std::fs::read_to_string(root.join(&m.path)).ok().as_deref() != Some(&m.text))
+        .map(|m| m.path)
+        .collect())
+}

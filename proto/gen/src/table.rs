@@ -1,0 +1,620 @@
+//! The wire table (`proto/schema/messages.toml`): read, checked and laid out.
+//!
+//! Every check names the table entry and the field it is about, so a mistake in the table is a
+//! one-line error, never a wrong mirror.
+
+use std::collections::BTreeSet;
+use std::fmt;
+
+use serde::Deserialize;
+
+/// The whole table.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Table {
+    /// The protocol version every header carries.
+    pub protocol_version: u16,
+    /// Enumerations (a u32 tag on the wire).
+    #[serde(rename = "enum", default)]
+    pub enums: Vec<Enum>,
+    /// Bit fields.
+    #[serde(default)]
+    pub flags: Vec<Flags>,
+    /// Structs nested in messages.
+    #[serde(rename = "struct", default)]
+    pub structs: Vec<Struct>,
+    /// Tagged unions.
+    #[serde(rename = "union", default)]
+    pub unions: Vec<Union>,
+    /// The messages.
+    #[serde(rename = "message", default)]
+    pub messages: Vec<Message>,
+}
+
+/// An enumeration.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Enum {
+    /// Its name (`enum<Name>` in a field's type).
+    pub name: String,
+    /// What it is.
+    pub doc: String,
+    /// Its values, in tag order.
+    pub values: Vec<EnumValue>,
+}
+
+/// One value of an [`Enum`].
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnumValue {
+    /// The u32 tag.
+    pub value: u32,
+    /// Its name.
+    pub name: String,
+    /// What it means.
+    #[serde(default)]
+    pub doc: String,
+}
+
+/// A bit field.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Flags {
+    /// Its name (a field's `flags`).
+    pub name: String,
+    /// Its bits.
+    pub bits: Vec<Bit>,
+}
+
+/// One bit of a [`Flags`].
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bit {
+    /// Bit number (0 = least significant).
+    pub bit: u32,
+    /// Its name.
+    pub name: String,
+    /// What it means when set.
+    pub doc: String,
+}
+
+/// A struct nested in messages.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Struct {
+    /// Its name (a field's type).
+    pub name: String,
+    /// What it is.
+    pub doc: String,
+    /// Its fields in wire order.
+    pub fields: Vec<Field>,
+}
+
+/// A tagged union.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Union {
+    /// Its name (`union<Name>`).
+    pub name: String,
+    /// What it is.
+    pub doc: String,
+    /// Its variants, in tag order.
+    pub variants: Vec<Variant>,
+}
+
+/// One variant of a [`Union`].
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Variant {
+    /// The u32 tag.
+    pub tag: u32,
+    /// Its name.
+    pub name: String,
+    /// What it does.
+    pub doc: String,
+    /// The fields after the tag.
+    pub fields: Vec<Field>,
+}
+
+/// A message.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Message {
+    /// Its Rust type name (`ImuMsg`).
+    pub name: String,
+    /// Its C name: `fd_<c_name>_msg`, `fd_decode_<c_name>`, `decode_<c_name>`.
+    pub c_name: String,
+    /// Its name in prose (`IMU`).
+    pub title: String,
+    /// Its Zenoh key pattern.
+    pub key: String,
+    /// Who publishes it.
+    pub direction: Direction,
+    /// The configuration section whose samples a lockstep tick carries, if any.
+    #[serde(default)]
+    pub lockstep: Option<String>,
+    /// The protocol version that introduced it.
+    pub since: u16,
+    /// What it is.
+    pub doc: String,
+    /// Its fields in wire order; the first is the header.
+    pub fields: Vec<Field>,
+}
+
+/// Who publishes a message.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Direction {
+    /// The server publishes it.
+    Server,
+    /// Flight code or an operator publishes it; the server takes it.
+    Client,
+}
+
+/// A field.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Field {
+    /// Its name.
+    pub name: String,
+    /// Its type, as written in the table.
+    #[serde(rename = "type")]
+    pub ty: String,
+    /// Its unit.
+    #[serde(default)]
+    pub unit: Option<String>,
+    /// The frame its components are in.
+    #[serde(default)]
+    pub frame: Option<String>,
+    /// What it means.
+    #[serde(default)]
+    pub doc: String,
+    /// The [`Flags`] of its bits.
+    #[serde(default)]
+    pub flags: Option<String>,
+    /// A `u8[n]` that holds UTF-8 text, NUL-padded.
+    #[serde(default)]
+    pub text: bool,
+    /// The bound of a `vec` count or of a `u8` count.
+    #[serde(default)]
+    pub max: Option<u64>,
+}
+
+/// A primitive wire type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Prim {
+    /// u8.
+    U8,
+    /// u16 LE.
+    U16,
+    /// u32 LE.
+    U32,
+    /// u64 LE.
+    U64,
+    /// i32 LE.
+    I32,
+    /// IEEE-754 binary64 LE.
+    F64,
+    /// One byte, 0 or 1.
+    Bool,
+}
+
+impl Prim {
+    fn parse(s: &str) -> Option<Self> {
+        Some(match s {
+            "u8" => Self::U8,
+            "u16" => Self::U16,
+            "u32" => Self::U32,
+            "u64" => Self::U64,
+            "i32" => Self::I32,
+            "f64" => Self::F64,
+            "bool" => Self::Bool,
+            _ => return None,
+        })
+    }
+
+    /// Encoded size (bytes).
+    pub fn size(self) -> usize {
+        match self {
+            Self::U8 | Self::Bool => 1,
+            Self::U16 => 2,
+            Self::U32 | Self::I32 => 4,
+            Self::U64 | Self::F64 => 8,
+        }
+    }
+
+    /// Its name in the table.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::U8 => "u8",
+            Self::U16 => "u16",
+            Self::U32 => "u32",
+            Self::U64 => "u64",
+            Self::I32 => "i32",
+            Self::F64 => "f64",
+            Self::Bool => "bool",
+        }
+    }
+}
+
+/// A field's type, resolved.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Ty {
+    /// A primitive.
+    Prim(Prim),
+    /// A fixed array of primitives.
+    Array(Prim, usize),
+    /// A nested struct, by index into [`Table::structs`].
+    Struct(usize),
+    /// An enumeration's u32 tag, by index into [`Table::enums`].
+    Enum(usize),
+    /// A tagged union, by index into [`Table::unions`].
+    Union(usize),
+    /// A u64 count then the elements.
+    Vec(Box<Ty>),
+}
+
+/// A mistake in the table: where it is and what is wrong.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TableError {
+    /// The file.
+    pub file: String,
+    /// The entry and field (`message ImuMsg, field omega_p_rad_s`).
+    pub place: String,
+    /// What is wrong.
+    pub problem: String,
+}
+
+impl fmt::Display for TableError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}: {}", self.file, self.place, self.problem)
+    }
+}
+
+impl std::error::Error for TableError {}
+
+/// The table's path in the repository.
+pub const TABLE_PATH: &str = "proto/schema/messages.toml";
+
+impl Table {
+    /// Reads and checks the table text (`file` names it in errors).
+    pub fn parse(file: &str, text: &str) -> Result<Self, TableError> {
+        let table: Table = toml::from_str(text).map_err(|e| TableError {
+            file: file.to_owned(),
+            place: "the file".to_owned(),
+            problem: e.to_string(),
+        })?;
+        table.check(file)?;
+        Ok(table)
+    }
+
+    fn err(file: &str, place: String, problem: impl Into<String>) -> TableError {
+        TableError {
+            file: file.to_owned(),
+            place,
+            problem: problem.into(),
+        }
+    }
+
+    /// Resolves a type written in the table.
+    pub fn resolve(&self, ty: &str) -> Result<Ty, String> {
+        let ty = ty.trim();
+        if let Some(p) = Prim::parse(ty) {
+            return Ok(Ty::Prim(p));
+        }
+        if let Some(inner) = ty.strip_prefix("vec<").and_then(|t| t.strip_suffix('>')) {
+            return Ok(Ty::Vec(Box::new(self.resolve(inner)?)));
+        }
+        if let Some(name) = ty.strip_prefix("enum<").and_then(|t| t.strip_suffix('>')) {
+            return self
+                .enums
+                .iter()
+                .position(|e| e.name == name)
+                .map(Ty::Enum)
+                .ok_or_else(|| format!("no [[enum]] named {name:?}"));
+        }
+        if let Some(name) = ty.strip_prefix("union<").and_then(|t| t.strip_suffix('>')) {
+            return self
+                .unions
+                .iter()
+                .position(|u| u.name == name)
+                .map(Ty::Union)
+                .ok_or_else(|| format!("no [[union]] named {name:?}"));
+        }
+        if let Some((elem, rest)) = ty.split_once('[') {
+            let n = rest
+                .strip_suffix(']')
+                .and_then(|n| n.parse::<usize>().ok())
+                .filter(|&n| n > 0)
+                .ok_or_else(|| format!("{ty:?}: an array is T[n] with n ≥ 1"))?;
+            let p = Prim::parse(elem)
+                .ok_or_else(|| format!("{ty:?}: an array's element is a primitive"))?;
+            return Ok(Ty::Array(p, n));
+        }
+        self.structs
+            .iter()
+            .position(|s| s.name == ty)
+            .map(Ty::Struct)
+            .ok_or_else(|| {
+                format!(
+                    "unknown type {ty:?} (a primitive, T[n], vec<T>, enum<Name>, union<Name> or a \
+                     [[struct]] name)"
+                )
+            })
+    }
+
+    /// The encoded size of a type when it is fixed.
+    pub fn fixed_size(&self, ty: &Ty) -> Option<usize> {
+        match ty {
+            Ty::Prim(p) => Some(p.size()),
+            Ty::Array(p, n) => Some(p.size() * n),
+            Ty::Struct(i) => self.fields_size(&self.structs[*i].fields),
+            Ty::Enum(_) => Some(4),
+            Ty::Union(i) => {
+                let sizes: Vec<Option<usize>> = self.unions[*i]
+                    .variants
+                    .iter()
+                    .map(|v| self.fields_size(&v.fields))
+                    .collect();
+                match sizes.first() {
+                    Some(Some(first)) if sizes.iter().all(|s| *s == Some(*first)) => {
+                        Some(4 + first)
+                    }
+                    _ => None,
+                }
+            }
+            Ty::Vec(_) => None,
+        }
+    }
+
+    /// The encoded size of fields when every one is fixed.
+    pub fn fields_size(&self, fields: &[Field]) -> Option<usize> {
+        fields
+            .iter()
+            .map(|f| self.resolve(&f.ty).ok().and_then(|t| self.fixed_size(&t)))
+            .sum()
+    }
+
+    /// The shortest encoding of a type (every vec empty, the shortest union variant).
+    pub fn min_size(&self, ty: &Ty) -> usize {
+        match ty {
+            Ty::Struct(i) => self.fields_min_size(&self.structs[*i].fields),
+            Ty::Union(i) => {
+                4 + self.unions[*i]
+                    .variants
+                    .iter()
+                    .map(|v| self.fields_min_size(&v.fields))
+                    .min()
+                    .unwrap_or(0)
+            }
+            Ty::Vec(_) => 8,
+            other => self.fixed_size(other).unwrap_or(0),
+        }
+    }
+
+    /// The shortest encoding of fields.
+    pub fn fields_min_size(&self, fields: &[Field]) -> usize {
+        fields
+            .iter()
+            .map(|f| self.resolve(&f.ty).map(|t| self.min_size(&t)).unwrap_or(0))
+            .sum()
+    }
+
+    /// A message by its Rust name.
+    pub fn message(&self, name: &str) -> Option<&Message> {
+        self.messages.iter().find(|m| m.name == name)
+    }
+
+    fn check_fields(&self, file: &str, owner: &str, fields: &[Field]) -> Result<(), TableError> {
+        let mut names = BTreeSet::new();
+        for f in fields {
+            let place = format!("{owner}, field {:?}", f.name);
+            if f.name.is_empty()
+                || !f
+                    .name
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_')
+            {
+                return Err(Self::err(
+                    file,
+                    place,
+                    "a field name is [A-Za-z0-9_], not empty",
+                ));
+            }
+            if !names.insert(f.name.as_str()) {
+                return Err(Self::err(file, place, "the name is used twice"));
+            }
+            let ty = self
+                .resolve(&f.ty)
+                .map_err(|e| Self::err(file, place.clone(), e))?;
+            if let Some(flags) = &f.flags {
+                if !matches!(ty, Ty::Prim(Prim::U8 | Prim::U16 | Prim::U32)) {
+                    return Err(Self::err(file, place, "`flags` is for a u8, u16 or u32"));
+                }
+                if !self.flags.iter().any(|x| &x.name == flags) {
+                    return Err(Self::err(
+                        file,
+                        place,
+                        format!("`flags` names no [[flags]] table {flags:?}"),
+                    ));
+                }
+            }
+            if f.text && !matches!(ty, Ty::Array(Prim::U8, _)) {
+                return Err(Self::err(file, place, "`text` is for a u8[n]"));
+            }
+            match (&ty, f.max) {
+                (Ty::Vec(_), None) => {
+                    return Err(Self::err(
+                        file,
+                        place,
+                        "a vec needs `max`, its count's bound",
+                    ))
+                }
+                (Ty::Vec(_) | Ty::Prim(Prim::U8), _) | (_, None) => {}
+                (_, Some(_)) => {
+                    return Err(Self::err(file, place, "`max` is for a vec or a u8 count"))
+                }
+            }
+            if let Ty::Vec(inner) = &ty {
+                if self.fixed_size(inner).is_none() && !matches!(**inner, Ty::Struct(_)) {
+                    return Err(Self::err(
+                        file,
+                        place,
+                        "a vec's element is a primitive or a struct",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks names, references and the messages' rules.
+    fn check(&self, file: &str) -> Result<(), TableError> {
+        let mut types = BTreeSet::new();
+        for name in self
+            .enums
+            .iter()
+            .map(|e| &e.name)
+            .chain(self.structs.iter().map(|s| &s.name))
+            .chain(self.unions.iter().map(|u| &u.name))
+            .chain(self.messages.iter().map(|m| &m.name))
+        {
+            if !types.insert(name.as_str()) {
+                return Err(Self::err(
+                    file,
+                    format!("type {name:?}"),
+                    "two entries have this name",
+                ));
+            }
+        }
+        for e in &self.enums {
+            for (i, v) in e.values.iter().enumerate() {
+                if v.value as usize != i {
+                    return Err(Self::err(
+                        file,
+                        format!("enum {}, value {:?}", e.name, v.name),
+                        format!("tags run 0, 1, 2, … in order: expected {i}"),
+                    ));
+                }
+            }
+        }
+        for fl in &self.flags {
+            let mut seen = BTreeSet::new();
+            for b in &fl.bits {
+                if b.bit >= 32 || !seen.insert(b.bit) {
+                    return Err(Self::err(
+                        file,
+                        format!("flags {}, bit {:?}", fl.name, b.name),
+                        "a bit is 0..=31 and appears once",
+                    ));
+                }
+            }
+        }
+        for s in &self.structs {
+            self.check_fields(file, &format!("struct {}", s.name), &s.fields)?;
+        }
+        for u in &self.unions {
+            for (i, v) in u.variants.iter().enumerate() {
+                let owner = format!("union {}, variant {}", u.name, v.name);
+                if v.tag as usize != i {
+                    return Err(Self::err(
+                        file,
+                        owner,
+                        format!("tags run 0, 1, 2, … in order: expected {i}"),
+                    ));
+                }
+                self.check_fields(file, &owner, &v.fields)?;
+            }
+        }
+        let mut c_names = BTreeSet::new();
+        for m in &self.messages {
+            let owner = format!("message {}", m.name);
+            self.check_fields(file, &owner, &m.fields)?;
+            if !c_names.insert(m.c_name.as_str())
+                || !m.c_name.chars().all(|c| c.is_ascii_lowercase() || c == '_')
+            {
+                return Err(Self::err(
+                    file,
+                    format!("{owner}, c_name"),
+                    "a c_name is [a-z_] and names one message",
+                ));
+            }
+            match m.fields.first() {
+                Some(f) if f.name == "header" && f.ty == "Header" => {}
+                _ => {
+                    return Err(Self::err(
+                        file,
+                        owner,
+                        "a message starts with `header`, of type Header",
+                    ))
+                }
+            }
+            if !m.key.starts_with("flexdyn/") || m.key.contains("//") {
+                return Err(Self::err(
+                    file,
+                    format!("{owner}, key"),
+                    "a key is flexdyn/<sc-id>/…",
+                ));
+            }
+            let chunks = key_chunks(&m.key);
+            if chunks
+                .iter()
+                .skip(2)
+                .any(|c| c.starts_with('<') && c != chunks.last().unwrap_or(c))
+            {
+                return Err(Self::err(
+                    file,
+                    format!("{owner}, key"),
+                    "only the vehicle (second) and the last chunk of a key may be a placeholder",
+                ));
+            }
+            if m.lockstep.is_some() && (m.direction != Direction::Server || !m.named()) {
+                return Err(Self::err(
+                    file,
+                    format!("{owner}, lockstep"),
+                    "only a server message with a name in its key is a lockstep sensor",
+                ));
+            }
+            if m.since > self.protocol_version {
+                return Err(Self::err(
+                    file,
+                    format!("{owner}, since"),
+                    "later than protocol_version",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The `/`-separated chunks of a key.
+pub fn key_chunks(key: &str) -> Vec<&str> {
+    key.split('/').collect()
+}
+
+impl Message {
+    /// Whether the key's last chunk is a placeholder (a sensor's name, the chief's id, the
+    /// sender's id).
+    pub fn named(&self) -> bool {
+        key_chunks(&self.key)
+            .last()
+            .is_some_and(|c| c.starts_with('<'))
+    }
+
+    /// The key after the vehicle chunk, up to (not including) a last placeholder:
+    /// `tlm/imu` for `flexdyn/<sc-id>/tlm/imu/<name>`, `status` for `flexdyn/<sc-id>/status`.
+    pub fn key_tail(&self) -> String {
+        let chunks = key_chunks(&self.key);
+        let end = if self.named() {
+            chunks.len() - 1
+        } else {
+            chunks.len()
+        };
+        chunks[2..end].join("/")
+    }
+
+    /// The C macro suffix: `MAGNETOMETER`.
+    pub fn upper(&self) -> String {
+        self.c_name.to_ascii_uppercase()
+    }
+}

@@ -1,0 +1,357 @@
+//! The wire table against what it describes, and the mirrors against the table.
+//!
+//! - Every generated file in the tree is what the table gives today (a mirror cannot lag).
+//! - The table against the Rust codec, which is not generated from it: each message's fixed
+//!   length or shortest encoding equals the codec's, and the table read as a decoder (field by
+//!   field, in its order and types, with no bincode or serde) turns every hand-derived golden
+//!   vector of `proto/golden/` into the same values, under the same names, as the Rust decoder.
+//!   A field missing, renamed, moved, of another type or with a wrong enum name fails here.
+//! - Mistakes in the table are refused with the entry and field named.
+
+use std::path::{Path, PathBuf};
+
+use flexdyn_proto::WireMessage;
+use flexdyn_wiregen::table::{Prim, Table, Ty};
+use serde_json::{json, Map, Value};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn table() -> Table {
+    flexdyn_wiregen::read_table(&root()).expect("the wire table reads")
+}
+
+#[test]
+fn every_mirror_is_what_the_table_gives() {
+    let stale = flexdyn_wiregen::stale(&root()).expect("the mirrors are generated");
+    assert!(
+        stale.is_empty(),
+        "{stale:?} differ from proto/schema/messages.toml: run `cargo run -p flexdyn-wiregen` and \
+         commit the result (never edit a generated file by hand)"
+    );
+}
+
+/// Reads `ty` at `*pos` of `bytes` as the table says, into the JSON the Rust types serialize
+/// to (serde's human-readable form: unit enums by name, a union as `{variant: fields}`, text as
+/// a string up to its first NUL).
+fn read(table: &Table, ty: &Ty, text: bool, bytes: &[u8], pos: &mut usize) -> Value {
+    let mut take = |n: usize| -> &[u8] {
+        let s = &bytes[*pos..*pos + n];
+        *pos += n;
+        s
+    };
+    match ty {
+        Ty::Prim(p) => {
+            let b = take(p.size());
+            match p {
+                Prim::U8 => json!(b[0]),
+                Prim::Bool => {
+                    assert!(b[0] <= 1, "a bool byte {}", b[0]);
+                    json!(b[0] == 1)
+                }
+                Prim::U16 => json!(u16::from_le_bytes([b[0], b[1]])),
+                Prim::U32 => json!(u32::from_le_bytes(b.try_into().unwrap())),
+                Prim::I32 => json!(i32::from_le_bytes(b.try_into().unwrap())),
+                Prim::U64 => json!(u64::from_le_bytes(b.try_into().unwrap())),
+                Prim::F64 => json!(f64::from_le_bytes(b.try_into().unwrap())),
+            }
+        }
+        Ty::Array(p, n) => {
+            if text {
+                let b = take(*n);
+                let end = b.iter().position(|&x| x == 0).unwrap_or(*n);
+                return json!(String::from_utf8_lossy(&b[..end]));
+            }
+            Value::Array(
+                (0..*n)
+                    .map(|_| read(table, &Ty::Prim(*p), false, bytes, pos))
+                    .collect(),
+            )
+        }
+        Ty::Struct(i) => read_fields(table, &table.structs[*i].fields, bytes, pos),
+        Ty::Enum(i) => {
+            let tag = u32::from_le_bytes(take(4).try_into().unwrap());
+            let e = &table.enums[*i];
+            json!(e.values[tag as usize].name)
+        }
+        Ty::Union(i) => {
+            let tag = u32::from_le_bytes(take(4).try_into().unwrap());
+            let v = &table.unions[*i].variants[tag as usize];
+            if v.fields.is_empty() {
+                json!(v.name)
+            } else {
+                let fields = read_fields(table, &v.fields, bytes, pos);
+                let mut m = Map::new();
+                m.insert(v.name.clone(), fields);
+                Value::Object(m)
+            }
+        }
+        Ty::Vec(inner) => {
+            let n = u64::from_le_bytes(take(8).try_into().unwrap());
+            Value::Array(
+                (0..n)
+                    .map(|_| read(table, inner, false, bytes, pos))
+                    .collect(),
+            )
+        }
+    }
+}
+
+fn read_fields(
+    table: &Table,
+    fields: &[flexdyn_wiregen::table::Field],
+    bytes: &[u8],
+    pos: &mut usize,
+) -> Value {
+    let mut m = Map::new();
+    for f in fields {
+        let ty = table.resolve(&f.ty).expect("checked");
+        m.insert(f.name.clone(), read(table, &ty, f.text, bytes, pos));
+    }
+    Value::Object(m)
+}
+
+/// The Rust decoder's view of golden `name` as JSON, and its table-driven reading.
+fn both<T: WireMessage>(table: &Table, name: &str) -> (Value, Value) {
+    let bytes = std::fs::read(root().join(format!("proto/golden/{name}.bin"))).unwrap();
+    let rust: T = flexdyn_proto::decode(&bytes).unwrap();
+    let msg = table
+        .message(T::NAME)
+        .unwrap_or_else(|| panic!("the table has no message {}", T::NAME));
+    let mut pos = 0;
+    let by_table = read_fields(table, &msg.fields, &bytes, &mut pos);
+    assert_eq!(
+        pos,
+        bytes.len(),
+        "{name}: the table reads {pos} of {} bytes",
+        bytes.len()
+    );
+    (serde_json::to_value(&rust).unwrap(), by_table)
+}
+
+/// Checks one message type against the table: lengths, and every golden of it.
+fn agree<T: WireMessage>(table: &Table, goldens: &[&str], seen: &mut Vec<&'static str>) {
+    let msg = table
+        .message(T::NAME)
+        .unwrap_or_else(|| panic!("the table has no message {}", T::NAME));
+    match T::LAYOUT {
+        flexdyn_proto::WireLayout::Fixed { len } => {
+            assert_eq!(
+                table.fields_size(&msg.fields),
+                Some(len),
+                "{}: length",
+                T::NAME
+            )
+        }
+        flexdyn_proto::WireLayout::Walked { min_len, .. } => {
+            assert_eq!(
+                table.fields_size(&msg.fields),
+                None,
+                "{}: variable",
+                T::NAME
+            );
+            assert_eq!(
+                table.fields_min_size(&msg.fields),
+                min_len,
+                "{}: shortest encoding",
+                T::NAME
+            );
+        }
+    }
+    assert_eq!(
+        table.fields_min_size(&msg.fields),
+        T::MIN_LEN,
+        "{}",
+        T::NAME
+    );
+    for g in goldens {
+        let (rust, by_table) = both::<T>(table, g);
+        assert_eq!(
+            rust, by_table,
+            "golden {g}: the Rust decoder (left) and the table (right)"
+        );
+    }
+    seen.push(T::NAME);
+}
+
+#[test]
+fn the_table_reads_every_golden_as_the_rust_decoder_does() {
+    use flexdyn_proto::*;
+    let t = table();
+    assert_eq!(t.protocol_version, PROTOCOL_VERSION);
+    let mut seen = Vec::new();
+    agree::<StateMsg>(&t, &["state"], &mut seen);
+    agree::<ImuMsg>(&t, &["imu"], &mut seen);
+    agree::<StarTrackerMsg>(&t, &["star_tracker"], &mut seen);
+    agree::<MagnetometerMsg>(&t, &["magnetometer"], &mut seen);
+    agree::<CssMsg>(&t, &["css"], &mut seen);
+    agree::<FssMsg>(&t, &["fss"], &mut seen);
+    agree::<GpsMsg>(&t, &["gps"], &mut seen);
+    agree::<CommandMsg>(
+        &t,
+        &["command_wrench", "command_no_command", "command_actuators"],
+        &mut seen,
+    );
+    agree::<TimeMsg>(&t, &["time"], &mut seen);
+    agree::<EnvironmentMsg>(&t, &["environment"], &mut seen);
+    agree::<OperatorMsg>(&t, &["operator"], &mut seen);
+    agree::<FaultEventMsg>(&t, &["fault_event"], &mut seen);
+    agree::<FaultCommandMsg>(&t, &["fault_command"], &mut seen);
+    agree::<RelativeStateMsg>(&t, &["relative_state"], &mut seen);
+    agree::<StatusMsg>(&t, &["status"], &mut seen);
+    // Every message of the table is a Rust message checked here, and the reverse.
+    let mut in_table: Vec<&str> = t.messages.iter().map(|m| m.name.as_str()).collect();
+    in_table.sort_unstable();
+    seen.sort_unstable();
+    assert_eq!(in_table, seen);
+    // Every golden file is read above (MANIFEST.tsv lists them).
+    let manifest = std::fs::read_to_string(root().join("proto/golden/MANIFEST.tsv")).unwrap();
+    let goldens = manifest
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .count();
+    assert_eq!(goldens, 17, "a golden was added: read it above");
+}
+
+#[test]
+fn the_keys_are_the_rust_keys() {
+    use flexdyn_proto::Topics;
+    let t = table();
+    let topics = Topics::new("sc1").unwrap();
+    let key = |c: &str, name: &str| -> String {
+        let m = t.messages.iter().find(|m| m.c_name == c).unwrap();
+        let base = format!("flexdyn/sc1/{}", m.key_tail());
+        if m.named() {
+            format!("{base}/{name}")
+        } else {
+            base
+        }
+    };
+    assert_eq!(key("state", ""), topics.state());
+    assert_eq!(key("imu", "hub"), topics.imu("hub").unwrap());
+    assert_eq!(
+        key("star_tracker", "st1"),
+        topics.star_tracker("st1").unwrap()
+    );
+    for (c, prefix) in [
+        ("magnetometer", flexdyn_proto::MAGNETOMETER_PREFIX),
+        ("css", flexdyn_proto::CSS_PREFIX),
+        ("fss", flexdyn_proto::FSS_PREFIX),
+        ("gps", flexdyn_proto::GPS_PREFIX),
+    ] {
+        assert_eq!(key(c, "x1"), topics.sensor(prefix, "x1").unwrap(), "{c}");
+    }
+    assert_eq!(key("command", "7"), topics.cmd(7));
+    assert_eq!(key("time", ""), topics.time());
+    assert_eq!(key("environment", ""), topics.environment());
+    assert_eq!(key("operator", ""), topics.operator());
+    assert_eq!(key("fault_event", ""), topics.fault_events());
+    assert_eq!(key("fault_command", ""), topics.fault());
+    assert_eq!(
+        key("relative_state", "chief"),
+        topics.relative_state("chief").unwrap()
+    );
+    assert_eq!(key("status", ""), topics.status());
+}
+
+/// The table with `from` replaced by `to` (once).
+fn edited(from: &str, to: &str) -> String {
+    let text = std::fs::read_to_string(root().join(flexdyn_wiregen::TABLE_PATH)).unwrap();
+    assert!(text.contains(from), "{from:?} is not in the table");
+    text.replacen(from, to, 1)
+}
+
+#[test]
+fn mistakes_in_the_table_are_named() {
+    let cases = [
+        (
+            edited(
+                r#"{ name = "b_s_t", type = "f64[3]""#,
+                r#"{ name = "b_s_t", type = "f65[3]""#,
+            ),
+            "message MagnetometerMsg, field \"b_s_t\"",
+        ),
+        (
+            edited(
+                r#"{ name = "saturation_flags", type = "u8", flags = "magnetometer_flags""#,
+                r#"{ name = "saturation_flags", type = "u8", flags = "magnetometer_bits""#,
+            ),
+            "no [[flags]] table \"magnetometer_bits\"",
+        ),
+        (
+            edited(
+                r#"{ name = "effectors", type = "vec<EffectorState>", max = 1024"#,
+                r#"{ name = "effectors", type = "vec<EffectorState>""#,
+            ),
+            "a vec needs `max`",
+        ),
+        (
+            edited(
+                r#"{ name = "alpha_rad", type = "f64""#,
+                r#"{ name = "beta_rad", type = "f64""#,
+            ),
+            "message FssMsg, field \"beta_rad\": the name is used twice",
+        ),
+        (
+            edited(r#"c_name = "gps""#, r#"c_name = "css""#),
+            "message GpsMsg, c_name",
+        ),
+        (
+            edited(
+                r#"{ value = 1, name = "Resume""#,
+                r#"{ value = 2, name = "Resume""#,
+            ),
+            "enum OperatorAction, value \"Resume\"",
+        ),
+        (
+            edited("since = 9", "since = 10"),
+            "message RelativeStateMsg, since",
+        ),
+    ];
+    for (text, expected) in cases {
+        let err = Table::parse("messages.toml", &text).expect_err(expected);
+        let shown = err.to_string();
+        assert!(
+            shown.starts_with("messages.toml: ") && shown.contains(expected),
+            "{shown}"
+        );
+    }
+}
+
+#[test]
+fn a_readme_without_a_message_block_is_refused() {
+    let t = table();
+    let readme = std::fs::read_to_string(root().join(flexdyn_wiregen::README_PATH)).unwrap();
+    let cut = readme.replacen("<!-- wire-table: message GpsMsg -->", "", 1);
+    let err = flexdyn_wiregen::readme::splice(&t, "README.md", &cut).unwrap_err();
+    assert!(err.contains("GpsMsg"), "{err}");
+    let typo = readme.replacen(
+        "<!-- wire-table: message GpsMsg -->",
+        "<!-- wire-table: message GspMsg -->",
+        1,
+    );
+    let err = flexdyn_wiregen::readme::splice(&t, "README.md", &typo).unwrap_err();
+    assert!(err.contains("no message GspMsg"), "{err}");
+}
+
+/// The generated byte tables give the offsets the Rust layout constants state.
+#[test]
+fn generated_offsets_are_the_layout_constants() {
+    let t = table();
+    let state = flexdyn_wiregen::readme::block(&t, "message StateMsg").unwrap();
+    assert!(state.contains(&format!(
+        "| {} | 8 | u64 | `effectors` count n_effectors |",
+        flexdyn_proto::STATE_EFFECTOR_COUNT_OFFSET
+    )));
+    let time = flexdyn_wiregen::readme::block(&t, "message TimeMsg").unwrap();
+    assert!(time.contains(&format!(
+        "| {} | 8 | u8[8] | `cuc_tai` |",
+        flexdyn_proto::TIME_CUC_OFFSET
+    )));
+    let cmd = flexdyn_wiregen::readme::block(&t, "message CommandMsg").unwrap();
+    assert!(cmd.contains(&format!(
+        "| {} | 4 | u32 | `kind` tag |",
+        flexdyn_proto::COMMAND_KIND_OFFSET
+    )));
+}
