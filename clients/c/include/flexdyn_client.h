@@ -47,6 +47,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "flexdyn_proto.h"
 
@@ -235,6 +236,100 @@ int flexdyn_decode_time(flexdyn_client *client, const uint8_t *buf, size_t len, 
 #define FLEXDYN_STRUCT_STATUS 6
 #define FLEXDYN_STRUCT_TIME 7
 size_t flexdyn_struct_size(int which);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Every message kind (protocol 9's fifteen), by its number FLEXDYN_KIND_* (flexdyn_client_messages.h,
+ * generated from the wire table proto/schema/messages.toml). The typed calls of that header -
+ * flexdyn_subscribe_magnetometer / _poll_ / _wait_, the same for css, fss, gps, environment,
+ * fault_event and relative_state, the lockstep getters flexdyn_lockstep_magnetometer_count /
+ * _name / flexdyn_lockstep_magnetometer (and css, fss, gps), flexdyn_publish_fault_command and
+ * flexdyn_publish_operator - are built on these byte-level calls, which you may also use
+ * directly. Keys: a kind whose key ends with a name (a sensor's, or the chief's id for
+ * relative state, flexdyn/<your sc>/tlm/rel/<chief>) takes that name, or NULL for every one. */
+
+/* One subscription per kind; subscribing again replaces it. */
+int flexdyn_subscribe_kind(flexdyn_client *client, int kind, const char *name, size_t capacity);
+/* The next sample of `kind`, checked with the Rust codec (an undecodable one is dropped:
+ * FLEXDYN_ERR_DECODE). *bytes points into the handle and stays valid until the next call on it.
+ * name_out as in flexdyn_poll_imu (NULL, or FLEXDYN_NAME_CAP bytes). */
+int flexdyn_poll_bytes(flexdyn_client *client, int kind, const uint8_t **bytes, size_t *len,
+                       char *name_out, size_t name_cap);
+int flexdyn_wait_bytes(flexdyn_client *client, int kind, const uint8_t **bytes, size_t *len,
+                       char *name_out, size_t name_cap, uint32_t timeout_ms);
+/* Puts an encoded message of a kind flight code or an operator sends (command, operator, fault
+ * command) on its key: a command on flexdyn/<sc>/cmd/<its sender_id>. It is checked with the
+ * Rust codec first: FLEXDYN_ERR_ARGUMENT, and nothing sent, for bytes the server would refuse
+ * to decode; FLEXDYN_ERR_USAGE for a kind the server publishes. */
+int flexdyn_publish_bytes(flexdyn_client *client, int kind, const uint8_t *buf, size_t len);
+/* Lockstep: the joined run's sensors of `kind` (IMU, star tracker, magnetometer, css, fss, GPS;
+ * 0 for any other kind or before a join), their names, and the held tick's encoded sample of
+ * entry `index` (FLEXDYN_ERR_ABSENT: not due at this tick, or lost). */
+size_t flexdyn_lockstep_sensor_count(const flexdyn_client *client, int kind);
+const char *flexdyn_lockstep_sensor_name(const flexdyn_client *client, int kind, size_t index);
+int flexdyn_lockstep_sample_bytes(flexdyn_client *client, int kind, size_t index,
+                                  const uint8_t **bytes, size_t *len);
+/* For the typed calls: flexdyn_proto.h refused bytes the library handed out (fd_status, field);
+ * records why and returns FLEXDYN_ERR_CAPACITY (your effectors array) or FLEXDYN_ERR_DECODE. */
+int flexdyn_decode_failed(flexdyn_client *client, int kind, int fd_status, const char *field);
+/* Records `message` as the last error and returns `code`. */
+int flexdyn_fail(flexdyn_client *client, int code, const char *message);
+
+#include "flexdyn_client_messages.h"
+
+/* ------------------------------------------------------------------------------------------ */
+/* Live faults, on flexdyn/<sc>/fault (proto/README.md, "FaultCommandMsg"). `stamp` is the header
+ * of any message of the server (its spacecraft_id and tick are copied); `seq` numbers your fault
+ * commands. The server checks a fault as it checks a [[faults]] entry and counts a refusal in
+ * StatusMsg rejected.fault_refused; its FaultEventMsg (flexdyn_subscribe_fault_event) says when
+ * it took effect. In lockstep, put it before your answer to tick at_tick - 1 for a deterministic
+ * run. */
+
+/* Injects `mode` (its code, proto/README.md "Fault modes") with `params` (2 values, unused ones
+ * 0; NULL = both 0) on `target` ("imus.hub.gyro", at most FD_FAULT_TARGET_LEN bytes), on `axes`
+ * (bit a for axis a + 1; 0 every axis), from boundary `at_tick` (FD_AT_NEXT_TICK: the next) for
+ * `duration_ns` (0: until cleared), its generator seeded with `seed`. */
+static inline int flexdyn_inject_fault(flexdyn_client *client, const fd_header *stamp,
+                                       uint64_t seq, const char *target, uint32_t mode,
+                                       const double params[2], uint32_t axes, uint64_t at_tick,
+                                       uint64_t duration_ns, uint64_t seed) {
+    fd_fault_command_msg m;
+    size_t i;
+    if (stamp == NULL || target == NULL)
+        return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "stamp or target is a null pointer");
+    memset(&m, 0, sizeof m);
+    for (i = 0; target[i] != '\0'; ++i) {
+        if (i == FD_FAULT_TARGET_LEN)
+            return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT,
+                                "target is longer than FD_FAULT_TARGET_LEN (128) bytes");
+        m.target[i] = (uint8_t)target[i];
+    }
+    m.header = fd_header_new(stamp->spacecraft_id, stamp->tick, stamp->sim_time_ns, seq);
+    m.action = FD_FAULT_INJECT;
+    m.at_tick = at_tick;
+    m.mode = mode;
+    if (params != NULL) {
+        m.params[0] = params[0];
+        m.params[1] = params[1];
+    }
+    m.axes = axes;
+    m.duration_ns = duration_ns;
+    m.seed = seed;
+    return flexdyn_publish_fault_command(client, &m);
+}
+
+/* Clears fault `fault_index` (a FaultEventMsg's) from boundary `at_tick` on. */
+static inline int flexdyn_clear_fault(flexdyn_client *client, const fd_header *stamp,
+                                      uint64_t seq, uint32_t fault_index, uint64_t at_tick) {
+    fd_fault_command_msg m;
+    if (stamp == NULL)
+        return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "stamp is a null pointer");
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(stamp->spacecraft_id, stamp->tick, stamp->sim_time_ns, seq);
+    m.action = FD_FAULT_CLEAR;
+    m.at_tick = at_tick;
+    m.fault_index = fault_index;
+    return flexdyn_publish_fault_command(client, &m);
+}
 
 #ifdef __cplusplus
 }

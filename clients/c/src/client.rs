@@ -25,6 +25,7 @@ use zenoh::sample::Sample;
 use zenoh::{Session, Wait};
 
 use crate::error::{Code, Error};
+use crate::kinds::{self, KINDS};
 
 /// The spacecraft id of the keys when the options name none.
 pub const DEFAULT_SC_ID: &str = "sc1";
@@ -86,8 +87,9 @@ struct Lockstep {
     receiver: TickReceiver,
     publisher: Publisher<'static>,
     _token: LivelinessToken,
-    imu_names: Vec<CString>,
-    star_tracker_names: Vec<CString>,
+    /// Per message kind ([`KINDS`]), the names of the run's sensors of that kind (empty for a
+    /// kind a tick does not carry).
+    names: Vec<Vec<CString>>,
     held: Option<Tick>,
     answered: bool,
 }
@@ -99,11 +101,8 @@ pub struct Client {
     /// The end of the run: subscribed to `flexdyn/<sc>/status` from open, before anything
     /// else, so the end cannot be heard before the frames it follows are subscribed to.
     run_end: RunEnd,
-    state: Option<Ring>,
-    imu: Option<Ring>,
-    star_tracker: Option<Ring>,
-    status: Option<Ring>,
-    time: Option<Ring>,
+    /// One subscription per message kind ([`KINDS`]), by number.
+    subs: Vec<Option<Ring>>,
     /// The newest time message taken from the `time` subscription.
     last_time: Option<TimeMsg>,
     lockstep: Option<Lockstep>,
@@ -111,31 +110,26 @@ pub struct Client {
     seq: u64,
 }
 
-/// Which subscription a poll or wait reads.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
-    /// `flexdyn/<sc>/tlm/state`.
-    State,
-    /// `flexdyn/<sc>/tlm/imu/<name>`.
-    Imu,
-    /// `flexdyn/<sc>/tlm/st/<name>`.
-    StarTracker,
-    /// `flexdyn/<sc>/status`.
-    Status,
-    /// `flexdyn/<sc>/tlm/time`.
-    Time,
+/// Which subscription a poll or wait reads: a message kind's number ([`KINDS`],
+/// `FLEXDYN_KIND_*` in C).
+pub type Kind = usize;
+
+/// The prose name of a kind (`IMU`).
+fn what(kind: Kind) -> &'static str {
+    KINDS.get(kind).map_or("unknown", |k| k.title)
 }
 
-impl Kind {
-    fn what(self) -> &'static str {
-        match self {
-            Kind::State => "state",
-            Kind::Imu => "IMU",
-            Kind::StarTracker => "star tracker",
-            Kind::Status => "status",
-            Kind::Time => "time",
-        }
-    }
+/// Checks a kind number from C.
+pub fn check_kind(kind: Kind) -> Result<&'static kinds::KindInfo, Error> {
+    KINDS.get(kind).ok_or_else(|| {
+        Error::new(
+            Code::Argument,
+            format!(
+                "kind {kind} names no message (FLEXDYN_KIND_* is 0..{})",
+                KINDS.len()
+            ),
+        )
+    })
 }
 
 /// A received sample: the last chunk of its key (a sensor's name) and its payload.
@@ -197,11 +191,7 @@ impl Client {
             session,
             topics,
             run_end,
-            state: None,
-            imu: None,
-            star_tracker: None,
-            status: None,
-            time: None,
+            subs: KINDS.iter().map(|_| None).collect(),
             last_time: None,
             lockstep: None,
             seq: 0,
@@ -213,15 +203,11 @@ impl Client {
         let Self {
             session,
             run_end,
-            state,
-            imu,
-            star_tracker,
-            status,
-            time,
+            subs,
             lockstep,
             ..
         } = self;
-        drop((state, imu, star_tracker, status, time, lockstep, run_end));
+        drop((subs, lockstep, run_end));
         session
             .close()
             .wait()
@@ -229,12 +215,24 @@ impl Client {
     }
 
     fn slot(&mut self, kind: Kind) -> &mut Option<Ring> {
-        match kind {
-            Kind::State => &mut self.state,
-            Kind::Imu => &mut self.imu,
-            Kind::StarTracker => &mut self.star_tracker,
-            Kind::Status => &mut self.status,
-            Kind::Time => &mut self.time,
+        &mut self.subs[kind]
+    }
+
+    /// The key of `kind` for one `name` (`Some`) or every one (`None`, a `*` chunk).
+    fn key(&self, kind: Kind, name: Option<&str>) -> Result<String, Error> {
+        let info = check_kind(kind)?;
+        let base = format!("flexdyn/{}/{}", self.topics.sc_id(), info.key_tail);
+        if !info.named {
+            return Ok(base);
+        }
+        match name {
+            None => Ok(format!("{base}/*")),
+            Some(n) => {
+                flexdyn_proto::validate_sensor_name(n).map_err(|e| {
+                    Error::new(Code::Argument, format!("{} name {n:?}: {e}", info.title))
+                })?;
+                Ok(format!("{base}/{n}"))
+            }
         }
     }
 
@@ -249,19 +247,7 @@ impl Client {
         if capacity == 0 {
             return Err(Error::new(Code::Argument, "capacity must be at least 1"));
         }
-        let bad_name = |e| Error::new(Code::Argument, format!("{} name: {e}", kind.what()));
-        let key = match (kind, name) {
-            (Kind::State, _) => self.topics.state().to_owned(),
-            (Kind::Status, _) => self.topics.status().to_owned(),
-            (Kind::Time, _) => self.topics.time(),
-            (Kind::Imu, Some(n)) => self.topics.imu(n).map_err(bad_name)?,
-            (Kind::Imu, None) => self.topics.imu_wildcard(),
-            (Kind::StarTracker, Some(n)) => self.topics.star_tracker(n).map_err(bad_name)?,
-            (Kind::StarTracker, None) => {
-                flexdyn_proto::star_tracker_wildcard_key(self.topics.sc_id())
-                    .map_err(|e| Error::new(Code::Argument, e.to_string()))?
-            }
-        };
+        let key = self.key(kind, name)?;
         // The old subscription goes first, so a sample is never queued twice.
         *self.slot(kind) = None;
         let sub = self
@@ -310,7 +296,7 @@ impl Client {
             Code::Usage,
             format!(
                 "not subscribed to {} (call the subscribe function first)",
-                kind.what()
+                what(kind)
             ),
         )
     }
@@ -330,13 +316,14 @@ impl Client {
 
     /// The next sample of `kind` at once (`Ok(None)` when there is none).
     pub fn poll(&mut self, kind: Kind) -> Result<Taken<Received>, Error> {
+        check_kind(kind)?;
         let Some(sub) = self.slot(kind).as_ref() else {
             return Err(Self::not_subscribed(kind));
         };
         let sample = sub.try_recv().map_err(|e| {
             Error::new(
                 Code::Closed,
-                format!("the {} subscription ended: {e}", kind.what()),
+                format!("the {} subscription ended: {e}", what(kind)),
             )
         })?;
         Ok(match sample {
@@ -348,30 +335,16 @@ impl Client {
     /// The next sample of `kind`, waiting up to `timeout` ([`Code::Timeout`]); once the run
     /// has ended, [`Taken::Ended`] as soon as nothing more is queued.
     pub fn wait(&mut self, kind: Kind, timeout: Duration) -> Result<Taken<Received>, Error> {
-        let Self {
-            run_end,
-            state,
-            imu,
-            star_tracker,
-            status,
-            time,
-            ..
-        } = self;
-        let slot = match kind {
-            Kind::State => state,
-            Kind::Imu => imu,
-            Kind::StarTracker => star_tracker,
-            Kind::Status => status,
-            Kind::Time => time,
-        };
-        let Some(sub) = slot.as_ref() else {
+        check_kind(kind)?;
+        let Self { run_end, subs, .. } = self;
+        let Some(sub) = subs[kind].as_ref() else {
             return Err(Self::not_subscribed(kind));
         };
         let waited = Self::wait_sliced(run_end, timeout, |slice| {
             sub.recv_timeout(slice).map_err(|e| {
                 Error::new(
                     Code::Closed,
-                    format!("the {} subscription ended: {e}", kind.what()),
+                    format!("the {} subscription ended: {e}", what(kind)),
                 )
             })
         })?;
@@ -382,7 +355,7 @@ impl Client {
                 Code::Timeout,
                 format!(
                     "no {} sample on {} within {} ms",
-                    kind.what(),
+                    what(kind),
                     sub.key_expr(),
                     timeout.as_millis()
                 ),
@@ -404,13 +377,54 @@ impl Client {
 
     /// The key of a received sample of `kind` named `name`, for messages.
     pub fn key_of(&self, kind: Kind, name: &str) -> String {
-        match kind {
-            Kind::State => self.topics.state().to_owned(),
-            Kind::Status => self.topics.status().to_owned(),
-            Kind::Time => self.topics.time(),
-            Kind::Imu => self.topics.imu(name).unwrap_or_default(),
-            Kind::StarTracker => self.topics.star_tracker(name).unwrap_or_default(),
+        self.key(kind, Some(name)).unwrap_or_default()
+    }
+
+    /// The next sample of `kind` (a poll when `timeout` is `None`), checked with the Rust
+    /// decoder of its kind: a sample that does not decode is dropped and is [`Code::Decode`].
+    pub fn receive_checked(
+        &mut self,
+        kind: Kind,
+        timeout: Option<Duration>,
+    ) -> Result<Taken<Received>, Error> {
+        let info = check_kind(kind)?;
+        let r = match self.receive(kind, timeout)? {
+            Taken::Got(r) => r,
+            other => return Ok(other),
+        };
+        (info.check)(&r.payload)
+            .map_err(|e| decode_error(info.title, &self.key_of(kind, &r.name), &e))?;
+        Ok(Taken::Got(r))
+    }
+
+    /// Puts the encoded message `bytes` of `kind` (one flight code or an operator sends) on
+    /// its key, after checking them with the Rust decoder. A command goes on the key of its
+    /// `sender_id`.
+    pub fn publish(&self, kind: Kind, bytes: &[u8]) -> Result<(), Error> {
+        let info = check_kind(kind)?;
+        if info.from_server {
+            return Err(Error::new(
+                Code::Usage,
+                format!(
+                    "the server publishes {} messages ({}); flight code does not",
+                    info.title, info.key
+                ),
+            ));
         }
+        (info.check)(bytes).map_err(|e| {
+            Error::new(
+                Code::Argument,
+                format!("not a valid {} message (nothing sent): {e}", info.title),
+            )
+        })?;
+        let key = if kind == kinds::COMMAND {
+            let cmd = flexdyn_proto::decode_command(bytes)
+                .map_err(|e| Error::new(Code::Argument, format!("not a valid command: {e}")))?;
+            self.topics.cmd(cmd.sender_id)
+        } else {
+            self.key(kind, None)?
+        };
+        self.put(key, bytes.to_vec())
     }
 
     /// A header for this client's next command, stamped from `stamp`.
@@ -449,7 +463,7 @@ impl Client {
     /// [`Taken::Empty`] when there is none; a wait says [`Taken::Ended`] once the run has
     /// ended and none is queued); it becomes [`Self::now`].
     pub fn take_time(&mut self, timeout: Option<Duration>) -> Result<Taken<TimeMsg>, Error> {
-        let r = match self.receive(Kind::Time, timeout)? {
+        let r = match self.receive(kinds::TIME, timeout)? {
             Taken::Got(r) => r,
             Taken::Empty => return Ok(Taken::Empty),
             Taken::Ended => return Ok(Taken::Ended),
@@ -495,15 +509,18 @@ impl Client {
             .config()
             .and_then(|cfg| SensorSchedule::from_config(&cfg))
             .map_err(|e| Error::new(Code::Config, e.to_string()))?;
-        let c_names = |names: Vec<&str>| -> Vec<CString> {
-            // Key chunks ([A-Za-z0-9_-]) hold no NUL.
-            names
-                .into_iter()
-                .map(|n| CString::new(n).unwrap_or_default())
-                .collect()
-        };
-        let imu_names = c_names(schedule.imus().collect());
-        let star_tracker_names = c_names(schedule.star_trackers().map(|(n, _)| n).collect());
+        let names = KINDS
+            .iter()
+            .map(|k| {
+                k.lockstep
+                    .and_then(|section| schedule.names(section))
+                    .unwrap_or_default()
+                    .into_iter()
+                    // Key chunks ([A-Za-z0-9_-]) hold no NUL.
+                    .map(|n| CString::new(n).unwrap_or_default())
+                    .collect()
+            })
+            .collect();
         let receiver = TickReceiver::declare(
             &self.session,
             &self.topics,
@@ -537,8 +554,7 @@ impl Client {
             receiver,
             publisher,
             _token: token,
-            imu_names,
-            star_tracker_names,
+            names,
             held: None,
             answered: false,
         });
@@ -593,11 +609,43 @@ impl Client {
         }
     }
 
-    /// The sensor names of the joined run (IMUs, then star trackers).
-    pub fn sensor_names(&self) -> (&[CString], &[CString]) {
+    /// The names of the joined run's sensors of `kind`, in configuration order (none before a
+    /// join, or for a kind a tick does not carry).
+    pub fn sensor_names(&self, kind: Kind) -> &[CString] {
         match &self.lockstep {
-            Some(ls) => (&ls.imu_names, &ls.star_tracker_names),
-            None => (&[], &[]),
+            Some(ls) => ls.names.get(kind).map_or(&[], Vec::as_slice),
+            None => &[],
+        }
+    }
+
+    /// The held tick's encoded sample of sensor `index` of `kind`.
+    pub fn held_sample(&mut self, kind: Kind, index: usize) -> Result<Vec<u8>, Error> {
+        let info = check_kind(kind)?;
+        let Some(section) = info.lockstep else {
+            return Err(Error::new(
+                Code::Argument,
+                format!("a lockstep tick carries no {} messages", info.title),
+            ));
+        };
+        let tick = self.held()?;
+        match tick.sample_bytes(section, index) {
+            Some(Some(bytes)) => Ok(bytes),
+            Some(None) => Err(Error::new(
+                Code::Absent,
+                format!(
+                    "{} {index} has no sample at tick {} (not due, or lost)",
+                    info.title,
+                    tick.tick()
+                ),
+            )),
+            None => Err(Error::new(
+                Code::Argument,
+                format!(
+                    "{} index {index}: the run has {} of them ([[{section}]])",
+                    info.title,
+                    self.sensor_names(kind).len()
+                ),
+            )),
         }
     }
 

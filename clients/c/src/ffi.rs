@@ -23,11 +23,14 @@ use crate::ctypes::{
     FdStarTrackerMsg, FdStateMsg, FdStatusMsg, FdTimeMsg,
 };
 use crate::error::{Code, Error};
+use crate::kinds;
 
 /// `flexdyn_client`: the opaque handle.
 pub struct FlexdynClient {
     client: Option<Client>,
     last_error: CString,
+    /// The bytes the last byte-level call handed out (valid until the next call).
+    bytes: Vec<u8>,
 }
 
 /// `flexdyn_options`.
@@ -324,6 +327,7 @@ pub extern "C" fn flexdyn_client_new() -> *mut FlexdynClient {
         Box::into_raw(Box::new(FlexdynClient {
             client: None,
             last_error: CString::default(),
+            bytes: Vec::new(),
         }))
     })
     .unwrap_or(std::ptr::null_mut())
@@ -477,7 +481,7 @@ pub unsafe extern "C" fn flexdyn_subscribe_state(
     capacity: usize,
 ) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe { subscribe(handle, Kind::State, std::ptr::null(), capacity) }
+    unsafe { subscribe(handle, kinds::STATE, std::ptr::null(), capacity) }
 }
 
 /// # Safety
@@ -487,7 +491,7 @@ unsafe fn state(handle: *mut FlexdynClient, out: *mut FdStateMsg, wait: Option<u
         if out.is_null() {
             return Err(null("out"));
         }
-        let r = take(h, Kind::State, wait, decode_state_bytes)?;
+        let r = take(h, kinds::STATE, wait, decode_state_bytes)?;
         if let Taken::Got((_, m)) = &r {
             // SAFETY: forwarded contract.
             unsafe { write_state(out, m)? };
@@ -566,7 +570,7 @@ pub unsafe extern "C" fn flexdyn_subscribe_imu(
     capacity: usize,
 ) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe { subscribe(handle, Kind::Imu, name, capacity) }
+    unsafe { subscribe(handle, kinds::IMU, name, capacity) }
 }
 
 fn imu_c(key: &str, b: &[u8]) -> Result<FdImuMsg, Error> {
@@ -598,7 +602,7 @@ pub unsafe extern "C" fn flexdyn_poll_imu(
     name_cap: usize,
 ) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe { sensor(handle, Kind::Imu, out, name_out, name_cap, None, imu_c) }
+    unsafe { sensor(handle, kinds::IMU, out, name_out, name_cap, None, imu_c) }
 }
 
 /// `flexdyn_wait_imu`.
@@ -617,7 +621,7 @@ pub unsafe extern "C" fn flexdyn_wait_imu(
     unsafe {
         sensor(
             handle,
-            Kind::Imu,
+            kinds::IMU,
             out,
             name_out,
             name_cap,
@@ -638,7 +642,7 @@ pub unsafe extern "C" fn flexdyn_subscribe_star_tracker(
     capacity: usize,
 ) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe { subscribe(handle, Kind::StarTracker, name, capacity) }
+    unsafe { subscribe(handle, kinds::STAR_TRACKER, name, capacity) }
 }
 
 /// `flexdyn_poll_star_tracker`.
@@ -656,7 +660,7 @@ pub unsafe extern "C" fn flexdyn_poll_star_tracker(
     unsafe {
         sensor(
             handle,
-            Kind::StarTracker,
+            kinds::STAR_TRACKER,
             out,
             name_out,
             name_cap,
@@ -682,7 +686,7 @@ pub unsafe extern "C" fn flexdyn_wait_star_tracker(
     unsafe {
         sensor(
             handle,
-            Kind::StarTracker,
+            kinds::STAR_TRACKER,
             out,
             name_out,
             name_cap,
@@ -702,7 +706,7 @@ pub unsafe extern "C" fn flexdyn_subscribe_status(
     capacity: usize,
 ) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe { subscribe(handle, Kind::Status, std::ptr::null(), capacity) }
+    unsafe { subscribe(handle, kinds::STATUS, std::ptr::null(), capacity) }
 }
 
 /// `flexdyn_poll_status`.
@@ -718,7 +722,7 @@ pub unsafe extern "C" fn flexdyn_poll_status(
     unsafe {
         sensor(
             handle,
-            Kind::Status,
+            kinds::STATUS,
             out,
             std::ptr::null_mut(),
             0,
@@ -742,7 +746,7 @@ pub unsafe extern "C" fn flexdyn_wait_status(
     unsafe {
         sensor(
             handle,
-            Kind::Status,
+            kinds::STATUS,
             out,
             std::ptr::null_mut(),
             0,
@@ -762,7 +766,7 @@ pub unsafe extern "C" fn flexdyn_subscribe_time(
     capacity: usize,
 ) -> c_int {
     // SAFETY: forwarded contract.
-    unsafe { subscribe(handle, Kind::Time, std::ptr::null(), capacity) }
+    unsafe { subscribe(handle, kinds::TIME, std::ptr::null(), capacity) }
 }
 
 /// A time message from `get` into `out` (`FLEXDYN_EMPTY` when there is none).
@@ -975,13 +979,12 @@ pub unsafe extern "C" fn flexdyn_lockstep_wait(
 /// `handle` null or live.
 unsafe fn with_names<R>(
     handle: *const FlexdynClient,
-    imus: bool,
+    kind: Kind,
     f: impl FnOnce(&[CString]) -> R,
 ) -> R {
     // SAFETY: by this function's contract; read-only.
     let client = unsafe { handle.as_ref() }.and_then(|h| h.client.as_ref());
-    let (i, s) = client.map_or((&[][..], &[][..]), Client::sensor_names);
-    f(if imus { i } else { s })
+    f(client.map_or(&[][..], |c| c.sensor_names(kind)))
 }
 
 /// The pointer to name `index` (it lives in the handle until the next join, leave or close, as
@@ -998,7 +1001,7 @@ fn name_ptr(names: &[CString], index: usize) -> *const c_char {
 pub unsafe extern "C" fn flexdyn_lockstep_imu_count(handle: *const FlexdynClient) -> usize {
     // SAFETY: forwarded contract.
     catch_unwind(AssertUnwindSafe(|| unsafe {
-        with_names(handle, true, <[CString]>::len)
+        with_names(handle, kinds::IMU, <[CString]>::len)
     }))
     .unwrap_or(0)
 }
@@ -1014,7 +1017,7 @@ pub unsafe extern "C" fn flexdyn_lockstep_imu_name(
 ) -> *const c_char {
     // SAFETY: forwarded contract.
     catch_unwind(AssertUnwindSafe(|| unsafe {
-        with_names(handle, true, |n| name_ptr(n, index))
+        with_names(handle, kinds::IMU, |n| name_ptr(n, index))
     }))
     .unwrap_or(std::ptr::null())
 }
@@ -1029,7 +1032,7 @@ pub unsafe extern "C" fn flexdyn_lockstep_star_tracker_count(
 ) -> usize {
     // SAFETY: forwarded contract.
     catch_unwind(AssertUnwindSafe(|| unsafe {
-        with_names(handle, false, <[CString]>::len)
+        with_names(handle, kinds::STAR_TRACKER, <[CString]>::len)
     }))
     .unwrap_or(0)
 }
@@ -1045,7 +1048,7 @@ pub unsafe extern "C" fn flexdyn_lockstep_star_tracker_name(
 ) -> *const c_char {
     // SAFETY: forwarded contract.
     catch_unwind(AssertUnwindSafe(|| unsafe {
-        with_names(handle, false, |n| name_ptr(n, index))
+        with_names(handle, kinds::STAR_TRACKER, |n| name_ptr(n, index))
     }))
     .unwrap_or(std::ptr::null())
 }
@@ -1301,6 +1304,264 @@ pub unsafe extern "C" fn flexdyn_decode_status(
 ) -> c_int {
     // SAFETY: forwarded contract.
     unsafe { decode_fixed(handle, buf, len, out, status_c) }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The byte-level calls under the typed calls of `flexdyn_client_messages.h` (generated from the
+// wire table): every message kind by its number.
+
+/// A C `int` kind number as a [`Kind`] (a negative one is out of range, like a large one).
+fn kind_of(kind: c_int) -> Result<Kind, Error> {
+    let k = usize::try_from(kind).unwrap_or(usize::MAX);
+    crate::client::check_kind(k).map(|_| k)
+}
+
+/// `flexdyn_subscribe_kind`.
+///
+/// # Safety
+/// `handle` live; `name` null or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_subscribe_kind(
+    handle: *mut FlexdynClient,
+    kind: c_int,
+    name: *const c_char,
+    capacity: usize,
+) -> c_int {
+    match kind_of(kind) {
+        // SAFETY: forwarded contract.
+        Ok(kind) => unsafe { subscribe(handle, kind, name, capacity) },
+        Err(e) => with_handle(handle, |_| Err(e)),
+    }
+}
+
+/// Keeps `data` in the handle and points `*bytes`/`*len` at it.
+///
+/// # Safety
+/// `bytes` and `len` are writable (checked non-null by the caller).
+unsafe fn hand_out(h: &mut FlexdynClient, data: Vec<u8>, bytes: *mut *const u8, len: *mut usize) {
+    h.bytes = data;
+    // SAFETY: writable, by this function's contract; the bytes live in the handle until the
+    // next call on it (the header's contract).
+    unsafe {
+        bytes.write(h.bytes.as_ptr());
+        len.write(h.bytes.len());
+    }
+}
+
+/// Hands out the next checked sample of `kind`: its bytes stay in the handle until the next
+/// call, `*bytes`/`*len` point at them.
+///
+/// # Safety
+/// `handle` live; `bytes` and `len` writable; `name_out` null or `name_cap` writable bytes.
+unsafe fn take_bytes(
+    handle: *mut FlexdynClient,
+    kind: c_int,
+    bytes: *mut *const u8,
+    len: *mut usize,
+    name_out: *mut c_char,
+    name_cap: usize,
+    wait: Option<u32>,
+) -> c_int {
+    with_handle(handle, |h| {
+        let kind = kind_of(kind)?;
+        if bytes.is_null() || len.is_null() {
+            return Err(null("bytes or len"));
+        }
+        check_name_buffer(name_out, name_cap)?;
+        let r = match h.client()?.receive_checked(kind, wait.map(timeout))? {
+            Taken::Got(r) => r,
+            Taken::Empty => return Ok(Code::Empty),
+            Taken::Ended => return Ok(Code::Ended),
+        };
+        // SAFETY: `bytes`, `len` writable and `name_cap >= NAME_CAP` (checked), by this
+        // function's contract.
+        unsafe {
+            hand_out(h, r.payload, bytes, len);
+            write_name(name_out, &r.name);
+        }
+        Ok(Code::Ok)
+    })
+}
+
+/// `flexdyn_poll_bytes`.
+///
+/// # Safety
+/// As [`take_bytes`].
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_poll_bytes(
+    handle: *mut FlexdynClient,
+    kind: c_int,
+    bytes: *mut *const u8,
+    len: *mut usize,
+    name_out: *mut c_char,
+    name_cap: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { take_bytes(handle, kind, bytes, len, name_out, name_cap, None) }
+}
+
+/// `flexdyn_wait_bytes`.
+///
+/// # Safety
+/// As [`take_bytes`].
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_wait_bytes(
+    handle: *mut FlexdynClient,
+    kind: c_int,
+    bytes: *mut *const u8,
+    len: *mut usize,
+    name_out: *mut c_char,
+    name_cap: usize,
+    timeout_ms: u32,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe {
+        take_bytes(
+            handle,
+            kind,
+            bytes,
+            len,
+            name_out,
+            name_cap,
+            Some(timeout_ms),
+        )
+    }
+}
+
+/// `flexdyn_publish_bytes`.
+///
+/// # Safety
+/// `handle` live; `buf` `len` bytes.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_publish_bytes(
+    handle: *mut FlexdynClient,
+    kind: c_int,
+    buf: *const u8,
+    len: usize,
+) -> c_int {
+    with_handle(handle, |h| {
+        let kind = kind_of(kind)?;
+        // SAFETY: forwarded contract.
+        let b = unsafe { bytes(buf, len)? };
+        h.client()?.publish(kind, b)?;
+        Ok(Code::Ok)
+    })
+}
+
+/// `flexdyn_lockstep_sensor_count`.
+///
+/// # Safety
+/// `handle` null or live.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_sensor_count(
+    handle: *const FlexdynClient,
+    kind: c_int,
+) -> usize {
+    let Ok(kind) = kind_of(kind) else { return 0 };
+    // SAFETY: forwarded contract.
+    catch_unwind(AssertUnwindSafe(|| unsafe {
+        with_names(handle, kind, <[CString]>::len)
+    }))
+    .unwrap_or(0)
+}
+
+/// `flexdyn_lockstep_sensor_name`: null for an index out of range.
+///
+/// # Safety
+/// `handle` null or live.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_sensor_name(
+    handle: *const FlexdynClient,
+    kind: c_int,
+    index: usize,
+) -> *const c_char {
+    let Ok(kind) = kind_of(kind) else {
+        return std::ptr::null();
+    };
+    // SAFETY: forwarded contract.
+    catch_unwind(AssertUnwindSafe(|| unsafe {
+        with_names(handle, kind, |n| name_ptr(n, index))
+    }))
+    .unwrap_or(std::ptr::null())
+}
+
+/// `flexdyn_lockstep_sample_bytes`.
+///
+/// # Safety
+/// `handle` live; `bytes` and `len` writable.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_lockstep_sample_bytes(
+    handle: *mut FlexdynClient,
+    kind: c_int,
+    index: usize,
+    bytes: *mut *const u8,
+    len: *mut usize,
+) -> c_int {
+    with_handle(handle, |h| {
+        let kind = kind_of(kind)?;
+        if bytes.is_null() || len.is_null() {
+            return Err(null("bytes or len"));
+        }
+        let sample = h.client()?.held_sample(kind, index)?;
+        // SAFETY: `bytes` and `len` writable (checked non-null), by this function's contract.
+        unsafe { hand_out(h, sample, bytes, len) };
+        Ok(Code::Ok)
+    })
+}
+
+/// `flexdyn_decode_failed`: the C decoder refused bytes the library handed out.
+///
+/// # Safety
+/// `handle` live; `field` null or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_decode_failed(
+    handle: *mut FlexdynClient,
+    kind: c_int,
+    fd_status: c_int,
+    field: *const c_char,
+) -> c_int {
+    with_handle(handle, |_| {
+        let kind = kind_of(kind)?;
+        let info = &kinds::KINDS[kind];
+        // SAFETY: forwarded contract; a field name is ASCII.
+        let field = unsafe { opt_str("field", field)? }.unwrap_or("");
+        // FD_ERR_CAPACITY (7): the caller's array is too small.
+        if fd_status == 7 {
+            return Err(Error::new(
+                Code::Capacity,
+                format!(
+                    "a {} sample does not fit your array ({field}); the sample is dropped",
+                    info.title
+                ),
+            ));
+        }
+        Err(Error::new(
+            Code::Decode,
+            format!(
+                "an undecodable {} sample (fd_status {fd_status}, {field}): flexdyn_proto.h \
+                 refused what the Rust codec accepted; please report it",
+                info.title
+            ),
+        ))
+    })
+}
+
+/// `flexdyn_fail`: records `message` as the handle's last error and returns `code`.
+///
+/// # Safety
+/// `handle` live; `message` null or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fail(
+    handle: *mut FlexdynClient,
+    code: c_int,
+    message: *const c_char,
+) -> c_int {
+    with_handle_int(handle, |h| {
+        // SAFETY: forwarded contract.
+        let m = unsafe { opt_str("message", message)? }.unwrap_or("");
+        h.set_error(m);
+        Ok(code)
+    })
 }
 
 /// `flexdyn_struct_size`.

@@ -10,6 +10,8 @@
 //! - [`error`]: the return codes and the error that carries one with its message.
 //! - [`ctypes`]: the `#[repr(C)]` mirrors of the `flexdyn_proto.h` structs and the conversions
 //!   from (and, for effector inputs, to) the Rust messages.
+//! - [`kinds`]: the message kinds of the wire table (generated): key, direction, lockstep
+//!   section and the Rust decoder that checks each sample before it is handed out.
 //! - [`client`]: the library in safe Rust: the session, subscriptions with ring queues, commands
 //!   and the lockstep participant (built on `flexdyn_proto::client`).
 //! - `ffi`: the `extern "C"` functions. The only module with `unsafe` code: pointer checks,
@@ -25,6 +27,9 @@ pub mod client;
 pub mod ctypes;
 pub mod error;
 mod ffi;
+// Written by flexdyn-wiregen from proto/schema/messages.toml.
+#[rustfmt::skip]
+pub mod kinds;
 
 pub use client::{Client, Options};
 pub use error::{Code, Error};

@@ -146,6 +146,26 @@ impl SensorSchedule {
     }
 }
 
+impl SensorSchedule {
+    /// The names of a configuration section's sensors (`imus`, `star_trackers`,
+    /// `magnetometers`, `coarse_sun_sensors`, `fine_sun_sensors`, `gps_receivers`), in
+    /// configuration order; `None` for any other section.
+    pub fn names(&self, section: &str) -> Option<Vec<&str>> {
+        fn periodic(list: &[Periodic]) -> Vec<&str> {
+            list.iter().map(|p| p.name.as_str()).collect()
+        }
+        Some(match section {
+            "imus" => self.imus().collect(),
+            "star_trackers" => periodic(&self.star_trackers),
+            "magnetometers" => periodic(&self.magnetometers),
+            "coarse_sun_sensors" => periodic(&self.coarse_sun_sensors),
+            "fine_sun_sensors" => periodic(&self.fine_sun_sensors),
+            "gps_receivers" => periodic(&self.gps_receivers),
+            _ => return None,
+        })
+    }
+}
+
 /// (name, period) of each entry of a periodic list.
 fn periods(list: &[Periodic]) -> impl Iterator<Item = (&str, u64)> {
     list.iter().map(|p| (p.name.as_str(), p.every))
@@ -200,6 +220,24 @@ impl Tick {
     /// The tick (frame index).
     pub fn tick(&self) -> u64 {
         self.state.header.tick
+    }
+
+    /// The encoded sample of entry `index` of a configuration section (as
+    /// [`SensorSchedule::names`]): `None` for an unknown section or an index past its end,
+    /// `Some(None)` when the tick carries no sample of that sensor (not due, or lost).
+    pub fn sample_bytes(&self, section: &str, index: usize) -> Option<Option<Vec<u8>>> {
+        fn one<T: crate::WireMessage>(list: &[Option<T>], index: usize) -> Option<Option<Vec<u8>>> {
+            list.get(index).map(|m| m.as_ref().map(crate::encode))
+        }
+        match section {
+            "imus" => one(&self.imus, index),
+            "star_trackers" => one(&self.star_trackers, index),
+            "magnetometers" => one(&self.magnetometers, index),
+            "coarse_sun_sensors" => one(&self.coarse_sun_sensors, index),
+            "fine_sun_sensors" => one(&self.fine_sun_sensors, index),
+            "gps_receivers" => one(&self.gps_receivers, index),
+            _ => None,
+        }
     }
 }
 
