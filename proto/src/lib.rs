@@ -11,7 +11,9 @@
 //!   over complete ([`client::lockstep::TickReceiver`]).
 //!
 //! `proto/README.md` is the language-neutral specification (byte tables, Python example,
-//! lockstep rules) for non-Rust flight code.
+//! lockstep rules) for non-Rust flight code. Its byte tables are generated from the wire table
+//! `proto/schema/messages.toml` (`cargo run -p flexdyn-wiregen`), which the tests of
+//! `proto/gen` check against these types and the goldens.
 //!
 //! # Topics
 //!
@@ -29,6 +31,8 @@
 //! | `flexdyn/<deputy-id>/tlm/rel/<chief-id>` | [`RelativeStateMsg`] | fleet server → anyone, every frame |
 //! | `flexdyn/<sc-id>/cmd/<sender-id>` | [`CommandMsg`] | flight code → server |
 //! | `flexdyn/<sc-id>/status` | [`StatusMsg`] | server → anyone |
+//! | `flexdyn/<sc-id>/tlm/fault` | [`FaultEventMsg`] | server → anyone, at each fault's activation and clearance |
+//! | `flexdyn/<sc-id>/fault` | [`FaultCommandMsg`] | operator → server |
 //! | `flexdyn/<sc-id>/operator` | [`OperatorMsg`] | operator → server |
 //! | `flexdyn/<sc-id>/participant/<sender-id>` | Zenoh liveliness token (no payload) | lockstep participant → server |
 //!
@@ -62,6 +66,8 @@
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
 //! | [`StatusMsg`] | [`STATUS_LEN`] = 235 |
 //! | [`OperatorMsg`] | [`OPERATOR_LEN`] = 42 |
+//! | [`FaultEventMsg`] | [`FAULT_EVENT_LEN`] = 199 |
+//! | [`FaultCommandMsg`] | [`FAULT_COMMAND_LEN`] = 214 |
 //! | [`RelativeStateMsg`] | [`RELATIVE_STATE_LEN`] = 102 |
 //!
 //! Decoders accept at most [`MAX_MESSAGE_BYTES`], [`MAX_EFFECTORS`] and
