@@ -250,6 +250,11 @@ impl WireMessage for FaultEventMsg {
     fn header(&self) -> &Header {
         &self.header
     }
+
+    /// Rejects bytes after the target's terminating NUL (the text rule).
+    fn validate(&self) -> Result<(), DecodeError> {
+        self.target.check_padding("target")
+    }
 }
 
 impl WireMessage for FaultCommandMsg {
@@ -262,8 +267,10 @@ impl WireMessage for FaultCommandMsg {
         &self.header
     }
 
-    /// Rejects non-finite parameters with [`DecodeError::NonFinite`].
+    /// Rejects bytes after the target's terminating NUL (the text rule, step 4 of the decoder
+    /// rules), then non-finite parameters with [`DecodeError::NonFinite`] (step 5).
     fn validate(&self) -> Result<(), DecodeError> {
+        self.target.check_padding("target")?;
         for (field, v) in ["params[0]", "params[1]"].into_iter().zip(self.params) {
             if !v.is_finite() {
                 return Err(DecodeError::NonFinite { field });

@@ -1076,6 +1076,26 @@ impl FaultTarget {
     }
 }
 
+impl FaultTarget {
+    /// The text rule of `proto/README.md` ("Decoder rules", step 4): the text ends at its first
+    /// NUL byte and every byte after it is NUL, so one target has one encoding. Another byte in
+    /// the padding is [`crate::DecodeError::Malformed`], naming `field`.
+    pub fn check_padding(&self, field: &str) -> Result<(), crate::DecodeError> {
+        let Some(end) = self.0.iter().position(|&b| b == 0) else {
+            return Ok(());
+        };
+        match self.0[end..].iter().position(|&b| b != 0) {
+            None => Ok(()),
+            Some(i) => Err(crate::DecodeError::Malformed(format!(
+                "{field}: byte {} is 0x{:02x}, after the text ended (NUL) at byte {end}; the \
+                 padding must be NUL",
+                end + i,
+                self.0[end + i]
+            ))),
+        }
+    }
+}
+
 impl Default for FaultTarget {
     fn default() -> Self {
         Self([0; FAULT_TARGET_LEN])

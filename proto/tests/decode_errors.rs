@@ -473,3 +473,61 @@ fn reject_counters_record() {
     c.stale_tick = u64::MAX;
     assert_eq!(c.total(), u64::MAX);
 }
+
+/// The text rule ("Decoder rules", step 4): a target ends at its first NUL and the padding after
+/// it is NUL; a FaultCommandMsg with `imus.hub.gyro`, NULs, then 0x80 is refused, not applied.
+#[test]
+fn text_after_its_nul_is_malformed() {
+    use flexdyn_proto::{
+        decode_fault_command, decode_fault_event, FaultAction, FaultCommandMsg, FaultEventMsg,
+        FaultTarget, FAULT_TARGET_LEN,
+    };
+    let cmd = FaultCommandMsg {
+        header: Header::new(1, 4, 0, 0),
+        action: FaultAction::Inject,
+        target: FaultTarget::new("imus.hub.gyro").unwrap(),
+        ..Default::default()
+    };
+    let good = encode(&cmd);
+    assert_eq!(decode_fault_command(&good).unwrap(), cmd);
+    let target_at = 86;
+    let mut bad = good.clone();
+    bad[target_at + FAULT_TARGET_LEN - 1] = 0x80;
+    match decode_fault_command(&bad) {
+        Err(DecodeError::Malformed(m)) => assert!(
+            m.contains("target: byte 127 is 0x80") && m.contains("at byte 13"),
+            "{m}"
+        ),
+        other => panic!("{other:?}"),
+    }
+    // Step 4 (the text) is reported before step 5 (a non-finite parameter).
+    bad[50..58].copy_from_slice(&f64::NAN.to_le_bytes());
+    assert!(matches!(
+        decode_fault_command(&bad),
+        Err(DecodeError::Malformed(_))
+    ));
+    // A byte right after the NUL, and a target with no NUL at all (128 bytes of text).
+    let mut bad = good.clone();
+    bad[target_at + 14] = b'x';
+    assert!(matches!(
+        decode_fault_command(&bad),
+        Err(DecodeError::Malformed(_))
+    ));
+    let mut full = good;
+    full[target_at..target_at + FAULT_TARGET_LEN].fill(b'a');
+    assert_eq!(
+        decode_fault_command(&full).unwrap().target.as_str(),
+        Some("a".repeat(FAULT_TARGET_LEN).as_str())
+    );
+    let ev = FaultEventMsg {
+        header: Header::new(1, 4, 0, 0),
+        target: FaultTarget::new("reaction_wheels.rw2").unwrap(),
+        ..Default::default()
+    };
+    let mut bad = encode(&ev);
+    bad[71 + 100] = 1;
+    assert!(matches!(
+        decode_fault_event(&bad),
+        Err(DecodeError::Malformed(_))
+    ));
+}

@@ -236,6 +236,14 @@ def test_fault_event_and_command(golden_dir):
     with pytest.raises(DecodeError) as e:
         FaultEventMsg.decode(bytes(bad))
     assert e.value.reason == "Malformed"
+    # The text rule: "imus.hub.gyro", NULs, then 0x80 is refused; 128 bytes without a NUL pass.
+    bad = bytearray(golden)
+    bad[71 + 127] = 0x80
+    with pytest.raises(DecodeError) as e:
+        FaultEventMsg.decode(bytes(bad))
+    assert e.value.reason == "Malformed"
+    bad[71:199] = b"x" * 128
+    assert FaultEventMsg.decode(bytes(bad)).target_str == "x" * 128
     # The SDK's builder gives the golden command from names.
     cmd = proto.fault_command(SC, "reaction_wheels.rw2", "torque_limit", at_tick=0x1_0000_0005,
                               duration_ns=2_000_000_000, seed=7, seq=2, tick=44, fraction=0.5)
@@ -248,6 +256,10 @@ def test_fault_event_and_command(golden_dir):
     with pytest.raises(DecodeError) as e:
         FaultCommandMsg.decode(bytes(bad))
     assert e.value.reason == "NonFinite" and e.value.canonical() == "E NonFinite params[1]"
+    bad[86 + 20] = 0x80  # after "reaction_wheels.rw2" and its NUL: the text rule comes first
+    with pytest.raises(DecodeError) as e:
+        FaultCommandMsg.decode(bytes(bad))
+    assert e.value.reason == "Malformed"
     with pytest.raises(ValueError):
         proto.fault_command(SC, "imus.hub.gyro", "bias_step", value=1.0, factor=2.0)
     assert proto.fault_key("sc1") == "flexdyn/sc1/fault"

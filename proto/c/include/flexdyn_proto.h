@@ -1223,6 +1223,16 @@ static inline size_t fd_encode_gps(const fd_gps_msg *m, uint8_t *buf, size_t cap
 
 /* FaultEventMsg and FaultCommandMsg (protocol 8, fixed length).                             */
 
+/* The text rule (README "Decoder rules", step 4): a text field ends at its first NUL byte and
+ * every byte after it is NUL. 1 when `p[0..n)` follows it. */
+static inline int fd_text_padded(const uint8_t *p, size_t n) {
+    size_t i = 0;
+    while (i < n && p[i] != 0u) ++i;
+    for (; i < n; ++i)
+        if (p[i] != 0u) return 0;
+    return 1;
+}
+
 static inline fd_error fd_decode_fault_event(const uint8_t *buf, size_t len,
                                              fd_fault_event_msg *out) {
     fd_error e = fd_check_size_and_version(buf, len, FD_FAULT_EVENT_LEN);
@@ -1233,6 +1243,8 @@ static inline fd_error fd_decode_fault_event(const uint8_t *buf, size_t len,
     if (fd_get_u32(buf + 34) > FD_FAULT_SOURCE_RANDOM)
         return fd_fail(FD_ERR_MALFORMED, 0, len, "source tag");
     if (buf[42] > 1) return fd_fail(FD_ERR_MALFORMED, 0, len, "active is not a bool");
+    if (!fd_text_padded(buf + 71, FD_FAULT_TARGET_LEN))
+        return fd_fail(FD_ERR_MALFORMED, 0, len, "target: a byte other than NUL after its NUL");
     fd_decode_header_at(buf, &out->header);
     out->fault_index = fd_get_u32(buf + 30);
     out->source = fd_get_u32(buf + 34);
@@ -1269,6 +1281,8 @@ static inline fd_error fd_decode_fault_command(const uint8_t *buf, size_t len,
     if ((e = fd_check_total(FD_FAULT_COMMAND_LEN, len)).status != FD_OK) return e;
     if (fd_get_u32(buf + 30) > FD_FAULT_CLEAR)
         return fd_fail(FD_ERR_MALFORMED, 0, len, "action tag");
+    if (!fd_text_padded(buf + 86, FD_FAULT_TARGET_LEN))
+        return fd_fail(FD_ERR_MALFORMED, 0, len, "target: a byte other than NUL after its NUL");
     /* Step 5: the parameters finite. */
     if (!fd_is_finite(fd_get_f64(buf + 50))) return fd_fail(FD_ERR_NON_FINITE, 0, len, "params[0]");
     if (!fd_is_finite(fd_get_f64(buf + 58))) return fd_fail(FD_ERR_NON_FINITE, 0, len, "params[1]");

@@ -517,6 +517,15 @@ static void test_faults(const char *dir) {
     golden[34] = 1;
     golden[42] = 2;
     CHECK(fd_decode_fault_event(golden, n, &ev_back).status == FD_ERR_MALFORMED, "active = 2");
+    golden[42] = 1;
+    /* The text rule: "imus.hub.gyro" (13 bytes at 71), NULs, then 0x80 in the last byte. */
+    golden[71 + 127] = 0x80;
+    CHECK(fd_decode_fault_event(golden, n, &ev_back).status == FD_ERR_MALFORMED,
+          "a byte after the target's NUL");
+    golden[71 + 127] = 0;
+    memset(golden + 71, 'x', FD_FAULT_TARGET_LEN);
+    CHECK(fd_decode_fault_event(golden, n, &ev_back).status == FD_OK,
+          "a target of 128 bytes (no NUL)");
 
     n = read_file(dir, "fault_command", golden, sizeof golden);
     memset(&cmd, 0, sizeof cmd);
@@ -541,6 +550,14 @@ static void test_faults(const char *dir) {
     CHECK(fd_decode_fault_command(golden, n, &cmd_back).status == FD_ERR_MALFORMED,
           "action tag 2");
     golden[30] = 0;
+    golden[86 + 20] = 0x80; /* after "reaction_wheels.rw2" and its NUL */
+    CHECK(fd_decode_fault_command(golden, n, &cmd_back).status == FD_ERR_MALFORMED,
+          "a byte after the target's NUL");
+    golden[65] = 0x7f;
+    golden[64] = 0xf0; /* and params[1] = +inf: the text (step 4) is reported first */
+    CHECK(fd_decode_fault_command(golden, n, &cmd_back).status == FD_ERR_MALFORMED,
+          "the text rule before the finite check");
+    golden[86 + 20] = 0;
     golden[65] = 0x7f;
     golden[64] = 0xf0; /* params[1] = +inf */
     e = fd_decode_fault_command(golden, n, &cmd_back);

@@ -1,17 +1,19 @@
-"""The flexdyn wire protocol, version 7, in pure Python.
+"""The flexdyn wire protocol, version 9, in pure Python.
 
 Every message of ``proto/README.md`` as a dataclass with ``encode()`` and ``decode(bytes)``.
 Decoding follows the README's decoder rules in the same order and raises :class:`DecodeError`
 with the same reasons as the Rust crate's ``DecodeError``:
 
 1. more than ``MAX_MESSAGE_BYTES`` -> ``TooLarge``;
-2. fewer than 2 bytes -> ``Length``; first two bytes (u16 LE) != 7 -> ``UnknownVersion``;
+2. fewer than 2 bytes -> ``Length``; first two bytes (u16 LE) != 9 -> ``UnknownVersion``;
 3. the total length from the layout (fixed; command tag at 34; walked counts, each bounded
    first) -> ``Length`` (needed = length implied by the counts read so far), ``Malformed``
    (unknown tag, count above its maximum), ``TrailingBytes``;
 4. fields in wire order: an enum tag out of range or a bool byte other than 0/1 -> ``Malformed``;
+   a text field (a fault ``target``) with a byte other than NUL after its first NUL ->
+   ``Malformed``;
 5. CommandMsg: a non-finite torque, force or input value -> ``NonFinite`` naming the field;
-   CssMsg: a detector count above ``MAX_CSS_DETECTORS`` -> ``Malformed``.
+   FaultCommandMsg: a non-finite parameter -> ``NonFinite``; CssMsg: a detector count above ``MAX_CSS_DETECTORS`` -> ``Malformed``.
 
 Units are in the field names (SI; ``_nm`` newton-metres, ``_newton`` newtons); frames too
 (``_b`` body, ``_n`` inertial, ``_p`` IMU platform, ``_c`` star-tracker case).
@@ -748,6 +750,14 @@ def _target_str(b: bytes) -> str:
     return b.split(b"\0", 1)[0].decode("utf-8", errors="replace")
 
 
+def _check_text_padded(b: bytes, field: str) -> None:
+    """The text rule (README "Decoder rules", step 4): the text ends at its first NUL byte and
+    every byte after it is NUL."""
+    end = b.find(b"\0")
+    if end >= 0 and b[end:].count(0) != len(b) - end:
+        raise DecodeError("Malformed", detail=f"{field}: a byte other than NUL after its NUL")
+
+
 @dataclass
 class FaultEventMsg:
     """A fault's activation (``active``) or clearance (``flexdyn/<sc-id>/tlm/fault``, protocol
@@ -790,6 +800,7 @@ class FaultEventMsg:
             raise DecodeError("Malformed", detail="source tag")
         if f[3] > 1:
             raise DecodeError("Malformed", detail="active is not a bool")
+        _check_text_padded(f[8], "target")
         return FaultEventMsg(Header.unpack(buf), f[0], f[1], f[2], f[3] == 1, f[4], f[5],
                              (f[6], f[7]), f[8])
 
@@ -862,6 +873,7 @@ class FaultCommandMsg:
         f = FaultCommandMsg._BODY.unpack_from(buf, HEADER_LEN)
         if f[0] > FAULT_CLEAR:
             raise DecodeError("Malformed", detail="action tag")
+        _check_text_padded(f[9], "target")
         for i in (0, 1):
             if not math.isfinite(f[4 + i]):
                 raise DecodeError("NonFinite", field=f"params[{i}]")
