@@ -13,7 +13,8 @@ with the same reasons as the Rust crate's ``DecodeError``:
    a text field (a fault ``target``) with a byte other than NUL after its first NUL ->
    ``Malformed``;
 5. CommandMsg: a non-finite torque, force or input value -> ``NonFinite`` naming the field;
-   FaultCommandMsg: a non-finite parameter -> ``NonFinite``; CssMsg: a detector count above ``MAX_CSS_DETECTORS`` -> ``Malformed``.
+   FaultCommandMsg: a non-finite parameter -> ``NonFinite``; CssMsg: a detector count above
+   ``MAX_CSS_DETECTORS`` -> ``Malformed``.
 
 Units are in the field names (SI; ``_nm`` newton-metres, ``_newton`` newtons); frames too
 (``_b`` body, ``_n`` inertial, ``_p`` IMU platform, ``_c`` star-tracker case).
