@@ -206,6 +206,18 @@ impl Server {
         Self { child, endpoint }
     }
 
+    /// A lockstep fleet server on `scenarios/formation.toml` (chief: participant 1, deputy: 2).
+    fn start_fleet(duration_s: &str) -> Self {
+        let mut cmd = Command::new(flexdyn_bin());
+        cmd.args(["run", "--mode", "lockstep", "--fleet"])
+            .arg(root().join("scenarios/formation.toml"))
+            .args(["--listen", ports::ANY_PORT, "--duration-s", duration_s])
+            .stdout(Stdio::null());
+        let mut child = ports::reporting(&mut cmd).spawn().expect("start flexdyn");
+        let endpoint = ports::zenoh_endpoint(&mut child);
+        Self { child, endpoint }
+    }
+
     fn wait(&mut self, limit: Duration) -> Option<i32> {
         wait_for(&mut self.child, limit).code()
     }
@@ -491,39 +503,8 @@ fn no_leak_over_10000_ticks() {
 
     // 500 ticks under valgrind's memcheck: no definite leak, no memory error.
     let plain = build_c(&["-O1", "-g"], "examples/pd_lockstep.c", "pd_lockstep_vg");
-    let supp = root().join("clients/c/tests/valgrind.supp");
     let server = Server::start("100");
-    // A fresh machine may lack it: the project's script installs Debian's package (as root).
-    let installed = Command::new("sh")
-        .arg(root().join("tests/deps/debian_package.sh"))
-        .args(["valgrind", "valgrind"])
-        .status();
-    assert!(
-        installed.as_ref().is_ok_and(|s| s.success()),
-        "valgrind is needed (Debian: apt-get install valgrind): {installed:?}"
-    );
-    let mut vg = Command::new("valgrind")
-        .args([
-            "--leak-check=full",
-            "--errors-for-leak-kinds=definite",
-            "--error-exitcode=99",
-        ])
-        .arg(format!("--suppressions={}", supp.display()))
-        .arg(&plain)
-        .args([server.endpoint.as_str(), "500", "-", "30000"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("valgrind (Debian: apt install valgrind)");
-    let status = wait_for(&mut vg, Duration::from_secs(120));
-    let mut err = String::new();
-    std::io::Read::read_to_string(vg.stderr.as_mut().unwrap(), &mut err).ok();
-    assert!(status.success(), "{status:?}\n{err}");
-    assert!(
-        err.contains("definitely lost: 0 bytes in 0 blocks")
-            || err.contains("no leaks are possible"),
-        "{err}"
-    );
+    valgrind(&plain, &[server.endpoint.as_str(), "500", "-", "30000"]);
     drop(server);
 }
 
@@ -740,6 +721,75 @@ fn every_message_kind_from_c_and_cpp() {
         assert_eq!(
             stdout.trim(),
             "ticks 31 imu 31 star 31 mag 31 (stuck 26) css 31 fss 31 env 31 events 1",
+            "{exe:?}"
+        );
+        assert_eq!(server.wait(Duration::from_secs(30)), Some(0));
+    }
+    // And under valgrind's memcheck: no memory error, no definite leak.
+    let plain = build_c(&["-O1", "-g"], "tests/every_message.c", "every_message_vg");
+    let server = Server::start_scenario("acs_full.toml", "3");
+    let out = valgrind(&plain, &[server.endpoint.as_str()]);
+    assert!(
+        out.starts_with("ticks 31 imu 31 star 31 mag 31 (stuck 26)"),
+        "{out}"
+    );
+}
+
+/// Runs `exe` with `args` under valgrind's memcheck (installing it on a fresh machine) and
+/// returns its stdout; fails on a memory error or a definite leak.
+fn valgrind(exe: &Path, args: &[&str]) -> String {
+    let installed = Command::new("sh")
+        .arg(root().join("tests/deps/debian_package.sh"))
+        .args(["valgrind", "valgrind"])
+        .status();
+    assert!(
+        installed.as_ref().is_ok_and(|s| s.success()),
+        "valgrind is needed (Debian: apt-get install valgrind): {installed:?}"
+    );
+    let supp = root().join("clients/c/tests/valgrind.supp");
+    let out = Command::new("valgrind")
+        .args([
+            "--leak-check=full",
+            "--errors-for-leak-kinds=definite",
+            "--error-exitcode=99",
+        ])
+        .arg(format!("--suppressions={}", supp.display()))
+        .arg(exe)
+        .args(args)
+        .output()
+        .expect("valgrind");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{:?}\n{err}", out.status);
+    assert!(
+        err.contains("definitely lost: 0 bytes in 0 blocks")
+            || err.contains("no leaks are possible"),
+        "{err}"
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// A fleet from C (`tests/relative.c`): the chief and the deputy of `scenarios/formation.toml`
+/// on two handles in one lockstep, and the deputy's relative state through the generated
+/// `flexdyn_subscribe_relative_state` / `flexdyn_poll_relative_state` (range, range rate and
+/// the tick-0 Hill position checked in the program); plain and under AddressSanitizer.
+#[test]
+fn relative_state_of_a_fleet_from_c() {
+    let asan = ["-O1", "-g", "-fsanitize=address", "-fno-omit-frame-pointer"];
+    for exe in [
+        build_c(&["-O2"], "tests/relative.c", "relative"),
+        build_c(&asan, "tests/relative.c", "relative_asan"),
+    ] {
+        // 2 s at 100 Hz: ticks 0..=200, one relative state each.
+        let mut server = Server::start_fleet("2");
+        let stdout = run_ok(
+            Command::new(&exe)
+                .arg(&server.endpoint)
+                .env("ASAN_OPTIONS", "detect_leaks=1:exitcode=23"),
+        );
+        // |(3, -95, 2)| = sqrt(9 + 9025 + 4) = 95.068396… m.
+        assert_eq!(
+            stdout.trim(),
+            "relative states 201, range at tick 0 95.068396 m",
             "{exe:?}"
         );
         assert_eq!(server.wait(Duration::from_secs(30)), Some(0));
