@@ -123,25 +123,12 @@ int flexdyn_subscribe_state(flexdyn_client *client, size_t capacity);
 int flexdyn_poll_state(flexdyn_client *client, fd_state_msg *out);
 int flexdyn_wait_state(flexdyn_client *client, fd_state_msg *out, uint32_t timeout_ms);
 
-/* name: one IMU, or NULL for all of them (flexdyn/<sc>/tlm/imu/ + star). */
-int flexdyn_subscribe_imu(flexdyn_client *client, const char *name, size_t capacity);
-/* name_out (may be NULL) receives the sensor's name, NUL-terminated: give it at least
- * FLEXDYN_NAME_CAP bytes (FLEXDYN_ERR_ARGUMENT otherwise, checked before a sample is taken). */
+/* The IMU, star tracker, status and every other message: flexdyn_client_messages.h (below),
+ * e.g. flexdyn_subscribe_imu(client, name or NULL, capacity), flexdyn_poll_imu(client, &out,
+ * name_out, name_cap), flexdyn_wait_imu(..., timeout_ms). A sensor's name_out (may be NULL)
+ * receives its name, NUL-terminated: give it at least FLEXDYN_NAME_CAP bytes
+ * (FLEXDYN_ERR_ARGUMENT otherwise, checked before a sample is taken). */
 #define FLEXDYN_NAME_CAP 65
-int flexdyn_poll_imu(flexdyn_client *client, fd_imu_msg *out, char *name_out, size_t name_cap);
-int flexdyn_wait_imu(flexdyn_client *client, fd_imu_msg *out, char *name_out, size_t name_cap,
-                     uint32_t timeout_ms);
-
-/* name: one star tracker, or NULL for all of them. */
-int flexdyn_subscribe_star_tracker(flexdyn_client *client, const char *name, size_t capacity);
-int flexdyn_poll_star_tracker(flexdyn_client *client, fd_star_tracker_msg *out, char *name_out,
-                              size_t name_cap);
-int flexdyn_wait_star_tracker(flexdyn_client *client, fd_star_tracker_msg *out, char *name_out,
-                              size_t name_cap, uint32_t timeout_ms);
-
-int flexdyn_subscribe_status(flexdyn_client *client, size_t capacity);
-int flexdyn_poll_status(flexdyn_client *client, fd_status_msg *out);
-int flexdyn_wait_status(flexdyn_client *client, fd_status_msg *out, uint32_t timeout_ms);
 
 /* ------------------------------------------------------------------------------------------ */
 /* The time service, flexdyn/<sc>/tlm/time: one fd_time_msg per published frame, before the
@@ -193,16 +180,11 @@ int flexdyn_lockstep_join(flexdyn_client *client, uint32_t sender_id, uint32_t t
  * every tick received before is handed out: leave the loop, flexdyn_run_ended says how it ended.
  * The last tick of a run (duration_s * frame_hz) needs no answer; an answer to it is ignored. */
 int flexdyn_lockstep_wait(flexdyn_client *client, fd_state_msg *state, uint32_t timeout_ms);
-/* The sensors each tick may carry, in configuration order (0 before a join). Names stay valid
- * until the next join, leave or close. */
-size_t flexdyn_lockstep_imu_count(const flexdyn_client *client);
-const char *flexdyn_lockstep_imu_name(const flexdyn_client *client, size_t index);
-size_t flexdyn_lockstep_star_tracker_count(const flexdyn_client *client);
-const char *flexdyn_lockstep_star_tracker_name(const flexdyn_client *client, size_t index);
-/* The held tick's sample of sensor `index`: FLEXDYN_OK, or FLEXDYN_ERR_ABSENT (a star tracker not
- * due at this tick, or a sample lost). */
-int flexdyn_lockstep_imu(flexdyn_client *client, size_t index, fd_imu_msg *out);
-int flexdyn_lockstep_star_tracker(flexdyn_client *client, size_t index, fd_star_tracker_msg *out);
+/* The sensors each tick carries, in configuration order (0 before a join), and the held tick's
+ * sample of each: flexdyn_lockstep_imu_count / _name / flexdyn_lockstep_imu(client, index, &out),
+ * and the same for star_tracker, magnetometer, css, fss and gps (flexdyn_client_messages.h).
+ * Names stay valid until the next join, leave or close. A getter says FLEXDYN_ERR_ABSENT for a
+ * sensor not due at this tick (or a sample lost). */
 /* The one answer to the held tick (FLEXDYN_ERR_USAGE if there is none or it was answered). */
 int flexdyn_lockstep_answer_wrench(flexdyn_client *client, const double torque_b_nm[3],
                                    const double force_b_newton[3]);

@@ -30,14 +30,118 @@
 /* A sample taken by a typed call: decode it into *out, or say why not (the library keeps
  * the message for flexdyn_last_error). */
 
+/* ---- ImuMsg (IMU), flexdyn/<sc-id>/tlm/imu/<name> ---- */
+static inline int flexdyn__finish_imu(flexdyn_client *client, int rc, const uint8_t *bytes,
+    size_t len, fd_imu_msg *out) {
+    fd_error e;
+    if (rc != FLEXDYN_OK) return rc;
+    e = fd_decode_imu(bytes, len, out);
+    if (e.status == FD_OK) return FLEXDYN_OK;
+    /* Never FLEXDYN_OK here, so *out is used only after a decode that filled it. */
+    rc = flexdyn_decode_failed(client, FLEXDYN_KIND_IMU, (int)e.status, e.field);
+    return rc == FLEXDYN_OK ? FLEXDYN_ERR_DECODE : rc;
+}
+/* name: one <name>, or NULL for every one (flexdyn/<sc-id>/tlm/imu/<name>). */
+static inline int flexdyn_subscribe_imu(flexdyn_client *client, const char *name, size_t capacity) {
+    return flexdyn_subscribe_kind(client, FLEXDYN_KIND_IMU, name, capacity);
+}
+/* name_out (may be NULL) receives the key's last chunk, <name>: FLEXDYN_NAME_CAP bytes. */
+static inline int flexdyn_poll_imu(flexdyn_client *client, fd_imu_msg *out, char *name_out,
+    size_t name_cap) {
+    const uint8_t *bytes = NULL;
+    size_t len = 0;
+    int rc;
+    if (out == NULL) return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "out is a null pointer");
+    rc = flexdyn_poll_bytes(client, FLEXDYN_KIND_IMU, &bytes, &len, name_out, name_cap);
+    return flexdyn__finish_imu(client, rc, bytes, len, out);
+}
+static inline int flexdyn_wait_imu(flexdyn_client *client, fd_imu_msg *out, char *name_out,
+    size_t name_cap, uint32_t timeout_ms) {
+    const uint8_t *bytes = NULL;
+    size_t len = 0;
+    int rc;
+    if (out == NULL) return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "out is a null pointer");
+    rc = flexdyn_wait_bytes(client, FLEXDYN_KIND_IMU, &bytes, &len, name_out, name_cap, timeout_ms);
+    return flexdyn__finish_imu(client, rc, bytes, len, out);
+}
+/* Lockstep: the [[imus]] of the joined run, in configuration order, and the held
+ * tick's sample of entry `index` (FLEXDYN_ERR_ABSENT: not due at this tick, or lost). */
+static inline size_t flexdyn_lockstep_imu_count(const flexdyn_client *client) {
+    return flexdyn_lockstep_sensor_count(client, FLEXDYN_KIND_IMU);
+}
+static inline const char *flexdyn_lockstep_imu_name(const flexdyn_client *client, size_t index) {
+    return flexdyn_lockstep_sensor_name(client, FLEXDYN_KIND_IMU, index);
+}
+static inline int flexdyn_lockstep_imu(flexdyn_client *client, size_t index, fd_imu_msg *out) {
+    const uint8_t *bytes = NULL;
+    size_t len = 0;
+    int rc;
+    if (out == NULL) return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "out is a null pointer");
+    rc = flexdyn_lockstep_sample_bytes(client, FLEXDYN_KIND_IMU, index, &bytes, &len);
+    return flexdyn__finish_imu(client, rc, bytes, len, out);
+}
+
+/* ---- StarTrackerMsg (star tracker), flexdyn/<sc-id>/tlm/st/<name> ---- */
+static inline int flexdyn__finish_star_tracker(flexdyn_client *client, int rc, const uint8_t *bytes,
+    size_t len, fd_star_tracker_msg *out) {
+    fd_error e;
+    if (rc != FLEXDYN_OK) return rc;
+    e = fd_decode_star_tracker(bytes, len, out);
+    if (e.status == FD_OK) return FLEXDYN_OK;
+    /* Never FLEXDYN_OK here, so *out is used only after a decode that filled it. */
+    rc = flexdyn_decode_failed(client, FLEXDYN_KIND_STAR_TRACKER, (int)e.status, e.field);
+    return rc == FLEXDYN_OK ? FLEXDYN_ERR_DECODE : rc;
+}
+/* name: one <name>, or NULL for every one (flexdyn/<sc-id>/tlm/st/<name>). */
+static inline int flexdyn_subscribe_star_tracker(flexdyn_client *client, const char *name, size_t capacity) {
+    return flexdyn_subscribe_kind(client, FLEXDYN_KIND_STAR_TRACKER, name, capacity);
+}
+/* name_out (may be NULL) receives the key's last chunk, <name>: FLEXDYN_NAME_CAP bytes. */
+static inline int flexdyn_poll_star_tracker(flexdyn_client *client, fd_star_tracker_msg *out, char *name_out,
+    size_t name_cap) {
+    const uint8_t *bytes = NULL;
+    size_t len = 0;
+    int rc;
+    if (out == NULL) return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "out is a null pointer");
+    rc = flexdyn_poll_bytes(client, FLEXDYN_KIND_STAR_TRACKER, &bytes, &len, name_out, name_cap);
+    return flexdyn__finish_star_tracker(client, rc, bytes, len, out);
+}
+static inline int flexdyn_wait_star_tracker(flexdyn_client *client, fd_star_tracker_msg *out, char *name_out,
+    size_t name_cap, uint32_t timeout_ms) {
+    const uint8_t *bytes = NULL;
+    size_t len = 0;
+    int rc;
+    if (out == NULL) return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "out is a null pointer");
+    rc = flexdyn_wait_bytes(client, FLEXDYN_KIND_STAR_TRACKER, &bytes, &len, name_out, name_cap, timeout_ms);
+    return flexdyn__finish_star_tracker(client, rc, bytes, len, out);
+}
+/* Lockstep: the [[star_trackers]] of the joined run, in configuration order, and the held
+ * tick's sample of entry `index` (FLEXDYN_ERR_ABSENT: not due at this tick, or lost). */
+static inline size_t flexdyn_lockstep_star_tracker_count(const flexdyn_client *client) {
+    return flexdyn_lockstep_sensor_count(client, FLEXDYN_KIND_STAR_TRACKER);
+}
+static inline const char *flexdyn_lockstep_star_tracker_name(const flexdyn_client *client, size_t index) {
+    return flexdyn_lockstep_sensor_name(client, FLEXDYN_KIND_STAR_TRACKER, index);
+}
+static inline int flexdyn_lockstep_star_tracker(flexdyn_client *client, size_t index, fd_star_tracker_msg *out) {
+    const uint8_t *bytes = NULL;
+    size_t len = 0;
+    int rc;
+    if (out == NULL) return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "out is a null pointer");
+    rc = flexdyn_lockstep_sample_bytes(client, FLEXDYN_KIND_STAR_TRACKER, index, &bytes, &len);
+    return flexdyn__finish_star_tracker(client, rc, bytes, len, out);
+}
+
 /* ---- MagnetometerMsg (magnetometer), flexdyn/<sc-id>/tlm/mag/<name> ---- */
 static inline int flexdyn__finish_magnetometer(flexdyn_client *client, int rc, const uint8_t *bytes,
     size_t len, fd_magnetometer_msg *out) {
     fd_error e;
     if (rc != FLEXDYN_OK) return rc;
     e = fd_decode_magnetometer(bytes, len, out);
-    return e.status == FD_OK ? FLEXDYN_OK
-                             : flexdyn_decode_failed(client, FLEXDYN_KIND_MAGNETOMETER, (int)e.status, e.field);
+    if (e.status == FD_OK) return FLEXDYN_OK;
+    /* Never FLEXDYN_OK here, so *out is used only after a decode that filled it. */
+    rc = flexdyn_decode_failed(client, FLEXDYN_KIND_MAGNETOMETER, (int)e.status, e.field);
+    return rc == FLEXDYN_OK ? FLEXDYN_ERR_DECODE : rc;
 }
 /* name: one <name>, or NULL for every one (flexdyn/<sc-id>/tlm/mag/<name>). */
 static inline int flexdyn_subscribe_magnetometer(flexdyn_client *client, const char *name, size_t capacity) {
@@ -85,8 +189,10 @@ static inline int flexdyn__finish_css(flexdyn_client *client, int rc, const uint
     fd_error e;
     if (rc != FLEXDYN_OK) return rc;
     e = fd_decode_css(bytes, len, out);
-    return e.status == FD_OK ? FLEXDYN_OK
-                             : flexdyn_decode_failed(client, FLEXDYN_KIND_CSS, (int)e.status, e.field);
+    if (e.status == FD_OK) return FLEXDYN_OK;
+    /* Never FLEXDYN_OK here, so *out is used only after a decode that filled it. */
+    rc = flexdyn_decode_failed(client, FLEXDYN_KIND_CSS, (int)e.status, e.field);
+    return rc == FLEXDYN_OK ? FLEXDYN_ERR_DECODE : rc;
 }
 /* name: one <name>, or NULL for every one (flexdyn/<sc-id>/tlm/css/<name>). */
 static inline int flexdyn_subscribe_css(flexdyn_client *client, const char *name, size_t capacity) {
@@ -134,8 +240,10 @@ static inline int flexdyn__finish_fss(flexdyn_client *client, int rc, const uint
     fd_error e;
     if (rc != FLEXDYN_OK) return rc;
     e = fd_decode_fss(bytes, len, out);
-    return e.status == FD_OK ? FLEXDYN_OK
-                             : flexdyn_decode_failed(client, FLEXDYN_KIND_FSS, (int)e.status, e.field);
+    if (e.status == FD_OK) return FLEXDYN_OK;
+    /* Never FLEXDYN_OK here, so *out is used only after a decode that filled it. */
+    rc = flexdyn_decode_failed(client, FLEXDYN_KIND_FSS, (int)e.status, e.field);
+    return rc == FLEXDYN_OK ? FLEXDYN_ERR_DECODE : rc;
 }
 /* name: one <name>, or NULL for every one (flexdyn/<sc-id>/tlm/fss/<name>). */
 static inline int flexdyn_subscribe_fss(flexdyn_client *client, const char *name, size_t capacity) {
@@ -183,8 +291,10 @@ static inline int flexdyn__finish_gps(flexdyn_client *client, int rc, const uint
     fd_error e;
     if (rc != FLEXDYN_OK) return rc;
     e = fd_decode_gps(bytes, len, out);
-    return e.status == FD_OK ? FLEXDYN_OK
-                             : flexdyn_decode_failed(client, FLEXDYN_KIND_GPS, (int)e.status, e.field);
+    if (e.status == FD_OK) return FLEXDYN_OK;
+    /* Never FLEXDYN_OK here, so *out is used only after a decode that filled it. */
+    rc = flexdyn_decode_failed(client, FLEXDYN_KIND_GPS, (int)e.status, e.field);
+    return rc == FLEXDYN_OK ? FLEXDYN_ERR_DECODE : rc;
 }
 /* name: one <name>, or NULL for every one (flexdyn/<sc-id>/tlm/gps/<name>). */
 static inline int flexdyn_subscribe_gps(flexdyn_client *client, const char *name, size_t capacity) {
@@ -232,8 +342,10 @@ static inline int flexdyn__finish_environment(flexdyn_client *client, int rc, co
     fd_error e;
     if (rc != FLEXDYN_OK) return rc;
     e = fd_decode_environment(bytes, len, out);
-    return e.status == FD_OK ? FLEXDYN_OK
-                             : flexdyn_decode_failed(client, FLEXDYN_KIND_ENVIRONMENT, (int)e.status, e.field);
+    if (e.status == FD_OK) return FLEXDYN_OK;
+    /* Never FLEXDYN_OK here, so *out is used only after a decode that filled it. */
+    rc = flexdyn_decode_failed(client, FLEXDYN_KIND_ENVIRONMENT, (int)e.status, e.field);
+    return rc == FLEXDYN_OK ? FLEXDYN_ERR_DECODE : rc;
 }
 static inline int flexdyn_subscribe_environment(flexdyn_client *client, size_t capacity) {
     return flexdyn_subscribe_kind(client, FLEXDYN_KIND_ENVIRONMENT, NULL, capacity);
@@ -261,8 +373,10 @@ static inline int flexdyn__finish_fault_event(flexdyn_client *client, int rc, co
     fd_error e;
     if (rc != FLEXDYN_OK) return rc;
     e = fd_decode_fault_event(bytes, len, out);
-    return e.status == FD_OK ? FLEXDYN_OK
-                             : flexdyn_decode_failed(client, FLEXDYN_KIND_FAULT_EVENT, (int)e.status, e.field);
+    if (e.status == FD_OK) return FLEXDYN_OK;
+    /* Never FLEXDYN_OK here, so *out is used only after a decode that filled it. */
+    rc = flexdyn_decode_failed(client, FLEXDYN_KIND_FAULT_EVENT, (int)e.status, e.field);
+    return rc == FLEXDYN_OK ? FLEXDYN_ERR_DECODE : rc;
 }
 static inline int flexdyn_subscribe_fault_event(flexdyn_client *client, size_t capacity) {
     return flexdyn_subscribe_kind(client, FLEXDYN_KIND_FAULT_EVENT, NULL, capacity);
@@ -290,8 +404,10 @@ static inline int flexdyn__finish_relative_state(flexdyn_client *client, int rc,
     fd_error e;
     if (rc != FLEXDYN_OK) return rc;
     e = fd_decode_relative_state(bytes, len, out);
-    return e.status == FD_OK ? FLEXDYN_OK
-                             : flexdyn_decode_failed(client, FLEXDYN_KIND_RELATIVE_STATE, (int)e.status, e.field);
+    if (e.status == FD_OK) return FLEXDYN_OK;
+    /* Never FLEXDYN_OK here, so *out is used only after a decode that filled it. */
+    rc = flexdyn_decode_failed(client, FLEXDYN_KIND_RELATIVE_STATE, (int)e.status, e.field);
+    return rc == FLEXDYN_OK ? FLEXDYN_ERR_DECODE : rc;
 }
 /* name: one <chief-id>, or NULL for every one (flexdyn/<deputy-id>/tlm/rel/<chief-id>). */
 static inline int flexdyn_subscribe_relative_state(flexdyn_client *client, const char *name, size_t capacity) {
@@ -315,6 +431,37 @@ static inline int flexdyn_wait_relative_state(flexdyn_client *client, fd_relativ
     if (out == NULL) return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "out is a null pointer");
     rc = flexdyn_wait_bytes(client, FLEXDYN_KIND_RELATIVE_STATE, &bytes, &len, name_out, name_cap, timeout_ms);
     return flexdyn__finish_relative_state(client, rc, bytes, len, out);
+}
+
+/* ---- StatusMsg (status), flexdyn/<sc-id>/status ---- */
+static inline int flexdyn__finish_status(flexdyn_client *client, int rc, const uint8_t *bytes,
+    size_t len, fd_status_msg *out) {
+    fd_error e;
+    if (rc != FLEXDYN_OK) return rc;
+    e = fd_decode_status(bytes, len, out);
+    if (e.status == FD_OK) return FLEXDYN_OK;
+    /* Never FLEXDYN_OK here, so *out is used only after a decode that filled it. */
+    rc = flexdyn_decode_failed(client, FLEXDYN_KIND_STATUS, (int)e.status, e.field);
+    return rc == FLEXDYN_OK ? FLEXDYN_ERR_DECODE : rc;
+}
+static inline int flexdyn_subscribe_status(flexdyn_client *client, size_t capacity) {
+    return flexdyn_subscribe_kind(client, FLEXDYN_KIND_STATUS, NULL, capacity);
+}
+static inline int flexdyn_poll_status(flexdyn_client *client, fd_status_msg *out) {
+    const uint8_t *bytes = NULL;
+    size_t len = 0;
+    int rc;
+    if (out == NULL) return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "out is a null pointer");
+    rc = flexdyn_poll_bytes(client, FLEXDYN_KIND_STATUS, &bytes, &len, NULL, 0);
+    return flexdyn__finish_status(client, rc, bytes, len, out);
+}
+static inline int flexdyn_wait_status(flexdyn_client *client, fd_status_msg *out, uint32_t timeout_ms) {
+    const uint8_t *bytes = NULL;
+    size_t len = 0;
+    int rc;
+    if (out == NULL) return flexdyn_fail(client, FLEXDYN_ERR_ARGUMENT, "out is a null pointer");
+    rc = flexdyn_wait_bytes(client, FLEXDYN_KIND_STATUS, &bytes, &len, NULL, 0, timeout_ms);
+    return flexdyn__finish_status(client, rc, bytes, len, out);
 }
 
 /* CommandMsg: variable length; sent with the library's own calls (flexdyn_send_*,
