@@ -103,6 +103,9 @@ pub mod attitude;
 pub mod client;
 pub mod codec;
 mod error;
+// Written by flexdyn-wiregen from proto/schema/messages.toml.
+#[rustfmt::skip]
+mod json_schemas;
 pub mod keys;
 mod layout;
 mod messages;
@@ -114,6 +117,8 @@ pub use codec::{
     decode_time, encode, encode_into,
 };
 pub use error::{DecodeError, KeyError};
+// The JSON Schemas of the messages' JSON (MCAP decoded channels, Foxglove), from the wire table.
+pub use json_schemas::json_schema_text;
 // The GPS receiver (issue 20, protocol 7).
 pub use codec::decode_gps;
 pub use keys::GPS_PREFIX;

@@ -21,7 +21,6 @@ use crate::PROTOCOL_VERSION;
 ///
 /// All fields are deterministic (no wall clock).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct Header {
     /// Wire protocol version, always [`PROTOCOL_VERSION`] when sent. Decoders check
     /// it (first two bytes, u16 LE) before anything else.
@@ -111,7 +110,6 @@ pub mod wheel_flags {
 /// u32 LE `flags`, u64 LE count + f64 `states`, u64 LE count + f64 `outputs`:
 /// 22 + 8·(states + outputs) bytes.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct EffectorState {
     /// Model tag, see [`effector_kind`]. Receivers skip kinds they do not know.
     pub kind: u16,
@@ -128,7 +126,6 @@ pub struct EffectorState {
 /// Inputs for one effector in a [`CommandKind::Actuators`] command. On the wire: u32 LE
 /// `effector_index`, u64 LE count, f64 `values`: 12 + 8·values bytes.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct EffectorInput {
     /// Index of the effector in [`StateMsg::effectors`].
     pub effector_index: u32,
@@ -140,7 +137,6 @@ pub struct EffectorInput {
 /// Conserved quantities (for verification: constant when no external wrench
 /// acts and the panels have no damping). 64 bytes on the wire.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct Conserved {
     /// Total orbital energy (J).
     pub orb_energy_j: f64,
@@ -156,7 +152,6 @@ pub struct Conserved {
 /// External wrench held constant over a frame, body components about point B.
 /// 48 bytes on the wire (torque first, like [`CommandKind::Wrench`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct AppliedWrench {
     /// Torque about B, B components (N·m).
     pub torque_b_nm: [f64; 3],
@@ -208,7 +203,6 @@ pub mod saturation_flags {
 /// clock). 327 bytes + each [`EffectorState`]; `effectors` is last on the wire so
 /// every other field sits at a fixed offset.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct StateMsg {
     /// Common header; `tick` is the frame this state belongs to.
     pub header: Header,
@@ -268,7 +262,6 @@ impl Default for StateMsg {
 ///
 /// All vectors are in the IMU platform frame P.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct ImuMsg {
     /// Common header; `tick` is the frame at whose end the sample was taken.
     pub header: Header,
@@ -286,7 +279,6 @@ pub struct ImuMsg {
 
 /// A star-tracker measurement, topic `flexdyn/<sc-id>/tlm/st/<name>`. 64 bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct StarTrackerMsg {
     /// Common header; `tick` is the frame at whose end the measurement was taken.
     pub header: Header,
@@ -326,7 +318,6 @@ pub mod magnetometer_flags {
 
 /// A three-axis magnetometer sample, topic `flexdyn/<sc-id>/tlm/mag/<name>`. 55 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct MagnetometerMsg {
     /// Common header; `tick` is the frame at whose end the sample was taken.
     pub header: Header,
@@ -343,7 +334,6 @@ pub const MAX_CSS_DETECTORS: usize = 16;
 /// A coarse-sun-sensor array sample, topic `flexdyn/<sc-id>/tlm/css/<name>`: one reading per
 /// cosine detector. 159 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct CssMsg {
     /// Common header; `tick` is the frame at whose end the sample was taken.
     pub header: Header,
@@ -370,7 +360,6 @@ pub mod fss_flags {
 
 /// A fine (two-axis) sun sensor sample, topic `flexdyn/<sc-id>/tlm/fss/<name>`. 47 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct FssMsg {
     /// Common header; `tick` is the frame at whose end the sample was taken.
     pub header: Header,
@@ -400,7 +389,6 @@ pub mod gps_flags {
 /// The message published at `header.sim_time_ns` carries the measurement valid at
 /// `valid_sim_time_ns` (earlier by the receiver's latency).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct GpsMsg {
     /// Common header; `tick` is the frame at whose end the message is published.
     pub header: Header,
@@ -425,7 +413,6 @@ pub struct GpsMsg {
 /// What a [`CommandMsg`] asks for. Wire: u32 LE variant index (0 = `Wrench`,
 /// 1 = `NoCommand`, 2 = `Actuators`), then the variant's fields.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum CommandKind {
     /// Tag 0: hold this wrench, body components about B, over the frame
     /// starting at `header.tick`. 48 bytes follow the tag.
@@ -468,7 +455,6 @@ impl Default for CommandKind {
 /// Decoding rejects NaN/infinite torque, force or input values with
 /// [`crate::DecodeError::NonFinite`].
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct CommandMsg {
     /// Common header: `tick` is the tick the command applies to (in lockstep the
     /// tick of the state it answers), `seq` the sender's own sequence number.
@@ -529,7 +515,6 @@ impl CommandMsg {
 
 /// How the server paces frames. Wire: u32 LE tag.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum Mode {
     /// Tag 0: frames paced by the wall clock.
     #[default]
@@ -542,7 +527,6 @@ pub enum Mode {
 
 /// Server life cycle. Wire: u32 LE tag.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum RunState {
     /// Tag 0: initialising, not stepping yet.
     #[default]
@@ -600,7 +584,6 @@ impl RunState {
 
 /// What the server applies when the latest command is stale. Wire: u32 LE tag.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum StalePolicy {
     /// Tag 0: keep applying the last commanded wrench.
     #[default]
@@ -618,7 +601,6 @@ impl StalePolicy {
 
 /// Frame-timing statistics since the run started. 40 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct FrameTiming {
     /// Median frame-start lateness versus the wall-clock schedule (ns; early
     /// starts count as 0).
@@ -639,7 +621,6 @@ pub const NO_COMMAND: u64 = u64::MAX;
 
 /// Command bookkeeping. 21 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct CommandStatus {
     /// `header.tick` of the last accepted command, [`NO_COMMAND`] if none yet.
     pub last_command_tick: u64,
@@ -655,7 +636,6 @@ pub struct CommandStatus {
 
 /// Rejected-command counters by reason, cumulative since start. 64 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct RejectCounters {
     /// Undecodable: wrong length, trailing bytes, oversize, bad enum tag or bool.
     pub malformed: u64,
@@ -728,7 +708,6 @@ impl RejectCounters {
 
 /// Server health, topic `flexdyn/<sc-id>/status`. 235 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct StatusMsg {
     /// Common header; `tick` is the last frame stepped, `seq` counts status messages.
     pub header: Header,
@@ -783,7 +762,6 @@ pub const CUC_PFIELD_TAI_4_3: u8 = 0x1F;
 
 /// A UTC calendar reading. 11 bytes on the wire. All zero when the run has no `[epoch]`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct UtcTime {
     /// Year (e.g. 2016).
     pub year: u16,
@@ -805,7 +783,6 @@ pub struct UtcTime {
 /// 2⁻³² s (`subseconds = floor(ns · 2³² / 10⁹)`). 8 bytes on the wire (little-endian here; a
 /// cFS adapter copies the two u32 into its own struct).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct SysTime {
     /// Whole seconds.
     pub seconds: u32,
@@ -819,7 +796,6 @@ pub struct SysTime {
 /// Deterministic (no wall clock). Flight code that runs off it (a cFS tone adapter, an
 /// F Prime rate-group driver) follows the simulation: its speed, its pauses and its steps.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct TimeMsg {
     /// Common header: `tick`, `sim_time_ns` (ns since the epoch, t = 0), and `seq` (= tick: one
     /// time message per published frame, so a pause leaves no gap).
@@ -865,7 +841,6 @@ pub struct TimeMsg {
 
 /// What an [`OperatorMsg`] asks for. Wire: u32 LE tag. Added in protocol version 6.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum OperatorAction {
     /// Tag 0: hold at the next tick. Real time: the next frame boundary; lockstep: the tick
     /// after the one published (as `RunTicks` with 1).
@@ -891,7 +866,6 @@ impl OperatorAction {
 /// On a lab network the shipped access-control list lets only the operator's subject put on
 /// this key (`scenarios/zenoh/secure-server.json5`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct OperatorMsg {
     /// Common header: `spacecraft_id` must be the server's; `tick` the newest tick the operator
     /// has seen (informational), `seq` the operator's own counter.
@@ -962,7 +936,6 @@ pub mod eclipse {
 /// environment sample the dynamic effectors read at that instant, and each source's force and
 /// torque evaluated by that dynamic effector itself at the tick's state.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct EnvironmentMsg {
     /// Common header; `tick` is the frame the values refer to.
     pub header: Header,
@@ -1162,19 +1135,8 @@ impl<'de> Deserialize<'de> for FaultTarget {
     }
 }
 
-#[cfg(feature = "json-schema")]
-impl schemars::JsonSchema for FaultTarget {
-    fn schema_name() -> std::borrow::Cow<'static, str> {
-        "FaultTarget".into()
-    }
-    fn json_schema(g: &mut schemars::SchemaGenerator) -> schemars::Schema {
-        <String>::json_schema(g)
-    }
-}
-
 /// Where a fault came from. Wire: u32 LE tag. Protocol version 8.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum FaultSource {
     /// Tag 0: a `[[faults]]` entry of the configuration (a schedule).
     #[default]
@@ -1199,7 +1161,6 @@ impl FaultSource {
 /// boundary (the first tick whose sensor samples and actuation carry the change), `header.seq`
 /// counts fault events from 0.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct FaultEventMsg {
     /// Common header.
     pub header: Header,
@@ -1225,7 +1186,6 @@ pub struct FaultEventMsg {
 
 /// What a [`FaultCommandMsg`] asks for. Wire: u32 LE tag. Protocol version 8.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub enum FaultAction {
     /// Tag 0: inject the fault the message describes.
     #[default]
@@ -1247,7 +1207,6 @@ impl FaultAction {
 /// On a lab network the shipped access-control list lets only the operator's subject put on
 /// this key (`scenarios/zenoh/secure-server.json5`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct FaultCommandMsg {
     /// Common header: `spacecraft_id` must be the server's; `tick` the newest tick the sender
     /// has seen (informational); `seq` the sender's counter.
@@ -1283,7 +1242,6 @@ pub struct FaultCommandMsg {
 /// momentum r × v, ŷ = ẑ × x̂ (along-track); it turns at (|r × v| / |r|²) ẑ.
 /// `header.spacecraft_id` is the deputy's; `header.seq` counts the messages from 0.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "json-schema", derive(schemars::JsonSchema))]
 pub struct RelativeStateMsg {
     /// Common header: the deputy's `spacecraft_id`; `tick` and `sim_time_ns` of the two
     /// vehicles' states.

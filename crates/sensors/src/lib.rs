@@ -269,6 +269,14 @@ impl SensorKind {
     }
 }
 
+/// The JSON Schema of message `M`'s JSON, from the wire table
+/// ([`flexdyn_proto::json_schema_text`]), for [`SensorKind::json_schema`].
+pub fn message_json_schema<M: flexdyn_proto::WireMessage>() -> serde_json::Value {
+    flexdyn_proto::json_schema_text(M::NAME)
+        .and_then(|text| serde_json::from_str(text).ok())
+        .unwrap_or(serde_json::Value::Null)
+}
+
 /// The message `msg` as `(header, JSON)`, for [`SensorKind::decode`].
 pub fn json_of<M: serde::Serialize>(header: Header, msg: &M) -> (Header, serde_json::Value) {
     (

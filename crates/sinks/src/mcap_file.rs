@@ -7,7 +7,7 @@
 //!   is the message's wire layout from `proto/README.md` and the protocol version. The payload is
 //!   the exact wire bytes, so a recording can be hashed and replayed bit for bit.
 //! - **Decoded**: topic = `/` + key ([`decoded_topic`]), `message_encoding` `json`, schema
-//!   `flexdyn.<Message>` (`jsonschema`, derived from the wire structs): readable by any MCAP tool.
+//!   `flexdyn.<Message>` (`jsonschema`, from the wire table): readable by any MCAP tool.
 //! - **3D**: `/flexdyn/<sc>/tf` (`foxglove.FrameTransforms`) for every state and
 //!   `/flexdyn/<sc>/scene` (`foxglove.SceneUpdate`) once per vehicle, when the vehicle's
 //!   configuration is known ([`VehicleInfo`]); `/flexdyn/<sc>/actuators` (thruster and rod

@@ -272,25 +272,24 @@ impl Decoded {
     }
 }
 
-/// The JSON Schema (draft 2020-12) of the decoded JSON of `kind`, derived from the wire structs.
+/// The JSON Schema (draft 2020-12) of the decoded JSON of `kind`, from the wire table
+/// (`proto/schema/json/`, written by flexdyn-wiregen).
 pub fn json_schema(kind: TopicKind) -> serde_json::Value {
-    let schema = match kind {
-        TopicKind::State => schemars::schema_for!(StateMsg),
-        TopicKind::Sensor(_) => {
-            return kind
-                .sensor_kind()
-                .map_or(serde_json::Value::Null, |k| (k.json_schema)())
-        }
-        TopicKind::Command => schemars::schema_for!(CommandMsg),
-        TopicKind::Status => schemars::schema_for!(StatusMsg),
-        TopicKind::Time => schemars::schema_for!(TimeMsg),
-        TopicKind::Operator => schemars::schema_for!(OperatorMsg),
-        TopicKind::Environment => schemars::schema_for!(EnvironmentMsg),
-        TopicKind::FaultEvent => schemars::schema_for!(FaultEventMsg),
-        TopicKind::FaultCommand => schemars::schema_for!(FaultCommandMsg),
-        TopicKind::RelativeState => schemars::schema_for!(RelativeStateMsg),
-    };
-    schema.to_value()
+    use flexdyn_sensors::message_json_schema as of;
+    match kind {
+        TopicKind::State => of::<StateMsg>(),
+        TopicKind::Sensor(_) => kind
+            .sensor_kind()
+            .map_or(serde_json::Value::Null, |k| (k.json_schema)()),
+        TopicKind::Command => of::<CommandMsg>(),
+        TopicKind::Status => of::<StatusMsg>(),
+        TopicKind::Time => of::<TimeMsg>(),
+        TopicKind::Operator => of::<OperatorMsg>(),
+        TopicKind::Environment => of::<EnvironmentMsg>(),
+        TopicKind::FaultEvent => of::<FaultEventMsg>(),
+        TopicKind::FaultCommand => of::<FaultCommandMsg>(),
+        TopicKind::RelativeState => of::<RelativeStateMsg>(),
+    }
 }
 
 /// The section of `proto/README.md` that specifies the wire layout of `kind`, after the

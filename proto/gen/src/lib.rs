@@ -10,8 +10,10 @@
 //! | the byte tables of `proto/README.md` (between markers) | [`readme`] |
 //! | the C client library's typed calls, `clients/c/include/flexdyn_client_messages.h` | [`c_client`] |
 //! | the C client library's message kinds, `clients/c/src/kinds.rs` | [`c_client`] |
+//! | the JSON Schemas of the messages' JSON (MCAP decoded channels, Foxglove), `proto/schema/json/*.json` and `proto/src/json_schemas.rs` | [`json_schema`] |
 
 pub mod c_client;
+pub mod json_schema;
 pub mod readme;
 pub mod table;
 
@@ -25,6 +27,10 @@ pub const README_PATH: &str = "proto/README.md";
 pub const C_HEADER_PATH: &str = "clients/c/include/flexdyn_client_messages.h";
 /// The C client library's generated kind table.
 pub const KINDS_PATH: &str = "clients/c/src/kinds.rs";
+/// The wire crate's generated index of the JSON Schemas.
+pub const JSON_SCHEMAS_RS_PATH: &str = "proto/src/json_schemas.rs";
+/// The directory of the generated JSON Schemas, one `<Message>.json` each.
+pub const JSON_SCHEMA_DIR: &str = "proto/schema/json";
 
 /// A generated file: its path under the repository root and its whole text.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -48,7 +54,7 @@ pub fn mirrors(root: &Path) -> Result<Vec<Mirror>, String> {
     let readme_path = root.join(README_PATH);
     let readme = std::fs::read_to_string(&readme_path)
         .map_err(|e| format!("{}: {e}", readme_path.display()))?;
-    Ok(vec![
+    Ok([
         Mirror {
             path: README_PATH.into(),
             text: readme::splice(&table, README_PATH, &readme)?,
@@ -61,7 +67,17 @@ pub fn mirrors(root: &Path) -> Result<Vec<Mirror>, String> {
             path: KINDS_PATH.into(),
             text: c_client::kinds_rs(&table),
         },
-    ])
+        Mirror {
+            path: JSON_SCHEMAS_RS_PATH.into(),
+            text: json_schema::rust_module(&table),
+        },
+    ]
+    .into_iter()
+    .chain(table.messages.iter().map(|m| Mirror {
+        path: Path::new(JSON_SCHEMA_DIR).join(format!("{}.json", m.name)),
+        text: json_schema::schema(&table, &m.name).unwrap_or_default(),
+    }))
+    .collect())
 }
 
 /// The mirrors under `root` whose file differs from the table's text.

@@ -20,6 +20,10 @@ fn main() -> ExitCode {
                 let path = root.join(&m.path);
                 let old = std::fs::read_to_string(&path).ok();
                 if old.as_deref() != Some(m.text.as_str()) {
+                    if let Some(dir) = path.parent() {
+                        std::fs::create_dir_all(dir)
+                            .map_err(|e| format!("{}: {e}", dir.display()))?;
+                    }
                     std::fs::write(&path, &m.text)
                         .map_err(|e| format!("{}: {e}", path.display()))?;
                     println!("wrote {}", m.path.display());

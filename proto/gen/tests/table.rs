@@ -355,3 +355,200 @@ fn generated_offsets_are_the_layout_constants() {
         flexdyn_proto::COMMAND_KIND_OFFSET
     )));
 }
+
+/// A JSON Schema validator for the keywords the generated schemas use (type, properties,
+/// required, additionalProperties, items, minItems, maxItems, minimum, maximum, maxLength, enum,
+/// const, oneOf): the error names the path of the first value that breaks its schema. Any
+/// other keyword fails the check, so a schema cannot use one this validator ignores.
+fn validate(schema: &Value, value: &Value, path: &str) -> Result<(), String> {
+    let obj = schema
+        .as_object()
+        .ok_or_else(|| format!("{path}: the schema is not an object"))?;
+    for (key, rule) in obj {
+        let bad = |what: &str| Err(format!("{path}: {what} ({key} = {rule})"));
+        match key.as_str() {
+            "$schema" | "title" | "description" => {}
+            "type" => {
+                let ok = match rule.as_str().unwrap_or_default() {
+                    "object" => value.is_object(),
+                    "array" => value.is_array(),
+                    "string" => value.is_string(),
+                    "boolean" => value.is_boolean(),
+                    "number" => value.is_number(),
+                    "integer" => value.is_u64() || value.is_i64(),
+                    _ => false,
+                };
+                if !ok {
+                    return bad(&format!("{value} is not of the type"));
+                }
+            }
+            "properties" => {
+                for (name, sub) in rule.as_object().unwrap() {
+                    if let Some(v) = value.get(name) {
+                        validate(sub, v, &format!("{path}.{name}"))?;
+                    }
+                }
+            }
+            "required" => {
+                for name in rule.as_array().unwrap() {
+                    if value.get(name.as_str().unwrap()).is_none() {
+                        return bad(&format!("{name} is missing"));
+                    }
+                }
+            }
+            "additionalProperties" => {
+                let known = obj["properties"].as_object().unwrap();
+                if let Some(extra) = value
+                    .as_object()
+                    .and_then(|o| o.keys().find(|k| !known.contains_key(*k)))
+                {
+                    return bad(&format!("{extra:?} is not a property"));
+                }
+            }
+            "items" => {
+                for (i, v) in value.as_array().into_iter().flatten().enumerate() {
+                    validate(rule, v, &format!("{path}[{i}]"))?;
+                }
+            }
+            "minItems" | "maxItems" => {
+                let n = value.as_array().map_or(0, Vec::len) as u64;
+                let limit = rule.as_u64().unwrap();
+                if (key == "minItems" && n < limit) || (key == "maxItems" && n > limit) {
+                    return bad(&format!("{n} items"));
+                }
+            }
+            "maxLength" => {
+                let n = value.as_str().map_or(0, |s| s.chars().count()) as u64;
+                if n > rule.as_u64().unwrap() {
+                    return bad(&format!("{n} characters"));
+                }
+            }
+            "minimum" | "maximum" => {
+                let within = match (value.as_i64(), value.as_u64(), rule.as_i64(), rule.as_u64()) {
+                    (_, Some(v), _, Some(r)) => {
+                        (key == "minimum" && v >= r) || (key == "maximum" && v <= r)
+                    }
+                    (Some(v), _, Some(r), _) => {
+                        (key == "minimum" && v >= r) || (key == "maximum" && v <= r)
+                    }
+                    (Some(v), _, None, Some(_)) => key == "maximum" || v >= 0,
+                    (None, Some(_), Some(r), None) => key == "minimum" || r >= 0,
+                    _ => false,
+                };
+                if !within {
+                    return bad(&format!("{value} is out of range"));
+                }
+            }
+            "enum" => {
+                if !rule.as_array().unwrap().contains(value) {
+                    return bad(&format!("{value} is not one of them"));
+                }
+            }
+            "const" => {
+                if rule != value {
+                    return bad(&format!("{value} is not it"));
+                }
+            }
+            "oneOf" => {
+                let fits = rule
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .filter(|s| validate(s, value, path).is_ok())
+                    .count();
+                if fits != 1 {
+                    return bad(&format!("{value} fits {fits} of the variants"));
+                }
+            }
+            other => return Err(format!("{path}: the validator does not know {other:?}")),
+        }
+    }
+    Ok(())
+}
+
+/// The generated JSON Schemas accept the JSON of every golden message, as the recorder and
+/// the viewer write it (serde's JSON of the Rust types), and refuse a JSON that is not one.
+#[test]
+fn the_json_schemas_accept_every_golden_and_refuse_broken_json() {
+    let t = table();
+    let goldens = [
+        ("state", "StateMsg"),
+        ("imu", "ImuMsg"),
+        ("star_tracker", "StarTrackerMsg"),
+        ("magnetometer", "MagnetometerMsg"),
+        ("css", "CssMsg"),
+        ("fss", "FssMsg"),
+        ("gps", "GpsMsg"),
+        ("command_wrench", "CommandMsg"),
+        ("command_no_command", "CommandMsg"),
+        ("command_actuators", "CommandMsg"),
+        ("time", "TimeMsg"),
+        ("environment", "EnvironmentMsg"),
+        ("operator", "OperatorMsg"),
+        ("fault_event", "FaultEventMsg"),
+        ("fault_command", "FaultCommandMsg"),
+        ("relative_state", "RelativeStateMsg"),
+        ("status", "StatusMsg"),
+    ];
+    for (golden, name) in goldens {
+        // The file the wire crate embeds is the generated schema.
+        let text = flexdyn_proto::json_schema_text(name).expect(name);
+        let schema: Value = serde_json::from_str(text).unwrap();
+        assert_eq!(
+            Some(&schema),
+            flexdyn_wiregen::json_schema::schema_value(&t, name).as_ref()
+        );
+        let bytes = std::fs::read(root().join(format!("proto/golden/{golden}.bin"))).unwrap();
+        let json = rust_json(name, &bytes);
+        validate(&schema, &json, name).unwrap_or_else(|e| panic!("golden {golden}: {e}"));
+    }
+    // Broken JSON is refused, with the path named.
+    let schema: Value =
+        serde_json::from_str(flexdyn_proto::json_schema_text("CommandMsg").unwrap()).unwrap();
+    let bytes = std::fs::read(root().join("proto/golden/command_actuators.bin")).unwrap();
+    let good = rust_json("CommandMsg", &bytes);
+    let broken = |edit: &dyn Fn(&mut Value)| -> String {
+        let mut v = good.clone();
+        edit(&mut v);
+        validate(&schema, &v, "CommandMsg").unwrap_err()
+    };
+    assert!(broken(&|v| v["extra"] = json!(1)).contains("\"extra\" is not a property"));
+    assert!(broken(&|v| {
+        v["header"].as_object_mut().unwrap().remove("tick");
+    })
+    .contains("CommandMsg.header: \"tick\" is missing"));
+    // Two torque components: no variant of the union fits.
+    assert!(
+        broken(&|v| v["kind"]["Actuators"]["torque_b_nm"] = json!([0.0, 1.0]))
+            .contains("CommandMsg.kind: {\"Actuators\"")
+    );
+    assert!(broken(&|v| v["kind"] = json!("Nothing")).contains("fits 0 of the variants"));
+    assert!(broken(&|v| v["sender_id"] = json!(-1)).contains("out of range"));
+    assert!(broken(&|v| v["sender_id"] = json!(1.5)).contains("is not of the type"));
+}
+
+/// The serde JSON of the golden `bytes` of message `name`, decoded by the Rust codec.
+fn rust_json(name: &str, bytes: &[u8]) -> Value {
+    use flexdyn_proto::*;
+    fn j<T: WireMessage>(b: &[u8]) -> Value {
+        serde_json::to_value(decode::<T>(b).unwrap()).unwrap()
+    }
+    match name {
+        "StateMsg" => j::<StateMsg>(bytes),
+        "ImuMsg" => j::<ImuMsg>(bytes),
+        "StarTrackerMsg" => j::<StarTrackerMsg>(bytes),
+        "MagnetometerMsg" => j::<MagnetometerMsg>(bytes),
+        "CssMsg" => j::<CssMsg>(bytes),
+        "FssMsg" => j::<FssMsg>(bytes),
+        "GpsMsg" => j::<GpsMsg>(bytes),
+        "CommandMsg" => j::<CommandMsg>(bytes),
+        "TimeMsg" => j::<TimeMsg>(bytes),
+        "EnvironmentMsg" => j::<EnvironmentMsg>(bytes),
+        "OperatorMsg" => j::<OperatorMsg>(bytes),
+        "FaultEventMsg" => j::<FaultEventMsg>(bytes),
+        "FaultCommandMsg" => j::<FaultCommandMsg>(bytes),
+        "RelativeStateMsg" => j::<RelativeStateMsg>(bytes),
+        "StatusMsg" => j::<StatusMsg>(bytes),
+        other => panic!("{other}"),
+    }
+}

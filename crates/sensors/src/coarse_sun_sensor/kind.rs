@@ -27,7 +27,7 @@ pub static KIND: SensorKind = SensorKind {
     build,
     decode: |b| decode_css(b).map(|m| json_of(m.header, &m)),
     default_json: || json_of(Default::default(), &CssMsg::default()).1,
-    json_schema: || schemars::schema_for!(CssMsg).to_value(),
+    json_schema: crate::message_json_schema::<CssMsg>,
     plot: (
         "sun_sensors_coarse.png",
         "Coarse sun sensors: each detector's reading (0 outside its field of view and in umbra)",

@@ -27,7 +27,7 @@ pub static KIND: SensorKind = SensorKind {
     build,
     decode: |b| decode_fss(b).map(|m| json_of(m.header, &m)),
     default_json: || json_of(Default::default(), &FssMsg::default()).1,
-    json_schema: || schemars::schema_for!(FssMsg).to_value(),
+    json_schema: crate::message_json_schema::<FssMsg>,
     plot: (
         "sun_sensors_fine.png",
         "Fine sun sensors: Sun angles in the sensor frame F (0 when not valid) and flags",

@@ -31,7 +31,7 @@ pub static KIND: SensorKind = SensorKind {
     build,
     decode: |b| decode_gps(b).map(|m| json_of(m.header, &m)),
     default_json: || json_of(Default::default(), &GpsMsg::default()).1,
-    json_schema: || schemars::schema_for!(GpsMsg).to_value(),
+    json_schema: crate::message_json_schema::<GpsMsg>,
     plot: (
         "gps.png",
         "GPS receivers: measured ECEF position and velocity, and the fix flag",

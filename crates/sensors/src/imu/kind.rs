@@ -43,7 +43,7 @@ pub static KIND: SensorKind = SensorKind {
     build,
     decode: |b| decode_imu(b).map(|m| json_of(m.header, &m)),
     default_json: || json_of(Default::default(), &ImuMsg::default()).1,
-    json_schema: || schemars::schema_for!(ImuMsg).to_value(),
+    json_schema: crate::message_json_schema::<ImuMsg>,
     plot: (
         "imu.png",
         "IMU measurements (sensor frame P)",

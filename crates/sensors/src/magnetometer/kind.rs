@@ -33,7 +33,7 @@ pub static KIND: SensorKind = SensorKind {
     build,
     decode: |b| decode_magnetometer(b).map(|m| json_of(m.header, &m)),
     default_json: || json_of(Default::default(), &MagnetometerMsg::default()).1,
-    json_schema: || schemars::schema_for!(MagnetometerMsg).to_value(),
+    json_schema: crate::message_json_schema::<MagnetometerMsg>,
     plot: (
         "magnetometer.png",
         "Magnetometers: measured field (sensor frame S) and saturated axes",

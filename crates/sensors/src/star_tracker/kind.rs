@@ -32,7 +32,7 @@ pub static KIND: SensorKind = SensorKind {
     build,
     decode: |b| decode_star_tracker(b).map(|m| json_of(m.header, &m)),
     default_json: || json_of(Default::default(), &StarTrackerMsg::default()).1,
-    json_schema: || schemars::schema_for!(StarTrackerMsg).to_value(),
+    json_schema: crate::message_json_schema::<StarTrackerMsg>,
     plot: (
         "star_tracker.png",
         "Star trackers: measured attitude q_CN (scalar first) and validity",
