@@ -21,6 +21,9 @@ fn description(f: &Field) -> String {
     if let Some(fr) = &f.frame {
         extra.push(format!("frame {fr}"));
     }
+    if f.finite {
+        extra.push("finite".to_owned());
+    }
     match (f.doc.is_empty(), extra.is_empty()) {
         (_, true) => f.doc.clone(),
         (true, false) => extra.join(", "),

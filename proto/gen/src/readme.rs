@@ -123,6 +123,9 @@ impl<'t> Walk<'t> {
         if f.text {
             add("UTF-8 text padded with NUL bytes (\"Decoder rules\")".to_owned());
         }
+        if f.finite {
+            add("finite: NaN or ±inf is NonFinite".to_owned());
+        }
         if let (Ty::Prim(Prim::U8), Some(max)) = (ty, f.max) {
             add(format!("0 ≤ value ≤ {max}, more is Malformed"));
         }

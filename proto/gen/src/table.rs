@@ -178,6 +178,9 @@ pub struct Field {
     /// The bound of a `vec` count or of a `u8` count.
     #[serde(default)]
     pub max: Option<u64>,
+    /// Decoders refuse a NaN or infinite value here (NonFinite): an f64, f64[n] or vec<f64>.
+    #[serde(default)]
+    pub finite: bool,
 }
 
 /// A primitive wire type.
@@ -438,6 +441,18 @@ impl Table {
                         format!("`flags` names no [[flags]] table {flags:?}"),
                     ));
                 }
+            }
+            let floats = match &ty {
+                Ty::Prim(Prim::F64) | Ty::Array(Prim::F64, _) => true,
+                Ty::Vec(inner) => **inner == Ty::Prim(Prim::F64),
+                _ => false,
+            };
+            if f.finite && !floats {
+                return Err(Self::err(
+                    file,
+                    place,
+                    "`finite` is for an f64, f64[n] or vec<f64>",
+                ));
             }
             if f.text && !matches!(ty, Ty::Array(Prim::U8, _)) {
                 return Err(Self::err(file, place, "`text` is for a u8[n]"));

@@ -552,3 +552,154 @@ fn rust_json(name: &str, bytes: &[u8]) -> Value {
         other => panic!("{other}"),
     }
 }
+
+/// Every f64 of a message's bytes as the table lays them out: (path, offset, `finite`).
+fn floats(
+    table: &Table,
+    fields: &[flexdyn_wiregen::table::Field],
+    bytes: &[u8],
+    pos: &mut usize,
+    prefix: &str,
+    out: &mut Vec<(String, usize, bool)>,
+) {
+    for f in fields {
+        let ty = table.resolve(&f.ty).expect("checked");
+        float_of(
+            table,
+            &ty,
+            f.finite,
+            bytes,
+            pos,
+            &format!("{prefix}{}", f.name),
+            out,
+        );
+    }
+}
+
+fn float_of(
+    table: &Table,
+    ty: &Ty,
+    finite: bool,
+    bytes: &[u8],
+    pos: &mut usize,
+    path: &str,
+    out: &mut Vec<(String, usize, bool)>,
+) {
+    let count = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+    match ty {
+        Ty::Prim(Prim::F64) => {
+            out.push((path.to_owned(), *pos, finite));
+            *pos += 8;
+        }
+        Ty::Array(Prim::F64, n) => {
+            for i in 0..*n {
+                out.push((format!("{path}[{i}]"), *pos + 8 * i, finite));
+            }
+            *pos += 8 * n;
+        }
+        Ty::Struct(i) => floats(
+            table,
+            &table.structs[*i].fields,
+            bytes,
+            pos,
+            &format!("{path}."),
+            out,
+        ),
+        Ty::Union(i) => {
+            let tag = u32::from_le_bytes(bytes[*pos..*pos + 4].try_into().unwrap()) as usize;
+            *pos += 4;
+            let v = &table.unions[*i].variants[tag];
+            floats(table, &v.fields, bytes, pos, &format!("{path}."), out);
+        }
+        Ty::Vec(inner) => {
+            let n = count(*pos);
+            *pos += 8;
+            for k in 0..n {
+                float_of(
+                    table,
+                    inner,
+                    finite,
+                    bytes,
+                    pos,
+                    &format!("{path}[{k}]"),
+                    out,
+                );
+            }
+        }
+        other => *pos += table.fixed_size(other).expect("fixed"),
+    }
+}
+
+/// The table's `finite` marks are the Rust decoder's checks: a NaN written into each f64 of
+/// every golden, one at a time, is refused (NonFinite) exactly where the table says `finite`,
+/// and accepted everywhere else.
+#[test]
+fn finite_marks_are_the_decoders_non_finite_checks() {
+    use flexdyn_proto::DecodeError;
+    let t = table();
+    let goldens = [
+        ("state", "StateMsg"),
+        ("imu", "ImuMsg"),
+        ("star_tracker", "StarTrackerMsg"),
+        ("magnetometer", "MagnetometerMsg"),
+        ("css", "CssMsg"),
+        ("fss", "FssMsg"),
+        ("gps", "GpsMsg"),
+        ("command_wrench", "CommandMsg"),
+        ("command_actuators", "CommandMsg"),
+        ("time", "TimeMsg"),
+        ("environment", "EnvironmentMsg"),
+        ("fault_event", "FaultEventMsg"),
+        ("fault_command", "FaultCommandMsg"),
+        ("relative_state", "RelativeStateMsg"),
+        ("status", "StatusMsg"),
+    ];
+    let (mut checked, mut refused) = (0, 0);
+    for (golden, name) in goldens {
+        let bytes = std::fs::read(root().join(format!("proto/golden/{golden}.bin"))).unwrap();
+        let msg = t.message(name).unwrap();
+        let mut out = Vec::new();
+        floats(&t, &msg.fields, &bytes, &mut 0, "", &mut out);
+        for (path, at, finite) in out {
+            let mut b = bytes.clone();
+            b[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+            let result = rust_decode(name, &b);
+            let decoded = result.is_ok();
+            let non_finite = matches!(result, Err(DecodeError::NonFinite { .. }));
+            assert_eq!(non_finite, finite, "golden {golden}, {path} at {at}: NaN");
+            assert_eq!(decoded, !finite, "golden {golden}, {path} at {at}: NaN");
+            checked += 1;
+            refused += usize::from(finite);
+        }
+    }
+    // Torque and force of the two wrench-carrying commands (12); the actuators golden's input
+    // values: 134 = 94 + (12 + 8 v1) + (12 + 8 v2) bytes, so v1 + v2 = 2; two fault parameters.
+    assert_eq!(refused, 12 + 2 + 2, "{checked} values checked");
+    assert!(checked > 150, "{checked}");
+}
+
+/// The Rust decoder's verdict on `bytes` as message `name`.
+fn rust_decode(name: &str, bytes: &[u8]) -> Result<(), flexdyn_proto::DecodeError> {
+    use flexdyn_proto::*;
+    fn d<T: WireMessage>(b: &[u8]) -> Result<(), DecodeError> {
+        decode::<T>(b).map(drop)
+    }
+    match name {
+        "StateMsg" => d::<StateMsg>(bytes),
+        "ImuMsg" => d::<ImuMsg>(bytes),
+        "StarTrackerMsg" => d::<StarTrackerMsg>(bytes),
+        "MagnetometerMsg" => d::<MagnetometerMsg>(bytes),
+        "CssMsg" => d::<CssMsg>(bytes),
+        "FssMsg" => d::<FssMsg>(bytes),
+        "GpsMsg" => d::<GpsMsg>(bytes),
+        "CommandMsg" => d::<CommandMsg>(bytes),
+        "TimeMsg" => d::<TimeMsg>(bytes),
+        "EnvironmentMsg" => d::<EnvironmentMsg>(bytes),
+        "OperatorMsg" => d::<OperatorMsg>(bytes),
+        "FaultEventMsg" => d::<FaultEventMsg>(bytes),
+        "FaultCommandMsg" => d::<FaultCommandMsg>(bytes),
+        "RelativeStateMsg" => d::<RelativeStateMsg>(bytes),
+        "StatusMsg" => d::<StatusMsg>(bytes),
+        other => panic!("{other}"),
+    }
+}
