@@ -471,26 +471,7 @@ fn validate(schema: &Value, value: &Value, path: &str) -> Result<(), String> {
 #[test]
 fn the_json_schemas_accept_every_golden_and_refuse_broken_json() {
     let t = table();
-    let goldens = [
-        ("state", "StateMsg"),
-        ("imu", "ImuMsg"),
-        ("star_tracker", "StarTrackerMsg"),
-        ("magnetometer", "MagnetometerMsg"),
-        ("css", "CssMsg"),
-        ("fss", "FssMsg"),
-        ("gps", "GpsMsg"),
-        ("command_wrench", "CommandMsg"),
-        ("command_no_command", "CommandMsg"),
-        ("command_actuators", "CommandMsg"),
-        ("time", "TimeMsg"),
-        ("environment", "EnvironmentMsg"),
-        ("operator", "OperatorMsg"),
-        ("fault_event", "FaultEventMsg"),
-        ("fault_command", "FaultCommandMsg"),
-        ("relative_state", "RelativeStateMsg"),
-        ("status", "StatusMsg"),
-    ];
-    for (golden, name) in goldens {
+    for (golden, name) in GOLDENS {
         // The file the wire crate embeds is the generated schema.
         let text = flexdyn_proto::json_schema_text(name).expect(name);
         let schema: Value = serde_json::from_str(text).unwrap();
@@ -529,28 +510,7 @@ fn the_json_schemas_accept_every_golden_and_refuse_broken_json() {
 
 /// The serde JSON of the golden `bytes` of message `name`, decoded by the Rust codec.
 fn rust_json(name: &str, bytes: &[u8]) -> Value {
-    use flexdyn_proto::*;
-    fn j<T: WireMessage>(b: &[u8]) -> Value {
-        serde_json::to_value(decode::<T>(b).unwrap()).unwrap()
-    }
-    match name {
-        "StateMsg" => j::<StateMsg>(bytes),
-        "ImuMsg" => j::<ImuMsg>(bytes),
-        "StarTrackerMsg" => j::<StarTrackerMsg>(bytes),
-        "MagnetometerMsg" => j::<MagnetometerMsg>(bytes),
-        "CssMsg" => j::<CssMsg>(bytes),
-        "FssMsg" => j::<FssMsg>(bytes),
-        "GpsMsg" => j::<GpsMsg>(bytes),
-        "CommandMsg" => j::<CommandMsg>(bytes),
-        "TimeMsg" => j::<TimeMsg>(bytes),
-        "EnvironmentMsg" => j::<EnvironmentMsg>(bytes),
-        "OperatorMsg" => j::<OperatorMsg>(bytes),
-        "FaultEventMsg" => j::<FaultEventMsg>(bytes),
-        "FaultCommandMsg" => j::<FaultCommandMsg>(bytes),
-        "RelativeStateMsg" => j::<RelativeStateMsg>(bytes),
-        "StatusMsg" => j::<StatusMsg>(bytes),
-        other => panic!("{other}"),
-    }
+    rust(name, bytes).unwrap()
 }
 
 /// Every f64 of a message's bytes as the table lays them out: (path, offset, `finite`).
@@ -637,25 +597,8 @@ fn float_of(
 fn finite_marks_are_the_decoders_non_finite_checks() {
     use flexdyn_proto::DecodeError;
     let t = table();
-    let goldens = [
-        ("state", "StateMsg"),
-        ("imu", "ImuMsg"),
-        ("star_tracker", "StarTrackerMsg"),
-        ("magnetometer", "MagnetometerMsg"),
-        ("css", "CssMsg"),
-        ("fss", "FssMsg"),
-        ("gps", "GpsMsg"),
-        ("command_wrench", "CommandMsg"),
-        ("command_actuators", "CommandMsg"),
-        ("time", "TimeMsg"),
-        ("environment", "EnvironmentMsg"),
-        ("fault_event", "FaultEventMsg"),
-        ("fault_command", "FaultCommandMsg"),
-        ("relative_state", "RelativeStateMsg"),
-        ("status", "StatusMsg"),
-    ];
     let (mut checked, mut refused) = (0, 0);
-    for (golden, name) in goldens {
+    for (golden, name) in GOLDENS {
         let bytes = std::fs::read(root().join(format!("proto/golden/{golden}.bin"))).unwrap();
         let msg = t.message(name).unwrap();
         let mut out = Vec::new();
@@ -663,7 +606,7 @@ fn finite_marks_are_the_decoders_non_finite_checks() {
         for (path, at, finite) in out {
             let mut b = bytes.clone();
             b[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
-            let result = rust_decode(name, &b);
+            let result = rust(name, &b);
             let decoded = result.is_ok();
             let non_finite = matches!(result, Err(DecodeError::NonFinite { .. }));
             assert_eq!(non_finite, finite, "golden {golden}, {path} at {at}: NaN");
@@ -678,11 +621,32 @@ fn finite_marks_are_the_decoders_non_finite_checks() {
     assert!(checked > 150, "{checked}");
 }
 
-/// The Rust decoder's verdict on `bytes` as message `name`.
-fn rust_decode(name: &str, bytes: &[u8]) -> Result<(), flexdyn_proto::DecodeError> {
+/// The golden files and their messages (proto/golden/MANIFEST.tsv).
+const GOLDENS: [(&str, &str); 17] = [
+    ("state", "StateMsg"),
+    ("imu", "ImuMsg"),
+    ("star_tracker", "StarTrackerMsg"),
+    ("magnetometer", "MagnetometerMsg"),
+    ("css", "CssMsg"),
+    ("fss", "FssMsg"),
+    ("gps", "GpsMsg"),
+    ("command_wrench", "CommandMsg"),
+    ("command_no_command", "CommandMsg"),
+    ("command_actuators", "CommandMsg"),
+    ("time", "TimeMsg"),
+    ("environment", "EnvironmentMsg"),
+    ("operator", "OperatorMsg"),
+    ("fault_event", "FaultEventMsg"),
+    ("fault_command", "FaultCommandMsg"),
+    ("relative_state", "RelativeStateMsg"),
+    ("status", "StatusMsg"),
+];
+
+/// The Rust decoder on `bytes` as message `name`: its serde JSON, or why it refused them.
+fn rust(name: &str, bytes: &[u8]) -> Result<Value, flexdyn_proto::DecodeError> {
     use flexdyn_proto::*;
-    fn d<T: WireMessage>(b: &[u8]) -> Result<(), DecodeError> {
-        decode::<T>(b).map(drop)
+    fn d<T: WireMessage>(b: &[u8]) -> Result<Value, DecodeError> {
+        decode::<T>(b).map(|m| serde_json::to_value(m).unwrap())
     }
     match name {
         "StateMsg" => d::<StateMsg>(bytes),
