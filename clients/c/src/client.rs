@@ -411,17 +411,18 @@ impl Client {
                 ),
             ));
         }
-        (info.check)(bytes).map_err(|e| {
+        let invalid = |e: DecodeError| {
             Error::new(
                 Code::Argument,
                 format!("not a valid {} message (nothing sent): {e}", info.title),
             )
-        })?;
+        };
+        // The check is the decode; a command's key needs its decoded sender id.
         let key = if kind == kinds::COMMAND {
-            let cmd = flexdyn_proto::decode_command(bytes)
-                .map_err(|e| Error::new(Code::Argument, format!("not a valid command: {e}")))?;
+            let cmd = flexdyn_proto::decode_command(bytes).map_err(invalid)?;
             self.topics.cmd(cmd.sender_id)
         } else {
+            (info.check)(bytes).map_err(invalid)?;
             self.key(kind, None)?
         };
         self.put(key, bytes.to_vec())

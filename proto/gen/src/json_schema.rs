@@ -47,7 +47,7 @@ fn prim(p: Prim) -> Value {
 fn of_type(table: &Table, ty: &Ty, f: Option<&Field>) -> Value {
     match ty {
         Ty::Prim(p) => prim(*p),
-        Ty::Array(p, n) if f.is_some_and(|f| f.text) => {
+        Ty::Array(_, n) if f.is_some_and(|f| f.text) => {
             json!({"type": "string", "maxLength": n})
         }
         Ty::Array(p, n) => {
