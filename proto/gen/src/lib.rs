@@ -8,11 +8,13 @@
 //! | mirror | module |
 //! |---|---|
 //! | the byte tables of `proto/README.md` (between markers) | [`readme`] |
+//! | the header-only C codec, `proto/c/include/flexdyn_proto.h` | [`c_proto`] |
 //! | the C client library's typed calls, `clients/c/include/flexdyn_client_messages.h` | [`c_client`] |
 //! | the C client library's message kinds, `clients/c/src/kinds.rs` | [`c_client`] |
 //! | the JSON Schemas of the messages' JSON (MCAP decoded channels, Foxglove), `proto/schema/json/*.json` and `proto/src/json_schemas.rs` | [`json_schema`] |
 
 pub mod c_client;
+pub mod c_proto;
 pub mod json_schema;
 pub mod readme;
 pub mod table;
@@ -25,6 +27,8 @@ pub use table::{Table, TableError, TABLE_PATH};
 pub const README_PATH: &str = "proto/README.md";
 /// The C client library's generated header.
 pub const C_HEADER_PATH: &str = "clients/c/include/flexdyn_client_messages.h";
+/// The header-only C codec.
+pub const C_PROTO_PATH: &str = "proto/c/include/flexdyn_proto.h";
 /// The C client library's generated kind table.
 pub const KINDS_PATH: &str = "clients/c/src/kinds.rs";
 /// The wire crate's generated index of the JSON Schemas.
@@ -62,6 +66,10 @@ pub fn mirrors(root: &Path) -> Result<Vec<Mirror>, String> {
         Mirror {
             path: C_HEADER_PATH.into(),
             text: c_client::header(&table),
+        },
+        Mirror {
+            path: C_PROTO_PATH.into(),
+            text: c_proto::header(&table),
         },
         Mirror {
             path: KINDS_PATH.into(),

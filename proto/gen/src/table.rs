@@ -14,6 +14,12 @@ use serde::Deserialize;
 pub struct Table {
     /// The protocol version every header carries.
     pub protocol_version: u16,
+    /// Named constants every codec shares.
+    #[serde(rename = "constant", default)]
+    pub constants: Vec<Constant>,
+    /// Named codes of integer fields that are not enumerations.
+    #[serde(default)]
+    pub codes: Vec<Codes>,
     /// Enumerations (a u32 tag on the wire).
     #[serde(rename = "enum", default)]
     pub enums: Vec<Enum>,
@@ -31,12 +37,67 @@ pub struct Table {
     pub messages: Vec<Message>,
 }
 
+/// A named constant.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Constant {
+    /// Its name, SCREAMING_SNAKE (`FD_<name>` in C).
+    pub name: String,
+    /// Its value.
+    pub value: ConstValue,
+    /// What it is.
+    pub doc: String,
+}
+
+/// A constant's value as the table writes it.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum ConstValue {
+    /// A TOML integer.
+    Int(i64),
+    /// A hexadecimal string (`"0xFFFFFFFFFFFFFFFF"`), for values above `i64::MAX`.
+    Hex(String),
+}
+
+impl Constant {
+    /// The value, or why it is not one.
+    pub fn value(&self) -> Result<u64, String> {
+        match &self.value {
+            ConstValue::Int(v) => {
+                u64::try_from(*v).map_err(|_| format!("{v} is negative: a constant is unsigned"))
+            }
+            ConstValue::Hex(h) => h
+                .strip_prefix("0x")
+                .and_then(|d| u64::from_str_radix(d, 16).ok())
+                .ok_or_else(|| format!("{h:?} is not 0x followed by at most 16 hex digits")),
+        }
+    }
+}
+
+/// Named codes of an integer field that a decoder does not refuse when unknown.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Codes {
+    /// Its name.
+    pub name: String,
+    /// The C macro prefix (`FD_<c_prefix>_<VALUE>`).
+    pub c_prefix: String,
+    /// Which field it names.
+    pub doc: String,
+    /// Its codes.
+    pub values: Vec<EnumValue>,
+}
+
 /// An enumeration.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Enum {
     /// Its name (`enum<Name>` in a field's type).
     pub name: String,
+    /// The C macro prefix of its values, `FD_<c_prefix>_<VALUE>`; the name in
+    /// SCREAMING_SNAKE when absent.
+    #[serde(default)]
+    pub c_prefix: Option<String>,
     /// What it is.
     pub doc: String,
     /// Its values, in tag order.
@@ -62,6 +123,8 @@ pub struct EnumValue {
 pub struct Flags {
     /// Its name (a field's `flags`).
     pub name: String,
+    /// The C macro prefix of its bits, `FD_<c_prefix>_<BIT>`.
+    pub c_prefix: String,
     /// Its bits.
     pub bits: Vec<Bit>,
 }
@@ -84,6 +147,9 @@ pub struct Bit {
 pub struct Struct {
     /// Its name (a field's type).
     pub name: String,
+    /// Its C name, `fd_<c_name>`; the name in snake_case when absent.
+    #[serde(default)]
+    pub c_name: Option<String>,
     /// What it is.
     pub doc: String,
     /// Its fields in wire order.
@@ -96,6 +162,8 @@ pub struct Struct {
 pub struct Union {
     /// Its name (`union<Name>`).
     pub name: String,
+    /// The C macro prefix of its tags, `FD_<c_prefix>_<VARIANT>`.
+    pub c_prefix: String,
     /// What it is.
     pub doc: String,
     /// Its variants, in tag order.
@@ -181,6 +249,10 @@ pub struct Field {
     /// Decoders refuse a NaN or infinite value here (NonFinite): an f64, f64[n] or vec<f64>.
     #[serde(default)]
     pub finite: bool,
+    /// C only: a struct-typed field whose members are the C struct's own, each name prefixed
+    /// with this (`rejected_malformed`), instead of a nested C struct.
+    #[serde(default)]
+    pub c_flatten: Option<String>,
 }
 
 /// A primitive wire type.
@@ -470,6 +542,13 @@ impl Table {
                     return Err(Self::err(file, place, "`max` is for a vec or a u8 count"))
                 }
             }
+            if f.c_flatten.is_some() && !matches!(ty, Ty::Struct(_)) {
+                return Err(Self::err(
+                    file,
+                    place,
+                    "`c_flatten` is for a struct-typed field",
+                ));
+            }
             if let Ty::Vec(inner) = &ty {
                 if self.fixed_size(inner).is_none() && !matches!(**inner, Ty::Struct(_)) {
                     return Err(Self::err(
@@ -483,8 +562,106 @@ impl Table {
         Ok(())
     }
 
+    /// The layout rules that let every decoder find each fixed field at a fixed offset: in a
+    /// message or a union variant only the last field may vary in size (a vec, or a union whose
+    /// variants differ); a struct that is a plain field is fixed; a vec's struct element may
+    /// hold vecs of primitives, not vecs of structs or unions.
+    fn check_layout(&self, file: &str, owner: &str, fields: &[Field]) -> Result<(), TableError> {
+        for (i, f) in fields.iter().enumerate() {
+            let place = format!("{owner}, field {:?}", f.name);
+            let ty = self
+                .resolve(&f.ty)
+                .map_err(|e| Self::err(file, place.clone(), e))?;
+            let last = i + 1 == fields.len();
+            match &ty {
+                Ty::Struct(s) if self.fixed_size(&ty).is_none() => {
+                    return Err(Self::err(
+                        file,
+                        place,
+                        format!(
+                            "struct {} varies in size: it may only be a vec's element",
+                            self.structs[*s].name
+                        ),
+                    ))
+                }
+                Ty::Vec(inner) => {
+                    if !last {
+                        return Err(Self::err(file, place, "a vec is the last field"));
+                    }
+                    if let Ty::Struct(s) = **inner {
+                        for g in &self.structs[s].fields {
+                            let gt = self
+                                .resolve(&g.ty)
+                                .map_err(|e| Self::err(file, place.clone(), e))?;
+                            let ok = match &gt {
+                                Ty::Vec(e) => {
+                                    self.fixed_size(e).is_some() && !matches!(**e, Ty::Struct(_))
+                                }
+                                other => self.fixed_size(other).is_some(),
+                            };
+                            if !ok {
+                                return Err(Self::err(
+                                    file,
+                                    format!("struct {}, field {:?}", self.structs[s].name, g.name),
+                                    "a vec's element holds fixed fields and vecs of primitives only",
+                                ));
+                            }
+                        }
+                    }
+                }
+                Ty::Union(u) => {
+                    if self.fixed_size(&ty).is_none() && !last {
+                        return Err(Self::err(
+                            file,
+                            place,
+                            "a union whose variants differ in size is the last field",
+                        ));
+                    }
+                    for v in &self.unions[*u].variants {
+                        self.check_layout(
+                            file,
+                            &format!("union {}, variant {}", self.unions[*u].name, v.name),
+                            &v.fields,
+                        )?;
+                    }
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
     /// Checks names, references and the messages' rules.
     fn check(&self, file: &str) -> Result<(), TableError> {
+        let screaming = |s: &str| {
+            !s.is_empty()
+                && s.chars()
+                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_')
+        };
+        let mut c_macros = BTreeSet::new();
+        for c in &self.constants {
+            let place = format!("constant {:?}", c.name);
+            if !screaming(&c.name) || !c_macros.insert(c.name.clone()) {
+                return Err(Self::err(
+                    file,
+                    place,
+                    "a constant's name is SCREAMING_SNAKE and used once",
+                ));
+            }
+            c.value().map_err(|e| Self::err(file, place, e))?;
+        }
+        for c in &self.codes {
+            let mut seen = BTreeSet::new();
+            for v in &c.values {
+                if !screaming(&v.name) || !seen.insert(v.value) {
+                    return Err(Self::err(
+                        file,
+                        format!("codes {}, value {:?}", c.name, v.name),
+                        "a code's name is SCREAMING_SNAKE and its value appears once",
+                    ));
+                }
+            }
+        }
         let mut types = BTreeSet::new();
         for name in self
             .enums
@@ -545,6 +722,7 @@ impl Table {
         for m in &self.messages {
             let owner = format!("message {}", m.name);
             self.check_fields(file, &owner, &m.fields)?;
+            self.check_layout(file, &owner, &m.fields)?;
             if !c_names.insert(m.c_name.as_str())
                 || !m.c_name.chars().all(|c| c.is_ascii_lowercase() || c == '_')
             {
@@ -605,6 +783,43 @@ impl Table {
 /// The `/`-separated chunks of a key.
 pub fn key_chunks(key: &str) -> Vec<&str> {
     key.split('/').collect()
+}
+
+/// `RunTicks` → `RUN_TICKS`, `command_flags` → `COMMAND_FLAGS`.
+pub fn screaming_snake(name: &str) -> String {
+    snake(name).to_ascii_uppercase()
+}
+
+/// `EffectorState` → `effector_state`; a name already in snake_case is kept.
+pub fn snake(name: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in name.chars().enumerate() {
+        if c.is_ascii_uppercase() {
+            if i > 0 && !out.ends_with('_') {
+                out.push('_');
+            }
+            out.push(c.to_ascii_lowercase());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+impl Enum {
+    /// `FD_<this>_<VALUE>` in C.
+    pub fn c_prefix(&self) -> String {
+        self.c_prefix
+            .clone()
+            .unwrap_or_else(|| screaming_snake(&self.name))
+    }
+}
+
+impl Struct {
+    /// `fd_<this>` in C.
+    pub fn c_name(&self) -> String {
+        self.c_name.clone().unwrap_or_else(|| snake(&self.name))
+    }
 }
 
 impl Message {

@@ -308,6 +308,30 @@ fn mistakes_in_the_table_are_named() {
             edited("since = 9", "since = 10"),
             "message RelativeStateMsg, since",
         ),
+        (
+            // A vec that is not last would move every field after it.
+            edited(
+                r#"  { name = "command_flags", type = "u8", flags = "command_flags""#,
+                r#"  { name = "extra", type = "vec<f64>", max = 4, doc = "" },
+  { name = "command_flags", type = "u8", flags = "command_flags""#,
+            ),
+            "message StateMsg, field \"extra\": a vec is the last field",
+        ),
+        (
+            edited(
+                r#"{ name = "range_m", type = "f64""#,
+                r#"{ name = "range_m", type = "f64", c_flatten = """#,
+            ),
+            "`c_flatten` is for a struct-typed field",
+        ),
+        (
+            edited(r#"value = "0xFFFFFFFFFFFFFFFF""#, r#"value = "FFFF""#),
+            "constant \"AT_NEXT_TICK\"",
+        ),
+        (
+            edited(r#"value = 65536"#, r#"value = -1"#),
+            "constant \"MAX_MESSAGE_BYTES\": -1 is negative",
+        ),
     ];
     for (text, expected) in cases {
         let err = Table::parse("messages.toml", &text).expect_err(expected);
