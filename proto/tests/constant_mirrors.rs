@@ -1,7 +1,7 @@
-//! The kind tags and flag bits are written three times: in `flexdyn_proto` (Rust), in the C
-//! header's `#define`s and in the Python package's constants. This reads the other two as text
-//! and checks every mirrored constant against the Rust one, so a new kind or flag cannot reach
-//! one codec and miss another.
+//! The kind tags and flag bits are in `flexdyn_proto` (Rust, hand-written), and in the C header's
+//! `#define`s and the Python package's constants (both generated from the wire table). This reads
+//! the other two as text and checks every mirrored constant against the Rust one, so a mistake
+//! in the table, or a kind or flag that reaches one codec and misses another, fails here.
 
 use std::collections::HashMap;
 
@@ -117,10 +117,10 @@ fn c_and_python_mirror_every_kind_and_flag() {
     let c = c_defines();
     let py = python_constants();
     for (name, rust) in mirrored {
-        // The Python package drops the `EFFECTOR_` of the kind tags.
-        let py_name = name.strip_prefix("EFFECTOR_").unwrap_or(name);
+        // Python names them as C does, without `FD_` (the kind tags are also aliased without
+        // `EFFECTOR_`, the names from before the wire table).
         assert_eq!(c.get(&format!("FD_{name}")), Some(&rust), "C FD_{name}");
-        assert_eq!(py.get(py_name), Some(&rust), "Python {py_name}");
+        assert_eq!(py.get(name), Some(&rust), "Python {name}");
     }
 }
 

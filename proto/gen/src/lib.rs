@@ -9,6 +9,7 @@
 //! |---|---|
 //! | the byte tables of `proto/README.md` (between markers) | [`readme`] |
 //! | the header-only C codec, `proto/c/include/flexdyn_proto.h` | [`c_proto`] |
+//! | the Python package's codec, `clients/python/src/flexdyn/proto.py` | [`py_proto`] |
 //! | the C client library's typed calls, `clients/c/include/flexdyn_client_messages.h` | [`c_client`] |
 //! | the C client library's message kinds, `clients/c/src/kinds.rs` | [`c_client`] |
 //! | the JSON Schemas of the messages' JSON (MCAP decoded channels, Foxglove), `proto/schema/json/*.json` and `proto/src/json_schemas.rs` | [`json_schema`] |
@@ -16,6 +17,7 @@
 pub mod c_client;
 pub mod c_proto;
 pub mod json_schema;
+pub mod py_proto;
 pub mod readme;
 pub mod table;
 
@@ -29,6 +31,8 @@ pub const README_PATH: &str = "proto/README.md";
 pub const C_HEADER_PATH: &str = "clients/c/include/flexdyn_client_messages.h";
 /// The header-only C codec.
 pub const C_PROTO_PATH: &str = "proto/c/include/flexdyn_proto.h";
+/// The Python package's codec.
+pub const PY_PROTO_PATH: &str = "clients/python/src/flexdyn/proto.py";
 /// The C client library's generated kind table.
 pub const KINDS_PATH: &str = "clients/c/src/kinds.rs";
 /// The wire crate's generated index of the JSON Schemas.
@@ -70,6 +74,10 @@ pub fn mirrors(root: &Path) -> Result<Vec<Mirror>, String> {
         Mirror {
             path: C_PROTO_PATH.into(),
             text: c_proto::header(&table),
+        },
+        Mirror {
+            path: PY_PROTO_PATH.into(),
+            text: py_proto::module(&table),
         },
         Mirror {
             path: KINDS_PATH.into(),

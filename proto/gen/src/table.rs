@@ -253,6 +253,14 @@ pub struct Field {
     /// with this (`rejected_malformed`), instead of a nested C struct.
     #[serde(default)]
     pub c_flatten: Option<String>,
+    /// Python only: a struct-typed field held as a tuple of the struct's fields in wire order
+    /// (`utc`: `(year, month, …)`), instead of a class of its own.
+    #[serde(default)]
+    pub py_tuple: bool,
+    /// The value a new message holds before it is set, where it is not zero: a number, an array
+    /// of numbers, a `[[constant]]`'s name, or (for an enum or union field) a value's name.
+    #[serde(default)]
+    pub default: Option<toml::Value>,
 }
 
 /// A primitive wire type.
@@ -549,6 +557,26 @@ impl Table {
                     "`c_flatten` is for a struct-typed field",
                 ));
             }
+            if f.py_tuple {
+                let prims = match &ty {
+                    Ty::Struct(s) => self.structs[*s]
+                        .fields
+                        .iter()
+                        .all(|g| matches!(self.resolve(&g.ty), Ok(Ty::Prim(p)) if p != Prim::Bool)),
+                    _ => false,
+                };
+                if !prims {
+                    return Err(Self::err(
+                        file,
+                        place,
+                        "`py_tuple` is for a struct of numbers",
+                    ));
+                }
+            }
+            if let Some(d) = &f.default {
+                self.check_default(&ty, d)
+                    .map_err(|e| Self::err(file, place.clone(), format!("`default`: {e}")))?;
+            }
             if let Ty::Vec(inner) = &ty {
                 if self.fixed_size(inner).is_none() && !matches!(**inner, Ty::Struct(_)) {
                     return Err(Self::err(
@@ -560,6 +588,43 @@ impl Table {
             }
         }
         Ok(())
+    }
+
+    /// Whether `d` is a default a field of type `ty` can hold.
+    fn check_default(&self, ty: &Ty, d: &toml::Value) -> Result<(), String> {
+        use toml::Value as V;
+        match (ty, d) {
+            (Ty::Prim(Prim::F64), V::Float(_) | V::Integer(_)) => Ok(()),
+            (Ty::Prim(p), V::Integer(_)) if *p != Prim::Bool => Ok(()),
+            (Ty::Prim(Prim::Bool), V::Boolean(_)) => Ok(()),
+            (Ty::Prim(p), V::String(name)) if *p != Prim::F64 && *p != Prim::Bool => self
+                .constants
+                .iter()
+                .any(|c| &c.name == name)
+                .then_some(())
+                .ok_or_else(|| format!("no [[constant]] named {name:?}")),
+            (Ty::Array(p, n), V::Array(items)) => {
+                if items.len() != *n {
+                    return Err(format!("{} values for {n} entries", items.len()));
+                }
+                items
+                    .iter()
+                    .try_for_each(|i| self.check_default(&Ty::Prim(*p), i))
+            }
+            (Ty::Enum(e), V::String(name)) => self.enums[*e]
+                .values
+                .iter()
+                .any(|v| &v.name == name)
+                .then_some(())
+                .ok_or_else(|| format!("enum {} has no value {name:?}", self.enums[*e].name)),
+            (Ty::Union(u), V::String(name)) => self.unions[*u]
+                .variants
+                .iter()
+                .any(|v| &v.name == name)
+                .then_some(())
+                .ok_or_else(|| format!("union {} has no variant {name:?}", self.unions[*u].name)),
+            _ => Err(format!("{d} does not suit this field's type")),
+        }
     }
 
     /// The layout rules that let every decoder find each fixed field at a fixed offset: in a

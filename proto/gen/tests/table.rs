@@ -329,6 +329,21 @@ fn mistakes_in_the_table_are_named() {
             "constant \"AT_NEXT_TICK\"",
         ),
         (
+            edited(r#"default = "AT_NEXT_TICK""#, r#"default = "AT_NEXT_TOCK""#),
+            "field \"at_tick\": `default`: no [[constant]] named \"AT_NEXT_TOCK\"",
+        ),
+        (
+            edited(r#"default = "NoCommand""#, r#"default = "Nothing""#),
+            "`default`: union CommandKind has no variant \"Nothing\"",
+        ),
+        (
+            edited(
+                r#"{ name = "drag", type = "AppliedWrench","#,
+                r#"{ name = "drag", type = "AppliedWrench", py_tuple = true,"#,
+            ),
+            "field \"drag\": `py_tuple` is for a struct of numbers",
+        ),
+        (
             edited(r#"value = 65536"#, r#"value = -1"#),
             "constant \"MAX_MESSAGE_BYTES\": -1 is negative",
         ),
