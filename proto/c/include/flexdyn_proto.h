@@ -79,9 +79,14 @@
 
 /* Encoded sizes (bytes) and offsets. */
 #define FD_HEADER_LEN 30u /* Header */
+#define FD_CONSERVED_LEN 64u /* Conserved */
 #define FD_SOURCE_WRENCH_LEN 48u /* AppliedWrench */
 #define FD_EFFECTOR_STATE_FIXED_LEN 22u /* EffectorState without its vecs' elements */
 #define FD_EFFECTOR_INPUT_FIXED_LEN 12u /* EffectorInput without its vecs' elements */
+#define FD_FRAME_TIMING_LEN 40u /* FrameTiming */
+#define FD_COMMAND_STATUS_LEN 21u /* CommandStatus */
+#define FD_REJECT_COUNTERS_LEN 80u /* RejectCounters */
+#define FD_UTC_TIME_LEN 11u /* UtcTime */
 #define FD_SYS_TIME_LEN 8u /* SysTime */
 #define FD_STATE_FIXED_LEN 327u /* StateMsg with no effectors */
 #define FD_STATE_EFFECTORS_COUNT_OFFSET 319u /* the u64 count of effectors */

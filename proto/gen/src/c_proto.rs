@@ -117,7 +117,7 @@ struct Gen<'t> {
 
 impl<'t> Gen<'t> {
     fn ty(&self, f: &Field) -> Ty {
-        self.t.resolve(&f.ty).expect("the table was checked")
+        self.t.ty_of(f)
     }
 
     fn size(&self, ty: &Ty) -> usize {
@@ -344,12 +344,7 @@ impl<'t> Gen<'t> {
 
     /// A field list split into its fixed part and its variable last field, if any.
     fn split<'f>(&self, fields: &'f [Field]) -> (&'f [Field], Option<&'f Field>) {
-        match fields.last() {
-            Some(f) if self.t.fixed_size(&self.ty(f)).is_none() => {
-                (&fields[..fields.len() - 1], Some(f))
-            }
-            _ => (fields, None),
-        }
+        self.t.split_tail(fields)
     }
 }
 
@@ -403,89 +398,13 @@ fn constants(g: &Gen, o: &mut String) {
         ));
     }
     o.push_str("\n/* Encoded sizes (bytes) and offsets. */\n");
-    for (i, s) in t.structs.iter().enumerate() {
-        if !struct_used(t, i) {
-            continue;
-        }
-        let c = s.c_name().to_ascii_uppercase();
-        match t.fields_size(&s.fields) {
-            Some(n) => o.push_str(&format!("#define FD_{c}_LEN {n}u /* {} */\n", s.name)),
-            None => o.push_str(&format!(
-                "#define FD_{c}_FIXED_LEN {}u /* {} without its vecs' elements */\n",
-                t.fields_min_size(&s.fields),
-                s.name
-            )),
-        }
-    }
-    for m in &t.messages {
-        let u = m.upper();
-        let (fixed, tail) = g.split(&m.fields);
-        let since = if m.since > 1 {
-            format!(", since protocol {}", m.since)
-        } else {
-            String::new()
-        };
-        let prefix_len = t.fields_size(fixed).expect("fixed");
-        match tail {
-            None => o.push_str(&format!(
-                "#define FD_{u}_LEN {prefix_len}u /* {}{since} */\n",
-                m.name
-            )),
-            Some(f) => match g.ty(f) {
-                Ty::Vec(_) => {
-                    o.push_str(&format!(
-                        "#define FD_{u}_FIXED_LEN {}u /* {} with no {}{since} */\n",
-                        prefix_len + 8,
-                        m.name,
-                        f.name
-                    ));
-                    o.push_str(&format!(
-                        "#define FD_{u}_{}_COUNT_OFFSET {prefix_len}u /* the u64 count of {} */\n",
-                        f.name.to_ascii_uppercase(),
-                        f.name
-                    ));
-                }
-                Ty::Union(ui) => {
-                    let un = &t.unions[ui];
-                    o.push_str(&format!(
-                        "#define FD_{u}_{}_OFFSET {prefix_len}u /* the u32 tag of {}{since} */\n",
-                        f.name.to_ascii_uppercase(),
-                        f.name
-                    ));
-                    for v in &un.variants {
-                        let vu = screaming_snake(&v.name);
-                        let (vf, vt) = g.split(&v.fields);
-                        let n = prefix_len + 4 + t.fields_size(vf).expect("fixed");
-                        match vt {
-                            None => o.push_str(&format!(
-                                "#define FD_{u}_{vu}_LEN {n}u /* {} {} */\n",
-                                m.name, v.name
-                            )),
-                            Some(_) => o.push_str(&format!(
-                                "#define FD_{u}_{vu}_FIXED_LEN {}u /* {} {} with no elements */\n",
-                                n + 8,
-                                m.name,
-                                v.name
-                            )),
-                        }
-                    }
-                }
-                _ => unreachable!("only a vec or a union varies"),
-            },
-        }
-        // Byte blocks (u8[n]) have a named offset, for code that reads them in place.
-        let mut k = 0;
-        for f in fixed {
-            let ty = g.ty(f);
-            if let Ty::Array(Prim::U8, _) = ty {
-                o.push_str(&format!(
-                    "#define FD_{u}_{}_OFFSET {k}u /* {} */\n",
-                    f.name.to_ascii_uppercase(),
-                    f.name
-                ));
-            }
-            k += g.size(&ty);
-        }
+    for c in crate::sizes::size_constants(t) {
+        o.push_str(&format!(
+            "#define FD_{} {}u /* {} */\n",
+            c.name,
+            c.value,
+            comment(&c.note)
+        ));
     }
     for e in &t.enums {
         o.push_str(&format!(
@@ -554,18 +473,7 @@ fn doc_tail(doc: &str) -> String {
 
 /// Whether a struct is a C type of its own (some field or vec uses it without flattening).
 fn struct_used(t: &Table, s: usize) -> bool {
-    let uses = |fields: &[Field]| {
-        fields.iter().any(|f| match t.resolve(&f.ty) {
-            Ok(Ty::Struct(i)) => i == s && f.c_flatten.is_none(),
-            Ok(Ty::Vec(inner)) => *inner == Ty::Struct(s),
-            _ => false,
-        })
-    };
-    t.messages.iter().any(|m| uses(&m.fields))
-        || t.structs.iter().any(|x| uses(&x.fields))
-        || t.unions
-            .iter()
-            .any(|u| u.variants.iter().any(|v| uses(&v.fields)))
+    t.struct_used(s, |f, elem| elem || f.c_flatten.is_none())
 }
 
 fn types(g: &Gen, o: &mut String) {
@@ -1549,33 +1457,18 @@ fn message(g: &Gen, m: &crate::table::Message, o: &mut String) {
 
 /// Key functions, `fd_<c_name>_key`, from each message's key pattern.
 fn keys(t: &Table, o: &mut String) {
+    use crate::sizes::{key_params, KeyName};
     for m in &t.messages {
-        let chunks = crate::table::key_chunks(&m.key);
-        let vehicle = chunks.get(1).copied().unwrap_or("<sc-id>");
-        let param = |p: &str| {
-            p.trim_start_matches('<')
-                .trim_end_matches('>')
-                .trim_end_matches("-id")
-                .replace('-', "_")
-        };
-        let sc = param(vehicle);
+        let (sc, last) = key_params(m);
         let tail = m.key_tail();
-        let last = if m.named() {
-            chunks.last().copied()
-        } else {
-            None
-        };
         let (args, name_expr, locals) = match last {
-            None => (String::new(), "FD_NULL".to_owned(), String::new()),
-            Some("<sender-id>") => (
+            KeyName::None => (String::new(), "FD_NULL".to_owned(), String::new()),
+            KeyName::SenderId => (
                 ", uint32_t sender_id".to_owned(),
                 "fd_decimal_u32(digits, sender_id)".to_owned(),
                 "    char digits[11];\n".to_owned(),
             ),
-            Some(p) => {
-                let n = param(p);
-                (format!(", const char *{n}"), n, String::new())
-            }
+            KeyName::Text(n) => (format!(", const char *{n}"), n, String::new()),
         };
         o.push_str(&format!(
             "/* {}: the {}'s key. */\nstatic inline size_t fd_{}_key(char *out, size_t cap, const char *{sc}{args}) {{\n{locals}    return fd_key(out, cap, {sc}, \"{tail}\", {name_expr});\n}}\n",

@@ -19,6 +19,7 @@ pub mod c_proto;
 pub mod json_schema;
 pub mod py_proto;
 pub mod readme;
+pub mod sizes;
 pub mod table;
 
 use std::path::{Path, PathBuf};

@@ -118,7 +118,7 @@ struct Gen<'t> {
 
 impl<'t> Gen<'t> {
     fn ty(&self, f: &Field) -> Ty {
-        self.t.resolve(&f.ty).expect("the table was checked")
+        self.t.ty_of(f)
     }
 
     fn size(&self, ty: &Ty) -> usize {
@@ -510,12 +510,7 @@ impl<'t> Gen<'t> {
 
     /// A field list split into its fixed part and its variable last field, if any.
     fn split<'f>(&self, fields: &'f [Field]) -> (&'f [Field], Option<&'f Field>) {
-        match fields.last() {
-            Some(f) if self.t.fixed_size(&self.ty(f)).is_none() => {
-                (&fields[..fields.len() - 1], Some(f))
-            }
-            _ => (fields, None),
-        }
+        self.t.split_tail(fields)
     }
 
     /// Step 3 for a vec whose count is at `off`: walk it (sets `n`, leaves `w.at` at the end).
@@ -807,49 +802,8 @@ fn constants(g: &Gen, o: &mut String) {
         ));
     }
     o.push_str("\n# Encoded sizes (bytes) and offsets.\n");
-    for (i, s) in t.structs.iter().enumerate() {
-        if !used_anywhere(t, i) {
-            continue;
-        }
-        let c = s.c_name().to_ascii_uppercase();
-        match t.fields_size(&s.fields) {
-            Some(n) => o.push_str(&format!("{c}_LEN = {n}\n")),
-            None => o.push_str(&format!(
-                "{c}_FIXED_LEN = {}\n",
-                t.fields_min_size(&s.fields)
-            )),
-        }
-    }
-    for m in &t.messages {
-        let u = m.upper();
-        let (fixed, tail) = g.split(&m.fields);
-        let prefix = t.fields_size(fixed).expect("fixed");
-        match tail.map(|f| (f, g.ty(f))) {
-            None => o.push_str(&format!("{u}_LEN = {prefix}\n")),
-            Some((f, Ty::Vec(_))) => {
-                o.push_str(&format!("{u}_FIXED_LEN = {}\n", prefix + 8));
-                o.push_str(&format!(
-                    "{u}_{}_COUNT_OFFSET = {prefix}\n",
-                    f.name.to_ascii_uppercase()
-                ));
-            }
-            Some((f, Ty::Union(ui))) => {
-                o.push_str(&format!(
-                    "{u}_{}_OFFSET = {prefix}\n",
-                    f.name.to_ascii_uppercase()
-                ));
-                for v in &t.unions[ui].variants {
-                    let (vf, vt) = g.split(&v.fields);
-                    let n = prefix + 4 + t.fields_size(vf).expect("fixed");
-                    let vu = screaming_snake(&v.name);
-                    match vt {
-                        None => o.push_str(&format!("{u}_{vu}_LEN = {n}\n")),
-                        Some(_) => o.push_str(&format!("{u}_{vu}_FIXED_LEN = {}\n", n + 8)),
-                    }
-                }
-            }
-            Some(_) => unreachable!("a vec or a union"),
-        }
+    for c in crate::sizes::size_constants(t) {
+        o.push_str(&format!("{} = {}\n", c.name, c.value));
     }
     for e in &t.enums {
         o.push_str(&format!("\n# {}: {}\n", e.name, e.doc));
@@ -899,36 +853,9 @@ fn constants(g: &Gen, o: &mut String) {
     }
 }
 
-/// Whether a struct is used at all by a message (any way).
-fn used_anywhere(t: &Table, s: usize) -> bool {
-    let uses = |fields: &[Field]| {
-        fields.iter().any(|f| match t.resolve(&f.ty) {
-            Ok(Ty::Struct(i)) => i == s,
-            Ok(Ty::Vec(inner)) => *inner == Ty::Struct(s),
-            _ => false,
-        })
-    };
-    t.messages.iter().any(|m| uses(&m.fields))
-        || t.unions
-            .iter()
-            .any(|u| u.variants.iter().any(|v| uses(&v.fields)))
-        || t.structs.iter().any(|x| uses(&x.fields))
-}
-
 /// Whether a struct is a Python class (some field nests it, or a vec holds it).
 fn used_as_class(t: &Table, s: usize) -> bool {
-    let uses = |fields: &[Field]| {
-        fields.iter().any(|f| match t.resolve(&f.ty) {
-            Ok(Ty::Struct(i)) => i == s && f.c_flatten.is_none() && !f.py_tuple,
-            Ok(Ty::Vec(inner)) => *inner == Ty::Struct(s),
-            _ => false,
-        })
-    };
-    t.messages.iter().any(|m| uses(&m.fields))
-        || t.unions
-            .iter()
-            .any(|u| u.variants.iter().any(|v| uses(&v.fields)))
-        || t.structs.iter().any(|x| uses(&x.fields))
+    t.struct_used(s, |f, elem| elem || (f.c_flatten.is_none() && !f.py_tuple))
 }
 
 fn class_head(o: &mut String, name: &str, docstring: &str, members: &[Member]) {
@@ -1275,31 +1202,17 @@ fn message(g: &Gen, m: &Message, o: &mut String) {
 
 /// Key functions, `<c_name>_key`, from each message's key pattern.
 fn keys(t: &Table, o: &mut String) {
+    use crate::sizes::{key_params, KeyName};
     for m in &t.messages {
-        let chunks = crate::table::key_chunks(&m.key);
-        let param = |p: &str| {
-            p.trim_start_matches('<')
-                .trim_end_matches('>')
-                .trim_end_matches("-id")
-                .replace('-', "_")
-        };
-        let sc = param(chunks.get(1).copied().unwrap_or("<sc-id>"));
+        let (sc, last) = key_params(m);
         let tail = m.key_tail();
-        let last = if m.named() {
-            chunks.last().copied()
-        } else {
-            None
-        };
         let (args, name_expr) = match last {
-            None => (String::new(), String::new()),
-            Some("<sender-id>") => (
+            KeyName::None => (String::new(), String::new()),
+            KeyName::SenderId => (
                 ", sender_id: int".to_owned(),
                 ", _sender(sender_id)".to_owned(),
             ),
-            Some(p) => {
-                let n = param(p);
-                (format!(", {n}: str"), format!(", {n}"))
-            }
+            KeyName::Text(n) => (format!(", {n}: str"), format!(", {n}")),
         };
         o.push_str(&format!(
             "\n\ndef {}_key({sc}: str{args}) -> str:\n    \"\"\"``{}``: the {}'s key ({}).\"\"\"\n    return _key({sc}, \"{tail}\"{name_expr})\n",
