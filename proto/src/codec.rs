@@ -16,16 +16,17 @@
 //!    [`DecodeError::Malformed`] for an unknown tag or an excessive count; this
 //!    also bounds any allocation before bincode sees a length prefix;
 //! 4. bincode decodes; bad enum tags, bool bytes etc. → [`DecodeError::Malformed`];
-//! 5. [`WireMessage::validate`] (commands: finite numbers) → [`DecodeError::NonFinite`]; a
-//!    [`crate::CssMsg`] detector count above its maximum → [`DecodeError::Malformed`].
+//! 5. [`WireMessage::validate`]: what bincode does not check, from the wire table (a bounded
+//!    `u8` count such as a [`crate::CssMsg`]'s detectors, a text field's padding →
+//!    [`DecodeError::Malformed`]; a non-finite value where the table says `finite` →
+//!    [`DecodeError::NonFinite`]).
+//!
+//! Each message's `decode_*` function and its `WireMessage` impl are generated from the wire
+//! table into `wire.rs`.
 
 use bincode::config::{Configuration, Fixint, Limit, LittleEndian};
 
-use crate::{
-    CommandMsg, CssMsg, DecodeError, EnvironmentMsg, FssMsg, Header, ImuMsg, MagnetometerMsg,
-    OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg, WireMessage, HEADER_LEN,
-    MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
-};
+use crate::{DecodeError, Header, WireMessage, HEADER_LEN, MAX_MESSAGE_BYTES, PROTOCOL_VERSION};
 
 /// The bincode configuration of the wire format.
 const CONFIG: Configuration<LittleEndian, Fixint, Limit<MAX_MESSAGE_BYTES>> =
@@ -42,7 +43,7 @@ pub fn encode<M: WireMessage>(msg: &M) -> Vec<u8> {
 /// capacity, so a publisher can reuse one buffer without allocating per frame.
 ///
 /// Encoding cannot fail; it does not run [`WireMessage::validate`], and a
-/// [`StateMsg`] with more than [`crate::MAX_EFFECTORS`] effectors encodes fine but
+/// [`crate::StateMsg`] with more than [`crate::MAX_EFFECTORS`] effectors encodes fine but
 /// is rejected by decoders.
 pub fn encode_into<M: WireMessage>(msg: &M, buf: &mut Vec<u8>) {
     buf.clear();
@@ -94,81 +95,6 @@ pub fn decode_header(bytes: &[u8]) -> Result<Header, DecodeError> {
     let (header, _): (Header, usize) = bincode::serde::decode_from_slice(head, CONFIG)
         .map_err(|e| map_err("Header", head.len(), e))?;
     Ok(header)
-}
-
-/// [`decode`] for [`StateMsg`].
-pub fn decode_state(bytes: &[u8]) -> Result<StateMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`ImuMsg`].
-pub fn decode_imu(bytes: &[u8]) -> Result<ImuMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`StarTrackerMsg`].
-pub fn decode_star_tracker(bytes: &[u8]) -> Result<StarTrackerMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`EnvironmentMsg`].
-pub fn decode_environment(bytes: &[u8]) -> Result<EnvironmentMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`MagnetometerMsg`].
-pub fn decode_magnetometer(bytes: &[u8]) -> Result<MagnetometerMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`CssMsg`] (rejects a detector count above [`crate::MAX_CSS_DETECTORS`]).
-pub fn decode_css(bytes: &[u8]) -> Result<CssMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`crate::GpsMsg`].
-pub fn decode_gps(bytes: &[u8]) -> Result<crate::GpsMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`FssMsg`].
-pub fn decode_fss(bytes: &[u8]) -> Result<FssMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`CommandMsg`] (rejects non-finite torque/force).
-pub fn decode_command(bytes: &[u8]) -> Result<CommandMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`TimeMsg`].
-pub fn decode_time(bytes: &[u8]) -> Result<TimeMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`OperatorMsg`].
-pub fn decode_operator(bytes: &[u8]) -> Result<OperatorMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`crate::FaultEventMsg`].
-pub fn decode_fault_event(bytes: &[u8]) -> Result<crate::FaultEventMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`crate::FaultCommandMsg`] (rejects non-finite parameters).
-pub fn decode_fault_command(bytes: &[u8]) -> Result<crate::FaultCommandMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`crate::RelativeStateMsg`].
-pub fn decode_relative_state(bytes: &[u8]) -> Result<crate::RelativeStateMsg, DecodeError> {
-    decode(bytes)
-}
-
-/// [`decode`] for [`StatusMsg`].
-pub fn decode_status(bytes: &[u8]) -> Result<StatusMsg, DecodeError> {
-    decode(bytes)
 }
 
 fn check_size_and_version(bytes: &[u8], min_len: usize) -> Result<(), DecodeError> {

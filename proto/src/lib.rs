@@ -110,17 +110,20 @@ pub mod keys;
 mod layout;
 mod messages;
 pub mod view;
+// Written by flexdyn-wiregen from proto/schema/messages.toml: each message's sizes, length rule,
+// checks and decoder, and the protocol's constants.
+#[rustfmt::skip]
+mod wire;
 
-pub use codec::{
-    decode, decode_command, decode_css, decode_environment, decode_fss, decode_header, decode_imu,
-    decode_magnetometer, decode_operator, decode_star_tracker, decode_state, decode_status,
-    decode_time, encode, encode_into,
-};
+pub use codec::{decode, decode_header, encode, encode_into};
+// Every message's decode_* function, the table's constants and every encoded size and offset:
+// all of wire.rs, so a message added to the table needs no line here.
 pub use error::{DecodeError, KeyError};
+#[doc(inline)]
+pub use wire::*;
 // The JSON Schemas of the messages' JSON (MCAP decoded channels, Foxglove), from the wire table.
 pub use json_schemas::json_schema_text;
 // The GPS receiver (issue 20, protocol 7).
-pub use codec::decode_gps;
 pub use keys::GPS_PREFIX;
 pub use keys::{
     cmd_key, cmd_wildcard_key, imu_key, imu_wildcard_key, operator_key, participant_key,
@@ -130,14 +133,8 @@ pub use keys::{
     FSS_PREFIX, IMU_PREFIX, KEY_ROOT, MAGNETOMETER_PREFIX, MAX_ID_LEN, OPERATOR_SUFFIX,
     PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
 };
-pub use layout::GPS_LEN;
 pub use layout::{
-    WireLayout, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
-    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CSS_LEN, EFFECTOR_INPUT_FIXED_LEN,
-    EFFECTOR_STATE_FIXED_LEN, ENVIRONMENT_LEN, FSS_LEN, HEADER_LEN, IMU_LEN, MAGNETOMETER_LEN,
-    MAX_EFFECTORS, MAX_EFFECTOR_VALUES, MAX_MESSAGE_BYTES, MAX_PANEL_PAIRS, OPERATOR_LEN,
-    STAR_TRACKER_LEN, STATE_EFFECTOR_COUNT_OFFSET, STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET,
-    TIME_LEN,
+    WireLayout, WireMessage, MAX_PANEL_PAIRS, STATE_EFFECTOR_COUNT_OFFSET, TIME_CUC_OFFSET,
 };
 pub use messages::{
     command_flags, eclipse, effector_kind, environment_flags, fss_flags, magnetometer_flags,
@@ -145,22 +142,16 @@ pub use messages::{
     wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, CssMsg,
     EffectorInput, EffectorState, EnvironmentMsg, FrameTiming, FssMsg, Header, ImuMsg,
     MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters, RunState, StalePolicy,
-    StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime, CUC_PFIELD_TAI_4_3,
-    MAX_CSS_DETECTORS, NO_COMMAND,
+    StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime,
 };
 pub use messages::{gps_flags, GpsMsg};
 // Fault injection (issue 21, protocol 8).
-pub use codec::{decode_fault_command, decode_fault_event};
 pub use keys::{FAULT_EVENT_SUFFIX, FAULT_SUFFIX};
-pub use layout::{FAULT_COMMAND_LEN, FAULT_EVENT_LEN};
 pub use messages::{
-    FaultAction, FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget, AT_NEXT_TICK,
-    FAULT_MODE_NAMES, FAULT_TARGET_LEN, MAX_STATUS_FAULTS,
+    FaultAction, FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget, FAULT_MODE_NAMES,
 };
 // A fleet deputy's state relative to its chief (issue 22, protocol 9).
-pub use codec::decode_relative_state;
 pub use keys::{relative_state_key, RELATIVE_STATE_PREFIX};
-pub use layout::RELATIVE_STATE_LEN;
 pub use messages::RelativeStateMsg;
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
@@ -179,4 +170,7 @@ pub use messages::RelativeStateMsg;
 /// active faults in StatusMsg, which grows to 235 bytes).
 /// Version 9: a fleet deputy's state relative to its chief (issue 22, [`RelativeStateMsg`] on
 /// `flexdyn/<deputy>/tlm/rel/<chief>`).
-pub const PROTOCOL_VERSION: u16 = 9;
+///
+/// The number itself is the wire table's `protocol_version` (`proto/schema/messages.toml`),
+/// exported with the table's other constants, sizes and `decode_*` functions above.
+pub use wire::PROTOCOL_VERSION;

@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::PROTOCOL_VERSION;
+use crate::{FAULT_TARGET_LEN, MAX_CSS_DETECTORS, PROTOCOL_VERSION};
 
 /// Common header, the first 30 bytes of every message.
 ///
@@ -327,10 +327,6 @@ pub struct MagnetometerMsg {
     pub saturation_flags: u8,
 }
 
-/// Most detectors one [`CssMsg`] carries (one coarse-sun-sensor array); a configuration may
-/// not have more.
-pub const MAX_CSS_DETECTORS: usize = 16;
-
 /// A coarse-sun-sensor array sample, topic `flexdyn/<sc-id>/tlm/css/<name>`: one reading per
 /// cosine detector. 159 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -615,10 +611,6 @@ pub struct FrameTiming {
     pub frames_skipped: u64,
 }
 
-/// Value of [`CommandStatus::last_command_tick`] and
-/// [`CommandStatus::command_age_ns`] before any command was accepted.
-pub const NO_COMMAND: u64 = u64::MAX;
-
 /// Command bookkeeping. 21 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct CommandStatus {
@@ -753,12 +745,6 @@ pub mod time_flags {
     /// Bits 3..7 are reserved: senders write 0, receivers ignore them.
     pub const RESERVED_MASK: u8 = !(EPOCH_VALID | TONE | LEAP_SECOND);
 }
-
-/// CCSDS unsegmented time code (CUC, CCSDS 301.0-B-4 §3.2) P-field of [`TimeMsg::cuc_tai`]:
-/// `0 001 11 11` = no extension, time code identification `001` (Level 1: epoch
-/// 1958-01-01T00:00:00 TAI), 4 octets of coarse time (seconds), 3 octets of fine time
-/// (units of 2⁻²⁴ s).
-pub const CUC_PFIELD_TAI_4_3: u8 = 0x1F;
 
 /// A UTC calendar reading. 11 bytes on the wire. All zero when the run has no `[epoch]`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -970,9 +956,6 @@ pub struct EnvironmentMsg {
     pub residual_dipole: AppliedWrench,
 }
 
-/// Largest fault index StatusMsg's [`StatusMsg::faults_active_bits`] can show (bits 0–255); a
-/// fault beyond it is counted in [`StatusMsg::faults_active`] only. Protocol version 8.
-pub const MAX_STATUS_FAULTS: usize = 256;
 /// The fault modes' names by code (the `mode` of [`FaultEventMsg`] and [`FaultCommandMsg`]):
 /// `proto/README.md`, "Fault modes"; the names a configuration's `[[faults]]` use.
 pub const FAULT_MODE_NAMES: [&str; 21] = [
@@ -998,11 +981,6 @@ pub const FAULT_MODE_NAMES: [&str; 21] = [
     "delayed",
     "corrupted",
 ];
-
-/// Bytes of a [`FaultTarget`]. Protocol version 8.
-pub const FAULT_TARGET_LEN: usize = 128;
-/// [`FaultCommandMsg::at_tick`] for "at the next frame boundary". Protocol version 8.
-pub const AT_NEXT_TICK: u64 = u64::MAX;
 
 /// A fault's target as written in a configuration (`imus.hub.gyro`, `reaction_wheels.rw2`):
 /// [`FAULT_TARGET_LEN`] bytes of UTF-8, padded with NUL bytes (no length prefix on the wire; in

@@ -225,7 +225,7 @@ fn huge_counts_are_rejected_without_allocating() {
     s.effectors[0].states = vec![0.0; MAX_EFFECTOR_VALUES + 1];
     assert!(matches!(
         decode_state(&encode(&s)),
-        Err(DecodeError::Malformed(m)) if m.contains("effector states count 9")
+        Err(DecodeError::Malformed(m)) if m.contains("effectors[].states count 9")
     ));
     s.effectors[0].states = vec![0.0; MAX_EFFECTOR_VALUES];
     s.effectors[0].outputs = vec![0.0; MAX_EFFECTOR_VALUES];
@@ -237,7 +237,7 @@ fn huge_counts_are_rejected_without_allocating() {
     let c = actuators(vec![input(0, &[0.0; MAX_EFFECTOR_VALUES + 1])]);
     assert!(matches!(
         decode_command(&encode(&c)),
-        Err(DecodeError::Malformed(m)) if m.contains("effector input values count 9")
+        Err(DecodeError::Malformed(m)) if m.contains("inputs[].values count 9")
     ));
 }
 

@@ -1439,7 +1439,7 @@ fn css_golden() {
     assert!(decode::<CssMsg>(&b).is_ok());
     b[30] = MAX_CSS_DETECTORS as u8 + 1;
     assert!(
-        matches!(decode::<CssMsg>(&b), Err(DecodeError::Malformed(ref m)) if m.contains("detector count 17")),
+        matches!(decode::<CssMsg>(&b), Err(DecodeError::Malformed(ref m)) if m.contains("detector_count 17")),
         "{:?}",
         decode::<CssMsg>(&b)
     );

@@ -70,12 +70,12 @@
 #define FD_MAX_MESSAGE_BYTES 65536u /* the largest buffer any decoder accepts (bytes); more is TooLarge */
 #define FD_MAX_EFFECTORS 1024u /* the largest effector count of a StateMsg, and input count of an `Actuators` command */
 #define FD_MAX_EFFECTOR_VALUES 8u /* the largest length of an effector's `states`, `outputs` or input `values` */
-#define FD_MAX_CSS_DETECTORS 16u /* the detectors a CssMsg carries at most */
+#define FD_MAX_CSS_DETECTORS 16u /* the most detectors one CssMsg carries (one coarse-sun-sensor array); a configuration may not have more */
 #define FD_FAULT_TARGET_LEN 128u /* the bytes of a fault target (UTF-8, NUL-padded) */
-#define FD_MAX_STATUS_FAULTS 256u /* the fault indices StatusMsg `faults_active_bits` can mark (4 words of 64 bits) */
-#define FD_CUC_PFIELD_TAI_4_3 31u /* TimeMsg `cuc_tai[0]`: the CCSDS 301.0-B-4 CUC P-field (TAI 1958 epoch, 4 coarse and 3 fine octets), 0x1F */
+#define FD_MAX_STATUS_FAULTS 256u /* the fault indices StatusMsg `faults_active_bits` can mark (bits 0–255 in 4 words); a fault beyond them is counted in `faults_active` only */
+#define FD_CUC_PFIELD_TAI_4_3 31u /* TimeMsg `cuc_tai[0]`: the P-field of the CCSDS unsegmented time code (CUC, CCSDS 301.0-B-4 §3.2), `0 001 11 11` = no extension, time code identification `001` (Level 1: epoch 1958-01-01T00:00:00 TAI), 4 octets of coarse time (seconds), 3 octets of fine time (units of 2⁻²⁴ s) */
 #define FD_AT_NEXT_TICK UINT64_MAX /* FaultCommandMsg `at_tick`: at the next frame boundary the server reaches */
-#define FD_NO_COMMAND UINT64_MAX /* CommandStatus `last_command_tick` and `command_age_ns` before any command */
+#define FD_NO_COMMAND UINT64_MAX /* CommandStatus `last_command_tick` and `command_age_ns` before any command was accepted */
 
 /* Encoded sizes (bytes) and offsets. */
 #define FD_HEADER_LEN 30u /* Header */

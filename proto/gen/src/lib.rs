@@ -10,6 +10,7 @@
 //! | the byte tables of `proto/README.md` (between markers) | [`readme`] |
 //! | the header-only C codec, `proto/c/include/flexdyn_proto.h` | [`c_proto`] |
 //! | the Python package's codec, `clients/python/src/flexdyn/proto.py` | [`py_proto`] |
+//! | the Rust codec's per-message code (sizes, constants, length rules, checks, decoders), `proto/src/wire.rs` | [`rust_wire`] |
 //! | the C client library's typed calls, `clients/c/include/flexdyn_client_messages.h` | [`c_client`] |
 //! | the C client library's message kinds, `clients/c/src/kinds.rs` | [`c_client`] |
 //! | the JSON Schemas of the messages' JSON (MCAP decoded channels, Foxglove), `proto/schema/json/*.json` and `proto/src/json_schemas.rs` | [`json_schema`] |
@@ -19,6 +20,7 @@ pub mod c_proto;
 pub mod json_schema;
 pub mod py_proto;
 pub mod readme;
+pub mod rust_wire;
 pub mod sizes;
 pub mod table;
 
@@ -34,6 +36,8 @@ pub const C_HEADER_PATH: &str = "clients/c/include/flexdyn_client_messages.h";
 pub const C_PROTO_PATH: &str = "proto/c/include/flexdyn_proto.h";
 /// The Python package's codec.
 pub const PY_PROTO_PATH: &str = "clients/python/src/flexdyn/proto.py";
+/// The Rust codec's per-message code.
+pub const RUST_WIRE_PATH: &str = "proto/src/wire.rs";
 /// The C client library's generated kind table.
 pub const KINDS_PATH: &str = "clients/c/src/kinds.rs";
 /// The wire crate's generated index of the JSON Schemas.
@@ -79,6 +83,10 @@ pub fn mirrors(root: &Path) -> Result<Vec<Mirror>, String> {
         Mirror {
             path: PY_PROTO_PATH.into(),
             text: py_proto::module(&table),
+        },
+        Mirror {
+            path: RUST_WIRE_PATH.into(),
+            text: rust_wire::module(&table),
         },
         Mirror {
             path: KINDS_PATH.into(),

@@ -12,6 +12,7 @@
 //! (`StatusMsg.rejected_malformed`), a union is its tag plus every variant's fields, a field with
 //! `py_tuple` is a tuple of its struct's numbers (`TimeMsg.utc`).
 
+use crate::sizes::wrap;
 use crate::table::{screaming_snake, Field, Message, Prim, Table, Ty};
 
 const PROLOGUE: &str = include_str!("py_proto/prologue.py");
@@ -68,26 +69,6 @@ fn zero(p: Prim) -> &'static str {
 /// A docstring-safe text.
 fn doc(s: &str) -> String {
     s.replace('\\', "\\\\").replace("\"\"\"", "'''")
-}
-
-/// `text` wrapped at `width` columns, each line after the first starting with `indent`.
-fn wrap(text: &str, width: usize, indent: &str) -> String {
-    let mut out = String::new();
-    let mut line = String::new();
-    for word in text.split_whitespace() {
-        if !line.is_empty() && line.len() + 1 + word.len() > width {
-            out.push_str(&line);
-            out.push('\n');
-            out.push_str(indent);
-            line.clear();
-        }
-        if !line.is_empty() {
-            line.push(' ');
-        }
-        line.push_str(word);
-    }
-    out.push_str(&line);
-    out
 }
 
 /// A Python class name for a struct.

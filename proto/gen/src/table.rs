@@ -45,6 +45,8 @@ pub struct Constant {
     pub name: String,
     /// Its value.
     pub value: ConstValue,
+    /// Its Rust type: `usize` (a size or count), `u64` or `u8`.
+    pub rust_type: String,
     /// What it is.
     pub doc: String,
 }
@@ -713,7 +715,25 @@ impl Table {
                     "a constant's name is SCREAMING_SNAKE and used once",
                 ));
             }
-            c.value().map_err(|e| Self::err(file, place, e))?;
+            let v = c.value().map_err(|e| Self::err(file, place.clone(), e))?;
+            let fits = match c.rust_type.as_str() {
+                "u8" => v <= u64::from(u8::MAX),
+                "u16" => v <= u64::from(u16::MAX),
+                "u32" => v <= u64::from(u32::MAX),
+                "u64" => true,
+                "usize" => v <= u64::from(u32::MAX),
+                _ => false,
+            };
+            if !fits {
+                return Err(Self::err(
+                    file,
+                    place,
+                    format!(
+                        "rust_type {:?}: a u8, u16, u32, u64 or usize that holds {v}",
+                        c.rust_type
+                    ),
+                ));
+            }
         }
         for c in &self.codes {
             let mut seen = BTreeSet::new();

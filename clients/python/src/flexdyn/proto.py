@@ -38,18 +38,22 @@ MAX_MESSAGE_BYTES = 65536
 MAX_EFFECTORS = 1024
 # the largest length of an effector's `states`, `outputs` or input `values`
 MAX_EFFECTOR_VALUES = 8
-# the detectors a CssMsg carries at most
+# the most detectors one CssMsg carries (one coarse-sun-sensor array); a configuration may not
+# have more
 MAX_CSS_DETECTORS = 16
 # the bytes of a fault target (UTF-8, NUL-padded)
 FAULT_TARGET_LEN = 128
-# the fault indices StatusMsg `faults_active_bits` can mark (4 words of 64 bits)
+# the fault indices StatusMsg `faults_active_bits` can mark (bits 0–255 in 4 words); a fault
+# beyond them is counted in `faults_active` only
 MAX_STATUS_FAULTS = 256
-# TimeMsg `cuc_tai[0]`: the CCSDS 301.0-B-4 CUC P-field (TAI 1958 epoch, 4 coarse and 3 fine
-# octets), 0x1F
+# TimeMsg `cuc_tai[0]`: the P-field of the CCSDS unsegmented time code (CUC, CCSDS 301.0-B-4
+# §3.2), `0 001 11 11` = no extension, time code identification `001` (Level 1: epoch
+# 1958-01-01T00:00:00 TAI), 4 octets of coarse time (seconds), 3 octets of fine time (units of
+# 2⁻²⁴ s)
 CUC_PFIELD_TAI_4_3 = 31
 # FaultCommandMsg `at_tick`: at the next frame boundary the server reaches
 AT_NEXT_TICK = 18446744073709551615
-# CommandStatus `last_command_tick` and `command_age_ns` before any command
+# CommandStatus `last_command_tick` and `command_age_ns` before any command was accepted
 NO_COMMAND = 18446744073709551615
 
 # Encoded sizes (bytes) and offsets.
