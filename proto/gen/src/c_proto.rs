@@ -581,17 +581,7 @@ fn decls(body: &str, candidates: &[(&str, &str)]) -> Vec<String> {
 }
 
 fn indent(lines: &[String], n: usize) -> String {
-    let pad = " ".repeat(n);
-    lines
-        .iter()
-        .map(|l| {
-            if l.is_empty() {
-                "\n".to_owned()
-            } else {
-                format!("{pad}{l}\n")
-            }
-        })
-        .collect()
+    crate::sizes::indent(lines.iter().map(String::as_str), n)
 }
 
 /// Everything about a vec at the end of a field list, found at absolute offset `off` (its

@@ -97,16 +97,7 @@ fn checks(
 }
 
 fn indent(text: &str, n: usize) -> String {
-    let pad = " ".repeat(n);
-    text.lines()
-        .map(|l| {
-            if l.is_empty() {
-                "\n".to_owned()
-            } else {
-                format!("{pad}{l}\n")
-            }
-        })
-        .collect()
+    crate::sizes::indent(text.lines(), n)
 }
 
 /// The walk of a vec whose count is at `off`: leaves the walker past its elements.

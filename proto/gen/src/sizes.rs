@@ -180,3 +180,17 @@ pub fn wrap(text: &str, width: usize, indent: &str) -> String {
     out.push_str(&line);
     out
 }
+
+/// Each line indented by `n` spaces and ended with a newline (an empty line stays empty).
+pub fn indent<'a>(lines: impl Iterator<Item = &'a str>, n: usize) -> String {
+    let pad = " ".repeat(n);
+    lines
+        .map(|l| {
+            if l.is_empty() {
+                "\n".to_owned()
+            } else {
+                format!("{pad}{l}\n")
+            }
+        })
+        .collect()
+}
