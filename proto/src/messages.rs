@@ -179,8 +179,14 @@ pub mod star_tracker_flags {
     pub const SUN_EXCLUSION: u8 = 1 << 0;
     /// Bit 1: |ω_B/N| exceeds the tracker's rate limit.
     pub const RATE_LIMIT: u8 = 1 << 1;
-    /// Bits 2..7 are reserved: senders write 0, receivers ignore them.
-    pub const RESERVED_MASK: u8 = !(SUN_EXCLUSION | RATE_LIMIT);
+    /// Bit 2: the boresight is within the configured exclusion angle of the Earth's limb (its
+    /// radius plus the configured atmosphere height), or on the Earth's disc.
+    pub const EARTH_EXCLUSION: u8 = 1 << 2;
+    /// Bit 3: the boresight is within the configured exclusion angle of the Moon's limb, or on
+    /// its disc.
+    pub const MOON_EXCLUSION: u8 = 1 << 3;
+    /// Bits 4..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 = !(SUN_EXCLUSION | RATE_LIMIT | EARTH_EXCLUSION | MOON_EXCLUSION);
 }
 
 /// Bits of [`ImuMsg::saturation_flags`].

@@ -53,7 +53,7 @@ fn python_constants() -> HashMap<String, u64> {
 
 #[test]
 fn c_and_python_mirror_every_kind_and_flag() {
-    let mirrored: [(&str, u64); 31] = [
+    let mirrored: [(&str, u64); 33] = [
         ("EFFECTOR_PANEL_PAIR", effector_kind::PANEL_PAIR.into()),
         (
             "EFFECTOR_REACTION_WHEEL",
@@ -81,6 +81,14 @@ fn c_and_python_mirror_every_kind_and_flag() {
         (
             "STAR_TRACKER_RATE_LIMIT",
             star_tracker_flags::RATE_LIMIT.into(),
+        ),
+        (
+            "STAR_TRACKER_EARTH_EXCLUSION",
+            star_tracker_flags::EARTH_EXCLUSION.into(),
+        ),
+        (
+            "STAR_TRACKER_MOON_EXCLUSION",
+            star_tracker_flags::MOON_EXCLUSION.into(),
         ),
         ("WHEEL_TORQUE_LIMITED", wheel_flags::TORQUE_LIMITED.into()),
         ("WHEEL_SPEED_LIMITED", wheel_flags::SPEED_LIMITED.into()),

@@ -1742,7 +1742,7 @@ fn flag_bits() {
     assert_eq!(saturation_flags::RESERVED_MASK, 0b1111_0000);
     assert_eq!(star_tracker_flags::SUN_EXCLUSION, 0b01);
     assert_eq!(star_tracker_flags::RATE_LIMIT, 0b10);
-    assert_eq!(star_tracker_flags::RESERVED_MASK, 0b1111_1100);
+    assert_eq!(star_tracker_flags::RESERVED_MASK, 0b1111_0000);
     assert_eq!(magnetometer_flags::AXIS_1, 0b001);
     assert_eq!(magnetometer_flags::AXIS_2, 0b010);
     assert_eq!(magnetometer_flags::AXIS_3, 0b100);

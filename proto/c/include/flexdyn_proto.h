@@ -173,6 +173,8 @@
 /* Bits of star_tracker_flags */
 #define FD_STAR_TRACKER_SUN_EXCLUSION 0x01u /* the boresight is within the configured exclusion angle of the Sun direction */
 #define FD_STAR_TRACKER_RATE_LIMIT 0x02u /* the body rate exceeds the tracker's `max_rate_rad_s` */
+#define FD_STAR_TRACKER_EARTH_EXCLUSION 0x04u /* the boresight is within `earth_exclusion_rad` of the Earth's limb (its radius plus the configured atmosphere height), or on the Earth's disc */
+#define FD_STAR_TRACKER_MOON_EXCLUSION 0x08u /* the boresight is within `moon_exclusion_rad` of the Moon's limb, or on its disc */
 
 /* Bits of magnetometer_flags */
 #define FD_MAGNETOMETER_AXIS_1 0x01u /* `b_s_t[0]` was clipped to ± the range */
