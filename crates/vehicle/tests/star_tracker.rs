@@ -27,6 +27,10 @@ fn tracker(seed: u64) -> StarTrackerConfig {
         sun_from_environment: false,
         sun_exclusion_rad: 0.5,
         max_rate_rad_s: 0.05,
+        earth_exclusion_rad: 0.0,
+        earth_radius_m: 6_378_137.0,
+        earth_atmosphere_m: 0.0,
+        moon_exclusion_rad: 0.0,
     }
 }
 
@@ -296,4 +300,89 @@ fn sun_exclusion_follows_the_environments_sun() {
     .to_string();
     assert!(e.starts_with("star_trackers[0].sun_direction_n"), "{e}");
     assert!(e.contains("not both"), "{e}");
+}
+
+/// The Earth-limb and Moon exclusion through the configuration and the vehicle: the Earth at the
+/// origin of N and the environment's Moon reach the tracker at each update.
+#[test]
+fn earth_and_moon_exclusion_from_the_configuration() {
+    let path = std::path::Path::new(crate::REPO).join("scenarios/wheels_star_tracker.toml");
+    let shipped = std::fs::read_to_string(path).unwrap();
+    // The shipped mounting looks along −y_B, which at t = 0 is 27° inside the Earth's disc (so an
+    // Earth exclusion would blind it from the start): turn the tracker to look along +y_B.
+    let mounting = "dcm_cb = [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]]";
+    assert!(shipped.contains(mounting));
+    let text = shipped.replacen(
+        mounting,
+        "dcm_cb = [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]",
+        1,
+    );
+    let anchor = "sun_direction_n = [1.0, 0.0, 0.0]";
+    assert!(text.contains(anchor));
+    let first = |keys: &str, extra: &str| {
+        let toml = format!(
+            "{}\n{extra}",
+            text.replacen(anchor, &format!("{anchor}\n{keys}"), 1)
+        );
+        let cfg = SimConfig::from_toml_str(&toml).unwrap();
+        let mut sim = Simulation::new(&cfg).unwrap();
+        let mut out = Vec::new();
+        sim.star_tracker_samples_into(0, &mut out);
+        out[0].1
+    };
+    // The boresight's angle to the Earth's limb at t = 0, by hand: the angle to the nadir minus
+    // the Earth's angular radius asin(R / |r|).
+    let cfg = SimConfig::from_toml_str(&text).unwrap();
+    let st = cfg
+        .sensors
+        .of::<StarTrackerConfig>()
+        .next()
+        .unwrap()
+        .clone();
+    let sim = Simulation::new(&cfg).unwrap();
+    let state = sim.spacecraft().state();
+    let b_n = (st.dcm_cb * mrp_to_dcm(&state.sigma_bn)).transpose() * st.boresight_c;
+    let r = state.r_bn_n;
+    let eta = b_n.dot(&(-r / r.norm())).acos() - (6_378_137.0 / r.norm()).asin();
+    assert!(
+        eta > 0.05,
+        "the shipped attitude looks {eta} rad from the limb"
+    );
+    let within = first(&format!("earth_exclusion_rad = {:e}", eta + 0.01), "");
+    assert!(!within.valid);
+    assert_eq!(within.status_flags, star_tracker_flags::EARTH_EXCLUSION);
+    let outside = first(&format!("earth_exclusion_rad = {:e}", eta - 0.01), "");
+    assert!(outside.valid, "{outside:?}");
+    // A 100 km atmosphere widens the disc by asin(R + h / |r|) − asin(R / |r|).
+    let widen = ((6_378_137.0 + 100e3) / r.norm()).asin() - (6_378_137.0 / r.norm()).asin();
+    let thick = first(
+        &format!(
+            "earth_exclusion_rad = {:e}\nearth_atmosphere_m = 100e3",
+            eta - widen + 0.001
+        ),
+        "",
+    );
+    assert_eq!(thick.status_flags, star_tracker_flags::EARTH_EXCLUSION);
+    // The Moon: an exclusion of π covers the sky once the environment has a Moon, and nothing
+    // without one.
+    let epoch = "[epoch]\nutc = \"2026-11-24T06:00:00Z\"\n[environment]\n";
+    let moon = first(
+        "moon_exclusion_rad = 3.141592653589793",
+        &format!("{epoch}moon = true\n"),
+    );
+    assert_eq!(moon.status_flags, star_tracker_flags::MOON_EXCLUSION);
+    let no_moon = first(
+        "moon_exclusion_rad = 3.141592653589793",
+        &format!("{epoch}gravity_gradient = true\n"),
+    );
+    assert!(no_moon.valid, "{no_moon:?}");
+    // A negative angle is refused, naming the field.
+    let e = SimConfig::from_toml_str(&text.replacen(
+        anchor,
+        &format!("{anchor}\nearth_exclusion_rad = -0.1"),
+        1,
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(e.starts_with("star_trackers[0].earth_exclusion_rad"), "{e}");
 }

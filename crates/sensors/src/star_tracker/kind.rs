@@ -47,7 +47,7 @@ pub static KIND: SensorKind = SensorKind {
                 ],
             },
             PanelSpec {
-                y_label: "valid; flags (1 Sun, 2 rate)",
+                y_label: "valid; flags (1 Sun, 2 rate, 4 Earth, 8 Moon)",
                 lines: &[("valid", "valid (0/1)"), ("status_flags", "status flags")],
             },
         ],

@@ -22,9 +22,30 @@
 //!   the direction of the environment sample's r_Sun/B at the update (no exclusion while the
 //!   sample has no Sun), or
 //! - |ω_B/N| exceeds `max_rate_rad_s` (flag `RATE_LIMIT`; the tracker cannot match smeared star
-//!   images).
+//!   images), or
+//! - the boresight is within `earth_exclusion_rad` of the Earth's limb (flag `EARTH_EXCLUSION`),
+//!   or within `moon_exclusion_rad` of the Moon's limb (flag `MOON_EXCLUSION`; the Moon of the
+//!   environment sample, no exclusion while it has none).
 //!
-//! Both use the true attitude and rate at the sample. The noise is drawn at every update, valid or
+//! # Body exclusion (Earth, Moon)
+//! A body of radius R whose centre is at d from point B (d = ‖r‖, r its position relative to B)
+//! fills a disc of angular radius ρ = asin(R / d) about the direction r̂ (the Earth's angular
+//! radius sin ρ = R_E / (R_E + H): Wertz and Larson, *Space Mission Analysis and Design*, 3rd
+//! ed., 1999, §5.1, eq. 5-1).
+//! The boresight's angle to the disc's edge, the limb, is
+//!
+//! η = acos(b̂_N · r̂) − ρ,
+//!
+//! negative while the boresight points into the disc. The tracker is excluded when η is below
+//! the exclusion half-angle, and always when B is inside the body's sphere (d ≤ R). For the
+//! Earth, r = −r_B/N (N is centred on the Earth) and R = `earth_radius_m` +
+//! `earth_atmosphere_m`: the bright limb includes the lit atmosphere, whose height the user sets
+//! (0 by default: the solid Earth). For the Moon, r = r_Moon/B of the environment sample and
+//! R = 1737.4 km, the IAU mean radius (Archinal et al., *Celest. Mech. Dyn. Astr.* 130:22, 2018,
+//! Table 5). An exclusion of 0 switches the check off, so a configuration without these keys
+//! gives the streams it gave before.
+//!
+//! All use the true attitude, rate and position at the sample. The noise is drawn at every update, valid or
 //! not, so the noise stream does not depend on the validity history.
 //!
 //! # Timing and random numbers
@@ -55,6 +76,10 @@ pub use kind::KIND;
 /// Tolerance on |‖v‖ − 1| for the boresight and the Sun direction.
 pub const UNIT_TOL: f64 = 1e-6;
 
+/// \[m\] the Moon's mean radius (IAU WG on Cartographic Coordinates and Rotational Elements,
+/// Archinal et al. 2018, Table 5: 1737.4 km).
+pub const MOON_RADIUS_M: f64 = 1_737_400.0;
+
 /// A star tracker's configuration (`[[star_trackers]]`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StarTrackerConfig {
@@ -84,6 +109,14 @@ pub struct StarTrackerConfig {
     pub sun_exclusion_rad: f64,
     /// [rad/s] largest |ω_B/N| at which the tracker still reports (∞: no limit).
     pub max_rate_rad_s: f64,
+    /// [rad] exclusion half-angle about the Earth's limb (0: no Earth exclusion).
+    pub earth_exclusion_rad: f64,
+    /// [m] the Earth's radius for the limb (default WGS-84 a, 6378137 m).
+    pub earth_radius_m: f64,
+    /// [m] height of the bright atmosphere above `earth_radius_m`, counted as the Earth's disc.
+    pub earth_atmosphere_m: f64,
+    /// [rad] exclusion half-angle about the Moon's limb (0: no Moon exclusion).
+    pub moon_exclusion_rad: f64,
 }
 
 impl StarTrackerConfig {
@@ -116,6 +149,10 @@ impl StarTrackerConfig {
         )?;
         check_sensor_term(path, "bias_c_rad", self.bias_c_rad.as_slice(), false)?;
         check_non_negative(path, "sun_exclusion_rad", self.sun_exclusion_rad)?;
+        check_non_negative(path, "earth_exclusion_rad", self.earth_exclusion_rad)?;
+        check_positive(path, "earth_radius_m", self.earth_radius_m)?;
+        check_non_negative(path, "earth_atmosphere_m", self.earth_atmosphere_m)?;
+        check_non_negative(path, "moon_exclusion_rad", self.moon_exclusion_rad)?;
         if self.max_rate_rad_s.is_nan() {
             return Err(ParamError::NotFinite {
                 field: join(path, "max_rate_rad_s"),
@@ -229,12 +266,30 @@ impl StarTracker {
     }
 
     /// One update with the unit Sun direction `sun_n` in N for the exclusion (`None`: no Sun,
-    /// no exclusion). Allocates nothing.
+    /// no exclusion), and no Earth or Moon. Allocates nothing.
     pub fn sample_with_sun(
         &mut self,
         sigma_bn: &Vector3<f64>,
         omega_bn_b: &Vector3<f64>,
         sun_n: Option<&Vector3<f64>>,
+    ) -> StarTrackerSample {
+        self.sample_in_sky(
+            sigma_bn,
+            omega_bn_b,
+            &Sky {
+                sun_n: sun_n.copied(),
+                ..Sky::default()
+            },
+        )
+    }
+
+    /// One update at the true attitude and rate with the bodies of `sky` (module docs,
+    /// "Validity" and "Body exclusion"). Allocates nothing.
+    pub fn sample_in_sky(
+        &mut self,
+        sigma_bn: &Vector3<f64>,
+        omega_bn_b: &Vector3<f64>,
+        sky: &Sky,
     ) -> StarTrackerSample {
         let (n1, n2) = self.rng.normal_pair();
         let (n3, _) = self.rng.normal_pair();
@@ -242,9 +297,20 @@ impl StarTracker {
         let dcm_cn = c.dcm_cb * mrp_to_dcm(sigma_bn);
         let mut flags = 0;
         let boresight_n = dcm_cn.transpose() * c.boresight_c;
-        if let Some(sun_n) = sun_n.filter(|_| c.sun_exclusion_rad > 0.0) {
-            if boresight_n.dot(sun_n).clamp(-1.0, 1.0).acos() < c.sun_exclusion_rad {
+        if let Some(sun_n) = sky.sun_n.filter(|_| c.sun_exclusion_rad > 0.0) {
+            if boresight_n.dot(&sun_n).clamp(-1.0, 1.0).acos() < c.sun_exclusion_rad {
                 flags |= star_tracker_flags::SUN_EXCLUSION;
+            }
+        }
+        if let Some(r_bn_n) = sky.r_bn_n.filter(|_| c.earth_exclusion_rad > 0.0) {
+            let radius = c.earth_radius_m + c.earth_atmosphere_m;
+            if limb_angle_rad(&boresight_n, &-r_bn_n, radius) < c.earth_exclusion_rad {
+                flags |= star_tracker_flags::EARTH_EXCLUSION;
+            }
+        }
+        if let Some(r_moon_b_n) = sky.r_moon_b_n.filter(|_| c.moon_exclusion_rad > 0.0) {
+            if limb_angle_rad(&boresight_n, &r_moon_b_n, MOON_RADIUS_M) < c.moon_exclusion_rad {
+                flags |= star_tracker_flags::MOON_EXCLUSION;
             }
         }
         if omega_bn_b.norm() > c.max_rate_rad_s {
@@ -296,26 +362,32 @@ impl Sensor for StarTracker {
         }
         out.push(("sun_exclusion_rad".into(), c.sun_exclusion_rad));
         out.push(("max_rate_rad_s".into(), c.max_rate_rad_s));
+        out.push(("earth_exclusion_rad".into(), c.earth_exclusion_rad));
+        out.push(("earth_radius_m".into(), c.earth_radius_m));
+        out.push(("earth_atmosphere_m".into(), c.earth_atmosphere_m));
+        out.push(("moon_exclusion_rad".into(), c.moon_exclusion_rad));
     }
 
     fn due(&self, tick: u64) -> bool {
         StarTracker::due(self, tick)
     }
 
-    /// One update at the true attitude and rate ([`StarTracker::sample_with_sun`]), with the
-    /// configured Sun direction or the environment's.
+    /// One update at the true attitude and rate ([`StarTracker::sample_in_sky`]), with the
+    /// configured Sun direction or the environment's, the Earth at the origin of N and the
+    /// environment's Moon.
     fn sample(&mut self, truth: &Truth<'_>) {
         let sun_n = if self.cfg.sun_from_environment {
             truth.sun_n()
         } else {
             Some(self.cfg.sun_direction_n)
         };
-        self.last = StarTracker::sample_with_sun(
-            self,
-            &truth.state.sigma_bn,
-            &truth.state.omega_bn_b,
-            sun_n.as_ref(),
-        );
+        let sky = Sky {
+            sun_n,
+            r_bn_n: Some(truth.state.r_bn_n),
+            r_moon_b_n: truth.env.map(|e| e.r_moon_b_n_m).filter(|r| r.norm() > 0.0),
+        };
+        self.last =
+            StarTracker::sample_in_sky(self, &truth.state.sigma_bn, &truth.state.omega_bn_b, &sky);
     }
 
     /// `seq` counts the tracker's updates: the frame's tick / `every_frames`.
@@ -367,6 +439,30 @@ impl Sensor for StarTracker {
     fn force_invalid(&mut self) {
         self.last.valid = false;
     }
+}
+
+/// Where the bodies a tracker must not look at are, at one update (N components).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Sky {
+    /// Unit direction from B to the Sun (`None`: no Sun, no Sun exclusion).
+    pub sun_n: Option<Vector3<f64>>,
+    /// \[m\] position of B relative to the Earth's centre, the origin of N (`None`: no Earth
+    /// exclusion).
+    pub r_bn_n: Option<Vector3<f64>>,
+    /// \[m\] position of the Moon's centre relative to B (`None`: no Moon exclusion).
+    pub r_moon_b_n: Option<Vector3<f64>>,
+}
+
+/// \[rad\] the angle from the unit `boresight_n` to the limb of a sphere of `radius_m` whose
+/// centre is at `r_n` from B: acos(b̂ · r̂) − asin(R / ‖r‖), negative inside the disc; −∞ when B
+/// is inside the sphere (module docs, "Body exclusion").
+pub fn limb_angle_rad(boresight_n: &Vector3<f64>, r_n: &Vector3<f64>, radius_m: f64) -> f64 {
+    let d = r_n.norm();
+    if d <= radius_m {
+        return f64::NEG_INFINITY;
+    }
+    let to_centre = boresight_n.dot(r_n) / d;
+    to_centre.clamp(-1.0, 1.0).acos() - (radius_m / d).asin()
 }
 
 /// The frame rotation [C̃C] by the rotation vector `theta` (through its MRP, exact).

@@ -13,6 +13,10 @@
 //!   would be blind over more than a hemisphere.
 //! - rate limit: trackers keep tracking up to a few °/s (the HAST above: 4°/s). Above 1 rad/s
 //!   (57°/s) is a warning.
+//! - Earth and Moon exclusion half-angles (from the limb): some degrees to about 30°; above 90°
+//!   the tracker is blind over more than a hemisphere, as for the Sun.
+//! - the atmosphere counted as the Earth's limb: tens of kilometres (the bright airglow and
+//!   scattering layer is below about 100 km). Above 1000 km is a warning.
 
 use super::StarTrackerConfig;
 use flexdyn_kernel::schema::plausible::{Implausible, Range, ARCSEC, DEG};
@@ -60,6 +64,36 @@ pub(crate) fn check(st: &StarTrackerConfig, path: &str, out: &mut Vec<Implausibl
                 si: "rad",
                 plausible: (0.1, std::f64::consts::FRAC_PI_2),
                 units: &[("deg", DEG)],
+            },
+        ),
+        (
+            "earth_exclusion_rad",
+            st.earth_exclusion_rad,
+            Range {
+                what: "a star tracker's Earth-limb exclusion half-angle",
+                si: "rad",
+                plausible: (0.01, std::f64::consts::FRAC_PI_2),
+                units: &[("deg", DEG)],
+            },
+        ),
+        (
+            "moon_exclusion_rad",
+            st.moon_exclusion_rad,
+            Range {
+                what: "a star tracker's Moon exclusion half-angle",
+                si: "rad",
+                plausible: (0.01, std::f64::consts::FRAC_PI_2),
+                units: &[("deg", DEG)],
+            },
+        ),
+        (
+            "earth_atmosphere_m",
+            st.earth_atmosphere_m,
+            Range {
+                what: "the atmosphere height of a star tracker's Earth limb",
+                si: "m",
+                plausible: (1.0, 1e6),
+                units: &[("km", 1e3)],
             },
         ),
         (

@@ -11,7 +11,7 @@ use flexdyn_kernel::schema::config_error::ConfigError;
 use flexdyn_kernel::schema::{mat3, vec3, SchemaError, TableReader};
 
 /// The keys of one `[[star_trackers]]` entry (the first six are required).
-pub(crate) const KEYS: [&str; 12] = [
+pub(crate) const KEYS: [&str; 16] = [
     "name",
     "dcm_cb",
     "sigma_cross_boresight_rad",
@@ -24,6 +24,10 @@ pub(crate) const KEYS: [&str; 12] = [
     "sun_from_environment",
     "sun_exclusion_rad",
     "max_rate_rad_s",
+    "earth_exclusion_rad",
+    "earth_radius_m",
+    "earth_atmosphere_m",
+    "moon_exclusion_rad",
 ];
 
 /// One entry as written (the rate is converted to frames by the configuration).
@@ -40,6 +44,10 @@ pub(crate) struct RawStarTracker {
     pub(crate) sun_from_environment: bool,
     pub(crate) sun_exclusion_rad: f64,
     pub(crate) max_rate_rad_s: f64,
+    pub(crate) earth_exclusion_rad: f64,
+    pub(crate) earth_radius_m: f64,
+    pub(crate) earth_atmosphere_m: f64,
+    pub(crate) moon_exclusion_rad: f64,
 }
 
 /// Reads one entry.
@@ -71,6 +79,12 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<RawStarTracker, SchemaErro
         sun_from_environment,
         sun_exclusion_rad: t.opt_f64("sun_exclusion_rad")?.unwrap_or(0.0),
         max_rate_rad_s: t.opt_f64("max_rate_rad_s")?.unwrap_or(f64::INFINITY),
+        earth_exclusion_rad: t.opt_f64("earth_exclusion_rad")?.unwrap_or(0.0),
+        earth_radius_m: t
+            .opt_f64("earth_radius_m")?
+            .unwrap_or(flexdyn_environment::geodetic::WGS84_A_M),
+        earth_atmosphere_m: t.opt_f64("earth_atmosphere_m")?.unwrap_or(0.0),
+        moon_exclusion_rad: t.opt_f64("moon_exclusion_rad")?.unwrap_or(0.0),
     })
 }
 
@@ -101,6 +115,10 @@ impl RawSensorConfig for RawStarTracker {
             sun_from_environment: raw.sun_from_environment,
             sun_exclusion_rad: raw.sun_exclusion_rad,
             max_rate_rad_s: raw.max_rate_rad_s,
+            earth_exclusion_rad: raw.earth_exclusion_rad,
+            earth_radius_m: raw.earth_radius_m,
+            earth_atmosphere_m: raw.earth_atmosphere_m,
+            moon_exclusion_rad: raw.moon_exclusion_rad,
         };
         cfg.validate(path).map_err(|e| ctx.param(e))?;
         Ok(Box::new(cfg))
