@@ -14,6 +14,8 @@ use flexdyn_proto::WireMessage;
 use flexdyn_wiregen::table::{Prim, Table, Ty};
 use serde_json::{json, Map, Value};
 
+mod shapes;
+
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
