@@ -16,10 +16,10 @@
 //!    [`DecodeError::Malformed`] for an unknown tag or an excessive count; this
 //!    also bounds any allocation before bincode sees a length prefix;
 //! 4. bincode decodes; bad enum tags, bool bytes etc. → [`DecodeError::Malformed`];
-//! 5. [`WireMessage::validate`]: what bincode does not check, from the wire table (a bounded
-//!    `u8` count such as a [`crate::CssMsg`]'s detectors, a text field's padding →
-//!    [`DecodeError::Malformed`]; a non-finite value where the table says `finite` →
-//!    [`DecodeError::NonFinite`]).
+//! 5. [`WireMessage::validate`], from the wire table: first the rest of step 4 that bincode
+//!    does not check (a bounded `u8` count such as a [`crate::CssMsg`]'s detectors, a text
+//!    field's padding → [`DecodeError::Malformed`]), then step 5 proper (a non-finite value
+//!    where the table says `finite` → [`DecodeError::NonFinite`]).
 //!
 //! Each message's `decode_*` function and its `WireMessage` impl are generated from the wire
 //! table into `wire.rs`.

@@ -1,6 +1,6 @@
 /*
  * A libFuzzer target over every decoder of flexdyn_proto.h, built with AddressSanitizer and
- * UndefinedBehaviorSanitizer (proto/tests/c_header.rs, `libfuzzer_with_sanitizers_finds_nothing`).
+ * UndefinedBehaviorSanitizer (proto/tests/c_libfuzzer.rs, `libfuzzer_with_sanitizers_finds_nothing`).
  *
  * Beyond "no crash, no memory error, no undefined behaviour", each input is held to the
  * header's own contract; a breach aborts, which libFuzzer reports as a crash with the input:

@@ -549,7 +549,7 @@ impl<'t> Gen<'t> {
         let name = &f.name;
         match *inner {
             Ty::Struct(s) => {
-                o.push(format!("{name} = []"));
+                o.push(format!("vec_{name} = []"));
                 o.push(format!("at = {at}"));
                 o.push("for _ in range(n):".into());
                 let mut k = 0;
@@ -651,13 +651,13 @@ impl<'t> Gen<'t> {
                     o.push(format!("    at += {k}"));
                 }
                 o.push(format!(
-                    "    {name}.append({}({}))",
+                    "    vec_{name}.append({}({}))",
                     class_of(self.t, s),
                     args.join(", ")
                 ));
             }
             Ty::Prim(p) => o.push(format!(
-                "{name} = list(struct.unpack_from(f\"<{{n}}{}\", buf, {at}))",
+                "vec_{name} = list(struct.unpack_from(f\"<{{n}}{}\", buf, {at}))",
                 fmt(p)
             )),
             _ => unreachable!("checked"),
@@ -1121,7 +1121,7 @@ fn message(g: &Gen, m: &Message, o: &mut String) {
         None => b.push(format!("return {}", call("cls", &args))),
         Some((f, Ty::Vec(_))) => {
             g.read_vec(f, prefix_len + 8, &mut b);
-            args.push(f.name.clone());
+            args.push(format!("vec_{}", f.name));
             b.push(format!("m = {}", call("cls", &args)));
             if has_finite {
                 b.push("m.validate()".into());
@@ -1154,7 +1154,7 @@ fn message(g: &Gen, m: &Message, o: &mut String) {
                 if let Some(vtf) = vt {
                     let voff = off + 4 + t.fields_size(vf).expect("fixed");
                     g.read_vec(vtf, voff + 8, &mut vb);
-                    vb.push(format!("m.{n} = {n}", n = vtf.name));
+                    vb.push(format!("m.{n} = vec_{n}", n = vtf.name));
                 }
                 if vb.is_empty() {
                     continue;

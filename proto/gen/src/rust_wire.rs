@@ -27,6 +27,7 @@ fn checks(
     fields: &[Field],
     access: &dyn Fn(&str) -> String,
     path: &str,
+    by_ref: bool,
 ) -> (Vec<String>, Vec<String>) {
     let (mut step4, mut step5) = (Vec::new(), Vec::new());
     for f in fields {
@@ -36,7 +37,8 @@ fn checks(
             Ty::Prim(Prim::U8) if f.max.is_some() => {
                 let max = f.max.unwrap_or(0);
                 step4.push(format!(
-                    "if u64::from({v}) > {max} {{\n    return Err(DecodeError::Malformed(format!(\"{p} {{}} exceeds maximum {max}\", {v})));\n}}"
+                    "if u64::from({}{v}) > {max} {{\n    return Err(DecodeError::Malformed(format!(\"{p} {{}} exceeds maximum {max}\", {v})));\n}}",
+                    if by_ref { "*" } else { "" }
                 ));
             }
             Ty::Array(Prim::U8, _) if f.text => {
@@ -86,6 +88,7 @@ fn checks(
                     &t.structs[s].fields,
                     &|n: &str| format!("{v}.{n}"),
                     &format!("{p}."),
+                    false,
                 );
                 step4.extend(a);
                 step5.extend(b);
@@ -162,7 +165,7 @@ fn message(t: &Table, m: &Message, o: &mut String) {
         Some(_) => min.to_string(),
     };
     // validate(): step 4 (what bincode leaves), then step 5, each in wire order.
-    let (mut s4, mut s5) = checks(t, fixed, &|n: &str| format!("self.{n}"), "");
+    let (mut s4, mut s5) = checks(t, fixed, &|n: &str| format!("self.{n}"), "", false);
     if let Some(f) = tail {
         match t.ty_of(f) {
             Ty::Vec(_) => {
@@ -171,6 +174,7 @@ fn message(t: &Table, m: &Message, o: &mut String) {
                     std::slice::from_ref(f),
                     &|n: &str| format!("self.{n}"),
                     "",
+                    false,
                 );
                 s4.extend(a);
                 s5.extend(b);
@@ -185,6 +189,8 @@ fn message(t: &Table, m: &Message, o: &mut String) {
                         &v.fields,
                         &|n: &str| n.to_owned(),
                         &format!("{}.", f.name),
+                        // Bound by reference in the match arm.
+                        true,
                     );
                     // Bind only the fields the checks read.
                     let pat = |lines: &[String]| {

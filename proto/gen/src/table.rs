@@ -358,6 +358,151 @@ impl fmt::Display for TableError {
 
 impl std::error::Error for TableError {}
 
+/// Names a field may not have: words of C, C++, Python and Rust, and the locals of the generated
+/// decoders that a field name could shadow.
+const RESERVED: &[&str] = &[
+    // C and C++
+    "auto",
+    "break",
+    "case",
+    "char",
+    "const",
+    "continue",
+    "default",
+    "do",
+    "double",
+    "else",
+    "enum",
+    "extern",
+    "float",
+    "for",
+    "goto",
+    "if",
+    "inline",
+    "int",
+    "long",
+    "register",
+    "restrict",
+    "return",
+    "short",
+    "signed",
+    "sizeof",
+    "static",
+    "struct",
+    "switch",
+    "typedef",
+    "union",
+    "unsigned",
+    "void",
+    "volatile",
+    "while",
+    "bool",
+    "class",
+    "delete",
+    "new",
+    "operator",
+    "private",
+    "protected",
+    "public",
+    "template",
+    "this",
+    "throw",
+    "try",
+    "catch",
+    "virtual",
+    "namespace",
+    "using",
+    "and",
+    "or",
+    "not",
+    "xor",
+    "friend",
+    "mutable",
+    "explicit",
+    "export",
+    "typename",
+    "nullptr",
+    "true",
+    "false",
+    // Python
+    "None",
+    "True",
+    "False",
+    "as",
+    "assert",
+    "async",
+    "await",
+    "def",
+    "del",
+    "elif",
+    "except",
+    "finally",
+    "from",
+    "global",
+    "import",
+    "in",
+    "is",
+    "lambda",
+    "nonlocal",
+    "pass",
+    "raise",
+    "with",
+    "yield",
+    "print",
+    "self",
+    "cls",
+    // Rust
+    "crate",
+    "dyn",
+    "fn",
+    "impl",
+    "let",
+    "loop",
+    "match",
+    "mod",
+    "move",
+    "mut",
+    "pub",
+    "ref",
+    "Self",
+    "super",
+    "trait",
+    "type",
+    "unsafe",
+    "use",
+    "where",
+    "abstract",
+    "become",
+    "box",
+    "final",
+    "macro",
+    "override",
+    "priv",
+    "typeof",
+    "unsized",
+    "yield",
+    // locals of the generated code
+    "buf",
+    "len",
+    "out",
+    "m",
+    "e",
+    "w",
+    "n",
+    "i",
+    "j",
+    "c",
+    "at",
+    "tag",
+    "expected",
+    "need",
+    "cap",
+    "el",
+    "f",
+    "struct",
+    "math",
+];
+
 /// The table's path in the repository.
 pub const TABLE_PATH: &str = "proto/schema/messages.toml";
 
@@ -509,6 +654,16 @@ impl Table {
             if !names.insert(f.name.as_str()) {
                 return Err(Self::err(file, place, "the name is used twice"));
             }
+            if f.name.starts_with(|c: char| c.is_ascii_digit())
+                || RESERVED.contains(&f.name.as_str())
+            {
+                return Err(Self::err(
+                    file,
+                    place,
+                    "a field name does not start with a digit and is not a word of C, C++, \
+                     Python or Rust, nor a local of the generated code",
+                ));
+            }
             let ty = self
                 .resolve(&f.ty)
                 .map_err(|e| Self::err(file, place.clone(), e))?;
@@ -629,66 +784,97 @@ impl Table {
         }
     }
 
-    /// The layout rules that let every decoder find each fixed field at a fixed offset: in a
-    /// message or a union variant only the last field may vary in size (a vec, or a union whose
-    /// variants differ); a struct that is a plain field is fixed; a vec's struct element may
-    /// hold vecs of primitives, not vecs of structs or unions.
-    fn check_layout(&self, file: &str, owner: &str, fields: &[Field]) -> Result<(), TableError> {
+    /// The shapes every generator writes (C, Python, Rust), checked so that a table the
+    /// generators cannot mirror is refused here with the entry's name, never half-generated:
+    /// - only the last field of a message or of a union variant varies in size (a vec), so every
+    ///   other field sits at a fixed offset; a union is only ever a message's last field;
+    /// - a vec's element is a number (not a bool) or a struct of numbers and vecs of numbers
+    ///   (no bool, enum, array, text, bound or nested struct: the elements are walked, and their
+    ///   only rule is `finite`);
+    /// - a struct nested whole (not `c_flatten`) carries no rule (no bool, enum, text, bound or
+    ///   `finite`); `c_flatten`, `py_tuple` and `text` are for a message's own fields;
+    /// - a struct refers only to structs defined before it.
+    fn check_layout(
+        &self,
+        file: &str,
+        owner: &str,
+        fields: &[Field],
+        in_message: bool,
+    ) -> Result<(), TableError> {
+        let numeric = |t: &Ty| matches!(t, Ty::Prim(p) if *p != Prim::Bool);
         for (i, f) in fields.iter().enumerate() {
             let place = format!("{owner}, field {:?}", f.name);
             let ty = self
                 .resolve(&f.ty)
                 .map_err(|e| Self::err(file, place.clone(), e))?;
             let last = i + 1 == fields.len();
+            if !in_message && (f.c_flatten.is_some() || f.py_tuple || f.text) {
+                return Err(Self::err(
+                    file,
+                    place,
+                    "`c_flatten`, `py_tuple` and `text` are for a message's own fields",
+                ));
+            }
             match &ty {
-                Ty::Struct(s) if self.fixed_size(&ty).is_none() => {
-                    return Err(Self::err(
-                        file,
-                        place,
-                        format!(
-                            "struct {} varies in size: it may only be a vec's element",
-                            self.structs[*s].name
-                        ),
-                    ))
+                Ty::Struct(s) => {
+                    let st = &self.structs[*s];
+                    if self.fixed_size(&ty).is_none() {
+                        return Err(Self::err(
+                            file,
+                            place,
+                            format!(
+                                "struct {} varies in size: it may only be a vec's element",
+                                st.name
+                            ),
+                        ));
+                    }
+                    if f.c_flatten.is_none() && self.has_rules(&st.fields, true) {
+                        return Err(Self::err(
+                            file,
+                            place,
+                            format!(
+                                "struct {} has a bool, an enum, a text field, a bound or a finite \
+                                 value: give the field `c_flatten` so every codec checks them in \
+                                 place",
+                                st.name
+                            ),
+                        ));
+                    }
                 }
                 Ty::Vec(inner) => {
                     if !last {
                         return Err(Self::err(file, place, "a vec is the last field"));
                     }
-                    if let Ty::Struct(s) = **inner {
-                        for g in &self.structs[s].fields {
-                            let gt = self
-                                .resolve(&g.ty)
-                                .map_err(|e| Self::err(file, place.clone(), e))?;
-                            let ok = match &gt {
-                                Ty::Vec(e) => {
-                                    self.fixed_size(e).is_some() && !matches!(**e, Ty::Struct(_))
+                    let elem_ok = match &**inner {
+                        Ty::Struct(s) => self.structs[*s].fields.iter().all(|g| {
+                            !g.text
+                                && match self.resolve(&g.ty) {
+                                    Ok(Ty::Vec(e)) => numeric(&e),
+                                    Ok(t) => g.max.is_none() && numeric(&t),
+                                    Err(_) => false,
                                 }
-                                other => self.fixed_size(other).is_some(),
-                            };
-                            if !ok {
-                                return Err(Self::err(
-                                    file,
-                                    format!("struct {}, field {:?}", self.structs[s].name, g.name),
-                                    "a vec's element holds fixed fields and vecs of primitives only",
-                                ));
-                            }
-                        }
-                    }
-                }
-                Ty::Union(u) => {
-                    if self.fixed_size(&ty).is_none() && !last {
+                        }),
+                        other => numeric(other),
+                    };
+                    if !elem_ok {
                         return Err(Self::err(
                             file,
                             place,
-                            "a union whose variants differ in size is the last field",
+                            "a vec's element is a number (not a bool) or a struct of numbers and \
+                             vecs of numbers",
                         ));
+                    }
+                }
+                Ty::Union(u) => {
+                    if !in_message || !last {
+                        return Err(Self::err(file, place, "a union is a message's last field"));
                     }
                     for v in &self.unions[*u].variants {
                         self.check_layout(
                             file,
                             &format!("union {}, variant {}", self.unions[*u].name, v.name),
                             &v.fields,
+                            false,
                         )?;
                     }
                 }
@@ -696,6 +882,63 @@ impl Table {
             }
         }
         Ok(())
+    }
+
+    /// The members a message has in C and Python (flattened structs and a union's variants
+    /// spread out), each with its type as written; a name shared by union variants must have
+    /// one type.
+    fn flat_members(
+        &self,
+        fields: &[Field],
+        prefix: &str,
+        out: &mut Vec<(String, String)>,
+    ) -> Result<(), String> {
+        for f in fields {
+            let name = format!("{prefix}{}", f.name);
+            match (self.resolve(&f.ty), &f.c_flatten) {
+                (Ok(Ty::Struct(s)), Some(p)) => {
+                    self.flat_members(&self.structs[s].fields, &format!("{prefix}{p}"), out)?
+                }
+                (Ok(Ty::Union(u)), _) => {
+                    out.push((name, f.ty.clone()));
+                    let mut shared: Vec<(String, String)> = Vec::new();
+                    for v in &self.unions[u].variants {
+                        let mut vm = Vec::new();
+                        self.flat_members(&v.fields, prefix, &mut vm)?;
+                        for (n, t) in vm {
+                            match shared.iter().find(|(m, _)| *m == n) {
+                                Some((_, t0)) if *t0 != t => {
+                                    return Err(format!(
+                                        "{n:?} has two types across the variants of union {}",
+                                        self.unions[u].name
+                                    ))
+                                }
+                                Some(_) => {}
+                                None => shared.push((n, t)),
+                            }
+                        }
+                    }
+                    out.extend(shared);
+                }
+                _ => out.push((name, f.ty.clone())),
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether fields carry a step-4 rule (bool, enum, text, bound), or with `finite` a step-5
+    /// one, nested structs included.
+    fn has_rules(&self, fields: &[Field], finite: bool) -> bool {
+        fields.iter().any(|f| {
+            f.text
+                || f.max.is_some()
+                || (finite && f.finite)
+                || match self.resolve(&f.ty) {
+                    Ok(Ty::Prim(Prim::Bool) | Ty::Array(Prim::Bool, _) | Ty::Enum(_)) => true,
+                    Ok(Ty::Struct(s)) => self.has_rules(&self.structs[s].fields, finite),
+                    _ => false,
+                }
+        })
     }
 
     /// Checks names, references and the messages' rules.
@@ -787,8 +1030,22 @@ impl Table {
                 }
             }
         }
-        for s in &self.structs {
+        for (i, s) in self.structs.iter().enumerate() {
             self.check_fields(file, &format!("struct {}", s.name), &s.fields)?;
+            for f in &s.fields {
+                let later = match self.resolve(&f.ty) {
+                    Ok(Ty::Struct(j)) => j >= i,
+                    Ok(Ty::Vec(inner)) => matches!(*inner, Ty::Struct(j) if j >= i),
+                    _ => false,
+                };
+                if later {
+                    return Err(Self::err(
+                        file,
+                        format!("struct {}, field {:?}", s.name, f.name),
+                        "a struct refers only to structs defined before it",
+                    ));
+                }
+            }
         }
         for u in &self.unions {
             for (i, v) in u.variants.iter().enumerate() {
@@ -807,7 +1064,23 @@ impl Table {
         for m in &self.messages {
             let owner = format!("message {}", m.name);
             self.check_fields(file, &owner, &m.fields)?;
-            self.check_layout(file, &owner, &m.fields)?;
+            self.check_layout(file, &owner, &m.fields, true)?;
+            let mut members = Vec::new();
+            self.flat_members(&m.fields, "", &mut members)
+                .map_err(|e| Self::err(file, owner.clone(), e))?;
+            let mut seen = BTreeSet::new();
+            for (n, _) in &members {
+                if !seen.insert(n.as_str()) {
+                    return Err(Self::err(
+                        file,
+                        owner,
+                        format!(
+                            "two members named {n:?} once flattened (c_flatten prefixes and union \
+                             variants share the message's C struct and Python class)"
+                        ),
+                    ));
+                }
+            }
             if !c_names.insert(m.c_name.as_str())
                 || !m.c_name.chars().all(|c| c.is_ascii_lowercase() || c == '_')
             {

@@ -346,6 +346,43 @@ fn mistakes_in_the_table_are_named() {
             "field \"drag\": `py_tuple` is for a struct of numbers",
         ),
         (
+            edited(
+                r#"{ name = "range_m", type = "f64""#,
+                r#"{ name = "type", type = "f64""#,
+            ),
+            "field \"type\": a field name does not start with a digit and is not a word",
+        ),
+        (
+            // A union variant's field and the message's share one C struct and Python class.
+            edited(
+                r#"{ name = "sender_id", type = "u32""#,
+                r#"{ name = "torque_b_nm", type = "u32""#,
+            ),
+            "message CommandMsg: two members named \"torque_b_nm\"",
+        ),
+        (
+            // CommandStatus holds a bool and an enum: nested whole, no codec would check them.
+            edited(
+                r#"{ name = "command", type = "CommandStatus", c_flatten = "","#,
+                r#"{ name = "command", type = "CommandStatus","#,
+            ),
+            "struct CommandStatus has a bool, an enum",
+        ),
+        (
+            edited(
+                r#"{ name = "states", type = "vec<f64>""#,
+                r#"{ name = "states", type = "vec<bool>""#,
+            ),
+            "field \"effectors\": a vec's element is a number (not a bool)",
+        ),
+        (
+            edited(
+                r#"{ name = "orb_energy_j", type = "f64""#,
+                r#"{ name = "orb_energy_j", type = "SysTime""#,
+            ),
+            "struct Conserved, field \"orb_energy_j\": a struct refers only to structs defined before it",
+        ),
+        (
             edited(r#"value = 65536"#, r#"value = -1"#),
             "constant \"MAX_MESSAGE_BYTES\": -1 is negative",
         ),

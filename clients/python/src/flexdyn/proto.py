@@ -13,12 +13,13 @@ with the same reasons as the Rust crate's ``DecodeError``:
 3. the total length from the layout (fixed; command tag at 34; walked counts, each bounded
    first) -> ``Length`` (needed = length implied by the counts read so far), ``Malformed``
    (unknown tag, count above its maximum), ``TrailingBytes``;
-4. fields in wire order: an enum tag out of range or a bool byte other than 0/1 -> ``Malformed``;
+4. fields in wire order: an enum tag out of range, a bool byte other than 0/1, or a bounded
+   count above its bound (a CssMsg's detectors above ``MAX_CSS_DETECTORS``) -> ``Malformed``;
    a text field (a fault ``target``) with a byte other than NUL after its first NUL ->
    ``Malformed``;
-5. CommandMsg: a non-finite torque, force or input value -> ``NonFinite`` naming the field;
-   FaultCommandMsg: a non-finite parameter -> ``NonFinite``; CssMsg: a detector count above
-   ``MAX_CSS_DETECTORS`` -> ``Malformed``.
+5. the fields the table marks finite (CommandMsg's torque, force and input values,
+   FaultCommandMsg's parameters), in wire order: a NaN or infinite value -> ``NonFinite``
+   naming the field.
 
 Units are in the field names (SI; ``_nm`` newton-metres, ``_newton`` newtons); frames too
 (``_b`` body, ``_n`` inertial, ``_p`` IMU platform, ``_c`` star-tracker case).
@@ -449,7 +450,7 @@ class StateMsg:
             w.values(8, 8, "effectors[].outputs")
         _check_total(w.at, buf)
         f = StateMsg._BODY.unpack_from(buf, HEADER_LEN)
-        effectors = []
+        vec_effectors = []
         at = 327
         for _ in range(n):
             v_kind, v_flags = struct.unpack_from("<HI", buf, at)
@@ -459,7 +460,7 @@ class StateMsg:
             (c,) = struct.unpack_from("<Q", buf, at)
             v_outputs = list(struct.unpack_from(f"<{c}d", buf, at + 8))
             at += 8 + 8 * c
-            effectors.append(EffectorState(v_kind, v_flags, v_states, v_outputs))
+            vec_effectors.append(EffectorState(v_kind, v_flags, v_states, v_outputs))
         m = cls(
             Header.unpack(buf),
             tuple(f[0:3]),
@@ -476,7 +477,7 @@ class StateMsg:
             tuple(f[30:33]),
             tuple(f[33:36]),
             f[36],
-            effectors,
+            vec_effectors,
         )
         return m
 
@@ -779,15 +780,15 @@ class CommandMsg:
             f = CommandMsg._ACTUATORS.unpack_from(buf, 38)
             m.torque_b_nm = tuple(f[0:3])
             m.force_b_newton = tuple(f[3:6])
-            inputs = []
+            vec_inputs = []
             at = 94
             for _ in range(n):
                 (v_effector_index,) = struct.unpack_from("<I", buf, at)
                 (c,) = struct.unpack_from("<Q", buf, at + 4)
                 v_values = list(struct.unpack_from(f"<{c}d", buf, at + 4 + 8))
                 at += 12 + 8 * c
-                inputs.append(EffectorInput(v_effector_index, v_values))
-            m.inputs = inputs
+                vec_inputs.append(EffectorInput(v_effector_index, v_values))
+            m.inputs = vec_inputs
         m.validate()
         return m
 

@@ -13,8 +13,10 @@
 //!   would be blind over more than a hemisphere.
 //! - rate limit: trackers keep tracking up to a few °/s (the HAST above: 4°/s). Above 1 rad/s
 //!   (57°/s) is a warning.
-//! - Earth and Moon exclusion half-angles (from the limb): some degrees to about 30°; above 90°
-//!   the tracker is blind over more than a hemisphere, as for the Sun.
+//! - Earth and Moon exclusion half-angles (from the limb): some degrees to about 30° on
+//!   datasheets. The blind cone about the body is its angular radius plus the half-angle (the
+//!   Earth's is 66° from a 7000 km orbit), so above 60° (π/3 rad) the Earth alone would hide
+//!   nearly the whole sky in LEO.
 //! - the atmosphere counted as the Earth's limb: tens of kilometres (the bright airglow and
 //!   scattering layer is below about 100 km). Above 1000 km is a warning.
 
@@ -72,7 +74,7 @@ pub(crate) fn check(st: &StarTrackerConfig, path: &str, out: &mut Vec<Implausibl
             Range {
                 what: "a star tracker's Earth-limb exclusion half-angle",
                 si: "rad",
-                plausible: (0.01, std::f64::consts::FRAC_PI_2),
+                plausible: (0.01, std::f64::consts::FRAC_PI_3),
                 units: &[("deg", DEG)],
             },
         ),
@@ -82,7 +84,7 @@ pub(crate) fn check(st: &StarTrackerConfig, path: &str, out: &mut Vec<Implausibl
             Range {
                 what: "a star tracker's Moon exclusion half-angle",
                 si: "rad",
-                plausible: (0.01, std::f64::consts::FRAC_PI_2),
+                plausible: (0.01, std::f64::consts::FRAC_PI_3),
                 units: &[("deg", DEG)],
             },
         ),

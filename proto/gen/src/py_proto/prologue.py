@@ -12,12 +12,13 @@ with the same reasons as the Rust crate's ``DecodeError``:
 3. the total length from the layout (fixed; command tag at 34; walked counts, each bounded
    first) -> ``Length`` (needed = length implied by the counts read so far), ``Malformed``
    (unknown tag, count above its maximum), ``TrailingBytes``;
-4. fields in wire order: an enum tag out of range or a bool byte other than 0/1 -> ``Malformed``;
+4. fields in wire order: an enum tag out of range, a bool byte other than 0/1, or a bounded
+   count above its bound (a CssMsg's detectors above ``MAX_CSS_DETECTORS``) -> ``Malformed``;
    a text field (a fault ``target``) with a byte other than NUL after its first NUL ->
    ``Malformed``;
-5. CommandMsg: a non-finite torque, force or input value -> ``NonFinite`` naming the field;
-   FaultCommandMsg: a non-finite parameter -> ``NonFinite``; CssMsg: a detector count above
-   ``MAX_CSS_DETECTORS`` -> ``Malformed``.
+5. the fields the table marks finite (CommandMsg's torque, force and input values,
+   FaultCommandMsg's parameters), in wire order: a NaN or infinite value -> ``NonFinite``
+   naming the field.
 
 Units are in the field names (SI; ``_nm`` newton-metres, ``_newton`` newtons); frames too
 (``_b`` body, ``_n`` inertial, ``_p`` IMU platform, ``_c`` star-tracker case).
