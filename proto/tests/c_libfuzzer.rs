@@ -30,8 +30,15 @@ fn debian_package(program: &str, package: &str) {
     );
 }
 
-/// clang with its libFuzzer runtime, installed if need be.
+/// clang with its libFuzzer runtime, installed if need be: once per process, since the tests
+/// run on parallel threads and two apt-get runs at once would fight over dpkg's lock.
 fn clang() -> &'static str {
+    static INSTALLED: std::sync::OnceLock<()> = std::sync::OnceLock::new();
+    INSTALLED.get_or_init(install_clang);
+    "clang"
+}
+
+fn install_clang() {
     debian_package("clang", "clang");
     let version = Command::new("clang").arg("-dumpversion").output().unwrap();
     let version = String::from_utf8_lossy(&version.stdout).trim().to_string();
@@ -46,7 +53,6 @@ fn clang() -> &'static str {
         runtime.to_str().unwrap(),
         &format!("libclang-rt-{major}-dev"),
     );
-    "clang"
 }
 
 /// Builds the target against the header in `include` as `name`.
