@@ -549,104 +549,68 @@ impl<'t> Gen<'t> {
         let name = &f.name;
         match *inner {
             Ty::Struct(s) => {
+                // The table allows only numbers and vecs of numbers in an element: the numbers
+                // between two vecs are read with one unpack, then each vec after its count.
                 o.push(format!("vec_{name} = []"));
                 o.push(format!("at = {at}"));
                 o.push("for _ in range(n):".into());
-                let mut k = 0;
-                let mut args = Vec::new();
-                let mut fixed_fmt = String::new();
-                let mut fixed_names: Vec<String> = Vec::new();
-                let flush = |fixed_fmt: &mut String,
-                             fixed_names: &mut Vec<String>,
-                             k: &mut usize,
-                             size: usize,
-                             o: &mut Vec<String>| {
-                    if fixed_names.is_empty() {
-                        return;
-                    }
-                    let lhs = if fixed_names.len() == 1 {
-                        format!("({},)", fixed_names[0])
-                    } else {
-                        fixed_names.join(", ")
-                    };
-                    let at_k = if *k == 0 {
+                let at_k = |k: usize| {
+                    if k == 0 {
                         "at".to_owned()
                     } else {
-                        format!("at + {}", *k)
-                    };
-                    o.push(format!(
-                        "    {lhs} = struct.unpack_from(\"<{fixed_fmt}\", buf, {at_k})"
-                    ));
-                    *k += size;
-                    fixed_fmt.clear();
-                    fixed_names.clear();
+                        format!("at + {k}")
+                    }
                 };
-                let mut fixed_size = 0;
+                let mut k = 0;
+                let mut args = Vec::new();
+                let mut run: (String, Vec<String>, usize) = (String::new(), Vec::new(), 0);
+                let flush =
+                    |run: &mut (String, Vec<String>, usize), k: &mut usize, o: &mut Vec<String>| {
+                        let (fmt_run, names, size) = std::mem::take(run);
+                        if names.is_empty() {
+                            return;
+                        }
+                        let lhs = if names.len() == 1 {
+                            format!("({},)", names[0])
+                        } else {
+                            names.join(", ")
+                        };
+                        o.push(format!(
+                            "    {lhs} = struct.unpack_from(\"<{fmt_run}\", buf, {})",
+                            at_k(*k)
+                        ));
+                        *k += size;
+                    };
                 for g in &self.t.structs[s].fields {
-                    let gt = self.ty(g);
-                    match &gt {
+                    let var = format!("v_{}", g.name);
+                    match self.ty(g) {
                         Ty::Vec(e) => {
-                            flush(&mut fixed_fmt, &mut fixed_names, &mut k, fixed_size, o);
-                            fixed_size = 0;
-                            let Ty::Prim(p) = **e else {
-                                unreachable!("checked")
-                            };
-                            let at_k = if k == 0 {
-                                "at".to_owned()
-                            } else {
-                                format!("at + {k}")
+                            flush(&mut run, &mut k, o);
+                            let Ty::Prim(p) = *e else {
+                                unreachable!("checked by the table")
                             };
                             o.push(format!(
-                                "    (c,) = struct.unpack_from(\"<Q\", buf, {at_k})"
+                                "    (c,) = struct.unpack_from(\"<Q\", buf, {})",
+                                at_k(k)
                             ));
                             o.push(format!(
-                                "    v_{} = list(struct.unpack_from(f\"<{{c}}{}\", buf, {at_k} + 8))",
-                                g.name,
-                                fmt(p)
+                                "    {var} = list(struct.unpack_from(f\"<{{c}}{}\", buf, {} + 8))",
+                                fmt(p),
+                                at_k(k)
                             ));
                             o.push(format!("    at += {} + {} * c", k + 8, p.size()));
                             k = 0;
-                            args.push(format!("v_{}", g.name));
                         }
                         Ty::Prim(p) => {
-                            fixed_fmt.push(fmt(*p));
-                            fixed_names.push(format!("v_{}", g.name));
-                            fixed_size += p.size();
-                            args.push(if *p == Prim::Bool {
-                                format!("v_{} == 1", g.name)
-                            } else {
-                                format!("v_{}", g.name)
-                            });
+                            run.0.push(fmt(p));
+                            run.1.push(var.clone());
+                            run.2 += p.size();
                         }
-                        Ty::Enum(_) => {
-                            fixed_fmt.push('I');
-                            fixed_names.push(format!("v_{}", g.name));
-                            fixed_size += 4;
-                            args.push(format!("v_{}", g.name));
-                        }
-                        other => {
-                            // Arrays and nested structs in an element: read on their own.
-                            flush(&mut fixed_fmt, &mut fixed_names, &mut k, fixed_size, o);
-                            fixed_size = 0;
-                            let mut f2 = String::new();
-                            self.format(std::slice::from_ref(g), &mut f2);
-                            let at_k = if k == 0 {
-                                "at".to_owned()
-                            } else {
-                                format!("at + {k}")
-                            };
-                            o.push(format!(
-                                "    f = struct.unpack_from(\"<{f2}\", buf, {at_k})"
-                            ));
-                            let mut vals = Vec::new();
-                            self.values(std::slice::from_ref(g), 0, &mut vals);
-                            o.push(format!("    v_{} = {}", g.name, vals.join(", ")));
-                            k += self.size(other);
-                            args.push(format!("v_{}", g.name));
-                        }
+                        _ => unreachable!("checked by the table: numbers and vecs of numbers"),
                     }
+                    args.push(var);
                 }
-                flush(&mut fixed_fmt, &mut fixed_names, &mut k, fixed_size, o);
+                flush(&mut run, &mut k, o);
                 if k > 0 {
                     o.push(format!("    at += {k}"));
                 }
