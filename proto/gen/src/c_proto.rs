@@ -61,6 +61,15 @@ fn field_comment(f: &Field) -> String {
     format!(" /* {} */", comment(&text))
 }
 
+/// The byte at `base + k`: `buf[318]`, or `(buf + at)[6]` when the base is an expression.
+fn byte(base: &str, k: usize) -> String {
+    if base.contains(' ') {
+        format!("({base})[{k}]")
+    } else {
+        format!("{base}[{k}]")
+    }
+}
+
 /// `buf + 30`, `buf + at`, `buf + at + 6`.
 fn at(base: &str, k: usize) -> String {
     if k == 0 {
@@ -286,7 +295,7 @@ impl<'t> Gen<'t> {
             let d = format!("{dst}{}", f.name);
             let src = at(base, k);
             match &ty {
-                Ty::Prim(Prim::U8 | Prim::Bool) => o.push(format!("{d} = {base}[{k}];")),
+                Ty::Prim(Prim::U8 | Prim::Bool) => o.push(format!("{d} = {};", byte(base, k))),
                 Ty::Prim(p) => o.push(format!("{d} = fd_get_{}({src});", p.name())),
                 Ty::Enum(_) => o.push(format!("{d} = fd_get_u32({src});")),
                 Ty::Array(Prim::U8 | Prim::Bool, n) => o.push(format!("memcpy({d}, {src}, {n});")),
@@ -318,7 +327,7 @@ impl<'t> Gen<'t> {
             let s = format!("{src}{}", f.name);
             let dst = at(base, k);
             match &ty {
-                Ty::Prim(Prim::U8 | Prim::Bool) => o.push(format!("{base}[{k}] = {s};")),
+                Ty::Prim(Prim::U8 | Prim::Bool) => o.push(format!("{} = {s};", byte(base, k))),
                 Ty::Prim(p) => o.push(format!("fd_put_{}({dst}, {s});", p.name())),
                 Ty::Enum(_) => o.push(format!("fd_put_u32({dst}, {s});")),
                 Ty::Array(Prim::U8 | Prim::Bool, n) => o.push(format!("memcpy({dst}, {s}, {n});")),
@@ -766,7 +775,7 @@ impl<'t> Gen<'t> {
                     self.put(fields, "buf + at", *k, "el->", &mut lines)
                 };
                 for l in lines {
-                    o.push(format!("    {}", fix_base(&l)));
+                    o.push(format!("    {l}"));
                 }
             }
         };
@@ -962,12 +971,6 @@ impl<'t> Gen<'t> {
             _ => tl.f.finite,
         }
     }
-}
-
-/// `fill`/`put` write `buf + at[k]` and `buf + at[k]` as the base; element code has no `[k]`
-/// byte indexing, so rewrite `buf + at[6]` into `(buf + at)[6]`.
-fn fix_base(line: &str) -> String {
-    line.replace("buf + at[", "(buf + at)[")
 }
 
 /// A step-4 check from the buffer: the `if` line.
