@@ -3,7 +3,9 @@
 
 use flexdyn_kernel::attitude::mrp_to_dcm;
 use flexdyn_proto::star_tracker_flags;
-use flexdyn_sensors::star_tracker::{rotation_vector, StarTracker, StarTrackerConfig};
+use flexdyn_sensors::star_tracker::{
+    rotation_vector, StarTracker, StarTrackerConfig, StarTrackerSample,
+};
 use flexdyn_vehicle::config::SimConfig;
 use flexdyn_vehicle::sim::Simulation;
 use nalgebra::{Matrix3, Vector3, Vector4};
@@ -232,6 +234,31 @@ fn configuration_errors_name_the_field() {
     }
 }
 
+/// The first star tracker's sample at tick 0 of the configuration `toml`.
+fn first_sample(toml: &str) -> StarTrackerSample {
+    let cfg = SimConfig::from_toml_str(toml).unwrap();
+    let mut sim = Simulation::new(&cfg).unwrap();
+    let mut out = Vec::new();
+    sim.star_tracker_samples_into(0, &mut out);
+    out[0].1
+}
+
+/// The first star tracker's boresight in N at t = 0 ([NC] b̂ with [CN] = [CB][BN]) and B's
+/// position r_B/N then, from the configuration `toml`.
+fn boresight_and_position_at_start(toml: &str) -> (Vector3<f64>, Vector3<f64>) {
+    let cfg = SimConfig::from_toml_str(toml).unwrap();
+    let st = cfg
+        .sensors
+        .of::<StarTrackerConfig>()
+        .next()
+        .unwrap()
+        .clone();
+    let sim = Simulation::new(&cfg).unwrap();
+    let state = sim.spacecraft().state();
+    let b_n = (st.dcm_cb * mrp_to_dcm(&state.sigma_bn)).transpose() * st.boresight_c;
+    (b_n, state.r_bn_n)
+}
+
 /// `sun_from_environment = true`: the Sun exclusion follows the environment's Sun (here a fixed
 /// Sun of `[environment]`, so the geometry is known): a boresight on the Sun is excluded, one
 /// away from it is not, and without a Sun in the environment nothing is excluded. The Sun seen
@@ -246,24 +273,8 @@ fn sun_exclusion_follows_the_environments_sun() {
         "sun_from_environment = true",
         1,
     );
-    // The boresight in N at t = 0, from the configuration: [NC] b̂ with [CN] = [CB][BN].
-    let cfg = SimConfig::from_toml_str(&tracked).unwrap();
-    let st = cfg
-        .sensors
-        .of::<StarTrackerConfig>()
-        .next()
-        .unwrap()
-        .clone();
-    let sim = Simulation::new(&cfg).unwrap();
-    let dcm_bn = mrp_to_dcm(&sim.spacecraft().state().sigma_bn);
-    let b_n = (st.dcm_cb * dcm_bn).transpose() * st.boresight_c;
-    let first = |environment: String| {
-        let cfg = SimConfig::from_toml_str(&format!("{tracked}\n{environment}")).unwrap();
-        let mut sim = Simulation::new(&cfg).unwrap();
-        let mut out = Vec::new();
-        sim.star_tracker_samples_into(0, &mut out);
-        out[0].1
-    };
+    let (b_n, _) = boresight_and_position_at_start(&tracked);
+    let first = |environment: String| first_sample(&format!("{tracked}\n{environment}"));
     let sun_along = |d: Vector3<f64>| {
         format!(
             "[epoch]\nutc = \"2026-11-24T06:00:00Z\"\n[environment]\nsun = true\n\
@@ -280,16 +291,12 @@ fn sun_exclusion_follows_the_environments_sun() {
     let no_sun = first("[environment]\ngravity_gradient = true\n".to_string());
     assert!(no_sun.valid, "{no_sun:?}");
     // The same boresight with the fixed direction of the configuration instead: excluded.
-    let fixed = SimConfig::from_toml_str(&text.replacen(
+    let fixed = first_sample(&text.replacen(
         "sun_direction_n = [1.0, 0.0, 0.0]",
         &format!("sun_direction_n = [{:e}, {:e}, {:e}]", b_n.x, b_n.y, b_n.z),
         1,
-    ))
-    .unwrap();
-    let mut sim = Simulation::new(&fixed).unwrap();
-    let mut out = Vec::new();
-    sim.star_tracker_samples_into(0, &mut out);
-    assert_eq!(out[0].1.status_flags, star_tracker_flags::SUN_EXCLUSION);
+    ));
+    assert_eq!(fixed.status_flags, star_tracker_flags::SUN_EXCLUSION);
     // Both at once is an error that names them.
     let e = SimConfig::from_toml_str(&text.replacen(
         "sun_direction_n = [1.0, 0.0, 0.0]",
@@ -320,29 +327,14 @@ fn earth_and_moon_exclusion_from_the_configuration() {
     let anchor = "sun_direction_n = [1.0, 0.0, 0.0]";
     assert!(text.contains(anchor));
     let first = |keys: &str, extra: &str| {
-        let toml = format!(
+        first_sample(&format!(
             "{}\n{extra}",
             text.replacen(anchor, &format!("{anchor}\n{keys}"), 1)
-        );
-        let cfg = SimConfig::from_toml_str(&toml).unwrap();
-        let mut sim = Simulation::new(&cfg).unwrap();
-        let mut out = Vec::new();
-        sim.star_tracker_samples_into(0, &mut out);
-        out[0].1
+        ))
     };
     // The boresight's angle to the Earth's limb at t = 0, by hand: the angle to the nadir minus
     // the Earth's angular radius asin(R / |r|).
-    let cfg = SimConfig::from_toml_str(&text).unwrap();
-    let st = cfg
-        .sensors
-        .of::<StarTrackerConfig>()
-        .next()
-        .unwrap()
-        .clone();
-    let sim = Simulation::new(&cfg).unwrap();
-    let state = sim.spacecraft().state();
-    let b_n = (st.dcm_cb * mrp_to_dcm(&state.sigma_bn)).transpose() * st.boresight_c;
-    let r = state.r_bn_n;
+    let (b_n, r) = boresight_and_position_at_start(&text);
     let eta = b_n.dot(&(-r / r.norm())).acos() - (6_378_137.0 / r.norm()).asin();
     assert!(
         eta > 0.05,
