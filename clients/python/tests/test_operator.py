@@ -21,15 +21,19 @@ def test_pause_holds_a_real_time_run_and_resume_continues_with_the_next_tick():
         with flexdyn.Client(server.endpoint) as client:
             statuses = []
             client.subscribe_status(statuses.append)
-            client.wait_tick(timeout_s=30.0)
+            first = client.wait_tick(timeout_s=30.0).header.tick
             client.pause()
             deadline = time.monotonic() + 5.0
             while not (client.now() and client.now().paused):
                 assert time.monotonic() < deadline, "no paused tick"
                 time.sleep(0.005)
             held = client.now().header.tick
+            # wait_tick hands out every tick up to the hold, in order, then nothing more.
+            drained = []
             with pytest.raises(TimeoutError):
-                client.wait_tick(timeout_s=0.5)
+                while True:
+                    drained.append(client.wait_tick(timeout_s=0.5).header.tick)
+            assert drained == list(range(first + 1, held + 1))
             assert client.now().header.tick == held
             time.sleep(0.2)
             assert statuses[-1].run_state == proto.RUN_STATE_PAUSED

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import logging
+import collections
 import threading
 import time
 from dataclasses import dataclass
@@ -119,6 +120,10 @@ class Client:
         # The time service (now / wait_tick): the last TimeMsg and its condition, on first use.
         self._time_cond: Optional[threading.Condition] = None
         self._now: Optional[TimeMsg] = None
+        # The ticks wait_tick has not returned yet, oldest first (the last 1024: 10 s at 100 Hz),
+        # and the tick it returned last (None before its first call).
+        self._ticks: collections.deque = collections.deque(maxlen=1024)
+        self._last_waited: Optional[int] = None
         #: Undecodable telemetry samples received (a sample that is not the message its key says).
         self.undecodable = 0
         #: Exceptions raised by telemetry callbacks (logged on the ``flexdyn`` logger; the other
@@ -269,6 +274,7 @@ class Client:
         cond = self._time_cond
         with cond:
             self._now = msg
+            self._ticks.append(msg)
             cond.notify_all()
 
     def now(self) -> Optional[TimeMsg]:
@@ -279,17 +285,28 @@ class Client:
         return self._now
 
     def wait_tick(self, timeout_s: float = 10.0) -> TimeMsg:
-        """Blocks until the next TimeMsg (a tick newer than :meth:`now` at the call) and returns
-        it; ``TimeoutError`` after ``timeout_s`` s of wall time without one (the server is
-        gone, or the run is paused). A rate-group driver calls it in a loop: one call per
-        frame, ``msg.flags & proto.TIME_TONE`` on the 1 Hz tone."""
+        """Blocks until the next TimeMsg and returns it; ``TimeoutError`` after ``timeout_s`` s of
+        wall time without one (the server is gone, or the run is paused). The first call returns
+        the first tick newer than :meth:`now` at the call; each later call returns the tick after
+        the one it returned last, in order and without a gap, even when the caller woke late
+        (the client holds the last 1024 ticks; a caller more than 1024 ticks behind resumes at
+        the oldest it holds). A rate-group driver calls it in a loop: one call per frame,
+        ``msg.flags & proto.TIME_TONE`` on the 1 Hz tone."""
         cond = self._clock()
         with cond:
-            last = self._now.header.tick if self._now is not None else -1
-            if not cond.wait_for(lambda: self._now is not None and self._now.header.tick > last,
-                                 timeout_s):
+            if self._last_waited is None:
+                self._last_waited = self._now.header.tick if self._now is not None else -1
+            last = self._last_waited
+            ticks = self._ticks
+            while ticks and ticks[0].header.tick <= last:
+                ticks.popleft()
+            if not cond.wait_for(lambda: bool(ticks) and ticks[-1].header.tick > last, timeout_s):
                 raise TimeoutError(f"no tick after {last} within {timeout_s} s")
-            return self._now
+            while ticks[0].header.tick <= last:
+                ticks.popleft()
+            msg = ticks.popleft()
+            self._last_waited = msg.header.tick
+            return msg
 
     def subscribe_status(self, callback: Callable[[StatusMsg], None]) -> object:
         """Calls `callback` with every StatusMsg (its own subscriber: status is not telemetry
