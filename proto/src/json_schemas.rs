@@ -21,6 +21,7 @@ pub fn json_schema_text(name: &str) -> Option<&'static str> {
         "FaultCommandMsg" => Some(include_str!("../schema/json/FaultCommandMsg.json")),
         "RelativeStateMsg" => Some(include_str!("../schema/json/RelativeStateMsg.json")),
         "StatusMsg" => Some(include_str!("../schema/json/StatusMsg.json")),
+        "FswMsg" => Some(include_str!("../schema/json/FswMsg.json")),
         _ => None,
     }
 }

@@ -29,6 +29,9 @@ pub const GPS_PREFIX: &str = "tlm/gps";
 /// Prefix of a fleet deputy's relative-state topic ([`crate::RelativeStateMsg`]); the chief's
 /// string id follows after a `/` (`flexdyn/<deputy>/tlm/rel/<chief>`). Protocol version 9.
 pub const RELATIVE_STATE_PREFIX: &str = "tlm/rel";
+/// Prefix of the flight code's telemetry topics ([`crate::FswMsg`]); the stream's name follows
+/// after a `/` (`flexdyn/<sc>/fsw/<name>`). Protocol version 10.
+pub const FSW_PREFIX: &str = "fsw";
 /// Prefix of the command topics; the sender's decimal `sender_id` follows after a `/`
 /// (`flexdyn/<sc>/cmd/<sender_id>`, every [`crate::CommandKind`]). One key per sender, so a
 /// Zenoh access-control list can reserve each participant's key for its authenticated subject.
@@ -140,6 +143,18 @@ pub fn relative_state_key(deputy: &str, chief: &str) -> Result<String, KeyError>
     Ok(format!(
         "{KEY_ROOT}/{deputy}/{RELATIVE_STATE_PREFIX}/{chief}"
     ))
+}
+
+/// `flexdyn/<sc>/fsw/<stream>`: where flight code publishes its telemetry stream `stream`
+/// ([`crate::FswMsg`], protocol 10).
+pub fn fsw_key(sc: &str, stream: &str) -> Result<String, KeyError> {
+    sensor_key(sc, FSW_PREFIX, stream)
+}
+
+/// `flexdyn/<sc>/fsw/*`: every telemetry stream of the flight code of `sc`.
+pub fn fsw_wildcard_key(sc: &str) -> Result<String, KeyError> {
+    validate_sc_id(sc)?;
+    Ok(format!("{KEY_ROOT}/{sc}/{FSW_PREFIX}/*"))
 }
 
 /// `flexdyn/<sc>/cmd/<sender_id>`: where participant `sender_id` publishes its commands.

@@ -34,6 +34,7 @@
 //! | `flexdyn/<sc-id>/tlm/fault` | [`FaultEventMsg`] | server → anyone, at each fault's activation and clearance |
 //! | `flexdyn/<sc-id>/fault` | [`FaultCommandMsg`] | operator → server |
 //! | `flexdyn/<sc-id>/operator` | [`OperatorMsg`] | operator → server |
+//! | `flexdyn/<sc-id>/fsw/<name>` | [`FswMsg`] | flight code → server and recorders (its own telemetry) |
 //! | `flexdyn/<sc-id>/participant/<sender-id>` | Zenoh liveliness token (no payload) | lockstep participant → server |
 //!
 //! Build keys with [`Topics`] or [`state_key`] & co; ids are validated
@@ -64,11 +65,12 @@
 //! | [`TimeMsg`] | [`TIME_LEN`] = 122 |
 //! | [`EnvironmentMsg`] | [`ENVIRONMENT_LEN`] = 368 |
 //! | [`CommandMsg`] | [`COMMAND_WRENCH_LEN`] = 86 (tag 0 `Wrench`), [`COMMAND_NO_COMMAND_LEN`] = 38 (tag 1 `NoCommand`) or [`COMMAND_ACTUATORS_FIXED_LEN`] = 94 + per input [`EFFECTOR_INPUT_FIXED_LEN`] = 12 + 8 per value (tag 2 `Actuators`); tag at offset 34 |
-//! | [`StatusMsg`] | [`STATUS_LEN`] = 235 |
+//! | [`StatusMsg`] | [`STATUS_LEN`] = 243 |
 //! | [`OperatorMsg`] | [`OPERATOR_LEN`] = 42 |
 //! | [`FaultEventMsg`] | [`FAULT_EVENT_LEN`] = 199 |
 //! | [`FaultCommandMsg`] | [`FAULT_COMMAND_LEN`] = 214 |
 //! | [`RelativeStateMsg`] | [`RELATIVE_STATE_LEN`] = 102 |
+//! | [`FswMsg`] | [`FSW_FIXED_LEN`] = 148 + 8 per value word (count prefix at offset 140, values last) |
 //!
 //! Decoders accept at most [`MAX_MESSAGE_BYTES`], [`MAX_EFFECTORS`] and
 //! [`MAX_EFFECTOR_VALUES`], reject trailing bytes, and never panic ([`DecodeError`]).
@@ -153,6 +155,9 @@ pub use messages::{
 // A fleet deputy's state relative to its chief (issue 22, protocol 9).
 pub use keys::{relative_state_key, RELATIVE_STATE_PREFIX};
 pub use messages::RelativeStateMsg;
+// The flight code's own telemetry (issue 37, protocol 10).
+pub use keys::{fsw_key, fsw_wildcard_key, FSW_PREFIX};
+pub use messages::{fsw_flags, FswMsg};
 
 /// Wire protocol version carried in every [`Header`]. Bump it on any layout change.
 /// Version 3: generic effector states in [`StateMsg`], [`CommandKind::Actuators`],
@@ -170,6 +175,8 @@ pub use messages::RelativeStateMsg;
 /// active faults in StatusMsg, which grows to 235 bytes).
 /// Version 9: a fleet deputy's state relative to its chief (issue 22, [`RelativeStateMsg`] on
 /// `flexdyn/<deputy>/tlm/rel/<chief>`).
+/// Version 10: the flight code's own telemetry (issue 37, [`FswMsg`] on
+/// `flexdyn/<sc-id>/fsw/<name>`, [`RejectCounters::fsw_refused`]; StatusMsg grows to 243 bytes).
 ///
 /// The number itself is the wire table's `protocol_version` (`proto/schema/messages.toml`),
 /// exported with the table's other constants, sizes and `decode_*` functions above.

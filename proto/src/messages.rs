@@ -668,6 +668,13 @@ pub struct RejectCounters {
     /// bad-version and wrong-spacecraft fault commands count under those reasons. Added in
     /// protocol version 8.
     pub fault_refused: u64,
+    /// A [`FswMsg`] the server did not record: an undeclared stream, a tick ahead of the server
+    /// or not after the stream's last recorded one, a mode or event the stream does not declare,
+    /// a value count other than the declaration's, a bool other than 0/1, a NaN or infinite f64
+    /// value, or COVARIANCE without ESTIMATE. Malformed, bad-version and wrong-spacecraft
+    /// samples count here too (not under those reasons: telemetry is not a command). Added in
+    /// protocol version 10.
+    pub fsw_refused: u64,
 }
 
 impl RejectCounters {
@@ -698,13 +705,14 @@ impl RejectCounters {
             self.wrong_identity,
             self.operator_refused,
             self.fault_refused,
+            self.fsw_refused,
         ]
         .iter()
         .fold(0u64, |a, &b| a.saturating_add(b))
     }
 }
 
-/// Server health, topic `flexdyn/<sc-id>/status`. 235 bytes.
+/// Server health, topic `flexdyn/<sc-id>/status`. 243 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct StatusMsg {
     /// Common header; `tick` is the last frame stepped, `seq` counts status messages.
@@ -1242,4 +1250,77 @@ pub struct RelativeStateMsg {
     pub range_m: f64,
     /// \[m/s\] d|r_Cd/Cc|/dt (the same in every frame).
     pub range_rate_m_s: f64,
+}
+
+/// FswMsg `flags`: which of its optional fields are set (protocol 10).
+pub mod fsw_flags {
+    /// Bit 0: `mode` is the flight code's mode at `header.tick`.
+    pub const MODE: u8 = 1 << 0;
+    /// Bit 1: `q_est_bn` is the flight code's attitude estimate.
+    pub const ESTIMATE: u8 = 1 << 1;
+    /// Bit 2: `q_target_rn` is the attitude the flight code points at.
+    pub const TARGET: u8 = 1 << 2;
+    /// Bit 3: `att_var_b_rad2` holds the estimate's error variances (needs ESTIMATE).
+    pub const COVARIANCE: u8 = 1 << 3;
+    /// Bits 4..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 = !(MODE | ESTIMATE | TARGET | COVARIANCE);
+}
+
+/// A sample of the flight code's own telemetry stream `<name>`, topic
+/// `flexdyn/<sc-id>/fsw/<name>`. 148 bytes + 8 per value word. Protocol version 10 (issue 37).
+///
+/// The stream is declared in the spacecraft configuration's `[[fsw_streams]]`: its modes, its
+/// events (each with a severity) and its values (each an f64, i64 or bool, with a length and a
+/// unit). The server checks a sample against that declaration, records it beside the truth, and
+/// applies nothing from it to the physics.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FswMsg {
+    /// Common header: `tick` is the tick the flight code answered (the newest it has seen),
+    /// `sim_time_ns` that tick's time, `seq` the sender's counter on this stream.
+    pub header: Header,
+    /// Which optional fields are set ([`fsw_flags`]).
+    pub flags: u8,
+    /// [`fsw_flags::MODE`]: index in the stream's `modes`.
+    pub mode: u32,
+    /// [`fsw_flags::ESTIMATE`]: the estimated attitude of B relative to N, quaternion (maps
+    /// N → B), scalar first.
+    pub q_est_bn: [f64; 4],
+    /// [`fsw_flags::TARGET`]: the reference attitude R the flight code points B at,
+    /// quaternion (maps N → R), scalar first.
+    pub q_target_rn: [f64; 4],
+    /// [`fsw_flags::COVARIANCE`]: \[rad²\] the variances of the estimate's attitude error
+    /// about the body axes (the diagonal of its covariance).
+    pub att_var_b_rad2: [f64; 3],
+    /// Events raised at `header.tick` (at most [`crate::MAX_FSW_EVENTS`]).
+    pub event_count: u8,
+    /// Event k's index in the stream's `events`, k < `event_count`; the rest 0.
+    pub events: [u16; 8],
+    /// One word per element of the stream's declared `values`, in declaration order: an f64 as
+    /// its IEEE-754 bits ([`f64::to_bits`]), an i64 in two's complement (`as u64`), a bool 0 or
+    /// 1 (at most [`crate::MAX_FSW_VALUES`]).
+    pub values: Vec<u64>,
+}
+
+impl Default for FswMsg {
+    fn default() -> Self {
+        Self {
+            header: Header::default(),
+            flags: 0,
+            mode: 0,
+            q_est_bn: [1.0, 0.0, 0.0, 0.0],
+            q_target_rn: [1.0, 0.0, 0.0, 0.0],
+            att_var_b_rad2: [0.0; 3],
+            event_count: 0,
+            events: [0; 8],
+            values: Vec::new(),
+        }
+    }
+}
+
+impl FswMsg {
+    /// The events raised, as indices in the stream's `events` (at most `event_count`, bounded by
+    /// the array).
+    pub fn event_indices(&self) -> &[u16] {
+        &self.events[..usize::from(self.event_count).min(self.events.len())]
+    }
 }

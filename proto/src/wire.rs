@@ -7,7 +7,7 @@ use crate::layout::{read_u32_le, sealed::Sealed, Walker, WireLayout, WireMessage
 use crate::DecodeError;
 
 /// The wire protocol version every header carries.
-pub const PROTOCOL_VERSION: u16 = 9;
+pub const PROTOCOL_VERSION: u16 = 10;
 
 // Named constants.
 /// the largest buffer any decoder accepts (bytes); more is TooLarge.
@@ -29,6 +29,10 @@ pub const MAX_STATUS_FAULTS: usize = 256;
 /// 1958-01-01T00:00:00 TAI), 4 octets of coarse time (seconds), 3 octets of fine time (units of
 /// 2⁻²⁴ s).
 pub const CUC_PFIELD_TAI_4_3: u8 = 31;
+/// the most value words one FswMsg carries (the sum of a stream's declared value lengths).
+pub const MAX_FSW_VALUES: usize = 256;
+/// the most events one FswMsg carries.
+pub const MAX_FSW_EVENTS: usize = 8;
 /// FaultCommandMsg `at_tick`: at the next frame boundary the server reaches.
 pub const AT_NEXT_TICK: u64 = u64::MAX;
 /// CommandStatus `last_command_tick` and `command_age_ns` before any command was accepted.
@@ -50,7 +54,7 @@ pub const FRAME_TIMING_LEN: usize = 40;
 /// CommandStatus.
 pub const COMMAND_STATUS_LEN: usize = 21;
 /// RejectCounters.
-pub const REJECT_COUNTERS_LEN: usize = 80;
+pub const REJECT_COUNTERS_LEN: usize = 88;
 /// UtcTime.
 pub const UTC_TIME_LEN: usize = 11;
 /// SysTime.
@@ -98,7 +102,11 @@ pub const FAULT_COMMAND_TARGET_OFFSET: usize = 86;
 /// RelativeStateMsg, since protocol 9.
 pub const RELATIVE_STATE_LEN: usize = 102;
 /// StatusMsg.
-pub const STATUS_LEN: usize = 235;
+pub const STATUS_LEN: usize = 243;
+/// FswMsg with no values, since protocol 10.
+pub const FSW_FIXED_LEN: usize = 148;
+/// the u64 count of values.
+pub const FSW_VALUES_COUNT_OFFSET: usize = 140;
 
 impl Sealed for crate::StateMsg {}
 
@@ -437,5 +445,53 @@ impl WireMessage for crate::StatusMsg {
 
 /// [`decode`](crate::decode) for [`StatusMsg`](crate::StatusMsg): status (`flexdyn/<sc-id>/status`).
 pub fn decode_status(bytes: &[u8]) -> Result<crate::StatusMsg, DecodeError> {
+    crate::decode(bytes)
+}
+
+impl Sealed for crate::FswMsg {}
+
+impl WireMessage for crate::FswMsg {
+    const NAME: &'static str = "FswMsg";
+    const LAYOUT: WireLayout = WireLayout::Walked { min_len: 148, walk: walk_fsw };
+    const MIN_LEN: usize = 148;
+    fn header(&self) -> &crate::Header {
+        &self.header
+    }
+
+    /// The decoder rules bincode does not apply: step 4's bounded counts and text padding,
+    /// then step 5's finite fields, each in wire order.
+    fn validate(&self) -> Result<(), DecodeError> {
+        if u64::from(self.event_count) > 8 {
+            return Err(DecodeError::Malformed(format!("event_count {} exceeds maximum 8", self.event_count)));
+        }
+        for (field, x) in ["q_est_bn[0]", "q_est_bn[1]", "q_est_bn[2]", "q_est_bn[3]"].into_iter().zip(self.q_est_bn.iter()) {
+            if !x.is_finite() {
+                return Err(DecodeError::NonFinite { field });
+            }
+        }
+        for (field, x) in ["q_target_rn[0]", "q_target_rn[1]", "q_target_rn[2]", "q_target_rn[3]"].into_iter().zip(self.q_target_rn.iter()) {
+            if !x.is_finite() {
+                return Err(DecodeError::NonFinite { field });
+            }
+        }
+        for (field, x) in ["att_var_b_rad2[0]", "att_var_b_rad2[1]", "att_var_b_rad2[2]"].into_iter().zip(self.att_var_b_rad2.iter()) {
+            if !x.is_finite() {
+                return Err(DecodeError::NonFinite { field });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The length of a FswMsg, walked from its bytes.
+fn walk_fsw(bytes: &[u8]) -> Result<usize, DecodeError> {
+    let mut w = Walker::at(bytes, 140);
+    let n = w.count("values", 256)?;
+    w.skip(8 * n)?;
+    Ok(w.end())
+}
+
+/// [`decode`](crate::decode) for [`FswMsg`](crate::FswMsg): flight-code telemetry (`flexdyn/<sc-id>/fsw/<name>`).
+pub fn decode_fsw(bytes: &[u8]) -> Result<crate::FswMsg, DecodeError> {
     crate::decode(bytes)
 }

@@ -288,7 +288,7 @@ impl Gen {
     }
 
     fn message(&mut self) -> Vec<u8> {
-        match self.below(15) {
+        match self.below(16) {
             0 => {
                 let effectors = (0..self.below(6))
                     .map(|_| EffectorState {
@@ -421,6 +421,37 @@ impl Gen {
                 params: self.v(),
                 target: FaultTarget(std::array::from_fn(|_| self.u64() as u8)),
             }),
+            // Protocol 10: the flight code's telemetry: event counts up to 9 (the last above the
+            // maximum) and 0..12 value words, or 257 (above the maximum).
+            15 => {
+                let finite = self.below(4) != 0;
+                let q = |s: &mut Self| -> f64 {
+                    if finite {
+                        s.finite()
+                    } else {
+                        s.f64()
+                    }
+                };
+                let q_est_bn = [q(self), q(self), q(self), q(self)];
+                let q_target_rn = [q(self), q(self), q(self), q(self)];
+                let att_var_b_rad2 = [q(self), q(self), q(self)];
+                let n = if self.below(8) == 0 {
+                    257
+                } else {
+                    self.below(12)
+                };
+                encode(&flexdyn_proto::FswMsg {
+                    header: self.header(),
+                    flags: self.u64() as u8,
+                    mode: self.u64() as u32,
+                    q_est_bn,
+                    q_target_rn,
+                    att_var_b_rad2,
+                    event_count: self.below(10) as u8,
+                    events: std::array::from_fn(|_| self.u64() as u16),
+                    values: (0..n).map(|_| self.u64()).collect(),
+                })
+            }
             // Protocol 9: a fleet deputy's relative state (fixed length, plain numbers).
             14 => encode(&flexdyn_proto::RelativeStateMsg {
                 header: self.header(),
@@ -488,6 +519,7 @@ impl Gen {
                         wrong_identity: self.u64(),
                         operator_refused: self.u64(),
                         fault_refused: self.u64(),
+                        fsw_refused: self.u64(),
                         ..RejectCounters::default()
                     },
                     faults_active: self.u64(),
@@ -533,7 +565,7 @@ impl Gen {
                     b = vec![3u8; MAX_MESSAGE_BYTES + 1 + self.below(8) as usize];
                 } else {
                     // A count field rewritten with a large value.
-                    let at = [319usize, 86, 327 + 6][self.below(3) as usize];
+                    let at = [319usize, 86, 327 + 6, 140][self.below(4) as usize];
                     if b.len() >= at + 8 {
                         let v = [1025u64, 9, u64::MAX, 1u64 << 40][self.below(4) as usize];
                         b[at..at + 8].copy_from_slice(&v.to_le_bytes());
@@ -607,6 +639,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
             "fault_event",
             "fault_command",
             "relative_state",
+            "fsw",
         ] {
             let want = rust_lines.next().expect("a Rust verdict per decoder");
             let got = c_lines.next().unwrap_or("<missing>");
@@ -627,7 +660,7 @@ fn c_and_rust_decoders_agree_on_100000_buffers() {
     }
     assert!(c_lines.next().is_none(), "extra C output");
     eprintln!(
-        "{N} buffers x 16 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
+        "{N} buffers x 17 decoders: {accepted} accepted, {rejected} rejected, by reason {reasons:?}"
     );
     // The stream exercises every outcome.
     for r in [

@@ -44,7 +44,7 @@ fn input(effector_index: u32, values: &[f64]) -> EffectorInput {
 
 #[test]
 fn unknown_version_is_checked_first() {
-    for version in [0u16, 1, 2, 3, 4, 5, 6, 7, 8, 10, 0xFFFF] {
+    for version in [0u16, 1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 0xFFFF] {
         let mut b = encode(&StatusMsg::default());
         b[..2].copy_from_slice(&version.to_le_bytes());
         assert_eq!(
@@ -443,7 +443,7 @@ fn encode_into_reuses_the_buffer() {
 fn header_new_sets_version() {
     let h = Header::new(1, 2, 3, 4);
     assert_eq!(h.protocol_version, flexdyn_proto::PROTOCOL_VERSION);
-    assert_eq!(Header::default().protocol_version, 9);
+    assert_eq!(Header::default().protocol_version, 10);
     assert_eq!(StateMsg::default().q_bn, [1.0, 0.0, 0.0, 0.0]);
 }
 

@@ -107,7 +107,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -367,7 +367,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -443,7 +443,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -490,7 +490,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -560,7 +560,7 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -591,7 +591,7 @@ const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
     (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
 ];
 const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -824,7 +824,7 @@ const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
 
 // The sun sensors' tables (protocol 6, issue 20).
 const CSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -860,7 +860,7 @@ const CSS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const FSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -886,7 +886,7 @@ const FSS_GOLDEN: &[(usize, &str, &str)] = &[
     (46, "07", "u8 flags = VALID | IN_FOV | SUNLIT = 0x07"),
 ];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -930,7 +930,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
 /// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
 /// TAI …036.0 s). `crates/server/src/clock.rs` produces exactly this message from that epoch.
 const TIME_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -1003,7 +1003,7 @@ const TIME_GOLDEN: &[(usize, &str, &str)] = &[
     (118, "00000000", "u32 tone_tai.subseconds = 0"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -1020,7 +1020,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -1086,26 +1086,31 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
         "0b00000000000000",
         "u64 rejected.fault_refused = 11 (protocol 8)",
     ),
-    (179, "0700000000000000", "u64 commands_dropped = 7"),
     (
-        187,
+        179,
+        "0c00000000000000",
+        "u64 rejected.fsw_refused = 12 (protocol 10)",
+    ),
+    (187, "0700000000000000", "u64 commands_dropped = 7"),
+    (
+        195,
         "15cd853dfe9c9717",
         "u64 wall_time_unix_ns = 1700000000123456789 (0x17979CFE3D85CD15)",
     ),
     (
-        195,
+        203,
         "0300000000000000",
         "u64 faults_active = 3 (protocol 8)",
     ),
     (
-        203,
+        211,
         "0500000000000000",
         "u64 faults_active_bits[0] = 0b101: faults 0 and 2",
     ),
-    (211, "0000000000000000", "u64 faults_active_bits[1] = 0"),
-    (219, "0000000000000000", "u64 faults_active_bits[2] = 0"),
+    (219, "0000000000000000", "u64 faults_active_bits[1] = 0"),
+    (227, "0000000000000000", "u64 faults_active_bits[2] = 0"),
     (
-        227,
+        235,
         "0000000000000080",
         "u64 faults_active_bits[3] = 1 << 63: fault 255",
     ),
@@ -1115,7 +1120,7 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
 // first live one) activated at tick 44: `bias_step` (mode 2) of 0.25 rad/s on axes 1 and 3 of
 // `imus.hub.gyro`, at 0.44 s exactly (edge = the boundary).
 const FAULT_EVENT_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -1163,7 +1168,7 @@ const FAULT_EVENT_GOLDEN: &[(usize, &str, &str)] = &[
 // `reaction_wheels.rw2`, at tick 0x1_0000_0005 (bytes on both sides of bit 32), for 2 s, seed
 // 7.
 const FAULT_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -1215,7 +1220,7 @@ const FAULT_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
 // Protocol 6 (issue 23, operator control): a `RunTicks` operator command. The tick count
 // 4294967301 = 0x1_0000_0005 has bytes on both sides of bit 32, so a u32 `ticks` would show.
 const OPERATOR_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -1448,7 +1453,7 @@ fn css_golden() {
 // ---- GpsMsg (protocol 7, issue 20): a self-contained block. ----
 /// GpsMsg, hand-derived from proto/README.md (147 bytes).
 const GPS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -1569,6 +1574,7 @@ fn status_golden() {
             wrong_identity: 9,
             operator_refused: 10,
             fault_refused: 11,
+            fsw_refused: 12,
         },
         commands_dropped: 7,
         wall_time_unix_ns: 1_700_000_000_123_456_789,
@@ -1817,7 +1823,7 @@ fn environment_golden() {
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 17] = [
+    let tables: [(&str, &str, Golden, &str); 18] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -1889,6 +1895,8 @@ fn exported_golden_files_match_the_tables() {
             RELATIVE_STATE_GOLDEN,
             "RELATIVE_STATE_GOLDEN",
         ),
+        // Protocol 10, the flight code's own telemetry.
+        ("fsw", "FswMsg", FSW_GOLDEN, "FSW_GOLDEN"),
     ];
     let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");
     let rows: Vec<Vec<&str>> = manifest
@@ -1920,7 +1928,7 @@ fn exported_golden_files_match_the_tables() {
 /// RelativeStateMsg, hand-derived from proto/README.md (102 bytes): deputy 0x11223344 at
 /// tick 1000 (t = 10 s) relative to chief 1.
 const RELATIVE_STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0900", "u16 header.protocol_version = 9"),
+    (0, "0a00", "u16 header.protocol_version = 10"),
     (
         2,
         "44332211",
@@ -1999,3 +2007,130 @@ fn relative_state_golden() {
     assert!(back.v_dc_h_m_s[1].is_sign_negative(), "-0.0 keeps its sign");
 }
 // ---- end RelativeStateMsg ----
+
+// ---- FswMsg (protocol 10, issue 37): a self-contained block. ----
+/// FswMsg, hand-derived from proto/README.md (148 + 3 · 8 = 172 bytes): stream sample of
+/// vehicle 0x11223344 answering tick 1000 (t = 10 s), its 7th, with every optional field set,
+/// two events and three value words (an f64, an i64 and a bool, in that declared order).
+const FSW_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0a00", "u16 header.protocol_version = 10"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "e803000000000000", "u64 header.tick = 1000 (0x3E8)"),
+    (
+        14,
+        "00e40b5402000000",
+        "u64 header.sim_time_ns = 10000000000 (0x2540BE400)",
+    ),
+    (22, "0700000000000000", "u64 header.seq = 7"),
+    (
+        30,
+        "0f",
+        "u8 flags = MODE | ESTIMATE | TARGET | COVARIANCE (bits 0–3)",
+    ),
+    (31, "02000000", "u32 mode = 2"),
+    (
+        35,
+        "000000000000e03f",
+        "f64 q_est_bn[0] = 0.5 (0x3FE0000000000000)",
+    ),
+    (
+        43,
+        "000000000000e0bf",
+        "f64 q_est_bn[1] = -0.5 (0xBFE0000000000000)",
+    ),
+    (51, "000000000000e03f", "f64 q_est_bn[2] = 0.5"),
+    (59, "000000000000e0bf", "f64 q_est_bn[3] = -0.5"),
+    (
+        67,
+        "000000000000f03f",
+        "f64 q_target_rn[0] = 1.0 (0x3FF0000000000000)",
+    ),
+    (75, "0000000000000000", "f64 q_target_rn[1] = 0.0"),
+    (
+        83,
+        "0000000000000080",
+        "f64 q_target_rn[2] = -0.0 (sign bit)",
+    ),
+    (91, "0000000000000000", "f64 q_target_rn[3] = 0.0"),
+    (
+        99,
+        "000000000000d03f",
+        "f64 att_var_b_rad2[0] = 0.25 (0x3FD0000000000000)",
+    ),
+    (
+        107,
+        "000000000000c03f",
+        "f64 att_var_b_rad2[1] = 0.125 (0x3FC0000000000000)",
+    ),
+    (
+        115,
+        "000000000000b03e",
+        "f64 att_var_b_rad2[2] = 2^-20 (exponent 1023 - 20 = 0x3EB: 0x3EB0000000000000)",
+    ),
+    (123, "02", "u8 event_count = 2"),
+    (124, "0300", "u16 events[0] = 3"),
+    (126, "0201", "u16 events[1] = 0x0102 (byte order)"),
+    (128, "000000000000000000000000", "u16 events[2..8] = 0"),
+    (140, "0300000000000000", "u64 values count = 3"),
+    (
+        148,
+        "000000000000f8bf",
+        "u64 values[0] = bits of f64 -1.5 (0xBFF8000000000000)",
+    ),
+    (
+        156,
+        "feffffffffffffff",
+        "u64 values[1] = i64 -2 in two's complement (0xFFFFFFFFFFFFFFFE)",
+    ),
+    (164, "0100000000000000", "u64 values[2] = bool true"),
+];
+
+fn fsw_golden_msg() -> flexdyn_proto::FswMsg {
+    use flexdyn_proto::fsw_flags;
+    flexdyn_proto::FswMsg {
+        header: Header::new(SC, 1000, 10_000_000_000, 7),
+        flags: fsw_flags::MODE | fsw_flags::ESTIMATE | fsw_flags::TARGET | fsw_flags::COVARIANCE,
+        mode: 2,
+        q_est_bn: [0.5, -0.5, 0.5, -0.5],
+        q_target_rn: [1.0, 0.0, -0.0, 0.0],
+        att_var_b_rad2: [0.25, 0.125, 1.0 / 1_048_576.0],
+        event_count: 2,
+        events: [3, 0x0102, 0, 0, 0, 0, 0, 0],
+        values: vec![(-1.5f64).to_bits(), (-2i64) as u64, 1],
+    }
+}
+
+#[test]
+fn fsw_golden() {
+    let msg = fsw_golden_msg();
+    check("FswMsg", FSW_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), flexdyn_proto::FSW_FIXED_LEN + 3 * 8);
+    assert_eq!(flexdyn_proto::FSW_FIXED_LEN, 148);
+    let back = flexdyn_proto::decode_fsw(&golden_bytes(FSW_GOLDEN)).unwrap();
+    assert_eq!(back, msg);
+    assert_eq!(back.event_indices(), &[3, 0x0102]);
+    assert!(
+        back.q_target_rn[2].is_sign_negative(),
+        "-0.0 keeps its sign"
+    );
+    // Nine events, or a NaN in the estimate, are refused by every decoder.
+    let mut bytes = golden_bytes(FSW_GOLDEN);
+    bytes[123] = 9;
+    assert!(matches!(
+        flexdyn_proto::decode_fsw(&bytes),
+        Err(DecodeError::Malformed(_))
+    ));
+    let mut bytes = golden_bytes(FSW_GOLDEN);
+    bytes[35..43].copy_from_slice(&f64::NAN.to_le_bytes());
+    assert!(matches!(
+        flexdyn_proto::decode_fsw(&bytes),
+        Err(DecodeError::NonFinite {
+            field: "q_est_bn[0]"
+        })
+    ));
+}
+// ---- end FswMsg ----

@@ -200,6 +200,7 @@ fn status() -> impl Strategy<Value = StatusMsg> {
                     wrong_identity: r.7,
                     operator_refused: r.8,
                     fault_refused,
+                    fsw_refused: !fault_refused,
                 },
                 commands_dropped: dropped,
                 wall_time_unix_ns: wall,
@@ -325,7 +326,7 @@ proptest! {
     /// Random bodies of exactly the right length reach bincode: the result is a
     /// message, Malformed or NonFinite, never a panic or a length error.
     #[test]
-    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 233)) {
+    fn right_length_random_bodies(body in prop::collection::vec(any::<u8>(), 241)) {
         let mut b = flexdyn_proto::PROTOCOL_VERSION.to_le_bytes().to_vec();
         b.extend_from_slice(&body);
         for r in [

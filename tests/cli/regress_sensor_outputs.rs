@@ -20,7 +20,10 @@ use flexdyn::commands::simulate::simulate_to;
 use flexdyn_vehicle::config::SimConfig;
 use sha2::{Digest, Sha256};
 
-/// (scenario, log interval \[s\], sha256 of the CSV). Re-minted for protocol version 9 (the
+/// (scenario, log interval \[s\], sha256 of the CSV). Re-minted for protocol version 10 (the
+/// flight code's telemetry, issue 37): with the CSV's `protocol_version` column set back to 9,
+/// all six hash to their protocol-9 values (checked with `flexdyn simulate` and a rewrite of
+/// that column). Re-minted for protocol version 9 (the
 /// fleet's relative-state message, issue 22): with the CSV's `protocol_version` column set back
 /// to 8, all six were checked to hash to their protocol-8 values. Re-minted for protocol
 /// version 8 (fault
@@ -33,32 +36,32 @@ const GOLDEN: [(&str, f64, &str); 6] = [
     (
         "imu_tactical",
         0.01,
-        "3a5653423600ea73d79a7acd13b7efd1233f889e2a2c3900948d890642a6cce7",
+        "eed792b77ee40928434d826ee45b6960ce0d0af9bd5fc21a3f988d64286b597b",
     ),
     (
         "imu_tactical",
         0.003,
-        "61753dd0a960addb4d8aa3db0ca4ee0d594dd614e31397f4bca6824fe538a593",
+        "8ad8f85a079763e835670069c22da9d284c7fe45e564916ebb545047651ef63e",
     ),
     (
         "imu_tactical",
         0.05,
-        "cbcf3ce84c76158e3bf656874972761a967bae5be92c2e3027b253265008010a",
+        "382c9c998926a376c4f75650dfcebcc891e433017af687b9fd61e86ef6755a9e",
     ),
     (
         "wheels_star_tracker",
         0.01,
-        "91b8bcc5e6eb258aa9f6cb6a26fd7ab4a6f215715419ab8bf040e6c2e32de9be",
+        "f5a4df3148effb65603cf602c9f38f16bd29b2e09395f03a8736908625e8bb9d",
     ),
     (
         "wheels_star_tracker",
         0.003,
-        "6d889fc6084b6351748047db85459ebf860a845e46a4dd29b77556fd5d9cba9c",
+        "b0eb07161b2af23972df71ab962bd6fb8271c6f35bef6885e5cc6e07dca99b0a",
     ),
     (
         "wheels_star_tracker",
         0.05,
-        "25405636113c1b52d6326e7c5843182ee62f3975fbdbdd5d58cd7a82ac84ed45",
+        "5317dcdbfe6f76c61ddec4ffb96bee09f8628067129bf3094b8ad4d0b6ffe21e",
     ),
 ];
 

@@ -108,6 +108,7 @@ fn bad_commands_are_counted_and_the_server_keeps_running() {
         wrong_identity: 2,
         operator_refused: 0,
         fault_refused: 0,
+        fsw_refused: 0,
     };
     assert!(
         wait_until(WAIT, || obs

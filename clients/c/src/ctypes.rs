@@ -119,6 +119,7 @@ pub struct FdStatusMsg {
     pub rejected_wrong_identity: u64,
     pub rejected_operator_refused: u64,
     pub rejected_fault_refused: u64,
+    pub rejected_fsw_refused: u64,
     pub commands_dropped: u64,
     pub wall_time_unix_ns: u64,
     pub faults_active: u64,
@@ -334,6 +335,7 @@ impl From<&StatusMsg> for FdStatusMsg {
             wrong_identity,
             operator_refused,
             fault_refused,
+            fsw_refused,
         } = *rejected;
         Self {
             header: header.into(),
@@ -358,6 +360,7 @@ impl From<&StatusMsg> for FdStatusMsg {
             rejected_wrong_identity: wrong_identity,
             rejected_operator_refused: operator_refused,
             rejected_fault_refused: fault_refused,
+            rejected_fsw_refused: fsw_refused,
             commands_dropped: *commands_dropped,
             wall_time_unix_ns: *wall_time_unix_ns,
             faults_active: *faults_active,

@@ -204,6 +204,7 @@ static void check_status(flexdyn_client *c, const char *dir) {
     SAME("status", a, b, rejected_wrong_identity);
     SAME("status", a, b, rejected_operator_refused);
     SAME("status", a, b, rejected_fault_refused);
+    SAME("status", a, b, rejected_fsw_refused);
     SAME("status", a, b, commands_dropped);
     SAME("status", a, b, wall_time_unix_ns);
     SAME("status", a, b, faults_active);

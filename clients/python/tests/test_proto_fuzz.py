@@ -15,6 +15,7 @@ from flexdyn.proto import (CommandMsg, DecodeError, EffectorInput, EffectorState
 from flexdyn.proto import GpsMsg  # protocol 7: the thirteenth decoder, generator arm 11
 from flexdyn.proto import FaultCommandMsg, FaultEventMsg  # protocol 8: decoders 14-15, arms 12-13
 from flexdyn.proto import RelativeStateMsg  # protocol 9: decoder 16, arm 14
+from flexdyn.proto import FswMsg  # protocol 10: decoder 17, arm 15
 
 N = 20_000
 
@@ -98,7 +99,8 @@ def status_line(m):
         m.command_stale, m.stale_policy, m.rejected_malformed, m.rejected_bad_version,
         m.rejected_non_finite, m.rejected_wrong_spacecraft, m.rejected_stale_tick,
         m.rejected_unknown_sender, m.rejected_bad_effector_input, m.rejected_wrong_identity,
-        m.rejected_operator_refused, m.rejected_fault_refused, m.commands_dropped,
+        m.rejected_operator_refused, m.rejected_fault_refused, m.rejected_fsw_refused,
+        m.commands_dropped,
         m.wall_time_unix_ns, m.faults_active, *m.faults_active_bits))
 
 
@@ -132,6 +134,11 @@ def relative_state_line(m):
                .f(m.r_dc_h_m).f(m.v_dc_h_m_s).f((m.range_m, m.range_rate_m_s)))
 
 
+def fsw_line(m):
+    return str(Line().h(m.header).u(m.flags, m.mode).f(m.q_est_bn).f(m.q_target_rn)
+               .f(m.att_var_b_rad2).u(m.event_count, *m.events, len(m.values), *m.values))
+
+
 DECODERS = [
     (StateMsg.decode, state_line), (ImuMsg.decode, imu_line),
     (StarTrackerMsg.decode, star_tracker_line), (MagnetometerMsg.decode, magnetometer_line),
@@ -142,6 +149,7 @@ DECODERS = [
     (GpsMsg.decode, gps_line),
     (FaultEventMsg.decode, fault_event_line), (FaultCommandMsg.decode, fault_command_line),
     (RelativeStateMsg.decode, relative_state_line),
+    (FswMsg.decode, fsw_line),
 ]
 
 
@@ -179,7 +187,7 @@ def gen_buffer(r):
     def header():
         return Header(r.getrandbits(32), r.getrandbits(64), r.getrandbits(64), r.getrandbits(64))
 
-    k = r.randrange(15)
+    k = r.randrange(16)
     if k == 0:
         b = StateMsg(header(), v(3), v(4), v(3), v(3), v(3), v(3), v(3), f64(), f64(), v(3), v(3),
                      v(3), v(3), r.getrandbits(8),
@@ -203,7 +211,7 @@ def gen_buffer(r):
                         for _ in range(r.randrange(5))] if kind == proto.ACTUATORS else []).encode()
     elif k == 4:
         b = StatusMsg(header(), r.randrange(3), r.randrange(6), *(r.getrandbits(64) for _ in range(7)),
-                      r.random() < 0.5, r.randrange(2), *(r.getrandbits(64) for _ in range(13)),
+                      r.random() < 0.5, r.randrange(2), *(r.getrandbits(64) for _ in range(14)),
                       tuple(r.getrandbits(64) for _ in range(4))).encode()
     elif k == 6:
         b = TimeMsg(header(), r.randrange(7), r.randrange(3), r.getrandbits(8), r.getrandbits(64),
@@ -236,6 +244,12 @@ def gen_buffer(r):
     elif k == 14:
         b = RelativeStateMsg(header(), r.getrandbits(32), r.getrandbits(32), v(3), v(3), f64(),
                              f64()).encode()
+    elif k == 15:  # event counts up to 9 (the last above the maximum), 0..257 values
+        g = fin if r.randrange(4) else f64
+        b = FswMsg(header(), r.getrandbits(8), r.getrandbits(32), v(4, g), v(4, g), v(3, g),
+                   r.randrange(10), tuple(r.getrandbits(16) for _ in range(8)),
+                   [r.getrandbits(64) for _ in range(r.randrange(12) if r.randrange(8) else 257)]
+                   ).encode()
     b = bytearray(b)
     k = r.randrange(10)
     if k in (3, 4, 5):
@@ -252,7 +266,7 @@ def gen_buffer(r):
         if r.randrange(20) == 0:
             b = bytearray(b"\x03" * (proto.MAX_MESSAGE_BYTES + 1 + r.randrange(8)))
         else:
-            at = r.choice([319, 86, 333])
+            at = r.choice([319, 86, 333, 140])
             if len(b) >= at + 8:
                 b[at:at + 8] = struct.pack("<Q", r.choice([1025, 9, 2**64 - 1, 2**40]))
     return bytes(b)
@@ -264,18 +278,18 @@ def test_python_and_rust_decoders_agree_on_20000_buffers(verdicts_bin):
     stream = b"".join(struct.pack("<I", len(b)) + b for b in buffers)
     rust = subprocess.run([str(verdicts_bin)], input=stream, capture_output=True, check=True)
     rust_lines = rust.stdout.decode().splitlines()
-    assert len(rust_lines) == 16 * N
+    assert len(rust_lines) == 17 * N
     reasons = {}
     names = ["state", "imu", "star_tracker", "magnetometer", "css", "fss", "environment",
              "command", "status", "time", "operator", "header", "gps", "fault_event",
-             "fault_command", "relative_state"]
+             "fault_command", "relative_state", "fsw"]
     for i, b in enumerate(buffers):
         for j, got in enumerate(python_lines(b)):
-            want = rust_lines[16 * i + j]
+            want = rust_lines[17 * i + j]
             assert got == want, f"buffer {i} ({len(b)} bytes), {names[j]}: Python {got!r} vs Rust {want!r}"
             key = want.split()[1] if want.startswith("E") else "accepted"
             reasons[key] = reasons.get(key, 0) + 1
-    print(f"{N} buffers x 16 decoders: {reasons}")
+    print(f"{N} buffers x 17 decoders: {reasons}")
     for k in ("accepted", "Length", "TrailingBytes", "TooLarge", "UnknownVersion", "NonFinite",
               "Malformed"):
         assert reasons.get(k, 0) > 0, k

@@ -21,7 +21,7 @@ def bits(x):
 def test_manifest_lists_every_file(golden_dir):
     rows = [l.split("\t") for l in (golden_dir / "MANIFEST.tsv").read_text().splitlines()
             if l and not l.startswith("#")]
-    assert len(rows) == 17
+    assert len(rows) == 18
     for name, _message, length, _source in rows:
         assert (golden_dir / f"{name}.bin").stat().st_size == int(length)
 
@@ -117,11 +117,11 @@ def test_commands(golden_dir):
 def test_status(golden_dir):
     m = StatusMsg(Header(SC, 0x0102030405060708, 1_500_000_000, 99), proto.MODE_LOCKSTEP, 1,
                   1000, 250_000, 3_000_000, 3, 2, 41, 1_000_000, True, proto.STALE_POLICY_ZERO,
-                  1, 2, 3, 4, 5, 6, 8, 9, 10, 11, 7, 1_700_000_000_123_456_789,
+                  1, 2, 3, 4, 5, 6, 8, 9, 10, 11, 12, 7, 1_700_000_000_123_456_789,
                   3, (0b101, 0, 0, 1 << 63))
     golden = (golden_dir / "status.bin").read_bytes()
     assert m.encode() == golden and StatusMsg.decode(golden) == m
-    assert len(golden) == proto.STATUS_LEN == 235
+    assert len(golden) == proto.STATUS_LEN == 243
     assert [i for i in range(300) if m.fault_active(i)] == [0, 2, 255]
 
 
@@ -283,3 +283,31 @@ def test_relative_state(golden_dir):
     with pytest.raises(DecodeError) as e:
         RelativeStateMsg.decode(b"\x08\x00" + golden[2:])
     assert e.value.reason == "UnknownVersion"
+
+
+def test_fsw(golden_dir):
+    # FSW_GOLDEN of proto/tests/golden.rs (protocol 10): every optional field, two events, three
+    # value words: an f64 (-1.5), an i64 (-2) and a bool (true).
+    from flexdyn.proto import FswMsg
+    words = [struct.unpack("<Q", struct.pack("<d", -1.5))[0], (-2) & 0xFFFFFFFFFFFFFFFF, 1]
+    m = FswMsg(Header(SC, 1000, 10_000_000_000, 7),
+               proto.FSW_MODE | proto.FSW_ESTIMATE | proto.FSW_TARGET | proto.FSW_COVARIANCE, 2,
+               (0.5, -0.5, 0.5, -0.5), (1.0, 0.0, -0.0, 0.0), (0.25, 0.125, 2.0 ** -20), 2,
+               (3, 0x0102, 0, 0, 0, 0, 0, 0), words)
+    golden = (golden_dir / "fsw.bin").read_bytes()
+    assert len(golden) == proto.FSW_FIXED_LEN + 3 * 8 == 172
+    assert m.encode() == golden
+    back = FswMsg.decode(golden)
+    assert back == m and bits(back.q_target_rn) == bits(m.q_target_rn)  # -0.0 keeps its sign
+    assert proto.fsw_key("sc1", "acs") == "flexdyn/sc1/fsw/acs"
+    bad = bytearray(golden)
+    bad[123] = 9
+    with pytest.raises(DecodeError) as e:
+        FswMsg.decode(bytes(bad))
+    assert e.value.reason == "Malformed"
+    bad = bytearray(golden)
+    bad[35:43] = struct.pack("<d", math.nan)
+    with pytest.raises(DecodeError) as e:
+        FswMsg.decode(bytes(bad))
+    assert e.value.reason == "NonFinite" and e.value.info["field"] == "q_est_bn[0]"
+

@@ -134,6 +134,9 @@ pub struct Shared {
     wrong_identity: AtomicU64,
     operator_refused: AtomicU64,
     fault_refused: AtomicU64,
+    fsw_refused: AtomicU64,
+    /// Flight-code telemetry samples accepted (`flexdyn/<sc>/fsw/*`, recorded when recording).
+    pub fsw_recorded: AtomicU64,
     /// Fault requests the physics side refused ([`flexdyn_faults::ports::INSTALL_REFUSALS`]),
     /// and the code of the last one, for the telemetry thread's log.
     pub faults_refused_physics: AtomicU64,
@@ -346,6 +349,11 @@ impl Shared {
         bump(&self.fault_refused);
     }
 
+    /// Count a flight-code telemetry sample the server did not record.
+    pub fn reject_fsw(&self) {
+        bump(&self.fsw_refused);
+    }
+
     /// Count a fault request the physics side refused, with its reason's code
     /// (allocation- and lock-free).
     pub fn reject_fault_physics(&self, code: u8) {
@@ -433,6 +441,7 @@ impl Shared {
             wrong_identity: l(&self.wrong_identity),
             operator_refused: l(&self.operator_refused),
             fault_refused: l(&self.fault_refused),
+            fsw_refused: l(&self.fsw_refused),
         }
     }
 

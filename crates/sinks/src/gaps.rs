@@ -34,7 +34,11 @@ impl SeqGaps {
             | TopicKind::Environment
             | TopicKind::FaultEvent
             | TopicKind::RelativeState => true,
-            TopicKind::Command | TopicKind::Operator | TopicKind::FaultCommand => false,
+            // The flight code's counters are its own, and the server records only the samples
+            // that pass its checks: a jump there is a refusal, counted in StatusMsg.
+            TopicKind::Command | TopicKind::Operator | TopicKind::FaultCommand | TopicKind::Fsw => {
+                false
+            }
         }
     }
 

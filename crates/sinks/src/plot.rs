@@ -273,7 +273,8 @@ fn from_mcap(
             | TopicKind::Command
             | TopicKind::Time
             | TopicKind::Operator
-            | TopicKind::FaultCommand => {}
+            | TopicKind::FaultCommand
+            | TopicKind::Fsw => {}
             TopicKind::RelativeState => {
                 if data.chief.as_ref().map(|(c, _)| c.as_str()) == topic.sensor {
                     data.relative.push(&cells);

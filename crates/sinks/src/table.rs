@@ -205,6 +205,7 @@ pub fn row(decoded: &Decoded) -> Vec<Column> {
                 Decoded::FaultEvent(m) => push_columns("", m, &[], &mut out),
                 Decoded::FaultCommand(m) => push_columns("", m, &[], &mut out),
                 Decoded::RelativeState(m) => push_columns("", m, &[], &mut out),
+                Decoded::Fsw(m) => push_columns("", m, &[], &mut out),
                 Decoded::State(_) | Decoded::Command(_) => {
                     push_value("", &decoded.to_json(), &mut out)
                 }

@@ -19,6 +19,8 @@ use flexdyn_proto::{
 };
 // A fleet deputy's relative state (protocol 9).
 use flexdyn_proto::{decode_relative_state, RelativeStateMsg, RELATIVE_STATE_PREFIX};
+// The flight code's own telemetry (protocol 10).
+use flexdyn_proto::{decode_fsw, FswMsg, FSW_PREFIX};
 
 use flexdyn_sensors::{SensorKind, KINDS};
 
@@ -48,6 +50,9 @@ pub enum TopicKind {
     /// `flexdyn/<deputy>/tlm/rel/<chief>`: [`RelativeStateMsg`] (a fleet deputy relative to
     /// its chief; the chief's id is the topic's `sensor`).
     RelativeState,
+    /// `flexdyn/<sc>/fsw/<name>`: [`FswMsg`] (the flight code's telemetry stream `<name>`,
+    /// the topic's `sensor`).
+    Fsw,
 }
 
 impl TopicKind {
@@ -64,6 +69,7 @@ impl TopicKind {
                 TopicKind::FaultEvent,
                 TopicKind::FaultCommand,
                 TopicKind::RelativeState,
+                TopicKind::Fsw,
             ])
     }
 
@@ -93,6 +99,7 @@ impl TopicKind {
             TopicKind::FaultEvent => "FaultEventMsg",
             TopicKind::FaultCommand => "FaultCommandMsg",
             TopicKind::RelativeState => "RelativeStateMsg",
+            TopicKind::Fsw => "FswMsg",
         }
     }
 }
@@ -139,6 +146,8 @@ pub fn classify(key: &str) -> Option<Topic<'_>> {
         (TopicKind::Command, Some(sender))
     } else if let Some(chief) = sensor(RELATIVE_STATE_PREFIX) {
         (TopicKind::RelativeState, Some(chief))
+    } else if let Some(stream) = sensor(FSW_PREFIX) {
+        (TopicKind::Fsw, Some(stream))
     } else if suffix == STATUS_SUFFIX {
         (TopicKind::Status, None)
     } else if suffix == OPERATOR_SUFFIX {
@@ -190,6 +199,8 @@ pub enum Decoded {
     FaultCommand(FaultCommandMsg),
     /// A fleet deputy's state relative to its chief.
     RelativeState(RelativeStateMsg),
+    /// A sample of the flight code's own telemetry.
+    Fsw(FswMsg),
 }
 
 impl Decoded {
@@ -216,6 +227,7 @@ impl Decoded {
             TopicKind::FaultEvent => Decoded::FaultEvent(decode_fault_event(payload)?),
             TopicKind::FaultCommand => Decoded::FaultCommand(decode_fault_command(payload)?),
             TopicKind::RelativeState => Decoded::RelativeState(decode_relative_state(payload)?),
+            TopicKind::Fsw => Decoded::Fsw(decode_fsw(payload)?),
         })
     }
 
@@ -232,6 +244,7 @@ impl Decoded {
             Decoded::FaultEvent(m) => &m.header,
             Decoded::FaultCommand(m) => &m.header,
             Decoded::RelativeState(m) => &m.header,
+            Decoded::Fsw(m) => &m.header,
         }
     }
 
@@ -249,6 +262,7 @@ impl Decoded {
             Decoded::FaultEvent(m) => serde_json::to_vec(m),
             Decoded::FaultCommand(m) => serde_json::to_vec(m),
             Decoded::RelativeState(m) => serde_json::to_vec(m),
+            Decoded::Fsw(m) => serde_json::to_vec(m),
         };
         v.unwrap_or_else(|_| b"null".to_vec())
     }
@@ -266,6 +280,7 @@ impl Decoded {
             Decoded::FaultEvent(m) => serde_json::to_value(m),
             Decoded::FaultCommand(m) => serde_json::to_value(m),
             Decoded::RelativeState(m) => serde_json::to_value(m),
+            Decoded::Fsw(m) => serde_json::to_value(m),
         };
         // The wire structs hold only numbers, bools, enums and vectors: always representable.
         v.unwrap_or(serde_json::Value::Null)
@@ -289,6 +304,7 @@ pub fn json_schema(kind: TopicKind) -> serde_json::Value {
         TopicKind::FaultEvent => of::<FaultEventMsg>(),
         TopicKind::FaultCommand => of::<FaultCommandMsg>(),
         TopicKind::RelativeState => of::<RelativeStateMsg>(),
+        TopicKind::Fsw => of::<FswMsg>(),
     }
 }
 

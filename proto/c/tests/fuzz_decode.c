@@ -256,6 +256,7 @@ static void one(const uint8_t *buf, size_t len) {
             u(m.rejected_wrong_identity);
             u(m.rejected_operator_refused);
             u(m.rejected_fault_refused);
+            u(m.rejected_fsw_refused);
             u(m.commands_dropped);
             u(m.wall_time_unix_ns);
             u(m.faults_active);
@@ -398,6 +399,27 @@ static void one(const uint8_t *buf, size_t len) {
             fs(m.v_dc_h_m_s, 3);
             fs(&m.range_m, 1);
             fs(&m.range_rate_m_s, 1);
+            printf("\n");
+        }
+    }
+    {
+        static fd_fsw_msg m; /* the seventeenth decoder (protocol 10); 2 KiB of values */
+        size_t i;
+        e = fd_decode_fsw(buf, len, &m);
+        if (e.status != FD_OK) {
+            print_error(&e);
+        } else if (reencodes(buf, len, fd_encode_fsw(&m, again, sizeof again))) {
+            printf("O");
+            h(&m.header);
+            u(m.flags);
+            u(m.mode);
+            fs(m.q_est_bn, 4);
+            fs(m.q_target_rn, 4);
+            fs(m.att_var_b_rad2, 3);
+            u(m.event_count);
+            for (i = 0; i < 8; ++i) u(m.events[i]);
+            u(m.n_values);
+            for (i = 0; i < m.n_values; ++i) u(m.values[i]);
             printf("\n");
         }
     }

@@ -56,7 +56,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     fd_header h;
     fd_error e = fd_decode_header(data, size, &h);
     if (e.status == FD_OK) {
-        if (size < FD_HEADER_LEN || size > FD_MAX_MESSAGE_BYTES || h.protocol_version != 9u) abort();
+        if (size < FD_HEADER_LEN || size > FD_MAX_MESSAGE_BYTES || h.protocol_version != FD_PROTOCOL_VERSION) abort();
     } else if (size >= FD_HEADER_LEN && size <= FD_MAX_MESSAGE_BYTES &&
                data[0] == (FD_PROTOCOL_VERSION & 0xFFu) && data[1] == (FD_PROTOCOL_VERSION >> 8)) {
         abort();
@@ -74,6 +74,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     ROUND_TRIP(fault_event, fd_fault_event_msg, (void)0);
     ROUND_TRIP(relative_state, fd_relative_state_msg, (void)0);
     ROUND_TRIP(status, fd_status_msg, (void)0);
+    ROUND_TRIP(fsw, fd_fsw_msg, (void)0);
     {
         fd_command_msg m;
         memset(&m, 0, sizeof m);

@@ -377,6 +377,7 @@ static void test_status(const char *dir) {
     m.rejected_wrong_identity = 9;
     m.rejected_operator_refused = 10;
     m.rejected_fault_refused = 11;
+    m.rejected_fsw_refused = 12;
     m.commands_dropped = 7;
     m.wall_time_unix_ns = 1700000000123456789u;
     m.faults_active = 3;
@@ -389,7 +390,8 @@ static void test_status(const char *dir) {
               back.rejected_bad_effector_input == 8 && back.rejected_wrong_identity == 9 &&
               back.rejected_operator_refused == 10 && back.commands_dropped == 7 &&
               back.stale_policy == 1 && back.command_stale == 1 &&
-              back.rejected_fault_refused == 11 && back.faults_active == 3 &&
+              back.rejected_fault_refused == 11 && back.rejected_fsw_refused == 12 &&
+              back.faults_active == 3 &&
               back.faults_active_bits[0] == 5u && back.faults_active_bits[1] == 0u &&
               back.faults_active_bits[3] == 0x8000000000000000u,
           "StatusMsg decodes to the table");
@@ -699,6 +701,52 @@ static void test_relative_state(const char *dir) {
     printf("RelativeStateMsg: decode ok\n");
 }
 
+/* FswMsg (protocol 10): the FSW_GOLDEN table of proto/tests/golden.rs. */
+static void test_fsw(const char *dir) {
+    uint8_t golden[256], enc[256];
+    size_t n = read_file(dir, "fsw", golden, sizeof golden);
+    static fd_fsw_msg m, back;
+    static const double q_est[4] = {0.5, -0.5, 0.5, -0.5}, q_target[4] = {1.0, 0.0, -0.0, 0.0};
+    static const double var[3] = {0.25, 0.125, 1.0 / 1048576.0};
+    double minus_1_5 = -1.5;
+    uint64_t f64_word;
+    char key[128];
+    fd_error e;
+    memcpy(&f64_word, &minus_1_5, 8);
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 1000u, 10000000000ull, 7u);
+    m.flags = FD_FSW_MODE | FD_FSW_ESTIMATE | FD_FSW_TARGET | FD_FSW_COVARIANCE;
+    m.mode = 2u;
+    memcpy(m.q_est_bn, q_est, sizeof q_est);
+    memcpy(m.q_target_rn, q_target, sizeof q_target);
+    memcpy(m.att_var_b_rad2, var, sizeof var);
+    m.event_count = 2;
+    m.events[0] = 3u;
+    m.events[1] = 0x0102u;
+    m.n_values = 3;
+    m.values[0] = f64_word;
+    m.values[1] = (uint64_t)(int64_t)-2;
+    m.values[2] = 1u;
+    CHECK(n == FD_FSW_FIXED_LEN + 3 * 8 && fd_fsw_len(&m) == n, "FswMsg length 172");
+    check_encoded("FswMsg", golden, n, enc, fd_encode_fsw(&m, enc, sizeof enc));
+    e = fd_decode_fsw(golden, n, &back);
+    CHECK(e.status == FD_OK && same_header(&back.header, &m.header) && back.flags == 0x0f &&
+              back.mode == 2u && same_bits(back.q_est_bn, q_est, 4) &&
+              same_bits(back.q_target_rn, q_target, 4) && same_bits(back.att_var_b_rad2, var, 3) &&
+              back.event_count == 2 && back.events[0] == 3u && back.events[1] == 0x0102u &&
+              back.n_values == 3 && back.values[0] == 0xBFF8000000000000u &&
+              back.values[1] == 0xFFFFFFFFFFFFFFFEu && back.values[2] == 1u,
+          "FswMsg decodes to the table");
+    e = fd_decode_fsw(golden, n - 1, &back);
+    CHECK(e.status == FD_ERR_LENGTH, "FswMsg short");
+    golden[123] = 9;
+    e = fd_decode_fsw(golden, n, &back);
+    CHECK(e.status == FD_ERR_MALFORMED, "FswMsg with nine events is malformed");
+    CHECK(fd_fsw_key(key, sizeof key, "sc1", "acs") > 0 && strcmp(key, "flexdyn/sc1/fsw/acs") == 0,
+          "fsw key");
+    printf("FswMsg: decode ok\n");
+}
+
 static void test_keys(void) {
     char key[128];
     CHECK(fd_state_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/tlm/state") == 0,
@@ -748,6 +796,7 @@ int main(int argc, char **argv) {
     test_keys();
     test_faults(argv[1]);
     test_relative_state(argv[1]);
+    test_fsw(argv[1]);
     if (failures != 0) {
         fprintf(stderr, "%d check(s) failed\n", failures);
         return 1;

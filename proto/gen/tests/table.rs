@@ -201,6 +201,7 @@ fn the_table_reads_every_golden_as_the_rust_decoder_does() {
     agree::<FaultEventMsg>(&t, &["fault_event"], &mut seen);
     agree::<FaultCommandMsg>(&t, &["fault_command"], &mut seen);
     agree::<RelativeStateMsg>(&t, &["relative_state"], &mut seen);
+    agree::<flexdyn_proto::FswMsg>(&t, &["fsw"], &mut seen);
     agree::<StatusMsg>(&t, &["status"], &mut seen);
     // Every message of the table is a Rust message checked here, and the reverse.
     let mut in_table: Vec<&str> = t.messages.iter().map(|m| m.name.as_str()).collect();
@@ -213,7 +214,7 @@ fn the_table_reads_every_golden_as_the_rust_decoder_does() {
         .lines()
         .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
         .count();
-    assert_eq!(goldens, 17, "a golden was added: read it above");
+    assert_eq!(goldens, 18, "a golden was added: read it above");
 }
 
 #[test]
@@ -255,6 +256,10 @@ fn the_keys_are_the_rust_keys() {
         topics.relative_state("chief").unwrap()
     );
     assert_eq!(key("status", ""), topics.status());
+    assert_eq!(
+        key("fsw", "acs"),
+        flexdyn_proto::fsw_key("sc1", "acs").unwrap()
+    );
 }
 
 /// The table with `from` replaced by `to` (once).
@@ -307,7 +312,7 @@ fn mistakes_in_the_table_are_named() {
             "enum OperatorAction, value \"Resume\"",
         ),
         (
-            edited("since = 9", "since = 10"),
+            edited("since = 9", "since = 11"),
             "message RelativeStateMsg, since",
         ),
         (
@@ -697,13 +702,14 @@ fn finite_marks_are_the_decoders_non_finite_checks() {
         }
     }
     // Torque and force of the two wrench-carrying commands (12); the actuators golden's input
-    // values: 134 = 94 + (12 + 8 v1) + (12 + 8 v2) bytes, so v1 + v2 = 2; two fault parameters.
-    assert_eq!(refused, 12 + 2 + 2, "{checked} values checked");
+    // values: 134 = 94 + (12 + 8 v1) + (12 + 8 v2) bytes, so v1 + v2 = 2; two fault parameters;
+    // FswMsg's estimate (4), target (4) and variances (3).
+    assert_eq!(refused, 12 + 2 + 2 + 11, "{checked} values checked");
     assert!(checked > 150, "{checked}");
 }
 
 /// The golden files and their messages (proto/golden/MANIFEST.tsv).
-const GOLDENS: [(&str, &str); 17] = [
+const GOLDENS: [(&str, &str); 18] = [
     ("state", "StateMsg"),
     ("imu", "ImuMsg"),
     ("star_tracker", "StarTrackerMsg"),
@@ -721,6 +727,7 @@ const GOLDENS: [(&str, &str); 17] = [
     ("fault_command", "FaultCommandMsg"),
     ("relative_state", "RelativeStateMsg"),
     ("status", "StatusMsg"),
+    ("fsw", "FswMsg"),
 ];
 
 /// The Rust decoder on `bytes` as message `name`: its serde JSON, or why it refused them.
@@ -745,6 +752,7 @@ fn rust(name: &str, bytes: &[u8]) -> Result<Value, flexdyn_proto::DecodeError> {
         "FaultCommandMsg" => d::<FaultCommandMsg>(bytes),
         "RelativeStateMsg" => d::<RelativeStateMsg>(bytes),
         "StatusMsg" => d::<StatusMsg>(bytes),
+        "FswMsg" => d::<FswMsg>(bytes),
         other => panic!("{other}"),
     }
 }

@@ -3,9 +3,9 @@
 //! `proto/c/tests/fuzz_decode.c`, the Python package's `tests/test_proto_fuzz.py`).
 //!
 //! Input (stdin): records of a u32 LE length and that many bytes. Output (stdout): per record,
-//! sixteen lines, one per decoder (state, imu, star tracker, magnetometer, css, fss,
+//! seventeen lines, one per decoder (state, imu, star tracker, magnetometer, css, fss,
 //! environment, command, status, time, operator, header, gps, fault event, fault command,
-//! relative state):
+//! relative state, fsw):
 //! `E <reason> [numbers or field]` for an error (the `DecodeError` variant; `Length needed
 //! actual`, `TrailingBytes expected actual`, `TooLarge actual`, `UnknownVersion found`,
 //! `NonFinite field`, `Malformed`), or `O <fields>` for a decoded message: every field in wire
@@ -26,6 +26,8 @@ use flexdyn_proto::{decode_gps, GpsMsg};
 use flexdyn_proto::{decode_fault_command, decode_fault_event, FaultCommandMsg, FaultEventMsg};
 // A fleet deputy's relative state (protocol 9), the sixteenth decoder.
 use flexdyn_proto::{decode_relative_state, RelativeStateMsg};
+// The flight code's own telemetry (protocol 10), the seventeenth decoder.
+use flexdyn_proto::{decode_fsw, FswMsg};
 
 fn err_line(e: &DecodeError) -> String {
     match e {
@@ -199,6 +201,7 @@ fn status_line(m: &StatusMsg) -> String {
         .u(r.wrong_identity)
         .u(r.operator_refused)
         .u(r.fault_refused)
+        .u(r.fsw_refused)
         .u(m.commands_dropped)
         .u(m.wall_time_unix_ns)
         .u(m.faults_active);
@@ -303,7 +306,26 @@ fn relative_state_line(m: &RelativeStateMsg) -> String {
     l.0
 }
 
-/// The sixteen verdicts for one buffer, in the order of the module docs.
+fn fsw_line(m: &FswMsg) -> String {
+    let mut l = Line::new();
+    l.h(&m.header)
+        .u(m.flags.into())
+        .u(m.mode.into())
+        .f(&m.q_est_bn)
+        .f(&m.q_target_rn)
+        .f(&m.att_var_b_rad2)
+        .u(m.event_count.into());
+    for e in m.events {
+        l.u(e.into());
+    }
+    l.u(m.values.len() as u64);
+    for &w in &m.values {
+        l.u(w);
+    }
+    l.0
+}
+
+/// The seventeen verdicts for one buffer, in the order of the module docs.
 fn rust_lines(b: &[u8]) -> Vec<String> {
     fn line<M>(r: Result<M, DecodeError>, f: impl Fn(&M) -> String) -> String {
         match r {
@@ -342,6 +364,7 @@ fn rust_lines(b: &[u8]) -> Vec<String> {
         line(decode_fault_event(b), fault_event_line),
         line(decode_fault_command(b), fault_command_line),
         line(decode_relative_state(b), relative_state_line),
+        line(decode_fsw(b), fsw_line),
     ]
 }
 
