@@ -22,6 +22,7 @@
 mod components;
 mod faults;
 mod file;
+pub mod fsw;
 mod schedule;
 mod sensors;
 mod warnings;
@@ -44,6 +45,10 @@ pub use flexdyn_kernel::schema::source_map::SourceMap;
 use flexdyn_kernel::schema::{mat3, vec3, SchemaError, TableReader};
 pub use flexdyn_kernel::schema::{At, Location};
 use flexdyn_proto::MAX_PANEL_PAIRS;
+pub use fsw::{
+    word_as_f64, FswEventDecl, FswRefusal, FswSeverity, FswStreamDecl, FswValueDecl, FswValueType,
+    FswValues, MAX_FSW_DECLARED_EVENTS, MAX_FSW_DECLARED_MODES, MAX_FSW_NAME_LEN, MAX_FSW_STREAMS,
+};
 pub use schedule::EffectorInputSegment;
 pub use warnings::{log_warnings, warning_message, ConfigWarning};
 
@@ -110,6 +115,10 @@ pub struct SimConfig {
     /// The faults (`[[faults]]`), resolved against the spacecraft and its sensors, in file
     /// order (empty if absent).
     pub faults: Vec<flexdyn_faults::FaultSpec>,
+    /// The flight code's telemetry streams (`[[fsw_streams]]`), validated, in file order (empty
+    /// if absent): what each [`flexdyn_proto::FswMsg`] on `flexdyn/<sc-id>/fsw/<name>` is
+    /// checked against ([`FswStreamDecl::check`]) and decoded by.
+    pub fsw_streams: Vec<FswStreamDecl>,
     /// The configuration text this was parsed from.
     pub source_toml: String,
 }
@@ -153,6 +162,11 @@ impl SimConfig {
     pub fn reference() -> Self {
         Self::from_toml_str(DEFAULT_CONFIG_TOML)
             .expect("the embedded default configuration is valid (see the unit test)")
+    }
+
+    /// The declared flight-code telemetry stream named `name` (`[[fsw_streams]]`), if any.
+    pub fn fsw_stream(&self, name: &str) -> Option<&FswStreamDecl> {
+        self.fsw_streams.iter().find(|s| s.name == name)
     }
 
     /// One-line summary, as `check-config` prints it after `ok: FILE: `.
@@ -361,6 +375,7 @@ const ROOT_KEYS: &[&str] = &[
     "effector_input_schedule",
     "server",
     "faults",
+    "fsw_streams",
 ];
 
 struct RawConfig {
@@ -377,6 +392,7 @@ struct RawConfig {
     server: toml::Table,
     sensors: sensors::RawSensors,
     faults: Vec<flexdyn_faults::schema::RawFault>,
+    fsw_streams: Vec<fsw::RawFswStream>,
 }
 
 struct RawSimulation {
@@ -519,8 +535,12 @@ impl RawConfig {
             &flexdyn_faults::schema::KEYS,
             flexdyn_faults::schema::read,
         )?;
+        let fsw_streams = root.read_tables("fsw_streams", &fsw::KEYS, |t| {
+            fsw::RawFswStream::read(t, map)
+        })?;
         Ok(RawConfig {
             faults,
+            fsw_streams,
             world,
             simulation,
             gravity,
@@ -705,6 +725,9 @@ impl RawConfig {
             }
         }
 
+        // [[fsw_streams]]
+        let fsw_streams = fsw::resolve(&self.fsw_streams, map)?;
+
         let mut cfg = SimConfig {
             step_ns,
             integrator,
@@ -725,6 +748,7 @@ impl RawConfig {
             environment,
             // Resolved below, against the built spacecraft and sensors.
             faults: Vec::new(),
+            fsw_streams,
             source_toml: source.to_string(),
         };
         check_body_extent(&cfg, map)?;
