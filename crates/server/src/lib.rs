@@ -64,6 +64,7 @@ pub mod error;
 pub mod fault_cmd;
 pub mod fault_log;
 pub mod fleet;
+mod fsw;
 mod intake;
 mod lateness_ring;
 pub mod lockstep;
@@ -177,6 +178,21 @@ pub async fn run(
         wiring.fault_sink,
         shared.clone(),
         settings.spacecraft_id,
+        record_tx.clone(),
+    )
+    .await?;
+
+    // zenoh rx: the flight code's own telemetry, checked against `[[fsw_streams]]` and recorded.
+    let _fsw = fsw::declare(
+        &session,
+        &topics,
+        fsw::FswIntake::new(
+            &topics,
+            cfg.fsw_streams.clone(),
+            settings.spacecraft_id,
+            cfg.frame_ns,
+        ),
+        shared.clone(),
         record_tx.clone(),
     )
     .await?;

@@ -265,6 +265,21 @@ pub async fn run(
         let resolver = cfg
             .live_fault_resolver()
             .map_err(|source| named(ServerError::Config { file: None, source }))?;
+        // The vehicle's flight-code telemetry, checked against its `[[fsw_streams]]`, recorded.
+        let fsw = super::fsw::declare(
+            &session,
+            &topics,
+            super::fsw::FswIntake::new(
+                &topics,
+                cfg.fsw_streams.clone(),
+                vs.spacecraft_id,
+                frame_ns,
+            ),
+            sh.clone(),
+            record_tx.clone(),
+        )
+        .await
+        .map_err(named)?;
         if mode == Mode::Lockstep {
             let presence = Presence::declare(&session, &topics, sh.clone())
                 .await
@@ -300,6 +315,7 @@ pub async fn run(
             resolver,
             fault_tx,
             config,
+            fsw,
         });
         outlets.push((endpoints.frames, recording, full_tx));
         thread_side.push((recycle_tx, fault_rx, fault_recycle_tx));
@@ -425,7 +441,7 @@ pub async fn run(
             .await
             .map_err(named)?,
         );
-        keep.push((p.config, commands, fault_commands));
+        keep.push((p.config, commands, fault_commands, p.fsw));
     }
     drop(cmd_tx);
     let _realtime = super::RealtimeHold::acquire(&settings)?;
@@ -578,6 +594,8 @@ struct VehicleParts {
     fault_tx: std::sync::mpsc::SyncSender<flexdyn_faults::ports::LiveRequest>,
     /// Its `flexdyn/<id>/config` queryable, kept for the run.
     config: zenoh::query::Queryable<()>,
+    /// Its flight-code telemetry subscriber (`flexdyn/<id>/fsw/*`), kept for the run.
+    fsw: zenoh::pubsub::Subscriber<()>,
 }
 
 /// `flexdyn run --fleet FILE`: the fleet file, the settings (the first vehicle's `[server]`
