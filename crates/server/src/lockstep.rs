@@ -277,11 +277,18 @@ impl LockstepCore {
         }
     }
 
-    /// Every vehicle's frame of tick `k`, in world order, each deputy's relative states after
-    /// its frame; then tick `k` counts as published.
+    /// Notes tick `k` reached, then publishes every vehicle's frame of it, in world order, each
+    /// deputy's relative states after its frame.
     fn publish(&mut self) {
         let started = Instant::now();
         let stamp = flexdyn_proto::client::transport::unix_now_ns();
+        // Noted before the states go out (as the physics thread does, and as `Shared::tick`
+        // says), so a participant's flight-code telemetry for tick k, sent as soon as it has
+        // the state of k, finds k reached.
+        for lane in &self.lanes {
+            lane.shared.tick.store(self.k, Ordering::Release);
+        }
+        self.control.tick.store(self.k, Ordering::Release);
         for (i, (v, lane)) in self
             .world
             .vehicles
@@ -303,10 +310,6 @@ impl LockstepCore {
                 lane.record.as_ref(),
             );
         }
-        for lane in &self.lanes {
-            lane.shared.tick.store(self.k, Ordering::Relaxed);
-        }
-        self.control.tick.store(self.k, Ordering::Relaxed);
         self.tick_published_at = Instant::now();
         self.spent.publish_ns += ns_between(started, self.tick_published_at);
     }
