@@ -22,7 +22,10 @@
 //!
 //! In lockstep the flight code answers tick k after the server published it, so a sample
 //! stamped k that arrives before the answer is recorded with tick k, and the recording of a
-//! lockstep run is the same whenever it is repeated.
+//! lockstep run is the same whenever it is repeated. The run's last tick is published for the
+//! record and no answer to it is awaited, so whether a sample for it arrives before the run
+//! closes is a race: a lockstep server records no sample stamped with its last tick (neither
+//! recorded nor counted as refused), and two runs' recordings stay identical.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -49,15 +52,19 @@ pub(super) struct FswIntake {
     spacecraft_id: u32,
     /// \[ns\] the frame period: a tick's time is tick × frame_ns.
     frame_ns: u64,
+    /// Lockstep: the run's last tick, whose samples are not recorded (module docs).
+    lockstep_last_tick: Option<u64>,
 }
 
 impl FswIntake {
-    /// The intake of `streams` for the vehicle of `topics`.
+    /// The intake of `streams` for the vehicle of `topics`; `lockstep_last_tick`: a lockstep
+    /// run's last tick, if it has one.
     pub(super) fn new(
         topics: &Topics,
         streams: Vec<FswStreamDecl>,
         spacecraft_id: u32,
         frame_ns: u64,
+        lockstep_last_tick: Option<u64>,
     ) -> Self {
         let keys = streams
             .iter()
@@ -76,17 +83,19 @@ impl FswIntake {
             next_tick,
             spacecraft_id,
             frame_ns,
+            lockstep_last_tick,
         }
     }
 
     /// Checks a sample that arrived on `key` while the server's last tick is `server_tick`:
-    /// the index of its stream, or the refusal's reason and what was wrong.
+    /// the index of its stream (`None`: a lockstep run's last tick, not recorded), or the
+    /// refusal's reason and what was wrong.
     pub(super) fn check(
         &self,
         key: &str,
         bytes: &[u8],
         server_tick: u64,
-    ) -> Result<usize, (&'static str, String)> {
+    ) -> Result<Option<usize>, (&'static str, String)> {
         let msg: FswMsg = decode_fsw(bytes).map_err(|e| {
             let reason = match e {
                 DecodeError::UnknownVersion { .. } => "bad_version",
@@ -141,6 +150,9 @@ impl FswIntake {
                 format!("stream `{}` sample for tick {tick}: {why}", stream.name),
             )
         })?;
+        if self.lockstep_last_tick == Some(tick) {
+            return Ok(None);
+        }
         // At most one sample per tick: claim the tick, or refuse a repeat (or an older one).
         let next = &self.next_tick[i];
         let mut seen = next.load(Ordering::Acquire);
@@ -157,7 +169,7 @@ impl FswIntake {
                 ));
             }
             match next.compare_exchange_weak(seen, tick + 1, Ordering::AcqRel, Ordering::Acquire) {
-                Ok(_) => return Ok(i),
+                Ok(_) => return Ok(Some(i)),
                 Err(now) => seen = now,
             }
         }
@@ -197,7 +209,8 @@ pub(super) async fn declare(
         let bytes = sample.payload().to_bytes();
         let server_tick = shared.tick.load(Ordering::Acquire);
         match intake.check(sample.key_expr().as_str(), &bytes, server_tick) {
-            Ok(i) => {
+            Ok(None) => {}
+            Ok(Some(i)) => {
                 shared.fsw_recorded.fetch_add(1, Ordering::Relaxed);
                 if let Some(rec) = &record {
                     rec.submit(RecordItem {
@@ -240,7 +253,7 @@ mod tests {
         );
         let cfg = SimConfig::from_toml_str(&toml).expect("the test dictionary");
         let topics = Topics::new("sc1").unwrap();
-        FswIntake::new(&topics, cfg.fsw_streams.clone(), 1, FRAME_NS)
+        FswIntake::new(&topics, cfg.fsw_streams.clone(), 1, FRAME_NS, Some(100))
     }
 
     fn sample(tick: u64) -> FswMsg {
@@ -253,9 +266,10 @@ mod tests {
         }
     }
 
-    fn reason(r: Result<usize, (&'static str, String)>) -> &'static str {
+    fn reason(r: Result<Option<usize>, (&'static str, String)>) -> &'static str {
         match r {
-            Ok(_) => "accepted",
+            Ok(Some(_)) => "accepted",
+            Ok(None) => "last_tick",
             Err((why, _)) => why,
         }
     }
@@ -272,6 +286,11 @@ mod tests {
         // Ahead of the server.
         assert_eq!(reason(t.check(key, &encode(&sample(6)), 5)), "future_tick");
         assert_eq!(reason(t.check(key, &encode(&sample(5)), 5)), "accepted");
+        // A lockstep run's last tick (100 here) is not recorded, and not refused either.
+        assert_eq!(
+            reason(t.check(key, &encode(&sample(100)), 100)),
+            "last_tick"
+        );
     }
 
     #[test]

@@ -191,6 +191,7 @@ pub async fn run(
             cfg.fsw_streams.clone(),
             settings.spacecraft_id,
             cfg.frame_ns,
+            total_frames.filter(|_| mode == Mode::Lockstep),
         ),
         shared.clone(),
         record_tx.clone(),

@@ -274,6 +274,7 @@ pub async fn run(
                 cfg.fsw_streams.clone(),
                 vs.spacecraft_id,
                 frame_ns,
+                total_frames.filter(|_| mode == Mode::Lockstep),
             ),
             sh.clone(),
             record_tx.clone(),
