@@ -13,6 +13,12 @@
 //! - the final pointing error;
 //! - a second run gives the same state stream bit for bit (sha256) and the same transcript.
 //!
+//! And the flight code's own telemetry (issue 37): the server records the demo's stream
+//! `flexdyn/sc1/fsw/acs` (`[[fsw_streams]]` of acs_full.toml) with `--record`; the mode
+//! timeline read back from each recording is the demo's transcript, transition for transition,
+//! one sample per tick answered, the target in the recording is the one the demo printed, and
+//! the two runs' recorded telemetry is identical byte for byte.
+//!
 //! **Shortened where the physics allows.** The frame rate stays the scenario's 10 Hz and the
 //! detumble, sun acquisition and fine pointing run in full; only momentum management is shorter
 //! than the orbit the binary does by default: 1500 s ([`UNLOAD_S`]), 1.2 time constants of the
@@ -87,6 +93,12 @@ struct Run {
     sun_b: BTreeMap<u64, Vector3<f64>>,
     /// The demo's standard output: its transitions, target and time in each mode.
     transcript: String,
+    /// The recorded flight-code telemetry (`flexdyn/sc1/fsw/acs`), in file order.
+    fsw: Vec<flexdyn_proto::FswMsg>,
+    /// Their exact payloads.
+    fsw_payloads: Vec<Vec<u8>>,
+    /// The server's count of refused telemetry.
+    fsw_refused: u64,
     wall_s: f64,
 }
 
@@ -95,6 +107,12 @@ fn sequence_run(unload_s: f64) -> Run {
     let topics = Topics::new("sc1").unwrap();
     let cfg =
         flexdyn_vehicle::config::SimConfig::from_file(&scenario_path()).expect("acs_full.toml");
+    // One file per run: the second run is compared with the first.
+    static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let record =
+        std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("acs_sequence_{n}.mcap"));
+    let _ = std::fs::remove_file(&record);
     let server = ServerHandle::start(
         ServerSettings {
             mode: Mode::Lockstep,
@@ -102,6 +120,7 @@ fn sequence_run(unload_s: f64) -> Run {
             participant_timeout: Duration::from_secs(30),
             presence_timeout: Duration::from_secs(30),
             duration_ns: Some((duration_s * 1e9).round() as u64),
+            record: Some(record.clone()),
             ..ServerSettings::default()
         },
         cfg,
@@ -145,10 +164,25 @@ fn sequence_run(unload_s: f64) -> Run {
     let mut states = recorder.states.lock().unwrap().clone();
     states.sort_by_key(|(t, _)| *t);
     let sun_b = sun_b.lock().unwrap().clone();
+    let rec = flexdyn_sinks::reader::read_recording(&record).expect("the recording");
+    let fsw_payloads: Vec<Vec<u8>> = rec
+        .samples
+        .into_iter()
+        .filter(|s| s.key == "flexdyn/sc1/fsw/acs")
+        .map(|s| s.payload)
+        .collect();
+    let fsw = fsw_payloads
+        .iter()
+        .map(|p| flexdyn_proto::decode_fsw(p).expect("a recorded FswMsg"))
+        .collect();
+    let _ = std::fs::remove_file(&record);
     Run {
         states,
         sun_b,
         transcript,
+        fsw,
+        fsw_payloads,
+        fsw_refused: report.rejected.fsw_refused,
         wall_s,
     }
 }
@@ -311,8 +345,59 @@ fn the_whole_acs_sequence_flies_in_lockstep_and_is_bit_identical() {
         times.join(", ")
     );
 
+    // The flight code's telemetry, as recorded: a sample per tick the demo answered (every
+    // tick but the last, which no answer follows), in order, none refused.
+    assert_eq!(a.fsw_refused, 0);
+    let recorded_ticks: Vec<u64> = a.fsw.iter().map(|m| m.header.tick).collect();
+    assert_eq!(recorded_ticks, (0..n_ticks - 1).collect::<Vec<_>>());
+    // The mode timeline read back from the recording is the demo's transcript: the same
+    // transitions at the same ticks (the stream's modes are the demo's names, in order).
+    let modes = [
+        "detumble",
+        "sun-acquisition",
+        "fine-pointing",
+        "momentum-management",
+    ];
+    let mut recorded_transitions = Vec::new();
+    for w in a.fsw.windows(2) {
+        assert_ne!(
+            w[1].flags & flexdyn_proto::fsw_flags::MODE,
+            0,
+            "every sample has a mode"
+        );
+        if w[1].mode != w[0].mode {
+            recorded_transitions.push((
+                w[1].header.tick,
+                modes[w[0].mode as usize].to_owned(),
+                modes[w[1].mode as usize].to_owned(),
+            ));
+        }
+    }
+    assert_eq!(recorded_transitions, transitions, "recording vs transcript");
+    // The target the flight code chose at run time is in the recording from the tick it was
+    // chosen on, as the quaternion of the σ_RN it printed.
+    let chosen = a
+        .fsw
+        .iter()
+        .find(|m| m.event_indices().contains(&0))
+        .expect("a target-chosen event");
+    assert_ne!(chosen.flags & flexdyn_proto::fsw_flags::TARGET, 0);
+    let q = flexdyn_kernel::attitude::mrp_to_quat(&sigma_rn);
+    for k in 0..4 {
+        assert!(
+            (chosen.q_target_rn[k] - q[k]).abs() < 1e-12,
+            "recorded target {:?} vs printed σ_RN {sigma_rn:?}",
+            chosen.q_target_rn
+        );
+    }
+
     // Two runs, one stream.
     let b = sequence_run(unload_s);
     assert_eq!(digest(&b.states), hash_a, "two identical runs differ");
     assert_eq!(b.transcript, a.transcript);
+    assert_eq!(b.fsw_refused, 0);
+    assert!(
+        b.fsw_payloads == a.fsw_payloads,
+        "the two runs' recorded flight-code telemetry differs"
+    );
 }

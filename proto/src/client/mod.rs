@@ -13,11 +13,14 @@
 //!   and a clean stop on SIGINT/SIGTERM.
 //! - [`vehicle`]: the vehicle a server runs, from its `flexdyn/<sc>/config` queryable: the
 //!   geometry, wheels and sensors flight code reads.
+//! - [`fsw`]: the flight code's own telemetry, a stream of the served `[[fsw_streams]]`
+//!   published with names, not word offsets.
 //! - [`run_end`]: the end of a run (the server's last status), so every client stops at once.
 //! - [`lockstep`]: complete ticks — the state of tick k with every sensor sample due at k —
 //!   through one `flexdyn/<sc>/tlm/**` subscriber ([`lockstep::TickReceiver`]).
 
 pub mod cli;
+pub mod fsw;
 pub mod lockstep;
 pub mod logging;
 pub mod run_end;

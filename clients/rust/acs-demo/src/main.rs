@@ -93,6 +93,7 @@ use flexdyn_acs_demo::acs::{inertia_about_b, mat3, wheel_control_torque, StarTra
 use flexdyn_acs_demo::fdir::{Event, GyroFdir, WheelFdir};
 use flexdyn_acs_demo::modes::{Mode, ModeSettings};
 use flexdyn_acs_demo::sequence::{AcsSequence, Gains, SequenceSetup};
+use flexdyn_acs_demo::telemetry::{ControllerTick, Telemetry};
 use flexdyn_proto::attitude::mrp_error;
 use flexdyn_proto::client::cli::{exit_with, stop_on_signals, usage, CommonArgs};
 use flexdyn_proto::client::lockstep::{SensorSchedule, TickReceiver};
@@ -202,6 +203,12 @@ struct Args {
     /// (`fdir-summary …`).
     #[arg(long)]
     fdir: bool,
+    /// The flight code's own telemetry stream (`flexdyn/<sc>/fsw/<name>`): its mode, events,
+    /// attitude estimate and target, and values, published every tick when the served
+    /// configuration declares a `[[fsw_streams]]` of this name
+    /// (`flexdyn_acs_demo::telemetry`); off otherwise.
+    #[arg(long, default_value = "acs")]
+    fsw_stream: String,
     /// The gyro monitor's window W [s] (rounded to whole star-tracker periods).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     fdir_window_s: f64,
@@ -656,6 +663,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     };
     let cfg = vehicle.config()?;
     let schedule = SensorSchedule::from_config(&cfg)?;
+    let mut telemetry = Telemetry::declare(&session, &topics, &vehicle, &args.fsw_stream)?;
     let frame_s = (1e9 / cfg.simulation.frame_hz).round() * 1e-9;
     let mut gyro = gyro(&args, &cfg, &schedule)?;
     let mut wheels = match args.actuator {
@@ -799,6 +807,10 @@ fn run(args: Args) -> anyhow::Result<()> {
             let out = fsw.step(&tick)?;
             print_sequence_events(&out);
             let out = last_sequence_output.insert(out);
+            // The flight code's telemetry of this tick goes out before its answer.
+            if let Some(t) = &mut telemetry {
+                t.sequence(h.tick, h.sim_time_ns, out)?;
+            }
             let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
             let inputs = std::mem::take(&mut out.inputs);
             let cmd = CommandMsg::actuators(header, args.sender_id, [0.0; 3], [0.0; 3], inputs);
@@ -838,6 +850,7 @@ fn run(args: Args) -> anyhow::Result<()> {
 
         // Answer with the state's spacecraft id, tick and sim time; our own sequence number.
         let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
+        let mut wheel_momentum_b_nms = Vector3::zeros();
         let (cmd, torque_b_nm) = match (sigma_bn, &mut wheels) {
             // No attitude yet (the star tracker has not given a valid one): answer the tick.
             (None, _) => {
@@ -866,13 +879,14 @@ fn run(args: Args) -> anyhow::Result<()> {
                         });
                     }
                 }
+                wheel_momentum_b_nms = array.momentum_b(&rate_b, &speeds);
                 let l = wheel_control_torque(
                     controller.k_nm,
                     controller.p_nms,
                     &controller.sigma_br(&sigma_bn),
                     &rate_b,
                     inertia,
-                    &array.momentum_b(&rate_b, &speeds),
+                    &wheel_momentum_b_nms,
                 );
                 let u = array.motor_torques(&l);
                 if let Some(f) = &mut fdir {
@@ -888,6 +902,17 @@ fn run(args: Args) -> anyhow::Result<()> {
                 (cmd, l)
             }
         };
+        // The flight code's telemetry of this tick goes out before its answer.
+        if let Some(t) = &mut telemetry {
+            let c = ControllerTick {
+                sigma_bn,
+                sigma_rn: controller.sigma_rn,
+                rate_b_rad_s: rate_b,
+                wheel_momentum_b_nms,
+                fdir_events: fdir.as_ref().map_or(&[], |f| f.events.as_slice()),
+            };
+            t.controller(h.tick, h.sim_time_ns, &c)?;
+        }
         encode_into(&cmd, &mut buf);
         commands
             .put(buf.as_slice())

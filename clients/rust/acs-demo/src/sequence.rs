@@ -133,6 +133,12 @@ pub struct Output {
     /// What the mode logic saw at this tick (the sensors' estimates: rate, Sun angle, pointing
     /// error).
     pub observation: Observation,
+    /// The attitude estimate σ_BN (star tracker, propagated with the gyro), once there is one.
+    pub sigma_bn_estimate: Option<Vector3<f64>>,
+    /// The Sun direction the coarse sun sensors give, B components (`None` in eclipse).
+    pub sun_b: Option<Vector3<f64>>,
+    /// The fine-pointing target σ_RN in force, once chosen.
+    pub target_sigma_rn: Option<Vector3<f64>>,
 }
 
 /// The flight software of the sequence (module docs).
@@ -380,6 +386,9 @@ impl AcsSequence {
             inputs,
             wheel_momentum_b_nms: h_w,
             observation: obs,
+            sigma_bn_estimate: sigma_bn,
+            sun_b,
+            target_sigma_rn: self.target_sigma_rn,
         })
     }
 
