@@ -23,6 +23,7 @@ mod config_fuzz;
 mod csv_dialect;
 mod doc_links;
 mod epoch_metadata;
+mod fsw_plots;
 mod gps;
 mod imu_seeds;
 mod magnetometer;

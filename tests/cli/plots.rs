@@ -714,7 +714,7 @@ fn shaded(figs: &[Figure]) -> Shaded<'_> {
         .flat_map(|f| {
             f.panels.iter().filter(|p| !p.faults.is_empty()).map(|p| {
                 (
-                    f.name,
+                    f.name.as_str(),
                     p.caption.clone().unwrap_or_else(|| p.y_label.clone()),
                     p.faults
                         .iter()

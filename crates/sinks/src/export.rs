@@ -6,12 +6,16 @@
 //! ([`super::fault_spans::event_comments`]), so `flexdyn plot` shades them from the CSV too;
 //! a fault already active when the recording began gets the line of the activation the
 //! recording missed ([`super::prior_faults`]: its inferred start, before the first row).
+//! A flight-code telemetry row (`flexdyn/<sc>/fsw/<name>`) also gets its stream's names and
+//! typed values after the wire columns when the recording's configuration declares the stream
+//! ([`super::fsw_columns`]).
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use super::error::SinkError;
 use super::fault_spans;
+use super::fsw_columns;
 use super::prior_faults;
 use super::reader::read_recording;
 use super::table::{row, CsvTable};
@@ -45,6 +49,15 @@ pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
         tracing::warn!(file = %args.file.display(), reason = %why, "the recording ends early (not closed cleanly); exporting what it holds");
     }
     std::fs::create_dir_all(&args.csv).map_err(|e| out_err(&args.csv, e))?;
+    // A sample's cells: the wire's, and for flight-code telemetry its declaration's names.
+    let decls = fsw_columns::declarations(&rec);
+    let cells = |key: &str, d: &Decoded| {
+        let mut cells = row(d);
+        if let (Decoded::Fsw(m), Some(decl)) = (d, decls.get(key)) {
+            cells.extend(fsw_columns::named_cells(decl, m));
+        }
+        cells
+    };
     // Pass 1: each topic's columns, in first-seen order.
     let mut columns: BTreeMap<String, Vec<String>> = BTreeMap::new();
     let mut seen: HashMap<String, HashSet<String>> = HashMap::new();
@@ -59,7 +72,7 @@ pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
         };
         let names = columns.entry(s.key.clone()).or_default();
         let known = seen.entry(s.key.clone()).or_default();
-        for (name, _) in row(&d) {
+        for (name, _) in cells(&s.key, &d) {
             if known.insert(name.clone()) {
                 names.push(name);
             }
@@ -111,7 +124,9 @@ pub fn export(args: &ExportArgs) -> Result<ExportReport, SinkError> {
         let Ok(d) = Decoded::decode(topic.kind, &s.payload) else {
             continue;
         };
-        table.write_row(&row(&d)).map_err(|e| out_err(path, e))?;
+        table
+            .write_row(&cells(&s.key, &d))
+            .map_err(|e| out_err(path, e))?;
         if let Some(n) = report.get_mut(path) {
             *n += 1;
         }

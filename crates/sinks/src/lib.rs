@@ -7,7 +7,8 @@
 //! - [`recorder`]: the recorder thread behind a bounded queue (lossless or counted drops).
 //! - [`gaps`]: what a recording misses, from the publishers' sequence numbers.
 //! - [`reader`]: reading a recording back, crash-truncated files included.
-//! - [`table`]: decoded messages as named columns (CSV export, plots).
+//! - [`table`]: decoded messages as named columns (CSV export, plots); [`fsw_columns`]: the
+//!   flight code's telemetry by its declared names.
 //! - [`record_cmd`], [`replay`], [`export`]: the `flexdyn record`, `replay` and `export`
 //!   subcommands.
 //! - [`plot`]: `flexdyn plot`, PNG figures of a recording or a CSV; [`fault_spans`]: the
@@ -29,6 +30,7 @@ pub mod columns;
 pub mod error;
 pub mod export;
 pub mod fault_spans;
+pub mod fsw_columns;
 pub mod gaps;
 #[cfg(test)]
 mod kind_round_trip;

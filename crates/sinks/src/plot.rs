@@ -57,6 +57,7 @@ use super::topics::{classify, Decoded, TopicKind};
 use flexdyn_kernel::attitude::mrp_error;
 use flexdyn_sensors::KINDS;
 
+pub mod fsw;
 pub mod read;
 
 const FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans-subset.ttf");
@@ -189,6 +190,9 @@ struct PlotData {
     /// `--relative-to`: the plotted vehicle's recorded RelativeStateMsg relative to the chief
     /// (`flexdyn/<sc>/tlm/rel/<chief>`), when the recording holds it.
     relative: Columns,
+    /// The flight code's telemetry streams the recording's configuration declares, with their
+    /// recorded samples ([`fsw`]).
+    fsw: Vec<fsw::FswSeries>,
 }
 
 /// \[s\] the first and last instant of `c` (0, 0 when empty).
@@ -231,6 +235,7 @@ fn from_mcap(
         chief: relative_to.map(|c| (c.to_owned(), Columns::default())),
         ..PlotData::default()
     };
+    let mut fsw_samples: BTreeMap<String, Vec<flexdyn_proto::FswMsg>> = BTreeMap::new();
     let mut progress = read::ReadProgress::decoding(rec.samples.len() as u64);
     for (i, s) in rec.samples.iter().enumerate() {
         if i % 4096 == 0 {
@@ -273,8 +278,15 @@ fn from_mcap(
             | TopicKind::Command
             | TopicKind::Time
             | TopicKind::Operator
-            | TopicKind::FaultCommand
-            | TopicKind::Fsw => {}
+            | TopicKind::FaultCommand => {}
+            TopicKind::Fsw => {
+                if let Decoded::Fsw(m) = d {
+                    fsw_samples
+                        .entry(topic.sensor.unwrap_or_default().to_owned())
+                        .or_default()
+                        .push(m);
+                }
+            }
             TopicKind::RelativeState => {
                 if data.chief.as_ref().map(|(c, _)| c.as_str()) == topic.sensor {
                     data.relative.push(&cells);
@@ -283,6 +295,7 @@ fn from_mcap(
         }
     }
     progress.finish(rec.samples.len() as u64);
+    data.fsw = fsw_series(&rec, &sc, fsw_samples);
     let (first, last) = time_span(&data.state);
     let events = prior_faults::fault_events(&rec)
         .remove(&sc)
@@ -307,6 +320,34 @@ fn from_mcap(
         }
     }
     Ok(data)
+}
+
+/// The streams the recording's configuration of vehicle `sc` declares, each with its samples
+/// (in tick order); none when the recording has no configuration of it (a warning when it has
+/// one that does not load).
+fn fsw_series(
+    rec: &crate::reader::Recording,
+    sc: &str,
+    mut samples: BTreeMap<String, Vec<flexdyn_proto::FswMsg>>,
+) -> Vec<fsw::FswSeries> {
+    let Some(info) = rec.vehicles().into_iter().find(|v| v.sc_id == sc) else {
+        return Vec::new();
+    };
+    let cfg = match flexdyn_vehicle::config::SimConfig::from_toml_str(&info.config_toml) {
+        Ok(c) => c,
+        Err(e) => {
+            tracing::warn!(sc_id = sc, error = %e, "the recording's configuration does not load: no flight-code figures");
+            return Vec::new();
+        }
+    };
+    cfg.fsw_streams
+        .into_iter()
+        .map(|decl| {
+            let mut samples = samples.remove(&decl.name).unwrap_or_default();
+            samples.sort_by_key(|m| m.header.tick);
+            fsw::FswSeries { decl, samples }
+        })
+        .collect()
 }
 
 /// A `simulate` sensor column `<kind>_<name>_<field>` (`imu_hub_omega_p_rad_s_1`,
@@ -488,13 +529,28 @@ pub struct Panel {
     pub components: Vec<String>,
     /// The faults of those components, each shaded over the intervals it was active.
     pub faults: Vec<FaultShading>,
+    /// Labelled shaded bands behind everything else (the flight code's modes, its events).
+    pub bands: Vec<Band>,
+}
+
+/// A labelled, coloured set of time intervals shaded behind a panel's lines (one legend entry).
+#[derive(Clone, Debug)]
+pub struct Band {
+    /// Its legend entry.
+    pub label: String,
+    /// Its colour.
+    pub color: RGBColor,
+    /// Its opacity (0–1).
+    pub alpha: f64,
+    /// \[s\] the intervals, in time order.
+    pub spans: Vec<(f64, f64)>,
 }
 
 /// One figure (one PNG file).
 #[derive(Clone, Debug)]
 pub struct Figure {
     /// The file name (`conservation.png`).
-    pub name: &'static str,
+    pub name: String,
     /// The title over every panel.
     pub title: String,
     /// The panels, filled row by row into `columns` columns.
@@ -604,6 +660,22 @@ fn draw_panel<Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueForma
         .x_label_formatter(x_ticks)
         .draw()
         .map_err(|e| e.to_string())?;
+    for b in &panel.bands {
+        let (y0, y1) = panel.y_range();
+        let (t0, t1) = panel.t_range();
+        let shade = b.color.mix(b.alpha);
+        chart
+            .draw_series(
+                b.spans
+                    .iter()
+                    .map(|(a, b)| (a.clamp(t0, t1), b.clamp(t0, t1)))
+                    .filter(|(a, b)| a < b)
+                    .map(|(a, b)| Rectangle::new([(a, y0), (b, y1)], shade.filled())),
+            )
+            .map_err(|e| e.to_string())?
+            .label(b.label.as_str())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
+    }
     if !panel.spans.is_empty() {
         let (y0, y1) = panel.y_range();
         let shade = RGBColor(255, 200, 0).mix(0.3);
@@ -953,7 +1025,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
     let mut skip = |name: &str, why: &str| skipped.push((name.to_owned(), why.to_owned()));
     let mut fig = |name: &'static str, title: String, panels: Vec<Panel>| {
         figures.push(Figure {
-            name,
+            name: name.to_owned(),
             title,
             panels,
             columns: 1,
@@ -1264,7 +1336,7 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
         (_, (Some(p50), Some(p99), Some(max), Some(overruns))) => {
             let us = |v: &Vec<f64>| v.iter().map(|x| x * 1e-3).collect::<Vec<_>>();
             figures.push(Figure {
-                name: "timing.png",
+                name: "timing.png".into(),
                 title: "Real-time frame lateness (cumulative percentiles from StatusMsg)".into(),
                 panels: vec![
                     Panel {
@@ -1291,7 +1363,48 @@ pub fn figures(args: &PlotArgs) -> Result<(Vec<Figure>, Skipped), SinkError> {
         )),
     }
     shade_faults(&mut figures, &data.faults, time_span(s).0);
+    flight_code_figures(&data, &mut figures, &mut skipped);
     Ok((figures, skipped))
+}
+
+/// The flight code's figures ([`fsw`]): each stream's mode timeline under the attitude, and its
+/// own figures against the truth attitude of the same ticks.
+fn flight_code_figures(data: &PlotData, figures: &mut Vec<Figure>, skipped: &mut Skipped) {
+    let s = &data.state;
+    let truth: fsw::Truth = match (
+        s.get("tick"),
+        (0..4)
+            .map(|i| s.get(&format!("q_bn_{i}")))
+            .collect::<Option<Vec<_>>>(),
+    ) {
+        (Some(ticks), Some(q)) => ticks
+            .iter()
+            .enumerate()
+            .map(|(k, tick)| {
+                (
+                    *tick as u64,
+                    nalgebra::Vector4::new(q[0][k], q[1][k], q[2][k], q[3][k]),
+                )
+            })
+            .collect(),
+        _ => fsw::Truth::new(),
+    };
+    for series in &data.fsw {
+        let name = &series.decl.name;
+        if series.samples.is_empty() {
+            skipped.push((
+                format!("fsw_{name}.png"),
+                format!("the configuration declares stream `{name}`, but the recording holds no sample of it"),
+            ));
+            continue;
+        }
+        if let Some(panel) = fsw::mode_panel(series) {
+            if let Some(att) = figures.iter_mut().find(|f| f.name == "attitude.png") {
+                att.panels.push(panel);
+            }
+        }
+        figures.extend(fsw::figures(series, &truth));
+    }
 }
 
 /// Whether a sensor's column `col` is one of its own: a coarse array's `readings_<k>` only
@@ -1467,7 +1580,7 @@ fn disturbance_panels(env: &Columns) -> Option<Vec<Panel>> {
 fn sensor_grid(name: &'static str, title: &str, panels: Vec<Panel>, rows: usize) -> Figure {
     let columns = panels.len() / rows.max(1);
     Figure {
-        name,
+        name: name.to_owned(),
         title: title.to_owned(),
         panels: interleave_columns(panels, columns),
         columns,
@@ -1509,7 +1622,7 @@ pub fn plot_with(args: &PlotArgs, written: &mut dyn FnMut(&Path)) -> Result<Plot
         skipped,
     };
     for f in &figures {
-        let path = args.output.join(f.name);
+        let path = args.output.join(&f.name);
         draw(&path, f)?;
         written(&path);
         report.written.push(path);
