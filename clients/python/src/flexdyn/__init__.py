@@ -6,6 +6,7 @@
   configuration (:meth:`Client.vehicle`);
 - :class:`LockstepParticipant`: answers every lockstep tick with your controller's output,
   computed from the tick's complete telemetry (the state and every sensor sample due at it);
+- :mod:`flexdyn.fsw`: the flight code's own telemetry (:meth:`Client.declare_fsw`);
 - :mod:`flexdyn.testing`: run a server for the duration of a test.
 """
 
@@ -18,6 +19,8 @@ from .proto import (CommandMsg, CssMsg, DecodeError, EffectorInput, EffectorStat
 from .proto import GpsMsg  # protocol 7
 from .proto import FaultCommandMsg, FaultEventMsg  # protocol 8
 from .proto import RelativeStateMsg  # protocol 9
+from .proto import FswMsg  # protocol 10
+from .fsw import FswDeclaration, FswStream  # protocol 10: the flight code's own telemetry
 
 __all__ = [
     "proto", "Client", "Subscription", "VehicleInfo", "session_config", "Answer",
@@ -25,6 +28,7 @@ __all__ = [
     "EffectorInput", "EffectorState", "EnvironmentMsg", "Header", "ImuMsg", "MagnetometerMsg", "StarTrackerMsg",
     "StateMsg",
     "StatusMsg", "TimeMsg", "CssMsg", "FssMsg", "OperatorMsg", "GpsMsg",
-    "FaultCommandMsg", "FaultEventMsg", "RelativeStateMsg",
+    "FaultCommandMsg", "FaultEventMsg", "RelativeStateMsg", "FswMsg", "FswDeclaration",
+    "FswStream",
 ]
 __version__ = "0.1.0"

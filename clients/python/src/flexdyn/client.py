@@ -16,11 +16,14 @@ import collections
 import threading
 import time
 from dataclasses import dataclass
-from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tuple, Union
+from typing import (TYPE_CHECKING, Any, Callable, Dict, Iterable, List, Optional, Sequence,
+                    Tuple, Union)
 
 import zenoh
 
 from . import proto
+if TYPE_CHECKING:  # the stream class, for annotations only (fsw imports nothing from here)
+    from .fsw import FswStream
 from .proto import (CommandMsg, CssMsg, EffectorInput, EnvironmentMsg, FssMsg, Header, ImuMsg,
                     MagnetometerMsg, OperatorMsg, StarTrackerMsg, StateMsg, StatusMsg, TimeMsg)
 
@@ -365,7 +368,12 @@ class Client:
                 raise RuntimeError("flexdyn.Client is closed")
             pub = self._command_pubs.get(cmd.sender_id)
             if pub is None:
-                pub = self.session.declare_publisher(proto.command_key(self.sc_id, cmd.sender_id))
+                # Blocking: a lockstep answer must never be dropped (Zenoh's default for a
+                # put is to drop a sample that finds the link's queue full for 1 ms, and the
+                # server then waits for an answer that will not come).
+                pub = self.session.declare_publisher(
+                    proto.command_key(self.sc_id, cmd.sender_id),
+                    congestion_control=zenoh.CongestionControl.BLOCK)
                 self._command_pubs[cmd.sender_id] = pub
             pub.put(payload)
 
@@ -419,6 +427,23 @@ class Client:
         if n < 1:
             raise ValueError("run_ticks needs n >= 1")
         self.operator(proto.OPERATOR_RUN_TICKS, n)
+
+    # -- the flight code's own telemetry (protocol 10) ---------------------------------------
+
+    def declare_fsw(self, name: str, timeout_s: float = 30.0) -> "FswStream":
+        """The telemetry stream `name` of the configuration's ``[[fsw_streams]]``, read from the
+        server (:meth:`vehicle`), bound to a publisher on ``flexdyn/<sc>/fsw/<name>``: publish
+        its samples with ``FswStream.publish(tick, sim_time_ns, mode=..., events=[...],
+        estimate=q_bn, target=q_rn, <value>=...)``. ``KeyError`` naming the declared streams
+        if the configuration has no such stream. The server records the samples beside the
+        truth, counts refused ones in ``StatusMsg.rejected_fsw_refused``, and applies nothing
+        from them to the physics."""
+        from .fsw import FswDeclaration, FswStream
+        declaration = FswDeclaration.from_config(self.vehicle(timeout_s).config(), name)
+        with self._pub_lock:
+            if self._closed:
+                raise RuntimeError("flexdyn.Client is closed")
+            return FswStream(self, declaration)
 
     # -- live faults (protocol 8) -------------------------------------------------------------
 
