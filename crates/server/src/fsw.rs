@@ -202,7 +202,10 @@ pub(super) async fn declare(
     shared: Arc<Shared>,
     record: Option<RecordTx>,
 ) -> Result<Subscriber<()>, ServerError> {
-    let log = Mutex::new(RejectLog::default());
+    let log = Mutex::new(RejectLog::counted_in(
+        "flight-code telemetry",
+        "fsw_refused",
+    ));
     let key = flexdyn_proto::fsw_wildcard_key(topics.sc_id())
         .map_err(|e| ServerError::Internal(format!("the fsw key: {e}")))?;
     let callback = move |sample: zenoh::sample::Sample| {

@@ -20,9 +20,21 @@ struct Entry {
 #[derive(Default)]
 pub struct RejectLog {
     entries: HashMap<(&'static str, Option<u32>), Entry>,
+    /// What is rejected and the one StatusMsg counter every reason counts in (`None`: a
+    /// command, counted under its reason).
+    counted_in: Option<(&'static str, &'static str)>,
 }
 
 impl RejectLog {
+    /// A log of rejected `what` (`flight-code telemetry`), whose every reason counts in
+    /// `StatusMsg.rejected.<counter>`.
+    pub fn counted_in(what: &'static str, counter: &'static str) -> Self {
+        Self {
+            counted_in: Some((what, counter)),
+            ..Self::default()
+        }
+    }
+
     /// Shortest interval between two lines for one (reason, sender).
     pub const EVERY: Duration = Duration::from_secs(10);
 
@@ -40,11 +52,13 @@ impl RejectLog {
         let sender_s = sender.map_or_else(|| "unknown".to_owned(), |s| s.to_string());
         match self.entries.get_mut(&(reason, sender)) {
             None => {
+                let (what, counter) = self.counted_in.unwrap_or(("a command", reason));
                 tracing::warn!(
                     reason,
                     sender = %sender_s,
-                    "rejected a command: {detail} (counted in StatusMsg.rejected.{reason}; \
-                     further ones from this sender are logged at most every {} s)",
+                    "rejected {what}: {detail} (reason {reason}, counted in \
+                     StatusMsg.rejected.{counter}; further ones for this reason are logged at \
+                     most every {} s)",
                     Self::EVERY.as_secs()
                 );
                 self.entries.insert(
