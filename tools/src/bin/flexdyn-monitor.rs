@@ -156,6 +156,8 @@ fn rejected_by_reason(r: &flexdyn_proto::RejectCounters) -> String {
         ("bad_effector_input", r.bad_effector_input),
         ("wrong_identity", r.wrong_identity),
         ("operator_refused", r.operator_refused),
+        ("fault_refused", r.fault_refused),
+        ("fsw_refused", r.fsw_refused),
     ]
     .iter()
     .filter(|(_, n)| *n > 0)
@@ -848,6 +850,13 @@ mod tests {
             ..none
         };
         assert_eq!(rejected_by_reason(&some), "malformed:2,wrong_identity:7");
+        // Refused fault commands and flight-code telemetry are reasons too.
+        let refused = flexdyn_proto::RejectCounters {
+            fault_refused: 1,
+            fsw_refused: 3,
+            ..none
+        };
+        assert_eq!(rejected_by_reason(&refused), "fault_refused:1,fsw_refused:3");
     }
 
     /// The eclipse state follows the message's `eclipse` code, and each quantity shows only
