@@ -856,7 +856,10 @@ mod tests {
             fsw_refused: 3,
             ..none
         };
-        assert_eq!(rejected_by_reason(&refused), "fault_refused:1,fsw_refused:3");
+        assert_eq!(
+            rejected_by_reason(&refused),
+            "fault_refused:1,fsw_refused:3"
+        );
     }
 
     /// The eclipse state follows the message's `eclipse` code, and each quantity shows only

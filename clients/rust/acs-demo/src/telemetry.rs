@@ -130,7 +130,7 @@ impl Telemetry {
 
     /// Publishes what the ACS sequence decided at tick `tick` (time `t_ns`).
     pub fn sequence(&mut self, tick: u64, t_ns: u64, out: &Output) -> anyhow::Result<()> {
-        self.stream.begin(tick, t_ns);
+        self.stream.begin(tick, t_ns)?;
         self.mode(out.mode.name())?;
         if out.new_target_sigma_rn.is_some() {
             self.event("target-chosen")?;
@@ -153,7 +153,7 @@ impl Telemetry {
 
     /// Publishes what the single controller (and its FDIR) decided at tick `tick`.
     pub fn controller(&mut self, tick: u64, t_ns: u64, c: &ControllerTick) -> anyhow::Result<()> {
-        self.stream.begin(tick, t_ns);
+        self.stream.begin(tick, t_ns)?;
         self.mode("pointing")?;
         if let Some(s) = &c.sigma_bn {
             self.stream.estimate(quat(s))?;
