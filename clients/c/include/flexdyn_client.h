@@ -220,14 +220,15 @@ int flexdyn_decode_time(flexdyn_client *client, const uint8_t *buf, size_t len, 
 size_t flexdyn_struct_size(int which);
 
 /* ------------------------------------------------------------------------------------------ */
-/* Every message kind (protocol 9's fifteen), by its number FLEXDYN_KIND_* (flexdyn_client_messages.h,
- * generated from the wire table proto/schema/messages.toml). The typed calls of that header -
- * flexdyn_subscribe_magnetometer / _poll_ / _wait_, the same for css, fss, gps, environment,
- * fault_event and relative_state, the lockstep getters flexdyn_lockstep_magnetometer_count /
- * _name / flexdyn_lockstep_magnetometer (and css, fss, gps), flexdyn_publish_fault_command and
- * flexdyn_publish_operator - are built on these byte-level calls, which you may also use
- * directly. Keys: a kind whose key ends with a name (a sensor's, or the chief's id for
- * relative state, flexdyn/<your sc>/tlm/rel/<chief>) takes that name, or NULL for every one. */
+/* Every message kind (protocol 10's sixteen), by its number FLEXDYN_KIND_*
+ * (flexdyn_client_messages.h, generated from the wire table proto/schema/messages.toml). The
+ * typed calls of that header - flexdyn_subscribe_magnetometer / _poll_ / _wait_, the same for
+ * css, fss, gps, environment, fault_event and relative_state, the lockstep getters
+ * flexdyn_lockstep_magnetometer_count / _name / flexdyn_lockstep_magnetometer (and css, fss,
+ * gps), flexdyn_publish_fault_command and flexdyn_publish_operator - are built on these
+ * byte-level calls, which you may also use directly. Keys: a kind whose key ends with a name
+ * (a sensor's, or the chief's id for relative state, flexdyn/<your sc>/tlm/rel/<chief>) takes
+ * that name, or NULL for every one. */
 
 /* One subscription per kind; subscribing again replaces it. */
 int flexdyn_subscribe_kind(flexdyn_client *client, int kind, const char *name, size_t capacity);
@@ -241,7 +242,8 @@ int flexdyn_wait_bytes(flexdyn_client *client, int kind, const uint8_t **bytes, 
 /* Puts an encoded message of a kind flight code or an operator sends (command, operator, fault
  * command) on its key: a command on flexdyn/<sc>/cmd/<its sender_id>. It is checked with the
  * Rust codec first: FLEXDYN_ERR_ARGUMENT, and nothing sent, for bytes the server would refuse
- * to decode; FLEXDYN_ERR_USAGE for a kind the server publishes. */
+ * to decode; FLEXDYN_ERR_USAGE for a kind the server publishes, and for FLEXDYN_KIND_FSW, whose
+ * key names its stream (publish it with flexdyn_fsw_declare and flexdyn_fsw_publish, below). */
 int flexdyn_publish_bytes(flexdyn_client *client, int kind, const uint8_t *buf, size_t len);
 /* Lockstep: the joined run's sensors of `kind` (IMU, star tracker, magnetometer, css, fss, GPS;
  * 0 for any other kind or before a join), their names, and the held tick's encoded sample of
@@ -312,6 +314,80 @@ static inline int flexdyn_clear_fault(flexdyn_client *client, const fd_header *s
     m.fault_index = fault_index;
     return flexdyn_publish_fault_command(client, &m);
 }
+
+/* ------------------------------------------------------------------------------------------ */
+/* The flight code's own telemetry (protocol 10, proto/README.md "FswMsg"): stream <name> of the
+ * served configuration's [[fsw_streams]] (its modes, events and values), published on
+ * flexdyn/<sc>/fsw/<name> and recorded by the server beside the truth; never applied to the
+ * physics. Declare a stream once, then for each sample: flexdyn_fsw_begin, the setters (by the
+ * names the configuration declares: the library counts the words), flexdyn_fsw_publish.
+ *
+ *     flexdyn_fsw_stream *acs = NULL;
+ *     if (flexdyn_fsw_declare(c, "acs", &acs, 5000) != FLEXDYN_OK) ... flexdyn_last_error(c)
+ *     flexdyn_fsw_begin(acs, &st.header);                 (the state you answer)
+ *     flexdyn_fsw_set_mode(acs, "detumble");
+ *     flexdyn_fsw_set_f64(acs, "h_b_nms", h_b_nms, 3);
+ *     if (flexdyn_fsw_publish(acs) != FLEXDYN_OK) ... flexdyn_fsw_last_error(acs)
+ *     ...
+ *     flexdyn_fsw_free(acs);                              (before flexdyn_client_free(c))
+ *
+ * Every call below but flexdyn_fsw_declare takes the stream handle and keeps its error message
+ * in it, for flexdyn_fsw_last_error (a NULL stream is FLEXDYN_ERR_ARGUMENT). A refusal names
+ * the stream and the field and changes nothing: the library refuses what the server would
+ * count in StatusMsg rejected_fsw_refused, so a mistake is an error code here rather than a
+ * sample lost there. A stream handle owns its Zenoh publisher and does not use its client
+ * handle after the declaration: use it from one thread at a time, which may be another than
+ * its client's. */
+
+typedef struct flexdyn_fsw_stream flexdyn_fsw_stream; /* opaque */
+
+/* Asks flexdyn/<sc>/config what the server runs (waiting up to timeout_ms, as
+ * flexdyn_lockstep_join does), finds `stream` in its [[fsw_streams]] and declares the publisher
+ * of flexdyn/<sc>/fsw/<stream>; *out is the new handle (NULL on any error). Errors go to the
+ * client: FLEXDYN_ERR_ARGUMENT for a stream the configuration does not declare (the message
+ * names the declared ones) or a name that is no key chunk, FLEXDYN_ERR_TIMEOUT when no server
+ * answered, FLEXDYN_ERR_CONFIG for a reply the library cannot read. Declaring the same stream
+ * twice gives two handles, each numbering its own samples: publish a stream from one. */
+int flexdyn_fsw_declare(flexdyn_client *client, const char *stream, flexdyn_fsw_stream **out,
+                        uint32_t timeout_ms);
+/* Undeclares the publisher and frees the handle (NULL is accepted). */
+void flexdyn_fsw_free(flexdyn_fsw_stream *stream);
+/* The last error of this stream, one line, "" if none; valid until the next call on it. */
+const char *flexdyn_fsw_last_error(const flexdyn_fsw_stream *stream);
+
+/* Starts the sample of the tick `stamp` carries: the header of a server message (the state you
+ * answer), whose spacecraft_id, tick and sim_time_ns are copied (its seq is ignored: the library
+ * numbers each stream's samples 0, 1, 2, ...). A sample begun and not published is dropped.
+ * FLEXDYN_ERR_ARGUMENT for another spacecraft's header; FLEXDYN_ERR_USAGE for a tick not after
+ * the last one this stream published (the server records at most one sample per tick per
+ * stream). In lockstep, publish the sample of tick k before your answer to tick k. */
+int flexdyn_fsw_begin(flexdyn_fsw_stream *stream, const fd_header *stamp);
+/* The setters of the sample begun (FLEXDYN_ERR_USAGE before flexdyn_fsw_begin). Each may be
+ * called again to replace what it set; what is not called stays unset (its flag clear). */
+/* The mode, by its name in the stream's `modes` (FD_FSW_MODE). */
+int flexdyn_fsw_set_mode(flexdyn_fsw_stream *stream, const char *mode);
+/* An event raised at this tick, by its name in the stream's `events`; up to FD_MAX_FSW_EVENTS
+ * (8) per sample. */
+int flexdyn_fsw_add_event(flexdyn_fsw_stream *stream, const char *event);
+/* The attitude estimate q_BN, scalar first (FD_FSW_ESTIMATE); finite. */
+int flexdyn_fsw_set_estimate(flexdyn_fsw_stream *stream, const double q_bn[4]);
+/* The target attitude q_RN the flight code points B at, scalar first (FD_FSW_TARGET); finite. */
+int flexdyn_fsw_set_target(flexdyn_fsw_stream *stream, const double q_rn[4]);
+/* The variances of the estimate's attitude error about the body axes [rad^2]
+ * (FD_FSW_COVARIANCE; needs an estimate in the same sample); finite. */
+int flexdyn_fsw_set_variance(flexdyn_fsw_stream *stream, const double var_b_rad2[3]);
+/* Declared value `name`: all its n elements (n = its declared `len`), of its declared type:
+ * f64 (finite), i64, or bool (0 is false, any other int true). FLEXDYN_ERR_ARGUMENT for a name
+ * the stream does not declare, another type or another length. */
+int flexdyn_fsw_set_f64(flexdyn_fsw_stream *stream, const char *name, const double *v, size_t n);
+int flexdyn_fsw_set_i64(flexdyn_fsw_stream *stream, const char *name, const int64_t *v, size_t n);
+int flexdyn_fsw_set_bool(flexdyn_fsw_stream *stream, const char *name, const int *v, size_t n);
+/* Encodes the sample begun with the library's Rust codec and puts it on the stream's key. Every
+ * declared value must have been set: otherwise FLEXDYN_ERR_USAGE naming the values left out,
+ * nothing is sent and the sample stays begun (set them and publish again); likewise for a
+ * variance without an estimate. Once sent, the next sample needs a flexdyn_fsw_begin with a
+ * later tick. FLEXDYN_ERR_ZENOH if the put failed (e.g. its client was closed). */
+int flexdyn_fsw_publish(flexdyn_fsw_stream *stream);
 
 #ifdef __cplusplus
 }

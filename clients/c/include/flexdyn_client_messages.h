@@ -498,7 +498,9 @@ static inline int flexdyn_publish_fault_command(flexdyn_client *client, const fd
     return flexdyn_publish_bytes(client, FLEXDYN_KIND_FAULT_COMMAND, buf, len);
 }
 
-/* FswMsg: variable length; sent with the library's own calls (flexdyn_send_*,
- * flexdyn_lockstep_answer_*). */
+/* FswMsg: variable length; the sample of a stream declared in the configuration's
+ * [[fsw_streams]], sent with the library's own calls on flexdyn/<sc-id>/fsw/<stream>:
+ * flexdyn_fsw_declare, flexdyn_fsw_begin, flexdyn_fsw_set_* and flexdyn_fsw_add_event by
+ * name, flexdyn_fsw_publish (flexdyn_client.h). */
 
 #endif /* FLEXDYN_CLIENT_MESSAGES_H */

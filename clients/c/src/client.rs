@@ -1,5 +1,6 @@
-//! The library in safe Rust: a Zenoh session with the subscriptions, commands and lockstep
-//! participant of `flexdyn_client.h`. [`crate::ffi`] only turns C pointers into these calls.
+//! The library in safe Rust: a Zenoh session with the subscriptions, commands, lockstep
+//! participant and flight-code telemetry streams of `flexdyn_client.h`. [`crate::ffi`] only
+//! turns C pointers into these calls.
 //!
 //! Samples are queued by Zenoh's threads in ring channels and taken only when the caller asks
 //! (poll or wait), so no user code ever runs on a Zenoh thread.
@@ -25,6 +26,7 @@ use zenoh::sample::Sample;
 use zenoh::{Session, Wait};
 
 use crate::error::{Code, Error};
+use crate::fsw::FswStream;
 use crate::kinds::{self, KINDS};
 
 /// The spacecraft id of the keys when the options name none.
@@ -399,7 +401,8 @@ impl Client {
 
     /// Puts the encoded message `bytes` of `kind` (one flight code or an operator sends) on
     /// its key, after checking them with the Rust decoder. A command goes on the key of its
-    /// `sender_id`.
+    /// `sender_id`; a flight-code telemetry sample is refused (its key names its stream: see
+    /// [`Self::declare_fsw`]).
     pub fn publish(&self, kind: Kind, bytes: &[u8]) -> Result<(), Error> {
         let info = check_kind(kind)?;
         if info.from_server {
@@ -407,6 +410,16 @@ impl Client {
                 Code::Usage,
                 format!(
                     "the server publishes {} messages ({}); flight code does not",
+                    info.title, info.key
+                ),
+            ));
+        }
+        if kind == kinds::FSW {
+            return Err(Error::new(
+                Code::Usage,
+                format!(
+                    "{} samples go on their stream's key ({}): publish them with \
+                     flexdyn_fsw_declare and flexdyn_fsw_publish",
                     info.title, info.key
                 ),
             ));
@@ -493,11 +506,9 @@ impl Client {
         self.put(self.topics.operator(), encode(&msg))
     }
 
-    /// Joins a lockstep run as `sender_id`: asks the server's configuration (up to `timeout`),
-    /// subscribes to all telemetry, declares the command publisher, then the token.
-    pub fn join(&mut self, sender_id: u32, timeout: Duration) -> Result<(), Error> {
-        self.lockstep = None;
-        let vehicle = Vehicle::query(&self.session, &self.topics, timeout).map_err(|e| {
+    /// What the server runs: the reply of `flexdyn/<sc>/config`, waiting up to `timeout`.
+    fn vehicle(&self, timeout: Duration) -> Result<Vehicle, Error> {
+        Vehicle::query(&self.session, &self.topics, timeout).map_err(|e| {
             use flexdyn_proto::client::vehicle::VehicleError as V;
             let code = match e {
                 V::NoAnswer { .. } => Code::Timeout,
@@ -505,7 +516,27 @@ impl Client {
                 _ => Code::Config,
             };
             Error::new(code, e.to_string())
-        })?;
+        })
+    }
+
+    /// Declares the flight code's telemetry stream `stream`: asks the server's configuration (up
+    /// to `timeout`) for its `[[fsw_streams]]` entry and declares the publisher of
+    /// `flexdyn/<sc>/fsw/<stream>`. The stream is independent of this client afterwards.
+    pub fn declare_fsw(&self, stream: &str, timeout: Duration) -> Result<FswStream, Error> {
+        let vehicle = self.vehicle(timeout)?;
+        Ok(FswStream::declare(
+            &self.session,
+            &self.topics,
+            &vehicle,
+            stream,
+        )?)
+    }
+
+    /// Joins a lockstep run as `sender_id`: asks the server's configuration (up to `timeout`),
+    /// subscribes to all telemetry, declares the command publisher, then the token.
+    pub fn join(&mut self, sender_id: u32, timeout: Duration) -> Result<(), Error> {
+        self.lockstep = None;
+        let vehicle = self.vehicle(timeout)?;
         let schedule = vehicle
             .config()
             .and_then(|cfg| SensorSchedule::from_config(&cfg))

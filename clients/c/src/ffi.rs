@@ -23,6 +23,7 @@ use crate::ctypes::{
     FdStarTrackerMsg, FdStateMsg, FdStatusMsg, FdTimeMsg,
 };
 use crate::error::{Code, Error};
+use crate::fsw::{self, FswStream};
 use crate::kinds;
 
 /// `flexdyn_client`: the opaque handle.
@@ -1242,4 +1243,301 @@ pub extern "C" fn flexdyn_struct_size(which: c_int) -> usize {
         7 => size_of::<FdTimeMsg>(),
         _ => 0,
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The flight code's own telemetry streams (FswMsg, protocol 10).
+
+/// `flexdyn_fsw_stream`: a declared stream, its sample being filled in and its publisher.
+pub struct FlexdynFswStream {
+    stream: FswStream,
+    last_error: CString,
+}
+
+/// Runs `f` on the stream handle, as [`with_handle_int`] does on a client handle: its error
+/// goes to the stream's `last_error`, a panic becomes [`Code::Internal`], a null handle is
+/// [`Code::Argument`].
+fn with_stream(
+    handle: *mut FlexdynFswStream,
+    f: impl FnOnce(&mut FswStream) -> Result<(), Error>,
+) -> c_int {
+    // SAFETY: a non-null `handle` comes from `flexdyn_fsw_declare` and is used by one thread at
+    // a time (the header's threading contract), so a unique reference for this call is sound.
+    let Some(h) = (unsafe { handle.as_mut() }) else {
+        return Code::Argument as c_int;
+    };
+    match catch_unwind(AssertUnwindSafe(|| f(&mut h.stream))) {
+        Ok(Ok(())) => Code::Ok as c_int,
+        Ok(Err(e)) => {
+            h.last_error = CString::new(e.message.replace('\0', " ")).unwrap_or_default();
+            e.code as c_int
+        }
+        Err(payload) => {
+            h.last_error = CString::new(
+                format!(
+                    "internal error (please report it; free this stream): {}",
+                    panic_message(payload.as_ref())
+                )
+                .replace('\0', " "),
+            )
+            .unwrap_or_default();
+            Code::Internal as c_int
+        }
+    }
+}
+
+/// `n` doubles at `p`, for `what`.
+///
+/// # Safety
+/// `p` is null or points to `N` doubles.
+unsafe fn doubles<const N: usize>(what: &str, p: *const f64) -> Result<[f64; N], Error> {
+    if p.is_null() {
+        return Err(null(what));
+    }
+    let mut v = [0.0; N];
+    // SAFETY: `N` doubles at `p`, by this function's contract.
+    v.copy_from_slice(unsafe { std::slice::from_raw_parts(p, N) });
+    Ok(v)
+}
+
+/// `n` elements at `p` (null only when `n` is 0).
+///
+/// # Safety
+/// `p` points to `n` `T`s live for the call.
+unsafe fn elements<'a, T>(p: *const T, n: usize) -> Result<&'a [T], Error> {
+    if n == 0 {
+        return Ok(&[]);
+    }
+    if p.is_null() {
+        return Err(null("v"));
+    }
+    // SAFETY: `n` elements at `p`, by this function's contract.
+    Ok(unsafe { std::slice::from_raw_parts(p, n) })
+}
+
+/// `flexdyn_fsw_declare`.
+///
+/// # Safety
+/// `handle` live; `stream` a NUL-terminated string; `out` null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_declare(
+    handle: *mut FlexdynClient,
+    stream: *const c_char,
+    out: *mut *mut FlexdynFswStream,
+    timeout_ms: u32,
+) -> c_int {
+    if !out.is_null() {
+        // SAFETY: non-null and writable, by this function's contract.
+        unsafe { out.write(std::ptr::null_mut()) };
+    }
+    with_handle(handle, |h| {
+        if out.is_null() {
+            return Err(null("out"));
+        }
+        // SAFETY: forwarded contract.
+        let name = unsafe { c_str("stream", stream)? };
+        let stream = h.client()?.declare_fsw(name, timeout(timeout_ms))?;
+        let boxed = Box::into_raw(Box::new(FlexdynFswStream {
+            stream,
+            last_error: CString::default(),
+        }));
+        // SAFETY: non-null and writable (checked), by this function's contract.
+        unsafe { out.write(boxed) };
+        Ok(Code::Ok)
+    })
+}
+
+/// `flexdyn_fsw_free`.
+///
+/// # Safety
+/// `handle` null or from [`flexdyn_fsw_declare`], not freed yet, and not used afterwards.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_free(handle: *mut FlexdynFswStream) {
+    if handle.is_null() {
+        return;
+    }
+    // SAFETY: from `Box::into_raw` in `flexdyn_fsw_declare`, freed once (this contract).
+    let h = unsafe { Box::from_raw(handle) };
+    let _ = catch_unwind(AssertUnwindSafe(move || drop(h)));
+}
+
+/// `flexdyn_fsw_last_error`.
+///
+/// # Safety
+/// `handle` is null or a live stream.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_last_error(handle: *const FlexdynFswStream) -> *const c_char {
+    // SAFETY: a live stream, by this function's contract.
+    match unsafe { handle.as_ref() } {
+        Some(h) => h.last_error.as_ptr(),
+        None => c"flexdyn_fsw_last_error: the stream is a null pointer".as_ptr(),
+    }
+}
+
+/// `flexdyn_fsw_begin`.
+///
+/// # Safety
+/// `handle` live; `stamp` null or an `fd_header`.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_begin(
+    handle: *mut FlexdynFswStream,
+    stamp: *const FdHeader,
+) -> c_int {
+    with_stream(handle, |s| {
+        // SAFETY: forwarded contract.
+        let stamp = unsafe { self::stamp(stamp)? };
+        Ok(s.begin_stamped(&stamp)?)
+    })
+}
+
+/// `flexdyn_fsw_set_mode`.
+///
+/// # Safety
+/// `handle` live; `mode` null or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_set_mode(
+    handle: *mut FlexdynFswStream,
+    mode: *const c_char,
+) -> c_int {
+    with_stream(handle, |s| {
+        // SAFETY: forwarded contract.
+        let mode = unsafe { c_str("mode", mode)? };
+        Ok(s.mode(mode)?)
+    })
+}
+
+/// `flexdyn_fsw_add_event`.
+///
+/// # Safety
+/// `handle` live; `event` null or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_add_event(
+    handle: *mut FlexdynFswStream,
+    event: *const c_char,
+) -> c_int {
+    with_stream(handle, |s| {
+        // SAFETY: forwarded contract.
+        let event = unsafe { c_str("event", event)? };
+        Ok(s.event(event)?)
+    })
+}
+
+/// `flexdyn_fsw_set_estimate`.
+///
+/// # Safety
+/// `handle` live; `q_bn` null or 4 doubles.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_set_estimate(
+    handle: *mut FlexdynFswStream,
+    q_bn: *const f64,
+) -> c_int {
+    with_stream(handle, |s| {
+        // SAFETY: forwarded contract.
+        let q = unsafe { doubles::<4>("q_bn", q_bn)? };
+        Ok(s.estimate(q)?)
+    })
+}
+
+/// `flexdyn_fsw_set_target`.
+///
+/// # Safety
+/// `handle` live; `q_rn` null or 4 doubles.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_set_target(
+    handle: *mut FlexdynFswStream,
+    q_rn: *const f64,
+) -> c_int {
+    with_stream(handle, |s| {
+        // SAFETY: forwarded contract.
+        let q = unsafe { doubles::<4>("q_rn", q_rn)? };
+        Ok(s.target(q)?)
+    })
+}
+
+/// `flexdyn_fsw_set_variance`.
+///
+/// # Safety
+/// `handle` live; `var_b_rad2` null or 3 doubles.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_set_variance(
+    handle: *mut FlexdynFswStream,
+    var_b_rad2: *const f64,
+) -> c_int {
+    with_stream(handle, |s| {
+        // SAFETY: forwarded contract.
+        let v = unsafe { doubles::<3>("var_b_rad2", var_b_rad2)? };
+        Ok(s.variance(v)?)
+    })
+}
+
+/// Sets value `name` of the sample begun from `n` elements at `v` with `set`.
+///
+/// # Safety
+/// `handle` live; `name` null or a NUL-terminated string; `v` `n` elements (null only when 0).
+unsafe fn set_value<T>(
+    handle: *mut FlexdynFswStream,
+    name: *const c_char,
+    v: *const T,
+    n: usize,
+    set: impl FnOnce(&mut FswStream, &str, &[T]) -> Result<(), fsw::FswError>,
+) -> c_int {
+    with_stream(handle, |s| {
+        // SAFETY: forwarded contract.
+        let (name, v) = unsafe { (c_str("name", name)?, elements(v, n)?) };
+        Ok(set(s, name, v)?)
+    })
+}
+
+/// `flexdyn_fsw_set_f64`.
+///
+/// # Safety
+/// `handle` live; `name` a NUL-terminated string; `v` `n` doubles (null only when 0).
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_set_f64(
+    handle: *mut FlexdynFswStream,
+    name: *const c_char,
+    v: *const f64,
+    n: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { set_value(handle, name, v, n, |s, name, v| s.f64s(name, v)) }
+}
+
+/// `flexdyn_fsw_set_i64`.
+///
+/// # Safety
+/// `handle` live; `name` a NUL-terminated string; `v` `n` `int64_t`s (null only when 0).
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_set_i64(
+    handle: *mut FlexdynFswStream,
+    name: *const c_char,
+    v: *const i64,
+    n: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { set_value(handle, name, v, n, |s, name, v| s.i64s(name, v)) }
+}
+
+/// `flexdyn_fsw_set_bool`.
+///
+/// # Safety
+/// `handle` live; `name` a NUL-terminated string; `v` `n` `int`s (null only when 0).
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_set_bool(
+    handle: *mut FlexdynFswStream,
+    name: *const c_char,
+    v: *const c_int,
+    n: usize,
+) -> c_int {
+    // SAFETY: forwarded contract.
+    unsafe { set_value(handle, name, v, n, |s, name, v| fsw::set_bools(s, name, v)) }
+}
+
+/// `flexdyn_fsw_publish`.
+///
+/// # Safety
+/// `handle` live.
+#[no_mangle]
+pub unsafe extern "C" fn flexdyn_fsw_publish(handle: *mut FlexdynFswStream) -> c_int {
+    with_stream(handle, |s| Ok(s.publish()?))
 }

@@ -14,6 +14,8 @@
 //!   section and the Rust decoder that checks each sample before it is handed out.
 //! - [`client`]: the library in safe Rust: the session, subscriptions with ring queues, commands
 //!   and the lockstep participant (built on `flexdyn_proto::client`).
+//! - [`fsw`]: the flight code's own telemetry streams (FswMsg): the Rust client's
+//!   `flexdyn_proto::client::fsw` with the library's return codes.
 //! - `ffi`: the `extern "C"` functions. The only module with `unsafe` code: pointer checks,
 //!   `catch_unwind` around every call, and the message of the last error in the handle.
 //!
@@ -27,6 +29,7 @@ pub mod client;
 pub mod ctypes;
 pub mod error;
 mod ffi;
+pub mod fsw;
 // Written by flexdyn-wiregen from proto/schema/messages.toml.
 #[rustfmt::skip]
 pub mod kinds;

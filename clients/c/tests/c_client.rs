@@ -24,6 +24,11 @@
 //! - `commands_outside_lockstep_arrive_as_sent`: `tests/send.c` sends every kind of command,
 //!   stamped from a state it waited for, to a Zenoh peer here that decodes them;
 //! - `readme_link_line_builds_the_example`: the book's compile-and-link line (docs/guides/flight-code.md), as written;
+//! - `fsw_telemetry_from_c_is_recorded_bit_for_bit`: `tests/fsw.c` (C99, C++17 and under
+//!   AddressSanitizer) declares the stream `acs` of the served configuration and publishes one
+//!   sample per answered tick by name with `flexdyn_fsw_*`, after checking the library's own
+//!   refusals; the server refuses none, and `flexdyn export` of its recording shows every sample
+//!   with the words sent;
 //! - `rate_groups_run_off_the_ticks_and_stop_while_paused`: `examples/rate_groups.c` drives
 //!   1/10/100 Hz groups from `flexdyn_wait_tick` against a real-time server, pauses it with
 //!   `flexdyn_send_operator`, sees no tick while it is held and resumes it.
@@ -200,6 +205,22 @@ impl Server {
             .args(["--listen", ports::ANY_PORT, "--duration-s", duration_s])
             .arg("--config")
             .arg(root().join("scenarios").join(scenario))
+            .stdout(Stdio::null());
+        let mut child = ports::reporting(&mut cmd).spawn().expect("start flexdyn");
+        let endpoint = ports::zenoh_endpoint(&mut child);
+        Self { child, endpoint }
+    }
+
+    /// A lockstep server with participant 1 on the configuration file `config`, recording to
+    /// `record`.
+    fn start_recording(config: &Path, record: &Path, duration_s: &str) -> Self {
+        let mut cmd = Command::new(flexdyn_bin());
+        cmd.args(["run", "--mode", "lockstep", "--participants", "1"])
+            .args(["--listen", ports::ANY_PORT, "--duration-s", duration_s])
+            .arg("--config")
+            .arg(config)
+            .arg("--record")
+            .arg(record)
             .stdout(Stdio::null());
         let mut child = ports::reporting(&mut cmd).spawn().expect("start flexdyn");
         let endpoint = ports::zenoh_endpoint(&mut child);
@@ -844,4 +865,177 @@ fn bdot_detumble_in_c_is_deterministic_and_detumbles() {
     let (control, _) = fly("300", "0", "bdot_control.bin");
     assert!(rate_at_end(&control) > 2.9, "{control}");
     eprintln!("{first}{control}");
+}
+
+/// The configuration of `tests/fsw.c`: `scenarios/reference.toml` (100 Hz) with the stream
+/// `acs` the program publishes.
+const FSW_STREAM_TOML: &str = r#"
+[[fsw_streams]]
+name = "acs"
+modes = ["detumble", "point"]
+events = [{ name = "gyro_fault", severity = "error" }]
+values = [
+  { name = "h_b_nms", type = "f64", len = 3, unit = "N·m·s" },
+  { name = "flags", type = "i64" },
+  { name = "ok", type = "bool" },
+]
+"#;
+
+/// A CSV `flexdyn export` wrote: its column names and rows, `#` comment lines skipped.
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let names = lines
+        .next()
+        .expect("a header row")
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(str::to_owned).collect())
+        .collect();
+    (names, rows)
+}
+
+/// The cell `name` of `row` as an integer (the exact word: `flexdyn export` writes integers,
+/// the FswMsg value words among them, as integers).
+fn cell_u64(names: &[String], row: &[String], name: &str) -> u64 {
+    let i = names
+        .iter()
+        .position(|n| n == name)
+        .unwrap_or_else(|| panic!("no column {name} in {names:?}"));
+    row[i]
+        .parse()
+        .unwrap_or_else(|e| panic!("{name} = {:?}: {e}", row[i]))
+}
+
+/// `tests/fsw.c` against a lockstep server whose configuration declares the stream `acs`,
+/// recording: built as C99, as C++17 and as C99 under AddressSanitizer, each run publishes one
+/// sample before its answer to each tick 0..99 (the last tick, 100, needs no answer) and checks
+/// the library's own refusals (undeclared stream, mode, event and value; wrong length and type;
+/// NaN; another spacecraft's stamp; a value left out; a variance without an estimate; a second
+/// sample for a tick). Then, independently of the program: the server refused none of what it
+/// got (its last StatusMsg in the recording), and `flexdyn export` of the recording has exactly
+/// one sample per answered tick, stamped with the tick's time, numbered 0, 1, 2 ..., with the
+/// mode, events, flags, quaternions and the value words the program derived from k, bit for bit.
+#[test]
+fn fsw_telemetry_from_c_is_recorded_bit_for_bit() {
+    use flexdyn_proto::fsw_flags;
+
+    let asan = ["-O1", "-g", "-fsanitize=address", "-fno-omit-frame-pointer"];
+    let dir = tmp().join("c_client_fsw");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let reference = std::fs::read_to_string(root().join("scenarios/reference.toml")).unwrap();
+    let config = dir.join("fsw.toml");
+    std::fs::write(&config, format!("{reference}{FSW_STREAM_TOML}")).unwrap();
+    let builds = [
+        ("c", build_c(&["-O2"], "tests/fsw.c", "fsw")),
+        (
+            "cpp",
+            build(
+                "CXX",
+                "g++",
+                &["-std=c++17", "-O2"],
+                &["tests/fsw.cpp"],
+                "fsw_cpp",
+            ),
+        ),
+        ("asan", build_c(&asan, "tests/fsw.c", "fsw_asan")),
+    ];
+    // 1 s at 100 Hz: ticks 0..=100, the last needing no answer.
+    const LAST_TICK: u64 = 100;
+    for (name, exe) in &builds {
+        let record = dir.join(format!("{name}.mcap"));
+        let mut server = Server::start_recording(&config, &record, "1");
+        let stdout = run_ok(
+            Command::new(exe)
+                .args([server.endpoint.as_str(), &LAST_TICK.to_string()])
+                .env("ASAN_OPTIONS", "detect_leaks=1:exitcode=23"),
+        );
+        assert_eq!(
+            stdout.trim(),
+            "published 100 refusals 15 rejected_fsw_refused 0",
+            "{name}"
+        );
+        assert_eq!(server.wait(Duration::from_secs(30)), Some(0), "{name}");
+
+        let csv = dir.join(format!("{name}_csv"));
+        run_ok(
+            Command::new(flexdyn_bin())
+                .arg("export")
+                .arg("--csv")
+                .arg(&csv)
+                .arg(&record),
+        );
+        // The server's last status: no sample refused, every one recorded.
+        let (names, rows) = read_csv(&csv.join("flexdyn_sc1_status.csv"));
+        let last = rows.last().expect("status rows");
+        let run_state = names.iter().position(|n| n == "run_state").unwrap();
+        assert_eq!(last[run_state], "Finished", "{name}");
+        assert_eq!(cell_u64(&names, last, "rejected_fsw_refused"), 0, "{name}");
+        // One row per answered tick, as sent: every tick checked, 5 (the event) and 99 (the
+        // last) among them.
+        let (names, rows) = read_csv(&csv.join("flexdyn_sc1_fsw_acs.csv"));
+        assert_eq!(rows.len() as u64, LAST_TICK, "{name}: {names:?}");
+        let word = |row: &[String], n: &str| cell_u64(&names, row, n);
+        let f64_bits = |x: f64| x.to_bits();
+        for (k, row) in (0u64..).zip(&rows) {
+            assert_eq!(word(row, "tick"), k, "{name}");
+            // 100 Hz: tick k is at k × 10 ms; the stream's own counter.
+            assert_eq!(word(row, "sim_time_ns"), k * 10_000_000, "{name}");
+            assert_eq!(word(row, "seq"), k, "{name}");
+            let mut flags = fsw_flags::MODE | fsw_flags::ESTIMATE;
+            if k == 3 {
+                flags |= fsw_flags::COVARIANCE;
+            }
+            if k >= 10 {
+                flags |= fsw_flags::TARGET;
+            }
+            assert_eq!(word(row, "flags"), u64::from(flags), "{name} tick {k}");
+            assert_eq!(word(row, "mode"), u64::from(k >= 10), "{name} tick {k}");
+            let events = if k == 5 { 1 } else { 0 };
+            assert_eq!(word(row, "event_count"), events, "{name} tick {k}");
+            // The value words: h_b_nms (3 f64), flags (i64), ok (bool), bit for bit.
+            let expected = [
+                f64_bits(k as f64 * 0.5),
+                f64_bits(-(k as f64)),
+                f64_bits(0.25),
+                (-(k as i64)) as u64,
+                k % 2,
+            ];
+            let got: Vec<u64> = (1..=5).map(|i| word(row, &format!("values_{i}"))).collect();
+            assert_eq!(got, expected, "{name} tick {k}");
+        }
+        // The quaternions and the variance: numbers, compared as numbers (the CSV prints the
+        // shortest text that reads back as the same f64).
+        let num = |row: &[String], n: &str| -> f64 {
+            let i = names
+                .iter()
+                .position(|c| c == n)
+                .unwrap_or_else(|| panic!("{n}"));
+            row[i].parse().unwrap()
+        };
+        let r3 = &rows[3];
+        assert_eq!(
+            [
+                num(r3, "att_var_b_rad2_1"),
+                num(r3, "att_var_b_rad2_2"),
+                num(r3, "att_var_b_rad2_3")
+            ],
+            [1e-6, 2e-6, 3e-6]
+        );
+        let r99 = &rows[99];
+        assert_eq!(
+            [
+                num(r99, "q_est_bn_0"),
+                num(r99, "q_est_bn_1"),
+                num(r99, "q_target_rn_2"),
+                num(r99, "q_target_rn_3")
+            ],
+            [0.6, 0.8, 0.6, 0.8]
+        );
+        let e5 = &rows[5];
+        assert_eq!(word(e5, "events_1"), 0, "gyro_fault is event 0");
+    }
 }
