@@ -669,7 +669,7 @@ pub struct RejectCounters {
     /// protocol version 8.
     pub fault_refused: u64,
     /// A [`FswMsg`] the server did not record: an undeclared stream, a tick ahead of the server
-    /// or not after the stream's last recorded one, a mode or event the stream does not declare,
+    /// or not after the stream's last recorded one, a `sim_time_ns` other than its tick's, a mode or event the stream does not declare,
     /// a value count other than the declaration's, a bool other than 0/1, a NaN or infinite f64
     /// value, or COVARIANCE without ESTIMATE. Malformed, bad-version and wrong-spacecraft
     /// samples count here too (not under those reasons: telemetry is not a command). Added in

@@ -24,8 +24,9 @@
 //! stamped k that arrives before the answer is recorded with tick k, and the recording of a
 //! lockstep run is the same whenever it is repeated. The run's last tick is published for the
 //! record and no answer to it is awaited, so whether a sample for it arrives before the run
-//! closes is a race: a lockstep server records no sample stamped with its last tick (neither
-//! recorded nor counted as refused), and two runs' recordings stay identical.
+//! closes is a race: a lockstep server neither records nor checks a sample of its spacecraft
+//! stamped with its last tick (so it is not counted as refused either), and two runs'
+//! recordings and final counts stay identical.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -113,6 +114,10 @@ impl FswIntake {
                 ),
             ));
         }
+        // A lockstep run's last tick: neither checked further nor recorded (module docs).
+        if self.lockstep_last_tick == Some(msg.header.tick) {
+            return Ok(None);
+        }
         let Some(i) = self.keys.iter().position(|k| &**k == key) else {
             return Err((
                 "unknown_stream",
@@ -150,9 +155,7 @@ impl FswIntake {
                 format!("stream `{}` sample for tick {tick}: {why}", stream.name),
             )
         })?;
-        if self.lockstep_last_tick == Some(tick) {
-            return Ok(None);
-        }
+
         // At most one sample per tick: claim the tick, or refuse a repeat (or an older one).
         let next = &self.next_tick[i];
         let mut seen = next.load(Ordering::Acquire);

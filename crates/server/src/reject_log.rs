@@ -52,15 +52,22 @@ impl RejectLog {
         let sender_s = sender.map_or_else(|| "unknown".to_owned(), |s| s.to_string());
         match self.entries.get_mut(&(reason, sender)) {
             None => {
-                let (what, counter) = self.counted_in.unwrap_or(("a command", reason));
-                tracing::warn!(
-                    reason,
-                    sender = %sender_s,
-                    "rejected {what}: {detail} (reason {reason}, counted in \
-                     StatusMsg.rejected.{counter}; further ones for this reason are logged at \
-                     most every {} s)",
-                    Self::EVERY.as_secs()
-                );
+                match self.counted_in {
+                    None => tracing::warn!(
+                        reason,
+                        sender = %sender_s,
+                        "rejected a command: {detail} (counted in StatusMsg.rejected.{reason}; \
+                         further ones from this sender are logged at most every {} s)",
+                        Self::EVERY.as_secs()
+                    ),
+                    Some((what, counter)) => tracing::warn!(
+                        reason,
+                        "rejected {what}: {detail} (reason {reason}, counted in \
+                         StatusMsg.rejected.{counter}; further ones for this reason are logged \
+                         at most every {} s)",
+                        Self::EVERY.as_secs()
+                    ),
+                }
                 self.entries.insert(
                     (reason, sender),
                     Entry {

@@ -215,7 +215,8 @@ impl TelemetryCtx {
             overruns = t.overrun_count,
             frames_skipped = t.frames_skipped,
             telemetry_dropped = self.shared.telemetry_dropped.load(Ordering::Relaxed),
-            commands_rejected = rejected.total(),
+            commands_rejected = rejected.total() - rejected.fsw_refused,
+            fsw_refused = rejected.fsw_refused,
             command_age_ms = if last_command.command_age_ns == flexdyn_proto::NO_COMMAND {
                 "none".to_owned()
             } else {
