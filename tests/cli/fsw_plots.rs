@@ -197,7 +197,7 @@ fn the_flight_codes_telemetry_is_plotted_against_the_truth() {
     assert_eq!(pointing.lines[0].points.len() as u64, TICKS);
 
     // About each axis, with ±3σ from the variances.
-    let est = find(&figs, "fsw_acs_estimation.png");
+    let est = find(&figs, "fsw_acs.estimation.png");
     for (axis, (want, sigma)) in [(1e-3_f64, 1e-3_f64), (0.0, 2e-3), (0.0, 3e-3)]
         .into_iter()
         .enumerate()
@@ -223,7 +223,7 @@ fn the_flight_codes_telemetry_is_plotted_against_the_truth() {
     }
 
     // The declared values, as sent.
-    let v = find(&figs, "fsw_acs_values.png");
+    let v = find(&figs, "fsw_acs.values.png");
     assert_eq!(v.panels.len(), 3);
     assert_eq!(v.panels[0].y_label, "h_b_nms (N·m·s)");
     assert_eq!(v.panels[0].lines[1].label, "h_b_nms[1]");
@@ -244,8 +244,8 @@ fn the_flight_codes_telemetry_is_plotted_against_the_truth() {
     for name in [
         "attitude.png",
         "fsw_acs.png",
-        "fsw_acs_estimation.png",
-        "fsw_acs_values.png",
+        "fsw_acs.estimation.png",
+        "fsw_acs.values.png",
     ] {
         assert!(
             report.written.contains(&out.join(name)),

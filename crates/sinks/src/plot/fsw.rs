@@ -7,9 +7,11 @@
 //! - `fsw_<stream>.png`: the mode timeline, the **pointing error against the flight code's own
 //!   target** (the truth attitude B against the target R the flight code published, principal
 //!   angle), and the **estimation error** (its estimate against the truth, principal angle);
-//! - `fsw_<stream>_estimation.png`: the estimation error about each body axis with ±3σ from the
+//! - `fsw_<stream>.estimation.png`: the estimation error about each body axis with ±3σ from the
 //!   variances the flight code published (only when it published an estimate);
-//! - `fsw_<stream>_values.png`: one panel per declared value (bools as 0/1).
+//! - `fsw_<stream>.values.png`: one panel per declared value (bools as 0/1).
+//!
+//! (A stream name has no `.`, so no two streams' figures share a name.)
 //!
 //! Angles: for unit quaternions q₁, q₂ (scalar first), the principal angle of the rotation
 //! between them is Φ = 2 atan2(√(1 − d²), |d|) with d = q₁·q₂ (Schaub & Junkins, *Analytical
@@ -62,22 +64,41 @@ fn t_s(m: &FswMsg) -> f64 {
     m.header.sim_time_ns as f64 / 1e9
 }
 
-/// The principal angle between two attitudes given as unit quaternions (module docs) \[rad\].
-pub fn principal_angle_rad(q1: &Vector4<f64>, q2: &Vector4<f64>) -> f64 {
-    let d = q1.dot(q2).abs().min(1.0);
-    2.0 * (1.0 - d * d).max(0.0).sqrt().atan2(d)
+/// `q` scaled to unit length; `None` for a quaternion too short to be an attitude (below
+/// 0.5: flight code's single-precision rounding is many orders smaller).
+fn unit(q: &Vector4<f64>) -> Option<Vector4<f64>> {
+    let n = q.norm();
+    (n > 0.5 && n.is_finite()).then(|| q / n)
 }
 
-/// The estimate's error about each body axis (module docs) \[rad\].
-pub fn axis_errors_rad(q_est_bn: &Vector4<f64>, q_bn: &Vector4<f64>) -> Vector3<f64> {
-    let c = quat_to_dcm(q_est_bn) * quat_to_dcm(q_bn).transpose();
+/// The relative rotation's quaternion q₁* ⊗ q₂ (scalar first; its scalar part is q₁·q₂).
+fn relative(q1: &Vector4<f64>, q2: &Vector4<f64>) -> Vector4<f64> {
+    let (a0, a) = (q1[0], Vector3::new(q1[1], q1[2], q1[3]));
+    let (b0, b) = (q2[0], Vector3::new(q2[1], q2[2], q2[3]));
+    let v = a0 * b - b0 * a - a.cross(&b);
+    Vector4::new(a0 * b0 + a.dot(&b), v[0], v[1], v[2])
+}
+
+/// The principal angle between two attitudes given as quaternions (module docs) \[rad\]:
+/// Φ = 2 atan2(|q_v|, |q_0|) of their relative rotation, from the quaternions scaled to unit
+/// length (accurate for small angles too); `None` for a quaternion that is not an attitude.
+pub fn principal_angle_rad(q1: &Vector4<f64>, q2: &Vector4<f64>) -> Option<f64> {
+    let r = relative(&unit(q1)?, &unit(q2)?);
+    let v = Vector3::new(r[1], r[2], r[3]).norm();
+    Some(2.0 * v.atan2(r[0].abs()))
+}
+
+/// The estimate's error about each body axis (module docs) \[rad\]; `None` for a quaternion
+/// that is not an attitude.
+pub fn axis_errors_rad(q_est_bn: &Vector4<f64>, q_bn: &Vector4<f64>) -> Option<Vector3<f64>> {
+    let c = quat_to_dcm(&unit(q_est_bn)?) * quat_to_dcm(&unit(q_bn)?).transpose();
     let sigma = dcm_to_mrp(&c);
     let n = sigma.norm();
-    if n == 0.0 {
+    Some(if n == 0.0 {
         Vector3::zeros()
     } else {
         sigma * (4.0 * n.atan() / n)
-    }
+    })
 }
 
 /// The mode timeline of a stream: the mode index, a band per mode over the time spent in it,
@@ -166,7 +187,7 @@ pub fn mode_panel(series: &FswSeries) -> Option<Panel> {
     })
 }
 
-/// `fsw_<stream>.png`, `fsw_<stream>_estimation.png`, `fsw_<stream>_values.png` (module docs).
+/// `fsw_<stream>.png`, `fsw_<stream>.estimation.png`, `fsw_<stream>.values.png` (module docs).
 pub fn figures(series: &FswSeries, truth: &Truth) -> Vec<Figure> {
     let name = &series.decl.name;
     let s = &series.samples;
@@ -183,12 +204,19 @@ pub fn figures(series: &FswSeries, truth: &Truth) -> Vec<Figure> {
         let Some(q_bn) = truth_at(m) else { continue };
         let t = t_s(m);
         if m.flags & fsw_flags::TARGET != 0 {
-            pointing.push((t, principal_angle_rad(q_bn, &q(m.q_target_rn)).to_degrees()));
+            if let Some(a) = principal_angle_rad(q_bn, &q(m.q_target_rn)) {
+                pointing.push((t, a.to_degrees()));
+            }
         }
         if m.flags & fsw_flags::ESTIMATE != 0 {
             let q_est = q(m.q_est_bn);
-            estimation.push((t, principal_angle_rad(q_bn, &q_est).to_degrees()));
-            let e = axis_errors_rad(&q_est, q_bn);
+            let (Some(a), Some(e)) = (
+                principal_angle_rad(q_bn, &q_est),
+                axis_errors_rad(&q_est, q_bn),
+            ) else {
+                continue;
+            };
+            estimation.push((t, a.to_degrees()));
             for i in 0..3 {
                 axes[i].push((t, e[i].to_degrees()));
                 if m.flags & fsw_flags::COVARIANCE != 0 {
@@ -254,7 +282,7 @@ pub fn figures(series: &FswSeries, truth: &Truth) -> Vec<Figure> {
             })
             .collect();
         out.push(Figure {
-            name: format!("fsw_{name}_estimation.png"),
+            name: format!("fsw_{name}.estimation.png"),
             title: format!(
                 "Flight code `{name}`: attitude estimation error about each body axis, with its 3σ"
             ),
@@ -295,7 +323,7 @@ pub fn figures(series: &FswSeries, truth: &Truth) -> Vec<Figure> {
     if !values.is_empty() {
         let columns = if values.len() > 4 { 2 } else { 1 };
         out.push(Figure {
-            name: format!("fsw_{name}_values.png"),
+            name: format!("fsw_{name}.values.png"),
             title: format!("Flight code `{name}`: its declared values"),
             panels: values,
             columns,
@@ -318,10 +346,16 @@ mod tests {
     fn angles_are_the_closed_forms() {
         let a = q_about_z(0.3);
         let b = q_about_z(0.3 + 1e-3);
-        assert!((principal_angle_rad(&a, &b) - 1e-3).abs() < 1e-12);
-        assert!((principal_angle_rad(&a, &(-b)) - 1e-3).abs() < 1e-12);
-        assert!((principal_angle_rad(&a, &q_about_z(0.3 + 2.0)) - 2.0).abs() < 1e-12);
-        let e = axis_errors_rad(&b, &a);
+        let angle = |x: &Vector4<f64>, y: &Vector4<f64>| principal_angle_rad(x, y).unwrap();
+        assert!((angle(&a, &b) - 1e-3).abs() < 1e-12);
+        assert!((angle(&a, &(-b)) - 1e-3).abs() < 1e-12);
+        assert!((angle(&a, &q_about_z(0.3 + 2.0)) - 2.0).abs() < 1e-12);
+        // Small angles stay accurate, and a quaternion off unit length (single precision) is
+        // scaled, not read as an error: 1e-7 rad between two quaternions 1e-7 too long.
+        let c = q_about_z(0.3 + 1e-7) * (1.0 + 1e-7);
+        assert!((angle(&(a * (1.0 + 1e-7)), &c) - 1e-7).abs() < 1e-15);
+        assert!(principal_angle_rad(&a, &Vector4::zeros()).is_none());
+        let e = axis_errors_rad(&b, &a).unwrap();
         assert!(e[0].abs() < 1e-15 && e[1].abs() < 1e-15, "{e:?}");
         assert!((e[2].abs() - 1e-3).abs() < 1e-12, "{e:?}");
     }
