@@ -271,11 +271,9 @@ def test_hostile_fsw_samples_are_all_refused_and_none_recorded(config, reference
             hostile.subscribe_status(on_status)
             assert at_hold.wait(60), "the run never reached the hold"
             with refused_seen:
-                # The participant has the state of HOLD, but a lockstep server notes the tick
-                # as published only once it has put the whole frame out (LockstepCore::publish),
-                # and a sample from another session can come in between: it would be refused
-                # as `future_tick`, not for the defect it carries. So wait until the server's
-                # status says HOLD.
+                # Wait until the server's status says HOLD, so that every hostile sample below
+                # is judged at tick HOLD (the server notes a tick before it publishes it, so
+                # none can be refused as `future_tick` instead of for the defect it carries).
                 assert refused_seen.wait_for(lambda: server_tick[0] >= HOLD, 60), (
                     f"the server's status never reached tick {HOLD}")
                 assert server_tick[0] == HOLD

@@ -19,11 +19,12 @@
 //! #         vehicle: &flexdyn_proto::client::vehicle::Vehicle) -> Result<(), Box<dyn std::error::Error>> {
 //! use flexdyn_proto::client::fsw::FswStream;
 //! let mut acs = FswStream::declare(session, topics, vehicle, "acs")?;
-//! // Once per tick answered, before the answer:
+//! // Once per tick answered, before the answer (the stream of scenarios/acs_full.toml):
 //! acs.begin(42, 420_000_000)?;
 //! acs.mode("detumble")?;
-//! acs.f64s("h_wheels_b_nms", &[0.1, 0.0, -0.2])?;
-//! acs.i64s("fdir_flags", &[0])?;
+//! acs.f64s("rate_b_rad_s", &[0.01, 0.0, -0.02])?;
+//! acs.f64s("wheel_momentum_b_nms", &[0.1, 0.0, -0.2])?;
+//! acs.bools("sun_visible", &[true])?;
 //! acs.publish()?;
 //! # Ok(()) }
 //! ```
@@ -183,9 +184,13 @@ fn quoted<'a>(names: impl Iterator<Item = &'a str>) -> String {
 impl FswDeclaration {
     /// Every stream the configuration text `config_toml` declares.
     pub fn all_from_config_toml(config_toml: &str) -> Result<Vec<Self>, FswError> {
-        toml::from_str::<Streams>(config_toml)
+        let all = toml::from_str::<Streams>(config_toml)
             .map(|s| s.fsw_streams)
-            .map_err(|e| FswError::Config(e.message().to_owned()))
+            .map_err(|e| FswError::Config(e.message().to_owned()))?;
+        for s in &all {
+            s.check()?;
+        }
+        Ok(all)
     }
 
     /// Stream `stream` of the configuration text `config_toml`, checked to fit a sample:
@@ -200,7 +205,6 @@ impl FswDeclaration {
                 stream: stream.to_owned(),
                 declared,
             })?;
-        s.check()?;
         Ok(s)
     }
 
@@ -265,9 +269,9 @@ impl FswSampler {
         let offsets = declaration
             .values
             .iter()
-            .scan(0, |at, v| {
+            .scan(0usize, |at, v| {
                 let first = *at;
-                *at += v.len;
+                *at = at.saturating_add(v.len);
                 Some(first)
             })
             .collect();

@@ -123,10 +123,10 @@ class Client:
         # The time service (now / wait_tick): the last TimeMsg and its condition, on first use.
         self._time_cond: Optional[threading.Condition] = None
         self._now: Optional[TimeMsg] = None
-        # The ticks wait_tick has not returned yet, oldest first (the last 1024: 10 s at 100 Hz),
-        # and the tick it returned last (None before its first call).
+        # The last 1024 TimeMsgs (10 s at 100 Hz), oldest first, shared by every waiter, and
+        # per thread the tick wait_tick handed it last.
         self._ticks: collections.deque = collections.deque(maxlen=1024)
-        self._last_waited: Optional[int] = None
+        self._waited = threading.local()
         #: Undecodable telemetry samples received (a sample that is not the message its key says).
         self.undecodable = 0
         #: Exceptions raised by telemetry callbacks (logged on the ``flexdyn`` logger; the other
@@ -287,28 +287,44 @@ class Client:
         self._clock()
         return self._now
 
+    def _tick_after(self, last: int) -> Optional[TimeMsg]:
+        """The held TimeMsg after tick `last` (under the clock's condition): the next one, the
+        oldest held if `last` is older than all of them, or the first of a new run when the
+        ticks went back (a server restarted on the same keys); ``None`` if none yet."""
+        ticks = self._ticks
+        n = len(ticks)
+        if n == 0:
+            return None
+        if ticks[-1].header.tick < last:
+            j = n - 1
+            while j > 0 and ticks[j - 1].header.tick < ticks[j].header.tick:
+                j -= 1
+            return ticks[j]
+        i = n - 1  # from the newest: a waiter that keeps up looks at one or two
+        while i >= 0 and ticks[i].header.tick > last:
+            i -= 1
+        return ticks[i + 1] if i + 1 < n else None
+
     def wait_tick(self, timeout_s: float = 10.0) -> TimeMsg:
         """Blocks until the next TimeMsg and returns it; ``TimeoutError`` after ``timeout_s`` s of
-        wall time without one (the server is gone, or the run is paused). The first call returns
-        the first tick newer than :meth:`now` at the call; each later call returns the tick after
-        the one it returned last, in order and without a gap, even when the caller woke late
-        (the client holds the last 1024 ticks; a caller more than 1024 ticks behind resumes at
-        the oldest it holds). A rate-group driver calls it in a loop: one call per frame,
-        ``msg.flags & proto.TIME_TONE`` on the 1 Hz tone."""
+        wall time without one (the server is gone, or the run is paused). A thread's first call
+        returns the first tick newer than :meth:`now` at the call; each later call returns the
+        tick after the one it returned last to that thread, in order and without a gap, even
+        when the thread woke late (the client holds the last 1024 ticks; a thread further
+        behind resumes at the oldest held). Each thread has its own position, so two rate
+        groups on two threads each see every tick; a server restarted on the same keys
+        (ticks going back) starts them again at its first tick held. A rate-group driver calls
+        it in a loop: one call per frame, ``msg.flags & proto.TIME_TONE`` on the 1 Hz tone."""
         cond = self._clock()
+        waited = self._waited
         with cond:
-            if self._last_waited is None:
-                self._last_waited = self._now.header.tick if self._now is not None else -1
-            last = self._last_waited
-            ticks = self._ticks
-            while ticks and ticks[0].header.tick <= last:
-                ticks.popleft()
-            if not cond.wait_for(lambda: bool(ticks) and ticks[-1].header.tick > last, timeout_s):
+            last = getattr(waited, "tick", None)
+            if last is None:
+                last = self._now.header.tick if self._now is not None else -1
+            if not cond.wait_for(lambda: self._tick_after(last) is not None, timeout_s):
                 raise TimeoutError(f"no tick after {last} within {timeout_s} s")
-            while ticks[0].header.tick <= last:
-                ticks.popleft()
-            msg = ticks.popleft()
-            self._last_waited = msg.header.tick
+            msg = self._tick_after(last)
+            waited.tick = msg.header.tick
             return msg
 
     def subscribe_status(self, callback: Callable[[StatusMsg], None]) -> object:
@@ -439,11 +455,12 @@ class Client:
         truth, counts refused ones in ``StatusMsg.rejected_fsw_refused``, and applies nothing
         from them to the physics."""
         from .fsw import FswDeclaration, FswStream
-        declaration = FswDeclaration.from_config(self.vehicle(timeout_s).config(), name)
+        vehicle = self.vehicle(timeout_s)
+        declaration = FswDeclaration.from_config(vehicle.config(), name)
         with self._pub_lock:
             if self._closed:
                 raise RuntimeError("flexdyn.Client is closed")
-            return FswStream(self, declaration)
+            return FswStream(self, declaration, vehicle.spacecraft_id)
 
     # -- live faults (protocol 8) -------------------------------------------------------------
 

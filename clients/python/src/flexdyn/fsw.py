@@ -7,9 +7,10 @@ docs/guides/fsw-telemetry.md). :meth:`flexdyn.Client.declare_fsw` reads the decl
 the server's configuration, so flight code names its modes, events and values as the
 configuration does, and a mistake is a ``ValueError`` here rather than a refusal counted there::
 
-    acs = client.declare_fsw("acs")
-    acs.publish(tick, sim_time_ns, mode="detumble", events=["gyro_fault"],
-                estimate=q_bn, target=q_rn, h_wheels_b_nms=(0.1, 0.0, -0.2), fdir_flags=3)
+    acs = client.declare_fsw("acs")     # the stream of scenarios/acs_full.toml
+    acs.publish(tick, sim_time_ns, mode="fine-pointing", events=["target-chosen"],
+                estimate=q_bn, target=q_rn, rate_b_rad_s=(0.01, 0.0, -0.02),
+                wheel_momentum_b_nms=(0.1, 0.0, -0.2), sun_visible=True)
 """
 
 from __future__ import annotations
@@ -181,9 +182,14 @@ def value_of(value: FswValue, words: Sequence[int]) -> List[Any]:
 class FswStream:
     """A declared stream bound to its publisher (from :meth:`flexdyn.Client.declare_fsw`)."""
 
-    def __init__(self, client: Any, declaration: FswDeclaration) -> None:
+    def __init__(self, client: Any, declaration: FswDeclaration,
+                 spacecraft_id: Optional[int] = None) -> None:
         self.declaration = declaration
         self._client = client
+        # The vehicle's numeric id as its server serves it (the client's own by default).
+        self.spacecraft_id = client.spacecraft_id if spacecraft_id is None else spacecraft_id
+        # The last tick published: a stream carries at most one sample per tick, in order.
+        self._last_tick: Optional[int] = None
         self._key = proto.fsw_key(client.sc_id, declaration.name)
         # Blocking, so this end never drops a sample (the client's command publishers block
         # too). Not express: an express sample takes a batch of the link's queue of its own,
@@ -208,18 +214,25 @@ class FswStream:
                 variance: Optional[Sequence[float]] = None, **values: Any) -> FswMsg:
         """Publishes one sample for `tick` (the tick this flight code answers, at its
         `sim_time_ns`); returns the message sent. Every declared value is given by name:
-        ``h_wheels_b_nms=(0.1, 0.0, -0.2)``. In lockstep, publish before answering the tick,
-        from this client, so the server has it before it steps on."""
+        ``wheel_momentum_b_nms=(0.1, 0.0, -0.2)``. In lockstep, publish before answering the
+        tick, from this client, so the server has it before it steps on. ``ValueError`` (and
+        nothing sent) for a tick not after the last one published: the server records at most
+        one sample per tick per stream."""
         with self._lock:
-            header = Header(self._client.spacecraft_id, tick, sim_time_ns, self._seq)
+            if self._last_tick is not None and tick <= self._last_tick:
+                raise ValueError(f"stream {self.declaration.name!r}: tick {tick} is not after "
+                                 f"tick {self._last_tick}, the last one published (at most one "
+                                 f"sample per tick, in order)")
+            header = Header(self.spacecraft_id, tick, sim_time_ns, self._seq)
             msg = self.declaration.sample(header, mode, events, estimate, target, variance,
                                           **values)
-            self._seq += 1
             payload = msg.encode()
-        with self._client._pub_lock:
-            if self._client._closed:
-                raise RuntimeError("flexdyn.Client is closed")
-            self._publisher.put(payload)
+            with self._client._pub_lock:
+                if self._client._closed:
+                    raise RuntimeError("flexdyn.Client is closed")
+                self._publisher.put(payload)
+            self._seq += 1
+            self._last_tick = tick
         return msg
 
     def undeclare(self) -> None:
