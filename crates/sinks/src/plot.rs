@@ -641,6 +641,34 @@ fn tick_label(y: f64, lo: f64, hi: f64) -> String {
 
 type Chart<'a, Y> = ChartContext<'a, BitMapBackend<'a>, Cartesian2d<RangedCoordf64, Y>>;
 
+/// Shades `spans` over the y range `y`, with one legend entry `label`; clipped to `t` when
+/// given (drawn from the axis' start when it began before the data).
+fn shade_spans<Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueFormatter<f64>>(
+    chart: &mut Chart<'_, Y>,
+    spans: &[(f64, f64)],
+    t: Option<(f64, f64)>,
+    (y0, y1): (f64, f64),
+    shade: RGBAColor,
+    label: &str,
+) -> Result<(), String> {
+    let clip = |(a, b): (f64, f64)| match t {
+        Some((t0, t1)) => (a.clamp(t0, t1), b.clamp(t0, t1)),
+        None => (a, b),
+    };
+    chart
+        .draw_series(
+            spans
+                .iter()
+                .map(|s| clip(*s))
+                .filter(|(a, b)| t.is_none() || a < b)
+                .map(|(a, b)| Rectangle::new([(a, y0), (b, y1)], shade.filled())),
+        )
+        .map_err(|e| e.to_string())?
+        .label(label)
+        .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
+    Ok(())
+}
+
 /// Axes, lines (points where `keep(y)`) and legend of one panel, on a linear or log y axis.
 fn draw_panel<Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueFormatter<f64>>(
     chart: &mut Chart<'_, Y>,
@@ -660,52 +688,26 @@ fn draw_panel<Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueForma
         .x_label_formatter(x_ticks)
         .draw()
         .map_err(|e| e.to_string())?;
+    let (y0, y1) = panel.y_range();
+    // A band or a fault active from before the data is drawn from the axis' start.
+    let t = Some(panel.t_range());
     for b in &panel.bands {
-        let (y0, y1) = panel.y_range();
-        let (t0, t1) = panel.t_range();
-        let shade = b.color.mix(b.alpha);
-        chart
-            .draw_series(
-                b.spans
-                    .iter()
-                    .map(|(a, b)| (a.clamp(t0, t1), b.clamp(t0, t1)))
-                    .filter(|(a, b)| a < b)
-                    .map(|(a, b)| Rectangle::new([(a, y0), (b, y1)], shade.filled())),
-            )
-            .map_err(|e| e.to_string())?
-            .label(b.label.as_str())
-            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
+        shade_spans(chart, &b.spans, t, (y0, y1), b.color.mix(b.alpha), &b.label)?;
     }
     if !panel.spans.is_empty() {
-        let (y0, y1) = panel.y_range();
         let shade = RGBColor(255, 200, 0).mix(0.3);
-        chart
-            .draw_series(
-                panel
-                    .spans
-                    .iter()
-                    .map(|(a, b)| Rectangle::new([(*a, y0), (*b, y1)], shade.filled())),
-            )
-            .map_err(|e| e.to_string())?
-            .label(panel.span_label.as_str())
-            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
+        shade_spans(
+            chart,
+            &panel.spans,
+            None,
+            (y0, y1),
+            shade,
+            &panel.span_label,
+        )?;
     }
     for f in &panel.faults {
-        let (y0, y1) = panel.y_range();
-        // A fault active from before the data is drawn from the axis' start.
-        let (t0, t1) = panel.t_range();
         let shade = fault_color(f.fault_index).mix(FAULT_ALPHA);
-        chart
-            .draw_series(
-                f.spans
-                    .iter()
-                    .map(|(a, b)| (a.clamp(t0, t1), b.clamp(t0, t1)))
-                    .filter(|(a, b)| a < b)
-                    .map(|(a, b)| Rectangle::new([(a, y0), (b, y1)], shade.filled())),
-            )
-            .map_err(|e| e.to_string())?
-            .label(f.label.as_str())
-            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 20, y + 6)], shade.filled()));
+        shade_spans(chart, &f.spans, t, (y0, y1), shade, &f.label)?;
     }
     // The first line last, on top: where lines coincide (a total dominated by one part) the
     // first one listed stays visible.
