@@ -31,7 +31,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
-use flexdyn_proto::{decode_fsw, DecodeError, FswMsg, Topics, FSW_PREFIX, KEY_ROOT};
+use flexdyn_proto::{decode_fsw, DecodeError, FswMsg, Topics};
 use flexdyn_sinks::recorder::{RecordItem, RecordTx};
 use flexdyn_vehicle::config::fsw::FswStreamDecl;
 use zenoh::pubsub::Subscriber;
@@ -59,33 +59,29 @@ pub(super) struct FswIntake {
 
 impl FswIntake {
     /// The intake of `streams` for the vehicle of `topics`; `lockstep_last_tick`: a lockstep
-    /// run's last tick, if it has one.
+    /// run's last tick, if it has one. (The configuration validated the names, so their keys
+    /// cannot fail.)
     pub(super) fn new(
         topics: &Topics,
         streams: Vec<FswStreamDecl>,
         spacecraft_id: u32,
         frame_ns: u64,
         lockstep_last_tick: Option<u64>,
-    ) -> Self {
+    ) -> Result<Self, ServerError> {
         let keys = streams
             .iter()
-            .map(|s| {
-                Arc::from(format!(
-                    "{KEY_ROOT}/{}/{FSW_PREFIX}/{}",
-                    topics.sc_id(),
-                    s.name
-                ))
-            })
-            .collect();
+            .map(|s| flexdyn_proto::fsw_key(topics.sc_id(), &s.name).map(Arc::from))
+            .collect::<Result<_, _>>()
+            .map_err(|e| ServerError::Internal(format!("a [[fsw_streams]] key: {e}")))?;
         let next_tick = streams.iter().map(|_| AtomicU64::new(0)).collect();
-        Self {
+        Ok(Self {
             streams,
             keys,
             next_tick,
             spacecraft_id,
             frame_ns,
             lockstep_last_tick,
-        }
+        })
     }
 
     /// Checks a sample that arrived on `key` while the server's last tick is `server_tick`:
@@ -259,7 +255,7 @@ mod tests {
         );
         let cfg = SimConfig::from_toml_str(&toml).expect("the test dictionary");
         let topics = Topics::new("sc1").unwrap();
-        FswIntake::new(&topics, cfg.fsw_streams.clone(), 1, FRAME_NS, Some(100))
+        FswIntake::new(&topics, cfg.fsw_streams.clone(), 1, FRAME_NS, Some(100)).unwrap()
     }
 
     fn sample(tick: u64) -> FswMsg {

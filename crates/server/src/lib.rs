@@ -192,7 +192,7 @@ pub async fn run(
             settings.spacecraft_id,
             cfg.frame_ns,
             total_frames.filter(|_| mode == Mode::Lockstep),
-        ),
+        )?,
         shared.clone(),
         record_tx.clone(),
     )

@@ -22,7 +22,10 @@ pub fn declarations(rec: &Recording) -> HashMap<String, FswStreamDecl> {
         match SimConfig::from_toml_str(&v.config_toml) {
             Ok(cfg) => {
                 for decl in cfg.fsw_streams {
-                    out.insert(format!("flexdyn/{}/fsw/{}", v.sc_id, decl.name), decl);
+                    // The configuration validated the names: their keys are there.
+                    if let Ok(key) = flexdyn_proto::fsw_key(&v.sc_id, &decl.name) {
+                        out.insert(key, decl);
+                    }
                 }
             }
             Err(e) => tracing::warn!(

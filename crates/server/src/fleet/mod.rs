@@ -275,7 +275,8 @@ pub async fn run(
                 vs.spacecraft_id,
                 frame_ns,
                 total_frames.filter(|_| mode == Mode::Lockstep),
-            ),
+            )
+            .map_err(named)?,
             sh.clone(),
             record_tx.clone(),
         )
