@@ -788,3 +788,164 @@ fn model_constants_are_dispersed_and_read_back_from_the_model() {
     // Twenty uniform draws on [0.6, 1.8] are not all alike.
     assert!(densities.iter().any(|d| (d - densities[0]).abs() > 0.01));
 }
+
+/// Issue 37 §3: a flight-code criterion names a stream, mode, event, value and fault the base
+/// configuration declares (`scenarios/fdir.toml`'s stream `acs`, its two faults); anything else
+/// is a load error naming the field, its line and what the configuration has.
+#[test]
+fn flight_code_criteria_name_what_the_base_configuration_declares() {
+    use flexdyn_campaign::criteria::{FswTarget, Quantity, Statistic};
+    let base = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/fdir.toml");
+    let head = format!(
+        "base = {:?}\nruns = 2\nseed = 1\nduration_s = 10.0\n",
+        base.display().to_string()
+    );
+    let crit = |body: &str| format!("{head}[[criteria]]\nname = \"c\"\n{body}");
+    let rows: &[(&str, &str, &[&str], &str)] = &[
+        (
+            "quantity = \"fsw_mode_entry\"\nstream = \"adcs\"\nmode = \"pointing\"\nbelow = 1.0\n",
+            "criteria[0].stream",
+            &["\"adcs\" is not a stream the base configuration declares", "acs"],
+            "stream =",
+        ),
+        (
+            "quantity = \"fsw_mode_time\"\nstream = \"acs\"\nmode = \"safe\"\nbelow = 1.0\n",
+            "criteria[0].mode",
+            &["\"safe\" is not a mode of stream \"acs\" (its modes: pointing)"],
+            "mode =",
+        ),
+        (
+            "quantity = \"fsw_event_time\"\nstream = \"acs\"\nevent = \"gyro-fail\"\nbelow = 1.0\n",
+            "criteria[0].event",
+            &["\"gyro-fail\" is not an event", "gyro-failure, wheel-failure"],
+            "event =",
+        ),
+        (
+            "quantity = \"fsw_event_latency\"\nstream = \"acs\"\nevent = \"wheel-failure\"\n\
+             fault = \"faults[2]\"\nbelow = 1.0\n",
+            "criteria[0].fault",
+            &["\"faults[2]\"", "has 2 [[faults]] entries"],
+            "fault =",
+        ),
+        (
+            "quantity = \"fsw_event_latency\"\nstream = \"acs\"\nevent = \"wheel-failure\"\n\
+             fault = \"rw2\"\nbelow = 1.0\n",
+            "criteria[0].fault",
+            &["not of the form \"faults[k]\""],
+            "fault =",
+        ),
+        (
+            "quantity = \"fsw_event_latency\"\nstream = \"acs\"\nevent = \"wheel-failure\"\nbelow = 1.0\n",
+            "criteria[0].fault",
+            &["missing"],
+            "[[criteria]]",
+        ),
+        (
+            "quantity = \"fsw_value\"\nstream = \"acs\"\nvalue = \"rate_b_rad_s[3]\"\n\
+             statistic = \"max\"\nbelow = 1.0\n",
+            "criteria[0].value",
+            &["element 3 of a value of 3"],
+            "value =",
+        ),
+        (
+            "quantity = \"fsw_value\"\nstream = \"acs\"\nvalue = \"rate\"\nstatistic = \"max\"\nbelow = 1.0\n",
+            "criteria[0].value",
+            &["\"rate\" is not a value of stream \"acs\"", "rate_b_rad_s, wheel_momentum_b_nms, fdir_flags"],
+            "value =",
+        ),
+        (
+            "quantity = \"fsw_value\"\nstream = \"acs\"\nvalue = \"rate_b_rad_s\"\nbelow = 1.0\n",
+            "criteria[0].statistic",
+            &["missing", "needs one of"],
+            "quantity =",
+        ),
+        // A vector's length is ≥ 0; one element may be judged against a negative bound.
+        (
+            "quantity = \"fsw_value\"\nstream = \"acs\"\nvalue = \"rate_b_rad_s\"\n\
+             statistic = \"final\"\nbelow = -1.0\n",
+            "criteria[0].below",
+            &["must be > 0", "could never pass"],
+            "below = -1.0",
+        ),
+        (
+            "quantity = \"fsw_event_time\"\nstream = \"acs\"\nevent = \"wheel-failure\"\n\
+             statistic = \"max\"\nbelow = 1.0\n",
+            "criteria[0].statistic",
+            &["does not apply to quantity \"fsw_event_time\"", "one time per run"],
+            "statistic =",
+        ),
+        (
+            "quantity = \"omega\"\nstream = \"acs\"\nstatistic = \"max\"\nbelow = 1.0\n",
+            "criteria[0].stream",
+            &["does not apply to quantity \"omega\""],
+            "stream =",
+        ),
+        (
+            "quantity = \"station_error\"\nstation_h_m = [0.0, -100.0, 0.0]\nstatistic = \"max\"\nbelow = 1.0\n",
+            "criteria[0].quantity",
+            &["a fleet deputy's quantity", "a single spacecraft has no chief"],
+            "quantity =",
+        ),
+        (
+            "quantity = \"fsw_modes\"\nstatistic = \"max\"\nbelow = 1.0\n",
+            "criteria[0].quantity",
+            &["\"fsw_modes\" is not one of", "\"fsw_mode_entry\"", "\"chief_pointing\""],
+            "quantity =",
+        ),
+    ];
+    for (body, field, says, marker) in rows {
+        let text = crit(body);
+        let e = plan_error(&text);
+        let head = format!("test-campaign.toml: {field}: ");
+        assert!(e.starts_with(&head), "{field}: {e}");
+        for w in *says {
+            assert!(e.contains(w), "{field}: no `{w}`: {e}");
+        }
+        let at = format!("line {}, column ", line_of(&text, marker));
+        assert!(e.contains(&at), "{field}: not at {at}: {e}");
+    }
+    // The embedded default declares no stream: said so.
+    let e = plan_error(
+        "runs = 1\nseed = 1\nduration_s = 1.0\n[[criteria]]\nname = \"c\"\n\
+         quantity = \"fsw_event_time\"\nstream = \"acs\"\nevent = \"x\"\nbelow = 1.0\n",
+    );
+    assert!(
+        e.contains("the base configuration has no [[fsw_streams]]"),
+        "{e}"
+    );
+
+    // Valid ones resolve to the declaration's indices.
+    let text = crit(
+        "quantity = \"fsw_event_latency\"\nstream = \"acs\"\nevent = \"wheel-failure\"\n\
+         fault = \"faults[1]\"\nbelow = 1.0\n\
+         [[criteria]]\nname = \"d\"\nquantity = \"fsw_value\"\nstream = \"acs\"\n\
+         value = \"wheel_momentum_b_nms[2]\"\nstatistic = \"max\"\nafter_s = 5.0\nbelow = -0.5\n",
+    );
+    let plan = campaign(&text).unwrap();
+    let c = &plan.campaign.criteria;
+    assert_eq!(
+        (c[0].quantity, c[0].statistic),
+        (Quantity::FswEventLatency, Statistic::Once)
+    );
+    let f = c[0].fsw.as_ref().unwrap();
+    assert_eq!(
+        f.target,
+        FswTarget::Event {
+            index: 1,
+            fault: Some(1)
+        }
+    );
+    assert_eq!(c[0].unit(), "s");
+    let f = c[1].fsw.as_ref().unwrap();
+    assert_eq!(
+        f.target,
+        FswTarget::Value {
+            index: 1,
+            element: Some(2)
+        }
+    );
+    assert_eq!(
+        (c[1].after_s, c[1].below, c[1].unit().as_str()),
+        (5.0, -0.5, "N·m·s")
+    );
+}

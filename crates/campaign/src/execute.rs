@@ -32,8 +32,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use flexdyn_proto::{decode_state, encode, CommandMsg, Header, Mode, StateMsg, Topics};
-use nalgebra::Vector3;
+use flexdyn_proto::{decode_state, encode, CommandMsg, FswMsg, Header, Mode, StateMsg, Topics};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use zenoh::qos::CongestionControl;
@@ -42,10 +41,9 @@ use zenoh::{Session, Wait};
 use super::command::split_command;
 use super::plan::{readback, Plan, RunPlan};
 use super::readback::fleet_readback;
+use super::spec::Campaign;
 pub use super::spec::OBSERVER_ID;
-use super::spec::{Campaign, Criterion, Quantity, Statistic};
 use super::verdict::Outcome;
-use flexdyn_kernel::attitude::mrp_error;
 use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
 use flexdyn_server::{ServerError, ServerSettings};
 use flexdyn_vehicle::config::SimConfig;
@@ -55,20 +53,15 @@ pub const CONTROLLER_ID: u32 = 1;
 /// The spacecraft id of every run (`{sc_id}`); runs are separated by port.
 pub const SC_ID: &str = "sc1";
 
+/// A run's recording, in its folder.
+pub const RECORDING: &str = "recording.mcap";
+
 /// How long after a controller exits 0 the server may still take to end by itself: a
 /// controller that stops on the end-of-run status exits while the server closes its session.
 const EXIT_GRACE: Duration = Duration::from_secs(2);
 
-/// One criterion's outcome.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct CriterionResult {
-    /// Its name.
-    pub name: String,
-    /// The statistic's value.
-    pub value: f64,
-    /// Whether it is below the bound.
-    pub passed: bool,
-}
+pub use super::judge::CriterionResult;
+use super::judge::{evaluate, evaluate_fsw, reduce, relative_series};
 
 /// What one run did (`run-NNNN/result.json`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -126,71 +119,6 @@ pub struct RunOptions {
     pub base_port: u16,
     /// Record each run to `run-NNNN/recording.mcap`.
     pub record: bool,
-}
-
-fn quantity(q: Quantity, s: &StateMsg, sigma_rn: &Vector3<f64>) -> f64 {
-    match q {
-        Quantity::SigmaBr => mrp_error(&Vector3::from(s.sigma_bn), sigma_rn).norm(),
-        Quantity::SigmaBn => Vector3::from(s.sigma_bn).norm(),
-        Quantity::Omega => Vector3::from(s.omega_bn_b_rad_s).norm(),
-        Quantity::Theta => s
-            .effectors
-            .iter()
-            .filter(|e| e.kind == flexdyn_proto::effector_kind::PANEL_PAIR)
-            .flat_map(|e| [e.states.first(), e.states.get(2)])
-            .flatten()
-            .fold(0.0f64, |m, x| m.max(x.abs())),
-        // Not in a StateMsg: read from the deputy's RelativeStateMsg stream instead.
-        Quantity::Range => f64::NAN,
-    }
-}
-
-/// Evaluates `c` over `states` (in tick order).
-pub fn evaluate(
-    c: &Criterion,
-    states: &[StateMsg],
-    sigma_rn: [f64; 3],
-    frame_s: f64,
-) -> CriterionResult {
-    let target = Vector3::from(sigma_rn);
-    let series: Vec<(f64, f64)> = states
-        .iter()
-        .map(|s| {
-            (
-                s.header.sim_time_ns as f64 * 1e-9,
-                quantity(c.quantity, s, &target),
-            )
-        })
-        .collect();
-    reduce(c, &series, frame_s)
-}
-
-/// `c`'s statistic over `series` ((t \[s\], value) in time order) and whether it passes.
-pub fn reduce(c: &Criterion, series: &[(f64, f64)], frame_s: f64) -> CriterionResult {
-    let value = match c.statistic {
-        Statistic::Final => series.last().map_or(f64::NAN, |(_, v)| *v),
-        Statistic::Max => series
-            .iter()
-            .filter(|(t, _)| *t >= c.after_s - 1e-9)
-            .fold(f64::NEG_INFINITY, |m, (_, v)| m.max(*v)),
-        Statistic::SettlingTime { threshold } => {
-            // The first time after which every sample stays below the threshold.
-            // NaN counts as outside the band.
-            let last_out = series
-                .iter()
-                .rposition(|(_, v)| v.is_nan() || *v >= threshold);
-            match last_out {
-                None => series.first().map_or(f64::NAN, |(t, _)| *t),
-                Some(i) if i + 1 < series.len() => series[i + 1].0,
-                Some(i) => series[i].0 + frame_s,
-            }
-        }
-    };
-    CriterionResult {
-        name: c.name.clone(),
-        value,
-        passed: value < c.below,
-    }
 }
 
 /// Every (tick, StateMsg payload) the observer received.
@@ -497,7 +425,10 @@ fn lockstep_settings(c: &Campaign, opts: &RunOptions, run_dir: &Path) -> ServerS
         presence_timeout: Duration::from_secs_f64(c.participant_timeout_s.max(10.0)),
         duration_ns: Some(c.duration_ns),
         summary_interval: Duration::from_secs(3600),
-        record: opts.record.then(|| run_dir.join("recording.mcap")),
+        // The flight code's telemetry is judged from the recording (the observer, a peer of the
+        // server, does not hear the controller's samples).
+        record: (opts.record || c.criteria.iter().any(|k| k.fsw.is_some()))
+            .then(|| run_dir.join(RECORDING)),
         ..ServerSettings::default()
     }
 }
@@ -828,12 +759,70 @@ fn run_inner(
     result.fault_activations_ns = first_activations("", &observed.faults[0]);
     result.sim_s = observed.sim_time_ns as f64 * 1e-9;
     let decoded = decode_states(states);
+    let fsw = recorded_fsw(c, run_dir, &[(SC_ID, None)])?;
     result.criteria = c
         .criteria
         .iter()
-        .map(|k| evaluate(k, &decoded, c.sigma_rn, frame_s))
+        .map(|k| match &k.fsw {
+            Some(f) => evaluate_fsw(
+                k,
+                fsw.get(&(SC_ID.to_owned(), f.decl.name.clone()))
+                    .map_or(&[][..], Vec::as_slice),
+                &result.fault_activations_ns,
+                "",
+                observed.sim_time_ns,
+                frame_s,
+            ),
+            None => evaluate(k, &decoded, c.sigma_rn, frame_s),
+        })
         .collect();
     Ok(())
+}
+
+/// The flight code's samples of every stream a criterion reads, from the run's recording, by
+/// (spacecraft id, stream), in tick order. `vehicles` are the recording's spacecraft ids with
+/// their vehicle (`None`: the one spacecraft). The recording holds what the server accepted:
+/// a refused sample is not there, so the criteria judge what the server recorded.
+fn recorded_fsw(
+    c: &Campaign,
+    run_dir: &Path,
+    vehicles: &[(&str, Option<&str>)],
+) -> Result<BTreeMap<(String, String), Vec<FswMsg>>, String> {
+    let mut keys = BTreeMap::new();
+    for k in &c.criteria {
+        let Some(f) = &k.fsw else { continue };
+        for (sc, vehicle) in vehicles {
+            if *vehicle == k.vehicle.as_deref() {
+                let key = flexdyn_proto::fsw_key(sc, &f.decl.name).map_err(|e| e.to_string())?;
+                keys.insert(key, ((*sc).to_owned(), f.decl.name.clone()));
+            }
+        }
+    }
+    let mut out: BTreeMap<(String, String), Vec<FswMsg>> = BTreeMap::new();
+    if keys.is_empty() {
+        return Ok(out);
+    }
+    let path = run_dir.join(RECORDING);
+    let rec = flexdyn_sinks::reader::read_recording(&path)
+        .map_err(|e| format!("the flight-code criteria read the run's recording: {e}"))?;
+    if let Some(why) = &rec.truncated {
+        return Err(format!("{} is cut short: {why}", path.display()));
+    }
+    for v in keys.values() {
+        out.entry(v.clone()).or_default();
+    }
+    for sample in &rec.samples {
+        if let Some(id) = keys.get(&sample.key) {
+            let msg = flexdyn_proto::decode_fsw(&sample.payload).map_err(|e| {
+                format!("{}: a recorded {} sample: {e}", path.display(), sample.key)
+            })?;
+            out.entry(id.clone()).or_default().push(msg);
+        }
+    }
+    for samples in out.values_mut() {
+        samples.sort_by_key(|m| m.header.tick);
+    }
+    Ok(out)
 }
 
 /// [`run_inner`] over a fleet.
@@ -856,7 +845,7 @@ fn run_fleet(
         let ranged = c
             .criteria
             .iter()
-            .any(|k| k.quantity == Quantity::Range && k.vehicle.as_deref() == Some(&v.id));
+            .any(|k| k.quantity.is_relative() && k.vehicle.as_deref() == Some(&v.id));
         if let (Some(ci), true) = (v.chief, ranged) {
             let key = Topics::new(&v.id)
                 .and_then(|t| t.relative_state(&fleet.vehicles[ci].id))
@@ -865,6 +854,12 @@ fn run_fleet(
         }
         observe.push((v.id.clone(), relative));
     }
+    // Each deputy's chief, by id (`chief_pointing` reads the chief's states).
+    let chiefs: Vec<(String, String)> = fleet
+        .vehicles
+        .iter()
+        .filter_map(|v| Some((v.id.clone(), fleet.vehicles[v.chief?].id.clone())))
+        .collect();
     // The observer answers every vehicle's ticks.
     for v in &mut fleet.vehicles {
         if !v.participants.contains(&OBSERVER_ID) {
@@ -905,7 +900,7 @@ fn run_fleet(
     result.states = observed.states.first().map_or(0, |s| s.len() as u64);
     result.sim_s = observed.sim_time_ns as f64 * 1e-9;
     let mut decoded = BTreeMap::new();
-    let mut ranges = BTreeMap::new();
+    let mut relatives = BTreeMap::new();
     for ((((id, _), states), relative), faults) in observe
         .iter()
         .zip(&observed.states)
@@ -920,29 +915,49 @@ fn run_fleet(
             .extend(first_activations(&format!("{id}."), faults));
         decoded.insert(id.as_str(), decode_states(states));
         if let Some(r) = relative.first() {
-            let series: Vec<(f64, f64)> = r
+            let msgs: Vec<_> = r
                 .iter()
                 .filter_map(|(_, p)| flexdyn_proto::decode_relative_state(p).ok())
-                .map(|m| (m.header.sim_time_ns as f64 * 1e-9, m.range_m))
                 .collect();
-            ranges.insert(id.as_str(), series);
+            relatives.insert(id.as_str(), msgs);
         }
     }
+    let chief_of: BTreeMap<&str, &str> = chiefs
+        .iter()
+        .map(|(d, ch)| (d.as_str(), ch.as_str()))
+        .collect();
+    let ids: Vec<(&str, Option<&str>)> = observe
+        .iter()
+        .map(|(id, _)| (id.as_str(), Some(id.as_str())))
+        .collect();
+    let fsw = recorded_fsw(c, run_dir, &ids)?;
+    let none: &[StateMsg] = &[];
     result.criteria = c
         .criteria
         .iter()
         .map(|k| {
             let id = k.vehicle.as_deref().unwrap_or_default();
-            match k.quantity {
-                Quantity::Range => {
-                    reduce(k, ranges.get(id).map_or(&[][..], Vec::as_slice), frame_s)
-                }
-                _ => evaluate(
+            let states = |v: &str| decoded.get(v).map_or(none, Vec::as_slice);
+            match (&k.fsw, k.quantity.is_relative()) {
+                (Some(f), _) => evaluate_fsw(
                     k,
-                    decoded.get(id).map_or(&[][..], Vec::as_slice),
-                    c.sigma_rn,
+                    fsw.get(&(id.to_owned(), f.decl.name.clone()))
+                        .map_or(&[][..], Vec::as_slice),
+                    &result.fault_activations_ns,
+                    &format!("{id}."),
+                    observed.sim_time_ns,
                     frame_s,
                 ),
+                (None, true) => {
+                    let series = relative_series(
+                        k,
+                        relatives.get(id).map_or(&[][..], Vec::as_slice),
+                        states(id),
+                        chief_of.get(id).map_or(none, |ch| states(ch)),
+                    );
+                    reduce(k, &series, frame_s)
+                }
+                (None, false) => evaluate(k, states(id), c.sigma_rn, frame_s),
             }
         })
         .collect();
@@ -1119,49 +1134,5 @@ mod tests {
             let line = p.record(Outcome::Passed, at(12.0 + f64::from(k) * 0.01));
             assert_eq!(line.is_some(), k % 2 == 0 || k == 20, "{k}: {line:?}");
         }
-    }
-
-    #[test]
-    fn statistics_follow_their_definitions() {
-        let states: Vec<StateMsg> = [0.3, 0.2, 0.05, 0.2, 0.01, 0.005]
-            .iter()
-            .enumerate()
-            .map(|(i, s)| StateMsg {
-                header: Header::new(1, i as u64, i as u64 * 1_000_000_000, i as u64),
-                sigma_bn: [*s, 0.0, 0.0],
-                ..StateMsg::default()
-            })
-            .collect();
-        let c = |statistic, after_s, below| Criterion {
-            name: "x".into(),
-            quantity: Quantity::SigmaBn,
-            statistic,
-            after_s,
-            below,
-            vehicle: None,
-        };
-        let r = evaluate(&c(Statistic::Final, 0.0, 0.01), &states, [0.0; 3], 1.0);
-        assert_eq!((r.value, r.passed), (0.005, true));
-        let r = evaluate(&c(Statistic::Max, 2.0, 0.1), &states, [0.0; 3], 1.0);
-        assert_eq!((r.value, r.passed), (0.2, false));
-        // Below 0.1 from t = 4 s on (t = 2 s dips but t = 3 s goes back up).
-        let r = evaluate(
-            &c(Statistic::SettlingTime { threshold: 0.1 }, 0.0, 5.0),
-            &states,
-            [0.0; 3],
-            1.0,
-        );
-        assert_eq!((r.value, r.passed), (4.0, true));
-        // |σ_BR| to a target equal to the state is 0.
-        let r = evaluate(
-            &Criterion {
-                quantity: Quantity::SigmaBr,
-                ..c(Statistic::Final, 0.0, 1e-12)
-            },
-            &states,
-            [0.005, 0.0, 0.0],
-            1.0,
-        );
-        assert!(r.value < 1e-15 && r.passed, "{r:?}");
     }
 }

@@ -25,8 +25,10 @@
 #![warn(missing_docs)]
 
 pub mod command;
+pub mod criteria;
 pub mod execute;
 pub mod fleet;
+pub mod judge;
 pub mod keys;
 pub mod plan;
 pub mod readback;

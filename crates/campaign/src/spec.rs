@@ -93,66 +93,7 @@ pub struct Dispersion {
     pub vehicle: Option<String>,
 }
 
-/// What a criterion measures at each state.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Quantity {
-    /// |σ_BR|, the attitude error to the campaign's `sigma_rn` (MRP, –).
-    SigmaBr,
-    /// |σ_BN| (–).
-    SigmaBn,
-    /// |ω_BN| (rad/s).
-    Omega,
-    /// The largest |θ1|, |θ2| over every panel pair (rad).
-    Theta,
-    /// A fleet deputy's range to its chief (m), from the RelativeStateMsg the server publishes.
-    Range,
-}
-
-/// How a criterion reduces the quantity over time.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Statistic {
-    /// The value at the last state.
-    Final,
-    /// The maximum over the states at or after `after_s`.
-    Max,
-    /// The time (s) after which the quantity stays below `threshold` to the end; the run's
-    /// duration + 1 frame if it never settles.
-    SettlingTime {
-        /// The settling band.
-        threshold: f64,
-    },
-}
-
-/// One `[[criteria]]` entry: passes when the statistic is below `below`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Criterion {
-    /// Unique name (a column of `summary.csv`).
-    pub name: String,
-    /// The quantity.
-    pub quantity: Quantity,
-    /// The reduction.
-    pub statistic: Statistic,
-    /// \[s\] the window starts here (for `max`; default 0).
-    pub after_s: f64,
-    /// Pass if the statistic is strictly below this.
-    pub below: f64,
-    /// The vehicle whose states it judges (a fleet campaign's; `None` otherwise).
-    pub vehicle: Option<String>,
-}
-
-impl Criterion {
-    /// The unit of the criterion's value (its figures' axis): seconds for a settling time,
-    /// else the quantity's (`–` for an MRP norm).
-    pub fn unit(&self) -> &'static str {
-        match (self.statistic, self.quantity) {
-            (Statistic::SettlingTime { .. }, _) => "s",
-            (_, Quantity::Omega) => "rad/s",
-            (_, Quantity::Theta) => "rad",
-            (_, Quantity::Range) => "m",
-            (_, Quantity::SigmaBr | Quantity::SigmaBn) => "–",
-        }
-    }
-}
+pub use super::criteria::{Criterion, FswRef, FswTarget, Quantity, Statistic};
 
 /// A validated campaign.
 #[derive(Clone, Debug)]
@@ -428,10 +369,10 @@ impl Campaign {
             None => None,
         };
         // The frame every run is a whole number of (a fleet's vehicles share theirs).
-        let (base_toml, frame_ns, frame_hz) = match &fleet {
+        let (base_toml, frame_ns, frame_hz, base) = match &fleet {
             Some(f) => {
                 let first = &f.config.vehicles[0].cfg;
-                (String::new(), first.frame_ns, first.frame_hz)
+                (String::new(), first.frame_ns, first.frame_hz, None)
             }
             None => {
                 let base_toml = match &base_path {
@@ -452,7 +393,7 @@ impl Campaign {
                     }
                 })?;
                 log_warnings(&base, base_path.as_deref());
-                (base_toml, base.frame_ns, base.frame_hz)
+                (base_toml, base.frame_ns, base.frame_hz, Some(base))
             }
         };
         let runs = root.int_in("runs", 1, 1_000_000).map_err(schema)? as u32;
@@ -615,146 +556,27 @@ impl Campaign {
             });
         }
 
-        let mut criteria: Vec<Criterion> = Vec::new();
         let tables = root
-            .tables(
-                "criteria",
-                &[
-                    "name",
-                    "quantity",
-                    "statistic",
-                    "after_s",
-                    "below",
-                    "threshold",
-                    "vehicle",
-                ],
-            )
+            .tables("criteria", &super::criteria::criterion_keys())
             .map_err(schema)?
             .unwrap_or_default();
-        for (i, t) in tables.iter().enumerate() {
-            let field = |k: &str| format!("criteria[{i}].{k}");
-            let name = t.string("name").map_err(schema)?;
-            if name.is_empty() || name.contains([',', '"', '\n']) {
-                return Err(invalid(
-                    &field("name"),
-                    "must be non-empty, without commas, quotes or newlines".into(),
-                ));
-            }
-            if criteria.iter().any(|c| c.name == name) {
-                return Err(invalid(&field("name"), format!("{name:?} is used twice")));
-            }
-            let vehicle = entry_vehicle(
+        let cx = super::criteria::Context {
+            source,
+            path,
+            fleet: fleet.as_ref(),
+            base: base.as_ref(),
+            duration_s,
+        };
+        let criteria = super::criteria::read(&tables, &cx, &|t, i| {
+            entry_vehicle(
                 t,
                 fleet.as_ref(),
                 &format!("criteria[{i}]"),
                 "name",
                 source,
                 path,
-            )?;
-            let quantity = match t.string("quantity").map_err(schema)?.as_str() {
-                "sigma_br" => Quantity::SigmaBr,
-                "sigma_bn" => Quantity::SigmaBn,
-                "omega" => Quantity::Omega,
-                "theta" => Quantity::Theta,
-                "range" => Quantity::Range,
-                other => {
-                    return Err(invalid(
-                        &field("quantity"),
-                        format!(
-                            "{other:?} is not one of \"sigma_br\", \"sigma_bn\", \"omega\", \
-                             \"theta\", \"range\" (a fleet's deputy)"
-                        ),
-                    ))
-                }
-            };
-            if quantity == Quantity::Range {
-                // A deputy's distance to its chief: only a vehicle given relative to one has it.
-                let deputy = fleet
-                    .as_ref()
-                    .zip(vehicle.as_deref())
-                    .and_then(|(f, id)| f.vehicle(id))
-                    .is_some_and(|v| v.chief.is_some());
-                if !deputy {
-                    return Err(invalid(
-                        &field("quantity"),
-                        format!(
-                            "range is a fleet deputy's distance to its chief, and {} has no chief \
-                             ([vehicles.relative] in the fleet file)",
-                            vehicle
-                                .as_ref()
-                                .map_or("a single spacecraft".to_owned(), |v| format!("{v:?}"))
-                        ),
-                    ));
-                }
-            }
-            let stat = t.string("statistic").map_err(schema)?;
-            let threshold = t.opt_f64("threshold").map_err(schema)?;
-            let statistic = match (stat.as_str(), threshold) {
-                ("final", None) => Statistic::Final,
-                ("max", None) => Statistic::Max,
-                ("settling_time", Some(threshold)) if threshold > 0.0 => {
-                    Statistic::SettlingTime { threshold }
-                }
-                ("settling_time", _) => {
-                    return Err(invalid(
-                        &field("threshold"),
-                        "settling_time needs a threshold > 0".into(),
-                    ))
-                }
-                ("final" | "max", Some(_)) => {
-                    return Err(invalid(
-                        &field("threshold"),
-                        format!("does not apply to statistic {stat:?}"),
-                    ))
-                }
-                (other, _) => {
-                    return Err(invalid(
-                        &field("statistic"),
-                        format!("{other:?} is not one of \"final\", \"max\", \"settling_time\""),
-                    ))
-                }
-            };
-            let after_s = t.opt_f64("after_s").map_err(schema)?;
-            if after_s.is_some() && statistic != Statistic::Max {
-                // Only `max` has a window; elsewhere the key would be silently ignored.
-                return Err(invalid(
-                    &field("after_s"),
-                    format!("does not apply to statistic {stat:?} (only \"max\" has a window)"),
-                ));
-            }
-            let after_s = after_s.unwrap_or(0.0);
-            if !(0.0..=duration_s).contains(&after_s) {
-                return Err(invalid(
-                    &field("after_s"),
-                    format!(
-                        "must be within 0..=duration_s ({}), got {}",
-                        Num(duration_s),
-                        Num(after_s)
-                    ),
-                ));
-            }
-            let below = t.f64("below").map_err(schema)?;
-            if below <= 0.0 {
-                // Every quantity is a magnitude or a time (≥ 0), and a criterion passes when
-                // its statistic is strictly below `below`.
-                return Err(invalid(
-                    &field("below"),
-                    format!(
-                        "must be > 0, got {}: every quantity is ≥ 0, so the criterion could never \
-                         pass",
-                        Num(below)
-                    ),
-                ));
-            }
-            criteria.push(Criterion {
-                name,
-                quantity,
-                statistic,
-                after_s,
-                below,
-                vehicle,
-            });
-        }
+            )
+        })?;
         Ok(Self {
             path: path.to_owned(),
             source: source.to_owned(),
@@ -1026,7 +848,7 @@ fn within_time(field: &str, seconds: f64) -> Result<u64, String> {
 }
 
 /// An error about `field` of the campaign file `path` (text `source`), with its position.
-fn invalid_at(source: &str, path: &Path, field: &str, problem: String) -> CampaignError {
+pub(crate) fn invalid_at(source: &str, path: &Path, field: &str, problem: String) -> CampaignError {
     CampaignError::Invalid {
         path: path.to_owned(),
         field: field.to_owned(),

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
-use super::execute::RunResult;
+use super::execute::{CriterionResult, RunResult};
 use super::plan::RunPlan;
 use super::verdict::{Outcome, Verdict};
 
@@ -205,6 +205,8 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
         }
         for c in &criteria {
             match r.and_then(|r| r.criteria.iter().find(|x| &x.name == c)) {
+                // No value (a mode never entered, a latency that does not apply): empty.
+                Some(x) if x.value.is_nan() => write!(csv, ",,{}", x.passed).ok(),
                 Some(x) => write!(csv, ",{},{}", x.value, x.passed).ok(),
                 None => write!(csv, ",,").ok(),
             };
@@ -297,29 +299,69 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
     for (run, why) in &s.failed {
         writeln!(t, "failed run {run}: {why}").ok();
     }
-    for c in &criteria {
-        let mut v: Vec<(u32, f64, bool)> = results
+    let struck = |run: u32| {
+        plans
             .iter()
-            .filter_map(|r| {
-                r.criteria
-                    .iter()
-                    .find(|x| &x.name == c)
-                    .map(|x| (r.run, x.value, x.passed))
-            })
+            .find(|p| p.run == run)
+            .is_some_and(|p| random_faults.iter().any(|k| failure_in_run(p, k).is_some()))
+    };
+    for c in &criteria {
+        let judged: Vec<(u32, &CriterionResult)> = results
+            .iter()
+            .filter_map(|r| r.criteria.iter().find(|x| &x.name == c).map(|x| (r.run, x)))
             .collect();
-        v.sort_by(|a, b| b.1.total_cmp(&a.1));
+        // Worst first: no value (never entered, never raised) before the largest.
+        let mut v: Vec<&(u32, &CriterionResult)> =
+            judged.iter().filter(|(_, x)| x.applies).collect();
+        v.sort_by(|a, b| b.1.value.total_cmp(&a.1.value));
         let worst: Vec<String> = v
             .iter()
             .take(3)
-            .map(|(r, x, p)| format!("run {r}: {x:.6e}{}", if *p { "" } else { " (fail)" }))
+            .map(|(r, x)| {
+                let value = if x.value.is_nan() {
+                    format!("none ({})", x.note.as_deref().unwrap_or("no value"))
+                } else {
+                    format!("{:.6e}", x.value)
+                };
+                format!("run {r}: {value}{}", if x.passed { "" } else { " (fail)" })
+            })
             .collect();
-        let fails = v.iter().filter(|x| !x.2).count();
+        let fails = v.iter().filter(|x| !x.1.passed).count();
         writeln!(
             t,
             "criterion {c}: {fails} failing; worst: {}",
             worst.join(", ")
         )
         .ok();
+        // Its own pass rate over the runs it was judged in and applies to, split like the
+        // campaign's when there are random faults.
+        let rate = |group: &dyn Fn(u32) -> bool| {
+            let n = v.iter().filter(|(r, _)| group(*r)).count() as u32;
+            let k = v.iter().filter(|(r, x)| group(*r) && x.passed).count() as u32;
+            if n == 0 {
+                "no run judged".to_owned()
+            } else {
+                rate_line(k, n)
+            }
+        };
+        let skipped = judged.len() - v.len();
+        let skipped = if skipped > 0 {
+            let why = judged
+                .iter()
+                .find_map(|(_, x)| x.note.as_deref().filter(|_| !x.applies))
+                .unwrap_or("");
+            format!(
+                " (does not apply to {skipped} run{}: {why})",
+                if skipped == 1 { "" } else { "s" }
+            )
+        } else {
+            String::new()
+        };
+        writeln!(t, "  {}{skipped}", rate(&|_| true)).ok();
+        if !random_faults.is_empty() {
+            writeln!(t, "  runs with a random failure: {}", rate(&struck)).ok();
+            writeln!(t, "  runs without: {}", rate(&|r| !struck(r))).ok();
+        }
     }
     let text_path = dir.join("summary.txt");
     std::fs::write(&text_path, &t).map_err(|e| io(&text_path, e))?;
@@ -637,10 +679,12 @@ mod tests {
                 vehicle_state_sha256: BTreeMap::new(),
                 states: 1,
                 fault_activations_ns: BTreeMap::new(),
-                criteria: vec![super::super::execute::CriterionResult {
+                criteria: vec![CriterionResult {
                     name: "settle".into(),
                     value: *settle,
                     passed: *settle < 5.0,
+                    applies: true,
+                    note: None,
                 }],
                 passed: *settle < 5.0,
                 outcome: if *settle < 5.0 {
