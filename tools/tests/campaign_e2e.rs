@@ -68,10 +68,7 @@ below = 1e-12
     (file, dir.join("out"))
 }
 
-fn result(dir: &Path, run: u32) -> RunResult {
-    let p = dir.join(format!("run-{run:04}/result.json"));
-    serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap()
-}
+use crate::support::campaign_result as result;
 
 fn demo_line() -> String {
     format!(

@@ -11,6 +11,9 @@
 //!   rounding at |r| ≈ 1e7 m, 1e-6 m allowed) and at most 2 m more (3 s of a PD law at
 //!   ω_c = 0.1 rad/s from a 6 m error moves the deputy less than ½·ω_c²·e0·t² ≈ 0.3 m);
 //!   an impossible criterion fails every run: exit code 3;
+//! - a deputy's station-keeping error in the chief's Hill frame (its maximum includes the
+//!   initial offset read back from the model) and its pointing at the chief (recomputed from the
+//!   run's recording);
 //! - `summary.csv` has one row per run, a hash column per vehicle and the dispersed columns
 //!   named `<vehicle>.<key>`;
 //! - run 2 rerun alone with `--index` gives the same hash for each vehicle.
@@ -100,6 +103,24 @@ quantity = "range"
 statistic = "max"
 below = 150.0
 
+# Issue 37 §3: the deputy's station-keeping error against its station (0, −100, 0) m in the
+# chief's Hill frame, and the angle between its body axis y_B and the direction to the chief.
+[[criteria]]
+vehicle = "deputy"
+name = "deputy_station_error"
+quantity = "station_error"
+station_h_m = [0.0, -100.0, 0.0]
+statistic = "max"
+below = 50.0
+
+[[criteria]]
+vehicle = "deputy"
+name = "deputy_points_at_chief"
+quantity = "chief_pointing"
+axis_b = [0.0, 2.0, 0.0]
+statistic = "final"
+below = 3.2
+
 # The deputy cannot be within a metre of the chief: fails in every run.
 [[criteria]]
 vehicle = "deputy"
@@ -116,10 +137,7 @@ below = 1.0
     (file, dir.join("out"))
 }
 
-fn result(dir: &Path, run: u32) -> RunResult {
-    let p = dir.join(format!("run-{run:04}/result.json"));
-    serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap()
-}
+use crate::support::campaign_result as result;
 
 fn run(
     file: &Path,
@@ -132,7 +150,7 @@ fn run(
         output: out.to_owned(),
         jobs,
         index,
-        record: false,
+        record: true,
         base_port: 0,
         without_random_faults: false,
     })
@@ -196,6 +214,30 @@ fn a_formation_campaign_runs_a_controller_per_vehicle_and_judges_each_vehicle() 
             "run {}: max range {} against the initial {rho0}",
             r.run,
             range.value
+        );
+        // The station error's maximum includes t = 0: |ρ0 − station|, and the 3 s move it
+        // by less than the range (above).
+        let e0: f64 = (0..3)
+            .map(|i| {
+                let station = [0.0, -100.0, 0.0][i];
+                (r.applied[&format!("deputy.relative.hill_position_m[{i}]")] - station).powi(2)
+            })
+            .sum::<f64>()
+            .sqrt();
+        let station = by_name("deputy_station_error");
+        assert!(
+            station.value >= e0 - 1e-6 && station.value < e0 + 2.0 && station.passed,
+            "run {}: max station error {} against the initial {e0}",
+            r.run,
+            station.value
+        );
+        let pointing = by_name("deputy_points_at_chief");
+        let want = pointing_from_recording(&out, r.run);
+        assert!(
+            (pointing.value - want).abs() < 1e-9 && pointing.passed,
+            "run {}: {} against {want} from the recording",
+            r.run,
+            pointing.value
         );
         let impossible = by_name("impossible_range");
         assert!(
@@ -268,4 +310,74 @@ fn a_formation_campaign_runs_a_controller_per_vehicle_and_judges_each_vehicle() 
         results[2].vehicle_state_sha256
     );
     assert!(!again.join("run-0001/result.json").exists());
+}
+
+/// The angle \[rad\] between the deputy's y_B and the direction to the chief at the run's last
+/// recorded tick, from its recording alone: the chief's Hill frame from its state (x̂ = r/|r|,
+/// ẑ = r × v/|r × v|, ŷ = ẑ × x̂), the direction −r_dc (RelativeStateMsg) in N, then in B
+/// through [BN] of the deputy's σ_BN (Schaub & Junkins eq. 3.153: [BN] = I + (8[σ̃]² −
+/// 4(1 − σ²)[σ̃])/(1 + σ²)²), and the angle from the normalised dot product.
+fn pointing_from_recording(out: &Path, run: u32) -> f64 {
+    use nalgebra::{Matrix3, Vector3};
+    let bytes = std::fs::read(out.join(format!("run-{run:04}/recording.mcap"))).unwrap();
+    let relative_topic = flexdyn_proto::Topics::new("deputy")
+        .unwrap()
+        .relative_state("chief")
+        .unwrap();
+    let (mut chief, mut deputy, mut rel) = (None, None, None);
+    let newest = |slot: &mut Option<(u64, Vec<u8>)>, tick: u64, data: &[u8]| {
+        if slot.as_ref().is_none_or(|(t, _)| tick > *t) {
+            *slot = Some((tick, data.to_vec()));
+        }
+    };
+    let chief_topic = flexdyn_proto::Topics::new("chief")
+        .unwrap()
+        .state()
+        .to_owned();
+    let deputy_topic = flexdyn_proto::Topics::new("deputy")
+        .unwrap()
+        .state()
+        .to_owned();
+    for m in mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(Result::unwrap)
+    {
+        if m.channel.topic == chief_topic {
+            let t = flexdyn_proto::decode_state(&m.data).unwrap().header.tick;
+            newest(&mut chief, t, &m.data);
+        } else if m.channel.topic == deputy_topic {
+            let t = flexdyn_proto::decode_state(&m.data).unwrap().header.tick;
+            newest(&mut deputy, t, &m.data);
+        } else if m.channel.topic == relative_topic {
+            let t = flexdyn_proto::decode_relative_state(&m.data)
+                .unwrap()
+                .header
+                .tick;
+            newest(&mut rel, t, &m.data);
+        }
+    }
+    let (chief, deputy, rel) = (chief.unwrap(), deputy.unwrap(), rel.unwrap());
+    assert!(
+        chief.0 == 300 && deputy.0 == 300 && rel.0 == 300,
+        "the last tick, 3 s at 100 Hz"
+    );
+    let chief = flexdyn_proto::decode_state(&chief.1).unwrap();
+    let deputy = flexdyn_proto::decode_state(&deputy.1).unwrap();
+    let rel = flexdyn_proto::decode_relative_state(&rel.1).unwrap();
+    let (r, v) = (
+        Vector3::from(chief.r_bn_n_m),
+        Vector3::from(chief.v_bn_n_m_s),
+    );
+    let x = r.normalize();
+    let z = r.cross(&v).normalize();
+    let y = z.cross(&x);
+    let rho = Vector3::from(rel.r_dc_h_m);
+    let to_chief_n = -(x * rho[0] + y * rho[1] + z * rho[2]);
+    let s = Vector3::from(deputy.sigma_bn);
+    let tilde = Matrix3::new(0.0, -s[2], s[1], s[2], 0.0, -s[0], -s[1], s[0], 0.0);
+    let s2 = s.norm_squared();
+    let c_bn =
+        Matrix3::identity() + (8.0 * tilde * tilde - 4.0 * (1.0 - s2) * tilde) / (1.0 + s2).powi(2);
+    let d_b = (c_bn * to_chief_n).normalize();
+    d_b[1].clamp(-1.0, 1.0).acos()
 }

@@ -11,6 +11,7 @@ mod support;
 mod acs_sequence;
 mod campaign_e2e;
 mod campaign_fleet_e2e;
+mod campaign_fsw;
 mod cli_errors;
 mod demo_complete_ticks;
 mod e2e_lockstep;
