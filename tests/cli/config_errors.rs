@@ -194,6 +194,7 @@ fn every_shipped_scenario_is_valid() {
             "damped_wing",
             "eight_pairs",
             "fdir",
+            "fdir_campaign",
             "folded_wing",
             "formation",
             "formation_campaign",
