@@ -8,7 +8,10 @@
 //!    default: the Zenoh thread that delivers the answer steps and publishes) and once with
 //!    `handoff = "thread"` (the previous design: physics thread + telemetry thread), so the
 //!    before and after are measured side by side;
-//! 3. lockstep with the reference configuration (100 Hz frames, 10 RK4 steps per frame), direct.
+//! 3. lockstep with the reference configuration (100 Hz frames, 10 RK4 steps per frame), direct;
+//! 4. case 2, direct, with the demo publishing the flight code's telemetry every tick (a declared
+//!    `[[fsw_streams]]`: one FswMsg per tick, 1 kHz), against case 2 without it in the same
+//!    round: what the telemetry intake costs the loop (issue 37).
 //!
 //! It prints each round and the medians: round trips/s, ticks/s, and the median of the per-round
 //! ratios (target ≥ 0.95 × the ping-pong for the one-step case, where the link dominates).
@@ -46,9 +49,39 @@ fn pingpong_rate(ticks: usize, recv_loop: bool) -> f64 {
     ticks as f64 / total.as_secs_f64()
 }
 
+/// The flight code's telemetry stream the demo publishes when the configuration declares it
+/// (`flexdyn_acs_demo::telemetry`: its estimate and target, its control rate, its wheel
+/// momentum), one FswMsg per answered tick.
+const FSW_STREAM: &str = "
+[[fsw_streams]]
+name = \"acs\"
+modes = [\"pointing\"]
+values = [
+  { name = \"rate_b_rad_s\", type = \"f64\", len = 3, unit = \"rad/s\" },
+  { name = \"wheel_momentum_b_nms\", type = \"f64\", len = 3, unit = \"N·m·s\" },
+]
+";
+
 /// Ticks per second of a lockstep run of `ticks` frames at `frame_hz` with the demo controller.
 fn lockstep_rate(ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
-    let cfg = reference_config(frame_hz);
+    lockstep_rate_of(ticks, reference_config(frame_hz), handoff, false)
+}
+
+/// [`lockstep_rate`] with the demo publishing its telemetry every tick ([`FSW_STREAM`]).
+fn lockstep_rate_with_telemetry(ticks: usize, frame_hz: f64) -> f64 {
+    let text = flexdyn_vehicle::config::DEFAULT_CONFIG_TOML
+        .replace("frame_hz = 100.0 ", &format!("frame_hz = {frame_hz:?} "));
+    let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(&format!("{text}{FSW_STREAM}"))
+        .expect("the reference spacecraft with a telemetry stream");
+    lockstep_rate_of(ticks, cfg, Handoff::Direct, true)
+}
+
+fn lockstep_rate_of(
+    ticks: usize,
+    cfg: flexdyn_vehicle::config::SimConfig,
+    handoff: Handoff,
+    expect_telemetry: bool,
+) -> f64 {
     let settings = ServerSettings {
         mode: Mode::Lockstep,
         handoff,
@@ -70,6 +103,15 @@ fn lockstep_rate(ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
         "truth",
     ]));
     let report = server.join(Duration::from_secs(300)).expect("lockstep run");
+    if expect_telemetry {
+        // The demo answers ticks 0..last; the last tick's sample is not recorded (a lockstep
+        // run awaits no answer to it).
+        assert_eq!(
+            report.fsw_accepted, report.last_tick,
+            "the demo's telemetry: one sample per answered tick, none refused ({:?})",
+            report.rejected
+        );
+    }
     report.last_tick as f64 / report.wall_s
 }
 
@@ -97,12 +139,21 @@ fn main() {
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut ratio1, mut ratio1l, mut ratiot, mut ratior) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut lsf, mut ratiof) = (Vec::new(), Vec::new());
     for r in 0..rounds {
         let p = pingpong_rate(ticks, false);
         let pl = pingpong_rate(ticks, true);
         let a = lockstep_rate(ticks, 1000.0, Handoff::Direct);
         let t = lockstep_rate(ticks, 1000.0, Handoff::Thread);
         let b = lockstep_rate(ticks / 4, 100.0, Handoff::Direct);
+        let f = lockstep_rate_with_telemetry(ticks, 1000.0);
+        println!(
+            "round {r}: lockstep 1 step/frame, direct, the demo publishing its telemetry every \
+             tick: {f:.0} ticks/s (ratio to without {:.2})",
+            f / a
+        );
+        lsf.push(f);
+        ratiof.push(f / a);
         println!(
             "round {r}: ping-pong {p:.0} rt/s (recv-loop pong {pl:.0}) | lockstep 1 step/frame: \
              direct {a:.0} ticks/s (ratio {:.2}), thread {t:.0} ticks/s (ratio {:.2}) | reference \
@@ -155,6 +206,12 @@ fn main() {
         "median lockstep ticks/s, reference (10 RK4 steps per frame), direct: {b:.0} ({:.1} \
          us/tick); median ratio {rr:.2}",
         1e6 / b
+    );
+    let (f, rf) = (median_mut(&mut lsf), median_mut(&mut ratiof));
+    println!(
+        "median lockstep ticks/s, 1 RK4 step per frame, direct, with the flight code's telemetry \
+         (one FswMsg per tick, 1 kHz): {f:.0} ({:.1} us/tick); median ratio to without {rf:.2}",
+        1e6 / f
     );
     println!("physics alone per frame: {phys1:.1} us (1 step), {phys10:.1} us (10 steps)");
 }

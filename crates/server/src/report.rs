@@ -37,6 +37,9 @@ pub struct RunReport {
     pub states_published: u64,
     /// Real time: frames whose telemetry was dropped (no free buffer).
     pub telemetry_dropped: u64,
+    /// The flight code's telemetry samples accepted (`flexdyn/<sc>/fsw/*`, recorded when
+    /// recording); the refused ones count in `rejected.fsw_refused`.
+    pub fsw_accepted: u64,
     /// Real time: lateness percentiles, overruns, skipped frames (zeros otherwise).
     pub timing: FrameTiming,
     /// Rejected commands by reason.
@@ -103,6 +106,9 @@ impl fmt::Display for RunReport {
             self.rejected.total(),
             self.commands_dropped,
         )?;
+        if self.fsw_accepted > 0 {
+            write!(f, " fsw_accepted={}", self.fsw_accepted)?;
+        }
         let l = &self.link_faults;
         if !l.is_zero() {
             write!(
@@ -170,6 +176,7 @@ impl RunReport {
             sim_time_ns: phys.sim_time_ns,
             states_published: load(&shared.published),
             telemetry_dropped: load(&shared.telemetry_dropped),
+            fsw_accepted: load(&shared.fsw_recorded),
             timing: timing_of(
                 lateness,
                 load(&shared.overruns),
@@ -204,6 +211,7 @@ impl RunReport {
             sim_time_ns: 0,
             states_published: 0,
             telemetry_dropped: 0,
+            fsw_accepted: 0,
             timing: FrameTiming::default(),
             rejected,
             commands_dropped: 0,
