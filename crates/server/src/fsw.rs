@@ -20,6 +20,11 @@
 //!   count other than the declaration's, a NaN or infinite f64 value, a bool other than 0/1,
 //!   COVARIANCE without ESTIMATE.
 //!
+//! An accepted sample is published again, unchanged, on its key to the other sessions connected
+//! to the server (remote only, dropped if a tool's link is full), so the tools that connect to
+//! the server (the monitor, `flexdyn view`, `flexdyn record`) hear what the server accepted; a
+//! refused sample goes nowhere.
+//!
 //! In lockstep the flight code answers tick k after the server published it, so a sample
 //! stamped k that arrives before the answer is recorded with tick k, and the recording of a
 //! lockstep run is the same whenever it is repeated. The run's last tick is published for the
@@ -35,7 +40,7 @@ use flexdyn_proto::{decode_fsw, DecodeError, FswMsg, Topics};
 use flexdyn_sinks::recorder::{RecordItem, RecordTx};
 use flexdyn_vehicle::config::fsw::FswStreamDecl;
 use zenoh::pubsub::Subscriber;
-use zenoh::Session;
+use zenoh::{Session, Wait};
 
 use super::error::ServerError;
 use super::reject_log::RejectLog;
@@ -207,6 +212,24 @@ pub(super) async fn declare(
     ));
     let key = flexdyn_proto::fsw_wildcard_key(topics.sc_id())
         .map_err(|e| ServerError::Internal(format!("the fsw key: {e}")))?;
+    // Each accepted sample goes out again to the other sessions connected to this one (the
+    // monitor, `flexdyn view`, `flexdyn record`): peers do not route between the clients of a
+    // server, so without this only the server would hear the flight code. Remote only (this
+    // session's own subscriber must not hear it twice), and dropped rather than waited for
+    // when a tool's link is full: a slow tool never holds this thread.
+    let mut republish = Vec::with_capacity(intake.streams.len());
+    for k in &intake.keys {
+        republish.push(
+            session
+                .declare_publisher(k.to_string())
+                .allowed_destination(zenoh::sample::Locality::Remote)
+                .congestion_control(zenoh::qos::CongestionControl::Drop)
+                .await
+                .map_err(|e| {
+                    ServerError::zenoh("declare the flight-code telemetry publisher", e)
+                })?,
+        );
+    }
     let callback = move |sample: zenoh::sample::Sample| {
         let bytes = sample.payload().to_bytes();
         let server_tick = shared.tick.load(Ordering::Acquire);
@@ -214,6 +237,8 @@ pub(super) async fn declare(
             Ok(None) => {}
             Ok(Some(i)) => {
                 shared.fsw_recorded.fetch_add(1, Ordering::Relaxed);
+                // The payload's buffer is shared, not copied.
+                let _ = republish[i].put(sample.payload().clone()).wait();
                 if let Some(rec) = &record {
                     rec.submit(RecordItem {
                         key: intake.key(i).clone(),
