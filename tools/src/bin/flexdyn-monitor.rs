@@ -38,13 +38,18 @@
 //!   `faults_active`) and which, by index, target and mode (`faults active=1 [#0 imus.hub.gyro
 //!   bias_step]`): the active set is StatusMsg's `faults_active_bits`, the names come from the
 //!   served configuration's `[[faults]]` (`flexdyn/<sc>/config`, asked once at start) and from
-//!   every fault event heard (`tlm/fault`, live faults included).
+//!   every fault event heard (`tlm/fault`, live faults included);
+//! - `fsw`: each flight-code telemetry stream heard (`flexdyn/<sc>/fsw/<stream>`, which the
+//!   server passes on once it has accepted a sample): its current mode and its last event with
+//!   the event's severity and time (`fsw acs: mode=fine-pointing last_event=wheel-failure
+//!   (error) at t=61.300s`), named by the served configuration's `[[fsw_streams]]`.
 
 use std::io::{IsTerminal as _, Write as _};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use clap::Parser;
+use flexdyn_proto::client::fsw::FswDeclaration;
 use flexdyn_proto::client::transport::{frame_stamp_ns, mode_name, unix_now_ns};
 use flexdyn_proto::{
     command_flags, decode_environment, decode_fault_event, decode_state, decode_status, eclipse,
@@ -108,6 +113,61 @@ struct Window {
     /// Fault names (`<target> <mode>`) by fault index: the served configuration's
     /// `[[faults]]`, and each fault event heard.
     fault_names: std::collections::BTreeMap<u32, String>,
+    /// The flight code's streams heard, by name: the current mode and the last event.
+    fsw: std::collections::BTreeMap<String, FswSeen>,
+    /// The served configuration's `[[fsw_streams]]`, by name (empty until it arrives).
+    fsw_declared: std::collections::BTreeMap<String, FswDeclaration>,
+}
+
+/// What the monitor heard of one flight-code telemetry stream.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct FswSeen {
+    /// The mode of the latest sample that named one (index into the stream's modes).
+    mode: Option<u32>,
+    /// The latest event: (its index, the sample's sim_time_ns).
+    last_event: Option<(u16, u64)>,
+}
+
+impl FswSeen {
+    /// Takes in a sample: its mode if it names one, its last event if it has any.
+    fn note(&mut self, m: &flexdyn_proto::FswMsg) {
+        if m.flags & flexdyn_proto::fsw_flags::MODE != 0 {
+            self.mode = Some(m.mode);
+        }
+        if let Some(&e) = m.event_indices().last() {
+            self.last_event = Some((e, m.header.sim_time_ns));
+        }
+    }
+}
+
+/// The telemetry segment: ` fsw <stream>: mode=<name> last_event=<name> (<severity>) at
+/// t=<s>s` per stream heard, names from its declaration (`#<index>` without one).
+fn fsw_str(
+    seen: &std::collections::BTreeMap<String, FswSeen>,
+    declared: &std::collections::BTreeMap<String, FswDeclaration>,
+) -> String {
+    let mut out = String::new();
+    for (stream, s) in seen {
+        let decl = declared.get(stream);
+        let mode = s.mode.map_or("-".to_owned(), |m| {
+            decl.and_then(|d| d.modes.get(m as usize))
+                .cloned()
+                .unwrap_or_else(|| format!("#{m}"))
+        });
+        out.push_str(&format!(" fsw {stream}: mode={mode}"));
+        if let Some((e, t_ns)) = s.last_event {
+            match decl.and_then(|d| d.events.get(usize::from(e))) {
+                Some(ev) => out.push_str(&format!(
+                    " last_event={} ({}) at t={:.3}s",
+                    ev.name,
+                    ev.severity,
+                    t_ns as f64 / 1e9
+                )),
+                None => out.push_str(&format!(" last_event=#{e} at t={:.3}s", t_ns as f64 / 1e9)),
+            }
+        }
+    }
+    out
 }
 
 /// A fault's name: `<target> <mode>` (the mode's code when this build does not know it).
@@ -394,6 +454,11 @@ fn line(w: &mut Window, interval: Duration, state_topic: &str) -> String {
             }
         }
     }
+    let fsw = fsw_str(&w.fsw, &w.fsw_declared);
+    if !fsw.is_empty() {
+        out.push_str(" |");
+        out.push_str(&fsw);
+    }
     w.states = 0;
     w.gaps = 0;
     w.undecodable = 0;
@@ -406,7 +471,7 @@ fn line(w: &mut Window, interval: Duration, state_topic: &str) -> String {
 struct Watch {
     topics: flexdyn_proto::Topics,
     window: Arc<Mutex<Window>>,
-    _subscribers: [zenoh::pubsub::Subscriber<()>; 5],
+    _subscribers: [zenoh::pubsub::Subscriber<()>; 6],
 }
 
 impl Watch {
@@ -519,28 +584,59 @@ impl Watch {
             })
             .wait()
             .map_err(|e| anyhow::anyhow!("cannot subscribe to {fault_key}: {e}"))?;
+        let w = window.clone();
+        let fsw_key = flexdyn_proto::fsw_wildcard_key(topics.sc_id())
+            .map_err(|e| anyhow::anyhow!("the flight-code telemetry key: {e}"))?;
+        let fsw_prefix = format!("flexdyn/{}/fsw/", topics.sc_id());
+        let _fsw = session
+            .declare_subscriber(fsw_key.as_str())
+            .callback(move |sample| {
+                let key = sample.key_expr().as_str();
+                let stream = key.strip_prefix(fsw_prefix.as_str()).unwrap_or(key);
+                if let Ok(m) = flexdyn_proto::decode_fsw(&sample.payload().to_bytes()) {
+                    let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
+                    match w.fsw.get_mut(stream) {
+                        Some(seen) => seen.note(&m),
+                        None => {
+                            let mut seen = FswSeen::default();
+                            seen.note(&m);
+                            w.fsw.insert(stream.to_owned(), seen);
+                        }
+                    }
+                }
+            })
+            .wait()
+            .map_err(|e| anyhow::anyhow!("cannot subscribe to {fsw_key}: {e}"))?;
         let (w, s, t) = (window.clone(), session.clone(), topics.clone());
         std::thread::spawn(move || {
             use flexdyn_proto::client::vehicle::Vehicle;
-            let faults = Vehicle::query(&s, &t, Duration::from_secs(60))
-                .and_then(|v| v.config())
-                .map(|c| c.faults);
-            match faults {
-                Ok(faults) => {
+            let vehicle = Vehicle::query(&s, &t, Duration::from_secs(60));
+            match vehicle.as_ref().map(|v| v.config()) {
+                Ok(Ok(c)) => {
                     let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
-                    for (i, f) in faults.iter().enumerate() {
+                    for (i, f) in c.faults.iter().enumerate() {
                         w.fault_names
                             .entry(i as u32)
                             .or_insert_with(|| format!("{} {}", f.target, f.mode));
                     }
                 }
-                Err(e) => tracing::debug!(error = %e, "no fault names from the configuration"),
+                Ok(Err(e)) => tracing::debug!(error = %e, "no fault names from the configuration"),
+                Err(e) => tracing::debug!(error = %e, "no configuration served"),
+            }
+            if let Ok(v) = &vehicle {
+                match FswDeclaration::all_from_config_toml(&v.config_toml) {
+                    Ok(all) => {
+                        let mut w = w.lock().unwrap_or_else(|p| p.into_inner());
+                        w.fsw_declared = all.into_iter().map(|d| (d.name.clone(), d)).collect();
+                    }
+                    Err(e) => tracing::debug!(error = %e, "no telemetry streams declared"),
+                }
             }
         });
         Ok(Self {
             topics,
             window,
-            _subscribers: [_states, _status, _environment, _sensors, _faults],
+            _subscribers: [_states, _status, _environment, _sensors, _faults, _fsw],
         })
     }
 
@@ -839,6 +935,48 @@ fn run_tui(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The telemetry segment names the mode and the last event by the declaration, keeps the
+    /// mode of a sample that names none, and falls back to indices without a declaration.
+    #[test]
+    fn the_flight_code_segment_names_the_mode_and_the_last_event() {
+        use flexdyn_proto::{fsw_flags, FswMsg, Header};
+        let toml = "[[fsw_streams]]\nname = \"acs\"\nmodes = [\"detumble\", \"pointing\"]\n\
+                    events = [{ name = \"gyro-failure\", severity = \"error\" }, { name = \"ok\" }]\n";
+        let declared: std::collections::BTreeMap<String, FswDeclaration> =
+            FswDeclaration::all_from_config_toml(toml)
+                .unwrap()
+                .into_iter()
+                .map(|d| (d.name.clone(), d))
+                .collect();
+        let sample = |tick: u64, mode: Option<u32>, events: &[u16]| {
+            let mut m = FswMsg {
+                header: Header::new(1, tick, tick * 100_000_000, tick),
+                flags: if mode.is_some() { fsw_flags::MODE } else { 0 },
+                mode: mode.unwrap_or(0),
+                event_count: events.len() as u8,
+                ..FswMsg::default()
+            };
+            m.events[..events.len()].copy_from_slice(events);
+            m
+        };
+        let mut seen = FswSeen::default();
+        seen.note(&sample(10, Some(1), &[]));
+        let mut all = std::collections::BTreeMap::new();
+        all.insert("acs".to_owned(), seen.clone());
+        assert_eq!(fsw_str(&all, &declared), " fsw acs: mode=pointing");
+        // A later sample with two events and no mode: the mode stays, the last event is shown.
+        seen.note(&sample(613, None, &[1, 0]));
+        all.insert("acs".to_owned(), seen);
+        assert_eq!(
+            fsw_str(&all, &declared),
+            " fsw acs: mode=pointing last_event=gyro-failure (error) at t=61.300s"
+        );
+        assert_eq!(
+            fsw_str(&all, &Default::default()),
+            " fsw acs: mode=#1 last_event=#0 at t=61.300s"
+        );
+    }
 
     #[test]
     fn rejections_name_every_nonzero_reason() {
