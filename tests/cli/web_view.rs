@@ -260,3 +260,99 @@ fn a_browser_shows_a_replay_on_the_viewers_own_port() {
     );
     drop(viewer);
 }
+
+/// Issue 37 §2: the page shows the flight code's mode and its last event, named by the served
+/// configuration's `[[fsw_streams]]`. A recording written here with the recorder's sink:
+/// `scenarios/fdir.toml`'s vehicle, 2 s of states at 10 Hz, and its stream `acs` every tick in
+/// mode 0 (`pointing`), with `gyro-failure` at 0.5 s and `wheel-failure`, `wheels-reconfigured`
+/// at 1.5 s; replayed with `flexdyn view --file`.
+#[test]
+fn a_browser_shows_the_flight_codes_mode_and_last_event() {
+    use flexdyn_proto::{encode, fsw_flags, FswMsg, Header, RunState, StateMsg, StatusMsg};
+    use flexdyn_sinks::mcap_file::{McapSink, RecordingInfo, VehicleInfo};
+    let browser = chromium();
+    let config_toml = std::fs::read_to_string(root().join("scenarios/fdir.toml")).unwrap();
+    let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(&config_toml).unwrap();
+    let decl = cfg.fsw_stream("acs").expect("fdir.toml declares acs");
+    let event = |name: &str| decl.event_index(name).unwrap();
+    let file = tmp("fsw_view.mcap");
+    let mut sink = McapSink::create(
+        &file,
+        &RecordingInfo {
+            recorder: "test".into(),
+            command_line: String::new(),
+        },
+    )
+    .unwrap();
+    sink.describe_vehicle(&VehicleInfo {
+        sc_id: "sc1".into(),
+        spacecraft_id: 1,
+        config_toml: config_toml.clone(),
+        server_settings: String::new(),
+        flexdyn_version: "test".into(),
+        git_commit: None,
+        epoch_utc: None,
+    })
+    .unwrap();
+    let frame_ns = 100_000_000;
+    for tick in 0..=20u64 {
+        let header = Header::new(1, tick, tick * frame_ns, tick);
+        let t_ns = tick * frame_ns;
+        let state = StateMsg {
+            header,
+            q_bn: [1.0, 0.0, 0.0, 0.0],
+            ..StateMsg::default()
+        };
+        sink.write("flexdyn/sc1/tlm/state", &encode(&state), Some(1), t_ns)
+            .unwrap();
+        let events: Vec<u16> = match tick {
+            5 => vec![event("gyro-failure")],
+            15 => vec![event("wheel-failure"), event("wheels-reconfigured")],
+            _ => vec![],
+        };
+        let mut fsw = FswMsg {
+            header,
+            flags: fsw_flags::MODE,
+            mode: 0,
+            event_count: events.len() as u8,
+            values: vec![0; decl.words()],
+            ..FswMsg::default()
+        };
+        fsw.events[..events.len()].copy_from_slice(&events);
+        sink.write("flexdyn/sc1/fsw/acs", &encode(&fsw), Some(1), t_ns)
+            .unwrap();
+    }
+    let status = StatusMsg {
+        header: Header::new(1, 20, 20 * frame_ns, 0),
+        run_state: RunState::Finished,
+        ..StatusMsg::default()
+    };
+    sink.write(
+        "flexdyn/sc1/status",
+        &encode(&status),
+        Some(1),
+        20 * frame_ns,
+    )
+    .unwrap();
+    sink.finish().unwrap();
+
+    let mut viewer = Guard(
+        ports::reporting(
+            Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+                .args(["view", "--file"])
+                .arg(&file)
+                .args(["--bind", "127.0.0.1:0", "--duration-s", "60"]),
+        )
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap(),
+    );
+    let port = page_port(&mut viewer.0);
+    let dom = browse(browser, port, 4000, &tmp("fsw_page.png"));
+    assert_eq!(element_text(&dom, "tick"), Some("20"), "{dom}");
+    assert_eq!(
+        element_text(&dom, "fsw"),
+        Some("acs: pointing · wheels-reconfigured (warning) at 1.500 s"),
+        "{dom}"
+    );
+}

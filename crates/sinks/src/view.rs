@@ -79,6 +79,9 @@ struct Translator {
     ctx: Arc<Context>,
     channels: HashMap<String, Arc<RawChannel>>,
     geometry: HashMap<String, Geometry>,
+    /// Per vehicle, its `[[fsw_streams]]` as the JSON of `/flexdyn/<sc>/fsw_streams` (only
+    /// vehicles that declare any).
+    fsw_streams: HashMap<String, String>,
     filter: Vec<String>,
     latest_time_ns: u64,
     /// The last simulation time announced to the viewers, and when.
@@ -91,6 +94,7 @@ impl Translator {
             ctx,
             channels: HashMap::new(),
             geometry: HashMap::new(),
+            fsw_streams: HashMap::new(),
             filter,
             latest_time_ns: 0,
             announced: None,
@@ -134,6 +138,9 @@ impl Translator {
     }
 
     fn describe(&mut self, info: &VehicleInfo) {
+        if let Some(json) = fsw_streams_json(&info.config_toml) {
+            self.fsw_streams.insert(info.sc_id.clone(), json);
+        }
         match info.geometry() {
             Ok(g) => {
                 self.geometry.insert(info.sc_id.clone(), g);
@@ -159,6 +166,16 @@ impl Translator {
             .collect();
         for (topic, json) in scenes {
             if let Some(c) = self.channel(&topic, scene_update_channel_schema) {
+                c.log_with_meta(json.as_bytes(), PartialMetadata { log_time: Some(t) });
+            }
+        }
+        let dictionaries: Vec<(String, String)> = self
+            .fsw_streams
+            .iter()
+            .map(|(sc, json)| (fsw_streams_topic(sc), json.clone()))
+            .collect();
+        for (topic, json) in dictionaries {
+            if let Some(c) = self.channel(&topic, fsw_streams_schema) {
                 c.log_with_meta(json.as_bytes(), PartialMetadata { log_time: Some(t) });
             }
         }
@@ -221,6 +238,66 @@ impl Translator {
             }
         }
     }
+}
+
+/// `/flexdyn/<sc>/fsw_streams`: the names behind the indices of the vehicle's flight-code
+/// telemetry (`/flexdyn/<sc>/fsw/<stream>`), sent with the scene.
+pub fn fsw_streams_topic(sc_id: &str) -> String {
+    format!("/flexdyn/{sc_id}/fsw_streams")
+}
+
+/// The JSON of `/flexdyn/<sc>/fsw_streams` for a vehicle configured by `config_toml`:
+/// `{"streams": [{"name", "modes": [...], "events": [{"name", "severity"}], "values": [{"name",
+/// "type", "len", "unit"}]}]}`; `None` when it declares no stream (or does not parse here).
+pub fn fsw_streams_json(config_toml: &str) -> Option<String> {
+    let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(config_toml).ok()?;
+    if cfg.fsw_streams.is_empty() {
+        return None;
+    }
+    let streams: Vec<serde_json::Value> = cfg
+        .fsw_streams
+        .iter()
+        .map(|d| {
+            serde_json::json!({
+                "name": d.name,
+                "modes": d.modes,
+                "events": d.events.iter().map(|e| serde_json::json!({
+                    "name": e.name, "severity": e.severity.name(),
+                })).collect::<Vec<_>>(),
+                "values": d.values.iter().map(|v| serde_json::json!({
+                    "name": v.name, "type": v.ty.name(), "len": v.len, "unit": v.unit,
+                })).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    Some(serde_json::json!({ "streams": streams }).to_string())
+}
+
+/// The schema of `/flexdyn/<sc>/fsw_streams` ([`fsw_streams_json`]).
+fn fsw_streams_schema() -> Schema {
+    let names = serde_json::json!({"type": "array", "items": {"type": "string"}});
+    let schema = serde_json::json!({
+        "type": "object",
+        "required": ["streams"],
+        "properties": {"streams": {"type": "array", "items": {
+            "type": "object",
+            "required": ["name", "modes", "events", "values"],
+            "properties": {
+                "name": {"type": "string"},
+                "modes": names,
+                "events": {"type": "array", "items": {"type": "object", "properties": {
+                    "name": {"type": "string"}, "severity": {"type": "string"}}}},
+                "values": {"type": "array", "items": {"type": "object", "properties": {
+                    "name": {"type": "string"}, "type": {"type": "string"},
+                    "len": {"type": "integer"}, "unit": {"type": "string"}}}},
+            },
+        }}},
+    });
+    Schema::new(
+        "flexdyn.FswStreams",
+        "jsonschema",
+        schema.to_string().into_bytes(),
+    )
 }
 
 /// The schema of every `foxglove.SceneUpdate` channel (the scenes and the arrows).

@@ -1,13 +1,16 @@
 // The page of `flexdyn view` (crates/sinks/src/web): a client of the Foxglove WebSocket protocol
 // (`foxglove.websocket.v1`) in plain JavaScript, connected back to the port that served it. It
 // subscribes to the decoded JSON channels of one vehicle and draws them on canvases: the
-// spacecraft in its body frame B, scrolling plots, the run state, the eclipse and the faults.
+// spacecraft in its body frame B, scrolling plots, the run state, the eclipse, the faults and
+// the flight code's mode and last event.
 // A live run and a replay (`flexdyn view --file`) are the same stream, so they look the same.
 //
 // Channels (crates/sinks/src/view.rs, all "json"): /flexdyn/<sc>/tlm/state (StateMsg),
 // /tlm/env (EnvironmentMsg), /tlm/fault (FaultEventMsg), /status (StatusMsg), and for the
 // geometry of the served configuration /scene (foxglove.SceneUpdate: cubes per frame) with
-// /tf (foxglove.FrameTransforms: the panels' frames at their hinge angles).
+// /tf (foxglove.FrameTransforms: the panels' frames at their hinge angles), and the flight
+// code's telemetry /fsw/<stream> (FswMsg, which a live server passes on once accepted) with the
+// names behind its indices /fsw_streams (the served configuration's [[fsw_streams]]).
 //
 // URL parameters: ?sc=ID (the vehicle; default the first one advertised), ?window=S (the plots'
 // span, default 60 s), ?hold=MS (see below).
@@ -64,6 +67,7 @@
   const view = {
     sc: WANT_SC, vehicles: new Set(), state: null, env: null, status: null,
     faults: new Map(), scene: null, tf: new Map(), messages: 0,
+    fsw: new Map(), fswStreams: new Map(), // stream → {mode, event, eventT}; stream → declaration
     playback: null, dataStart: null, dataEnd: null, playbackState: null,
   };
   let ws = null;
@@ -77,8 +81,11 @@
   let requestNo = 0;
 
   function kindOf(topic) {
-    const m = /^\/flexdyn\/([^/]+)\/(tlm\/state|tlm\/env|tlm\/fault|status|scene|tf)$/.exec(topic);
-    return m ? { sc: m[1], kind: m[2].replace('tlm/', '') } : null;
+    const m = /^\/flexdyn\/([^/]+)\/(tlm\/state|tlm\/env|tlm\/fault|status|scene|tf|fsw_streams|fsw\/[^/]+)$/.exec(topic);
+    if (!m) return null;
+    // The flight code's telemetry: the kind `fsw` and the stream's name.
+    if (m[2].startsWith('fsw/')) return { sc: m[1], kind: 'fsw', stream: m[2].slice(4) };
+    return { sc: m[1], kind: m[2].replace('tlm/', '') };
   }
 
   function subscribeWanted() {
@@ -89,7 +96,7 @@
       if (!k || k.sc !== view.sc || subscribed.has(id) || ch.encoding !== 'json') continue;
       const sub = nextSub++;
       subscribed.set(id, sub);
-      subKinds.set(sub, k.kind);
+      subKinds.set(sub, k.kind === 'fsw' ? 'fsw/' + k.stream : k.kind);
       list.push({ id: sub, channelId: id });
     }
     if (list.length) ws.send(JSON.stringify({ op: 'subscribe', subscriptions: list }));
@@ -194,6 +201,18 @@
     } else if (kind === 'scene') {
       view.scene = msg;
       sceneDirty = true;
+    } else if (kind === 'fsw_streams') {
+      for (const d of msg.streams || []) view.fswStreams.set(d.name, d);
+    } else if (kind.startsWith('fsw/')) {
+      // FswMsg: flags bit 0 says `mode` is set; `events` holds `event_count` indices.
+      const stream = kind.slice(4);
+      const seen = view.fsw.get(stream) || { mode: null, event: null, eventT: null };
+      if (msg.flags & 1) seen.mode = msg.mode;
+      if (msg.event_count > 0) {
+        seen.event = msg.events[msg.event_count - 1];
+        seen.eventT = msg.header.sim_time_ns / 1e9;
+      }
+      view.fsw.set(stream, seen);
     } else if (kind === 'tf') {
       for (const tr of msg.transforms || []) view.tf.set(tr.child_frame_id, tr);
       sceneDirty = true;
@@ -284,6 +303,18 @@
     if (count > active.length) active.push((count - active.length) + ' more active (StatusMsg)');
     fe.textContent = active.length ? active.join('; ') : 'none';
     fe.className = active.length ? 'active' : '';
+    // The flight code: each stream's mode and last event, named by its declaration.
+    const fsw = [...view.fsw.entries()].sort().map(([stream, f]) => {
+      const d = view.fswStreams.get(stream);
+      const mode = f.mode === null ? '–' : (d && d.modes[f.mode]) || '#' + f.mode;
+      let text = stream + ': ' + mode;
+      if (f.event !== null) {
+        const e = d && d.events[f.event];
+        text += ' · ' + (e ? e.name + ' (' + e.severity + ')' : '#' + f.event) + ' at ' + f.eventT.toFixed(3) + ' s';
+      }
+      return text;
+    });
+    $('fsw').textContent = fsw.length ? fsw.join('; ') : 'none';
     if (view.playback) {
       $('pb-state').textContent = view.playbackState || '–';
       $('pb-toggle').textContent = (view.playbackState === 'paused' || view.playbackState === 'ended') ? 'play' : 'pause';
