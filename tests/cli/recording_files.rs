@@ -288,6 +288,9 @@ fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
             );
         }
     }
+    // The flight code's telemetry (issue 37) is not in a batch recording: a recording of one
+    // sample of the stream `acs` that acs_full.toml declares, written by the recorder's sink.
+    first.extend(fsw_decoded_messages(&scenario));
     let layout: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(root().join("docs/foxglove/flexdyn-layout.json")).unwrap(),
     )
@@ -324,11 +327,78 @@ fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
         }
     }
     assert!(checked >= 20, "only {checked} paths checked");
-    // The fault panels are among them (a layout without them fails here).
-    for panel in ["RawMessages!faults", "StateTransitions!faults"] {
+    // The fault and flight-code panels are among them (a layout without them fails here).
+    for panel in [
+        "RawMessages!faults",
+        "StateTransitions!faults",
+        "RawMessages!fsw",
+        "StateTransitions!fsw",
+    ] {
         assert!(layout["configById"].get(panel).is_some(), "no {panel}");
     }
     assert!(first.contains_key("/flexdyn/sc1/tlm/fault"));
+}
+
+/// The first JSON message of each decoded channel of a recording that holds one sample of
+/// the flight code's stream `acs` (a mode, an event, an estimate and every declared value),
+/// written by [`McapSink`] for a vehicle configured by `config_toml`.
+fn fsw_decoded_messages(config_toml: &str) -> BTreeMap<String, serde_json::Value> {
+    use flexdyn_proto::{encode, fsw_flags, FswMsg, Header};
+    use flexdyn_sinks::mcap_file::{McapSink, RecordingInfo, VehicleInfo};
+    let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(config_toml).unwrap();
+    let words = cfg
+        .fsw_stream("acs")
+        .expect("acs_full.toml declares acs")
+        .words();
+    let file = tmp("layout_fsw.mcap");
+    let mut sink = McapSink::create(
+        &file,
+        &RecordingInfo {
+            recorder: "test".into(),
+            command_line: String::new(),
+        },
+    )
+    .unwrap();
+    sink.describe_vehicle(&VehicleInfo {
+        sc_id: "sc1".into(),
+        spacecraft_id: 1,
+        config_toml: config_toml.to_owned(),
+        server_settings: String::new(),
+        flexdyn_version: "test".into(),
+        git_commit: None,
+        epoch_utc: None,
+    })
+    .unwrap();
+    let msg = FswMsg {
+        header: Header::new(1, 10, 100_000_000, 10),
+        flags: fsw_flags::MODE | fsw_flags::ESTIMATE | fsw_flags::TARGET,
+        mode: 1,
+        q_est_bn: [1.0, 0.0, 0.0, 0.0],
+        q_target_rn: [1.0, 0.0, 0.0, 0.0],
+        event_count: 1,
+        values: vec![0; words],
+        ..FswMsg::default()
+    };
+    sink.write("flexdyn/sc1/fsw/acs", &encode(&msg), Some(1), 100_000_000)
+        .unwrap();
+    sink.finish().unwrap();
+    let bytes = std::fs::read(&file).unwrap();
+    let mut first = BTreeMap::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        if m.channel.message_encoding == "json" && !first.contains_key(&m.channel.topic) {
+            first.insert(
+                m.channel.topic.clone(),
+                serde_json::from_slice(&m.data).unwrap(),
+            );
+        }
+    }
+    assert!(
+        first.contains_key("/flexdyn/sc1/fsw/acs"),
+        "{:?}",
+        first.keys()
+    );
+    first
 }
 
 /// `flexdyn record` of a synthetic publisher whose StateMsg sequence numbers 0..100 skip
