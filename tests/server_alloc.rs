@@ -3,7 +3,8 @@
 //! server's own [`Stepper`] — the code both the physics thread and the direct lockstep core run
 //! — holding the commands, integrating the RK4 frame, sampling the IMU and star tracker,
 //! filling the telemetry and checking it finite, and the buffer hand-off through the bounded
-//! channels.
+//! channels; and beside it, the check of the flight code's telemetry arriving at 1 kHz (the
+//! work of the `flexdyn/<sc>/fsw/*` callback for an accepted sample).
 //!
 //! `assert_no_alloc`'s global allocator counts (de)allocations made on this thread inside
 //! `assert_no_alloc(..)` (features `warn_debug`/`warn_release`: count and warn, don't abort).
@@ -178,8 +179,68 @@ fn frame_path_does_not_allocate(cfg: &SimConfig) {
     frame_path_with_live_faults(cfg, Vec::new());
 }
 
+/// Issue 37: the flight code's telemetry arriving at 1 kHz, one sample per frame of a 1 kHz
+/// server, each judged by the server's telemetry intake ([`FswIntake::check`], what the
+/// subscriber's callback runs) beside the frame path, as on the Zenoh thread that in
+/// lockstep's direct hand-off both takes the samples and steps the frames. Every sample is
+/// accepted (a mode, an event every 50th tick, an estimate with variances, 7 value words), and
+/// neither the intake nor the frame path allocates.
+#[test]
+fn the_frame_path_does_not_allocate_with_telemetry_at_1_khz() {
+    use flexdyn_proto::{encode, fsw_flags, FswMsg, Topics};
+    use flexdyn_server::fsw::FswIntake;
+    let text = format!(
+        "{}\n[[fsw_streams]]\nname = \"acs\"\nmodes = [\"detumble\", \"pointing\"]\n\
+         events = [{{ name = \"target-chosen\" }}]\n\
+         values = [{{ name = \"rate_b_rad_s\", type = \"f64\", len = 3 }}, \
+         {{ name = \"wheel_momentum_b_nms\", type = \"f64\", len = 3 }}, \
+         {{ name = \"sun_visible\", type = \"bool\" }}]\n",
+        WHEELS.replace("frame_hz = 100.0 ", "frame_hz = 1000.0 ")
+    );
+    let cfg = SimConfig::from_toml_str(&text).unwrap();
+    assert_eq!(cfg.frame_ns, 1_000_000, "frames of 1 ms");
+    let topics = Topics::new("sc1").unwrap();
+    let intake = FswIntake::new(&topics, cfg.fsw_streams.clone(), 1, cfg.frame_ns, None).unwrap();
+    let key = flexdyn_proto::fsw_key("sc1", "acs").unwrap();
+    // Encoded up front, as they arrive from the wire.
+    let samples: Vec<Vec<u8>> = (0..200u64)
+        .map(|k| {
+            let mut m = FswMsg {
+                header: Header::new(1, k, k * cfg.frame_ns, k),
+                flags: fsw_flags::MODE | fsw_flags::ESTIMATE | fsw_flags::COVARIANCE,
+                mode: u32::from(k >= 100),
+                q_est_bn: [1.0, 0.0, 0.0, 0.0],
+                att_var_b_rad2: [1e-10; 3],
+                values: vec![1e-3f64.to_bits(), 0, 0, 0, 0, 0, 1],
+                ..FswMsg::default()
+            };
+            if k % 50 == 0 {
+                m.event_count = 1;
+            }
+            encode(&m)
+        })
+        .collect();
+    let mut accepted = 0u32;
+    frame_path_with(&cfg, Vec::new(), &mut |k| {
+        if intake.check(&key, &samples[k as usize], k) == Ok(Some(0)) {
+            accepted += 1;
+        }
+    });
+    assert_eq!(accepted, 200, "every sample accepted, ticks 0..199");
+}
+
 /// The frame path over 200 frames, installing each live request before stepping its frame.
-fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)>) {
+fn frame_path_with_live_faults(cfg: &SimConfig, live: Vec<(u64, LiveRequest)>) {
+    frame_path_with(cfg, live, &mut |_| {});
+}
+
+/// The frame path over 200 frames, installing each live request before stepping its frame
+/// and running `beside(k)` before frame k (inside the measured region from frame 1).
+fn frame_path_with(
+    cfg: &SimConfig,
+    mut live: Vec<(u64, LiveRequest)>,
+    beside: &mut dyn FnMut(u64),
+) {
     let sim = Simulation::new(cfg).unwrap();
     assert!(sim.n_imus() > 0);
     assert!(!sim.star_trackers().is_empty());
@@ -223,6 +284,7 @@ fn frame_path_with_live_faults(cfg: &SimConfig, mut live: Vec<(u64, LiveRequest)
         .collect();
     let (recycle_tx, recycle_rx) = sync_channel::<CommandMsg>(512);
     let mut frame_once = |k: u64| {
+        beside(k);
         let wrench = CommandMsg::wrench(Header::new(1, k, 0, k), 1, [0.0, 0.0, 0.01], [0.0; 3]);
         cmd_tx.try_send(wrench).unwrap();
         cmd_tx.try_send(wheel_commands.pop().unwrap()).unwrap();

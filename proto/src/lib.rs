@@ -108,6 +108,7 @@ mod error;
 // Written by flexdyn-wiregen from proto/schema/messages.toml.
 #[rustfmt::skip]
 mod json_schemas;
+pub mod fsw_view;
 pub mod keys;
 mod layout;
 mod messages;

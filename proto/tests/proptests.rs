@@ -535,3 +535,88 @@ proptest! {
         view_agrees(&bytes)?;
     }
 }
+
+/// `view_fsw` (the allocation-free reading of a flight-code sample) against `decode_fsw`: the
+/// same sample for the bytes `decode_fsw` accepts, the same class of error for the others.
+fn fsw_view_agrees(bytes: &[u8]) -> Result<(), TestCaseError> {
+    use flexdyn_proto::fsw_view::view_fsw;
+    use flexdyn_proto::view::ViewError;
+    match (flexdyn_proto::decode_fsw(bytes), view_fsw(bytes)) {
+        (Ok(m), Ok(v)) => prop_assert_eq!(v.to_owned_msg(), m),
+        (Err(e), Err(v)) => prop_assert_eq!(v, ViewError::of(&e), "{}", e),
+        (d, v) => prop_assert!(false, "decode {:?} but view {:?}", d, v),
+    }
+    Ok(())
+}
+
+/// A FswMsg with any bits in its floats (NaN, infinities), up to 9 events (one beyond the
+/// maximum) and up to 12 value words.
+fn fsw_sample() -> impl Strategy<Value = flexdyn_proto::FswMsg> {
+    (
+        header(),
+        any::<u8>(),
+        any::<u32>(),
+        prop::array::uniform4(any_bits_f64()),
+        prop::array::uniform4(any_bits_f64()),
+        prop::array::uniform3(any_bits_f64()),
+        0u8..10,
+        prop::array::uniform8(any::<u16>()),
+        prop::collection::vec(any::<u64>(), 0..12),
+    )
+        .prop_map(
+            |(
+                header,
+                flags,
+                mode,
+                q_est_bn,
+                q_target_rn,
+                att_var_b_rad2,
+                event_count,
+                events,
+                values,
+            )| {
+                flexdyn_proto::FswMsg {
+                    header,
+                    flags,
+                    mode,
+                    q_est_bn,
+                    q_target_rn,
+                    att_var_b_rad2,
+                    event_count,
+                    events,
+                    values,
+                }
+            },
+        )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2048))]
+
+    #[test]
+    fn the_fsw_view_agrees_with_the_decoder_on_arbitrary_bytes(
+        bytes in prop::collection::vec(any::<u8>(), 0..300)
+    ) {
+        fsw_view_agrees(&bytes)?;
+    }
+
+    /// Samples with any field values, then bit-damaged, truncated or extended.
+    #[test]
+    fn the_fsw_view_agrees_with_the_decoder_on_damaged_samples(
+        msg in fsw_sample(),
+        flip in prop::collection::vec((0usize..400, 0u8..8), 0..4),
+        cut in 0usize..8,
+    ) {
+        let mut bytes = flexdyn_proto::encode(&msg);
+        fsw_view_agrees(&bytes)?;
+        for (at, bit) in flip {
+            let n = bytes.len();
+            bytes[at % n] ^= 1 << bit;
+        }
+        fsw_view_agrees(&bytes)?;
+        let short = bytes.len().saturating_sub(cut);
+        fsw_view_agrees(&bytes[..short])?;
+        bytes.extend(std::iter::repeat_n(0u8, cut));
+        fsw_view_agrees(&bytes)?;
+    }
+}

@@ -36,7 +36,9 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
-use flexdyn_proto::{decode_fsw, DecodeError, FswMsg, Topics};
+use flexdyn_proto::fsw_view::view_fsw;
+use flexdyn_proto::view::ViewError;
+use flexdyn_proto::{decode_fsw, Topics};
 use flexdyn_sinks::recorder::{RecordItem, RecordTx};
 use flexdyn_vehicle::config::fsw::FswStreamDecl;
 use zenoh::pubsub::Subscriber;
@@ -46,8 +48,9 @@ use super::error::ServerError;
 use super::reject_log::RejectLog;
 use super::shared::Shared;
 
-/// What the callback checks a sample against.
-pub(super) struct FswIntake {
+/// What the callback checks a sample against (public for `tests/server_alloc.rs`, which runs
+/// it beside the frame path).
+pub struct FswIntake {
     /// The declared streams, in configuration order.
     streams: Vec<FswStreamDecl>,
     /// The full key of each stream (`flexdyn/<sc>/fsw/<name>`), shared with the recorder.
@@ -66,7 +69,7 @@ impl FswIntake {
     /// The intake of `streams` for the vehicle of `topics`; `lockstep_last_tick`: a lockstep
     /// run's last tick, if it has one. (The configuration validated the names, so their keys
     /// cannot fail.)
-    pub(super) fn new(
+    pub fn new(
         topics: &Topics,
         streams: Vec<FswStreamDecl>,
         spacecraft_id: u32,
@@ -92,19 +95,24 @@ impl FswIntake {
     /// Checks a sample that arrived on `key` while the server's last tick is `server_tick`:
     /// the index of its stream (`None`: a lockstep run's last tick, not recorded), or the
     /// refusal's reason and what was wrong.
-    pub(super) fn check(
+    pub fn check(
         &self,
         key: &str,
         bytes: &[u8],
         server_tick: u64,
     ) -> Result<Option<usize>, (&'static str, String)> {
-        let msg: FswMsg = decode_fsw(bytes).map_err(|e| {
+        // Read in place: an accepted sample allocates nothing. A refused one is decoded
+        // again for the decoder's message (the refusal path may allocate).
+        let msg = view_fsw(bytes).map_err(|e| {
             let reason = match e {
-                DecodeError::UnknownVersion { .. } => "bad_version",
-                DecodeError::NonFinite { .. } => "non_finite",
-                _ => "malformed",
+                ViewError::UnknownVersion { .. } => "bad_version",
+                ViewError::NonFinite => "non_finite",
+                ViewError::Malformed => "malformed",
             };
-            (reason, format!("flight-code telemetry on {key}: {e}"))
+            let detail = decode_fsw(bytes)
+                .err()
+                .map_or_else(|| format!("{e:?}"), |d| d.to_string());
+            (reason, format!("flight-code telemetry on {key}: {detail}"))
         })?;
         if msg.header.spacecraft_id != self.spacecraft_id {
             return Err((
@@ -150,7 +158,7 @@ impl FswIntake {
                 ),
             ));
         }
-        stream.check(&msg).map_err(|why| {
+        stream.check_view(&msg).map_err(|why| {
             (
                 why.reason(),
                 format!("stream `{}` sample for tick {tick}: {why}", stream.name),
@@ -192,7 +200,7 @@ impl FswIntake {
     }
 
     /// The recorder's key of stream `i`.
-    pub(super) fn key(&self, i: usize) -> &Arc<str> {
+    pub fn key(&self, i: usize) -> &Arc<str> {
         &self.keys[i]
     }
 }
@@ -265,7 +273,7 @@ pub(super) async fn declare(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flexdyn_proto::{encode, fsw_flags, Header};
+    use flexdyn_proto::{encode, fsw_flags, FswMsg, Header};
     use flexdyn_vehicle::config::SimConfig;
 
     const FRAME_NS: u64 = 10_000_000;

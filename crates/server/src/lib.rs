@@ -64,7 +64,7 @@ pub mod error;
 pub mod fault_cmd;
 pub mod fault_log;
 pub mod fleet;
-mod fsw;
+pub mod fsw;
 mod intake;
 mod lateness_ring;
 pub mod lockstep;

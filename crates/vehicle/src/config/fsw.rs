@@ -36,6 +36,7 @@ use toml::de::DeValue;
 use toml::Spanned;
 
 use flexdyn_kernel::schema::{SchemaError, TableReader};
+use flexdyn_proto::fsw_view::FswView;
 use flexdyn_proto::keys::validate_sensor_name;
 use flexdyn_proto::{fsw_flags, FswMsg, KeyError, MAX_FSW_VALUES};
 
@@ -249,18 +250,44 @@ impl FswStreamDecl {
     /// each f64 word is finite, each bool word is 0 or 1, and [`fsw_flags::COVARIANCE`] comes
     /// with [`fsw_flags::ESTIMATE`]. The first problem found, in that order, is the refusal.
     ///
-    /// It allocates nothing unless it refuses (it runs for every sample the server receives).
+    /// It allocates nothing unless it refuses.
     pub fn check(&self, msg: &FswMsg) -> Result<(), FswRefusal> {
-        if msg.flags & fsw_flags::MODE != 0
-            && usize::try_from(msg.mode).map_or(true, |m| m >= self.modes.len())
+        self.check_sample(
+            msg.flags,
+            msg.mode,
+            msg.event_indices(),
+            msg.values.len(),
+            |i| msg.values.get(i).copied().unwrap_or(0),
+        )
+    }
+
+    /// [`Self::check`] of a sample read in place (what the server runs for every sample it
+    /// receives, on a thread that may step the frames): allocates nothing unless it refuses.
+    pub fn check_view(&self, v: &FswView<'_>) -> Result<(), FswRefusal> {
+        self.check_sample(v.flags, v.mode, v.event_indices(), v.values_len(), |i| {
+            v.value_word(i).unwrap_or(0)
+        })
+    }
+
+    /// [`Self::check`] of a sample's parts: its flags, mode, event indices, and `n` value
+    /// words, word `i` being `word(i)`.
+    fn check_sample(
+        &self,
+        flags: u8,
+        mode: u32,
+        events: &[u16],
+        n: usize,
+        word: impl Fn(usize) -> u64,
+    ) -> Result<(), FswRefusal> {
+        if flags & fsw_flags::MODE != 0
+            && usize::try_from(mode).map_or(true, |m| m >= self.modes.len())
         {
             return Err(FswRefusal::UnknownMode {
-                index: msg.mode,
+                index: mode,
                 declared: self.modes.len(),
             });
         }
-        if let Some(&index) = msg
-            .event_indices()
+        if let Some(&index) = events
             .iter()
             .find(|&&e| usize::from(e) >= self.events.len())
         {
@@ -270,37 +297,30 @@ impl FswStreamDecl {
             });
         }
         let declared = self.words();
-        if msg.values.len() != declared {
-            return Err(FswRefusal::WrongCount {
-                got: msg.values.len(),
-                declared,
-            });
+        if n != declared {
+            return Err(FswRefusal::WrongCount { got: n, declared });
         }
-        // `values` holds exactly the declared words: walk them in declaration order.
-        let mut rest = msg.values.as_slice();
+        // Exactly the declared words: walk them in declaration order.
         for v in &self.values {
-            let (words, tail) = rest.split_at(v.len.min(rest.len()));
-            rest = tail;
-            match v.ty {
-                FswValueType::F64 => {
-                    if let Some(k) = words.iter().position(|&w| !f64::from_bits(w).is_finite()) {
+            for k in 0..v.len {
+                let w = word(v.offset + k);
+                match v.ty {
+                    FswValueType::F64 if !f64::from_bits(w).is_finite() => {
                         return Err(FswRefusal::NonFinite {
                             value: v.element_name(k),
                         });
                     }
-                }
-                FswValueType::Bool => {
-                    if let Some(k) = words.iter().position(|&w| w > 1) {
+                    FswValueType::Bool if w > 1 => {
                         return Err(FswRefusal::NotBool {
                             value: v.element_name(k),
-                            word: words[k],
+                            word: w,
                         });
                     }
+                    _ => {}
                 }
-                FswValueType::I64 => {}
             }
         }
-        if msg.flags & fsw_flags::COVARIANCE != 0 && msg.flags & fsw_flags::ESTIMATE == 0 {
+        if flags & fsw_flags::COVARIANCE != 0 && flags & fsw_flags::ESTIMATE == 0 {
             return Err(FswRefusal::CovarianceWithoutEstimate);
         }
         Ok(())
