@@ -5,16 +5,15 @@
 //! [`view_fsw`] accepts exactly the bytes [`crate::decode_fsw`] accepts, with the same values,
 //! and refuses the others with the class of [`crate::DecodeError`] that `decode_fsw` gives
 //! (`tests/proptests.rs` checks both on arbitrary, truncated and bit-damaged samples). The
-//! checks, in `decode`'s order: at most [`MAX_MESSAGE_BYTES`]; the protocol version; the length
+//! checks, in `decode`'s order: at most [`crate::MAX_MESSAGE_BYTES`]; the protocol version; the length
 //! the value count at [`FSW_VALUES_COUNT_OFFSET`] implies (the count within
 //! [`MAX_FSW_VALUES`]) against the buffer; `event_count` within [`MAX_FSW_EVENTS`]; then
 //! `q_est_bn`, `q_target_rn` and `att_var_b_rad2` finite, in wire order (proto/README.md,
 //! "FswMsg").
 
-use crate::view::{f64_at, u16_at, u32_at, u64_at, ViewError};
+use crate::view::{f64_at, header_at, size_and_version, u16_at, u32_at, u64_at, ViewError};
 use crate::{
     FswMsg, Header, FSW_FIXED_LEN, FSW_VALUES_COUNT_OFFSET, MAX_FSW_EVENTS, MAX_FSW_VALUES,
-    MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
 };
 
 /// A flight-code telemetry sample, read in place (the fields of [`FswMsg`]).
@@ -85,13 +84,7 @@ fn floats<const N: usize>(b: &[u8], at: usize) -> Result<([f64; N], bool), ViewE
 
 /// Reads a [`FswMsg`] in place (module docs). Allocates nothing.
 pub fn view_fsw(bytes: &[u8]) -> Result<FswView<'_>, ViewError> {
-    if bytes.len() > MAX_MESSAGE_BYTES {
-        return Err(ViewError::Malformed);
-    }
-    let found = u16_at(bytes, 0).ok_or(ViewError::Malformed)?;
-    if found != PROTOCOL_VERSION {
-        return Err(ViewError::UnknownVersion { found });
-    }
+    let found = size_and_version(bytes)?;
     let n = u64_at(bytes, FSW_VALUES_COUNT_OFFSET).ok_or(ViewError::Malformed)?;
     let n = usize::try_from(n)
         .ok()
@@ -104,13 +97,7 @@ pub fn view_fsw(bytes: &[u8]) -> Result<FswView<'_>, ViewError> {
     if usize::from(event_count) > MAX_FSW_EVENTS {
         return Err(ViewError::Malformed);
     }
-    let header = Header {
-        protocol_version: found,
-        spacecraft_id: u32_at(bytes, 2).ok_or(ViewError::Malformed)?,
-        tick: u64_at(bytes, 6).ok_or(ViewError::Malformed)?,
-        sim_time_ns: u64_at(bytes, 14).ok_or(ViewError::Malformed)?,
-        seq: u64_at(bytes, 22).ok_or(ViewError::Malformed)?,
-    };
+    let header = header_at(bytes, found)?;
     let (q_est_bn, est_ok) = floats::<4>(bytes, 35)?;
     let (q_target_rn, target_ok) = floats::<4>(bytes, 67)?;
     let (att_var_b_rad2, var_ok) = floats::<3>(bytes, 99)?;

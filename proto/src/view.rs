@@ -179,8 +179,9 @@ fn walk_inputs(bytes: &[u8]) -> Result<(usize, usize), ViewError> {
     Ok((at, count as usize))
 }
 
-/// Reads a [`CommandMsg`] in place (module docs). Allocates nothing.
-pub fn view_command(bytes: &[u8]) -> Result<CommandView<'_>, ViewError> {
+/// `decode`'s first two checks: at most [`MAX_MESSAGE_BYTES`], and the protocol version
+/// (returned).
+pub(crate) fn size_and_version(bytes: &[u8]) -> Result<u16, ViewError> {
     if bytes.len() > MAX_MESSAGE_BYTES {
         return Err(ViewError::Malformed);
     }
@@ -188,6 +189,23 @@ pub fn view_command(bytes: &[u8]) -> Result<CommandView<'_>, ViewError> {
     if found != PROTOCOL_VERSION {
         return Err(ViewError::UnknownVersion { found });
     }
+    Ok(found)
+}
+
+/// The [`Header`] at the start of `bytes`, whose version is `found`.
+pub(crate) fn header_at(bytes: &[u8], found: u16) -> Result<Header, ViewError> {
+    Ok(Header {
+        protocol_version: found,
+        spacecraft_id: u32_at(bytes, 2).ok_or(ViewError::Malformed)?,
+        tick: u64_at(bytes, 6).ok_or(ViewError::Malformed)?,
+        sim_time_ns: u64_at(bytes, 14).ok_or(ViewError::Malformed)?,
+        seq: u64_at(bytes, 22).ok_or(ViewError::Malformed)?,
+    })
+}
+
+/// Reads a [`CommandMsg`] in place (module docs). Allocates nothing.
+pub fn view_command(bytes: &[u8]) -> Result<CommandView<'_>, ViewError> {
+    let found = size_and_version(bytes)?;
     let tag = u32_at(bytes, COMMAND_KIND_OFFSET).ok_or(ViewError::Malformed)?;
     let (expected, inputs) = match tag {
         0 => (COMMAND_WRENCH_LEN, 0),
@@ -198,13 +216,7 @@ pub fn view_command(bytes: &[u8]) -> Result<CommandView<'_>, ViewError> {
     if bytes.len() != expected {
         return Err(ViewError::Malformed);
     }
-    let header = Header {
-        protocol_version: found,
-        spacecraft_id: u32_at(bytes, 2).ok_or(ViewError::Malformed)?,
-        tick: u64_at(bytes, 6).ok_or(ViewError::Malformed)?,
-        sim_time_ns: u64_at(bytes, 14).ok_or(ViewError::Malformed)?,
-        seq: u64_at(bytes, 22).ok_or(ViewError::Malformed)?,
-    };
+    let header = header_at(bytes, found)?;
     let sender_id = u32_at(bytes, HEADER_LEN).ok_or(ViewError::Malformed)?;
     let wrench = || -> Result<([f64; 3], [f64; 3]), ViewError> {
         let torque = v3_at(bytes, COMMAND_KIND_OFFSET + 4).ok_or(ViewError::Malformed)?;

@@ -13,7 +13,6 @@
 use std::path::{Path, PathBuf};
 
 use flexdyn_proto::{encode, fsw_flags, FswMsg, Header, StateMsg};
-use flexdyn_sinks::mcap_file::{McapSink, RecordingInfo, VehicleInfo};
 use flexdyn_sinks::plot::{figures, plot, Figure, PlotArgs};
 
 const FRAME_NS: u64 = 100_000_000;
@@ -67,25 +66,11 @@ name = "nav"
 /// The recording, written to `name` (one per test: the tests run at once).
 fn recording(name: &str) -> PathBuf {
     let rec = tmp(name);
-    let info = RecordingInfo {
-        recorder: "tests/cli/fsw_plots.rs".into(),
-        command_line: String::new(),
-    };
-    let mut sink = McapSink::create(&rec, &info).unwrap();
     let config_toml = format!(
         "{}\n{STREAMS}",
         flexdyn_vehicle::config::DEFAULT_CONFIG_TOML
     );
-    sink.describe_vehicle(&VehicleInfo {
-        sc_id: "sc1".into(),
-        spacecraft_id: 1,
-        config_toml,
-        server_settings: String::new(),
-        flexdyn_version: "test".into(),
-        git_commit: None,
-        epoch_utc: None,
-    })
-    .unwrap();
+    let mut sink = crate::mcap_support::sink_for(&rec, &config_toml);
     for k in 0..TICKS {
         let t_ns = k * FRAME_NS;
         let theta = 0.01 * k as f64;

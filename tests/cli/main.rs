@@ -11,6 +11,8 @@
 #[allow(dead_code)]
 mod campaign_support;
 #[allow(dead_code)]
+mod mcap_support;
+#[allow(dead_code)]
 mod py_support;
 
 mod campaign_cli;

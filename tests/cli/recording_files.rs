@@ -3,6 +3,7 @@
 //! `tests/py/check_recording.py`, in its own venv `<target>/python-mcap-venv`) and the CSV
 //! files.
 
+use crate::mcap_support::{first_json_messages, sink_for};
 use crate::py_support;
 use flexdyn_testkit::ports;
 
@@ -277,17 +278,7 @@ fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
     )
     .unwrap();
     let file = batch_recording_of("layout.mcap", config.to_str().unwrap());
-    let bytes = std::fs::read(&file).unwrap();
-    let mut first: BTreeMap<String, serde_json::Value> = BTreeMap::new();
-    for m in mcap::MessageStream::new(&bytes).unwrap() {
-        let m = m.unwrap();
-        if m.channel.message_encoding == "json" && !first.contains_key(&m.channel.topic) {
-            first.insert(
-                m.channel.topic.clone(),
-                serde_json::from_slice(&m.data).unwrap(),
-            );
-        }
-    }
+    let mut first = first_json_messages(&std::fs::read(&file).unwrap());
     // The flight code's telemetry (issue 37) is not in a batch recording: a recording of one
     // sample of the stream `acs` that acs_full.toml declares, written by the recorder's sink.
     first.extend(fsw_decoded_messages(&scenario));
@@ -344,31 +335,13 @@ fn the_shipped_foxglove_layout_names_only_recorded_topics_and_fields() {
 /// written by [`McapSink`] for a vehicle configured by `config_toml`.
 fn fsw_decoded_messages(config_toml: &str) -> BTreeMap<String, serde_json::Value> {
     use flexdyn_proto::{encode, fsw_flags, FswMsg, Header};
-    use flexdyn_sinks::mcap_file::{McapSink, RecordingInfo, VehicleInfo};
     let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(config_toml).unwrap();
     let words = cfg
         .fsw_stream("acs")
         .expect("acs_full.toml declares acs")
         .words();
     let file = tmp("layout_fsw.mcap");
-    let mut sink = McapSink::create(
-        &file,
-        &RecordingInfo {
-            recorder: "test".into(),
-            command_line: String::new(),
-        },
-    )
-    .unwrap();
-    sink.describe_vehicle(&VehicleInfo {
-        sc_id: "sc1".into(),
-        spacecraft_id: 1,
-        config_toml: config_toml.to_owned(),
-        server_settings: String::new(),
-        flexdyn_version: "test".into(),
-        git_commit: None,
-        epoch_utc: None,
-    })
-    .unwrap();
+    let mut sink = sink_for(&file, config_toml);
     let msg = FswMsg {
         header: Header::new(1, 10, 100_000_000, 10),
         flags: fsw_flags::MODE | fsw_flags::ESTIMATE | fsw_flags::TARGET,
@@ -382,17 +355,7 @@ fn fsw_decoded_messages(config_toml: &str) -> BTreeMap<String, serde_json::Value
     sink.write("flexdyn/sc1/fsw/acs", &encode(&msg), Some(1), 100_000_000)
         .unwrap();
     sink.finish().unwrap();
-    let bytes = std::fs::read(&file).unwrap();
-    let mut first = BTreeMap::new();
-    for m in mcap::MessageStream::new(&bytes).unwrap() {
-        let m = m.unwrap();
-        if m.channel.message_encoding == "json" && !first.contains_key(&m.channel.topic) {
-            first.insert(
-                m.channel.topic.clone(),
-                serde_json::from_slice(&m.data).unwrap(),
-            );
-        }
-    }
+    let first = first_json_messages(&std::fs::read(&file).unwrap());
     assert!(
         first.contains_key("/flexdyn/sc1/fsw/acs"),
         "{:?}",

@@ -117,6 +117,23 @@ fn page_port(child: &mut Child) -> u16 {
     port
 }
 
+/// `flexdyn view --file FILE` on a port the OS picks (stopped when dropped), and that port.
+fn serve_file(file: &Path) -> (Guard, u16) {
+    let mut viewer = Guard(
+        ports::reporting(
+            Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+                .args(["view", "--file"])
+                .arg(file)
+                .args(["--bind", "127.0.0.1:0", "--duration-s", "60"]),
+        )
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap(),
+    );
+    let port = page_port(&mut viewer.0);
+    (viewer, port)
+}
+
 /// `flexdyn run --view` serves the same page for its own live run (issue 36: "and from the
 /// server when asked"): a real-time run of the LEO scenario, the page held 2.5 s, shows a tick
 /// of the run (> 0: data came) and the run state `Running`.
@@ -193,18 +210,7 @@ fn a_browser_shows_a_replay_on_the_viewers_own_port() {
         .clone();
 
     // The viewer on a port the OS picks; its one log line names the page and the protocol.
-    let mut viewer = Guard(
-        ports::reporting(
-            Command::new(env!("CARGO_BIN_EXE_flexdyn"))
-                .args(["view", "--file"])
-                .arg(&file)
-                .args(["--bind", "127.0.0.1:0", "--duration-s", "60"]),
-        )
-        .stdout(Stdio::null())
-        .spawn()
-        .unwrap(),
-    );
-    let port = page_port(&mut viewer.0);
+    let (viewer, port) = serve_file(&file);
 
     let shot = tmp("page.png");
     let dom = browse(browser, port, HOLD_MS, &shot);
@@ -269,31 +275,13 @@ fn a_browser_shows_a_replay_on_the_viewers_own_port() {
 #[test]
 fn a_browser_shows_the_flight_codes_mode_and_last_event() {
     use flexdyn_proto::{encode, fsw_flags, FswMsg, Header, RunState, StateMsg, StatusMsg};
-    use flexdyn_sinks::mcap_file::{McapSink, RecordingInfo, VehicleInfo};
     let browser = chromium();
     let config_toml = std::fs::read_to_string(root().join("scenarios/fdir.toml")).unwrap();
     let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(&config_toml).unwrap();
     let decl = cfg.fsw_stream("acs").expect("fdir.toml declares acs");
     let event = |name: &str| decl.event_index(name).unwrap();
     let file = tmp("fsw_view.mcap");
-    let mut sink = McapSink::create(
-        &file,
-        &RecordingInfo {
-            recorder: "test".into(),
-            command_line: String::new(),
-        },
-    )
-    .unwrap();
-    sink.describe_vehicle(&VehicleInfo {
-        sc_id: "sc1".into(),
-        spacecraft_id: 1,
-        config_toml: config_toml.clone(),
-        server_settings: String::new(),
-        flexdyn_version: "test".into(),
-        git_commit: None,
-        epoch_utc: None,
-    })
-    .unwrap();
+    let mut sink = crate::mcap_support::sink_for(&file, &config_toml);
     let frame_ns = 100_000_000;
     for tick in 0..=20u64 {
         let header = Header::new(1, tick, tick * frame_ns, tick);
@@ -336,18 +324,7 @@ fn a_browser_shows_the_flight_codes_mode_and_last_event() {
     .unwrap();
     sink.finish().unwrap();
 
-    let mut viewer = Guard(
-        ports::reporting(
-            Command::new(env!("CARGO_BIN_EXE_flexdyn"))
-                .args(["view", "--file"])
-                .arg(&file)
-                .args(["--bind", "127.0.0.1:0", "--duration-s", "60"]),
-        )
-        .stdout(Stdio::null())
-        .spawn()
-        .unwrap(),
-    );
-    let port = page_port(&mut viewer.0);
+    let (_viewer, port) = serve_file(&file);
     let dom = browse(browser, port, 4000, &tmp("fsw_page.png"));
     assert_eq!(element_text(&dom, "tick"), Some("20"), "{dom}");
     assert_eq!(

@@ -34,19 +34,6 @@ const LAST_TICK: u64 = 50;
 /// \[ms\] the issue's target.
 const TARGET_MS: f64 = 100.0;
 
-/// The libraries `rustc --print native-static-libs` names for the static library on Linux
-/// (docs/guides/flight-code.md).
-const NATIVE_LIBS: &[&str] = &[
-    "-ldl",
-    "-lgcc_s",
-    "-lutil",
-    "-lrt",
-    "-lpthread",
-    "-lm",
-    "-ldl",
-    "-lc",
-];
-
 /// The Python participant: answers every tick with a zero wrench until the run ends.
 const PYTHON_PARTICIPANT: &str = "
 import sys, flexdyn
@@ -61,34 +48,9 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// What a cargo build of `package` produced with `suffix` (`.a`), built by a nested cargo (a
-/// no-op when fresh). Cargo runs with the variables it set for this bench removed, so build
-/// scripts do not rerun.
+/// What `cargo build -p package` produced that ends with `suffix` (`.a`).
 fn cargo_artifact(package: &str, suffix: &str) -> PathBuf {
-    let mut cmd = Command::new(env!("CARGO"));
-    cmd.current_dir(root()).args([
-        "build",
-        "--release",
-        "-p",
-        package,
-        "--message-format=json-render-diagnostics",
-    ]);
-    for (key, _) in std::env::vars_os() {
-        let k = key.to_string_lossy();
-        if k.starts_with("CARGO_PKG_")
-            || k.starts_with("CARGO_MANIFEST_")
-            || k.starts_with("CARGO_CRATE_")
-            || k.starts_with("CARGO_BIN_")
-            || k == "CARGO_PRIMARY_PACKAGE"
-            || k == "CARGO_TARGET_TMPDIR"
-            || k == "OUT_DIR"
-        {
-            cmd.env_remove(&key);
-        }
-    }
-    let out = cmd.stderr(Stdio::inherit()).output().expect("run cargo");
-    assert!(out.status.success(), "cargo build -p {package} failed");
-    String::from_utf8_lossy(&out.stdout)
+    flexdyn_testkit::cargo_build::cargo_build(&root(), &["-p", package])
         .lines()
         .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
         .filter(|m| m["reason"] == "compiler-artifact")
@@ -117,7 +79,7 @@ fn build_pd_lockstep() -> PathBuf {
         .arg(root().join("clients/c/include"))
         .arg(root().join("clients/c/examples/pd_lockstep.c"))
         .arg(&lib)
-        .args(NATIVE_LIBS)
+        .args(flexdyn_testkit::cargo_build::NATIVE_LIBS)
         .arg("-o")
         .arg(&exe)
         .status()

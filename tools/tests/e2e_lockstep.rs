@@ -412,21 +412,13 @@ fn wheels_on_sensors_run(
     let server = ServerHandle::start(settings, cfg);
     let port = server.port;
     let recorder = Recorder::start(port, &topics, 2);
-    let _ctrl = ChildGuard::spawn(
+    let _ctrl = ChildGuard::spawn(crate::support::on_sensors(
         Command::new(demo_bin::acs_demo())
             .args(["--connect", &endpoint(port), "--sender-id", "1"])
             .args(["--k-nm", &k_nm.to_string(), "--p-nms", &p_nms.to_string()])
-            .args(["--log-every-s", "0"])
-            .args(["--actuator", "wheels", "--attitude-source", "star-tracker"])
-            .args([
-                "--star-tracker",
-                "st1",
-                "--rate-source",
-                "gyro",
-                "--imu",
-                "hub",
-            ]),
-    );
+            .args(["--log-every-s", "0"]),
+        "hub",
+    ));
     let report = server.join(timeout).expect("wheels-on-sensors run");
     let mut states = recorder.states.lock().unwrap().clone();
     states.sort_by_key(|(t, _)| *t);

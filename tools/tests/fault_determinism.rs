@@ -100,20 +100,12 @@ fn run(seed: u64) -> (flexdyn_server::RunReport, Vec<(u64, Vec<u8>)>) {
     let server = ServerHandle::start(settings, config(seed));
     let port = server.port;
     let recorder = Recorder::start(port, &topics, 2);
-    let _ctrl = ChildGuard::spawn(
+    let _ctrl = ChildGuard::spawn(crate::support::on_sensors(
         Command::new(demo_bin::acs_demo())
             .args(["--connect", &endpoint(port), "--sender-id", "1"])
-            .args(["--k-nm", "10", "--p-nms", "150", "--log-every-s", "0"])
-            .args(["--actuator", "wheels", "--attitude-source", "star-tracker"])
-            .args([
-                "--star-tracker",
-                "st1",
-                "--rate-source",
-                "gyro",
-                "--imu",
-                "hub",
-            ]),
-    );
+            .args(["--k-nm", "10", "--p-nms", "150", "--log-every-s", "0"]),
+        "hub",
+    ));
     let report = server.join(Duration::from_secs(120)).expect("the run");
     let mut states = recorder.states.lock().unwrap().clone();
     states.sort_by_key(|(t, _)| *t);

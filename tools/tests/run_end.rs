@@ -19,28 +19,20 @@ use flexdyn_server::ServerSettings;
 /// Far above any delivery time, far below "never".
 const EXIT_BOUND: Duration = Duration::from_secs(10);
 
-#[test]
-fn the_demo_and_the_monitor_stop_when_the_server_finishes() {
-    let settings = ServerSettings {
-        mode: Mode::Lockstep,
-        participants: vec![1],
-        duration_ns: Some(3_000_000_000),
-        ..ServerSettings::default()
-    };
-    let server = ServerHandle::start(settings, reference_config(100.0));
-    let connect = endpoint(server.port);
+/// `flexdyn-monitor --plain` on `connect`, its output lines, and its first line. It prints its
+/// first line once its subscribers are declared: only then may the run start (the demo is the
+/// participant the lockstep server waits for). A monitor that subscribes after the run ended
+/// cannot hear its end; on a loaded CI machine it once did.
+fn start_monitor(connect: &str) -> (ChildGuard, std::sync::mpsc::Receiver<String>, String) {
     let mut monitor = ChildGuard(
         Command::new(env!("CARGO_BIN_EXE_flexdyn-monitor"))
-            .args(["--connect", &connect, "--plain", "--interval-s", "0.5"])
+            .args(["--connect", connect, "--plain", "--interval-s", "0.5"])
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()
             .unwrap(),
     );
-    // The monitor prints its first line once its subscribers are declared: only then may the
-    // run start (the demo is the participant the lockstep server waits for). A monitor that
-    // subscribes after the run ended cannot hear its end; on a loaded CI machine it once did.
     let (tx, lines) = std::sync::mpsc::channel::<String>();
     let stdout = monitor.0.stdout.take().unwrap();
     std::thread::spawn(move || {
@@ -54,6 +46,20 @@ fn the_demo_and_the_monitor_stop_when_the_server_finishes() {
     let first = lines
         .recv_timeout(Duration::from_secs(30))
         .expect("the monitor printed nothing within 30 s");
+    (monitor, lines, first)
+}
+
+#[test]
+fn the_demo_and_the_monitor_stop_when_the_server_finishes() {
+    let settings = ServerSettings {
+        mode: Mode::Lockstep,
+        participants: vec![1],
+        duration_ns: Some(3_000_000_000),
+        ..ServerSettings::default()
+    };
+    let server = ServerHandle::start(settings, reference_config(100.0));
+    let connect = endpoint(server.port);
+    let (mut monitor, lines, first) = start_monitor(&connect);
     let mut out = vec![first];
     let mut demo = ChildGuard::spawn(
         Command::new(demo_bin::acs_demo())
@@ -109,44 +115,14 @@ fn the_monitor_shows_the_flight_codes_mode_and_last_event() {
     };
     let server = ServerHandle::start(settings, cfg);
     let connect = endpoint(server.port);
-    let mut monitor = ChildGuard(
-        Command::new(env!("CARGO_BIN_EXE_flexdyn-monitor"))
-            .args(["--connect", &connect, "--plain", "--interval-s", "0.5"])
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap(),
-    );
-    let (tx, lines) = std::sync::mpsc::channel::<String>();
-    let stdout = monitor.0.stdout.take().unwrap();
-    std::thread::spawn(move || {
-        for line in std::io::BufRead::lines(std::io::BufReader::new(stdout)) {
-            let Ok(line) = line else { break };
-            if tx.send(line).is_err() {
-                break;
-            }
-        }
-    });
-    // The monitor's subscribers are declared once it prints: only then may the run start.
-    let first = lines
-        .recv_timeout(Duration::from_secs(30))
-        .expect("the monitor printed nothing within 30 s");
+    let (mut monitor, lines, first) = start_monitor(&connect);
     let mut out = vec![first];
-    let mut demo = ChildGuard::spawn(
+    let mut demo = ChildGuard::spawn(crate::support::on_sensors(
         Command::new(demo_bin::acs_demo())
             .args(["--connect", &connect, "--sender-id", "1", "--fdir"])
-            .args(["--actuator", "wheels", "--attitude-source", "star-tracker"])
-            .args([
-                "--star-tracker",
-                "st1",
-                "--rate-source",
-                "gyro",
-                "--imu",
-                "imu_a",
-            ])
             .args(["--log-every-s", "0"]),
-    );
+        "imu_a",
+    ));
     let report = server.join(Duration::from_secs(120)).expect("the run");
     assert_eq!(report.last_tick, 650);
     assert!(demo.wait_timeout(EXIT_BOUND).is_some_and(|s| s.success()));

@@ -43,18 +43,7 @@ use flexdyn_proto::{decode_state, effector_kind, StateMsg};
 
 use flexdyn_testkit::ports;
 
-/// The libraries `rustc --print native-static-libs` names for the static library on Linux
-/// (docs/guides/flight-code.md).
-const NATIVE_LIBS: &[&str] = &[
-    "-ldl",
-    "-lgcc_s",
-    "-lutil",
-    "-lrt",
-    "-lpthread",
-    "-lm",
-    "-ldl",
-    "-lc",
-];
+use flexdyn_testkit::cargo_build::NATIVE_LIBS;
 
 /// The wheel-speed damping of `examples/pd_lockstep.c` [N m s/rad].
 const C_WHEEL_NMS: f64 = 1e-4;
@@ -89,35 +78,7 @@ fn static_lib() -> PathBuf {
 fn flexdyn_bin() -> &'static Path {
     static ONCE: OnceLock<PathBuf> = OnceLock::new();
     ONCE.get_or_init(|| {
-        let mut cmd = Command::new(env!("CARGO"));
-        cmd.current_dir(root()).args([
-            "build",
-            "-p",
-            "flexdyn",
-            "--bin",
-            "flexdyn",
-            "--message-format=json-render-diagnostics",
-        ]);
-        for (key, _) in std::env::vars_os() {
-            let k = key.to_string_lossy();
-            let set_for_tests = k.starts_with("CARGO_PKG_")
-                || k.starts_with("CARGO_MANIFEST_")
-                || k.starts_with("CARGO_CRATE_")
-                || k.starts_with("CARGO_BIN_")
-                || k == "CARGO_PRIMARY_PACKAGE"
-                || k == "CARGO_TARGET_TMPDIR"
-                || k == "CARGO_RUSTC_CURRENT_DIR"
-                || k == "OUT_DIR";
-            if set_for_tests {
-                cmd.env_remove(&key);
-            }
-        }
-        if !cfg!(debug_assertions) {
-            cmd.arg("--release");
-        }
-        let out = cmd.stderr(Stdio::inherit()).output().expect("run cargo");
-        assert!(out.status.success(), "cargo build -p flexdyn failed");
-        String::from_utf8_lossy(&out.stdout)
+        flexdyn_testkit::cargo_build::cargo_build(&root(), &["-p", "flexdyn", "--bin", "flexdyn"])
             .lines()
             .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
             .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == "flexdyn")

@@ -13,6 +13,7 @@
 //! crate whose tests use them.
 
 pub mod alloc_counter;
+pub mod cargo_build;
 pub mod cli_errors;
 pub mod demo_bin;
 pub mod fleets;

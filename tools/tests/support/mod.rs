@@ -49,3 +49,21 @@ pub fn campaign_run_and_summarize(
     eprintln!("{}", summary.text);
     (report.exit_code, summary.text)
 }
+
+/// The demo's arguments for flying on its sensors and wheels: the star tracker `st1` for the
+/// attitude, the gyro of the IMU `imu` for the rate, the reaction wheels as actuators.
+#[allow(dead_code)]
+pub fn on_sensors<'c>(
+    cmd: &'c mut std::process::Command,
+    imu: &str,
+) -> &'c mut std::process::Command {
+    cmd.args(["--actuator", "wheels", "--attitude-source", "star-tracker"])
+        .args([
+            "--star-tracker",
+            "st1",
+            "--rate-source",
+            "gyro",
+            "--imu",
+            imu,
+        ])
+}
