@@ -10,7 +10,8 @@
 use std::collections::HashMap;
 
 use flexdyn_proto::{fsw_flags, FswMsg};
-use flexdyn_vehicle::config::{FswStreamDecl, FswValueType, SimConfig};
+use flexdyn_vehicle::config::fsw::read_streams;
+use flexdyn_vehicle::config::{FswStreamDecl, FswValueType};
 
 use super::reader::Recording;
 use super::table::Cell;
@@ -19,9 +20,9 @@ use super::table::Cell;
 pub fn declarations(rec: &Recording) -> HashMap<String, FswStreamDecl> {
     let mut out = HashMap::new();
     for v in rec.vehicles() {
-        match SimConfig::from_toml_str(&v.config_toml) {
-            Ok(cfg) => {
-                for decl in cfg.fsw_streams {
+        match read_streams(&v.config_toml) {
+            Ok(streams) => {
+                for decl in streams {
                     // The configuration validated the names: their keys are there.
                     if let Ok(key) = flexdyn_proto::fsw_key(&v.sc_id, &decl.name) {
                         out.insert(key, decl);
@@ -31,7 +32,7 @@ pub fn declarations(rec: &Recording) -> HashMap<String, FswStreamDecl> {
             Err(e) => tracing::warn!(
                 sc_id = %v.sc_id,
                 error = %e,
-                "the recording's configuration does not load: flight-code columns by wire only"
+                "the recording's [[fsw_streams]] do not load: flight-code columns by wire only"
             ),
         }
     }

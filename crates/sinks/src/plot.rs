@@ -333,14 +333,14 @@ fn fsw_series(
     let Some(info) = rec.vehicles().into_iter().find(|v| v.sc_id == sc) else {
         return Vec::new();
     };
-    let cfg = match flexdyn_vehicle::config::SimConfig::from_toml_str(&info.config_toml) {
-        Ok(c) => c,
+    let streams = match flexdyn_vehicle::config::fsw::read_streams(&info.config_toml) {
+        Ok(s) => s,
         Err(e) => {
-            tracing::warn!(sc_id = sc, error = %e, "the recording's configuration does not load: no flight-code figures");
+            tracing::warn!(sc_id = sc, error = %e, "the recording's [[fsw_streams]] do not load: no flight-code figures");
             return Vec::new();
         }
     };
-    cfg.fsw_streams
+    streams
         .into_iter()
         .map(|decl| {
             let mut samples = samples.remove(&decl.name).unwrap_or_default();

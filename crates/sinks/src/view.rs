@@ -250,12 +250,11 @@ pub fn fsw_streams_topic(sc_id: &str) -> String {
 /// `{"streams": [{"name", "modes": [...], "events": [{"name", "severity"}], "values": [{"name",
 /// "type", "len", "unit"}]}]}`; `None` when it declares no stream (or does not parse here).
 pub fn fsw_streams_json(config_toml: &str) -> Option<String> {
-    let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(config_toml).ok()?;
-    if cfg.fsw_streams.is_empty() {
+    let declared = flexdyn_vehicle::config::fsw::read_streams(config_toml).ok()?;
+    if declared.is_empty() {
         return None;
     }
-    let streams: Vec<serde_json::Value> = cfg
-        .fsw_streams
+    let streams: Vec<serde_json::Value> = declared
         .iter()
         .map(|d| {
             serde_json::json!({

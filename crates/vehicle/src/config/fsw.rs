@@ -555,6 +555,20 @@ fn quoted(allowed: impl Iterator<Item = &'static str>) -> String {
 }
 
 /// Pass 4: validates every stream; errors name the entry and the field.
+/// The `[[fsw_streams]]` of the configuration text `source` alone, read and validated as
+/// [`super::SimConfig`] reads them (the same errors), without reading or building the rest:
+/// what the readers of a recording need, where the configuration's relative file paths may not
+/// resolve and its vehicle need not be built.
+pub fn read_streams(source: &str) -> Result<Vec<FswStreamDecl>, ConfigError> {
+    let doc = super::parse_document(source)?;
+    let map = SourceMap::new(source, doc.get_ref());
+    // Every other root key is the rest of the configuration's, not checked here.
+    let keys: Vec<&str> = doc.get_ref().keys().map(|k| k.get_ref().as_ref()).collect();
+    let root = TableReader::root(source, doc.get_ref(), &keys)?;
+    let raw = root.read_tables("fsw_streams", &KEYS, |t| RawFswStream::read(t, &map))?;
+    resolve(&raw, &map)
+}
+
 pub(super) fn resolve(
     raw: &[RawFswStream],
     map: &SourceMap,
@@ -730,6 +744,29 @@ values = [
   { name = "sun_valid", type = "bool" },
 ]
 "#;
+
+    /// `read_streams` reads the streams alone, exactly as the whole configuration does: the
+    /// same declarations, the same errors; and a configuration the vehicle of which does not
+    /// build (here a negative hub mass) still gives its streams.
+    #[test]
+    fn the_streams_are_read_alone_as_the_configuration_reads_them() {
+        let whole = parse(ACS).unwrap();
+        assert_eq!(read_streams(&text(ACS)).unwrap(), whole.fsw_streams);
+        assert_eq!(read_streams(DEFAULT_CONFIG_TOML).unwrap(), Vec::new());
+        let broken = text(ACS).replacen("mass_kg = 750.0", "mass_kg = -750.0", 1);
+        assert!(
+            SimConfig::from_toml_str(&broken).is_err(),
+            "the hub mass is refused"
+        );
+        assert_eq!(read_streams(&broken).unwrap(), whole.fsw_streams);
+        let bad = ACS.replace("type = \"i64\"", "type = \"i32\"");
+        assert_eq!(
+            read_streams(&text(&bad)).unwrap_err().to_string(),
+            parse(&bad).unwrap_err().to_string()
+        );
+        let e = read_streams("[[fsw_streams]\n").unwrap_err();
+        assert!(matches!(e, ConfigError::Syntax { line: 1, .. }), "{e}");
+    }
 
     /// The reference configuration with `extra` appended.
     fn text(extra: &str) -> String {

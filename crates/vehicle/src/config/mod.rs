@@ -132,17 +132,7 @@ impl SimConfig {
     /// Like [`Self::from_toml_str`], with relative paths in the file (`orbit.elements_file`)
     /// resolved against `base_dir`.
     pub fn from_toml_str_in(s: &str, base_dir: &Path) -> Result<Self, ConfigError> {
-        let doc = DeTable::parse(s).map_err(|e| {
-            let loc = e
-                .span()
-                .map(|sp| location(s, sp.start))
-                .unwrap_or(Location { line: 1, column: 1 });
-            ConfigError::Syntax {
-                line: loc.line,
-                column: loc.column,
-                message: e.message().to_string(),
-            }
-        })?;
+        let doc = parse_document(s)?;
         let map = SourceMap::new(s, doc.get_ref());
         let raw = RawConfig::read(s, doc.get_ref(), &map)?;
         map.check_all_finite(doc.get_ref())?;
@@ -357,6 +347,21 @@ pub fn config_summary(cfg: &SimConfig) -> String {
             n => format!(", {n} effector input schedule rows"),
         },
     )
+}
+
+/// The TOML document `s`, or its syntax error with its line and column.
+pub(crate) fn parse_document(s: &str) -> Result<toml::Spanned<DeTable<'_>>, ConfigError> {
+    DeTable::parse(s).map_err(|e| {
+        let loc = e
+            .span()
+            .map(|sp| location(s, sp.start))
+            .unwrap_or(Location { line: 1, column: 1 });
+        ConfigError::Syntax {
+            line: loc.line,
+            column: loc.column,
+            message: e.message().to_string(),
+        }
+    })
 }
 
 // ---------------------------------------------------------------------------------------------
