@@ -327,6 +327,9 @@ fn a_browser_shows_the_flight_codes_mode_and_last_event() {
     let (_viewer, port) = serve_file(&file);
     let dom = browse(browser, port, 4000, &tmp("fsw_page.png"));
     assert_eq!(element_text(&dom, "tick"), Some("20"), "{dom}");
+    // The recording's one StatusMsg, at its last instant: its channel is advertised before the
+    // replay plays it (a channel opened by its first message lost it).
+    assert_eq!(element_text(&dom, "run-state"), Some("Finished"), "{dom}");
     assert_eq!(
         element_text(&dom, "fsw"),
         Some("acs: pointing · wheels-reconfigured (warning) at 1.500 s"),

@@ -181,6 +181,18 @@ impl Translator {
         }
     }
 
+    /// Opens the decoded channel of `key` before its first message: a replay knows its keys up
+    /// front, and a viewer subscribes to a channel only once it is advertised, so a channel
+    /// opened by its first message would lose that message (a one-off status or fault event).
+    fn advertise(&mut self, key: &str) {
+        let Some(topic) = classify(key) else { return };
+        if !self.filter.is_empty() && !self.filter.iter().any(|s| s == topic.sc_id) {
+            return;
+        }
+        let kind = topic.kind;
+        self.channel(&decoded_topic(key), || decoded_schema(kind));
+    }
+
     fn sample(&mut self, key: &str, payload: &[u8]) {
         let Some(topic) = classify(key) else { return };
         if !self.filter.is_empty() && !self.filter.iter().any(|s| s == topic.sc_id) {
@@ -193,13 +205,7 @@ impl Translator {
         let kind = topic.kind;
         let sc_id = topic.sc_id.to_owned();
         let json_topic = decoded_topic(key);
-        if let Some(c) = self.channel(&json_topic, || {
-            Schema::new(
-                format!("flexdyn.{}", kind.message_name()),
-                "jsonschema",
-                json_schema(kind).to_string().into_bytes(),
-            )
-        }) {
+        if let Some(c) = self.channel(&json_topic, || decoded_schema(kind)) {
             let json = decoded.to_json_bytes();
             c.log_with_meta(&json, PartialMetadata { log_time: Some(t) });
         }
@@ -296,6 +302,15 @@ fn fsw_streams_schema() -> Schema {
         "flexdyn.FswStreams",
         "jsonschema",
         schema.to_string().into_bytes(),
+    )
+}
+
+/// The schema of the decoded channel of a message kind (`flexdyn.<Message>`).
+fn decoded_schema(kind: super::topics::TopicKind) -> Schema {
+    Schema::new(
+        format!("flexdyn.{}", kind.message_name()),
+        "jsonschema",
+        json_schema(kind).to_string().into_bytes(),
     )
 }
 
@@ -466,6 +481,11 @@ pub fn view(args: &ViewArgs) -> Result<ViewReport, SinkError> {
                     let mut t = translator.lock().unwrap_or_else(|e| e.into_inner());
                     for v in rec.vehicles() {
                         t.describe(&v);
+                    }
+                    let keys: std::collections::BTreeSet<&str> =
+                        rec.samples.iter().map(|s| s.key.as_str()).collect();
+                    for key in keys {
+                        t.advertise(key);
                     }
                 }
                 let mut samples_sorted = rec.samples;
