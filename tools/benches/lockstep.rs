@@ -69,11 +69,12 @@ fn lockstep_rate(ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
 
 /// [`lockstep_rate`] with the demo publishing its telemetry every tick ([`FSW_STREAM`]).
 fn lockstep_rate_with_telemetry(ticks: usize, frame_hz: f64) -> f64 {
-    let text = flexdyn_vehicle::config::DEFAULT_CONFIG_TOML
-        .replace("frame_hz = 100.0 ", &format!("frame_hz = {frame_hz:?} "));
-    let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(&format!("{text}{FSW_STREAM}"))
-        .expect("the reference spacecraft with a telemetry stream");
-    lockstep_rate_of(ticks, cfg, Handoff::Direct, true)
+    lockstep_rate_of(
+        ticks,
+        support::reference_config_with(frame_hz, FSW_STREAM),
+        Handoff::Direct,
+        true,
+    )
 }
 
 fn lockstep_rate_of(

@@ -137,7 +137,7 @@ pub fn reduce(c: &Criterion, series: &[(f64, f64)], frame_s: f64) -> CriterionRe
 
 /// A deputy's quantity (`range`, `station_error`, `chief_pointing`) tick by tick, from its
 /// RelativeStateMsg stream and, for `chief_pointing`, its own and its chief's states (all in
-/// tick order, ticks 0..=N each).
+/// tick order).
 ///
 /// `chief_pointing`: the direction from the deputy's centre of mass to the chief's is
 /// −r_dc (RelativeStateMsg, H components); [NH] = [HN]ᵀ is the chief's Hill frame from its
@@ -163,16 +163,11 @@ pub fn relative_series(
         }
         Quantity::ChiefPointing => {
             let axis_b = Vector3::from(c.axis_b.unwrap_or([1.0, 0.0, 0.0]));
-            let by_tick = |s: &[StateMsg]| -> BTreeMap<u64, StateMsg> {
-                s.iter().map(|m| (m.header.tick, m.clone())).collect()
-            };
-            let (dep, chf) = (by_tick(deputy), by_tick(chief));
             relative
                 .iter()
                 .map(|m| {
-                    let angle = dep
-                        .get(&m.header.tick)
-                        .zip(chf.get(&m.header.tick))
+                    let angle = state_at(deputy, m.header.tick)
+                        .zip(state_at(chief, m.header.tick))
                         .and_then(|(d, ch)| {
                             let c_hn =
                                 dcm_hn(&Vector3::from(ch.r_bn_n_m), &Vector3::from(ch.v_bn_n_m_s))?;
@@ -192,6 +187,12 @@ pub fn relative_series(
         }
         _ => Vec::new(),
     }
+}
+
+/// The state of `tick` in `states` (in tick order): found by binary search, not copied.
+fn state_at(states: &[StateMsg], tick: u64) -> Option<&StateMsg> {
+    let i = states.binary_search_by_key(&tick, |m| m.header.tick).ok()?;
+    states.get(i)
 }
 
 /// An `fsw_` criterion judged on the stream's recorded samples (`samples`, in tick order),

@@ -70,9 +70,15 @@ pub fn connecting_session(port: u16) -> Session {
 
 /// The embedded reference spacecraft at `frame_hz`.
 pub fn reference_config(frame_hz: f64) -> SimConfig {
+    reference_config_with(frame_hz, "")
+}
+
+/// The embedded reference spacecraft at `frame_hz`, with the TOML `extra` appended (for
+/// example a `[[fsw_streams]]` declaration).
+pub fn reference_config_with(frame_hz: f64, extra: &str) -> SimConfig {
     let text =
         DEFAULT_CONFIG_TOML.replace("frame_hz = 100.0 ", &format!("frame_hz = {frame_hz:?} "));
-    SimConfig::from_toml_str(&text).unwrap()
+    SimConfig::from_toml_str(&format!("{text}{extra}")).unwrap()
 }
 
 /// Polls `cond` every millisecond until it holds or `timeout` passes.
