@@ -4,11 +4,18 @@
 //! - **shipped**: the file as it is (10 ms RK4 step, 10 Hz frames and sensors);
 //! - **1 ms + GPS**: a 1 ms step and a 1 Hz GPS receiver added.
 //!
-//! Each case is timed two ways, per RK4 step:
+//! Each case is timed three ways, per RK4 step:
 //! - `vehicle`: the vehicle runtime alone, frame by frame as the server steps it
-//!   (`Simulation::step_frame` with the environment, then the sensors due at the next tick);
+//!   (`Simulation::step_frame`, then the sensors due at the next tick), with the environment
+//!   models on their worker thread as the server runs them (`offload_environment`);
+//! - `1 thread`: the same with the environment models on the stepping thread, i.e. everything
+//!   on one core, as Basilisk runs;
 //! - `simulate`: the `flexdyn simulate` loop writing a row every second into a sink, so the
-//!   cost of the front end shows beside the runtime's.
+//!   cost of the front end shows beside the runtime's (it offloads the environment too).
+//!
+//! The worker is a cache: a sample it has not answered in time is evaluated on the stepping
+//! thread, and the output is the same bits either way. The summary prints the share of samples
+//! the worker answered.
 //!
 //! Issue 41's goal is the full scenario at ≥ 20× Basilisk's same scenario, measured in the same
 //! run. With `FLEXDYN_PEERS_PYTHON` (a Python with `bsk==2.12.1` and numpy) and
@@ -81,9 +88,15 @@ fn config(case: &Case) -> SimConfig {
 }
 
 /// ns per RK4 step of the vehicle's frame as the server runs it (`step_frame`, then the sensors
-/// due at the next tick sampled) over one span, after a one-second warm-up.
-fn time_vehicle(cfg: &SimConfig) -> f64 {
+/// due at the next tick sampled) over one span, after a one-second warm-up; with `offload`, the
+/// environment models on their worker thread. Also the share of environment samples the worker
+/// answered (0 without it).
+fn time_vehicle(cfg: &SimConfig, offload: bool) -> (f64, f64) {
     let mut sim = Simulation::new(cfg).expect("the scenario builds");
+    if offload {
+        sim.offload_environment()
+            .expect("the environment worker starts");
+    }
     let frames_per_s = (1e9 / cfg.frame_ns as f64).round() as u64;
     let mut tick = 0u64;
     let mut frame = |sim: &mut Simulation| {
@@ -101,7 +114,20 @@ fn time_vehicle(cfg: &SimConfig) -> f64 {
     }
     let ns = t.elapsed().as_nanos() as f64;
     black_box(sim.t_sim_ns());
-    ns / (frames * sim.steps_per_frame()) as f64
+    let updates_per_s = cfg
+        .environment
+        .as_ref()
+        .map_or(0.0, |e| 1e9 / e.update_ns as f64);
+    let updates = (SPAN_S + 1.0) * updates_per_s;
+    let answered = sim.environment().map_or(0, |e| e.prefetched_samples()) as f64;
+    (
+        ns / (frames * sim.steps_per_frame()) as f64,
+        if updates > 0.0 {
+            answered / updates
+        } else {
+            0.0
+        },
+    )
 }
 
 /// ns per RK4 step of the `simulate` loop writing a row every second into a sink.
@@ -166,9 +192,14 @@ fn main() {
             "t0.csv",
         )
         .expect("the t = 0 row");
-        let (mut vehicle, mut simulate, mut basilisk) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut vehicle, mut one_thread, mut simulate, mut basilisk) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut answered = Vec::new();
         for round in 0..rounds {
-            vehicle.push(time_vehicle(&cfg));
+            let (ns, share) = time_vehicle(&cfg, true);
+            vehicle.push(ns);
+            answered.push(share);
+            one_thread.push(time_vehicle(&cfg, false).0);
             simulate.push(time_simulate(&cfg));
             let peer_ns = peer
                 .as_ref()
@@ -179,9 +210,12 @@ fn main() {
                 None => {}
             }
             println!(
-                "{:<16} round {round}: vehicle {:>8.0} ns/step, simulate {:>8.0} ns/step{}",
+                "{:<16} round {round}: vehicle {:>8.0} ns/step ({:.0} % of samples from the worker), \
+                 1 thread {:>8.0}, simulate {:>8.0}{}",
                 case.label,
                 vehicle[round],
+                answered[round] * 100.0,
+                one_thread[round],
                 simulate[round],
                 match peer_ns {
                     Some(Ok(ns)) => format!(", basilisk {ns:>9.0} ns/step"),
@@ -191,31 +225,27 @@ fn main() {
         }
         summary.push((
             case.label,
-            median(vehicle),
-            median(simulate),
+            [median(vehicle), median(one_thread), median(simulate)],
             (!basilisk.is_empty()).then(|| median(basilisk)),
         ));
     }
     let _ = std::fs::remove_dir_all(&scratch);
     println!(
-        "\n{:<16} {:>16} {:>16} {:>18} {:>12} {:>12}",
-        "case",
-        "vehicle ns/step",
-        "simulate ns/step",
-        "basilisk ns/step",
-        "× (vehicle)",
-        "× (simulate)"
+        "\nns per step (medians), and Basilisk's time over each:\n{:<16} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
+        "case", "vehicle", "1 thread", "simulate", "basilisk", "×vehicle", "×1thread", "×simul."
     );
-    for (label, v, s, b) in summary {
+    for (label, ns, b) in summary {
+        let [v, one, s] = ns;
         match b {
             Some(b) => println!(
-                "{label:<16} {v:>16.0} {s:>16.0} {b:>18.0} {:>12.1} {:>12.1}",
+                "{label:<16} {v:>9.0} {one:>9.0} {s:>9.0} {b:>9.0} {:>9.1} {:>9.1} {:>9.1}",
                 b / v,
+                b / one,
                 b / s
             ),
             None => println!(
-                "{label:<16} {v:>16.0} {s:>16.0} {:>18} {:>12} {:>12}",
-                "(no peer)", "-", "-"
+                "{label:<16} {v:>9.0} {one:>9.0} {s:>9.0} {:>9} {:>9} {:>9} {:>9}",
+                "(no peer)", "-", "-", "-"
             ),
         }
     }

@@ -176,16 +176,13 @@ pub async fn run(
         .iter()
         .map(|v| vehicle_settings(&settings, v))
         .collect();
-    let world = World::new(&fleet)?;
+    let mut world = World::new(&fleet)?;
+    // The environment models run on their own threads, never on the physics thread.
+    world.offload_environments();
     let pairs = world.relative_pairs().to_vec();
     let frame_ns = world.vehicles().first().map_or(1, |v| v.sim.frame_ns());
     let total_frames = settings.duration_frames(frame_ns)?;
-    let mut vehicles = world.into_vehicles();
-    for v in &mut vehicles {
-        if let Err(e) = v.sim.offload_environment() {
-            tracing::warn!(vehicle = %v.id, error = %e, "environment updates stay on the physics thread");
-        }
-    }
+    let vehicles = world.into_vehicles();
     tracing::info!(
         mode = mode_name(mode),
         zid = %session.zid(),

@@ -130,6 +130,18 @@ impl World {
         &mut self.vehicles
     }
 
+    /// Moves each vehicle's environment updates to a worker thread of its own
+    /// ([`Simulation::offload_environment`]), so the models never run on the stepping thread. The
+    /// samples are the same bits either way, so a vehicle whose worker cannot be spawned keeps
+    /// its updates on the stepping thread, with a warning, and only runs slower.
+    pub fn offload_environments(&mut self) {
+        for v in &mut self.vehicles {
+            if let Err(e) = v.sim.offload_environment() {
+                tracing::warn!(vehicle = %v.id, error = %e, "environment updates stay on the stepping thread");
+            }
+        }
+    }
+
     /// \[ns\] simulation time (every vehicle's).
     pub fn t_sim_ns(&self) -> u64 {
         self.vehicles.first().map_or(0, |v| v.sim.t_sim_ns())

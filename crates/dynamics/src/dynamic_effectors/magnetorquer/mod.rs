@@ -113,6 +113,11 @@ impl DynamicEffector for Magnetorquer {
     }
 
     fn add_force_torque(&mut self, stage: &StageState, env: &EnvironmentSample, sum: &mut Wrench) {
+        if self.dipole_am2 == 0.0 {
+            // An idle rod's m × B is ±0 in each component: it adds nothing (as for a shut
+            // thruster, only an exactly −0 sum would differ, by its sign).
+            return;
+        }
         let b_b_t = stage.dcm_bn * env.b_field_n_t;
         sum.torque_b_nm += dipole_torque_b_nm(&self.dipole_b_am2(), &b_b_t);
     }

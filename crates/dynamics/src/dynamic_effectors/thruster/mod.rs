@@ -168,7 +168,11 @@ fn lag_segment(kappa0: f64, u: f64, d_s: f64, tau_s: f64) -> (f64, f64) {
     if d_s <= 0.0 {
         return (kappa0, 0.0);
     }
-    if tau_s == 0.0 {
+    // τ = 0: the valve state at once. κ₀ = u (a shut valve at rest, or a valve open long
+    // enough for κ to reach 1 exactly): κ stays u. The general expressions below give the same
+    // bits then, since (κ₀ − u) = +0 makes both second terms +0 and x + (+0) = x for the
+    // non-negative u·d; this only skips their e^(−d/τ) (an idle thruster's whole cost).
+    if tau_s == 0.0 || kappa0 == u {
         return (u, u * d_s);
     }
     // 1 − e^(−d/τ), accurate for d ≪ τ.
@@ -324,6 +328,11 @@ impl DynamicEffector for Thruster {
         _env: &EnvironmentSample,
         sum: &mut Wrench,
     ) {
+        if self.force_avg_newton == 0.0 {
+            // A shut, spent thruster adds ±0 to each component: nothing (a sum that is exactly
+            // −0 would become +0, which no later operation tells apart from −0 but a sign).
+            return;
+        }
         let f_b = self.params.force_axis_b * self.force_avg_newton;
         sum.force_b_newton += f_b;
         sum.torque_b_nm += self.params.r_tb_b_m.cross(&f_b);

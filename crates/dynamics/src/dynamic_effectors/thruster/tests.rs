@@ -86,6 +86,23 @@ fn lag_segment_matches_a_numerical_integration() {
     assert_eq!(lag_segment(0.4, 1.0, 0.01, 0.0), (1.0, 0.01));
     // Nothing happens in no time.
     assert_eq!(lag_segment(0.4, 1.0, 0.0, 0.02), (0.4, 0.0));
+    // At rest (κ₀ = u), the shortcut gives the general expressions' bits.
+    for (u, d, tau) in [
+        (0.0f64, 0.01f64, 0.025f64),
+        (1.0, 0.001, 0.015),
+        (1.0, 0.0437, 0.02),
+    ] {
+        let one_minus_e = -(-d / tau).exp_m1();
+        let general = (
+            u + (u - u) * (1.0 - one_minus_e),
+            u * d + (u - u) * tau * one_minus_e,
+        );
+        let (k, i) = lag_segment(u, u, d, tau);
+        assert_eq!(
+            (k.to_bits(), i.to_bits()),
+            (general.0.to_bits(), general.1.to_bits())
+        );
+    }
 }
 
 /// One pulse of on-time t_on, then tail-off: the impulse is F [t_on − (τ_r − τ_f)(1 − e^(−t_on/τ_r))]
