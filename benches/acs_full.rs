@@ -11,7 +11,7 @@
 //! - `1 thread`: the same with the environment models on the stepping thread, i.e. everything
 //!   on one core, as Basilisk runs;
 //! - `simulate`: the `flexdyn simulate` loop writing a row every second into a sink, so the
-//!   cost of the front end shows beside the runtime's (it offloads the environment too).
+//!   cost of the front end shows beside the runtime's.
 //!
 //! The worker is a cache: a sample it has not answered in time is evaluated on the stepping
 //! thread, and the output is the same bits either way. The summary prints the share of samples

@@ -325,18 +325,6 @@ fn poll_period(elapsed: Duration, n: u64) -> Duration {
     (per_request / 8).clamp(POLL_MIN, POLL_MAX)
 }
 
-/// Asks Linux to wake this thread within 1 µs of the sleeps it asks for. A thread's default
-/// timer slack is 50 µs (prctl(2), `PR_SET_TIMERSLACK`), so a 20 µs look at the slot became
-/// ~70 µs, and in a batch run whose updates come every few tens of µs the worker answered few of
-/// them in time. One system call, on the worker, at its start; elsewhere nothing.
-fn fine_timer_slack() {
-    #[cfg(target_os = "linux")]
-    {
-        // A refusal leaves the default slack: the worker then only answers fewer samples in time.
-        let _ = rustix::thread::set_current_timer_slack(std::num::NonZeroU64::new(1_000));
-    }
-}
-
 /// A worker thread that evaluates the next environment sample ahead of time (module docs).
 /// Dropping it stops and joins the thread.
 pub struct Prefetcher {
@@ -363,7 +351,6 @@ impl Prefetcher {
         let handle = std::thread::Builder::new()
             .name("flexdyn-environment".into())
             .spawn(move || {
-                fine_timer_slack();
                 let mut pace = Pace::new(Instant::now());
                 while !worker_slot.stop.load(Ordering::Acquire) {
                     if !worker_slot.serve(&fill) {

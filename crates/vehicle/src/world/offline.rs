@@ -42,11 +42,11 @@ pub trait RowSink {
 }
 
 /// Steps `world` through `plan`, calling `sink` at each stop; the rows written. An error from
-/// the sink stops the run there. The environment models run on worker threads, as in the server
-/// ([`World::offload_environments`]): the output is the same bits, the stepping thread is freed
-/// of them.
+/// the sink stops the run there. The environment models run on the stepping thread: a batch run
+/// offloading them to a worker ran slower whenever the other core was busy (a campaign's other
+/// runs, a build), since the worker's looks take the CPU the stepping thread needs
+/// (`benches/acs_full.rs`, columns `vehicle` and `1 thread`).
 pub fn walk<S: RowSink>(world: &mut World, plan: RowPlan, sink: &mut S) -> Result<u64, S::Error> {
-    world.offload_environments();
     let log_steps = plan.log_steps.max(1);
     let steps_per_frame = world.steps_per_frame().max(1);
     let n_logged = plan.total_steps / log_steps;
