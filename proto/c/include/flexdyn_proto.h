@@ -121,8 +121,8 @@
 #define FD_MODE_BATCH 2u /* as fast as possible, no participants */
 
 /* RunState: Where the run is. (u32 tag) */
-#define FD_RUN_STATE_STARTING 0u
-#define FD_RUN_STATE_RUNNING 1u
+#define FD_RUN_STATE_STARTING 0u /* initialising, not stepping yet */
+#define FD_RUN_STATE_RUNNING 1u /* stepping */
 #define FD_RUN_STATE_STOPPING 2u /* stop requested, last frame in progress */
 #define FD_RUN_STATE_FINISHED 3u /* ran to `duration_s` */
 #define FD_RUN_STATE_FAILED 4u /* ended on an error */
@@ -562,7 +562,7 @@ typedef struct {
     uint64_t frame_ns; /* ns: the frame period (`simulation.frame_hz`) */
     double speed; /* real time: `--speed` (1.0 = real time); lockstep and batch: 0.0 */
     uint64_t tai_ns_1958; /* ns: TAI since 1958-01-01T00:00:00 TAI (the CCSDS Level 1 epoch) */
-    uint16_t utc_year;
+    uint16_t utc_year; /* e.g. 2016 */
     uint8_t utc_month; /* 1–12 */
     uint8_t utc_day; /* 1–31 */
     uint8_t utc_hour; /* 0–23 */

@@ -391,6 +391,48 @@ fn mistakes_in_the_table_are_named() {
             edited(r#"value = 65536"#, r#"value = -1"#),
             "constant \"MAX_MESSAGE_BYTES\": -1 is negative",
         ),
+        (
+            // The Rust type of a text field is a hand-written newtype: it must be named.
+            edited(
+                r#"text = true, rust_type = "FaultTarget","#,
+                r#"text = true,"#,
+            ),
+            "field \"target\": a text field, and only a text field, names its Rust newtype",
+        ),
+        (
+            edited(
+                r#"{ name = "range_m", type = "f64""#,
+                r#"{ name = "range_m", type = "f64", rust_type = "Range""#,
+            ),
+            "field \"range_m\": a text field, and only a text field",
+        ),
+        (
+            edited(r#"rust_default = 0.0,"#, r#"rust_default = "ZERO","#),
+            "field \"shadow_factor\": `rust_default`: \"ZERO\" does not suit",
+        ),
+        (
+            edited(r#"rust_derive = ["Hash"]"#, r#"rust_derive = ["Ord"]"#),
+            "struct Header, rust_derive: the only extra derive is \"Hash\"",
+        ),
+        (
+            edited(
+                r#"of = "EffectorState.kind""#,
+                r#"of = "EffectorState.kinds""#,
+            ),
+            "codes EffectorKind, of: EffectorState has no field \"kinds\"",
+        ),
+        (
+            edited(r#"of = "EnvironmentMsg.eclipse""#, r#"of = "EnvironmentMsg.b_n_t""#),
+            "codes Eclipse, of: EnvironmentMsg.b_n_t is not a u8, u16 or u32",
+        ),
+        (
+            // Bits no field names in `flags` say which field carries them.
+            edited(
+                "name = \"wheel_flags\"\nof = \"EffectorState.flags\"\n",
+                "name = \"wheel_flags\"\n",
+            ),
+            "flags wheel_flags: bits are carried by the fields that name them",
+        ),
     ];
     for (text, expected) in cases {
         let err = Table::parse("messages.toml", &text).expect_err(expected);

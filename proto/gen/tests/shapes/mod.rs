@@ -67,7 +67,7 @@ fields = [
   { name = "mode", type = "enum<ProbeMode>" },
   { name = "bits", type = "bool[2]" },
   { name = "count", type = "u8", max = 3 },
-  { name = "label", type = "u8[8]", text = true },
+  { name = "label", type = "u8[8]", text = true, rust_type = "ProbeLabel" },
   { name = "offset", type = "i32" },
   { name = "vals", type = "f64[2]", finite = true },
   { name = "pick", type = "union<ProbePick>" },
