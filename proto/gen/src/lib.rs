@@ -14,9 +14,12 @@
 //! | the Rust message types (structs, enums, unions, codes and bits, `Default`s, docs), `proto/src/messages.rs` | [`rust_types`] |
 //! | the C client library's typed calls, `clients/c/include/flexdyn_client_messages.h` | [`c_client`] |
 //! | the C client library's message kinds, `clients/c/src/kinds.rs` | [`c_client`] |
+//! | the C client library's `#[repr(C)]` mirrors of the header's structs and the conversions from the Rust messages, `clients/c/src/ctypes.rs` | [`c_ctypes`] |
 //! | the JSON Schemas of the messages' JSON (MCAP decoded channels, Foxglove), `proto/schema/json/*.json` and `proto/src/json_schemas.rs` | [`json_schema`] |
 
 pub mod c_client;
+pub mod c_ctypes;
+pub mod c_members;
 pub mod c_proto;
 pub mod json_schema;
 pub mod py_proto;
@@ -44,6 +47,8 @@ pub const RUST_WIRE_PATH: &str = "proto/src/wire.rs";
 pub const RUST_TYPES_PATH: &str = "proto/src/messages.rs";
 /// The C client library's generated kind table.
 pub const KINDS_PATH: &str = "clients/c/src/kinds.rs";
+/// The C client library's mirrors of the header's structs.
+pub const CTYPES_PATH: &str = "clients/c/src/ctypes.rs";
 /// The wire crate's generated index of the JSON Schemas.
 pub const JSON_SCHEMAS_RS_PATH: &str = "proto/src/json_schemas.rs";
 /// The directory of the generated JSON Schemas, one `<Message>.json` each.
@@ -99,6 +104,10 @@ pub fn mirrors(root: &Path) -> Result<Vec<Mirror>, String> {
         Mirror {
             path: KINDS_PATH.into(),
             text: c_client::kinds_rs(&table),
+        },
+        Mirror {
+            path: CTYPES_PATH.into(),
+            text: c_ctypes::module(&table),
         },
         Mirror {
             path: JSON_SCHEMAS_RS_PATH.into(),

@@ -1358,6 +1358,18 @@ pub fn screaming_snake(name: &str) -> String {
     snake(name).to_ascii_uppercase()
 }
 
+/// `source_wrench` → `SourceWrench`.
+pub fn camel(name: &str) -> String {
+    name.split('_')
+        .map(|w| {
+            let mut c = w.chars();
+            c.next()
+                .map(|f| f.to_ascii_uppercase().to_string() + c.as_str())
+                .unwrap_or_default()
+        })
+        .collect()
+}
+
 /// `EffectorState` → `effector_state`; a name already in snake_case is kept.
 pub fn snake(name: &str) -> String {
     let mut out = String::new();
