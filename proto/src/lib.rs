@@ -11,9 +11,10 @@
 //!   over complete ([`client::lockstep::TickReceiver`]).
 //!
 //! `proto/README.md` is the language-neutral specification (byte tables, Python example,
-//! lockstep rules) for non-Rust flight code. Its byte tables are generated from the wire table
-//! `proto/schema/messages.toml` (`cargo run -p flexdyn-wiregen`), which the tests of
-//! `proto/gen` check against these types and the goldens.
+//! lockstep rules) for non-Rust flight code. Its byte tables, this crate's message types and
+//! their per-message codec are generated from the wire table `proto/schema/messages.toml`
+//! (`cargo run -p flexdyn-wiregen`), which the tests of `proto/gen` check against the
+//! hand-derived goldens.
 //!
 //! # Topics
 //!
@@ -111,6 +112,8 @@ mod json_schemas;
 pub mod fsw_view;
 pub mod keys;
 mod layout;
+// Written by flexdyn-wiregen from proto/schema/messages.toml: every message type, with its docs;
+// their methods are hand-written in messages/methods.rs.
 mod messages;
 pub mod view;
 // Written by flexdyn-wiregen from proto/schema/messages.toml: each message's sizes, length rule,

@@ -19,10 +19,11 @@ use crate::client::{
     Kind, Options, Taken,
 };
 use crate::ctypes::{
-    effector_input, fill_state, finite3, FdEffectorInput, FdEffectorState, FdHeader, FdImuMsg,
-    FdStarTrackerMsg, FdStateMsg, FdStatusMsg, FdTimeMsg,
+    fill_state, FdEffectorInput, FdEffectorState, FdHeader, FdImuMsg, FdStarTrackerMsg, FdStateMsg,
+    FdStatusMsg, FdTimeMsg,
 };
 use crate::error::{Code, Error};
+use crate::from_c::{effector_input, finite3};
 use crate::fsw::{self, FswStream};
 use crate::kinds;
 

@@ -9,7 +9,9 @@
 //! # Layout
 //! - [`error`]: the return codes and the error that carries one with its message.
 //! - [`ctypes`]: the `#[repr(C)]` mirrors of the `flexdyn_proto.h` structs and the conversions
-//!   from (and, for effector inputs, to) the Rust messages.
+//!   from the Rust messages (generated from the wire table).
+//! - [`from_c`]: the checked conversions of what a C caller passes (effector inputs, wrenches)
+//!   to Rust values.
 //! - [`kinds`]: the message kinds of the wire table (generated): key, direction, lockstep
 //!   section and the Rust decoder that checks each sample before it is handed out.
 //! - [`client`]: the library in safe Rust: the session, subscriptions with ring queues, commands
@@ -26,9 +28,13 @@
 #![warn(missing_docs)]
 
 pub mod client;
+// Written by flexdyn-wiregen from proto/schema/messages.toml.
 pub mod ctypes;
+#[cfg(test)]
+mod ctypes_tests;
 pub mod error;
 mod ffi;
+pub mod from_c;
 pub mod fsw;
 // Written by flexdyn-wiregen from proto/schema/messages.toml.
 #[rustfmt::skip]

@@ -121,8 +121,8 @@
 #define FD_MODE_BATCH 2u /* as fast as possible, no participants */
 
 /* RunState: Where the run is. (u32 tag) */
-#define FD_RUN_STATE_STARTING 0u
-#define FD_RUN_STATE_RUNNING 1u
+#define FD_RUN_STATE_STARTING 0u /* initialising, not stepping yet */
+#define FD_RUN_STATE_RUNNING 1u /* stepping */
 #define FD_RUN_STATE_STOPPING 2u /* stop requested, last frame in progress */
 #define FD_RUN_STATE_FINISHED 3u /* ran to `duration_s` */
 #define FD_RUN_STATE_FAILED 4u /* ended on an error */
@@ -155,7 +155,7 @@
 /* EffectorKind: EffectorState `kind` (u16) */
 #define FD_EFFECTOR_PANEL_PAIR 1u /* a dual-hinged panel pair */
 #define FD_EFFECTOR_REACTION_WHEEL 2u /* a reaction wheel */
-#define FD_EFFECTOR_MAGNETORQUER 3u /* a magnetorquer */
+#define FD_EFFECTOR_MAGNETORQUER 3u /* a magnetorquer rod */
 #define FD_EFFECTOR_THRUSTER 4u /* a thruster */
 
 /* Eclipse: EnvironmentMsg `eclipse` (u8) */
@@ -169,10 +169,10 @@
 #define FD_COMMAND_FLAG_NO_COMMAND_YET 0x04u /* no command received since start; wrench is zero */
 
 /* Bits of saturation_flags */
-#define FD_SATURATION_GYRO_RATE 0x01u /* a gyro axis hit its range limit */
-#define FD_SATURATION_ACCEL 0x02u /* an accelerometer axis hit its range limit */
-#define FD_SATURATION_DTHETA 0x04u /* an integrated-angle axis saturated */
-#define FD_SATURATION_DV 0x08u /* an integrated-velocity axis saturated */
+#define FD_SATURATION_GYRO_RATE 0x01u /* a gyro axis (`omega_p_rad_s`) hit its range limit */
+#define FD_SATURATION_ACCEL 0x02u /* an accelerometer axis (`accel_p_m_s2`) hit its range limit */
+#define FD_SATURATION_DTHETA 0x04u /* an integrated-angle axis (`dtheta_p_rad`) saturated */
+#define FD_SATURATION_DV 0x08u /* an integrated-velocity axis (`dv_p_m_s`) saturated */
 
 /* Bits of star_tracker_flags */
 #define FD_STAR_TRACKER_SUN_EXCLUSION 0x01u /* the boresight is within the configured exclusion angle of the Sun direction */
@@ -188,12 +188,12 @@
 /* Bits of fss_flags */
 #define FD_FSS_VALID 0x01u /* the angles are a measurement (IN_FOV and SUNLIT); otherwise both are 0 */
 #define FD_FSS_IN_FOV 0x02u /* the Sun is within the field-of-view half-angle of the boresight */
-#define FD_FSS_SUNLIT 0x04u /* the shadow factor is at least the sensor's threshold */
+#define FD_FSS_SUNLIT 0x04u /* the shadow factor is at least the sensor's threshold (not in eclipse) */
 
 /* Bits of gps_flags */
 #define FD_GPS_FIX 0x01u /* the receiver has a fix: the time and the configured frames' fields are a measurement; without it every number is 0 */
-#define FD_GPS_ECEF 0x02u /* the ECEF fields are configured output */
-#define FD_GPS_INERTIAL 0x04u /* the N fields are configured output */
+#define FD_GPS_ECEF 0x02u /* the ECEF fields (`r_be_e_m`, `v_be_e_m_s`) are configured output */
+#define FD_GPS_INERTIAL 0x04u /* the N fields (`r_bn_n_m`, `v_bn_n_m_s`) are configured output */
 
 /* Bits of time_flags */
 #define FD_TIME_EPOCH_VALID 0x01u /* the configuration has an `[epoch]`: the calendar fields are set (without it every one is zero) */
@@ -201,12 +201,12 @@
 #define FD_TIME_LEAP_SECOND 0x04u /* the instant lies inside an inserted leap second (UTC reads 23:59:60.x) */
 
 /* Bits of environment_flags */
-#define FD_ENVIRONMENT_EPOCH_VALID 0x01u /* `tai_ns_1958` is set */
-#define FD_ENVIRONMENT_MAGNETIC 0x02u /* a magnetic-field model is on */
-#define FD_ENVIRONMENT_SUN 0x04u /* the Sun ephemeris is on */
-#define FD_ENVIRONMENT_MOON 0x08u /* the Moon ephemeris is on */
-#define FD_ENVIRONMENT_SHADOW 0x10u /* a shadow model is on */
-#define FD_ENVIRONMENT_ATMOSPHERE 0x20u /* an atmosphere model is on */
+#define FD_ENVIRONMENT_EPOCH_VALID 0x01u /* the configuration has an `[epoch]`: `tai_ns_1958` is set */
+#define FD_ENVIRONMENT_MAGNETIC 0x02u /* a magnetic-field model is on (`b_n_t`, `b_b_t`) */
+#define FD_ENVIRONMENT_SUN 0x04u /* the Sun ephemeris is on (`sun_n`, `sun_b`) */
+#define FD_ENVIRONMENT_MOON 0x08u /* the Moon ephemeris is on (`moon_n`) */
+#define FD_ENVIRONMENT_SHADOW 0x10u /* a shadow model is on (`shadow_factor`, `eclipse`) */
+#define FD_ENVIRONMENT_ATMOSPHERE 0x20u /* an atmosphere model is on (`density_kg_m3`) */
 
 /* Bits of fsw_flags */
 #define FD_FSW_MODE 0x01u /* `mode` is the flight code's mode at `header.tick` */
@@ -477,7 +477,7 @@ typedef struct {
     double v_bn_n_m_s[3]; /* m/s, N: inertial velocity of B */
     double nongrav_accel_bn_n_m_s2[3]; /* m/s², N: non-gravitational acceleration of B */
     double orb_energy_j; /* J: orbital energy */
-    double rot_energy_j; /* J: rotational energy */
+    double rot_energy_j; /* J: rotational energy of the hub and its appended bodies */
     double orb_ang_mom_n[3]; /* kg·m²/s, N: orbital angular momentum about the inertial origin */
     double rot_ang_mom_c_n[3]; /* kg·m²/s, N: rotational angular momentum about the system centre of mass C */
     double torque_b_nm[3]; /* N·m, B: torque about B */
@@ -562,7 +562,7 @@ typedef struct {
     uint64_t frame_ns; /* ns: the frame period (`simulation.frame_hz`) */
     double speed; /* real time: `--speed` (1.0 = real time); lockstep and batch: 0.0 */
     uint64_t tai_ns_1958; /* ns: TAI since 1958-01-01T00:00:00 TAI (the CCSDS Level 1 epoch) */
-    uint16_t utc_year;
+    uint16_t utc_year; /* e.g. 2016 */
     uint8_t utc_month; /* 1–12 */
     uint8_t utc_day; /* 1–31 */
     uint8_t utc_hour; /* 0–23 */

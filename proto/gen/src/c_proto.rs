@@ -12,6 +12,7 @@
 //! or of a union variant varies in size, and a vec's struct element holds fixed fields and vecs
 //! of primitives.
 
+use crate::c_members::{comment, members, struct_used, CType};
 use crate::table::{screaming_snake, Field, Prim, Table, Ty};
 
 const PROLOGUE: &str = include_str!("c_proto/prologue.h");
@@ -35,30 +36,6 @@ fn ctype(p: Prim) -> &'static str {
         Prim::I32 => "int32_t",
         Prim::F64 => "double",
     }
-}
-
-/// A C comment's text: no comment terminator inside.
-fn comment(s: &str) -> String {
-    s.replace("*/", "* /").replace('\n', " ")
-}
-
-/// `/* unit, frame: doc */` for a field, empty when the table says nothing.
-fn field_comment(f: &Field) -> String {
-    let mut parts = Vec::new();
-    if let Some(u) = &f.unit {
-        parts.push(u.clone());
-    }
-    if let Some(fr) = &f.frame {
-        parts.push(fr.clone());
-    }
-    let head = parts.join(", ");
-    let text = match (head.is_empty(), f.doc.is_empty()) {
-        (true, true) => return String::new(),
-        (true, false) => f.doc.clone(),
-        (false, true) => head,
-        (false, false) => format!("{head}: {}", f.doc),
-    };
-    format!(" /* {} */", comment(&text))
 }
 
 /// The byte at `base + k`: `buf[318]`, or `(buf + at)[6]` when the base is an expression.
@@ -208,75 +185,6 @@ impl<'t> Gen<'t> {
             }
             if let Some(n) = self.t.fixed_size(&ty) {
                 k += n;
-            }
-        }
-    }
-
-    /// C member declarations of `fields`, names prefixed with `prefix`.
-    fn members(&self, fields: &[Field], prefix: &str, out: &mut Vec<String>) {
-        for f in fields {
-            let name = format!("{prefix}{}", f.name);
-            let note = field_comment(f);
-            match self.ty(f) {
-                Ty::Prim(p) => out.push(format!("{} {name};{note}", ctype(p))),
-                Ty::Array(p, n) => out.push(format!("{} {name}[{n}];{note}", ctype(p))),
-                Ty::Enum(e) => out.push(format!(
-                    "uint32_t {name}; /* FD_{}_*{} */",
-                    self.t.enums[e].c_prefix(),
-                    if f.doc.is_empty() {
-                        String::new()
-                    } else {
-                        format!(": {}", comment(&f.doc))
-                    }
-                )),
-                Ty::Struct(s) => match &f.c_flatten {
-                    Some(p) => {
-                        self.members(&self.t.structs[s].fields, &format!("{prefix}{p}"), out)
-                    }
-                    None => out.push(format!("fd_{} {name};{note}", self.struct_c(s))),
-                },
-                Ty::Union(u) => {
-                    let un = &self.t.unions[u];
-                    out.push(format!(
-                        "uint32_t {name}; /* FD_{}_*: {} */",
-                        un.c_prefix,
-                        comment(&un.doc)
-                    ));
-                    let mut seen: Vec<String> = Vec::new();
-                    for v in &un.variants {
-                        let mut vm = Vec::new();
-                        self.members(&v.fields, prefix, &mut vm);
-                        for line in vm {
-                            let decl = line.split(" /*").next().unwrap_or(&line).to_owned();
-                            if !seen.contains(&decl) {
-                                seen.push(decl);
-                                out.push(line);
-                            }
-                        }
-                    }
-                }
-                Ty::Vec(inner) => match *inner {
-                    Ty::Struct(s) => {
-                        out.push(format!("uint64_t n_{name};"));
-                        out.push(format!(
-                            "fd_{} *{name}; /* caller storage, n_{name} entries: {} */",
-                            self.struct_c(s),
-                            comment(&f.doc)
-                        ));
-                        out.push(format!(
-                            "size_t {name}_capacity; /* entries {name} can hold */"
-                        ));
-                    }
-                    Ty::Prim(p) => {
-                        out.push(format!("uint64_t n_{name};"));
-                        out.push(format!(
-                            "{} {name}[{}];{note}",
-                            ctype(p),
-                            f.max.unwrap_or(0)
-                        ));
-                    }
-                    _ => unreachable!("checked by the table"),
-                },
             }
         }
     }
@@ -480,9 +388,25 @@ fn doc_tail(doc: &str) -> String {
     }
 }
 
-/// Whether a struct is a C type of its own (some field or vec uses it without flattening).
-fn struct_used(t: &Table, s: usize) -> bool {
-    t.struct_used(s, |f, elem| elem || f.c_flatten.is_none())
+/// The C declarations of a struct's members, each with its comment.
+fn declarations(t: &Table, fields: &[Field]) -> Vec<String> {
+    members(t, fields, "")
+        .into_iter()
+        .map(|m| {
+            let n = &m.name;
+            let decl = match m.ty {
+                CType::Prim(p) => format!("{} {n}", ctype(p)),
+                CType::Array(p, len) => format!("{} {n}[{len}]", ctype(p)),
+                CType::Struct(s) => format!("fd_{} {n}", t.structs[s].c_name()),
+                CType::Elements(s) => format!("fd_{} *{n}", t.structs[s].c_name()),
+                CType::Capacity => format!("size_t {n}"),
+            };
+            match m.comment.is_empty() {
+                true => format!("{decl};"),
+                false => format!("{decl}; /* {} */", m.comment),
+            }
+        })
+        .collect()
 }
 
 fn types(g: &Gen, o: &mut String) {
@@ -494,8 +418,7 @@ fn types(g: &Gen, o: &mut String) {
         if !struct_used(t, i) {
             continue;
         }
-        let mut lines = Vec::new();
-        g.members(&s.fields, "", &mut lines);
+        let lines = declarations(t, &s.fields);
         o.push_str(&format!(
             "\n/* {}: {} */\ntypedef struct {{\n",
             s.name,
@@ -507,8 +430,7 @@ fn types(g: &Gen, o: &mut String) {
         o.push_str(&format!("}} fd_{};\n", s.c_name()));
     }
     for m in &t.messages {
-        let mut lines = Vec::new();
-        g.members(&m.fields, "", &mut lines);
+        let lines = declarations(t, &m.fields);
         o.push_str(&format!(
             "\n/* {}, {}: {} */\ntypedef struct {{\n",
             m.name,

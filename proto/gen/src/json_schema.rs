@@ -13,7 +13,7 @@ use serde_json::{json, Map, Value};
 use crate::table::{Field, Prim, Table, Ty};
 
 /// The description of a field: its meaning, then its unit and frame.
-fn description(f: &Field) -> String {
+pub(crate) fn description(f: &Field) -> String {
     let mut extra = Vec::new();
     if let Some(u) = &f.unit {
         extra.push(format!("unit {u}"));

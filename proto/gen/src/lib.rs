@@ -11,15 +11,20 @@
 //! | the header-only C codec, `proto/c/include/flexdyn_proto.h` | [`c_proto`] |
 //! | the Python package's codec, `clients/python/src/flexdyn/proto.py` | [`py_proto`] |
 //! | the Rust codec's per-message code (sizes, constants, length rules, checks, decoders), `proto/src/wire.rs` | [`rust_wire`] |
+//! | the Rust message types (structs, enums, unions, codes and bits, `Default`s, docs), `proto/src/messages.rs` | [`rust_types`] |
 //! | the C client library's typed calls, `clients/c/include/flexdyn_client_messages.h` | [`c_client`] |
 //! | the C client library's message kinds, `clients/c/src/kinds.rs` | [`c_client`] |
+//! | the C client library's `#[repr(C)]` mirrors of the header's structs and the conversions from the Rust messages, `clients/c/src/ctypes.rs` | [`c_ctypes`] |
 //! | the JSON Schemas of the messages' JSON (MCAP decoded channels, Foxglove), `proto/schema/json/*.json` and `proto/src/json_schemas.rs` | [`json_schema`] |
 
 pub mod c_client;
+pub mod c_ctypes;
+pub mod c_members;
 pub mod c_proto;
 pub mod json_schema;
 pub mod py_proto;
 pub mod readme;
+pub mod rust_types;
 pub mod rust_wire;
 pub mod sizes;
 pub mod table;
@@ -38,8 +43,12 @@ pub const C_PROTO_PATH: &str = "proto/c/include/flexdyn_proto.h";
 pub const PY_PROTO_PATH: &str = "clients/python/src/flexdyn/proto.py";
 /// The Rust codec's per-message code.
 pub const RUST_WIRE_PATH: &str = "proto/src/wire.rs";
+/// The Rust message types.
+pub const RUST_TYPES_PATH: &str = "proto/src/messages.rs";
 /// The C client library's generated kind table.
 pub const KINDS_PATH: &str = "clients/c/src/kinds.rs";
+/// The C client library's mirrors of the header's structs.
+pub const CTYPES_PATH: &str = "clients/c/src/ctypes.rs";
 /// The wire crate's generated index of the JSON Schemas.
 pub const JSON_SCHEMAS_RS_PATH: &str = "proto/src/json_schemas.rs";
 /// The directory of the generated JSON Schemas, one `<Message>.json` each.
@@ -89,8 +98,16 @@ pub fn mirrors(root: &Path) -> Result<Vec<Mirror>, String> {
             text: rust_wire::module(&table),
         },
         Mirror {
+            path: RUST_TYPES_PATH.into(),
+            text: rust_types::module(&table, TABLE_PATH).map_err(|e| e.to_string())?,
+        },
+        Mirror {
             path: KINDS_PATH.into(),
             text: c_client::kinds_rs(&table),
+        },
+        Mirror {
+            path: CTYPES_PATH.into(),
+            text: c_ctypes::module(&table),
         },
         Mirror {
             path: JSON_SCHEMAS_RS_PATH.into(),

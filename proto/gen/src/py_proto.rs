@@ -13,7 +13,7 @@
 //! `py_tuple` is a tuple of its struct's numbers (`TimeMsg.utc`).
 
 use crate::sizes::wrap;
-use crate::table::{screaming_snake, Field, Message, Prim, Table, Ty};
+use crate::table::{camel, screaming_snake, Field, Message, Prim, Table, Ty};
 
 const PROLOGUE: &str = include_str!("py_proto/prologue.py");
 const HELPERS: &str = include_str!("py_proto/helpers.py");
@@ -73,17 +73,8 @@ fn doc(s: &str) -> String {
 
 /// A Python class name for a struct.
 fn class_of(t: &Table, s: usize) -> String {
-    let st = &t.structs[s];
     // The C name in CamelCase (AppliedWrench is SourceWrench on both sides).
-    st.c_name()
-        .split('_')
-        .map(|w| {
-            let mut c = w.chars();
-            c.next()
-                .map(|f| f.to_ascii_uppercase().to_string() + c.as_str())
-                .unwrap_or_default()
-        })
-        .collect()
+    camel(&t.structs[s].c_name())
 }
 
 /// One dataclass member: name, annotation, default.

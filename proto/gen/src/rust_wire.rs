@@ -4,9 +4,8 @@
 //! `WireMessage` impl (name, length rule, shortest length, and `validate`: the step-4 rules
 //! bincode does not check, a bounded `u8` count and a text field's padding, then the `finite`
 //! fields in wire order), the walk of its counts when its length varies, and its `decode_*`
-//! function. The message types (`proto/src/messages.rs`), the generic codec (`codec.rs`) and the
-//! length-rule machinery (`layout.rs`) are hand-written; the table's tests check the types
-//! against the table on every golden.
+//! function. The message types are written by [`crate::rust_types`]; the generic codec
+//! (`codec.rs`) and the length-rule machinery (`layout.rs`) are hand-written.
 
 use crate::sizes::size_constants;
 use crate::table::{Field, Message, Prim, Table, Ty};

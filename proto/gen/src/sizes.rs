@@ -50,6 +50,16 @@ pub struct SizeConst {
     pub note: String,
 }
 
+/// The name of an encoded size: `<PREFIX>_LEN` when `fixed`, else `<PREFIX>_FIXED_LEN` (the
+/// length with every vec empty).
+pub fn len_name(prefix: &str, fixed: bool) -> String {
+    if fixed {
+        format!("{prefix}_LEN")
+    } else {
+        format!("{prefix}_FIXED_LEN")
+    }
+}
+
 /// Every named size and offset: each used struct's length (or fixed length), each message's
 /// length, or for a variable one its fixed length and the offset of its count or tag and each
 /// union variant's length, and the offset of each byte block (`u8[n]`).
@@ -63,9 +73,9 @@ pub fn size_constants(t: &Table) -> Vec<SizeConst> {
         }
         let c = s.c_name().to_ascii_uppercase();
         match t.fields_size(&s.fields) {
-            Some(n) => push(format!("{c}_LEN"), n, s.name.clone()),
+            Some(n) => push(len_name(&c, true), n, s.name.clone()),
             None => push(
-                format!("{c}_FIXED_LEN"),
+                len_name(&c, false),
                 t.fields_min_size(&s.fields),
                 format!("{} without its vecs' elements", s.name),
             ),
@@ -81,10 +91,10 @@ pub fn size_constants(t: &Table) -> Vec<SizeConst> {
         };
         let prefix = t.fields_size(fixed).expect("fixed");
         match tail.map(|f| (f, t.ty_of(f))) {
-            None => push(format!("{u}_LEN"), prefix, format!("{}{since}", m.name)),
+            None => push(len_name(&u, true), prefix, format!("{}{since}", m.name)),
             Some((f, Ty::Vec(_))) => {
                 push(
-                    format!("{u}_FIXED_LEN"),
+                    len_name(&u, false),
                     prefix + 8,
                     format!("{} with no {}{since}", m.name, f.name),
                 );
@@ -101,13 +111,13 @@ pub fn size_constants(t: &Table) -> Vec<SizeConst> {
                     format!("the u32 tag of {}{since}", f.name),
                 );
                 for v in &t.unions[ui].variants {
-                    let vu = screaming_snake(&v.name);
+                    let vu = format!("{u}_{}", screaming_snake(&v.name));
                     let (vf, vt) = t.split_tail(&v.fields);
                     let n = prefix + 4 + t.fields_size(vf).expect("fixed");
                     match vt {
-                        None => push(format!("{u}_{vu}_LEN"), n, format!("{} {}", m.name, v.name)),
+                        None => push(len_name(&vu, true), n, format!("{} {}", m.name, v.name)),
                         Some(_) => push(
-                            format!("{u}_{vu}_FIXED_LEN"),
+                            len_name(&vu, false),
                             n + 8,
                             format!("{} {} with no elements", m.name, v.name),
                         ),

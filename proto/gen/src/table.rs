@@ -86,6 +86,13 @@ pub struct Codes {
     pub c_prefix: String,
     /// Which field it names.
     pub doc: String,
+    /// The field it codes, `Owner.field` (a struct's or message's integer field): the Rust
+    /// constants take its type.
+    pub of: String,
+    /// Rust documentation only (Markdown, links resolve in `proto/src/messages.rs`): prose
+    /// that follows `doc` on docs.rs; the other mirrors keep to `doc`.
+    #[serde(default)]
+    pub note: String,
     /// Its codes.
     pub values: Vec<EnumValue>,
 }
@@ -104,6 +111,10 @@ pub struct Enum {
     pub doc: String,
     /// Its values, in tag order.
     pub values: Vec<EnumValue>,
+    /// Rust documentation only (Markdown, links resolve in `proto/src/messages.rs`): prose
+    /// that follows `doc` on docs.rs; the other mirrors keep to `doc`.
+    #[serde(default)]
+    pub note: String,
 }
 
 /// One value of an [`Enum`].
@@ -117,6 +128,10 @@ pub struct EnumValue {
     /// What it means.
     #[serde(default)]
     pub doc: String,
+    /// Rust documentation only (Markdown, links resolve in `proto/src/messages.rs`): prose
+    /// that follows `doc` on docs.rs; the other mirrors keep to `doc`.
+    #[serde(default)]
+    pub note: String,
 }
 
 /// A bit field.
@@ -127,6 +142,14 @@ pub struct Flags {
     pub name: String,
     /// The C macro prefix of its bits, `FD_<c_prefix>_<BIT>`.
     pub c_prefix: String,
+    /// The field that carries the bits when no field names them in its `flags` (bits that
+    /// depend on another field, as an effector's on its kind): `Owner.field`.
+    #[serde(default)]
+    pub of: Option<String>,
+    /// Rust documentation only (Markdown, links resolve in `proto/src/messages.rs`): prose
+    /// that follows `doc` on docs.rs; the other mirrors keep to `doc`.
+    #[serde(default)]
+    pub note: String,
     /// Its bits.
     pub bits: Vec<Bit>,
 }
@@ -141,6 +164,10 @@ pub struct Bit {
     pub name: String,
     /// What it means when set.
     pub doc: String,
+    /// Rust documentation only (Markdown, links resolve in `proto/src/messages.rs`): prose
+    /// that follows `doc` on docs.rs; the other mirrors keep to `doc`.
+    #[serde(default)]
+    pub note: String,
 }
 
 /// A struct nested in messages.
@@ -154,6 +181,13 @@ pub struct Struct {
     pub c_name: Option<String>,
     /// What it is.
     pub doc: String,
+    /// Rust documentation only (Markdown, links resolve in `proto/src/messages.rs`): prose
+    /// that follows `doc` on docs.rs; the other mirrors keep to `doc`.
+    #[serde(default)]
+    pub note: String,
+    /// Rust derives beyond those its fields allow (`Hash`).
+    #[serde(default)]
+    pub rust_derive: Vec<String>,
     /// Its fields in wire order.
     pub fields: Vec<Field>,
 }
@@ -168,6 +202,10 @@ pub struct Union {
     pub c_prefix: String,
     /// What it is.
     pub doc: String,
+    /// Rust documentation only (Markdown, links resolve in `proto/src/messages.rs`): prose
+    /// that follows `doc` on docs.rs; the other mirrors keep to `doc`.
+    #[serde(default)]
+    pub note: String,
     /// Its variants, in tag order.
     pub variants: Vec<Variant>,
 }
@@ -182,6 +220,10 @@ pub struct Variant {
     pub name: String,
     /// What it does.
     pub doc: String,
+    /// Rust documentation only (Markdown, links resolve in `proto/src/messages.rs`): prose
+    /// that follows `doc` on docs.rs; the other mirrors keep to `doc`.
+    #[serde(default)]
+    pub note: String,
     /// The fields after the tag.
     pub fields: Vec<Field>,
 }
@@ -207,6 +249,13 @@ pub struct Message {
     pub since: u16,
     /// What it is.
     pub doc: String,
+    /// Rust documentation only (Markdown, links resolve in `proto/src/messages.rs`): prose
+    /// that follows `doc` on docs.rs; the other mirrors keep to `doc`.
+    #[serde(default)]
+    pub note: String,
+    /// Rust derives beyond those its fields allow (`Hash`).
+    #[serde(default)]
+    pub rust_derive: Vec<String>,
     /// Its fields in wire order; the first is the header.
     pub fields: Vec<Field>,
 }
@@ -239,6 +288,10 @@ pub struct Field {
     /// What it means.
     #[serde(default)]
     pub doc: String,
+    /// Rust documentation only (Markdown, links resolve in `proto/src/messages.rs`): prose
+    /// that follows `doc` on docs.rs; the other mirrors keep to `doc`.
+    #[serde(default)]
+    pub note: String,
     /// The [`Flags`] of its bits.
     #[serde(default)]
     pub flags: Option<String>,
@@ -263,6 +316,14 @@ pub struct Field {
     /// of numbers, a `[[constant]]`'s name, or (for an enum or union field) a value's name.
     #[serde(default)]
     pub default: Option<toml::Value>,
+    /// Rust only: the value of the type's `Default` where it differs from `default` (the Rust
+    /// API's value, older than the table's).
+    #[serde(default)]
+    pub rust_default: Option<toml::Value>,
+    /// Rust only: the type of a `text` field, a hand-written newtype of its bytes (`.0`) with
+    /// `check_padding` (`FaultTarget`).
+    #[serde(default)]
+    pub rust_type: Option<String>,
 }
 
 /// A primitive wire type.
@@ -730,9 +791,27 @@ impl Table {
                     ));
                 }
             }
-            if let Some(d) = &f.default {
-                self.check_default(&ty, d)
-                    .map_err(|e| Self::err(file, place.clone(), format!("`default`: {e}")))?;
+            for (key, d) in [("default", &f.default), ("rust_default", &f.rust_default)] {
+                if let Some(d) = d {
+                    self.check_default(&ty, d)
+                        .map_err(|e| Self::err(file, place.clone(), format!("`{key}`: {e}")))?;
+                }
+            }
+            let rust_type_ok = |n: &str| {
+                n.starts_with(|c: char| c.is_ascii_uppercase())
+                    && n.chars().all(|c| c.is_ascii_alphanumeric())
+            };
+            match (&f.rust_type, f.text) {
+                (Some(n), true) if rust_type_ok(n) => {}
+                (None, false) => {}
+                _ => {
+                    return Err(Self::err(
+                        file,
+                        place,
+                        "a text field, and only a text field, names its Rust newtype in \
+                         `rust_type` (CamelCase)",
+                    ))
+                }
             }
             if let Ty::Vec(inner) = &ty {
                 if self.fixed_size(inner).is_none() && !matches!(**inner, Ty::Struct(_)) {
@@ -754,12 +833,11 @@ impl Table {
             (Ty::Prim(Prim::F64), V::Float(_) | V::Integer(_)) => Ok(()),
             (Ty::Prim(p), V::Integer(_)) if *p != Prim::Bool => Ok(()),
             (Ty::Prim(Prim::Bool), V::Boolean(_)) => Ok(()),
-            (Ty::Prim(p), V::String(name)) if *p != Prim::F64 && *p != Prim::Bool => self
-                .constants
-                .iter()
-                .any(|c| &c.name == name)
-                .then_some(())
-                .ok_or_else(|| format!("no [[constant]] named {name:?}")),
+            (Ty::Prim(p), V::String(name)) if *p != Prim::F64 && *p != Prim::Bool => {
+                (name == "PROTOCOL_VERSION" || self.constants.iter().any(|c| &c.name == name))
+                    .then_some(())
+                    .ok_or_else(|| format!("no [[constant]] named {name:?}"))
+            }
             (Ty::Array(p, n), V::Array(items)) => {
                 if items.len() != *n {
                     return Err(format!("{} values for {n} entries", items.len()));
@@ -1134,7 +1212,139 @@ impl Table {
                 ));
             }
         }
+        self.check_rust(file)
+    }
+
+    /// Checks what only the Rust types read: extra derives, and the fields that carry codes and
+    /// bits.
+    fn check_rust(&self, file: &str) -> Result<(), TableError> {
+        let float = |t: &Ty| matches!(t, Ty::Prim(Prim::F64) | Ty::Array(Prim::F64, _));
+        let typed = self
+            .structs
+            .iter()
+            .map(|s| (format!("struct {}", s.name), &s.rust_derive, &s.fields))
+            .chain(
+                self.messages
+                    .iter()
+                    .map(|m| (format!("message {}", m.name), &m.rust_derive, &m.fields)),
+            );
+        for (owner, derives, fields) in typed {
+            if derives.iter().any(|d| d != "Hash")
+                || (!derives.is_empty() && self.holds(fields, &float))
+            {
+                return Err(Self::err(
+                    file,
+                    format!("{owner}, rust_derive"),
+                    "the only extra derive is \"Hash\", for a type without f64",
+                ));
+            }
+        }
+        for c in &self.codes {
+            self.field_at(&c.of)
+                .map_err(|e| Self::err(file, format!("codes {}, of", c.name), e))?;
+        }
+        for fl in &self.flags {
+            let place = format!("flags {}", fl.name);
+            let named = self.flag_fields(&fl.name);
+            let carriers =
+                match (&fl.of, named.is_empty()) {
+                    (Some(of), true) => vec![self
+                        .field_at(of)
+                        .map_err(|e| Self::err(file, format!("{place}, of"), e))?],
+                    (None, false) => named,
+                    _ => return Err(Self::err(
+                        file,
+                        place,
+                        "bits are carried by the fields that name them in `flags`, or, when none \
+                         does, by the field `of` names (one of the two)",
+                    )),
+                };
+            if carriers.iter().any(|(_, f)| f.ty != carriers[0].1.ty) {
+                return Err(Self::err(
+                    file,
+                    place,
+                    "the fields that carry the bits have one type",
+                ));
+            }
+        }
         Ok(())
+    }
+
+    /// Whether a type in `fields` (nested structs, union variants and vec elements included) is
+    /// one `is` accepts.
+    pub fn holds(&self, fields: &[Field], is: &dyn Fn(&Ty) -> bool) -> bool {
+        fields
+            .iter()
+            .any(|f| self.resolve(&f.ty).is_ok_and(|ty| self.ty_holds(&ty, is)))
+    }
+
+    /// Whether `ty` is, or holds, a type `is` accepts.
+    pub fn ty_holds(&self, ty: &Ty, is: &dyn Fn(&Ty) -> bool) -> bool {
+        is(ty)
+            || match ty {
+                Ty::Struct(s) => self.holds(&self.structs[*s].fields, is),
+                Ty::Union(u) => self.unions[*u]
+                    .variants
+                    .iter()
+                    .any(|v| self.holds(&v.fields, is)),
+                Ty::Vec(inner) => self.ty_holds(inner, is),
+                _ => false,
+            }
+    }
+
+    /// The integer field `Owner.field` of a struct or message: its owner's name and the field.
+    pub fn field_at(&self, path: &str) -> Result<(&str, &Field), String> {
+        let (owner, name) = path
+            .split_once('.')
+            .ok_or_else(|| format!("{path:?} is not Owner.field"))?;
+        let (owner, fields) = self
+            .structs
+            .iter()
+            .map(|s| (s.name.as_str(), &s.fields))
+            .chain(self.messages.iter().map(|m| (m.name.as_str(), &m.fields)))
+            .find(|(n, _)| *n == owner)
+            .ok_or_else(|| format!("no struct or message named {owner:?}"))?;
+        let f = fields
+            .iter()
+            .find(|f| f.name == name)
+            .ok_or_else(|| format!("{owner} has no field {name:?}"))?;
+        match self.resolve(&f.ty) {
+            Ok(Ty::Prim(Prim::U8 | Prim::U16 | Prim::U32)) => Ok((owner, f)),
+            _ => Err(format!("{path} is not a u8, u16 or u32")),
+        }
+    }
+
+    /// The fields that name [[flags]] `name` in their `flags`, with their owners' names.
+    pub fn flag_fields(&self, name: &str) -> Vec<(&str, &Field)> {
+        let owners = self
+            .structs
+            .iter()
+            .map(|s| (s.name.as_str(), &s.fields))
+            .chain(self.messages.iter().map(|m| (m.name.as_str(), &m.fields)))
+            .chain(
+                self.unions
+                    .iter()
+                    .flat_map(|u| u.variants.iter().map(move |v| (u.name.as_str(), &v.fields))),
+            );
+        owners
+            .flat_map(|(o, fields)| fields.iter().map(move |f| (o, f)))
+            .filter(|(_, f)| f.flags.as_deref() == Some(name))
+            .collect()
+    }
+
+    /// The fields that carry [[flags]] `name` (checked: at least one, of one type).
+    pub fn flag_carriers(&self, name: &str) -> Vec<(&str, &Field)> {
+        let named = self.flag_fields(name);
+        if !named.is_empty() {
+            return named;
+        }
+        self.flags
+            .iter()
+            .find(|f| f.name == name)
+            .and_then(|f| f.of.as_deref())
+            .and_then(|of| self.field_at(of).ok())
+            .into_iter()
+            .collect()
     }
 }
 
@@ -1146,6 +1356,18 @@ pub fn key_chunks(key: &str) -> Vec<&str> {
 /// `RunTicks` → `RUN_TICKS`, `command_flags` → `COMMAND_FLAGS`.
 pub fn screaming_snake(name: &str) -> String {
     snake(name).to_ascii_uppercase()
+}
+
+/// `source_wrench` → `SourceWrench`.
+pub fn camel(name: &str) -> String {
+    name.split('_')
+        .map(|w| {
+            let mut c = w.chars();
+            c.next()
+                .map(|f| f.to_ascii_uppercase().to_string() + c.as_str())
+                .unwrap_or_default()
+        })
+        .collect()
 }
 
 /// `EffectorState` → `effector_state`; a name already in snake_case is kept.

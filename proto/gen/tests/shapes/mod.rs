@@ -3,8 +3,8 @@
 //! bounded u8 count, a text field, an i32, finite floats, a union whose variants carry a bool, an
 //! enum and a vec of structs that themselves hold a vec, and a vec of primitives at a message's
 //! end. (Structs nested whole are today's Header, AppliedWrench and SysTime, covered by the
-//! goldens and the fuzzers; the Rust half needs hand-written types, so only the real messages
-//! exercise it.)
+//! goldens and the fuzzers; the Rust half is compiled only from the real table, so only the real
+//! messages exercise it.)
 //!
 //! Two probe messages are appended to the real table; the generators write the C header and the
 //! Python module from it; buffers are packed here by hand, little-endian, at offsets worked out
@@ -67,7 +67,7 @@ fields = [
   { name = "mode", type = "enum<ProbeMode>" },
   { name = "bits", type = "bool[2]" },
   { name = "count", type = "u8", max = 3 },
-  { name = "label", type = "u8[8]", text = true },
+  { name = "label", type = "u8[8]", text = true, rust_type = "ProbeLabel" },
   { name = "offset", type = "i32" },
   { name = "vals", type = "f64[2]", finite = true },
   { name = "pick", type = "union<ProbePick>" },
