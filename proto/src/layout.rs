@@ -29,8 +29,9 @@ pub enum WireLayout {
     Walked {
         /// Shortest possible encoding (bytes).
         min_len: usize,
-        /// Returns the total length implied by the bytes, or the error to report.
-        walk: fn(&[u8]) -> Result<usize, DecodeError>,
+        /// Returns the total length implied by the bytes, or why it cannot (without
+        /// allocating: the in-place views walk on paths that allocate nothing).
+        walk: fn(&[u8]) -> Result<usize, WalkError>,
     },
 }
 
@@ -60,6 +61,58 @@ pub trait WireMessage: Serialize + DeserializeOwned + sealed::Sealed {
     }
 }
 
+/// Why a walk of the count prefixes stopped: the decoder's [`DecodeError`], not yet written
+/// out (a view only needs its class, and must not allocate).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WalkError {
+    /// The buffer ends first: [`DecodeError::Length`].
+    Length {
+        /// Bytes the walk needed.
+        needed: usize,
+        /// Bytes there are.
+        actual: usize,
+    },
+    /// A count beyond its bound: [`DecodeError::Malformed`].
+    Count {
+        /// The vec (`inputs[].values`).
+        what: &'static str,
+        /// The count read.
+        count: u64,
+        /// Where it was read.
+        at: usize,
+        /// Its bound.
+        max: usize,
+    },
+    /// A union tag that names no variant: [`DecodeError::Malformed`].
+    Tag {
+        /// The union field (`kind`).
+        what: &'static str,
+        /// The tag read.
+        tag: u32,
+        /// Where it was read.
+        at: usize,
+    },
+}
+
+impl From<WalkError> for DecodeError {
+    fn from(e: WalkError) -> Self {
+        match e {
+            WalkError::Length { needed, actual } => DecodeError::Length { needed, actual },
+            WalkError::Count {
+                what,
+                count,
+                at,
+                max,
+            } => DecodeError::Malformed(format!(
+                "{what} count {count} at offset {at} exceeds maximum {max}"
+            )),
+            WalkError::Tag { what, tag, at } => {
+                DecodeError::Malformed(format!("unknown {what} tag {tag} at offset {at}"))
+            }
+        }
+    }
+}
+
 /// A bounds-checked reader of count prefixes, for [`WireLayout::Walked`].
 pub(crate) struct Walker<'b> {
     bytes: &'b [u8],
@@ -78,13 +131,13 @@ impl<'b> Walker<'b> {
     }
 
     /// Skips `n` bytes; an error if the buffer ends first.
-    pub(crate) fn skip(&mut self, n: usize) -> Result<(), DecodeError> {
-        let end = self.at.checked_add(n).ok_or(DecodeError::Length {
+    pub(crate) fn skip(&mut self, n: usize) -> Result<(), WalkError> {
+        let end = self.at.checked_add(n).ok_or(WalkError::Length {
             needed: usize::MAX,
             actual: self.bytes.len(),
         })?;
         if end > self.bytes.len() {
-            return Err(DecodeError::Length {
+            return Err(WalkError::Length {
                 needed: end,
                 actual: self.bytes.len(),
             });
@@ -94,16 +147,18 @@ impl<'b> Walker<'b> {
     }
 
     /// Reads a u64 LE count at the cursor and checks it against `max`.
-    pub(crate) fn count(&mut self, what: &str, max: usize) -> Result<usize, DecodeError> {
-        let count = read_u64_le(self.bytes, self.at).ok_or(DecodeError::Length {
+    pub(crate) fn count(&mut self, what: &'static str, max: usize) -> Result<usize, WalkError> {
+        let count = read_u64_le(self.bytes, self.at).ok_or(WalkError::Length {
             needed: self.at + 8,
             actual: self.bytes.len(),
         })?;
         if count > max as u64 {
-            return Err(DecodeError::Malformed(format!(
-                "{what} count {count} at offset {} exceeds maximum {max}",
-                self.at
-            )));
+            return Err(WalkError::Count {
+                what,
+                count,
+                at: self.at,
+                max,
+            });
         }
         self.at += 8;
         Ok(count as usize)
@@ -112,10 +167,10 @@ impl<'b> Walker<'b> {
     /// Reads a count of at most `max` values of `size` bytes and skips them.
     pub(crate) fn values(
         &mut self,
-        what: &str,
+        what: &'static str,
         max: usize,
         size: usize,
-    ) -> Result<(), DecodeError> {
+    ) -> Result<(), WalkError> {
         let n = self.count(what, max)?;
         self.skip(size * n)
     }
@@ -127,7 +182,7 @@ impl WireLayout {
     pub fn expected_len(&self, bytes: &[u8]) -> Result<usize, DecodeError> {
         match *self {
             WireLayout::Fixed { len } => Ok(len),
-            WireLayout::Walked { walk, .. } => walk(bytes),
+            WireLayout::Walked { walk, .. } => walk(bytes).map_err(DecodeError::from),
         }
     }
 }

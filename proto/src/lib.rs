@@ -109,13 +109,16 @@ mod error;
 // Written by flexdyn-wiregen from proto/schema/messages.toml.
 #[rustfmt::skip]
 mod json_schemas;
-pub mod fsw_view;
 pub mod keys;
 mod layout;
 // Written by flexdyn-wiregen from proto/schema/messages.toml: every message type, with its docs;
 // their methods are hand-written in messages/methods.rs.
 mod messages;
 pub mod view;
+// Written by flexdyn-wiregen from proto/schema/messages.toml: every message's in-place view; the
+// machinery they use is hand-written in view.rs.
+#[rustfmt::skip]
+mod views;
 // Written by flexdyn-wiregen from proto/schema/messages.toml: each message's sizes, length rule,
 // checks and decoder, and the protocol's constants.
 #[rustfmt::skip]
@@ -140,7 +143,8 @@ pub use keys::{
     PARTICIPANT_PREFIX, STAR_TRACKER_PREFIX, STATE_SUFFIX, STATUS_SUFFIX, TIME_SUFFIX,
 };
 pub use layout::{
-    WireLayout, WireMessage, MAX_PANEL_PAIRS, STATE_EFFECTOR_COUNT_OFFSET, TIME_CUC_OFFSET,
+    WalkError, WireLayout, WireMessage, MAX_PANEL_PAIRS, STATE_EFFECTOR_COUNT_OFFSET,
+    TIME_CUC_OFFSET,
 };
 pub use messages::{
     command_flags, eclipse, effector_kind, environment_flags, fss_flags, magnetometer_flags,

@@ -1,23 +1,33 @@
-//! A [`CommandMsg`] read in place, without allocating: for the one caller that must judge a
-//! command on a path that allocates nothing, the server's damaged-link check (a `corrupted`
-//! command-link fault decodes each damaged command on the stepping thread).
+//! Messages read in place, without allocating: for the callers that must judge a message on a
+//! path that allocates nothing (the server's check of each flight-code telemetry sample, on a
+//! thread that may step the frames in lockstep; its damaged-link check, which reads each damaged
+//! command on the stepping thread).
 //!
-//! [`view_command`] accepts exactly the bytes [`crate::decode_command`] accepts, with the same
-//! values, and refuses the others with the class of [`DecodeError`] that `decode_command`
-//! gives (`tests/proptests.rs` checks both on arbitrary, truncated and bit-damaged commands).
-//! The checks, in `decode`'s order (module docs of the codec): at most [`MAX_MESSAGE_BYTES`];
-//! the protocol version; the length the layout implies (the tag at [`COMMAND_KIND_OFFSET`], and
-//! for `Actuators` each count within [`MAX_EFFECTORS`] / [`MAX_EFFECTOR_VALUES`]) against the
-//! buffer; then every number finite.
+//! Every message of the wire table has a view, generated from the table into `views.rs`
+//! (`cargo run -p flexdyn-wiregen`): `view_<message>(bytes)` (`view_command`, `view_fsw`, …)
+//! returns an `…View` (`CommandView`, `FswView`, …) with one accessor per field, or the class of
+//! [`DecodeError`] that the message's `decode_*` gives for the same bytes. A view accepts exactly
+//! the bytes its decoder accepts, with the same values (`tests/proptests.rs` checks every view
+//! against its decoder on arbitrary, truncated and bit-damaged messages). The checks, in
+//! `decode`'s order (module docs of the codec): at most [`MAX_MESSAGE_BYTES`]; the protocol
+//! version; the length the layout implies (the walk of the counts and the tag, shared with the
+//! decoder) against the buffer; what bincode refuses (an enum tag it does not know, a bool byte
+//! other than 0 or 1) and the rest of step 4 (a bounded `u8` count, a text field's padding), all
+//! [`ViewError::Malformed`]; then step 5, every `finite` number ([`ViewError::NonFinite`]).
+//!
+//! A variable-length part is read as a [`Prims`] (a `vec` of numbers) or a [`List`] of element
+//! views (a `vec` of structs, `EffectorInputView`, `EffectorStateView`), walked as it is
+//! iterated. This file is the machinery the generated views use.
 
-use crate::{
-    CommandMsg, DecodeError, Header, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_KIND_OFFSET,
-    COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, HEADER_LEN, MAX_EFFECTORS, MAX_EFFECTOR_VALUES,
-    MAX_MESSAGE_BYTES, PROTOCOL_VERSION,
-};
+use std::marker::PhantomData;
 
-/// Why [`view_command`] refused: the class of the [`DecodeError`] `decode_command` gives for the
-/// same bytes.
+use crate::layout::WireLayout;
+use crate::{DecodeError, WireMessage, MAX_MESSAGE_BYTES, PROTOCOL_VERSION};
+
+pub use crate::views::*;
+
+/// Why a view refused: the class of the [`DecodeError`] the message's decoder gives for the same
+/// bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ViewError {
     /// [`DecodeError::UnknownVersion`].
@@ -27,7 +37,8 @@ pub enum ViewError {
     },
     /// [`DecodeError::NonFinite`].
     NonFinite,
-    /// Any other: too large, too short, trailing bytes, an unknown tag, a count too large.
+    /// Any other: too large, too short, trailing bytes, an unknown tag, a count too large, a
+    /// bool byte other than 0 or 1, a text field's padding.
     Malformed,
 }
 
@@ -42,49 +53,180 @@ impl ViewError {
     }
 }
 
-/// A command, read in place.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CommandView<'a> {
-    /// Its header.
-    pub header: Header,
-    /// Its sender.
-    pub sender_id: u32,
-    /// What it commands.
-    pub kind: CommandViewKind<'a>,
+/// A message's view: what the generic callers (the property tests, tools) use.
+pub trait MessageView<'a>: Sized + Copy {
+    /// The message it reads.
+    type Msg: WireMessage;
+
+    /// Reads `bytes` in place (module docs). Allocates nothing.
+    fn read(bytes: &'a [u8]) -> Result<Self, ViewError>;
+
+    /// The owned message (allocates for a `vec`): for tests and tools.
+    fn to_msg(&self) -> Self::Msg;
 }
 
-/// [`crate::CommandKind`], read in place.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum CommandViewKind<'a> {
-    /// Tag 0.
-    Wrench {
-        /// Torque about B, B components (N·m).
-        torque_b_nm: [f64; 3],
-        /// Force at B, B components (N).
-        force_b_newton: [f64; 3],
-    },
-    /// Tag 1.
-    NoCommand,
-    /// Tag 2.
-    Actuators {
-        /// Torque about B, B components (N·m).
-        torque_b_nm: [f64; 3],
-        /// Force at B, B components (N).
-        force_b_newton: [f64; 3],
-        /// The per-effector inputs.
-        inputs: InputsView<'a>,
-    },
+/// A number as the wire holds it: little-endian, fixed width.
+pub trait WirePrim: Copy + Default {
+    /// Its encoded size (bytes).
+    const SIZE: usize;
+
+    /// The value at byte `at` of `b` (the default if `b` ends first: a view reads validated
+    /// bytes, so that never happens).
+    fn at(b: &[u8], at: usize) -> Self;
 }
 
-/// The effector inputs of an `Actuators` command: their encoding, already walked.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct InputsView<'a> {
+macro_rules! wire_prim {
+    ($($t:ty),*) => {$(
+        impl WirePrim for $t {
+            const SIZE: usize = std::mem::size_of::<$t>();
+
+            fn at(b: &[u8], at: usize) -> Self {
+                b.get(at..at.saturating_add(Self::SIZE))
+                    .and_then(|s| s.try_into().ok())
+                    .map_or_else(Self::default, <$t>::from_le_bytes)
+            }
+        }
+    )*};
+}
+
+wire_prim!(u8, u16, u32, u64, i32, f64);
+
+impl WirePrim for bool {
+    const SIZE: usize = 1;
+
+    fn at(b: &[u8], at: usize) -> Self {
+        b.get(at).is_some_and(|&x| x != 0)
+    }
+}
+
+/// The `T` at byte `at` of `b`.
+pub(crate) fn rd<T: WirePrim>(b: &[u8], at: usize) -> T {
+    T::at(b, at)
+}
+
+/// The `N` `T`s from byte `at` of `b`.
+pub(crate) fn rd_arr<T: WirePrim, const N: usize>(b: &[u8], at: usize) -> [T; N] {
+    let mut out = [T::default(); N];
+    for (k, x) in out.iter_mut().enumerate() {
+        *x = T::at(b, at + k * T::SIZE);
+    }
+    out
+}
+
+/// Whether the `n` text bytes from `at` follow the text rule: after the first NUL, only NULs
+/// (`FaultTarget::check_padding`).
+pub(crate) fn text_ok(b: &[u8], at: usize, n: usize) -> bool {
+    let text = b.get(at..at + n).unwrap_or_default();
+    text.iter()
+        .position(|&x| x == 0)
+        .is_none_or(|end| text[end..].iter().all(|&x| x == 0))
+}
+
+/// Whether `x` holds a NaN or an infinity.
+pub(crate) fn any_non_finite<const N: usize>(x: &[f64; N]) -> bool {
+    x.iter().any(|v| !v.is_finite())
+}
+
+/// The offset after the `vec` of `size`-byte elements whose count is at byte `at` of `b`.
+pub(crate) fn skip_vec(b: &[u8], at: usize, size: usize) -> usize {
+    let n = usize::try_from(rd::<u64>(b, at)).unwrap_or(usize::MAX);
+    at.saturating_add(8).saturating_add(n.saturating_mul(size))
+}
+
+/// `decode`'s first three checks: at most [`MAX_MESSAGE_BYTES`], the protocol version, and
+/// the length `layout` implies. Allocates nothing.
+pub(crate) fn check_frame(bytes: &[u8], layout: WireLayout) -> Result<(), ViewError> {
+    if bytes.len() > MAX_MESSAGE_BYTES {
+        return Err(ViewError::Malformed);
+    }
+    let found = rd::<u16>(bytes, 0);
+    if bytes.len() < 2 {
+        return Err(ViewError::Malformed);
+    }
+    if found != PROTOCOL_VERSION {
+        return Err(ViewError::UnknownVersion { found });
+    }
+    let expected = match layout {
+        WireLayout::Fixed { len } => len,
+        WireLayout::Walked { walk, .. } => walk(bytes).map_err(|_| ViewError::Malformed)?,
+    };
+    if bytes.len() == expected {
+        Ok(())
+    } else {
+        Err(ViewError::Malformed)
+    }
+}
+
+/// A `vec` of numbers, read in place.
+#[derive(Clone, Copy, PartialEq)]
+pub struct Prims<'a, T> {
+    bytes: &'a [u8],
+    of: PhantomData<T>,
+}
+
+impl<'a, T: WirePrim> Prims<'a, T> {
+    /// The `vec` whose count is at byte `at` of `b`.
+    pub(crate) fn at(b: &'a [u8], at: usize) -> Self {
+        let end = skip_vec(b, at, T::SIZE).min(b.len());
+        Self {
+            bytes: b.get(at.saturating_add(8)..end).unwrap_or_default(),
+            of: PhantomData,
+        }
+    }
+
+    /// How many numbers.
+    pub fn len(&self) -> usize {
+        self.bytes.len() / T::SIZE
+    }
+
+    /// Whether there is none.
+    pub fn is_empty(&self) -> bool {
+        self.bytes.is_empty()
+    }
+
+    /// Number `i` (`None` beyond [`Self::len`]).
+    pub fn get(&self, i: usize) -> Option<T> {
+        (i < self.len()).then(|| T::at(self.bytes, i * T::SIZE))
+    }
+
+    /// The numbers, in order.
+    pub fn iter(&self) -> impl Iterator<Item = T> + 'a {
+        let bytes = self.bytes;
+        (0..bytes.len() / T::SIZE).map(move |i| T::at(bytes, i * T::SIZE))
+    }
+}
+
+impl<T: WirePrim + std::fmt::Debug> std::fmt::Debug for Prims<'_, T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
+}
+
+/// A struct of a `vec` read in place: it knows its own length.
+pub trait Element<'a>: Copy {
+    /// The element at the start of `bytes`, and the bytes after it.
+    fn split(bytes: &'a [u8]) -> (Self, &'a [u8]);
+}
+
+/// A `vec` of structs, read in place: its elements are walked as it is iterated.
+#[derive(Clone, Copy, PartialEq)]
+pub struct List<'a, E> {
     count: usize,
     bytes: &'a [u8],
+    of: PhantomData<E>,
 }
 
-impl<'a> InputsView<'a> {
-    /// How many inputs.
+impl<'a, E: Element<'a>> List<'a, E> {
+    /// The `vec` whose count is at byte `at` of `b` (its elements run to the end of `b`).
+    pub(crate) fn at(b: &'a [u8], at: usize) -> Self {
+        Self {
+            count: usize::try_from(rd::<u64>(b, at)).unwrap_or(0),
+            bytes: b.get(at.saturating_add(8)..).unwrap_or_default(),
+            of: PhantomData,
+        }
+    }
+
+    /// How many elements.
     pub fn len(&self) -> usize {
         self.count
     }
@@ -94,205 +236,19 @@ impl<'a> InputsView<'a> {
         self.count == 0
     }
 
-    /// Each input: its effector index and its values.
-    pub fn iter(&self) -> impl Iterator<Item = (u32, ValuesView<'a>)> + 'a {
+    /// The elements, in order.
+    pub fn iter(&self) -> impl Iterator<Item = E> + 'a {
         let mut rest = self.bytes;
         (0..self.count).map(move |_| {
-            // Walked by `view_command`: the reads are in bounds.
-            let index = u32_at(rest, 0).unwrap_or_default();
-            let n = u64_at(rest, 4).unwrap_or_default() as usize;
-            let end = 12 + 8 * n;
-            let values = ValuesView {
-                bytes: rest.get(12..end).unwrap_or_default(),
-            };
-            rest = rest.get(end..).unwrap_or_default();
-            (index, values)
+            let (e, after) = E::split(rest);
+            rest = after;
+            e
         })
     }
 }
 
-/// The values of one effector input.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ValuesView<'a> {
-    bytes: &'a [u8],
-}
-
-impl<'a> ValuesView<'a> {
-    /// How many values.
-    pub fn len(&self) -> usize {
-        self.bytes.len() / 8
-    }
-
-    /// Whether there is none.
-    pub fn is_empty(&self) -> bool {
-        self.bytes.is_empty()
-    }
-
-    /// The values, in order.
-    pub fn iter(&self) -> impl Iterator<Item = f64> + 'a {
-        self.bytes
-            .chunks_exact(8)
-            .map(|c| f64::from_le_bytes(c.try_into().unwrap_or_default()))
-    }
-}
-
-pub(crate) fn u16_at(b: &[u8], at: usize) -> Option<u16> {
-    Some(u16::from_le_bytes(b.get(at..at + 2)?.try_into().ok()?))
-}
-
-pub(crate) fn u32_at(b: &[u8], at: usize) -> Option<u32> {
-    Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
-}
-
-pub(crate) fn u64_at(b: &[u8], at: usize) -> Option<u64> {
-    Some(u64::from_le_bytes(b.get(at..at + 8)?.try_into().ok()?))
-}
-
-pub(crate) fn f64_at(b: &[u8], at: usize) -> Option<f64> {
-    u64_at(b, at).map(f64::from_bits)
-}
-
-fn v3_at(b: &[u8], at: usize) -> Option<[f64; 3]> {
-    Some([f64_at(b, at)?, f64_at(b, at + 8)?, f64_at(b, at + 16)?])
-}
-
-/// The length an `Actuators` command's inputs imply (walked from the input count at offset
-/// [`COMMAND_ACTUATORS_FIXED_LEN`] − 8), and the count; `Malformed` as `decode` refuses it.
-fn walk_inputs(bytes: &[u8]) -> Result<(usize, usize), ViewError> {
-    let mut at = COMMAND_ACTUATORS_FIXED_LEN - 8;
-    let count = u64_at(bytes, at).ok_or(ViewError::Malformed)?;
-    if count > MAX_EFFECTORS as u64 {
-        return Err(ViewError::Malformed);
-    }
-    at += 8;
-    for _ in 0..count {
-        at += 4;
-        let n = u64_at(bytes, at).ok_or(ViewError::Malformed)?;
-        if n > MAX_EFFECTOR_VALUES as u64 {
-            return Err(ViewError::Malformed);
-        }
-        at += 8 + 8 * n as usize;
-        if at > bytes.len() {
-            return Err(ViewError::Malformed);
-        }
-    }
-    Ok((at, count as usize))
-}
-
-/// `decode`'s first two checks: at most [`MAX_MESSAGE_BYTES`], and the protocol version
-/// (returned).
-pub(crate) fn size_and_version(bytes: &[u8]) -> Result<u16, ViewError> {
-    if bytes.len() > MAX_MESSAGE_BYTES {
-        return Err(ViewError::Malformed);
-    }
-    let found = u16_at(bytes, 0).ok_or(ViewError::Malformed)?;
-    if found != PROTOCOL_VERSION {
-        return Err(ViewError::UnknownVersion { found });
-    }
-    Ok(found)
-}
-
-/// The [`Header`] at the start of `bytes`, whose version is `found`.
-pub(crate) fn header_at(bytes: &[u8], found: u16) -> Result<Header, ViewError> {
-    Ok(Header {
-        protocol_version: found,
-        spacecraft_id: u32_at(bytes, 2).ok_or(ViewError::Malformed)?,
-        tick: u64_at(bytes, 6).ok_or(ViewError::Malformed)?,
-        sim_time_ns: u64_at(bytes, 14).ok_or(ViewError::Malformed)?,
-        seq: u64_at(bytes, 22).ok_or(ViewError::Malformed)?,
-    })
-}
-
-/// Reads a [`CommandMsg`] in place (module docs). Allocates nothing.
-pub fn view_command(bytes: &[u8]) -> Result<CommandView<'_>, ViewError> {
-    let found = size_and_version(bytes)?;
-    let tag = u32_at(bytes, COMMAND_KIND_OFFSET).ok_or(ViewError::Malformed)?;
-    let (expected, inputs) = match tag {
-        0 => (COMMAND_WRENCH_LEN, 0),
-        1 => (COMMAND_NO_COMMAND_LEN, 0),
-        2 => walk_inputs(bytes)?,
-        _ => return Err(ViewError::Malformed),
-    };
-    if bytes.len() != expected {
-        return Err(ViewError::Malformed);
-    }
-    let header = header_at(bytes, found)?;
-    let sender_id = u32_at(bytes, HEADER_LEN).ok_or(ViewError::Malformed)?;
-    let wrench = || -> Result<([f64; 3], [f64; 3]), ViewError> {
-        let torque = v3_at(bytes, COMMAND_KIND_OFFSET + 4).ok_or(ViewError::Malformed)?;
-        let force = v3_at(bytes, COMMAND_KIND_OFFSET + 28).ok_or(ViewError::Malformed)?;
-        if torque.iter().chain(&force).all(|v| v.is_finite()) {
-            Ok((torque, force))
-        } else {
-            Err(ViewError::NonFinite)
-        }
-    };
-    let kind = match tag {
-        0 => {
-            let (torque_b_nm, force_b_newton) = wrench()?;
-            CommandViewKind::Wrench {
-                torque_b_nm,
-                force_b_newton,
-            }
-        }
-        1 => CommandViewKind::NoCommand,
-        _ => {
-            let (torque_b_nm, force_b_newton) = wrench()?;
-            let inputs = InputsView {
-                count: inputs,
-                bytes: bytes
-                    .get(COMMAND_ACTUATORS_FIXED_LEN..)
-                    .ok_or(ViewError::Malformed)?,
-            };
-            if inputs.iter().any(|(_, v)| v.iter().any(|x| !x.is_finite())) {
-                return Err(ViewError::NonFinite);
-            }
-            CommandViewKind::Actuators {
-                torque_b_nm,
-                force_b_newton,
-                inputs,
-            }
-        }
-    };
-    Ok(CommandView {
-        header,
-        sender_id,
-        kind,
-    })
-}
-
-impl CommandView<'_> {
-    /// The owned command (allocates for `Actuators`): for tests and tools.
-    pub fn to_owned_msg(&self) -> CommandMsg {
-        let kind = match self.kind {
-            CommandViewKind::Wrench {
-                torque_b_nm,
-                force_b_newton,
-            } => crate::CommandKind::Wrench {
-                torque_b_nm,
-                force_b_newton,
-            },
-            CommandViewKind::NoCommand => crate::CommandKind::NoCommand,
-            CommandViewKind::Actuators {
-                torque_b_nm,
-                force_b_newton,
-                inputs,
-            } => crate::CommandKind::Actuators {
-                torque_b_nm,
-                force_b_newton,
-                inputs: inputs
-                    .iter()
-                    .map(|(effector_index, v)| crate::EffectorInput {
-                        effector_index,
-                        values: v.iter().collect(),
-                    })
-                    .collect(),
-            },
-        };
-        CommandMsg {
-            header: self.header,
-            sender_id: self.sender_id,
-            kind,
-        }
+impl<'a, E: Element<'a> + std::fmt::Debug> std::fmt::Debug for List<'a, E> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
     }
 }

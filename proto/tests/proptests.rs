@@ -1,6 +1,7 @@
 //! Property tests of the codec: no input makes a decoder panic, random
 //! messages round-trip, and every truncation or extension is an error.
 
+use flexdyn_proto::view::{MessageView, ViewError};
 use flexdyn_proto::{
     decode, decode_command, decode_header, decode_imu, decode_magnetometer, decode_operator,
     decode_star_tracker, decode_state, decode_status, decode_time, encode, AppliedWrench,
@@ -481,72 +482,116 @@ proptest! {
     }
 }
 
-/// `view_command` (the allocation-free reading of a command) against `decode_command`: the same
-/// command for the bytes `decode_command` accepts, the same class of error for the others.
-fn view_agrees(bytes: &[u8]) -> Result<(), TestCaseError> {
-    use flexdyn_proto::view::{view_command, ViewError};
-    match (decode_command(bytes), view_command(bytes)) {
-        (Ok(m), Ok(v)) => prop_assert_eq!(v.to_owned_msg(), m),
+/// A message's view (its allocation-free reading) against its decoder: the same message, bit
+/// for bit (NaN payloads included: the owned message from the view encodes to the same bytes as
+/// the decoded one, and both to the input), for the bytes the decoder accepts; the same class of
+/// error for the others.
+fn view_agrees<'a, V>(bytes: &'a [u8]) -> Result<(), TestCaseError>
+where
+    V: MessageView<'a> + std::fmt::Debug,
+    V::Msg: std::fmt::Debug,
+{
+    match (decode::<V::Msg>(bytes), V::read(bytes)) {
+        (Ok(m), Ok(v)) => {
+            let decoded = encode(&m);
+            prop_assert_eq!(&encode(&v.to_msg()), &decoded);
+            prop_assert_eq!(decoded.as_slice(), bytes);
+        }
         (Err(e), Err(v)) => prop_assert_eq!(v, ViewError::of(&e), "{}", e),
         (d, v) => prop_assert!(false, "decode {:?} but view {:?}", d, v),
     }
     Ok(())
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig::with_cases(2048))]
+/// Every message's view against its decoder on the same bytes.
+fn every_view_agrees(bytes: &[u8]) -> Result<(), TestCaseError> {
+    use flexdyn_proto::view::*;
+    view_agrees::<StateView>(bytes)?;
+    view_agrees::<ImuView>(bytes)?;
+    view_agrees::<StarTrackerView>(bytes)?;
+    view_agrees::<MagnetometerView>(bytes)?;
+    view_agrees::<CssView>(bytes)?;
+    view_agrees::<FssView>(bytes)?;
+    view_agrees::<GpsView>(bytes)?;
+    view_agrees::<CommandView>(bytes)?;
+    view_agrees::<TimeView>(bytes)?;
+    view_agrees::<EnvironmentView>(bytes)?;
+    view_agrees::<OperatorView>(bytes)?;
+    view_agrees::<FaultEventView>(bytes)?;
+    view_agrees::<FaultCommandView>(bytes)?;
+    view_agrees::<RelativeStateView>(bytes)?;
+    view_agrees::<StatusView>(bytes)?;
+    view_agrees::<FswView>(bytes)?;
+    Ok(())
+}
 
-    #[test]
-    fn the_command_view_agrees_with_the_decoder_on_arbitrary_bytes(
-        bytes in prop::collection::vec(any::<u8>(), 0..300)
-    ) {
-        view_agrees(&bytes)?;
-    }
+/// The shortest encoding of every message (its whole length when fixed).
+const MIN_LENS: [usize; 16] = [
+    <StateMsg as WireMessage>::MIN_LEN,
+    <ImuMsg as WireMessage>::MIN_LEN,
+    <StarTrackerMsg as WireMessage>::MIN_LEN,
+    <flexdyn_proto::MagnetometerMsg as WireMessage>::MIN_LEN,
+    <flexdyn_proto::CssMsg as WireMessage>::MIN_LEN,
+    <flexdyn_proto::FssMsg as WireMessage>::MIN_LEN,
+    <flexdyn_proto::GpsMsg as WireMessage>::MIN_LEN,
+    <CommandMsg as WireMessage>::MIN_LEN,
+    <TimeMsg as WireMessage>::MIN_LEN,
+    <flexdyn_proto::EnvironmentMsg as WireMessage>::MIN_LEN,
+    <OperatorMsg as WireMessage>::MIN_LEN,
+    <flexdyn_proto::FaultEventMsg as WireMessage>::MIN_LEN,
+    <flexdyn_proto::FaultCommandMsg as WireMessage>::MIN_LEN,
+    <flexdyn_proto::RelativeStateMsg as WireMessage>::MIN_LEN,
+    <StatusMsg as WireMessage>::MIN_LEN,
+    <flexdyn_proto::FswMsg as WireMessage>::MIN_LEN,
+];
 
-    /// Commands of every kind (any bit pattern in the numbers: NaN, infinities), then damaged
-    /// as a `corrupted` link damages them (a bit flipped with probability p, p from 10⁻⁴ to 1/2),
-    /// then truncated or extended.
-    #[test]
-    fn the_command_view_agrees_with_the_decoder_on_damaged_commands(
-        msg in command_with(any_bits_f64),
-        seed in any::<u64>(),
-        p in prop_oneof![Just(0.0), 1e-4..0.5f64],
-        cut in 0usize..8,
-    ) {
-        let mut bytes = encode(&msg);
-        view_agrees(&bytes)?;
-        let mut s = seed | 1;
-        for b in bytes.iter_mut() {
-            for bit in 0..8 {
-                // xorshift64*: a uniform u in [0, 1) per bit.
-                s ^= s >> 12;
-                s ^= s << 25;
-                s ^= s >> 27;
-                let u = (s.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64;
-                if u < p {
-                    *b ^= 1 << bit;
-                }
+/// Bytes framed as one of the messages: the protocol version, then as many bytes as the
+/// message's shortest encoding, mostly 0 and 1 (so that enum tags, bools, counts and text
+/// padding are often valid and the accepting path is taken), the rest any byte.
+fn framed() -> impl Strategy<Value = Vec<u8>> {
+    let byte = prop_oneof![6 => Just(0u8), 1 => Just(1u8), 2 => any::<u8>()];
+    (0..MIN_LENS.len())
+        .prop_flat_map(move |i| prop::collection::vec(byte.clone(), MIN_LENS[i] - 2))
+        .prop_map(|body| {
+            let mut bytes = flexdyn_proto::PROTOCOL_VERSION.to_le_bytes().to_vec();
+            bytes.extend(body);
+            bytes
+        })
+}
+
+/// `bytes` with each bit flipped with probability `p` (xorshift64* from `seed`), as a
+/// `corrupted` command link damages a command.
+fn damage(bytes: &mut [u8], seed: u64, p: f64) {
+    let mut s = seed | 1;
+    for b in bytes.iter_mut() {
+        for bit in 0..8 {
+            // xorshift64*: a uniform u in [0, 1) per bit.
+            s ^= s >> 12;
+            s ^= s << 25;
+            s ^= s >> 27;
+            let u = (s.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64;
+            if u < p {
+                *b ^= 1 << bit;
             }
         }
-        view_agrees(&bytes)?;
-        let short = bytes.len().saturating_sub(cut);
-        view_agrees(&bytes[..short])?;
-        bytes.extend(std::iter::repeat_n(0u8, cut));
-        view_agrees(&bytes)?;
     }
 }
 
-/// `view_fsw` (the allocation-free reading of a flight-code sample) against `decode_fsw`: the
-/// same sample for the bytes `decode_fsw` accepts, the same class of error for the others.
-fn fsw_view_agrees(bytes: &[u8]) -> Result<(), TestCaseError> {
-    use flexdyn_proto::fsw_view::view_fsw;
-    use flexdyn_proto::view::ViewError;
-    match (flexdyn_proto::decode_fsw(bytes), view_fsw(bytes)) {
-        (Ok(m), Ok(v)) => prop_assert_eq!(v.to_owned_msg(), m),
-        (Err(e), Err(v)) => prop_assert_eq!(v, ViewError::of(&e), "{}", e),
-        (d, v) => prop_assert!(false, "decode {:?} but view {:?}", d, v),
-    }
-    Ok(())
+/// Every view against its decoder on `bytes`, then on `bytes` damaged, then truncated and
+/// extended by `cut` bytes.
+fn damaged_views_agree(
+    mut bytes: Vec<u8>,
+    seed: u64,
+    p: f64,
+    cut: usize,
+) -> Result<(), TestCaseError> {
+    every_view_agrees(&bytes)?;
+    damage(&mut bytes, seed, p);
+    every_view_agrees(&bytes)?;
+    let short = bytes.len().saturating_sub(cut);
+    every_view_agrees(&bytes[..short])?;
+    bytes.extend(std::iter::repeat_n(0u8, cut));
+    every_view_agrees(&bytes)
 }
 
 /// A FswMsg with any bits in its floats (NaN, infinities), up to 9 events (one beyond the
@@ -594,29 +639,120 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(2048))]
 
     #[test]
-    fn the_fsw_view_agrees_with_the_decoder_on_arbitrary_bytes(
+    fn every_view_agrees_with_its_decoder_on_arbitrary_bytes(
         bytes in prop::collection::vec(any::<u8>(), 0..300)
     ) {
-        fsw_view_agrees(&bytes)?;
+        every_view_agrees(&bytes)?;
     }
 
-    /// Samples with any field values, then bit-damaged, truncated or extended.
+    /// Bytes framed as each message in turn (version and length right, the body mostly 0 and
+    /// 1), then damaged, truncated or extended.
     #[test]
-    fn the_fsw_view_agrees_with_the_decoder_on_damaged_samples(
-        msg in fsw_sample(),
-        flip in prop::collection::vec((0usize..400, 0u8..8), 0..4),
+    fn every_view_agrees_with_its_decoder_on_framed_bytes(
+        bytes in framed(),
+        seed in any::<u64>(),
+        p in prop_oneof![Just(0.0), 1e-4..0.05f64],
         cut in 0usize..8,
     ) {
-        let mut bytes = flexdyn_proto::encode(&msg);
-        fsw_view_agrees(&bytes)?;
-        for (at, bit) in flip {
-            let n = bytes.len();
-            bytes[at % n] ^= 1 << bit;
-        }
-        fsw_view_agrees(&bytes)?;
-        let short = bytes.len().saturating_sub(cut);
-        fsw_view_agrees(&bytes[..short])?;
-        bytes.extend(std::iter::repeat_n(0u8, cut));
-        fsw_view_agrees(&bytes)?;
+        damaged_views_agree(bytes, seed, p, cut)?;
+    }
+
+    /// Commands of every kind (any bit pattern in the numbers: NaN, infinities), then damaged
+    /// as a `corrupted` link damages them (a bit flipped with probability p, p from 10⁻⁴ to 1/2),
+    /// then truncated or extended.
+    #[test]
+    fn every_view_agrees_with_its_decoder_on_damaged_commands(
+        msg in command_with(any_bits_f64),
+        seed in any::<u64>(),
+        p in prop_oneof![Just(0.0), 1e-4..0.5f64],
+        cut in 0usize..8,
+    ) {
+        damaged_views_agree(encode(&msg), seed, p, cut)?;
+    }
+
+    /// Flight-code samples with any field values, then damaged, truncated or extended.
+    #[test]
+    fn every_view_agrees_with_its_decoder_on_damaged_samples(
+        msg in fsw_sample(),
+        seed in any::<u64>(),
+        p in prop_oneof![Just(0.0), 1e-4..0.05f64],
+        cut in 0usize..8,
+    ) {
+        damaged_views_agree(encode(&msg), seed, p, cut)?;
+    }
+
+    /// State messages (effectors with states and outputs, any bits in the floats), then
+    /// damaged, truncated or extended.
+    #[test]
+    fn every_view_agrees_with_its_decoder_on_damaged_states(
+        msg in state(),
+        seed in any::<u64>(),
+        p in prop_oneof![Just(0.0), 1e-4..0.05f64],
+        cut in 0usize..8,
+    ) {
+        damaged_views_agree(encode(&msg), seed, p, cut)?;
+    }
+
+    /// Status and time messages (enums, bools, nested structs), then damaged, truncated or
+    /// extended.
+    #[test]
+    fn every_view_agrees_with_its_decoder_on_damaged_status_and_time(
+        status in status(),
+        time in time(),
+        seed in any::<u64>(),
+        p in prop_oneof![Just(0.0), 1e-4..0.05f64],
+        cut in 0usize..8,
+    ) {
+        damaged_views_agree(encode(&status), seed, p, cut)?;
+        damaged_views_agree(encode(&time), seed, p, cut)?;
+    }
+}
+
+/// The text rule, byte by byte, in the view and the decoder alike (the case: a target,
+/// NULs, then a 0x80 byte is refused; a target that fills all 128 bytes has no padding and is
+/// accepted; a NUL first and text after it is refused).
+#[test]
+fn the_views_apply_the_text_rule_as_the_decoders_do() {
+    use flexdyn_proto::view::{view_fault_command, view_fault_event};
+    use flexdyn_proto::{
+        FaultCommandMsg, FaultEventMsg, FaultTarget, FAULT_COMMAND_TARGET_OFFSET,
+        FAULT_EVENT_TARGET_OFFSET,
+    };
+    let command = FaultCommandMsg {
+        target: FaultTarget::new("imus.hub.gyro").unwrap(),
+        ..FaultCommandMsg::default()
+    };
+    let event = FaultEventMsg {
+        target: FaultTarget::new("imus.hub.gyro").unwrap(),
+        ..FaultEventMsg::default()
+    };
+    let cases = [
+        (encode(&command), FAULT_COMMAND_TARGET_OFFSET),
+        (encode(&event), FAULT_EVENT_TARGET_OFFSET),
+    ];
+    for (good, at) in cases {
+        let classes = |b: &[u8]| {
+            let v = view_fault_command(b)
+                .map(|_| ())
+                .or_else(|_| view_fault_event(b).map(|_| ()));
+            let d = flexdyn_proto::decode_fault_command(b)
+                .map(|_| ())
+                .or_else(|_| flexdyn_proto::decode_fault_event(b).map(|_| ()));
+            (v.is_ok(), d.is_ok())
+        };
+        assert_eq!(classes(&good), (true, true));
+        let mut after_nul = good.clone();
+        after_nul[at + 20] = 0x80;
+        assert_eq!(classes(&after_nul), (false, false), "a byte after the NUL");
+        let mut nul_first = good.clone();
+        nul_first[at] = 0;
+        assert_eq!(
+            classes(&nul_first),
+            (false, false),
+            "text after a leading NUL"
+        );
+        let mut full = good.clone();
+        full[at..at + 128].fill(b'x');
+        assert_eq!(classes(&full), (true, true), "128 bytes of text");
     }
 }

@@ -15,7 +15,7 @@
 
 use std::ops::Range;
 
-use flexdyn_proto::view::{view_command, CommandView, CommandViewKind, ViewError};
+use flexdyn_proto::view::{view_command, CommandKindView, CommandView, ViewError};
 use flexdyn_proto::{
     command_flags, CommandKind, CommandMsg, CommandStatus, StalePolicy, NO_COMMAND,
 };
@@ -155,10 +155,16 @@ fn check_view_inputs(
     seen: &mut [bool],
     cmd: &CommandView<'_>,
 ) -> Option<Offer> {
-    let CommandViewKind::Actuators { inputs, .. } = cmd.kind else {
+    let CommandKindView::Actuators { inputs, .. } = cmd.kind() else {
         return None;
     };
-    check_input_sizes(ranges, seen, inputs.iter().map(|(i, v)| (i, v.len())))
+    check_input_sizes(
+        ranges,
+        seen,
+        inputs
+            .iter()
+            .map(|i| (i.effector_index(), i.values().len())),
+    )
 }
 
 /// [`check_inputs`] on each input's effector index and value count.
@@ -295,15 +301,15 @@ impl CommandBook {
 
     /// [`Self::take`] for a command read in place (a damaged one).
     fn take_view(slot: &mut Slot, ranges: &[Range<usize>], cmd: &CommandView<'_>, k: u64) {
-        match cmd.kind {
-            CommandViewKind::Wrench {
+        match cmd.kind() {
+            CommandKindView::Wrench {
                 torque_b_nm,
                 force_b_newton,
             } => {
                 slot.torque_b_nm = torque_b_nm;
                 slot.force_b_newton = force_b_newton;
             }
-            CommandViewKind::Actuators {
+            CommandKindView::Actuators {
                 torque_b_nm,
                 force_b_newton,
                 inputs,
@@ -311,17 +317,17 @@ impl CommandBook {
                 slot.torque_b_nm = torque_b_nm;
                 slot.force_b_newton = force_b_newton;
                 // Checked by `check_view_inputs` before.
-                for (index, values) in inputs.iter() {
-                    let r = ranges[index as usize].clone();
+                for input in inputs.iter() {
+                    let r = ranges[input.effector_index() as usize].clone();
                     slot.inputs[r]
                         .iter_mut()
-                        .zip(values.iter())
+                        .zip(input.values().iter())
                         .for_each(|(to, v)| *to = v);
                 }
             }
-            CommandViewKind::NoCommand => {}
+            CommandKindView::NoCommand => {}
         }
-        Self::stamp(slot, cmd.header.tick, k);
+        Self::stamp(slot, cmd.header().tick, k);
     }
 
     /// Marks `slot` as holding the command of tick `tick`, taken at boundary `k`.
@@ -454,13 +460,15 @@ impl CommandBook {
         // on the stepping thread.
         let reject = match view_command(&self.scratch) {
             Err(e) => Err(Damaged::of_view(e)),
-            Ok(d) if d.header.spacecraft_id != self.spacecraft_id => Err(Damaged::WrongSpacecraft),
-            Ok(d) if d.sender_id != slot.sender_id => Err(Damaged::WrongIdentity),
+            Ok(d) if d.header().spacecraft_id != self.spacecraft_id => {
+                Err(Damaged::WrongSpacecraft)
+            }
+            Ok(d) if d.sender_id() != slot.sender_id => Err(Damaged::WrongIdentity),
             Ok(d)
-                if (lockstep && d.header.tick != k)
+                if (lockstep && d.header().tick != k)
                     || (!lockstep
-                        && (d.header.tick > k
-                            || (slot.has_command && d.header.tick < slot.last_tick))) =>
+                        && (d.header().tick > k
+                            || (slot.has_command && d.header().tick < slot.last_tick))) =>
             {
                 Err(Damaged::StaleTick)
             }

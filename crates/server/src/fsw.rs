@@ -36,7 +36,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
-use flexdyn_proto::fsw_view::view_fsw;
+use flexdyn_proto::view::view_fsw;
 use flexdyn_proto::view::ViewError;
 use flexdyn_proto::{decode_fsw, Topics};
 use flexdyn_sinks::recorder::{RecordItem, RecordTx};
@@ -114,17 +114,18 @@ impl FswIntake {
                 .map_or_else(|| format!("{e:?}"), |d| d.to_string());
             (reason, format!("flight-code telemetry on {key}: {detail}"))
         })?;
-        if msg.header.spacecraft_id != self.spacecraft_id {
+        if msg.header().spacecraft_id != self.spacecraft_id {
             return Err((
                 "wrong_spacecraft",
                 format!(
                     "flight-code telemetry on {key} for spacecraft_id {}, not this server's {}",
-                    msg.header.spacecraft_id, self.spacecraft_id
+                    msg.header().spacecraft_id,
+                    self.spacecraft_id
                 ),
             ));
         }
         // A lockstep run's last tick: neither checked further nor recorded (module docs).
-        if self.lockstep_last_tick == Some(msg.header.tick) {
+        if self.lockstep_last_tick == Some(msg.header().tick) {
             return Ok(None);
         }
         let Some(i) = self.keys.iter().position(|k| &**k == key) else {
@@ -137,7 +138,7 @@ impl FswIntake {
             ));
         };
         let stream = &self.streams[i];
-        let tick = msg.header.tick;
+        let tick = msg.header().tick;
         if tick > server_tick {
             return Err((
                 "future_tick",
@@ -148,13 +149,14 @@ impl FswIntake {
             ));
         }
         let due_ns = tick.saturating_mul(self.frame_ns);
-        if msg.header.sim_time_ns != due_ns {
+        if msg.header().sim_time_ns != due_ns {
             return Err((
                 "wrong_time",
                 format!(
                     "stream `{}` sample for tick {tick} says sim_time_ns {}, but that tick is at \
                      {due_ns} ns",
-                    stream.name, msg.header.sim_time_ns
+                    stream.name,
+                    msg.header().sim_time_ns
                 ),
             ));
         }

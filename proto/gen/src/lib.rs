@@ -12,6 +12,7 @@
 //! | the Python package's codec, `clients/python/src/flexdyn/proto.py` | [`py_proto`] |
 //! | the Rust codec's per-message code (sizes, constants, length rules, checks, decoders), `proto/src/wire.rs` | [`rust_wire`] |
 //! | the Rust message types (structs, enums, unions, codes and bits, `Default`s, docs), `proto/src/messages.rs` | [`rust_types`] |
+//! | the Rust in-place views (every message read without allocating), `proto/src/views.rs` | [`rust_views`] |
 //! | the C client library's typed calls, `clients/c/include/flexdyn_client_messages.h` | [`c_client`] |
 //! | the C client library's message kinds, `clients/c/src/kinds.rs` | [`c_client`] |
 //! | the C client library's `#[repr(C)]` mirrors of the header's structs and the conversions from the Rust messages, `clients/c/src/ctypes.rs` | [`c_ctypes`] |
@@ -25,6 +26,7 @@ pub mod json_schema;
 pub mod py_proto;
 pub mod readme;
 pub mod rust_types;
+pub mod rust_views;
 pub mod rust_wire;
 pub mod sizes;
 pub mod table;
@@ -45,6 +47,8 @@ pub const PY_PROTO_PATH: &str = "clients/python/src/flexdyn/proto.py";
 pub const RUST_WIRE_PATH: &str = "proto/src/wire.rs";
 /// The Rust message types.
 pub const RUST_TYPES_PATH: &str = "proto/src/messages.rs";
+/// The Rust in-place views.
+pub const RUST_VIEWS_PATH: &str = "proto/src/views.rs";
 /// The C client library's generated kind table.
 pub const KINDS_PATH: &str = "clients/c/src/kinds.rs";
 /// The C client library's mirrors of the header's structs.
@@ -100,6 +104,10 @@ pub fn mirrors(root: &Path) -> Result<Vec<Mirror>, String> {
         Mirror {
             path: RUST_TYPES_PATH.into(),
             text: rust_types::module(&table, TABLE_PATH).map_err(|e| e.to_string())?,
+        },
+        Mirror {
+            path: RUST_VIEWS_PATH.into(),
+            text: rust_views::module(&table)?,
         },
         Mirror {
             path: KINDS_PATH.into(),

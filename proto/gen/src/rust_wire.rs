@@ -256,14 +256,14 @@ fn message(t: &Table, m: &Message, o: &mut String) {
     // The walk of a variable message.
     if let Some(f) = tail {
         o.push_str(&format!(
-            "\n/// The length of a {name}, walked from its bytes.\nfn {walk}(bytes: &[u8]) -> Result<usize, DecodeError> {{\n"
+            "\n/// The length of a {name}, walked from its bytes.\nfn {walk}(bytes: &[u8]) -> Result<usize, WalkError> {{\n"
         ));
         match t.ty_of(f) {
             Ty::Vec(_) => walk_vec(t, f, prefix, o, "    "),
             Ty::Union(ui) => {
                 let un = &t.unions[ui];
                 o.push_str(&format!(
-                    "    let tag = read_u32_le(bytes, {prefix}).ok_or(DecodeError::Length {{\n        needed: {},\n        actual: bytes.len(),\n    }})?;\n    match tag {{\n",
+                    "    let tag = read_u32_le(bytes, {prefix}).ok_or(WalkError::Length {{\n        needed: {},\n        actual: bytes.len(),\n    }})?;\n    match tag {{\n",
                     prefix + 4
                 ));
                 for v in &un.variants {
@@ -279,7 +279,7 @@ fn message(t: &Table, m: &Message, o: &mut String) {
                     }
                 }
                 o.push_str(&format!(
-                    "        _ => Err(DecodeError::Malformed(format!(\n            \"unknown {} tag {{tag}} at offset {prefix}\"\n        ))),\n    }}\n",
+                    "        _ => Err(WalkError::Tag {{\n            what: \"{}\",\n            tag,\n            at: {prefix},\n        }}),\n    }}\n",
                     f.name
                 ));
             }
@@ -297,7 +297,7 @@ fn message(t: &Table, m: &Message, o: &mut String) {
 pub fn module(t: &Table) -> String {
     let mut o = String::new();
     o.push_str(&format!(
-        "//! The per-message half of the Rust codec: sizes, constants, each message's length rule\n//! and checks, and its decoder.\n//!\n//! {GENERATED}\n\nuse crate::layout::{{read_u32_le, sealed::Sealed, Walker, WireLayout, WireMessage}};\nuse crate::DecodeError;\n\n/// The wire protocol version every header carries.\npub const PROTOCOL_VERSION: u16 = {};\n",
+        "//! The per-message half of the Rust codec: sizes, constants, each message's length rule\n//! and checks, and its decoder.\n//!\n//! {GENERATED}\n\nuse crate::layout::{{read_u32_le, sealed::Sealed, WalkError, Walker, WireLayout, WireMessage}};\nuse crate::DecodeError;\n\n/// The wire protocol version every header carries.\npub const PROTOCOL_VERSION: u16 = {};\n",
         t.protocol_version
     ));
     o.push_str("\n// Named constants.\n");

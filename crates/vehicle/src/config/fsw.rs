@@ -36,8 +36,8 @@ use toml::de::DeValue;
 use toml::Spanned;
 
 use flexdyn_kernel::schema::{SchemaError, TableReader};
-use flexdyn_proto::fsw_view::FswView;
 use flexdyn_proto::keys::validate_sensor_name;
+use flexdyn_proto::view::FswView;
 use flexdyn_proto::{fsw_flags, FswMsg, KeyError, MAX_FSW_VALUES};
 
 use super::{ConfigError, SourceMap};
@@ -264,9 +264,15 @@ impl FswStreamDecl {
     /// [`Self::check`] of a sample read in place (what the server runs for every sample it
     /// receives, on a thread that may step the frames): allocates nothing unless it refuses.
     pub fn check_view(&self, v: &FswView<'_>) -> Result<(), FswRefusal> {
-        self.check_sample(v.flags, v.mode, v.event_indices(), v.values_len(), |i| {
-            v.value_word(i).unwrap_or(0)
-        })
+        let events = v.events();
+        let values = v.values();
+        self.check_sample(
+            v.flags(),
+            v.mode(),
+            &events[..usize::from(v.event_count()).min(events.len())],
+            values.len(),
+            |i| values.get(i).unwrap_or(0),
+        )
     }
 
     /// [`Self::check`] of a sample's parts: its flags, mode, event indices, and `n` value
