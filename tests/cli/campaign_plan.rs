@@ -191,6 +191,37 @@ fn wrong_keys_are_load_errors_that_name_the_field() {
     );
 }
 
+/// `[resources]`: read with its defaults, and every bad value refused naming its key.
+#[test]
+fn resources_are_read_and_checked() {
+    let head = "runs = 1\nseed = 1\nduration_s = 1.0\n";
+    let plan = campaign(head).unwrap();
+    let r = plan.campaign.resources;
+    assert_eq!(
+        (r.cpus_per_run, r.memory_mb, r.time_limit_s),
+        (2, None, None)
+    );
+    let plan = campaign(&format!(
+        "{head}[resources]\ncpus_per_run = 4\nmemory_mb = 2048\ntime_limit_s = 600\n"
+    ))
+    .unwrap();
+    let r = plan.campaign.resources;
+    assert_eq!(
+        (r.cpus_per_run, r.memory_mb, r.time_limit_s),
+        (4, Some(2048), Some(600))
+    );
+    for (body, key) in [
+        ("cpus_per_run = 0", "resources.cpus_per_run"),
+        ("memory_mb = 0", "resources.memory_mb"),
+        ("time_limit_s = 0", "resources.time_limit_s"),
+        ("time_limit_s = 1.5", "resources.time_limit_s"),
+        ("gpus = 1", "gpus"),
+    ] {
+        let e = campaign(&format!("{head}[resources]\n{body}\n")).unwrap_err();
+        assert!(e.contains(key), "{body}: {e}");
+    }
+}
+
 #[test]
 fn invalid_draws_are_redrawn_and_recorded_or_the_run_is_invalid() {
     // I_xx ~ U(0, 3000) with I_yy = 800, I_zz = 600: the triangle inequality needs

@@ -19,6 +19,7 @@ mod campaign_cli;
 mod campaign_faults;
 mod campaign_fleet_plan;
 mod campaign_plan;
+mod campaign_slurm;
 mod cli_simulate;
 mod config_errors;
 mod config_fuzz;

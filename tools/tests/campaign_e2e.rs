@@ -125,7 +125,11 @@ fn twenty_runs_two_at_a_time_then_one_again_alone() {
     hashes.dedup();
     assert_eq!(hashes.len(), 20);
 
-    let summary = campaign(&CampaignCommand::Summarize { dir: out.clone() }).unwrap();
+    let summary = campaign(&CampaignCommand::Summarize {
+        dir: out.clone(),
+        slurm_array: None,
+    })
+    .unwrap();
     let text = summary.text;
     eprintln!("{text}");
     assert_eq!(summary.exit_code, 3);
@@ -195,7 +199,11 @@ fn a_crashing_controller_fails_its_run_and_the_campaign_goes_on() {
     for r in [0, 2] {
         assert_eq!(result(&out, r).status, "ok");
     }
-    let summary = campaign(&CampaignCommand::Summarize { dir: out }).unwrap();
+    let summary = campaign(&CampaignCommand::Summarize {
+        dir: out,
+        slurm_array: None,
+    })
+    .unwrap();
     assert!(
         summary.text.contains("failed run 1: the controller exited"),
         "{}",
@@ -358,7 +366,11 @@ fn random_wheel_seizures_fail_the_runs_they_strike() {
     assert!(k > 0 && m > 0, "both groups: {failure_ns:?}");
     assert_eq!(code, 3, "the struck runs fail");
 
-    let summary = campaign(&CampaignCommand::Summarize { dir: out.clone() }).unwrap();
+    let summary = campaign(&CampaignCommand::Summarize {
+        dir: out.clone(),
+        slurm_array: None,
+    })
+    .unwrap();
     let text = summary.text;
     eprintln!("{text}");
     let csv = std::fs::read_to_string(out.join("summary.csv")).unwrap();
@@ -426,9 +438,12 @@ fn random_wheel_seizures_fail_the_runs_they_strike() {
         let want = first_step_ns / frame_ns + 1;
         assert_eq!(first_differing, Some(want as usize), "run {run}");
     }
-    let text = campaign(&CampaignCommand::Summarize { dir: healthy })
-        .unwrap()
-        .text;
+    let text = campaign(&CampaignCommand::Summarize {
+        dir: healthy,
+        slurm_array: None,
+    })
+    .unwrap()
+    .text;
     let all = format!("{SEIZURE_RUNS} of {SEIZURE_RUNS} planned runs passed");
     assert!(text.contains(&all), "{text}");
 }

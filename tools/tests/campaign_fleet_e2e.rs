@@ -264,7 +264,11 @@ fn a_formation_campaign_runs_a_controller_per_vehicle_and_judges_each_vehicle() 
     hashes.dedup();
     assert_eq!(hashes.len(), 2 * RUNS as usize);
 
-    let summary = campaign(&CampaignCommand::Summarize { dir: out.clone() }).unwrap();
+    let summary = campaign(&CampaignCommand::Summarize {
+        dir: out.clone(),
+        slurm_array: None,
+    })
+    .unwrap();
     eprintln!("{}", summary.text);
     assert_eq!(summary.exit_code, 3);
     assert!(

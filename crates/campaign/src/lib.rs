@@ -11,6 +11,8 @@
 //! - [`execute`]: one run = a lockstep server on its own port (the fleet server over a fleet),
 //!   an observer participant and the flight code (a controller per `[[controllers]]` entry
 //!   over a fleet); `--jobs N` runs N at a time, `--index I` exactly one.
+//! - [`slurm`]: the campaign as a Slurm job array and a dependent summarize job (`submit
+//!   --slurm`, `resubmit`), and the tasks that could not run as Slurm tells it.
 //! - [`summary`]: `summary.csv`, the pass rate with its Wilson interval, worst and failed runs,
 //!   figures.
 //! - [`verdict`]: each run's outcome, and the exit code of `run` and `summarize` (0 every run
@@ -32,6 +34,7 @@ pub mod judge;
 pub mod keys;
 pub mod plan;
 pub mod readback;
+pub mod slurm;
 pub mod spec;
 pub mod summary;
 pub mod verdict;
@@ -84,6 +87,46 @@ pub enum CampaignCommand {
     Summarize {
         /// The output directory of `plan`/`run`.
         dir: PathBuf,
+        /// First mark the runs of this Slurm array job that ended without a result as not run,
+        /// with their Slurm state (what the summarize job of `submit --slurm` does).
+        #[arg(long, value_name = "JOB_ID")]
+        slurm_array: Option<String>,
+    },
+    /// Plan the campaign into a directory every node sees and submit it to Slurm: a job array
+    /// with one task per run (the campaign's `[resources]` per task), then a summarize job
+    /// after it. Prints the job ids; with --wait, waits and exits with the verdict as `run`.
+    Submit {
+        /// The campaign file (TOML).
+        file: PathBuf,
+        /// Output directory, on a file system every node mounts at the same path.
+        #[arg(long, short, value_name = "DIR")]
+        output: PathBuf,
+        /// Submit to Slurm (`sbatch`; the only scheduler today).
+        #[arg(long, required = true)]
+        slurm: bool,
+        /// Wait for the summarize job, then report and exit with the campaign's verdict.
+        #[arg(long)]
+        wait: bool,
+        /// `sbatch --partition` (default: the cluster's default partition).
+        #[arg(long, value_name = "NAME")]
+        partition: Option<String>,
+        /// The flexdyn binary the tasks run, at the same path on every node [default: this
+        /// one].
+        #[arg(long, value_name = "PATH")]
+        flexdyn: Option<PathBuf>,
+        /// Remove the base configuration's random faults (`[[faults]]` with `mtbf_s`).
+        #[arg(long)]
+        without_random_faults: bool,
+    },
+    /// Submit again, to the same scheduler and with the same options, exactly the runs of a
+    /// submitted campaign that have no passed or failed result (lost nodes, time limits,
+    /// cancelled tasks), then a new summarize job.
+    Resubmit {
+        /// The output directory of `submit`.
+        dir: PathBuf,
+        /// Wait for the summarize job, then report and exit with the campaign's verdict.
+        #[arg(long)]
+        wait: bool,
     },
 }
 
@@ -189,18 +232,145 @@ pub fn main(cmd: &CampaignCommand) -> Result<Report, (u8, String)> {
                 exit_code: verdict.exit_code(),
             })
         }
-        CampaignCommand::Summarize { dir } => {
-            let s = summary::summarize(dir).map_err(|e| (verdict::EXIT_INVALID_INPUT, e))?;
-            Ok(Report {
-                text: format!(
-                    "{}wrote {} and {} figures\n{}",
-                    s.text,
-                    dir.join("summary.csv").display(),
-                    s.figures.len(),
-                    s.verdict.line()
-                ),
-                exit_code: s.verdict.exit_code(),
-            })
+        CampaignCommand::Summarize { dir, slurm_array } => {
+            let mut text = String::new();
+            if let Some(job) = slurm_array {
+                text = mark_slurm_failures(dir, job)?;
+            }
+            summarize(dir, text)
+        }
+        CampaignCommand::Submit {
+            file,
+            output,
+            slurm: _,
+            wait,
+            partition,
+            flexdyn,
+            without_random_faults,
+        } => {
+            let campaign = load(file, *without_random_faults).map_err(bad)?;
+            let resources = campaign.resources;
+            let plan = plan::Plan::new(campaign).map_err(bad)?;
+            let runs = plan
+                .write(output)
+                .map_err(|e| (1, format!("{}: {e}", output.display())))?;
+            let absolute = |p: &std::path::Path| {
+                std::fs::canonicalize(p).map_err(|e| (1, format!("{}: {e}", p.display())))
+            };
+            let opts = slurm::SlurmOptions {
+                flexdyn: match flexdyn {
+                    Some(f) => absolute(f)?,
+                    None => std::env::current_exe()
+                        .map_err(|e| (1, format!("the flexdyn binary's path: {e}")))?,
+                },
+                partition: partition.clone(),
+                without_random_faults: *without_random_faults,
+            };
+            let indices: Vec<u32> = runs.iter().map(|r| r.run).collect();
+            let dir = absolute(output)?;
+            let sub = slurm::submit(&absolute(file)?, &dir, &indices, &resources, &opts)
+                .map_err(|e| (1, e))?;
+            submitted(&dir, &sub, *wait)
+        }
+        CampaignCommand::Resubmit { dir, wait } => {
+            let last = slurm::submissions(dir)
+                .map_err(|e| (verdict::EXIT_INVALID_INPUT, e))?
+                .pop()
+                .ok_or_else(|| {
+                    (
+                        verdict::EXIT_INVALID_INPUT,
+                        format!("{}: no submission recorded", dir.display()),
+                    )
+                })?;
+            let plans = summary::planned_runs(dir).map_err(|e| (verdict::EXIT_INVALID_INPUT, e))?;
+            let missing = slurm::missing_runs(dir, &plans);
+            if missing.is_empty() {
+                return summarize(
+                    dir,
+                    "every planned run has a result: nothing to resubmit\n".into(),
+                );
+            }
+            // The reruns write their own results: the not-run ones go.
+            for p in plans.iter().filter(|p| missing.contains(&p.run)) {
+                let _ = std::fs::remove_file(dir.join(&p.dir).join("result.json"));
+            }
+            let resources = load(&last.campaign, last.without_random_faults)
+                .map_err(bad)?
+                .resources;
+            let opts = slurm::SlurmOptions {
+                flexdyn: last.flexdyn.clone(),
+                partition: last.partition.clone(),
+                without_random_faults: last.without_random_faults,
+            };
+            let dir =
+                std::fs::canonicalize(dir).map_err(|e| (1, format!("{}: {e}", dir.display())))?;
+            let sub = slurm::submit(&last.campaign, &dir, &missing, &resources, &opts)
+                .map_err(|e| (1, e))?;
+            submitted(&dir, &sub, *wait)
         }
     }
+}
+
+/// The report of `summarize`, after the lines in `text`.
+fn summarize(dir: &std::path::Path, text: String) -> Result<Report, (u8, String)> {
+    let s = summary::summarize(dir).map_err(|e| (verdict::EXIT_INVALID_INPUT, e))?;
+    Ok(Report {
+        text: format!(
+            "{text}{}wrote {} and {} figures\n{}",
+            s.text,
+            dir.join("summary.csv").display(),
+            s.figures.len(),
+            s.verdict.line()
+        ),
+        exit_code: s.verdict.exit_code(),
+    })
+}
+
+/// Marks the tasks of Slurm array `job` that ended without a result as not run; one line per
+/// run marked.
+fn mark_slurm_failures(dir: &std::path::Path, job: &str) -> Result<String, (u8, String)> {
+    let plans = summary::planned_runs(dir).map_err(|e| (verdict::EXIT_INVALID_INPUT, e))?;
+    let states = slurm::task_states(job).map_err(|e| (verdict::EXIT_NOT_RUN, e))?;
+    // The array's tasks as submitted (the record of the submission), else those Slurm names.
+    let indices: Vec<u32> = match slurm::submissions(dir)
+        .ok()
+        .and_then(|all| all.into_iter().find(|s| s.array_job == job))
+    {
+        Some(sub) => sub.indices,
+        None => states.iter().map(|t| t.task).collect(),
+    };
+    let marked = slurm::mark_not_run(dir, &plans, job, &indices, &states).map_err(|e| (1, e))?;
+    Ok(marked
+        .iter()
+        .map(|run| format!("run {run} could not run on Slurm (its result.json says why)\n"))
+        .collect())
+}
+
+/// The report of a submission: its job ids; with `wait`, the campaign's verdict once its
+/// summarize job has ended.
+fn submitted(
+    dir: &std::path::Path,
+    sub: &slurm::Submission,
+    wait: bool,
+) -> Result<Report, (u8, String)> {
+    let head = format!(
+        "submitted {} runs as Slurm array job {} and the summarize job {} (job scripts and logs in {})\n",
+        sub.indices.len(),
+        sub.array_job,
+        sub.summarize_job,
+        dir.join(slurm::SLURM_DIR).display()
+    );
+    if !wait {
+        return Ok(Report {
+            text: format!(
+                "{head}when the summarize job has ended: flexdyn campaign summarize {}",
+                dir.display()
+            ),
+            exit_code: verdict::EXIT_PASSED,
+        });
+    }
+    slurm::wait_for(&sub.summarize_job).map_err(|e| (1, e))?;
+    // The summarize job marked the failed tasks; marking again finds them marked.
+    let marked = mark_slurm_failures(dir, &sub.array_job)?;
+    summarize(dir, head + &marked)
 }

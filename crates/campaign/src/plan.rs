@@ -480,7 +480,7 @@ impl Plan {
     pub fn write(&self, dir: &Path) -> Result<Vec<RunPlan>, std::io::Error> {
         let runs: Vec<RunPlan> = (0..self.campaign.runs).map(|r| self.run(r)).collect();
         std::fs::create_dir_all(dir)?;
-        std::fs::write(dir.join("campaign.toml"), &self.campaign.source)?;
+        write_settled(&dir.join("campaign.toml"), self.campaign.source.as_bytes())?;
         for r in &runs {
             let d = dir.join(&r.dir);
             std::fs::create_dir_all(&d)?;
@@ -488,19 +488,33 @@ impl Plan {
                 continue;
             }
             if self.campaign.fleet.is_some() {
-                std::fs::write(d.join("fleet.toml"), &r.config_toml)?;
+                write_settled(&d.join("fleet.toml"), r.config_toml.as_bytes())?;
                 for (id, text) in &r.vehicle_configs {
-                    std::fs::write(d.join(super::fleet::vehicle_file(id)), text)?;
+                    write_settled(&d.join(super::fleet::vehicle_file(id)), text.as_bytes())?;
                 }
             } else {
-                std::fs::write(d.join("config.toml"), &r.config_toml)?;
+                write_settled(&d.join("config.toml"), r.config_toml.as_bytes())?;
             }
         }
         let text =
             serde_json::to_string_pretty(&self.manifest(&runs)).map_err(std::io::Error::other)?;
-        std::fs::write(dir.join("manifest.json"), text + "\n")?;
+        write_settled(&dir.join("manifest.json"), (text + "\n").as_bytes())?;
         Ok(runs)
     }
+}
+
+/// Writes `bytes` to `path` unless the file already holds exactly them, through a temporary
+/// file renamed over it. Every `campaign run --index` of a fanned-out campaign writes the same
+/// plan into the shared directory while other runs read it: an unchanged file is left alone,
+/// and a changed one is never seen half written.
+fn write_settled(path: &Path, bytes: &[u8]) -> Result<(), std::io::Error> {
+    if std::fs::read(path).is_ok_and(|old| old == bytes) {
+        return Ok(());
+    }
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(format!(".tmp-{}", std::process::id()));
+    std::fs::write(&tmp, bytes)?;
+    std::fs::rename(&tmp, path)
 }
 
 /// The units of a campaign over `fleet` (each vehicle's document: its configuration with its

@@ -11,6 +11,11 @@
 //! max_redraws = 100
 //! participant_timeout_s = 5.0
 //!
+//! [resources]                    # per run, for `campaign submit --slurm` (optional)
+//! cpus_per_run = 2
+//! memory_mb = 2048
+//! time_limit_s = 600
+//!
 //! [[dispersions]]
 //! key = "hub.inertia_bc_b_kg_m2[0][0]"
 //! distribution = "normal"        # mean = the nominal value unless `mean` is given
@@ -134,6 +139,32 @@ pub struct Campaign {
     pub fleet: Option<FleetBase>,
     /// `[[controllers]]` of a fleet campaign.
     pub controllers: Vec<Controller>,
+    /// `[resources]`: what one run asks of a batch scheduler.
+    pub resources: Resources,
+}
+
+/// `[resources]`: what one run needs on a cluster node (`campaign submit --slurm` asks for it
+/// per array task). A run is a lockstep server plus its flight code, so two CPUs keep the two
+/// from taking turns on one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Resources {
+    /// `cpus_per_run` (default 2).
+    pub cpus_per_run: u32,
+    /// `memory_mb`: \[MB\] memory per run; `None`: the partition's default.
+    pub memory_mb: Option<u64>,
+    /// `time_limit_s`: \[s\] wall-time limit per run; `None`: the partition's default. A run
+    /// stopped by it could not be run (it is not a verdict on the flight code).
+    pub time_limit_s: Option<u64>,
+}
+
+impl Default for Resources {
+    fn default() -> Self {
+        Self {
+            cpus_per_run: 2,
+            memory_mb: None,
+            time_limit_s: None,
+        }
+    }
 }
 
 /// One `[[controllers]]` entry of a fleet campaign: a flight-code process per run.
@@ -242,6 +273,7 @@ const ROOT_KEYS: &[&str] = &[
     "participant_timeout_s",
     "dispersions",
     "criteria",
+    "resources",
 ];
 
 /// \[s\] default of `participant_timeout_s`.
@@ -457,6 +489,30 @@ impl Campaign {
         within_time("participant_timeout_s", participant_timeout_s)
             .map_err(|p| invalid("participant_timeout_s", p))?;
 
+        let resources = match root
+            .opt_table("resources", &["cpus_per_run", "memory_mb", "time_limit_s"])
+            .map_err(schema)?
+        {
+            None => Resources::default(),
+            Some(t) => Resources {
+                cpus_per_run: match t.get("cpus_per_run") {
+                    Some(_) => t.int_in("cpus_per_run", 1, 4096).map_err(schema)? as u32,
+                    None => Resources::default().cpus_per_run,
+                },
+                memory_mb: match t.get("memory_mb") {
+                    Some(_) => Some(t.int_in("memory_mb", 1, 1 << 40).map_err(schema)? as u64),
+                    None => None,
+                },
+                time_limit_s: match t.get("time_limit_s") {
+                    // Slurm's limit is whole seconds at most a year here (`D-HH:MM:SS`).
+                    Some(_) => {
+                        Some(t.int_in("time_limit_s", 1, 366 * 86_400).map_err(schema)? as u64)
+                    }
+                    None => None,
+                },
+            },
+        };
+
         let mut dispersions = Vec::new();
         let tables = root
             .tables(
@@ -595,6 +651,7 @@ impl Campaign {
             random_faults_removed: false,
             fleet,
             controllers,
+            resources,
         })
     }
 }

@@ -23,8 +23,9 @@ pub struct Summary {
     pub completed: u32,
     /// Planned runs without `result.json`.
     pub missing: Vec<u32>,
-    /// Runs whose status is not `ok` (server error, controller exit, invalid draw).
-    pub failed: Vec<(u32, String)>,
+    /// Runs whose status is not `ok` (server error, controller exit, invalid draw, a Slurm
+    /// task that ended without a result), with their outcome.
+    pub failed: Vec<(u32, Outcome, String)>,
     /// The planned runs by outcome (a missing run could not be run): the exit code.
     pub verdict: Verdict,
     /// Wilson 95 % interval of the pass rate over the planned runs.
@@ -92,8 +93,8 @@ fn io(path: &Path, e: impl std::fmt::Display) -> String {
     format!("{}: {e}", path.display())
 }
 
-/// Summarises the campaign in `dir` (written by `plan` and `run`).
-pub fn summarize(dir: &Path) -> Result<Summary, String> {
+/// The manifest of the campaign in `dir` and its planned runs.
+fn read_manifest(dir: &Path) -> Result<(serde_json::Value, Vec<RunPlan>), String> {
     let manifest_path = dir.join("manifest.json");
     let manifest: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(&manifest_path).map_err(|e| io(&manifest_path, e))?,
@@ -101,6 +102,18 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
     .map_err(|e| io(&manifest_path, e))?;
     let plans: Vec<RunPlan> = serde_json::from_value(manifest["run_plans"].clone())
         .map_err(|e| io(&manifest_path, format!("run_plans: {e}")))?;
+    Ok((manifest, plans))
+}
+
+/// The planned runs of the campaign in `dir` (its `manifest.json`).
+pub fn planned_runs(dir: &Path) -> Result<Vec<RunPlan>, String> {
+    read_manifest(dir).map(|(_, plans)| plans)
+}
+
+/// Summarises the campaign in `dir` (written by `plan` and `run`).
+pub fn summarize(dir: &Path) -> Result<Summary, String> {
+    let manifest_path = dir.join("manifest.json");
+    let (manifest, plans) = read_manifest(dir)?;
     let keys: Vec<String> = serde_json::from_value(manifest["dispersed_keys"].clone())
         .map_err(|e| io(&manifest_path, format!("dispersed_keys: {e}")))?;
     let criteria: Vec<String> = serde_json::from_value(manifest["criteria"].clone())
@@ -117,7 +130,7 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
             Ok(text) => {
                 let r: RunResult = serde_json::from_str(&text).map_err(|e| io(&path, e))?;
                 if r.status != "ok" {
-                    s.failed.push((r.run, r.status.clone()));
+                    s.failed.push((r.run, r.outcome, r.status.clone()));
                 }
                 s.completed += 1;
                 if r.passed {
@@ -296,8 +309,11 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
         )
         .ok();
     }
-    for (run, why) in &s.failed {
-        writeln!(t, "failed run {run}: {why}").ok();
+    for (run, outcome, why) in &s.failed {
+        match outcome {
+            Outcome::NotRun => writeln!(t, "run {run} could not be run: {why}").ok(),
+            _ => writeln!(t, "failed run {run}: {why}").ok(),
+        };
     }
     let struck = |run: u32| {
         plans

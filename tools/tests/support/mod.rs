@@ -44,6 +44,7 @@ pub fn campaign_run_and_summarize(
     eprintln!("{}", report.text);
     let summary = campaign(&CampaignCommand::Summarize {
         dir: out.to_owned(),
+        slurm_array: None,
     })
     .unwrap();
     eprintln!("{}", summary.text);
