@@ -61,6 +61,11 @@ fn slosh_scenario_takes_its_parameters_from_the_fill_levels() {
     assert_eq!(p("l_m"), pendulum.pendulum_length_m);
     assert_eq!(p("r_pb_b_m[2]"), -0.5 + pendulum.hinge_height_m);
     assert_eq!(p("hang_axis_b[2]"), -1.0);
+    // The slosh masses count in the vehicle's total mass (the summary's).
+    assert_eq!(
+        cfg.total_mass_kg(),
+        950.0 + linear.slosh_mass_kg + pendulum.slosh_mass_kg
+    );
     // 89.9 kg and 80.8 kg, as the scenario's header says.
     assert!((linear.slosh_mass_kg - 89.93).abs() < 0.01);
     assert!((pendulum.slosh_mass_kg - 80.85).abs() < 0.01);

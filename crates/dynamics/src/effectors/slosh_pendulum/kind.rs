@@ -34,6 +34,10 @@ impl ComponentParams for SloshPendulumEntry {
     fn wire_counts(&self) -> (usize, usize) {
         (STATE_NAMES.len(), 0)
     }
+    fn added_mass_kg(&self) -> f64 {
+        // Validated before this is asked; an invalid entry adds nothing.
+        self.resolve("").map_or(0.0, |p| p.mass_kg)
+    }
     fn build(&self, path: &str, _timing: StepTiming) -> Result<BuiltComponent, ParamError> {
         Ok(BuiltComponent::Body(Box::new(SloshPendulum::new(
             self.resolve(path)?,
