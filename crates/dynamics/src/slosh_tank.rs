@@ -55,13 +55,13 @@ pub const XI_1: f64 = 1.841_183_781_340_659;
 /// An upright circular cylindrical tank with a flat bottom, partly filled with liquid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CylindricalTank {
-    /// [m] inner radius R.
+    /// \[m\] inner radius R.
     pub radius_m: f64,
-    /// [m] liquid depth h above the bottom (the fill level).
+    /// \[m\] liquid depth h above the bottom (the fill level).
     pub fill_height_m: f64,
-    /// [kg/m³] liquid density ρ_L.
+    /// \[kg/m³\] liquid density ρ_L.
     pub density_kg_m3: f64,
-    /// [m] the centre of the tank's bottom relative to B, B components.
+    /// \[m\] the centre of the tank's bottom relative to B, B components.
     pub r_bottom_b_m: Vector3<f64>,
     /// The tank's axis in B (unit), from the bottom towards the free surface: the settling
     /// acceleration (thrust) points along it, the apparent gravity against it.
@@ -71,29 +71,29 @@ pub struct CylindricalTank {
 /// The first lateral slosh mode of a [`CylindricalTank`] at one fill level.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SloshMode {
-    /// [kg] the liquid's mass m_L.
+    /// \[kg\] the liquid's mass m_L.
     pub liquid_mass_kg: f64,
-    /// [kg] the sloshing mass m₁ (T2).
+    /// \[kg\] the sloshing mass m₁ (T2).
     pub slosh_mass_kg: f64,
-    /// [kg] the non-sloshing mass m₀ = m_L − m₁ (T6).
+    /// \[kg\] the non-sloshing mass m₀ = m_L − m₁ (T6).
     pub fixed_mass_kg: f64,
-    /// [m] the pendulum's length L₁ (T3).
+    /// \[m\] the pendulum's length L₁ (T3).
     pub pendulum_length_m: f64,
-    /// [m] height of the slosh mass above the bottom, h₁ (T4).
+    /// \[m\] height of the slosh mass above the bottom, h₁ (T4).
     pub slosh_height_m: f64,
-    /// [m] height of the pendulum's hinge above the bottom, h₁ + L₁ (T5).
+    /// \[m\] height of the pendulum's hinge above the bottom, h₁ + L₁ (T5).
     pub hinge_height_m: f64,
-    /// [m] height of the non-sloshing mass above the bottom, h₀ (T6).
+    /// \[m\] height of the non-sloshing mass above the bottom, h₀ (T6).
     pub fixed_height_m: f64,
 }
 
 impl SloshMode {
-    /// [rad/s] ω₁ at settling acceleration `accel_m_s2` (T1): ω₁² = a / L₁.
+    /// \[rad/s\] ω₁ at settling acceleration `accel_m_s2` (T1): ω₁² = a / L₁.
     pub fn omega_rad_s(&self, accel_m_s2: f64) -> f64 {
         (accel_m_s2 / self.pendulum_length_m).sqrt()
     }
 
-    /// [N/m] the spring-mass model's stiffness at settling acceleration `accel_m_s2` (T3).
+    /// \[N/m\] the spring-mass model's stiffness at settling acceleration `accel_m_s2` (T3).
     pub fn k_n_m(&self, accel_m_s2: f64) -> f64 {
         self.slosh_mass_kg * accel_m_s2 / self.pendulum_length_m
     }
@@ -134,7 +134,7 @@ impl CylindricalTank {
         }
     }
 
-    /// [m] the point at `height_m` above the bottom on the tank's axis, relative to B.
+    /// \[m\] the point at `height_m` above the bottom on the tank's axis, relative to B.
     pub fn on_axis_b_m(&self, height_m: f64) -> Vector3<f64> {
         self.r_bottom_b_m + self.axis_b * height_m
     }
@@ -202,6 +202,64 @@ pub fn read_tank(
     };
     Ok(Some((tank, accel)))
 }
+
+/// The registry entry of a slosh kind and its [`crate::component::ComponentParams`]: both slosh
+/// kinds are appended bodies configured through the generic list whose entry resolves (a tank
+/// mapped, [`read_tank`]) to the parameters their effector is built from. `$entry` has
+/// `name: String` and `resolve(&self, path) -> Result<$params, ParamError>`, the resolved
+/// `$params` have `validate(path)` and `mass_kg`, and `$body::new($params, path)` builds the
+/// effector.
+macro_rules! slosh_component {
+    ($(#[$doc:meta])* $entry:ty => $body:ident, section $section:literal, noun $noun:literal) => {
+        $(#[$doc])*
+        pub static COMPONENT: $crate::component::ComponentKind = $crate::component::ComponentKind {
+            effector: super::KIND,
+            section: $section,
+            noun: $noun,
+            wire_names: |_, _| Some((&super::STATE_NAMES, &[])),
+            reader: Some($crate::component::ComponentReader {
+                keys: &super::schema::KEYS,
+                read: |t| $crate::component::read_boxed(t, super::schema::read),
+            }),
+            fault_modes: &[],
+        };
+
+        impl $crate::component::ComponentParams for $entry {
+            fn component_kind() -> &'static $crate::component::ComponentKind {
+                &COMPONENT
+            }
+            fn name(&self) -> &str {
+                &self.name
+            }
+            fn validate(
+                &self,
+                path: &str,
+                _timing: $crate::component::StepTiming,
+            ) -> Result<(), flexdyn_kernel::validate::ParamError> {
+                self.resolve(path)?.validate(path)
+            }
+            fn wire_counts(&self) -> (usize, usize) {
+                (super::STATE_NAMES.len(), 0)
+            }
+            fn added_mass_kg(&self) -> f64 {
+                // Validated before this is asked; an invalid entry adds nothing.
+                self.resolve("").map_or(0.0, |p| p.mass_kg)
+            }
+            fn build(
+                &self,
+                path: &str,
+                _timing: $crate::component::StepTiming,
+            ) -> Result<$crate::component::BuiltComponent, flexdyn_kernel::validate::ParamError>
+            {
+                Ok($crate::component::BuiltComponent::Body(Box::new(super::$body::new(
+                    self.resolve(path)?,
+                    path,
+                )?)))
+            }
+        }
+    };
+}
+pub(crate) use slosh_component;
 
 #[cfg(test)]
 mod tests {

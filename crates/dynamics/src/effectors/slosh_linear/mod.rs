@@ -25,13 +25,13 @@
 //!   **c_ρ = −(k ρ + c ρ̇)/m − p̂ᵀ(ω × (ω × r))**.
 //! - (L4) The particle's mass m r″ = m ρ̈ p̂ enters the hub's translational equation through
 //!   m_sc c″ (note, Eq. `Final5`). Substituting (L3):
-//!   **[A_contr] = m p̂ a_ρᵀ = −m p̂p̂ᵀ**, **[B_contr] = m p̂ b_ρᵀ**, **v_trans,contr = −m c_ρ p̂**.
+//!   **\[A_contr\] = m p̂ a_ρᵀ = −m p̂p̂ᵀ**, **\[B_contr\] = m p̂ b_ρᵀ**, **v_trans,contr = −m c_ρ p̂**.
 //! - (L5) Its m r × r″ = −m ρ̈ b_ρ enters the rotational equation about B (Eq. `Final6`), which also
-//!   carries −ω × (m r × r′) and the particle's share of −[I′_sc,B]ω:
-//!   **[C_contr] = −m b_ρ a_ρᵀ = [B_contr]ᵀ**, **[D_contr] = −m b_ρ b_ρᵀ**,
-//!   **v_rot,contr = m c_ρ b_ρ − ω × (m r × r′) − [I′]ω**, where [I] = m(|r|²[1] − r rᵀ) gives
-//!   [I′]ω = m(2 (r·r′) ω − r′ (r·ω) − r (r′·ω)).
-//! - (L6) Mass properties about B: m, m r, m r′ = m ρ̇ p̂, [I] = m [r̃][r̃]ᵀ (a point mass).
+//!   carries −ω × (m r × r′) and the particle's share of −\[I′_sc,B\]ω:
+//!   **\[C_contr\] = −m b_ρ a_ρᵀ = \[B_contr\]ᵀ**, **\[D_contr\] = −m b_ρ b_ρᵀ**,
+//!   **v_rot,contr = m c_ρ b_ρ − ω × (m r × r′) − \[I′\]ω**, where \[I\] = m(|r|²\[1\] − r rᵀ) gives
+//!   \[I′\]ω = m(2 (r·r′) ω − r′ (r·ω) − r (r′·ω)).
+//! - (L6) Mass properties about B: m, m r, m r′ = m ρ̇ p̂, \[I\] = m \[r̃\]\[r̃\]ᵀ (a point mass).
 //! - (L7) Energy and momentum: a point mass at r moving at r′ in B, plus the spring's ½ k ρ². The
 //!   spring and the damper are internal forces: the angular momentum about the system's centre of
 //!   mass is conserved, and with c = 0 so is the energy.
@@ -39,15 +39,16 @@
 //! # Parameters from a tank's fill level
 //! The sloshing mass, its stiffness and its rest point come from the tank and how full it is:
 //! [`crate::slosh_tank`] maps a fill level to them (first lateral mode of an upright cylindrical
-//! tank), and [`SloshLinearParams::from_tank`] builds a particle from that mapping.
+//! tank), and [`SloshLinearEntry::resolve`] builds a particle from that mapping (a `tank` table in
+//! the configuration).
 //!
 //! Integrated state: `[ρ, ρ̇]`.
 
 use nalgebra::Vector3;
 
 use crate::effector::{
-    BackSubContributions, EffectorKind, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics,
-    StateEffector,
+    point_mass_i_prime_omega, BackSubContributions, EffectorKind, EffectorMassProps,
+    EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
 use flexdyn_kernel::validate::ParamError;
 
@@ -66,7 +67,7 @@ pub const KIND: EffectorKind = EffectorKind {
     column_prefix: "slosh",
 };
 
-/// State order: ρ [m], ρ̇ [m/s].
+/// State order: ρ \[m\], ρ̇ \[m/s\].
 pub const STATE_NAMES: [&str; 2] = ["rho_m", "rho_dot_m_s"];
 
 /// Index of ρ in the particle's state slice.
@@ -77,11 +78,11 @@ pub const RHO_DOT: usize = 1;
 /// Geometry and back-substitution terms cached between the passes of one evaluation.
 #[derive(Debug, Clone, Copy)]
 struct Cache {
-    /// [m] r_Pc/B (L1).
+    /// \[m\] r_Pc/B (L1).
     r_pcb_b: Vector3<f64>,
-    /// [m] b_ρ = p̂ × r_Pc/B (L3).
+    /// \[m\] b_ρ = p̂ × r_Pc/B (L3).
     b_rho: Vector3<f64>,
-    /// [m/s²] c_ρ (L3).
+    /// \[m/s²\] c_ρ (L3).
     c_rho: f64,
 }
 
@@ -131,10 +132,6 @@ impl StateEffector for SloshLinear {
         KIND
     }
 
-    fn state_len(&self) -> usize {
-        2
-    }
-
     fn state_names(&self) -> &'static [&'static str] {
         &STATE_NAMES
     }
@@ -160,20 +157,9 @@ impl StateEffector for SloshLinear {
 
     fn update_mass_props(&mut self, x: &[f64], sum: &mut EffectorMassProps) {
         // (L6)
-        let m = self.params.mass_kg;
         let r = self.r_pcb_b_m(x[RHO]);
         self.cache.r_pcb_b = r;
-        sum.mass_kg += m;
-        sum.first_moment_b_kg_m += r * m;
-        sum.first_moment_prime_b_kg_m_s += self.params.p_hat_b * (m * x[RHO_DOT]);
-        let i_b = &mut sum.inertia_pnt_b_b_kg_m2;
-        let d = m * r.norm_squared();
-        for i in 0..3 {
-            i_b[(i, i)] += d;
-            for j in 0..3 {
-                i_b[(i, j)] -= m * r[i] * r[j];
-            }
-        }
+        sum.add_point_mass(self.params.mass_kg, &r, &(self.params.p_hat_b * x[RHO_DOT]));
     }
 
     fn update_contributions(
@@ -202,9 +188,9 @@ impl StateEffector for SloshLinear {
         // v_rot,contr = m c_ρ b_ρ − ω × (m r × r′) − [I′]ω.
         sum.matrix_c += b_contr.transpose();
         sum.matrix_d -= b_rho * b_rho.transpose() * m;
-        let i_prime_omega =
-            (w * (2.0 * r.dot(&r_prime)) - r_prime * r.dot(w) - r * r_prime.dot(w)) * m;
-        sum.vec_rot += b_rho * (m * c_rho) - w.cross(&(r.cross(&r_prime) * m)) - i_prime_omega;
+        sum.vec_rot += b_rho * (m * c_rho)
+            - w.cross(&(r.cross(&r_prime) * m))
+            - point_mass_i_prime_omega(m, &r, &r_prime, w);
     }
 
     fn compute_derivatives(&mut self, x: &[f64], hub_accel: &HubAccel, dx: &mut [f64]) {
@@ -220,15 +206,8 @@ impl StateEffector for SloshLinear {
         // (L7)
         let p = &self.params;
         let r = self.r_pcb_b_m(x[RHO]);
-        let r_prime = p.p_hat_b * x[RHO_DOT];
-        let mut em = EnergyMomentum::rigid_body(
-            p.mass_kg,
-            &r,
-            &r_prime,
-            &nalgebra::Matrix3::zeros(),
-            omega_bn_b,
-            omega_bn_b,
-        );
+        let mut em =
+            EnergyMomentum::point_mass(p.mass_kg, &r, &(p.p_hat_b * x[RHO_DOT]), omega_bn_b);
         em.potential_j = 0.5 * p.k_n_m * x[RHO] * x[RHO];
         em
     }

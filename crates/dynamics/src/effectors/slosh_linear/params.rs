@@ -8,7 +8,7 @@ use flexdyn_kernel::validate::{
     check_finite, check_non_negative, check_positive, check_unit_axis, join, ParamError,
 };
 
-/// [-] largest |p̂ · tank axis| for a tank-set particle: its axis must be lateral, since the
+/// \[-\] largest |p̂ · tank axis| for a tank-set particle: its axis must be lateral, since the
 /// mode of [`crate::slosh_tank`] is the lateral one.
 pub const LATERAL_TOL: f64 = 1e-6;
 
@@ -17,11 +17,11 @@ pub const LATERAL_TOL: f64 = 1e-6;
 pub enum SloshLinearSource {
     /// Given directly.
     Direct {
-        /// [m] rest point P relative to B, B components.
+        /// \[m\] rest point P relative to B, B components.
         r_pb_b_m: Vector3<f64>,
-        /// [kg] sloshing mass.
+        /// \[kg\] sloshing mass.
         mass_kg: f64,
-        /// [N/m] spring stiffness.
+        /// \[N/m\] spring stiffness.
         k_n_m: f64,
     },
     /// Set by a tank's fill level ([`crate::slosh_tank`], Eqs. T2–T4): m = m₁, k = m₁ω₁² at
@@ -29,7 +29,7 @@ pub enum SloshLinearSource {
     Tank {
         /// The tank and its fill level.
         tank: CylindricalTank,
-        /// [m/s²] the settling (thrust) acceleration along the tank's axis that sets k.
+        /// \[m/s²\] the settling (thrust) acceleration along the tank's axis that sets k.
         settling_accel_m_s2: f64,
     },
 }
@@ -43,11 +43,11 @@ pub struct SloshLinearEntry {
     pub p_hat_b: Vector3<f64>,
     /// Mass, stiffness and rest point.
     pub source: SloshLinearSource,
-    /// [N·s/m] damping coefficient c.
+    /// \[N·s/m\] damping coefficient c.
     pub c_n_s_m: f64,
-    /// [m] initial ρ.
+    /// \[m\] initial ρ.
     pub rho_m: f64,
-    /// [m/s] initial ρ̇.
+    /// \[m/s\] initial ρ̇.
     pub rho_dot_m_s: f64,
 }
 
@@ -105,21 +105,21 @@ impl SloshLinearEntry {
 pub struct SloshLinearParams {
     /// Name used in logs, messages and telemetry.
     pub name: String,
-    /// [m] the rest point P of the particle (ρ = 0) relative to B, B components.
+    /// \[m\] the rest point P of the particle (ρ = 0) relative to B, B components.
     pub r_pb_b_m: Vector3<f64>,
     /// The axis p̂ along which the particle moves, B components (a unit vector within
     /// [`flexdyn_kernel::validate::UNIT_AXIS_TOL`]); ρ > 0 displaces it along +p̂.
     pub p_hat_b: Vector3<f64>,
-    /// [kg] the sloshing mass m (the fixed, non-sloshing part of the propellant belongs to the
+    /// \[kg\] the sloshing mass m (the fixed, non-sloshing part of the propellant belongs to the
     /// hub's mass properties).
     pub mass_kg: f64,
-    /// [N/m] spring stiffness k.
+    /// \[N/m\] spring stiffness k.
     pub k_n_m: f64,
-    /// [N·s/m] damping coefficient c.
+    /// \[N·s/m\] damping coefficient c.
     pub c_n_s_m: f64,
-    /// [m] initial displacement ρ.
+    /// \[m\] initial displacement ρ.
     pub rho_m: f64,
-    /// [m/s] initial rate ρ̇.
+    /// \[m/s\] initial rate ρ̇.
     pub rho_dot_m_s: f64,
 }
 

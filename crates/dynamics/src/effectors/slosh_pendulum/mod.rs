@@ -29,16 +29,16 @@
 //!   **φ̈ = −ê_φ·s / (l cos θ) + 2 tan θ θ̇ φ̇ − (c/(m l²)) φ̇** and
 //!   **θ̈ = −ê_θ·s / l − sin θ cos θ φ̇² − (c/(m l²)) θ̇**, with s = r̈_B/N + ω̇ × r + w.
 //! - (P4) Substituting (P3) into (P2) gives the particle's relative acceleration in Cartesian form,
-//!   free of the angles' singularity: with [P_t] = [1] − êêᵀ (the plane the mass can move in),
-//!   **r″ = −[P_t](r̈_B/N + ω̇ × r) + g**, **g = −[P_t] w − (|r′|²/l) ê − (c/(m l²)) r′**.
+//!   free of the angles' singularity: with \[P_t\] = \[1\] − êêᵀ (the plane the mass can move in),
+//!   **r″ = −\[P_t\]·(r̈_B/N + ω̇ × r) + g**, **g = −\[P_t\] w − (|r′|²/l) ê − (c/(m l²)) r′**.
 //! - (P5) The hub's translational equation gains m r″ (through m_sc c″):
-//!   **[A_contr] = −m [P_t]**, **[B_contr] = m [P_t][r̃]** (from −[P_t](ω̇ × r) = [P_t][r̃]ω̇),
+//!   **\[A_contr\] = −m \[P_t\]**, **\[B_contr\] = m \[P_t\]\[r̃\]** (from −\[P_t\]·(ω̇ × r) = \[P_t\]\[r̃\]ω̇),
 //!   **v_trans,contr = −m g** (m r″ is on the left of the hub's equation, its free part g moves
 //!   to the right).
 //! - (P6) The rotational equation about B gains m r × r″, plus −ω × (m r × r′) and the mass's
-//!   share of −[I′_sc,B]ω: **[C_contr] = −m [r̃][P_t] = [B_contr]ᵀ**,
-//!   **[D_contr] = m [r̃][P_t][r̃]**, **v_rot,contr = −m r × g − ω × (m r × r′) − [I′]ω**, with
-//!   [I′]ω = m (2 (r·r′) ω − r′ (r·ω) − r (r′·ω)) as for any point mass.
+//!   share of −\[I′_sc,B\]ω: **\[C_contr\] = −m \[r̃\]\[P_t\] = \[B_contr\]ᵀ**,
+//!   **\[D_contr\] = m \[r̃\]·\[P_t\]·\[r̃\]**, **v_rot,contr = −m r × g − ω × (m r × r′) − \[I′\]ω**, with
+//!   \[I′\]ω = m (2 (r·r′) ω − r′ (r·ω) − r (r′·ω)) as for any point mass.
 //! - (P7) Mass properties: a point mass m at r moving at r′; energy ½ m |r′ + ω × r|², no stored
 //!   potential (the restoring effect is the hub's acceleration). The rod tension and the damping
 //!   are internal: the angular momentum about the system's centre of mass is conserved, and with
@@ -64,8 +64,8 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::effector::{
-    BackSubContributions, EffectorKind, EffectorMassProps, EnergyMomentum, HubAccel, HubKinematics,
-    StateEffector,
+    point_mass_i_prime_omega, BackSubContributions, EffectorKind, EffectorMassProps,
+    EnergyMomentum, HubAccel, HubKinematics, StateEffector,
 };
 use flexdyn_kernel::attitude::tilde;
 use flexdyn_kernel::validate::ParamError;
@@ -88,7 +88,7 @@ pub const KIND: EffectorKind = EffectorKind {
     column_prefix: "pendulum",
 };
 
-/// State order: φ [rad], φ̇ [rad/s], θ [rad], θ̇ [rad/s].
+/// State order: φ \[rad\], φ̇ \[rad/s\], θ \[rad\], θ̇ \[rad/s\].
 pub const STATE_NAMES: [&str; 4] = ["phi_rad", "phi_dot_rad_s", "theta_rad", "theta_dot_rad_s"];
 
 /// Index of φ in the pendulum's state slice.
@@ -110,7 +110,7 @@ struct Geometry {
     /// sin θ, cos θ.
     sin_theta: f64,
     cos_theta: f64,
-    /// [m] r_Pc/B and [m/s] r′_Pc/B.
+    /// \[m\] r_Pc/B and \[m/s\] r′_Pc/B.
     r: Vector3<f64>,
     r_prime: Vector3<f64>,
 }
@@ -119,7 +119,7 @@ struct Geometry {
 #[derive(Debug, Clone, Copy)]
 struct Cache {
     g: Geometry,
-    /// [m/s²] w = ω × (ω × r) + 2 ω × r′ (P3).
+    /// \[m/s²\] w = ω × (ω × r) + 2 ω × r′ (P3).
     w: Vector3<f64>,
 }
 
@@ -131,7 +131,7 @@ pub struct SloshPendulum {
     p1: Vector3<f64>,
     p2: Vector3<f64>,
     p3: Vector3<f64>,
-    /// [1/s] c/(m l²).
+    /// \[1/s\] c/(m l²).
     damping_rate: f64,
     cache: Cache,
 }
@@ -205,7 +205,7 @@ impl SloshPendulum {
         }
     }
 
-    /// [m] r_Pc/B, the mass's position relative to B at state `x` (P1).
+    /// \[m\] r_Pc/B, the mass's position relative to B at state `x` (P1).
     pub fn r_pcb_b_m(&self, x: &[f64]) -> Vector3<f64> {
         self.geometry(x).r
     }
@@ -218,10 +218,6 @@ impl StateEffector for SloshPendulum {
 
     fn kind(&self) -> EffectorKind {
         KIND
-    }
-
-    fn state_len(&self) -> usize {
-        4
     }
 
     fn state_names(&self) -> &'static [&'static str] {
@@ -256,12 +252,7 @@ impl StateEffector for SloshPendulum {
         // (P7): a point mass at r moving at r′.
         let g = self.geometry(x);
         self.cache.g = g;
-        let m = self.params.mass_kg;
-        sum.mass_kg += m;
-        sum.first_moment_b_kg_m += g.r * m;
-        sum.first_moment_prime_b_kg_m_s += g.r_prime * m;
-        sum.inertia_pnt_b_b_kg_m2 +=
-            (Matrix3::from_diagonal_element(g.r.norm_squared()) - g.r * g.r.transpose()) * m;
+        sum.add_point_mass(self.params.mass_kg, &g.r, &g.r_prime);
     }
 
     fn update_contributions(
@@ -279,21 +270,24 @@ impl StateEffector for SloshPendulum {
         let w = omega.cross(&omega.cross(r)) + omega.cross(r_prime) * 2.0;
         self.cache.w = w;
         // (P4): g = −[P_t] w − (|r′|²/l) ê − (c/(m l²)) r′, [P_t] = [1] − êêᵀ.
-        let p_t = Matrix3::identity() - e * e.transpose();
-        let free = -(p_t * w) - e * (r_prime.norm_squared() / l) - r_prime * self.damping_rate;
-        // (P5): [A_contr] = −m[P_t], [B_contr] = m[P_t][r̃], v_trans,contr = −m g.
-        let r_tilde = tilde(r);
-        let b_contr = p_t * r_tilde * m;
-        sum.matrix_a -= p_t * m;
-        sum.matrix_b += b_contr;
-        sum.vec_trans -= free * m;
-        // (P6): [C_contr] = [B_contr]ᵀ, [D_contr] = m[r̃][P_t][r̃],
+        let free = e * (e.dot(&w) - r_prime.norm_squared() / l) - w - r_prime * self.damping_rate;
+        // (P5): [A_contr] = −m[P_t], [B_contr] = m[P_t]·[r̃], v_trans,contr = −m g.
+        // (P6): [C_contr] = [B_contr]ᵀ, [D_contr] = m[r̃]·[P_t]·[r̃],
         // v_rot,contr = −m r × g − ω × (m r × r′) − [I′]ω.
+        // As rank-one updates: êᵀ[r̃] = (ê × r)ᵀ and [r̃][r̃] = r rᵀ − |r|²[1] give
+        // [B_contr] = m([r̃] − ê (ê × r)ᵀ) and [D_contr] = m(r rᵀ − |r|²[1] + q qᵀ), q = r × ê.
+        let q = r.cross(e);
+        let r_tilde = tilde(r);
+        let b_contr = (r_tilde + e * q.transpose()) * m;
+        sum.matrix_a += (e * e.transpose() - Matrix3::identity()) * m;
+        sum.matrix_b += b_contr;
         sum.matrix_c += b_contr.transpose();
-        sum.matrix_d += r_tilde * b_contr;
-        let i_prime_omega =
-            (omega * (2.0 * r.dot(r_prime)) - r_prime * r.dot(omega) - r * r_prime.dot(omega)) * m;
-        sum.vec_rot -= (r.cross(&free) + omega.cross(&r.cross(r_prime))) * m + i_prime_omega;
+        sum.matrix_d += (r * r.transpose() + q * q.transpose()
+            - Matrix3::from_diagonal_element(r.norm_squared()))
+            * m;
+        sum.vec_trans -= free * m;
+        sum.vec_rot -= (r.cross(&free) + omega.cross(&r.cross(r_prime))) * m
+            + point_mass_i_prime_omega(m, r, r_prime, omega);
     }
 
     fn compute_derivatives(&mut self, x: &[f64], hub_accel: &HubAccel, dx: &mut [f64]) {
@@ -316,13 +310,6 @@ impl StateEffector for SloshPendulum {
     fn energy_momentum(&self, x: &[f64], omega_bn_b: &Vector3<f64>) -> EnergyMomentum {
         // (P7)
         let g = self.geometry(x);
-        EnergyMomentum::rigid_body(
-            self.params.mass_kg,
-            &g.r,
-            &g.r_prime,
-            &Matrix3::zeros(),
-            omega_bn_b,
-            omega_bn_b,
-        )
+        EnergyMomentum::point_mass(self.params.mass_kg, &g.r, &g.r_prime, omega_bn_b)
     }
 }

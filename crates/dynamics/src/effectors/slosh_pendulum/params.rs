@@ -8,7 +8,7 @@ use flexdyn_kernel::validate::{
     check_finite, check_non_negative, check_positive, check_unit_axis, join, ParamError,
 };
 
-/// [rad] largest initial |θ|: the angles are singular at |θ| = 90° (see the module docs), and a
+/// \[rad\] largest initial |θ|: the angles are singular at |θ| = 90° (see the module docs), and a
 /// slosh pendulum swung that far is outside any equivalent mechanical model's range.
 pub const MAX_INITIAL_THETA_RAD: f64 = 80.0 * std::f64::consts::PI / 180.0;
 
@@ -17,25 +17,25 @@ pub const MAX_INITIAL_THETA_RAD: f64 = 80.0 * std::f64::consts::PI / 180.0;
 pub struct SloshPendulumParams {
     /// Name used in logs, messages and telemetry.
     pub name: String,
-    /// [m] the pivot (hinge) P relative to B, B components.
+    /// \[m\] the pivot (hinge) P relative to B, B components.
     pub r_pb_b_m: Vector3<f64>,
     /// p̂1, the direction the rod points at φ = θ = 0, B components (unit): the nominal hang,
     /// against the settling acceleration.
     pub hang_axis_b: Vector3<f64>,
-    /// [m] rod length l.
+    /// \[m\] rod length l.
     pub l_m: f64,
-    /// [kg] pendulum (sloshing) mass m.
+    /// \[kg\] pendulum (sloshing) mass m.
     pub mass_kg: f64,
-    /// [N·m·s/rad] damping c: the torque about P opposing the rod's angular velocity relative to
+    /// \[N·m·s/rad\] damping c: the torque about P opposing the rod's angular velocity relative to
     /// B (Rayleigh function ½ c |ê′|²).
     pub c_nm_s_rad: f64,
-    /// [rad] initial azimuth φ.
+    /// \[rad\] initial azimuth φ.
     pub phi_rad: f64,
-    /// [rad/s] initial φ̇.
+    /// \[rad/s\] initial φ̇.
     pub phi_dot_rad_s: f64,
-    /// [rad] initial elevation θ.
+    /// \[rad\] initial elevation θ.
     pub theta_rad: f64,
-    /// [rad/s] initial θ̇.
+    /// \[rad/s\] initial θ̇.
     pub theta_dot_rad_s: f64,
 }
 
@@ -69,13 +69,13 @@ impl SloshPendulumParams {
 pub enum SloshPendulumSource {
     /// Given directly.
     Direct {
-        /// [m] pivot P relative to B.
+        /// \[m\] pivot P relative to B.
         r_pb_b_m: Vector3<f64>,
         /// p̂1 in B (unit).
         hang_axis_b: Vector3<f64>,
-        /// [m] rod length.
+        /// \[m\] rod length.
         l_m: f64,
-        /// [kg] pendulum mass.
+        /// \[kg\] pendulum mass.
         mass_kg: f64,
     },
     /// Set by a tank's fill level ([`crate::slosh_tank`], Eqs. T2, T3, T5): m = m₁, l = L₁, the
@@ -90,15 +90,15 @@ pub struct SloshPendulumEntry {
     pub name: String,
     /// Pivot, hang, length and mass.
     pub source: SloshPendulumSource,
-    /// [N·m·s/rad] damping c.
+    /// \[N·m·s/rad\] damping c.
     pub c_nm_s_rad: f64,
-    /// [rad] initial φ.
+    /// \[rad\] initial φ.
     pub phi_rad: f64,
-    /// [rad/s] initial φ̇.
+    /// \[rad/s\] initial φ̇.
     pub phi_dot_rad_s: f64,
-    /// [rad] initial θ.
+    /// \[rad\] initial θ.
     pub theta_rad: f64,
-    /// [rad/s] initial θ̇.
+    /// \[rad/s\] initial θ̇.
     pub theta_dot_rad_s: f64,
 }
 
