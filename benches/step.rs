@@ -43,16 +43,7 @@ fn spacecraft_with_wheels(n: usize) -> Spacecraft {
         w.viscous_friction_nm_s_rad = 1e-6;
         w.coulomb_friction_nm = 5e-4;
     });
-    let mut sc = Spacecraft::new(
-        common::reference_hub(),
-        GravityModel::PointMass {
-            mu_m3_s2: common::MU_EARTH,
-        },
-        effectors,
-        common::reference_initial(),
-        1_000_000,
-    )
-    .unwrap();
+    let mut sc = reference_with(effectors);
     let u: Vec<f64> = (0..n).map(|j| 0.01 * (j as f64 + 1.0)).collect();
     sc.set_effector_inputs(&u).unwrap();
     sc
@@ -541,6 +532,11 @@ fn spacecraft_with_slosh(particles: usize, pendulums: usize) -> Spacecraft {
             SloshPendulum::new(p, &format!("slosh_pendulums[{j}]")).unwrap(),
         ));
     }
+    reference_with(effectors)
+}
+
+/// The reference hub, orbit and 1 ms step with `effectors` appended.
+fn reference_with(effectors: Vec<Box<dyn flexdyn_dynamics::StateEffector>>) -> Spacecraft {
     Spacecraft::new(
         common::reference_hub(),
         GravityModel::PointMass {

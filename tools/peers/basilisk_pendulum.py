@@ -46,30 +46,31 @@ def run(step_s, damping):
     sc.ModelTag = "spacecraftBody"
     sim.AddModelToTask("task", sc)
     dmat = [[damping, 0.0, 0.0], [0.0, damping, 0.0], [0.0, 0.0, damping]]
-    p1 = sphericalPendulum.SphericalPendulum()
-    p1.pendulumRadius = 0.3
-    p1.d = [[0.1], [0.1], [0.1]]
-    p1.D = dmat
-    p1.phiDotInit = 0.01
-    p1.thetaDotInit = 0.05
-    p1.massInit = 20.0
-    p1.pHat_01 = [[np.sqrt(2) / 2], [0], [np.sqrt(2) / 2]]
-    p1.pHat_02 = [[0], [1], [0]]
-    p1.pHat_03 = [[-np.sqrt(2) / 2], [0], [np.sqrt(2) / 2]]
-    p2 = sphericalPendulum.SphericalPendulum()
-    p2.pendulumRadius = 0.4
-    p2.d = [[0.1], [0.1], [0.1]]
-    p2.D = dmat
-    p2.phiDotInit = 0.1
-    p2.thetaDotInit = 0.5
-    p2.massInit = 40.0
+    s2 = np.sqrt(2) / 2
+    # (pendulumRadius, massInit, phiDotInit, thetaDotInit, P0 frame or None for B)
+    specs = [
+        (0.3, 20.0, 0.01, 0.05, ([s2, 0, s2], [0, 1, 0], [-s2, 0, s2])),
+        (0.4, 40.0, 0.1, 0.5, None),
+    ]
+    pendulums = []
+    for radius, mass, phi_dot, theta_dot, frame in specs:
+        p = sphericalPendulum.SphericalPendulum()
+        p.pendulumRadius = radius
+        p.d = [[0.1], [0.1], [0.1]]
+        p.D = dmat
+        p.phiDotInit = phi_dot
+        p.thetaDotInit = theta_dot
+        p.massInit = mass
+        if frame is not None:
+            p.pHat_01, p.pHat_02, p.pHat_03 = ([[c] for c in v] for v in frame)
+        pendulums.append(p)
     sc.hub.mHub = 1500
     sc.hub.r_BcB_B = [[1.0], [0.5], [0.1]]
     sc.hub.IHubPntBc_B = [[900.0, 0.0, 0.0], [0.0, 800.0, 0.0], [0.0, 0.0, 600.0]]
     sc.hub.sigma_BNInit = [[0.0], [0.0], [0.0]]
     sc.hub.omega_BN_BInit = [[1.0], [0.5], [0.1]]
-    sc.addStateEffector(p1)
-    sc.addStateEffector(p2)
+    for p in pendulums:
+        sc.addStateEffector(p)
     grav = simIncludeGravBody.gravBodyFactory()
     earth = grav.createEarth()
     earth.isCentralBody = True
@@ -90,7 +91,7 @@ def run(step_s, damping):
     sim.ConfigureStopTime(macros.sec2nano(10.0))
     sim.ExecuteSimulation()
     masses = []
-    for p in (p1, p2):
+    for p in pendulums:
         get = lambda n: sc.dynManager.getStateObject(n).getState()[0][0]  # noqa: E731
         phi, theta = get(p.nameOfPhiState), get(p.nameOfThetaState)
         phid, thetad = get(p.nameOfPhiDotState), get(p.nameOfThetaDotState)
