@@ -92,9 +92,9 @@ pub trait ComponentParams: Debug + Clone + PartialEq + Send + Sync + 'static {
     fn wire_counts(&self) -> (usize, usize);
     /// Builds the effector; `path` names its fields in errors and in its parameters.
     fn build(&self, path: &str, timing: StepTiming) -> Result<BuiltComponent, ParamError>;
-    /// \[kg\] the mass it adds to the vehicle (an appended body's), once validated; 0 for an
-    /// actuator whose mass is the hub's.
-    fn added_mass_kg(&self) -> f64 {
+    /// \[kg\] the mass it adds to the vehicle (an appended body's; 0 for an actuator whose mass
+    /// is the hub's).
+    fn mass_kg(&self) -> f64 {
         0.0
     }
 }
@@ -112,8 +112,8 @@ pub trait ComponentSpec: Debug + Send + Sync {
     fn wire_counts(&self) -> (usize, usize);
     /// See [`ComponentParams::build`].
     fn build(&self, path: &str, timing: StepTiming) -> Result<BuiltComponent, ParamError>;
-    /// See [`ComponentParams::added_mass_kg`].
-    fn added_mass_kg(&self) -> f64;
+    /// See [`ComponentParams::mass_kg`].
+    fn mass_kg(&self) -> f64;
     /// A boxed copy.
     fn box_clone(&self) -> Box<dyn ComponentSpec>;
     /// Whether `other` is the same kind with equal parameters.
@@ -140,8 +140,8 @@ impl<P: ComponentParams> ComponentSpec for P {
     fn build(&self, path: &str, timing: StepTiming) -> Result<BuiltComponent, ParamError> {
         ComponentParams::build(self, path, timing)
     }
-    fn added_mass_kg(&self) -> f64 {
-        ComponentParams::added_mass_kg(self)
+    fn mass_kg(&self) -> f64 {
+        ComponentParams::mass_kg(self)
     }
     fn box_clone(&self) -> Box<dyn ComponentSpec> {
         Box::new(self.clone())

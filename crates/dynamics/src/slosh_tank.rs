@@ -241,7 +241,7 @@ macro_rules! slosh_component {
             fn wire_counts(&self) -> (usize, usize) {
                 (super::STATE_NAMES.len(), 0)
             }
-            fn added_mass_kg(&self) -> f64 {
+            fn mass_kg(&self) -> f64 {
                 // Validated before this is asked; an invalid entry adds nothing.
                 self.resolve("").map_or(0.0, |p| p.mass_kg)
             }

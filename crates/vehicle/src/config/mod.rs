@@ -179,11 +179,7 @@ impl SimConfig {
                 .map(|(p, _)| p.panel1.mass_kg + p.panel2.mass_kg)
                 .sum::<f64>()
             + self.reaction_wheels.iter().map(|w| w.mass_kg).sum::<f64>()
-            + self
-                .components
-                .iter()
-                .map(|c| c.added_mass_kg())
-                .sum::<f64>()
+            + self.components.iter().map(|c| c.mass_kg()).sum::<f64>()
     }
 
     /// What the vehicle's sensors are built from ([`SensorBank::new`]): their parameters, the
