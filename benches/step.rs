@@ -14,6 +14,10 @@
 //! (commanded) or 4 thrusters (firing every frame), printed per device beside the same
 //! simulation without them and beside one panel pair.
 //!
+//! Issue 39 (fuel slosh): the reference spacecraft (2 pairs) with 4 linear spring-mass-damper
+//! particles or 4 spherical pendulums (damped, so every term runs), printed per device beside
+//! the same spacecraft without them and beside one panel pair, measured in the same run.
+//!
 //! Peers in the same run: with `FLEXDYN_PEERS_PYTHON` pointing at a Python that has
 //! `mujoco==4.0.0` and `bsk==2.12.1` (see `tools/peers/README.md`), the bench then runs
 //! `tools/peers/{mujoco,basilisk}_step.py` one after the other — the same spacecraft, RK4 at 1 ms —
@@ -39,16 +43,7 @@ fn spacecraft_with_wheels(n: usize) -> Spacecraft {
         w.viscous_friction_nm_s_rad = 1e-6;
         w.coulomb_friction_nm = 5e-4;
     });
-    let mut sc = Spacecraft::new(
-        common::reference_hub(),
-        GravityModel::PointMass {
-            mu_m3_s2: common::MU_EARTH,
-        },
-        effectors,
-        common::reference_initial(),
-        1_000_000,
-    )
-    .unwrap();
+    let mut sc = reference_with(effectors);
     let u: Vec<f64> = (0..n).map(|j| 0.01 * (j as f64 + 1.0)).collect();
     sc.set_effector_inputs(&u).unwrap();
     sc
@@ -494,6 +489,83 @@ fn sensor_summary(pair_ns: f64) {
     print_added_cost("one device", base, &rows, pair_ns);
 }
 
+/// The reference spacecraft (2 pairs) with `particles` spring-mass slosh particles and
+/// `pendulums` slosh pendulums, each displaced from rest, on axes that differ per device.
+fn spacecraft_with_slosh(particles: usize, pendulums: usize) -> Spacecraft {
+    use flexdyn_dynamics::effectors::slosh_linear::{SloshLinear, SloshLinearParams};
+    use flexdyn_dynamics::effectors::slosh_pendulum::{SloshPendulum, SloshPendulumParams};
+    use nalgebra::Vector3;
+    let mut effectors = common::reference_effectors_with_wheels(0, |_| {});
+    let axis = |j: usize| {
+        let az = (45.0 + 90.0 * j as f64).to_radians();
+        Vector3::new(az.cos(), az.sin(), 0.0)
+    };
+    for j in 0..particles {
+        let p = SloshLinearParams {
+            name: format!("slosh{j}"),
+            r_pb_b_m: axis(j) * 0.5 - Vector3::z() * 0.3,
+            p_hat_b: axis(j + 1),
+            mass_kg: 20.0,
+            k_n_m: 50.0,
+            c_n_s_m: 0.5,
+            rho_m: 0.02,
+            rho_dot_m_s: 0.0,
+        };
+        effectors.push(Box::new(
+            SloshLinear::new(p, &format!("slosh_linear[{j}]")).unwrap(),
+        ));
+    }
+    for j in 0..pendulums {
+        let p = SloshPendulumParams {
+            name: format!("pendulum{j}"),
+            r_pb_b_m: axis(j) * 0.5,
+            hang_axis_b: -Vector3::z(),
+            l_m: 0.25,
+            mass_kg: 20.0,
+            c_nm_s_rad: 0.05,
+            phi_rad: 0.05,
+            phi_dot_rad_s: 0.0,
+            theta_rad: -0.03,
+            theta_dot_rad_s: 0.0,
+        };
+        effectors.push(Box::new(
+            SloshPendulum::new(p, &format!("slosh_pendulums[{j}]")).unwrap(),
+        ));
+    }
+    reference_with(effectors)
+}
+
+/// The reference hub, orbit and 1 ms step with `effectors` appended.
+fn reference_with(effectors: Vec<Box<dyn flexdyn_dynamics::StateEffector>>) -> Spacecraft {
+    Spacecraft::new(
+        common::reference_hub(),
+        GravityModel::PointMass {
+            mu_m3_s2: common::MU_EARTH,
+        },
+        effectors,
+        common::reference_initial(),
+        1_000_000,
+    )
+    .unwrap()
+}
+
+/// Each slosh model's cost per step, per device (4 of each), against the same spacecraft
+/// without them and against one panel pair (`pair_ns`, from the same run's fit).
+fn slosh_summary(pair_ns: f64) {
+    let base = median_ns_per_step(spacecraft_with_slosh(0, 0));
+    let linear = median_ns_per_step(spacecraft_with_slosh(4, 0));
+    let pendulum = median_ns_per_step(spacecraft_with_slosh(0, 4));
+    println!(
+        "\nrk4_step with fuel slosh, 2 pairs, per device (4 particles: {linear:.1} ns/step, \
+         4 pendulums: {pendulum:.1} ns/step; median of 31 batches x 20000 steps):"
+    );
+    let rows = [
+        ("slosh_linear", base + (linear - base) / 4.0),
+        ("slosh_pendulum", base + (pendulum - base) / 4.0),
+    ];
+    print_added_cost("one device", base, &rows, pair_ns);
+}
+
 fn main() {
     let mut c = Criterion::default().configure_from_args();
     bench_step(&mut c);
@@ -501,6 +573,7 @@ fn main() {
     let rows = summary();
     wheel_summary();
     environment_summary(fit(&rows).1);
+    slosh_summary(fit(&rows).1);
     world_summary(fit(&rows).1);
     actuator_summary(fit(&rows).1);
     sensor_summary(fit(&rows).1);

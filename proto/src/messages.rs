@@ -31,6 +31,13 @@ pub mod effector_kind {
     /// flags [`super::thruster_flags`]; one input, the valve-open time per frame (s) or the duty
     /// cycle (0–1), as configured.
     pub const THRUSTER: u16 = 4;
+    /// A linear spring-mass-damper fuel slosh particle. States `[ρ m, ρ̇ m/s]` (displacement of
+    /// the slosh mass along its axis from its rest point); no outputs, no flags, no inputs.
+    pub const SLOSH_LINEAR: u16 = 6;
+    /// A spherical-pendulum fuel slosh mass. States `[φ rad, φ̇ rad/s, θ rad, θ̇ rad/s]` (the
+    /// rod's azimuth about p̂3 and elevation out of the p̂1–p̂2 plane of its pendulum frame);
+    /// no outputs, no flags, no inputs.
+    pub const SLOSH_PENDULUM: u16 = 7;
 }
 
 /// Values of [`EnvironmentMsg::eclipse`]: from the shadow factor ν.

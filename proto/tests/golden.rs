@@ -1769,6 +1769,8 @@ fn flag_bits() {
     assert_eq!(effector_kind::REACTION_WHEEL, 2);
     assert_eq!(effector_kind::MAGNETORQUER, 3);
     assert_eq!(effector_kind::THRUSTER, 4);
+    assert_eq!(effector_kind::SLOSH_LINEAR, 6);
+    assert_eq!(effector_kind::SLOSH_PENDULUM, 7);
     assert_eq!(magnetorquer_flags::SATURATED, 0b001);
     assert_eq!(thruster_flags::FIRING, 0b001);
     assert_eq!(thruster_flags::BELOW_MIN_ON_TIME, 0b010);

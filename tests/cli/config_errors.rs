@@ -203,6 +203,7 @@ fn every_shipped_scenario_is_valid() {
             "leo_environment",
             "no_gravity",
             "reference",
+            "slosh",
             "srp_cannonball_basilisk",
             "wheel_slew",
             "wheels_star_tracker"

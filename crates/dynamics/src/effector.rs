@@ -75,6 +75,36 @@ impl AddAssign for EffectorMassProps {
     }
 }
 
+impl EffectorMassProps {
+    /// Adds a point mass `mass_kg` at `r_b` moving at `r_prime_b` relative to B (B components):
+    /// m, m r, m r′ and the inertia about B m \[r̃\]\[r̃\]ᵀ = m (|r|² \[1\] − r rᵀ).
+    #[inline(always)]
+    pub fn add_point_mass(&mut self, mass_kg: f64, r_b: &Vector3<f64>, r_prime_b: &Vector3<f64>) {
+        self.mass_kg += mass_kg;
+        self.first_moment_b_kg_m += r_b * mass_kg;
+        self.first_moment_prime_b_kg_m_s += r_prime_b * mass_kg;
+        self.inertia_pnt_b_b_kg_m2 +=
+            (Matrix3::from_diagonal_element(r_b.norm_squared()) - r_b * r_b.transpose()) * mass_kg;
+    }
+}
+
+/// \[N·m\] \[I′\]ω of a point mass `mass_kg` at `r_b` moving at `r_prime_b` relative to B, when B
+/// rotates at `omega_bn_b`: the body-frame derivative of m (|r|² \[1\] − r rᵀ) applied to ω,
+/// m (2 (r·r′) ω − r′ (r·ω) − r (r′·ω)). Its negative is the mass's share of Eq. 150's
+/// −\[I′_sc,B\]ω, which an effector adds to its v_rot contribution.
+#[inline(always)]
+pub fn point_mass_i_prime_omega(
+    mass_kg: f64,
+    r_b: &Vector3<f64>,
+    r_prime_b: &Vector3<f64>,
+    omega_bn_b: &Vector3<f64>,
+) -> Vector3<f64> {
+    (omega_bn_b * (2.0 * r_b.dot(r_prime_b))
+        - r_prime_b * r_b.dot(omega_bn_b)
+        - r_b * r_prime_b.dot(omega_bn_b))
+        * mass_kg
+}
+
 /// An effector's contributions to the hub system of Eq. 151:
 /// `[[A, B], [C, D]] [r̈_B/N; ω̇_B/N] = [v_trans; v_rot]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -184,6 +214,27 @@ impl EnergyMomentum {
             kinetic_rel_b_j: 0.5 * (omega_body_b.dot(&i_omega) + mass_kg * r_dot_b.norm_squared()),
             potential_j: 0.0,
         }
+    }
+}
+
+impl EnergyMomentum {
+    /// The contribution of a point mass `mass_kg` at `r_b` moving at `r_prime_b` relative to the
+    /// B frame, when B rotates at `omega_bn_b` ([`Self::rigid_body`] without inertia).
+    #[inline]
+    pub fn point_mass(
+        mass_kg: f64,
+        r_b: &Vector3<f64>,
+        r_prime_b: &Vector3<f64>,
+        omega_bn_b: &Vector3<f64>,
+    ) -> Self {
+        Self::rigid_body(
+            mass_kg,
+            r_b,
+            r_prime_b,
+            &Matrix3::zeros(),
+            omega_bn_b,
+            omega_bn_b,
+        )
     }
 }
 

@@ -5,12 +5,15 @@
 use super::component::ComponentKind;
 use super::dynamic_effectors::{magnetorquer, thruster};
 use super::effectors::{panel_pair, reaction_wheel};
+use super::effectors::{slosh_linear, slosh_pendulum};
 use super::EffectorKind;
 
 /// Every kind, in effector-list order: the appended bodies first, then the listed actuators.
 pub static KINDS: &[&ComponentKind] = &[
     &panel_pair::kind::COMPONENT,
     &reaction_wheel::kind::COMPONENT,
+    &slosh_linear::kind::COMPONENT,
+    &slosh_pendulum::kind::COMPONENT,
     &magnetorquer::kind::COMPONENT,
     &thruster::kind::COMPONENT,
 ];

@@ -53,6 +53,7 @@ pub mod integrator;
 pub mod kinds;
 pub mod params;
 pub mod reference;
+pub mod slosh_tank;
 pub mod spacecraft;
 pub mod stage_hook;
 

@@ -5,7 +5,9 @@
 //! - [`conservation`]: energy and angular momentum of the free spacecraft;
 //! - [`analytic_limit`]: a pair on a near-fixed hub against the linearised eigenproblem;
 //! - [`validate_dense_kane`]: back-substitution against a dense Kane formulation;
-//! - [`gravity_vs_sgp4`]: the point-mass and J2 gravity against SGP4's propagation.
+//! - [`gravity_vs_sgp4`]: the point-mass and J2 gravity against SGP4's propagation;
+//! - [`slosh`]: the fuel-slosh effectors against a dense Kane solve, invariants, closed-form
+//!   frequencies and decay rates.
 //!
 //! [`common`] builds the reference spacecraft of `scenarios/reference.toml` in code.
 
@@ -16,4 +18,5 @@ mod analytic_limit;
 mod attitude;
 mod conservation;
 mod gravity_vs_sgp4;
+mod slosh;
 mod validate_dense_kane;

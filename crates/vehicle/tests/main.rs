@@ -44,5 +44,6 @@ mod imu_panel_modes;
 mod imu_truth;
 mod reaction_wheels;
 mod rk4_bit_identity;
+mod slosh;
 mod star_tracker;
 mod surface_forces;

@@ -4,3 +4,5 @@
 
 pub mod panel_pair;
 pub mod reaction_wheel;
+pub mod slosh_linear;
+pub mod slosh_pendulum;

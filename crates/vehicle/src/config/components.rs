@@ -78,27 +78,29 @@ mod tests {
     /// configuration says of itself (a test of the configuration, which builds them).
     #[test]
     fn wire_names_match_what_each_built_effector_says() {
-        let text = std::fs::read_to_string(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../scenarios/acs_full.toml"
-        ))
-        .unwrap();
-        let sc = SimConfig::from_toml_str(&text)
-            .unwrap()
-            .build_spacecraft()
-            .unwrap();
-        assert!(sc.effector_count() >= 3);
         let mut kinds = std::collections::BTreeSet::new();
-        for e in sc.effector_entries() {
-            let (kind, states, outputs) =
-                kinds::wire_names(e.kind.wire_tag, e.state_names.len(), e.output_names.len())
-                    .unwrap();
-            assert_eq!(kind, e.kind);
-            assert_eq!(states, e.state_names);
-            assert_eq!(outputs, e.output_names);
-            kinds.insert(kind.name);
+        for scenario in ["acs_full", "slosh"] {
+            let text = std::fs::read_to_string(format!(
+                "{}/../../scenarios/{scenario}.toml",
+                env!("CARGO_MANIFEST_DIR")
+            ))
+            .unwrap();
+            let sc = SimConfig::from_toml_str(&text)
+                .unwrap()
+                .build_spacecraft()
+                .unwrap();
+            assert!(sc.effector_count() >= 3);
+            for e in sc.effector_entries() {
+                let (kind, states, outputs) =
+                    kinds::wire_names(e.kind.wire_tag, e.state_names.len(), e.output_names.len())
+                        .unwrap();
+                assert_eq!(kind, e.kind);
+                assert_eq!(states, e.state_names);
+                assert_eq!(outputs, e.output_names);
+                kinds.insert(kind.name);
+            }
         }
-        // Every registered kind is in acs_full, bodies and actuators.
+        // Between them, acs_full and slosh have every registered kind, bodies and actuators.
         let registered: std::collections::BTreeSet<_> =
             kinds::KINDS.iter().map(|k| k.effector.name).collect();
         assert_eq!(kinds, registered);
