@@ -4,13 +4,14 @@
 
 use super::component::ComponentKind;
 use super::dynamic_effectors::{magnetorquer, thruster};
-use super::effectors::{panel_pair, reaction_wheel};
+use super::effectors::{panel_chain, panel_pair, reaction_wheel};
 use super::EffectorKind;
 
 /// Every kind, in effector-list order: the appended bodies first, then the listed actuators.
 pub static KINDS: &[&ComponentKind] = &[
     &panel_pair::kind::COMPONENT,
     &reaction_wheel::kind::COMPONENT,
+    &panel_chain::kind::COMPONENT,
     &magnetorquer::kind::COMPONENT,
     &thruster::kind::COMPONENT,
 ];

@@ -157,6 +157,7 @@
 #define FD_EFFECTOR_REACTION_WHEEL 2u /* a reaction wheel */
 #define FD_EFFECTOR_MAGNETORQUER 3u /* a magnetorquer rod */
 #define FD_EFFECTOR_THRUSTER 4u /* a thruster */
+#define FD_EFFECTOR_PANEL_CHAIN 5u /* a chain of N hinged panels */
 
 /* Eclipse: EnvironmentMsg `eclipse` (u8) */
 #define FD_ECLIPSE_SUNLIT 0u /* ν = 1, also without a shadow model */
