@@ -5,6 +5,7 @@
 //! - [`conservation`]: energy and angular momentum of the free spacecraft;
 //! - [`analytic_limit`]: a pair on a near-fixed hub against the linearised eigenproblem;
 //! - [`validate_dense_kane`]: back-substitution against a dense Kane formulation;
+//! - [`validate_dense_kane_chain`]: the N-link panel chain against its own dense Kane model;
 //! - [`gravity_vs_sgp4`]: the point-mass and J2 gravity against SGP4's propagation.
 //!
 //! [`common`] builds the reference spacecraft of `scenarios/reference.toml` in code.
@@ -17,3 +18,4 @@ mod attitude;
 mod conservation;
 mod gravity_vs_sgp4;
 mod validate_dense_kane;
+mod validate_dense_kane_chain;
