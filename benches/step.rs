@@ -14,6 +14,12 @@
 //! (commanded) or 4 thrusters (firing every frame), printed per device beside the same
 //! simulation without them and beside one panel pair.
 //!
+//! Issue 39 §2 (panel chains): the reference hub with one chain of N = 1 … 10 unequal panels
+//! (`reference::unequal_chain`), medians and the least-squares cost per added link, beside the
+//! cost of a panel pair; with `FLEXDYN_PEERS_PYTHON`, the 10-link chain against MuJoCo's
+//! equivalent tree (`tools/peers/mujoco_chain.py`) in the same run.
+//! `FLEXDYN_BENCH_ONLY=chain cargo bench --bench step` runs only these rows (about a minute).
+//!
 //! Peers in the same run: with `FLEXDYN_PEERS_PYTHON` pointing at a Python that has
 //! `mujoco==4.0.0` and `bsk==2.12.1` (see `tools/peers/README.md`), the bench then runs
 //! `tools/peers/{mujoco,basilisk}_step.py` one after the other — the same spacecraft, RK4 at 1 ms —
@@ -105,8 +111,15 @@ fn bench_step(c: &mut Criterion) {
 
 /// Runs a peer script; returns (pairs, median ns per step) from its `peer=… pairs=N median_ns_per_step=x` lines.
 fn run_peer(python: &str, script: &str) -> Result<Vec<(usize, f64)>, String> {
+    run_peer_keyed(python, &[script], "pairs=")
+}
+
+/// Runs `python args…`; returns (count, median ns per step) from its lines that carry `key`
+/// (`pairs=` or `links=`) and `median_ns_per_step=`.
+fn run_peer_keyed(python: &str, args: &[&str], key: &str) -> Result<Vec<(usize, f64)>, String> {
+    let script = args[0];
     let out = std::process::Command::new(python)
-        .arg(script)
+        .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .stderr(std::process::Stdio::inherit())
         .output()
@@ -120,14 +133,14 @@ fn run_peer(python: &str, script: &str) -> Result<Vec<(usize, f64)>, String> {
         .filter_map(|line| {
             let field = |key: &str| line.split_whitespace().find_map(|kv| kv.strip_prefix(key));
             Some((
-                field("pairs=")?.parse().ok()?,
+                field(key)?.parse().ok()?,
                 field("median_ns_per_step=")?.parse().ok()?,
             ))
         })
         .collect();
     if rows.is_empty() {
         return Err(format!(
-            "{script} printed no `pairs=… median_ns_per_step=…` lines"
+            "{script} printed no `{key}… median_ns_per_step=…` lines"
         ));
     }
     Ok(rows)
@@ -494,7 +507,79 @@ fn sensor_summary(pair_ns: f64) {
     print_added_cost("one device", base, &rows, pair_ns);
 }
 
+/// The N-link chains (issue 39 §2): cost per added link, and the 10-link chain against MuJoCo's
+/// tree in the same run. `pair_ns` is the cost of one added panel pair, when measured.
+fn chain_summary(pair_ns: Option<f64>) {
+    const LINKS: std::ops::RangeInclusive<usize> = 1..=10;
+    let (batches, steps) = (11, 5_000);
+    let gravity = GravityModel::PointMass {
+        mu_m3_s2: common::MU_EARTH,
+    };
+    let base = common::median_ns_per_step(
+        &mut common::build(
+            common::reference_hub(),
+            gravity,
+            Vec::new(),
+            common::reference_initial(),
+            1_000_000,
+        ),
+        batches,
+        steps,
+    );
+    let rows: Vec<(f64, f64)> = LINKS
+        .map(|n| {
+            let mut sc = common::reference_with_chain(gravity, n, 0.0);
+            (
+                n as f64,
+                common::median_ns_per_step(&mut sc, batches, steps),
+            )
+        })
+        .collect();
+    let (intercept, slope) = fit(&rows);
+    println!(
+        "\nrk4_step, reference hub + one N-link chain of unequal panels (median of {batches} \
+         batches x {steps} steps; rigid hub alone {base:.1} ns):"
+    );
+    println!(
+        "{:>6} {:>14} {:>16}",
+        "links", "median ns/step", "ns over the hub"
+    );
+    for (n, ns) in &rows {
+        println!("{n:>6} {ns:>14.1} {:>16.1}", ns - base);
+    }
+    print!("linear fit: {intercept:.1} ns + {slope:.1} ns per link");
+    match pair_ns {
+        Some(p) => println!(" ({:.2} panel pairs per link)", slope / p),
+        None => println!(),
+    }
+    let Ok(python) = std::env::var("FLEXDYN_PEERS_PYTHON") else {
+        println!("MuJoCo chain: skipped (set FLEXDYN_PEERS_PYTHON; see tools/peers/README.md)");
+        return;
+    };
+    match run_peer_keyed(
+        &python,
+        &["tools/peers/mujoco_chain.py", "--links", "10"],
+        "links=",
+    ) {
+        Err(e) => println!("MuJoCo chain: {e}"),
+        Ok(peer) => {
+            let ns = rows[rows.len() - 1].1;
+            for (n, peer_ns) in peer {
+                println!(
+                    "{n}-link chain, same run: MuJoCo 4.0.0 {peer_ns:.1} ns/step, flexdyn \
+                     {ns:.1} ns/step: {:.1}x",
+                    peer_ns / ns
+                );
+            }
+        }
+    }
+}
+
 fn main() {
+    if std::env::var("FLEXDYN_BENCH_ONLY").as_deref() == Ok("chain") {
+        chain_summary(None);
+        return;
+    }
     let mut c = Criterion::default().configure_from_args();
     bench_step(&mut c);
     c.final_summary();
@@ -504,5 +589,6 @@ fn main() {
     world_summary(fit(&rows).1);
     actuator_summary(fit(&rows).1);
     sensor_summary(fit(&rows).1);
+    chain_summary(Some(fit(&rows).1));
     peers(&rows);
 }

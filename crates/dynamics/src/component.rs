@@ -92,6 +92,11 @@ pub trait ComponentParams: Debug + Clone + PartialEq + Send + Sync + 'static {
     fn wire_counts(&self) -> (usize, usize);
     /// Builds the effector; `path` names its fields in errors and in its parameters.
     fn build(&self, path: &str, timing: StepTiming) -> Result<BuiltComponent, ParamError>;
+    /// \[kg\] the mass it adds to the vehicle (an appended body's; 0 for an actuator whose mass
+    /// is the hub's).
+    fn mass_kg(&self) -> f64 {
+        0.0
+    }
 }
 
 /// The object-safe face of [`ComponentParams`], implemented for every such type, so that a
@@ -107,6 +112,8 @@ pub trait ComponentSpec: Debug + Send + Sync {
     fn wire_counts(&self) -> (usize, usize);
     /// See [`ComponentParams::build`].
     fn build(&self, path: &str, timing: StepTiming) -> Result<BuiltComponent, ParamError>;
+    /// See [`ComponentParams::mass_kg`].
+    fn mass_kg(&self) -> f64;
     /// A boxed copy.
     fn box_clone(&self) -> Box<dyn ComponentSpec>;
     /// Whether `other` is the same kind with equal parameters.
@@ -132,6 +139,9 @@ impl<P: ComponentParams> ComponentSpec for P {
     }
     fn build(&self, path: &str, timing: StepTiming) -> Result<BuiltComponent, ParamError> {
         ComponentParams::build(self, path, timing)
+    }
+    fn mass_kg(&self) -> f64 {
+        ComponentParams::mass_kg(self)
     }
     fn box_clone(&self) -> Box<dyn ComponentSpec> {
         Box::new(self.clone())

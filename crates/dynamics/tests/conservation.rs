@@ -225,8 +225,8 @@ fn validate_conservation_every_integrator() {
 /// N-link chains of unequal panels (`reference::unequal_chain`: every mass, inertia, length,
 /// hinge offset and stiffness differs along the chain), undamped, on the reference hub, for
 /// N = 1, 3 and 5, in free space and in orbit: the same invariants to the same 1e-12 bound as
-/// the pairs. Measured: rotational + spring energy within 3.5e-14 (N = 5), momentum about C
-/// within 8.9e-15, orbital quantities within 1.7e-14. A wrong term in the chain's hinge rows or
+/// the pairs. Measured: rotational + spring energy within 2.2e-14 (N = 5), momentum about C
+/// within 1.3e-14, orbital quantities within 1.4e-14. A wrong term in the chain's hinge rows or
 /// hub contributions drifts the energy or the momentum (the N = 2 chain equals the pair to
 /// round-off, `panel_chain::tests`).
 #[test]

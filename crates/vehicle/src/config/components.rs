@@ -78,17 +78,32 @@ mod tests {
     /// configuration says of itself (a test of the configuration, which builds them).
     #[test]
     fn wire_names_match_what_each_built_effector_says() {
-        let text = std::fs::read_to_string(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../scenarios/acs_full.toml"
-        ))
-        .unwrap();
-        let sc = SimConfig::from_toml_str(&text)
-            .unwrap()
-            .build_spacecraft()
-            .unwrap();
-        assert!(sc.effector_count() >= 3);
         let mut kinds = std::collections::BTreeSet::new();
+        for file in ["acs_full.toml", "panel_chain.toml"] {
+            let path = format!("{}/../../scenarios/{file}", env!("CARGO_MANIFEST_DIR"));
+            let text = std::fs::read_to_string(path).unwrap();
+            let sc = SimConfig::from_toml_str(&text)
+                .unwrap()
+                .build_spacecraft()
+                .unwrap();
+            assert!(sc.effector_count() >= 2);
+            check_wire_names(&sc, &mut kinds);
+        }
+        // Every registered kind is in acs_full or panel_chain, bodies and actuators.
+        let registered: std::collections::BTreeSet<_> =
+            kinds::KINDS.iter().map(|k| k.effector.name).collect();
+        assert_eq!(kinds, registered);
+        assert!(kinds::wire_names(999, 1, 0).is_none());
+        assert!(
+            kinds::wire_names(flexdyn_dynamics::effectors::panel_pair::KIND.wire_tag, 3, 0)
+                .is_none()
+        );
+    }
+
+    fn check_wire_names(
+        sc: &flexdyn_dynamics::Spacecraft,
+        kinds: &mut std::collections::BTreeSet<&'static str>,
+    ) {
         for e in sc.effector_entries() {
             let (kind, states, outputs) =
                 kinds::wire_names(e.kind.wire_tag, e.state_names.len(), e.output_names.len())
@@ -98,14 +113,5 @@ mod tests {
             assert_eq!(outputs, e.output_names);
             kinds.insert(kind.name);
         }
-        // Every registered kind is in acs_full, bodies and actuators.
-        let registered: std::collections::BTreeSet<_> =
-            kinds::KINDS.iter().map(|k| k.effector.name).collect();
-        assert_eq!(kinds, registered);
-        assert!(kinds::wire_names(999, 1, 0).is_none());
-        assert!(
-            kinds::wire_names(flexdyn_dynamics::effectors::panel_pair::KIND.wire_tag, 3, 0)
-                .is_none()
-        );
     }
 }

@@ -169,7 +169,7 @@ impl SimConfig {
         self.frame_ns / self.step_ns
     }
 
-    /// \[kg\] total mass: hub plus every panel and wheel rotor.
+    /// \[kg\] total mass: hub plus every panel, wheel rotor and chain panel.
     pub fn total_mass_kg(&self) -> f64 {
         self.hub.mass_kg
             + self
@@ -178,6 +178,7 @@ impl SimConfig {
                 .map(|(p, _)| p.panel1.mass_kg + p.panel2.mass_kg)
                 .sum::<f64>()
             + self.reaction_wheels.iter().map(|w| w.mass_kg).sum::<f64>()
+            + self.components.iter().map(|c| c.mass_kg()).sum::<f64>()
     }
 
     /// What the vehicle's sensors are built from ([`SensorBank::new`]): their parameters, the

@@ -50,6 +50,9 @@ impl ComponentParams for PanelChainParams {
     fn wire_counts(&self) -> (usize, usize) {
         (2 * self.panels.len(), 0)
     }
+    fn mass_kg(&self) -> f64 {
+        self.panels.iter().map(|p| p.mass_kg).sum()
+    }
     fn build(&self, path: &str, _timing: StepTiming) -> Result<BuiltComponent, ParamError> {
         Ok(BuiltComponent::Body(Box::new(PanelChain::new(
             self.clone(),
