@@ -547,11 +547,23 @@ fn chain_summary(pair_ns: Option<f64>) {
     for (n, ns) in &rows {
         println!("{n:>6} {ns:>14.1} {:>16.1}", ns - base);
     }
-    print!("linear fit: {intercept:.1} ns + {slope:.1} ns per link");
-    match pair_ns {
-        Some(p) => println!(" ({:.2} panel pairs per link)", slope / p),
-        None => println!(),
-    }
+    // Alone (FLEXDYN_BENCH_ONLY=chain), one added pair is measured here: the slope over 1, 2,
+    // 4 and 8 pairs.
+    let pair_ns = pair_ns.unwrap_or_else(|| {
+        let pairs: Vec<(f64, f64)> = [1, 2, 4, 8]
+            .iter()
+            .map(|&n| {
+                let ns = common::median_ns_per_step(&mut spacecraft(n), batches, steps);
+                (n as f64, ns)
+            })
+            .collect();
+        fit(&pairs).1
+    });
+    println!(
+        "linear fit: {intercept:.1} ns + {slope:.1} ns per link; one panel pair adds \
+         {pair_ns:.1} ns, so a link costs {:.2} pairs",
+        slope / pair_ns
+    );
     let Ok(python) = std::env::var("FLEXDYN_PEERS_PYTHON") else {
         println!("MuJoCo chain: skipped (set FLEXDYN_PEERS_PYTHON; see tools/peers/README.md)");
         return;

@@ -20,9 +20,7 @@ over 5 s above 1e-6) exits 1 before timing.
 import argparse
 import math
 import os
-import statistics
 import sys
-import time
 
 import numpy as np
 
@@ -30,6 +28,7 @@ import mujoco
 import mujoco.rollout
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mujoco_step  # noqa: E402
 from mujoco_step import (HUB_INERTIA, HUB_MASS, OMEGA_BN_B, R_BCB_B, R_CN_N, STEP_S,  # noqa: E402
                          V_CN_N, fmt)
 
@@ -111,28 +110,6 @@ def sanity(n, log):
             and dL < 1e-6 and dE < 1e-6)
 
 
-def bench(n, reps, steps, log):
-    model, data = make(n)
-    nstate = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-    init = np.empty((1, nstate))
-    mujoco.mj_getState(model, data, init[0], mujoco.mjtState.mjSTATE_FULLPHYSICS)
-    state = np.empty((1, steps, nstate))
-    sens = np.empty((1, steps, model.nsensordata))
-    roll = mujoco.rollout.Rollout(nthread=0)
-    roll.rollout(model, data, init, nstep=steps, state=state, sensordata=sens)
-    init[0] = state[0, -1]
-    per_step = []
-    for _ in range(reps):
-        t0 = time.perf_counter_ns()
-        roll.rollout(model, data, init, nstep=steps, state=state, sensordata=sens)
-        per_step.append((time.perf_counter_ns() - t0) / steps)
-        init[0] = state[0, -1]
-    roll.close()
-    med = statistics.median(per_step)
-    log(f"  links={n}: median {med:.1f} ns/step (min {min(per_step):.1f}, max {max(per_step):.1f})")
-    return med
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--links", default="10", help="comma-separated link counts (default 10)")
@@ -153,8 +130,8 @@ def main():
         log("sanity checks FAILED")
         return 1
     for n in counts:
-        print(f"peer=mujoco links={n} median_ns_per_step={bench(n, args.reps, args.steps, log):.1f}",
-              flush=True)
+        med = mujoco_step.bench(n, args.reps, args.steps, log, make=make, label="links")
+        print(f"peer=mujoco links={n} median_ns_per_step={med:.1f}", flush=True)
     return 0
 
 

@@ -777,6 +777,19 @@ fn build_library_with_step(cfg: &Config, step_ns: u64) -> Spacecraft {
             Box::new(wheel) as Box<dyn StateEffector>
         }))
         .collect();
+    let mut sc = spacecraft_of(cfg, effectors, step_ns);
+    let u: Vec<f64> = cfg.wheels.iter().map(|(_, u)| *u).collect();
+    sc.set_effector_inputs(&u).expect("one input per wheel");
+    sc
+}
+
+/// The library spacecraft of `cfg`'s hub, gravity and wrench with `effectors` (the states are
+/// set per sample, so the initial state is arbitrary).
+pub(crate) fn spacecraft_of(
+    cfg: &Config,
+    effectors: Vec<Box<dyn StateEffector>>,
+    step_ns: u64,
+) -> Spacecraft {
     let gravity = match cfg.mu {
         None => GravityModel::None,
         Some(mu) => GravityModel::PointMass { mu_m3_s2: mu },
@@ -795,8 +808,6 @@ fn build_library_with_step(cfg: &Config, step_ns: u64) -> Spacecraft {
         force_b_newton: cfg.force_b,
         torque_b_nm: cfg.torque_b,
     });
-    let u: Vec<f64> = cfg.wheels.iter().map(|(_, u)| *u).collect();
-    sc.set_effector_inputs(&u).expect("one input per wheel");
     sc
 }
 

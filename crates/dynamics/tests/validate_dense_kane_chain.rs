@@ -30,13 +30,11 @@
 
 use super::validate_dense_kane::{
     axis, backward_error, dcm_bn_from_mrp, dense_solve, inf_norm, median, random_config,
-    random_panel, rel_err, rot2, set_block, set_col, skeel_cond, skew, Assembler, Body, Config,
-    Dense, Ranges, Rng, M3, ROUNDOFF_FACTOR, V3,
+    random_panel, rel_err, rot2, set_block, set_col, skeel_cond, skew, spacecraft_of, Assembler,
+    Body, Config, Dense, Ranges, Rng, M3, ROUNDOFF_FACTOR, V3,
 };
 use flexdyn_dynamics::effectors::panel_chain::{ChainPanelParams, PanelChain, PanelChainParams};
-use flexdyn_dynamics::{
-    GravityModel, HubInitial, InitialTranslation, Spacecraft, State, StateEffector,
-};
+use flexdyn_dynamics::{Spacecraft, State};
 use nalgebra::{DMatrix, DVector};
 
 /// A hub (with its force, torque and gravity from the pair oracle's generator) and one chain.
@@ -253,31 +251,7 @@ fn dense_kane_chain(case: &ChainCase, x: &State) -> Dense {
 
 fn build_library(case: &ChainCase) -> Spacecraft {
     let chain = PanelChain::new(case.chain.clone(), "panel_chains[0]").expect("valid chain");
-    let gravity = match case.base.mu {
-        None => GravityModel::None,
-        Some(mu) => GravityModel::PointMass { mu_m3_s2: mu },
-    };
-    let initial = HubInitial {
-        translation: InitialTranslation::PointB {
-            r_bn_n_m: V3::new(7.0e6, 0.0, 0.0),
-            v_bn_n_m_s: V3::zeros(),
-        },
-        sigma_bn: V3::zeros(),
-        omega_bn_b_rad_s: V3::zeros(),
-    };
-    let effectors: Vec<Box<dyn StateEffector>> = vec![Box::new(chain)];
-    let mut sc = Spacecraft::new(
-        case.base.hub.clone(),
-        gravity,
-        effectors,
-        initial,
-        1_000_000,
-    )
-    .expect("valid spacecraft");
-    sc.set_wrench(flexdyn_dynamics::Wrench {
-        force_b_newton: case.base.force_b,
-        torque_b_nm: case.base.torque_b,
-    });
+    let mut sc = spacecraft_of(&case.base, vec![Box::new(chain)], 1_000_000);
     sc.set_effector_inputs(&case.u)
         .expect("one input per hinge");
     sc

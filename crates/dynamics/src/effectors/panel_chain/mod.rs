@@ -471,6 +471,8 @@ impl StateEffector for PanelChain {
     }
 
     fn update_mass_props(&mut self, x: &[f64], sum: &mut EffectorMassProps) {
+        // The workspace is moved out while the walk borrows `self` (an empty Vec does not
+        // allocate) and put back after.
         let mut work = std::mem::take(&mut self.work);
         self.for_each_link(x, |k, g| {
             let link = &self.links[k];
