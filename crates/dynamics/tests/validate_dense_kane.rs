@@ -530,6 +530,29 @@ pub(crate) fn set_col(m: &mut DMatrix<f64>, col: usize, v: &V3) {
     m.fixed_view_mut::<3, 1>(0, col).copy_from(v);
 }
 
+/// Adds the hub (rigid, CoM at r_Bc/B, angular velocity `w`) with the torque `torque` on it and
+/// its weight in the uniform field `g_b`: partial velocities [I, −[r̃_Bc/B], 0…] and [0, I, 0…].
+pub(crate) fn add_hub(asm: &mut Assembler, hub: &HubParams, w: &V3, g_b: &V3, torque: &V3) {
+    let n = asm.m.nrows();
+    let mut v = DMatrix::zeros(3, n);
+    let mut wm = DMatrix::zeros(3, n);
+    set_block(&mut v, 0, &M3::identity());
+    set_block(&mut v, 3, &(-skew(&hub.r_bcb_b_m)));
+    set_block(&mut wm, 3, &M3::identity());
+    asm.add(&Body {
+        mass: hub.mass_kg,
+        i_c: hub.inertia_bc_b_kg_m2,
+        v: &v,
+        w: &wm,
+        a_vp: w.cross(&w.cross(&hub.r_bcb_b_m)),
+        omega: *w,
+        alpha_vp: V3::zeros(),
+        force: g_b * hub.mass_kg,
+        torque: *torque,
+        gyroscopic: None,
+    });
+}
+
 fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
     let np = cfg.pairs.len();
     let nw = cfg.wheels.len();
@@ -604,11 +627,6 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
 
     // Hub.
     {
-        let mut v = DMatrix::zeros(3, n);
-        let mut wm = DMatrix::zeros(3, n);
-        set_block(&mut v, 0, &M3::identity());
-        set_block(&mut v, 3, &(-skew(&hub.r_bcb_b_m)));
-        set_block(&mut wm, 3, &M3::identity());
         let mut torque = cfg.torque_b;
         for (g, (tau1, _)) in geoms.iter().zip(&taus) {
             torque -= axis(&g.c1, 1) * *tau1; // reaction of hinge 1
@@ -616,18 +634,7 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
         for ((wp, _), tau) in cfg.wheels.iter().zip(&wheel_taus) {
             torque -= wp.spin_axis_b * *tau; // reaction of the wheel motor and bearing
         }
-        asm.add(&Body {
-            mass: hub.mass_kg,
-            i_c: hub.inertia_bc_b_kg_m2,
-            v: &v,
-            w: &wm,
-            a_vp: w.cross(&w.cross(&hub.r_bcb_b_m)),
-            omega: w,
-            alpha_vp: V3::zeros(),
-            force: g_b * hub.mass_kg,
-            torque,
-            gyroscopic: None,
-        });
+        add_hub(&mut asm, hub, &w, &g_b, &torque);
     }
 
     // Panels.

@@ -29,7 +29,7 @@
 //! the projection by the partial velocities, not written in by hand.
 
 use super::validate_dense_kane::{
-    axis, backward_error, dcm_bn_from_mrp, dense_solve, inf_norm, median, random_config,
+    add_hub, axis, backward_error, dcm_bn_from_mrp, dense_solve, inf_norm, median, random_config,
     random_panel, rel_err, rot2, set_block, set_col, skeel_cond, skew, spacecraft_of, Assembler,
     Body, Config, Dense, Ranges, Rng, M3, ROUNDOFF_FACTOR, V3,
 };
@@ -192,26 +192,7 @@ fn dense_kane_chain(case: &ChainCase, x: &State) -> Dense {
     for k in 0..3 {
         asm.f[k] += cfg.force_b[k];
     }
-    // Hub.
-    {
-        let mut v = DMatrix::zeros(3, n);
-        let mut wm = DMatrix::zeros(3, n);
-        set_block(&mut v, 0, &M3::identity());
-        set_block(&mut v, 3, &(-skew(&hub.r_bcb_b_m)));
-        set_block(&mut wm, 3, &M3::identity());
-        asm.add(&Body {
-            mass: hub.mass_kg,
-            i_c: hub.inertia_bc_b_kg_m2,
-            v: &v,
-            w: &wm,
-            a_vp: w.cross(&w.cross(&hub.r_bcb_b_m)),
-            omega: w,
-            alpha_vp: V3::zeros(),
-            force: g_b * hub.mass_kg,
-            torque: cfg.torque_b - e * tau[0],
-            gyroscopic: None,
-        });
-    }
+    add_hub(&mut asm, hub, &w, &g_b, &(cfg.torque_b - e * tau[0]));
     // Panels.
     let mut rate = 0.0;
     for k in 0..nl {
