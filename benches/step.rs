@@ -17,6 +17,11 @@
 //! Issue 39 (fuel slosh): the reference spacecraft (2 pairs) with 4 linear spring-mass-damper
 //! particles or 4 spherical pendulums (damped, so every term runs), printed per device beside
 //! the same spacecraft without them and beside one panel pair, measured in the same run.
+//! Issue 39 §2 (panel chains): the reference hub with one chain of N = 1 … 10 unequal panels
+//! (`reference::unequal_chain`), medians and the least-squares cost per added link, beside the
+//! cost of a panel pair; with `FLEXDYN_PEERS_PYTHON`, the 10-link chain against MuJoCo's
+//! equivalent tree (`tools/peers/mujoco_chain.py`) in the same run.
+//! `FLEXDYN_BENCH_ONLY=chain cargo bench --bench step` runs only these rows (about a minute).
 //!
 //! Peers in the same run: with `FLEXDYN_PEERS_PYTHON` pointing at a Python that has
 //! `mujoco==4.0.0` and `bsk==2.12.1` (see `tools/peers/README.md`), the bench then runs
@@ -100,8 +105,15 @@ fn bench_step(c: &mut Criterion) {
 
 /// Runs a peer script; returns (pairs, median ns per step) from its `peer=… pairs=N median_ns_per_step=x` lines.
 fn run_peer(python: &str, script: &str) -> Result<Vec<(usize, f64)>, String> {
+    run_peer_keyed(python, &[script], "pairs=")
+}
+
+/// Runs `python args…`; returns (count, median ns per step) from its lines that carry `key`
+/// (`pairs=` or `links=`) and `median_ns_per_step=`.
+fn run_peer_keyed(python: &str, args: &[&str], key: &str) -> Result<Vec<(usize, f64)>, String> {
+    let script = args[0];
     let out = std::process::Command::new(python)
-        .arg(script)
+        .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .stderr(std::process::Stdio::inherit())
         .output()
@@ -115,14 +127,14 @@ fn run_peer(python: &str, script: &str) -> Result<Vec<(usize, f64)>, String> {
         .filter_map(|line| {
             let field = |key: &str| line.split_whitespace().find_map(|kv| kv.strip_prefix(key));
             Some((
-                field("pairs=")?.parse().ok()?,
+                field(key)?.parse().ok()?,
                 field("median_ns_per_step=")?.parse().ok()?,
             ))
         })
         .collect();
     if rows.is_empty() {
         return Err(format!(
-            "{script} printed no `pairs=… median_ns_per_step=…` lines"
+            "{script} printed no `{key}… median_ns_per_step=…` lines"
         ));
     }
     Ok(rows)
@@ -566,7 +578,91 @@ fn slosh_summary(pair_ns: f64) {
     print_added_cost("one device", base, &rows, pair_ns);
 }
 
+/// The N-link chains (issue 39 §2): cost per added link, and the 10-link chain against MuJoCo's
+/// tree in the same run. `pair_ns` is the cost of one added panel pair, when measured.
+fn chain_summary(pair_ns: Option<f64>) {
+    const LINKS: std::ops::RangeInclusive<usize> = 1..=10;
+    let (batches, steps) = (11, 5_000);
+    let gravity = GravityModel::PointMass {
+        mu_m3_s2: common::MU_EARTH,
+    };
+    let base = common::median_ns_per_step(
+        &mut common::build(
+            common::reference_hub(),
+            gravity,
+            Vec::new(),
+            common::reference_initial(),
+            1_000_000,
+        ),
+        batches,
+        steps,
+    );
+    let rows: Vec<(f64, f64)> = LINKS
+        .map(|n| {
+            let mut sc = common::reference_with_chain(gravity, n, 0.0);
+            (
+                n as f64,
+                common::median_ns_per_step(&mut sc, batches, steps),
+            )
+        })
+        .collect();
+    let (intercept, slope) = fit(&rows);
+    println!(
+        "\nrk4_step, reference hub + one N-link chain of unequal panels (median of {batches} \
+         batches x {steps} steps; rigid hub alone {base:.1} ns):"
+    );
+    println!(
+        "{:>6} {:>14} {:>16}",
+        "links", "median ns/step", "ns over the hub"
+    );
+    for (n, ns) in &rows {
+        println!("{n:>6} {ns:>14.1} {:>16.1}", ns - base);
+    }
+    // Alone (FLEXDYN_BENCH_ONLY=chain), one added pair is measured here: the slope over 1, 2,
+    // 4 and 8 pairs.
+    let pair_ns = pair_ns.unwrap_or_else(|| {
+        let pairs: Vec<(f64, f64)> = [1, 2, 4, 8]
+            .iter()
+            .map(|&n| {
+                let ns = common::median_ns_per_step(&mut spacecraft(n), batches, steps);
+                (n as f64, ns)
+            })
+            .collect();
+        fit(&pairs).1
+    });
+    println!(
+        "linear fit: {intercept:.1} ns + {slope:.1} ns per link; one panel pair adds \
+         {pair_ns:.1} ns, so a link costs {:.2} pairs",
+        slope / pair_ns
+    );
+    let Ok(python) = std::env::var("FLEXDYN_PEERS_PYTHON") else {
+        println!("MuJoCo chain: skipped (set FLEXDYN_PEERS_PYTHON; see tools/peers/README.md)");
+        return;
+    };
+    match run_peer_keyed(
+        &python,
+        &["tools/peers/mujoco_chain.py", "--links", "10"],
+        "links=",
+    ) {
+        Err(e) => println!("MuJoCo chain: {e}"),
+        Ok(peer) => {
+            let ns = rows[rows.len() - 1].1;
+            for (n, peer_ns) in peer {
+                println!(
+                    "{n}-link chain, same run: MuJoCo 4.0.0 {peer_ns:.1} ns/step, flexdyn \
+                     {ns:.1} ns/step: {:.1}x",
+                    peer_ns / ns
+                );
+            }
+        }
+    }
+}
+
 fn main() {
+    if std::env::var("FLEXDYN_BENCH_ONLY").as_deref() == Ok("chain") {
+        chain_summary(None);
+        return;
+    }
     let mut c = Criterion::default().configure_from_args();
     bench_step(&mut c);
     c.final_summary();
@@ -577,5 +673,6 @@ fn main() {
     world_summary(fit(&rows).1);
     actuator_summary(fit(&rows).1);
     sensor_summary(fit(&rows).1);
+    chain_summary(Some(fit(&rows).1));
     peers(&rows);
 }

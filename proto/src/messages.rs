@@ -31,6 +31,10 @@ pub mod effector_kind {
     /// flags [`super::thruster_flags`]; one input, the valve-open time per frame (s) or the duty
     /// cycle (0–1), as configured.
     pub const THRUSTER: u16 = 4;
+    /// A chain of N hinged panels. States `[θ1 rad, θ̇1 rad/s, θ2 rad, θ̇2 rad/s, …, θN
+    /// rad, θ̇N rad/s]` (θk relative to panel k − 1, 2N values, so N ≤ 4 on the wire); no
+    /// outputs, no flags; N inputs, the hinge motor torques (N·m).
+    pub const PANEL_CHAIN: u16 = 5;
     /// A linear spring-mass-damper fuel slosh particle. States `[ρ m, ρ̇ m/s]` (displacement of
     /// the slosh mass along its axis from its rest point); no outputs, no flags, no inputs.
     pub const SLOSH_LINEAR: u16 = 6;
@@ -425,7 +429,7 @@ pub struct AppliedWrench {
 
 /// One appended body or actuator in [`StateMsg`](crate::StateMsg) (22 + 8·(n_states + n_outputs)
 /// bytes). In the server's effector order: the configuration's `panel_pairs`, `reaction_wheels`,
-/// `magnetorquers`, then `thrusters`.
+/// `panel_chains`, `magnetorquers`, then `thrusters`.
 ///
 /// 22 bytes on the wire with every vec empty
 /// ([`EFFECTOR_STATE_FIXED_LEN`](crate::EFFECTOR_STATE_FIXED_LEN)), + 8 per entry of `states` and

@@ -202,6 +202,7 @@ fn every_shipped_scenario_is_valid() {
             "j2_orbit",
             "leo_environment",
             "no_gravity",
+            "panel_chain",
             "reference",
             "slosh",
             "srp_cannonball_basilisk",

@@ -124,32 +124,74 @@ fn the_clients_reader_agrees_with_the_servers_on_every_scenario() {
 }
 
 /// What flight code reads of the served configuration names the same effector indices the
-/// server lists: the rods after the wheels, the thrusters after the rods, in file order.
+/// server lists: the chains and slosh bodies after the wheels, the rods after them, the
+/// thrusters after the rods, in file order; in every scenario with appended bodies of the
+/// generic list.
 #[test]
 fn flight_code_finds_the_actuators_at_the_servers_indices() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/acs_full.toml");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let vehicle = flexdyn_proto::client::vehicle::VehicleConfig::from_toml(&text).unwrap();
-    let sc = SimConfig::from_toml_str(&text)
-        .unwrap()
-        .build_spacecraft()
-        .unwrap();
-    let entries: Vec<_> = sc.effector_entries().collect();
-    let first_rod = vehicle.first_magnetorquer_index() as usize;
-    let first_thruster = vehicle.first_thruster_index() as usize;
-    for (k, rod) in vehicle.magnetorquers.iter().enumerate() {
-        let e = &entries[first_rod + k];
-        assert_eq!((e.kind.name, e.name), ("magnetorquer", rod.name.as_str()));
+    for scenario in ["acs_full", "slosh", "panel_chain"] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("scenarios/{scenario}.toml"));
+        let text = std::fs::read_to_string(&path).unwrap();
+        let vehicle = flexdyn_proto::client::vehicle::VehicleConfig::from_toml(&text).unwrap();
+        let sc = SimConfig::from_toml_str(&text)
+            .unwrap()
+            .build_spacecraft()
+            .unwrap();
+        let entries: Vec<_> = sc.effector_entries().collect();
+        let kinds_at = |first: u32, n: usize| -> Vec<&str> {
+            entries[first as usize..first as usize + n]
+                .iter()
+                .map(|e| e.kind.name)
+                .collect()
+        };
+        assert!(
+            kinds_at(vehicle.first_chain_index(), vehicle.panel_chains.len())
+                .iter()
+                .all(|k| *k == "panel_chain"),
+            "{scenario}"
+        );
+        let slosh = kinds_at(
+            vehicle.first_slosh_index(),
+            vehicle.slosh_linear.len() + vehicle.slosh_pendulums.len(),
+        );
+        let (linear, pendulums) = slosh.split_at(vehicle.slosh_linear.len());
+        assert!(linear.iter().all(|k| *k == "slosh_linear"), "{scenario}");
+        assert!(
+            pendulums.iter().all(|k| *k == "slosh_pendulum"),
+            "{scenario}"
+        );
+        let first_rod = vehicle.first_magnetorquer_index() as usize;
+        let first_thruster = vehicle.first_thruster_index() as usize;
+        for (k, rod) in vehicle.magnetorquers.iter().enumerate() {
+            let e = &entries[first_rod + k];
+            assert_eq!((e.kind.name, e.name), ("magnetorquer", rod.name.as_str()));
+        }
+        for (k, t) in vehicle.thrusters.iter().enumerate() {
+            let e = &entries[first_thruster + k];
+            assert_eq!(
+                (e.kind.name, e.name),
+                ("thruster", t.name.as_str()),
+                "{scenario}"
+            );
+        }
+        assert_eq!(
+            first_thruster + vehicle.thrusters.len(),
+            entries.len(),
+            "{scenario}"
+        );
+        if scenario == "acs_full" {
+            assert_eq!(
+                (vehicle.magnetorquers.len(), vehicle.thrusters.len()),
+                (3, 4)
+            );
+            assert!(vehicle
+                .thrusters
+                .iter()
+                .all(|t| t.command.is_none() && t.min_on_time_s == 0.02));
+        }
+        if scenario == "slosh" {
+            assert!(!vehicle.slosh_linear.is_empty() && !vehicle.slosh_pendulums.is_empty());
+        }
     }
-    for (k, t) in vehicle.thrusters.iter().enumerate() {
-        let e = &entries[first_thruster + k];
-        assert_eq!((e.kind.name, e.name), ("thruster", t.name.as_str()));
-        assert_eq!(t.command, None);
-        assert_eq!(t.min_on_time_s, 0.02);
-    }
-    assert_eq!(first_thruster + vehicle.thrusters.len(), entries.len());
-    assert_eq!(
-        (vehicle.magnetorquers.len(), vehicle.thrusters.len()),
-        (3, 4)
-    );
 }

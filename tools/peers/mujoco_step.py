@@ -190,7 +190,8 @@ def sanity(n, log):
     return ok
 
 
-def bench(n, reps, steps, log):
+def bench(n, reps, steps, log, make=make, label="pairs"):
+    """Median ns per RK4 step of the model `make(n)` builds (`mujoco_chain.py` passes its own)."""
     model, data = make(n)
     nstate = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_FULLPHYSICS)
     init = np.empty((1, nstate))
@@ -210,9 +211,9 @@ def bench(n, reps, steps, log):
         init[0] = state[0, -1]
     roll.close()
     if not np.all(np.isfinite(state)):
-        log(f"  WARNING pairs={n}: non-finite state during timing")
+        log(f"  WARNING {label}={n}: non-finite state during timing")
     med = statistics.median(per_step)
-    log(f"  pairs={n}: median {med:.1f} ns/step (min {min(per_step):.1f}, "
+    log(f"  {label}={n}: median {med:.1f} ns/step (min {min(per_step):.1f}, "
         f"max {max(per_step):.1f}; {reps} reps x {steps} steps)")
     return med
 

@@ -4,7 +4,7 @@
 
 use super::component::ComponentKind;
 use super::dynamic_effectors::{magnetorquer, thruster};
-use super::effectors::{panel_pair, reaction_wheel};
+use super::effectors::{panel_chain, panel_pair, reaction_wheel};
 use super::effectors::{slosh_linear, slosh_pendulum};
 use super::EffectorKind;
 
@@ -12,6 +12,7 @@ use super::EffectorKind;
 pub static KINDS: &[&ComponentKind] = &[
     &panel_pair::kind::COMPONENT,
     &reaction_wheel::kind::COMPONENT,
+    &panel_chain::kind::COMPONENT,
     &slosh_linear::kind::COMPONENT,
     &slosh_pendulum::kind::COMPONENT,
     &magnetorquer::kind::COMPONENT,

@@ -296,3 +296,56 @@ pub fn median_ns_per_step(sc: &mut Spacecraft, batches: usize, steps: usize) -> 
     per_step.sort_by(|a, b| a.total_cmp(b));
     per_step[per_step.len() / 2]
 }
+
+/// A chain of `n` unequal panels hinged at the reference `wing_px` hinge (H1 at (0.5, 0, 1) m,
+/// ĥ1 = −b̂1, so the chain extends along +b̂1), with damping `c` \[N m s/rad\] on every hinge
+/// and small distinct initial deflections. Panel k (0-based) has mass 40 − 3k kg, inertia
+/// (30 − 2k, 15 − k, 16 − k) kg m², length 1.5 − 0.05k m, d = 0.45 l + 0.02k m, stiffness
+/// 100 + 15k N m/rad, θ = 0.06 sin(1 + k) rad and θ̇ = 0.02 cos(2 + k) rad/s: every parameter
+/// differs from panel to panel (`tools/peers/mujoco_chain.py` builds the same chain). Valid
+/// for 1 ≤ n ≤ 10.
+pub fn unequal_chain(n: usize, c: f64) -> crate::effectors::panel_chain::PanelChainParams {
+    use crate::effectors::panel_chain::{ChainPanelParams, PanelChainParams};
+    PanelChainParams {
+        name: format!("chain{n}"),
+        r_h1b_b_m: Vector3::new(0.5, 0.0, 1.0),
+        dcm_h1b: Matrix3::from_diagonal(&Vector3::new(-1.0, -1.0, 1.0)),
+        panels: (0..n)
+            .map(|k| {
+                let kf = k as f64;
+                let l_m = 1.5 - 0.05 * kf;
+                ChainPanelParams {
+                    mass_kg: 40.0 - 3.0 * kf,
+                    inertia_s_kg_m2: Vector3::new(30.0 - 2.0 * kf, 15.0 - kf, 16.0 - kf),
+                    d_m: 0.45 * l_m + 0.02 * kf,
+                    l_m,
+                    k_nm_rad: 100.0 + 15.0 * kf,
+                    c_nm_s_rad: c,
+                    theta_h_rad: 0.0,
+                    motor_torque_nm: 0.0,
+                    theta_rad: 0.06 * (1.0 + kf).sin(),
+                    theta_dot_rad_s: 0.02 * (2.0 + kf).cos(),
+                }
+            })
+            .collect(),
+    }
+}
+
+/// The reference hub with one [`unequal_chain`] of `n` panels (no pairs) and the reference
+/// initial state, 1 ms step.
+///
+/// # Panics
+/// If `n` is outside 1 … 10 (the fixture's panels stay valid only there).
+pub fn reference_with_chain(gravity: GravityModel, n: usize, c: f64) -> Spacecraft {
+    let chain =
+        crate::effectors::panel_chain::PanelChain::new(unequal_chain(n, c), "panel_chains[0]")
+            .expect("valid chain");
+    Spacecraft::new(
+        reference_hub(),
+        gravity,
+        vec![Box::new(chain)],
+        reference_initial(),
+        1_000_000,
+    )
+    .expect("valid spacecraft")
+}

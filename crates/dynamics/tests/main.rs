@@ -5,6 +5,8 @@
 //! - [`conservation`]: energy and angular momentum of the free spacecraft;
 //! - [`analytic_limit`]: a pair on a near-fixed hub against the linearised eigenproblem;
 //! - [`validate_dense_kane`]: back-substitution against a dense Kane formulation;
+//! - [`validate_basilisk_nhinged`]: the panel chain against Basilisk's N-hinged effector;
+//! - [`validate_dense_kane_chain`]: the N-link panel chain against its own dense Kane model;
 //! - [`gravity_vs_sgp4`]: the point-mass and J2 gravity against SGP4's propagation;
 //! - [`slosh`]: the fuel-slosh effectors against a dense Kane solve, invariants, closed-form
 //!   frequencies and decay rates.
@@ -19,4 +21,6 @@ mod attitude;
 mod conservation;
 mod gravity_vs_sgp4;
 mod slosh;
+mod validate_basilisk_nhinged;
 mod validate_dense_kane;
+mod validate_dense_kane_chain;

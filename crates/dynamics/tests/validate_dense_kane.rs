@@ -80,30 +80,30 @@ use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
-type V3 = Vector3<f64>;
-type M3 = Matrix3<f64>;
+pub(crate) type V3 = Vector3<f64>;
+pub(crate) type M3 = Matrix3<f64>;
 
 /// Earth's gravitational parameter [m³/s²], for the point-mass gravity cases.
-const MU_EARTH: f64 = 3.986_004_418e14;
+pub(crate) const MU_EARTH: f64 = 3.986_004_418e14;
 
 // ---------------------------------------------------------------------------------------------
 // Small independent helpers
 // ---------------------------------------------------------------------------------------------
 
 /// [ã] with [ã] b = a × b.
-fn skew(a: &V3) -> M3 {
+pub(crate) fn skew(a: &V3) -> M3 {
     M3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
 }
 
 /// Principal rotation about axis 2: M2(a) = [[c, 0, −s], [0, 1, 0], [s, 0, c]].
-fn rot2(a: f64) -> M3 {
+pub(crate) fn rot2(a: f64) -> M3 {
     let (s, c) = a.sin_cos();
     M3::new(c, 0.0, -s, 0.0, 1.0, 0.0, s, 0.0, c)
 }
 
 /// [BN] from the MRP σ_B/N, written from the Euler parameters (β0 = (1−σ²)/(1+σ²),
 /// βi = 2σi/(1+σ²)) rather than the closed MRP form the library uses.
-fn dcm_bn_from_mrp(s: &V3) -> M3 {
+pub(crate) fn dcm_bn_from_mrp(s: &V3) -> M3 {
     let s2 = s.norm_squared();
     let b0 = (1.0 - s2) / (1.0 + s2);
     let b = s * (2.0 / (1.0 + s2));
@@ -122,29 +122,29 @@ fn dcm_bn_from_mrp(s: &V3) -> M3 {
 }
 
 /// Row k of a DCM as a column vector (the k-th axis of the frame, in the other frame's components).
-fn axis(c: &M3, k: usize) -> V3 {
+pub(crate) fn axis(c: &M3, k: usize) -> V3 {
     c.row(k).transpose()
 }
 
 /// Seeded uniform sampler.
-struct Rng(ChaCha8Rng);
+pub(crate) struct Rng(ChaCha8Rng);
 
 impl Rng {
-    fn new(seed: u64) -> Self {
+    pub(crate) fn new(seed: u64) -> Self {
         Self(ChaCha8Rng::seed_from_u64(seed))
     }
     /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
+    pub(crate) fn unit(&mut self) -> f64 {
         (self.0.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+    pub(crate) fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.unit()
     }
     /// Log-uniform in [lo, hi].
-    fn log_range(&mut self, lo: f64, hi: f64) -> f64 {
+    pub(crate) fn log_range(&mut self, lo: f64, hi: f64) -> f64 {
         (lo.ln() + (hi.ln() - lo.ln()) * self.unit()).exp()
     }
-    fn vec(&mut self, half: f64) -> V3 {
+    pub(crate) fn vec(&mut self, half: f64) -> V3 {
         V3::new(
             self.range(-half, half),
             self.range(-half, half),
@@ -152,7 +152,7 @@ impl Rng {
         )
     }
     /// A uniformly distributed proper rotation matrix (from a uniformly distributed unit quaternion).
-    fn rotation(&mut self) -> M3 {
+    pub(crate) fn rotation(&mut self) -> M3 {
         loop {
             let q = [
                 self.range(-1.0, 1.0),
@@ -183,7 +183,7 @@ impl Rng {
     /// second moments along the three axes, so the triangle inequality holds by construction.
     /// One of the three may be nearly zero (a thin plate, I3 ≈ I1 + I2); two may not (a rod is
     /// neither a hub nor a panel).
-    fn principal_moments(&mut self, scale: f64) -> V3 {
+    pub(crate) fn principal_moments(&mut self, scale: f64) -> V3 {
         let a = scale * self.log_range(0.05, 1.0);
         let b = scale * self.log_range(0.05, 1.0);
         let c = scale * self.log_range(1e-4, 1.0);
@@ -196,16 +196,16 @@ impl Rng {
 // ---------------------------------------------------------------------------------------------
 
 #[derive(Debug, Clone)]
-struct Config {
-    hub: HubParams,
-    pairs: Vec<PanelPairParams>,
+pub(crate) struct Config {
+    pub(crate) hub: HubParams,
+    pub(crate) pairs: Vec<PanelPairParams>,
     /// None: free space; Some(μ): point-mass gravity.
-    mu: Option<f64>,
-    force_b: V3,
-    torque_b: V3,
+    pub(crate) mu: Option<f64>,
+    pub(crate) force_b: V3,
+    pub(crate) torque_b: V3,
     /// Reaction wheels and their commanded motor torques [N·m] (after the panel pairs in the
     /// library's effector order).
-    wheels: Vec<(ReactionWheelParams, f64)>,
+    pub(crate) wheels: Vec<(ReactionWheelParams, f64)>,
 }
 
 #[derive(Debug, Clone)]
@@ -224,7 +224,7 @@ struct Sample {
 /// product simulates; `Extreme` ones (every mass independently 1–1000 kg, so a 1 kg hub may carry
 /// a 200 kg panel on a 5 m arm) probe the ill-conditioned corner.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Ranges {
+pub(crate) enum Ranges {
     Plausible,
     Extreme,
 }
@@ -244,7 +244,7 @@ impl Ranges {
     }
 }
 
-fn random_panel(rng: &mut Rng, size_m: f64, ranges: Ranges) -> PanelParams {
+pub(crate) fn random_panel(rng: &mut Rng, size_m: f64, ranges: Ranges) -> PanelParams {
     let (lo, hi) = ranges.panel_mass_kg();
     let mass_kg = rng.log_range(lo, hi);
     PanelParams {
@@ -266,7 +266,12 @@ fn random_panel(rng: &mut Rng, size_m: f64, ranges: Ranges) -> PanelParams {
     }
 }
 
-fn random_config(rng: &mut Rng, n_pairs: usize, gravity: bool, ranges: Ranges) -> Config {
+pub(crate) fn random_config(
+    rng: &mut Rng,
+    n_pairs: usize,
+    gravity: bool,
+    ranges: Ranges,
+) -> Config {
     let (lo, hi) = ranges.hub_mass_kg();
     let hub_mass = rng.log_range(lo, hi);
     let hub_size = rng.range(0.3, 3.0);
@@ -465,44 +470,44 @@ enum Variant {
 }
 
 /// The dense system M q̈ = f, q̈ = [a_B (B); ω̇ (B); θ̈_11; θ̈_12; …].
-struct Dense {
-    m: DMatrix<f64>,
-    f: DVector<f64>,
+pub(crate) struct Dense {
+    pub(crate) m: DMatrix<f64>,
+    pub(crate) f: DVector<f64>,
     /// The uniform gravity field at the system CoM, B components.
-    g_b: V3,
+    pub(crate) g_b: V3,
 }
 
 /// Accumulates one rigid body's contribution to M and f (see the module docs).
-struct Assembler {
-    m: DMatrix<f64>,
-    f: DVector<f64>,
+pub(crate) struct Assembler {
+    pub(crate) m: DMatrix<f64>,
+    pub(crate) f: DVector<f64>,
 }
 
 /// One rigid body's Kane data.
-struct Body<'a> {
-    mass: f64,
+pub(crate) struct Body<'a> {
+    pub(crate) mass: f64,
     /// Inertia about the body's CoM, B components.
-    i_c: M3,
+    pub(crate) i_c: M3,
     /// Partial velocities of the CoM (3 × n).
-    v: &'a DMatrix<f64>,
+    pub(crate) v: &'a DMatrix<f64>,
     /// Partial angular velocities (3 × n).
-    w: &'a DMatrix<f64>,
+    pub(crate) w: &'a DMatrix<f64>,
     /// Velocity-product part of the CoM's inertial acceleration.
-    a_vp: V3,
+    pub(crate) a_vp: V3,
     /// Inertial angular velocity of the body.
-    omega: V3,
+    pub(crate) omega: V3,
     /// Velocity-product part of the body's angular acceleration.
-    alpha_vp: V3,
+    pub(crate) alpha_vp: V3,
     /// Resultant applied force (through the CoM) and torque.
-    force: V3,
-    torque: V3,
+    pub(crate) force: V3,
+    pub(crate) torque: V3,
     /// ω_body × [I_c] ω_body when given in an expanded form (a spinning rotor: see the wheel
     /// bodies); `None` computes it directly.
-    gyroscopic: Option<V3>,
+    pub(crate) gyroscopic: Option<V3>,
 }
 
 impl Assembler {
-    fn add(&mut self, b: &Body<'_>) {
+    pub(crate) fn add(&mut self, b: &Body<'_>) {
         let v = b.v;
         let w = b.w;
         let i_c = DMatrix::from_column_slice(3, 3, b.i_c.as_slice());
@@ -517,12 +522,35 @@ impl Assembler {
     }
 }
 
-fn set_block(m: &mut DMatrix<f64>, col: usize, block: &M3) {
+pub(crate) fn set_block(m: &mut DMatrix<f64>, col: usize, block: &M3) {
     m.fixed_view_mut::<3, 3>(0, col).copy_from(block);
 }
 
-fn set_col(m: &mut DMatrix<f64>, col: usize, v: &V3) {
+pub(crate) fn set_col(m: &mut DMatrix<f64>, col: usize, v: &V3) {
     m.fixed_view_mut::<3, 1>(0, col).copy_from(v);
+}
+
+/// Adds the hub (rigid, CoM at r_Bc/B, angular velocity `w`) with the torque `torque` on it and
+/// its weight in the uniform field `g_b`: partial velocities [I, −[r̃_Bc/B], 0…] and [0, I, 0…].
+pub(crate) fn add_hub(asm: &mut Assembler, hub: &HubParams, w: &V3, g_b: &V3, torque: &V3) {
+    let n = asm.m.nrows();
+    let mut v = DMatrix::zeros(3, n);
+    let mut wm = DMatrix::zeros(3, n);
+    set_block(&mut v, 0, &M3::identity());
+    set_block(&mut v, 3, &(-skew(&hub.r_bcb_b_m)));
+    set_block(&mut wm, 3, &M3::identity());
+    asm.add(&Body {
+        mass: hub.mass_kg,
+        i_c: hub.inertia_bc_b_kg_m2,
+        v: &v,
+        w: &wm,
+        a_vp: w.cross(&w.cross(&hub.r_bcb_b_m)),
+        omega: *w,
+        alpha_vp: V3::zeros(),
+        force: g_b * hub.mass_kg,
+        torque: *torque,
+        gyroscopic: None,
+    });
 }
 
 fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
@@ -599,11 +627,6 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
 
     // Hub.
     {
-        let mut v = DMatrix::zeros(3, n);
-        let mut wm = DMatrix::zeros(3, n);
-        set_block(&mut v, 0, &M3::identity());
-        set_block(&mut v, 3, &(-skew(&hub.r_bcb_b_m)));
-        set_block(&mut wm, 3, &M3::identity());
         let mut torque = cfg.torque_b;
         for (g, (tau1, _)) in geoms.iter().zip(&taus) {
             torque -= axis(&g.c1, 1) * *tau1; // reaction of hinge 1
@@ -611,18 +634,7 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
         for ((wp, _), tau) in cfg.wheels.iter().zip(&wheel_taus) {
             torque -= wp.spin_axis_b * *tau; // reaction of the wheel motor and bearing
         }
-        asm.add(&Body {
-            mass: hub.mass_kg,
-            i_c: hub.inertia_bc_b_kg_m2,
-            v: &v,
-            w: &wm,
-            a_vp: w.cross(&w.cross(&hub.r_bcb_b_m)),
-            omega: w,
-            alpha_vp: V3::zeros(),
-            force: g_b * hub.mass_kg,
-            torque,
-            gyroscopic: None,
-        });
+        add_hub(&mut asm, hub, &w, &g_b, &torque);
     }
 
     // Panels.
@@ -737,7 +749,7 @@ fn dense_kane(cfg: &Config, x: &Sample, variant: Variant) -> Dense {
 }
 
 /// Dense LU solve of M q̈ = f.
-fn dense_solve(d: &Dense) -> DVector<f64> {
+pub(crate) fn dense_solve(d: &Dense) -> DVector<f64> {
     d.m.clone()
         .lu()
         .solve(&d.f)
@@ -772,6 +784,19 @@ fn build_library_with_step(cfg: &Config, step_ns: u64) -> Spacecraft {
             Box::new(wheel) as Box<dyn StateEffector>
         }))
         .collect();
+    let mut sc = spacecraft_of(cfg, effectors, step_ns);
+    let u: Vec<f64> = cfg.wheels.iter().map(|(_, u)| *u).collect();
+    sc.set_effector_inputs(&u).expect("one input per wheel");
+    sc
+}
+
+/// The library spacecraft of `cfg`'s hub, gravity and wrench with `effectors` (the states are
+/// set per sample, so the initial state is arbitrary).
+pub(crate) fn spacecraft_of(
+    cfg: &Config,
+    effectors: Vec<Box<dyn StateEffector>>,
+    step_ns: u64,
+) -> Spacecraft {
     let gravity = match cfg.mu {
         None => GravityModel::None,
         Some(mu) => GravityModel::PointMass { mu_m3_s2: mu },
@@ -790,8 +815,6 @@ fn build_library_with_step(cfg: &Config, step_ns: u64) -> Spacecraft {
         force_b_newton: cfg.force_b,
         torque_b_nm: cfg.torque_b,
     });
-    let u: Vec<f64> = cfg.wheels.iter().map(|(_, u)| *u).collect();
-    sc.set_effector_inputs(&u).expect("one input per wheel");
     sc
 }
 
@@ -830,11 +853,11 @@ fn library_accel(sc: &mut Spacecraft, x: &Sample) -> (DVector<f64>, V3) {
     (q, out.nongrav_accel_bn_b)
 }
 
-fn inf_norm(v: &DVector<f64>) -> f64 {
+pub(crate) fn inf_norm(v: &DVector<f64>) -> f64 {
     v.iter().fold(0.0_f64, |a, x| a.max(x.abs()))
 }
 
-fn rel_err(lib: &DVector<f64>, dense: &DVector<f64>) -> f64 {
+pub(crate) fn rel_err(lib: &DVector<f64>, dense: &DVector<f64>) -> f64 {
     inf_norm(&(lib - dense)) / inf_norm(dense).max(1e-300)
 }
 
@@ -849,7 +872,7 @@ fn cond(m: &DMatrix<f64>) -> f64 {
 /// and f — which is what rounding while *assembling* them produces, in the library as here —
 /// moves q by up to about κ_S·ε relative. So two correct f64 implementations that assemble the
 /// same equations in a different order can differ by O(κ_S·eps), whatever solver either uses.
-fn skeel_cond(d: &Dense, q: &DVector<f64>) -> f64 {
+pub(crate) fn skeel_cond(d: &Dense, q: &DVector<f64>) -> f64 {
     let m_inv = d.m.clone().try_inverse().expect("invertible").abs();
     inf_norm(&(m_inv * (d.m.abs() * q.abs() + d.f.abs()))) / inf_norm(q)
 }
@@ -859,7 +882,7 @@ fn skeel_cond(d: &Dense, q: &DVector<f64>) -> f64 {
 /// perturbed for q to be their exact solution, so it is independent of the conditioning: a
 /// correct library answer scores O(eps) even where the forward error is amplified by κ, while any
 /// wrong term in the library's equations scores at least its own relative size.
-fn backward_error(d: &Dense, q: &DVector<f64>) -> f64 {
+pub(crate) fn backward_error(d: &Dense, q: &DVector<f64>) -> f64 {
     let m_norm =
         d.m.row_iter()
             .map(|r| r.iter().map(|v| v.abs()).sum::<f64>())
@@ -867,7 +890,7 @@ fn backward_error(d: &Dense, q: &DVector<f64>) -> f64 {
     inf_norm(&(&d.m * q - &d.f)) / (m_norm * inf_norm(q) + inf_norm(&d.f))
 }
 
-fn median(v: &mut [f64]) -> f64 {
+pub(crate) fn median(v: &mut [f64]) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
     v[v.len() / 2]
 }
@@ -974,7 +997,7 @@ fn validate_dense_kane_mass_matrix_spd() {
 const WELL_CONDITIONED_KAPPA: f64 = 1e3;
 /// Round-off envelope for the ill-conditioned tail: rel err ≤ this × κ_S × eps (measured ≤ 4.4
 /// here; ≤ 12 when rod-like inertias are also sampled).
-const ROUNDOFF_FACTOR: f64 = 32.0;
+pub(crate) const ROUNDOFF_FACTOR: f64 = 32.0;
 
 /// The main cross-check: library back-substitution vs dense Kane LU, 1260 random states.
 ///

@@ -42,6 +42,7 @@ mod imu_alloc;
 mod imu_config;
 mod imu_panel_modes;
 mod imu_truth;
+mod panel_chain;
 mod reaction_wheels;
 mod rk4_bit_identity;
 mod slosh;

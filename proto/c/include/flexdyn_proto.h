@@ -157,6 +157,7 @@
 #define FD_EFFECTOR_REACTION_WHEEL 2u /* a reaction wheel */
 #define FD_EFFECTOR_MAGNETORQUER 3u /* a magnetorquer rod */
 #define FD_EFFECTOR_THRUSTER 4u /* a thruster */
+#define FD_EFFECTOR_PANEL_CHAIN 5u /* a chain of N hinged panels */
 #define FD_EFFECTOR_SLOSH_LINEAR 6u /* a linear spring-mass-damper fuel slosh particle */
 #define FD_EFFECTOR_SLOSH_PENDULUM 7u /* a spherical-pendulum fuel slosh mass */
 

@@ -128,7 +128,18 @@ pub struct VehicleConfig {
     /// `[[reaction_wheels]]`, in file order (effector indices after the panel pairs).
     #[serde(default)]
     pub reaction_wheels: Vec<ReactionWheel>,
-    /// `[[magnetorquers]]`, in file order (effector indices after the wheels).
+    /// `[[panel_chains]]`, in file order (effector indices after the wheels).
+    #[serde(default)]
+    pub panel_chains: Vec<PanelChain>,
+    /// `[[slosh_linear]]`, in file order (effector indices after the panel chains): kept as
+    /// tables, for their count (flight code does not read slosh parameters).
+    #[serde(default)]
+    pub slosh_linear: Vec<toml::Table>,
+    /// `[[slosh_pendulums]]`, in file order (effector indices after the linear slosh
+    /// particles): kept as tables, for their count.
+    #[serde(default)]
+    pub slosh_pendulums: Vec<toml::Table>,
+    /// `[[magnetorquers]]`, in file order (effector indices after the slosh bodies).
     #[serde(default)]
     pub magnetorquers: Vec<Magnetorquer>,
     /// `[[thrusters]]`, in file order (effector indices after the magnetorquers).
@@ -177,9 +188,21 @@ impl VehicleConfig {
         self.panel_pairs.len() as u32
     }
 
-    /// The effector index of the first magnetorquer (after every wheel).
-    pub fn first_magnetorquer_index(&self) -> u32 {
+    /// The effector index of the first panel chain (after every wheel).
+    pub fn first_chain_index(&self) -> u32 {
         self.first_wheel_index() + self.reaction_wheels.len() as u32
+    }
+
+    /// The effector index of the first fuel-slosh body (after every panel chain): the linear
+    /// particles, then the pendulums.
+    pub fn first_slosh_index(&self) -> u32 {
+        self.first_chain_index() + self.panel_chains.len() as u32
+    }
+
+    /// The effector index of the first magnetorquer (after every appended body: pairs, wheels,
+    /// chains, slosh bodies).
+    pub fn first_magnetorquer_index(&self) -> u32 {
+        self.first_slosh_index() + (self.slosh_linear.len() + self.slosh_pendulums.len()) as u32
     }
 
     /// The effector index of the first thruster (after every magnetorquer).
@@ -303,7 +326,21 @@ pub struct PanelPair {
     pub panel2: Panel,
 }
 
-/// One panel of a pair.
+/// A `[[panel_chains]]` entry: N hinged panels in series (inputs: one motor torque per hinge,
+/// N·m, in `Actuators` commands).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub struct PanelChain {
+    /// Its name.
+    pub name: String,
+    /// \[m\] hinge 1 relative to B, B components.
+    pub r_h1b_b_m: [f64; 3],
+    /// [H1 B], rows ĥ1, ĥ2, ĥ3 in B; every hinge axis is ĥ2.
+    pub dcm_h1b: [[f64; 3]; 3],
+    /// The panels, from the hub outwards (each with `l_m`, optional on the last).
+    pub panels: Vec<Panel>,
+}
+
+/// One panel of a pair or a chain.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 pub struct Panel {
     /// \[kg\]
@@ -312,7 +349,7 @@ pub struct Panel {
     pub inertia_s_kg_m2: [f64; 3],
     /// \[m\] hinge to centre of mass.
     pub d_m: f64,
-    /// \[m\] hinge to hinge (panel 1 only).
+    /// \[m\] hinge to hinge (a pair's panel 1, a chain's panels but the last).
     #[serde(default)]
     pub l_m: Option<f64>,
 }

@@ -2,6 +2,7 @@
 //! configuration schema (`schema.rs`), its [`StateEffector`](super::StateEffector)
 //! implementation with its state, input and output names, and its tests.
 
+pub mod panel_chain;
 pub mod panel_pair;
 pub mod reaction_wheel;
 pub mod slosh_linear;

@@ -169,8 +169,8 @@ impl SimConfig {
         self.frame_ns / self.step_ns
     }
 
-    /// \[kg\] total mass: hub plus every panel, wheel rotor and appended body of the generic
-    /// list (slosh masses).
+    /// \[kg\] total mass: hub plus every panel, wheel rotor, chain panel and appended body of the
+    /// generic list (slosh masses).
     pub fn total_mass_kg(&self) -> f64 {
         self.hub.mass_kg
             + self

@@ -1,0 +1,96 @@
+//! `[[panel_chains]]` read through the generic component list: the shipped scenario builds, its
+//! chains sit between the wheels and the actuators in the effector list with their state and
+//! input names, stepping allocates nothing, and the errors name the entry, the panel and the
+//! field.
+
+use flexdyn_dynamics::effectors::panel_chain;
+use flexdyn_testkit::alloc_counter::allocations;
+use flexdyn_vehicle::config::SimConfig;
+use flexdyn_vehicle::sim::Simulation;
+
+fn scenario() -> String {
+    std::fs::read_to_string(format!("{}/scenarios/panel_chain.toml", crate::REPO)).unwrap()
+}
+
+#[test]
+fn the_chain_scenario_builds_and_steps_without_allocating() {
+    let cfg = SimConfig::from_toml_str(&scenario()).unwrap();
+    let chain_mass: f64 = 40.0 + 32.0 + 25.0 + 18.0 + 40.0 + 32.0 + 25.0;
+    assert!((cfg.total_mass_kg() - (750.0 + chain_mass)).abs() < 1e-9);
+    assert!(
+        cfg.summary().contains("2 panel_chains"),
+        "{}",
+        cfg.summary()
+    );
+    let mut sim = Simulation::new(&cfg).unwrap();
+    let entries: Vec<_> = sim.spacecraft().effector_entries().collect();
+    assert_eq!(entries.len(), 2);
+    assert_eq!(entries[0].kind, panel_chain::KIND);
+    assert_eq!(entries[0].state_names, &panel_chain::STATE_NAMES[..8]);
+    assert_eq!(entries[1].state_names, &panel_chain::STATE_NAMES[..6]);
+    assert_eq!(entries[1].input_names, &panel_chain::INPUT_NAMES[..3]);
+    // Motor torques commanded like any effector input (4 for wing_px, 3 for wing_mx).
+    sim.set_effector_inputs(&[0.5, 0.0, 0.0, 0.1, -0.2, 0.0, 0.0])
+        .unwrap();
+    let mut msg = sim.blank_state();
+    sim.step_frame();
+    sim.state_into(&mut msg);
+    let before = allocations();
+    for _ in 0..20 {
+        sim.step_frame();
+        sim.state_into(&mut msg);
+    }
+    assert_eq!(
+        allocations() - before,
+        0,
+        "allocations while stepping chains"
+    );
+    assert_eq!(
+        msg.effectors[0].kind,
+        flexdyn_proto::effector_kind::PANEL_CHAIN
+    );
+    assert_eq!(msg.effectors[0].states.len(), 8);
+    assert!(msg.effectors[0].states.iter().all(|v| v.is_finite()));
+}
+
+/// The configuration's errors name the entry, the panel and the field.
+#[test]
+fn bad_chain_entries_are_named() {
+    let text = scenario();
+    let cases = [
+        (
+            text.replacen("mass_kg = 25.0", "mass_kg = -25.0", 1),
+            "panel_chains[0].panels[2].mass_kg",
+        ),
+        (
+            text.replacen("l_m = 1.4\n", "", 1),
+            "panel_chains[0].panels[1].l_m",
+        ),
+        (
+            text.replacen("d_m = 0.65\n", "d_m = 2.0\n", 1),
+            "panel_chains[0].panels[1].d_m",
+        ),
+        (
+            text.replacen("k_nm_rad = 60.0", "k_nm_rad = 60.0\nk_nm = 1.0", 1),
+            "panel_chains[0].panels[3].k_nm",
+        ),
+        (
+            text.replacen("name = \"wing_mx\"", "name = \"wing_px\"", 1),
+            "panel_chains[1].name",
+        ),
+        (
+            // A fifth panel: more states than a StateMsg entry carries.
+            text.replacen(
+                "theta_dot_rad_s = 0.02\n",
+                "theta_dot_rad_s = 0.02\nl_m = 1.2\n\n[[panel_chains.panels]]\nmass_kg = 10.0\n\
+                 inertia_s_kg_m2 = [6.0, 3.0, 4.0]\nd_m = 0.5\nk_nm_rad = 40.0\nc_nm_s_rad = 0.5\n",
+                1,
+            ),
+            "panel_chains[0].panels: has 5 panels",
+        ),
+    ];
+    for (toml, field) in cases {
+        let e = SimConfig::from_toml_str(&toml).unwrap_err().to_string();
+        assert!(e.contains(field), "{field}: {e}");
+    }
+}

@@ -1,0 +1,119 @@
+#!/usr/bin/env python3
+"""Reference numbers: Basilisk's N-hinged rigid-body effector on its own unit-test case.
+
+Reproduces `src/simulation/dynamics/NHingedRigidBodies/_UnitTest/test_nHingedRigidBodyStateEffector.py`
+of Basilisk 2.12.1 (AVSLab/basilisk): a 750 kg hub (I = diag(900, 800, 600) kg m^2 about its CoM,
+which is at B) with two `NHingedRigidBodyStateEffector`s of identical panels (50 kg,
+I = diag(50, 25, 25) kg m^2 about the panel CoM, d = 0.75 m, k = 500 N m/rad, c = 0,
+theta_0 = 0): four panels hinged at (0.5, 0, 1) m with [HB] = diag(-1, -1, 1), three at
+(-0.5, 0, 1) m with [HB] = I; the first panel of the four starts at 5 deg, every other at 0;
+omega_BN_B = (0.1, -0.1, 0.1) rad/s; RK4 (Basilisk's default) at 0.1 ms. Case `NoGravity`:
+r_CN_N = (0.1, -0.4, 0.3) m, v_CN_N = (-0.2, 0.5, 0.1) m/s, no gravity. Case `Gravity`: point-mass
+Earth (mu = 3.986004415e14) and the unit test's orbit.
+
+Basilisk's conventions, as flexdyn's panel chain maps them (docs/models/panel-chains.md):
+- [S_k B] = M2(theta_1 + ... + theta_k) [HB]: theta_k relative to panel k - 1, as flexdyn's
+  (theta_h = 0);
+- the hinge of panel k + 1 is at 2 d_k from hinge k along -s_k1 (Basilisk has no separate length):
+  flexdyn's l_k = 2 d_k = 1.5 m;
+- the spring acts on theta - theta_0 (theta_0 = 0 here), the damper on thetaDot: flexdyn's k, c;
+- every panel has the same mass, d and inertia (the model's assumption).
+
+Prints on stdout, for each case, the state at t = 0.25, 0.5, 0.75 and 1.0 s as a Rust table:
+`(case, t_s, [theta x 7], [thetaDot x 7], sigma_BN, omega_BN_B, r_BN_N, v_BN_N)` with every
+number in `repr` (round-trip) form. `crates/dynamics/tests/validate_basilisk_nhinged.rs` embeds
+the output; regenerate it with
+
+    target/peers-venv/bin/python tools/peers/basilisk_nhinged.py
+"""
+
+import math
+import sys
+
+from Basilisk.simulation import gravityEffector, nHingedRigidBodyStateEffector, spacecraft
+from Basilisk.utilities import SimulationBaseClass, macros
+
+STEP_S = 1e-4
+SAMPLE_TIMES_S = (0.25, 0.5, 0.75, 1.0)
+
+
+def run(case):
+    sim = SimulationBaseClass.SimBaseClass()
+    proc = sim.CreateNewProcess("proc")
+    proc.addTask(sim.CreateNewTask("task", macros.sec2nano(STEP_S)))
+    sc = spacecraft.Spacecraft()
+    sc.ModelTag = "spacecraftBody"
+
+    eff1 = nHingedRigidBodyStateEffector.NHingedRigidBodyStateEffector()
+    eff2 = nHingedRigidBodyStateEffector.NHingedRigidBodyStateEffector()
+    eff1.r_HB_B = [[0.5], [0.0], [1.0]]
+    eff1.dcm_HB = [[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]
+    eff2.r_HB_B = [[-0.5], [0.0], [1.0]]
+    eff2.dcm_HB = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    panel = nHingedRigidBodyStateEffector.HingedPanel()
+    panel.mass = 50.0
+    panel.IPntS_S = [[50.0, 0.0, 0.0], [0.0, 25.0, 0.0], [0.0, 0.0, 25.0]]
+    panel.d = 0.75
+    panel.k = 500.0
+    panel.c = 0.0
+    panel.thetaInit = 5 * math.pi / 180.0
+    panel.thetaDotInit = 0.0
+    panel.theta_0 = 0.0
+    eff1.addHingedPanel(panel)
+    panel.thetaInit = 0.0
+    for _ in range(3):
+        eff1.addHingedPanel(panel)
+    for _ in range(3):
+        eff2.addHingedPanel(panel)
+    sc.addStateEffector(eff1)
+    sc.addStateEffector(eff2)
+
+    sc.hub.mHub = 750.0
+    sc.hub.r_BcB_B = [[0.0], [0.0], [0.0]]
+    sc.hub.IHubPntBc_B = [[900.0, 0.0, 0.0], [0.0, 800.0, 0.0], [0.0, 0.0, 600.0]]
+    sc.hub.r_CN_NInit = [[0.1], [-0.4], [0.3]]
+    sc.hub.v_CN_NInit = [[-0.2], [0.5], [0.1]]
+    sc.hub.sigma_BNInit = [[0.0], [0.0], [0.0]]
+    sc.hub.omega_BN_BInit = [[0.1], [-0.1], [0.1]]
+    sim.AddModelToTask("task", sc)
+    if case == "Gravity":
+        earth = gravityEffector.GravBodyData()
+        earth.planetName = "earth_planet_data"
+        earth.mu = 0.3986004415e15
+        earth.isCentralBody = True
+        sc.gravField.gravBodies = spacecraft.GravBodyVector([earth])
+        sc.hub.r_CN_NInit = [[-4020338.690396649], [7490566.741852513], [5248299.211589362]]
+        sc.hub.v_CN_NInit = [[-5199.77710904224], [-3436.681645356935], [1041.576797498721]]
+
+    sim.InitializeSimulation()
+    names = [(e.nameOfThetaState, e.nameOfThetaDotState) for e in (eff1, eff2)]
+    hub = sc.hub
+    rows = []
+    for t in SAMPLE_TIMES_S:
+        sim.ConfigureStopTime(macros.sec2nano(t))
+        sim.ExecuteSimulation()
+        get = lambda name: [v[0] for v in sc.dynManager.getStateObject(name).getState()]
+        theta = get(names[0][0]) + get(names[1][0])
+        theta_dot = get(names[0][1]) + get(names[1][1])
+        rows.append((t, theta, theta_dot, get(hub.nameOfHubSigma), get(hub.nameOfHubOmega),
+                     get(hub.nameOfHubPosition), get(hub.nameOfHubVelocity)))
+        if not all(math.isfinite(v) for r in rows[-1][1:] for v in r):
+            print(f"{case}: non-finite state at t = {t}", file=sys.stderr)
+            sys.exit(1)
+    return rows
+
+
+def fmt(v):
+    return "[" + ", ".join(repr(float(x)) for x in v) + "]"
+
+
+def main():
+    print("// Generated by tools/peers/basilisk_nhinged.py (Basilisk 2.12.1); do not edit.")
+    for case in ("NoGravity", "Gravity"):
+        for t, th, thd, sigma, omega, r, v in run(case):
+            print(f'    ("{case}", {t!r}, {fmt(th)}, {fmt(thd)}, {fmt(sigma)}, {fmt(omega)}, '
+                  f"{fmt(r)}, {fmt(v)}),")
+
+
+if __name__ == "__main__":
+    main()
