@@ -110,6 +110,32 @@ pub struct RunResult {
     pub sim_s: f64,
 }
 
+impl RunResult {
+    /// Planned run `rp` before it ran (or when it could not run): its seeds and redraws, no
+    /// results, outcome `not_run`, `status`.
+    pub fn not_run(rp: &RunPlan, status: String) -> Self {
+        Self {
+            run: rp.run,
+            run_seed: rp.run_seed,
+            sensor_seeds: rp.sensor_seeds.clone(),
+            redraws: rp.redraws,
+            applied: BTreeMap::new(),
+            state_sha256: String::new(),
+            vehicle_state_sha256: BTreeMap::new(),
+            states: 0,
+            fault_activations_ns: BTreeMap::new(),
+            criteria: Vec::new(),
+            passed: false,
+            outcome: Outcome::NotRun,
+            status,
+            controller_exit: None,
+            controller_exits: BTreeMap::new(),
+            wall_s: 0.0,
+            sim_s: 0.0,
+        }
+    }
+}
+
 /// Options of `campaign run`.
 #[derive(Clone, Debug)]
 pub struct RunOptions {
@@ -274,25 +300,7 @@ pub fn execute(plan: &Plan, rp: &RunPlan, opts: &RunOptions) -> RunResult {
     let c = &plan.campaign;
     let run_dir = opts.dir.join(&rp.dir);
     let _ = std::fs::create_dir_all(&run_dir);
-    let mut result = RunResult {
-        run: rp.run,
-        run_seed: rp.run_seed,
-        sensor_seeds: rp.sensor_seeds.clone(),
-        redraws: rp.redraws,
-        applied: BTreeMap::new(),
-        state_sha256: String::new(),
-        vehicle_state_sha256: BTreeMap::new(),
-        states: 0,
-        fault_activations_ns: BTreeMap::new(),
-        criteria: Vec::new(),
-        passed: false,
-        outcome: Outcome::NotRun,
-        status: String::new(),
-        controller_exit: None,
-        controller_exits: BTreeMap::new(),
-        wall_s: 0.0,
-        sim_s: 0.0,
-    };
+    let mut result = RunResult::not_run(rp, String::new());
     (result.status, result.outcome) = match run_inner(c, rp, opts, &run_dir, &mut result) {
         Ok(()) if result.criteria.iter().all(|k| k.passed) => ("ok".into(), Outcome::Passed),
         Ok(()) => ("ok".into(), Outcome::Failed),

@@ -404,25 +404,10 @@ pub fn mark_not_run(
         if path.exists() {
             continue;
         }
-        let result = RunResult {
-            run: rp.run,
-            run_seed: rp.run_seed,
-            sensor_seeds: rp.sensor_seeds.clone(),
-            redraws: rp.redraws,
-            applied: Default::default(),
-            state_sha256: String::new(),
-            vehicle_state_sha256: Default::default(),
-            states: 0,
-            fault_activations_ns: Default::default(),
-            criteria: Vec::new(),
-            passed: false,
-            outcome: Outcome::NotRun,
-            status: format!("Slurm task {array_job}_{task} {how} and left no result"),
-            controller_exit: None,
-            controller_exits: Default::default(),
-            wall_s: 0.0,
-            sim_s: 0.0,
-        };
+        let result = RunResult::not_run(
+            rp,
+            format!("Slurm task {array_job}_{task} {how} and left no result"),
+        );
         std::fs::create_dir_all(dir.join(&rp.dir)).map_err(|e| e.to_string())?;
         let text = serde_json::to_string_pretty(&result).map_err(|e| e.to_string())?;
         std::fs::write(&path, text + "\n").map_err(|e| format!("{}: {e}", path.display()))?;
