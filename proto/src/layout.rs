@@ -5,6 +5,7 @@
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
+use crate::view::WirePrim;
 use crate::{DecodeError, Header};
 
 /// Largest panel-pair count a configuration may have (each pair is one effector).
@@ -148,7 +149,7 @@ impl<'b> Walker<'b> {
 
     /// Reads a u64 LE count at the cursor and checks it against `max`.
     pub(crate) fn count(&mut self, what: &'static str, max: usize) -> Result<usize, WalkError> {
-        let count = read_u64_le(self.bytes, self.at).ok_or(WalkError::Length {
+        let count = u64::read_le(self.bytes, self.at).ok_or(WalkError::Length {
             needed: self.at + 8,
             actual: self.bytes.len(),
         })?;
@@ -185,15 +186,4 @@ impl WireLayout {
             WireLayout::Walked { walk, .. } => walk(bytes).map_err(DecodeError::from),
         }
     }
-}
-
-fn read_u64_le(bytes: &[u8], at: usize) -> Option<u64> {
-    let b: [u8; 8] = bytes.get(at..at.checked_add(8)?)?.try_into().ok()?;
-    Some(u64::from_le_bytes(b))
-}
-
-/// The u32 LE at `at`, if the buffer holds it.
-pub(crate) fn read_u32_le(bytes: &[u8], at: usize) -> Option<u32> {
-    let b: [u8; 4] = bytes.get(at..at.checked_add(4)?)?.try_into().ok()?;
-    Some(u32::from_le_bytes(b))
 }

@@ -65,14 +65,20 @@ pub trait MessageView<'a>: Sized + Copy {
     fn to_msg(&self) -> Self::Msg;
 }
 
-/// A number as the wire holds it: little-endian, fixed width.
+/// A number as the wire holds it: little-endian, fixed width. The one reader of numbers at an
+/// offset, for the views and for the decoder's walk of the counts (`layout.rs`).
 pub trait WirePrim: Copy + Default {
     /// Its encoded size (bytes).
     const SIZE: usize;
 
+    /// The value at byte `at` of `b`, if `b` holds it.
+    fn read_le(b: &[u8], at: usize) -> Option<Self>;
+
     /// The value at byte `at` of `b` (the default if `b` ends first: a view reads validated
     /// bytes, so that never happens).
-    fn at(b: &[u8], at: usize) -> Self;
+    fn at(b: &[u8], at: usize) -> Self {
+        Self::read_le(b, at).unwrap_or_default()
+    }
 }
 
 macro_rules! wire_prim {
@@ -80,10 +86,9 @@ macro_rules! wire_prim {
         impl WirePrim for $t {
             const SIZE: usize = std::mem::size_of::<$t>();
 
-            fn at(b: &[u8], at: usize) -> Self {
-                b.get(at..at.saturating_add(Self::SIZE))
-                    .and_then(|s| s.try_into().ok())
-                    .map_or_else(Self::default, <$t>::from_le_bytes)
+            fn read_le(b: &[u8], at: usize) -> Option<Self> {
+                let bytes = b.get(at..at.checked_add(Self::SIZE)?)?;
+                Some(<$t>::from_le_bytes(bytes.try_into().ok()?))
             }
         }
     )*};
@@ -94,8 +99,8 @@ wire_prim!(u8, u16, u32, u64, i32, f64);
 impl WirePrim for bool {
     const SIZE: usize = 1;
 
-    fn at(b: &[u8], at: usize) -> Self {
-        b.get(at).is_some_and(|&x| x != 0)
+    fn read_le(b: &[u8], at: usize) -> Option<Self> {
+        b.get(at).map(|&x| x != 0)
     }
 }
 
@@ -139,10 +144,7 @@ pub(crate) fn check_frame(bytes: &[u8], layout: WireLayout) -> Result<(), ViewEr
     if bytes.len() > MAX_MESSAGE_BYTES {
         return Err(ViewError::Malformed);
     }
-    let found = rd::<u16>(bytes, 0);
-    if bytes.len() < 2 {
-        return Err(ViewError::Malformed);
-    }
+    let found = u16::read_le(bytes, 0).ok_or(ViewError::Malformed)?;
     if found != PROTOCOL_VERSION {
         return Err(ViewError::UnknownVersion { found });
     }

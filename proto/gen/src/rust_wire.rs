@@ -263,7 +263,7 @@ fn message(t: &Table, m: &Message, o: &mut String) {
             Ty::Union(ui) => {
                 let un = &t.unions[ui];
                 o.push_str(&format!(
-                    "    let tag = read_u32_le(bytes, {prefix}).ok_or(WalkError::Length {{\n        needed: {},\n        actual: bytes.len(),\n    }})?;\n    match tag {{\n",
+                    "    let tag = u32::read_le(bytes, {prefix}).ok_or(WalkError::Length {{\n        needed: {},\n        actual: bytes.len(),\n    }})?;\n    match tag {{\n",
                     prefix + 4
                 ));
                 for v in &un.variants {
@@ -297,7 +297,7 @@ fn message(t: &Table, m: &Message, o: &mut String) {
 pub fn module(t: &Table) -> String {
     let mut o = String::new();
     o.push_str(&format!(
-        "//! The per-message half of the Rust codec: sizes, constants, each message's length rule\n//! and checks, and its decoder.\n//!\n//! {GENERATED}\n\nuse crate::layout::{{read_u32_le, sealed::Sealed, WalkError, Walker, WireLayout, WireMessage}};\nuse crate::DecodeError;\n\n/// The wire protocol version every header carries.\npub const PROTOCOL_VERSION: u16 = {};\n",
+        "//! The per-message half of the Rust codec: sizes, constants, each message's length rule\n//! and checks, and its decoder.\n//!\n//! {GENERATED}\n\nuse crate::layout::{{sealed::Sealed, WalkError, Walker, WireLayout, WireMessage}};\nuse crate::view::WirePrim;\nuse crate::DecodeError;\n\n/// The wire protocol version every header carries.\npub const PROTOCOL_VERSION: u16 = {};\n",
         t.protocol_version
     ));
     o.push_str("\n// Named constants.\n");
