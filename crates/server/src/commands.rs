@@ -458,21 +458,19 @@ impl CommandBook {
         let slot = &self.slots[i];
         // Read in place: decoding a damaged Actuators command would allocate its inputs here,
         // on the stepping thread.
-        let reject = match view_command(&self.scratch) {
+        // The header read once, beside the view.
+        let reject = match view_command(&self.scratch).map(|d| (d, d.header())) {
             Err(e) => Err(Damaged::of_view(e)),
-            Ok(d) if d.header().spacecraft_id != self.spacecraft_id => {
-                Err(Damaged::WrongSpacecraft)
-            }
-            Ok(d) if d.sender_id() != slot.sender_id => Err(Damaged::WrongIdentity),
-            Ok(d)
-                if (lockstep && d.header().tick != k)
+            Ok((_, h)) if h.spacecraft_id != self.spacecraft_id => Err(Damaged::WrongSpacecraft),
+            Ok((d, _)) if d.sender_id() != slot.sender_id => Err(Damaged::WrongIdentity),
+            Ok((_, h))
+                if (lockstep && h.tick != k)
                     || (!lockstep
-                        && (d.header().tick > k
-                            || (slot.has_command && d.header().tick < slot.last_tick))) =>
+                        && (h.tick > k || (slot.has_command && h.tick < slot.last_tick))) =>
             {
                 Err(Damaged::StaleTick)
             }
-            Ok(d) => match check_view_inputs(&self.input_ranges, &mut self.seen, &d) {
+            Ok((d, _)) => match check_view_inputs(&self.input_ranges, &mut self.seen, &d) {
                 Some(_) => Err(Damaged::BadEffectorInput),
                 None => Ok(d),
             },

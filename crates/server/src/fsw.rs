@@ -114,18 +114,18 @@ impl FswIntake {
                 .map_or_else(|| format!("{e:?}"), |d| d.to_string());
             (reason, format!("flight-code telemetry on {key}: {detail}"))
         })?;
-        if msg.header().spacecraft_id != self.spacecraft_id {
+        let header = msg.header();
+        if header.spacecraft_id != self.spacecraft_id {
             return Err((
                 "wrong_spacecraft",
                 format!(
                     "flight-code telemetry on {key} for spacecraft_id {}, not this server's {}",
-                    msg.header().spacecraft_id,
-                    self.spacecraft_id
+                    header.spacecraft_id, self.spacecraft_id
                 ),
             ));
         }
         // A lockstep run's last tick: neither checked further nor recorded (module docs).
-        if self.lockstep_last_tick == Some(msg.header().tick) {
+        if self.lockstep_last_tick == Some(header.tick) {
             return Ok(None);
         }
         let Some(i) = self.keys.iter().position(|k| &**k == key) else {
@@ -138,7 +138,7 @@ impl FswIntake {
             ));
         };
         let stream = &self.streams[i];
-        let tick = msg.header().tick;
+        let tick = header.tick;
         if tick > server_tick {
             return Err((
                 "future_tick",
@@ -149,14 +149,13 @@ impl FswIntake {
             ));
         }
         let due_ns = tick.saturating_mul(self.frame_ns);
-        if msg.header().sim_time_ns != due_ns {
+        if header.sim_time_ns != due_ns {
             return Err((
                 "wrong_time",
                 format!(
                     "stream `{}` sample for tick {tick} says sim_time_ns {}, but that tick is at \
                      {due_ns} ns",
-                    stream.name,
-                    msg.header().sim_time_ns
+                    stream.name, header.sim_time_ns
                 ),
             ));
         }
