@@ -125,6 +125,7 @@ pub fn fleet_to<W: Write>(
         total_steps: steps,
         log_steps: every,
         frame_stops: false,
+        start_step: 0,
     };
     let mut sink = FleetRows { out, line, target };
     let rows = walk(&mut world, plan, &mut sink)?;

@@ -18,6 +18,7 @@ use flexdyn_vehicle::config::{config_message, whole_ns, ConfigError, SimConfig};
 
 pub mod campaign;
 pub mod check_config;
+pub mod checkpoint;
 pub mod export;
 pub mod fleet;
 pub mod plot;
@@ -113,6 +114,24 @@ pub enum CliError {
         /// The first non-finite quantity, by its CSV column name.
         quantity: String,
     },
+    /// A checkpoint is refused (damaged, of another version, or not fitting this run).
+    #[error("checkpoint `{}`: {source}", file.display())]
+    Checkpoint {
+        /// The checkpoint file.
+        file: PathBuf,
+        /// Why.
+        #[source]
+        source: flexdyn_vehicle::checkpoint::CheckpointError,
+    },
+    /// Reading an input failed.
+    #[error("cannot read {target}: {source}")]
+    Input {
+        /// What was being read.
+        target: String,
+        /// The I/O error.
+        #[source]
+        source: io::Error,
+    },
     /// Writing the output failed.
     #[error("cannot write {target}: {source}")]
     Output {
@@ -129,7 +148,11 @@ impl CliError {
     /// 1 for a failure while running (output not writable).
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Config { .. } | CliError::Arg { .. } | CliError::Settings(_) => 2,
+            CliError::Config { .. }
+            | CliError::Arg { .. }
+            | CliError::Settings(_)
+            | CliError::Checkpoint { .. }
+            | CliError::Input { .. } => 2,
             CliError::Output { .. } | CliError::NonFinite { .. } => 1,
         }
     }

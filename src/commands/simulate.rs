@@ -5,12 +5,14 @@
 use std::fmt;
 use std::io::Write;
 use std::num::NonZeroU64;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use flexdyn_kernel::numfmt::Num;
 use flexdyn_proto::{command_flags, AppliedWrench, EnvironmentMsg, Header, StateMsg};
 
+use super::checkpoint::{self as ckpt, SaveAt, Source};
 use super::{exit, load, summary, whole_steps, CliError, OfflineRun};
 use flexdyn_sensors::Sensor;
 use flexdyn_server::settings::ServerSettings;
@@ -18,6 +20,7 @@ use flexdyn_sinks::table::{
     first_non_finite_column, prefixed_columns, state_row, Column, CsvTable,
     ENVIRONMENT_COLUMN_PREFIX,
 };
+use flexdyn_vehicle::checkpoint::{Checkpoint, CheckpointHeader};
 use flexdyn_vehicle::config::{log_warnings, SimConfig};
 use flexdyn_vehicle::sim::Simulation;
 use flexdyn_vehicle::world::{walk, RowPlan, RowSink, World};
@@ -41,6 +44,18 @@ pub struct SimulateArgs {
         allow_negative_numbers = true
     )]
     pub log_every_s: f64,
+    /// Write a checkpoint of the run at this simulated time (a frame boundary on which a row
+    /// falls) to `--checkpoint`; the run goes on to the end.
+    #[arg(long, value_name = "SECONDS", requires = "checkpoint")]
+    pub checkpoint_at_s: Option<f64>,
+    /// The checkpoint file `--checkpoint-at-s` writes.
+    #[arg(long, value_name = "FILE", requires = "checkpoint_at_s")]
+    pub checkpoint: Option<PathBuf>,
+    /// Resume from a checkpoint: the run continues from its instant with its configuration
+    /// (or, with `--config`, a compatible other one: a fork) and writes the rows after it,
+    /// bit-identical to the uninterrupted run's. `--duration-s` still counts from t = 0.
+    #[arg(long, value_name = "FILE")]
+    pub resume: Option<PathBuf>,
 }
 
 impl Default for SimulateArgs {
@@ -49,8 +64,20 @@ impl Default for SimulateArgs {
             config: None,
             run: OfflineRun::default(),
             log_every_s: 0.01,
+            checkpoint_at_s: None,
+            checkpoint: None,
+            resume: None,
         }
     }
+}
+
+/// The checkpoints of a `simulate` run: the one it resumes from, the one it writes.
+#[derive(Debug, Default)]
+pub struct Checkpoints<'a> {
+    /// Resume from this checkpoint (read from this file).
+    pub resume: Option<(&'a Checkpoint<'a>, &'a Path)>,
+    /// Write a checkpoint, recording this configuration as the run's source.
+    pub save: Option<(SaveAt, Source)>,
 }
 
 /// What `simulate` did.
@@ -156,6 +183,27 @@ pub fn simulate_to<W: Write>(
     out: W,
     target: &str,
 ) -> Result<SimulateReport, CliError> {
+    simulate_with(
+        cfg,
+        duration_s,
+        log_every_s,
+        out,
+        target,
+        Checkpoints::default(),
+    )
+}
+
+/// [`simulate_to`], resuming from a checkpoint and writing one as `checkpoints` asks. A resumed
+/// run writes the rows after the checkpoint's instant (its comments and header as a whole run
+/// writes them), each bit-identical to the uninterrupted run's.
+pub fn simulate_with<W: Write>(
+    cfg: &SimConfig,
+    duration_s: f64,
+    log_every_s: f64,
+    out: W,
+    target: &str,
+    checkpoints: Checkpoints<'_>,
+) -> Result<SimulateReport, CliError> {
     let total_steps = whole_steps("--duration-s", duration_s, cfg.step_ns, true)?;
     let log_steps = whole_steps("--log-every-s", log_every_s, cfg.step_ns, false)?;
     let mut sim = Simulation::new(cfg).map_err(|source| CliError::Config { file: None, source })?;
@@ -173,6 +221,14 @@ pub fn simulate_to<W: Write>(
     let spacecraft_id = settings.spacecraft_id;
     let steps_per_frame = sim.steps_per_frame();
     let at_frames = sim.sensors().any(|s| !s.every_output());
+    // A world of one, stepped by the offline loop every front end shares; a resumed run's state
+    // is restored before anything is written.
+    let mut world = World::of_one(settings.sc_id, spacecraft_id, sim);
+    let start_step = match checkpoints.resume {
+        Some((c, file)) => resume(c, file, &mut world, log_steps, total_steps)?,
+        None => 0,
+    };
+    let sim = &world.vehicles()[0].sim;
 
     let mut state = sim.blank_state();
     state.command_flags = command_flags::NO_COMMAND_YET;
@@ -215,13 +271,32 @@ pub fn simulate_to<W: Write>(
         last: vec![(None, Vec::new()); sim.sensors().len()],
         table,
         target,
+        save: None,
     };
-    // A world of one, stepped by the offline loop every front end shares.
-    let mut world = World::of_one(settings.sc_id, spacecraft_id, sim);
+    if let Some((at, source)) = checkpoints.save {
+        let step = save_step(&at, cfg, log_steps, total_steps, start_step)?;
+        rows.save = Some((
+            step,
+            CheckpointHeader {
+                front_end: "simulate".into(),
+                source_sha256: CheckpointHeader::digest(&source.text),
+                source_path: source.path,
+                source_text: source.text,
+                tick: step / steps_per_frame.max(1),
+                t_sim_ns: step * cfg.step_ns,
+                step_ns: cfg.step_ns,
+                frame_ns: cfg.frame_ns,
+                row_steps: log_steps,
+                ..CheckpointHeader::default()
+            },
+            at.file,
+        ));
+    }
     let plan = RowPlan {
         total_steps,
         log_steps,
         frame_stops: at_frames,
+        start_step,
     };
     let start = Instant::now();
     let written = walk(&mut world, plan, &mut rows)?;
@@ -229,7 +304,7 @@ pub fn simulate_to<W: Write>(
     rows.table.flush().map_err(io_err)?;
     tracing::debug!(steps = total_steps, rows = written, "simulate done");
     Ok(SimulateReport {
-        steps: total_steps,
+        steps: total_steps - start_step,
         rows: written,
         wall_s,
     })
@@ -250,6 +325,8 @@ struct SimulateRows<'a, W: Write> {
     last: Vec<(Option<u64>, Vec<u8>)>,
     table: CsvTable<W>,
     target: &'a str,
+    /// A checkpoint to write after the row at this step.
+    save: Option<(u64, CheckpointHeader, PathBuf)>,
 }
 
 impl<W: Write> SimulateRows<'_, W> {
@@ -317,20 +394,139 @@ impl<W: Write> RowSink for SimulateRows<'_, W> {
                 quantity: quantity.to_owned(),
             });
         }
-        self.table.write_row(&row).map_err(io_err)
+        self.table.write_row(&row).map_err(io_err)?;
+        if let Some((at, header, file)) = &self.save {
+            if *at == step {
+                ckpt::write(file, header, world)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Restores checkpoint `c` (read from `file`) into `world`, freshly built; the step it is at.
+fn resume(
+    c: &Checkpoint<'_>,
+    file: &Path,
+    world: &mut World,
+    log_steps: u64,
+    total_steps: u64,
+) -> Result<u64, CliError> {
+    c.restore(world).map_err(|e| ckpt::error(file, e))?;
+    let h = &c.header;
+    if h.row_steps != log_steps {
+        return Err(CliError::Arg {
+            flag: "--log-every-s",
+            problem: format!(
+                "the checkpoint's rows fall every {} s; resume with that interval",
+                Num((h.row_steps * h.step_ns) as f64 * 1e-9)
+            ),
+        });
+    }
+    let start_step = h.t_sim_ns / h.step_ns.max(1);
+    if start_step > total_steps {
+        return Err(CliError::Arg {
+            flag: "--duration-s",
+            problem: format!(
+                "the checkpoint is at t = {} s, after the end of the run (the duration counts \
+                 from t = 0)",
+                Num(h.t_sim_ns as f64 * 1e-9)
+            ),
+        });
+    }
+    Ok(start_step)
+}
+
+/// The step of `--checkpoint-at-s`: a whole number of steps, on a row and a frame boundary,
+/// within the run and after a resumed start.
+fn save_step(
+    at: &SaveAt,
+    cfg: &SimConfig,
+    log_steps: u64,
+    total_steps: u64,
+    start_step: u64,
+) -> Result<u64, CliError> {
+    let flag = "--checkpoint-at-s";
+    let step = whole_steps(flag, at.t_s, cfg.step_ns, true)?;
+    let steps_per_frame = (cfg.frame_ns / cfg.step_ns).max(1);
+    let problem = if step > total_steps {
+        Some("is after the end of the run".to_string())
+    } else if step % log_steps != 0 || step % steps_per_frame != 0 {
+        Some(format!(
+            "must fall on a row (every {} s) and a frame boundary (every {} s)",
+            Num((log_steps * cfg.step_ns) as f64 * 1e-9),
+            Num(cfg.frame_ns as f64 * 1e-9)
+        ))
+    } else if start_step > 0 && step <= start_step {
+        Some("must be after the checkpoint this run resumes from".to_string())
+    } else {
+        None
+    };
+    match problem {
+        Some(problem) => Err(CliError::Arg { flag, problem }),
+        None => Ok(step),
     }
 }
 
 /// `flexdyn simulate`: loads the configuration, checks the options, and writes the CSV to the
 /// output file or stdout. The output file is created only once everything else is valid.
 pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
-    let cfg = load(args.config.as_deref())?;
+    // A resumed run: the checkpoint's configuration, or with `--config` another one (a fork).
+    let bytes = match &args.resume {
+        Some(file) => Some(ckpt::read(file)?),
+        None => None,
+    };
+    let resumed = match (&args.resume, &bytes) {
+        (Some(file), Some(b)) => Some((ckpt::parse(file, b, "simulate")?, file.as_path())),
+        _ => None,
+    };
+    let source = match (&resumed, &args.config) {
+        (Some((c, _)), None) => Source {
+            path: c.header.source_path.clone(),
+            text: c.header.source_text.clone(),
+        },
+        _ => Source::of(args.config.as_deref())?,
+    };
+    let cfg = match (&resumed, &args.config) {
+        (Some(_), None) => source.config()?,
+        _ => load(args.config.as_deref())?,
+    };
+    if let Some((c, file)) = &resumed {
+        if CheckpointHeader::digest(&source.text) != c.header.source_sha256 {
+            summary(format_args!(
+                "note: resuming `{}` with a configuration that differs from the one it was \
+                 taken with: a fork",
+                file.display()
+            ));
+        }
+    }
     log_warnings(&cfg, args.config.as_deref());
     // Check the options before creating (and truncating) the output file.
     whole_steps("--duration-s", args.run.duration_s, cfg.step_ns, true)?;
     whole_steps("--log-every-s", args.log_every_s, cfg.step_ns, false)?;
+    let save = match (args.checkpoint_at_s, &args.checkpoint) {
+        (Some(t_s), Some(file)) => Some((
+            SaveAt {
+                t_s,
+                file: file.clone(),
+            },
+            source,
+        )),
+        _ => None,
+    };
     let (out, target) = args.run.open_csv()?;
-    simulate_to(&cfg, args.run.duration_s, args.log_every_s, out, &target)
+    let checkpoints = Checkpoints {
+        resume: resumed.as_ref().map(|(c, f)| (c, *f)),
+        save,
+    };
+    simulate_with(
+        &cfg,
+        args.run.duration_s,
+        args.log_every_s,
+        out,
+        &target,
+        checkpoints,
+    )
 }
 
 /// `flexdyn simulate`: the CSV, then `steps=… wall_s=… steps_per_s=…` on stderr.

@@ -20,6 +20,7 @@ mod campaign_faults;
 mod campaign_fleet_plan;
 mod campaign_plan;
 mod campaign_slurm;
+mod checkpoint;
 mod cli_simulate;
 mod config_errors;
 mod config_fuzz;

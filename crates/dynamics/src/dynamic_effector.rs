@@ -36,6 +36,7 @@ use nalgebra::{Matrix3, Vector3};
 use super::effector::EffectorKind;
 use super::params::Wrench;
 use flexdyn_environment::EnvironmentSample;
+use flexdyn_kernel::archive::Archive;
 
 /// The vehicle at one RK4 stage, as a dynamic effector sees it.
 #[derive(Debug, Clone, Copy)]
@@ -176,4 +177,9 @@ pub trait DynamicEffector: Send + std::fmt::Debug {
     fn outputs(&self, _out: &mut [f64]) -> u32 {
         0
     }
+    /// Lists the effector's mutable state (held inputs, a valve's timing, counters) for a
+    /// checkpoint ([`flexdyn_kernel::archive`]). A value memoised from its inputs (a held Sun
+    /// direction) is not state: it is the same bits when recomputed. Required, so a new kind
+    /// says what it holds. Not on the stepping path.
+    fn archive(&mut self, a: &mut Archive<'_>);
 }

@@ -22,6 +22,7 @@
 
 use std::ops::AddAssign;
 
+use flexdyn_kernel::archive::Archive;
 use nalgebra::{Matrix3, Vector3};
 
 /// Hub kinematics an effector needs for its contributions.
@@ -328,4 +329,9 @@ pub trait StateEffector: Send + std::fmt::Debug {
     fn compute_derivatives(&mut self, x: &[f64], hub_accel: &HubAccel, dx: &mut [f64]);
     /// Energy and momentum contributions at state `x` when the hub rotates at `omega_bn_b`.
     fn energy_momentum(&self, x: &[f64], omega_bn_b: &Vector3<f64>) -> EnergyMomentum;
+    /// Lists the body's mutable state outside the integrated states (held inputs, clipping
+    /// flags) for a checkpoint ([`flexdyn_kernel::archive`]). Geometry cached between the calls
+    /// of one evaluation is not state: every evaluation recomputes it from `x`. Required, so a
+    /// new kind says what it holds. Not on the stepping path.
+    fn archive(&mut self, a: &mut Archive<'_>);
 }

@@ -21,6 +21,7 @@ use super::integrator::{ButcherTableau, Combine, RK4};
 use super::params::{GravityModel, HubParams, Wrench};
 use super::stage_hook::{NoHook, StageCombine, StageHook};
 use flexdyn_environment::EnvironmentSample;
+use flexdyn_kernel::archive::{Archive, Archived};
 use flexdyn_kernel::attitude::{mrp_rate, mrp_switch, mrp_to_dcm, tilde};
 use flexdyn_kernel::validate::{check_finite, ParamError};
 
@@ -949,6 +950,45 @@ impl Spacecraft {
         hook.end_step(&StageCombine::new(method, h));
         mrp_switch(&mut state.sigma_bn);
         self.t_sim_ns += self.step_ns;
+    }
+
+    /// Lists the vehicle's mutable state for a checkpoint ([`flexdyn_kernel::archive`]): the
+    /// time, the integrated state, the applied wrench, the environment sample the dynamic
+    /// effectors read, then each appended body and each dynamic effector in its own section
+    /// (named by kind and name, so a restore into another vehicle stops there). The stage
+    /// buffers are scratch, overwritten by every step. Not on the stepping path.
+    pub fn archive(&mut self, a: &mut Archive<'_>) {
+        a.section("spacecraft", |a| {
+            a.put(&mut self.t_sim_ns);
+            // Named field by field: a new field does not compile until it is listed here.
+            let State {
+                r_bn_n,
+                v_bn_n,
+                sigma_bn,
+                omega_bn_b,
+                effectors,
+            } = &mut self.state;
+            a.put(r_bn_n);
+            a.put(v_bn_n);
+            a.put(sigma_bn);
+            a.put(omega_bn_b);
+            a.expect_count("effector states", effectors.len());
+            a.put(&mut effectors[..]);
+            let eom = &mut self.eom;
+            a.put(&mut eom.force_b_newton);
+            a.put(&mut eom.torque_b_nm);
+            eom.env.archive(a);
+            a.expect_count("appended bodies", eom.effectors.len());
+            for e in &mut eom.effectors {
+                let name = format!("{} {}", e.kind().name, e.name());
+                a.section(&name, |a| e.archive(a));
+            }
+            a.expect_count("dynamic effectors", eom.dynamic.len());
+            for e in &mut eom.dynamic {
+                let name = e.name().to_string();
+                a.section(&name, |a| e.archive(a));
+            }
+        });
     }
 
     /// Chooses the integration method (construction time: it resizes the stage buffers). The

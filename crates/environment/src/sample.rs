@@ -49,3 +49,29 @@ impl Default for EnvironmentSample {
         Self::NONE
     }
 }
+
+impl flexdyn_kernel::archive::Archived for EnvironmentSample {
+    /// Every field, for a checkpoint (a held sample is state: it is what the effectors and the
+    /// sensors read until the next update).
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        // Named field by field: a new field does not compile until it is listed here.
+        let Self {
+            t_sim_ns,
+            b_field_n_t,
+            r_sun_b_n_m,
+            r_moon_b_n_m,
+            shadow_factor,
+            density_kg_m3,
+            wind_n_m_s,
+        } = self;
+        a.section("environment sample", |a| {
+            a.put(t_sim_ns);
+            a.put(b_field_n_t);
+            a.put(r_sun_b_n_m);
+            a.put(r_moon_b_n_m);
+            a.put(shadow_factor);
+            a.put(density_kg_m3);
+            a.put(wind_n_m_s);
+        });
+    }
+}

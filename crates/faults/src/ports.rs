@@ -172,6 +172,30 @@ pub struct Faults {
 }
 
 impl Live {
+    /// A configured fault's state, for a checkpoint (its spec, target and actuator are built
+    /// from the configuration).
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            spec: _,
+            target: _,
+            cleared_from_ns,
+            reported,
+            rng,
+            on,
+            held,
+            held_set,
+            actuator: _,
+        } = self;
+        a.put(cleared_from_ns);
+        a.put(reported);
+        a.put(rng);
+        a.put(on);
+        for channel in held.iter_mut() {
+            a.put(channel);
+        }
+        a.put(held_set);
+    }
+
     /// A fault of `spec` on the vehicle `host`.
     pub(super) fn new(spec: FaultSpec, host: &FaultHost<'_>) -> Result<Self, ConfigError> {
         let actuator = match spec.port {
@@ -261,6 +285,57 @@ impl Faults {
                 Ok(Installed(None))
             }
         }
+    }
+
+    /// Lists the faults' state for a checkpoint: each configured fault's activation, held
+    /// values and generator, the events not yet taken and the counters. A fault injected live
+    /// (by an operator command) is not yet part of a checkpoint: with one installed, a save
+    /// fails with [`ArchiveError::Invalid`](flexdyn_kernel::archive::ArchiveError) naming the
+    /// count (inject it from the configuration's `[[faults]]` instead). Not on the stepping path.
+    pub fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        a.section("faults", |a| {
+            let live = self.live.len() - self.configured;
+            if live > 0 {
+                a.invalid(
+                    "faults injected live (a checkpoint cannot hold them yet)",
+                    live as u64,
+                );
+                return;
+            }
+            a.expect_count("configured faults", self.configured);
+            for l in &mut self.live[..self.configured] {
+                l.archive(a);
+            }
+            let mut n = self.events.len();
+            a.length("fault events not yet taken", &mut n, self.events.capacity());
+            if a.failed() {
+                return;
+            }
+            let mut bytes = Vec::new();
+            let mut restored = Vec::with_capacity(n);
+            for i in 0..n {
+                bytes.clear();
+                if let Some(e) = self.events.get(i) {
+                    flexdyn_proto::encode_into(e, &mut bytes);
+                }
+                a.blob("a fault event", &mut bytes, flexdyn_proto::FAULT_EVENT_LEN);
+                if !a.is_saving() && !a.failed() {
+                    match flexdyn_proto::decode::<FaultEventMsg>(&bytes) {
+                        Ok(e) => restored.push(e),
+                        Err(_) => a.invalid("a fault event that does not decode", i as u64),
+                    }
+                }
+            }
+            if !a.is_saving() && !a.failed() {
+                self.events.clear();
+                self.events.extend(restored);
+            }
+            a.put(&mut self.events_lost);
+            a.put(&mut self.event_seq);
+            a.put(&mut self.last_boundary_ns);
+            a.put(&mut self.active_count);
+            a.put(&mut self.active_bits);
+        });
     }
 
     /// Notes each fault's state at the boundary of tick `k` (time `t_ns`): an event for every

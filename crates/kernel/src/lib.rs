@@ -1,5 +1,7 @@
 //! flexdyn's kernel: what every layer above it shares and nothing of the physics.
 //!
+//! - [`archive`]: a run's mutable state as bytes, listed once per component for both the save
+//!   and the restore of a checkpoint;
 //! - [`attitude`]: the MRP, DCM and quaternion kernels (those of `flexdyn_proto::attitude`, which
 //!   flight code uses without linking the simulator);
 //! - [`numfmt`]: numbers formatted for messages and files;
@@ -16,6 +18,7 @@
 
 #![warn(missing_docs)]
 
+pub mod archive;
 pub mod attitude;
 pub mod numfmt;
 pub mod schema;

@@ -18,6 +18,26 @@ pub struct SensorBank {
 }
 
 impl SensorBank {
+    /// Lists every sensor's mutable state in its own section (named by kind and name), and
+    /// which sensors the last sample took, for a checkpoint. Not on the stepping path.
+    pub fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        a.section("sensors", |a| {
+            a.expect_count("sensors", self.sensors.len());
+            for s in &mut self.sensors {
+                let name = format!("{} {}", s.kind().config_array, s.name());
+                a.section(&name, |a| s.archive(a));
+            }
+            let mut n = self.sampled.len();
+            a.length("sensors sampled last", &mut n, self.sensors.len());
+            self.sampled.resize(n, 0);
+            for i in &mut self.sampled {
+                let mut v = *i as u64;
+                a.put(&mut v);
+                *i = (v as usize).min(self.sensors.len().saturating_sub(1));
+            }
+        });
+    }
+
     /// Every registered kind's sensors of `ctx` ([`SensorBuild`]).
     pub fn new(ctx: &SensorBuild<'_>) -> Result<Self, ConfigError> {
         let mut sensors = Vec::new();

@@ -159,6 +159,11 @@ pub trait Sensor: std::fmt::Debug + Send {
     /// For the kind's own typed views ([`SensorBank::of`]).
     fn as_any(&self) -> &dyn Any;
 
+    /// Lists its mutable state for a checkpoint ([`flexdyn_kernel::archive`]): its random
+    /// generator, its error states, what it holds between samples and its last sample.
+    /// Required, so a new kind says what it holds. Not on the stepping path.
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>);
+
     /// The output channels a fault can transform (`flexdyn_faults`), by name (`gyro`): the
     /// kind's statement of where its value modes apply. None by default (then only `dropout`,
     /// and `validity_off` with [`Self::has_validity`], apply).

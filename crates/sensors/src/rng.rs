@@ -110,6 +110,25 @@ pub struct NormalRng {
     rng: ChaCha8Rng,
 }
 
+impl flexdyn_kernel::archive::Archived for NormalRng {
+    /// The generator's key, stream and position in its stream (ChaCha8's seed, stream id and
+    /// word position): restored, it continues the same sequence from the same word.
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let mut seed = self.rng.get_seed();
+        let mut stream = self.rng.get_stream();
+        let mut word_pos = self.rng.get_word_pos();
+        a.put(&mut seed);
+        a.put(&mut stream);
+        a.put(&mut word_pos);
+        if !a.is_saving() && !a.failed() {
+            let mut rng = ChaCha8Rng::from_seed(seed);
+            rng.set_stream(stream);
+            rng.set_word_pos(word_pos);
+            self.rng = rng;
+        }
+    }
+}
+
 impl NormalRng {
     /// A generator seeded with `seed` (ChaCha8's `seed_from_u64`).
     pub fn new(seed: u64) -> Self {

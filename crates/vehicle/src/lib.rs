@@ -6,6 +6,8 @@
 //!   resolver, checked against the vehicle it builds);
 //! - [`sim`]: one vehicle, the [`sim::Simulation`]: the spacecraft, its schedules and commands, its
 //!   sensor bank sampled from one truth per frame, its fault ports and its environment;
+//! - [`checkpoint`]: a run's complete state at a frame boundary as a versioned, checksummed file's
+//!   bytes, to resume or fork it bit for bit;
 //! - [`world`]: several vehicles on one tick (the fleet file, the world that steps them, relative
 //!   states in a chief's Hill frame).
 //!
@@ -13,10 +15,12 @@
 //! Above every model crate (kernel, environment, dynamics, sensors, faults), which it assembles;
 //! the server, the sinks, the campaigns and the command line sit above it. It must never depend on
 //! them, nor on any I/O stack (`zenoh`, `tokio`, `foxglove`, `plotters`, `mcap`): `.ci/layers`
-//! checks the dependency graph. Reading a configuration file is its only I/O.
+//! checks the dependency graph. Reading a configuration file is its only I/O (a checkpoint is bytes; the front ends write
+//! and read its file).
 
 #![warn(missing_docs)]
 
+pub mod checkpoint;
 pub mod config;
 pub mod sim;
 pub mod world;

@@ -63,6 +63,7 @@ impl DynamicEffector for ConstantTorque {
     fn name(&self) -> &str {
         "constant"
     }
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
     fn add_force_torque(&mut self, _s: &StageState, _e: &EnvironmentSample, sum: &mut Wrench) {
         sum.torque_b_nm += self.0;
     }
@@ -77,6 +78,7 @@ impl DynamicEffector for RampTorque {
     fn name(&self) -> &str {
         "ramp"
     }
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
     fn add_force_torque(&mut self, s: &StageState, _e: &EnvironmentSample, sum: &mut Wrench) {
         sum.torque_b_nm += self.k_nm_s * s.t_s();
     }
@@ -93,6 +95,7 @@ impl DynamicEffector for ForceAtPoint {
     fn name(&self) -> &str {
         "force_at_point"
     }
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
     fn add_force_torque(&mut self, _s: &StageState, _e: &EnvironmentSample, sum: &mut Wrench) {
         sum.force_b_newton += self.force_b_newton;
         sum.torque_b_nm += self.r_pb_b_m.cross(&self.force_b_newton);
@@ -187,6 +190,7 @@ fn the_stage_state_carries_the_flexed_inertia_about_the_centre_of_mass() {
         fn name(&self) -> &str {
             "probe"
         }
+        fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
         fn add_force_torque(&mut self, s: &StageState, _e: &EnvironmentSample, _w: &mut Wrench) {
             *self.0.lock().unwrap() = Some(*s);
         }

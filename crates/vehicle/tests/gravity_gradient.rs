@@ -100,6 +100,7 @@ impl DynamicEffector for Probe {
     fn name(&self) -> &str {
         "probe"
     }
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
     fn add_force_torque(&mut self, s: &StageState, _e: &EnvironmentSample, _w: &mut Wrench) {
         *self.0.lock().unwrap() = Some(*s);
     }
@@ -192,6 +193,7 @@ fn without_the_gradient_force_momentum_about_the_planet_is_not_conserved() {
         fn name(&self) -> &str {
             "torque_only"
         }
+        fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
         fn add_force_torque(&mut self, s: &StageState, _e: &EnvironmentSample, sum: &mut Wrench) {
             sum.torque_b_nm += gravity_gradient::torque_c_b_nm(
                 MU_SMALL,

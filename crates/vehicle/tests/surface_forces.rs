@@ -97,6 +97,7 @@ impl DynamicEffector for Metered {
     fn name(&self) -> &str {
         "metered"
     }
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
     fn add_force_torque(&mut self, s: &StageState, env: &EnvironmentSample, sum: &mut Wrench) {
         let mut own = Wrench::default();
         self.inner.add_force_torque(s, env, &mut own);

@@ -425,6 +425,39 @@ impl EnvironmentModel {
         }
     }
 
+    /// Lists the schedule and the held sample for a checkpoint: the next update time, the
+    /// sample held until then and the request the next update evaluates. Restored into an
+    /// offloaded model, the request is posted to the worker again (its answer is the same bits
+    /// as an evaluation here). The models themselves are configuration. Not on the stepping
+    /// path.
+    pub fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        use flexdyn_kernel::archive::Archived;
+        a.section("environment", |a| {
+            a.put(&mut self.next_update_ns);
+            self.sample.archive(a);
+            let mut has_next = self.next.is_some();
+            a.put(&mut has_next);
+            if has_next {
+                let mut req = self.next.unwrap_or(Request {
+                    t_sim_ns: 0,
+                    r_bn_n_m: Vector3::zeros(),
+                    v_bn_n_m_s: Vector3::zeros(),
+                });
+                a.put(&mut req.t_sim_ns);
+                a.put(&mut req.r_bn_n_m);
+                a.put(&mut req.v_bn_n_m_s);
+                self.next = Some(req);
+            } else {
+                self.next = None;
+            }
+            if !a.is_saving() && !a.failed() {
+                if let (Some(p), Some(req)) = (&self.prefetch, &self.next) {
+                    p.post(req);
+                }
+            }
+        });
+    }
+
     /// Refills the held sample when `t_sim_ns` has reached the next update time (the first call
     /// always updates), and returns it then; `None` while the held sample still stands.
     pub fn update_if_due(

@@ -250,6 +250,22 @@ impl Sensor for CoarseSunSensor {
         self
     }
 
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            cfg: _,
+            cos_fov: _,
+            rng,
+            last:
+                CoarseSunSensorSample {
+                    detector_count,
+                    readings,
+                },
+        } = self;
+        a.put(rng);
+        a.put(detector_count);
+        a.put(readings);
+    }
+
     /// `readings` (one axis per detector, in the output unit).
     fn fault_channels(&self) -> &'static [&'static str] {
         &["readings"]

@@ -265,6 +265,24 @@ impl Sensor for FineSunSensor {
         self
     }
 
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            cfg: _,
+            cos_fov: _,
+            rng,
+            last:
+                FineSunSensorSample {
+                    alpha_rad,
+                    beta_rad,
+                    flags,
+                },
+        } = self;
+        a.put(rng);
+        a.put(alpha_rad);
+        a.put(beta_rad);
+        a.put(flags);
+    }
+
     /// `alpha` and `beta` (rad).
     fn fault_channels(&self) -> &'static [&'static str] {
         &["alpha", "beta"]

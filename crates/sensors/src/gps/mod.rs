@@ -289,6 +289,30 @@ impl Gps {
     }
 }
 
+impl GpsSample {
+    /// Every field, for a checkpoint.
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            valid_sim_time_ns,
+            gps_week,
+            gps_seconds_of_week,
+            r_be_e_m,
+            v_be_e_m_s,
+            r_bn_n_m,
+            v_bn_n_m_s,
+            flags,
+        } = self;
+        a.put(valid_sim_time_ns);
+        a.put(gps_week);
+        a.put(gps_seconds_of_week);
+        a.put(r_be_e_m);
+        a.put(v_be_e_m_s);
+        a.put(r_bn_n_m);
+        a.put(v_bn_n_m_s);
+        a.put(flags);
+    }
+}
+
 impl Sensor for Gps {
     fn kind(&self) -> &'static SensorKind {
         &KIND
@@ -361,6 +385,28 @@ impl Sensor for Gps {
 
     fn as_any(&self) -> &dyn std::any::Any {
         self
+    }
+
+    /// The generator, the latency ring (its slots are indexed by tick), the last sample and
+    /// whether it was published.
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            cfg: _,
+            world: _,
+            frame_ns: _,
+            has_errors: _,
+            rng,
+            ring,
+            last,
+            published,
+        } = self;
+        a.put(rng);
+        a.expect_count("latency slots", ring.len());
+        for s in ring.iter_mut() {
+            s.archive(a);
+        }
+        last.archive(a);
+        a.put(published);
     }
 
     /// The solution's vectors, each in the frame its name ends with; a channel whose frame is

@@ -624,6 +624,60 @@ pub struct Imu {
     accel: Triad,
 }
 
+impl Triad {
+    /// The error states, for a checkpoint.
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            p: _,
+            gain: _,
+            gm_bias,
+            rw_bias,
+            remainder,
+        } = self;
+        a.put(gm_bias);
+        a.put(rw_bias);
+        a.put(remainder);
+    }
+}
+
+impl ImuSample {
+    /// Every field, for a checkpoint.
+    pub(crate) fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            omega_p_rad_s,
+            accel_p_m_s2,
+            dtheta_p_rad,
+            dv_p_m_s,
+            saturation_flags,
+        } = self;
+        a.put(omega_p_rad_s);
+        a.put(accel_p_m_s2);
+        a.put(dtheta_p_rad);
+        a.put(dv_p_m_s);
+        a.put(saturation_flags);
+    }
+}
+
+impl Imu {
+    /// The generator, the sample interval it was last given and both triads' error states, for
+    /// a checkpoint.
+    pub(crate) fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            name: _,
+            seed: _,
+            dcm_pb: _,
+            sample_interval_s,
+            rng,
+            gyro,
+            accel,
+        } = self;
+        a.put(sample_interval_s);
+        a.put(rng);
+        gyro.archive(a);
+        accel.archive(a);
+    }
+}
+
 impl Imu {
     /// Validates `cfg` (errors name `path`, e.g. `imus[0]`), seeds the RNG and draws the initial
     /// Gauss–Markov biases. `sample_interval_s` is the nominal sample interval T_s (> 0).

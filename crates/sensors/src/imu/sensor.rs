@@ -175,6 +175,26 @@ impl Sensor for ImuSensor {
         self
     }
 
+    /// The error model, the Δv and the stage values of the interval under way, where the
+    /// interval started, and the last sample.
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            imu,
+            point: _,
+            dv_p_m_s,
+            stage_f_p_m_s2,
+            interval_start_ns,
+            sigma_bn_start,
+            last,
+        } = self;
+        imu.archive(a);
+        a.put(dv_p_m_s);
+        a.put(stage_f_p_m_s2);
+        a.put(interval_start_ns);
+        a.put(sigma_bn_start);
+        last.archive(a);
+    }
+
     /// `gyro` (ω, rad/s), `accel` (specific force, m/s²), `dtheta` (Δθ, rad), `dv` (Δv, m/s),
     /// each in P.
     fn fault_channels(&self) -> &'static [&'static str] {

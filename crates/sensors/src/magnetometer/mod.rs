@@ -265,6 +265,22 @@ impl Sensor for Magnetometer {
         self
     }
 
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            cfg: _,
+            gain_sb: _,
+            rng,
+            last:
+                MagnetometerSample {
+                    b_s_t,
+                    saturation_flags,
+                },
+        } = self;
+        a.put(rng);
+        a.put(b_s_t);
+        a.put(saturation_flags);
+    }
+
     /// `field` (B in S, T).
     fn fault_channels(&self) -> &'static [&'static str] {
         &["field"]

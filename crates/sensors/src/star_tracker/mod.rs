@@ -407,6 +407,27 @@ impl Sensor for StarTracker {
         self
     }
 
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            cfg: _,
+            e1_c: _,
+            e2_c: _,
+            rng,
+            held_q_cn,
+            last:
+                StarTrackerSample {
+                    q_cn,
+                    valid,
+                    status_flags,
+                },
+        } = self;
+        a.put(rng);
+        a.put(held_q_cn);
+        a.put(q_cn);
+        a.put(valid);
+        a.put(status_flags);
+    }
+
     /// `q` (q_CN, scalar first; a fault's transform is not renormalised).
     fn fault_channels(&self) -> &'static [&'static str] {
         &["q"]

@@ -11,6 +11,7 @@
 //! from one [`Truth`], and the IMUs integrate their Δv over the integrator's stages (the bank is
 //! the step's [`flexdyn_dynamics::stage_hook::StageHook`]).
 
+mod archive;
 mod sensor_views;
 
 use std::num::NonZeroU64;

@@ -19,12 +19,27 @@ pub struct RowPlan {
     /// Whether to stop at every frame boundary between the rows too ([`RowSink::frame`]): a
     /// sensor sampled at frame boundaries (a star tracker) samples where a server would.
     pub frame_stops: bool,
+    /// The step the world is at when the walk begins: 0 for a run from t = 0, or a resumed
+    /// checkpoint's. A resumed walk stops only after it: its rows are the multiples of
+    /// `log_steps` beyond it, its frame stops the boundaries beyond it (what fell on it was
+    /// written before the checkpoint).
+    pub start_step: u64,
 }
 
 impl RowPlan {
-    /// Rows the plan writes: one at step 0 and one per whole log interval.
+    /// Rows the plan writes: one at step 0 and one per whole log interval (from a resumed
+    /// start, those beyond it).
     pub fn rows(&self) -> u64 {
-        self.total_steps / self.log_steps.max(1) + 1
+        (self.total_steps / self.log_steps.max(1) + 1).saturating_sub(self.first_row())
+    }
+
+    /// The index of the first row the walk writes.
+    fn first_row(&self) -> u64 {
+        if self.start_step == 0 {
+            0
+        } else {
+            self.start_step / self.log_steps.max(1) + 1
+        }
     }
 }
 
@@ -50,11 +65,11 @@ pub fn walk<S: RowSink>(world: &mut World, plan: RowPlan, sink: &mut S) -> Resul
     let log_steps = plan.log_steps.max(1);
     let steps_per_frame = world.steps_per_frame().max(1);
     let n_logged = plan.total_steps / log_steps;
-    let mut step = 0u64;
-    if plan.frame_stops {
+    let mut step = plan.start_step;
+    if plan.frame_stops && step == 0 {
         sink.frame(world, 0);
     }
-    for k in 0..=n_logged {
+    for k in plan.first_row()..=n_logged {
         // Step to the row, stopping at each frame boundary when the plan asks for it.
         let row_step = k * log_steps;
         while step < row_step {
@@ -72,8 +87,8 @@ pub fn walk<S: RowSink>(world: &mut World, plan: RowPlan, sink: &mut S) -> Resul
         sink.row(world, k, step)?;
     }
     // Steps after the last multiple of the log interval, up to the duration.
-    world.step_n(plan.total_steps - step);
-    Ok(n_logged + 1)
+    world.step_n(plan.total_steps.saturating_sub(step));
+    Ok(plan.rows())
 }
 
 #[cfg(test)]
@@ -123,6 +138,7 @@ mod tests {
             total_steps: 25,
             log_steps: 7,
             frame_stops: false,
+            start_step: 0,
         };
         assert_eq!(walk(&mut w, plan, &mut s), Ok(4));
         assert_eq!(plan.rows(), 4);
@@ -144,10 +160,32 @@ mod tests {
             total_steps: 25,
             log_steps: 7,
             frame_stops: true,
+            start_step: 0,
         };
         assert_eq!(walk(&mut w, plan, &mut s), Ok(4));
         assert_eq!(s.frames, [0, 10, 20]);
         assert_eq!(s.rows.len(), 4);
+        assert_eq!(w.t_sim_ns(), 25_000_000);
+    }
+
+    #[test]
+    fn a_resumed_walk_stops_only_after_its_start() {
+        // Resumed at step 14 (a row and not a frame boundary): rows at 21 only (14 was written
+        // before the checkpoint), frame stops at 20 only; then the tail to 25.
+        let mut w = world();
+        w.step_n(14);
+        let mut s = Stops::default();
+        let plan = RowPlan {
+            total_steps: 25,
+            log_steps: 7,
+            frame_stops: true,
+            start_step: 14,
+        };
+        assert_eq!(plan.rows(), 1);
+        assert_eq!(walk(&mut w, plan, &mut s), Ok(1));
+        assert_eq!(s.frames, [20]);
+        let at: Vec<(u64, u64)> = s.rows.iter().map(|r| (r.0, r.1)).collect();
+        assert_eq!(at, [(3, 21)]);
         assert_eq!(w.t_sim_ns(), 25_000_000);
     }
 
@@ -159,6 +197,7 @@ mod tests {
             total_steps: 1000,
             log_steps: 1,
             frame_stops: false,
+            start_step: 0,
         };
         assert_eq!(walk(&mut w, plan, &mut s), Err(()));
         assert_eq!(s.rows.len(), 100);

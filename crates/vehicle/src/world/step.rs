@@ -176,6 +176,19 @@ impl World {
         }
     }
 
+    /// Lists every vehicle's mutable state, each in a section named by its id, for a
+    /// checkpoint ([`crate::checkpoint`]). The shared environment part is a cache (the same bits
+    /// whoever fills it) and is not listed. Not on the stepping path.
+    pub fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        a.section("world", |a| {
+            a.expect_count("vehicles", self.vehicles.len());
+            for v in &mut self.vehicles {
+                let name = format!("vehicle {}", v.id);
+                a.section(&name, |a| v.sim.archive(a));
+            }
+        });
+    }
+
     /// The (chief, deputy) pairs of the fleet file's `relative` tables.
     pub fn relative_pairs(&self) -> &[(usize, usize)] {
         &self.pairs

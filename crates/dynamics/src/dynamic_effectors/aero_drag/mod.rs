@@ -54,4 +54,7 @@ impl DynamicEffector for AeroDrag {
     fn parameters(&self, out: &mut Vec<(String, f64)>) {
         self.facets.parameters(out);
     }
+
+    /// Nothing: its parameters are configuration (a held Sun is memoised from its inputs).
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
 }

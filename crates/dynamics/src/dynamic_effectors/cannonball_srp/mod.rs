@@ -65,4 +65,7 @@ impl DynamicEffector for CannonballSrp {
             self.irradiance_1au_w_m2,
         ));
     }
+
+    /// Nothing: its parameters are configuration (a held Sun is memoised from its inputs).
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
 }

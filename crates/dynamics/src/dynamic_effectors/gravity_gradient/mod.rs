@@ -146,6 +146,9 @@ impl DynamicEffector for GravityGradient {
         sum.force_b_newton += force;
         sum.torque_b_nm += torque_c + c.cross(&force);
     }
+
+    /// Nothing: its parameters are configuration (a held Sun is memoised from its inputs).
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
 }
 
 #[cfg(test)]

@@ -163,6 +163,18 @@ impl DynamicEffector for Magnetorquer {
             0
         }
     }
+
+    /// The held dipole and its saturation flag.
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            params: _,
+            path: _,
+            dipole_am2,
+            saturated,
+        } = self;
+        a.put(dipole_am2);
+        a.put(saturated);
+    }
 }
 
 #[cfg(test)]

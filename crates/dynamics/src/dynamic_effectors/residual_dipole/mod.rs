@@ -46,4 +46,7 @@ impl DynamicEffector for ResidualDipole {
             ));
         }
     }
+
+    /// Nothing: its parameters are configuration (a held Sun is memoised from its inputs).
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
 }

@@ -128,4 +128,7 @@ impl DynamicEffector for SolarPressure {
             self.irradiance_1au_w_m2,
         ));
     }
+
+    /// Nothing: its parameters are configuration (a held Sun is memoised from its inputs).
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
 }

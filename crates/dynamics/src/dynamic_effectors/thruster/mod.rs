@@ -403,6 +403,51 @@ impl DynamicEffector for Thruster {
         out[3] = self.impulse_n_s;
         self.command_flags | if self.step.open_at_start { FIRING } else { 0 }
     }
+
+    /// The held on-time and its flags, the valve and the thrust lag's state, the step's thrust
+    /// and the counters.
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        // Named field by field: a new field does not compile until it is listed here or marked
+        // as configuration (`_`).
+        let Self {
+            params: _,
+            path: _,
+            frame_ns: _,
+            step_ns: _,
+            min_on_ns: _,
+            on_ns,
+            command_flags,
+            kappa,
+            t_anchor_ns,
+            valve_open,
+            step:
+                StepThrust {
+                    t_end_ns,
+                    kappa_end,
+                    kappa_integral_s,
+                    opens,
+                    open_at_end,
+                    open_at_start,
+                },
+            force_avg_newton,
+            pulse_count,
+            impulse_n_s,
+        } = self;
+        a.put(on_ns);
+        a.put(command_flags);
+        a.put(kappa);
+        a.put(t_anchor_ns);
+        a.put(valve_open);
+        a.put(t_end_ns);
+        a.put(kappa_end);
+        a.put(kappa_integral_s);
+        a.put(opens);
+        a.put(open_at_end);
+        a.put(open_at_start);
+        a.put(force_avg_newton);
+        a.put(pulse_count);
+        a.put(impulse_n_s);
+    }
 }
 
 #[cfg(test)]

@@ -609,4 +609,9 @@ impl StateEffector for PanelChain {
         });
         em
     }
+
+    /// The held hinge-motor torques; the per-link work arrays are recomputed from `x`.
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        a.put(&mut self.motor_torque_nm[..]);
+    }
 }

@@ -547,4 +547,7 @@ impl StateEffector for PanelPair {
             + 0.5 * p.panel2.k_nm_rad * x[THETA2] * x[THETA2];
         em
     }
+
+    /// Nothing beyond the integrated states: the cached geometry is recomputed from `x`.
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
 }

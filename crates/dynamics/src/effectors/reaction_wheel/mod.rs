@@ -346,4 +346,30 @@ impl StateEffector for ReactionWheel {
             omega_bn_b,
         )
     }
+
+    /// The held command, the torque applied after clipping this step, its flags and the spin
+    /// torque.
+    fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        // Named field by field: a new field does not compile until it is listed here or marked
+        // as configuration (`_`).
+        let Self {
+            params: _,
+            g_s: _,
+            g_2: _,
+            g_3: _,
+            first_moment_b: _,
+            inertia_w_b: _,
+            inertia_pnt_b_b: _,
+            matrix_d: _,
+            imbalanced: _,
+            commanded_nm,
+            applied_nm,
+            flags,
+            spin_torque_nm,
+        } = self;
+        a.put(commanded_nm);
+        a.put(applied_nm);
+        a.put(flags);
+        a.put(spin_torque_nm);
+    }
 }

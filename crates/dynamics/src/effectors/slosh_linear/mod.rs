@@ -211,4 +211,7 @@ impl StateEffector for SloshLinear {
         em.potential_j = 0.5 * p.k_n_m * x[RHO] * x[RHO];
         em
     }
+
+    /// Nothing beyond the integrated states: the cached geometry is recomputed from `x`.
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
 }

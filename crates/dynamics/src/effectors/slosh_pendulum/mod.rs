@@ -312,4 +312,7 @@ impl StateEffector for SloshPendulum {
         let g = self.geometry(x);
         EnergyMomentum::point_mass(self.params.mass_kg, &g.r, &g.r_prime, omega_bn_b)
     }
+
+    /// Nothing beyond the integrated states: the cached geometry is recomputed from `x`.
+    fn archive(&mut self, _a: &mut flexdyn_kernel::archive::Archive<'_>) {}
 }
