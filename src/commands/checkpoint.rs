@@ -5,7 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
-use super::CliError;
+use super::{whole_steps, CliError};
+use flexdyn_kernel::numfmt::Num;
 use flexdyn_vehicle::checkpoint::{self, Checkpoint, CheckpointError, CheckpointHeader};
 use flexdyn_vehicle::config::{SimConfig, DEFAULT_CONFIG_TOML};
 use flexdyn_vehicle::world::World;
@@ -111,4 +112,69 @@ pub fn write(file: &Path, header: &CheckpointHeader, world: &mut World) -> Resul
     let part = PathBuf::from(part);
     std::fs::write(&part, &bytes).map_err(output)?;
     std::fs::rename(&part, file).map_err(output)
+}
+
+/// Restores checkpoint `c` (read from `file`) into `world`, freshly built; the step it is at.
+pub(crate) fn resume(
+    c: &Checkpoint<'_>,
+    file: &Path,
+    world: &mut World,
+    log_steps: u64,
+    total_steps: u64,
+) -> Result<u64, CliError> {
+    c.restore(world).map_err(|e| error(file, e))?;
+    let h = &c.header;
+    if h.row_steps != log_steps {
+        return Err(CliError::Arg {
+            flag: "--log-every-s",
+            problem: format!(
+                "the checkpoint's rows fall every {} s; resume with that interval",
+                Num((h.row_steps * h.step_ns) as f64 * 1e-9)
+            ),
+        });
+    }
+    let start_step = h.t_sim_ns / h.step_ns.max(1);
+    if start_step > total_steps {
+        return Err(CliError::Arg {
+            flag: "--duration-s",
+            problem: format!(
+                "the checkpoint is at t = {} s, after the end of the run (the duration counts \
+                 from t = 0)",
+                Num(h.t_sim_ns as f64 * 1e-9)
+            ),
+        });
+    }
+    Ok(start_step)
+}
+
+/// The step of `--checkpoint-at-s`: a whole number of steps, on a row and a frame boundary,
+/// within the run and after a resumed start.
+pub(crate) fn save_step(
+    at: &SaveAt,
+    step_ns: u64,
+    frame_ns: u64,
+    log_steps: u64,
+    total_steps: u64,
+    start_step: u64,
+) -> Result<u64, CliError> {
+    let flag = "--checkpoint-at-s";
+    let step = whole_steps(flag, at.t_s, step_ns, true)?;
+    let steps_per_frame = (frame_ns / step_ns).max(1);
+    let problem = if step > total_steps {
+        Some("is after the end of the run".to_string())
+    } else if step % log_steps != 0 || step % steps_per_frame != 0 {
+        Some(format!(
+            "must fall on a row (every {} s) and a frame boundary (every {} s)",
+            Num((log_steps * step_ns) as f64 * 1e-9),
+            Num(frame_ns as f64 * 1e-9)
+        ))
+    } else if start_step > 0 && step <= start_step {
+        Some("must be after the checkpoint this run resumes from".to_string())
+    } else {
+        None
+    };
+    match problem {
+        Some(problem) => Err(CliError::Arg { flag, problem }),
+        None => Ok(step),
+    }
 }

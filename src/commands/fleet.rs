@@ -18,7 +18,9 @@ use nalgebra::Vector3;
 
 use std::process::ExitCode;
 
+use super::checkpoint::{self as ckpt, SaveAt, Source};
 use super::{exit, summary, whole_steps, CliError, OfflineRun};
+use flexdyn_vehicle::checkpoint::CheckpointHeader;
 use flexdyn_vehicle::world::relative::com_state_n;
 use flexdyn_vehicle::world::{walk, FleetConfig, FleetError, RowPlan, RowSink, World};
 
@@ -39,6 +41,18 @@ pub struct FleetArgs {
         allow_negative_numbers = true
     )]
     pub log_every_s: f64,
+    /// Write a checkpoint of every vehicle at this simulated time (a row instant and a frame
+    /// boundary) to `--checkpoint`; the run goes on to the end.
+    #[arg(long, value_name = "SECONDS", requires = "checkpoint")]
+    pub checkpoint_at_s: Option<f64>,
+    /// The checkpoint file `--checkpoint-at-s` writes.
+    #[arg(long, value_name = "FILE", requires = "checkpoint_at_s")]
+    pub checkpoint: Option<PathBuf>,
+    /// Resume from a checkpoint of this fleet (a fleet file that differs from the one it was
+    /// taken with is a fork): the rows after its instant, bit-identical to the uninterrupted
+    /// run's. `--duration-s` still counts from t = 0.
+    #[arg(long, value_name = "FILE")]
+    pub resume: Option<PathBuf>,
 }
 
 /// An error of `flexdyn fleet`.
@@ -97,8 +111,53 @@ pub fn fleet_to<W: Write>(
 ) -> Result<FleetReport, FleetRunError> {
     let mut world = World::new(fleet)?;
     let step_ns = fleet.vehicles[0].cfg.step_ns;
+    let frame_ns = fleet.vehicles[0].cfg.frame_ns;
     let steps = whole_steps("--duration-s", args.run.duration_s, step_ns, true)?;
     let every = whole_steps("--log-every-s", args.log_every_s, step_ns, false)?;
+    // A resumed run's state is restored before anything is written.
+    let bytes = args.resume.as_deref().map(ckpt::read).transpose()?;
+    let start_step = match (args.resume.as_deref(), &bytes) {
+        (Some(file), Some(b)) => {
+            let c = ckpt::parse(file, b, "fleet")?;
+            let text = Source::of(Some(&args.fleet))?.text;
+            if CheckpointHeader::digest(&text) != c.header.source_sha256 {
+                summary(format_args!(
+                    "note: resuming `{}` with a fleet file that differs from the one it was \
+                     taken with: a fork",
+                    file.display()
+                ));
+            }
+            ckpt::resume(&c, file, &mut world, every, steps)?
+        }
+        _ => 0,
+    };
+    let save = match (args.checkpoint_at_s, &args.checkpoint) {
+        (Some(t_s), Some(file)) => {
+            let at = SaveAt {
+                t_s,
+                file: file.clone(),
+            };
+            let step = ckpt::save_step(&at, step_ns, frame_ns, every, steps, start_step)?;
+            let source = Source::of(Some(&args.fleet))?;
+            Some((
+                step,
+                CheckpointHeader {
+                    front_end: "fleet".into(),
+                    source_sha256: CheckpointHeader::digest(&source.text),
+                    source_path: source.path,
+                    source_text: source.text,
+                    tick: step / world.steps_per_frame().max(1),
+                    t_sim_ns: step * step_ns,
+                    step_ns,
+                    frame_ns,
+                    row_steps: every,
+                    ..CheckpointHeader::default()
+                },
+                at.file,
+            ))
+        }
+        _ => None,
+    };
     let mut line = String::from("t_s");
     for v in world.vehicles() {
         for q in ["r_cn_n_m", "v_cn_n_m_s"] {
@@ -125,14 +184,19 @@ pub fn fleet_to<W: Write>(
         total_steps: steps,
         log_steps: every,
         frame_stops: false,
-        start_step: 0,
+        start_step,
     };
-    let mut sink = FleetRows { out, line, target };
+    let mut sink = FleetRows {
+        out,
+        line,
+        target,
+        save,
+    };
     let rows = walk(&mut world, plan, &mut sink)?;
     sink.out.flush().map_err(|e| output_err(target, e))?;
     Ok(FleetReport {
         vehicles: world.vehicles().len(),
-        steps,
+        steps: steps - start_step,
         rows,
     })
 }
@@ -143,17 +207,27 @@ struct FleetRows<'a, W: Write> {
     /// The row's text, reused row to row.
     line: String,
     target: &'a str,
+    /// A checkpoint to write after the row at this step.
+    save: Option<(u64, CheckpointHeader, PathBuf)>,
 }
 
 impl<W: Write> RowSink for FleetRows<'_, W> {
     type Error = FleetRunError;
 
-    fn row(&mut self, world: &mut World, _k: u64, _step: u64) -> Result<(), FleetRunError> {
+    fn row(&mut self, world: &mut World, _k: u64, step: u64) -> Result<(), FleetRunError> {
         self.line.clear();
         row(world, &mut self.line);
         self.out
             .write_all(self.line.as_bytes())
-            .map_err(|e| output_err(self.target, e))
+            .map_err(|e| output_err(self.target, e))?;
+        if let Some((at, header, file)) = &self.save {
+            if *at == step {
+                // Everything written so far reaches the file before the checkpoint does.
+                self.out.flush().map_err(|e| output_err(self.target, e))?;
+                ckpt::write(file, header, world)?;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -221,6 +295,9 @@ mod tests {
                 output: None,
             },
             log_every_s: 0.1,
+            checkpoint_at_s: None,
+            checkpoint: None,
+            resume: None,
         };
         let mut csv = Vec::new();
         let report = fleet_to(&fleet, &args, "memory", &mut csv).unwrap();

@@ -9,7 +9,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use flexdyn_kernel::numfmt::Num;
 use flexdyn_proto::{command_flags, AppliedWrench, EnvironmentMsg, Header, StateMsg};
 
 use super::checkpoint::{self as ckpt, SaveAt, Source};
@@ -225,7 +224,7 @@ pub fn simulate_with<W: Write>(
     // is restored before anything is written.
     let mut world = World::of_one(settings.sc_id, spacecraft_id, sim);
     let start_step = match checkpoints.resume {
-        Some((c, file)) => resume(c, file, &mut world, log_steps, total_steps)?,
+        Some((c, file)) => ckpt::resume(c, file, &mut world, log_steps, total_steps)?,
         None => 0,
     };
     let sim = &world.vehicles()[0].sim;
@@ -274,7 +273,14 @@ pub fn simulate_with<W: Write>(
         save: None,
     };
     if let Some((at, source)) = checkpoints.save {
-        let step = save_step(&at, cfg, log_steps, total_steps, start_step)?;
+        let step = ckpt::save_step(
+            &at,
+            cfg.step_ns,
+            cfg.frame_ns,
+            log_steps,
+            total_steps,
+            start_step,
+        )?;
         rows.save = Some((
             step,
             CheckpointHeader {
@@ -401,70 +407,6 @@ impl<W: Write> RowSink for SimulateRows<'_, W> {
             }
         }
         Ok(())
-    }
-}
-
-/// Restores checkpoint `c` (read from `file`) into `world`, freshly built; the step it is at.
-fn resume(
-    c: &Checkpoint<'_>,
-    file: &Path,
-    world: &mut World,
-    log_steps: u64,
-    total_steps: u64,
-) -> Result<u64, CliError> {
-    c.restore(world).map_err(|e| ckpt::error(file, e))?;
-    let h = &c.header;
-    if h.row_steps != log_steps {
-        return Err(CliError::Arg {
-            flag: "--log-every-s",
-            problem: format!(
-                "the checkpoint's rows fall every {} s; resume with that interval",
-                Num((h.row_steps * h.step_ns) as f64 * 1e-9)
-            ),
-        });
-    }
-    let start_step = h.t_sim_ns / h.step_ns.max(1);
-    if start_step > total_steps {
-        return Err(CliError::Arg {
-            flag: "--duration-s",
-            problem: format!(
-                "the checkpoint is at t = {} s, after the end of the run (the duration counts \
-                 from t = 0)",
-                Num(h.t_sim_ns as f64 * 1e-9)
-            ),
-        });
-    }
-    Ok(start_step)
-}
-
-/// The step of `--checkpoint-at-s`: a whole number of steps, on a row and a frame boundary,
-/// within the run and after a resumed start.
-fn save_step(
-    at: &SaveAt,
-    cfg: &SimConfig,
-    log_steps: u64,
-    total_steps: u64,
-    start_step: u64,
-) -> Result<u64, CliError> {
-    let flag = "--checkpoint-at-s";
-    let step = whole_steps(flag, at.t_s, cfg.step_ns, true)?;
-    let steps_per_frame = (cfg.frame_ns / cfg.step_ns).max(1);
-    let problem = if step > total_steps {
-        Some("is after the end of the run".to_string())
-    } else if step % log_steps != 0 || step % steps_per_frame != 0 {
-        Some(format!(
-            "must fall on a row (every {} s) and a frame boundary (every {} s)",
-            Num((log_steps * cfg.step_ns) as f64 * 1e-9),
-            Num(cfg.frame_ns as f64 * 1e-9)
-        ))
-    } else if start_step > 0 && step <= start_step {
-        Some("must be after the checkpoint this run resumes from".to_string())
-    } else {
-        None
-    };
-    match problem {
-        Some(problem) => Err(CliError::Arg { flag, problem }),
-        None => Ok(step),
     }
 }
 

@@ -347,3 +347,67 @@ fn a_damaged_foreign_or_mismatched_checkpoint_is_refused_naming_file_and_reason(
         "{e}"
     );
 }
+
+#[test]
+fn a_resumed_fleet_writes_the_uninterrupted_rows_bit_for_bit() {
+    // Two LEO spacecraft with their environments (sharing the Earth's orientation, the Sun and
+    // the Moon), the deputy relative to the chief: checkpoint at 7.5 s, resume, compare.
+    let scenarios = format!("{}/scenarios/", env!("CARGO_MANIFEST_DIR"));
+    let fleet = scratch("leo_pair.toml");
+    let text = flexdyn_testkit::fleets::LEO_PAIR.replace(
+        "spacecraft_file = \"",
+        &format!("spacecraft_file = \"{scenarios}"),
+    );
+    std::fs::write(&fleet, text).unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (full, resumed, ckpt) = (
+        scratch("fleet-full.csv"),
+        scratch("fleet-resumed.csv"),
+        scratch("fleet.ckpt"),
+    );
+    let (fl, fu, re, ck) = (s(&fleet), s(&full), s(&resumed), s(&ckpt));
+    let base = ["fleet", &fl, "--duration-s", "12", "--log-every-s", "0.5"];
+    let mut first = base.to_vec();
+    first.extend(["-o", &fu, "--checkpoint-at-s", "7.5", "--checkpoint", &ck]);
+    ok(&flexdyn(&first), "the fleet run that writes the checkpoint");
+    let mut second = base.to_vec();
+    second.extend(["-o", &re, "--resume", &ck]);
+    ok(&flexdyn(&second), "the resumed fleet");
+    let a = std::fs::read_to_string(&full).unwrap();
+    let b = std::fs::read_to_string(&resumed).unwrap();
+    let (a_lines, b_lines): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
+    assert_eq!(a_lines[0], b_lines[0], "header");
+    let after: Vec<&str> = a_lines[1..]
+        .iter()
+        .copied()
+        .filter(|l| l.split(',').next().unwrap().parse::<f64>().unwrap() > 7.5)
+        .collect();
+    assert_eq!(after.len(), 9, "rows at 8, 8.5, …, 12 s");
+    assert_eq!(&b_lines[1..], &after[..]);
+    // A simulate checkpoint is not a fleet's.
+    let single = scratch("single.ckpt");
+    ok(
+        &flexdyn(&[
+            "simulate",
+            "--duration-s",
+            "1",
+            "-o",
+            &s(&scratch("single.csv")),
+            "--checkpoint-at-s",
+            "0.5",
+            "--checkpoint",
+            &s(&single),
+        ]),
+        "a simulate checkpoint",
+    );
+    let mut wrong = base.to_vec();
+    let si = s(&single);
+    wrong.extend(["-o", "-", "--resume", &si]);
+    let o = flexdyn(&wrong);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("the front end `simulate`; this run has `fleet`"),
+        "{err}"
+    );
+}
