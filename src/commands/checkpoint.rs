@@ -38,15 +38,18 @@ impl Source {
                 text: DEFAULT_CONFIG_TOML.to_string(),
             }),
             Some(p) => {
-                let text = std::fs::read_to_string(p).map_err(|source| CliError::Config {
+                let io = |source| CliError::Config {
                     file: Some(p.to_path_buf()),
                     source: flexdyn_vehicle::config::ConfigError::Io {
                         path: p.to_path_buf(),
                         source,
                     },
-                })?;
+                };
+                let text = std::fs::read_to_string(p).map_err(io)?;
+                // Absolute, so a resume from another directory finds the files it names.
+                let path = std::fs::canonicalize(p).map_err(io)?;
                 Ok(Self {
-                    path: p.display().to_string(),
+                    path: path.display().to_string(),
                     text,
                 })
             }
@@ -124,6 +127,16 @@ pub(crate) fn resume(
 ) -> Result<u64, CliError> {
     c.restore(world).map_err(|e| error(file, e))?;
     let h = &c.header;
+    if world.t_sim_ns() != h.t_sim_ns || h.t_sim_ns == 0 {
+        return Err(error(
+            file,
+            CheckpointError::Mismatch {
+                what: "its header at t =",
+                checkpoint: format!("{} ns", h.t_sim_ns),
+                run: format!("its state at t = {} ns", world.t_sim_ns()),
+            },
+        ));
+    }
     if h.row_steps != log_steps {
         return Err(CliError::Arg {
             flag: "--log-every-s",
@@ -160,7 +173,9 @@ pub(crate) fn save_step(
     let flag = "--checkpoint-at-s";
     let step = whole_steps(flag, at.t_s, step_ns, true)?;
     let steps_per_frame = (frame_ns / step_ns).max(1);
-    let problem = if step > total_steps {
+    let problem = if step == 0 {
+        Some("must be after t = 0 (a run from t = 0 is its configuration)".to_string())
+    } else if step > total_steps {
         Some("is after the end of the run".to_string())
     } else if step % log_steps != 0 || step % steps_per_frame != 0 {
         Some(format!(
@@ -168,7 +183,7 @@ pub(crate) fn save_step(
             Num((log_steps * step_ns) as f64 * 1e-9),
             Num(frame_ns as f64 * 1e-9)
         ))
-    } else if start_step > 0 && step <= start_step {
+    } else if step <= start_step {
         Some("must be after the checkpoint this run resumes from".to_string())
     } else {
         None

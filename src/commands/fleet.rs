@@ -91,8 +91,10 @@ pub struct FleetReport {
 /// Runs `flexdyn fleet`.
 pub fn fleet(args: &FleetArgs) -> Result<FleetReport, FleetRunError> {
     let fleet = FleetConfig::from_file(&args.fleet)?;
-    let (out, target) = args.run.open_csv().map_err(FleetRunError::Cli)?;
-    fleet_to(&fleet, args, &target, io::BufWriter::new(out))
+    fleet_with(&fleet, args, || {
+        let (out, target) = args.run.open_csv()?;
+        Ok((io::BufWriter::new(out), target))
+    })
 }
 
 fn output_err(target: &str, source: io::Error) -> FleetRunError {
@@ -107,7 +109,17 @@ pub fn fleet_to<W: Write>(
     fleet: &FleetConfig,
     args: &FleetArgs,
     target: &str,
-    mut out: W,
+    out: W,
+) -> Result<FleetReport, FleetRunError> {
+    fleet_with(fleet, args, || Ok((out, target.to_string())))
+}
+
+/// [`fleet_to`], with the output given by `open` (the CSV and its name for errors), called once
+/// the options and the checkpoints are checked: a refused run never creates or truncates it.
+pub fn fleet_with<W: Write>(
+    fleet: &FleetConfig,
+    args: &FleetArgs,
+    open: impl FnOnce() -> Result<(W, String), CliError>,
 ) -> Result<FleetReport, FleetRunError> {
     let mut world = World::new(fleet)?;
     let step_ns = fleet.vehicles[0].cfg.step_ns;
@@ -176,6 +188,9 @@ pub fn fleet_to<W: Write>(
         let _ = write!(line, ",{pair}_range_m,{pair}_range_rate_m_s");
     }
     line.push('\n');
+    // Everything is checked: only now is the output created.
+    let (mut out, target) = open()?;
+    let target = target.as_str();
     out.write_all(line.as_bytes())
         .map_err(|e| output_err(target, e))?;
     // The offline loop every front end shares: a row at t = 0 and at every whole log

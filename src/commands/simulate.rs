@@ -186,21 +186,21 @@ pub fn simulate_to<W: Write>(
         cfg,
         duration_s,
         log_every_s,
-        out,
-        target,
+        || Ok((out, target.to_string())),
         Checkpoints::default(),
     )
 }
 
 /// [`simulate_to`], resuming from a checkpoint and writing one as `checkpoints` asks. A resumed
 /// run writes the rows after the checkpoint's instant (its comments and header as a whole run
-/// writes them), each bit-identical to the uninterrupted run's.
+/// writes them), each bit-identical to the uninterrupted run's. `open` gives the output and its
+/// name for errors; it is called once every option, the configuration and the checkpoints have
+/// been checked, so a refused run never creates or truncates its output.
 pub fn simulate_with<W: Write>(
     cfg: &SimConfig,
     duration_s: f64,
     log_every_s: f64,
-    out: W,
-    target: &str,
+    open: impl FnOnce() -> Result<(W, String), CliError>,
     checkpoints: Checkpoints<'_>,
 ) -> Result<SimulateReport, CliError> {
     let total_steps = whole_steps("--duration-s", duration_s, cfg.step_ns, true)?;
@@ -210,10 +210,6 @@ pub fn simulate_with<W: Write>(
     if let Some(ns) = NonZeroU64::new(log_steps * cfg.step_ns) {
         sim.set_sensor_sample_interval_ns(ns);
     }
-    let io_err = |source| CliError::Output {
-        target: target.to_string(),
-        source,
-    };
     // The server's numeric id, so a row equals the StateMsg a server run of this file
     // publishes (`check-config` and `run` validate `[server]`; `simulate` only reads the id).
     let settings = ServerSettings::from_table(&cfg.server).unwrap_or_default();
@@ -228,6 +224,35 @@ pub fn simulate_with<W: Write>(
         None => 0,
     };
     let sim = &world.vehicles()[0].sim;
+    let save = match checkpoints.save {
+        Some((at, source)) => {
+            let step = ckpt::save_step(
+                &at,
+                cfg.step_ns,
+                cfg.frame_ns,
+                log_steps,
+                total_steps,
+                start_step,
+            )?;
+            Some((
+                step,
+                CheckpointHeader {
+                    front_end: "simulate".into(),
+                    source_sha256: CheckpointHeader::digest(&source.text),
+                    source_path: source.path,
+                    source_text: source.text,
+                    tick: step / steps_per_frame.max(1),
+                    t_sim_ns: step * cfg.step_ns,
+                    step_ns: cfg.step_ns,
+                    frame_ns: cfg.frame_ns,
+                    row_steps: log_steps,
+                    ..CheckpointHeader::default()
+                },
+                at.file,
+            ))
+        }
+        None => None,
+    };
 
     let mut state = sim.blank_state();
     state.command_flags = command_flags::NO_COMMAND_YET;
@@ -260,6 +285,13 @@ pub fn simulate_with<W: Write>(
                 .map(|(i, f)| flexdyn_sinks::fault_spans::csv_comment(i, f)),
         )
         .collect();
+    // Everything is checked: only now is the output created.
+    let (out, target) = open()?;
+    let target = target.as_str();
+    let io_err = |source| CliError::Output {
+        target: target.to_string(),
+        source,
+    };
     let table = CsvTable::with_comments(out, &comments, &columns).map_err(io_err)?;
     let mut rows = SimulateRows {
         cfg,
@@ -270,34 +302,8 @@ pub fn simulate_with<W: Write>(
         last: vec![(None, Vec::new()); sim.sensors().len()],
         table,
         target,
-        save: None,
+        save,
     };
-    if let Some((at, source)) = checkpoints.save {
-        let step = ckpt::save_step(
-            &at,
-            cfg.step_ns,
-            cfg.frame_ns,
-            log_steps,
-            total_steps,
-            start_step,
-        )?;
-        rows.save = Some((
-            step,
-            CheckpointHeader {
-                front_end: "simulate".into(),
-                source_sha256: CheckpointHeader::digest(&source.text),
-                source_path: source.path,
-                source_text: source.text,
-                tick: step / steps_per_frame.max(1),
-                t_sim_ns: step * cfg.step_ns,
-                step_ns: cfg.step_ns,
-                frame_ns: cfg.frame_ns,
-                row_steps: log_steps,
-                ..CheckpointHeader::default()
-            },
-            at.file,
-        ));
-    }
     let plan = RowPlan {
         total_steps,
         log_steps,
@@ -403,6 +409,8 @@ impl<W: Write> RowSink for SimulateRows<'_, W> {
         self.table.write_row(&row).map_err(io_err)?;
         if let Some((at, header, file)) = &self.save {
             if *at == step {
+                // Everything written so far reaches the output before the checkpoint does.
+                self.table.flush().map_err(io_err)?;
                 ckpt::write(file, header, world)?;
             }
         }
@@ -456,7 +464,6 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
         )),
         _ => None,
     };
-    let (out, target) = args.run.open_csv()?;
     let checkpoints = Checkpoints {
         resume: resumed.as_ref().map(|(c, f)| (c, *f)),
         save,
@@ -465,8 +472,7 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
         &cfg,
         args.run.duration_s,
         args.log_every_s,
-        out,
-        &target,
+        || args.run.open_csv(),
         checkpoints,
     )
 }

@@ -346,6 +346,62 @@ fn a_damaged_foreign_or_mismatched_checkpoint_is_refused_naming_file_and_reason(
         e.contains("--log-every-s") && e.contains("every 0.01 s"),
         "{e}"
     );
+
+    // A refused run leaves an existing output as it was: a resume that does not fit, a
+    // checkpoint instant off the rows or at t = 0, for simulate and for fleet.
+    let keep = scratch("keep.csv");
+    let k = keep.to_str().unwrap();
+    let before = "t_s,x\n0,1\n";
+    let fleet = scratch("keep_fleet.toml");
+    std::fs::write(
+        &fleet,
+        format!(
+            "[[vehicles]]\nid = \"a\"\nspacecraft_file = \"{}\"\n",
+            scenario("reference")
+        ),
+    )
+    .unwrap();
+    let f = fleet.to_str().unwrap();
+    let chain = scenario("panel_chain");
+    let cases: [&[&str]; 5] = [
+        &["simulate", "--config", &chain, "--resume", s],
+        &[
+            "simulate",
+            "--checkpoint-at-s",
+            "0.015",
+            "--checkpoint",
+            "x.ckpt",
+        ],
+        &[
+            "simulate",
+            "--checkpoint-at-s",
+            "0",
+            "--checkpoint",
+            "x.ckpt",
+        ],
+        &["fleet", f, "--resume", s],
+        &[
+            "fleet",
+            f,
+            "--checkpoint-at-s",
+            "0.015",
+            "--checkpoint",
+            "x.ckpt",
+        ],
+    ];
+    for case in cases {
+        std::fs::write(&keep, before).unwrap();
+        let mut args = case.to_vec();
+        args.extend(["--duration-s", "1", "--log-every-s", "0.01", "-o", k]);
+        let o = flexdyn(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{case:?}: {err}");
+        assert_eq!(
+            std::fs::read_to_string(&keep).unwrap(),
+            before,
+            "{case:?} left the output as it was"
+        );
+    }
 }
 
 #[test]

@@ -56,9 +56,9 @@ const MAX_SOURCE_LEN: usize = 64 << 20;
 pub struct CheckpointHeader {
     /// The wire protocol version of the stream it continues ([`flexdyn_proto::PROTOCOL_VERSION`]).
     pub protocol_version: u16,
-    /// The front end that wrote it: `simulate`, `fleet` or `server`.
+    /// The front end that wrote it: `simulate` or `fleet`.
     pub front_end: String,
-    /// The configuration file's path as the run was given it (empty for the embedded default).
+    /// The configuration file's absolute path (empty for the embedded default).
     pub source_path: String,
     /// The configuration file's text.
     pub source_text: String,

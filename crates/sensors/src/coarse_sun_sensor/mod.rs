@@ -257,12 +257,12 @@ impl Sensor for CoarseSunSensor {
             rng,
             last:
                 CoarseSunSensorSample {
-                    detector_count,
+                    // The configuration's (the number of normals), not state.
+                    detector_count: _,
                     readings,
                 },
         } = self;
         a.put(rng);
-        a.put(detector_count);
         a.put(readings);
     }
 

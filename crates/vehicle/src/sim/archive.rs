@@ -12,7 +12,16 @@ impl Simulation {
     /// schedules themselves) is not listed: restore into a vehicle built from a compatible
     /// configuration. The hub outputs cached for the current frame are dropped on a restore and
     /// recomputed from the restored state (the same bits). Not on the stepping path.
+    ///
+    /// The schedules' progress is not listed either: a save first applies the schedules at the
+    /// checkpoint's instant (as every state record does; a no-op after one), and a restore finds
+    /// the rows applied by time in the run's own schedules, so a fork's schedules are the ones in
+    /// effect from the checkpoint on. A fork whose scheduled effector inputs in effect then differ
+    /// from the checkpoint's hands its own to the effectors at once.
     pub fn archive(&mut self, a: &mut Archive<'_>) {
+        if a.is_saving() {
+            self.apply_schedules();
+        }
         // Named field by field: a new field does not compile until it is listed here or marked
         // as configuration (`_`).
         let Simulation {
@@ -35,11 +44,9 @@ impl Simulation {
             environment_every_frames: _,
             faults,
         } = self;
+        let mut fork_inputs = false;
         a.section("vehicle", |a| {
             sc.archive(a);
-            let mut n = *cursor;
-            a.length("wrench schedule rows applied", &mut n, schedule.len());
-            *cursor = n;
             let Wrench {
                 force_b_newton,
                 torque_b_nm,
@@ -57,9 +64,6 @@ impl Simulation {
             }
             a.expect_count("effector flags", flags_scratch.len());
             a.put(&mut flags_scratch[..]);
-            let mut n = *input_cursor;
-            a.length("input schedule rows applied", &mut n, input_schedule.len());
-            *input_cursor = n;
             if !a.is_saving() {
                 *frame_outputs = None;
             }
@@ -75,6 +79,27 @@ impl Simulation {
                 ),
             }
             faults.archive(a);
+            if !a.is_saving() && !a.failed() {
+                // The rows applied by the checkpoint's instant, in this run's schedules.
+                let t_ns = sc.t_sim_ns();
+                *cursor = schedule.iter().take_while(|r| r.t_start_ns <= t_ns).count();
+                *input_cursor = input_schedule
+                    .iter()
+                    .take_while(|r| r.t_start_ns <= t_ns)
+                    .count();
+                let mut in_effect = vec![0.0; scheduled_inputs.len()];
+                for row in &input_schedule[..*input_cursor] {
+                    let r = sc.effector_input_ranges()[row.effector_index].clone();
+                    in_effect[r].copy_from_slice(&row.inputs);
+                }
+                if in_effect != *scheduled_inputs {
+                    *scheduled_inputs = in_effect;
+                    fork_inputs = true;
+                }
+            }
         });
+        if fork_inputs {
+            self.push_inputs();
+        }
     }
 }
