@@ -328,4 +328,14 @@ pub trait StateEffector: Send + std::fmt::Debug {
     fn compute_derivatives(&mut self, x: &[f64], hub_accel: &HubAccel, dx: &mut [f64]);
     /// Energy and momentum contributions at state `x` when the hub rotates at `omega_bn_b`.
     fn energy_momentum(&self, x: &[f64], omega_bn_b: &Vector3<f64>) -> EnergyMomentum;
+    /// \[kg\] the propellant a tank holds at state `x` (never negative); `None` (the default)
+    /// for a body that is not a propellant tank. Dynamic effectors that name this body
+    /// ([`super::DynamicEffector::propellant_tank`]) draw from it.
+    fn propellant_kg(&self, _x: &[f64]) -> Option<f64> {
+        None
+    }
+    /// \[kg/s\] the mass flow (≥ 0) its thrusters draw over the coming step, constant over the
+    /// step: the spacecraft sets it once per step after the thrusters have solved theirs.
+    /// Only called on bodies whose [`Self::propellant_kg`] is `Some`.
+    fn set_propellant_outflow(&mut self, _outflow_kg_s: f64) {}
 }
