@@ -43,6 +43,7 @@ mod imu_config;
 mod imu_panel_modes;
 mod imu_truth;
 mod panel_chain;
+mod propellant_tank;
 mod reaction_wheels;
 mod rk4_bit_identity;
 mod slosh;

@@ -6,7 +6,7 @@
 //! `"constant_volume"` takes `radius_m`, `"constant_density"` takes `density_kg_m3`.
 
 use super::{PropellantTankParams, TankInertiaModel};
-use flexdyn_kernel::schema::{vec3, At, SchemaError, TableReader};
+use flexdyn_kernel::schema::{vec3, SchemaError, TableReader};
 
 /// The keys of one `[[propellant_tanks]]` entry.
 pub const KEYS: [&str; 6] = [
@@ -39,14 +39,13 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<PropellantTankParams, SchemaError
             TankInertiaModel::ConstantVolume { .. } => TankInertiaModel::NAMES[0],
             TankInertiaModel::ConstantDensity { .. } => TankInertiaModel::NAMES[1],
         };
-        return Err(SchemaError::InvalidValue {
-            field: t.field(other_key),
-            message: format!(
+        return Err(t.refuse(
+            other_key,
+            format!(
                 "a `{model}` tank does not take {other_key} (`constant_volume` takes radius_m, \
                  `constant_density` takes density_kg_m3)"
             ),
-            at: At(None),
-        });
+        ));
     }
     Ok(PropellantTankParams {
         name: t.string("name")?,
