@@ -21,10 +21,7 @@ use flexdyn_dynamics::dynamic_effectors::thruster::{
 use flexdyn_dynamics::effectors::propellant_tank::{
     PropellantTank, PropellantTankParams, TankInertiaModel, EMPTY,
 };
-use flexdyn_dynamics::{
-    EffectorMassProps, GravityModel, HubInitial, HubParams, InitialTranslation, Spacecraft,
-    StateEffector,
-};
+use flexdyn_dynamics::{EffectorMassProps, GravityModel, HubParams, Spacecraft, StateEffector};
 
 const STEP_NS: u64 = 1_000_000; // 1 ms
 const FRAME_NS: u64 = 100_000_000; // 10 Hz
@@ -85,14 +82,7 @@ fn free_vehicle(effectors: Vec<Box<dyn StateEffector>>) -> Spacecraft {
         },
         GravityModel::None,
         effectors,
-        HubInitial {
-            translation: InitialTranslation::PointB {
-                r_bn_n_m: Vector3::zeros(),
-                v_bn_n_m_s: Vector3::zeros(),
-            },
-            sigma_bn: Vector3::zeros(),
-            omega_bn_b_rad_s: Vector3::zeros(),
-        },
+        at_rest(),
         STEP_NS,
     )
     .expect("valid spacecraft")
