@@ -149,7 +149,7 @@ impl TankInertiaModel {
 
     /// \[m²\] R² at propellant mass `m_kg` (≥ 0).
     #[inline]
-    fn radius_sq_m2(&self, m_kg: f64) -> f64 {
+    pub fn radius_sq_m2(&self, m_kg: f64) -> f64 {
         match *self {
             Self::ConstantVolume { radius_m } => radius_m * radius_m,
             Self::ConstantDensity { density_kg_m3 } => (3.0 * m_kg
@@ -163,7 +163,12 @@ impl TankInertiaModel {
     /// \[kg·m²/s\] its rate I′ when the mass changes at `mdot_kg_s`.
     #[inline]
     pub fn inertia_and_rate(&self, m_kg: f64, mdot_kg_s: f64) -> (f64, f64) {
-        let r2 = self.radius_sq_m2(m_kg);
+        self.inertia_and_rate_at(m_kg, self.radius_sq_m2(m_kg), mdot_kg_s)
+    }
+
+    /// [`Self::inertia_and_rate`] with R² = `r2` at `m_kg` already known.
+    #[inline]
+    fn inertia_and_rate_at(&self, m_kg: f64, r2: f64, mdot_kg_s: f64) -> (f64, f64) {
         let rate = match self {
             Self::ConstantVolume { .. } => 0.4 * mdot_kg_s * r2,
             Self::ConstantDensity { .. } => (2.0 / 3.0) * mdot_kg_s * r2,
@@ -209,6 +214,9 @@ pub struct PropellantTank {
     empty_below_kg: f64,
     /// \[kg/s\] dm_p/dt over the step being integrated (D1), set by the spacecraft.
     mdot_kg_s: f64,
+    /// (m_p, R²(m_p)) of the last evaluation: a tank nothing draws from keeps its mass, and
+    /// the constant-density radius costs a cube root.
+    radius_sq_at: (f64, f64),
 }
 
 impl PropellantTank {
@@ -217,6 +225,10 @@ impl PropellantTank {
         params.validate(path)?;
         Ok(Self {
             empty_below_kg: params.propellant_mass_kg * EMPTY_FRACTION,
+            radius_sq_at: (
+                params.propellant_mass_kg,
+                params.inertia.radius_sq_m2(params.propellant_mass_kg),
+            ),
             params,
             mdot_kg_s: 0.0,
         })
@@ -225,6 +237,17 @@ impl PropellantTank {
     /// The parameters.
     pub fn params(&self) -> &PropellantTankParams {
         &self.params
+    }
+
+    /// (D6) at mass state `m_kg` (≥ 0) with the step's ṁ_p: (I, I′), R² computed once per mass.
+    #[inline]
+    fn inertia_now(&mut self, m_kg: f64) -> (f64, f64) {
+        if self.radius_sq_at.0 != m_kg {
+            self.radius_sq_at = (m_kg, self.params.inertia.radius_sq_m2(m_kg));
+        }
+        self.params
+            .inertia
+            .inertia_and_rate_at(m_kg, self.radius_sq_at.1, self.mdot_kg_s)
     }
 
     /// \[kg\] the propellant it can still deliver at mass state `m_kg`: 0 once empty (D5).
@@ -291,7 +314,7 @@ impl StateEffector for PropellantTank {
     fn update_mass_props(&mut self, x: &[f64], sum: &mut EffectorMassProps) {
         // (D2): m_p, m_p r_T, [I_Tc] + m_p [r̃_T][r̃_T]ᵀ; never a negative mass.
         let m = x[MASS].max(0.0);
-        let (i_tc, _) = self.params.inertia.inertia_and_rate(m, 0.0);
+        let (i_tc, _) = self.inertia_now(m);
         sum.add_point_mass(m, &self.params.r_tcb_b_m, &Vector3::zeros());
         sum.inertia_pnt_b_b_kg_m2 += Matrix3::from_diagonal_element(i_tc);
     }
@@ -307,9 +330,9 @@ impl StateEffector for PropellantTank {
             // Not drawn from: a rigid mass of the hub, with nothing to add.
             return;
         }
+        let (_, i_tc_prime) = self.inertia_now(x[MASS].max(0.0));
         let w = &hub.omega_bn_b;
         let r = &self.params.r_tcb_b_m;
-        let (_, i_tc_prime) = self.params.inertia.inertia_and_rate(x[MASS].max(0.0), mdot);
         // (D3): the propellant leaving the tank at r_T, −ṁ_p ω × r_T.
         let f_b = -w.cross(r) * mdot;
         sum.vec_trans += f_b;
