@@ -22,6 +22,10 @@
 //! cost of a panel pair; with `FLEXDYN_PEERS_PYTHON`, the 10-link chain against MuJoCo's
 //! equivalent tree (`tools/peers/mujoco_chain.py`) in the same run.
 //! `FLEXDYN_BENCH_ONLY=chain cargo bench --bench step` runs only these rows (about a minute).
+//! Issue 39 §3 (propellant depletion): the reference spacecraft (2 pairs) with 4 thrusters
+//! firing every step, each drawing from its own propellant tank, against the same thrusters
+//! without tanks, per tank and beside one panel pair; and 4 tanks nothing draws from.
+//! `FLEXDYN_BENCH_ONLY=tank cargo bench --bench step` runs only these rows and the pair fit.
 //!
 //! Peers in the same run: with `FLEXDYN_PEERS_PYTHON` pointing at a Python that has
 //! `mujoco==4.0.0` and `bsk==2.12.1` (see `tools/peers/README.md`), the bench then runs
@@ -547,6 +551,76 @@ fn spacecraft_with_slosh(particles: usize, pendulums: usize) -> Spacecraft {
     reference_with(effectors)
 }
 
+/// The reference spacecraft (2 pairs) with `thrusters` 1 N thrusters held open (duty 1, on
+/// axes that differ per device), each drawing from its own 50 kg tank when `fed`, and `idle`
+/// more tanks nothing draws from.
+fn spacecraft_with_tanks(thrusters: usize, fed: bool, idle: usize) -> Spacecraft {
+    use flexdyn_dynamics::dynamic_effectors::thruster::{
+        Thruster, ThrusterCommand, ThrusterParams,
+    };
+    use flexdyn_dynamics::effectors::propellant_tank::{
+        PropellantTank, PropellantTankParams, TankInertiaModel,
+    };
+    use nalgebra::Vector3;
+    let mut effectors = common::reference_effectors_with_wheels(0, |_| {});
+    let at = |j: usize| {
+        let az = (45.0 + 90.0 * j as f64).to_radians();
+        Vector3::new(az.cos(), az.sin(), 0.2)
+    };
+    let tanks = if fed { thrusters } else { 0 } + idle;
+    for j in 0..tanks {
+        let p = PropellantTankParams {
+            name: format!("tank{j}"),
+            r_tcb_b_m: at(j) * 0.6,
+            propellant_mass_kg: 50.0,
+            inertia: TankInertiaModel::ConstantDensity {
+                density_kg_m3: 1004.0,
+            },
+        };
+        effectors.push(Box::new(
+            PropellantTank::new(p, &format!("propellant_tanks[{j}]")).unwrap(),
+        ));
+    }
+    let mut sc = reference_with(effectors);
+    for j in 0..thrusters {
+        let p = ThrusterParams {
+            name: format!("thr{j}"),
+            r_tb_b_m: at(j),
+            force_axis_b: at(j + 1).normalize(),
+            max_thrust_newton: 1.0,
+            isp_s: 220.0,
+            min_on_time_s: 0.0,
+            rise_time_constant_s: 0.0,
+            tail_off_time_constant_s: 0.0,
+            command: ThrusterCommand::DutyCycle,
+            tank: fed.then(|| format!("tank{j}")),
+        };
+        let t = Thruster::new(p, &format!("thrusters[{j}]"), 10_000_000, 1_000_000).unwrap();
+        sc.add_dynamic_effector(Box::new(t));
+    }
+    sc.set_effector_inputs(&vec![1.0; thrusters]).unwrap();
+    sc
+}
+
+/// The propellant tank's cost per step (issue 39 §3), per tank (4 of each case), against the
+/// same spacecraft without tanks and against one panel pair (`pair_ns`, same run): a tank its
+/// firing thruster draws from (the feed, the mass flow and the depletion terms of both), and a
+/// tank nothing draws from (its mass properties only).
+fn tank_summary(pair_ns: f64) {
+    let base = median_ns_per_step(spacecraft_with_tanks(4, false, 0));
+    let fed = median_ns_per_step(spacecraft_with_tanks(4, true, 0));
+    let idle = median_ns_per_step(spacecraft_with_tanks(4, false, 4));
+    println!(
+        "\nrk4_step with propellant tanks, 2 pairs + 4 firing thrusters, per tank (4 fed: \
+         {fed:.1} ns/step, 4 idle: {idle:.1} ns/step; median of 31 batches x 20000 steps):"
+    );
+    let rows = [
+        ("tank, fed", base + (fed - base) / 4.0),
+        ("tank, idle", base + (idle - base) / 4.0),
+    ];
+    print_added_cost("one tank", base, &rows, pair_ns);
+}
+
 /// The reference hub, orbit and 1 ms step with `effectors` appended.
 fn reference_with(effectors: Vec<Box<dyn flexdyn_dynamics::StateEffector>>) -> Spacecraft {
     Spacecraft::new(
@@ -663,6 +737,14 @@ fn main() {
         chain_summary(None);
         return;
     }
+    if std::env::var("FLEXDYN_BENCH_ONLY").as_deref() == Ok("tank") {
+        let pairs: Vec<(f64, f64)> = [1, 2, 4, 8]
+            .iter()
+            .map(|&n| (n as f64, median_ns_per_step(spacecraft(n))))
+            .collect();
+        tank_summary(fit(&pairs).1);
+        return;
+    }
     let mut c = Criterion::default().configure_from_args();
     bench_step(&mut c);
     c.final_summary();
@@ -670,6 +752,7 @@ fn main() {
     wheel_summary();
     environment_summary(fit(&rows).1);
     slosh_summary(fit(&rows).1);
+    tank_summary(fit(&rows).1);
     world_summary(fit(&rows).1);
     actuator_summary(fit(&rows).1);
     sensor_summary(fit(&rows).1);

@@ -148,11 +148,11 @@ pub use layout::{
 };
 pub use messages::{
     command_flags, eclipse, effector_kind, environment_flags, fss_flags, magnetometer_flags,
-    magnetorquer_flags, saturation_flags, star_tracker_flags, thruster_flags, time_flags,
-    wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus, Conserved, CssMsg,
-    EffectorInput, EffectorState, EnvironmentMsg, FrameTiming, FssMsg, Header, ImuMsg,
-    MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters, RunState, StalePolicy,
-    StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime,
+    magnetorquer_flags, propellant_tank_flags, saturation_flags, star_tracker_flags,
+    thruster_flags, time_flags, wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus,
+    Conserved, CssMsg, EffectorInput, EffectorState, EnvironmentMsg, FrameTiming, FssMsg, Header,
+    ImuMsg, MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters, RunState,
+    StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime,
 };
 pub use messages::{gps_flags, GpsMsg};
 // Fault injection (issue 21, protocol 8).

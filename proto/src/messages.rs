@@ -42,6 +42,10 @@ pub mod effector_kind {
     /// rod's azimuth about p̂3 and elevation out of the p̂1–p̂2 plane of its pendulum frame);
     /// no outputs, no flags, no inputs.
     pub const SLOSH_PENDULUM: u16 = 7;
+    /// A propellant tank its thrusters deplete. States `[m_p kg]` (the propellant aboard); outputs
+    /// `[dm_p/dt kg/s (≤ 0), fraction of the initial load remaining, propellant used kg]`; flags
+    /// [`super::propellant_tank_flags`]; no inputs.
+    pub const PROPELLANT_TANK: u16 = 8;
 }
 
 /// Values of [`EnvironmentMsg::eclipse`]: from the shadow factor ν.
@@ -353,6 +357,12 @@ pub mod thruster_flags {
     pub const BELOW_MIN_ON_TIME: u32 = 1 << 1;
     /// Bit 2: the command was outside 0 … frame period (or 0 … 1) and was clipped.
     pub const COMMAND_CLIPPED: u32 = 1 << 2;
+}
+
+/// Bits of [`EffectorState::flags`]: for a [`effector_kind::PROPELLANT_TANK`] entry.
+pub mod propellant_tank_flags {
+    /// Bit 0: the tank holds no propellant: the thrusters that draw from it produce no thrust.
+    pub const EMPTY: u32 = 1 << 0;
 }
 
 /// Start of every message (30 bytes). All its fields are deterministic (no wall clock).

@@ -22,15 +22,16 @@
 
 use flexdyn_proto::{
     command_flags, decode, decode_header, eclipse, effector_kind, encode, environment_flags,
-    fss_flags, magnetometer_flags, magnetorquer_flags, saturation_flags, star_tracker_flags,
-    thruster_flags, time_flags, wheel_flags, AppliedWrench, CommandKind, CommandMsg, CommandStatus,
-    Conserved, CssMsg, DecodeError, EffectorInput, EffectorState, EnvironmentMsg, FrameTiming,
-    FssMsg, Header, ImuMsg, MagnetometerMsg, Mode, OperatorAction, OperatorMsg, RejectCounters,
-    RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg, SysTime, TimeMsg, UtcTime,
-    WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN, COMMAND_WRENCH_LEN, CSS_LEN,
-    CUC_PFIELD_TAI_4_3, EFFECTOR_INPUT_FIXED_LEN, EFFECTOR_STATE_FIXED_LEN, ENVIRONMENT_LEN,
-    FSS_LEN, IMU_LEN, MAGNETOMETER_LEN, MAX_CSS_DETECTORS, OPERATOR_LEN, STAR_TRACKER_LEN,
-    STATE_FIXED_LEN, STATUS_LEN, TIME_CUC_OFFSET, TIME_LEN,
+    fss_flags, magnetometer_flags, magnetorquer_flags, propellant_tank_flags, saturation_flags,
+    star_tracker_flags, thruster_flags, time_flags, wheel_flags, AppliedWrench, CommandKind,
+    CommandMsg, CommandStatus, Conserved, CssMsg, DecodeError, EffectorInput, EffectorState,
+    EnvironmentMsg, FrameTiming, FssMsg, Header, ImuMsg, MagnetometerMsg, Mode, OperatorAction,
+    OperatorMsg, RejectCounters, RunState, StalePolicy, StarTrackerMsg, StateMsg, StatusMsg,
+    SysTime, TimeMsg, UtcTime, WireMessage, COMMAND_ACTUATORS_FIXED_LEN, COMMAND_NO_COMMAND_LEN,
+    COMMAND_WRENCH_LEN, CSS_LEN, CUC_PFIELD_TAI_4_3, EFFECTOR_INPUT_FIXED_LEN,
+    EFFECTOR_STATE_FIXED_LEN, ENVIRONMENT_LEN, FSS_LEN, IMU_LEN, MAGNETOMETER_LEN,
+    MAX_CSS_DETECTORS, OPERATOR_LEN, STAR_TRACKER_LEN, STATE_FIXED_LEN, STATUS_LEN,
+    TIME_CUC_OFFSET, TIME_LEN,
 };
 use flexdyn_proto::{
     FaultAction, FaultCommandMsg, FaultEventMsg, FaultSource, FaultTarget, FAULT_COMMAND_LEN,
@@ -1771,6 +1772,8 @@ fn flag_bits() {
     assert_eq!(effector_kind::THRUSTER, 4);
     assert_eq!(effector_kind::SLOSH_LINEAR, 6);
     assert_eq!(effector_kind::SLOSH_PENDULUM, 7);
+    assert_eq!(effector_kind::PROPELLANT_TANK, 8);
+    assert_eq!(propellant_tank_flags::EMPTY, 0b001);
     assert_eq!(magnetorquer_flags::SATURATED, 0b001);
     assert_eq!(thruster_flags::FIRING, 0b001);
     assert_eq!(thruster_flags::BELOW_MIN_ON_TIME, 0b010);

@@ -140,6 +140,9 @@ fn a_resumed_run_writes_the_uninterrupted_rows_bit_for_bit() {
     // Faults: an IMU stuck since 3 s is held through the checkpoint (its held values are
     // state), a wheel seizes after it.
     resume_matches("fdir", Some(&scenario("fdir")), "70", "0.5", "5");
+    // A tank drained by thrusters, resumed mid-burn (5 … 65 s), with schedule rows after the
+    // checkpoint (65, 70, 72 s) found by time in the resumed run's own schedule.
+    resume_matches("depletion", Some(&scenario("depletion")), "75", "0.5", "30");
     // Appended bodies with their own states: slosh particles and a panel chain.
     resume_matches("slosh", Some(&scenario("slosh")), "4", "0.01", "1.5");
     resume_matches(

@@ -192,6 +192,7 @@ fn every_shipped_scenario_is_valid() {
             "acs_full",
             "campaign",
             "damped_wing",
+            "depletion",
             "eight_pairs",
             "fdir",
             "fdir_campaign",

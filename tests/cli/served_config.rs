@@ -124,12 +124,12 @@ fn the_clients_reader_agrees_with_the_servers_on_every_scenario() {
 }
 
 /// What flight code reads of the served configuration names the same effector indices the
-/// server lists: the chains and slosh bodies after the wheels, the rods after them, the
-/// thrusters after the rods, in file order; in every scenario with appended bodies of the
-/// generic list.
+/// server lists: the chains, slosh bodies and propellant tanks after the wheels, the rods after
+/// them, the thrusters after the rods, in file order; in every scenario with appended bodies of
+/// the generic list.
 #[test]
 fn flight_code_finds_the_actuators_at_the_servers_indices() {
-    for scenario in ["acs_full", "slosh", "panel_chain"] {
+    for scenario in ["acs_full", "slosh", "panel_chain", "depletion"] {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join(format!("scenarios/{scenario}.toml"));
         let text = std::fs::read_to_string(&path).unwrap();
@@ -159,6 +159,12 @@ fn flight_code_finds_the_actuators_at_the_servers_indices() {
         assert!(linear.iter().all(|k| *k == "slosh_linear"), "{scenario}");
         assert!(
             pendulums.iter().all(|k| *k == "slosh_pendulum"),
+            "{scenario}"
+        );
+        assert!(
+            kinds_at(vehicle.first_tank_index(), vehicle.propellant_tanks.len())
+                .iter()
+                .all(|k| *k == "propellant_tank"),
             "{scenario}"
         );
         let first_rod = vehicle.first_magnetorquer_index() as usize;
@@ -192,6 +198,10 @@ fn flight_code_finds_the_actuators_at_the_servers_indices() {
         }
         if scenario == "slosh" {
             assert!(!vehicle.slosh_linear.is_empty() && !vehicle.slosh_pendulums.is_empty());
+        }
+        if scenario == "depletion" {
+            assert_eq!(vehicle.propellant_tanks.len(), 2);
+            assert_eq!(vehicle.thrusters[0].tank.as_deref(), Some("main"));
         }
     }
 }

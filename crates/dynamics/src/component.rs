@@ -97,6 +97,23 @@ pub trait ComponentParams: Debug + Clone + PartialEq + Send + Sync + 'static {
     fn mass_kg(&self) -> f64 {
         0.0
     }
+    /// Another entry this one names, which must exist: (its own field, the section the named
+    /// entry is in, the name), e.g. a thruster's `tank` names a `propellant_tanks` entry.
+    /// `None` (the default) for an entry that names none.
+    fn refers_to(&self) -> Option<ComponentRef<'_>> {
+        None
+    }
+}
+
+/// A reference from one configured entry to another, by name ([`ComponentParams::refers_to`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ComponentRef<'a> {
+    /// The referring entry's field (`tank`).
+    pub field: &'static str,
+    /// The section of the entry it names (`propellant_tanks`).
+    pub section: &'static str,
+    /// The name it gives.
+    pub name: &'a str,
 }
 
 /// The object-safe face of [`ComponentParams`], implemented for every such type, so that a
@@ -114,6 +131,8 @@ pub trait ComponentSpec: Debug + Send + Sync {
     fn build(&self, path: &str, timing: StepTiming) -> Result<BuiltComponent, ParamError>;
     /// See [`ComponentParams::mass_kg`].
     fn mass_kg(&self) -> f64;
+    /// See [`ComponentParams::refers_to`].
+    fn refers_to(&self) -> Option<ComponentRef<'_>>;
     /// A boxed copy.
     fn box_clone(&self) -> Box<dyn ComponentSpec>;
     /// Whether `other` is the same kind with equal parameters.
@@ -142,6 +161,9 @@ impl<P: ComponentParams> ComponentSpec for P {
     }
     fn mass_kg(&self) -> f64 {
         ComponentParams::mass_kg(self)
+    }
+    fn refers_to(&self) -> Option<ComponentRef<'_>> {
+        ComponentParams::refers_to(self)
     }
     fn box_clone(&self) -> Box<dyn ComponentSpec> {
         Box::new(self.clone())

@@ -182,4 +182,23 @@ pub trait DynamicEffector: Send + std::fmt::Debug {
     /// direction) is not state: it is the same bits when recomputed. Required, so a new kind
     /// says what it holds. Not on the stepping path.
     fn archive(&mut self, a: &mut Archive<'_>);
+
+    /// The name of the propellant tank (a state effector whose
+    /// [`StateEffector::propellant_kg`](super::StateEffector::propellant_kg) is `Some`) this
+    /// effector draws from, if any (a thruster with `tank = "…"`). `None` (the default): it
+    /// burns nothing the vehicle carries. Construction time only.
+    fn propellant_tank(&self) -> Option<&str> {
+        None
+    }
+    /// \[kg/s\] the propellant it would burn over the step solved by the last
+    /// [`Self::begin_step`] with a full supply (a thruster: its step-average thrust over
+    /// I_sp g₀). Called once per step, after [`Self::begin_step`].
+    fn propellant_demand_kg_s(&self) -> f64 {
+        0.0
+    }
+    /// The fraction (0 … 1) of [`Self::propellant_demand_kg_s`] its tank can deliver over the
+    /// coming step: 1 while there is enough, less in the step the tank runs dry, 0 once it is
+    /// empty. The effector scales its force (and its mass flow) by it. Called once per step,
+    /// after [`Self::begin_step`], only on effectors that name a tank.
+    fn set_propellant_supply(&mut self, _fraction: f64) {}
 }

@@ -334,4 +334,14 @@ pub trait StateEffector: Send + std::fmt::Debug {
     /// of one evaluation is not state: every evaluation recomputes it from `x`. Required, so a
     /// new kind says what it holds. Not on the stepping path.
     fn archive(&mut self, a: &mut Archive<'_>);
+    /// \[kg\] the propellant a tank holds at state `x` (never negative); `None` (the default)
+    /// for a body that is not a propellant tank. Dynamic effectors that name this body
+    /// ([`super::DynamicEffector::propellant_tank`]) draw from it.
+    fn propellant_kg(&self, _x: &[f64]) -> Option<f64> {
+        None
+    }
+    /// \[kg/s\] the mass flow (≥ 0) its thrusters draw over the coming step, constant over the
+    /// step: the spacecraft sets it once per step after the thrusters have solved theirs.
+    /// Only called on bodies whose [`Self::propellant_kg`] is `Some`.
+    fn set_propellant_outflow(&mut self, _outflow_kg_s: f64) {}
 }

@@ -4,7 +4,7 @@
 
 use super::component::ComponentKind;
 use super::dynamic_effectors::{magnetorquer, thruster};
-use super::effectors::{panel_chain, panel_pair, reaction_wheel};
+use super::effectors::{panel_chain, panel_pair, propellant_tank, reaction_wheel};
 use super::effectors::{slosh_linear, slosh_pendulum};
 use super::EffectorKind;
 
@@ -15,6 +15,7 @@ pub static KINDS: &[&ComponentKind] = &[
     &panel_chain::kind::COMPONENT,
     &slosh_linear::kind::COMPONENT,
     &slosh_pendulum::kind::COMPONENT,
+    &propellant_tank::kind::COMPONENT,
     &magnetorquer::kind::COMPONENT,
     &thruster::kind::COMPONENT,
 ];

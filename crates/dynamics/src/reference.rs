@@ -133,6 +133,19 @@ pub fn reference_initial() -> HubInitial {
     }
 }
 
+/// Point B at the origin of N, at rest, attitude N, not turning: the start of the tests that
+/// watch one effect on a free vehicle (a slosh mode, a burn).
+pub fn at_rest() -> HubInitial {
+    HubInitial {
+        translation: InitialTranslation::PointB {
+            r_bn_n_m: Vector3::zeros(),
+            v_bn_n_m_s: Vector3::zeros(),
+        },
+        sigma_bn: Vector3::zeros(),
+        omega_bn_b_rad_s: Vector3::zeros(),
+    }
+}
+
 /// A spacecraft of `hub` and `pairs` (hinge names `panel_pairs[i]`).
 ///
 /// # Panics

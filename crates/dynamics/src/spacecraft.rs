@@ -349,6 +349,35 @@ struct EquationsOfMotion {
     /// evaluation reads).
     input_ranges: Vec<Range<usize>>,
     output_ranges: Vec<Range<usize>>,
+    /// Each propellant tank and the dynamic effectors that draw from it (empty without tanks:
+    /// then stepping does exactly what it did before tanks existed).
+    feeds: Vec<PropellantFeed>,
+    /// \[s\] the integration step, over which a tank's outflow is held.
+    step_s: f64,
+}
+
+/// A propellant tank (an index into the state effectors) and the dynamic effectors (indices
+/// into the dynamic list) that draw from it.
+#[derive(Debug)]
+struct PropellantFeed {
+    tank: usize,
+    thrusters: Vec<usize>,
+}
+
+/// The fraction (0 … 1) of a demand of `demand_kg_s` held over `step_s` that `available_kg`
+/// of propellant can deliver: 1 while it suffices; in the step the tank runs dry the fraction
+/// that empties it exactly at the step's end (so its mass reaches 0, never below); 0 when it
+/// is empty.
+#[inline]
+fn propellant_supply(available_kg: f64, demand_kg_s: f64, step_s: f64) -> f64 {
+    let wanted_kg = demand_kg_s * step_s;
+    if wanted_kg <= available_kg {
+        1.0
+    } else if available_kg > 0.0 {
+        available_kg / wanted_kg
+    } else {
+        0.0
+    }
 }
 
 /// One entry of the vehicle's effector list ([`Spacecraft::effector_entries`]): an appended body
@@ -418,6 +447,21 @@ impl EquationsOfMotion {
         }
         for &i in &self.dynamic_stepped {
             self.dynamic[i].begin_step(t_step_ns);
+        }
+        // Each tank's outflow over the step: what its thrusters' step-average forces burn,
+        // limited to what it holds (`propellant_tank` module docs, (D1) and (D5)).
+        for feed in &self.feeds {
+            let xe = &x.effectors[self.ranges[feed.tank].clone()];
+            let available_kg = self.effectors[feed.tank].propellant_kg(xe).unwrap_or(0.0);
+            let mut demand_kg_s = 0.0;
+            for &i in &feed.thrusters {
+                demand_kg_s += self.dynamic[i].propellant_demand_kg_s();
+            }
+            let supply = propellant_supply(available_kg, demand_kg_s, self.step_s);
+            for &i in &feed.thrusters {
+                self.dynamic[i].set_propellant_supply(supply);
+            }
+            self.effectors[feed.tank].set_propellant_outflow(demand_kg_s * supply);
         }
     }
 
@@ -590,6 +634,8 @@ impl Spacecraft {
                 stepped,
                 force_b_newton: Vector3::zeros(),
                 torque_b_nm: Vector3::zeros(),
+                feeds: Vec::new(),
+                step_s: step_ns as f64 * 1e-9,
             },
             state: zero.clone(),
             t_sim_ns: 0,
@@ -815,7 +861,43 @@ impl Spacecraft {
 
     /// Adds a dynamic effector (an external force and torque evaluated at every integrator stage);
     /// returns its index. Construction-time only.
+    ///
+    /// # Panics
+    /// If the effector draws from a propellant tank the spacecraft does not have (see
+    /// [`Self::try_add_dynamic_effector`], which says so as an error).
     pub fn add_dynamic_effector(&mut self, effector: Box<dyn DynamicEffector>) -> usize {
+        self.try_add_dynamic_effector(effector)
+            .unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`Self::add_dynamic_effector`], failing if the effector names a propellant tank
+    /// ([`DynamicEffector::propellant_tank`]) that is not among the state effectors (a body
+    /// whose [`StateEffector::propellant_kg`] is `Some`, of that name). Construction-time only.
+    pub fn try_add_dynamic_effector(
+        &mut self,
+        effector: Box<dyn DynamicEffector>,
+    ) -> Result<usize, ParamError> {
+        if let Some(tank_name) = effector.propellant_tank() {
+            let eom = &mut self.eom;
+            let x = &self.state.effectors;
+            let tank = (0..eom.effectors.len())
+                .find(|&i| {
+                    let e = &eom.effectors[i];
+                    e.name() == tank_name && e.propellant_kg(&x[eom.ranges[i].clone()]).is_some()
+                })
+                .ok_or_else(|| ParamError::Invalid {
+                    field: format!("{}.tank", effector.name()),
+                    problem: format!("no propellant tank is named `{tank_name}`"),
+                })?;
+            let index = eom.dynamic.len();
+            match eom.feeds.iter_mut().find(|f| f.tank == tank) {
+                Some(feed) => feed.thrusters.push(index),
+                None => eom.feeds.push(PropellantFeed {
+                    tank,
+                    thrusters: vec![index],
+                }),
+            }
+        }
         if effector.uses_begin_step() {
             self.eom.dynamic_stepped.push(self.eom.dynamic.len());
         }
@@ -830,7 +912,7 @@ impl Spacecraft {
             append(&mut eom.output_ranges, effector.output_names().len());
         }
         self.eom.dynamic.push(effector);
-        self.eom.dynamic.len() - 1
+        Ok(self.eom.dynamic.len() - 1)
     }
 
     /// The dynamic effectors, in registration order.

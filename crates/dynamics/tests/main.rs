@@ -8,6 +8,8 @@
 //! - [`validate_basilisk_nhinged`]: the panel chain against Basilisk's N-hinged effector;
 //! - [`validate_dense_kane_chain`]: the N-link panel chain against its own dense Kane model;
 //! - [`gravity_vs_sgp4`]: the point-mass and J2 gravity against SGP4's propagation;
+//! - [`propellant_tank`]: mass depletion against ∫F/(I_sp g₀), hand-computed mass properties,
+//!   invariants and the rocket equation;
 //! - [`slosh`]: the fuel-slosh effectors against a dense Kane solve, invariants, closed-form
 //!   frequencies and decay rates.
 //!
@@ -20,6 +22,7 @@ mod analytic_limit;
 mod attitude;
 mod conservation;
 mod gravity_vs_sgp4;
+mod propellant_tank;
 mod slosh;
 mod validate_basilisk_nhinged;
 mod validate_dense_kane;

@@ -418,17 +418,6 @@ fn point_hub(mass_kg: f64, inertia_kg_m2: f64) -> HubParams {
     }
 }
 
-fn at_rest() -> HubInitial {
-    HubInitial {
-        translation: InitialTranslation::PointB {
-            r_bn_n_m: Vector3::zeros(),
-            v_bn_n_m_s: Vector3::zeros(),
-        },
-        sigma_bn: Vector3::zeros(),
-        omega_bn_b_rad_s: Vector3::zeros(),
-    }
-}
-
 /// The spring-mass on a free hub, its axis through the hub's centre of mass: a two-body
 /// oscillator at ω = √(k/μ), μ = m M/(m + M), and with damping c it decays at σ = c/(2μ) with
 /// ω_d = √(k/μ − σ²). Measured over 20 s at 1 ms.

@@ -18,6 +18,30 @@ fn the_allocation_counter_is_installed() {
     flexdyn_testkit::alloc_counter::assert_installed();
 }
 
+/// The kind of every entry of `sc`'s effector list, in order.
+pub fn effector_kind_names(sc: &flexdyn_dynamics::Spacecraft) -> Vec<&'static str> {
+    sc.effector_entries().map(|e| e.kind.name).collect()
+}
+
+/// Each case `(from, to, field, words)`: the configuration `text` with `from` (found exactly
+/// once) replaced by `to` is refused with one error that starts with and names `field` and says
+/// `words`. Returns the messages, for what a caller checks beyond that.
+pub fn config_error_cases(text: &str, cases: &[(&str, &str, &str, &str)]) -> Vec<String> {
+    let mut messages = Vec::new();
+    for &(from, to, field, words) in cases {
+        assert_eq!(text.matches(from).count(), 1, "{from}");
+        let bad = text.replace(from, to);
+        let err = flexdyn_vehicle::config::SimConfig::from_toml_str(&bad).unwrap_err();
+        let msg = err.to_string();
+        eprintln!("{msg}");
+        assert!(msg.starts_with(field), "{msg}");
+        assert_eq!(err.field(), Some(field), "{msg}");
+        assert!(msg.contains(words), "{msg}");
+        messages.push(msg);
+    }
+    messages
+}
+
 // Shared by the files below.
 #[allow(dead_code)]
 mod imu_support;
@@ -43,6 +67,7 @@ mod imu_config;
 mod imu_panel_modes;
 mod imu_truth;
 mod panel_chain;
+mod propellant_tank;
 mod reaction_wheels;
 mod rk4_bit_identity;
 mod slosh;

@@ -160,6 +160,7 @@
 #define FD_EFFECTOR_PANEL_CHAIN 5u /* a chain of N hinged panels */
 #define FD_EFFECTOR_SLOSH_LINEAR 6u /* a linear spring-mass-damper fuel slosh particle */
 #define FD_EFFECTOR_SLOSH_PENDULUM 7u /* a spherical-pendulum fuel slosh mass */
+#define FD_EFFECTOR_PROPELLANT_TANK 8u /* a propellant tank its thrusters deplete */
 
 /* Eclipse: EnvironmentMsg `eclipse` (u8) */
 #define FD_ECLIPSE_SUNLIT 0u /* ν = 1, also without a shadow model */
@@ -228,6 +229,9 @@
 #define FD_THRUSTER_FIRING 0x01u /* the valve is open now */
 #define FD_THRUSTER_BELOW_MIN_ON_TIME 0x02u /* the commanded on-time is shorter than `min_on_time_s`, the valve stays shut */
 #define FD_THRUSTER_COMMAND_CLIPPED 0x04u /* the command was outside 0 … frame period (or 0 … 1) and was clipped */
+
+/* Bits of propellant_tank_flags */
+#define FD_PROPELLANT_TANK_EMPTY 0x01u /* the tank holds no propellant: the thrusters that draw from it produce no thrust */
 
 /* ------------------------------------------------------------------------------------------ */
 /* Errors: the Rust DecodeError variants, plus FD_ERR_CAPACITY for caller storage.              */

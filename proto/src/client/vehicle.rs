@@ -139,7 +139,11 @@ pub struct VehicleConfig {
     /// particles): kept as tables, for their count.
     #[serde(default)]
     pub slosh_pendulums: Vec<toml::Table>,
-    /// `[[magnetorquers]]`, in file order (effector indices after the slosh bodies).
+    /// `[[propellant_tanks]]`, in file order (effector indices after the slosh bodies): kept as
+    /// tables, for their count (their telemetry is the propellant left; they take no input).
+    #[serde(default)]
+    pub propellant_tanks: Vec<toml::Table>,
+    /// `[[magnetorquers]]`, in file order (effector indices after the propellant tanks).
     #[serde(default)]
     pub magnetorquers: Vec<Magnetorquer>,
     /// `[[thrusters]]`, in file order (effector indices after the magnetorquers).
@@ -199,10 +203,15 @@ impl VehicleConfig {
         self.first_chain_index() + self.panel_chains.len() as u32
     }
 
-    /// The effector index of the first magnetorquer (after every appended body: pairs, wheels,
-    /// chains, slosh bodies).
-    pub fn first_magnetorquer_index(&self) -> u32 {
+    /// The effector index of the first propellant tank (after every fuel-slosh body).
+    pub fn first_tank_index(&self) -> u32 {
         self.first_slosh_index() + (self.slosh_linear.len() + self.slosh_pendulums.len()) as u32
+    }
+
+    /// The effector index of the first magnetorquer (after every appended body: pairs, wheels,
+    /// chains, slosh bodies, propellant tanks).
+    pub fn first_magnetorquer_index(&self) -> u32 {
+        self.first_tank_index() + self.propellant_tanks.len() as u32
     }
 
     /// The effector index of the first thruster (after every magnetorquer).
@@ -416,6 +425,10 @@ pub struct Thruster {
     /// `"on_time_s"` (absent) or `"duty_cycle"`: what its one input means.
     #[serde(default)]
     pub command: Option<String>,
+    /// The `[[propellant_tanks]]` entry it draws from (absent: none; its thrust does not
+    /// change the vehicle's mass).
+    #[serde(default)]
+    pub tank: Option<String>,
 }
 
 /// One `[[imus]]` entry.

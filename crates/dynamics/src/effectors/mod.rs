@@ -4,6 +4,7 @@
 
 pub mod panel_chain;
 pub mod panel_pair;
+pub mod propellant_tank;
 pub mod reaction_wheel;
 pub mod slosh_linear;
 pub mod slosh_pendulum;

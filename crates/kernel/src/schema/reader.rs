@@ -67,6 +67,18 @@ impl<'a, 'i> TableReader<'a, 'i> {
         join_key(&self.path, key)
     }
 
+    /// An error at `key` of this table, located at its value (or at the table when absent):
+    /// for a key that is well-formed but not allowed beside the others.
+    pub fn refuse(&self, key: &str, message: String) -> SchemaError {
+        SchemaError::InvalidValue {
+            field: self.field(key),
+            message,
+            at: self
+                .get(key)
+                .map_or(self.at, |v| self.at_span(v.span().start)),
+        }
+    }
+
     fn at_span(&self, start: usize) -> At {
         At(Some(location(self.source, start)))
     }

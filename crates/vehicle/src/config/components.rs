@@ -55,6 +55,21 @@ pub(super) fn resolve(
         unique_name(map, &path, c.name(), &mut names, c.kind().noun)?;
         c.validate(&path, timing).map_err(|e| map.param_error(e))?;
     }
+    // Every entry another names (a thruster's `tank`) exists.
+    for (path, c) in components.with_paths() {
+        let Some(r) = c.refers_to() else {
+            continue;
+        };
+        if !components
+            .iter()
+            .any(|o| o.kind().section == r.section && o.name() == r.name)
+        {
+            return Err(map.invalid(
+                &format!("{path}.{}", r.field),
+                format!("no [[{}]] entry is named `{}`", r.section, r.name),
+            ));
+        }
+    }
     Ok(components)
 }
 
@@ -79,7 +94,7 @@ mod tests {
     #[test]
     fn wire_names_match_what_each_built_effector_says() {
         let mut kinds = std::collections::BTreeSet::new();
-        for scenario in ["acs_full", "slosh", "panel_chain"] {
+        for scenario in ["acs_full", "slosh", "panel_chain", "depletion"] {
             let text = std::fs::read_to_string(format!(
                 "{}/../../scenarios/{scenario}.toml",
                 env!("CARGO_MANIFEST_DIR")
@@ -92,8 +107,8 @@ mod tests {
             assert!(sc.effector_count() >= 2);
             check_wire_names(&sc, &mut kinds);
         }
-        // Between them, acs_full, slosh and panel_chain have every registered kind, bodies and
-        // actuators.
+        // Between them, acs_full, slosh, panel_chain and depletion have every registered kind,
+        // bodies and actuators.
         let registered: std::collections::BTreeSet<_> =
             kinds::KINDS.iter().map(|k| k.effector.name).collect();
         assert_eq!(kinds, registered);

@@ -249,7 +249,7 @@ impl SimConfig {
         )?;
         sc.set_integrator(self.integrator);
         for actuator in listed {
-            sc.add_dynamic_effector(actuator);
+            sc.try_add_dynamic_effector(actuator)?;
         }
         if let Some(env) = &self.environment {
             world::add_dynamic_effectors(&mut sc, env, &self.gravity);

@@ -43,8 +43,8 @@ pub struct EffectorInputSegment {
     /// \[ns\] time from which the inputs apply (until the same effector's next row).
     pub t_start_ns: u64,
     /// The effector's index in the spacecraft's effector order (panel pairs, reaction wheels,
-    /// the appended bodies of the generic list: panel chains, slosh bodies; then the
-    /// actuators), as in `StateMsg.effectors` and `Actuators` commands.
+    /// the appended bodies of the generic list: panel chains, slosh bodies, propellant tanks;
+    /// then the actuators), as in `StateMsg.effectors` and `Actuators` commands.
     pub effector_index: usize,
     /// Its inputs, one per [`flexdyn_dynamics::StateEffector::input_names`] (a wheel: the motor
     /// torque, N·m, about +ĝ_s).

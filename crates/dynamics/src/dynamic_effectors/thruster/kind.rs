@@ -4,7 +4,8 @@
 
 use super::{schema, Thruster, ThrusterParams, KIND, OUTPUT_NAMES};
 use crate::component::{
-    read_boxed, BuiltComponent, ComponentKind, ComponentParams, ComponentReader, StepTiming,
+    read_boxed, BuiltComponent, ComponentKind, ComponentParams, ComponentReader, ComponentRef,
+    StepTiming,
 };
 use flexdyn_kernel::validate::ParamError;
 
@@ -33,6 +34,13 @@ impl ComponentParams for ThrusterParams {
     }
     fn wire_counts(&self) -> (usize, usize) {
         (0, OUTPUT_NAMES.len())
+    }
+    fn refers_to(&self) -> Option<ComponentRef<'_>> {
+        self.tank.as_deref().map(|name| ComponentRef {
+            field: "tank",
+            section: crate::effectors::propellant_tank::kind::COMPONENT.section,
+            name,
+        })
     }
     fn build(&self, path: &str, timing: StepTiming) -> Result<BuiltComponent, ParamError> {
         let thruster = Thruster::new(self.clone(), path, timing.frame_ns, timing.step_ns)?;

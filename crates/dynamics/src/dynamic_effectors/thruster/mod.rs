@@ -28,8 +28,19 @@
 //! exhaust) at the nozzle point T, so the torque about B is r_T/B × F (Sidi, *Spacecraft
 //! Dynamics and Control*, §7.2). Propellant follows ṁ = F/(I_sp g₀), g₀ = 9.806 65 m/s²
 //! (Sutton & Biblarz, *Rocket Propulsion Elements*, 9th ed., eq. 2-5), so the propellant used is
-//! the impulse over I_sp g₀. The vehicle's mass and inertia are kept constant: the propellant
-//! used is reported, not removed (a tank that moves the mass properties is not modelled).
+//! the impulse over I_sp g₀. Without `tank` the vehicle's mass and inertia are kept constant:
+//! the propellant used is reported, not removed.
+//!
+//! **Drawing from a tank.** With `tank = "<name>"` the thruster burns the propellant of that
+//! `[[propellant_tanks]]` entry ([`crate::effectors::propellant_tank`]): the spacecraft sums its
+//! thrusters' step demands F̄/(I_sp g₀), and the tank's mass falls at that rate over the step
+//! (linearly, exact for the step-average force), moving the vehicle's mass, centre of mass and
+//! inertia. In the step the tank runs dry every thruster it feeds delivers the fraction s of its
+//! force that empties the tank exactly at the step's end, and none after it (s = 0; the tank
+//! flags `EMPTY`). A fed thruster also adds the mass-depletion force of its exhaust leaving the
+//! rotating vehicle, −ṁ ω × r_T/B applied at T, whose moment is the jet damping
+//! −ṁ [r̃_T/B][r̃_T/B]ᵀ ω (the tank module's (D3)–(D4)).
+//!
 //! A pulse is one opening of the valve; PWM at duty 1 holds it open and counts once.
 //!
 //! Basilisk's `ThrusterDynamicEffector` ramps thrust linearly over fixed on/off ramp times and
@@ -125,6 +136,9 @@ pub struct ThrusterParams {
     pub tail_off_time_constant_s: f64,
     /// What the input means.
     pub command: ThrusterCommand,
+    /// The `[[propellant_tanks]]` entry it draws from, by name; `None`: it burns nothing the
+    /// vehicle carries (its mass properties stay constant).
+    pub tank: Option<String>,
 }
 
 impl ThrusterParams {
@@ -157,7 +171,14 @@ impl ThrusterParams {
             path,
             "tail_off_time_constant_s",
             self.tail_off_time_constant_s,
-        )
+        )?;
+        if self.tank.as_deref() == Some("") {
+            return Err(ParamError::Invalid {
+                field: join(path, "tank"),
+                problem: "must name a [[propellant_tanks]] entry, not be empty".into(),
+            });
+        }
+        Ok(())
     }
 }
 
@@ -222,6 +243,9 @@ pub struct Thruster {
     force_avg_newton: f64,
     pulse_count: u64,
     impulse_n_s: f64,
+    /// The fraction of the step's force its tank can feed (1 without a tank, or while the tank
+    /// has enough; [`DynamicEffector::set_propellant_supply`]).
+    supply: f64,
 }
 
 impl Thruster {
@@ -251,6 +275,7 @@ impl Thruster {
             force_avg_newton: 0.0,
             pulse_count: 0,
             impulse_n_s: 0.0,
+            supply: 1.0,
         };
         t.solve_step(0);
         Ok(t)
@@ -295,6 +320,13 @@ impl Thruster {
     pub fn propellant_used_kg(&self) -> f64 {
         self.impulse_n_s / (self.params.isp_s * G0_M_S2)
     }
+
+    /// \[kg/s\] the mass flow over the step being integrated, after its tank's supply:
+    /// s F̄ / (I_sp g₀).
+    #[inline]
+    pub fn mass_flow_kg_s(&self) -> f64 {
+        self.supply * self.force_avg_newton / (self.params.isp_s * G0_M_S2)
+    }
 }
 
 impl DynamicEffector for Thruster {
@@ -314,28 +346,53 @@ impl DynamicEffector for Thruster {
         if t_step_ns != self.t_anchor_ns && self.step.t_end_ns == t_step_ns {
             let s = self.step;
             self.kappa = s.kappa_end;
-            self.impulse_n_s += self.params.max_thrust_newton * s.kappa_integral_s;
+            if self.params.tank.is_some() {
+                self.impulse_n_s +=
+                    self.params.max_thrust_newton * s.kappa_integral_s * self.supply;
+            } else {
+                self.impulse_n_s += self.params.max_thrust_newton * s.kappa_integral_s;
+            }
             self.pulse_count += u64::from(s.opens);
             self.valve_open = s.open_at_end;
         }
         self.t_anchor_ns = t_step_ns;
         self.solve_step(t_step_ns);
+        // Full supply until the spacecraft says what the tank can feed over this step.
+        self.supply = 1.0;
     }
 
-    fn add_force_torque(
-        &mut self,
-        _stage: &StageState,
-        _env: &EnvironmentSample,
-        sum: &mut Wrench,
-    ) {
+    fn add_force_torque(&mut self, stage: &StageState, _env: &EnvironmentSample, sum: &mut Wrench) {
         if self.force_avg_newton == 0.0 {
             // A shut, spent thruster adds ±0 to each component: nothing (a sum that is exactly
             // −0 would become +0, which no later operation tells apart from −0 but a sign).
             return;
         }
-        let f_b = self.params.force_axis_b * self.force_avg_newton;
+        if self.params.tank.is_none() {
+            let f_b = self.params.force_axis_b * self.force_avg_newton;
+            sum.force_b_newton += f_b;
+            sum.torque_b_nm += self.params.r_tb_b_m.cross(&f_b);
+            return;
+        }
+        // Fed by a tank: the thrust the supply allows, plus the exhaust's mass-depletion force
+        // −ṁ ω × r_T/B at T (tank module, (D3)); its moment r_T/B × (−ṁ ω × r_T/B) is the
+        // jet damping −ṁ [r̃][r̃]ᵀ ω (D4).
+        let r = &self.params.r_tb_b_m;
+        let f_b = self.params.force_axis_b * (self.force_avg_newton * self.supply)
+            - stage.omega_bn_b_rad_s.cross(r) * self.mass_flow_kg_s();
         sum.force_b_newton += f_b;
-        sum.torque_b_nm += self.params.r_tb_b_m.cross(&f_b);
+        sum.torque_b_nm += r.cross(&f_b);
+    }
+
+    fn propellant_tank(&self) -> Option<&str> {
+        self.params.tank.as_deref()
+    }
+
+    fn propellant_demand_kg_s(&self) -> f64 {
+        self.force_avg_newton / (self.params.isp_s * G0_M_S2)
+    }
+
+    fn set_propellant_supply(&mut self, fraction: f64) {
+        self.supply = fraction;
     }
 
     fn parameters(&self, out: &mut Vec<(String, f64)>) {
@@ -397,7 +454,7 @@ impl DynamicEffector for Thruster {
     }
 
     fn outputs(&self, out: &mut [f64]) -> u32 {
-        out[0] = self.params.max_thrust_newton * self.kappa;
+        out[0] = self.params.max_thrust_newton * self.kappa * self.supply;
         out[1] = self.pulse_count as f64;
         out[2] = self.propellant_used_kg();
         out[3] = self.impulse_n_s;
@@ -432,6 +489,7 @@ impl DynamicEffector for Thruster {
             force_avg_newton,
             pulse_count,
             impulse_n_s,
+            supply,
         } = self;
         a.put(on_ns);
         a.put(command_flags);
@@ -447,6 +505,7 @@ impl DynamicEffector for Thruster {
         a.put(force_avg_newton);
         a.put(pulse_count);
         a.put(impulse_n_s);
+        a.put(supply);
     }
 }
 

@@ -5,7 +5,7 @@ use super::{ThrusterCommand, ThrusterParams};
 use flexdyn_kernel::schema::{vec3, SchemaError, TableReader};
 
 /// The keys of one `[[thrusters]]` entry (the first five are required).
-pub(crate) const KEYS: [&str; 9] = [
+pub(crate) const KEYS: [&str; 10] = [
     "name",
     "r_tb_b_m",
     "force_axis_b",
@@ -15,6 +15,7 @@ pub(crate) const KEYS: [&str; 9] = [
     "rise_time_constant_s",
     "tail_off_time_constant_s",
     "command",
+    "tank",
 ];
 
 /// Reads one entry (shape only; [`ThrusterParams::validate`] checks the values).
@@ -34,5 +35,6 @@ pub(crate) fn read(t: &TableReader<'_, '_>) -> Result<ThrusterParams, SchemaErro
         rise_time_constant_s: opt("rise_time_constant_s")?,
         tail_off_time_constant_s: opt("tail_off_time_constant_s")?,
         command,
+        tank: t.get("tank").map(|_| t.string("tank")).transpose()?,
     })
 }

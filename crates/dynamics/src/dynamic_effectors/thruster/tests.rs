@@ -16,6 +16,7 @@ fn params(tau_rise_s: f64, tau_fall_s: f64, min_on_s: f64) -> ThrusterParams {
         rise_time_constant_s: tau_rise_s,
         tail_off_time_constant_s: tau_fall_s,
         command: ThrusterCommand::OnTime,
+        tank: None,
     }
 }
 
