@@ -55,6 +55,7 @@ use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
 
+use super::albedo::AlbedoCap;
 use super::EnvironmentSample;
 
 /// \[m³/s²\] the Earth's gravitational parameter for the prediction (EGM-96 / WGS-84 value,
@@ -127,12 +128,14 @@ impl Request {
 const REQUEST_WORDS: usize = 7;
 /// The answer: the request it answers, then the sample.
 const ANSWER_WORDS: usize = REQUEST_WORDS + SAMPLE_WORDS;
-const SAMPLE_WORDS: usize = 15;
+/// The sample's scalar and vector fields, then whether it has an albedo cap and the cap.
+const SAMPLE_WORDS: usize = 16 + AlbedoCap::WORDS;
 
 fn sample_to_words(s: &EnvironmentSample) -> [u64; SAMPLE_WORDS] {
     let b = |x: f64| x.to_bits();
     let (bf, sun, moon, wind) = (s.b_field_n_t, s.r_sun_b_n_m, s.r_moon_b_n_m, s.wind_n_m_s);
-    [
+    let mut w = [0u64; SAMPLE_WORDS];
+    w[..16].copy_from_slice(&[
         s.t_sim_ns,
         b(bf.x),
         b(bf.y),
@@ -148,7 +151,16 @@ fn sample_to_words(s: &EnvironmentSample) -> [u64; SAMPLE_WORDS] {
         b(wind.x),
         b(wind.y),
         b(wind.z),
-    ]
+        u64::from(s.albedo.is_some()),
+    ]);
+    if let Some(cap) = &s.albedo {
+        let mut f = [0.0; AlbedoCap::WORDS];
+        cap.to_words(&mut f);
+        for (o, x) in w[16..].iter_mut().zip(f) {
+            *o = x.to_bits();
+        }
+    }
+    w
 }
 
 fn sample_from_words(w: &[u64]) -> EnvironmentSample {
@@ -162,6 +174,7 @@ fn sample_from_words(w: &[u64]) -> EnvironmentSample {
         shadow_factor: f(10),
         density_kg_m3: f(11),
         wind_n_m_s: v(12),
+        albedo: (w[15] != 0).then(|| AlbedoCap::from_words(&std::array::from_fn(|i| f(16 + i)))),
     }
 }
 
@@ -417,6 +430,13 @@ mod tests {
         out.b_field_n_t = req.r_bn_n_m * 1e-12;
         out.density_kg_m3 = req.v_bn_n_m_s.norm() * 1e-15;
         out.shadow_factor = 0.5;
+        // An albedo cap, so that the slot's words carry one too.
+        let albedo = crate::albedo::Albedo {
+            coefficient: 0.3,
+            earth_radius_m: 6.378e6,
+            irradiance_1au_w_m2: 1361.0,
+        };
+        out.albedo = albedo.cap(&req.r_bn_n_m, &Vector3::new(1.5e11, 2.0e10, 0.0));
     }
 
     fn request(t: u64) -> Request {
