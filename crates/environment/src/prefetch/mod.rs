@@ -485,11 +485,14 @@ mod tests {
     /// reads no cap (the stale words behind the head are not read).
     #[test]
     fn a_sample_without_a_cap_after_one_with_a_cap_has_none() {
+        // Posted, served by `f` and picked up.
+        let round = |slot: &Slot, req: &Request, f: &dyn Fn(&Request, &mut EnvironmentSample)| {
+            assert!(slot.post(req) && slot.serve(&f));
+            slot.answer(req).expect("the worker's answer")
+        };
         let slot = Slot::new();
         let with_cap = request(100);
-        assert!(slot.post(&with_cap));
-        assert!(slot.serve(&fill));
-        let answer = slot.answer(&with_cap).unwrap();
+        let answer = round(&slot, &with_cap, &fill);
         assert!(answer.albedo.is_some());
         assert_eq!(answer, direct(&with_cap));
         let without = request(200);
@@ -497,9 +500,7 @@ mod tests {
             fill(req, out);
             out.albedo = None;
         };
-        assert!(slot.post(&without));
-        assert!(slot.serve(&no_cap));
-        let answer = slot.answer(&without).unwrap();
+        let answer = round(&slot, &without, &no_cap);
         assert_eq!(answer.albedo, None);
         assert_eq!(answer.b_field_n_t, direct(&without).b_field_n_t);
     }
