@@ -26,6 +26,10 @@
 //! firing every step, each drawing from its own propellant tank, against the same thrusters
 //! without tanks, per tank and beside one panel pair; and 4 tanks nothing draws from.
 //! `FLEXDYN_BENCH_ONLY=tank cargo bench --bench step` runs only these rows and the pair fit.
+//! Issue 39 §4 (Earth albedo): the cost of one environment update's albedo cap and of one
+//! coarse-sun detector's sum over it, then the LEO scenario's step with the cap evaluated at
+//! every step, and its frame loop (all on at 10 Hz, offloaded, with its coarse sun array), with
+//! albedo against without, beside one panel pair. `FLEXDYN_BENCH_ONLY=albedo` runs only these.
 //!
 //! Peers in the same run: with `FLEXDYN_PEERS_PYTHON` pointing at a Python that has
 //! `mujoco==4.0.0` and `bsk==2.12.1` (see `tools/peers/README.md`), the bench then runs
@@ -692,18 +696,7 @@ fn chain_summary(pair_ns: Option<f64>) {
     for (n, ns) in &rows {
         println!("{n:>6} {ns:>14.1} {:>16.1}", ns - base);
     }
-    // Alone (FLEXDYN_BENCH_ONLY=chain), one added pair is measured here: the slope over 1, 2,
-    // 4 and 8 pairs.
-    let pair_ns = pair_ns.unwrap_or_else(|| {
-        let pairs: Vec<(f64, f64)> = [1, 2, 4, 8]
-            .iter()
-            .map(|&n| {
-                let ns = common::median_ns_per_step(&mut spacecraft(n), batches, steps);
-                (n as f64, ns)
-            })
-            .collect();
-        fit(&pairs).1
-    });
+    let pair_ns = pair_ns.unwrap_or_else(|| pair_ns_alone(batches, steps));
     println!(
         "linear fit: {intercept:.1} ns + {slope:.1} ns per link; one panel pair adds \
          {pair_ns:.1} ns, so a link costs {:.2} pairs",
@@ -732,18 +725,103 @@ fn chain_summary(pair_ns: Option<f64>) {
     }
 }
 
+/// Alone (`FLEXDYN_BENCH_ONLY=chain`, `tank` or `albedo`), one added pair is measured here: the slope of
+/// the medians over 1, 2, 4 and 8 pairs.
+fn pair_ns_alone(batches: usize, steps: usize) -> f64 {
+    let pairs: Vec<(f64, f64)> = [1, 2, 4, 8]
+        .iter()
+        .map(|&n| {
+            let ns = common::median_ns_per_step(&mut spacecraft(n), batches, steps);
+            (n as f64, ns)
+        })
+        .collect();
+    fit(&pairs).1
+}
+
+/// Median ns per call of `f` over 31 batches of `calls` calls.
+fn median_ns_per_call(calls: usize, mut f: impl FnMut(usize)) -> f64 {
+    let samples: Vec<f64> = (0..31)
+        .map(|_| {
+            let t = Instant::now();
+            for i in 0..calls {
+                f(i);
+            }
+            t.elapsed().as_secs_f64() * 1e9 / calls as f64
+        })
+        .collect();
+    median(samples)
+}
+
+/// Earth albedo on the coarse sun sensors (issue 39 §4): the cost of one environment update's
+/// cap (`Albedo::cap`, (A3)–(A6), on the environment worker in the server) and of one
+/// detector's sum (`AlbedoCap::irradiance_fraction`, (A7), on the physics thread); then per
+/// step, in `scenarios/leo_environment.toml`: the cap evaluated at every step on the stepping
+/// thread (the worst case, `update_hz = 1000`), and the frame loop of its 6-detector array with
+/// everything on at 10 Hz and the environment offloaded (the server's way), with albedo against
+/// without; each against one panel pair (`pair_ns`, measured here when `None`).
+fn albedo_summary(pair_ns: Option<f64>) {
+    use flexdyn_environment::albedo::Albedo;
+    use nalgebra::Vector3;
+    let albedo = Albedo {
+        coefficient: 0.3,
+        earth_radius_m: 6_378_137.0,
+        irradiance_1au_w_m2: 1361.0,
+    };
+    // B on a 500 km circle (a different point per call), the Sun 1 au away off its plane.
+    let r_b = |i: usize| {
+        let a = i as f64 * 1e-3;
+        6_878e3 * Vector3::new(a.cos(), a.sin(), 0.1)
+    };
+    let sun = Vector3::new(1.2e11, 0.5e11, 0.6e11);
+    let cap_ns = median_ns_per_call(10_000, |i| {
+        black_box(albedo.cap(black_box(&r_b(i)), &sun));
+    });
+    let cap = albedo.cap(&r_b(0), &sun).unwrap();
+    let detector_ns = median_ns_per_call(100_000, |i| {
+        let n = Vector3::new(-1.0, (i % 7) as f64 * 0.1, 0.2).normalize();
+        black_box(cap.irradiance_fraction(black_box(&n), 0.17));
+    });
+    println!(
+        "
+Earth albedo: one cap (8 x 16 elements) {cap_ns:.1} ns per environment update; one \
+         detector's sum {detector_ns:.1} ns per array sample (median of 31 batches)"
+    );
+    let every = |lines: &str| format!("[environment]\nupdate_hz = 1000.0\n{lines}");
+    let sun_shadow = every("sun = true\nshadow = \"conical\"\n");
+    let with_albedo = every("sun = true\nshadow = \"conical\"\nalbedo = \"lambertian\"\n");
+    let mut sims = vec![leo_simulation(&sun_shadow), leo_simulation(&with_albedo)];
+    let ns = interleaved_ns_per_step(&mut sims, step_batch);
+    let pair_ns = pair_ns.unwrap_or_else(|| pair_ns_alone(11, 5_000));
+    println!(
+        "Simulation::step in scenarios/leo_environment.toml, sun + shadow updated every step on \
+         the stepping thread (median of 15 interleaved x 5000 steps):"
+    );
+    print_added_cost("environment", ns[0], &[("+ albedo", ns[1])], pair_ns);
+    // The scenario as shipped (its coarse sun sensors among its sensors), all on at 10 Hz,
+    // offloaded, with and without albedo.
+    let leo = include_str!("../scenarios/leo_environment.toml");
+    let frame_loop = |text: &str| {
+        let cfg = flexdyn_vehicle::config::SimConfig::from_toml_str(text).unwrap();
+        let mut sim = flexdyn_vehicle::sim::Simulation::new(&cfg).unwrap();
+        sim.offload_environment().unwrap();
+        sim
+    };
+    let on = leo.replacen("sun = true\n", "sun = true\nalbedo = \"lambertian\"\n", 1);
+    let mut sims = vec![frame_loop(leo), frame_loop(&on)];
+    let ns = interleaved_ns_per_step(&mut sims, frame_batch);
+    println!(
+        "frame loop of scenarios/leo_environment.toml (all on @ 10 Hz, offloaded; its sensors \
+         with one 6-detector coarse sun array @ 10 Hz) (median of 15 interleaved x 500 frames):"
+    );
+    print_added_cost("environment", ns[0], &[("+ albedo", ns[1])], pair_ns);
+}
+
 fn main() {
-    if std::env::var("FLEXDYN_BENCH_ONLY").as_deref() == Ok("chain") {
-        chain_summary(None);
-        return;
-    }
-    if std::env::var("FLEXDYN_BENCH_ONLY").as_deref() == Ok("tank") {
-        let pairs: Vec<(f64, f64)> = [1, 2, 4, 8]
-            .iter()
-            .map(|&n| (n as f64, median_ns_per_step(spacecraft(n))))
-            .collect();
-        tank_summary(fit(&pairs).1);
-        return;
+    match std::env::var("FLEXDYN_BENCH_ONLY").as_deref() {
+        Ok("chain") => return chain_summary(None),
+        Ok("albedo") => return albedo_summary(None),
+        Ok("tank") => return tank_summary(pair_ns_alone(11, 5_000)),
+        _ => {}
     }
     let mut c = Criterion::default().configure_from_args();
     bench_step(&mut c);
@@ -757,5 +835,6 @@ fn main() {
     actuator_summary(fit(&rows).1);
     sensor_summary(fit(&rows).1);
     chain_summary(Some(fit(&rows).1));
+    albedo_summary(Some(fit(&rows).1));
     peers(&rows);
 }

@@ -32,7 +32,7 @@ pub mod effector_kind {
     /// cycle (0–1), as configured.
     pub const THRUSTER: u16 = 4;
     /// A chain of N hinged panels. States `[θ1 rad, θ̇1 rad/s, θ2 rad, θ̇2 rad/s, …, θN
-    /// rad, θ̇N rad/s]` (θk relative to panel k − 1, 2N values, so N ≤ 4 on the wire); no
+    /// rad, θ̇N rad/s]` (θk relative to panel k − 1, 2N values, so N ≤ 16 on the wire); no
     /// outputs, no flags; N inputs, the hinge motor torques (N·m).
     pub const PANEL_CHAIN: u16 = 5;
     /// A linear spring-mass-damper fuel slosh particle. States `[ρ m, ρ̇ m/s]` (displacement of
@@ -317,8 +317,11 @@ pub mod environment_flags {
     pub const SHADOW: u8 = 1 << 4;
     /// Bit 5: an atmosphere model is on (`density_kg_m3`).
     pub const ATMOSPHERE: u8 = 1 << 5;
-    /// Bits 6..7 are reserved: senders write 0, receivers ignore them.
-    pub const RESERVED_MASK: u8 = !(EPOCH_VALID | MAGNETIC | SUN | MOON | SHADOW | ATMOSPHERE);
+    /// Bit 6: Earth albedo is on (`albedo_nadir_w_m2`; since protocol 11).
+    pub const ALBEDO: u8 = 1 << 6;
+    /// Bits 7..7 are reserved: senders write 0, receivers ignore them.
+    pub const RESERVED_MASK: u8 =
+        !(EPOCH_VALID | MAGNETIC | SUN | MOON | SHADOW | ATMOSPHERE | ALBEDO);
 }
 
 /// Bits of [`FswMsg::flags`]: which of its optional fields are set.
@@ -378,7 +381,7 @@ pub mod propellant_tank_flags {
 /// 30 bytes on the wire ([`HEADER_LEN`](crate::HEADER_LEN)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Header {
-    /// Always the protocol version (10); checked first, other values rejected. That is
+    /// Always the protocol version (11); checked first, other values rejected. That is
     /// [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION); decoders check it (the first two bytes, u16
     /// LE) before anything else.
     pub protocol_version: u16,
@@ -451,9 +454,9 @@ pub struct EffectorState {
     /// Kind-specific status bits (0 for kinds without flags). E.g. [`wheel_flags`].
     pub flags: u32,
     /// The kind's integrated states, in its order. In the units the kind documents
-    /// ([`effector_kind`]). At most 8 entries; decoders refuse more (Malformed).
+    /// ([`effector_kind`]). At most 32 entries; decoders refuse more (Malformed).
     pub states: Vec<f64>,
-    /// The kind's outputs, in its order. E.g. a wheel's applied torques. At most 8 entries;
+    /// The kind's outputs, in its order. E.g. a wheel's applied torques. At most 32 entries;
     /// decoders refuse more (Malformed).
     pub outputs: Vec<f64>,
 }
@@ -468,7 +471,7 @@ pub struct EffectorInput {
     /// Index in [`StateMsg`](crate::StateMsg) `effectors`.
     pub effector_index: u32,
     /// The effector kind's inputs ("Effector kinds") (finite). As many as the kind takes (a
-    /// reaction wheel: 1, the motor torque in N·m). At most 8 entries; decoders refuse more
+    /// reaction wheel: 1, the motor torque in N·m). At most 32 entries; decoders refuse more
     /// (Malformed).
     pub values: Vec<f64>,
 }
@@ -889,7 +892,7 @@ pub struct TimeMsg {
 /// at that instant, and each source's force and torque evaluated by that dynamic effector itself at
 /// the tick's state.
 ///
-/// Topic `flexdyn/<sc-id>/tlm/env`; 368 bytes ([`ENVIRONMENT_LEN`](crate::ENVIRONMENT_LEN)). Since
+/// Topic `flexdyn/<sc-id>/tlm/env`; 376 bytes ([`ENVIRONMENT_LEN`](crate::ENVIRONMENT_LEN)). Since
 /// protocol version 6.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EnvironmentMsg {
@@ -926,6 +929,11 @@ pub struct EnvironmentMsg {
     /// m × B (its force is zero). The residual dipole's torque in the field; a uniform field
     /// exerts no force.
     pub residual_dipole: AppliedWrench,
+    /// Earth albedo's irradiance on a plate at B facing the nadir with a full hemisphere of view; 0
+    /// when albedo is off (since protocol 11) (unit W/m²). The sum of the environment sample's
+    /// albedo cap over a nadir plate (`flexdyn_environment::albedo`, (A7) times S): what a
+    /// coarse-sun detector facing the nadir reads of albedo, in W/m².
+    pub albedo_nadir_w_m2: f64,
 }
 
 /// An operator's command: pause and resume a real-time run; in lockstep, run N ticks and then hold.

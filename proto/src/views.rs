@@ -811,6 +811,11 @@ impl<'a> EnvironmentView<'a> {
         read_applied_wrench(self.bytes, 320)
     }
 
+    /// [`EnvironmentMsg::albedo_nadir_w_m2`](crate::EnvironmentMsg::albedo_nadir_w_m2).
+    pub fn albedo_nadir_w_m2(&self) -> f64 {
+        rd::<f64>(self.bytes, 368)
+    }
+
     /// The owned message (allocates for a `vec`): for tests and tools.
     pub fn to_owned_msg(&self) -> crate::EnvironmentMsg {
         crate::EnvironmentMsg {
@@ -829,6 +834,7 @@ impl<'a> EnvironmentView<'a> {
             drag: self.drag(),
             solar_pressure: self.solar_pressure(),
             residual_dipole: self.residual_dipole(),
+            albedo_nadir_w_m2: self.albedo_nadir_w_m2(),
         }
     }
 

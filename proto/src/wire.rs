@@ -8,7 +8,7 @@ use crate::view::WirePrim;
 use crate::DecodeError;
 
 /// The wire protocol version every header carries.
-pub const PROTOCOL_VERSION: u16 = 10;
+pub const PROTOCOL_VERSION: u16 = 11;
 
 // Named constants.
 /// the largest buffer any decoder accepts (bytes); more is TooLarge.
@@ -16,7 +16,7 @@ pub const MAX_MESSAGE_BYTES: usize = 65536;
 /// the largest effector count of a StateMsg, and input count of an `Actuators` command.
 pub const MAX_EFFECTORS: usize = 1024;
 /// the largest length of an effector's `states`, `outputs` or input `values`.
-pub const MAX_EFFECTOR_VALUES: usize = 8;
+pub const MAX_EFFECTOR_VALUES: usize = 32;
 /// the most detectors one CssMsg carries (one coarse-sun-sensor array); a configuration may not
 /// have more.
 pub const MAX_CSS_DETECTORS: usize = 16;
@@ -89,7 +89,7 @@ pub const TIME_LEN: usize = 122;
 /// cuc_tai.
 pub const TIME_CUC_TAI_OFFSET: usize = 98;
 /// EnvironmentMsg, since protocol 6.
-pub const ENVIRONMENT_LEN: usize = 368;
+pub const ENVIRONMENT_LEN: usize = 376;
 /// OperatorMsg, since protocol 6.
 pub const OPERATOR_LEN: usize = 42;
 /// FaultEventMsg, since protocol 8.
@@ -126,8 +126,8 @@ fn walk_state(bytes: &[u8]) -> Result<usize, WalkError> {
     let n = w.count("effectors", 1024)?;
     for _ in 0..n {
         w.skip(6)?;
-        w.values("effectors[].states", 8, 8)?;
-        w.values("effectors[].outputs", 8, 8)?;
+        w.values("effectors[].states", 32, 8)?;
+        w.values("effectors[].outputs", 32, 8)?;
     }
     Ok(w.end())
 }
@@ -303,7 +303,7 @@ fn walk_command(bytes: &[u8]) -> Result<usize, WalkError> {
             let n = w.count("inputs", 1024)?;
             for _ in 0..n {
                 w.skip(4)?;
-                w.values("inputs[].values", 8, 8)?;
+                w.values("inputs[].values", 32, 8)?;
             }
             Ok(w.end())
         }

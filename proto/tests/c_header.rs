@@ -395,6 +395,7 @@ impl Gen {
                 drag: self.wrench(),
                 solar_pressure: self.wrench(),
                 residual_dipole: self.wrench(),
+                albedo_nadir_w_m2: self.f64(),
             }),
             11 => encode(&GpsMsg {
                 header: self.header(),

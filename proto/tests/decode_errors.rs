@@ -44,7 +44,7 @@ fn input(effector_index: u32, values: &[f64]) -> EffectorInput {
 
 #[test]
 fn unknown_version_is_checked_first() {
-    for version in [0u16, 1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 0xFFFF] {
+    for version in [0u16, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 12, 0xFFFF] {
         let mut b = encode(&StatusMsg::default());
         b[..2].copy_from_slice(&version.to_le_bytes());
         assert_eq!(
@@ -225,7 +225,7 @@ fn huge_counts_are_rejected_without_allocating() {
     s.effectors[0].states = vec![0.0; MAX_EFFECTOR_VALUES + 1];
     assert!(matches!(
         decode_state(&encode(&s)),
-        Err(DecodeError::Malformed(m)) if m.contains("effectors[].states count 9")
+        Err(DecodeError::Malformed(m)) if m.contains("effectors[].states count 33")
     ));
     s.effectors[0].states = vec![0.0; MAX_EFFECTOR_VALUES];
     s.effectors[0].outputs = vec![0.0; MAX_EFFECTOR_VALUES];
@@ -237,7 +237,7 @@ fn huge_counts_are_rejected_without_allocating() {
     let c = actuators(vec![input(0, &[0.0; MAX_EFFECTOR_VALUES + 1])]);
     assert!(matches!(
         decode_command(&encode(&c)),
-        Err(DecodeError::Malformed(m)) if m.contains("inputs[].values count 9")
+        Err(DecodeError::Malformed(m)) if m.contains("inputs[].values count 33")
     ));
 }
 
@@ -443,7 +443,7 @@ fn encode_into_reuses_the_buffer() {
 fn header_new_sets_version() {
     let h = Header::new(1, 2, 3, 4);
     assert_eq!(h.protocol_version, flexdyn_proto::PROTOCOL_VERSION);
-    assert_eq!(Header::default().protocol_version, 10);
+    assert_eq!(Header::default().protocol_version, 11);
     assert_eq!(StateMsg::default().q_bn, [1.0, 0.0, 0.0, 0.0]);
 }
 

@@ -108,7 +108,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -368,7 +368,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -444,7 +444,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -491,7 +491,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -561,7 +561,7 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -592,7 +592,7 @@ const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
     (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
 ];
 const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -612,8 +612,8 @@ const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
     ),
     (
         38,
-        "37",
-        "u8 flags = EPOCH_VALID | MAGNETIC | SUN | SHADOW | ATMOSPHERE = 0x37",
+        "77",
+        "u8 flags = EPOCH_VALID | MAGNETIC | SUN | SHADOW | ATMOSPHERE | ALBEDO = 0x77",
     ),
     (39, "01", "u8 eclipse = PENUMBRA = 1"),
     (
@@ -821,11 +821,18 @@ const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
         "0000000000000000",
         "f64 residual_dipole.force_b_newton[2] = 0.0 (bits 0x0000000000000000)",
     ),
+    // Protocol 11: 0.171875 = 11/64 = 1.375 × 2^-3: exponent 1023 − 3 = 0x3FC, fraction
+    // .375 = .011b → 0x6 in the top nibble.
+    (
+        368,
+        "000000000000c63f",
+        "f64 albedo_nadir_w_m2 = 0.171875 (bits 0x3FC6000000000000)",
+    ),
 ];
 
 // The sun sensors' tables (protocol 6, issue 20).
 const CSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -861,7 +868,7 @@ const CSS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const FSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -887,7 +894,7 @@ const FSS_GOLDEN: &[(usize, &str, &str)] = &[
     (46, "07", "u8 flags = VALID | IN_FOV | SUNLIT = 0x07"),
 ];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -931,7 +938,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
 /// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
 /// TAI …036.0 s). `crates/server/src/clock.rs` produces exactly this message from that epoch.
 const TIME_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -1004,7 +1011,7 @@ const TIME_GOLDEN: &[(usize, &str, &str)] = &[
     (118, "00000000", "u32 tone_tai.subseconds = 0"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -1021,7 +1028,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -1121,7 +1128,7 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
 // first live one) activated at tick 44: `bias_step` (mode 2) of 0.25 rad/s on axes 1 and 3 of
 // `imus.hub.gyro`, at 0.44 s exactly (edge = the boundary).
 const FAULT_EVENT_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -1169,7 +1176,7 @@ const FAULT_EVENT_GOLDEN: &[(usize, &str, &str)] = &[
 // `reaction_wheels.rw2`, at tick 0x1_0000_0005 (bytes on both sides of bit 32), for 2 s, seed
 // 7.
 const FAULT_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -1221,7 +1228,7 @@ const FAULT_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
 // Protocol 6 (issue 23, operator control): a `RunTicks` operator command. The tick count
 // 4294967301 = 0x1_0000_0005 has bytes on both sides of bit 32, so a u32 `ticks` would show.
 const OPERATOR_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -1454,7 +1461,7 @@ fn css_golden() {
 // ---- GpsMsg (protocol 7, issue 20): a self-contained block. ----
 /// GpsMsg, hand-derived from proto/README.md (147 bytes).
 const GPS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -1789,7 +1796,8 @@ fn environment_golden() {
             | environment_flags::MAGNETIC
             | environment_flags::SUN
             | environment_flags::SHADOW
-            | environment_flags::ATMOSPHERE,
+            | environment_flags::ATMOSPHERE
+            | environment_flags::ALBEDO,
         eclipse: eclipse::PENUMBRA,
         b_n_t: [2f64.powi(-15), -(2f64.powi(-16)), 2f64.powi(-17)],
         b_b_t: [-0.0, 2f64.powi(-14), -(2f64.powi(-18))],
@@ -1814,6 +1822,7 @@ fn environment_golden() {
             torque_b_nm: [0.125, -0.25, 2f64.powi(-7)],
             force_b_newton: [0.0; 3],
         },
+        albedo_nadir_w_m2: 0.171875,
     };
     check("EnvironmentMsg", ENVIRONMENT_GOLDEN, &msg);
     assert_eq!(encode(&msg).len(), ENVIRONMENT_LEN);
@@ -1933,7 +1942,7 @@ fn exported_golden_files_match_the_tables() {
 /// RelativeStateMsg, hand-derived from proto/README.md (102 bytes): deputy 0x11223344 at
 /// tick 1000 (t = 10 s) relative to chief 1.
 const RELATIVE_STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",
@@ -2018,7 +2027,7 @@ fn relative_state_golden() {
 /// vehicle 0x11223344 answering tick 1000 (t = 10 s), its 7th, with every optional field set,
 /// two events and three value words (an f64, an i64 and a bool, in that declared order).
 const FSW_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0a00", "u16 header.protocol_version = 10"),
+    (0, "0b00", "u16 header.protocol_version = 11"),
     (
         2,
         "44332211",

@@ -129,6 +129,23 @@ fn a_resumed_run_writes_the_uninterrupted_rows_bit_for_bit() {
     // Every sensor kind but the GPS, wheels, thrusters, magnetorquers, the environment
     // (IGRF, Sun, Moon, shadow, drag and SRP facets) and flight-code streams.
     resume_matches("acs_full", Some(&scenario("acs_full")), "30", "0.1", "12.3");
+    // The same with Earth albedo on the coarse sun sensors: the environment's held sample
+    // carries the visible cap.
+    let with_albedo = std::fs::read_to_string(scenario("acs_full"))
+        .unwrap()
+        .replace(
+            "[environment]\n",
+            "[environment]\nalbedo = \"lambertian\"\n",
+        );
+    let albedo_cfg = scratch("acs_full_albedo.toml");
+    std::fs::write(&albedo_cfg, with_albedo).unwrap();
+    resume_matches(
+        "acs_full_albedo",
+        Some(albedo_cfg.to_str().unwrap()),
+        "20",
+        "0.1",
+        "9.9",
+    );
     // A GPS with latency, and the environment record.
     resume_matches(
         "leo_environment",

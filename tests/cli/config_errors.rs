@@ -1565,6 +1565,41 @@ fn world_rows() -> Vec<Case> {
                 assert_eq!(sc.dynamic_effectors().len(), 1);
             },
         ),
+        // Earth albedo (issue 39 §4): off by default, 0.3 when on, needs the Sun.
+        accepts_and(
+            leo("moon = true", "moon = true\nalbedo = \"lambertian\""),
+            |cfg| {
+                let env = cfg.environment.as_ref().unwrap();
+                assert_eq!(env.albedo_coefficient, Some(0.3));
+            },
+        ),
+        accepts_and(leo("moon = true", "moon = true"), |cfg| {
+            assert_eq!(cfg.environment.as_ref().unwrap().albedo_coefficient, None);
+        }),
+        rejects(
+            leo(
+                "moon = true",
+                "moon = true\nalbedo = \"lambertian\"\nalbedo_coefficient = 1.3",
+            ),
+            "environment.albedo_coefficient",
+            &["1.3", "from 0 to 1"],
+        ),
+        rejects(
+            leo("moon = true", "moon = true\nalbedo_coefficient = 0.3"),
+            "environment.albedo_coefficient",
+            &["only used by albedo = \"lambertian\""],
+        ),
+        rejects(
+            leo("moon = true", "moon = true\nalbedo = \"toms\""),
+            "environment.albedo",
+            &["unknown model \"toms\""],
+        ),
+        rejects(
+            text("[hub]", "[environment]\nalbedo = \"lambertian\"\n\n[hub]"),
+            "environment.albedo",
+            &["sunlight reflected by the Earth", "environment.sun = true"],
+        )
+        .at_line_of("albedo = \"lambertian\"", None),
     ]
 }
 

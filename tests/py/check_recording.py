@@ -118,9 +118,9 @@ ENV_SOURCES = ("gravity_gradient", "drag", "solar_pressure", "residual_dipole")
 
 
 def decode_environment_raw(data):
-    """An EnvironmentMsg (368 bytes, proto/README.md offsets), as the JSON channel names it."""
-    if len(data) != 368:
-        fail("EnvironmentMsg of %d bytes (expected 368)" % len(data))
+    """An EnvironmentMsg (376 bytes, proto/README.md offsets), as the JSON channel names it."""
+    if len(data) != 376:
+        fail("EnvironmentMsg of %d bytes (expected 376)" % len(data))
     version, sc, tick, t_ns, seq = struct.unpack_from("<HIQQQ", data, 0)
     f = lambda off, n: list(struct.unpack_from("<%dd" % n, data, off))
     out = {
@@ -133,6 +133,7 @@ def decode_environment_raw(data):
     }
     for i, src in enumerate(ENV_SOURCES):
         out[src] = {"torque_b_nm": f(176 + 48 * i, 3), "force_b_newton": f(200 + 48 * i, 3)}
+    out["albedo_nadir_w_m2"] = f(368, 1)[0]  # since protocol 11
     return out
 
 

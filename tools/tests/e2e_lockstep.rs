@@ -206,16 +206,31 @@ fn lockstep_run_settings(
 /// exactly the protocol-9 values (`ba61b8e0…c0462d425558820d29378e94ed5c5f313` and
 /// `42e17d0f…c34cb7041e47ce5a6c68c4de9`), checked by running every e2e_lockstep test with the
 /// byte rewritten before this re-mint.
+///
+/// Protocol version 11 (Earth albedo and 32 effector values, issue 39 §4; StateMsg's layout is
+/// unchanged) is checked without a re-mint: [`digest`] hashes each StateMsg with its version
+/// bytes written back to [`MINTED_PROTOCOL_VERSION`] (after checking they are the current
+/// version), which is what each re-mint above checked by hand; every other byte as received.
 const GYRO_FEEDBACK_SHA256: &str =
     "f4d3ac80bfbfb1eecbe7f964b43a02f7e17be1bf797c11a4c5b83c980f2de319";
 const WHEELS_ON_SENSORS_SHA256: &str =
     "5881e6e1ed9efba1e91f3456997b6d57e547b906a69fc1ef56afc0a9c521a061";
 
+/// The protocol version the goldens were minted at.
+const MINTED_PROTOCOL_VERSION: u16 = 10;
+
 fn digest(states: &[(u64, Vec<u8>)]) -> String {
     let mut h = Sha256::new();
     for (i, (tick, bytes)) in states.iter().enumerate() {
         assert_eq!(*tick, i as u64, "ticks are not contiguous from 0");
-        h.update(bytes);
+        let (version, rest) = bytes.split_at(2);
+        assert_eq!(
+            version,
+            flexdyn_proto::PROTOCOL_VERSION.to_le_bytes(),
+            "a StateMsg's version bytes"
+        );
+        h.update(MINTED_PROTOCOL_VERSION.to_le_bytes());
+        h.update(rest);
     }
     h.finalize().iter().map(|b| format!("{b:02x}")).collect()
 }

@@ -15,7 +15,7 @@ use crate::error::{Code, Error};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FdHeader {
-    /// always the protocol version (10); checked first, other values rejected
+    /// always the protocol version (11); checked first, other values rejected
     pub protocol_version: u16,
     /// numeric vehicle id
     pub spacecraft_id: u32,
@@ -48,10 +48,10 @@ pub struct FdEffectorState {
     pub flags: u32,
     pub n_states: u64,
     /// the kind's integrated states, in its order
-    pub states: [f64; 8],
+    pub states: [f64; 32],
     pub n_outputs: u64,
     /// the kind's outputs, in its order
-    pub outputs: [f64; 8],
+    pub outputs: [f64; 32],
 }
 
 /// `fd_effector_input`: [`EffectorInput`](flexdyn_proto::EffectorInput) as the C header declares
@@ -63,7 +63,7 @@ pub struct FdEffectorInput {
     pub effector_index: u32,
     pub n_values: u64,
     /// the effector kind's inputs ("Effector kinds")
-    pub values: [f64; 8],
+    pub values: [f64; 32],
 }
 
 /// `fd_sys_time`: [`SysTime`](flexdyn_proto::SysTime) as the C header declares it.
@@ -323,6 +323,9 @@ pub struct FdEnvironmentMsg {
     pub solar_pressure: FdSourceWrench,
     /// m × B (its force is zero)
     pub residual_dipole: FdSourceWrench,
+    /// W/m²: Earth albedo's irradiance on a plate at B facing the nadir with a full hemisphere of
+    /// view; 0 when albedo is off (since protocol 11)
+    pub albedo_nadir_w_m2: f64,
 }
 
 /// `fd_operator_msg`: [`OperatorMsg`](flexdyn_proto::OperatorMsg) as the C header declares it.
@@ -682,6 +685,7 @@ impl From<&flexdyn_proto::EnvironmentMsg> for FdEnvironmentMsg {
             drag: (&m.drag).into(),
             solar_pressure: (&m.solar_pressure).into(),
             residual_dipole: (&m.residual_dipole).into(),
+            albedo_nadir_w_m2: m.albedo_nadir_w_m2,
         }
     }
 }

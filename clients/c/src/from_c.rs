@@ -54,11 +54,11 @@ mod tests {
     fn bad_effector_inputs_are_named() {
         let mut c = FdEffectorInput {
             effector_index: 4,
-            n_values: 9,
+            n_values: 33,
             ..FdEffectorInput::default()
         };
         let e = effector_input(2, &c).unwrap_err();
-        assert_eq!(e.message, "inputs[2].n_values = 9 exceeds 8");
+        assert_eq!(e.message, "inputs[2].n_values = 33 exceeds 32");
         c.n_values = 2;
         c.values[1] = f64::NAN;
         let e = effector_input(0, &c).unwrap_err();

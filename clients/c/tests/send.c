@@ -67,8 +67,8 @@ int main(int argc, char **argv) {
         bad = 1;
     }
     torque[1] = 0.0;
-    in[1].n_values = 9;
-    bad |= expect(c, "9 values", flexdyn_send_actuators(c, 7, &st.header, torque, force, in, 2),
+    in[1].n_values = 33; /* MAX_EFFECTOR_VALUES + 1 */
+    bad |= expect(c, "33 values", flexdyn_send_actuators(c, 7, &st.header, torque, force, in, 2),
                   FLEXDYN_ERR_ARGUMENT);
     bad |= expect(c, "null stamp", flexdyn_send_no_command(c, 7, NULL), FLEXDYN_ERR_ARGUMENT);
     bad |= expect(c, "close", flexdyn_close(c), FLEXDYN_OK);

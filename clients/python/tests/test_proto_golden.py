@@ -185,13 +185,14 @@ def test_environment(golden_dir):
     m = EnvironmentMsg(
         Header(SC, 17, 170_000_000, 2), 0x0102030405060708,
         proto.ENVIRONMENT_EPOCH_VALID | proto.ENVIRONMENT_MAGNETIC | proto.ENVIRONMENT_SUN
-        | proto.ENVIRONMENT_SHADOW | proto.ENVIRONMENT_ATMOSPHERE, proto.ECLIPSE_PENUMBRA,
+        | proto.ENVIRONMENT_SHADOW | proto.ENVIRONMENT_ATMOSPHERE | proto.ENVIRONMENT_ALBEDO,
+        proto.ECLIPSE_PENUMBRA,
         (2.0**-15, -(2.0**-16), 2.0**-17), (-0.0, 2.0**-14, -(2.0**-18)), (0.5, -0.5, 0.75),
         (0.25, 1.0, -0.125), (-1.0, 0.375, 0.0625), 0.625, 2.0**-40,
         SourceWrench((2.0**-20, -(2.0**-21), 2.0**-22), (2.0**-30, 0.0, -(2.0**-31))),
         SourceWrench((1.5, -2.5, 3.5), (4.0, -8.0, 16.0)),
         SourceWrench((2.0**-24, 2.0**-25, 2.0**-26), (-(2.0**-24), -(2.0**-25), -(2.0**-26))),
-        SourceWrench((0.125, -0.25, 2.0**-7), (0.0, 0.0, 0.0)))
+        SourceWrench((0.125, -0.25, 2.0**-7), (0.0, 0.0, 0.0)), 0.171875)
     golden = (golden_dir / "environment.bin").read_bytes()
     assert len(golden) == proto.ENVIRONMENT_LEN
     assert m.encode() == golden

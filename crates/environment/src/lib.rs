@@ -44,6 +44,8 @@
 //!   coefficients, and the torque on a residual dipole.
 //! - [`atmosphere`]: exponential (Vallado Table 8-4) and NRLMSISE-00 densities, and the wind of a
 //!   co-rotating atmosphere.
+//! - [`albedo`]: sunlight reflected by the Earth (a Lambertian sphere of uniform albedo), the
+//!   visible cap discretised for the coarse sun sensors.
 //! - [`cannonball`]: the cannonball model of solar radiation pressure (a sphere of area A and
 //!   coefficient C_R).
 //! - [`facets`]: the flat-plate model of the vehicle's surfaces: drag and solar-radiation-pressure
@@ -58,6 +60,7 @@
 
 #![warn(missing_docs)]
 
+pub mod albedo;
 pub mod atmosphere;
 pub mod cannonball;
 pub mod common;

@@ -4,10 +4,12 @@
 //! magnetic field, the ephemerides and the density) and held between updates; the dynamic
 //! effectors combine it with the hub state of each RK4 stage (attitude, position, velocity).
 //! A quantity whose model is off keeps its neutral value ([`EnvironmentSample::NONE`]): no field,
-//! no Sun (a zero vector), full sunlight, vacuum, no wind. That way an effector never has to ask
+//! no Sun (a zero vector), full sunlight, vacuum, no wind, no albedo. That way an effector never has to ask
 //! whether a model exists: a magnetic torque in a zero field is zero.
 
 use nalgebra::Vector3;
+
+use crate::albedo::AlbedoCap;
 
 /// The environment at one instant, in the inertial frame N unless a name says otherwise.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,10 +31,13 @@ pub struct EnvironmentSample {
     /// \[m/s\] velocity of the local atmosphere relative to N, N components (e.g. a co-rotating
     /// atmosphere's ω_E × r).
     pub wind_n_m_s: Vector3<f64>,
+    /// The Earth's visible cap discretised for albedo ([`crate::albedo`]); `None` when albedo is
+    /// off (or B is not above the Earth).
+    pub albedo: Option<AlbedoCap>,
 }
 
 impl EnvironmentSample {
-    /// No environment: no field, no Sun or Moon, full sunlight, vacuum, no wind.
+    /// No environment: no field, no Sun or Moon, full sunlight, vacuum, no wind, no albedo.
     pub const NONE: EnvironmentSample = EnvironmentSample {
         t_sim_ns: 0,
         b_field_n_t: Vector3::new(0.0, 0.0, 0.0),
@@ -41,6 +46,7 @@ impl EnvironmentSample {
         shadow_factor: 1.0,
         density_kg_m3: 0.0,
         wind_n_m_s: Vector3::new(0.0, 0.0, 0.0),
+        albedo: None,
     };
 }
 
@@ -63,6 +69,7 @@ impl flexdyn_kernel::archive::Archived for EnvironmentSample {
             shadow_factor,
             density_kg_m3,
             wind_n_m_s,
+            albedo,
         } = self;
         a.section("environment sample", |a| {
             a.put(t_sim_ns);
@@ -72,6 +79,38 @@ impl flexdyn_kernel::archive::Archived for EnvironmentSample {
             a.put(shadow_factor);
             a.put(density_kg_m3);
             a.put(wind_n_m_s);
+            let mut has_albedo = albedo.is_some();
+            a.put(&mut has_albedo);
+            if has_albedo {
+                let cap = albedo.get_or_insert(AlbedoCap {
+                    nadir_n: Vector3::zeros(),
+                    x_n: Vector3::zeros(),
+                    y_n: Vector3::zeros(),
+                    cos_eta: [0.0; crate::albedo::ALBEDO_RINGS],
+                    sin_eta: [0.0; crate::albedo::ALBEDO_RINGS],
+                    weight: [0.0; crate::albedo::ALBEDO_ELEMENTS],
+                    solar_irradiance_w_m2: 0.0,
+                });
+                // Named field by field, as above.
+                let AlbedoCap {
+                    nadir_n,
+                    x_n,
+                    y_n,
+                    cos_eta,
+                    sin_eta,
+                    weight,
+                    solar_irradiance_w_m2,
+                } = cap;
+                a.put(nadir_n);
+                a.put(x_n);
+                a.put(y_n);
+                a.put(cos_eta);
+                a.put(sin_eta);
+                a.put(weight);
+                a.put(solar_irradiance_w_m2);
+            } else {
+                *albedo = None;
+            }
         });
     }
 }

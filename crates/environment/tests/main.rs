@@ -10,6 +10,7 @@
 // The references' digits are kept as published (SOFA prints 19 significant digits).
 #![allow(clippy::excessive_precision)]
 
+mod albedo;
 mod atmosphere;
 mod earth_rotation;
 mod ephemeris;

@@ -17,11 +17,16 @@ use nalgebra::Vector3;
 const STEPS: usize = 3_000;
 
 fn leo() -> Simulation {
+    leo_edited(|text| text)
+}
+
+fn leo_edited(edit: impl FnOnce(String) -> String) -> Simulation {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../scenarios/leo_environment.toml"
     );
-    let cfg = SimConfig::from_toml_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let text = edit(std::fs::read_to_string(path).unwrap());
+    let cfg = SimConfig::from_toml_str(&text).unwrap();
     Simulation::new(&cfg).unwrap()
 }
 
@@ -42,6 +47,14 @@ fn trace(sim: &mut Simulation, mut pace: impl FnMut(usize)) -> Vec<Vec<u64>> {
                     s.shadow_factor.to_bits(),
                     s.t_sim_ns,
                 ])
+                .chain(s.albedo.iter().flat_map(|cap| {
+                    cap.weight
+                        .iter()
+                        .chain(&cap.cos_eta)
+                        .chain(cap.nadir_n.iter())
+                        .map(|w| w.to_bits())
+                        .collect::<Vec<_>>()
+                }))
                 .collect()
         })
         .collect()
@@ -77,6 +90,35 @@ fn offloaded_updates_are_bit_identical_to_updates_on_the_stepping_thread() {
     racing.offload_environment().unwrap();
     let got = trace(&mut racing, |_| {});
     first_difference(&reference, &got, "racing worker");
+}
+
+/// With Earth albedo on, the cap (its 128 weights, the rings and the frame) comes through the
+/// worker's slot bit for bit too.
+#[test]
+fn offloaded_albedo_caps_are_bit_identical() {
+    let with_albedo =
+        |text: String| text.replacen("sun = true\n", "sun = true\nalbedo = \"lambertian\"\n", 1);
+    let mut inline = leo_edited(with_albedo);
+    let reference = trace(&mut inline, |_| {});
+    let cap = inline
+        .environment()
+        .unwrap()
+        .sample()
+        .albedo
+        .expect("a cap");
+    assert!(
+        cap.weight.iter().any(|w| *w > 0.0),
+        "the scenario starts over lit ground"
+    );
+    let mut racing = leo_edited(with_albedo);
+    racing.offload_environment().unwrap();
+    let got = trace(&mut racing, |k| {
+        if k % 100 == 1 {
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        }
+    });
+    assert!(racing.environment().unwrap().prefetched_samples() > 0);
+    first_difference(&reference, &got, "worker with albedo");
 }
 
 fn first_difference(a: &[Vec<u64>], b: &[Vec<u64>], what: &str) {

@@ -53,6 +53,36 @@ fn the_chain_scenario_builds_and_steps_without_allocating() {
     assert!(msg.effectors[0].states.iter().all(|v| v.is_finite()));
 }
 
+/// The scenario with `n` more panels at the end of its first chain (after its last panel's
+/// `theta_dot_rad_s = 0.02`, which it gives a length so that another panel may follow).
+fn with_extra_panels(text: &str, n: usize) -> String {
+    // Every panel but the chain's last has a length to the next hinge.
+    let panel = "\n[[panel_chains.panels]]\nmass_kg = 10.0\ninertia_s_kg_m2 = [6.0, 3.0, 4.0]\n\
+                 d_m = 0.5\nk_nm_rad = 40.0\nc_nm_s_rad = 0.5\n";
+    let panels = vec![panel; n].join("l_m = 1.2\n");
+    text.replacen(
+        "theta_dot_rad_s = 0.02\n",
+        &format!("theta_dot_rad_s = 0.02\nl_m = 1.2\n{panels}"),
+        1,
+    )
+}
+
+/// Sixteen panels (the model's limit) are carried on the wire since protocol 11: 32 states in
+/// the chain's StateMsg entry (`MAX_EFFECTOR_VALUES`), which encode and decode.
+#[test]
+fn a_sixteen_panel_chain_goes_on_the_wire() {
+    assert_eq!(panel_chain::MAX_WIRE_LINKS, 16);
+    let cfg = SimConfig::from_toml_str(&with_extra_panels(&scenario(), 12)).unwrap();
+    let mut sim = Simulation::new(&cfg).unwrap();
+    sim.step_frame();
+    let mut msg = sim.blank_state();
+    sim.state_into(&mut msg);
+    assert_eq!(msg.effectors[0].states.len(), 32);
+    let back: flexdyn_proto::StateMsg =
+        flexdyn_proto::decode(&flexdyn_proto::encode(&msg)).unwrap();
+    assert_eq!(back, msg);
+}
+
 /// The configuration's errors name the entry, the panel and the field.
 #[test]
 fn bad_chain_entries_are_named() {
@@ -79,14 +109,10 @@ fn bad_chain_entries_are_named() {
             "panel_chains[1].name",
         ),
         (
-            // A fifth panel: more states than a StateMsg entry carries.
-            text.replacen(
-                "theta_dot_rad_s = 0.02\n",
-                "theta_dot_rad_s = 0.02\nl_m = 1.2\n\n[[panel_chains.panels]]\nmass_kg = 10.0\n\
-                 inertia_s_kg_m2 = [6.0, 3.0, 4.0]\nd_m = 0.5\nk_nm_rad = 40.0\nc_nm_s_rad = 0.5\n",
-                1,
-            ),
-            "panel_chains[0].panels: has 5 panels",
+            // Thirteen more panels (17): beyond the model's 16, which are also the wire's
+            // (MAX_EFFECTOR_VALUES = 32 states since protocol 11, two per panel).
+            with_extra_panels(&text, 13),
+            "panel_chains[0].panels: has 17 panels",
         ),
     ];
     for (toml, field) in cases {

@@ -592,7 +592,7 @@ static void test_environment(const char *dir) {
     m.header = fd_header_new(SC, 17, 170000000u, 2);
     m.tai_ns_1958 = 0x0102030405060708ull;
     m.flags = FD_ENVIRONMENT_EPOCH_VALID | FD_ENVIRONMENT_MAGNETIC | FD_ENVIRONMENT_SUN |
-              FD_ENVIRONMENT_SHADOW | FD_ENVIRONMENT_ATMOSPHERE;
+              FD_ENVIRONMENT_SHADOW | FD_ENVIRONMENT_ATMOSPHERE | FD_ENVIRONMENT_ALBEDO;
     m.eclipse = FD_ECLIPSE_PENUMBRA;
     memcpy(m.b_n_t, b_n, sizeof b_n);
     memcpy(m.b_b_t, b_b, sizeof b_b);
@@ -609,10 +609,11 @@ static void test_environment(const char *dir) {
     memcpy(m.solar_pressure.force_b_newton, srp_f, sizeof srp_f);
     memcpy(m.residual_dipole.torque_b_nm, dip_t, sizeof dip_t);
     memcpy(m.residual_dipole.force_b_newton, zero, sizeof zero);
+    m.albedo_nadir_w_m2 = 0.171875; /* 11/64 */
     check_encoded("EnvironmentMsg", golden, n, enc, fd_encode_environment(&m, enc, sizeof enc));
     e = fd_decode_environment(golden, n, &back);
     CHECK(e.status == FD_OK && same_header(&back.header, &m.header) &&
-              back.tai_ns_1958 == m.tai_ns_1958 && back.flags == 0x37 && back.eclipse == 1 &&
+              back.tai_ns_1958 == m.tai_ns_1958 && back.flags == 0x77 && back.eclipse == 1 &&
               same_bits(back.b_n_t, b_n, 3) && same_bits(back.b_b_t, b_b, 3) &&
               same_bits(back.sun_n, sun_n, 3) && same_bits(back.sun_b, sun_b, 3) &&
               same_bits(back.moon_n, moon_n, 3) && same_bits(&back.shadow_factor, &m.shadow_factor, 1) &&
@@ -624,7 +625,8 @@ static void test_environment(const char *dir) {
               same_bits(back.solar_pressure.torque_b_nm, srp_t, 3) &&
               same_bits(back.solar_pressure.force_b_newton, srp_f, 3) &&
               same_bits(back.residual_dipole.torque_b_nm, dip_t, 3) &&
-              same_bits(back.residual_dipole.force_b_newton, zero, 3),
+              same_bits(back.residual_dipole.force_b_newton, zero, 3) &&
+              same_bits(&back.albedo_nadir_w_m2, &m.albedo_nadir_w_m2, 1),
           "EnvironmentMsg decodes to the table");
     e = fd_decode_environment(golden, n - 1, &back);
     CHECK(e.status == FD_ERR_LENGTH && e.needed == FD_ENVIRONMENT_LEN, "EnvironmentMsg short");

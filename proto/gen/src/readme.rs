@@ -375,7 +375,11 @@ fn flags_table(table: &Table, name: &str, width_bits: u32) -> String {
         ));
         top = top.max(b.bit + 1);
     }
-    if top < width_bits {
+    if top + 1 == width_bits {
+        out.push_str(&format!(
+            "\nBit {top} is reserved: sent as 0, ignored on receipt.\n"
+        ));
+    } else if top < width_bits {
         out.push_str(&format!(
             "\nBits {top}–{} are reserved: sent as 0, ignored on receipt.\n",
             width_bits - 1

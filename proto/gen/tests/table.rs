@@ -281,7 +281,7 @@ fn mistakes_in_the_table_are_named() {
             "enum OperatorAction, value \"Resume\"",
         ),
         (
-            edited("since = 9", "since = 11"),
+            edited("since = 9", "since = 12"),
             "message RelativeStateMsg, since",
         ),
         (

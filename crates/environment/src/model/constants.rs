@@ -12,12 +12,14 @@
 //! | `earth_rotation`, `earth_rotation_rate_rad_s`, `earth_rotation_angle_rad` | the Earth-fixed frame | `"iau2006"` |
 //! | `sun_direction_n`, `sun_distance_m` | `sun = true` | the ephemeris; 1 au |
 //! | `shadow_earth_radius_m`, `shadow_sun_radius_m` | `shadow` | 6378137 m; 695700 km |
-//! | `solar_irradiance_1au_w_m2` | `solar_pressure` | 1361 W/m² |
+//! | `solar_irradiance_1au_w_m2` | `solar_pressure`, `albedo` | 1361 W/m² |
+//! | `albedo_coefficient` | `albedo = "lambertian"` | 0.3 |
 //! | `solar_pressure_model`, `cannonball_area_m2`, `cannonball_reflectivity_coefficient`, `cannonball_r_cp_b_m` | `solar_pressure` | `"facets"` |
 
 use nalgebra::Vector3;
 
 use super::schema::invalid;
+use crate::albedo::DEFAULT_ALBEDO_COEFFICIENT;
 use crate::atmosphere::{
     AltitudeDefinition, AtmosphereError, ExponentialAtmosphere, ExponentialBand,
 };
@@ -33,13 +35,13 @@ use flexdyn_kernel::numfmt::Num;
 use flexdyn_kernel::schema::{concat_keys, SchemaError, TableReader};
 
 /// The keys this file reads (the tail of [`super::schema::KEYS`]).
-pub const KEYS: [&str; 24] = concat_keys(
+pub const KEYS: [&str; 25] = concat_keys(
     concat_keys::<6, 5, 11>(DIPOLE_KEYS, EXPONENTIAL_KEYS),
     OTHER_KEYS,
 );
 
 /// The keys of the wind, the Earth's rotation, the Sun, the shadow and solar pressure.
-const OTHER_KEYS: [&str; 13] = [
+const OTHER_KEYS: [&str; 14] = [
     "corotating_wind",
     "earth_rotation",
     "earth_rotation_rate_rad_s",
@@ -53,6 +55,7 @@ const OTHER_KEYS: [&str; 13] = [
     "cannonball_area_m2",
     "cannonball_reflectivity_coefficient",
     "cannonball_r_cp_b_m",
+    "albedo_coefficient",
 ];
 
 /// The Gauss-coefficient keys of `magnetic = "dipole"`.
@@ -365,13 +368,14 @@ pub(super) fn shadow_radii(
     Ok((earth, sun))
 }
 
-/// `solar_irradiance_1au_w_m2` (only with solar pressure).
-pub(super) fn irradiance(
-    t: &TableReader<'_, '_>,
-    solar_pressure: bool,
-) -> Result<f64, SchemaError> {
-    if !solar_pressure {
-        refuse_unused(t, &["solar_irradiance_1au_w_m2"], "solar_pressure = true")?;
+/// `solar_irradiance_1au_w_m2` (only with solar pressure or albedo).
+pub(super) fn irradiance(t: &TableReader<'_, '_>, used: bool) -> Result<f64, SchemaError> {
+    if !used {
+        refuse_unused(
+            t,
+            &["solar_irradiance_1au_w_m2"],
+            "solar_pressure = true or albedo = \"lambertian\"",
+        )?;
     }
     bounded(
         t,
@@ -422,4 +426,24 @@ pub(super) fn cannonball(
             format!("unknown model \"{other}\" (expected \"facets\" or \"cannonball\")"),
         )),
     }
+}
+
+/// `albedo_coefficient` (only with `albedo = "lambertian"`, default
+/// [`DEFAULT_ALBEDO_COEFFICIENT`]): `Some(a)` when albedo is on.
+pub(super) fn albedo_coefficient(
+    t: &TableReader<'_, '_>,
+    albedo_on: bool,
+) -> Result<Option<f64>, SchemaError> {
+    if !albedo_on {
+        refuse_unused(t, &["albedo_coefficient"], "albedo = \"lambertian\"")?;
+        return Ok(None);
+    }
+    bounded(
+        t,
+        "albedo_coefficient",
+        DEFAULT_ALBEDO_COEFFICIENT,
+        |a| (0.0..=1.0).contains(&a),
+        "an albedo coefficient from 0 to 1 (the Earth's mean is about 0.3)",
+    )
+    .map(Some)
 }

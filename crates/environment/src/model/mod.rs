@@ -10,7 +10,8 @@
 //! 4. the density at r (exponential or NRLMSISE-00) and the co-rotating wind ω⊕ × r
 //!    ([`crate::atmosphere`]);
 //! 5. the Sun and Moon positions (geocentric, N), made relative to B
-//!    ([`crate::ephemeris`]), and the shadow factor ([`crate::shadow`]).
+//!    ([`crate::ephemeris`]), and the shadow factor ([`crate::shadow`]);
+//! 6. the Earth's visible cap for albedo, discretised ([`crate::albedo`]).
 //!
 //! [`EnvironmentModel::fill`] allocates nothing, locks nothing and returns no `Result`: every
 //! parameter was checked when the model was built. [`EnvironmentModel::update_if_due`] runs it at
@@ -26,6 +27,7 @@ use std::sync::{Arc, OnceLock};
 
 use nalgebra::Vector3;
 
+use super::albedo::Albedo;
 use super::atmosphere::{AltitudeDefinition, ExponentialAtmosphere, Nrlmsise00Model, SpaceWeather};
 use super::cannonball::Cannonball;
 use super::common::{Common, CommonCache, Parts};
@@ -122,6 +124,10 @@ pub struct EnvironmentSettings {
     pub solar_irradiance_1au_w_m2: f64,
     /// Dynamic effector: a residual dipole \[A·m²\], B components.
     pub residual_dipole_m_b_am2: Option<Vector3<f64>>,
+    /// \[-\] Earth albedo (`albedo = "lambertian"`, needs the Sun): its coefficient a; `None`
+    /// (the default): off. The sphere is the shadow's ([`Self::shadow_earth_radius_m`]) and the
+    /// irradiance [`Self::solar_irradiance_1au_w_m2`] ([`crate::albedo`]).
+    pub albedo_coefficient: Option<f64>,
 }
 
 impl EnvironmentSettings {
@@ -170,6 +176,7 @@ struct Models {
     sun_fixed_n_m: Option<Vector3<f64>>,
     moon: bool,
     shadow: Option<ShadowGeometry>,
+    albedo: Option<Albedo>,
     /// The world's memo of the position-independent parts, when the vehicle is one of several
     /// ([`EnvironmentModel::share_common`]); set once, before any update.
     common: OnceLock<Arc<CommonCache>>,
@@ -238,6 +245,8 @@ pub struct ModelsOn {
     pub shadow: bool,
     /// An atmosphere.
     pub atmosphere: bool,
+    /// Earth albedo.
+    pub albedo: bool,
 }
 
 impl EnvironmentModel {
@@ -286,6 +295,11 @@ impl EnvironmentModel {
                     model,
                     earth_radius_m: settings.shadow_earth_radius_m,
                     sun_radius_m: settings.shadow_sun_radius_m,
+                }),
+                albedo: settings.albedo_coefficient.map(|coefficient| Albedo {
+                    coefficient,
+                    earth_radius_m: settings.shadow_earth_radius_m,
+                    irradiance_1au_w_m2: settings.solar_irradiance_1au_w_m2,
                 }),
                 common: OnceLock::new(),
             }),
@@ -413,7 +427,7 @@ impl EnvironmentModel {
         }
     }
 
-    /// Which models are on: (magnetic field, Sun, Moon, shadow, atmosphere).
+    /// Which models are on: (magnetic field, Sun, Moon, shadow, atmosphere, albedo).
     pub fn models_on(&self) -> ModelsOn {
         let m = &self.models;
         ModelsOn {
@@ -422,6 +436,7 @@ impl EnvironmentModel {
             moon: m.moon,
             shadow: m.shadow.is_some(),
             atmosphere: !matches!(m.air, Air::Off),
+            albedo: m.albedo.is_some(),
         }
     }
 
@@ -606,6 +621,10 @@ impl Models {
             out.r_sun_b_n_m = r_sun_n_m - r_bn_n_m;
             if let Some(geometry) = &self.shadow {
                 out.shadow_factor = geometry.factor(r_bn_n_m, &r_sun_n_m);
+            }
+            // The visible cap for albedo, (A3)–(A6) of [`crate::albedo`].
+            if let Some(albedo) = &self.albedo {
+                out.albedo = albedo.cap(r_bn_n_m, &r_sun_n_m);
             }
         }
         if self.moon {

@@ -13,6 +13,8 @@
 //! sun = true                  # default false
 //! moon = true                 # default false
 //! shadow = "conical"          # "conical", "cylindrical" or "off" (default; needs sun)
+//! albedo = "lambertian"       # Earth albedo on the sun sensors: "lambertian" or "off" (default;
+//! albedo_coefficient = 0.3    #   needs sun); its coefficient, 0..=1 (default 0.3)
 //! gravity_gradient = true     # dynamic effectors, default false
 //! drag = true                 # needs an atmosphere and facets
 //! solar_pressure = true       # needs the Sun and facets
@@ -49,7 +51,7 @@ use flexdyn_kernel::schema::{concat_keys, At, SchemaError, TableReader};
 use flexdyn_kernel::validate::MAX_DIPOLE_AM2;
 
 /// The keys of `[environment]` that switch the models on and give their parameters.
-const SWITCH_KEYS: [&str; 16] = [
+const SWITCH_KEYS: [&str; 17] = [
     "update_hz",
     "telemetry_rate_hz",
     "magnetic",
@@ -61,6 +63,7 @@ const SWITCH_KEYS: [&str; 16] = [
     "sun",
     "moon",
     "shadow",
+    "albedo",
     "gravity_gradient",
     "drag",
     "solar_pressure",
@@ -70,7 +73,7 @@ const SWITCH_KEYS: [&str; 16] = [
 
 /// The keys of `[environment]`: the switches, then the models' constants
 /// ([`constants::KEYS`]).
-pub const KEYS: [&str; 40] = concat_keys(SWITCH_KEYS, constants::KEYS);
+pub const KEYS: [&str; 42] = concat_keys(SWITCH_KEYS, constants::KEYS);
 
 /// The keys of each `[[environment.facets]]`.
 pub(crate) const FACET_KEYS: [&str; 7] = [
@@ -219,6 +222,23 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
             format!("a shadow needs the Sun: set {} = true", t.field("sun")),
         ));
     }
+    let albedo_on = match choice(t, "albedo", &["lambertian", "off"])? {
+        "lambertian" => {
+            if !sun {
+                return Err(invalid(
+                    t,
+                    "albedo",
+                    format!(
+                        "albedo is sunlight reflected by the Earth: set {} = true",
+                        t.field("sun")
+                    ),
+                ));
+            }
+            true
+        }
+        _ => false,
+    };
+    let albedo_coefficient = constants::albedo_coefficient(t, albedo_on)?;
     let corotating_wind = constants::corotating_wind(t, atmosphere != AtmosphereSetting::Off)?;
     let earth_rotation = constants::earth_rotation(t)?;
     let sun_fixed_n_m = constants::sun_fixed(t, sun)?;
@@ -257,7 +277,7 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
     let gravity_gradient = t.opt_bool("gravity_gradient")?.unwrap_or(false);
     let drag = t.opt_bool("drag")?.unwrap_or(false);
     let solar_pressure = t.opt_bool("solar_pressure")?.unwrap_or(false);
-    let solar_irradiance_1au_w_m2 = constants::irradiance(t, solar_pressure)?;
+    let solar_irradiance_1au_w_m2 = constants::irradiance(t, solar_pressure || albedo_on)?;
     let cannonball = constants::cannonball(t, solar_pressure)?;
     let residual_dipole_m_b_am2 = t
         .opt_floats::<3>("residual_dipole_m_b_am2")?
@@ -338,5 +358,6 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
         cannonball,
         solar_irradiance_1au_w_m2,
         residual_dipole_m_b_am2,
+        albedo_coefficient,
     })
 }

@@ -55,6 +55,7 @@ use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
 
+use super::albedo::AlbedoCap;
 use super::EnvironmentSample;
 
 /// \[m³/s²\] the Earth's gravitational parameter for the prediction (EGM-96 / WGS-84 value,
@@ -127,12 +128,18 @@ impl Request {
 const REQUEST_WORDS: usize = 7;
 /// The answer: the request it answers, then the sample.
 const ANSWER_WORDS: usize = REQUEST_WORDS + SAMPLE_WORDS;
-const SAMPLE_WORDS: usize = 15;
+/// The sample's scalar and vector fields, then whether it has an albedo cap: the words every
+/// answer carries. The cap's words follow only when it has one, so that without albedo the slot
+/// moves as few words as before it.
+const SAMPLE_HEAD_WORDS: usize = 16;
+/// The head, then the albedo cap.
+const SAMPLE_WORDS: usize = SAMPLE_HEAD_WORDS + AlbedoCap::WORDS;
 
-fn sample_to_words(s: &EnvironmentSample) -> [u64; SAMPLE_WORDS] {
+/// Writes `s` into `w`; returns how many words it used (the head, and the cap's if it has one).
+fn sample_to_words(s: &EnvironmentSample, w: &mut [u64]) -> usize {
     let b = |x: f64| x.to_bits();
     let (bf, sun, moon, wind) = (s.b_field_n_t, s.r_sun_b_n_m, s.r_moon_b_n_m, s.wind_n_m_s);
-    [
+    w[..SAMPLE_HEAD_WORDS].copy_from_slice(&[
         s.t_sim_ns,
         b(bf.x),
         b(bf.y),
@@ -148,7 +155,19 @@ fn sample_to_words(s: &EnvironmentSample) -> [u64; SAMPLE_WORDS] {
         b(wind.x),
         b(wind.y),
         b(wind.z),
-    ]
+        u64::from(s.albedo.is_some()),
+    ]);
+    match &s.albedo {
+        Some(cap) => {
+            let mut f = [0.0; AlbedoCap::WORDS];
+            cap.to_words(&mut f);
+            for (o, x) in w[SAMPLE_HEAD_WORDS..SAMPLE_WORDS].iter_mut().zip(f) {
+                *o = x.to_bits();
+            }
+            SAMPLE_WORDS
+        }
+        None => SAMPLE_HEAD_WORDS,
+    }
 }
 
 fn sample_from_words(w: &[u64]) -> EnvironmentSample {
@@ -162,6 +181,8 @@ fn sample_from_words(w: &[u64]) -> EnvironmentSample {
         shadow_factor: f(10),
         density_kg_m3: f(11),
         wind_n_m_s: v(12),
+        albedo: (w[15] != 0)
+            .then(|| AlbedoCap::from_words(&std::array::from_fn(|i| f(SAMPLE_HEAD_WORDS + i)))),
     }
 }
 
@@ -225,11 +246,21 @@ impl Slot {
         match self.state.load(Ordering::Acquire) {
             DONE => {
                 let mut w = [0u64; ANSWER_WORDS];
-                for (x, cell) in w.iter_mut().zip(&self.answer) {
+                // The head first; the cap's words only when its flag (the head's last word)
+                // says the answer has one.
+                let head = REQUEST_WORDS + SAMPLE_HEAD_WORDS;
+                for (x, cell) in w[..head].iter_mut().zip(&self.answer) {
                     *x = cell.load(Ordering::Relaxed);
                 }
-                (w[..REQUEST_WORDS] == req.to_words())
-                    .then(|| sample_from_words(&w[REQUEST_WORDS..]))
+                if w[..REQUEST_WORDS] != req.to_words() {
+                    return None;
+                }
+                if w[head - 1] != 0 {
+                    for (x, cell) in w[head..].iter_mut().zip(&self.answer[head..]) {
+                        *x = cell.load(Ordering::Relaxed);
+                    }
+                }
+                Some(sample_from_words(&w[REQUEST_WORDS..]))
             }
             REQUESTED => {
                 let _ = self.state.compare_exchange(
@@ -261,12 +292,11 @@ impl Slot {
         let req = Request::from_words(&w);
         let mut sample = EnvironmentSample::NONE;
         fill(&req, &mut sample);
-        for (cell, x) in self
-            .answer
-            .iter()
-            .zip(req.to_words().into_iter().chain(sample_to_words(&sample)))
-        {
-            cell.store(x, Ordering::Relaxed);
+        let mut words = [0u64; ANSWER_WORDS];
+        words[..REQUEST_WORDS].copy_from_slice(&req.to_words());
+        let used = REQUEST_WORDS + sample_to_words(&sample, &mut words[REQUEST_WORDS..]);
+        for (cell, x) in self.answer.iter().zip(&words[..used]) {
+            cell.store(*x, Ordering::Relaxed);
         }
         self.state.store(DONE, Ordering::Release);
         true
@@ -417,6 +447,13 @@ mod tests {
         out.b_field_n_t = req.r_bn_n_m * 1e-12;
         out.density_kg_m3 = req.v_bn_n_m_s.norm() * 1e-15;
         out.shadow_factor = 0.5;
+        // An albedo cap, so that the slot's words carry one too.
+        let albedo = crate::albedo::Albedo {
+            coefficient: 0.3,
+            earth_radius_m: 6.378e6,
+            irradiance_1au_w_m2: 1361.0,
+        };
+        out.albedo = albedo.cap(&req.r_bn_n_m, &Vector3::new(1.5e11, 2.0e10, 0.0));
     }
 
     fn request(t: u64) -> Request {
@@ -442,6 +479,30 @@ mod tests {
         assert_eq!(slot.answer(&req), Some(direct(&req)));
         // Read twice (telemetry, then the update): the same answer.
         assert_eq!(slot.answer(&req), Some(direct(&req)));
+    }
+
+    /// The cap's words travel only with a cap: an answer without one after an answer with one
+    /// reads no cap (the stale words behind the head are not read).
+    #[test]
+    fn a_sample_without_a_cap_after_one_with_a_cap_has_none() {
+        // Posted, served by `f` and picked up.
+        let round = |slot: &Slot, req: &Request, f: &dyn Fn(&Request, &mut EnvironmentSample)| {
+            assert!(slot.post(req) && slot.serve(&f));
+            slot.answer(req).expect("the worker's answer")
+        };
+        let slot = Slot::new();
+        let with_cap = request(100);
+        let answer = round(&slot, &with_cap, &fill);
+        assert!(answer.albedo.is_some());
+        assert_eq!(answer, direct(&with_cap));
+        let without = request(200);
+        let no_cap = |req: &Request, out: &mut EnvironmentSample| {
+            fill(req, out);
+            out.albedo = None;
+        };
+        let answer = round(&slot, &without, &no_cap);
+        assert_eq!(answer.albedo, None);
+        assert_eq!(answer.b_field_n_t, direct(&without).b_field_n_t);
     }
 
     #[test]

@@ -436,6 +436,7 @@ impl Simulation {
             (f::MOON, on.moon),
             (f::SHADOW, on.shadow),
             (f::ATMOSPHERE, on.atmosphere),
+            (f::ALBEDO, on.albedo),
         ] {
             if is_on {
                 flags |= bit;
@@ -461,6 +462,10 @@ impl Simulation {
         out.drag = wire(&w[EnvironmentSource::Drag as usize]);
         out.solar_pressure = wire(&w[EnvironmentSource::SolarPressure as usize]);
         out.residual_dipole = wire(&w[EnvironmentSource::ResidualDipole as usize]);
+        out.albedo_nadir_w_m2 = env
+            .albedo
+            .as_ref()
+            .map_or(0.0, |cap| cap.nadir_irradiance_w_m2());
     }
 
     /// The `[epoch]` (the instant of t = 0), if configured.

@@ -70,7 +70,7 @@
 //! factorisation, with every array sized at construction (no allocation in the stepping path).
 //! A chain holds at most [`MAX_LINKS`] panels (the static state-name table); a configured chain
 //! at most [`MAX_WIRE_LINKS`], because a StateMsg effector entry carries at most
-//! `flexdyn_proto::MAX_EFFECTOR_VALUES` states.
+//! `flexdyn_proto::MAX_EFFECTOR_VALUES` states: 32 since protocol 11, so both limits are 16.
 //!
 //! Integrated state: `[θ1, θ̇1, θ2, θ̇2, …, θN, θ̇N]`, the pair's order, so the N = 2 chain's
 //! state vector is the pair's.
