@@ -11,6 +11,23 @@ use flexdyn_vehicle::checkpoint::{self, Checkpoint, CheckpointError, CheckpointH
 use flexdyn_vehicle::config::{SimConfig, DEFAULT_CONFIG_TOML};
 use flexdyn_vehicle::world::World;
 
+/// The checkpoint options `simulate` and `fleet` share.
+#[derive(Debug, Clone, PartialEq, Default, clap::Args)]
+pub struct CheckpointArgs {
+    /// Write a checkpoint of the run at this simulated time (after t = 0, a frame boundary on
+    /// which a row falls) to `--checkpoint`; the run goes on to the end.
+    #[arg(long, value_name = "SECONDS", requires = "checkpoint")]
+    pub checkpoint_at_s: Option<f64>,
+    /// The checkpoint file `--checkpoint-at-s` writes.
+    #[arg(long, value_name = "FILE", requires = "checkpoint_at_s")]
+    pub checkpoint: Option<PathBuf>,
+    /// Resume from a checkpoint: the rows after its instant, bit-identical to the uninterrupted
+    /// run's; another configuration or fleet file than the one it was taken with is a fork.
+    /// `--duration-s` still counts from t = 0.
+    #[arg(long, value_name = "FILE")]
+    pub resume: Option<PathBuf>,
+}
+
 /// Where and when a run writes a checkpoint.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SaveAt {

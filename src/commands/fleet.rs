@@ -18,7 +18,7 @@ use nalgebra::Vector3;
 
 use std::process::ExitCode;
 
-use super::checkpoint::{self as ckpt, SaveAt, Source};
+use super::checkpoint::{self as ckpt, CheckpointArgs, SaveAt, Source};
 use super::{exit, summary, whole_steps, CliError, OfflineRun};
 use flexdyn_vehicle::checkpoint::CheckpointHeader;
 use flexdyn_vehicle::world::relative::com_state_n;
@@ -41,18 +41,9 @@ pub struct FleetArgs {
         allow_negative_numbers = true
     )]
     pub log_every_s: f64,
-    /// Write a checkpoint of every vehicle at this simulated time (a row instant and a frame
-    /// boundary) to `--checkpoint`; the run goes on to the end.
-    #[arg(long, value_name = "SECONDS", requires = "checkpoint")]
-    pub checkpoint_at_s: Option<f64>,
-    /// The checkpoint file `--checkpoint-at-s` writes.
-    #[arg(long, value_name = "FILE", requires = "checkpoint_at_s")]
-    pub checkpoint: Option<PathBuf>,
-    /// Resume from a checkpoint of this fleet (a fleet file that differs from the one it was
-    /// taken with is a fork): the rows after its instant, bit-identical to the uninterrupted
-    /// run's. `--duration-s` still counts from t = 0.
-    #[arg(long, value_name = "FILE")]
-    pub resume: Option<PathBuf>,
+    /// Checkpoints: save one, or resume from one.
+    #[command(flatten)]
+    pub checkpoints: CheckpointArgs,
 }
 
 /// An error of `flexdyn fleet`.
@@ -127,8 +118,13 @@ pub fn fleet_with<W: Write>(
     let steps = whole_steps("--duration-s", args.run.duration_s, step_ns, true)?;
     let every = whole_steps("--log-every-s", args.log_every_s, step_ns, false)?;
     // A resumed run's state is restored before anything is written.
-    let bytes = args.resume.as_deref().map(ckpt::read).transpose()?;
-    let start_step = match (args.resume.as_deref(), &bytes) {
+    let bytes = args
+        .checkpoints
+        .resume
+        .as_deref()
+        .map(ckpt::read)
+        .transpose()?;
+    let start_step = match (args.checkpoints.resume.as_deref(), &bytes) {
         (Some(file), Some(b)) => {
             let c = ckpt::parse(file, b, "fleet")?;
             let text = Source::of(Some(&args.fleet))?.text;
@@ -143,7 +139,10 @@ pub fn fleet_with<W: Write>(
         }
         _ => 0,
     };
-    let save = match (args.checkpoint_at_s, &args.checkpoint) {
+    let save = match (
+        args.checkpoints.checkpoint_at_s,
+        &args.checkpoints.checkpoint,
+    ) {
         (Some(t_s), Some(file)) => {
             let at = SaveAt {
                 t_s,
@@ -293,7 +292,7 @@ pub fn main(args: &FleetArgs) -> ExitCode {
 
 #[cfg(test)]
 mod tests {
-    use super::{fleet_to, FleetArgs, OfflineRun};
+    use super::{fleet_to, CheckpointArgs, FleetArgs, OfflineRun};
     use flexdyn_testkit::fleets::LEO_PAIR;
     use flexdyn_vehicle::world::{FleetConfig, World};
     use std::path::Path;
@@ -310,9 +309,7 @@ mod tests {
                 output: None,
             },
             log_every_s: 0.1,
-            checkpoint_at_s: None,
-            checkpoint: None,
-            resume: None,
+            checkpoints: CheckpointArgs::default(),
         };
         let mut csv = Vec::new();
         let report = fleet_to(&fleet, &args, "memory", &mut csv).unwrap();

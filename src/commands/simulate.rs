@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use flexdyn_proto::{command_flags, AppliedWrench, EnvironmentMsg, Header, StateMsg};
 
-use super::checkpoint::{self as ckpt, SaveAt, Source};
+use super::checkpoint::{self as ckpt, CheckpointArgs, SaveAt, Source};
 use super::{exit, load, summary, whole_steps, CliError, OfflineRun};
 use flexdyn_sensors::Sensor;
 use flexdyn_server::settings::ServerSettings;
@@ -43,18 +43,9 @@ pub struct SimulateArgs {
         allow_negative_numbers = true
     )]
     pub log_every_s: f64,
-    /// Write a checkpoint of the run at this simulated time (a frame boundary on which a row
-    /// falls) to `--checkpoint`; the run goes on to the end.
-    #[arg(long, value_name = "SECONDS", requires = "checkpoint")]
-    pub checkpoint_at_s: Option<f64>,
-    /// The checkpoint file `--checkpoint-at-s` writes.
-    #[arg(long, value_name = "FILE", requires = "checkpoint_at_s")]
-    pub checkpoint: Option<PathBuf>,
-    /// Resume from a checkpoint: the run continues from its instant with its configuration
-    /// (or, with `--config`, a compatible other one: a fork) and writes the rows after it,
-    /// bit-identical to the uninterrupted run's. `--duration-s` still counts from t = 0.
-    #[arg(long, value_name = "FILE")]
-    pub resume: Option<PathBuf>,
+    /// Checkpoints: save one, or resume from one.
+    #[command(flatten)]
+    pub checkpoints: CheckpointArgs,
 }
 
 impl Default for SimulateArgs {
@@ -63,9 +54,7 @@ impl Default for SimulateArgs {
             config: None,
             run: OfflineRun::default(),
             log_every_s: 0.01,
-            checkpoint_at_s: None,
-            checkpoint: None,
-            resume: None,
+            checkpoints: CheckpointArgs::default(),
         }
     }
 }
@@ -422,11 +411,11 @@ impl<W: Write> RowSink for SimulateRows<'_, W> {
 /// output file or stdout. The output file is created only once everything else is valid.
 pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
     // A resumed run: the checkpoint's configuration, or with `--config` another one (a fork).
-    let bytes = match &args.resume {
+    let bytes = match &args.checkpoints.resume {
         Some(file) => Some(ckpt::read(file)?),
         None => None,
     };
-    let resumed = match (&args.resume, &bytes) {
+    let resumed = match (&args.checkpoints.resume, &bytes) {
         (Some(file), Some(b)) => Some((ckpt::parse(file, b, "simulate")?, file.as_path())),
         _ => None,
     };
@@ -454,7 +443,10 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
     // Check the options before creating (and truncating) the output file.
     whole_steps("--duration-s", args.run.duration_s, cfg.step_ns, true)?;
     whole_steps("--log-every-s", args.log_every_s, cfg.step_ns, false)?;
-    let save = match (args.checkpoint_at_s, &args.checkpoint) {
+    let save = match (
+        args.checkpoints.checkpoint_at_s,
+        &args.checkpoints.checkpoint,
+    ) {
         (Some(t_s), Some(file)) => Some((
             SaveAt {
                 t_s,
