@@ -487,3 +487,53 @@ fn a_resumed_fleet_writes_the_uninterrupted_rows_bit_for_bit() {
         "{err}"
     );
 }
+
+#[test]
+fn a_forks_schedule_rows_after_the_checkpoint_apply_at_their_own_times() {
+    // depletion: the engine burns from 5 s and stops at 65 s. The fork stops it at 45 s. From a
+    // checkpoint at 30 s the fork's rows equal that configuration flown from t = 0: the rows
+    // applied by 30 s are found by time in the fork's own schedule, and its 45 s row applies at
+    // 45 s.
+    let original = std::fs::read_to_string(scenario("depletion")).unwrap();
+    let marker = "t_s = 65.0\neffector = \"engine\"\ninputs = [0.0]";
+    assert!(
+        original.contains(marker),
+        "scenarios/depletion.toml's engine cut-off moved"
+    );
+    let fork_cfg = scratch("depletion_cut_45s.toml");
+    std::fs::write(
+        &fork_cfg,
+        original.replace(marker, "t_s = 45.0\neffector = \"engine\"\ninputs = [0.0]"),
+    )
+    .unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (ckpt, full, fork) = (
+        scratch("depletion-30s.ckpt"),
+        scratch("depletion-cut-full.csv"),
+        scratch("depletion-cut-fork.csv"),
+    );
+    let (c, fc, fu, fo) = (s(&ckpt), s(&fork_cfg), s(&full), s(&fork));
+    let dep = scenario("depletion");
+    let base = ["simulate", "--duration-s", "60", "--log-every-s", "0.5"];
+    let mut a = base.to_vec();
+    let orig_csv = s(&scratch("depletion-orig.csv"));
+    a.extend(["--config", &dep, "-o", &orig_csv]);
+    a.extend(["--checkpoint-at-s", "30", "--checkpoint", &c]);
+    ok(&flexdyn(&a), "the original run");
+    let mut b = base.to_vec();
+    b.extend(["--config", &fc, "-o", &fu]);
+    ok(&flexdyn(&b), "the fork's configuration from t = 0");
+    let mut f = base.to_vec();
+    f.extend(["--config", &fc, "-o", &fo, "--resume", &c]);
+    ok(&flexdyn(&f), "the fork");
+    let fork_rows = read_csv(&fork).rows;
+    assert_eq!(fork_rows.len(), 60);
+    assert_eq!(fork_rows, rows_after(&read_csv(&full), 30_000_000_000));
+    let orig_rows = rows_after(&read_csv(Path::new(&orig_csv)), 30_000_000_000);
+    // Rows at 30.5 … 44.5 s (the 45 s row already shows the fork's engine off).
+    assert_eq!(fork_rows[..29], orig_rows[..29], "30 … 45 s: the same burn");
+    assert_ne!(
+        fork_rows[35], orig_rows[35],
+        "after 45 s: the fork's engine is off"
+    );
+}
