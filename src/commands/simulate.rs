@@ -419,18 +419,23 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
         (Some(file), Some(b)) => Some((ckpt::parse(file, b, "simulate")?, file.as_path())),
         _ => None,
     };
+    // The configuration's path and text, which a checkpoint records: read only when this run
+    // resumes or saves one.
     let source = match (&resumed, &args.config) {
-        (Some((c, _)), None) => Source {
+        (Some((c, _)), None) => Some(Source {
             path: c.header.source_path.clone(),
             text: c.header.source_text.clone(),
-        },
-        _ => Source::of(args.config.as_deref())?,
+        }),
+        _ if resumed.is_some() || args.checkpoints.checkpoint_at_s.is_some() => {
+            Some(Source::of(args.config.as_deref())?)
+        }
+        _ => None,
     };
-    let cfg = match (&resumed, &args.config) {
-        (Some(_), None) => source.config()?,
+    let cfg = match (&resumed, &source, &args.config) {
+        (Some(_), Some(source), None) => source.config()?,
         _ => load(args.config.as_deref())?,
     };
-    if let Some((c, file)) = &resumed {
+    if let (Some((c, file)), Some(source)) = (&resumed, &source) {
         if CheckpointHeader::digest(&source.text) != c.header.source_sha256 {
             summary(format_args!(
                 "note: resuming `{}` with a configuration that differs from the one it was \
@@ -440,14 +445,14 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
         }
     }
     log_warnings(&cfg, args.config.as_deref());
-    // Check the options before creating (and truncating) the output file.
-    whole_steps("--duration-s", args.run.duration_s, cfg.step_ns, true)?;
-    whole_steps("--log-every-s", args.log_every_s, cfg.step_ns, false)?;
+    // `simulate_with` checks the options, the configuration and the checkpoints before it
+    // creates (and truncates) the output file.
     let save = match (
         args.checkpoints.checkpoint_at_s,
         &args.checkpoints.checkpoint,
+        source,
     ) {
-        (Some(t_s), Some(file)) => Some((
+        (Some(t_s), Some(file), Some(source)) => Some((
             SaveAt {
                 t_s,
                 file: file.clone(),
