@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use super::{whole_steps, CliError};
 use flexdyn_kernel::numfmt::Num;
-use flexdyn_vehicle::checkpoint::{self, Checkpoint, CheckpointError, CheckpointHeader};
-use flexdyn_vehicle::config::{SimConfig, DEFAULT_CONFIG_TOML};
+use flexdyn_vehicle::checkpoint::{self, Checkpoint, CheckpointError, CheckpointHeader, Source};
+use flexdyn_vehicle::config::SimConfig;
 use flexdyn_vehicle::world::World;
 
 /// The checkpoint options `simulate` and `fleet` share.
@@ -37,51 +37,22 @@ pub struct SaveAt {
     pub file: PathBuf,
 }
 
-/// The configuration a run came from, as its checkpoints record it.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Source {
-    /// The file as the run was given it (empty: the embedded default).
-    pub path: String,
-    /// Its text.
-    pub text: String,
+/// The configuration file `path` (its text read again), or the embedded default, as a
+/// checkpoint records it.
+pub fn source_of(path: Option<&Path>) -> Result<Source, CliError> {
+    Source::of(path).map_err(|source| CliError::Config {
+        file: path.map(Path::to_path_buf),
+        source,
+    })
 }
 
-impl Source {
-    /// The configuration file `path` (its text read again), or the embedded default.
-    pub fn of(path: Option<&Path>) -> Result<Self, CliError> {
-        match path {
-            None => Ok(Self {
-                path: String::new(),
-                text: DEFAULT_CONFIG_TOML.to_string(),
-            }),
-            Some(p) => {
-                let io = |source| CliError::Config {
-                    file: Some(p.to_path_buf()),
-                    source: flexdyn_vehicle::config::ConfigError::Io {
-                        path: p.to_path_buf(),
-                        source,
-                    },
-                };
-                let text = std::fs::read_to_string(p).map_err(io)?;
-                // Absolute, so a resume from another directory finds the files it names.
-                let path = std::fs::canonicalize(p).map_err(io)?;
-                Ok(Self {
-                    path: path.display().to_string(),
-                    text,
-                })
-            }
-        }
-    }
-
-    /// The configuration a checkpoint recorded, parsed with relative paths resolved beside the
-    /// file it came from.
-    pub fn config(&self) -> Result<SimConfig, CliError> {
-        let base = Path::new(&self.path).parent().unwrap_or(Path::new("."));
-        SimConfig::from_toml_str_in(&self.text, base).map_err(|source| CliError::Config {
-            file: (!self.path.is_empty()).then(|| PathBuf::from(&self.path)),
-            source,
-        })
-    }
+/// The configuration a checkpoint recorded, parsed with relative paths resolved beside the
+/// file it came from.
+pub fn recorded_config(source: &Source) -> Result<SimConfig, CliError> {
+    source.config().map_err(|e| CliError::Config {
+        file: source.file(),
+        source: e,
+    })
 }
 
 /// A checkpoint file's error, naming the file.
@@ -106,18 +77,7 @@ pub fn parse<'a>(
     bytes: &'a [u8],
     front_end: &str,
 ) -> Result<Checkpoint<'a>, CliError> {
-    let c = Checkpoint::parse(bytes).map_err(|e| error(file, e))?;
-    if c.header.front_end != front_end {
-        return Err(error(
-            file,
-            CheckpointError::Mismatch {
-                what: "the front end",
-                checkpoint: format!("`{}`", c.header.front_end),
-                run: format!("`{front_end}`"),
-            },
-        ));
-    }
-    Ok(c)
+    Checkpoint::parse_of(bytes, front_end).map_err(|e| error(file, e))
 }
 
 /// Writes the checkpoint of `world` to `file`: beside it first, then renamed over it.

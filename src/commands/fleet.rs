@@ -18,7 +18,7 @@ use nalgebra::Vector3;
 
 use std::process::ExitCode;
 
-use super::checkpoint::{self as ckpt, CheckpointArgs, SaveAt, Source};
+use super::checkpoint::{self as ckpt, CheckpointArgs, SaveAt};
 use super::{exit, summary, whole_steps, CliError, OfflineRun};
 use flexdyn_vehicle::checkpoint::CheckpointHeader;
 use flexdyn_vehicle::world::relative::com_state_n;
@@ -127,7 +127,7 @@ pub fn fleet_with<W: Write>(
     let start_step = match (args.checkpoints.resume.as_deref(), &bytes) {
         (Some(file), Some(b)) => {
             let c = ckpt::parse(file, b, "fleet")?;
-            let text = Source::of(Some(&args.fleet))?.text;
+            let text = ckpt::source_of(Some(&args.fleet))?.text;
             if CheckpointHeader::digest(&text) != c.header.source_sha256 {
                 summary(format_args!(
                     "note: resuming `{}` with a fleet file that differs from the one it was \
@@ -149,7 +149,7 @@ pub fn fleet_with<W: Write>(
                 file: file.clone(),
             };
             let step = ckpt::save_step(&at, step_ns, frame_ns, every, steps, start_step)?;
-            let source = Source::of(Some(&args.fleet))?;
+            let source = ckpt::source_of(Some(&args.fleet))?;
             Some((
                 step,
                 CheckpointHeader {

@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use flexdyn_proto::{command_flags, AppliedWrench, EnvironmentMsg, Header, StateMsg};
 
-use super::checkpoint::{self as ckpt, CheckpointArgs, SaveAt, Source};
+use super::checkpoint::{self as ckpt, CheckpointArgs, SaveAt};
 use super::{exit, load, summary, whole_steps, CliError, OfflineRun};
 use flexdyn_sensors::Sensor;
 use flexdyn_server::settings::ServerSettings;
@@ -19,6 +19,7 @@ use flexdyn_sinks::table::{
     first_non_finite_column, prefixed_columns, state_row, Column, CsvTable,
     ENVIRONMENT_COLUMN_PREFIX,
 };
+use flexdyn_vehicle::checkpoint::Source;
 use flexdyn_vehicle::checkpoint::{Checkpoint, CheckpointHeader};
 use flexdyn_vehicle::config::{log_warnings, SimConfig};
 use flexdyn_vehicle::sim::Simulation;
@@ -422,17 +423,14 @@ pub fn simulate(args: &SimulateArgs) -> Result<SimulateReport, CliError> {
     // The configuration's path and text, which a checkpoint records: read only when this run
     // resumes or saves one.
     let source = match (&resumed, &args.config) {
-        (Some((c, _)), None) => Some(Source {
-            path: c.header.source_path.clone(),
-            text: c.header.source_text.clone(),
-        }),
+        (Some((c, _)), None) => Some(Source::recorded(&c.header)),
         _ if resumed.is_some() || args.checkpoints.checkpoint_at_s.is_some() => {
-            Some(Source::of(args.config.as_deref())?)
+            Some(ckpt::source_of(args.config.as_deref())?)
         }
         _ => None,
     };
     let cfg = match (&resumed, &source, &args.config) {
-        (Some(_), Some(source), None) => source.config()?,
+        (Some(_), Some(source), None) => ckpt::recorded_config(source)?,
         _ => load(args.config.as_deref())?,
     };
     if let (Some((c, file)), Some(source)) = (&resumed, &source) {

@@ -9,6 +9,7 @@
 // The end-to-end harness, shared with the other suites (`crates/testkit-server`).
 use flexdyn_testkit_server::server as server_support;
 
+mod checkpoint_lockstep;
 mod environment_message;
 mod faults_config;
 mod faults_dropout_lockstep;

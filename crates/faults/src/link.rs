@@ -116,6 +116,36 @@ impl LinkFaults {
         }
     }
 
+    /// Lists what the run changed: each fault's live clear and activity, and the last tick
+    /// evaluated; the windows, modes and seeds are the configuration's. Not on the stepping
+    /// path.
+    pub fn archive(&mut self, a: &mut flexdyn_kernel::archive::Archive<'_>) {
+        let Self {
+            faults,
+            frame_ns: _,
+            evaluated,
+        } = self;
+        a.section("link faults", |a| {
+            a.expect_count("command-link faults", faults.len());
+            for f in faults.iter_mut() {
+                let LinkFault {
+                    fault_index: _,
+                    field: _,
+                    target: _,
+                    sender_id: _,
+                    mode: _,
+                    window: _,
+                    seed: _,
+                    cleared_from_ns,
+                    active,
+                } = f;
+                a.put(cleared_from_ns);
+                a.put(active);
+            }
+            a.put(evaluated);
+        });
+    }
+
     /// Whether there is none.
     pub fn is_empty(&self) -> bool {
         self.faults.is_empty()

@@ -1,12 +1,14 @@
 //! `flexdyn run`: its arguments, and the process-level wrapper around [`super::run`] (settings
 //! from the file and the options, the tokio runtime, the Zenoh session, SIGINT/SIGTERM).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
+use super::checkpoint::{self, CheckpointSettings};
 use super::error::{ServerError, SettingsError};
 use super::settings::{ServerSettings, Value};
 use super::RunReport;
 use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_vehicle::checkpoint::{CheckpointHeader, Source};
 use flexdyn_vehicle::config::{load_config, log_warnings, SimConfig};
 
 /// Arguments of `flexdyn run` (plain `flexdyn` runs with all defaults). Every server option
@@ -124,6 +126,27 @@ pub struct RunArgs {
         default_missing_value = flexdyn_sinks::view::DEFAULT_BIND
     )]
     pub view: Option<String>,
+    /// Save a checkpoint of the run at this tick (a frame boundary after the first) to
+    /// `--checkpoint`; the run goes on (docs/guides/checkpoints.md).
+    #[arg(
+        long,
+        value_name = "TICK",
+        requires = "checkpoint",
+        conflicts_with = "fleet"
+    )]
+    pub checkpoint_at_tick: Option<u64>,
+    /// The file `--checkpoint-at-tick` writes.
+    #[arg(long, value_name = "FILE", requires = "checkpoint_at_tick")]
+    pub checkpoint: Option<PathBuf>,
+    /// Where an operator's checkpoint requests (OperatorMsg `Checkpoint`) are written, as
+    /// `<sc_id>-tick<k>.ckpt`; without it they are refused.
+    #[arg(long, value_name = "DIR", conflicts_with = "fleet")]
+    pub checkpoint_dir: Option<PathBuf>,
+    /// Resume from a checkpoint of `flexdyn run`: the stream from its tick on is the
+    /// uninterrupted run's, bit for bit (lockstep); with `--config` another configuration than
+    /// the one it was taken with, a fork. `--duration-s` still counts from t = 0.
+    #[arg(long, value_name = "FILE", conflicts_with = "fleet")]
+    pub resume: Option<PathBuf>,
     /// Zenoh endpoints and configuration file.
     #[command(flatten)]
     pub zenoh: ZenohArgs,
@@ -201,12 +224,10 @@ async fn shutdown_signal() -> Result<impl std::future::Future<Output = ()>, Serv
 /// session (which flushes the last samples).
 pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
     let file = args.config.as_deref();
-    let cfg = load_config(file).map_err(|source| ServerError::Config {
-        file: file.map(Path::to_path_buf),
-        source,
-    })?;
+    let (cfg, checkpoints) = checkpoint_settings(args)?;
     log_warnings(&cfg, file);
-    let settings = args.settings(&cfg)?;
+    let mut settings = args.settings(&cfg)?;
+    settings.checkpoints = checkpoints;
     let zcfg = zenoh_config(&args.zenoh, Role::Server)?;
     super::access::check(&zcfg, &settings)?;
     // Every thread started from here on (tokio's, Zenoh's, the server's) inherits this thread's
@@ -225,6 +246,49 @@ pub fn run_from_args(args: &RunArgs) -> Result<RunReport, ServerError> {
         }
         super::run(session, settings, cfg, shutdown)
     })
+}
+
+/// The configuration to run and the checkpoint settings: a resumed run's configuration is the
+/// one its checkpoint records, unless `--config` names another (a fork).
+fn checkpoint_settings(args: &RunArgs) -> Result<(SimConfig, CheckpointSettings), ServerError> {
+    let file = args.config.as_deref();
+    let config_error = |file: Option<PathBuf>| {
+        move |source| ServerError::Config {
+            file: file.clone(),
+            source,
+        }
+    };
+    let resumed = args
+        .resume
+        .as_deref()
+        .map(|f| checkpoint::read(f, checkpoint::FRONT_END))
+        .transpose()?;
+    let saves = args.checkpoint_at_tick.is_some() || args.checkpoint_dir.is_some();
+    let source = match (&resumed, file) {
+        (Some((_, header)), None) => Source::recorded(header),
+        (Some(_), Some(_)) => Source::of(file).map_err(config_error(args.config.clone()))?,
+        (None, _) if saves => Source::of(file).map_err(config_error(args.config.clone()))?,
+        (None, _) => Source::default(),
+    };
+    let cfg = match (&resumed, file) {
+        (Some(_), None) => source.config().map_err(config_error(source.file()))?,
+        _ => load_config(file).map_err(config_error(args.config.clone()))?,
+    };
+    if let Some((r, header)) = &resumed {
+        if CheckpointHeader::digest(&source.text) != header.source_sha256 {
+            tracing::warn!(
+                checkpoint = %r.file.display(),
+                "resuming with a configuration that differs from the one it was taken with: a fork"
+            );
+        }
+    }
+    let checkpoints = CheckpointSettings {
+        save_at: args.checkpoint_at_tick.zip(args.checkpoint.clone()),
+        dir: args.checkpoint_dir.clone(),
+        source,
+        resume: resumed.map(|(r, _)| r),
+    };
+    Ok((cfg, checkpoints))
 }
 
 /// `--view` connects to the server as a tool with the default configuration: with a Zenoh

@@ -21,6 +21,7 @@ use flexdyn_proto::{
 };
 
 use flexdyn_faults::link::{damage, LinkFaults, LinkStats};
+use flexdyn_kernel::archive::{Archive, Archived};
 
 /// What the book did with an offered command.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -102,6 +103,46 @@ struct Slot {
     received_tick: u64,
     /// Lockstep: answered the current tick.
     answered: bool,
+}
+
+impl Archived for Slot {
+    /// The participant's last command and its bookkeeping; the sender id is the run's (the
+    /// book's sections are checked by count and size).
+    fn archive(&mut self, a: &mut Archive<'_>) {
+        let Self {
+            sender_id: _,
+            torque_b_nm,
+            force_b_newton,
+            inputs,
+            has_command,
+            last_tick,
+            received_tick,
+            answered,
+        } = self;
+        a.put(torque_b_nm);
+        a.put(force_b_newton);
+        a.expect_count("a participant's effector inputs", inputs.len());
+        a.put(&mut inputs[..]);
+        a.put(has_command);
+        a.put(last_tick);
+        a.put(received_tick);
+        a.put(answered);
+    }
+}
+
+impl Archived for DelayLine {
+    fn archive(&mut self, a: &mut Archive<'_>) {
+        let Self {
+            slot: _,
+            ring,
+            ticks,
+        } = self;
+        a.expect_count("a delay line's entries", ring.len());
+        for (entry, tick) in ring.iter_mut().zip(ticks.iter_mut()) {
+            a.put(entry);
+            a.put(tick);
+        }
+    }
 }
 
 /// The wrench held over one frame, with its telemetry flags and status.
@@ -196,6 +237,30 @@ fn copy_slot(to: &mut Slot, from: &Slot) {
     to.answered = from.answered;
 }
 
+impl Archived for Held {
+    /// The wrench held over the last frame and the status its telemetry carries.
+    fn archive(&mut self, a: &mut Archive<'_>) {
+        let Self {
+            torque_b_nm,
+            force_b_newton,
+            flags,
+            status,
+        } = self;
+        a.put(torque_b_nm);
+        a.put(force_b_newton);
+        a.put(flags);
+        let CommandStatus {
+            last_command_tick,
+            command_age_ns,
+            command_stale,
+            stale_policy: _,
+        } = status;
+        a.put(last_command_tick);
+        a.put(command_age_ns);
+        a.put(command_stale);
+    }
+}
+
 /// Per-participant command state, in ascending sender-id order.
 #[derive(Clone, Debug)]
 pub struct CommandBook {
@@ -225,6 +290,61 @@ pub struct CommandBook {
 }
 
 impl CommandBook {
+    /// Lists the book's mutable state for a checkpoint: every participant's last command, the
+    /// answers of the current tick, the summed inputs, the command-link faults and their delay
+    /// lines and statistics. Configuration (participants, frame, staleness, the input layout)
+    /// and scratch are the run's. Not on the stepping path.
+    pub fn archive(&mut self, a: &mut Archive<'_>) {
+        let Self {
+            slots,
+            frame_ns: _,
+            stale_after_ns: _,
+            policy: _,
+            answered,
+            input_ranges: _,
+            seen: _,
+            held_inputs,
+            links,
+            spacecraft_id: _,
+            delay,
+            empty: _,
+            scratch: _,
+            stats,
+        } = self;
+        a.section("commands", |a| {
+            a.expect_count("participants", slots.len());
+            for s in slots.iter_mut() {
+                a.put(s);
+            }
+            let mut n = *answered as u64;
+            a.put(&mut n);
+            *answered = (n as usize).min(slots.len());
+            a.expect_count("summed effector inputs", held_inputs.len());
+            a.put(&mut held_inputs[..]);
+            links.archive(a);
+            a.expect_count("delay lines", delay.len());
+            for d in delay.iter_mut() {
+                a.put(d);
+            }
+            let flexdyn_faults::link::LinkStats {
+                commands_dropped,
+                empty_answers,
+                delayed_frames,
+                commands_corrupted,
+                corrupted_rejected,
+            } = stats;
+            for v in [
+                commands_dropped,
+                empty_answers,
+                delayed_frames,
+                commands_corrupted,
+                corrupted_rejected,
+            ] {
+                a.put(v);
+            }
+        });
+    }
+
     /// A book for `participants` (sorted, unique sender ids) on a spacecraft whose effectors'
     /// inputs sit at `input_ranges` of one flat vector.
     pub fn new(

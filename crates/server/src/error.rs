@@ -194,6 +194,14 @@ pub enum ServerError {
         /// What the OS refused and what the setting needs.
         problem: String,
     },
+    /// A checkpoint to resume from that cannot be used.
+    #[error("checkpoint `{}`: {problem}", file.display())]
+    Checkpoint {
+        /// The checkpoint file.
+        file: PathBuf,
+        /// Why it is refused.
+        problem: String,
+    },
     /// A thread of the server could not be started or panicked.
     #[error("internal error: {0}")]
     Internal(String),

@@ -57,6 +57,7 @@
 #![warn(missing_docs)]
 
 pub mod access;
+pub mod checkpoint;
 pub mod cli;
 pub mod clock;
 pub mod commands;
@@ -96,7 +97,7 @@ use zenoh::Session;
 pub use error::{ServerError, SettingsError, ZenohConfigError};
 pub use flexdyn_proto::client::transport::frame_stamp_ns;
 pub use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs, DEFAULT_ENDPOINT};
-pub use report::{Outcome, PublishCost, RunReport};
+pub use report::{CheckpointSummary, Outcome, PublishCost, RunReport};
 pub use settings::{mode_name, Handoff, OverrunPolicy, ServerSettings};
 pub use setup::RECORD_QUEUE;
 
@@ -138,6 +139,8 @@ pub async fn run(
     let shared = Arc::new(Shared::new(&settings.participants));
     shared.set_run_state(RunState::Starting);
     let state_pub = endpoints.state_pub.clone();
+    // Checkpoints: the writer thread, and the stepping side that takes them.
+    let (writer, checkpointer) = start_checkpoints(&settings, &sim, total_frames)?;
     let wiring = Wiring::new(
         endpoints,
         sim,
@@ -145,6 +148,7 @@ pub async fn run(
         total_frames,
         &shared,
         record_tx.clone(),
+        checkpointer,
     )?;
     // Hard real time: after the buffers exist (mlockall faults them in), before the physics
     // thread starts; undone when the run ends.
@@ -246,6 +250,9 @@ pub async fn run(
     let started = Instant::now();
     let physics = run_frames(wiring_frames, &settings, &shared, shutdown.as_mut()).await?;
     let wall_s = started.elapsed().as_secs_f64();
+    if let Some(w) = &writer {
+        w.flush();
+    }
     let tlm = telemetry
         .await
         .map_err(|_| ServerError::Internal("the telemetry thread panicked".into()))?;
@@ -262,8 +269,67 @@ pub async fn run(
         recording,
     );
     report.physics_thread = physics.usage;
+    report.checkpoints = writer.map(|w| w.stats.summary());
     tracing::info!("{report}");
     Ok(report)
+}
+
+/// The checkpoint writer and the stepping side of a run that saves checkpoints (`None` for
+/// one that saves none); checks that a resumed run starts before its end.
+fn start_checkpoints(
+    settings: &ServerSettings,
+    sim: &Simulation,
+    total_frames: Option<u64>,
+) -> Result<(Option<checkpoint::Writer>, Option<checkpoint::Checkpointer>), ServerError> {
+    let c = &settings.checkpoints;
+    let start = c.start_tick();
+    if let (Some(r), Some(total)) = (&c.resume, total_frames) {
+        if start >= total {
+            return Err(SettingsError::Invalid {
+                name: "--duration-s".into(),
+                problem: format!(
+                    "the checkpoint `{}` is at tick {start}, at or after the end of the run \
+                     (tick {total}; the duration counts from t = 0)",
+                    r.file.display()
+                ),
+            }
+            .into());
+        }
+    }
+    if let Some((tick, _)) = &c.save_at {
+        let problem = if *tick <= start {
+            Some("must be after the tick the run starts at".to_string())
+        } else if total_frames.is_some_and(|t| *tick > t) {
+            Some("is after the end of the run".to_string())
+        } else {
+            None
+        };
+        if let Some(problem) = problem {
+            return Err(SettingsError::Invalid {
+                name: "--checkpoint-at-tick".into(),
+                problem: format!("{tick} {problem}"),
+            }
+            .into());
+        }
+    }
+    if let Some(dir) = c.dir.as_ref().filter(|d| !d.is_dir()) {
+        return Err(SettingsError::Invalid {
+            name: "--checkpoint-dir".into(),
+            problem: format!("`{}` is not a directory", dir.display()),
+        }
+        .into());
+    }
+    if !c.saves() {
+        return Ok((None, None));
+    }
+    let (w, cp) = checkpoint::Writer::start(
+        c,
+        checkpoint::FRONT_END,
+        &settings.sc_id,
+        sim.step_ns(),
+        sim.frame_ns(),
+    )?;
+    Ok((Some(w), Some(cp)))
 }
 
 /// Validates the settings against `cfg`, builds the simulation and logs what is starting:
@@ -341,8 +407,11 @@ impl Wiring {
         total_frames: Option<u64>,
         shared: &Arc<Shared>,
         record: Option<RecordTx>,
+        checkpoints: Option<checkpoint::Checkpointer>,
     ) -> Result<Self, ServerError> {
         let mode = settings.mode;
+        let resume = settings.checkpoints.resume.as_ref();
+        let start_tick = settings.checkpoints.start_tick();
         // Who publishes the frames (see `publish`): batch always the telemetry thread.
         let direct = settings.direct_handoff();
         tracing::info!(
@@ -394,12 +463,15 @@ impl Wiring {
             for v in &mut world.vehicles {
                 v.frame = Some(new_frame());
             }
+            if let Some(r) = resume {
+                checkpoint::restore(r, &mut world)?;
+            }
             let lane = lockstep::CoreLane {
                 publisher,
                 record: recording.clone(),
                 shared: shared.clone(),
             };
-            let core = Arc::new(Mutex::new(LockstepCore::new(
+            let mut core = LockstepCore::new(
                 world,
                 vec![lane],
                 Vec::new(),
@@ -407,7 +479,12 @@ impl Wiring {
                 false,
                 total_frames,
                 events.clone(),
-            )));
+            )
+            .with_checkpoints(checkpoints);
+            if resume.is_some() {
+                core.resumed_at(start_tick);
+            }
+            let core = Arc::new(Mutex::new(core));
             let seat = lockstep::VehicleCore {
                 vehicle: 0,
                 core: core.clone(),
@@ -458,8 +535,13 @@ impl Wiring {
                 lateness: None,
                 relative: Vec::new(),
                 name_vehicles: false,
+                start_tick,
+                checkpoints,
             };
-            let world = WorldStepper::one(settings.sc_id.clone(), stepper);
+            let mut world = WorldStepper::one(settings.sc_id.clone(), stepper);
+            if let Some(r) = resume {
+                checkpoint::restore(r, &mut world)?;
+            }
             let frames = Frames::Physics(Box::new(physics), Box::new(world));
             (
                 frames,

@@ -34,6 +34,7 @@ use std::time::Instant;
 use flexdyn_proto::{CommandMsg, RunState};
 use tokio::sync::Notify;
 
+use super::checkpoint::Checkpointer;
 use super::error::ServerError;
 use super::physics::{Ending, PhysicsReport, Spent};
 use super::publish::{FramePublisher, Recording};
@@ -114,11 +115,14 @@ pub struct LockstepCore {
     /// `k → k + 1` waits for [`Self::release_if_due`].
     holding: bool,
     spent: Spent,
+    /// Takes the checkpoints due at each boundary (`None`: this run saves none).
+    checkpoints: Option<Checkpointer>,
 }
 
 impl LockstepCore {
     /// A core at tick 0, not yet started; every vehicle of `world` has its own telemetry buffer
-    /// and `lanes[i]` is vehicle `i`'s; `events` is notified when the run ends.
+    /// and `lanes[i]` is vehicle `i`'s; `events` is notified when the run ends. A resumed run
+    /// starts at its checkpoint's tick ([`Self::resumed_at`]).
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         world: WorldStepper,
@@ -142,9 +146,27 @@ impl LockstepCore {
             events,
             holding: false,
             spent: Spent::default(),
+            checkpoints: None,
         };
         core.world.begin_tick(0);
         core
+    }
+
+    /// Takes the checkpoints `c` says are due.
+    pub fn with_checkpoints(mut self, c: Option<Checkpointer>) -> Self {
+        self.checkpoints = c;
+        self
+    }
+
+    /// The world, before the run starts (to restore a checkpoint into).
+    pub fn world_mut(&mut self) -> &mut WorldStepper {
+        &mut self.world
+    }
+
+    /// Starts at tick `k` (a checkpoint restored into the world was taken there).
+    pub fn resumed_at(&mut self, k: u64) {
+        self.k = k;
+        self.world.begin_tick(k);
     }
 
     fn set_run_state(&self, s: RunState) {
@@ -175,14 +197,14 @@ impl LockstepCore {
             return;
         }
         self.set_run_state(RunState::Running);
-        if let Err((v, e)) = self.world.fill(0) {
+        if let Err((v, e)) = self.world.fill(self.k) {
             let e = self.named(v, e);
             self.end(Phase::Failed(e));
             return;
         }
         self.mark_hold();
         self.publish();
-        if self.total_frames == Some(0) {
+        if self.total_frames == Some(self.k) {
             self.end(Phase::Finished);
             return;
         }
@@ -326,6 +348,10 @@ impl LockstepCore {
                 v.stepper.note_links(&lane.shared);
             }
             self.k += 1;
+            // A checkpoint due at boundary k + 1: its state before the telemetry is filled.
+            if let Some(c) = self.checkpoints.as_mut() {
+                c.at_boundary(&mut self.world, self.k);
+            }
             let filled = self.world.fill(self.k);
             self.spent.frames += 1;
             self.spent.physics_ns += ns_between(started, Instant::now());

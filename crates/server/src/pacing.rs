@@ -58,6 +58,8 @@ pub enum FrameEnd {
 #[derive(Debug)]
 pub struct Pacer {
     t0: Instant,
+    /// The boundary due at `t0` (a resumed run's first tick; else 0).
+    first_tick: u64,
     period_ns: u64,
     spin: Duration,
     policy: OverrunPolicy,
@@ -80,6 +82,7 @@ impl Pacer {
     ) -> Self {
         Self {
             t0,
+            first_tick: 0,
             period_ns,
             spin,
             policy,
@@ -90,9 +93,16 @@ impl Pacer {
         }
     }
 
+    /// The same schedule with boundary `k` (a resumed run's first) due at `t0` instead of 0.
+    pub fn first_tick(mut self, k: u64) -> Self {
+        self.first_tick = k;
+        self
+    }
+
     /// When boundary `k` is due.
     pub fn deadline(&self, k: u64) -> Instant {
-        self.t0 + Duration::from_nanos(k.saturating_mul(self.period_ns))
+        let frames = k.saturating_sub(self.first_tick);
+        self.t0 + Duration::from_nanos(frames.saturating_mul(self.period_ns))
     }
 
     /// Waits for boundary `k` and returns its lateness in ns (0 if the wait ended exactly on

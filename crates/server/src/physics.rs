@@ -36,6 +36,7 @@ use std::time::{Duration, Instant};
 use flexdyn_proto::client::transport::unix_now_ns;
 use flexdyn_proto::{CommandMsg, Mode, RunState};
 
+use super::checkpoint::Checkpointer;
 use super::error::ServerError;
 use super::lateness_ring::LatenessRing;
 use super::pacing::{FrameEnd, Pacer};
@@ -164,6 +165,10 @@ pub struct PhysicsCtx {
     pub relative: Vec<RelativePublisher>,
     /// Whether an error about one vehicle names it ([`ServerError::Vehicle`]: a fleet's).
     pub name_vehicles: bool,
+    /// The first tick (a resumed checkpoint's; else 0).
+    pub start_tick: u64,
+    /// Takes the checkpoints due at each boundary (`None`: this run saves none).
+    pub checkpoints: Option<Checkpointer>,
 }
 
 enum Wait {
@@ -457,8 +462,8 @@ impl PhysicsCtx {
             }
         };
 
-        let mut k: u64 = 0;
-        if !self.fill(world, 0, realtime)? {
+        let mut k: u64 = self.start_tick;
+        if !self.fill(world, k, realtime)? {
             return Ok(stopped(&self.control));
         }
         // Real time: boundary 0 is due one frame from now, so the I/O side is settled.
@@ -471,7 +476,8 @@ impl PhysicsCtx {
             self.settings.spin,
             self.settings.overrun_policy,
             self.settings.overrun_limit,
-        );
+        )
+        .first_tick(k);
         self.set_run_state(RunState::Running);
         // The overrun log's clock starts before the first frame.
         monotonic_ns();
@@ -552,12 +558,16 @@ impl PhysicsCtx {
                 v.stepper.note_links(&lane.shared);
             }
             k += 1;
+            // A checkpoint due at boundary k + 1: its state before the telemetry is filled.
+            if let Some(c) = self.checkpoints.as_mut() {
+                c.at_boundary(world, k);
+            }
             if !self.fill(world, k, realtime)? {
                 return Ok(stopped(&self.control));
             }
             spent.frames += 1;
             spent.physics_ns += ns_since(t);
-            if realtime && k == 1 {
+            if realtime && k == self.start_tick + 1 {
                 // Once, off the measured frames: the counters' baseline (reads /proc twice,
                 // the first read warms the reading itself).
                 ThreadUsage::this_thread();

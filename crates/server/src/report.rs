@@ -66,6 +66,20 @@ pub struct RunReport {
     /// end of the frame's work; for lining overruns up with other counters (the
     /// `realtime_lateness` bench does, with the steal time and the scheduler's statistics).
     pub overrun_frames_ns: Vec<(u64, u64)>,
+    /// The checkpoints this run saved (`None`: it saves none).
+    pub checkpoints: Option<CheckpointSummary>,
+}
+
+/// The checkpoints a run saved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct CheckpointSummary {
+    /// Written to their files.
+    pub written: u64,
+    /// Not taken or not written (each logged with its reason).
+    pub failed: u64,
+    /// \[ns\] the longest time the stepping thread spent listing one checkpoint's state (the
+    /// checksum and the file are the writer thread's).
+    pub max_list_ns: u64,
 }
 
 /// The time the physics thread spent handing frames off (real time).
@@ -149,6 +163,15 @@ impl fmt::Display for RunReport {
                 u.involuntary_switches
             )?;
         }
+        if let Some(c) = &self.checkpoints {
+            write!(
+                f,
+                " checkpoints written={} failed={} max_list_us={:.1}",
+                c.written,
+                c.failed,
+                c.max_list_ns as f64 * 1e-3
+            )?;
+        }
         Ok(())
     }
 }
@@ -199,6 +222,7 @@ impl RunReport {
             physics_thread: None,
             overrun_frames_ns: shared.overrun_log.frames(),
             lateness: (mode == Mode::RealTime).then(|| lateness.clone()),
+            checkpoints: None,
         }
     }
 
@@ -222,6 +246,7 @@ impl RunReport {
             physics_thread: None,
             overrun_frames_ns: Vec::new(),
             lateness: None,
+            checkpoints: None,
         }
     }
 }

@@ -197,6 +197,9 @@ pub struct ServerSettings {
     /// `flexdyn run --record FILE.mcap`: record the server's own output (state, sensors, status,
     /// and every command received) to this file. Command line only (not a `[server]` key).
     pub record: Option<std::path::PathBuf>,
+    /// `flexdyn run --checkpoint-at-tick/--checkpoint`, `--checkpoint-dir`, `--resume`: the
+    /// checkpoints this run saves and the one it resumes from (docs/guides/checkpoints.md).
+    pub checkpoints: super::checkpoint::CheckpointSettings,
 }
 
 impl Default for ServerSettings {
@@ -226,6 +229,7 @@ impl Default for ServerSettings {
             participant_subjects: std::collections::BTreeMap::new(),
             speed: 1.0,
             record: None,
+            checkpoints: super::checkpoint::CheckpointSettings::default(),
         }
     }
 }

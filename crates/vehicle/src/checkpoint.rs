@@ -37,6 +37,7 @@
 
 use sha2::{Digest, Sha256};
 
+use crate::config::{ConfigError, SimConfig, DEFAULT_CONFIG_TOML};
 use crate::world::World;
 use flexdyn_kernel::archive::{Archive, ArchiveError};
 
@@ -56,7 +57,8 @@ const MAX_SOURCE_LEN: usize = 64 << 20;
 pub struct CheckpointHeader {
     /// The wire protocol version of the stream it continues ([`flexdyn_proto::PROTOCOL_VERSION`]).
     pub protocol_version: u16,
-    /// The front end that wrote it: `simulate` or `fleet`.
+    /// The front end that wrote it: `simulate`, `fleet`, `run` (a server of one spacecraft) or
+    /// `run --fleet`.
     pub front_end: String,
     /// The configuration file's absolute path (empty for the embedded default).
     pub source_path: String,
@@ -100,6 +102,70 @@ impl CheckpointHeader {
             a.put(&mut self.frame_ns);
             a.put(&mut self.row_steps);
         });
+    }
+}
+
+/// The configuration a run came from, as its checkpoints record it.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Source {
+    /// The file's absolute path (empty: the embedded default).
+    pub path: String,
+    /// Its text.
+    pub text: String,
+}
+
+impl Source {
+    /// The configuration (or fleet) file `path`, its text read again, or the embedded default.
+    pub fn of(path: Option<&std::path::Path>) -> Result<Self, ConfigError> {
+        let Some(p) = path else {
+            return Ok(Self {
+                path: String::new(),
+                text: DEFAULT_CONFIG_TOML.to_string(),
+            });
+        };
+        let io = |source| ConfigError::Io {
+            path: p.to_path_buf(),
+            source,
+        };
+        let text = std::fs::read_to_string(p).map_err(io)?;
+        // Absolute, so a resume from another directory finds the files it names.
+        let path = std::fs::canonicalize(p).map_err(io)?;
+        Ok(Self {
+            path: path.display().to_string(),
+            text,
+        })
+    }
+
+    /// What a checkpoint recorded.
+    pub fn recorded(header: &CheckpointHeader) -> Self {
+        Self {
+            path: header.source_path.clone(),
+            text: header.source_text.clone(),
+        }
+    }
+
+    /// The file's path (`None`: the embedded default).
+    pub fn file(&self) -> Option<std::path::PathBuf> {
+        (!self.path.is_empty()).then(|| std::path::PathBuf::from(&self.path))
+    }
+
+    /// The directory its relative paths are resolved in.
+    pub fn base_dir(&self) -> &std::path::Path {
+        std::path::Path::new(&self.path)
+            .parent()
+            .unwrap_or(std::path::Path::new("."))
+    }
+
+    /// The configuration it holds, parsed with relative paths resolved beside its file.
+    pub fn config(&self) -> Result<SimConfig, ConfigError> {
+        SimConfig::from_toml_str_in(&self.text, self.base_dir())
+    }
+
+    /// Fills `header`'s source fields with this one.
+    pub fn into_header(self, header: &mut CheckpointHeader) {
+        header.source_sha256 = CheckpointHeader::digest(&self.text);
+        header.source_path = self.path;
+        header.source_text = self.text;
     }
 }
 
@@ -165,6 +231,24 @@ pub enum CheckpointError {
 /// injected live, `flexdyn_faults::Faults::archive`). Not on the stepping path: it allocates
 /// the file's bytes.
 pub fn save(header: &CheckpointHeader, world: &mut World) -> Result<Vec<u8>, CheckpointError> {
+    save_with(header, |a| world.archive(a))
+}
+
+/// [`save`] of a run whose state `body` lists (a server lists its vehicles' simulations and
+/// command books; [`World::archive`] is the offline runs').
+pub fn save_with(
+    header: &CheckpointHeader,
+    body: impl FnOnce(&mut Archive<'_>),
+) -> Result<Vec<u8>, CheckpointError> {
+    list_with(header, body).map(seal)
+}
+
+/// [`save_with`] without the checksum: the bytes before it, for [`seal`] to finish on another
+/// thread (a server lists on the thread that steps the frames and checksums on its writer's).
+pub fn list_with(
+    header: &CheckpointHeader,
+    body: impl FnOnce(&mut Archive<'_>),
+) -> Result<Vec<u8>, CheckpointError> {
     let mut header = header.clone();
     header.protocol_version = flexdyn_proto::PROTOCOL_VERSION;
     let mut out = Vec::with_capacity(PREFIX_LEN + header.source_text.len() + 64 * 1024);
@@ -173,13 +257,18 @@ pub fn save(header: &CheckpointHeader, world: &mut World) -> Result<Vec<u8>, Che
     out.extend_from_slice(&0u64.to_le_bytes());
     let mut a = Archive::saving(&mut out);
     header.archive(&mut a);
-    world.archive(&mut a);
+    body(&mut a);
     a.finish()?;
     let payload_len = (out.len() - PREFIX_LEN) as u64;
     out[12..20].copy_from_slice(&payload_len.to_le_bytes());
-    let digest: [u8; 32] = Sha256::digest(&out).into();
-    out.extend_from_slice(&digest);
     Ok(out)
+}
+
+/// Appends the SHA-256 of `listed` ([`list_with`]'s bytes): a checkpoint file's bytes.
+pub fn seal(mut listed: Vec<u8>) -> Vec<u8> {
+    let digest: [u8; 32] = Sha256::digest(&listed).into();
+    listed.extend_from_slice(&digest);
+    listed
 }
 
 /// A checkpoint's bytes, checked (magic, version, length, checksum, protocol) and split into
@@ -245,16 +334,40 @@ impl<'a> Checkpoint<'a> {
         })
     }
 
+    /// [`Self::parse`], and checks that the front end `front_end` wrote it.
+    pub fn parse_of(bytes: &'a [u8], front_end: &str) -> Result<Self, CheckpointError> {
+        let c = Self::parse(bytes)?;
+        if c.header.front_end != front_end {
+            return Err(CheckpointError::Mismatch {
+                what: "the front end",
+                checkpoint: format!("`{}`", c.header.front_end),
+                run: format!("`{front_end}`"),
+            });
+        }
+        Ok(c)
+    }
+
     /// Restores the state into `world`, freshly built from a compatible configuration (module
     /// docs): its step and frame must be the checkpoint's. On an error `world` is half
     /// restored: discard it.
     pub fn restore(&self, world: &mut World) -> Result<(), CheckpointError> {
-        let h = &self.header;
         let run_step = world.vehicles().first().map_or(0, |v| v.sim.step_ns());
         let run_frame = world.vehicles().first().map_or(0, |v| v.sim.frame_ns());
+        self.restore_with(run_step, run_frame, |a| world.archive(a))
+    }
+
+    /// [`Self::restore`] into a run of step `run_step_ns` and frame `run_frame_ns` whose state
+    /// `body` lists, as [`save_with`]'s did.
+    pub fn restore_with(
+        &self,
+        run_step_ns: u64,
+        run_frame_ns: u64,
+        body: impl FnOnce(&mut Archive<'_>),
+    ) -> Result<(), CheckpointError> {
+        let h = &self.header;
         for (what, checkpoint, run) in [
-            ("an RK4 step of", h.step_ns, run_step),
-            ("a frame period of", h.frame_ns, run_frame),
+            ("an RK4 step of", h.step_ns, run_step_ns),
+            ("a frame period of", h.frame_ns, run_frame_ns),
         ] {
             if checkpoint != run {
                 return Err(CheckpointError::Mismatch {
@@ -265,7 +378,7 @@ impl<'a> Checkpoint<'a> {
             }
         }
         let mut a = Archive::loading(self.world);
-        world.archive(&mut a);
+        body(&mut a);
         a.finish()?;
         Ok(())
     }
@@ -283,7 +396,6 @@ fn section_len(bytes: &[u8]) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::{SimConfig, DEFAULT_CONFIG_TOML};
     use crate::sim::Simulation;
 
     fn world() -> World {

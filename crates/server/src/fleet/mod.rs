@@ -515,6 +515,8 @@ pub async fn run(
                 lateness: Some(lateness),
                 relative: std::mem::take(relative),
                 name_vehicles: true,
+                start_tick: 0,
+                checkpoints: None,
             };
             super::run_physics_thread(physics, world, &settings, &shared, shutdown.as_mut()).await
         }
