@@ -1,0 +1,4 @@
+//! The codecs against published definitions and examples: one executable, one module per
+//! codec. Every expected value names its source or is derived in a comment.
+
+mod checksum;
