@@ -25,5 +25,6 @@
 
 pub mod byte_order;
 pub mod checksum;
+pub mod framing;
 
 pub use byte_order::ByteOrder;

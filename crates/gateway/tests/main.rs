@@ -2,3 +2,5 @@
 //! codec. Every expected value names its source or is derived in a comment.
 
 mod checksum;
+mod framing;
+mod prng;

@@ -1,0 +1,85 @@
+//! SLIP, "A Nonstandard for Transmission of IP Datagrams over Serial Lines" (RFC 1055, 1988).
+//!
+//! A frame ends with END (0xC0); an END or ESC (0xDB) octet in the payload is sent as ESC
+//! ESC_END (0xDB 0xDC) or ESC ESC_ESC (0xDB 0xDD). The encoder also sends an END before the
+//! frame, as RFC 1055's `send_packet` suggests, to flush line noise into an empty frame, which
+//! the decoder ignores. An ESC followed by anything but ESC_END or ESC_ESC is a protocol
+//! violation the RFC leaves to the implementation: here the frame is rejected (bad escape).
+
+use super::accumulator::Accumulator;
+use super::{DecodeCounters, Malformed, StreamDecoder};
+
+/// Frame end.
+pub const END: u8 = 0xC0;
+/// Escape.
+pub const ESC: u8 = 0xDB;
+/// Escaped END.
+pub const ESC_END: u8 = 0xDC;
+/// Escaped ESC.
+pub const ESC_ESC: u8 = 0xDD;
+
+/// Appends `payload` as one SLIP frame: END, the escaped payload, END.
+pub fn encode(payload: &[u8], out: &mut Vec<u8>) {
+    out.push(END);
+    for &b in payload {
+        match b {
+            END => out.extend_from_slice(&[ESC, ESC_END]),
+            ESC => out.extend_from_slice(&[ESC, ESC_ESC]),
+            _ => out.push(b),
+        }
+    }
+    out.push(END);
+}
+
+/// Incremental SLIP decoder.
+#[derive(Debug, Clone)]
+pub struct SlipDecoder {
+    frame: Accumulator,
+    escaped: bool,
+    counters: DecodeCounters,
+}
+
+impl SlipDecoder {
+    /// A decoder of payloads up to `max_payload_bytes` octets.
+    pub fn new(max_payload_bytes: usize) -> Self {
+        Self {
+            frame: Accumulator::new(max_payload_bytes),
+            escaped: false,
+            counters: DecodeCounters::default(),
+        }
+    }
+}
+
+impl StreamDecoder for SlipDecoder {
+    fn feed(&mut self, input: &[u8], on_frame: &mut dyn FnMut(&[u8])) {
+        for &b in input {
+            if b == END {
+                if std::mem::take(&mut self.escaped) {
+                    self.frame.poison(Malformed::BadEscape);
+                }
+                if let Some(payload) = self.frame.end(&mut self.counters) {
+                    on_frame(payload);
+                    self.counters.frames += 1;
+                }
+            } else if std::mem::take(&mut self.escaped) {
+                match b {
+                    ESC_END => self.frame.push(END),
+                    ESC_ESC => self.frame.push(ESC),
+                    _ => self.frame.poison(Malformed::BadEscape),
+                }
+            } else if b == ESC {
+                self.escaped = true;
+            } else {
+                self.frame.push(b);
+            }
+        }
+    }
+
+    fn counters(&self) -> &DecodeCounters {
+        &self.counters
+    }
+
+    fn pending_bytes(&self) -> usize {
+        self.frame.len() + usize::from(self.escaped)
+    }
+}
