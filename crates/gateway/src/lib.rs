@@ -26,5 +26,6 @@
 pub mod byte_order;
 pub mod checksum;
 pub mod framing;
+pub mod nmea;
 
 pub use byte_order::ByteOrder;

@@ -3,4 +3,5 @@
 
 mod checksum;
 mod framing;
+mod nmea;
 mod prng;

@@ -1,7 +1,8 @@
 //! After construction, the decoders allocate and free nothing: a stream of good, corrupted,
 //! truncated and oversize frames and garbage is fed, whole and byte by byte, inside
 //! `assert_no_alloc`, whose global allocator counts every (de)allocation made on this thread
-//! there (features `warn_debug`/`warn_release`: count and warn, don't abort).
+//! there (features `warn_debug`/`warn_release`: count and warn, don't abort). Nor do the NMEA
+//! writers, into a buffer with room for the sentence.
 
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
 use flexdyn_gateway::checksum::presets::{CRC16_IBM_SDLC, CRC32C};
@@ -14,7 +15,9 @@ use flexdyn_gateway::framing::length::{
 use flexdyn_gateway::framing::lines::{self, LineDecoder, LineEnding};
 use flexdyn_gateway::framing::slip::{self, SlipDecoder};
 use flexdyn_gateway::framing::{FrameCheck, StreamDecoder};
+use flexdyn_gateway::nmea::{Dgps, FixQuality, Gga, LocalZone, Mode, NmeaStyle, Rmc, Zda};
 use flexdyn_gateway::ByteOrder;
+use hifitime::Epoch;
 
 #[global_allocator]
 static ALLOC: AllocDisabler = AllocDisabler;
@@ -120,4 +123,53 @@ fn decoders_do_not_allocate_after_construction() {
     for (mut decoder, stream) in cases {
         assert!(frames_without_allocating(&mut *decoder, &stream) > 0);
     }
+}
+
+#[test]
+fn nmea_writers_do_not_allocate_into_a_buffer_with_room() {
+    let style = NmeaStyle::default();
+    let time = Epoch::from_gregorian_utc(2026, 11, 30, 12, 0, 0, 123_456_789);
+    let gga = Gga {
+        time,
+        latitude_deg: -33.9,
+        longitude_deg: 151.2,
+        fix_quality: FixQuality::Differential,
+        satellites: 11,
+        hdop: 0.8,
+        altitude_msl_m: 58.0,
+        geoid_separation_m: 22.3,
+        dgps: Some(Dgps {
+            age_s: 2.0,
+            station_id: 17,
+        }),
+    };
+    let rmc = Rmc {
+        time,
+        valid: true,
+        latitude_deg: -33.9,
+        longitude_deg: 151.2,
+        speed_knots: 7.5,
+        course_deg: 270.0,
+        magnetic_variation_deg: Some(12.6),
+        mode: Some(Mode::Autonomous),
+    };
+    let zda = Zda {
+        time,
+        local_zone: Some(LocalZone {
+            hours: 10,
+            minutes: 0,
+        }),
+    };
+    let mut out = String::with_capacity(1024);
+    reset_violation_count();
+    assert_no_alloc(|| {
+        for _ in 0..10 {
+            out.clear();
+            gga.write(&style, &mut out).unwrap();
+            rmc.write(&style, &mut out).unwrap();
+            zda.write(&style, &mut out).unwrap();
+        }
+    });
+    assert_eq!(violation_count(), 0, "an NMEA writer allocated");
+    assert_eq!(out.matches("\r\n").count(), 3);
 }

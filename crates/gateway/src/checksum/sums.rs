@@ -1,5 +1,4 @@
-//! The two simplest checks: the XOR of all octets (NMEA 0183's sentence checksum, IEC 61162-1
-//! §7.2.3) and their sum modulo 256.
+//! The two simplest checks: the XOR of all octets (NMEA 0183's sentence checksum) and their sum modulo 256.
 
 /// The XOR of every octet of `data`.
 pub fn xor8(data: &[u8]) -> u8 {
