@@ -24,6 +24,7 @@
 #![warn(missing_docs)]
 
 pub mod byte_order;
+pub mod ccsds;
 pub mod checksum;
 pub mod framing;
 pub mod nmea;
