@@ -3,7 +3,7 @@
 //! layouts the standards give.
 
 use flexdyn_gateway::ccsds::{
-    encode_packet, Apid, CcsdsError, CucEpoch, CucFormat, CucTime, PacketType, PrimaryHeader,
+    Apid, CcsdsError, CucEpoch, CucFormat, CucTime, PacketTemplate, PacketType, PrimaryHeader,
     SequenceCount, SequenceCounter, SequenceFlags,
 };
 
@@ -124,17 +124,20 @@ fn a_packet_with_a_cuc_secondary_header() {
     agency_cuc_4_2()
         .encode(1_500_000_000, &mut secondary)
         .unwrap();
+    let template = PacketTemplate {
+        packet_type: PacketType::Telemetry,
+        apid: Apid::new(0x123).unwrap(),
+        sequence_flags: SequenceFlags::Unsegmented,
+    };
     let mut packet = Vec::new();
-    let header = encode_packet(
-        PacketType::Telemetry,
-        Apid::new(0x123).unwrap(),
-        SequenceFlags::Unsegmented,
-        SequenceCount::new(5).unwrap(),
-        &secondary,
-        &[0xDE, 0xAD, 0xBF],
-        &mut packet,
-    )
-    .unwrap();
+    let header = template
+        .encode(
+            SequenceCount::new(5).unwrap(),
+            &secondary,
+            &[0xDE, 0xAD, 0xBF],
+            &mut packet,
+        )
+        .unwrap();
     assert_eq!(
         packet,
         [0x09, 0x23, 0xC0, 0x05, 0x00, 0x09, 0x2E, 0, 0, 0, 1, 0x80, 0x00, 0xDE, 0xAD, 0xBF]
@@ -149,48 +152,30 @@ fn a_packet_with_a_cuc_secondary_header() {
 
 #[test]
 fn packets_that_the_data_length_cannot_describe_are_refused() {
-    let apid = Apid::new(1).unwrap();
+    let template = PacketTemplate {
+        packet_type: PacketType::Telemetry,
+        apid: Apid::new(1).unwrap(),
+        sequence_flags: SequenceFlags::Unsegmented,
+    };
     let count = SequenceCount::default();
     let mut out = Vec::new();
-    let err = encode_packet(
-        PacketType::Telemetry,
-        apid,
-        SequenceFlags::Unsegmented,
-        count,
-        &[],
-        &[],
-        &mut out,
-    )
-    .unwrap_err();
+    let err = template.encode(count, &[], &[], &mut out).unwrap_err();
     assert_eq!(err, CcsdsError::EmptyDataField);
-    let big = vec![0u8; 65_537];
-    let err = encode_packet(
-        PacketType::Telemetry,
-        apid,
-        SequenceFlags::Unsegmented,
-        count,
-        &[],
-        &big,
-        &mut out,
-    )
-    .unwrap_err();
+    let err = template
+        .encode(count, &[], &[0; 65_537], &mut out)
+        .unwrap_err();
     assert_eq!(
         err.to_string(),
         "packet data field of 65537 octets is above the 65536 the 16-bit data length can count (§4.1.3.5)"
     );
+    // A secondary header counts in the data field too.
+    let err = template
+        .encode(count, &[0; 2], &[0; 65_535], &mut out)
+        .unwrap_err();
+    assert_eq!(err, CcsdsError::DataFieldTooLong { len_bytes: 65_537 });
     assert!(out.is_empty());
     // 65536 octets is the most: data length 0xFFFF.
-    let largest = vec![0u8; 65_536];
-    let header = encode_packet(
-        PacketType::Telemetry,
-        apid,
-        SequenceFlags::Unsegmented,
-        count,
-        &[],
-        &largest,
-        &mut out,
-    )
-    .unwrap();
+    let header = template.encode(count, &[], &[0; 65_536], &mut out).unwrap();
     assert_eq!(header.data_length, 0xFFFF);
     assert_eq!(out.len(), 6 + 65_536);
 }

@@ -53,6 +53,14 @@ fn decode_every_way(
     whole
 }
 
+/// The counters of a clean stream: `frames` delivered, nothing rejected.
+fn clean(frames: u64) -> DecodeCounters {
+    DecodeCounters {
+        frames,
+        ..Default::default()
+    }
+}
+
 fn crc(params: flexdyn_gateway::checksum::CrcParams) -> Checksum {
     Checksum::Crc(Box::new(Crc::new(params).unwrap()))
 }
@@ -79,13 +87,7 @@ fn slip_escapes_end_and_esc_as_rfc_1055_specifies() {
     assert_eq!(out, [0xC0, 0x01, 0xDB, 0xDC, 0x02, 0xDB, 0xDD, 0x03, 0xC0]);
     let (frames, counters) = decode_every_way(&|| Box::new(SlipDecoder::new(16)), &out);
     assert_eq!(frames, [vec![0x01, 0xC0, 0x02, 0xDB, 0x03]]);
-    assert_eq!(
-        counters,
-        DecodeCounters {
-            frames: 1,
-            ..Default::default()
-        }
-    );
+    assert_eq!(counters, clean(1));
 }
 
 /// ESC then 0x05 (neither ESC_END nor ESC_ESC): that frame is rejected, the next delivered.
@@ -100,9 +102,8 @@ fn slip_counts_a_bad_escape_and_keeps_the_next_frame() {
     assert_eq!(
         counters,
         DecodeCounters {
-            frames: 1,
             bad_escape: 2,
-            ..Default::default()
+            ..clean(1)
         }
     );
 }
@@ -117,9 +118,8 @@ fn slip_drops_an_oversize_frame_whole_and_counts_it_once() {
     assert_eq!(
         counters,
         DecodeCounters {
-            frames: 1,
             oversize: 1,
-            ..Default::default()
+            ..clean(1)
         }
     );
 }
@@ -193,9 +193,8 @@ fn cobs_counts_a_block_that_runs_past_the_frame() {
     assert_eq!(
         counters,
         DecodeCounters {
-            frames: 1,
             bad_encoding: 1,
-            ..Default::default()
+            ..clean(1)
         }
     );
 }
@@ -260,13 +259,7 @@ fn hdlc_fcs16_frame_gives_the_rfc_1662_good_fcs() {
     );
     let (frames, counters) = decode_every_way(&|| Box::new(HdlcDecoder::new(&framing, 32)), &out);
     assert_eq!(frames, [content.to_vec()]);
-    assert_eq!(
-        counters,
-        DecodeCounters {
-            frames: 1,
-            ..Default::default()
-        }
-    );
+    assert_eq!(counters, clean(1));
 }
 
 /// Garbage before the first flag, a frame with a flipped octet (bad FCS), an aborted frame
@@ -289,12 +282,11 @@ fn hdlc_counts_garbage_bad_fcs_abort_and_runt() {
         decode_every_way(&|| Box::new(HdlcDecoder::new(&framing, 32)), &stream);
     assert_eq!(frames, [b"good".to_vec()]);
     let expected = DecodeCounters {
-        frames: 1,
         garbage_bytes: 3,
         bad_checksum: 1,
         aborted: 1,
         bad_length: 1,
-        ..Default::default()
+        ..clean(1)
     };
     assert_eq!(counters, expected);
 }
@@ -320,9 +312,8 @@ fn lines_drop_an_oversize_line_and_count_it_once() {
     assert_eq!(
         counters,
         DecodeCounters {
-            frames: 1,
             oversize: 2,
-            ..Default::default()
+            ..clean(1)
         }
     );
 }
@@ -392,13 +383,7 @@ fn a_sync_length_frame_is_laid_out_as_configured() {
         decode_every_way(&|| Box::new(LengthDecoder::new(vendor_framing(64))), &out);
     assert_eq!(frames, [expected.clone()]);
     assert_eq!(framing.payload(&frames[0]), b"123456789");
-    assert_eq!(
-        counters,
-        DecodeCounters {
-            frames: 1,
-            ..Default::default()
-        }
-    );
+    assert_eq!(counters, clean(1));
 }
 
 /// A CCSDS-like field: big-endian, 1 octet, counting "octets after the field − 1"
@@ -466,11 +451,10 @@ fn impossible_lengths_are_counted_and_the_next_frame_found() {
     assert_eq!(
         counters,
         DecodeCounters {
-            frames: 1,
             garbage_bytes: 2,
             bad_length: 1,
             oversize: 1,
-            ..Default::default()
+            ..clean(1)
         }
     );
 }
@@ -700,14 +684,7 @@ fn random_payloads_round_trip_through_every_framing_in_any_chunks() {
                 .collect();
         }
         assert_eq!(frames, payloads, "{name}");
-        assert_eq!(
-            counters,
-            DecodeCounters {
-                frames: 200,
-                ..Default::default()
-            },
-            "{name}"
-        );
+        assert_eq!(counters, clean(200), "{name}");
     }
 }
 

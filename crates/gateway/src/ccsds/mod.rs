@@ -17,7 +17,7 @@ pub mod primary_header;
 
 pub use cuc::{CucEpoch, CucFormat, CucTime};
 pub use error::CcsdsError;
-pub use packet::encode_packet;
+pub use packet::PacketTemplate;
 pub use primary_header::{
     Apid, PacketType, PrimaryHeader, SequenceCount, SequenceCounter, SequenceFlags,
 };

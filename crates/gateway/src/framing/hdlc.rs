@@ -10,7 +10,7 @@
 //! It does not drop unescaped control characters (§7.1 lets a receiver do so); the address
 //! and control fields, if any, are the caller's content.
 
-use super::accumulator::Accumulator;
+use super::unstuffer::{Stuffing, Unstuffer};
 use super::{DecodeCounters, FrameCheck, Malformed, StreamDecoder};
 
 /// Flag sequence.
@@ -50,14 +50,27 @@ impl HdlcFraming {
     }
 }
 
+/// RFC 1662's stuffing: 0x7D then the octet XOR 0x20; 0x7D then the flag aborts the frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Hdlc;
+
+impl Stuffing for Hdlc {
+    const DELIMITER: u8 = FLAG;
+    const ESCAPE: u8 = ESCAPE;
+    const ESCAPED_DELIMITER: Malformed = Malformed::Aborted;
+
+    fn unescape(octet: u8) -> Option<u8> {
+        Some(octet ^ ESCAPE_XOR)
+    }
+}
+
 /// Incremental decoder of HDLC-like frames.
 #[derive(Debug, Clone)]
 pub struct HdlcDecoder {
     fcs: Option<FrameCheck>,
-    frame: Accumulator,
+    frame: Unstuffer<Hdlc>,
     /// No flag seen yet: octets are garbage.
     hunting: bool,
-    escaped: bool,
     counters: DecodeCounters,
 }
 
@@ -67,9 +80,8 @@ impl HdlcDecoder {
         let fcs_len = framing.fcs.as_ref().map_or(0, FrameCheck::len_bytes);
         Self {
             fcs: framing.fcs.clone(),
-            frame: Accumulator::new(max_content_bytes + fcs_len),
+            frame: Unstuffer::new(max_content_bytes + fcs_len),
             hunting: true,
-            escaped: false,
             counters: DecodeCounters::default(),
         }
     }
@@ -86,31 +98,20 @@ impl StreamDecoder for HdlcDecoder {
                 }
                 continue;
             }
-            if b == FLAG {
-                if std::mem::take(&mut self.escaped) {
-                    self.frame.poison(Malformed::Aborted);
+            let Some(frame) = self.frame.push(b, &mut self.counters) else {
+                continue;
+            };
+            let content = match &self.fcs {
+                None => Ok(&*frame),
+                Some(check) if frame.len() < check.len_bytes() => Err(Malformed::BadLength),
+                Some(check) => check.strip(frame).ok_or(Malformed::BadChecksum),
+            };
+            match content {
+                Ok(content) => {
+                    on_frame(content);
+                    self.counters.frames += 1;
                 }
-                let Some(frame) = self.frame.end(&mut self.counters) else {
-                    continue;
-                };
-                let content = match &self.fcs {
-                    None => Ok(&*frame),
-                    Some(check) if frame.len() < check.len_bytes() => Err(Malformed::BadLength),
-                    Some(check) => check.strip(frame).ok_or(Malformed::BadChecksum),
-                };
-                match content {
-                    Ok(content) => {
-                        on_frame(content);
-                        self.counters.frames += 1;
-                    }
-                    Err(reason) => self.counters.record(reason),
-                }
-            } else if std::mem::take(&mut self.escaped) {
-                self.frame.push(b ^ ESCAPE_XOR);
-            } else if b == ESCAPE {
-                self.escaped = true;
-            } else {
-                self.frame.push(b);
+                Err(reason) => self.counters.record(reason),
             }
         }
     }
@@ -120,6 +121,6 @@ impl StreamDecoder for HdlcDecoder {
     }
 
     fn pending_bytes(&self) -> usize {
-        self.frame.len() + usize::from(self.escaped)
+        self.frame.pending_bytes()
     }
 }

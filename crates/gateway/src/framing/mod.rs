@@ -6,7 +6,9 @@
 //! - [`cobs`]: Consistent Overhead Byte Stuffing (Cheshire & Baker, IEEE/ACM Trans.
 //!   Networking 7(2), 1999), zero-delimited;
 //! - [`hdlc`]: HDLC-like byte stuffing (RFC 1662 §4.2) with an optional FCS;
-//! - [`lines`]: newline-terminated text lines (NMEA 0183, command consoles).
+//! - [`lines`]: newline-terminated text lines (NMEA 0183, command consoles);
+//! - [`accumulator`] and [`unstuffer`]: the frame buffer of the delimiter framings and the
+//!   unstuffing state machine SLIP and HDLC share.
 //!
 //! Every decoder implements [`StreamDecoder`]. Its contract:
 //! - **chunking does not matter**: feeding a stream byte by byte or all at once gives the same
@@ -28,6 +30,7 @@ pub mod hdlc;
 pub mod length;
 pub mod lines;
 pub mod slip;
+pub mod unstuffer;
 
 pub use counters::{DecodeCounters, Malformed};
 pub use error::FramingError;

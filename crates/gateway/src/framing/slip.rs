@@ -6,7 +6,7 @@
 //! the decoder ignores. An ESC followed by anything but ESC_END or ESC_ESC is a protocol
 //! violation the RFC leaves to the implementation: here the frame is rejected (bad escape).
 
-use super::accumulator::Accumulator;
+use super::unstuffer::{Stuffing, Unstuffer};
 use super::{DecodeCounters, Malformed, StreamDecoder};
 
 /// Frame end.
@@ -31,11 +31,28 @@ pub fn encode(payload: &[u8], out: &mut Vec<u8>) {
     out.push(END);
 }
 
+/// SLIP's stuffing: ESC ESC_END for END, ESC ESC_ESC for ESC, nothing else after ESC.
+#[derive(Debug, Clone, Copy)]
+pub struct Slip;
+
+impl Stuffing for Slip {
+    const DELIMITER: u8 = END;
+    const ESCAPE: u8 = ESC;
+    const ESCAPED_DELIMITER: Malformed = Malformed::BadEscape;
+
+    fn unescape(octet: u8) -> Option<u8> {
+        match octet {
+            ESC_END => Some(END),
+            ESC_ESC => Some(ESC),
+            _ => None,
+        }
+    }
+}
+
 /// Incremental SLIP decoder.
 #[derive(Debug, Clone)]
 pub struct SlipDecoder {
-    frame: Accumulator,
-    escaped: bool,
+    frame: Unstuffer<Slip>,
     counters: DecodeCounters,
 }
 
@@ -43,8 +60,7 @@ impl SlipDecoder {
     /// A decoder of payloads up to `max_payload_bytes` octets.
     pub fn new(max_payload_bytes: usize) -> Self {
         Self {
-            frame: Accumulator::new(max_payload_bytes),
-            escaped: false,
+            frame: Unstuffer::new(max_payload_bytes),
             counters: DecodeCounters::default(),
         }
     }
@@ -53,24 +69,9 @@ impl SlipDecoder {
 impl StreamDecoder for SlipDecoder {
     fn feed(&mut self, input: &[u8], on_frame: &mut dyn FnMut(&[u8])) {
         for &b in input {
-            if b == END {
-                if std::mem::take(&mut self.escaped) {
-                    self.frame.poison(Malformed::BadEscape);
-                }
-                if let Some(payload) = self.frame.end(&mut self.counters) {
-                    on_frame(payload);
-                    self.counters.frames += 1;
-                }
-            } else if std::mem::take(&mut self.escaped) {
-                match b {
-                    ESC_END => self.frame.push(END),
-                    ESC_ESC => self.frame.push(ESC),
-                    _ => self.frame.poison(Malformed::BadEscape),
-                }
-            } else if b == ESC {
-                self.escaped = true;
-            } else {
-                self.frame.push(b);
+            if let Some(payload) = self.frame.push(b, &mut self.counters) {
+                on_frame(payload);
+                self.counters.frames += 1;
             }
         }
     }
@@ -80,6 +81,6 @@ impl StreamDecoder for SlipDecoder {
     }
 
     fn pending_bytes(&self) -> usize {
-        self.frame.len() + usize::from(self.escaped)
+        self.frame.pending_bytes()
     }
 }

@@ -6,6 +6,7 @@ use std::fmt::Write;
 
 use hifitime::{Duration, Epoch, TimeScale};
 
+use super::sentence::SentenceWriter;
 use super::{Fixed, NmeaError};
 
 /// UTC calendar fields, the seconds rounded to the time field's decimals.
@@ -182,4 +183,39 @@ pub fn write_angle(
     } else {
         hemispheres[0]
     });
+}
+
+/// A latitude and longitude checked for a sentence (finite, within ±90° and ±180°).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Position {
+    latitude_deg: f64,
+    longitude_deg: f64,
+}
+
+impl Position {
+    /// Checks a geodetic latitude and a longitude, degrees, north and east positive.
+    pub fn checked(latitude_deg: f64, longitude_deg: f64) -> Result<Self, NmeaError> {
+        Ok(Self {
+            latitude_deg: in_range("latitude_deg", latitude_deg, -90.0, 90.0, "-90..=90")?,
+            longitude_deg: in_range("longitude_deg", longitude_deg, -180.0, 180.0, "-180..=180")?,
+        })
+    }
+
+    /// Writes the four fields `ddmm.m…,N|S,dddmm.m…,E|W`.
+    pub fn write(&self, sentence: &mut SentenceWriter<'_>, minute_decimals: u8) {
+        write_angle(
+            sentence.field(),
+            self.latitude_deg,
+            2,
+            minute_decimals,
+            ['N', 'S'],
+        );
+        write_angle(
+            sentence.field(),
+            self.longitude_deg,
+            3,
+            minute_decimals,
+            ['E', 'W'],
+        );
+    }
 }

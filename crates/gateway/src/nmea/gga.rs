@@ -15,7 +15,7 @@ use std::fmt::Write;
 
 use hifitime::Epoch;
 
-use super::fields::{fixed_value, in_range, write_angle, write_fixed, UtcFields};
+use super::fields::{fixed_value, in_range, write_fixed, Position, UtcFields};
 use super::sentence::SentenceWriter;
 use super::{NmeaError, NmeaStyle};
 
@@ -78,14 +78,7 @@ impl Gga {
     /// Appends the sentence to `out` (nothing is appended on error).
     pub fn write(&self, style: &NmeaStyle, out: &mut String) -> Result<(), NmeaError> {
         style.validate()?;
-        let latitude_deg = in_range("latitude_deg", self.latitude_deg, -90.0, 90.0, "-90..=90")?;
-        let longitude_deg = in_range(
-            "longitude_deg",
-            self.longitude_deg,
-            -180.0,
-            180.0,
-            "-180..=180",
-        )?;
+        let position = Position::checked(self.latitude_deg, self.longitude_deg)?;
         let hdop = fixed_value("hdop", self.hdop, false)?;
         let altitude_msl_m = fixed_value("altitude_msl_m", self.altitude_msl_m, true)?;
         let geoid_separation_m = fixed_value("geoid_separation_m", self.geoid_separation_m, true)?;
@@ -106,20 +99,7 @@ impl Gga {
 
         let mut s = SentenceWriter::start(out, style.talker, "GGA");
         utc.write_time(s.field());
-        write_angle(
-            s.field(),
-            latitude_deg,
-            2,
-            style.minute_decimals,
-            ['N', 'S'],
-        );
-        write_angle(
-            s.field(),
-            longitude_deg,
-            3,
-            style.minute_decimals,
-            ['E', 'W'],
-        );
+        position.write(&mut s, style.minute_decimals);
         let _ = write!(s.field(), "{}", self.fix_quality as u8);
         let _ = write!(
             s.field(),

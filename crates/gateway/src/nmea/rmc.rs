@@ -15,7 +15,7 @@ use std::fmt::Write;
 
 use hifitime::Epoch;
 
-use super::fields::{fixed_value, in_range, write_angle, write_fixed, UtcFields};
+use super::fields::{fixed_value, in_range, write_fixed, Position, UtcFields};
 use super::sentence::SentenceWriter;
 use super::{NmeaError, NmeaStyle};
 
@@ -75,14 +75,7 @@ impl Rmc {
     /// Appends the sentence to `out` (nothing is appended on error).
     pub fn write(&self, style: &NmeaStyle, out: &mut String) -> Result<(), NmeaError> {
         style.validate()?;
-        let latitude_deg = in_range("latitude_deg", self.latitude_deg, -90.0, 90.0, "-90..=90")?;
-        let longitude_deg = in_range(
-            "longitude_deg",
-            self.longitude_deg,
-            -180.0,
-            180.0,
-            "-180..=180",
-        )?;
+        let position = Position::checked(self.latitude_deg, self.longitude_deg)?;
         let speed_knots = fixed_value("speed_knots", self.speed_knots, false)?;
         let course_deg = in_range("course_deg", self.course_deg, 0.0, 360.0, "0..=360")?;
         let variation = match self.magnetic_variation_deg {
@@ -101,20 +94,7 @@ impl Rmc {
         let mut s = SentenceWriter::start(out, style.talker, "RMC");
         utc.write_time(s.field());
         s.field().push(if self.valid { 'A' } else { 'V' });
-        write_angle(
-            s.field(),
-            latitude_deg,
-            2,
-            style.minute_decimals,
-            ['N', 'S'],
-        );
-        write_angle(
-            s.field(),
-            longitude_deg,
-            3,
-            style.minute_decimals,
-            ['E', 'W'],
-        );
+        position.write(&mut s, style.minute_decimals);
         write_fixed(s.field(), speed_knots, style.speed_knots);
         write_fixed(s.field(), course_deg, style.course_deg);
         let _ = write!(s.field(), "{:02}{:02}{:02}", utc.day, utc.month, year % 100);
