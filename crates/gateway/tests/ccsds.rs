@@ -1,4 +1,4 @@
-//! CCSDS Space Packet primary headers (CCSDS 133.0-B-2 §4.1.3) and CUC time codes (CCSDS
+//! CCSDS Space Packet primary headers (CCSDS 133.0-B-2 §4.1) and CUC time codes (CCSDS
 //! 301.0-B-4 §3.2). Expected octets are derived bit by bit in the comments from the field
 //! layouts the standards give.
 
@@ -77,7 +77,7 @@ fn every_field_combination_round_trips() {
     }
 }
 
-/// §4.1.3.4.3: the count is modulo 16384, 16383 is followed by 0.
+/// The sequence count is a 14-bit counter, modulo 16384, 16383 is followed by 0.
 #[test]
 fn the_sequence_count_wraps_after_16383() {
     let mut counter = SequenceCounter::starting_at(SequenceCount::new(16382).unwrap());
@@ -92,7 +92,7 @@ fn out_of_range_fields_are_refused_with_a_clear_error() {
     assert_eq!(err, CcsdsError::Apid { apid: 2048 });
     assert_eq!(
         err.to_string(),
-        "APID 2048 is above 2047 (11 bits, CCSDS 133.0-B-2 §4.1.3.3.4)"
+        "APID 2048 is above 2047 (the 11-bit APID field of the Space Packet primary header)"
     );
     assert_eq!(
         SequenceCount::new(16384).unwrap_err(),
@@ -166,7 +166,7 @@ fn packets_that_the_data_length_cannot_describe_are_refused() {
         .unwrap_err();
     assert_eq!(
         err.to_string(),
-        "packet data field of 65537 octets is above the 65536 the 16-bit data length can count (§4.1.3.5)"
+        "packet data field of 65537 octets is above the 65536 the 16-bit data length (octets − 1) can count"
     );
     // A secondary header counts in the data field too.
     let err = template
@@ -180,7 +180,7 @@ fn packets_that_the_data_length_cannot_describe_are_refused() {
     assert_eq!(out.len(), 6 + 65_536);
 }
 
-/// P-field (301.0-B-4 §3.2.2): extension 0, id, coarse − 1 (2 bits), fine (2 bits):
+/// P-field (301.0-B-4 §3.2): extension 0, id, coarse − 1 (2 bits), fine (2 bits):
 /// - agency epoch 010, 4 coarse, 2 fine: 0 010 11 10 = 0x2E;
 /// - 1958 TAI epoch 001, 4 coarse, 3 fine: 0 001 11 11 = 0x1F;
 /// - agency epoch, 1 coarse, 0 fine: 0 010 00 00 = 0x20.

@@ -429,6 +429,10 @@ fn the_reader_refuses_damaged_sentences_with_the_reason() {
         Err(NmeaError::ChecksumDigits(_))
     ));
     assert!(matches!(
+        Sentence::parse(&good.replace("*47", "*+7")),
+        Err(NmeaError::ChecksumDigits(_))
+    ));
+    assert!(matches!(
         Sentence::parse("$GPGGA,1\u{7}*00"),
         Err(NmeaError::NotPrintable { position: 8 })
     ));

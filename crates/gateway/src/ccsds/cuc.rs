@@ -1,7 +1,7 @@
 //! The CCSDS Unsegmented time Code, CUC (CCSDS 301.0-B-4 §3.2): a binary count of seconds
 //! since an epoch (the coarse time, 1 to 4 octets) and of fractions of a second (the fine
 //! time, 0 to 3 octets, in units of 2^(−8·fine octets) s), most significant octet first,
-//! optionally preceded by its one-octet P-field (§3.2.2):
+//! optionally preceded by its one-octet P-field:
 //!
 //! ```text
 //! bit 0     extension flag (0: no second P-field octet; extensions are not written here)

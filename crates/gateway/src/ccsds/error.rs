@@ -6,22 +6,24 @@ use thiserror::Error;
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum CcsdsError {
     /// An APID above 11 bits.
-    #[error("APID {apid} is above 2047 (11 bits, CCSDS 133.0-B-2 §4.1.3.3.4)")]
+    #[error(
+        "APID {apid} is above 2047 (the 11-bit APID field of the Space Packet primary header)"
+    )]
     Apid {
         /// The APID given.
         apid: u16,
     },
     /// A sequence count above 14 bits.
-    #[error("sequence count {count} is above 16383 (14 bits, §4.1.3.4.3)")]
+    #[error("sequence count {count} is above 16383 (the 14-bit packet sequence count)")]
     SequenceCount {
         /// The count given.
         count: u16,
     },
     /// A packet data field of no octet.
-    #[error("the packet data field is empty: it must hold at least one octet (§4.1.4.1)")]
+    #[error("the packet data field is empty: a Space Packet holds at least one octet of secondary header or user data")]
     EmptyDataField,
     /// A packet data field above 65536 octets.
-    #[error("packet data field of {len_bytes} octets is above the 65536 the 16-bit data length can count (§4.1.3.5)")]
+    #[error("packet data field of {len_bytes} octets is above the 65536 the 16-bit data length (octets − 1) can count")]
     DataFieldTooLong {
         /// Octets of secondary header and user data.
         len_bytes: usize,
@@ -37,19 +39,19 @@ pub enum CcsdsError {
         got_bytes: usize,
     },
     /// A packet version number other than 0 (version 1 packets are the only ones defined).
-    #[error("packet version number {version}: only 0 (binary 000, §4.1.3.2) is defined")]
+    #[error("packet version number {version}: only 0 (binary 000, the Space Packet) is handled")]
     Version {
         /// The version read.
         version: u8,
     },
     /// CUC coarse time octets outside 1..=4.
-    #[error("CUC coarse time of {octets} octets: 1 to 4 without a P-field extension (CCSDS 301.0-B-4 §3.2.2)")]
+    #[error("CUC coarse time of {octets} octets: 1 to 4 without a P-field extension (CCSDS 301.0-B-4 §3.2)")]
     CoarseOctets {
         /// Octets requested.
         octets: u8,
     },
     /// CUC fine time octets above 3.
-    #[error("CUC fine time of {octets} octets: 0 to 3 without a P-field extension (CCSDS 301.0-B-4 §3.2.2)")]
+    #[error("CUC fine time of {octets} octets: 0 to 3 without a P-field extension (CCSDS 301.0-B-4 §3.2)")]
     FineOctets {
         /// Octets requested.
         octets: u8,

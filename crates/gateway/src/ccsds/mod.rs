@@ -1,10 +1,10 @@
 //! CCSDS Space Packets and CCSDS Unsegmented Time Codes.
 //!
 //! - [`primary_header`]: the 6-octet Space Packet primary header (CCSDS 133.0-B-2, "Space
-//!   Packet Protocol", Blue Book issue 2, 2020, §4.1.3), its fields' types, and the
+//!   Packet Protocol", Blue Book issue 2, June 2020, §4.1), its fields' types, and the
 //!   per-APID sequence counter;
-//! - [`packet`]: a whole packet from its header fields, an optional secondary header and the
-//!   user data (§4.1.4), with the data length computed;
+//! - [`packet`]: a whole packet from a [`PacketTemplate`] (type, APID, flags), its sequence
+//!   count, an optional secondary header and the user data, with the data length computed;
 //! - [`cuc`]: the CCSDS Unsegmented time Code (CCSDS 301.0-B-4, "Time Code Formats", 2010,
 //!   §3.2) from integer nanoseconds since an epoch, with or without its P-field, as a
 //!   packet's secondary header;

@@ -1,4 +1,4 @@
-//! The Space Packet primary header, CCSDS 133.0-B-2 §4.1.3 (bit 0 is the most significant bit
+//! The Space Packet primary header, CCSDS 133.0-B-2 §4.1 (bit 0 is the most significant bit
 //! of the first octet):
 //!
 //! ```text
@@ -65,7 +65,7 @@ pub struct Apid(u16);
 impl Apid {
     /// The largest APID.
     pub const MAX: u16 = 0x7FF;
-    /// The APID of idle packets (all ones, §4.1.3.3.4.4).
+    /// The APID of idle packets (all ones).
     pub const IDLE: Apid = Apid(0x7FF);
 
     /// An APID, refused above 2047.
@@ -103,7 +103,7 @@ impl SequenceCount {
         self.0
     }
 
-    /// The next count, modulo 16384 (§4.1.3.4.3.4: 16383 is followed by 0).
+    /// The next count, modulo 16384 (16383 is followed by 0).
     pub fn next(self) -> Self {
         SequenceCount((self.0 + 1) & Self::MAX)
     }

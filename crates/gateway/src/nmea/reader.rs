@@ -34,8 +34,11 @@ impl<'a> Sentence<'a> {
         let (content, digits) = body
             .rsplit_once('*')
             .ok_or_else(|| NmeaError::NoChecksum(text.to_owned()))?;
-        let stated = match (digits.len(), u8::from_str_radix(digits, 16)) {
-            (2, Ok(value)) => value,
+        // Exactly two hex digits (`from_str_radix` alone would take "+F").
+        let stated = match u8::from_str_radix(digits, 16) {
+            Ok(value) if digits.len() == 2 && digits.bytes().all(|b| b.is_ascii_hexdigit()) => {
+                value
+            }
             _ => return Err(NmeaError::ChecksumDigits(digits.to_owned())),
         };
         let computed = xor8(content.as_bytes());
