@@ -16,8 +16,9 @@
 //! - **malformed input is counted, never delivered**: each rejected frame adds one to the
 //!   counter of its reason ([`Malformed`]), bytes outside any frame add to
 //!   [`DecodeCounters::garbage_bytes`], and the decoder resynchronises on the next frame;
-//! - **bounded**: a frame longer than the capacity given at construction is dropped whole
-//!   (counted once as oversize), so a flood costs no memory;
+//! - **bounded**: nothing longer than the capacity given at construction is held: a delimited
+//!   frame that outgrows it is dropped whole, a length field that announces more is rejected,
+//!   each counted once as oversize, so a flood costs no memory;
 //! - **no allocation after construction**: buffers are sized by `new`, and `feed` hands each
 //!   frame to the callback as a borrowed slice of them (`tests/no_alloc.rs` checks it).
 
