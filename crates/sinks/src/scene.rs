@@ -559,17 +559,28 @@ pub fn environment_scene(env: &EnvironmentMsg, prefix: &str, t_ns: u64) -> Value
 /// The colour of every panel, pairs' and chains' alike.
 const PANEL_RGBA: [f64; 4] = [0.15, 0.3, 0.8, 1.0];
 
+/// The hub's opacity when the vehicle has propellant tanks, which are usually inside it.
+pub const HUB_ALPHA_WITH_TANKS: f64 = 0.35;
+
 /// The `foxglove.SceneUpdate` that draws the spacecraft: a grey hub box in B, a blue box per
 /// panel (of the pairs, then of the chains) in its own frame, a translucent gold plate per facet
 /// in B, and a translucent sphere per propellant tank in B ([`TankGeometry`]; the propellant in
-/// it is drawn per state, by [`actuator_scene`]), frame-locked and never expiring (lifetime 0).
+/// it is drawn per state, by [`actuator_scene`]; with tanks the hub is translucent,
+/// [`HUB_ALPHA_WITH_TANKS`], since they are usually inside it), frame-locked and never expiring
+/// (lifetime 0).
 pub fn scene_update(geometry: &Geometry, prefix: &str, t_ns: u64) -> Value {
+    // Tanks sit inside the bus: with any, the hub is see-through so they show.
+    let hub_alpha = if geometry.tanks.is_empty() {
+        1.0
+    } else {
+        HUB_ALPHA_WITH_TANKS
+    };
     let mut entities = vec![cube_entity(
         t_ns,
         &format!("{prefix}{FRAME_B}"),
         &format!("{prefix}hub"),
         &geometry.hub,
-        [0.75, 0.75, 0.78, 1.0],
+        [0.75, 0.75, 0.78, hub_alpha],
     )];
     for pair in &geometry.pairs {
         for (which, cube) in [("panel1", &pair.panel1), ("panel2", &pair.panel2)] {
@@ -1195,6 +1206,18 @@ mod tests {
         let entities = scene["entities"].as_array().unwrap();
         assert_eq!(entities.len(), 1 + 2 * cfg.panel_pairs.len() + 2);
         let shells = &entities[entities.len() - 2..];
+        // The tanks are inside the hub (main at z = 0.4 m, the hub's box spans z = 1 ± 1.48 m):
+        // it is see-through; without tanks it is opaque.
+        let alpha = |s: &Value| s["entities"][0]["cubes"][0]["color"]["a"].as_f64().unwrap();
+        assert_eq!(alpha(&scene), HUB_ALPHA_WITH_TANKS);
+        assert_eq!(
+            alpha(&scene_update(
+                &Geometry::from_config(&SimConfig::reference()),
+                "",
+                0
+            )),
+            1.0
+        );
         let diameter = |e: &Value, id: &str| {
             assert_eq!(e["id"], id);
             assert_eq!(e["frame_id"], "sc1/B");

@@ -374,7 +374,7 @@
           out.push({
             c: add(mat.apply(pose.R, [p.x, p.y, p.z]), pose.o),
             R: mat.mul(pose.R, mat.quat(cube.pose.orientation)),
-            h: [s.x / 2, s.y / 2, s.z / 2], rgb: cssColor(cube.color),
+            h: [s.x / 2, s.y / 2, s.z / 2], rgb: cssColor(cube.color), a: cube.color.a,
           });
         }
       }
@@ -470,7 +470,7 @@
           const toEye = [-centre[0], -D - centre[1], -centre[2]];
           if (nc[0] * toEye[0] + nc[1] * toEye[1] + nc[2] * toEye[2] <= 0) continue;
           const lum = 0.3 + 0.7 * Math.max(0, nc[0] * light[0] + nc[1] * light[1] + nc[2] * light[2]);
-          faces.push({ pts, depth, rgb: b.rgb.map((x) => Math.round(x * lum)) });
+          faces.push({ pts, depth, rgb: b.rgb.map((x) => Math.round(x * lum)), a: b.a === undefined ? 1 : b.a });
         }
       }
     }
@@ -494,7 +494,7 @@
       g.beginPath();
       f.pts.forEach((p, i) => (i ? g.lineTo(p[0], p[1]) : g.moveTo(p[0], p[1])));
       g.closePath();
-      g.fillStyle = 'rgb(' + f.rgb.join(',') + ')';
+      g.fillStyle = 'rgba(' + f.rgb.join(',') + ',' + f.a + ')';
       g.fill();
       g.strokeStyle = 'rgba(0,0,0,0.45)';
       g.lineWidth = dpr;
