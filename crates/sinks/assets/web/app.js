@@ -434,6 +434,8 @@
     g.fillRect(0, 0, W, H);
     const list = boxes();
     const balls = spheres();
+    // What is drawn, in the page's text too (a headless browser's --dump-dom reads it).
+    $('drawn').textContent = list.length + ' boxes, ' + balls.length + ' spheres';
     let extent = 1;
     for (const b of list) extent = Math.max(extent, Math.hypot(...b.c) + Math.hypot(...b.h));
     for (const s of balls) extent = Math.max(extent, Math.hypot(...s.c) + s.r);
