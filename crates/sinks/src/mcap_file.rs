@@ -66,7 +66,8 @@ pub fn environment_topic(sc_id: &str) -> String {
 }
 
 /// The topic of a vehicle's actuator arrows (thruster firings, rod dipoles) and of the
-/// propellant left in its tanks, a `foxglove.SceneUpdate` per state ([`super::scene::actuator_scene`]).
+/// propellant left in its tanks, a `foxglove.SceneUpdate` per state
+/// ([`super::scene::actuator_scene`]).
 pub fn actuator_topic(sc_id: &str) -> String {
     format!("/flexdyn/{sc_id}/actuators")
 }

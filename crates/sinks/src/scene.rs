@@ -285,7 +285,8 @@ fn entries_of(state: &StateMsg, kind: u16) -> impl Iterator<Item = &EffectorStat
 
 /// The `foxglove.FrameTransforms` of one state: N → B, then B → panel 1 and panel 1 → panel 2
 /// of each pair whose effector is in the message, then B → panel 1 → … → panel N of each chain
-/// whose effector is (k-th pair or chain of the geometry ↔ k-th entry of its kind). `prefix` is prepended to every frame id
+/// whose effector is (the k-th pair or chain of the geometry is the k-th entry of its kind).
+/// `prefix` is prepended to every frame id
 /// (e.g. `sc1/`), so several vehicles can share one scene; with a prefix, the last transform
 /// is the identity from the common `N` to the vehicle's `<prefix>N` (every vehicle's inertial
 /// frame is the same frame), which joins the vehicles' frame trees into one: Foxglove's 3D

@@ -3,8 +3,9 @@
 //! mode faster than the step can follow). Each model judges its own values against the
 //! hardware it stands for (`plausibility.rs` beside the star tracker, the IMU and the reaction
 //! wheel, with their datasheet ranges, and beside the panel chain, against the hub and the
-//! step); this module gathers them with their positions in the file. A warning never rejects a configuration: `check-config` lists them,
-//! and `run`, `simulate` and `campaign` log them at WARN.
+//! step); this module gathers them with their positions in the file. A warning never rejects a
+//! configuration: `check-config` lists them, and `run`, `simulate` and `campaign` log them at
+//! WARN.
 
 use std::fmt;
 use std::path::Path;
