@@ -12,7 +12,8 @@
 //! converted from a pair is drawn where the pair is.
 //!
 //! The angles come from the chain's StateMsg entry (`effector_kind::PANEL_CHAIN`, states
-//! `[θ1, θ̇1, θ2, θ̇2, …]`, the wire table's `panel_chain` row): θ_k is state 2(k − 1).
+//! `[θ1, θ̇1, θ2, θ̇2, …]` in the wire table, `proto/schema/messages.toml`): θ_k is state
+//! 2(k − 1).
 
 use nalgebra::{Matrix3, Vector3};
 use serde_json::Value;

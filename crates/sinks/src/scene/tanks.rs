@@ -12,9 +12,9 @@
 //!   the whole tank at a falling density, it is the volume the propellant left would fill at
 //!   its initial density: the fill level, seen as a volume.
 //!
-//! m_p is the tank's one state in its StateMsg entry (`effector_kind::PROPELLANT_TANK`, the wire
-//! table's `propellant_tank` row); a tank flagged EMPTY (or with f = 0) has an empty entity,
-//! which clears its propellant sphere.
+//! m_p is the tank's one state in its StateMsg entry (`effector_kind::PROPELLANT_TANK` in the
+//! wire table, `proto/schema/messages.toml`); a tank flagged EMPTY (or with f = 0) has an empty
+//! entity, which clears its propellant sphere.
 
 use nalgebra::Vector3;
 use serde_json::Value;
@@ -62,7 +62,7 @@ impl TankGeometry {
     /// tank was loaded empty.
     pub fn propellant_radius_m(&self, entry: &EffectorState) -> f64 {
         let m_p = entry.states.get(MASS).copied().unwrap_or(0.0);
-        if entry.flags & EMPTY != 0 || self.full_kg <= 0.0 || !(m_p > 0.0) {
+        if entry.flags & EMPTY != 0 || self.full_kg <= 0.0 || m_p.is_nan() || m_p <= 0.0 {
             return 0.0;
         }
         self.radius_m * (m_p / self.full_kg).min(1.0).cbrt()

@@ -166,7 +166,7 @@ pub fn fastest_mode(chain: &PanelChainParams, hub: &HubParams) -> Option<(f64, u
         .copied()
         .enumerate()
         .max_by(|a, b| a.1.total_cmp(&b.1))?;
-    if !(lambda > 0.0) {
+    if lambda.is_nan() || lambda <= 0.0 {
         return None;
     }
     // The mode in hinge angles: v = L⁻ᵀ y; the hinge with the largest k_i v_i².
