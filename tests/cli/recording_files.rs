@@ -758,3 +758,58 @@ fn one_recording_holds_several_vehicles() {
     // Both scenarios step 100 Hz frames from t = 0, so the recorded instants coincide.
     crate::plots::plot_relative_motion(&file, "two_vehicles_plots");
 }
+
+/// The 3D channels of a recording draw the panel chains and the propellant tanks (issue 39): a
+/// batch run of `scenarios/panel_chain.toml` records a frame per chain panel in `/tf` and a box
+/// in each of them in `/scene`; one of `scenarios/depletion.toml` records each tank's shell in
+/// `/scene` and, with every state, the propellant sphere inside it in `/actuators` (full at
+/// the start: the engine fires from 5 s, after the run, so the two spheres are one size).
+#[test]
+fn a_recording_draws_the_chains_and_the_tanks() {
+    let chains = first_json_messages(
+        &std::fs::read(batch_recording_of("chains.mcap", "panel_chain.toml")).unwrap(),
+    );
+    let frames: Vec<String> = chains["/flexdyn/sc1/tf"]["transforms"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["child_frame_id"].as_str().unwrap().to_owned())
+        .collect();
+    let expected: Vec<String> = (1..=4)
+        .map(|k| format!("sc1/wing_px/panel{k}"))
+        .chain((1..=3).map(|k| format!("sc1/wing_mx/panel{k}")))
+        .collect();
+    for f in &expected {
+        assert!(frames.contains(f), "no transform to {f}: {frames:?}");
+    }
+    let boxes: Vec<&str> = chains["/flexdyn/sc1/scene"]["entities"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| !e["cubes"].as_array().unwrap().is_empty())
+        .map(|e| e["frame_id"].as_str().unwrap())
+        .collect();
+    assert_eq!(boxes.len(), 1 + expected.len(), "{boxes:?}");
+    assert!(expected.iter().all(|f| boxes.contains(&f.as_str())));
+
+    let tanks = first_json_messages(
+        &std::fs::read(batch_recording_of("tanks.mcap", "depletion.toml")).unwrap(),
+    );
+    let sphere_of = |update: &serde_json::Value, id: &str| -> f64 {
+        let e = update["entities"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["id"] == id)
+            .unwrap_or_else(|| panic!("no entity {id}"));
+        e["spheres"][0]["size"]["x"].as_f64().unwrap()
+    };
+    for k in 0..2 {
+        let shell = sphere_of(&tanks["/flexdyn/sc1/scene"], &format!("sc1/tank{k}"));
+        let fill = sphere_of(
+            &tanks["/flexdyn/sc1/actuators"],
+            &format!("sc1/propellant{k}"),
+        );
+        assert!(shell > 0.0 && fill == shell, "tank {k}: {fill} in {shell}");
+    }
+}

@@ -11,10 +11,11 @@
 //!
 //! The two original appended bodies (panel pairs, reaction wheels) are listed in the registry for
 //! every generic use (telemetry names, campaign sections, CSV) but keep their typed fields in
-//! `flexdyn_vehicle::config::SimConfig` (`panel_pairs`, `reaction_wheels`): their plausibility checks
-//! compare them with the hub and the step across kinds (mass ratios, hinge frequencies) and
-//! every test of the paper's system reads them by type. Their [`ComponentKind::reader`] is
-//! `None`.
+//! `flexdyn_vehicle::config::SimConfig` (`panel_pairs`, `reaction_wheels`): every test of the
+//! paper's system reads them by type. Their [`ComponentKind::reader`] is `None`. Plausibility
+//! checks that need the hub or the step (the panel chain's hinge frequency,
+//! [`crate::effectors::panel_chain::plausibility`]) are called with them from the
+//! configuration's warnings, which reads generic kinds by type too.
 
 use std::any::Any;
 use std::fmt::Debug;

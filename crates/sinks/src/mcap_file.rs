@@ -11,7 +11,8 @@
 //! - **3D**: `/flexdyn/<sc>/tf` (`foxglove.FrameTransforms`) for every state and
 //!   `/flexdyn/<sc>/scene` (`foxglove.SceneUpdate`) once per vehicle, when the vehicle's
 //!   configuration is known ([`VehicleInfo`]); `/flexdyn/<sc>/actuators` (thruster and rod
-//!   arrows, [`actuator_topic`]) for every state of a vehicle that has them; and
+//!   arrows and the propellant left in each tank, [`actuator_topic`]) for every state of a
+//!   vehicle that has any of them; and
 //!   `/flexdyn/<sc>/environment` (the Sun and magnetic-field arrows, [`environment_topic`]) for
 //!   every EnvironmentMsg.
 //!
@@ -64,8 +65,9 @@ pub fn environment_topic(sc_id: &str) -> String {
     format!("/flexdyn/{sc_id}/environment")
 }
 
-/// The topic of a vehicle's actuator arrows (thruster firings, rod dipoles), a
-/// `foxglove.SceneUpdate` per state ([`super::scene::actuator_scene`]).
+/// The topic of a vehicle's actuator arrows (thruster firings, rod dipoles) and of the
+/// propellant left in its tanks, a `foxglove.SceneUpdate` per state
+/// ([`super::scene::actuator_scene`]).
 pub fn actuator_topic(sc_id: &str) -> String {
     format!("/flexdyn/{sc_id}/actuators")
 }

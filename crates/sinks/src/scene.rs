@@ -1,7 +1,9 @@
 //! The spacecraft for Foxglove's 3D panel: `foxglove.FrameTransforms` (N → B from σ_BN and
-//! r_BN, B → each panel at its hinge angles) and a `foxglove.SceneUpdate` with one box for the
-//! hub and one for each panel, sized from the configuration. Both as JSON with a JSON Schema
-//! (the schema names are Foxglove's well-known ones, so the 3D panel recognises them).
+//! r_BN, B → each panel of the pairs and chains at its hinge angles) and a
+//! `foxglove.SceneUpdate` with one box for the hub and one for each panel, sized from the
+//! configuration, and a sphere for each propellant tank. Both as JSON with a JSON Schema (the
+//! schema names are Foxglove's well-known ones, so the 3D panel recognises them). The chains'
+//! frames and boxes are in [`chains`], the tanks' spheres in [`tanks`].
 //!
 //! # Frames (Allard & Schaub, Sec. II, Eqs. 1–7)
 //! - `N` inertial; `B` hub body frame at point B: translation r_BN (N components), rotation [NB].
@@ -21,9 +23,17 @@ use serde_json::{json, Value};
 
 use flexdyn_dynamics::dynamic_effectors::magnetorquer::MagnetorquerParams;
 use flexdyn_dynamics::dynamic_effectors::thruster::ThrusterParams;
+use flexdyn_dynamics::effectors::panel_chain::PanelChainParams;
+use flexdyn_dynamics::effectors::propellant_tank::PropellantTankParams;
 use flexdyn_kernel::attitude::{dcm_to_quat, m2, mrp_to_quat};
-use flexdyn_proto::{EnvironmentMsg, StateMsg};
+use flexdyn_proto::{EffectorState, EnvironmentMsg, StateMsg};
 use flexdyn_vehicle::config::SimConfig;
+
+mod chains;
+mod tanks;
+
+pub use chains::{ChainGeometry, ChainLink};
+pub use tanks::TankGeometry;
 
 /// Name of the inertial frame.
 pub const FRAME_N: &str = "N";
@@ -65,8 +75,14 @@ pub struct PairGeometry {
 pub struct Geometry {
     /// The hub's box in B.
     pub hub: Cuboid,
-    /// The panel pairs, in effector order (they are effectors 0..n of every StateMsg).
+    /// The panel pairs, in effector order (the StateMsg entries of kind `PANEL_PAIR`, in order).
     pub pairs: Vec<PairGeometry>,
+    /// The panel chains (`[[panel_chains]]`), in effector order (the entries of kind
+    /// `PANEL_CHAIN`).
+    pub chains: Vec<ChainGeometry>,
+    /// The propellant tanks (`[[propellant_tanks]]`), in effector order (the entries of kind
+    /// `PROPELLANT_TANK`).
+    pub tanks: Vec<TankGeometry>,
     /// The `[[environment.facets]]` plates in B (drag and solar pressure act on them): a square
     /// of the facet's area centred on its centre of pressure, normal along its box z axis.
     pub facets: Vec<Cuboid>,
@@ -126,6 +142,28 @@ pub fn equivalent_box_m(mass_kg: f64, principal_kg_m2: &Vector3<f64>) -> Vector3
     e
 }
 
+/// A panel's box in its own frame S: the homogeneous box of its mass and principal inertia
+/// ([`equivalent_box_m`]) with its long edge 2·d from the hinge along −ŝ1, so the box centre
+/// (−d, 0, 0) is the panel's centre of mass (Eqs. 6–7), and the real `width_m` (along ŝ2) and
+/// `thickness_m` (along ŝ3) where the configuration gives them. Pairs and chains alike.
+pub fn panel_box(
+    mass_kg: f64,
+    inertia_s_kg_m2: &Vector3<f64>,
+    d_m: f64,
+    width_m: Option<f64>,
+    thickness_m: Option<f64>,
+) -> Cuboid {
+    let mut size = equivalent_box_m(mass_kg, inertia_s_kg_m2);
+    size.x = 2.0 * d_m;
+    size.y = width_m.unwrap_or(size.y);
+    size.z = thickness_m.unwrap_or(size.z);
+    Cuboid {
+        center_m: Vector3::new(-d_m, 0.0, 0.0),
+        q_frame_box: Vector4::new(1.0, 0.0, 0.0, 0.0),
+        size_m: size,
+    }
+}
+
 impl Geometry {
     /// The geometry of `cfg`: the hub box from its mass and inertia about its centre of mass
     /// (along the inertia's principal axes, centred on B_c), each panel's box from its mass and
@@ -147,16 +185,13 @@ impl Geometry {
             size_m: equivalent_box_m(hub.mass_kg, &eig.eigenvalues),
         };
         let panel_box = |p: &flexdyn_dynamics::PanelParams| {
-            let mut size = equivalent_box_m(p.mass_kg, &p.inertia_s_kg_m2);
-            size.x = 2.0 * p.d_m;
-            // Real dimensions, where the configuration gives them.
-            size.y = p.width_m.unwrap_or(size.y);
-            size.z = p.thickness_m.unwrap_or(size.z);
-            Cuboid {
-                center_m: Vector3::new(-p.d_m, 0.0, 0.0),
-                q_frame_box: Vector4::new(1.0, 0.0, 0.0, 0.0),
-                size_m: size,
-            }
+            panel_box(
+                p.mass_kg,
+                &p.inertia_s_kg_m2,
+                p.d_m,
+                p.width_m,
+                p.thickness_m,
+            )
         };
         let pairs = cfg
             .panel_pairs
@@ -195,9 +230,21 @@ impl Geometry {
                 full_scale: m.max_dipole_am2,
             })
             .collect();
+        let chains = cfg
+            .components
+            .of::<PanelChainParams>()
+            .map(ChainGeometry::new)
+            .collect();
+        let tanks = cfg
+            .components
+            .of::<PropellantTankParams>()
+            .map(TankGeometry::new)
+            .collect();
         Self {
             hub: hub_box,
             pairs,
+            chains,
+            tanks,
             facets,
             thrusters,
             rods,
@@ -231,8 +278,15 @@ fn transform(t_ns: u64, parent: &str, child: &str, r: &Vector3<f64>, q: &Vector4
     })
 }
 
+/// The StateMsg entries of wire kind `kind`, in effector order.
+fn entries_of(state: &StateMsg, kind: u16) -> impl Iterator<Item = &EffectorState> {
+    state.effectors.iter().filter(move |e| e.kind == kind)
+}
+
 /// The `foxglove.FrameTransforms` of one state: N → B, then B → panel 1 and panel 1 → panel 2
-/// of each pair whose effector is in the message. `prefix` is prepended to every frame id
+/// of each pair whose effector is in the message, then B → panel 1 → … → panel N of each chain
+/// whose effector is (the k-th pair or chain of the geometry is the k-th entry of its kind).
+/// `prefix` is prepended to every frame id
 /// (e.g. `sc1/`), so several vehicles can share one scene; with a prefix, the last transform
 /// is the identity from the common `N` to the vehicle's `<prefix>N` (every vehicle's inertial
 /// frame is the same frame), which joins the vehicles' frame trees into one: Foxglove's 3D
@@ -249,7 +303,8 @@ pub fn frame_transforms(state: &StateMsg, geometry: &Geometry, prefix: &str) -> 
         &Vector3::from(state.r_bn_n_m),
         &mrp_to_quat(&sigma),
     )];
-    for (pair, eff) in geometry.pairs.iter().zip(&state.effectors) {
+    let pairs = entries_of(state, flexdyn_proto::effector_kind::PANEL_PAIR);
+    for (pair, eff) in geometry.pairs.iter().zip(pairs) {
         let (Some(&theta1), Some(&theta2)) = (eff.states.first(), eff.states.get(2)) else {
             continue;
         };
@@ -270,6 +325,10 @@ pub fn frame_transforms(state: &StateMsg, geometry: &Geometry, prefix: &str) -> 
             &Vector3::new(-pair.l1_m, 0.0, 0.0),
             &dcm_to_quat(&m2(theta2 + pair.theta_h2s1_rad)),
         ));
+    }
+    let chains = entries_of(state, flexdyn_proto::effector_kind::PANEL_CHAIN);
+    for (chain, eff) in geometry.chains.iter().zip(chains) {
+        transforms.extend(chain.transforms(t, prefix, eff));
     }
     if !prefix.is_empty() {
         transforms.push(transform(
@@ -316,6 +375,28 @@ fn cube_entity(t_ns: u64, frame: &str, id: &str, c: &Cuboid, rgba: [f64; 4]) -> 
     entity(t_ns, frame, id, json!([]), cubes)
 }
 
+/// A sphere entity of `diameter_m` centred at `center_m` in `frame` (none when the diameter is
+/// 0: the entity then clears the last one).
+fn sphere_entity(
+    t_ns: u64,
+    frame: &str,
+    id: &str,
+    center_m: &Vector3<f64>,
+    diameter_m: f64,
+    rgba: [f64; 4],
+) -> Value {
+    let mut e = entity(t_ns, frame, id, json!([]), json!([]));
+    if diameter_m > 0.0 {
+        let identity = Vector4::new(1.0, 0.0, 0.0, 0.0);
+        e["spheres"] = json!([{
+            "pose": {"position": vec3(center_m), "orientation": quat(&identity)},
+            "size": vec3(&Vector3::repeat(diameter_m)),
+            "color": color(rgba),
+        }]);
+    }
+    e
+}
+
 /// The rotation (w, x, y, z) that turns x̂ onto the unit vector `d` (a Foxglove arrow points
 /// along its pose's +x): about x̂ × d by the angle between them, q = (1 + x̂·d, x̂ × d)
 /// normalised; about ẑ by π when d = −x̂.
@@ -359,16 +440,18 @@ fn arrow_entity(
 /// The actuators at one state, as a `foxglove.SceneUpdate` of arrows in B, or `None` for a
 /// vehicle without them: each firing thruster's plume (from the nozzle, against the force,
 /// [`ARROW_FULL_M`] long at full thrust, orange) and each rod's dipole (from its centre along
-/// ±its axis, full length at its largest dipole, purple). A thruster that is not firing, or a
-/// rod at zero, has an empty entity, which clears its arrow. Entities follow the thrusters and
-/// rods of `state` in effector order.
+/// ±its axis, full length at its largest dipole, purple), and the propellant left in each
+/// tank (an orange sphere inside the tank's shell, its volume the tank's fill fraction:
+/// [`TankGeometry`]). A thruster that is not firing, a rod at zero or an empty tank has an
+/// empty entity, which clears its arrow or sphere. Entities follow the thrusters, rods and
+/// tanks of `state` in effector order.
 pub fn actuator_scene(
     geometry: &Geometry,
     state: &StateMsg,
     prefix: &str,
     t_ns: u64,
 ) -> Option<Value> {
-    if geometry.thrusters.is_empty() && geometry.rods.is_empty() {
+    if geometry.thrusters.is_empty() && geometry.rods.is_empty() && geometry.tanks.is_empty() {
         return None;
     }
     let frame = format!("{prefix}{FRAME_B}");
@@ -413,6 +496,10 @@ pub fn actuator_scene(
             length,
             [0.55, 0.2, 0.75, 0.9],
         ));
+    }
+    let tanks = entries_of(state, flexdyn_proto::effector_kind::PROPELLANT_TANK);
+    for (k, (tank, entry)) in geometry.tanks.iter().zip(tanks).enumerate() {
+        entities.push(tank.propellant(&frame, prefix, k, entry, t_ns));
     }
     Some(json!({ "deletions": [], "entities": entities }))
 }
@@ -470,28 +557,40 @@ pub fn environment_scene(env: &EnvironmentMsg, prefix: &str, t_ns: u64) -> Value
     json!({ "deletions": [], "entities": [sun, field] })
 }
 
+/// The colour of every panel, pairs' and chains' alike.
+const PANEL_RGBA: [f64; 4] = [0.15, 0.3, 0.8, 1.0];
+
+/// The hub's opacity when the vehicle has propellant tanks, which are usually inside it.
+pub const HUB_ALPHA_WITH_TANKS: f64 = 0.35;
+
 /// The `foxglove.SceneUpdate` that draws the spacecraft: a grey hub box in B, a blue box per
-/// panel in its own frame, and a translucent gold plate per facet in B, frame-locked and never
-/// expiring (lifetime 0).
+/// panel (of the pairs, then of the chains) in its own frame, a translucent gold plate per facet
+/// in B, and a translucent sphere per propellant tank in B ([`TankGeometry`]; the propellant in
+/// it is drawn per state, by [`actuator_scene`]; with tanks the hub is translucent,
+/// [`HUB_ALPHA_WITH_TANKS`], since they are usually inside it), frame-locked and never expiring
+/// (lifetime 0).
 pub fn scene_update(geometry: &Geometry, prefix: &str, t_ns: u64) -> Value {
+    // Tanks sit inside the bus: with any, the hub is see-through so they show.
+    let hub_alpha = if geometry.tanks.is_empty() {
+        1.0
+    } else {
+        HUB_ALPHA_WITH_TANKS
+    };
     let mut entities = vec![cube_entity(
         t_ns,
         &format!("{prefix}{FRAME_B}"),
         &format!("{prefix}hub"),
         &geometry.hub,
-        [0.75, 0.75, 0.78, 1.0],
+        [0.75, 0.75, 0.78, hub_alpha],
     )];
     for pair in &geometry.pairs {
         for (which, cube) in [("panel1", &pair.panel1), ("panel2", &pair.panel2)] {
             let frame = format!("{prefix}{}/{which}", pair.name);
-            entities.push(cube_entity(
-                t_ns,
-                &frame,
-                &frame,
-                cube,
-                [0.15, 0.3, 0.8, 1.0],
-            ));
+            entities.push(cube_entity(t_ns, &frame, &frame, cube, PANEL_RGBA));
         }
+    }
+    for chain in &geometry.chains {
+        entities.extend(chain.entities(prefix, t_ns));
     }
     for (k, facet) in geometry.facets.iter().enumerate() {
         entities.push(cube_entity(
@@ -501,6 +600,10 @@ pub fn scene_update(geometry: &Geometry, prefix: &str, t_ns: u64) -> Value {
             facet,
             [0.85, 0.65, 0.13, 0.6],
         ));
+    }
+    let frame_b = format!("{prefix}{FRAME_B}");
+    for (k, tank) in geometry.tanks.iter().enumerate() {
+        entities.push(tank.shell(&frame_b, prefix, k, t_ns));
     }
     json!({ "deletions": [], "entities": entities })
 }
@@ -569,13 +672,15 @@ pub fn frame_transforms_schema() -> Value {
     s
 }
 
-/// JSON Schema of `foxglove.SceneUpdate` (cube and arrow entities; the other primitive arrays are
-/// empty).
+/// JSON Schema of `foxglove.SceneUpdate` (cube, sphere and arrow entities; the other primitive
+/// arrays are empty).
 pub fn scene_update_schema() -> Value {
     let color = obj(
         &["r", "g", "b", "a"],
         json!({"r": num(), "g": num(), "b": num(), "a": num()}),
     );
+    // Foxglove's CubePrimitive and SpherePrimitive have the same fields (a sphere's size is its
+    // diameters along its axes).
     let cube = obj(
         &["pose", "size", "color"],
         json!({
@@ -584,6 +689,7 @@ pub fn scene_update_schema() -> Value {
             "color": color.clone(),
         }),
     );
+    let sphere = cube.clone();
     let arrow = obj(
         &[
             "pose",
@@ -621,7 +727,7 @@ pub fn scene_update_schema() -> Value {
             "metadata": empty_array,
             "arrows": {"type": "array", "items": arrow},
             "cubes": {"type": "array", "items": cube},
-            "spheres": empty_array,
+            "spheres": {"type": "array", "items": sphere},
             "cylinders": empty_array,
             "lines": empty_array,
             "triangles": empty_array,
@@ -935,6 +1041,232 @@ mod tests {
         let off = environment_scene(&env, "sc1/", 3);
         for e in off["entities"].as_array().unwrap() {
             assert!(e["arrows"].as_array().unwrap().is_empty(), "{e}");
+        }
+    }
+
+    fn scenario(name: &str) -> SimConfig {
+        SimConfig::from_file(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join(format!("../../scenarios/{name}")),
+        )
+        .unwrap()
+    }
+
+    fn vec_of(v: &Value) -> Vector3<f64> {
+        let f = |k: &str| v[k].as_f64().unwrap();
+        Vector3::new(f("x"), f("y"), f("z"))
+    }
+
+    /// The pose in B (rotation R: frame → B components, origin o) of `frame`, composed from the
+    /// transforms of `list` by walking parents up to `root`.
+    fn pose_in(list: &[Value], root: &str, mut frame: String) -> (Matrix3<f64>, Vector3<f64>) {
+        let (mut r, mut o) = (Matrix3::identity(), Vector3::zeros());
+        while frame != root {
+            let t = list
+                .iter()
+                .find(|t| t["child_frame_id"] == frame.as_str())
+                .unwrap_or_else(|| panic!("no transform to {frame}"));
+            let rp = active(&q_of(&t["rotation"]));
+            o = rp * o + vec_of(&t["translation"]);
+            r = rp * r;
+            frame = t["parent_frame_id"].as_str().unwrap().to_owned();
+        }
+        (r, o)
+    }
+
+    /// Each chain's panels hang at their hinge angles: walking the transforms from B to panel k
+    /// gives the hinge H_k and the axis ŝ_k1 of the chain's own kinematics,
+    /// Φ_k = Σ_{j≤k} (θ_j + θ_Hj), ŝ_k1 = cos Φ_k ĥ11 − sin Φ_k ĥ13, H_k+1 = H_k − l_k ŝ_k1
+    /// (panel_chain/mod.rs, (C1)–(C2)), written out here from the configuration; each panel has
+    /// a box 2 d_k long in its frame.
+    #[test]
+    fn a_chain_draws_its_panels_at_their_hinge_angles() {
+        let cfg = scenario("panel_chain.toml");
+        let g = Geometry::from_config(&cfg);
+        assert_eq!(g.chains.len(), 2);
+        let mut state = flexdyn_vehicle::sim::Simulation::new(&cfg)
+            .unwrap()
+            .state_msg();
+        let chains: Vec<usize> = (0..state.effectors.len())
+            .filter(|&i| state.effectors[i].kind == flexdyn_proto::effector_kind::PANEL_CHAIN)
+            .collect();
+        assert_eq!(chains.len(), 2);
+        // Angles far from the configuration's, distinct per panel (θ_k = 0.1 k − 0.25 c).
+        for (c, &i) in chains.iter().enumerate() {
+            for k in 0..state.effectors[i].states.len() / 2 {
+                state.effectors[i].states[2 * k] = 0.1 * (k as f64 + 1.0) - 0.25 * c as f64;
+            }
+        }
+        let tf = frame_transforms(&state, &g, "sc1/");
+        let list = tf["transforms"].as_array().unwrap();
+        // N → B, 4 + 3 panels, and the prefix's N → sc1/N.
+        assert_eq!(list.len(), 1 + 4 + 3 + 1);
+        for (c, params) in cfg.components.of::<PanelChainParams>().enumerate() {
+            let entry = &state.effectors[chains[c]];
+            let (mut phi, mut hinge) = (0.0, params.r_h1b_b_m);
+            let h = params.dcm_h1b;
+            for (k, p) in params.panels.iter().enumerate() {
+                phi += entry.states[2 * k] + p.theta_h_rad;
+                let s1 = h.row(0).transpose() * phi.cos() - h.row(2).transpose() * phi.sin();
+                let frame = format!("sc1/{}/panel{}", params.name, k + 1);
+                let (r, o) = pose_in(list, "sc1/B", frame);
+                assert!(
+                    (o - hinge).norm() < 1e-12,
+                    "{} panel {k}: {o} vs {hinge}",
+                    params.name
+                );
+                assert!(
+                    (r * Vector3::x() - s1).norm() < 1e-12,
+                    "{} panel {k}",
+                    params.name
+                );
+                // Every hinge turns about ê = ĥ12.
+                assert!((r * Vector3::y() - h.row(1).transpose()).norm() < 1e-12);
+                hinge -= p.l_m * s1;
+            }
+        }
+        // The scene: the hub, then one box per chain panel in its frame, 2 d_k long.
+        let scene = scene_update(&g, "sc1/", 0);
+        let entities = scene["entities"].as_array().unwrap();
+        assert_eq!(entities.len(), 1 + 4 + 3);
+        let panels = cfg
+            .components
+            .of::<PanelChainParams>()
+            .flat_map(|c| c.panels.iter().enumerate().map(move |(k, p)| (c, k, p)));
+        for (e, (c, k, p)) in entities[1..].iter().zip(panels) {
+            assert_eq!(e["frame_id"], format!("sc1/{}/panel{}", c.name, k + 1));
+            assert!(list.iter().any(|t| t["child_frame_id"] == e["frame_id"]));
+            let cube = &e["cubes"][0];
+            assert_eq!(vec_of(&cube["size"]).x, 2.0 * p.d_m);
+            assert_eq!(
+                vec_of(&cube["pose"]["position"]),
+                Vector3::new(-p.d_m, 0.0, 0.0)
+            );
+        }
+        // A short entry (fewer angles than panels) draws no frames rather than wrong ones.
+        state.effectors[chains[0]].states.truncate(4);
+        let short = frame_transforms(&state, &g, "");
+        assert_eq!(short["transforms"].as_array().unwrap().len(), 1 + 3);
+    }
+
+    /// The two-panel chain of a pair (`PanelChainParams::from_pair`) is drawn exactly where the
+    /// pair is: the same hinges, axes and boxes at the same angles.
+    #[test]
+    fn a_pair_as_a_chain_is_drawn_where_the_pair_is() {
+        let cfg = SimConfig::reference();
+        let (pair, initial) = &cfg.panel_pairs[0];
+        let mut folded = pair.clone();
+        folded.theta_h2s1_rad = 0.4; // a hinge-2 offset, so θ_H is exercised
+        let chain = PanelChainParams::from_pair(&folded, initial);
+        let mut g = Geometry::from_config(&cfg);
+        g.pairs.truncate(1);
+        g.pairs[0].theta_h2s1_rad = folded.theta_h2s1_rad;
+        g.chains = vec![ChainGeometry::new(&chain)];
+        g.chains[0].name = "as_chain".into();
+        let (th1, th2) = (0.3, -0.7);
+        let state = StateMsg {
+            effectors: [
+                flexdyn_proto::effector_kind::PANEL_PAIR,
+                flexdyn_proto::effector_kind::PANEL_CHAIN,
+            ]
+            .iter()
+            .map(|&kind| flexdyn_proto::EffectorState {
+                kind,
+                flags: 0,
+                states: vec![th1, 0.0, th2, 0.0],
+                outputs: vec![],
+            })
+            .collect(),
+            ..StateMsg::default()
+        };
+        let tf = frame_transforms(&state, &g, "");
+        let list = tf["transforms"].as_array().unwrap();
+        assert_eq!(list.len(), 1 + 2 + 2);
+        for k in ["panel1", "panel2"] {
+            let (rp, op) = pose_in(list, "B", format!("{}/{k}", pair.name));
+            let (rc, oc) = pose_in(list, "B", format!("as_chain/{k}"));
+            assert!((rp - rc).abs().max() < 1e-15, "{k}");
+            assert!((op - oc).norm() < 1e-15, "{k}");
+        }
+        assert_eq!(g.chains[0].links[0].panel, g.pairs[0].panel1);
+        assert_eq!(g.chains[0].links[1].panel, g.pairs[0].panel2);
+    }
+
+    /// Each tank is a translucent sphere at its centroid, R_tank across (`radius_m`, or the
+    /// sphere of the load at its density: (4/3)π R³ ρ = m_0), and the propellant a sphere inside
+    /// it that holds the fill fraction of its volume: at m_0/8 its radius is R_tank/2
+    /// ((1/8)^(1/3) = 1/2); an EMPTY tank clears it.
+    #[test]
+    fn a_tank_is_a_shell_with_its_propellant_inside() {
+        let cfg = scenario("depletion.toml");
+        let g = Geometry::from_config(&cfg);
+        let params: Vec<&PropellantTankParams> =
+            cfg.components.of::<PropellantTankParams>().collect();
+        assert_eq!(g.tanks.len(), 2);
+        let scene = scene_update(&g, "sc1/", 0);
+        let entities = scene["entities"].as_array().unwrap();
+        assert_eq!(entities.len(), 1 + 2 * cfg.panel_pairs.len() + 2);
+        let shells = &entities[entities.len() - 2..];
+        // The tanks are inside the hub (main at z = 0.4 m, the hub's box spans z = 1 ± 1.48 m):
+        // it is see-through; without tanks it is opaque.
+        let alpha = |s: &Value| s["entities"][0]["cubes"][0]["color"]["a"].as_f64().unwrap();
+        assert_eq!(alpha(&scene), HUB_ALPHA_WITH_TANKS);
+        assert_eq!(
+            alpha(&scene_update(
+                &Geometry::from_config(&SimConfig::reference()),
+                "",
+                0
+            )),
+            1.0
+        );
+        let diameter = |e: &Value, id: &str| {
+            assert_eq!(e["id"], id);
+            assert_eq!(e["frame_id"], "sc1/B");
+            let spheres = e["spheres"].as_array().unwrap();
+            if spheres.is_empty() {
+                return 0.0;
+            }
+            let size = vec_of(&spheres[0]["size"]);
+            assert_eq!((size.x, size.y), (size.z, size.z));
+            size.x
+        };
+        // main: constant density, so its sphere holds the load at ρ = 1004 kg/m³.
+        let r_main = diameter(&shells[0], "sc1/tank0") / 2.0;
+        let rho = 1004.0;
+        let mass = 4.0 / 3.0 * std::f64::consts::PI * r_main.powi(3) * rho;
+        assert!((mass - 120.0).abs() < 1e-9, "{r_main} m holds {mass} kg");
+        // rcs: constant volume, radius_m = 0.15.
+        assert_eq!(diameter(&shells[1], "sc1/tank1"), 0.3);
+        for (e, p) in shells.iter().zip(&params) {
+            assert_eq!(vec_of(&e["spheres"][0]["pose"]["position"]), p.r_tcb_b_m);
+        }
+        // Per state, beside the 3 thrusters' plumes: full at the start.
+        let mut state = flexdyn_vehicle::sim::Simulation::new(&cfg)
+            .unwrap()
+            .state_msg();
+        let arrows = actuator_scene(&g, &state, "sc1/", 0).unwrap();
+        let list = arrows["entities"].as_array().unwrap();
+        assert_eq!(list.len(), 3 + 2);
+        assert_eq!(diameter(&list[3], "sc1/propellant0"), 2.0 * r_main);
+        assert_eq!(diameter(&list[4], "sc1/propellant1"), 0.3);
+        // An eighth of main's load left: half the radius; rcs flagged empty: cleared.
+        let tanks: Vec<usize> = (0..state.effectors.len())
+            .filter(|&i| state.effectors[i].kind == flexdyn_proto::effector_kind::PROPELLANT_TANK)
+            .collect();
+        state.effectors[tanks[0]].states[0] = 120.0 / 8.0;
+        state.effectors[tanks[1]].flags |= flexdyn_proto::propellant_tank_flags::EMPTY;
+        let arrows = actuator_scene(&g, &state, "sc1/", 0).unwrap();
+        let list = arrows["entities"].as_array().unwrap();
+        assert!((diameter(&list[3], "sc1/propellant0") - r_main).abs() < 1e-12);
+        assert_eq!(diameter(&list[4], "sc1/propellant1"), 0.0);
+        // The schema requires of a sphere what it requires of a cube.
+        let schema = scene_update_schema();
+        let sphere = &schema["properties"]["entities"]["items"]["properties"]["spheres"]["items"];
+        for k in sphere["required"].as_array().unwrap() {
+            assert!(
+                list[3]["spheres"][0].get(k.as_str().unwrap()).is_some(),
+                "{k}"
+            );
         }
     }
 

@@ -7,8 +7,10 @@
 //
 // Channels (crates/sinks/src/view.rs, all "json"): /flexdyn/<sc>/tlm/state (StateMsg),
 // /tlm/env (EnvironmentMsg), /tlm/fault (FaultEventMsg), /status (StatusMsg), and for the
-// geometry of the served configuration /scene (foxglove.SceneUpdate: cubes per frame) with
-// /tf (foxglove.FrameTransforms: the panels' frames at their hinge angles), and the flight
+// geometry of the served configuration /scene (foxglove.SceneUpdate: cubes per frame, spheres
+// for the tanks) with /tf (foxglove.FrameTransforms: the frames of the pairs' and chains' panels
+// at their hinge angles) and /actuators (per state: the propellant left in each tank, a sphere;
+// its arrows are not drawn here), and the flight
 // code's telemetry /fsw/<stream> (FswMsg, which a live server passes on once accepted) with the
 // names behind its indices /fsw_streams (the served configuration's [[fsw_streams]]).
 //
@@ -66,7 +68,7 @@
   // ---- What the stream said --------------------------------------------------------------------
   const view = {
     sc: WANT_SC, vehicles: new Set(), state: null, env: null, status: null,
-    faults: new Map(), scene: null, tf: new Map(), messages: 0,
+    faults: new Map(), scene: null, tf: new Map(), actuators: null, messages: 0,
     fsw: new Map(), fswStreams: new Map(), // stream → {mode, event, eventT}; stream → declaration
     playback: null, dataStart: null, dataEnd: null, playbackState: null,
   };
@@ -81,7 +83,7 @@
   let requestNo = 0;
 
   function kindOf(topic) {
-    const m = /^\/flexdyn\/([^/]+)\/(tlm\/state|tlm\/env|tlm\/fault|status|scene|tf|fsw_streams|fsw\/[^/]+)$/.exec(topic);
+    const m = /^\/flexdyn\/([^/]+)\/(tlm\/state|tlm\/env|tlm\/fault|status|scene|actuators|tf|fsw_streams|fsw\/[^/]+)$/.exec(topic);
     if (!m) return null;
     // The flight code's telemetry: the kind `fsw` and the stream's name.
     if (m[2].startsWith('fsw/')) return { sc: m[1], kind: 'fsw', stream: m[2].slice(4) };
@@ -200,6 +202,9 @@
       view.faults.set(msg.fault_index, msg);
     } else if (kind === 'scene') {
       view.scene = msg;
+      sceneDirty = true;
+    } else if (kind === 'actuators') {
+      view.actuators = msg;
       sceneDirty = true;
     } else if (kind === 'fsw_streams') {
       for (const d of msg.streams || []) view.fswStreams.set(d.name, d);
@@ -369,7 +374,7 @@
           out.push({
             c: add(mat.apply(pose.R, [p.x, p.y, p.z]), pose.o),
             R: mat.mul(pose.R, mat.quat(cube.pose.orientation)),
-            h: [s.x / 2, s.y / 2, s.z / 2], rgb: cssColor(cube.color),
+            h: [s.x / 2, s.y / 2, s.z / 2], rgb: cssColor(cube.color), a: cube.color.a,
           });
         }
       }
@@ -395,6 +400,24 @@
     return out;
   }
 
+  // Spheres {c: centre in B, r: radius, rgb, a} of the served configuration (/scene: the tanks)
+  // and of the latest state (/actuators: the propellant in them).
+  function spheres() {
+    const out = [];
+    for (const update of [view.scene, view.actuators]) {
+      for (const e of (update && view.sc && update.entities) || []) {
+        if (!e.frame_id.startsWith(view.sc + '/')) continue;
+        const pose = e.frame_id === view.sc + '/B' ? { R: mat.id, o: [0, 0, 0] } : poseInB(e.frame_id);
+        if (!pose) continue;
+        for (const s of e.spheres || []) {
+          const p = s.pose.position;
+          out.push({ c: add(mat.apply(pose.R, [p.x, p.y, p.z]), pose.o), r: s.size.x / 2, rgb: cssColor(s.color), a: s.color.a });
+        }
+      }
+    }
+    return out;
+  }
+
   function fitCanvas(c) {
     const dpr = window.devicePixelRatio || 1;
     const w = Math.max(1, Math.round(c.clientWidth * dpr)), h = Math.max(1, Math.round(c.clientHeight * dpr));
@@ -410,8 +433,12 @@
     g.fillStyle = '#0b0e13';
     g.fillRect(0, 0, W, H);
     const list = boxes();
+    const balls = spheres();
+    // What is drawn, in the page's text too (a headless browser's --dump-dom reads it).
+    $('drawn').textContent = list.length + ' boxes, ' + balls.length + ' spheres';
     let extent = 1;
     for (const b of list) extent = Math.max(extent, Math.hypot(...b.c) + Math.hypot(...b.h));
+    for (const s of balls) extent = Math.max(extent, Math.hypot(...s.c) + s.r);
     // Camera: yaw about B's z, then pitch; screen x right, z up, y into the screen.
     const cy = Math.cos(cam.yaw), sy = Math.sin(cam.yaw), cp = Math.cos(cam.pitch), sp = Math.sin(cam.pitch);
     const toCam = (p) => {
@@ -445,17 +472,31 @@
           const toEye = [-centre[0], -D - centre[1], -centre[2]];
           if (nc[0] * toEye[0] + nc[1] * toEye[1] + nc[2] * toEye[2] <= 0) continue;
           const lum = 0.3 + 0.7 * Math.max(0, nc[0] * light[0] + nc[1] * light[1] + nc[2] * light[2]);
-          faces.push({ pts, depth, rgb: b.rgb.map((x) => Math.round(x * lum)) });
+          faces.push({ pts, depth, rgb: b.rgb.map((x) => Math.round(x * lum)), a: b.a === undefined ? 1 : b.a });
         }
       }
+    }
+    // A sphere is a disc at its projected centre; its depth is its nearest point's, so a shell
+    // is painted over the smaller sphere inside it.
+    for (const s of balls) {
+      const p = proj(s.c);
+      const rpx = s.r * scale * D / (D + p[2]);
+      faces.push({ disc: [p[0], p[1], rpx], depth: p[2] - s.r, rgb: s.rgb.map(Math.round), a: s.a });
     }
     faces.sort((a, b) => b.depth - a.depth);
     g.lineJoin = 'round';
     for (const f of faces) {
+      if (f.disc) {
+        g.beginPath();
+        g.arc(f.disc[0], f.disc[1], f.disc[2], 0, 2 * Math.PI);
+        g.fillStyle = 'rgba(' + f.rgb.join(',') + ',' + f.a + ')';
+        g.fill();
+        continue;
+      }
       g.beginPath();
       f.pts.forEach((p, i) => (i ? g.lineTo(p[0], p[1]) : g.moveTo(p[0], p[1])));
       g.closePath();
-      g.fillStyle = 'rgb(' + f.rgb.join(',') + ')';
+      g.fillStyle = 'rgba(' + f.rgb.join(',') + ',' + f.a + ')';
       g.fill();
       g.strokeStyle = 'rgba(0,0,0,0.45)';
       g.lineWidth = dpr;

@@ -85,6 +85,7 @@ use flexdyn_kernel::validate::ParamError;
 
 pub mod kind;
 mod params;
+pub mod plausibility;
 pub mod schema;
 #[cfg(test)]
 mod tests;
