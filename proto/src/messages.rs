@@ -155,6 +155,12 @@ pub enum OperatorAction {
     /// Tag 2: lockstep: step `ticks` frames, then hold. Counted from the tick published (or held)
     /// now.
     RunTicks,
+    /// Tag 3: save a checkpoint of the run at tick `ticks`. The server writes the checkpoint of
+    /// frame boundary `ticks` (0: the next boundary; in lockstep the tick after the one published)
+    /// into its `--checkpoint-dir` as `<sc_id>-tick<k>.ckpt`. Refused (counted in
+    /// `rejected.operator_refused`) in batch, without `--checkpoint-dir`, for a tick already
+    /// published, or while another checkpoint request is pending. Added in protocol version 12.
+    Checkpoint,
 }
 
 impl OperatorAction {
@@ -381,7 +387,7 @@ pub mod propellant_tank_flags {
 /// 30 bytes on the wire ([`HEADER_LEN`](crate::HEADER_LEN)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Header {
-    /// Always the protocol version (11); checked first, other values rejected. That is
+    /// Always the protocol version (12); checked first, other values rejected. That is
     /// [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION); decoders check it (the first two bytes, u16
     /// LE) before anything else.
     pub protocol_version: u16,
@@ -538,8 +544,9 @@ pub struct RejectCounters {
     /// An [`OperatorMsg`](crate::OperatorMsg) the server did not apply (since protocol 6). An
     /// action that does not fit the mode (anything in batch, `RunTicks` in real time), `RunTicks`
     /// with `ticks = 0`, `Resume` with nothing held or pending, `Pause` while already held or
-    /// pending. Malformed, bad-version and wrong-spacecraft operator messages count under those
-    /// reasons.
+    /// pending, `Checkpoint` without `--checkpoint-dir`, for a tick already published or while
+    /// another checkpoint request is pending (since protocol 12). Malformed, bad-version and
+    /// wrong-spacecraft operator messages count under those reasons.
     pub operator_refused: u64,
     /// A [`FaultCommandMsg`](crate::FaultCommandMsg) the server did not apply (since protocol 8).
     /// An unknown target, a mode the target does not take, parameters out of range, a target that
@@ -936,9 +943,9 @@ pub struct EnvironmentMsg {
     pub albedo_nadir_w_m2: f64,
 }
 
-/// An operator's command: pause and resume a real-time run; in lockstep, run N ticks and then hold.
-/// On a lab network the shipped access-control list lets only the operator's subject put on this
-/// key (`scenarios/zenoh/secure-server.json5`).
+/// An operator's command: pause and resume a real-time run; in lockstep, run N ticks and then hold;
+/// save a checkpoint at a named tick. On a lab network the shipped access-control list lets only
+/// the operator's subject put on this key (`scenarios/zenoh/secure-server.json5`).
 ///
 /// Topic `flexdyn/<sc-id>/operator`; 42 bytes ([`OPERATOR_LEN`](crate::OPERATOR_LEN)). Since
 /// protocol version 6.
@@ -949,7 +956,8 @@ pub struct OperatorMsg {
     pub header: Header,
     /// An operator's request.
     pub action: OperatorAction,
-    /// `RunTicks`: frames to step before holding, ≥ 1; other actions: 0 (ignored).
+    /// `RunTicks`: frames to step before holding, ≥ 1; `Checkpoint`: the tick to save at, 0 = the
+    /// next boundary; other actions: 0 (ignored).
     pub ticks: u64,
 }
 

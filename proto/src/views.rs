@@ -866,7 +866,7 @@ pub struct OperatorView<'a> {
 /// accepts, with its values, or the class of its error ([`crate::view`]). Allocates nothing.
 pub fn view_operator(bytes: &[u8]) -> Result<OperatorView<'_>, ViewError> {
     check_frame(bytes, <crate::OperatorMsg as WireMessage>::LAYOUT)?;
-    if rd::<u32>(bytes, 30) > 2 {
+    if rd::<u32>(bytes, 30) > 3 {
         return Err(ViewError::Malformed);
     }
     Ok(OperatorView { bytes })
@@ -1607,7 +1607,8 @@ fn read_operator_action(b: &[u8], at: usize) -> crate::OperatorAction {
     match rd::<u32>(b, at) {
         0 => crate::OperatorAction::Pause,
         1 => crate::OperatorAction::Resume,
-        _ => crate::OperatorAction::RunTicks,
+        2 => crate::OperatorAction::RunTicks,
+        _ => crate::OperatorAction::Checkpoint,
     }
 }
 

@@ -8,7 +8,7 @@ use crate::view::WirePrim;
 use crate::DecodeError;
 
 /// The wire protocol version every header carries.
-pub const PROTOCOL_VERSION: u16 = 11;
+pub const PROTOCOL_VERSION: u16 = 12;
 
 // Named constants.
 /// the largest buffer any decoder accepts (bytes); more is TooLarge.

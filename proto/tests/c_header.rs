@@ -359,7 +359,8 @@ impl Gen {
                     OperatorAction::Pause,
                     OperatorAction::Resume,
                     OperatorAction::RunTicks,
-                ][self.below(3) as usize],
+                    OperatorAction::Checkpoint,
+                ][self.below(4) as usize],
                 self.u64(),
             )),
             5 => encode(&MagnetometerMsg {

@@ -44,7 +44,7 @@ fn input(effector_index: u32, values: &[f64]) -> EffectorInput {
 
 #[test]
 fn unknown_version_is_checked_first() {
-    for version in [0u16, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 12, 0xFFFF] {
+    for version in [0u16, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 13, 0xFFFF] {
         let mut b = encode(&StatusMsg::default());
         b[..2].copy_from_slice(&version.to_le_bytes());
         assert_eq!(
@@ -264,14 +264,14 @@ fn malformed_enum_tags_and_bools() {
         decode_time(&long),
         Err(DecodeError::TrailingBytes { .. })
     ));
-    // OperatorMsg (protocol 6): its action tag (0..=2), fixed length 42.
+    // OperatorMsg (protocol 6): its action tag (0..=3 since protocol 12), fixed length 42.
     let op = encode(&OperatorMsg::new(
         Header::new(1, 2, 3, 4),
         OperatorAction::RunTicks,
         5,
     ));
     assert_eq!(op.len(), OPERATOR_LEN);
-    for (offset, value) in [(30usize, 3u8), (33, 0x80)] {
+    for (offset, value) in [(30usize, 4u8), (33, 0x80)] {
         let mut b = op.clone();
         b[offset] = value;
         assert!(
@@ -443,7 +443,7 @@ fn encode_into_reuses_the_buffer() {
 fn header_new_sets_version() {
     let h = Header::new(1, 2, 3, 4);
     assert_eq!(h.protocol_version, flexdyn_proto::PROTOCOL_VERSION);
-    assert_eq!(Header::default().protocol_version, 11);
+    assert_eq!(Header::default().protocol_version, 12);
     assert_eq!(StateMsg::default().q_bn, [1.0, 0.0, 0.0, 0.0]);
 }
 

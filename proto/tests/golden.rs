@@ -108,7 +108,7 @@ fn check<M: WireMessage + PartialEq + std::fmt::Debug>(name: &str, table: Golden
 }
 
 const STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -368,7 +368,7 @@ const STATE_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const IMU_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -444,7 +444,7 @@ const IMU_GOLDEN: &[(usize, &str, &str)] = &[
     (126, "09", "u8 saturation_flags = 9 (GYRO_RATE | DV)"),
 ];
 const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -491,7 +491,7 @@ const COMMAND_WRENCH_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -561,7 +561,7 @@ const COMMAND_ACTUATORS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -592,7 +592,7 @@ const MAGNETOMETER_GOLDEN: &[(usize, &str, &str)] = &[
     (54, "05", "u8 saturation_flags = AXIS_1 | AXIS_3 = 0x05"),
 ];
 const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -832,7 +832,7 @@ const ENVIRONMENT_GOLDEN: &[(usize, &str, &str)] = &[
 
 // The sun sensors' tables (protocol 6, issue 20).
 const CSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -868,7 +868,7 @@ const CSS_GOLDEN: &[(usize, &str, &str)] = &[
     ),
 ];
 const FSS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -894,7 +894,7 @@ const FSS_GOLDEN: &[(usize, &str, &str)] = &[
     (46, "07", "u8 flags = VALID | IN_FOV | SUNLIT = 0x07"),
 ];
 const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -938,7 +938,7 @@ const STAR_TRACKER_GOLDEN: &[(usize, &str, &str)] = &[
 /// 1930 (1930 · 604,800 = 1,167,264,000) + 17.25 s. The last tone was at tick 4 (t = 0.5 s,
 /// TAI …036.0 s). `crates/server/src/clock.rs` produces exactly this message from that epoch.
 const TIME_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -1011,7 +1011,7 @@ const TIME_GOLDEN: &[(usize, &str, &str)] = &[
     (118, "00000000", "u32 tone_tai.subseconds = 0"),
 ];
 const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -1028,7 +1028,7 @@ const COMMAND_NO_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
     (34, "01000000", "u32 kind tag = 1 (NoCommand)"),
 ];
 const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -1128,7 +1128,7 @@ const STATUS_GOLDEN: &[(usize, &str, &str)] = &[
 // first live one) activated at tick 44: `bias_step` (mode 2) of 0.25 rad/s on axes 1 and 3 of
 // `imus.hub.gyro`, at 0.44 s exactly (edge = the boundary).
 const FAULT_EVENT_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -1176,7 +1176,7 @@ const FAULT_EVENT_GOLDEN: &[(usize, &str, &str)] = &[
 // `reaction_wheels.rw2`, at tick 0x1_0000_0005 (bytes on both sides of bit 32), for 2 s, seed
 // 7.
 const FAULT_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -1228,7 +1228,7 @@ const FAULT_COMMAND_GOLDEN: &[(usize, &str, &str)] = &[
 // Protocol 6 (issue 23, operator control): a `RunTicks` operator command. The tick count
 // 4294967301 = 0x1_0000_0005 has bytes on both sides of bit 32, so a u32 `ticks` would show.
 const OPERATOR_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -1247,6 +1247,28 @@ const OPERATOR_GOLDEN: &[(usize, &str, &str)] = &[
         "0500000001000000",
         "u64 ticks = 4294967301 (0x100000005)",
     ),
+];
+
+// Protocol 12 (issue 40 §2, operator checkpoints): a `Checkpoint` operator command naming
+// frame boundary 1000 = 0x3E8 (LE e8 03 then six zero bytes), sent by an operator who last saw
+// tick 44 (t = 0.44 s), its 4th command. The header is the RunTicks golden's but for seq 4; the
+// action tag is the new one, 3; `ticks` is the tick to save at.
+const OPERATOR_CHECKPOINT_GOLDEN: &[(usize, &str, &str)] = &[
+    (0, "0c00", "u16 header.protocol_version = 12"),
+    (
+        2,
+        "44332211",
+        "u32 header.spacecraft_id = 287454020 (0x11223344)",
+    ),
+    (6, "2c00000000000000", "u64 header.tick = 44"),
+    (
+        14,
+        "00de391a00000000",
+        "u64 header.sim_time_ns = 440000000 (0x1A39DE00)",
+    ),
+    (22, "0400000000000000", "u64 header.seq = 4"),
+    (30, "03000000", "u32 action tag = 3 (Checkpoint)"),
+    (34, "e803000000000000", "u64 ticks = 1000 (0x3E8)"),
 ];
 
 const SC: u32 = 0x1122_3344;
@@ -1461,7 +1483,7 @@ fn css_golden() {
 // ---- GpsMsg (protocol 7, issue 20): a self-contained block. ----
 /// GpsMsg, hand-derived from proto/README.md (147 bytes).
 const GPS_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -1607,6 +1629,7 @@ fn operator_golden() {
         (OperatorAction::Pause, 0u32),
         (OperatorAction::Resume, 1),
         (OperatorAction::RunTicks, 2),
+        (OperatorAction::Checkpoint, 3),
     ] {
         let bytes = encode(&OperatorMsg::new(Header::default(), action, 0));
         assert_eq!(
@@ -1616,6 +1639,18 @@ fn operator_golden() {
         );
         assert_eq!(action.tag(), tag);
     }
+}
+
+/// Protocol 12: a `Checkpoint` operator command (issue 40 §2).
+#[test]
+fn operator_checkpoint_golden() {
+    let msg = OperatorMsg::new(
+        Header::new(SC, 44, 440_000_000, 4),
+        OperatorAction::Checkpoint,
+        1000,
+    );
+    check("OperatorMsg", OPERATOR_CHECKPOINT_GOLDEN, &msg);
+    assert_eq!(encode(&msg).len(), OPERATOR_LEN);
 }
 
 /// Protocol 8: a fault event; every [`FaultSource`] tag pinned.
@@ -1837,7 +1872,7 @@ fn environment_golden() {
 #[test]
 fn exported_golden_files_match_the_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("golden");
-    let tables: [(&str, &str, Golden, &str); 18] = [
+    let tables: [(&str, &str, Golden, &str); 19] = [
         ("state", "StateMsg", STATE_GOLDEN, "STATE_GOLDEN"),
         ("imu", "ImuMsg", IMU_GOLDEN, "IMU_GOLDEN"),
         (
@@ -1911,6 +1946,13 @@ fn exported_golden_files_match_the_tables() {
         ),
         // Protocol 10, the flight code's own telemetry.
         ("fsw", "FswMsg", FSW_GOLDEN, "FSW_GOLDEN"),
+        // Protocol 12, the operator's checkpoint action.
+        (
+            "operator_checkpoint",
+            "OperatorMsg",
+            OPERATOR_CHECKPOINT_GOLDEN,
+            "OPERATOR_CHECKPOINT_GOLDEN",
+        ),
     ];
     let manifest = std::fs::read_to_string(dir.join("MANIFEST.tsv")).expect("MANIFEST.tsv");
     let rows: Vec<Vec<&str>> = manifest
@@ -1942,7 +1984,7 @@ fn exported_golden_files_match_the_tables() {
 /// RelativeStateMsg, hand-derived from proto/README.md (102 bytes): deputy 0x11223344 at
 /// tick 1000 (t = 10 s) relative to chief 1.
 const RELATIVE_STATE_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",
@@ -2027,7 +2069,7 @@ fn relative_state_golden() {
 /// vehicle 0x11223344 answering tick 1000 (t = 10 s), its 7th, with every optional field set,
 /// two events and three value words (an f64, an i64 and a bool, in that declared order).
 const FSW_GOLDEN: &[(usize, &str, &str)] = &[
-    (0, "0b00", "u16 header.protocol_version = 11"),
+    (0, "0c00", "u16 header.protocol_version = 12"),
     (
         2,
         "44332211",

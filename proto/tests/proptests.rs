@@ -264,7 +264,8 @@ fn operator() -> impl Strategy<Value = OperatorMsg> {
     let action = prop_oneof![
         Just(OperatorAction::Pause),
         Just(OperatorAction::Resume),
-        Just(OperatorAction::RunTicks)
+        Just(OperatorAction::RunTicks),
+        Just(OperatorAction::Checkpoint)
     ];
     (header(), action, any::<u64>()).prop_map(|(h, a, n)| OperatorMsg::new(h, a, n))
 }

@@ -147,7 +147,8 @@ int flexdyn_now(flexdyn_client *client, fd_time_msg *out);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Operator control, on flexdyn/<sc>/operator (proto/README.md, "OperatorMsg"): action
- * FD_OPERATOR_PAUSE, _RESUME or _RUN_TICKS (lockstep: step `ticks` frames, then hold). `stamp` is
+ * FD_OPERATOR_PAUSE, _RESUME, _RUN_TICKS (lockstep: step `ticks` frames, then hold) or
+ * _CHECKPOINT (protocol 12: save a checkpoint at tick `ticks`, 0 = the next boundary). `stamp` is
  * the header of any message of the server (its spacecraft_id is copied). On a lab network the
  * server's ACL lets only the operator's subject put there. */
 int flexdyn_send_operator(flexdyn_client *client, const fd_header *stamp, uint32_t action,

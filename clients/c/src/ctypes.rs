@@ -15,7 +15,7 @@ use crate::error::{Code, Error};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FdHeader {
-    /// always the protocol version (11); checked first, other values rejected
+    /// always the protocol version (12); checked first, other values rejected
     pub protocol_version: u16,
     /// numeric vehicle id
     pub spacecraft_id: u32,
@@ -337,7 +337,8 @@ pub struct FdOperatorMsg {
     pub header: FdHeader,
     /// `FD_OPERATOR_*`
     pub action: u32,
-    /// `RunTicks`: frames to step before holding, ≥ 1; other actions: 0 (ignored)
+    /// `RunTicks`: frames to step before holding, ≥ 1; `Checkpoint`: the tick to save at, 0 = the
+    /// next boundary; other actions: 0 (ignored)
     pub ticks: u64,
 }
 

@@ -632,11 +632,13 @@ pub unsafe extern "C" fn flexdyn_send_operator(
             0 => OperatorAction::Pause,
             1 => OperatorAction::Resume,
             2 => OperatorAction::RunTicks,
+            3 => OperatorAction::Checkpoint,
             other => {
                 return Err(Error::new(
                     Code::Argument,
                     format!(
-                        "operator action {other} is not FD_OPERATOR_PAUSE, _RESUME or _RUN_TICKS"
+                        "operator action {other} is not FD_OPERATOR_PAUSE, _RESUME, _RUN_TICKS \
+                         or _CHECKPOINT"
                     ),
                 ))
             }

@@ -21,7 +21,7 @@ def bits(x):
 def test_manifest_lists_every_file(golden_dir):
     rows = [l.split("\t") for l in (golden_dir / "MANIFEST.tsv").read_text().splitlines()
             if l and not l.startswith("#")]
-    assert len(rows) == 18
+    assert len(rows) == 19
     for name, _message, length, _source in rows:
         assert (golden_dir / f"{name}.bin").stat().st_size == int(length)
 
@@ -153,7 +153,7 @@ def test_operator(golden_dir):
     assert len(golden) == proto.OPERATOR_LEN
     assert m.encode() == golden and OperatorMsg.decode(golden) == m
     bad = bytearray(golden)
-    bad[30] = 3
+    bad[30] = 4
     with pytest.raises(DecodeError) as e:
         OperatorMsg.decode(bytes(bad))
     assert e.value.reason == "Malformed"
@@ -161,6 +161,15 @@ def test_operator(golden_dir):
         OperatorMsg.decode(golden + b"\0")
     assert e.value.reason == "TrailingBytes"
     assert proto.operator_key("sc1") == "flexdyn/sc1/operator"
+
+
+def test_operator_checkpoint(golden_dir):
+    # OPERATOR_CHECKPOINT_GOLDEN of proto/tests/golden.rs (protocol 12): save at tick 1000.
+    m = OperatorMsg(Header(SC, 44, 440_000_000, 4), proto.OPERATOR_CHECKPOINT, 1000)
+    golden = (golden_dir / "operator_checkpoint.bin").read_bytes()
+    assert len(golden) == proto.OPERATOR_LEN
+    assert golden[30:34] == b"\x03\x00\x00\x00" and golden[34:42] == (1000).to_bytes(8, "little")
+    assert m.encode() == golden and OperatorMsg.decode(golden) == m
 
 
 def test_versions_and_keys():

@@ -36,7 +36,7 @@ pub fn decide(
     target: Option<u64>,
     tick: u64,
 ) -> Result<Option<u64>, &'static str> {
-    use OperatorAction::{Pause, Resume, RunTicks};
+    use OperatorAction::{Checkpoint, Pause, Resume, RunTicks};
     match (mode, action) {
         (Mode::Batch, _) => Err("operator commands do not apply to a batch run"),
         (_, Pause) if target.is_some() => {
@@ -53,6 +53,7 @@ pub fn decide(
         }
         (Mode::Lockstep, RunTicks) if ticks == 0 => Err("run_ticks with ticks = 0"),
         (Mode::Lockstep, RunTicks) => Ok(Some(tick.saturating_add(ticks))),
+        (_, Checkpoint) => Err("checkpoint: this server saves no checkpoints"),
     }
 }
 
@@ -148,7 +149,7 @@ pub(super) async fn declare(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use OperatorAction::{Pause, Resume, RunTicks};
+    use OperatorAction::{Checkpoint, Pause, Resume, RunTicks};
 
     #[test]
     fn each_action_moves_the_hold_target_as_documented() {
@@ -171,8 +172,11 @@ mod tests {
         assert!(decide(Mode::Lockstep, Pause, 0, Some(8), 7).is_err());
         assert_eq!(decide(Mode::Lockstep, Resume, 0, Some(8), 8), Ok(None));
         assert!(decide(Mode::Lockstep, Resume, 0, None, 8).is_err());
+        // Checkpoint (protocol 12): refused by this server, leaving the hold target alone.
+        assert!(decide(Mode::RealTime, Checkpoint, 0, None, 41).is_err());
+        assert!(decide(Mode::Lockstep, Checkpoint, 50, Some(8), 7).is_err());
         // Batch: nothing applies.
-        for a in [Pause, Resume, RunTicks] {
+        for a in [Pause, Resume, RunTicks, Checkpoint] {
             assert!(decide(Mode::Batch, a, 1, None, 0).is_err());
             assert!(decide(Mode::Batch, a, 1, Some(3), 0).is_err());
         }

@@ -583,6 +583,7 @@ mod tests {
             OperatorAction::Pause,
             OperatorAction::Resume,
             OperatorAction::RunTicks,
+            OperatorAction::Checkpoint,
         ] {
             same(
                 "",

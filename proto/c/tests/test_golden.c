@@ -477,13 +477,28 @@ static void test_operator(const char *dir) {
     CHECK(e.status == FD_OK && same_header(&back.header, &m.header) && back.action == 2 &&
               back.ticks == m.ticks,
           "OperatorMsg decodes to the table");
-    golden[30] = 3;
+    golden[30] = 4;
     e = fd_decode_operator(golden, n, &back);
-    CHECK(e.status == FD_ERR_MALFORMED, "OperatorMsg action tag 3");
+    CHECK(e.status == FD_ERR_MALFORMED, "OperatorMsg action tag 4");
     e = fd_decode_operator(golden, n - 1, &back);
     CHECK(e.status == FD_ERR_LENGTH && e.needed == FD_OPERATOR_LEN, "OperatorMsg short");
     CHECK(fd_operator_key(key, sizeof key, "sc1") > 0 && strcmp(key, "flexdyn/sc1/operator") == 0,
           "operator key");
+    /* OPERATOR_CHECKPOINT_GOLDEN (protocol 12): save a checkpoint at tick 1000. */
+    n = read_file(dir, "operator_checkpoint", golden, sizeof golden);
+    memset(&m, 0, sizeof m);
+    m.header = fd_header_new(SC, 44, 440000000u, 4);
+    m.action = FD_OPERATOR_CHECKPOINT;
+    m.ticks = 1000u;
+    CHECK(n == FD_OPERATOR_LEN, "operator_checkpoint.bin length");
+    check_encoded("OperatorMsg (Checkpoint)", golden, n, enc,
+                  fd_encode_operator(&m, enc, sizeof enc));
+    e = fd_decode_operator(golden, n, &back);
+    CHECK(e.status == FD_OK && same_header(&back.header, &m.header) && back.action == 3 &&
+              back.ticks == 1000u,
+          "OperatorMsg (Checkpoint) decodes to the table");
+    m.action = FD_OPERATOR_CHECKPOINT + 1;
+    CHECK(fd_encode_operator(&m, enc, sizeof enc) == 0, "OperatorMsg action 4 is not encoded");
     printf("OperatorMsg: ok\n");
 }
 

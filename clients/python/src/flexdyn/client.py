@@ -414,10 +414,12 @@ class Client:
 
     def operator(self, action: int, ticks: int = 0) -> None:
         """Publishes an OperatorMsg on ``flexdyn/<sc>/operator``: ``proto.OPERATOR_PAUSE``,
-        ``OPERATOR_RESUME`` or ``OPERATOR_RUN_TICKS`` (proto/README.md, "OperatorMsg"). The
-        server applies it or counts it in ``StatusMsg.rejected_operator_refused``; on a lab
-        network only the operator's subject may put there."""
-        if action not in (proto.OPERATOR_PAUSE, proto.OPERATOR_RESUME, proto.OPERATOR_RUN_TICKS):
+        ``OPERATOR_RESUME``, ``OPERATOR_RUN_TICKS`` or (protocol 12) ``OPERATOR_CHECKPOINT``
+        (proto/README.md, "OperatorMsg"). The server applies it or counts it in
+        ``StatusMsg.rejected_operator_refused``; on a lab network only the operator's subject may
+        put there."""
+        if action not in (proto.OPERATOR_PAUSE, proto.OPERATOR_RESUME, proto.OPERATOR_RUN_TICKS,
+                          proto.OPERATOR_CHECKPOINT):
             raise ValueError(f"unknown operator action {action!r}")
         if not (isinstance(ticks, int) and 0 <= ticks < 2**64):
             raise ValueError(f"ticks must be an integer 0..2**64-1, not {ticks!r}")

@@ -130,9 +130,9 @@ impl Le {
         self.0.extend(v);
         self
     }
-    /// The header: version 11, spacecraft 7, tick 11, 22 ns, seq 33.
+    /// The header: version 12, spacecraft 7, tick 11, 22 ns, seq 33.
     fn header() -> Self {
-        Le::default().u16(11).u32(7).u64(11).u64(22).u64(33)
+        Le::default().u16(12).u32(7).u64(11).u64(22).u64(33)
     }
 }
 
@@ -154,7 +154,7 @@ fn probe_prefix() -> Le {
 /// The cases: a name, the bytes, and what both codecs must print.
 fn cases() -> Vec<(&'static str, Vec<u8>, String)> {
     let fixed =
-        "hdr 11 7 11 22 33 flag 1 mode 2 bits 1 0 count 3 label ab offset -5 vals 0.5 -2.25";
+        "hdr 12 7 11 22 33 flag 1 mode 2 bits 1 0 count 3 label ab offset -5 vals 0.5 -2.25";
     let scalar = probe_prefix().u32(0).f64(1.5).u8(1).0;
     let nothing = probe_prefix().u32(1).0;
     // Items: level 1, two elements: (id 4, data [7, 8], weight 0.25), (id 5, data [], weight -1).
@@ -193,7 +193,7 @@ fn cases() -> Vec<(&'static str, Vec<u8>, String)> {
         (
             "list",
             list.clone(),
-            "OK hdr 11 7 11 22 33 n16 65535 samples -1 0 2000000000".to_string(),
+            "OK hdr 12 7 11 22 33 n16 65535 samples -1 0 2000000000".to_string(),
         ),
     ];
     let with = |mut b: Vec<u8>, at: usize, v: &[u8]| {
