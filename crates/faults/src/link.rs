@@ -129,16 +129,18 @@ impl LinkFaults {
             a.expect_count("command-link faults", faults.len());
             for f in faults.iter_mut() {
                 let LinkFault {
-                    fault_index: _,
+                    fault_index,
                     field: _,
                     target: _,
-                    sender_id: _,
+                    sender_id,
                     mode: _,
                     window: _,
                     seed: _,
                     cleared_from_ns,
                     active,
                 } = f;
+                a.expect_count("a command-link fault's index", *fault_index as usize);
+                a.expect_count("a command-link fault's participant", *sender_id as usize);
                 a.put(cleared_from_ns);
                 a.put(active);
             }

@@ -162,14 +162,14 @@ pub fn restore(r: &Resumed, world: &mut WorldStepper) -> Result<(), ServerError>
     c.restore_with(step_ns, frame_ns, |a| list(world, a))
         .map_err(|e| refused(&r.file, e))?;
     if world.sim_time_ns() != c.header.t_sim_ns {
-        return Err(refused(
-            &r.file,
-            CheckpointError::Mismatch {
-                what: "its header at t =",
-                checkpoint: format!("{} ns", c.header.t_sim_ns),
-                run: format!("its state at t = {} ns", world.sim_time_ns()),
-            },
-        ));
+        return Err(ServerError::Checkpoint {
+            file: r.file.clone(),
+            problem: format!(
+                "its header says t = {} ns and its state t = {} ns: it is damaged",
+                c.header.t_sim_ns,
+                world.sim_time_ns()
+            ),
+        });
     }
     Ok(())
 }
@@ -248,6 +248,7 @@ impl Checkpointer {
                 }
                 Err(_) => {
                     self.stats.failed.fetch_add(1, Ordering::Relaxed);
+                    tracing::error!(tick = k, "checkpoint not taken: the writer thread is gone");
                 }
             }
         }
@@ -310,12 +311,25 @@ impl Writer {
         ))
     }
 
+    /// The requested tick an operator's checkpoint requests set, when `settings` give them a
+    /// directory (`None`: they are refused).
+    pub fn operator_requests(&self, settings: &CheckpointSettings) -> Option<Arc<AtomicU64>> {
+        settings.dir.as_ref().map(|_| self.requested.clone())
+    }
+
     /// Waits (up to 10 s) until every checkpoint taken so far is written.
     pub fn flush(&self) {
         let (ack_tx, ack_rx) = sync_channel(1);
         if self.tx.send(Job::Flush(ack_tx)).is_ok() {
             let _ = ack_rx.recv_timeout(std::time::Duration::from_secs(10));
         }
+    }
+}
+
+impl Drop for Writer {
+    /// A run that ends on an error still writes the checkpoints it took.
+    fn drop(&mut self) {
+        self.flush();
     }
 }
 
@@ -348,9 +362,19 @@ fn write_all(rx: &Receiver<Job>, stats: &CheckpointStats) {
 }
 
 fn write_file(file: &Path, bytes: &[u8]) -> Result<(), String> {
+    use std::io::Write;
     let mut part = file.as_os_str().to_owned();
     part.push(".part");
     let part = PathBuf::from(part);
-    std::fs::write(&part, bytes).map_err(|e| format!("cannot write `{}`: {e}", part.display()))?;
-    std::fs::rename(&part, file).map_err(|e| format!("cannot rename `{}`: {e}", part.display()))
+    let written = std::fs::File::create(&part)
+        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
+        .map_err(|e| format!("cannot write `{}`: {e}", part.display()))
+        .and_then(|()| {
+            std::fs::rename(&part, file)
+                .map_err(|e| format!("cannot rename `{}`: {e}", part.display()))
+        });
+    if written.is_err() {
+        let _ = std::fs::remove_file(&part);
+    }
+    written
 }

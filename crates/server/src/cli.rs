@@ -139,13 +139,14 @@ pub struct RunArgs {
     #[arg(long, value_name = "FILE", requires = "checkpoint_at_tick")]
     pub checkpoint: Option<PathBuf>,
     /// Where an operator's checkpoint requests (OperatorMsg `Checkpoint`) are written, as
-    /// `<sc_id>-tick<k>.ckpt`; without it they are refused.
-    #[arg(long, value_name = "DIR", conflicts_with = "fleet")]
+    /// `<sc_id>-tick<k>.ckpt` (a fleet's: `fleet-tick<k>.ckpt`); without it they are refused.
+    #[arg(long, value_name = "DIR")]
     pub checkpoint_dir: Option<PathBuf>,
-    /// Resume from a checkpoint of `flexdyn run`: the stream from its tick on is the
-    /// uninterrupted run's, bit for bit (lockstep); with `--config` another configuration than
-    /// the one it was taken with, a fork. `--duration-s` still counts from t = 0.
-    #[arg(long, value_name = "FILE", conflicts_with = "fleet")]
+    /// Resume from a checkpoint of `flexdyn run` (of `flexdyn run --fleet` with `--fleet`): the
+    /// stream from its tick on is the uninterrupted run's, bit for bit (lockstep); with
+    /// `--config` another configuration than the one it was taken with, a fork (with `--fleet`,
+    /// a fleet file that differs). `--duration-s` still counts from t = 0.
+    #[arg(long, value_name = "FILE")]
     pub resume: Option<PathBuf>,
     /// Zenoh endpoints and configuration file.
     #[command(flatten)]
@@ -289,6 +290,47 @@ fn checkpoint_settings(args: &RunArgs) -> Result<(SimConfig, CheckpointSettings)
         resume: resumed.map(|(r, _)| r),
     };
     Ok((cfg, checkpoints))
+}
+
+/// The checkpoint settings of a fleet server (`--fleet FILE`): its checkpoints record the fleet
+/// file; a fleet file that differs from the one a resumed checkpoint recorded is a fork.
+pub(super) fn fleet_checkpoint_settings(
+    args: &RunArgs,
+    fleet_file: &std::path::Path,
+) -> Result<CheckpointSettings, ServerError> {
+    let resumed = args
+        .resume
+        .as_deref()
+        .map(|f| checkpoint::read(f, checkpoint::FRONT_END_FLEET))
+        .transpose()?;
+    let saves = args.checkpoint_at_tick.is_some() || args.checkpoint_dir.is_some();
+    let source = if resumed.is_some() || saves {
+        Source::of(Some(fleet_file)).map_err(|source| ServerError::Config {
+            file: Some(fleet_file.to_path_buf()),
+            source,
+        })?
+    } else {
+        Source::default()
+    };
+    note_fork(resumed.as_ref(), &source);
+    Ok(CheckpointSettings {
+        save_at: args.checkpoint_at_tick.zip(args.checkpoint.clone()),
+        dir: args.checkpoint_dir.clone(),
+        source,
+        resume: resumed.map(|(r, _)| r),
+    })
+}
+
+/// Logs a resume whose configuration differs from the checkpoint's: a fork.
+fn note_fork(resumed: Option<&(checkpoint::Resumed, CheckpointHeader)>, source: &Source) {
+    if let Some((r, header)) = resumed {
+        if CheckpointHeader::digest(&source.text) != header.source_sha256 {
+            tracing::warn!(
+                checkpoint = %r.file.display(),
+                "resuming with a configuration that differs from the one it was taken with: a fork"
+            );
+        }
+    }
 }
 
 /// `--view` connects to the server as a tool with the default configuration: with a Zenoh

@@ -106,11 +106,11 @@ struct Slot {
 }
 
 impl Archived for Slot {
-    /// The participant's last command and its bookkeeping; the sender id is the run's (the
-    /// book's sections are checked by count and size).
+    /// The participant's last command and its bookkeeping; its sender id must be the run's (a
+    /// fork with other participants does not fit).
     fn archive(&mut self, a: &mut Archive<'_>) {
         let Self {
-            sender_id: _,
+            sender_id,
             torque_b_nm,
             force_b_newton,
             inputs,
@@ -119,6 +119,7 @@ impl Archived for Slot {
             received_tick,
             answered,
         } = self;
+        a.expect_count("a participant's sender id", *sender_id as usize);
         a.put(torque_b_nm);
         a.put(force_b_newton);
         a.expect_count("a participant's effector inputs", inputs.len());

@@ -140,7 +140,12 @@ pub async fn run(
     shared.set_run_state(RunState::Starting);
     let state_pub = endpoints.state_pub.clone();
     // Checkpoints: the writer thread, and the stepping side that takes them.
-    let (writer, checkpointer) = start_checkpoints(&settings, &sim, total_frames)?;
+    let (writer, checkpointer) = start_checkpoints(
+        &settings,
+        (checkpoint::FRONT_END, &settings.sc_id),
+        (sim.step_ns(), sim.frame_ns()),
+        total_frames,
+    )?;
     let wiring = Wiring::new(
         endpoints,
         sim,
@@ -168,6 +173,9 @@ pub async fn run(
         core,
         record_tx.clone(),
         shared.clone(),
+        writer
+            .as_ref()
+            .and_then(|w| w.operator_requests(&settings.checkpoints)),
     )
     .await?;
 
@@ -275,10 +283,12 @@ pub async fn run(
 }
 
 /// The checkpoint writer and the stepping side of a run that saves checkpoints (`None` for
-/// one that saves none); checks that a resumed run starts before its end.
-fn start_checkpoints(
+/// one that saves none), for the front end and file stem `(front_end, stem)` and the step and
+/// frame `(step_ns, frame_ns)`; checks that a resumed run starts before its end.
+pub(crate) fn start_checkpoints(
     settings: &ServerSettings,
-    sim: &Simulation,
+    (front_end, stem): (&str, &str),
+    (step_ns, frame_ns): (u64, u64),
     total_frames: Option<u64>,
 ) -> Result<(Option<checkpoint::Writer>, Option<checkpoint::Checkpointer>), ServerError> {
     let c = &settings.checkpoints;
@@ -312,6 +322,23 @@ fn start_checkpoints(
             .into());
         }
     }
+    if let Some((_, file)) = &c.save_at {
+        let parent = file
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(std::path::Path::new("."));
+        if !parent.is_dir() {
+            return Err(SettingsError::Invalid {
+                name: "--checkpoint".into(),
+                problem: format!(
+                    "`{}`: its directory `{}` does not exist",
+                    file.display(),
+                    parent.display()
+                ),
+            }
+            .into());
+        }
+    }
     if let Some(dir) = c.dir.as_ref().filter(|d| !d.is_dir()) {
         return Err(SettingsError::Invalid {
             name: "--checkpoint-dir".into(),
@@ -322,13 +349,7 @@ fn start_checkpoints(
     if !c.saves() {
         return Ok((None, None));
     }
-    let (w, cp) = checkpoint::Writer::start(
-        c,
-        checkpoint::FRONT_END,
-        &settings.sc_id,
-        sim.step_ns(),
-        sim.frame_ns(),
-    )?;
+    let (w, cp) = checkpoint::Writer::start(c, front_end, stem, step_ns, frame_ns)?;
     Ok((Some(w), Some(cp)))
 }
 
@@ -463,9 +484,6 @@ impl Wiring {
             for v in &mut world.vehicles {
                 v.frame = Some(new_frame());
             }
-            if let Some(r) = resume {
-                checkpoint::restore(r, &mut world)?;
-            }
             let lane = lockstep::CoreLane {
                 publisher,
                 record: recording.clone(),
@@ -481,7 +499,10 @@ impl Wiring {
                 events.clone(),
             )
             .with_checkpoints(checkpoints);
-            if resume.is_some() {
+            // Restored after the core began tick 0 on the fresh world, so nothing of that
+            // beginning stays in the restored books.
+            if let Some(r) = resume {
+                checkpoint::restore(r, core.world_mut())?;
                 core.resumed_at(start_tick);
             }
             let core = Arc::new(Mutex::new(core));

@@ -348,7 +348,7 @@ impl LockstepCore {
                 v.stepper.note_links(&lane.shared);
             }
             self.k += 1;
-            // A checkpoint due at boundary k + 1: its state before the telemetry is filled.
+            // A checkpoint due at this boundary: its state before its telemetry is filled.
             if let Some(c) = self.checkpoints.as_mut() {
                 c.at_boundary(&mut self.world, self.k);
             }

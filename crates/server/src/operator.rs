@@ -1,5 +1,7 @@
 //! Operator control: the callback of `flexdyn/<sc>/operator` ([`OperatorMsg`], protocol 6) that
-//! pauses and resumes a real-time run and, in lockstep, runs N ticks and then holds.
+//! pauses and resumes a real-time run and, in lockstep, runs N ticks and then holds; and (protocol
+//! 12) asks for a checkpoint at a tick ([`checkpoint_tick`]), which the checkpoint writer's
+//! requested tick carries to whoever steps the frames ([`super::checkpoint`]).
 //!
 //! The callback only moves the run's **hold target** ([`Shared::hold_target`]): "hold at the
 //! first frame boundary at or after tick h". Whoever steps the frames reads it once per frame
@@ -13,6 +15,7 @@
 //! may put on the key is Zenoh's access-control list (the shipped
 //! `scenarios/zenoh/secure-server.json5` lets only user `operator`).
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use flexdyn_proto::{decode_operator, Mode, OperatorAction, OperatorMsg, Topics};
@@ -53,7 +56,28 @@ pub fn decide(
         }
         (Mode::Lockstep, RunTicks) if ticks == 0 => Err("run_ticks with ticks = 0"),
         (Mode::Lockstep, RunTicks) => Ok(Some(tick.saturating_add(ticks))),
-        (_, Checkpoint) => Err("checkpoint: this server saves no checkpoints"),
+        // Not a hold: `checkpoint_tick` decides it.
+        (_, Checkpoint) => Err("checkpoint requests do not move the hold target"),
+    }
+}
+
+/// The tick an operator's checkpoint request (`ticks`; 0: the next boundary) saves at, with the
+/// frames published up to tick `tick`; or why it is refused. `dir` says whether the server has
+/// a `--checkpoint-dir`, `pending` whether a request waits already.
+pub fn checkpoint_tick(
+    mode: Mode,
+    ticks: u64,
+    dir: bool,
+    pending: bool,
+    tick: u64,
+) -> Result<u64, &'static str> {
+    match mode {
+        Mode::Batch => Err("operator commands do not apply to a batch run"),
+        _ if !dir => Err("checkpoint: this server has no --checkpoint-dir"),
+        _ if pending => Err("checkpoint: another checkpoint request is pending"),
+        _ if ticks == 0 => Ok(tick.saturating_add(1)),
+        _ if ticks <= tick => Err("checkpoint: that tick is already published"),
+        _ => Ok(ticks),
     }
 }
 
@@ -62,7 +86,8 @@ pub fn decide(
 /// `handoff = "direct"`): a release steps the held frame there at once. Refusals count in
 /// `shared`; the hold target (and the tick it is decided against) is `hold`'s: the vehicle's
 /// own `shared` for one vehicle, one for the whole fleet in fleet mode (any vehicle's operator
-/// key pauses, resumes or runs the fleet).
+/// key pauses, resumes or runs the fleet). `checkpoints` is the checkpoint writer's requested
+/// tick when the server has a `--checkpoint-dir` (`None`: checkpoint requests are refused).
 // Eight: the run's keys, counters, hold, mode and ids, the lockstep core and the recorder are
 // each what one caller has and the other does not (one vehicle, or a fleet).
 #[allow(clippy::too_many_arguments)]
@@ -75,6 +100,7 @@ pub(super) async fn declare(
     core: Option<Arc<Mutex<LockstepCore>>>,
     record: Option<RecordTx>,
     hold: Arc<Shared>,
+    checkpoints: Option<Arc<AtomicU64>>,
 ) -> Result<Subscriber<()>, ServerError> {
     let log = Mutex::new(RejectLog::default());
     // Serialises decisions (read the target, write it back) between concurrent deliveries.
@@ -115,7 +141,27 @@ pub(super) async fn declare(
         let mut core_guard = core
             .as_ref()
             .map(|c| c.lock().unwrap_or_else(|p| p.into_inner()));
-        let tick = hold.tick.load(std::sync::atomic::Ordering::Acquire);
+        let tick = hold.tick.load(Ordering::Acquire);
+        if msg.action == OperatorAction::Checkpoint {
+            let requested = checkpoints.as_deref();
+            let pending = requested.is_some_and(|r| r.load(Ordering::Acquire) != u64::MAX);
+            match checkpoint_tick(mode, msg.ticks, requested.is_some(), pending, tick) {
+                Ok(at) => {
+                    if let Some(r) = requested {
+                        r.store(at, Ordering::Release);
+                    }
+                    tracing::info!(tick, at, "operator checkpoint requested");
+                }
+                Err(why) => {
+                    warn(
+                        "operator_refused",
+                        &format_args!("operator command Checkpoint refused: {why}"),
+                    );
+                    shared.reject_operator();
+                }
+            }
+            return;
+        }
         match decide(mode, msg.action, msg.ticks, hold.hold_target(), tick) {
             Ok(target) => {
                 hold.set_hold_target(target);
@@ -152,6 +198,19 @@ mod tests {
     use OperatorAction::{Checkpoint, Pause, Resume, RunTicks};
 
     #[test]
+    fn a_checkpoint_request_saves_at_a_tick_still_to_come() {
+        // 0: the next boundary after the one published.
+        assert_eq!(checkpoint_tick(Mode::Lockstep, 0, true, false, 41), Ok(42));
+        assert_eq!(checkpoint_tick(Mode::RealTime, 0, true, false, 41), Ok(42));
+        assert_eq!(checkpoint_tick(Mode::Lockstep, 50, true, false, 41), Ok(50));
+        // A tick already published, a pending request, no directory, batch: refused.
+        assert!(checkpoint_tick(Mode::Lockstep, 41, true, false, 41).is_err());
+        assert!(checkpoint_tick(Mode::Lockstep, 50, true, true, 41).is_err());
+        assert!(checkpoint_tick(Mode::Lockstep, 50, false, false, 41).is_err());
+        assert!(checkpoint_tick(Mode::Batch, 50, true, false, 41).is_err());
+    }
+
+    #[test]
     fn each_action_moves_the_hold_target_as_documented() {
         // Real time: pause holds at the next boundary; resume clears; run_ticks is refused.
         assert_eq!(decide(Mode::RealTime, Pause, 0, None, 41), Ok(Some(0)));
@@ -172,7 +231,7 @@ mod tests {
         assert!(decide(Mode::Lockstep, Pause, 0, Some(8), 7).is_err());
         assert_eq!(decide(Mode::Lockstep, Resume, 0, Some(8), 8), Ok(None));
         assert!(decide(Mode::Lockstep, Resume, 0, None, 8).is_err());
-        // Checkpoint (protocol 12): refused by this server, leaving the hold target alone.
+        // Checkpoint (protocol 12): never moves the hold target (`checkpoint_tick` decides it).
         assert!(decide(Mode::RealTime, Checkpoint, 0, None, 41).is_err());
         assert!(decide(Mode::Lockstep, Checkpoint, 50, Some(8), 7).is_err());
         // Batch: nothing applies.

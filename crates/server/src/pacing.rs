@@ -162,6 +162,16 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_resumed_schedule_is_due_from_its_first_tick() {
+        let t0 = Instant::now();
+        let p =
+            Pacer::new(t0, 1_000_000, Duration::ZERO, OverrunPolicy::CatchUp, 10).first_tick(500);
+        // Boundary 500 is due at t0 (not 0.5 s later), 503 three periods after.
+        assert_eq!(p.deadline(500), t0);
+        assert_eq!(p.deadline(503), t0 + Duration::from_millis(3));
+    }
+
+    #[test]
     fn skip_counts_whole_missed_periods() {
         assert_eq!(periods_to_skip(0, 1000), 0);
         assert_eq!(periods_to_skip(999, 1000), 0);

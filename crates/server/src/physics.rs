@@ -558,7 +558,7 @@ impl PhysicsCtx {
                 v.stepper.note_links(&lane.shared);
             }
             k += 1;
-            // A checkpoint due at boundary k + 1: its state before the telemetry is filled.
+            // A checkpoint due at this boundary: its state before its telemetry is filled.
             if let Some(c) = self.checkpoints.as_mut() {
                 c.at_boundary(world, k);
             }

@@ -334,10 +334,25 @@ pub async fn run(
 
     // The world, and what steps it.
     let ids: Vec<String> = vehicles.iter().map(|v| v.id.clone()).collect();
-    let world = WorldStepper::new(vehicles, &vsettings).with_relative_pairs(&pairs);
+    let mut world = WorldStepper::new(vehicles, &vsettings).with_relative_pairs(&pairs);
+    let step_ns = world
+        .vehicles
+        .first()
+        .map_or(1, |v| v.stepper.sim.step_ns());
+    let (writer, checkpointer) = super::start_checkpoints(
+        &settings,
+        (super::checkpoint::FRONT_END_FLEET, "fleet"),
+        (step_ns, frame_ns),
+        total_frames,
+    )?;
+    let mut checkpointer = Some(checkpointer).flatten();
+    let start_tick = settings.checkpoints.start_tick();
     let mut keep = Vec::with_capacity(parts.len());
     let mut alive = Vec::new();
     let mut lanes = Vec::new();
+    if let (false, Some(r)) = (direct, &settings.checkpoints.resume) {
+        super::checkpoint::restore(r, &mut world)?;
+    }
     let mut engine = if direct {
         let mut core_lanes = Vec::with_capacity(outlets.len());
         for ((publisher, record, telemetry_alive), sh) in outlets.into_iter().zip(&shared) {
@@ -349,7 +364,7 @@ pub async fn run(
             alive.push(telemetry_alive);
         }
         let events = Arc::new(Notify::new());
-        let core = LockstepCore::new(
+        let mut core = LockstepCore::new(
             world,
             core_lanes,
             relative,
@@ -357,7 +372,13 @@ pub async fn run(
             true,
             total_frames,
             events.clone(),
-        );
+        )
+        .with_checkpoints(checkpointer.take());
+        // Restored after the core began tick 0 on the fresh world (see `super::Wiring`).
+        if let Some(r) = &settings.checkpoints.resume {
+            super::checkpoint::restore(r, core.world_mut())?;
+            core.resumed_at(start_tick);
+        }
         Engine::Core {
             core: Arc::new(Mutex::new(core)),
             events,
@@ -436,6 +457,9 @@ pub async fn run(
                 core.clone(),
                 record_tx.clone(),
                 hold.clone(),
+                writer
+                    .as_ref()
+                    .and_then(|w| w.operator_requests(&settings.checkpoints)),
             )
             .await
             .map_err(named)?,
@@ -515,13 +539,16 @@ pub async fn run(
                 lateness: Some(lateness),
                 relative: std::mem::take(relative),
                 name_vehicles: true,
-                start_tick: 0,
-                checkpoints: None,
+                start_tick,
+                checkpoints: checkpointer.take(),
             };
             super::run_physics_thread(physics, world, &settings, &shared, shutdown.as_mut()).await
         }
     };
     let wall_s = started.elapsed().as_secs_f64();
+    if let Some(w) = &writer {
+        w.flush();
+    }
     // The core's telemetry threads end when their channels close; the physics thread's when
     // it drops its lanes.
     drop(alive);
@@ -546,7 +573,8 @@ pub async fn run(
         .zip(&shared)
         .zip(&lateness)
         .map(|((id, sh), h)| {
-            let r = RunReport::collect(mode, physics, sh, h, wall_s, None);
+            let mut r = RunReport::collect(mode, physics, sh, h, wall_s, None);
+            r.checkpoints = writer.as_ref().map(|w| w.stats.summary());
             (id, r)
         })
         .collect();
@@ -603,7 +631,8 @@ struct VehicleParts {
 /// table and the options), a tokio runtime, the Zenoh session, SIGINT/SIGTERM.
 pub fn run_from_args(args: &RunArgs, fleet_file: &Path) -> Result<FleetReport, ServerError> {
     let fleet = FleetConfig::from_file(fleet_file)?;
-    let settings = args.settings(&fleet.vehicles[0].cfg)?;
+    let mut settings = args.settings(&fleet.vehicles[0].cfg)?;
+    settings.checkpoints = super::cli::fleet_checkpoint_settings(args, fleet_file)?;
     let zcfg = zenoh_config(&args.zenoh, Role::Server)?;
     super::access::check(
         &zcfg,
