@@ -266,14 +266,14 @@ pub struct Writer {
 
 impl Writer {
     /// Starts the writer thread, and the stepping thread's side for a run of `front_end` whose
-    /// files are named after `stem` (the spacecraft id, or `fleet`), with `header`'s step,
-    /// frame and source.
+    /// files are named after `stem` (the spacecraft id, or `fleet`), with the step and frame
+    /// `(step_ns, frame_ns)`; `sync`: each file is synced to the disk before it is renamed into
+    /// place ([`write_file`]).
     pub fn start(
         settings: &CheckpointSettings,
-        front_end: &str,
-        stem: &str,
-        step_ns: u64,
-        frame_ns: u64,
+        (front_end, stem): (&str, &str),
+        (step_ns, frame_ns): (u64, u64),
+        sync: bool,
     ) -> Result<(Self, Checkpointer), ServerError> {
         let (tx, rx) = sync_channel(WRITER_QUEUE);
         let stats = Arc::new(CheckpointStats::default());
@@ -281,7 +281,7 @@ impl Writer {
         let thread_stats = stats.clone();
         std::thread::Builder::new()
             .name("flexdyn-checkpoint".into())
-            .spawn(move || write_all(&rx, &thread_stats))
+            .spawn(move || write_all(&rx, &thread_stats, sync))
             .map_err(|e| {
                 ServerError::Internal(format!("cannot start the checkpoint writer: {e}"))
             })?;
@@ -335,7 +335,7 @@ impl Drop for Writer {
 
 /// The writer thread: writes each checkpoint beside its file, then renames it over, so a
 /// reader never sees half of one.
-fn write_all(rx: &Receiver<Job>, stats: &CheckpointStats) {
+fn write_all(rx: &Receiver<Job>, stats: &CheckpointStats, sync: bool) {
     while let Ok(job) = rx.recv() {
         let (file, tick, bytes) = match job {
             Job::Flush(ack) => {
@@ -347,7 +347,7 @@ fn write_all(rx: &Receiver<Job>, stats: &CheckpointStats) {
         let written = bytes
             .map(checkpoint::seal)
             .map_err(|e| e.to_string())
-            .and_then(|b| write_file(&file, &b).map(|()| b.len()));
+            .and_then(|b| write_file(&file, &b, sync).map(|()| b.len()));
         match written {
             Ok(len) => {
                 stats.written.fetch_add(1, Ordering::Relaxed);
@@ -361,13 +361,22 @@ fn write_all(rx: &Receiver<Job>, stats: &CheckpointStats) {
     }
 }
 
-fn write_file(file: &Path, bytes: &[u8]) -> Result<(), String> {
+/// Writes `bytes` beside `file`, then renames it over. `sync`: flushed to the disk before the
+/// rename (not in real time, where a sync's I/O measurably delayed the physics thread's
+/// boundaries on the development machine; a file a crash damaged is refused by its checksum).
+fn write_file(file: &Path, bytes: &[u8], sync: bool) -> Result<(), String> {
     use std::io::Write;
     let mut part = file.as_os_str().to_owned();
     part.push(".part");
     let part = PathBuf::from(part);
     let written = std::fs::File::create(&part)
-        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
+        .and_then(|mut f| {
+            f.write_all(bytes)?;
+            if sync {
+                f.sync_all()?;
+            }
+            Ok(())
+        })
         .map_err(|e| format!("cannot write `{}`: {e}", part.display()))
         .and_then(|()| {
             std::fs::rename(&part, file)

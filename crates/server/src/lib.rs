@@ -349,7 +349,8 @@ pub(crate) fn start_checkpoints(
     if !c.saves() {
         return Ok((None, None));
     }
-    let (w, cp) = checkpoint::Writer::start(c, front_end, stem, step_ns, frame_ns)?;
+    let sync = settings.mode != Mode::RealTime;
+    let (w, cp) = checkpoint::Writer::start(c, (front_end, stem), (step_ns, frame_ns), sync)?;
     Ok((Some(w), Some(cp)))
 }
 
