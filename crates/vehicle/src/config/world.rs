@@ -13,10 +13,7 @@ use flexdyn_environment::epoch::schema::{self as epoch_schema, RawEpoch};
 use flexdyn_environment::epoch::SimEpoch;
 use flexdyn_environment::geodetic::WGS84_A_M;
 use flexdyn_environment::model::schema as env_schema;
-use flexdyn_environment::model::{
-    AtmosphereSetting, EnvironmentBuildError, EnvironmentModel, EnvironmentSettings,
-    MagneticSetting,
-};
+use flexdyn_environment::model::{EnvironmentBuildError, EnvironmentModel, EnvironmentSettings};
 use flexdyn_environment::orbit::schema::{self as orbit_schema, InitialOrbit, RawOrbit};
 use flexdyn_kernel::schema::{SchemaError, TableReader};
 
@@ -176,15 +173,7 @@ impl RawWorld {
                 }
                 match &epoch {
                     None if env.needs_epoch() => {
-                        let field = [
-                            ("magnetic", env.magnetic != MagneticSetting::Off),
-                            ("atmosphere", env.atmosphere != AtmosphereSetting::Off),
-                            ("sun", env.sun),
-                            ("moon", env.moon),
-                        ]
-                        .iter()
-                        .find(|(_, on)| *on)
-                        .map_or("environment", |(k, _)| k);
+                        let field = env.dated_model().unwrap_or("environment");
                         return Err(needs_epoch(
                             &format!("environment.{field}"),
                             &format!("environment.{field}"),
