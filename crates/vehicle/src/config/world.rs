@@ -1,10 +1,11 @@
 //! The world sections of a configuration: `[epoch]`, `[orbit]` and `[environment]`.
 //!
 //! Their readers live with their models (`environment::epoch::schema`,
-//! `environment::orbit::schema`, `environment::model::schema`, which asks each registered model for its keys); this file registers them and
-//! runs the checks that need the rest of the file: `[orbit]` against `[initial]` and the gravity
-//! model, every dated model against `[epoch]`, the magnetic model's span against the epoch, and
-//! the gravity gradient against the gravity model. Without these sections nothing changes.
+//! `environment::orbit::schema`, `environment::model::schema`, which asks each registered
+//! environment model for its keys); this file registers them and runs the checks that need the
+//! rest of the file: `[orbit]` against `[initial]` and the gravity model, every dated model
+//! against `[epoch]`, the magnetic model's span against the epoch, and the gravity gradient
+//! against the gravity model. Without these sections nothing changes.
 
 use std::path::Path;
 
