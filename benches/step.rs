@@ -363,7 +363,7 @@ fn world_summary(pair_ns: f64) {
             "igrf + dipole",
             every("magnetic = \"igrf14\"\nresidual_dipole_m_b_am2 = [0.1, 0.0, 0.0]\n"),
         ),
-        // The constants that match a reference tool (environment::model::constants).
+        // The constants that match a reference tool (each environment model's `schema.rs`).
         (
             "sun + cannonball",
             every(

@@ -1570,11 +1570,11 @@ fn world_rows() -> Vec<Case> {
             leo("moon = true", "moon = true\nalbedo = \"lambertian\""),
             |cfg| {
                 let env = cfg.environment.as_ref().unwrap();
-                assert_eq!(env.albedo_coefficient, Some(0.3));
+                assert_eq!(env.models.albedo, Some(0.3));
             },
         ),
         accepts_and(leo("moon = true", "moon = true"), |cfg| {
-            assert_eq!(cfg.environment.as_ref().unwrap().albedo_coefficient, None);
+            assert_eq!(cfg.environment.as_ref().unwrap().models.albedo, None);
         }),
         rejects(
             leo(

@@ -51,6 +51,13 @@
 //! - [`facets`]: the flat-plate model of the vehicle's surfaces: drag and solar-radiation-pressure
 //!   forces and torques about B.
 //!
+//! # The registry of environment models
+//! Each model that fills part of the [`EnvironmentSample`] is a folder here whose `part.rs`
+//! implements [`model::part::EnvironmentPart`] (its keys of `[environment]`, its settings, its
+//! build, its part of an update, its fields in the prefetch slot and in a checkpoint), and one
+//! line of the registry below. The order of the lines is the order of the sample's fields in
+//! the prefetch slot and in a checkpoint: append a new model at the end.
+//!
 //! # Layer
 //! Above `flexdyn-kernel`. It depends on the kernel, `nalgebra`, and the field's own crates
 //! (`hifitime` for time scales, `sgp4` for mean elements, `tobari` for NRLMSISE-00). It must never
@@ -77,3 +84,16 @@ pub mod sample;
 pub mod shadow;
 
 pub use sample::EnvironmentSample;
+
+model::part::environment_models! {
+    /// The magnetic field (`magnetic`, …): `b_field_n_t`.
+    magnetic: magnetic::MagneticField,
+    /// The Sun and the Moon (`sun`, `moon`, a fixed Sun): `r_sun_b_n_m`, `r_moon_b_n_m`.
+    ephemeris: ephemeris::Ephemeris,
+    /// The Earth's shadow (`shadow` and its radii): `shadow_factor`.
+    shadow: shadow::ShadowGeometry,
+    /// The atmosphere and its wind (`atmosphere`, …): `density_kg_m3`, `wind_n_m_s`.
+    atmosphere: atmosphere::Atmosphere,
+    /// The Earth's albedo (`albedo`, `albedo_coefficient`): `albedo`.
+    albedo: albedo::Albedo,
+}

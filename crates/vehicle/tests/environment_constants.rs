@@ -250,7 +250,14 @@ fn cannonball_srp_matches_basilisks_unit_test_case() {
     let path = format!("{}/scenarios/srp_cannonball_basilisk.toml", crate::REPO);
     let cfg = SimConfig::from_toml_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
     let r_sun: Vector3<f64> = Vector3::new(507128401.716, 22652490.9092, -14854379.6232);
-    let want_sun_n_m = cfg.environment.as_ref().unwrap().sun_fixed_n_m.unwrap();
+    let want_sun_n_m = cfg
+        .environment
+        .as_ref()
+        .unwrap()
+        .models
+        .ephemeris
+        .sun_fixed_n_m
+        .unwrap();
     assert!(close(&want_sun_n_m, &r_sun, 1e-15), "{want_sun_n_m:?}");
     let mut sim = Simulation::new(&cfg).unwrap();
     sim.step();

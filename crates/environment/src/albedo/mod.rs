@@ -78,6 +78,9 @@
 //! reflection, the Sun's finite size at the terminator and its parallax across the Earth
 //! (R / 1 au = 4e-5 rad).
 
+pub mod part;
+pub mod schema;
+
 use nalgebra::Vector3;
 
 use crate::ephemeris::AU_M;

@@ -14,6 +14,8 @@
 
 pub mod exponential;
 pub mod nrlmsise;
+pub mod part;
+pub mod schema;
 pub mod wind;
 
 pub use exponential::{
@@ -23,6 +25,8 @@ pub use exponential::{
 pub use nrlmsise::{
     AtmosphereState, Composition, Nrlmsise00Model, SpaceWeather, LOWEST_THERMOSPHERE_ALTITUDE_M,
 };
+pub use part::Atmosphere;
+pub use schema::{AirSetting, AtmosphereSetting};
 pub use wind::{corotation_wind_n_m_s, velocity_relative_to_air_n_m_s};
 
 /// An invalid atmosphere parameter. Every variant names the field.

@@ -46,6 +46,7 @@
 //! bench prints both costs.
 
 mod nutation_2000b;
+pub mod schema;
 mod uniform;
 
 pub use uniform::UniformRotation;

@@ -26,12 +26,16 @@
 
 pub mod moon;
 mod moon_terms;
+pub mod part;
 pub mod precession;
+pub mod schema;
 pub mod sun;
 
 use nalgebra::Vector3;
 
 pub use moon::{moon_ecliptic_of_date, moon_position_n_m};
+pub use part::Ephemeris;
+pub use schema::EphemerisSetting;
 pub use sun::{sun_ecliptic_of_date, sun_position_n_m};
 
 /// [d] Julian Date of the epoch J2000.0 (2000-01-01 12:00 TT).

@@ -30,9 +30,13 @@
 
 pub mod dipole;
 pub mod igrf;
+pub mod part;
+pub mod schema;
 
 pub use dipole::{dipole_field_t, dipole_torque_b_nm, CentredDipole};
 pub use igrf::{GaussCoefficients, Igrf, SphericalField, IGRF_MAX_DEGREE};
+pub use part::MagneticField;
+pub use schema::MagneticSetting;
 
 /// An invalid magnetic-field model or a date it does not cover.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -2,16 +2,17 @@
 //! ([`schema`]), and the [`EnvironmentModel`] that fills an [`EnvironmentSample`] from the
 //! simulation time and the hub's position and velocity.
 //!
-//! One update runs the chain (each step cites its own module):
-//! 1. the epoch's time scales at `t_sim_ns` ([`crate::epoch`]);
-//! 2. the Earth's orientation, N → E ([`crate::earth_rotation`]);
-//! 3. r in the Earth-fixed frame; the magnetic field there (IGRF-14 or a centred dipole),
-//!    rotated back to N ([`crate::magnetic`]);
-//! 4. the density at r (exponential or NRLMSISE-00) and the co-rotating wind ω⊕ × r
-//!    ([`crate::atmosphere`]);
-//! 5. the Sun and Moon positions (geocentric, N), made relative to B
-//!    ([`crate::ephemeris`]), and the shadow factor ([`crate::shadow`]);
-//! 6. the Earth's visible cap for albedo, discretised ([`crate::albedo`]).
+//! One update runs:
+//! 1. the shared, position-independent part that the models on need ([`part::Needs`]): the
+//!    epoch's time scales at `t_sim_ns` ([`crate::epoch`]), the Earth's orientation N → E
+//!    ([`crate::earth_rotation`]), the Sun's and the Moon's geocentric positions
+//!    ([`crate::ephemeris`]), shared by a world's vehicles ([`crate::common`]); then B's
+//!    position in the Earth-fixed frame;
+//! 2. every registered model that is on ([`part`]; the registry is in `crate::lib`), each
+//!    filling its fields of the sample from those inputs: the magnetic field
+//!    ([`crate::magnetic`]), the Sun and the Moon relative to B ([`crate::ephemeris`]), the
+//!    shadow factor ([`crate::shadow`]), the density and the wind ([`crate::atmosphere`]), the
+//!    Earth's visible cap for albedo ([`crate::albedo`]).
 //!
 //! [`EnvironmentModel::fill`] allocates nothing, locks nothing and returns no `Result`: every
 //! parameter was checked when the model was built. [`EnvironmentModel::update_if_due`] runs it at
@@ -21,58 +22,26 @@
 //! evaluation to a worker thread without changing a bit ([`super::prefetch`]).
 
 pub mod constants;
+pub mod part;
 pub mod schema;
 
 use std::sync::{Arc, OnceLock};
 
 use nalgebra::Vector3;
 
-use super::albedo::Albedo;
-use super::atmosphere::{AltitudeDefinition, ExponentialAtmosphere, Nrlmsise00Model, SpaceWeather};
 use super::cannonball::Cannonball;
 use super::common::{Common, CommonCache, Parts};
 use super::earth_rotation::{EarthOrientation, EarthOrientationModel};
 use super::ephemeris::{moon_position_n_m, sun_position_n_m};
 use super::epoch::SimEpoch;
 use super::facets::Facet;
-use super::geodetic::geodetic_from_ecef;
-use super::magnetic::{CentredDipole, Igrf, MagneticError};
+use super::magnetic::MagneticError;
 use super::prefetch::{Prefetcher, Request};
-use super::shadow::{ShadowGeometry, ShadowModel};
-use super::EnvironmentSample;
+use super::{BuiltModels, EnvironmentSample, ModelSettings};
+use part::At;
 
-/// Which magnetic-field model is on.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum MagneticSetting {
-    /// No field.
-    Off,
-    /// IGRF-14 to `degree` (1..=13).
-    Igrf14 {
-        /// Highest degree n.
-        degree: usize,
-    },
-    /// The centred dipole of IGRF-14's degree-1 coefficients at the epoch: tilted (g₁⁰, g₁¹,
-    /// h₁¹) or axial (g₁⁰ only).
-    Dipole {
-        /// Tilted (true) or axial (false).
-        tilted: bool,
-    },
-    /// A centred dipole given outright (`magnetic = "dipole"`: Gauss coefficients and a
-    /// reference radius, or a moment and an axis): the date does not enter.
-    GivenDipole(CentredDipole),
-}
-
-/// Which atmosphere is on.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum AtmosphereSetting {
-    /// Vacuum.
-    Off,
-    /// An exponential atmosphere: Vallado's bands (Table 8-4) on the geodetic height by
-    /// default, or one given band over the chosen altitude.
-    Exponential(ExponentialAtmosphere),
-    /// NRLMSISE-00 with constant space weather.
-    Nrlmsise00(SpaceWeather),
-}
+pub use super::atmosphere::AtmosphereSetting;
+pub use super::magnetic::MagneticSetting;
 
 /// The validated `[environment]` table.
 #[derive(Debug, Clone, PartialEq)]
@@ -87,28 +56,11 @@ pub struct EnvironmentSettings {
     /// `telemetry_rate_hz` as a whole number of frames (set by the configuration, which knows
     /// the frame rate).
     pub telemetry_every_frames: Option<u64>,
-    /// Magnetic field.
-    pub magnetic: MagneticSetting,
-    /// Atmosphere (with a co-rotating wind when on).
-    pub atmosphere: AtmosphereSetting,
-    /// The Sun (from the ephemeris unless [`Self::sun_fixed_n_m`] is set).
-    pub sun: bool,
-    /// \[m\] a fixed geocentric Sun position in N (`sun_direction_n` × `sun_distance_m`)
-    /// instead of the ephemeris.
-    pub sun_fixed_n_m: Option<Vector3<f64>>,
+    /// Every registered model's settings (`crate::lib`'s registry): the magnetic field, the
+    /// Sun and the Moon, the shadow, the atmosphere, the albedo.
+    pub models: ModelSettings,
     /// The model of the Earth's orientation, `[E N]` (IAU 2006/2000B by default).
     pub earth_rotation: EarthOrientationModel,
-    /// Whether the atmosphere co-rotates with the Earth (`corotating_wind`, default true): the
-    /// wind ω⊕ × r; false: still air in N.
-    pub corotating_wind: bool,
-    /// Moon ephemeris.
-    pub moon: bool,
-    /// Shadow geometry (needs the Sun), or none (full sunlight).
-    pub shadow: Option<ShadowModel>,
-    /// \[m\] the occulting Earth's radius for the shadow (default WGS-84 a).
-    pub shadow_earth_radius_m: f64,
-    /// \[m\] the Sun's radius for the shadow (default the IAU 2015 nominal radius).
-    pub shadow_sun_radius_m: f64,
     /// The vehicle's flat plates (`[[environment.facets]]`), B frame.
     pub facets: Vec<Facet>,
     /// Dynamic effector: gravity-gradient torque.
@@ -124,37 +76,19 @@ pub struct EnvironmentSettings {
     pub solar_irradiance_1au_w_m2: f64,
     /// Dynamic effector: a residual dipole \[A·m²\], B components.
     pub residual_dipole_m_b_am2: Option<Vector3<f64>>,
-    /// \[-\] Earth albedo (`albedo = "lambertian"`, needs the Sun): its coefficient a; `None`
-    /// (the default): off. The sphere is the shadow's ([`Self::shadow_earth_radius_m`]) and the
-    /// irradiance [`Self::solar_irradiance_1au_w_m2`] ([`crate::albedo`]).
-    pub albedo_coefficient: Option<f64>,
 }
 
 impl EnvironmentSettings {
     /// Whether any model needs the epoch (everything but the gravity gradient and the facets).
     pub fn needs_epoch(&self) -> bool {
-        self.magnetic != MagneticSetting::Off
-            || self.atmosphere != AtmosphereSetting::Off
-            || self.sun
-            || self.moon
-            || self.shadow.is_some()
+        self.dated_model().is_some()
     }
-}
 
-/// The magnetic field, built.
-#[derive(Debug, Clone)]
-enum Field {
-    Off,
-    Igrf(Box<Igrf>),
-    Dipole(CentredDipole),
-}
-
-/// The atmosphere, built.
-#[derive(Debug, Clone)]
-enum Air {
-    Off,
-    Exponential(ExponentialAtmosphere),
-    Nrlmsise00(Nrlmsise00Model),
+    /// The key (`magnetic`, `sun`, …) of the first registered model that is on and needs the
+    /// epoch, for the error without one.
+    pub fn dated_model(&self) -> Option<&'static str> {
+        self.models.needs_epoch()
+    }
 }
 
 /// \[m\] how far the actual position at an update may be from the predicted one before the
@@ -169,14 +103,8 @@ pub const STALE_PREDICTION_M: f64 = 10.0;
 struct Models {
     epoch: SimEpoch,
     rotation: EarthOrientation,
-    field: Field,
-    air: Air,
-    corotating_wind: bool,
-    sun: bool,
-    sun_fixed_n_m: Option<Vector3<f64>>,
-    moon: bool,
-    shadow: Option<ShadowGeometry>,
-    albedo: Option<Albedo>,
+    /// Every registered model, built.
+    models: BuiltModels,
     /// The world's memo of the position-independent parts, when the vehicle is one of several
     /// ([`EnvironmentModel::share_common`]); set once, before any update.
     common: OnceLock<Arc<CommonCache>>,
@@ -232,21 +160,32 @@ pub enum EnvironmentBuildError {
     Atmosphere(#[from] super::atmosphere::AtmosphereError),
 }
 
-/// Which environment models are on ([`EnvironmentModel::models_on`]).
+/// Which environment models are on ([`EnvironmentModel::models_on`]), by the names the
+/// models give themselves (`"magnetic"`, `"sun"`, `"moon"`, `"shadow"`, `"atmosphere"`,
+/// `"albedo"`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ModelsOn {
-    /// A magnetic field (IGRF or a dipole).
-    pub magnetic: bool,
-    /// The Sun ephemeris.
-    pub sun: bool,
-    /// The Moon ephemeris.
-    pub moon: bool,
-    /// A shadow model.
-    pub shadow: bool,
-    /// An atmosphere.
-    pub atmosphere: bool,
-    /// Earth albedo.
-    pub albedo: bool,
+    names: [&'static str; MAX_MODELS_ON],
+    len: usize,
+}
+
+/// The most model names [`ModelsOn`] holds.
+const MAX_MODELS_ON: usize = 16;
+
+impl ModelsOn {
+    /// Marks `name` as on (a name past [`MAX_MODELS_ON`] is dropped; the models registered
+    /// today give six names).
+    pub fn set(&mut self, name: &'static str) {
+        if self.len < MAX_MODELS_ON && !self.is_on(name) {
+            self.names[self.len] = name;
+            self.len += 1;
+        }
+    }
+
+    /// Whether the model `name` is on.
+    pub fn is_on(&self, name: &str) -> bool {
+        self.names[..self.len].contains(&name)
+    }
 }
 
 impl EnvironmentModel {
@@ -256,51 +195,11 @@ impl EnvironmentModel {
         settings: &EnvironmentSettings,
         epoch: &SimEpoch,
     ) -> Result<Self, EnvironmentBuildError> {
-        let year = epoch.utc_calendar(0).decimal_year();
-        let field = match settings.magnetic {
-            MagneticSetting::Off => Field::Off,
-            MagneticSetting::Igrf14 { degree } => {
-                let igrf = Igrf::igrf14(degree)?;
-                igrf.check_date(year)?;
-                Field::Igrf(Box::new(igrf))
-            }
-            MagneticSetting::GivenDipole(d) => Field::Dipole(d),
-            MagneticSetting::Dipole { tilted } => {
-                let igrf = Igrf::igrf14(1)?;
-                igrf.check_date(year)?;
-                let c = igrf.coefficients_at(year);
-                Field::Dipole(if tilted {
-                    CentredDipole::tilted(&c)
-                } else {
-                    CentredDipole::axial(&c)
-                })
-            }
-        };
-        let air = match settings.atmosphere {
-            AtmosphereSetting::Off => Air::Off,
-            AtmosphereSetting::Exponential(e) => Air::Exponential(e),
-            AtmosphereSetting::Nrlmsise00(w) => Air::Nrlmsise00(Nrlmsise00Model::new(w)?),
-        };
         Ok(Self {
             models: Arc::new(Models {
                 epoch: epoch.clone(),
                 rotation: EarthOrientation::new(settings.earth_rotation, epoch.earth_orientation()),
-                field,
-                air,
-                corotating_wind: settings.corotating_wind,
-                sun: settings.sun,
-                sun_fixed_n_m: settings.sun_fixed_n_m,
-                moon: settings.moon,
-                shadow: settings.shadow.map(|model| ShadowGeometry {
-                    model,
-                    earth_radius_m: settings.shadow_earth_radius_m,
-                    sun_radius_m: settings.shadow_sun_radius_m,
-                }),
-                albedo: settings.albedo_coefficient.map(|coefficient| Albedo {
-                    coefficient,
-                    earth_radius_m: settings.shadow_earth_radius_m,
-                    irradiance_1au_w_m2: settings.solar_irradiance_1au_w_m2,
-                }),
+                models: BuiltModels::new(settings, epoch)?,
                 common: OnceLock::new(),
             }),
             update_ns: settings.update_ns.max(1),
@@ -371,26 +270,7 @@ impl EnvironmentModel {
     /// `environment.exponential_*` band of an exponential atmosphere given one), for a
     /// campaign's read-back. Not on the stepping path.
     pub fn parameters(&self, out: &mut Vec<(String, f64)>) {
-        if let Air::Exponential(ExponentialAtmosphere { band: Some(b), .. }) = &self.models.air {
-            out.push((
-                "environment.exponential_base_altitude_m".into(),
-                b.base_altitude_m,
-            ));
-            out.push((
-                "environment.exponential_base_density_kg_m3".into(),
-                b.density_kg_m3,
-            ));
-            out.push((
-                "environment.exponential_scale_height_m".into(),
-                b.scale_height_m,
-            ));
-        }
-        if let Air::Nrlmsise00(m) = &self.models.air {
-            let w = m.weather();
-            out.push(("environment.f107_sfu".into(), w.f107_sfu));
-            out.push(("environment.f107a_sfu".into(), w.f107a_sfu));
-            out.push(("environment.ap".into(), w.ap));
-        }
+        self.models.models.parameters(out);
     }
 
     /// The sample last filled by [`Self::update_if_due`].
@@ -427,17 +307,11 @@ impl EnvironmentModel {
         }
     }
 
-    /// Which models are on: (magnetic field, Sun, Moon, shadow, atmosphere, albedo).
+    /// Which models are on.
     pub fn models_on(&self) -> ModelsOn {
-        let m = &self.models;
-        ModelsOn {
-            magnetic: !matches!(m.field, Field::Off),
-            sun: m.sun,
-            moon: m.moon,
-            shadow: m.shadow.is_some(),
-            atmosphere: !matches!(m.air, Air::Off),
-            albedo: m.albedo.is_some(),
-        }
+        let mut on = ModelsOn::default();
+        self.models.models.models_on(&mut on);
+        on
     }
 
     /// Lists the schedule and the held sample for a checkpoint: the next update time, the
@@ -537,24 +411,15 @@ impl Models {
     ) {
         *out = EnvironmentSample::NONE;
         out.t_sim_ns = t_sim_ns;
-        let field_on = !matches!(self.field, Field::Off);
-        let air_on = !matches!(self.air, Air::Off);
-        // The Earth's orientation for the models that work in the Earth-fixed frame: the field,
-        // a geodetic altitude and the co-rotating wind. The IAU chain (precession-nutation and
-        // sidereal time, ~1.5 µs) is position-independent and shared ([`super::common`]); a
-        // uniform rotation is evaluated here.
-        let air_needs_frame = match &self.air {
-            Air::Off => false,
-            Air::Exponential(e) => {
-                self.corotating_wind || e.altitude == AltitudeDefinition::Geodetic
-            }
-            Air::Nrlmsise00(_) => true,
-        };
-        let need_frame = field_on || air_needs_frame;
+        let needs = self.models.needs();
+        // The Earth's orientation for the models that work in the Earth-fixed frame (the field,
+        // a geodetic altitude, the co-rotating wind). The IAU chain (precession-nutation and
+        // sidereal time, ~1.5 µs) is position-independent and shared with the Sun and the Moon
+        // ([`super::common`]); a uniform rotation is evaluated here.
         let parts = Parts {
-            earth: need_frame && self.rotation.is_dated(),
-            sun: self.sun && self.sun_fixed_n_m.is_none(),
-            moon: self.moon,
+            earth: needs.frame && self.rotation.is_dated(),
+            sun: needs.sun_ephemeris,
+            moon: needs.moon_ephemeris,
         };
         let common = match self.common.get() {
             Some(cache) => {
@@ -563,73 +428,28 @@ impl Models {
             None => self.common_at(t_sim_ns, parts),
         };
         let earth = match &self.rotation {
-            EarthOrientation::Uniform(u) if need_frame => u.at(t_sim_ns),
+            EarthOrientation::Uniform(u) if needs.frame => u.at(t_sim_ns),
             _ => common.earth,
         };
-        if need_frame || air_on {
-            let r_e_m = if need_frame {
+        let at = At {
+            t_sim_ns,
+            r_bn_n_m,
+            epoch: &self.epoch,
+            earth: &earth,
+            r_e_m: if needs.frame {
                 earth.r_e(r_bn_n_m)
             } else {
                 Vector3::zeros()
-            };
-            let b_e_t = match &self.field {
-                Field::Off => None,
-                Field::Igrf(igrf) => {
-                    let year = self.epoch.utc_calendar(t_sim_ns).decimal_year();
-                    Some(igrf.field_ecef_t(year, &r_e_m))
-                }
-                Field::Dipole(d) => Some(d.field_ecef_t(&r_e_m)),
-            };
-            if let Some(b_e_t) = b_e_t {
-                out.b_field_n_t = earth.dcm_en.tr_mul(&b_e_t);
-            }
-            let density_kg_m3 = match &self.air {
-                Air::Off => None,
-                Air::Exponential(e) => {
-                    let altitude_m = match e.altitude {
-                        AltitudeDefinition::Geodetic => geodetic_from_ecef(&r_e_m).height_m,
-                        // |r| is the same in every frame: no Earth orientation needed.
-                        AltitudeDefinition::Spherical { radius_m } => r_bn_n_m.norm() - radius_m,
-                    };
-                    Some(e.density_at_altitude_kg_m3(altitude_m))
-                }
-                Air::Nrlmsise00(m) => {
-                    let cal = self.epoch.utc_calendar(t_sim_ns);
-                    let ut_s = f64::from(cal.hour) * 3600.0
-                        + f64::from(cal.minute) * 60.0
-                        + f64::from(cal.second.min(59))
-                        + f64::from(cal.nanosecond) * 1e-9;
-                    Some(m.drag_density_kg_m3(
-                        day_of_year(cal.year, cal.month, cal.day),
-                        ut_s,
-                        &r_e_m,
-                    ))
-                }
-            };
-            if let Some(rho) = density_kg_m3 {
-                out.density_kg_m3 = rho;
-                // Co-rotating atmosphere (Vallado §8.6.2): v_wind = ω⊕ × r, N components; or
-                // still air in N when `corotating_wind = false`.
-                if self.corotating_wind {
-                    out.wind_n_m_s = earth.omega_en_n_rad_s.cross(r_bn_n_m);
-                }
-            }
-        }
-        // The Sun and Moon positions relative to B and the shadow factor.
-        if self.sun {
-            let r_sun_n_m = self.sun_fixed_n_m.unwrap_or(common.r_sun_n_m);
-            out.r_sun_b_n_m = r_sun_n_m - r_bn_n_m;
-            if let Some(geometry) = &self.shadow {
-                out.shadow_factor = geometry.factor(r_bn_n_m, &r_sun_n_m);
-            }
-            // The visible cap for albedo, (A3)–(A6) of [`crate::albedo`].
-            if let Some(albedo) = &self.albedo {
-                out.albedo = albedo.cap(r_bn_n_m, &r_sun_n_m);
-            }
-        }
-        if self.moon {
-            out.r_moon_b_n_m = common.r_moon_n_m - r_bn_n_m;
-        }
+            },
+            // The Sun is an input of the models that need sunlight (the shadow, the albedo).
+            r_sun_n_m: self
+                .models
+                .ephemeris
+                .as_ref()
+                .and_then(|e| e.sun_n_m(&common.r_sun_n_m)),
+            r_moon_n_m: common.r_moon_n_m,
+        };
+        self.models.fill(&at, out);
     }
 
     /// The position-independent `parts` at `t_sim_ns`: what a world's vehicles share
@@ -648,26 +468,5 @@ impl Models {
             c.r_moon_n_m = moon_position_n_m(t_tt_jc);
         }
         c
-    }
-}
-
-/// Day of the year, 1 on 1 January (Gregorian).
-fn day_of_year(year: i32, month: u8, day: u8) -> u32 {
-    const CUM: [u32; 12] = [0, 31, 59, 90, 120, 151, 181, 212, 243, 273, 304, 334];
-    let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
-    let m = usize::from(month.clamp(1, 12)) - 1;
-    CUM[m] + u32::from(leap && month > 2) + u32::from(day)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::day_of_year;
-
-    #[test]
-    fn day_of_year_counts_from_one() {
-        assert_eq!(day_of_year(2026, 1, 1), 1);
-        assert_eq!(day_of_year(2026, 11, 24), 328);
-        assert_eq!(day_of_year(2024, 12, 31), 366);
-        assert_eq!(day_of_year(2023, 3, 1), 60);
     }
 }

@@ -30,10 +30,11 @@
 //! diffuse = 0.1
 //! ```
 //!
-//! The keys that set each model's constants (a given dipole, the exponential atmosphere's band
-//! and altitude, the wind, the Earth's rotation, a fixed Sun, the shadow's radii, the
-//! irradiance, a cannonball) are read by [`super::constants`], which lists them with their
-//! defaults.
+//! Each environment model reads its own keys, in its folder (`magnetic/schema.rs`, …), and
+//! lists them in its [`EnvironmentPart::KEYS`](super::part::EnvironmentPart::KEYS): this file
+//! reads the update's rates, asks every registered model ([`crate::ModelSettings::read`]) and
+//! the Earth's orientation ([`crate::earth_rotation::schema`]) for theirs, and reads the dynamic
+//! effectors' switches, the facets and their constants ([`super::constants`]).
 //!
 //! The reader checks keys, types, names and each facet; the cross-checks that need the rest of
 //! the configuration (an epoch, a gravity model, the step) are the configuration's.
@@ -41,29 +42,22 @@
 use nalgebra::Vector3;
 
 use super::constants;
-use super::{AtmosphereSetting, EnvironmentSettings, MagneticSetting};
-use crate::atmosphere::SpaceWeather;
+use super::EnvironmentSettings;
+use crate::atmosphere::AtmosphereSetting;
 use crate::facets::{Facet, FacetError};
-use crate::magnetic::IGRF_MAX_DEGREE;
-use crate::shadow::ShadowModel;
+use crate::magnetic::MagneticSetting;
+use crate::{earth_rotation, ModelSettings, MODEL_KEYS};
 use flexdyn_kernel::numfmt::Num;
-use flexdyn_kernel::schema::{concat_keys, At, SchemaError, TableReader};
+use flexdyn_kernel::schema::{At, SchemaError, TableReader};
 use flexdyn_kernel::validate::MAX_DIPOLE_AM2;
 
-/// The keys of `[environment]` that switch the models on and give their parameters.
-const SWITCH_KEYS: [&str; 17] = [
-    "update_hz",
-    "telemetry_rate_hz",
-    "magnetic",
-    "magnetic_degree",
-    "atmosphere",
-    "f107_sfu",
-    "f107a_sfu",
-    "ap",
-    "sun",
-    "moon",
-    "shadow",
-    "albedo",
+pub(crate) use constants::{bounded, refuse_unused, unit_vector};
+
+/// The update's keys.
+const RATE_KEYS: [&str; 2] = ["update_hz", "telemetry_rate_hz"];
+
+/// The keys of the dynamic effectors the table switches on, and of the facets.
+const EFFECTOR_KEYS: [&str; 5] = [
     "gravity_gradient",
     "drag",
     "solar_pressure",
@@ -71,9 +65,58 @@ const SWITCH_KEYS: [&str; 17] = [
     "facets",
 ];
 
-/// The keys of `[environment]`: the switches, then the models' constants
-/// ([`constants::KEYS`]).
-pub const KEYS: [&str; 42] = concat_keys(SWITCH_KEYS, constants::KEYS);
+/// The groups of keys of `[environment]`, in the order an unknown key's message lists them:
+/// the rates, every registered model's, the effectors', the Earth's orientation's and the
+/// effectors' constants.
+const KEY_GROUPS: [&[&[&str]]; 3] = [
+    &[&RATE_KEYS],
+    MODEL_KEYS,
+    &[
+        &EFFECTOR_KEYS,
+        &earth_rotation::schema::KEYS,
+        &constants::KEYS,
+    ],
+];
+
+/// How many keys `groups` hold.
+const fn key_count(groups: &[&[&[&str]]]) -> usize {
+    let mut n = 0;
+    let mut i = 0;
+    while i < groups.len() {
+        let mut j = 0;
+        while j < groups[i].len() {
+            n += groups[i][j].len();
+            j += 1;
+        }
+        i += 1;
+    }
+    n
+}
+
+/// The keys of `groups`, one after the other.
+const fn flatten<const N: usize>(groups: &[&[&[&'static str]]]) -> [&'static str; N] {
+    let mut out = [""; N];
+    let mut n = 0;
+    let mut i = 0;
+    while i < groups.len() {
+        let mut j = 0;
+        while j < groups[i].len() {
+            let mut k = 0;
+            while k < groups[i][j].len() {
+                out[n] = groups[i][j][k];
+                n += 1;
+                k += 1;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    assert!(n == N, "flatten: N must be the number of keys");
+    out
+}
+
+/// The keys of `[environment]`.
+pub const KEYS: [&str; key_count(&KEY_GROUPS)] = flatten(&KEY_GROUPS);
 
 /// The keys of each `[[environment.facets]]`.
 pub(crate) const FACET_KEYS: [&str; 7] = [
@@ -89,7 +132,7 @@ pub(crate) const FACET_KEYS: [&str; 7] = [
 /// \[Hz\] default `update_hz`.
 pub const DEFAULT_UPDATE_HZ: f64 = 10.0;
 
-pub(super) fn invalid(t: &TableReader<'_, '_>, key: &str, message: String) -> SchemaError {
+pub(crate) fn invalid(t: &TableReader<'_, '_>, key: &str, message: String) -> SchemaError {
     SchemaError::InvalidValue {
         field: t.field(key),
         message,
@@ -97,7 +140,7 @@ pub(super) fn invalid(t: &TableReader<'_, '_>, key: &str, message: String) -> Sc
     }
 }
 
-fn choice<'c>(
+pub(crate) fn choice<'c>(
     t: &TableReader<'_, '_>,
     key: &str,
     choices: &[&'c str],
@@ -132,118 +175,8 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
     let update_ns = (1e9 / update_hz).round() as u64;
     // Checked against the frame rate (a whole number of frames) by the configuration.
     let telemetry_rate_hz = t.opt_f64("telemetry_rate_hz")?;
-    let magnetic = match choice(
-        t,
-        "magnetic",
-        &["igrf14", "dipole_tilted", "dipole_axial", "dipole", "off"],
-    )? {
-        "igrf14" => MagneticSetting::Igrf14 {
-            degree: match t.get("magnetic_degree") {
-                Some(_) => t.int_in("magnetic_degree", 1, IGRF_MAX_DEGREE as i64)? as usize,
-                None => IGRF_MAX_DEGREE,
-            },
-        },
-        other => {
-            if t.get("magnetic_degree").is_some() {
-                return Err(invalid(
-                    t,
-                    "magnetic_degree",
-                    format!(
-                        "only used by magnetic = \"igrf14\" (magnetic is \"{other}\"); remove it"
-                    ),
-                ));
-            }
-            match other {
-                "dipole" => MagneticSetting::GivenDipole(constants::given_dipole(t)?),
-                "dipole_tilted" => MagneticSetting::Dipole { tilted: true },
-                "dipole_axial" => MagneticSetting::Dipole { tilted: false },
-                _ => MagneticSetting::Off,
-            }
-        }
-    };
-    let weather_keys = ["f107_sfu", "f107a_sfu", "ap"];
-    let atmosphere = match choice(t, "atmosphere", &["exponential", "nrlmsise00", "off"])? {
-        "nrlmsise00" => {
-            let w = SpaceWeather {
-                f107_sfu: t.f64("f107_sfu")?,
-                f107a_sfu: t.f64("f107a_sfu")?,
-                ap: t.f64("ap")?,
-            };
-            let w = w.validated().map_err(|e| {
-                let msg = e.to_string();
-                let key = weather_keys
-                    .iter()
-                    .copied()
-                    .find(|k| msg.contains(k))
-                    .unwrap_or("f107_sfu");
-                invalid(t, key, msg)
-            })?;
-            AtmosphereSetting::Nrlmsise00(w)
-        }
-        other => {
-            if let Some(k) = weather_keys.iter().find(|k| t.get(k).is_some()) {
-                return Err(invalid(
-                    t,
-                    k,
-                    format!(
-                        "only used by atmosphere = \"nrlmsise00\" (atmosphere is \"{other}\"); \
-                         remove it"
-                    ),
-                ));
-            }
-            if other == "exponential" {
-                AtmosphereSetting::Exponential(constants::exponential(t)?)
-            } else {
-                AtmosphereSetting::Off
-            }
-        }
-    };
-    if !matches!(magnetic, MagneticSetting::GivenDipole(_)) {
-        constants::refuse_unused(t, &constants::DIPOLE_KEYS, "magnetic = \"dipole\"")?;
-    }
-    if !matches!(atmosphere, AtmosphereSetting::Exponential(_)) {
-        constants::refuse_unused(
-            t,
-            &constants::EXPONENTIAL_KEYS,
-            "atmosphere = \"exponential\"",
-        )?;
-    }
-    let sun = t.opt_bool("sun")?.unwrap_or(false);
-    let moon = t.opt_bool("moon")?.unwrap_or(false);
-    let shadow = match choice(t, "shadow", &["conical", "cylindrical", "off"])? {
-        "conical" => Some(ShadowModel::Conical),
-        "cylindrical" => Some(ShadowModel::Cylindrical),
-        _ => None,
-    };
-    if shadow.is_some() && !sun {
-        return Err(invalid(
-            t,
-            "shadow",
-            format!("a shadow needs the Sun: set {} = true", t.field("sun")),
-        ));
-    }
-    let albedo_on = match choice(t, "albedo", &["lambertian", "off"])? {
-        "lambertian" => {
-            if !sun {
-                return Err(invalid(
-                    t,
-                    "albedo",
-                    format!(
-                        "albedo is sunlight reflected by the Earth: set {} = true",
-                        t.field("sun")
-                    ),
-                ));
-            }
-            true
-        }
-        _ => false,
-    };
-    let albedo_coefficient = constants::albedo_coefficient(t, albedo_on)?;
-    let corotating_wind = constants::corotating_wind(t, atmosphere != AtmosphereSetting::Off)?;
-    let earth_rotation = constants::earth_rotation(t)?;
-    let sun_fixed_n_m = constants::sun_fixed(t, sun)?;
-    let (shadow_earth_radius_m, shadow_sun_radius_m) =
-        constants::shadow_radii(t, shadow.is_some())?;
+    let models = ModelSettings::read(t)?;
+    let earth_rotation = earth_rotation::schema::read(t)?;
     let facets = t
         .tables("facets", &FACET_KEYS)?
         .unwrap_or_default()
@@ -277,19 +210,21 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
     let gravity_gradient = t.opt_bool("gravity_gradient")?.unwrap_or(false);
     let drag = t.opt_bool("drag")?.unwrap_or(false);
     let solar_pressure = t.opt_bool("solar_pressure")?.unwrap_or(false);
-    let solar_irradiance_1au_w_m2 = constants::irradiance(t, solar_pressure || albedo_on)?;
+    let (irradiance_read, users) = models.irradiance_users();
+    let solar_irradiance_1au_w_m2 =
+        constants::irradiance(t, solar_pressure || irradiance_read, &users)?;
     let cannonball = constants::cannonball(t, solar_pressure)?;
     let residual_dipole_m_b_am2 = t
         .opt_floats::<3>("residual_dipole_m_b_am2")?
         .map(Vector3::from);
-    if drag && atmosphere == AtmosphereSetting::Off {
+    if drag && models.atmosphere.atmosphere == AtmosphereSetting::Off {
         return Err(invalid(
             t,
             "drag",
             format!("drag needs an atmosphere: set {}", t.field("atmosphere")),
         ));
     }
-    if solar_pressure && !sun {
+    if solar_pressure && !models.ephemeris.sun {
         return Err(invalid(
             t,
             "solar_pressure",
@@ -326,7 +261,7 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
             ),
         ));
     }
-    if residual_dipole_m_b_am2.is_some() && magnetic == MagneticSetting::Off {
+    if residual_dipole_m_b_am2.is_some() && models.magnetic == MagneticSetting::Off {
         return Err(invalid(
             t,
             "residual_dipole_m_b_am2",
@@ -341,16 +276,8 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
         update_hz,
         telemetry_rate_hz,
         telemetry_every_frames: None,
-        magnetic,
-        atmosphere,
-        sun,
-        sun_fixed_n_m,
+        models,
         earth_rotation,
-        corotating_wind,
-        moon,
-        shadow,
-        shadow_earth_radius_m,
-        shadow_sun_radius_m,
         facets,
         gravity_gradient,
         drag,
@@ -358,6 +285,19 @@ pub fn read(t: &TableReader<'_, '_>) -> Result<EnvironmentSettings, SchemaError>
         cannonball,
         solar_irradiance_1au_w_m2,
         residual_dipole_m_b_am2,
-        albedo_coefficient,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::KEYS;
+
+    #[test]
+    fn every_key_is_read_by_one_reader() {
+        for (i, k) in KEYS.iter().enumerate() {
+            assert!(!KEYS[..i].contains(k), "{k} twice");
+        }
+        // The rates' keys first, then the first model's.
+        assert_eq!(KEYS[..3], ["update_hz", "telemetry_rate_hz", "magnetic"]);
+    }
 }

@@ -55,8 +55,7 @@ use std::time::{Duration, Instant};
 
 use nalgebra::Vector3;
 
-use super::albedo::AlbedoCap;
-use super::EnvironmentSample;
+use super::{sample_from_words, sample_to_words, EnvironmentSample, SAMPLE_WORDS};
 
 /// \[m³/s²\] the Earth's gravitational parameter for the prediction (EGM-96 / WGS-84 value,
 /// NIMA TR8350.2, Table 3.4). Only the prediction's third-order term depends on its exact value.
@@ -126,65 +125,10 @@ impl Request {
 }
 
 const REQUEST_WORDS: usize = 7;
-/// The answer: the request it answers, then the sample.
-const ANSWER_WORDS: usize = REQUEST_WORDS + SAMPLE_WORDS;
-/// The sample's scalar and vector fields, then whether it has an albedo cap: the words every
-/// answer carries. The cap's words follow only when it has one, so that without albedo the slot
-/// moves as few words as before it.
-const SAMPLE_HEAD_WORDS: usize = 16;
-/// The head, then the albedo cap.
-const SAMPLE_WORDS: usize = SAMPLE_HEAD_WORDS + AlbedoCap::WORDS;
-
-/// Writes `s` into `w`; returns how many words it used (the head, and the cap's if it has one).
-fn sample_to_words(s: &EnvironmentSample, w: &mut [u64]) -> usize {
-    let b = |x: f64| x.to_bits();
-    let (bf, sun, moon, wind) = (s.b_field_n_t, s.r_sun_b_n_m, s.r_moon_b_n_m, s.wind_n_m_s);
-    w[..SAMPLE_HEAD_WORDS].copy_from_slice(&[
-        s.t_sim_ns,
-        b(bf.x),
-        b(bf.y),
-        b(bf.z),
-        b(sun.x),
-        b(sun.y),
-        b(sun.z),
-        b(moon.x),
-        b(moon.y),
-        b(moon.z),
-        b(s.shadow_factor),
-        b(s.density_kg_m3),
-        b(wind.x),
-        b(wind.y),
-        b(wind.z),
-        u64::from(s.albedo.is_some()),
-    ]);
-    match &s.albedo {
-        Some(cap) => {
-            let mut f = [0.0; AlbedoCap::WORDS];
-            cap.to_words(&mut f);
-            for (o, x) in w[SAMPLE_HEAD_WORDS..SAMPLE_WORDS].iter_mut().zip(f) {
-                *o = x.to_bits();
-            }
-            SAMPLE_WORDS
-        }
-        None => SAMPLE_HEAD_WORDS,
-    }
-}
-
-fn sample_from_words(w: &[u64]) -> EnvironmentSample {
-    let f = |i: usize| f64::from_bits(w[i]);
-    let v = |i: usize| Vector3::new(f(i), f(i + 1), f(i + 2));
-    EnvironmentSample {
-        t_sim_ns: w[0],
-        b_field_n_t: v(1),
-        r_sun_b_n_m: v(4),
-        r_moon_b_n_m: v(7),
-        shadow_factor: f(10),
-        density_kg_m3: f(11),
-        wind_n_m_s: v(12),
-        albedo: (w[15] != 0)
-            .then(|| AlbedoCap::from_words(&std::array::from_fn(|i| f(SAMPLE_HEAD_WORDS + i)))),
-    }
-}
+/// The answer: the request it answers, how many words of sample follow, then the sample (its
+/// time and each registered model's fields: [`crate::model::part::EnvironmentPart::to_words`]).
+/// Only the words a sample uses move, so that without albedo the slot does not move the cap's.
+const ANSWER_WORDS: usize = REQUEST_WORDS + 1 + SAMPLE_WORDS;
 
 /// No request outstanding (the slot's request words are the physics thread's to write).
 const IDLE: u8 = 0;
@@ -246,21 +190,19 @@ impl Slot {
         match self.state.load(Ordering::Acquire) {
             DONE => {
                 let mut w = [0u64; ANSWER_WORDS];
-                // The head first; the cap's words only when its flag (the head's last word)
-                // says the answer has one.
-                let head = REQUEST_WORDS + SAMPLE_HEAD_WORDS;
+                // The request and the sample's length first; then that many words.
+                let head = REQUEST_WORDS + 1;
                 for (x, cell) in w[..head].iter_mut().zip(&self.answer) {
                     *x = cell.load(Ordering::Relaxed);
                 }
                 if w[..REQUEST_WORDS] != req.to_words() {
                     return None;
                 }
-                if w[head - 1] != 0 {
-                    for (x, cell) in w[head..].iter_mut().zip(&self.answer[head..]) {
-                        *x = cell.load(Ordering::Relaxed);
-                    }
+                let end = head + (w[REQUEST_WORDS] as usize).min(SAMPLE_WORDS);
+                for (x, cell) in w[head..end].iter_mut().zip(&self.answer[head..end]) {
+                    *x = cell.load(Ordering::Relaxed);
                 }
-                Some(sample_from_words(&w[REQUEST_WORDS..]))
+                Some(sample_from_words(&w[head..end]))
             }
             REQUESTED => {
                 let _ = self.state.compare_exchange(
@@ -294,7 +236,9 @@ impl Slot {
         fill(&req, &mut sample);
         let mut words = [0u64; ANSWER_WORDS];
         words[..REQUEST_WORDS].copy_from_slice(&req.to_words());
-        let used = REQUEST_WORDS + sample_to_words(&sample, &mut words[REQUEST_WORDS..]);
+        let n = sample_to_words(&sample, &mut words[REQUEST_WORDS + 1..]);
+        words[REQUEST_WORDS] = n as u64;
+        let used = REQUEST_WORDS + 1 + n;
         for (cell, x) in self.answer.iter().zip(&words[..used]) {
             cell.store(*x, Ordering::Relaxed);
         }

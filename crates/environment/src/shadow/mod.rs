@@ -17,6 +17,11 @@
 //! boundary by at most 21 km of height, about 3 s of a low orbit's eclipse entry. Eclipses by the
 //! Moon are not modelled.
 
+pub mod part;
+pub mod schema;
+
+pub use schema::ShadowSetting;
+
 use nalgebra::Vector3;
 
 use super::ephemeris::SUN_RADIUS_M;

@@ -1,10 +1,11 @@
 //! The world sections of a configuration: `[epoch]`, `[orbit]` and `[environment]`.
 //!
 //! Their readers live with their models (`environment::epoch::schema`,
-//! `environment::orbit::schema`, `environment::model::schema`); this file registers them and
-//! runs the checks that need the rest of the file: `[orbit]` against `[initial]` and the gravity
-//! model, every dated model against `[epoch]`, the magnetic model's span against the epoch, and
-//! the gravity gradient against the gravity model. Without these sections nothing changes.
+//! `environment::orbit::schema`, `environment::model::schema`, which asks each registered
+//! environment model for its keys); this file registers them and runs the checks that need the
+//! rest of the file: `[orbit]` against `[initial]` and the gravity model, every dated model
+//! against `[epoch]`, the magnetic model's span against the epoch, and the gravity gradient
+//! against the gravity model. Without these sections nothing changes.
 
 use std::path::Path;
 
@@ -13,10 +14,7 @@ use flexdyn_environment::epoch::schema::{self as epoch_schema, RawEpoch};
 use flexdyn_environment::epoch::SimEpoch;
 use flexdyn_environment::geodetic::WGS84_A_M;
 use flexdyn_environment::model::schema as env_schema;
-use flexdyn_environment::model::{
-    AtmosphereSetting, EnvironmentBuildError, EnvironmentModel, EnvironmentSettings,
-    MagneticSetting,
-};
+use flexdyn_environment::model::{EnvironmentBuildError, EnvironmentModel, EnvironmentSettings};
 use flexdyn_environment::orbit::schema::{self as orbit_schema, InitialOrbit, RawOrbit};
 use flexdyn_kernel::schema::{SchemaError, TableReader};
 
@@ -176,15 +174,7 @@ impl RawWorld {
                 }
                 match &epoch {
                     None if env.needs_epoch() => {
-                        let field = [
-                            ("magnetic", env.magnetic != MagneticSetting::Off),
-                            ("atmosphere", env.atmosphere != AtmosphereSetting::Off),
-                            ("sun", env.sun),
-                            ("moon", env.moon),
-                        ]
-                        .iter()
-                        .find(|(_, on)| *on)
-                        .map_or("environment", |(k, _)| k);
+                        let field = env.dated_model().unwrap_or("environment");
                         return Err(needs_epoch(
                             &format!("environment.{field}"),
                             &format!("environment.{field}"),

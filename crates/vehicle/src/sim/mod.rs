@@ -431,12 +431,12 @@ impl Simulation {
         let mut flags = 0;
         for (bit, is_on) in [
             (f::EPOCH_VALID, self.epoch.is_some()),
-            (f::MAGNETIC, on.magnetic),
-            (f::SUN, on.sun),
-            (f::MOON, on.moon),
-            (f::SHADOW, on.shadow),
-            (f::ATMOSPHERE, on.atmosphere),
-            (f::ALBEDO, on.albedo),
+            (f::MAGNETIC, on.is_on("magnetic")),
+            (f::SUN, on.is_on("sun")),
+            (f::MOON, on.is_on("moon")),
+            (f::SHADOW, on.is_on("shadow")),
+            (f::ATMOSPHERE, on.is_on("atmosphere")),
+            (f::ALBEDO, on.is_on("albedo")),
         ] {
             if is_on {
                 flags |= bit;
