@@ -49,9 +49,10 @@ struct Run {
 fn acs_full_50hz() -> (SimConfig, Source) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/acs_full.toml");
     let mut source = Source::of(Some(&path)).expect("scenarios/acs_full.toml");
-    source.text = source
-        .text
-        .replacen("frame_hz = 10.0 ", &format!("frame_hz = {FRAME_HZ:.1} "), 1);
+    source.text =
+        source
+            .text
+            .replacen("frame_hz = 10.0 ", &format!("frame_hz = {FRAME_HZ:.1} "), 1);
     let cfg = source.config().expect("acs_full at 50 Hz");
     assert_eq!(cfg.frame_ns, 20_000_000, "the frame is 50 Hz");
     (cfg, source)
