@@ -120,3 +120,24 @@ fn bad_chain_entries_are_named() {
         assert!(e.contains(field), "{field}: {e}");
     }
 }
+
+/// A chain may not take a pair's name: both are drawn as `<name>/panel<k>` in the 3D scene.
+#[test]
+fn a_chain_named_like_a_pair_is_refused() {
+    let reference =
+        std::fs::read_to_string(format!("{}/scenarios/reference.toml", crate::REPO)).unwrap();
+    let text = scenario();
+    let chains = &text[text.find("\n[[panel_chains]]").unwrap()..];
+    // The reference's pairs are wing_px and wing_mx; so are the chain scenario's chains.
+    let e = SimConfig::from_toml_str(&format!("{reference}\n{chains}"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("panel_chains[0].name") && e.contains("`wing_px` is also a panel pair's name"),
+        "{e}"
+    );
+    let renamed = chains
+        .replace("\"wing_px\"", "\"boom_px\"")
+        .replace("\"wing_mx\"", "\"boom_mx\"");
+    SimConfig::from_toml_str(&format!("{reference}\n{renamed}")).unwrap();
+}

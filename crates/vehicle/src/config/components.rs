@@ -38,11 +38,13 @@ pub(super) fn read(root: &TableReader<'_, '_>) -> Result<Vec<Box<dyn ComponentSp
     Ok(items)
 }
 
-/// Validates every component for `timing`; errors name the entry and the field.
+/// Validates every component for `timing`; errors name the entry and the field. `pair_names`
+/// are the `[[panel_pairs]]` names, which a chain may not take.
 pub(super) fn resolve(
     items: Vec<Box<dyn ComponentSpec>>,
     map: &SourceMap,
     timing: StepTiming,
+    pair_names: &HashSet<String>,
 ) -> Result<Components, ConfigError> {
     let components = Components::new(items);
     let mut names = HashSet::new();
@@ -54,6 +56,22 @@ pub(super) fn resolve(
         }
         unique_name(map, &path, c.name(), &mut names, c.kind().noun)?;
         c.validate(&path, timing).map_err(|e| map.param_error(e))?;
+    }
+    // Pairs and chains share the 3D scene's frame ids (`<name>/panel<k>`): one name each.
+    for (path, c) in components
+        .with_paths()
+        .filter(|(_, c)| c.kind().section == "panel_chains")
+    {
+        if pair_names.contains(c.name()) {
+            return Err(map.invalid(
+                &format!("{path}.name"),
+                format!(
+                    "`{}` is also a panel pair's name: pairs and chains share the view's \
+                     frame ids (`<name>/panel<k>`), so each needs its own name",
+                    c.name()
+                ),
+            ));
+        }
     }
     // Every entry another names (a thruster's `tank`) exists.
     for (path, c) in components.with_paths() {

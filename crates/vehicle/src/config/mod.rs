@@ -691,7 +691,7 @@ impl RawConfig {
         }
         // The generic sections: [[magnetorquers]], [[thrusters]], …
         let timing = StepTiming { step_ns, frame_ns };
-        let components = components::resolve(self.components, map, timing)?;
+        let components = components::resolve(self.components, map, timing, &names)?;
         check_wire_capacity(map, panel_pairs.len(), &reaction_wheels, &components)?;
 
         // [[wrench_schedule]]
