@@ -83,15 +83,12 @@ pub fn parse<'a>(
 /// Writes the checkpoint of `world` to `file`: beside it first, then renamed over it.
 pub fn write(file: &Path, header: &CheckpointHeader, world: &mut World) -> Result<(), CliError> {
     let bytes = checkpoint::save(header, world).map_err(|e| error(file, e))?;
-    let output = |source| CliError::Output {
+    // Not synced, as before: an offline run's checkpoint is written once, and a file a crash
+    // damaged is refused by its checksum.
+    checkpoint::write_file(file, &bytes, false).map_err(|source| CliError::Output {
         target: format!("checkpoint `{}`", file.display()),
         source,
-    };
-    let mut part = file.as_os_str().to_owned();
-    part.push(".part");
-    let part = PathBuf::from(part);
-    std::fs::write(&part, &bytes).map_err(output)?;
-    std::fs::rename(&part, file).map_err(output)
+    })
 }
 
 /// Restores checkpoint `c` (read from `file`) into `world`, freshly built; the step it is at.

@@ -213,10 +213,9 @@ impl Checkpointer {
     #[cold]
     fn take(&mut self, world: &mut WorldStepper, k: u64, cli: bool, operator: bool) {
         let started = Instant::now();
-        let mut header = self.header.clone();
-        header.tick = k;
-        header.t_sim_ns = world.sim_time_ns();
-        let bytes = checkpoint::list_with(&header, |a| list(world, a));
+        self.header.tick = k;
+        self.header.t_sim_ns = world.sim_time_ns();
+        let bytes = checkpoint::list_with(&self.header, |a| list(world, a));
         let list_ns = u64::try_from(started.elapsed().as_nanos()).unwrap_or(u64::MAX);
         self.stats.max_list_ns.fetch_max(list_ns, Ordering::Relaxed);
         let mut files = Vec::with_capacity(2);
@@ -268,7 +267,7 @@ impl Writer {
     /// Starts the writer thread, and the stepping thread's side for a run of `front_end` whose
     /// files are named after `stem` (the spacecraft id, or `fleet`), with the step and frame
     /// `(step_ns, frame_ns)`; `sync`: each file is synced to the disk before it is renamed into
-    /// place ([`write_file`]).
+    /// place ([`checkpoint::write_file`]).
     pub fn start(
         settings: &CheckpointSettings,
         (front_end, stem): (&str, &str),
@@ -347,7 +346,11 @@ fn write_all(rx: &Receiver<Job>, stats: &CheckpointStats, sync: bool) {
         let written = bytes
             .map(checkpoint::seal)
             .map_err(|e| e.to_string())
-            .and_then(|b| write_file(&file, &b, sync).map(|()| b.len()));
+            .and_then(|b| {
+                checkpoint::write_file(&file, &b, sync)
+                    .map(|()| b.len())
+                    .map_err(|e| e.to_string())
+            });
         match written {
             Ok(len) => {
                 stats.written.fetch_add(1, Ordering::Relaxed);
@@ -359,31 +362,4 @@ fn write_all(rx: &Receiver<Job>, stats: &CheckpointStats, sync: bool) {
             }
         }
     }
-}
-
-/// Writes `bytes` beside `file`, then renames it over. `sync`: flushed to the disk before the
-/// rename (not in real time, where a sync's I/O measurably delayed the physics thread's
-/// boundaries on the development machine; a file a crash damaged is refused by its checksum).
-fn write_file(file: &Path, bytes: &[u8], sync: bool) -> Result<(), String> {
-    use std::io::Write;
-    let mut part = file.as_os_str().to_owned();
-    part.push(".part");
-    let part = PathBuf::from(part);
-    let written = std::fs::File::create(&part)
-        .and_then(|mut f| {
-            f.write_all(bytes)?;
-            if sync {
-                f.sync_all()?;
-            }
-            Ok(())
-        })
-        .map_err(|e| format!("cannot write `{}`: {e}", part.display()))
-        .and_then(|()| {
-            std::fs::rename(&part, file)
-                .map_err(|e| format!("cannot rename `{}`: {e}", part.display()))
-        });
-    if written.is_err() {
-        let _ = std::fs::remove_file(&part);
-    }
-    written
 }

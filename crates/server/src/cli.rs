@@ -259,37 +259,18 @@ fn checkpoint_settings(args: &RunArgs) -> Result<(SimConfig, CheckpointSettings)
             source,
         }
     };
-    let resumed = args
-        .resume
-        .as_deref()
-        .map(|f| checkpoint::read(f, checkpoint::FRONT_END))
-        .transpose()?;
-    let saves = args.checkpoint_at_tick.is_some() || args.checkpoint_dir.is_some();
+    let resumed = resumed(args, checkpoint::FRONT_END)?;
     let source = match (&resumed, file) {
         (Some((_, header)), None) => Source::recorded(header),
         (Some(_), Some(_)) => Source::of(file).map_err(config_error(args.config.clone()))?,
-        (None, _) if saves => Source::of(file).map_err(config_error(args.config.clone()))?,
+        (None, _) if saves(args) => Source::of(file).map_err(config_error(args.config.clone()))?,
         (None, _) => Source::default(),
     };
     let cfg = match (&resumed, file) {
         (Some(_), None) => source.config().map_err(config_error(source.file()))?,
         _ => load_config(file).map_err(config_error(args.config.clone()))?,
     };
-    if let Some((r, header)) = &resumed {
-        if CheckpointHeader::digest(&source.text) != header.source_sha256 {
-            tracing::warn!(
-                checkpoint = %r.file.display(),
-                "resuming with a configuration that differs from the one it was taken with: a fork"
-            );
-        }
-    }
-    let checkpoints = CheckpointSettings {
-        save_at: args.checkpoint_at_tick.zip(args.checkpoint.clone()),
-        dir: args.checkpoint_dir.clone(),
-        source,
-        resume: resumed.map(|(r, _)| r),
-    };
-    Ok((cfg, checkpoints))
+    Ok((cfg, with_source(args, resumed, source)))
 }
 
 /// The checkpoint settings of a fleet server (`--fleet FILE`): its checkpoints record the fleet
@@ -298,13 +279,8 @@ pub(super) fn fleet_checkpoint_settings(
     args: &RunArgs,
     fleet_file: &std::path::Path,
 ) -> Result<CheckpointSettings, ServerError> {
-    let resumed = args
-        .resume
-        .as_deref()
-        .map(|f| checkpoint::read(f, checkpoint::FRONT_END_FLEET))
-        .transpose()?;
-    let saves = args.checkpoint_at_tick.is_some() || args.checkpoint_dir.is_some();
-    let source = if resumed.is_some() || saves {
+    let resumed = resumed(args, checkpoint::FRONT_END_FLEET)?;
+    let source = if resumed.is_some() || saves(args) {
         Source::of(Some(fleet_file)).map_err(|source| ServerError::Config {
             file: Some(fleet_file.to_path_buf()),
             source,
@@ -312,24 +288,45 @@ pub(super) fn fleet_checkpoint_settings(
     } else {
         Source::default()
     };
-    note_fork(resumed.as_ref(), &source);
-    Ok(CheckpointSettings {
-        save_at: args.checkpoint_at_tick.zip(args.checkpoint.clone()),
-        dir: args.checkpoint_dir.clone(),
-        source,
-        resume: resumed.map(|(r, _)| r),
-    })
+    Ok(with_source(args, resumed, source))
 }
 
-/// Logs a resume whose configuration differs from the checkpoint's: a fork.
-fn note_fork(resumed: Option<&(checkpoint::Resumed, CheckpointHeader)>, source: &Source) {
-    if let Some((r, header)) = resumed {
+/// `--resume`'s checkpoint, read and checked for `front_end`, with its header.
+fn resumed(
+    args: &RunArgs,
+    front_end: &str,
+) -> Result<Option<(checkpoint::Resumed, CheckpointHeader)>, ServerError> {
+    args.resume
+        .as_deref()
+        .map(|f| checkpoint::read(f, front_end))
+        .transpose()
+}
+
+/// Whether the run may save a checkpoint (`--checkpoint-at-tick` or `--checkpoint-dir`).
+fn saves(args: &RunArgs) -> bool {
+    args.checkpoint_at_tick.is_some() || args.checkpoint_dir.is_some()
+}
+
+/// The checkpoint settings of `args` for a run of configuration `source`; a resume whose
+/// configuration differs from the checkpoint's is logged as a fork.
+fn with_source(
+    args: &RunArgs,
+    resumed: Option<(checkpoint::Resumed, CheckpointHeader)>,
+    source: Source,
+) -> CheckpointSettings {
+    if let Some((r, header)) = &resumed {
         if CheckpointHeader::digest(&source.text) != header.source_sha256 {
             tracing::warn!(
                 checkpoint = %r.file.display(),
                 "resuming with a configuration that differs from the one it was taken with: a fork"
             );
         }
+    }
+    CheckpointSettings {
+        save_at: args.checkpoint_at_tick.zip(args.checkpoint.clone()),
+        dir: args.checkpoint_dir.clone(),
+        source,
+        resume: resumed.map(|(r, _)| r),
     }
 }
 

@@ -271,6 +271,30 @@ pub fn seal(mut listed: Vec<u8>) -> Vec<u8> {
     listed
 }
 
+/// Writes a checkpoint file's `bytes` to `file`: beside it first (`<file>.part`, removed again
+/// if anything fails), then renamed over it, so a reader never sees half of one. `sync`: the
+/// bytes reach the disk before the rename (a server in real time does without: a sync's I/O
+/// delayed its boundaries, and a file a crash damaged is refused by its checksum).
+pub fn write_file(file: &std::path::Path, bytes: &[u8], sync: bool) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut part = file.as_os_str().to_owned();
+    part.push(".part");
+    let part = std::path::PathBuf::from(part);
+    let written = std::fs::File::create(&part)
+        .and_then(|mut f| {
+            f.write_all(bytes)?;
+            if sync {
+                f.sync_all()?;
+            }
+            Ok(())
+        })
+        .and_then(|()| std::fs::rename(&part, file));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&part);
+    }
+    written
+}
+
 /// A checkpoint's bytes, checked (magic, version, length, checksum, protocol) and split into
 /// its header and its world state.
 #[derive(Debug)]

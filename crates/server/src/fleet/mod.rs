@@ -339,13 +339,12 @@ pub async fn run(
         .vehicles
         .first()
         .map_or(1, |v| v.stepper.sim.step_ns());
-    let (writer, checkpointer) = super::start_checkpoints(
+    let (writer, mut checkpointer) = super::start_checkpoints(
         &settings,
         (super::checkpoint::FRONT_END_FLEET, "fleet"),
         (step_ns, frame_ns),
         total_frames,
     )?;
-    let mut checkpointer = Some(checkpointer).flatten();
     let start_tick = settings.checkpoints.start_tick();
     let mut keep = Vec::with_capacity(parts.len());
     let mut alive = Vec::new();
