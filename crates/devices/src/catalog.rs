@@ -28,7 +28,7 @@ use flexdyn_proto::client::vehicle::VehicleConfig;
 use flexdyn_proto::{effector_kind, fss_flags, gps_flags, EffectorInput};
 
 /// Where each group's channels start in the value array, by sensor kind, in configuration order.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct VehicleCatalog {
     catalog: Catalog,
     imus: Vec<(usize, usize)>,
@@ -53,9 +53,16 @@ impl VehicleCatalog {
         let frame_ns = (1e9 / cfg.simulation.frame_hz).round() as u64;
         let mut c = Self {
             catalog: Catalog::new(frame_ns),
-            ..Self::default()
+            imus: Vec::new(),
+            trackers: Vec::new(),
+            magnetometers: Vec::new(),
+            css: Vec::new(),
+            fss: Vec::new(),
+            gps: Vec::new(),
+            wheels: Vec::new(),
+            input_effectors: Vec::new(),
         };
-        let mut add = |cat: &mut Catalog, group: String, fields: Vec<(String, &'static str)>| {
+        let add = |cat: &mut Catalog, group: String, fields: Vec<(String, &'static str)>| {
             let f: Vec<(&str, &str)> = fields.iter().map(|(n, u)| (n.as_str(), *u)).collect();
             let first = cat.channel_count();
             (cat.add_group(&group, &f), first)

@@ -19,7 +19,8 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use flexdyn_gateway::device::{Device, DeviceCounters, DeviceSet, TickTime, Utc};
+use flexdyn_gateway::device::engine::Behaviour;
+use flexdyn_gateway::device::{Device, DeviceCounters, DeviceSet, EndpointSpec, TickTime, Utc};
 use flexdyn_proto::client::lockstep::Tick;
 use flexdyn_proto::{time_flags, TimeMsg};
 
@@ -62,6 +63,8 @@ pub struct DeviceReport {
     pub name: String,
     /// Where its driver found it.
     pub endpoint: String,
+    /// Its messages' names, in the order of `engine.frames_in`.
+    pub messages: Vec<String>,
     /// Frames in and out, and malformed input by reason.
     pub engine: DeviceCounters,
     /// What became of its output frames.
@@ -97,10 +100,13 @@ impl Gateway {
         for device in set.devices {
             let endpoint = Endpoint::open(device.endpoint(), link_dir)
                 .map_err(|e| (device.name().to_owned(), e))?;
-            let baud = device.baud();
+            let baud = match device.endpoint() {
+                EndpointSpec::Pty { baud, .. } => *baud,
+                _ => None,
+            };
             out_len = out_len.max(device.max_output_len());
             slots.push(Slot {
-                binary: device.is_binary(),
+                binary: matches!(device.behaviour(), Behaviour::Binary(_)),
                 outbox: Outbox::new(OUTBOX_BYTES.max(4 * device.max_output_len()), baud),
                 device,
                 endpoint,
@@ -156,7 +162,7 @@ impl Gateway {
                     Pacing::Lockstep => arrived,
                     Pacing::RealTime => arrived + Duration::from_nanos(s.device.latency_ns()),
                 };
-                s.outbox.push(&self.out, at);
+                s.outbox.push(&self.out, at, pacing == Pacing::RealTime);
             }
             s.outbox.flush(Instant::now(), &mut s.endpoint)?;
         }
@@ -202,7 +208,8 @@ impl Gateway {
                         &mut self.out,
                     );
                     if !self.out.is_empty() {
-                        s.outbox.push(&self.out, Instant::now());
+                        // Lockstep: an answer goes at once (no latency, no baud timing).
+                        s.outbox.push(&self.out, Instant::now(), false);
                         s.outbox.flush(Instant::now(), &mut s.endpoint)?;
                     }
                     *owe = owe.saturating_sub(taken.due_received);
@@ -241,12 +248,14 @@ impl Gateway {
                 .filter(|(_, o)| **o > 0)
                 .filter_map(|(s, _)| s.endpoint.fd())
                 .collect();
-            // A TCP device without a connection has only its listener: look again soon.
-            poll_any(&fds, wait_ms.clamp(1, 50)).map_err(std::io::Error::from)?;
+            // A TCP device without a connection has only its listener, and a full line holds a
+            // frame back: look again soon.
+            poll_any(&fds, wait_ms.clamp(1, 10)).map_err(std::io::Error::from)?;
             for (s, o) in self.slots.iter_mut().zip(&owed) {
                 if *o > 0 {
                     s.endpoint.driver_present(s.binary);
                 }
+                s.outbox.flush(Instant::now(), &mut s.endpoint)?;
             }
         }
     }
@@ -269,7 +278,7 @@ impl Gateway {
                     &mut self.out,
                 );
                 if !self.out.is_empty() {
-                    s.outbox.push(&self.out, Instant::now());
+                    s.outbox.push(&self.out, Instant::now(), true);
                 }
             }
             s.outbox.flush(Instant::now(), &mut s.endpoint)?;
@@ -320,6 +329,7 @@ impl Gateway {
             .map(|s| DeviceReport {
                 name: s.device.name().to_owned(),
                 endpoint: s.endpoint.describe(),
+                messages: s.device.message_names().to_vec(),
                 engine: s.device.counters().clone(),
                 line: s.outbox.counters(),
                 late_ticks: s.late_ticks,

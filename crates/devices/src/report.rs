@@ -58,19 +58,43 @@ pub fn toml(devices: &[DeviceReport], commands_sent: u64) -> String {
     s
 }
 
-/// Every counter of a device, by name.
+/// Every counter of a device, by name: frames in by message (`in_<message>`), the framing's
+/// and the engine's rejections by reason (`rejected_<reason>`), the line's fate of each frame.
 fn counters(d: &DeviceReport) -> Vec<(String, u64)> {
-    let mut c: Vec<(String, u64)> = d
-        .engine
-        .named()
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v))
-        .collect();
-    c.push(("line_frames_sent".into(), d.line.frames_sent));
-    c.push(("line_bytes_sent".into(), d.line.bytes_sent));
-    c.push(("line_frames_unheard".into(), d.line.frames_unheard));
-    c.push(("line_frames_dropped_full".into(), d.line.frames_dropped_full));
-    c.push(("late_ticks".into(), d.late_ticks));
-    c.push(("missing_inputs".into(), d.missing_inputs));
+    let e = &d.engine;
+    let f = &e.framing;
+    let mut c: Vec<(String, u64)> = vec![("frames_out".into(), e.frames_out)];
+    c.extend(
+        d.messages
+            .iter()
+            .zip(&e.frames_in)
+            .map(|(m, n)| (format!("in_{m}"), *n)),
+    );
+    for (k, v) in [
+        ("framed", f.frames),
+        ("garbage_bytes", f.garbage_bytes),
+        ("rejected_checksum", f.bad_checksum),
+        ("rejected_length_field", f.bad_length),
+        ("rejected_oversize", f.oversize),
+        ("rejected_escape", f.bad_escape),
+        ("rejected_encoding", f.bad_encoding),
+        ("rejected_aborted", f.aborted),
+        ("rejected_unknown_id", e.unknown_id),
+        ("rejected_not_an_input", e.unknown_request),
+        ("rejected_payload_length", e.bad_length),
+        ("rejected_constant", e.bad_constant),
+        ("rejected_non_finite", e.bad_value),
+        ("rejected_total", e.rejected_frames()),
+        ("clamped", e.clamped),
+        ("unsendable", e.unsendable),
+        ("line_frames_sent", d.line.frames_sent),
+        ("line_bytes_sent", d.line.bytes_sent),
+        ("line_frames_unheard", d.line.frames_unheard),
+        ("line_frames_dropped_full", d.line.frames_dropped_full),
+        ("late_ticks", d.late_ticks),
+        ("missing_inputs", d.missing_inputs),
+    ] {
+        c.push((k.to_owned(), v));
+    }
     c
 }

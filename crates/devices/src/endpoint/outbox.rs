@@ -57,9 +57,9 @@ impl Outbox {
         }
     }
 
-    /// Queues `frame`, to go no sooner than `earliest` (and, on a line with a baud rate, once
-    /// its bytes would have crossed the line after those before it).
-    pub fn push(&mut self, frame: &[u8], earliest: Instant) {
+    /// Queues `frame`, to go no sooner than `earliest` and, when `paced` (real time) on a line
+    /// with a baud rate, once its bytes would have crossed the line after those before it.
+    pub fn push(&mut self, frame: &[u8], earliest: Instant, paced: bool) {
         if frame.is_empty() {
             return;
         }
@@ -68,7 +68,7 @@ impl Outbox {
             return;
         }
         let at = match self.baud {
-            Some(b) if b > 0 => {
+            Some(b) if b > 0 && paced => {
                 let start = self.line_free_at.map_or(earliest, |f| f.max(earliest));
                 let ns = frame.len() as u64 * BITS_PER_BYTE * 1_000_000_000 / u64::from(b);
                 let done = start + Duration::from_nanos(ns);
