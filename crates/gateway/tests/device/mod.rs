@@ -6,6 +6,7 @@ mod examples;
 mod loader;
 mod malformed;
 mod round_trip;
+mod units_time;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
