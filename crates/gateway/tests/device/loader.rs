@@ -202,13 +202,16 @@ fn messages_that_cannot_work_are_refused() {
         problem.contains("`nothing`") && problem.contains("[q]"),
         "{problem}"
     );
-    // Two messages with one id.
+    // Two in-messages with one id (an in- and an out-message may share one: a reply may carry
+    // its request's id).
     let d = format!(
         "{}\n[[message]]\nname = \"cmd\"\ndirection = \"in\"\nid = 1\n",
         tracker(SYNC, PERIODIC, Q0)
     );
+    load(&d).unwrap();
+    let d = format!("{d}\n[[message]]\nname = \"cmd2\"\ndirection = \"in\"\nid = 1\n");
     let (_, key, _) = invalid(load(&d));
-    assert_eq!(key, "message[1].id");
+    assert_eq!(key, "message[2].id");
     // An out-message that is never sent.
     let (_, key, problem) = invalid(load(&tracker(SYNC, "", Q0)));
     assert_eq!(key, "message[0]");
