@@ -277,3 +277,57 @@ fn shipped_devices_declare_lockstep_inputs_latency_and_room() {
     assert_eq!(st1.max_output_len(), (1 + 4096 / 6) * 33);
     assert!(devices["gps1"].max_output_len() >= 3 * 82);
 }
+
+#[test]
+fn validate_gga_position_of_the_classic_example() {
+    // The textbook GGA (NMEA Revealed; DePriest): 4807.038,N 01131.000,E, 545.4 m. The ECEF
+    // position comes from the closed-form forward map (NIMA TR8350.2 eq. 4-14), independent
+    // of the receiver's inverse (Bowring's iteration).
+    use flexdyn_environment::geodetic::{ecef_from_geodetic, Geodetic};
+    let r = ecef_from_geodetic(&Geodetic {
+        lat_rad: (48.0 + 7.038 / 60.0_f64).to_radians(),
+        lon_rad: (11.0 + 31.0 / 60.0_f64).to_radians(),
+        height_m: 545.4,
+    });
+    let cat = catalog();
+    let mut devices = shipped(&cat);
+    let gps1 = devices.get_mut("gps1").unwrap();
+    let v = values(
+        &cat,
+        &[
+            ("gps.gps1.r_be_e_m[0]", r.x),
+            ("gps.gps1.r_be_e_m[1]", r.y),
+            ("gps.gps1.r_be_e_m[2]", r.z),
+            ("gps.gps1.valid", 1.0),
+        ],
+    );
+    let mut out = Vec::new();
+    gps1.emit_due(&tick_time(0), &v, &[], &mut out);
+    let text = String::from_utf8(out).unwrap();
+    assert!(
+        text.starts_with("$GPGGA,120000.00,4807.0380,N,01131.0000,E,1,08,1.0,545.4,M,0.0,M,,*"),
+        "{text}"
+    );
+}
+
+#[test]
+fn the_answer_counter_wraps_at_its_fields_width() {
+    let cat = catalog();
+    let mut devices = shipped(&cat);
+    let st1 = devices.get_mut("st1").unwrap();
+    let v = values(&cat, &[]);
+    let mut commands = vec![0.0; cat.input_count()];
+    let mut out = Vec::new();
+    // 258 answers: counters 0, 1, …, 255, 0, 1 (a u8 field).
+    for _ in 0..258 {
+        out.clear();
+        st1.take_bytes(
+            &tracker_frame(&[0x01]),
+            &tick_time(0),
+            &v,
+            &mut commands,
+            &mut out,
+        );
+    }
+    assert_eq!(out[3 + 27], 1);
+}
