@@ -33,7 +33,7 @@ use crate::ByteOrder;
 pub struct Built {
     /// The engine.
     pub behaviour: Behaviour,
-    /// [ns] declared output latency.
+    /// \[ns\] declared output latency.
     pub latency_ns: u64,
     /// Lockstep time-out.
     pub timeout: Duration,
