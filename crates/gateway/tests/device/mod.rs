@@ -195,3 +195,11 @@ fn the_bitwise_oracles_give_the_published_check_values() {
     assert_eq!(crc16_ccitt_false(b"123456789"), 0x29B1);
     assert_eq!(crc16_kermit(b"123456789"), 0x2189);
 }
+
+#[test]
+fn devices_can_move_to_the_runtimes_threads() {
+    fn send<T: Send + 'static>() {}
+    send::<Device>();
+    send::<DeviceSet>();
+    send::<Catalog>();
+}
