@@ -170,5 +170,23 @@ fn a_ccsds_telecommand_is_read_by_its_apid() {
     );
     assert_eq!(d.counters().unknown_id, 1);
     assert_eq!(d.counters().bad_constant, 1);
+    // Garbage (version bits not 000) and a packet whose CRC is off by one bit: counted, the
+    // command not applied.
+    let mut bad = vec![0x10, 0x55, 0xC0, 0x03, 0x00, 0x03, 0x00, 0x01];
+    let crc = super::crc16_ccitt_false(&bad) ^ 0x0100;
+    bad.extend_from_slice(&crc.to_be_bytes());
+    let mut stream = vec![0xE0, 0xFF, 0x20];
+    stream.extend(&bad);
+    d.take_bytes(&stream, &tick_time(0), &[], &mut commands, &mut out);
+    let framing = d.counters().framing;
+    assert_eq!(framing.bad_checksum, 1);
+    // With no sync marker the decoder searches the rejected packet's octets for a header: the
+    // bad CRC is 0x8729, so after its first octet (0x10) come 55 C0 (version bits 010, 110:
+    // garbage), then 03 00 03 00 01 87 and 00 03 00 01 87 29, headers of 398 and 34 608
+    // octets (oversize, above the 10 of this device's longest packet), and 03 00 01 87 29,
+    // five octets waiting for a sixth.
+    assert_eq!(framing.garbage_bytes, 3 + 2);
+    assert_eq!(framing.oversize, 2);
     assert!((commands[dipole] + 1.5).abs() < 1e-12);
+    assert!(out.is_empty());
 }
