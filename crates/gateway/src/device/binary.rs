@@ -200,18 +200,23 @@ impl BinaryDevice {
                 },
                 None => None,
             };
-            let Some(index) = messages.iter().position(|m| {
+            let selects = |m: &Message| {
                 (id.is_none() || m.id == id)
                     && (unwrapped.apid.is_none() || m.apid == unwrapped.apid)
-            }) else {
-                counters.unknown_id += 1;
+            };
+            // An in-message first: a reply may carry its request's id.
+            let Some(index) = messages
+                .iter()
+                .position(|m| m.direction == Direction::In && selects(m))
+            else {
+                if messages.iter().any(selects) {
+                    counters.unknown_request += 1;
+                } else {
+                    counters.unknown_id += 1;
+                }
                 return;
             };
             let message = &mut messages[index];
-            if message.direction == Direction::Out {
-                counters.unknown_request += 1;
-                return;
-            }
             match message.decode(unwrapped.payload) {
                 Err(Reject::BadLength) => counters.bad_length += 1,
                 Err(Reject::BadConstant) => counters.bad_constant += 1,

@@ -47,7 +47,7 @@ pub struct Catalog {
 }
 
 impl Catalog {
-    /// An empty catalog for a server whose frame period is `frame_ns` [ns].
+    /// An empty catalog for a server whose frame period is `frame_ns` \[ns\].
     pub fn new(frame_ns: u64) -> Self {
         Self {
             frame_ns,
@@ -57,7 +57,7 @@ impl Catalog {
         }
     }
 
-    /// [ns] The frame period: a periodic output's period must be a whole number of frames.
+    /// \[ns\] The frame period: a periodic output's period must be a whole number of frames.
     pub fn frame_ns(&self) -> u64 {
         self.frame_ns
     }

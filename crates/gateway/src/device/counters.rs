@@ -8,7 +8,8 @@ use crate::framing::DecodeCounters;
 pub struct DeviceCounters {
     /// Frames written to the driver (outputs and responses).
     pub frames_out: u64,
-    /// Frames accepted from the driver, by message index ([`crate::device::Device::message_names`]).
+    /// Frames accepted from the driver, by message index
+    /// ([`crate::device::Device::message_names`]).
     pub frames_in: Vec<u64>,
     /// The framing layer's tallies: frames delimited, garbage octets, and frames rejected for a
     /// bad check, bad length field, oversize, bad escape, bad encoding or abort.

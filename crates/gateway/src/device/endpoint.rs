@@ -12,7 +12,7 @@ pub enum EndpointSpec {
     Pty {
         /// Path of the symlink.
         link: PathBuf,
-        /// [bit/s] line rate.
+        /// \[bit/s\] line rate.
         baud: Option<u32>,
     },
     /// A TCP server the driver connects to.

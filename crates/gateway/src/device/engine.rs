@@ -155,7 +155,7 @@ impl Device {
         self.timeout
     }
 
-    /// Real time: [ns] the declared output latency.
+    /// Real time: \[ns\] the declared output latency.
     pub fn latency_ns(&self) -> u64 {
         self.latency_ns
     }

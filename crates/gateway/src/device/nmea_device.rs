@@ -29,9 +29,9 @@ use crate::framing::lines::LineDecoder;
 use crate::framing::StreamDecoder;
 use crate::nmea::{FixQuality, Gga, Mode, NmeaStyle, Rmc, Zda};
 
-/// [m/s] one knot: 1852 m per hour.
+/// \[m/s\] one knot: 1852 m per hour.
 const KNOT_M_S: f64 = 1852.0 / 3600.0;
-/// [ns] from 1900-01-01 TAI (hifitime's reference) to 1958-01-01 TAI: 58 years with 14
+/// \[ns\] from 1900-01-01 TAI (hifitime's reference) to 1958-01-01 TAI: 58 years with 14
 /// leap days (1904 … 1956) = 21 184 days.
 const TAI_1900_TO_1958_NS: i128 = 21_184 * 86_400 * 1_000_000_000;
 /// The longest sentence written (NMEA 0183 allows 82 characters; the style's decimals may

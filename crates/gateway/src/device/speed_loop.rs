@@ -19,15 +19,15 @@ pub enum DriveMode {
 /// A proportional speed loop on one wheel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpeedLoop {
-    /// The measured speed channel [rad/s].
+    /// The measured speed channel \[rad/s\].
     pub measured_channel: usize,
-    /// The torque input it drives [N m].
+    /// The torque input it drives \[N m\].
     pub torque_input: usize,
-    /// [N m/(rad/s)] proportional gain.
+    /// \[N m/(rad/s)\] proportional gain.
     pub gain_nm_per_rad_s: f64,
-    /// [N m] torque limit (> 0).
+    /// \[N m\] torque limit (> 0).
     pub max_torque_nm: f64,
-    /// [rad/s] the setpoint.
+    /// \[rad/s\] the setpoint.
     pub setpoint_rad_s: f64,
     /// The mode.
     pub mode: DriveMode,

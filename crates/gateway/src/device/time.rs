@@ -26,19 +26,19 @@ pub struct Utc {
 pub struct TickTime {
     /// The tick (frame) number.
     pub tick: u64,
-    /// [ns] simulation time, tick · frame period.
+    /// \[ns\] simulation time, tick · frame period.
     pub sim_time_ns: u64,
     /// The scenario has an epoch: the fields below are meaningful (zero otherwise).
     pub has_epoch: bool,
-    /// [ns] TAI since 1958-01-01T00:00:00 TAI (the CCSDS level-1 epoch).
+    /// \[ns\] TAI since 1958-01-01T00:00:00 TAI (the CCSDS level-1 epoch).
     pub tai_ns_1958: u64,
     /// UTC calendar reading.
     pub utc: Utc,
     /// Weeks since 1980-01-06 (GPS), not modulo 1024.
     pub gps_week: u32,
-    /// [ns] since the start of the GPS week.
+    /// \[ns\] since the start of the GPS week.
     pub gps_ns_of_week: u64,
-    /// [ns] mission elapsed time.
+    /// \[ns\] mission elapsed time.
     pub met_ns: u64,
 }
 

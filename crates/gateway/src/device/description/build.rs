@@ -33,7 +33,7 @@ use crate::ByteOrder;
 pub struct Built {
     /// The engine.
     pub behaviour: Behaviour,
-    /// [ns] declared output latency.
+    /// \[ns\] declared output latency.
     pub latency_ns: u64,
     /// Lockstep time-out.
     pub timeout: Duration,
@@ -186,7 +186,8 @@ impl Context<'_> {
             return self.err(
                 key,
                 format!(
-                    "{seconds} s is not a whole number of frames ({frame_s} s each): use a multiple of {frame_s} s"
+                    "{seconds} s is not a whole number of frames ({frame_s} s each): \
+                     use a multiple of {frame_s} s"
                 ),
             );
         }
@@ -209,7 +210,10 @@ impl Context<'_> {
                         return self.err(
                             key,
                             format!(
-                                "unknown checksum `{name}`: expected xor8, sum8, fletcher16, fletcher32, a CRC's parameters {{ width, poly, init, refin, refout, xorout }}, or one of [{}] (and the aliases CRC-16/CCITT-FALSE, CRC-32, CRC-32C)",
+                                "unknown checksum `{name}`: expected xor8, sum8, fletcher16, \
+                                 fletcher32, a CRC's parameters \
+                                 {{ width, poly, init, refin, refout, xorout }}, or one of [{}] \
+                                 (and the aliases CRC-16/CCITT-FALSE, CRC-32, CRC-32C)",
                                 names.join(", ")
                             ),
                         );
@@ -311,7 +315,8 @@ fn build_nmea(file: DescriptionFile, latency_ns: u64, ctx: &Context<'_>) -> Resu
                 ctx.err(
                     "gps",
                     format!(
-                        "group `{}` has no field `{name}` (a GPS group has gps_week, gps_seconds_of_week, r_be_e_m[0..2], v_be_e_m_s[0..2], valid)",
+                        "group `{}` has no field `{name}` (a GPS group has gps_week, \
+                         gps_seconds_of_week, r_be_e_m[0..2], v_be_e_m_s[0..2], valid)",
                         ctx.catalog.groups()[group].name
                     ),
                 )
@@ -529,17 +534,24 @@ fn wire(
             only(&["sync", "header", "length", "checksum_from"])?;
             let sync = spec.sync.clone().unwrap_or_default();
             if sync.is_empty() {
-                return ctx.err("framing.sync", "missing or empty: a frame start is found by its sync octets");
+                return ctx.err(
+                    "framing.sync",
+                    "missing or empty: a frame start is found by its sync octets",
+                );
             }
             let header = spec.header.clone().unwrap_or_default();
             let Some(length) = &spec.length else {
-                return ctx.err("framing.length", "missing: { offset, size, counts, adjust }");
+                return ctx.err(
+                    "framing.length",
+                    "missing: { offset, size, counts, adjust }",
+                );
             };
             if length.offset != sync.len() + header.len() {
                 return ctx.err(
                     "framing.length.offset",
                     format!(
-                        "{}: the length field follows the {} sync and {} header octets, at offset {}",
+                        "{}: the length field follows the {} sync and {} header octets, \
+                         at offset {}",
                         length.offset,
                         sync.len(),
                         header.len(),
@@ -576,7 +588,8 @@ fn wire(
                 check_from_bytes: spec.checksum_from.unwrap_or(0),
                 max_frame_bytes: length.offset + length.size + max_payload + check_len,
             };
-            let framing = LengthFraming::new(config).or_else(|e| ctx.err("framing", e.to_string()))?;
+            let framing =
+                LengthFraming::new(config).or_else(|e| ctx.err("framing", e.to_string()))?;
             Ok(Wire::Length { framing, header })
         }
         "slip" => {
@@ -589,12 +602,15 @@ fn wire(
         }
         "hdlc" => {
             only(&["accm"])?;
+            // RFC 1662 §C: the FCS goes least significant octet first, unless told otherwise.
+            let hdlc_order = ctx.order(
+                "framing.checksum_order",
+                spec.checksum_order.as_deref(),
+                ByteOrder::LittleEndian,
+            )?;
             let fcs = check.map(|c| FrameCheck {
                 checksum: c.checksum,
-                // RFC 1662 §C: the FCS goes least significant octet first.
-                order: ctx
-                    .order("framing.checksum_order", spec.checksum_order.as_deref(), ByteOrder::LittleEndian)
-                    .unwrap_or(ByteOrder::LittleEndian),
+                order: hdlc_order,
             });
             Ok(Wire::Hdlc(HdlcFraming {
                 fcs,
@@ -616,7 +632,8 @@ fn wire(
                             )
                         }
                     };
-                    let format = CucFormat::new(epoch, s.cuc_coarse_octets, s.cuc_fine_octets, s.p_field)
+                    let (coarse, fine) = (s.cuc_coarse_octets, s.cuc_fine_octets);
+                    let format = CucFormat::new(epoch, coarse, fine, s.p_field)
                         .or_else(|e| ctx.err("framing.secondary_header", e.to_string()))?;
                     Some((format, source))
                 }
@@ -625,7 +642,8 @@ fn wire(
         }
         "lines" => ctx.err(
             "framing.kind",
-            "`lines` carry text, not binary fields: a GPS speaking NMEA 0183 is `protocol = \"nmea0183\"`",
+            "`lines` carry text, not binary fields: \
+             a GPS speaking NMEA 0183 is `protocol = \"nmea0183\"`",
         ),
         other => ctx.err(
             "framing.kind",
@@ -697,13 +715,26 @@ fn messages(
             (false, Some(_)) => return ctx.err(key("apid"), "only used with framing `ccsds`"),
             (false, None) => None,
         };
-        let clash = messages
-            .iter()
-            .any(|m| (id_field.is_none() || m.id == spec.id) && (apid.is_none() || m.apid == apid));
-        if clash {
+        // Frames are told apart by id (and APID) within a direction: a reply may carry its
+        // request's id. Without an id field there can be one in-message (or one per APID).
+        let clash = messages.iter().any(|m| {
+            m.direction == direction
+                && (id_field.is_none() || m.id == spec.id)
+                && (apid.is_none() || m.apid == apid)
+        });
+        if clash && (direction == Direction::In || id_field.is_some()) {
+            let what = if id_field.is_some() {
+                "id"
+            } else if apid.is_some() {
+                "apid"
+            } else {
+                "direction"
+            };
             return ctx.err(
-                key(if id_field.is_some() { "id" } else if apid.is_some() { "apid" } else { "name" }),
-                "another message has the same id/APID: a received frame could not be told apart (without an [id] field there can be one message, or one per APID)",
+                key(what),
+                "another message of this direction has the same id/APID: a received frame \
+                 could not be told apart (without an [id] field there can be one in-message, \
+                 or one per APID)",
             );
         }
         let mut schedule = Schedule::Never;
@@ -814,7 +845,11 @@ fn messages(
         if m.direction == Direction::Out && m.schedule == Schedule::Never && !answered {
             return ctx.err(
                 format!("message[{i}]"),
-                format!("out-message `{}` is never sent: give `every_s`, `on_sample`, or name it as an in-message's `response`", m.name),
+                format!(
+                    "out-message `{}` is never sent: give `every_s`, `on_sample`, \
+                     or name it as an in-message's `response`",
+                    m.name
+                ),
             );
         }
     }
@@ -870,7 +905,10 @@ fn field(
     let Some(scalar) = Scalar::by_name(type_name) else {
         return ctx.err(
             k("type"),
-            format!("unknown type `{type_name}`: expected u8, u16, u32, u64, i8, i16, i32, i64, f32 or f64"),
+            format!(
+                "unknown type `{type_name}`: \
+                 expected u8, u16, u32, u64, i8, i16, i32, i64, f32 or f64"
+            ),
         );
     };
     let scale = spec.scale.unwrap_or(1.0);
@@ -911,7 +949,8 @@ fn field(
                 (Some(s), None, None) if s.starts_with("time.") => {
                     let Some((time, si)) = TimeSource::by_name(s) else {
                         let names: Vec<&str> = TimeSource::ALL.iter().map(|t| t.0).collect();
-                        return ctx.err(k("source"), format!("unknown time `{s}`; times: [{}]", names.join(", ")));
+                        let problem = format!("unknown time `{s}`; times: [{}]", names.join(", "));
+                        return ctx.err(k("source"), problem);
                     };
                     let factor = ctx.unit_factor(&k("unit"), si, unit, &format!("`{s}`"))?;
                     (Source::Time(time), Dest::Ignore, factor)
@@ -919,7 +958,8 @@ fn field(
                 (Some(s), None, None) => {
                     let channel = ctx.channel(&k("source"), s)?;
                     let c = &ctx.catalog.channels()[channel];
-                    let factor = ctx.unit_factor(&k("unit"), &c.unit, unit, &format!("`{}`", c.name))?;
+                    let of = format!("`{}`", c.name);
+                    let factor = ctx.unit_factor(&k("unit"), &c.unit, unit, &of)?;
                     (Source::Channel(channel), Dest::Ignore, factor)
                 }
                 (None, Some(g), None) => {
@@ -940,12 +980,11 @@ fn field(
                     // A constant is given in the field's unit.
                     (Source::Constant(v), Dest::Ignore, 1.0)
                 }
-                _ => {
-                    return ctx.err(
-                        k("source"),
-                        "an out-message's field needs exactly one of `source` (a channel, `time.…` or `counter`), `valid` (a group) or `value`",
-                    )
-                }
+                _ => return ctx.err(
+                    k("source"),
+                    "an out-message's field needs exactly one of `source` (a channel, `time.…` \
+                         or `counter`), `valid` (a group) or `value`",
+                ),
             }
         }
         Direction::In => {

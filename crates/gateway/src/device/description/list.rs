@@ -30,7 +30,9 @@ pub fn endpoint(
                 file,
                 key(k),
                 format!(
-                    "device `{}`: `{addr}` is not a loopback address; set `allow_lab_interfaces = true` at the top of the device list to use a lab interface",
+                    "device `{}`: `{addr}` is not a loopback address; set \
+                     `allow_lab_interfaces = true` at the top of the device list to use a lab \
+                     interface",
                     device.name
                 ),
             ));
@@ -50,7 +52,8 @@ pub fn endpoint(
         return Err(DescriptionError::invalid(
             file,
             format!("device[{index}].endpoint"),
-            "give exactly one of { pty = \"..\", baud = .. }, { tcp_server = \"..\" }, { tcp_client = \"..\" }, { udp_local = \"..\", udp_remote = \"..\" }",
+            "give exactly one of { pty = \"..\", baud = .. }, { tcp_server = \"..\" }, \
+             { tcp_client = \"..\" }, { udp_local = \"..\", udp_remote = \"..\" }",
         ));
     }
     if table.baud.is_some() && table.pty.is_none() {

@@ -40,7 +40,7 @@ pub struct ListDevice {
 pub struct EndpointTable {
     /// Pty symlink path.
     pub pty: Option<String>,
-    /// [bit/s] pty line rate.
+    /// \[bit/s\] pty line rate.
     pub baud: Option<u32>,
     /// TCP listen address.
     pub tcp_server: Option<String>,
@@ -62,7 +62,7 @@ pub struct DescriptionFile {
     pub model: Option<String>,
     /// `"big"` (default) or `"little"`: the order of every multi-octet field.
     pub byte_order: Option<String>,
-    /// [ms] declared output latency (real time): bytes go out this long after their tick.
+    /// \[ms\] declared output latency (real time): bytes go out this long after their tick.
     pub output_latency_ms: Option<f64>,
     /// How frames are delimited and checked (binary protocol).
     pub framing: Option<FramingSpec>,
@@ -251,9 +251,9 @@ pub struct SpeedLoopSpec {
     pub measured: String,
     /// The torque input it drives (N m).
     pub torque: String,
-    /// [N m/(rad/s)] proportional gain.
+    /// \[N m/(rad/s)\] proportional gain.
     pub gain_nm_per_rad_s: f64,
-    /// [N m] torque limit.
+    /// \[N m\] torque limit.
     pub max_torque_nm: f64,
 }
 
