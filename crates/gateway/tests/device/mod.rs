@@ -76,7 +76,7 @@ pub fn catalog() -> Catalog {
 
 /// The shipped device list.
 pub fn shipped_list() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/wheels_star_tracker.devices.toml")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/gateway_pointing.devices.toml")
 }
 
 /// The shipped devices, by name.
