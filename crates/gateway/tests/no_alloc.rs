@@ -183,6 +183,15 @@ fn device_catalog() -> Catalog {
     let q: Vec<String> = (0..4).map(|i| format!("q_cn[{i}]")).collect();
     let mut st: Vec<(&str, &str)> = q.iter().map(|n| (n.as_str(), "1")).collect();
     st.extend([("valid", "1"), ("status_flags", "1")]);
+    c.add_group(
+        "imu.hub",
+        &[
+            ("omega_p_rad_s[0]", "rad/s"),
+            ("omega_p_rad_s[1]", "rad/s"),
+            ("omega_p_rad_s[2]", "rad/s"),
+            ("saturation_flags", "1"),
+        ],
+    );
     c.add_group("star_tracker.st1", &st);
     c.add_group(
         "magnetometer.mag1",
@@ -221,7 +230,7 @@ fn device_catalog() -> Catalog {
 fn devices_do_not_allocate_after_construction() {
     let catalog = device_catalog();
     let list = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenarios/wheels_star_tracker.devices.toml");
+        .join("../../scenarios/gateway_pointing.devices.toml");
     let mut set = DeviceSet::load(&list, &catalog).unwrap();
     let mut values = vec![0.0; catalog.channel_count()];
     values[catalog.channel_index("gps.gps1.r_be_e_m[0]").unwrap()] = 4.0e6;

@@ -107,7 +107,7 @@ impl Device {
     ) -> usize {
         match &mut self.behaviour {
             Behaviour::Binary(b) => b.emit_due(now, values, fresh, &mut self.counters, out),
-            Behaviour::Nmea(n) => n.emit_due(now, values, &mut self.counters, out),
+            Behaviour::Nmea(n) => n.emit_due(now, values, fresh, &mut self.counters, out),
         }
     }
 

@@ -3,8 +3,13 @@
 //! fields `gps_week`, `gps_seconds_of_week`, `r_be_e_m[0..2]` (ECEF position, m),
 //! `v_be_e_m_s[0..2]` (ECEF velocity, m/s) and `valid` (1/0):
 //!
-//! - time and date: the tick's UTC ([`TickTime::utc`]); without an epoch nothing is sent
-//!   (counted unsendable);
+//! - when: with the receiver's solutions, as a receiver sends its sentences: a sentence goes out
+//!   at a tick the GPS group publishes, if its `every_s` has passed since it last went (the
+//!   first solution always);
+//! - time and date: the solution's own, from its GPS week and seconds of week (GPS time,
+//!   IS-GPS-200 §3.3.4, turned to UTC by hifitime's leap-second table), as a receiver stamps its
+//!   fix; without a fix (week 0) the tick's UTC ([`TickTime::utc`]); without an epoch nothing
+//!   is sent (counted unsendable);
 //! - latitude, longitude and height: WGS-84 geodetic from the ECEF position
 //!   ([`flexdyn_environment::geodetic::geodetic_from_ecef`], Bowring 1976);
 //! - GGA altitude: the height above the ellipsoid, with a geoid separation of 0 (the
@@ -18,7 +23,7 @@
 //! Lines the driver sends are delimited and counted (unknown request): the receiver takes
 //! no commands.
 
-use hifitime::{Duration, Epoch};
+use hifitime::{Duration, Epoch, TimeScale};
 use nalgebra::Vector3;
 
 use flexdyn_environment::geodetic::{dcm_ned_ecef, geodetic_from_ecef};
@@ -68,6 +73,12 @@ impl SentenceKind {
 /// The GPS group's channels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GpsChannels {
+    /// The group (its freshness says a solution was published at the tick).
+    pub group: usize,
+    /// `gps_week`.
+    pub gps_week: usize,
+    /// `gps_seconds_of_week`.
+    pub gps_seconds_of_week: usize,
     /// `r_be_e_m[0..2]`.
     pub r_be_e_m: [usize; 3],
     /// `v_be_e_m_s[0..2]`.
@@ -84,6 +95,8 @@ pub struct NmeaDevice {
     satellites: u8,
     hdop: f64,
     sentences: Vec<(SentenceKind, u64)>,
+    /// The tick each sentence last went out.
+    last_sent: Vec<Option<u64>>,
     text: String,
     lines: LineDecoder,
 }
@@ -102,6 +115,7 @@ impl NmeaDevice {
             style,
             satellites,
             hdop,
+            last_sent: vec![None; sentences.len()],
             sentences,
             text: String::with_capacity(MAX_SENTENCE_BYTES),
             lines: LineDecoder::new(MAX_LINE_BYTES),
@@ -207,21 +221,43 @@ impl NmeaDevice {
         written.is_ok()
     }
 
-    /// Appends every sentence due at `now`; returns the sentences written.
+    /// The time of the solution in `values`: its GPS week and seconds of week when it has a
+    /// fix, else the tick's.
+    fn solution_epoch(&self, now: &TickTime, values: &[f64]) -> Option<Epoch> {
+        let tick = Self::epoch(now)?;
+        let week = values.get(self.gps.gps_week).copied().unwrap_or(0.0);
+        let sow = values
+            .get(self.gps.gps_seconds_of_week)
+            .copied()
+            .unwrap_or(0.0);
+        if !(week >= 1.0 && week < f64::from(u32::MAX) && (0.0..604_800.0).contains(&sow)) {
+            return Some(tick);
+        }
+        let ns = (sow * 1e9).round() as u64;
+        Some(Epoch::from_time_of_week(week as u32, ns, TimeScale::GPST))
+    }
+
+    /// Appends every sentence due at `now` (module note); returns the sentences written.
     pub fn emit_due(
         &mut self,
         now: &TickTime,
         values: &[f64],
+        fresh: &[bool],
         counters: &mut DeviceCounters,
         out: &mut Vec<u8>,
     ) -> usize {
         let mut frames = 0;
+        if !fresh.get(self.gps.group).copied().unwrap_or(false) {
+            return 0;
+        }
+        let time = self.solution_epoch(now, values);
         for i in 0..self.sentences.len() {
             let (kind, period) = self.sentences[i];
-            if !now.tick.is_multiple_of(period) {
+            if self.last_sent[i].is_some_and(|t| now.tick < t.saturating_add(period)) {
                 continue;
             }
-            match Self::epoch(now) {
+            self.last_sent[i] = Some(now.tick);
+            match time {
                 Some(time) if self.write(kind, time, values) => {
                     out.extend_from_slice(self.text.as_bytes());
                     counters.frames_out += 1;

@@ -225,9 +225,13 @@ fn validate_gps_nmea_sentences_at_one_hertz() {
             ("gps.gps1.valid", 1.0),
         ],
     );
-    let fresh = vec![false; cat.group_count()];
+    // Sentences go with the receiver's solutions: when its group publishes.
+    let mut fresh = vec![false; cat.group_count()];
     let mut out = Vec::new();
+    assert_eq!(gps1.emit_due(&tick_time(0), &v, &fresh, &mut out), 0);
+    fresh[cat.group_index("gps.gps1").unwrap()] = true;
     assert_eq!(gps1.emit_due(&tick_time(0), &v, &fresh, &mut out), 3);
+    // No GPS week in the solution: stamped with the tick's UTC.
     // 7000 m/s = 7000 · 3600 / 1852 kn = 13 606.91 kn; course north = 0°; 2026-11-30 12:00:00.
     let expected = [
         sentence("GPGGA,120000.00,0000.0000,N,00000.0000,E,1,08,1.0,0.0,M,0.0,M,,"),
@@ -240,20 +244,31 @@ fn validate_gps_nmea_sentences_at_one_hertz() {
     for line in expected.split_inclusive("\r\n") {
         Sentence::parse(line).unwrap().expect_fields().unwrap();
     }
-    // Not due between whole seconds; due again at tick 100.
+    // Not again within every_s = 1 s (100 ticks), even on a fresh solution; due at tick 100.
     out.clear();
     for tick in 1..100 {
         assert_eq!(gps1.emit_due(&tick_time(tick), &v, &fresh, &mut out), 0);
     }
     assert_eq!(gps1.emit_due(&tick_time(100), &v, &fresh, &mut out), 3);
+    // A solution with its GPS time is stamped with it, in UTC: week 2447, 129 617.8 s is
+    // 2026-11-30 12:00:17.8 GPS (days from 1980-01-06 = 7 · 2447 + 1, 129 617.8 s = 1 d
+    // 12 h 0 min 17.8 s), and GPS − UTC = 18 s since 2017: 11:59:59.80 UTC.
+    out.clear();
+    let mut timed = v.clone();
+    timed[cat.channel_index("gps.gps1.gps_week").unwrap()] = 2447.0;
+    timed[cat.channel_index("gps.gps1.gps_seconds_of_week").unwrap()] = 129_617.8;
+    assert_eq!(gps1.emit_due(&tick_time(200), &timed, &fresh, &mut out), 3);
+    let text = String::from_utf8(out.clone()).unwrap();
+    assert!(text.starts_with("$GPGGA,115959.80,"), "{text}");
+    assert!(text.contains("$GPZDA,115959.80,30,11,2026,,"), "{text}");
     // An invalid solution: fix quality 0, status V, mode N.
     out.clear();
     let mut invalid = v.clone();
     invalid[cat.channel_index("gps.gps1.valid").unwrap()] = 0.0;
-    gps1.emit_due(&tick_time(0), &invalid, &fresh, &mut out);
+    gps1.emit_due(&tick_time(300), &invalid, &fresh, &mut out);
     let text = String::from_utf8(out).unwrap();
     assert!(text.contains(",E,0,08,"), "{text}");
-    assert!(text.contains("120000.00,V,"), "{text}");
+    assert!(text.contains("120003.00,V,"), "{text}");
     assert!(text.contains(",N*"), "{text}");
 }
 
@@ -261,7 +276,7 @@ fn validate_gps_nmea_sentences_at_one_hertz() {
 fn shipped_devices_declare_lockstep_inputs_latency_and_room() {
     let cat = catalog();
     let devices = shipped(&cat);
-    assert_eq!(devices.len(), 7);
+    assert_eq!(devices.len(), 8);
     let st1 = &devices["st1"];
     // due_every_s = 0.1 at 100 Hz: every 10 ticks from tick 0.
     assert_eq!(
@@ -301,8 +316,10 @@ fn validate_gga_position_of_the_classic_example() {
             ("gps.gps1.valid", 1.0),
         ],
     );
+    let mut fresh = vec![false; cat.group_count()];
+    fresh[cat.group_index("gps.gps1").unwrap()] = true;
     let mut out = Vec::new();
-    gps1.emit_due(&tick_time(0), &v, &[], &mut out);
+    gps1.emit_due(&tick_time(0), &v, &fresh, &mut out);
     let text = String::from_utf8(out).unwrap();
     assert!(
         text.starts_with("$GPGGA,120000.00,4807.0380,N,01131.0000,E,1,08,1.0,545.4,M,0.0,M,,*"),

@@ -279,5 +279,5 @@ fn the_nmea_protocol_checks_its_group_and_sentences() {
         "protocol = \"nmea0183\"\ngps = \"imu.hub\"\n[[sentence]]\ntype = \"GGA\"\nevery_s = 1.0\n";
     let (_, key, problem) = invalid(load(d));
     assert_eq!(key, "gps");
-    assert!(problem.contains("r_be_e_m[0]"), "{problem}");
+    assert!(problem.contains("no field `gps_week`"), "{problem}");
 }

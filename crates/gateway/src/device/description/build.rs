@@ -325,6 +325,9 @@ fn build_nmea(file: DescriptionFile, latency_ns: u64, ctx: &Context<'_>) -> Resu
         )
     };
     let channels = GpsChannels {
+        group,
+        gps_week: field("gps_week")?,
+        gps_seconds_of_week: field("gps_seconds_of_week")?,
         r_be_e_m: [
             field("r_be_e_m[0]")?,
             field("r_be_e_m[1]")?,
