@@ -443,6 +443,7 @@ static void mrp_from_dcm(double c[3][3], double s[3]) {
 struct hostile {
     int on;
     unsigned long rng;
+    long calls;
     long bad_crc, bad_length, oversize, garbage_bytes, partial, flood_bytes;
 };
 
@@ -457,7 +458,13 @@ static uint8_t next_byte(struct hostile *h, uint8_t avoid1, uint8_t avoid2) {
 /* Malformed star-tracker input, each kind once per call, every byte of it counted by the
  * gateway's sync-and-length decoder as described in the tally below. */
 static void hostile_tracker(int fd, struct hostile *h) {
-    uint8_t f[300];
+    uint8_t f[4096];
+    /* every 50th cycle, a flood: 4096 octets, none of them the first sync octet */
+    if (h->calls++ % 50 == 0) {
+        for (size_t i = 0; i < sizeof f; i++) f[i] = next_byte(h, 0xEB, 0xEB);
+        write_all(fd, f, sizeof f);
+        h->flood_bytes += (long)sizeof f;
+    }
     /* garbage: 7 octets, none of them the first sync octet */
     for (int i = 0; i < 7; i++) f[i] = next_byte(h, 0xEB, 0xEB);
     write_all(fd, f, 7);
@@ -478,6 +485,11 @@ static void hostile_tracker(int fd, struct hostile *h) {
  * its message; the SLIP decoder counts them, the engine never applies them. */
 static void hostile_wheel(int fd, struct hostile *h) {
     uint8_t f[600];
+    /* a frame cut short: END, the id and one octet, and no END (the next frame's opening END
+     * closes it) */
+    const uint8_t cut[3] = {0xC0, 0x10, 0xE8};
+    write_all(fd, cut, sizeof cut);
+    h->partial++;
     uint8_t cmd[3] = {0x10, 0x10, 0x27}; /* +100 mN m */
     size_t n = slip_frame(cmd, 3, f);
     f[n - 2] ^= 0x01; /* the CRC's high octet (never an escape or END after the flip) */
@@ -487,12 +499,11 @@ static void hostile_wheel(int fd, struct hostile *h) {
     n = slip_frame(shortcmd, 2, f);
     write_all(fd, f, n);
     h->bad_length++;
-    /* a flood of 300 non-END octets in one frame: longer than any frame the device takes */
+    /* 300 non-END octets in one frame: longer than any frame the device takes */
     f[0] = 0xC0;
     for (int i = 1; i <= 300; i++) f[i] = next_byte(h, 0xC0, 0xDB);
     write_all(fd, f, 301);
     h->oversize++;
-    h->flood_bytes += 300;
 }
 
 /* ---- the loop ---- */
@@ -507,7 +518,7 @@ int main(int argc, char **argv) {
     const char *dir = argv[1];
     int gps_on = 0, mag_port = 0;
     double k_nm = 10.0, p_nms = 150.0;
-    struct hostile h = {0, 0x853c49e6748fea9bul, 0, 0, 0, 0, 0, 0};
+    struct hostile h = {0, 0x853c49e6748fea9bul, 0, 0, 0, 0, 0, 0, 0};
     for (int i = 2; i < argc; i++) {
         if (strcmp(argv[i], "--gps") == 0) gps_on = 1;
         else if (strcmp(argv[i], "--hostile") == 0) h.on = 1;

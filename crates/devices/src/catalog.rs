@@ -91,7 +91,11 @@ impl VehicleCatalog {
         }
         for a in &cfg.coarse_sun_sensors {
             let k = a.normals_b.len().min(16);
-            let (g, first) = add(&mut c.catalog, format!("css.{}", a.name), vector("readings", "1", k));
+            let (g, first) = add(
+                &mut c.catalog,
+                format!("css.{}", a.name),
+                vector("readings", "1", k),
+            );
             c.css.push((g, first, k));
         }
         for s in &cfg.fine_sun_sensors {
@@ -176,7 +180,12 @@ impl VehicleCatalog {
                 put(
                     g,
                     first,
-                    &[m.b_s_t[0], m.b_s_t[1], m.b_s_t[2], f64::from(m.saturation_flags)],
+                    &[
+                        m.b_s_t[0],
+                        m.b_s_t[1],
+                        m.b_s_t[2],
+                        f64::from(m.saturation_flags),
+                    ],
                 );
             }
         }
@@ -191,7 +200,12 @@ impl VehicleCatalog {
                 put(
                     g,
                     first,
-                    &[m.alpha_rad, m.beta_rad, f64::from(u8::from(valid)), f64::from(m.flags)],
+                    &[
+                        m.alpha_rad,
+                        m.beta_rad,
+                        f64::from(u8::from(valid)),
+                        f64::from(m.flags),
+                    ],
                 );
             }
         }
@@ -210,9 +224,12 @@ impl VehicleCatalog {
             }
         }
         for &(g, first, e) in &self.wheels {
-            if let Some(w) = tick.state.effectors.get(e as usize).filter(|w| {
-                w.kind == effector_kind::REACTION_WHEEL && !w.states.is_empty()
-            }) {
+            if let Some(w) = tick
+                .state
+                .effectors
+                .get(e as usize)
+                .filter(|w| w.kind == effector_kind::REACTION_WHEEL && !w.states.is_empty())
+            {
                 let torque = w.outputs.first().copied().unwrap_or(0.0);
                 put(g, first, &[w.states[0], torque]);
             }

@@ -77,7 +77,8 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
     };
     let cfg = vehicle.config()?;
     let catalog = VehicleCatalog::from_config(&cfg);
-    let set = DeviceSet::load(&args.devices, catalog.catalog()).map_err(|e| usage(e.to_string()))?;
+    let set =
+        DeviceSet::load(&args.devices, catalog.catalog()).map_err(|e| usage(e.to_string()))?;
     let mut gateway = Gateway::open(set, catalog, &args.link_dir)
         .map_err(|(name, e)| anyhow::anyhow!("device {name}: {e}"))?;
     for (name, at) in gateway.endpoints() {
@@ -94,8 +95,10 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
     let schedule = SensorSchedule::from_config(&cfg)?;
     let run_end = RunEnd::declare(&session, &topics)
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.status()))?;
-    let mut ticks = TickReceiver::declare(&session, &topics, schedule, 1024, Duration::from_secs(5))
-        .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.telemetry_wildcard()))?;
+    let mut ticks =
+        TickReceiver::declare(&session, &topics, schedule, 1024, Duration::from_secs(5)).map_err(
+            |e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.telemetry_wildcard()),
+        )?;
     let cmd_key = topics.cmd(args.sender_id);
     let publisher = session
         .declare_publisher(cmd_key.clone())
@@ -108,7 +111,11 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
         .declare_token(topics.participant(args.sender_id))
         .wait()
         .map_err(|e| anyhow::anyhow!("cannot declare the liveliness token: {e}"))?;
-    tracing::info!(sender_id = args.sender_id, commands = cmd_key, "flexdyn gateway running");
+    tracing::info!(
+        sender_id = args.sender_id,
+        commands = cmd_key,
+        "flexdyn gateway running"
+    );
 
     let mut seq = 0u64;
     let mut buf = Vec::with_capacity(256);
@@ -120,7 +127,10 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
             Pacing::Lockstep => Duration::from_millis(20),
             Pacing::RealTime => Duration::ZERO,
         };
-        let Some(tick) = ticks.recv_timeout(slice).map_err(|e| anyhow::anyhow!("{e}"))? else {
+        let Some(tick) = ticks
+            .recv_timeout(slice)
+            .map_err(|e| anyhow::anyhow!("{e}"))?
+        else {
             if let Some(end) = run_end.ended() {
                 ended = Some(end);
                 break;
@@ -174,7 +184,11 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
 }
 
 /// Waits until every device's driver is there; `false` on a stop signal.
-fn wait_for_drivers(gateway: &mut Gateway, limit_s: f64, stop: &AtomicBool) -> anyhow::Result<bool> {
+fn wait_for_drivers(
+    gateway: &mut Gateway,
+    limit_s: f64,
+    stop: &AtomicBool,
+) -> anyhow::Result<bool> {
     let start = Instant::now();
     let mut said = Vec::new();
     loop {

@@ -50,7 +50,12 @@ pub fn text(devices: &[DeviceReport], commands_sent: u64) -> String {
 pub fn toml(devices: &[DeviceReport], commands_sent: u64) -> String {
     let mut s = format!("commands_sent = {commands_sent}\n");
     for d in devices {
-        let _ = writeln!(s, "\n[device.{}]\nendpoint = {}", quote(&d.name), quote(&d.endpoint));
+        let _ = writeln!(
+            s,
+            "\n[device.{}]\nendpoint = {}",
+            quote(&d.name),
+            quote(&d.endpoint)
+        );
         for (k, v) in counters(d) {
             let _ = writeln!(s, "{k} = {v}");
         }

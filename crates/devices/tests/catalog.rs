@@ -42,9 +42,12 @@ fn shipped_lists_resolve_against_their_scenarios() {
 #[test]
 fn a_list_needing_a_sensor_the_scenario_lacks_is_refused_by_name() {
     let cat = catalog_of("wheels_star_tracker.toml");
-    let e = DeviceSet::load(&scenarios().join("gateway_pointing.devices.toml"), cat.catalog())
-        .unwrap_err()
-        .to_string();
+    let e = DeviceSet::load(
+        &scenarios().join("gateway_pointing.devices.toml"),
+        cat.catalog(),
+    )
+    .unwrap_err()
+    .to_string();
     // wheels_star_tracker.toml has no magnetometer: mag1's description names its channels.
     assert!(e.contains("magnetometer.toml"), "{e}");
     assert!(e.contains("magnetometer.mag1"), "{e}");

@@ -41,7 +41,10 @@ fn a_pty_is_raw_and_carries_every_byte_value_both_ways() {
     let d = dir("pty_raw");
     let link = d.join("dev.tty");
     let mut pty = Pty::open(&link, Some(115_200)).unwrap();
-    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
     // No driver yet: the master sees the slave hung up.
     assert!(!pty.driver_present(true));
     let mut driver = std::fs::OpenOptions::new()
@@ -72,7 +75,10 @@ fn a_pty_is_raw_and_carries_every_byte_value_both_ways() {
     assert!(!pty.driver_present(true));
     assert_eq!(pty.read(&mut [0u8; 8]).unwrap(), 0);
     drop(pty);
-    assert!(std::fs::symlink_metadata(&link).is_err(), "the link goes with the gateway");
+    assert!(
+        std::fs::symlink_metadata(&link).is_err(),
+        "the link goes with the gateway"
+    );
 }
 
 #[test]
@@ -90,7 +96,10 @@ fn a_stale_link_is_replaced_and_a_strangers_file_is_not() {
     match Pty::open(&file, None) {
         Err(e @ EndpointError::Link { .. }) => {
             let m = e.to_string();
-            assert!(m.contains("plain.tty") && m.contains("other than a symbolic link"), "{m}");
+            assert!(
+                m.contains("plain.tty") && m.contains("other than a symbolic link"),
+                "{m}"
+            );
         }
         other => panic!("expected a refusal, got {other:?}"),
     }
@@ -129,7 +138,10 @@ fn tcp_takes_one_driver_at_a_time_and_takes_it_back_after_a_reconnect() {
     assert_eq!(dev.refused, 1);
     drop(b);
     a.write_all(b"\x00\xC0\xFFhello").unwrap();
-    assert_eq!(read_n(|buf| dev.read(buf).unwrap(), 8), b"\x00\xC0\xFFhello");
+    assert_eq!(
+        read_n(|buf| dev.read(buf).unwrap(), 8),
+        b"\x00\xC0\xFFhello"
+    );
     assert_eq!(dev.write(b"back").unwrap(), Some(4));
     let mut four = [0u8; 4];
     a.read_exact(&mut four).unwrap();
@@ -142,7 +154,11 @@ fn tcp_takes_one_driver_at_a_time_and_takes_it_back_after_a_reconnect() {
         std::thread::sleep(Duration::from_millis(1));
     }
     assert!(!dev.driver_present());
-    assert_eq!(dev.write(b"lost").unwrap(), None, "no driver: nobody hears it");
+    assert_eq!(
+        dev.write(b"lost").unwrap(),
+        None,
+        "no driver: nobody hears it"
+    );
     let _c = TcpStream::connect(addr).unwrap();
     wait(&mut dev);
     assert_eq!((dev.connects, dev.disconnects), (2, 1));

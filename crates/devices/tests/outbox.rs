@@ -20,7 +20,8 @@ fn a_paced_frame_goes_when_its_bytes_have_crossed_the_line() {
     let mut o2 = Outbox::new(1024, Some(115_200));
     o2.push(&[0xAA; 33], t0, true);
     o2.push(&[0x55; 11], t0, true);
-    o2.flush(t0 + Duration::from_millis(10), &mut sink()).unwrap();
+    o2.flush(t0 + Duration::from_millis(10), &mut sink())
+        .unwrap();
     assert_eq!(o2.counters().frames_sent, 2);
     // Unpaced (lockstep): at once, whatever the baud rate.
     let mut o3 = Outbox::new(1024, Some(9_600));

@@ -31,10 +31,7 @@ pub fn venv_python(target_tmpdir: &Path, name: &str, pip_args: &[String], stamp:
     // The tests of one binary run as threads: one of them makes the venv, the others wait.
     static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let _guard = LOCK.lock().unwrap_or_else(|e| e.into_inner());
-    let target = target_tmpdir
-        .parent()
-        .expect("target dir")
-        .to_path_buf();
+    let target = target_tmpdir.parent().expect("target dir").to_path_buf();
     let venv = target.join(name);
     let python = venv.join("bin/python");
     if !python.is_file() {

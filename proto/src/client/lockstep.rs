@@ -28,8 +28,9 @@ use std::time::{Duration, Instant};
 
 use crate::{
     decode_css, decode_fault_event, decode_fss, decode_gps, decode_imu, decode_magnetometer,
-    decode_star_tracker, decode_state, decode_time, CssMsg, DecodeError, FaultEventMsg, FssMsg, GpsMsg, ImuMsg,
-    MagnetometerMsg, StarTrackerMsg, StateMsg, Telemetry, TimeMsg, Topics, FAULT_MODE_NAMES,
+    decode_star_tracker, decode_state, decode_time, CssMsg, DecodeError, FaultEventMsg, FssMsg,
+    GpsMsg, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, Telemetry, TimeMsg, Topics,
+    FAULT_MODE_NAMES,
 };
 use zenoh::handlers::{RingChannel, RingChannelHandler};
 use zenoh::pubsub::Subscriber;

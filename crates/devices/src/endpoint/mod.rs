@@ -153,7 +153,9 @@ impl Endpoint {
         match self {
             Self::Pty(p) => p.write(frame).map(Some).map_err(std::io::Error::from),
             Self::Tcp(t) => t.write(frame),
-            Self::Udp(u) => u.send(frame).map(|sent| Some(if sent { frame.len() } else { 0 })),
+            Self::Udp(u) => u
+                .send(frame)
+                .map(|sent| Some(if sent { frame.len() } else { 0 })),
         }
     }
 

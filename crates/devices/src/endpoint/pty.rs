@@ -47,7 +47,8 @@ impl Pty {
             .map_err(|e| fail("posix_openpt", e))?;
         rustix::pty::grantpt(&master).map_err(|e| fail("grantpt", e))?;
         rustix::pty::unlockpt(&master).map_err(|e| fail("unlockpt", e))?;
-        let slave_path = rustix::pty::ptsname(&master, Vec::new()).map_err(|e| fail("ptsname", e))?;
+        let slave_path =
+            rustix::pty::ptsname(&master, Vec::new()).map_err(|e| fail("ptsname", e))?;
         rustix::io::ioctl_fionbio(&master, true).map_err(|e| fail("non-blocking master", e))?;
         {
             // Raw mode before any driver opens it; closed again at once (see the module note).
@@ -195,7 +196,10 @@ fn replace_link(link: &Path, target: &Path) -> Result<(), EndpointError> {
     }
     if let Some(dir) = link.parent().filter(|d| !d.as_os_str().is_empty()) {
         if !dir.is_dir() {
-            return Err(err(format!("its directory {} does not exist", dir.display())));
+            return Err(err(format!(
+                "its directory {} does not exist",
+                dir.display()
+            )));
         }
     }
     std::os::unix::fs::symlink(target, link).map_err(|e| err(e.to_string()))

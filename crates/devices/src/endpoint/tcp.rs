@@ -101,7 +101,10 @@ impl Tcp {
                 }
             },
             None if self.stream.is_none() => {
-                if self.last_attempt.is_none_or(|t| t.elapsed() >= CONNECT_RETRY) {
+                if self
+                    .last_attempt
+                    .is_none_or(|t| t.elapsed() >= CONNECT_RETRY)
+                {
                     self.last_attempt = Some(Instant::now());
                     if let Ok(s) = TcpStream::connect_timeout(&self.peer, CONNECT_TIMEOUT) {
                         if s.set_nonblocking(true).is_ok() {
