@@ -589,7 +589,7 @@ int main(int argc, char **argv) {
         /* 1. the rate sensor's frame paces the cycle */
         int n = cobs_read(imu, p, sizeof p);
         if (n < 0) {
-            fprintf(stderr, "pointing_driver: the rate sensor's line closed or went quiet\n");
+            fprintf(stderr, "pointing_driver: the rate sensor's line closed (or was silent for 20 s): done\n");
             break;
         }
         if (n != 20 || p[0] != 0x31) continue;

@@ -58,27 +58,7 @@ fn driver() -> &'static Path {
             );
         }
         let exe = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pointing_driver");
-        let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
-        let out = Command::new(&cc)
-            .args([
-                "-std=c99",
-                "-O2",
-                "-Wall",
-                "-Wextra",
-                "-Werror",
-                "-pedantic",
-                "-o",
-            ])
-            .arg(&exe)
-            .arg(&src)
-            .arg("-lm")
-            .output()
-            .unwrap_or_else(|e| panic!("no C compiler ({cc}: {e}): install gcc or set CC"));
-        assert!(
-            out.status.success(),
-            "{cc} failed:\n{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        flexdyn_testkit::c_program::compile_c99(&src, &exe, &["-lm"]);
         exe
     })
 }

@@ -4,6 +4,7 @@
 //! - [`demo_bin`]: where the demo flight code binaries are, checked built after their sources;
 //! - [`cli_errors`]: the error rules every flexdyn binary follows on bad input;
 //! - [`fleets`]: fleet files the tests fly (text only: the tests parse them);
+//! - [`c_program`]: C programs built from source as strictly as a user's CI would;
 //! - [`python`]: a virtual environment for the checks against independent Python readers;
 //! - [`alloc_counter`]: a counting global allocator, for the tests that prove a hot path
 //!   allocates nothing;
@@ -14,6 +15,7 @@
 //! crate whose tests use them.
 
 pub mod alloc_counter;
+pub mod c_program;
 pub mod cargo_build;
 pub mod cli_errors;
 pub mod demo_bin;
