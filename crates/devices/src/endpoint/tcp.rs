@@ -100,19 +100,18 @@ impl Tcp {
                     }
                 }
             },
-            None if self.stream.is_none() => {
-                if self
+            None if self.stream.is_none()
+                && self
                     .last_attempt
-                    .is_none_or(|t| t.elapsed() >= CONNECT_RETRY)
-                {
-                    self.last_attempt = Some(Instant::now());
-                    if let Ok(s) = TcpStream::connect_timeout(&self.peer, CONNECT_TIMEOUT) {
-                        if s.set_nonblocking(true).is_ok() {
-                            let _ = s.set_nodelay(true);
-                            self.connects += 1;
-                            tracing::info!(peer = %self.peer, "connected to the driver");
-                            self.stream = Some(s);
-                        }
+                    .is_none_or(|t| t.elapsed() >= CONNECT_RETRY) =>
+            {
+                self.last_attempt = Some(Instant::now());
+                if let Ok(s) = TcpStream::connect_timeout(&self.peer, CONNECT_TIMEOUT) {
+                    if s.set_nonblocking(true).is_ok() {
+                        let _ = s.set_nodelay(true);
+                        self.connects += 1;
+                        tracing::info!(peer = %self.peer, "connected to the driver");
+                        self.stream = Some(s);
                     }
                 }
             }
