@@ -162,7 +162,7 @@ impl Gateway {
                     Pacing::Lockstep => arrived,
                     Pacing::RealTime => arrived + Duration::from_nanos(s.device.latency_ns()),
                 };
-                s.outbox.push(&self.out, at, pacing == Pacing::RealTime);
+                queue(s, &self.out, at, pacing == Pacing::RealTime);
             }
             s.outbox.flush(Instant::now(), &mut s.endpoint)?;
         }
@@ -209,7 +209,7 @@ impl Gateway {
                     );
                     if !self.out.is_empty() {
                         // Lockstep: an answer goes at once (no latency, no baud timing).
-                        s.outbox.push(&self.out, Instant::now(), false);
+                        queue(s, &self.out, Instant::now(), false);
                         s.outbox.flush(Instant::now(), &mut s.endpoint)?;
                     }
                     *owe = owe.saturating_sub(taken.due_received);
@@ -278,7 +278,7 @@ impl Gateway {
                     &mut self.out,
                 );
                 if !self.out.is_empty() {
-                    s.outbox.push(&self.out, Instant::now(), true);
+                    queue(s, &self.out, Instant::now(), true);
                 }
             }
             s.outbox.flush(Instant::now(), &mut s.endpoint)?;
@@ -336,6 +336,22 @@ impl Gateway {
                 missing_inputs: s.missing_inputs,
             })
             .collect()
+    }
+}
+
+/// Queues each frame the device's last call appended to `out` on its own (a datagram
+/// endpoint sends one frame per datagram; a stream endpoint times each frame on the line).
+fn queue(s: &mut Slot, out: &[u8], earliest: Instant, paced: bool) {
+    let mut start = 0;
+    for &end in s.device.frame_ends() {
+        if let Some(frame) = out.get(start..end) {
+            s.outbox.push(frame, earliest, paced);
+        }
+        start = end;
+    }
+    // Octets after the last frame end (none from a described device): as one frame.
+    if let Some(rest) = out.get(start..).filter(|r| !r.is_empty()) {
+        s.outbox.push(rest, earliest, paced);
     }
 }
 

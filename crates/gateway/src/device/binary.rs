@@ -3,6 +3,7 @@
 //! loop. Every buffer is sized at construction.
 
 use super::counters::DeviceCounters;
+use super::engine::MAX_READ_CHUNK;
 use super::field::Dest;
 use super::message::{Direction, IdField, Message, Reject, Schedule};
 use super::speed_loop::SpeedLoop;
@@ -27,6 +28,9 @@ struct Transmitter {
     id_field: Option<IdField>,
     /// The payload being encoded (capacity: the longest payload).
     payload: Vec<u8>,
+    /// Where each frame appended by the current call ends in `out` (capacity: the most frames
+    /// one call appends), so a datagram endpoint sends each frame as its own datagram.
+    frame_ends: Vec<usize>,
 }
 
 impl Transmitter {
@@ -45,7 +49,12 @@ impl Transmitter {
             .wire
             .encode(&self.payload, message.apid, true, now, out)
         {
-            Ok(()) => counters.frames_out += 1,
+            Ok(()) => {
+                counters.frames_out += 1;
+                if self.frame_ends.len() < self.frame_ends.capacity() {
+                    self.frame_ends.push(out.len());
+                }
+            }
             Err(_) => counters.unsendable += 1,
         }
     }
@@ -90,11 +99,19 @@ impl BinaryDevice {
                 wire,
                 id_field,
                 payload: Vec::with_capacity(max_payload),
+                // One call appends at most every out-message (emit_due) or one response per
+                // octet of a read chunk (take_bytes).
+                frame_ends: Vec::with_capacity(messages.len().max(MAX_READ_CHUNK + 1)),
             },
             messages,
             speed_loop,
             wire_rejects: DecodeCounters::default(),
         }
+    }
+
+    /// Where each frame the last `emit_due` or `take_bytes` call appended ends in its `out`.
+    pub fn frame_ends(&self) -> &[usize] {
+        &self.tx.frame_ends
     }
 
     /// The messages, in description order.
@@ -149,6 +166,7 @@ impl BinaryDevice {
     ) -> usize {
         let before = counters.frames_out;
         let Self { tx, messages, .. } = self;
+        tx.frame_ends.clear();
         for message in messages.iter_mut() {
             let due = message.direction == Direction::Out
                 && match message.schedule {
@@ -181,6 +199,7 @@ impl BinaryDevice {
             speed_loop,
             wire_rejects,
         } = self;
+        tx.frame_ends.clear();
         decoder.feed(bytes, &mut |frame| {
             let unwrapped = match tx.wire.unwrap(frame, wire_rejects) {
                 Ok(u) => u,

@@ -133,6 +133,16 @@ impl Device {
         }
     }
 
+    /// Where each frame appended to `out` by the last [`Device::emit_due`] or
+    /// [`Device::take_bytes`] call ends (offsets into that `out`, in order), so a datagram
+    /// endpoint can send one frame per datagram.
+    pub fn frame_ends(&self) -> &[usize] {
+        match &self.behaviour {
+            Behaviour::Binary(b) => b.frame_ends(),
+            Behaviour::Nmea(n) => n.frame_ends(),
+        }
+    }
+
     /// Once per tick, after the inputs and before the commands go to the server: device
     /// behaviour (a wheel drive's speed loop in speed mode).
     pub fn drive(&mut self, _now: &TickTime, values: &[f64], commands: &mut [f64]) {

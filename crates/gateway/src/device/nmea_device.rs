@@ -97,6 +97,8 @@ pub struct NmeaDevice {
     sentences: Vec<(SentenceKind, u64)>,
     /// The tick each sentence last went out.
     last_sent: Vec<Option<u64>>,
+    /// Where each sentence appended by the last `emit_due` ends in its `out`.
+    frame_ends: Vec<usize>,
     text: String,
     lines: LineDecoder,
 }
@@ -116,6 +118,7 @@ impl NmeaDevice {
             satellites,
             hdop,
             last_sent: vec![None; sentences.len()],
+            frame_ends: Vec::with_capacity(sentences.len()),
             sentences,
             text: String::with_capacity(MAX_SENTENCE_BYTES),
             lines: LineDecoder::new(MAX_LINE_BYTES),
@@ -247,6 +250,7 @@ impl NmeaDevice {
         out: &mut Vec<u8>,
     ) -> usize {
         let mut frames = 0;
+        self.frame_ends.clear();
         if !fresh.get(self.gps.group).copied().unwrap_or(false) {
             return 0;
         }
@@ -260,6 +264,7 @@ impl NmeaDevice {
             match time {
                 Some(time) if self.write(kind, time, values) => {
                     out.extend_from_slice(self.text.as_bytes());
+                    self.frame_ends.push(out.len());
                     counters.frames_out += 1;
                     frames += 1;
                 }
@@ -269,8 +274,15 @@ impl NmeaDevice {
         frames
     }
 
+    /// Where each sentence the last `emit_due` appended ends in its `out` (none after
+    /// `take_bytes`: the receiver answers nothing).
+    pub fn frame_ends(&self) -> &[usize] {
+        &self.frame_ends
+    }
+
     /// Delimits and counts the driver's lines.
     pub fn take_bytes(&mut self, bytes: &[u8], counters: &mut DeviceCounters) {
+        self.frame_ends.clear();
         let mut lines = 0;
         self.lines.feed(bytes, &mut |_| lines += 1);
         counters.unknown_request += lines;

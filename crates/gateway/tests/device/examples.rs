@@ -348,3 +348,41 @@ fn the_answer_counter_wraps_at_its_fields_width() {
     }
     assert_eq!(out[3 + 27], 1);
 }
+
+#[test]
+fn each_frame_of_a_call_is_delimited_for_datagram_endpoints() {
+    let cat = catalog();
+    let mut devices = shipped(&cat);
+    // Two speed requests in one read: two answers (SLIP: END, 7 payload octets + 2 CRC with
+    // no octet to escape at speed 0, END = 11 octets each), each its own frame.
+    let rw1 = devices.get_mut("rw1").unwrap();
+    let mut input = wheel_frame(&[0x20]);
+    input.extend(wheel_frame(&[0x20]));
+    let v = values(&cat, &[]);
+    let mut commands = vec![0.0; cat.input_count()];
+    let mut out = Vec::new();
+    rw1.take_bytes(&input, &tick_time(0), &v, &mut commands, &mut out);
+    let ends = rw1.frame_ends().to_vec();
+    assert_eq!(ends.len(), 2);
+    assert_eq!(*ends.last().unwrap(), out.len());
+    let first = &out[..ends[0]];
+    let second = &out[ends[0]..ends[1]];
+    for f in [first, second] {
+        assert_eq!((f[0], f[f.len() - 1]), (0xC0, 0xC0), "{f:02X?}");
+    }
+    // The GPS receiver: GGA, RMC and ZDA, each ending in CR LF.
+    let gps1 = devices.get_mut("gps1").unwrap();
+    let mut fresh = vec![false; cat.group_count()];
+    fresh[cat.group_index("gps.gps1").unwrap()] = true;
+    let v = values(&cat, &[("gps.gps1.r_be_e_m[0]", 6_378_137.0), ("gps.gps1.valid", 1.0)]);
+    out.clear();
+    assert_eq!(gps1.emit_due(&tick_time(0), &v, &fresh, &mut out), 3);
+    let ends = gps1.frame_ends().to_vec();
+    assert_eq!(ends.len(), 3);
+    let mut start = 0;
+    for (end, kind) in ends.iter().zip(["GGA", "RMC", "ZDA"]) {
+        let s = std::str::from_utf8(&out[start..*end]).unwrap();
+        assert!(s.starts_with(&format!("$GP{kind},")) && s.ends_with("\r\n"), "{s}");
+        start = *end;
+    }
+}
