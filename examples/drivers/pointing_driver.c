@@ -205,16 +205,17 @@ static size_t slip_frame(const uint8_t *payload, size_t len, uint8_t *out) {
     return n;
 }
 
-/* Reads one valid SLIP frame's payload (check removed); its length. */
+/* Reads one valid SLIP frame's payload (check removed); its length. A frame with a bad escape
+ * or longer than the buffer is dropped whole. */
 static int slip_read(int fd, uint8_t *p, size_t cap) {
     uint8_t c[128];
     size_t n = 0;
-    int esc = 0;
+    int esc = 0, bad = 0;
     for (;;) {
         int b = read_byte(fd);
         if (b < 0) return -1;
         if (b == 0xC0) {
-            if (n >= 3 && !esc) {
+            if (n >= 3 && !esc && !bad) {
                 uint16_t crc = (uint16_t)(c[n - 2] | c[n - 1] << 8);
                 if (crc == crc16_kermit(c, n - 2) && n - 2 <= cap) {
                     memcpy(p, c, n - 2);
@@ -223,13 +224,15 @@ static int slip_read(int fd, uint8_t *p, size_t cap) {
             }
             n = 0;
             esc = 0;
+            bad = 0;
             continue;
         }
         if (esc) {
-            b = b == 0xDC ? 0xC0 : b == 0xDD ? 0xDB : -2;
             esc = 0;
-            if (b == -2) {
-                n = sizeof c; /* a bad escape spoils the frame */
+            if (b == 0xDC) b = 0xC0;
+            else if (b == 0xDD) b = 0xDB;
+            else {
+                bad = 1;
                 continue;
             }
         } else if (b == 0xDB) {
@@ -237,6 +240,7 @@ static int slip_read(int fd, uint8_t *p, size_t cap) {
             continue;
         }
         if (n < sizeof c) c[n++] = (uint8_t)b;
+        else bad = 1;
     }
 }
 

@@ -285,9 +285,10 @@ fn a_hostile_driver_is_counted_exactly_and_never_applied() {
     // again for a sync, so they count as garbage when they hold none):
     // - tracker, every 50th cycle (cycles 0, 50, …: 5 of 201): a flood of 4096 octets, none of
     //   them 0xEB → 4096 garbage octets each;
-    // - tracker, every cycle: 7 garbage octets (no 0xEB) → 7; a request (EB 90 01 01 c c) with
-    //   the CRC's last octet flipped → one bad check, then its 5 octets after EB → 5 garbage
-    //   (no 0xEB among them); a frame of LEN 0 → framed, then too short for an id (bad
+    // - tracker, every cycle: 7 garbage octets (no 0xEB) → 7; a request EB 90 01 01 45 1C
+    //   (CRC-16/CCITT-FALSE of EB 90 01 01 = 0x451C) with the last octet flipped (1C ^ 5A =
+    //   46) → one bad check, then its 5 octets after EB, 90 01 01 45 46 → 5 garbage (none is
+    //   0xEB); a frame of LEN 0 → framed, then too short for an id (bad
     //   payload length);
     // - each wheel, every cycle: C0 10 E8 cut short, closed by the next frame's opening END →
     //   a frame whose 2 octets are shorter than id + CRC (bad payload length at the framing:

@@ -71,7 +71,8 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
     let topics = args.common.topics()?;
     let stop = stop_on_signals()?;
     let session = args.common.open_session()?;
-    let idle = Duration::from_secs_f64(args.idle_exit_s);
+    let idle = Duration::try_from_secs_f64(args.idle_exit_s)
+        .map_err(|_| usage("--idle-exit-s is too large"))?;
     let Some(vehicle) = wait_for_vehicle(&session, &topics, idle, &stop)? else {
         return close(session);
     };
@@ -138,8 +139,14 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
             if pacing == Pacing::RealTime {
                 gateway.service(Duration::from_millis(1))?;
             }
-            if last_tick_at.elapsed() >= idle.max(Duration::from_secs(5)) && seq == 0 {
-                bail!("no tick from the server within {} s", idle.as_secs_f64());
+            // A server that publishes neither a tick nor its status (which it keeps doing while
+            // paused) for the idle time is gone.
+            let silent = run_end.last_heard().is_none_or(|t| t.elapsed() >= idle);
+            if last_tick_at.elapsed() >= idle && silent {
+                bail!(
+                    "no tick and no status from the server for {} s (--idle-exit-s): it is gone",
+                    idle.as_secs_f64()
+                );
             }
             continue;
         };
@@ -164,9 +171,10 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
     }
     gateway.drain(Duration::from_millis(200));
     let devices = gateway.report();
-    print!("{}", report::text(&devices, seq));
+    let untimed = gateway.ticks_without_time();
+    print!("{}", report::text(&devices, seq, untimed));
     if let Some(f) = &args.report {
-        std::fs::write(f, report::toml(&devices, seq))
+        std::fs::write(f, report::toml(&devices, seq, untimed))
             .with_context(|| format!("cannot write {}", f.display()))?;
     }
     drop(token);

@@ -35,8 +35,10 @@ fn quote(s: &str) -> String {
 }
 
 /// One line per device and counter, for people.
-pub fn text(devices: &[DeviceReport], commands_sent: u64) -> String {
-    let mut s = format!("gateway: {commands_sent} commands sent\n");
+pub fn text(devices: &[DeviceReport], commands_sent: u64, ticks_without_time: u64) -> String {
+    let mut s = format!(
+        "gateway: {commands_sent} commands sent, {ticks_without_time} ticks without their time message\n"
+    );
     for d in devices {
         let _ = writeln!(s, "device {} ({}):", d.name, d.endpoint);
         for (k, v) in counters(d) {
@@ -47,8 +49,9 @@ pub fn text(devices: &[DeviceReport], commands_sent: u64) -> String {
 }
 
 /// The same as TOML: a table per device.
-pub fn toml(devices: &[DeviceReport], commands_sent: u64) -> String {
-    let mut s = format!("commands_sent = {commands_sent}\n");
+pub fn toml(devices: &[DeviceReport], commands_sent: u64, ticks_without_time: u64) -> String {
+    let mut s =
+        format!("commands_sent = {commands_sent}\nticks_without_time = {ticks_without_time}\n");
     for d in devices {
         let _ = writeln!(
             s,
@@ -98,8 +101,10 @@ fn counters(d: &DeviceReport) -> Vec<(String, u64)> {
         ("line_frames_dropped_full", d.line.frames_dropped_full),
         ("late_ticks", d.late_ticks),
         ("missing_inputs", d.missing_inputs),
+        ("late_outputs", d.late_outputs),
     ] {
         c.push((k.to_owned(), v));
     }
+    c.extend(d.link.iter().map(|(k, v)| ((*k).to_owned(), *v)));
     c
 }

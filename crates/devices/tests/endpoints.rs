@@ -65,7 +65,7 @@ fn a_pty_is_raw_and_carries_every_byte_value_both_ways() {
     assert_eq!(got, all, "driver -> gateway");
     let mut written = 0;
     while written < all.len() {
-        written += pty.write(&all[written..]).unwrap();
+        written += pty.write(&all[written..]).unwrap().unwrap();
     }
     let mut back = vec![0u8; all.len()];
     driver.read_exact(&mut back).unwrap();
@@ -74,6 +74,11 @@ fn a_pty_is_raw_and_carries_every_byte_value_both_ways() {
     drop(driver);
     assert!(!pty.driver_present(true));
     assert_eq!(pty.read(&mut [0u8; 8]).unwrap(), 0);
+    assert_eq!(
+        pty.write(b"lost").unwrap(),
+        None,
+        "nobody holds the line: nobody hears it"
+    );
     drop(pty);
     assert!(
         std::fs::symlink_metadata(&link).is_err(),
@@ -91,6 +96,14 @@ fn a_stale_link_is_replaced_and_a_strangers_file_is_not() {
         std::fs::read_link(&link).unwrap().to_string_lossy(),
         pty.slave()
     );
+    // A user's link to something else is left alone.
+    let theirs = d.join("theirs.tty");
+    let target = d.join("their-file");
+    std::fs::write(&target, b"x").unwrap();
+    std::os::unix::fs::symlink(&target, &theirs).unwrap();
+    let e = Pty::open(&theirs, None).unwrap_err().to_string();
+    assert!(e.contains("replaces only links to pseudo-terminals"), "{e}");
+    assert_eq!(std::fs::read_link(&theirs).unwrap(), target);
     let file = d.join("plain.tty");
     std::fs::write(&file, b"mine").unwrap();
     match Pty::open(&file, None) {
@@ -181,8 +194,8 @@ fn udp_sends_each_frame_as_a_datagram_and_takes_only_the_drivers() {
     let driver = UdpSocket::bind("127.0.0.1:0").unwrap();
     let mut dev = Udp::open("127.0.0.1:0".parse().unwrap(), driver.local_addr().unwrap()).unwrap();
     driver.connect(dev.local_addr()).unwrap();
-    assert!(dev.send(b"one").unwrap());
-    assert!(dev.send(b"two!").unwrap());
+    assert_eq!(dev.send(b"one").unwrap(), Some(true));
+    assert_eq!(dev.send(b"two!").unwrap(), Some(true));
     let mut buf = [0u8; 16];
     assert_eq!(driver.recv(&mut buf).unwrap(), 3);
     assert_eq!(driver.recv(&mut buf).unwrap(), 4);

@@ -5,4 +5,5 @@
 
 mod catalog;
 mod endpoints;
+mod lockstep;
 mod outbox;

@@ -151,11 +151,25 @@ impl Endpoint {
     /// driver is there to take them. A UDP frame goes whole or not at all.
     pub fn write(&mut self, frame: &[u8]) -> std::io::Result<Option<usize>> {
         match self {
-            Self::Pty(p) => p.write(frame).map(Some).map_err(std::io::Error::from),
+            Self::Pty(p) => p.write(frame).map_err(std::io::Error::from),
             Self::Tcp(t) => t.write(frame),
-            Self::Udp(u) => u
-                .send(frame)
-                .map(|sent| Some(if sent { frame.len() } else { 0 })),
+            Self::Udp(u) => Ok(u
+                .send(frame)?
+                .map(|sent| if sent { frame.len() } else { 0 })),
+        }
+    }
+
+    /// The line's own tallies, by name: connections made, lost and refused (TCP), datagrams
+    /// refused (UDP).
+    pub fn counters(&self) -> Vec<(&'static str, u64)> {
+        match self {
+            Self::Pty(_) => Vec::new(),
+            Self::Tcp(t) => vec![
+                ("link_connects", t.connects),
+                ("link_disconnects", t.disconnects),
+                ("link_refused_connections", t.refused),
+            ],
+            Self::Udp(u) => vec![("link_refused_datagrams", u.unreachable)],
         }
     }
 

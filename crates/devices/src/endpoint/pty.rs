@@ -31,6 +31,8 @@ pub struct Pty {
     baud: Option<u32>,
     /// Whether a driver held the slave open at the last look.
     present: bool,
+    /// Whether a driver has opened it before.
+    opened_before: bool,
 }
 
 impl Pty {
@@ -77,6 +79,7 @@ impl Pty {
             link: link.to_path_buf(),
             baud,
             present: false,
+            opened_before: false,
         })
     }
 
@@ -96,6 +99,13 @@ impl Pty {
     pub fn driver_present(&mut self, binary: bool) -> bool {
         let now = !matches!(poll_one(self.master.as_fd(), 0), Ok(r) if r.hung_up);
         if now && !self.present {
+            if self.opened_before {
+                // A driver reopened the line: what the last one left unread, or wrote and the
+                // gateway did not take, is not this one's.
+                let _ =
+                    rustix::termios::tcflush(&self.master, rustix::termios::QueueSelector::IOFlush);
+            }
+            self.opened_before = true;
             self.check_line(binary);
         }
         self.present = now;
@@ -146,11 +156,17 @@ impl Pty {
         }
     }
 
-    /// Writes as much of `bytes` as the line takes now (non-blocking); the number written.
-    pub fn write(&mut self, bytes: &[u8]) -> Result<usize, Errno> {
+    /// Writes as much of `bytes` as the line takes now (non-blocking): the number written,
+    /// or `None` when no process holds the slave, so nobody hears them (the kernel would
+    /// otherwise keep them for whoever opens the line next).
+    pub fn write(&mut self, bytes: &[u8]) -> Result<Option<usize>, Errno> {
+        if poll_one(self.master.as_fd(), 0)?.hung_up {
+            return Ok(None);
+        }
         match rustix::io::write(&self.master, bytes) {
-            Ok(n) => Ok(n),
-            Err(Errno::AGAIN | Errno::IO) => Ok(0),
+            Ok(n) => Ok(Some(n)),
+            Err(Errno::AGAIN) => Ok(Some(0)),
+            Err(Errno::IO) => Ok(None),
             Err(e) => Err(e),
         }
     }
@@ -175,7 +191,10 @@ impl Drop for Pty {
     }
 }
 
-/// Points `link` at `target`, replacing a symbolic link already there.
+/// Points `link` at `target`. A symbolic link already there is replaced only if it is a
+/// pseudo-terminal's (`/dev/pts/…`) or dangling: a stale link of an earlier run, never a link a
+/// user made to something else. The new link is made under a temporary name and renamed into
+/// place, so a driver never sees the path missing or half made.
 fn replace_link(link: &Path, target: &Path) -> Result<(), EndpointError> {
     let err = |reason: String| EndpointError::Link {
         link: link.to_path_buf(),
@@ -183,7 +202,14 @@ fn replace_link(link: &Path, target: &Path) -> Result<(), EndpointError> {
     };
     match std::fs::symlink_metadata(link) {
         Ok(m) if m.file_type().is_symlink() => {
-            std::fs::remove_file(link).map_err(|e| err(format!("cannot replace it: {e}")))?
+            let to = std::fs::read_link(link).map_err(|e| err(e.to_string()))?;
+            if !to.starts_with("/dev/pts") && link.exists() {
+                return Err(err(format!(
+                    "a symbolic link to {} is there; the gateway replaces only links to \
+                     pseudo-terminals and dangling ones",
+                    to.display()
+                )));
+            }
         }
         Ok(_) => {
             return Err(err(
@@ -202,5 +228,13 @@ fn replace_link(link: &Path, target: &Path) -> Result<(), EndpointError> {
             )));
         }
     }
-    std::os::unix::fs::symlink(target, link).map_err(|e| err(e.to_string()))
+    let mut temp = link.as_os_str().to_owned();
+    temp.push(format!(".flexdyn-{}", std::process::id()));
+    let temp = std::path::PathBuf::from(temp);
+    let _ = std::fs::remove_file(&temp);
+    std::os::unix::fs::symlink(target, &temp).map_err(|e| err(e.to_string()))?;
+    std::fs::rename(&temp, link).map_err(|e| {
+        let _ = std::fs::remove_file(&temp);
+        err(e.to_string())
+    })
 }

@@ -62,14 +62,15 @@ impl Udp {
         }
     }
 
-    /// Sends `frame` as one datagram; `false` if it could not go (no room, or no driver).
-    pub fn send(&mut self, frame: &[u8]) -> std::io::Result<bool> {
+    /// Sends `frame` as one datagram: `Some(true)` sent, `Some(false)` no room yet (try
+    /// again), `None` refused (no driver bound there: nobody hears it).
+    pub fn send(&mut self, frame: &[u8]) -> std::io::Result<Option<bool>> {
         match self.socket.send(frame) {
-            Ok(_) => Ok(true),
-            Err(e) if e.kind() == ErrorKind::WouldBlock => Ok(false),
+            Ok(_) => Ok(Some(true)),
+            Err(e) if e.kind() == ErrorKind::WouldBlock => Ok(Some(false)),
             Err(e) if e.kind() == ErrorKind::ConnectionRefused => {
                 self.unreachable += 1;
-                Ok(false)
+                Ok(None)
             }
             Err(e) => Err(e),
         }

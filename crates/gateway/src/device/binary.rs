@@ -287,6 +287,24 @@ impl BinaryDevice {
         }
     }
 
+    /// Whether in-message `message` is due from the driver at `tick` (lockstep).
+    pub fn input_due(&self, message: usize, tick: u64) -> bool {
+        self.messages
+            .get(message)
+            .and_then(|m| m.due_period_ticks)
+            .is_some_and(|p| tick.is_multiple_of(p))
+    }
+
+    /// Whether the device takes input messages of which none is ever due (in lockstep the
+    /// runtime never waits for them).
+    pub fn has_undue_inputs(&self) -> bool {
+        let inputs = self
+            .messages
+            .iter()
+            .filter(|m| m.direction == Direction::In);
+        inputs.clone().next().is_some() && inputs.clone().all(|m| m.due_period_ticks.is_none())
+    }
+
     /// In-messages owed at `tick` in lockstep.
     pub fn inputs_due(&self, tick: u64) -> u32 {
         self.messages

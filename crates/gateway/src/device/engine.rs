@@ -151,6 +151,24 @@ impl Device {
         }
     }
 
+    /// Lockstep: whether message `message` (an index of [`Device::message_names`] and of
+    /// [`DeviceCounters::frames_in`]) is owed by the driver at `tick`.
+    pub fn input_due(&self, message: usize, tick: u64) -> bool {
+        match &self.behaviour {
+            Behaviour::Binary(b) => b.input_due(message, tick),
+            Behaviour::Nmea(_) => false,
+        }
+    }
+
+    /// Whether the device takes input messages none of which is ever due: in lockstep nothing
+    /// waits for them, so the runtime reads them at no defined tick (it warns at start).
+    pub fn has_undue_inputs(&self) -> bool {
+        match &self.behaviour {
+            Behaviour::Binary(b) => b.has_undue_inputs(),
+            Behaviour::Nmea(_) => false,
+        }
+    }
+
     /// Lockstep: the input frames (commands and requests) the driver owes at `tick`.
     pub fn inputs_due(&self, tick: u64) -> u32 {
         match &self.behaviour {

@@ -374,7 +374,13 @@ fn each_frame_of_a_call_is_delimited_for_datagram_endpoints() {
     let gps1 = devices.get_mut("gps1").unwrap();
     let mut fresh = vec![false; cat.group_count()];
     fresh[cat.group_index("gps.gps1").unwrap()] = true;
-    let v = values(&cat, &[("gps.gps1.r_be_e_m[0]", 6_378_137.0), ("gps.gps1.valid", 1.0)]);
+    let v = values(
+        &cat,
+        &[
+            ("gps.gps1.r_be_e_m[0]", 6_378_137.0),
+            ("gps.gps1.valid", 1.0),
+        ],
+    );
     out.clear();
     assert_eq!(gps1.emit_due(&tick_time(0), &v, &fresh, &mut out), 3);
     let ends = gps1.frame_ends().to_vec();
@@ -382,7 +388,10 @@ fn each_frame_of_a_call_is_delimited_for_datagram_endpoints() {
     let mut start = 0;
     for (end, kind) in ends.iter().zip(["GGA", "RMC", "ZDA"]) {
         let s = std::str::from_utf8(&out[start..*end]).unwrap();
-        assert!(s.starts_with(&format!("$GP{kind},")) && s.ends_with("\r\n"), "{s}");
+        assert!(
+            s.starts_with(&format!("$GP{kind},")) && s.ends_with("\r\n"),
+            "{s}"
+        );
         start = *end;
     }
 }
