@@ -38,7 +38,7 @@ fn catalog() -> (VehicleCatalog, VehicleConfig) {
 /// Tick `k` of wheels_star_tracker (100 Hz) with a valid star-tracker sample every 10 ticks.
 fn tick(k: u64, cfg: &VehicleConfig) -> Tick {
     let header = Header::new(1, k, k * 10_000_000, k);
-    let st = (k % 10 == 0).then(|| StarTrackerMsg {
+    let st = k.is_multiple_of(10).then_some(StarTrackerMsg {
         header,
         q_cn: [1.0, 0.0, 0.0, 0.0],
         valid: true,
