@@ -59,6 +59,10 @@ enum Command {
     View(view::ViewArgs),
     /// Draw PNG figures of a recording or a simulate/export CSV.
     Plot(plot::PlotArgs),
+    /// The device gateway: the served vehicle's sensors and actuators as byte-stream devices
+    /// (pseudo-terminals, TCP, UDP) that unmodified flight drivers open, described by TOML
+    /// files; a lockstep participant like any flight code.
+    Gateway(Box<flexdyn_devices::participant::GatewayArgs>),
     /// Monte Carlo campaigns: plan, run (locally or one index at a time), summarize.
     #[command(subcommand)]
     Campaign(flexdyn_campaign::CampaignCommand),
@@ -88,6 +92,7 @@ fn main() -> ExitCode {
         Some(Command::Export(a)) => commands::export::main(&a),
         Some(Command::View(a)) => commands::view::main(&a),
         Some(Command::Plot(a)) => commands::plot::main(&a),
+        Some(Command::Gateway(a)) => commands::gateway::main(&a),
         Some(Command::Campaign(c)) => commands::campaign::main(&c),
     }
 }

@@ -21,6 +21,7 @@ pub mod check_config;
 pub mod checkpoint;
 pub mod export;
 pub mod fleet;
+pub mod gateway;
 pub mod plot;
 pub mod print_default_config;
 pub mod record;

@@ -10,6 +10,7 @@
 use flexdyn_testkit_server::server as server_support;
 
 mod checkpoint_lockstep;
+mod device_gateway;
 mod environment_message;
 mod faults_config;
 mod faults_dropout_lockstep;

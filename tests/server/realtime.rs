@@ -5,5 +5,6 @@
 
 use flexdyn_testkit_server::server as server_support;
 
+mod device_gateway_realtime;
 mod fleet_realtime;
 mod server_realtime;

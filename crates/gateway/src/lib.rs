@@ -10,13 +10,16 @@
 //! - [`nmea`]: NMEA 0183 GGA, RMC and ZDA sentence writers and a sentence reader;
 //! - [`ccsds`]: the CCSDS Space Packet primary header (CCSDS 133.0-B-2) and the CUC time code
 //!   (CCSDS 301.0-B-4 §3.2);
-//! - [`ByteOrder`]: the octet order of multi-octet integers.
+//! - [`ByteOrder`]: the octet order of multi-octet integers;
+//! - [`device`]: described devices: the catalog of channels, the TOML device list and
+//!   descriptions, and the engine that encodes outputs, decodes the driver's frames, applies
+//!   commands, answers requests and runs a wheel's speed loop.
 //!
 //! # Layer
 //! Above the model crates (it sits after `flexdyn-vehicle` in `.ci/layers`, so that a device
 //! description may later read the models' types) and below the sinks, the server and the
-//! campaigns. Today it depends on `thiserror` and `hifitime` (UTC calendar fields for NMEA)
-//! only, and on no flexdyn crate. It must never depend on an I/O stack (`zenoh`, `tokio`,
+//! campaigns. It depends on `thiserror`, `hifitime` (UTC calendar fields for NMEA), `serde` and
+//! `toml` (device descriptions), and `flexdyn-environment` (WGS-84 geodetic coordinates). It must never depend on an I/O stack (`zenoh`, `tokio`,
 //! `foxglove`, `plotters`, `mcap`) nor on a flexdyn crate above it (`flexdyn-sinks`,
 //! `flexdyn-server`, `flexdyn-campaign`, the root package): `.ci/layers` checks both. The
 //! gateway's runtime (ptys, sockets, lockstep) belongs above it and calls it.
@@ -26,6 +29,7 @@
 pub mod byte_order;
 pub mod ccsds;
 pub mod checksum;
+pub mod device;
 pub mod framing;
 pub mod nmea;
 

@@ -3,6 +3,7 @@
 
 mod ccsds;
 mod checksum;
+mod device;
 mod framing;
 mod nmea;
 mod prng;

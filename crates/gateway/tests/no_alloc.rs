@@ -2,11 +2,13 @@
 //! truncated and oversize frames and garbage is fed, whole and byte by byte, inside
 //! `assert_no_alloc`, whose global allocator counts every (de)allocation made on this thread
 //! there (features `warn_debug`/`warn_release`: count and warn, don't abort). Nor do the NMEA
-//! writers, into a buffer with room for the sentence.
+//! writers, into a buffer with room for the sentence. Nor do the shipped devices' `emit_due`,
+//! `take_bytes` and `drive`, into an output buffer of `max_output_len` octets.
 
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
 use flexdyn_gateway::checksum::presets::{CRC16_IBM_SDLC, CRC32C};
 use flexdyn_gateway::checksum::{Checksum, Crc};
+use flexdyn_gateway::device::{Catalog, DeviceSet, TickTime, Utc, MAX_READ_CHUNK};
 use flexdyn_gateway::framing::cobs::{self, CobsDecoder};
 use flexdyn_gateway::framing::hdlc::{HdlcDecoder, HdlcFraming};
 use flexdyn_gateway::framing::length::{
@@ -172,4 +174,127 @@ fn nmea_writers_do_not_allocate_into_a_buffer_with_room() {
     });
     assert_eq!(violation_count(), 0, "an NMEA writer allocated");
     assert_eq!(out.matches("\r\n").count(), 3);
+}
+
+/// The catalog of `tests/device/mod.rs` (wheels_star_tracker with a magnetometer and a GPS
+/// receiver), rebuilt here: this executable has its own allocator and no shared modules.
+fn device_catalog() -> Catalog {
+    let mut c = Catalog::new(10_000_000);
+    let q: Vec<String> = (0..4).map(|i| format!("q_cn[{i}]")).collect();
+    let mut st: Vec<(&str, &str)> = q.iter().map(|n| (n.as_str(), "1")).collect();
+    st.extend([("valid", "1"), ("status_flags", "1")]);
+    c.add_group(
+        "imu.hub",
+        &[
+            ("omega_p_rad_s[0]", "rad/s"),
+            ("omega_p_rad_s[1]", "rad/s"),
+            ("omega_p_rad_s[2]", "rad/s"),
+            ("saturation_flags", "1"),
+        ],
+    );
+    c.add_group("star_tracker.st1", &st);
+    c.add_group(
+        "magnetometer.mag1",
+        &[
+            ("b_s_t[0]", "T"),
+            ("b_s_t[1]", "T"),
+            ("b_s_t[2]", "T"),
+            ("saturation_flags", "1"),
+        ],
+    );
+    c.add_group(
+        "gps.gps1",
+        &[
+            ("gps_week", "1"),
+            ("gps_seconds_of_week", "s"),
+            ("r_be_e_m[0]", "m"),
+            ("r_be_e_m[1]", "m"),
+            ("r_be_e_m[2]", "m"),
+            ("v_be_e_m_s[0]", "m/s"),
+            ("v_be_e_m_s[1]", "m/s"),
+            ("v_be_e_m_s[2]", "m/s"),
+            ("valid", "1"),
+            ("flags", "1"),
+        ],
+    );
+    for w in 1..=4 {
+        c.add_group(&format!("wheel.rw{w}"), &[("speed_rad_s", "rad/s")]);
+    }
+    for w in 1..=4 {
+        c.add_input(&format!("wheel.rw{w}.torque_nm"), "N m");
+    }
+    c
+}
+
+#[test]
+fn devices_do_not_allocate_after_construction() {
+    let catalog = device_catalog();
+    let list = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenarios/gateway_pointing.devices.toml");
+    let mut set = DeviceSet::load(&list, &catalog).unwrap();
+    let mut values = vec![0.0; catalog.channel_count()];
+    values[catalog.channel_index("gps.gps1.r_be_e_m[0]").unwrap()] = 4.0e6;
+    values[catalog.channel_index("gps.gps1.r_be_e_m[2]").unwrap()] = 5.0e6;
+    values[catalog.channel_index("gps.gps1.v_be_e_m_s[1]").unwrap()] = 7.0e3;
+    values[catalog.channel_index("gps.gps1.valid").unwrap()] = 1.0;
+    values[catalog.channel_index("star_tracker.st1.q_cn[0]").unwrap()] = 1.0;
+    values[catalog.channel_index("magnetometer.mag1.b_s_t[0]").unwrap()] = 2e-5;
+    values[catalog.channel_index("wheel.rw1.speed_rad_s").unwrap()] = 100.0;
+    let fresh = vec![true; catalog.group_count()];
+    // Driver input: star-tracker requests and wheel commands (SLIP, CRC-16/KERMIT) between
+    // garbage, in one stream every device reads (each decodes its own framing, counts the rest).
+    let mut input = Vec::new();
+    let request = [0xEB, 0x90, 0x01, 0x01];
+    let crc16_ccitt_false =
+        Crc::new(flexdyn_gateway::checksum::presets::CRC16_CCITT_FALSE).unwrap();
+    let kermit = Crc::new(flexdyn_gateway::checksum::presets::CRC16_KERMIT).unwrap();
+    for n in 0..40u8 {
+        input.extend_from_slice(&request);
+        input.extend_from_slice(&(crc16_ccitt_false.checksum(&request) as u16).to_be_bytes());
+        let speed = [0x11, 0x00, 0x00, 0x7A, 0x44];
+        for payload in [&[0x20][..], &speed[..], &[0x10, n, 0x01][..]] {
+            let mut content = payload.to_vec();
+            content.extend_from_slice(&(kermit.checksum(payload) as u16).to_le_bytes());
+            slip::encode(&content, &mut input);
+        }
+        input.extend_from_slice(&[n, 0xC0, 0x55, 0xDB, 0x00, 0x7E]);
+    }
+    assert!(input.len() <= MAX_READ_CHUNK);
+    let mut commands = vec![0.0; catalog.input_count()];
+    for device in &mut set.devices {
+        let mut out = Vec::with_capacity(device.max_output_len());
+        let mut frames = 0;
+        reset_violation_count();
+        assert_no_alloc(|| {
+            for tick in 0..300u64 {
+                let now = TickTime {
+                    tick,
+                    sim_time_ns: tick * 10_000_000,
+                    has_epoch: true,
+                    tai_ns_1958: 2_000_000_000_000_000_000 + tick * 10_000_000,
+                    utc: Utc {
+                        year: 2026,
+                        month: 11,
+                        day: 30,
+                        hour: 23,
+                        minute: 59,
+                        second: 58 + (tick / 100) as u8,
+                        nanosecond: (tick % 100) as u32 * 10_000_000,
+                    },
+                    gps_week: 2447,
+                    gps_ns_of_week: tick * 10_000_000,
+                    met_ns: tick * 10_000_000,
+                };
+                out.clear();
+                frames += device.emit_due(&now, &values, &fresh, &mut out);
+                out.clear();
+                let chunk = &input[(tick as usize * 37) % input.len()..];
+                let taken = device.take_bytes(chunk, &now, &values, &mut commands, &mut out);
+                frames += taken.frames_accepted as usize;
+                device.drive(&now, &values, &mut commands);
+            }
+        });
+        assert_eq!(violation_count(), 0, "device {} allocated", device.name());
+        assert!(frames > 0, "device {} did nothing", device.name());
+    }
 }

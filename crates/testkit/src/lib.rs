@@ -4,6 +4,8 @@
 //! - [`demo_bin`]: where the demo flight code binaries are, checked built after their sources;
 //! - [`cli_errors`]: the error rules every flexdyn binary follows on bad input;
 //! - [`fleets`]: fleet files the tests fly (text only: the tests parse them);
+//! - [`c_program`]: C programs built from source as strictly as a user's CI would;
+//! - [`python`]: a virtual environment for the checks against independent Python readers;
 //! - [`alloc_counter`]: a counting global allocator, for the tests that prove a hot path
 //!   allocates nothing;
 //! - [`median`] and [`median_mut`]: the figure the benchmarks print.
@@ -13,11 +15,13 @@
 //! crate whose tests use them.
 
 pub mod alloc_counter;
+pub mod c_program;
 pub mod cargo_build;
 pub mod cli_errors;
 pub mod demo_bin;
 pub mod fleets;
 pub mod ports;
+pub mod python;
 
 /// The median of `v` as the benchmarks print it: the upper median (`v[len / 2]` once sorted by
 /// `f64::total_cmp`) for an even count. Panics on an empty `v`.

@@ -28,8 +28,9 @@ use std::time::{Duration, Instant};
 
 use crate::{
     decode_css, decode_fault_event, decode_fss, decode_gps, decode_imu, decode_magnetometer,
-    decode_star_tracker, decode_state, CssMsg, DecodeError, FaultEventMsg, FssMsg, GpsMsg, ImuMsg,
-    MagnetometerMsg, StarTrackerMsg, StateMsg, Telemetry, Topics, FAULT_MODE_NAMES,
+    decode_star_tracker, decode_state, decode_time, CssMsg, DecodeError, FaultEventMsg, FssMsg,
+    GpsMsg, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, Telemetry, TimeMsg, Topics,
+    FAULT_MODE_NAMES,
 };
 use zenoh::handlers::{RingChannel, RingChannelHandler};
 use zenoh::pubsub::Subscriber;
@@ -210,6 +211,10 @@ pub struct Tick {
     /// The GPS solutions published at the tick, in configuration order (`None`: none published
     /// at this tick, or lost); each is valid its receiver's latency before the tick.
     pub gps_receivers: Vec<Option<GpsMsg>>,
+    /// The time service's message of the tick (UTC, TAI, GPS time, CCSDS CUC), published
+    /// before the tick's samples on the same subscriber; `None` if it was lost. Not awaited:
+    /// a tick is complete without it.
+    pub time: Option<TimeMsg>,
     /// The due samples that never came, as `imu/<name>`, `st/<name>`, `mag/<name>`,
     /// `css/<name>`, `fss/<name>` or `gps/<name>`. Empty in lockstep unless a sample was lost
     /// or withheld by a `dropout` fault.
@@ -250,6 +255,7 @@ struct Partial {
     coarse_sun_sensors: Vec<Option<CssMsg>>,
     fine_sun_sensors: Vec<Option<FssMsg>>,
     gps_receivers: Vec<Option<GpsMsg>>,
+    time: Option<TimeMsg>,
 }
 
 impl Partial {
@@ -261,6 +267,7 @@ impl Partial {
             coarse_sun_sensors: vec![None; s.coarse_sun_sensors.len()],
             fine_sun_sensors: vec![None; s.fine_sun_sensors.len()],
             gps_receivers: vec![None; s.gps_receivers.len()],
+            time: None,
         }
     }
 }
@@ -368,11 +375,12 @@ impl TickAssembler {
             Css(usize, CssMsg),
             Fss(usize, FssMsg),
             Gps(usize, GpsMsg),
+            Time(TimeMsg),
         }
         let s = &self.schedule;
         let msg = match topic {
-            // The time service is not part of a tick's samples (wait for it separately).
-            Telemetry::Time => return Ok(()),
+            // The time service comes with its tick, but is never awaited.
+            Telemetry::Time => Msg::Time(decode_time(payload)?),
             // Nor is the environment message (truth for operators, after the state).
             Telemetry::Environment => return Ok(()),
             // Nor is a fleet deputy's relative state (after the state; Client::subscribe).
@@ -411,6 +419,7 @@ impl TickAssembler {
             Msg::Css(_, m) => m.header.tick,
             Msg::Fss(_, m) => m.header.tick,
             Msg::Gps(_, m) => m.header.tick,
+            Msg::Time(m) => m.header.tick,
         };
         if self.last.is_some_and(|last| tick <= last) {
             return Ok(()); // its tick was released already (it came after the time limit)
@@ -433,6 +442,7 @@ impl TickAssembler {
             Msg::Css(i, m) => self.partial_mut(tick).coarse_sun_sensors[i] = Some(m),
             Msg::Fss(i, m) => self.partial_mut(tick).fine_sun_sensors[i] = Some(m),
             Msg::Gps(i, m) => self.partial_mut(tick).gps_receivers[i] = Some(m),
+            Msg::Time(m) => self.partial_mut(tick).time = Some(m),
         }
         if self.held.is_some() && self.awaited().is_empty() {
             if let Some(t) = self.release() {
@@ -552,6 +562,7 @@ impl TickAssembler {
             coarse_sun_sensors: p.coarse_sun_sensors,
             fine_sun_sensors: p.fine_sun_sensors,
             gps_receivers: p.gps_receivers,
+            time: p.time,
             missing,
         })
     }

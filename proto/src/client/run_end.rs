@@ -38,6 +38,7 @@ impl Ended {
 /// A subscriber on a vehicle's status that remembers the first end of run it hears.
 pub struct RunEnd {
     seen: Arc<Mutex<Option<Ended>>>,
+    last_status: Arc<Mutex<Option<Instant>>>,
     _subscriber: Subscriber<()>,
 }
 
@@ -46,13 +47,16 @@ impl RunEnd {
     /// end cannot be heard before the frames it follows are subscribed to.
     pub fn declare(session: &Session, topics: &Topics) -> zenoh::Result<Self> {
         let seen = Arc::new(Mutex::new(None));
+        let last_status = Arc::new(Mutex::new(None));
         let slot = Arc::clone(&seen);
+        let heard = Arc::clone(&last_status);
         let subscriber = session
             .declare_subscriber(topics.status())
             .callback(move |sample| {
                 let Ok(status) = decode_status(&sample.payload().to_bytes()) else {
                     return;
                 };
+                *heard.lock().unwrap_or_else(|p| p.into_inner()) = Some(Instant::now());
                 if !status.run_state.ended() {
                     return;
                 }
@@ -66,8 +70,15 @@ impl RunEnd {
             .wait()?;
         Ok(Self {
             seen,
+            last_status,
             _subscriber: subscriber,
         })
+    }
+
+    /// When the last status message came: a server that still publishes its status (also
+    /// while paused) is alive.
+    pub fn last_heard(&self) -> Option<Instant> {
+        *self.last_status.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// How the run ended, once the server said so.
