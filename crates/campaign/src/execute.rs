@@ -76,9 +76,13 @@ pub struct RunResult {
     pub redraws: u32,
     /// Dispersed parameters as read back from the built model, by key.
     pub applied: BTreeMap<String, f64>,
-    /// SHA-256 over the StateMsg payloads, ticks 0..=N in order (empty if the run failed, and
-    /// over a fleet).
+    /// SHA-256 over the StateMsg payloads, ticks `start_tick`..=N in order (empty if the run
+    /// failed, and over a fleet).
     pub state_sha256: String,
+    /// The first tick observed, hashed and judged: the checkpoint's in a campaign that starts
+    /// every run from one (`start_from`), else 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub start_tick: u64,
     /// Over a fleet: the SHA-256 over each vehicle's StateMsg payloads, ticks 0..=N in order,
     /// by vehicle id (empty if the run failed).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
@@ -110,6 +114,10 @@ pub struct RunResult {
     pub sim_s: f64,
 }
 
+fn is_zero(n: &u64) -> bool {
+    *n == 0
+}
+
 impl RunResult {
     /// Planned run `rp` before it ran (or when it could not run): its seeds and redraws, no
     /// results, outcome `not_run`, `status`.
@@ -121,6 +129,7 @@ impl RunResult {
             redraws: rp.redraws,
             applied: BTreeMap::new(),
             state_sha256: String::new(),
+            start_tick: 0,
             vehicle_state_sha256: BTreeMap::new(),
             states: 0,
             fault_activations_ns: BTreeMap::new(),
@@ -425,19 +434,41 @@ fn run_port(opts: &RunOptions, run: u32) -> Result<u16, String> {
     }
 }
 
-/// The lockstep settings every run shares (a single spacecraft adds its ids and participants).
-fn lockstep_settings(c: &Campaign, opts: &RunOptions, run_dir: &Path) -> ServerSettings {
+/// The settings of a one-spacecraft run's server, without its recording: lockstep, spacecraft
+/// [`SC_ID`], the observer and (with a controller) the flight code as participants. A
+/// campaign's checkpoint must fit these ([`super::fork`]).
+pub fn single_settings(c: &Campaign) -> ServerSettings {
+    let mut participants = vec![OBSERVER_ID];
+    if c.controller.is_some() {
+        participants.insert(0, CONTROLLER_ID);
+    }
+    ServerSettings {
+        sc_id: SC_ID.into(),
+        participants,
+        ..shared_settings(c)
+    }
+}
+
+/// The lockstep settings every run shares, without a recording.
+fn shared_settings(c: &Campaign) -> ServerSettings {
     ServerSettings {
         mode: Mode::Lockstep,
         participant_timeout: Duration::from_secs_f64(c.participant_timeout_s),
         presence_timeout: Duration::from_secs_f64(c.participant_timeout_s.max(10.0)),
         duration_ns: Some(c.duration_ns),
         summary_interval: Duration::from_secs(3600),
+        ..ServerSettings::default()
+    }
+}
+
+/// The lockstep settings every run shares (a single spacecraft adds its ids and participants).
+fn lockstep_settings(c: &Campaign, opts: &RunOptions, run_dir: &Path) -> ServerSettings {
+    ServerSettings {
         // The flight code's telemetry is judged from the recording (the observer, a peer of the
         // server, does not hear the controller's samples).
         record: (opts.record || c.criteria.iter().any(|k| k.fsw.is_some()))
             .then(|| run_dir.join(RECORDING)),
-        ..ServerSettings::default()
+        ..shared_settings(c)
     }
 }
 
@@ -457,9 +488,13 @@ fn sorted(r: &Received) -> Vec<(u64, Vec<u8>)> {
     s
 }
 
-/// Whether `s` holds ticks 0..=`last` exactly once each, in order.
-fn complete(s: &[(u64, Vec<u8>)], last: u64) -> bool {
-    s.len() as u64 == last + 1 && s.iter().enumerate().all(|(i, (t, _))| *t == i as u64)
+/// Whether `s` holds ticks `first`..=`last` exactly once each, in order.
+fn complete(s: &[(u64, Vec<u8>)], first: u64, last: u64) -> bool {
+    last >= first
+        && s.len() as u64 == last - first + 1
+        && s.iter()
+            .enumerate()
+            .all(|(i, (t, _))| *t == first + i as u64)
 }
 
 fn close(observers: &[Observer]) {
@@ -471,9 +506,11 @@ fn close(observers: &[Observer]) {
 /// Runs `server` to its end in lockstep with an observer per vehicle of `observe` (its id and
 /// the relative-state keys to record) and the `controllers`; each controller's exit status is
 /// pushed to `exits`, in order, whatever the outcome. A controller that exits before the end
-/// stops the run at once.
+/// stops the run at once. The server starts at `first_tick` (a resumed checkpoint's, else 0):
+/// the observer must see every tick from it to the end.
 fn run_lockstep(
     server: Server,
+    first_tick: u64,
     observe: &[(String, Vec<String>)],
     controllers: &[Launch],
     port: u16,
@@ -636,7 +673,8 @@ fn run_lockstep(
     let give_up = Instant::now() + Duration::from_secs(2);
     let arrived = |o: &Observer| {
         let n = |r: &Received| r.lock().unwrap_or_else(|e| e.into_inner()).len() as u64;
-        n(&o.states) > last_tick && o.relative.iter().all(|r| n(r) > last_tick)
+        let due = (last_tick + 1).saturating_sub(first_tick);
+        n(&o.states) >= due && o.relative.iter().all(|r| n(r) >= due)
     };
     while !observers.iter().all(&arrived) && Instant::now() < give_up {
         std::thread::sleep(Duration::from_millis(5));
@@ -655,18 +693,21 @@ fn run_lockstep(
             String::new()
         };
         let states = sorted(&o.states);
-        if !complete(&states, last_tick) {
+        if !complete(&states, first_tick, last_tick) {
             close(&observers);
             return Err(RunFailure::from(format!(
-                "the observer saw {} states{of} for ticks 0..={last_tick}",
+                "the observer saw {} states{of} for ticks {first_tick}..={last_tick}",
                 states.len(),
             )));
         }
         let relative: Vec<_> = o.relative.iter().map(sorted).collect();
-        if let Some(r) = relative.iter().find(|r| !complete(r, last_tick)) {
+        if let Some(r) = relative
+            .iter()
+            .find(|r| !complete(r, first_tick, last_tick))
+        {
             close(&observers);
             return Err(RunFailure::from(format!(
-                "the observer saw {} relative states{of} for ticks 0..={last_tick}",
+                "the observer saw {} relative states{of} for ticks {first_tick}..={last_tick}",
                 r.len(),
             )));
         }
@@ -732,15 +773,17 @@ fn run_inner(
     // Base port 0: every run's server takes a free port from the OS.
     let port = run_port(opts, rp.run)?;
     let frame_s = cfg.frame_ns as f64 * 1e-9;
-    let mut participants = vec![OBSERVER_ID];
-    if c.controller.is_some() {
-        participants.insert(0, CONTROLLER_ID);
-    }
-    let settings = ServerSettings {
-        sc_id: SC_ID.into(),
-        participants,
-        ..lockstep_settings(c, opts, run_dir)
+    let mut settings = ServerSettings {
+        record: lockstep_settings(c, opts, run_dir).record,
+        ..single_settings(c)
     };
+    // A forked campaign: the server resumes the checkpoint (its own checks refuse one that
+    // does not fit the run's configuration) and publishes from its tick on.
+    let start_tick = c.start_from.as_ref().map_or(0, |s| s.tick);
+    if let Some(start) = &c.start_from {
+        settings.checkpoints.source = start.source.clone();
+        settings.checkpoints.resume = Some(start.resumed());
+    }
     let controllers: Vec<Launch> = c
         .controller
         .iter()
@@ -753,6 +796,7 @@ fn run_inner(
     let mut exits = Vec::new();
     let observed = run_lockstep(
         Server::Single(settings, Box::new(cfg)),
+        start_tick,
         &[(SC_ID.to_owned(), Vec::new())],
         &controllers,
         port,
@@ -762,6 +806,7 @@ fn run_inner(
     result.controller_exit = exits.into_iter().next();
     let observed = observed?;
     let states = &observed.states[0];
+    result.start_tick = start_tick;
     result.state_sha256 = sha256_hex(states);
     result.states = states.len() as u64;
     result.fault_activations_ns = first_activations("", &observed.faults[0]);
@@ -784,6 +829,17 @@ fn run_inner(
             None => evaluate(k, &decoded, c.sigma_rn, frame_s),
         })
         .collect();
+    if let Some(start) = &c.start_from {
+        for (r, k) in result.criteria.iter_mut().zip(&c.criteria) {
+            if super::judge::reads_the_whole_run(k) {
+                let seen = start.seen_from();
+                r.note = Some(match r.note.take() {
+                    Some(n) => format!("{n}; {seen}"),
+                    None => seen,
+                });
+            }
+        }
+    }
     Ok(())
 }
 
@@ -892,6 +948,7 @@ fn run_fleet(
     let mut exits = Vec::new();
     let observed = run_lockstep(
         Server::Fleet(lockstep_settings(c, opts, run_dir), Box::new(fleet)),
+        0,
         &observe,
         &controllers,
         port,

@@ -30,6 +30,7 @@ pub mod command;
 pub mod criteria;
 pub mod execute;
 pub mod fleet;
+pub mod fork;
 pub mod judge;
 pub mod keys;
 pub mod plan;

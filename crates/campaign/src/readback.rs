@@ -16,7 +16,8 @@ use flexdyn_vehicle::world::{relative_state_hill, FleetConfig};
 /// `initial.v_bn_n_m_s[i]`), each effector's [`flexdyn_dynamics::StateEffector::parameters`]
 /// under its kind's section (`panel_pairs[k].`, `reaction_wheels[k].`: [`flexdyn_dynamics::kinds`]), each dynamic effector's
 /// [`flexdyn_dynamics::DynamicEffector::parameters`] (facets, residual dipole), the environment
-/// models' (space weather) and the epoch's `epoch.offset_s`.
+/// models' (space weather), the epoch's `epoch.offset_s` and each scheduled fault's window
+/// (`faults[k].start_s`, `duration_s`, `period_s`).
 pub fn readback(
     cfg: &SimConfig,
 ) -> Result<BTreeMap<String, f64>, flexdyn_vehicle::config::ConfigError> {
@@ -77,6 +78,21 @@ pub fn readback(
         env.parameters(&mut params);
     }
     out.extend(params);
+    // Each scheduled fault's window as resolved (a random fault's start is its drawn failure
+    // time, not a parameter: its `mtbf_s` and seed are).
+    for (k, f) in cfg.faults.iter().enumerate() {
+        if f.source != flexdyn_proto::FaultSource::Config {
+            continue;
+        }
+        let w = &f.window;
+        out.insert(format!("faults[{k}].start_s"), w.start_ns as f64 * 1e-9);
+        if let Some(d) = w.duration_ns {
+            out.insert(format!("faults[{k}].duration_s"), d as f64 * 1e-9);
+        }
+        if let Some(p) = w.period_ns {
+            out.insert(format!("faults[{k}].period_s"), p as f64 * 1e-9);
+        }
+    }
     Ok(out)
 }
 

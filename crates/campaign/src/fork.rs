@@ -1,0 +1,190 @@
+//! A campaign that starts every run from one checkpoint (`start_from = "detumbled.ckpt"`): each
+//! run is a fork of the run the checkpoint was taken from, resumed at its tick K, so a thousand
+//! "what next" runs do not each fly the first K ticks again (docs/guides/campaigns.md, "Start
+//! every run from a checkpoint").
+//!
+//! - The checkpoint is read and checked when the campaign is loaded ([`StartFrom::read`]): a
+//!   missing, damaged or foreign file is refused, naming the file and the reason, before any
+//!   run starts. It must be a checkpoint of the campaign's own lockstep server (front end `run`,
+//!   spacecraft `sc1`, the campaign's participants): `flexdyn campaign checkpoint` writes one.
+//! - The runs' base configuration is the one the checkpoint recorded (a `base` given beside
+//!   `start_from` must be that file's text).
+//! - Whether the base fits the checkpoint (the same vehicle, effectors, sensors, faults and
+//!   participants, step and frame) is the server's own resume check
+//!   ([`flexdyn_server::checkpoint::check_fits`]), asked once at plan time and again by every
+//!   run's server.
+//! - A dispersion may only change what acts after the checkpoint ([`check_key`]): the window of
+//!   a configured fault that opens after it. Anything that acted before K (the initial state, a
+//!   mass, a sensor's noise) is already fixed by the checkpoint's state, and a run that changed
+//!   it would not be the flight the checkpoint continues: it is refused with the reason.
+//! - What every run observes, hashes and judges starts at tick K ([`StartFrom::tick`]).
+
+use std::path::{Path, PathBuf};
+
+use sha2::{Digest, Sha256};
+
+use flexdyn_kernel::numfmt::Num;
+use flexdyn_server::checkpoint::{Resumed, FRONT_END};
+use flexdyn_vehicle::checkpoint::Source;
+use flexdyn_vehicle::config::SimConfig;
+
+/// `start_from`: the checkpoint every run of a campaign starts from.
+#[derive(Clone, Debug)]
+pub struct StartFrom {
+    /// The checkpoint file, as resolved against the campaign file.
+    pub path: PathBuf,
+    /// Its bytes (checked: magic, format version, length, checksum, front end `run`).
+    pub bytes: Vec<u8>,
+    /// SHA-256 of the file, hex.
+    pub sha256: String,
+    /// The frame boundary it was taken at (> 0): every run's first observed tick.
+    pub tick: u64,
+    /// \[ns\] the simulation time at that tick.
+    pub t_sim_ns: u64,
+    /// The configuration it recorded: the runs' base.
+    pub source: Source,
+    /// SHA-256 of that configuration's text, as the checkpoint holds it.
+    pub source_sha256: [u8; 32],
+}
+
+impl StartFrom {
+    /// Reads and checks checkpoint `path`; the error names the file and why it is refused.
+    pub fn read(path: &Path) -> Result<Self, String> {
+        let (resumed, header) =
+            flexdyn_server::checkpoint::read(path, FRONT_END).map_err(|e| e.to_string())?;
+        let sha256 = hex(&Sha256::digest(&resumed.bytes));
+        Ok(Self {
+            path: path.to_owned(),
+            sha256,
+            tick: header.tick,
+            t_sim_ns: header.t_sim_ns,
+            source: Source::recorded(&header),
+            source_sha256: header.source_sha256,
+            bytes: resumed.bytes,
+        })
+    }
+
+    /// \[s\] the checkpoint's simulation time.
+    pub fn t_s(&self) -> f64 {
+        self.t_sim_ns as f64 * 1e-9
+    }
+
+    /// What a run's server resumes from.
+    pub fn resumed(&self) -> Resumed {
+        Resumed {
+            file: self.path.clone(),
+            bytes: self.bytes.clone(),
+            tick: self.tick,
+        }
+    }
+
+    /// The note on a criterion that reduces a run's series (`max`, `settling_time`, the flight
+    /// code's times): what it saw.
+    pub fn seen_from(&self) -> String {
+        format!(
+            "seen from tick {} (t = {} s), the checkpoint's; before it the run is the \
+             checkpoint's flight, not observed",
+            self.tick,
+            Num(self.t_s())
+        )
+    }
+
+    /// The manifest's record of the fork.
+    pub fn manifest(&self) -> serde_json::Value {
+        serde_json::json!({
+            "file": self.path.display().to_string(),
+            "sha256": self.sha256,
+            "tick": self.tick,
+            "t_s": self.t_s(),
+            "configuration": self.source.file().map_or(
+                "(embedded default)".to_owned(), |p| p.display().to_string()),
+            "configuration_sha256": hex(&self.source_sha256),
+        })
+    }
+}
+
+/// Lower-case hex of `bytes`.
+pub fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The fault index and field of a concrete key `faults[k].<field>`, if it is one.
+fn fault_field(key: &str) -> Option<(usize, &str)> {
+    let (k, field) = key.strip_prefix("faults[")?.split_once("].")?;
+    Some((k.parse().ok()?, field))
+}
+
+/// Whether the concrete dispersion key `key` of a campaign forked from `start` may be dispersed
+/// over the base `cfg` (the checkpoint's configuration): only the window (`start_s`,
+/// `duration_s`, `period_s`) of a configured fault whose window opens after the checkpoint.
+/// Anything else acted on the flight before tick K, which the checkpoint has already fixed.
+pub fn check_key(key: &str, cfg: &SimConfig, start: &StartFrom) -> Result<(), String> {
+    let at = format!(
+        "the checkpoint {} at tick {} (t = {} s)",
+        start.path.display(),
+        start.tick,
+        Num(start.t_s())
+    );
+    let Some((k, field)) = fault_field(key) else {
+        let what = if key.starts_with("initial.") {
+            "is the state at t = 0"
+        } else {
+            "acts on the flight from t = 0"
+        };
+        return Err(format!(
+            "{key} {what}; every run starts from {at}, whose state already holds its effect, so \
+             a run with another value would not be the flight the checkpoint continues: only \
+             what acts after the checkpoint can be dispersed (the window of a fault that opens \
+             after it: faults[k].start_s, duration_s, period_s)"
+        ));
+    };
+    let Some(fault) = cfg.faults.get(k) else {
+        return Err(format!("{key}: the base has no faults[{k}]"));
+    };
+    if !matches!(field, "start_s" | "duration_s" | "period_s") {
+        return Err(format!(
+            "{key}: only a fault's window (start_s, duration_s, period_s) can be dispersed \
+             from {at}"
+        ));
+    }
+    if fault.window.start_ns <= start.t_sim_ns {
+        return Err(format!(
+            "{key}: faults[{k}] opens at t = {} s, not after {at}: its activation before the \
+             checkpoint is part of the checkpoint's state, so its window cannot change",
+            Num(fault.window.start_ns as f64 * 1e-9)
+        ));
+    }
+    Ok(())
+}
+
+/// Whether a draw of `distribution` for the key `key` (already [`check_key`]ed) always falls
+/// after the checkpoint: a fault's `start_s` must be drawn after it, so only a uniform
+/// distribution whose `low` is after it is accepted (a normal one can draw any time).
+pub fn check_draws(
+    key: &str,
+    distribution: &super::spec::Distribution,
+    start: &StartFrom,
+) -> Result<(), String> {
+    if fault_field(key).map(|(_, f)| f) != Some("start_s") {
+        return Ok(());
+    }
+    let t_k = start.t_s();
+    match distribution {
+        super::spec::Distribution::Uniform { low, .. } if *low > t_k => Ok(()),
+        super::spec::Distribution::Uniform { low, .. } => Err(format!(
+            "{key}: low = {} s can draw a start at or before the checkpoint {} (t = {} s): the \
+             fault would have struck in the flight the checkpoint already holds; give low > {}",
+            Num(*low),
+            start.path.display(),
+            Num(t_k),
+            Num(t_k)
+        )),
+        _ => Err(format!(
+            "{key}: a normal distribution can draw a start at or before the checkpoint {} (t = \
+             {} s); use distribution = \"uniform\" with low > {}",
+            start.path.display(),
+            Num(t_k),
+            Num(t_k)
+        )),
+    }
+}
