@@ -750,6 +750,81 @@ fn decode_states(states: &[(u64, Vec<u8>)]) -> Vec<StateMsg> {
         .collect()
 }
 
+/// `flexdyn campaign checkpoint`: flies campaign `c`'s base configuration, undispersed, as its
+/// runs are flown (its lockstep server, observer and controller, spacecraft [`SC_ID`]) up to
+/// `tick` and saves the checkpoint there to `file`: the checkpoint a `start_from` of the same
+/// campaign fits. Its controller's log is `file` with `.controller.log` appended. Returns the
+/// checkpoint's \[ns\] simulation time.
+pub fn nominal_checkpoint(
+    c: &Campaign,
+    tick: u64,
+    file: &Path,
+    base_port: u16,
+) -> Result<u64, String> {
+    if c.fleet.is_some() {
+        return Err("a campaign over a fleet cannot start from a checkpoint yet".into());
+    }
+    if c.start_from.is_some() {
+        return Err(
+            "this campaign already starts from a checkpoint (start_from): take the checkpoint \
+             with the campaign that flies from t = 0"
+                .into(),
+        );
+    }
+    let dir = file
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let cfg = SimConfig::from_toml_str_in(&c.base_toml, &c.base_dir())
+        .map_err(|e| c.base_error(e).to_string())?;
+    let mut settings = single_settings(c);
+    settings.duration_ns = Some(tick.saturating_mul(cfg.frame_ns));
+    settings.checkpoints.save_at = Some((tick, file.to_owned()));
+    settings.checkpoints.source = flexdyn_vehicle::checkpoint::Source::of(c.base_path.as_deref())
+        .map_err(|e| c.base_error(e).to_string())?;
+    let log = format!(
+        "{}.controller.log",
+        file.file_name()
+            .map_or("checkpoint".into(), |f| f.to_string_lossy())
+    );
+    let controllers: Vec<Launch> = c
+        .controller
+        .iter()
+        .map(|line| Launch {
+            line: substitute(line, SC_ID, CONTROLLER_ID, 0, None),
+            log: log.clone(),
+            who: "the controller".into(),
+        })
+        .collect();
+    let mut exits = Vec::new();
+    let port = run_port(
+        &RunOptions {
+            dir: dir.to_owned(),
+            base_port,
+            record: false,
+        },
+        0,
+    )?;
+    let observed = run_lockstep(
+        Server::Single(settings, Box::new(cfg)),
+        0,
+        &[(SC_ID.to_owned(), Vec::new())],
+        &controllers,
+        port,
+        dir,
+        &mut exits,
+    )
+    .map_err(|e| e.message)?;
+    if !file.is_file() {
+        return Err(format!(
+            "the run reached t = {} s and no checkpoint was written to {}",
+            observed.sim_time_ns as f64 * 1e-9,
+            file.display()
+        ));
+    }
+    Ok(observed.sim_time_ns)
+}
+
 fn run_inner(
     c: &Campaign,
     rp: &RunPlan,

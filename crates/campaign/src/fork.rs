@@ -23,6 +23,7 @@ use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
 
+use super::spec::CampaignError;
 use flexdyn_kernel::numfmt::Num;
 use flexdyn_server::checkpoint::{Resumed, FRONT_END};
 use flexdyn_vehicle::checkpoint::Source;
@@ -101,6 +102,25 @@ impl StartFrom {
             "configuration_sha256": hex(&self.source_sha256),
         })
     }
+}
+
+/// The line `campaign run` and `summarize` print about the fork.
+pub fn line(start: &StartFrom) -> String {
+    line_of(
+        &start.path.display().to_string(),
+        &start.sha256,
+        start.tick,
+        start.t_s(),
+    )
+}
+
+/// The fork's line from its parts (the manifest's `start_from`).
+pub fn line_of(file: &str, sha256: &str, tick: u64, t_s: f64) -> String {
+    format!(
+        "forked: every run starts from checkpoint {file} (sha256 {sha256}) at tick {tick} (t = \
+         {} s); hashes and criteria cover tick {tick} to the end",
+        Num(t_s)
+    )
 }
 
 /// Lower-case hex of `bytes`.
@@ -187,4 +207,33 @@ pub fn check_draws(
             Num(t_k)
         )),
     }
+}
+
+/// The frame boundary of `flexdyn campaign checkpoint --at-s` for campaign `c`: a whole number
+/// of frames, after t = 0 and before the end of the runs.
+pub fn checkpoint_tick(c: &super::spec::Campaign, at_s: f64) -> Result<u64, CampaignError> {
+    let bad = |problem: String| CampaignError::Invalid {
+        path: c.path.clone(),
+        field: "--at-s".into(),
+        problem,
+        at: flexdyn_kernel::schema::At(None),
+    };
+    let cfg =
+        SimConfig::from_toml_str_in(&c.base_toml, &c.base_dir()).map_err(|e| c.base_error(e))?;
+    let t_ns = flexdyn_vehicle::config::whole_ns(at_s).ok_or_else(|| {
+        bad(format!(
+            "{} s is not a whole number of nanoseconds",
+            Num(at_s)
+        ))
+    })?;
+    if t_ns == 0 || t_ns % cfg.frame_ns != 0 || t_ns >= c.duration_ns {
+        return Err(bad(format!(
+            "{} s must be a whole number of frames (frame = {} s), after t = 0 and before the \
+             end of the runs (duration_s = {} s)",
+            Num(at_s),
+            Num(cfg.frame_ns as f64 * 1e-9),
+            Num(c.duration_s)
+        )));
+    }
+    Ok(t_ns / cfg.frame_ns)
 }

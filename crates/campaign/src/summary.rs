@@ -240,6 +240,25 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
 
     s.wilson_95 = wilson(s.passed, s.planned, Z_95);
     let mut t = String::new();
+    // A forked campaign (`start_from`): which checkpoint, and what the hashes cover.
+    if let Some(f) = manifest["start_from"].as_object() {
+        let text = |k: &str| f.get(k).and_then(|v| v.as_str()).unwrap_or("?").to_owned();
+        writeln!(
+            t,
+            "{}",
+            super::fork::line_of(
+                &text("file"),
+                &text("sha256"),
+                f.get("tick")
+                    .and_then(serde_json::Value::as_u64)
+                    .unwrap_or(0),
+                f.get("t_s")
+                    .and_then(serde_json::Value::as_f64)
+                    .unwrap_or(f64::NAN),
+            )
+        )
+        .ok();
+    }
     writeln!(
         t,
         "{} of {} planned runs passed ({:.1} %); Wilson 95 % interval {:.1} %–{:.1} % (missing and failed runs count as not passed)",

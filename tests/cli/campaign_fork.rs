@@ -1,0 +1,364 @@
+//! A campaign that starts every run from one checkpoint (`start_from`), through the binary:
+//! `flexdyn campaign checkpoint` flies the base to 4 s of a 5 s run (tick 40 of 50, 80 %), and
+//! the forked campaigns start there.
+//!
+//! The oracle is the uninterrupted run, flown here from t = 0 by the server library with the
+//! campaign's own settings and observer (no checkpoint, no resume): its StateMsg payloads from
+//! tick 40 on. A forked run whose dispersion changes nothing within the run must hash exactly
+//! those; one whose dispersed fault strikes after the checkpoint must publish those bytes up to
+//! the fault's frame and differ from the next tick on. Refusals (a dispersed initial state, a
+//! fault that could strike before the checkpoint, a missing or damaged checkpoint) must come
+//! before any run starts: no output folder is created.
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
+use std::time::{Duration, Instant};
+
+use flexdyn_campaign::execute::{single_settings, Observer, RunResult, OBSERVER_ID, SC_ID};
+use flexdyn_campaign::spec::Campaign;
+use flexdyn_proto::client::transport::{listening_on, zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::Topics;
+use flexdyn_vehicle::config::SimConfig;
+use sha2::{Digest, Sha256};
+use zenoh::Wait;
+
+/// \[s\] the run, and the checkpoint at 80 % of it.
+const DURATION_S: f64 = 5.0;
+const CHECKPOINT_S: f64 = 4.0;
+/// acs_full's frame (10 Hz) and RK4 step.
+const FRAME_NS: u64 = 100_000_000;
+const STEP_NS: u64 = 10_000_000;
+const K: u64 = 40;
+const LAST_TICK: u64 = 50;
+
+fn flexdyn(args: &[&str]) -> Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args(args)
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("runs the flexdyn binary")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A fresh folder with the base (`scenarios/acs_full.toml` with rw1 seizing at 1000 s, after
+/// the runs end) and the campaign that flies it from t = 0, open loop, one run.
+fn setup(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let base = format!(
+        "{}\n[[faults]]\ntarget = \"reaction_wheels.rw1\"\nmode = \"seized\"\nstart_s = 1000.0\n",
+        include_str!("../../scenarios/acs_full.toml")
+    );
+    std::fs::write(dir.join("base.toml"), base).unwrap();
+    std::fs::write(
+        dir.join("nominal.toml"),
+        format!("base = \"base.toml\"\nruns = 1\nseed = 1\nduration_s = {DURATION_S:?}\n"),
+    )
+    .unwrap();
+    dir
+}
+
+/// A campaign forked from `detumbled.ckpt` with `dispersions` (TOML) and a max-rate criterion.
+fn forked(dir: &Path, name: &str, runs: u32, dispersions: &str) -> PathBuf {
+    let text = format!(
+        "start_from = \"detumbled.ckpt\"\nruns = {runs}\nseed = 7\nduration_s = {DURATION_S:?}\n\
+         {dispersions}\n[[criteria]]\nname = \"rate\"\nquantity = \"omega\"\nstatistic = \"max\"\n\
+         below = 1.0\n"
+    );
+    let file = dir.join(name);
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
+fn take_checkpoint(dir: &Path) -> PathBuf {
+    let ckpt = dir.join("detumbled.ckpt");
+    let out = flexdyn(&[
+        "campaign",
+        "checkpoint",
+        dir.join("nominal.toml").to_str().unwrap(),
+        "--at-s",
+        &CHECKPOINT_S.to_string(),
+        "-o",
+        ckpt.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(stderr(&out).contains("at tick 40"), "{}", stderr(&out));
+    ckpt
+}
+
+/// The StateMsg payloads of the nominal campaign's base flown from t = 0 to the end, by tick:
+/// the server library with the campaign's settings, answered by the campaign's observer.
+fn uninterrupted(dir: &Path) -> Vec<(u64, Vec<u8>)> {
+    let c = Campaign::from_file(&dir.join("nominal.toml")).unwrap();
+    let cfg = SimConfig::from_toml_str_in(&c.base_toml, &c.base_dir()).unwrap();
+    let settings = single_settings(&c);
+    let args = ZenohArgs {
+        listen: vec!["tcp/127.0.0.1:0".into()],
+        connect: vec![],
+        zenoh_config: None,
+    };
+    let session = zenoh::open(zenoh_config(&args, Role::Server).unwrap())
+        .wait()
+        .unwrap();
+    let endpoint = listening_on(&session).into_iter().next().unwrap();
+    let server = std::thread::spawn(move || {
+        tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(1)
+            .enable_all()
+            .build()
+            .unwrap()
+            .block_on(flexdyn_server::run(
+                session,
+                settings,
+                cfg,
+                std::future::pending::<()>(),
+            ))
+            .map(|r| r.last_tick)
+    });
+    let obs = Observer::start(&endpoint, &Topics::new(SC_ID).unwrap(), OBSERVER_ID).unwrap();
+    let last = server.join().unwrap().unwrap();
+    assert_eq!(last, LAST_TICK);
+    let give_up = Instant::now() + Duration::from_secs(10);
+    loop {
+        let mut states = obs.states.lock().unwrap().clone();
+        if states.len() as u64 == LAST_TICK + 1 || Instant::now() > give_up {
+            states.sort_by_key(|(t, _)| *t);
+            let ticks: Vec<u64> = states.iter().map(|(t, _)| *t).collect();
+            assert_eq!(ticks, (0..=LAST_TICK).collect::<Vec<_>>());
+            return states;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+fn sha256_hex<'a>(payloads: impl Iterator<Item = &'a [u8]>) -> String {
+    let mut h = Sha256::new();
+    for p in payloads {
+        h.update(p);
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+fn run(file: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "campaign",
+        "run",
+        file.to_str().unwrap(),
+        "--output",
+        out.to_str().unwrap(),
+        "--base-port",
+        "0",
+    ];
+    args.extend_from_slice(extra);
+    flexdyn(&args)
+}
+
+fn result(out: &Path, run: u32) -> RunResult {
+    let path = out.join(format!("run-{run:04}")).join("result.json");
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// (1) and (2): a no-op dispersion hashes the uninterrupted run's states from tick K; a fault
+/// dispersed after K changes the stream from the tick after it strikes, and not before.
+#[test]
+fn forked_runs_continue_the_uninterrupted_run_from_the_checkpoint() {
+    let dir = setup("campaign_fork");
+    let ckpt = take_checkpoint(&dir);
+    let reference = uninterrupted(&dir);
+    let from_k = || reference.iter().filter(|(t, _)| *t >= K);
+    let want = sha256_hex(from_k().map(|(_, p)| p.as_slice()));
+    // The whole-run hash differs from the one from K: the comparison below can fail.
+    assert_ne!(
+        want,
+        sha256_hex(reference.iter().map(|(_, p)| p.as_slice()))
+    );
+
+    // (1) The fault is moved, but within [900, 950) s: after the end of every run.
+    let noop = forked(
+        &dir,
+        "noop.toml",
+        3,
+        "[[dispersions]]\nkey = \"faults[0].start_s\"\ndistribution = \"uniform\"\n\
+         low = 900.0\nhigh = 950.0\n",
+    );
+    let out = dir.join("noop-out");
+    let o = run(&noop, &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let file_sha = sha256_hex(std::iter::once(std::fs::read(&ckpt).unwrap().as_slice()));
+    assert!(
+        stderr(&o).contains(&format!("(sha256 {file_sha}) at tick {K}")),
+        "{}",
+        stderr(&o)
+    );
+    let mut moved = Vec::new();
+    for i in 0..3 {
+        let r = result(&out, i);
+        assert_eq!(r.status, "ok");
+        assert_eq!(r.start_tick, K);
+        assert_eq!(r.states, LAST_TICK - K + 1);
+        assert_eq!(r.state_sha256, want, "run {i}");
+        let note = r.criteria[0].note.as_deref().unwrap_or_default();
+        assert!(note.contains("seen from tick 40 (t = 4 s)"), "{note}");
+        moved.push(r.applied["faults[0].start_s"]);
+    }
+    assert!(
+        moved.iter().all(|t| (900.0..950.0).contains(t)),
+        "{moved:?}"
+    );
+    assert!(
+        moved[0] != moved[1],
+        "the dispersion drew one value: {moved:?}"
+    );
+    // The manifest and the summary record the fork.
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["start_from"]["sha256"], file_sha.as_str());
+    assert_eq!(manifest["start_from"]["tick"], K);
+    let sum = flexdyn(&["campaign", "summarize", out.to_str().unwrap()]);
+    assert!(
+        stderr(&sum).contains(&format!("forked: every run starts from checkpoint")),
+        "{}",
+        stderr(&sum)
+    );
+
+    // (2) The seizure is dispersed within (4.3, 4.9) s, after the checkpoint.
+    let fault = forked(
+        &dir,
+        "fault.toml",
+        3,
+        "[[dispersions]]\nkey = \"faults[0].start_s\"\ndistribution = \"uniform\"\n\
+         low = 4.3\nhigh = 4.9\n",
+    );
+    let out = dir.join("fault-out");
+    let o = run(&fault, &out, &["--record"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let state_key = Topics::new(SC_ID).unwrap().state().to_owned();
+    let mut hashes = Vec::new();
+    for i in 0..3 {
+        let r = result(&out, i);
+        assert_eq!(r.status, "ok");
+        let start_ns = (r.applied["faults[0].start_s"] * 1e9).round() as u64;
+        assert!((4_300_000_000..4_900_000_000).contains(&start_ns));
+        let struck_ns = r.fault_activations_ns["faults[0]"];
+        assert!(
+            (start_ns..start_ns + FRAME_NS).contains(&struck_ns),
+            "run {i}: planned {start_ns} ns, struck {struck_ns} ns"
+        );
+        // A fault is looked at once per step, at its start: the first step it acts on starts
+        // at the first step boundary at or after its edge, and the first state it changes is
+        // the tick after that boundary.
+        let first_step_ns = struck_ns.div_ceil(STEP_NS) * STEP_NS;
+        let first_changed = first_step_ns / FRAME_NS + 1;
+        let rec = flexdyn_sinks::reader::read_recording(
+            &out.join(format!("run-{i:04}")).join("recording.mcap"),
+        )
+        .unwrap();
+        let mut forked: Vec<(u64, Vec<u8>)> = rec
+            .samples
+            .iter()
+            .filter(|s| s.key == state_key)
+            .map(|s| {
+                let m = flexdyn_proto::decode_state(&s.payload).unwrap();
+                (m.header.tick, s.payload.clone())
+            })
+            .collect();
+        forked.sort_by_key(|(t, _)| *t);
+        assert_eq!(forked.first().map(|(t, _)| *t), Some(K), "run {i}");
+        assert_eq!(forked.len() as u64, LAST_TICK - K + 1, "run {i}");
+        for (tick, payload) in &forked {
+            let same = reference[*tick as usize].1 == *payload;
+            assert_eq!(
+                same,
+                *tick < first_changed,
+                "run {i}, tick {tick}: the seizure struck at {struck_ns} ns"
+            );
+        }
+        assert_eq!(
+            r.state_sha256,
+            sha256_hex(forked.iter().map(|(_, p)| p.as_slice()))
+        );
+        hashes.push(r.state_sha256);
+    }
+    hashes.dedup();
+    assert_eq!(hashes.len(), 3, "three fault times, three streams");
+}
+
+/// (3) What the checkpoint already fixed cannot be dispersed, a fault cannot be moved to before
+/// it, and a missing or damaged checkpoint is refused: each before any run starts, naming the
+/// campaign file, the field and why.
+#[test]
+fn a_fork_refuses_what_the_checkpoint_already_fixed() {
+    let dir = setup("campaign_fork_refusals");
+    take_checkpoint(&dir);
+    let refused = |name: &str, dispersions: &str, wants: &[&str]| {
+        let file = forked(&dir, name, 2, dispersions);
+        let out = dir.join(format!("{name}-out"));
+        let o = run(&file, &out, &[]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {e}");
+        assert!(e.contains(file.to_str().unwrap()), "{name}: {e}");
+        for w in wants {
+            assert!(e.contains(w), "{name}: wants {w:?} in {e}");
+        }
+        assert!(!out.exists(), "{name}: refused after the output was made");
+    };
+    refused(
+        "attitude.toml",
+        "[[dispersions]]\nkey = \"initial.sigma_bn\"\ndistribution = \"normal\"\nsigma = 0.01\n",
+        &[
+            "dispersions[0].key",
+            "initial.sigma_bn[0] is the state at t = 0",
+            "tick 40",
+        ],
+    );
+    refused(
+        "mass.toml",
+        "[[dispersions]]\nkey = \"hub.mass_kg\"\ndistribution = \"normal\"\nsigma = 1.0\n",
+        &[
+            "dispersions[0].key",
+            "hub.mass_kg acts on the flight from t = 0",
+        ],
+    );
+    refused(
+        "early_fault.toml",
+        "[[dispersions]]\nkey = \"faults[0].start_s\"\ndistribution = \"uniform\"\n\
+         low = 3.5\nhigh = 4.5\n",
+        &[
+            "dispersions[0].key",
+            "low = 3.5 s can draw a start at or before the checkpoint",
+        ],
+    );
+    refused(
+        "normal_fault.toml",
+        "[[dispersions]]\nkey = \"faults[0].start_s\"\ndistribution = \"normal\"\nsigma = 0.1\n",
+        &["a normal distribution can draw a start at or before the checkpoint"],
+    );
+    // A missing file, and one cut short.
+    let ckpt = std::fs::read(dir.join("detumbled.ckpt")).unwrap();
+    std::fs::rename(dir.join("detumbled.ckpt"), dir.join("kept.ckpt")).unwrap();
+    refused(
+        "missing.toml",
+        "",
+        &["start_from", "detumbled.ckpt", "cannot read it"],
+    );
+    std::fs::write(dir.join("detumbled.ckpt"), &ckpt[..ckpt.len() / 2]).unwrap();
+    refused(
+        "damaged.toml",
+        "",
+        &["start_from", "detumbled.ckpt", "cut short"],
+    );
+    // A checkpoint of a run with other participants (this one has a controller, sender 1) does
+    // not fit: the server's resume check, asked at plan time.
+    std::fs::write(dir.join("detumbled.ckpt"), &ckpt).unwrap();
+    let with_controller = forked(&dir, "controller.toml", 2, "controller = \"true\"\n");
+    let out = dir.join("controller-out");
+    let o = run(&with_controller, &out, &[]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("start_from") && e.contains("participant"), "{e}");
+    assert!(!out.exists());
+}
