@@ -220,7 +220,10 @@ fn forked_runs_continue_the_uninterrupted_run_from_the_checkpoint() {
     assert_eq!(manifest["start_from"]["tick"], K);
     let sum = flexdyn(&["campaign", "summarize", out.to_str().unwrap()]);
     assert!(
-        stderr(&sum).contains(&format!("forked: every run starts from checkpoint")),
+        stderr(&sum).contains(&format!(
+            "forked: every run starts from checkpoint {} (sha256 {file_sha}) at tick {K}",
+            ckpt.display()
+        )),
         "{}",
         stderr(&sum)
     );

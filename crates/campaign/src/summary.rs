@@ -710,6 +710,7 @@ mod tests {
                 sensor_seeds: BTreeMap::new(),
                 redraws: 0,
                 applied: [("hub.mass_kg".to_owned(), 400.0 + 50.0 * r as f64)].into(),
+                start_tick: 0,
                 state_sha256: String::new(),
                 vehicle_state_sha256: BTreeMap::new(),
                 states: 1,
