@@ -1,7 +1,9 @@
 //! `flexdyn campaign run`: each run is a lockstep server on its own loopback port, an observer
 //! participant in this process (sender id [`OBSERVER_ID`], answering `NoCommand`, so it sees
 //! every tick from 0), and the flight code as a child process (sender id 1), when the campaign
-//! has a `controller`. Open-loop runs have the observer only.
+//! has a `controller`. Open-loop runs have the observer only. In a campaign with `start_from`
+//! ([`super::fork`]) the server resumes the checkpoint, and everything below (the hash, the
+//! states, the criteria) starts at its tick.
 //!
 //! A run writes `run-NNNN/result.json`: the parameters read back from its built model, its
 //! seeds, the SHA-256 over its StateMsg payloads in tick order, the criteria, each fault's first

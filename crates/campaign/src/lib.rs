@@ -5,6 +5,8 @@
 //! - [`keys`]: TOML paths into a configuration (`panel_pairs[*].panel1.k_nm_rad`).
 //! - [`fleet`]: a campaign over a fleet file (`fleet` in place of `base`): each vehicle's
 //!   document to disperse, and a run's fleet file and vehicle configurations.
+//! - [`fork`]: a campaign whose runs all start from one checkpoint (`start_from`): the file
+//!   read and checked, what may be dispersed after it, what a run observes from its tick.
 //! - [`readback`]: the parameters of the built model, of one spacecraft or of every vehicle.
 //! - [`plan`]: per-run draws from the master seed, redraws of invalid draws, sensor seeds and
 //!   the manifest.

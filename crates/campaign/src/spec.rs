@@ -28,6 +28,10 @@
 //! below = 0.01
 //! ```
 //!
+//! Starting every run from a checkpoint (docs/guides/campaigns.md, "Start every run from a
+//! checkpoint"; [`super::fork`]): `start_from = "detumbled.ckpt"` (relative to this file) in
+//! place of `base`, and only a fault's window that opens after the checkpoint dispersed.
+//!
 //! Over a fleet (docs/guides/campaigns.md, "Campaigns over a fleet"): `fleet = "formation.toml"` replaces `base`,
 //! every dispersion and criterion names its `vehicle`, and `[[controllers]]` (one per vehicle,
 //! or one for several) replaces `controller`:
