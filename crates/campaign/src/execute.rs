@@ -816,7 +816,14 @@ pub fn nominal_checkpoint(
         dir,
         &mut exits,
     )
-    .map_err(|e| e.message)?;
+    .map_err(|e| match c.controller {
+        Some(_) => format!(
+            "{} (the controller's log: {})",
+            e.message,
+            dir.join(&log).display()
+        ),
+        None => e.message,
+    })?;
     if !file.is_file() {
         return Err(format!(
             "the run reached t = {} s and no checkpoint was written to {}",
