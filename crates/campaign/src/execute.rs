@@ -1260,6 +1260,19 @@ impl Progress {
 mod tests {
     use super::*;
 
+    /// A forked run's stream is complete from the checkpoint's tick: every tick K..=N once, in
+    /// order; one from tick 0, a gap or a repeat is not.
+    #[test]
+    fn a_stream_is_complete_from_its_first_tick() {
+        let s = |ticks: &[u64]| ticks.iter().map(|t| (*t, Vec::new())).collect::<Vec<_>>();
+        assert!(complete(&s(&[40, 41, 42]), 40, 42));
+        assert!(complete(&s(&[0, 1, 2]), 0, 2));
+        assert!(!complete(&s(&[0, 1, 2]), 1, 2));
+        assert!(!complete(&s(&[40, 42]), 40, 42));
+        assert!(!complete(&s(&[40, 41, 41]), 40, 42));
+        assert!(!complete(&s(&[]), 40, 39));
+    }
+
     /// Issue 36: without a terminal the progress is plain lines, at every tenth of the runs,
     /// at the last, and every 5 s while nothing finishes.
     #[test]
