@@ -365,3 +365,97 @@ fn a_fork_refuses_what_the_checkpoint_already_fixed() {
     assert!(e.contains("start_from") && e.contains("participant"), "{e}");
     assert!(!out.exists());
 }
+
+/// (1) in lockstep with flight code: the reference spacecraft under `flexdyn-acs-demo` (on the
+/// true attitude and rate, so its commands are a function of each tick's telemetry alone, which
+/// is what a participant must be for a resume to be bit for bit; docs/guides/checkpoints.md).
+/// The oracle is the same campaign flown whole from t = 0 with `--record`: its recorded states
+/// from the checkpoint's tick on (the recording holds the bytes the server published; the
+/// forked runs' hash is over the same bytes as the observer received them).
+#[test]
+fn forked_runs_with_flight_code_continue_the_uninterrupted_run() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("campaign_fork_fsw");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // A link dropout after the end of the runs: its window is what the forks disperse.
+    let base = format!(
+        "{}\n[[faults]]\ntarget = \"links.1\"\nmode = \"dropped\"\nstart_s = 1000.0\n\
+         duration_s = 0.5\n",
+        include_str!("../../scenarios/reference.toml")
+    );
+    std::fs::write(dir.join("base.toml"), base).unwrap();
+    let controller = format!(
+        "controller = \"{} --connect {{endpoint}} --sc-id {{sc_id}} --sender-id {{sender_id}} \
+         --sigma-rn 0.1,0.2,-0.1 --rate-source truth --log-every-s 0 --idle-exit-s 5\"\n",
+        flexdyn_testkit::demo_bin::acs_demo()
+    );
+    // 2 s at 100 Hz: ticks 0..=200, the checkpoint at 1.6 s (tick 160, 80 %).
+    let campaign = |head: &str| {
+        format!(
+            "{head}\nruns = 2\nseed = 3\nduration_s = 2.0\nsigma_rn = [0.1, 0.2, -0.1]\n\
+             {controller}[[dispersions]]\nkey = \"faults[0].start_s\"\ndistribution = \
+             \"uniform\"\nlow = 900.0\nhigh = 950.0\n"
+        )
+    };
+    std::fs::write(dir.join("whole.toml"), campaign("base = \"base.toml\"")).unwrap();
+    std::fs::write(
+        dir.join("forked.toml"),
+        campaign("start_from = \"detumbled.ckpt\""),
+    )
+    .unwrap();
+    let o = flexdyn(&[
+        "campaign",
+        "checkpoint",
+        dir.join("whole.toml").to_str().unwrap(),
+        "--at-s",
+        "1.6",
+        "-o",
+        dir.join("detumbled.ckpt").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("at tick 160"), "{}", stderr(&o));
+
+    let whole = dir.join("whole-out");
+    let o = run(&dir.join("whole.toml"), &whole, &["--record"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let state_key = Topics::new(SC_ID).unwrap().state().to_owned();
+    let rec =
+        flexdyn_sinks::reader::read_recording(&whole.join("run-0000/recording.mcap")).unwrap();
+    let mut states: Vec<(u64, Vec<u8>)> = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == state_key)
+        .map(|s| {
+            let m = flexdyn_proto::decode_state(&s.payload).unwrap();
+            (m.header.tick, s.payload.clone())
+        })
+        .collect();
+    states.sort_by_key(|(t, _)| *t);
+    assert_eq!(
+        states.iter().map(|(t, _)| *t).collect::<Vec<_>>(),
+        (0..=200).collect::<Vec<_>>()
+    );
+    // The recording is the stream the observer hashed.
+    assert_eq!(
+        sha256_hex(states.iter().map(|(_, p)| p.as_slice())),
+        result(&whole, 0).state_sha256
+    );
+    let want = sha256_hex(
+        states
+            .iter()
+            .filter(|(t, _)| *t >= 160)
+            .map(|(_, p)| p.as_slice()),
+    );
+
+    let forked = dir.join("forked-out");
+    let o = run(&dir.join("forked.toml"), &forked, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for i in 0..2 {
+        let r = result(&forked, i);
+        assert_eq!(r.status, "ok");
+        assert_eq!(r.start_tick, 160);
+        assert_eq!(r.states, 41);
+        assert_eq!(r.controller_exit.as_deref(), Some("exit 0"));
+        assert_eq!(r.state_sha256, want, "run {i}");
+    }
+}
