@@ -95,7 +95,14 @@ fn take_checkpoint(dir: &Path) -> PathBuf {
 fn uninterrupted(dir: &Path) -> Vec<(u64, Vec<u8>)> {
     let c = Campaign::from_file(&dir.join("nominal.toml")).unwrap();
     let cfg = SimConfig::from_toml_str_in(&c.base_toml, &c.base_dir()).unwrap();
-    let settings = single_settings(&c);
+    fly_from_zero(&c, cfg, None)
+}
+
+/// The StateMsg payloads of `cfg` flown from t = 0 to the end with campaign `c`'s settings (no
+/// checkpoint, no resume), by tick, recorded to `record` if given.
+fn fly_from_zero(c: &Campaign, cfg: SimConfig, record: Option<PathBuf>) -> Vec<(u64, Vec<u8>)> {
+    let mut settings = single_settings(c);
+    settings.record = record;
     let args = ZenohArgs {
         listen: vec!["tcp/127.0.0.1:0".into()],
         connect: vec![],
@@ -288,6 +295,81 @@ fn forked_runs_continue_the_uninterrupted_run_from_the_checkpoint() {
     }
     hashes.dedup();
     assert_eq!(hashes.len(), 3, "three fault times, three streams");
+}
+
+/// The payloads recorded in `file` under `key`, in log-time order, with their \[ns\] log time.
+fn recorded(file: &Path, key: &str) -> Vec<(u64, Vec<u8>)> {
+    let rec = flexdyn_sinks::reader::read_recording(file).unwrap();
+    let mut out: Vec<(u64, Vec<u8>)> = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == key)
+        .map(|s| (s.log_time_ns, s.payload.clone()))
+        .collect();
+    out.sort_by_key(|(t, _)| *t);
+    out
+}
+
+/// (4) A random fault (`mtbf_s`) that opens after the checkpoint gets each run's own seed, and
+/// the run is the flight of its own configuration: a noise fault on the star tracker, whose
+/// generator the checkpoint holds with the base's seed, draws from the run's seed. Each forked
+/// run's states from tick K and its star tracker's samples from the checkpoint on are those
+/// of its run-NNNN/config.toml flown from t = 0 by the server library.
+#[test]
+fn a_random_fault_after_the_checkpoint_draws_from_each_runs_own_seed() {
+    let dir = setup("campaign_fork_random_fault");
+    // faults[1]: noise on st1 from a failure time after 4.05 s (mean 0.1 s later).
+    let mut base = std::fs::read_to_string(dir.join("base.toml")).unwrap();
+    base.push_str(
+        "\n[[faults]]\ntarget = \"star_trackers.st1\"\nmode = \"noise\"\nsigma = 0.01\n\
+         start_s = 4.05\nmtbf_s = 0.1\nseed = 5\n",
+    );
+    std::fs::write(dir.join("base.toml"), base).unwrap();
+    take_checkpoint(&dir);
+    let file = forked(&dir, "random.toml", 3, "");
+    let out = dir.join("random-out");
+    let o = run(&file, &out, &["--record"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let c = Campaign::from_file(&file).unwrap();
+    let st1 = Topics::new(SC_ID).unwrap().star_tracker("st1").unwrap();
+    let t_k = K * FRAME_NS;
+    let mut streams = Vec::new();
+    for i in 0..3 {
+        let r = result(&out, i);
+        assert_eq!(r.status, "ok", "run {i}");
+        let struck = r.fault_activations_ns.get("faults[1]").copied();
+        assert!(
+            struck.is_some_and(|t| t > 4_050_000_000),
+            "run {i}: the noise fault struck at {struck:?} ns"
+        );
+        let run_dir = out.join(format!("run-{i:04}"));
+        let text = std::fs::read_to_string(run_dir.join("config.toml")).unwrap();
+        let cfg = SimConfig::from_toml_str_in(&text, &c.base_dir()).unwrap();
+        let whole = dir.join(format!("whole-{i}.mcap"));
+        let states = fly_from_zero(&c, cfg, Some(whole.clone()));
+        let want = sha256_hex(
+            states
+                .iter()
+                .filter(|(t, _)| *t >= K)
+                .map(|(_, p)| p.as_slice()),
+        );
+        assert_eq!(r.state_sha256, want, "run {i}");
+        let forked = recorded(&run_dir.join("recording.mcap"), &st1);
+        let from_zero: Vec<_> = recorded(&whole, &st1)
+            .into_iter()
+            .filter(|(t, _)| *t >= forked.first().map_or(t_k, |f| f.0))
+            .collect();
+        assert!(forked.len() >= 5, "run {i}: {} st1 samples", forked.len());
+        assert!(forked.iter().all(|(t, _)| *t >= t_k));
+        assert_eq!(forked.len(), from_zero.len(), "run {i}");
+        for (f, z) in forked.iter().zip(&from_zero) {
+            assert_eq!(f, z, "run {i}: the st1 sample at {} ns", f.0);
+        }
+        streams.push(forked);
+    }
+    // Three seeds, three noise streams.
+    assert_ne!(streams[0], streams[1]);
+    assert_ne!(streams[1], streams[2]);
 }
 
 /// (3) What the checkpoint already fixed cannot be dispersed, a fault cannot be moved to before
