@@ -752,33 +752,41 @@ fn decode_states(states: &[(u64, Vec<u8>)]) -> Vec<StateMsg> {
         .collect()
 }
 
-/// `flexdyn campaign checkpoint`: flies campaign `c`'s base configuration, undispersed, as its
-/// runs are flown (its lockstep server, observer and controller, spacecraft [`SC_ID`]) up to
-/// `tick` and saves the checkpoint there to `file`: the checkpoint a `start_from` of the same
-/// campaign fits. Its controller's log is `file` with `.controller.log` appended. Returns the
-/// checkpoint's \[ns\] simulation time.
+/// `flexdyn campaign checkpoint`: flies campaign `c`'s base configuration `cfg`, undispersed,
+/// as its runs are flown (its lockstep server, observer and controller, spacecraft [`SC_ID`])
+/// up to `tick` and saves the checkpoint there to `file`: the checkpoint a `start_from` of the
+/// same campaign fits ([`super::fork::checkpoint_at`] gives `cfg` and `tick`, and refuses a
+/// campaign that has none). An older `file` is removed first, and the one written is read back
+/// and its tick checked, so a stale file is never reported as written. Its controller's log is
+/// `file` with `.controller.log` appended. Returns the checkpoint's \[ns\] simulation time.
 pub fn nominal_checkpoint(
     c: &Campaign,
+    cfg: SimConfig,
     tick: u64,
     file: &Path,
     base_port: u16,
 ) -> Result<u64, String> {
-    if c.fleet.is_some() {
-        return Err("a campaign over a fleet cannot start from a checkpoint yet".into());
-    }
-    if c.start_from.is_some() {
-        return Err(
-            "this campaign already starts from a checkpoint (start_from): take the checkpoint \
-             with the campaign that flies from t = 0"
-                .into(),
-        );
-    }
     let dir = file
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let cfg = SimConfig::from_toml_str_in(&c.base_toml, &c.base_dir())
-        .map_err(|e| c.base_error(e).to_string())?;
+    if !dir.is_dir() {
+        return Err(format!(
+            "cannot write {}: the directory {} does not exist",
+            file.display(),
+            dir.display()
+        ));
+    }
+    match std::fs::remove_file(file) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => {
+            return Err(format!(
+                "cannot remove the older {} before writing it: {e}",
+                file.display()
+            ))
+        }
+    }
     let mut settings = single_settings(c);
     settings.duration_ns = Some(tick.saturating_mul(cfg.frame_ns));
     settings.checkpoints.save_at = Some((tick, file.to_owned()));
@@ -829,6 +837,15 @@ pub fn nominal_checkpoint(
             "the run reached t = {} s and no checkpoint was written to {}",
             observed.sim_time_ns as f64 * 1e-9,
             file.display()
+        ));
+    }
+    let (_, header) = flexdyn_server::checkpoint::read(file, flexdyn_server::checkpoint::FRONT_END)
+        .map_err(|e| format!("the checkpoint written does not read back: {e}"))?;
+    if header.tick != tick {
+        return Err(format!(
+            "{} holds tick {}, not tick {tick} as asked",
+            file.display(),
+            header.tick
         ));
     }
     Ok(observed.sim_time_ns)

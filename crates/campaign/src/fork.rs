@@ -209,9 +209,28 @@ pub fn check_draws(
     }
 }
 
-/// The frame boundary of `flexdyn campaign checkpoint --at-s` for campaign `c`: a whole number
-/// of frames, after t = 0 and before the end of the runs.
-pub fn checkpoint_tick(c: &super::spec::Campaign, at_s: f64) -> Result<u64, CampaignError> {
+/// Why a campaign over a fleet has no fork (`start_from`), nor a checkpoint to fork from.
+pub const NO_FLEET_YET: &str = "a campaign over a fleet cannot start from a checkpoint yet";
+
+/// What `flexdyn campaign checkpoint --at-s` flies for campaign `c`: its base configuration
+/// and the frame boundary, a whole number of frames after t = 0 and before the end of the runs.
+/// Refused (invalid input): a campaign over a fleet, one that already starts from a checkpoint,
+/// and a time that is not such a boundary.
+pub fn checkpoint_at(
+    c: &super::spec::Campaign,
+    at_s: f64,
+) -> Result<(SimConfig, u64), CampaignError> {
+    if c.fleet.is_some() {
+        return Err(c.invalid("fleet", NO_FLEET_YET.into()));
+    }
+    if c.start_from.is_some() {
+        return Err(c.invalid(
+            "start_from",
+            "this campaign already starts from a checkpoint: take the checkpoint with the \
+             campaign that flies from t = 0"
+                .into(),
+        ));
+    }
     let bad = |problem: String| CampaignError::Invalid {
         path: c.path.clone(),
         field: "--at-s".into(),
@@ -235,5 +254,6 @@ pub fn checkpoint_tick(c: &super::spec::Campaign, at_s: f64) -> Result<u64, Camp
             Num(c.duration_s)
         )));
     }
-    Ok(t_ns / cfg.frame_ns)
+    let tick = t_ns / cfg.frame_ns;
+    Ok((cfg, tick))
 }

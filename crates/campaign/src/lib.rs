@@ -268,23 +268,9 @@ pub fn main(cmd: &CampaignCommand) -> Result<Report, (u8, String)> {
             base_port,
         } => {
             let c = load(file, false).map_err(bad)?;
-            if c.start_from.is_some() || c.fleet.is_some() {
-                let (field, why) = match c.fleet {
-                    Some(_) => (
-                        "fleet",
-                        "a campaign over a fleet cannot start from a checkpoint yet",
-                    ),
-                    None => (
-                        "start_from",
-                        "this campaign already starts from a checkpoint: take the checkpoint with \
-                         the campaign that flies from t = 0",
-                    ),
-                };
-                return Err(bad(c.invalid(field, why.into())));
-            }
-            let tick = fork::checkpoint_tick(&c, *at_s).map_err(bad)?;
+            let (cfg, tick) = fork::checkpoint_at(&c, *at_s).map_err(bad)?;
             let started = std::time::Instant::now();
-            let t_ns = execute::nominal_checkpoint(&c, tick, output, *base_port)
+            let t_ns = execute::nominal_checkpoint(&c, cfg, tick, output, *base_port)
                 .map_err(|e| (verdict::EXIT_NOT_RUN, format!("{}: {e}", file.display())))?;
             Ok(Report {
                 text: format!(

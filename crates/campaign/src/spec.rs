@@ -417,8 +417,8 @@ impl Campaign {
             return Err(invalid(
                 "start_from",
                 format!(
-                    "a campaign over a fleet cannot start from a checkpoint yet ({} is one \
-                     spacecraft's); start_from works with base",
+                    "{} ({} is one spacecraft's); start_from works with base",
+                    super::fork::NO_FLEET_YET,
                     start.path.display()
                 ),
             ));
