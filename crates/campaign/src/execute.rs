@@ -480,7 +480,12 @@ fn sha256_hex(states: &[(u64, Vec<u8>)]) -> String {
     for (_, p) in states {
         h.update(p);
     }
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    hex(&h.finalize())
+}
+
+/// Lower-case hex of `bytes` (a digest, as the manifest and results write it).
+pub fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// `r`'s samples, sorted by tick.

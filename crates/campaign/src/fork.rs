@@ -23,6 +23,8 @@ use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
 
+use super::execute::hex;
+use super::readback::{nearest_ns, FAULT_WINDOW_FIELDS};
 use super::spec::CampaignError;
 use flexdyn_kernel::numfmt::Num;
 use flexdyn_server::checkpoint::{Resumed, FRONT_END};
@@ -123,11 +125,6 @@ pub fn line_of(file: &str, sha256: &str, tick: u64, t_s: f64) -> String {
     )
 }
 
-/// Lower-case hex of `bytes`.
-pub fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
-}
-
 /// The fault index and field of a concrete key `faults[k].<field>`, if it is one.
 fn fault_field(key: &str) -> Option<(usize, &str)> {
     let (k, field) = key.strip_prefix("faults[")?.split_once("].")?;
@@ -145,6 +142,7 @@ pub fn check_key(key: &str, cfg: &SimConfig, start: &StartFrom) -> Result<(), St
         start.tick,
         Num(start.t_s())
     );
+    let fields = FAULT_WINDOW_FIELDS.join(", ");
     let Some((k, field)) = fault_field(key) else {
         let what = if key.starts_with("initial.") {
             "is the state at t = 0"
@@ -155,16 +153,15 @@ pub fn check_key(key: &str, cfg: &SimConfig, start: &StartFrom) -> Result<(), St
             "{key} {what}; every run starts from {at}, whose state already holds its effect, so \
              a run with another value would not be the flight the checkpoint continues: only \
              what acts after the checkpoint can be dispersed (the window of a fault that opens \
-             after it: faults[k].start_s, duration_s, period_s)"
+             after it: faults[k].{fields})"
         ));
     };
     let Some(fault) = cfg.faults.get(k) else {
         return Err(format!("{key}: the base has no faults[{k}]"));
     };
-    if !matches!(field, "start_s" | "duration_s" | "period_s") {
+    if !FAULT_WINDOW_FIELDS.contains(&field) {
         return Err(format!(
-            "{key}: only a fault's window (start_s, duration_s, period_s) can be dispersed \
-             from {at}"
+            "{key}: only a fault's window ({fields}) can be dispersed from {at}"
         ));
     }
     if fault.window.start_ns <= start.t_sim_ns {
@@ -185,26 +182,33 @@ pub fn check_draws(
     distribution: &super::spec::Distribution,
     start: &StartFrom,
 ) -> Result<(), String> {
+    use super::spec::Distribution;
     if fault_field(key).map(|(_, f)| f) != Some("start_s") {
         return Ok(());
     }
-    let t_k = start.t_s();
+    let t_k = Num(start.t_s());
+    let ckpt = start.path.display();
     match distribution {
-        super::spec::Distribution::Uniform { low, .. } if *low > t_k => Ok(()),
-        super::spec::Distribution::Uniform { low, .. } => Err(format!(
-            "{key}: low = {} s can draw a start at or before the checkpoint {} (t = {} s): the \
-             fault would have struck in the flight the checkpoint already holds; give low > {}",
+        // A draw is rounded to the nanosecond: `low` must be after the checkpoint once rounded.
+        Distribution::Uniform { low, .. }
+            if nearest_ns(*low).is_some_and(|l| l > start.t_sim_ns) =>
+        {
+            Ok(())
+        }
+        Distribution::Uniform { low, .. } => Err(format!(
+            "{key}: low = {} s can draw a start at or before the checkpoint {ckpt} (t = {t_k} \
+             s): the fault would have struck in the flight the checkpoint already holds; give \
+             low > {t_k}",
             Num(*low),
-            start.path.display(),
-            Num(t_k),
-            Num(t_k)
         )),
-        _ => Err(format!(
-            "{key}: a normal distribution can draw a start at or before the checkpoint {} (t = \
-             {} s); use distribution = \"uniform\" with low > {}",
-            start.path.display(),
-            Num(t_k),
-            Num(t_k)
+        Distribution::Normal { .. } => Err(format!(
+            "{key}: a normal distribution can draw a start at or before the checkpoint {ckpt} \
+             (t = {t_k} s); use distribution = \"uniform\" with low > {t_k}"
+        )),
+        Distribution::UniformAttitude => Err(format!(
+            "{key}: uniform_attitude draws an orientation, not a time; a start after the \
+             checkpoint {ckpt} (t = {t_k} s) is drawn from distribution = \"uniform\" with \
+             low > {t_k}"
         )),
     }
 }

@@ -43,8 +43,8 @@ use toml::Table;
 
 use super::fleet::{offsets_table, FleetBase};
 use super::keys;
-use super::readback::fleet_readback;
 pub use super::readback::readback;
+use super::readback::{fleet_readback, nearest_ns, FAULT_WINDOW_FIELDS};
 use super::spec::{Campaign, CampaignError, Distribution};
 use flexdyn_sensors::rng::NormalRng;
 use flexdyn_vehicle::config::SimConfig;
@@ -457,10 +457,7 @@ impl Plan {
     /// The manifest (JSON) of `runs`.
     pub fn manifest(&self, runs: &[RunPlan]) -> serde_json::Value {
         let c = &self.campaign;
-        let sha: String = Sha256::digest(c.source.as_bytes())
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect();
+        let sha = super::execute::hex(&Sha256::digest(c.source.as_bytes()));
         let mut m = serde_json::json!({
             "campaign_sha256": sha,
             "flexdyn_version": env!("CARGO_PKG_VERSION"),
@@ -618,17 +615,16 @@ fn check_fleet_key(fleet: &FleetBase, id: &str, key: &str) -> Result<(), String>
 }
 
 /// `x` drawn for key `k`, rounded to a whole nanosecond if `k` is a fault's window time
-/// (`faults[k].start_s`, `duration_s`, `period_s`), which the configuration takes only in whole
-/// nanoseconds.
+/// ([`FAULT_WINDOW_FIELDS`]), which the configuration takes only in whole nanoseconds (a value
+/// that is not a time is left for the configuration to refuse).
 fn whole_ns_if_time(k: &str, x: f64) -> f64 {
     let time = k.starts_with("faults[")
-        && [".start_s", ".duration_s", ".period_s"]
+        && FAULT_WINDOW_FIELDS
             .iter()
-            .any(|f| k.ends_with(f));
-    if time {
-        (x * 1e9).round() / 1e9
-    } else {
-        x
+            .any(|f| k.strip_suffix(f).is_some_and(|h| h.ends_with('.')));
+    match nearest_ns(x) {
+        Some(ns) if time => ns as f64 * 1e-9,
+        _ => x,
     }
 }
 

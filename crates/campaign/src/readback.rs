@@ -85,15 +85,29 @@ pub fn readback(
             continue;
         }
         let w = &f.window;
-        out.insert(format!("faults[{k}].start_s"), w.start_ns as f64 * 1e-9);
-        if let Some(d) = w.duration_ns {
-            out.insert(format!("faults[{k}].duration_s"), d as f64 * 1e-9);
-        }
-        if let Some(p) = w.period_ns {
-            out.insert(format!("faults[{k}].period_s"), p as f64 * 1e-9);
+        for (field, ns) in
+            FAULT_WINDOW_FIELDS
+                .iter()
+                .zip([Some(w.start_ns), w.duration_ns, w.period_ns])
+        {
+            if let Some(ns) = ns {
+                out.insert(format!("faults[{k}].{field}"), ns as f64 * 1e-9);
+            }
         }
     }
     Ok(out)
+}
+
+/// The fields of a fault's window (`faults[k].<field>`), in seconds, which the configuration
+/// takes only in whole nanoseconds: what [`readback`] reads back of a scheduled fault, what a
+/// campaign rounds a draw of to the nanosecond, and all a forked campaign may disperse.
+pub const FAULT_WINDOW_FIELDS: [&str; 3] = ["start_s", "duration_s", "period_s"];
+
+/// `x` \[s\] to the nearest whole nanosecond, `None` if it is not a time (not finite, < 0,
+/// beyond `u64` nanoseconds): the configuration's own conversion
+/// ([`flexdyn_kernel::schema::checks::round_ns`]) of the rounded value.
+pub fn nearest_ns(x: f64) -> Option<u64> {
+    flexdyn_kernel::schema::checks::round_ns((x * 1e9).round())
 }
 
 /// Every vehicle's [`readback`], keys prefixed with `<id>.`, and for each vehicle given relative
