@@ -174,6 +174,42 @@ pub fn check_key(key: &str, cfg: &SimConfig, start: &StartFrom) -> Result<(), St
     Ok(())
 }
 
+/// Whether criterion `c` of a campaign forked from `start` over the base `cfg` can be judged:
+/// a flight code's latency after a fault (`fsw_event_latency`) needs the fault to open after
+/// the checkpoint. One that opens at or before it struck in the checkpoint's flight, before
+/// the flight code of a fork started: no fork would measure a latency, and every one would
+/// pass it as "did not activate within the run".
+pub fn check_criterion(
+    c: &super::criteria::Criterion,
+    cfg: &SimConfig,
+    start: &StartFrom,
+) -> Result<(), String> {
+    let Some(super::criteria::FswRef {
+        target: super::criteria::FswTarget::Event { fault: Some(k), .. },
+        ..
+    }) = &c.fsw
+    else {
+        return Ok(());
+    };
+    let Some(fault) = cfg.faults.get(*k) else {
+        return Ok(());
+    };
+    if fault.window.start_ns <= start.t_sim_ns {
+        return Err(format!(
+            "{}: faults[{k}] opens at t = {} s, not after the checkpoint {} at tick {} (t = {} \
+             s): it struck in the checkpoint's flight, before each run's flight code started, so \
+             no run could measure a latency after it and every run would pass the criterion \
+             without one; name a fault that opens after the checkpoint",
+            c.name,
+            Num(fault.window.start_ns as f64 * 1e-9),
+            start.path.display(),
+            start.tick,
+            Num(start.t_s())
+        ));
+    }
+    Ok(())
+}
+
 /// Whether a draw of `distribution` for the key `key` (already [`check_key`]ed) always falls
 /// after the checkpoint: a fault's `start_s` must be drawn after it, so only a uniform
 /// distribution whose `low` is after it is accepted (a normal one can draw any time).

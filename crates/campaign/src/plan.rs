@@ -236,6 +236,10 @@ impl Plan {
                             format!("{e} (the campaign's base and lockstep participants)"),
                         )
                     })?;
+                    for (i, k) in campaign.criteria.iter().enumerate() {
+                        super::fork::check_criterion(k, &cfg, start)
+                            .map_err(|e| campaign.invalid(&format!("criteria[{i}].fault"), e))?;
+                    }
                 }
                 let fork_at_s = campaign.start_from.as_ref().map(|s| s.t_s());
                 (
