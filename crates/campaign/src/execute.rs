@@ -85,6 +85,11 @@ pub struct RunResult {
     /// every run from one (`start_from`), else 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub start_tick: u64,
+    /// SHA-256 (hex) of the checkpoint file this run started from (`start_from`), as the run
+    /// read it; empty for a run from t = 0. `summarize` flags a run whose checkpoint is not the
+    /// manifest's.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub start_from_sha256: String,
     /// Over a fleet: the SHA-256 over each vehicle's StateMsg payloads, ticks 0..=N in order,
     /// by vehicle id (empty if the run failed).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
@@ -132,6 +137,7 @@ impl RunResult {
             applied: BTreeMap::new(),
             state_sha256: String::new(),
             start_tick: 0,
+            start_from_sha256: String::new(),
             vehicle_state_sha256: BTreeMap::new(),
             states: 0,
             fault_activations_ns: BTreeMap::new(),
@@ -913,6 +919,10 @@ fn run_inner(
     let observed = observed?;
     let states = &observed.states[0];
     result.start_tick = start_tick;
+    result.start_from_sha256 = c
+        .start_from
+        .as_ref()
+        .map_or_else(String::new, |s| s.sha256.clone());
     result.state_sha256 = sha256_hex(states);
     result.states = states.len() as u64;
     result.fault_activations_ns = first_activations("", &observed.faults[0]);
