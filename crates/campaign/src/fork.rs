@@ -17,7 +17,10 @@
 //!   a configured fault that opens after it. Anything that acted before K (the initial state, a
 //!   mass, a sensor's noise) is already fixed by the checkpoint's state, and a run that changed
 //!   it would not be the flight the checkpoint continues: it is refused with the reason.
-//! - What every run observes, hashes and judges starts at tick K ([`StartFrom::tick`]).
+//! - A flight-code latency from a fault (`fsw_event_latency`) must name a fault that opens after
+//!   the checkpoint ([`check_criterion`]): no fork observes one that struck before it.
+//! - What every run observes, hashes and judges starts at tick K ([`StartFrom::tick`]); each
+//!   result records the SHA-256 of the checkpoint it read (`start_from_sha256`).
 
 use std::path::{Path, PathBuf};
 
