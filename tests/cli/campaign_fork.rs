@@ -87,6 +87,12 @@ fn take_checkpoint(dir: &Path) -> PathBuf {
     ]);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     assert!(stderr(&out).contains("at tick 40"), "{}", stderr(&out));
+    // The campaign file is in the same folder: its start_from is the file name.
+    assert!(
+        stderr(&out).contains("start_from = \"detumbled.ckpt\" (relative to the campaign file)"),
+        "{}",
+        stderr(&out)
+    );
     ckpt
 }
 

@@ -172,6 +172,19 @@ fn load(
     Ok(c)
 }
 
+/// `output` as a campaign file `campaign` names it in `start_from` (relative to the campaign
+/// file's folder): the path below that folder, else the absolute path.
+fn relative_to_campaign(campaign: &std::path::Path, output: &std::path::Path) -> PathBuf {
+    let abs = |p: &std::path::Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_owned());
+    let out = abs(output);
+    let folder = abs(campaign
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new(".")));
+    out.strip_prefix(&folder)
+        .map_or(out.clone(), |p| p.to_owned())
+}
+
 /// Runs a `flexdyn campaign` subcommand; returns its report, or the exit code (2 for invalid
 /// input, 1 for a directory that cannot be written or read) and an error message.
 pub fn main(cmd: &CampaignCommand) -> Result<Report, (u8, String)> {
@@ -272,14 +285,16 @@ pub fn main(cmd: &CampaignCommand) -> Result<Report, (u8, String)> {
             let started = std::time::Instant::now();
             let t_ns = execute::nominal_checkpoint(&c, cfg, tick, output, *base_port)
                 .map_err(|e| (verdict::EXIT_NOT_RUN, format!("{}: {e}", file.display())))?;
+            // start_from is read relative to the campaign file, not to where this runs.
+            let from_campaign = relative_to_campaign(file, output);
             Ok(Report {
                 text: format!(
-                    "wrote {} at tick {tick} (t = {} s) in {:.1} s: start_from = \"{}\" starts \
-                     every run of the campaign there",
+                    "wrote {} at tick {tick} (t = {} s) in {:.1} s: start_from = \"{}\" \
+                     (relative to the campaign file) starts every run of the campaign there",
                     output.display(),
                     flexdyn_kernel::numfmt::Num(t_ns as f64 * 1e-9),
                     started.elapsed().as_secs_f64(),
-                    output.display()
+                    from_campaign.display()
                 ),
                 exit_code: verdict::EXIT_PASSED,
             })
