@@ -212,6 +212,7 @@ fn forked_runs_continue_the_uninterrupted_run_from_the_checkpoint() {
         let r = result(&out, i);
         assert_eq!(r.status, "ok");
         assert_eq!(r.start_tick, K);
+        assert_eq!(r.start_from_sha256, file_sha, "run {i}");
         assert_eq!(r.states, LAST_TICK - K + 1);
         assert_eq!(r.state_sha256, want, "run {i}");
         let note = r.criteria[0].note.as_deref().unwrap_or_default();
@@ -237,6 +238,25 @@ fn forked_runs_continue_the_uninterrupted_run_from_the_checkpoint() {
             "forked: every run starts from checkpoint {} (sha256 {file_sha}) at tick {K}",
             ckpt.display()
         )),
+        "{}",
+        stderr(&sum)
+    );
+    // A run whose result names another checkpoint (the file replaced between the plan and
+    // the run) is flagged.
+    let r1 = out.join("run-0001").join("result.json");
+    let text = std::fs::read_to_string(&r1).unwrap();
+    std::fs::write(&r1, text.replace(&file_sha, &"0".repeat(64))).unwrap();
+    let sum = flexdyn(&["campaign", "summarize", out.to_str().unwrap()]);
+    assert!(
+        stderr(&sum).contains(&format!(
+            "run 1: started from a checkpoint with sha256 {}, not the manifest's",
+            "0".repeat(64)
+        )),
+        "{}",
+        stderr(&sum)
+    );
+    assert!(
+        !stderr(&sum).contains("run 0: started from"),
         "{}",
         stderr(&sum)
     );
