@@ -396,6 +396,162 @@ fn a_random_fault_after_the_checkpoint_draws_from_each_runs_own_seed() {
     // Three seeds, three noise streams.
     assert_ne!(streams[0], streams[1]);
     assert_ne!(streams[1], streams[2]);
+    // Without the random faults the runs would not fit the checkpoint, which holds their state.
+    let out = dir.join("without-out");
+    let o = run(&file, &out, &["--without-random-faults"]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("start_from") && e.contains("--without-random-faults would remove 1 fault(s)"),
+        "{e}"
+    );
+    assert!(!out.exists());
+}
+
+/// (5) What does not fit a fork or its checkpoint, each refused as invalid input (exit 2)
+/// before anything runs: a `base` beside `start_from` that is not the checkpoint's
+/// configuration, a checkpoint at or after the end of the runs, a flight-code latency from a
+/// fault that opened before the checkpoint; and `campaign checkpoint` of a forked campaign, of
+/// a fleet, or at a time that is not a frame boundary within the run. A checkpoint that
+/// cannot be written (a missing directory) or whose run stops early is an error (exit 1), and
+/// never leaves an older file in its place.
+#[test]
+fn a_fork_and_its_checkpoint_refuse_what_does_not_fit() {
+    let dir = setup("campaign_fork_fit");
+    // faults[1]: a star-tracker dropout at 2 s, before the checkpoint.
+    let mut base = std::fs::read_to_string(dir.join("base.toml")).unwrap();
+    base.push_str(
+        "\n[[faults]]\ntarget = \"star_trackers.st1\"\nmode = \"dropout\"\nstart_s = 2.0\n\
+         duration_s = 0.5\n",
+    );
+    std::fs::write(dir.join("base.toml"), base).unwrap();
+    let ckpt = take_checkpoint(&dir);
+    let refused = |name: &str, text: &str, wants: &[&str]| {
+        let file = dir.join(name);
+        std::fs::write(&file, text).unwrap();
+        let out = dir.join(format!("{name}-out"));
+        let o = run(&file, &out, &[]);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {e}");
+        assert!(e.contains(file.to_str().unwrap()), "{name}: {e}");
+        for w in wants {
+            assert!(e.contains(w), "{name}: wants {w:?} in {e}");
+        }
+        assert!(!out.exists(), "{name}: refused after the output was made");
+    };
+    let head = |duration_s: f64| {
+        format!(
+            "start_from = \"detumbled.ckpt\"\nruns = 2\nseed = 1\nduration_s = {duration_s:?}\n"
+        )
+    };
+    // The unmodified acs_full is not the checkpoint's configuration.
+    std::fs::write(
+        dir.join("other.toml"),
+        include_str!("../../scenarios/acs_full.toml"),
+    )
+    .unwrap();
+    refused(
+        "other_base.toml",
+        &format!("base = \"other.toml\"\n{}", head(DURATION_S)),
+        &[
+            "base",
+            "other.toml",
+            "is not the configuration the checkpoint",
+        ],
+    );
+    refused(
+        "short.toml",
+        &head(CHECKPOINT_S),
+        &["start_from", "at t = 4 s, at or after the end of the runs"],
+    );
+    refused(
+        "latency.toml",
+        &format!(
+            "{}[[criteria]]\nname = \"recovery\"\nquantity = \"fsw_event_latency\"\n\
+             stream = \"acs\"\nevent = \"target-chosen\"\nfault = \"faults[1]\"\nbelow = 1.0\n",
+            head(DURATION_S)
+        ),
+        &[
+            "criteria[0].fault",
+            "recovery: faults[1] opens at t = 2 s, not after the checkpoint",
+        ],
+    );
+
+    // campaign checkpoint: invalid input, nothing written.
+    let checkpoint = |campaign: &Path, at_s: &str, output: &Path| {
+        flexdyn(&[
+            "campaign",
+            "checkpoint",
+            campaign.to_str().unwrap(),
+            "--at-s",
+            at_s,
+            "-o",
+            output.to_str().unwrap(),
+        ])
+    };
+    let nominal = dir.join("nominal.toml");
+    let new = dir.join("new.ckpt");
+    let invalid = |campaign: &Path, at_s: &str, wants: &[&str]| {
+        let o = checkpoint(campaign, at_s, &new);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{at_s}: {e}");
+        for w in wants {
+            assert!(e.contains(w), "wants {w:?} in {e}");
+        }
+        assert!(!new.exists());
+    };
+    std::fs::write(dir.join("forked.toml"), head(DURATION_S)).unwrap();
+    invalid(
+        &dir.join("forked.toml"),
+        "2",
+        &["start_from", "already starts from a checkpoint"],
+    );
+    std::fs::write(
+        dir.join("fleet.toml"),
+        format!(
+            "[[vehicles]]\nid = \"chief\"\nspacecraft_file = {:?}\n",
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("scenarios/imu_tactical.toml")
+                .display()
+                .to_string()
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("over_fleet.toml"),
+        "fleet = \"fleet.toml\"\nruns = 1\nseed = 1\nduration_s = 1.0\n",
+    )
+    .unwrap();
+    invalid(
+        &dir.join("over_fleet.toml"),
+        "0.5",
+        &[
+            "fleet",
+            "a campaign over a fleet cannot start from a checkpoint yet",
+        ],
+    );
+    for at_s in ["0", "4.05", "5", "6"] {
+        invalid(
+            &nominal,
+            at_s,
+            &["--at-s", "must be a whole number of frames (frame = 0.1 s)"],
+        );
+    }
+
+    // Not written: exit 1, and no older file left to pass for the new one.
+    let o = checkpoint(&nominal, "2", &dir.join("no-such-dir").join("new.ckpt"));
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("does not exist"), "{}", stderr(&o));
+    std::fs::write(
+        dir.join("stops.toml"),
+        "base = \"base.toml\"\nruns = 1\nseed = 1\n\
+        duration_s = 5.0\ncontroller = \"true\"\n",
+    )
+    .unwrap();
+    std::fs::copy(&ckpt, &new).unwrap();
+    let o = checkpoint(&dir.join("stops.toml"), "2", &new);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(!new.exists(), "the older checkpoint is still there");
 }
 
 /// (3) What the checkpoint already fixed cannot be dispersed, a fault cannot be moved to before
