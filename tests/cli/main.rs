@@ -18,6 +18,7 @@ mod py_support;
 mod campaign_cli;
 mod campaign_faults;
 mod campaign_fleet_plan;
+mod campaign_fork;
 mod campaign_plan;
 mod campaign_slurm;
 mod checkpoint;

@@ -1,7 +1,9 @@
 //! `flexdyn campaign run`: each run is a lockstep server on its own loopback port, an observer
 //! participant in this process (sender id [`OBSERVER_ID`], answering `NoCommand`, so it sees
 //! every tick from 0), and the flight code as a child process (sender id 1), when the campaign
-//! has a `controller`. Open-loop runs have the observer only.
+//! has a `controller`. Open-loop runs have the observer only. In a campaign with `start_from`
+//! ([`super::fork`]) the server resumes the checkpoint, and everything below (the hash, the
+//! states, the criteria) starts at its tick.
 //!
 //! A run writes `run-NNNN/result.json`: the parameters read back from its built model, its
 //! seeds, the SHA-256 over its StateMsg payloads in tick order, the criteria, each fault's first
@@ -76,9 +78,18 @@ pub struct RunResult {
     pub redraws: u32,
     /// Dispersed parameters as read back from the built model, by key.
     pub applied: BTreeMap<String, f64>,
-    /// SHA-256 over the StateMsg payloads, ticks 0..=N in order (empty if the run failed, and
-    /// over a fleet).
+    /// SHA-256 over the StateMsg payloads, ticks `start_tick`..=N in order (empty if the run
+    /// failed, and over a fleet).
     pub state_sha256: String,
+    /// The first tick observed, hashed and judged: the checkpoint's in a campaign that starts
+    /// every run from one (`start_from`), else 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub start_tick: u64,
+    /// SHA-256 (hex) of the checkpoint file this run started from (`start_from`), as the run
+    /// read it; empty for a run from t = 0. `summarize` flags a run whose checkpoint is not the
+    /// manifest's.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub start_from_sha256: String,
     /// Over a fleet: the SHA-256 over each vehicle's StateMsg payloads, ticks 0..=N in order,
     /// by vehicle id (empty if the run failed).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
@@ -110,6 +121,10 @@ pub struct RunResult {
     pub sim_s: f64,
 }
 
+fn is_zero(n: &u64) -> bool {
+    *n == 0
+}
+
 impl RunResult {
     /// Planned run `rp` before it ran (or when it could not run): its seeds and redraws, no
     /// results, outcome `not_run`, `status`.
@@ -121,6 +136,8 @@ impl RunResult {
             redraws: rp.redraws,
             applied: BTreeMap::new(),
             state_sha256: String::new(),
+            start_tick: 0,
+            start_from_sha256: String::new(),
             vehicle_state_sha256: BTreeMap::new(),
             states: 0,
             fault_activations_ns: BTreeMap::new(),
@@ -425,19 +442,41 @@ fn run_port(opts: &RunOptions, run: u32) -> Result<u16, String> {
     }
 }
 
-/// The lockstep settings every run shares (a single spacecraft adds its ids and participants).
-fn lockstep_settings(c: &Campaign, opts: &RunOptions, run_dir: &Path) -> ServerSettings {
+/// The settings of a one-spacecraft run's server, without its recording: lockstep, spacecraft
+/// [`SC_ID`], the observer and (with a controller) the flight code as participants. A
+/// campaign's checkpoint must fit these ([`super::fork`]).
+pub fn single_settings(c: &Campaign) -> ServerSettings {
+    let mut participants = vec![OBSERVER_ID];
+    if c.controller.is_some() {
+        participants.insert(0, CONTROLLER_ID);
+    }
+    ServerSettings {
+        sc_id: SC_ID.into(),
+        participants,
+        ..shared_settings(c)
+    }
+}
+
+/// The lockstep settings every run shares, without a recording.
+fn shared_settings(c: &Campaign) -> ServerSettings {
     ServerSettings {
         mode: Mode::Lockstep,
         participant_timeout: Duration::from_secs_f64(c.participant_timeout_s),
         presence_timeout: Duration::from_secs_f64(c.participant_timeout_s.max(10.0)),
         duration_ns: Some(c.duration_ns),
         summary_interval: Duration::from_secs(3600),
+        ..ServerSettings::default()
+    }
+}
+
+/// The lockstep settings every run shares (a single spacecraft adds its ids and participants).
+fn lockstep_settings(c: &Campaign, opts: &RunOptions, run_dir: &Path) -> ServerSettings {
+    ServerSettings {
         // The flight code's telemetry is judged from the recording (the observer, a peer of the
         // server, does not hear the controller's samples).
         record: (opts.record || c.criteria.iter().any(|k| k.fsw.is_some()))
             .then(|| run_dir.join(RECORDING)),
-        ..ServerSettings::default()
+        ..shared_settings(c)
     }
 }
 
@@ -447,7 +486,12 @@ fn sha256_hex(states: &[(u64, Vec<u8>)]) -> String {
     for (_, p) in states {
         h.update(p);
     }
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    hex(&h.finalize())
+}
+
+/// Lower-case hex of `bytes` (a digest, as the manifest and results write it).
+pub fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// `r`'s samples, sorted by tick.
@@ -457,9 +501,13 @@ fn sorted(r: &Received) -> Vec<(u64, Vec<u8>)> {
     s
 }
 
-/// Whether `s` holds ticks 0..=`last` exactly once each, in order.
-fn complete(s: &[(u64, Vec<u8>)], last: u64) -> bool {
-    s.len() as u64 == last + 1 && s.iter().enumerate().all(|(i, (t, _))| *t == i as u64)
+/// Whether `s` holds ticks `first`..=`last` exactly once each, in order.
+fn complete(s: &[(u64, Vec<u8>)], first: u64, last: u64) -> bool {
+    last >= first
+        && s.len() as u64 == last - first + 1
+        && s.iter()
+            .enumerate()
+            .all(|(i, (t, _))| *t == first + i as u64)
 }
 
 fn close(observers: &[Observer]) {
@@ -471,9 +519,11 @@ fn close(observers: &[Observer]) {
 /// Runs `server` to its end in lockstep with an observer per vehicle of `observe` (its id and
 /// the relative-state keys to record) and the `controllers`; each controller's exit status is
 /// pushed to `exits`, in order, whatever the outcome. A controller that exits before the end
-/// stops the run at once.
+/// stops the run at once. The server starts at `first_tick` (a resumed checkpoint's, else 0):
+/// the observer must see every tick from it to the end.
 fn run_lockstep(
     server: Server,
+    first_tick: u64,
     observe: &[(String, Vec<String>)],
     controllers: &[Launch],
     port: u16,
@@ -636,7 +686,8 @@ fn run_lockstep(
     let give_up = Instant::now() + Duration::from_secs(2);
     let arrived = |o: &Observer| {
         let n = |r: &Received| r.lock().unwrap_or_else(|e| e.into_inner()).len() as u64;
-        n(&o.states) > last_tick && o.relative.iter().all(|r| n(r) > last_tick)
+        let due = (last_tick + 1).saturating_sub(first_tick);
+        n(&o.states) >= due && o.relative.iter().all(|r| n(r) >= due)
     };
     while !observers.iter().all(&arrived) && Instant::now() < give_up {
         std::thread::sleep(Duration::from_millis(5));
@@ -655,18 +706,21 @@ fn run_lockstep(
             String::new()
         };
         let states = sorted(&o.states);
-        if !complete(&states, last_tick) {
+        if !complete(&states, first_tick, last_tick) {
             close(&observers);
             return Err(RunFailure::from(format!(
-                "the observer saw {} states{of} for ticks 0..={last_tick}",
+                "the observer saw {} states{of} for ticks {first_tick}..={last_tick}",
                 states.len(),
             )));
         }
         let relative: Vec<_> = o.relative.iter().map(sorted).collect();
-        if let Some(r) = relative.iter().find(|r| !complete(r, last_tick)) {
+        if let Some(r) = relative
+            .iter()
+            .find(|r| !complete(r, first_tick, last_tick))
+        {
             close(&observers);
             return Err(RunFailure::from(format!(
-                "the observer saw {} relative states{of} for ticks 0..={last_tick}",
+                "the observer saw {} relative states{of} for ticks {first_tick}..={last_tick}",
                 r.len(),
             )));
         }
@@ -709,6 +763,105 @@ fn decode_states(states: &[(u64, Vec<u8>)]) -> Vec<StateMsg> {
         .collect()
 }
 
+/// `flexdyn campaign checkpoint`: flies campaign `c`'s base configuration `cfg`, undispersed,
+/// as its runs are flown (its lockstep server, observer and controller, spacecraft [`SC_ID`])
+/// up to `tick` and saves the checkpoint there to `file`: the checkpoint a `start_from` of the
+/// same campaign fits ([`super::fork::checkpoint_at`] gives `cfg` and `tick`, and refuses a
+/// campaign that has none). An older `file` is removed first, and the one written is read back
+/// and its tick checked, so a stale file is never reported as written. Its controller's log is
+/// `file` with `.controller.log` appended. Returns the checkpoint's \[ns\] simulation time.
+pub fn nominal_checkpoint(
+    c: &Campaign,
+    cfg: SimConfig,
+    tick: u64,
+    file: &Path,
+    base_port: u16,
+) -> Result<u64, String> {
+    let dir = file
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        return Err(format!(
+            "cannot write {}: the directory {} does not exist",
+            file.display(),
+            dir.display()
+        ));
+    }
+    match std::fs::remove_file(file) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => {
+            return Err(format!(
+                "cannot remove the older {} before writing it: {e}",
+                file.display()
+            ))
+        }
+    }
+    let mut settings = single_settings(c);
+    settings.duration_ns = Some(tick.saturating_mul(cfg.frame_ns));
+    settings.checkpoints.save_at = Some((tick, file.to_owned()));
+    settings.checkpoints.source = flexdyn_vehicle::checkpoint::Source::of(c.base_path.as_deref())
+        .map_err(|e| c.base_error(e).to_string())?;
+    let log = format!(
+        "{}.controller.log",
+        file.file_name()
+            .map_or("checkpoint".into(), |f| f.to_string_lossy())
+    );
+    let controllers: Vec<Launch> = c
+        .controller
+        .iter()
+        .map(|line| Launch {
+            line: substitute(line, SC_ID, CONTROLLER_ID, 0, None),
+            log: log.clone(),
+            who: "the controller".into(),
+        })
+        .collect();
+    let mut exits = Vec::new();
+    let port = run_port(
+        &RunOptions {
+            dir: dir.to_owned(),
+            base_port,
+            record: false,
+        },
+        0,
+    )?;
+    let observed = run_lockstep(
+        Server::Single(settings, Box::new(cfg)),
+        0,
+        &[(SC_ID.to_owned(), Vec::new())],
+        &controllers,
+        port,
+        dir,
+        &mut exits,
+    )
+    .map_err(|e| match c.controller {
+        Some(_) => format!(
+            "{} (the controller's log: {})",
+            e.message,
+            dir.join(&log).display()
+        ),
+        None => e.message,
+    })?;
+    if !file.is_file() {
+        return Err(format!(
+            "the run reached t = {} s and no checkpoint was written to {}",
+            observed.sim_time_ns as f64 * 1e-9,
+            file.display()
+        ));
+    }
+    let (_, header) = flexdyn_server::checkpoint::read(file, flexdyn_server::checkpoint::FRONT_END)
+        .map_err(|e| format!("the checkpoint written does not read back: {e}"))?;
+    if header.tick != tick {
+        return Err(format!(
+            "{} holds tick {}, not tick {tick} as asked",
+            file.display(),
+            header.tick
+        ));
+    }
+    Ok(observed.sim_time_ns)
+}
+
 fn run_inner(
     c: &Campaign,
     rp: &RunPlan,
@@ -732,15 +885,17 @@ fn run_inner(
     // Base port 0: every run's server takes a free port from the OS.
     let port = run_port(opts, rp.run)?;
     let frame_s = cfg.frame_ns as f64 * 1e-9;
-    let mut participants = vec![OBSERVER_ID];
-    if c.controller.is_some() {
-        participants.insert(0, CONTROLLER_ID);
-    }
-    let settings = ServerSettings {
-        sc_id: SC_ID.into(),
-        participants,
-        ..lockstep_settings(c, opts, run_dir)
+    let mut settings = ServerSettings {
+        record: lockstep_settings(c, opts, run_dir).record,
+        ..single_settings(c)
     };
+    // A forked campaign: the server resumes the checkpoint (its own checks refuse one that
+    // does not fit the run's configuration) and publishes from its tick on.
+    let start_tick = c.start_from.as_ref().map_or(0, |s| s.tick);
+    if let Some(start) = &c.start_from {
+        settings.checkpoints.source = start.source.clone();
+        settings.checkpoints.resume = Some(start.resumed());
+    }
     let controllers: Vec<Launch> = c
         .controller
         .iter()
@@ -753,6 +908,7 @@ fn run_inner(
     let mut exits = Vec::new();
     let observed = run_lockstep(
         Server::Single(settings, Box::new(cfg)),
+        start_tick,
         &[(SC_ID.to_owned(), Vec::new())],
         &controllers,
         port,
@@ -762,6 +918,11 @@ fn run_inner(
     result.controller_exit = exits.into_iter().next();
     let observed = observed?;
     let states = &observed.states[0];
+    result.start_tick = start_tick;
+    result.start_from_sha256 = c
+        .start_from
+        .as_ref()
+        .map_or_else(String::new, |s| s.sha256.clone());
     result.state_sha256 = sha256_hex(states);
     result.states = states.len() as u64;
     result.fault_activations_ns = first_activations("", &observed.faults[0]);
@@ -784,6 +945,17 @@ fn run_inner(
             None => evaluate(k, &decoded, c.sigma_rn, frame_s),
         })
         .collect();
+    if let Some(start) = &c.start_from {
+        for (r, k) in result.criteria.iter_mut().zip(&c.criteria) {
+            if super::judge::reads_the_whole_run(k) {
+                let seen = start.seen_from();
+                r.note = Some(match r.note.take() {
+                    Some(n) => format!("{n}; {seen}"),
+                    None => seen,
+                });
+            }
+        }
+    }
     Ok(())
 }
 
@@ -892,6 +1064,7 @@ fn run_fleet(
     let mut exits = Vec::new();
     let observed = run_lockstep(
         Server::Fleet(lockstep_settings(c, opts, run_dir), Box::new(fleet)),
+        0,
         &observe,
         &controllers,
         port,
@@ -1118,6 +1291,19 @@ impl Progress {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A forked run's stream is complete from the checkpoint's tick: every tick K..=N once, in
+    /// order; one from tick 0, a gap or a repeat is not.
+    #[test]
+    fn a_stream_is_complete_from_its_first_tick() {
+        let s = |ticks: &[u64]| ticks.iter().map(|t| (*t, Vec::new())).collect::<Vec<_>>();
+        assert!(complete(&s(&[40, 41, 42]), 40, 42));
+        assert!(complete(&s(&[0, 1, 2]), 0, 2));
+        assert!(!complete(&s(&[0, 1, 2]), 1, 2));
+        assert!(!complete(&s(&[40, 42]), 40, 42));
+        assert!(!complete(&s(&[40, 41, 41]), 40, 42));
+        assert!(!complete(&s(&[]), 40, 39));
+    }
 
     /// Issue 36: without a terminal the progress is plain lines, at every tenth of the runs,
     /// at the last, and every 5 s while nothing finishes.

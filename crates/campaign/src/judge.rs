@@ -91,6 +91,13 @@ fn quantity(q: Quantity, s: &StateMsg, sigma_rn: &Vector3<f64>) -> f64 {
     }
 }
 
+/// Whether `c` reduces what the run did over its length (a maximum, a settling time, the flight
+/// code's times), not its last state alone: in a campaign whose runs start from a checkpoint it
+/// sees the ticks from the checkpoint's on, and its result says so.
+pub fn reads_the_whole_run(c: &Criterion) -> bool {
+    !matches!(c.statistic, Statistic::Final)
+}
+
 /// Evaluates `c` over `states` (in tick order).
 pub fn evaluate(
     c: &Criterion,

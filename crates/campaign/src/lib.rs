@@ -5,6 +5,8 @@
 //! - [`keys`]: TOML paths into a configuration (`panel_pairs[*].panel1.k_nm_rad`).
 //! - [`fleet`]: a campaign over a fleet file (`fleet` in place of `base`): each vehicle's
 //!   document to disperse, and a run's fleet file and vehicle configurations.
+//! - [`fork`]: a campaign whose runs all start from one checkpoint (`start_from`): the file
+//!   read and checked, what may be dispersed after it, what a run observes from its tick.
 //! - [`readback`]: the parameters of the built model, of one spacecraft or of every vehicle.
 //! - [`plan`]: per-run draws from the master seed, redraws of invalid draws, sensor seeds and
 //!   the manifest.
@@ -30,6 +32,7 @@ pub mod command;
 pub mod criteria;
 pub mod execute;
 pub mod fleet;
+pub mod fork;
 pub mod judge;
 pub mod keys;
 pub mod plan;
@@ -81,6 +84,23 @@ pub enum CampaignCommand {
         /// same runs without them, to compare pass rates.
         #[arg(long)]
         without_random_faults: bool,
+    },
+    /// Fly the campaign's base configuration, undispersed, as its runs are flown (lockstep
+    /// server, controller, observer) up to --at-s and save a checkpoint there: the file a
+    /// campaign's `start_from` starts every run from.
+    Checkpoint {
+        /// The campaign file (TOML), without `start_from`.
+        file: PathBuf,
+        /// \[s\] when: a whole number of frames, after t = 0 and before the campaign's
+        /// duration_s.
+        #[arg(long, value_name = "SECONDS")]
+        at_s: f64,
+        /// The checkpoint file to write.
+        #[arg(long, short, value_name = "FILE")]
+        output: PathBuf,
+        /// The server listens on 127.0.0.1:PORT; 0: a free port from the OS.
+        #[arg(long, value_name = "PORT", default_value_t = 0)]
+        base_port: u16,
     },
     /// Write summary.csv, summary.txt and figures from a campaign directory. Exit code: 0 every
     /// planned run passed, 1 a run is missing or could not be run, 3 a run failed.
@@ -152,6 +172,19 @@ fn load(
     Ok(c)
 }
 
+/// `output` as a campaign file `campaign` names it in `start_from` (relative to the campaign
+/// file's folder): the path below that folder, else the absolute path.
+fn relative_to_campaign(campaign: &std::path::Path, output: &std::path::Path) -> PathBuf {
+    let abs = |p: &std::path::Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_owned());
+    let out = abs(output);
+    let folder = abs(campaign
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new(".")));
+    out.strip_prefix(&folder)
+        .map_or(out.clone(), |p| p.to_owned())
+}
+
 /// Runs a `flexdyn campaign` subcommand; returns its report, or the exit code (2 for invalid
 /// input, 1 for a directory that cannot be written or read) and an error message.
 pub fn main(cmd: &CampaignCommand) -> Result<Report, (u8, String)> {
@@ -215,13 +248,22 @@ pub fn main(cmd: &CampaignCommand) -> Result<Report, (u8, String)> {
             let results = execute::execute_many(&plan, &runs, &indices, jobs.unwrap_or(1), &opts);
             let wall = started.elapsed().as_secs_f64();
             let passed = results.iter().filter(|r| r.passed).count();
-            let sim: f64 = results.iter().map(|r| r.sim_s).sum();
+            // Simulated time flown: a forked run starts at its checkpoint's time.
+            let t_start_s = plan.campaign.start_from.as_ref().map_or(0.0, |s| s.t_s());
+            let sim: f64 = results
+                .iter()
+                .filter(|r| r.sim_s > 0.0)
+                .map(|r| r.sim_s - t_start_s)
+                .sum();
             let mut text = format!(
                 "{} runs in {wall:.1} s ({:.1} runs/min, {:.1} simulated s per wall s): {passed} passed",
                 results.len(),
                 results.len() as f64 / wall * 60.0,
                 sim / wall
             );
+            if let Some(start) = &plan.campaign.start_from {
+                text.push_str(&format!("\n{}", fork::line(start)));
+            }
             for r in results.iter().filter(|r| r.status != "ok") {
                 text.push_str(&format!("\nrun {}: {}", r.run, r.status));
             }
@@ -230,6 +272,31 @@ pub fn main(cmd: &CampaignCommand) -> Result<Report, (u8, String)> {
             Ok(Report {
                 text,
                 exit_code: verdict.exit_code(),
+            })
+        }
+        CampaignCommand::Checkpoint {
+            file,
+            at_s,
+            output,
+            base_port,
+        } => {
+            let c = load(file, false).map_err(bad)?;
+            let (cfg, tick) = fork::checkpoint_at(&c, *at_s).map_err(bad)?;
+            let started = std::time::Instant::now();
+            let t_ns = execute::nominal_checkpoint(&c, cfg, tick, output, *base_port)
+                .map_err(|e| (verdict::EXIT_NOT_RUN, format!("{}: {e}", file.display())))?;
+            // start_from is read relative to the campaign file, not to where this runs.
+            let from_campaign = relative_to_campaign(file, output);
+            Ok(Report {
+                text: format!(
+                    "wrote {} at tick {tick} (t = {} s) in {:.1} s: start_from = \"{}\" \
+                     (relative to the campaign file) starts every run of the campaign there",
+                    output.display(),
+                    flexdyn_kernel::numfmt::Num(t_ns as f64 * 1e-9),
+                    started.elapsed().as_secs_f64(),
+                    from_campaign.display()
+                ),
+                exit_code: verdict::EXIT_PASSED,
             })
         }
         CampaignCommand::Summarize { dir, slurm_array } => {

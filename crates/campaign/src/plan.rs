@@ -43,8 +43,8 @@ use toml::Table;
 
 use super::fleet::{offsets_table, FleetBase};
 use super::keys;
-use super::readback::fleet_readback;
 pub use super::readback::readback;
+use super::readback::{fleet_readback, nearest_ns, FAULT_WINDOW_FIELDS};
 use super::spec::{Campaign, CampaignError, Distribution};
 use flexdyn_sensors::rng::NormalRng;
 use flexdyn_vehicle::config::SimConfig;
@@ -140,10 +140,14 @@ struct Unit {
 }
 
 impl Unit {
-    fn new(prefix: String, base: Table) -> Self {
+    /// The unit of document `base`; `fork_at_s`: the time of the checkpoint every run starts
+    /// from, if any.
+    fn new(prefix: String, base: Table, fork_at_s: Option<f64>) -> Self {
         let mut seed_keys = Vec::new();
+        // A forked run's sensors continue the checkpoint's generators (a seed would change
+        // nothing): their seeds stay the checkpoint configuration's.
         for section in flexdyn_sensors::KINDS.iter().map(|k| k.config_array) {
-            if let Some(toml::Value::Array(items)) = base.get(section) {
+            if let (Some(toml::Value::Array(items)), None) = (base.get(section), fork_at_s) {
                 for (k, item) in items.iter().enumerate() {
                     if item.get("seed").is_some() {
                         seed_keys.push(format!("{section}[{k}].seed"));
@@ -152,12 +156,19 @@ impl Unit {
             }
         }
         // A random fault (`mtbf_s`) gets a seed of its own per run, written in if absent, so
-        // every run samples its own failure time.
+        // every run samples its own failure time; in a forked campaign only one whose
+        // `start_s` is after the checkpoint (its failure time is then after it too).
         let mut random_faults = Vec::new();
         if let Some(toml::Value::Array(items)) = base.get("faults") {
             for (k, item) in items.iter().enumerate() {
                 if item.get("mtbf_s").is_some() {
-                    seed_keys.push(format!("faults[{k}].seed"));
+                    let start_s = item
+                        .get("start_s")
+                        .and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
+                        .unwrap_or(0.0);
+                    if fork_at_s.is_none_or(|t| start_s > t) {
+                        seed_keys.push(format!("faults[{k}].seed"));
+                    }
                     random_faults.push(k);
                 }
             }
@@ -194,8 +205,11 @@ impl Plan {
     /// Resolves every dispersion key against the base configuration (or each vehicle's) and
     /// its built model.
     pub fn new(campaign: Campaign) -> Result<Self, CampaignError> {
-        let (units, model) = match &campaign.fleet {
-            Some(fleet) => fleet_units(&campaign, fleet)?,
+        let (units, base_cfg, model) = match &campaign.fleet {
+            Some(fleet) => {
+                let (units, model) = fleet_units(&campaign, fleet)?;
+                (units, None, model)
+            }
             None => {
                 // Dispersion keys are the campaign file's fields; a bad base is the base file's.
                 let mut base: Table = toml::from_str(&campaign.base_toml)
@@ -209,7 +223,30 @@ impl Plan {
                 inline_elements_file(&mut base, &base_dir)
                     .map_err(|e| campaign.invalid("base", e))?;
                 let model = readback(&cfg).map_err(|e| campaign.base_error(e))?;
-                (vec![Unit::new(String::new(), base)], model)
+                if let Some(start) = &campaign.start_from {
+                    // The server's own resume check, before any run starts.
+                    flexdyn_server::checkpoint::check_fits(
+                        &start.resumed(),
+                        &super::execute::single_settings(&campaign),
+                        &cfg,
+                    )
+                    .map_err(|e| {
+                        campaign.invalid(
+                            "start_from",
+                            format!("{e} (the campaign's base and lockstep participants)"),
+                        )
+                    })?;
+                    for (i, k) in campaign.criteria.iter().enumerate() {
+                        super::fork::check_criterion(k, &cfg, start)
+                            .map_err(|e| campaign.invalid(&format!("criteria[{i}].fault"), e))?;
+                    }
+                }
+                let fork_at_s = campaign.start_from.as_ref().map(|s| s.t_s());
+                (
+                    vec![Unit::new(String::new(), base, fork_at_s)],
+                    Some(cfg),
+                    model,
+                )
             }
         };
         let mut all_keys: Vec<Vec<String>> = Vec::new();
@@ -251,6 +288,13 @@ impl Plan {
                     ));
                 }
             }
+            if let (Some(start), Some(cfg)) = (&campaign.start_from, &base_cfg) {
+                for k in &concrete {
+                    super::fork::check_key(k, cfg, start)
+                        .and_then(|()| super::fork::check_draws(k, &d.distribution, start))
+                        .map_err(|e| campaign.invalid(&field, e))?;
+                }
+            }
             if d.distribution == Distribution::UniformAttitude
                 && (concrete.len() != 3 || !d.key.ends_with("sigma_bn"))
             {
@@ -290,6 +334,7 @@ impl Plan {
                 let (base, prefix) = (&self.units[*u].base, &self.units[*u].prefix);
                 let doc = &mut docs[*u];
                 let mut put = |k: &String, x: f64| {
+                    let x = whole_ns_if_time(k, x);
                     keys::set(&mut *doc, k, x);
                     dispersed.insert(format!("{prefix}{k}"), x);
                 };
@@ -416,10 +461,7 @@ impl Plan {
     /// The manifest (JSON) of `runs`.
     pub fn manifest(&self, runs: &[RunPlan]) -> serde_json::Value {
         let c = &self.campaign;
-        let sha: String = Sha256::digest(c.source.as_bytes())
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect();
+        let sha = super::execute::hex(&Sha256::digest(c.source.as_bytes()));
         let mut m = serde_json::json!({
             "campaign_sha256": sha,
             "flexdyn_version": env!("CARGO_PKG_VERSION"),
@@ -440,6 +482,10 @@ impl Plan {
             })).collect::<Vec<_>>(),
             "run_plans": runs,
         });
+        if let (Some(start), Some(obj)) = (&c.start_from, m.as_object_mut()) {
+            // Every run is a fork of the checkpoint's run at its tick.
+            obj.insert("start_from".into(), start.manifest());
+        }
         if let (Some(fleet), Some(obj)) = (&c.fleet, m.as_object_mut()) {
             // Over a fleet: the fleet file instead of a base, a controller per vehicle, and the
             // vehicles (their order is summary.csv's hash columns').
@@ -535,7 +581,7 @@ fn fleet_units(
                 toml::Value::Table(offsets_table(&v.offsets)),
             );
         }
-        units.push(Unit::new(format!("{}.", v.id), doc));
+        units.push(Unit::new(format!("{}.", v.id), doc, None));
     }
     // The base fleet as a run would build it, read back.
     let docs: Vec<Table> = units.iter().map(|u| u.base.clone()).collect();
@@ -569,6 +615,20 @@ fn check_fleet_key(fleet: &FleetBase, id: &str, key: &str) -> Result<(), String>
             ))
         }
         _ => Ok(()),
+    }
+}
+
+/// `x` drawn for key `k`, rounded to a whole nanosecond if `k` is a fault's window time
+/// ([`FAULT_WINDOW_FIELDS`]), which the configuration takes only in whole nanoseconds (a value
+/// that is not a time is left for the configuration to refuse).
+fn whole_ns_if_time(k: &str, x: f64) -> f64 {
+    let time = k.starts_with("faults[")
+        && FAULT_WINDOW_FIELDS
+            .iter()
+            .any(|f| k.strip_suffix(f).is_some_and(|h| h.ends_with('.')));
+    match nearest_ns(x) {
+        Some(ns) if time => ns as f64 * 1e-9,
+        _ => x,
     }
 }
 

@@ -16,7 +16,8 @@ use flexdyn_vehicle::world::{relative_state_hill, FleetConfig};
 /// `initial.v_bn_n_m_s[i]`), each effector's [`flexdyn_dynamics::StateEffector::parameters`]
 /// under its kind's section (`panel_pairs[k].`, `reaction_wheels[k].`: [`flexdyn_dynamics::kinds`]), each dynamic effector's
 /// [`flexdyn_dynamics::DynamicEffector::parameters`] (facets, residual dipole), the environment
-/// models' (space weather) and the epoch's `epoch.offset_s`.
+/// models' (space weather), the epoch's `epoch.offset_s` and each scheduled fault's window
+/// (`faults[k].start_s`, `duration_s`, `period_s`).
 pub fn readback(
     cfg: &SimConfig,
 ) -> Result<BTreeMap<String, f64>, flexdyn_vehicle::config::ConfigError> {
@@ -77,7 +78,36 @@ pub fn readback(
         env.parameters(&mut params);
     }
     out.extend(params);
+    // Each scheduled fault's window as resolved (a random fault's start is its drawn failure
+    // time, not a parameter: its `mtbf_s` and seed are).
+    for (k, f) in cfg.faults.iter().enumerate() {
+        if f.source != flexdyn_proto::FaultSource::Config {
+            continue;
+        }
+        let w = &f.window;
+        for (field, ns) in
+            FAULT_WINDOW_FIELDS
+                .iter()
+                .zip([Some(w.start_ns), w.duration_ns, w.period_ns])
+        {
+            if let Some(ns) = ns {
+                out.insert(format!("faults[{k}].{field}"), ns as f64 * 1e-9);
+            }
+        }
+    }
     Ok(out)
+}
+
+/// The fields of a fault's window (`faults[k].<field>`), in seconds, which the configuration
+/// takes only in whole nanoseconds: what [`readback`] reads back of a scheduled fault, what a
+/// campaign rounds a draw of to the nanosecond, and all a forked campaign may disperse.
+pub const FAULT_WINDOW_FIELDS: [&str; 3] = ["start_s", "duration_s", "period_s"];
+
+/// `x` \[s\] to the nearest whole nanosecond, `None` if it is not a time (not finite, < 0,
+/// beyond `u64` nanoseconds): the configuration's own conversion
+/// ([`flexdyn_kernel::schema::checks::round_ns`]) of the rounded value.
+pub fn nearest_ns(x: f64) -> Option<u64> {
+    flexdyn_kernel::schema::checks::round_ns((x * 1e9).round())
 }
 
 /// Every vehicle's [`readback`], keys prefixed with `<id>.`, and for each vehicle given relative

@@ -28,6 +28,10 @@
 //! below = 0.01
 //! ```
 //!
+//! Starting every run from a checkpoint (docs/guides/campaigns.md, "Start every run from a
+//! checkpoint"; [`super::fork`]): `start_from = "detumbled.ckpt"` (relative to this file) in
+//! place of `base`, and only a fault's window that opens after the checkpoint dispersed.
+//!
 //! Over a fleet (docs/guides/campaigns.md, "Campaigns over a fleet"): `fleet = "formation.toml"` replaces `base`,
 //! every dispersion and criterion names its `vehicle`, and `[[controllers]]` (one per vehicle,
 //! or one for several) replaces `controller`:
@@ -141,6 +145,9 @@ pub struct Campaign {
     pub controllers: Vec<Controller>,
     /// `[resources]`: what one run asks of a batch scheduler.
     pub resources: Resources,
+    /// `start_from`: the checkpoint every run starts from (a fork at its tick; `None`: every
+    /// run starts at t = 0). The base is then the configuration it recorded.
+    pub start_from: Option<super::fork::StartFrom>,
 }
 
 /// `[resources]`: what one run needs on a cluster node (`campaign submit --slurm` asks for it
@@ -274,6 +281,7 @@ const ROOT_KEYS: &[&str] = &[
     "dispersions",
     "criteria",
     "resources",
+    "start_from",
 ];
 
 /// \[s\] default of `participant_timeout_s`.
@@ -312,6 +320,17 @@ impl Campaign {
         } else {
             let (text, n) =
                 remove_random_faults(&self.base_toml).map_err(|e| self.invalid("base", e))?;
+            if let (Some(start), true) = (&self.start_from, n > 0) {
+                return Err(self.invalid(
+                    "start_from",
+                    format!(
+                        "--without-random-faults would remove {n} fault(s) from the base, and \
+                         the checkpoint {} holds their state: a run without them cannot start \
+                         from it",
+                        start.path.display()
+                    ),
+                ));
+            }
             self.base_toml = text;
             removed = n;
         }
@@ -378,8 +397,14 @@ impl Campaign {
                 path.parent().unwrap_or(Path::new(".")).join(rel)
             }))
         };
-        let base_path = file_field("base")?;
+        let mut base_path = file_field("base")?;
         let fleet_path = file_field("fleet")?;
+        let start_from = match file_field("start_from")? {
+            Some(p) => {
+                Some(super::fork::StartFrom::read(&p).map_err(|e| invalid("start_from", e))?)
+            }
+            None => None,
+        };
         if base_path.is_some() && fleet_path.is_some() {
             return Err(invalid(
                 "fleet",
@@ -388,6 +413,49 @@ impl Campaign {
                     .into(),
             ));
         }
+        if let (Some(start), Some(_)) = (&start_from, &fleet_path) {
+            return Err(invalid(
+                "start_from",
+                format!(
+                    "{} ({} is one spacecraft's); start_from works with base",
+                    super::fork::NO_FLEET_YET,
+                    start.path.display()
+                ),
+            ));
+        }
+        // A forked campaign's base is the configuration its checkpoint recorded.
+        let forked_base = match &start_from {
+            Some(start) => {
+                if let Some(p) = &base_path {
+                    let text = std::fs::read_to_string(p).map_err(|e| {
+                        invalid("base", format!("cannot read {}: {e}", p.display()))
+                    })?;
+                    if flexdyn_vehicle::checkpoint::CheckpointHeader::digest(&text)
+                        != start.source_sha256
+                    {
+                        return Err(invalid(
+                            "base",
+                            format!(
+                                "{} is not the configuration the checkpoint {} was taken with \
+                                 ({}): every run starts from that checkpoint, so its base is \
+                                 that configuration; leave base out",
+                                p.display(),
+                                start.path.display(),
+                                start
+                                    .source
+                                    .file()
+                                    .map_or("the embedded default".to_owned(), |f| f
+                                        .display()
+                                        .to_string())
+                            ),
+                        ));
+                    }
+                }
+                base_path = start.source.file();
+                Some(start.source.text.clone())
+            }
+            None => None,
+        };
         let fleet = match &fleet_path {
             Some(p) => {
                 let text = std::fs::read_to_string(p)
@@ -407,11 +475,12 @@ impl Campaign {
                 (String::new(), first.frame_ns, first.frame_hz, None)
             }
             None => {
-                let base_toml = match &base_path {
-                    Some(p) => std::fs::read_to_string(p).map_err(|e| {
+                let base_toml = match (&forked_base, &base_path) {
+                    (Some(text), _) => text.clone(),
+                    (None, Some(p)) => std::fs::read_to_string(p).map_err(|e| {
                         invalid("base", format!("cannot read {}: {e}", p.display()))
                     })?,
-                    None => DEFAULT_CONFIG_TOML.to_owned(),
+                    (None, None) => DEFAULT_CONFIG_TOML.to_owned(),
                 };
                 let base_dir = base_path
                     .as_deref()
@@ -443,6 +512,20 @@ impl Campaign {
                     Num(frame_hz)
                 ),
             ));
+        }
+        if let Some(start) = &start_from {
+            if start.t_sim_ns >= duration_ns {
+                return Err(invalid(
+                    "start_from",
+                    format!(
+                        "the checkpoint {} is at t = {} s, at or after the end of the runs \
+                         (duration_s = {} s, counted from t = 0)",
+                        start.path.display(),
+                        Num(start.t_s()),
+                        Num(duration_s)
+                    ),
+                ));
+            }
         }
         let controller = match root.get("controller") {
             Some(_) => Some(root.string("controller").map_err(schema)?),
@@ -652,6 +735,7 @@ impl Campaign {
             fleet,
             controllers,
             resources,
+            start_from,
         })
     }
 }

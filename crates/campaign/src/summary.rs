@@ -240,6 +240,45 @@ pub fn summarize(dir: &Path) -> Result<Summary, String> {
 
     s.wilson_95 = wilson(s.passed, s.planned, Z_95);
     let mut t = String::new();
+    // A forked campaign (`start_from`): which checkpoint, what the hashes cover, and the runs
+    // that did not start from it.
+    if let Some(f) = manifest["start_from"].as_object() {
+        let text = |k: &str| f.get(k).and_then(serde_json::Value::as_str);
+        let tick = f.get("tick").and_then(serde_json::Value::as_u64);
+        let t_s = f.get("t_s").and_then(serde_json::Value::as_f64);
+        match (text("file"), text("sha256"), tick, t_s) {
+            (Some(file), Some(sha), Some(tick), Some(t_s)) => {
+                writeln!(t, "{}", super::fork::line_of(file, sha, tick, t_s)).ok()
+            }
+            _ => writeln!(
+                t,
+                "forked (start_from), but the manifest's start_from record is incomplete (it \
+                 needs file, sha256, tick and t_s): {}",
+                manifest["start_from"]
+            )
+            .ok(),
+        };
+        let want = text("sha256").unwrap_or_default();
+        for r in results.iter().filter(|r| r.status == "ok") {
+            if r.start_from_sha256.is_empty() {
+                writeln!(
+                    t,
+                    "run {}: its result does not record the checkpoint it started from",
+                    r.run
+                )
+                .ok();
+            } else if r.start_from_sha256 != want {
+                writeln!(
+                    t,
+                    "run {}: started from a checkpoint with sha256 {}, not the manifest's: the \
+                     file changed between the plan and the run, so the run is not a fork of \
+                     this campaign's checkpoint",
+                    r.run, r.start_from_sha256
+                )
+                .ok();
+            }
+        }
+    }
     writeln!(
         t,
         "{} of {} planned runs passed ({:.1} %); Wilson 95 % interval {:.1} %–{:.1} % (missing and failed runs count as not passed)",
@@ -691,6 +730,8 @@ mod tests {
                 sensor_seeds: BTreeMap::new(),
                 redraws: 0,
                 applied: [("hub.mass_kg".to_owned(), 400.0 + 50.0 * r as f64)].into(),
+                start_tick: 0,
+                start_from_sha256: String::new(),
                 state_sha256: String::new(),
                 vehicle_state_sha256: BTreeMap::new(),
                 states: 1,

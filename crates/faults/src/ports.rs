@@ -196,6 +196,20 @@ impl Live {
         a.put(held_set);
     }
 
+    /// After a restore at the boundary `at_ns` (`None`: before the first): a fault whose
+    /// window opens after it has never been active in a run of this configuration, so it has
+    /// drawn nothing and its generator is the one its own seed gives at t = 0. The checkpoint
+    /// may hold the generator of another seed (a campaign's fork gives each run's random fault
+    /// a seed of its own; the checkpoint was taken with the base's): its state is set to
+    /// what a run of this configuration flown from t = 0 holds here. For a plain resume (the
+    /// same seed) this is the state restored, unchanged.
+    fn reseed_if_never_active(&mut self, at_ns: Option<u64>) {
+        let opens_later = at_ns.is_none_or(|t| self.spec.window.start_ns > t);
+        if opens_later && self.reported.is_none() && self.on.is_none() && !self.held_set {
+            self.rng = NormalRng::new(self.spec.seed);
+        }
+    }
+
     /// A fault of `spec` on the vehicle `host`.
     pub(super) fn new(spec: FaultSpec, host: &FaultHost<'_>) -> Result<Self, ConfigError> {
         let actuator = match spec.port {
@@ -335,6 +349,12 @@ impl Faults {
             a.put(&mut self.last_boundary_ns);
             a.put(&mut self.active_count);
             a.put(&mut self.active_bits);
+            if !a.is_saving() && !a.failed() {
+                let at_ns = self.last_boundary_ns;
+                for l in &mut self.live[..self.configured] {
+                    l.reseed_if_never_active(at_ns);
+                }
+            }
         });
     }
 
@@ -760,5 +780,61 @@ mod tests {
         assert_eq!(got.iter().filter(|e| e.0 == 1 && e.1 == 1).count(), 6);
         // The active set at the last boundary (50 ns): only the open-ended fault 4.
         assert_eq!(faults.active(), (1, [1 << 4, 0, 0, 0]));
+    }
+
+    /// A checkpoint restored into a configuration whose faults have other seeds (a campaign's
+    /// fork): a fault that opens after the checkpoint gets its own seed's generator, as a run
+    /// of that configuration from t = 0 holds it; one that opened before keeps the
+    /// checkpoint's generator (its draws are part of the flight); with the same seeds, a
+    /// restore changes nothing.
+    #[test]
+    fn a_restored_fault_that_never_fired_draws_from_its_own_seed() {
+        let faults_with = |seeds: [u64; 2]| {
+            let mut live = vec![
+                fault(FaultWindow::from(1_000), u64::MAX),
+                fault(FaultWindow::from(100), u64::MAX),
+            ];
+            for (l, s) in live.iter_mut().zip(seeds) {
+                l.spec.seed = s;
+                l.rng = NormalRng::new(s);
+            }
+            let mut f = Faults {
+                configured: live.len(),
+                frame_ns: 100,
+                live,
+                ..Faults::default()
+            };
+            f.reserve_live();
+            f
+        };
+        // The checkpoint's flight, to the boundary at 500 ns: fault 1 opened at 100 and drew.
+        let mut saved = faults_with([1, 1]);
+        for k in 0..=5 {
+            saved.note_boundary(k, k * 100);
+        }
+        saved.live[1].on = Some(100);
+        let drawn = saved.live[1].rng.next_u64();
+        let mut bytes = Vec::new();
+        let mut a = flexdyn_kernel::archive::Archive::saving(&mut bytes);
+        saved.archive(&mut a);
+        a.finish().unwrap();
+        let restored = |seeds: [u64; 2]| {
+            let mut f = faults_with(seeds);
+            let mut a = flexdyn_kernel::archive::Archive::loading(&bytes);
+            f.archive(&mut a);
+            a.finish().unwrap();
+            f
+        };
+        let next = |f: &mut Faults, i: usize| f.live[i].rng.next_u64();
+        let checkpoint_next = saved.live[1].rng.clone().next_u64();
+        assert_ne!(checkpoint_next, drawn);
+        // Other seeds: fault 0 draws from its own; fault 1 continues the checkpoint's stream.
+        let mut fork = restored([2, 2]);
+        assert_eq!(next(&mut fork, 0), NormalRng::new(2).next_u64());
+        assert_eq!(next(&mut fork, 1), checkpoint_next);
+        // The same seeds: the state saved, both.
+        let mut resumed = restored([1, 1]);
+        assert_eq!(next(&mut resumed, 0), NormalRng::new(1).next_u64());
+        assert_eq!(next(&mut resumed, 1), checkpoint_next);
     }
 }

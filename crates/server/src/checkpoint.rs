@@ -174,6 +174,23 @@ pub fn restore(r: &Resumed, world: &mut WorldStepper) -> Result<(), ServerError>
     Ok(())
 }
 
+/// Whether checkpoint `r` fits a one-spacecraft server of `settings` over `cfg`, without
+/// running it: the world is built as the server builds it and `r` restored into it, with the
+/// checks of a resume (the same vehicle, effectors, sensors, faults and participants, the same
+/// step and frame). A campaign that starts every run from one checkpoint asks this before
+/// any run starts (`flexdyn_campaign::fork`).
+pub fn check_fits(
+    r: &Resumed,
+    settings: &super::ServerSettings,
+    cfg: &flexdyn_vehicle::config::SimConfig,
+) -> Result<(), ServerError> {
+    let sim = flexdyn_vehicle::sim::Simulation::new(cfg)
+        .map_err(|source| ServerError::Config { file: None, source })?;
+    let stepper = super::stepper::Stepper::new(sim, settings);
+    let mut world = WorldStepper::one(settings.sc_id.clone(), stepper);
+    restore(r, &mut world)
+}
+
 /// A checkpoint listed on the stepping thread, for the writer.
 enum Job {
     Write {
