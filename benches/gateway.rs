@@ -22,8 +22,6 @@ use std::time::{Duration, Instant};
 use flexdyn_devices::catalog::VehicleCatalog;
 use flexdyn_gateway::device::{DeviceSet, TickTime};
 use flexdyn_proto::client::vehicle::VehicleConfig;
-use flexdyn_proto::Mode;
-use flexdyn_server::ServerSettings;
 use flexdyn_testkit::{demo_bin, median};
 use flexdyn_testkit_server::server::{endpoint, ServerHandle};
 use flexdyn_vehicle::checkpoint::Source;
@@ -125,20 +123,10 @@ fn physics_frame_ns(frames: u64) -> f64 {
 }
 
 fn lockstep_server(ticks: usize) -> ServerHandle {
-    let cfg = Source::of(Some(&root().join("scenarios/wheels_star_tracker.toml")))
-        .unwrap()
-        .config()
-        .unwrap();
-    ServerHandle::start(
-        ServerSettings {
-            mode: Mode::Lockstep,
-            participants: vec![1],
-            participant_timeout: Duration::from_secs(60),
-            presence_timeout: Duration::from_secs(120),
-            duration_ns: Some(ticks as u64 * 10_000_000),
-            ..ServerSettings::default()
-        },
-        cfg,
+    ServerHandle::lockstep_on(
+        &root().join("scenarios/wheels_star_tracker.toml"),
+        vec![1],
+        ticks as u64 * 10_000_000,
     )
 }
 

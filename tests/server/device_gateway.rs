@@ -21,11 +21,9 @@ use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
-use flexdyn_proto::{decode_gps, decode_magnetometer, decode_state, decode_time, Mode, Topics};
-use flexdyn_server::ServerSettings;
+use flexdyn_proto::{decode_gps, decode_magnetometer, decode_state, decode_time, Topics};
 use flexdyn_testkit::python::venv_python;
 use flexdyn_testkit_server::participants::{digest, Recorder};
-use flexdyn_vehicle::checkpoint::Source;
 use zenoh::Wait;
 
 fn root() -> PathBuf {
@@ -91,20 +89,10 @@ fn wait(child: &mut Child, limit: Duration, what: &str) -> bool {
 /// A lockstep server on `scenario` for `duration_s`, participants 1 (the gateway) and 2 (a
 /// recorder of every state).
 fn server(scenario: &str, duration_s: f64) -> ServerHandle {
-    let cfg = Source::of(Some(&root().join("scenarios").join(scenario)))
-        .unwrap()
-        .config()
-        .unwrap();
-    ServerHandle::start(
-        ServerSettings {
-            mode: Mode::Lockstep,
-            participants: vec![1, 2],
-            participant_timeout: Duration::from_secs(60),
-            presence_timeout: Duration::from_secs(120),
-            duration_ns: Some((duration_s * 1e9).round() as u64),
-            ..ServerSettings::default()
-        },
-        cfg,
+    ServerHandle::lockstep_on(
+        &root().join("scenarios").join(scenario),
+        vec![1, 2],
+        (duration_s * 1e9).round() as u64,
     )
 }
 

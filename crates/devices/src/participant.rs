@@ -19,10 +19,10 @@ use anyhow::{bail, Context};
 use flexdyn_gateway::device::DeviceSet;
 use flexdyn_proto::client::cli::{stop_on_signals, usage, CommonArgs};
 use flexdyn_proto::client::lockstep::{SensorSchedule, TickReceiver};
+use flexdyn_proto::client::participant::Participant;
 use flexdyn_proto::client::run_end::RunEnd;
 use flexdyn_proto::client::vehicle::{Vehicle, VehicleError};
-use flexdyn_proto::{encode_into, CommandMsg, Header, Mode, RunState, Topics};
-use zenoh::qos::CongestionControl;
+use flexdyn_proto::{CommandMsg, Header, Mode, RunState, Topics};
 use zenoh::{Session, Wait};
 
 use crate::catalog::VehicleCatalog;
@@ -100,21 +100,10 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
         TickReceiver::declare(&session, &topics, schedule, 1024, Duration::from_secs(5)).map_err(
             |e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.telemetry_wildcard()),
         )?;
-    let cmd_key = topics.cmd(args.sender_id);
-    let publisher = session
-        .declare_publisher(cmd_key.clone())
-        .congestion_control(CongestionControl::Block)
-        .express(true)
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot declare {cmd_key}: {e}"))?;
-    let token = session
-        .liveliness()
-        .declare_token(topics.participant(args.sender_id))
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot declare the liveliness token: {e}"))?;
+    let participant = Participant::declare(&session, &topics, args.sender_id)?;
     tracing::info!(
         sender_id = args.sender_id,
-        commands = cmd_key,
+        commands = participant.key(),
         "flexdyn gateway running"
     );
 
@@ -162,10 +151,8 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
         let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
         let inputs = gateway.catalog().effector_inputs(gateway.commands());
         let cmd = CommandMsg::actuators(header, args.sender_id, [0.0; 3], [0.0; 3], inputs);
-        encode_into(&cmd, &mut buf);
-        publisher
-            .put(buf.as_slice())
-            .wait()
+        participant
+            .send(&cmd, &mut buf)
             .map_err(|e| anyhow::anyhow!("cannot publish the command: {e}"))?;
         seq += 1;
     }
@@ -177,8 +164,7 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
         std::fs::write(f, report::toml(&devices, seq, untimed))
             .with_context(|| format!("cannot write {}", f.display()))?;
     }
-    drop(token);
-    drop(publisher);
+    drop(participant);
     drop(ticks);
     drop(run_end);
     close(session)?;

@@ -7,3 +7,4 @@ mod device;
 mod framing;
 mod nmea;
 mod prng;
+mod support;

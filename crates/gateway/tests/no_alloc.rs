@@ -8,7 +8,7 @@
 use assert_no_alloc::{assert_no_alloc, reset_violation_count, violation_count, AllocDisabler};
 use flexdyn_gateway::checksum::presets::{CRC16_IBM_SDLC, CRC32C};
 use flexdyn_gateway::checksum::{Checksum, Crc};
-use flexdyn_gateway::device::{Catalog, DeviceSet, TickTime, Utc, MAX_READ_CHUNK};
+use flexdyn_gateway::device::{DeviceSet, TickTime, Utc, MAX_READ_CHUNK};
 use flexdyn_gateway::framing::cobs::{self, CobsDecoder};
 use flexdyn_gateway::framing::hdlc::{HdlcDecoder, HdlcFraming};
 use flexdyn_gateway::framing::length::{
@@ -20,6 +20,8 @@ use flexdyn_gateway::framing::{FrameCheck, StreamDecoder};
 use flexdyn_gateway::nmea::{Dgps, FixQuality, Gga, LocalZone, Mode, NmeaStyle, Rmc, Zda};
 use flexdyn_gateway::ByteOrder;
 use hifitime::Epoch;
+
+mod support;
 
 #[global_allocator]
 static ALLOC: AllocDisabler = AllocDisabler;
@@ -176,62 +178,10 @@ fn nmea_writers_do_not_allocate_into_a_buffer_with_room() {
     assert_eq!(out.matches("\r\n").count(), 3);
 }
 
-/// The catalog of `tests/device/mod.rs` (wheels_star_tracker with a magnetometer and a GPS
-/// receiver), rebuilt here: this executable has its own allocator and no shared modules.
-fn device_catalog() -> Catalog {
-    let mut c = Catalog::new(10_000_000);
-    let q: Vec<String> = (0..4).map(|i| format!("q_cn[{i}]")).collect();
-    let mut st: Vec<(&str, &str)> = q.iter().map(|n| (n.as_str(), "1")).collect();
-    st.extend([("valid", "1"), ("status_flags", "1")]);
-    c.add_group(
-        "imu.hub",
-        &[
-            ("omega_p_rad_s[0]", "rad/s"),
-            ("omega_p_rad_s[1]", "rad/s"),
-            ("omega_p_rad_s[2]", "rad/s"),
-            ("saturation_flags", "1"),
-        ],
-    );
-    c.add_group("star_tracker.st1", &st);
-    c.add_group(
-        "magnetometer.mag1",
-        &[
-            ("b_s_t[0]", "T"),
-            ("b_s_t[1]", "T"),
-            ("b_s_t[2]", "T"),
-            ("saturation_flags", "1"),
-        ],
-    );
-    c.add_group(
-        "gps.gps1",
-        &[
-            ("gps_week", "1"),
-            ("gps_seconds_of_week", "s"),
-            ("r_be_e_m[0]", "m"),
-            ("r_be_e_m[1]", "m"),
-            ("r_be_e_m[2]", "m"),
-            ("v_be_e_m_s[0]", "m/s"),
-            ("v_be_e_m_s[1]", "m/s"),
-            ("v_be_e_m_s[2]", "m/s"),
-            ("valid", "1"),
-            ("flags", "1"),
-        ],
-    );
-    for w in 1..=4 {
-        c.add_group(&format!("wheel.rw{w}"), &[("speed_rad_s", "rad/s")]);
-    }
-    for w in 1..=4 {
-        c.add_input(&format!("wheel.rw{w}.torque_nm"), "N m");
-    }
-    c
-}
-
 #[test]
 fn devices_do_not_allocate_after_construction() {
-    let catalog = device_catalog();
-    let list = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenarios/gateway_pointing.devices.toml");
-    let mut set = DeviceSet::load(&list, &catalog).unwrap();
+    let catalog = support::catalog();
+    let mut set = DeviceSet::load(&support::shipped_list(), &catalog).unwrap();
     let mut values = vec![0.0; catalog.channel_count()];
     values[catalog.channel_index("gps.gps1.r_be_e_m[0]").unwrap()] = 4.0e6;
     values[catalog.channel_index("gps.gps1.r_be_e_m[2]").unwrap()] = 5.0e6;

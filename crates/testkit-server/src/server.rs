@@ -1,12 +1,14 @@
 //! Harness for the server tests: loopback sessions built with the one config builder
 //! (multicast scouting off), an in-process server with a bounded join, and condition waits.
 
+use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
-use flexdyn_proto::{decode_state, decode_status, StateMsg, StatusMsg, Topics};
+use flexdyn_proto::{decode_state, decode_status, Mode, StateMsg, StatusMsg, Topics};
 use flexdyn_server as server;
+use flexdyn_vehicle::checkpoint::Source;
 use flexdyn_vehicle::config::{SimConfig, DEFAULT_CONFIG_TOML};
 use zenoh::{Session, Wait};
 
@@ -235,6 +237,24 @@ impl ServerHandle {
         Self::spawn(session, move |session, shutdown| {
             server::run(session, settings, cfg, shutdown)
         })
+    }
+
+    /// A lockstep server ([`Self::start`]) on the scenario file `scenario`, waiting for
+    /// `participants` (60 s for an answer, 120 s for their tokens), for `duration_ns` of
+    /// simulated time.
+    pub fn lockstep_on(scenario: &Path, participants: Vec<u32>, duration_ns: u64) -> Self {
+        let cfg = Source::of(Some(scenario)).unwrap().config().unwrap();
+        Self::start(
+            server::ServerSettings {
+                mode: Mode::Lockstep,
+                participants,
+                participant_timeout: Duration::from_secs(60),
+                presence_timeout: Duration::from_secs(120),
+                duration_ns: Some(duration_ns),
+                ..server::ServerSettings::default()
+            },
+            cfg,
+        )
     }
 }
 

@@ -16,6 +16,8 @@
 //! - [`fsw`]: the flight code's own telemetry, a stream of the served `[[fsw_streams]]`
 //!   published with names, not word offsets.
 //! - [`run_end`]: the end of a run (the server's last status), so every client stops at once.
+//! - [`participant`]: a lockstep participant's command publisher and liveliness token
+//!   ([`participant::Participant`]).
 //! - [`lockstep`]: complete ticks — the state of tick k with every sensor sample due at k —
 //!   through one `flexdyn/<sc>/tlm/**` subscriber ([`lockstep::TickReceiver`]).
 
@@ -23,6 +25,7 @@ pub mod cli;
 pub mod fsw;
 pub mod lockstep;
 pub mod logging;
+pub mod participant;
 pub mod run_end;
 pub mod transport;
 pub mod vehicle;

@@ -97,11 +97,11 @@ use flexdyn_acs_demo::telemetry::{ControllerTick, Telemetry};
 use flexdyn_proto::attitude::mrp_error;
 use flexdyn_proto::client::cli::{exit_with, stop_on_signals, usage, CommonArgs};
 use flexdyn_proto::client::lockstep::{SensorSchedule, TickReceiver};
+use flexdyn_proto::client::participant::Participant;
 use flexdyn_proto::client::run_end::RunEnd;
 use flexdyn_proto::client::vehicle::{Vehicle, VehicleConfig};
-use flexdyn_proto::{encode_into, CommandMsg, Header, RunState, Topics};
+use flexdyn_proto::{CommandMsg, Header, RunState, Topics};
 use nalgebra::{Matrix3, Vector3};
-use zenoh::qos::CongestionControl;
 use zenoh::{Session, Wait};
 
 /// Demo MRP PD attitude controller: subscribes to flexdyn telemetry, publishes commands.
@@ -716,28 +716,17 @@ fn run(args: Args) -> anyhow::Result<()> {
     )
     .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.telemetry_wildcard()))?;
 
-    // 4. The command publisher. Block (never drop) and express (no batching: lowest latency).
-    let cmd_key = topics.cmd(args.sender_id);
-    let commands = session
-        .declare_publisher(cmd_key.clone())
-        .congestion_control(CongestionControl::Block)
-        .express(true)
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot declare {cmd_key}: {e}"))?;
-
-    // 5. Announce ourselves to a lockstep server (harmless in real time).
-    let token = session
-        .liveliness()
-        .declare_token(topics.participant(args.sender_id))
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot declare the liveliness token: {e}"))?;
+    // 4. The command publisher, Block (never drop) and express (no batching: lowest latency),
+    // 5. then the liveliness token that announces us to a lockstep server (harmless in real
+    //    time).
+    let participant = Participant::declare(&session, &topics, args.sender_id)?;
     tracing::info!(
         sender_id = args.sender_id,
         k_nm = controller.k_nm,
         p_nms = controller.p_nms,
         sigma_rn = ?controller.sigma_rn.as_slice(),
         telemetry = topics.telemetry_wildcard(),
-        commands = cmd_key,
+        commands = participant.key(),
         "flexdyn-acs-demo running"
     );
 
@@ -814,10 +803,8 @@ fn run(args: Args) -> anyhow::Result<()> {
             let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
             let inputs = std::mem::take(&mut out.inputs);
             let cmd = CommandMsg::actuators(header, args.sender_id, [0.0; 3], [0.0; 3], inputs);
-            encode_into(&cmd, &mut buf);
-            commands
-                .put(buf.as_slice())
-                .wait()
+            participant
+                .send(&cmd, &mut buf)
                 .map_err(|e| anyhow::anyhow!("cannot publish the command: {e}"))?;
             seq += 1;
             if log_every_ns > 0 && h.sim_time_ns >= next_log_ns {
@@ -913,10 +900,8 @@ fn run(args: Args) -> anyhow::Result<()> {
             };
             t.controller(h.tick, h.sim_time_ns, &c)?;
         }
-        encode_into(&cmd, &mut buf);
-        commands
-            .put(buf.as_slice())
-            .wait()
+        participant
+            .send(&cmd, &mut buf)
             .map_err(|e| anyhow::anyhow!("cannot publish the command: {e}"))
             .context("publishing")?;
         seq += 1;
@@ -943,8 +928,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         print_fdir_summary(f);
     }
     // Undeclare the token first (a lockstep server sees us leave), then close the session.
-    drop(token);
-    drop(commands);
+    drop(participant);
     drop(ticks);
     drop(run_end);
     close(session)?;

@@ -22,6 +22,7 @@ use super::time::TickTime;
 use crate::ccsds::packet::MAX_DATA_FIELD_BYTES;
 use crate::ccsds::primary_header::PRIMARY_HEADER_BYTES;
 use crate::ccsds::{Apid, CucFormat, PacketTemplate, PacketType, SequenceCounter, SequenceFlags};
+use crate::framing::window::Window;
 use crate::framing::{DecodeCounters, FrameCheck, Malformed, StreamDecoder};
 
 /// What the CUC secondary header counts from.
@@ -144,9 +145,7 @@ pub struct CcsdsDecoder {
     check: Option<FrameCheck>,
     /// The fewest octets a packet may have: header, secondary header, one octet, check.
     min_packet_bytes: usize,
-    window: Box<[u8]>,
-    start: usize,
-    end: usize,
+    window: Window,
     counters: DecodeCounters,
 }
 
@@ -157,23 +156,21 @@ impl CcsdsDecoder {
         Self {
             check: framing.check.clone(),
             min_packet_bytes,
-            window: vec![0; max_packet_bytes.max(min_packet_bytes)].into_boxed_slice(),
-            start: 0,
-            end: 0,
+            window: Window::new(max_packet_bytes.max(min_packet_bytes)),
             counters: DecodeCounters::default(),
         }
     }
 
     fn parse(&mut self, on_frame: &mut dyn FnMut(&[u8])) {
         loop {
-            let pending = &self.window[self.start..self.end];
+            let pending = self.window.pending();
             let Some(&first) = pending.first() else {
                 return;
             };
             // Version number 000 (bits 0–2).
             if first >> 5 != 0 {
                 self.counters.garbage_bytes += 1;
-                self.start += 1;
+                self.window.consume(1);
                 continue;
             }
             if pending.len() < PRIMARY_HEADER_BYTES {
@@ -183,14 +180,14 @@ impl CcsdsDecoder {
             let packet_len = PRIMARY_HEADER_BYTES + data_length + 1;
             let reason = if packet_len < self.min_packet_bytes {
                 Some(Malformed::BadLength)
-            } else if packet_len > self.window.len() {
+            } else if packet_len > self.window.capacity() {
                 Some(Malformed::Oversize)
             } else {
                 None
             };
             if let Some(reason) = reason {
                 self.counters.record(reason);
-                self.start += 1;
+                self.window.consume(1);
                 continue;
             }
             if pending.len() < packet_len {
@@ -204,10 +201,10 @@ impl CcsdsDecoder {
             if good {
                 on_frame(packet);
                 self.counters.frames += 1;
-                self.start += packet_len;
+                self.window.consume(packet_len);
             } else {
                 self.counters.bad_checksum += 1;
-                self.start += 1;
+                self.window.consume(1);
             }
         }
     }
@@ -216,20 +213,8 @@ impl CcsdsDecoder {
 impl StreamDecoder for CcsdsDecoder {
     fn feed(&mut self, mut input: &[u8], on_frame: &mut dyn FnMut(&[u8])) {
         while !input.is_empty() {
-            if self.end == self.window.len() {
-                self.window.copy_within(self.start..self.end, 0);
-                self.end -= self.start;
-                self.start = 0;
-            }
-            let take = input.len().min(self.window.len() - self.end);
-            self.window[self.end..self.end + take].copy_from_slice(&input[..take]);
-            self.end += take;
-            input = &input[take..];
+            self.window.fill_from(&mut input);
             self.parse(on_frame);
-            if self.start == self.end {
-                self.start = 0;
-                self.end = 0;
-            }
         }
     }
 
@@ -238,6 +223,6 @@ impl StreamDecoder for CcsdsDecoder {
     }
 
     fn pending_bytes(&self) -> usize {
-        self.end - self.start
+        self.window.pending().len()
     }
 }

@@ -8,7 +8,9 @@
 //! - [`hdlc`]: HDLC-like byte stuffing (RFC 1662 §4.2) with an optional FCS;
 //! - [`lines`]: newline-terminated text lines (NMEA 0183, command consoles);
 //! - [`accumulator`] and [`unstuffer`]: the frame buffer of the delimiter framings and the
-//!   unstuffing state machine SLIP and HDLC share.
+//!   unstuffing state machine SLIP and HDLC share;
+//! - [`window`]: the stream window of the decoders that parse in place (sync-and-length, and
+//!   the device CCSDS Space Packets).
 //!
 //! Every decoder implements [`StreamDecoder`]. Its contract:
 //! - **chunking does not matter**: feeding a stream byte by byte or all at once gives the same
@@ -32,6 +34,7 @@ pub mod length;
 pub mod lines;
 pub mod slip;
 pub mod unstuffer;
+pub mod window;
 
 pub use counters::{DecodeCounters, Malformed};
 pub use error::FramingError;

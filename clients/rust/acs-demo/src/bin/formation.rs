@@ -18,11 +18,11 @@ use flexdyn_acs_demo::formation::{
     com_offset_b, com_state_n, pointing_errors, relative_hill, station_force_b, StationGains,
 };
 use flexdyn_proto::client::cli::{exit_with, stop_on_signals, CommonArgs};
+use flexdyn_proto::client::participant::Participant;
 use flexdyn_proto::client::run_end::RunEnd;
 use flexdyn_proto::client::vehicle::Vehicle;
-use flexdyn_proto::{decode_state, encode_into, CommandMsg, Header, RunState, StateMsg, Topics};
+use flexdyn_proto::{decode_state, CommandMsg, Header, RunState, StateMsg, Topics};
 use nalgebra::Vector3;
-use zenoh::qos::CongestionControl;
 use zenoh::Wait;
 
 /// Formation demo: the deputy holds a Hill-frame station and points at the chief.
@@ -117,18 +117,7 @@ fn run(args: Args) -> anyhow::Result<()> {
                 .map_err(|e| anyhow::anyhow!("cannot subscribe to {key}: {e}"))?,
         );
     }
-    let cmd_key = deputy.cmd(args.sender_id);
-    let commands = session
-        .declare_publisher(cmd_key.clone())
-        .congestion_control(CongestionControl::Block)
-        .express(true)
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot declare {cmd_key}: {e}"))?;
-    let token = session
-        .liveliness()
-        .declare_token(deputy.participant(args.sender_id))
-        .wait()
-        .map_err(|e| anyhow::anyhow!("cannot declare the liveliness token: {e}"))?;
+    let participant = Participant::declare(&session, &deputy, args.sender_id)?;
     tracing::info!(chief = %args.chief, deputy = deputy.sc_id(), ?station, "flexdyn-formation-demo running");
 
     let (mut chiefs, mut deputies) = (BTreeMap::new(), BTreeMap::new());
@@ -204,15 +193,13 @@ fn run(args: Args) -> anyhow::Result<()> {
             force_b.into(),
         );
         seq += 1;
-        encode_into(&cmd, &mut buf);
-        commands
-            .put(buf.as_slice())
-            .wait()
+        participant
+            .send(&cmd, &mut buf)
             .map_err(|e| anyhow::anyhow!("cannot publish the command: {e}"))?;
         chiefs = chiefs.split_off(&(k + 1));
         deputies = deputies.split_off(&(k + 1));
     }
-    drop(token);
+    drop(participant);
     drop(subs);
     drop(run_end);
     session

@@ -15,27 +15,24 @@
 //! input cannot change the outcome.
 
 use super::LengthFraming;
+use crate::framing::window::Window;
 use crate::framing::{DecodeCounters, StreamDecoder};
 
 /// Incremental decoder of a [`LengthFraming`].
 #[derive(Debug, Clone)]
 pub struct LengthDecoder {
     framing: LengthFraming,
-    window: Box<[u8]>,
-    start: usize,
-    end: usize,
+    window: Window,
     counters: DecodeCounters,
 }
 
 impl LengthDecoder {
     /// A decoder with a window of the framing's maximum frame length (allocated here only).
     pub fn new(framing: LengthFraming) -> Self {
-        let window = vec![0; framing.config().max_frame_bytes].into_boxed_slice();
+        let window = Window::new(framing.config().max_frame_bytes);
         Self {
             framing,
             window,
-            start: 0,
-            end: 0,
             counters: DecodeCounters::default(),
         }
     }
@@ -52,11 +49,11 @@ impl LengthDecoder {
         let field = config.length;
         let header_len = self.framing.header_len();
         loop {
-            let pending = &self.window[self.start..self.end];
+            let pending = self.window.pending();
             let seen = pending.len().min(sync.len());
             if pending[..seen] != sync[..seen] {
                 self.counters.garbage_bytes += 1;
-                self.start += 1;
+                self.window.consume(1);
                 continue;
             }
             if pending.len() < header_len {
@@ -69,7 +66,7 @@ impl LengthDecoder {
                 Ok(len) => len,
                 Err(reason) => {
                     self.counters.record(reason);
-                    self.start += 1;
+                    self.window.consume(1);
                     continue;
                 }
             };
@@ -87,10 +84,10 @@ impl LengthDecoder {
             if good {
                 on_frame(frame);
                 self.counters.frames += 1;
-                self.start += frame_len;
+                self.window.consume(frame_len);
             } else {
                 self.counters.bad_checksum += 1;
-                self.start += 1;
+                self.window.consume(1);
             }
         }
     }
@@ -99,20 +96,8 @@ impl LengthDecoder {
 impl StreamDecoder for LengthDecoder {
     fn feed(&mut self, mut input: &[u8], on_frame: &mut dyn FnMut(&[u8])) {
         while !input.is_empty() {
-            if self.end == self.window.len() {
-                self.window.copy_within(self.start..self.end, 0);
-                self.end -= self.start;
-                self.start = 0;
-            }
-            let take = input.len().min(self.window.len() - self.end);
-            self.window[self.end..self.end + take].copy_from_slice(&input[..take]);
-            self.end += take;
-            input = &input[take..];
+            self.window.fill_from(&mut input);
             self.parse(on_frame);
-            if self.start == self.end {
-                self.start = 0;
-                self.end = 0;
-            }
         }
     }
 
@@ -121,6 +106,6 @@ impl StreamDecoder for LengthDecoder {
     }
 
     fn pending_bytes(&self) -> usize {
-        self.end - self.start
+        self.window.pending().len()
     }
 }
