@@ -255,7 +255,6 @@ struct Partial {
     coarse_sun_sensors: Vec<Option<CssMsg>>,
     fine_sun_sensors: Vec<Option<FssMsg>>,
     gps_receivers: Vec<Option<GpsMsg>>,
-    time: Option<TimeMsg>,
 }
 
 impl Partial {
@@ -267,7 +266,6 @@ impl Partial {
             coarse_sun_sensors: vec![None; s.coarse_sun_sensors.len()],
             fine_sun_sensors: vec![None; s.fine_sun_sensors.len()],
             gps_receivers: vec![None; s.gps_receivers.len()],
-            time: None,
         }
     }
 }
@@ -321,6 +319,9 @@ pub struct TickAssembler {
     held: Option<StateMsg>,
     /// Samples by tick, for ticks after the last one released.
     partial: BTreeMap<u64, Partial>,
+    /// The latest time message: it comes first of its tick, and goes with that tick's release
+    /// (kept apart from `partial`, so a tick of states alone costs no entry there).
+    time: Option<TimeMsg>,
     /// The last tick released.
     last: Option<u64>,
 }
@@ -335,6 +336,7 @@ impl TickAssembler {
             schedule,
             held: None,
             partial: BTreeMap::new(),
+            time: None,
             last: None,
         }
     }
@@ -442,7 +444,7 @@ impl TickAssembler {
             Msg::Css(i, m) => self.partial_mut(tick).coarse_sun_sensors[i] = Some(m),
             Msg::Fss(i, m) => self.partial_mut(tick).fine_sun_sensors[i] = Some(m),
             Msg::Gps(i, m) => self.partial_mut(tick).gps_receivers[i] = Some(m),
-            Msg::Time(m) => self.partial_mut(tick).time = Some(m),
+            Msg::Time(m) => self.time = Some(m),
         }
         if self.held.is_some() && self.awaited().is_empty() {
             if let Some(t) = self.release() {
@@ -562,7 +564,7 @@ impl TickAssembler {
             coarse_sun_sensors: p.coarse_sun_sensors,
             fine_sun_sensors: p.fine_sun_sensors,
             gps_receivers: p.gps_receivers,
-            time: p.time,
+            time: self.time.filter(|t| t.header.tick == tick),
             missing,
         })
     }
@@ -868,6 +870,30 @@ mod tests {
         f.imu("hub", 17);
         f.state(17);
         assert_eq!(f.a.waiting(), Some(17));
+    }
+
+    #[test]
+    fn each_tick_carries_its_own_time_message_and_no_other() {
+        let mut f = Feed::new();
+        let time = |tick| TimeMsg {
+            header: header(tick),
+            met_ns: tick * 10_000_000,
+            ..TimeMsg::default()
+        };
+        // Tick 1 (no star tracker, magnetometer or CSS due): its time first, as the server
+        // publishes it, then the IMUs and the state.
+        f.push("flexdyn/sc1/tlm/time", encode(&time(1)));
+        f.imu("hub", 1);
+        f.imu("bracket", 1);
+        f.state(1);
+        assert_eq!(f.out.len(), 1);
+        assert_eq!(f.out[0].time, Some(time(1)));
+        // Tick 3 whose time message was lost: the tick comes without one, not with tick 1's.
+        f.imu("hub", 3);
+        f.imu("bracket", 3);
+        f.state(3);
+        assert_eq!(f.out.len(), 2);
+        assert_eq!(f.out[1].time, None);
     }
 
     #[test]
