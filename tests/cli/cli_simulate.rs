@@ -671,11 +671,13 @@ fn shipped_scenarios_give_no_warning() {
     let mut checked = 0;
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
-        // Not a campaign, and not a fleet file (`[[vehicles]]`): a spacecraft.
+        // Not a campaign, not a device list (`*.devices.toml`) and not a fleet file
+        // (`[[vehicles]]`): a spacecraft.
         let is_config = path.extension().is_some_and(|e| e == "toml")
-            && path
-                .file_stem()
-                .is_some_and(|s| !s.to_string_lossy().ends_with("campaign"))
+            && path.file_stem().is_some_and(|s| {
+                let s = s.to_string_lossy();
+                !s.ends_with("campaign") && !s.ends_with(".devices")
+            })
             && !std::fs::read_to_string(&path)
                 .unwrap()
                 .contains("[[vehicles]]");

@@ -154,7 +154,17 @@ fn every_shipped_scenario_is_valid() {
             && std::fs::read_to_string(&path)
                 .unwrap()
                 .contains("[[vehicles]]");
-        if stem.ends_with("campaign") {
+        if let Some(scenario) = stem.strip_suffix(".devices") {
+            // A device gateway's device list: every description it names resolves against what
+            // its scenario (the same name without `.devices`) serves.
+            let text = std::fs::read_to_string(scenarios_dir().join(format!("{scenario}.toml")))
+                .unwrap_or_else(|e| panic!("{}: no scenario {scenario}.toml: {e}", path.display()));
+            let cfg = flexdyn_proto::client::vehicle::VehicleConfig::from_toml(&text).unwrap();
+            let catalog = flexdyn_devices::catalog::VehicleCatalog::from_config(&cfg);
+            flexdyn_gateway::device::DeviceSet::load(&path, catalog.catalog())
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            names.push(stem);
+        } else if stem.ends_with("campaign") {
             // A Monte Carlo campaign (over the reference spacecraft, or over a fleet), not a
             // spacecraft: it must load and plan (every dispersion key resolved and read back
             // from the model) and draw a valid first run.
@@ -199,6 +209,8 @@ fn every_shipped_scenario_is_valid() {
             "folded_wing",
             "formation",
             "formation_campaign",
+            "gateway_pointing",
+            "gateway_pointing.devices",
             "imu_tactical",
             "j2_orbit",
             "leo_environment",
@@ -208,7 +220,8 @@ fn every_shipped_scenario_is_valid() {
             "slosh",
             "srp_cannonball_basilisk",
             "wheel_slew",
-            "wheels_star_tracker"
+            "wheels_star_tracker",
+            "wheels_star_tracker.devices"
         ]
     );
 }
