@@ -22,7 +22,7 @@ use flexdyn_proto::client::lockstep::{SensorSchedule, TickReceiver};
 use flexdyn_proto::client::participant::Participant;
 use flexdyn_proto::client::run_end::RunEnd;
 use flexdyn_proto::client::vehicle::{Vehicle, VehicleError};
-use flexdyn_proto::{CommandMsg, Header, Mode, RunState, Topics};
+use flexdyn_proto::{CommandMsg, Header, Mode, Topics};
 use zenoh::{Session, Wait};
 
 use crate::catalog::VehicleCatalog;
@@ -168,13 +168,7 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
     drop(ticks);
     drop(run_end);
     close(session)?;
-    match ended {
-        Some(end) if end.run_state == RunState::Failed => bail!(
-            "the server reports that the run failed at tick {} (its log says why)",
-            end.tick
-        ),
-        _ => Ok(()),
-    }
+    flexdyn_proto::client::run_end::outcome(ended)
 }
 
 /// Waits until every device's driver is there; `false` on a stop signal.

@@ -86,3 +86,15 @@ impl RunEnd {
         *self.seen.lock().unwrap_or_else(|p| p.into_inner())
     }
 }
+
+/// A client's exit after the run: an error naming the tick if the server said the run failed
+/// (its log says why), else success (finished, stopped, or no end heard).
+pub fn outcome(ended: Option<Ended>) -> anyhow::Result<()> {
+    match ended {
+        Some(end) if end.run_state == RunState::Failed => anyhow::bail!(
+            "the server reports that the run failed at tick {} (its log says why)",
+            end.tick
+        ),
+        _ => Ok(()),
+    }
+}

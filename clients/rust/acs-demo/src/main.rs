@@ -100,7 +100,7 @@ use flexdyn_proto::client::lockstep::{SensorSchedule, TickReceiver};
 use flexdyn_proto::client::participant::Participant;
 use flexdyn_proto::client::run_end::RunEnd;
 use flexdyn_proto::client::vehicle::{Vehicle, VehicleConfig};
-use flexdyn_proto::{CommandMsg, Header, RunState, Topics};
+use flexdyn_proto::{CommandMsg, Header, Topics};
 use nalgebra::{Matrix3, Vector3};
 use zenoh::{Session, Wait};
 
@@ -932,13 +932,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     drop(ticks);
     drop(run_end);
     close(session)?;
-    match ended {
-        Some(end) if end.run_state == RunState::Failed => bail!(
-            "the server reports that the run failed at tick {} (its log says why)",
-            end.tick
-        ),
-        _ => Ok(()),
-    }
+    flexdyn_proto::client::run_end::outcome(ended)
 }
 
 fn close(session: Session) -> anyhow::Result<()> {

@@ -21,7 +21,7 @@ use flexdyn_proto::client::cli::{exit_with, stop_on_signals, CommonArgs};
 use flexdyn_proto::client::participant::Participant;
 use flexdyn_proto::client::run_end::RunEnd;
 use flexdyn_proto::client::vehicle::Vehicle;
-use flexdyn_proto::{decode_state, CommandMsg, Header, RunState, StateMsg, Topics};
+use flexdyn_proto::{decode_state, CommandMsg, Header, StateMsg, Topics};
 use nalgebra::Vector3;
 use zenoh::Wait;
 
@@ -206,13 +206,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         .close()
         .wait()
         .map_err(|e| anyhow::anyhow!("closing the session: {e}"))?;
-    match ended {
-        Some(end) if end.run_state == RunState::Failed => bail!(
-            "the server reports that the run failed at tick {} (its log says why)",
-            end.tick
-        ),
-        _ => Ok(()),
-    }
+    flexdyn_proto::client::run_end::outcome(ended)
 }
 
 fn main() -> std::process::ExitCode {
