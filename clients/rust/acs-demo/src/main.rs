@@ -704,7 +704,8 @@ fn run(args: Args) -> anyhow::Result<()> {
 
     // 3. The end of the run (the server's last status), then the telemetry: one subscriber on flexdyn/<sc>/tlm/**, assembled into complete ticks.
     //    Declared before the token, so the server cannot publish tick 0 before we can receive
-    //    it. A ring buffer: in real time, if we ever fall behind, the oldest samples go.
+    //    it. At most 256 complete ticks wait for us: in real time, if we ever fall behind, the
+    //    oldest ticks go (counted in `ticks.lost`).
     let run_end = RunEnd::declare(&session, &topics)
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.status()))?;
     let mut ticks = TickReceiver::declare(
