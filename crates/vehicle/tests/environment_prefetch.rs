@@ -32,9 +32,17 @@ fn leo_edited(edit: impl FnOnce(String) -> String) -> Simulation {
 
 /// Every step's state (position, velocity, attitude, rate) and held sample, as bits.
 fn trace(sim: &mut Simulation, mut pace: impl FnMut(usize)) -> Vec<Vec<u64>> {
+    trace_with(sim, |_, k| pace(k))
+}
+
+/// [`trace`], calling `before` with the simulation before each step.
+fn trace_with(
+    sim: &mut Simulation,
+    mut before: impl FnMut(&mut Simulation, usize),
+) -> Vec<Vec<u64>> {
     (0..STEPS)
         .map(|k| {
-            pace(k);
+            before(sim, k);
             sim.step();
             let x = sim.spacecraft().state();
             let s = sim.environment().unwrap().sample();
@@ -119,6 +127,39 @@ fn offloaded_albedo_caps_are_bit_identical() {
     });
     assert!(racing.environment().unwrap().prefetched_samples() > 0);
     first_difference(&reference, &got, "worker with albedo");
+}
+
+/// The environment record read at every frame boundary (`Simulation::environment_into`, what
+/// the server publishes and `simulate` writes) evaluates the update due at that instant ahead
+/// of the next step; the step then takes that evaluation instead of running the models again:
+/// one evaluation per update instant, and the run is bit-identical to one that reads nothing.
+#[test]
+fn the_environment_record_and_the_next_update_share_one_evaluation() {
+    let mut quiet = leo();
+    let reference = trace(&mut quiet, |_| {});
+    let mut read = leo();
+    let mut msg = flexdyn_proto::EnvironmentMsg::default();
+    let mut records = Vec::new();
+    // 10 steps a frame, an update every 100 steps (10 Hz): read at every frame boundary, so
+    // that every tenth read falls on an update instant and the others on held samples.
+    let got = trace_with(&mut read, |sim, k| {
+        if k % 10 == 0 {
+            sim.environment_into(&mut msg);
+            records.push((msg.header.sim_time_ns, msg.b_n_t));
+        }
+    });
+    first_difference(&reference, &got, "reading the environment record");
+    let updates = (STEPS / 100) as u64;
+    assert_eq!(records.len(), STEPS / 10);
+    assert_eq!(quiet.environment().unwrap().updates_evaluated(), updates);
+    assert_eq!(read.environment().unwrap().updates_evaluated(), updates);
+    // The record at an update instant is that update's sample: the field the next 100 steps
+    // hold (the trace's columns 12..15 are the held B field).
+    for (i, (t_ns, b)) in records.iter().enumerate().step_by(10) {
+        assert_eq!(*t_ns, (i as u64) * 10_000_000);
+        let held: Vec<u64> = b.iter().map(|c| c.to_bits()).collect();
+        assert_eq!(held, reference[i * 10][12..15], "record {i}");
+    }
 }
 
 fn first_difference(a: &[Vec<u64>], b: &[Vec<u64>], what: &str) {

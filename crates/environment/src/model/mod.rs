@@ -130,6 +130,37 @@ pub struct EnvironmentModel {
     next: Option<Request>,
     /// The worker that evaluates `next` ahead of time ([`Self::offload`]).
     prefetch: Option<Prefetcher>,
+    /// The update [`Self::sample_from`] evaluated ahead of its instant, for
+    /// [`Self::update_if_due`] to take at the same instant and state instead of evaluating it
+    /// a second time.
+    memo: Option<Memo>,
+    /// Updates evaluated by this model (by the models here or taken from the worker), not
+    /// counting those taken from the memo.
+    evaluated: u64,
+}
+
+/// An evaluated update and the inputs it was evaluated for: the instant and B's position and
+/// velocity, bit for bit. The fourth input, the request predicted at the update before
+/// (`EnvironmentModel::next`), is the same while the memo lives: every change of it clears the
+/// memo.
+#[derive(Debug, Clone, Copy)]
+struct Memo {
+    t_sim_ns: u64,
+    r_bn_n_m: [u64; 3],
+    v_bn_n_m_s: [u64; 3],
+    sample: EnvironmentSample,
+}
+
+impl Memo {
+    fn bits(v: &Vector3<f64>) -> [u64; 3] {
+        [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]
+    }
+
+    fn holds(&self, t_sim_ns: u64, r_bn_n_m: &Vector3<f64>, v_bn_n_m_s: &Vector3<f64>) -> bool {
+        self.t_sim_ns == t_sim_ns
+            && self.r_bn_n_m == Self::bits(r_bn_n_m)
+            && self.v_bn_n_m_s == Self::bits(v_bn_n_m_s)
+    }
 }
 
 impl Clone for EnvironmentModel {
@@ -144,6 +175,8 @@ impl Clone for EnvironmentModel {
             sample: self.sample,
             next: self.next,
             prefetch: None,
+            memo: self.memo,
+            evaluated: self.evaluated,
         }
     }
 }
@@ -208,6 +241,8 @@ impl EnvironmentModel {
             sample: EnvironmentSample::NONE,
             next: None,
             prefetch: None,
+            memo: None,
+            evaluated: 0,
         })
     }
 
@@ -253,6 +288,12 @@ impl EnvironmentModel {
         self.prefetch.as_ref().map_or(0, Prefetcher::answers_taken)
     }
 
+    /// How many updates were evaluated (here or by the worker) rather than taken from an
+    /// evaluation [`Self::sample_from`] made ahead of them: one per update instant.
+    pub fn updates_evaluated(&self) -> u64 {
+        self.evaluated
+    }
+
     /// Whether the worker has answered the request posted at the last update, so the next
     /// update will take its answer (false without a worker). Tests and benchmarks use it to wait
     /// for the worker deterministically; the stepping path never waits.
@@ -293,15 +334,17 @@ impl EnvironmentModel {
     /// The sample in force from `t_sim_ns` on, without touching the update schedule: the one
     /// [`Self::update_if_due`] would hold after a call at `t_sim_ns` (evaluated if an update is
     /// due then, else the held one). For telemetry at an instant where the next step's update
-    /// has not run yet. Allocation-free.
+    /// has not run yet. An update evaluated here is kept, and the update at the same instant
+    /// and state takes it instead of evaluating the models again (the same bits: the same
+    /// function of the same inputs). Allocation-free.
     pub fn sample_from(
-        &self,
+        &mut self,
         t_sim_ns: u64,
         r_bn_n_m: &Vector3<f64>,
         v_bn_n_m_s: &Vector3<f64>,
     ) -> EnvironmentSample {
         if self.next_update_ns.is_none_or(|next| t_sim_ns >= next) {
-            self.evaluate_update(t_sim_ns, r_bn_n_m, v_bn_n_m_s)
+            self.evaluate_update_once(t_sim_ns, r_bn_n_m, v_bn_n_m_s)
         } else {
             self.sample
         }
@@ -340,6 +383,7 @@ impl EnvironmentModel {
                 self.next = None;
             }
             if !a.is_saving() && !a.failed() {
+                self.memo = None;
                 if let (Some(p), Some(req)) = (&self.prefetch, &self.next) {
                     p.post(req);
                 }
@@ -358,7 +402,9 @@ impl EnvironmentModel {
         if self.next_update_ns.is_some_and(|next| t_sim_ns < next) {
             return None;
         }
-        self.sample = self.evaluate_update(t_sim_ns, r_bn_n_m, v_bn_n_m_s);
+        self.sample = self.evaluate_update_once(t_sim_ns, r_bn_n_m, v_bn_n_m_s);
+        // `next` changes below: a memo of this update is spent.
+        self.memo = None;
         let due_ns = t_sim_ns.saturating_add(self.update_ns);
         self.next_update_ns = Some(due_ns);
         // The next update happens at the first step boundary at or after `due_ns`.
@@ -369,6 +415,31 @@ impl EnvironmentModel {
         }
         self.next = Some(req);
         Some(&self.sample)
+    }
+
+    /// [`Self::evaluate_update`], or the memo of the same evaluation made ahead by
+    /// [`Self::sample_from`].
+    fn evaluate_update_once(
+        &mut self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+    ) -> EnvironmentSample {
+        if let Some(m) = self
+            .memo
+            .filter(|m| m.holds(t_sim_ns, r_bn_n_m, v_bn_n_m_s))
+        {
+            return m.sample;
+        }
+        let sample = self.evaluate_update(t_sim_ns, r_bn_n_m, v_bn_n_m_s);
+        self.evaluated += 1;
+        self.memo = Some(Memo {
+            t_sim_ns,
+            r_bn_n_m: Memo::bits(r_bn_n_m),
+            v_bn_n_m_s: Memo::bits(v_bn_n_m_s),
+            sample,
+        });
+        sample
     }
 
     /// The sample of an update at `t_sim_ns`: the predicted request's (from the worker if it

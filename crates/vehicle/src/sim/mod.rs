@@ -414,7 +414,7 @@ impl Simulation {
         use flexdyn_proto::{eclipse, environment_flags as f, AppliedWrench};
         let t = self.sc.t_sim_ns();
         let x = self.sc.state();
-        let (env, on) = match &self.environment {
+        let (env, on) = match &mut self.environment {
             Some(m) => (m.sample_from(t, &x.r_bn_n, &x.v_bn_n), m.models_on()),
             None => (*self.sc.environment(), Default::default()),
         };
