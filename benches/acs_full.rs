@@ -4,10 +4,12 @@
 //! - **shipped**: the file as it is (10 ms RK4 step, 10 Hz frames and sensors);
 //! - **1 ms + GPS**: a 1 ms step and a 1 Hz GPS receiver added.
 //!
-//! Each case is timed three ways, per RK4 step:
+//! Each case is timed four ways, per RK4 step:
 //! - `vehicle`: the vehicle runtime alone, frame by frame as the server steps it
 //!   (`Simulation::step_frame`, then the sensors due at the next tick), with the environment
 //!   models on their worker thread as the server runs them (`offload_environment`);
+//! - `+records`: the same, plus the records the server fills at each tick: the state, and the
+//!   environment record when `telemetry_rate_hz` makes it due (every frame in this file);
 //! - `1 thread`: the same with the environment models on the stepping thread, i.e. everything
 //!   on one core, as Basilisk runs;
 //! - `simulate`: the `flexdyn simulate` loop writing a row every second into a sink, so the
@@ -35,12 +37,15 @@ use std::process::{Command, Stdio};
 use std::time::Instant;
 
 use flexdyn::commands::simulate::simulate_to;
+use flexdyn_proto::EnvironmentMsg;
 use flexdyn_vehicle::config::SimConfig;
 use flexdyn_vehicle::sim::Simulation;
 
 const ACS_FULL: &str = include_str!("../scenarios/acs_full.toml");
 /// Simulated seconds per timed span (flexdyn and Basilisk alike).
 const SPAN_S: f64 = 10.0;
+/// Spans per flexdyn vehicle measurement, whose median it reports ([`time_vehicle`]).
+const SPANS: usize = 5;
 
 /// The LEO scenario, whose 1 Hz GPS receiver the "1 ms + GPS" case adds.
 const LEO: &str = include_str!("../scenarios/leo_environment.toml");
@@ -88,10 +93,19 @@ fn config(case: &Case) -> SimConfig {
 }
 
 /// ns per RK4 step of the vehicle's frame as the server runs it (`step_frame`, then the sensors
-/// due at the next tick sampled) over one span, after a one-second warm-up; with `offload`, the
-/// environment models on their worker thread. Also the share of environment samples the worker
-/// answered (0 without it).
-fn time_vehicle(cfg: &SimConfig, offload: bool) -> (f64, f64) {
+/// due at the next tick sampled): the median of [`SPANS`] consecutive spans, after a one-second
+/// warm-up; with `offload`, the environment models on their worker thread. Also the share of
+/// environment samples the worker answered (0 without it).
+///
+/// One span of the shipped case is 1,000 steps, about 4 ms of wall time: one interrupt or
+/// migration moves a single span's figure by tens of percent (session 21 saw a binary's rounds
+/// swing between two modes), so each measurement is the median of several, as Basilisk's peer
+/// takes the median of its spans.
+///
+/// With `records`, each frame also fills the records the server publishes at its tick
+/// (`flexdyn_server::stepper`): the state record, and the environment record on the ticks
+/// that are multiples of `environment_every_frames`.
+fn time_vehicle(cfg: &SimConfig, offload: bool, records: bool) -> (f64, f64) {
     let mut sim = Simulation::new(cfg).expect("the scenario builds");
     if offload {
         sim.offload_environment()
@@ -99,29 +113,44 @@ fn time_vehicle(cfg: &SimConfig, offload: bool) -> (f64, f64) {
     }
     let frames_per_s = (1e9 / cfg.frame_ns as f64).round() as u64;
     let mut tick = 0u64;
+    let mut state = sim.blank_state();
+    let mut environment = EnvironmentMsg::default();
     let mut frame = |sim: &mut Simulation| {
         sim.step_frame();
         tick += 1;
         sim.sample_sensors(|s| s.due(tick));
+        if records {
+            sim.state_into(&mut state);
+            if let Some(every) = sim.environment_every_frames() {
+                if tick.is_multiple_of(every) {
+                    sim.environment_into(&mut environment);
+                }
+            }
+            black_box((&state, &environment));
+        }
     };
     for _ in 0..frames_per_s {
         frame(&mut sim);
     }
     let frames = (SPAN_S * frames_per_s as f64) as u64;
-    let t = Instant::now();
-    for _ in 0..frames {
-        frame(&mut sim);
+    let steps = (frames * sim.steps_per_frame()) as f64;
+    let mut spans = Vec::with_capacity(SPANS);
+    for _ in 0..SPANS {
+        let t = Instant::now();
+        for _ in 0..frames {
+            frame(&mut sim);
+        }
+        spans.push(t.elapsed().as_nanos() as f64 / steps);
     }
-    let ns = t.elapsed().as_nanos() as f64;
     black_box(sim.t_sim_ns());
     let updates_per_s = cfg
         .environment
         .as_ref()
         .map_or(0.0, |e| 1e9 / e.update_ns as f64);
-    let updates = (SPAN_S + 1.0) * updates_per_s;
+    let updates = (SPAN_S * SPANS as f64 + 1.0) * updates_per_s;
     let answered = sim.environment().map_or(0, |e| e.prefetched_samples()) as f64;
     (
-        ns / (frames * sim.steps_per_frame()) as f64,
+        median(spans),
         if updates > 0.0 {
             answered / updates
         } else {
@@ -192,14 +221,15 @@ fn main() {
             "t0.csv",
         )
         .expect("the t = 0 row");
-        let (mut vehicle, mut one_thread, mut simulate, mut basilisk) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut vehicle, mut records, mut one_thread, mut simulate, mut basilisk) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut answered = Vec::new();
         for round in 0..rounds {
-            let (ns, share) = time_vehicle(&cfg, true);
+            let (ns, share) = time_vehicle(&cfg, true, false);
             vehicle.push(ns);
             answered.push(share);
-            one_thread.push(time_vehicle(&cfg, false).0);
+            records.push(time_vehicle(&cfg, true, true).0);
+            one_thread.push(time_vehicle(&cfg, false, false).0);
             simulate.push(time_simulate(&cfg));
             let peer_ns = peer
                 .as_ref()
@@ -211,10 +241,11 @@ fn main() {
             }
             println!(
                 "{:<16} round {round}: vehicle {:>8.0} ns/step ({:.0} % of samples from the worker), \
-                 1 thread {:>8.0}, simulate {:>8.0}{}",
+                 +records {:>8.0}, 1 thread {:>8.0}, simulate {:>8.0}{}",
                 case.label,
                 vehicle[round],
                 answered[round] * 100.0,
+                records[round],
                 one_thread[round],
                 simulate[round],
                 match peer_ns {
@@ -225,27 +256,33 @@ fn main() {
         }
         summary.push((
             case.label,
-            [median(vehicle), median(one_thread), median(simulate)],
+            [
+                median(vehicle),
+                median(records),
+                median(one_thread),
+                median(simulate),
+            ],
             (!basilisk.is_empty()).then(|| median(basilisk)),
         ));
     }
     let _ = std::fs::remove_dir_all(&scratch);
     println!(
-        "\nns per step (medians), and Basilisk's time over each:\n{:<16} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
-        "case", "vehicle", "1 thread", "simulate", "basilisk", "×vehicle", "×1thread", "×simul."
+        "\nns per step (medians), and Basilisk's time over each:\n{:<16} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
+        "case", "vehicle", "+records", "1 thread", "simulate", "basilisk", "×vehicle", "×records", "×1thread", "×simul."
     );
     for (label, ns, b) in summary {
-        let [v, one, s] = ns;
+        let [v, rec, one, s] = ns;
         match b {
             Some(b) => println!(
-                "{label:<16} {v:>9.0} {one:>9.0} {s:>9.0} {b:>9.0} {:>9.1} {:>9.1} {:>9.1}",
+                "{label:<16} {v:>9.0} {rec:>9.0} {one:>9.0} {s:>9.0} {b:>9.0} {:>9.1} {:>9.1} {:>9.1} {:>9.1}",
                 b / v,
+                b / rec,
                 b / one,
                 b / s
             ),
             None => println!(
-                "{label:<16} {v:>9.0} {one:>9.0} {s:>9.0} {:>9} {:>9} {:>9} {:>9}",
-                "(no peer)", "-", "-", "-"
+                "{label:<16} {v:>9.0} {rec:>9.0} {one:>9.0} {s:>9.0} {:>9} {:>9} {:>9} {:>9} {:>9}",
+                "(no peer)", "-", "-", "-", "-"
             ),
         }
     }
