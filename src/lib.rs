@@ -4,21 +4,21 @@
 //! The workspace is cut into crates along its layers, bottom up (each depends only on those below
 //! it; `.ci/layers` checks it from cargo's dependency graph):
 //! - `flexdyn-proto` (`proto/`): the wire;
-//! - `flexdyn-kernel`: [`attitude`], [`numfmt`], [`validate`] and the typed TOML [`schema`]
+//! - `flexdyn-kernel`: `attitude`, `numfmt`, `validate` and the typed TOML `schema`
 //!   reader;
-//! - `flexdyn-environment` ([`environment`]): the epoch and its time scales, the Earth's
+//! - `flexdyn-environment` (`environment`): the epoch and its time scales, the Earth's
 //!   rotation, orbits from elements, TLE and OMM, ephemerides, shadow, magnetic field,
 //!   atmosphere, facets, and the sample the dynamic effectors and sensors read;
-//! - `flexdyn-dynamics` ([`dynamics`]): the hub, state effectors by back-substitution, dynamic
+//! - `flexdyn-dynamics` (`dynamics`): the hub, state effectors by back-substitution, dynamic
 //!   effectors, integrators;
-//! - `flexdyn-sensors` ([`sensors`]) and `flexdyn-faults` ([`faults`]);
-//! - `flexdyn-vehicle`: the [`config`]uration file, one vehicle ([`sim`]) and the world of
-//!   vehicles ([`world`]);
-//! - `flexdyn-sinks` ([`sinks`], and [`signals`]): recording (MCAP), replay, export, the live
+//! - `flexdyn-sensors` (`sensors`) and `flexdyn-faults` (`faults`);
+//! - `flexdyn-vehicle`: the `config`uration file, one vehicle (`sim`) and the world of
+//!   vehicles (`world`);
+//! - `flexdyn-sinks` (`sinks`, and `signals`): recording (MCAP), replay, export, the live
 //!   Foxglove view and plots; the first layer with an I/O stack;
-//! - `flexdyn-server` ([`server`]): the Zenoh server (`flexdyn run`): real-time, lockstep and
+//! - `flexdyn-server` (`server`): the Zenoh server (`flexdyn run`): real-time, lockstep and
 //!   batch propagation;
-//! - `flexdyn-campaign` ([`campaign`]): Monte Carlo campaigns with flight code in the loop.
+//! - `flexdyn-campaign` (`campaign`): Monte Carlo campaigns with flight code in the loop.
 //!
 //! This crate is the `flexdyn` binary's library half: [`commands`], one file per subcommand
 //! (`run`, `simulate`, `fleet`, `check-config`, `record`, `replay`, `export`, `view`, `plot`,

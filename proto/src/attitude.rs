@@ -8,9 +8,9 @@
 //!
 //! Conventions (Schaub & Junkins, *Analytical Mechanics of Space Systems*):
 //! - `sigma_bn` is the MRP set of frame B relative to N: σ = ê tan(Φ/4).
-//! - `dcm_bn` = [BN] maps N components to B components: `v_b = dcm_bn * v_n`.
+//! - `dcm_bn` = \[BN\] maps N components to B components: `v_b = dcm_bn * v_n`.
 //! - `q_bn` = (β0, β1, β2, β3), **scalar first**, the Euler parameters of the same rotation, so
-//!   that [BN] is the usual Euler-parameter DCM of q_bn.
+//!   that \[BN\] is the usual Euler-parameter DCM of q_bn.
 //! - The shadow set σ_s = −σ/|σ|² describes the same attitude; [`mrp_switch`] swaps to it when
 //!   |σ| > 1, which keeps |σ| ≤ 1.
 
@@ -22,7 +22,7 @@ pub fn tilde(a: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
 }
 
-/// [BN] from the MRP set σ_BN: [BN] = I + (8[σ̃]² − 4(1 − σ²)[σ̃]) / (1 + σ²)².
+/// \[BN\] from the MRP set σ_BN: \[BN\] = I + (8[σ̃]² − 4(1 − σ²)[σ̃]) / (1 + σ²)².
 pub fn mrp_to_dcm(sigma_bn: &Vector3<f64>) -> Matrix3<f64> {
     let s2 = sigma_bn.norm_squared();
     let st = tilde(sigma_bn);
@@ -30,7 +30,7 @@ pub fn mrp_to_dcm(sigma_bn: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::identity() + (st * st * 8.0 - st * (4.0 * (1.0 - s2))) / den
 }
 
-/// MRP set (with |σ| ≤ 1) of a proper orthonormal DCM [BN], through the quaternion.
+/// MRP set (with |σ| ≤ 1) of a proper orthonormal DCM \[BN\], through the quaternion.
 pub fn dcm_to_mrp(dcm_bn: &Matrix3<f64>) -> Vector3<f64> {
     quat_to_mrp(&dcm_to_quat(dcm_bn))
 }
@@ -54,7 +54,7 @@ pub fn quat_to_mrp(q_bn: &Vector4<f64>) -> Vector3<f64> {
     Vector3::new(q[1] / den, q[2] / den, q[3] / den)
 }
 
-/// [BN] from a unit quaternion (scalar first).
+/// \[BN\] from a unit quaternion (scalar first).
 pub fn quat_to_dcm(q: &Vector4<f64>) -> Matrix3<f64> {
     let (b0, b1, b2, b3) = (q[0], q[1], q[2], q[3]);
     Matrix3::new(
@@ -173,7 +173,7 @@ pub fn m3(angle_rad: f64) -> Matrix3<f64> {
     Matrix3::new(c, s, 0.0, -s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
-/// MRP error σ_BR of B relative to R, from σ_BN and σ_RN: [BR] = [BN][RN]ᵀ, returned with |σ| ≤ 1.
+/// MRP error σ_BR of B relative to R, from σ_BN and σ_RN: \[BR\] = \[BN\]\[RN\]ᵀ, returned with |σ| ≤ 1.
 pub fn mrp_error(sigma_bn: &Vector3<f64>, sigma_rn: &Vector3<f64>) -> Vector3<f64> {
     dcm_to_mrp(&(mrp_to_dcm(sigma_bn) * mrp_to_dcm(sigma_rn).transpose()))
 }

@@ -10,7 +10,7 @@ use flexdyn_server::settings::ServerSettings;
 use flexdyn_vehicle::config::warning_message;
 
 /// `flexdyn check-config FILE`: parses, validates and builds the spacecraft; returns one
-/// `warning: FILE: field: …` line per implausible value ([`SimConfig::warnings`]: legal, but
+/// `warning: FILE: field: …` line per implausible value (`SimConfig::warnings`: legal, but
 /// almost surely a unit slip), then the summary line `ok: FILE: …`.
 ///
 /// It runs every check that `flexdyn run` and `flexdyn simulate` run on a file, the `[server]`

@@ -8,7 +8,7 @@
 //! - per deputy `<d>` given relative to chief `<c>`: `<d>_in_<c>_r_h_m_{1,2,3}` and
 //!   `<d>_in_<c>_v_h_m_s_{1,2,3}` (the deputy relative to the chief in the chief's Hill frame:
 //!   radial, along-track, cross-track; the rate seen in that frame), `<d>_in_<c>_range_m` and
-//!   `<d>_in_<c>_range_rate_m_s` ([`super::relative`]).
+//!   `<d>_in_<c>_range_rate_m_s` (`super::relative`).
 
 use std::fmt::Write as _;
 use std::io::{self, Write};

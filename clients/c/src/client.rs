@@ -1,5 +1,5 @@
 //! The library in safe Rust: a Zenoh session with the subscriptions, commands, lockstep
-//! participant and flight-code telemetry streams of `flexdyn_client.h`. [`crate::ffi`] only
+//! participant and flight-code telemetry streams of `flexdyn_client.h`. `crate::ffi` only
 //! turns C pointers into these calls.
 //!
 //! Samples are queued by Zenoh's threads in ring channels and taken only when the caller asks

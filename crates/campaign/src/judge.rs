@@ -147,11 +147,11 @@ pub fn reduce(c: &Criterion, series: &[(f64, f64)], frame_s: f64) -> CriterionRe
 /// tick order).
 ///
 /// `chief_pointing`: the direction from the deputy's centre of mass to the chief's is
-/// −r_dc (RelativeStateMsg, H components); [NH] = [HN]ᵀ is the chief's Hill frame from its
+/// −r_dc (RelativeStateMsg, H components); \[NH\] = \[HN\]ᵀ is the chief's Hill frame from its
 /// published position and velocity (rows x̂ = r/|r|, ẑ = h/|h|, ŷ = ẑ × x̂: Vallado §6.8, as the
 /// server computes it, there from the centre of mass: the B point shifts x̂ by |c_B|/|r|, about
-/// 1e-7 rad); [BN] from the deputy's σ_BN (Schaub & Junkins eq. 3.153). The angle between the
-/// axis â and d_B = [BN][NH](−r_dc) is atan2(|â × d_B|, â·d_B) (accurate at 0 and π).
+/// 1e-7 rad); \[BN\] from the deputy's σ_BN (Schaub & Junkins eq. 3.153). The angle between the
+/// axis â and d_B = \[BN\]\[NH\](−r_dc) is atan2(|â × d_B|, â·d_B) (accurate at 0 and π).
 pub fn relative_series(
     c: &Criterion,
     relative: &[RelativeStateMsg],

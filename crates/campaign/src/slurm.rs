@@ -14,8 +14,8 @@
 //! that ended without a `result.json` (a node lost, the time limit, cancelled, out of memory, a
 //! binary missing on the node) could not be run: it gets a `result.json` with outcome `not_run`
 //! and the Slurm state in its status (`Slurm task 12_7 ended TIMEOUT (exit 0:0) without a
-//! result`), so the summary names it and the verdict is INCOMPLETE (exit 1). `campaign resubmit
-//! <dir>` then submits exactly the runs without a `passed` or `failed` result, and a new
+//! result`), so the summary names it and the verdict is INCOMPLETE (exit 1).
+//! `campaign resubmit <dir>` then submits exactly the runs without a `passed` or `failed` result, and a new
 //! summarize job.
 //!
 //! Nothing here runs on the stepping path: it starts `sbatch`, `squeue`, `sacct` and

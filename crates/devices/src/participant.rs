@@ -39,7 +39,7 @@ pub struct GatewayArgs {
     /// Where relative pseudo-terminal links of the device list go.
     #[arg(long, value_name = "DIR", default_value = ".")]
     pub link_dir: PathBuf,
-    /// Numeric participant id: commands go to flexdyn/<sc>/cmd/<ID>; must be among the server's
+    /// Numeric participant id: commands go to flexdyn/\<sc>/cmd/\<ID>; must be among the server's
     /// participants.
     #[arg(long, value_name = "ID", default_value_t = 1)]
     pub sender_id: u32,

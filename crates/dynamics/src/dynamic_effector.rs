@@ -51,7 +51,7 @@ pub struct StageState {
     pub v_bn_n_m_s: Vector3<f64>,
     /// MRP σ_B/N.
     pub sigma_bn: Vector3<f64>,
-    /// [BN]: maps N components to B components.
+    /// \[BN\]: maps N components to B components.
     pub dcm_bn: Matrix3<f64>,
     /// \[rad/s\] ω_B/N, B components.
     pub omega_bn_b_rad_s: Vector3<f64>,
@@ -73,7 +73,7 @@ impl StageState {
     }
 
     /// \[kg·m²\] inertia of the whole vehicle about its centre of mass C, B components, by the
-    /// parallel-axis theorem: [I_C] = [I_B] − m [c̃][c̃]ᵀ = [I_B] − m (|c|² 𝟙 − c cᵀ).
+    /// parallel-axis theorem: \[I_C\] = \[I_B\] − m [c̃]\[c̃\]ᵀ = \[I_B\] − m (|c|² 𝟙 − c cᵀ).
     #[inline]
     pub fn inertia_pnt_c_b_kg_m2(&self) -> Matrix3<f64> {
         let c = &self.r_cb_b_m;

@@ -6,8 +6,8 @@
 //! contributions depend on ω, never on the other effectors' mass properties):
 //!
 //! 1. [`StateEffector::update_mass_props`] — the effector's mass, first moment and inertia about B
-//!    (their sums give m_sc, c, c′ and [I_sc,B] of Eqs. 3, 4 and 19);
-//! 2. [`StateEffector::update_contributions`] — its [A], [B], [C], [D], v_trans and v_rot
+//!    (their sums give m_sc, c, c′ and \[I_sc,B\] of Eqs. 3, 4 and 19);
+//! 2. [`StateEffector::update_contributions`] — its \[A\], \[B\], \[C\], \[D\], v_trans and v_rot
 //!    contributions to the hub system (Eqs. 139–144 for a panel pair). The body's share of
 //!    Eq. 150's −[I′_sc,B]ω is part of its v_rot contribution, because only the product with ω is
 //!    ever needed and it is far cheaper than a 3×3 [I′] per body;
@@ -46,7 +46,7 @@ pub struct HubAccel {
 /// Mass properties of an effector about point B, B components (summed into Eqs. 3, 4 and 19).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EffectorMassProps {
-    /// [kg] mass.
+    /// \[kg\] mass.
     pub mass_kg: f64,
     /// [kg·m] first moment Σ m r_Sc/B.
     pub first_moment_b_kg_m: Vector3<f64>,
@@ -110,15 +110,15 @@ pub fn point_mass_i_prime_omega(
 /// `[[A, B], [C, D]] [r̈_B/N; ω̇_B/N] = [v_trans; v_rot]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BackSubContributions {
-    /// [kg] [A_contr], Eq. 139.
+    /// \[kg\] \[A_contr\], Eq. 139.
     pub matrix_a: Matrix3<f64>,
-    /// [kg·m] [B_contr], Eq. 140.
+    /// [kg·m] \[B_contr\], Eq. 140.
     pub matrix_b: Matrix3<f64>,
-    /// [kg·m] [C_contr], Eq. 142.
+    /// [kg·m] \[C_contr\], Eq. 142.
     pub matrix_c: Matrix3<f64>,
-    /// [kg·m²] [D_contr], Eq. 143.
+    /// [kg·m²] \[D_contr\], Eq. 143.
     pub matrix_d: Matrix3<f64>,
-    /// [N] v_trans,contr, Eq. 141.
+    /// \[N\] v_trans,contr, Eq. 141.
     pub vec_trans: Vector3<f64>,
     /// [N·m] v_rot,contr, Eq. 144, plus the body's −[I′]ω share of Eq. 150.
     pub vec_rot: Vector3<f64>,
@@ -153,17 +153,17 @@ impl AddAssign for BackSubContributions {
 /// [`Spacecraft`](super::Spacecraft) shifts the sums to the system centre of mass C.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EnergyMomentum {
-    /// [kg] mass.
+    /// \[kg\] mass.
     pub mass_kg: f64,
     /// [kg·m] first moment Σ m r_i/B.
     pub first_moment_b_kg_m: Vector3<f64>,
     /// [kg·m/s] linear momentum relative to B's translation, Σ m ṙ_i/B (ṙ = r′ + ω × r).
     pub lin_mom_rel_b_kg_m_s: Vector3<f64>,
-    /// [kg·m²/s] angular momentum about B, Σ ([I_i] ω_i + m r_i/B × ṙ_i/B).
+    /// [kg·m²/s] angular momentum about B, Σ (\[I_i\] ω_i + m r_i/B × ṙ_i/B).
     pub ang_mom_pnt_b_b_kg_m2_s: Vector3<f64>,
-    /// [J] kinetic energy relative to B's translation, ½ Σ (ω_iᵀ[I_i]ω_i + m |ṙ_i/B|²).
+    /// \[J\] kinetic energy relative to B's translation, ½ Σ (ω_iᵀ\[I_i\]ω_i + m |ṙ_i/B|²).
     pub kinetic_rel_b_j: f64,
-    /// [J] stored potential energy (springs).
+    /// \[J\] stored potential energy (springs).
     pub potential_j: f64,
 }
 

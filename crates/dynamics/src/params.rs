@@ -11,11 +11,11 @@ use nalgebra::{Matrix3, Vector3};
 /// Rigid hub parameters.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HubParams {
-    /// [kg] hub mass.
+    /// \[kg\] hub mass.
     pub mass_kg: f64,
     /// [kg·m²] hub inertia about its own centre of mass Bc, in B components (symmetric positive-definite).
     pub inertia_bc_b_kg_m2: Matrix3<f64>,
-    /// [m] position of the hub centre of mass Bc relative to point B, in B components.
+    /// \[m\] position of the hub centre of mass Bc relative to point B, in B components.
     pub r_bcb_b_m: Vector3<f64>,
 }
 
@@ -36,7 +36,7 @@ pub enum GravityModel {
         mu_m3_s2: f64,
         /// [-] J2 coefficient.
         j2: f64,
-        /// [m] equatorial radius.
+        /// \[m\] equatorial radius.
         r_eq_m: f64,
     },
 }
@@ -44,9 +44,9 @@ pub enum GravityModel {
 /// A point fixed on the hub where a sensor (an IMU) sits, with its platform frame P.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SensorPoint {
-    /// [m] sensor location S relative to B, in B components.
+    /// \[m\] sensor location S relative to B, in B components.
     pub r_sb_b_m: Vector3<f64>,
-    /// DCM [PB]: maps B components to platform P components.
+    /// DCM \[PB\]: maps B components to platform P components.
     pub dcm_pb: Matrix3<f64>,
 }
 
@@ -82,9 +82,9 @@ impl std::ops::Add for Wrench {
 /// One row of the piecewise-constant external wrench schedule on the hub.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WrenchSegment {
-    /// [ns] time from which this row applies (until the next row).
+    /// \[ns\] time from which this row applies (until the next row).
     pub t_start_ns: u64,
-    /// [N] force on the hub, B components, applied at point B.
+    /// \[N\] force on the hub, B components, applied at point B.
     pub force_b_newton: Vector3<f64>,
     /// [N·m] torque on the hub, B components.
     pub torque_b_nm: Vector3<f64>,

@@ -2,7 +2,7 @@
 //! Runge–Kutta method of [`super::integrator`] (RK4 by default).
 //!
 //! Per derivative evaluation the hub sums the effectors' mass properties and back-substitution
-//! contributions, assembles Eqs. 145–150 (with erratum E2: [C] = m_sc[c̃] + [C_contr]) and solves
+//! contributions, assembles Eqs. 145–150 (with erratum E2: \[C\] = m_sc[c̃] + \[C_contr\]) and solves
 //! Eq. 151 by the Schur complement of Eqs. 152–153, using LU factorisations — never explicit
 //! inverses. Gravity is evaluated at the system centre of mass C and applied as a uniform field.
 
@@ -28,7 +28,7 @@ use flexdyn_kernel::validate::{check_finite, ParamError};
 /// The integrated state (also used for its time derivative).
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
-    /// [m] r_B/N in N components (derivative: ṙ = v).
+    /// \[m\] r_B/N in N components (derivative: ṙ = v).
     pub r_bn_n: Vector3<f64>,
     /// [m/s] v_B/N in N components (derivative: r̈_B/N in N).
     pub v_bn_n: Vector3<f64>,
@@ -141,14 +141,14 @@ impl State {
 /// How the initial translational state is given.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum InitialTranslation {
-    /// Position [m] and velocity [m/s] of point B relative to N, N components.
+    /// Position \[m\] and velocity [m/s] of point B relative to N, N components.
     PointB {
         /// r_B/N.
         r_bn_n_m: Vector3<f64>,
         /// v_B/N.
         v_bn_n_m_s: Vector3<f64>,
     },
-    /// Position [m] and velocity [m/s] of the system centre of mass C relative to N, N components.
+    /// Position \[m\] and velocity [m/s] of the system centre of mass C relative to N, N components.
     CenterOfMass {
         /// r_C/N.
         r_cn_n_m: Vector3<f64>,
@@ -172,9 +172,9 @@ pub struct HubInitial {
 /// totRotAngMomPntC_N), computed from the state.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Conserved {
-    /// [J] orbital energy of the centre of mass: ½ m_sc |v_C/N|² + m_sc U(r_C/N).
+    /// \[J\] orbital energy of the centre of mass: ½ m_sc |v_C/N|² + m_sc U(r_C/N).
     pub orb_energy_j: f64,
-    /// [J] rotational kinetic energy about C plus spring energy.
+    /// \[J\] rotational kinetic energy about C plus spring energy.
     pub rot_energy_j: f64,
     /// [kg·m²/s] orbital angular momentum of C about N, m_sc r_C/N × v_C/N, N components.
     pub orb_ang_mom_n: Vector3<f64>,
@@ -693,12 +693,12 @@ impl Spacecraft {
         Ok(())
     }
 
-    /// [ns] simulation time.
+    /// \[ns\] simulation time.
     pub fn t_sim_ns(&self) -> u64 {
         self.t_sim_ns
     }
 
-    /// [ns] integration step.
+    /// \[ns\] integration step.
     pub fn step_ns(&self) -> u64 {
         self.step_ns
     }
@@ -1135,7 +1135,7 @@ impl Spacecraft {
         self.conserved_at(&self.state)
     }
 
-    /// [kg] total mass, [m] centre of mass relative to B (B components), and [m/s] its velocity
+    /// \[kg\] total mass, \[m\] centre of mass relative to B (B components), and [m/s] its velocity
     /// relative to B's translation (B components) at the current state.
     pub fn center_of_mass(&self) -> (f64, Vector3<f64>, Vector3<f64>) {
         let em = self.energy_momentum_sum(&self.state);

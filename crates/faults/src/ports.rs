@@ -254,7 +254,7 @@ impl Faults {
         self.events = Vec::with_capacity(self.event_capacity());
     }
 
-    /// Most events [`Self::take_events`] can hand out at once (size a frame's buffer with it).
+    /// Most events `Self::take_events` can hand out at once (size a frame's buffer with it).
     pub fn event_capacity(&self) -> usize {
         event_capacity(&self.live[..self.configured], self.frame_ns)
     }

@@ -1,5 +1,5 @@
 //! The `[[faults]]` schema: one entry per fault. Keys and types are checked here; the target,
-//! the mode and its parameters by [`super::targets::resolve`], against the built spacecraft and
+//! the mode and its parameters by `super::targets::resolve`, against the built spacecraft and
 //! sensors.
 //!
 //! ```toml
@@ -18,7 +18,7 @@
 use flexdyn_kernel::schema::{SchemaError, TableReader};
 
 /// The keys of one `[[faults]]` entry (`target` and `mode` are required): the general ones,
-/// then [`PARAM_KEYS`].
+/// then `PARAM_KEYS`.
 pub const KEYS: [&str; 16] = {
     let general = [
         "target",

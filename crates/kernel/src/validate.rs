@@ -125,7 +125,7 @@ pub enum ParamError {
     },
 }
 
-/// Tolerance on ‖[C][C]ᵀ − I‖ (max element) and |det C − 1| for a DCM to count as orthonormal.
+/// Tolerance on ‖\[C\]\[C\]ᵀ − I‖ (max element) and |det C − 1| for a DCM to count as orthonormal.
 pub const DCM_ORTHONORMAL_TOL: f64 = 1e-9;
 /// Relative tolerance on the asymmetry of an inertia matrix.
 pub const INERTIA_SYMMETRY_TOL: f64 = 1e-9;

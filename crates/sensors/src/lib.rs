@@ -76,7 +76,7 @@ pub struct Truth<'a> {
 }
 
 impl Truth<'_> {
-    /// The unit Sun direction in B, [BN] (r_sun / |r_sun|) with r_sun the Sun's position from
+    /// The unit Sun direction in B, \[BN\] (r_sun / |r_sun|) with r_sun the Sun's position from
     /// point B in the environment sample, and the sample's shadow factor; `None` without a Sun
     /// (no environment sample, or a zero Sun vector: no ephemeris). For the sun sensors.
     pub fn sun_b(&self) -> Option<(nalgebra::Vector3<f64>, f64)> {

@@ -5,7 +5,7 @@
 //! here, on the Zenoh thread. The physics side only receives the ready-made request: through a
 //! bounded channel it drains before stepping each frame (its box goes back through a recycle
 //! channel, to be freed by the telemetry thread), or, in lockstep with `handoff = "direct"`,
-//! straight into the [`LockstepCore`] under its lock (the core steps on this side anyway).
+//! straight into the `LockstepCore` under its lock (the core steps on this side anyway).
 //!
 //! In lockstep a fault for `at_tick` = k + 1 put before the answer to tick k, from the same
 //! Zenoh session, is installed before frame k → k + 1 is stepped: Zenoh delivers one session's

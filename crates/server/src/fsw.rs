@@ -1,4 +1,4 @@
-//! The flight code's own telemetry: the callback of `flexdyn/<sc>/fsw/*` ([`FswMsg`],
+//! The flight code's own telemetry: the callback of `flexdyn/<sc>/fsw/*` (`FswMsg`,
 //! protocol 10).
 //!
 //! A sample is checked against its stream's declaration in the configuration's
@@ -16,7 +16,7 @@
 //! - `wrong_time`: `header.sim_time_ns` is not its tick's time (tick × frame period);
 //! - `rate_bound`: not after the stream's last recorded tick (a stream records at most one
 //!   sample per tick, so the frame rate bounds every stream, and a flood records nothing more);
-//! - the declaration's reasons ([`FswRefusal::reason`]): an undeclared mode or event, a value
+//! - the declaration's reasons (`FswRefusal::reason`): an undeclared mode or event, a value
 //!   count other than the declaration's, a NaN or infinite f64 value, a bool other than 0/1,
 //!   COVARIANCE without ESTIMATE.
 //!

@@ -14,7 +14,7 @@
 //! What it trades: the core sits behind a mutex taken once per command. With one participant
 //! it is never contended; with several, their callbacks take turns, which is what lockstep
 //! needs anyway. The per-frame work itself (command book, RK4, sensors, telemetry fill) is the
-//! same allocation-free [`Stepper`] the physics thread runs; the Zenoh `put` allocates inside
+//! same allocation-free `Stepper` the physics thread runs; the Zenoh `put` allocates inside
 //! Zenoh, as it does on the telemetry thread. The stream is bit-identical to the threaded
 //! design's: the same commands are offered for the same ticks in the same order.
 //!

@@ -1,5 +1,5 @@
 //! A message straight into named columns, without a JSON tree in between: a serde
-//! [`Serializer`] that names each leaf as [`crate::table`] names a JSON value's (the same rules:
+//! `Serializer` that names each leaf as [`crate::table`] names a JSON value's (the same rules:
 //! the header's fields unprefixed, nested fields `<field>_<sub>`, arrays numbered from 1, a
 //! quaternion `q_…` from 0, booleans as 0/1, unit variants by name, a non-finite number as NaN).
 //!

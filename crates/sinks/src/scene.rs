@@ -3,18 +3,18 @@
 //! `foxglove.SceneUpdate` with one box for the hub and one for each panel, sized from the
 //! configuration, and a sphere for each propellant tank. Both as JSON with a JSON Schema (the
 //! schema names are Foxglove's well-known ones, so the 3D panel recognises them). The chains'
-//! frames and boxes are in [`chains`], the tanks' spheres in [`tanks`].
+//! frames and boxes are in `chains`, the tanks' spheres in `tanks`.
 //!
 //! # Frames (Allard & Schaub, Sec. II, Eqs. 1–7)
-//! - `N` inertial; `B` hub body frame at point B: translation r_BN (N components), rotation [NB].
+//! - `N` inertial; `B` hub body frame at point B: translation r_BN (N components), rotation \[NB\].
 //! - `<pair>/panel1`: origin at hinge H1 (r_H1B in B), axes S1 with [S1 B] = M2(θ1) [H1 B]
 //!   (ŝ11 = ĥ11 cos θ1 − ĥ13 sin θ1, `crates/dynamics/src/effectors/panel_pair/mod.rs`, `frames`).
 //! - `<pair>/panel2`: origin at hinge H2 = H1 − l1 ŝ11 (S1 components (−l1, 0, 0)), axes S2 with
 //!   [S2 S1] = M2(θ2 + θ_H2S1).
 //!
 //! A Foxglove transform from `parent` to `child` gives the child origin in the parent frame and
-//! the rotation that takes child components to parent components, i.e. [PC] = [CP]ᵀ. For a
-//! passive DCM [CP] with Euler parameters β (scalar first), that active rotation is the Hamilton
+//! the rotation that takes child components to parent components, i.e. \[PC\] = \[CP\]ᵀ. For a
+//! passive DCM \[CP\] with Euler parameters β (scalar first), that active rotation is the Hamilton
 //! quaternion (w, x, y, z) = (β0, β1, β2, β3) (Schaub & Junkins, Sec. 3.5), which is what
 //! [`flexdyn_kernel::attitude::dcm_to_quat`] and [`flexdyn_kernel::attitude::mrp_to_quat`] return.
 
@@ -43,11 +43,11 @@ pub const FRAME_B: &str = "B";
 /// A box: centre and axes in its frame, and edge lengths.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cuboid {
-    /// [m] centre, in the frame's components.
+    /// \[m\] centre, in the frame's components.
     pub center_m: Vector3<f64>,
     /// The box axes as the rotation from box to frame components, quaternion (w, x, y, z).
     pub q_frame_box: Vector4<f64>,
-    /// [m] edge lengths along the box axes.
+    /// \[m\] edge lengths along the box axes.
     pub size_m: Vector3<f64>,
 }
 
@@ -56,13 +56,13 @@ pub struct Cuboid {
 pub struct PairGeometry {
     /// The pair's configured name (frame ids `<name>/panel1`, `<name>/panel2`).
     pub name: String,
-    /// [m] hinge 1 location relative to B, B components.
+    /// \[m\] hinge 1 location relative to B, B components.
     pub r_h1b_b_m: Vector3<f64>,
     /// [H1 B].
     pub dcm_h1b: Matrix3<f64>,
-    /// [rad] fixed angle of H2 about ŝ12 relative to S1.
+    /// \[rad\] fixed angle of H2 about ŝ12 relative to S1.
     pub theta_h2s1_rad: f64,
-    /// [m] panel 1 length (H1 to H2).
+    /// \[m\] panel 1 length (H1 to H2).
     pub l1_m: f64,
     /// Panel 1's box in its S1 frame.
     pub panel1: Cuboid,

@@ -301,7 +301,7 @@ pub struct Field {
     /// The bound of a `vec` count or of a `u8` count.
     #[serde(default)]
     pub max: Option<u64>,
-    /// Decoders refuse a NaN or infinite value here (NonFinite): an f64, f64[n] or vec<f64>.
+    /// Decoders refuse a NaN or infinite value here (NonFinite): an f64, f64\[n\] or vec\<f64>.
     #[serde(default)]
     pub finite: bool,
     /// C only: a struct-typed field whose members are the C struct's own, each name prefixed
@@ -1314,7 +1314,7 @@ impl Table {
         }
     }
 
-    /// The fields that name [[flags]] `name` in their `flags`, with their owners' names.
+    /// The fields that name [\[flags\]] `name` in their `flags`, with their owners' names.
     pub fn flag_fields(&self, name: &str) -> Vec<(&str, &Field)> {
         let owners = self
             .structs
@@ -1332,7 +1332,7 @@ impl Table {
             .collect()
     }
 
-    /// The fields that carry [[flags]] `name` (checked: at least one, of one type).
+    /// The fields that carry [\[flags\]] `name` (checked: at least one, of one type).
     pub fn flag_carriers(&self, name: &str) -> Vec<(&str, &Field)> {
         let named = self.flag_fields(name);
         if !named.is_empty() {

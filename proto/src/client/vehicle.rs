@@ -22,7 +22,7 @@ pub enum VehicleError {
     NoAnswer {
         /// The queryable's key.
         key: String,
-        /// How long it was asked [s].
+        /// How long it was asked \[s\].
         timeout_s: f64,
     },
     /// Zenoh refused the query.
@@ -438,7 +438,7 @@ pub struct Imu {
     pub name: String,
     /// \[m\] sensor location relative to B, B components.
     pub r_sb_b_m: [f64; 3],
-    /// [PB]: maps B components to the platform frame P.
+    /// \[PB\]: maps B components to the platform frame P.
     pub dcm_pb: [[f64; 3]; 3],
     /// `[imus.<name>.gyro]`: the gyro's error specification (an ideal gyro when absent).
     #[serde(default)]
@@ -468,7 +468,7 @@ pub struct GyroSpec {
 pub struct StarTracker {
     /// Its name (topic `flexdyn/<sc>/tlm/st/<name>`).
     pub name: String,
-    /// [CB]: maps B components to the case frame C.
+    /// \[CB\]: maps B components to the case frame C.
     pub dcm_cb: [[f64; 3]; 3],
     /// \[Hz\] update rate (a whole divisor of the frame rate).
     pub rate_hz: f64,
@@ -502,7 +502,7 @@ pub struct Fault {
 pub struct Magnetometer {
     /// Its name (topic `flexdyn/<sc>/tlm/mag/<name>`).
     pub name: String,
-    /// [SB]: maps B components to the sensor frame S.
+    /// \[SB\]: maps B components to the sensor frame S.
     pub dcm_sb: [[f64; 3]; 3],
     /// \[Hz\] update rate (a whole divisor of the frame rate).
     pub rate_hz: f64,
@@ -513,7 +513,7 @@ pub struct Magnetometer {
 pub struct FineSunSensor {
     /// Its name (topic `flexdyn/<sc>/tlm/fss/<name>`).
     pub name: String,
-    /// [FB]: maps B components to the sensor frame F (boresight +z_F).
+    /// \[FB\]: maps B components to the sensor frame F (boresight +z_F).
     pub dcm_fb: [[f64; 3]; 3],
     /// \[Hz\] update rate (a whole divisor of the frame rate).
     pub rate_hz: f64,

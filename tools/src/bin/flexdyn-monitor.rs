@@ -28,7 +28,7 @@
 //! - `thrusters`: with thrusters, how many fire now, their pulses and propellant used so far,
 //!   and `!min` when a command is below a thruster's minimum on-time;
 //! - `env`: with an `[environment]` that publishes its message (`tlm/env`), the eclipse state
-//!   (`sunlit`, `penumbra`, `umbra`) with the shadow factor ν, |B| [µT] and the density
+//!   (`sunlit`, `penumbra`, `umbra`) with the shadow factor ν, |B| \[µT\] and the density
 //!   [kg/m³], each only when its model is on;
 //! - `sensors`: every sensor message heard in the interval (`flexdyn/<sc>/tlm/<kind>/<name>`),
 //!   as `<kind>/<name>=<messages per second>`;
@@ -655,7 +655,7 @@ impl Watch {
             .map(|s| (s.run_state, s.header.tick))
     }
 
-    /// The interval's summary line (see [`line`]), prefixed `[<id>] ` when `prefixed`.
+    /// The interval's summary line (see [`line`](fn@line)), prefixed `[<id>] ` when `prefixed`.
     fn line(&self, interval: Duration, prefixed: bool) -> String {
         let mut w = self.window.lock().unwrap_or_else(|p| p.into_inner());
         let text = line(&mut w, interval, self.topics.state());

@@ -55,7 +55,7 @@ pub fn inertia_about_b(cfg: &VehicleConfig) -> anyhow::Result<Matrix3<f64>> {
 }
 
 /// The wheel array as flight code sees it: each wheel's effector index on the wire, its spin
-/// axis and spin inertia, and the minimum-norm torque distribution [G_s]⁺ = [G_s]ᵀ([G_s][G_s]ᵀ)⁻¹.
+/// axis and spin inertia, and the minimum-norm torque distribution \[G_s\]⁺ = \[G_s\]ᵀ(\[G_s\]\[G_s\]ᵀ)⁻¹.
 #[derive(Debug, Clone)]
 pub struct WheelArray {
     /// Index of each wheel in `StateMsg::effectors` (after the panel pairs).
@@ -128,7 +128,7 @@ impl WheelArray {
             .collect()
     }
 
-    /// Motor torques u = −[G_s]⁺ L that give the hub the torque L (the hub receives −Σ ĝ_j u_j).
+    /// Motor torques u = −\[G_s\]⁺ L that give the hub the torque L (the hub receives −Σ ĝ_j u_j).
     pub fn motor_torques(&self, torque_b_nm: &Vector3<f64>) -> Vec<f64> {
         let l = nalgebra::DVector::from_column_slice(torque_b_nm.as_slice());
         (&self.pinv * l).iter().map(|u| -u).collect()
@@ -159,9 +159,9 @@ impl WheelArray {
 
 /// The body torque the wheel law asks for (Schaub & Junkins, *Analytical Mechanics of Space
 /// Systems*, ch. 8, MRP feedback with reaction wheels):
-/// L = −K σ_BR − P ω + ω × ([I] ω + [G_s] h_s), with h_s,j = J_s,j (ĝ_jᵀ ω + Ω_j). The last term
-/// cancels the gyroscopic coupling of the body and wheel momenta, so with −[G_s] u = L the
-/// closed loop is [I] ω̇ = −K σ − P ω as for the wrench controller.
+/// L = −K σ_BR − P ω + ω × (\[I\] ω + \[G_s\] h_s), with h_s,j = J_s,j (ĝ_jᵀ ω + Ω_j). The last term
+/// cancels the gyroscopic coupling of the body and wheel momenta, so with −\[G_s\] u = L the
+/// closed loop is \[I\] ω̇ = −K σ − P ω as for the wrench controller.
 pub fn wheel_control_torque(
     k_nm: f64,
     p_nms: f64,
@@ -174,11 +174,11 @@ pub fn wheel_control_torque(
         + omega_bn_b.cross(&(inertia_b * omega_bn_b + wheel_momentum_b))
 }
 
-/// σ_BN from a star tracker: [BN] = [CB]ᵀ [C̃N], between updates propagated with the gyro rate,
+/// σ_BN from a star tracker: \[BN\] = \[CB\]ᵀ [C̃N], between updates propagated with the gyro rate,
 /// σ̇ = ¼ [B(σ)] ω (Schaub & Junkins §3.7), one Euler step per frame, shadow set switched.
 #[derive(Debug, Clone)]
 pub struct StarTrackerAttitude {
-    /// The tracker's mounting [CB].
+    /// The tracker's mounting \[CB\].
     pub dcm_cb: Matrix3<f64>,
     /// It updates on ticks that are multiples of this.
     pub every_frames: u64,

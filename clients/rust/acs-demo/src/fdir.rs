@@ -6,12 +6,12 @@
 //! is reproducible bit for bit.
 //!
 //! # Gyro monitor: gyro-integrated versus star-tracker attitude change
-//! At every valid star-tracker sample k the tracker gives [B_k N] = [CB]ᵀ [C̃N]. Each gyro is
+//! At every valid star-tracker sample k the tracker gives [B_k N] = \[CB\]ᵀ [C̃N]. Each gyro is
 //! integrated between frames (trapezoidal rate, frame rotation R(φ) = exp(−[φ̃]), exact through
 //! the MRP tan(|φ|/4) φ̂) into G(t) = [B_t B_0]. Over a window of M tracker samples, W = M T_st
 //! seconds from sample j to sample k, the tracker's attitude change is [B_k B_j] = [B_k N][B_j N]ᵀ
-//! and the gyro's G_k G_jᵀ; their error E = [B_k B_j] (G_k G_jᵀ)ᵀ ≈ I − [ẽ] gives the residual
-//! rotation e = vee((Eᵀ − E)/2) (B components), taken to the tracker's case frame, e_C = [CB] e.
+//! and the gyro's G_k G_jᵀ; their error E = [B_k B_j] (G_k G_jᵀ)ᵀ ≈ I − \[ẽ\] gives the residual
+//! rotation e = vee((Eᵀ − E)/2) (B components), taken to the tracker's case frame, e_C = \[CB\] e.
 //! Only the window's two end samples of the tracker enter (the tracker noise of the samples in
 //! between cancels), while a fault's effect grows with W.
 //!
@@ -69,15 +69,15 @@
 //! ```
 //!
 //! is healthy −τ_f − J_s ĝᵀ ω̄̇, bounded by τ_c + c_v |Ω|max + J_s α_max, with τ_c and c_v the
-//! Coulomb and viscous friction and α_max = Σ_j u_max,j / λ_min([I]) the hub's largest angular
+//! Coulomb and viscous friction and α_max = Σ_j u_max,j / λ_min(\[I\]) the hub's largest angular
 //! acceleration from the wheels. The threshold is twice that bound (the factor covers the
 //! wings' coupling into ω̇, not in α_max). A wheel fails a frame when |r| exceeds it and is
 //! declared failed after [`WHEEL_PERSISTENCE`] consecutive failed frames. Frames near the speed
 //! limit (where the motor stops accelerating) are not tested. A seized bearing (the rotor braked
 //! to rest at the motor's torque limit, then held) gives |r| ≈ u_max at once.
 //!
-//! **Recovery.** The failed wheel's column of [G_s] is set to zero and the allocation becomes
-//! [G_s']⁺ = [G_s']ᵀ ([G_s'][G_s']ᵀ)⁻¹: the failed wheel gets u = 0, and the three others (if
+//! **Recovery.** The failed wheel's column of \[G_s\] is set to zero and the allocation becomes
+//! [G_s']⁺ = [G_s']ᵀ ([G_s']\[G_s'\]ᵀ)⁻¹: the failed wheel gets u = 0, and the three others (if
 //! they still span three axes) give exactly the requested torque ([`WheelArray::without`]).
 //!
 //! In real time the command acts a frame later than in lockstep; the wheel residual then also
@@ -599,7 +599,7 @@ pub fn gyro_statistic(
 }
 
 impl WheelArray {
-    /// The same array without wheel `failed`: its column of [G_s] set to zero, so the
+    /// The same array without wheel `failed`: its column of \[G_s\] set to zero, so the
     /// minimum-norm allocation gives it u = 0 and the others the requested torque exactly
     /// (an error if they no longer span three axes).
     pub fn without(&self, failed: &[bool]) -> anyhow::Result<Self> {

@@ -4,10 +4,10 @@
 //! - Hill (LVLH) frame H of the chief (Clohessy & Wiltshire 1960; Schaub & Junkins,
 //!   *Analytical Mechanics of Space Systems*, 4th ed., §14.2): x̂ = r_c/|r_c| (radial),
 //!   ẑ = (r_c × v_c)/|r_c × v_c| (orbit normal), ŷ = ẑ × x̂ (along-track); it turns at
-//!   ω_HN = (r_c × v_c)/|r_c|². The deputy relative to the chief: ρ_H = [HN](r_d − r_c) and
-//!   ρ̇_H = [HN](v_d − v_c) − ω_HN × ρ (the transport theorem).
+//!   ω_HN = (r_c × v_c)/|r_c|². The deputy relative to the chief: ρ_H = \[HN\](r_d − r_c) and
+//!   ρ̇_H = \[HN\](v_d − v_c) − ω_HN × ρ (the transport theorem).
 //! - Station keeping: a PD law on the Hill-frame error, a_H = −ω_c² (ρ − ρ*) − 2 ζ ω_c ρ̇, as a
-//!   body force F_B = m [BN][NH] a_H. With ω_c ≫ n the CW coupling (at most 3n²|ρ − ρ*| and
+//!   body force F_B = m \[BN\]\[NH\] a_H. With ω_c ≫ n the CW coupling (at most 3n²|ρ − ρ*| and
 //!   2n|ρ̇|) is a small perturbation of the closed loop's ω_c² + 2ζω_c s + s² (ρ* on the
 //!   along-track axis is a CW equilibrium, so the station needs no force).
 //! - Pointing: the reference frame R has r̂₁ = the unit vector from the deputy to the chief,
@@ -15,7 +15,7 @@
 //!   (L = −Kσ_BR − P(ω_BN − ω_RN)) turns body x̂ onto r̂₁, with ω_RN ≈ ω_HN (the line of sight
 //!   to a chief on station turns with the Hill frame).
 //! - Centres of mass: the state message gives point B; each vehicle's centre of mass C is
-//!   r_C = r_B + [NB] r_CB_B with r_CB_B from the served configuration's masses (panels at
+//!   r_C = r_B + \[NB\] r_CB_B with r_CB_B from the served configuration's masses (panels at
 //!   their hinge angle 0: [`com_offset_b`]).
 
 use flexdyn_proto::attitude::{dcm_to_mrp, mrp_error, mrp_to_dcm};
@@ -52,7 +52,7 @@ pub fn com_state_n(
     (r_bn_n + nb * r_cb_b, v_bn_n + nb * omega_bn_b.cross(r_cb_b))
 }
 
-/// The chief's Hill frame: [HN] and ω_HN in N. `None` without an orbit plane.
+/// The chief's Hill frame: \[HN\] and ω_HN in N. `None` without an orbit plane.
 pub fn hill_frame(r_c: &Vector3<f64>, v_c: &Vector3<f64>) -> Option<(Matrix3<f64>, Vector3<f64>)> {
     let h = r_c.cross(v_c);
     let (rn, hn) = (r_c.norm(), h.norm());
@@ -66,7 +66,7 @@ pub fn hill_frame(r_c: &Vector3<f64>, v_c: &Vector3<f64>) -> Option<(Matrix3<f64
     Some((hn_dcm, h / (rn * rn)))
 }
 
-/// The deputy relative to the chief in the chief's Hill frame: (ρ_H, ρ̇_H, [HN], ω_HN in N).
+/// The deputy relative to the chief in the chief's Hill frame: (ρ_H, ρ̇_H, \[HN\], ω_HN in N).
 pub type HillRelative = (Vector3<f64>, Vector3<f64>, Matrix3<f64>, Vector3<f64>);
 
 /// The deputy at (`r_d`, `v_d`) relative to the chief at (`r_c`, `v_c`): [`HillRelative`].

@@ -20,7 +20,7 @@ use flexdyn_proto::EffectorInput;
 use nalgebra::{DMatrix, DVector, Vector3};
 
 /// The rods as flight code sees them: effector indices, axes, limits, and the minimum-norm
-/// allocation [A]⁺ = [A]ᵀ([A][A]ᵀ)⁻¹ of a body dipole to rod dipoles.
+/// allocation \[A\]⁺ = \[A\]ᵀ(\[A\]\[A\]ᵀ)⁻¹ of a body dipole to rod dipoles.
 #[derive(Debug, Clone)]
 pub struct RodArray {
     /// Index of each rod in `StateMsg::effectors` and `Actuators` commands.

@@ -9,11 +9,11 @@
 //! |---|---|---|---|
 //! | Detumble | gyro, magnetometer | rods (wheels idle) | m = k_ω (ω × B)/\|B\|², each rod clipped |
 //! | SunAcquisition | gyro, coarse sun sensors | wheels | τ = k_p (n̂ × ŝ) − k_d ω (+ gyroscopic term) |
-//! | FinePointing | gyro, star tracker | wheels | L = −Kσ_BR − Pω + ω × ([I]ω + h_w) |
+//! | FinePointing | gyro, star tracker | wheels | L = −Kσ_BR − Pω + ω × (\[I\]ω + h_w) |
 //! | MomentumManagement | + magnetometer | wheels + rods | fine pointing, m = (B × τ_d)/\|B\|², τ_d = −k_u h_w |
 //!
 //! **Detumble law and gain.** B-dot with the rate from the gyro instead of a finite difference
-//! of the field: Ḃ_B = −ω × B_B + [BN] Ḃ_N, and a finite difference also sees the field's own
+//! of the field: Ḃ_B = −ω × B_B + \[BN\] Ḃ_N, and a finite difference also sees the field's own
 //! turning along the orbit (about twice the orbit rate, 0.13°/s here), so a magnetometer-only
 //! B-dot settles the body at that rate, above the 0.1°/s the sequence asks for. With the gyro,
 //! m = (k_ω/|B|) (ω × b̂) gives τ = m × B = −k_ω ω_⊥ (the rate across the field, which turns
@@ -249,9 +249,9 @@ impl AcsSequence {
     }
 
     /// The Sun-pointing target nearest σ_BN: the smallest rotation that takes the panel normal
-    /// onto the Sun, applied to the current attitude. With [NB] = [BN]ᵀ, n_N = [NB] n_B,
-    /// s_N = [NB] s_B and C the rotation taking n_N to s_N, the target's axes in N are C [NB],
-    /// so [RN] = [BN] Cᵀ.
+    /// onto the Sun, applied to the current attitude. With \[NB\] = \[BN\]ᵀ, n_N = \[NB\] n_B,
+    /// s_N = \[NB\] s_B and C the rotation taking n_N to s_N, the target's axes in N are C \[NB\],
+    /// so \[RN\] = \[BN\] Cᵀ.
     pub fn sun_pointing_target(
         sigma_bn: &Vector3<f64>,
         panel_normal_b: &Vector3<f64>,

@@ -11,11 +11,11 @@
 /// One band of the table.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ExponentialBand {
-    /// [m] base altitude h0 of the band.
+    /// \[m\] base altitude h0 of the band.
     pub base_altitude_m: f64,
     /// [kg/m³] nominal density ρ0 at the base.
     pub density_kg_m3: f64,
-    /// [m] scale height H.
+    /// \[m\] scale height H.
     pub scale_height_m: f64,
 }
 
@@ -34,7 +34,7 @@ const fn band(base_km: f64, density_kg_m3: f64, scale_height_km: f64) -> Exponen
     }
 }
 
-/// Vallado (2013) Table 8-4: base altitude [km], nominal density [kg/m³], scale height [km].
+/// Vallado (2013) Table 8-4: base altitude \[km\], nominal density [kg/m³], scale height \[km\].
 #[rustfmt::skip]
 pub const VALLADO_TABLE_8_4: [ExponentialBand; 28] = [
     band(0.0, 1.225, 7.249),
@@ -67,7 +67,7 @@ pub const VALLADO_TABLE_8_4: [ExponentialBand; 28] = [
     band(1000.0, 3.019e-15, 268.00),
 ];
 
-/// [kg/m³] the density at `altitude_m` [m] above the ellipsoid (use the geodetic height). Below
+/// [kg/m³] the density at `altitude_m` \[m\] above the ellipsoid (use the geodetic height). Below
 /// 0 m the first band is extended downward and above 1000 km the last band upward, as the table
 /// gives no more. Allocation-free and panic-free (a NaN altitude gives NaN).
 pub fn exponential_density_kg_m3(altitude_m: f64) -> f64 {

@@ -5,7 +5,7 @@
 //! The inputs are those of the reference program `gtd7`: day of year, UT seconds, geodetic
 //! altitude, latitude and longitude, the local apparent solar time, F10.7 of the previous day,
 //! its 81-day centred average, and the daily Ap. [`Nrlmsise00Model::state`] sets the local solar
-//! time to `UT/3600 + longitude/15` [h], the relation the model's documentation prescribes for
+//! time to `UT/3600 + longitude/15` \[h\], the relation the model's documentation prescribes for
 //! physically consistent input (no equation of time).
 //!
 //! Two densities are given: the total mass density of `gtd7` (He, O, N₂, O₂, Ar, H, N), which the
@@ -50,16 +50,16 @@ use crate::geodetic::{geodetic_from_ecef, Geodetic};
 
 /// [kg] the atomic mass unit as the model uses it (1.66e-24 g in `gtd7`/`gtd7d`).
 const MODEL_AMU_KG: f64 = 1.66e-27;
-/// [km] the bottom of the thermospheric profile (`zn2[0]` of the model); below it `tobari` 0.2.0
+/// \[km\] the bottom of the thermospheric profile (`zn2[0]` of the model); below it `tobari` 0.2.0
 /// does not evaluate NRLMSISE-00 (see the module docs).
 pub const LOWEST_THERMOSPHERE_ALTITUDE_M: f64 = 72_500.0;
 
 /// Solar and geomagnetic activity, held constant over a run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpaceWeather {
-    /// [sfu] F10.7 of the previous day (1 sfu = 1e-22 W m⁻² Hz⁻¹).
+    /// \[sfu\] F10.7 of the previous day (1 sfu = 1e-22 W m⁻² Hz⁻¹).
     pub f107_sfu: f64,
-    /// [sfu] 81-day average of F10.7, centred on the day.
+    /// \[sfu\] 81-day average of F10.7, centred on the day.
     pub f107a_sfu: f64,
     /// [-] daily planetary geomagnetic index Ap.
     pub ap: f64,
@@ -92,9 +92,9 @@ impl SpaceWeather {
 /// Temperatures and composition at a point (NRLMSISE-00 proper, 72.5 km and above).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Composition {
-    /// [K] exospheric temperature.
+    /// \[K\] exospheric temperature.
     pub exospheric_temperature_k: f64,
-    /// [K] temperature at the altitude.
+    /// \[K\] temperature at the altitude.
     pub temperature_k: f64,
     /// [m⁻³] number densities of He, O, N₂, O₂, Ar, H, N and anomalous O, in that order.
     pub number_densities_m3: [f64; 8],
@@ -138,7 +138,7 @@ impl Nrlmsise00Model {
         self.state_at_local_solar_time(day_of_year, ut_s, point, lst_h)
     }
 
-    /// As [`Nrlmsise00Model::state`] with the local apparent solar time `lst_h` [h] given
+    /// As [`Nrlmsise00Model::state`] with the local apparent solar time `lst_h` \[h\] given
     /// explicitly (the reference test cases use a time inconsistent with UT and longitude, to
     /// exercise the model's terms separately).
     pub fn state_at_local_solar_time(
@@ -176,7 +176,7 @@ impl Nrlmsise00Model {
         corrected(&output, point.height_m * 1e-3, latitude_deg)
     }
 
-    /// [kg/m³] the drag density (`gtd7d`) at the Earth-fixed position `r_ecef_m` [m].
+    /// [kg/m³] the drag density (`gtd7d`) at the Earth-fixed position `r_ecef_m` \[m\].
     pub fn drag_density_kg_m3(&self, day_of_year: u32, ut_s: f64, r_ecef_m: &Vector3<f64>) -> f64 {
         self.state(day_of_year, ut_s, &geodetic_from_ecef(r_ecef_m))
             .drag_density_kg_m3

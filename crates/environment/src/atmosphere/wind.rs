@@ -10,7 +10,7 @@
 
 use nalgebra::Vector3;
 
-/// [m/s] the velocity of the co-rotating atmosphere at `r_n_m` [m], ω⊕ × r, in the frame of the
+/// [m/s] the velocity of the co-rotating atmosphere at `r_n_m` \[m\], ω⊕ × r, in the frame of the
 /// arguments (N, with `omega_earth_n_rad_s` the Earth's angular velocity in N).
 pub fn corotation_wind_n_m_s(
     r_n_m: &Vector3<f64>,

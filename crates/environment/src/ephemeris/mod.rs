@@ -38,13 +38,13 @@ pub use part::Ephemeris;
 pub use schema::EphemerisSetting;
 pub use sun::{sun_ecliptic_of_date, sun_position_n_m};
 
-/// [d] Julian Date of the epoch J2000.0 (2000-01-01 12:00 TT).
+/// \[d\] Julian Date of the epoch J2000.0 (2000-01-01 12:00 TT).
 pub const J2000_JD: f64 = 2_451_545.0;
-/// [d] days per Julian century.
+/// \[d\] days per Julian century.
 pub const DAYS_PER_JULIAN_CENTURY: f64 = 36_525.0;
-/// [m] the astronomical unit (IAU 2012 Resolution B2, exact).
+/// \[m\] the astronomical unit (IAU 2012 Resolution B2, exact).
 pub const AU_M: f64 = 149_597_870_700.0;
-/// [m] nominal solar radius (IAU 2015 Resolution B3).
+/// \[m\] nominal solar radius (IAU 2015 Resolution B3).
 pub const SUN_RADIUS_M: f64 = 695_700_000.0;
 
 /// Julian centuries of TT since J2000.0 from a Julian Date in TT (Meeus eq. 22.1).
@@ -55,11 +55,11 @@ pub fn julian_centuries_tt(jd_tt: f64) -> f64 {
 /// A geocentric position in spherical coordinates on the mean ecliptic and equinox of date.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EclipticOfDate {
-    /// [rad] ecliptic longitude λ, in [0, 2π).
+    /// \[rad\] ecliptic longitude λ, in [0, 2π).
     pub lon_rad: f64,
-    /// [rad] ecliptic latitude β.
+    /// \[rad\] ecliptic latitude β.
     pub lat_rad: f64,
-    /// [m] distance from the Earth's centre.
+    /// \[m\] distance from the Earth's centre.
     pub distance_m: f64,
 }
 

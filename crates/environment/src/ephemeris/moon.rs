@@ -76,7 +76,7 @@ pub fn moon_ecliptic_of_date(t_tt_jc: f64) -> EclipticOfDate {
     }
 }
 
-/// [m] the Moon's geocentric position in N (mean equator and equinox of J2000.0 ≈ GCRF) at
+/// \[m\] the Moon's geocentric position in N (mean equator and equinox of J2000.0 ≈ GCRF) at
 /// `t_tt_jc` Julian centuries of TT since J2000.0.
 pub fn moon_position_n_m(t_tt_jc: f64) -> Vector3<f64> {
     moon_ecliptic_of_date(t_tt_jc).to_n_m(t_tt_jc)

@@ -20,7 +20,7 @@ use flexdyn_kernel::attitude::{m1, m2, m3};
 
 const ARCSEC_TO_RAD: f64 = std::f64::consts::PI / (180.0 * 3600.0);
 
-/// [rad] mean obliquity of the ecliptic of date ε0 (Meeus eq. 22.2) at `t_tt_jc` Julian
+/// \[rad\] mean obliquity of the ecliptic of date ε0 (Meeus eq. 22.2) at `t_tt_jc` Julian
 /// centuries of TT since J2000.0.
 pub fn mean_obliquity_rad(t_tt_jc: f64) -> f64 {
     let t = t_tt_jc;

@@ -31,7 +31,7 @@ pub fn sun_ecliptic_of_date(t_tt_jc: f64) -> EclipticOfDate {
     }
 }
 
-/// [m] the Sun's geocentric position in N (mean equator and equinox of J2000.0 ≈ GCRF) at
+/// \[m\] the Sun's geocentric position in N (mean equator and equinox of J2000.0 ≈ GCRF) at
 /// `t_tt_jc` Julian centuries of TT since J2000.0.
 pub fn sun_position_n_m(t_tt_jc: f64) -> Vector3<f64> {
     sun_ecliptic_of_date(t_tt_jc).to_n_m(t_tt_jc)

@@ -15,7 +15,7 @@
 //!   (periodic, Fairhead & Bretagnon 1990), which is below every model's error here, so TT
 //!   stands in for TDB.
 //! - **UTC** = TAI − ΔAT, ΔAT from the IERS leap-second table (Bulletin C) shipped with
-//!   hifitime — no table is typed here ([`leap`]). During an inserted leap second the UTC
+//!   hifitime — no table is typed here (`leap`). During an inserted leap second the UTC
 //!   calendar reads 23:59:60.x. ΔAT after the table's last entry (37 s from 2017-01-01) is held
 //!   at that value: a leap second announced after the hifitime release in use is missed until
 //!   hifitime is updated.

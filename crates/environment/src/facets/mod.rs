@@ -45,7 +45,7 @@ pub const SOLAR_IRRADIANCE_1AU_W_M2: f64 = 1361.0;
 /// [m/s] the speed of light.
 pub const SPEED_OF_LIGHT_M_S: f64 = 299_792_458.0;
 
-/// [N/m²] the solar radiation pressure at `sun_distance_m` [m] from the Sun's centre, for a
+/// [N/m²] the solar radiation pressure at `sun_distance_m` \[m\] from the Sun's centre, for a
 /// visible fraction `shadow_factor` of the solar disc: P = (Φ/c) (1 AU / r)² ν, with Φ the
 /// irradiance at 1 AU (`irradiance_1au_w_m2`, nominally [`SOLAR_IRRADIANCE_1AU_W_M2`]).
 pub fn solar_pressure_n_m2(
@@ -60,11 +60,11 @@ pub fn solar_pressure_n_m2(
 /// One flat plate of the vehicle's surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Facet {
-    /// [m²] area A.
+    /// \[m²\] area A.
     pub area_m2: f64,
     /// [-] outward unit normal n̂, B components.
     pub normal_b: Vector3<f64>,
-    /// [m] centre of pressure relative to point B, B components.
+    /// \[m\] centre of pressure relative to point B, B components.
     pub r_cp_b_m: Vector3<f64>,
     /// [-] drag coefficient C_D (2.2 is the usual value for a flat plate in free molecular flow).
     pub drag_coefficient: f64,

@@ -10,7 +10,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-/// [m] WGS-84 semi-major axis a.
+/// \[m\] WGS-84 semi-major axis a.
 pub const WGS84_A_M: f64 = 6_378_137.0;
 /// [-] WGS-84 flattening f.
 pub const WGS84_F: f64 = 1.0 / 298.257_223_563;
@@ -20,11 +20,11 @@ pub const WGS84_E2: f64 = WGS84_F * (2.0 - WGS84_F);
 /// A point as geodetic latitude, longitude and height above the WGS-84 ellipsoid.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Geodetic {
-    /// [rad] geodetic latitude φ, in [−π/2, π/2].
+    /// \[rad\] geodetic latitude φ, in [−π/2, π/2].
     pub lat_rad: f64,
-    /// [rad] east longitude λ, in (−π, π].
+    /// \[rad\] east longitude λ, in (−π, π].
     pub lon_rad: f64,
-    /// [m] height above the ellipsoid along its normal.
+    /// \[m\] height above the ellipsoid along its normal.
     pub height_m: f64,
 }
 
@@ -41,7 +41,7 @@ pub fn ecef_from_geodetic(p: &Geodetic) -> Vector3<f64> {
     )
 }
 
-/// The geodetic coordinates of an Earth-fixed position `r_ecef_m` [m] (Bowring 1976, four fixed
+/// The geodetic coordinates of an Earth-fixed position `r_ecef_m` \[m\] (Bowring 1976, four fixed
 /// iterations). Allocation-free and panic-free for every finite input; the Earth's centre maps
 /// to latitude 0, height −a.
 pub fn geodetic_from_ecef(r_ecef_m: &Vector3<f64>) -> Geodetic {

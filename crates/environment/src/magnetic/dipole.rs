@@ -62,14 +62,14 @@ impl CentredDipole {
         }
     }
 
-    /// [T] the dipole's field in Earth-fixed components at `r_ecef_m` [m]:
+    /// \[T\] the dipole's field in Earth-fixed components at `r_ecef_m` \[m\]:
     /// (μ0/4π) [3 (m·r̂) r̂ − m] / r³. Allocation-free; zero at the centre.
     pub fn field_ecef_t(&self, r_ecef_m: &Vector3<f64>) -> Vector3<f64> {
         dipole_field_t(&self.m_ecef_am2, r_ecef_m)
     }
 }
 
-/// [T] the field of a point dipole of moment `m_am2` [A·m²] at `r_m` [m] from it (any frame, the
+/// \[T\] the field of a point dipole of moment `m_am2` [A·m²] at `r_m` \[m\] from it (any frame, the
 /// same for both): (μ0/4π) [3 (m·r̂) r̂ − m] / r³ (Jackson, *Classical Electrodynamics*, 3rd ed.,
 /// eq. 5.56). Allocation-free; zero at the dipole itself.
 pub fn dipole_field_t(m_am2: &Vector3<f64>, r_m: &Vector3<f64>) -> Vector3<f64> {
@@ -82,7 +82,7 @@ pub fn dipole_field_t(m_am2: &Vector3<f64>, r_m: &Vector3<f64>) -> Vector3<f64> 
 }
 
 /// [N·m] the torque τ = m × B on a magnetic dipole `m_b_am2` [A·m²] (a spacecraft's residual
-/// dipole, or a magnetorquer's commanded moment) in the field `b_b_t` [T], both in B components
+/// dipole, or a magnetorquer's commanded moment) in the field `b_b_t` \[T\], both in B components
 /// (Griffiths, *Introduction to Electrodynamics*, 4th ed., eq. 6.1). The field is uniform over
 /// the vehicle, so there is no force.
 pub fn dipole_torque_b_nm(m_b_am2: &Vector3<f64>, b_b_t: &Vector3<f64>) -> Vector3<f64> {

@@ -34,7 +34,7 @@ use super::MagneticError;
 pub const IGRF_MAX_DEGREE: usize = 13;
 const N: usize = IGRF_MAX_DEGREE + 1;
 
-/// [m] the IGRF reference radius a (the Earth's mean radius of the model).
+/// \[m\] the IGRF reference radius a (the Earth's mean radius of the model).
 pub const IGRF_REFERENCE_RADIUS_M: f64 = 6_371_200.0;
 
 /// The IGRF-14 coefficient file, shipped in the repository (see `README.md` beside it).
@@ -46,22 +46,22 @@ pub const IGRF14_SHC: &str = include_str!("IGRF14.SHC");
 pub struct GaussCoefficients {
     /// [-] the highest degree n used, 1..=13.
     pub degree: usize,
-    /// [nT] gₙᵐ, `g_nt[n][m]`.
+    /// \[nT\] gₙᵐ, `g_nt[n][m]`.
     pub g_nt: [[f64; N]; N],
-    /// [nT] hₙᵐ, `h_nt[n][m]` (hₙ⁰ = 0).
+    /// \[nT\] hₙᵐ, `h_nt[n][m]` (hₙ⁰ = 0).
     pub h_nt: [[f64; N]; N],
 }
 
-/// The field at a point in geocentric spherical components [nT]: radial (outward), along the
+/// The field at a point in geocentric spherical components \[nT\]: radial (outward), along the
 /// colatitude (southward) and along the longitude (eastward). The geocentric north-east-down
 /// components are (−`b_theta`, `b_phi`, −`b_r`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SphericalField {
-    /// [nT] B_r, outward.
+    /// \[nT\] B_r, outward.
     pub b_r_nt: f64,
-    /// [nT] B_θ, toward increasing colatitude (south).
+    /// \[nT\] B_θ, toward increasing colatitude (south).
     pub b_theta_nt: f64,
-    /// [nT] B_φ, east.
+    /// \[nT\] B_φ, east.
     pub b_phi_nt: f64,
 }
 
@@ -74,7 +74,7 @@ impl GaussCoefficients {
         }
     }
 
-    /// The field at geocentric radius `radius_m` [m], colatitude `colat_rad` and east longitude
+    /// The field at geocentric radius `radius_m` \[m\], colatitude `colat_rad` and east longitude
     /// `lon_rad` (the synthesis of the module docs). Allocation-free and panic-free; on the polar
     /// axis the limit is taken (sin θ is held at 1e-300, where every m ≥ 1 term is exact).
     pub fn field_spherical_nt(
@@ -148,7 +148,7 @@ impl GaussCoefficients {
         }
     }
 
-    /// [T] the field in Earth-fixed components at `r_ecef_m` [m]. Allocation-free and
+    /// \[T\] the field in Earth-fixed components at `r_ecef_m` \[m\]. Allocation-free and
     /// panic-free; at the Earth's centre it returns zero.
     pub fn field_ecef_t(&self, r_ecef_m: &Vector3<f64>) -> Vector3<f64> {
         let radius_m = r_ecef_m.norm();
@@ -207,7 +207,7 @@ impl Igrf {
         self.degree
     }
 
-    /// [yr] the first and last epochs of the model (1900.0 and 2030.0 for IGRF-14).
+    /// \[yr\] the first and last epochs of the model (1900.0 and 2030.0 for IGRF-14).
     pub fn validity_years(&self) -> (f64, f64) {
         (
             self.epochs_year[0],
@@ -255,7 +255,7 @@ impl Igrf {
         out
     }
 
-    /// [T] the field in Earth-fixed components at `r_ecef_m` [m] on `decimal_year`
+    /// \[T\] the field in Earth-fixed components at `r_ecef_m` \[m\] on `decimal_year`
     /// ([`Igrf::coefficients_at`] then [`GaussCoefficients::field_ecef_t`]). When the field is
     /// sampled often within a short span, keep the coefficients and call the latter: they change
     /// by at most 0.004 nT per hour (the largest secular variation, 35 nT/yr).

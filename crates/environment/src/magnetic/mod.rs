@@ -56,11 +56,11 @@ pub enum MagneticError {
          {first_year:.1} to {last_year:.1}"
     )]
     DateOutsideModel {
-        /// [yr] the date asked for.
+        /// \[yr\] the date asked for.
         decimal_year: f64,
-        /// [yr] the model's first epoch.
+        /// \[yr\] the model's first epoch.
         first_year: f64,
-        /// [yr] the model's last epoch.
+        /// \[yr\] the model's last epoch.
         last_year: f64,
     },
     /// The coefficient file cannot be read.
@@ -73,7 +73,7 @@ pub enum MagneticError {
     },
 }
 
-/// [yr] the decimal year of a UTC date: `year + (day_of_year − 1 + ut_s / 86400) / days`, with
+/// \[yr\] the decimal year of a UTC date: `year + (day_of_year − 1 + ut_s / 86400) / days`, with
 /// `days` 365 or 366 (Gregorian leap years) and `day_of_year` from 1 (the convention of the IGRF
 /// programs).
 pub fn decimal_year(year: i32, day_of_year: u32, ut_s: f64) -> f64 {

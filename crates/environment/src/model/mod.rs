@@ -206,7 +206,7 @@ pub struct ModelsOn {
 const MAX_MODELS_ON: usize = 16;
 
 impl ModelsOn {
-    /// Marks `name` as on (a name past [`MAX_MODELS_ON`] is dropped; the models registered
+    /// Marks `name` as on (a name past `MAX_MODELS_ON` is dropped; the models registered
     /// today give six names).
     pub fn set(&mut self, name: &'static str) {
         if self.len < MAX_MODELS_ON && !self.is_on(name) {

@@ -6,7 +6,7 @@
 //! settings, how it is built for an epoch, what of the shared update it needs (the Earth-fixed
 //! frame, the Sun's or the Moon's ephemeris), how it fills its fields of a sample, and how those
 //! fields travel through the prefetch slot and a checkpoint. `crate::lib` registers each with one
-//! line of [`environment_models!`], and the model ([`super`]), the schema ([`super::schema`]),
+//! line of `environment_models!`, and the model ([`super`]), the schema ([`super::schema`]),
 //! the prefetch slot ([`crate::prefetch`]) and the sample's archive ([`crate::sample`]) loop over
 //! that list.
 //!

@@ -32,7 +32,7 @@
 //!
 //! Each environment model reads its own keys, in its folder (`magnetic/schema.rs`, …), and
 //! lists them in its [`EnvironmentPart::KEYS`](super::part::EnvironmentPart::KEYS): this file
-//! reads the update's rates, asks every registered model ([`crate::ModelSettings::read`]) and
+//! reads the update's rates, asks every registered model (`crate::ModelSettings::read`) and
 //! the Earth's orientation ([`crate::earth_rotation::schema`]) for theirs, and reads the dynamic
 //! effectors' switches, the facets and their constants ([`super::constants`]).
 //!

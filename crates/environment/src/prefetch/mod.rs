@@ -44,7 +44,7 @@
 //! hypervisor): at a 10 Hz update of a 1 kHz step that was ~70 ns per step, so offloading the
 //! models cost the stepping thread more than evaluating them there (`benches/step.rs`, "all @
 //! 10 Hz, offloaded"). Instead the worker sleeps between looks at the slot for an eighth of the
-//! wall time between the physics thread's recent requests ([`poll_period`]: 20 µs to 5 ms), so it
+//! wall time between the physics thread's recent requests (`poll_period`: 20 µs to 5 ms), so it
 //! claims a request within about an eighth of the time the answer has before it is needed, and
 //! costs ~200 short wake-ups a second in a real-time run (10 Hz updates).
 

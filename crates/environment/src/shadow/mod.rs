@@ -27,7 +27,7 @@ use nalgebra::Vector3;
 use super::ephemeris::SUN_RADIUS_M;
 use super::geodetic::WGS84_A_M;
 
-/// [m] radius of the occulting Earth (WGS-84 equatorial radius).
+/// \[m\] radius of the occulting Earth (WGS-84 equatorial radius).
 pub const EARTH_SHADOW_RADIUS_M: f64 = WGS84_A_M;
 
 /// Which shadow geometry to use.

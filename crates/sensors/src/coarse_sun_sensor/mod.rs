@@ -31,7 +31,7 @@
 //! normalisation as the direct term's cₖ ν (the direct irradiance over S), so in the output
 //! unit albedo adds scale · αₖ (C5): a detector facing the nadir under a fully lit cap at 500 km
 //! reads about 0.26 scale with a = 0.3. The field of view applies per element direction: an
-//! element outside the detector's cone adds nothing. n̂ₖ,N = [BN]ᵀ n̂ₖ is formed once per
+//! element outside the detector's cone adds nothing. n̂ₖ,N = \[BN\]ᵀ n̂ₖ is formed once per
 //! detector and sample; (C4) is 2 multiply-adds per element and allocates nothing. Albedo is
 //! not scaled by the spacecraft's shadow factor ν: it is light from the lit Earth, and a
 //! detector facing it reads it in penumbra at its full value (in the umbra of a spherical Earth

@@ -3,7 +3,7 @@
 //! `FssMsg` on `flexdyn/<sc-id>/tlm/fss/<name>`.
 //!
 //! # Measurement model
-//! The sensor is mounted with the fixed DCM [FB]; its boresight is F's axis 3. With ŝ_B the
+//! The sensor is mounted with the fixed DCM \[FB\]; its boresight is F's axis 3. With ŝ_B the
 //! unit Sun direction from the environment sample and ν its shadow factor,
 //!
 //! ```text
@@ -21,7 +21,7 @@
 //! at right angles, each measuring atan of the in-plane component over the boresight
 //! component). A flight unit calibrated to another convention (e.g. the angle from the boresight
 //! and an azimuth) converts from these. With every error term zero the output is exactly
-//! atan2(s₁, s₃), atan2(s₂, s₃) of [FB][BN](r_sun/|r_sun|).
+//! atan2(s₁, s₃), atan2(s₂, s₃) of \[FB\]\[BN\](r_sun/|r_sun|).
 //!
 //! # Neglected
 //! Earth albedo (it shifts the sensed centroid when the Earth is in the field of view), the
@@ -56,7 +56,7 @@ pub use kind::KIND;
 pub struct FineSunSensorConfig {
     /// Name: the last chunk of its topic key.
     pub name: String,
-    /// Mounting DCM [FB]: maps B components to sensor-frame F components (boresight +3).
+    /// Mounting DCM \[FB\]: maps B components to sensor-frame F components (boresight +3).
     pub dcm_fb: Matrix3<f64>,
     /// \[rad\] field-of-view half-angle about the boresight, in (0, π/2).
     pub fov_half_angle_rad: f64,

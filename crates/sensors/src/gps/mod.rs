@@ -17,7 +17,7 @@
 //! ```
 //!
 //! z_r, z_v are three standard normals each. The N output is the ECEF solution carried to N
-//! (r_N = [EN]ᵀ r_E, v_N = [EN]ᵀ v_E + ω × r_N, linear in the error), written as truth plus
+//! (r_N = \[EN\]ᵀ r_E, v_N = \[EN\]ᵀ v_E + ω × r_N, linear in the error), written as truth plus
 //! the rotated error so that with every error term zero each frame's output is its truth bit
 //! for bit: N straight from the state, ECEF from [`EarthOrientation`]. The antenna is at B (no
 //! lever arm) and the receiver clock is perfect.

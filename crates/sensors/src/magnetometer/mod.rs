@@ -3,7 +3,7 @@
 //! published as `MagnetometerMsg` on `flexdyn/<sc-id>/tlm/mag/<name>`.
 //!
 //! # Measurement model
-//! The sensor is mounted with the fixed DCM [SB]. At each update, from the environment sample
+//! The sensor is mounted with the fixed DCM \[SB\]. At each update, from the environment sample
 //! (IGRF via [`flexdyn_environment`]; a zero field when no magnetic model is configured),
 //!
 //! ```text
@@ -16,7 +16,7 @@
 //! bias and σ the 1σ white noise per axis and sample. Then, per axis: saturation (y clipped to
 //! ±`range_t`, setting that axis's [`flexdyn_proto::magnetometer_flags`] bit; 0 = unlimited),
 //! then quantisation (y rounded to the nearest multiple of `lsb_t`; 0 = not quantised). With
-//! every error term zero, y_S = [SB][BN] B_N exactly (the same floating-point products).
+//! every error term zero, y_S = \[SB\]\[BN\] B_N exactly (the same floating-point products).
 //!
 //! # The spacecraft's own field
 //! Flight magnetometers also see the field of the spacecraft's magnetorquers (issue 20 §3). When
@@ -60,7 +60,7 @@ pub use kind::KIND;
 pub struct MagnetometerConfig {
     /// Name: the last chunk of its topic key.
     pub name: String,
-    /// Mounting DCM [SB]: maps B components to sensor-frame S components.
+    /// Mounting DCM \[SB\]: maps B components to sensor-frame S components.
     pub dcm_sb: Matrix3<f64>,
     /// \[–\] scale-factor error per axis, a fraction.
     pub scale_factor: Vector3<f64>,
@@ -163,7 +163,7 @@ impl Magnetometer {
         self.last
     }
 
-    /// The field at the sensor, B components: [BN] B_N from the environment sample (zero
+    /// The field at the sensor, B components: \[BN\] B_N from the environment sample (zero
     /// without one), plus, when the sensor's position is configured, the field of every
     /// magnetic dipole the spacecraft's dynamic effectors carry (module docs).
     pub fn truth_b_t(&self, truth: &Truth<'_>) -> Vector3<f64> {

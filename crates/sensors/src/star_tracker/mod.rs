@@ -2,10 +2,10 @@
 //! validity conditions, published as `StarTrackerMsg` on `flexdyn/<sc-id>/tlm/st/<name>`.
 //!
 //! # Measurement model
-//! The tracker is mounted with the fixed DCM [CB]; its boresight b̂ is a unit vector in C
-//! (default +ẑ_C). At each update the true attitude is [CN] = [CB][BN], and the measurement is
+//! The tracker is mounted with the fixed DCM \[CB\]; its boresight b̂ is a unit vector in C
+//! (default +ẑ_C). At each update the true attitude is \[CN\] = \[CB\]\[BN\], and the measurement is
 //!
-//! [C̃N] = R(δθ) [CN],  δθ = β + σ_x n₁ ê₁ + σ_x n₂ ê₂ + σ_b n₃ b̂   (C components),
+//! [C̃N] = R(δθ) \[CN\],  δθ = β + σ_x n₁ ê₁ + σ_x n₂ ê₂ + σ_b n₃ b̂   (C components),
 //!
 //! where (ê₁, ê₂, b̂) is a right-handed orthonormal triad in C (ê₁ is the unit vector of b̂ × x̂_C,
 //! or of b̂ × ŷ_C when b̂ ∥ x̂_C), n₁…n₃ are independent standard normals, σ_x is the
@@ -17,7 +17,7 @@
 //! # Validity
 //! A measurement is invalid (`valid = false`, the quaternion held at the last valid one, the
 //! identity before the first) when
-//! - the boresight in N, [NC] b̂, is within `sun_exclusion_rad` of the Sun direction (flag
+//! - the boresight in N, \[NC\] b̂, is within `sun_exclusion_rad` of the Sun direction (flag
 //!   `SUN_EXCLUSION`): the configured `sun_direction_n`, or with `sun_from_environment = true`
 //!   the direction of the environment sample's r_Sun/B at the update (no exclusion while the
 //!   sample has no Sun), or
@@ -85,15 +85,15 @@ pub const MOON_RADIUS_M: f64 = 1_737_400.0;
 pub struct StarTrackerConfig {
     /// Name: the last chunk of its topic key.
     pub name: String,
-    /// Mounting DCM [CB]: maps B components to case-frame C components.
+    /// Mounting DCM \[CB\]: maps B components to case-frame C components.
     pub dcm_cb: Matrix3<f64>,
     /// Boresight b̂ in C components (unit).
     pub boresight_c: Vector3<f64>,
-    /// [rad] 1σ noise about each cross-boresight axis.
+    /// \[rad\] 1σ noise about each cross-boresight axis.
     pub sigma_cross_boresight_rad: f64,
-    /// [rad] 1σ noise about the boresight.
+    /// \[rad\] 1σ noise about the boresight.
     pub sigma_about_boresight_rad: f64,
-    /// [rad] constant bias, a small rotation vector in C components.
+    /// \[rad\] constant bias, a small rotation vector in C components.
     pub bias_c_rad: Vector3<f64>,
     /// Updates every this many frames (from `rate_hz`; ≥ 1).
     pub every_frames: u64,
@@ -105,17 +105,17 @@ pub struct StarTrackerConfig {
     /// each update (`sun_from_environment = true`: the ephemeris or the configured fixed Sun,
     /// seen from B) instead of [`Self::sun_direction_n`].
     pub sun_from_environment: bool,
-    /// [rad] Sun exclusion half-angle about the boresight (0: no exclusion).
+    /// \[rad\] Sun exclusion half-angle about the boresight (0: no exclusion).
     pub sun_exclusion_rad: f64,
     /// [rad/s] largest |ω_B/N| at which the tracker still reports (∞: no limit).
     pub max_rate_rad_s: f64,
-    /// [rad] exclusion half-angle about the Earth's limb (0: no Earth exclusion).
+    /// \[rad\] exclusion half-angle about the Earth's limb (0: no Earth exclusion).
     pub earth_exclusion_rad: f64,
-    /// [m] the Earth's radius for the limb (default WGS-84 a, 6378137 m).
+    /// \[m\] the Earth's radius for the limb (default WGS-84 a, 6378137 m).
     pub earth_radius_m: f64,
-    /// [m] height of the bright atmosphere above `earth_radius_m`, counted as the Earth's disc.
+    /// \[m\] height of the bright atmosphere above `earth_radius_m`, counted as the Earth's disc.
     pub earth_atmosphere_m: f64,
-    /// [rad] exclusion half-angle about the Moon's limb (0: no Moon exclusion).
+    /// \[rad\] exclusion half-angle about the Moon's limb (0: no Moon exclusion).
     pub moon_exclusion_rad: f64,
 }
 

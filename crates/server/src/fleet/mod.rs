@@ -26,7 +26,7 @@
 //!   `--participants` are refused with `--fleet`).
 //! - **Lateness** (real time): the fleet has one frame boundary, so one lateness per frame; the
 //!   physics thread hands it to every vehicle's telemetry thread through a ring of atomics
-//!   ([`super::lateness_ring`]), and each vehicle's StatusMsg and report carry its p50, p99 and
+//!   (`super::lateness_ring`), and each vehicle's StatusMsg and report carry its p50, p99 and
 //!   maximum, as a one-vehicle server's do.
 //! - **`--record`**: one MCAP file holds every vehicle (each described by its configuration),
 //!   its frames, statuses and commands, and each deputy's relative states. The physics thread

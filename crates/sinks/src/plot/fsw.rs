@@ -16,7 +16,7 @@
 //! Angles: for unit quaternions q₁, q₂ (scalar first), the principal angle of the rotation
 //! between them is Φ = 2 atan2(√(1 − d²), |d|) with d = q₁·q₂ (Schaub & Junkins, *Analytical
 //! Mechanics of Space Systems*, 4th ed., §3.5: β₀ = cos Φ/2 of the relative rotation). The
-//! per-axis estimation error is the principal rotation vector Φ ê of [B̂B] = [B̂N][BN]ᵀ, from
+//! per-axis estimation error is the principal rotation vector Φ ê of [B̂B] = [B̂N]\[BN\]ᵀ, from
 //! its MRP σ = tan(Φ/4) ê (§3.7): Φ ê = 4 atan(|σ|) σ/|σ|, B components.
 
 use std::collections::BTreeMap;

@@ -4,7 +4,7 @@
 //! (`assets/web/`), so it needs no network, no CDN and nothing installed but a browser.
 //!
 //! A request that asks for a WebSocket upgrade (`Upgrade: websocket`) is not answered here: it
-//! goes on to the Foxglove server as before ([`super::relay`]).
+//! goes on to the Foxglove server as before (`super::relay`).
 
 /// The page.
 const INDEX_HTML: &str = include_str!("../../assets/web/index.html");

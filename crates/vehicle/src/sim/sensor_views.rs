@@ -37,7 +37,7 @@ impl Simulation {
         self.imu_sensors().map(ImuSensor::imu).collect()
     }
 
-    /// Where each IMU sits (r_S/B) and how its platform is turned ([PB]), in config order.
+    /// Where each IMU sits (r_S/B) and how its platform is turned (\[PB\]), in config order.
     pub fn imu_points(&self) -> Vec<SensorPoint> {
         self.imu_sensors().map(|s| *s.point()).collect()
     }

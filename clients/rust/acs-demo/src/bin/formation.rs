@@ -32,7 +32,7 @@ struct Args {
     /// The deputy (`--sc-id`) and the connection.
     #[command(flatten)]
     common: CommonArgs,
-    /// The chief's id (its keys flexdyn/<CHIEF>/…).
+    /// The chief's id (its keys flexdyn/\<CHIEF>/…).
     #[arg(long)]
     chief: String,
     /// Our sender id (a participant of the deputy in the fleet file).

@@ -3,7 +3,7 @@
 //! At each RK4 stage the velocity of the hub point B relative to the local atmosphere is
 //! v_rel = v_B/N − v_wind (Vallado, *Fundamentals of Astrodynamics and Applications*, 4th ed.,
 //! §8.6.2), with the wind from the held [`EnvironmentSample`] (a co-rotating atmosphere's
-//! ω⊕ × r, or zero) and the density from the same sample. Rotated into B by the stage's [BN], it
+//! ω⊕ × r, or zero) and the density from the same sample. Rotated into B by the stage's \[BN\], it
 //! drives the facet forces F = −½ ρ C_D A |v_rel|² cos θ v̂_rel of
 //! [`flexdyn_environment::facets`], summed at B with their moments about B.
 //!

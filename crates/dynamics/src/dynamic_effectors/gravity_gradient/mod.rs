@@ -5,13 +5,13 @@
 //! Expand the point-mass potential of every mass element about the system centre of mass C to
 //! second order in its distance from C (MacCullagh's formula; Schaub & Junkins, *Analytical
 //! Mechanics of Space Systems*, 4th ed., §4.5 "Gravity gradient torque"; Hughes, *Spacecraft
-//! Attitude Dynamics*, §8.2). With R = r_C/N and [I_C] the vehicle's inertia about C, both in B
+//! Attitude Dynamics*, §8.2). With R = r_C/N and \[I_C\] the vehicle's inertia about C, both in B
 //! components, R = |R| and μ the gravitational parameter:
 //!
 //! - potential beyond the point-mass term (GG1):
-//!   V = μ/(2R⁵) (3 Rᵀ[I_C]R − R² tr[I_C]);
-//! - torque about C (GG2): L_C = −R × ∂V/∂R|attitude = (3μ/R⁵) R × [I_C]R;
-//! - force on C (GG3): F = −∂V/∂R = (3μ/(2R⁵)) [(5 Rᵀ[I_C]R/R² − tr[I_C]) R − 2 [I_C]R].
+//!   V = μ/(2R⁵) (3 Rᵀ\[I_C\]R − R² tr\[I_C\]);
+//! - torque about C (GG2): L_C = −R × ∂V/∂R|attitude = (3μ/R⁵) R × \[I_C\]R;
+//! - force on C (GG3): F = −∂V/∂R = (3μ/(2R⁵)) [(5 Rᵀ\[I_C\]R/R² − tr\[I_C\]) R − 2 \[I_C\]R].
 //!
 //! The point-mass part −μm/R is the uniform field the spacecraft already applies at C. GG3 is
 //! the force that goes with GG2: R × F = −L_C, so the pair moves angular momentum between the
@@ -20,7 +20,7 @@
 //! force for a 1000 kg, 1000 kg·m² vehicle in LEO, but without it neither invariant holds to
 //! round-off, which is how the tests check the model.
 //!
-//! [I_C] is the whole vehicle's inertia *at the stage*: flexing panels and spinning wheels are
+//! \[I_C\] is the whole vehicle's inertia *at the stage*: flexing panels and spinning wheels are
 //! in it as they are ([`StageState::inertia_pnt_c_b_kg_m2`]). Higher-order terms (O((size/R)³))
 //! are neglected: for a 10 m vehicle at 7000 km they are ~10⁻⁶ of GG2.
 //!
@@ -76,7 +76,7 @@ fn force_and_torque_c(
 }
 
 /// \[N·m\] GG2: the torque about C for the CoM at `r_cn_b_m` (R, B components) and the inertia
-/// about C `inertia_c_b_kg_m2` (B components): (3μ/R⁵) R × [I_C]R.
+/// about C `inertia_c_b_kg_m2` (B components): (3μ/R⁵) R × \[I_C\]R.
 #[inline]
 pub fn torque_c_b_nm(
     mu_m3_s2: f64,
@@ -88,7 +88,7 @@ pub fn torque_c_b_nm(
 }
 
 /// \[N\] GG3: the second-order force on C, B components:
-/// (3μ/(2R⁵)) [(5 Rᵀ[I_C]R/R² − tr[I_C]) R − 2 [I_C]R].
+/// (3μ/(2R⁵)) [(5 Rᵀ\[I_C\]R/R² − tr\[I_C\]) R − 2 \[I_C\]R].
 #[inline]
 pub fn force_b_newton(
     mu_m3_s2: f64,
@@ -99,7 +99,7 @@ pub fn force_b_newton(
     force_and_torque_c(mu_m3_s2, r_cn_b_m, &i_r, inertia_c_b_kg_m2.trace()).0
 }
 
-/// \[J\] GG1: the potential beyond the point-mass term, μ/(2R⁵) (3 Rᵀ[I_C]R − R² tr[I_C]).
+/// \[J\] GG1: the potential beyond the point-mass term, μ/(2R⁵) (3 Rᵀ\[I_C\]R − R² tr\[I_C\]).
 pub fn potential_j(
     mu_m3_s2: f64,
     r_cn_b_m: &Vector3<f64>,

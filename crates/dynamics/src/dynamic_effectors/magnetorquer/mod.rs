@@ -3,7 +3,7 @@
 //!
 //! τ = m × B (Griffiths, *Introduction to Electrodynamics*, 4th ed., eq. 6.1), with
 //! m = μ â, μ the commanded dipole clipped to ±`max_dipole_am2`, â the rod's axis in B, and
-//! B_B = [BN] B_N from the held [`EnvironmentSample`] rotated by each stage's attitude. The field
+//! B_B = \[BN\] B_N from the held [`EnvironmentSample`] rotated by each stage's attitude. The field
 //! is uniform over the vehicle, so a rod exerts no force. This is the law of Basilisk's
 //! `MtbEffector` as well; there the rods are grouped in one module, here each rod is one entry
 //! of the effector list with one input, so a failed rod, a fault or a dispersion names it.

@@ -2,7 +2,7 @@
 //!
 //! τ = m × B (Griffiths, *Introduction to Electrodynamics*, 4th ed., eq. 6.1), with the
 //! configured dipole m fixed in B and the field of the held [`EnvironmentSample`] rotated into
-//! B by the stage's [BN]: B_B = [BN] B_N. The field is uniform over the vehicle, so there is no
+//! B by the stage's \[BN\]: B_B = \[BN\] B_N. The field is uniform over the vehicle, so there is no
 //! force. A magnetorquer's commanded dipole obeys the same law; this effector is the part of the
 //! vehicle's moment that nobody commands (currents in harnesses and solar arrays, magnetised
 //! parts), typically 0.01–1 A·m² on a small satellite.

@@ -1,6 +1,6 @@
 //! Solar radiation pressure and its torque from the flat-plate model of the vehicle's surfaces.
 //!
-//! At each RK4 stage the direction to the Sun in B is [BN] r_Sun/B (the held
+//! At each RK4 stage the direction to the Sun in B is \[BN\] r_Sun/B (the held
 //! [`EnvironmentSample`]'s Sun position relative to B), and the pressure is
 //! P = (Φ/c) (1 AU / |r_Sun/B|)² ν ([`flexdyn_environment::facets::solar_pressure_n_m2`]), with
 //! ν the sample's shadow factor (0 in umbra, the visible fraction of the disc in penumbra). The

@@ -39,7 +39,7 @@
 //! force that empties the tank exactly at the step's end, and none after it (s = 0; the tank
 //! flags `EMPTY`). A fed thruster also adds the mass-depletion force of its exhaust leaving the
 //! rotating vehicle, −ṁ ω × r_T/B applied at T, whose moment is the jet damping
-//! −ṁ [r̃_T/B][r̃_T/B]ᵀ ω (the tank module's (D3)–(D4)).
+//! −ṁ [r̃_T/B]\[r̃_T/B\]ᵀ ω (the tank module's (D3)–(D4)).
 //!
 //! A pulse is one opening of the valve; PWM at duty 1 holds it open and counts once.
 //!

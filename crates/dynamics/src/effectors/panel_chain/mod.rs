@@ -21,20 +21,20 @@
 //!
 //! # The hinge equations
 //! (C6) Kane's equation for θ_i (Eqs. 91–95 and 117, one row per hinge):
-//! Σ_{k≥i} [m_k p_ik · a_Sck + ê · ([I_k] α_k + ω_Sk × [I_k] ω_Sk)] = τ_i, with
+//! Σ_{k≥i} [m_k p_ik · a_Sck + ê · (\[I_k\] α_k + ω_Sk × \[I_k\] ω_Sk)] = τ_i, with
 //! a_Sck = r̈_B/N + ω̇ × r_Sck + ω × (ω × r_Sck) + 2 ω × r′_Sck + r″_Sck and the hinge torque
 //! τ_i = −k_i θ_i − c_i θ̇_i + u_i on panel i (the inboard body takes −τ_i, so τ_i is the whole
-//! generalised active force of row i). Since ê is a principal axis, ê·[I_k] = I_k2 êᵀ and the
+//! generalised active force of row i). Since ê is a principal axis, ê·\[I_k\] = I_k2 êᵀ and the
 //! gyroscopic term is (I_k1 − I_k3) ω_k1 ω_k3 with ω_kj = ω·ŝ_kj (as in Eq. 124). Collected:
 //!
-//! (C7) [M_θ] θ̈ = −[A_θ] r̈_B/N − [B_θ] ω̇_B/N + F_θ, an N×N system whose rows are
+//! (C7) \[M_θ\] θ̈ = −\[A_θ\] r̈_B/N − \[B_θ\] ω̇_B/N + F_θ, an N×N system whose rows are
 //! - M_im = Σ_{k≥max(i,m)} (m_k p_ik·p_mk + I_k2)  (symmetric positive-definite: the Kane block),
 //! - A_θ,i = Σ_{k≥i} m_k p_ikᵀ,
 //! - B_θ,i = Σ_{k≥i} (m_k (r_Sck × p_ik)ᵀ + I_k2 êᵀ),
 //! - F_i = τ_i − Σ_{k≥i} [m_k p_ik·(ω × (ω × r_Sck) + 2 ω × r′_Sck + κ_k) + (I_k1 − I_k3) ω_k1 ω_k3].
 //!
 //! For N = 2 these are Kane's rows: row 2 is the pair's Eq. 120 (erratum E1 applied) and row 1
-//! is Eq. 119 + Eq. 120 (`docs/errata.md`, Section IV), so [M_θ] = T [A_i] with
+//! is Eq. 119 + Eq. 120 (`docs/errata.md`, Section IV), so \[M_θ\] = T \[A_i\] with
 //! T = [[1, 1], [0, 1]] and the solution θ̈ is the pair's.
 //!
 //! (C8) With p_ik = l_i ŝ_i3 + p_i+1,k (i < k), every sum folds into one sweep from the tip,
@@ -49,24 +49,24 @@
 //!   p_ik = D_im + p_mk for k ≥ m).
 //!
 //! # Back-substitution and the hub contributions
-//! (C9) With [M_θ] = L Lᵀ (Cholesky), X_f = −[M_θ]⁻¹[A_θ], X_g = −[M_θ]⁻¹[B_θ],
-//! x_v = [M_θ]⁻¹ F_θ (N×3, N×3, N): θ̈ = X_f r̈_B/N + X_g ω̇_B/N + x_v (Eqs. 129–132).
+//! (C9) With \[M_θ\] = L Lᵀ (Cholesky), X_f = −\[M_θ\]⁻¹\[A_θ\], X_g = −\[M_θ\]⁻¹\[B_θ\],
+//! x_v = \[M_θ\]⁻¹ F_θ (N×3, N×3, N): θ̈ = X_f r̈_B/N + X_g ω̇_B/N + x_v (Eqs. 129–132).
 //!
 //! (C10) The θ̈ terms of the hub's translational and rotational equations (Eqs. 133–134) are
-//! Σ_k m_k r″_Sck|θ̈ = [A_θ]ᵀ θ̈ and Σ_k (m_k r_Sck × r″_Sck|θ̈ + I_k2 Ω̇_k ê) = [B_θ]ᵀ θ̈ (the
+//! Σ_k m_k r″_Sck|θ̈ = \[A_θ\]ᵀ θ̈ and Σ_k (m_k r_Sck × r″_Sck|θ̈ + I_k2 Ω̇_k ê) = \[B_θ\]ᵀ θ̈ (the
 //! same rows: Kane's symmetry). Substituting (C9) (Eqs. 139–144):
-//! - [A_contr] = [A_θ]ᵀ X_f, [B_contr] = [A_θ]ᵀ X_g, [C_contr] = [B_θ]ᵀ X_f = [B_contr]ᵀ,
-//!   [D_contr] = [B_θ]ᵀ X_g ([A_contr] and [D_contr] symmetric);
-//! - v_trans,contr = −Σ_k m_k κ_k − [A_θ]ᵀ x_v;
-//! - v_rot,contr = −Σ_k (h_k + m_k r_Sck × (2 ω × r′_Sck + κ_k)) − [B_θ]ᵀ x_v, with
+//! - \[A_contr\] = \[A_θ\]ᵀ X_f, \[B_contr\] = \[A_θ\]ᵀ X_g, \[C_contr\] = \[B_θ\]ᵀ X_f = \[B_contr\]ᵀ,
+//!   \[D_contr\] = \[B_θ\]ᵀ X_g (\[A_contr\] and \[D_contr\] symmetric);
+//! - v_trans,contr = −Σ_k m_k κ_k − \[A_θ\]ᵀ x_v;
+//! - v_rot,contr = −Σ_k (h_k + m_k r_Sck × (2 ω × r′_Sck + κ_k)) − \[B_θ\]ᵀ x_v, with
 //!   h_k = Ω_k ((I_k3 − I_k1)(ω_k3 ŝ_k1 + ω_k1 ŝ_k3) + I_k2 (ω_k1 ŝ_k3 − ω_k3 ŝ_k1)). The sum is
 //!   what panel k adds beyond a body frozen in B (whose terms the hub already carries through
-//!   [I_sc,B], c and c′): h_k = [I_k]α_k + ω_Sk×[I_k]ω_Sk − ([I_k]ω̇ + ω×[I_k]ω) − I_k2 Ω̇_k ê,
+//!   \[I_sc,B\], c and c′): h_k = \[I_k\]α_k + ω_Sk×\[I_k\]ω_Sk − (\[I_k\]ω̇ + ω×\[I_k\]ω) − I_k2 Ω̇_k ê,
 //!   and m_k r × (2ω × r′ + κ) from a_Sck. Together they equal the pair's ω × H_rel, its
 //!   centripetal torques and its share of Eq. 150's −[I′]ω.
 //!
 //! # Cost and storage
-//! One evaluation is O(N) for the sweep, O(N²) for the off-diagonal of [M_θ] and N³/6 for the
+//! One evaluation is O(N) for the sweep, O(N²) for the off-diagonal of \[M_θ\] and N³/6 for the
 //! factorisation, with every array sized at construction (no allocation in the stepping path).
 //! A chain holds at most [`MAX_LINKS`] panels (the static state-name table); a configured chain
 //! at most [`MAX_WIRE_LINKS`], because a StateMsg effector entry carries at most

@@ -20,16 +20,16 @@
 //! # The fastest hinge mode
 //! The hinge modes are those of the chain on a free hub, linearised at the configured initial
 //! angles: the generalised speeds u = (ṙ_B, ω, θ̇_1 … θ̇_N), the mass matrix
-//! [M] = Σ_bodies (m J_vᵀ J_v + J_ωᵀ [I_c] J_ω) of the hub and the panels, with the rows of
+//! \[M\] = Σ_bodies (m J_vᵀ J_v + J_ωᵀ \[I_c\] J_ω) of the hub and the panels, with the rows of
 //! each body's centre-of-mass velocity and angular velocity (panel_chain/mod.rs, (C1)–(C5)):
 //! - hub: v = ṙ_B − [r̃_BcB] ω, ω_hub = ω;
 //! - panel k: v = ṙ_B − [r̃_Sck] ω + Σ_{i≤k} p_ik θ̇_i, p_ik = ê × (r_Sck − r_Hi);
-//!   ω_k = ω + Σ_{i≤k} θ̇_i ê, and [I_c] = Σ_j I_kj ŝ_kj ŝ_kjᵀ in B.
+//!   ω_k = ω + Σ_{i≤k} θ̇_i ê, and \[I_c\] = Σ_j I_kj ŝ_kj ŝ_kjᵀ in B.
 //!
 //! The hub's six speeds carry no stiffness, so they are eliminated (a free hub takes whatever
-//! motion keeps the momenta zero): [M_eff] = [M_θθ] − [M_hθ]ᵀ [M_hh]⁻¹ [M_hθ], and the hinge
-//! modes are [K] v = ω² [M_eff] v with [K] = diag(k_i). With [M_eff] = L Lᵀ, ω_max² is the
-//! largest eigenvalue of L⁻¹ [K] L⁻ᵀ. A light hub raises ω_max (the hub recoils, so less inertia
+//! motion keeps the momenta zero): \[M_eff\] = \[M_θθ\] − \[M_hθ\]ᵀ \[M_hh\]⁻¹ \[M_hθ\], and the hinge
+//! modes are \[K\] v = ω² \[M_eff\] v with \[K\] = diag(k_i). With \[M_eff\] = L Lᵀ, ω_max² is the
+//! largest eigenvalue of L⁻¹ \[K\] L⁻ᵀ. A light hub raises ω_max (the hub recoils, so less inertia
 //! resists the hinge): this is where the ratio of panel to hub mass enters. The other bodies
 //! of the vehicle are left out: held rigid they only add inertia to the hub, so ω_max here is
 //! at or above the vehicle's.

@@ -32,7 +32,7 @@ pub const KIND: EffectorKind = EffectorKind {
     column_prefix: "pair",
 };
 
-/// State order: θ1 [rad], θ̇1 [rad/s], θ2 [rad], θ̇2 [rad/s].
+/// State order: θ1 \[rad\], θ̇1 [rad/s], θ2 \[rad\], θ̇2 [rad/s].
 pub const STATE_NAMES: [&str; 4] = ["theta1", "theta1_dot", "theta2", "theta2_dot"];
 
 /// The panel frames at one state: [S1 B] = M2(θ1)[H1 B], [S2 B] = M2(φ)[S1 B], φ = θ2 + θ_H2S1.

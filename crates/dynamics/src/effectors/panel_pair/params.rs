@@ -11,20 +11,20 @@ use flexdyn_kernel::validate::{
 /// One rigid panel of a dual-hinged pair.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PanelParams {
-    /// [kg] panel mass.
+    /// \[kg\] panel mass.
     pub mass_kg: f64,
     /// [kg·m²] principal inertia about the panel centre of mass, in its S frame: (I_s1, I_s2, I_s3).
     pub inertia_s_kg_m2: Vector3<f64>,
-    /// [m] distance from the panel's hinge to its centre of mass, along −ŝ1.
+    /// \[m\] distance from the panel's hinge to its centre of mass, along −ŝ1.
     pub d_m: f64,
     /// [N·m/rad] torsional stiffness of the panel's hinge.
     pub k_nm_rad: f64,
     /// [N·m·s/rad] torsional damping of the panel's hinge.
     pub c_nm_s_rad: f64,
-    /// [m] the panel's width along its hinge axis ŝ2, if given: drawn (`flexdyn view`) instead
+    /// \[m\] the panel's width along its hinge axis ŝ2, if given: drawn (`flexdyn view`) instead
     /// of the width of the box with the panel's inertia. Not used by the dynamics.
     pub width_m: Option<f64>,
-    /// [m] the panel's thickness along ŝ3, if given; drawn like `width_m`.
+    /// \[m\] the panel's thickness along ŝ3, if given; drawn like `width_m`.
     pub thickness_m: Option<f64>,
 }
 
@@ -34,14 +34,14 @@ pub struct PanelParams {
 pub struct PanelPairParams {
     /// Name used in logs and error messages.
     pub name: String,
-    /// [m] hinge 1 location H1 relative to B, in B components.
+    /// \[m\] hinge 1 location H1 relative to B, in B components.
     pub r_h1b_b_m: Vector3<f64>,
-    /// DCM [H1B]: maps B components to hinge-1 frame H1 components (rows are ĥ1, ĥ2, ĥ3 in B).
+    /// DCM \[H1B\]: maps B components to hinge-1 frame H1 components (rows are ĥ1, ĥ2, ĥ3 in B).
     pub dcm_h1b: Matrix3<f64>,
-    /// [rad] fixed rotation of the hinge-2 frame H2 about the (common) hinge axis ŝ12,
+    /// \[rad\] fixed rotation of the hinge-2 frame H2 about the (common) hinge axis ŝ12,
     /// relative to S1: [H2 S1] = M2(theta_h2s1). Non-zero models folded or undeployed wings.
     pub theta_h2s1_rad: f64,
-    /// [m] length of panel 1 (hinge 1 to hinge 2).
+    /// \[m\] length of panel 1 (hinge 1 to hinge 2).
     pub l1_m: f64,
     /// Panel 1 (inboard).
     pub panel1: PanelParams,
@@ -55,11 +55,11 @@ pub struct PanelPairParams {
 /// Initial state of one pair.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct PanelPairInitial {
-    /// [rad] θ1, panel 1 deflection about ŝ12 from H1.
+    /// \[rad\] θ1, panel 1 deflection about ŝ12 from H1.
     pub theta1_rad: f64,
     /// [rad/s] θ̇1.
     pub theta1_dot_rad_s: f64,
-    /// [rad] θ2, panel 2 deflection relative to panel 1 (and H2).
+    /// \[rad\] θ2, panel 2 deflection relative to panel 1 (and H2).
     pub theta2_rad: f64,
     /// [rad/s] θ̇2.
     pub theta2_dot_rad_s: f64,

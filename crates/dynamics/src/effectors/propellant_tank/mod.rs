@@ -28,9 +28,9 @@
 //!   to round-off.
 //! - **(D2) Mass properties** about B (note, Eqs. `eq:def_rCB`, `eq:eq45`, `eq:eq46`): the
 //!   propellant adds m_p, the first moment m_p r_T and the inertia
-//!   [I_T,B] = [I_Tc(m_p)] + m_p [r̃_T][r̃_T]ᵀ, where [I_Tc] is the tank model's inertia about
+//!   \[I_T,B\] = [I_Tc(m_p)] + m_p [r̃_T]\[r̃_T\]ᵀ, where \[I_Tc\] is the tank model's inertia about
 //!   its centroid (D6). The hub sums them with every other body's each evaluation, so m_sc, c
-//!   and [I_sc,B] of the equations of motion follow the propellant.
+//!   and \[I_sc,B\] of the equations of motion follow the propellant.
 //! - **(D3) Translational equation.** The linear momentum of the control volume (hub, bodies and
 //!   the propellant still aboard) changes by the external force less the momentum flux out of
 //!   the nozzles (the note's Reynolds-transport form, Eq. `eq:ComplTranslEOM`). With the first
@@ -47,12 +47,12 @@
 //!   depleting centre of mass's c′ and c″ (Eqs. `eq:eq17`, `eq:eq18`) and m̈ terms, which
 //!   vanish inside a step here (ṁ is constant over a step).
 //! - **(D4) Rotational equation** (note, Eqs. `eq:HscB_dot`, `eq:eq48`, `eq:eq53`, `eq:eq55`):
-//!   [I_sc,B] ω̇ + m_sc [c̃] r̈_B = −ω × [I_sc,B] ω − [K] ω + L_B, with
-//!   [K] = Σ_tanks [I_T,B]′ + Σ_j ṁ_j [r̃_N,j][r̃_N,j]ᵀ, and for a centroid fixed in B
-//!   [I_T,B]′ = [I_Tc]′ + ṁ_p [r̃_T][r̃_T]ᵀ. The tank adds its share −[I_T,B]′ ω to v_rot, as
-//!   every body adds its −[I′]ω; since r_T × (ω × r_T) = [r̃_T][r̃_T]ᵀ ω, its point-mass part is
+//!   \[I_sc,B\] ω̇ + m_sc [c̃] r̈_B = −ω × \[I_sc,B\] ω − \[K\] ω + L_B, with
+//!   \[K\] = Σ_tanks \[I_T,B\]′ + Σ_j ṁ_j [r̃_N,j]\[r̃_N,j\]ᵀ, and for a centroid fixed in B
+//!   \[I_T,B\]′ = \[I_Tc\]′ + ṁ_p [r̃_T]\[r̃_T\]ᵀ. The tank adds its share −\[I_T,B\]′ ω to v_rot, as
+//!   every body adds its −[I′]ω; since r_T × (ω × r_T) = [r̃_T]\[r̃_T\]ᵀ ω, its point-mass part is
 //!   exactly the moment of the force of (D3) at T, so the tank adds
-//!   **v_rot += −[I_Tc]′ ω + r_T × (−ṁ_p ω × r_T)**. The nozzle's part −ṁ_j [r̃_N][r̃_N]ᵀ ω (the
+//!   **v_rot += −\[I_Tc\]′ ω + r_T × (−ṁ_p ω × r_T)**. The nozzle's part −ṁ_j [r̃_N]\[r̃_N\]ᵀ ω (the
 //!   *jet damping*) is likewise the moment of the nozzle's force of (D3) at r_N, which the
 //!   thruster applies there.
 //! - **(D5) Running dry.** Each step the spacecraft sums the demand D = Σ_j F̄_j/(I_sp,j g₀) of
@@ -62,7 +62,7 @@
 //!   and flow, so the impulse stays I_sp g₀ times the propellant used and m_p never goes
 //!   negative (a residue of round-off below 1e-12 of the load counts as empty).
 //! - **(D6) Tank inertia models** (note, "Tank models"; Panicucci et al., the same section),
-//!   both a sphere of propellant about its centre, so [I_Tc] = I(m_p) [1]:
+//!   both a sphere of propellant about its centre, so \[I_Tc\] = I(m_p) \[1\]:
 //!   - `constant_volume` (the propellant stays spread uniformly through a sphere of fixed
 //!     radius R and its density falls as it is used, the "uniform burn" limit):
 //!     I = (2/5) m_p R², I′ = (2/5) ṁ_p R² — the inertia is proportional to the mass;
@@ -72,7 +72,7 @@
 //!     note's constant-density result). It falls faster than the mass (I ∝ m_p^(5/3)).
 //!
 //!   The propellant's centroid is fixed in both (r′_T = r″_T = 0), so the tank adds nothing to
-//!   [A], [B], [C], [D] and has no accelerations to back-substitute.
+//!   \[A\], \[B\], \[C\], \[D\] and has no accelerations to back-substitute.
 //! - **(D7) Energy and momentum**: a rigid body of mass m_p at r_T with inertia [I_Tc(m_p)],
 //!   rotating with the hub. With no thrust m_p is constant and the tank is a rigid part of the
 //!   hub: the conserved quantities stay conserved.
@@ -83,7 +83,7 @@
 //!   2 ṁ ω ℓ, the same order as (D3)'s terms — 9e-5 N for 1 N at I_sp 220 s (ṁ = 4.6e-4 kg/s),
 //!   ω = 0.1 rad/s and ℓ = 1 m, 1e-4 of the thrust — and it depends on the plumbing's routing,
 //!   which the configuration does not describe.
-//! - The nozzle-exit term of [K], ṁ_j (A_noz/4π) [BM] diag(2, 1, 1) [BM]ᵀ (Eq. `eq:eq53`'s
+//! - The nozzle-exit term of \[K\], ṁ_j (A_noz/4π) \[BM\] diag(2, 1, 1) \[BM\]ᵀ (Eq. `eq:eq53`'s
 //!   second integral): A_noz/(4π) ≈ 2e-5 m² for a 1 N nozzle against |r_N|² ≈ 1 m², 1e-5 of the
 //!   jet damping, which is itself ~1e-4 of the thrust's torque.
 //! - The propellant's own motion in the tank: its slosh is the separate `[[slosh_linear]]` /

@@ -12,18 +12,18 @@
 //! The rotor W has mass `m_w` with its centre of mass fixed at r_W/B, spin axis ĝ_s (B
 //! components, constant), spin inertia J_s and transverse inertia J_t about W:
 //!
-//! - (W1) [I_W] = J_s ĝ_s ĝ_sᵀ + J_t ([I₃] − ĝ_s ĝ_sᵀ), constant in B; ω_W/N = ω_B/N + Ω ĝ_s.
-//! - (W2) Mass properties about B: m_w, first moment m_w r_W/B, inertia [I_W] + m_w [r̃][r̃]ᵀ,
+//! - (W1) \[I_W\] = J_s ĝ_s ĝ_sᵀ + J_t (\[I₃\] − ĝ_s ĝ_sᵀ), constant in B; ω_W/N = ω_B/N + Ω ĝ_s.
+//! - (W2) Mass properties about B: m_w, first moment m_w r_W/B, inertia \[I_W\] + m_w [r̃]\[r̃\]ᵀ,
 //!   r′ = 0 (the rotor's centre of mass does not move in B).
 //! - (W3) Spin equation: the spin-axis component of the rotor's angular-momentum rate about W
-//!   equals the motor torque u plus the bearing friction τ_f. With H_W = [I_W]ω + J_s Ω ĝ_s,
+//!   equals the motor torque u plus the bearing friction τ_f. With H_W = \[I_W\]ω + J_s Ω ĝ_s,
 //!   ĝ_sᵀ(ω × H_W) = 0 for an axisymmetric rotor, so J_s (ĝ_sᵀ ω̇ + Ω̇) = u + τ_f, i.e.
 //!   **Ω̇ = (u + τ_f)/J_s − ĝ_sᵀ ω̇_B/N**.
 //! - (W4) The rotor's share of the system's rotational equation about B adds, beyond what its
-//!   inertia in [I_sc,B] already carries, J_s Ω̇ ĝ_s + ω × (J_s Ω ĝ_s). Substituting (W3):
-//!   **[D_contr] = −J_s ĝ_s ĝ_sᵀ** and **v_rot,contr = −ĝ_s (u + τ_f) − ω × (J_s Ω ĝ_s)**.
+//!   inertia in \[I_sc,B\] already carries, J_s Ω̇ ĝ_s + ω × (J_s Ω ĝ_s). Substituting (W3):
+//!   **\[D_contr\] = −J_s ĝ_s ĝ_sᵀ** and **v_rot,contr = −ĝ_s (u + τ_f) − ω × (J_s Ω ĝ_s)**.
 //!   The translational rows get nothing beyond the mass properties of (W2).
-//! - (W5) Energy and momentum: the rotor is a rigid body at r_W/B with inertia [I_W] and angular
+//! - (W5) Energy and momentum: the rotor is a rigid body at r_W/B with inertia \[I_W\] and angular
 //!   velocity ω + Ω ĝ_s. The motor and the friction are internal torques, so the total angular
 //!   momentum about C is conserved and the rotational energy changes at the rate (u + τ_f) Ω.
 //!
@@ -77,7 +77,7 @@ pub const KIND: EffectorKind = EffectorKind {
 
 /// States of a balanced wheel: Ω [rad/s].
 pub const BALANCED_STATE_NAMES: [&str; 1] = ["omega_rad_s"];
-/// States of an imbalanced wheel: Ω [rad/s], θ [rad].
+/// States of an imbalanced wheel: Ω [rad/s], θ \[rad\].
 pub const IMBALANCED_STATE_NAMES: [&str; 2] = ["omega_rad_s", "angle_rad"];
 /// The one input: the commanded motor torque [N·m] about +ĝ_s, acting on the rotor (the hub
 /// receives its reaction).

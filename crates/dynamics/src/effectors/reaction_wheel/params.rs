@@ -15,9 +15,9 @@ pub struct ReactionWheelParams {
     pub name: String,
     /// Spin axis ĝ_s in B components (a unit vector within [`flexdyn_kernel::validate::UNIT_AXIS_TOL`]).
     pub spin_axis_b: Vector3<f64>,
-    /// [m] rotor centre of mass W relative to B, B components.
+    /// \[m\] rotor centre of mass W relative to B, B components.
     pub r_wb_b_m: Vector3<f64>,
-    /// [kg] rotor mass (the housing belongs to the hub's mass properties).
+    /// \[kg\] rotor mass (the housing belongs to the hub's mass properties).
     pub mass_kg: f64,
     /// [kg·m²] rotor inertia about the spin axis, J_s.
     pub j_s_kg_m2: f64,

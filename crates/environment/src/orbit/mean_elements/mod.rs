@@ -3,14 +3,14 @@
 //! # Formats
 //! [`parse_element_sets`] recognises, from the text itself:
 //! - TLE / 3LE (parsed by the `sgp4` crate, which checks the columns and checksums);
-//! - CCSDS OMM KVN (`CCSDS_OMM_VERS = …`), [`kvn`];
-//! - CCSDS OMM XML (NDM/XML, as CelesTrak and Space-Track serve it), [`xml`];
-//! - OMM JSON (CelesTrak numbers, Space-Track strings), [`json`];
-//! - OMM CSV (CelesTrak, Space-Track), [`csv`].
+//! - CCSDS OMM KVN (`CCSDS_OMM_VERS = …`), `kvn`;
+//! - CCSDS OMM XML (NDM/XML, as CelesTrak and Space-Track serve it), `xml`;
+//! - OMM JSON (CelesTrak numbers, Space-Track strings), `json`;
+//! - OMM CSV (CelesTrak, Space-Track), `csv`.
 //!
 //! The `sgp4` crate reads TLEs and (with its `serde` feature) CelesTrak JSON only, with messages
 //! that do not name the field; every OMM form is therefore read here into keyword fields and
-//! built in one place ([`fields`]), which checks the metadata (centre EARTH, frame TEME, time
+//! built in one place (`fields`), which checks the metadata (centre EARTH, frame TEME, time
 //! system UTC, theory SGP4, ephemeris type 0), the units, the ranges, and names the keyword
 //! (and line) of any problem.
 //!
