@@ -343,11 +343,20 @@ impl EnvironmentModel {
         r_bn_n_m: &Vector3<f64>,
         v_bn_n_m_s: &Vector3<f64>,
     ) -> EnvironmentSample {
-        if self.next_update_ns.is_none_or(|next| t_sim_ns >= next) {
-            self.evaluate_update_once(t_sim_ns, r_bn_n_m, v_bn_n_m_s)
-        } else {
-            self.sample
+        if self.next_update_ns.is_some_and(|next| t_sim_ns < next) {
+            return self.sample;
         }
+        if let Some(sample) = self.memo_of(t_sim_ns, r_bn_n_m, v_bn_n_m_s) {
+            return sample;
+        }
+        let sample = self.evaluate_counted(t_sim_ns, r_bn_n_m, v_bn_n_m_s);
+        self.memo = Some(Memo {
+            t_sim_ns,
+            r_bn_n_m: Memo::bits(r_bn_n_m),
+            v_bn_n_m_s: Memo::bits(v_bn_n_m_s),
+            sample,
+        });
+        sample
     }
 
     /// Which models are on.
@@ -402,7 +411,10 @@ impl EnvironmentModel {
         if self.next_update_ns.is_some_and(|next| t_sim_ns < next) {
             return None;
         }
-        self.sample = self.evaluate_update_once(t_sim_ns, r_bn_n_m, v_bn_n_m_s);
+        self.sample = match self.memo_of(t_sim_ns, r_bn_n_m, v_bn_n_m_s) {
+            Some(sample) => sample,
+            None => self.evaluate_counted(t_sim_ns, r_bn_n_m, v_bn_n_m_s),
+        };
         // `next` changes below: a memo of this update is spent.
         self.memo = None;
         let due_ns = t_sim_ns.saturating_add(self.update_ns);
@@ -417,29 +429,27 @@ impl EnvironmentModel {
         Some(&self.sample)
     }
 
-    /// [`Self::evaluate_update`], or the memo of the same evaluation made ahead by
-    /// [`Self::sample_from`].
-    fn evaluate_update_once(
+    /// The memo, if it holds the update at `t_sim_ns` for this state.
+    fn memo_of(
+        &self,
+        t_sim_ns: u64,
+        r_bn_n_m: &Vector3<f64>,
+        v_bn_n_m_s: &Vector3<f64>,
+    ) -> Option<EnvironmentSample> {
+        self.memo
+            .filter(|m| m.holds(t_sim_ns, r_bn_n_m, v_bn_n_m_s))
+            .map(|m| m.sample)
+    }
+
+    /// [`Self::evaluate_update`], counted in [`Self::updates_evaluated`].
+    fn evaluate_counted(
         &mut self,
         t_sim_ns: u64,
         r_bn_n_m: &Vector3<f64>,
         v_bn_n_m_s: &Vector3<f64>,
     ) -> EnvironmentSample {
-        if let Some(m) = self
-            .memo
-            .filter(|m| m.holds(t_sim_ns, r_bn_n_m, v_bn_n_m_s))
-        {
-            return m.sample;
-        }
-        let sample = self.evaluate_update(t_sim_ns, r_bn_n_m, v_bn_n_m_s);
         self.evaluated += 1;
-        self.memo = Some(Memo {
-            t_sim_ns,
-            r_bn_n_m: Memo::bits(r_bn_n_m),
-            v_bn_n_m_s: Memo::bits(v_bn_n_m_s),
-            sample,
-        });
-        sample
+        self.evaluate_update(t_sim_ns, r_bn_n_m, v_bn_n_m_s)
     }
 
     /// The sample of an update at `t_sim_ns`: the predicted request's (from the worker if it
