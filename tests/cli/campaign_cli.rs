@@ -6,13 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-fn flexdyn(args: &[&str]) -> Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_flexdyn"))
-        .args(args)
-        .env("RUST_LOG", "warn")
-        .output()
-        .expect("runs the flexdyn binary")
-}
+use crate::campaign_support::flexdyn;
 
 /// Writes `name/campaign.toml`: one open-loop run of 0.5 s with `extra` appended.
 fn campaign(name: &str, extra: &str) -> (PathBuf, PathBuf) {

@@ -8,7 +8,8 @@
 //! there) through [`failure_delay_ns`], the documented exponential draw.
 
 use std::path::{Path, PathBuf};
-use std::process::Output;
+
+use crate::campaign_support::flexdyn;
 
 use flexdyn_campaign::summary::{wilson, Z_95};
 use flexdyn_faults::failure_delay_ns;
@@ -17,14 +18,6 @@ const RUNS: u32 = 8;
 /// \[s\] the wheel's MTBF and the run's length: P(failure within a run) = 1 − e^(−1/2) ≈ 0.39.
 const MTBF_S: f64 = 2.0;
 const DURATION_S: f64 = 1.0;
-
-fn flexdyn(args: &[&str]) -> Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_flexdyn"))
-        .args(args)
-        .env("RUST_LOG", "warn")
-        .output()
-        .expect("runs the flexdyn binary")
-}
 
 /// Writes the base (`scenarios/acs_full.toml` with a random seizure of rw1 from t = 0.25 s) and
 /// the campaign file (open loop, |ω| below 1 rad/s) into a fresh folder.

@@ -12,6 +12,8 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
+
+use crate::campaign_support::flexdyn;
 use std::time::{Duration, Instant};
 
 use flexdyn_campaign::execute::{single_settings, Observer, RunResult, OBSERVER_ID, SC_ID};
@@ -30,14 +32,6 @@ const FRAME_NS: u64 = 100_000_000;
 const STEP_NS: u64 = 10_000_000;
 const K: u64 = 40;
 const LAST_TICK: u64 = 50;
-
-fn flexdyn(args: &[&str]) -> Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_flexdyn"))
-        .args(args)
-        .env("RUST_LOG", "warn")
-        .output()
-        .expect("runs the flexdyn binary")
-}
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

@@ -1,6 +1,19 @@
-//! The statistical checks of the campaign planning tests (`tests/cli/campaign_plan.rs`,
-//! `tests/cli/campaign_fleet_plan.rs`): a sample's mean and variance against the distribution it
-//! was drawn from, within 4 standard errors.
+//! What the campaign tests share: the `flexdyn` binary run as a CI job runs it
+//! ([`flexdyn`], for `campaign_cli.rs`, `campaign_faults.rs`, `campaign_fork.rs`), and the
+//! statistical checks of the planning tests (`campaign_plan.rs`, `campaign_fleet_plan.rs`): a
+//! sample's mean and variance against the distribution it was drawn from, within 4 standard
+//! errors.
+
+use std::process::Output;
+
+/// Runs the `flexdyn` binary with `args` (warnings and errors logged only) to completion.
+pub fn flexdyn(args: &[&str]) -> Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_flexdyn"))
+        .args(args)
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("runs the flexdyn binary")
+}
 
 pub fn stats(x: &[f64]) -> (f64, f64) {
     let n = x.len() as f64;
