@@ -266,7 +266,6 @@ fn forked_runs_continue_the_uninterrupted_run_from_the_checkpoint() {
     let out = dir.join("fault-out");
     let o = run(&fault, &out, &["--record"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let state_key = Topics::new(SC_ID).unwrap().state().to_owned();
     let mut hashes = Vec::new();
     for i in 0..3 {
         let r = result(&out, i);
@@ -283,20 +282,7 @@ fn forked_runs_continue_the_uninterrupted_run_from_the_checkpoint() {
         // the tick after that boundary.
         let first_step_ns = struck_ns.div_ceil(STEP_NS) * STEP_NS;
         let first_changed = first_step_ns / FRAME_NS + 1;
-        let rec = flexdyn_sinks::reader::read_recording(
-            &out.join(format!("run-{i:04}")).join("recording.mcap"),
-        )
-        .unwrap();
-        let mut forked: Vec<(u64, Vec<u8>)> = rec
-            .samples
-            .iter()
-            .filter(|s| s.key == state_key)
-            .map(|s| {
-                let m = flexdyn_proto::decode_state(&s.payload).unwrap();
-                (m.header.tick, s.payload.clone())
-            })
-            .collect();
-        forked.sort_by_key(|(t, _)| *t);
+        let forked = recorded_states(&out.join(format!("run-{i:04}")));
         assert_eq!(forked.first().map(|(t, _)| *t), Some(K), "run {i}");
         assert_eq!(forked.len() as u64, LAST_TICK - K + 1, "run {i}");
         for (tick, payload) in &forked {
@@ -315,6 +301,23 @@ fn forked_runs_continue_the_uninterrupted_run_from_the_checkpoint() {
     }
     hashes.dedup();
     assert_eq!(hashes.len(), 3, "three fault times, three streams");
+}
+
+/// The StateMsg payloads of a run's recording (`<run_dir>/recording.mcap`), by tick.
+fn recorded_states(run_dir: &Path) -> Vec<(u64, Vec<u8>)> {
+    let state_key = Topics::new(SC_ID).unwrap().state().to_owned();
+    let rec = flexdyn_sinks::reader::read_recording(&run_dir.join("recording.mcap")).unwrap();
+    let mut states: Vec<(u64, Vec<u8>)> = rec
+        .samples
+        .iter()
+        .filter(|s| s.key == state_key)
+        .map(|s| {
+            let m = flexdyn_proto::decode_state(&s.payload).unwrap();
+            (m.header.tick, s.payload.clone())
+        })
+        .collect();
+    states.sort_by_key(|(t, _)| *t);
+    states
 }
 
 /// The payloads recorded in `file` under `key`, in log-time order, with their \[ns\] log time.
@@ -676,19 +679,7 @@ fn forked_runs_with_flight_code_continue_the_uninterrupted_run() {
     let whole = dir.join("whole-out");
     let o = run(&dir.join("whole.toml"), &whole, &["--record"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let state_key = Topics::new(SC_ID).unwrap().state().to_owned();
-    let rec =
-        flexdyn_sinks::reader::read_recording(&whole.join("run-0000/recording.mcap")).unwrap();
-    let mut states: Vec<(u64, Vec<u8>)> = rec
-        .samples
-        .iter()
-        .filter(|s| s.key == state_key)
-        .map(|s| {
-            let m = flexdyn_proto::decode_state(&s.payload).unwrap();
-            (m.header.tick, s.payload.clone())
-        })
-        .collect();
-    states.sort_by_key(|(t, _)| *t);
+    let states = recorded_states(&whole.join("run-0000"));
     assert_eq!(
         states.iter().map(|(t, _)| *t).collect::<Vec<_>>(),
         (0..=200).collect::<Vec<_>>()
