@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use flexdyn_proto::client::lockstep::{SensorSchedule, Tick, TickReceiver};
 use flexdyn_proto::client::run_end::{Ended, RunEnd};
-use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::client::transport::{declared_key, zenoh_config, Role, ZenohArgs};
 use flexdyn_proto::client::vehicle::Vehicle;
 use flexdyn_proto::{
     decode_imu, decode_star_tracker, decode_state, decode_status, decode_time, encode, CommandMsg,
@@ -567,9 +567,11 @@ impl Client {
             )
         })?;
         let cmd_key = self.topics.cmd(sender_id);
+        let declared = declared_key(&self.session, cmd_key.clone())
+            .map_err(|e| Error::zenoh(&format!("cannot declare {cmd_key}"), e))?;
         let publisher = self
             .session
-            .declare_publisher(cmd_key.clone())
+            .declare_publisher(declared)
             .congestion_control(CongestionControl::Block)
             .express(true)
             .wait()

@@ -46,7 +46,7 @@ use super::readback::fleet_readback;
 use super::spec::Campaign;
 pub use super::spec::OBSERVER_ID;
 use super::verdict::Outcome;
-use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
+use flexdyn_proto::client::transport::{declared_key, zenoh_config, Role, ZenohArgs};
 use flexdyn_server::{ServerError, ServerSettings};
 use flexdyn_vehicle::config::SimConfig;
 use flexdyn_vehicle::world::FleetConfig;
@@ -214,8 +214,10 @@ impl Observer {
         let session = zenoh::open(cfg)
             .wait()
             .map_err(|e| format!("observer session: {e}"))?;
+        let declared = declared_key(&session, topics.cmd(sender_id))
+            .map_err(|e| format!("observer publisher: {e}"))?;
         let publisher = session
-            .declare_publisher(topics.cmd(sender_id))
+            .declare_publisher(declared)
             .congestion_control(CongestionControl::Block)
             .express(true)
             .wait()

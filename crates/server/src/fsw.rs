@@ -226,11 +226,18 @@ pub(super) async fn declare(
     // server, so without this only the server would hear the flight code. Remote only (this
     // session's own subscriber must not hear it twice), and dropped rather than waited for
     // when a tool's link is full: a slow tool never holds this thread.
+    // Each stream's key is declared, so Zenoh routes the samples that come in on it, and the
+    // ones that go out again, by cached routes (`transport::declared_key`); the declarations
+    // live in the publishers, which live in the callback.
     let mut republish = Vec::with_capacity(intake.streams.len());
     for k in &intake.keys {
+        let declared = session
+            .declare_keyexpr(k.to_string())
+            .await
+            .map_err(|e| ServerError::zenoh("declare the flight-code telemetry publisher", e))?;
         republish.push(
             session
-                .declare_publisher(k.to_string())
+                .declare_publisher(declared)
                 .allowed_destination(zenoh::sample::Locality::Remote)
                 .congestion_control(zenoh::qos::CongestionControl::Drop)
                 .await

@@ -8,6 +8,7 @@ use std::sync::mpsc::{SyncSender, TrySendError};
 use std::sync::{Arc, Mutex};
 
 use flexdyn_proto::{decode_command, CommandMsg, Topics};
+use zenoh::key_expr::KeyExpr;
 use zenoh::pubsub::Subscriber;
 use zenoh::Session;
 
@@ -35,8 +36,16 @@ pub(super) enum CommandSink {
     Core(VehicleCore),
 }
 
-/// Subscribes the command callback to `flexdyn/<sc>/cmd/*`; dropping the subscriber stops the
-/// commands.
+/// The command subscriber, and the participants' command keys declared to the session so
+/// that Zenoh routes each command by a cached route
+/// ([`flexdyn_proto::client::transport::declared_key`]). Dropping it stops the commands.
+pub(super) struct Intake {
+    _subscriber: Subscriber<()>,
+    _keys: Vec<KeyExpr<'static>>,
+}
+
+/// Subscribes the command callback to `flexdyn/<sc>/cmd/*`, with the key of each of
+/// `settings.participants` declared.
 pub(super) async fn declare(
     session: &Session,
     topics: &Topics,
@@ -44,8 +53,17 @@ pub(super) async fn declare(
     shared: Arc<Shared>,
     settings: &ServerSettings,
     record: Option<RecordTx>,
-) -> Result<Subscriber<()>, ServerError> {
-    session
+) -> Result<Intake, ServerError> {
+    let mut keys = Vec::with_capacity(settings.participants.len());
+    for p in &settings.participants {
+        keys.push(
+            session
+                .declare_keyexpr(topics.cmd(*p))
+                .await
+                .map_err(|e| ServerError::zenoh("declare a participant's command key", e))?,
+        );
+    }
+    let subscriber = session
         .declare_subscriber(topics.cmd_wildcard().to_owned())
         .callback(command_callback(
             sink,
@@ -56,7 +74,11 @@ pub(super) async fn declare(
             record,
         ))
         .await
-        .map_err(|e| ServerError::zenoh("declare the command subscriber", e))
+        .map_err(|e| ServerError::zenoh("declare the command subscriber", e))?;
+    Ok(Intake {
+        _subscriber: subscriber,
+        _keys: keys,
+    })
 }
 
 /// Queues a sample that arrived (a command, an operator command) for the `--record` file, as

@@ -45,8 +45,13 @@ impl RelativePublisher {
         } else {
             CongestionControl::Block
         };
+        // Declared, so its samples go by a cached route (`transport::declared_key`).
+        let declared = session
+            .declare_keyexpr(key.clone())
+            .await
+            .map_err(|e| ServerError::zenoh("declare the relative-state publisher", e))?;
         let publisher = session
-            .declare_publisher(key.clone())
+            .declare_publisher(declared)
             .congestion_control(congestion)
             .express(mode != Mode::Batch)
             .await

@@ -63,12 +63,19 @@ impl Endpoints {
         // The environment, fault-event and relative messages follow the state and stay express
         // (they are the frame's tail; nothing else would flush them). Batch mode batches all.
         let express = settings.mode != Mode::Batch;
-        let telemetry_pub = |key: String, what: &'static str, express: bool| {
-            let declared = session
+        // Each key declared first, so Zenoh routes its samples by a cached route
+        // (`flexdyn_proto::client::transport::declared_key`).
+        let telemetry_pub = |key: String, what: &'static str, express: bool| async move {
+            let key = session
+                .declare_keyexpr(key)
+                .await
+                .map_err(|e| ServerError::zenoh(what, e))?;
+            session
                 .declare_publisher(key)
                 .congestion_control(congestion)
-                .express(express);
-            async move { declared.await.map_err(|e| ServerError::zenoh(what, e)) }
+                .express(express)
+                .await
+                .map_err(|e| ServerError::zenoh(what, e))
         };
         let state_pub = telemetry_pub(
             topics.state().to_owned(),
@@ -76,8 +83,12 @@ impl Endpoints {
             express,
         )
         .await?;
+        let status_key = session
+            .declare_keyexpr(topics.status().to_owned())
+            .await
+            .map_err(|e| ServerError::zenoh("declare the status publisher", e))?;
         let status_pub = session
-            .declare_publisher(topics.status().to_owned())
+            .declare_publisher(status_key)
             .congestion_control(congestion)
             .await
             .map_err(|e| ServerError::zenoh("declare the status publisher", e))?;

@@ -592,8 +592,13 @@ impl FswStream {
             stream: stream.to_owned(),
             problem: e.to_string(),
         })?;
+        let declared =
+            super::transport::declared_key(session, key.clone()).map_err(|e| FswError::Zenoh {
+                message: clean_zenoh_message(&e.to_string()),
+                key: key.clone(),
+            })?;
         let publisher = session
-            .declare_publisher(key.clone())
+            .declare_publisher(declared)
             .congestion_control(zenoh::qos::CongestionControl::Block)
             .express(false)
             .wait()

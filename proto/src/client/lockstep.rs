@@ -33,10 +33,12 @@ use crate::{
     GpsMsg, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, Telemetry, TimeMsg, Topics,
     FAULT_MODE_NAMES,
 };
+use zenoh::key_expr::KeyExpr;
 use zenoh::pubsub::Subscriber;
 use zenoh::sample::Sample;
 use zenoh::{Session, Wait};
 
+use crate::client::transport::declared_key;
 use crate::client::vehicle::{VehicleConfig, VehicleError};
 
 /// A sensor that publishes on the ticks `offset + n · every` (n ≥ 0).
@@ -148,6 +150,27 @@ impl SensorSchedule {
 }
 
 impl SensorSchedule {
+    /// The telemetry keys of `topics` a tick of this schedule may carry: the state, the time
+    /// message, the environment message, the fault events and each scheduled sensor's key.
+    pub fn keys(&self, topics: &Topics) -> Vec<String> {
+        let mut keys = vec![
+            topics.state().to_owned(),
+            topics.time(),
+            topics.environment(),
+            topics.fault_events(),
+        ];
+        for (section, route) in SENSOR_SECTIONS {
+            for name in self.names(section).unwrap_or_default() {
+                // The schedule's names came from a configuration the server accepted; a name
+                // that makes no key has no samples to route either.
+                if let Ok(key) = topics.sensor(&format!("tlm/{route}"), name) {
+                    keys.push(key);
+                }
+            }
+        }
+        keys
+    }
+
     /// The names of a configuration section's sensors (`imus`, `star_trackers`,
     /// `magnetometers`, `coarse_sun_sensors`, `fine_sun_sensors`, `gps_receivers`), in
     /// configuration order; `None` for any other section.
@@ -591,6 +614,9 @@ impl TickAssembler {
 /// most one tick is in flight.
 pub struct TickReceiver {
     _subscriber: Subscriber<()>,
+    /// The keys of the samples it receives, declared to the session so that Zenoh routes them
+    /// by cached routes ([`crate::client::transport::declared_key`]); declared while they live.
+    _keys: Vec<KeyExpr<'static>>,
     shared: Arc<Shared>,
     schedule: SensorSchedule,
     sensor_timeout: Duration,
@@ -683,8 +709,14 @@ impl TickReceiver {
             .declare_subscriber(topics.telemetry_wildcard())
             .callback(move |sample| feed.take(&sample))
             .wait()?;
+        let keys = schedule
+            .keys(topics)
+            .into_iter()
+            .map(|key| declared_key(session, key))
+            .collect::<zenoh::Result<_>>()?;
         Ok(Self {
             _subscriber: subscriber,
+            _keys: keys,
             shared,
             schedule,
             sensor_timeout,
@@ -778,6 +810,39 @@ mod tests {
             fine_sun_sensors: vec![],
             gps_receivers: vec![],
         }
+    }
+
+    /// The keys a receiver declares are the keys its assembler reads each scheduled sample
+    /// from, one each, plus the fault events it reads apart.
+    #[test]
+    fn the_declared_keys_are_the_keys_of_the_scheduled_samples() {
+        let topics = Topics::new("sc1").unwrap();
+        let keys = schedule().keys(&topics);
+        assert_eq!(keys[3], topics.fault_events());
+        let read: Vec<Telemetry> = keys.iter().filter_map(|k| topics.telemetry(k)).collect();
+        use Telemetry::*;
+        assert_eq!(
+            read,
+            [
+                State,
+                Time,
+                Environment,
+                Imu("hub"),
+                Imu("bracket"),
+                StarTracker("st1"),
+                StarTracker("st2"),
+                Magnetometer("mag1"),
+                Css("css"),
+            ]
+        );
+        assert_eq!(keys.len(), read.len() + 1);
+        let keys = sun_and_gps_schedule().keys(&topics);
+        let read: Vec<Telemetry> = keys
+            .iter()
+            .skip(4)
+            .filter_map(|k| topics.telemetry(k))
+            .collect();
+        assert_eq!(read, [Fss("fss"), Gps("gps1")]);
     }
 
     /// A fine sun sensor every 5 frames and a GPS receiver every 10 frames with a latency of 3:

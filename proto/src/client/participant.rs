@@ -53,8 +53,10 @@ impl Participant {
         sender_id: u32,
     ) -> Result<Self, ParticipantError> {
         let key = topics.cmd(sender_id);
+        let declared = super::transport::declared_key(session, key.clone())
+            .map_err(|e| ParticipantError::Publisher(key.clone(), e))?;
         let publisher = session
-            .declare_publisher(key.clone())
+            .declare_publisher(declared)
             .congestion_control(CongestionControl::Block)
             .express(true)
             .wait()

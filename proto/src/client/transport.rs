@@ -15,12 +15,39 @@
 //!    even if the file switches it on (a warning is logged): flexdyn never sends multicast, so
 //!    nothing leaves this machine unless an endpoint says so.
 //!
+//! Every key a process publishes or receives every tick is declared to its session
+//! ([`declared_key`]), so Zenoh routes it by a cached route rather than matching the key against
+//! every subscription each time.
+//!
 //! A listening process logs where it listens ([`log_listening`]); `--listen tcp/127.0.0.1:0`
 //! lets the OS pick a free port, and that line names it.
 
 use std::path::PathBuf;
 
 use zenoh::sample::Sample;
+
+/// `key` declared to `session` as a key expression of its own (`Session::declare_keyexpr`),
+/// for a key that is published or received every tick. The declaration lasts as long as the
+/// returned value: publish with it (`declare_publisher(declared)`), or keep it beside the
+/// subscriber that receives the key.
+///
+/// # Why
+/// Zenoh caches a data route per resource of its routing tables, and a key that nothing
+/// declared exactly has no resource: flexdyn subscribes with wildcards (`flexdyn/<sc>/tlm/**`,
+/// `flexdyn/<sc>/cmd/*`), so each sample was matched against the whole tree, in every router it
+/// crossed, and against each of the session's subscribers. In a lockstep run (`flexdyn run
+/// --mode lockstep`, the reference spacecraft at 1 kHz, `flexdyn-acs-demo`), Zenoh's trace
+/// showed `compute_data_route` three times per sample in each process, and declaring the
+/// state, time and command keys on both sides took the run from 3668–4191 to 4303–4591 ticks
+/// per second (five alternating pairs, docs/developer/benchmarks.md). A plain ping-pong
+/// subscribes to its exact keys, so its routes were cached already.
+pub fn declared_key(
+    session: &zenoh::Session,
+    key: impl Into<String>,
+) -> zenoh::Result<zenoh::key_expr::KeyExpr<'static>> {
+    use zenoh::Wait;
+    session.declare_keyexpr(key.into()).wait()
+}
 
 /// The default Zenoh endpoint of the server (`flexdyn run` listens, the tools connect).
 pub const DEFAULT_ENDPOINT: &str = "tcp/127.0.0.1:7447";
