@@ -16,8 +16,8 @@ use super::{exit, load, summary, whole_steps, CliError, OfflineRun};
 use flexdyn_sensors::Sensor;
 use flexdyn_server::settings::ServerSettings;
 use flexdyn_sinks::table::{
-    first_non_finite_column, prefixed_columns, state_row, Column, CsvTable,
-    ENVIRONMENT_COLUMN_PREFIX,
+    first_non_finite_column, prefixed_cells, prefixed_columns, state_cells, state_row, Cell,
+    Column, CsvTable, ENVIRONMENT_COLUMN_PREFIX,
 };
 use flexdyn_vehicle::checkpoint::Source;
 use flexdyn_vehicle::checkpoint::{Checkpoint, CheckpointHeader};
@@ -140,8 +140,28 @@ fn simulate_row(
 /// A sensor's CSV columns from its encoded message `bytes`: the fields without the header,
 /// prefixed `<kind>_<name>_` (`imu_hub_omega_p_rad_s_1`, `st_st1_q_cn_0`).
 fn sensor_columns(s: &dyn Sensor, bytes: &[u8]) -> Vec<Column> {
-    let json = (s.kind().decode)(bytes).map_or(serde_json::Value::Null, |(_, json)| json);
-    prefixed_columns(&sensor_prefix(s), &json)
+    prefixed_columns(&sensor_prefix(s), &sensor_json(s, bytes))
+}
+
+/// A sensor's encoded message as its kind decodes it (`null` if it does not decode).
+fn sensor_json(s: &dyn Sensor, bytes: &[u8]) -> serde_json::Value {
+    (s.kind().decode)(bytes).map_or(serde_json::Value::Null, |(_, json)| json)
+}
+
+/// Where a row's cells go in the header: the state, scheduled-wrench and environment cells
+/// first, always all of them, then each sensor's block, in publication order.
+struct Layout {
+    /// The number of state, scheduled-wrench and environment cells.
+    fixed: usize,
+    /// Per sensor: the header position of its first cell and its number of cells.
+    sensors: Vec<(usize, usize)>,
+}
+
+/// A row's cells without names, and their header positions ([`SimulateRows::row`]).
+#[derive(Default)]
+struct Placed {
+    cells: Vec<Column>,
+    positions: Vec<usize>,
 }
 
 /// `<kind>_<name>`.
@@ -192,6 +212,19 @@ pub fn simulate_with<W: Write>(
     log_every_s: f64,
     open: impl FnOnce() -> Result<(W, String), CliError>,
     checkpoints: Checkpoints<'_>,
+) -> Result<SimulateReport, CliError> {
+    simulate_rows(cfg, duration_s, log_every_s, open, checkpoints, false)
+}
+
+/// [`simulate_with`], each row written by position ([`Layout`]), or with `by_name` every row
+/// built with its column names and placed by name (the tests' reference).
+fn simulate_rows<W: Write>(
+    cfg: &SimConfig,
+    duration_s: f64,
+    log_every_s: f64,
+    open: impl FnOnce() -> Result<(W, String), CliError>,
+    checkpoints: Checkpoints<'_>,
+    by_name: bool,
 ) -> Result<SimulateReport, CliError> {
     let total_steps = whole_steps("--duration-s", duration_s, cfg.step_ns, true)?;
     let log_steps = whole_steps("--log-every-s", log_every_s, cfg.step_ns, false)?;
@@ -251,12 +284,31 @@ pub fn simulate_with<W: Write>(
         .environment_every_frames()
         .map(|_| EnvironmentMsg::default());
     // The header: every column a row can have (each sensor as at a sample).
-    let all = sim.sensors().sensors().iter().map(|s| {
-        Some(prefixed_columns(
-            &sensor_prefix(s.as_ref()),
-            &(s.kind().default_json)(),
-        ))
-    });
+    let blocks: Vec<Vec<Column>> = sim
+        .sensors()
+        .sensors()
+        .iter()
+        .map(|s| prefixed_columns(&sensor_prefix(s.as_ref()), &(s.kind().default_json)()))
+        .collect();
+    let fixed = simulate_row(
+        &state,
+        &AppliedWrench::default(),
+        environment.as_ref(),
+        std::iter::empty(),
+    )
+    .len();
+    let mut at = fixed;
+    let layout = Layout {
+        fixed,
+        sensors: blocks
+            .iter()
+            .map(|b| {
+                at += b.len();
+                (at - b.len(), b.len())
+            })
+            .collect(),
+    };
+    let all = blocks.into_iter().map(Some);
     let columns: Vec<String> =
         simulate_row(&state, &AppliedWrench::default(), environment.as_ref(), all)
             .into_iter()
@@ -291,6 +343,8 @@ pub fn simulate_with<W: Write>(
         environment,
         last: vec![(None, Vec::new()); sim.sensors().len()],
         table,
+        layout: (!by_name).then_some(layout),
+        placed: Placed::default(),
         target,
         save,
     };
@@ -326,6 +380,12 @@ struct SimulateRows<'a, W: Write> {
     /// step: a 10 Hz sensor logged every second is encoded ten times and formatted once.
     last: Vec<(Option<u64>, Vec<u8>)>,
     table: CsvTable<W>,
+    /// Where a row's cells go: each row is written by position, its cells built without
+    /// names. A row whose cells do not fit it, or that has a non-finite value, is built by
+    /// name (`None`: every row is, the reference the tests compare with).
+    layout: Option<Layout>,
+    /// The last row's cells, reused.
+    placed: Placed,
     target: &'a str,
     /// A checkpoint to write after the row at this step.
     save: Option<(u64, CheckpointHeader, PathBuf)>,
@@ -377,6 +437,23 @@ impl<W: Write> RowSink for SimulateRows<'_, W> {
             sim.environment_into(env);
         }
         let bank = sim.sensors().sensors();
+        if let Some(layout) = &self.layout {
+            let wrench = scheduled_wrench(self.cfg, t_ns);
+            let env = self.environment.as_ref();
+            let sensors = self.last.iter().zip(bank).map(|((at, bytes), s)| {
+                (*at == Some(step)).then(|| sensor_json(s.as_ref(), bytes))
+            });
+            if self
+                .placed
+                .place(layout, &self.state, &wrench, env, sensors)
+            {
+                let placed = &self.placed;
+                let cells = placed.cells.iter().map(|(_, c)| c);
+                let row = placed.positions.iter().copied().zip(cells);
+                self.table.write_positioned(row).map_err(io_err)?;
+                return self.after_row(world, step);
+            }
+        }
         let now =
             self.last.iter().zip(bank).map(|((at, bytes), s)| {
                 (*at == Some(step)).then(|| sensor_columns(s.as_ref(), bytes))
@@ -397,14 +474,63 @@ impl<W: Write> RowSink for SimulateRows<'_, W> {
             });
         }
         self.table.write_row(&row).map_err(io_err)?;
+        self.after_row(world, step)
+    }
+}
+
+impl<W: Write> SimulateRows<'_, W> {
+    /// After the row at `step`: the checkpoint, if one is due there.
+    fn after_row(&mut self, world: &mut World, step: u64) -> Result<(), CliError> {
         if let Some((at, header, file)) = &self.save {
             if *at == step {
                 // Everything written so far reaches the output before the checkpoint does.
-                self.table.flush().map_err(io_err)?;
+                self.table.flush().map_err(|source| CliError::Output {
+                    target: self.target.to_string(),
+                    source,
+                })?;
                 ckpt::write(file, header, world)?;
             }
         }
         Ok(())
+    }
+}
+
+impl Placed {
+    /// Builds a row's cells (as [`simulate_row`] orders them, without names) and their header
+    /// positions; `false` if they do not fit `layout` (a sensor message that did not decode)
+    /// or a value is not finite: that row is built by name, which names the bad column.
+    fn place(
+        &mut self,
+        layout: &Layout,
+        state: &StateMsg,
+        wrench: &AppliedWrench,
+        environment: Option<&EnvironmentMsg>,
+        sensors: impl Iterator<Item = Option<serde_json::Value>>,
+    ) -> bool {
+        let (cells, positions) = (&mut self.cells, &mut self.positions);
+        cells.clear();
+        positions.clear();
+        state_cells(state, cells);
+        prefixed_cells(wrench, cells);
+        if let Some(env) = environment {
+            prefixed_cells(env, cells);
+        }
+        if cells.len() != layout.fixed {
+            return false;
+        }
+        positions.extend(0..layout.fixed);
+        for (json, &(first, len)) in sensors.zip(&layout.sensors) {
+            let Some(json) = json else { continue };
+            let before = cells.len();
+            prefixed_cells(&json, cells);
+            if cells.len() - before != len {
+                return false;
+            }
+            positions.extend(first..first + len);
+        }
+        cells
+            .iter()
+            .all(|(_, c)| !matches!(c, Cell::Num(x) if !x.is_finite()))
     }
 }
 
@@ -502,6 +628,51 @@ mod tests {
         // 4 states and a flag, 6 scheduled wrench.
         assert_eq!(n_cols, 1 + 5 + 22 + 8 + 7 + 2 * 5 + 6);
         assert!(lines[1..].iter().all(|l| l.split(',').count() == n_cols));
+    }
+
+    /// `simulate`'s rows placed by position are byte for byte the rows built by name, on the
+    /// files with the most kinds of columns: `acs_full.toml` (two panel pairs, four wheels,
+    /// the environment record, a sensor of every kind at 10 Hz and the IMUs at every row) and
+    /// `leo_environment.toml` (a GPS receiver at 1 Hz with its latency), both logged at every
+    /// RK4 step so that most rows carry only some of the sensors.
+    #[test]
+    fn rows_placed_by_position_are_the_rows_placed_by_name() {
+        for (file, text, duration_s) in [
+            (
+                "acs_full.toml",
+                include_str!("../../scenarios/acs_full.toml"),
+                2.0,
+            ),
+            (
+                "leo_environment.toml",
+                include_str!("../../scenarios/leo_environment.toml"),
+                3.0,
+            ),
+        ] {
+            let cfg = SimConfig::from_toml_str(text).unwrap();
+            let csv = |by_name: bool| {
+                let mut buf = Vec::new();
+                let out = &mut buf;
+                let open = move || Ok((out, "buffer".to_string()));
+                let every_s = cfg.step_ns as f64 / 1e9;
+                let checkpoints = Checkpoints::default();
+                simulate_rows(&cfg, duration_s, every_s, open, checkpoints, by_name).unwrap();
+                String::from_utf8(buf).unwrap()
+            };
+            let (placed, named) = (csv(false), csv(true));
+            let lines = named.lines().count();
+            assert!(lines > 20, "{file}: {lines} lines");
+            // Rows with and without sensor cells, so both kinds were compared.
+            let with_empty = named.lines().filter(|l| l.contains(",,")).count();
+            assert!(
+                with_empty > 0 && with_empty < lines - 1,
+                "{file}: {with_empty}"
+            );
+            for (i, (a, b)) in placed.lines().zip(named.lines()).enumerate() {
+                assert_eq!(a, b, "{file}, line {i}");
+            }
+            assert_eq!(placed.len(), named.len(), "{file}");
+        }
     }
 
     #[test]

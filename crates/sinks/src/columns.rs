@@ -22,11 +22,26 @@ pub fn push_columns<T: Serialize + ?Sized>(
 ) {
     let mut s = Leaf {
         name: prefix,
+        named: true,
         first: 1,
         skip,
         out,
     };
     // Serializing into columns cannot fail: every wire type is plain data.
+    let _ = msg.serialize(&mut s);
+}
+
+/// The cells [`push_columns`] would append, in the same order, each with an empty name: for a
+/// writer that knows the columns already (`simulate` after its header), without building a
+/// name per cell per row.
+pub fn push_cells<T: Serialize + ?Sized>(msg: &T, skip: &[&str], out: &mut Vec<Column>) {
+    let mut s = Leaf {
+        name: "",
+        named: false,
+        first: 1,
+        skip,
+        out,
+    };
     let _ = msg.serialize(&mut s);
 }
 
@@ -51,6 +66,8 @@ impl ser::Error for Unsupported {
 /// One value to be written under `name`; an array below it numbers its items from `first`.
 struct Leaf<'a, 'o> {
     name: &'a str,
+    /// Names are built; `false` for [`push_cells`] (every name left empty).
+    named: bool,
     first: usize,
     /// Fields left out (top level only; empty below).
     skip: &'a [&'a str],
@@ -59,14 +76,23 @@ struct Leaf<'a, 'o> {
 
 impl Leaf<'_, '_> {
     fn cell(&mut self, cell: Cell) {
-        self.out.push((self.name.to_owned(), cell));
+        self.out.push((self.own_name(), cell));
+    }
+
+    fn own_name(&self) -> String {
+        if self.named {
+            self.name.to_owned()
+        } else {
+            String::new()
+        }
     }
 }
 
 /// The name of field `key` of the value named `parent` (the header's fields are not
 /// prefixed).
-fn child_name(parent: &str, key: &str) -> String {
+fn child_name(parent: &str, key: &str, named: bool) -> String {
     match (key, parent.is_empty()) {
+        _ if !named => String::new(),
         ("header", _) => parent.to_owned(),
         (_, true) => key.to_owned(),
         (_, false) => format!("{parent}_{key}"),
@@ -78,11 +104,13 @@ fn field<T: Serialize + ?Sized>(
     parent: &str,
     key: &str,
     value: &T,
+    named: bool,
     out: &mut Vec<Column>,
 ) -> Result<(), Unsupported> {
-    let name = child_name(parent, key);
+    let name = child_name(parent, key, named);
     let mut leaf = Leaf {
         name: &name,
+        named,
         first: if key.starts_with("q_") { 0 } else { 1 },
         skip: &[],
         out,
@@ -93,6 +121,7 @@ fn field<T: Serialize + ?Sized>(
 /// The items of an array, numbered from `first`.
 struct Items<'o> {
     name: String,
+    named: bool,
     first: usize,
     next: usize,
     out: &'o mut Vec<Column>,
@@ -101,6 +130,7 @@ struct Items<'o> {
 /// The fields of a struct or map.
 struct Fields<'a, 'o> {
     name: String,
+    named: bool,
     skip: &'a [&'a str],
     out: &'o mut Vec<Column>,
     /// A map's key, between `serialize_key` and `serialize_value`.
@@ -171,7 +201,11 @@ impl<'a, 'o, 'l> ser::Serializer for &'l mut Leaf<'a, 'o> {
     fn serialize_bytes(self, v: &[u8]) -> Result<(), Unsupported> {
         // As JSON: an array of numbers.
         for (i, b) in v.iter().enumerate() {
-            let name = format!("{}_{}", self.name, i + self.first);
+            let name = if self.named {
+                format!("{}_{}", self.name, i + self.first)
+            } else {
+                String::new()
+            };
             self.out.push((name, Cell::Int((*b).into())));
         }
         Ok(())
@@ -212,11 +246,12 @@ impl<'a, 'o, 'l> ser::Serializer for &'l mut Leaf<'a, 'o> {
         value: &T,
     ) -> Result<(), Unsupported> {
         // As JSON: {"<variant>": value}.
-        field(self.name, variant, value, self.out)
+        field(self.name, variant, value, self.named, self.out)
     }
     fn serialize_seq(self, _len: Option<usize>) -> Result<Items<'l>, Unsupported> {
         Ok(Items {
-            name: self.name.to_owned(),
+            name: self.own_name(),
+            named: self.named,
             first: self.first,
             next: 0,
             out: self.out,
@@ -241,7 +276,8 @@ impl<'a, 'o, 'l> ser::Serializer for &'l mut Leaf<'a, 'o> {
     ) -> Result<Items<'l>, Unsupported> {
         // As JSON: {"<variant>": [...]}.
         Ok(Items {
-            name: child_name(self.name, variant),
+            name: child_name(self.name, variant, self.named),
+            named: self.named,
             first: 1,
             next: 0,
             out: self.out,
@@ -249,7 +285,8 @@ impl<'a, 'o, 'l> ser::Serializer for &'l mut Leaf<'a, 'o> {
     }
     fn serialize_map(self, _len: Option<usize>) -> Result<Fields<'a, 'l>, Unsupported> {
         Ok(Fields {
-            name: self.name.to_owned(),
+            name: self.own_name(),
+            named: self.named,
             skip: self.skip,
             out: self.out,
             key: None,
@@ -271,7 +308,8 @@ impl<'a, 'o, 'l> ser::Serializer for &'l mut Leaf<'a, 'o> {
     ) -> Result<Fields<'a, 'l>, Unsupported> {
         // As JSON: {"<variant>": {...}}.
         Ok(Fields {
-            name: child_name(self.name, variant),
+            name: child_name(self.name, variant, self.named),
+            named: self.named,
             skip: &[],
             out: self.out,
             key: None,
@@ -281,10 +319,15 @@ impl<'a, 'o, 'l> ser::Serializer for &'l mut Leaf<'a, 'o> {
 
 impl Items<'_> {
     fn item<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Unsupported> {
-        let name = format!("{}_{}", self.name, self.next + self.first);
+        let name = if self.named {
+            format!("{}_{}", self.name, self.next + self.first)
+        } else {
+            String::new()
+        };
         self.next += 1;
         let mut leaf = Leaf {
             name: &name,
+            named: self.named,
             first: 1,
             skip: &[],
             out: self.out,
@@ -327,7 +370,7 @@ impl ser::SerializeStruct for Fields<'_, '_> {
         if self.skip.contains(&key) {
             return Ok(());
         }
-        field(&self.name, key, value, self.out)
+        field(&self.name, key, value, self.named, self.out)
     }
     fn end(self) -> Result<(), Unsupported> {
         Ok(())
@@ -342,7 +385,7 @@ impl ser::SerializeStructVariant for Fields<'_, '_> {
         key: &'static str,
         value: &T,
     ) -> Result<(), Unsupported> {
-        field(&self.name, key, value, self.out)
+        field(&self.name, key, value, self.named, self.out)
     }
     fn end(self) -> Result<(), Unsupported> {
         Ok(())
@@ -364,7 +407,7 @@ impl ser::SerializeMap for Fields<'_, '_> {
         if self.skip.contains(&key.as_str()) {
             return Ok(());
         }
-        field(&self.name, &key, value, self.out)
+        field(&self.name, &key, value, self.named, self.out)
     }
     fn end(self) -> Result<(), Unsupported> {
         Ok(())

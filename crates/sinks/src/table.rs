@@ -22,7 +22,7 @@ use flexdyn_proto::StateMsg;
 use serde::Serialize;
 use serde_json::Value;
 
-use super::columns::push_columns;
+use super::columns::{push_cells, push_columns};
 use super::topics::Decoded;
 use flexdyn_dynamics::kinds::wire_names;
 use flexdyn_kernel::numfmt::Num;
@@ -224,6 +224,40 @@ pub fn state_row(state: &StateMsg) -> Vec<Column> {
     out
 }
 
+/// [`state_row`]'s cells, in its order, each with an empty name ([`push_cells`]): appended to
+/// `out`.
+pub fn state_cells(state: &StateMsg, out: &mut Vec<Column>) {
+    out.push((
+        String::new(),
+        Cell::Num(state.header.sim_time_ns as f64 / 1e9),
+    ));
+    push_cells(state, &["effectors"], out);
+    for e in &state.effectors {
+        let flags = (String::new(), Cell::Int(e.flags.into()));
+        match wire_names(e.kind, e.states.len(), e.outputs.len()) {
+            // As `push_effectors`: each value beside its name, so as many as there are names.
+            Some((_, states, outputs)) => {
+                let values = states
+                    .iter()
+                    .zip(&e.states)
+                    .chain(outputs.iter().zip(&e.outputs));
+                out.extend(values.map(|(_, x)| (String::new(), Cell::Num(*x))));
+            }
+            None => {
+                out.push((String::new(), Cell::Int(e.kind.into())));
+                let values = e.states.iter().chain(&e.outputs);
+                out.extend(values.map(|x| (String::new(), Cell::Num(*x))));
+            }
+        }
+        out.push(flags);
+    }
+}
+
+/// [`prefixed_columns`]'s cells, in its order, each with an empty name: appended to `out`.
+pub fn prefixed_cells<T: Serialize>(msg: &T, out: &mut Vec<Column>) {
+    push_cells(msg, &["header"], out);
+}
+
 /// Prefix of `simulate`'s environment columns (`env_b_n_t_1`, `env_drag_torque_b_nm_1`): the
 /// fields of the EnvironmentMsg without its header.
 pub const ENVIRONMENT_COLUMN_PREFIX: &str = "env";
@@ -330,6 +364,34 @@ impl<W: Write> CsvTable<W> {
             use std::fmt::Write as _;
             let _ = write!(self.cells[i], "{cell}");
         }
+        self.write_cells()
+    }
+
+    /// Writes one row from cells given by their column's position in the header (the order of
+    /// the columns it was created with), a column not given left empty: [`Self::write_row`]
+    /// for a writer that knows where its cells go, without looking up a name per cell. A
+    /// position past the header is an error (`InvalidInput`).
+    pub fn write_positioned<'c>(
+        &mut self,
+        cells: impl IntoIterator<Item = (usize, &'c Cell)>,
+    ) -> io::Result<()> {
+        self.cells.iter_mut().for_each(String::clear);
+        let columns = self.cells.len();
+        for (i, cell) in cells {
+            let Some(text) = self.cells.get_mut(i) else {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    format!("column {i} is past the CSV header's {columns}"),
+                ));
+            };
+            use std::fmt::Write as _;
+            let _ = write!(text, "{cell}");
+        }
+        self.write_cells()
+    }
+
+    /// The cells as one CSV line.
+    fn write_cells(&mut self) -> io::Result<()> {
         for (i, c) in self.cells.iter().enumerate() {
             if i > 0 {
                 self.out.write_all(b",")?;
@@ -349,6 +411,40 @@ impl<W: Write> CsvTable<W> {
 mod tests {
     use super::*;
     use flexdyn_proto::{effector_kind, EffectorState, StateMsg};
+
+    /// `state_cells` is `state_row` without the names: the same cells in the same order, for
+    /// known and unknown effector kinds, and a non-finite value kept as NaN.
+    #[test]
+    fn state_cells_are_the_state_rows_cells_without_names() {
+        let mut s = StateMsg {
+            omega_bn_b_rad_s: [0.1, f64::INFINITY, -0.2],
+            ..StateMsg::default()
+        };
+        s.header.sim_time_ns = 30_000_000;
+        s.effectors = vec![
+            EffectorState {
+                kind: effector_kind::REACTION_WHEEL,
+                flags: 1,
+                states: vec![42.0],
+                outputs: vec![0.5, -0.25],
+            },
+            EffectorState {
+                kind: 77,
+                flags: 2,
+                states: vec![5.0, 6.0],
+                outputs: vec![7.0],
+            },
+        ];
+        let named = state_row(&s);
+        let mut cells = Vec::new();
+        state_cells(&s, &mut cells);
+        assert!(cells.iter().all(|(n, _)| n.is_empty()));
+        let text = |row: &[Column]| row.iter().map(|(_, c)| c.to_string()).collect::<Vec<_>>();
+        assert_eq!(text(&cells), text(&named));
+        assert!(cells
+            .iter()
+            .any(|(_, c)| matches!(c, Cell::Num(x) if x.is_nan())));
+    }
 
     #[test]
     fn a_state_row_names_its_columns_like_simulate() {
