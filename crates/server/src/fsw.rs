@@ -36,6 +36,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
+use flexdyn_proto::client::transport::declared_key;
 use flexdyn_proto::view::view_fsw;
 use flexdyn_proto::view::ViewError;
 use flexdyn_proto::{decode_fsw, Topics};
@@ -231,9 +232,7 @@ pub(super) async fn declare(
     // live in the publishers, which live in the callback.
     let mut republish = Vec::with_capacity(intake.streams.len());
     for k in &intake.keys {
-        let declared = session
-            .declare_keyexpr(k.to_string())
-            .await
+        let declared = declared_key(session, k.to_string())
             .map_err(|e| ServerError::zenoh("declare the flight-code telemetry publisher", e))?;
         republish.push(
             session

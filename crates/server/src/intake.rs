@@ -7,6 +7,7 @@
 use std::sync::mpsc::{SyncSender, TrySendError};
 use std::sync::{Arc, Mutex};
 
+use flexdyn_proto::client::transport::declared_key;
 use flexdyn_proto::{decode_command, CommandMsg, Topics};
 use zenoh::key_expr::KeyExpr;
 use zenoh::pubsub::Subscriber;
@@ -57,9 +58,7 @@ pub(super) async fn declare(
     let mut keys = Vec::with_capacity(settings.participants.len());
     for p in &settings.participants {
         keys.push(
-            session
-                .declare_keyexpr(topics.cmd(*p))
-                .await
+            declared_key(session, topics.cmd(*p))
                 .map_err(|e| ServerError::zenoh("declare a participant's command key", e))?,
         );
     }

@@ -7,6 +7,7 @@
 
 use std::sync::atomic::Ordering;
 
+use flexdyn_proto::client::transport::declared_key;
 use flexdyn_proto::{encode_into, Mode, Topics, RELATIVE_STATE_LEN};
 use zenoh::pubsub::Publisher;
 use zenoh::qos::CongestionControl;
@@ -46,9 +47,7 @@ impl RelativePublisher {
             CongestionControl::Block
         };
         // Declared, so its samples go by a cached route (`transport::declared_key`).
-        let declared = session
-            .declare_keyexpr(key.clone())
-            .await
+        let declared = declared_key(session, key.clone())
             .map_err(|e| ServerError::zenoh("declare the relative-state publisher", e))?;
         let publisher = session
             .declare_publisher(declared)

@@ -7,6 +7,7 @@
 
 use std::sync::Arc;
 
+use flexdyn_proto::client::transport::declared_key;
 use flexdyn_proto::{Mode, Topics};
 use zenoh::pubsub::Publisher;
 use zenoh::qos::CongestionControl;
@@ -66,10 +67,7 @@ impl Endpoints {
         // Each key declared first, so Zenoh routes its samples by a cached route
         // (`flexdyn_proto::client::transport::declared_key`).
         let telemetry_pub = |key: String, what: &'static str, express: bool| async move {
-            let key = session
-                .declare_keyexpr(key)
-                .await
-                .map_err(|e| ServerError::zenoh(what, e))?;
+            let key = declared_key(session, key).map_err(|e| ServerError::zenoh(what, e))?;
             session
                 .declare_publisher(key)
                 .congestion_control(congestion)
@@ -83,9 +81,7 @@ impl Endpoints {
             express,
         )
         .await?;
-        let status_key = session
-            .declare_keyexpr(topics.status().to_owned())
-            .await
+        let status_key = declared_key(session, topics.status())
             .map_err(|e| ServerError::zenoh("declare the status publisher", e))?;
         let status_pub = session
             .declare_publisher(status_key)
