@@ -290,30 +290,26 @@ fn simulate_rows<W: Write>(
         .iter()
         .map(|s| prefixed_columns(&sensor_prefix(s.as_ref()), &(s.kind().default_json)()))
         .collect();
-    let fixed = simulate_row(
-        &state,
-        &AppliedWrench::default(),
-        environment.as_ref(),
-        std::iter::empty(),
-    )
-    .len();
-    let mut at = fixed;
-    let layout = Layout {
-        fixed,
-        sensors: blocks
-            .iter()
-            .map(|b| {
-                at += b.len();
-                (at - b.len(), b.len())
-            })
-            .collect(),
-    };
+    let lens: Vec<usize> = blocks.iter().map(Vec::len).collect();
     let all = blocks.into_iter().map(Some);
     let columns: Vec<String> =
         simulate_row(&state, &AppliedWrench::default(), environment.as_ref(), all)
             .into_iter()
             .map(|(name, _)| name)
             .collect();
+    // The sensors' blocks close the header; what comes before them is the fixed part.
+    let fixed = columns.len() - lens.iter().sum::<usize>();
+    let mut at = fixed;
+    let layout = Layout {
+        fixed,
+        sensors: lens
+            .into_iter()
+            .map(|len| {
+                at += len;
+                (at - len, len)
+            })
+            .collect(),
+    };
     // What t_s = 0 is, when the configuration has an [epoch]; then each fault's resolved
     // window (`flexdyn plot` shades it).
     let comments: Vec<String> = cfg
