@@ -35,6 +35,7 @@ class FakeClient:
         self._subscribers = []
         self.taps = []
         self.sent = []  # (tick, kind)
+        self.declared = []  # keys, in the order declare_keys got them
         outer = self
 
         class Token:
@@ -67,6 +68,9 @@ class FakeClient:
 
     def add_telemetry_tap(self, tap):
         self.taps.append(tap)
+
+    def declare_keys(self, keys):
+        self.declared.extend(keys)
 
     def remove_telemetry_tap(self, tap):
         self.taps.remove(tap)
@@ -293,6 +297,10 @@ def test_magnetometers_and_sun_sensors_are_scheduled_and_delivered_in_the_tick()
     assert s.due(8) == ("imu/hub", "fss/fss")
     assert s.due(13) == ("imu/hub", "gps/gps1")
     assert s.due(10) == ("imu/hub", "mag/mag1", "css/css")
+    # Every route due at some tick (the periods' least common multiple, 20, after the GPS's
+    # 3 frames of latency covers them all), each once.
+    due_somewhen = {r for tick in range(23) for r in s.due(tick)}
+    assert sorted(s.routes()) == sorted(due_somewhen) and len(s.routes()) == 5
 
     c, seen = FakeClient(), []
     c.vehicle = lambda timeout_s: flexdyn.VehicleInfo("sc1", 1, ENV_SENSORS_TOML, "", None, None)
@@ -356,4 +364,18 @@ def test_a_dropout_fault_event_stops_the_wait_for_the_samples_it_withholds():
     c.feed("state", state(11))
     assert len(seen) == 3, "no dropout any more: imu/bracket of tick 11 is waited for"
     assert p.incomplete_ticks == 2 and [s[0] for s in c.sent] == [3, 7, 9]
+    p.close()
+
+
+def test_a_participant_declares_the_keys_it_reads_at_every_tick():
+    # Declared keys are routed by a route Zenoh computed once (Client.declare_keys); the
+    # participant's are the state, the time service, the environment and fault events, and
+    # every sensor sample of its schedule, under the spacecraft's telemetry prefix.
+    c, seen = FakeClient(), []
+    c.vehicle = lambda timeout_s: flexdyn.VehicleInfo("sc1", 1, ENV_SENSORS_TOML, "", None, None)
+    p = participant(c, seen)
+    expected = ["flexdyn/sc1/tlm/" + r for r in ("time", "state", "env", "fault", "imu/hub",
+                                                 "mag/mag1", "css/css", "fss/fss", "gps/gps1")]
+    assert c.declared == expected
+    assert proto.state_key("sc1") in c.declared and proto.gps_key("sc1", "gps1") in c.declared
     p.close()

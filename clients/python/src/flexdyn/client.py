@@ -113,6 +113,9 @@ class Client:
         # caller's; this lock keeps a put and close() from overlapping.
         self._pub_lock = threading.Lock()
         self._closed = False
+        # Keys declared to the session (`Session.declare_keyexpr`), by key, for the Client's
+        # life: the command keys and the telemetry keys read at every tick (`declare_keys`).
+        self._declared: Dict[str, object] = {}
         # Telemetry: one subscriber on flexdyn/<sc>/tlm/**, declared on first use; the callbacks
         # by route ("state", "imu/<name>", "st/<name>"), then the taps (every decoded sample).
         # `_dispatch` is held while a sample is delivered, so callbacks never overlap.
@@ -132,6 +135,25 @@ class Client:
         #: Exceptions raised by telemetry callbacks (logged on the ``flexdyn`` logger; the other
         #: callbacks of the same sample still run).
         self.callback_errors: List[BaseException] = []
+
+    # -- declared keys ---------------------------------------------------------------------
+
+    def _declared_key(self, key: str):
+        with self._lock:
+            declared = self._declared.get(key)
+            if declared is None:
+                declared = self._declared[key] = self.session.declare_keyexpr(key)
+            return declared
+
+    def declare_keys(self, keys: Iterable[str]) -> None:
+        """Declares each of `keys` to the session (``Session.declare_keyexpr``), once, for as
+        long as the Client lives. Zenoh then routes a declared key's samples by a route it
+        computed once, instead of matching each sample against the subscriptions (the
+        telemetry subscriber's ``tlm/**`` is a wildcard): for the keys received or sent at every
+        tick. The route subscriptions, the command publishers and :class:`LockstepParticipant`
+        declare theirs (docs/guides/flight-code.md)."""
+        for key in keys:
+            self._declared_key(key)
 
     # -- subscriptions ---------------------------------------------------------------------
 
@@ -170,6 +192,7 @@ class Client:
                     proto.telemetry_key(self.sc_id), self._on_telemetry)
 
     def _telemetry_add(self, route: str, callback: Callable) -> Subscription:
+        self._declared_key(self._tlm_prefix + route)
         with self._dispatch:
             self._routes.setdefault(route, []).append(callback)
         self._telemetry_subscriber()
@@ -386,10 +409,12 @@ class Client:
             if pub is None:
                 # Blocking: a lockstep answer must never be dropped (Zenoh's default for a
                 # put is to drop a sample that finds the link's queue full for 1 ms, and the
-                # server then waits for an answer that will not come).
+                # server then waits for an answer that will not come). Express: sent at once,
+                # not held for a batch (and it takes along a flight-code telemetry sample
+                # published before it, which is batched), as the Rust participant's.
                 pub = self.session.declare_publisher(
-                    proto.command_key(self.sc_id, cmd.sender_id),
-                    congestion_control=zenoh.CongestionControl.BLOCK)
+                    self._declared_key(proto.command_key(self.sc_id, cmd.sender_id)),
+                    congestion_control=zenoh.CongestionControl.BLOCK, express=True)
                 self._command_pubs[cmd.sender_id] = pub
             pub.put(payload)
 
@@ -520,6 +545,10 @@ class Client:
             for pub in self._command_pubs.values():
                 pub.undeclare()
             self._command_pubs.clear()
+        with self._lock:
+            for declared in self._declared.values():
+                self.session.undeclare(declared)
+            self._declared.clear()
         self.session.close()
 
     def __enter__(self) -> "Client":

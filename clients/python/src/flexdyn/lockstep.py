@@ -110,6 +110,14 @@ class SensorSchedule:
         return cls(tuple(str(imu["name"]) for imu in config.get("imus", [])),
                    _periods(config, "star_trackers", frame_hz), others, tuple(delayed))
 
+    def routes(self) -> Tuple[str, ...]:
+        """The route of every sensor sample the schedule awaits at some tick, in the order of
+        :meth:`due`."""
+        return tuple([f"imu/{n}" for n in self.imus]
+                     + [f"st/{n}" for n, _ in self.star_trackers]
+                     + [r for r, _ in self.others]
+                     + [r for r, _, _ in self.delayed])
+
     def due(self, tick: int) -> Tuple[str, ...]:
         """The routes of the samples published at `tick` (``imu/<name>``, ``st/<name>``,
         ``mag/<name>``, ...)."""
@@ -212,6 +220,11 @@ class LockstepParticipant:
         self._changed = threading.Condition()
         self._status_sub = client.subscribe_status(self._on_status)
         client.add_telemetry_tap(self._on_sample)
+        # The keys it reads at every tick, declared (Client.declare_keys): the state, the time
+        # service, the environment and fault events, and every scheduled sensor's.
+        prefix = proto.telemetry_key(client.sc_id)[:-2]
+        client.declare_keys(prefix + route for route in
+                            ("time", "state", "env", "fault") + self.schedule.routes())
         self._token = client.session.liveliness().declare_token(
             proto.participant_key(client.sc_id, sender_id))
 
