@@ -47,9 +47,32 @@
 //! wall time between the physics thread's recent requests (`poll_period`: 20 µs to 5 ms), so it
 //! claims a request within about an eighth of the time the answer has before it is needed, and
 //! costs ~200 short wake-ups a second in a real-time run (10 Hz updates).
+//!
+//! # When requests come faster than a sleep: it spins
+//! A sleep shorter than 20 µs is mostly the kernel's timer slack, so a worker that sleeps cannot
+//! follow requests less than 160 µs apart. That is a batch or benchmark run of a vehicle whose
+//! environment updates every few steps: `scenarios/acs_full.toml` updates it every 10 steps of
+//! ~4 µs, and its worker, waking every ~70 µs, answered 2–5 % of the requests
+//! (`cargo bench --bench acs_full`); the rest ran on the stepping thread. While requests keep
+//! coming that often (`SPIN_WINDOW`), the worker looks at the slot without sleeping
+//! (`std::hint::spin_loop`) and yields its core every 20 µs, so a thread woken on that core
+//! runs. It spins only with one of a process-wide count of tickets, one fewer than the cores the
+//! process may use (one on two cores, none on one): a fleet's workers do not fill the machine.
+//! Spinning stops within 160 µs of the last request, so a real-time or lockstep run (requests
+//! milliseconds apart) never spins.
+//!
+//! A spinning worker needs a core of its own. In some rounds of the bench (most often right
+//! after the Basilisk peer had run) the kernel started the worker on the stepping thread's
+//! core, and neither the worker's yields nor its sleeps moved it to the idle one: it looked at
+//! its slot once per time slice of the stepping thread, every ~4 ms, and answered 1 % of the
+//! requests (`perf record -e sched:sched_switch,sched:sched_wakeup_new`). So a worker that
+//! comes back to its slot 500 µs (`STARVED`) later than it meant while requests come fast moves
+//! itself to another of its allowed cores (`leave_this_core`), at most once per 10 ms
+//! (`SPIN_RETRY`); starved again within that time, every core is busy, and it sleeps between
+//! looks for 100 ms (`SPIN_REST`).
 
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
-use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, AtomicUsize, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::thread::{JoinHandle, Thread};
 use std::time::{Duration, Instant};
 
@@ -254,6 +277,17 @@ const POLL_MIN: Duration = Duration::from_micros(20);
 const POLL_MAX: Duration = Duration::from_millis(5);
 /// \[s\] how long without a request before the worker starts polling less often.
 const IDLE_BACKOFF: Duration = Duration::from_secs(1);
+/// \[s\] the request interval below which a sleep cannot follow the requests: an eighth of it
+/// is under [`POLL_MIN`]. While requests keep coming at least this often, the worker spins
+/// ([`Pace::spins`]).
+const SPIN_WINDOW: Duration = Duration::from_micros(8 * 20);
+/// \[s\] how long a spinning worker looks at the slot before it yields its core once.
+const SPIN_SLICE: Duration = Duration::from_micros(20);
+/// \[s\] a worker that comes back to its slot this much later than it meant to (after a spin
+/// or a sleep) was kept off its core by a busy thread on it, such as the stepping thread when
+/// the kernel started the worker on its core (module docs): its time slices of ~4 ms leave the
+/// worker a look now and then. A timer's slack is 50 µs.
+const STARVED: Duration = Duration::from_micros(500);
 
 /// The worker's polling period: an eighth of the wall time between the requests posted since its
 /// last look ([`poll_period`]), kept while none arrive.
@@ -270,6 +304,13 @@ impl Pace {
             seen: (0, now),
             poll: Duration::from_millis(1),
         }
+    }
+
+    /// Whether the worker should spin rather than sleep before its next look: the requests come
+    /// faster than a sleep can follow ([`SPIN_WINDOW`]: the period is at its floor) and the last
+    /// one came within that window. A run that pauses stops the spinning within 160 µs.
+    fn spins(&self, now: Instant) -> bool {
+        self.poll <= POLL_MIN && now.saturating_duration_since(self.seen.1) < SPIN_WINDOW
     }
 
     /// The sleep before the next look, having seen `posted` requests in all at `now`. Quick to
@@ -299,6 +340,164 @@ fn poll_period(elapsed: Duration, n: u64) -> Duration {
     (per_request / 8).clamp(POLL_MIN, POLL_MAX)
 }
 
+/// The number of workers of this process that may spin at once: one core fewer than the
+/// process may use (the stepping thread keeps one busy), none on one core.
+fn spin_slots() -> usize {
+    static SLOTS: OnceLock<usize> = OnceLock::new();
+    *SLOTS.get_or_init(|| {
+        std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .saturating_sub(1)
+    })
+}
+
+/// Workers spinning now, across the process (a fleet has one worker per vehicle).
+static SPINNING: AtomicUsize = AtomicUsize::new(0);
+
+/// A worker's leave to spin: one of `slots` counted by `spinning`, given back when dropped.
+struct SpinTicket(&'static AtomicUsize);
+
+impl SpinTicket {
+    fn take(spinning: &'static AtomicUsize, slots: usize) -> Option<Self> {
+        spinning
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| {
+                (n < slots).then_some(n + 1)
+            })
+            .ok()
+            .map(|_| SpinTicket(spinning))
+    }
+}
+
+impl Drop for SpinTicket {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+/// \[s\] after moving off a shared core, a worker that finds itself starved again within this
+/// time shares every core it may use with busy threads: it stops spinning for [`SPIN_REST`].
+const SPIN_RETRY: Duration = Duration::from_millis(10);
+/// \[s\] how long a worker that found every core busy polls by sleeping before it spins again.
+const SPIN_REST: Duration = Duration::from_millis(100);
+
+/// Outside Linux the worker does not move (it keeps spinning where the scheduler puts it).
+#[cfg(not(target_os = "linux"))]
+fn leave_this_core() -> bool {
+    false
+}
+
+/// Moves the calling thread off the core it runs on, if it may run on another: it restricts its
+/// allowed cores to the others (the kernel moves it at once), then allows them all again, so the
+/// scheduler stays free to place it later. Returns whether it moved.
+///
+/// Why: a spinning worker that shares a core with the stepping thread looks at its slot only
+/// when the stepping thread's time slice ends, every few milliseconds (module docs).
+#[cfg(target_os = "linux")]
+fn leave_this_core() -> bool {
+    let Ok(allowed) = rustix::thread::sched_getaffinity(None) else {
+        return false;
+    };
+    let mut others = allowed;
+    others.unset(rustix::thread::sched_getcpu());
+    if others.count() == 0 {
+        return false;
+    }
+    let moved = rustix::thread::sched_setaffinity(None, &others).is_ok();
+    // Allowed everywhere again; it stays where it is until the scheduler has a reason.
+    let _ = rustix::thread::sched_setaffinity(None, &allowed);
+    moved
+}
+
+/// Worker: looks at `slot` until a request is there, `slice` has passed or the worker is told to
+/// stop, without a system call; then yields its core once, so that a thread waiting for it runs.
+fn spin_once(slot: &Slot, slice: Duration) {
+    let until = Instant::now() + slice;
+    let mut looks = 0u32;
+    while slot.state.load(Ordering::Acquire) != REQUESTED && !slot.stop.load(Ordering::Relaxed) {
+        std::hint::spin_loop();
+        looks = looks.wrapping_add(1);
+        if looks.is_multiple_of(64) && Instant::now() >= until {
+            break;
+        }
+    }
+    std::thread::yield_now();
+}
+
+/// A worker's spinning: its ticket, and what it does when it finds itself starved.
+#[derive(Default)]
+struct Spin {
+    ticket: Option<SpinTicket>,
+    /// When it last moved off a core it shared.
+    moved_at: Option<Instant>,
+    /// Until when it polls by sleeping, having found every core it may use busy.
+    rest_until: Option<Instant>,
+}
+
+impl Spin {
+    /// Whether the worker may spin now (taking a ticket if it holds none).
+    fn may_spin(&mut self, now: Instant) -> bool {
+        if self.rest_until.is_some_and(|t| now < t) {
+            return false;
+        }
+        self.ticket = self
+            .ticket
+            .take()
+            .or_else(|| SpinTicket::take(&SPINNING, spin_slots()));
+        self.ticket.is_some()
+    }
+
+    /// Gives the ticket back.
+    fn stop(&mut self) {
+        self.ticket = None;
+    }
+
+    /// The worker was kept off its core while requests came fast: it moves to another core,
+    /// unless it did so less than [`SPIN_RETRY`] ago (every core is busy then: it rests).
+    fn starved(&mut self, now: Instant) {
+        if self
+            .moved_at
+            .is_some_and(|t| now.saturating_duration_since(t) < SPIN_RETRY)
+        {
+            self.stop();
+            self.rest_until = Some(now + SPIN_REST);
+        } else {
+            leave_this_core();
+            self.moved_at = Some(now);
+        }
+    }
+}
+
+/// The worker thread's loop: serve a request if there is one; otherwise spin or sleep until the
+/// next look ([`Pace`], [`Spin`]).
+fn work(slot: &Slot, fill: &impl Fn(&Request, &mut EnvironmentSample)) {
+    let mut pace = Pace::new(Instant::now());
+    let mut spin = Spin::default();
+    // When the worker last looked at the slot, and how long it meant to be away after that.
+    let mut looked = (Instant::now(), Duration::ZERO);
+    while !slot.stop.load(Ordering::Acquire) {
+        // Back much later than it meant while requests come fast: starved on a shared core.
+        let now = Instant::now();
+        if pace.poll <= POLL_MIN && now.saturating_duration_since(looked.0) > looked.1 + STARVED {
+            spin.starved(now);
+        }
+        if slot.serve(fill) {
+            looked = (Instant::now(), Duration::ZERO);
+            continue;
+        }
+        let now = Instant::now();
+        let poll = pace.next_poll(slot.posted.load(Ordering::Relaxed), now);
+        let away = if pace.spins(now) && spin.may_spin(now) {
+            spin_once(slot, SPIN_SLICE);
+            SPIN_SLICE
+        } else {
+            spin.stop();
+            std::thread::park_timeout(poll);
+            poll
+        };
+        looked = (now, away);
+    }
+}
+
 /// A worker thread that evaluates the next environment sample ahead of time (module docs).
 /// Dropping it stops and joins the thread.
 pub struct Prefetcher {
@@ -325,13 +524,7 @@ impl Prefetcher {
         let handle = std::thread::Builder::new()
             .name("flexdyn-environment".into())
             .spawn(move || {
-                let mut pace = Pace::new(Instant::now());
-                while !worker_slot.stop.load(Ordering::Acquire) {
-                    if !worker_slot.serve(&fill) {
-                        let posted = worker_slot.posted.load(Ordering::Relaxed);
-                        std::thread::park_timeout(pace.next_poll(posted, Instant::now()));
-                    }
-                }
+                work(&worker_slot, &fill);
             })?;
         Ok(Self {
             slot,
@@ -542,6 +735,113 @@ mod tests {
             looks,
             [us(160), us(320), us(640), us(1280), us(2560), POLL_MAX]
         );
+    }
+
+    #[test]
+    fn the_worker_spins_only_while_requests_come_faster_than_a_sleep_can_follow() {
+        let us = Duration::from_micros;
+        let t0 = Instant::now();
+        let mut pace = Pace::new(t0);
+        // Requests 40 µs apart (acs_full.toml's 10 steps of ~4 µs): the period is at its floor,
+        // and the worker spins until 160 µs after the last one.
+        let mut t = t0;
+        for k in 1..=5 {
+            t = t0 + us(40 * k);
+            pace.next_poll(k, t);
+        }
+        assert!(pace.spins(t));
+        assert!(pace.spins(t + us(159)));
+        assert!(!pace.spins(t + us(160)), "a paused run stops the spinning");
+        // Requests 170 µs apart: an eighth is above the floor; the worker sleeps.
+        let mut pace = Pace::new(t0);
+        for k in 1..=5 {
+            t = t0 + us(170 * k);
+            pace.next_poll(k, t);
+        }
+        assert_eq!(pace.poll, us(21) + Duration::from_nanos(250));
+        assert!(!pace.spins(t));
+        // One request after a 100 ms gap, fast again: the period at most doubles from the
+        // floor, so the worker does not spin until a second fast request brings it back.
+        let mut pace = Pace::new(t0);
+        pace.next_poll(1, t0 + us(40));
+        pace.next_poll(2, t0 + us(80));
+        assert!(pace.spins(t0 + us(80)));
+        pace.next_poll(3, t0 + us(100_080));
+        assert!(!pace.spins(t0 + us(100_080)));
+        pace.next_poll(4, t0 + us(100_120));
+        assert!(pace.spins(t0 + us(100_120)));
+    }
+
+    #[test]
+    fn no_more_workers_spin_than_there_are_tickets() {
+        static SPINNING_HERE: AtomicUsize = AtomicUsize::new(0);
+        let a = SpinTicket::take(&SPINNING_HERE, 2).expect("the first of two");
+        let b = SpinTicket::take(&SPINNING_HERE, 2).expect("the second of two");
+        assert!(
+            SpinTicket::take(&SPINNING_HERE, 2).is_none(),
+            "a third of two"
+        );
+        drop(a);
+        let c = SpinTicket::take(&SPINNING_HERE, 2).expect("a ticket given back");
+        drop((b, c));
+        assert_eq!(SPINNING_HERE.load(Ordering::Acquire), 0);
+        // One core: nobody spins.
+        assert!(SpinTicket::take(&SPINNING_HERE, 0).is_none());
+    }
+
+    #[test]
+    fn a_spinning_worker_stops_looking_when_a_request_comes_or_its_slice_ends() {
+        let slot = Slot::new();
+        // Nothing requested: back after its slice.
+        let t0 = Instant::now();
+        spin_once(&slot, Duration::from_millis(2));
+        assert!(t0.elapsed() >= Duration::from_millis(2));
+        // A request waiting: back at once (well before a 10 s slice).
+        assert!(slot.post(&request(7)));
+        let t0 = Instant::now();
+        spin_once(&slot, Duration::from_secs(10));
+        assert!(t0.elapsed() < Duration::from_secs(5));
+    }
+
+    #[test]
+    fn a_starved_worker_moves_once_then_rests_if_starved_again_soon() {
+        let t0 = Instant::now();
+        let mut spin = Spin::default();
+        spin.starved(t0);
+        assert_eq!(spin.moved_at, Some(t0), "the first time it moves");
+        assert_eq!(spin.rest_until, None);
+        // Starved again 11 ms later: the move helped for a while; it moves again.
+        let t1 = t0 + Duration::from_millis(11);
+        spin.starved(t1);
+        assert_eq!((spin.moved_at, spin.rest_until), (Some(t1), None));
+        // Again within 10 ms of that move: every core is busy; it rests for 100 ms.
+        let t2 = t1 + Duration::from_millis(3);
+        spin.starved(t2);
+        assert_eq!(spin.rest_until, Some(t2 + SPIN_REST));
+        assert!(spin.ticket.is_none());
+        assert!(!spin.may_spin(t2 + Duration::from_millis(99)));
+        assert!(spin.ticket.is_none(), "no ticket is taken while resting");
+    }
+
+    #[test]
+    #[cfg(target_os = "linux")]
+    fn leaving_this_core_moves_the_thread_and_gives_back_its_cores() {
+        let allowed = rustix::thread::sched_getaffinity(None).unwrap();
+        let before = rustix::thread::sched_getcpu();
+        let moved = leave_this_core();
+        let after = rustix::thread::sched_getaffinity(None).unwrap();
+        assert!(
+            (0..rustix::thread::CpuSet::MAX_CPU).all(|c| after.is_set(c) == allowed.is_set(c)),
+            "the allowed cores are given back"
+        );
+        if allowed.count() >= 2 {
+            assert!(moved);
+            // Right after the move it runs elsewhere (the scheduler has had no reason to
+            // move it back within these few instructions).
+            assert_ne!(rustix::thread::sched_getcpu(), before);
+        } else {
+            assert!(!moved, "one core: nowhere to go");
+        }
     }
 
     #[test]
