@@ -58,18 +58,20 @@
 //! (`std::hint::spin_loop`) and yields its core every 20 µs, so a thread woken on that core
 //! runs. It spins only with one of a process-wide count of tickets, one fewer than the cores the
 //! process may use (one on two cores, none on one): a fleet's workers do not fill the machine.
-//! Spinning stops within 160 µs of the last request, so a real-time or lockstep run (requests
-//! milliseconds apart) never spins.
+//! Spinning stops 160 µs after the worker last saw a new request, so a real-time run at the
+//! shipped rates or a lockstep run at a participant's usual pace (requests milliseconds apart)
+//! does not spin; an update rate above the frame rate in real time, or a participant answering
+//! in tens of microseconds, does.
 //!
 //! A spinning worker needs a core of its own. In some rounds of the bench (most often right
 //! after the Basilisk peer had run) the kernel started the worker on the stepping thread's
 //! core, and neither the worker's yields nor its sleeps moved it to the idle one: it looked at
 //! its slot once per time slice of the stepping thread, every ~4 ms, and answered 1 % of the
 //! requests (`perf record -e sched:sched_switch,sched:sched_wakeup_new`). So a worker that
-//! comes back to its slot 500 µs (`STARVED`) later than it meant while requests come fast moves
-//! itself to another of its allowed cores (`leave_this_core`), at most once per 10 ms
-//! (`SPIN_RETRY`); starved again within that time, every core is busy, and it sleeps between
-//! looks for 100 ms (`SPIN_REST`).
+//! comes back to its slot 500 µs (`STARVED`) later than it meant while spinning moves itself to
+//! another of its allowed cores (`leave_this_core`), at most once per 10 ms (`SPIN_RETRY`);
+//! starved again within that time, or with no other core, it sleeps between looks for 100 ms
+//! (`SPIN_REST`).
 
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, AtomicUsize, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -387,8 +389,9 @@ fn leave_this_core() -> bool {
 }
 
 /// Moves the calling thread off the core it runs on, if it may run on another: it restricts its
-/// allowed cores to the others (the kernel moves it at once), then allows them all again, so the
-/// scheduler stays free to place it later. Returns whether it moved.
+/// allowed cores to the others (the kernel moves it at once), then restores the set it had, so
+/// the scheduler stays free to place it later (and a set the server restricted stays so).
+/// Returns whether it moved.
 ///
 /// Why: a spinning worker that shares a core with the stepping thread looks at its slot only
 /// when the stepping thread's time slice ends, every few milliseconds (module docs).
@@ -403,7 +406,7 @@ fn leave_this_core() -> bool {
         return false;
     }
     let moved = rustix::thread::sched_setaffinity(None, &others).is_ok();
-    // Allowed everywhere again; it stays where it is until the scheduler has a reason.
+    // Its own set again; it stays where it is until the scheduler has a reason to move it.
     let _ = rustix::thread::sched_setaffinity(None, &allowed);
     moved
 }
@@ -451,18 +454,21 @@ impl Spin {
         self.ticket = None;
     }
 
-    /// The worker was kept off its core while requests came fast: it moves to another core,
-    /// unless it did so less than [`SPIN_RETRY`] ago (every core is busy then: it rests).
+    /// The spinning worker was kept off its core: it moves to another core, unless it did so
+    /// less than [`SPIN_RETRY`] ago or has no other core to go to; then it rests (the cores it
+    /// may use are busy). On two cores a worker starved by another thread than the stepping
+    /// thread moves onto the stepping thread's core, where it is starved again at once, and
+    /// rests: the stepping thread loses one of the worker's 20 µs slices, as its yields give
+    /// the core back.
     fn starved(&mut self, now: Instant) {
-        if self
+        let moved_lately = self
             .moved_at
-            .is_some_and(|t| now.saturating_duration_since(t) < SPIN_RETRY)
-        {
+            .is_some_and(|t| now.saturating_duration_since(t) < SPIN_RETRY);
+        if !moved_lately && leave_this_core() {
+            self.moved_at = Some(now);
+        } else {
             self.stop();
             self.rest_until = Some(now + SPIN_REST);
-        } else {
-            leave_this_core();
-            self.moved_at = Some(now);
         }
     }
 }
@@ -475,9 +481,10 @@ fn work(slot: &Slot, fill: &impl Fn(&Request, &mut EnvironmentSample)) {
     // When the worker last looked at the slot, and how long it meant to be away after that.
     let mut looked = (Instant::now(), Duration::ZERO);
     while !slot.stop.load(Ordering::Acquire) {
-        // Back much later than it meant while requests come fast: starved on a shared core.
+        // Spinning (it holds a ticket) and back much later than it meant: starved on a shared
+        // core. A sleeping worker's lateness does not matter to anyone.
         let now = Instant::now();
-        if pace.poll <= POLL_MIN && now.saturating_duration_since(looked.0) > looked.1 + STARVED {
+        if spin.ticket.is_some() && now.saturating_duration_since(looked.0) > looked.1 + STARVED {
             spin.starved(now);
         }
         if slot.serve(fill) {
@@ -804,10 +811,20 @@ mod tests {
     }
 
     #[test]
+    #[cfg(target_os = "linux")]
     fn a_starved_worker_moves_once_then_rests_if_starved_again_soon() {
+        // Moving needs a second core; on one, a starved worker rests at once.
+        let cores = rustix::thread::sched_getaffinity(None).unwrap().count();
         let t0 = Instant::now();
         let mut spin = Spin::default();
         spin.starved(t0);
+        if cores < 2 {
+            assert_eq!(
+                (spin.moved_at, spin.rest_until),
+                (None, Some(t0 + SPIN_REST))
+            );
+            return;
+        }
         assert_eq!(spin.moved_at, Some(t0), "the first time it moves");
         assert_eq!(spin.rest_until, None);
         // Starved again 11 ms later: the move helped for a while; it moves again.
@@ -827,21 +844,15 @@ mod tests {
     #[cfg(target_os = "linux")]
     fn leaving_this_core_moves_the_thread_and_gives_back_its_cores() {
         let allowed = rustix::thread::sched_getaffinity(None).unwrap();
-        let before = rustix::thread::sched_getcpu();
         let moved = leave_this_core();
         let after = rustix::thread::sched_getaffinity(None).unwrap();
         assert!(
             (0..rustix::thread::CpuSet::MAX_CPU).all(|c| after.is_set(c) == allowed.is_set(c)),
             "the allowed cores are given back"
         );
-        if allowed.count() >= 2 {
-            assert!(moved);
-            // Right after the move it runs elsewhere (the scheduler has had no reason to
-            // move it back within these few instructions).
-            assert_ne!(rustix::thread::sched_getcpu(), before);
-        } else {
-            assert!(!moved, "one core: nowhere to go");
-        }
+        // A thread may always restrict its own cores (no privilege needed), so with two it
+        // moves; where it runs afterwards is the scheduler's to change, so it is not checked.
+        assert_eq!(moved, allowed.count() >= 2);
     }
 
     #[test]
