@@ -282,7 +282,7 @@ const IDLE_BACKOFF: Duration = Duration::from_secs(1);
 /// \[s\] the request interval below which a sleep cannot follow the requests: an eighth of it
 /// is under [`POLL_MIN`]. While requests keep coming at least this often, the worker spins
 /// ([`Pace::spins`]).
-const SPIN_WINDOW: Duration = Duration::from_micros(8 * 20);
+const SPIN_WINDOW: Duration = POLL_MIN.saturating_mul(8);
 /// \[s\] how long a spinning worker looks at the slot before it yields its core once.
 const SPIN_SLICE: Duration = Duration::from_micros(20);
 /// \[s\] a worker that comes back to its slot this much later than it meant to (after a spin
@@ -442,10 +442,9 @@ impl Spin {
         if self.rest_until.is_some_and(|t| now < t) {
             return false;
         }
-        self.ticket = self
-            .ticket
-            .take()
-            .or_else(|| SpinTicket::take(&SPINNING, spin_slots()));
+        if self.ticket.is_none() {
+            self.ticket = SpinTicket::take(&SPINNING, spin_slots());
+        }
         self.ticket.is_some()
     }
 
