@@ -110,22 +110,24 @@ class SensorSchedule:
         return cls(tuple(str(imu["name"]) for imu in config.get("imus", [])),
                    _periods(config, "star_trackers", frame_hz), others, tuple(delayed))
 
+    def _entries(self) -> List[Tuple[str, int, int]]:
+        """(route, period in frames, latency in frames) of every scheduled sample, in
+        publication order: an IMU each frame, the rate-driven kinds from tick 0."""
+        return ([(f"imu/{n}", 1, 0) for n in self.imus]
+                + [(f"st/{n}", every, 0) for n, every in self.star_trackers]
+                + [(r, every, 0) for r, every in self.others]
+                + list(self.delayed))
+
     def routes(self) -> Tuple[str, ...]:
         """The route of every sensor sample the schedule awaits at some tick, in the order of
         :meth:`due`."""
-        return tuple([f"imu/{n}" for n in self.imus]
-                     + [f"st/{n}" for n, _ in self.star_trackers]
-                     + [r for r, _ in self.others]
-                     + [r for r, _, _ in self.delayed])
+        return tuple(r for r, _, _ in self._entries())
 
     def due(self, tick: int) -> Tuple[str, ...]:
         """The routes of the samples published at `tick` (``imu/<name>``, ``st/<name>``,
         ``mag/<name>``, ...)."""
-        return tuple([f"imu/{n}" for n in self.imus]
-                     + [f"st/{n}" for n, every in self.star_trackers if tick % every == 0]
-                     + [r for r, every in self.others if tick % every == 0]
-                     + [r for r, every, latency in self.delayed
-                        if tick >= latency and (tick - latency) % every == 0])
+        return tuple(r for r, every, latency in self._entries()
+                     if tick >= latency and (tick - latency) % every == 0)
 
 
 @dataclass
