@@ -377,8 +377,9 @@ fn clock_keeps_up(seen: &Seen) {
     );
 }
 
-fn recording() -> PathBuf {
-    let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join("view_file.mcap");
+/// A 20 s batch recording of the default configuration, in `CARGO_TARGET_TMPDIR/name`.
+fn recording(name: &str) -> PathBuf {
+    let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
     let _ = std::fs::remove_file(&file);
     let status = Command::new(env!("CARGO_BIN_EXE_flexdyn"))
         .args([
@@ -400,9 +401,8 @@ fn recording() -> PathBuf {
     file
 }
 
-#[test]
-fn a_recording_plays_back_with_seek() {
-    let file = recording();
+/// `flexdyn view --file FILE` on a port the OS picks (stopped when dropped), and that port.
+fn view_file(file: &Path) -> (Guard, u16) {
     let mut viewer = flexdyn(&[
         "view",
         "--file",
@@ -413,6 +413,13 @@ fn a_recording_plays_back_with_seek() {
         "120",
     ]);
     let wport = ws_port(&mut viewer.0);
+    (viewer, wport)
+}
+
+#[test]
+fn a_recording_plays_back_with_seek() {
+    let file = recording("view_file.mcap");
+    let (_viewer, wport) = view_file(&file);
     let rec = read_recording(&file).unwrap();
     let reference: HashMap<u64, StateMsg> = rec
         .samples
@@ -421,15 +428,9 @@ fn a_recording_plays_back_with_seek() {
         .map(|s| decode_state(&s.payload).unwrap())
         .map(|s| (s.header.tick, s))
         .collect();
-    // Play at 20× from t = 15 s: playbackControlRequest (client binary opcode 3).
+    // Play at 20× from t = 15 s.
     let seek_ns: u64 = 15_000_000_000;
-    let mut req = vec![3u8, 0];
-    req.extend_from_slice(&20.0f32.to_le_bytes());
-    req.push(1);
-    req.extend_from_slice(&seek_ns.to_le_bytes());
-    let id = b"seek-1";
-    req.extend_from_slice(&(id.len() as u32).to_le_bytes());
-    req.extend_from_slice(id);
+    let req = playback_request(0, 20.0, Some(seek_ns), b"seek-1");
     let rt = tokio::runtime::Runtime::new().unwrap();
     let seen = rt.block_on(watch(wport, "foxglove.sdk.v1", 60, Some(req)));
     let compared = check_against(&seen, &reference);
@@ -448,6 +449,82 @@ fn a_recording_plays_back_with_seek() {
         "file: {} states received, {compared} compared with the recording, {late} after the seek",
         seen.messages[&1].len()
     );
+}
+
+/// A playbackControlRequest (client binary opcode 3): `command` 0 plays, 1 pauses; at `speed`;
+/// a seek to `seek_ns` when given.
+fn playback_request(command: u8, speed: f32, seek_ns: Option<u64>, id: &[u8]) -> Vec<u8> {
+    let mut req = vec![3u8, command];
+    req.extend_from_slice(&speed.to_le_bytes());
+    req.push(u8::from(seek_ns.is_some()));
+    req.extend_from_slice(&seek_ns.unwrap_or(0).to_le_bytes());
+    req.extend_from_slice(&(id.len() as u32).to_le_bytes());
+    req.extend_from_slice(id);
+    req
+}
+
+/// The scene describes the vehicle and is sent once a second while a replay plays; a viewer
+/// that subscribes while the replay is paused (or after it ended, when nothing plays) gets the
+/// last one at once. Before, it got none until the replay played again: a browser that opened
+/// its page late in a short replay showed the flight code's modes by number, never by name.
+/// Here the client pauses the replay, waits 1.5 s (past any periodic send), then subscribes to
+/// `/flexdyn/sc1/scene` alone, and must get one SceneUpdate within 5 s.
+#[test]
+fn a_viewer_subscribing_while_paused_gets_the_scene_at_once() {
+    let file = recording("view_paused.mcap");
+    let (_viewer, wport) = view_file(&file);
+    let rt = tokio::runtime::Runtime::new().unwrap();
+    rt.block_on(async {
+        let mut ws = connect(wport, "foxglove.sdk.v1").await;
+        let mut seen = Seen::default();
+        let scene_topic = "/flexdyn/sc1/scene";
+        pump_until(&mut ws, &mut seen, Duration::from_secs(20), |s| {
+            s.server_info.is_some() && s.channels.contains_key(scene_topic)
+        })
+        .await;
+        ws.send(Message::Binary(
+            playback_request(1, 1.0, None, b"pause").into(),
+        ))
+        .await
+        .unwrap();
+        pump_until(&mut ws, &mut seen, Duration::from_secs(10), |s| {
+            !s.playback_states.is_empty()
+        })
+        .await;
+        let quiet_until = Instant::now() + Duration::from_millis(1500);
+        while let Ok(Some(Ok(m))) = tokio::time::timeout_at(quiet_until.into(), ws.next()).await {
+            seen.take(m);
+        }
+        let (scene_id, schema, _) = seen.channels[scene_topic].clone();
+        assert_eq!(schema, "foxglove.SceneUpdate");
+        let subscribed = Instant::now();
+        ws.send(Message::Text(
+            json!({"op": "subscribe", "subscriptions": [{"id": 7, "channelId": scene_id}]})
+                .to_string()
+                .into(),
+        ))
+        .await
+        .unwrap();
+        pump_until(&mut ws, &mut seen, Duration::from_secs(5), |s| {
+            s.messages.contains_key(&7)
+        })
+        .await;
+        let (_, scene) = &seen.messages[&7][0];
+        let entities = scene["entities"]
+            .as_array()
+            .expect("a SceneUpdate has entities");
+        assert!(
+            entities
+                .iter()
+                .any(|e| e["cubes"].as_array().is_some_and(|c| !c.is_empty())),
+            "the scene draws no box: {scene}"
+        );
+        eprintln!(
+            "paused replay: the scene came {:.0} ms after the subscription",
+            subscribed.elapsed().as_secs_f64() * 1e3
+        );
+        let _ = ws.close(None).await;
+    });
 }
 
 /// Several vehicles in one view (issue 22: `view` must handle them): two servers, each a

@@ -22,10 +22,10 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use foxglove::websocket::{
-    Capability, PlaybackCommand, PlaybackControlRequest, PlaybackState, PlaybackStatus,
-    ServerListener,
+    Capability, ChannelView, Client, PlaybackCommand, PlaybackControlRequest, PlaybackState,
+    PlaybackStatus, ServerListener,
 };
-use foxglove::{Context, PartialMetadata, RawChannel, Schema, WebSocketServer};
+use foxglove::{ChannelId, Context, PartialMetadata, RawChannel, Schema, WebSocketServer};
 use zenoh::sample::SampleKind;
 
 use super::error::SinkError;
@@ -42,7 +42,8 @@ use flexdyn_proto::client::transport::{zenoh_config, Role, ZenohArgs};
 
 /// Default address of the viewer (Foxglove's default connection is `ws://localhost:8765`).
 pub const DEFAULT_BIND: &str = "127.0.0.1:8765";
-/// How often the scene is sent again, for viewers that connect later.
+/// How often the scene is sent again while a replay plays or a live stream runs. A viewer
+/// that subscribes in between gets the last one at once ([`Latched`]).
 const SCENE_PERIOD: Duration = Duration::from_secs(1);
 /// Shortest wall time between two live clock announcements. The SDK puts them on each viewer's
 /// control queue (`--backlog` long), which, unlike the data queue, does not drop its oldest:
@@ -74,9 +75,56 @@ pub struct ViewArgs {
     pub zenoh: ZenohArgs,
 }
 
+/// The last message of each channel that describes the vehicles rather than streams them (the
+/// scene and the flight code's names), by channel. The SDK sends a channel's messages only to
+/// the viewers subscribed at the time, so each viewer gets these again as it subscribes
+/// ([`Listener::on_subscribe`]): one that subscribes between two sends of [`SCENE_PERIOD`],
+/// or after a replay ended, sees them at once instead of never.
+#[derive(Default)]
+struct Latched(Mutex<HashMap<ChannelId, Kept>>);
+
+/// A latched message: its channel, its JSON and its simulation time.
+type Kept = (Arc<RawChannel>, Vec<u8>, u64);
+
+impl Latched {
+    /// Sends `json` on `channel` at simulation time `t_ns`, and keeps it for later subscribers.
+    fn log(&self, channel: &Arc<RawChannel>, json: &[u8], t_ns: u64) {
+        channel.log_with_meta(
+            json,
+            PartialMetadata {
+                log_time: Some(t_ns),
+            },
+        );
+        self.0
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .insert(channel.id(), (channel.clone(), json.to_vec(), t_ns));
+    }
+
+    /// Sends the kept message of `channel`, if any, to the viewer behind `client` alone.
+    fn resend(&self, client: &Client, channel: ChannelId) {
+        let kept = self
+            .0
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .get(&channel)
+            .cloned();
+        if let Some((c, json, t_ns)) = kept {
+            c.log_with_meta_to_sink(
+                &json,
+                PartialMetadata {
+                    log_time: Some(t_ns),
+                },
+                client.sink_id(),
+            );
+        }
+    }
+}
+
 /// Turns flexdyn samples into Foxglove channel messages.
 struct Translator {
     ctx: Arc<Context>,
+    latched: Arc<Latched>,
     channels: HashMap<String, Arc<RawChannel>>,
     geometry: HashMap<String, Geometry>,
     /// Per vehicle, its `[[fsw_streams]]` as the JSON of `/flexdyn/<sc>/fsw_streams` (only
@@ -89,9 +137,10 @@ struct Translator {
 }
 
 impl Translator {
-    fn new(ctx: Arc<Context>, filter: Vec<String>) -> Self {
+    fn new(ctx: Arc<Context>, latched: Arc<Latched>, filter: Vec<String>) -> Self {
         Self {
             ctx,
+            latched,
             channels: HashMap::new(),
             geometry: HashMap::new(),
             fsw_streams: HashMap::new(),
@@ -166,7 +215,7 @@ impl Translator {
             .collect();
         for (topic, json) in scenes {
             if let Some(c) = self.channel(&topic, scene_update_channel_schema) {
-                c.log_with_meta(json.as_bytes(), PartialMetadata { log_time: Some(t) });
+                self.latched.log(&c, json.as_bytes(), t);
             }
         }
         let dictionaries: Vec<(String, String)> = self
@@ -176,7 +225,7 @@ impl Translator {
             .collect();
         for (topic, json) in dictionaries {
             if let Some(c) = self.channel(&topic, fsw_streams_schema) {
-                c.log_with_meta(json.as_bytes(), PartialMetadata { log_time: Some(t) });
+                self.latched.log(&c, json.as_bytes(), t);
             }
         }
     }
@@ -348,11 +397,20 @@ struct Player {
     current_ns: u64,
 }
 
-struct Controls(Arc<Mutex<Player>>);
+/// The protocol's callbacks: playback control of a recording, and the latched messages sent
+/// to each new subscriber.
+struct Listener {
+    player: Arc<Mutex<Player>>,
+    latched: Arc<Latched>,
+}
 
-impl ServerListener for Controls {
+impl ServerListener for Listener {
+    fn on_subscribe(&self, client: Client, channel: ChannelView) {
+        self.latched.resend(&client, channel.id());
+    }
+
     fn on_playback_control_request(&self, req: PlaybackControlRequest) -> Option<PlaybackState> {
-        let mut p = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let mut p = self.player.lock().unwrap_or_else(|e| e.into_inner());
         p.playing = req.playback_command == PlaybackCommand::Play;
         if req.playback_speed.is_finite() && req.playback_speed > 0.0 {
             p.speed = req.playback_speed;
@@ -428,20 +486,24 @@ pub fn view(args: &ViewArgs) -> Result<ViewReport, SinkError> {
             .local_addr()
             .map_err(|e| SinkError::Runtime(format!("{host}:{port}: {e}")))?
             .port();
+        let latched = Arc::new(Latched::default());
         let mut server = WebSocketServer::new()
             .name(format!("flexdyn {}", super::mcap_file::flexdyn_version()))
             .bind("127.0.0.1", 0)
             .context(&ctx)
             .message_backlog_size(args.backlog)
-            .capabilities([Capability::Time]);
+            .capabilities([Capability::Time])
+            .listener(Arc::new(Listener {
+                player: player.clone(),
+                latched: latched.clone(),
+            }));
         if let Some(rec) = &recording {
             let first = rec.samples.iter().map(|s| s.log_time_ns).min().unwrap_or(0);
             let last = rec.samples.iter().map(|s| s.log_time_ns).max().unwrap_or(0);
             player.lock().unwrap_or_else(|e| e.into_inner()).current_ns = first;
             server = server
                 .capabilities([Capability::Time, Capability::PlaybackControl])
-                .playback_time_range(first, last)
-                .listener(Arc::new(Controls(player.clone())));
+                .playback_time_range(first, last);
         }
         let handle = Arc::new(
             server
@@ -461,7 +523,11 @@ pub fn view(args: &ViewArgs) -> Result<ViewReport, SinkError> {
         tracing::info!(
             "view: open http://{url_host}:{bound}/ in a browser, or connect Foxglove to ws://{url_host}:{bound}"
         );
-        let translator = Arc::new(Mutex::new(Translator::new(ctx.clone(), args.sc_id.clone())));
+        let translator = Arc::new(Mutex::new(Translator::new(
+            ctx.clone(),
+            latched,
+            args.sc_id.clone(),
+        )));
         let samples = Arc::new(std::sync::atomic::AtomicU64::new(0));
         let stop = async {
             let mut shutdown = std::pin::pin!(shutdown);
