@@ -22,5 +22,6 @@ mod operator_control;
 mod server_bad_input;
 mod server_cli;
 mod server_wheels;
+mod tick_handler;
 mod time_service;
 mod view_ws;

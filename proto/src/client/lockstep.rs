@@ -14,7 +14,10 @@
 //!   state and its due samples) once it is complete;
 //! - [`TickReceiver`] is the Zenoh side: **one** subscriber on `flexdyn/<sc>/tlm/**` (which
 //!   delivers in publication order) feeding an assembler, with a time limit for a sample that
-//!   never comes.
+//!   never comes. It hands each complete tick to the reader's thread
+//!   ([`TickReceiver::declare`]), or runs a [`TickHandler`] on it right where it completes, on
+//!   the Zenoh thread that delivered its last sample ([`TickReceiver::declare_with_handler`]):
+//!   no thread hop between the state and the answer, as in a Zenoh ping-pong.
 //!
 //! A sensor in a `dropout` fault publishes nothing, by design, so its due samples will not
 //! come: the assembler learns each dropout's interval from the fault events on
@@ -631,11 +634,36 @@ pub struct TickReceiver {
     pub lost: u64,
 }
 
+/// Flight code that answers each complete tick where it completes
+/// ([`TickReceiver::declare_with_handler`]).
+///
+/// `on_tick` runs on the Zenoh thread that delivered the tick's last sample, or, for a tick
+/// released without some of its samples after the sensor time limit, on the thread that calls
+/// [`TickReceiver::recv_timeout`]; never two at once, and in tick order. While it runs, that
+/// Zenoh thread delivers nothing else to the session: keep it to the flight code's own work
+/// (read, compute, publish the answer) and leave blocking I/O to another thread.
+pub trait TickHandler: Send {
+    /// Handles one complete tick (the state of its frame and its due sensor samples).
+    fn on_tick(&mut self, tick: Tick);
+}
+
+impl<F: FnMut(Tick) + Send> TickHandler for F {
+    fn on_tick(&mut self, tick: Tick) {
+        self(tick);
+    }
+}
+
+/// A handler shared between the receiver and its owner, who keeps a clone to read its state.
+pub type SharedHandler = Arc<Mutex<dyn TickHandler>>;
+
 /// What the subscriber's callback and the reader share.
 struct Shared {
     inner: Mutex<Inner>,
     /// Signalled when `ready` stops being empty.
     ready: Condvar,
+    /// With a handler, the ticks go to it instead of `ready`'s reader. Locked before `inner`
+    /// and held while the ticks it takes are handled, so they are handled in order.
+    handler: Option<SharedHandler>,
 }
 
 struct Inner {
@@ -646,6 +674,8 @@ struct Inner {
     lost: u64,
     /// Times the callback signalled the reader (once per tick that found `ready` empty).
     signals: u64,
+    /// With a handler: the ticks it was handed with samples missing.
+    incomplete: u64,
 }
 
 impl Shared {
@@ -658,6 +688,10 @@ impl Shared {
     /// The subscriber's callback: one sample into the assembler.
     fn take(&self, sample: &Sample) {
         let payload = sample.payload().to_bytes();
+        let mut handler = self
+            .handler
+            .as_ref()
+            .map(|h| h.lock().unwrap_or_else(PoisonError::into_inner));
         let mut g = self.lock();
         let was_empty = g.ready.is_empty();
         let Inner {
@@ -669,6 +703,10 @@ impl Shared {
             if g.undecodable == 1 || g.undecodable.is_multiple_of(100) {
                 tracing::warn!(key = %sample.key_expr(), error = %e, undecodable = g.undecodable, "an undecodable sample");
             }
+        }
+        if let Some(h) = handler.as_deref_mut() {
+            g.hand_over(h);
+            return;
         }
         while g.ready.len() > g.capacity {
             g.ready.pop_front();
@@ -683,15 +721,67 @@ impl Shared {
     }
 }
 
+impl Inner {
+    /// Hands the ready ticks to the handler, in order (the caller holds the handler's lock).
+    fn hand_over(&mut self, handler: &mut dyn TickHandler) {
+        while let Some(t) = self.ready.pop_front() {
+            if !t.missing.is_empty() {
+                self.incomplete += 1;
+                warn_incomplete(&t, self.incomplete);
+            }
+            handler.on_tick(t);
+        }
+    }
+}
+
+/// Warns of a tick handed out without some of its samples (the first, then every 100th).
+fn warn_incomplete(t: &Tick, incomplete: u64) {
+    if incomplete == 1 || incomplete.is_multiple_of(100) {
+        tracing::warn!(
+            tick = t.tick(),
+            missing = ?t.missing,
+            incomplete,
+            "a tick without all its sensor samples"
+        );
+    }
+}
+
 impl TickReceiver {
     /// Subscribes to the telemetry of `topics` (do it before declaring a lockstep
-    /// participant's liveliness token, so tick 0 cannot be missed).
+    /// participant's liveliness token, so tick 0 cannot be missed); the reader takes the
+    /// complete ticks with [`Self::recv_timeout`].
     pub fn declare(
         session: &Session,
         topics: &Topics,
         schedule: SensorSchedule,
         capacity: usize,
         sensor_timeout: Duration,
+    ) -> zenoh::Result<Self> {
+        Self::declare_inner(session, topics, schedule, capacity, sensor_timeout, None)
+    }
+
+    /// Like [`Self::declare`], but each complete tick goes to `handler` on the Zenoh thread
+    /// that completed it ([`TickHandler`]), instead of waking a reader: the answer leaves
+    /// without a hop between threads. Keep calling [`Self::recv_timeout`] (it returns `None`):
+    /// it releases a tick whose samples are overdue to the handler, and is where the owner
+    /// notices the end of the run. The owner keeps a clone of `handler` to read its state.
+    pub fn declare_with_handler(
+        session: &Session,
+        topics: &Topics,
+        schedule: SensorSchedule,
+        sensor_timeout: Duration,
+        handler: SharedHandler,
+    ) -> zenoh::Result<Self> {
+        Self::declare_inner(session, topics, schedule, 1, sensor_timeout, Some(handler))
+    }
+
+    fn declare_inner(
+        session: &Session,
+        topics: &Topics,
+        schedule: SensorSchedule,
+        capacity: usize,
+        sensor_timeout: Duration,
+        handler: Option<SharedHandler>,
     ) -> zenoh::Result<Self> {
         let shared = Arc::new(Shared {
             inner: Mutex::new(Inner {
@@ -701,8 +791,10 @@ impl TickReceiver {
                 undecodable: 0,
                 lost: 0,
                 signals: 0,
+                incomplete: 0,
             }),
             ready: Condvar::new(),
+            handler,
         });
         let feed = shared.clone();
         let subscriber = session
@@ -733,27 +825,34 @@ impl TickReceiver {
     }
 
     /// The next tick, waiting at most `timeout` for it; `Ok(None)` if none is complete by then.
+    /// With a handler ([`Self::declare_with_handler`]) it hands a tick released after the
+    /// sensor time limit to the handler, and returns `Ok(None)` at `timeout`.
     /// (It never fails today; the `Result` is kept for the callers written against the
     /// channel-backed receiver.)
     pub fn recv_timeout(&mut self, timeout: Duration) -> zenoh::Result<Option<Tick>> {
         let deadline = Instant::now() + timeout;
         let shared = self.shared.clone();
+        // With a handler, its lock comes first (the callback's order); it is taken only for a
+        // release, so the callbacks run freely while this waits.
         let mut g = shared.lock();
         loop {
             self.undecodable = g.undecodable;
             self.lost = g.lost;
-            if let Some(t) = g.ready.pop_front() {
+            if let Some(handler) = &shared.handler {
+                if !g.ready.is_empty() {
+                    drop(g);
+                    let mut h = handler.lock().unwrap_or_else(PoisonError::into_inner);
+                    g = shared.lock();
+                    g.hand_over(&mut *h);
+                    self.incomplete = g.incomplete;
+                    continue;
+                }
+                self.incomplete = g.incomplete;
+            } else if let Some(t) = g.ready.pop_front() {
                 drop(g);
                 if !t.missing.is_empty() {
                     self.incomplete += 1;
-                    if self.incomplete == 1 || self.incomplete.is_multiple_of(100) {
-                        tracing::warn!(
-                            tick = t.tick(),
-                            missing = ?t.missing,
-                            incomplete = self.incomplete,
-                            "a tick without all its sensor samples"
-                        );
-                    }
+                    warn_incomplete(&t, self.incomplete);
                 }
                 return Ok(Some(t));
             }
