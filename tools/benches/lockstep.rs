@@ -4,7 +4,8 @@
 //! 1. ping-pong: this process pings (a StateMsg-sized sample), `flexdyn-pingpong pong` (a child
 //!    process) answers with a CommandMsg-sized sample;
 //! 2. lockstep, one RK4 step per frame (1 kHz frames): the server in this process, the demo
-//!    controller `flexdyn-acs-demo` as a child process, once with `handoff = "direct"` (the
+//!    controller `flexdyn-acs-demo` as a child process (answering each tick on the Zenoh thread
+//!    that completes it, its default `--handoff direct`), once with `handoff = "direct"` (the
 //!    default: the Zenoh thread that delivers the answer steps and publishes) and once with
 //!    `handoff = "thread"` (the previous design: physics thread + telemetry thread), so the
 //!    before and after are measured side by side;
@@ -12,6 +13,9 @@
 //! 4. case 2, direct, with the demo publishing the flight code's telemetry every tick (a declared
 //!    `[[fsw_streams]]`: one FswMsg per tick, 1 kHz), against case 2 without it in the same
 //!    round: what the telemetry intake costs the loop (issue 37).
+//! 5. case 2, direct, with the demo answering on its main thread (`--handoff thread`, its
+//!    design before it answered on the Zenoh thread that completes the tick): the client's own
+//!    thread hop, side by side.
 //!
 //! It prints each round and the medians: round trips/s, ticks/s, and the median of the per-round
 //! ratios (target ≥ 0.95 × the ping-pong for the one-step case, where the link dominates).
@@ -62,9 +66,26 @@ values = [
 ]
 ";
 
-/// Ticks per second of a lockstep run of `ticks` frames at `frame_hz` with the demo controller.
+/// Ticks per second of a lockstep run of `ticks` frames at `frame_hz` with the demo controller
+/// answering on the Zenoh thread that delivered the tick (its default `--handoff direct`).
 fn lockstep_rate(ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
-    lockstep_rate_of(ticks, reference_config(frame_hz), handoff, false)
+    lockstep_rate_of(
+        ticks,
+        reference_config(frame_hz),
+        handoff,
+        DemoHandoff::Direct,
+    )
+}
+
+/// Which thread of the demo answers a tick (its `--handoff`).
+#[derive(Clone, Copy, PartialEq)]
+enum DemoHandoff {
+    /// The Zenoh thread that completed the tick.
+    Direct,
+    /// Its main thread, woken by the Zenoh thread (the previous design).
+    Thread,
+    /// Direct, and it publishes its telemetry every tick ([`FSW_STREAM`]).
+    DirectWithTelemetry,
 }
 
 /// [`lockstep_rate`] with the demo publishing its telemetry every tick ([`FSW_STREAM`]).
@@ -73,7 +94,7 @@ fn lockstep_rate_with_telemetry(ticks: usize, frame_hz: f64) -> f64 {
         ticks,
         support::reference_config_with(frame_hz, FSW_STREAM),
         Handoff::Direct,
-        true,
+        DemoHandoff::DirectWithTelemetry,
     )
 }
 
@@ -81,7 +102,7 @@ fn lockstep_rate_of(
     ticks: usize,
     cfg: flexdyn_vehicle::config::SimConfig,
     handoff: Handoff,
-    expect_telemetry: bool,
+    demo: DemoHandoff,
 ) -> f64 {
     let settings = ServerSettings {
         mode: Mode::Lockstep,
@@ -102,9 +123,15 @@ fn lockstep_rate_of(
         "0",
         "--rate-source",
         "truth",
+        "--handoff",
+        if demo == DemoHandoff::Thread {
+            "thread"
+        } else {
+            "direct"
+        },
     ]));
     let report = server.join(Duration::from_secs(300)).expect("lockstep run");
-    if expect_telemetry {
+    if demo == DemoHandoff::DirectWithTelemetry {
         // The demo answers ticks 0..last; the last tick's sample is not recorded (a lockstep
         // run awaits no answer to it).
         assert_eq!(
@@ -141,6 +168,7 @@ fn main() {
     let (mut ratio1, mut ratio1l, mut ratiot, mut ratior) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut lsf, mut ratiof) = (Vec::new(), Vec::new());
+    let (mut lsd, mut ratiod) = (Vec::new(), Vec::new());
     for r in 0..rounds {
         let p = pingpong_rate(ticks, false);
         let pl = pingpong_rate(ticks, true);
@@ -148,6 +176,19 @@ fn main() {
         let t = lockstep_rate(ticks, 1000.0, Handoff::Thread);
         let b = lockstep_rate(ticks / 4, 100.0, Handoff::Direct);
         let f = lockstep_rate_with_telemetry(ticks, 1000.0);
+        let d = lockstep_rate_of(
+            ticks,
+            reference_config(1000.0),
+            Handoff::Direct,
+            DemoHandoff::Thread,
+        );
+        println!(
+            "round {r}: lockstep 1 step/frame, direct, the demo answering on its main thread \
+             (--handoff thread): {d:.0} ticks/s (ratio {:.2})",
+            d / p
+        );
+        lsd.push(d);
+        ratiod.push(d / p);
         println!(
             "round {r}: lockstep 1 step/frame, direct, the demo publishing its telemetry every \
              tick: {f:.0} ticks/s (ratio to without {:.2})",
@@ -213,6 +254,12 @@ fn main() {
         "median lockstep ticks/s, 1 RK4 step per frame, direct, with the flight code's telemetry \
          (one FswMsg per tick, 1 kHz): {f:.0} ({:.1} us/tick); median ratio to without {rf:.2}",
         1e6 / f
+    );
+    let (d, rd) = (median_mut(&mut lsd), median_mut(&mut ratiod));
+    println!(
+        "median lockstep ticks/s, 1 RK4 step per frame, direct, the demo answering on its main \
+         thread (before): {d:.0} ({:.1} us/tick); median ratio {rd:.2}",
+        1e6 / d
     );
     println!("physics alone per frame: {phys1:.1} us (1 step), {phys10:.1} us (10 steps)");
 }

@@ -84,6 +84,7 @@
 //! control law. Everything on the wire comes from the `flexdyn-proto` crate (see
 //! `proto/README.md` for C and Python byte layouts).
 
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context as _};
@@ -96,7 +97,7 @@ use flexdyn_acs_demo::sequence::{AcsSequence, Gains, SequenceSetup};
 use flexdyn_acs_demo::telemetry::{ControllerTick, Telemetry};
 use flexdyn_proto::attitude::mrp_error;
 use flexdyn_proto::client::cli::{exit_with, stop_on_signals, usage, CommonArgs};
-use flexdyn_proto::client::lockstep::{SensorSchedule, TickReceiver};
+use flexdyn_proto::client::lockstep::{SensorSchedule, Tick, TickHandler, TickReceiver};
 use flexdyn_proto::client::participant::Participant;
 use flexdyn_proto::client::run_end::RunEnd;
 use flexdyn_proto::client::vehicle::{Vehicle, VehicleConfig};
@@ -212,6 +213,20 @@ struct Args {
     /// The gyro monitor's window W [s] (rounded to whole star-tracker periods).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     fdir_window_s: f64,
+    /// Where each tick is answered: `direct` on the Zenoh thread that delivered its last
+    /// sample (no thread hop between the state and the command, as in a Zenoh ping-pong);
+    /// `thread` on the main thread, which the Zenoh thread wakes per tick.
+    #[arg(long, value_enum, default_value_t = Handoff::Direct)]
+    handoff: Handoff,
+}
+
+/// Which thread answers a tick.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum Handoff {
+    /// The Zenoh thread that completed the tick.
+    Direct,
+    /// The main thread.
+    Thread,
 }
 
 /// What the controller commands.
@@ -663,16 +678,15 @@ fn run(args: Args) -> anyhow::Result<()> {
     };
     let cfg = vehicle.config()?;
     let schedule = SensorSchedule::from_config(&cfg)?;
-    let mut telemetry = Telemetry::declare(&session, &topics, &vehicle, &args.fsw_stream)?;
+    let telemetry = Telemetry::declare(&session, &topics, &vehicle, &args.fsw_stream)?;
     let frame_s = (1e9 / cfg.simulation.frame_hz).round() * 1e-9;
-    let mut gyro = gyro(&args, &cfg, &schedule)?;
-    let mut wheels = match args.actuator {
+    let gyro = gyro(&args, &cfg, &schedule)?;
+    let wheels = match args.actuator {
         Actuator::Wrench => None,
         Actuator::Wheels => Some((WheelArray::from_config(&cfg)?, inertia_about_b(&cfg)?)),
     };
-    let mut sequence = sequence(&args, &cfg, &schedule)?;
-    let mut last_t_ns = 0u64;
-    let mut tracker = match (args.attitude_source, &args.star_tracker) {
+    let sequence = sequence(&args, &cfg, &schedule)?;
+    let tracker = match (args.attitude_source, &args.star_tracker) {
         (AttitudeSource::StarTracker, Some(name)) => {
             let est = StarTrackerAttitude::from_config(&cfg, name)?;
             let index = schedule
@@ -685,7 +699,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         _ => None,
     };
 
-    let mut fdir = match (args.fdir, &args.imu, &args.star_tracker) {
+    let fdir = match (args.fdir, &args.imu, &args.star_tracker) {
         (true, Some(imu), Some(st)) => Some(Fdir {
             gyro: GyroFdir::new(&cfg, &schedule, imu, st, args.fdir_window_s)?,
             wheels: WheelFdir::new(&cfg)?,
@@ -702,24 +716,52 @@ fn run(args: Args) -> anyhow::Result<()> {
         );
     }
 
-    // 3. The end of the run (the server's last status), then the telemetry: one subscriber on flexdyn/<sc>/tlm/**, assembled into complete ticks.
-    //    Declared before the token, so the server cannot publish tick 0 before we can receive
-    //    it. At most 256 complete ticks wait for us: in real time, if we ever fall behind, the
-    //    oldest ticks go (counted in `ticks.lost`).
+    // 3. The end of the run (the server's last status), then the telemetry: one subscriber on
+    //    flexdyn/<sc>/tlm/**, assembled into complete ticks. Declared before the token, so the
+    //    server cannot publish tick 0 before we can receive it. `--handoff direct` answers each
+    //    tick on the Zenoh thread that completed it; `thread` queues at most 256 complete ticks
+    //    for this thread (in real time, if it ever falls behind, the oldest go: `ticks.lost`).
     let run_end = RunEnd::declare(&session, &topics)
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.status()))?;
-    let mut ticks = TickReceiver::declare(
-        &session,
-        &topics,
-        schedule,
-        256,
-        Duration::from_secs_f64(args.sensor_timeout_s),
-    )
-    .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.telemetry_wildcard()))?;
+    let flight = Arc::new(Mutex::new(Flight {
+        sender_id: args.sender_id,
+        controller,
+        frame_s,
+        log_every_ns: (args.log_every_s.max(0.0) * 1e9) as u64,
+        next_log_ns: 0,
+        sequence,
+        last_sequence_output: None,
+        telemetry,
+        gyro,
+        tracker,
+        wheels,
+        fdir,
+        participant: None,
+        pending: Vec::new(),
+        buf: Vec::with_capacity(128),
+        seq: 0,
+        states_received: 0,
+        last_state_at: Instant::now(),
+        last_t_ns: 0,
+        failed: None,
+    }));
+    let sensor_timeout = Duration::from_secs_f64(args.sensor_timeout_s);
+    let declared = match args.handoff {
+        Handoff::Direct => TickReceiver::declare_with_handler(
+            &session,
+            &topics,
+            schedule,
+            sensor_timeout,
+            flight.clone(),
+        ),
+        Handoff::Thread => TickReceiver::declare(&session, &topics, schedule, 256, sensor_timeout),
+    };
+    let mut ticks = declared
+        .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.telemetry_wildcard()))?;
 
     // 4. The command publisher, Block (never drop) and express (no batching: lowest latency),
     // 5. then the liveliness token that announces us to a lockstep server (harmless in real
-    //    time).
+    //    time). A tick that completed before the publisher was in place is answered now.
     let participant = Participant::declare(&session, &topics, args.sender_id)?;
     tracing::info!(
         sender_id = args.sender_id,
@@ -728,27 +770,30 @@ fn run(args: Args) -> anyhow::Result<()> {
         sigma_rn = ?controller.sigma_rn.as_slice(),
         telemetry = topics.telemetry_wildcard(),
         commands = participant.key(),
+        handoff = ?args.handoff,
         "flexdyn-acs-demo running"
     );
+    lock(&flight).start(participant);
 
     // 6. The loop: one command per tick, until the server ends the run, SIGINT/SIGTERM or
     //    --idle-exit-s.
-    let log_every_ns = (args.log_every_s.max(0.0) * 1e9) as u64;
-    let mut next_log_ns = 0u64;
-    let mut seq = 0u64;
-    let mut buf = Vec::with_capacity(128);
-    let mut states_received = 0u64;
-    let mut last_state_at = Instant::now();
-    let mut last_sequence_output = None;
     let mut ended = None;
     loop {
         if stop.load(std::sync::atomic::Ordering::Relaxed) {
+            let states_received = lock(&flight).states_received;
             tracing::info!(states_received, "stop signal: closing the session");
             break;
         }
+        let (states_before, last_state_at) = {
+            let mut f = lock(&flight);
+            if let Some(e) = f.failed.take() {
+                return Err(e);
+            }
+            (f.states_received, f.last_state_at)
+        };
         if let Some(d) = idle {
             if last_state_at.elapsed() >= d {
-                if states_received == 0 {
+                if states_before == 0 {
                     bail!(
                         "no state received on {} within {} s (--idle-exit-s): the server \
                          answered but published nothing",
@@ -757,7 +802,7 @@ fn run(args: Args) -> anyhow::Result<()> {
                     );
                 }
                 tracing::info!(
-                    states_received,
+                    states_received = states_before,
                     "no state for {} s; exiting",
                     d.as_secs_f64()
                 );
@@ -765,50 +810,125 @@ fn run(args: Args) -> anyhow::Result<()> {
             }
         }
         // Wake every 20 ms to notice the end of the run, a signal or the idle limit. Once the
-        // server has said the run ended, every frame it published is on its way: take what is
-        // still queued, then stop when nothing more comes within that slice.
-        let Some(tick) = ticks
+        // server has said the run ended, every frame it published is on its way: answer what
+        // still comes, then stop after a slice in which nothing did.
+        if let Some(tick) = ticks
             .recv_timeout(Duration::from_millis(20))
             .map_err(|e| anyhow::anyhow!("{e}"))?
-        else {
-            if let Some(end) = run_end.ended() {
-                tracing::info!(
-                    states_received,
-                    tick = end.tick,
-                    after_ms = end.heard_at.elapsed().as_secs_f64() * 1e3,
-                    "the server reports the run {}: exiting",
-                    end.word()
-                );
-                ended = Some(end);
-                break;
-            }
+        {
+            lock(&flight).on_tick(tick);
             continue;
-        };
-        states_received += 1;
-        last_state_at = Instant::now();
+        }
+        if lock(&flight).states_received != states_before {
+            continue;
+        }
+        if let Some(end) = run_end.ended() {
+            tracing::info!(
+                states_received = states_before,
+                tick = end.tick,
+                after_ms = end.heard_at.elapsed().as_secs_f64() * 1e3,
+                "the server reports the run {}: exiting",
+                end.word()
+            );
+            ended = Some(end);
+            break;
+        }
+    }
+    // Undeclare the token first (a lockstep server sees us leave), then the subscribers, then
+    // close the session.
+    let participant = {
+        let mut f = lock(&flight);
+        if let Some(e) = f.failed.take() {
+            return Err(e);
+        }
+        if let Some(fsw) = &f.sequence {
+            print_sequence_summary(fsw, f.last_sequence_output.as_ref(), f.last_t_ns);
+        }
+        if let Some(fdir) = &f.fdir {
+            print_fdir_summary(fdir);
+        }
+        f.participant.take()
+    };
+    drop(participant);
+    drop(ticks);
+    drop(run_end);
+    close(session)?;
+    flexdyn_proto::client::run_end::outcome(ended)
+}
+
+/// The flight code of one run: what it answers each tick with, and what it has seen. It runs
+/// on the Zenoh thread that completed the tick (`--handoff direct`) or on the main thread
+/// (`thread`), one tick at a time behind its mutex.
+struct Flight {
+    sender_id: u32,
+    controller: Controller,
+    /// [s] the frame period (the star tracker's propagation step).
+    frame_s: f64,
+    log_every_ns: u64,
+    next_log_ns: u64,
+    sequence: Option<AcsSequence>,
+    last_sequence_output: Option<flexdyn_acs_demo::sequence::Output>,
+    telemetry: Option<Telemetry>,
+    gyro: Option<GyroFeedback>,
+    tracker: Option<(StarTrackerAttitude, usize)>,
+    wheels: Option<(WheelArray, Matrix3<f64>)>,
+    fdir: Option<Fdir>,
+    /// The command publisher and the liveliness token, once declared ([`Self::start`]).
+    participant: Option<Participant>,
+    /// Ticks that completed before the participant was declared, answered by [`Self::start`].
+    pending: Vec<Tick>,
+    buf: Vec<u8>,
+    seq: u64,
+    states_received: u64,
+    last_state_at: Instant,
+    last_t_ns: u64,
+    /// The first error; the run stops on it and later ticks go unanswered.
+    failed: Option<anyhow::Error>,
+}
+
+/// The flight code, locked (a panic while it was held leaves it usable).
+fn lock(flight: &Mutex<Flight>) -> MutexGuard<'_, Flight> {
+    flight.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+impl Flight {
+    /// Takes the declared participant and answers the ticks that waited for it.
+    fn start(&mut self, participant: Participant) {
+        self.participant = Some(participant);
+        for tick in std::mem::take(&mut self.pending) {
+            self.on_tick(tick);
+        }
+    }
+
+    /// Answers one tick: the flight code's telemetry of the tick, then its command.
+    fn answer(&mut self, tick: &Tick) -> anyhow::Result<()> {
+        self.states_received += 1;
+        self.last_state_at = Instant::now();
         let state = &tick.state;
         let h = state.header;
 
         // The rate feedback: this tick's gyro sample, or truth.
-        last_t_ns = h.sim_time_ns;
+        self.last_t_ns = h.sim_time_ns;
 
         // The whole ACS sequence: its own sensors, modes and actuators.
-        if let Some(fsw) = &mut sequence {
-            let out = fsw.step(&tick)?;
+        if let Some(fsw) = &mut self.sequence {
+            let out = fsw.step(tick)?;
             print_sequence_events(&out);
-            let out = last_sequence_output.insert(out);
+            let out = self.last_sequence_output.insert(out);
             // The flight code's telemetry of this tick goes out before its answer.
-            if let Some(t) = &mut telemetry {
+            if let Some(t) = &mut self.telemetry {
                 t.sequence(h.tick, h.sim_time_ns, out)?;
             }
-            let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
+            let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, self.seq);
             let inputs = std::mem::take(&mut out.inputs);
-            let cmd = CommandMsg::actuators(header, args.sender_id, [0.0; 3], [0.0; 3], inputs);
-            participant
-                .send(&cmd, &mut buf)
+            let cmd = CommandMsg::actuators(header, self.sender_id, [0.0; 3], [0.0; 3], inputs);
+            self.participant
+                .as_ref()
+                .context("no command publisher yet")?
+                .send(&cmd, &mut self.buf)
                 .map_err(|e| anyhow::anyhow!("cannot publish the command: {e}"))?;
-            seq += 1;
-            if log_every_ns > 0 && h.sim_time_ns >= next_log_ns {
+            self.seq += 1;
+            if self.log_every_ns > 0 && h.sim_time_ns >= self.next_log_ns {
                 tracing::info!(
                     tick = h.tick,
                     t_s = h.sim_time_ns as f64 / 1e9,
@@ -817,49 +937,52 @@ fn run(args: Args) -> anyhow::Result<()> {
                     wheel_momentum_nms = out.wheel_momentum_b_nms.norm(),
                     "sequence"
                 );
-                next_log_ns = h.sim_time_ns.saturating_add(log_every_ns);
+                self.next_log_ns = h.sim_time_ns.saturating_add(self.log_every_ns);
             }
-            continue;
+            return Ok(());
         }
 
-        let rate_b = match (&mut fdir, &mut gyro) {
+        let rate_b = match (&mut self.fdir, &mut self.gyro) {
             (Some(f), _) => f
                 .gyro
-                .update(&tick, &mut f.events)
+                .update(tick, &mut f.events)
                 .with_context(|| format!("no gyro rate for tick {} (no sample yet)", h.tick))?,
             (None, Some(g)) => g.rate_for(h.tick, tick.imus[g.index].as_ref())?,
             (None, None) => Vector3::from(state.omega_bn_b_rad_s),
         };
         // The attitude: truth, or the star tracker's (propagated with the rate between updates).
-        let sigma_bn = match &mut tracker {
-            Some((est, index)) => est.update(tick.star_trackers[*index].as_ref(), &rate_b, frame_s),
+        let sigma_bn = match &mut self.tracker {
+            Some((est, index)) => {
+                est.update(tick.star_trackers[*index].as_ref(), &rate_b, self.frame_s)
+            }
             None => Some(Vector3::from(state.sigma_bn)),
         };
 
         // Answer with the state's spacecraft id, tick and sim time; our own sequence number.
-        let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, seq);
+        let header = Header::new(h.spacecraft_id, h.tick, h.sim_time_ns, self.seq);
         let mut wheel_momentum_b_nms = Vector3::zeros();
-        let (cmd, torque_b_nm) = match (sigma_bn, &mut wheels) {
+        let controller = self.controller;
+        let (cmd, torque_b_nm) = match (sigma_bn, &mut self.wheels) {
             // No attitude yet (the star tracker has not given a valid one): answer the tick.
             (None, _) => {
-                if let Some(f) = &mut fdir {
+                if let Some(f) = &mut self.fdir {
                     f.wheels.uncommanded();
                 }
                 (
-                    CommandMsg::no_command(header, args.sender_id),
+                    CommandMsg::no_command(header, self.sender_id),
                     Vector3::zeros(),
                 )
             }
             (Some(sigma_bn), None) => {
                 let t = controller.torque_b_nm(&sigma_bn, &rate_b);
                 (
-                    CommandMsg::wrench(header, args.sender_id, t.into(), [0.0; 3]),
+                    CommandMsg::wrench(header, self.sender_id, t.into(), [0.0; 3]),
                     t,
                 )
             }
             (Some(sigma_bn), Some((array, inertia))) => {
                 let speeds = array.speeds(state)?;
-                if let Some(f) = &mut fdir {
+                if let Some(f) = &mut self.fdir {
                     if f.wheels.check(&speeds, &mut f.events).is_some() {
                         *array = array.without(&f.wheels.failed_list())?;
                         f.events.push(Event::Wheels {
@@ -877,12 +1000,12 @@ fn run(args: Args) -> anyhow::Result<()> {
                     &wheel_momentum_b_nms,
                 );
                 let u = array.motor_torques(&l);
-                if let Some(f) = &mut fdir {
+                if let Some(f) = &mut self.fdir {
                     f.wheels.commanded(&speeds, &u);
                 }
                 let cmd = CommandMsg::actuators(
                     header,
-                    args.sender_id,
+                    self.sender_id,
                     [0.0; 3],
                     [0.0; 3],
                     array.inputs(&u),
@@ -891,26 +1014,28 @@ fn run(args: Args) -> anyhow::Result<()> {
             }
         };
         // The flight code's telemetry of this tick goes out before its answer.
-        if let Some(t) = &mut telemetry {
+        if let Some(t) = &mut self.telemetry {
             let c = ControllerTick {
                 sigma_bn,
                 sigma_rn: controller.sigma_rn,
                 rate_b_rad_s: rate_b,
                 wheel_momentum_b_nms,
-                fdir_events: fdir.as_ref().map_or(&[], |f| f.events.as_slice()),
+                fdir_events: self.fdir.as_ref().map_or(&[], |f| f.events.as_slice()),
             };
             t.controller(h.tick, h.sim_time_ns, &c)?;
         }
-        participant
-            .send(&cmd, &mut buf)
+        self.participant
+            .as_ref()
+            .context("no command publisher yet")?
+            .send(&cmd, &mut self.buf)
             .map_err(|e| anyhow::anyhow!("cannot publish the command: {e}"))
             .context("publishing")?;
-        seq += 1;
-        if let Some(f) = &mut fdir {
+        self.seq += 1;
+        if let Some(f) = &mut self.fdir {
             print_fdir_events(h.tick, h.sim_time_ns, &mut f.events);
         }
 
-        if log_every_ns > 0 && h.sim_time_ns >= next_log_ns {
+        if self.log_every_ns > 0 && h.sim_time_ns >= self.next_log_ns {
             tracing::info!(
                 tick = h.tick,
                 t_s = h.sim_time_ns as f64 / 1e9,
@@ -919,21 +1044,25 @@ fn run(args: Args) -> anyhow::Result<()> {
                 torque_b_nm = ?torque_b_nm.as_slice(),
                 "control"
             );
-            next_log_ns = h.sim_time_ns.saturating_add(log_every_ns);
+            self.next_log_ns = h.sim_time_ns.saturating_add(self.log_every_ns);
+        }
+        Ok(())
+    }
+}
+
+impl TickHandler for Flight {
+    fn on_tick(&mut self, tick: Tick) {
+        if self.failed.is_some() {
+            return;
+        }
+        if self.participant.is_none() {
+            self.pending.push(tick);
+            return;
+        }
+        if let Err(e) = self.answer(&tick) {
+            self.failed = Some(e);
         }
     }
-    if let Some(fsw) = &sequence {
-        print_sequence_summary(fsw, last_sequence_output.as_ref(), last_t_ns);
-    }
-    if let Some(f) = &fdir {
-        print_fdir_summary(f);
-    }
-    // Undeclare the token first (a lockstep server sees us leave), then close the session.
-    drop(participant);
-    drop(ticks);
-    drop(run_end);
-    close(session)?;
-    flexdyn_proto::client::run_end::outcome(ended)
 }
 
 fn close(session: Session) -> anyhow::Result<()> {
