@@ -29,6 +29,8 @@ struct Answer {
     participant: Option<Participant>,
     buf: Vec<u8>,
     seen: Vec<(u64, Vec<String>)>,
+    /// When each tick was handled.
+    at: Vec<Instant>,
     threads: HashSet<ThreadId>,
 }
 
@@ -36,6 +38,7 @@ impl TickHandler for Answer {
     fn on_tick(&mut self, tick: Tick) {
         let k = tick.tick();
         self.seen.push((k, tick.missing.clone()));
+        self.at.push(Instant::now());
         self.threads.insert(std::thread::current().id());
         let h = Header::new(1, k, tick.state.header.sim_time_ns, k);
         self.participant
@@ -73,6 +76,7 @@ fn run(
         participant: None,
         buf: Vec::new(),
         seen: Vec::new(),
+        at: Vec::new(),
         threads: HashSet::new(),
     }));
     let mut receiver = TickReceiver::declare_with_handler(
@@ -83,7 +87,11 @@ fn run(
         answer.clone(),
     )
     .unwrap();
-    answer.lock().unwrap().participant = Some(Participant::declare(&session, &topics, 1).unwrap());
+    // Under the handler's lock: tick 0 can come as soon as the token exists.
+    {
+        let mut a = answer.lock().unwrap();
+        a.participant = Some(Participant::declare(&session, &topics, 1).unwrap());
+    }
     let give_up = Instant::now() + Duration::from_secs(60);
     while answer.lock().unwrap().seen.last().map(|s| s.0) != Some(ticks) {
         assert!(
@@ -135,7 +143,8 @@ fn a_handler_answers_each_tick_where_it_completes() {
 
 /// The client expects an IMU `ghost` the server does not have, so no tick completes: each is
 /// released after the 100 ms sensor limit by `recv_timeout`, on the caller's thread, and
-/// reaches the handler in order with `imu/ghost` missing.
+/// reaches the handler in order with `imu/ghost` missing. The server publishes tick k + 1 only
+/// once tick k is answered, so consecutive answers are at least the limit apart.
 #[test]
 fn a_tick_released_after_the_sensor_limit_goes_to_the_handler() {
     let hub = WHEELS
@@ -155,6 +164,16 @@ fn a_tick_released_after_the_sensor_limit_goes_to_the_handler() {
         .collect();
     assert_eq!(answer.seen, want);
     assert_eq!(incomplete, ticks + 1);
+    let gaps: Vec<Duration> = answer.at.windows(2).map(|p| p[1] - p[0]).collect();
+    eprintln!("sensor limit 100 ms: answers {gaps:?} apart");
+    for (k, pair) in answer.at.windows(2).enumerate() {
+        let gap = pair[1] - pair[0];
+        assert!(
+            gap >= Duration::from_millis(100),
+            "tick {} was answered {gap:?} after tick {k}, within the sensor limit",
+            k + 1
+        );
+    }
     assert_eq!(
         answer.threads,
         HashSet::from([std::thread::current().id()]),

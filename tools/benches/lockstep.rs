@@ -5,7 +5,8 @@
 //!    process) answers with a CommandMsg-sized sample;
 //! 2. lockstep, one RK4 step per frame (1 kHz frames): the server in this process, the demo
 //!    controller `flexdyn-acs-demo` as a child process (answering each tick on the Zenoh thread
-//!    that completes it, its default `--handoff direct`), once with `handoff = "direct"` (the
+//!    that completes it, its default `--answer-on zenoh-thread`), once with the server's
+//!    `handoff = "direct"` (the
 //!    default: the Zenoh thread that delivers the answer steps and publishes) and once with
 //!    `handoff = "thread"` (the previous design: physics thread + telemetry thread), so the
 //!    before and after are measured side by side;
@@ -13,9 +14,9 @@
 //! 4. case 2, direct, with the demo publishing the flight code's telemetry every tick (a declared
 //!    `[[fsw_streams]]`: one FswMsg per tick, 1 kHz), against case 2 without it in the same
 //!    round: what the telemetry intake costs the loop (issue 37).
-//! 5. case 2, direct, with the demo answering on its main thread (`--handoff thread`, its
-//!    design before it answered on the Zenoh thread that completes the tick): the client's own
-//!    thread hop, side by side.
+//! 5. case 2, direct, with the demo answering on its main thread (`--answer-on main-thread`,
+//!    its design before it answered on the Zenoh thread that completes the tick): the client's
+//!    own thread hop, side by side.
 //!
 //! It prints each round and the medians: round trips/s, ticks/s, and the median of the per-round
 //! ratios (target ≥ 0.95 × the ping-pong for the one-step case, where the link dominates).
@@ -67,25 +68,16 @@ values = [
 ";
 
 /// Ticks per second of a lockstep run of `ticks` frames at `frame_hz` with the demo controller
-/// answering on the Zenoh thread that delivered the tick (its default `--handoff direct`).
+/// answering on the Zenoh thread that delivered the tick (its default `--answer-on
+/// zenoh-thread`).
 fn lockstep_rate(ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
     lockstep_rate_of(
         ticks,
         reference_config(frame_hz),
         handoff,
-        DemoHandoff::Direct,
+        "zenoh-thread",
+        false,
     )
-}
-
-/// Which thread of the demo answers a tick (its `--handoff`).
-#[derive(Clone, Copy, PartialEq)]
-enum DemoHandoff {
-    /// The Zenoh thread that completed the tick.
-    Direct,
-    /// Its main thread, woken by the Zenoh thread (the previous design).
-    Thread,
-    /// Direct, and it publishes its telemetry every tick ([`FSW_STREAM`]).
-    DirectWithTelemetry,
 }
 
 /// [`lockstep_rate`] with the demo publishing its telemetry every tick ([`FSW_STREAM`]).
@@ -94,15 +86,20 @@ fn lockstep_rate_with_telemetry(ticks: usize, frame_hz: f64) -> f64 {
         ticks,
         support::reference_config_with(frame_hz, FSW_STREAM),
         Handoff::Direct,
-        DemoHandoff::DirectWithTelemetry,
+        "zenoh-thread",
+        true,
     )
 }
 
+/// Ticks per second of a lockstep run of `ticks` frames of `cfg`, the server stepping with
+/// `handoff`, the demo answering on `answer_on` (its `--answer-on`); with `expect_telemetry`,
+/// checks that the demo's telemetry came every answered tick.
 fn lockstep_rate_of(
     ticks: usize,
     cfg: flexdyn_vehicle::config::SimConfig,
     handoff: Handoff,
-    demo: DemoHandoff,
+    answer_on: &str,
+    expect_telemetry: bool,
 ) -> f64 {
     let settings = ServerSettings {
         mode: Mode::Lockstep,
@@ -123,15 +120,11 @@ fn lockstep_rate_of(
         "0",
         "--rate-source",
         "truth",
-        "--handoff",
-        if demo == DemoHandoff::Thread {
-            "thread"
-        } else {
-            "direct"
-        },
+        "--answer-on",
+        answer_on,
     ]));
     let report = server.join(Duration::from_secs(300)).expect("lockstep run");
-    if demo == DemoHandoff::DirectWithTelemetry {
+    if expect_telemetry {
         // The demo answers ticks 0..last; the last tick's sample is not recorded (a lockstep
         // run awaits no answer to it).
         assert_eq!(
@@ -180,11 +173,12 @@ fn main() {
             ticks,
             reference_config(1000.0),
             Handoff::Direct,
-            DemoHandoff::Thread,
+            "main-thread",
+            false,
         );
         println!(
             "round {r}: lockstep 1 step/frame, direct, the demo answering on its main thread \
-             (--handoff thread): {d:.0} ticks/s (ratio {:.2})",
+             (--answer-on main-thread): {d:.0} ticks/s (ratio {:.2})",
             d / p
         );
         lsd.push(d);

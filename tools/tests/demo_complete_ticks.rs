@@ -8,6 +8,8 @@
 //! K = 0 and P = 1 N·m·s the demo's torque is −ω_B, and the `hub` IMU's mounting is the
 //! identity, so every answer must be exactly −(the gyro rate of its own tick). The previous
 //! demo waited at most 50 ms for a sample, then held the previous tick's rate: it failed here.
+//! Both of the demo's ways of answering are checked: on the Zenoh thread that completes the
+//! tick (its default) and on its main thread (`--answer-on main-thread`).
 
 use flexdyn_testkit::demo_bin;
 
@@ -29,6 +31,16 @@ fn omega(k: u64) -> [f64; 3] {
 
 #[test]
 fn the_demo_answers_each_tick_from_its_own_imu_sample_however_late() {
+    answers_from_own_samples("zenoh-thread");
+}
+
+#[test]
+fn the_demo_answering_on_its_main_thread_does_too() {
+    answers_from_own_samples("main-thread");
+}
+
+/// The stand-in server's 20 ticks, answered by the demo with `--answer-on answer_on`.
+fn answers_from_own_samples(answer_on: &str) {
     // The stand-in server listens on a port the OS picks, and reports it.
     let zargs = ZenohArgs {
         listen: vec!["tcp/127.0.0.1:0".to_owned()],
@@ -91,7 +103,7 @@ fn the_demo_answers_each_tick_from_its_own_imu_sample_however_late() {
             "--log-every-s",
             "0",
         ])
-        .args(["--idle-exit-s", "10"])
+        .args(["--idle-exit-s", "10", "--answer-on", answer_on])
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::null())
@@ -162,7 +174,7 @@ fn the_demo_answers_each_tick_from_its_own_imu_sample_however_late() {
     let _ = demo.wait();
     assert!(
         wrong.is_empty(),
-        "answers not from their own tick:\n{}",
+        "--answer-on {answer_on}: answers not from their own tick:\n{}",
         wrong.join("\n")
     );
 }

@@ -614,7 +614,7 @@ impl TickAssembler {
 ///
 /// At most `capacity` complete ticks wait for the reader: in real time, a reader that falls
 /// behind loses the oldest ticks ([`Self::lost`]) rather than queueing stale ones; in lockstep at
-/// most one tick is in flight.
+/// most one tick is in flight. With a handler no tick waits ([`TickHandler`]).
 pub struct TickReceiver {
     _subscriber: Subscriber<()>,
     /// The keys of the samples it receives, declared to the session so that Zenoh routes them
@@ -627,7 +627,8 @@ pub struct TickReceiver {
     waiting_since: Option<(u64, Instant)>,
     /// Undecodable samples received (as of the last [`Self::recv_timeout`]).
     pub undecodable: u64,
-    /// Ticks handed out with samples missing.
+    /// Ticks handed out with samples missing (to the handler too; as of the last
+    /// [`Self::recv_timeout`] then).
     pub incomplete: u64,
     /// Complete ticks dropped, oldest first, because more than `capacity` waited for the
     /// reader (as of the last [`Self::recv_timeout`]).
@@ -639,9 +640,21 @@ pub struct TickReceiver {
 ///
 /// `on_tick` runs on the Zenoh thread that delivered the tick's last sample, or, for a tick
 /// released without some of its samples after the sensor time limit, on the thread that calls
-/// [`TickReceiver::recv_timeout`]; never two at once, and in tick order. While it runs, that
-/// Zenoh thread delivers nothing else to the session: keep it to the flight code's own work
-/// (read, compute, publish the answer) and leave blocking I/O to another thread.
+/// [`TickReceiver::recv_timeout`] (or on a Zenoh thread whose sample arrives while that call
+/// hands it over); never two at once, and in tick order.
+///
+/// While it runs, that Zenoh thread delivers nothing else to the session, so:
+/// - keep it to the flight code's own work (read, compute, publish the answer) and leave
+///   blocking I/O to another thread;
+/// - never wait on a Zenoh query inside it (its reply would come on the thread it blocks);
+/// - in real time, a handler slower than a frame holds up the telemetry behind it, and the
+///   server drops samples rather than wait (there is no queue of whole ticks to lose instead,
+///   as [`TickReceiver::declare`]'s reader has);
+/// - a panic in it unwinds into Zenoh's receiving task, which ends it: catch it in `on_tick`
+///   (`std::panic::catch_unwind`) and report it to the owner.
+///
+/// Do not hold the handler's lock while calling [`TickReceiver::recv_timeout`]: it may take
+/// that lock to hand over a released tick.
 pub trait TickHandler: Send {
     /// Handles one complete tick (the state of its frame and its due sensor samples).
     fn on_tick(&mut self, tick: Tick);
@@ -659,7 +672,8 @@ pub type SharedHandler = Arc<Mutex<dyn TickHandler>>;
 /// What the subscriber's callback and the reader share.
 struct Shared {
     inner: Mutex<Inner>,
-    /// Signalled when `ready` stops being empty.
+    /// Signalled when `ready` stops being empty (without a handler), or, with one, when a tick
+    /// starts waiting for an overdue sample, so that the reader starts its time limit then.
     ready: Condvar,
     /// With a handler, the ticks go to it instead of `ready`'s reader. Locked before `inner`
     /// and held while the ticks it takes are handled, so they are handled in order.
@@ -676,6 +690,8 @@ struct Inner {
     signals: u64,
     /// With a handler: the ticks it was handed with samples missing.
     incomplete: u64,
+    /// With a handler: the held tick whose wait the callback last signalled to the reader.
+    held_signalled: Option<u64>,
 }
 
 impl Shared {
@@ -706,6 +722,18 @@ impl Shared {
         }
         if let Some(h) = handler.as_deref_mut() {
             g.hand_over(h);
+            // A tick that now waits for an overdue sample: wake the reader once, so that its
+            // time limit runs from now, not from the reader's next look.
+            let held = g.assembler.waiting();
+            let signal = held.is_some() && held != g.held_signalled;
+            if signal {
+                g.held_signalled = held;
+            }
+            drop(g);
+            drop(handler);
+            if signal {
+                self.ready.notify_one();
+            }
             return;
         }
         while g.ready.len() > g.capacity {
@@ -792,6 +820,7 @@ impl TickReceiver {
                 lost: 0,
                 signals: 0,
                 incomplete: 0,
+                held_signalled: None,
             }),
             ready: Condvar::new(),
             handler,

@@ -81,7 +81,10 @@
 //! # Copying this package
 //! Keep `run`'s order (session → configuration → telemetry subscriber → publisher → token →
 //! loop). Replace [`GyroFeedback`] by your rate source and [`Controller::torque_b_nm`] by your
-//! control law. Everything on the wire comes from the `flexdyn-proto` crate (see
+//! control law. The answer to a tick is [`Flight::answer`]; [`Flight`] is the flight code's
+//! state, answering on the Zenoh thread that completes each tick (`--answer-on zenoh-thread`)
+//! or on the main thread (`main-thread`), and [`Flight::start`] answers the ticks that came
+//! before the command publisher was declared. Everything on the wire comes from the `flexdyn-proto` crate (see
 //! `proto/README.md` for C and Python byte layouts).
 
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
@@ -213,20 +216,23 @@ struct Args {
     /// The gyro monitor's window W [s] (rounded to whole star-tracker periods).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     fdir_window_s: f64,
-    /// Where each tick is answered: `direct` on the Zenoh thread that delivered its last
-    /// sample (no thread hop between the state and the command, as in a Zenoh ping-pong);
-    /// `thread` on the main thread, which the Zenoh thread wakes per tick.
-    #[arg(long, value_enum, default_value_t = Handoff::Direct)]
-    handoff: Handoff,
+    /// Which thread answers a tick. `zenoh-thread`: the Zenoh thread that delivered its last
+    /// sample (no thread wake-up between the state and the command, as in a Zenoh ping-pong);
+    /// in real time, a tick answered slower than a frame holds up the telemetry behind it and
+    /// the server drops samples. `main-thread`: the main thread, which the Zenoh thread wakes
+    /// per tick; up to 256 complete ticks wait for it, and in real time it loses whole old
+    /// ticks when it falls behind.
+    #[arg(long, value_enum, default_value_t = AnswerOn::ZenohThread)]
+    answer_on: AnswerOn,
 }
 
 /// Which thread answers a tick.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-enum Handoff {
+enum AnswerOn {
     /// The Zenoh thread that completed the tick.
-    Direct,
+    ZenohThread,
     /// The main thread.
-    Thread,
+    MainThread,
 }
 
 /// What the controller commands.
@@ -718,9 +724,10 @@ fn run(args: Args) -> anyhow::Result<()> {
 
     // 3. The end of the run (the server's last status), then the telemetry: one subscriber on
     //    flexdyn/<sc>/tlm/**, assembled into complete ticks. Declared before the token, so the
-    //    server cannot publish tick 0 before we can receive it. `--handoff direct` answers each
-    //    tick on the Zenoh thread that completed it; `thread` queues at most 256 complete ticks
-    //    for this thread (in real time, if it ever falls behind, the oldest go: `ticks.lost`).
+    //    server cannot publish tick 0 before we can receive it. `--answer-on zenoh-thread`
+    //    answers each tick on the Zenoh thread that completed it; `main-thread` queues at most
+    //    256 complete ticks for this thread (in real time, if it ever falls behind, the oldest
+    //    go: `ticks.lost`).
     let run_end = RunEnd::declare(&session, &topics)
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.status()))?;
     let flight = Arc::new(Mutex::new(Flight {
@@ -746,15 +753,17 @@ fn run(args: Args) -> anyhow::Result<()> {
         failed: None,
     }));
     let sensor_timeout = Duration::from_secs_f64(args.sensor_timeout_s);
-    let declared = match args.handoff {
-        Handoff::Direct => TickReceiver::declare_with_handler(
+    let declared = match args.answer_on {
+        AnswerOn::ZenohThread => TickReceiver::declare_with_handler(
             &session,
             &topics,
             schedule,
             sensor_timeout,
             flight.clone(),
         ),
-        Handoff::Thread => TickReceiver::declare(&session, &topics, schedule, 256, sensor_timeout),
+        AnswerOn::MainThread => {
+            TickReceiver::declare(&session, &topics, schedule, 256, sensor_timeout)
+        }
     };
     let mut ticks = declared
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.telemetry_wildcard()))?;
@@ -770,7 +779,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         sigma_rn = ?controller.sigma_rn.as_slice(),
         telemetry = topics.telemetry_wildcard(),
         commands = participant.key(),
-        handoff = ?args.handoff,
+        answer_on = ?args.answer_on,
         "flexdyn-acs-demo running"
     );
     lock(&flight).start(participant);
@@ -787,6 +796,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         let (states_before, last_state_at) = {
             let mut f = lock(&flight);
             if let Some(e) = f.failed.take() {
+                // The token goes first, as at a normal end.
+                drop(f.participant.take());
                 return Err(e);
             }
             (f.states_received, f.last_state_at)
@@ -839,6 +850,7 @@ fn run(args: Args) -> anyhow::Result<()> {
     let participant = {
         let mut f = lock(&flight);
         if let Some(e) = f.failed.take() {
+            drop(f.participant.take());
             return Err(e);
         }
         if let Some(fsw) = &f.sequence {
@@ -857,8 +869,8 @@ fn run(args: Args) -> anyhow::Result<()> {
 }
 
 /// The flight code of one run: what it answers each tick with, and what it has seen. It runs
-/// on the Zenoh thread that completed the tick (`--handoff direct`) or on the main thread
-/// (`thread`), one tick at a time behind its mutex.
+/// on the Zenoh thread that completed the tick (`--answer-on zenoh-thread`) or on the main
+/// thread (`main-thread`), one tick at a time behind its mutex.
 struct Flight {
     sender_id: u32,
     controller: Controller,
@@ -882,7 +894,7 @@ struct Flight {
     states_received: u64,
     last_state_at: Instant,
     last_t_ns: u64,
-    /// The first error; the run stops on it and later ticks go unanswered.
+    /// The first error or panic; the run stops on it and later ticks go unanswered.
     failed: Option<anyhow::Error>,
 }
 
@@ -1059,8 +1071,24 @@ impl TickHandler for Flight {
             self.pending.push(tick);
             return;
         }
-        if let Err(e) = self.answer(&tick) {
-            self.failed = Some(e);
+        // A panic would otherwise unwind into Zenoh's receiving task and end it, leaving the
+        // main thread waiting: it becomes the run's error instead.
+        let answered =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| self.answer(&tick)));
+        match answered {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => self.failed = Some(e),
+            Err(panic) => {
+                let what = panic
+                    .downcast_ref::<&str>()
+                    .map(|s| (*s).to_owned())
+                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "a panic".to_owned());
+                self.failed = Some(anyhow::anyhow!(
+                    "the flight code panicked at tick {}: {what}",
+                    tick.tick()
+                ));
+            }
         }
     }
 }
