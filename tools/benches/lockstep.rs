@@ -6,10 +6,9 @@
 //! 2. lockstep, one RK4 step per frame (1 kHz frames): the server in this process, the demo
 //!    controller `flexdyn-acs-demo` as a child process (answering each tick on the Zenoh thread
 //!    that completes it, its default `--answer-on zenoh-thread`), once with the server's
-//!    `handoff = "direct"` (the
-//!    default: the Zenoh thread that delivers the answer steps and publishes) and once with
-//!    `handoff = "thread"` (the previous design: physics thread + telemetry thread), so the
-//!    before and after are measured side by side;
+//!    `handoff = "direct"` (the default: the Zenoh thread that delivers the answer steps and
+//!    publishes) and once with `handoff = "thread"` (the previous design: physics thread +
+//!    telemetry thread), so the before and after are measured side by side;
 //! 3. lockstep with the reference configuration (100 Hz frames, 10 RK4 steps per frame), direct;
 //! 4. case 2, direct, with the demo publishing the flight code's telemetry every tick (a declared
 //!    `[[fsw_streams]]`: one FswMsg per tick, 1 kHz), against case 2 without it in the same

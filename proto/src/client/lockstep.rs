@@ -627,8 +627,8 @@ pub struct TickReceiver {
     waiting_since: Option<(u64, Instant)>,
     /// Undecodable samples received (as of the last [`Self::recv_timeout`]).
     pub undecodable: u64,
-    /// Ticks handed out with samples missing (to the handler too; as of the last
-    /// [`Self::recv_timeout`] then).
+    /// Ticks handed out (or to the handler) with samples missing (as of the last
+    /// [`Self::recv_timeout`]).
     pub incomplete: u64,
     /// Complete ticks dropped, oldest first, because more than `capacity` waited for the
     /// reader (as of the last [`Self::recv_timeout`]).
@@ -688,7 +688,7 @@ struct Inner {
     lost: u64,
     /// Times the callback signalled the reader (once per tick that found `ready` empty).
     signals: u64,
-    /// With a handler: the ticks it was handed with samples missing.
+    /// Ticks taken from `ready` with samples missing ([`Inner::pop_ready`]).
     incomplete: u64,
     /// With a handler: the held tick whose wait the callback last signalled to the reader.
     held_signalled: Option<u64>,
@@ -750,27 +750,29 @@ impl Shared {
 }
 
 impl Inner {
+    /// The oldest ready tick; one without all its samples is counted in `incomplete` and
+    /// warned of (the first, then every 100th).
+    fn pop_ready(&mut self) -> Option<Tick> {
+        let t = self.ready.pop_front()?;
+        if !t.missing.is_empty() {
+            self.incomplete += 1;
+            if self.incomplete == 1 || self.incomplete.is_multiple_of(100) {
+                tracing::warn!(
+                    tick = t.tick(),
+                    missing = ?t.missing,
+                    incomplete = self.incomplete,
+                    "a tick without all its sensor samples"
+                );
+            }
+        }
+        Some(t)
+    }
+
     /// Hands the ready ticks to the handler, in order (the caller holds the handler's lock).
     fn hand_over(&mut self, handler: &mut dyn TickHandler) {
-        while let Some(t) = self.ready.pop_front() {
-            if !t.missing.is_empty() {
-                self.incomplete += 1;
-                warn_incomplete(&t, self.incomplete);
-            }
+        while let Some(t) = self.pop_ready() {
             handler.on_tick(t);
         }
-    }
-}
-
-/// Warns of a tick handed out without some of its samples (the first, then every 100th).
-fn warn_incomplete(t: &Tick, incomplete: u64) {
-    if incomplete == 1 || incomplete.is_multiple_of(100) {
-        tracing::warn!(
-            tick = t.tick(),
-            missing = ?t.missing,
-            incomplete,
-            "a tick without all its sensor samples"
-        );
     }
 }
 
@@ -873,18 +875,13 @@ impl TickReceiver {
                     let mut h = handler.lock().unwrap_or_else(PoisonError::into_inner);
                     g = shared.lock();
                     g.hand_over(&mut *h);
-                    self.incomplete = g.incomplete;
                     continue;
                 }
+            } else if let Some(t) = g.pop_ready() {
                 self.incomplete = g.incomplete;
-            } else if let Some(t) = g.ready.pop_front() {
-                drop(g);
-                if !t.missing.is_empty() {
-                    self.incomplete += 1;
-                    warn_incomplete(&t, self.incomplete);
-                }
                 return Ok(Some(t));
             }
+            self.incomplete = g.incomplete;
             // Give up on a held tick once its samples are overdue.
             let mut wake = deadline;
             match (g.assembler.waiting(), self.waiting_since) {

@@ -84,8 +84,8 @@
 //! control law. The answer to a tick is [`Flight::answer`]; [`Flight`] is the flight code's
 //! state, answering on the Zenoh thread that completes each tick (`--answer-on zenoh-thread`)
 //! or on the main thread (`main-thread`), and [`Flight::start`] answers the ticks that came
-//! before the command publisher was declared. Everything on the wire comes from the `flexdyn-proto` crate (see
-//! `proto/README.md` for C and Python byte layouts).
+//! before the command publisher was declared. Everything on the wire comes from the
+//! `flexdyn-proto` crate (see `proto/README.md` for C and Python byte layouts).
 
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::{Duration, Instant};
@@ -793,15 +793,13 @@ fn run(args: Args) -> anyhow::Result<()> {
             tracing::info!(states_received, "stop signal: closing the session");
             break;
         }
-        let (states_before, last_state_at) = {
-            let mut f = lock(&flight);
-            if let Some(e) = f.failed.take() {
-                // The token goes first, as at a normal end.
-                drop(f.participant.take());
-                return Err(e);
-            }
-            (f.states_received, f.last_state_at)
+        let (states_before, last_state_at, failed) = {
+            let f = lock(&flight);
+            (f.states_received, f.last_state_at, f.failed.is_some())
         };
+        if failed {
+            break; // the error is returned below, after the token goes
+        }
         if let Some(d) = idle {
             if last_state_at.elapsed() >= d {
                 if states_before == 0 {
@@ -846,7 +844,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     // Undeclare the token first (a lockstep server sees us leave), then the subscribers, then
-    // close the session.
+    // close the session. The flight code's error, if any, is the run's.
     let participant = {
         let mut f = lock(&flight);
         if let Some(e) = f.failed.take() {
