@@ -83,7 +83,14 @@ pub fn usage_line(clap_message: &str) -> String {
 /// Parses a binary's command line with the rule every flexdyn binary follows: a usage error is
 /// one `error:` line ([`usage_line`]) with exit code 2; `--help` and `--version` print and
 /// exit 0. `Err` carries the exit code to return.
+///
+/// First of all it checks that the processor has the instructions this build uses
+/// ([`super::cpu::check`]): if not, one `error:` line naming them, and exit code 1.
 pub fn parse_args<A: clap::Parser>() -> Result<A, std::process::ExitCode> {
+    if let Err(message) = super::cpu::check() {
+        print_error(message);
+        return Err(std::process::ExitCode::FAILURE);
+    }
     match A::try_parse() {
         Ok(a) => Ok(a),
         Err(e) => match e.kind() {

@@ -9,6 +9,8 @@
 //!   scouting always off), for the server and its clients alike.
 //! - [`logging`]: stderr logging that survives a closed pipe, and the usage-error rule of every
 //!   binary (one `error:` line, exit 2).
+//! - [`cpu`]: the check every binary makes first, that the processor has the instructions the
+//!   build uses (x86-64-v3 on x86-64).
 //! - [`cli`]: the connection options every client shares ([`cli::CommonArgs`]), its exit codes
 //!   and a clean stop on SIGINT/SIGTERM.
 //! - [`vehicle`]: the vehicle a server runs, from its `flexdyn/<sc>/config` queryable: the
@@ -22,6 +24,7 @@
 //!   through one `flexdyn/<sc>/tlm/**` subscriber ([`lockstep::TickReceiver`]).
 
 pub mod cli;
+pub mod cpu;
 pub mod fsw;
 pub mod lockstep;
 pub mod logging;
