@@ -289,8 +289,24 @@ impl Thruster {
     /// Solves the step starting at `t_ns` from κ at `t_ns` and the current command.
     #[inline]
     fn solve_step(&mut self, t_ns: u64) {
-        let phase_ns = t_ns % self.frame_ns;
         let h_ns = self.step_ns;
+        if self.on_ns == 0 && self.kappa == 0.0 {
+            // Shut all step, at rest: the general path below then opens for 0 ns, so its first
+            // segment is (κ₀, +0); the shut segment starts at κ₀ = ±0 = u and gives (+0, 0·h = +0);
+            // the integral is +0 + +0 = +0 and the force F_max·(+0)/h = +0 (F_max > 0). The same
+            // bits without the remainder and conversions: the cost of an idle thruster.
+            self.step = StepThrust {
+                t_end_ns: t_ns + h_ns,
+                kappa_end: 0.0,
+                kappa_integral_s: 0.0,
+                opens: false,
+                open_at_end: false,
+                open_at_start: false,
+            };
+            self.force_avg_newton = 0.0;
+            return;
+        }
+        let phase_ns = t_ns % self.frame_ns;
         let open_ns = self.on_ns.saturating_sub(phase_ns).min(h_ns);
         let (k1, i1) = lag_segment(
             self.kappa,
