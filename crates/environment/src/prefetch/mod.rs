@@ -172,6 +172,9 @@ struct Slot {
     /// Requests posted by the physics thread (the worker paces its polling by their rate).
     posted: AtomicU64,
     stop: AtomicBool,
+    /// The core the physics thread last posted from ([`current_cpu`]; `usize::MAX`: unknown),
+    /// so that a worker about to spin can tell it shares that core.
+    physics_cpu: AtomicUsize,
     request: [AtomicU64; REQUEST_WORDS],
     answer: [AtomicU64; ANSWER_WORDS],
 }
@@ -183,6 +186,7 @@ impl Slot {
             taken: AtomicU64::new(0),
             posted: AtomicU64::new(0),
             stop: AtomicBool::new(false),
+            physics_cpu: AtomicUsize::new(usize::MAX),
             request: std::array::from_fn(|_| AtomicU64::new(0)),
             answer: std::array::from_fn(|_| AtomicU64::new(0)),
         }
@@ -388,6 +392,21 @@ fn leave_this_core() -> bool {
     false
 }
 
+/// The core the calling thread runs on: Linux's `getcpu` through the vDSO, a function call
+/// without a system call (tens of nanoseconds). `usize::MAX` outside Linux (never equal to a
+/// core, so a worker there never thinks it shares one).
+#[cfg(target_os = "linux")]
+#[inline]
+fn current_cpu() -> usize {
+    rustix::thread::sched_getcpu()
+}
+
+#[cfg(not(target_os = "linux"))]
+#[inline]
+fn current_cpu() -> usize {
+    usize::MAX
+}
+
 /// Moves the calling thread off the core it runs on, if it may run on another: it restricts its
 /// allowed cores to the others (the kernel moves it at once), then restores the set it had, so
 /// the scheduler stays free to place it later (and a set the server restricted stays so).
@@ -472,6 +491,14 @@ impl Spin {
     }
 }
 
+/// Whether the worker runs on the core the physics thread last posted from: spinning there, it
+/// would take that core from the stepping thread for a slice, then be kept off it for the
+/// stepping thread's time slice (module docs).
+fn shares_physics_core(slot: &Slot) -> bool {
+    let physics = slot.physics_cpu.load(Ordering::Relaxed);
+    physics != usize::MAX && current_cpu() == physics
+}
+
 /// The worker thread's loop: serve a request if there is one; otherwise spin or sleep until the
 /// next look ([`Pace`], [`Spin`]).
 fn work(slot: &Slot, fill: &impl Fn(&Request, &mut EnvironmentSample)) {
@@ -493,6 +520,10 @@ fn work(slot: &Slot, fill: &impl Fn(&Request, &mut EnvironmentSample)) {
         let now = Instant::now();
         let poll = pace.next_poll(slot.posted.load(Ordering::Relaxed), now);
         let away = if pace.spins(now) && spin.may_spin(now) {
+            if shares_physics_core(slot) {
+                // Found on the stepping thread's core before the starvation shows: move now.
+                spin.starved(now);
+            }
             spin_once(slot, SPIN_SLICE);
             SPIN_SLICE
         } else {
@@ -543,6 +574,9 @@ impl Prefetcher {
     /// atomics only; the worker polls, see the module docs).
     #[inline]
     pub fn post(&self, req: &Request) {
+        self.slot
+            .physics_cpu
+            .store(current_cpu(), Ordering::Relaxed);
         self.slot.post(req);
         self.slot.posted.fetch_add(1, Ordering::Relaxed);
     }
