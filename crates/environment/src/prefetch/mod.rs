@@ -72,6 +72,12 @@
 //! another of its allowed cores (`leave_this_core`), at most once per 10 ms (`SPIN_RETRY`);
 //! starved again within that time, or with no other core, it sleeps between looks for 100 ms
 //! (`SPIN_REST`).
+//!
+//! Most often the worker lands there at its first spin: the kernel wakes it from its sleep on
+//! the core of the thread it preempts. So the physics thread notes its core at each post
+//! (`getcpu` through the vDSO, no system call), and a worker about to spin on that same core
+//! moves the same way at once, instead of after the stepping thread's time slice: in the
+//! shipped case that slice had cost 84–98 updates in a row evaluated on the stepping thread.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, AtomicUsize, Ordering};
 use std::sync::{Arc, OnceLock};
