@@ -525,11 +525,15 @@ fn work(slot: &Slot, fill: &impl Fn(&Request, &mut EnvironmentSample)) {
         }
         let now = Instant::now();
         let poll = pace.next_poll(slot.posted.load(Ordering::Relaxed), now);
-        let away = if pace.spins(now) && spin.may_spin(now) {
+        let spin_now = pace.spins(now) && spin.may_spin(now) && {
             if shares_physics_core(slot) {
-                // Found on the stepping thread's core before the starvation shows: move now.
+                // Found on the stepping thread's core before the starvation shows: move now
+                // (or, having moved lately, rest: then it sleeps, not spins, from this look on).
                 spin.starved(now);
             }
+            spin.ticket.is_some()
+        };
+        let away = if spin_now {
             spin_once(slot, SPIN_SLICE);
             SPIN_SLICE
         } else {
@@ -651,6 +655,32 @@ mod tests {
         let mut s = EnvironmentSample::NONE;
         fill(req, &mut s);
         s
+    }
+
+    /// A worker compares its core with the one the physics thread last posted from (which
+    /// `post` records): that core is shared; an unknown one, or another, is not. The test
+    /// thread is held on its core meanwhile, so that the cores it reads agree.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn the_core_the_physics_thread_posts_from_is_the_one_a_worker_must_leave() {
+        let allowed = rustix::thread::sched_getaffinity(None).expect("affinity");
+        let mut here = rustix::thread::CpuSet::new();
+        here.set(current_cpu());
+        rustix::thread::sched_setaffinity(None, &here).expect("pin the test thread");
+        let prefetcher = Prefetcher::spawn(fill).expect("worker");
+        let slot = &prefetcher.slot;
+        let unknown = shares_physics_core(slot);
+        prefetcher.post(&request(10));
+        let posted_from = slot.physics_cpu.load(Ordering::Relaxed);
+        let same = shares_physics_core(slot);
+        slot.physics_cpu.store(current_cpu() + 1, Ordering::Relaxed);
+        let other = shares_physics_core(slot);
+        let core = current_cpu();
+        let _ = rustix::thread::sched_setaffinity(None, &allowed);
+        assert!(!unknown, "no post yet: no core to leave");
+        assert_eq!(posted_from, core, "post records the posting core");
+        assert!(same, "the posting core is shared");
+        assert!(!other, "another core is not");
     }
 
     #[test]
