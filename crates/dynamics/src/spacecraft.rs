@@ -231,36 +231,44 @@ impl Lu3 {
         Self { lu, perm }
     }
 
+    /// Forward and back substitution for `N` right-hand sides side by side: lane `l` of the
+    /// rows `b0`, `b1`, `b2` (already in pivot order) is one right-hand side, and each lane
+    /// takes exactly the same operations in the same order, so a lane's bits do not depend on
+    /// `N`. Written lane-wise so that several right-hand sides run as one vector pass whose
+    /// divisions overlap. Returns the rows x0, x1, x2 of the solutions.
     #[inline(always)]
-    fn solve(&self, b: &Vector3<f64>) -> Vector3<f64> {
+    fn solve_lanes<const N: usize>(
+        &self,
+        b0: [f64; N],
+        b1: [f64; N],
+        b2: [f64; N],
+    ) -> [[f64; N]; 3] {
         let lu = &self.lu;
-        let y0 = b[self.perm[0]];
-        let y1 = b[self.perm[1]] - lu[(1, 0)] * y0;
-        let y2 = b[self.perm[2]] - lu[(2, 0)] * y0 - lu[(2, 1)] * y1;
-        let x2 = y2 / lu[(2, 2)];
-        let x1 = (y1 - lu[(1, 2)] * x2) / lu[(1, 1)];
-        let x0 = (y0 - lu[(0, 1)] * x1 - lu[(0, 2)] * x2) / lu[(0, 0)];
-        Vector3::new(x0, x1, x2)
-    }
-
-    /// A⁻¹[B | v]: the three columns of `b` and `v` solved side by side, each lane with exactly
-    /// the operations of [`Self::solve`] in its order (so the same bits), written lane-wise so
-    /// that the four right-hand sides run as one vector pass whose divisions overlap.
-    #[inline(always)]
-    fn solve_matrix_and(&self, b: &Matrix3<f64>, v: &Vector3<f64>) -> (Matrix3<f64>, Vector3<f64>) {
-        let lu = &self.lu;
-        let [p0, p1, p2] = self.perm;
-        let rhs = |row: usize| [b[(row, 0)], b[(row, 1)], b[(row, 2)], v[row]];
-        let (b0, b1, b2) = (rhs(p0), rhs(p1), rhs(p2));
-        let (mut x0, mut x1, mut x2) = ([0.0; 4], [0.0; 4], [0.0; 4]);
-        for l in 0..4 {
+        let mut x = [[0.0; N]; 3];
+        for l in 0..N {
             let y0 = b0[l];
             let y1 = b1[l] - lu[(1, 0)] * y0;
             let y2 = b2[l] - lu[(2, 0)] * y0 - lu[(2, 1)] * y1;
-            x2[l] = y2 / lu[(2, 2)];
-            x1[l] = (y1 - lu[(1, 2)] * x2[l]) / lu[(1, 1)];
-            x0[l] = (y0 - lu[(0, 1)] * x1[l] - lu[(0, 2)] * x2[l]) / lu[(0, 0)];
+            x[2][l] = y2 / lu[(2, 2)];
+            x[1][l] = (y1 - lu[(1, 2)] * x[2][l]) / lu[(1, 1)];
+            x[0][l] = (y0 - lu[(0, 1)] * x[1][l] - lu[(0, 2)] * x[2][l]) / lu[(0, 0)];
         }
+        x
+    }
+
+    #[inline(always)]
+    fn solve(&self, b: &Vector3<f64>) -> Vector3<f64> {
+        let [p0, p1, p2] = self.perm;
+        let [[x0], [x1], [x2]] = self.solve_lanes([b[p0]], [b[p1]], [b[p2]]);
+        Vector3::new(x0, x1, x2)
+    }
+
+    /// A⁻¹[B | v]: the three columns of `b` and `v`, four lanes of [`Self::solve_lanes`].
+    #[inline(always)]
+    fn solve_matrix_and(&self, b: &Matrix3<f64>, v: &Vector3<f64>) -> (Matrix3<f64>, Vector3<f64>) {
+        let rhs = |row: usize| [b[(row, 0)], b[(row, 1)], b[(row, 2)], v[row]];
+        let [p0, p1, p2] = self.perm;
+        let [x0, x1, x2] = self.solve_lanes(rhs(p0), rhs(p1), rhs(p2));
         (
             Matrix3::new(
                 x0[0], x0[1], x0[2], x1[0], x1[1], x1[2], x2[0], x2[1], x2[2],
@@ -1167,7 +1175,7 @@ impl Spacecraft {
 mod tests {
     use super::*;
 
-    /// The four right-hand sides solved side by side are each the single solve's bits, and the
+    /// The four right-hand sides solved side by side are each the one-lane solve's bits, and the
     /// solves invert the matrix: A·X = B and A·y = v to rounding, for matrices whose pivoting
     /// takes each row order (a small splitmix sequence supplies the entries).
     #[test]
