@@ -244,9 +244,7 @@ impl Gps {
 
     /// One measurement from `truth` by the model of the module docs. Allocation-free.
     pub fn measure(&mut self, truth: &Truth<'_>) -> GpsSample {
-        let (z1, z2) = self.rng.normal_pair();
-        let (z3, z4) = self.rng.normal_pair();
-        let (z5, z6) = self.rng.normal_pair();
+        let [(z1, z2), (z3, z4), (z5, z6)] = self.rng.normal_pairs::<3>();
         let c = &self.cfg;
         let t_ns = truth.t_sim_ns;
         let mut s = GpsSample {

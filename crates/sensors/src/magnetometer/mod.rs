@@ -185,8 +185,7 @@ impl Magnetometer {
 
     /// One measurement of the field `b_b_t` (B components) by the model of the module docs.
     pub fn measure(&mut self, b_b_t: &Vector3<f64>) -> MagnetometerSample {
-        let (z1, z2) = self.rng.normal_pair();
-        let (z3, _) = self.rng.normal_pair();
+        let [(z1, z2), (z3, _)] = self.rng.normal_pairs::<2>();
         let c = &self.cfg;
         let mut y = self.gain_sb * b_b_t + c.bias_s_t + Vector3::new(z1, z2, z3) * c.noise_sigma_t;
         let mut flags = 0;

@@ -291,8 +291,7 @@ impl StarTracker {
         omega_bn_b: &Vector3<f64>,
         sky: &Sky,
     ) -> StarTrackerSample {
-        let (n1, n2) = self.rng.normal_pair();
-        let (n3, _) = self.rng.normal_pair();
+        let [(n1, n2), (n3, _)] = self.rng.normal_pairs::<2>();
         let c = &self.cfg;
         let dcm_cn = c.dcm_cb * mrp_to_dcm(sigma_bn);
         let mut flags = 0;
