@@ -299,6 +299,7 @@ impl FacetModel {
     /// F = −½ ρ (Σ u_k) v and τ = −½ ρ (Σ u_k r_k) × v with u_k = C_D,k A_k (n̂_k·v) over the
     /// facets with n̂_k·v > 0: no square root and no division at a stage. At rest every n̂_k·v
     /// is 0 and the wrench is zero.
+    #[inline]
     pub fn drag_wrench_b(&self, v_rel_b_m_s: &Vector3<f64>, density_kg_m3: f64) -> FacetWrench {
         let mut u_sum_m3_s = 0.0;
         let mut u_r_sum_m4_s = Vector3::zeros();
@@ -337,6 +338,7 @@ impl FacetModel {
     /// [`Self::srp_wrench_b`] for a direction to the Sun `sun_hat_b` already of unit length (the
     /// stage path: the solar-pressure effector normalises the held Sun direction once per
     /// environment sample, in N, and only rotates it at a stage).
+    #[inline]
     pub fn srp_wrench_unit_b(&self, sun_hat_b: &Vector3<f64>, pressure_n_m2: f64) -> FacetWrench {
         let mut a_sum_m2 = 0.0;
         let mut a_r_sum_m3 = Vector3::zeros();

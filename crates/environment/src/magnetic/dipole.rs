@@ -85,6 +85,7 @@ pub fn dipole_field_t(m_am2: &Vector3<f64>, r_m: &Vector3<f64>) -> Vector3<f64> 
 /// dipole, or a magnetorquer's commanded moment) in the field `b_b_t` \[T\], both in B components
 /// (Griffiths, *Introduction to Electrodynamics*, 4th ed., eq. 6.1). The field is uniform over
 /// the vehicle, so there is no force.
+#[inline]
 pub fn dipole_torque_b_nm(m_b_am2: &Vector3<f64>, b_b_t: &Vector3<f64>) -> Vector3<f64> {
     m_b_am2.cross(b_b_t)
 }
