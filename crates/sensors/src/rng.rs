@@ -30,27 +30,12 @@ pub fn ln_portable(x: f64) -> f64 {
         x *= 18_014_398_509_481_984.0; // 2^54, exact
         e = -54;
     }
-    let bits = x.to_bits();
-    e += ((bits >> 52) & 0x7ff) as i64 - 1023;
-    let mut m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | (1023u64 << 52));
-    if m > std::f64::consts::SQRT_2 {
-        m *= 0.5;
-        e += 1;
-    }
-    let f = (m - 1.0) / (m + 1.0);
-    let f2 = f * f;
-    // 2 atanh f = 2 Σ f^(2k+1)/(2k+1), k = 0..12, Horner in f².
-    let mut s = 2.0 / 25.0;
-    for k in (0..12).rev() {
-        s = s * f2 + 2.0 / (2 * k + 1) as f64;
-    }
-    let ef = e as f64;
-    ef * LN2_HI + (f * s + ef * LN2_LO)
+    let [ln] = ln_normal_lanes([x], [e]);
+    ln
 }
 
-/// [`ln_portable`] of `N` values side by side. Each lane does the same IEEE-754 operations in the
-/// same order as the scalar function, so each result is its result bit for bit. The scalar
-/// function is one chain of dependent multiply-adds (about 130 cycles); with the lanes' chains
+/// [`ln_portable`] of `N` values side by side, each its result bit for bit. The scalar function
+/// is one chain of dependent multiply-adds (about 130 cycles); with the lanes' chains
 /// interleaved, the processor runs them at once. Any value outside the positive normal range
 /// (zero, subnormal, negative, infinite, NaN) sends the whole call to the scalar function.
 #[inline(always)]
@@ -60,11 +45,18 @@ pub(crate) fn ln_portable_lanes<const N: usize>(x: [f64; N]) -> [f64; N] {
     {
         return x.map(ln_portable);
     }
+    ln_normal_lanes(x, [0; N])
+}
+
+/// ln(x_i · 2^e0_i) for positive normal x_i, lane by lane: [`ln_portable`]'s series, each lane
+/// with the same IEEE-754 operations in the same order whatever `N` is.
+#[inline(always)]
+fn ln_normal_lanes<const N: usize>(x: [f64; N], e0: [i64; N]) -> [f64; N] {
     let mut f = [0.0; N];
     let mut ef = [0.0; N];
     for i in 0..N {
         let bits = x[i].to_bits();
-        let mut e = ((bits >> 52) & 0x7ff) as i64 - 1023;
+        let mut e = e0[i] + ((bits >> 52) & 0x7ff) as i64 - 1023;
         let mut m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | (1023u64 << 52));
         if m > std::f64::consts::SQRT_2 {
             m *= 0.5;
@@ -74,6 +66,7 @@ pub(crate) fn ln_portable_lanes<const N: usize>(x: [f64; N]) -> [f64; N] {
         ef[i] = e as f64;
     }
     let f2 = f.map(|v| v * v);
+    // 2 atanh f = 2 Σ f^(2k+1)/(2k+1), k = 0..12, Horner in f².
     let mut s = [2.0 / 25.0; N];
     for k in (0..12).rev() {
         let c = 2.0 / (2 * k + 1) as f64;
