@@ -2,8 +2,9 @@
 //! wheel `Actuators` commands, the latter handed back through the recycle channel), then the
 //! server's own [`Stepper`] — the code both the physics thread and the direct lockstep core run
 //! — holding the commands, integrating the RK4 frame, sampling the IMU and star tracker,
-//! filling the telemetry and checking it finite, and the buffer hand-off through the bounded
-//! channels; and beside it, the check of the flight code's telemetry arriving at 1 kHz (the
+//! filling the telemetry and checking it finite, the tick's note in the run's [`TickCost`]
+//! (its period into the histogram), and the buffer hand-off through the bounded channels; and
+//! beside it, the check of the flight code's telemetry arriving at 1 kHz (the
 //! work of the `flexdyn/<sc>/fsw/*` callback for an accepted sample).
 //!
 //! `assert_no_alloc`'s global allocator counts (de)allocations made on this thread inside
@@ -16,6 +17,7 @@ use flexdyn_faults::ports::{Installed, LiveRequest};
 use flexdyn_proto::{CommandMsg, EffectorInput, FaultAction, FaultCommandMsg, FaultTarget, Header};
 use flexdyn_server::shared::Frame;
 use flexdyn_server::stepper::Stepper;
+use flexdyn_server::tick_cost::TickCost;
 use flexdyn_server::ServerSettings;
 use flexdyn_vehicle::config::SimConfig;
 use flexdyn_vehicle::sim::Simulation;
@@ -283,8 +285,10 @@ fn frame_path_with(
         })
         .collect();
     let (recycle_tx, recycle_rx) = sync_channel::<CommandMsg>(512);
+    let mut ticks = TickCost::default();
     let mut frame_once = |k: u64| {
         beside(k);
+        ticks.published(k, std::time::Instant::now());
         let wrench = CommandMsg::wrench(Header::new(1, k, 0, k), 1, [0.0, 0.0, 0.01], [0.0; 3]);
         cmd_tx.try_send(wrench).unwrap();
         cmd_tx.try_send(wheel_commands.pop().unwrap()).unwrap();
@@ -317,6 +321,9 @@ fn frame_path_with(
         }
     });
     assert_eq!(violation_count(), 0, "the frame path allocated");
+    ticks.frames = 199;
+    let periods = ticks.summary().unwrap();
+    assert!(periods.period_max_us > 0.0, "{periods:?}");
     let links = w.book.link_stats();
     if w.book
         .links()

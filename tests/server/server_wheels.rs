@@ -107,6 +107,18 @@ fn actuators_drive_the_wheels_and_bad_inputs_are_counted() {
     assert_eq!(answered, 101, "every tick answered");
     let report = server.join(WAIT).expect("the run");
     assert_eq!(report.last_tick, 100);
+    // Where the ticks went: 100 frames stepped; tick 5 was answered 200 ms after its state
+    // came, so one tick period is at least that long, and the mean wait per frame at least a
+    // hundredth of it. 100 ticks are too few for a settled rate (SETTLE_TICKS = 1000).
+    let ticks = report.ticks.expect("a lockstep run reports its ticks");
+    assert_eq!(ticks.frames, 100);
+    assert!(ticks.period_max_us >= 200_000.0, "{ticks:?}");
+    assert!(ticks.wait_us >= 2_000.0, "{ticks:?}");
+    assert!(
+        ticks.physics_us > 0.0 && ticks.publish_us > 0.0,
+        "{ticks:?}"
+    );
+    assert_eq!(ticks.settled_ticks_per_s, None);
     let want = RejectCounters {
         bad_effector_input: 4,
         non_finite: 1,

@@ -19,6 +19,14 @@
 //!
 //! It prints each round and the medians: round trips/s, ticks/s, and the median of the per-round
 //! ratios (target ≥ 0.95 × the ping-pong for the one-step case, where the link dominates).
+//!
+//! Both sides leave their first 1000 iterations out: the ping-pong its first 1000 round trips
+//! (unmeasured), the lockstep runs their first 1000 ticks (the server's settled tick rate,
+//! `settled_ticks_per_s` of its run report, [`flexdyn_server::tick_cost`]). The first
+//! iterations after an idle spell are slower on this VM, for both: a ping-pong started after
+//! 400 ms idle took 101–105 µs per round trip over its first 1000 and 85–88 µs after. The
+//! whole-run lockstep rate (first ticks included) is printed beside it for the one-step case,
+//! with the server's per-tick breakdown (stepping, publishing, waiting for the answer).
 //! Rounds alternate the measurements so that a change in machine load hits every side alike.
 //! The physics cost of a frame is measured alone too, to explain the reference case.
 //!
@@ -66,10 +74,20 @@ values = [
 ]
 ";
 
-/// Ticks per second of a lockstep run of `ticks` frames at `frame_hz` with the demo controller
-/// answering on the Zenoh thread that delivered the tick (its default `--answer-on
-/// zenoh-thread`).
-fn lockstep_rate(ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
+/// A lockstep run's rates and the server's per-tick breakdown.
+#[derive(Clone, Copy)]
+struct Measured {
+    /// Ticks per second from the 1000th tick to the last (the server's settled rate).
+    settled: f64,
+    /// Ticks per second over the whole run.
+    whole: f64,
+    /// Where the server's ticks went.
+    ticks: flexdyn_server::tick_cost::TickSummary,
+}
+
+/// A lockstep run of `ticks` frames at `frame_hz` with the demo controller answering on the
+/// Zenoh thread that delivered the tick (its default `--answer-on zenoh-thread`).
+fn lockstep_rate(ticks: usize, frame_hz: f64, handoff: Handoff) -> Measured {
     lockstep_rate_of(
         ticks,
         reference_config(frame_hz),
@@ -80,7 +98,7 @@ fn lockstep_rate(ticks: usize, frame_hz: f64, handoff: Handoff) -> f64 {
 }
 
 /// [`lockstep_rate`] with the demo publishing its telemetry every tick ([`FSW_STREAM`]).
-fn lockstep_rate_with_telemetry(ticks: usize, frame_hz: f64) -> f64 {
+fn lockstep_rate_with_telemetry(ticks: usize, frame_hz: f64) -> Measured {
     lockstep_rate_of(
         ticks,
         support::reference_config_with(frame_hz, FSW_STREAM),
@@ -90,16 +108,17 @@ fn lockstep_rate_with_telemetry(ticks: usize, frame_hz: f64) -> f64 {
     )
 }
 
-/// Ticks per second of a lockstep run of `ticks` frames of `cfg`, the server stepping with
-/// `handoff`, the demo answering on `answer_on` (its `--answer-on`); with `expect_telemetry`,
-/// checks that the demo's telemetry came every answered tick.
+/// A lockstep run of `ticks` frames (plus the 1000 the settled rate leaves out) of `cfg`, the
+/// server stepping with `handoff`, the demo answering on `answer_on` (its `--answer-on`); with
+/// `expect_telemetry`, checks that the demo's telemetry came every answered tick.
 fn lockstep_rate_of(
     ticks: usize,
     cfg: flexdyn_vehicle::config::SimConfig,
     handoff: Handoff,
     answer_on: &str,
     expect_telemetry: bool,
-) -> f64 {
+) -> Measured {
+    let ticks = ticks + flexdyn_server::tick_cost::SETTLE_TICKS as usize;
     let settings = ServerSettings {
         mode: Mode::Lockstep,
         handoff,
@@ -132,7 +151,15 @@ fn lockstep_rate_of(
             report.rejected
         );
     }
-    report.last_tick as f64 / report.wall_s
+    let summary = report.ticks.expect("a lockstep run reports its ticks");
+    let whole = report.last_tick as f64 / report.wall_s;
+    Measured {
+        settled: summary
+            .settled_ticks_per_s
+            .expect("a run past its settling ticks"),
+        whole,
+        ticks: summary,
+    }
 }
 
 /// \[µs\] physics cost of one frame (step_frame + state_into), alone.
@@ -161,20 +188,38 @@ fn main() {
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut lsf, mut ratiof) = (Vec::new(), Vec::new());
     let (mut lsd, mut ratiod) = (Vec::new(), Vec::new());
+    let (mut ratio1w, mut breakdown) = (Vec::new(), Vec::new());
     for r in 0..rounds {
         let p = pingpong_rate(ticks, false);
         let pl = pingpong_rate(ticks, true);
-        let a = lockstep_rate(ticks, 1000.0, Handoff::Direct);
-        let t = lockstep_rate(ticks, 1000.0, Handoff::Thread);
-        let b = lockstep_rate(ticks / 4, 100.0, Handoff::Direct);
-        let f = lockstep_rate_with_telemetry(ticks, 1000.0);
+        let am = lockstep_rate(ticks, 1000.0, Handoff::Direct);
+        let a = am.settled;
+        let t = lockstep_rate(ticks, 1000.0, Handoff::Thread).settled;
+        let b = lockstep_rate(ticks / 4, 100.0, Handoff::Direct).settled;
+        let f = lockstep_rate_with_telemetry(ticks, 1000.0).settled;
         let d = lockstep_rate_of(
             ticks,
             reference_config(1000.0),
             Handoff::Direct,
             "main-thread",
             false,
+        )
+        .settled;
+        let x = am.ticks;
+        println!(
+            "round {r}: lockstep 1 step/frame, direct, per tick: stepping {:.1} us, publishing \
+             {:.1} us, waiting for the answer {:.1} us; period p50 {:.1} us, p99 {:.1} us; whole \
+             run (first ticks included) {:.0} ticks/s (ratio {:.2})",
+            x.physics_us,
+            x.publish_us,
+            x.wait_us,
+            x.period_p50_us,
+            x.period_p99_us,
+            am.whole,
+            am.whole / p
         );
+        ratio1w.push(am.whole / p);
+        breakdown.push(x);
         println!(
             "round {r}: lockstep 1 step/frame, direct, the demo answering on its main thread \
              (--answer-on main-thread): {d:.0} ticks/s (ratio {:.2})",
@@ -231,6 +276,20 @@ fn main() {
         "median lockstep ticks/s, 1 RK4 step per frame, handoff direct: {a:.0} ({:.1} us/tick); \
          median ratio {r1:.2} (target >= 0.95), {r1l:.2} vs the receive-loop pong",
         1e6 / a
+    );
+    let med = |f: fn(&flexdyn_server::tick_cost::TickSummary) -> f64| {
+        let mut v: Vec<f64> = breakdown.iter().map(f).collect();
+        median_mut(&mut v)
+    };
+    let (xs, xp, xw) = (
+        med(|x| x.physics_us),
+        med(|x| x.publish_us),
+        med(|x| x.wait_us),
+    );
+    println!(
+        "  its server side per tick (medians): stepping {xs:.1} us, publishing {xp:.1} us, \
+         waiting for the answer {xw:.1} us; whole-run ratio (first 1000 ticks included) {:.2}",
+        median_mut(&mut ratio1w)
     );
     println!(
         "median lockstep ticks/s, 1 RK4 step per frame, handoff thread (before): {t:.0} ({:.1} \

@@ -83,6 +83,7 @@ mod setup;
 pub mod shared;
 pub mod stepper;
 pub mod telemetry;
+pub mod tick_cost;
 pub mod world;
 
 use std::future::Future;
@@ -277,6 +278,9 @@ pub async fn run(
         recording,
     );
     report.physics_thread = physics.usage;
+    if mode != Mode::RealTime {
+        report.ticks = physics.ticks.summary();
+    }
     report.checkpoints = writer.map(|w| w.stats.summary());
     tracing::info!("{report}");
     Ok(report)
@@ -768,7 +772,7 @@ async fn run_physics_thread(
             if let Err(e) = prepare_physics_thread(&thread_settings) {
                 let _ = done_tx.send(PhysicsOutcome {
                     result: Err(e),
-                    spent: physics::Spent::default(),
+                    ticks: tick_cost::TickCost::default(),
                     usage: None,
                 });
                 return;
@@ -826,7 +830,7 @@ async fn run_lockstep_core(
     let mut core = lock();
     PhysicsOutcome {
         result: core.outcome(),
-        spent: core.spent(),
+        ticks: core.ticks(),
         usage: None,
     }
 }

@@ -36,11 +36,12 @@ use tokio::sync::Notify;
 
 use super::checkpoint::Checkpointer;
 use super::error::ServerError;
-use super::physics::{Ending, PhysicsReport, Spent};
+use super::physics::{Ending, PhysicsReport};
 use super::publish::{FramePublisher, Recording};
 use super::relative::{publish_deputy, RelativePublisher};
 use super::shared::Shared;
 use super::stepper::count_offer;
+use super::tick_cost::TickCost;
 use super::world::WorldStepper;
 
 /// Where a direct lockstep run is.
@@ -114,7 +115,7 @@ pub struct LockstepCore {
     /// Holding at tick `k` on an operator's request: its answers are taken, but frame
     /// `k → k + 1` waits for [`Self::release_if_due`].
     holding: bool,
-    spent: Spent,
+    spent: TickCost,
     /// Takes the checkpoints due at each boundary (`None`: this run saves none).
     checkpoints: Option<Checkpointer>,
 }
@@ -145,7 +146,7 @@ impl LockstepCore {
             tick_published_at: Instant::now(),
             events,
             holding: false,
-            spent: Spent::default(),
+            spent: TickCost::default(),
             checkpoints: None,
         };
         core.world.begin_tick(0);
@@ -303,6 +304,7 @@ impl LockstepCore {
     /// deputy's relative states after its frame.
     fn publish(&mut self) {
         let started = Instant::now();
+        self.spent.published(self.k, started);
         let stamp = flexdyn_proto::client::transport::unix_now_ns();
         // Noted before the states go out (as the physics thread does, and as `Shared::tick`
         // says), so a participant's flight-code telemetry for tick k, sent as soon as it has
@@ -416,9 +418,10 @@ impl LockstepCore {
         }
     }
 
-    /// Where the core's time went: stepping and filling, publishing, and waiting for answers.
-    pub fn spent(&self) -> Spent {
-        self.spent
+    /// Where the core's time went: stepping and filling, publishing, and waiting for answers;
+    /// and when the ticks went out.
+    pub fn ticks(&self) -> TickCost {
+        self.spent.clone()
     }
 
     /// The outcome once [`Self::ended`]: the last tick published and its simulation time, or

@@ -46,6 +46,7 @@ use super::rt::{monotonic_ns, ThreadUsage};
 use super::settings::ServerSettings;
 use super::shared::{Frame, Shared};
 use super::stepper::count_offer;
+use super::tick_cost::TickCost;
 use super::world::WorldStepper;
 use flexdyn_faults::ports::{Installed, LiveRequest};
 
@@ -76,27 +77,13 @@ pub struct PhysicsReport {
     pub sim_time_ns: u64,
 }
 
-/// Where the physics thread's time went (wall-clock ns).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Spent {
-    /// Frames stepped.
-    pub frames: u64,
-    /// \[ns\] stepping and filling the frames (every vehicle), without the waits and the
-    /// hand-outs.
-    pub physics_ns: u64,
-    /// \[ns\] handing out the frames at the boundaries (the puts, when this thread publishes).
-    pub publish_ns: u64,
-    /// \[ns\] waiting for the commands (lockstep: the barrier).
-    pub wait_ns: u64,
-}
-
 /// How the physics thread ended, what it did, and (real time) its counters from the end of
 /// the first frame to the end.
 pub struct PhysicsOutcome {
     /// The ending, or the error that stopped the run.
     pub result: Result<PhysicsReport, ServerError>,
-    /// Where the thread's time went.
-    pub spent: Spent,
+    /// Where the thread's time went, and when the ticks went out.
+    pub ticks: TickCost,
     /// Real time: the thread's page faults and context switches over the measured frames.
     pub usage: Option<ThreadUsage>,
 }
@@ -216,8 +203,8 @@ impl PhysicsCtx {
     /// Runs the loop over `world` to its end; sets every vehicle's run state accordingly.
     pub fn run(mut self, mut world: WorldStepper) -> PhysicsOutcome {
         let mut warm = None;
-        let mut spent = Spent::default();
-        let result = self.frame_loop(&mut world, &mut warm, &mut spent);
+        let mut ticks = TickCost::default();
+        let result = self.frame_loop(&mut world, &mut warm, &mut ticks);
         self.set_run_state(match &result {
             Ok(r) if r.ending == Ending::Finished => RunState::Finished,
             Ok(_) => RunState::Stopped,
@@ -226,7 +213,7 @@ impl PhysicsCtx {
         let usage = warm.map(|w: ThreadUsage| ThreadUsage::this_thread().since(&w));
         PhysicsOutcome {
             result,
-            spent,
+            ticks,
             usage,
         }
     }
@@ -446,7 +433,7 @@ impl PhysicsCtx {
         &mut self,
         world: &mut WorldStepper,
         warm: &mut Option<ThreadUsage>,
-        spent: &mut Spent,
+        spent: &mut TickCost,
     ) -> Result<PhysicsReport, ServerError> {
         let mode = self.settings.mode;
         let realtime = mode == Mode::RealTime;
@@ -517,6 +504,7 @@ impl PhysicsCtx {
                 }
             }
             let t = Instant::now();
+            spent.published(k, t);
             self.hand_out(world, lateness_ns, realtime)?;
             spent.publish_ns += ns_since(t);
             if self.total_frames == Some(k) {

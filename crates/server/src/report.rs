@@ -11,6 +11,7 @@ use super::rt::ThreadUsage;
 use super::settings::mode_name;
 use super::shared::Shared;
 use super::telemetry::timing_of;
+use super::tick_cost::TickSummary;
 use flexdyn_sinks::recorder::RecordReport;
 
 /// How a run ended without error.
@@ -68,6 +69,9 @@ pub struct RunReport {
     pub overrun_frames_ns: Vec<(u64, u64)>,
     /// The checkpoints this run saved (`None`: it saves none).
     pub checkpoints: Option<CheckpointSummary>,
+    /// Lockstep and batch: where the ticks went (per-tick means, the tick period's
+    /// distribution, the settled tick rate; [`super::tick_cost`]).
+    pub ticks: Option<TickSummary>,
 }
 
 /// The checkpoints a run saved.
@@ -163,6 +167,22 @@ impl fmt::Display for RunReport {
                 u.involuntary_switches
             )?;
         }
+        if let Some(t) = &self.ticks {
+            write!(
+                f,
+                " ticks_us physics={:.1} publish={:.1} wait={:.1} period_p50={:.1} \
+                 period_p99={:.1} period_max={:.1}",
+                t.physics_us,
+                t.publish_us,
+                t.wait_us,
+                t.period_p50_us,
+                t.period_p99_us,
+                t.period_max_us
+            )?;
+            if let Some(r) = t.settled_ticks_per_s {
+                write!(f, " settled_ticks_per_s={r:.0}")?;
+            }
+        }
         if let Some(c) = &self.checkpoints {
             write!(
                 f,
@@ -223,6 +243,7 @@ impl RunReport {
             overrun_frames_ns: shared.overrun_log.frames(),
             lateness: (mode == Mode::RealTime).then(|| lateness.clone()),
             checkpoints: None,
+            ticks: None,
         }
     }
 
@@ -247,6 +268,7 @@ impl RunReport {
             overrun_frames_ns: Vec::new(),
             lateness: None,
             checkpoints: None,
+            ticks: None,
         }
     }
 }

@@ -566,7 +566,8 @@ pub async fn run(
     drop(engine);
     let recording = super::finish_recording(recorder)?;
     let outcome = outcome?;
-    let (physics, spent) = (outcome.result?, outcome.spent);
+    let (physics, spent) = (outcome.result?, outcome.ticks);
+    let ticks = (mode != Mode::RealTime).then(|| spent.summary()).flatten();
     let vehicles = ids
         .into_iter()
         .zip(&shared)
@@ -574,6 +575,7 @@ pub async fn run(
         .map(|((id, sh), h)| {
             let mut r = RunReport::collect(mode, physics, sh, h, wall_s, None);
             r.checkpoints = writer.as_ref().map(|w| w.stats.summary());
+            r.ticks = ticks;
             (id, r)
         })
         .collect();
