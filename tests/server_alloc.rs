@@ -321,7 +321,8 @@ fn frame_path_with(
         }
     });
     assert_eq!(violation_count(), 0, "the frame path allocated");
-    ticks.frames = 199;
+    // Frames 0 to 199 were stepped.
+    ticks.frames = 200;
     let periods = ticks.summary().unwrap();
     assert!(periods.period_max_us > 0.0, "{periods:?}");
     let links = w.book.link_stats();

@@ -5,7 +5,8 @@
 //!    process) answers with a CommandMsg-sized sample; once right before and once right after
 //!    case 2's direct run, and the round's ping-pong rate is the geometric mean of the two (the
 //!    load of this VM drifts within seconds: with one ping-pong per round, before every lockstep
-//!    run, the per-round ratios of one binary ranged from 0.76 to 1.13 on 2026-12-01);
+//!    run, the per-round ratios of one binary ranged from 0.76 to 1.13 on 2026-12-01). Every
+//!    case's ratio divides by it; only case 2's runs between the two;
 //! 2. lockstep, one RK4 step per frame (1 kHz frames): the server in this process, the demo
 //!    controller `flexdyn-acs-demo` as a child process (answering each tick on the Zenoh thread
 //!    that completes it, its default `--answer-on zenoh-thread`), once with the server's
@@ -81,9 +82,9 @@ values = [
 #[derive(Clone, Copy)]
 struct Measured {
     /// Ticks per second from the 1000th tick to the last (the server's settled rate).
-    settled: f64,
-    /// Ticks per second over the whole run.
-    whole: f64,
+    settled_ticks_per_s: f64,
+    /// Ticks per second over the whole run (its first 1000 ticks included).
+    whole_ticks_per_s: f64,
     /// Where the server's ticks went.
     ticks: flexdyn_server::tick_cost::TickSummary,
 }
@@ -121,7 +122,8 @@ fn lockstep_rate_of(
     answer_on: &str,
     expect_telemetry: bool,
 ) -> Measured {
-    let ticks = ticks + flexdyn_server::tick_cost::SETTLE_TICKS as usize;
+    // At least one tick after the settled one, so that the run has a settled rate.
+    let ticks = ticks.max(1) + flexdyn_server::tick_cost::SETTLE_TICKS as usize;
     let settings = ServerSettings {
         mode: Mode::Lockstep,
         handoff,
@@ -157,10 +159,10 @@ fn lockstep_rate_of(
     let summary = report.ticks.expect("a lockstep run reports its ticks");
     let whole = report.last_tick as f64 / report.wall_s;
     Measured {
-        settled: summary
+        settled_ticks_per_s: summary
             .settled_ticks_per_s
             .expect("a run past its settling ticks"),
-        whole,
+        whole_ticks_per_s: whole,
         ticks: summary,
     }
 }
@@ -200,10 +202,10 @@ fn main() {
         let p_after = pingpong_rate(ticks, false);
         let p = (p_before * p_after).sqrt();
         let pl = pingpong_rate(ticks, true);
-        let a = am.settled;
-        let t = lockstep_rate(ticks, 1000.0, Handoff::Thread).settled;
-        let b = lockstep_rate(ticks / 4, 100.0, Handoff::Direct).settled;
-        let f = lockstep_rate_with_telemetry(ticks, 1000.0).settled;
+        let a = am.settled_ticks_per_s;
+        let t = lockstep_rate(ticks, 1000.0, Handoff::Thread).settled_ticks_per_s;
+        let b = lockstep_rate(ticks / 4, 100.0, Handoff::Direct).settled_ticks_per_s;
+        let f = lockstep_rate_with_telemetry(ticks, 1000.0).settled_ticks_per_s;
         let d = lockstep_rate_of(
             ticks,
             reference_config(1000.0),
@@ -211,7 +213,7 @@ fn main() {
             "main-thread",
             false,
         )
-        .settled;
+        .settled_ticks_per_s;
         let x = am.ticks;
         println!(
             "round {r}: lockstep 1 step/frame, direct, per tick: stepping {:.1} us, publishing \
@@ -222,10 +224,10 @@ fn main() {
             x.wait_us,
             x.period_p50_us,
             x.period_p99_us,
-            am.whole,
-            am.whole / p
+            am.whole_ticks_per_s,
+            am.whole_ticks_per_s / p
         );
-        ratio1w.push(am.whole / p);
+        ratio1w.push(am.whole_ticks_per_s / p);
         breakdown.push(x);
         println!(
             "round {r}: lockstep 1 step/frame, direct, the demo answering on its main thread \

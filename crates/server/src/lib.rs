@@ -830,7 +830,7 @@ async fn run_lockstep_core(
     let mut core = lock();
     PhysicsOutcome {
         result: core.outcome(),
-        ticks: core.ticks(),
+        ticks: core.take_ticks(),
         usage: None,
     }
 }

@@ -115,7 +115,7 @@ pub struct LockstepCore {
     /// Holding at tick `k` on an operator's request: its answers are taken, but frame
     /// `k → k + 1` waits for [`Self::release_if_due`].
     holding: bool,
-    spent: TickCost,
+    ticks: TickCost,
     /// Takes the checkpoints due at each boundary (`None`: this run saves none).
     checkpoints: Option<Checkpointer>,
 }
@@ -146,7 +146,7 @@ impl LockstepCore {
             tick_published_at: Instant::now(),
             events,
             holding: false,
-            spent: TickCost::default(),
+            ticks: TickCost::default(),
             checkpoints: None,
         };
         core.world.begin_tick(0);
@@ -257,6 +257,7 @@ impl LockstepCore {
         }
         self.set_run_state(RunState::Running);
         self.tick_published_at = Instant::now();
+        self.ticks.released(self.tick_published_at);
         tracing::info!(tick = self.k, "released by the operator");
         if matches!(self.phase, Phase::Running) && self.world.all_answered() {
             self.advance();
@@ -304,7 +305,7 @@ impl LockstepCore {
     /// deputy's relative states after its frame.
     fn publish(&mut self) {
         let started = Instant::now();
-        self.spent.published(self.k, started);
+        self.ticks.published(self.k, started);
         let stamp = flexdyn_proto::client::transport::unix_now_ns();
         // Noted before the states go out (as the physics thread does, and as `Shared::tick`
         // says), so a participant's flight-code telemetry for tick k, sent as soon as it has
@@ -335,7 +336,7 @@ impl LockstepCore {
             );
         }
         self.tick_published_at = Instant::now();
-        self.spent.publish_ns += ns_between(started, self.tick_published_at);
+        self.ticks.publish_ns += ns_between(started, self.tick_published_at);
     }
 
     /// Steps the answered tick, publishes the next, and goes on stepping while a tick needs no
@@ -344,7 +345,7 @@ impl LockstepCore {
     fn advance(&mut self) {
         loop {
             let started = Instant::now();
-            self.spent.wait_ns += ns_between(self.tick_published_at, started);
+            self.ticks.wait_ns += ns_between(self.tick_published_at, started);
             self.world.step(self.k);
             for (v, lane) in self.world.vehicles.iter().zip(&self.lanes) {
                 v.stepper.note_links(&lane.shared);
@@ -355,8 +356,8 @@ impl LockstepCore {
                 c.at_boundary(&mut self.world, self.k);
             }
             let filled = self.world.fill(self.k);
-            self.spent.frames += 1;
-            self.spent.physics_ns += ns_between(started, Instant::now());
+            self.ticks.frames += 1;
+            self.ticks.physics_ns += ns_between(started, Instant::now());
             if let Err((v, e)) = filled {
                 let e = self.named(v, e);
                 self.end(Phase::Failed(e));
@@ -419,9 +420,9 @@ impl LockstepCore {
     }
 
     /// Where the core's time went: stepping and filling, publishing, and waiting for answers;
-    /// and when the ticks went out.
-    pub fn ticks(&self) -> TickCost {
-        self.spent.clone()
+    /// and when the ticks went out (taken: the core keeps an empty record).
+    pub fn take_ticks(&mut self) -> TickCost {
+        std::mem::take(&mut self.ticks)
     }
 
     /// The outcome once [`Self::ended`]: the last tick published and its simulation time, or

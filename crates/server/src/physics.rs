@@ -433,7 +433,7 @@ impl PhysicsCtx {
         &mut self,
         world: &mut WorldStepper,
         warm: &mut Option<ThreadUsage>,
-        spent: &mut TickCost,
+        ticks: &mut TickCost,
     ) -> Result<PhysicsReport, ServerError> {
         let mode = self.settings.mode;
         let realtime = mode == Mode::RealTime;
@@ -504,9 +504,13 @@ impl PhysicsCtx {
                 }
             }
             let t = Instant::now();
-            spent.published(k, t);
+            // Real time paces the ticks itself (its lateness is the record there): no tick note
+            // on its latency-sensitive path.
+            if !realtime {
+                ticks.published(k, t);
+            }
             self.hand_out(world, lateness_ns, realtime)?;
-            spent.publish_ns += ns_since(t);
+            ticks.publish_ns += ns_since(t);
             if self.total_frames == Some(k) {
                 return Ok(PhysicsReport {
                     ending: Ending::Finished,
@@ -518,6 +522,7 @@ impl PhysicsCtx {
                 if !self.hold(k) {
                     return Ok(stopped(&self.control));
                 }
+                ticks.released(Instant::now());
                 // Real time: boundary k + 1 is due one period after the release, not at its
                 // old deadline (no burst of catch-up frames).
                 if realtime {
@@ -535,7 +540,7 @@ impl PhysicsCtx {
                 }
                 Mode::RealTime | Mode::Batch => self.drain_commands(world, k),
             }
-            spent.wait_ns += ns_since(t);
+            ticks.wait_ns += ns_since(t);
 
             // Live faults for boundary k + 1 on, then 3. integrate every vehicle's frame and
             // 4. fill its telemetry of tick k + 1.
@@ -553,8 +558,8 @@ impl PhysicsCtx {
             if !self.fill(world, k, realtime)? {
                 return Ok(stopped(&self.control));
             }
-            spent.frames += 1;
-            spent.physics_ns += ns_since(t);
+            ticks.frames += 1;
+            ticks.physics_ns += ns_since(t);
             if realtime && k == self.start_tick + 1 {
                 // Once, off the measured frames: the counters' baseline (reads /proc twice,
                 // the first read warms the reading itself).

@@ -168,20 +168,7 @@ impl fmt::Display for RunReport {
             )?;
         }
         if let Some(t) = &self.ticks {
-            write!(
-                f,
-                " ticks_us physics={:.1} publish={:.1} wait={:.1} period_p50={:.1} \
-                 period_p99={:.1} period_max={:.1}",
-                t.physics_us,
-                t.publish_us,
-                t.wait_us,
-                t.period_p50_us,
-                t.period_p99_us,
-                t.period_max_us
-            )?;
-            if let Some(r) = t.settled_ticks_per_s {
-                write!(f, " settled_ticks_per_s={r:.0}")?;
-            }
+            write!(f, "{t}")?;
         }
         if let Some(c) = &self.checkpoints {
             write!(

@@ -87,6 +87,9 @@ pub struct FleetReport {
     pub wait_ns: u64,
     /// `--record`: what the file holds.
     pub recording: Option<flexdyn_sinks::recorder::RecordReport>,
+    /// Lockstep and batch: where the world's ticks went (every vehicle's frames per tick;
+    /// [`super::tick_cost`]). On the fleet's line only: the vehicles' lines would repeat it.
+    pub ticks: Option<super::tick_cost::TickSummary>,
 }
 
 impl FleetReport {
@@ -110,6 +113,9 @@ impl std::fmt::Display for FleetReport {
             self.frames,
             self.physics_ns_per_vehicle_frame() * 1e-3
         )?;
+        if let Some(t) = &self.ticks {
+            write!(f, "{t}")?;
+        }
         for (id, r) in &self.vehicles {
             write!(f, "\n  {id}: {r}")?;
         }
@@ -506,6 +512,7 @@ pub async fn run(
                 publish_ns: 0,
                 wait_ns: 0,
                 recording,
+                ticks: None,
             });
         }
     }
@@ -575,7 +582,6 @@ pub async fn run(
         .map(|((id, sh), h)| {
             let mut r = RunReport::collect(mode, physics, sh, h, wall_s, None);
             r.checkpoints = writer.as_ref().map(|w| w.stats.summary());
-            r.ticks = ticks;
             (id, r)
         })
         .collect();
@@ -586,6 +592,7 @@ pub async fn run(
         publish_ns: spent.publish_ns,
         wait_ns: spent.wait_ns,
         recording,
+        ticks,
     };
     tracing::info!("{report}");
     Ok(report)
