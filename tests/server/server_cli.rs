@@ -455,6 +455,23 @@ fn batch_mode_runs_to_the_duration() {
         err.contains("run finished: mode=batch last_tick=2000"),
         "stderr:\n{err}"
     );
+    // Where the ticks went (docs/guides/server.md, "Lifecycle and logs"): every field, and a
+    // settled rate, since 2000 ticks are more than the 1000 it leaves out.
+    let line = err
+        .lines()
+        .find(|l| l.contains("run finished:"))
+        .unwrap_or_default();
+    for field in [
+        " ticks_us physics=",
+        " publish=",
+        " wait=",
+        " period_p50=",
+        " period_p99=",
+        " period_max=",
+        " settled_ticks_per_s=",
+    ] {
+        assert!(line.contains(field), "{field} missing: {line}");
+    }
 }
 
 #[test]
