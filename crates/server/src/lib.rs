@@ -278,9 +278,7 @@ pub async fn run(
         recording,
     );
     report.physics_thread = physics.usage;
-    if mode != Mode::RealTime {
-        report.ticks = physics.ticks.summary();
-    }
+    report.ticks = physics.ticks.summary();
     report.checkpoints = writer.map(|w| w.stats.summary());
     tracing::info!("{report}");
     Ok(report)

@@ -41,7 +41,7 @@ use super::publish::{FramePublisher, Recording};
 use super::relative::{publish_deputy, RelativePublisher};
 use super::shared::Shared;
 use super::stepper::count_offer;
-use super::tick_cost::TickCost;
+use super::tick_cost::{ns_between, TickCost};
 use super::world::WorldStepper;
 
 /// Where a direct lockstep run is.
@@ -439,8 +439,4 @@ impl LockstepCore {
             _ => Ok(report(Ending::Stopped)),
         }
     }
-}
-
-fn ns_between(a: Instant, b: Instant) -> u64 {
-    u64::try_from(b.saturating_duration_since(a).as_nanos()).unwrap_or(u64::MAX)
 }

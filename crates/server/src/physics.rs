@@ -46,7 +46,7 @@ use super::rt::{monotonic_ns, ThreadUsage};
 use super::settings::ServerSettings;
 use super::shared::{Frame, Shared};
 use super::stepper::count_offer;
-use super::tick_cost::TickCost;
+use super::tick_cost::{ns_between, TickCost};
 use super::world::WorldStepper;
 use flexdyn_faults::ports::{Installed, LiveRequest};
 
@@ -164,7 +164,7 @@ enum Wait {
 }
 
 fn ns_since(t: Instant) -> u64 {
-    u64::try_from(t.elapsed().as_nanos()).unwrap_or(u64::MAX)
+    ns_between(t, Instant::now())
 }
 
 /// A free telemetry buffer: real time never waits (`None` = drop this frame's telemetry, counted

@@ -28,21 +28,28 @@ use super::shared::{Frame, Shared};
 /// physics side dropping its end, which wakes nobody) is noticed.
 const PARK_MAX: Duration = Duration::from_millis(20);
 
-/// Largest lateness the histogram resolves (larger values are clamped): 1 hour in ns.
-const LATENESS_MAX_NS: u64 = 3_600_000_000_000;
+/// Largest duration a [`ns_histogram`] resolves (larger values are clamped): 1 hour in ns.
+const HISTOGRAM_MAX_NS: u64 = 3_600_000_000_000;
 
-/// A new lateness histogram (ns, 3 significant digits).
-pub fn lateness_histogram() -> Histogram<u64> {
-    Histogram::new_with_bounds(1, LATENESS_MAX_NS, 3).expect("constant histogram bounds are valid")
+/// A new histogram of durations in ns (1 ns to 1 h, 3 significant digits: a value reads to
+/// 0.1 %): the real-time lateness's, and a lockstep or batch run's tick periods
+/// ([`super::tick_cost`]). Its bounds are fixed, so recording never allocates.
+pub fn ns_histogram() -> Histogram<u64> {
+    Histogram::new_with_bounds(1, HISTOGRAM_MAX_NS, 3).expect("constant histogram bounds are valid")
+}
+
+/// p50, p99 and max of a [`ns_histogram`] (zeros when empty).
+pub fn p50_p99_max(h: &Histogram<u64>) -> (u64, u64, u64) {
+    if h.is_empty() {
+        (0, 0, 0)
+    } else {
+        (h.value_at_quantile(0.5), h.value_at_quantile(0.99), h.max())
+    }
 }
 
 /// p50, p99 and max of a lateness histogram (zeros when empty).
 pub fn timing_of(h: &Histogram<u64>, overruns: u64, skipped: u64) -> FrameTiming {
-    let (p50, p99, max) = if h.is_empty() {
-        (0, 0, 0)
-    } else {
-        (h.value_at_quantile(0.5), h.value_at_quantile(0.99), h.max())
-    };
+    let (p50, p99, max) = p50_p99_max(h);
     FrameTiming {
         lateness_p50_ns: p50,
         lateness_p99_ns: p99,
@@ -55,7 +62,7 @@ pub fn timing_of(h: &Histogram<u64>, overruns: u64, skipped: u64) -> FrameTiming
 /// Records the lateness values new in `ring` into `h`; a value the ring overwrote before this
 /// thread woke (4 s of 1 kHz frames late) is logged, not invented.
 fn drain_lateness(ring: &LatenessRing, next: &mut u64, h: &mut Histogram<u64>) {
-    let missed = ring.drain(next, |ns| h.saturating_record(ns.min(LATENESS_MAX_NS)));
+    let missed = ring.drain(next, |ns| h.saturating_record(ns.min(HISTOGRAM_MAX_NS)));
     if missed > 0 {
         tracing::warn!(
             missed,
@@ -235,7 +242,7 @@ impl TelemetryCtx {
         let summary_period = self.settings.summary_interval;
         let mut p = Publishing {
             status_seq: 0,
-            lateness: lateness_histogram(),
+            lateness: ns_histogram(),
         };
         let rec = self.record.take();
         let mut publisher = self.publisher.take();
@@ -297,7 +304,7 @@ impl TelemetryCtx {
                 Ok(frame) => {
                     if realtime {
                         p.lateness
-                            .saturating_record(frame.lateness_ns.min(LATENESS_MAX_NS));
+                            .saturating_record(frame.lateness_ns.min(HISTOGRAM_MAX_NS));
                     }
                     match (&mut publisher, frame.published) {
                         (Some(publisher), false) => {

@@ -22,13 +22,10 @@ use std::time::Instant;
 
 use hdrhistogram::Histogram;
 
+use super::telemetry::{ns_histogram, p50_p99_max};
+
 /// Ticks left out of [`TickSummary::settled_ticks_per_s`] at the start of a run.
 pub const SETTLE_TICKS: u64 = 1000;
-
-/// Longest tick period the histogram resolves (longer ones are clamped): 1 hour in ns, the
-/// real-time lateness histogram's bound (`super::telemetry`); with 3 significant digits, as
-/// there, a period reads to 0.1 % (hdrhistogram's precision parameter).
-const PERIOD_MAX_NS: u64 = 3_600_000_000_000;
 
 /// Where the stepping thread's time went (wall-clock ns), and when the ticks went out.
 #[derive(Clone, Debug)]
@@ -62,8 +59,7 @@ impl Default for TickCost {
             physics_ns: 0,
             publish_ns: 0,
             wait_ns: 0,
-            periods: Histogram::new_with_bounds(1, PERIOD_MAX_NS, 3)
-                .expect("constant histogram bounds are valid"),
+            periods: ns_histogram(),
             held_since_settled_ns: 0,
             first: None,
             settled: None,
@@ -121,9 +117,8 @@ impl TickCost {
     #[inline]
     pub fn published(&mut self, k: u64, at: Instant) {
         if let Some((_, before)) = self.last {
-            let ns =
-                u64::try_from(at.saturating_duration_since(before).as_nanos()).unwrap_or(u64::MAX);
-            self.periods.saturating_record(ns.max(1));
+            self.periods
+                .saturating_record(ns_between(before, at).max(1));
         }
         match self.first {
             None => self.first = Some((k, at)),
@@ -139,30 +134,23 @@ impl TickCost {
     pub fn released(&mut self, at: Instant) {
         if let Some((k, since)) = self.last {
             if self.settled.is_some() {
-                let held_ns = u64::try_from(at.saturating_duration_since(since).as_nanos())
-                    .unwrap_or(u64::MAX);
-                self.held_since_settled_ns = self.held_since_settled_ns.saturating_add(held_ns);
+                self.held_since_settled_ns = self
+                    .held_since_settled_ns
+                    .saturating_add(ns_between(since, at));
             }
             self.last = Some((k, at));
         }
     }
 
-    /// The summary, `None` before a frame was stepped.
+    /// The summary, `None` before a tick was published and a frame stepped (so always in real
+    /// time, whose loop notes no ticks).
     pub fn summary(&self) -> Option<TickSummary> {
-        if self.frames == 0 {
+        if self.frames == 0 || self.first.is_none() {
             return None;
         }
         let per_frame = |ns: u64| ns as f64 * 1e-3 / self.frames as f64;
         let us = |ns: u64| ns as f64 * 1e-3;
-        let (p50, p99, max) = if self.periods.is_empty() {
-            (0, 0, 0)
-        } else {
-            (
-                self.periods.value_at_quantile(0.5),
-                self.periods.value_at_quantile(0.99),
-                self.periods.max(),
-            )
-        };
+        let (p50, p99, max) = p50_p99_max(&self.periods);
         let settled_ticks_per_s = match (self.settled, self.last) {
             (Some((k0, t0)), Some((k1, t1))) if k1 > k0 => {
                 // Every hold from the settled tick on lies within t1 - t0 (t1 is the last
@@ -185,6 +173,12 @@ impl TickCost {
             settled_ticks_per_s,
         })
     }
+}
+
+/// \[ns\] from `a` to `b` (0 if `b` is earlier, `u64::MAX` past 584 years).
+#[inline]
+pub fn ns_between(a: Instant, b: Instant) -> u64 {
+    u64::try_from(b.saturating_duration_since(a).as_nanos()).unwrap_or(u64::MAX)
 }
 
 #[cfg(test)]

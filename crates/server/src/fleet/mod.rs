@@ -574,7 +574,7 @@ pub async fn run(
     let recording = super::finish_recording(recorder)?;
     let outcome = outcome?;
     let (physics, spent) = (outcome.result?, outcome.ticks);
-    let ticks = (mode != Mode::RealTime).then(|| spent.summary()).flatten();
+    let ticks = spent.summary();
     let vehicles = ids
         .into_iter()
         .zip(&shared)
