@@ -29,6 +29,8 @@ struct Answer {
     participant: Option<Participant>,
     buf: Vec<u8>,
     seen: Vec<(u64, Vec<String>)>,
+    /// The tick of each tick's time message (`None`: it carried none).
+    timed: Vec<Option<u64>>,
     /// When each tick was handled.
     at: Vec<Instant>,
     threads: HashSet<ThreadId>,
@@ -38,6 +40,7 @@ impl TickHandler for Answer {
     fn on_tick(&mut self, tick: Tick) {
         let k = tick.tick();
         self.seen.push((k, tick.missing.clone()));
+        self.timed.push(tick.time.map(|t| t.header.tick));
         self.at.push(Instant::now());
         self.threads.insert(std::thread::current().id());
         let h = Header::new(1, k, tick.state.header.sim_time_ns, k);
@@ -50,7 +53,8 @@ impl TickHandler for Answer {
 }
 
 /// A lockstep run of `ticks` frames of `server_toml`, answered by an [`Answer`] whose receiver
-/// follows the schedule of `client_toml` with `sensor_timeout`; the main thread keeps calling
+/// follows the schedule of `client_toml` (without the time message unless `time`) with
+/// `sensor_timeout`; the main thread keeps calling
 /// `recv_timeout` until the last tick is answered. Returns the handler and the receiver's count
 /// of incomplete ticks.
 fn run(
@@ -58,6 +62,7 @@ fn run(
     client_toml: &str,
     ticks: u64,
     sensor_timeout: Duration,
+    time: bool,
 ) -> (Answer, u64) {
     let topics = Topics::new("sc1").unwrap();
     let server = ServerHandle::start(
@@ -71,11 +76,17 @@ fn run(
     );
     let schedule =
         SensorSchedule::from_config(&VehicleConfig::from_toml(client_toml).unwrap()).unwrap();
+    let schedule = if time {
+        schedule
+    } else {
+        schedule.without_time()
+    };
     let session = connecting_session(server.port);
     let answer = Arc::new(Mutex::new(Answer {
         participant: None,
         buf: Vec::new(),
         seen: Vec::new(),
+        timed: Vec::new(),
         at: Vec::new(),
         threads: HashSet::new(),
     }));
@@ -114,7 +125,11 @@ fn run(
 
 /// The IMU dropout of `faults_dropout_lockstep` (ticks 10 to 19 withheld): every tick is
 /// answered once, in order, on a thread other than the caller's, the withheld ones without
-/// `imu/hub` (released by the fault events, not the hour-long time limit).
+/// `imu/hub` (released by the fault events, not the hour-long time limit), and each with its
+/// own time message. The receiver takes the state, the IMU, the star tracker, the time message
+/// and the fault events through one subscriber each, so this shows that they reach its
+/// assembler in the server's publication order: a time message after its state would leave
+/// its tick without one, a fault event after the next state would hold a tick for an hour.
 #[test]
 fn a_handler_answers_each_tick_where_it_completes() {
     let text = format!(
@@ -122,7 +137,7 @@ fn a_handler_answers_each_tick_where_it_completes() {
          duration_s = 0.1\n"
     );
     let ticks = 40;
-    let (answer, incomplete) = run(&text, &text, ticks, Duration::from_secs(3600));
+    let (answer, incomplete) = run(&text, &text, ticks, Duration::from_secs(3600), true);
     let want: Vec<(u64, Vec<String>)> = (0..=ticks)
         .map(|k| {
             let missing = if (10..20).contains(&k) {
@@ -134,6 +149,7 @@ fn a_handler_answers_each_tick_where_it_completes() {
         })
         .collect();
     assert_eq!(answer.seen, want);
+    assert_eq!(answer.timed, (0..=ticks).map(Some).collect::<Vec<_>>());
     assert_eq!(incomplete, 10);
     assert!(
         !answer.threads.contains(&std::thread::current().id()),
@@ -158,7 +174,7 @@ fn a_tick_released_after_the_sensor_limit_goes_to_the_handler() {
     let ghost = rest[..end].replacen("name = \"hub\"", "name = \"ghost\"", 1);
     let client = format!("{WHEELS}\n{ghost}");
     let ticks = 4;
-    let (answer, incomplete) = run(WHEELS, &client, ticks, Duration::from_millis(100));
+    let (answer, incomplete) = run(WHEELS, &client, ticks, Duration::from_millis(100), true);
     let want: Vec<(u64, Vec<String>)> = (0..=ticks)
         .map(|k| (k, vec!["imu/ghost".to_owned()]))
         .collect();
@@ -179,4 +195,16 @@ fn a_tick_released_after_the_sensor_limit_goes_to_the_handler() {
         HashSet::from([std::thread::current().id()]),
         "the released ticks are answered by recv_timeout's caller"
     );
+}
+
+/// A schedule without the time message: every tick still comes complete and in order, without
+/// one (the receiver never subscribed to it).
+#[test]
+fn a_schedule_without_time_answers_every_tick_without_it() {
+    let ticks = 20;
+    let (answer, incomplete) = run(WHEELS, WHEELS, ticks, Duration::from_secs(3600), false);
+    let want: Vec<(u64, Vec<String>)> = (0..=ticks).map(|k| (k, vec![])).collect();
+    assert_eq!(answer.seen, want);
+    assert_eq!(answer.timed, vec![None; ticks as usize + 1]);
+    assert_eq!(incomplete, 0);
 }

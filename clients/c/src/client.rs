@@ -533,7 +533,8 @@ impl Client {
     }
 
     /// Joins a lockstep run as `sender_id`: asks the server's configuration (up to `timeout`),
-    /// subscribes to all telemetry, declares the command publisher, then the token.
+    /// subscribes to the telemetry its ticks are assembled from, declares the command
+    /// publisher, then the token.
     pub fn join(&mut self, sender_id: u32, timeout: Duration) -> Result<(), Error> {
         self.lockstep = None;
         let vehicle = self.vehicle(timeout)?;

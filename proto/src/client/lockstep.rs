@@ -12,9 +12,12 @@
 //!   serves ([`crate::client::vehicle`]), never from guessing;
 //! - [`TickAssembler`] takes the telemetry samples as they come and hands out a [`Tick`] (the
 //!   state and its due samples) once it is complete;
-//! - [`TickReceiver`] is the Zenoh side: **one** subscriber on `flexdyn/<sc>/tlm/**` (which
-//!   delivers in publication order) feeding an assembler, with a time limit for a sample that
-//!   never comes. It hands each complete tick to the reader's thread
+//! - [`TickReceiver`] is the Zenoh side: a callback subscriber on each key a tick is assembled
+//!   from ([`SensorSchedule::keys`]), all feeding one assembler, with a time limit for a sample
+//!   that never comes. Zenoh runs a callback subscriber's callback on the thread that reads the
+//!   link, before it reads the next message, so the assembler sees the samples in publication
+//!   order, whichever subscriber each came through. It hands each complete tick to the reader's
+//!   thread
 //!   ([`TickReceiver::declare`]), or runs a [`TickHandler`] on it right where it completes, on
 //!   the Zenoh thread that delivered its last sample ([`TickReceiver::declare_with_handler`]):
 //!   no thread hop between the state and the answer, as in a Zenoh ping-pong.
@@ -36,7 +39,6 @@ use crate::{
     GpsMsg, ImuMsg, MagnetometerMsg, StarTrackerMsg, StateMsg, Telemetry, TimeMsg, Topics,
     FAULT_MODE_NAMES,
 };
-use zenoh::key_expr::KeyExpr;
 use zenoh::pubsub::Subscriber;
 use zenoh::sample::Sample;
 use zenoh::{Session, Wait};
@@ -66,6 +68,9 @@ impl Periodic {
 /// (its solutions, each published its latency after the instant it is valid).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SensorSchedule {
+    /// Whether a tick carries the time service's message ([`Tick::time`]); see
+    /// [`Self::without_time`].
+    time: bool,
     imus: Vec<String>,
     star_trackers: Vec<Periodic>,
     magnetometers: Vec<Periodic>,
@@ -85,6 +90,7 @@ impl SensorSchedule {
             })
         };
         Ok(Self {
+            time: true,
             imus: cfg.imus.iter().map(|i| i.name.clone()).collect(),
             star_trackers: cfg
                 .star_trackers
@@ -117,6 +123,23 @@ impl SensorSchedule {
                 })
                 .collect::<Result<_, VehicleError>>()?,
         })
+    }
+
+    /// The same schedule, its ticks without the time service's message: a [`TickReceiver`]
+    /// then does not subscribe to `flexdyn/<sc>/tlm/time`, so Zenoh does not send it to this
+    /// session, and [`Tick::time`] is `None`. For flight code that
+    /// keeps no clock of its own from the time service (UTC, TAI, GPS time, CCSDS CUC): in a
+    /// lockstep run at 1 kHz it shortens every tick by a few µs (`docs/developer/benchmarks.md`).
+    pub fn without_time(self) -> Self {
+        Self {
+            time: false,
+            ..self
+        }
+    }
+
+    /// Whether its ticks carry the time service's message ([`Self::without_time`]).
+    pub fn has_time(&self) -> bool {
+        self.time
     }
 
     /// The IMU names, in configuration order.
@@ -153,15 +176,15 @@ impl SensorSchedule {
 }
 
 impl SensorSchedule {
-    /// The telemetry keys of `topics` a tick of this schedule may carry: the state, the time
-    /// message, the environment message, the fault events and each scheduled sensor's key.
+    /// The telemetry keys of `topics` a tick of this schedule is assembled from: the state, the
+    /// time message (unless [`Self::without_time`]), the fault events (which tell of withheld
+    /// samples) and each scheduled sensor's key. Not the environment, relative or flight-code
+    /// telemetry, which a tick does not carry.
     pub fn keys(&self, topics: &Topics) -> Vec<String> {
-        let mut keys = vec![
-            topics.state().to_owned(),
-            topics.time(),
-            topics.environment(),
-            topics.fault_events(),
-        ];
+        let mut keys = vec![topics.state().to_owned(), topics.fault_events()];
+        if self.time {
+            keys.push(topics.time());
+        }
         for (section, route) in SENSOR_SECTIONS {
             for name in self.names(section).unwrap_or_default() {
                 // The schedule's names came from a configuration the server accepted; a name
@@ -238,8 +261,8 @@ pub struct Tick {
     /// at this tick, or lost); each is valid its receiver's latency before the tick.
     pub gps_receivers: Vec<Option<GpsMsg>>,
     /// The time service's message of the tick (UTC, TAI, GPS time, CCSDS CUC), published
-    /// before the tick's samples on the same subscriber; `None` if it was lost. Not awaited:
-    /// a tick is complete without it.
+    /// before the tick's samples; `None` if it was lost, or if the schedule leaves it out
+    /// ([`SensorSchedule::without_time`]). Not awaited: a tick is complete without it.
     pub time: Option<TimeMsg>,
     /// The due samples that never came, as `imu/<name>`, `st/<name>`, `mag/<name>`,
     /// `css/<name>`, `fss/<name>` or `gps/<name>`. Empty in lockstep unless a sample was lost
@@ -408,7 +431,8 @@ impl TickAssembler {
         let s = &self.schedule;
         let msg = match topic {
             // The time service comes with its tick, but is never awaited.
-            Telemetry::Time => Msg::Time(decode_time(payload)?),
+            Telemetry::Time if s.time => Msg::Time(decode_time(payload)?),
+            Telemetry::Time => return Ok(()),
             // Nor is the environment message (truth for operators, after the state).
             Telemetry::Environment => return Ok(()),
             // Nor is a fleet deputy's relative state (after the state; Client::subscribe).
@@ -616,10 +640,10 @@ impl TickAssembler {
 /// behind loses the oldest ticks ([`Self::lost`]) rather than queueing stale ones; in lockstep at
 /// most one tick is in flight. With a handler no tick waits ([`TickHandler`]).
 pub struct TickReceiver {
-    _subscriber: Subscriber<()>,
-    /// The keys of the samples it receives, declared to the session so that Zenoh routes them
-    /// by cached routes ([`crate::client::transport::declared_key`]); declared while they live.
-    _keys: Vec<KeyExpr<'static>>,
+    /// One per key of [`SensorSchedule::keys`], each on its key declared to the session so
+    /// that Zenoh routes its samples by a cached route
+    /// ([`crate::client::transport::declared_key`]).
+    _subscribers: Vec<Subscriber<()>>,
     shared: Arc<Shared>,
     schedule: SensorSchedule,
     sensor_timeout: Duration,
@@ -827,19 +851,23 @@ impl TickReceiver {
             ready: Condvar::new(),
             handler,
         });
-        let feed = shared.clone();
-        let subscriber = session
-            .declare_subscriber(topics.telemetry_wildcard())
-            .callback(move |sample| feed.take(&sample))
-            .wait()?;
-        let keys = schedule
+        // One callback subscriber per key rather than one on `tlm/**`: Zenoh then sends this
+        // session only what a tick is assembled from (not the time message when the schedule
+        // leaves it out, nor the environment or another process's telemetry), and the
+        // callbacks still run in arrival order on the thread that reads the link (module docs).
+        let subscribers = schedule
             .keys(topics)
             .into_iter()
-            .map(|key| declared_key(session, key))
+            .map(|key| {
+                let feed = shared.clone();
+                session
+                    .declare_subscriber(declared_key(session, key)?)
+                    .callback(move |sample| feed.take(&sample))
+                    .wait()
+            })
             .collect::<zenoh::Result<_>>()?;
         Ok(Self {
-            _subscriber: subscriber,
-            _keys: keys,
+            _subscribers: subscribers,
             shared,
             schedule,
             sensor_timeout,
@@ -928,6 +956,7 @@ mod tests {
             offset: 0,
         };
         SensorSchedule {
+            time: true,
             imus: vec!["hub".into(), "bracket".into()],
             star_trackers: vec![every("st1", 10), every("st2", 4)],
             magnetometers: vec![every("mag1", 2)],
@@ -937,43 +966,77 @@ mod tests {
         }
     }
 
-    /// The keys a receiver declares are the keys its assembler reads each scheduled sample
-    /// from, one each, plus the fault events it reads apart.
+    /// The keys a receiver subscribes to are the keys its assembler reads: the state, the
+    /// fault events, the time message unless the schedule leaves it out, and each scheduled
+    /// sample's key, one each; never the environment message, which a tick does not carry.
     #[test]
-    fn the_declared_keys_are_the_keys_of_the_scheduled_samples() {
+    fn the_subscribed_keys_are_the_keys_a_tick_is_assembled_from() {
         let topics = Topics::new("sc1").unwrap();
         let keys = schedule().keys(&topics);
-        assert_eq!(keys[3], topics.fault_events());
+        assert_eq!(keys[1], topics.fault_events());
         let read: Vec<Telemetry> = keys.iter().filter_map(|k| topics.telemetry(k)).collect();
         use Telemetry::*;
-        assert_eq!(
-            read,
-            [
-                State,
-                Time,
-                Environment,
-                Imu("hub"),
-                Imu("bracket"),
-                StarTracker("st1"),
-                StarTracker("st2"),
-                Magnetometer("mag1"),
-                Css("css"),
-            ]
-        );
+        let sensors = [
+            Imu("hub"),
+            Imu("bracket"),
+            StarTracker("st1"),
+            StarTracker("st2"),
+            Magnetometer("mag1"),
+            Css("css"),
+        ];
+        assert_eq!(read[..2], [State, Time]);
+        assert_eq!(read[2..], sensors);
+        assert_eq!(keys.len(), read.len() + 1);
+        let keys = schedule().without_time().keys(&topics);
+        let read: Vec<Telemetry> = keys.iter().filter_map(|k| topics.telemetry(k)).collect();
+        assert_eq!(read[..1], [State]);
+        assert_eq!(read[1..], sensors);
         assert_eq!(keys.len(), read.len() + 1);
         let keys = sun_and_gps_schedule().keys(&topics);
         let read: Vec<Telemetry> = keys
             .iter()
-            .skip(4)
+            .skip(3)
             .filter_map(|k| topics.telemetry(k))
             .collect();
         assert_eq!(read, [Fss("fss"), Gps("gps1")]);
+    }
+
+    /// A schedule without the time message ignores one pushed to its assembler: the tick comes
+    /// without it, as it does when the receiver never subscribed to it.
+    #[test]
+    fn a_schedule_without_time_hands_out_ticks_without_it() {
+        let mut f = Feed {
+            a: TickAssembler::new(
+                Topics::new("sc1").unwrap(),
+                sun_and_gps_schedule().without_time(),
+            ),
+            out: Vec::new(),
+        };
+        let time = TimeMsg {
+            header: header(1),
+            met_ns: 10_000_000,
+            ..TimeMsg::default()
+        };
+        f.push("flexdyn/sc1/tlm/time", encode(&time));
+        f.state(1);
+        assert_eq!(f.out.len(), 1);
+        assert_eq!(f.out[0].time, None);
+        assert!(!f.a.schedule().has_time());
+        // The same samples with the time message kept: the tick carries it.
+        let mut f = Feed {
+            a: TickAssembler::new(Topics::new("sc1").unwrap(), sun_and_gps_schedule()),
+            out: Vec::new(),
+        };
+        f.push("flexdyn/sc1/tlm/time", encode(&time));
+        f.state(1);
+        assert_eq!(f.out[0].time, Some(time));
     }
 
     /// A fine sun sensor every 5 frames and a GPS receiver every 10 frames with a latency of 3:
     /// its solutions are due at ticks 3, 13, 23, …, never at 0.
     fn sun_and_gps_schedule() -> SensorSchedule {
         SensorSchedule {
+            time: true,
             imus: vec![],
             star_trackers: vec![],
             magnetometers: vec![],

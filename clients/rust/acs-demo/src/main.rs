@@ -683,7 +683,9 @@ fn run(args: Args) -> anyhow::Result<()> {
         return close(session);
     };
     let cfg = vehicle.config()?;
-    let schedule = SensorSchedule::from_config(&cfg)?;
+    // Its controller and mode manager run on the tick's own time (`sim_time_ns`), never on the
+    // time service's UTC or GPS time: it does not subscribe to the time message.
+    let schedule = SensorSchedule::from_config(&cfg)?.without_time();
     let telemetry = Telemetry::declare(&session, &topics, &vehicle, &args.fsw_stream)?;
     let frame_s = (1e9 / cfg.simulation.frame_hz).round() * 1e-9;
     let gyro = gyro(&args, &cfg, &schedule)?;
@@ -765,8 +767,12 @@ fn run(args: Args) -> anyhow::Result<()> {
             TickReceiver::declare(&session, &topics, schedule, 256, sensor_timeout)
         }
     };
-    let mut ticks = declared
-        .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.telemetry_wildcard()))?;
+    let mut ticks = declared.map_err(|e| {
+        anyhow::anyhow!(
+            "cannot subscribe to the tick's telemetry under {}: {e}",
+            topics.telemetry_wildcard()
+        )
+    })?;
 
     // 4. The command publisher, Block (never drop) and express (no batching: lowest latency),
     // 5. then the liveliness token that announces us to a lockstep server (harmless in real
@@ -777,7 +783,7 @@ fn run(args: Args) -> anyhow::Result<()> {
         k_nm = controller.k_nm,
         p_nms = controller.p_nms,
         sigma_rn = ?controller.sigma_rn.as_slice(),
-        telemetry = topics.telemetry_wildcard(),
+        telemetry = ?ticks.schedule().keys(&topics),
         commands = participant.key(),
         answer_on = ?args.answer_on,
         "flexdyn-acs-demo running"
