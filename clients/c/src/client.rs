@@ -563,7 +563,10 @@ impl Client {
         )
         .map_err(|e| {
             Error::zenoh(
-                &format!("cannot subscribe to {}", self.topics.telemetry_wildcard()),
+                &format!(
+                    "cannot subscribe to the tick's telemetry under {}",
+                    self.topics.telemetry_wildcard()
+                ),
                 e,
             )
         })?;

@@ -98,7 +98,12 @@ pub fn run(args: &GatewayArgs) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.status()))?;
     let mut ticks =
         TickReceiver::declare(&session, &topics, schedule, 1024, Duration::from_secs(5)).map_err(
-            |e| anyhow::anyhow!("cannot subscribe to {}: {e}", topics.telemetry_wildcard()),
+            |e| {
+                anyhow::anyhow!(
+                    "cannot subscribe to the tick's telemetry under {}: {e}",
+                    topics.telemetry_wildcard()
+                )
+            },
         )?;
     let participant = Participant::declare(&session, &topics, args.sender_id)?;
     tracing::info!(

@@ -15,7 +15,7 @@
 //! - [`TickReceiver`] is the Zenoh side: a callback subscriber on each key a tick is assembled
 //!   from ([`SensorSchedule::keys`]), all feeding one assembler, with a time limit for a sample
 //!   that never comes. Zenoh runs a callback subscriber's callback on the thread that reads the
-//!   link, before it reads the next message, so the assembler sees the samples in publication
+//!   link, before it handles the next message, so the assembler sees the samples in publication
 //!   order, whichever subscriber each came through. It hands each complete tick to the reader's
 //!   thread
 //!   ([`TickReceiver::declare`]), or runs a [`TickHandler`] on it right where it completes, on
@@ -126,10 +126,11 @@ impl SensorSchedule {
     }
 
     /// The same schedule, its ticks without the time service's message: a [`TickReceiver`]
-    /// then does not subscribe to `flexdyn/<sc>/tlm/time`, so Zenoh does not send it to this
-    /// session, and [`Tick::time`] is `None`. For flight code that
-    /// keeps no clock of its own from the time service (UTC, TAI, GPS time, CCSDS CUC): in a
-    /// lockstep run at 1 kHz it shortens every tick by a few µs (`docs/developer/benchmarks.md`).
+    /// then does not subscribe to `flexdyn/<sc>/tlm/time` (so Zenoh does not send it to this
+    /// session, unless another of its subscribers matches it), and [`Tick::time`] is `None`.
+    /// For flight code that keeps no clock of its own from the time service (UTC, TAI, GPS
+    /// time, CCSDS CUC): in a lockstep run at 1 kHz it shortened every tick by about 2 µs
+    /// (`docs/developer/benchmarks.md`).
     pub fn without_time(self) -> Self {
         Self {
             time: false,
@@ -620,8 +621,8 @@ impl TickAssembler {
     }
 }
 
-/// Complete ticks from a server: one subscriber on `flexdyn/<sc>/tlm/**` whose callback feeds
-/// a [`TickAssembler`] as the samples arrive, on Zenoh's receiving thread, and wakes the reader
+/// Complete ticks from a server: a callback subscriber on each key of [`SensorSchedule::keys`],
+/// all feeding one [`TickAssembler`] as the samples arrive, on Zenoh's receiving thread, and wakes the reader
 /// only when a tick is complete. A tick whose samples have not all come `sensor_timeout` after
 /// its state is handed out without them; one whose missing samples a `dropout` fault withheld is
 /// handed out as soon as the fault event says so (module docs).

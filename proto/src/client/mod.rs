@@ -21,7 +21,8 @@
 //! - [`participant`]: a lockstep participant's command publisher and liveliness token
 //!   ([`participant::Participant`]).
 //! - [`lockstep`]: complete ticks — the state of tick k with every sensor sample due at k —
-//!   through one `flexdyn/<sc>/tlm/**` subscriber ([`lockstep::TickReceiver`]).
+//!   through a callback subscriber on each key a tick is assembled from
+//!   ([`lockstep::TickReceiver`]).
 
 pub mod cli;
 pub mod cpu;

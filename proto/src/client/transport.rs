@@ -28,13 +28,13 @@ use zenoh::sample::Sample;
 
 /// `key` declared to `session` as a key expression of its own (`Session::declare_keyexpr`),
 /// for a key that is published or received every tick. The declaration lasts as long as the
-/// returned value: publish with it (`declare_publisher(declared)`), or keep it beside the
-/// subscriber that receives the key.
+/// returned value: publish with it (`declare_publisher(declared)`), or subscribe with it
+/// (`declare_subscriber(declared)`: the subscriber keeps it).
 ///
 /// # Why
 /// Zenoh caches a data route per resource of its routing tables, and a key that nothing
-/// declared exactly has no resource: flexdyn subscribes with wildcards (`flexdyn/<sc>/tlm/**`,
-/// `flexdyn/<sc>/cmd/*`), so each sample was matched against the whole tree, in every router it
+/// declared exactly has no resource: flexdyn subscribes with wildcards (`flexdyn/<sc>/tlm/**`
+/// in the recorder and viewers, `flexdyn/<sc>/cmd/*`), so each sample was matched against the whole tree, in every router it
 /// crossed, and against each of the session's subscribers. In a lockstep run (`flexdyn run
 /// --mode lockstep`, the reference spacecraft at 1 kHz, `flexdyn-acs-demo`), Zenoh's trace
 /// showed `compute_data_route` three times per sample in each process, and declaring the

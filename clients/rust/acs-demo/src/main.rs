@@ -28,10 +28,12 @@
 //!   2. subscribe to the telemetry **before** declaring the liveliness token
 //!      `flexdyn/<sc>/participant/<sender-id>`: the server starts at tick 0 only once it sees
 //!      the token;
-//!   3. answer tick k from the state **and every sensor sample due at tick k**: one subscriber
-//!      on `flexdyn/<sc>/tlm/**`, and which samples are due from the server's configuration
-//!      queryable ([`TickReceiver`]). Separate subscribers can see a state before its own
-//!      tick's IMU sample, and a run then depends on thread timing.
+//!   3. answer tick k from the state **and every sensor sample due at tick k**, assembled in
+//!      publication order, and which samples are due from the server's configuration
+//!      queryable ([`TickReceiver`]: a callback subscriber per key, each run on the thread that
+//!      reads the link). Subscribers that each queue their samples for a thread of their own
+//!      can see a state before its own tick's IMU sample, and a run then depends on thread
+//!      timing.
 //!
 //! # The end of the run
 //! The demo stops as soon as the server's last status says the run `finished`, `stopped` or
@@ -724,8 +726,8 @@ fn run(args: Args) -> anyhow::Result<()> {
         );
     }
 
-    // 3. The end of the run (the server's last status), then the telemetry: one subscriber on
-    //    flexdyn/<sc>/tlm/**, assembled into complete ticks. Declared before the token, so the
+    // 3. The end of the run (the server's last status), then the telemetry: a callback
+    //    subscriber on each key a tick is assembled from, into complete ticks. Declared before the token, so the
     //    server cannot publish tick 0 before we can receive it. `--answer-on zenoh-thread`
     //    answers each tick on the Zenoh thread that completed it; `main-thread` queues at most
     //    256 complete ticks for this thread (in real time, if it ever falls behind, the oldest
