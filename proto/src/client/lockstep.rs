@@ -1006,13 +1006,7 @@ mod tests {
     /// without it, as it does when the receiver never subscribed to it.
     #[test]
     fn a_schedule_without_time_hands_out_ticks_without_it() {
-        let mut f = Feed {
-            a: TickAssembler::new(
-                Topics::new("sc1").unwrap(),
-                sun_and_gps_schedule().without_time(),
-            ),
-            out: Vec::new(),
-        };
+        let mut f = Feed::with(sun_and_gps_schedule().without_time());
         let time = TimeMsg {
             header: header(1),
             met_ns: 10_000_000,
@@ -1024,10 +1018,7 @@ mod tests {
         assert_eq!(f.out[0].time, None);
         assert!(!f.a.schedule().has_time());
         // The same samples with the time message kept: the tick carries it.
-        let mut f = Feed {
-            a: TickAssembler::new(Topics::new("sc1").unwrap(), sun_and_gps_schedule()),
-            out: Vec::new(),
-        };
+        let mut f = Feed::with(sun_and_gps_schedule());
         f.push("flexdyn/sc1/tlm/time", encode(&time));
         f.state(1);
         assert_eq!(f.out[0].time, Some(time));
@@ -1066,9 +1057,11 @@ mod tests {
 
     impl Feed {
         fn new() -> Self {
-            let topics = Topics::new("sc1").unwrap();
+            Self::with(schedule())
+        }
+        fn with(schedule: SensorSchedule) -> Self {
             Self {
-                a: TickAssembler::new(topics, schedule()),
+                a: TickAssembler::new(Topics::new("sc1").unwrap(), schedule),
                 out: Vec::new(),
             }
         }
